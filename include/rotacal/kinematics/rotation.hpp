@@ -1,0 +1,126 @@
+#pragma once
+/// \file
+/// Rigid rotations used by every kinematic formula in rotacal: rotation about an arbitrary line
+/// (Flynn et al. 2016, Eq. 1) and the elementary homogeneous transforms D_x..D_c
+/// (Oyama & Ibaraki, Eq. 1). Templated on Scalar so ceres::Jet flows through.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cmath>
+
+namespace rotacal {
+
+template <typename Scalar>
+using Vec3 = Eigen::Matrix<Scalar, 3, 1>;
+template <typename Scalar>
+using Mat3 = Eigen::Matrix<Scalar, 3, 3>;
+template <typename Scalar>
+using Mat4 = Eigen::Matrix<Scalar, 4, 4>;
+
+/// Rigid transform p -> R p + t. Kept as a plain (R, t) pair rather than Eigen::Transform so
+/// that Jets, composition and inversion are explicit and cheap.
+template <typename Scalar>
+struct Pose {
+  Mat3<Scalar> R = Mat3<Scalar>::Identity();
+  Vec3<Scalar> t = Vec3<Scalar>::Zero();
+
+  Vec3<Scalar> operator*(const Vec3<Scalar>& p) const { return R * p + t; }
+  Pose operator*(const Pose& o) const { return {R * o.R, R * o.t + t}; }
+  Pose inverse() const { return {R.transpose(), -(R.transpose() * t)}; }
+  Mat4<Scalar> matrix() const {
+    Mat4<Scalar> m = Mat4<Scalar>::Identity();
+    m.template topLeftCorner<3, 3>() = R;
+    m.template topRightCorner<3, 1>() = t;
+    return m;
+  }
+  template <typename Other>
+  Pose<Other> cast() const {
+    return {R.template cast<Other>(), t.template cast<Other>()};
+  }
+};
+
+/// Rotation matrix for angle theta (rad) about unit axis u (Rodrigues).
+template <typename Scalar>
+Mat3<Scalar> rotation_about_axis(const Vec3<Scalar>& u, const Scalar& theta) {
+  using std::cos;
+  using std::sin;
+  Mat3<Scalar> K;
+  K << Scalar(0), -u.z(), u.y(), u.z(), Scalar(0), -u.x(), -u.y(), u.x(), Scalar(0);
+  return Mat3<Scalar>::Identity() + sin(theta) * K + (Scalar(1) - cos(theta)) * (K * K);
+}
+
+/// Rotation by theta (rad, right-handed) about the line through `point` with direction
+/// `direction` (any non-zero length; it is normalised here so that ISO 230-7 directions such
+/// as (1, E_C0A, -E_B0A) can be passed as they are). Flynn et al. 2016, Eq. 1, in matrix form:
+/// x' = R (x - a) + a.
+template <typename Scalar>
+Pose<Scalar> rotation_about_line(const Vec3<Scalar>& point, const Vec3<Scalar>& direction,
+                                 const Scalar& theta) {
+  const Vec3<Scalar> u = direction / direction.norm();
+  Pose<Scalar> T;
+  T.R = rotation_about_axis<Scalar>(u, theta);
+  T.t = point - T.R * point;
+  return T;
+}
+
+/// Flynn et al. 2016, Eq. 1 written out component by component: rotates q = (x, y, z) about
+/// the line through (a, b, c) with unit direction (u, v, w). The y row as printed in the paper
+/// has two sign slips ("cu + aw - wx + uz"); this is the standard form, "cu - aw + wx - uz".
+/// Kept as the reference the matrix form above is tested against.
+template <typename Scalar>
+Vec3<Scalar> flynn_eq1(const Vec3<Scalar>& q, const Vec3<Scalar>& abc, const Vec3<Scalar>& uvw,
+                       const Scalar& theta) {
+  using std::cos;
+  using std::sin;
+  const Scalar x = q.x(), y = q.y(), z = q.z();
+  const Scalar a = abc.x(), b = abc.y(), c = abc.z();
+  const Scalar u = uvw.x(), v = uvw.y(), w = uvw.z();
+  const Scalar C = cos(theta), S = sin(theta), K = Scalar(1) - C;
+  const Scalar dot = u * x + v * y + w * z;
+  return Vec3<Scalar>((a * (v * v + w * w) - u * (b * v + c * w - dot)) * K + x * C +
+                          (-c * v + b * w - w * y + v * z) * S,
+                      (b * (u * u + w * w) - v * (a * u + c * w - dot)) * K + y * C +
+                          (c * u - a * w + w * x - u * z) * S,
+                      (c * (u * u + v * v) - w * (a * u + b * v - dot)) * K + z * C +
+                          (-b * u + a * v - v * x + u * y) * S);
+}
+
+/// Elementary homogeneous transforms of Oyama & Ibaraki, Eq. 1.
+template <typename Scalar>
+Mat4<Scalar> D_x(const Scalar& X) {
+  Mat4<Scalar> m = Mat4<Scalar>::Identity();
+  m(0, 3) = X;
+  return m;
+}
+template <typename Scalar>
+Mat4<Scalar> D_y(const Scalar& Y) {
+  Mat4<Scalar> m = Mat4<Scalar>::Identity();
+  m(1, 3) = Y;
+  return m;
+}
+template <typename Scalar>
+Mat4<Scalar> D_z(const Scalar& Z) {
+  Mat4<Scalar> m = Mat4<Scalar>::Identity();
+  m(2, 3) = Z;
+  return m;
+}
+template <typename Scalar>
+Mat4<Scalar> D_a(const Scalar& A) {
+  Mat4<Scalar> m = Mat4<Scalar>::Identity();
+  m.template topLeftCorner<3, 3>() = rotation_about_axis<Scalar>(Vec3<Scalar>::UnitX(), A);
+  return m;
+}
+template <typename Scalar>
+Mat4<Scalar> D_b(const Scalar& B) {
+  Mat4<Scalar> m = Mat4<Scalar>::Identity();
+  m.template topLeftCorner<3, 3>() = rotation_about_axis<Scalar>(Vec3<Scalar>::UnitY(), B);
+  return m;
+}
+template <typename Scalar>
+Mat4<Scalar> D_c(const Scalar& C) {
+  Mat4<Scalar> m = Mat4<Scalar>::Identity();
+  m.template topLeftCorner<3, 3>() = rotation_about_axis<Scalar>(Vec3<Scalar>::UnitZ(), C);
+  return m;
+}
+
+}  // namespace rotacal
