@@ -1,0 +1,56 @@
+// Bindings for include/rotacal/kinematics: thin wrappers, numpy in, numpy out.
+#include "numpy.hpp"
+#include "rotacal/kinematics/machine.hpp"
+
+namespace rotacal::py {
+
+namespace {
+LocationErrors<double> errors_of(const pyb::array_t<double, pyb::array::c_style |
+                                                                pyb::array::forcecast>& e) {
+  return LocationErrors<double>(vec_of<8>(e, "errors"));
+}
+}  // namespace
+
+void bind_kinematics(pyb::module_& m) {
+  pyb::enum_<MachineType>(m, "MachineType")
+      .value("AC_trt", MachineType::AC_trt)
+      .value("BC_trt", MachineType::BC_trt);
+  m.def("parse_machine_type", &parse_machine_type, pyb::arg("text"),
+        "Machine type from its file name ('AC-trt' or 'BC-trt').");
+  m.def("machine_name", pyb::overload_cast<MachineType>(&to_string), pyb::arg("machine"));
+  m.def("location_error_names", &location_error_names, pyb::arg("machine"),
+        "ISO 230-7 names of the 8 location errors, in the order of every errors vector.");
+
+  m.def(
+      "forward",
+      [](MachineType machine, const pyb::array_t<double, pyb::array::c_style |
+                                                             pyb::array::forcecast>& errors,
+         const pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>& angles,
+         const pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>& q_table) {
+        const auto e = errors_of(errors);
+        const auto a = rows_of<2>(angles, "angles");
+        const auto q = rows_of<3>(q_table, "q_table");
+        if (a.rows() != q.rows())
+          throw InvalidArgument("forward: angles and q_table must have the same number of rows");
+        Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> p(q.rows(), 3);
+        for (Eigen::Index i = 0; i < q.rows(); ++i)
+          p.row(i) = forward<double>(machine, e, {a(i, 0), a(i, 1)}, q.row(i).transpose())
+                         .transpose();
+        return p;
+      },
+      pyb::arg("machine"), pyb::arg("errors"), pyb::arg("angles"), pyb::arg("q_table"),
+      R"doc(Machine-frame positions of table points.
+
+Parameters
+----------
+machine : MachineType
+errors : (8,) location errors, order of location_error_names (mm, rad)
+angles : (N, 2) tilt and C angles, rad
+q_table : (N, 3) points in the table frame, mm
+
+Returns
+-------
+(N, 3) machine-frame positions, mm)doc");
+}
+
+}  // namespace rotacal::py

@@ -1,0 +1,23 @@
+// rotacal._core: the private extension behind the typed Python package. Each bind_* lives in
+// its own file next to this one, one per C++ module.
+#include <pybind11/pybind11.h>
+
+#include "rotacal/core/error.hpp"
+
+namespace pyb = pybind11;
+
+namespace rotacal::py {
+void bind_kinematics(pyb::module_& m);
+}  // namespace rotacal::py
+
+PYBIND11_MODULE(_core, m) {
+  m.doc() = "rotacal native core (use the rotacal package, not this module)";
+  // Typed exceptions: Python sees rotacal.Error and its subclasses. pybind11 tries the most
+  // recently registered translator first, so the base is registered first.
+  auto error = pyb::register_exception<rotacal::Error>(m, "Error", PyExc_RuntimeError);
+  pyb::register_exception<rotacal::InvalidArgument>(m, "InvalidArgument", error.ptr());
+  pyb::register_exception<rotacal::DegenerateGeometry>(m, "DegenerateGeometry", error.ptr());
+  pyb::register_exception<rotacal::ParseError>(m, "ParseError", error.ptr());
+  pyb::register_exception<rotacal::IoError>(m, "IoError", error.ptr());
+  rotacal::py::bind_kinematics(m);
+}
