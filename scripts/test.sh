@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# The whole test suite: C++ tests (ctest), the installed CMake package used from a separate
+# project, the Python package built by pip and its tests (pytest), the benchmarks once each
+# as a smoke check, and the C++ tests again under AddressSanitizer + UBSan.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+ROOT=$PWD
+PY=${PYTHON:-python3}
+export CMAKE_BUILD_PARALLEL_LEVEL=${CMAKE_BUILD_PARALLEL_LEVEL:-$(nproc)}
+
+step() { printf '\n==== %s\n' "$*"; }
+
+step "set-up"
+bash scripts/setup.sh
+
+step "C++ build and tests (Release)"
+cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release -DROTACAL_BUILD_BENCH=ON
+cmake --build build/release
+ctest --test-dir build/release --output-on-failure
+
+step "CMake package: find_package(rotacal CONFIG REQUIRED) from a separate project"
+rm -rf build/install build/consumer
+cmake --install build/release --prefix build/install --component dev
+cmake -S tests/consumer -B build/consumer -G Ninja -DCMAKE_PREFIX_PATH="$ROOT/build/install"
+cmake --build build/consumer
+./build/consumer/rotacal_consumer
+
+step "Python package (pip install .) and pytest"
+"$PY" -m pip install -q --disable-pip-version-check --no-build-isolation .
+(cd tests/python && "$PY" -m pytest -q -p no:cacheprovider .)
+
+step "C++ tests under AddressSanitizer + UBSan"
+cmake -S . -B build/asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DROTACAL_SANITIZE=ON \
+      -DROTACAL_BUILD_BENCH=OFF
+cmake --build build/asan
+ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
+  ctest --test-dir build/asan --output-on-failure
