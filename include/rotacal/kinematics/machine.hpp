@@ -88,15 +88,27 @@ struct RotaryAngles {
   Scalar rot = Scalar(0);
 };
 
+/// Rigid motion of the tilt axis alone: exact rotation about its actual line.
+template <typename Scalar>
+Pose<Scalar> tilt_axis_motion(MachineType m, const LocationErrors<Scalar>& e, const Scalar& tilt) {
+  const AxisLine<Scalar> T = tilt_axis_line(m, e);
+  return rotation_about_line(T.point, T.direction, tilt);
+}
+
+/// Rigid motion of the C axis alone: exact rotation about its actual line.
+template <typename Scalar>
+Pose<Scalar> c_axis_motion(MachineType m, const LocationErrors<Scalar>& e, const Scalar& rot) {
+  const AxisLine<Scalar> C = c_axis_line(m, e);
+  return rotation_about_line(C.point, C.direction, rot);
+}
+
 /// Pose of the table frame in the machine frame: q_table -> p_machine =
 /// Rot(tilt line, tilt) * Rot(C line, rot) * q_table, exact rotations about the actual lines.
+/// (kinematics/effects.hpp inserts error motions between these two stages.)
 template <typename Scalar>
 Pose<Scalar> table_pose(MachineType m, const LocationErrors<Scalar>& e,
                         const RotaryAngles<Scalar>& angles) {
-  const AxisLine<Scalar> T = tilt_axis_line(m, e);
-  const AxisLine<Scalar> C = c_axis_line(m, e);
-  return rotation_about_line(T.point, T.direction, angles.tilt) *
-         rotation_about_line(C.point, C.direction, angles.rot);
+  return tilt_axis_motion(m, e, angles.tilt) * c_axis_motion(m, e, angles.rot);
 }
 
 /// Forward kinematics: machine-frame position of a point fixed on the table.

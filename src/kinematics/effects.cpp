@@ -1,0 +1,169 @@
+#include "rotacal/kinematics/effects.hpp"
+
+#include <algorithm>
+#include <cctype>
+
+namespace rotacal {
+
+namespace {
+
+struct KindInfo {
+  EffectKind kind;
+  const char* stem;     // id up to the axis
+  bool rotary_axis;     // takes A/B/C
+  bool tilt_only;       // only A or B
+  bool linear_axis;     // takes X/Y/Z
+  bool harmonic;        // has _hn
+  int params;
+  const char* names;    // comma separated
+  const char* units;
+  const char* cause;
+};
+
+const KindInfo kKinds[] = {
+    {EffectKind::ballbar_length_offset, "ballbar_length_offset", false, false, false, false, 1,
+     "dL", "mm", "the calibrated ballbar length L0 is wrong"},
+    {EffectKind::ballbar_thermal_drift, "ballbar_thermal_drift", false, false, false, false, 1,
+     "k", "mm/s", "the bar or the set-up grows with temperature during the test"},
+    {EffectKind::tool_offset_Z, "tool_offset_Z", false, false, false, false, 1, "d", "mm",
+     "the tool-cup centre is not at the programmed tool length"},
+    {EffectKind::rotary_zero_offset, "rotary_zero_offset", true, false, false, false, 1, "eps",
+     "rad", "the zero of the rotary axis is off"},
+    {EffectKind::angular_positioning, "angular_positioning", true, false, false, true, 2, "a,b",
+     "rad,rad", "angular positioning error of the rotary axis (encoder eccentricity, worm or gear error)"},
+    {EffectKind::radial_motion, "radial_motion", true, false, false, true, 4, "a,b,c,d",
+     "mm,mm,mm,mm", "radial error motion of the rotary axis (out-of-round bearing track)"},
+    {EffectKind::axial_motion, "axial_motion", true, false, false, true, 2, "a,b", "mm,mm",
+     "axial error motion of the rotary axis (face runout)"},
+    {EffectKind::tilt_motion, "tilt_motion", true, false, false, true, 4, "a,b,c,d",
+     "rad,rad,rad,rad", "tilt error motion of the rotary axis (wobble of the rotating table)"},
+    {EffectKind::gravity_sag, "gravity_sag", true, true, false, false, 1, "s", "mm",
+     "the tilting table deflects under its own weight"},
+    {EffectKind::coning, "coning", true, true, false, false, 1, "k", "rad/rad",
+     "the tilting axis' orientation changes in proportion to its angle (coning)"},
+    {EffectKind::linear_squareness, "linear_squareness", false, false, true, false, 1, "s", "rad",
+     "two linear axes are out of square"},
+    {EffectKind::linear_scale, "linear_scale", false, false, true, false, 1, "k", "mm/mm",
+     "linear positioning scale error"},
+    {EffectKind::thermal_drift, "thermal_drift", false, false, true, false, 1, "d", "mm/s",
+     "the machine structure drifts while the test runs"},
+};
+
+const KindInfo& info(EffectKind k) {
+  for (const KindInfo& i : kKinds)
+    if (i.kind == k) return i;
+  throw Error("internal error: effect kind without catalogue entry");
+}
+
+std::vector<std::string> split(const std::string& s) {
+  std::vector<std::string> out;
+  std::size_t a = 0;
+  for (std::size_t b; (b = s.find(',', a)) != std::string::npos; a = b + 1)
+    out.push_back(s.substr(a, b - a));
+  out.push_back(s.substr(a));
+  return out;
+}
+
+const char* squareness_plane(char axis) { return axis == 'X' ? "XY" : axis == 'Y' ? "YZ" : "ZX"; }
+
+}  // namespace
+
+std::string Effect::id() const {
+  const KindInfo& k = info(kind);
+  std::string s = k.stem;
+  if (kind == EffectKind::linear_squareness) return s + "_" + squareness_plane(axis);
+  if (k.rotary_axis || k.linear_axis) s += std::string("_") + axis;
+  if (k.harmonic) s += "_h" + std::to_string(harmonic);
+  return s;
+}
+
+Effect Effect::parse(const std::string& id) {
+  for (const KindInfo& k : kKinds) {
+    const std::string stem = k.stem;
+    if (id.compare(0, stem.size(), stem) != 0) continue;
+    std::string rest = id.substr(stem.size());
+    Effect f;
+    f.kind = k.kind;
+    if (!k.rotary_axis && !k.linear_axis) {
+      if (rest.empty()) return f;
+      continue;
+    }
+    if (k.kind == EffectKind::linear_squareness) {
+      for (char a : {'X', 'Y', 'Z'})
+        if (rest == std::string("_") + squareness_plane(a)) return Effect{k.kind, a, 0};
+      break;
+    }
+    if (rest.size() < 2 || rest[0] != '_') break;
+    const char a = rest[1];
+    const bool ok_axis = k.rotary_axis ? (a == 'A' || a == 'B' || a == 'C') && !(k.tilt_only && a == 'C')
+                                       : (a == 'X' || a == 'Y' || a == 'Z');
+    if (!ok_axis) break;
+    f.axis = a;
+    rest = rest.substr(2);
+    if (!k.harmonic) {
+      if (rest.empty()) return f;
+      break;
+    }
+    if (rest.size() < 3 || rest.compare(0, 2, "_h") != 0) break;
+    const std::string n = rest.substr(2);
+    if (n.empty() || n.size() > 2 || !std::all_of(n.begin(), n.end(), ::isdigit)) break;
+    f.harmonic = std::stoi(n);
+    if (f.harmonic < 1 || (k.kind == EffectKind::radial_motion && f.harmonic < 2)) break;
+    return f;
+  }
+  throw InvalidArgument("'" + id + "' is not an effect id of the catalogue (shared/spec/effects.md)");
+}
+
+int Effect::num_params() const { return info(kind).params; }
+std::vector<std::string> Effect::param_names() const { return split(info(kind).names); }
+std::vector<std::string> Effect::param_units() const { return split(info(kind).units); }
+std::string Effect::cause() const { return info(kind).cause; }
+
+bool Effect::applies_to(MachineType m) const {
+  if (!info(kind).rotary_axis) return true;
+  return axis == 'C' || axis == tilt_axis_letter(m);
+}
+
+std::vector<Effect> effect_catalogue(MachineType m, int max_harmonic) {
+  std::vector<Effect> out;
+  const char T = tilt_axis_letter(m);
+  for (const KindInfo& k : kKinds) {
+    if (k.linear_axis) {
+      for (char a : {'X', 'Y', 'Z'}) out.push_back({k.kind, a, 0});
+    } else if (k.rotary_axis) {
+      for (char a : {T, 'C'}) {
+        if (k.tilt_only && a == 'C') continue;
+        if (!k.harmonic) {
+          out.push_back({k.kind, a, 0});
+          continue;
+        }
+        for (int n = k.kind == EffectKind::radial_motion ? 2 : 1; n <= max_harmonic; ++n)
+          out.push_back({k.kind, a, n});
+      }
+    } else {
+      out.push_back({k.kind, 0, 0});
+    }
+  }
+  return out;
+}
+
+int EffectModel::num_params() const {
+  int n = 0;
+  for (const Effect& f : effects) n += f.num_params();
+  return n;
+}
+
+int EffectModel::offset(std::size_t i) const {
+  int n = 0;
+  for (std::size_t k = 0; k < i; ++k) n += effects[k].num_params();
+  return n;
+}
+
+std::vector<std::string> EffectModel::param_labels() const {
+  std::vector<std::string> out;
+  for (const Effect& f : effects)
+    for (const std::string& n : f.param_names()) out.push_back(f.id() + "." + n);
+  return out;
+}
+
+}  // namespace rotacal
