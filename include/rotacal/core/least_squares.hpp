@@ -1,0 +1,51 @@
+#pragma once
+/// \file
+/// What every joint fit reports after Ceres has converged: the weighted Jacobian at the
+/// solution, which parameter combinations the data cannot see (SVD of the column-normalised
+/// Jacobian), and the 1-sigma covariance of the parameters that it can see.
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+namespace ceres {
+class Problem;
+}
+
+namespace rotacal {
+
+/// Dense Jacobian of the problem's residuals with respect to `blocks` in their ambient
+/// coordinates (columns in block order; constant blocks and blocks with a manifold included),
+/// evaluated at the blocks' current values. Manifolds are detached and re-attached around the
+/// evaluation, so the problem must not own them (manifold_ownership = DO_NOT_TAKE_OWNERSHIP).
+Eigen::MatrixXd evaluate_jacobian(ceres::Problem& problem, const std::vector<double*>& blocks,
+                                  Eigen::VectorXd* residuals = nullptr);
+
+/// Which parameter combinations the data cannot determine. J is weighted (residuals in units
+/// of their sigma); `scales` holds a plausible magnitude of each parameter (e.g. 1 mm, 1 mrad).
+/// A direction is unobservable when moving along it by those magnitudes changes chi-square by
+/// less than `min_chi2_change`: singular value of J*diag(scales) below its square root.
+struct Observability {
+  std::vector<bool> observable;             ///< per parameter: takes part in no null direction
+  std::vector<Eigen::VectorXd> null_space;  ///< directions in parameter space (original units)
+  Eigen::VectorXd singular_values;          ///< of J*diag(scales), descending
+  /// Parameters to hold fixed so that the rest is determined: one per null direction, the one
+  /// with the largest (scaled) share in it.
+  std::vector<int> to_fix;
+  /// Null direction k in words, e.g. "E_X0C +1 mm with E_B0C +0.0167 rad changes no reading".
+  std::string describe(int k, const std::vector<std::string>& names,
+                       const std::vector<std::string>& units) const;
+};
+Observability analyse_observability(const Eigen::MatrixXd& J, const Eigen::VectorXd& scales,
+                                    double min_chi2_change = 1.0);
+
+/// Plausible magnitude of a parameter by its unit, for analyse_observability: 1 mm, 1 mrad,
+/// 1 um/s, 1e-3 for ratios (rad/rad, mm/mm). Throws InvalidArgument for an unknown unit.
+double plausible_magnitude(const std::string& unit);
+
+/// 1-sigma covariance (J^T J)^-1 * sigma2 restricted to the parameters in `free` (others get
+/// zero rows/columns), computed by SVD of the column-normalised Jacobian for conditioning.
+Eigen::MatrixXd covariance_from_jacobian(const Eigen::MatrixXd& J, const std::vector<bool>& free,
+                                         double sigma2);
+
+}  // namespace rotacal

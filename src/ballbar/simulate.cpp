@@ -1,0 +1,48 @@
+#include "rotacal/ballbar/simulate.hpp"
+
+#include <cmath>
+#include <random>
+
+namespace rotacal {
+
+std::vector<double> predict_lengths(const BallbarMachineModel& model,
+                                    const std::vector<BallbarSample>& samples) {
+  if (static_cast<int>(model.effect_params.size()) != model.effects.num_params())
+    throw InvalidArgument("effect_params: expected " + std::to_string(model.effects.num_params()) +
+                          " values for the model's effects, got " +
+                          std::to_string(model.effect_params.size()));
+  std::vector<double> out;
+  out.reserve(samples.size());
+  for (const BallbarSample& s : samples)
+    out.push_back(predicted_length<double>(model.machine, model.errors, model.pivot, model.effects,
+                                           model.effect_params.data(), s));
+  return out;
+}
+
+BallbarSession simulate_ballbar(const BallbarSession& commanded, const BallbarMachineModel& truth,
+                                const BallbarSimulationOptions& options) {
+  if (truth.machine != commanded.machine)
+    throw InvalidArgument("simulate_ballbar: model is for " + to_string(truth.machine) +
+                          " but the session is for " + to_string(commanded.machine));
+  if (!(options.noise_um >= 0.0) || !std::isfinite(options.noise_um))
+    throw InvalidArgument("noise_um must be finite and >= 0");
+  for (const Effect& f : truth.effects.effects)
+    if (!f.applies_to(truth.machine))
+      throw InvalidArgument("effect " + f.id() + " does not exist on a " + to_string(truth.machine));
+  BallbarSession out = commanded;
+  const std::vector<double> L = predict_lengths(truth, commanded.samples);
+  std::mt19937_64 rng(options.seed);
+  std::normal_distribution<double> noise(0.0, options.noise_um * 1e-3);
+  for (std::size_t i = 0; i < L.size(); ++i)
+    out.samples[i].length = L[i] + (options.noise_um > 0 ? noise(rng) : 0.0);
+  if (options.declare_noise) {
+    out.noise_um = options.noise_um;
+    bool found = false;
+    for (auto& kv : out.metadata)
+      if (kv.first == "noise_um") kv.second = std::to_string(options.noise_um), found = true;
+    if (!found) out.metadata.emplace_back("noise_um", std::to_string(options.noise_um));
+  }
+  return out;
+}
+
+}  // namespace rotacal

@@ -1,0 +1,140 @@
+#include "rotacal/core/least_squares.hpp"
+
+#include <ceres/ceres.h>
+
+#include <Eigen/SVD>
+#include <cmath>
+#include <sstream>
+
+#include "rotacal/core/error.hpp"
+
+namespace rotacal {
+
+Eigen::MatrixXd evaluate_jacobian(ceres::Problem& problem, const std::vector<double*>& blocks,
+                                  Eigen::VectorXd* residuals) {
+  // Ceres reports Jacobians in each block's tangent space and none for constant blocks; lift
+  // both for this evaluation so that every column is there, then put them back.
+  std::vector<double*> made_variable;
+  std::vector<std::pair<double*, const ceres::Manifold*>> lifted;
+  for (double* b : blocks) {
+    if (problem.IsParameterBlockConstant(b)) {
+      problem.SetParameterBlockVariable(b);
+      made_variable.push_back(b);
+    }
+    if (const ceres::Manifold* m = problem.GetManifold(b)) {
+      lifted.emplace_back(b, m);
+      problem.SetManifold(b, nullptr);
+    }
+  }
+  ceres::Problem::EvaluateOptions opt;
+  opt.parameter_blocks = blocks;
+  ceres::CRSMatrix crs;
+  std::vector<double> r;
+  problem.Evaluate(opt, nullptr, &r, nullptr, &crs);
+  for (auto& [b, m] : lifted) problem.SetManifold(b, const_cast<ceres::Manifold*>(m));
+  for (double* b : made_variable) problem.SetParameterBlockConstant(b);
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+  for (int i = 0; i < crs.num_rows; ++i)
+    for (int k = crs.rows[i]; k < crs.rows[i + 1]; ++k) J(i, crs.cols[k]) = crs.values[k];
+  if (residuals)
+    *residuals = Eigen::Map<Eigen::VectorXd>(r.data(), static_cast<Eigen::Index>(r.size()));
+  return J;
+}
+
+namespace {
+Eigen::VectorXd column_scales(const Eigen::MatrixXd& J) {
+  Eigen::VectorXd s = J.colwise().norm().transpose();
+  for (Eigen::Index j = 0; j < s.size(); ++j)
+    if (!(s[j] > 0.0)) s[j] = 1.0;  // a column of zeros: the parameter does nothing
+  return s;
+}
+}  // namespace
+
+Observability analyse_observability(const Eigen::MatrixXd& J, const Eigen::VectorXd& scales,
+                                    double min_chi2_change) {
+  const Eigen::Index p = J.cols();
+  if (scales.size() != p)
+    throw InvalidArgument("analyse_observability: scales has " + std::to_string(scales.size()) +
+                          " entries for " + std::to_string(p) + " parameters");
+  Observability o;
+  o.observable.assign(static_cast<std::size_t>(p), true);
+  if (p == 0) return o;
+  const Eigen::MatrixXd Js = J * scales.asDiagonal();
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(Js, Eigen::ComputeFullV);
+  o.singular_values = Eigen::VectorXd::Zero(p);
+  o.singular_values.head(svd.singularValues().size()) = svd.singularValues();
+  const double limit = std::sqrt(min_chi2_change);
+  for (Eigen::Index k = 0; k < p; ++k) {
+    if (o.singular_values[k] >= limit) continue;
+    const Eigen::VectorXd vs = svd.matrixV().col(k);
+    o.null_space.push_back(vs.cwiseProduct(scales));
+    int best = 0;
+    for (Eigen::Index j = 0; j < p; ++j) {
+      if (std::abs(vs[j]) > 0.05) o.observable[static_cast<std::size_t>(j)] = false;
+      if (std::abs(vs[j]) > std::abs(vs[best])) best = static_cast<int>(j);
+    }
+    o.to_fix.push_back(best);
+  }
+  return o;
+}
+
+double plausible_magnitude(const std::string& unit) {
+  if (unit == "mm") return 1.0;
+  if (unit == "rad") return 1e-3;
+  if (unit == "mm/s") return 1e-3;
+  if (unit == "rad/rad" || unit == "mm/mm") return 1e-3;
+  throw InvalidArgument("plausible_magnitude: unknown unit '" + unit + "'");
+}
+
+std::string Observability::describe(int k, const std::vector<std::string>& names,
+                                    const std::vector<std::string>& units) const {
+  const Eigen::VectorXd& v = null_space.at(static_cast<std::size_t>(k));
+  // Lead with the parameter that has the largest share relative to its plausible size.
+  int lead = 0;
+  double lead_share = -1.0;
+  for (Eigen::Index j = 0; j < v.size(); ++j) {
+    const double share = std::abs(v[j]) / plausible_magnitude(units.at(static_cast<std::size_t>(j)));
+    if (share > lead_share) lead = static_cast<int>(j), lead_share = share;
+  }
+  const double unit_step = plausible_magnitude(units.at(static_cast<std::size_t>(lead)));
+  std::ostringstream out;
+  out.precision(3);
+  out << names.at(static_cast<std::size_t>(lead)) << " +" << unit_step << " " << units[static_cast<std::size_t>(lead)];
+  for (Eigen::Index j = 0; j < v.size(); ++j) {
+    if (j == lead) continue;
+    const double step = v[j] / v[lead] * unit_step;
+    if (std::abs(step) < 0.05 * plausible_magnitude(units[static_cast<std::size_t>(j)])) continue;
+    out << " with " << names[static_cast<std::size_t>(j)] << " " << (step < 0 ? "" : "+") << step
+        << " " << units[static_cast<std::size_t>(j)];
+  }
+  out << " changes no reading measurably";
+  return out.str();
+}
+
+Eigen::MatrixXd covariance_from_jacobian(const Eigen::MatrixXd& J, const std::vector<bool>& free,
+                                         double sigma2) {
+  const Eigen::Index p = J.cols();
+  ROTACAL_ASSERT(static_cast<Eigen::Index>(free.size()) == p);
+  std::vector<Eigen::Index> idx;
+  for (Eigen::Index j = 0; j < p; ++j)
+    if (free[static_cast<std::size_t>(j)]) idx.push_back(j);
+  Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(p, p);
+  if (idx.empty()) return cov;
+  Eigen::MatrixXd Jf(J.rows(), static_cast<Eigen::Index>(idx.size()));
+  for (std::size_t k = 0; k < idx.size(); ++k) Jf.col(static_cast<Eigen::Index>(k)) = J.col(idx[k]);
+  const Eigen::VectorXd s = column_scales(Jf);
+  const Eigen::MatrixXd Jn = Jf * s.cwiseInverse().asDiagonal();
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(Jn, Eigen::ComputeThinV);
+  const Eigen::VectorXd sv = svd.singularValues();
+  Eigen::VectorXd inv2 = Eigen::VectorXd::Zero(sv.size());
+  for (Eigen::Index k = 0; k < sv.size(); ++k)
+    if (sv[k] > 1e-12 * sv[0]) inv2[k] = 1.0 / (sv[k] * sv[k]);
+  const Eigen::MatrixXd Cn = svd.matrixV() * inv2.asDiagonal() * svd.matrixV().transpose();
+  const Eigen::MatrixXd Cf = s.cwiseInverse().asDiagonal() * Cn * s.cwiseInverse().asDiagonal() * sigma2;
+  for (std::size_t a = 0; a < idx.size(); ++a)
+    for (std::size_t b = 0; b < idx.size(); ++b)
+      cov(idx[a], idx[b]) = Cf(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
+  return cov;
+}
+
+}  // namespace rotacal
