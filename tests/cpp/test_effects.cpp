@@ -123,3 +123,24 @@ TEST_CASE("effect parameters are differentiable with ceres::Jet", "[effects][jet
     for (int k = 0; k < 3; ++k) CHECK_THAT(pm[k].v[i], WithinAbs(fd[k], 1e-5 * (1 + std::abs(fd[k]))));
   }
 }
+
+TEST_CASE("table_point agrees with table_pose for every stage", "[effects]") {
+  const auto m = MachineType::AC_trt;
+  EffectModel fx{{Effect::parse("thermal_drift_X"), Effect::parse("coning_A"),
+                  Effect::parse("tilt_motion_A_h2"), Effect::parse("radial_motion_C_h2"),
+                  Effect::parse("rotary_zero_offset_C")}};
+  const std::vector<double> p = {1e-5, 1e-4, 1e-5, 2e-5, -1e-5, 3e-5, 1e-3, 2e-3, -1e-3, 4e-4, 2e-4};
+  REQUIRE(static_cast<int>(p.size()) == fx.num_params());
+  LocationErrors<double> e;
+  e.v << 0.01, -0.02, 1e-5, 2e-5, 0.03, 0.01, -1e-5, 3e-5;
+  const Eigen::Vector3d q(120, 10, 60);
+  for (double a : {-1.0, 0.3}) {
+    const Eigen::Vector3d p1 = table_pose<double>(m, e, fx, p.data(), {a, 2.0}, 50.0) * q;
+    const Eigen::Vector3d p2 = table_point<double>(m, e, fx, p.data(), {a, 2.0}, 50.0, q);
+    CHECK((p1 - p2).norm() < 1e-12);
+  }
+  // With no effects both reduce to the baseline kinematics of machine.hpp.
+  const EffectModel none;
+  CHECK((table_point<double>(m, e, none, nullptr, {0.4, 1.0}, 0.0, q) -
+         forward<double>(m, e, {0.4, 1.0}, q)).norm() < 1e-12);
+}

@@ -69,3 +69,11 @@ TEST_CASE("rotation_about_line is differentiable with ceres::Jet", "[rotation][j
       u.cross(rotation_about_line<double>(a, d, th) * q - a);
   for (int i = 0; i < 3; ++i) CHECK_THAT(p[i].v[0], WithinAbs(expected[i], 1e-10));
 }
+
+TEST_CASE("rotate_point_about_line is the Pose form applied to a point", "[rotation]") {
+  const Eigen::Vector3d a(3, -1, 2), d(0.2, 1.0, -0.3), q(40, 5, -7);
+  for (double th : {-2.0, 0.0, 0.3, 3.0}) {
+    CHECK((rotate_point_about_line<double>(a, d, th, q) - rotation_about_line<double>(a, d, th) * q)
+              .norm() < 1e-12);
+  }
+}

@@ -27,7 +27,7 @@ template <typename Scalar>
 Scalar predicted_length(MachineType m, const LocationErrors<Scalar>& e, const Vec3<Scalar>& pivot,
                         const EffectModel& fx, const Scalar* fx_params, const BallbarSample& s) {
   const Vec3<Scalar> tool = tool_position(fx, fx_params, s.xyz, s.time);
-  const Vec3<Scalar> ball = table_pose(m, e, fx, fx_params, s.angles_rad(), s.time) * pivot;
+  const Vec3<Scalar> ball = table_point(m, e, fx, fx_params, s.angles_rad(), s.time, pivot);
   return (tool - ball).norm() + ballbar_reading_error(fx, fx_params, s.time);
 }
 

@@ -96,16 +96,22 @@ inline int axis_index(char axis) { return axis == 'A' || axis == 'X' ? 0 : (axis
 
 }  // namespace detail
 
-/// Pose of the table in the machine frame with location errors and effects, at commanded
-/// rotary angles (rad) and time t (s). `p` points at EffectModel::num_params() values.
-template <typename Scalar>
-Pose<Scalar> table_pose(MachineType m, const LocationErrors<Scalar>& e, const EffectModel& fx,
-                        const Scalar* p, const RotaryAngles<double>& cmd, double t) {
+/// Walks the stages of the table's motion from the innermost (C error motion) to the
+/// outermost (machine-frame translations), handing each to `acc`: `acc.rigid(Pose)` for error
+/// motions and coning, `acc.about_line(AxisLine, angle)` for the two axis rotations,
+/// `acc.translate(Vec3)` for drift and sag. Identity stages are skipped. This is the one place
+/// that fixes the order of composition (see the file comment); table_pose and table_point
+/// below are its two accumulators.
+template <typename Scalar, typename Accumulator>
+void walk_table_stages(MachineType m, const LocationErrors<Scalar>& e, const EffectModel& fx,
+                       const Scalar* p, const RotaryAngles<double>& cmd, double t,
+                       Accumulator& acc) {
   using std::cos;
   using std::sin;
   const char tilt_axis = tilt_axis_letter(m);
   Scalar tilt(cmd.tilt), rot(cmd.rot);
   Pose<Scalar> E_T, E_C, K;
+  bool has_E_T = false, has_E_C = false, has_K = false, has_D = false;
   Vec3<Scalar> D = Vec3<Scalar>::Zero();
   for (std::size_t i = 0; i < fx.effects.size(); ++i) {
     const Effect& f = fx.effects[i];
@@ -124,6 +130,7 @@ Pose<Scalar> table_pose(MachineType m, const LocationErrors<Scalar>& e, const Ef
       case EffectKind::axial_motion:
       case EffectKind::tilt_motion: {
         Pose<Scalar>& E = on_c ? E_C : E_T;
+        (on_c ? has_E_C : has_E_T) = true;
         const int k = detail::axis_index(f.axis), i1 = (k + 1) % 3, i2 = (k + 2) % 3;
         if (f.kind == EffectKind::radial_motion) {
           E.t[i1] += q[0] * c + q[1] * s;
@@ -140,23 +147,71 @@ Pose<Scalar> table_pose(MachineType m, const LocationErrors<Scalar>& e, const Ef
       }
       case EffectKind::gravity_sag:
         D.z() -= q[0] * (Scalar(1) - cos(Scalar(cmd.tilt)));
+        has_D = true;
         break;
       case EffectKind::coning:
         K.R = rotation_about_axis<Scalar>(
                   tilt_axis == 'B' ? Vec3<Scalar>::UnitX() : Vec3<Scalar>::UnitY(),
                   q[0] * Scalar(cmd.tilt)) *
               K.R;
+        has_K = true;
         break;
       case EffectKind::thermal_drift:
         D[detail::axis_index(f.axis)] += q[0] * Scalar(t);
+        has_D = true;
         break;
       default:  // tool-side and instrument effects do not move the table
         break;
     }
   }
-  Pose<Scalar> Dt;
-  Dt.t = D;
-  return Dt * K * tilt_axis_motion(m, e, tilt) * E_T * c_axis_motion(m, e, rot) * E_C;
+  if (has_E_C) acc.rigid(E_C);
+  acc.about_line(c_axis_line(m, e), rot);
+  if (has_E_T) acc.rigid(E_T);
+  acc.about_line(tilt_axis_line(m, e), tilt);
+  if (has_K) acc.rigid(K);
+  if (has_D) acc.translate(D);
+}
+
+namespace detail {
+template <typename Scalar>
+struct PoseAccumulator {  // T <- stage * T
+  Pose<Scalar> T;
+  void rigid(const Pose<Scalar>& P) { T = P * T; }
+  void about_line(const AxisLine<Scalar>& L, const Scalar& a) {
+    T = rotation_about_line(L.point, L.direction, a) * T;
+  }
+  void translate(const Vec3<Scalar>& d) { T.t += d; }
+};
+template <typename Scalar>
+struct PointAccumulator {  // q <- stage(q)
+  Vec3<Scalar> q;
+  void rigid(const Pose<Scalar>& P) { q = P * q; }
+  void about_line(const AxisLine<Scalar>& L, const Scalar& a) {
+    q = rotate_point_about_line(L.point, L.direction, a, q);
+  }
+  void translate(const Vec3<Scalar>& d) { q += d; }
+};
+}  // namespace detail
+
+/// Pose of the table in the machine frame with location errors and effects, at commanded
+/// rotary angles (rad) and time t (s). `p` points at EffectModel::num_params() values.
+template <typename Scalar>
+Pose<Scalar> table_pose(MachineType m, const LocationErrors<Scalar>& e, const EffectModel& fx,
+                        const Scalar* p, const RotaryAngles<double>& cmd, double t) {
+  detail::PoseAccumulator<Scalar> acc;
+  walk_table_stages(m, e, fx, p, cmd, t, acc);
+  return acc.T;
+}
+
+/// Machine-frame position of the table point q (same motion as table_pose, applied to one
+/// point: several times cheaper inside a fit).
+template <typename Scalar>
+Vec3<Scalar> table_point(MachineType m, const LocationErrors<Scalar>& e, const EffectModel& fx,
+                         const Scalar* p, const RotaryAngles<double>& cmd, double t,
+                         const Vec3<Scalar>& q) {
+  detail::PointAccumulator<Scalar> acc{q};
+  walk_table_stages(m, e, fx, p, cmd, t, acc);
+  return acc.q;
 }
 
 /// Actual position of the tool-side ball for a commanded xyz (mm) at time t.

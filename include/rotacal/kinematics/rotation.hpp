@@ -63,6 +63,21 @@ Pose<Scalar> rotation_about_line(const Vec3<Scalar>& point, const Vec3<Scalar>& 
   return T;
 }
 
+/// Rotate the point q by theta (rad) about the line through `point` along `direction` (any
+/// non-zero length): the vector form of Flynn et al. 2016, Eq. 1,
+///   q' = a + v cos(theta) + (u x v) sin(theta) + u (u . v) (1 - cos(theta)),  v = q - a.
+/// Cheaper than building the Pose when only one point is needed (the ballbar's pivot).
+template <typename Scalar>
+Vec3<Scalar> rotate_point_about_line(const Vec3<Scalar>& point, const Vec3<Scalar>& direction,
+                                     const Scalar& theta, const Vec3<Scalar>& q) {
+  using std::cos;
+  using std::sin;
+  const Vec3<Scalar> u = direction / direction.norm();
+  const Vec3<Scalar> v = q - point;
+  const Scalar c = cos(theta), s = sin(theta);
+  return point + v * c + u.cross(v) * s + u * (u.dot(v) * (Scalar(1) - c));
+}
+
 /// Flynn et al. 2016, Eq. 1 written out component by component: rotates q = (x, y, z) about
 /// the line through (a, b, c) with unit direction (u, v, w). The y row as printed in the paper
 /// has two sign slips ("cu + aw - wx + uz"); this is the standard form, "cu - aw + wx - uz".
