@@ -169,6 +169,8 @@ BallbarIdentification identify_joint(const BallbarSession& session,
   // J is in units of 1/sigma_mm; (J^T J)^-1 * sigma_mm^2 is the covariance at unit variance
   // ratio, scaled by the residual variance.
   out.covariance = covariance_from_jacobian(J, free, s2_mm / (sigma_mm * sigma_mm));
+  out.jacobian = J * sigma_mm;  // back from weighted residuals to mm
+  for (bool f : free) out.fixed.push_back(!f);
 
   const std::vector<double> values = [&] {
     std::vector<double> v(e.data(), e.data() + 8);

@@ -28,6 +28,10 @@ struct BallbarIdentification {
   std::vector<ParameterEstimate> parameters;  ///< 8 location errors, pivot x y z, then extras
   Eigen::MatrixXd covariance;         ///< in `parameters` order, 1-sigma^2
   std::vector<double> residuals;      ///< measured - model, mm, per sample (session order)
+  /// d(model length)/d(parameter) at the solution, mm per parameter unit; one row per fitted
+  /// sample (in session order of the samples used), columns in `parameters` order.
+  Eigen::MatrixXd jacobian;
+  std::vector<bool> fixed;            ///< per parameter: held at its start value
   double residual_rms_um = 0.0;
   double sigma_um = 0.0;              ///< noise level used for the covariance
   std::size_t n_samples = 0;

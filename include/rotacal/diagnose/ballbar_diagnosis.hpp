@@ -1,0 +1,46 @@
+#pragma once
+/// \file
+/// The diagnosis of a ballbar session: the DiagnosisProblem for the exact ballbar model,
+/// baseline = location errors + actual pivot (identify_joint with no effects).
+
+#include "rotacal/diagnose/diagnosis.hpp"
+#include "rotacal/io/session.hpp"
+
+namespace rotacal {
+
+class BallbarDiagnosisProblem : public DiagnosisProblem {
+ public:
+  /// `reference` is a complete standard test for the same machine (commanded rows; lengths
+  /// unused), used to name the test that separates two ambiguous candidates; may be empty.
+  explicit BallbarDiagnosisProblem(BallbarSession session, BallbarSession reference = {});
+
+  MachineType machine() const override { return session_.machine; }
+  const std::vector<std::string>& groups() const override { return groups_; }
+  const std::vector<double>& times() const override { return times_; }
+  const std::vector<RotaryAngles<double>>& angles() const override { return angles_; }
+  std::optional<double> declared_noise_um() const override { return session_.noise_um; }
+  std::vector<Effect> candidates(int max_harmonic) const override;
+  ModelFit fit(const EffectModel& effects) const override;
+  Eigen::MatrixXd candidate_jacobian(const ModelFit& at, const Effect& candidate) const override;
+  std::vector<std::string> reference_groups() const override;
+  Eigen::MatrixXd reference_jacobian(const ModelFit& at, const Effect& candidate,
+                                     std::vector<std::string>* row_groups) const override;
+
+  /// The identification behind the last call to fit().
+  const BallbarSession& session() const { return session_; }
+
+ private:
+  Eigen::MatrixXd jacobian_on(const std::vector<BallbarSample>& samples, const ModelFit& at,
+                              const Effect& candidate) const;
+  BallbarSession session_;
+  BallbarSession reference_;
+  std::vector<std::string> groups_;
+  std::vector<double> times_;
+  std::vector<RotaryAngles<double>> angles_;
+};
+
+/// Diagnose a ballbar session (see diagnosis.hpp).
+Diagnosis diagnose_ballbar(const BallbarSession& session, const DiagnosisOptions& options = {},
+                           const BallbarSession& reference = {});
+
+}  // namespace rotacal

@@ -1,0 +1,421 @@
+#include "rotacal/diagnose/diagnosis.hpp"
+
+#include <Eigen/QR>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <sstream>
+
+#include "rotacal/core/least_squares.hpp"
+#include "rotacal/core/stats.hpp"
+
+namespace rotacal {
+
+namespace {
+
+double rss(const Eigen::VectorXd& r) { return r.squaredNorm(); }
+double rms_um(const Eigen::VectorXd& r) {
+  return r.size() ? std::sqrt(r.squaredNorm() / static_cast<double>(r.size())) * 1e3 : 0.0;
+}
+
+// Plausible magnitudes of a candidate's parameters (for observability and scaling).
+Eigen::VectorXd magnitudes(const Effect& c) {
+  const auto units = c.param_units();
+  Eigen::VectorXd m(static_cast<Eigen::Index>(units.size()));
+  for (std::size_t k = 0; k < units.size(); ++k)
+    m[static_cast<Eigen::Index>(k)] = plausible_magnitude(units[k]);
+  return m;
+}
+
+// Least squares y ~ X d with columns scaled to unit norm and rank-revealing QR, so that
+// directions the rows cannot see get no weight instead of blowing up.
+Eigen::VectorXd solve_ls(const Eigen::MatrixXd& X, const Eigen::VectorXd& y) {
+  if (X.cols() == 0) return Eigen::VectorXd();
+  Eigen::VectorXd s = X.colwise().norm().transpose();
+  for (Eigen::Index j = 0; j < s.size(); ++j)
+    if (!(s[j] > 0.0)) s[j] = 1.0;
+  const Eigen::MatrixXd Xs = X * s.cwiseInverse().asDiagonal();
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Xs);
+  qr.setThreshold(1e-9);
+  return (qr.solve(y)).cwiseQuotient(s);
+}
+
+// Orthogonal projection of the columns of C onto the complement of span(J).
+Eigen::MatrixXd project_out(const Eigen::MatrixXd& J, const Eigen::MatrixXd& C) {
+  if (J.cols() == 0) return C;
+  Eigen::MatrixXd out = C;
+  for (Eigen::Index k = 0; k < C.cols(); ++k) out.col(k) -= J * solve_ls(J, C.col(k));
+  return out;
+}
+
+// Free (non-zero) columns of a fit's Jacobian.
+Eigen::MatrixXd free_columns(const Eigen::MatrixXd& J) {
+  std::vector<Eigen::Index> keep;
+  for (Eigen::Index j = 0; j < J.cols(); ++j)
+    if (J.col(j).squaredNorm() > 0.0) keep.push_back(j);
+  Eigen::MatrixXd out(J.rows(), static_cast<Eigen::Index>(keep.size()));
+  for (std::size_t k = 0; k < keep.size(); ++k) out.col(static_cast<Eigen::Index>(k)) = J.col(keep[k]);
+  return out;
+}
+
+// Blocked K-fold assignment: each group's readings in time order, cut into K contiguous blocks.
+std::vector<int> cv_folds(const DiagnosisProblem& P, int K) {
+  const auto& g = P.groups();
+  const auto& t = P.times();
+  std::map<std::string, std::vector<std::size_t>> by_group;
+  for (std::size_t i = 0; i < g.size(); ++i) by_group[g[i]].push_back(i);
+  std::vector<int> fold(g.size(), 0);
+  for (auto& kv : by_group) {
+    auto& idx = kv.second;
+    std::stable_sort(idx.begin(), idx.end(), [&](std::size_t a, std::size_t b) { return t[a] < t[b]; });
+    for (std::size_t k = 0; k < idx.size(); ++k)
+      fold[idx[k]] = static_cast<int>(k * static_cast<std::size_t>(K) / idx.size());
+  }
+  return fold;
+}
+
+// Cross-validated RMS (um) of predicting r from columns X (linearised refit on the rest).
+double cv_rms_um(const Eigen::MatrixXd& X, const Eigen::VectorXd& r, const std::vector<int>& fold,
+                 int K) {
+  double ss = 0.0;
+  std::size_t n = 0;
+  for (int k = 0; k < K; ++k) {
+    std::vector<Eigen::Index> tr, te;
+    for (std::size_t i = 0; i < fold.size(); ++i)
+      (fold[i] == k ? te : tr).push_back(static_cast<Eigen::Index>(i));
+    if (te.empty() || tr.empty()) continue;
+    Eigen::MatrixXd Xt(static_cast<Eigen::Index>(tr.size()), X.cols());
+    Eigen::VectorXd yt(static_cast<Eigen::Index>(tr.size()));
+    for (std::size_t i = 0; i < tr.size(); ++i) {
+      Xt.row(static_cast<Eigen::Index>(i)) = X.row(tr[i]);
+      yt[static_cast<Eigen::Index>(i)] = r[tr[i]];
+    }
+    const Eigen::VectorXd d = solve_ls(Xt, yt);
+    for (Eigen::Index i : te) {
+      const double e = r[i] - (X.cols() ? X.row(i).dot(d) : 0.0);
+      ss += e * e;
+      ++n;
+    }
+  }
+  return n ? std::sqrt(ss / static_cast<double>(n)) * 1e3 : 0.0;
+}
+
+struct Score {
+  Effect effect;
+  bool observable = false;
+  std::string why_not;
+  int k = 0;                   // observable directions
+  Eigen::MatrixXd A;           // observable part of the candidate's columns, J projected out
+  Eigen::MatrixXd X;           // [J, candidate columns] for cross-validation
+  Eigen::VectorXd signature;   // fitted change of the model, mm
+  double rss1 = 0.0;
+  double delta_bic = 0.0;
+  double f_pvalue = 1.0;
+};
+
+Score score(const DiagnosisProblem& P, const ModelFit& fit, const Eigen::MatrixXd& Jfree,
+            const Effect& c, double sigma_mm) {
+  Score s;
+  s.effect = c;
+  const Eigen::MatrixXd Jc = P.candidate_jacobian(fit, c);
+  const Eigen::VectorXd m = magnitudes(c);
+  const Eigen::MatrixXd raw = Jc * m.asDiagonal() / sigma_mm;
+  const Eigen::MatrixXd perp = project_out(Jfree, Jc) * m.asDiagonal() / sigma_mm;
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(perp, Eigen::ComputeThinV);
+  const Eigen::VectorXd sv = svd.singularValues();
+  std::vector<Eigen::Index> dirs;
+  for (Eigen::Index i = 0; i < sv.size(); ++i)
+    if (sv[i] >= 1.0) dirs.push_back(i);  // moving by plausible magnitudes: chi2 change >= 1
+  if (dirs.empty()) {
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd_raw(raw);
+    const bool absorbed = svd_raw.singularValues().size() && svd_raw.singularValues()[0] >= 1.0;
+    s.why_not = absorbed
+                    ? "its effect on these readings is indistinguishable from the location "
+                      "errors and set-up parameters already in the model"
+                    : "it changes none of these readings beyond the noise";
+    return s;
+  }
+  s.observable = true;
+  s.k = static_cast<int>(dirs.size());
+  Eigen::MatrixXd V(perp.cols(), s.k);
+  for (int i = 0; i < s.k; ++i) V.col(i) = svd.matrixV().col(dirs[static_cast<std::size_t>(i)]);
+  s.A = perp * V * sigma_mm;  // back to mm per scaled unit
+  Eigen::MatrixXd Jc_obs = Jc * m.asDiagonal() * V;
+  s.X.resize(Jfree.rows(), Jfree.cols() + s.k);
+  s.X << Jfree, Jc_obs;
+  const Eigen::VectorXd d = solve_ls(s.A, fit.residuals);
+  s.signature = s.A * d;
+  const double rss0 = rss(fit.residuals);
+  s.rss1 = std::max(rss(fit.residuals - s.signature), 1e-300);
+  const double n = static_cast<double>(fit.residuals.size());
+  const double dof = n - fit.num_free - s.k;
+  s.delta_bic = n * std::log(s.rss1 / rss0) + s.k * std::log(n);
+  const double F = ((rss0 - s.rss1) / s.k) / (s.rss1 / dof);
+  s.f_pvalue = stats::f_sf(std::max(F, 0.0), s.k, dof);
+  return s;
+}
+
+double correlation(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  const double na = a.norm(), nb = b.norm();
+  return na > 0 && nb > 0 ? a.dot(b) / (na * nb) : 0.0;
+}
+
+std::string separating_test(const DiagnosisProblem& P, const ModelFit& fit, const Score& a,
+                            const Score& b, double sigma_mm) {
+  if (P.reference_groups().empty())
+    return "no standard test is known for this instrument; none of this session's tests "
+           "separates them";
+  // Fit each candidate's full parameter vector to this session's residual, then compare what
+  // they predict on the standard test.
+  std::vector<std::string> rows_a, rows_b;
+  const Eigen::MatrixXd Ra = P.reference_jacobian(fit, a.effect, &rows_a);
+  const Eigen::MatrixXd Rb = P.reference_jacobian(fit, b.effect, &rows_b);
+  const Eigen::VectorXd pa = P.candidate_jacobian(fit, a.effect).jacobiSvd(Eigen::ComputeThinU | Eigen::ComputeThinV).solve(a.signature);
+  const Eigen::VectorXd pb = P.candidate_jacobian(fit, b.effect).jacobiSvd(Eigen::ComputeThinU | Eigen::ComputeThinV).solve(b.signature);
+  const Eigen::VectorXd diff = Ra * pa - Rb * pb;
+  std::map<std::string, std::pair<double, int>> per;
+  for (std::size_t i = 0; i < rows_a.size(); ++i) {
+    auto& acc = per[rows_a[i]];
+    acc.first += diff[static_cast<Eigen::Index>(i)] * diff[static_cast<Eigen::Index>(i)];
+    acc.second += 1;
+  }
+  std::string best;
+  double best_rms = 0.0;
+  for (auto& kv : per) {
+    const double r = std::sqrt(kv.second.first / kv.second.second);
+    if (r > best_rms) best_rms = r, best = kv.first;
+  }
+  std::ostringstream out;
+  out.precision(2);
+  if (best.empty() || best_rms < sigma_mm)
+    out << "no test of the standard set separates them (predicted difference below the noise)";
+  else
+    out << "a '" << best << "' test separates them: their predictions differ there by "
+        << std::fixed << best_rms * 1e3 << " um RMS";
+  return out.str();
+}
+
+std::string describe_structure(const std::vector<GroupResidual>& groups) {
+  const GroupResidual* worst = nullptr;
+  for (const GroupResidual& g : groups)
+    if (!worst || g.rms_um > worst->rms_um) worst = &g;
+  if (!worst) return "";
+  std::ostringstream out;
+  out.precision(3);
+  out << "largest residual in '" << worst->group << "' (" << worst->rms_um << " um RMS";
+  if (!worst->harmonic_um.empty()) {
+    const auto it = std::max_element(worst->harmonic_um.begin(), worst->harmonic_um.end());
+    out << "; strongest order " << (it - worst->harmonic_um.begin()) + 1 << " in " << worst->angle_axis
+        << ", " << *it << " um";
+  }
+  out << "; trend " << worst->trend_um_per_s << " um/s)";
+  return out.str();
+}
+
+}  // namespace
+
+double estimate_noise_um(const DiagnosisProblem& P, const Eigen::VectorXd& r) {
+  const auto& g = P.groups();
+  const auto& t = P.times();
+  std::map<std::string, std::vector<std::size_t>> by_group;
+  for (std::size_t i = 0; i < g.size(); ++i) by_group[g[i]].push_back(i);
+  double ss = 0.0;
+  std::size_t n = 0;
+  for (auto& kv : by_group) {
+    auto& idx = kv.second;
+    std::stable_sort(idx.begin(), idx.end(), [&](std::size_t a, std::size_t b) { return t[a] < t[b]; });
+    for (std::size_t k = 1; k < idx.size(); ++k) {
+      const double d = r[static_cast<Eigen::Index>(idx[k])] - r[static_cast<Eigen::Index>(idx[k - 1])];
+      ss += d * d;
+      ++n;
+    }
+  }
+  if (n == 0) throw InvalidArgument("estimate_noise_um: no group has two readings");
+  return std::sqrt(ss / (2.0 * static_cast<double>(n))) * 1e3;
+}
+
+std::vector<GroupResidual> residual_structure(const DiagnosisProblem& P, const Eigen::VectorXd& r) {
+  const auto& g = P.groups();
+  const auto& t = P.times();
+  const auto& a = P.angles();
+  std::vector<std::string> order;
+  for (const std::string& s : g)
+    if (std::find(order.begin(), order.end(), s) == order.end()) order.push_back(s);
+  std::vector<GroupResidual> out;
+  const char tilt = tilt_axis_letter(P.machine());
+  for (const std::string& name : order) {
+    std::vector<std::size_t> idx;
+    for (std::size_t i = 0; i < g.size(); ++i)
+      if (g[i] == name) idx.push_back(i);
+    GroupResidual G;
+    G.group = name;
+    G.n = idx.size();
+    double lo_t = 1e300, hi_t = -1e300, lo_r = 1e300, hi_r = -1e300;
+    Eigen::VectorXd y(static_cast<Eigen::Index>(idx.size()));
+    for (std::size_t k = 0; k < idx.size(); ++k) {
+      y[static_cast<Eigen::Index>(k)] = r[static_cast<Eigen::Index>(idx[k])];
+      lo_t = std::min(lo_t, a[idx[k]].tilt), hi_t = std::max(hi_t, a[idx[k]].tilt);
+      lo_r = std::min(lo_r, a[idx[k]].rot), hi_r = std::max(hi_r, a[idx[k]].rot);
+    }
+    G.rms_um = rms_um(y);
+    G.mean_um = y.mean() * 1e3;
+    // Trend against time.
+    Eigen::MatrixXd T(y.size(), 2);
+    for (Eigen::Index k = 0; k < y.size(); ++k) T(k, 0) = 1.0, T(k, 1) = t[idx[static_cast<std::size_t>(k)]];
+    if (y.size() >= 3) G.trend_um_per_s = solve_ls(T, y)[1] * 1e3;
+    // Harmonics in the angle that varies (if it spans at least 90 deg).
+    const double span_t = hi_t - lo_t, span_r = hi_r - lo_r;
+    const bool use_rot = span_r >= span_t;
+    if (std::max(span_t, span_r) >= M_PI / 2 && y.size() >= 20) {
+      G.angle_axis = use_rot ? 'C' : tilt;
+      const int orders = 8;
+      Eigen::MatrixXd H(y.size(), 1 + 2 * orders);
+      for (Eigen::Index k = 0; k < y.size(); ++k) {
+        const double th = use_rot ? a[idx[static_cast<std::size_t>(k)]].rot : a[idx[static_cast<std::size_t>(k)]].tilt;
+        H(k, 0) = 1.0;
+        for (int o = 1; o <= orders; ++o) H(k, 2 * o - 1) = std::cos(o * th), H(k, 2 * o) = std::sin(o * th);
+      }
+      const Eigen::VectorXd c = solve_ls(H, y);
+      for (int o = 1; o <= orders; ++o) G.harmonic_um.push_back(std::hypot(c[2 * o - 1], c[2 * o]) * 1e3);
+    }
+    out.push_back(G);
+  }
+  return out;
+}
+
+Diagnosis diagnose(const DiagnosisProblem& P, const DiagnosisOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Diagnosis D;
+  D.machine = P.machine();
+  std::vector<Effect> candidates = P.candidates(options.max_harmonic);
+  if (!options.only.empty()) {
+    std::vector<Effect> keep;
+    for (const std::string& id : options.only) {
+      const Effect e = Effect::parse(id);
+      if (std::find(candidates.begin(), candidates.end(), e) == candidates.end())
+        throw InvalidArgument("options.only: " + id + " is not a candidate for this session");
+      keep.push_back(e);
+    }
+    candidates = keep;
+  }
+
+  ModelFit fit = P.fit(EffectModel{});
+  D.baseline_fit = fit;
+  const double n = static_cast<double>(fit.residuals.size());
+  const std::optional<double> declared = P.declared_noise_um();
+  const double noise_um = declared ? *declared : estimate_noise_um(P, fit.residuals);
+  const double sigma_mm = noise_um * 1e-3;
+  D.baseline.noise_um = noise_um;
+  D.baseline.noise_source = declared ? "declared" : "estimated from successive differences";
+  D.baseline.residual_rms_um = rms_um(fit.residuals);
+  D.baseline.n = fit.residuals.size();
+  D.baseline.dof = static_cast<int>(n) - fit.num_free;
+  const double chi2 = rss(fit.residuals) / (sigma_mm * sigma_mm);
+  D.baseline.chi2_per_dof = chi2 / D.baseline.dof;
+  D.baseline.p_value = stats::chi2_sf(chi2, D.baseline.dof);
+  D.structure_before = residual_structure(P, fit.residuals);
+
+  const std::vector<int> fold = cv_folds(P, options.cv_blocks);
+  EffectModel model;
+  std::vector<bool> done(candidates.size(), false);
+  bool first_round = true;
+  for (int step = 0; step < options.max_findings; ++step) {
+    const Eigen::MatrixXd Jfree = free_columns(fit.jacobian);
+    std::vector<Score> scores;
+    for (std::size_t c = 0; c < candidates.size(); ++c) {
+      if (done[c]) continue;
+      Score s = score(P, fit, Jfree, candidates[c], sigma_mm);
+      if (!s.observable) {
+        if (first_round) D.unobservable.push_back({candidates[c].id(), s.why_not});
+        done[c] = true;
+        continue;
+      }
+      scores.push_back(std::move(s));
+    }
+    first_round = false;
+    const double m_tests = std::max<double>(1.0, static_cast<double>(scores.size()));
+    std::vector<const Score*> passing;
+    for (const Score& s : scores)
+      if (s.f_pvalue < options.alpha / m_tests && s.delta_bic < options.min_delta_bic) passing.push_back(&s);
+    std::sort(passing.begin(), passing.end(),
+              [](const Score* a, const Score* b) { return a->delta_bic < b->delta_bic; });
+    const Score* chosen = nullptr;
+    double cv_before = 0.0, cv_after = 0.0;
+    for (const Score* s : passing) {
+      cv_before = cv_rms_um(Jfree, fit.residuals, fold, options.cv_blocks);
+      cv_after = cv_rms_um(s->X, fit.residuals, fold, options.cv_blocks);
+      if (cv_after < cv_before) {
+        chosen = s;
+        break;
+      }
+    }
+    if (!chosen) break;
+
+    // Candidates that explain the same signal about as well.
+    Ambiguity amb;
+    for (const Score* s : passing) {
+      if (s == chosen) continue;
+      const double dbic = s->delta_bic - chosen->delta_bic;
+      const double corr = std::abs(correlation(s->signature, chosen->signature));
+      if (dbic < options.ambiguity_delta_bic && corr >= options.ambiguity_correlation) {
+        if (amb.effects.empty()) amb.effects.push_back(chosen->effect.id());
+        amb.effects.push_back(s->effect.id());
+        amb.delta_bic = std::max(amb.delta_bic, dbic);
+        amb.correlation = amb.effects.size() == 2 ? corr : std::min(amb.correlation, corr);
+        amb.separating_test = separating_test(P, fit, *chosen, *s, sigma_mm);
+      }
+    }
+    if (!amb.effects.empty()) D.ambiguous.push_back(amb);
+
+    // Add it and refit the whole model (nonlinear).
+    const Effect effect = chosen->effect;
+    for (std::size_t c = 0; c < candidates.size(); ++c)
+      if (candidates[c] == effect) done[c] = true;
+    model.effects.push_back(effect);
+    const double rss_before = rss(fit.residuals);
+    const double rms_before = rms_um(fit.residuals);
+    const double f_p = chosen->f_pvalue;
+    const ModelFit before = fit;
+    fit = P.fit(model);
+    Finding F;
+    F.effect = effect;
+    F.cause = effect.cause();
+    F.gain.rms_before_um = rms_before;
+    F.gain.rms_after_um = rms_um(fit.residuals);
+    F.gain.delta_bic = n * std::log(std::max(rss(fit.residuals), 1e-300) / rss_before) +
+                       (fit.num_free - before.num_free) * std::log(n);
+    F.gain.cv_rms_before_um = cv_before;
+    F.gain.cv_rms_after_um = cv_after;
+    F.gain.f_pvalue = f_p;
+    for (const ParameterEstimate& b : before.parameters) {
+      for (const ParameterEstimate& a : fit.parameters) {
+        if (a.name != b.name || !a.observable || !b.observable) continue;
+        if (std::abs(a.value - b.value) > std::max(a.std, 1e-15))
+          F.shifts.push_back({a.name, b.value, a.value, a.std, a.unit});
+      }
+    }
+    D.findings.push_back(F);
+  }
+
+  // Effect parameters from the final fit.
+  for (Finding& F : D.findings) {
+    const std::string id = F.effect.id();
+    for (const ParameterEstimate& p : fit.parameters)
+      if (p.name == id || p.name.rfind(id + ".", 0) == 0) F.parameters.push_back(p);
+  }
+  D.final_fit = fit;
+  D.structure_after = residual_structure(P, fit.residuals);
+  const int dof = static_cast<int>(n) - fit.num_free;
+  const double chi2_final = rss(fit.residuals) / (sigma_mm * sigma_mm);
+  D.unexplained.chi2_per_dof = chi2_final / dof;
+  D.unexplained.p_value = stats::chi2_sf(chi2_final, dof);
+  D.unexplained.present = D.unexplained.p_value < 1e-3;
+  if (D.unexplained.present) D.unexplained.signature = describe_structure(D.structure_after);
+  D.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return D;
+}
+
+}  // namespace rotacal
