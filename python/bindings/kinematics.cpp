@@ -1,5 +1,6 @@
 // Bindings for include/rotacal/kinematics: thin wrappers, numpy in, numpy out.
 #include "numpy.hpp"
+#include "rotacal/kinematics/effects.hpp"
 #include "rotacal/kinematics/machine.hpp"
 
 namespace rotacal::py {
@@ -20,6 +21,20 @@ void bind_kinematics(pyb::module_& m) {
   m.def("machine_name", pyb::overload_cast<MachineType>(&to_string), pyb::arg("machine"));
   m.def("location_error_names", &location_error_names, pyb::arg("machine"),
         "ISO 230-7 names of the 8 location errors, in the order of every errors vector.");
+
+  pyb::class_<Effect>(m, "Effect", "One entry of the effects catalogue (shared/spec/effects.md).")
+      .def(pyb::init(&Effect::parse), pyb::arg("id"), "Parse a catalogue id such as 'coning_B'.")
+      .def_property_readonly("id", &Effect::id)
+      .def_property_readonly("cause", &Effect::cause)
+      .def_property_readonly("num_params", &Effect::num_params)
+      .def_property_readonly("param_names", &Effect::param_names)
+      .def_property_readonly("param_units", &Effect::param_units)
+      .def_readonly("harmonic", &Effect::harmonic)
+      .def("applies_to", &Effect::applies_to, pyb::arg("machine"))
+      .def("__repr__", [](const Effect& e) { return "Effect('" + e.id() + "')"; })
+      .def("__eq__", [](const Effect& a, const Effect& b) { return a == b; });
+  m.def("effect_catalogue", &effect_catalogue, pyb::arg("machine"), pyb::arg("max_harmonic") = 4,
+        "Every catalogue entry that applies to the machine, harmonics 1..max_harmonic.");
 
   m.def(
       "forward",

@@ -8,6 +8,8 @@ namespace pyb = pybind11;
 
 namespace rotacal::py {
 void bind_kinematics(pyb::module_& m);
+void bind_ballbar(pyb::module_& m);
+void bind_diagnose(pyb::module_& m);
 }  // namespace rotacal::py
 
 PYBIND11_MODULE(_core, m) {
@@ -20,4 +22,6 @@ PYBIND11_MODULE(_core, m) {
   pyb::register_exception<rotacal::ParseError>(m, "ParseError", error.ptr());
   pyb::register_exception<rotacal::IoError>(m, "IoError", error.ptr());
   rotacal::py::bind_kinematics(m);
+  rotacal::py::bind_ballbar(m);
+  rotacal::py::bind_diagnose(m);
 }

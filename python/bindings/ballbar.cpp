@@ -1,0 +1,137 @@
+// Bindings for include/rotacal/ballbar (model, simulation, joint fit, compensation).
+#include "numpy.hpp"
+#include "rotacal/ballbar/compensate.hpp"
+#include "rotacal/ballbar/identify.hpp"
+#include "rotacal/ballbar/simulate.hpp"
+
+namespace rotacal::py {
+
+namespace {
+EffectModel effects_of(const std::vector<std::string>& ids) {
+  EffectModel fx;
+  for (const std::string& id : ids) fx.effects.push_back(Effect::parse(id));
+  return fx;
+}
+std::vector<std::string> ids_of(const EffectModel& fx) {
+  std::vector<std::string> ids;
+  for (const Effect& e : fx.effects) ids.push_back(e.id());
+  return ids;
+}
+}  // namespace
+
+void bind_ballbar(pyb::module_& m) {
+  pyb::class_<ParameterEstimate>(m, "ParameterEstimate")
+      .def_readonly("name", &ParameterEstimate::name)
+      .def_readonly("value", &ParameterEstimate::value)
+      .def_readonly("std", &ParameterEstimate::std)
+      .def_readonly("unit", &ParameterEstimate::unit)
+      .def_readonly("observable", &ParameterEstimate::observable)
+      .def("__repr__", [](const ParameterEstimate& p) {
+        return "ParameterEstimate(" + p.name + "=" + std::to_string(p.value) + " +- " +
+               std::to_string(p.std) + " " + p.unit + (p.observable ? "" : ", unobservable") + ")";
+      });
+
+  pyb::class_<BallbarMachineModel>(m, "BallbarMachineModel",
+                                   "Location errors, actual pivot and effects of a machine.")
+      .def(pyb::init([](MachineType machine, const pyb::array_t<double, pyb::array::c_style |
+                                                                               pyb::array::forcecast>& errors,
+                        const pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>& pivot,
+                        const std::vector<std::string>& effects,
+                        const std::vector<double>& effect_params) {
+             BallbarMachineModel b;
+             b.machine = machine;
+             b.errors = LocationErrors<double>(vec_of<8>(errors, "errors"));
+             b.pivot = vec_of<3>(pivot, "pivot");
+             b.effects = effects_of(effects);
+             b.effect_params = effect_params;
+             if (static_cast<int>(b.effect_params.size()) != b.effects.num_params())
+               throw InvalidArgument("effect_params: expected " +
+                                     std::to_string(b.effects.num_params()) + " values");
+             return b;
+           }),
+           pyb::arg("machine"), pyb::arg("errors"), pyb::arg("pivot"),
+           pyb::arg("effects") = std::vector<std::string>{},
+           pyb::arg("effect_params") = std::vector<double>{})
+      .def_readonly("machine", &BallbarMachineModel::machine)
+      .def_property_readonly("errors", [](const BallbarMachineModel& b) { return Eigen::VectorXd(b.errors.v); })
+      .def_property_readonly("pivot", [](const BallbarMachineModel& b) { return Eigen::Vector3d(b.pivot); })
+      .def_property_readonly("effects", [](const BallbarMachineModel& b) { return ids_of(b.effects); })
+      .def_readonly("effect_params", &BallbarMachineModel::effect_params);
+
+  pyb::class_<BallbarIdentification>(m, "BallbarIdentification")
+      .def_readonly("method", &BallbarIdentification::method)
+      .def_readonly("model", &BallbarIdentification::model)
+      .def_readonly("parameters", &BallbarIdentification::parameters)
+      .def_readonly("covariance", &BallbarIdentification::covariance)
+      .def_property_readonly("residuals", [](const BallbarIdentification& r) {
+        return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(
+            r.residuals.data(), static_cast<Eigen::Index>(r.residuals.size())));
+      })
+      .def_readonly("residual_rms_um", &BallbarIdentification::residual_rms_um)
+      .def_readonly("sigma_um", &BallbarIdentification::sigma_um)
+      .def_readonly("n_samples", &BallbarIdentification::n_samples)
+      .def_readonly("converged", &BallbarIdentification::converged)
+      .def_readonly("iterations", &BallbarIdentification::iterations)
+      .def_readonly("unobservable", &BallbarIdentification::unobservable)
+      .def_readonly("notes", &BallbarIdentification::notes);
+
+  m.def(
+      "identify_joint",
+      [](const BallbarSession& session, bool fit_length_offset,
+         const std::vector<std::string>& effects, const std::vector<std::string>& tests) {
+        JointFitOptions o;
+        o.fit_length_offset = fit_length_offset;
+        o.effects = effects_of(effects);
+        o.tests = tests;
+        pyb::gil_scoped_release release;
+        return identify_joint(session, o);
+      },
+      pyb::arg("session"), pyb::arg("fit_length_offset") = false,
+      pyb::arg("effects") = std::vector<std::string>{}, pyb::arg("tests") = std::vector<std::string>{},
+      "Joint Ceres fit of the 8 location errors and the actual pivot to every sample.");
+
+  m.def(
+      "simulate_ballbar",
+      [](const BallbarSession& commanded, const BallbarMachineModel& truth, double noise_um,
+         std::uint64_t seed, bool declare_noise) {
+        return simulate_ballbar(commanded, truth, {noise_um, seed, declare_noise});
+      },
+      pyb::arg("commanded"), pyb::arg("truth"), pyb::arg("noise_um") = 0.5, pyb::arg("seed") = 1,
+      pyb::arg("declare_noise") = true,
+      "The session as the machine `truth` would measure it (lengths filled in, Gaussian noise).");
+
+  m.def(
+      "predict_session_lengths",
+      [](const BallbarMachineModel& model, const BallbarSession& s) {
+        const std::vector<double> L = predict_lengths(model, s.samples);
+        return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(L.data(), static_cast<Eigen::Index>(L.size())));
+      },
+      pyb::arg("model"), pyb::arg("session"),
+      "Predicted centre-to-centre lengths (mm) of every sample of the session on the model.");
+
+  m.def("compensate_commands", &compensate_commands, pyb::arg("nominal"), pyb::arg("identified"),
+        pyb::arg("machine"));
+
+  pyb::class_<CompensationRow>(m, "CompensationRow")
+      .def_readonly("name", &CompensationRow::name)
+      .def_readonly("unit", &CompensationRow::unit)
+      .def_readonly("before", &CompensationRow::before)
+      .def_readonly("after", &CompensationRow::after)
+      .def_readonly("std_after", &CompensationRow::std_after)
+      .def_readonly("change_percent", &CompensationRow::change_percent);
+  pyb::class_<CompensationReport>(m, "CompensationReport")
+      .def_readonly("rows", &CompensationReport::rows)
+      .def_readonly("before", &CompensationReport::before)
+      .def_readonly("after", &CompensationReport::after);
+  m.def(
+      "verify_compensation",
+      [](const BallbarSession& commanded, const BallbarMachineModel& truth, double noise_um,
+         std::uint64_t seed) {
+        pyb::gil_scoped_release release;
+        return verify_compensation(commanded, truth, {noise_um, seed, true});
+      },
+      pyb::arg("commanded"), pyb::arg("truth"), pyb::arg("noise_um") = 0.5, pyb::arg("seed") = 1,
+      "Measure, identify, compensate, measure again, identify again (Flynn et al., Table 2).");
+}
+
+}  // namespace rotacal::py

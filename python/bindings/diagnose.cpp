@@ -1,0 +1,112 @@
+// Bindings for include/rotacal/diagnose.
+#include "numpy.hpp"
+#include "rotacal/diagnose/ballbar_diagnosis.hpp"
+
+namespace rotacal::py {
+
+void bind_diagnose(pyb::module_& m) {
+  pyb::class_<DiagnosisOptions>(m, "DiagnosisOptions")
+      .def(pyb::init<>())
+      .def_readwrite("max_harmonic", &DiagnosisOptions::max_harmonic)
+      .def_readwrite("max_findings", &DiagnosisOptions::max_findings)
+      .def_readwrite("alpha", &DiagnosisOptions::alpha)
+      .def_readwrite("min_delta_bic", &DiagnosisOptions::min_delta_bic)
+      .def_readwrite("cv_blocks", &DiagnosisOptions::cv_blocks)
+      .def_readwrite("only", &DiagnosisOptions::only);
+
+  pyb::class_<ModelFit>(m, "ModelFit")
+      .def_property_readonly("effects",
+                             [](const ModelFit& f) {
+                               std::vector<std::string> ids;
+                               for (const Effect& e : f.effects.effects) ids.push_back(e.id());
+                               return ids;
+                             })
+      .def_readonly("parameters", &ModelFit::parameters)
+      .def_readonly("residuals", &ModelFit::residuals)
+      .def_readonly("num_free", &ModelFit::num_free);
+
+  pyb::class_<GroupResidual>(m, "GroupResidual")
+      .def_readonly("group", &GroupResidual::group)
+      .def_readonly("n", &GroupResidual::n)
+      .def_readonly("rms_um", &GroupResidual::rms_um)
+      .def_readonly("mean_um", &GroupResidual::mean_um)
+      .def_property_readonly("angle_axis", [](const GroupResidual& g) {
+        return g.angle_axis ? std::string(1, g.angle_axis) : std::string();
+      })
+      .def_readonly("harmonic_um", &GroupResidual::harmonic_um)
+      .def_readonly("trend_um_per_s", &GroupResidual::trend_um_per_s);
+
+  pyb::class_<Gain>(m, "Gain")
+      .def_readonly("rms_before_um", &Gain::rms_before_um)
+      .def_readonly("rms_after_um", &Gain::rms_after_um)
+      .def_readonly("delta_bic", &Gain::delta_bic)
+      .def_readonly("cv_rms_before_um", &Gain::cv_rms_before_um)
+      .def_readonly("cv_rms_after_um", &Gain::cv_rms_after_um)
+      .def_readonly("f_pvalue", &Gain::f_pvalue);
+
+  pyb::class_<Finding::Shift>(m, "ParameterShift")
+      .def_readonly("name", &Finding::Shift::name)
+      .def_readonly("before", &Finding::Shift::before)
+      .def_readonly("after", &Finding::Shift::after)
+      .def_readonly("std_after", &Finding::Shift::std_after)
+      .def_readonly("unit", &Finding::Shift::unit);
+
+  pyb::class_<Finding>(m, "Finding")
+      .def_property_readonly("effect", [](const Finding& f) { return f.effect.id(); })
+      .def_readonly("cause", &Finding::cause)
+      .def_readonly("parameters", &Finding::parameters)
+      .def_readonly("gain", &Finding::gain)
+      .def_readonly("shifts", &Finding::shifts);
+
+  pyb::class_<Ambiguity>(m, "Ambiguity")
+      .def_readonly("effects", &Ambiguity::effects)
+      .def_readonly("delta_bic", &Ambiguity::delta_bic)
+      .def_readonly("correlation", &Ambiguity::correlation)
+      .def_readonly("separating_test", &Ambiguity::separating_test);
+
+  pyb::class_<UnobservableEffect>(m, "UnobservableEffect")
+      .def_readonly("effect", &UnobservableEffect::effect)
+      .def_readonly("reason", &UnobservableEffect::reason);
+
+  pyb::class_<Unexplained>(m, "Unexplained")
+      .def_readonly("present", &Unexplained::present)
+      .def_readonly("chi2_per_dof", &Unexplained::chi2_per_dof)
+      .def_readonly("p_value", &Unexplained::p_value)
+      .def_readonly("signature", &Unexplained::signature);
+
+  pyb::class_<Diagnosis::Baseline>(m, "DiagnosisBaseline")
+      .def_readonly("residual_rms_um", &Diagnosis::Baseline::residual_rms_um)
+      .def_readonly("noise_um", &Diagnosis::Baseline::noise_um)
+      .def_readonly("noise_source", &Diagnosis::Baseline::noise_source)
+      .def_readonly("chi2_per_dof", &Diagnosis::Baseline::chi2_per_dof)
+      .def_readonly("p_value", &Diagnosis::Baseline::p_value)
+      .def_readonly("n", &Diagnosis::Baseline::n)
+      .def_readonly("dof", &Diagnosis::Baseline::dof);
+
+  pyb::class_<Diagnosis>(m, "Diagnosis")
+      .def_readonly("machine", &Diagnosis::machine)
+      .def_readonly("baseline", &Diagnosis::baseline)
+      .def_readonly("structure_before", &Diagnosis::structure_before)
+      .def_readonly("structure_after", &Diagnosis::structure_after)
+      .def_readonly("findings", &Diagnosis::findings)
+      .def_readonly("ambiguous", &Diagnosis::ambiguous)
+      .def_readonly("unobservable", &Diagnosis::unobservable)
+      .def_readonly("unexplained", &Diagnosis::unexplained)
+      .def_readonly("baseline_fit", &Diagnosis::baseline_fit)
+      .def_readonly("final_fit", &Diagnosis::final_fit)
+      .def_readonly("seconds", &Diagnosis::seconds);
+
+  m.def(
+      "diagnose_ballbar",
+      [](const BallbarSession& session, const DiagnosisOptions& options,
+         const std::optional<BallbarSession>& reference) {
+        pyb::gil_scoped_release release;
+        return diagnose_ballbar(session, options, reference.value_or(BallbarSession{}));
+      },
+      pyb::arg("session"), pyb::arg("options") = DiagnosisOptions{},
+      pyb::arg("reference") = std::nullopt,
+      "Diagnose a ballbar session: baseline fit, residual structure, catalogue candidates, "
+      "findings with their gain.");
+}
+
+}  // namespace rotacal::py
