@@ -43,12 +43,23 @@ Eigen::VectorXd solve_ls(const Eigen::MatrixXd& X, const Eigen::VectorXd& y) {
   return (qr.solve(y)).cwiseQuotient(s);
 }
 
-// Orthogonal projection of the columns of C onto the complement of span(J).
-Eigen::MatrixXd project_out(const Eigen::MatrixXd& J, const Eigen::MatrixXd& C) {
-  if (J.cols() == 0) return C;
-  Eigen::MatrixXd out = C;
-  for (Eigen::Index k = 0; k < C.cols(); ++k) out.col(k) -= J * solve_ls(J, C.col(k));
-  return out;
+// Orthonormal basis of span(J) (rank-revealing), computed once per model and reused for
+// every candidate's projection.
+Eigen::MatrixXd orthonormal_basis(const Eigen::MatrixXd& J) {
+  if (J.cols() == 0) return Eigen::MatrixXd(J.rows(), 0);
+  Eigen::VectorXd s = J.colwise().norm().transpose();
+  for (Eigen::Index j = 0; j < s.size(); ++j)
+    if (!(s[j] > 0.0)) s[j] = 1.0;
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(J * s.cwiseInverse().asDiagonal());
+  qr.setThreshold(1e-9);
+  const Eigen::Index r = qr.rank();
+  Eigen::MatrixXd Q = Eigen::MatrixXd::Identity(J.rows(), r);
+  return qr.householderQ() * Q;
+}
+
+// Columns of C with their component in span(Q) removed (Q orthonormal).
+Eigen::MatrixXd project_out(const Eigen::MatrixXd& Q, const Eigen::MatrixXd& C) {
+  return C - Q * (Q.transpose() * C);
 }
 
 // Free (non-zero) columns of a fit's Jacobian.
@@ -117,13 +128,13 @@ struct Score {
 };
 
 Score score(const DiagnosisProblem& P, const ModelFit& fit, const Eigen::MatrixXd& Jfree,
-            const Effect& c, double sigma_mm) {
+            const Eigen::MatrixXd& Q, const Effect& c, double sigma_mm) {
   Score s;
   s.effect = c;
   const Eigen::MatrixXd Jc = P.candidate_jacobian(fit, c);
   const Eigen::VectorXd m = magnitudes(c);
   const Eigen::MatrixXd raw = Jc * m.asDiagonal() / sigma_mm;
-  const Eigen::MatrixXd perp = project_out(Jfree, Jc) * m.asDiagonal() / sigma_mm;
+  const Eigen::MatrixXd perp = project_out(Q, Jc) * m.asDiagonal() / sigma_mm;
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(perp, Eigen::ComputeThinV);
   const Eigen::VectorXd sv = svd.singularValues();
   std::vector<Eigen::Index> dirs;
@@ -324,10 +335,11 @@ Diagnosis diagnose(const DiagnosisProblem& P, const DiagnosisOptions& options) {
   bool first_round = true;
   for (int step = 0; step < options.max_findings; ++step) {
     const Eigen::MatrixXd Jfree = free_columns(fit.jacobian);
+    const Eigen::MatrixXd Q = orthonormal_basis(Jfree);
     std::vector<Score> scores;
     for (std::size_t c = 0; c < candidates.size(); ++c) {
       if (done[c]) continue;
-      Score s = score(P, fit, Jfree, candidates[c], sigma_mm);
+      Score s = score(P, fit, Jfree, Q, candidates[c], sigma_mm);
       if (!s.observable) {
         if (first_round) D.unobservable.push_back({candidates[c].id(), s.why_not});
         done[c] = true;

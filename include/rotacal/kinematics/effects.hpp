@@ -19,6 +19,7 @@
 /// ../shared/data/rtest_bc_oyama.csv (0.31 um residual RMS for 0.3 um noise; applying it in
 /// the B turning frame instead leaves 8-14 um).
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -110,9 +111,10 @@ void walk_table_stages(MachineType m, const LocationErrors<Scalar>& e, const Eff
   using std::sin;
   const char tilt_axis = tilt_axis_letter(m);
   Scalar tilt(cmd.tilt), rot(cmd.rot);
-  Pose<Scalar> E_T, E_C, K;
-  bool has_E_T = false, has_E_C = false, has_K = false, has_D = false;
-  Vec3<Scalar> D = Vec3<Scalar>::Zero();
+  // Error motions, coning and translations exist only when an effect asks for them (most
+  // fits have none, and identity Jets are not free).
+  std::optional<Pose<Scalar>> E_T, E_C, K;
+  std::optional<Vec3<Scalar>> D;
   for (std::size_t i = 0; i < fx.effects.size(); ++i) {
     const Effect& f = fx.effects[i];
     const Scalar* q = p + fx.offset(i);
@@ -129,8 +131,9 @@ void walk_table_stages(MachineType m, const LocationErrors<Scalar>& e, const Eff
       case EffectKind::radial_motion:
       case EffectKind::axial_motion:
       case EffectKind::tilt_motion: {
-        Pose<Scalar>& E = on_c ? E_C : E_T;
-        (on_c ? has_E_C : has_E_T) = true;
+        std::optional<Pose<Scalar>>& Eo = on_c ? E_C : E_T;
+        if (!Eo) Eo.emplace();
+        Pose<Scalar>& E = *Eo;
         const int k = detail::axis_index(f.axis), i1 = (k + 1) % 3, i2 = (k + 2) % 3;
         if (f.kind == EffectKind::radial_motion) {
           E.t[i1] += q[0] * c + q[1] * s;
@@ -146,30 +149,30 @@ void walk_table_stages(MachineType m, const LocationErrors<Scalar>& e, const Eff
         break;
       }
       case EffectKind::gravity_sag:
-        D.z() -= q[0] * (Scalar(1) - cos(Scalar(cmd.tilt)));
-        has_D = true;
+        if (!D) D = Vec3<Scalar>::Zero();
+        D->z() -= q[0] * (Scalar(1) - cos(Scalar(cmd.tilt)));
         break;
       case EffectKind::coning:
-        K.R = rotation_about_axis<Scalar>(
-                  tilt_axis == 'B' ? Vec3<Scalar>::UnitX() : Vec3<Scalar>::UnitY(),
-                  q[0] * Scalar(cmd.tilt)) *
-              K.R;
-        has_K = true;
+        if (!K) K.emplace();
+        K->R = rotation_about_axis<Scalar>(
+                   tilt_axis == 'B' ? Vec3<Scalar>::UnitX() : Vec3<Scalar>::UnitY(),
+                   q[0] * Scalar(cmd.tilt)) *
+               K->R;
         break;
       case EffectKind::thermal_drift:
-        D[detail::axis_index(f.axis)] += q[0] * Scalar(t);
-        has_D = true;
+        if (!D) D = Vec3<Scalar>::Zero();
+        (*D)[detail::axis_index(f.axis)] += q[0] * Scalar(t);
         break;
       default:  // tool-side and instrument effects do not move the table
         break;
     }
   }
-  if (has_E_C) acc.rigid(E_C);
+  if (E_C) acc.rigid(*E_C);
   acc.about_line(c_axis_line(m, e), rot);
-  if (has_E_T) acc.rigid(E_T);
+  if (E_T) acc.rigid(*E_T);
   acc.about_line(tilt_axis_line(m, e), tilt);
-  if (has_K) acc.rigid(K);
-  if (has_D) acc.translate(D);
+  if (K) acc.rigid(*K);
+  if (D) acc.translate(*D);
 }
 
 namespace detail {
