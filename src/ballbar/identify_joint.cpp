@@ -24,17 +24,32 @@ struct BallbarLengthResidual {
                         double inv_sigma)
       : machine_(m), sample_(s), effects_(fx), inv_sigma_(inv_sigma) {}
 
+  // With effects: blocks (errors, pivot, effect parameters), sizes known at run time.
   template <typename T>
   bool operator()(T const* const* p, T* residual) const {
-    const LocationErrors<T> e = LocationErrors<T>::from_ptr(p[0]);
-    const Vec3<T> pivot(p[1][0], p[1][1], p[1][2]);
-    const T L = predicted_length<T>(machine_, e, pivot, effects_, p[2], sample_);
+    return (*this)(p[0], p[1], p[2], residual);
+  }
+
+  // Without effects (the usual case): fixed sizes, so Ceres uses Jet<double, 11>.
+  template <typename T>
+  bool operator()(const T* errors, const T* pivot, T* residual) const {
+    return (*this)(errors, pivot, static_cast<const T*>(nullptr), residual);
+  }
+
+  template <typename T>
+  bool operator()(const T* errors, const T* pivot_ptr, const T* effect_params, T* residual) const {
+    const LocationErrors<T> e = LocationErrors<T>::from_ptr(errors);
+    const Vec3<T> pivot(pivot_ptr[0], pivot_ptr[1], pivot_ptr[2]);
+    const T L = predicted_length<T>(machine_, e, pivot, effects_, effect_params, sample_);
     residual[0] = (L - T(sample_.length)) * T(inv_sigma_);
     return true;
   }
 
   static ceres::CostFunction* Create(MachineType m, const BallbarSample& s, const EffectModel& fx,
                                      double inv_sigma, int n_effect_params) {
+    if (fx.effects.empty())
+      return new ceres::AutoDiffCostFunction<BallbarLengthResidual, 1, 8, 3>(
+          new BallbarLengthResidual(m, s, fx, inv_sigma));
     auto* cost = new ceres::DynamicAutoDiffCostFunction<BallbarLengthResidual, 16>(
         new BallbarLengthResidual(m, s, fx, inv_sigma));
     cost->AddParameterBlock(8);
@@ -87,9 +102,11 @@ BallbarIdentification identify_joint(const BallbarSession& session,
   for (std::size_t i : used) {
     ceres::CostFunction* cost = BallbarLengthResidual::Create(
         session.machine, session.samples[i], fx, 1.0 / sigma_mm, static_cast<int>(fxp.size()));
-    problem.AddResidualBlock(cost, nullptr, {e.data(), pivot.data(), fxp.data()});
+    if (P == 0)
+      problem.AddResidualBlock(cost, nullptr, e.data(), pivot.data());
+    else
+      problem.AddResidualBlock(cost, nullptr, {e.data(), pivot.data(), fxp.data()});
   }
-  if (P == 0) problem.SetParameterBlockConstant(fxp.data());
 
   // Names and units of the unknowns, in Jacobian column order.
   std::vector<std::string> names, units;
@@ -103,7 +120,8 @@ BallbarIdentification identify_joint(const BallbarSession& session,
     for (std::size_t k = 0; k < pn.size(); ++k)
       names.push_back(f.id() + (pn.size() > 1 ? "." + pn[k] : "")), units.push_back(pu[k]);
   }
-  const std::vector<double*> blocks = {e.data(), pivot.data(), fxp.data()};
+  std::vector<double*> blocks = {e.data(), pivot.data()};
+  if (P > 0) blocks.push_back(fxp.data());
 
   // Observability at the start point (the model is nearly linear over um-sized errors): fix
   // one parameter per invisible combination so the solver does not wander along it.
