@@ -1,0 +1,84 @@
+#pragma once
+/// \file
+/// `rotacal-ballbar/1` and `rotacal-rtest/1` files (../shared/spec/formats.md): strict readers
+/// whose errors name file, line, column and what is wrong; writers whose output reads back
+/// bit-identical (shortest round-trip decimal for every double); appending writers for
+/// recorders, which flush every row so a crash never loses what was already read.
+
+#include <cstdio>
+#include <istream>
+#include <string>
+#include <variant>
+
+#include "rotacal/io/session.hpp"
+
+namespace rotacal {
+
+/// Read a ballbar session; throws ParseError (file, line, column, what) or IoError.
+BallbarSession read_ballbar(const std::string& path);
+/// Parse a ballbar session from a stream; `name` is used in error messages.
+BallbarSession parse_ballbar(std::istream& in, const std::string& name);
+/// Write a ballbar session (to a temporary file, then renamed over `path`); throws IoError
+/// naming the path, InvalidArgument for a session that breaks the format.
+void write_ballbar(const BallbarSession& session, const std::string& path);
+/// The file text of a session.
+std::string format_ballbar(const BallbarSession& session);
+
+RtestSession read_rtest(const std::string& path);
+RtestSession parse_rtest(std::istream& in, const std::string& name);
+void write_rtest(const RtestSession& session, const std::string& path);
+std::string format_rtest(const RtestSession& session);
+
+/// Either kind of session, chosen by the file's `# format:` line.
+using AnySession = std::variant<BallbarSession, RtestSession>;
+AnySession read_session(const std::string& path);
+
+/// Appending writer for recorders: writes the metadata and header at once, then one row per
+/// append(), flushed to the operating system before append() returns.
+class BallbarWriter {
+ public:
+  /// `header` supplies machine, metadata and extra columns; its samples are not written.
+  BallbarWriter(const std::string& path, const BallbarSession& header);
+  ~BallbarWriter();
+  BallbarWriter(const BallbarWriter&) = delete;
+  BallbarWriter& operator=(const BallbarWriter&) = delete;
+  void append(const BallbarSample& sample);
+  /// A `# text` line at this point of the file (e.g. a gap marker).
+  void annotate(const std::string& text);
+  std::size_t rows() const { return rows_; }
+  void close();
+
+ private:
+  std::FILE* file_ = nullptr;
+  std::string path_;
+  std::size_t columns_ = 0;
+  std::size_t rows_ = 0;
+  double last_time_ = -1e300;
+};
+
+class RtestWriter {
+ public:
+  /// `header` supplies machine, nests, probe directions and metadata; `raw` selects d1,d2,d3
+  /// columns (probe readings) instead of dx,dy,dz.
+  RtestWriter(const std::string& path, const RtestSession& header, bool raw);
+  ~RtestWriter();
+  RtestWriter(const RtestWriter&) = delete;
+  RtestWriter& operator=(const RtestWriter&) = delete;
+  void append(const RtestSample& sample);
+  void annotate(const std::string& text);
+  std::size_t rows() const { return rows_; }
+  void close();
+
+ private:
+  std::FILE* file_ = nullptr;
+  std::string path_;
+  bool raw_ = false;
+  std::size_t extra_ = 0;
+  std::size_t rows_ = 0;
+  double last_time_ = -1e300;
+};
+
+/// Shortest decimal text that reads back as exactly `v`.
+std::string format_number(double v);
+
+}  // namespace rotacal

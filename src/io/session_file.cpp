@@ -1,0 +1,612 @@
+#include <algorithm>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "rotacal/io/ballbar_file.hpp"
+
+namespace rotacal {
+
+namespace {
+
+const char* kBallbarFormat = "rotacal-ballbar/1";
+const char* kRtestFormat = "rotacal-rtest/1";
+
+std::string trim(const std::string& s) {
+  const auto a = s.find_first_not_of(" \t\r");
+  if (a == std::string::npos) return "";
+  const auto b = s.find_last_not_of(" \t\r");
+  return s.substr(a, b - a + 1);
+}
+
+// One field of a data row, with its 1-based character column for error messages.
+struct Field {
+  std::string text;
+  int column = 1;
+};
+
+std::vector<Field> split_fields(const std::string& line) {
+  std::vector<Field> out;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = line.find(',', start);
+    const std::string raw = line.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    const std::size_t lead = raw.find_first_not_of(" \t");
+    out.push_back({trim(raw), static_cast<int>(start + (lead == std::string::npos ? 0 : lead)) + 1});
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return out;
+}
+
+// The parse state shared by both formats: file name, line number, metadata, header.
+struct Reader {
+  std::string name;
+  int line_no = 0;
+  Metadata metadata;
+  std::vector<std::string> header;
+  int header_line = 0;
+
+  [[noreturn]] void fail(int line, int column, const std::string& what) const {
+    throw ParseError(name, line, column, what);
+  }
+
+  double number(const Field& f, const std::string& what) const {
+    double v = 0.0;
+    const char* b = f.text.data();
+    const char* e = b + f.text.size();
+    const auto r = std::from_chars(b, e, v);
+    if (f.text.empty()) fail(line_no, f.column, what + " is empty");
+    if (r.ec != std::errc() || r.ptr != e)
+      fail(line_no, f.column, what + ": '" + f.text + "' is not a number");
+    if (!std::isfinite(v)) fail(line_no, f.column, what + " is " + f.text + " (must be finite)");
+    return v;
+  }
+
+  const std::string* meta(const std::string& key) const {
+    for (const auto& kv : metadata)
+      if (kv.first == key) return &kv.second;
+    return nullptr;
+  }
+
+  int meta_line(const std::string& key) const {
+    for (std::size_t i = 0; i < metadata.size(); ++i)
+      if (metadata[i].first == key) return meta_lines[i];
+    return 0;
+  }
+
+  double meta_number(const std::string& key, const std::string& value) const {
+    Field f{trim(value), 0};
+    Reader copy = *this;
+    copy.line_no = meta_line(key);
+    return copy.number(f, "metadata '" + key + "'");
+  }
+
+  Eigen::Vector3d meta_vector(const std::string& key, const std::string& value) const {
+    const std::vector<Field> parts = split_fields(value);
+    if (parts.size() != 3)
+      fail(meta_line(key), 0, "metadata '" + key + "' must be three numbers 'x, y, z', got '" + value + "'");
+    Eigen::Vector3d v;
+    for (int k = 0; k < 3; ++k) v[k] = meta_number(key, parts[static_cast<std::size_t>(k)].text);
+    return v;
+  }
+
+  std::vector<int> meta_lines;
+};
+
+// Reads metadata up to and including the column header; returns the rows that follow as
+// (line number, text), with `#` lines after the header returned as annotations.
+struct RawFile {
+  std::vector<std::pair<int, std::string>> rows;
+  std::vector<std::pair<std::size_t, std::string>> annotations;  // before row index
+};
+
+RawFile read_structure(std::istream& in, Reader& R, const char* expected_format) {
+  RawFile out;
+  std::string line;
+  bool format_seen = false;
+  bool any = false;
+  while (std::getline(in, line)) {
+    ++R.line_no;
+    const std::string t = trim(line);
+    if (t.empty()) continue;
+    any = true;
+    if (t[0] == '#') {
+      const std::string body = trim(t.substr(1));
+      if (!R.header.empty()) {
+        out.annotations.emplace_back(out.rows.size(), body);
+        continue;
+      }
+      const auto colon = body.find(':');
+      if (colon == std::string::npos) {
+        if (!format_seen) R.fail(R.line_no, 1, std::string("first line must be '# format: ") + expected_format + "'");
+        out.annotations.emplace_back(0, body);  // a comment before the header: kept
+        continue;
+      }
+      const std::string key = trim(body.substr(0, colon));
+      const std::string value = trim(body.substr(colon + 1));
+      if (!format_seen) {
+        if (key != "format")
+          R.fail(R.line_no, 1, std::string("first line must be '# format: ") + expected_format + "', got '" + t + "'");
+        if (value != expected_format)
+          R.fail(R.line_no, static_cast<int>(line.find(value)) + 1,
+                 "format '" + value + "' is not " + expected_format);
+        format_seen = true;
+      }
+      for (const auto& kv : R.metadata)
+        if (kv.first == key) R.fail(R.line_no, 1, "metadata key '" + key + "' appears twice");
+      R.metadata.emplace_back(key, value);
+      R.meta_lines.push_back(R.line_no);
+      continue;
+    }
+    if (!format_seen)
+      R.fail(R.line_no, 1, std::string("first line must be '# format: ") + expected_format + "'");
+    if (R.header.empty()) {
+      for (const Field& f : split_fields(line)) {
+        if (f.text.empty()) R.fail(R.line_no, f.column, "empty column name in the header");
+        if (std::find(R.header.begin(), R.header.end(), f.text) != R.header.end())
+          R.fail(R.line_no, f.column, "column '" + f.text + "' appears twice");
+        R.header.push_back(f.text);
+      }
+      R.header_line = R.line_no;
+      continue;
+    }
+    out.rows.emplace_back(R.line_no, line);
+  }
+  if (!any) R.fail(0, 0, "empty file");
+  if (R.header.empty()) R.fail(R.line_no, 0, "no column header line");
+  if (out.rows.empty()) R.fail(R.line_no, 0, "no data rows after the header");
+  return out;
+}
+
+int column_index(const Reader& R, const std::string& name, bool required) {
+  const auto it = std::find(R.header.begin(), R.header.end(), name);
+  if (it == R.header.end()) {
+    if (required) R.fail(R.header_line, 0, "missing required column '" + name + "'");
+    return -1;
+  }
+  return static_cast<int>(it - R.header.begin());
+}
+
+MachineType read_machine(const Reader& R) {
+  const std::string* m = R.meta("machine");
+  if (!m) R.fail(0, 0, "missing metadata 'machine' (AC-trt or BC-trt)");
+  try {
+    return parse_machine_type(*m);
+  } catch (const InvalidArgument&) {
+    R.fail(R.meta_line("machine"), 0, "unknown machine '" + *m + "' (known: AC-trt, BC-trt)");
+  }
+}
+
+void check_units(const Reader& R) {
+  const std::string* u = R.meta("units");
+  if (!u) return;
+  std::string compact;
+  for (char c : *u)
+    if (c != ' ') compact += c;
+  if (compact != "mm,deg,s")
+    R.fail(R.meta_line("units"), 0, "units '" + *u + "' are not supported (must be 'mm, deg, s')");
+}
+
+std::optional<double> read_noise(const Reader& R) {
+  const std::string* n = R.meta("noise_um");
+  if (!n) return std::nullopt;
+  const double v = R.meta_number("noise_um", *n);
+  if (!(v > 0.0)) R.fail(R.meta_line("noise_um"), 0, "noise_um must be > 0, got " + *n);
+  return v;
+}
+
+// Rotary columns must be named after the machine's axes.
+void check_rotary_columns(const Reader& R, MachineType m) {
+  const std::string tilt(1, tilt_axis_letter(m));
+  const std::string other = m == MachineType::AC_trt ? "B" : "A";
+  if (std::find(R.header.begin(), R.header.end(), other) != R.header.end())
+    R.fail(R.header_line, 0, "column '" + other + "' does not belong to a " + to_string(m) +
+                                 " machine (rotary columns are " + tilt + ", C)");
+}
+
+std::vector<Field> row_fields(Reader& R, const std::pair<int, std::string>& row) {
+  R.line_no = row.first;
+  std::vector<Field> f = split_fields(row.second);
+  if (f.size() != R.header.size())
+    R.fail(row.first, 0, "expected " + std::to_string(R.header.size()) + " fields as in the header, got " +
+                             std::to_string(f.size()));
+  return f;
+}
+
+void check_time(Reader& R, const Field& f, double t, double& last) {
+  if (t < last)
+    R.fail(R.line_no, f.column, "time " + f.text + " is before the previous row's (time must not decrease)");
+  last = t;
+}
+
+std::vector<Annotation> annotations_of(const RawFile& raw) {
+  std::vector<Annotation> out;
+  for (const auto& a : raw.annotations) out.push_back({a.first, a.second});
+  return out;
+}
+
+std::ifstream open_for_reading(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw IoError(path + ": cannot open for reading: " + std::strerror(errno));
+  return in;
+}
+
+void write_atomically(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".tmp";
+  std::FILE* f = std::fopen(tmp.c_str(), "wb");
+  if (!f) throw IoError(path + ": cannot open for writing: " + std::strerror(errno));
+  const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size() && std::fflush(f) == 0;
+  const bool closed = std::fclose(f) == 0;
+  if (!ok || !closed) {
+    std::remove(tmp.c_str());
+    throw IoError(path + ": write failed: " + std::strerror(errno));
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    throw IoError(path + ": cannot replace: " + std::strerror(errno));
+  }
+}
+
+std::string vec_text(const Eigen::Vector3d& v) {
+  return format_number(v.x()) + ", " + format_number(v.y()) + ", " + format_number(v.z());
+}
+
+bool is_known_ballbar_key(const std::string& k) {
+  return k == "format" || k == "machine" || k == "units" || k == "ballbar_length" || k == "pivot" ||
+         k == "noise_um";
+}
+
+bool is_known_rtest_key(const std::string& k) {
+  return k == "format" || k == "machine" || k == "units" || k == "noise_um" || k.rfind("nest.", 0) == 0 ||
+         (k.rfind("probe.", 0) == 0 && k.size() > 4 && k.compare(k.size() - 4, 4, ".dir") == 0);
+}
+
+std::string ballbar_head(const BallbarSession& s) {
+  std::string out = std::string("# format: ") + kBallbarFormat + "\n";
+  out += "# machine: " + to_string(s.machine) + "\n# units: mm, deg, s\n";
+  out += "# ballbar_length: " + format_number(s.ballbar_length) + "\n";
+  out += "# pivot: " + vec_text(s.pivot) + "\n";
+  if (s.noise_um) out += "# noise_um: " + format_number(*s.noise_um) + "\n";
+  for (const auto& kv : s.metadata)
+    if (!is_known_ballbar_key(kv.first)) out += "# " + kv.first + ": " + kv.second + "\n";
+  const char T = tilt_axis_letter(s.machine);
+  out += std::string("test,time,X,Y,Z,") + T + ",C,length";
+  for (const std::string& c : s.extra_columns) out += "," + c;
+  return out + "\n";
+}
+
+void check_label(const std::string& label, const char* what) {
+  if (label.empty() || label.find_first_of(",\n\r#") != std::string::npos || trim(label) != label)
+    throw InvalidArgument(std::string(what) + " '" + label +
+                          "' cannot be written (empty, or contains a comma, '#', newline or edge spaces)");
+}
+
+std::string ballbar_row(const BallbarSample& r, std::size_t extra) {
+  check_label(r.test, "test label");
+  if (r.extra.size() != extra)
+    throw InvalidArgument("sample has " + std::to_string(r.extra.size()) + " extra values for " +
+                          std::to_string(extra) + " extra columns");
+  std::string out = r.test + "," + format_number(r.time) + "," + format_number(r.xyz.x()) + "," +
+                    format_number(r.xyz.y()) + "," + format_number(r.xyz.z()) + "," +
+                    format_number(r.tilt_deg) + "," + format_number(r.rot_deg) + "," +
+                    format_number(r.length);
+  for (const std::string& e : r.extra) out += "," + e;
+  return out + "\n";
+}
+
+// Which displacement columns an R-test file carries.
+struct RtestColumns {
+  bool d = true;     // dx,dy,dz
+  bool raw = false;  // d1,d2,d3
+};
+
+std::string rtest_head(const RtestSession& s, RtestColumns cols) {
+  std::string out = std::string("# format: ") + kRtestFormat + "\n";
+  out += "# machine: " + to_string(s.machine) + "\n# units: mm, deg, s\n";
+  for (const auto& n : s.nests) out += "# nest." + n.first + ": " + vec_text(n.second) + "\n";
+  for (const auto& p : s.probe_dirs)
+    out += "# probe." + std::to_string(p.first) + ".dir: " + vec_text(p.second) + "\n";
+  if (s.noise_um) out += "# noise_um: " + format_number(*s.noise_um) + "\n";
+  for (const auto& kv : s.metadata)
+    if (!is_known_rtest_key(kv.first)) out += "# " + kv.first + ": " + kv.second + "\n";
+  const char T = tilt_axis_letter(s.machine);
+  out += std::string("setup,time,") + T + ",C,X,Y,Z";
+  if (cols.d) out += ",dx,dy,dz";
+  if (cols.raw) out += ",d1,d2,d3";
+  for (const std::string& c : s.extra_columns) out += "," + c;
+  return out + "\n";
+}
+
+std::string rtest_row(const RtestSample& r, RtestColumns cols, std::size_t extra) {
+  check_label(r.setup, "setup label");
+  if (r.extra.size() != extra) throw InvalidArgument("R-test sample: wrong number of extra values");
+  std::string out = r.setup + "," + format_number(r.time) + "," + format_number(r.tilt_deg) + "," +
+                    format_number(r.rot_deg) + "," + format_number(r.xyz.x()) + "," +
+                    format_number(r.xyz.y()) + "," + format_number(r.xyz.z());
+  auto add = [&](const std::optional<Eigen::Vector3d>& v, const char* names) {
+    if (!v)
+      throw InvalidArgument(std::string("R-test sample at time ") + format_number(r.time) + " has no " +
+                            names + " values");
+    out += "," + format_number(v->x()) + "," + format_number(v->y()) + "," + format_number(v->z());
+  };
+  if (cols.d) add(r.d, "dx,dy,dz");
+  if (cols.raw) add(r.raw, "d1,d2,d3");
+  for (const std::string& e : r.extra) out += "," + e;
+  return out + "\n";
+}
+
+template <typename Sample, typename RowFn>
+std::string with_annotations(const std::vector<Sample>& samples,
+                             const std::vector<Annotation>& annotations, RowFn row) {
+  std::string out;
+  std::size_t a = 0;
+  for (std::size_t i = 0; i <= samples.size(); ++i) {
+    for (; a < annotations.size() && annotations[a].before_sample <= i; ++a)
+      out += "# " + annotations[a].text + "\n";
+    if (i < samples.size()) out += row(samples[i]);
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string format_number(double v) {
+  if (!std::isfinite(v)) throw InvalidArgument("cannot write a non-finite number to a session file");
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof(buf), v);
+  ROTACAL_ASSERT(r.ec == std::errc());
+  return std::string(buf, r.ptr);
+}
+
+// ---------------------------------------------------------------- ballbar
+
+BallbarSession parse_ballbar(std::istream& in, const std::string& name) {
+  Reader R;
+  R.name = name;
+  const RawFile raw = read_structure(in, R, kBallbarFormat);
+  BallbarSession s;
+  s.machine = read_machine(R);
+  check_units(R);
+  const std::string* L = R.meta("ballbar_length");
+  if (!L) R.fail(0, 0, "missing metadata 'ballbar_length' (calibrated length L0, mm)");
+  s.ballbar_length = R.meta_number("ballbar_length", *L);
+  if (!(s.ballbar_length > 0.0)) R.fail(R.meta_line("ballbar_length"), 0, "ballbar_length must be > 0");
+  const std::string* P = R.meta("pivot");
+  if (!P) R.fail(0, 0, "missing metadata 'pivot' (nominal centre-pivot position 'x, y, z', mm)");
+  s.pivot = R.meta_vector("pivot", *P);
+  s.noise_um = read_noise(R);
+  s.metadata = R.metadata;
+  check_rotary_columns(R, s.machine);
+  const std::string T(1, tilt_axis_letter(s.machine));
+  const int c_test = column_index(R, "test", true), c_time = column_index(R, "time", true),
+            c_x = column_index(R, "X", true), c_y = column_index(R, "Y", true),
+            c_z = column_index(R, "Z", true), c_t = column_index(R, T, true),
+            c_c = column_index(R, "C", true), c_len = column_index(R, "length", true);
+  const std::set<int> known = {c_test, c_time, c_x, c_y, c_z, c_t, c_c, c_len};
+  std::vector<int> extra_idx;
+  for (int i = 0; i < static_cast<int>(R.header.size()); ++i)
+    if (!known.count(i)) extra_idx.push_back(i), s.extra_columns.push_back(R.header[static_cast<std::size_t>(i)]);
+  double last = -1e300;
+  s.samples.reserve(raw.rows.size());
+  for (const auto& row : raw.rows) {
+    const std::vector<Field> f = row_fields(R, row);
+    BallbarSample b;
+    b.test = f[static_cast<std::size_t>(c_test)].text;
+    if (b.test.empty()) R.fail(R.line_no, f[static_cast<std::size_t>(c_test)].column, "test label is empty");
+    b.time = R.number(f[static_cast<std::size_t>(c_time)], "time");
+    check_time(R, f[static_cast<std::size_t>(c_time)], b.time, last);
+    b.xyz = {R.number(f[static_cast<std::size_t>(c_x)], "X"), R.number(f[static_cast<std::size_t>(c_y)], "Y"),
+             R.number(f[static_cast<std::size_t>(c_z)], "Z")};
+    b.tilt_deg = R.number(f[static_cast<std::size_t>(c_t)], T);
+    b.rot_deg = R.number(f[static_cast<std::size_t>(c_c)], "C");
+    b.length = R.number(f[static_cast<std::size_t>(c_len)], "length");
+    if (!(b.length > 0.0)) R.fail(R.line_no, f[static_cast<std::size_t>(c_len)].column, "length must be > 0");
+    for (int i : extra_idx) b.extra.push_back(f[static_cast<std::size_t>(i)].text);
+    s.samples.push_back(std::move(b));
+  }
+  s.annotations = annotations_of(raw);
+  return s;
+}
+
+BallbarSession read_ballbar(const std::string& path) {
+  std::ifstream in = open_for_reading(path);
+  return parse_ballbar(in, path);
+}
+
+std::string format_ballbar(const BallbarSession& s) {
+  if (!(s.ballbar_length > 0.0)) throw InvalidArgument("ballbar_length must be > 0");
+  return ballbar_head(s) + with_annotations(s.samples, s.annotations, [&](const BallbarSample& r) {
+           return ballbar_row(r, s.extra_columns.size());
+         });
+}
+
+void write_ballbar(const BallbarSession& s, const std::string& path) {
+  write_atomically(path, format_ballbar(s));
+}
+
+// ---------------------------------------------------------------- R-test
+
+RtestSession parse_rtest(std::istream& in, const std::string& name) {
+  Reader R;
+  R.name = name;
+  const RawFile raw = read_structure(in, R, kRtestFormat);
+  RtestSession s;
+  s.machine = read_machine(R);
+  check_units(R);
+  s.noise_um = read_noise(R);
+  for (const auto& kv : R.metadata) {
+    if (kv.first.rfind("nest.", 0) == 0) {
+      const std::string label = kv.first.substr(5);
+      if (label.empty()) R.fail(R.meta_line(kv.first), 0, "nest metadata needs a label: 'nest.N'");
+      s.nests[label] = R.meta_vector(kv.first, kv.second);
+    } else if (kv.first.rfind("probe.", 0) == 0 && kv.first.size() > 10 &&
+               kv.first.compare(kv.first.size() - 4, 4, ".dir") == 0) {
+      const std::string n = kv.first.substr(6, kv.first.size() - 10);
+      if (n != "1" && n != "2" && n != "3")
+        R.fail(R.meta_line(kv.first), 0, "probe number must be 1, 2 or 3 in '" + kv.first + "'");
+      const Eigen::Vector3d d = R.meta_vector(kv.first, kv.second);
+      if (std::abs(d.norm() - 1.0) > 1e-6)
+        R.fail(R.meta_line(kv.first), 0, kv.first + " must be a unit vector (norm " + format_number(d.norm()) + ")");
+      s.probe_dirs[std::stoi(n)] = d;
+    }
+  }
+  s.metadata = R.metadata;
+  check_rotary_columns(R, s.machine);
+  const std::string T(1, tilt_axis_letter(s.machine));
+  const int c_setup = column_index(R, "setup", true), c_time = column_index(R, "time", true),
+            c_t = column_index(R, T, true), c_c = column_index(R, "C", true),
+            c_x = column_index(R, "X", true), c_y = column_index(R, "Y", true),
+            c_z = column_index(R, "Z", true);
+  const int c_dx = column_index(R, "dx", false), c_dy = column_index(R, "dy", false),
+            c_dz = column_index(R, "dz", false);
+  const int c_d1 = column_index(R, "d1", false), c_d2 = column_index(R, "d2", false),
+            c_d3 = column_index(R, "d3", false);
+  const int n_d = (c_dx >= 0) + (c_dy >= 0) + (c_dz >= 0), n_raw = (c_d1 >= 0) + (c_d2 >= 0) + (c_d3 >= 0);
+  if (n_d != 0 && n_d != 3) R.fail(R.header_line, 0, "dx, dy, dz must come together");
+  if (n_raw != 0 && n_raw != 3) R.fail(R.header_line, 0, "d1, d2, d3 must come together");
+  if (n_d == 0 && n_raw == 0)
+    R.fail(R.header_line, 0, "missing required columns: either dx,dy,dz or d1,d2,d3");
+  if (n_raw == 3)
+    for (int k = 1; k <= 3; ++k)
+      if (!s.probe_dirs.count(k))
+        R.fail(0, 0, "raw columns d1,d2,d3 need metadata 'probe." + std::to_string(k) + ".dir'");
+  const std::set<int> known = {c_setup, c_time, c_t, c_c, c_x, c_y, c_z, c_dx, c_dy, c_dz, c_d1, c_d2, c_d3};
+  std::vector<int> extra_idx;
+  for (int i = 0; i < static_cast<int>(R.header.size()); ++i)
+    if (!known.count(i)) extra_idx.push_back(i), s.extra_columns.push_back(R.header[static_cast<std::size_t>(i)]);
+  double last = -1e300;
+  for (const auto& row : raw.rows) {
+    const std::vector<Field> f = row_fields(R, row);
+    auto F = [&](int c) -> const Field& { return f[static_cast<std::size_t>(c)]; };
+    RtestSample r;
+    r.setup = F(c_setup).text;
+    if (!s.nests.count(r.setup))
+      R.fail(R.line_no, F(c_setup).column, "setup '" + r.setup + "' has no 'nest." + r.setup + "' metadata");
+    r.time = R.number(F(c_time), "time");
+    check_time(R, F(c_time), r.time, last);
+    r.tilt_deg = R.number(F(c_t), T);
+    r.rot_deg = R.number(F(c_c), "C");
+    r.xyz = {R.number(F(c_x), "X"), R.number(F(c_y), "Y"), R.number(F(c_z), "Z")};
+    if (n_d == 3) r.d = Eigen::Vector3d(R.number(F(c_dx), "dx"), R.number(F(c_dy), "dy"), R.number(F(c_dz), "dz"));
+    if (n_raw == 3) r.raw = Eigen::Vector3d(R.number(F(c_d1), "d1"), R.number(F(c_d2), "d2"), R.number(F(c_d3), "d3"));
+    for (int i : extra_idx) r.extra.push_back(F(i).text);
+    s.samples.push_back(std::move(r));
+  }
+  s.annotations = annotations_of(raw);
+  return s;
+}
+
+RtestSession read_rtest(const std::string& path) {
+  std::ifstream in = open_for_reading(path);
+  return parse_rtest(in, path);
+}
+
+std::string format_rtest(const RtestSession& s) {
+  RtestColumns cols;
+  cols.d = !s.samples.empty() && s.samples.front().d.has_value();
+  cols.raw = !s.samples.empty() && s.samples.front().raw.has_value();
+  if (!cols.d && !cols.raw) throw InvalidArgument("R-test session has neither dx,dy,dz nor d1,d2,d3 values");
+  for (const RtestSample& r : s.samples) {
+    if (!s.nests.count(r.setup)) throw InvalidArgument("setup '" + r.setup + "' has no nest in the session");
+    if (r.d.has_value() != cols.d || r.raw.has_value() != cols.raw)
+      throw InvalidArgument("every R-test sample must carry the same columns (dx,dy,dz and/or d1,d2,d3)");
+  }
+  return rtest_head(s, cols) + with_annotations(s.samples, s.annotations, [&](const RtestSample& r) {
+           return rtest_row(r, cols, s.extra_columns.size());
+         });
+}
+
+void write_rtest(const RtestSession& s, const std::string& path) { write_atomically(path, format_rtest(s)); }
+
+AnySession read_session(const std::string& path) {
+  std::ifstream in = open_for_reading(path);
+  std::string line;
+  while (std::getline(in, line) && trim(line).empty()) {
+  }
+  const std::string t = trim(line);
+  in.clear();
+  in.seekg(0);
+  if (t.find(kRtestFormat) != std::string::npos) return parse_rtest(in, path);
+  if (t.find(kBallbarFormat) != std::string::npos || t.empty()) return parse_ballbar(in, path);
+  throw ParseError(path, 1, 1, std::string("first line must be '# format: ") + kBallbarFormat + "' or '# format: " +
+                                   kRtestFormat + "', got '" + t + "'");
+}
+
+// ---------------------------------------------------------------- appending writers
+
+namespace {
+std::FILE* open_for_append(const std::string& path, const std::string& head) {
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  if (!f) throw IoError(path + ": cannot open for writing: " + std::strerror(errno));
+  if (std::fputs(head.c_str(), f) < 0 || std::fflush(f) != 0) {
+    std::fclose(f);
+    throw IoError(path + ": write failed: " + std::strerror(errno));
+  }
+  return f;
+}
+void put(std::FILE* f, const std::string& path, const std::string& text) {
+  if (!f) throw IoError(path + ": writer is closed");
+  if (std::fputs(text.c_str(), f) < 0 || std::fflush(f) != 0)
+    throw IoError(path + ": write failed: " + std::strerror(errno));
+}
+std::string annotation_line(const std::string& text) {
+  std::string t = text;
+  std::replace(t.begin(), t.end(), '\n', ' ');
+  return "# " + trim(t) + "\n";
+}
+}  // namespace
+
+BallbarWriter::BallbarWriter(const std::string& path, const BallbarSession& header)
+    : path_(path), columns_(header.extra_columns.size()) {
+  file_ = open_for_append(path, ballbar_head(header));
+}
+BallbarWriter::~BallbarWriter() {
+  if (file_) std::fclose(file_);
+}
+void BallbarWriter::append(const BallbarSample& s) {
+  if (s.time < last_time_) throw InvalidArgument(path_ + ": sample time " + format_number(s.time) + " goes backwards");
+  put(file_, path_, ballbar_row(s, columns_));
+  last_time_ = s.time;
+  ++rows_;
+}
+void BallbarWriter::annotate(const std::string& text) { put(file_, path_, annotation_line(text)); }
+void BallbarWriter::close() {
+  if (file_ && std::fclose(file_) != 0) {
+    file_ = nullptr;
+    throw IoError(path_ + ": close failed: " + std::strerror(errno));
+  }
+  file_ = nullptr;
+}
+
+RtestWriter::RtestWriter(const std::string& path, const RtestSession& header, bool raw)
+    : path_(path), raw_(raw), extra_(header.extra_columns.size()) {
+  if (raw)
+    for (int k = 1; k <= 3; ++k)
+      if (!header.probe_dirs.count(k))
+        throw InvalidArgument("RtestWriter: raw columns need probe." + std::to_string(k) + ".dir");
+  file_ = open_for_append(path, rtest_head(header, RtestColumns{!raw, raw}));
+}
+RtestWriter::~RtestWriter() {
+  if (file_) std::fclose(file_);
+}
+void RtestWriter::append(const RtestSample& s) {
+  if (s.time < last_time_) throw InvalidArgument(path_ + ": sample time " + format_number(s.time) + " goes backwards");
+  put(file_, path_, rtest_row(s, RtestColumns{!raw_, raw_}, extra_));
+  last_time_ = s.time;
+  ++rows_;
+}
+void RtestWriter::annotate(const std::string& text) { put(file_, path_, annotation_line(text)); }
+void RtestWriter::close() {
+  if (file_ && std::fclose(file_) != 0) {
+    file_ = nullptr;
+    throw IoError(path_ + ": close failed: " + std::strerror(errno));
+  }
+  file_ = nullptr;
+}
+
+}  // namespace rotacal
