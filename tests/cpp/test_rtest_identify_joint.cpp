@@ -1,0 +1,174 @@
+// Tests of rtest/identify_joint.hpp: joint fit, observability per nest arrangement, and the
+// gravity/coning map on ../shared/data/rtest_bc_oyama.csv.
+#include <catch2/catch.hpp>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include "rotacal/core/error.hpp"
+#include "rotacal/rtest/identify_joint.hpp"
+#include "rotacal/rtest/simulate.hpp"
+
+using namespace rotacal;
+
+namespace {
+constexpr double kDeg = M_PI / 180.0;
+
+// Minimal reader for the example file (the library's reader lives in io/, owned elsewhere).
+RtestSession load_oyama() {
+  std::ifstream in(std::string(ROTACAL_SHARED_DIR) + "/data/rtest_bc_oyama.csv");
+  REQUIRE(in.good());
+  RtestSession s;
+  s.machine = MachineType::BC_trt;
+  s.nests["1"] = Eigen::Vector3d(100, 0, 60);  // the file's nest.1 / nest.2 metadata
+  s.nests["2"] = Eigen::Vector3d(0, -120, 140);
+  std::string line;
+  bool header = false;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    if (!header) { header = true; continue; }
+    std::stringstream ss(line);
+    std::string tok;
+    std::vector<std::string> f;
+    while (std::getline(ss, tok, ',')) f.push_back(tok);
+    REQUIRE(f.size() == 10);
+    RtestSample r;
+    r.setup = f[0];
+    r.time = std::stod(f[1]);
+    r.tilt_deg = std::stod(f[2]);
+    r.rot_deg = std::stod(f[3]);
+    r.xyz = Eigen::Vector3d(std::stod(f[4]), std::stod(f[5]), std::stod(f[6]));
+    r.d = Eigen::Vector3d(std::stod(f[7]), std::stod(f[8]), std::stod(f[9]));
+    s.samples.push_back(r);
+  }
+  return s;
+}
+
+RtestTruth oyama_truth() {  // rtest_bc_oyama.truth.json
+  RtestTruth t;
+  t.errors.v << 0.01459190348066346, 0.014212100597282357, 3.1102339878434216e-05,
+      -2.385536385835234e-05, -0.016912021691263143, 0.017858631217842532,
+      1.1379169104710182e-05, -4.973692463737003e-05;
+  t.effects.effects = {Effect::parse("gravity_sag_B"), Effect::parse("coning_B")};
+  t.effect_params = {0.006, 0.000145};
+  return t;
+}
+}  // namespace
+
+TEST_CASE("joint map on rtest_bc_oyama.csv shows gravity sag and coning of B (Oyama Sec. 5.3)") {
+  const RtestSession s = load_oyama();
+  const RtestJointIdentification id = identify_joint(s);
+  const RtestTruth truth = oyama_truth();
+  REQUIRE(id.converged);
+  CHECK(id.unobservable.empty());  // default basis, 2 nests at different heights
+  // The file's noise is 0.3 um: 504 readings, ~70 unknowns -> sigma within 15%.
+  CHECK(id.sigma_um == Approx(0.3).epsilon(0.15));
+  const double s_sag = truth.effect_params[0], k_con = truth.effect_params[1];
+  std::vector<double> dz, dz_sd;
+  for (int i = -3; i <= 3; ++i) {
+    const double B = i * 30 * kDeg;
+    AxisErrors<double> sd;
+    const AxisErrors<double> w = id.model.w_BY(B, &sd);
+    INFO("B = " << i * 30 << ": dz_BY " << w[2] * 1e3 << " +- " << sd[2] * 1e3 << " um, alpha_BY "
+                << w[3] * 1e6 << " +- " << sd[3] * 1e6 << " urad");
+    // Against the truth file, within the reported 1-sigma (3.5 sigma bound; the basis error of
+    // 1 - cos B by even powers up to b^6 is < 0.01 um).
+    CHECK(std::abs(w[2] - (-s_sag * (1 - std::cos(B)))) <= 3.5 * sd[2] + 1e-9);
+    CHECK(std::abs(w[3] - k_con * B) <= 3.5 * sd[3] + 1e-12);
+    // The map is the part beyond the location errors: everything else stays near zero.
+    for (int k : {0, 1, 4, 5}) CHECK(std::abs(w[k]) <= 4.0 * sd[k] + 1e-12);
+    dz.push_back(w[2]);
+    dz_sd.push_back(sd[2]);
+  }
+  // What the paper saw: the table sinks towards B = +-90 deg ...
+  CHECK(dz[0] < dz[2] - 3 * (dz_sd[0] + dz_sd[2]));
+  CHECK(dz[6] < dz[4] - 3 * (dz_sd[6] + dz_sd[4]));
+  CHECK(dz[0] < -0.004);  // 6 um of sag at 90 deg, seen as > 4 um
+  // ... and alpha_BY grows linearly with B (coning): slope from the map's two ends.
+  AxisErrors<double> sd90;
+  const double slope = id.model.w_BY(M_PI / 2, &sd90)[3] / (M_PI / 2);
+  CHECK(std::abs(slope - k_con) <= 3.5 * sd90[3] / (M_PI / 2));
+  // Location errors against the truth file within their reported uncertainty.
+  const auto& names = location_error_names(MachineType::BC_trt);
+  for (int j = 0; j < 8; ++j) {
+    const ParameterEstimate& p = id.parameter(names[static_cast<std::size_t>(j)]);
+    INFO(p.name << " " << p.value << " +- " << p.std << " truth " << truth.errors.v[j]);
+    CHECK(p.observable);
+    CHECK(std::abs(p.value - truth.errors.v[j]) < 4.0 * p.std);
+  }
+}
+
+namespace {
+RtestJointIdentification fit_with(const std::vector<Eigen::Vector3d>& nests, bool gamma_cb) {
+  RtestSimOptions o;
+  o.pattern.nests = nests;
+  o.seed = 21;
+  RtestJointOptions jo;
+  jo.basis.gamma_cb = gamma_cb;
+  return identify_joint(simulate_rtest(oyama_truth(), o).session, jo);
+}
+bool visible(const RtestJointIdentification& id, const std::string& name) {
+  return id.parameter(name).observable;
+}
+}  // namespace
+
+TEST_CASE("which nest arrangements see the C axis' orientation and angular positioning (Fig. 3)") {
+  const Eigen::Vector3d n1(100, 0, 60), n2_low(0, -120, 60), n2_high(0, -120, 140),
+      n2_above(100, 0, 140), n3(-80, 60, 100);
+  // gamma_CB = 0 assumed (Oyama Sec. 4.2):
+  {  // one nest: the C axis' tilt cannot be told from its map (needs two points, Fig. 3)
+    const auto id = fit_with({n1}, false);
+    CHECK_FALSE(visible(id, "E_A0C"));
+    CHECK_FALSE(visible(id, "E_B0C"));
+    CHECK_FALSE(id.unobservable.empty());
+  }
+  {  // two nests at the same height: the line joining them has no Z component -> still blind
+    const auto id = fit_with({n1, n2_low}, false);
+    CHECK_FALSE(visible(id, "E_A0C"));
+    CHECK_FALSE(visible(id, "E_B0C"));
+  }
+  {  // two nests at different heights (the paper's set-up): orientation visible, nothing hidden
+    const auto id = fit_with({n1, n2_high}, false);
+    CHECK(visible(id, "E_A0C"));
+    CHECK(visible(id, "E_B0C"));
+    CHECK(id.unobservable.empty());
+    CHECK(id.parameter("E_A0C").std < 2e-6);
+  }
+  // gamma_CB fitted: two nests see 5 of 6 degrees of freedom per pose.
+  {
+    const auto id = fit_with({n1, n2_above}, true);  // same radius, different heights
+    CHECK(visible(id, "E_A0C"));
+    CHECK_FALSE(visible(id, "gamma_CB.cos1.b0"));  // first harmonic of angular positioning
+    CHECK(visible(id, "gamma_CB.cos2.b0"));
+    CHECK(id.unobservable.size() == 2);
+  }
+  {  // three nests not on one line: everything visible
+    const auto id = fit_with({n1, n2_high, n3}, true);
+    CHECK(id.unobservable.empty());
+    CHECK(visible(id, "gamma_CB.cos1.b0"));
+  }
+  {  // nests on the C axis: no angular positioning of C at all
+    const auto id = fit_with({Eigen::Vector3d(0, 0, 60), Eigen::Vector3d(0, 0, 140)}, true);
+    CHECK_FALSE(visible(id, "gamma_CB.cos2.b0"));
+    CHECK(visible(id, "E_A0C"));
+  }
+}
+
+TEST_CASE("joint fit recovers C-axis error motions and reports them in words when hidden") {
+  RtestTruth t;
+  t.effects.effects = {Effect::parse("axial_motion_C_h2"), Effect::parse("radial_motion_C_h2")};
+  t.effect_params = {0.002, -0.001, 0.0015, 0.0, 0.0, -0.001};
+  RtestSimOptions o;
+  o.noise_um = 0.3;
+  o.seed = 4;
+  const RtestSimulation sim = simulate_rtest(t, o);
+  const RtestJointIdentification id = identify_joint(sim.session);
+  REQUIRE(id.converged);
+  // Axial motion of C in its turning frame is dz_CB = a cos 2C + b sin 2C in the B frame.
+  const ParameterEstimate& a = id.parameter("dz_CB.cos2.b0");
+  const ParameterEstimate& b = id.parameter("dz_CB.sin2.b0");
+  CHECK(std::abs(a.value - 0.002) < 4 * a.std);
+  CHECK(std::abs(b.value + 0.001) < 4 * b.std);
+  CHECK(id.sigma_um == Approx(0.3).epsilon(0.15));
+  CHECK_THROWS_AS(identify_joint(RtestSession{}), InvalidArgument);
+}
