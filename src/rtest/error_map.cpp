@@ -1,0 +1,137 @@
+#include "rotacal/rtest/error_map.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "rotacal/core/error.hpp"
+
+namespace rotacal {
+
+namespace {
+constexpr double kDeg = M_PI / 180.0;
+std::string num(double v) {
+  if (!std::isfinite(v)) return "";
+  char b[40];
+  std::snprintf(b, sizeof b, "%.9g", v);
+  return b;
+}
+std::string jnum(double v) { return std::isfinite(v) ? num(v) : "null"; }
+}  // namespace
+
+RtestErrorMap error_map(const RtestJointIdentification& id, const std::vector<double>& b_deg,
+                        const std::vector<double>& c_deg) {
+  RtestErrorMap m;
+  m.method = id.method;
+  m.notes = id.notes;
+  for (double b : b_deg)
+    for (double c : c_deg) {
+      RtestErrorMapEntry e;
+      e.b_deg = b;
+      e.c_deg = c;
+      e.w_BY = id.model.w_BY(b * kDeg, &e.w_BY_std);
+      e.w_CB = id.model.w_CB(b * kDeg, c * kDeg, &e.w_CB_std);
+      m.entries.push_back(e);
+    }
+  return m;
+}
+
+RtestErrorMap error_map(const RtestPaperIdentification& id) {
+  RtestErrorMap m;
+  m.method = id.method;
+  m.notes = id.notes;
+  for (std::size_t i = 0; i < id.b_deg.size(); ++i)
+    for (std::size_t j = 0; j < id.c_deg.size(); ++j) {
+      RtestErrorMapEntry e;
+      e.b_deg = id.b_deg[i];
+      e.c_deg = id.c_deg[j];
+      e.w_BY = id.w_BY[i];
+      e.w_BY_std = id.w_BY_std[i];
+      e.w_CB = id.w_CB[i][j];
+      e.w_CB_std = id.w_CB_std[i][j];
+      e.w_CB_std[5] = std::numeric_limits<double>::quiet_NaN();  // assumed, not identified
+      m.entries.push_back(e);
+    }
+  return m;
+}
+
+std::string error_map_csv(const RtestErrorMap& map) {
+  std::ostringstream o;
+  o << "B,C";
+  for (const char* suffix : {"", "_std"})
+    for (const char* ax : {"BY", "CB"})
+      for (int k = 0; k < 6; ++k) o << "," << oyama_error_name(k, ax) << suffix;
+  o << "\n";
+  for (const RtestErrorMapEntry& e : map.entries) {
+    o << num(e.b_deg) << "," << num(e.c_deg);
+    for (const AxisErrors<double>* w : {&e.w_BY, &e.w_CB, &e.w_BY_std, &e.w_CB_std})
+      for (int k = 0; k < 6; ++k) o << "," << num((*w)[k]);
+    o << "\n";
+  }
+  return o.str();
+}
+
+std::string error_map_json(const RtestErrorMap& map) {
+  std::ostringstream o;
+  auto vec = [&](const AxisErrors<double>& w) {
+    o << "[";
+    for (int k = 0; k < 6; ++k) o << (k ? ", " : "") << jnum(w[k]);
+    o << "]";
+  };
+  o << "{\n  \"method\": \"" << map.method << "\",\n"
+    << "  \"order\": [\"dx\", \"dy\", \"dz\", \"alpha\", \"beta\", \"gamma\"],\n"
+    << "  \"units\": [\"mm\", \"mm\", \"mm\", \"rad\", \"rad\", \"rad\"],\n  \"notes\": [";
+  for (std::size_t i = 0; i < map.notes.size(); ++i) {
+    std::string s = map.notes[i];
+    std::string esc;
+    for (char c : s) esc += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
+    o << (i ? ", " : "") << "\"" << esc << "\"";
+  }
+  o << "],\n  \"entries\": [\n";
+  for (std::size_t i = 0; i < map.entries.size(); ++i) {
+    const RtestErrorMapEntry& e = map.entries[i];
+    o << "    {\"B\": " << jnum(e.b_deg) << ", \"C\": " << jnum(e.c_deg) << ", \"BY\": ";
+    vec(e.w_BY);
+    o << ", \"BY_std\": ";
+    vec(e.w_BY_std);
+    o << ", \"CB\": ";
+    vec(e.w_CB);
+    o << ", \"CB_std\": ";
+    vec(e.w_CB_std);
+    o << "}" << (i + 1 < map.entries.size() ? "," : "") << "\n";
+  }
+  o << "  ]\n}\n";
+  return o.str();
+}
+
+void write_text_file(const std::string& path, const std::string& text) {
+  std::ofstream f(path);
+  if (!f) throw IoError(path + ": cannot open for writing");
+  f << text;
+  if (!f) throw IoError(path + ": write failed");
+}
+
+double prediction_rms_um(const RtestSession& session, const RtestPredictor& predict) {
+  if (session.samples.empty()) throw InvalidArgument("prediction_rms_um: session has no samples");
+  double ss = 0.0;
+  std::size_t n = 0;
+  for (const std::string& setup : session.setups()) {
+    const auto it = session.nests.find(setup);
+    if (it == session.nests.end())
+      throw InvalidArgument("prediction_rms_um: session.nests: no nest." + setup);
+    std::vector<Eigen::Vector3d> r;
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (std::size_t i : session.indices_of(setup)) {
+      const RtestSample& s = session.samples[i];
+      if (!s.d) throw InvalidArgument("prediction_rms_um: a sample has no dx,dy,dz");
+      r.push_back(*s.d - predict(it->second, s.angles_rad().tilt, s.angles_rad().rot));
+      mean += r.back();
+    }
+    mean /= static_cast<double>(r.size());
+    for (const auto& v : r) ss += (v - mean).squaredNorm(), n += 3;
+  }
+  return std::sqrt(ss / static_cast<double>(n)) * 1e3;
+}
+
+}  // namespace rotacal
