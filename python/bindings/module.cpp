@@ -8,6 +8,7 @@ namespace pyb = pybind11;
 
 namespace rotacal::py {
 void bind_kinematics(pyb::module_& m);
+void bind_io(pyb::module_& m);
 void bind_ballbar(pyb::module_& m);
 void bind_diagnose(pyb::module_& m);
 }  // namespace rotacal::py
@@ -22,6 +23,7 @@ PYBIND11_MODULE(_core, m) {
   pyb::register_exception<rotacal::ParseError>(m, "ParseError", error.ptr());
   pyb::register_exception<rotacal::IoError>(m, "IoError", error.ptr());
   rotacal::py::bind_kinematics(m);
+  rotacal::py::bind_io(m);
   rotacal::py::bind_ballbar(m);
   rotacal::py::bind_diagnose(m);
 }

@@ -1,18 +1,32 @@
 """rotacal: calibration of the rotary axes of 5-axis machine tools.
 
-A typed wrapper over the private extension ``rotacal._core``.
+A typed wrapper over the private extension ``rotacal._core``: sessions are numpy-backed
+objects, analyses return result objects whose ``to_dict()`` is the JSON the CLI prints.
 """
 from ._core import (  # noqa: F401
+    BallbarMachineModel,
+    BallbarSession,
     DegenerateGeometry,
+    Effect,
     Error,
     InvalidArgument,
     IoError,
     MachineType,
     ParseError,
+    RtestSession,
+    compensate_commands,
+    effect_catalogue,
     forward,
     location_error_names,
     machine_name,
     parse_machine_type,
+    simulate_ballbar,
+    verify_compensation,
 )
+from .ballbar import identify, predict, random_location_errors  # noqa: F401
+from .diagnosis import diagnose  # noqa: F401
+from .models import ballbar_model_from_dict, load_model, save_model  # noqa: F401
+from .results import DiagnosisResult, Identification  # noqa: F401
+from .sessions import load, save  # noqa: F401
 
 __version__ = "0.1.0"

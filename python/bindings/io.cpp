@@ -1,0 +1,76 @@
+// Bindings for include/rotacal/io: session classes with numpy columns, readers and writers.
+#include "numpy.hpp"
+#include "rotacal/io/ballbar_file.hpp"
+#include "rotacal/io/session_arrays.hpp"
+
+namespace rotacal::py {
+
+namespace {
+pyb::dict metadata_dict(const Metadata& m) {
+  pyb::dict d;
+  for (const auto& kv : m) d[pyb::str(kv.first)] = kv.second;
+  return d;
+}
+}  // namespace
+
+void bind_io(pyb::module_& m) {
+  pyb::class_<BallbarSession>(m, "BallbarSession", "A rotacal-ballbar/1 session (mm, deg, s).")
+      .def(pyb::init(&make_ballbar_session), pyb::arg("machine"), pyb::arg("ballbar_length"),
+           pyb::arg("pivot"), pyb::arg("tests"), pyb::arg("time"), pyb::arg("xyz"),
+           pyb::arg("angles_deg"), pyb::arg("length"), pyb::arg("noise_um") = std::nullopt,
+           "Build a session from columns: tests (N labels), time (N,), xyz (N,3) tool cup, "
+           "angles_deg (N,2) tilt and C, length (N,) measured lengths.")
+      .def_readonly("machine", &BallbarSession::machine)
+      .def_readonly("ballbar_length", &BallbarSession::ballbar_length)
+      .def_property_readonly("pivot", [](const BallbarSession& s) { return Eigen::Vector3d(s.pivot); })
+      .def_readonly("noise_um", &BallbarSession::noise_um)
+      .def_property_readonly("metadata", [](const BallbarSession& s) { return metadata_dict(s.metadata); })
+      .def_property_readonly("tests", &ballbar_tests, "test label of every sample")
+      .def_property_readonly("test_names", &BallbarSession::tests, "distinct test labels, in order")
+      .def_property_readonly("time", &ballbar_times)
+      .def_property_readonly("xyz", &ballbar_xyz)
+      .def_property_readonly("angles_deg", &ballbar_angles_deg)
+      .def_property_readonly("length", &ballbar_lengths)
+      .def_property_readonly("annotations",
+                             [](const BallbarSession& s) {
+                               std::vector<std::pair<std::size_t, std::string>> out;
+                               for (const Annotation& a : s.annotations) out.emplace_back(a.before_sample, a.text);
+                               return out;
+                             })
+      .def("with_lengths", &with_lengths, pyb::arg("length"),
+           "The same session with other lengths (e.g. a model's prediction).")
+      .def("__len__", [](const BallbarSession& s) { return s.samples.size(); })
+      .def("__repr__", [](const BallbarSession& s) {
+        return "<BallbarSession " + to_string(s.machine) + ", " + std::to_string(s.samples.size()) +
+               " samples, L0 = " + format_number(s.ballbar_length) + " mm>";
+      });
+
+  pyb::class_<RtestSession>(m, "RtestSession", "A rotacal-rtest/1 session (mm, deg, s).")
+      .def_readonly("machine", &RtestSession::machine)
+      .def_readonly("nests", &RtestSession::nests)
+      .def_readonly("probe_dirs", &RtestSession::probe_dirs)
+      .def_readonly("noise_um", &RtestSession::noise_um)
+      .def_property_readonly("metadata", [](const RtestSession& s) { return metadata_dict(s.metadata); })
+      .def_property_readonly("setups", &rtest_setups, "set-up (nest) label of every pose")
+      .def_property_readonly("time", &rtest_times)
+      .def_property_readonly("angles_deg", &rtest_angles_deg)
+      .def_property_readonly("xyz", &rtest_xyz)
+      .def_property_readonly("d", &rtest_displacements, "dx, dy, dz (N,3), table frame, mm")
+      .def("with_displacements", &with_displacements, pyb::arg("d"))
+      .def("__len__", [](const RtestSession& s) { return s.samples.size(); })
+      .def("__repr__", [](const RtestSession& s) {
+        return "<RtestSession " + to_string(s.machine) + ", " + std::to_string(s.samples.size()) +
+               " poses, " + std::to_string(s.nests.size()) + " nests>";
+      });
+
+  m.def("read_session", &read_session, pyb::arg("path"),
+        "Read a rotacal-ballbar/1 or rotacal-rtest/1 file (chosen by its format line).");
+  m.def("read_ballbar", &read_ballbar, pyb::arg("path"));
+  m.def("read_rtest", &read_rtest, pyb::arg("path"));
+  m.def("write_ballbar", &write_ballbar, pyb::arg("session"), pyb::arg("path"));
+  m.def("write_rtest", &write_rtest, pyb::arg("session"), pyb::arg("path"));
+  m.def("format_ballbar", &format_ballbar, pyb::arg("session"));
+  m.def("format_rtest", &format_rtest, pyb::arg("session"));
+}
+
+}  // namespace rotacal::py

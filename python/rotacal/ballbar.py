@@ -1,0 +1,52 @@
+"""Single set-up ballbar test: identification, simulation, prediction, compensation."""
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+
+from . import _core
+from .results import Identification
+
+
+def identify(session: _core.BallbarSession, method: str = "joint", *,
+             fit_length_offset: bool = False, effects: Sequence[str] = (),
+             tests: Sequence[str] = ()) -> Identification:
+    """Identify the 8 location errors (and the actual pivot) of a ballbar session.
+
+    Parameters
+    ----------
+    method : "joint" (default) fits the exact model to every sample with Ceres and reports
+        1-sigma uncertainties; "paper" runs Flynn et al.'s chain (sphere fit, Hyper circle
+        fit, SVD plane fit).
+    fit_length_offset : also fit an offset of the calibrated bar length (joint only).
+    effects : catalogue ids to fit along (joint only), e.g. ["gravity_sag_A"].
+    tests : restrict to these test labels (default: all).
+    """
+    if not isinstance(session, _core.BallbarSession):
+        raise _core.InvalidArgument("identify: session must be a BallbarSession")
+    if method == "joint":
+        raw = _core.identify_joint(session, fit_length_offset, list(effects), list(tests))
+    elif method == "paper":
+        if fit_length_offset or effects:
+            raise _core.InvalidArgument("identify: the paper method fits no length offset or effects")
+        if not hasattr(_core, "identify_paper"):
+            raise _core.Error("identify: the paper method is not available in this build")
+        raw = _core.identify_paper(session)
+    else:
+        raise _core.InvalidArgument(f"identify: method must be 'joint' or 'paper', got {method!r}")
+    return Identification(raw)
+
+
+def predict(model: _core.BallbarMachineModel, session: _core.BallbarSession) -> _core.BallbarSession:
+    """The session with every length replaced by the model's prediction."""
+    return session.with_lengths(_core.predict_session_lengths(model, session))
+
+
+def random_location_errors(machine, rng: np.random.Generator, position_mm: float = 0.03,
+                           angle_rad: float = 5e-5) -> np.ndarray:
+    """Location errors drawn as N(0, position_mm) and N(0, angle_rad), in the machine's order."""
+    # Order of every errors vector: tilt position (2), tilt orientation (2), C position (2),
+    # C orientation (2).
+    scale = np.array([position_mm] * 2 + [angle_rad] * 2 + [position_mm] * 2 + [angle_rad] * 2)
+    return rng.normal(0.0, 1.0, 8) * scale

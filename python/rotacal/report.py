@@ -1,0 +1,248 @@
+"""Self-contained HTML reports (no network needed to open them): set-up, location errors in
+an ISO 230-7 style table, ballbar polar plots of measured against model with the deviation
+magnified, residual plots, and the diagnosis with before/after plots."""
+from __future__ import annotations
+
+import base64
+import datetime as _dt
+import html
+import io
+from pathlib import Path
+from typing import Any, Iterable
+
+import numpy as np
+
+import matplotlib
+
+matplotlib.use("Agg")  # files only, never a window
+import matplotlib.pyplot as plt  # noqa: E402
+
+# Words for the ISO 230-7 location errors of a tilting-rotary table (Flynn et al., Table 1).
+ERROR_WORDS = {
+    "E_X0C": "position of C in X", "E_Y0C": "position of C in Y",
+    "E_A0C": "orientation of C about X (squareness C to Y)",
+    "E_B0C": "orientation of C about Y (squareness C to X)",
+    "E_Y0A": "position of A in Y", "E_Z0A": "position of A in Z",
+    "E_B0A": "orientation of A about Y (squareness A to Z)",
+    "E_C0A": "orientation of A about Z (squareness A to Y)",
+    "E_X0B": "position of B in X", "E_Z0B": "position of B in Z",
+    "E_A0B": "orientation of B about X (squareness B to Z)",
+    "E_C0B": "orientation of B about Z (squareness B to X)",
+}
+
+_CSS = """
+body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;margin:2em auto;max-width:1100px;color:#222}
+h1{font-size:1.6em;border-bottom:2px solid #246;padding-bottom:.3em}
+h2{font-size:1.25em;color:#246;margin-top:1.6em}
+table{border-collapse:collapse;margin:.6em 0}
+td,th{border:1px solid #bbb;padding:.25em .6em;text-align:right}
+th{background:#eef2f7} td.l,th.l{text-align:left}
+.muted{color:#777}.warn{color:#a40}.ok{color:#270}
+figure{display:inline-block;margin:.5em;text-align:center}
+figcaption{font-size:.85em;color:#555}
+"""
+
+
+def _png(fig) -> str:
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=90, bbox_inches="tight")
+    plt.close(fig)
+    return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii")
+
+
+def _img(src: str, caption: str, section: str) -> str:
+    return (f'<figure data-section="{section}"><img src="{src}" alt="{html.escape(caption)}">'
+            f"<figcaption>{html.escape(caption)}</figcaption></figure>")
+
+
+def _fmt(p: dict, scale: float) -> tuple[str, str]:
+    if p.get("value") is None:
+        return "unobservable", ""
+    return f"{p['value'] * scale:+.2f}", f"{p['std'] * scale:.2f}"
+
+
+def location_error_table(errors: dict) -> str:
+    """ISO 230-7 style table; positions in um, orientations in urad."""
+    rows = ["<table><tr><th class=l>Error</th><th class=l>Meaning</th><th>Value</th>"
+            "<th>1&sigma;</th><th>Unit</th></tr>"]
+    for name, p in errors.items():
+        scale, unit = (1e3, "&micro;m") if p["unit"] == "mm" else (1e6, "&micro;rad")
+        v, s = _fmt(p, scale)
+        rows.append(f"<tr><td class=l>{name}</td><td class=l>{html.escape(ERROR_WORDS.get(name, ''))}</td>"
+                    f"<td>{v}</td><td>{s}</td><td>{unit}</td></tr>")
+    rows.append("</table>")
+    return "\n".join(rows)
+
+
+def _swept_angle(angles_deg: np.ndarray) -> tuple[np.ndarray, int]:
+    span = angles_deg.max(axis=0) - angles_deg.min(axis=0)
+    k = int(np.argmax(span))
+    return np.radians(angles_deg[:, k]), k
+
+
+def polar_plots(tests: np.ndarray, angles_deg: np.ndarray, measured: np.ndarray,
+                model: np.ndarray, nominal: float, axis_names: tuple[str, str]) -> list[str]:
+    """One polar plot per rotary test: measured and model deviation from L0, magnified."""
+    figs = []
+    for t in dict.fromkeys(tests):
+        sel = tests == t
+        if sel.sum() < 10:
+            continue
+        theta, k = _swept_angle(angles_deg[sel])
+        if np.ptp(theta) < np.radians(30):
+            continue  # an arc at fixed rotary angles (sphere tests) has no angle to plot against
+        dev_m = (measured[sel] - nominal) * 1e3
+        dev_p = (model[sel] - nominal) * 1e3
+        span = max(np.ptp(np.r_[dev_m, dev_p]), 1.0)
+        base = 2.0 * span  # the reference circle; deviations are drawn magnified around it
+        fig = plt.figure(figsize=(4.2, 4.2))
+        ax = fig.add_subplot(projection="polar")
+        ax.plot(theta, base + dev_m - dev_p.mean(), ".", ms=2, color="#c33", label="measured")
+        ax.plot(theta, base + dev_p - dev_p.mean(), "-", lw=1.2, color="#246", label="model")
+        ax.plot(np.linspace(0, 2 * np.pi, 361), np.full(361, base), ":", color="#999", lw=0.8)
+        ax.set_rmin(0)
+        ax.set_rmax(base + span * 1.2)
+        ax.set_yticklabels([])
+        ax.set_title(f"{t}: deviation from L0 against {axis_names[k]}\n"
+                     f"scale: ring spacing {span / 2:.2g} \u00b5m", fontsize=8)
+        ax.legend(loc="lower right", fontsize=7)
+        figs.append((_png(fig), f"{t}: measured and model, deviation magnified"))
+    return figs
+
+
+def residual_plot(tests: np.ndarray, residuals: list[tuple[str, np.ndarray]]) -> str:
+    """Residual per sample, tests side by side, for one or more models."""
+    fig, ax = plt.subplots(figsize=(9, 3))
+    x = np.arange(len(tests))
+    for label, r in residuals:
+        ax.plot(x, r * 1e3, ".", ms=2, label=label)
+    for t in dict.fromkeys(tests):
+        idx = np.flatnonzero(tests == t)
+        ax.axvline(idx[0], color="#ccc", lw=0.8)
+        ax.text(idx.mean(), ax.get_ylim()[1], t, ha="center", va="bottom", fontsize=7)
+    ax.set_xlabel("sample")
+    ax.set_ylabel("residual (\u00b5m)")
+    ax.legend(fontsize=7, loc="lower right")
+    return _png(fig)
+
+
+def harmonic_plot(structure: list[dict], title: str) -> str | None:
+    groups = [g for g in structure if g["harmonic_um"]]
+    if not groups:
+        return None
+    fig, ax = plt.subplots(figsize=(6, 3))
+    w = 0.8 / len(groups)
+    for i, g in enumerate(groups):
+        orders = np.arange(1, len(g["harmonic_um"]) + 1)
+        ax.bar(orders + i * w, g["harmonic_um"], width=w, label=f"{g['group']} ({g['angle_axis']})")
+    ax.set_xlabel("harmonic order in the swept rotary angle")
+    ax.set_ylabel("amplitude (\u00b5m)")
+    ax.set_title(title, fontsize=9)
+    ax.legend(fontsize=6)
+    return _png(fig)
+
+
+def ballbar_report(path: str | Path, session: Any, identification: Any,
+                   diagnosis: Any | None = None, title: str | None = None,
+                   source: str = "", extra_sections: Iterable[str] = ()) -> Path:
+    """Write the HTML report of a ballbar session. Returns the path written."""
+    from . import _core
+
+    path = Path(path)
+    ident = identification.to_dict()
+    tests = np.asarray(session.tests)
+    angles = np.asarray(session.angles_deg)
+    measured = np.asarray(session.length)
+    model = _core.predict_session_lengths(identification.raw.model, session)
+    machine = ident["machine"]
+    axis_names = (machine[0], "C")
+    parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(title or 'rotacal report')}</title>"
+             f"<style>{_CSS}</style></head><body>"]
+    parts.append(f"<h1>{html.escape(title or 'Single set-up ballbar test')}</h1>")
+    parts.append(f"<p class=muted>rotacal {html.escape(_version())} &middot; "
+                 f"{_dt.datetime.now().strftime('%Y-%m-%d %H:%M')} &middot; {html.escape(source)}</p>")
+
+    pv = ident["pivot"]
+    pivot_txt = ", ".join("unobservable" if pv[a]["value"] is None else f"{pv[a]['value']:.4f}" for a in "xyz")
+    parts.append('<section id="setup"><h2>Machine and set-up</h2><table>'
+                 f"<tr><th class=l>Machine</th><td class=l>{machine} (tilting-rotary table)</td></tr>"
+                 f"<tr><th class=l>Ballbar length L0</th><td class=l>{session.ballbar_length:.4f} mm</td></tr>"
+                 f"<tr><th class=l>Nominal pivot (table frame)</th><td class=l>{', '.join(f'{v:.4f}' for v in session.pivot)} mm</td></tr>"
+                 f"<tr><th class=l>Identified pivot</th><td class=l>{pivot_txt} mm</td></tr>"
+                 f"<tr><th class=l>Samples / tests</th><td class=l>{len(tests)} / {', '.join(dict.fromkeys(tests))}</td></tr>"
+                 "</table></section>")
+
+    parts.append(f'<section id="location-errors"><h2>Location errors (ISO 230-7), method: {ident["method"]}</h2>')
+    parts.append(location_error_table(ident["location_errors"]))
+    parts.append(f"<p>Residual RMS {ident['residual_rms_um']:.3f} &micro;m over {ident['n_samples']} samples.</p>")
+    if ident["unobservable"]:
+        parts.append("<p class=warn>Not determined by this session's tests:</p><ul>" +
+                     "".join(f"<li>{html.escape(u)}</li>" for u in ident["unobservable"]) + "</ul>")
+    parts.append("</section>")
+
+    parts.append('<section id="polar"><h2>Ballbar plots: measured against model</h2>')
+    for src, cap in polar_plots(tests, angles, measured, model, session.ballbar_length, axis_names):
+        parts.append(_img(src, cap, "polar"))
+    parts.append("</section>")
+
+    residuals = [("location-error model", np.asarray(identification.residuals))]
+    if diagnosis is not None and diagnosis.findings:
+        residuals.append(("extended model", np.asarray(diagnosis.raw.final_fit.residuals)))
+    parts.append('<section id="residuals"><h2>Residuals</h2>')
+    parts.append(_img(residual_plot(tests, residuals), "residual per sample (measured - model)", "residuals"))
+    parts.append("</section>")
+
+    if diagnosis is not None:
+        parts.append(diagnosis_section(diagnosis.to_dict()))
+    parts.extend(extra_sections)
+    parts.append("</body></html>")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text("\n".join(parts))
+    tmp.replace(path)
+    return path
+
+
+def diagnosis_section(d: dict) -> str:
+    b = d["baseline"]
+    out = ['<section id="diagnosis"><h2>Diagnosis</h2>',
+           f"<p>Baseline (location errors and pivot): residual RMS {b['residual_rms_um']:.3f} &micro;m, "
+           f"noise {b['noise_um']:.3f} &micro;m ({html.escape(b['noise_source'])}), "
+           f"&chi;&sup2;/dof {b['chi2_per_dof']:.2f} (p = {b['p_value']:.2g}).</p>"]
+    if not d["findings"]:
+        out.append("<p class=ok>No effect of the catalogue is significant: the location-error model "
+                   "explains the data to the noise.</p>")
+    else:
+        out.append("<table><tr><th class=l>#</th><th class=l>Effect</th><th class=l>Cause</th>"
+                   "<th class=l>Parameters</th><th>RMS before</th><th>RMS after</th><th>&Delta;BIC</th>"
+                   "<th>CV RMS before</th><th>CV RMS after</th></tr>")
+        for i, f in enumerate(d["findings"], 1):
+            params = "<br>".join(
+                f"{html.escape(k)} = {v['value']:.4g} &plusmn; {v['std']:.2g} {html.escape(v['unit'])}"
+                if v["value"] is not None else f"{html.escape(k)}: unobservable" for k, v in f["parameters"].items())
+            g = f["gain"]
+            out.append(f"<tr><td class=l>{i}</td><td class=l>{f['effect']}</td><td class=l>{html.escape(f['cause'])}</td>"
+                       f"<td class=l>{params}</td><td>{g['rms_before_um']:.3f}</td><td>{g['rms_after_um']:.3f}</td>"
+                       f"<td>{g['delta_bic']:.1f}</td><td>{g['cv_rms_before_um']:.3f}</td><td>{g['cv_rms_after_um']:.3f}</td></tr>")
+        out.append("</table><p class=muted>RMS in &micro;m; CV: blocked cross-validation.</p>")
+    for a in d["ambiguous"]:
+        out.append(f"<p class=warn>Cannot be told apart with this data: {', '.join(a['effects'])} "
+                   f"({html.escape(a['separating_test'])}).</p>")
+    if d["unexplained"]["present"]:
+        out.append(f"<p class=warn>Unexplained structure remains (&chi;&sup2;/dof "
+                   f"{d['unexplained']['chi2_per_dof']:.2f}): {html.escape(d['unexplained']['signature'])}</p>")
+    for title, key in (("before", "before"), ("after", "after")):
+        src = harmonic_plot(d["residual_structure"][key], f"residual harmonics {title} the diagnosis")
+        if src:
+            out.append(_img(src, f"residual harmonics {title}", "diagnosis"))
+    if d["unobservable"]:
+        out.append("<details><summary>Effects this session cannot see</summary><ul>" +
+                   "".join(f"<li>{u['effect']}: {html.escape(u['reason'])}</li>" for u in d["unobservable"]) +
+                   "</ul></details>")
+    out.append("</section>")
+    return "\n".join(out)
+
+
+def _version() -> str:
+    from . import __version__
+    return __version__
