@@ -1,0 +1,429 @@
+#include "rotacal/ballbar/test_plan.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "rotacal/core/error.hpp"
+
+namespace rotacal {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDeg = kPi / 180.0;
+// Grid and coincidence tolerances: angles in deg, lengths in mm. Far below any NC resolution,
+// far above the rounding of lo + k * step.
+constexpr double kAngleTol = 1e-9;
+constexpr double kLengthTol = 1e-9;
+// Largest number of samples one sweep may have (a guard against step = 1e-12 exhausting memory).
+constexpr double kMaxSamplesPerSweep = 1e6;
+
+void require(bool ok, const std::string& what) {
+  if (!ok) throw InvalidArgument("plan_ballbar_test: " + what);
+}
+
+bool finite3(const Eigen::Vector3d& v) { return v.allFinite(); }
+
+// lo + k step for k = 0, 1, ... up to hi; hi is appended when it is off the grid. A span of
+// exactly 360 deg is a full turn: the end pose repeats the start and is left out.
+std::vector<double> sweep(double lo, double hi, double step) {
+  const double span = hi - lo;
+  const bool full_turn = std::abs(span - 360.0) < kAngleTol;
+  const double n_real = span / step;
+  const long n = static_cast<long>(std::floor(n_real + kAngleTol));
+  std::vector<double> v;
+  v.reserve(static_cast<std::size_t>(n) + 2);
+  for (long k = 0; k <= n; ++k) v.push_back(lo + static_cast<double>(k) * step);
+  const bool on_grid = std::abs(n_real - static_cast<double>(n)) < kAngleTol;
+  if (full_turn) {
+    if (on_grid) v.pop_back();
+  } else if (!on_grid) {
+    v.push_back(hi);
+  }
+  return v;
+}
+
+void check_range(const std::array<double, 2>& r, const char* name, double step) {
+  const std::string n = name;
+  require(std::isfinite(r[0]) && std::isfinite(r[1]), n + " must be finite");
+  require(r[1] > r[0], n + " must be increasing (got " + std::to_string(r[0]) + ", " +
+                           std::to_string(r[1]) + ")");
+  require(r[1] - r[0] <= 360.0 + kAngleTol,
+          n + " spans " + std::to_string(r[1] - r[0]) + " deg, more than a full turn");
+  require((r[1] - r[0]) / step <= kMaxSamplesPerSweep,
+          n + " / step_deg gives more than 1e6 samples per sweep");
+}
+
+void validate(const BallbarSetup& s) {
+  require(std::isfinite(s.ballbar_length) && s.ballbar_length > 0.0,
+          "ballbar_length must be a positive finite length in mm");
+  require(finite3(s.pivot), "pivot must be finite");
+  require(std::isfinite(s.step_deg) && s.step_deg > 0.0 && s.step_deg <= 90.0,
+          "step_deg must be in (0, 90] deg");
+  require(std::isfinite(s.feed_mm_per_min) && s.feed_mm_per_min > 0.0,
+          "feed_mm_per_min must be positive and finite");
+  require(std::isfinite(s.feed_deg_per_min) && s.feed_deg_per_min > 0.0,
+          "feed_deg_per_min must be positive and finite");
+  check_range(s.tilt_range_deg, "tilt_range_deg", s.step_deg);
+  require(s.tilt_range_deg[0] >= -180.0 && s.tilt_range_deg[1] <= 180.0,
+          "tilt_range_deg must lie within [-180, 180] deg");
+  check_range(s.rot_range_deg, "rot_range_deg", s.step_deg);
+  require(!s.tests.empty(), "tests is empty");
+  for (std::size_t i = 0; i < s.tests.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      require(s.tests[i] != s.tests[j],
+              "test " + test_label(s.tests[i], s.machine) + " is listed twice");
+}
+
+// Unit vector from an axis through the origin with direction `axis` to the pivot, in the
+// plane normal to the axis. Throws if the pivot lies on the axis (no radial direction).
+Eigen::Vector3d radial_direction(const Eigen::Vector3d& pivot, const Eigen::Vector3d& axis,
+                                 const std::string& test) {
+  const Eigen::Vector3d r = pivot - axis * axis.dot(pivot);
+  require(r.norm() > 1e-6, test + " needs the pivot off the axis it turns about (pivot is " +
+                               std::to_string(r.norm()) + " mm from it)");
+  return r.normalized();
+}
+
+Eigen::Vector3d tilt_axis_direction(MachineType m) {
+  return m == MachineType::AC_trt ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+}
+
+// The table-frame tool point of a test that keeps the tool fixed on the table.
+Eigen::Vector3d fixed_tool_point(const BallbarSetup& s, BallbarTest t) {
+  const Eigen::Vector3d& p = s.pivot;
+  const double L = s.ballbar_length;
+  const std::string label = test_label(t, s.machine);
+  switch (t) {
+    case BallbarTest::radial_tilt:
+      return p + L * radial_direction(p, tilt_axis_direction(s.machine), label);
+    case BallbarTest::axial_tilt:
+      return p + L * tilt_axis_direction(s.machine);
+    case BallbarTest::radial_c: {
+      const double sign = s.radial_c_side == RadialSide::outside ? 1.0 : -1.0;
+      return p + sign * L * radial_direction(p, Eigen::Vector3d::UnitZ(), label);
+    }
+    case BallbarTest::axial_c:
+      return p + L * Eigen::Vector3d::UnitZ();
+    default:
+      break;
+  }
+  ROTACAL_ASSERT(false);
+  return p;
+}
+
+PlannedSample make_sample(const Eigen::Vector3d& p_table, double tilt_deg, double rot_deg) {
+  PlannedSample s;
+  s.p_table = p_table;
+  s.tilt_deg = tilt_deg;
+  s.rot_deg = rot_deg;
+  return s;
+}
+
+PlanSegment make_test(const BallbarSetup& s, BallbarTest t) {
+  PlanSegment seg;
+  seg.label = test_label(t, s.machine);
+  seg.kind = SegmentKind::test;
+  seg.test = t;
+  const Eigen::Vector3d& p = s.pivot;
+  const double L = s.ballbar_length;
+  switch (t) {
+    case BallbarTest::sphere_xy:
+      for (double a : sweep(0.0, 360.0, s.step_deg))
+        seg.samples.push_back(
+            make_sample(p + L * Eigen::Vector3d(std::cos(a * kDeg), std::sin(a * kDeg), 0.0), 0, 0));
+      break;
+    case BallbarTest::sphere_yz:
+      for (double a : sweep(0.0, 180.0, s.step_deg))
+        seg.samples.push_back(
+            make_sample(p + L * Eigen::Vector3d(0.0, std::cos(a * kDeg), std::sin(a * kDeg)), 0, 0));
+      break;
+    case BallbarTest::sphere_zx:
+      for (double a : sweep(0.0, 180.0, s.step_deg))
+        seg.samples.push_back(
+            make_sample(p + L * Eigen::Vector3d(std::cos(a * kDeg), 0.0, std::sin(a * kDeg)), 0, 0));
+      break;
+    case BallbarTest::radial_tilt:
+    case BallbarTest::axial_tilt: {
+      const Eigen::Vector3d q = fixed_tool_point(s, t);
+      for (double a : sweep(s.tilt_range_deg[0], s.tilt_range_deg[1], s.step_deg))
+        seg.samples.push_back(make_sample(q, a, 0.0));
+      break;
+    }
+    case BallbarTest::radial_c:
+    case BallbarTest::axial_c: {
+      const Eigen::Vector3d q = fixed_tool_point(s, t);
+      for (double a : sweep(s.rot_range_deg[0], s.rot_range_deg[1], s.step_deg))
+        seg.samples.push_back(make_sample(q, 0.0, a));
+      break;
+    }
+  }
+  return seg;
+}
+
+PlanSegment transition(SegmentKind kind) {
+  PlanSegment seg;
+  seg.label = "transition";
+  seg.kind = kind;
+  return seg;
+}
+
+int intervals(double extent_deg, double step_deg) {
+  return std::max(1, static_cast<int>(std::ceil(extent_deg / step_deg - kAngleTol)));
+}
+
+// Rotary axes from (t0, c0) to (t1, c1) with the tool fixed on the table at q: both axes
+// interpolated together, steps no larger than step_deg. Holds the points after the start,
+// the end only if `include_end`.
+PlanSegment rotary_move(const Eigen::Vector3d& q, double t0, double c0, double t1, double c1,
+                        double step_deg, bool include_end) {
+  PlanSegment seg = transition(SegmentKind::rotary_transition);
+  const int n = intervals(std::max(std::abs(t1 - t0), std::abs(c1 - c0)), step_deg);
+  for (int k = 1; k < n; ++k) {
+    const double f = static_cast<double>(k) / n;
+    seg.samples.push_back(make_sample(q, t0 + f * (t1 - t0), c0 + f * (c1 - c0)));
+  }
+  if (include_end) seg.samples.push_back(make_sample(q, t1, c1));
+  return seg;
+}
+
+// Great-circle arc about the pivot from a to b (both at distance L0 from it) at rotary zero.
+PlanSegment arc_move(const Eigen::Vector3d& pivot, const Eigen::Vector3d& a,
+                     const Eigen::Vector3d& b, double step_deg, bool include_end) {
+  PlanSegment seg = transition(SegmentKind::arc_transition);
+  const Eigen::Vector3d u = (a - pivot).normalized();
+  const Eigen::Vector3d w = (b - pivot).normalized();
+  const double L = (a - pivot).norm();
+  const Eigen::Vector3d cross = u.cross(w);
+  const double s = cross.norm();
+  const double c = u.dot(w);
+  Eigen::Vector3d axis;
+  if (s > 1e-12) {
+    axis = cross / s;
+  } else {
+    // Opposite ends (same ends never get here): any great circle through both works; take the
+    // one over the top of the pivot (rotating u about u x Z moves it towards +Z), or the ZX
+    // plane when u is vertical.
+    const Eigen::Vector3d uz = u.cross(Eigen::Vector3d::UnitZ());
+    axis = uz.norm() > 1e-12 ? Eigen::Vector3d(uz.normalized()) : Eigen::Vector3d::UnitY();
+  }
+  const double angle = std::atan2(s, c);
+  seg.arc.start = a;
+  seg.arc.end = b;
+  seg.arc.center = pivot;
+  seg.arc.axis = axis;
+  seg.arc.angle = angle;
+  seg.arc.principal_axis = -1;
+  for (int i = 0; i < 3; ++i) {
+    Eigen::Vector3d e = Eigen::Vector3d::Zero();
+    e[i] = 1.0;
+    if ((axis - e).norm() < 1e-12 || (axis + e).norm() < 1e-12) {
+      seg.arc.principal_axis = i;
+      seg.arc.axis = axis[i] > 0 ? e : Eigen::Vector3d(-e);  // exact, so the plane stays exact
+    }
+  }
+  const int n = intervals(angle / kDeg, step_deg);
+  for (int k = 1; k < n; ++k) {
+    const double phi = angle * static_cast<double>(k) / n;
+    seg.samples.push_back(
+        make_sample(pivot + L * (rotation_about_axis<double>(seg.arc.axis, phi) * u), 0.0, 0.0));
+  }
+  if (include_end) seg.samples.push_back(make_sample(b, 0.0, 0.0));
+  return seg;
+}
+
+bool at_zero(const PlannedSample& s) { return s.tilt_deg == 0.0 && s.rot_deg == 0.0; }
+
+// The moves from the last sample of one test to the first sample of the next, in order; every
+// one keeps the tool at L0 from the pivot. The last move stops short of `to`, which is the
+// next test's first sample.
+std::vector<PlanSegment> transitions(const BallbarSetup& s, const PlannedSample& from,
+                                     const PlannedSample& to) {
+  struct Move {
+    enum { rotary, arc } kind;
+    Eigen::Vector3d a, b;
+    double t0, c0, t1, c1;
+  };
+  std::vector<Move> moves;
+  const bool same_point = (from.p_table - to.p_table).norm() < kLengthTol;
+  const bool same_angles = from.tilt_deg == to.tilt_deg && from.rot_deg == to.rot_deg;
+  if (same_point) {
+    if (!same_angles)
+      moves.push_back(
+          {Move::rotary, from.p_table, from.p_table, from.tilt_deg, from.rot_deg, to.tilt_deg,
+           to.rot_deg});
+  } else {
+    if (!at_zero(from))
+      moves.push_back(
+          {Move::rotary, from.p_table, from.p_table, from.tilt_deg, from.rot_deg, 0.0, 0.0});
+    moves.push_back({Move::arc, from.p_table, to.p_table, 0.0, 0.0, 0.0, 0.0});
+    if (!at_zero(to))
+      moves.push_back({Move::rotary, to.p_table, to.p_table, 0.0, 0.0, to.tilt_deg, to.rot_deg});
+  }
+  std::vector<PlanSegment> out;
+  for (std::size_t i = 0; i < moves.size(); ++i) {
+    const Move& m = moves[i];
+    const bool include_end = i + 1 < moves.size();
+    if (m.kind == Move::rotary)
+      out.push_back(rotary_move(m.a, m.t0, m.c0, m.t1, m.c1, s.step_deg, include_end));
+    else
+      out.push_back(arc_move(s.pivot, m.a, m.b, s.step_deg, include_end));
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string test_label(BallbarTest test, MachineType machine) {
+  const std::string tilt(1, tilt_axis_letter(machine));
+  switch (test) {
+    case BallbarTest::sphere_xy: return "sphere_xy";
+    case BallbarTest::sphere_yz: return "sphere_yz";
+    case BallbarTest::sphere_zx: return "sphere_zx";
+    case BallbarTest::radial_tilt: return "radial_" + tilt;
+    case BallbarTest::axial_tilt: return "axial_" + tilt;
+    case BallbarTest::radial_c: return "radial_C";
+    case BallbarTest::axial_c: return "axial_C";
+  }
+  ROTACAL_ASSERT(false);
+  return {};
+}
+
+BallbarTest parse_ballbar_test(const std::string& label, MachineType machine) {
+  static const BallbarTest all[] = {BallbarTest::sphere_xy,   BallbarTest::sphere_yz,
+                                    BallbarTest::sphere_zx,   BallbarTest::radial_tilt,
+                                    BallbarTest::axial_tilt,  BallbarTest::radial_c,
+                                    BallbarTest::axial_c};
+  std::string known;
+  for (BallbarTest t : all) {
+    if (test_label(t, machine) == label) return t;
+    known += (known.empty() ? "" : ", ") + test_label(t, machine);
+  }
+  throw InvalidArgument("unknown ballbar test '" + label + "' for a " + to_string(machine) +
+                        " machine (known: " + known + ")");
+}
+
+std::vector<BallbarTest> default_ballbar_tests() {
+  return {BallbarTest::sphere_xy,   BallbarTest::sphere_yz, BallbarTest::sphere_zx,
+          BallbarTest::radial_tilt, BallbarTest::axial_c,   BallbarTest::radial_c,
+          BallbarTest::axial_tilt};
+}
+
+std::string to_string(RadialSide side) {
+  return side == RadialSide::outside ? "outside" : "inside";
+}
+
+RadialSide parse_radial_side(const std::string& text) {
+  if (text == "outside" || text == "+") return RadialSide::outside;
+  if (text == "inside" || text == "-") return RadialSide::inside;
+  throw InvalidArgument("unknown radial side '" + text + "' (known: outside, inside, +, -)");
+}
+
+RotaryAngles<double> PlannedSample::angles_rad() const { return {tilt_deg * kDeg, rot_deg * kDeg}; }
+
+std::size_t BallbarPlan::num_samples() const {
+  std::size_t n = 0;
+  for (const auto& s : segments) n += s.samples.size();
+  return n;
+}
+
+double BallbarPlan::duration() const {
+  for (auto it = segments.rbegin(); it != segments.rend(); ++it)
+    if (!it->samples.empty()) return it->samples.back().time;
+  return 0.0;
+}
+
+BallbarPlan plan_ballbar_test(const BallbarSetup& setup,
+                              const std::optional<LocationErrors<double>>& identified) {
+  validate(setup);
+  if (identified) require(identified->v.allFinite(), "identified location errors must be finite");
+
+  BallbarPlan plan;
+  plan.setup = setup;
+  plan.compensation = identified;
+
+  for (BallbarTest t : setup.tests) {
+    PlanSegment test = make_test(setup, t);
+    ROTACAL_ASSERT(!test.samples.empty());
+    if (!plan.segments.empty()) {
+      const PlannedSample& last = plan.segments.back().samples.back();
+      // segments.back() is the previous test here, never a transition.
+      for (PlanSegment& tr : transitions(setup, last, test.samples.front())) {
+        // A rotary move of one step has no point of its own: the next test's first sample is
+        // its end. An arc without points still is a move (it carries its geometry).
+        if (tr.kind == SegmentKind::rotary_transition && tr.samples.empty()) continue;
+        plan.segments.push_back(std::move(tr));
+      }
+    }
+    plan.segments.push_back(std::move(test));
+  }
+
+  // Machine axes (inverse kinematics on the nominal or identified model) and time stamps.
+  const LocationErrors<double> e = identified ? *identified : LocationErrors<double>();
+  const PlannedSample* prev = nullptr;
+  for (PlanSegment& seg : plan.segments) {
+    for (PlannedSample& s : seg.samples) {
+      s.xyz = inverse(setup.machine, e, s.angles_rad(), s.p_table).xyz;
+      if (prev == nullptr) {
+        s.time = 0.0;
+      } else {
+        const double linear = (s.xyz - prev->xyz).norm() / setup.feed_mm_per_min;
+        const double rotary =
+            std::max(std::abs(s.tilt_deg - prev->tilt_deg), std::abs(s.rot_deg - prev->rot_deg)) /
+            setup.feed_deg_per_min;
+        const double dt = 60.0 * std::max(linear, rotary);
+        ROTACAL_ASSERT(dt > 0.0);
+        s.time = prev->time + dt;
+      }
+      prev = &s;
+    }
+  }
+  return plan;
+}
+
+PlanTable tabulate(const BallbarPlan& plan) {
+  PlanTable t;
+  const auto n = static_cast<Eigen::Index>(plan.num_samples());
+  t.labels.reserve(static_cast<std::size_t>(n));
+  t.segment.reserve(static_cast<std::size_t>(n));
+  t.time.resize(n);
+  t.p_table.resize(n, 3);
+  t.angles_deg.resize(n, 2);
+  t.machine_axes.resize(n, 5);
+  Eigen::Index i = 0;
+  for (std::size_t k = 0; k < plan.segments.size(); ++k) {
+    for (const PlannedSample& s : plan.segments[k].samples) {
+      t.labels.push_back(plan.segments[k].label);
+      t.segment.push_back(static_cast<int>(k));
+      t.time[i] = s.time;
+      t.p_table.row(i) = s.p_table.transpose();
+      t.angles_deg.row(i) << s.tilt_deg, s.rot_deg;
+      t.machine_axes.row(i) << s.xyz.x(), s.xyz.y(), s.xyz.z(), s.tilt_deg, s.rot_deg;
+      ++i;
+    }
+  }
+  return t;
+}
+
+BallbarSession commanded_session(const BallbarPlan& plan) {
+  BallbarSession session;
+  session.machine = plan.setup.machine;
+  session.ballbar_length = plan.setup.ballbar_length;
+  session.pivot = plan.setup.pivot;
+  for (const PlanSegment& seg : plan.segments) {
+    if (seg.kind != SegmentKind::test) continue;
+    for (const PlannedSample& s : seg.samples) {
+      BallbarSample b;
+      b.test = seg.label;
+      b.time = s.time;
+      b.xyz = s.xyz;
+      b.tilt_deg = s.tilt_deg;
+      b.rot_deg = s.rot_deg;
+      b.length = plan.setup.ballbar_length;
+      session.samples.push_back(std::move(b));
+    }
+  }
+  return session;
+}
+
+}  // namespace rotacal
