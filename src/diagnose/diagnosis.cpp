@@ -128,7 +128,7 @@ struct Score {
 };
 
 Score score(const DiagnosisProblem& P, const ModelFit& fit, const Eigen::MatrixXd& Jfree,
-            const Eigen::MatrixXd& Q, const Effect& c, double sigma_mm) {
+            const Eigen::MatrixXd& Q, const Effect& c, double sigma_mm, double min_chi2) {
   Score s;
   s.effect = c;
   const Eigen::MatrixXd Jc = P.candidate_jacobian(fit, c);
@@ -138,15 +138,17 @@ Score score(const DiagnosisProblem& P, const ModelFit& fit, const Eigen::MatrixX
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(perp, Eigen::ComputeThinV);
   const Eigen::VectorXd sv = svd.singularValues();
   std::vector<Eigen::Index> dirs;
+  const double limit = std::sqrt(min_chi2);
   for (Eigen::Index i = 0; i < sv.size(); ++i)
-    if (sv[i] >= 1.0) dirs.push_back(i);  // moving by plausible magnitudes: chi2 change >= 1
+    if (sv[i] >= limit) dirs.push_back(i);  // plausible sizes change chi-square by >= min_chi2
   if (dirs.empty()) {
     Eigen::JacobiSVD<Eigen::MatrixXd> svd_raw(raw);
-    const bool absorbed = svd_raw.singularValues().size() && svd_raw.singularValues()[0] >= 1.0;
+    const bool absorbed = svd_raw.singularValues().size() && svd_raw.singularValues()[0] >= limit;
     s.why_not = absorbed
                     ? "its effect on these readings is indistinguishable from the location "
                       "errors and set-up parameters already in the model"
-                    : "it changes none of these readings beyond the noise";
+                    : "at any plausible size it changes these readings by less than 5 sigma "
+                      "in all (e.g. a motion perpendicular to the bar)";
     return s;
   }
   s.observable = true;
@@ -339,7 +341,7 @@ Diagnosis diagnose(const DiagnosisProblem& P, const DiagnosisOptions& options) {
     std::vector<Score> scores;
     for (std::size_t c = 0; c < candidates.size(); ++c) {
       if (done[c]) continue;
-      Score s = score(P, fit, Jfree, Q, candidates[c], sigma_mm);
+      Score s = score(P, fit, Jfree, Q, candidates[c], sigma_mm, options.min_visible_chi2);
       if (!s.observable) {
         if (first_round) D.unobservable.push_back({candidates[c].id(), s.why_not});
         done[c] = true;
@@ -348,6 +350,12 @@ Diagnosis diagnose(const DiagnosisProblem& P, const DiagnosisOptions& options) {
       scores.push_back(std::move(s));
     }
     first_round = false;
+    std::vector<CandidateScore> table;
+    for (const Score& s : scores)
+      table.push_back({s.effect.id(), s.k, s.delta_bic, s.f_pvalue, std::sqrt(s.rss1 / n) * 1e3});
+    std::sort(table.begin(), table.end(),
+              [](const CandidateScore& a, const CandidateScore& b) { return a.delta_bic < b.delta_bic; });
+    D.rounds.push_back(std::move(table));
     const double m_tests = std::max<double>(1.0, static_cast<double>(scores.size()));
     std::vector<const Score*> passing;
     for (const Score& s : scores)

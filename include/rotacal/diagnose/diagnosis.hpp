@@ -74,6 +74,10 @@ struct DiagnosisOptions {
   double ambiguity_delta_bic = 10.0;  ///< candidates within this BIC of the best ...
   double ambiguity_correlation = 0.95;  ///< ... whose fitted signatures correlate this well
   std::vector<std::string> only;  ///< restrict candidates to these ids (empty: all)
+  /// A candidate is visible when moving its parameters by plausible sizes (1 mm, 1 mrad,
+  /// 1 um/s, 1e-3 for ratios) beyond what the model absorbs changes chi-square by at least
+  /// this much (25: a 5-sigma change); others are reported unobservable.
+  double min_visible_chi2 = 25.0;
 };
 
 /// Residual structure of one group.
@@ -132,6 +136,15 @@ struct Unexplained {
   std::string signature;  ///< the strongest remaining structure, in words
 };
 
+/// How one candidate scored against a model (linearised refit).
+struct CandidateScore {
+  std::string effect;
+  int visible_params = 0;  ///< parameter directions the data can see
+  double delta_bic = 0.0;
+  double f_pvalue = 1.0;
+  double rms_after_um = 0.0;
+};
+
 struct Diagnosis {
   MachineType machine = MachineType::AC_trt;
   struct Baseline {
@@ -146,6 +159,9 @@ struct Diagnosis {
   std::vector<GroupResidual> structure_before;
   std::vector<GroupResidual> structure_after;
   std::vector<Finding> findings;  ///< in the order they were added
+  /// Every observable candidate scored against each model in turn (rounds[0]: baseline),
+  /// best first.
+  std::vector<std::vector<CandidateScore>> rounds;
   std::vector<Ambiguity> ambiguous;
   std::vector<UnobservableEffect> unobservable;
   Unexplained unexplained;
