@@ -204,7 +204,8 @@ std::string separating_test(const DiagnosisProblem& P, const ModelFit& fit, cons
   std::ostringstream out;
   out.precision(2);
   if (best.empty() || best_rms < sigma_mm)
-    out << "no test of the standard set separates them (predicted difference below the noise)";
+    out << "no test of the standard single set-up separates them (their predictions differ by "
+           "less than the noise there): another set-up, e.g. another pivot position, is needed";
   else
     out << "a '" << best << "' test separates them: their predictions differ there by "
         << std::fixed << best_rms * 1e3 << " um RMS";
@@ -279,11 +280,12 @@ std::vector<GroupResidual> residual_structure(const DiagnosisProblem& P, const E
     Eigen::MatrixXd T(y.size(), 2);
     for (Eigen::Index k = 0; k < y.size(); ++k) T(k, 0) = 1.0, T(k, 1) = t[idx[static_cast<std::size_t>(k)]];
     if (y.size() >= 3) G.trend_um_per_s = solve_ls(T, y)[1] * 1e3;
-    // Harmonics in the angle that varies (if it spans at least 90 deg).
+    // Harmonics in the swept angle: only over a (nearly) full turn. On a partial arc the
+    // cos/sin of different orders are nearly collinear and the "spectrum" means nothing.
     const double span_t = hi_t - lo_t, span_r = hi_r - lo_r;
     const bool use_rot = span_r >= span_t;
-    if (std::max(span_t, span_r) >= M_PI / 2 && y.size() >= 20) {
-      G.angle_axis = use_rot ? 'C' : tilt;
+    if (std::max(span_t, span_r) > 0.0) G.angle_axis = use_rot ? 'C' : tilt;
+    if (std::max(span_t, span_r) >= 330.0 * M_PI / 180.0 && y.size() >= 20) {
       const int orders = 8;
       Eigen::MatrixXd H(y.size(), 1 + 2 * orders);
       for (Eigen::Index k = 0; k < y.size(); ++k) {

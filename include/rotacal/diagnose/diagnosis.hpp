@@ -87,7 +87,8 @@ struct GroupResidual {
   double rms_um = 0.0;
   double mean_um = 0.0;
   char angle_axis = 0;                 ///< the rotary axis that varies in the group (0: none)
-  std::vector<double> harmonic_um;     ///< amplitude of orders 1..8 in that angle, um
+  std::vector<double> harmonic_um;     ///< amplitude of orders 1..8 in that angle, um (only
+                                       ///< when it sweeps a full turn; empty otherwise)
   double trend_um_per_s = 0.0;         ///< least-squares slope against time
 };
 

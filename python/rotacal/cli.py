@@ -1,0 +1,457 @@
+"""The ``rotacal`` command line.
+
+Exit codes: 0 success; 2 usage error; 3 invalid input (a malformed file, a bad parameter, a
+degenerate geometry); 4 I/O error (cannot read or write a file or device); 5 any other
+rotacal error.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+
+from . import _core
+from .ballbar import identify, predict, random_location_errors
+from .diagnosis import diagnose
+from .models import ballbar_model_from_dict, load_model, save_model
+from .sessions import load, save
+
+EXIT_OK, EXIT_USAGE, EXIT_INPUT, EXIT_IO, EXIT_ERROR = 0, 2, 3, 4, 5
+
+EPILOG = ("exit codes: 0 success, 2 usage error, 3 invalid input (malformed file, bad parameter, "
+          "degenerate geometry), 4 I/O error, 5 other rotacal error")
+
+# Flynn et al. 2016, Table 2, uncompensated: the machine of the paper's experiment.
+TABLE2_ERRORS = {"E_Y0A": 0.0726, "E_Z0A": -0.0202, "E_B0A": 1.1284e-05, "E_C0A": -0.000113006,
+                 "E_X0C": 0.0283, "E_Y0C": 0.1041, "E_A0C": 5.1954e-06, "E_B0C": -4.1544e-05}
+
+
+def _say(msg: str) -> None:
+    print(msg, file=sys.stderr, flush=True)
+
+
+def _floats(text: str, n: int, what: str) -> list[float]:
+    try:
+        vals = [float(v) for v in text.split(",")]
+    except ValueError:
+        raise _core.InvalidArgument(f"{what}: '{text}' is not {n} comma-separated numbers") from None
+    if len(vals) != n or not all(np.isfinite(vals)):
+        raise _core.InvalidArgument(f"{what}: '{text}' must be {n} finite comma-separated numbers")
+    return vals
+
+
+# ------------------------------------------------------------------------- plan and set-up
+
+def _add_setup_args(p: argparse.ArgumentParser) -> None:
+    g = p.add_argument_group("test set-up (Flynn et al. 2016, Table 1)")
+    g.add_argument("--machine", default="AC-trt", help="AC-trt or BC-trt (default AC-trt)")
+    g.add_argument("--length", type=float, default=100.0, help="calibrated ballbar length L0, mm")
+    g.add_argument("--pivot", default="120,0,60", help="nominal pivot x,y,z on the table, mm (O_x, 0, O_z)")
+    g.add_argument("--a-range", "--b-range", dest="tilt_range", default="-90,90",
+                   help="tilt axis range, deg (A for AC-trt, B for BC-trt)")
+    g.add_argument("--c-range", default="0,359", help="C range, deg")
+    g.add_argument("--step", type=float, default=1.0, help="sample spacing, deg")
+    g.add_argument("--feed", type=float, default=1000.0, help="linear feed, mm/min")
+    g.add_argument("--rotary-feed", type=float, default=3600.0, help="rotary feed, deg/min")
+    g.add_argument("--tests", default="", help="comma-separated test labels (default: all seven)")
+    g.add_argument("--radial-c", default="outside", help="radial C tool circle outside or inside the pivot's")
+
+
+def _setup(a: argparse.Namespace):
+    s = _core.BallbarSetup()
+    s.machine = _core.parse_machine_type(a.machine)
+    s.ballbar_length = a.length
+    s.pivot = np.array(_floats(a.pivot, 3, "--pivot"))
+    s.tilt_range_deg = np.array(_floats(a.tilt_range, 2, "--a-range/--b-range"))
+    s.rot_range_deg = np.array(_floats(a.c_range, 2, "--c-range"))
+    s.step_deg = a.step
+    s.feed_mm_per_min = a.feed
+    s.feed_deg_per_min = a.rotary_feed
+    if a.tests:
+        s.tests = [_core.parse_ballbar_test(t.strip(), s.machine) for t in a.tests.split(",")]
+    s.radial_c_side = _core.parse_radial_side(a.radial_c)
+    return s
+
+
+def cmd_plan(a: argparse.Namespace) -> int:
+    setup = _setup(a)
+    identified = None
+    if a.compensate:
+        model = ballbar_model_from_dict(load_model(a.compensate), a.compensate)
+        if model.machine != setup.machine:
+            raise _core.InvalidArgument(f"{a.compensate}: model is for {_core.machine_name(model.machine)}")
+        identified = model.errors
+    plan = _core.plan_ballbar_test(setup, identified)
+    text = _core.write_nc_program(plan, _core.parse_nc_dialect(a.dialect))
+    Path(a.output).write_text(text)
+    _say(f"wrote {a.output}: {a.dialect} program, {plan.num_samples} points, {plan.duration:.0f} s"
+         + (" (compensated)" if identified is not None else ""))
+    if a.session:
+        save(plan.commanded_session(), a.session)
+        _say(f"wrote {a.session}: the commanded rows as a session template")
+    return EXIT_OK
+
+
+# ------------------------------------------------------------------------- simulate
+
+def _truth(a: argparse.Namespace, machine) -> dict:
+    names = list(_core.location_error_names(machine))
+    rng = np.random.default_rng(a.seed)
+    if a.errors == "random":
+        errors = dict(zip(names, random_location_errors(machine, rng).tolist()))
+    elif a.errors == "table2":
+        if machine != _core.MachineType.AC_trt:
+            raise _core.InvalidArgument("--errors table2 is the paper's AC-trt machine")
+        errors = dict(TABLE2_ERRORS)
+    elif a.errors == "zero":
+        errors = {n: 0.0 for n in names}
+    else:
+        errors = {n: 0.0 for n in names}
+        for item in a.errors.split(","):
+            key, _, val = item.partition("=")
+            if key.strip() not in names:
+                raise _core.InvalidArgument(f"--errors: '{key}' is not a location error of {_core.machine_name(machine)}")
+            errors[key.strip()] = _floats(val, 1, f"--errors {key}")[0]
+    effects = {}
+    for item in a.effect or []:
+        key, _, val = item.partition("=")
+        eff = _core.Effect(key.strip())
+        effects[eff.id] = _floats(val, eff.num_params, f"--effect {key}")
+    return {"errors": errors, "pivot_error": (rng.normal(0.0, a.pivot_error, 3)).tolist(),
+            "effects": effects, "noise_um": a.noise, "seed": a.seed}
+
+
+def simulate_session(setup, truth: dict):
+    """Plan the test, run it on the machine described by `truth`, return (session, model)."""
+    plan = _core.plan_ballbar_test(setup, None)
+    commanded = plan.commanded_session()
+    names = list(_core.location_error_names(setup.machine))
+    ids = list(truth["effects"].keys())
+    params = [v for i in ids for v in truth["effects"][i]]
+    model = _core.BallbarMachineModel(setup.machine, np.array([truth["errors"][n] for n in names]),
+                                      np.asarray(setup.pivot) + np.array(truth["pivot_error"]), ids, params)
+    return _core.simulate_ballbar(commanded, model, truth["noise_um"], truth["seed"]), model
+
+
+def cmd_simulate(a: argparse.Namespace) -> int:
+    if a.kind != "ballbar":
+        raise _core.InvalidArgument("simulate: only 'ballbar' is available from this command so far")
+    setup = _setup(a)
+    truth = _truth(a, setup.machine)
+    session, model = simulate_session(setup, truth)
+    save(session, a.output)
+    truth["pivot_actual"] = model.pivot.tolist()
+    if a.truth:
+        Path(a.truth).write_text(json.dumps(truth, indent=1) + "\n")
+    _say(f"wrote {a.output}: {len(session)} samples on a simulated {a.machine}"
+         + (f", truth in {a.truth}" if a.truth else ""))
+    return EXIT_OK
+
+
+# ------------------------------------------------------------------------- analyse
+
+def _ballbar(path: str):
+    s = load(path)
+    if not isinstance(s, _core.BallbarSession):
+        raise _core.InvalidArgument(f"{path}: this command needs a rotacal-ballbar/1 session")
+    return s
+
+
+def _print_identification(d: dict) -> None:
+    print(f"{d['method']} identification, {d['machine']}, {d['n_samples']} samples, "
+          f"residual RMS {d['residual_rms_um']:.3f} um")
+    for name, p in d["location_errors"].items():
+        if p["value"] is None:
+            print(f"  {name:6s}  unobservable")
+        elif p["unit"] == "mm":
+            print(f"  {name:6s} {p['value'] * 1e3:+9.3f} um  +- {p['std'] * 1e3:.3f}")
+        else:
+            print(f"  {name:6s} {p['value'] * 1e6:+9.3f} urad +- {p['std'] * 1e6:.3f}")
+    for axis, p in d["pivot"].items():
+        print(f"  pivot {axis}  " + ("unobservable" if p["value"] is None else f"{p['value']:.4f} mm +- {p['std'] * 1e3:.3f} um"))
+    for u in d["unobservable"]:
+        print(f"  not determined by these tests: {u}")
+
+
+def cmd_identify(a: argparse.Namespace) -> int:
+    s = load(a.file)
+    if isinstance(s, _core.RtestSession):
+        from . import rtest  # noqa: F401  (the R-test API; raises if not built)
+        result = rtest.identify_rtest(s, method=a.method)
+    else:
+        result = identify(s, a.method, fit_length_offset=a.length_offset)
+    d = result.to_dict()
+    if a.save_model:
+        save_model(result.model_dict(), a.save_model)
+        _say(f"wrote {a.save_model}")
+    if a.json:
+        print(json.dumps(d, indent=1))
+    else:
+        _print_identification(d)
+    return EXIT_OK
+
+
+def cmd_diagnose(a: argparse.Namespace) -> int:
+    s = _ballbar(a.file)
+    result = diagnose(s, max_harmonic=a.max_harmonic)
+    d = result.to_dict()
+    if a.report:
+        from .report import ballbar_report
+        ballbar_report(a.report, s, identify(s), result, source=a.file)
+        _say(f"wrote {a.report}")
+    if a.json:
+        print(json.dumps(d, indent=1))
+        return EXIT_OK
+    b = d["baseline"]
+    print(f"baseline: residual RMS {b['residual_rms_um']:.3f} um, noise {b['noise_um']:.3f} um "
+          f"({b['noise_source']}), chi2/dof {b['chi2_per_dof']:.2f}")
+    if not d["findings"]:
+        print("no effect of the catalogue is significant")
+    for i, f in enumerate(d["findings"], 1):
+        g = f["gain"]
+        print(f"{i}. {f['effect']}: {f['cause']}")
+        for name, p in f["parameters"].items():
+            print(f"     {name} = " + ("unobservable" if p["value"] is None else f"{p['value']:.4g} +- {p['std']:.2g} {p['unit']}"))
+        print(f"     RMS {g['rms_before_um']:.3f} -> {g['rms_after_um']:.3f} um, delta BIC {g['delta_bic']:.1f}, "
+              f"CV RMS {g['cv_rms_before_um']:.3f} -> {g['cv_rms_after_um']:.3f} um")
+    for amb in d["ambiguous"]:
+        print(f"cannot be told apart with this data: {', '.join(amb['effects'])} ({amb['separating_test']})")
+    if d["unexplained"]["present"]:
+        print(f"unexplained structure remains: {d['unexplained']['signature']}")
+    print(f"{len(d['unobservable'])} catalogue entries are invisible to this session's tests "
+          "(--json lists them with reasons)")
+    return EXIT_OK
+
+
+def cmd_predict(a: argparse.Namespace) -> int:
+    model_dict = load_model(a.model)
+    s = load(a.session)
+    if model_dict.get("kind") == "rtest":
+        from . import rtest
+        out = rtest.predict_rtest(model_dict, s)
+    else:
+        out = predict(ballbar_model_from_dict(model_dict, a.model), s)
+        res = (s.length - out.length) * 1e3
+        _say(f"measured - predicted: RMS {np.sqrt(np.mean(res ** 2)):.3f} um over {len(s)} samples")
+    save(out, a.output)
+    _say(f"wrote {a.output}")
+    return EXIT_OK
+
+
+def compensation_table(report) -> list[dict]:
+    return [{"name": r.name, "unit": r.unit, "before": r.before, "after": r.after,
+             "std_after": r.std_after, "change_percent": r.change_percent} for r in report.rows]
+
+
+def _print_compensation(rows: list[dict]) -> None:
+    print("error    uncompensated   compensated    change   (Flynn et al. Table 2 layout)")
+    for r in rows:
+        k, unit = (1e3, "um") if r["unit"] == "mm" else (1e6, "urad")
+        print(f"{r['name']:6s} {r['before'] * k:+12.3f} {r['after'] * k:+12.3f} {unit:4s} {r['change_percent']:+8.1f} %")
+
+
+def cmd_compensate(a: argparse.Namespace) -> int:
+    setup = _setup(a)
+    if a.model:
+        model = ballbar_model_from_dict(load_model(a.model), a.model)
+        plan = _core.plan_ballbar_test(setup, model.errors)
+        Path(a.output).write_text(_core.write_nc_program(plan, _core.parse_nc_dialect(a.dialect)))
+        _say(f"wrote {a.output}: compensated {a.dialect} program")
+    if a.verify:
+        truth = _truth(a, setup.machine)
+        _, machine = simulate_session(setup, truth)
+        commanded = _core.plan_ballbar_test(setup, None).commanded_session()
+        _say("measuring, identifying, compensating and measuring again on the simulated machine ...")
+        rep = _core.verify_compensation(commanded, machine, truth["noise_um"], truth["seed"])
+        rows = compensation_table(rep)
+        if a.json:
+            print(json.dumps(rows, indent=1))
+        else:
+            _print_compensation(rows)
+    if not a.model and not a.verify:
+        raise _core.InvalidArgument("compensate: give --model MODEL.json (write a program) and/or --verify")
+    return EXIT_OK
+
+
+def cmd_report(a: argparse.Namespace) -> int:
+    from .report import ballbar_report
+    s = _ballbar(a.file)
+    ident = identify(s, a.method)
+    d = diagnose(s) if not a.no_diagnosis else None
+    ballbar_report(a.output, s, ident, d, source=a.file)
+    print(Path(a.output).resolve())
+    return EXIT_OK
+
+
+# ------------------------------------------------------------------------- demo (main job)
+
+def cmd_demo(a: argparse.Namespace) -> int:
+    """Simulate a machine with errors and one hidden effect, measure, identify, diagnose,
+    compensate, and write a report."""
+    from .report import ballbar_report
+    out = Path(a.output)
+    out.mkdir(parents=True, exist_ok=True)
+    steps = 6
+    t0 = time.monotonic()
+
+    def step(i: int, what: str) -> None:
+        _say(f"[{i}/{steps}] {what} ({time.monotonic() - t0:.1f} s)")
+
+    step(1, "planning the single set-up ballbar test (AC-trt, L0 = 100 mm, pivot 120, 0, 60)")
+    setup = _core.BallbarSetup()
+    plan = _core.plan_ballbar_test(setup, None)
+    (out / "ballbar_test.ngc").write_text(_core.write_nc_program(plan, _core.parse_nc_dialect("linuxcnc")))
+    (out / "ballbar_test.h").write_text(_core.write_nc_program(plan, _core.parse_nc_dialect("heidenhain")))
+
+    step(2, "simulating the machine of Flynn et al. Table 2 with a pivot set-up error and a hidden effect")
+    truth = {"errors": dict(TABLE2_ERRORS), "pivot_error": [0.012, -0.008, 0.015],
+             "effects": {"gravity_sag_A": [a.sag]}, "noise_um": 0.5, "seed": a.seed}
+    session, machine = simulate_session(setup, truth)
+    save(session, out / "session.csv")
+    truth["pivot_actual"] = machine.pivot.tolist()
+    (out / "truth.json").write_text(json.dumps(truth, indent=1) + "\n")
+
+    step(3, "identifying the location errors (joint Ceres fit)")
+    ident = identify(session)
+    save_model(ident.model_dict(), out / "model.json")
+    (out / "identification.json").write_text(json.dumps(ident.to_dict(), indent=1) + "\n")
+
+    step(4, "diagnosing what the location-error model gets wrong")
+    diag = diagnose(session, reference=plan.commanded_session())
+    dd = diag.to_dict()
+    (out / "diagnosis.json").write_text(json.dumps(dd, indent=1) + "\n")
+
+    step(5, "compensating and measuring again (Table 2 experiment)")
+    rows = compensation_table(_core.verify_compensation(plan.commanded_session(), machine, 0.5, a.seed))
+    (out / "compensation.json").write_text(json.dumps(rows, indent=1) + "\n")
+
+    step(6, "writing the report")
+    comp_html = ["<section id='compensation'><h2>Compensation (Flynn et al. Table 2 experiment, simulated)</h2>"
+                 "<table><tr><th class=l>Error</th><th>Uncompensated</th><th>Compensated</th><th>Change</th></tr>"]
+    for r in rows:
+        k, unit = (1e3, "&micro;m") if r["unit"] == "mm" else (1e6, "&micro;rad")
+        comp_html.append(f"<tr><td class=l>{r['name']}</td><td>{r['before'] * k:+.2f} {unit}</td>"
+                         f"<td>{r['after'] * k:+.2f} {unit}</td><td>{r['change_percent']:+.1f} %</td></tr>")
+    comp_html.append("</table></section>")
+    report = ballbar_report(out / "report.html", session, ident, diag, title="rotacal demo: single set-up ballbar test",
+                            source=str(out / "session.csv"), extra_sections=["\n".join(comp_html)])
+
+    print(f"hidden effect: gravity_sag_A, s = {a.sag * 1e3:.1f} um")
+    if dd["findings"]:
+        f = dd["findings"][0]
+        p = next(iter(f["parameters"].values()))
+        print(f"diagnosis found: {f['effect']} ({f['cause']}), "
+              + (f"s = {p['value'] * 1e3:.2f} +- {p['std'] * 1e3:.2f} um" if p["value"] is not None else "unobservable"))
+    else:
+        print("diagnosis found nothing significant")
+    worst = max(r["change_percent"] for r in rows)
+    print(f"compensation reduced every location error by at least {-worst:.1f} %")
+    print(f"report: {report.resolve()}")
+    return EXIT_OK
+
+
+# ------------------------------------------------------------------------- parser
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="rotacal", description="Calibration of the rotary axes of 5-axis machine tools.",
+                                epilog=EPILOG)
+    sub = p.add_subparsers(dest="command", required=True)
+
+    q = sub.add_parser("plan", help="plan a test and write its NC program", epilog=EPILOG)
+    q.add_argument("kind", choices=["ballbar"])
+    _add_setup_args(q)
+    q.add_argument("--dialect", default="linuxcnc", help="linuxcnc (machine axes), heidenhain, siemens, fanuc")
+    q.add_argument("--compensate", metavar="MODEL.json", help="emit the program compensated for a fitted model")
+    q.add_argument("--session", metavar="CSV", help="also write the commanded rows as a session template")
+    q.add_argument("-o", "--output", required=True)
+    q.set_defaults(func=cmd_plan)
+
+    q = sub.add_parser("simulate", help="simulate a measurement on a machine with errors", epilog=EPILOG)
+    q.add_argument("kind", choices=["ballbar"])
+    _add_setup_args(q)
+    _add_truth_args(q)
+    q.add_argument("--truth", metavar="JSON", help="write the simulated machine here")
+    q.add_argument("-o", "--output", required=True)
+    q.set_defaults(func=cmd_simulate)
+
+    q = sub.add_parser("identify", help="identify location errors from a session", epilog=EPILOG)
+    q.add_argument("file")
+    q.add_argument("--method", default="joint", choices=["joint", "paper"])
+    q.add_argument("--length-offset", action="store_true", help="also fit an offset of L0 (joint)")
+    q.add_argument("--json", action="store_true", help="print the result as JSON")
+    q.add_argument("--save-model", metavar="MODEL.json")
+    q.set_defaults(func=cmd_identify)
+
+    q = sub.add_parser("diagnose", help="find what the model gets wrong and why", epilog=EPILOG)
+    q.add_argument("file")
+    q.add_argument("--max-harmonic", type=int, default=4)
+    q.add_argument("--json", action="store_true")
+    q.add_argument("--report", metavar="OUT.html")
+    q.set_defaults(func=cmd_diagnose)
+
+    q = sub.add_parser("predict", help="predict a session with a fitted model", epilog=EPILOG)
+    q.add_argument("session")
+    q.add_argument("--model", required=True)
+    q.add_argument("-o", "--output", required=True)
+    q.set_defaults(func=cmd_predict)
+
+    q = sub.add_parser("compensate", help="compensated NC program, and its verification in simulation", epilog=EPILOG)
+    _add_setup_args(q)
+    _add_truth_args(q)
+    q.add_argument("--model", metavar="MODEL.json", help="fitted model to compensate")
+    q.add_argument("--dialect", default="linuxcnc")
+    q.add_argument("-o", "--output", default="compensated.ngc")
+    q.add_argument("--verify", action="store_true",
+                   help="measure, identify, compensate and measure again on a simulated machine (--errors ...)")
+    q.add_argument("--json", action="store_true")
+    q.set_defaults(func=cmd_compensate)
+
+    q = sub.add_parser("report", help="self-contained HTML report of a session", epilog=EPILOG)
+    q.add_argument("file")
+    q.add_argument("--method", default="joint", choices=["joint", "paper"])
+    q.add_argument("--no-diagnosis", action="store_true")
+    q.add_argument("-o", "--output", required=True)
+    q.set_defaults(func=cmd_report)
+
+    q = sub.add_parser("demo", help="the whole job on a simulated machine: plan, simulate, identify, "
+                                    "diagnose, compensate, report", epilog=EPILOG)
+    q.add_argument("-o", "--output", default="out/demo")
+    q.add_argument("--seed", type=int, default=2016)
+    q.add_argument("--sag", type=float, default=0.004, help="hidden gravity sag of the A table, mm")
+    q.set_defaults(func=cmd_demo)
+    return p
+
+
+def _add_truth_args(q: argparse.ArgumentParser) -> None:
+    g = q.add_argument_group("simulated machine")
+    g.add_argument("--errors", default="random",
+                   help="random (seeded), table2 (Flynn et al.), zero, or NAME=VALUE,... (mm, rad)")
+    g.add_argument("--effect", action="append", metavar="ID=P1,P2",
+                   help="hide a catalogue effect, e.g. gravity_sag_A=0.004 (repeatable)")
+    g.add_argument("--pivot-error", type=float, default=0.02, help="1-sigma pivot placement error, mm")
+    g.add_argument("--noise", type=float, default=0.5, help="1-sigma reading noise, um")
+    g.add_argument("--seed", type=int, default=1)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except (_core.ParseError, _core.InvalidArgument, _core.DegenerateGeometry) as e:
+        _say(f"rotacal: error: {e}")
+        return EXIT_INPUT
+    except (_core.IoError, OSError) as e:
+        _say(f"rotacal: error: {e}")
+        return EXIT_IO
+    except _core.Error as e:
+        _say(f"rotacal: error: {e}")
+        return EXIT_ERROR
+
+
+if __name__ == "__main__":
+    sys.exit(main())
