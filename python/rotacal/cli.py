@@ -438,8 +438,26 @@ def _add_truth_args(q: argparse.ArgumentParser) -> None:
     g.add_argument("--seed", type=int, default=1)
 
 
+# Options whose values may start with '-' ("--a-range -90,90"): argparse would take the value
+# for an option, so such pairs are joined as "--a-range=-90,90" before parsing.
+_SIGNED_VALUE_OPTIONS = {"--a-range", "--b-range", "--c-range", "--pivot", "--errors"}
+
+
+def _join_signed_values(argv: Sequence[str]) -> list[str]:
+    out: list[str] = []
+    it = iter(argv)
+    for tok in it:
+        if tok in _SIGNED_VALUE_OPTIONS:
+            nxt = next(it, None)
+            out.append(tok if nxt is None else f"{tok}={nxt}")
+        else:
+            out.append(tok)
+    return out
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    argv = list(sys.argv[1:] if argv is None else argv)
+    args = build_parser().parse_args(_join_signed_values(argv))
     try:
         return args.func(args)
     except (_core.ParseError, _core.InvalidArgument, _core.DegenerateGeometry) as e:

@@ -1,0 +1,112 @@
+"""The command line and the examples, run as a user runs them."""
+import json
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def rotacal(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "rotacal", *map(str, args)], capture_output=True, text=True,
+                          cwd=cwd, timeout=600)
+
+
+@pytest.mark.parametrize("cmd", ["plan", "simulate", "identify", "diagnose", "predict", "compensate", "report", "demo"])
+def test_help(cmd):
+    r = rotacal(cmd, "--help")
+    assert r.returncode == 0 and "exit codes" in r.stdout
+
+
+def test_demo_finds_the_hidden_effect(tmp_path):
+    r = rotacal("demo", "-o", tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert "[6/6]" in r.stderr  # progress on every step
+    d = json.loads((tmp_path / "diagnosis.json").read_text())
+    assert d["findings"][0]["effect"] == "gravity_sag_A"
+    s = d["findings"][0]["parameters"]["gravity_sag_A"]
+    assert abs(s["value"] - 0.004) <= 3 * s["std"]
+    report = (tmp_path / "report.html").read_text()
+    assert str((tmp_path / "report.html").resolve()) in r.stdout
+    for section in ("setup", "location-errors", "polar", "residuals", "diagnosis", "compensation"):
+        assert f'id="{section}"' in report or f"id='{section}'" in report
+    rows = json.loads((tmp_path / "compensation.json").read_text())
+    assert all(row["change_percent"] < -85 for row in rows)
+
+
+def test_identify_json_and_model_round_trip(shared_data, tmp_path):
+    r = rotacal("identify", shared_data / "ballbar_ac_table2.csv", "--json", "--save-model", tmp_path / "m.json")
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout)
+    assert d["method"] == "joint" and set(d["location_errors"]) == {
+        "E_Y0A", "E_Z0A", "E_B0A", "E_C0A", "E_X0C", "E_Y0C", "E_A0C", "E_B0C"}
+    # A model fitted on one file predicts another session of the same machine; here the
+    # same file, so the residual equals the fit's.
+    r = rotacal("predict", shared_data / "ballbar_ac_table2.csv", "--model", tmp_path / "m.json", "-o", tmp_path / "p.csv")
+    assert r.returncode == 0, r.stderr
+    rms = float(re.search(r"RMS ([0-9.]+) um", r.stderr).group(1))
+    assert rms == pytest.approx(d["residual_rms_um"], abs=1e-3)
+    # ... and a machine with other errors badly.
+    r = rotacal("predict", shared_data / "ballbar_ac_random.csv", "--model", tmp_path / "m.json", "-o", tmp_path / "q.csv")
+    assert float(re.search(r"RMS ([0-9.]+) um", r.stderr).group(1)) > 10
+
+
+def test_diagnose_null_file(shared_data):
+    r = rotacal("diagnose", shared_data / "ballbar_ac_random.csv", "--json")
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout)
+    assert d["findings"] == [] and not d["unexplained"]["present"]
+    assert {"baseline", "findings", "ambiguous", "unobservable", "unexplained", "final_model"} <= set(d)
+
+
+def test_simulate_then_identify(tmp_path):
+    r = rotacal("simulate", "ballbar", "--errors", "table2", "--seed", "3", "-o", tmp_path / "s.csv",
+                "--truth", tmp_path / "t.json")
+    assert r.returncode == 0, r.stderr
+    truth = json.loads((tmp_path / "t.json").read_text())
+    d = json.loads(rotacal("identify", tmp_path / "s.csv", "--json").stdout)
+    for name, p in d["location_errors"].items():
+        assert abs(p["value"] - truth["errors"][name]) <= 3 * p["std"], name
+
+
+def test_plan_writes_programs(tmp_path):
+    for dialect, marker in [("linuxcnc", "G21"), ("heidenhain", "TCPM"), ("siemens", "TRAORI"), ("fanuc", "G43.4")]:
+        out = tmp_path / f"p.{dialect}"
+        r = rotacal("plan", "ballbar", "--machine", "AC-trt", "--length", "100", "--pivot", "120,0,60",
+                    "--a-range", "-90,90", "--step", "1", "--dialect", dialect, "-o", out)
+        assert r.returncode == 0, r.stderr
+        assert marker in out.read_text()
+
+
+def test_errors_have_exit_codes(tmp_path):
+    bad = tmp_path / "bad.csv"
+    bad.write_text("# format: rotacal-ballbar/1\n# machine: AC-trt\n# ballbar_length: 100\n# pivot: 1,2,3\n"
+                   "test,time,X,Y,Z,A,C,length\nt,0,1,2,x,0,0,100\n")
+    r = rotacal("identify", bad)
+    assert r.returncode == 3 and "bad.csv:6" in r.stderr
+    r = rotacal("identify", tmp_path / "missing.csv")
+    assert r.returncode == 4 and "missing.csv" in r.stderr
+    r = rotacal("plan", "ballbar", "--pivot", "1,2", "-o", tmp_path / "x.ngc")
+    assert r.returncode == 3 and "--pivot" in r.stderr
+    assert rotacal("identify").returncode == 2
+
+
+@pytest.mark.parametrize("script,args", [("simulate_and_diagnose.py", []),
+                                         ("identify_session.py", ["ballbar_ac_table2.csv"])])
+def test_examples_run(shared_data, script, args):
+    r = subprocess.run([sys.executable, str(ROOT / "examples" / script), *[str(shared_data / a) for a in args]],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip()
+
+
+def test_readme_python_example_runs(shared_data, tmp_path):
+    text = (ROOT / "README.md").read_text()
+    blocks = re.findall(r"```python\n(.*?)```", text, re.S)
+    assert blocks, "README has no python example"
+    for code in blocks:
+        r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, cwd=ROOT)
+        assert r.returncode == 0, r.stderr
