@@ -93,7 +93,8 @@ class Writer {
       for (char& c : text) {
         if (c == '(') c = '[';
         if (c == ')') c = ']';
-        if (d_ == NcDialect::fanuc) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+        if (d_ == NcDialect::fanuc)
+          c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
       }
       line("(" + text + ")");
     } else {
@@ -132,7 +133,8 @@ class Writer {
   // the NOMINAL kinematics take to the planned machine axes (= p_table for a nominal plan).
   Eigen::Vector3d coords(const PlannedSample& s) const {
     if (!is_tcp_dialect() || !tcp_on_) return s.xyz;
-    const Pose<double> T = table_pose(plan_.setup.machine, LocationErrors<double>(), s.angles_rad());
+    const Pose<double> T =
+        table_pose(plan_.setup.machine, LocationErrors<double>(), s.angles_rad());
     return T.inverse() * s.xyz;
   }
 
@@ -174,8 +176,8 @@ class Writer {
       static const char* planes[] = {"G19", "G18", "G17"};
       const Eigen::Vector3d off = a.center - cur.xyz;  // I J K: centre relative to the start
       line(std::string(planes[n]) + (positive ? " G3 " : " G2 ") + names[lo] + num(e[lo]) + " " +
-           names[hi] + num(e[hi]) + " " + centre_names[lo] + num(off[lo]) + " " +
-           centre_names[hi] + num(off[hi]) + " " + feed_word(dt));
+           names[hi] + num(e[hi]) + " " + centre_names[lo] + num(off[lo]) + " " + centre_names[hi] +
+           num(off[hi]) + " " + feed_word(dt));
     }
     cur = {e, 0.0, 0.0, t_end};
   }
@@ -262,8 +264,7 @@ class Writer {
         if (o_.tool > 0) line("G43 H" + std::to_string(o_.tool));
         break;
       case NcDialect::heidenhain: {
-        if (o_.program_name.empty() ||
-            o_.program_name.find_first_of(" \t\n;") != std::string::npos)
+        if (o_.program_name.empty() || o_.program_name.find_first_of(" \t\n;") != std::string::npos)
           throw InvalidArgument("write_nc_program: program_name must be one word, got '" +
                                 o_.program_name + "'");
         line("BEGIN PGM " + o_.program_name + " MM");
@@ -364,10 +365,14 @@ class Writer {
 
 std::string to_string(NcDialect dialect) {
   switch (dialect) {
-    case NcDialect::linuxcnc: return "linuxcnc";
-    case NcDialect::heidenhain: return "heidenhain";
-    case NcDialect::siemens: return "siemens";
-    case NcDialect::fanuc: return "fanuc";
+    case NcDialect::linuxcnc:
+      return "linuxcnc";
+    case NcDialect::heidenhain:
+      return "heidenhain";
+    case NcDialect::siemens:
+      return "siemens";
+    case NcDialect::fanuc:
+      return "fanuc";
   }
   ROTACAL_ASSERT(false);
   return {};

@@ -130,18 +130,18 @@ PlanSegment make_test(const BallbarSetup& s, BallbarTest t) {
   switch (t) {
     case BallbarTest::sphere_xy:
       for (double a : sweep(0.0, 360.0, s.step_deg))
-        seg.samples.push_back(
-            make_sample(p + L * Eigen::Vector3d(std::cos(a * kDeg), std::sin(a * kDeg), 0.0), 0, 0));
+        seg.samples.push_back(make_sample(
+            p + L * Eigen::Vector3d(std::cos(a * kDeg), std::sin(a * kDeg), 0.0), 0, 0));
       break;
     case BallbarTest::sphere_yz:
       for (double a : sweep(0.0, 180.0, s.step_deg))
-        seg.samples.push_back(
-            make_sample(p + L * Eigen::Vector3d(0.0, std::cos(a * kDeg), std::sin(a * kDeg)), 0, 0));
+        seg.samples.push_back(make_sample(
+            p + L * Eigen::Vector3d(0.0, std::cos(a * kDeg), std::sin(a * kDeg)), 0, 0));
       break;
     case BallbarTest::sphere_zx:
       for (double a : sweep(0.0, 180.0, s.step_deg))
-        seg.samples.push_back(
-            make_sample(p + L * Eigen::Vector3d(std::cos(a * kDeg), 0.0, std::sin(a * kDeg)), 0, 0));
+        seg.samples.push_back(make_sample(
+            p + L * Eigen::Vector3d(std::cos(a * kDeg), 0.0, std::sin(a * kDeg)), 0, 0));
       break;
     case BallbarTest::radial_tilt:
     case BallbarTest::axial_tilt: {
@@ -172,17 +172,20 @@ int intervals(double extent_deg, double step_deg) {
   return std::max(1, static_cast<int>(std::ceil(extent_deg / step_deg - kAngleTol)));
 }
 
-// Rotary axes from (t0, c0) to (t1, c1) with the tool fixed on the table at q: both axes
-// interpolated together, steps no larger than step_deg. Holds the points after the start,
-// the end only if `include_end`.
+// Rotary axes from (t0, c0) to (t1, c1) with the tool fixed on the table at q (any path of
+// the axes keeps the ballbar in place). Both axes turn together by step_deg per block until
+// each reaches its end, so from on-grid angles every commanded angle stays on the grid (no
+// A-17.0474 in the program). Holds the points after the start, the end only if `include_end`.
 PlanSegment rotary_move(const Eigen::Vector3d& q, double t0, double c0, double t1, double c1,
                         double step_deg, bool include_end) {
   PlanSegment seg = transition(SegmentKind::rotary_transition);
   const int n = intervals(std::max(std::abs(t1 - t0), std::abs(c1 - c0)), step_deg);
-  for (int k = 1; k < n; ++k) {
-    const double f = static_cast<double>(k) / n;
-    seg.samples.push_back(make_sample(q, t0 + f * (t1 - t0), c0 + f * (c1 - c0)));
-  }
+  auto towards = [step_deg](double from, double to, int k) {
+    const double d = std::min(static_cast<double>(k) * step_deg, std::abs(to - from));
+    return to >= from ? from + d : from - d;
+  };
+  for (int k = 1; k < n; ++k)
+    seg.samples.push_back(make_sample(q, towards(t0, t1, k), towards(c0, c1, k)));
   if (include_end) seg.samples.push_back(make_sample(q, t1, c1));
   return seg;
 }
@@ -249,9 +252,8 @@ std::vector<PlanSegment> transitions(const BallbarSetup& s, const PlannedSample&
   const bool same_angles = from.tilt_deg == to.tilt_deg && from.rot_deg == to.rot_deg;
   if (same_point) {
     if (!same_angles)
-      moves.push_back(
-          {Move::rotary, from.p_table, from.p_table, from.tilt_deg, from.rot_deg, to.tilt_deg,
-           to.rot_deg});
+      moves.push_back({Move::rotary, from.p_table, from.p_table, from.tilt_deg, from.rot_deg,
+                       to.tilt_deg, to.rot_deg});
   } else {
     if (!at_zero(from))
       moves.push_back(
@@ -277,22 +279,29 @@ std::vector<PlanSegment> transitions(const BallbarSetup& s, const PlannedSample&
 std::string test_label(BallbarTest test, MachineType machine) {
   const std::string tilt(1, tilt_axis_letter(machine));
   switch (test) {
-    case BallbarTest::sphere_xy: return "sphere_xy";
-    case BallbarTest::sphere_yz: return "sphere_yz";
-    case BallbarTest::sphere_zx: return "sphere_zx";
-    case BallbarTest::radial_tilt: return "radial_" + tilt;
-    case BallbarTest::axial_tilt: return "axial_" + tilt;
-    case BallbarTest::radial_c: return "radial_C";
-    case BallbarTest::axial_c: return "axial_C";
+    case BallbarTest::sphere_xy:
+      return "sphere_xy";
+    case BallbarTest::sphere_yz:
+      return "sphere_yz";
+    case BallbarTest::sphere_zx:
+      return "sphere_zx";
+    case BallbarTest::radial_tilt:
+      return "radial_" + tilt;
+    case BallbarTest::axial_tilt:
+      return "axial_" + tilt;
+    case BallbarTest::radial_c:
+      return "radial_C";
+    case BallbarTest::axial_c:
+      return "axial_C";
   }
   ROTACAL_ASSERT(false);
   return {};
 }
 
 BallbarTest parse_ballbar_test(const std::string& label, MachineType machine) {
-  static const BallbarTest all[] = {BallbarTest::sphere_xy,   BallbarTest::sphere_yz,
-                                    BallbarTest::sphere_zx,   BallbarTest::radial_tilt,
-                                    BallbarTest::axial_tilt,  BallbarTest::radial_c,
+  static const BallbarTest all[] = {BallbarTest::sphere_xy,  BallbarTest::sphere_yz,
+                                    BallbarTest::sphere_zx,  BallbarTest::radial_tilt,
+                                    BallbarTest::axial_tilt, BallbarTest::radial_c,
                                     BallbarTest::axial_c};
   std::string known;
   for (BallbarTest t : all) {

@@ -1,5 +1,4 @@
 #include <catch2/catch.hpp>
-
 #include <cctype>
 #include <cmath>
 #include <map>
@@ -34,8 +33,9 @@ std::size_t count_prefix(const std::vector<std::string>& lines, const std::strin
 double word(const std::string& block, char letter) {
   std::istringstream in(block);
   for (std::string w; in >> w;)
-    if (w.size() > 1 && w[0] == letter && (std::isdigit(static_cast<unsigned char>(w[1])) ||
-                                           w[1] == '-' || w[1] == '+' || w[1] == '.'))
+    if (w.size() > 1 && w[0] == letter &&
+        (std::isdigit(static_cast<unsigned char>(w[1])) || w[1] == '-' || w[1] == '+' ||
+         w[1] == '.'))
       return std::stod(w.substr(1));
   return std::nan("");
 }
@@ -93,8 +93,9 @@ TEST_CASE("linuxcnc program structure", "[ballbar][nc]") {
   CHECK(contains(text, "(machine: AC-trt)"));
   CHECK(contains(text, "(ballbar length L0: 100.0000 mm)"));
   CHECK(contains(text, "(pivot: 120.0000, 0.0000, 60.0000 mm"));
-  CHECK(contains(text, "(test order: sphere_xy, sphere_yz, sphere_zx, radial_A, axial_C, "
-                       "radial_C, axial_A)"));
+  CHECK(contains(text,
+                 "(test order: sphere_xy, sphere_yz, sphere_zx, radial_A, axial_C, "
+                 "radial_C, axial_A)"));
   CHECK(contains(text, "(kinematics: nominal)"));
   CHECK(count_prefix(lines, "G21 G90 G94") == 1);
   CHECK(count_prefix(lines, "G43 H1") == 1);
@@ -121,7 +122,8 @@ TEST_CASE("linuxcnc program structure", "[ballbar][nc]") {
   CHECK(arc == "G17 G3 X120.0000 Y100.0000 I-99.9848 J1.7452 F6.2963");
   // sphere_zx (20, 0, 60) -> top of the sphere (120, 0, 160) about (120, 0, 60).
   bool found = false;
-  for (const auto& l : lines) found = found || l == "G18 G3 X120.0000 Z160.0000 I100.0000 K0.0000 F6.3663";
+  for (const auto& l : lines)
+    found = found || l == "G18 G3 X120.0000 Z160.0000 I100.0000 K0.0000 F6.3663";
   CHECK(found);
 }
 

@@ -1,5 +1,4 @@
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <map>
 #include <sstream>
@@ -65,8 +64,8 @@ TEST_CASE("default AC-trt plan reproduces the commanded rows of ballbar_ac_table
       const BallbarSample& r = ref.samples[rows[k]];
       const PlannedSample& s = seg.samples[k];
       worst_xyz = std::max(worst_xyz, (s.xyz - r.xyz).cwiseAbs().maxCoeff());
-      worst_angle = std::max({worst_angle, std::abs(s.tilt_deg - r.tilt_deg),
-                              std::abs(s.rot_deg - r.rot_deg)});
+      worst_angle = std::max(
+          {worst_angle, std::abs(s.tilt_deg - r.tilt_deg), std::abs(s.rot_deg - r.rot_deg)});
     }
   }
   INFO("worst X,Y,Z difference " << worst_xyz << " mm, worst angle " << worst_angle << " deg");
@@ -118,10 +117,9 @@ TEST_CASE("default plan layout: segments, transitions and arcs as derived by han
   // the axial_C point (end kept), arc to (220, 0, 60). radial_C and axial_A share the tool
   // point: one rotary move C 359 -> 0 with A 0 -> -90 (359 steps, 358 between).
   const std::vector<Expect> expect = {
-      {"sphere_xy", T, 360}, {"transition", A, 90}, {"sphere_yz", T, 181},
-      {"transition", A, 89}, {"sphere_zx", T, 181}, {"transition", A, 90},
-      {"transition", R, 89}, {"radial_A", T, 181},  {"transition", R, 89},
-      {"axial_C", T, 360},   {"transition", R, 359}, {"transition", A, 89},
+      {"sphere_xy", T, 360}, {"transition", A, 90},  {"sphere_yz", T, 181},  {"transition", A, 89},
+      {"sphere_zx", T, 181}, {"transition", A, 90},  {"transition", R, 89},  {"radial_A", T, 181},
+      {"transition", R, 89}, {"axial_C", T, 360},    {"transition", R, 359}, {"transition", A, 89},
       {"radial_C", T, 360},  {"transition", R, 358}, {"axial_A", T, 181}};
   REQUIRE(plan.segments.size() == expect.size());
   for (std::size_t i = 0; i < expect.size(); ++i) {
@@ -156,9 +154,10 @@ TEST_CASE("default plan layout: segments, transitions and arcs as derived by han
   for (const auto& seg : plan.segments) {
     for (const auto& p : seg.samples) {
       if (prev && seg.kind != SegmentKind::test) {
-        const double turn = std::acos(std::min(
-            1.0, (prev->p_table - plan.setup.pivot).normalized().dot(
-                     (p.p_table - plan.setup.pivot).normalized())));
+        const double turn =
+            std::acos(std::min(1.0, (prev->p_table - plan.setup.pivot)
+                                        .normalized()
+                                        .dot((p.p_table - plan.setup.pivot).normalized())));
         worst_step = std::max({worst_step, turn / kDeg, std::abs(p.tilt_deg - prev->tilt_deg),
                                std::abs(p.rot_deg - prev->rot_deg)});
       }
@@ -227,11 +226,11 @@ TEST_CASE("radial C inside and outside the pivot circle (Flynn's +-L0)", "[ballb
   BallbarSetup s;
   s.tests = {BallbarTest::radial_c};
   s.radial_c_side = RadialSide::inside;
-  CHECK((plan_ballbar_test(s).segments[0].samples[0].p_table - Eigen::Vector3d(20, 0, 60))
-            .norm() < 1e-12);
+  CHECK((plan_ballbar_test(s).segments[0].samples[0].p_table - Eigen::Vector3d(20, 0, 60)).norm() <
+        1e-12);
   s.radial_c_side = RadialSide::outside;
-  CHECK((plan_ballbar_test(s).segments[0].samples[0].p_table - Eigen::Vector3d(220, 0, 60))
-            .norm() < 1e-12);
+  CHECK((plan_ballbar_test(s).segments[0].samples[0].p_table - Eigen::Vector3d(220, 0, 60)).norm() <
+        1e-12);
   CHECK(parse_radial_side("-") == RadialSide::inside);
   CHECK(parse_radial_side("outside") == RadialSide::outside);
   CHECK_THROWS_AS(parse_radial_side("left"), InvalidArgument);
@@ -338,7 +337,7 @@ TEST_CASE("bad setups are refused with the option named", "[ballbar][plan]") {
   s.pivot = Eigen::Vector3d(0.0, 0.0, 60.0);  // on the C axis: no radial direction for C
   CHECK(refused(s, "radial_C"));
   s.tests = {BallbarTest::sphere_xy, BallbarTest::radial_tilt};
-  CHECK_NOTHROW(plan_ballbar_test(s));  // radial_A is fine: 60 mm above the A axis
+  CHECK_NOTHROW(plan_ballbar_test(s));         // radial_A is fine: 60 mm above the A axis
   s.pivot = Eigen::Vector3d(120.0, 0.0, 0.0);  // on the A axis
   CHECK(refused(s, "radial_A"));
   LocationErrors<double> bad;
@@ -371,8 +370,7 @@ TEST_CASE("tabulate and commanded_session flatten the plan in order", "[ballbar]
   const BallbarSession session = commanded_session(plan);
   CHECK(session.samples.size() == 360 + 181 + 181 + 181 + 360 + 360 + 181);
   CHECK(session.tests() == std::vector<std::string>{"sphere_xy", "sphere_yz", "sphere_zx",
-                                                    "radial_A", "axial_C", "radial_C",
-                                                    "axial_A"});
+                                                    "radial_A", "axial_C", "radial_C", "axial_A"});
   CHECK(session.samples.back().length == 100.0);
   // The session writer accepts it and reads it back.
   const std::string text = format_ballbar(session);

@@ -26,7 +26,15 @@ namespace rotacal {
 
 /// The tests of the single set-up method. `radial_tilt` / `axial_tilt` are labelled radial_A /
 /// axial_A on an AC-trt machine and radial_B / axial_B on a BC-trt machine.
-enum class BallbarTest { sphere_xy, sphere_yz, sphere_zx, radial_tilt, axial_tilt, radial_c, axial_c };
+enum class BallbarTest {
+  sphere_xy,
+  sphere_yz,
+  sphere_zx,
+  radial_tilt,
+  axial_tilt,
+  radial_c,
+  axial_c
+};
 
 /// Session label of a test on a machine: "sphere_xy", ..., "radial_A" or "radial_B", "axial_C".
 std::string test_label(BallbarTest test, MachineType machine);
@@ -59,8 +67,8 @@ struct BallbarSetup {
   /// Sample spacing of every test and of the sampled transitions, deg (rotary angle or angle
   /// about the pivot). A range whose end is off this grid gets the end as a last sample.
   double step_deg = 1.0;
-  double feed_mm_per_min = 1000.0;  ///< linear axes (machine X, Y, Z path), mm/min
-  double feed_deg_per_min = 3600.0; ///< rotary axes, deg/min
+  double feed_mm_per_min = 1000.0;   ///< linear axes (machine X, Y, Z path), mm/min
+  double feed_deg_per_min = 3600.0;  ///< rotary axes, deg/min
   std::vector<BallbarTest> tests = default_ballbar_tests();  ///< tests to run, in this order
   RadialSide radial_c_side = RadialSide::outside;            ///< Flynn's '±' of radial C
 };
@@ -88,8 +96,9 @@ struct TransitionArc {
   Eigen::Vector3d start = Eigen::Vector3d::Zero();   ///< table frame = machine frame, mm
   Eigen::Vector3d end = Eigen::Vector3d::Zero();     ///< table frame = machine frame, mm
   Eigen::Vector3d center = Eigen::Vector3d::Zero();  ///< the nominal pivot, mm
-  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();   ///< unit; start turns positively about it to end
-  double angle = 0.0;                                ///< rad, in (0, pi]
+  Eigen::Vector3d axis =
+      Eigen::Vector3d::UnitZ();  ///< unit; start turns positively about it to end
+  double angle = 0.0;            ///< rad, in (0, pi]
   /// If `axis` is +-X, +-Y or +-Z: that index (0: YZ plane, G19; 1: ZX plane, G18; 2: XY plane,
   /// G17), so the arc can be one circular-interpolation block. -1 otherwise.
   int principal_axis = -1;
@@ -139,17 +148,19 @@ struct BallbarPlan {
 /// Throws InvalidArgument naming the option for a non-positive or non-finite length, step or
 /// feed, an empty or reversed range, a span over 360 deg, no or repeated tests, a pivot on the
 /// axis that a radial test turns about, or non-finite errors.
-BallbarPlan plan_ballbar_test(const BallbarSetup& setup,
-                              const std::optional<LocationErrors<double>>& identified = std::nullopt);
+BallbarPlan plan_ballbar_test(
+    const BallbarSetup& setup,
+    const std::optional<LocationErrors<double>>& identified = std::nullopt);
 
 /// The plan as flat arrays, one row per sample in program order (for bindings and tools).
 struct PlanTable {
   std::vector<std::string> labels;  ///< segment label of each sample
   std::vector<int> segment;         ///< index into plan.segments
   Eigen::VectorXd time;             ///< s
-  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> p_table;       ///< mm, table frame
-  Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor> angles_deg;    ///< tilt, C; deg
-  Eigen::Matrix<double, Eigen::Dynamic, 5, Eigen::RowMajor> machine_axes;  ///< X,Y,Z mm; tilt, C deg
+  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> p_table;     ///< mm, table frame
+  Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor> angles_deg;  ///< tilt, C; deg
+  Eigen::Matrix<double, Eigen::Dynamic, 5, Eigen::RowMajor>
+      machine_axes;  ///< X,Y,Z mm; tilt, C deg
 };
 PlanTable tabulate(const BallbarPlan& plan);
 
