@@ -11,6 +11,7 @@ void bind_kinematics(pyb::module_& m);
 void bind_io(pyb::module_& m);
 void bind_ballbar(pyb::module_& m);
 void bind_diagnose(pyb::module_& m);
+void bind_ballbar_plan(pyb::module_& m);
 }  // namespace rotacal::py
 
 PYBIND11_MODULE(_core, m) {
@@ -26,4 +27,5 @@ PYBIND11_MODULE(_core, m) {
   rotacal::py::bind_io(m);
   rotacal::py::bind_ballbar(m);
   rotacal::py::bind_diagnose(m);
+  rotacal::py::bind_ballbar_plan(m);
 }

@@ -1,0 +1,169 @@
+// Bindings for include/rotacal/ballbar/{test_plan,nc_program}.hpp: thin wrappers, numpy out.
+#include "numpy.hpp"
+#include "rotacal/ballbar/nc_program.hpp"
+#include "rotacal/ballbar/test_plan.hpp"
+
+namespace rotacal::py {
+
+void bind_ballbar_plan(pyb::module_& m) {
+  pyb::enum_<BallbarTest>(m, "BallbarTest",
+                          "Tests of the single set-up method; *_tilt are A or B by machine.")
+      .value("sphere_xy", BallbarTest::sphere_xy)
+      .value("sphere_yz", BallbarTest::sphere_yz)
+      .value("sphere_zx", BallbarTest::sphere_zx)
+      .value("radial_tilt", BallbarTest::radial_tilt)
+      .value("axial_tilt", BallbarTest::axial_tilt)
+      .value("radial_c", BallbarTest::radial_c)
+      .value("axial_c", BallbarTest::axial_c);
+  pyb::enum_<RadialSide>(m, "RadialSide", "Flynn's +-L0 of the radial C test.")
+      .value("outside", RadialSide::outside)
+      .value("inside", RadialSide::inside);
+  pyb::enum_<SegmentKind>(m, "SegmentKind")
+      .value("test", SegmentKind::test)
+      .value("rotary_transition", SegmentKind::rotary_transition)
+      .value("arc_transition", SegmentKind::arc_transition);
+  pyb::enum_<NcDialect>(m, "NcDialect")
+      .value("linuxcnc", NcDialect::linuxcnc)
+      .value("heidenhain", NcDialect::heidenhain)
+      .value("siemens", NcDialect::siemens)
+      .value("fanuc", NcDialect::fanuc);
+
+  m.def("test_label", &test_label, pyb::arg("test"), pyb::arg("machine"),
+        "Session label of a test on a machine, e.g. 'radial_A'.");
+  m.def("parse_ballbar_test", &parse_ballbar_test, pyb::arg("label"), pyb::arg("machine"),
+        "Test from its session label ('radial_B' only on a BC-trt machine).");
+  m.def("default_ballbar_tests", &default_ballbar_tests,
+        "sphere_xy, sphere_yz, sphere_zx, radial tilt, axial C, radial C, axial tilt.");
+  m.def("parse_radial_side", &parse_radial_side, pyb::arg("text"));
+  m.def("parse_nc_dialect", &parse_nc_dialect, pyb::arg("text"));
+
+  const BallbarSetup d;
+  pyb::class_<BallbarSetup>(m, "BallbarSetup",
+                            "Layout of the single set-up ballbar test (mm, deg, mm/min, deg/min).")
+      .def(pyb::init([](MachineType machine, double ballbar_length, const Eigen::Vector3d& pivot,
+                        std::array<double, 2> tilt_range_deg, std::array<double, 2> rot_range_deg,
+                        double step_deg, double feed_mm_per_min, double feed_deg_per_min,
+                        std::vector<BallbarTest> tests, RadialSide radial_c_side) {
+             return BallbarSetup{machine,         ballbar_length,   pivot,
+                                 tilt_range_deg,  rot_range_deg,    step_deg,
+                                 feed_mm_per_min, feed_deg_per_min, std::move(tests),
+                                 radial_c_side};
+           }),
+           pyb::arg("machine") = d.machine, pyb::arg("ballbar_length") = d.ballbar_length,
+           pyb::arg("pivot") = d.pivot, pyb::arg("tilt_range_deg") = d.tilt_range_deg,
+           pyb::arg("rot_range_deg") = d.rot_range_deg, pyb::arg("step_deg") = d.step_deg,
+           pyb::arg("feed_mm_per_min") = d.feed_mm_per_min,
+           pyb::arg("feed_deg_per_min") = d.feed_deg_per_min, pyb::arg("tests") = d.tests,
+           pyb::arg("radial_c_side") = d.radial_c_side)
+      .def_readwrite("machine", &BallbarSetup::machine)
+      .def_readwrite("ballbar_length", &BallbarSetup::ballbar_length, "L0, mm")
+      .def_readwrite("pivot", &BallbarSetup::pivot, "nominal pivot ball centre, table frame, mm")
+      .def_readwrite("tilt_range_deg", &BallbarSetup::tilt_range_deg)
+      .def_readwrite("rot_range_deg", &BallbarSetup::rot_range_deg,
+                     "C sweep, deg; a 360 deg span is a full turn without its repeated end")
+      .def_readwrite("step_deg", &BallbarSetup::step_deg)
+      .def_readwrite("feed_mm_per_min", &BallbarSetup::feed_mm_per_min)
+      .def_readwrite("feed_deg_per_min", &BallbarSetup::feed_deg_per_min)
+      .def_readwrite("tests", &BallbarSetup::tests)
+      .def_readwrite("radial_c_side", &BallbarSetup::radial_c_side);
+
+  pyb::class_<TransitionArc>(m, "TransitionArc",
+                             "Great-circle arc about the pivot at rotary zero (mm, rad).")
+      .def_readonly("start", &TransitionArc::start)
+      .def_readonly("end", &TransitionArc::end)
+      .def_readonly("center", &TransitionArc::center)
+      .def_readonly("axis", &TransitionArc::axis)
+      .def_readonly("angle", &TransitionArc::angle)
+      .def_readonly("principal_axis", &TransitionArc::principal_axis);
+
+  pyb::class_<PlanSegment>(m, "PlanSegment")
+      .def_readonly("label", &PlanSegment::label)
+      .def_readonly("kind", &PlanSegment::kind)
+      .def_readonly("test", &PlanSegment::test)
+      .def_readonly("arc", &PlanSegment::arc)
+      .def_property_readonly("num_samples", [](const PlanSegment& s) { return s.samples.size(); });
+
+  pyb::class_<BallbarPlan>(m, "BallbarPlan",
+                           "Planned toolpath; per-sample arrays in program order.")
+      .def_readonly("setup", &BallbarPlan::setup)
+      .def_property_readonly(
+          "compensation",
+          [](const BallbarPlan& p) -> std::optional<Eigen::Matrix<double, 8, 1>> {
+            if (!p.compensation) return std::nullopt;
+            return p.compensation->v;
+          },
+          "(8,) location errors the machine axes were computed with, or None (nominal)")
+      .def_readonly("segments", &BallbarPlan::segments)
+      .def_property_readonly("num_samples", &BallbarPlan::num_samples)
+      .def_property_readonly("duration", &BallbarPlan::duration, "s")
+      .def_property_readonly(
+          "labels", [](const BallbarPlan& p) { return tabulate(p).labels; },
+          "segment label per sample ('transition' between tests)")
+      .def_property_readonly("segment_index",
+                             [](const BallbarPlan& p) { return tabulate(p).segment; })
+      .def_property_readonly(
+          "time", [](const BallbarPlan& p) { return tabulate(p).time; }, "(N,) s")
+      .def_property_readonly(
+          "p_table", [](const BallbarPlan& p) { return tabulate(p).p_table; },
+          "(N, 3) tool-cup ball centre, table frame, mm")
+      .def_property_readonly(
+          "angles_deg", [](const BallbarPlan& p) { return tabulate(p).angles_deg; },
+          "(N, 2) tilt (A or B) and C, deg")
+      .def_property_readonly(
+          "machine_axes", [](const BallbarPlan& p) { return tabulate(p).machine_axes; },
+          "(N, 5) X, Y, Z (mm), tilt, C (deg)")
+      .def("commanded_session", &commanded_session,
+           "The test samples as a BallbarSession (length = L0), e.g. for simulate_ballbar.");
+
+  m.def(
+      "plan_ballbar_test",
+      [](const BallbarSetup& setup,
+         const std::optional<pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>>&
+             identified) {
+        std::optional<LocationErrors<double>> e;
+        if (identified) e = LocationErrors<double>(vec_of<8>(*identified, "identified"));
+        pyb::gil_scoped_release release;
+        return plan_ballbar_test(setup, e);
+      },
+      pyb::arg("setup") = BallbarSetup{}, pyb::arg("identified") = pyb::none(),
+      R"doc(Plan the single set-up ballbar test (Flynn et al. 2016, Sec. 3).
+
+Parameters
+----------
+setup : BallbarSetup
+identified : (8,) location errors (mm, rad; order of location_error_names), optional.
+    Given, the machine axes are the compensated command for that machine.
+
+Returns
+-------
+BallbarPlan: labels, time (N,), p_table (N, 3), angles_deg (N, 2), machine_axes (N, 5))doc");
+
+  const NcProgramOptions o;
+  pyb::class_<NcProgramOptions>(m, "NcProgramOptions")
+      .def(pyb::init([](int decimals, int tool, bool stop_to_mount, std::string program_name,
+                        int program_number) {
+             return NcProgramOptions{decimals, tool, stop_to_mount, std::move(program_name),
+                                     program_number};
+           }),
+           pyb::arg("decimals") = o.decimals, pyb::arg("tool") = o.tool,
+           pyb::arg("stop_to_mount") = o.stop_to_mount, pyb::arg("program_name") = o.program_name,
+           pyb::arg("program_number") = o.program_number)
+      .def_readwrite("decimals", &NcProgramOptions::decimals)
+      .def_readwrite("tool", &NcProgramOptions::tool)
+      .def_readwrite("stop_to_mount", &NcProgramOptions::stop_to_mount)
+      .def_readwrite("program_name", &NcProgramOptions::program_name)
+      .def_readwrite("program_number", &NcProgramOptions::program_number);
+
+  m.def("write_nc_program", &write_nc_program, pyb::arg("plan"), pyb::arg("dialect"),
+        pyb::arg("options") = NcProgramOptions{},
+        "NC program text: 'linuxcnc' machine axes (G93 G1), or TCP programs for 'heidenhain' "
+        "(FUNCTION TCPM), 'siemens' (TRAORI), 'fanuc' (G43.4).");
+  m.def(
+      "write_nc_program",
+      [](const BallbarPlan& plan, const std::string& dialect, const NcProgramOptions& options) {
+        return write_nc_program(plan, parse_nc_dialect(dialect), options);
+      },
+      pyb::arg("plan"), pyb::arg("dialect"), pyb::arg("options") = NcProgramOptions{});
+}
+
+}  // namespace rotacal::py
