@@ -1,0 +1,144 @@
+#include "rotacal/fit/circle.hpp"
+
+#include <ceres/ceres.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "rotacal/core/error.hpp"
+
+namespace rotacal {
+
+namespace {
+
+void check_points(const Eigen::Ref<const Points2>& p, const char* who) {
+  if (!p.allFinite()) throw InvalidArgument(std::string(who) + ": points contain NaN or infinity");
+  if (p.rows() < 3)
+    throw DegenerateGeometry(std::string(who) + ": " + std::to_string(p.rows()) +
+                             " points cannot determine a circle (need 3 or more)");
+  const Eigen::RowVector2d mean = p.colwise().mean();
+  const Eigen::MatrixXd c = p.rowwise() - mean;
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(c);
+  const auto s = svd.singularValues();
+  if (!(s[1] > 1e-9 * s[0]))
+    throw DegenerateGeometry(std::string(who) + ": the points are collinear; no circle passes through them");
+}
+
+// r = |p - c| - R for one point (Ceres examples/circle_fit.cc shape, without its
+// reparameterisation: the radius here is at least one sagitta away from zero).
+struct CircleDistance {
+  explicit CircleDistance(const Eigen::Vector2d& p) : p_(p) {}
+  template <typename T>
+  bool operator()(const T* centre, const T* radius, T* residual) const {
+    const T dx = T(p_.x()) - centre[0], dy = T(p_.y()) - centre[1];
+    residual[0] = ceres::sqrt(dx * dx + dy * dy) - radius[0];
+    return true;
+  }
+  static ceres::CostFunction* Create(const Eigen::Vector2d& p) {
+    return new ceres::AutoDiffCostFunction<CircleDistance, 1, 2, 1>(new CircleDistance(p));
+  }
+  Eigen::Vector2d p_;
+};
+
+// Orthogonal residuals, covariance from their Jacobian, and the short-arc check.
+CircleFit finish(const Eigen::Ref<const Points2>& p, Eigen::Vector2d centre, double radius,
+                 const CircleFitOptions& o, const char* who) {
+  if (o.refine) {
+    ceres::Problem problem;
+    for (Eigen::Index i = 0; i < p.rows(); ++i)
+      problem.AddResidualBlock(CircleDistance::Create(p.row(i).transpose()), nullptr, centre.data(), &radius);
+    ceres::Solver::Options so;
+    so.linear_solver_type = ceres::DENSE_QR;
+    so.function_tolerance = 1e-14;
+    so.parameter_tolerance = 1e-14;
+    ceres::Solver::Summary summary;
+    ceres::Solve(so, &problem, &summary);
+  }
+  CircleFit f;
+  f.centre = centre;
+  f.radius = radius;
+  f.n = static_cast<int>(p.rows());
+  Eigen::MatrixXd J(p.rows(), 3);
+  double ss = 0.0;
+  double lo = M_PI, hi = -M_PI;
+  std::vector<double> angles;
+  for (Eigen::Index i = 0; i < p.rows(); ++i) {
+    const Eigen::Vector2d d = p.row(i).transpose() - centre;
+    const double dist = d.norm();
+    ss += (dist - radius) * (dist - radius);
+    J.row(i) << -d.x() / dist, -d.y() / dist, -1.0;
+    angles.push_back(std::atan2(d.y(), d.x()));
+    lo = std::min(lo, angles.back()), hi = std::max(hi, angles.back());
+  }
+  f.rms = std::sqrt(ss / static_cast<double>(p.rows()));
+  // Angular extent of the arc: 2 pi minus the largest gap between neighbouring points.
+  std::sort(angles.begin(), angles.end());
+  double gap = angles.front() + 2 * M_PI - angles.back();
+  for (std::size_t k = 1; k < angles.size(); ++k) gap = std::max(gap, angles[k] - angles[k - 1]);
+  const double span = 2 * M_PI - gap;
+  const double sagitta = radius * (1.0 - std::cos(std::min(span, M_PI) / 2.0));
+  const double scatter = p.rows() > 3 ? std::sqrt(ss / static_cast<double>(p.rows() - 3)) : 0.0;
+  if (sagitta < o.min_sagitta_ratio * scatter)
+    throw DegenerateGeometry(std::string(who) + ": the arc is too short to fit: its sagitta " +
+                             std::to_string(sagitta) + " is below " + std::to_string(o.min_sagitta_ratio) +
+                             " x the scatter " + std::to_string(scatter));
+  const double s2 = o.sigma > 0 ? o.sigma * o.sigma : (p.rows() > 3 ? ss / static_cast<double>(p.rows() - 3) : 0.0);
+  f.covariance = (J.transpose() * J).inverse() * s2;
+  return f;
+}
+
+}  // namespace
+
+CircleFit hyper_circle_fit(const Eigen::Ref<const Points2>& p, const CircleFitOptions& o) {
+  check_points(p, "hyper_circle_fit");
+  // Moments of the centred data (Al-Sharadqah & Chernov 2009; Chernov's reference "Hyper"
+  // algorithm, solved by Newton's method on the characteristic polynomial).
+  const Eigen::RowVector2d mean = p.colwise().mean();
+  double Mxx = 0, Myy = 0, Mxy = 0, Mxz = 0, Myz = 0, Mzz = 0;
+  const double n = static_cast<double>(p.rows());
+  for (Eigen::Index i = 0; i < p.rows(); ++i) {
+    const double x = p(i, 0) - mean.x(), y = p(i, 1) - mean.y(), z = x * x + y * y;
+    Mxx += x * x, Myy += y * y, Mxy += x * y, Mxz += x * z, Myz += y * z, Mzz += z * z;
+  }
+  Mxx /= n, Myy /= n, Mxy /= n, Mxz /= n, Myz /= n, Mzz /= n;
+  const double Mz = Mxx + Myy, Cov_xy = Mxx * Myy - Mxy * Mxy, Var_z = Mzz - Mz * Mz;
+  const double A2 = 4 * Cov_xy - 3 * Mz * Mz - Mzz;
+  const double A1 = Var_z * Mz + 4 * Cov_xy * Mz - Mxz * Mxz - Myz * Myz;
+  const double A0 = Mxz * (Mxz * Myy - Myz * Mxy) + Myz * (Myz * Mxx - Mxz * Mxy) - Var_z * Cov_xy;
+  double x = 0.0, y = A0;
+  for (int it = 0; it < 99; ++it) {
+    const double Dy = A1 + x * (2 * A2 + 16 * x * x);
+    const double xnew = x - y / Dy;
+    if (xnew == x || !std::isfinite(xnew)) break;
+    const double ynew = A0 + xnew * (A1 + xnew * (A2 + 4 * xnew * xnew));
+    if (std::abs(ynew) >= std::abs(y)) break;
+    x = xnew, y = ynew;
+  }
+  const double det = x * x - x * Mz + Cov_xy;
+  const double cx = (Mxz * (Myy - x) - Myz * Mxy) / det / 2.0;
+  const double cy = (Myz * (Mxx - x) - Mxz * Mxy) / det / 2.0;
+  const double r = std::sqrt(cx * cx + cy * cy + Mz - 2 * x);
+  if (!std::isfinite(r)) throw DegenerateGeometry("hyper_circle_fit: no circle fits these points");
+  return finish(p, Eigen::Vector2d(cx + mean.x(), cy + mean.y()), r, o, "hyper_circle_fit");
+}
+
+CircleFit kasa_circle_fit(const Eigen::Ref<const Points2>& p, const CircleFitOptions& o) {
+  check_points(p, "kasa_circle_fit");
+  const Eigen::RowVector2d mean = p.colwise().mean();
+  Eigen::MatrixXd A(p.rows(), 3);
+  Eigen::VectorXd b(p.rows());
+  for (Eigen::Index i = 0; i < p.rows(); ++i) {
+    const double x = p(i, 0) - mean.x(), y = p(i, 1) - mean.y();
+    A.row(i) << x, y, 1.0;
+    b[i] = -(x * x + y * y);
+  }
+  const Eigen::Vector3d s = A.colPivHouseholderQr().solve(b);  // x^2+y^2 + D x + E y + F = 0
+  const Eigen::Vector2d c(-s[0] / 2, -s[1] / 2);
+  const double r = std::sqrt(c.squaredNorm() - s[2]);
+  if (!std::isfinite(r)) throw DegenerateGeometry("kasa_circle_fit: no circle fits these points");
+  return finish(p, c + mean.transpose(), r, o, "kasa_circle_fit");
+}
+
+}  // namespace rotacal
