@@ -2,6 +2,7 @@
 #include "numpy.hpp"
 #include "rotacal/ballbar/compensate.hpp"
 #include "rotacal/ballbar/identify.hpp"
+#include "rotacal/ballbar/identify_paper.hpp"
 #include "rotacal/ballbar/simulate.hpp"
 
 namespace rotacal::py {
@@ -89,6 +90,15 @@ void bind_ballbar(pyb::module_& m) {
       pyb::arg("session"), pyb::arg("fit_length_offset") = false,
       pyb::arg("effects") = std::vector<std::string>{}, pyb::arg("tests") = std::vector<std::string>{},
       "Joint Ceres fit of the 8 location errors and the actual pivot to every sample.");
+
+  m.def(
+      "identify_paper",
+      [](const BallbarSession& session) {
+        pyb::gil_scoped_release release;
+        return identify_paper(session);
+      },
+      pyb::arg("session"),
+      "Flynn et al. 2016's chain: sphere fit, Hyper circle fits, SVD plane fits, transport.");
 
   m.def(
       "simulate_ballbar",

@@ -30,8 +30,6 @@ def identify(session: _core.BallbarSession, method: str = "joint", *,
     elif method == "paper":
         if fit_length_offset or effects:
             raise _core.InvalidArgument("identify: the paper method fits no length offset or effects")
-        if not hasattr(_core, "identify_paper"):
-            raise _core.Error("identify: the paper method is not available in this build")
         raw = _core.identify_paper(session)
     else:
         raise _core.InvalidArgument(f"identify: method must be 'joint' or 'paper', got {method!r}")

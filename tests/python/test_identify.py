@@ -50,3 +50,16 @@ def test_model_file_round_trip_and_predict(shared_data, tmp_path):
     (tmp_path / "bad.json").write_text('{"format": "rotacal-model/1", "kind": "ballbar", "machine": "AC-trt"}')
     with pytest.raises(rotacal.InvalidArgument, match="location_errors lacks"):
         rotacal.ballbar_model_from_dict(rotacal.load_model(tmp_path / "bad.json"), "bad.json")
+
+
+@pytest.mark.parametrize("name", ["ballbar_ac_table2.csv", "ballbar_ac_random.csv"])
+def test_paper_chain_recovers_truth(shared_data, name):
+    """Flynn et al.'s chain: within 3 sigma plus an allowance for its small-error
+    approximations (0.5 um, 2 urad; the measured bias on these files is below that)."""
+    path = shared_data / name
+    t = truth(path)
+    d = rotacal.identify(rotacal.load(path), method="paper").to_dict()
+    assert d["method"] == "paper" and d["notes"]
+    for n, v in d["location_errors"].items():
+        allow = 0.5e-3 if v["unit"] == "mm" else 2e-6
+        assert abs(v["value"] - t["errors"][n]) <= 3 * v["std"] + allow, (n, v, t["errors"][n])
