@@ -25,9 +25,20 @@ cmake -S tests/consumer -B build/consumer -G Ninja -DCMAKE_PREFIX_PATH="$ROOT/bu
 cmake --build build/consumer
 ./build/consumer/rotacal_consumer
 
+step "C++ example (examples/cpp) against the installed package"
+cmake -S examples/cpp -B build/example -G Ninja -DCMAKE_PREFIX_PATH="$ROOT/build/install"
+cmake --build build/example
+./build/example/quickstart ../shared/data/ballbar_ac_table2.csv
+
 step "Python package (pip install .) and pytest"
 "$PY" -m pip install -q --disable-pip-version-check --no-build-isolation .
 (cd tests/python && "$PY" -m pytest -q -p no:cacheprovider .)
+
+step "Benchmarks, once each as a smoke check (figures: run them without --smoke)"
+./build/release/bench/ballbar_accuracy --smoke
+./build/release/bench/diagnose_bench --smoke
+./build/release/bench/rtest_bench
+"$PY" bench/ballbar_speed.py --repeat 1
 
 step "C++ tests under AddressSanitizer + UBSan"
 cmake -S . -B build/asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DROTACAL_SANITIZE=ON \

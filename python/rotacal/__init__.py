@@ -17,10 +17,14 @@ from ._core import (  # noqa: F401
     compensate_commands,
     effect_catalogue,
     forward,
+    hyper_circle_fit,
+    kasa_circle_fit,
     location_error_names,
     machine_name,
     parse_machine_type,
     simulate_ballbar,
+    sphere_fit,
+    svd_plane_fit,
     verify_compensation,
 )
 from ._core import BallbarPlan, BallbarSetup, BallbarTest, NcDialect, NcProgramOptions, RadialSide, parse_ballbar_test, parse_nc_dialect, parse_radial_side, plan_ballbar_test, write_nc_program  # noqa: F401,E501
