@@ -195,6 +195,11 @@ def ballbar_report(path: str | Path, session: Any, identification: Any,
     if diagnosis is not None:
         parts.append(diagnosis_section(diagnosis.to_dict()))
     parts.extend(extra_sections)
+    # Records on load how many figures decoded, so a browser test can check they render.
+    parts.append("<script>window.addEventListener('load',function(){var im=document.images,ok=0;"
+                 "for(var i=0;i<im.length;i++){if(im[i].complete&&im[i].naturalWidth>0)ok++;}"
+                 "document.body.setAttribute('data-images',im.length);"
+                 "document.body.setAttribute('data-images-rendered',ok);});</script>")
     parts.append("</body></html>")
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(path.name + ".tmp")

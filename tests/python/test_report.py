@@ -1,0 +1,42 @@
+"""The HTML report, opened in headless Chromium as a person would open it."""
+import re
+import shutil
+import subprocess
+import sys
+
+import pytest
+
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+         "--disable-background-networking", "--disable-component-update", "--disable-sync"]
+
+
+@pytest.fixture(scope="module")
+def report(shared_data, tmp_path_factory):
+    out = tmp_path_factory.mktemp("report") / "report.html"
+    r = subprocess.run([sys.executable, "-m", "rotacal", "report", str(shared_data / "ballbar_ac_table2.csv"),
+                        "-o", str(out)], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    return out
+
+
+def test_report_is_self_contained(report):
+    html = report.read_text()
+    assert not re.search(r"(src|href)=\"(https?:)?//", html), "the report must open without network"
+    assert html.count("data:image/png;base64,") >= 5
+
+
+@pytest.mark.skipif(CHROMIUM is None, reason="Debian's chromium is installed by scripts/setup.sh")
+def test_report_renders_in_chromium(report, tmp_path):
+    profile = tmp_path / "profile"
+    dom = subprocess.run([CHROMIUM, *FLAGS, f"--user-data-dir={profile}", "--dump-dom", report.as_uri()],
+                         capture_output=True, text=True, timeout=120).stdout
+    for section in ("setup", "location-errors", "polar", "residuals", "diagnosis"):
+        assert f'id="{section}"' in dom, section
+    n = int(re.search(r'data-images="(\d+)"', dom).group(1))
+    ok = int(re.search(r'data-images-rendered="(\d+)"', dom).group(1))
+    assert n >= 5 and ok == n, (ok, n)
+    png = tmp_path / "shot.png"
+    subprocess.run([CHROMIUM, *FLAGS, f"--user-data-dir={profile}", "--window-size=1200,2400",
+                    f"--screenshot={png}", report.as_uri()], capture_output=True, timeout=120)
+    assert png.stat().st_size > 50_000  # a page with tables and plots, not a blank one
