@@ -1,6 +1,7 @@
 // Bindings for include/rotacal/diagnose.
 #include "numpy.hpp"
 #include "rotacal/diagnose/ballbar_diagnosis.hpp"
+#include "rotacal/diagnose/rtest_diagnosis.hpp"
 
 namespace rotacal::py {
 
@@ -74,6 +75,13 @@ void bind_diagnose(pyb::module_& m) {
       .def_readonly("p_value", &Unexplained::p_value)
       .def_readonly("signature", &Unexplained::signature);
 
+  pyb::class_<CandidateScore>(m, "CandidateScore")
+      .def_readonly("effect", &CandidateScore::effect)
+      .def_readonly("visible_params", &CandidateScore::visible_params)
+      .def_readonly("delta_bic", &CandidateScore::delta_bic)
+      .def_readonly("f_pvalue", &CandidateScore::f_pvalue)
+      .def_readonly("rms_after_um", &CandidateScore::rms_after_um);
+
   pyb::class_<Diagnosis::Baseline>(m, "DiagnosisBaseline")
       .def_readonly("residual_rms_um", &Diagnosis::Baseline::residual_rms_um)
       .def_readonly("noise_um", &Diagnosis::Baseline::noise_um)
@@ -94,6 +102,7 @@ void bind_diagnose(pyb::module_& m) {
       .def_readonly("unexplained", &Diagnosis::unexplained)
       .def_readonly("baseline_fit", &Diagnosis::baseline_fit)
       .def_readonly("final_fit", &Diagnosis::final_fit)
+      .def_readonly("rounds", &Diagnosis::rounds)
       .def_readonly("seconds", &Diagnosis::seconds);
 
   m.def(
@@ -107,6 +116,15 @@ void bind_diagnose(pyb::module_& m) {
       pyb::arg("reference") = std::nullopt,
       "Diagnose a ballbar session: baseline fit, residual structure, catalogue candidates, "
       "findings with their gain.");
+
+  m.def(
+      "diagnose_rtest",
+      [](const RtestSession& session, const DiagnosisOptions& options) {
+        pyb::gil_scoped_release release;
+        return diagnose_rtest(session, options);
+      },
+      pyb::arg("session"), pyb::arg("options") = DiagnosisOptions{},
+      "Diagnose an R-test session (baseline: location errors and a probe zero per set-up).");
 }
 
 }  // namespace rotacal::py

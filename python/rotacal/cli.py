@@ -197,12 +197,15 @@ def cmd_identify(a: argparse.Namespace) -> int:
 
 
 def cmd_diagnose(a: argparse.Namespace) -> int:
-    s = _ballbar(a.file)
+    s = load(a.file)
     result = diagnose(s, max_harmonic=a.max_harmonic)
     d = result.to_dict()
     if a.report:
-        from .report import ballbar_report
-        ballbar_report(a.report, s, identify(s), result, source=a.file)
+        from .report import ballbar_report, diagnosis_report
+        if isinstance(s, _core.BallbarSession):
+            ballbar_report(a.report, s, identify(s), result, source=a.file)
+        else:
+            diagnosis_report(a.report, d, title="R-test diagnosis", source=a.file)
         _say(f"wrote {a.report}")
     if a.json:
         print(json.dumps(d, indent=1))

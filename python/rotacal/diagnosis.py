@@ -13,7 +13,7 @@ def diagnose(session, *, max_harmonic: int = 4, max_findings: int = 4, alpha: fl
 
     Parameters
     ----------
-    session : a BallbarSession
+    session : a BallbarSession or an RtestSession (with dx,dy,dz)
     max_harmonic : highest harmonic order tried for the *_hn catalogue entries
     max_findings : stop after this many effects
     alpha : family-wise false-finding rate per step
@@ -28,4 +28,6 @@ def diagnose(session, *, max_harmonic: int = 4, max_findings: int = 4, alpha: fl
     o.only = list(only)
     if isinstance(session, _core.BallbarSession):
         return DiagnosisResult(_core.diagnose_ballbar(session, o, reference))
+    if isinstance(session, _core.RtestSession):
+        return DiagnosisResult(_core.diagnose_rtest(session, o))
     raise _core.InvalidArgument(f"diagnose: unsupported session type {type(session).__name__}")

@@ -107,3 +107,25 @@ def load_model(path: str | Path) -> dict:
     if not isinstance(d, dict) or d.get("format") != FORMAT:
         raise _core.InvalidArgument(f"{path}: not a {FORMAT} file")
     return d
+
+
+def fit_model_dict(machine: Any, parameters: list, effects: list[str]) -> dict:
+    """Model dict of a diagnosis' final fit: a ballbar model (with its pivot), or for R-test
+    the location errors, the probe zero of each set-up and the effects."""
+    if any(p.name == "pivot_x" for p in parameters):
+        return ballbar_model_dict(machine, parameters, effects)
+    names = list(_core.location_error_names(machine))
+    by_name = {p.name: p for p in parameters}
+    zeros: dict[str, dict] = {}
+    for p in parameters:
+        if p.name.startswith("zero."):
+            _, setup, axis = p.name.split(".")
+            zeros.setdefault(setup, {})[axis] = estimate_dict(p)
+    out = {"format": FORMAT, "kind": "rtest-diagnosis", "machine": _core.machine_name(machine),
+           "location_errors": {n: estimate_dict(by_name[n]) for n in names},
+           "probe_zeros": zeros, "effects": []}
+    for eid in effects:
+        eff = _core.Effect(eid)
+        out["effects"].append({"id": eid, "cause": eff.cause, "params": {
+            pn: estimate_dict(by_name[eid if eff.num_params == 1 else f"{eid}.{pn}"]) for pn in eff.param_names}})
+    return out

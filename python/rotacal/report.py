@@ -208,6 +208,19 @@ def ballbar_report(path: str | Path, session: Any, identification: Any,
     return path
 
 
+def diagnosis_report(path: str | Path, d: dict, title: str, source: str = "") -> Path:
+    """A report with the diagnosis alone (e.g. of an R-test session)."""
+    path = Path(path)
+    page = (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(title)}</title>"
+            f"<style>{_CSS}</style></head><body><h1>{html.escape(title)}</h1>"
+            f"<p class=muted>rotacal {html.escape(_version())} &middot; {html.escape(source)}</p>"
+            f"{diagnosis_section(d)}</body></html>")
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(page)
+    tmp.replace(path)
+    return path
+
+
 def diagnosis_section(d: dict) -> str:
     b = d["baseline"]
     out = ['<section id="diagnosis"><h2>Diagnosis</h2>',

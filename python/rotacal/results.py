@@ -6,7 +6,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from . import _core
-from .models import ballbar_model_dict, estimate_dict
+from .models import ballbar_model_dict, estimate_dict, fit_model_dict
 
 
 @dataclass
@@ -115,7 +115,10 @@ class DiagnosisResult:
                 "before": [_group(g) for g in d.structure_before],
                 "after": [_group(g) for g in d.structure_after],
             },
-            "final_model": ballbar_model_dict(d.machine, d.final_fit.parameters, d.final_fit.effects),
+            "candidates_first_round": [
+                {"effect": c.effect, "delta_bic": c.delta_bic, "f_test_p": c.f_pvalue,
+                 "visible_params": c.visible_params} for c in (d.rounds[0] if d.rounds else [])][:10],
+            "final_model": fit_model_dict(d.machine, d.final_fit.parameters, d.final_fit.effects),
             "seconds": d.seconds,
         }
 

@@ -301,8 +301,39 @@ std::vector<GroupResidual> residual_structure(const DiagnosisProblem& P, const E
   return out;
 }
 
+namespace {
+
+Diagnosis diagnose_at_noise(const DiagnosisProblem& P, const DiagnosisOptions& options,
+                            std::optional<double> noise_override, const std::string& noise_source);
+
+}  // namespace
+
 Diagnosis diagnose(const DiagnosisProblem& P, const DiagnosisOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
+  Diagnosis D = diagnose_at_noise(P, options, std::nullopt, "");
+  if (!P.declared_noise_um()) {
+    // Successive differences overestimate the noise when the sampling is sparse against the
+    // systematic errors (an R-test's 30 degree steps): if the extended model leaves less, that
+    // is the better estimate, and the statistics are redone with it.
+    const double n = static_cast<double>(D.final_fit.residuals.size());
+    const double s_final =
+        std::sqrt(D.final_fit.residuals.squaredNorm() / std::max(1.0, n - D.final_fit.num_free)) * 1e3;
+    if (s_final < 0.8 * D.baseline.noise_um) {
+      std::ostringstream why;
+      why.precision(3);
+      why << "estimated from the residuals of the extended model (successive differences gave "
+          << D.baseline.noise_um << " um: the sampling is too sparse for them)";
+      D = diagnose_at_noise(P, options, s_final, why.str());
+    }
+  }
+  D.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return D;
+}
+
+namespace {
+
+Diagnosis diagnose_at_noise(const DiagnosisProblem& P, const DiagnosisOptions& options,
+                            std::optional<double> noise_override, const std::string& noise_source) {
   Diagnosis D;
   D.machine = P.machine();
   std::vector<Effect> candidates = P.candidates(options.max_harmonic);
@@ -321,10 +352,12 @@ Diagnosis diagnose(const DiagnosisProblem& P, const DiagnosisOptions& options) {
   D.baseline_fit = fit;
   const double n = static_cast<double>(fit.residuals.size());
   const std::optional<double> declared = P.declared_noise_um();
-  const double noise_um = declared ? *declared : estimate_noise_um(P, fit.residuals);
+  const double noise_um = declared ? *declared : noise_override ? *noise_override : estimate_noise_um(P, fit.residuals);
   const double sigma_mm = noise_um * 1e-3;
   D.baseline.noise_um = noise_um;
-  D.baseline.noise_source = declared ? "declared" : "estimated from successive differences";
+  D.baseline.noise_source = declared         ? "declared"
+                            : noise_override ? noise_source
+                                             : "estimated from successive differences";
   D.baseline.residual_rms_um = rms_um(fit.residuals);
   D.baseline.n = fit.residuals.size();
   D.baseline.dof = static_cast<int>(n) - fit.num_free;
@@ -436,8 +469,9 @@ Diagnosis diagnose(const DiagnosisProblem& P, const DiagnosisOptions& options) {
   D.unexplained.p_value = stats::chi2_sf(chi2_final, dof);
   D.unexplained.present = D.unexplained.p_value < 1e-3;
   if (D.unexplained.present) D.unexplained.signature = describe_structure(D.structure_after);
-  D.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return D;
 }
+
+}  // namespace
 
 }  // namespace rotacal

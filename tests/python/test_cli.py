@@ -110,3 +110,15 @@ def test_readme_python_example_runs(shared_data, tmp_path):
     for code in blocks:
         r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, cwd=ROOT)
         assert r.returncode == 0, r.stderr
+
+
+def test_diagnose_rtest_file_names_gravity_and_coning(shared_data, tmp_path):
+    r = rotacal("diagnose", shared_data / "rtest_bc_oyama.csv", "--json", "--report", tmp_path / "r.html")
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout)
+    found = {f["effect"]: f["parameters"] for f in d["findings"]}
+    assert set(found) == {"gravity_sag_B", "coning_B"}
+    s = found["gravity_sag_B"]["gravity_sag_B"]
+    assert abs(s["value"] - 0.006) <= 3 * s["std"]
+    assert d["final_model"]["kind"] == "rtest-diagnosis" and set(d["final_model"]["probe_zeros"]) == {"1", "2"}
+    assert 'id="diagnosis"' in (tmp_path / "r.html").read_text()

@@ -1,0 +1,41 @@
+#pragma once
+/// \file
+/// The diagnosis of an R-test session: the DiagnosisProblem for the exact R-test reading,
+///   d = T(B, C, t)^-1 * p_tool(xyz, t) - q_nest + zero_setup      (Oyama Eq. 4, in the table frame)
+/// with baseline = the 8 location errors + an unknown probe zero per set-up, and the
+/// catalogue's effects (kinematics/effects.hpp) as the candidate extensions. Every reading
+/// has three components (dx, dy, dz); each is one residual.
+
+#include "rotacal/diagnose/diagnosis.hpp"
+#include "rotacal/io/session.hpp"
+
+namespace rotacal {
+
+class RtestDiagnosisProblem : public DiagnosisProblem {
+ public:
+  /// Throws InvalidArgument if the session has no dx,dy,dz (convert raw probe readings first).
+  explicit RtestDiagnosisProblem(RtestSession session);
+
+  MachineType machine() const override { return session_.machine; }
+  const std::vector<std::string>& groups() const override { return groups_; }
+  const std::vector<double>& times() const override { return times_; }
+  const std::vector<RotaryAngles<double>>& angles() const override { return angles_; }
+  std::optional<double> declared_noise_um() const override { return session_.noise_um; }
+  /// The catalogue less the ballbar's own entries.
+  std::vector<Effect> candidates(int max_harmonic) const override;
+  ModelFit fit(const EffectModel& effects) const override;
+  Eigen::MatrixXd candidate_jacobian(const ModelFit& at, const Effect& candidate) const override;
+
+ private:
+  RtestSession session_;
+  std::vector<std::string> setups_;  // distinct, in order
+  std::vector<int> setup_of_;        // per sample
+  std::vector<std::string> groups_;  // per reading component
+  std::vector<double> times_;
+  std::vector<RotaryAngles<double>> angles_;
+};
+
+/// Diagnose an R-test session (see diagnosis.hpp).
+Diagnosis diagnose_rtest(const RtestSession& session, const DiagnosisOptions& options = {});
+
+}  // namespace rotacal
