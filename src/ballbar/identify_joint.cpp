@@ -132,20 +132,9 @@ BallbarIdentification identify_joint(const BallbarSession& session,
   const Observability obs = analyse_observability(J0, scales, options.observability_min_chi2);
   std::vector<bool> free(static_cast<std::size_t>(n_par), true);
   for (int j : obs.to_fix) free[static_cast<std::size_t>(j)] = false;
-  auto fix_subset = [&](double* block, int offset, int size) {
-    std::vector<int> fixed;
-    for (int k = 0; k < size; ++k)
-      if (!free[static_cast<std::size_t>(offset + k)]) fixed.push_back(k);
-    if (static_cast<int>(fixed.size()) == size)
-      problem.SetParameterBlockConstant(block);
-    else if (!fixed.empty()) {
-      manifolds.push_back(std::make_unique<ceres::SubsetManifold>(size, fixed));
-      problem.SetManifold(block, manifolds.back().get());
-    }
-  };
-  fix_subset(e.data(), 0, 8);
-  fix_subset(pivot.data(), 8, 3);
-  if (P > 0) fix_subset(fxp.data(), 11, P);
+  std::vector<std::pair<double*, int>> sized = {{e.data(), 8}, {pivot.data(), 3}};
+  if (P > 0) sized.emplace_back(fxp.data(), P);
+  hold_fixed(problem, sized, free, manifolds);
 
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_QR;

@@ -111,6 +111,23 @@ std::string Observability::describe(int k, const std::vector<std::string>& names
   return out.str();
 }
 
+void hold_fixed(ceres::Problem& problem, const std::vector<std::pair<double*, int>>& blocks,
+                const std::vector<bool>& free, std::vector<std::unique_ptr<ceres::Manifold>>& owned) {
+  std::size_t offset = 0;
+  for (const auto& [block, size] : blocks) {
+    std::vector<int> fixed;
+    for (int k = 0; k < size; ++k)
+      if (!free.at(offset + static_cast<std::size_t>(k))) fixed.push_back(k);
+    if (static_cast<int>(fixed.size()) == size) {
+      problem.SetParameterBlockConstant(block);
+    } else if (!fixed.empty()) {
+      owned.push_back(std::make_unique<ceres::SubsetManifold>(size, fixed));
+      problem.SetManifold(block, owned.back().get());
+    }
+    offset += static_cast<std::size_t>(size);
+  }
+}
+
 Eigen::MatrixXd covariance_from_jacobian(const Eigen::MatrixXd& J, const std::vector<bool>& free,
                                          double sigma2) {
   const Eigen::Index p = J.cols();

@@ -123,20 +123,10 @@ ModelFit RtestDiagnosisProblem::fit(const EffectModel& fx) const {
   const Observability obs = analyse_observability(evaluate_jacobian(problem, blocks).leftCols(n_par), scales);
   std::vector<bool> free(static_cast<std::size_t>(n_par), true);
   for (int j : obs.to_fix) free[static_cast<std::size_t>(j)] = false;
-  auto fix_subset = [&](double* block, int offset, int size) {
-    std::vector<int> fixed;
-    for (int k = 0; k < size; ++k)
-      if (!free[static_cast<std::size_t>(offset + k)]) fixed.push_back(k);
-    if (static_cast<int>(fixed.size()) == size) {
-      problem.SetParameterBlockConstant(block);
-    } else if (!fixed.empty()) {
-      manifolds.push_back(std::make_unique<ceres::SubsetManifold>(size, fixed));
-      problem.SetManifold(block, manifolds.back().get());
-    }
-  };
-  fix_subset(e.data(), 0, 8);
-  for (int s = 0; s < S; ++s) fix_subset(zeros[static_cast<std::size_t>(s)].data(), 8 + 3 * s, 3);
-  if (P > 0) fix_subset(fxp.data(), 8 + 3 * S, P);
+  std::vector<std::pair<double*, int>> sized = {{e.data(), 8}};
+  for (auto& z : zeros) sized.emplace_back(z.data(), 3);
+  if (P > 0) sized.emplace_back(fxp.data(), P);
+  hold_fixed(problem, sized, free, manifolds);
 
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_QR;

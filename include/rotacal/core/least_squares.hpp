@@ -5,11 +5,14 @@
 /// Jacobian), and the 1-sigma covariance of the parameters that it can see.
 
 #include <Eigen/Core>
+#include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace ceres {
 class Problem;
+class Manifold;
 }
 
 namespace rotacal {
@@ -42,6 +45,12 @@ Observability analyse_observability(const Eigen::MatrixXd& J, const Eigen::Vecto
 /// Plausible magnitude of a parameter by its unit, for analyse_observability: 1 mm, 1 mrad,
 /// 1 um/s, 1e-3 for ratios (rad/rad, mm/mm). Throws InvalidArgument for an unknown unit.
 double plausible_magnitude(const std::string& unit);
+
+/// Hold the parameters marked false in `free` (flat, in block order) at their current values:
+/// a block fixed entirely becomes constant, a partly fixed one gets a SubsetManifold kept in
+/// `owned` (so the problem must use manifold_ownership = DO_NOT_TAKE_OWNERSHIP).
+void hold_fixed(ceres::Problem& problem, const std::vector<std::pair<double*, int>>& blocks,
+                const std::vector<bool>& free, std::vector<std::unique_ptr<ceres::Manifold>>& owned);
 
 /// 1-sigma covariance (J^T J)^-1 * sigma2 restricted to the parameters in `free` (others get
 /// zero rows/columns), computed by SVD of the column-normalised Jacobian for conditioning.
