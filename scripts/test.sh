@@ -41,8 +41,9 @@ step "Benchmarks, once each as a smoke check (figures: run them without --smoke)
 "$PY" bench/ballbar_speed.py --repeat 1
 
 step "C++ tests under AddressSanitizer + UBSan"
-cmake -S . -B build/asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DROTACAL_SANITIZE=ON \
-      -DROTACAL_BUILD_BENCH=OFF
+# -O1 and line tables only: what ASan recommends, and far quicker to compile than -O2 -g.
+cmake -S . -B build/asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" \
+      -DROTACAL_SANITIZE=ON -DROTACAL_BUILD_BENCH=OFF
 cmake --build build/asan
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
   ctest --test-dir build/asan --output-on-failure
