@@ -11,6 +11,7 @@ void bind_kinematics(pyb::module_& m);
 void bind_io(pyb::module_& m);
 void bind_ballbar(pyb::module_& m);
 void bind_fit(pyb::module_& m);
+void bind_rtest(pyb::module_& m);
 void bind_diagnose(pyb::module_& m);
 void bind_ballbar_plan(pyb::module_& m);
 }  // namespace rotacal::py
@@ -28,6 +29,7 @@ PYBIND11_MODULE(_core, m) {
   rotacal::py::bind_io(m);
   rotacal::py::bind_ballbar(m);
   rotacal::py::bind_fit(m);
+  rotacal::py::bind_rtest(m);
   rotacal::py::bind_diagnose(m);
   rotacal::py::bind_ballbar_plan(m);
 }

@@ -32,6 +32,7 @@ from .ballbar import identify, predict, random_location_errors  # noqa: F401
 from .diagnosis import diagnose  # noqa: F401
 from .models import ballbar_model_from_dict, load_model, save_model  # noqa: F401
 from .results import DiagnosisResult, Identification  # noqa: F401
+from .rtest import identify_rtest  # noqa: F401
 from .sessions import load, save  # noqa: F401
 
 __version__ = "0.1.0"

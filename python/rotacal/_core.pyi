@@ -220,3 +220,30 @@ class Diagnosis:
 def diagnose_ballbar(session: BallbarSession, options: DiagnosisOptions = ...,
                      reference: Optional[BallbarSession] = None) -> Diagnosis: ...
 def diagnose_rtest(session: RtestSession, options: DiagnosisOptions = ...) -> Diagnosis: ...
+
+# ---------------------------------------------------------------- R-test
+class RtestJointIdentification:
+    method: str
+    parameters: list[ParameterEstimate]
+    covariance: Array
+    probe_zeros: dict[str, Array]
+    residual_rms_um: float
+    sigma_um: float
+    n_samples: int
+    converged: bool
+    iterations: int
+    unobservable: list[str]
+    notes: list[str]
+
+class RtestPaperIdentification:
+    method: str
+    b_deg: list[float]
+    c_deg: list[float]
+    residual_rms_um: float
+    n_samples: int
+    unobservable: list[str]
+    notes: list[str]
+
+def identify_rtest_joint(session: RtestSession) -> RtestJointIdentification: ...
+def identify_rtest_paper(session: RtestSession) -> RtestPaperIdentification: ...
+def rtest_error_map(identification: object, *args: object) -> str: ...

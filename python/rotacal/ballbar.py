@@ -12,7 +12,8 @@ from .results import Identification
 def identify(session: _core.BallbarSession, method: str = "joint", *,
              fit_length_offset: bool = False, effects: Sequence[str] = (),
              tests: Sequence[str] = ()) -> Identification:
-    """Identify the 8 location errors (and the actual pivot) of a ballbar session.
+    """Identify the 8 location errors (and the actual pivot) of a ballbar session; an R-test
+    session goes to rotacal.identify_rtest.
 
     Parameters
     ----------
@@ -23,8 +24,13 @@ def identify(session: _core.BallbarSession, method: str = "joint", *,
     effects : catalogue ids to fit along (joint only), e.g. ["gravity_sag_A"].
     tests : restrict to these test labels (default: all).
     """
+    if isinstance(session, _core.RtestSession):
+        if fit_length_offset or effects or tests:
+            raise _core.InvalidArgument("identify: an R-test session takes only `method`")
+        from .rtest import identify_rtest
+        return identify_rtest(session, method)
     if not isinstance(session, _core.BallbarSession):
-        raise _core.InvalidArgument("identify: session must be a BallbarSession")
+        raise _core.InvalidArgument("identify: session must be a BallbarSession or an RtestSession")
     if method == "joint":
         raw = _core.identify_joint(session, fit_length_offset, list(effects), list(tests))
     elif method == "paper":

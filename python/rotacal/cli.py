@@ -180,16 +180,12 @@ def _print_identification(d: dict) -> None:
 
 def cmd_identify(a: argparse.Namespace) -> int:
     s = load(a.file)
-    if isinstance(s, _core.RtestSession):
-        from . import rtest  # noqa: F401  (the R-test API; raises if not built)
-        result = rtest.identify_rtest(s, method=a.method)
-    else:
-        result = identify(s, a.method, fit_length_offset=a.length_offset)
+    result = identify(s, a.method, fit_length_offset=a.length_offset)
     d = result.to_dict()
     if a.save_model:
         save_model(result.model_dict(), a.save_model)
         _say(f"wrote {a.save_model}")
-    if a.json:
+    if a.json or isinstance(s, _core.RtestSession):
         print(json.dumps(d, indent=1))
     else:
         _print_identification(d)
