@@ -301,22 +301,12 @@ RtestJointIdentification identify_joint(const RtestSession& session,
   const Observability obs = analyse_observability(J0, scales, options.observability_min_chi2);
   std::vector<bool> free(static_cast<std::size_t>(n_par), true);
   for (int j : obs.to_fix) free[static_cast<std::size_t>(j)] = false;
-  auto fix_subset = [&](double* block, int offset, int size) {
-    std::vector<int> fixed;
-    for (int k = 0; k < size; ++k)
-      if (!free[static_cast<std::size_t>(offset + k)]) fixed.push_back(k);
-    if (static_cast<int>(fixed.size()) == size)
-      problem.SetParameterBlockConstant(block);
-    else if (!fixed.empty()) {
-      manifolds.push_back(std::make_unique<ceres::SubsetManifold>(size, fixed));
-      problem.SetManifold(block, manifolds.back().get());
-    }
-  };
-  fix_subset(e.data(), 0, 8);
-  if (nb > 0) fix_subset(cb.data(), 8, nb);
-  if (nc > 0) fix_subset(cc.data(), 8 + nb, nc);
-  for (std::size_t k = 0; k < zeros.size(); ++k)
-    fix_subset(zeros[k].data(), n_model + 3 * static_cast<int>(k), 3);
+  // `free` is in `names` order: location errors, B map, C map, then the zeros set-up by set-up.
+  std::vector<std::pair<double*, int>> sized = {{e.data(), 8}};
+  if (nb > 0) sized.emplace_back(cb.data(), nb);  // empty bases are constant already
+  if (nc > 0) sized.emplace_back(cc.data(), nc);
+  for (auto& z : zeros) sized.emplace_back(z.data(), 3);
+  hold_fixed(problem, sized, free, manifolds);
 
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_QR;
