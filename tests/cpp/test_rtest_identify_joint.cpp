@@ -1,11 +1,10 @@
 // Tests of rtest/identify_joint.hpp: joint fit, observability per nest arrangement, and the
 // gravity/coning map on ../shared/data/rtest_bc_oyama.csv.
 #include <catch2/catch.hpp>
-#include <fstream>
 #include <iostream>
-#include <sstream>
 
 #include "rotacal/core/error.hpp"
+#include "rotacal/io/ballbar_file.hpp"
 #include "rotacal/rtest/identify_joint.hpp"
 #include "rotacal/rtest/simulate.hpp"
 
@@ -14,34 +13,8 @@ using namespace rotacal;
 namespace {
 constexpr double kDeg = M_PI / 180.0;
 
-// Minimal reader for the example file (the library's reader lives in io/, owned elsewhere).
 RtestSession load_oyama() {
-  std::ifstream in(std::string(ROTACAL_SHARED_DIR) + "/data/rtest_bc_oyama.csv");
-  REQUIRE(in.good());
-  RtestSession s;
-  s.machine = MachineType::BC_trt;
-  s.nests["1"] = Eigen::Vector3d(100, 0, 60);  // the file's nest.1 / nest.2 metadata
-  s.nests["2"] = Eigen::Vector3d(0, -120, 140);
-  std::string line;
-  bool header = false;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    if (!header) { header = true; continue; }
-    std::stringstream ss(line);
-    std::string tok;
-    std::vector<std::string> f;
-    while (std::getline(ss, tok, ',')) f.push_back(tok);
-    REQUIRE(f.size() == 10);
-    RtestSample r;
-    r.setup = f[0];
-    r.time = std::stod(f[1]);
-    r.tilt_deg = std::stod(f[2]);
-    r.rot_deg = std::stod(f[3]);
-    r.xyz = Eigen::Vector3d(std::stod(f[4]), std::stod(f[5]), std::stod(f[6]));
-    r.d = Eigen::Vector3d(std::stod(f[7]), std::stod(f[8]), std::stod(f[9]));
-    s.samples.push_back(r);
-  }
-  return s;
+  return read_rtest(std::string(ROTACAL_SHARED_DIR) + "/data/rtest_bc_oyama.csv");
 }
 
 RtestTruth oyama_truth() {  // rtest_bc_oyama.truth.json

@@ -1,41 +1,15 @@
 // Tests of rtest/simulate.hpp, cross-checked against the independent implementation's session
 // ../shared/data/rtest_bc_oyama.csv.
 #include <catch2/catch.hpp>
-#include <fstream>
-#include <sstream>
 
 #include "rotacal/core/error.hpp"
+#include "rotacal/io/ballbar_file.hpp"
 #include "rotacal/rtest/simulate.hpp"
 
 using namespace rotacal;
 
 namespace {
-// Minimal reader for the example file (the library's reader lives in io/, owned elsewhere).
-std::vector<RtestSample> load_rows(const std::string& path) {
-  std::ifstream in(path);
-  REQUIRE(in.good());
-  std::vector<RtestSample> rows;
-  std::string line;
-  bool header = false;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    if (!header) { header = true; continue; }
-    std::stringstream ss(line);
-    std::string tok;
-    std::vector<std::string> f;
-    while (std::getline(ss, tok, ',')) f.push_back(tok);
-    REQUIRE(f.size() == 10);
-    RtestSample r;
-    r.setup = f[0];
-    r.time = std::stod(f[1]);
-    r.tilt_deg = std::stod(f[2]);
-    r.rot_deg = std::stod(f[3]);
-    r.xyz = Eigen::Vector3d(std::stod(f[4]), std::stod(f[5]), std::stod(f[6]));
-    r.d = Eigen::Vector3d(std::stod(f[7]), std::stod(f[8]), std::stod(f[9]));
-    rows.push_back(r);
-  }
-  return rows;
-}
+std::vector<RtestSample> load_rows(const std::string& path) { return read_rtest(path).samples; }
 
 RtestTruth oyama_truth() {  // rtest_bc_oyama.truth.json
   RtestTruth t;
