@@ -1,15 +1,155 @@
-// Bindings for include/rotacal/rtest (identification and error map; the C++ module does the work).
+// Bindings for include/rotacal/rtest: device calibration, simulation, identification, error
+// map and prediction. Thin: numpy in and out, the C++ module does the work.
 #include "numpy.hpp"
+#include "rotacal/rtest/device.hpp"
 #include "rotacal/rtest/error_map.hpp"
+#include "rotacal/rtest/predict.hpp"
+#include "rotacal/rtest/simulate.hpp"
 
 namespace rotacal::py {
 
+namespace {
+using Array = pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>;
+using Rows3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+using Rows6 = Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>;
+
+EffectModel effect_model(const std::vector<std::string>& ids) {
+  EffectModel fx;
+  for (const std::string& id : ids) fx.effects.push_back(Effect::parse(id));
+  return fx;
+}
+
+std::vector<Eigen::Vector3d> vectors_of(const Array& a, const char* name) {
+  const auto m = rows_of<3>(a, name);
+  std::vector<Eigen::Vector3d> out;
+  for (Eigen::Index i = 0; i < m.rows(); ++i) out.emplace_back(m.row(i).transpose());
+  return out;
+}
+
+Rows3 rows_from(const std::vector<Eigen::Vector3d>& v) {
+  Rows3 m(static_cast<Eigen::Index>(v.size()), 3);
+  for (std::size_t i = 0; i < v.size(); ++i) m.row(static_cast<Eigen::Index>(i)) = v[i].transpose();
+  return m;
+}
+
+Eigen::Matrix3d matrix3_of(const Array& a, const char* name) {
+  const auto m = rows_of<3>(a, name);
+  if (m.rows() != 3)
+    throw InvalidArgument(std::string(name) + ": expected an array of shape (3, 3)");
+  return m;
+}
+
+// Evaluates f(row) -> (value, std) for each row of angles; returns both as (N, K) arrays.
+template <int K, typename F>
+std::pair<Eigen::Matrix<double, Eigen::Dynamic, K, Eigen::RowMajor>,
+          Eigen::Matrix<double, Eigen::Dynamic, K, Eigen::RowMajor>>
+evaluate_rows(Eigen::Index n, F f) {
+  Eigen::Matrix<double, Eigen::Dynamic, K, Eigen::RowMajor> v(n, K), s(n, K);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    Eigen::Matrix<double, K, 1> sd;
+    v.row(i) = f(i, sd).transpose();
+    s.row(i) = sd.transpose();
+  }
+  return {v, s};
+}
+}  // namespace
+
 void bind_rtest(pyb::module_& m) {
+  // ------------------------------------------------------------------ model
+  pyb::class_<RtestBasis>(
+      m, "RtestBasis", "Smooth basis of the position-dependent errors (rtest/identify_joint.hpp).")
+      .def(pyb::init([](int b_degree, int c_harmonics, int c_b_degree, bool gamma_cb) {
+             RtestBasis b;
+             b.b_degree = b_degree;
+             b.c_harmonics = c_harmonics;
+             b.c_b_degree = c_b_degree;
+             b.gamma_cb = gamma_cb;
+             return b;
+           }),
+           pyb::arg("b_degree") = RtestBasis{}.b_degree,
+           pyb::arg("c_harmonics") = RtestBasis{}.c_harmonics,
+           pyb::arg("c_b_degree") = RtestBasis{}.c_b_degree,
+           pyb::arg("gamma_cb") = RtestBasis{}.gamma_cb)
+      .def_readonly("b_degree", &RtestBasis::b_degree,
+                    "highest power of b = B / 90 deg in the B map")
+      .def_readonly("c_harmonics", &RtestBasis::c_harmonics, "harmonics 1..K of C in the C map")
+      .def_readonly("c_b_degree", &RtestBasis::c_b_degree, "degree in b of the C-map coefficients")
+      .def_readonly("gamma_cb", &RtestBasis::gamma_cb,
+                    "gamma_CB (angular positioning of C) in the C map")
+      .def("coefficient_names", &RtestBasis::coefficient_names,
+           "Names of the map coefficients, B map first, in parameter order.");
+
+  pyb::class_<RtestJointModel>(
+      m, "RtestJointModel",
+      "Location errors and smooth error maps of a B/C table, with covariance.")
+      .def(pyb::init([](MachineType machine, const RtestBasis& basis, const Eigen::VectorXd& params,
+                        const Eigen::MatrixXd& covariance, const std::vector<bool>& observable) {
+             return make_rtest_joint_model(machine, basis, params, covariance, observable);
+           }),
+           pyb::arg("machine"), pyb::arg("basis"), pyb::arg("params"), pyb::arg("covariance"),
+           pyb::arg("observable"),
+           "Rebuild a model from its parts (checked against the basis: rtest/predict.hpp).")
+      .def_readonly("machine", &RtestJointModel::machine)
+      .def_readonly("basis", &RtestJointModel::basis)
+      .def_readonly("params", &RtestJointModel::params,
+                    "8 location errors, then the map coefficients (mm, rad)")
+      .def_readonly("covariance", &RtestJointModel::covariance)
+      .def_readonly("observable", &RtestJointModel::observable)
+      .def(
+          "readings",
+          [](const RtestJointModel& mo, const Array& q, const Array& angles) {
+            const Eigen::Vector3d qv = vec_of<3>(q, "q");
+            const auto a = rows_of<2>(angles, "angles");
+            return evaluate_rows<3>(a.rows(), [&](Eigen::Index i, Eigen::Vector3d& sd) {
+              return mo.reading(qv, a(i, 0), a(i, 1), &sd);
+            });
+          },
+          pyb::arg("q"), pyb::arg("angles"),
+          "R-test readings (N, 3) of the nest at q (table frame, mm) at angles (N, 2) = (B, C) in "
+          "rad, without probe zero, and their 1-sigma (N, 3) (NaN where an unobservable parameter "
+          "enters).")
+      .def(
+          "table_errors",
+          [](const RtestJointModel& mo, const Array& q, const Array& angles) {
+            const Eigen::Vector3d qv = vec_of<3>(q, "q");
+            const auto a = rows_of<2>(angles, "angles");
+            return evaluate_rows<3>(a.rows(), [&](Eigen::Index i, Eigen::Vector3d& sd) {
+              return mo.table_error(qv, a(i, 0), a(i, 1), &sd);
+            });
+          },
+          pyb::arg("q"), pyb::arg("angles"),
+          "Error T q - T_nominal q (N, 3) of the table point q (mm) at angles (N, 2) in rad, "
+          "machine frame, mm, and its 1-sigma.")
+      .def(
+          "w_by",
+          [](const RtestJointModel& mo, const Eigen::VectorXd& B) {
+            return evaluate_rows<6>(B.size(), [&](Eigen::Index i, AxisErrors<double>& sd) {
+              return mo.w_BY(B[i], &sd);
+            });
+          },
+          pyb::arg("B"),
+          "B-axis map (N, 6) = (dx, dy, dz, alpha, beta, gamma)_BY (mm, rad) at B (N,) in rad, "
+          "and its 1-sigma.")
+      .def(
+          "w_cb",
+          [](const RtestJointModel& mo, const Array& angles) {
+            const auto a = rows_of<2>(angles, "angles");
+            return evaluate_rows<6>(a.rows(), [&](Eigen::Index i, AxisErrors<double>& sd) {
+              return mo.w_CB(a(i, 0), a(i, 1), &sd);
+            });
+          },
+          pyb::arg("angles"),
+          "C-axis map (N, 6) at angles (N, 2) = (B, C) in rad, and its 1-sigma.");
+
+  // ------------------------------------------------------------------ identification
   pyb::class_<RtestJointIdentification>(m, "RtestJointIdentification")
       .def_readonly("method", &RtestJointIdentification::method)
+      .def_readonly("model", &RtestJointIdentification::model)
       .def_readonly("parameters", &RtestJointIdentification::parameters)
       .def_readonly("covariance", &RtestJointIdentification::covariance)
       .def_readonly("probe_zeros", &RtestJointIdentification::probe_zeros)
+      .def_property_readonly(
+          "residuals", [](const RtestJointIdentification& r) { return rows_from(r.residuals); })
       .def_readonly("residual_rms_um", &RtestJointIdentification::residual_rms_um)
       .def_readonly("sigma_um", &RtestJointIdentification::sigma_um)
       .def_readonly("n_samples", &RtestJointIdentification::n_samples)
@@ -29,11 +169,13 @@ void bind_rtest(pyb::module_& m) {
 
   m.def(
       "identify_rtest_joint",
-      [](const RtestSession& session) {
+      [](const RtestSession& session, const RtestBasis& basis) {
         pyb::gil_scoped_release release;
-        return identify_joint(session);
+        RtestJointOptions o;
+        o.basis = basis;
+        return identify_joint(session, o);
       },
-      pyb::arg("session"),
+      pyb::arg("session"), pyb::arg("basis") = RtestBasis{},
       "Joint Ceres fit of an R-test session: location errors, smooth B and C maps, a probe zero "
       "per set-up, with observability (rtest/identify_joint.hpp).");
   m.def(
@@ -60,6 +202,187 @@ void bind_rtest(pyb::module_& m) {
       },
       pyb::arg("identification"), pyb::arg("format") = "json",
       "The paper method's error map at its measured grid, as JSON or CSV text.");
+
+  // ------------------------------------------------------------------ prediction
+  m.def("predict_rtest_session", &predict_session, pyb::arg("model"), pyb::arg("session"),
+        pyb::arg("probe_zeros") = std::map<std::string, Eigen::Vector3d>{},
+        "The session with dx,dy,dz predicted by the model and 1-sigma columns dx_std, dy_std, "
+        "dz_std; probe_zeros (set-up -> (3,) mm) are added if given (rtest/predict.hpp).");
+  m.def(
+      "rtest_prediction_rms_um",
+      [](const RtestJointModel& mo, const RtestSession& session) {
+        return prediction_rms_um(session, [&](const Eigen::Vector3d& q, double B, double C) {
+          return mo.reading(q, B, C);
+        });
+      },
+      pyb::arg("model"), pyb::arg("session"),
+      "RMS (um) of measured - predicted readings after one constant offset per set-up.");
+
+  // ------------------------------------------------------------------ simulation
+  m.def(
+      "simulate_rtest",
+      [](MachineType machine, const Array& errors, const std::vector<std::string>& effects,
+         const std::vector<double>& effect_params, const std::vector<double>& b_deg,
+         const std::vector<double>& c_deg, const Array& nests, double dwell_s, double noise_um,
+         double probe_zero_um, std::optional<Array> probe_dirs, bool write_d, unsigned seed) {
+        RtestTruth t;
+        t.machine = machine;
+        t.errors = LocationErrors<double>(vec_of<8>(errors, "errors"));
+        t.effects = effect_model(effects);
+        t.effect_params = effect_params;
+        RtestSimOptions o;
+        o.pattern.b_deg = b_deg;
+        o.pattern.c_deg = c_deg;
+        o.pattern.nests = vectors_of(nests, "nests");
+        o.pattern.dwell_s = dwell_s;
+        o.noise_um = noise_um;
+        o.probe_zero_um = probe_zero_um;
+        if (probe_dirs) o.probe_dirs = matrix3_of(*probe_dirs, "probe_dirs");
+        o.write_d = write_d;
+        o.seed = seed;
+        RtestSimulation sim = simulate_rtest(t, o);
+        return std::make_pair(std::move(sim.session), rows_from(sim.probe_zeros));
+      },
+      pyb::arg("machine"), pyb::arg("errors"), pyb::arg("effects"), pyb::arg("effect_params"),
+      pyb::arg("b_deg"), pyb::arg("c_deg"), pyb::arg("nests"), pyb::arg("dwell_s"),
+      pyb::arg("noise_um"), pyb::arg("probe_zero_um"), pyb::arg("probe_dirs") = std::nullopt,
+      pyb::arg("write_d") = true, pyb::arg("seed") = 1u,
+      R"doc(Simulate an R-test session (rtest/simulate.hpp).
+
+Parameters
+----------
+machine : MachineType (BC_trt)
+errors : (8,) location errors (mm, rad)
+effects, effect_params : catalogue ids and their parameters back to back
+b_deg, c_deg : the grid, B outer and C inner (deg)
+nests : (K, 3) nominal ball centres, table frame (mm)
+dwell_s : time between readings (s)
+noise_um, probe_zero_um : 1-sigma reading noise and per-set-up probe zero (um)
+probe_dirs : (3, 3) rows = probe directions: raw d1,d2,d3 are written as well
+write_d : with probe_dirs, also write dx,dy,dz
+
+Returns
+-------
+(session, probe_zeros (K, 3) mm))doc");
+  m.def(
+      "rtest_readings",
+      [](MachineType machine, const Array& errors, const std::vector<std::string>& effects,
+         const std::vector<double>& effect_params, const Array& q, const Array& angles,
+         const Eigen::VectorXd& time) {
+        RtestTruth t;
+        t.machine = machine;
+        t.errors = LocationErrors<double>(vec_of<8>(errors, "errors"));
+        t.effects = effect_model(effects);
+        t.effect_params = effect_params;
+        if (static_cast<int>(t.effect_params.size()) != t.effects.num_params())
+          throw InvalidArgument("effect_params: expected " +
+                                std::to_string(t.effects.num_params()) + " values");
+        const Eigen::Vector3d qv = vec_of<3>(q, "q");
+        const auto a = rows_of<2>(angles, "angles");
+        if (time.size() != a.rows()) throw InvalidArgument("time: one value per row of angles");
+        Rows3 d(a.rows(), 3);
+        for (Eigen::Index i = 0; i < a.rows(); ++i)
+          d.row(i) = rtest_reading(t, qv, {a(i, 0), a(i, 1)}, time[i]).transpose();
+        return d;
+      },
+      pyb::arg("machine"), pyb::arg("errors"), pyb::arg("effects"), pyb::arg("effect_params"),
+      pyb::arg("q"), pyb::arg("angles"), pyb::arg("time"),
+      "Noise-free readings (N, 3) of the nest at q (mm) at angles (N, 2) in rad and time (N,) s, "
+      "no probe zero: the simulator's truth.");
+
+  // ------------------------------------------------------------------ device (Sec. 3.1-3.2)
+  pyb::class_<ProbeCalibration>(m, "ProbeCalibration", "Probe directions from linear moves.")
+      .def_readonly("dirs", &ProbeCalibration::dirs, "unit directions (rows), table frame")
+      .def_readonly("gains", &ProbeCalibration::gains)
+      .def_readonly("zeros", &ProbeCalibration::zeros, "probe zero offsets, mm")
+      .def_readonly("direction_std_rad", &ProbeCalibration::direction_std_rad)
+      .def_readonly("gain_std", &ProbeCalibration::gain_std)
+      .def_property_readonly("residuals",
+                             [](const ProbeCalibration& c) { return rows_from(c.residuals); })
+      .def_readonly("residual_rms_um", &ProbeCalibration::residual_rms_um)
+      .def_readonly("sigma_um", &ProbeCalibration::sigma_um);
+  pyb::class_<SphereOffsetCalibration>(m, "SphereOffsetCalibration",
+                                       "Sphere offset from the spindle axis.")
+      .def_readonly("offset", &SphereOffsetCalibration::offset, "(x, y) at spindle angle 0, mm")
+      .def_readonly("offset_std", &SphereOffsetCalibration::offset_std)
+      .def_readonly("centre", &SphereOffsetCalibration::centre)
+      .def_readonly("residual_rms_um", &SphereOffsetCalibration::residual_rms_um);
+
+  m.def(
+      "calibrate_probe_directions",
+      [](const Array& moves, const Array& readings) {
+        const auto mv = rows_of<3>(moves, "moves");
+        const auto rd = rows_of<3>(readings, "readings");
+        if (mv.rows() != rd.rows()) throw InvalidArgument("readings: one row per move");
+        std::vector<ProbeCalibrationSample> s(static_cast<std::size_t>(mv.rows()));
+        for (Eigen::Index i = 0; i < mv.rows(); ++i)
+          s[static_cast<std::size_t>(i)] = {mv.row(i).transpose(), rd.row(i).transpose()};
+        return calibrate_probe_directions(s);
+      },
+      pyb::arg("moves"), pyb::arg("readings"),
+      "Probe directions, gains and zeros from commanded moves (N, 3) and readings (N, 3), mm.");
+  m.def(
+      "simulate_probe_calibration",
+      [](const Array& dirs, const Array& zeros, const Array& moves, double noise_um,
+         unsigned seed) {
+        Rows3 r;
+        const auto s =
+            simulate_probe_calibration(matrix3_of(dirs, "dirs"), vec_of<3>(zeros, "zeros"),
+                                       vectors_of(moves, "moves"), noise_um, seed);
+        r.resize(static_cast<Eigen::Index>(s.size()), 3);
+        for (std::size_t i = 0; i < s.size(); ++i)
+          r.row(static_cast<Eigen::Index>(i)) = s[i].readings.transpose();
+        return r;
+      },
+      pyb::arg("dirs"), pyb::arg("zeros"), pyb::arg("moves"), pyb::arg("noise_um"),
+      pyb::arg("seed"), "Simulated readings (N, 3) of the direction calibration.");
+  m.def(
+      "default_calibration_moves",
+      [](double step_mm) { return rows_from(default_calibration_moves(step_mm)); },
+      pyb::arg("step_mm") = 0.5, "+-step along X, Y, Z and the 4 body diagonals (14, 3), mm.");
+  m.def(
+      "calibrate_sphere_offset",
+      [](const Array& dirs, const Eigen::VectorXd& angles, const Array& readings) {
+        const auto rd = rows_of<3>(readings, "readings");
+        if (rd.rows() != angles.size()) throw InvalidArgument("readings: one row per angle");
+        std::vector<SpindleIndexSample> s(static_cast<std::size_t>(rd.rows()));
+        for (Eigen::Index i = 0; i < rd.rows(); ++i)
+          s[static_cast<std::size_t>(i)] = {angles[i], rd.row(i).transpose()};
+        return calibrate_sphere_offset(matrix3_of(dirs, "dirs"), s);
+      },
+      pyb::arg("dirs"), pyb::arg("angles"), pyb::arg("readings"),
+      "Sphere offset from spindle indexing: angles (N,) rad, readings (N, 3) mm.");
+  m.def(
+      "simulate_spindle_indexing",
+      [](const Array& dirs, const Array& zeros, const Array& offset, const Array& centre,
+         const std::vector<double>& angles, double noise_um, unsigned seed) {
+        const auto s = simulate_spindle_indexing(
+            matrix3_of(dirs, "dirs"), vec_of<3>(zeros, "zeros"), vec_of<2>(offset, "offset"),
+            vec_of<3>(centre, "centre"), angles, noise_um, seed);
+        Rows3 r(static_cast<Eigen::Index>(s.size()), 3);
+        for (std::size_t i = 0; i < s.size(); ++i)
+          r.row(static_cast<Eigen::Index>(i)) = s[i].readings.transpose();
+        return r;
+      },
+      pyb::arg("dirs"), pyb::arg("zeros"), pyb::arg("offset"), pyb::arg("centre"),
+      pyb::arg("angles"), pyb::arg("noise_um"), pyb::arg("seed"),
+      "Simulated spindle-indexing readings (N, 3), mm.");
+  m.def(
+      "displacements_from_raw",
+      [](const RtestSession& s, std::optional<Array> dirs) {
+        return dirs ? displacements_from_raw(s, matrix3_of(*dirs, "dirs"))
+                    : displacements_from_raw(s);
+      },
+      pyb::arg("session"), pyb::arg("dirs") = std::nullopt,
+      "Fill dx,dy,dz from raw d1,d2,d3 with the session's probe.N.dir, or with calibrated dirs "
+      "(3, 3) (rows keep a dx,dy,dz they already have).");
+  m.def(
+      "compensate_sphere_offset",
+      [](const RtestSession& s, const Array& offset) {
+        return compensate_sphere_offset(s, vec_of<2>(offset, "offset"));
+      },
+      pyb::arg("session"), pyb::arg("offset"),
+      "The session with the sphere's offset (x, y) from the spindle axis taken out of every d.");
 }
 
 }  // namespace rotacal::py

@@ -222,11 +222,35 @@ def diagnose_ballbar(session: BallbarSession, options: DiagnosisOptions = ...,
 def diagnose_rtest(session: RtestSession, options: DiagnosisOptions = ...) -> Diagnosis: ...
 
 # ---------------------------------------------------------------- R-test
+class RtestBasis:
+    def __init__(self, b_degree: int = 6, c_harmonics: int = 2, c_b_degree: int = 1,
+                 gamma_cb: bool = False) -> None: ...
+    b_degree: int
+    c_harmonics: int
+    c_b_degree: int
+    gamma_cb: bool
+    def coefficient_names(self) -> list[str]: ...
+
+class RtestJointModel:
+    def __init__(self, machine: MachineType, basis: RtestBasis, params: ArrayLike, covariance: ArrayLike,
+                 observable: Sequence[bool]) -> None: ...
+    machine: MachineType
+    basis: RtestBasis
+    params: Array
+    covariance: Array
+    observable: list[bool]
+    def readings(self, q: ArrayLike, angles: ArrayLike) -> tuple[Array, Array]: ...
+    def table_errors(self, q: ArrayLike, angles: ArrayLike) -> tuple[Array, Array]: ...
+    def w_by(self, B: ArrayLike) -> tuple[Array, Array]: ...
+    def w_cb(self, angles: ArrayLike) -> tuple[Array, Array]: ...
+
 class RtestJointIdentification:
     method: str
+    model: RtestJointModel
     parameters: list[ParameterEstimate]
     covariance: Array
     probe_zeros: dict[str, Array]
+    residuals: Array
     residual_rms_um: float
     sigma_um: float
     n_samples: int
@@ -244,6 +268,41 @@ class RtestPaperIdentification:
     unobservable: list[str]
     notes: list[str]
 
-def identify_rtest_joint(session: RtestSession) -> RtestJointIdentification: ...
+def identify_rtest_joint(session: RtestSession, basis: RtestBasis = ...) -> RtestJointIdentification: ...
 def identify_rtest_paper(session: RtestSession) -> RtestPaperIdentification: ...
 def rtest_error_map(identification: object, *args: object) -> str: ...
+def predict_rtest_session(model: RtestJointModel, session: RtestSession,
+                          probe_zeros: dict[str, ArrayLike] = ...) -> RtestSession: ...
+def rtest_prediction_rms_um(model: RtestJointModel, session: RtestSession) -> float: ...
+def simulate_rtest(machine: MachineType, errors: ArrayLike, effects: Sequence[str], effect_params: Sequence[float],
+                   b_deg: Sequence[float], c_deg: Sequence[float], nests: ArrayLike, dwell_s: float,
+                   noise_um: float, probe_zero_um: float, probe_dirs: Optional[ArrayLike] = None,
+                   write_d: bool = True, seed: int = 1) -> tuple[RtestSession, Array]: ...
+def rtest_readings(machine: MachineType, errors: ArrayLike, effects: Sequence[str], effect_params: Sequence[float],
+                   q: ArrayLike, angles: ArrayLike, time: ArrayLike) -> Array: ...
+
+class ProbeCalibration:
+    dirs: Array
+    gains: Array
+    zeros: Array
+    direction_std_rad: Array
+    gain_std: Array
+    residuals: Array
+    residual_rms_um: float
+    sigma_um: float
+
+class SphereOffsetCalibration:
+    offset: Array
+    offset_std: Array
+    centre: Array
+    residual_rms_um: float
+
+def calibrate_probe_directions(moves: ArrayLike, readings: ArrayLike) -> ProbeCalibration: ...
+def simulate_probe_calibration(dirs: ArrayLike, zeros: ArrayLike, moves: ArrayLike, noise_um: float,
+                               seed: int) -> Array: ...
+def default_calibration_moves(step_mm: float = 0.5) -> Array: ...
+def calibrate_sphere_offset(dirs: ArrayLike, angles: ArrayLike, readings: ArrayLike) -> SphereOffsetCalibration: ...
+def simulate_spindle_indexing(dirs: ArrayLike, zeros: ArrayLike, offset: ArrayLike, centre: ArrayLike,
+                              angles: Sequence[float], noise_um: float, seed: int) -> Array: ...
+def displacements_from_raw(session: RtestSession, dirs: Optional[ArrayLike] = None) -> RtestSession: ...
+def compensate_sphere_offset(session: RtestSession, offset: ArrayLike) -> RtestSession: ...
