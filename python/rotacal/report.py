@@ -195,12 +195,19 @@ def ballbar_report(path: str | Path, session: Any, identification: Any,
     if diagnosis is not None:
         parts.append(diagnosis_section(diagnosis.to_dict()))
     parts.extend(extra_sections)
-    # Records on load how many figures decoded, so a browser test can check they render.
-    parts.append("<script>window.addEventListener('load',function(){var im=document.images,ok=0;"
-                 "for(var i=0;i<im.length;i++){if(im[i].complete&&im[i].naturalWidth>0)ok++;}"
-                 "document.body.setAttribute('data-images',im.length);"
-                 "document.body.setAttribute('data-images-rendered',ok);});</script>")
-    parts.append("</body></html>")
+    return _write_page(path, parts)
+
+
+# Records on load how many figures decoded, so a browser test can check they render.
+_IMAGE_CHECK = ("<script>window.addEventListener('load',function(){var im=document.images,ok=0;"
+                "for(var i=0;i<im.length;i++){if(im[i].complete&&im[i].naturalWidth>0)ok++;}"
+                "document.body.setAttribute('data-images',im.length);"
+                "document.body.setAttribute('data-images-rendered',ok);});</script>")
+
+
+def _write_page(path: Path, parts: list[str]) -> Path:
+    """Close the page (with the image check) and write it atomically."""
+    parts = parts + [_IMAGE_CHECK, "</body></html>"]
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(path.name + ".tmp")
     tmp.write_text("\n".join(parts))
@@ -264,3 +271,142 @@ def diagnosis_section(d: dict) -> str:
 def _version() -> str:
     from . import __version__
     return __version__
+
+
+# ------------------------------------------------------------------------- R-test
+
+_COMPONENTS = ["dx", "dy", "dz", "alpha", "beta", "gamma"]
+
+
+def _component_scale(k: int) -> tuple[float, str]:
+    return (1e3, "\u00b5m") if k < 3 else (1e6, "\u00b5rad")
+
+
+def _band(ax, x: np.ndarray, v: np.ndarray, s: np.ndarray, color: str, label: str | None) -> None:
+    ax.plot(x, v, "-", lw=1.2, color=color, label=label)
+    if np.all(np.isfinite(s)):
+        ax.fill_between(x, v - s, v + s, color=color, alpha=0.25, lw=0)
+
+
+def rtest_b_map_plot(model: Any, b_range_deg: tuple[float, float]) -> str:
+    """The six B-axis errors w_BY against B with their 1-sigma band."""
+    b = np.linspace(b_range_deg[0], b_range_deg[1], 181)
+    v, s = (np.asarray(a) for a in model.w_by(np.radians(b)))
+    fig, axes = plt.subplots(2, 3, figsize=(10, 5.2), sharex=True)
+    for k, ax in enumerate(axes.flat):
+        scale, unit = _component_scale(k)
+        _band(ax, b, v[:, k] * scale, s[:, k] * scale, "#246", None)
+        ax.axhline(0, color="#999", lw=0.6)
+        ax.set_title(f"{_COMPONENTS[k]}_BY ({unit})" + ("" if np.all(np.isfinite(s[:, k])) else ", not determined"),
+                     fontsize=9)
+        ax.tick_params(labelsize=7)
+        if k >= 3:
+            ax.set_xlabel("B (deg)", fontsize=8)
+    fig.suptitle("B-axis errors beyond its location errors, joint fit (band: 1\u03c3)", fontsize=10)
+    fig.tight_layout()
+    return _png(fig)
+
+
+def rtest_c_map_plot(model: Any, b_values_deg: Iterable[float]) -> str:
+    """The C-axis errors w_CB against C, one curve per B, with their 1-sigma bands."""
+    c = np.linspace(0.0, 360.0, 181)
+    b_values = list(b_values_deg)
+    colors = plt.cm.viridis(np.linspace(0.0, 0.9, max(len(b_values), 1)))
+    fig, axes = plt.subplots(2, 3, figsize=(10, 5.2), sharex=True)
+    fitted = 6 if model.basis.gamma_cb else 5
+    for bi, b in enumerate(b_values):
+        ang = np.column_stack([np.full_like(c, np.radians(b)), np.radians(c)])
+        v, s = (np.asarray(a) for a in model.w_cb(ang))
+        for k in range(fitted):
+            scale, _ = _component_scale(k)
+            _band(axes.flat[k], c, v[:, k] * scale, s[:, k] * scale, colors[bi], f"B = {b:g}\u00b0")
+    for k, ax in enumerate(axes.flat):
+        scale, unit = _component_scale(k)
+        ax.set_title(f"{_COMPONENTS[k]}_CB ({unit})", fontsize=9)
+        ax.tick_params(labelsize=7)
+        if k >= 3:
+            ax.set_xlabel("C (deg)", fontsize=8)
+        if k >= fitted:
+            ax.text(0.5, 0.5, "not fitted: assumed 0\n(Oyama Sec. 4.2)", ha="center", va="center",
+                    transform=ax.transAxes, fontsize=8, color="#777")
+        ax.axhline(0, color="#999", lw=0.6)
+    axes.flat[0].legend(fontsize=6, ncol=2)
+    fig.suptitle("C-axis errors beyond its location errors, joint fit (bands: 1\u03c3)", fontsize=10)
+    fig.tight_layout()
+    return _png(fig)
+
+
+def rtest_residual_plot(setups: np.ndarray, residuals: np.ndarray) -> str:
+    """Residual (measured - model) of each reading component per pose."""
+    labels = np.array([f"set-up {s}" for s in setups])
+    return residual_plot(labels, [(f"d{a}", residuals[:, k]) for k, a in enumerate("xyz")])
+
+
+def rtest_report(path: str | Path, session: Any, identification: Any, diagnosis: Any | None = None,
+                 title: str | None = None, source: str = "") -> Path:
+    """Write the HTML report of an R-test session: set-up, location errors (ISO 230-7 table),
+    the error map against B and C with uncertainty bands, residuals and the diagnosis."""
+    from . import _core
+
+    path = Path(path)
+    ident = identification.to_dict()
+    if ident["method"] != "joint":
+        raise _core.InvalidArgument("rtest_report: needs the joint identification (its model draws the map)")
+    model = identification.raw.model
+    setups = np.asarray(session.setups)
+    angles = np.asarray(session.angles_deg)
+    b_meas = sorted(set(np.round(angles[:, 0], 6).tolist()))
+    c_meas = sorted(set(np.round(angles[:, 1], 6).tolist()))
+    heading = title or "R-test: location errors and error map of the rotary axes"
+    parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(heading)}</title>"
+             f"<style>{_CSS}</style></head><body>", f"<h1>{html.escape(heading)}</h1>",
+             f"<p class=muted>rotacal {html.escape(_version())} &middot; "
+             f"{_dt.datetime.now().strftime('%Y-%m-%d %H:%M')} &middot; {html.escape(source)}</p>"]
+
+    rows = [f"<tr><th class=l>Machine</th><td class=l>{ident['machine']} (tilting-rotary table)</td></tr>"]
+    for label, q in sorted(session.nests.items()):
+        rows.append(f"<tr><th class=l>Nest {html.escape(label)} (table frame)</th>"
+                    f"<td class=l>{', '.join(f'{v:.4f}' for v in q)} mm</td></tr>")
+    for n, d in sorted(session.probe_dirs.items()):
+        rows.append(f"<tr><th class=l>Probe {n} direction</th><td class=l>{', '.join(f'{v:.6f}' for v in d)}</td></tr>")
+    rows.append(f"<tr><th class=l>Poses</th><td class=l>{len(setups)} ({len(b_meas)} B &times; {len(c_meas)} C "
+                f"positions, {len(set(setups.tolist()))} set-ups)</td></tr>")
+    rows.append(f"<tr><th class=l>B (deg)</th><td class=l>{', '.join(f'{b:g}' for b in b_meas)}</td></tr>")
+    rows.append(f"<tr><th class=l>C (deg)</th><td class=l>{', '.join(f'{c:g}' for c in c_meas)}</td></tr>")
+    if session.noise_um is not None:
+        rows.append(f"<tr><th class=l>Stated noise</th><td class=l>{session.noise_um:.3f} &micro;m</td></tr>")
+    parts.append('<section id="setup"><h2>Machine and set-up</h2><table>' + "".join(rows) + "</table></section>")
+
+    parts.append('<section id="location-errors"><h2>Location errors (ISO 230-7), joint fit</h2>')
+    parts.append(location_error_table(ident["location_errors"]))
+    zeros = ", ".join(f"set-up {k}: ({', '.join(f'{v * 1e3:+.2f}' for v in z)}) &micro;m"
+                      for k, z in ident["probe_zeros"].items())
+    parts.append(f"<p>Residual RMS {ident['residual_rms_um']:.3f} &micro;m over {ident['n_samples']} poses "
+                 f"(3 readings each). Fitted probe zeros: {zeros}.</p>")
+    if ident["unobservable"]:
+        parts.append("<p class=warn>Not determined by this session's nests:</p><ul>" +
+                     "".join(f"<li>{html.escape(u)}</li>" for u in ident["unobservable"]) + "</ul>")
+    parts.append("<ul class=muted>" + "".join(f"<li>{html.escape(n)}</li>" for n in ident["notes"]) + "</ul>")
+    parts.append("</section>")
+
+    map_csv = identification.error_map("csv", b_meas, c_meas)
+    parts.append('<section id="error-map"><h2>Error map (Oyama &amp; Ibaraki Sec. 5.2)</h2>'
+                 "<p>Position-dependent errors of the B axis (w_BY, in front of the B rotation) and of "
+                 "the C axis (w_CB, in the B-axis frame), beyond the rigid axis lines whose location "
+                 "errors are in the table above. Curves: the joint fit's smooth maps; bands: "
+                 "&plusmn;1&sigma; from the parameter covariance. "
+                 f"<a download='error_map.csv' href='data:text/csv;base64,"
+                 f"{base64.b64encode(map_csv.encode()).decode('ascii')}'>The map at the measured angles "
+                 "(CSV)</a>.</p>")
+    parts.append(_img(rtest_b_map_plot(model, (b_meas[0], b_meas[-1])), "B-axis errors against B", "error-map"))
+    parts.append(_img(rtest_c_map_plot(model, b_meas), "C-axis errors against C at each measured B", "error-map"))
+    parts.append("</section>")
+
+    parts.append('<section id="residuals"><h2>Residuals</h2>')
+    parts.append(_img(rtest_residual_plot(setups, np.asarray(identification.raw.residuals)),
+                      "residual per pose and reading (measured - joint model)", "residuals"))
+    parts.append("</section>")
+
+    if diagnosis is not None:
+        parts.append(diagnosis_section(diagnosis.to_dict()))
+    return _write_page(path, parts)
