@@ -19,6 +19,7 @@ from . import _core
 from .ballbar import identify, predict, random_location_errors
 from .diagnosis import diagnose
 from .models import ballbar_model_from_dict, load_model, save_model
+from .rtest import DEFAULT_DWELL_S, DEFAULT_NOISE_UM, DEFAULT_PROBE_ZERO_UM
 from .sessions import load, save
 
 EXIT_OK, EXIT_USAGE, EXIT_INPUT, EXIT_IO, EXIT_ERROR = 0, 2, 3, 4, 5
@@ -139,8 +140,6 @@ def simulate_session(setup, truth: dict):
 
 
 def cmd_simulate(a: argparse.Namespace) -> int:
-    if a.kind != "ballbar":
-        raise _core.InvalidArgument("simulate: only 'ballbar' is available from this command so far")
     setup = _setup(a)
     truth = _truth(a, setup.machine)
     session, model = simulate_session(setup, truth)
@@ -150,6 +149,52 @@ def cmd_simulate(a: argparse.Namespace) -> int:
         Path(a.truth).write_text(json.dumps(truth, indent=1) + "\n")
     _say(f"wrote {a.output}: {len(session)} samples on a simulated {a.machine}"
          + (f", truth in {a.truth}" if a.truth else ""))
+    return EXIT_OK
+
+
+def _named_values(text: str, names: list[str], what: str) -> dict[str, float]:
+    """'NAME=VALUE,NAME=VALUE' -> dict, every NAME one of `names`."""
+    out: dict[str, float] = {}
+    for item in text.split(","):
+        key, _, val = item.partition("=")
+        if key.strip() not in names:
+            raise _core.InvalidArgument(f"{what}: '{key}' is not one of {', '.join(names)}")
+        out[key.strip()] = _floats(val, 1, f"{what} {key}")[0]
+    return out
+
+
+def cmd_simulate_rtest(a: argparse.Namespace) -> int:
+    from . import rtest
+    machine = _core.parse_machine_type(a.machine)
+    b0, b1 = _floats(a.tilt_range, 2, "--b-range")
+    c0, c1 = _floats(a.c_range, 2, "--c-range")
+    b_deg = rtest.angle_grid(b0, b1, a.b_step, "--b-range/--b-step")
+    c_deg = rtest.angle_grid(c0, c1, a.c_step, "--c-range/--c-step", full_turn=True)
+    nests = [_floats(n, 3, "--nest") for n in a.nest] if a.nest else rtest.DEFAULT_NESTS
+    errors = a.errors if a.errors in ("random", "zero") else _named_values(
+        a.errors, list(_core.location_error_names(machine)), "--errors")
+    effects = {}
+    for item in a.effect or []:
+        key, _, val = item.partition("=")
+        eff = _core.Effect(key.strip())
+        effects[eff.id] = _floats(val, eff.num_params, f"--effect {key}")
+    dirs = None
+    if a.probe_dir:
+        if len(a.probe_dir) != 3:
+            raise _core.InvalidArgument(f"--probe-dir: give it 3 times (probes 1, 2, 3), got {len(a.probe_dir)}")
+        dirs = np.array([_floats(d, 3, "--probe-dir") for d in a.probe_dir])
+        dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    elif a.raw_only:
+        raise _core.InvalidArgument("--raw-only needs the probe directions (--probe-dir x3)")
+    session, truth = rtest.simulate_rtest(errors, effects, machine=a.machine, b_deg=b_deg, c_deg=c_deg,
+                                          nests=nests, noise_um=a.noise, probe_zero_um=a.probe_zero,
+                                          probe_dirs=dirs, write_d=not a.raw_only, dwell_s=a.dwell,
+                                          seed=a.seed)
+    save(session, a.output)
+    truth_path = Path(a.truth) if a.truth else Path(a.output).with_suffix(".truth.json")
+    rtest.save_truth(truth, truth_path)
+    _say(f"wrote {a.output}: {len(session)} poses ({len(b_deg)} B x {len(c_deg)} C x {len(nests)} nests) "
+         f"on a simulated {a.machine}, truth in {truth_path}")
     return EXIT_OK
 
 
@@ -230,9 +275,14 @@ def cmd_diagnose(a: argparse.Namespace) -> int:
 def cmd_predict(a: argparse.Namespace) -> int:
     model_dict = load_model(a.model)
     s = load(a.session)
-    if model_dict.get("kind") == "rtest":
+    if isinstance(s, _core.RtestSession):
         from . import rtest
-        out = rtest.predict_rtest(model_dict, s)
+        out = rtest.predict_rtest(model_dict, s, a.probe_zeros, source=a.model)
+        if rtest._has_displacements(s) or s.probe_dirs:
+            _say(f"measured - predicted: RMS {rtest.prediction_rms_um(model_dict, s, a.model):.3f} um over "
+                 f"{len(s)} poses (one constant per set-up removed: its probe zero)")
+    elif a.probe_zeros != "none":
+        raise _core.InvalidArgument("predict: --probe-zeros is for R-test sessions")
     else:
         out = predict(ballbar_model_from_dict(model_dict, a.model), s)
         res = (s.length - out.length) * 1e3
@@ -278,7 +328,15 @@ def cmd_compensate(a: argparse.Namespace) -> int:
 
 
 def cmd_report(a: argparse.Namespace) -> int:
-    from .report import ballbar_report
+    from .report import ballbar_report, rtest_report
+    s = load(a.file)
+    if isinstance(s, _core.RtestSession):
+        from .rtest import identify_rtest
+        ident = identify_rtest(s, "joint")
+        d = diagnose(s) if not a.no_diagnosis else None
+        rtest_report(a.output, s, ident, d, source=a.file)
+        print(Path(a.output).resolve())
+        return EXIT_OK
     s = _ballbar(a.file)
     ident = identify(s, a.method)
     d = diagnose(s) if not a.no_diagnosis else None
@@ -371,19 +429,27 @@ def build_parser() -> argparse.ArgumentParser:
     q.set_defaults(func=cmd_plan)
 
     q = sub.add_parser("simulate", help="simulate a measurement on a machine with errors", epilog=EPILOG)
-    q.add_argument("kind", choices=["ballbar"])
-    _add_setup_args(q)
-    _add_truth_args(q)
-    q.add_argument("--truth", metavar="JSON", help="write the simulated machine here")
-    q.add_argument("-o", "--output", required=True)
-    q.set_defaults(func=cmd_simulate)
+    kinds = q.add_subparsers(dest="kind", required=True, metavar="{ballbar,rtest}")
+    k = kinds.add_parser("ballbar", help="the single set-up ballbar test (Flynn et al. 2016)", epilog=EPILOG)
+    _add_setup_args(k)
+    _add_truth_args(k)
+    k.add_argument("--truth", metavar="JSON", help="write the simulated machine here")
+    k.add_argument("-o", "--output", required=True)
+    k.set_defaults(func=cmd_simulate)
+    k = kinds.add_parser("rtest", help="the R-test pattern of Oyama & Ibaraki Sec. 3.3 on a B/C table",
+                         description="Writes a rotacal-rtest/1 session and, beside it, FILE.truth.json "
+                                     "(the simulated machine, the probe zeros and the pattern).",
+                         epilog=EPILOG)
+    _add_rtest_sim_args(k)
+    k.set_defaults(func=cmd_simulate_rtest)
 
     q = sub.add_parser("identify", help="identify location errors from a session", epilog=EPILOG)
     q.add_argument("file")
     q.add_argument("--method", default="joint", choices=["joint", "paper"])
     q.add_argument("--length-offset", action="store_true", help="also fit an offset of L0 (joint)")
     q.add_argument("--json", action="store_true", help="print the result as JSON")
-    q.add_argument("--save-model", metavar="MODEL.json")
+    q.add_argument("--save-model", metavar="MODEL.json",
+                   help="write the fitted model (ballbar, or R-test joint: location errors, maps, covariance)")
     q.set_defaults(func=cmd_identify)
 
     q = sub.add_parser("diagnose", help="find what the model gets wrong and why", epilog=EPILOG)
@@ -396,7 +462,11 @@ def build_parser() -> argparse.ArgumentParser:
     q = sub.add_parser("predict", help="predict a session with a fitted model", epilog=EPILOG)
     q.add_argument("session")
     q.add_argument("--model", required=True)
-    q.add_argument("-o", "--output", required=True)
+    q.add_argument("--probe-zeros", choices=["none", "fitted"], default="none",
+                   help="R-test: add the probe zeros fitted for the same set-ups (same nests), or none "
+                        "(default: a new set-up's zeros are unknown)")
+    q.add_argument("-o", "--output", required=True,
+                   help="the session with predicted lengths (ballbar) or dx,dy,dz and dx_std,dy_std,dz_std (R-test)")
     q.set_defaults(func=cmd_predict)
 
     q = sub.add_parser("compensate", help="compensated NC program, and its verification in simulation", epilog=EPILOG)
@@ -426,6 +496,34 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+def _add_rtest_sim_args(q: argparse.ArgumentParser) -> None:
+    g = q.add_argument_group("measurement pattern (Oyama & Ibaraki Sec. 3.3)")
+    g.add_argument("--machine", default="BC-trt", help="BC-trt (the R-test model's machine) or AC-trt")
+    g.add_argument("--b-range", dest="tilt_range", default="-90,90", help="tilt axis range, deg (inclusive)")
+    g.add_argument("--b-step", type=float, default=30.0, help="tilt step, deg")
+    g.add_argument("--c-range", default="0,360",
+                   help="C range, deg (inclusive; an end one full turn after the start is left out)")
+    g.add_argument("--c-step", type=float, default=30.0, help="C step, deg")
+    g.add_argument("--nest", action="append", metavar="X,Y,Z",
+                   help="nominal ball centre of a sensor nest, table frame, mm (repeatable; default "
+                        "the paper's two: 100,0,60 and 0,-120,140)")
+    g.add_argument("--dwell", type=float, default=DEFAULT_DWELL_S, help="time between readings, s")
+    g = q.add_argument_group("simulated machine and instrument")
+    g.add_argument("--errors", default="random",
+                   help="location errors: random (seeded), zero, or NAME=VALUE,... (mm, rad)")
+    g.add_argument("--effect", action="append", metavar="ID=P1,P2",
+                   help="position-dependent error from the effects catalogue, e.g. gravity_sag_B=0.006 "
+                        "or axial_motion_C_h2=0.002,-0.001 (repeatable)")
+    g.add_argument("--noise", type=float, default=DEFAULT_NOISE_UM, help="1-sigma reading noise, um")
+    g.add_argument("--probe-zero", type=float, default=DEFAULT_PROBE_ZERO_UM, help="1-sigma probe zero per set-up, um")
+    g.add_argument("--probe-dir", action="append", metavar="X,Y,Z",
+                   help="probe direction (give 3 times, normalised): also write raw d1,d2,d3 with probe.N.dir")
+    g.add_argument("--raw-only", action="store_true", help="with --probe-dir: write d1,d2,d3 but no dx,dy,dz")
+    g.add_argument("--seed", type=int, default=1)
+    q.add_argument("--truth", metavar="JSON", help="where to write the truth (default: FILE.truth.json)")
+    q.add_argument("-o", "--output", required=True)
+
+
 def _add_truth_args(q: argparse.ArgumentParser) -> None:
     g = q.add_argument_group("simulated machine")
     g.add_argument("--errors", default="random",
@@ -439,7 +537,7 @@ def _add_truth_args(q: argparse.ArgumentParser) -> None:
 
 # Options whose values may start with '-' ("--a-range -90,90"): argparse would take the value
 # for an option, so such pairs are joined as "--a-range=-90,90" before parsing.
-_SIGNED_VALUE_OPTIONS = {"--a-range", "--b-range", "--c-range", "--pivot", "--errors"}
+_SIGNED_VALUE_OPTIONS = {"--a-range", "--b-range", "--c-range", "--pivot", "--errors", "--nest", "--probe-dir"}
 
 
 def _join_signed_values(argv: Sequence[str]) -> list[str]:

@@ -129,3 +129,120 @@ def fit_model_dict(machine: Any, parameters: list, effects: list[str]) -> dict:
         out["effects"].append({"id": eid, "cause": eff.cause, "params": {
             pn: estimate_dict(by_name[eid if eff.num_params == 1 else f"{eid}.{pn}"]) for pn in eff.param_names}})
     return out
+
+
+# ------------------------------------------------------------------------- R-test joint model
+
+RTEST_KIND = "rtest-joint"
+
+# What the basis' coefficients mean (rotacal/rtest/identify_joint.hpp), written into the file
+# so that a reader without the library can evaluate the maps.
+RTEST_BASIS_DEFINITION = (
+    "b = B / 90 deg. Table pose T(B, C) = E(w_BY(B)) Rot(B line, B) E(w_CB(B, C)) Rot(C line, C), "
+    "E(w) = Dx(dx) Dy(dy) Dz(dz) Da(alpha) Db(beta) Dc(gamma) (Oyama & Ibaraki Eq. 1), axis lines "
+    "from the location errors (ISO 230-7). w_BY translations: coefficient 'k_BY.bP' multiplies "
+    "b^P (even P >= 2); rotations: odd P >= 1. w_CB component k: 'k_CB.cosN.bM' multiplies "
+    "b^M cos(N C), 'k_CB.sinN.bM' b^M sin(N C); 'dxy_CB.back1.u.b0' adds (cos C, -sin C) to "
+    "(dx, dy)_CB and '.v.b0' (sin C, cos C), likewise 'alphabeta_CB.back1' for (alpha, beta)_CB. "
+    "R-test reading of the nest at q: d = T^-1 (Ry(B) Rz(C) q) - q + probe zero. Units mm, rad.")
+
+
+def rtest_model_dict(ident: Any, nests: dict) -> dict:
+    """Model dict (``kind: rtest-joint``) of a joint R-test identification: location errors,
+    map coefficients and their covariance, the basis and its definition, the nests and the
+    fitted probe zero of each set-up."""
+    raw = ident
+    model = raw.model
+    machine = model.machine
+    basis = model.basis
+    le_names = list(_core.location_error_names(machine))
+    coef_names = list(basis.coefficient_names())
+    by_name = {p.name: p for p in raw.parameters}
+    zeros: dict[str, dict] = {}
+    for setup in raw.probe_zeros:
+        zeros[setup] = {a: estimate_dict(by_name[f"zero.{setup}.{a}"]) for a in "xyz"}
+    return {
+        "format": FORMAT,
+        "kind": RTEST_KIND,
+        "machine": _core.machine_name(machine),
+        "basis": {"b_degree": basis.b_degree, "c_harmonics": basis.c_harmonics,
+                  "c_b_degree": basis.c_b_degree, "gamma_cb": bool(basis.gamma_cb),
+                  "definition": RTEST_BASIS_DEFINITION},
+        "location_errors": {n: estimate_dict(by_name[n]) for n in le_names},
+        "map_coefficients": {n: estimate_dict(by_name[n]) for n in coef_names},
+        "covariance": {"parameters": le_names + coef_names,
+                       "matrix": np.asarray(model.covariance).tolist()},
+        "nests": {k: np.asarray(v, dtype=float).tolist() for k, v in nests.items()},
+        "probe_zeros": zeros,
+        "fit": {"residual_rms_um": float(raw.residual_rms_um), "sigma_um": float(raw.sigma_um),
+                "n_samples": int(raw.n_samples), "converged": bool(raw.converged),
+                "unobservable": list(raw.unobservable), "notes": list(raw.notes)},
+    }
+
+
+def _int_field(d: dict, key: str, where: str) -> int:
+    v = d.get(key)
+    if not isinstance(v, int) or isinstance(v, bool) or v < 0:
+        raise _core.InvalidArgument(f"{where}.{key}: must be an integer >= 0, got {v!r}")
+    return v
+
+
+def rtest_model_from_dict(d: dict, source: str = "<model>") -> tuple[Any, dict, dict]:
+    """(RtestJointModel, nests, probe zeros) from a ``rtest-joint`` model dict; errors name the
+    file and the key. Unobservable values (null) are taken as zero and flagged unobservable,
+    so that predictions they enter carry no uncertainty (NaN)."""
+    if d.get("format") != FORMAT:
+        raise _core.InvalidArgument(f"{source}: not a {FORMAT} file (format: {d.get('format')!r})")
+    if d.get("kind") != RTEST_KIND:
+        raise _core.InvalidArgument(f"{source}: kind {d.get('kind')!r} is not an R-test joint model "
+                                    f"('{RTEST_KIND}')")
+    machine = _core.parse_machine_type(d.get("machine", ""))
+    b = d.get("basis")
+    if not isinstance(b, dict):
+        raise _core.InvalidArgument(f"{source}: missing 'basis'")
+    if not isinstance(b.get("gamma_cb"), bool):
+        raise _core.InvalidArgument(f"{source}: basis.gamma_cb: must be true or false")
+    basis = _core.RtestBasis(_int_field(b, "b_degree", f"{source}: basis"),
+                             _int_field(b, "c_harmonics", f"{source}: basis"),
+                             _int_field(b, "c_b_degree", f"{source}: basis"), b["gamma_cb"])
+    names = list(_core.location_error_names(machine)) + list(basis.coefficient_names())
+    values: dict[str, dict] = {}
+    for key in ("location_errors", "map_coefficients"):
+        part = d.get(key, {})
+        if not isinstance(part, dict):
+            raise _core.InvalidArgument(f"{source}: {key}: must be an object")
+        for n, est in part.items():
+            values[n] = est if isinstance(est, dict) else {"value": est}
+    missing = [n for n in names if n not in values]
+    unknown = [n for n in values if n not in names]
+    if missing or unknown:
+        raise _core.InvalidArgument(
+            f"{source}: the parameters do not match basis {b['b_degree']}/{b['c_harmonics']}/"
+            f"{b['c_b_degree']}" + (f"; missing: {', '.join(missing[:5])}" if missing else "")
+            + (f"; unknown: {', '.join(unknown[:5])}" if unknown else ""))
+    params = np.array([_value(values[n], f"{source}: {n}") for n in names])
+    observable = [values[n].get("value") is not None for n in names]
+    cov = d.get("covariance", {})
+    if not isinstance(cov, dict) or cov.get("parameters") != names:
+        raise _core.InvalidArgument(f"{source}: covariance.parameters must list the {len(names)} "
+                                    "parameters in basis order")
+    try:
+        matrix = np.array(cov.get("matrix"), dtype=float)
+    except (TypeError, ValueError):
+        raise _core.InvalidArgument(f"{source}: covariance.matrix: not a matrix of numbers") from None
+    if matrix.shape != (len(names), len(names)):
+        raise _core.InvalidArgument(f"{source}: covariance.matrix: shape {matrix.shape}, expected "
+                                    f"({len(names)}, {len(names)})")
+    model = _core.RtestJointModel(machine, basis, params, matrix, observable)
+    nests = {str(k): np.array(_floats_of(v, 3, f"{source}: nests.{k}")) for k, v in d.get("nests", {}).items()}
+    zeros = {}
+    for setup, z in d.get("probe_zeros", {}).items():
+        zeros[str(setup)] = np.array([_value(z.get(a, {}), f"{source}: probe_zeros.{setup}.{a}") for a in "xyz"])
+    return model, nests, zeros
+
+
+def _floats_of(v: Any, n: int, where: str) -> list[float]:
+    if (not isinstance(v, list) or len(v) != n
+            or not all(isinstance(x, (int, float)) and math.isfinite(x) for x in v)):
+        raise _core.InvalidArgument(f"{where}: must be {n} finite numbers, got {v!r}")
+    return [float(x) for x in v]

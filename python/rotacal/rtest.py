@@ -1,19 +1,29 @@
-"""R-test: identification of the location errors and error map of a B/C table
-(Oyama & Ibaraki), on numpy-backed RtestSession objects."""
+"""R-test (Oyama & Ibaraki): simulation, probe calibration, identification of the location
+errors and error map of a B/C table, model files and prediction, on numpy-backed
+RtestSession objects. Angles are in degrees here (as in the files); the C++ core takes radians.
+"""
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
-from typing import Any
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Mapping, Sequence, Union
 
 import numpy as np
 
 from . import _core
-from .models import estimate_dict
+from .ballbar import random_location_errors
+from .models import estimate_dict, rtest_model_dict, rtest_model_from_dict
 
 # The measurement pattern of Oyama Sec. 3.3, used for the map grid by default.
 B_GRID = list(range(-90, 91, 30))
 C_GRID = list(range(0, 360, 30))
+# The two nests of the paper's set-up (as in ../shared/data/rtest_bc_oyama.csv), table frame, mm.
+DEFAULT_NESTS = [(100.0, 0.0, 60.0), (0.0, -120.0, 140.0)]
+# Defaults of the C++ simulator (rtest/simulate.hpp: RtestSimOptions, RtestPattern).
+DEFAULT_NOISE_UM = 0.3
+DEFAULT_PROBE_ZERO_UM = 20.0
+DEFAULT_DWELL_S = 6.0
 
 
 @dataclass
@@ -22,21 +32,31 @@ class RtestIdentification:
 
     raw: Any
     machine: Any
+    nests: dict = field(default_factory=dict)
+    notes: list = field(default_factory=list)
 
-    def error_map(self, fmt: str = "json") -> str:
+    def error_map(self, fmt: str = "json", b_deg: Sequence[float] = B_GRID,
+                  c_deg: Sequence[float] = C_GRID) -> str:
+        """The error map as JSON or CSV text: on the grid (deg) for the joint model, at the
+        measured grid for the paper's method."""
         if self.raw.method == "joint":
-            return _core.rtest_error_map(self.raw, B_GRID, C_GRID, fmt)
+            return _core.rtest_error_map(self.raw, list(b_deg), list(c_deg), fmt)
         return _core.rtest_error_map(self.raw, fmt)
 
     def model_dict(self) -> dict:
-        raise _core.InvalidArgument("R-test model files are not available yet: use the error map "
-                                    "(rotacal identify --json) or the C++ RtestJointModel to predict")
+        """The fitted joint model as a ``rotacal-model/1`` dict of kind ``rtest-joint``
+        (rotacal.models), for ``save_model`` and ``predict_rtest``."""
+        if self.raw.method != "joint":
+            raise _core.InvalidArgument(
+                "identify --save-model: the paper method's map exists only at the measured angles and "
+                "predicts no other pose; use --method joint for a model file")
+        return rtest_model_dict(self.raw, self.nests)
 
     def to_dict(self) -> dict:
         r = self.raw
         out = {"method": r.method, "machine": _core.machine_name(self.machine),
                "residual_rms_um": float(r.residual_rms_um), "n_samples": int(r.n_samples),
-               "unobservable": list(r.unobservable), "notes": list(r.notes),
+               "unobservable": list(r.unobservable), "notes": list(self.notes) + list(r.notes),
                "error_map": json.loads(self.error_map("json"))}
         if r.method == "joint":
             names = list(_core.location_error_names(self.machine))
@@ -47,11 +67,245 @@ class RtestIdentification:
         return out
 
 
-def identify_rtest(session: _core.RtestSession, method: str = "joint") -> RtestIdentification:
+def _has_displacements(session: _core.RtestSession) -> bool:
+    try:
+        session.d
+    except _core.InvalidArgument:
+        return False
+    return True
+
+
+def with_displacements(session: _core.RtestSession,
+                       dirs: np.ndarray | None = None) -> tuple[_core.RtestSession, list[str]]:
+    """The session with dx,dy,dz filled from raw d1,d2,d3 where missing, and a note saying so.
+
+    ``dirs`` (3, 3), rows = probe directions, e.g. from ``calibrate_probes``; by default the
+    file's ``probe.N.dir``. Rows that already have dx,dy,dz keep them.
+    """
+    if dirs is None and _has_displacements(session):
+        return session, []
+    out = _core.displacements_from_raw(session, None if dirs is None else np.asarray(dirs, dtype=float))
+    src = "the calibrated directions given" if dirs is not None else "the file's probe.N.dir"
+    return out, [f"dx,dy,dz computed from raw d1,d2,d3 with {src} (d = Dirs^-1 raw)"]
+
+
+def identify_rtest(session: _core.RtestSession, method: str = "joint",
+                   basis: Any | None = None) -> RtestIdentification:
     """Identify an R-test session: method "joint" (Ceres fit with smooth maps, default) or
-    "paper" (Oyama & Ibaraki's Eqs. 10-22)."""
+    "paper" (Oyama & Ibaraki's Eqs. 10-22). A session with raw d1,d2,d3 only is converted
+    with its probe.N.dir first (said in the notes). ``basis``: a rotacal._core.RtestBasis for
+    the joint fit (default: B polynomial to b^6, C harmonics 1-2, degree 1 in B)."""
+    s, notes = with_displacements(session)
+    nests = {k: np.asarray(v) for k, v in session.nests.items()}
     if method == "joint":
-        return RtestIdentification(_core.identify_rtest_joint(session), session.machine)
+        raw = _core.identify_rtest_joint(s, basis if basis is not None else _core.RtestBasis())
+        return RtestIdentification(raw, session.machine, nests, notes)
+    if basis is not None:
+        raise _core.InvalidArgument("identify_rtest: the paper method takes no basis")
     if method == "paper":
-        return RtestIdentification(_core.identify_rtest_paper(session), session.machine)
+        return RtestIdentification(_core.identify_rtest_paper(s), session.machine, nests, notes)
     raise _core.InvalidArgument(f"identify_rtest: method must be 'joint' or 'paper', got {method!r}")
+
+
+# ------------------------------------------------------------------------- prediction
+
+def predict_rtest(model: Mapping, session: _core.RtestSession, probe_zeros: str = "none",
+                  source: str = "<model>") -> _core.RtestSession:
+    """The session with dx,dy,dz predicted by an ``rtest-joint`` model dict (``load_model``),
+    plus 1-sigma columns dx_std, dy_std, dz_std (mm).
+
+    probe_zeros : "none" (default) predicts the table's error as a nest with zero probe offsets
+        reads it, the only choice for a new set-up, whose probe zeros are unknown; "fitted" adds
+        the probe zeros fitted for the set-ups of the same label, which must be at the same nest
+        position (the same physical set-up, e.g. held-out poses of the fitted session).
+    """
+    m, nests, zeros = rtest_model_from_dict(dict(model), source)
+    if probe_zeros == "none":
+        return _core.predict_rtest_session(m, session)
+    if probe_zeros != "fitted":
+        raise _core.InvalidArgument(f"predict: probe_zeros must be 'none' or 'fitted', got {probe_zeros!r}")
+    for setup in dict.fromkeys(session.setups):
+        if setup not in zeros or setup not in nests:
+            raise _core.InvalidArgument(f"{source}: no fitted probe zero for set-up '{setup}'")
+        here = np.asarray(session.nests[setup])
+        if np.max(np.abs(here - nests[setup])) > 1e-6:
+            raise _core.InvalidArgument(
+                f"{source}: set-up '{setup}' was fitted with its nest at {nests[setup].tolist()}, the "
+                f"session has it at {here.tolist()}: fitted probe zeros belong to the fitted set-up")
+    return _core.predict_rtest_session(m, session, {k: zeros[k] for k in dict.fromkeys(session.setups)})
+
+
+def prediction_rms_um(model: Mapping, session: _core.RtestSession, source: str = "<model>") -> float:
+    """RMS (um) of measured - predicted readings after one constant offset per set-up (its
+    probe zero), over all components; raw-only sessions are converted with probe.N.dir."""
+    m, _, _ = rtest_model_from_dict(dict(model), source)
+    s, _ = with_displacements(session)
+    return float(_core.rtest_prediction_rms_um(m, s))
+
+
+# ------------------------------------------------------------------------- simulation
+
+Errors = Union[str, Mapping[str, float], Sequence[float], np.ndarray]
+
+
+def angle_grid(start: float, stop: float, step: float, what: str, full_turn: bool = False) -> list[float]:
+    """start, start + step, ... up to stop (inclusive, deg). With ``full_turn`` an end at
+    start + 360 is left out: it is the start position again."""
+    if not (np.isfinite(start) and np.isfinite(stop) and np.isfinite(step)) or step <= 0 or stop < start:
+        raise _core.InvalidArgument(f"{what}: need start <= stop and step > 0, got {start:g},{stop:g} "
+                                    f"step {step:g}")
+    n = int(np.floor((stop - start) / step + 1e-9))
+    grid = [start + k * step for k in range(n + 1)]
+    if full_turn and abs(grid[-1] - (start + 360.0)) < 1e-9 and len(grid) > 1:
+        grid.pop()
+    return [round(g, 9) for g in grid]
+
+
+def _errors_vector(errors: Errors, machine: Any, rng: np.random.Generator) -> np.ndarray:
+    names = list(_core.location_error_names(machine))
+    if isinstance(errors, str):
+        if errors == "random":
+            return random_location_errors(machine, rng)
+        if errors == "zero":
+            return np.zeros(8)
+        raise _core.InvalidArgument(f"errors: 'random', 'zero' or NAME=VALUE pairs, got {errors!r}")
+    if isinstance(errors, Mapping):
+        unknown = [k for k in errors if k not in names]
+        if unknown:
+            raise _core.InvalidArgument(f"errors: {', '.join(unknown)} not a location error of "
+                                        f"{_core.machine_name(machine)} ({', '.join(names)})")
+        return np.array([float(errors.get(n, 0.0)) for n in names])
+    v = np.asarray(errors, dtype=float)
+    if v.shape != (8,):
+        raise _core.InvalidArgument(f"errors: expected 8 values in the order {', '.join(names)}")
+    return v
+
+
+def simulate_rtest(errors: Errors = "random", effects: Mapping[str, Any] | None = None, *,
+                   machine: str = "BC-trt", b_deg: Sequence[float] = B_GRID,
+                   c_deg: Sequence[float] = C_GRID, nests: Sequence[Sequence[float]] = DEFAULT_NESTS,
+                   noise_um: float = DEFAULT_NOISE_UM, probe_zero_um: float = DEFAULT_PROBE_ZERO_UM,
+                   probe_dirs: np.ndarray | None = None, write_d: bool = True,
+                   dwell_s: float = DEFAULT_DWELL_S, seed: int = 1) -> tuple[_core.RtestSession, dict]:
+    """Simulate an R-test session (Oyama Sec. 3.3 pattern: B outer, C inner, one nest after the
+    other) on a machine with location errors and catalogue effects (shared/spec/effects.md).
+
+    Parameters
+    ----------
+    errors : "random" (N(0, 30 um), N(0, 50 urad), seeded), "zero", a dict NAME -> value
+        (mm, rad; others zero) or the 8 values in location_error_names order.
+    effects : catalogue id -> parameter value (one-parameter effects) or list of values,
+        e.g. {"gravity_sag_B": 0.006, "coning_B": 1.45e-4, "axial_motion_C_h2": [0.002, -0.001]}.
+    b_deg, c_deg : the grid (deg). nests : nominal ball centres, table frame (mm).
+    noise_um : 1-sigma per reading (um). probe_zero_um : 1-sigma of each set-up's probe zero.
+    probe_dirs : (3, 3), rows = unit probe directions: raw d1,d2,d3 with probe.N.dir are written
+        (and dx,dy,dz unless ``write_d`` is False).
+    seed : draws the random errors, the probe zeros and the noise.
+
+    Returns
+    -------
+    (session, truth) where truth has the shape of ../shared/data/*.truth.json: errors, effects,
+    nests, noise_um, plus probe_zeros (mm per set-up), the pattern, seed and probe_dirs.
+    """
+    mtype = _core.parse_machine_type(machine)
+    rng = np.random.default_rng(seed)
+    e = _errors_vector(errors, mtype, rng)
+    ids, params, effects_out = [], [], {}
+    for eid, val in (effects or {}).items():
+        eff = _core.Effect(eid)
+        vals = [float(v) for v in np.atleast_1d(np.asarray(val, dtype=float))]
+        if len(vals) != eff.num_params:
+            raise _core.InvalidArgument(f"effects: {eid} takes {eff.num_params} values "
+                                        f"({', '.join(eff.param_names)}), got {len(vals)}")
+        ids.append(eff.id)
+        params.extend(vals)
+        effects_out[eff.id] = vals[0] if eff.num_params == 1 else vals
+    nest_arr = np.asarray(nests, dtype=float).reshape(-1, 3)
+    dirs = None if probe_dirs is None else np.asarray(probe_dirs, dtype=float)
+    session, zeros = _core.simulate_rtest(mtype, e, ids, params, list(map(float, b_deg)),
+                                          list(map(float, c_deg)), nest_arr, float(dwell_s),
+                                          float(noise_um), float(probe_zero_um), dirs, bool(write_d),
+                                          int(seed) % 2**32)
+    truth = {"errors": dict(zip(_core.location_error_names(mtype), e.tolist())),
+             "effects": effects_out,
+             "nests": nest_arr.tolist(),
+             "noise_um": float(noise_um),
+             "probe_zeros": np.asarray(zeros).tolist(),
+             "probe_zero_um": float(probe_zero_um),
+             "machine": _core.machine_name(mtype),
+             "pattern": {"b_deg": list(map(float, b_deg)), "c_deg": list(map(float, c_deg)),
+                         "dwell_s": float(dwell_s)},
+             "seed": int(seed)}
+    if dirs is not None:
+        truth["probe_dirs"] = dirs.tolist()
+    return session, truth
+
+
+def truth_readings(truth: Mapping, session: _core.RtestSession, probe_zeros: bool = True) -> np.ndarray:
+    """Noise-free dx,dy,dz (N, 3) of every row of a session on the machine of a truth dict
+    (``simulate_rtest``), with the truth's probe zero of each set-up (set-up "k" is nest k)
+    unless ``probe_zeros`` is False."""
+    mtype = _core.parse_machine_type(truth.get("machine", "BC-trt"))
+    names = list(_core.location_error_names(mtype))
+    e = np.array([truth["errors"][n] for n in names])
+    ids = list(truth.get("effects", {}))
+    params = [float(v) for i in ids for v in np.atleast_1d(truth["effects"][i])]
+    setups = np.asarray(session.setups)
+    angles = np.radians(np.asarray(session.angles_deg))
+    time = np.asarray(session.time)
+    out = np.zeros((len(setups), 3))
+    for setup in dict.fromkeys(setups):
+        sel = setups == setup
+        q = np.asarray(session.nests[setup])
+        out[sel] = _core.rtest_readings(mtype, e, ids, params, q, angles[sel], time[sel])
+        if probe_zeros:
+            out[sel] += np.asarray(truth["probe_zeros"][int(setup) - 1])
+    return out
+
+
+def save_truth(truth: Mapping, path: str | Path) -> None:
+    """Write a truth dict as JSON (temporary file first)."""
+    path = Path(path)
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(json.dumps(truth, indent=1) + "\n")
+    tmp.replace(path)
+
+
+# ------------------------------------------------------------------------- device calibration
+
+def calibrate_probes(moves: np.ndarray, readings: np.ndarray) -> Any:
+    """Identify the probe directions of an R-test nest (Oyama Sec. 3.2) from known linear moves.
+
+    With the rotary axes at 0 the sphere is moved by commanded steps ``moves`` (N, 3, mm,
+    machine = table frame) and the three probes read ``readings`` (N, 3, mm). Per probe i,
+    reading_ik = g_i . move_k + zero_i is solved by linear least squares; dir_i = g_i / |g_i|.
+    Needs >= 5 moves spanning 3-D (e.g. ``rotacal._core.default_calibration_moves()``).
+
+    Returns a ProbeCalibration: ``dirs`` (3, 3, rows = unit directions), ``gains``, ``zeros``
+    (mm), ``direction_std_rad`` and ``gain_std`` (1 sigma), ``residuals``, ``sigma_um``.
+    Raises InvalidArgument (too few moves) or DegenerateGeometry (moves not spanning 3-D).
+    """
+    return _core.calibrate_probe_directions(np.asarray(moves, dtype=float), np.asarray(readings, dtype=float))
+
+
+def calibrate_sphere_offset(dirs: np.ndarray, spindle_deg: Sequence[float], readings: np.ndarray) -> Any:
+    """The sphere's offset from the spindle axis from spindle indexing (Oyama Sec. 3.2).
+
+    The spindle is turned to the angles ``spindle_deg`` (N,) with the machine at rest; the
+    probes (directions ``dirs``, rows, e.g. from ``calibrate_probes``) read ``readings``
+    (N, 3, mm). The sphere centre runs on a circle c + Rz(theta) o about the spindle axis,
+    fitted linearly. Needs >= 3 distinct angles.
+
+    Returns a SphereOffsetCalibration: ``offset`` (x, y at spindle angle 0, mm), ``offset_std``,
+    ``centre`` and ``residual_rms_um``. Use ``compensate_sphere_offset`` on a session measured
+    with that spindle orientation.
+    """
+    return _core.calibrate_sphere_offset(np.asarray(dirs, dtype=float),
+                                         np.radians(np.asarray(spindle_deg, dtype=float)),
+                                         np.asarray(readings, dtype=float))
+
+
+def compensate_sphere_offset(session: _core.RtestSession, offset: Sequence[float]) -> _core.RtestSession:
+    """The session with a sphere offset (x, y, mm, machine frame) taken out of every dx,dy,dz."""
+    s, _ = with_displacements(session)
+    return _core.compensate_sphere_offset(s, np.asarray(offset, dtype=float))

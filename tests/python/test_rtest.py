@@ -1,5 +1,6 @@
 """R-test from Python: identification of the independent implementation's file against its truth."""
 import json
+import re
 import subprocess
 import sys
 
@@ -49,5 +50,226 @@ def test_cli_identify_rtest(shared_data, tmp_path):
     r = run("identify", shared_data / "rtest_bc_oyama.csv")
     assert r.returncode == 0, r.stderr
     assert set(json.loads(r.stdout)["location_errors"]) >= {"E_X0B", "E_Z0B", "E_X0C", "E_Y0C"}
-    r = run("identify", shared_data / "rtest_bc_oyama.csv", "--save-model", tmp_path / "m.json")
-    assert r.returncode == 3 and "not available yet" in r.stderr
+    r = run("identify", shared_data / "rtest_bc_oyama.csv", "--method", "paper", "--save-model", tmp_path / "m.json")
+    assert r.returncode == 3 and "--method joint" in r.stderr and not (tmp_path / "m.json").exists()
+
+
+# ------------------------------------------------------------------------- simulate, model files, predict
+
+def rotacal_cli(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "rotacal", *map(str, args)], capture_output=True, text=True,
+                          timeout=300, cwd=cwd)
+
+
+def split_by_c(path, step):
+    """Two files from one session: rows with C on multiples of `step` deg, and the others."""
+    lines = path.read_text().splitlines()
+    meta = [ln for ln in lines if ln.startswith("#")]
+    header, *rows = [ln for ln in lines if ln and not ln.startswith("#")]
+    c_col = header.split(",").index("C")
+    on = [r for r in rows if float(r.split(",")[c_col]) % step == 0]
+    off = [r for r in rows if float(r.split(",")[c_col]) % step != 0]
+    out = []
+    for name, part in (("fit", on), ("held", off)):
+        p = path.with_name(f"{path.stem}.{name}.csv")
+        p.write_text("\n".join(meta + [header] + part) + "\n")
+        out.append(p)
+    return out
+
+
+EFFECTS = ["--effect", "gravity_sag_B=0.006", "--effect", "coning_B=0.000145",
+           "--effect", "axial_motion_C_h2=0.002,-0.001"]
+
+
+@pytest.fixture(scope="module")
+def held_out(tmp_path_factory):
+    """Simulate C = 0, 15, ..., 345; fit on C = 0, 30, ...; predict C = 15, 45, ... through files."""
+    tmp = tmp_path_factory.mktemp("heldout")
+    r = rotacal_cli("simulate", "rtest", "--c-step", "15", *EFFECTS, "--seed", "11", "-o", tmp / "s.csv")
+    assert r.returncode == 0, r.stderr
+    fit, held = split_by_c(tmp / "s.csv", 30)
+    r = rotacal_cli("identify", fit, "--save-model", tmp / "m.json")
+    assert r.returncode == 0, r.stderr
+    r = rotacal_cli("predict", held, "--model", tmp / "m.json", "--probe-zeros", "fitted", "-o", tmp / "p.csv")
+    assert r.returncode == 0, r.stderr
+    return tmp, fit, held, json.loads((tmp / "s.truth.json").read_text()), r.stderr
+
+
+def test_held_out_poses_are_predicted_to_the_noise(held_out):
+    tmp, fit, held, truth, stderr = held_out
+    s_held = rotacal.load(held)
+    pred = rotacal.load(tmp / "p.csv")
+    assert len(s_held) == len(pred) == 168 and set(np.asarray(pred.angles_deg)[:, 1] % 30) == {15.0}
+    # Truth: the noise-free readings of the simulated machine with each set-up's probe zero.
+    d_true = rotacal.rtest.truth_readings(truth, s_held)
+    err = np.asarray(pred.d) - d_true
+    noise = truth["noise_um"] * 1e-3
+    rms = np.sqrt(np.mean(err ** 2))
+    # The model's own error: noise * sqrt(p / n) ~ 0.3 * sqrt(70 / 504) um; the bound is 2x noise.
+    assert rms < 2 * noise, rms
+    assert rms < 0.5 * noise, rms  # what the estimate above says it should be
+    # The 1-sigma columns account for it (probe-zero uncertainty noise / sqrt(84) added).
+    std = np.array([[float(v) for v in row.split(",")[-3:]] for row in
+                    (tmp / "p.csv").read_text().splitlines() if row[:1].isdigit()])
+    assert std.shape == err.shape and np.all(std > 0)
+    z = err / np.hypot(std, noise / np.sqrt(84))
+    assert 0.3 < np.sqrt(np.mean(z ** 2)) < 2.0
+    # The CLI's measured - predicted RMS (one offset per set-up removed) is the noise.
+    rms_cli = float(re.search(r"RMS ([0-9.]+) um", stderr).group(1))
+    assert abs(rms_cli - truth["noise_um"]) < 0.15 * truth["noise_um"]
+
+
+def test_model_file_round_trip_predicts_as_in_memory(held_out):
+    tmp, fit, held, truth, _ = held_out
+    ident = rotacal.identify_rtest(rotacal.load(fit))
+    s_held = rotacal.load(held)
+    in_memory = rotacal.rtest.predict_rtest(ident.model_dict(), s_held, probe_zeros="fitted")
+    saved = rotacal.load_model(tmp / "m.json")
+    assert saved["kind"] == "rtest-joint" and saved["nests"] == {"1": [100.0, 0.0, 60.0], "2": [0.0, -120.0, 140.0]}
+    from_file = rotacal.rtest.predict_rtest(saved, s_held, probe_zeros="fitted")
+    assert np.array_equal(np.asarray(in_memory.d), np.asarray(from_file.d))
+    assert rotacal._core.format_rtest(in_memory) == rotacal._core.format_rtest(from_file)
+    assert rotacal._core.format_rtest(from_file) == (tmp / "p.csv").read_text()
+    # Without the fitted zeros the prediction is the table's error alone: it differs by the zeros.
+    bare = np.asarray(rotacal.rtest.predict_rtest(saved, s_held).d)
+    zeros = np.array([ident.raw.probe_zeros[k] for k in s_held.setups])
+    assert np.allclose(bare + zeros, np.asarray(from_file.d), atol=1e-15)
+    # The location errors in the file are the fit's, within their uncertainty of the truth.
+    for n, p in saved["location_errors"].items():
+        assert abs(p["value"] - truth["errors"][n]) < 4 * p["std"], n
+
+
+def test_model_file_errors_name_file_and_key(held_out, tmp_path, shared_data):
+    tmp, fit, held, _, _ = held_out
+    good = json.loads((tmp / "m.json").read_text())
+    s = rotacal.load(held)
+
+    def broken(change, match):
+        d = json.loads(json.dumps(good))
+        change(d)
+        path = tmp_path / "bad.json"
+        path.write_text(json.dumps(d))
+        with pytest.raises(rotacal.InvalidArgument, match=match):
+            rotacal.rtest.predict_rtest(rotacal.load_model(path), s, source=str(path))
+
+    broken(lambda d: d.update(kind="ballbar"), "bad.json: kind 'ballbar'")
+    broken(lambda d: d["map_coefficients"].pop("dz_BY.b2"), "missing: dz_BY.b2")
+    broken(lambda d: d["basis"].update(c_harmonics=3), "do not match basis")
+    broken(lambda d: d["covariance"]["matrix"].pop(), r"covariance.matrix: shape")
+    broken(lambda d: d["location_errors"]["E_X0B"].update(value="x"), "E_X0B: 'value' must be a finite number")
+    # Fitted probe zeros belong to the fitted set-up: a moved nest is refused.
+    (tmp_path / "moved.csv").write_text(held.read_text().replace("# nest.2: 0, -120, 140", "# nest.2: 0, -120, 150"))
+    r = rotacal_cli("predict", tmp_path / "moved.csv", "--model", tmp / "m.json", "--probe-zeros", "fitted",
+                    "-o", tmp_path / "x.csv")
+    assert r.returncode == 3 and "set-up '2'" in r.stderr
+    # An R-test session with a ballbar model, and the other way round.
+    (tmp_path / "ballbar.json").write_text(json.dumps(dict(good, kind="ballbar")))
+    r = rotacal_cli("predict", held, "--model", tmp_path / "ballbar.json", "-o", tmp_path / "x.csv")
+    assert r.returncode == 3 and "not an R-test joint model" in r.stderr
+    r = rotacal_cli("predict", shared_data / "ballbar_ac_table2.csv", "--model", tmp / "m.json", "-o", tmp_path / "x.csv")
+    assert r.returncode == 3 and "not a ballbar model" in r.stderr
+
+
+def test_simulate_rtest_pattern_truth_and_identification(tmp_path):
+    out = tmp_path / "sim.csv"
+    r = rotacal_cli("simulate", "rtest", "--b-range", "-90,90", "--b-step", "45", "--c-range", "0,360",
+                    "--c-step", "45", "--nest", "100,0,60", "--nest", "0,-120,140", "--nest", "-80,60,100",
+                    "--errors", "E_X0B=0.02,E_B0C=-4e-5", *EFFECTS[:4], "--noise", "0.5", "--seed", "4", "-o", out)
+    assert r.returncode == 0, r.stderr
+    s = rotacal.load(out)
+    assert len(s) == 5 * 8 * 3 and sorted(s.nests) == ["1", "2", "3"] and s.noise_um == 0.5
+    a = np.asarray(s.angles_deg)
+    assert sorted(set(a[:, 0])) == [-90, -45, 0, 45, 90] and sorted(set(a[:, 1])) == list(range(0, 360, 45))
+    # Beside it, the truth in the shape of ../shared/data/rtest_bc_oyama.truth.json.
+    truth = json.loads(out.with_suffix(".truth.json").read_text())
+    assert {"errors", "effects", "nests", "noise_um"} <= set(truth)
+    assert truth["errors"]["E_X0B"] == 0.02 and truth["errors"]["E_Z0B"] == 0.0
+    assert truth["effects"] == {"gravity_sag_B": 0.006, "coning_B": 0.000145}
+    assert len(truth["probe_zeros"]) == 3
+    # The readings are the truth plus noise of the stated size.
+    res = np.asarray(s.d) - rotacal.rtest.truth_readings(truth, s)
+    assert abs(np.sqrt(np.mean(res ** 2)) - 0.5e-3) < 0.15 * 0.5e-3
+    d = rotacal.identify(s).to_dict()
+    for n, p in d["location_errors"].items():
+        assert abs(p["value"] - truth["errors"][n]) < 4 * p["std"], n
+    # Random errors are seeded; the ballbar simulator still answers as before.
+    r1 = rotacal_cli("simulate", "rtest", "--seed", "9", "-o", tmp_path / "a.csv")
+    r2 = rotacal_cli("simulate", "rtest", "--seed", "9", "-o", tmp_path / "b.csv", "--truth", tmp_path / "t.json")
+    assert r1.returncode == r2.returncode == 0
+    assert (tmp_path / "a.csv").read_text() == (tmp_path / "b.csv").read_text()
+    assert json.loads((tmp_path / "t.json").read_text())["errors"]["E_X0B"] != 0.0
+    for bad, what in ((["--b-step", "0"], "--b-range/--b-step"), (["--effect", "coning_B=1,2"], "coning_B"),
+                      (["--errors", "E_Y0A=1"], "E_Y0A"), (["--probe-dir", "1,0,0"], "--probe-dir"),
+                      (["--nest", "1,2"], "--nest")):
+        r = rotacal_cli("simulate", "rtest", *bad, "-o", tmp_path / "x.csv")
+        assert r.returncode == 3 and what in r.stderr, (bad, r.stderr)
+
+
+# ------------------------------------------------------------------------- device calibration
+
+# Three probes roughly along the diagonals of a nest, as on commercial R-test heads.
+DIRS = np.array([[0.8, 0.05, -0.6], [-0.4, 0.7, -0.6], [-0.4, -0.72, -0.55]])
+DIRS = DIRS / np.linalg.norm(DIRS, axis=1, keepdims=True)
+
+
+def test_probe_calibration_recovers_directions_and_sphere_offset():
+    noise_um = 0.3
+    moves = rotacal._core.default_calibration_moves(0.5)
+    zeros = np.array([0.11, -0.05, 0.3])
+    readings = rotacal._core.simulate_probe_calibration(DIRS, zeros, moves, noise_um, 5)
+    cal = rotacal.rtest.calibrate_probes(moves, readings)
+    assert cal.sigma_um == pytest.approx(noise_um, rel=0.4)  # 30 dof: +-40% is > 3 sigma
+    dirs = np.asarray(cal.dirs)
+    for i in range(3):
+        angle = np.arccos(min(1.0, float(dirs[i] @ DIRS[i])))
+        assert 0 < cal.direction_std_rad[i] < 3e-3
+        assert angle < 4 * cal.direction_std_rad[i], (i, angle)
+        assert abs(cal.zeros[i] - zeros[i]) < 6 * noise_um * 1e-3 / np.sqrt(len(moves))
+    with pytest.raises(rotacal.InvalidArgument):
+        rotacal.rtest.calibrate_probes(moves[:4], readings[:4])
+    flat = moves.copy()
+    flat[:, 2] = 0
+    with pytest.raises(rotacal.DegenerateGeometry):
+        rotacal.rtest.calibrate_probes(flat, readings)
+
+    spindle = np.arange(0, 360, 45.0)
+    offset = np.array([0.004, -0.0025])
+    r = rotacal._core.simulate_spindle_indexing(DIRS, zeros, offset, np.array([0.01, 0.02, -0.03]),
+                                                np.radians(spindle), noise_um, 6)
+    so = rotacal.rtest.calibrate_sphere_offset(dirs, spindle, r)
+    assert np.all(np.abs(np.asarray(so.offset) - offset) < 4 * np.asarray(so.offset_std))
+    assert np.all(np.asarray(so.offset_std) < 1e-3)
+
+
+def test_raw_probe_session_is_converted(tmp_path):
+    out = tmp_path / "raw.csv"
+    dirs = [f"--probe-dir={','.join(map(str, d))}" for d in DIRS]
+    r = rotacal_cli("simulate", "rtest", *dirs, "--raw-only", *EFFECTS[:4], "--seed", "8", "-o", out)
+    assert r.returncode == 0, r.stderr
+    text = out.read_text()
+    assert "probe.3.dir:" in text and "setup,time,B,C,X,Y,Z,d1,d2,d3\n" in text
+    s = rotacal.load(out)
+    with pytest.raises(rotacal.InvalidArgument, match="raw"):
+        s.d
+    truth = json.loads(out.with_suffix(".truth.json").read_text())
+    converted, notes = rotacal.rtest.with_displacements(s)
+    assert "probe.N.dir" in notes[0]
+    # d = Dirs^-1 raw: its noise is the reading noise through Dirs^-1 (per component, RMS).
+    err = np.asarray(converted.d) - rotacal.rtest.truth_readings(truth, s)
+    inv = np.linalg.inv(DIRS)
+    expected = truth["noise_um"] * 1e-3 * np.sqrt(np.mean(np.sum(inv ** 2, axis=1)))
+    assert abs(np.sqrt(np.mean(err ** 2)) - expected) < 0.15 * expected
+    # identify and report take the raw file as it is (the conversion is stated in the notes).
+    d = rotacal.identify(s).to_dict()
+    assert any("d1,d2,d3" in n for n in d["notes"])
+    for n, p in d["location_errors"].items():
+        assert abs(p["value"] - truth["errors"][n]) < 4 * p["std"], n
+    # With calibrated directions instead of the file's.
+    moves = rotacal._core.default_calibration_moves(0.5)
+    cal = rotacal.rtest.calibrate_probes(moves, rotacal._core.simulate_probe_calibration(
+        DIRS, np.zeros(3), moves, truth["noise_um"], 2))
+    calibrated, notes = rotacal.rtest.with_displacements(s, cal.dirs)
+    assert "calibrated" in notes[0]
+    # Direction errors of ~1 mrad on readings of ~50 um add < 0.1 um: still the noise level.
+    err = np.asarray(calibrated.d) - rotacal.rtest.truth_readings(truth, s)
+    assert np.sqrt(np.mean(err ** 2)) < 1.5 * expected
