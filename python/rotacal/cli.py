@@ -331,7 +331,11 @@ def cmd_report(a: argparse.Namespace) -> int:
     from .report import ballbar_report, rtest_report
     s = load(a.file)
     if isinstance(s, _core.RtestSession):
-        from .rtest import identify_rtest
+        from .rtest import identify_rtest, with_displacements
+        if a.method != "joint":
+            raise _core.InvalidArgument("report: an R-test report draws the joint fit's smooth maps; the paper "
+                                        "method's per-angle map is in `rotacal identify --method paper`")
+        s, _ = with_displacements(s)  # raw d1,d2,d3 with the file's probe.N.dir (identify notes it too)
         ident = identify_rtest(s, "joint")
         d = diagnose(s) if not a.no_diagnosis else None
         rtest_report(a.output, s, ident, d, source=a.file)

@@ -264,6 +264,9 @@ def test_raw_probe_session_is_converted(tmp_path):
     assert any("d1,d2,d3" in n for n in d["notes"])
     for n, p in d["location_errors"].items():
         assert abs(p["value"] - truth["errors"][n]) < 4 * p["std"], n
+    r = rotacal_cli("report", out, "--no-diagnosis", "-o", tmp_path / "raw.html")
+    assert r.returncode == 0, r.stderr
+    assert 'id="error-map"' in (tmp_path / "raw.html").read_text()
     # With calibrated directions instead of the file's.
     moves = rotacal._core.default_calibration_moves(0.5)
     cal = rotacal.rtest.calibrate_probes(moves, rotacal._core.simulate_probe_calibration(
