@@ -5,7 +5,7 @@
 set -euo pipefail
 
 APT_PACKAGES=(build-essential cmake ninja-build pkg-config libeigen3-dev libceres-dev catch2
-              libserialport-dev clang linuxcnc-uspace chromium)
+              libserialport-dev clang libclang-rt-14-dev linuxcnc-uspace chromium)
 missing=()
 for p in "${APT_PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
