@@ -1,0 +1,167 @@
+#pragma once
+/// \file
+/// Virtual instruments: a ballbar and an R-test that open a pseudo-terminal and speak the
+/// protocols of ballbar_protocol.hpp and probe_protocol.hpp, driven by the machine simulator.
+/// They run on their own thread until stopped, and can act out the faults a real link has
+/// (garbage, corrupt and lost frames, split writes, unplug, silence, wrong baud rate).
+
+#include <Eigen/Core>
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include "rotacal/ballbar/model.hpp"
+#include "rotacal/ballbar/timeline.hpp"
+#include "rotacal/hw/frame.hpp"
+#include "rotacal/hw/probe_protocol.hpp"
+#include "rotacal/hw/pseudo_terminal.hpp"
+#include "rotacal/rtest/simulate.hpp"
+
+namespace rotacal::hw {
+
+/// Faults to act out, counted in streamed frames (0 / -1: never).
+struct FaultInjection {
+  int garbage_every = 0;   ///< after every Nth frame, 7 bytes of line noise
+  int corrupt_every = 0;   ///< every Nth frame has one bit flipped (checksum fails)
+  int drop_every = 0;      ///< every Nth frame is not sent (sequence gap)
+  bool split_frames = false;  ///< every frame in two writes, 1 ms apart
+  long close_after = -1;   ///< hang up the line after this many frames (device unplugged)
+  long silence_after = -1; ///< stop sending after this many frames, line stays open
+};
+
+/// What an instrument did, for tests and the `virtual` command's summary.
+struct VirtualStats {
+  std::uint64_t frames_sent = 0;
+  std::uint64_t frames_dropped = 0;
+  std::uint64_t frames_corrupted = 0;
+  std::uint64_t replies_sent = 0;  ///< text replies / polled answers
+  bool finished = false;           ///< the program ran to its end
+};
+
+/// Common part: the pty, the serving thread, pacing and fault injection.
+class VirtualInstrument {
+ public:
+  virtual ~VirtualInstrument();
+  /// The path a host opens, e.g. /dev/pts/7.
+  const std::string& port() const { return pty_.slave_path(); }
+  /// Serve on a background thread.
+  void start();
+  /// Stop serving and join the thread (idempotent). Rethrows an error the thread died of.
+  void stop();
+  bool finished() const { return finished_.load(); }
+  VirtualStats stats() const;
+
+ protected:
+  VirtualInstrument(int baud, double speed, const FaultInjection& faults);
+  /// One pass of the serving loop, called every millisecond or so.
+  virtual void serve_once() = 0;
+  /// Virtual time, s, since `clock_start()` (wall time times speed).
+  double now() const;
+  void clock_start();
+  bool clock_running() const { return clock_running_; }
+  /// Command lines that arrived from the host since the last call.
+  std::vector<std::string> read_lines();
+  /// A streamed frame: faults applied, counted.
+  void send_frame(Bytes frame);
+  /// A reply (text frame or ASCII line): never faulted, except by a wrong baud rate.
+  void send_reply(const Bytes& bytes);
+  void send_reply(const std::string& text) { send_reply(Bytes(text.begin(), text.end())); }
+  void mark_finished() { finished_ = true; stats_.finished = true; }
+  bool line_up() const { return !hung_up_; }
+
+ private:
+  void write_all(const Bytes& bytes);
+  void run();
+
+  PseudoTerminal pty_;
+  int baud_;
+  double speed_;
+  FaultInjection faults_;
+  std::thread thread_;
+  std::atomic<bool> stop_{false};
+  std::atomic<bool> finished_{false};
+  bool hung_up_ = false;
+  bool silent_ = false;
+  bool clock_running_ = false;
+  double clock_origin_ = 0.0;
+  std::string line_buffer_;
+  std::uint64_t stream_count_ = 0;
+  mutable std::mutex stats_mutex_;
+  VirtualStats stats_;
+  std::string thread_error_;
+};
+
+struct VirtualBallbarOptions {
+  BallbarMachineModel truth;  ///< the machine measured (its pivot is the actual pivot)
+  double noise_um = 0.5;
+  std::uint64_t seed = 1;
+  double rate_hz = 1000.0;  ///< default sample rate (the host may send RATE)
+  double speed = 1.0;       ///< virtual seconds per wall-clock second (>1: faster than real)
+  int baud = 115200;
+  FaultInjection faults;
+};
+
+/// A ballbar transducer on a machine running the test program: every sample is the exact
+/// length (ballbar/model.hpp) at the commanded pose of that instant plus Gaussian noise.
+class VirtualBallbar final : public VirtualInstrument {
+ public:
+  VirtualBallbar(ProgramTimeline program, const VirtualBallbarOptions& options);
+
+ private:
+  void serve_once() override;
+  ProgramTimeline program_;
+  VirtualBallbarOptions options_;
+  struct Noise;
+  std::shared_ptr<Noise> noise_;
+  bool streaming_ = false;
+  double rate_hz_;
+  std::uint64_t next_sample_ = 0;
+  std::uint16_t seq_ = 0;
+  double zero_mm_ = 0.0;  ///< displacement subtracted after ZERO
+};
+
+struct VirtualRtestOptions {
+  RtestTruth truth;
+  RtestSimOptions sim;  ///< pattern (poses, dwell), noise, probe zeros sigma, seed
+  Eigen::Matrix3d probe_dirs = Eigen::Matrix3d::Identity();  ///< rows: probe directions
+  ProbeMode mode = ProbeMode::keyence;
+  double rate_hz = 100.0;  ///< stream mode
+  double speed = 1.0;
+  int baud = 115200;
+  FaultInjection faults;
+};
+
+/// An R-test on a B/C table running the measurement pattern: pose k is held for the middle
+/// 80 % of its dwell around the time the simulator gives it; in between the table moves.
+/// Polled modes start the program at the first request, stream mode at START.
+class VirtualRtest final : public VirtualInstrument {
+ public:
+  explicit VirtualRtest(const VirtualRtestOptions& options);
+  /// The commanded session the instrument runs (rows: set-up, time, B, C, X, Y, Z), and the
+  /// probe zeros it was given, per set-up (table frame, mm).
+  const RtestSession& program() const { return program_; }
+  const std::vector<Eigen::Vector3d>& probe_zeros() const { return zeros_; }
+
+ private:
+  void serve_once() override;
+  /// Probe readings (mm) at virtual time t, and whether the table is at rest.
+  Eigen::Vector3d readings_at(double t, bool* at_rest);
+  VirtualRtestOptions options_;
+  RtestSession program_;
+  std::vector<Eigen::Vector3d> zeros_;
+  std::vector<Eigen::Vector3d> exact_;  ///< noise-free readings per pose
+  struct Noise;
+  std::shared_ptr<Noise> noise_;
+  bool streaming_ = false;
+  std::uint64_t next_sample_ = 0;
+  std::uint16_t seq_ = 0;
+};
+
+/// Fraction of a pose's dwell during which the table is at rest (centred on the pose time).
+inline constexpr double kRtestRestFraction = 0.8;
+
+}  // namespace rotacal::hw

@@ -1,0 +1,372 @@
+#include "rotacal/hw/virtual_instrument.hpp"
+
+#include <poll.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <random>
+
+#include "rotacal/hw/ballbar_protocol.hpp"
+#include "rotacal/hw/transport.hpp"
+
+namespace rotacal::hw {
+
+namespace {
+double wall_seconds() {
+  using namespace std::chrono;
+  return duration<double>(steady_clock::now().time_since_epoch()).count();
+}
+}  // namespace
+
+// --------------------------------------------------------------------------- common part
+
+VirtualInstrument::VirtualInstrument(int baud, double speed, const FaultInjection& faults)
+    : baud_(baud), speed_(speed), faults_(faults) {
+  if (!(speed > 0.0) || !std::isfinite(speed))
+    throw InvalidArgument("virtual instrument: speed " + std::to_string(speed) + " must be positive");
+}
+
+VirtualInstrument::~VirtualInstrument() {
+  stop_ = true;
+  if (thread_.joinable()) thread_.join();
+}
+
+void VirtualInstrument::start() {
+  if (thread_.joinable()) return;
+  stop_ = false;
+  thread_ = std::thread([this] { run(); });
+}
+
+void VirtualInstrument::stop() {
+  stop_ = true;
+  if (thread_.joinable()) thread_.join();
+  if (!thread_error_.empty()) throw SerialError("virtual instrument on " + port() + ": " + thread_error_);
+}
+
+VirtualStats VirtualInstrument::stats() const {
+  std::lock_guard<std::mutex> lock(stats_mutex_);
+  return stats_;
+}
+
+void VirtualInstrument::run() {
+  try {
+    while (!stop_ && !hung_up_) {
+      pollfd p{pty_.master(), POLLIN, 0};
+      ::poll(&p, 1, 1);
+      serve_once();
+    }
+  } catch (const std::exception& e) {
+    thread_error_ = e.what();
+  }
+  finished_ = true;
+}
+
+double VirtualInstrument::now() const {
+  return clock_running_ ? (wall_seconds() - clock_origin_) * speed_ : 0.0;
+}
+
+void VirtualInstrument::clock_start() {
+  clock_origin_ = wall_seconds();
+  clock_running_ = true;
+}
+
+std::vector<std::string> VirtualInstrument::read_lines() {
+  std::vector<std::string> lines;
+  if (hung_up_) return lines;
+  std::uint8_t buf[512];
+  for (;;) {
+    const ssize_t n = ::read(pty_.master(), buf, sizeof buf);
+    if (n <= 0) break;
+    const std::uint8_t* b = buf;
+    for (ssize_t i = 0; i < n; ++i) {
+      const char c = static_cast<char>(b[i]);
+      if (c == '\r' || c == '\n') {
+        if (!line_buffer_.empty()) lines.push_back(line_buffer_);
+        line_buffer_.clear();
+      } else if (line_buffer_.size() < 128) {
+        line_buffer_ += c;
+      }
+    }
+  }
+  return lines;
+}
+
+void VirtualInstrument::write_all(const Bytes& bytes) {
+  if (hung_up_ || silent_) return;
+  Bytes out = bytes;
+  // A host at the wrong baud rate samples the bits at the wrong instants: it reads garbage.
+  const int host = pty_.host_baud();
+  if (host != 0 && host != baud_)
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = static_cast<std::uint8_t>(out[i] * 37u + 11u);
+  std::size_t done = 0;
+  int stalls = 0;
+  while (done < out.size() && !stop_) {
+    const ssize_t w = ::write(pty_.master(), out.data() + done, out.size() - done);
+    if (w > 0) {
+      done += static_cast<std::size_t>(w);
+      stalls = 0;
+      continue;
+    }
+    if (w < 0 && errno != EAGAIN && errno != EINTR)
+      throw SerialError(std::string("write to the pty master: ") + std::strerror(errno));
+    // The host is not reading: wait for room, like a UART with hardware flow control.
+    pollfd p{pty_.master(), POLLOUT, 0};
+    ::poll(&p, 1, 10);
+    if (++stalls > 500) return;  // 5 s without a reader: drop, as a device would
+  }
+}
+
+void VirtualInstrument::send_reply(const Bytes& bytes) {
+  write_all(bytes);
+  std::lock_guard<std::mutex> lock(stats_mutex_);
+  ++stats_.replies_sent;
+}
+
+void VirtualInstrument::send_frame(Bytes frame) {
+  const std::uint64_t k = ++stream_count_;  // 1-based frame count
+  if (faults_.close_after >= 0 && static_cast<long>(k) > faults_.close_after) {
+    pty_.hang_up();
+    hung_up_ = true;
+    return;
+  }
+  if (faults_.silence_after >= 0 && static_cast<long>(k) > faults_.silence_after) silent_ = true;
+  std::lock_guard<std::mutex> lock(stats_mutex_);
+  if (faults_.drop_every > 0 && k % faults_.drop_every == 0) {
+    ++stats_.frames_dropped;
+    return;
+  }
+  if (faults_.corrupt_every > 0 && k % faults_.corrupt_every == 0) {
+    frame[4 + (k % (frame.size() - 6))] ^= 0x10;  // a payload bit
+    ++stats_.frames_corrupted;
+  }
+  if (faults_.split_frames) {
+    const std::size_t half = frame.size() / 2;
+    write_all(Bytes(frame.begin(), frame.begin() + static_cast<long>(half)));
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    write_all(Bytes(frame.begin() + static_cast<long>(half), frame.end()));
+  } else {
+    write_all(frame);
+  }
+  if (faults_.garbage_every > 0 && k % faults_.garbage_every == 0)
+    write_all(Bytes{0x13, 0xAA, 0x37, 0x00, 0xFF, 0x55, 0x42});
+  if (!silent_) ++stats_.frames_sent;
+}
+
+// --------------------------------------------------------------------------- ballbar
+
+struct VirtualBallbar::Noise {
+  std::mt19937_64 rng;
+  std::normal_distribution<double> gauss{0.0, 1.0};
+};
+
+VirtualBallbar::VirtualBallbar(ProgramTimeline program, const VirtualBallbarOptions& options)
+    : VirtualInstrument(options.baud, options.speed, options.faults),
+      program_(std::move(program)),
+      options_(options),
+      noise_(std::make_shared<Noise>()),
+      rate_hz_(options.rate_hz) {
+  if (!(options.noise_um >= 0.0)) throw InvalidArgument("virtual ballbar: noise_um must be >= 0");
+  if (!(options.rate_hz >= 1.0 && options.rate_hz <= 1000.0))
+    throw InvalidArgument("virtual ballbar: rate_hz " + std::to_string(options.rate_hz) + " must be 1..1000");
+  if (options.truth.machine != program_.header().machine)
+    throw InvalidArgument("virtual ballbar: the machine model and the program are for different machines");
+  noise_->rng.seed(options.seed);
+}
+
+void VirtualBallbar::serve_once() {
+  for (const std::string& line : read_lines()) {
+    const auto cmd = parse_command(line);
+    if (!cmd) {
+      send_reply(encode_text("ERR unknown command '" + line + "'"));
+      continue;
+    }
+    switch (cmd->command) {
+      case BallbarCommand::identify: send_reply(encode_text("ID rotacal-virtual-ballbar 1.0")); break;
+      case BallbarCommand::rate:
+        if (streaming_) {
+          send_reply(encode_text("ERR RATE while streaming"));
+        } else {
+          rate_hz_ = cmd->rate_hz;
+          send_reply(encode_text("OK RATE " + std::to_string(static_cast<int>(rate_hz_))));
+        }
+        break;
+      case BallbarCommand::zero: {
+        // Zero at the current pose (normally done in the calibrator, at L0, before START).
+        const BallbarSample s = program_.at(now());
+        zero_mm_ = predict_lengths(options_.truth, {s})[0] - program_.header().ballbar_length;
+        send_reply(encode_text("OK ZERO"));
+        break;
+      }
+      case BallbarCommand::start:
+        streaming_ = true;
+        next_sample_ = 0;
+        clock_start();
+        send_reply(encode_text("OK START"));
+        break;
+      case BallbarCommand::stop:
+        streaming_ = false;
+        send_reply(encode_text("OK STOP"));
+        break;
+    }
+  }
+  if (!streaming_) return;
+  const double t_now = now();
+  const double L0 = program_.header().ballbar_length;
+  int batch = 0;
+  while (streaming_ && line_up() && batch < 200) {
+    const double t = static_cast<double>(next_sample_) / rate_hz_;
+    if (t > t_now) break;
+    if (t > program_.duration()) {
+      streaming_ = false;
+      send_reply(encode_text("END"));
+      mark_finished();
+      break;
+    }
+    const BallbarSample s = program_.at(t);
+    const double length = predict_lengths(options_.truth, {s})[0] +
+                          1e-3 * options_.noise_um * noise_->gauss(noise_->rng);
+    BallbarFrame f;
+    f.seq = seq_++;
+    f.t_us = static_cast<std::uint32_t>(std::llround(t * 1e6));
+    const double nm = std::round((length - L0 - zero_mm_) * 1e6);
+    f.displacement_nm = static_cast<std::int32_t>(std::clamp(nm, -2.0e9, 2.0e9));
+    if (std::abs(length - L0 - zero_mm_) > 1.0) f.status |= kStatusOverRange;  // +-1 mm travel
+    send_frame(encode_ballbar_sample(f));
+    ++next_sample_;
+    ++batch;
+  }
+}
+
+// --------------------------------------------------------------------------- R-test
+
+struct VirtualRtest::Noise {
+  std::mt19937_64 rng;
+  std::normal_distribution<double> gauss{0.0, 1.0};
+};
+
+VirtualRtest::VirtualRtest(const VirtualRtestOptions& options)
+    : VirtualInstrument(options.baud, options.speed, options.faults),
+      options_(options),
+      noise_(std::make_shared<Noise>()) {
+  // The simulator's noise-free raw readings are the exact readings of each pose at rest.
+  RtestSimOptions exact = options.sim;
+  exact.noise_um = 0.0;
+  exact.probe_dirs = options.probe_dirs;
+  exact.write_d = false;
+  RtestSimulation sim = simulate_rtest(options.truth, exact);
+  program_ = std::move(sim.session);
+  zeros_ = std::move(sim.probe_zeros);
+  for (RtestSample& s : program_.samples) {
+    exact_.push_back(*s.raw);
+    s.raw.reset();
+  }
+  program_.probe_dirs.clear();
+  program_.noise_um.reset();
+  noise_->rng.seed(options.sim.seed + 7919);
+}
+
+Eigen::Vector3d VirtualRtest::readings_at(double t, bool* at_rest) {
+  const auto& rows = program_.samples;
+  const double dwell = options_.sim.pattern.dwell_s;
+  const double t0 = rows.front().time;
+  const double x = (t - t0) / dwell;
+  const long k = std::clamp(std::lround(x), 0L, static_cast<long>(rows.size()) - 1);
+  const double off = x - static_cast<double>(k);
+  Eigen::Vector3d r;
+  if (std::abs(off) <= 0.5 * kRtestRestFraction || (k == 0 && off < 0) ||
+      (k + 1 == static_cast<long>(rows.size()) && off > 0)) {
+    *at_rest = true;
+    r = exact_[static_cast<std::size_t>(k)];
+  } else {
+    // Moving between poses: the readings slide from one pose's to the next, with a
+    // following-error bump that a recorder must not mistake for a measurement.
+    *at_rest = false;
+    const long a = off > 0 ? k : k - 1;
+    const double u = (x - static_cast<double>(a) - 0.5 * kRtestRestFraction) / (1.0 - kRtestRestFraction);
+    const auto ia = static_cast<std::size_t>(a);
+    r = exact_[ia] + u * (exact_[ia + 1] - exact_[ia]) + Eigen::Vector3d::Constant(0.005 * std::sin(M_PI * u));
+  }
+  for (int i = 0; i < 3; ++i) r[i] += 1e-3 * options_.sim.noise_um * noise_->gauss(noise_->rng);
+  return r;
+}
+
+void VirtualRtest::serve_once() {
+  const double end = program_.samples.back().time + 0.5 * options_.sim.pattern.dwell_s;
+  auto value = [](double mm) {
+    if (mm > 2.0) return GaugeValue{GaugeValue::Kind::over_range, 0.0, 1};
+    if (mm < -2.0) return GaugeValue{GaugeValue::Kind::under_range, 0.0, 1};
+    return GaugeValue{GaugeValue::Kind::value, mm, 0};
+  };
+  for (const std::string& line : read_lines()) {
+    if (options_.mode == ProbeMode::stream) {
+      const auto cmd = parse_command(line);
+      if (cmd && cmd->command == BallbarCommand::start) {
+        streaming_ = true;
+        next_sample_ = 0;
+        clock_start();
+        send_reply(encode_text("OK START"));
+      } else if (cmd && cmd->command == BallbarCommand::stop) {
+        streaming_ = false;
+        send_reply(encode_text("OK STOP"));
+      } else if (cmd && cmd->command == BallbarCommand::identify) {
+        send_reply(encode_text("ID rotacal-virtual-rtest 1.0"));
+      } else if (cmd && cmd->command == BallbarCommand::rate && !streaming_) {
+        options_.rate_hz = cmd->rate_hz;
+        send_reply(encode_text("OK RATE " + std::to_string(static_cast<int>(cmd->rate_hz))));
+      } else {
+        send_reply(encode_text("ERR unknown command '" + line + "'"));
+      }
+      continue;
+    }
+    if (!clock_running()) clock_start();  // polled: the program starts at the first request
+    bool rest = false;
+    const Eigen::Vector3d r = readings_at(now(), &rest);
+    if (now() > end) mark_finished();
+    if (options_.mode == ProbeMode::sylvac) {
+      const auto ch = parse_sylvac_request(line);
+      send_reply(ch ? format_sylvac_reply(value(r[*ch - 1]))
+                    : format_sylvac_reply(GaugeValue{GaugeValue::Kind::error, 0.0, -1}));
+    } else {
+      const auto ch = parse_keyence_request(line);
+      KeyenceReply reply;
+      if (!ch) {
+        reply = {0, {GaugeValue{GaugeValue::Kind::error, 0.0, 2}}};  // ER,M0,02: command error
+      } else if (*ch == 0) {
+        reply = {0, {value(r[0]), value(r[1]), value(r[2])}};
+      } else {
+        reply = {*ch, {value(r[*ch - 1])}};
+      }
+      send_reply(format_keyence_reply(reply));
+    }
+  }
+  if (!streaming_) return;
+  const double t_now = now();
+  int batch = 0;
+  while (streaming_ && line_up() && batch < 200) {
+    const double t = static_cast<double>(next_sample_) / options_.rate_hz;
+    if (t > t_now) break;
+    if (t > end) {
+      streaming_ = false;
+      send_reply(encode_text("END"));
+      mark_finished();
+      break;
+    }
+    bool rest = false;
+    const Eigen::Vector3d r = readings_at(t, &rest);
+    ProbeFrame f;
+    f.seq = seq_++;
+    f.t_us = static_cast<std::uint32_t>(std::llround(t * 1e6));
+    for (int i = 0; i < 3; ++i) {
+      f.nm[i] = static_cast<std::int32_t>(std::llround(std::clamp(r[i], -2.0, 2.0) * 1e6));
+      if (std::abs(r[i]) > 2.0) f.status |= static_cast<std::uint8_t>(1u << i);
+    }
+    send_frame(encode_probe_sample(f));
+    ++next_sample_;
+    ++batch;
+  }
+}
+
+}  // namespace rotacal::hw
