@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The whole test suite: C++ tests (ctest), the installed CMake package used from a separate
 # project, the Python package built by pip and its tests (pytest), the benchmarks once each
-# as a smoke check, and the C++ tests again under AddressSanitizer + UBSan.
+# as a smoke check, the decoders under libFuzzer for a bounded time, and the C++ tests again
+# under AddressSanitizer + UBSan.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$PWD
@@ -39,6 +40,11 @@ step "Benchmarks, once each as a smoke check (figures: run them without --smoke)
 ./build/release/bench/diagnose_bench --smoke
 ./build/release/bench/rtest_bench
 "$PY" bench/ballbar_speed.py --repeat 1
+
+step "libFuzzer targets of the instrument decoders, 20 s each (clang)"
+cmake -S fuzz -B build/fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DROTACAL_FUZZ_SECONDS=20
+cmake --build build/fuzz
+ctest --test-dir build/fuzz --output-on-failure
 
 step "C++ tests under AddressSanitizer + UBSan"
 # -O1 and line tables only: what ASan recommends, and far quicker to compile than -O2 -g.

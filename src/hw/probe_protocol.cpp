@@ -11,16 +11,22 @@ namespace rotacal::hw {
 
 namespace {
 
-// A signed decimal "+012.3456": sign, digits, one point, digits; nothing else.
+// A signed decimal "+012.3456": sign, at most 4 integer digits (a gauge reads well under 10 m),
+// an optional point and at most 6 decimals; nothing else.
 std::optional<double> parse_signed_decimal(const std::string& s) {
   if (s.size() < 2 || (s[0] != '+' && s[0] != '-')) return std::nullopt;
-  int digits = 0, points = 0;
+  int int_digits = 0, frac_digits = 0;
+  bool point = false;
   for (std::size_t i = 1; i < s.size(); ++i) {
-    if (s[i] >= '0' && s[i] <= '9') ++digits;
-    else if (s[i] == '.') ++points;
-    else return std::nullopt;
+    if (s[i] >= '0' && s[i] <= '9') {
+      (point ? frac_digits : int_digits) += 1;
+    } else if (s[i] == '.' && !point) {
+      point = true;
+    } else {
+      return std::nullopt;
+    }
   }
-  if (digits == 0 || points > 1 || digits > 12) return std::nullopt;
+  if (int_digits == 0 || int_digits > 4 || frac_digits > 6) return std::nullopt;
   return std::strtod(s.c_str(), nullptr);
 }
 

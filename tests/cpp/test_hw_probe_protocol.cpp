@@ -40,7 +40,8 @@ TEST_CASE("sylvac-style replies", "[hw]") {
   CHECK(parse_sylvac_reply("Err02")->kind == GaugeValue::Kind::error);
   CHECK(parse_sylvac_reply("Err02")->code == 2);
   CHECK(parse_sylvac_reply("?")->kind == GaugeValue::Kind::error);
-  for (const char* bad : {"", "12.3", "+", "+1.2.3", "+12a", "Err1", "+nan"}) CHECK_FALSE(parse_sylvac_reply(bad));
+  for (const char* bad : {"", "12.3", "+", "+1.2.3", "+12a", "Err1", "+nan", "+0444444412", "+1.1234567"})
+    CHECK_FALSE(parse_sylvac_reply(bad));  // the 10-digit value: found by fuzz_probe_lines
   // format then parse gives the value back to the reply's 0.1 um resolution
   const std::string line = format_sylvac_reply({GaugeValue::Kind::value, -1.23456, 0});
   CHECK(line == "-001.2346\r");
