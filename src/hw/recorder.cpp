@@ -112,9 +112,9 @@ std::optional<std::pair<StopReason, std::string>> handshake(ByteTransport& port,
 
 template <typename Writer>
 void finish(Writer& out, RecordSummary& sum) {
+  sum.rows = out.rows();
   out.annotate("summary: " + sum.describe());
   out.close();
-  sum.rows = out.rows();
 }
 
 }  // namespace

@@ -29,7 +29,9 @@ VirtualInstrument::VirtualInstrument(int baud, double speed, const FaultInjectio
     throw InvalidArgument("virtual instrument: speed " + std::to_string(speed) + " must be positive");
 }
 
-VirtualInstrument::~VirtualInstrument() {
+VirtualInstrument::~VirtualInstrument() { halt(); }
+
+void VirtualInstrument::halt() noexcept {
   stop_ = true;
   if (thread_.joinable()) thread_.join();
 }

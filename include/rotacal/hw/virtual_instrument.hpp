@@ -57,6 +57,9 @@ class VirtualInstrument {
 
  protected:
   VirtualInstrument(int baud, double speed, const FaultInjection& faults);
+  /// Stop and join the thread without throwing. Every derived destructor calls it first: the
+  /// thread calls serve_once(), which must not outlive the derived object.
+  void halt() noexcept;
   /// One pass of the serving loop, called every millisecond or so.
   virtual void serve_once() = 0;
   /// Virtual time, s, since `clock_start()` (wall time times speed).
@@ -110,6 +113,7 @@ struct VirtualBallbarOptions {
 class VirtualBallbar final : public VirtualInstrument {
  public:
   VirtualBallbar(ProgramTimeline program, const VirtualBallbarOptions& options);
+  ~VirtualBallbar() override { halt(); }
 
  private:
   void serve_once() override;
@@ -141,6 +145,7 @@ struct VirtualRtestOptions {
 class VirtualRtest final : public VirtualInstrument {
  public:
   explicit VirtualRtest(const VirtualRtestOptions& options);
+  ~VirtualRtest() override { halt(); }
   /// The commanded session the instrument runs (rows: set-up, time, B, C, X, Y, Z), and the
   /// probe zeros it was given, per set-up (table frame, mm).
   const RtestSession& program() const { return program_; }
