@@ -7,18 +7,6 @@
 
 namespace rotacal::py {
 
-namespace {
-EffectModel effects_of(const std::vector<std::string>& ids) {
-  EffectModel fx;
-  for (const std::string& id : ids) fx.effects.push_back(Effect::parse(id));
-  return fx;
-}
-std::vector<std::string> ids_of(const EffectModel& fx) {
-  std::vector<std::string> ids;
-  for (const Effect& e : fx.effects) ids.push_back(e.id());
-  return ids;
-}
-}  // namespace
 
 void bind_ballbar(pyb::module_& m) {
   pyb::class_<ParameterEstimate>(m, "ParameterEstimate")

@@ -10,8 +10,10 @@
 
 #include <Eigen/Core>
 #include <string>
+#include <vector>
 
 #include "rotacal/core/error.hpp"
+#include "rotacal/kinematics/effects.hpp"
 
 namespace rotacal::py {
 
@@ -42,6 +44,43 @@ Eigen::Matrix<double, K, 1> vec_of(
   Eigen::Matrix<double, K, 1> v;
   std::copy(a.data(), a.data() + K, v.data());
   return v;
+}
+
+using Array = pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>;
+using Rows3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
+/// An (N, 3) array as N vectors.
+inline std::vector<Eigen::Vector3d> vectors_of(const Array& a, const char* name) {
+  const auto m = rows_of<3>(a, name);
+  std::vector<Eigen::Vector3d> out;
+  for (Eigen::Index i = 0; i < m.rows(); ++i) out.emplace_back(m.row(i).transpose());
+  return out;
+}
+
+/// N vectors as an (N, 3) array.
+inline Rows3 rows_from(const std::vector<Eigen::Vector3d>& v) {
+  Rows3 m(static_cast<Eigen::Index>(v.size()), 3);
+  for (std::size_t i = 0; i < v.size(); ++i) m.row(static_cast<Eigen::Index>(i)) = v[i].transpose();
+  return m;
+}
+
+/// A (3, 3) array.
+inline Eigen::Matrix3d matrix3_of(const Array& a, const char* name) {
+  const auto m = rows_of<3>(a, name);
+  if (m.rows() != 3) throw InvalidArgument(std::string(name) + ": expected an array of shape (3, 3)");
+  return m;
+}
+
+/// Catalogue ids (shared/spec/effects.md) as an effect model, and back.
+inline EffectModel effects_of(const std::vector<std::string>& ids) {
+  EffectModel fx;
+  for (const std::string& id : ids) fx.effects.push_back(Effect::parse(id));
+  return fx;
+}
+inline std::vector<std::string> ids_of(const EffectModel& fx) {
+  std::vector<std::string> ids;
+  for (const Effect& e : fx.effects) ids.push_back(e.id());
+  return ids;
 }
 
 }  // namespace rotacal::py

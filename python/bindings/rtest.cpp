@@ -9,35 +9,7 @@
 namespace rotacal::py {
 
 namespace {
-using Array = pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>;
-using Rows3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 using Rows6 = Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>;
-
-EffectModel effect_model(const std::vector<std::string>& ids) {
-  EffectModel fx;
-  for (const std::string& id : ids) fx.effects.push_back(Effect::parse(id));
-  return fx;
-}
-
-std::vector<Eigen::Vector3d> vectors_of(const Array& a, const char* name) {
-  const auto m = rows_of<3>(a, name);
-  std::vector<Eigen::Vector3d> out;
-  for (Eigen::Index i = 0; i < m.rows(); ++i) out.emplace_back(m.row(i).transpose());
-  return out;
-}
-
-Rows3 rows_from(const std::vector<Eigen::Vector3d>& v) {
-  Rows3 m(static_cast<Eigen::Index>(v.size()), 3);
-  for (std::size_t i = 0; i < v.size(); ++i) m.row(static_cast<Eigen::Index>(i)) = v[i].transpose();
-  return m;
-}
-
-Eigen::Matrix3d matrix3_of(const Array& a, const char* name) {
-  const auto m = rows_of<3>(a, name);
-  if (m.rows() != 3)
-    throw InvalidArgument(std::string(name) + ": expected an array of shape (3, 3)");
-  return m;
-}
 
 // Evaluates f(row) -> (value, std) for each row of angles; returns both as (N, K) arrays.
 template <int K, typename F>
@@ -228,7 +200,7 @@ void bind_rtest(pyb::module_& m) {
         RtestTruth t;
         t.machine = machine;
         t.errors = LocationErrors<double>(vec_of<8>(errors, "errors"));
-        t.effects = effect_model(effects);
+        t.effects = effects_of(effects);
         t.effect_params = effect_params;
         RtestSimOptions o;
         o.pattern.b_deg = b_deg;
@@ -272,7 +244,7 @@ Returns
         RtestTruth t;
         t.machine = machine;
         t.errors = LocationErrors<double>(vec_of<8>(errors, "errors"));
-        t.effects = effect_model(effects);
+        t.effects = effects_of(effects);
         t.effect_params = effect_params;
         if (static_cast<int>(t.effect_params.size()) != t.effects.num_params())
           throw InvalidArgument("effect_params: expected " +
