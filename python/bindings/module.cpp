@@ -3,6 +3,9 @@
 #include <pybind11/pybind11.h>
 
 #include "rotacal/core/error.hpp"
+#ifdef ROTACAL_WITH_HW
+#include "rotacal/hw/transport.hpp"
+#endif
 
 namespace pyb = pybind11;
 
@@ -14,6 +17,9 @@ void bind_fit(pyb::module_& m);
 void bind_rtest(pyb::module_& m);
 void bind_diagnose(pyb::module_& m);
 void bind_ballbar_plan(pyb::module_& m);
+#ifdef ROTACAL_WITH_HW
+void bind_hw(pyb::module_& m);
+#endif
 }  // namespace rotacal::py
 
 PYBIND11_MODULE(_core, m) {
@@ -24,7 +30,10 @@ PYBIND11_MODULE(_core, m) {
   pyb::register_exception<rotacal::InvalidArgument>(m, "InvalidArgument", error.ptr());
   pyb::register_exception<rotacal::DegenerateGeometry>(m, "DegenerateGeometry", error.ptr());
   pyb::register_exception<rotacal::ParseError>(m, "ParseError", error.ptr());
-  pyb::register_exception<rotacal::IoError>(m, "IoError", error.ptr());
+  auto io_error = pyb::register_exception<rotacal::IoError>(m, "IoError", error.ptr());
+#ifndef ROTACAL_WITH_HW
+  (void)io_error;
+#endif
   rotacal::py::bind_kinematics(m);
   rotacal::py::bind_io(m);
   rotacal::py::bind_ballbar(m);
@@ -32,4 +41,9 @@ PYBIND11_MODULE(_core, m) {
   rotacal::py::bind_rtest(m);
   rotacal::py::bind_diagnose(m);
   rotacal::py::bind_ballbar_plan(m);
+#ifdef ROTACAL_WITH_HW
+  auto serial = pyb::register_exception<rotacal::hw::SerialError>(m, "SerialError", io_error.ptr());
+  pyb::register_exception<rotacal::hw::DeviceDisconnected>(m, "DeviceDisconnected", serial.ptr());
+  rotacal::py::bind_hw(m);
+#endif
 }

@@ -127,16 +127,20 @@ def _truth(a: argparse.Namespace, machine) -> dict:
             "effects": effects, "noise_um": a.noise, "seed": a.seed}
 
 
-def simulate_session(setup, truth: dict):
-    """Plan the test, run it on the machine described by `truth`, return (session, model)."""
-    plan = _core.plan_ballbar_test(setup, None)
-    commanded = plan.commanded_session()
+def machine_model(setup, truth: dict):
+    """The simulated machine described by `truth` (errors, pivot error, effects)."""
     names = list(_core.location_error_names(setup.machine))
     ids = list(truth["effects"].keys())
     params = [v for i in ids for v in truth["effects"][i]]
-    model = _core.BallbarMachineModel(setup.machine, np.array([truth["errors"][n] for n in names]),
-                                      np.asarray(setup.pivot) + np.array(truth["pivot_error"]), ids, params)
-    return _core.simulate_ballbar(commanded, model, truth["noise_um"], truth["seed"]), model
+    return _core.BallbarMachineModel(setup.machine, np.array([truth["errors"][n] for n in names]),
+                                     np.asarray(setup.pivot) + np.array(truth["pivot_error"]), ids, params)
+
+
+def simulate_session(setup, truth: dict):
+    """Plan the test, run it on the machine described by `truth`, return (session, model)."""
+    plan = _core.plan_ballbar_test(setup, None)
+    model = machine_model(setup, truth)
+    return _core.simulate_ballbar(plan.commanded_session(), model, truth["noise_um"], truth["seed"]), model
 
 
 def cmd_simulate(a: argparse.Namespace) -> int:
@@ -163,28 +167,40 @@ def _named_values(text: str, names: list[str], what: str) -> dict[str, float]:
     return out
 
 
-def cmd_simulate_rtest(a: argparse.Namespace) -> int:
+def _rtest_inputs(a: argparse.Namespace) -> dict:
+    """The pattern and simulated machine of `simulate rtest` / `virtual rtest` / `record rtest`."""
     from . import rtest
     machine = _core.parse_machine_type(a.machine)
     b0, b1 = _floats(a.tilt_range, 2, "--b-range")
     c0, c1 = _floats(a.c_range, 2, "--c-range")
-    b_deg = rtest.angle_grid(b0, b1, a.b_step, "--b-range/--b-step")
-    c_deg = rtest.angle_grid(c0, c1, a.c_step, "--c-range/--c-step", full_turn=True)
-    nests = [_floats(n, 3, "--nest") for n in a.nest] if a.nest else rtest.DEFAULT_NESTS
-    errors = a.errors if a.errors in ("random", "zero") else _named_values(
-        a.errors, list(_core.location_error_names(machine)), "--errors")
-    effects = {}
-    for item in a.effect or []:
-        key, _, val = item.partition("=")
-        eff = _core.Effect(key.strip())
-        effects[eff.id] = _floats(val, eff.num_params, f"--effect {key}")
-    dirs = None
+    out = {"machine": a.machine,
+           "b_deg": rtest.angle_grid(b0, b1, a.b_step, "--b-range/--b-step"),
+           "c_deg": rtest.angle_grid(c0, c1, a.c_step, "--c-range/--c-step", full_turn=True),
+           "nests": [_floats(n, 3, "--nest") for n in a.nest] if a.nest else rtest.DEFAULT_NESTS,
+           "dwell_s": a.dwell, "probe_dirs": None}
+    if getattr(a, "errors", None) is not None:
+        out["errors"] = a.errors if a.errors in ("random", "zero") else _named_values(
+            a.errors, list(_core.location_error_names(machine)), "--errors")
+        effects = {}
+        for item in a.effect or []:
+            key, _, val = item.partition("=")
+            eff = _core.Effect(key.strip())
+            effects[eff.id] = _floats(val, eff.num_params, f"--effect {key}")
+        out["effects"] = effects
     if a.probe_dir:
         if len(a.probe_dir) != 3:
             raise _core.InvalidArgument(f"--probe-dir: give it 3 times (probes 1, 2, 3), got {len(a.probe_dir)}")
         dirs = np.array([_floats(d, 3, "--probe-dir") for d in a.probe_dir])
-        dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
-    elif a.raw_only:
+        out["probe_dirs"] = dirs / np.linalg.norm(dirs, axis=1, keepdims=True)
+    return out
+
+
+def cmd_simulate_rtest(a: argparse.Namespace) -> int:
+    from . import rtest
+    r = _rtest_inputs(a)
+    b_deg, c_deg, nests, dirs = r["b_deg"], r["c_deg"], r["nests"], r["probe_dirs"]
+    errors, effects = r["errors"], r["effects"]
+    if dirs is None and a.raw_only:
         raise _core.InvalidArgument("--raw-only needs the probe directions (--probe-dir x3)")
     session, truth = rtest.simulate_rtest(errors, effects, machine=a.machine, b_deg=b_deg, c_deg=c_deg,
                                           nests=nests, noise_um=a.noise, probe_zero_um=a.probe_zero,
@@ -416,6 +432,119 @@ def cmd_demo(a: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+# ------------------------------------------------------------------------- instruments
+
+def _faults(a: argparse.Namespace):
+    f = _core.FaultInjection()
+    f.garbage_every, f.corrupt_every, f.drop_every = a.fault_garbage, a.fault_corrupt, a.fault_drop
+    f.split_frames = a.fault_split
+    f.close_after, f.silence_after = a.fault_unplug_after, a.fault_silence_after
+    return f
+
+
+def _serve(dev, what: str, a: argparse.Namespace, detail: str) -> int:
+    """Print the device path, then serve until Ctrl-C (or the program's end with --exit-when-done)."""
+    print(dev.port, flush=True)
+    _say(f"virtual {what} on {dev.port} ({detail}); Ctrl-C to stop")
+    try:
+        while not (a.exit_when_done and dev.finished):
+            time.sleep(0.05)
+        time.sleep(0.5)  # let the host read the last bytes before the line goes away
+    except KeyboardInterrupt:
+        pass
+    dev.stop()
+    st = dev.stats()
+    _say(f"virtual {what}: {st['frames_sent']} frames, {st['replies_sent']} replies, "
+         f"{st['frames_dropped']} dropped and {st['frames_corrupted']} corrupted on purpose"
+         + (", program finished" if st["finished"] else ""))
+    return EXIT_OK
+
+
+def cmd_virtual_ballbar(a: argparse.Namespace) -> int:
+    from .instruments import virtual_ballbar
+    setup = _setup(a)
+    truth = _truth(a, setup.machine)
+    plan = _core.plan_ballbar_test(setup, None)
+    model = machine_model(setup, truth)
+    truth["pivot_actual"] = model.pivot.tolist()
+    if a.truth:
+        Path(a.truth).write_text(json.dumps(truth, indent=1) + "\n")
+    dev = virtual_ballbar(plan, model, noise_um=a.noise, seed=a.seed, rate_hz=a.rate, speed=a.speed,
+                          baud=a.baud, faults=_faults(a))
+    return _serve(dev, "ballbar", a, f"{plan.duration:.1f} s program at {a.rate:g} Hz, speed x{a.speed:g}")
+
+
+def cmd_virtual_rtest(a: argparse.Namespace) -> int:
+    from .instruments import virtual_rtest
+    r = _rtest_inputs(a)
+    dev, truth = virtual_rtest(r["errors"], r["effects"], machine=r["machine"], b_deg=r["b_deg"], c_deg=r["c_deg"],
+                               nests=r["nests"], dwell_s=r["dwell_s"], noise_um=a.noise, probe_zero_um=a.probe_zero,
+                               probe_dirs=r["probe_dirs"], seed=a.seed, mode=a.mode, rate_hz=a.rate,
+                               speed=a.speed, baud=a.baud, faults=_faults(a))
+    if a.truth:
+        Path(a.truth).write_text(json.dumps(truth, indent=1) + "\n")
+    return _serve(dev, "R-test", a, f"{a.mode} mode, {len(dev.program)} poses, speed x{a.speed:g}")
+
+
+# Exit code of a recording by how it stopped: the data are in the file either way.
+_RECORD_EXIT = {"end of program": EXIT_OK, "stopped": EXIT_OK, "device disconnected": EXIT_IO,
+                "silence (timeout)": EXIT_IO, "no valid data": EXIT_IO}
+
+
+def _report_recording(summary, path: str, json_out: bool) -> int:
+    if json_out:
+        print(json.dumps({k: getattr(summary, k) for k in ("rows", "frames", "lost", "crc_errors", "malformed",
+                                                              "garbage_bytes", "over_range", "timeouts",
+                                                              "reason", "detail")} | {"path": path}))
+    _say(f"wrote {path}: {summary.describe()}")
+    return _RECORD_EXIT[summary.reason]
+
+
+def cmd_record_ballbar(a: argparse.Namespace) -> int:
+    from .instruments import record_ballbar
+    plan = _core.plan_ballbar_test(_setup(a), None)
+    summary = record_ballbar(a.port, plan, a.output, baud=a.baud, rate_hz=a.rate, zero=a.zero,
+                             silence_timeout_s=a.silence, progress=not a.no_progress)
+    return _report_recording(summary, a.output, a.json)
+
+
+def cmd_record_rtest(a: argparse.Namespace) -> int:
+    from .instruments import record_rtest, rtest_program
+    r = _rtest_inputs(a)
+    program = rtest_program(r["machine"], r["b_deg"], r["c_deg"], r["nests"], r["dwell_s"])
+    summary = record_rtest(a.port, program, a.output, mode=a.mode, dwell_s=r["dwell_s"], probe_dirs=r["probe_dirs"],
+                           baud=a.baud, rate_hz=a.rate, speed=a.speed, silence_timeout_s=a.silence,
+                           progress=not a.no_progress)
+    return _report_recording(summary, a.output, a.json)
+
+
+def _add_link_args(q: argparse.ArgumentParser, rate: float) -> None:
+    g = q.add_argument_group("serial link")
+    g.add_argument("--baud", type=int, default=115200, help="baud rate (default 115200)")
+    g.add_argument("--rate", type=float, default=rate, help=f"stream sample rate, Hz (default {rate:g})")
+
+
+def _add_virtual_args(q: argparse.ArgumentParser) -> None:
+    q.add_argument("--speed", type=float, default=1.0, help="virtual seconds per real second (default 1: real time)")
+    q.add_argument("--exit-when-done", action="store_true", help="stop serving when the program has run")
+    q.add_argument("--truth", metavar="JSON", help="write the simulated machine here")
+    g = q.add_argument_group("faults to act out (for testing recorders; 0 or -1: never)")
+    g.add_argument("--fault-garbage", type=int, default=0, metavar="N", help="line noise after every Nth frame")
+    g.add_argument("--fault-corrupt", type=int, default=0, metavar="N", help="flip a bit in every Nth frame")
+    g.add_argument("--fault-drop", type=int, default=0, metavar="N", help="do not send every Nth frame")
+    g.add_argument("--fault-split", action="store_true", help="send every frame in two writes")
+    g.add_argument("--fault-unplug-after", type=int, default=-1, metavar="N", help="hang up after N frames")
+    g.add_argument("--fault-silence-after", type=int, default=-1, metavar="N", help="go silent after N frames")
+
+
+def _add_record_args(q: argparse.ArgumentParser) -> None:
+    q.add_argument("--port", required=True, help="serial port, e.g. /dev/ttyUSB0, /dev/serial/by-id/..., /dev/pts/N")
+    q.add_argument("--silence", type=float, default=3.0, help="stop after this many seconds without data")
+    q.add_argument("--no-progress", action="store_true", help="no progress bar")
+    q.add_argument("--json", action="store_true", help="print the recording summary as JSON")
+    q.add_argument("-o", "--output", required=True)
+
+
 # ------------------------------------------------------------------------- parser
 
 def build_parser() -> argparse.ArgumentParser:
@@ -484,6 +613,44 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--json", action="store_true")
     q.set_defaults(func=cmd_compensate)
 
+    q = sub.add_parser("virtual", help="a virtual instrument on a pseudo-terminal (prints its path)",
+                       epilog=EPILOG)
+    kinds = q.add_subparsers(dest="kind", required=True)
+    k = kinds.add_parser("ballbar", help="a ballbar on a simulated machine running the test program", epilog=EPILOG)
+    _add_setup_args(k)
+    _add_truth_args(k)
+    _add_link_args(k, 1000.0)
+    _add_virtual_args(k)
+    k.set_defaults(func=cmd_virtual_ballbar)
+    k = kinds.add_parser("rtest", help="an R-test on a simulated B/C table running the pattern", epilog=EPILOG)
+    _add_rtest_pattern_args(k)
+    _add_rtest_machine_args(k, "probe direction (give 3 times; default a 45-deg tripod)")
+    k.add_argument("--mode", default="keyence", choices=["sylvac", "keyence", "stream"], help="probe protocol")
+    _add_link_args(k, 100.0)
+    _add_virtual_args(k)
+    k.set_defaults(func=cmd_virtual_rtest)
+
+    q = sub.add_parser("record", help="record a session from an instrument on a serial port",
+                       epilog=EPILOG + "; a recording that ends by disconnect, silence or no valid data "
+                                       "exits with 4, its rows kept in the file")
+    kinds = q.add_subparsers(dest="kind", required=True)
+    k = kinds.add_parser("ballbar", help="record a ballbar test (the same set-up options as plan)", epilog=EPILOG)
+    _add_setup_args(k)
+    _add_link_args(k, 1000.0)
+    k.add_argument("--zero", action="store_true", help="zero the transducer before START (normally done in the calibrator)")
+    _add_record_args(k)
+    k.set_defaults(func=cmd_record_ballbar)
+    k = kinds.add_parser("rtest", help="record an R-test (the same pattern options as simulate rtest)", epilog=EPILOG)
+    _add_rtest_pattern_args(k)
+    k.add_argument("--probe-dir", action="append", metavar="X,Y,Z",
+                   help="calibrated probe direction (give 3 times; default a 45-deg tripod)")
+    k.add_argument("--mode", default="keyence", choices=["sylvac", "keyence", "stream"], help="probe protocol")
+    k.add_argument("--speed", type=float, default=1.0,
+                   help="polled modes: the instrument's virtual seconds per real second (virtual instruments only)")
+    _add_link_args(k, 100.0)
+    _add_record_args(k)
+    k.set_defaults(func=cmd_record_rtest)
+
     q = sub.add_parser("report", help="self-contained HTML report of a session", epilog=EPILOG)
     q.add_argument("file")
     q.add_argument("--method", default="joint", choices=["joint", "paper"])
@@ -500,7 +667,7 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
-def _add_rtest_sim_args(q: argparse.ArgumentParser) -> None:
+def _add_rtest_pattern_args(q: argparse.ArgumentParser) -> None:
     g = q.add_argument_group("measurement pattern (Oyama & Ibaraki Sec. 3.3)")
     g.add_argument("--machine", default="BC-trt", help="BC-trt (the R-test model's machine) or AC-trt")
     g.add_argument("--b-range", dest="tilt_range", default="-90,90", help="tilt axis range, deg (inclusive)")
@@ -512,6 +679,9 @@ def _add_rtest_sim_args(q: argparse.ArgumentParser) -> None:
                    help="nominal ball centre of a sensor nest, table frame, mm (repeatable; default "
                         "the paper's two: 100,0,60 and 0,-120,140)")
     g.add_argument("--dwell", type=float, default=DEFAULT_DWELL_S, help="time between readings, s")
+
+
+def _add_rtest_machine_args(q: argparse.ArgumentParser, probe_dir_help: str) -> None:
     g = q.add_argument_group("simulated machine and instrument")
     g.add_argument("--errors", default="random",
                    help="location errors: random (seeded), zero, or NAME=VALUE,... (mm, rad)")
@@ -520,10 +690,15 @@ def _add_rtest_sim_args(q: argparse.ArgumentParser) -> None:
                         "or axial_motion_C_h2=0.002,-0.001 (repeatable)")
     g.add_argument("--noise", type=float, default=DEFAULT_NOISE_UM, help="1-sigma reading noise, um")
     g.add_argument("--probe-zero", type=float, default=DEFAULT_PROBE_ZERO_UM, help="1-sigma probe zero per set-up, um")
-    g.add_argument("--probe-dir", action="append", metavar="X,Y,Z",
-                   help="probe direction (give 3 times, normalised): also write raw d1,d2,d3 with probe.N.dir")
-    g.add_argument("--raw-only", action="store_true", help="with --probe-dir: write d1,d2,d3 but no dx,dy,dz")
+    g.add_argument("--probe-dir", action="append", metavar="X,Y,Z", help=probe_dir_help)
     g.add_argument("--seed", type=int, default=1)
+
+
+def _add_rtest_sim_args(q: argparse.ArgumentParser) -> None:
+    _add_rtest_pattern_args(q)
+    _add_rtest_machine_args(q, "probe direction (give 3 times, normalised): also write raw d1,d2,d3 "
+                               "with probe.N.dir")
+    q.add_argument("--raw-only", action="store_true", help="with --probe-dir: write d1,d2,d3 but no dx,dy,dz")
     q.add_argument("--truth", metavar="JSON", help="where to write the truth (default: FILE.truth.json)")
     q.add_argument("-o", "--output", required=True)
 

@@ -181,6 +181,24 @@ def _errors_vector(errors: Errors, machine: Any, rng: np.random.Generator) -> np
     return v
 
 
+def machine_truth(errors: Errors, effects: Mapping[str, Any] | None, machine: str, seed: int):
+    """The simulated machine: (machine type, 8 location errors, effect ids, their parameters back
+    to back, effects as given for the truth file). Random errors are drawn from ``seed``."""
+    mtype = _core.parse_machine_type(machine)
+    e = _errors_vector(errors, mtype, np.random.default_rng(seed))
+    ids, params, effects_out = [], [], {}
+    for eid, val in (effects or {}).items():
+        eff = _core.Effect(eid)
+        vals = [float(v) for v in np.atleast_1d(np.asarray(val, dtype=float))]
+        if len(vals) != eff.num_params:
+            raise _core.InvalidArgument(f"effects: {eid} takes {eff.num_params} values "
+                                        f"({', '.join(eff.param_names)}), got {len(vals)}")
+        ids.append(eff.id)
+        params.extend(vals)
+        effects_out[eff.id] = vals[0] if eff.num_params == 1 else vals
+    return mtype, e, ids, params, effects_out
+
+
 def simulate_rtest(errors: Errors = "random", effects: Mapping[str, Any] | None = None, *,
                    machine: str = "BC-trt", b_deg: Sequence[float] = B_GRID,
                    c_deg: Sequence[float] = C_GRID, nests: Sequence[Sequence[float]] = DEFAULT_NESTS,
@@ -207,19 +225,7 @@ def simulate_rtest(errors: Errors = "random", effects: Mapping[str, Any] | None 
     (session, truth) where truth has the shape of ../shared/data/*.truth.json: errors, effects,
     nests, noise_um, plus probe_zeros (mm per set-up), the pattern, seed and probe_dirs.
     """
-    mtype = _core.parse_machine_type(machine)
-    rng = np.random.default_rng(seed)
-    e = _errors_vector(errors, mtype, rng)
-    ids, params, effects_out = [], [], {}
-    for eid, val in (effects or {}).items():
-        eff = _core.Effect(eid)
-        vals = [float(v) for v in np.atleast_1d(np.asarray(val, dtype=float))]
-        if len(vals) != eff.num_params:
-            raise _core.InvalidArgument(f"effects: {eid} takes {eff.num_params} values "
-                                        f"({', '.join(eff.param_names)}), got {len(vals)}")
-        ids.append(eff.id)
-        params.extend(vals)
-        effects_out[eff.id] = vals[0] if eff.num_params == 1 else vals
+    mtype, e, ids, params, effects_out = machine_truth(errors, effects, machine, seed)
     nest_arr = np.asarray(nests, dtype=float).reshape(-1, 3)
     dirs = None if probe_dirs is None else np.asarray(probe_dirs, dtype=float)
     session, zeros = _core.simulate_rtest(mtype, e, ids, params, list(map(float, b_deg)),

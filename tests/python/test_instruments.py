@@ -1,0 +1,161 @@
+"""Virtual instruments and recorders from Python and the command line, as a user runs them:
+a virtual instrument on a pseudo-terminal, `rotacal record`, then identification."""
+import json
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import rotacal
+from rotacal import _core
+from rotacal.instruments import ProgressBar, record_ballbar, virtual_ballbar
+
+ROOT = Path(__file__).resolve().parents[2]
+FAST = ["--step", "3", "--rate", "50"]  # 442 s of program at 50 Hz
+
+
+def rotacal_cli(*args, timeout=300):
+    return subprocess.run([sys.executable, "-m", "rotacal", *map(str, args)], capture_output=True, text=True,
+                          timeout=timeout)
+
+
+class Virtual:
+    """`rotacal virtual ...` in the background; the first line it prints is the port."""
+
+    def __init__(self, *args):
+        self.proc = subprocess.Popen([sys.executable, "-m", "rotacal", "virtual", *map(str, args)],
+                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        self.port = self.proc.stdout.readline().strip()
+        assert self.port.startswith("/dev/"), self.proc.stderr.read()
+
+    def close(self):
+        if self.proc.poll() is None:
+            self.proc.send_signal(signal.SIGINT)
+        return self.proc.communicate(timeout=30)
+
+
+def within_3_sigma(location_errors: dict, truth: dict):
+    checked = 0
+    for name, true in truth.items():
+        p = location_errors[name]
+        if p["value"] is None:  # unobservable: reported, not returned as a number
+            continue
+        assert abs(p["value"] - true) <= 3 * p["std"], (name, p, true)
+        checked += 1
+    return checked
+
+
+def test_record_ballbar_cli_end_to_end(tmp_path):
+    v = Virtual("ballbar", *FAST, "--speed", "60", "--truth", tmp_path / "truth.json", "--exit-when-done")
+    r = rotacal_cli("record", "ballbar", "--port", v.port, *FAST, "-o", tmp_path / "s.csv", "--json")
+    _, err = v.close()
+    assert r.returncode == 0, r.stderr
+    summary = json.loads(r.stdout)
+    assert summary["reason"] == "end of program"
+    assert summary["lost"] == 0 and summary["crc_errors"] == 0
+    assert "program finished" in err
+    assert "recording [" in r.stderr  # the progress bar
+    ident = rotacal_cli("identify", tmp_path / "s.csv", "--json")
+    assert ident.returncode == 0, ident.stderr
+    d = json.loads(ident.stdout)
+    assert d["n_samples"] == summary["rows"] > 20000
+    truth = json.loads((tmp_path / "truth.json").read_text())
+    assert within_3_sigma(d["location_errors"], truth["errors"]) == 8
+
+
+def test_faults_are_counted_and_marked(tmp_path):
+    v = Virtual("ballbar", *FAST, "--speed", "60", "--exit-when-done", "--fault-drop", "101", "--fault-corrupt",
+                "137", "--fault-garbage", "50", "--fault-split")
+    r = rotacal_cli("record", "ballbar", "--port", v.port, *FAST, "-o", tmp_path / "s.csv", "--json",
+                    "--no-progress")
+    _, err = v.close()
+    assert r.returncode == 0, r.stderr
+    s = json.loads(r.stdout)
+    dropped = int(err.split(" dropped")[0].split()[-1])
+    corrupted = int(err.split(" corrupted")[0].split()[-1])
+    assert dropped > 100 and corrupted > 100
+    assert s["crc_errors"] == corrupted
+    assert s["lost"] == dropped + corrupted
+    assert s["garbage_bytes"] > 0
+    text = (tmp_path / "s.csv").read_text()
+    assert text.count("# gap:") >= dropped and "# corrupt:" in text
+    assert len(rotacal.load(tmp_path / "s.csv")) == s["rows"]
+
+
+def test_ctrl_c_stops_cleanly_and_keeps_the_rows(tmp_path):
+    v = Virtual("ballbar", *FAST, "--speed", "5")
+    rec = subprocess.Popen([sys.executable, "-m", "rotacal", "record", "ballbar", "--port", v.port, *FAST,
+                            "-o", tmp_path / "s.csv", "--json"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           text=True)
+    time.sleep(4.0)
+    rec.send_signal(signal.SIGINT)
+    out, err = rec.communicate(timeout=30)
+    v.close()
+    assert rec.returncode == 0, err
+    s = json.loads(out)
+    assert s["reason"] == "stopped"
+    assert s["rows"] > 100
+    session = rotacal.load(tmp_path / "s.csv")
+    assert len(session) == s["rows"]
+    assert "# summary:" in (tmp_path / "s.csv").read_text()
+
+
+@pytest.mark.parametrize("mode", ["sylvac", "keyence", "stream"])
+def test_record_rtest_cli_end_to_end(tmp_path, mode):
+    v = Virtual("rtest", "--mode", mode, "--speed", "150", "--truth", tmp_path / "truth.json", "--exit-when-done")
+    r = rotacal_cli("record", "rtest", "--port", v.port, "--mode", mode, "--speed", "150",
+                    "-o", tmp_path / "r.csv", "--json")
+    v.close()
+    assert r.returncode == 0, r.stderr
+    s = json.loads(r.stdout)
+    assert s["reason"] == "end of program" and s["lost"] == 0 and s["rows"] == 168
+    ident = rotacal_cli("identify", tmp_path / "r.csv", "--json")
+    assert ident.returncode == 0, ident.stderr
+    truth = json.loads((tmp_path / "truth.json").read_text())
+    assert within_3_sigma(json.loads(ident.stdout)["location_errors"], truth["errors"]) >= 4
+
+
+def test_python_api_records_and_identifies(tmp_path):
+    setup = _core.BallbarSetup()
+    setup.step_deg = 3.0
+    plan = _core.plan_ballbar_test(setup, None)
+    errors = np.array([0.03, -0.02, 4e-5, -6e-5, 0.025, 0.04, 3e-5, -5e-5])
+    truth = _core.BallbarMachineModel(setup.machine, errors, np.asarray(setup.pivot) + [0.01, -0.01, 0.02])
+    dev = virtual_ballbar(plan, truth, rate_hz=50, speed=60)
+    calls = []
+    summary = record_ballbar(dev.port, plan, tmp_path / "s.csv", rate_hz=50,
+                             progress=lambda *p: calls.append(p) or True)
+    dev.stop()
+    assert summary.reason == "end of program" and summary.lost == 0
+    assert len(calls) > 3 and calls[-1][0] <= summary.rows  # rows as they grew
+    ident = rotacal.identify(rotacal.load(tmp_path / "s.csv"))
+    for name, true in zip(_core.location_error_names(setup.machine), errors):
+        p = ident.parameter(name)
+        assert abs(p.value - true) <= 3 * p.std, name
+
+
+def test_bad_port_exits_with_io_error_naming_it(tmp_path):
+    r = rotacal_cli("record", "ballbar", "--port", "/dev/rotacal-no-such-port", "-o", tmp_path / "s.csv")
+    assert r.returncode == 4
+    assert "/dev/rotacal-no-such-port" in r.stderr
+
+
+def test_progress_bar_prints_deciles_to_a_log(capsys):
+    import io
+    buf = io.StringIO()
+    bar = ProgressBar("work", 10.0, " s", stream=buf)
+    for i in range(101):
+        bar.update(i / 10)
+    lines = buf.getvalue().splitlines()
+    assert len(lines) == 11 and lines[-1].startswith("work [" + "#" * 30 + "] 100.0%")
+
+
+def test_example_records_from_a_virtual_ballbar(tmp_path):
+    r = subprocess.run([sys.executable, str(ROOT / "examples" / "record_virtual_ballbar.py"), tmp_path / "s.csv"],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert "stopped: end of program" in r.stdout and "E_B0C" in r.stdout
