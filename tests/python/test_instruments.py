@@ -106,8 +106,10 @@ def test_ctrl_c_stops_cleanly_and_keeps_the_rows(tmp_path):
 
 @pytest.mark.parametrize("mode", ["sylvac", "keyence", "stream"])
 def test_record_rtest_cli_end_to_end(tmp_path, mode):
-    v = Virtual("rtest", "--mode", mode, "--speed", "150", "--truth", tmp_path / "truth.json", "--exit-when-done")
-    r = rotacal_cli("record", "rtest", "--port", v.port, "--mode", mode, "--speed", "150",
+    # Polled modes pace on the host clock: slow enough that half a dwell is 50 ms of real time.
+    speed = "150" if mode == "stream" else "60"
+    v = Virtual("rtest", "--mode", mode, "--speed", speed, "--truth", tmp_path / "truth.json", "--exit-when-done")
+    r = rotacal_cli("record", "rtest", "--port", v.port, "--mode", mode, "--speed", speed,
                     "-o", tmp_path / "r.csv", "--json")
     v.close()
     assert r.returncode == 0, r.stderr
