@@ -25,6 +25,7 @@ cmake --install build/release --prefix build/install --component dev
 cmake -S tests/consumer -B build/consumer -G Ninja -DCMAKE_PREFIX_PATH="$ROOT/build/install"
 cmake --build build/consumer
 ./build/consumer/rotacal_consumer
+./build/consumer/rotacal_consumer_hw
 
 step "C++ example (examples/cpp) against the installed package"
 cmake -S examples/cpp -B build/example -G Ninja -DCMAKE_PREFIX_PATH="$ROOT/build/install"
@@ -39,6 +40,7 @@ step "Benchmarks, once each as a smoke check (figures: run them without --smoke)
 ./build/release/bench/ballbar_accuracy --smoke
 ./build/release/bench/diagnose_bench --smoke
 ./build/release/bench/rtest_bench
+./build/release/bench/hw_stream --smoke
 "$PY" bench/ballbar_speed.py --repeat 1
 
 step "libFuzzer targets of the instrument decoders, 20 s each (clang)"
