@@ -42,6 +42,47 @@ def identify(session: _core.BallbarSession, method: str = "joint", *,
     return Identification(raw)
 
 
+def monte_carlo(session: _core.BallbarSession, result: Identification, draws: int = 100, *,
+                seed: int = 1, progress: bool = True) -> dict:
+    """Check the reported uncertainties by Monte Carlo (GUM Supplement 1 style): simulate
+    ``draws`` sessions of the same poses on the identified machine with the fitted noise,
+    identify each the same way, and compare the spread with the reported 1-sigma.
+
+    Returns {"draws", "noise_um", "method", "parameters": {name: {"std_reported", "std_mc",
+    "ratio", "bias", "unit"}}} for every observable parameter; a ratio near 1 means the
+    reported uncertainty is right, well above 1 that it is optimistic.
+    """
+    from .progress import ProgressBar
+    if draws < 2:
+        raise _core.InvalidArgument(f"monte_carlo: draws must be at least 2, got {draws}")
+    raw = result.raw
+    method = raw.method
+    effects = list(raw.model.effects)
+    fit_offset = any(p.name == "ballbar_length_offset" for p in raw.parameters)
+    if fit_offset:
+        raise _core.InvalidArgument("monte_carlo: a fit with a length offset is not supported")
+    bar = ProgressBar("Monte Carlo", draws, " draws") if progress else None
+    values = []
+    for k in range(draws):
+        sim = _core.simulate_ballbar(session, raw.model, float(raw.sigma_um), seed + k)
+        r = identify(sim, method, effects=effects if method == "joint" else ())
+        values.append([p.value for p in r.raw.parameters])
+        if bar:
+            bar.update(k + 1)
+    if bar:
+        bar.close()
+    v = np.array(values)
+    out = {}
+    for j, p in enumerate(raw.parameters):
+        if not p.observable:
+            continue
+        std_mc = float(np.std(v[:, j], ddof=1))
+        out[p.name] = {"std_reported": float(p.std), "std_mc": std_mc,
+                       "ratio": std_mc / p.std if p.std > 0 else float("inf"),
+                       "bias": float(np.mean(v[:, j]) - p.value), "unit": p.unit}
+    return {"draws": draws, "noise_um": float(raw.sigma_um), "method": method, "parameters": out}
+
+
 def predict(model: _core.BallbarMachineModel, session: _core.BallbarSession) -> _core.BallbarSession:
     """The session with every length replaced by the model's prediction."""
     return session.with_lengths(_core.predict_session_lengths(model, session))

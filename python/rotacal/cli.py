@@ -237,12 +237,25 @@ def _print_identification(d: dict) -> None:
         print(f"  pivot {axis}  " + ("unobservable" if p["value"] is None else f"{p['value']:.4f} mm +- {p['std'] * 1e3:.3f} um"))
     for u in d["unobservable"]:
         print(f"  not determined by these tests: {u}")
+    mc = d.get("monte_carlo")
+    if mc:
+        print(f"Monte Carlo check of the 1-sigma, {mc['draws']} draws at {mc['noise_um']:.3f} um noise "
+              "(ratio = Monte Carlo sigma / reported sigma):")
+        for name, m in mc["parameters"].items():
+            scale, unit = (1e6, "urad") if m["unit"] == "rad" else (1e3, "um")
+            print(f"  {name:16s} reported {m['std_reported'] * scale:8.3f}  Monte Carlo {m['std_mc'] * scale:8.3f} "
+                  f"{unit:4s}  ratio {m['ratio']:.2f}")
 
 
 def cmd_identify(a: argparse.Namespace) -> int:
     s = load(a.file)
     result = identify(s, a.method, fit_length_offset=a.length_offset)
     d = result.to_dict()
+    if a.monte_carlo:
+        if not isinstance(s, _core.BallbarSession):
+            raise _core.InvalidArgument("--monte-carlo: for ballbar sessions")
+        from .ballbar import monte_carlo
+        d["monte_carlo"] = monte_carlo(s, result, a.monte_carlo, seed=a.seed)
     if a.save_model:
         save_model(result.model_dict(), a.save_model)
         _say(f"wrote {a.save_model}")
@@ -583,6 +596,9 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--json", action="store_true", help="print the result as JSON")
     q.add_argument("--save-model", metavar="MODEL.json",
                    help="write the fitted model (ballbar, or R-test joint: location errors, maps, covariance)")
+    q.add_argument("--monte-carlo", type=int, default=0, metavar="N",
+                   help="check the 1-sigma by N simulated repeats of the session (ballbar; progress bar)")
+    q.add_argument("--seed", type=int, default=1, help="seed of the Monte Carlo draws")
     q.set_defaults(func=cmd_identify)
 
     q = sub.add_parser("diagnose", help="find what the model gets wrong and why", epilog=EPILOG)

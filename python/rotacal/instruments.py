@@ -17,49 +17,13 @@ from typing import Any, Callable, Mapping, Sequence, TextIO
 import numpy as np
 
 from . import _core, rtest
+from .progress import ProgressBar
 
 # A tripod of probes, each 45 deg off the vertical, as R-test nests are commonly built.
 DEFAULT_PROBE_DIRS = np.array([[1.0, 0.0, -1.0], [0.0, 1.0, -1.0], [-1.0, -1.0, -1.0]])
 DEFAULT_PROBE_DIRS /= np.linalg.norm(DEFAULT_PROBE_DIRS, axis=1, keepdims=True)
 
 Progress = Callable[[int, int, int, float, float], bool]
-
-
-class ProgressBar:
-    """A one-line progress bar on stderr for long work (recording, Monte Carlo).
-
-    On a terminal it redraws in place; otherwise (a log file, CI) it prints a line at every
-    tenth of the way, so logs stay short. ``ROTACAL_PROGRESS=0`` silences it.
-    """
-
-    def __init__(self, label: str, total: float, unit: str = "", stream: TextIO | None = None):
-        self.label, self.total, self.unit = label, float(total), unit
-        self.stream = stream or sys.stderr
-        self.enabled = os.environ.get("ROTACAL_PROGRESS", "1") != "0"
-        self.tty = self.stream.isatty()
-        self._last_decile = -1
-        self._t0 = time.monotonic()
-
-    def update(self, done: float, note: str = "") -> None:
-        if not self.enabled:
-            return
-        frac = min(max(done / self.total, 0.0), 1.0) if self.total > 0 else 0.0
-        elapsed = time.monotonic() - self._t0
-        eta = f", {elapsed * (1 - frac) / frac:4.0f} s left" if 0.02 < frac < 1 else ""
-        text = (f"{self.label} [{'#' * int(30 * frac):<30s}] {100 * frac:5.1f}% "
-                f"{done:.1f}/{self.total:.1f}{self.unit}{eta}" + (f"  {note}" if note else ""))
-        if self.tty:
-            self.stream.write("\r" + text + "\033[K")
-            self.stream.flush()
-        elif int(10 * frac) > self._last_decile:
-            self._last_decile = int(10 * frac)
-            self.stream.write(text + "\n")
-            self.stream.flush()
-
-    def close(self) -> None:
-        if self.enabled and self.tty:
-            self.stream.write("\n")
-            self.stream.flush()
 
 
 class RecordingProgress:

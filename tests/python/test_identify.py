@@ -63,3 +63,26 @@ def test_paper_chain_recovers_truth(shared_data, name):
     for n, v in d["location_errors"].items():
         allow = 0.5e-3 if v["unit"] == "mm" else 2e-6
         assert abs(v["value"] - t["errors"][n]) <= 3 * v["std"] + allow, (n, v, t["errors"][n])
+
+
+def test_monte_carlo_confirms_the_reported_sigma(shared_data):
+    # 40 repeats: the Monte Carlo sigma of each parameter is within ~3 x 11 % of the truth, so
+    # a ratio outside 0.55..1.5 means the reported (linearised) 1-sigma is wrong.
+    from rotacal.ballbar import monte_carlo
+    s = rotacal.load(shared_data / "ballbar_ac_table2.csv")
+    mc = monte_carlo(s, rotacal.identify(s), draws=40, seed=3, progress=False)
+    assert mc["draws"] == 40 and len(mc["parameters"]) == 11
+    for name, m in mc["parameters"].items():
+        assert 0.55 < m["ratio"] < 1.5, (name, m)
+        assert abs(m["bias"]) < 4 * m["std_reported"] / np.sqrt(40) + 1e-12, (name, m)
+
+
+def test_monte_carlo_cli_shows_progress(shared_data):
+    import subprocess
+    import sys
+    r = subprocess.run([sys.executable, "-m", "rotacal", "identify", str(shared_data / "ballbar_ac_table2.csv"),
+                        "--monte-carlo", "10", "--json"], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert "Monte Carlo [" in r.stderr and "100.0%" in r.stderr
+    import json
+    assert json.loads(r.stdout)["monte_carlo"]["draws"] == 10
