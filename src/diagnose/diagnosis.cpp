@@ -231,6 +231,130 @@ std::string describe_structure(const std::vector<GroupResidual>& groups) {
 
 }  // namespace
 
+HarmonicResolution resolve_harmonics(const std::vector<double>& angles_rad, char axis,
+                                     int max_order, double min_new_content) {
+  if (max_order < 0) throw InvalidArgument("resolve_harmonics: max_order must be >= 0");
+  if (!(min_new_content > 0.0 && min_new_content <= 1.0))
+    throw InvalidArgument("resolve_harmonics: min_new_content must be in (0, 1]");
+  HarmonicResolution R;
+  R.axis = axis;
+  R.max_order = max_order;
+  R.min_new_content = min_new_content;
+  if (angles_rad.empty()) {
+    R.new_content.assign(static_cast<std::size_t>(max_order), 0.0);
+    return R;
+  }
+  // Distinct angles on the circle: readings at the same commanded angle (or within encoder
+  // jitter, 0.05 deg) count once, with their number as weight.
+  const double turn = 2.0 * M_PI, same = 0.05 * M_PI / 180.0;
+  std::vector<double> a;
+  a.reserve(angles_rad.size());
+  for (double x : angles_rad) a.push_back(x - turn * std::floor(x / turn));
+  std::sort(a.begin(), a.end());
+  std::vector<double> at;
+  std::vector<double> count;
+  for (double x : a) {
+    if (!at.empty() && x - at.back() <= same) count.back() += 1.0;
+    else at.push_back(x), count.push_back(1.0);
+  }
+  if (at.size() > 1 && at.front() + turn - at.back() <= same) {  // wraps past 360 deg
+    count.front() += count.back();
+    at.pop_back(), count.pop_back();
+  }
+  const auto N = static_cast<Eigen::Index>(at.size());
+  R.distinct_angles = static_cast<int>(N);
+  double widest_gap = N > 1 ? 0.0 : turn;
+  bool even = N >= 3;
+  for (std::size_t i = 0; i < at.size(); ++i) {
+    const double gap = i + 1 < at.size() ? at[i + 1] - at[i] : at.front() + turn - at.back();
+    widest_gap = std::max(widest_gap, gap);
+    even = even && std::abs(gap - turn / static_cast<double>(N)) <= same;
+  }
+  R.span_deg = (turn - widest_gap) * 180.0 / M_PI;
+  if (even) R.even_step_deg = 360.0 / static_cast<double>(N);
+
+  // Weighted design, scaled so that an even full turn gives orthonormal columns.
+  const double total = static_cast<double>(angles_rad.size());
+  Eigen::MatrixXd H(N, 1 + 2 * max_order);
+  for (Eigen::Index i = 0; i < N; ++i) {
+    const double w = std::sqrt(count[static_cast<std::size_t>(i)] / total);
+    const double th = at[static_cast<std::size_t>(i)];
+    H(i, 0) = w;
+    for (int k = 1; k <= max_order; ++k) {
+      H(i, 2 * k - 1) = w * M_SQRT2 * std::cos(k * th);
+      H(i, 2 * k) = w * M_SQRT2 * std::sin(k * th);
+    }
+  }
+  R.resolved = max_order;
+  for (int k = 1; k <= max_order; ++k) {
+    // Orthonormal basis of the span of orders 0..k-1 (rank-revealing: once an order is
+    // unresolvable the lower columns may be dependent), then what of order k lies outside it.
+    Eigen::JacobiSVD<Eigen::MatrixXd> lower(H.leftCols(2 * k - 1), Eigen::ComputeThinU);
+    Eigen::Index rank = 0;
+    for (Eigen::Index i = 0; i < lower.singularValues().size(); ++i)
+      rank += lower.singularValues()[i] > 1e-9 * std::max(1.0, lower.singularValues()[0]);
+    const Eigen::MatrixXd U = lower.matrixU().leftCols(rank);
+    const Eigen::MatrixXd pair = H.middleCols(2 * k - 1, 2);
+    const Eigen::MatrixXd rest = pair - U * (U.transpose() * pair);
+    double nc = 0.0;
+    if (N - rank >= 2) {  // two new directions are needed at all (2k + 1 <= N)
+      Eigen::JacobiSVD<Eigen::MatrixXd> svd(rest);
+      nc = svd.singularValues()[1];
+      if (nc < 1e-9) nc = 0.0;  // rounding of an exactly dependent pair
+    }
+    R.new_content.push_back(nc);
+    if (nc < min_new_content && R.resolved == max_order) R.resolved = k - 1;
+  }
+  return R;
+}
+
+std::string HarmonicResolution::why_not(int order) const {
+  std::ostringstream out;
+  out.precision(3);
+  out << axis << " is sampled at " << distinct_angles << " distinct angle"
+      << (distinct_angles == 1 ? "" : "s");
+  if (even_step_deg > 0.0) out << ", " << even_step_deg << " deg apart over a full turn";
+  else out << " spanning " << span_deg << " deg";
+  if (order <= resolved || order > max_order) {
+    out << ": order " << order << " is resolved";
+    return out.str();
+  }
+  const int first = resolved + 1;
+  const double nc = new_content[static_cast<std::size_t>(order - 1)];
+  if (order > first && nc >= min_new_content) {
+    out << ": order " << order << " is left out with the other orders above " << first - 1
+        << ", since order " << first << " is not resolvable there";
+    return out.str();
+  }
+  const int N = distinct_angles;
+  if (even_step_deg > 0.0 && 2 * order >= N) {
+    // Folding on an even grid: cos/sin of order k at th_i = i 2 pi/N equal those of k mod N,
+    // and of N - (k mod N) with the sine's sign flipped.
+    int alias = order % N;
+    if (2 * alias > N) alias = N - alias;
+    out << ", which resolves the orders below " << N / 2.0 << " (half the number of angles, the "
+        << "Nyquist limit) only: order " << order;
+    if (2 * alias == N)
+      out << " is that limit: its sine vanishes at every sampled angle, so its amplitude and "
+             "phase cannot be told apart";
+    else if (alias == 0)
+      out << " is constant at every sampled angle (an offset)";
+    else
+      out << " takes the same values there as order " << alias << " (aliasing)";
+    return out.str();
+  }
+  if (2 * order + 1 > N)
+    out << ": order " << order << " needs at least " << 2 * order + 1
+        << " distinct angles to be told apart from the lower orders";
+  else if (nc == 0.0)
+    out << ": there order " << order << " is a combination of the lower orders (aliasing)";
+  else
+    out << ": there only " << 100.0 * nc << " % of order " << order
+        << "'s signature is not a combination of the lower orders (" << 100.0 * min_new_content
+        << " % needed)";
+  return out.str();
+}
+
 double estimate_noise_um(const DiagnosisProblem& P, const Eigen::VectorXd& r) {
   const auto& g = P.groups();
   const auto& t = P.times();
@@ -251,7 +375,8 @@ double estimate_noise_um(const DiagnosisProblem& P, const Eigen::VectorXd& r) {
   return std::sqrt(ss / (2.0 * static_cast<double>(n))) * 1e3;
 }
 
-std::vector<GroupResidual> residual_structure(const DiagnosisProblem& P, const Eigen::VectorXd& r) {
+std::vector<GroupResidual> residual_structure(const DiagnosisProblem& P, const Eigen::VectorXd& r,
+                                              int max_order, double min_new_content) {
   const auto& g = P.groups();
   const auto& t = P.times();
   const auto& a = P.angles();
@@ -285,16 +410,44 @@ std::vector<GroupResidual> residual_structure(const DiagnosisProblem& P, const E
     const double span_t = hi_t - lo_t, span_r = hi_r - lo_r;
     const bool use_rot = span_r >= span_t;
     if (std::max(span_t, span_r) > 0.0) G.angle_axis = use_rot ? 'C' : tilt;
-    if (std::max(span_t, span_r) >= 330.0 * M_PI / 180.0 && y.size() >= 20) {
-      const int orders = 8;
-      Eigen::MatrixXd H(y.size(), 1 + 2 * orders);
-      for (Eigen::Index k = 0; k < y.size(); ++k) {
-        const double th = use_rot ? a[idx[static_cast<std::size_t>(k)]].rot : a[idx[static_cast<std::size_t>(k)]].tilt;
-        H(k, 0) = 1.0;
-        for (int o = 1; o <= orders; ++o) H(k, 2 * o - 1) = std::cos(o * th), H(k, 2 * o) = std::sin(o * th);
+    // Only the orders the group's angular sampling resolves are fitted: beyond them the design
+    // is rank-deficient (C every 30 deg: order 6 has a vanishing sine, 7 and 8 take the values
+    // of 5 and 4), and a fit would return rounding noise divided by ~1e-15 (1e14 um and more).
+    const double span = std::max(span_t, span_r);
+    if (span >= 330.0 * M_PI / 180.0 && y.size() >= 20 && max_order > 0) {
+      std::vector<double> th(idx.size());
+      for (std::size_t k = 0; k < idx.size(); ++k) th[k] = use_rot ? a[idx[k]].rot : a[idx[k]].tilt;
+      const HarmonicResolution res =
+          resolve_harmonics(th, G.angle_axis, max_order, min_new_content);
+      const int orders = res.resolved;
+      if (orders > 0) {
+        Eigen::MatrixXd H(y.size(), 1 + 2 * orders);
+        for (Eigen::Index k = 0; k < y.size(); ++k) {
+          H(k, 0) = 1.0;
+          for (int o = 1; o <= orders; ++o) {
+            H(k, 2 * o - 1) = std::cos(o * th[static_cast<std::size_t>(k)]);
+            H(k, 2 * o) = std::sin(o * th[static_cast<std::size_t>(k)]);
+          }
+        }
+        const Eigen::VectorXd c = solve_ls(H, y);
+        for (int o = 1; o <= orders; ++o)
+          G.harmonic_um.push_back(std::hypot(c[2 * o - 1], c[2 * o]) * 1e3);
       }
-      const Eigen::VectorXd c = solve_ls(H, y);
-      for (int o = 1; o <= orders; ++o) G.harmonic_um.push_back(std::hypot(c[2 * o - 1], c[2 * o]) * 1e3);
+      if (orders < max_order) {
+        for (int o = orders + 1; o <= max_order; ++o) G.harmonics_left_out.push_back(o);
+        std::ostringstream note;
+        note << (orders + 1 == max_order ? "order " : "orders ") << orders + 1;
+        if (orders + 1 < max_order) note << "-" << max_order;
+        note << " in " << G.angle_axis << " left out: " << res.why_not(orders + 1);
+        G.harmonic_note = note.str();
+      }
+    } else if (G.angle_axis && max_order > 0) {
+      std::ostringstream note;
+      note.precision(3);
+      note << "no harmonics: ";
+      if (y.size() < 20) note << "only " << y.size() << " readings";
+      else note << G.angle_axis << " sweeps " << span * 180.0 / M_PI << " deg, not a full turn";
+      G.harmonic_note = note.str();
     }
     out.push_back(G);
   }
@@ -366,6 +519,27 @@ Diagnosis diagnose_at_noise(const DiagnosisProblem& P, const DiagnosisOptions& o
   D.baseline.p_value = stats::chi2_sf(chi2, D.baseline.dof);
   D.structure_before = residual_structure(P, fit.residuals);
 
+  // A *_hn candidate of an order its axis' sampling cannot resolve takes, at the sampled
+  // angles, the values of lower orders (C every 30 deg: order 7 is order 5): scored, it would
+  // name an order the data cannot tell. Judged on every reading's angle of that axis, since the
+  // effect's parameters are shared by all of them.
+  std::vector<std::string> unresolved(candidates.size());
+  {
+    std::map<char, int> top;
+    for (const Effect& c : candidates)
+      if (c.harmonic > 0) top[c.axis] = std::max(top[c.axis], c.harmonic);
+    for (const auto& [axis, order] : top) {
+      std::vector<double> th;
+      for (const RotaryAngles<double>& r : P.angles()) th.push_back(axis == 'C' ? r.rot : r.tilt);
+      const HarmonicResolution res =
+          resolve_harmonics(th, axis, order, options.min_harmonic_new_content);
+      for (std::size_t c = 0; c < candidates.size(); ++c)
+        if (candidates[c].axis == axis && candidates[c].harmonic > res.resolved)
+          unresolved[c] = "the sampling cannot resolve its harmonic order: " +
+                          res.why_not(candidates[c].harmonic);
+    }
+  }
+
   const std::vector<int> fold = cv_folds(P, options.cv_blocks);
   EffectModel model;
   std::vector<bool> done(candidates.size(), false);
@@ -376,6 +550,11 @@ Diagnosis diagnose_at_noise(const DiagnosisProblem& P, const DiagnosisOptions& o
     std::vector<Score> scores;
     for (std::size_t c = 0; c < candidates.size(); ++c) {
       if (done[c]) continue;
+      if (!unresolved[c].empty()) {
+        D.unobservable.push_back({candidates[c].id(), unresolved[c]});
+        done[c] = true;
+        continue;
+      }
       Score s = score(P, fit, Jfree, Q, candidates[c], sigma_mm, options.min_visible_chi2);
       if (!s.observable) {
         if (first_round) D.unobservable.push_back({candidates[c].id(), s.why_not});

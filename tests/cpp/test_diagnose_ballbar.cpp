@@ -151,3 +151,30 @@ TEST_CASE("two hidden effects are both found", "[diagnose]") {
     CHECK(found.size() == 2);
   }
 }
+
+TEST_CASE("ballbar residual harmonics: full C turns keep every order, half A turns none",
+          "[diagnose]") {
+  // 360 C angles 1 deg apart resolve all 8 orders; radial_A/axial_A sweep 180 deg only.
+  std::mt19937 rng(505);
+  const Diagnosis D = diagnose_hidden(random_machine(rng), 13);
+  for (const GroupResidual& g : D.structure_before) {
+    INFO(g.group << ": " << g.harmonic_note);
+    if (g.angle_axis == 'C') {
+      CHECK(g.harmonic_um.size() == 8);
+      CHECK(g.harmonics_left_out.empty());
+      CHECK(g.harmonic_note.empty());
+      // Null data: each order's amplitude is within 5 sigma sqrt(2/n) of zero.
+      for (double h : g.harmonic_um)
+        CHECK(h < 5.0 * kNoiseUm * std::sqrt(2.0 / static_cast<double>(g.n)));
+    } else if (g.angle_axis == 'A') {
+      CHECK(g.harmonic_um.empty());
+      CHECK(g.harmonic_note.find("not a full turn") != std::string::npos);
+    }
+  }
+  // 181 A angles over a half turn resolve the catalogue's orders (up to 4): no harmonic
+  // candidate is dropped for its sampling (some are for their geometry).
+  for (const UnobservableEffect& u : D.unobservable) {
+    INFO(u.effect << ": " << u.reason);
+    CHECK(u.reason.find("cannot resolve its harmonic order") == std::string::npos);
+  }
+}

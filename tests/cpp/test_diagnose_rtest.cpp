@@ -131,3 +131,112 @@ TEST_CASE("every catalogue effect an R-test can see, hidden at 5 sigma, is found
   WARN(tried << " R-test catalogue effects hidden and found; invisible at plausible sizes: " << invisible);
   CHECK(tried >= 20);
 }
+
+TEST_CASE("R-test residual harmonics stop below the Nyquist limit of the 30 degree C steps",
+          "[diagnose]") {
+  // C every 30 deg: 12 distinct angles resolve orders 1..5 only (order 6 has a vanishing sine,
+  // 7 and 8 alias onto 5 and 4). B: 7 distinct angles over a half turn resolve orders 1..3.
+  std::mt19937 rng(41);
+  const double noise_um = 0.3;
+  RtestSimOptions o;
+  o.noise_um = noise_um;
+  o.seed = 4;
+  RtestSession s = simulate_rtest(random_table(rng), o).session;
+  s.noise_um = noise_um;
+  DiagnosisOptions opt;
+  opt.max_harmonic = 8;
+  const Diagnosis D = diagnose_rtest(s, opt);
+  CHECK(D.findings.empty());
+  for (const auto* structure : {&D.structure_before, &D.structure_after}) {
+    REQUIRE(structure->size() == 2);
+    for (const GroupResidual& g : *structure) {
+      INFO(g.group);
+      CHECK(g.angle_axis == 'C');
+      // Null data: the residual is the noise, so each order's cos/sin coefficient has a
+      // standard deviation of sigma sqrt(2/n); 5 of them bound the amplitude (P ~ 4e-6 each).
+      const double bound = 5.0 * noise_um * std::sqrt(2.0 / static_cast<double>(g.n));
+      CHECK(g.harmonic_um.size() == 5);
+      for (double h : g.harmonic_um) {
+        CHECK(std::isfinite(h));
+        CHECK(h < bound);
+      }
+      // The orders left out are named, with the reason.
+      CHECK(g.harmonics_left_out == std::vector<int>{6, 7, 8});
+      INFO(g.harmonic_note);
+      CHECK(g.harmonic_note.find("12 distinct angles") != std::string::npos);
+      CHECK(g.harmonic_note.find("Nyquist") != std::string::npos);
+    }
+  }
+  std::vector<std::string> unobservable;
+  for (const UnobservableEffect& u : D.unobservable) {
+    unobservable.push_back(u.effect);
+    if (Effect::parse(u.effect).harmonic > 0)
+      CHECK(u.reason.find("cannot resolve") != std::string::npos);
+  }
+  for (const char* id : {"angular_positioning_C_h6", "radial_motion_C_h7", "tilt_motion_C_h8",
+                         "axial_motion_B_h4", "tilt_motion_B_h8"})
+    CHECK(std::find(unobservable.begin(), unobservable.end(), id) != unobservable.end());
+  // Harmonic candidates the sampling cannot resolve are never scored.
+  for (const auto& round : D.rounds)
+    for (const CandidateScore& c : round) {
+      const Effect e = Effect::parse(c.effect);
+      INFO(c.effect);
+      CHECK(e.harmonic <= (e.axis == 'C' ? 5 : 3));
+    }
+}
+
+TEST_CASE("harmonic resolution: Nyquist on even turns, rank and conditioning otherwise",
+          "[diagnose]") {
+  const double deg = M_PI / 180.0;
+  auto grid = [&](double from, double step, int n, int repeats) {
+    std::vector<double> a;
+    for (int r = 0; r < repeats; ++r)
+      for (int i = 0; i < n; ++i) a.push_back((from + step * i) * deg);
+    return a;
+  };
+  // 12 angles 30 deg apart (an R-test's C), each read 21 times: orders 1..5 exactly.
+  HarmonicResolution R = resolve_harmonics(grid(0, 30, 12, 21), 'C', 8, 0.1);
+  CHECK(R.distinct_angles == 12);
+  CHECK(R.even_step_deg == Approx(30.0));
+  CHECK(R.resolved == 5);
+  for (int k = 1; k <= 8; ++k)
+    CHECK(R.new_content[static_cast<std::size_t>(k - 1)] == Approx(k < 6 ? 1.0 : 0.0).margin(1e-9));
+  CHECK(R.why_not(6).find("order 6 is that limit: its sine vanishes") != std::string::npos);
+  CHECK(R.why_not(7).find("same values there as order 5") != std::string::npos);
+  // Encoder jitter below 0.05 deg does not make new angles; 13 even angles resolve 1..6.
+  std::vector<double> jitter = grid(0, 30, 12, 3);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> U(-0.02 * deg, 0.02 * deg);
+  for (double& a : jitter) a += U(rng);
+  CHECK(resolve_harmonics(jitter, 'C', 8, 0.1).resolved == 5);
+  CHECK(resolve_harmonics(grid(0, 360.0 / 13, 13, 1), 'C', 8, 0.1).resolved == 6);
+  // A dense full turn (a ballbar's C test) resolves all 8 orders.
+  CHECK(resolve_harmonics(grid(0, 1, 360, 1), 'C', 8, 0.1).resolved == 8);
+  // 7 angles over a half turn (an R-test's B): 7 values fit orders 0..3 at most; order 3 has
+  // only ~9 % new content (a badly conditioned spectrum, still a distinct effect order).
+  R = resolve_harmonics(grid(-90, 30, 7, 24), 'B', 8, 0.01);
+  CHECK(R.even_step_deg == 0.0);
+  CHECK(R.span_deg == Approx(180.0));
+  CHECK(R.resolved == 3);
+  CHECK(R.why_not(4).find("needs at least 9 distinct angles") != std::string::npos);
+  CHECK(resolve_harmonics(grid(-90, 30, 7, 24), 'B', 8, 0.1).resolved == 2);
+  // Uneven full turn: the orders kept give a fit whose amplitudes the noise cannot blow up.
+  std::uniform_real_distribution<double> turn(0.0, 2 * M_PI);
+  std::vector<double> uneven;
+  for (int i = 0; i < 15; ++i) uneven.push_back(turn(rng));
+  R = resolve_harmonics(uneven, 'C', 8, 0.1);
+  CHECK(R.resolved <= 7);
+  Eigen::MatrixXd H(static_cast<Eigen::Index>(uneven.size()), 1 + 2 * R.resolved);
+  for (Eigen::Index i = 0; i < H.rows(); ++i) {
+    H(i, 0) = 1.0;
+    const double th = uneven[static_cast<std::size_t>(i)];
+    for (int k = 1; k <= R.resolved; ++k) {
+      H(i, 2 * k - 1) = M_SQRT2 * std::cos(k * th);
+      H(i, 2 * k) = M_SQRT2 * std::sin(k * th);
+    }
+  }
+  const Eigen::VectorXd sv = H.jacobiSvd().singularValues();
+  CHECK(sv[sv.size() - 1] > 0.0);
+  CHECK(sv[0] / sv[sv.size() - 1] < 1e3);
+  CHECK_THROWS_AS(resolve_harmonics(uneven, 'C', 8, 0.0), InvalidArgument);
+}

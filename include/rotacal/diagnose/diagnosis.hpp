@@ -8,14 +8,16 @@
 /// Jacobian; the engine does the statistics:
 ///  1. baseline fit; adequacy by chi-square against the noise (declared in the file, or
 ///     estimated from successive differences, which smooth systematic errors barely affect);
-///  2. residual structure per group (test or nest): RMS, harmonics in the rotary angle, trend;
+///  2. residual structure per group (test or nest): RMS, harmonics in the rotary angle (only
+///     the orders its angular sampling resolves, see HarmonicResolution), trend;
 ///  3. every candidate scored by a linearised refit from the current model (the model is
 ///     linear in um/urad-sized parameters to far below the noise): delta BIC, F-test with a
 ///     Bonferroni correction over the candidates, and blocked cross-validation (contiguous
 ///     blocks of each group left out in turn, so the extension must predict unseen angles);
 ///  4. the best significant candidate is added, the model refitted (nonlinear), and 3 repeats
 ///     until nothing significant is left;
-///  5. candidates the data cannot see are reported unobservable; candidates that explain the
+///  5. candidates the data cannot see, and *_hn candidates of an order the sampling of their
+///     axis cannot resolve (aliased), are reported unobservable; candidates that explain the
 ///     data as well as the chosen one are reported ambiguous; significant structure that is
 ///     left is reported unexplained with its signature.
 
@@ -78,7 +80,42 @@ struct DiagnosisOptions {
   /// 1 um/s, 1e-3 for ratios) beyond what the model absorbs changes chi-square by at least
   /// this much (25: a 5-sigma change); others are reported unobservable.
   double min_visible_chi2 = 25.0;
+  /// A *_hn candidate is scored only if its axis' sampled angles resolve order n (see
+  /// HarmonicResolution) with at least this new content: below it the order aliases onto the
+  /// lower ones (C every 30 deg: order 7 takes the values of order 5) and is reported
+  /// unobservable. Lenient on purpose: how well a resolvable order stands apart from the
+  /// others is judged with the noise, by the F-test, cross-validation and the ambiguity report.
+  double min_harmonic_new_content = 0.01;
 };
+
+/// Which harmonic orders of one rotary angle a set of readings resolves.
+///
+/// The design [1, cos k th, sin k th] (k = 1..max_order) is taken at the distinct angles
+/// (angles within 0.05 deg merged, each row weighted by the square root of its number of
+/// readings, so it has the normal matrix of the fit over all readings), with the columns scaled
+/// so that an evenly sampled full turn makes them orthonormal. The "new content" of order k is
+/// the smaller singular value of its (cos, sin) pair once the span of orders 0..k-1 is
+/// projected out: 1 for an even full turn, 1/sqrt(variance inflation) of the pair in general,
+/// 0 when the pair is rank-deficient against the lower orders. With N evenly spaced distinct
+/// angles over a full turn, order k has new content 1 for k < N/2 and 0 from N/2 on (Nyquist:
+/// order N/2 has a vanishing sine, order N-k takes the values of order k).
+struct HarmonicResolution {
+  char axis = 0;                    ///< angle the orders are in ('A', 'B' or 'C')
+  int max_order = 0;                ///< orders asked for
+  int distinct_angles = 0;          ///< after merging angles within 0.05 deg
+  double span_deg = 0.0;            ///< the smallest arc holding every angle, deg
+  double even_step_deg = 0.0;       ///< step of an evenly spaced full turn, deg (0: uneven)
+  double min_new_content = 0.0;     ///< threshold used
+  std::vector<double> new_content;  ///< of orders 1..max_order
+  int resolved = 0;                 ///< orders 1..resolved all have new content >= threshold
+  /// Why `order` (resolved < order <= max_order) is left out, in words.
+  std::string why_not(int order) const;
+};
+
+/// Resolution of harmonic orders 1..max_order in `angles_rad` (one per reading, any turn).
+/// Throws InvalidArgument if max_order < 0 or min_new_content is not in (0, 1].
+HarmonicResolution resolve_harmonics(const std::vector<double>& angles_rad, char axis,
+                                     int max_order, double min_new_content);
 
 /// Residual structure of one group.
 struct GroupResidual {
@@ -87,8 +124,12 @@ struct GroupResidual {
   double rms_um = 0.0;
   double mean_um = 0.0;
   char angle_axis = 0;                 ///< the rotary axis that varies in the group (0: none)
-  std::vector<double> harmonic_um;     ///< amplitude of orders 1..8 in that angle, um (only
-                                       ///< when it sweeps a full turn; empty otherwise)
+  std::vector<double> harmonic_um;     ///< amplitude of orders 1..K in that angle, um: only
+                                       ///< when it sweeps a full turn, and only the orders its
+                                       ///< sampling resolves (K <= 8; empty otherwise)
+  std::vector<int> harmonics_left_out; ///< orders K+1..8 not fitted: the sampling cannot
+                                       ///< resolve them (no amplitude is given for them)
+  std::string harmonic_note;           ///< why harmonics were left out, in words (empty if none)
   double trend_um_per_s = 0.0;         ///< least-squares slope against time
 };
 
@@ -175,8 +216,15 @@ struct Diagnosis {
 Diagnosis diagnose(const DiagnosisProblem& problem, const DiagnosisOptions& options = {});
 
 /// Residual structure of `residuals` (mm) grouped as the problem groups its readings.
+/// Harmonics of orders 1..max_order are fitted in a group's swept angle when it sweeps a full
+/// turn, up to the last order its sampling resolves with a new content of at least
+/// `min_new_content` (0.1: no order kept has its amplitude's noise inflated more than ~10x over
+/// an evenly sampled turn by the lower orders; a spectrum is a description, so orders that
+/// would mostly amplify the noise are left out). The orders left out, and why, are named in
+/// GroupResidual::harmonics_left_out and harmonic_note.
 std::vector<GroupResidual> residual_structure(const DiagnosisProblem& problem,
-                                              const Eigen::VectorXd& residuals);
+                                              const Eigen::VectorXd& residuals, int max_order = 8,
+                                              double min_new_content = 0.1);
 
 /// Noise estimate (um) from successive differences within each group, in time order:
 /// sigma^2 = sum (r_{i+1} - r_i)^2 / (2 (n - 1)).
