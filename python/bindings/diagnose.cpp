@@ -35,6 +35,8 @@ void bind_diagnose(pyb::module_& m) {
         return g.angle_axis ? std::string(1, g.angle_axis) : std::string();
       })
       .def_readonly("harmonic_um", &GroupResidual::harmonic_um)
+      .def_readonly("harmonics_left_out", &GroupResidual::harmonics_left_out)
+      .def_readonly("harmonic_note", &GroupResidual::harmonic_note)
       .def_readonly("trend_um_per_s", &GroupResidual::trend_um_per_s);
 
   pyb::class_<Gain>(m, "Gain")

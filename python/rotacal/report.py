@@ -260,6 +260,9 @@ def diagnosis_section(d: dict) -> str:
         src = harmonic_plot(d["residual_structure"][key], f"residual harmonics {title} the diagnosis")
         if src:
             out.append(_img(src, f"residual harmonics {title}", "diagnosis"))
+    notes = {g["harmonic_note"] for g in d["residual_structure"]["before"] if g.get("harmonic_note")}
+    for note in sorted(notes):
+        out.append(f"<p class=muted>{html.escape(note)}</p>")
     if d["unobservable"]:
         out.append("<details><summary>Effects this session cannot see</summary><ul>" +
                    "".join(f"<li>{u['effect']}: {html.escape(u['reason'])}</li>" for u in d["unobservable"]) +

@@ -126,4 +126,5 @@ class DiagnosisResult:
 def _group(g) -> dict:
     return {"group": g.group, "n": int(g.n), "rms_um": g.rms_um, "mean_um": g.mean_um,
             "angle_axis": g.angle_axis, "harmonic_um": list(g.harmonic_um),
+            "harmonics_left_out": list(g.harmonics_left_out), "harmonic_note": g.harmonic_note,
             "trend_um_per_s": g.trend_um_per_s}

@@ -276,3 +276,12 @@ def test_raw_probe_session_is_converted(tmp_path):
     # Direction errors of ~1 mrad on readings of ~50 um add < 0.1 um: still the noise level.
     err = np.asarray(calibrated.d) - rotacal.rtest.truth_readings(truth, s)
     assert np.sqrt(np.mean(err ** 2)) < 1.5 * expected
+
+
+def test_diagnosis_json_says_which_harmonics_the_sampling_cannot_resolve(shared_data):
+    # C every 30 deg resolves harmonics 1-5 only; 6-8 are left out with the reason, not numbers.
+    d = rotacal.diagnose(rotacal.load(shared_data / "rtest_bc_oyama.csv")).to_dict()
+    for g in d["residual_structure"]["before"]:
+        assert len(g["harmonic_um"]) == 5 and g["harmonics_left_out"] == [6, 7, 8]
+        assert all(0 <= a < 1.0 for a in g["harmonic_um"])  # um, finite
+        assert "left out" in g["harmonic_note"] and "12 distinct angles" in g["harmonic_note"]
