@@ -326,7 +326,6 @@ void VirtualRtest::serve_once() {
     if (!clock_running()) clock_start();  // polled: the program starts at the first request
     bool rest = false;
     const Eigen::Vector3d r = readings_at(now(), &rest);
-    if (now() > end) mark_finished();
     if (options_.mode == ProbeMode::sylvac) {
       const auto ch = parse_sylvac_request(line);
       send_reply(ch ? format_sylvac_reply(value(r[*ch - 1]))
@@ -344,6 +343,8 @@ void VirtualRtest::serve_once() {
       send_reply(format_keyence_reply(reply));
     }
   }
+  // Polled: the pattern has run once its last dwell is over, asked or not.
+  if (options_.mode != ProbeMode::stream && clock_running() && now() > end) mark_finished();
   if (!streaming_) return;
   const double t_now = now();
   int batch = 0;

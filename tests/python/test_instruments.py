@@ -38,14 +38,22 @@ class Virtual:
         return self.proc.communicate(timeout=30)
 
 
-def within_3_sigma(location_errors: dict, truth: dict):
-    checked = 0
+def within_3_sigma(location_errors: dict, truth: dict, allow_one_beyond: bool = False):
+    """Every observable estimate within 3 sigma of the truth. `allow_one_beyond`: for runs
+    whose noise is not reproducible (polled modes pace on the host clock, so the number of
+    readings per pose varies), one of the eight may lie between 3 and 4 sigma, the rate
+    at which eight honest estimates do that in a few per cent of runs."""
+    checked, beyond = 0, []
     for name, true in truth.items():
         p = location_errors[name]
         if p["value"] is None:  # unobservable: reported, not returned as a number
             continue
-        assert abs(p["value"] - true) <= 3 * p["std"], (name, p, true)
+        z = abs(p["value"] - true) / p["std"]
+        assert z <= 4, (name, p, true)
+        if z > 3:
+            beyond.append((name, z))
         checked += 1
+    assert len(beyond) <= (1 if allow_one_beyond else 0), beyond
     return checked
 
 
@@ -118,7 +126,8 @@ def test_record_rtest_cli_end_to_end(tmp_path, mode):
     ident = rotacal_cli("identify", tmp_path / "r.csv", "--json")
     assert ident.returncode == 0, ident.stderr
     truth = json.loads((tmp_path / "truth.json").read_text())
-    assert within_3_sigma(json.loads(ident.stdout)["location_errors"], truth["errors"]) >= 4
+    assert within_3_sigma(json.loads(ident.stdout)["location_errors"], truth["errors"],
+                          allow_one_beyond=mode != "stream") >= 4
 
 
 def test_python_api_records_and_identifies(tmp_path):
