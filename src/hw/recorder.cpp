@@ -43,6 +43,35 @@ struct DeviceClock {
   }
 };
 
+// Where a stream is: unwrapped time and last sequence number. A jump in sequence numbers is
+// counted and marked in the file; a sample whose time goes backwards is refused.
+struct StreamPosition {
+  DeviceClock clock;
+  std::optional<std::uint16_t> last_seq;
+  double last_t = 0.0;
+
+  template <typename Writer>
+  std::optional<double> advance(std::uint16_t seq, std::uint32_t t_us, Writer& out, RecordSummary& sum) {
+    const double t = clock.seconds(t_us);
+    if (last_seq) {
+      const int gap = sequence_gap(*last_seq, seq);
+      if (gap > 0) {
+        sum.lost += static_cast<std::size_t>(gap);
+        out.annotate("gap: " + std::to_string(gap) + " samples lost between seq " + std::to_string(*last_seq) +
+                     " and " + std::to_string(seq) + " (t=" + fixed(last_t, 4) + ".." + fixed(t, 4) + " s)");
+      }
+    }
+    last_seq = seq;
+    if (t < last_t) {
+      ++sum.malformed;
+      out.annotate("malformed: sample time " + fixed(t, 6) + " s goes backwards (seq " + std::to_string(seq) + ")");
+      return std::nullopt;
+    }
+    last_t = t;
+    return t;
+  }
+};
+
 // Bytes in, frames out across reads; counts what it had to skip.
 struct FrameReader {
   Bytes pending;
@@ -169,9 +198,8 @@ RecordSummary record_ballbar(ByteTransport& port, const ProgramTimeline& program
       finish(out, sum);
       return sum;
     }
-    DeviceClock clock;
-    std::optional<std::uint16_t> last_seq;
-    double last_t = 0.0, last_data = wall_seconds(), last_progress = 0.0;
+    StreamPosition stream;
+    double last_data = wall_seconds(), last_progress = 0.0;
     std::size_t garbage_since_data = 0;
     std::uint8_t buf[4096];
     for (;;) {
@@ -198,40 +226,24 @@ RecordSummary record_ballbar(ByteTransport& port, const ProgramTimeline& program
         if (!s) {
           ++sum.malformed;
           out.annotate("malformed: frame of type " + std::to_string(f.type) + " and " +
-                       std::to_string(f.payload.size()) + " bytes near t=" + fixed(last_t, 4) + " s");
+                       std::to_string(f.payload.size()) + " bytes near t=" + fixed(stream.last_t, 4) + " s");
           continue;
         }
         ++sum.frames;
-        const double t = clock.seconds(s->t_us);
-        if (last_seq) {
-          const int gap = sequence_gap(*last_seq, s->seq);
-          if (gap > 0) {
-            sum.lost += static_cast<std::size_t>(gap);
-            out.annotate("gap: " + std::to_string(gap) + " samples lost between seq " +
-                         std::to_string(*last_seq) + " and " + std::to_string(s->seq) + " (t=" +
-                         fixed(last_t, 4) + ".." + fixed(t, 4) + " s)");
-          }
-        }
-        last_seq = s->seq;
-        if (t < last_t) {
-          ++sum.malformed;
-          out.annotate("malformed: sample time " + fixed(t, 6) + " s goes backwards (seq " +
-                       std::to_string(s->seq) + ")");
-          continue;
-        }
-        last_t = t;
+        const auto t = stream.advance(s->seq, s->t_us, out, sum);
+        if (!t) continue;
         if (s->status & kStatusOverRange) {
           ++sum.over_range;
-          out.annotate("over range: seq " + std::to_string(s->seq) + " at t=" + fixed(t, 4) + " s");
+          out.annotate("over range: seq " + std::to_string(s->seq) + " at t=" + fixed(*t, 4) + " s");
           continue;
         }
-        BallbarSample row = program.at(t);
+        BallbarSample row = program.at(*t);
         row.length = L0 + 1e-6 * s->displacement_nm;
         out.append(row);
       }
       if (new_crc > 0)
         out.annotate("corrupt: " + std::to_string(new_crc) + " frames failed their checksum near t=" +
-                     fixed(last_t, 4) + " s");
+                     fixed(stream.last_t, 4) + " s");
       if (ended) {
         sum.reason = StopReason::end_of_program;
         guard.active = false;
@@ -245,7 +257,7 @@ RecordSummary record_ballbar(ByteTransport& port, const ProgramTimeline& program
       }
       if (opt.progress && now - last_progress >= opt.progress_interval_s) {
         last_progress = now;
-        if (!opt.progress({out.rows(), sum.lost, sum.crc_errors + sum.malformed, last_t, program.duration()})) {
+        if (!opt.progress({out.rows(), sum.lost, sum.crc_errors + sum.malformed, stream.last_t, program.duration()})) {
           sum.reason = StopReason::stopped;
           break;
         }
@@ -430,9 +442,8 @@ RecordSummary record_rtest(ByteTransport& port, ProbeMode mode, const RtestSessi
         finish(out, sum);
         return sum;
       }
-      DeviceClock clock;
-      std::optional<std::uint16_t> last_seq;
-      double last_t = 0.0, last_data = wall_seconds();
+      StreamPosition stream;
+      double last_data = wall_seconds();
       std::size_t garbage_since_data = 0;
       std::uint8_t buf[4096];
       for (;;) {
@@ -456,27 +467,17 @@ RecordSummary record_rtest(ByteTransport& port, ProbeMode mode, const RtestSessi
             continue;
           }
           ++sum.frames;
-          const double t = clock.seconds(s->t_us);
-          if (last_seq) {
-            const int gap = sequence_gap(*last_seq, s->seq);
-            if (gap > 0) {
-              sum.lost += static_cast<std::size_t>(gap);
-              out.annotate("gap: " + std::to_string(gap) + " samples lost between seq " +
-                           std::to_string(*last_seq) + " and " + std::to_string(s->seq) + " (t=" +
-                           fixed(last_t, 4) + ".." + fixed(t, 4) + " s)");
-            }
-          }
-          last_seq = s->seq;
-          last_t = t;
+          const auto t = stream.advance(s->seq, s->t_us, out, sum);
+          if (!t) continue;
           if (s->status) {
             ++sum.over_range;
             continue;
           }
-          poses.add(t, Eigen::Vector3d(1e-6 * s->nm[0], 1e-6 * s->nm[1], 1e-6 * s->nm[2]));
+          poses.add(*t, Eigen::Vector3d(1e-6 * s->nm[0], 1e-6 * s->nm[1], 1e-6 * s->nm[2]));
         }
         if (new_crc > 0)
           out.annotate("corrupt: " + std::to_string(new_crc) + " frames failed their checksum near t=" +
-                       fixed(last_t, 4) + " s");
+                       fixed(stream.last_t, 4) + " s");
         if (ended) {
           guard.active = false;
           poses.advance(1e300);
@@ -489,7 +490,7 @@ RecordSummary record_rtest(ByteTransport& port, ProbeMode mode, const RtestSessi
                        " bytes without a valid frame: wrong baud rate or not this protocol?";
           break;
         }
-        if (!progress(last_t)) {
+        if (!progress(stream.last_t)) {
           sum.reason = StopReason::stopped;
           break;
         }

@@ -135,15 +135,17 @@ void VirtualInstrument::send_frame(Bytes frame) {
     return;
   }
   if (faults_.silence_after >= 0 && static_cast<long>(k) > faults_.silence_after) silent_ = true;
-  std::lock_guard<std::mutex> lock(stats_mutex_);
-  if (faults_.drop_every > 0 && k % faults_.drop_every == 0) {
-    ++stats_.frames_dropped;
-    return;
+  if (silent_) return;
+  const bool drop = faults_.drop_every > 0 && k % faults_.drop_every == 0;
+  const bool corrupt = !drop && faults_.corrupt_every > 0 && k % faults_.corrupt_every == 0;
+  {
+    std::lock_guard<std::mutex> lock(stats_mutex_);  // not held while writing: a write may block
+    stats_.frames_dropped += drop;
+    stats_.frames_corrupted += corrupt;
+    stats_.frames_sent += !drop;
   }
-  if (faults_.corrupt_every > 0 && k % faults_.corrupt_every == 0) {
-    frame[4 + (k % (frame.size() - 6))] ^= 0x10;  // a payload bit
-    ++stats_.frames_corrupted;
-  }
+  if (drop) return;
+  if (corrupt) frame[4 + (k % (frame.size() - 6))] ^= 0x10;  // a payload bit
   if (faults_.split_frames) {
     const std::size_t half = frame.size() / 2;
     write_all(Bytes(frame.begin(), frame.begin() + static_cast<long>(half)));
@@ -154,7 +156,6 @@ void VirtualInstrument::send_frame(Bytes frame) {
   }
   if (faults_.garbage_every > 0 && k % faults_.garbage_every == 0)
     write_all(Bytes{0x13, 0xAA, 0x37, 0x00, 0xFF, 0x55, 0x42});
-  if (!silent_) ++stats_.frames_sent;
 }
 
 // --------------------------------------------------------------------------- ballbar
