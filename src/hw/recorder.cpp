@@ -139,6 +139,23 @@ std::optional<std::pair<StopReason, std::string>> handshake(ByteTransport& port,
   return std::make_pair(StopReason::silence, "no reply to '" + cmd + "' within " + fixed(timeout_s, 1) + " s");
 }
 
+// ID?, [ZERO,] RATE, START. False (reason and detail in `sum`) if the instrument does not
+// answer as it should; `guard` sends STOP later once START has gone out.
+bool start_stream(ByteTransport& port, FrameReader& reader, RecordSummary& sum, const RecordOptions& opt,
+                  bool zero, StreamGuard& guard) {
+  auto fail = handshake(port, reader, sum, format_command(BallbarCommand::identify), "ID ", 1.0);
+  if (!fail && zero) fail = handshake(port, reader, sum, format_command(BallbarCommand::zero), "OK ZERO", 1.0);
+  if (!fail) fail = handshake(port, reader, sum, format_command(BallbarCommand::rate, opt.rate_hz), "OK RATE", 1.0);
+  if (!fail) {
+    guard.active = true;
+    fail = handshake(port, reader, sum, format_command(BallbarCommand::start), "OK START", 1.0);
+  }
+  if (!fail) return true;
+  sum.reason = fail->first;
+  sum.detail = fail->second;
+  return false;
+}
+
 template <typename Writer>
 void finish(Writer& out, RecordSummary& sum) {
   sum.rows = out.rows();
@@ -184,17 +201,7 @@ RecordSummary record_ballbar(ByteTransport& port, const ProgramTimeline& program
   const double L0 = program.header().ballbar_length;
   try {
     port.flush_input();
-    std::optional<std::pair<StopReason, std::string>> fail =
-        handshake(port, reader, sum, format_command(BallbarCommand::identify), "ID ", 1.0);
-    if (!fail && opt.zero) fail = handshake(port, reader, sum, format_command(BallbarCommand::zero), "OK ZERO", 1.0);
-    if (!fail) fail = handshake(port, reader, sum, format_command(BallbarCommand::rate, opt.rate_hz), "OK RATE", 1.0);
-    if (!fail) {
-      guard.active = true;
-      fail = handshake(port, reader, sum, format_command(BallbarCommand::start), "OK START", 1.0);
-    }
-    if (fail) {
-      sum.reason = fail->first;
-      sum.detail = fail->second;
+    if (!start_stream(port, reader, sum, opt, opt.zero, guard)) {
       finish(out, sum);
       return sum;
     }
@@ -430,15 +437,7 @@ RecordSummary record_rtest(ByteTransport& port, ProbeMode mode, const RtestSessi
     port.flush_input();
     if (mode == ProbeMode::stream) {
       FrameReader reader;
-      auto fail = handshake(port, reader, sum, format_command(BallbarCommand::identify), "ID ", 1.0);
-      if (!fail) fail = handshake(port, reader, sum, format_command(BallbarCommand::rate, opt.rate_hz), "OK RATE", 1.0);
-      if (!fail) {
-        guard.active = true;
-        fail = handshake(port, reader, sum, format_command(BallbarCommand::start), "OK START", 1.0);
-      }
-      if (fail) {
-        sum.reason = fail->first;
-        sum.detail = fail->second;
+      if (!start_stream(port, reader, sum, opt, false, guard)) {
         finish(out, sum);
         return sum;
       }

@@ -11,13 +11,16 @@ FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-
          "--disable-background-networking", "--disable-component-update", "--disable-sync"]
 
 
-@pytest.fixture(scope="module")
-def report(shared_data, tmp_path_factory):
-    out = tmp_path_factory.mktemp("report") / "report.html"
-    r = subprocess.run([sys.executable, "-m", "rotacal", "report", str(shared_data / "ballbar_ac_table2.csv"),
-                        "-o", str(out)], capture_output=True, text=True, timeout=300)
+def write_report(session, out):
+    r = subprocess.run([sys.executable, "-m", "rotacal", "report", str(session), "-o", str(out)],
+                       capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr
     return out
+
+
+@pytest.fixture(scope="module")
+def report(shared_data, tmp_path_factory):
+    return write_report(shared_data / "ballbar_ac_table2.csv", tmp_path_factory.mktemp("report") / "report.html")
 
 
 def test_report_is_self_contained(report):
@@ -44,11 +47,7 @@ def test_report_renders_in_chromium(report, tmp_path):
 
 @pytest.fixture(scope="module")
 def rtest_report(shared_data, tmp_path_factory):
-    out = tmp_path_factory.mktemp("rtest_report") / "report.html"
-    r = subprocess.run([sys.executable, "-m", "rotacal", "report", str(shared_data / "rtest_bc_oyama.csv"),
-                        "-o", str(out)], capture_output=True, text=True, timeout=300)
-    assert r.returncode == 0, r.stderr
-    return out
+    return write_report(shared_data / "rtest_bc_oyama.csv", tmp_path_factory.mktemp("rtest_report") / "report.html")
 
 
 def test_rtest_report_is_self_contained(rtest_report):
