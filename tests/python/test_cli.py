@@ -104,6 +104,18 @@ def test_examples_run(shared_data, script, args):
     assert r.stdout.strip()
 
 
+def test_plan_example_writes_every_dialect(tmp_path):
+    r = subprocess.run([sys.executable, str(ROOT / "examples" / "plan_ballbar_test.py"), str(tmp_path)],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    for name in ("ballbar_test.ngc", "ballbar_test.h", "ballbar_test.mpf", "ballbar_test.nc"):
+        assert (tmp_path / name).stat().st_size > 10_000, name
+    assert "FUNCTION TCPM" in (tmp_path / "ballbar_test.h").read_text()
+    from rotacal import load
+    session = load(tmp_path / "commanded.csv")
+    assert len(session) > 1000 and "radial_C" in r.stdout
+
+
 def test_readme_python_example_runs(shared_data, tmp_path):
     text = (ROOT / "README.md").read_text()
     blocks = re.findall(r"```python\n(.*?)```", text, re.S)
