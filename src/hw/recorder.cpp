@@ -156,6 +156,20 @@ bool start_stream(ByteTransport& port, FrameReader& reader, RecordSummary& sum, 
   return false;
 }
 
+// After each read of a stream: mark checksum failures in the file, and give up (true, reason
+// no_valid_data) when too many bytes have passed without a valid frame.
+template <typename Writer>
+bool check_link(Writer& out, RecordSummary& sum, std::size_t new_crc, std::size_t garbage_since_data,
+                double t, const RecordOptions& opt) {
+  if (new_crc > 0)
+    out.annotate("corrupt: " + std::to_string(new_crc) + " frames failed their checksum near t=" + fixed(t, 4) +
+                 " s");
+  if (garbage_since_data <= opt.max_garbage_without_data) return false;
+  sum.reason = StopReason::no_valid_data;
+  sum.detail = std::to_string(garbage_since_data) + " bytes without a valid frame: wrong baud rate or not this protocol?";
+  return true;
+}
+
 template <typename Writer>
 void finish(Writer& out, RecordSummary& sum) {
   sum.rows = out.rows();
@@ -248,20 +262,13 @@ RecordSummary record_ballbar(ByteTransport& port, const ProgramTimeline& program
         row.length = L0 + 1e-6 * s->displacement_nm;
         out.append(row);
       }
-      if (new_crc > 0)
-        out.annotate("corrupt: " + std::to_string(new_crc) + " frames failed their checksum near t=" +
-                     fixed(stream.last_t, 4) + " s");
+      const bool link_lost = check_link(out, sum, new_crc, garbage_since_data, stream.last_t, opt);
       if (ended) {
         sum.reason = StopReason::end_of_program;
         guard.active = false;
         break;
       }
-      if (garbage_since_data > opt.max_garbage_without_data) {
-        sum.reason = StopReason::no_valid_data;
-        sum.detail = std::to_string(garbage_since_data) +
-                     " bytes without a valid frame: wrong baud rate or not this protocol?";
-        break;
-      }
+      if (link_lost) break;
       if (opt.progress && now - last_progress >= opt.progress_interval_s) {
         last_progress = now;
         if (!opt.progress({out.rows(), sum.lost, sum.crc_errors + sum.malformed, stream.last_t, program.duration()})) {
@@ -474,21 +481,14 @@ RecordSummary record_rtest(ByteTransport& port, ProbeMode mode, const RtestSessi
           }
           poses.add(*t, Eigen::Vector3d(1e-6 * s->nm[0], 1e-6 * s->nm[1], 1e-6 * s->nm[2]));
         }
-        if (new_crc > 0)
-          out.annotate("corrupt: " + std::to_string(new_crc) + " frames failed their checksum near t=" +
-                       fixed(stream.last_t, 4) + " s");
+        const bool link_lost = check_link(out, sum, new_crc, garbage_since_data, stream.last_t, opt);
         if (ended) {
           guard.active = false;
           poses.advance(1e300);
           sum.reason = StopReason::end_of_program;
           break;
         }
-        if (garbage_since_data > opt.max_garbage_without_data) {
-          sum.reason = StopReason::no_valid_data;
-          sum.detail = std::to_string(garbage_since_data) +
-                       " bytes without a valid frame: wrong baud rate or not this protocol?";
-          break;
-        }
+        if (link_lost) break;
         if (!progress(stream.last_t)) {
           sum.reason = StopReason::stopped;
           break;
