@@ -5,7 +5,8 @@
 set -euo pipefail
 
 APT_PACKAGES=(build-essential cmake ninja-build pkg-config libeigen3-dev libceres-dev catch2
-              libserialport-dev clang libclang-rt-14-dev linuxcnc-uspace chromium)
+              libserialport-dev clang libclang-rt-14-dev linuxcnc-uspace chromium
+              nlohmann-json3-dev stress-ng)
 missing=()
 for p in "${APT_PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -20,4 +21,4 @@ fi
 PY=${PYTHON:-python3}
 "$PY" -m pip install -q --disable-pip-version-check \
   "numpy>=1.22" "matplotlib>=3.5" "scipy>=1.9" "pytest>=7" \
-  "pybind11>=2.11" "scikit-build-core>=0.10"
+  "pybind11>=2.11" "scikit-build-core>=0.10" "pybind11-stubgen==2.5.5"
