@@ -698,11 +698,21 @@ def _conclusions(r: dict) -> list[str]:
                        + (f" (largest change between runs at a plausible size: {v['between_runs']['largest_at_plausible_size']:.2f}"
                           f" {v['unit']}, {v['between_runs']['by']})" if v["verdict"] == "no single cause at a plausible size" else "")
                        + ".")
+    for g in r["ambiguous"]:
+        out.append(f"Not told apart by the 8 values: {', '.join(g['candidates'])}; "
+                   + (f"run 2's raw {g['separating_test']} data would separate them." if g["raw_data_separates"]
+                      else "no test of the session separates them; " + "; ".join(g["further_measurement"]) + "."))
+    if any(c["kind"] == "between_runs" for c in r["ranked_causes"][:1]):
+        out.append("A repeated uncompensated run after the same interval tells every change between the runs "
+                   "from a constant effect: a change moves its before-values by the size it adds after compensation "
+                   "(ranked_causes[].repeat_uncompensated_shift), a constant effect does not move them.")
     e = r["extended_model"]
     for u, t in e["sum_abs_unexplained"].items():
         out.append(f"Extended model ({len(e['causes'])} causes at plausible sizes) accounts for {t['accounted_for']:.2f} "
                    f"of {t['baseline']:.2f} {u} (sum of |measured - predicted| over the {u} values); "
                    f"{t['extended']:.2f} {u} remain.")
+    if not r["sweep"]:
+        return out
     stable = [s["scenario"] for s in r["sweep"] if set(s["outside"]) == set(r["outside"])]
     out.append(f"The same values fall outside in {len(stable)} of {len(r['sweep'])} swept scenarios"
                + (f" (differs in: {', '.join(s['scenario'] for s in r['sweep'] if s['scenario'] not in stable)})."
@@ -767,7 +777,3 @@ def render(r: dict) -> str:
     L += [f"- {c}" for c in r["conclusions"]]
     return "\n".join(L)
 
-
-def main_text(draws: int = 200, seed: int = 1) -> str:
-    """The Table 2 analysis with the default assumptions, as text."""
-    return render(analyse(draws=draws, seed=seed))
