@@ -1,6 +1,7 @@
 // Bindings for include/rotacal/io: session classes with numpy columns, readers and writers.
 #include "numpy.hpp"
 #include "rotacal/io/ballbar_file.hpp"
+#include "rotacal/io/output_file.hpp"
 #include "rotacal/io/session_arrays.hpp"
 
 namespace rotacal::py {
@@ -71,6 +72,31 @@ void bind_io(pyb::module_& m) {
   m.def("write_rtest", &write_rtest, pyb::arg("session"), pyb::arg("path"));
   m.def("format_ballbar", &format_ballbar, pyb::arg("session"));
   m.def("format_rtest", &format_rtest, pyb::arg("session"));
+
+  // The output rule (rotacal/io/output_file.hpp). The GIL is released: a FIFO blocks until read.
+  m.def(
+      "write_output",
+      [](const std::string& path, const pyb::bytes& data, const std::vector<std::string>& inputs,
+         const std::vector<std::string>& other_outputs) {
+        std::string text = data;
+        pyb::gil_scoped_release release;
+        write_output(path, text, OutputOptions{inputs, other_outputs});
+      },
+      pyb::arg("path"), pyb::arg("data"), pyb::arg("inputs") = std::vector<std::string>{},
+      pyb::arg("other_outputs") = std::vector<std::string>{},
+      "Write bytes to path: regular files replaced atomically, devices and FIFOs written through; "
+      "a directory, an input or another output is refused (IoError).");
+  m.def(
+      "check_output",
+      [](const std::string& path, const std::vector<std::string>& inputs,
+         const std::vector<std::string>& other_outputs) {
+        return check_output(path, OutputOptions{inputs, other_outputs}) == OutputKind::WriteThrough
+                   ? "write-through"
+                   : "replace";
+      },
+      pyb::arg("path"), pyb::arg("inputs") = std::vector<std::string>{},
+      pyb::arg("other_outputs") = std::vector<std::string>{},
+      "Check an output path without writing: 'replace' or 'write-through'; raises IoError.");
 }
 
 }  // namespace rotacal::py

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from . import _core
+from .outputs import write_output
 
 FORMAT = "rotacal-model/1"
 
@@ -89,12 +90,9 @@ def ballbar_model_from_dict(d: dict, source: str = "<model>") -> _core.BallbarMa
     return _core.BallbarMachineModel(machine, errors, pivot, ids, params)
 
 
-def save_model(model: dict, path: str | Path) -> None:
-    """Write a model dict as JSON (to a temporary file first, so a crash never leaves half a file)."""
-    path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(json.dumps(model, indent=2) + "\n")
-    tmp.replace(path)
+def save_model(model: dict, path: str | Path, inputs: tuple = (), other_outputs: tuple = ()) -> None:
+    """Write a model dict as strict JSON by the output rule (rotacal.outputs.write_output)."""
+    write_output(path, json.dumps(model, indent=2) + "\n", inputs, other_outputs)
 
 
 def load_model(path: str | Path) -> dict:

@@ -1,3 +1,4 @@
+// rotacal-ballbar/1 and rotacal-rtest/1 session files: strict readers, exact writers, appending writers.
 #include <algorithm>
 #include <cerrno>
 #include <charconv>
@@ -8,6 +9,7 @@
 #include <sstream>
 
 #include "rotacal/io/ballbar_file.hpp"
+#include "rotacal/io/output_file.hpp"
 
 namespace rotacal {
 
@@ -236,22 +238,6 @@ std::ifstream open_for_reading(const std::string& path) {
   return in;
 }
 
-void write_atomically(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
-  std::FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (!f) throw IoError(path + ": cannot open for writing: " + std::strerror(errno));
-  const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size() && std::fflush(f) == 0;
-  const bool closed = std::fclose(f) == 0;
-  if (!ok || !closed) {
-    std::remove(tmp.c_str());
-    throw IoError(path + ": write failed: " + std::strerror(errno));
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    throw IoError(path + ": cannot replace: " + std::strerror(errno));
-  }
-}
-
 std::string vec_text(const Eigen::Vector3d& v) {
   return format_number(v.x()) + ", " + format_number(v.y()) + ", " + format_number(v.z());
 }
@@ -426,7 +412,7 @@ std::string format_ballbar(const BallbarSession& s) {
 }
 
 void write_ballbar(const BallbarSession& s, const std::string& path) {
-  write_atomically(path, format_ballbar(s));
+  write_output(path, format_ballbar(s));
 }
 
 // ---------------------------------------------------------------- R-test
@@ -521,7 +507,7 @@ std::string format_rtest(const RtestSession& s) {
          });
 }
 
-void write_rtest(const RtestSession& s, const std::string& path) { write_atomically(path, format_rtest(s)); }
+void write_rtest(const RtestSession& s, const std::string& path) { write_output(path, format_rtest(s)); }
 
 AnySession read_session(const std::string& path) {
   std::ifstream in = open_for_reading(path);

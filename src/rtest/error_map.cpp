@@ -1,3 +1,4 @@
+// R-test error maps (Oyama & Ibaraki): tabulated from the paper method, written as CSV and JSON.
 #include "rotacal/rtest/error_map.hpp"
 
 #include <cmath>
@@ -6,6 +7,7 @@
 #include <sstream>
 
 #include "rotacal/core/error.hpp"
+#include "rotacal/io/output_file.hpp"
 
 namespace rotacal {
 
@@ -106,10 +108,7 @@ std::string error_map_json(const RtestErrorMap& map) {
 }
 
 void write_text_file(const std::string& path, const std::string& text) {
-  std::ofstream f(path);
-  if (!f) throw IoError(path + ": cannot open for writing");
-  f << text;
-  if (!f) throw IoError(path + ": write failed");
+  write_output(path, text);
 }
 
 double prediction_rms_um(const RtestSession& session, const RtestPredictor& predict) {

@@ -18,8 +18,9 @@ namespace rotacal {
 BallbarSession read_ballbar(const std::string& path);
 /// Parse a ballbar session from a stream; `name` is used in error messages.
 BallbarSession parse_ballbar(std::istream& in, const std::string& name);
-/// Write a ballbar session (to a temporary file, then renamed over `path`); throws IoError
-/// naming the path, InvalidArgument for a session that breaks the format.
+/// Write a ballbar session by the output rule of rotacal/io/output_file.hpp (regular files
+/// replaced atomically, devices written through); throws IoError naming the path,
+/// InvalidArgument for a session that breaks the format.
 void write_ballbar(const BallbarSession& session, const std::string& path);
 /// The file text of a session.
 std::string format_ballbar(const BallbarSession& session);
