@@ -6,7 +6,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Ambiguity', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'CandidateScore', 'CircleFit', 'CompensationReport', 'CompensationRow', 'DegenerateGeometry', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'FaultInjection', 'Finding', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'MachineType', 'ModelFit', 'NcDialect', 'NcProgramOptions', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestJointIdentification', 'RtestJointModel', 'RtestPaperIdentification', 'RtestSession', 'SegmentKind', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TransitionArc', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'compensate_commands', 'compensate_sphere_offset', 'default_ballbar_tests', 'default_calibration_moves', 'diagnose_ballbar', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'format_ballbar', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'parse_ballbar_test', 'parse_machine_type', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'test_label', 'verify_compensation', 'write_ballbar', 'write_nc_program', 'write_rtest']
+__all__: list[str] = ['Ambiguity', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'CandidateScore', 'CircleFit', 'CompensationReport', 'CompensationRow', 'DegenerateGeometry', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'FaultInjection', 'Finding', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'MachineType', 'ModelFit', 'NcDialect', 'NcProgramOptions', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestJointIdentification', 'RtestJointModel', 'RtestPaperIdentification', 'RtestSession', 'SegmentKind', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TransitionArc', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_output', 'compensate_commands', 'compensate_sphere_offset', 'default_ballbar_tests', 'default_calibration_moves', 'diagnose_ballbar', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'format_ballbar', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'parse_ballbar_test', 'parse_machine_type', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'test_label', 'verify_compensation', 'write_ballbar', 'write_nc_program', 'write_output', 'write_rtest']
 class Ambiguity:
     @property
     def correlation(self) -> float:
@@ -1292,6 +1292,10 @@ def calibrate_sphere_offset(dirs: typing.Annotated[numpy.typing.ArrayLike, numpy
     """
     Sphere offset from spindle indexing: angles (N,) rad, readings (N, 3) mm.
     """
+def check_output(path: str, inputs: collections.abc.Sequence[str] = [], other_outputs: collections.abc.Sequence[str] = []) -> str:
+    """
+    Check an output path without writing: 'replace' or 'write-through'; raises IoError.
+    """
 def compensate_commands(nominal: BallbarSession, identified: ..., machine: MachineType) -> BallbarSession:
     ...
 def compensate_sphere_offset(session: RtestSession, offset: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> RtestSession:
@@ -1517,5 +1521,9 @@ def write_nc_program(plan: BallbarPlan, dialect: NcDialect, options: NcProgramOp
 @typing.overload
 def write_nc_program(plan: BallbarPlan, dialect: str, options: NcProgramOptions = ...) -> str:
     ...
+def write_output(path: str, data: bytes, inputs: collections.abc.Sequence[str] = [], other_outputs: collections.abc.Sequence[str] = []) -> None:
+    """
+    Write bytes to path: regular files replaced atomically, devices and FIFOs written through; a directory, an input or another output is refused (IoError).
+    """
 def write_rtest(session: RtestSession, path: str) -> None:
     ...

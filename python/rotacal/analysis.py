@@ -50,14 +50,15 @@ def predict_session(model: Mapping, session: Any, probe_zeros: str = "none",
 
 
 def write_report(path: str | Path, session: Any, method: str = "joint", with_diagnosis: bool = True,
-                 source: str = "") -> Path:
-    """The HTML report of a session (rotacal.report): identification, plots and diagnosis."""
+                 source: str = "", inputs: Sequence[str] = ()) -> Path:
+    """The HTML report of a session (rotacal.report): identification, plots and diagnosis,
+    written by the output rule (``inputs`` of the command are refused as the target)."""
     from . import report  # draws: matplotlib is imported only here
 
     def ballbar_report():
         ident = ballbar.identify(session, method)
         d = diagnose(session) if with_diagnosis else None
-        return report.ballbar_report(path, session, ident, d, source=source)
+        return report.ballbar_report(path, session, ident, d, source=source, inputs=inputs)
 
     def rtest_report():
         if method != "joint":
@@ -66,16 +67,19 @@ def write_report(path: str | Path, session: Any, method: str = "joint", with_dia
         s, _ = rtest.with_displacements(session)  # raw d1,d2,d3 with the file's probe.N.dir (identify notes it too)
         ident = rtest.identify_rtest(s, "joint")
         d = diagnose(s) if with_diagnosis else None
-        return report.rtest_report(path, s, ident, d, source=source)
+        return report.rtest_report(path, s, ident, d, source=source, inputs=inputs)
 
     return by_kind(session, {BALLBAR: ballbar_report, RTEST: rtest_report}, "report")()
 
 
-def write_diagnosis_report(path: str | Path, session: Any, result: Any, source: str = "") -> Path:
+def write_diagnosis_report(path: str | Path, session: Any, result: Any, source: str = "",
+                           inputs: Sequence[str] = ()) -> Path:
     """``diagnose --report``: the ballbar report with this diagnosis, or the diagnosis alone (R-test)."""
     from . import report
 
     return by_kind(session, {
-        BALLBAR: lambda: report.ballbar_report(path, session, ballbar.identify(session), result, source=source),
-        RTEST: lambda: report.diagnosis_report(path, result.to_dict(), title="R-test diagnosis", source=source),
+        BALLBAR: lambda: report.ballbar_report(path, session, ballbar.identify(session), result, source=source,
+                                               inputs=inputs),
+        RTEST: lambda: report.diagnosis_report(path, result.to_dict(), title="R-test diagnosis", source=source,
+                                               inputs=inputs),
     }, "diagnose --report")()

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 import time
 from pathlib import Path
@@ -16,6 +17,7 @@ from typing import Any, Callable, Sequence
 from . import _core, jsontext, rtest
 from .diagnosis import MAX_HARMONIC
 from .machines import BALLBAR_NOISE_UM, PIVOT_ERROR_MM
+from .outputs import check_output, write_output
 from .sessions import BALLBAR, RTEST, by_kind, checked_path, load, save
 
 EXIT_OK, EXIT_USAGE, EXIT_INPUT, EXIT_IO, EXIT_ERROR = 0, 2, 3, 4, 5
@@ -104,6 +106,15 @@ def errors_option(text: str) -> Any:
     return out
 
 
+def check_outputs(outputs: Sequence[str | None], inputs: Sequence[str | None] = ()) -> None:
+    """Refuse, before any work, an output path the output rule refuses (rotacal.outputs): a
+    directory, a missing folder, one of the command's inputs or another of its outputs."""
+    ins = [i for i in inputs if i]
+    outs = [o for o in outputs if o]
+    for k, o in enumerate(outs):
+        check_output(o, ins, outs[:k] + outs[k + 1:])
+
+
 # ------------------------------------------------------------------------- plan and set-up
 
 def _add_setup_args(p: argparse.ArgumentParser) -> None:
@@ -149,6 +160,7 @@ def _setup(a: argparse.Namespace) -> Any:
 
 def cmd_plan(a: argparse.Namespace) -> int:
     from .models import ballbar_model_from_dict, load_model
+    check_outputs([a.output, a.session], [a.compensate])
     setup = _setup(a)
     identified = None
     if a.compensate:
@@ -158,11 +170,11 @@ def cmd_plan(a: argparse.Namespace) -> int:
         identified = model.errors
     plan = _core.plan_ballbar_test(setup, identified)
     text = _core.write_nc_program(plan, _core.parse_nc_dialect(a.dialect))
-    Path(a.output).write_text(text)
+    write_output(a.output, text, [a.compensate] if a.compensate else [], [a.session] if a.session else [])
     _say(f"wrote {a.output}: {a.dialect} program, {plan.num_samples} points, {plan.duration:.0f} s"
          + (" (compensated)" if identified is not None else ""))
     if a.session:
-        save(plan.commanded_session(), a.session)
+        save(plan.commanded_session(), a.session, [a.compensate], [a.output])
         _say(f"wrote {a.session}: the commanded rows as a session template")
     return EXIT_OK
 
@@ -179,19 +191,20 @@ def _truth(a: argparse.Namespace, setup: Any) -> dict:
                          pivot_error_mm=a.pivot_error, noise_um=a.noise, seed=a.seed)
 
 
-def _write_truth(truth: dict, path: str) -> None:
-    Path(path).write_text(jsontext.dumps(truth) + "\n")
+def _write_truth(truth: dict, path: str, other_outputs: Sequence[str | None] = ()) -> None:
+    write_output(path, jsontext.dumps(truth) + "\n", other_outputs=[o for o in other_outputs if o])
 
 
 def cmd_simulate(a: argparse.Namespace) -> int:
     from .machines import simulate_ballbar_test
+    check_outputs([a.output, a.truth])
     setup = _setup(a)
     truth = _truth(a, setup)
     session, model = simulate_ballbar_test(setup, truth)
-    save(session, a.output)
+    save(session, a.output, other_outputs=[a.truth])
     truth["pivot_actual"] = model.pivot.tolist()
     if a.truth:
-        _write_truth(truth, a.truth)
+        _write_truth(truth, a.truth, [a.output])
     _say(f"wrote {a.output}: {len(session)} samples on a simulated {_core.machine_name(setup.machine)}"
          + (f", truth in {a.truth}" if a.truth else ""))
     return EXIT_OK
@@ -223,7 +236,8 @@ def _rtest_inputs(a: argparse.Namespace) -> dict:
 
 
 def cmd_simulate_rtest(a: argparse.Namespace) -> int:
-    from . import rtest
+    truth_path = a.truth if a.truth else str(Path(a.output).with_suffix(".truth.json"))
+    check_outputs([a.output, truth_path])
     r = _rtest_inputs(a)
     b_deg, c_deg, nests, dirs = r["b_deg"], r["c_deg"], r["nests"], r["probe_dirs"]
     if dirs is None and a.raw_only:
@@ -232,9 +246,8 @@ def cmd_simulate_rtest(a: argparse.Namespace) -> int:
                                           nests=nests, noise_um=a.noise, probe_zero_um=a.probe_zero,
                                           probe_dirs=dirs, write_d=not a.raw_only, dwell_s=a.dwell,
                                           seed=a.seed)
-    save(session, a.output)
-    truth_path = Path(a.truth) if a.truth else Path(a.output).with_suffix(".truth.json")
-    rtest.save_truth(truth, truth_path)
+    save(session, a.output, other_outputs=[truth_path])
+    rtest.save_truth(truth, truth_path, other_outputs=[a.output])
     _say(f"wrote {a.output}: {len(session)} poses ({len(b_deg)} B x {len(c_deg)} C x {len(nests)} nests) "
          f"on a simulated {a.machine}, truth in {truth_path}")
     return EXIT_OK
@@ -268,6 +281,7 @@ def _print_identification(d: dict) -> None:
 
 def cmd_identify(a: argparse.Namespace) -> int:
     from .analysis import identify
+    check_outputs([a.save_model], [a.file])
     s = load(a.file)
     result = identify(s, a.method, fit_length_offset=a.length_offset)
     d = result.to_dict()
@@ -278,7 +292,7 @@ def cmd_identify(a: argparse.Namespace) -> int:
         from .models import save_model
         model = result.model_dict()
         jsontext.require_finite(model, f"--save-model {a.save_model}")
-        save_model(model, a.save_model)
+        save_model(model, a.save_model, inputs=(a.file,))
         _say(f"wrote {a.save_model}")
     if by_kind(s, {BALLBAR: a.json, RTEST: True}, "identify"):
         print(jsontext.dumps(d))
@@ -310,12 +324,13 @@ def _print_diagnosis(d: dict) -> None:
 
 def cmd_diagnose(a: argparse.Namespace) -> int:
     from .diagnosis import diagnose
+    check_outputs([a.report], [a.file])
     s = load(a.file)
     result = diagnose(s, max_harmonic=a.max_harmonic)
     d = result.to_dict()
     if a.report:
         from .analysis import write_diagnosis_report
-        write_diagnosis_report(a.report, s, result, source=a.file)
+        write_diagnosis_report(a.report, s, result, source=a.file, inputs=[a.file])
         _say(f"wrote {a.report}")
     if a.json:
         print(jsontext.dumps(d))
@@ -327,12 +342,13 @@ def cmd_diagnose(a: argparse.Namespace) -> int:
 def cmd_predict(a: argparse.Namespace) -> int:
     from .analysis import predict_session
     from .models import load_model
+    check_outputs([a.output], [a.session, a.model])
     model_dict = load_model(a.model)
     s = load(a.session)
     out, line = predict_session(model_dict, s, a.probe_zeros, source=a.model)
     if line:
         _say(line)
-    save(out, a.output)
+    save(out, a.output, inputs=[a.session, a.model])
     _say(f"wrote {a.output}")
     return EXIT_OK
 
@@ -347,12 +363,14 @@ def _print_compensation(rows: list[dict]) -> None:
 def cmd_compensate(a: argparse.Namespace) -> int:
     if not a.model and not a.verify:
         raise OptionError("compensate: give --model MODEL.json (write a program) and/or --verify")
+    if a.model:
+        check_outputs([a.output], [a.model])
     setup = _setup(a)
     if a.model:
         from .models import ballbar_model_from_dict, load_model
         model = ballbar_model_from_dict(load_model(a.model), a.model)
         plan = _core.plan_ballbar_test(setup, model.errors)
-        Path(a.output).write_text(_core.write_nc_program(plan, _core.parse_nc_dialect(a.dialect)))
+        write_output(a.output, _core.write_nc_program(plan, _core.parse_nc_dialect(a.dialect)), [a.model])
         _say(f"wrote {a.output}: compensated {a.dialect} program")
     if a.verify:
         from .ballbar import compensation_table
@@ -371,8 +389,9 @@ def cmd_compensate(a: argparse.Namespace) -> int:
 
 def cmd_report(a: argparse.Namespace) -> int:
     from .analysis import write_report
+    check_outputs([a.output], [a.file])
     s = load(a.file)
-    out = write_report(a.output, s, a.method, with_diagnosis=not a.no_diagnosis, source=a.file)
+    out = write_report(a.output, s, a.method, with_diagnosis=not a.no_diagnosis, source=a.file, inputs=[a.file])
     print(Path(out).resolve())
     return EXIT_OK
 
@@ -701,19 +720,42 @@ def _join_signed_values(argv: Sequence[str]) -> list[str]:
     return out
 
 
+def _message(e: BaseException, limit: int = 2000) -> str:
+    """An error message fit for a terminal: bounded (a file's line may be megabytes long)."""
+    text = str(e)
+    return text if len(text) <= limit else text[:limit] + f"... ({len(text) - limit} more characters)"
+
+
 def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; returns the exit code. Every failure ends in a one-line message
+    and the documented code, never a traceback (ROTACAL_TRACEBACK=1 shows it for debugging)."""
     argv = list(sys.argv[1:] if argv is None else argv)
     try:
         args = build_parser().parse_args(_join_signed_values(argv))
         return args.func(args)
     except (OptionError, _core.ParseError, _core.InvalidArgument, _core.DegenerateGeometry) as e:
-        _say(f"rotacal: error: {e}")
+        _say(f"rotacal: error: {_message(e)}")
         return EXIT_INPUT
-    except (_core.IoError, OSError) as e:
-        _say(f"rotacal: error: {e}")
+    except UnicodeError as e:  # text that is not UTF-8 where the reader did not say so itself
+        _say(f"rotacal: error: input is not UTF-8 text: {_message(e)}")
+        return EXIT_INPUT
+    except (_core.IoError, OSError, MemoryError) as e:
+        _say(f"rotacal: error: {_message(e) or type(e).__name__}")
         return EXIT_IO
     except _core.Error as e:
-        _say(f"rotacal: error: {e}")
+        _say(f"rotacal: error: {_message(e)}")
+        return EXIT_ERROR
+    except KeyboardInterrupt:
+        _say("rotacal: interrupted")
+        return 130
+    except Exception as e:  # a bug: say what and where, without a traceback
+        if os.environ.get("ROTACAL_TRACEBACK"):
+            raise
+        tb = e.__traceback__
+        while tb is not None and tb.tb_next is not None:
+            tb = tb.tb_next
+        where = f" at {Path(tb.tb_frame.f_code.co_filename).name}:{tb.tb_lineno}" if tb else ""
+        _say(f"rotacal: internal error ({type(e).__name__}{where}): {_message(e)}")
         return EXIT_ERROR
 
 

@@ -1,16 +1,16 @@
 """The whole job on a simulated machine: plan, simulate, identify, diagnose, compensate and report (``rotacal demo``)."""
 from __future__ import annotations
 
-import json
 import time
 from pathlib import Path
 from typing import Callable
 
-from . import _core
+from . import _core, jsontext
 from .ballbar import compensation_table, identify
 from .diagnosis import diagnose
 from .machines import ballbar_truth, simulate_ballbar_test
 from .models import save_model
+from .outputs import write_output
 from .sessions import save
 
 STEPS = 6
@@ -29,14 +29,14 @@ def compensation_section(rows: list[dict]) -> str:
 
 
 def _write_json(path: Path, data: object) -> None:
-    path.write_text(json.dumps(data, indent=1) + "\n")
+    write_output(path, jsontext.dumps(data) + "\n")
 
 
 def run_demo(output: str | Path, seed: int = 2016, sag_mm: float = 0.004,
              say: Callable[[str], None] = lambda _: None) -> dict:
     """Simulate the machine of Flynn et al. Table 2 with a pivot set-up error and a hidden
     gravity sag, measure, identify, diagnose, compensate and write every file and the report
-    into ``output`` (created). ``say`` receives one progress line per step.
+    into ``output`` (created, with its parents: the one output folder a command makes). ``say`` receives one progress line per step.
 
     Returns {"sag_mm", "finding" (the first finding's dict or None), "worst_change_percent",
     "report" (path)}.
@@ -53,8 +53,8 @@ def run_demo(output: str | Path, seed: int = 2016, sag_mm: float = 0.004,
     step(1, "planning the single set-up ballbar test (AC-trt, L0 = 100 mm, pivot 120, 0, 60)")
     setup = _core.BallbarSetup()
     plan = _core.plan_ballbar_test(setup, None)
-    (out / "ballbar_test.ngc").write_text(_core.write_nc_program(plan, _core.parse_nc_dialect("linuxcnc")))
-    (out / "ballbar_test.h").write_text(_core.write_nc_program(plan, _core.parse_nc_dialect("heidenhain")))
+    for name, dialect in (("ballbar_test.ngc", "linuxcnc"), ("ballbar_test.h", "heidenhain")):
+        write_output(out / name, _core.write_nc_program(plan, _core.parse_nc_dialect(dialect)))
 
     step(2, "simulating the machine of Flynn et al. Table 2 with a pivot set-up error and a hidden effect")
     truth = ballbar_truth(setup.machine, "table2", {"gravity_sag_A": [sag_mm]}, noise_um=0.5, seed=seed)

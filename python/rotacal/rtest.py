@@ -246,12 +246,11 @@ def truth_readings(truth: Mapping, session: _core.RtestSession, probe_zeros: boo
     return out
 
 
-def save_truth(truth: Mapping, path: str | Path) -> None:
-    """Write a truth dict as JSON (temporary file first)."""
-    path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(json.dumps(truth, indent=1) + "\n")
-    tmp.replace(path)
+def save_truth(truth: Mapping, path: str | Path, other_outputs: Sequence[str | Path] = ()) -> None:
+    """Write a truth dict as strict JSON by the output rule (rotacal.outputs)."""
+    from . import jsontext
+    from .outputs import write_output
+    write_output(path, jsontext.dumps(dict(truth)) + "\n", other_outputs=[str(o) for o in other_outputs])
 
 
 # ------------------------------------------------------------------------- device calibration
