@@ -164,7 +164,7 @@ def ballbar_report(path: str | Path, session: Any, identification: Any,
 
     path = Path(path)
     ident = identification.to_dict()
-    tests = np.asarray(session.tests)
+    tests = np.asarray(session.tests, dtype=object)  # object: a long label must not widen every row
     angles = np.asarray(session.angles_deg)
     measured = np.asarray(session.length)
     model = _core.predict_session_lengths(identification.raw.model, session)
@@ -352,7 +352,7 @@ def rtest_c_map_plot(model: Any, b_values_deg: Iterable[float]) -> str:
 
 def rtest_residual_plot(setups: np.ndarray, residuals: np.ndarray) -> str:
     """Residual (measured - model) of each reading component per pose."""
-    labels = np.array([f"set-up {s}" for s in setups])
+    labels = np.array([f"set-up {s}" for s in setups], dtype=object)
     return residual_plot(labels, [(f"d{a}", residuals[:, k]) for k, a in enumerate("xyz")])
 
 
@@ -367,7 +367,7 @@ def rtest_report(path: str | Path, session: Any, identification: Any, diagnosis:
     if ident["method"] != "joint":
         raise _core.InvalidArgument("rtest_report: needs the joint identification (its model draws the map)")
     model = identification.raw.model
-    setups = np.asarray(session.setups)
+    setups = np.asarray(session.setups, dtype=object)
     angles = np.asarray(session.angles_deg)
     b_meas = sorted(set(np.round(angles[:, 0], 6).tolist()))
     c_meas = sorted(set(np.round(angles[:, 1], 6).tolist()))

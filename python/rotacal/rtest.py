@@ -233,7 +233,7 @@ def truth_readings(truth: Mapping, session: _core.RtestSession, probe_zeros: boo
     e = np.array([truth["errors"][n] for n in names])
     ids = list(truth.get("effects", {}))
     params = [float(v) for i in ids for v in np.atleast_1d(truth["effects"][i])]
-    setups = np.asarray(session.setups)
+    setups = np.asarray(session.setups, dtype=object)
     angles = np.radians(np.asarray(session.angles_deg))
     time = np.asarray(session.time)
     out = np.zeros((len(setups), 3))

@@ -125,9 +125,9 @@ def load(path: str | Path) -> Session:
     return session
 
 
-def session_text(session: Session) -> str:
-    """The file text of a session, refused (InvalidArgument) unless ``load`` reads it back:
-    no file is written that rotacal would refuse to read."""
+def session_text(session: Session, what: str = "save") -> str:
+    """The file text of a session, refused (InvalidArgument naming ``what``) unless ``load``
+    reads it back: no file is written that rotacal would refuse to read."""
     text = _FORMATTERS[kind(session)](session)
     with tempfile.TemporaryDirectory(prefix="rotacal-check-") as d:
         probe = os.path.join(d, "session.csv")
@@ -137,8 +137,9 @@ def session_text(session: Session) -> str:
             _core.read_session(probe)
         except _core.ParseError as e:
             reason = str(e).replace(probe, "the session")
-            raise _core.InvalidArgument(f"save: this session would make a file that load refuses: {reason}") from None
+            raise _core.InvalidArgument(f"{what}: this session would make a file that load refuses: {reason}") from None
     return text
+
 
 
 def save(session: Session, path: str | Path, inputs: Iterable[str | Path] = (),
