@@ -6,7 +6,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from . import _core
-from .machines import random_location_errors  # noqa: F401  (rotacal.random_location_errors)
+from .machines import ballbar_machine_model, random_location_errors  # noqa: F401  (rotacal.random_location_errors)
 from .results import Identification
 from .sessions import BALLBAR, require
 
@@ -88,3 +88,27 @@ def compensation_table(report: Any) -> list[dict]:
     """The rows of a CompensationReport (verify_compensation) as dicts, Flynn et al. Table 2 layout."""
     return [{"name": r.name, "unit": r.unit, "before": r.before, "after": r.after,
              "std_after": r.std_after, "change_percent": r.change_percent} for r in report.rows]
+
+
+def nc_program(setup: Any, dialect: str = "linuxcnc", model: Any = None,
+               source: str = "<model>") -> tuple[Any, str]:
+    """(plan, NC program text) of the test of ``setup`` in ``dialect``; with a fitted
+    BallbarMachineModel the program is compensated for its location errors (its machine must
+    be the set-up's, ``source`` names the model in the error)."""
+    identified = None
+    if model is not None:
+        if model.machine != setup.machine:
+            raise _core.InvalidArgument(f"{source}: model is for {_core.machine_name(model.machine)}, the test "
+                                        f"for {_core.machine_name(setup.machine)}")
+        identified = model.errors
+    plan = _core.plan_ballbar_test(setup, identified)
+    return plan, _core.write_nc_program(plan, _core.parse_nc_dialect(dialect))
+
+
+def verify_compensation(setup: Any, truth: Any) -> list[dict]:
+    """Flynn et al.'s Table 2 experiment in simulation: measure the test of ``setup`` on the
+    machine of ``truth`` (machines.ballbar_truth), identify, compensate, measure again;
+    the rows of compensation_table."""
+    commanded = _core.plan_ballbar_test(setup, None).commanded_session()
+    machine = ballbar_machine_model(setup, truth)
+    return compensation_table(_core.verify_compensation(commanded, machine, truth["noise_um"], truth["seed"]))

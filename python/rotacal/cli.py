@@ -158,21 +158,21 @@ def _setup(a: argparse.Namespace) -> Any:
     return s
 
 
-def cmd_plan(a: argparse.Namespace) -> int:
+def _model(path: str | None) -> Any:
+    """The ballbar model of a --model/--compensate file, or None."""
+    if not path:
+        return None
     from .models import ballbar_model_from_dict, load_model
+    return ballbar_model_from_dict(load_model(path), path)
+
+
+def cmd_plan(a: argparse.Namespace) -> int:
+    from .ballbar import nc_program
     check_outputs([a.output, a.session], [a.compensate])
-    setup = _setup(a)
-    identified = None
-    if a.compensate:
-        model = ballbar_model_from_dict(load_model(a.compensate), a.compensate)
-        if model.machine != setup.machine:
-            raise _core.InvalidArgument(f"{a.compensate}: model is for {_core.machine_name(model.machine)}")
-        identified = model.errors
-    plan = _core.plan_ballbar_test(setup, identified)
-    text = _core.write_nc_program(plan, _core.parse_nc_dialect(a.dialect))
+    plan, text = nc_program(_setup(a), a.dialect, _model(a.compensate), a.compensate)
     write_output(a.output, text, [a.compensate] if a.compensate else [], [a.session] if a.session else [])
     _say(f"wrote {a.output}: {a.dialect} program, {plan.num_samples} points, {plan.duration:.0f} s"
-         + (" (compensated)" if identified is not None else ""))
+         + (" (compensated)" if a.compensate else ""))
     if a.session:
         save(plan.commanded_session(), a.session, [a.compensate], [a.output])
         _say(f"wrote {a.session}: the commanded rows as a session template")
@@ -366,20 +366,15 @@ def cmd_compensate(a: argparse.Namespace) -> int:
     if a.model:
         check_outputs([a.output], [a.model])
     setup = _setup(a)
+    from .ballbar import nc_program, verify_compensation
     if a.model:
-        from .models import ballbar_model_from_dict, load_model
-        model = ballbar_model_from_dict(load_model(a.model), a.model)
-        plan = _core.plan_ballbar_test(setup, model.errors)
-        write_output(a.output, _core.write_nc_program(plan, _core.parse_nc_dialect(a.dialect)), [a.model])
+        _, text = nc_program(setup, a.dialect, _model(a.model), a.model)
+        write_output(a.output, text, [a.model])
         _say(f"wrote {a.output}: compensated {a.dialect} program")
     if a.verify:
-        from .ballbar import compensation_table
-        from .machines import ballbar_machine_model
         truth = _truth(a, setup)
-        machine = ballbar_machine_model(setup, truth)
-        commanded = _core.plan_ballbar_test(setup, None).commanded_session()
         _say("measuring, identifying, compensating and measuring again on the simulated machine ...")
-        rows = compensation_table(_core.verify_compensation(commanded, machine, truth["noise_um"], truth["seed"]))
+        rows = verify_compensation(setup, truth)
         if a.json:
             print(jsontext.dumps(rows))
         else:

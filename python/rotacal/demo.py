@@ -6,7 +6,7 @@ from pathlib import Path
 from typing import Callable
 
 from . import _core, jsontext
-from .ballbar import compensation_table, identify
+from .ballbar import identify, nc_program, verify_compensation
 from .diagnosis import diagnose
 from .machines import ballbar_truth, simulate_ballbar_test
 from .models import save_model
@@ -52,9 +52,9 @@ def run_demo(output: str | Path, seed: int = 2016, sag_mm: float = 0.004,
 
     step(1, "planning the single set-up ballbar test (AC-trt, L0 = 100 mm, pivot 120, 0, 60)")
     setup = _core.BallbarSetup()
-    plan = _core.plan_ballbar_test(setup, None)
     for name, dialect in (("ballbar_test.ngc", "linuxcnc"), ("ballbar_test.h", "heidenhain")):
-        write_output(out / name, _core.write_nc_program(plan, _core.parse_nc_dialect(dialect)))
+        plan, text = nc_program(setup, dialect)
+        write_output(out / name, text)
 
     step(2, "simulating the machine of Flynn et al. Table 2 with a pivot set-up error and a hidden effect")
     truth = ballbar_truth(setup.machine, "table2", {"gravity_sag_A": [sag_mm]}, noise_um=0.5, seed=seed)
@@ -75,7 +75,7 @@ def run_demo(output: str | Path, seed: int = 2016, sag_mm: float = 0.004,
     _write_json(out / "diagnosis.json", dd)
 
     step(5, "compensating and measuring again (Table 2 experiment)")
-    rows = compensation_table(_core.verify_compensation(plan.commanded_session(), machine, 0.5, seed))
+    rows = verify_compensation(setup, truth)
     _write_json(out / "compensation.json", rows)
 
     step(6, "writing the report")
