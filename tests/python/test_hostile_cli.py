@@ -319,6 +319,55 @@ def test_devices_written_through_not_replaced(files):
         assert stat.S_ISCHR(os.stat("/dev/null").st_mode)
 
 
+@pytest.mark.skipif(os.geteuid() != 0, reason="mknod needs root")
+def test_own_null_device_is_not_replaced(files, tmp_path):
+    # The reproducer: mknod mynull c 1 3; rotacal report S.csv -o mynull
+    mynull = tmp_path / "mynull"
+    os.mknod(mynull, stat.S_IFCHR | 0o666, os.makedev(1, 3))
+    r = rotacal_cli("report", files["good"], "--no-diagnosis", "-o", mynull)
+    assert r.returncode == 0, r.stderr
+    assert stat.S_ISCHR(os.stat(mynull).st_mode)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["mynull"]
+
+
+def test_failure_leaves_nothing_behind(files, tmp_path):
+    for args in (("report", files["nonutf8"], "-o", tmp_path / "r.html"),
+                 ("simulate", "ballbar", "--effect", "no_such_effect=1", "-o", tmp_path / "s.csv"),
+                 ("predict", files["good"], "--model", files["good"], "-o", tmp_path / "p.csv")):
+        r = rotacal_cli(*args)
+        assert r.returncode == EXIT_INPUT, (args, r.stderr)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_megabyte_label_report_is_bounded(files, tmp_path):
+    # A 1 MB test label took 14 GB in report: numpy widened every row's label to the longest.
+    head, rows = _rows(files["good"])
+    first = rows[0].split(",")[0]
+    label = "L" * 1_000_000
+    src = tmp_path / "label.csv"
+    src.write_text("\n".join(head + [label + r[len(first):] if r.startswith(first + ",") else r for r in rows]) + "\n")
+    r = rotacal_cli("report", src, "--no-diagnosis", "-o", tmp_path / "r.html", timeout=300, memory_bytes=4 << 30)
+    assert r.returncode in (0, EXIT_INPUT), r.stderr[-500:]
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full")
+def test_full_disk_is_a_file_system_error(files):
+    for args in (("simulate", "ballbar", "-o", "/dev/full"), ("identify", files["good"], "--save-model", "/dev/full"),
+                 ("plan", "ballbar", "-o", "/dev/full")):
+        r = rotacal_cli(*args)
+        assert r.returncode == EXIT_IO and "/dev/full" in r.stderr and "space" in r.stderr, (args, r.stderr)
+
+
+def test_fifo_written_through(tmp_path):
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+    reader = subprocess.Popen(["cat", str(fifo)], stdout=subprocess.PIPE)
+    r = rotacal_cli("simulate", "ballbar", "-o", fifo)
+    text = reader.communicate(timeout=60)[0].decode()
+    assert r.returncode == 0, r.stderr
+    assert stat.S_ISFIFO(os.stat(fifo).st_mode) and text.startswith("# format: rotacal-ballbar/1")
+
+
 def test_users_tmp_file_and_symlink_kept(files, tmp_path):
     out = tmp_path / "p.ngc"
     (tmp_path / "p.ngc.tmp").write_text("mine")
