@@ -1,4 +1,4 @@
-"""Strict JSON text: never NaN or Infinity; a number that is not finite is written as null and the reason listed."""
+"""Strict JSON text: never NaN or Infinity; a number that is not finite is written null and its reason listed under "null_reasons"."""
 from __future__ import annotations
 
 import json
@@ -7,41 +7,51 @@ from typing import Any
 
 from . import _core
 
+# The convention of the model file (docs/model_file.md): "null_reasons" maps the JSON pointer
+# (RFC 6901) of each null that stands for a non-finite number to why.
+NULL_REASONS = "null_reasons"
 
-def _clean(v: Any, where: str, reasons: list[dict]) -> Any:
+
+def _pointer_token(key: Any) -> str:
+    return str(key).replace("~", "~0").replace("/", "~1")
+
+
+def _why(v: float) -> str:
+    name = "NaN" if math.isnan(v) else ("+Infinity" if v > 0 else "-Infinity")
+    return f"{name}: not determined by the data"
+
+
+def _clean(v: Any, pointer: str, reasons: dict[str, str]) -> Any:
     if isinstance(v, dict):
-        return {k: _clean(x, f"{where}.{k}" if where else str(k), reasons) for k, x in v.items()}
+        return {k: _clean(x, f"{pointer}/{_pointer_token(k)}", reasons) for k, x in v.items()}
     if isinstance(v, (list, tuple)):
-        return [_clean(x, f"{where}[{i}]", reasons) for i, x in enumerate(v)]
+        return [_clean(x, f"{pointer}/{i}", reasons) for i, x in enumerate(v)]
     if isinstance(v, float) and not math.isfinite(v):
-        reasons.append({"field": where, "value": repr(v),
-                        "reason": "not a finite number: the data do not determine it"})
+        reasons[pointer] = _why(v)
         return None
     return v
 
 
-def non_finite_fields(data: Any) -> list[dict]:
-    """[{"field", "value", "reason"}] for every NaN or infinite number in ``data``."""
-    reasons: list[dict] = []
+def non_finite(data: Any) -> dict[str, str]:
+    """JSON pointer -> reason of every NaN or infinite number in ``data``."""
+    reasons: dict[str, str] = {}
     _clean(data, "", reasons)
     return reasons
 
 
 def dumps(data: Any, indent: int | None = 1) -> str:
     """JSON text of ``data`` that every strict parser reads: each NaN or infinity becomes null,
-    and a dict gets a "non_finite" list saying which fields and why."""
-    reasons: list[dict] = []
+    and a dict gets "null_reasons" saying which fields and why."""
+    reasons: dict[str, str] = {}
     clean = _clean(data, "", reasons)
     if reasons and isinstance(clean, dict):
-        clean["non_finite"] = reasons
+        clean[NULL_REASONS] = reasons
     return json.dumps(clean, indent=indent, allow_nan=False)
 
 
 def require_finite(data: Any, what: str) -> None:
-    """Refuse data with a NaN or infinity (InvalidArgument naming the fields), e.g. a model
-    file, where null would silently mean "nominal"."""
-    bad = non_finite_fields(data)
+    """Refuse data with a NaN or infinity (InvalidArgument naming the fields by JSON pointer)."""
+    bad = non_finite(data)
     if bad:
-        fields = ", ".join(f"{b['field']} = {b['value']}" for b in bad[:5])
-        raise _core.InvalidArgument(f"{what}: not finite: {fields}"
-                                    + (f" and {len(bad) - 5} more" if len(bad) > 5 else ""))
+        fields = ", ".join(f"{p} ({r.split(':')[0]})" for p, r in list(bad.items())[:5])
+        raise _core.InvalidArgument(f"{what}: not finite: {fields}" + (f" and {len(bad) - 5} more" if len(bad) > 5 else ""))

@@ -246,7 +246,7 @@ def test_json_is_strict_on_identical_rows(files, tmp_path):
     assert r.returncode == 0, r.stderr
     d = strict_json(r.stdout)
     assert d["baseline"]["p_value"] is None
-    assert any(n["field"] == "baseline.p_value" for n in d["non_finite"])
+    assert "not determined" in d["null_reasons"]["/baseline/p_value"]
     model = tmp_path / "m.json"
     r = rotacal_cli("identify", files["same"], "--json", "--save-model", model)
     assert r.returncode == 0, r.stderr
@@ -256,8 +256,10 @@ def test_json_is_strict_on_identical_rows(files, tmp_path):
 
 def test_jsontext_refuses_nan_for_model_files():
     from rotacal import jsontext
-    assert json.loads(jsontext.dumps({"a": float("inf"), "b": [1.0, float("nan")]}))["non_finite"][1]["field"] == "b[1]"
-    with pytest.raises(rotacal.InvalidArgument, match=r"location_errors.E_Y0A.std = inf"):
+    d = json.loads(jsontext.dumps({"a": float("inf"), "b/c": [1.0, float("nan")]}))
+    assert d["a"] is None and d["null_reasons"] == {"/a": "+Infinity: not determined by the data",
+                                                    "/b~1c/1": "NaN: not determined by the data"}
+    with pytest.raises(rotacal.InvalidArgument, match=r"/location_errors/E_Y0A/std \(\+Infinity\)"):
         jsontext.require_finite({"location_errors": {"E_Y0A": {"value": 0.1, "std": float("inf")}}}, "--save-model")
 
 
