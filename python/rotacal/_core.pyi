@@ -6,7 +6,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Ambiguity', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'CandidateScore', 'CircleFit', 'CompensationReport', 'CompensationRow', 'DegenerateGeometry', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'FaultInjection', 'Finding', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'MachineType', 'ModelFit', 'NcDialect', 'NcProgramOptions', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestJointIdentification', 'RtestJointModel', 'RtestPaperIdentification', 'RtestSession', 'SegmentKind', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TransitionArc', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_output', 'compensate_commands', 'compensate_sphere_offset', 'default_ballbar_tests', 'default_calibration_moves', 'diagnose_ballbar', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'format_ballbar', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'parse_ballbar_test', 'parse_machine_type', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'test_label', 'verify_compensation', 'write_ballbar', 'write_nc_program', 'write_output', 'write_rtest']
+__all__: list[str] = ['Ambiguity', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'CandidateScore', 'CircleFit', 'CompensationReport', 'CompensationRow', 'DegenerateGeometry', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'FaultInjection', 'Finding', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'MachineType', 'ModelFit', 'NcDialect', 'NcProgramOptions', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestJointIdentification', 'RtestJointModel', 'RtestPaperIdentification', 'RtestSession', 'SegmentKind', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TransitionArc', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'ballbar_model_document', 'ballbar_model_from_document', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_output', 'compensate_commands', 'compensate_sphere_offset', 'default_ballbar_tests', 'default_calibration_moves', 'diagnose_ballbar', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'parse_ballbar_test', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'test_label', 'verify_compensation', 'write_ballbar', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
 class Ambiguity:
     @property
     def correlation(self) -> float:
@@ -186,6 +186,11 @@ class BallbarSession:
     @property
     def time(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         ...
+    @property
+    def warnings(self) -> list[str]:
+        """
+        what the reader found suspicious but kept
+        """
     @property
     def xyz(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
         ...
@@ -1107,6 +1112,11 @@ class RtestSession:
     def time(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         ...
     @property
+    def warnings(self) -> list[str]:
+        """
+        what the reader found suspicious but kept
+        """
+    @property
     def xyz(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
         ...
 class SegmentKind:
@@ -1284,6 +1294,10 @@ class VirtualRtest:
         """
         Commanded rows (set-up, time, B, C, X, Y, Z) and nests.
         """
+def ballbar_model_document(model: ...) -> typing.Any:
+    ...
+def ballbar_model_from_document(document: dict, source: str = '<model>') -> ...:
+    ...
 def calibrate_probe_directions(moves: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], readings: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> ProbeCalibration:
     """
     Probe directions, gains and zeros from commanded moves (N, 3) and readings (N, 3), mm.
@@ -1328,6 +1342,10 @@ def effect_catalogue(machine: MachineType, max_harmonic: typing.SupportsInt | ty
     """
 def format_ballbar(session: BallbarSession) -> str:
     ...
+def format_model_document(document: dict, source: str = 'model') -> str:
+    """
+    Strict JSON text of a model document (non-finite numbers as null with a reason), validated.
+    """
 def format_rtest(session: RtestSession) -> str:
     ...
 def forward(machine: MachineType, errors: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], angles: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], q_table: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
@@ -1403,6 +1421,8 @@ def parse_machine_type(text: str) -> MachineType:
     """
     Machine type from its file name ('AC-trt' or 'BC-trt').
     """
+def parse_model_document(text: str, source: str = '<model>') -> typing.Any:
+    ...
 def parse_nc_dialect(text: str) -> NcDialect:
     ...
 def parse_radial_side(text: str) -> RadialSide:
@@ -1431,6 +1451,10 @@ def predict_session_lengths(model: BallbarMachineModel, session: BallbarSession)
     """
 def read_ballbar(path: str) -> BallbarSession:
     ...
+def read_model_document(path: str) -> typing.Any:
+    """
+    Read a rotacal-model file (strict JSON, version, kind, machine checked); the document as a dict. ParseError (syntax), InvalidArgument (content), IoError.
+    """
 def read_rtest(path: str) -> RtestSession:
     ...
 def read_session(path: str) -> rotacal._core.BallbarSession | rotacal._core.RtestSession:
@@ -1512,6 +1536,8 @@ def verify_compensation(commanded: BallbarSession, truth: BallbarMachineModel, n
     Measure, identify, compensate, measure again, identify again (Flynn et al., Table 2).
     """
 def write_ballbar(session: BallbarSession, path: str) -> None:
+    ...
+def write_model_document(document: dict, path: str, inputs: collections.abc.Sequence[str] = [], other_outputs: collections.abc.Sequence[str] = []) -> None:
     ...
 @typing.overload
 def write_nc_program(plan: BallbarPlan, dialect: NcDialect, options: NcProgramOptions = ...) -> str:

@@ -255,6 +255,14 @@ def cmd_simulate_rtest(a: argparse.Namespace) -> int:
 
 # ------------------------------------------------------------------------- analyse
 
+def _load(path: str) -> Any:
+    """The session of ``path``; what its reader warned about (e.g. repeated rows) on stderr."""
+    s = load(path)
+    for w in s.warnings:
+        _say(f"rotacal: warning: {path}: {w}")
+    return s
+
+
 def _print_identification(d: dict) -> None:
     print(f"{d['method']} identification, {d['machine']}, {d['n_samples']} samples, "
           f"residual RMS {d['residual_rms_um']:.3f} um")
@@ -282,7 +290,7 @@ def _print_identification(d: dict) -> None:
 def cmd_identify(a: argparse.Namespace) -> int:
     from .analysis import identify
     check_outputs([a.save_model], [a.file])
-    s = load(a.file)
+    s = _load(a.file)
     result = identify(s, a.method, fit_length_offset=a.length_offset)
     d = result.to_dict()
     if a.monte_carlo:
@@ -290,9 +298,8 @@ def cmd_identify(a: argparse.Namespace) -> int:
         d["monte_carlo"] = monte_carlo(by_kind(s, {BALLBAR: s}, "--monte-carlo"), result, a.monte_carlo, seed=a.seed)
     if a.save_model:
         from .models import save_model
-        model = result.model_dict()
-        jsontext.require_finite(model, f"--save-model {a.save_model}")
-        save_model(model, a.save_model, inputs=(a.file,))
+        # The C++ model writer is strict: a non-finite number is written null with its reason.
+        save_model(result.model_dict(), a.save_model, inputs=(a.file,))
         _say(f"wrote {a.save_model}")
     if by_kind(s, {BALLBAR: a.json, RTEST: True}, "identify"):
         print(jsontext.dumps(d))
@@ -325,7 +332,7 @@ def _print_diagnosis(d: dict) -> None:
 def cmd_diagnose(a: argparse.Namespace) -> int:
     from .diagnosis import diagnose
     check_outputs([a.report], [a.file])
-    s = load(a.file)
+    s = _load(a.file)
     result = diagnose(s, max_harmonic=a.max_harmonic)
     d = result.to_dict()
     if a.report:
@@ -344,7 +351,7 @@ def cmd_predict(a: argparse.Namespace) -> int:
     from .models import load_model
     check_outputs([a.output], [a.session, a.model])
     model_dict = load_model(a.model)
-    s = load(a.session)
+    s = _load(a.session)
     out, line = predict_session(model_dict, s, a.probe_zeros, source=a.model)
     if line:
         _say(line)
@@ -385,7 +392,7 @@ def cmd_compensate(a: argparse.Namespace) -> int:
 def cmd_report(a: argparse.Namespace) -> int:
     from .analysis import write_report
     check_outputs([a.output], [a.file])
-    s = load(a.file)
+    s = _load(a.file)
     out = write_report(a.output, s, a.method, with_diagnosis=not a.no_diagnosis, source=a.file, inputs=[a.file])
     print(Path(out).resolve())
     return EXIT_OK

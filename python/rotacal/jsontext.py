@@ -5,8 +5,6 @@ import json
 import math
 from typing import Any
 
-from . import _core
-
 # The convention of the model file (docs/model_file.md): "null_reasons" maps the JSON pointer
 # (RFC 6901) of each null that stands for a non-finite number to why.
 NULL_REASONS = "null_reasons"
@@ -48,10 +46,3 @@ def dumps(data: Any, indent: int | None = 1) -> str:
         clean[NULL_REASONS] = reasons
     return json.dumps(clean, indent=indent, allow_nan=False)
 
-
-def require_finite(data: Any, what: str) -> None:
-    """Refuse data with a NaN or infinity (InvalidArgument naming the fields by JSON pointer)."""
-    bad = non_finite(data)
-    if bad:
-        fields = ", ".join(f"{p} ({r.split(':')[0]})" for p, r in list(bad.items())[:5])
-        raise _core.InvalidArgument(f"{what}: not finite: {fields}" + (f" and {len(bad) - 5} more" if len(bad) > 5 else ""))

@@ -92,8 +92,21 @@ def first_non_utf8(path: str, limit: int = _SCAN_LIMIT) -> tuple[int, int, int] 
     return None
 
 
+def _is_utf16(path: str) -> bool:
+    if not os.path.isfile(path):  # a FIFO would block, a device give other bytes
+        return False
+    try:
+        with open(path, "rb") as f:
+            return f.read(2) in (b"\xff\xfe", b"\xfe\xff")
+    except OSError:
+        return False
+
+
 def _not_utf8(path: str) -> _core.Error:
-    """The parse error of a file that is not UTF-8 text, naming file, line and column."""
+    """The parse error of a file that is not UTF-8 text, naming file, line and column (a
+    regular file: a FIFO cannot be read again, a device gives other bytes)."""
+    if not os.path.isfile(path):
+        return _core.ParseError(f"{path}: not UTF-8 text (session files are UTF-8 text)")
     try:
         with open(path, "rb") as f:
             head = f.read(4)
@@ -105,7 +118,7 @@ def _not_utf8(path: str) -> _core.Error:
     if where is None:
         return _core.ParseError(f"{path}: not UTF-8 text")
     line, col, byte = where
-    return _core.ParseError(f"{path}:{line}:{col}: byte 0x{byte:02x} is not UTF-8 text")
+    return _core.ParseError(f"{path}:{line}:{col}: byte 0x{byte:02X} is not UTF-8 (session files are UTF-8 text)")
 
 
 def load(path: str | Path) -> Session:
@@ -122,6 +135,10 @@ def load(path: str | Path) -> Session:
         getattr(session, _LABELS[kind(session)])  # every label must be text Python can hold
     except UnicodeDecodeError:
         raise _not_utf8(p) from None
+    except _core.ParseError as e:
+        if _is_utf16(p):  # say what the file is, not only its first byte
+            raise _not_utf8(p) from None
+        raise e
     return session
 
 
