@@ -414,15 +414,19 @@ def _columns(length):
 
 
 @pytest.mark.parametrize("length", [[100.0, 0.0, 100.0], [100.0, -100.0, 100.0]])
-def test_save_never_writes_a_file_load_refuses(tmp_path, length):
-    # BallbarSession(...) itself should refuse these (its C++ constructor, make_ballbar_session);
-    # whatever it accepts, save writes nothing that load would refuse.
-    try:
-        s = rotacal.BallbarSession(**_columns(length))
-    except rotacal.InvalidArgument as e:
-        assert "length" in str(e)
-        return
-    with pytest.raises(rotacal.InvalidArgument, match="length must be > 0"):
+def test_ballbar_session_refuses_non_positive_lengths(length):
+    with pytest.raises(rotacal.InvalidArgument, match="length"):
+        rotacal.BallbarSession(**_columns(length))
+
+
+def test_save_never_writes_a_file_load_refuses(tmp_path, monkeypatch):
+    # Whatever a session holds, save checks its text with the reader first: a text the reader
+    # refuses (here a formatter made to drop the format line) writes nothing.
+    from rotacal import sessions
+    s = rotacal.BallbarSession(**_columns([100.0, 100.01, 99.99]))
+    broken = {k: (lambda session, f=f: f(session).split("\n", 1)[1]) for k, f in sessions._FORMATTERS.items()}
+    monkeypatch.setattr(sessions, "_FORMATTERS", broken)
+    with pytest.raises(rotacal.InvalidArgument, match="would make a file that load refuses"):
         rotacal.save(s, tmp_path / "bad.csv")
     assert list(tmp_path.iterdir()) == []
 
