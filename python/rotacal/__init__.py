@@ -33,6 +33,7 @@ from .ballbar import predict  # noqa: F401
 from .machines import TABLE2_ERRORS, random_location_errors  # noqa: F401
 from .diagnosis import diagnose  # noqa: F401
 from .models import ballbar_model_from_dict, load_model, save_model  # noqa: F401
+from .outputs import write_output  # noqa: F401
 from .results import DiagnosisResult, Identification  # noqa: F401
 from .rtest import identify_rtest  # noqa: F401
 from .sessions import load, save  # noqa: F401
