@@ -33,7 +33,7 @@ for test in dict.fromkeys(labels):
 
 for dialect, suffix in (("linuxcnc", "ngc"), ("heidenhain", "h"), ("siemens", "mpf"), ("fanuc", "nc")):
     path = out / f"ballbar_test.{suffix}"
-    path.write_text(_core.write_nc_program(plan, dialect))
+    rotacal.write_output(path, _core.write_nc_program(plan, dialect))  # never a half-written program
     print(f"wrote {path} ({dialect})")
 template = out / "commanded.csv"
 rotacal.save(plan.commanded_session(), template)

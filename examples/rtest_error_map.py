@@ -42,8 +42,8 @@ for e in d["error_map"]["entries"]:
 
 out = Path(args.output)
 out.mkdir(parents=True, exist_ok=True)
-(out / "error_map.csv").write_text(result.error_map("csv"))
-(out / "error_map.json").write_text(result.error_map("json"))
+rotacal.write_output(out / "error_map.csv", result.error_map("csv"))
+rotacal.write_output(out / "error_map.json", result.error_map("json"))
 rotacal.save_model(result.model_dict(), out / "model.json")
 # The model predicts the table's error at any (B, C) for any table point, with 1 sigma.
 model = rotacal.load_model(out / "model.json")

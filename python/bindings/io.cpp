@@ -1,6 +1,8 @@
 // Bindings for include/rotacal/io: session classes with numpy columns, readers and writers.
 #include "numpy.hpp"
 #include "rotacal/io/ballbar_file.hpp"
+#include "rotacal/io/model_file.hpp"
+#include "rotacal/io/output_file.hpp"
 #include "rotacal/io/session_arrays.hpp"
 
 namespace rotacal::py {
@@ -11,6 +13,62 @@ pyb::dict metadata_dict(const Metadata& m) {
   for (const auto& kv : m) d[pyb::str(kv.first)] = kv.second;
   return d;
 }
+// Python objects <-> JSON values for model documents (dicts of str keys, lists, numbers, None).
+nlohmann::ordered_json to_json(const pyb::handle& o, const std::string& where, int depth = 0) {
+  if (depth > 64) throw InvalidArgument(where + ": nested too deeply");
+  if (o.is_none()) return nullptr;
+  if (pyb::isinstance<pyb::bool_>(o)) return o.cast<bool>();
+  if (pyb::isinstance<pyb::int_>(o)) {
+    try {
+      return o.cast<long long>();
+    } catch (const pyb::cast_error&) {
+      throw InvalidArgument(where + ": integer out of range");
+    }
+  }
+  if (pyb::isinstance<pyb::float_>(o)) return o.cast<double>();
+  if (pyb::isinstance<pyb::str>(o)) return o.cast<std::string>();
+  if (pyb::isinstance<pyb::dict>(o)) {
+    nlohmann::ordered_json out = nlohmann::ordered_json::object();
+    for (const auto& kv : o.cast<pyb::dict>()) {
+      if (!pyb::isinstance<pyb::str>(kv.first)) throw InvalidArgument(where + ": keys must be str");
+      const std::string key = kv.first.cast<std::string>();
+      out[key] = to_json(kv.second, where + "." + key, depth + 1);
+    }
+    return out;
+  }
+  if (pyb::isinstance<pyb::list>(o) || pyb::isinstance<pyb::tuple>(o)) {
+    nlohmann::ordered_json out = nlohmann::ordered_json::array();
+    std::size_t i = 0;
+    for (const auto& x : o) out.push_back(to_json(x, where + "[" + std::to_string(i++) + "]", depth + 1));
+    return out;
+  }
+  if (pyb::hasattr(o, "tolist")) return to_json(o.attr("tolist")(), where, depth + 1);  // numpy
+  throw InvalidArgument(where + ": a " + std::string(pyb::str(o.get_type().attr("__name__"))) +
+                        " cannot be written as JSON");
+}
+
+pyb::object from_json(const nlohmann::ordered_json& j) {
+  switch (j.type()) {
+    case nlohmann::ordered_json::value_t::null: return pyb::none();
+    case nlohmann::ordered_json::value_t::boolean: return pyb::bool_(j.get<bool>());
+    case nlohmann::ordered_json::value_t::number_integer: return pyb::int_(j.get<long long>());
+    case nlohmann::ordered_json::value_t::number_unsigned: return pyb::int_(j.get<unsigned long long>());
+    case nlohmann::ordered_json::value_t::number_float: return pyb::float_(j.get<double>());
+    case nlohmann::ordered_json::value_t::string: return pyb::str(j.get<std::string>());
+    case nlohmann::ordered_json::value_t::array: {
+      pyb::list out;
+      for (const auto& x : j) out.append(from_json(x));
+      return std::move(out);
+    }
+    case nlohmann::ordered_json::value_t::object: {
+      pyb::dict out;
+      for (auto it = j.begin(); it != j.end(); ++it) out[pyb::str(it.key())] = from_json(it.value());
+      return std::move(out);
+    }
+    default: throw InvalidArgument("model document: a JSON value of an unsupported type");
+  }
+}
+
 }  // namespace
 
 void bind_io(pyb::module_& m) {
@@ -25,6 +83,7 @@ void bind_io(pyb::module_& m) {
       .def_property_readonly("pivot", [](const BallbarSession& s) { return Eigen::Vector3d(s.pivot); })
       .def_readonly("noise_um", &BallbarSession::noise_um)
       .def_property_readonly("metadata", [](const BallbarSession& s) { return metadata_dict(s.metadata); })
+      .def_readonly("warnings", &BallbarSession::warnings, "what the reader found suspicious but kept")
       .def_property_readonly("tests", &ballbar_tests, "test label of every sample")
       .def_property_readonly("test_names", &BallbarSession::tests, "distinct test labels, in order")
       .def_property_readonly("time", &ballbar_times)
@@ -51,6 +110,7 @@ void bind_io(pyb::module_& m) {
       .def_readonly("probe_dirs", &RtestSession::probe_dirs)
       .def_readonly("noise_um", &RtestSession::noise_um)
       .def_property_readonly("metadata", [](const RtestSession& s) { return metadata_dict(s.metadata); })
+      .def_readonly("warnings", &RtestSession::warnings, "what the reader found suspicious but kept")
       .def_property_readonly("setups", &rtest_setups, "set-up (nest) label of every pose")
       .def_property_readonly("time", &rtest_times)
       .def_property_readonly("angles_deg", &rtest_angles_deg)
@@ -71,6 +131,67 @@ void bind_io(pyb::module_& m) {
   m.def("write_rtest", &write_rtest, pyb::arg("session"), pyb::arg("path"));
   m.def("format_ballbar", &format_ballbar, pyb::arg("session"));
   m.def("format_rtest", &format_rtest, pyb::arg("session"));
+
+  // Model files (rotacal/io/model_file.hpp): documents as dicts, validated and written in C++.
+  m.def(
+      "read_model_document",
+      [](const std::string& path) { return from_json(read_model_document(path)); }, pyb::arg("path"),
+      "Read a rotacal-model file (strict JSON, version, kind, machine checked); the document as a "
+      "dict. ParseError (syntax), InvalidArgument (content), IoError.");
+  m.def(
+      "parse_model_document",
+      [](const std::string& text, const std::string& source) { return from_json(parse_model(text, source).document); },  // full check
+      pyb::arg("text"), pyb::arg("source") = "<model>");
+  m.def(
+      "format_model_document",
+      [](const pyb::dict& doc, const std::string& source) { return format_model(to_json(doc, source), source); },
+      pyb::arg("document"), pyb::arg("source") = "model",
+      "Strict JSON text of a model document (non-finite numbers as null with a reason), validated.");
+  m.def(
+      "write_model_document",
+      [](const pyb::dict& doc, const std::string& path, const std::vector<std::string>& inputs,
+         const std::vector<std::string>& other_outputs) {
+        nlohmann::ordered_json j = to_json(doc, path);
+        pyb::gil_scoped_release release;
+        write_model(j, path, OutputOptions{inputs, other_outputs});
+      },
+      pyb::arg("document"), pyb::arg("path"), pyb::arg("inputs") = std::vector<std::string>{},
+      pyb::arg("other_outputs") = std::vector<std::string>{});
+  m.def(
+      "ballbar_model_from_document",
+      [](const pyb::dict& doc, const std::string& source) {
+        return ballbar_machine_model(model_from_json(to_json(doc, source), source));
+      },
+      pyb::arg("document"), pyb::arg("source") = "<model>");
+  m.def(
+      "ballbar_model_document",
+      [](const BallbarMachineModel& model) { return from_json(ballbar_model_document(model)); },
+      pyb::arg("model"));
+
+  // The output rule (rotacal/io/output_file.hpp). The GIL is released: a FIFO blocks until read.
+  m.def(
+      "write_output",
+      [](const std::string& path, const pyb::bytes& data, const std::vector<std::string>& inputs,
+         const std::vector<std::string>& other_outputs) {
+        std::string text = data;
+        pyb::gil_scoped_release release;
+        write_output(path, text, OutputOptions{inputs, other_outputs});
+      },
+      pyb::arg("path"), pyb::arg("data"), pyb::arg("inputs") = std::vector<std::string>{},
+      pyb::arg("other_outputs") = std::vector<std::string>{},
+      "Write bytes to path: regular files replaced atomically, devices and FIFOs written through; "
+      "a directory, an input or another output is refused (IoError).");
+  m.def(
+      "check_output",
+      [](const std::string& path, const std::vector<std::string>& inputs,
+         const std::vector<std::string>& other_outputs) {
+        return check_output(path, OutputOptions{inputs, other_outputs}) == OutputKind::WriteThrough
+                   ? "write-through"
+                   : "replace";
+      },
+      pyb::arg("path"), pyb::arg("inputs") = std::vector<std::string>{},
+      pyb::arg("other_outputs") = std::vector<std::string>{},
+      "Check an output path without writing: 'replace' or 'write-through'; raises IoError.");
 }
 
 }  // namespace rotacal::py

@@ -28,9 +28,12 @@ from ._core import (  # noqa: F401
     verify_compensation,
 )
 from ._core import BallbarPlan, BallbarSetup, BallbarTest, NcDialect, NcProgramOptions, RadialSide, parse_ballbar_test, parse_nc_dialect, parse_radial_side, plan_ballbar_test, write_nc_program  # noqa: F401,E501
-from .ballbar import identify, predict, random_location_errors  # noqa: F401
+from .analysis import identify  # noqa: F401
+from .ballbar import predict  # noqa: F401
+from .machines import TABLE2_ERRORS, random_location_errors  # noqa: F401
 from .diagnosis import diagnose  # noqa: F401
 from .models import ballbar_model_from_dict, load_model, save_model  # noqa: F401
+from .outputs import write_output  # noqa: F401
 from .results import DiagnosisResult, Identification  # noqa: F401
 from .rtest import identify_rtest  # noqa: F401
 from .sessions import load, save  # noqa: F401

@@ -1,372 +1,1555 @@
-"""Type stubs for the native extension rotacal._core (units: mm, rad inside, deg in sessions)."""
+"""
+rotacal native core (use the rotacal package, not this module)
+"""
 from __future__ import annotations
-
-import enum
-from typing import Callable, Optional, Sequence, Union
-
-import numpy as np
-import numpy.typing as npt
-
-Array = npt.NDArray[np.float64]
-ArrayLike = npt.ArrayLike
-
-class Error(RuntimeError): ...
-class InvalidArgument(Error): ...
-class DegenerateGeometry(Error): ...
-class ParseError(Error): ...
-class IoError(Error): ...
-
-class MachineType(enum.Enum):
-    AC_trt: MachineType
-    BC_trt: MachineType
-
-def parse_machine_type(text: str) -> MachineType: ...
-def machine_name(machine: MachineType) -> str: ...
-def location_error_names(machine: MachineType) -> list[str]: ...
-def forward(machine: MachineType, errors: ArrayLike, angles: ArrayLike, q_table: ArrayLike) -> Array: ...
-
-class Effect:
-    def __init__(self, id: str) -> None: ...
-    id: str
-    cause: str
-    num_params: int
-    param_names: list[str]
-    param_units: list[str]
-    harmonic: int
-    def applies_to(self, machine: MachineType) -> bool: ...
-
-def effect_catalogue(machine: MachineType, max_harmonic: int = 4) -> list[Effect]: ...
-
-# ---------------------------------------------------------------- sessions
-class BallbarSession:
-    def __init__(self, machine: MachineType, ballbar_length: float, pivot: ArrayLike, tests: Sequence[str],
-                 time: ArrayLike, xyz: ArrayLike, angles_deg: ArrayLike, length: ArrayLike,
-                 noise_um: Optional[float] = None) -> None: ...
-    machine: MachineType
-    ballbar_length: float
-    pivot: Array
-    noise_um: Optional[float]
-    metadata: dict[str, str]
-    tests: list[str]
-    test_names: list[str]
-    time: Array
-    xyz: Array
-    angles_deg: Array
-    length: Array
-    annotations: list[tuple[int, str]]
-    def with_lengths(self, length: ArrayLike) -> BallbarSession: ...
-    def __len__(self) -> int: ...
-
-class RtestSession:
-    machine: MachineType
-    nests: dict[str, Array]
-    probe_dirs: dict[int, Array]
-    noise_um: Optional[float]
-    metadata: dict[str, str]
-    setups: list[str]
-    time: Array
-    angles_deg: Array
-    xyz: Array
-    d: Array
-    def with_displacements(self, d: ArrayLike) -> RtestSession: ...
-    def __len__(self) -> int: ...
-
-def read_session(path: str) -> Union[BallbarSession, RtestSession]: ...
-def read_ballbar(path: str) -> BallbarSession: ...
-def read_rtest(path: str) -> RtestSession: ...
-def write_ballbar(session: BallbarSession, path: str) -> None: ...
-def write_rtest(session: RtestSession, path: str) -> None: ...
-def format_ballbar(session: BallbarSession) -> str: ...
-def format_rtest(session: RtestSession) -> str: ...
-
-# ---------------------------------------------------------------- fits
-class CircleFit:
-    centre: Array
-    radius: float
-    covariance: Array
-    rms: float
-    n: int
-
-class SphereFit:
-    centre: Array
-    radius: float
-    covariance: Array
-    rms: float
-    n: int
-    converged: bool
-
-class PlaneFit:
-    centroid: Array
-    normal: Array
-    singular_values: Array
-    normal_covariance: Array
-    rms: float
-    n: int
-
-def hyper_circle_fit(points: ArrayLike, sigma: float = 0.0, refine: bool = False) -> CircleFit: ...
-def kasa_circle_fit(points: ArrayLike, sigma: float = 0.0, refine: bool = False) -> CircleFit: ...
-def sphere_fit(points: ArrayLike, radius: Optional[float] = None, sigma: float = 0.0) -> SphereFit: ...
-def svd_plane_fit(points: ArrayLike, normal_hint: ArrayLike = ..., sigma: float = 0.0) -> PlaneFit: ...
-
-# ---------------------------------------------------------------- ballbar
-class ParameterEstimate:
-    name: str
-    value: float
-    std: float
-    unit: str
-    observable: bool
-
-class BallbarMachineModel:
-    def __init__(self, machine: MachineType, errors: ArrayLike, pivot: ArrayLike, effects: Sequence[str] = ...,
-                 effect_params: Sequence[float] = ...) -> None: ...
-    machine: MachineType
-    errors: Array
-    pivot: Array
-    effects: list[str]
-    effect_params: list[float]
-
+import collections.abc
+import numpy
+import numpy.typing
+import typing
+__all__: list[str] = ['Ambiguity', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'CandidateScore', 'CircleFit', 'CompensationReport', 'CompensationRow', 'DegenerateGeometry', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'FaultInjection', 'Finding', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'MachineType', 'ModelFit', 'NcDialect', 'NcProgramOptions', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestJointIdentification', 'RtestJointModel', 'RtestPaperIdentification', 'RtestSession', 'SegmentKind', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TransitionArc', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'ballbar_model_document', 'ballbar_model_from_document', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_output', 'compensate_commands', 'compensate_sphere_offset', 'default_ballbar_tests', 'default_calibration_moves', 'diagnose_ballbar', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'parse_ballbar_test', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'test_label', 'verify_compensation', 'write_ballbar', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
+class Ambiguity:
+    @property
+    def correlation(self) -> float:
+        ...
+    @property
+    def delta_bic(self) -> float:
+        ...
+    @property
+    def effects(self) -> list[str]:
+        ...
+    @property
+    def separating_test(self) -> str:
+        ...
 class BallbarIdentification:
-    method: str
-    model: BallbarMachineModel
-    parameters: list[ParameterEstimate]
-    covariance: Array
-    residuals: Array
-    residual_rms_um: float
-    sigma_um: float
-    n_samples: int
-    converged: bool
-    iterations: int
-    unobservable: list[str]
-    notes: list[str]
-
-def identify_joint(session: BallbarSession, fit_length_offset: bool = False, effects: Sequence[str] = ...,
-                   tests: Sequence[str] = ...) -> BallbarIdentification: ...
-def identify_paper(session: BallbarSession) -> BallbarIdentification: ...
-def simulate_ballbar(commanded: BallbarSession, truth: BallbarMachineModel, noise_um: float = 0.5, seed: int = 1,
-                     declare_noise: bool = True) -> BallbarSession: ...
-def predict_session_lengths(model: BallbarMachineModel, session: BallbarSession) -> Array: ...
-def compensate_commands(nominal: BallbarSession, identified: ArrayLike, machine: MachineType) -> BallbarSession: ...
-
-class CompensationRow:
-    name: str
-    unit: str
-    before: float
-    after: float
-    std_after: float
-    change_percent: float
-
-class CompensationReport:
-    rows: list[CompensationRow]
-    before: BallbarIdentification
-    after: BallbarIdentification
-
-def verify_compensation(commanded: BallbarSession, truth: BallbarMachineModel, noise_um: float = 0.5,
-                        seed: int = 1) -> CompensationReport: ...
-
-# planning (test_plan.hpp, nc_program.hpp)
-class BallbarSetup:
-    def __init__(self) -> None: ...
-    machine: MachineType
-    ballbar_length: float
-    pivot: Array
-    tilt_range_deg: Array
-    rot_range_deg: Array
-    step_deg: float
-    feed_mm_per_min: float
-    feed_deg_per_min: float
-
+    @property
+    def converged(self) -> bool:
+        ...
+    @property
+    def covariance(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        ...
+    @property
+    def iterations(self) -> int:
+        ...
+    @property
+    def method(self) -> str:
+        ...
+    @property
+    def model(self) -> BallbarMachineModel:
+        ...
+    @property
+    def n_samples(self) -> int:
+        ...
+    @property
+    def notes(self) -> list[str]:
+        ...
+    @property
+    def parameters(self) -> list[ParameterEstimate]:
+        ...
+    @property
+    def residual_rms_um(self) -> float:
+        ...
+    @property
+    def residuals(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def sigma_um(self) -> float:
+        ...
+    @property
+    def unobservable(self) -> list[str]:
+        ...
+class BallbarMachineModel:
+    """
+    Location errors, actual pivot and effects of a machine.
+    """
+    def __init__(self, machine: MachineType, errors: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], pivot: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], effects: collections.abc.Sequence[str] = [], effect_params: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] = []) -> None:
+        ...
+    @property
+    def effect_params(self) -> list[float]:
+        ...
+    @property
+    def effects(self) -> list[str]:
+        ...
+    @property
+    def errors(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def machine(self) -> MachineType:
+        ...
+    @property
+    def pivot(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
 class BallbarPlan:
-    num_samples: int
-    duration: float
-    labels: list[str]
-    time: Array
-    p_table: Array
-    angles_deg: Array
-    machine_axes: Array
-    def commanded_session(self) -> BallbarSession: ...
-
-def plan_ballbar_test(setup: BallbarSetup, identified: Optional[ArrayLike] = None) -> BallbarPlan: ...
-def write_nc_program(plan: BallbarPlan, dialect: object, options: object = ...) -> str: ...
-
-# ---------------------------------------------------------------- diagnosis
-class DiagnosisOptions:
-    def __init__(self) -> None: ...
-    max_harmonic: int
-    max_findings: int
-    alpha: float
-    min_delta_bic: float
-    cv_blocks: int
-    only: list[str]
-
-class Gain:
-    rms_before_um: float
-    rms_after_um: float
-    delta_bic: float
-    cv_rms_before_um: float
-    cv_rms_after_um: float
-    f_pvalue: float
-
-class Finding:
-    effect: str
-    cause: str
-    parameters: list[ParameterEstimate]
-    gain: Gain
-
+    """
+    Planned toolpath; per-sample arrays in program order.
+    """
+    def commanded_session(self) -> BallbarSession:
+        """
+        The test samples as a BallbarSession (length = L0), e.g. for simulate_ballbar.
+        """
+    @property
+    def angles_deg(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 2]"]:
+        """
+        (N, 2) tilt (A or B) and C, deg
+        """
+    @property
+    def compensation(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[8, 1]"] | None:
+        """
+        (8,) location errors the machine axes were computed with, or None (nominal)
+        """
+    @property
+    def duration(self) -> float:
+        """
+        s
+        """
+    @property
+    def labels(self) -> list[str]:
+        """
+        segment label per sample ('transition' between tests)
+        """
+    @property
+    def machine_axes(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 5]"]:
+        """
+        (N, 5) X, Y, Z (mm), tilt, C (deg)
+        """
+    @property
+    def num_samples(self) -> int:
+        ...
+    @property
+    def p_table(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
+        """
+        (N, 3) tool-cup ball centre, table frame, mm
+        """
+    @property
+    def segment_index(self) -> list[int]:
+        ...
+    @property
+    def segments(self) -> list[PlanSegment]:
+        ...
+    @property
+    def setup(self) -> BallbarSetup:
+        ...
+    @property
+    def time(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        (N,) s
+        """
+class BallbarSession:
+    """
+    A rotacal-ballbar/1 session (mm, deg, s).
+    """
+    def __init__(self, machine: MachineType, ballbar_length: typing.SupportsFloat | typing.SupportsIndex, pivot: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], tests: collections.abc.Sequence[str], time: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], xyz: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 3]"], angles_deg: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 2]"], length: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], noise_um: typing.SupportsFloat | typing.SupportsIndex | None = None) -> None:
+        """
+        Build a session from columns: tests (N labels), time (N,), xyz (N,3) tool cup, angles_deg (N,2) tilt and C, length (N,) measured lengths.
+        """
+    def __len__(self) -> int:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def with_lengths(self, length: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> BallbarSession:
+        """
+        The same session with other lengths (e.g. a model's prediction).
+        """
+    @property
+    def angles_deg(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 2]"]:
+        ...
+    @property
+    def annotations(self) -> list[tuple[int, str]]:
+        ...
+    @property
+    def ballbar_length(self) -> float:
+        ...
+    @property
+    def length(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def machine(self) -> MachineType:
+        ...
+    @property
+    def metadata(self) -> dict:
+        ...
+    @property
+    def noise_um(self) -> float | None:
+        ...
+    @property
+    def pivot(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @property
+    def test_names(self) -> list[str]:
+        """
+        distinct test labels, in order
+        """
+    @property
+    def tests(self) -> list[str]:
+        """
+        test label of every sample
+        """
+    @property
+    def time(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def warnings(self) -> list[str]:
+        """
+        what the reader found suspicious but kept
+        """
+    @property
+    def xyz(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
+        ...
+class BallbarSetup:
+    """
+    Layout of the single set-up ballbar test (mm, deg, mm/min, deg/min).
+    """
+    machine: MachineType
+    radial_c_side: RadialSide
+    def __init__(self, machine: MachineType = MachineType.AC_trt, ballbar_length: typing.SupportsFloat | typing.SupportsIndex = 100.0, pivot: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ..., tilt_range_deg: typing.Annotated[collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], "FixedSize(2)"] = [-90.0, 90.0], rot_range_deg: typing.Annotated[collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], "FixedSize(2)"] = [0.0, 360.0], step_deg: typing.SupportsFloat | typing.SupportsIndex = 1.0, feed_mm_per_min: typing.SupportsFloat | typing.SupportsIndex = 1000.0, feed_deg_per_min: typing.SupportsFloat | typing.SupportsIndex = 3600.0, tests: collections.abc.Sequence[BallbarTest] = ..., radial_c_side: RadialSide = RadialSide.outside) -> None:
+        ...
+    @property
+    def ballbar_length(self) -> float:
+        """
+        L0, mm
+        """
+    @ballbar_length.setter
+    def ballbar_length(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def feed_deg_per_min(self) -> float:
+        ...
+    @feed_deg_per_min.setter
+    def feed_deg_per_min(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def feed_mm_per_min(self) -> float:
+        ...
+    @feed_mm_per_min.setter
+    def feed_mm_per_min(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def pivot(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        """
+        nominal pivot ball centre, table frame, mm
+        """
+    @pivot.setter
+    def pivot(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+        ...
+    @property
+    def rot_range_deg(self) -> typing.Annotated[list[float], "FixedSize(2)"]:
+        """
+        C sweep, deg; a 360 deg span is a full turn without its repeated end
+        """
+    @rot_range_deg.setter
+    def rot_range_deg(self, arg0: typing.Annotated[collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], "FixedSize(2)"]) -> None:
+        ...
+    @property
+    def step_deg(self) -> float:
+        ...
+    @step_deg.setter
+    def step_deg(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def tests(self) -> list[BallbarTest]:
+        ...
+    @tests.setter
+    def tests(self, arg0: collections.abc.Sequence[BallbarTest]) -> None:
+        ...
+    @property
+    def tilt_range_deg(self) -> typing.Annotated[list[float], "FixedSize(2)"]:
+        ...
+    @tilt_range_deg.setter
+    def tilt_range_deg(self, arg0: typing.Annotated[collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], "FixedSize(2)"]) -> None:
+        ...
+class BallbarTest:
+    """
+    Tests of the single set-up method; *_tilt are A or B by machine.
+    
+    Members:
+    
+      sphere_xy
+    
+      sphere_yz
+    
+      sphere_zx
+    
+      radial_tilt
+    
+      axial_tilt
+    
+      radial_c
+    
+      axial_c
+    """
+    __members__: typing.ClassVar[dict[str, BallbarTest]]  # value = {'sphere_xy': <BallbarTest.sphere_xy: 0>, 'sphere_yz': <BallbarTest.sphere_yz: 1>, 'sphere_zx': <BallbarTest.sphere_zx: 2>, 'radial_tilt': <BallbarTest.radial_tilt: 3>, 'axial_tilt': <BallbarTest.axial_tilt: 4>, 'radial_c': <BallbarTest.radial_c: 5>, 'axial_c': <BallbarTest.axial_c: 6>}
+    axial_c: typing.ClassVar[BallbarTest]  # value = <BallbarTest.axial_c: 6>
+    axial_tilt: typing.ClassVar[BallbarTest]  # value = <BallbarTest.axial_tilt: 4>
+    radial_c: typing.ClassVar[BallbarTest]  # value = <BallbarTest.radial_c: 5>
+    radial_tilt: typing.ClassVar[BallbarTest]  # value = <BallbarTest.radial_tilt: 3>
+    sphere_xy: typing.ClassVar[BallbarTest]  # value = <BallbarTest.sphere_xy: 0>
+    sphere_yz: typing.ClassVar[BallbarTest]  # value = <BallbarTest.sphere_yz: 1>
+    sphere_zx: typing.ClassVar[BallbarTest]  # value = <BallbarTest.sphere_zx: 2>
+    @typing.overload
+    def __eq__(self, other: BallbarTest) -> bool:
+        ...
+    @typing.overload
+    def __eq__(self, other: typing.Any) -> bool:
+        ...
+    def __getstate__(self) -> int:
+        ...
+    def __hash__(self) -> int:
+        ...
+    def __index__(self) -> int:
+        ...
+    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __int__(self) -> int:
+        ...
+    @typing.overload
+    def __ne__(self, other: BallbarTest) -> bool:
+        ...
+    @typing.overload
+    def __ne__(self, other: typing.Any) -> bool:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __str__(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def value(self) -> int:
+        ...
+class CandidateScore:
+    @property
+    def delta_bic(self) -> float:
+        ...
+    @property
+    def effect(self) -> str:
+        ...
+    @property
+    def f_pvalue(self) -> float:
+        ...
+    @property
+    def rms_after_um(self) -> float:
+        ...
+    @property
+    def visible_params(self) -> int:
+        ...
+class CircleFit:
+    @property
+    def centre(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[2, 1]"]:
+        ...
+    @property
+    def covariance(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
+        """
+        (cx, cy, r), 1-sigma^2
+        """
+    @property
+    def n(self) -> int:
+        ...
+    @property
+    def radius(self) -> float:
+        ...
+    @property
+    def rms(self) -> float:
+        ...
+class CompensationReport:
+    @property
+    def after(self) -> BallbarIdentification:
+        ...
+    @property
+    def before(self) -> BallbarIdentification:
+        ...
+    @property
+    def rows(self) -> list[CompensationRow]:
+        ...
+class CompensationRow:
+    @property
+    def after(self) -> float:
+        ...
+    @property
+    def before(self) -> float:
+        ...
+    @property
+    def change_percent(self) -> float:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def std_after(self) -> float:
+        ...
+    @property
+    def unit(self) -> str:
+        ...
+class DegenerateGeometry(Error):
+    pass
+class DeviceDisconnected(SerialError):
+    pass
 class Diagnosis:
-    machine: MachineType
-    findings: list[Finding]
-    seconds: float
-
-def diagnose_ballbar(session: BallbarSession, options: DiagnosisOptions = ...,
-                     reference: Optional[BallbarSession] = None) -> Diagnosis: ...
-def diagnose_rtest(session: RtestSession, options: DiagnosisOptions = ...) -> Diagnosis: ...
-
-# ---------------------------------------------------------------- R-test
-class RtestBasis:
-    def __init__(self, b_degree: int = 6, c_harmonics: int = 2, c_b_degree: int = 1,
-                 gamma_cb: bool = False) -> None: ...
-    b_degree: int
-    c_harmonics: int
-    c_b_degree: int
-    gamma_cb: bool
-    def coefficient_names(self) -> list[str]: ...
-
-class RtestJointModel:
-    def __init__(self, machine: MachineType, basis: RtestBasis, params: ArrayLike, covariance: ArrayLike,
-                 observable: Sequence[bool]) -> None: ...
-    machine: MachineType
-    basis: RtestBasis
-    params: Array
-    covariance: Array
-    observable: list[bool]
-    def readings(self, q: ArrayLike, angles: ArrayLike) -> tuple[Array, Array]: ...
-    def table_errors(self, q: ArrayLike, angles: ArrayLike) -> tuple[Array, Array]: ...
-    def w_by(self, B: ArrayLike) -> tuple[Array, Array]: ...
-    def w_cb(self, angles: ArrayLike) -> tuple[Array, Array]: ...
-
-class RtestJointIdentification:
-    method: str
-    model: RtestJointModel
-    parameters: list[ParameterEstimate]
-    covariance: Array
-    probe_zeros: dict[str, Array]
-    residuals: Array
-    residual_rms_um: float
-    sigma_um: float
-    n_samples: int
-    converged: bool
-    iterations: int
-    unobservable: list[str]
-    notes: list[str]
-
-class RtestPaperIdentification:
-    method: str
-    b_deg: list[float]
-    c_deg: list[float]
-    residual_rms_um: float
-    n_samples: int
-    unobservable: list[str]
-    notes: list[str]
-
-def identify_rtest_joint(session: RtestSession, basis: RtestBasis = ...) -> RtestJointIdentification: ...
-def identify_rtest_paper(session: RtestSession) -> RtestPaperIdentification: ...
-def rtest_error_map(identification: object, *args: object) -> str: ...
-def predict_rtest_session(model: RtestJointModel, session: RtestSession,
-                          probe_zeros: dict[str, ArrayLike] = ...) -> RtestSession: ...
-def rtest_prediction_rms_um(model: RtestJointModel, session: RtestSession) -> float: ...
-def simulate_rtest(machine: MachineType, errors: ArrayLike, effects: Sequence[str], effect_params: Sequence[float],
-                   b_deg: Sequence[float], c_deg: Sequence[float], nests: ArrayLike, dwell_s: float,
-                   noise_um: float, probe_zero_um: float, probe_dirs: Optional[ArrayLike] = None,
-                   write_d: bool = True, seed: int = 1) -> tuple[RtestSession, Array]: ...
-def rtest_readings(machine: MachineType, errors: ArrayLike, effects: Sequence[str], effect_params: Sequence[float],
-                   q: ArrayLike, angles: ArrayLike, time: ArrayLike) -> Array: ...
-
-class ProbeCalibration:
-    dirs: Array
-    gains: Array
-    zeros: Array
-    direction_std_rad: Array
-    gain_std: Array
-    residuals: Array
-    residual_rms_um: float
-    sigma_um: float
-
-class SphereOffsetCalibration:
-    offset: Array
-    offset_std: Array
-    centre: Array
-    residual_rms_um: float
-
-def calibrate_probe_directions(moves: ArrayLike, readings: ArrayLike) -> ProbeCalibration: ...
-def simulate_probe_calibration(dirs: ArrayLike, zeros: ArrayLike, moves: ArrayLike, noise_um: float,
-                               seed: int) -> Array: ...
-def default_calibration_moves(step_mm: float = 0.5) -> Array: ...
-def calibrate_sphere_offset(dirs: ArrayLike, angles: ArrayLike, readings: ArrayLike) -> SphereOffsetCalibration: ...
-def simulate_spindle_indexing(dirs: ArrayLike, zeros: ArrayLike, offset: ArrayLike, centre: ArrayLike,
-                              angles: Sequence[float], noise_um: float, seed: int) -> Array: ...
-def displacements_from_raw(session: RtestSession, dirs: Optional[ArrayLike] = None) -> RtestSession: ...
-def compensate_sphere_offset(session: RtestSession, offset: ArrayLike) -> RtestSession: ...
-
-# --- hw: virtual instruments and recorders (include/rotacal/hw)
-class SerialError(IoError): ...
-class DeviceDisconnected(SerialError): ...
-
+    @property
+    def ambiguous(self) -> list[Ambiguity]:
+        ...
+    @property
+    def baseline(self) -> DiagnosisBaseline:
+        ...
+    @property
+    def baseline_fit(self) -> ModelFit:
+        ...
+    @property
+    def final_fit(self) -> ModelFit:
+        ...
+    @property
+    def findings(self) -> list[Finding]:
+        ...
+    @property
+    def machine(self) -> MachineType:
+        ...
+    @property
+    def rounds(self) -> list[list[CandidateScore]]:
+        ...
+    @property
+    def seconds(self) -> float:
+        ...
+    @property
+    def structure_after(self) -> list[GroupResidual]:
+        ...
+    @property
+    def structure_before(self) -> list[GroupResidual]:
+        ...
+    @property
+    def unexplained(self) -> Unexplained:
+        ...
+    @property
+    def unobservable(self) -> list[UnobservableEffect]:
+        ...
+class DiagnosisBaseline:
+    @property
+    def chi2_per_dof(self) -> float:
+        ...
+    @property
+    def dof(self) -> int:
+        ...
+    @property
+    def n(self) -> int:
+        ...
+    @property
+    def noise_source(self) -> str:
+        ...
+    @property
+    def noise_um(self) -> float:
+        ...
+    @property
+    def p_value(self) -> float:
+        ...
+    @property
+    def residual_rms_um(self) -> float:
+        ...
+class DiagnosisOptions:
+    def __init__(self) -> None:
+        ...
+    @property
+    def alpha(self) -> float:
+        ...
+    @alpha.setter
+    def alpha(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def cv_blocks(self) -> int:
+        ...
+    @cv_blocks.setter
+    def cv_blocks(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def max_findings(self) -> int:
+        ...
+    @max_findings.setter
+    def max_findings(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def max_harmonic(self) -> int:
+        ...
+    @max_harmonic.setter
+    def max_harmonic(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def min_delta_bic(self) -> float:
+        ...
+    @min_delta_bic.setter
+    def min_delta_bic(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def only(self) -> list[str]:
+        ...
+    @only.setter
+    def only(self, arg0: collections.abc.Sequence[str]) -> None:
+        ...
+class Effect:
+    """
+    One entry of the effects catalogue (shared/spec/effects.md).
+    """
+    __hash__: typing.ClassVar[None] = None
+    def __eq__(self, arg0: Effect) -> bool:
+        ...
+    def __init__(self, id: str) -> None:
+        """
+        Parse a catalogue id such as 'coning_B'.
+        """
+    def __repr__(self) -> str:
+        ...
+    def applies_to(self, machine: MachineType) -> bool:
+        ...
+    @property
+    def cause(self) -> str:
+        ...
+    @property
+    def harmonic(self) -> int:
+        ...
+    @property
+    def id(self) -> str:
+        ...
+    @property
+    def num_params(self) -> int:
+        ...
+    @property
+    def param_names(self) -> list[str]:
+        ...
+    @property
+    def param_units(self) -> list[str]:
+        ...
+class Error(RuntimeError):
+    pass
 class FaultInjection:
-    garbage_every: int
-    corrupt_every: int
-    drop_every: int
+    """
+    Faults a virtual instrument acts out (counted in frames).
+    """
     split_frames: bool
-    close_after: int
-    silence_after: int
-    def __init__(self) -> None: ...
-
-class VirtualBallbar:
-    def __init__(self, plan: BallbarPlan, truth: BallbarMachineModel, noise_um: float = 0.5, seed: int = 1,
-                 rate_hz: float = 1000.0, speed: float = 1.0, baud: int = 115200,
-                 faults: FaultInjection = ...) -> None: ...
+    def __init__(self) -> None:
+        ...
     @property
-    def port(self) -> str: ...
+    def close_after(self) -> int:
+        ...
+    @close_after.setter
+    def close_after(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
     @property
-    def finished(self) -> bool: ...
-    def start(self) -> None: ...
-    def stop(self) -> None: ...
-    def stats(self) -> dict: ...
-
-class VirtualRtest:
-    def __init__(self, machine: MachineType, errors: ArrayLike, effects: Sequence[str],
-                 effect_params: Sequence[float], b_deg: Sequence[float], c_deg: Sequence[float],
-                 nests: ArrayLike, dwell_s: float, noise_um: float, probe_zero_um: float, probe_dirs: ArrayLike,
-                 seed: int, mode: str = "keyence", rate_hz: float = 100.0, speed: float = 1.0,
-                 baud: int = 115200, faults: FaultInjection = ...) -> None: ...
+    def corrupt_every(self) -> int:
+        ...
+    @corrupt_every.setter
+    def corrupt_every(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
     @property
-    def port(self) -> str: ...
+    def drop_every(self) -> int:
+        ...
+    @drop_every.setter
+    def drop_every(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
     @property
-    def finished(self) -> bool: ...
+    def garbage_every(self) -> int:
+        ...
+    @garbage_every.setter
+    def garbage_every(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
     @property
-    def program(self) -> RtestSession: ...
+    def silence_after(self) -> int:
+        ...
+    @silence_after.setter
+    def silence_after(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+class Finding:
     @property
-    def probe_zeros(self) -> Array: ...
-    def start(self) -> None: ...
-    def stop(self) -> None: ...
-    def stats(self) -> dict: ...
-
+    def cause(self) -> str:
+        ...
+    @property
+    def effect(self) -> str:
+        ...
+    @property
+    def gain(self) -> Gain:
+        ...
+    @property
+    def parameters(self) -> list[ParameterEstimate]:
+        ...
+    @property
+    def shifts(self) -> list[ParameterShift]:
+        ...
+class Gain:
+    @property
+    def cv_rms_after_um(self) -> float:
+        ...
+    @property
+    def cv_rms_before_um(self) -> float:
+        ...
+    @property
+    def delta_bic(self) -> float:
+        ...
+    @property
+    def f_pvalue(self) -> float:
+        ...
+    @property
+    def rms_after_um(self) -> float:
+        ...
+    @property
+    def rms_before_um(self) -> float:
+        ...
+class GroupResidual:
+    @property
+    def angle_axis(self) -> str:
+        ...
+    @property
+    def group(self) -> str:
+        ...
+    @property
+    def harmonic_note(self) -> str:
+        ...
+    @property
+    def harmonic_um(self) -> list[float]:
+        ...
+    @property
+    def harmonics_left_out(self) -> list[int]:
+        ...
+    @property
+    def mean_um(self) -> float:
+        ...
+    @property
+    def n(self) -> int:
+        ...
+    @property
+    def rms_um(self) -> float:
+        ...
+    @property
+    def trend_um_per_s(self) -> float:
+        ...
+class InvalidArgument(Error):
+    pass
+class IoError(Error):
+    pass
+class MachineType:
+    """
+    Members:
+    
+      AC_trt
+    
+      BC_trt
+    """
+    AC_trt: typing.ClassVar[MachineType]  # value = <MachineType.AC_trt: 0>
+    BC_trt: typing.ClassVar[MachineType]  # value = <MachineType.BC_trt: 1>
+    __members__: typing.ClassVar[dict[str, MachineType]]  # value = {'AC_trt': <MachineType.AC_trt: 0>, 'BC_trt': <MachineType.BC_trt: 1>}
+    @typing.overload
+    def __eq__(self, other: MachineType) -> bool:
+        ...
+    @typing.overload
+    def __eq__(self, other: typing.Any) -> bool:
+        ...
+    def __getstate__(self) -> int:
+        ...
+    def __hash__(self) -> int:
+        ...
+    def __index__(self) -> int:
+        ...
+    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __int__(self) -> int:
+        ...
+    @typing.overload
+    def __ne__(self, other: MachineType) -> bool:
+        ...
+    @typing.overload
+    def __ne__(self, other: typing.Any) -> bool:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __str__(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def value(self) -> int:
+        ...
+class ModelFit:
+    @property
+    def effects(self) -> list[str]:
+        ...
+    @property
+    def num_free(self) -> int:
+        ...
+    @property
+    def parameters(self) -> list[ParameterEstimate]:
+        ...
+    @property
+    def residuals(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+class NcDialect:
+    """
+    Members:
+    
+      linuxcnc
+    
+      heidenhain
+    
+      siemens
+    
+      fanuc
+    """
+    __members__: typing.ClassVar[dict[str, NcDialect]]  # value = {'linuxcnc': <NcDialect.linuxcnc: 0>, 'heidenhain': <NcDialect.heidenhain: 1>, 'siemens': <NcDialect.siemens: 2>, 'fanuc': <NcDialect.fanuc: 3>}
+    fanuc: typing.ClassVar[NcDialect]  # value = <NcDialect.fanuc: 3>
+    heidenhain: typing.ClassVar[NcDialect]  # value = <NcDialect.heidenhain: 1>
+    linuxcnc: typing.ClassVar[NcDialect]  # value = <NcDialect.linuxcnc: 0>
+    siemens: typing.ClassVar[NcDialect]  # value = <NcDialect.siemens: 2>
+    @typing.overload
+    def __eq__(self, other: NcDialect) -> bool:
+        ...
+    @typing.overload
+    def __eq__(self, other: typing.Any) -> bool:
+        ...
+    def __getstate__(self) -> int:
+        ...
+    def __hash__(self) -> int:
+        ...
+    def __index__(self) -> int:
+        ...
+    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __int__(self) -> int:
+        ...
+    @typing.overload
+    def __ne__(self, other: NcDialect) -> bool:
+        ...
+    @typing.overload
+    def __ne__(self, other: typing.Any) -> bool:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __str__(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def value(self) -> int:
+        ...
+class NcProgramOptions:
+    program_name: str
+    stop_to_mount: bool
+    def __init__(self, decimals: typing.SupportsInt | typing.SupportsIndex = 4, tool: typing.SupportsInt | typing.SupportsIndex = 1, stop_to_mount: bool = True, program_name: str = 'ROTACAL_BALLBAR', program_number: typing.SupportsInt | typing.SupportsIndex = 1000) -> None:
+        ...
+    @property
+    def decimals(self) -> int:
+        ...
+    @decimals.setter
+    def decimals(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def program_number(self) -> int:
+        ...
+    @program_number.setter
+    def program_number(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def tool(self) -> int:
+        ...
+    @tool.setter
+    def tool(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+class ParameterEstimate:
+    def __repr__(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def observable(self) -> bool:
+        ...
+    @property
+    def std(self) -> float:
+        ...
+    @property
+    def unit(self) -> str:
+        ...
+    @property
+    def value(self) -> float:
+        ...
+class ParameterShift:
+    @property
+    def after(self) -> float:
+        ...
+    @property
+    def before(self) -> float:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def std_after(self) -> float:
+        ...
+    @property
+    def unit(self) -> str:
+        ...
+class ParseError(Error):
+    pass
+class PlanSegment:
+    @property
+    def arc(self) -> TransitionArc:
+        ...
+    @property
+    def kind(self) -> SegmentKind:
+        ...
+    @property
+    def label(self) -> str:
+        ...
+    @property
+    def num_samples(self) -> int:
+        ...
+    @property
+    def test(self) -> rotacal._core.BallbarTest | None:
+        ...
+class PlaneFit:
+    @property
+    def centroid(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @property
+    def n(self) -> int:
+        ...
+    @property
+    def normal(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @property
+    def normal_covariance(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
+        ...
+    @property
+    def rms(self) -> float:
+        ...
+    @property
+    def singular_values(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+class ProbeCalibration:
+    """
+    Probe directions from linear moves.
+    """
+    @property
+    def direction_std_rad(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @property
+    def dirs(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
+        """
+        unit directions (rows), table frame
+        """
+    @property
+    def gain_std(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @property
+    def gains(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @property
+    def residual_rms_um(self) -> float:
+        ...
+    @property
+    def residuals(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
+        ...
+    @property
+    def sigma_um(self) -> float:
+        ...
+    @property
+    def zeros(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        """
+        probe zero offsets, mm
+        """
+class RadialSide:
+    """
+    Flynn's +-L0 of the radial C test.
+    
+    Members:
+    
+      outside
+    
+      inside
+    """
+    __members__: typing.ClassVar[dict[str, RadialSide]]  # value = {'outside': <RadialSide.outside: 0>, 'inside': <RadialSide.inside: 1>}
+    inside: typing.ClassVar[RadialSide]  # value = <RadialSide.inside: 1>
+    outside: typing.ClassVar[RadialSide]  # value = <RadialSide.outside: 0>
+    @typing.overload
+    def __eq__(self, other: RadialSide) -> bool:
+        ...
+    @typing.overload
+    def __eq__(self, other: typing.Any) -> bool:
+        ...
+    def __getstate__(self) -> int:
+        ...
+    def __hash__(self) -> int:
+        ...
+    def __index__(self) -> int:
+        ...
+    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __int__(self) -> int:
+        ...
+    @typing.overload
+    def __ne__(self, other: RadialSide) -> bool:
+        ...
+    @typing.overload
+    def __ne__(self, other: typing.Any) -> bool:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __str__(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def value(self) -> int:
+        ...
 class RecordSummary:
-    rows: int
-    frames: int
-    lost: int
-    crc_errors: int
-    malformed: int
-    garbage_bytes: int
-    over_range: int
-    timeouts: int
-    reason: str
-    detail: str
-    def describe(self) -> str: ...
-
-def record_ballbar(port: str, plan: BallbarPlan, path: str, baud: int = 115200, rate_hz: float = 1000.0,
-                   zero: bool = False, silence_timeout_s: float = 3.0,
-                   progress: Optional[Callable[[int, int, int, float, float], bool]] = None) -> RecordSummary: ...
-def record_rtest(port: str, mode: str, program: RtestSession, dwell_s: float, probe_dirs: ArrayLike, path: str,
-                 baud: int = 115200, rate_hz: float = 100.0, speed: float = 1.0, silence_timeout_s: float = 3.0,
-                 progress: Optional[Callable[[int, int, int, float, float], bool]] = None) -> RecordSummary: ...
-def list_serial_ports() -> list[tuple[str, str, str]]: ...
+    def describe(self) -> str:
+        ...
+    @property
+    def crc_errors(self) -> int:
+        ...
+    @property
+    def detail(self) -> str:
+        ...
+    @property
+    def frames(self) -> int:
+        ...
+    @property
+    def garbage_bytes(self) -> int:
+        ...
+    @property
+    def lost(self) -> int:
+        ...
+    @property
+    def malformed(self) -> int:
+        ...
+    @property
+    def over_range(self) -> int:
+        ...
+    @property
+    def reason(self) -> str:
+        ...
+    @property
+    def rows(self) -> int:
+        ...
+    @property
+    def timeouts(self) -> int:
+        ...
+class RtestBasis:
+    """
+    Smooth basis of the position-dependent errors (rtest/identify_joint.hpp).
+    """
+    def __init__(self, b_degree: typing.SupportsInt | typing.SupportsIndex = 6, c_harmonics: typing.SupportsInt | typing.SupportsIndex = 2, c_b_degree: typing.SupportsInt | typing.SupportsIndex = 1, gamma_cb: bool = False) -> None:
+        ...
+    def coefficient_names(self) -> list[str]:
+        """
+        Names of the map coefficients, B map first, in parameter order.
+        """
+    @property
+    def b_degree(self) -> int:
+        """
+        highest power of b = B / 90 deg in the B map
+        """
+    @property
+    def c_b_degree(self) -> int:
+        """
+        degree in b of the C-map coefficients
+        """
+    @property
+    def c_harmonics(self) -> int:
+        """
+        harmonics 1..K of C in the C map
+        """
+    @property
+    def gamma_cb(self) -> bool:
+        """
+        gamma_CB (angular positioning of C) in the C map
+        """
+class RtestJointIdentification:
+    @property
+    def converged(self) -> bool:
+        ...
+    @property
+    def covariance(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        ...
+    @property
+    def iterations(self) -> int:
+        ...
+    @property
+    def method(self) -> str:
+        ...
+    @property
+    def model(self) -> RtestJointModel:
+        ...
+    @property
+    def n_samples(self) -> int:
+        ...
+    @property
+    def notes(self) -> list[str]:
+        ...
+    @property
+    def parameters(self) -> list[ParameterEstimate]:
+        ...
+    @property
+    def probe_zeros(self) -> dict[str, typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]]:
+        ...
+    @property
+    def residual_rms_um(self) -> float:
+        ...
+    @property
+    def residuals(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
+        ...
+    @property
+    def sigma_um(self) -> float:
+        ...
+    @property
+    def unobservable(self) -> list[str]:
+        ...
+class RtestJointModel:
+    """
+    Location errors and smooth error maps of a B/C table, with covariance.
+    """
+    def __init__(self, machine: MachineType, basis: RtestBasis, params: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], covariance: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"], observable: collections.abc.Sequence[bool]) -> None:
+        """
+        Rebuild a model from its parts (checked against the basis: rtest/predict.hpp).
+        """
+    def readings(self, q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], angles: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]]:
+        """
+        R-test readings (N, 3) of the nest at q (table frame, mm) at angles (N, 2) = (B, C) in rad, without probe zero, and their 1-sigma (N, 3) (NaN where an unobservable parameter enters).
+        """
+    def table_errors(self, q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], angles: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]]:
+        """
+        Error T q - T_nominal q (N, 3) of the table point q (mm) at angles (N, 2) in rad, machine frame, mm, and its 1-sigma.
+        """
+    def w_by(self, B: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 6]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 6]"]]:
+        """
+        B-axis map (N, 6) = (dx, dy, dz, alpha, beta, gamma)_BY (mm, rad) at B (N,) in rad, and its 1-sigma.
+        """
+    def w_cb(self, angles: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 6]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 6]"]]:
+        """
+        C-axis map (N, 6) at angles (N, 2) = (B, C) in rad, and its 1-sigma.
+        """
+    @property
+    def basis(self) -> RtestBasis:
+        ...
+    @property
+    def covariance(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        ...
+    @property
+    def machine(self) -> MachineType:
+        ...
+    @property
+    def observable(self) -> list[bool]:
+        ...
+    @property
+    def params(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        8 location errors, then the map coefficients (mm, rad)
+        """
+class RtestPaperIdentification:
+    @property
+    def b_deg(self) -> list[float]:
+        ...
+    @property
+    def c_deg(self) -> list[float]:
+        ...
+    @property
+    def method(self) -> str:
+        ...
+    @property
+    def n_samples(self) -> int:
+        ...
+    @property
+    def notes(self) -> list[str]:
+        ...
+    @property
+    def residual_rms_um(self) -> float:
+        ...
+    @property
+    def unobservable(self) -> list[str]:
+        ...
+class RtestSession:
+    """
+    A rotacal-rtest/1 session (mm, deg, s).
+    """
+    def __len__(self) -> int:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def with_displacements(self, d: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 3]"]) -> RtestSession:
+        ...
+    @property
+    def angles_deg(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 2]"]:
+        ...
+    @property
+    def d(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
+        """
+        dx, dy, dz (N,3), table frame, mm
+        """
+    @property
+    def machine(self) -> MachineType:
+        ...
+    @property
+    def metadata(self) -> dict:
+        ...
+    @property
+    def nests(self) -> dict[str, typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]]:
+        ...
+    @property
+    def noise_um(self) -> float | None:
+        ...
+    @property
+    def probe_dirs(self) -> dict[int, typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]]:
+        ...
+    @property
+    def setups(self) -> list[str]:
+        """
+        set-up (nest) label of every pose
+        """
+    @property
+    def time(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def warnings(self) -> list[str]:
+        """
+        what the reader found suspicious but kept
+        """
+    @property
+    def xyz(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
+        ...
+class SegmentKind:
+    """
+    Members:
+    
+      test
+    
+      rotary_transition
+    
+      arc_transition
+    """
+    __members__: typing.ClassVar[dict[str, SegmentKind]]  # value = {'test': <SegmentKind.test: 0>, 'rotary_transition': <SegmentKind.rotary_transition: 1>, 'arc_transition': <SegmentKind.arc_transition: 2>}
+    arc_transition: typing.ClassVar[SegmentKind]  # value = <SegmentKind.arc_transition: 2>
+    rotary_transition: typing.ClassVar[SegmentKind]  # value = <SegmentKind.rotary_transition: 1>
+    test: typing.ClassVar[SegmentKind]  # value = <SegmentKind.test: 0>
+    @typing.overload
+    def __eq__(self, other: SegmentKind) -> bool:
+        ...
+    @typing.overload
+    def __eq__(self, other: typing.Any) -> bool:
+        ...
+    def __getstate__(self) -> int:
+        ...
+    def __hash__(self) -> int:
+        ...
+    def __index__(self) -> int:
+        ...
+    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __int__(self) -> int:
+        ...
+    @typing.overload
+    def __ne__(self, other: SegmentKind) -> bool:
+        ...
+    @typing.overload
+    def __ne__(self, other: typing.Any) -> bool:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __str__(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def value(self) -> int:
+        ...
+class SerialError(IoError):
+    pass
+class SphereFit:
+    @property
+    def centre(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @property
+    def converged(self) -> bool:
+        ...
+    @property
+    def covariance(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
+        """
+        (cx, cy, cz, r), 1-sigma^2
+        """
+    @property
+    def n(self) -> int:
+        ...
+    @property
+    def radius(self) -> float:
+        ...
+    @property
+    def rms(self) -> float:
+        ...
+class SphereOffsetCalibration:
+    """
+    Sphere offset from the spindle axis.
+    """
+    @property
+    def centre(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @property
+    def offset(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[2, 1]"]:
+        """
+        (x, y) at spindle angle 0, mm
+        """
+    @property
+    def offset_std(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[2, 1]"]:
+        ...
+    @property
+    def residual_rms_um(self) -> float:
+        ...
+class TransitionArc:
+    """
+    Great-circle arc about the pivot at rotary zero (mm, rad).
+    """
+    @property
+    def angle(self) -> float:
+        ...
+    @property
+    def axis(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @property
+    def center(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @property
+    def end(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @property
+    def principal_axis(self) -> int:
+        ...
+    @property
+    def start(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+class Unexplained:
+    @property
+    def chi2_per_dof(self) -> float:
+        ...
+    @property
+    def p_value(self) -> float:
+        ...
+    @property
+    def present(self) -> bool:
+        ...
+    @property
+    def signature(self) -> str:
+        ...
+class UnobservableEffect:
+    @property
+    def effect(self) -> str:
+        ...
+    @property
+    def reason(self) -> str:
+        ...
+class VirtualBallbar:
+    """
+    A ballbar on a simulated machine, served on a pseudo-terminal.
+    """
+    def __init__(self, plan: BallbarPlan, truth: BallbarMachineModel, noise_um: typing.SupportsFloat | typing.SupportsIndex = 0.5, seed: typing.SupportsInt | typing.SupportsIndex = 1, rate_hz: typing.SupportsFloat | typing.SupportsIndex = 1000.0, speed: typing.SupportsFloat | typing.SupportsIndex = 1.0, baud: typing.SupportsInt | typing.SupportsIndex = 115200, faults: FaultInjection = ...) -> None:
+        ...
+    def start(self) -> None:
+        ...
+    def stats(self) -> dict:
+        ...
+    def stop(self) -> None:
+        ...
+    @property
+    def finished(self) -> bool:
+        ...
+    @property
+    def port(self) -> str:
+        ...
+class VirtualRtest:
+    """
+    An R-test on a simulated B/C table, served on a pseudo-terminal.
+    """
+    def __init__(self, machine: MachineType, errors: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], effects: collections.abc.Sequence[str], effect_params: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], b_deg: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], c_deg: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], nests: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], dwell_s: typing.SupportsFloat | typing.SupportsIndex, noise_um: typing.SupportsFloat | typing.SupportsIndex, probe_zero_um: typing.SupportsFloat | typing.SupportsIndex, probe_dirs: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], seed: typing.SupportsInt | typing.SupportsIndex, mode: str = 'keyence', rate_hz: typing.SupportsFloat | typing.SupportsIndex = 100.0, speed: typing.SupportsFloat | typing.SupportsIndex = 1.0, baud: typing.SupportsInt | typing.SupportsIndex = 115200, faults: FaultInjection = ...) -> None:
+        ...
+    def start(self) -> None:
+        ...
+    def stats(self) -> dict:
+        ...
+    def stop(self) -> None:
+        ...
+    @property
+    def finished(self) -> bool:
+        ...
+    @property
+    def port(self) -> str:
+        ...
+    @property
+    def probe_zeros(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
+        ...
+    @property
+    def program(self) -> RtestSession:
+        """
+        Commanded rows (set-up, time, B, C, X, Y, Z) and nests.
+        """
+def ballbar_model_document(model: ...) -> typing.Any:
+    ...
+def ballbar_model_from_document(document: dict, source: str = '<model>') -> ...:
+    ...
+def calibrate_probe_directions(moves: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], readings: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> ProbeCalibration:
+    """
+    Probe directions, gains and zeros from commanded moves (N, 3) and readings (N, 3), mm.
+    """
+def calibrate_sphere_offset(dirs: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], angles: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], readings: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> SphereOffsetCalibration:
+    """
+    Sphere offset from spindle indexing: angles (N,) rad, readings (N, 3) mm.
+    """
+def check_output(path: str, inputs: collections.abc.Sequence[str] = [], other_outputs: collections.abc.Sequence[str] = []) -> str:
+    """
+    Check an output path without writing: 'replace' or 'write-through'; raises IoError.
+    """
+def compensate_commands(nominal: BallbarSession, identified: ..., machine: MachineType) -> BallbarSession:
+    ...
+def compensate_sphere_offset(session: RtestSession, offset: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> RtestSession:
+    """
+    The session with the sphere's offset (x, y) from the spindle axis taken out of every d.
+    """
+def default_ballbar_tests() -> list[BallbarTest]:
+    """
+    sphere_xy, sphere_yz, sphere_zx, radial tilt, axial C, radial C, axial tilt.
+    """
+def default_calibration_moves(step_mm: typing.SupportsFloat | typing.SupportsIndex = 0.5) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
+    """
+    +-step along X, Y, Z and the 4 body diagonals (14, 3), mm.
+    """
+def diagnose_ballbar(session: BallbarSession, options: DiagnosisOptions = ..., reference: rotacal._core.BallbarSession | None = None) -> Diagnosis:
+    """
+    Diagnose a ballbar session: baseline fit, residual structure, catalogue candidates, findings with their gain.
+    """
+def diagnose_rtest(session: RtestSession, options: DiagnosisOptions = ...) -> Diagnosis:
+    """
+    Diagnose an R-test session (baseline: location errors and a probe zero per set-up).
+    """
+def displacements_from_raw(session: RtestSession, dirs: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] | None = None) -> RtestSession:
+    """
+    Fill dx,dy,dz from raw d1,d2,d3 with the session's probe.N.dir, or with calibrated dirs (3, 3) (rows keep a dx,dy,dz they already have).
+    """
+def effect_catalogue(machine: MachineType, max_harmonic: typing.SupportsInt | typing.SupportsIndex = 4) -> list[Effect]:
+    """
+    Every catalogue entry that applies to the machine, harmonics 1..max_harmonic.
+    """
+def format_ballbar(session: BallbarSession) -> str:
+    ...
+def format_model_document(document: dict, source: str = 'model') -> str:
+    """
+    Strict JSON text of a model document (non-finite numbers as null with a reason), validated.
+    """
+def format_rtest(session: RtestSession) -> str:
+    ...
+def forward(machine: MachineType, errors: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], angles: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], q_table: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
+    """
+    Machine-frame positions of table points.
+    
+    Parameters
+    ----------
+    machine : MachineType
+    errors : (8,) location errors, order of location_error_names (mm, rad)
+    angles : (N, 2) tilt and C angles, rad
+    q_table : (N, 3) points in the table frame, mm
+    
+    Returns
+    -------
+    (N, 3) machine-frame positions, mm
+    """
+def hyper_circle_fit(points: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], sigma: typing.SupportsFloat | typing.SupportsIndex = 0.0, refine: bool = False) -> CircleFit:
+    """
+    Circle fit to (N, 2) points.
+    
+    Parameters
+    ----------
+    points : (N, 2) array
+    sigma : known 1-sigma noise of the points (0: estimated from the residuals)
+    refine : polish by orthogonal distances (Ceres)
+    
+    Raises rotacal.DegenerateGeometry for < 3, collinear points or a too short arc.
+    """
+def identify_joint(session: BallbarSession, fit_length_offset: bool = False, effects: collections.abc.Sequence[str] = [], tests: collections.abc.Sequence[str] = []) -> BallbarIdentification:
+    """
+    Joint Ceres fit of the 8 location errors and the actual pivot to every sample.
+    """
+def identify_paper(session: BallbarSession) -> BallbarIdentification:
+    """
+    Flynn et al. 2016's chain: sphere fit, Hyper circle fits, SVD plane fits, transport.
+    """
+def identify_rtest_joint(session: RtestSession, basis: RtestBasis = ...) -> RtestJointIdentification:
+    """
+    Joint Ceres fit of an R-test session: location errors, smooth B and C maps, a probe zero per set-up, with observability (rtest/identify_joint.hpp).
+    """
+def identify_rtest_paper(session: RtestSession) -> RtestPaperIdentification:
+    """
+    Oyama & Ibaraki's method, Eqs. 10-22 (rtest/identify_paper.hpp).
+    """
+def kasa_circle_fit(points: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], sigma: typing.SupportsFloat | typing.SupportsIndex = 0.0, refine: bool = False) -> CircleFit:
+    """
+    Circle fit to (N, 2) points.
+    
+    Parameters
+    ----------
+    points : (N, 2) array
+    sigma : known 1-sigma noise of the points (0: estimated from the residuals)
+    refine : polish by orthogonal distances (Ceres)
+    
+    Raises rotacal.DegenerateGeometry for < 3, collinear points or a too short arc.
+    """
+def list_serial_ports() -> list[tuple[str, str, str]]:
+    """
+    (path, description, transport) of every serial port libserialport finds.
+    """
+def location_error_names(machine: MachineType) -> typing.Annotated[list[str], "FixedSize(8)"]:
+    """
+    ISO 230-7 names of the 8 location errors, in the order of every errors vector.
+    """
+def machine_name(machine: MachineType) -> str:
+    ...
+def parse_ballbar_test(label: str, machine: MachineType) -> BallbarTest:
+    """
+    Test from its session label ('radial_B' only on a BC-trt machine).
+    """
+def parse_machine_type(text: str) -> MachineType:
+    """
+    Machine type from its file name ('AC-trt' or 'BC-trt').
+    """
+def parse_model_document(text: str, source: str = '<model>') -> typing.Any:
+    ...
+def parse_nc_dialect(text: str) -> NcDialect:
+    ...
+def parse_radial_side(text: str) -> RadialSide:
+    ...
+def plan_ballbar_test(setup: BallbarSetup = ..., identified: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] | None = None) -> BallbarPlan:
+    """
+    Plan the single set-up ballbar test (Flynn et al. 2016, Sec. 3).
+    
+    Parameters
+    ----------
+    setup : BallbarSetup
+    identified : (8,) location errors (mm, rad; order of location_error_names), optional.
+        Given, the machine axes are the compensated command for that machine.
+    
+    Returns
+    -------
+    BallbarPlan: labels, time (N,), p_table (N, 3), angles_deg (N, 2), machine_axes (N, 5)
+    """
+def predict_rtest_session(model: RtestJointModel, session: RtestSession, probe_zeros: collections.abc.Mapping[str, typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]] = {}) -> RtestSession:
+    """
+    The session with dx,dy,dz predicted by the model and 1-sigma columns dx_std, dy_std, dz_std; probe_zeros (set-up -> (3,) mm) are added if given (rtest/predict.hpp).
+    """
+def predict_session_lengths(model: BallbarMachineModel, session: BallbarSession) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+    """
+    Predicted centre-to-centre lengths (mm) of every sample of the session on the model.
+    """
+def read_ballbar(path: str) -> BallbarSession:
+    ...
+def read_model_document(path: str) -> typing.Any:
+    """
+    Read a rotacal-model file (strict JSON, version, kind, machine checked); the document as a dict. ParseError (syntax), InvalidArgument (content), IoError.
+    """
+def read_rtest(path: str) -> RtestSession:
+    ...
+def read_session(path: str) -> rotacal._core.BallbarSession | rotacal._core.RtestSession:
+    """
+    Read a rotacal-ballbar/1 or rotacal-rtest/1 file (chosen by its format line).
+    """
+def record_ballbar(port: str, plan: BallbarPlan, path: str, baud: typing.SupportsInt | typing.SupportsIndex = 115200, rate_hz: typing.SupportsFloat | typing.SupportsIndex = 1000.0, zero: bool = False, silence_timeout_s: typing.SupportsFloat | typing.SupportsIndex = 3.0, progress: collections.abc.Callable | None = None) -> RecordSummary:
+    """
+    Record a ballbar test from a serial port into a rotacal-ballbar/1 file (hw/recorder.hpp). progress(rows, lost, corrupt, t_s, duration_s) -> bool is called a few times a second; returning False stops the recording.
+    """
+def record_rtest(port: str, mode: str, program: RtestSession, dwell_s: typing.SupportsFloat | typing.SupportsIndex, probe_dirs: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], path: str, baud: typing.SupportsInt | typing.SupportsIndex = 115200, rate_hz: typing.SupportsFloat | typing.SupportsIndex = 100.0, speed: typing.SupportsFloat | typing.SupportsIndex = 1.0, silence_timeout_s: typing.SupportsFloat | typing.SupportsIndex = 3.0, progress: collections.abc.Callable | None = None) -> RecordSummary:
+    """
+    Record an R-test (sylvac, keyence or stream mode) into a rotacal-rtest/1 file with raw d1,d2,d3 (hw/recorder.hpp); progress as for record_ballbar.
+    """
+@typing.overload
+def rtest_error_map(identification: RtestJointIdentification, b_deg: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], c_deg: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], format: str = 'json') -> str:
+    """
+    The joint model's error map on a grid (deg), as JSON or CSV text.
+    """
+@typing.overload
+def rtest_error_map(identification: RtestPaperIdentification, format: str = 'json') -> str:
+    """
+    The paper method's error map at its measured grid, as JSON or CSV text.
+    """
+def rtest_prediction_rms_um(model: RtestJointModel, session: RtestSession) -> float:
+    """
+    RMS (um) of measured - predicted readings after one constant offset per set-up.
+    """
+def rtest_readings(machine: MachineType, errors: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], effects: collections.abc.Sequence[str], effect_params: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], angles: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], time: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
+    """
+    Noise-free readings (N, 3) of the nest at q (mm) at angles (N, 2) in rad and time (N,) s, no probe zero: the simulator's truth.
+    """
+def simulate_ballbar(commanded: BallbarSession, truth: BallbarMachineModel, noise_um: typing.SupportsFloat | typing.SupportsIndex = 0.5, seed: typing.SupportsInt | typing.SupportsIndex = 1, declare_noise: bool = True) -> BallbarSession:
+    """
+    The session as the machine `truth` would measure it (lengths filled in, Gaussian noise).
+    """
+def simulate_probe_calibration(dirs: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], zeros: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], moves: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], noise_um: typing.SupportsFloat | typing.SupportsIndex, seed: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
+    """
+    Simulated readings (N, 3) of the direction calibration.
+    """
+def simulate_rtest(machine: MachineType, errors: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], effects: collections.abc.Sequence[str], effect_params: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], b_deg: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], c_deg: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], nests: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], dwell_s: typing.SupportsFloat | typing.SupportsIndex, noise_um: typing.SupportsFloat | typing.SupportsIndex, probe_zero_um: typing.SupportsFloat | typing.SupportsIndex, probe_dirs: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] | None = None, write_d: bool = True, seed: typing.SupportsInt | typing.SupportsIndex = 1) -> tuple[RtestSession, typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]]:
+    """
+    Simulate an R-test session (rtest/simulate.hpp).
+    
+    Parameters
+    ----------
+    machine : MachineType (BC_trt)
+    errors : (8,) location errors (mm, rad)
+    effects, effect_params : catalogue ids and their parameters back to back
+    b_deg, c_deg : the grid, B outer and C inner (deg)
+    nests : (K, 3) nominal ball centres, table frame (mm)
+    dwell_s : time between readings (s)
+    noise_um, probe_zero_um : 1-sigma reading noise and per-set-up probe zero (um)
+    probe_dirs : (3, 3) rows = probe directions: raw d1,d2,d3 are written as well
+    write_d : with probe_dirs, also write dx,dy,dz
+    
+    Returns
+    -------
+    (session, probe_zeros (K, 3) mm)
+    """
+def simulate_spindle_indexing(dirs: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], zeros: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], offset: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], centre: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], angles: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], noise_um: typing.SupportsFloat | typing.SupportsIndex, seed: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
+    """
+    Simulated spindle-indexing readings (N, 3), mm.
+    """
+def sphere_fit(points: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], radius: typing.SupportsFloat | typing.SupportsIndex | None = None, sigma: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> SphereFit:
+    """
+    Least-squares sphere to (N, 3) points; radius fixes it (e.g. the ballbar length).
+    """
+def svd_plane_fit(points: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], normal_hint: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] = ..., sigma: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> PlaneFit:
+    """
+    Total-least-squares plane (Flynn et al. Eq. 3).
+    """
+def test_label(test: BallbarTest, machine: MachineType) -> str:
+    """
+    Session label of a test on a machine, e.g. 'radial_A'.
+    """
+def verify_compensation(commanded: BallbarSession, truth: BallbarMachineModel, noise_um: typing.SupportsFloat | typing.SupportsIndex = 0.5, seed: typing.SupportsInt | typing.SupportsIndex = 1) -> CompensationReport:
+    """
+    Measure, identify, compensate, measure again, identify again (Flynn et al., Table 2).
+    """
+def write_ballbar(session: BallbarSession, path: str) -> None:
+    ...
+def write_model_document(document: dict, path: str, inputs: collections.abc.Sequence[str] = [], other_outputs: collections.abc.Sequence[str] = []) -> None:
+    ...
+@typing.overload
+def write_nc_program(plan: BallbarPlan, dialect: NcDialect, options: NcProgramOptions = ...) -> str:
+    """
+    NC program text: 'linuxcnc' machine axes (G93 G1), or TCP programs for 'heidenhain' (FUNCTION TCPM), 'siemens' (TRAORI), 'fanuc' (G43.4).
+    """
+@typing.overload
+def write_nc_program(plan: BallbarPlan, dialect: str, options: NcProgramOptions = ...) -> str:
+    ...
+def write_output(path: str, data: bytes, inputs: collections.abc.Sequence[str] = [], other_outputs: collections.abc.Sequence[str] = []) -> None:
+    """
+    Write bytes to path: regular files replaced atomically, devices and FIFOs written through; a directory, an input or another output is refused (IoError).
+    """
+def write_rtest(session: RtestSession, path: str) -> None:
+    ...

@@ -1,19 +1,21 @@
 """Single set-up ballbar test: identification, simulation, prediction, compensation."""
 from __future__ import annotations
 
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
 from . import _core
+from .machines import ballbar_machine_model, random_location_errors  # noqa: F401  (rotacal.random_location_errors)
 from .results import Identification
+from .sessions import BALLBAR, require
 
 
 def identify(session: _core.BallbarSession, method: str = "joint", *,
              fit_length_offset: bool = False, effects: Sequence[str] = (),
              tests: Sequence[str] = ()) -> Identification:
-    """Identify the 8 location errors (and the actual pivot) of a ballbar session; an R-test
-    session goes to rotacal.identify_rtest.
+    """Identify the 8 location errors (and the actual pivot) of a ballbar session
+    (rotacal.identify takes either kind of session).
 
     Parameters
     ----------
@@ -24,13 +26,7 @@ def identify(session: _core.BallbarSession, method: str = "joint", *,
     effects : catalogue ids to fit along (joint only), e.g. ["gravity_sag_A"].
     tests : restrict to these test labels (default: all).
     """
-    if isinstance(session, _core.RtestSession):
-        if fit_length_offset or effects or tests:
-            raise _core.InvalidArgument("identify: an R-test session takes only `method`")
-        from .rtest import identify_rtest
-        return identify_rtest(session, method)
-    if not isinstance(session, _core.BallbarSession):
-        raise _core.InvalidArgument("identify: session must be a BallbarSession or an RtestSession")
+    require(session, BALLBAR, "identify")
     if method == "joint":
         raw = _core.identify_joint(session, fit_length_offset, list(effects), list(tests))
     elif method == "paper":
@@ -88,10 +84,31 @@ def predict(model: _core.BallbarMachineModel, session: _core.BallbarSession) -> 
     return session.with_lengths(_core.predict_session_lengths(model, session))
 
 
-def random_location_errors(machine, rng: np.random.Generator, position_mm: float = 0.03,
-                           angle_rad: float = 5e-5) -> np.ndarray:
-    """Location errors drawn as N(0, position_mm) and N(0, angle_rad), in the machine's order."""
-    # Order of every errors vector: tilt position (2), tilt orientation (2), C position (2),
-    # C orientation (2).
-    scale = np.array([position_mm] * 2 + [angle_rad] * 2 + [position_mm] * 2 + [angle_rad] * 2)
-    return rng.normal(0.0, 1.0, 8) * scale
+def compensation_table(report: Any) -> list[dict]:
+    """The rows of a CompensationReport (verify_compensation) as dicts, Flynn et al. Table 2 layout."""
+    return [{"name": r.name, "unit": r.unit, "before": r.before, "after": r.after,
+             "std_after": r.std_after, "change_percent": r.change_percent} for r in report.rows]
+
+
+def nc_program(setup: Any, dialect: str = "linuxcnc", model: Any = None,
+               source: str = "<model>") -> tuple[Any, str]:
+    """(plan, NC program text) of the test of ``setup`` in ``dialect``; with a fitted
+    BallbarMachineModel the program is compensated for its location errors (its machine must
+    be the set-up's, ``source`` names the model in the error)."""
+    identified = None
+    if model is not None:
+        if model.machine != setup.machine:
+            raise _core.InvalidArgument(f"{source}: model is for {_core.machine_name(model.machine)}, the test "
+                                        f"for {_core.machine_name(setup.machine)}")
+        identified = model.errors
+    plan = _core.plan_ballbar_test(setup, identified)
+    return plan, _core.write_nc_program(plan, _core.parse_nc_dialect(dialect))
+
+
+def verify_compensation(setup: Any, truth: Any) -> list[dict]:
+    """Flynn et al.'s Table 2 experiment in simulation: measure the test of ``setup`` on the
+    machine of ``truth`` (machines.ballbar_truth), identify, compensate, measure again;
+    the rows of compensation_table."""
+    commanded = _core.plan_ballbar_test(setup, None).commanded_session()
+    machine = ballbar_machine_model(setup, truth)
+    return compensation_table(_core.verify_compensation(commanded, machine, truth["noise_um"], truth["seed"]))

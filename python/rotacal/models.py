@@ -13,8 +13,8 @@ when the model is used.
 """
 from __future__ import annotations
 
-import json
 import math
+import os
 from pathlib import Path
 from typing import Any
 
@@ -66,47 +66,25 @@ def _value(d: dict, where: str) -> float:
 
 
 def ballbar_model_from_dict(d: dict, source: str = "<model>") -> _core.BallbarMachineModel:
-    """BallbarMachineModel from a model dict; errors name the file and the key."""
-    if d.get("format") != FORMAT:
-        raise _core.InvalidArgument(f"{source}: not a {FORMAT} file (format: {d.get('format')!r})")
-    if d.get("kind") != "ballbar":
+    """BallbarMachineModel from a model dict, validated by the C++ reader (io/model_file.hpp);
+    errors name the file and the member."""
+    if isinstance(d, dict) and d.get("kind") not in (None, "ballbar"):
         raise _core.InvalidArgument(f"{source}: kind {d.get('kind')!r} is not a ballbar model")
-    machine = _core.parse_machine_type(d.get("machine", ""))
-    names = list(_core.location_error_names(machine))
-    le = d.get("location_errors", {})
-    missing = [n for n in names if n not in le]
-    if missing:
-        raise _core.InvalidArgument(f"{source}: location_errors lacks {', '.join(missing)}")
-    errors = np.array([_value(le[n], f"{source}: location_errors.{n}") for n in names])
-    pv = d.get("pivot", {})
-    pivot = np.array([_value(pv.get(a, {}), f"{source}: pivot.{a}") for a in "xyz"])
-    ids, params = [], []
-    for k, e in enumerate(d.get("effects", [])):
-        eff = _core.Effect(e["id"])
-        ids.append(e["id"])
-        for pname in eff.param_names:
-            params.append(_value(e.get("params", {}).get(pname, {}), f"{source}: effects[{k}].{pname}"))
-    return _core.BallbarMachineModel(machine, errors, pivot, ids, params)
+    return _core.ballbar_model_from_document(d, source)
 
 
-def save_model(model: dict, path: str | Path) -> None:
-    """Write a model dict as JSON (to a temporary file first, so a crash never leaves half a file)."""
-    path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(json.dumps(model, indent=2) + "\n")
-    tmp.replace(path)
+def save_model(model: dict, path: str | Path, inputs: tuple = (), other_outputs: tuple = ()) -> None:
+    """Write a model dict through the C++ writer: validated as the reader would, strict JSON
+    (a non-finite number is written null, its reason under "null_reasons"), by the output rule
+    of rotacal.outputs (regular files replaced atomically, devices written through)."""
+    _core.write_model_document(model, os.fspath(path), [os.fspath(p) for p in inputs],
+                               [os.fspath(p) for p in other_outputs])
 
 
 def load_model(path: str | Path) -> dict:
-    """Read a model file; raises rotacal.InvalidArgument naming the file if it is not one."""
-    path = Path(path)
-    try:
-        d = json.loads(path.read_text())
-    except json.JSONDecodeError as e:
-        raise _core.InvalidArgument(f"{path}:{e.lineno}:{e.colno}: not valid JSON: {e.msg}") from None
-    if not isinstance(d, dict) or d.get("format") != FORMAT:
-        raise _core.InvalidArgument(f"{path}: not a {FORMAT} file")
-    return d
+    """Read a model file through the C++ reader; raises rotacal.ParseError naming the file,
+    line and column (syntax) or member (content), rotacal.IoError if it cannot be read."""
+    return _core.read_model_document(os.fspath(path))
 
 
 def fit_model_dict(machine: Any, parameters: list, effects: list[str]) -> dict:

@@ -43,6 +43,19 @@ figcaption{font-size:.85em;color:#555}
 """
 
 
+def _e(text: Any) -> str:
+    """HTML-escaped text: everything that may come from a file (labels, names, notes)."""
+    return html.escape(str(text), quote=True)
+
+
+def _plot_text(text: Any, limit: int = 60) -> str:
+    """A label from a file as matplotlib text: cut to ``limit`` characters, and '$' escaped so
+    that it is never read as mathtext (an unbalanced '$' would stop the report)."""
+    t = str(text)
+    t = t if len(t) <= limit else t[:limit - 1] + "\u2026"
+    return t.replace("$", r"\$")
+
+
 def _png(fig) -> str:
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=90, bbox_inches="tight")
@@ -51,8 +64,8 @@ def _png(fig) -> str:
 
 
 def _img(src: str, caption: str, section: str) -> str:
-    return (f'<figure data-section="{section}"><img src="{src}" alt="{html.escape(caption)}">'
-            f"<figcaption>{html.escape(caption)}</figcaption></figure>")
+    return (f'<figure data-section="{_e(section)}"><img src="{src}" alt="{_e(caption)}">'
+            f"<figcaption>{_e(caption)}</figcaption></figure>")
 
 
 def _fmt(p: dict, scale: float) -> tuple[str, str]:
@@ -68,7 +81,7 @@ def location_error_table(errors: dict) -> str:
     for name, p in errors.items():
         scale, unit = (1e3, "&micro;m") if p["unit"] == "mm" else (1e6, "&micro;rad")
         v, s = _fmt(p, scale)
-        rows.append(f"<tr><td class=l>{name}</td><td class=l>{html.escape(ERROR_WORDS.get(name, ''))}</td>"
+        rows.append(f"<tr><td class=l>{_e(name)}</td><td class=l>{_e(ERROR_WORDS.get(name, ''))}</td>"
                     f"<td>{v}</td><td>{s}</td><td>{unit}</td></tr>")
     rows.append("</table>")
     return "\n".join(rows)
@@ -103,10 +116,10 @@ def polar_plots(tests: np.ndarray, angles_deg: np.ndarray, measured: np.ndarray,
         ax.set_rmin(0)
         ax.set_rmax(base + span * 1.2)
         ax.set_yticklabels([])
-        ax.set_title(f"{t}: deviation from L0 against {axis_names[k]}\n"
+        ax.set_title(f"{_plot_text(t)}: deviation from L0 against {axis_names[k]}\n"
                      f"scale: ring spacing {span / 2:.2g} \u00b5m", fontsize=8)
         ax.legend(loc="lower right", fontsize=7)
-        figs.append((_png(fig), f"{t}: measured and model, deviation magnified"))
+        figs.append((_png(fig), f"{_plot_text(t)}: measured and model, deviation magnified"))
     return figs
 
 
@@ -119,7 +132,7 @@ def residual_plot(tests: np.ndarray, residuals: list[tuple[str, np.ndarray]]) ->
     for t in dict.fromkeys(tests):
         idx = np.flatnonzero(tests == t)
         ax.axvline(idx[0], color="#ccc", lw=0.8)
-        ax.text(idx.mean(), ax.get_ylim()[1], t, ha="center", va="bottom", fontsize=7)
+        ax.text(idx.mean(), ax.get_ylim()[1], _plot_text(t), ha="center", va="bottom", fontsize=7)
     ax.set_xlabel("sample")
     ax.set_ylabel("residual (\u00b5m)")
     ax.legend(fontsize=7, loc="lower right")
@@ -134,7 +147,7 @@ def harmonic_plot(structure: list[dict], title: str) -> str | None:
     w = 0.8 / len(groups)
     for i, g in enumerate(groups):
         orders = np.arange(1, len(g["harmonic_um"]) + 1)
-        ax.bar(orders + i * w, g["harmonic_um"], width=w, label=f"{g['group']} ({g['angle_axis']})")
+        ax.bar(orders + i * w, g["harmonic_um"], width=w, label=_plot_text(f"{g['group']} ({g['angle_axis']})"))
     ax.set_xlabel("harmonic order in the swept rotary angle")
     ax.set_ylabel("amplitude (\u00b5m)")
     ax.set_title(title, fontsize=9)
@@ -144,40 +157,41 @@ def harmonic_plot(structure: list[dict], title: str) -> str | None:
 
 def ballbar_report(path: str | Path, session: Any, identification: Any,
                    diagnosis: Any | None = None, title: str | None = None,
-                   source: str = "", extra_sections: Iterable[str] = ()) -> Path:
-    """Write the HTML report of a ballbar session. Returns the path written."""
+                   source: str = "", extra_sections: Iterable[str] = (), inputs: Iterable[str] = ()) -> Path:
+    """Write the HTML report of a ballbar session (by the output rule; ``inputs`` are refused
+    as the target). Every text from a file is escaped. Returns the path written."""
     from . import _core
 
     path = Path(path)
     ident = identification.to_dict()
-    tests = np.asarray(session.tests)
+    tests = np.asarray(session.tests, dtype=object)  # object: a long label must not widen every row
     angles = np.asarray(session.angles_deg)
     measured = np.asarray(session.length)
     model = _core.predict_session_lengths(identification.raw.model, session)
     machine = ident["machine"]
     axis_names = (machine[0], "C")
-    parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(title or 'rotacal report')}</title>"
+    parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{_e(title or 'rotacal report')}</title>"
              f"<style>{_CSS}</style></head><body>"]
-    parts.append(f"<h1>{html.escape(title or 'Single set-up ballbar test')}</h1>")
-    parts.append(f"<p class=muted>rotacal {html.escape(_version())} &middot; "
-                 f"{_dt.datetime.now().strftime('%Y-%m-%d %H:%M')} &middot; {html.escape(source)}</p>")
+    parts.append(f"<h1>{_e(title or 'Single set-up ballbar test')}</h1>")
+    parts.append(f"<p class=muted>rotacal {_e(_version())} &middot; "
+                 f"{_dt.datetime.now().strftime('%Y-%m-%d %H:%M')} &middot; {_e(source)}</p>")
 
     pv = ident["pivot"]
     pivot_txt = ", ".join("unobservable" if pv[a]["value"] is None else f"{pv[a]['value']:.4f}" for a in "xyz")
     parts.append('<section id="setup"><h2>Machine and set-up</h2><table>'
-                 f"<tr><th class=l>Machine</th><td class=l>{machine} (tilting-rotary table)</td></tr>"
+                 f"<tr><th class=l>Machine</th><td class=l>{_e(machine)} (tilting-rotary table)</td></tr>"
                  f"<tr><th class=l>Ballbar length L0</th><td class=l>{session.ballbar_length:.4f} mm</td></tr>"
                  f"<tr><th class=l>Nominal pivot (table frame)</th><td class=l>{', '.join(f'{v:.4f}' for v in session.pivot)} mm</td></tr>"
                  f"<tr><th class=l>Identified pivot</th><td class=l>{pivot_txt} mm</td></tr>"
-                 f"<tr><th class=l>Samples / tests</th><td class=l>{len(tests)} / {', '.join(dict.fromkeys(tests))}</td></tr>"
+                 f"<tr><th class=l>Samples / tests</th><td class=l>{len(tests)} / {_e(', '.join(dict.fromkeys(tests)))}</td></tr>"
                  "</table></section>")
 
-    parts.append(f'<section id="location-errors"><h2>Location errors (ISO 230-7), method: {ident["method"]}</h2>')
+    parts.append(f'<section id="location-errors"><h2>Location errors (ISO 230-7), method: {_e(ident["method"])}</h2>')
     parts.append(location_error_table(ident["location_errors"]))
     parts.append(f"<p>Residual RMS {ident['residual_rms_um']:.3f} &micro;m over {ident['n_samples']} samples.</p>")
     if ident["unobservable"]:
         parts.append("<p class=warn>Not determined by this session's tests:</p><ul>" +
-                     "".join(f"<li>{html.escape(u)}</li>" for u in ident["unobservable"]) + "</ul>")
+                     "".join(f"<li>{_e(u)}</li>" for u in ident["unobservable"]) + "</ul>")
     parts.append("</section>")
 
     parts.append('<section id="polar"><h2>Ballbar plots: measured against model</h2>')
@@ -195,7 +209,7 @@ def ballbar_report(path: str | Path, session: Any, identification: Any,
     if diagnosis is not None:
         parts.append(diagnosis_section(diagnosis.to_dict()))
     parts.extend(extra_sections)
-    return _write_page(path, parts)
+    return _write_page(path, parts, inputs)
 
 
 # Records on load how many figures decoded, so a browser test can check they render.
@@ -205,26 +219,23 @@ _IMAGE_CHECK = ("<script>window.addEventListener('load',function(){var im=docume
                 "document.body.setAttribute('data-images-rendered',ok);});</script>")
 
 
-def _write_page(path: Path, parts: list[str]) -> Path:
-    """Close the page (with the image check) and write it atomically."""
+def _write_page(path: Path, parts: list[str], inputs: Iterable[str] = ()) -> Path:
+    """Close the page (with the image check) and write it by the output rule."""
+    from .outputs import write_output
     parts = parts + [_IMAGE_CHECK, "</body></html>"]
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text("\n".join(parts))
-    tmp.replace(path)
+    write_output(path, "\n".join(parts), [str(i) for i in inputs])
     return path
 
 
-def diagnosis_report(path: str | Path, d: dict, title: str, source: str = "") -> Path:
+def diagnosis_report(path: str | Path, d: dict, title: str, source: str = "", inputs: Iterable[str] = ()) -> Path:
     """A report with the diagnosis alone (e.g. of an R-test session)."""
+    from .outputs import write_output
     path = Path(path)
-    page = (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(title)}</title>"
-            f"<style>{_CSS}</style></head><body><h1>{html.escape(title)}</h1>"
-            f"<p class=muted>rotacal {html.escape(_version())} &middot; {html.escape(source)}</p>"
+    page = (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{_e(title)}</title>"
+            f"<style>{_CSS}</style></head><body><h1>{_e(title)}</h1>"
+            f"<p class=muted>rotacal {_e(_version())} &middot; {_e(source)}</p>"
             f"{diagnosis_section(d)}</body></html>")
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(page)
-    tmp.replace(path)
+    write_output(path, page, [str(i) for i in inputs])
     return path
 
 
@@ -232,7 +243,7 @@ def diagnosis_section(d: dict) -> str:
     b = d["baseline"]
     out = ['<section id="diagnosis"><h2>Diagnosis</h2>',
            f"<p>Baseline (location errors and pivot): residual RMS {b['residual_rms_um']:.3f} &micro;m, "
-           f"noise {b['noise_um']:.3f} &micro;m ({html.escape(b['noise_source'])}), "
+           f"noise {b['noise_um']:.3f} &micro;m ({_e(b['noise_source'])}), "
            f"&chi;&sup2;/dof {b['chi2_per_dof']:.2f} (p = {b['p_value']:.2g}).</p>"]
     if not d["findings"]:
         out.append("<p class=ok>No effect of the catalogue is significant: the location-error model "
@@ -243,29 +254,29 @@ def diagnosis_section(d: dict) -> str:
                    "<th>CV RMS before</th><th>CV RMS after</th></tr>")
         for i, f in enumerate(d["findings"], 1):
             params = "<br>".join(
-                f"{html.escape(k)} = {v['value']:.4g} &plusmn; {v['std']:.2g} {html.escape(v['unit'])}"
-                if v["value"] is not None else f"{html.escape(k)}: unobservable" for k, v in f["parameters"].items())
+                f"{_e(k)} = {v['value']:.4g} &plusmn; {v['std']:.2g} {_e(v['unit'])}"
+                if v["value"] is not None else f"{_e(k)}: unobservable" for k, v in f["parameters"].items())
             g = f["gain"]
-            out.append(f"<tr><td class=l>{i}</td><td class=l>{f['effect']}</td><td class=l>{html.escape(f['cause'])}</td>"
+            out.append(f"<tr><td class=l>{i}</td><td class=l>{_e(f['effect'])}</td><td class=l>{_e(f['cause'])}</td>"
                        f"<td class=l>{params}</td><td>{g['rms_before_um']:.3f}</td><td>{g['rms_after_um']:.3f}</td>"
                        f"<td>{g['delta_bic']:.1f}</td><td>{g['cv_rms_before_um']:.3f}</td><td>{g['cv_rms_after_um']:.3f}</td></tr>")
         out.append("</table><p class=muted>RMS in &micro;m; CV: blocked cross-validation.</p>")
     for a in d["ambiguous"]:
-        out.append(f"<p class=warn>Cannot be told apart with this data: {', '.join(a['effects'])} "
-                   f"({html.escape(a['separating_test'])}).</p>")
+        out.append(f"<p class=warn>Cannot be told apart with this data: {_e(', '.join(a['effects']))} "
+                   f"({_e(a['separating_test'])}).</p>")
     if d["unexplained"]["present"]:
         out.append(f"<p class=warn>Unexplained structure remains (&chi;&sup2;/dof "
-                   f"{d['unexplained']['chi2_per_dof']:.2f}): {html.escape(d['unexplained']['signature'])}</p>")
+                   f"{d['unexplained']['chi2_per_dof']:.2f}): {_e(d['unexplained']['signature'])}</p>")
     for title, key in (("before", "before"), ("after", "after")):
         src = harmonic_plot(d["residual_structure"][key], f"residual harmonics {title} the diagnosis")
         if src:
             out.append(_img(src, f"residual harmonics {title}", "diagnosis"))
     notes = {g["harmonic_note"] for g in d["residual_structure"]["before"] if g.get("harmonic_note")}
     for note in sorted(notes):
-        out.append(f"<p class=muted>{html.escape(note)}</p>")
+        out.append(f"<p class=muted>{_e(note)}</p>")
     if d["unobservable"]:
         out.append("<details><summary>Effects this session cannot see</summary><ul>" +
-                   "".join(f"<li>{u['effect']}: {html.escape(u['reason'])}</li>" for u in d["unobservable"]) +
+                   "".join(f"<li>{_e(u['effect'])}: {_e(u['reason'])}</li>" for u in d["unobservable"]) +
                    "</ul></details>")
     out.append("</section>")
     return "\n".join(out)
@@ -341,12 +352,12 @@ def rtest_c_map_plot(model: Any, b_values_deg: Iterable[float]) -> str:
 
 def rtest_residual_plot(setups: np.ndarray, residuals: np.ndarray) -> str:
     """Residual (measured - model) of each reading component per pose."""
-    labels = np.array([f"set-up {s}" for s in setups])
+    labels = np.array([f"set-up {s}" for s in setups], dtype=object)
     return residual_plot(labels, [(f"d{a}", residuals[:, k]) for k, a in enumerate("xyz")])
 
 
 def rtest_report(path: str | Path, session: Any, identification: Any, diagnosis: Any | None = None,
-                 title: str | None = None, source: str = "") -> Path:
+                 title: str | None = None, source: str = "", inputs: Iterable[str] = ()) -> Path:
     """Write the HTML report of an R-test session: set-up, location errors (ISO 230-7 table),
     the error map against B and C with uncertainty bands, residuals and the diagnosis."""
     from . import _core
@@ -356,22 +367,22 @@ def rtest_report(path: str | Path, session: Any, identification: Any, diagnosis:
     if ident["method"] != "joint":
         raise _core.InvalidArgument("rtest_report: needs the joint identification (its model draws the map)")
     model = identification.raw.model
-    setups = np.asarray(session.setups)
+    setups = np.asarray(session.setups, dtype=object)
     angles = np.asarray(session.angles_deg)
     b_meas = sorted(set(np.round(angles[:, 0], 6).tolist()))
     c_meas = sorted(set(np.round(angles[:, 1], 6).tolist()))
     heading = title or "R-test: location errors and error map of the rotary axes"
-    parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(heading)}</title>"
-             f"<style>{_CSS}</style></head><body>", f"<h1>{html.escape(heading)}</h1>",
-             f"<p class=muted>rotacal {html.escape(_version())} &middot; "
-             f"{_dt.datetime.now().strftime('%Y-%m-%d %H:%M')} &middot; {html.escape(source)}</p>"]
+    parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{_e(heading)}</title>"
+             f"<style>{_CSS}</style></head><body>", f"<h1>{_e(heading)}</h1>",
+             f"<p class=muted>rotacal {_e(_version())} &middot; "
+             f"{_dt.datetime.now().strftime('%Y-%m-%d %H:%M')} &middot; {_e(source)}</p>"]
 
-    rows = [f"<tr><th class=l>Machine</th><td class=l>{ident['machine']} (tilting-rotary table)</td></tr>"]
+    rows = [f"<tr><th class=l>Machine</th><td class=l>{_e(ident['machine'])} (tilting-rotary table)</td></tr>"]
     for label, q in sorted(session.nests.items()):
-        rows.append(f"<tr><th class=l>Nest {html.escape(label)} (table frame)</th>"
+        rows.append(f"<tr><th class=l>Nest {_e(label)} (table frame)</th>"
                     f"<td class=l>{', '.join(f'{v:.4f}' for v in q)} mm</td></tr>")
     for n, d in sorted(session.probe_dirs.items()):
-        rows.append(f"<tr><th class=l>Probe {n} direction</th><td class=l>{', '.join(f'{v:.6f}' for v in d)}</td></tr>")
+        rows.append(f"<tr><th class=l>Probe {_e(str(n))} direction</th><td class=l>{', '.join(f'{v:.6f}' for v in d)}</td></tr>")
     rows.append(f"<tr><th class=l>Poses</th><td class=l>{len(setups)} ({len(b_meas)} B &times; {len(c_meas)} C "
                 f"positions, {len(set(setups.tolist()))} set-ups)</td></tr>")
     rows.append(f"<tr><th class=l>B (deg)</th><td class=l>{', '.join(f'{b:g}' for b in b_meas)}</td></tr>")
@@ -382,14 +393,14 @@ def rtest_report(path: str | Path, session: Any, identification: Any, diagnosis:
 
     parts.append('<section id="location-errors"><h2>Location errors (ISO 230-7), joint fit</h2>')
     parts.append(location_error_table(ident["location_errors"]))
-    zeros = ", ".join(f"set-up {k}: ({', '.join(f'{v * 1e3:+.2f}' for v in z)}) &micro;m"
+    zeros = ", ".join(f"set-up {_e(k)}: ({', '.join(f'{v * 1e3:+.2f}' for v in z)}) &micro;m"
                       for k, z in ident["probe_zeros"].items())
     parts.append(f"<p>Residual RMS {ident['residual_rms_um']:.3f} &micro;m over {ident['n_samples']} poses "
                  f"(3 readings each). Fitted probe zeros: {zeros}.</p>")
     if ident["unobservable"]:
         parts.append("<p class=warn>Not determined by this session's nests:</p><ul>" +
-                     "".join(f"<li>{html.escape(u)}</li>" for u in ident["unobservable"]) + "</ul>")
-    parts.append("<ul class=muted>" + "".join(f"<li>{html.escape(n)}</li>" for n in ident["notes"]) + "</ul>")
+                     "".join(f"<li>{_e(u)}</li>" for u in ident["unobservable"]) + "</ul>")
+    parts.append("<ul class=muted>" + "".join(f"<li>{_e(n)}</li>" for n in ident["notes"]) + "</ul>")
     parts.append("</section>")
 
     map_csv = identification.error_map("csv", b_meas, c_meas)
@@ -412,4 +423,4 @@ def rtest_report(path: str | Path, session: Any, identification: Any, diagnosis:
 
     if diagnosis is not None:
         parts.append(diagnosis_section(diagnosis.to_dict()))
-    return _write_page(path, parts)
+    return _write_page(path, parts, inputs)

@@ -7,12 +7,12 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping, Sequence, Union
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 
 from . import _core
-from .ballbar import random_location_errors
+from .machines import Errors, machine_truth  # noqa: F401  (rotacal.rtest.machine_truth)
 from .models import estimate_dict, rtest_model_dict, rtest_model_from_dict
 
 # The measurement pattern of Oyama Sec. 3.3, used for the map grid by default.
@@ -20,10 +20,14 @@ B_GRID = list(range(-90, 91, 30))
 C_GRID = list(range(0, 360, 30))
 # The two nests of the paper's set-up (as in ../shared/data/rtest_bc_oyama.csv), table frame, mm.
 DEFAULT_NESTS = [(100.0, 0.0, 60.0), (0.0, -120.0, 140.0)]
-# Defaults of the C++ simulator (rtest/simulate.hpp: RtestSimOptions, RtestPattern).
+# Defaults of the C++ simulator (rtest/simulate.hpp: RtestSimOptions, RtestPattern), restated
+# because those structs are not bound: bind them and read these from the extension.
 DEFAULT_NOISE_UM = 0.3
 DEFAULT_PROBE_ZERO_UM = 20.0
 DEFAULT_DWELL_S = 6.0
+# Bounds of a pattern: positions per axis and poses in all (a day of 6-s dwells is 14400).
+MAX_GRID_POINTS = 3600
+MAX_POSES = 100_000
 
 
 @dataclass
@@ -67,7 +71,8 @@ class RtestIdentification:
         return out
 
 
-def _has_displacements(session: _core.RtestSession) -> bool:
+def has_displacements(session: _core.RtestSession) -> bool:
+    """Whether every row has dx,dy,dz (else only raw d1,d2,d3)."""
     try:
         session.d
     except _core.InvalidArgument:
@@ -82,7 +87,7 @@ def with_displacements(session: _core.RtestSession,
     ``dirs`` (3, 3), rows = probe directions, e.g. from ``calibrate_probes``; by default the
     file's ``probe.N.dir``. Rows that already have dx,dy,dz keep them.
     """
-    if dirs is None and _has_displacements(session):
+    if dirs is None and has_displacements(session):
         return session, []
     out = _core.displacements_from_raw(session, None if dirs is None else np.asarray(dirs, dtype=float))
     src = "the calibrated directions given" if dirs is not None else "the file's probe.N.dir"
@@ -145,9 +150,6 @@ def prediction_rms_um(model: Mapping, session: _core.RtestSession, source: str =
 
 # ------------------------------------------------------------------------- simulation
 
-Errors = Union[str, Mapping[str, float], Sequence[float], np.ndarray]
-
-
 def angle_grid(start: float, stop: float, step: float, what: str, full_turn: bool = False) -> list[float]:
     """start, start + step, ... up to stop (inclusive, deg). With ``full_turn`` an end at
     start + 360 is left out: it is the start position again."""
@@ -155,48 +157,13 @@ def angle_grid(start: float, stop: float, step: float, what: str, full_turn: boo
         raise _core.InvalidArgument(f"{what}: need start <= stop and step > 0, got {start:g},{stop:g} "
                                     f"step {step:g}")
     n = int(np.floor((stop - start) / step + 1e-9))
+    if n + 1 > MAX_GRID_POINTS:
+        raise _core.InvalidArgument(f"{what}: {start:g} to {stop:g} in steps of {step:g} deg is {n + 1} positions, "
+                                    f"more than {MAX_GRID_POINTS}")
     grid = [start + k * step for k in range(n + 1)]
     if full_turn and abs(grid[-1] - (start + 360.0)) < 1e-9 and len(grid) > 1:
         grid.pop()
     return [round(g, 9) for g in grid]
-
-
-def _errors_vector(errors: Errors, machine: Any, rng: np.random.Generator) -> np.ndarray:
-    names = list(_core.location_error_names(machine))
-    if isinstance(errors, str):
-        if errors == "random":
-            return random_location_errors(machine, rng)
-        if errors == "zero":
-            return np.zeros(8)
-        raise _core.InvalidArgument(f"errors: 'random', 'zero' or NAME=VALUE pairs, got {errors!r}")
-    if isinstance(errors, Mapping):
-        unknown = [k for k in errors if k not in names]
-        if unknown:
-            raise _core.InvalidArgument(f"errors: {', '.join(unknown)} not a location error of "
-                                        f"{_core.machine_name(machine)} ({', '.join(names)})")
-        return np.array([float(errors.get(n, 0.0)) for n in names])
-    v = np.asarray(errors, dtype=float)
-    if v.shape != (8,):
-        raise _core.InvalidArgument(f"errors: expected 8 values in the order {', '.join(names)}")
-    return v
-
-
-def machine_truth(errors: Errors, effects: Mapping[str, Any] | None, machine: str, seed: int):
-    """The simulated machine: (machine type, 8 location errors, effect ids, their parameters back
-    to back, effects as given for the truth file). Random errors are drawn from ``seed``."""
-    mtype = _core.parse_machine_type(machine)
-    e = _errors_vector(errors, mtype, np.random.default_rng(seed))
-    ids, params, effects_out = [], [], {}
-    for eid, val in (effects or {}).items():
-        eff = _core.Effect(eid)
-        vals = [float(v) for v in np.atleast_1d(np.asarray(val, dtype=float))]
-        if len(vals) != eff.num_params:
-            raise _core.InvalidArgument(f"effects: {eid} takes {eff.num_params} values "
-                                        f"({', '.join(eff.param_names)}), got {len(vals)}")
-        ids.append(eff.id)
-        params.extend(vals)
-        effects_out[eff.id] = vals[0] if eff.num_params == 1 else vals
-    return mtype, e, ids, params, effects_out
 
 
 def simulate_rtest(errors: Errors = "random", effects: Mapping[str, Any] | None = None, *,
@@ -227,11 +194,21 @@ def simulate_rtest(errors: Errors = "random", effects: Mapping[str, Any] | None 
     """
     mtype, e, ids, params, effects_out = machine_truth(errors, effects, machine, seed)
     nest_arr = np.asarray(nests, dtype=float).reshape(-1, 3)
+    n_poses = len(b_deg) * len(c_deg) * len(nest_arr)
+    if n_poses > MAX_POSES:
+        raise _core.InvalidArgument(f"simulate_rtest: {len(b_deg)} B x {len(c_deg)} C x {len(nest_arr)} nests is "
+                                    f"{n_poses} poses, more than {MAX_POSES}")
+    if not (np.isfinite(dwell_s) and dwell_s > 0):
+        raise _core.InvalidArgument(f"simulate_rtest: dwell_s must be > 0 s (time must increase), got {dwell_s:g}")
+    if not (np.isfinite(noise_um) and noise_um >= 0 and np.isfinite(probe_zero_um) and probe_zero_um >= 0):
+        raise _core.InvalidArgument("simulate_rtest: noise_um and probe_zero_um must be finite and >= 0")
+    if not 0 <= int(seed) < 2**32:
+        raise _core.InvalidArgument(f"simulate_rtest: seed must be in [0, 2^32 - 1], got {seed}")
     dirs = None if probe_dirs is None else np.asarray(probe_dirs, dtype=float)
     session, zeros = _core.simulate_rtest(mtype, e, ids, params, list(map(float, b_deg)),
                                           list(map(float, c_deg)), nest_arr, float(dwell_s),
                                           float(noise_um), float(probe_zero_um), dirs, bool(write_d),
-                                          int(seed) % 2**32)
+                                          int(seed))
     truth = {"errors": dict(zip(_core.location_error_names(mtype), e.tolist())),
              "effects": effects_out,
              "nests": nest_arr.tolist(),
@@ -256,7 +233,7 @@ def truth_readings(truth: Mapping, session: _core.RtestSession, probe_zeros: boo
     e = np.array([truth["errors"][n] for n in names])
     ids = list(truth.get("effects", {}))
     params = [float(v) for i in ids for v in np.atleast_1d(truth["effects"][i])]
-    setups = np.asarray(session.setups)
+    setups = np.asarray(session.setups, dtype=object)
     angles = np.radians(np.asarray(session.angles_deg))
     time = np.asarray(session.time)
     out = np.zeros((len(setups), 3))
@@ -269,12 +246,11 @@ def truth_readings(truth: Mapping, session: _core.RtestSession, probe_zeros: boo
     return out
 
 
-def save_truth(truth: Mapping, path: str | Path) -> None:
-    """Write a truth dict as JSON (temporary file first)."""
-    path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(json.dumps(truth, indent=1) + "\n")
-    tmp.replace(path)
+def save_truth(truth: Mapping, path: str | Path, other_outputs: Sequence[str | Path] = ()) -> None:
+    """Write a truth dict as strict JSON by the output rule (rotacal.outputs)."""
+    from . import jsontext
+    from .outputs import write_output
+    write_output(path, jsontext.dumps(dict(truth)) + "\n", other_outputs=[str(o) for o in other_outputs])
 
 
 # ------------------------------------------------------------------------- device calibration

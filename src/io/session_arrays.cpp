@@ -1,4 +1,7 @@
+// Sessions to and from numpy-shaped columns, validated as the file reader validates them.
 #include "rotacal/io/session_arrays.hpp"
+
+#include "rotacal/io/ballbar_file.hpp"
 
 #include <cmath>
 
@@ -19,6 +22,15 @@ void check_rows(Eigen::Index n, Eigen::Index expected, const char* name) {
 template <typename M>
 void check_finite(const M& m, const char* name) {
   if (!m.allFinite()) throw InvalidArgument(std::string(name) + " contains NaN or infinity");
+}
+// The file reader's limits (ballbar_file.hpp), so a session built from arrays is one that
+// `save` can write and `load` read back.
+template <typename M>
+void check_range(const M& m, const char* name, double lo, double hi, const char* unit) {
+  for (Eigen::Index i = 0; i < m.size(); ++i)
+    if (!(m.data()[i] >= lo && m.data()[i] <= hi))
+      throw InvalidArgument(std::string(name) + ": " + format_number(m.data()[i]) + " (entry " + std::to_string(i) +
+                            ") is outside [" + format_number(lo) + ", " + format_number(hi) + "] " + unit);
 }
 }  // namespace
 
@@ -61,9 +73,15 @@ BallbarSession make_ballbar_session(MachineType machine, double ballbar_length,
   check_finite(angles_deg, "angles_deg");
   check_finite(length, "length");
   check_finite(pivot, "pivot");
-  if (!(ballbar_length > 0.0) || !std::isfinite(ballbar_length))
-    throw InvalidArgument("ballbar_length must be finite and > 0");
-  if (noise_um && !(*noise_um > 0.0)) throw InvalidArgument("noise_um must be > 0");
+  if (!(ballbar_length >= kMinLengthMm && ballbar_length <= kMaxLengthMm))
+    throw InvalidArgument("ballbar_length must be finite and within [0.001, 10000] mm");
+  if (noise_um && !(*noise_um > 0.0 && *noise_um <= kMaxNoiseUm))
+    throw InvalidArgument("noise_um must be > 0 and <= 1e5");
+  check_range(time, "time", -kMaxAbsTimeS, kMaxAbsTimeS, "s");
+  check_range(xyz, "xyz", -kMaxAbsPositionMm, kMaxAbsPositionMm, "mm");
+  check_range(angles_deg, "angles_deg", -kMaxAbsAngleDeg, kMaxAbsAngleDeg, "deg");
+  check_range(length, "length", kMinLengthMm, kMaxLengthMm, "mm");
+  check_range(pivot, "pivot", -kMaxAbsPositionMm, kMaxAbsPositionMm, "mm");
   BallbarSession s;
   s.machine = machine;
   s.ballbar_length = ballbar_length;
@@ -74,6 +92,8 @@ BallbarSession make_ballbar_session(MachineType machine, double ballbar_length,
       throw InvalidArgument("time decreases at row " + std::to_string(i));
     if (tests[static_cast<std::size_t>(i)].empty())
       throw InvalidArgument("tests: empty label at row " + std::to_string(i));
+    if (tests[static_cast<std::size_t>(i)].size() > kMaxLabelBytes)
+      throw InvalidArgument("tests: label at row " + std::to_string(i) + " is longer than 256 bytes");
     BallbarSample b;
     b.test = tests[static_cast<std::size_t>(i)];
     b.time = time[i];

@@ -1,3 +1,6 @@
+// rotacal-ballbar/1 and rotacal-rtest/1 session files: strict readers, exact writers, appending writers.
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <charconv>
@@ -5,9 +8,11 @@
 #include <cstring>
 #include <fstream>
 #include <set>
+#include <unordered_map>
 #include <sstream>
 
 #include "rotacal/io/ballbar_file.hpp"
+#include "rotacal/io/output_file.hpp"
 
 namespace rotacal {
 
@@ -21,6 +26,15 @@ std::string trim(const std::string& s) {
   if (a == std::string::npos) return "";
   const auto b = s.find_last_not_of(" \t\r");
   return s.substr(a, b - a + 1);
+}
+
+// Shows at most ~80 characters of offending text in a message (an error message never
+// echoes a megabyte line back).
+std::string excerpt(const std::string& t) {
+  if (t.size() <= 80) return t;
+  std::size_t cut = 77;
+  while (cut > 0 && (static_cast<unsigned char>(t[cut]) & 0xC0) == 0x80) --cut;  // whole UTF-8 chars
+  return t.substr(0, cut) + "...";
 }
 
 // One field of a data row, with its 1-based character column for error messages.
@@ -62,9 +76,26 @@ struct Reader {
     const auto r = std::from_chars(b, e, v);
     if (f.text.empty()) fail(line_no, f.column, what + " is empty");
     if (r.ec != std::errc() || r.ptr != e)
-      fail(line_no, f.column, what + ": '" + f.text + "' is not a number");
-    if (!std::isfinite(v)) fail(line_no, f.column, what + " is " + f.text + " (must be finite)");
+      fail(line_no, f.column, what + ": '" + excerpt(f.text) + "' is not a number");
+    if (!std::isfinite(v)) fail(line_no, f.column, what + " is " + excerpt(f.text) + " (must be finite)");
     return v;
+  }
+
+  // A number within [lo, hi]: beyond, it cannot come from a machine tool.
+  double bounded(const Field& f, const std::string& what, double lo, double hi, const char* unit) const {
+    const double v = number(f, what);
+    if (v < lo || v > hi)
+      fail(line_no, f.column, what + " " + excerpt(f.text) + " is outside [" + format_number(lo) + ", " +
+                                  format_number(hi) + "] " + unit + " (wrong units, or not a measurement)");
+    return v;
+  }
+
+  std::string label(const Field& f, const std::string& what) const {
+    if (f.text.empty()) fail(line_no, f.column, what + " is empty");
+    if (f.text.size() > kMaxLabelBytes)
+      fail(line_no, f.column, what + " is longer than " + std::to_string(kMaxLabelBytes) + " bytes ('" +
+                                  excerpt(f.text) + "')");
+    return f.text;
   }
 
   const std::string* meta(const std::string& key) const {
@@ -79,23 +110,130 @@ struct Reader {
     return 0;
   }
 
-  double meta_number(const std::string& key, const std::string& value) const {
+  double meta_number(const std::string& key, const std::string& value, double lo = -1e300,
+                     double hi = 1e300, const char* unit = "") const {
     Field f{trim(value), 0};
     Reader copy = *this;
     copy.line_no = meta_line(key);
-    return copy.number(f, "metadata '" + key + "'");
+    return copy.bounded(f, "metadata '" + key + "'", lo, hi, unit);
   }
 
-  Eigen::Vector3d meta_vector(const std::string& key, const std::string& value) const {
+  Eigen::Vector3d meta_vector(const std::string& key, const std::string& value, double limit = 1e300,
+                              const char* unit = "") const {
     const std::vector<Field> parts = split_fields(value);
     if (parts.size() != 3)
-      fail(meta_line(key), 0, "metadata '" + key + "' must be three numbers 'x, y, z', got '" + value + "'");
+      fail(meta_line(key), 0, "metadata '" + key + "' must be three numbers 'x, y, z', got '" + excerpt(value) + "'");
     Eigen::Vector3d v;
-    for (int k = 0; k < 3; ++k) v[k] = meta_number(key, parts[static_cast<std::size_t>(k)].text);
+    for (int k = 0; k < 3; ++k) v[k] = meta_number(key, parts[static_cast<std::size_t>(k)].text, -limit, limit, unit);
     return v;
   }
 
   std::vector<int> meta_lines;
+};
+
+// Length in bytes of the valid UTF-8 sequence at s[i], 0 if it is not one (RFC 3629: no
+// overlong forms, no surrogates, at most U+10FFFF).
+std::size_t utf8_length(const std::string& s, std::size_t i) {
+  const auto b = [&](std::size_t k) { return static_cast<unsigned char>(s[k]); };
+  const unsigned char c = b(i);
+  if (c < 0x80) return 1;
+  std::size_t n;
+  unsigned cp;
+  if (c >= 0xC2 && c <= 0xDF) n = 2, cp = c & 0x1F;
+  else if (c >= 0xE0 && c <= 0xEF) n = 3, cp = c & 0x0F;
+  else if (c >= 0xF0 && c <= 0xF4) n = 4, cp = c & 0x07;
+  else return 0;
+  if (i + n > s.size()) return 0;
+  for (std::size_t k = 1; k < n; ++k) {
+    if ((b(i + k) & 0xC0) != 0x80) return 0;
+    cp = (cp << 6) | (b(i + k) & 0x3F);
+  }
+  if ((n == 3 && cp < 0x800) || (n == 4 && (cp < 0x10000 || cp > 0x10FFFF)) || (cp >= 0xD800 && cp <= 0xDFFF))
+    return 0;
+  return n;
+}
+
+// Lines of a session file, read in bounded chunks: a line longer than kMaxLineBytes (a binary
+// file, /dev/zero, a file with CR-only line ends) is refused as soon as it is seen, so memory
+// stays bounded whatever the input. Each line is checked: UTF-8, no control characters but
+// tab, a CR only as the CRLF line end.
+class LineSource {
+ public:
+  LineSource(std::istream& in, const std::string& name) : in_(in), name_(name) {}
+
+  bool next(std::string& line, int& line_no) {
+    line.clear();
+    for (;;) {
+      if (pos_ == len_) {
+        if (eof_) break;
+        in_.read(buf_, sizeof buf_);
+        len_ = static_cast<std::size_t>(in_.gcount());
+        pos_ = 0;
+        if (len_ == 0) {
+          if (in_.bad()) throw IoError(name_ + ": read failed");
+          eof_ = true;
+          break;
+        }
+      }
+      const char* start = buf_ + pos_;
+      const void* nl = std::memchr(start, '\n', len_ - pos_);
+      const std::size_t take = nl ? static_cast<std::size_t>(static_cast<const char*>(nl) - start) : len_ - pos_;
+      if (line.size() + take > kMaxLineBytes) too_long(line.append(start, std::min(take, std::size_t(100))));
+      line.append(start, take);
+      pos_ += take;
+      if (nl) {
+        ++pos_;
+        return finish(line, line_no);
+      }
+    }
+    if (line.empty()) return false;  // end of file
+    return finish(line, line_no);
+  }
+
+ private:
+  bool finish(std::string& line, int& line_no) {
+    ++line_no_;
+    line_no = line_no_;
+    if (!line.empty() && line.back() == '\r') line.pop_back();  // CRLF
+    if (line_no_ == 1 && line.compare(0, 3, "\xEF\xBB\xBF") == 0)
+      throw ParseError(name_, 1, 1, "the file starts with a UTF-8 byte-order mark (bytes EF BB BF); "
+                                    "session files are UTF-8 without one: save it without the BOM");
+    for (std::size_t i = 0; i < line.size();) {
+      const unsigned char c = static_cast<unsigned char>(line[i]);
+      if (c == '\r')
+        throw ParseError(name_, line_no_, static_cast<int>(i) + 1,
+                         "carriage return inside a line (line ends must be LF or CRLF, not CR alone)");
+      if (c < 0x20 && c != '\t') {
+        char hex[8];
+        std::snprintf(hex, sizeof hex, "0x%02X", c);
+        throw ParseError(name_, line_no_, static_cast<int>(i) + 1,
+                         std::string("control character ") + hex + " (not a text file?)");
+      }
+      const std::size_t n = utf8_length(line, i);
+      if (n == 0) {
+        char hex[8];
+        std::snprintf(hex, sizeof hex, "0x%02X", c);
+        throw ParseError(name_, line_no_, static_cast<int>(i) + 1,
+                         std::string("byte ") + hex + " is not UTF-8 (session files are UTF-8 text)");
+      }
+      i += n;
+    }
+    return true;
+  }
+
+  [[noreturn]] void too_long(const std::string& head) const {
+    std::string shown;
+    for (char c : head.substr(0, 40)) shown += (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7F) ? '?' : c;
+    throw ParseError(name_, line_no_ + 1, 0, "line longer than " + std::to_string(kMaxLineBytes) +
+                                                 " bytes (a binary file, or CR-only line ends?), starting '" + shown + "...'");
+  }
+
+  std::istream& in_;
+  std::string name_;
+  char buf_[1 << 16];
+  std::size_t pos_ = 0, len_ = 0;
+  bool eof_ = false;
+  int line_no_ = 0;
 };
 
 // Reads metadata up to and including the column header; returns the rows that follow as
@@ -110,8 +248,8 @@ RawFile read_structure(std::istream& in, Reader& R, const char* expected_format)
   std::string line;
   bool format_seen = false;
   bool any = false;
-  while (std::getline(in, line)) {
-    ++R.line_no;
+  LineSource lines(in, R.name);
+  while (lines.next(line, R.line_no)) {
     const std::string t = trim(line);
     if (t.empty()) continue;
     any = true;
@@ -131,14 +269,14 @@ RawFile read_structure(std::istream& in, Reader& R, const char* expected_format)
       const std::string value = trim(body.substr(colon + 1));
       if (!format_seen) {
         if (key != "format")
-          R.fail(R.line_no, 1, std::string("first line must be '# format: ") + expected_format + "', got '" + t + "'");
+          R.fail(R.line_no, 1, std::string("first line must be '# format: ") + expected_format + "', got '" + excerpt(t) + "'");
         if (value != expected_format)
           R.fail(R.line_no, static_cast<int>(line.find(value)) + 1,
-                 "format '" + value + "' is not " + expected_format);
+                 "format '" + excerpt(value) + "' is not " + expected_format);
         format_seen = true;
       }
       for (const auto& kv : R.metadata)
-        if (kv.first == key) R.fail(R.line_no, 1, "metadata key '" + key + "' appears twice");
+        if (kv.first == key) R.fail(R.line_no, 1, "metadata key '" + excerpt(key) + "' appears twice");
       R.metadata.emplace_back(key, value);
       R.meta_lines.push_back(R.line_no);
       continue;
@@ -148,8 +286,10 @@ RawFile read_structure(std::istream& in, Reader& R, const char* expected_format)
     if (R.header.empty()) {
       for (const Field& f : split_fields(line)) {
         if (f.text.empty()) R.fail(R.line_no, f.column, "empty column name in the header");
+        if (f.text.size() > kMaxLabelBytes)
+          R.fail(R.line_no, f.column, "column name longer than " + std::to_string(kMaxLabelBytes) + " bytes");
         if (std::find(R.header.begin(), R.header.end(), f.text) != R.header.end())
-          R.fail(R.line_no, f.column, "column '" + f.text + "' appears twice");
+          R.fail(R.line_no, f.column, "column '" + excerpt(f.text) + "' appears twice");
         R.header.push_back(f.text);
       }
       R.header_line = R.line_no;
@@ -178,7 +318,7 @@ MachineType read_machine(const Reader& R) {
   try {
     return parse_machine_type(*m);
   } catch (const InvalidArgument&) {
-    R.fail(R.meta_line("machine"), 0, "unknown machine '" + *m + "' (known: AC-trt, BC-trt)");
+    R.fail(R.meta_line("machine"), 0, "unknown machine '" + excerpt(*m) + "' (known: AC-trt, BC-trt)");
   }
 }
 
@@ -189,14 +329,14 @@ void check_units(const Reader& R) {
   for (char c : *u)
     if (c != ' ') compact += c;
   if (compact != "mm,deg,s")
-    R.fail(R.meta_line("units"), 0, "units '" + *u + "' are not supported (must be 'mm, deg, s')");
+    R.fail(R.meta_line("units"), 0, "units '" + excerpt(*u) + "' are not supported (must be 'mm, deg, s')");
 }
 
 std::optional<double> read_noise(const Reader& R) {
   const std::string* n = R.meta("noise_um");
   if (!n) return std::nullopt;
-  const double v = R.meta_number("noise_um", *n);
-  if (!(v > 0.0)) R.fail(R.meta_line("noise_um"), 0, "noise_um must be > 0, got " + *n);
+  const double v = R.meta_number("noise_um", *n, 0.0, kMaxNoiseUm, "um");
+  if (!(v > 0.0)) R.fail(R.meta_line("noise_um"), 0, "noise_um must be > 0, got " + excerpt(*n));
   return v;
 }
 
@@ -218,9 +358,32 @@ std::vector<Field> row_fields(Reader& R, const std::pair<int, std::string>& row)
   return f;
 }
 
+// Rows that repeat an earlier row exactly (same label, time and values: a recorder or a
+// copy-paste wrote them twice). They are kept, as the file says, but reported: a fit would
+// otherwise count one measurement twice and shrink its sigma by sqrt(2) without a word.
+struct DuplicateRows {
+  std::unordered_map<std::string, int> first_line;
+  std::size_t count = 0;
+  int example_line = 0, example_of = 0;
+
+  void add(const std::pair<int, std::string>& row, int line) {
+    std::string key;
+    for (const Field& f : split_fields(row.second)) key += f.text + ",";
+    const auto ins = first_line.emplace(std::move(key), line);
+    if (!ins.second && count++ == 0) example_line = line, example_of = ins.first->second;
+  }
+  void report(std::vector<std::string>& warnings) const {
+    if (count == 0) return;
+    warnings.push_back(std::to_string(count) + " row" + (count > 1 ? "s repeat" : " repeats") +
+                       " an earlier row exactly (first: line " + std::to_string(example_line) + " repeats line " +
+                       std::to_string(example_of) + "); each counts as a separate measurement in a fit: "
+                       "remove them if they were written twice");
+  }
+};
+
 void check_time(Reader& R, const Field& f, double t, double& last) {
   if (t < last)
-    R.fail(R.line_no, f.column, "time " + f.text + " is before the previous row's (time must not decrease)");
+    R.fail(R.line_no, f.column, "time " + excerpt(f.text) + " is before the previous row's (time must not decrease)");
   last = t;
 }
 
@@ -231,25 +394,15 @@ std::vector<Annotation> annotations_of(const RawFile& raw) {
 }
 
 std::ifstream open_for_reading(const std::string& path) {
-  std::ifstream in(path);
+  if (path.find('\0') != std::string::npos)
+    throw IoError(std::string(path.c_str()) + "...: path contains a NUL byte");
+  if (path.empty()) throw IoError("(empty path): an input path must not be empty");
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
+    throw IoError(path + ": is a directory, not a session file");
+  std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError(path + ": cannot open for reading: " + std::strerror(errno));
   return in;
-}
-
-void write_atomically(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
-  std::FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (!f) throw IoError(path + ": cannot open for writing: " + std::strerror(errno));
-  const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size() && std::fflush(f) == 0;
-  const bool closed = std::fclose(f) == 0;
-  if (!ok || !closed) {
-    std::remove(tmp.c_str());
-    throw IoError(path + ": write failed: " + std::strerror(errno));
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    throw IoError(path + ": cannot replace: " + std::strerror(errno));
-  }
 }
 
 std::string vec_text(const Eigen::Vector3d& v) {
@@ -374,11 +527,11 @@ BallbarSession parse_ballbar(std::istream& in, const std::string& name) {
   check_units(R);
   const std::string* L = R.meta("ballbar_length");
   if (!L) R.fail(0, 0, "missing metadata 'ballbar_length' (calibrated length L0, mm)");
-  s.ballbar_length = R.meta_number("ballbar_length", *L);
+  s.ballbar_length = R.meta_number("ballbar_length", *L, kMinLengthMm, kMaxLengthMm, "mm");
   if (!(s.ballbar_length > 0.0)) R.fail(R.meta_line("ballbar_length"), 0, "ballbar_length must be > 0");
   const std::string* P = R.meta("pivot");
   if (!P) R.fail(0, 0, "missing metadata 'pivot' (nominal centre-pivot position 'x, y, z', mm)");
-  s.pivot = R.meta_vector("pivot", *P);
+  s.pivot = R.meta_vector("pivot", *P, kMaxAbsPositionMm, "mm");
   s.noise_um = read_noise(R);
   s.metadata = R.metadata;
   check_rotary_columns(R, s.machine);
@@ -392,24 +545,30 @@ BallbarSession parse_ballbar(std::istream& in, const std::string& name) {
   for (int i = 0; i < static_cast<int>(R.header.size()); ++i)
     if (!known.count(i)) extra_idx.push_back(i), s.extra_columns.push_back(R.header[static_cast<std::size_t>(i)]);
   double last = -1e300;
+  DuplicateRows dups;
   s.samples.reserve(raw.rows.size());
   for (const auto& row : raw.rows) {
     const std::vector<Field> f = row_fields(R, row);
+    auto F = [&](int c) -> const Field& { return f[static_cast<std::size_t>(c)]; };
     BallbarSample b;
-    b.test = f[static_cast<std::size_t>(c_test)].text;
-    if (b.test.empty()) R.fail(R.line_no, f[static_cast<std::size_t>(c_test)].column, "test label is empty");
-    b.time = R.number(f[static_cast<std::size_t>(c_time)], "time");
-    check_time(R, f[static_cast<std::size_t>(c_time)], b.time, last);
-    b.xyz = {R.number(f[static_cast<std::size_t>(c_x)], "X"), R.number(f[static_cast<std::size_t>(c_y)], "Y"),
-             R.number(f[static_cast<std::size_t>(c_z)], "Z")};
-    b.tilt_deg = R.number(f[static_cast<std::size_t>(c_t)], T);
-    b.rot_deg = R.number(f[static_cast<std::size_t>(c_c)], "C");
-    b.length = R.number(f[static_cast<std::size_t>(c_len)], "length");
-    if (!(b.length > 0.0)) R.fail(R.line_no, f[static_cast<std::size_t>(c_len)].column, "length must be > 0");
+    b.test = R.label(F(c_test), "test label");
+    b.time = R.bounded(F(c_time), "time", -kMaxAbsTimeS, kMaxAbsTimeS, "s");
+    check_time(R, F(c_time), b.time, last);
+    b.xyz = {R.bounded(F(c_x), "X", -kMaxAbsPositionMm, kMaxAbsPositionMm, "mm"),
+             R.bounded(F(c_y), "Y", -kMaxAbsPositionMm, kMaxAbsPositionMm, "mm"),
+             R.bounded(F(c_z), "Z", -kMaxAbsPositionMm, kMaxAbsPositionMm, "mm")};
+    b.tilt_deg = R.bounded(F(c_t), T, -kMaxAbsAngleDeg, kMaxAbsAngleDeg, "deg");
+    b.rot_deg = R.bounded(F(c_c), "C", -kMaxAbsAngleDeg, kMaxAbsAngleDeg, "deg");
+    const Field& fl = F(c_len);
+    b.length = R.number(fl, "length");
+    if (!(b.length > 0.0)) R.fail(R.line_no, fl.column, "length must be > 0");
+    b.length = R.bounded(fl, "length", kMinLengthMm, kMaxLengthMm, "mm");
+    dups.add(row, R.line_no);
     for (int i : extra_idx) b.extra.push_back(f[static_cast<std::size_t>(i)].text);
     s.samples.push_back(std::move(b));
   }
   s.annotations = annotations_of(raw);
+  dups.report(s.warnings);
   return s;
 }
 
@@ -418,15 +577,41 @@ BallbarSession read_ballbar(const std::string& path) {
   return parse_ballbar(in, path);
 }
 
+// The writers refuse what the readers would refuse, so no file is written that cannot be
+// read back (a simulation with absurd noise, a negative dwell).
+void check_writable(double v, double lo, double hi, const char* what, std::size_t row) {
+  if (!(v >= lo && v <= hi))
+    throw InvalidArgument(std::string(what) + " " + (std::isfinite(v) ? format_number(v) : std::string("non-finite")) +
+                          " of sample " + std::to_string(row) + " is outside [" + format_number(lo) + ", " +
+                          format_number(hi) + "]: a file with it could not be read back");
+}
+
+template <typename Sample>
+void check_samples(const std::vector<Sample>& samples) {
+  double last = -kMaxAbsTimeS;
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const Sample& r = samples[i];
+    check_writable(r.time, last, kMaxAbsTimeS, "time", i);
+    last = r.time;
+    for (int k = 0; k < 3; ++k) check_writable(r.xyz[k], -kMaxAbsPositionMm, kMaxAbsPositionMm, "X/Y/Z", i);
+    check_writable(r.tilt_deg, -kMaxAbsAngleDeg, kMaxAbsAngleDeg, "tilt angle", i);
+    check_writable(r.rot_deg, -kMaxAbsAngleDeg, kMaxAbsAngleDeg, "C", i);
+  }
+}
+
 std::string format_ballbar(const BallbarSession& s) {
-  if (!(s.ballbar_length > 0.0)) throw InvalidArgument("ballbar_length must be > 0");
+  if (!(s.ballbar_length >= kMinLengthMm && s.ballbar_length <= kMaxLengthMm))
+    throw InvalidArgument("ballbar_length must be within [0.001, 10000] mm");
+  check_samples(s.samples);
+  for (std::size_t i = 0; i < s.samples.size(); ++i)
+    check_writable(s.samples[i].length, kMinLengthMm, kMaxLengthMm, "length", i);
   return ballbar_head(s) + with_annotations(s.samples, s.annotations, [&](const BallbarSample& r) {
            return ballbar_row(r, s.extra_columns.size());
          });
 }
 
 void write_ballbar(const BallbarSession& s, const std::string& path) {
-  write_atomically(path, format_ballbar(s));
+  write_output(path, format_ballbar(s));
 }
 
 // ---------------------------------------------------------------- R-test
@@ -443,13 +628,13 @@ RtestSession parse_rtest(std::istream& in, const std::string& name) {
     if (kv.first.rfind("nest.", 0) == 0) {
       const std::string label = kv.first.substr(5);
       if (label.empty()) R.fail(R.meta_line(kv.first), 0, "nest metadata needs a label: 'nest.N'");
-      s.nests[label] = R.meta_vector(kv.first, kv.second);
+      s.nests[label] = R.meta_vector(kv.first, kv.second, kMaxAbsPositionMm, "mm");
     } else if (kv.first.rfind("probe.", 0) == 0 && kv.first.size() > 10 &&
                kv.first.compare(kv.first.size() - 4, 4, ".dir") == 0) {
       const std::string n = kv.first.substr(6, kv.first.size() - 10);
       if (n != "1" && n != "2" && n != "3")
         R.fail(R.meta_line(kv.first), 0, "probe number must be 1, 2 or 3 in '" + kv.first + "'");
-      const Eigen::Vector3d d = R.meta_vector(kv.first, kv.second);
+      const Eigen::Vector3d d = R.meta_vector(kv.first, kv.second, 2.0, "");
       if (std::abs(d.norm() - 1.0) > 1e-6)
         R.fail(R.meta_line(kv.first), 0, kv.first + " must be a unit vector (norm " + format_number(d.norm()) + ")");
       s.probe_dirs[std::stoi(n)] = d;
@@ -480,24 +665,33 @@ RtestSession parse_rtest(std::istream& in, const std::string& name) {
   for (int i = 0; i < static_cast<int>(R.header.size()); ++i)
     if (!known.count(i)) extra_idx.push_back(i), s.extra_columns.push_back(R.header[static_cast<std::size_t>(i)]);
   double last = -1e300;
+  DuplicateRows dups;
   for (const auto& row : raw.rows) {
     const std::vector<Field> f = row_fields(R, row);
     auto F = [&](int c) -> const Field& { return f[static_cast<std::size_t>(c)]; };
     RtestSample r;
-    r.setup = F(c_setup).text;
+    r.setup = R.label(F(c_setup), "setup label");
     if (!s.nests.count(r.setup))
-      R.fail(R.line_no, F(c_setup).column, "setup '" + r.setup + "' has no 'nest." + r.setup + "' metadata");
-    r.time = R.number(F(c_time), "time");
+      R.fail(R.line_no, F(c_setup).column, "setup '" + excerpt(r.setup) + "' has no 'nest." + excerpt(r.setup) + "' metadata");
+    const auto pos = [&](int c, const char* what) {
+      return R.bounded(F(c), what, -kMaxAbsPositionMm, kMaxAbsPositionMm, "mm");
+    };
+    const auto disp = [&](int c, const char* what) {
+      return R.bounded(F(c), what, -kMaxAbsDisplacementMm, kMaxAbsDisplacementMm, "mm");
+    };
+    r.time = R.bounded(F(c_time), "time", -kMaxAbsTimeS, kMaxAbsTimeS, "s");
     check_time(R, F(c_time), r.time, last);
-    r.tilt_deg = R.number(F(c_t), T);
-    r.rot_deg = R.number(F(c_c), "C");
-    r.xyz = {R.number(F(c_x), "X"), R.number(F(c_y), "Y"), R.number(F(c_z), "Z")};
-    if (n_d == 3) r.d = Eigen::Vector3d(R.number(F(c_dx), "dx"), R.number(F(c_dy), "dy"), R.number(F(c_dz), "dz"));
-    if (n_raw == 3) r.raw = Eigen::Vector3d(R.number(F(c_d1), "d1"), R.number(F(c_d2), "d2"), R.number(F(c_d3), "d3"));
+    r.tilt_deg = R.bounded(F(c_t), T, -kMaxAbsAngleDeg, kMaxAbsAngleDeg, "deg");
+    r.rot_deg = R.bounded(F(c_c), "C", -kMaxAbsAngleDeg, kMaxAbsAngleDeg, "deg");
+    r.xyz = {pos(c_x, "X"), pos(c_y, "Y"), pos(c_z, "Z")};
+    if (n_d == 3) r.d = Eigen::Vector3d(disp(c_dx, "dx"), disp(c_dy, "dy"), disp(c_dz, "dz"));
+    if (n_raw == 3) r.raw = Eigen::Vector3d(disp(c_d1, "d1"), disp(c_d2, "d2"), disp(c_d3, "d3"));
+    dups.add(row, R.line_no);
     for (int i : extra_idx) r.extra.push_back(F(i).text);
     s.samples.push_back(std::move(r));
   }
   s.annotations = annotations_of(raw);
+  dups.report(s.warnings);
   return s;
 }
 
@@ -511,7 +705,12 @@ std::string format_rtest(const RtestSession& s) {
   cols.d = !s.samples.empty() && s.samples.front().d.has_value();
   cols.raw = !s.samples.empty() && s.samples.front().raw.has_value();
   if (!cols.d && !cols.raw) throw InvalidArgument("R-test session has neither dx,dy,dz nor d1,d2,d3 values");
+  check_samples(s.samples);
   for (const RtestSample& r : s.samples) {
+    for (const auto* v : {&r.d, &r.raw})
+      if (*v)
+        for (int k = 0; k < 3; ++k)
+          check_writable((**v)[k], -kMaxAbsDisplacementMm, kMaxAbsDisplacementMm, "displacement", 0);
     if (!s.nests.count(r.setup)) throw InvalidArgument("setup '" + r.setup + "' has no nest in the session");
     if (r.d.has_value() != cols.d || r.raw.has_value() != cols.raw)
       throw InvalidArgument("every R-test sample must carry the same columns (dx,dy,dz and/or d1,d2,d3)");
@@ -521,20 +720,38 @@ std::string format_rtest(const RtestSession& s) {
          });
 }
 
-void write_rtest(const RtestSession& s, const std::string& path) { write_atomically(path, format_rtest(s)); }
+void write_rtest(const RtestSession& s, const std::string& path) { write_output(path, format_rtest(s)); }
 
 AnySession read_session(const std::string& path) {
   std::ifstream in = open_for_reading(path);
+  // Sniff the format line from the first 4 kB only (a file without line ends stays bounded).
+  std::string head(4096, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
   std::string line;
-  while (std::getline(in, line) && trim(line).empty()) {
+  for (std::size_t a = 0; a < head.size();) {
+    const std::size_t nl = std::min(head.find('\n', a), head.size());
+    line = head.substr(a, nl - a);
+    if (!trim(line).empty()) break;
+    a = nl + 1;
   }
   const std::string t = trim(line);
   in.clear();
   in.seekg(0);
+  if (!in) {
+    in = open_for_reading(path);  // not seekable: open again
+  }
   if (t.find(kRtestFormat) != std::string::npos) return parse_rtest(in, path);
-  if (t.find(kBallbarFormat) != std::string::npos || t.empty()) return parse_ballbar(in, path);
+  // Anything but a plain-text first line (binary data, no line end in 4 kB, not UTF-8) gets
+  // the ballbar reader's precise message (line, column, byte).
+  const bool plain = head.find('\n') != std::string::npos &&
+                     std::all_of(line.begin(), line.end(), [](char c) {
+                       const unsigned char u = static_cast<unsigned char>(c);
+                       return (u >= 0x20 && u < 0x7F) || u == '\t' || u == '\r';
+                     });
+  if (t.find(kBallbarFormat) != std::string::npos || t.empty() || !plain) return parse_ballbar(in, path);
   throw ParseError(path, 1, 1, std::string("first line must be '# format: ") + kBallbarFormat + "' or '# format: " +
-                                   kRtestFormat + "', got '" + t + "'");
+                                   kRtestFormat + "', got '" + excerpt(t) + "'");
 }
 
 // ---------------------------------------------------------------- appending writers

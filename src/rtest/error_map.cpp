@@ -1,3 +1,4 @@
+// R-test error maps (Oyama & Ibaraki): tabulated from the paper method, written as CSV and JSON.
 #include "rotacal/rtest/error_map.hpp"
 
 #include <cmath>
@@ -5,7 +6,10 @@
 #include <fstream>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 #include "rotacal/core/error.hpp"
+#include "rotacal/io/output_file.hpp"
 
 namespace rotacal {
 
@@ -17,7 +21,6 @@ std::string num(double v) {
   std::snprintf(b, sizeof b, "%.9g", v);
   return b;
 }
-std::string jnum(double v) { return std::isfinite(v) ? num(v) : "null"; }
 }  // namespace
 
 RtestErrorMap error_map(const RtestJointIdentification& id, const std::vector<double>& b_deg,
@@ -73,43 +76,54 @@ std::string error_map_csv(const RtestErrorMap& map) {
 }
 
 std::string error_map_json(const RtestErrorMap& map) {
-  std::ostringstream o;
+  using ojson = nlohmann::ordered_json;
+  // Strict JSON through nlohmann (escaping of every string, shortest round-trip numbers); a
+  // non-finite value is written null, and "null_means" says why rather than a silent null.
+  bool any_null = false;
   auto vec = [&](const AxisErrors<double>& w) {
-    o << "[";
-    for (int k = 0; k < 6; ++k) o << (k ? ", " : "") << jnum(w[k]);
-    o << "]";
+    ojson a = ojson::array();
+    for (int k = 0; k < 6; ++k) {
+      if (std::isfinite(w[k])) {
+        a.push_back(w[k]);
+      } else {
+        a.push_back(nullptr);
+        any_null = true;
+      }
+    }
+    return a;
   };
-  o << "{\n  \"method\": \"" << map.method << "\",\n"
-    << "  \"order\": [\"dx\", \"dy\", \"dz\", \"alpha\", \"beta\", \"gamma\"],\n"
-    << "  \"units\": [\"mm\", \"mm\", \"mm\", \"rad\", \"rad\", \"rad\"],\n  \"notes\": [";
-  for (std::size_t i = 0; i < map.notes.size(); ++i) {
-    std::string s = map.notes[i];
-    std::string esc;
-    for (char c : s) esc += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
-    o << (i ? ", " : "") << "\"" << esc << "\"";
+  ojson head;
+  head["method"] = map.method;
+  head["order"] = {"dx", "dy", "dz", "alpha", "beta", "gamma"};
+  head["units"] = {"mm", "mm", "mm", "rad", "rad", "rad"};
+  head["notes"] = map.notes;
+  std::vector<std::string> rows;
+  for (const RtestErrorMapEntry& e : map.entries) {
+    if (!std::isfinite(e.b_deg) || !std::isfinite(e.c_deg))
+      throw InvalidArgument("error_map_json: an entry's B or C is not finite");
+    ojson row;
+    row["B"] = e.b_deg;
+    row["C"] = e.c_deg;
+    row["BY"] = vec(e.w_BY);
+    row["BY_std"] = vec(e.w_BY_std);
+    row["CB"] = vec(e.w_CB);
+    row["CB_std"] = vec(e.w_CB_std);
+    rows.push_back(row.dump());
   }
-  o << "],\n  \"entries\": [\n";
-  for (std::size_t i = 0; i < map.entries.size(); ++i) {
-    const RtestErrorMapEntry& e = map.entries[i];
-    o << "    {\"B\": " << jnum(e.b_deg) << ", \"C\": " << jnum(e.c_deg) << ", \"BY\": ";
-    vec(e.w_BY);
-    o << ", \"BY_std\": ";
-    vec(e.w_BY_std);
-    o << ", \"CB\": ";
-    vec(e.w_CB);
-    o << ", \"CB_std\": ";
-    vec(e.w_CB_std);
-    o << "}" << (i + 1 < map.entries.size() ? "," : "") << "\n";
-  }
-  o << "  ]\n}\n";
-  return o.str();
+  if (any_null)
+    head["null_means"] =
+        "a null std: the component is assumed, not identified, by this method (e.g. gamma_CB of the "
+        "paper method, Oyama & Ibaraki Sec. 4.2); a null value: not determined by the data";
+  // One entry per line keeps an 84-pose map readable; the rest is nlohmann's indented dump.
+  std::string text = head.dump(2);
+  text.pop_back();  // the closing brace
+  text += ",\n  \"entries\": [\n";
+  for (std::size_t i = 0; i < rows.size(); ++i) text += "    " + rows[i] + (i + 1 < rows.size() ? ",\n" : "\n");
+  return text + "  ]\n}\n";
 }
 
 void write_text_file(const std::string& path, const std::string& text) {
-  std::ofstream f(path);
-  if (!f) throw IoError(path + ": cannot open for writing");
-  f << text;
-  if (!f) throw IoError(path + ": write failed");
+  write_output(path, text);
 }
 
 double prediction_rms_um(const RtestSession& session, const RtestPredictor& predict) {

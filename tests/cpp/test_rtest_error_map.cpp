@@ -1,5 +1,6 @@
 // Tests of rtest/error_map.hpp: map writers and held-out prediction.
 #include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
 #include <iostream>
 
 #include "rotacal/core/error.hpp"
@@ -82,5 +83,17 @@ TEST_CASE("error map writers") {
   const RtestErrorMap pm = error_map(identify_paper(sim.session));
   CHECK(pm.entries.size() == 84);
   CHECK(error_map_csv(pm).find(",\n") != std::string::npos);  // gamma_CB std: not identified
+  // Strict JSON: parsed by nlohmann (no NaN tokens), the null explained, every entry there.
+  const nlohmann::json pj = nlohmann::json::parse(error_map_json(pm));
+  CHECK(pj["entries"].size() == 84);
+  CHECK(pj["entries"][0]["CB_std"][5].is_null());
+  CHECK(pj["entries"][0]["CB"][0].get<double>() == pm.entries[0].w_CB[0]);
+  CHECK_THAT(pj["null_means"].get<std::string>(), Catch::Contains("not identified"));
+  RtestErrorMap quoted = m;
+  quoted.notes = {"a \"quoted\" note\twith a tab and \x01 control", "non-ASCII: \xc2\xb5m"};
+  const nlohmann::json qj = nlohmann::json::parse(error_map_json(quoted));
+  CHECK(qj["notes"][0].get<std::string>() == quoted.notes[0]);
+  CHECK(qj["notes"][1].get<std::string>() == quoted.notes[1]);
+  CHECK_FALSE(nlohmann::json::parse(error_map_json(m)).contains("null_means"));
   CHECK_THROWS_AS(write_text_file("/nonexistent-dir/x.csv", csv), IoError);
 }

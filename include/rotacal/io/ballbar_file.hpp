@@ -14,12 +14,26 @@
 
 namespace rotacal {
 
+/// Limits of what a session file may hold. Beyond them a value cannot come from a machine
+/// tool (a typo, wrong units, binary data): the reader refuses it naming file, line and column,
+/// before any numeric kernel sees it.
+inline constexpr std::size_t kMaxLineBytes = 65536;    ///< one line, bytes
+inline constexpr std::size_t kMaxLabelBytes = 256;     ///< a test or set-up label, a column name
+inline constexpr double kMaxAbsPositionMm = 1.0e5;     ///< X, Y, Z, pivot, nests (100 m)
+inline constexpr double kMaxAbsAngleDeg = 1.0e6;       ///< rotary angles (2778 turns)
+inline constexpr double kMinLengthMm = 1.0e-3;         ///< ballbar lengths and L0
+inline constexpr double kMaxLengthMm = 1.0e4;
+inline constexpr double kMaxAbsTimeS = 1.0e9;          ///< time column (31 years)
+inline constexpr double kMaxAbsDisplacementMm = 1.0e2; ///< R-test dx, dy, dz and d1, d2, d3
+inline constexpr double kMaxNoiseUm = 1.0e5;           ///< noise_um metadata
+
 /// Read a ballbar session; throws ParseError (file, line, column, what) or IoError.
 BallbarSession read_ballbar(const std::string& path);
 /// Parse a ballbar session from a stream; `name` is used in error messages.
 BallbarSession parse_ballbar(std::istream& in, const std::string& name);
-/// Write a ballbar session (to a temporary file, then renamed over `path`); throws IoError
-/// naming the path, InvalidArgument for a session that breaks the format.
+/// Write a ballbar session by the output rule of rotacal/io/output_file.hpp (regular files
+/// replaced atomically, devices written through); throws IoError naming the path,
+/// InvalidArgument for a session that breaks the format.
 void write_ballbar(const BallbarSession& session, const std::string& path);
 /// The file text of a session.
 std::string format_ballbar(const BallbarSession& session);

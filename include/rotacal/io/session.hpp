@@ -48,6 +48,8 @@ struct BallbarSession {
   std::vector<std::string> extra_columns;               ///< columns beyond the required ones
   std::vector<Annotation> annotations;
   std::vector<BallbarSample> samples;
+  /// What the reader found suspicious but kept (e.g. rows repeated exactly); not written back.
+  std::vector<std::string> warnings;
 
   /// Distinct test labels in order of first appearance.
   std::vector<std::string> tests() const;
@@ -79,6 +81,8 @@ struct RtestSession {
   std::vector<std::string> extra_columns;
   std::vector<Annotation> annotations;
   std::vector<RtestSample> samples;
+  /// What the reader found suspicious but kept (e.g. rows repeated exactly); not written back.
+  std::vector<std::string> warnings;
 
   std::vector<std::string> setups() const;
   std::vector<std::size_t> indices_of(const std::string& setup) const;

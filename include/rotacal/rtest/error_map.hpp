@@ -37,7 +37,8 @@ RtestErrorMap error_map(const RtestPaperIdentification& id);
 
 std::string error_map_csv(const RtestErrorMap& map);
 std::string error_map_json(const RtestErrorMap& map);
-/// Write either text to `path`; throws IoError naming the path if it cannot be written.
+/// Write either text to `path` by the output rule of rotacal/io/output_file.hpp; throws
+/// IoError naming the path if it cannot be written.
 void write_text_file(const std::string& path, const std::string& text);
 
 /// Predicted reading of the nest at q (table frame) at (B, C) in rad.

@@ -1,0 +1,48 @@
+#pragma once
+/// \file
+/// The one rule by which every rotacal writer (C++ and Python) puts a file on disk.
+///
+/// - A regular file, or a path that does not exist yet, is written to a uniquely named
+///   temporary file in the same directory (O_EXCL, mode 0666 & ~umask or the old file's mode),
+///   fsynced, renamed over the target and the directory fsynced: a reader, a crash or a full
+///   disk sees the old file or the new one, never half of one.
+/// - A character device or a FIFO (`-o /dev/null`, a pipe) is written through, never replaced.
+/// - A symbolic link is followed to its target, which is then written by the rules above.
+/// - Refused with IoError naming the path: a directory, a block device or socket, a path with a
+///   NUL byte, a missing parent directory, an existing file the caller may not write, one of
+///   the command's own inputs, or another output of the same command (same st_dev/st_ino, or
+///   the same canonical path for files that do not exist yet).
+/// - Nothing is left behind on any failure, including an exception thrown while the content is
+///   produced (the content is produced before anything is opened).
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace rotacal {
+
+/// The other paths of the command that writes an output; none of them may be the output.
+struct OutputOptions {
+  std::vector<std::string> inputs;         ///< files the command reads
+  std::vector<std::string> other_outputs;  ///< the command's other outputs
+};
+
+/// How an output path will be written (see check_output).
+enum class OutputKind {
+  Replace,       ///< regular file or new path: temporary file + rename
+  WriteThrough,  ///< character device or FIFO: opened and written, never replaced
+};
+
+/// Check an output path by the rule above without writing anything (so a command can refuse
+/// a bad `-o` before a long computation); returns how it would be written. Throws IoError.
+OutputKind check_output(const std::string& path, const OutputOptions& options = {});
+
+/// Write `data` to `path` by the rule above. Throws IoError naming the path.
+void write_output(const std::string& path, const std::string& data, const OutputOptions& options = {});
+
+/// Produce the content with `produce` (which may throw: then nothing is written and the old
+/// file stays), then write it by the rule above.
+void write_output(const std::string& path, const std::function<std::string()>& produce,
+                  const OutputOptions& options = {});
+
+}  // namespace rotacal

@@ -1,0 +1,85 @@
+"""What each command does with each kind of session: identify, predict and report a ballbar or an R-test session."""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Mapping, Sequence
+
+import numpy as np
+
+from . import _core, ballbar, rtest
+from .diagnosis import diagnose
+from .models import ballbar_model_from_dict
+from .sessions import BALLBAR, RTEST, by_kind
+
+
+def identify(session: Any, method: str = "joint", *, fit_length_offset: bool = False,
+             effects: Sequence[str] = (), tests: Sequence[str] = ()) -> Any:
+    """Identify the location errors of a ballbar session (rotacal.ballbar.identify: options
+    ``fit_length_offset``, ``effects``, ``tests``) or of an R-test session
+    (rotacal.identify_rtest: ``method`` only)."""
+    def rtest_identify():
+        if fit_length_offset or effects or tests:
+            raise _core.InvalidArgument("identify: an R-test session takes only `method`")
+        return rtest.identify_rtest(session, method)
+
+    run = by_kind(session, {BALLBAR: lambda: ballbar.identify(session, method, fit_length_offset=fit_length_offset,
+                                                               effects=effects, tests=tests),
+                            RTEST: rtest_identify}, "identify")
+    return run()
+
+
+def predict_session(model: Mapping, session: Any, probe_zeros: str = "none",
+                    source: str = "<model>") -> tuple[Any, str | None]:
+    """A session predicted by a model dict (rotacal.load_model), and a line saying how well it
+    matches the measurement (None when the session has no readings to compare)."""
+    def ballbar_predict():
+        if probe_zeros != "none":
+            raise _core.InvalidArgument("predict: --probe-zeros is for R-test sessions")
+        out = ballbar.predict(ballbar_model_from_dict(dict(model), source), session)
+        res = (np.asarray(session.length) - np.asarray(out.length)) * 1e3
+        return out, f"measured - predicted: RMS {np.sqrt(np.mean(res ** 2)):.3f} um over {len(session)} samples"
+
+    def rtest_predict():
+        out = rtest.predict_rtest(model, session, probe_zeros, source=source)
+        if not (rtest.has_displacements(session) or session.probe_dirs):
+            return out, None
+        return out, (f"measured - predicted: RMS {rtest.prediction_rms_um(model, session, source):.3f} um over "
+                     f"{len(session)} poses (one constant per set-up removed: its probe zero)")
+
+    return by_kind(session, {BALLBAR: ballbar_predict, RTEST: rtest_predict}, "predict")()
+
+
+def write_report(path: str | Path, session: Any, method: str = "joint", with_diagnosis: bool = True,
+                 source: str = "", inputs: Sequence[str] = ()) -> Path:
+    """The HTML report of a session (rotacal.report): identification, plots and diagnosis,
+    written by the output rule (``inputs`` of the command are refused as the target)."""
+    from . import report  # draws: matplotlib is imported only here
+
+    def ballbar_report():
+        ident = ballbar.identify(session, method)
+        d = diagnose(session) if with_diagnosis else None
+        return report.ballbar_report(path, session, ident, d, source=source, inputs=inputs)
+
+    def rtest_report():
+        if method != "joint":
+            raise _core.InvalidArgument("report: an R-test report draws the joint fit's smooth maps; the paper "
+                                        "method's per-angle map is in `rotacal identify --method paper`")
+        s, _ = rtest.with_displacements(session)  # raw d1,d2,d3 with the file's probe.N.dir (identify notes it too)
+        ident = rtest.identify_rtest(s, "joint")
+        d = diagnose(s) if with_diagnosis else None
+        return report.rtest_report(path, s, ident, d, source=source, inputs=inputs)
+
+    return by_kind(session, {BALLBAR: ballbar_report, RTEST: rtest_report}, "report")()
+
+
+def write_diagnosis_report(path: str | Path, session: Any, result: Any, source: str = "",
+                           inputs: Sequence[str] = ()) -> Path:
+    """``diagnose --report``: the ballbar report with this diagnosis, or the diagnosis alone (R-test)."""
+    from . import report
+
+    return by_kind(session, {
+        BALLBAR: lambda: report.ballbar_report(path, session, ballbar.identify(session), result, source=source,
+                                               inputs=inputs),
+        RTEST: lambda: report.diagnosis_report(path, result.to_dict(), title="R-test diagnosis", source=source,
+                                               inputs=inputs),
+    }, "diagnose --report")()

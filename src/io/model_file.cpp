@@ -1,0 +1,406 @@
+// rotacal-model/1 files: strict JSON (nlohmann), validated member by member, versioned.
+#include "rotacal/io/model_file.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <set>
+
+#include "rotacal/core/error.hpp"
+#include "rotacal/rtest/identify_joint.hpp"
+
+namespace rotacal {
+
+namespace {
+
+using json = nlohmann::ordered_json;
+
+const std::set<std::string> kKinds = {"ballbar", "rtest-joint", "rtest-diagnosis"};
+
+[[noreturn]] void bad(const std::string& source, const std::string& where, const std::string& what) {
+  throw InvalidArgument(source + ": " + (where.empty() ? "" : where + ": ") + what);
+}
+
+// At most ~80 characters of a value in a message.
+std::string shown(const json& v) {
+  std::string s = v.dump();
+  if (s.size() > 80) s = s.substr(0, 77) + "...";
+  return s;
+}
+
+// Reads `rotacal-model/M` or `rotacal-model/M.N`; refuses another major version by name.
+int format_minor(const json& doc, const std::string& source) {
+  const auto it = doc.find("format");
+  if (it == doc.end() || !it->is_string()) bad(source, "format", "missing: not a rotacal-model file");
+  const std::string f = it->get<std::string>();
+  const std::string prefix = "rotacal-model/";
+  if (f.rfind(prefix, 0) != 0) bad(source, "format", shown(*it) + " is not a rotacal-model file");
+  const std::string ver = f.substr(prefix.size());
+  int major = -1, minor = 0;
+  const std::size_t dot = ver.find('.');
+  try {
+    std::size_t used = 0;
+    major = std::stoi(ver.substr(0, dot), &used);
+    if (used != ver.substr(0, dot).size()) major = -1;
+    if (dot != std::string::npos) {
+      minor = std::stoi(ver.substr(dot + 1), &used);
+      if (used != ver.size() - dot - 1 || minor < 0) major = -1;
+    }
+  } catch (const std::exception&) {
+    major = -1;
+  }
+  if (major < 1) bad(source, "format", "cannot read the version of " + shown(*it));
+  if (major > kModelFormatMajor)
+    bad(source, "format",
+        f + " was written by a newer rotacal; this one reads " + kModelFormat + ": upgrade rotacal");
+  if (major < kModelFormatMajor) bad(source, "format", f + " is older than any rotacal wrote");
+  return minor;
+}
+
+const json& member(const json& obj, const std::string& key, const std::string& source,
+                   const std::string& where) {
+  const auto it = obj.find(key);
+  if (it == obj.end()) bad(source, where.empty() ? key : where + "." + key, "missing");
+  return *it;
+}
+
+const json& object_member(const json& obj, const std::string& key, const std::string& source,
+                          const std::string& where = "") {
+  const json& v = member(obj, key, source, where);
+  if (!v.is_object()) bad(source, where.empty() ? key : where + "." + key, "must be an object, got " + shown(v));
+  return v;
+}
+
+// One {"value", "std", "unit"} entry; returns the value (null -> nullopt: unobservable).
+std::optional<double> estimate(const json& e, const std::string& where, const std::string& unit,
+                               double limit, const std::string& source) {
+  if (!e.is_object()) bad(source, where, "must be an object {\"value\", \"std\", \"unit\"}, got " + shown(e));
+  const json& v = member(e, "value", source, where);
+  if (e.contains("unit")) {
+    const json& u = e["unit"];
+    if (!u.is_string() || u.get<std::string>() != unit)
+      bad(source, where + ".unit", shown(u) + ": this parameter is in " + unit);
+  }
+  if (e.contains("std")) {
+    const json& s = e["std"];
+    if (!s.is_null() && (!s.is_number() || !(s.get<double>() >= 0.0)))
+      bad(source, where + ".std", "must be a number >= 0 or null, got " + shown(s));
+  }
+  if (v.is_null()) return std::nullopt;
+  if (!v.is_number()) bad(source, where + ".value", "must be a number or null, got " + shown(v));
+  const double x = v.get<double>();
+  if (!std::isfinite(x) || std::fabs(x) > limit)
+    bad(source, where + ".value",
+        shown(v) + " " + unit + " is beyond " + json(limit).dump() + " " + unit + ", which no machine tool has");
+  return x;
+}
+
+void check_rtest_joint(const json& doc, MachineType machine, const std::string& source) {
+  const json& b = object_member(doc, "basis", source);
+  RtestBasis basis;
+  int* fields[] = {&basis.b_degree, &basis.c_harmonics, &basis.c_b_degree};
+  const char* keys[] = {"b_degree", "c_harmonics", "c_b_degree"};
+  for (int k = 0; k < 3; ++k) {
+    const json& v = member(b, keys[k], source, "basis");
+    if (!v.is_number_integer() || v.get<long long>() < 0 || v.get<long long>() > 32)
+      bad(source, std::string("basis.") + keys[k], "must be an integer 0..32, got " + shown(v));
+    *fields[k] = v.get<int>();
+  }
+  const json& g = member(b, "gamma_cb", source, "basis");
+  if (!g.is_boolean()) bad(source, "basis.gamma_cb", "must be true or false, got " + shown(g));
+  basis.gamma_cb = g.get<bool>();
+  std::vector<std::string> names(location_error_names(machine).begin(), location_error_names(machine).end());
+  const std::vector<std::string> coef = basis.coefficient_names();
+  const json& mc = object_member(doc, "map_coefficients", source);
+  for (const std::string& n : coef) {
+    const json& e = member(mc, n, source, "map_coefficients");
+    const bool angle = n.rfind("d", 0) != 0;
+    estimate(e.is_object() ? e : json{{"value", e}}, "map_coefficients." + n, angle ? "rad" : "mm",
+             angle ? kMaxModelAngleError : kMaxModelPositionError, source);
+  }
+  for (auto it = mc.begin(); it != mc.end(); ++it)
+    if (std::find(coef.begin(), coef.end(), it.key()) == coef.end())
+      bad(source, "map_coefficients." + it.key(), "is not a coefficient of this basis");
+  names.insert(names.end(), coef.begin(), coef.end());
+  const json& cov = object_member(doc, "covariance", source);
+  const json& params = member(cov, "parameters", source, "covariance");
+  if (params != json(names))
+    bad(source, "covariance.parameters", "must list the " + std::to_string(names.size()) +
+                                             " parameters (location errors, then the basis' coefficients)");
+  const json& m = member(cov, "matrix", source, "covariance");
+  if (!m.is_array() || m.size() != names.size())
+    bad(source, "covariance.matrix", "must be " + std::to_string(names.size()) + " rows");
+  for (std::size_t i = 0; i < m.size(); ++i) {
+    if (!m[i].is_array() || m[i].size() != names.size())
+      bad(source, "covariance.matrix[" + std::to_string(i) + "]", "must be " + std::to_string(names.size()) + " numbers");
+    for (const json& x : m[i])
+      if (!x.is_number() && !x.is_null())
+        bad(source, "covariance.matrix[" + std::to_string(i) + "]", "must hold numbers (or null), got " + shown(x));
+  }
+  if (doc.contains("nests")) {
+    const json& nests = object_member(doc, "nests", source);
+    for (auto it = nests.begin(); it != nests.end(); ++it) {
+      const json& v = it.value();
+      if (!v.is_array() || v.size() != 3 || !v[0].is_number() || !v[1].is_number() || !v[2].is_number())
+        bad(source, "nests." + it.key(), "must be 3 numbers (mm), got " + shown(v));
+      for (const json& x : v)
+        if (std::fabs(x.get<double>()) > kMaxModelPivot)
+          bad(source, "nests." + it.key(), shown(v) + " is beyond " + json(kMaxModelPivot).dump() + " mm");
+    }
+  }
+}
+
+void probe_zeros(const json& doc, const std::string& source) {
+  if (!doc.contains("probe_zeros")) return;
+  const json& z = object_member(doc, "probe_zeros", source);
+  for (auto it = z.begin(); it != z.end(); ++it) {
+    if (!it.value().is_object()) bad(source, "probe_zeros." + it.key(), "must be an object {x, y, z}");
+    for (const char* a : {"x", "y", "z"})
+      estimate(member(it.value(), a, source, "probe_zeros." + it.key()), "probe_zeros." + it.key() + "." + a, "mm",
+               kMaxModelPositionError, source);
+  }
+}
+
+std::pair<int, int> line_column(const std::string& text, std::size_t byte) {
+  int line = 1, col = 1;
+  for (std::size_t i = 0; i < byte && i < text.size(); ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      col = 1;
+    } else {
+      ++col;
+    }
+  }
+  return {line, col};
+}
+
+void nullify(json& v, const std::string& pointer, json& reasons) {
+  if (v.is_number_float()) {
+    const double x = v.get<double>();
+    if (!std::isfinite(x)) {
+      reasons[pointer] = std::isnan(x) ? "NaN: not determined by the data"
+                                       : (x > 0 ? "+Infinity: not determined by the data"
+                                                : "-Infinity: not determined by the data");
+      v = nullptr;
+    }
+  } else if (v.is_object()) {
+    for (auto it = v.begin(); it != v.end(); ++it) {
+      std::string key = it.key();
+      // RFC 6901 escapes: ~ -> ~0, / -> ~1.
+      std::string esc;
+      for (char c : key) esc += c == '~' ? std::string("~0") : c == '/' ? std::string("~1") : std::string(1, c);
+      nullify(it.value(), pointer + "/" + esc, reasons);
+    }
+  } else if (v.is_array()) {
+    for (std::size_t i = 0; i < v.size(); ++i) nullify(v[i], pointer + "/" + std::to_string(i), reasons);
+  }
+}
+
+// Format and version, kind, machine: what every use of a model file needs.
+void check_envelope(const json& doc, const std::string& source, ModelFile& m) {
+  if (!doc.is_object()) bad(source, "", "a model file is a JSON object, got " + shown(doc));
+  m.format_minor = format_minor(doc, source);
+  const json& kind = member(doc, "kind", source, "");
+  if (!kind.is_string() || !kKinds.count(kind.get<std::string>()))
+    bad(source, "kind", shown(kind) + " is not one of ballbar, rtest-joint, rtest-diagnosis");
+  m.kind = kind.get<std::string>();
+  const json& machine = member(doc, "machine", source, "");
+  if (!machine.is_string()) bad(source, "machine", "must be a string such as \"AC-trt\", got " + shown(machine));
+  try {
+    m.machine = parse_machine_type(machine.get<std::string>());
+  } catch (const InvalidArgument& e) {
+    bad(source, "machine", e.what());
+  }
+}
+
+json parse_json(const std::string& text, const std::string& source) {
+  try {
+    // Strict RFC 8259: NaN/Infinity tokens, comments and trailing commas are syntax errors.
+    return json::parse(text);
+  } catch (const json::parse_error& e) {
+    const auto lc = line_column(text, e.byte > 0 ? e.byte - 1 : 0);
+    std::string what = e.what();
+    const std::size_t colon = what.find("syntax error");
+    if (colon != std::string::npos) what = what.substr(colon);
+    if (what.size() > 160) what = what.substr(0, 157) + "...";
+    throw ParseError(source, lc.first, lc.second, "not valid JSON: " + what);
+  }
+}
+
+std::string read_text(const std::string& path) {
+  if (path.find('\0') != std::string::npos) throw IoError(std::string(path.c_str()) + "...: path contains a NUL byte");
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw IoError(path + ": cannot open for reading: " + std::strerror(errno));
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || S_ISDIR(st.st_mode)) {
+    ::close(fd);
+    throw IoError(path + ": is a directory, not a model file");
+  }
+  std::string text;
+  char buf[65536];
+  for (;;) {
+    const ssize_t n = ::read(fd, buf, sizeof buf);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      const int err = errno;
+      ::close(fd);
+      throw IoError(path + ": read failed: " + std::strerror(err));
+    }
+    if (n == 0) break;
+    text.append(buf, static_cast<std::size_t>(n));
+    if (text.size() > kMaxModelFileBytes) {
+      ::close(fd);
+      throw IoError(path + ": larger than " + std::to_string(kMaxModelFileBytes >> 20) +
+                    " MB: not a model file");
+    }
+  }
+  ::close(fd);
+  return text;
+}
+
+}  // namespace
+
+json read_model_document(const std::string& path) {
+  json doc = parse_json(read_text(path), path);
+  ModelFile envelope;
+  check_envelope(doc, path, envelope);
+  return doc;
+}
+
+ModelFile model_from_json(const json& doc, const std::string& source) {
+  ModelFile m;
+  check_envelope(doc, source, m);
+  static const json kEmpty = json::object();
+  const json& le = doc.contains("location_errors") ? doc["location_errors"] : kEmpty;
+  if (!le.is_object()) bad(source, "location_errors", "must be an object, got " + shown(le));
+  const auto& names = location_error_names(m.machine);
+  std::string lacking;
+  for (const std::string& n : names)
+    if (!le.contains(n)) lacking += (lacking.empty() ? "" : ", ") + n;
+  if (!lacking.empty()) bad(source, "", "location_errors lacks " + lacking);
+  for (int k = 0; k < 8; ++k) {
+    const bool angle = location_error_is_angle(k);
+    const std::optional<double> v =
+        estimate(member(le, names[k], source, "location_errors"), "location_errors." + names[k],
+                 angle ? "rad" : "mm", angle ? kMaxModelAngleError : kMaxModelPositionError, source);
+    m.location_errors.v[k] = v.value_or(0.0);
+    m.observable[static_cast<std::size_t>(k)] = v.has_value();
+  }
+  for (auto it = le.begin(); it != le.end(); ++it)
+    if (std::find(names.begin(), names.end(), it.key()) == names.end())
+      bad(source, "location_errors." + it.key(), "is not a location error of a " + to_string(m.machine) + " machine");
+  if (m.kind == "ballbar") {
+    const json& pv = object_member(doc, "pivot", source);
+    Eigen::Vector3d p;
+    for (int a = 0; a < 3; ++a) {
+      const std::string axis(1, "xyz"[a]);
+      p[a] = estimate(member(pv, axis, source, "pivot"), "pivot." + axis, "mm", kMaxModelPivot, source).value_or(0.0);
+    }
+    m.pivot = p;
+  }
+  if (doc.contains("effects")) {
+    const json& fx = doc["effects"];
+    if (!fx.is_array()) bad(source, "effects", "must be a list, got " + shown(fx));
+    for (std::size_t i = 0; i < fx.size(); ++i) {
+      const std::string where = "effects[" + std::to_string(i) + "]";
+      if (!fx[i].is_object()) bad(source, where, "must be an object {\"id\", \"params\"}");
+      const json& id = member(fx[i], "id", source, where);
+      if (!id.is_string()) bad(source, where + ".id", "must be a string, got " + shown(id));
+      Effect e;
+      try {
+        e = Effect::parse(id.get<std::string>());
+      } catch (const InvalidArgument& ex) {
+        bad(source, where + ".id", ex.what());
+      }
+      if (!e.applies_to(m.machine))
+        bad(source, where + ".id", id.get<std::string>() + " does not exist on a " + to_string(m.machine) + " machine");
+      const json& params = object_member(fx[i], "params", source, where);
+      const auto pn = e.param_names();
+      const auto pu = e.param_units();
+      for (std::size_t k = 0; k < pn.size(); ++k) {
+        // Effect parameters have no single physical bound; finite and unit-checked.
+        const std::optional<double> v = estimate(member(params, pn[k], source, where + ".params"),
+                                                 where + ".params." + pn[k], pu[k], 1.0e6, source);
+        m.effect_params.push_back(v.value_or(0.0));
+      }
+      m.effects.effects.push_back(e);
+    }
+  }
+  if (m.kind == "rtest-joint") check_rtest_joint(doc, m.machine, source);
+  probe_zeros(doc, source);
+  if (doc.contains("null_reasons") && !doc["null_reasons"].is_object())
+    bad(source, "null_reasons", "must be an object (JSON pointer -> reason)");
+  m.document = doc;
+  return m;
+}
+
+ModelFile parse_model(const std::string& text, const std::string& source) {
+  return model_from_json(parse_json(text, source), source);
+}
+
+ModelFile read_model(const std::string& path) { return model_from_json(parse_json(read_text(path), path), path); }
+
+json strict_json(json document) {
+  json reasons = json::object();
+  nullify(document, "", reasons);
+  if (!reasons.empty()) {
+    json& all = document["null_reasons"];
+    if (!all.is_object()) all = json::object();
+    for (auto it = reasons.begin(); it != reasons.end(); ++it) all[it.key()] = it.value();
+  }
+  return document;
+}
+
+std::string format_model(const json& document, const std::string& source) {
+  const json doc = strict_json(document);
+  model_from_json(doc, source);  // never write what the reader would refuse
+  return doc.dump(2) + "\n";
+}
+
+void write_model(const json& document, const std::string& path, const OutputOptions& options) {
+  write_output(path, [&] { return format_model(document, path); }, options);
+}
+
+json ballbar_model_document(const BallbarMachineModel& model) {
+  json doc = {{"format", kModelFormat}, {"kind", "ballbar"}, {"machine", to_string(model.machine)}};
+  json le = json::object();
+  const auto& names = location_error_names(model.machine);
+  for (int k = 0; k < 8; ++k)
+    le[names[k]] = {{"value", model.errors.v[k]}, {"unit", location_error_is_angle(k) ? "rad" : "mm"}};
+  doc["location_errors"] = le;
+  doc["pivot"] = json::object();
+  for (int a = 0; a < 3; ++a) doc["pivot"][std::string(1, "xyz"[a])] = {{"value", model.pivot[a]}, {"unit", "mm"}};
+  json fx = json::array();
+  std::size_t offset = 0;
+  for (const Effect& e : model.effects.effects) {
+    json params = json::object();
+    const auto pn = e.param_names();
+    const auto pu = e.param_units();
+    for (std::size_t k = 0; k < pn.size(); ++k) {
+      if (offset >= model.effect_params.size())
+        throw InvalidArgument("ballbar_model_document: effect_params has fewer values than the effects need");
+      params[pn[k]] = {{"value", model.effect_params[offset++]}, {"unit", pu[k]}};
+    }
+    fx.push_back({{"id", e.id()}, {"cause", e.cause()}, {"params", params}});
+  }
+  doc["effects"] = fx;
+  return doc;
+}
+
+BallbarMachineModel ballbar_machine_model(const ModelFile& model) {
+  if (model.kind != "ballbar" || !model.pivot)
+    throw InvalidArgument("ballbar_machine_model: a " + model.kind + " model is not a ballbar model");
+  BallbarMachineModel m;
+  m.machine = model.machine;
+  m.errors = model.location_errors;
+  m.pivot = *model.pivot;
+  m.effects = model.effects;
+  m.effect_params = model.effect_params;
+  return m;
+}
+
+}  // namespace rotacal

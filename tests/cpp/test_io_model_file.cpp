@@ -1,0 +1,163 @@
+// Tests of rotacal-model/1 files (io/model_file.hpp): round trip, strict JSON, versions,
+// units and limits, and the files the Python writer made before the C++ one existed.
+#include <catch2/catch.hpp>
+#include <unistd.h>
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include "rotacal/core/error.hpp"
+#include "rotacal/io/model_file.hpp"
+
+using namespace rotacal;
+using json = nlohmann::ordered_json;
+
+namespace {
+
+BallbarMachineModel sample_model() {
+  BallbarMachineModel m;
+  m.machine = MachineType::AC_trt;
+  // Flynn et al. Table 2 magnitudes (mm, rad), not round numbers, so a digit lost shows.
+  m.errors.v << 0.0712345678901, -0.0231, 1.234e-4, -5.6789e-5, 0.0133910001, 0.0125, 2.2e-5, -3.3e-5;
+  m.pivot = Eigen::Vector3d(120.000123, -0.5, 60.25);
+  m.effects.effects = {Effect::parse("gravity_sag_A")};
+  m.effect_params = {0.004};
+  return m;
+}
+
+std::string tmp_path(const std::string& name) {
+  return "/tmp/rotacal-model-test-" + std::to_string(::getpid()) + "-" + name;
+}
+
+}  // namespace
+
+TEST_CASE("a ballbar model survives write and read bit for bit") {
+  const BallbarMachineModel m = sample_model();
+  const std::string path = tmp_path("m.json");
+  write_model(ballbar_model_document(m), path);
+  const ModelFile f = read_model(path);
+  ::unlink(path.c_str());
+  CHECK(f.kind == "ballbar");
+  CHECK(f.machine == MachineType::AC_trt);
+  for (int k = 0; k < 8; ++k) CHECK(f.location_errors.v[k] == m.errors.v[k]);
+  CHECK(*f.pivot == m.pivot);
+  const BallbarMachineModel back = ballbar_machine_model(f);
+  REQUIRE(back.effects.effects.size() == 1);
+  CHECK(back.effects.effects[0] == m.effects.effects[0]);
+  CHECK(back.effect_params == m.effect_params);
+}
+
+TEST_CASE("a non-finite number is written as null with its reason, never NaN or Infinity") {
+  json doc = ballbar_model_document(sample_model());
+  doc["location_errors"]["E_Y0A"]["std"] = std::numeric_limits<double>::infinity();
+  doc["fit"] = {{"chi2", std::nan("")}};
+  const std::string text = format_model(doc);
+  CHECK(text.find(": Infinity") == std::string::npos);
+  CHECK(text.find(": NaN") == std::string::npos);
+  const ModelFile f = parse_model(text, "m.json");
+  CHECK(f.document["location_errors"]["E_Y0A"]["std"].is_null());
+  CHECK(f.document["fit"]["chi2"].is_null());
+  CHECK_THAT(f.document["null_reasons"]["/location_errors/E_Y0A/std"].get<std::string>(),
+             Catch::StartsWith("+Infinity"));
+  CHECK_THAT(f.document["null_reasons"]["/fit/chi2"].get<std::string>(), Catch::StartsWith("NaN"));
+}
+
+TEST_CASE("an unobservable location error (null) is nominal and flagged") {
+  json doc = ballbar_model_document(sample_model());
+  doc["location_errors"]["E_C0A"] = {{"value", nullptr}, {"std", nullptr}, {"unit", "rad"}, {"observable", false}};
+  const ModelFile f = model_from_json(doc, "m.json");
+  CHECK(f.location_errors.v[3] == 0.0);
+  CHECK_FALSE(f.observable[3]);
+  CHECK(f.observable[0]);
+}
+
+TEST_CASE("versions: a newer major version is refused by name, a minor one is read") {
+  json doc = ballbar_model_document(sample_model());
+  doc["format"] = "rotacal-model/2";
+  CHECK_THROWS_WITH(model_from_json(doc, "new.json"),
+                    Catch::Contains("new.json") && Catch::Contains("rotacal-model/2") &&
+                        Catch::Contains("newer rotacal"));
+  doc["format"] = "rotacal-model/1.4";
+  doc["added_in_1_4"] = {1, 2, 3};
+  const ModelFile f = model_from_json(doc, "minor.json");
+  CHECK(f.format_minor == 4);
+  CHECK(f.document["added_in_1_4"].size() == 3);  // kept for a round trip
+  doc["format"] = "rotacal-ballbar/1";
+  CHECK_THROWS_WITH(model_from_json(doc, "x.json"), Catch::Contains("not a rotacal-model file"));
+  doc["format"] = "rotacal-model/x";
+  CHECK_THROWS_AS(model_from_json(doc, "x.json"), InvalidArgument);
+}
+
+TEST_CASE("content errors name the file and the member") {
+  const json good = ballbar_model_document(sample_model());
+  auto refused = [&](auto change, const std::string& words) {
+    json d = good;
+    change(d);
+    CHECK_THROWS_WITH(model_from_json(d, "bad.json"), Catch::Contains("bad.json") && Catch::Contains(words));
+  };
+  refused([](json& d) { d["location_errors"]["E_Y0C"]["unit"] = "um"; }, "location_errors.E_Y0C.unit");
+  refused([](json& d) { d["location_errors"]["E_B0A"]["value"] = 1e300; }, "which no machine tool has");
+  refused([](json& d) { d["location_errors"]["E_B0A"]["value"] = "x"; }, "must be a number or null");
+  refused([](json& d) { d["location_errors"].erase("E_Y0A"); }, "location_errors lacks E_Y0A");
+  refused([](json& d) { d["location_errors"]["E_X0B"] = {{"value", 0.0}, {"unit", "mm"}}; }, "not a location error");
+  refused([](json& d) { d["machine"] = "XY-trt"; }, "machine");
+  refused([](json& d) { d["kind"] = "laser"; }, "kind");
+  refused([](json& d) { d["pivot"].erase("z"); }, "pivot.z");
+  refused([](json& d) { d["pivot"]["x"]["value"] = 1e160; }, "pivot.x.value");
+  refused([](json& d) { d["effects"][0]["id"] = "gravity_sag_B"; }, "does not exist on a AC-trt");
+  refused([](json& d) { d["effects"][0]["params"] = json::object(); }, "effects[0].params.s");
+  refused([](json& d) { d["location_errors"]["E_Y0A"]["std"] = -1.0; }, "E_Y0A.std");
+  refused([](json& d) { d = json::array(); }, "JSON object");
+  // The writer refuses what the reader would, so no unreadable file is ever written.
+  json bad = good;
+  bad["location_errors"]["E_Y0C"]["unit"] = "um";
+  CHECK_THROWS_AS(format_model(bad, "out.json"), InvalidArgument);
+}
+
+TEST_CASE("syntax errors, NaN tokens and unreadable paths are refused with file, line, column") {
+  try {
+    parse_model("{\n  \"format\": \"rotacal-model/1\",\n  \"x\": NaN\n}\n", "m.json");
+    FAIL("NaN accepted");
+  } catch (const ParseError& e) {
+    CHECK(e.file() == "m.json");
+    CHECK(e.line() == 3);
+    CHECK(e.column() >= 8);
+  }
+  CHECK_THROWS_AS(parse_model("{\"a\": 1,}", "m.json"), ParseError);
+  CHECK_THROWS_WITH(read_model("/tmp"), Catch::Contains("directory"));
+  CHECK_THROWS_AS(read_model("/tmp"), IoError);
+  CHECK_THROWS_AS(read_model("/nonexistent/m.json"), IoError);
+}
+
+TEST_CASE("a file as the Python writer made it before the C++ one existed is read") {
+  // Verbatim layout of python/rotacal/models.py (json.dumps(model, indent=2)) at 6af68ce:
+  // an unobservable error with "observable": false, a cause string, extra fit members.
+  const std::string text = R"({
+  "format": "rotacal-model/1",
+  "kind": "ballbar",
+  "machine": "BC-trt",
+  "location_errors": {
+    "E_X0B": {"value": 0.0213, "std": 0.0004, "unit": "mm"},
+    "E_Z0B": {"value": -0.0101, "std": 0.0003, "unit": "mm"},
+    "E_A0B": {"value": 4.1e-05, "std": 2e-06, "unit": "rad"},
+    "E_C0B": {"value": null, "std": null, "unit": "rad", "observable": false},
+    "E_X0C": {"value": 0.0051, "std": 0.0002, "unit": "mm"},
+    "E_Y0C": {"value": 0.0134, "std": 0.0002, "unit": "mm"},
+    "E_A0C": {"value": -1.2e-05, "std": 1e-06, "unit": "rad"},
+    "E_B0C": {"value": 3e-06, "std": 1e-06, "unit": "rad"}
+  },
+  "pivot": {"x": {"value": 0.01, "std": 0.001, "unit": "mm"},
+            "y": {"value": 120.002, "std": 0.001, "unit": "mm"},
+            "z": {"value": 59.998, "std": 0.001, "unit": "mm"}},
+  "effects": [{"id": "ballbar_length_offset", "cause": "the calibrated ballbar length L0 is wrong",
+               "params": {"dL": {"value": 0.0021, "std": 0.0001, "unit": "mm"}}}]
+})";
+  const ModelFile f = parse_model(text, "old.json");
+  CHECK(f.machine == MachineType::BC_trt);
+  CHECK(f.location_errors.v[0] == 0.0213);
+  CHECK_FALSE(f.observable[3]);
+  CHECK(f.pivot->y() == 120.002);
+  CHECK(f.effect_params == std::vector<double>{0.0021});
+}
