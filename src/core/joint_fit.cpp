@@ -24,25 +24,31 @@ namespace {
 struct NormalEquations {
   Eigen::VectorXd D;         // column norms of the weighted Jacobian (free columns)
   Eigen::MatrixXd A;         // (J D^-1)^T (J D^-1)
-  Eigen::VectorXd sigma_y;   // sqrt(diag(A^-1)): 1 sigma in normalised coordinates (chi2 units)
+  Eigen::MatrixXd Ainv;      // A^-1: covariance in normalised coordinates (chi2 units)
+  Eigen::VectorXd sigma_y;   // sqrt(diag(A^-1)): 1 sigma in normalised coordinates
   Eigen::LDLT<Eigen::MatrixXd> ldlt;
 };
 
 NormalEquations normal_equations(const Eigen::MatrixXd& Jw, const std::vector<Eigen::Index>& idx) {
   const Eigen::Index q = static_cast<Eigen::Index>(idx.size());
   NormalEquations ne;
-  ne.A.resize(q, q);
-  // J^T J of the free columns without copying them.
-  for (Eigen::Index a = 0; a < q; ++a)
-    for (Eigen::Index b = a; b < q; ++b)
-      ne.A(a, b) = ne.A(b, a) = Jw.col(idx[static_cast<std::size_t>(a)]).dot(Jw.col(idx[static_cast<std::size_t>(b)]));
+  ne.A.setZero(q, q);
+  if (q == Jw.cols()) {  // all columns free: one blocked product
+    ne.A.selfadjointView<Eigen::Lower>().rankUpdate(Jw.transpose());
+    ne.A.triangularView<Eigen::StrictlyUpper>() = ne.A.transpose();
+  } else {
+    for (Eigen::Index a = 0; a < q; ++a)
+      for (Eigen::Index b = a; b < q; ++b)
+        ne.A(a, b) = ne.A(b, a) =
+            Jw.col(idx[static_cast<std::size_t>(a)]).dot(Jw.col(idx[static_cast<std::size_t>(b)]));
+  }
   ne.D = ne.A.diagonal().cwiseSqrt();
   for (Eigen::Index a = 0; a < q; ++a)
     if (!(ne.D[a] > 0.0)) ne.D[a] = 1.0;
   ne.A = ne.D.cwiseInverse().asDiagonal() * ne.A * ne.D.cwiseInverse().asDiagonal();
   ne.ldlt.compute(ne.A);
-  const Eigen::MatrixXd Ainv = ne.ldlt.solve(Eigen::MatrixXd::Identity(q, q));
-  ne.sigma_y = Ainv.diagonal().cwiseMax(0.0).cwiseSqrt();
+  ne.Ainv = ne.ldlt.solve(Eigen::MatrixXd::Identity(q, q));
+  ne.sigma_y = ne.Ainv.diagonal().cwiseMax(0.0).cwiseSqrt();
   return ne;
 }
 
@@ -98,17 +104,24 @@ JointFitOutcome solve_joint(const ResidualModel& model, const std::vector<FitPar
   for (int j = 0; j < p; ++j)
     if (!params[static_cast<std::size_t>(j)].held) analysed.push_back(j);
   {
-    Eigen::MatrixXd Ja(n, static_cast<Eigen::Index>(analysed.size()));
-    Eigen::VectorXd scales(static_cast<Eigen::Index>(analysed.size()));
+    // One p x p normal matrix instead of a copy of the n x p Jacobian.
+    Eigen::MatrixXd G(p, p);
+    G.setZero();
+    G.selfadjointView<Eigen::Lower>().rankUpdate(Jw.transpose());
+    G.triangularView<Eigen::StrictlyUpper>() = G.transpose();
+    const Eigen::Index m = static_cast<Eigen::Index>(analysed.size());
+    Eigen::MatrixXd Ga(m, m);
+    Eigen::VectorXd scales(m);
     std::vector<std::string> names, units;
-    for (std::size_t k = 0; k < analysed.size(); ++k) {
-      const FitParameter& fp = params[static_cast<std::size_t>(analysed[k])];
-      Ja.col(static_cast<Eigen::Index>(k)) = Jw.col(analysed[k]);
-      scales[static_cast<Eigen::Index>(k)] = fp.scale > 0.0 ? fp.scale : plausible_magnitude(fp.unit);
+    for (Eigen::Index a = 0; a < m; ++a) {
+      const FitParameter& fp = params[static_cast<std::size_t>(analysed[static_cast<std::size_t>(a)])];
+      for (Eigen::Index b = 0; b < m; ++b)
+        Ga(a, b) = G(analysed[static_cast<std::size_t>(a)], analysed[static_cast<std::size_t>(b)]);
+      scales[a] = fp.scale > 0.0 ? fp.scale : plausible_magnitude(fp.unit);
       names.push_back(fp.name);
       units.push_back(fp.unit);
     }
-    out.observability = analyse_observability(Ja, scales, s.observability_min_chi2);
+    out.observability = analyse_observability_normal(Ga, scales, s.observability_min_chi2);
     for (std::size_t k = 0; k < out.observability.null_space.size(); ++k)
       out.unobservable.push_back(out.observability.describe(static_cast<int>(k), names, units));
   }
@@ -216,18 +229,23 @@ JointFitOutcome solve_joint(const ResidualModel& model, const std::vector<FitPar
   sum.chi2_per_dof = cost / dof;
   out.values = x;
   out.residuals = -r;
+  // (Jw^T Jw)^-1 of the free parameters from the last normal equations (Jacobian within 0.01
+  // sigma of the solution), scaled by s^2 / sigma^2 without a whitener.
+  out.residual_variance = s.whitener ? 1.0 : r.squaredNorm() / dof;
+  const double ratio = s.whitener ? 1.0 : out.residual_variance / (s.sigma * s.sigma);
+  out.covariance = Eigen::MatrixXd::Zero(p, p);
+  for (Eigen::Index a = 0; a < q; ++a)
+    for (Eigen::Index b = 0; b < q; ++b)
+      out.covariance(idx[static_cast<std::size_t>(a)], idx[static_cast<std::size_t>(b)]) =
+          ne.Ainv(a, b) / (ne.D[a] * ne.D[b]) * ratio;
   if (s.whitener) {
-    out.residual_variance = 1.0;
-    out.covariance = covariance_from_jacobian(Jw, out.free, 1.0);
     // The unwhitened Jacobian for the caller (Jw was whitened in place).
     out.jacobian.resize(n, p);
     Eigen::VectorXd tmp(n);
     model.evaluate(x_J, tmp, &out.jacobian);
   } else {
-    out.residual_variance = r.squaredNorm() / dof;
     out.jacobian = std::move(Jw);
     out.jacobian *= s.sigma;
-    out.covariance = covariance_from_jacobian(out.jacobian, out.free, out.residual_variance);
   }
   for (int j = 0; j < p; ++j) {
     ParameterEstimate e;
