@@ -17,19 +17,32 @@ class BallbarLengthModel : public ResidualModel {
   int num_parameters() const override { return 11 + P_; }
   void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r,
                 Eigen::MatrixXd* J) const override {
-    const auto f = [this](Eigen::Index i, const auto* p, auto* out) {
-      using T = std::remove_const_t<std::remove_pointer_t<decltype(p)>>;
-      const Vec3<T> pivot(p[8], p[9], p[10]);
-      const Eigen::Vector3d xyz = d_.xyz.col(i);
-      out[0] = predicted_length<T>(d_.machine, LocationErrors<T>::from_ptr(p), pivot, fx_,
-                                   P_ > 0 ? p + 11 : nullptr, xyz,
-                                   d_.angles[static_cast<std::size_t>(i)], d_.time[i]) -
-               T(d_.length[i]);
-    };
-    evaluate_with_jets(f, d_.size(), 1, x, r, J);
+    evaluate_with_jets([this](Eigen::Index i, const auto* p, auto* out) { sample(i, p, out); },
+                       d_.size(), 1, x, r, J);
+  }
+  bool evaluate_subset(const Eigen::VectorXd& x, Eigen::Index stride, Eigen::VectorXd& r,
+                       Eigen::MatrixXd* J) const override {
+    const Eigen::Index m = (d_.size() + stride - 1) / stride;
+    r.resize(m);
+    if (J) J->resize(m, num_parameters());
+    evaluate_with_jets(
+        [this, stride](Eigen::Index i, const auto* p, auto* out) { sample(i * stride, p, out); }, m, 1,
+        x, r, J);
+    return true;
   }
 
  private:
+  // L_model - L_measured of sample i, on double or Jets.
+  template <typename T>
+  void sample(Eigen::Index i, const T* p, T* out) const {
+    const Vec3<T> pivot(p[8], p[9], p[10]);
+    const Eigen::Vector3d xyz = d_.xyz.col(i);
+    out[0] = predicted_length<T>(d_.machine, LocationErrors<T>::from_ptr(p), pivot, fx_,
+                                 P_ > 0 ? p + 11 : nullptr, xyz, d_.angles[static_cast<std::size_t>(i)],
+                                 d_.time[i]) -
+             T(d_.length[i]);
+  }
+
   const BallbarArrays& d_;
   const EffectModel& fx_;
   int P_;

@@ -41,6 +41,15 @@ class ResidualModel {
   /// also J = d model / d x (num_residuals x num_parameters, already sized by the caller).
   virtual void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r,
                         Eigen::MatrixXd* J) const = 0;
+  /// Samples (each with rows_per_item() residuals, consecutive).
+  virtual Eigen::Index num_items() const { return num_residuals(); }
+  virtual int rows_per_item() const { return 1; }
+  /// The same for samples 0, stride, 2 stride, ... only (r and J resized here), for a cheap
+  /// start on long sessions. Returns false if the model does not offer it.
+  virtual bool evaluate_subset(const Eigen::VectorXd& /*x*/, Eigen::Index /*stride*/,
+                               Eigen::VectorXd& /*r*/, Eigen::MatrixXd* /*J*/) const {
+    return false;
+  }
 };
 
 /// One unknown of a fit.
@@ -82,8 +91,9 @@ struct JointFitOutcome {
   FitSummary summary;
 };
 
-/// Observability at the start (fix one parameter per invisible combination) -> Gauss-Newton
-/// with step control -> covariance at the solution -> estimates. Throws InvalidArgument for
+/// [Long sessions: Gauss-Newton on every k-th sample, for a start near the solution] ->
+/// observability (fix one parameter per invisible combination) -> Gauss-Newton with step
+/// control -> covariance at the solution -> estimates. Throws InvalidArgument for
 /// fewer residuals than free parameters, a whitener of the wrong size, or a non-finite
 /// residual at the start (naming the first bad residual).
 JointFitOutcome solve_joint(const ResidualModel& model, const std::vector<FitParameter>& parameters,
