@@ -222,6 +222,9 @@ JointFitOutcome solve_joint(const ResidualModel& model, const std::vector<FitPar
   bool at_J = true;
   double cost = rw.squaredNorm();
   double lambda = 0.0, last_step = -1.0;
+  // Largest contraction ratio of chord steps since the last refresh, from steps above 1e-3
+  // sigma (below that the ratio measures round-off, not the Jacobian); 0: none measured yet.
+  double rho = 0.0;
   Eigen::VectorXd r_t(n), rw_t(n), x_t(p);
   const auto refresh = [&] {
     model.evaluate(x, r, &Jw);
@@ -233,6 +236,7 @@ JointFitOutcome solve_joint(const ResidualModel& model, const std::vector<FitPar
     at_J = true;
     cost = rw.squaredNorm();
     last_step = -1.0;
+    rho = 0.0;
   };
   sum.message = "reached max_iterations";
   while (sum.iterations < s.max_iterations) {
@@ -253,8 +257,8 @@ JointFitOutcome solve_joint(const ResidualModel& model, const std::vector<FitPar
       break;
     }
     if (step < s.step_tolerance_sigma && lambda == 0.0) {
-      const double rho = last_step > 0.0 ? step / last_step : 1.0;
-      if (at_J || rho * std::sqrt(std::max(cost, 1.0)) < 1e-2) {
+      const double rho_now = last_step > 1e-3 ? std::max(rho, step / last_step) : rho;
+      if (at_J || (rho_now > 0.0 && rho_now * std::sqrt(std::max(cost, 1.0)) < 1e-2)) {
         sum.converged = true;
         sum.message = "step below " + std::to_string(s.step_tolerance_sigma) + " sigma";
         break;
@@ -269,7 +273,8 @@ JointFitOutcome solve_joint(const ResidualModel& model, const std::vector<FitPar
     rw_t = r_t;
     weigh(rw_t);
     const double cost_t = rw_t.squaredNorm();
-    if (std::isfinite(cost_t) && cost_t <= cost * (1.0 + 1e-12)) {
+    // A step below 1e-3 sigma changes chi2 by < 1e-6: its sign is round-off, so it is taken.
+    if (std::isfinite(cost_t) && (cost_t <= cost * (1.0 + 1e-12) || (step < 1e-3 && cost_t <= cost + 1e-6))) {
       x.swap(x_t);
       r.swap(r_t);
       rw.swap(rw_t);
@@ -277,6 +282,7 @@ JointFitOutcome solve_joint(const ResidualModel& model, const std::vector<FitPar
       ++sum.iterations;
       lambda = 0.0;
       const bool slow = last_step >= 0.0 && step > 0.1 * last_step;
+      if (last_step > 1e-3) rho = std::max(rho, step / last_step);
       last_step = step;
       at_J = false;
       if (slow) refresh();
