@@ -1,5 +1,5 @@
-#pragma once
 // The ballbar joint fit's residual model and set-up, shared by identify_joint and monte_carlo.
+#pragma once
 
 #include <type_traits>
 

@@ -3,17 +3,17 @@
 //
 // Why not Ceres here: the fits have 11 to ~70 unknowns and up to 10^6 scalar residuals,
 // with every residual depending on (nearly) every unknown, so the problem is one dense block.
-// Built per sample, Ceres spends its time in per-block bookkeeping: the ballbar fit of
-// ballbar_ac_table2.csv (1,804 residual blocks) took 24 ms, of which model and Jacobian
-// arithmetic were ~1.4 ms per evaluation; 90,000 samples took 1.36 s and 189 MB. A dense
-// normal-equation solve over a Jacobian evaluated in one batch costs n p^2 flops (0.2 Mflop for
-// table2) and needs one n x p array; the Jets of the model are then the whole cost (~0.8 us a
-// sample for the ballbar's 11 unknowns). The models are nearly linear over um-sized errors, so
-// the Jacobian is kept while it still contracts the step (chord iteration, residuals only), and
-// on a long session the first steps are taken on every k-th sample (k ~ n / 32p), so that the
-// one full Jacobian is evaluated near the solution, where the covariance is computed. Measured
-// (table2, 1,804 samples, 2-core machine under load): 6 ms CPU with two full Jacobians, ... with
-// the subsample start; Ceres before: 24 ms.
+// Built per sample, Ceres spent its time in per-block bookkeeping: the ballbar fit of
+// ballbar_ac_table2.csv (1,804 residual blocks) took 24 ms and the R-test joint fit 202 ms
+// (issue 14), 90,000 ballbar samples 1.36 s and 189 MB. A dense normal-equation solve over a
+// Jacobian evaluated in one batch costs n p^2 flops (0.2 Mflop for table2) and needs one n x p
+// array; the Jets of the model are then the whole cost (~0.8 us a sample for the ballbar's 11
+// unknowns). The models are nearly linear over um-sized errors, so the Jacobian is kept while
+// it still contracts the step (chord iteration, residuals only), and on a long session the
+// first steps are taken on every k-th sample (k ~ n / 32p), so that one full Jacobian,
+// evaluated near the solution, serves the last step and the covariance. Measured on the 2-core
+// machine (CPU time, other jobs running): table2 3.8 ms (one full Jacobian; 6 ms with two),
+// R-test 2 x 84 poses 5.1 ms, 600,000 ballbar samples 1.2 s and 183 MB peak for the process.
 #include "rotacal/core/joint_fit.hpp"
 
 #include <Eigen/Cholesky>

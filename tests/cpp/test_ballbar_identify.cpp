@@ -1,3 +1,4 @@
+// Tests of the ballbar joint fit and paper chain: random machines, observability, compensation.
 #include <catch2/catch.hpp>
 
 #include <random>
