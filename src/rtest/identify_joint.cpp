@@ -191,7 +191,9 @@ class RtestJointResiduals : public ResidualModel {
       : nb_(basis.num_b_coefficients()), nc_(basis.num_c_coefficients()),
         S_(static_cast<int>(setups.size())) {
     const std::size_t n = session.samples.size();
-    B_.resize(n), C_.resize(n), setup_.resize(n), Lb_.resize(n), Lc_.resize(n);
+    B_.resize(n), C_.resize(n), setup_.resize(n);
+    Lb_ = Eigen::MatrixXd::Zero(6 * static_cast<Eigen::Index>(n), nb_);
+    Lc_ = Eigen::MatrixXd::Zero(6 * static_cast<Eigen::Index>(n), nc_);
     xyz_.resize(3, static_cast<Eigen::Index>(n)), q_.resize(3, static_cast<Eigen::Index>(n));
     d_.resize(3, static_cast<Eigen::Index>(n));
     for (std::size_t i = 0; i < n; ++i) {
@@ -202,13 +204,12 @@ class RtestJointResiduals : public ResidualModel {
       xyz_.col(static_cast<Eigen::Index>(i)) = s.xyz;
       q_.col(static_cast<Eigen::Index>(i)) = session.nests.at(s.setup);
       d_.col(static_cast<Eigen::Index>(i)) = *s.d;
-      Lb_[i] = Eigen::MatrixXd::Zero(6, nb_);
+      const Eigen::Index r6 = 6 * static_cast<Eigen::Index>(i);
       int o = 0;
       for (int k = 0; k < 6; ++k)
-        for (double phi : basis.b_terms(k, a.tilt)) Lb_[i](k, o++) = phi;
-      Lc_[i] = Eigen::MatrixXd::Zero(6, nc_);
+        for (double phi : basis.b_terms(k, a.tilt)) Lb_(r6 + k, o++) = phi;
       o = 0;
-      for (const AxisErrors<double>& t : basis.c_terms(a.tilt, a.rot)) Lc_[i].col(o++) = t;
+      for (const AxisErrors<double>& t : basis.c_terms(a.tilt, a.rot)) Lc_.block<6, 1>(r6, o++) = t;
     }
   }
   Eigen::Index num_residuals() const override { return 3 * static_cast<Eigen::Index>(B_.size()); }
@@ -223,7 +224,8 @@ class RtestJointResiduals : public ResidualModel {
     for (int k = 0; k < 8; ++k) ej.v[k] = Jet(x[k], k);
     for (std::size_t i = 0; i < B_.size(); ++i) {
       const Eigen::Index row = 3 * static_cast<Eigen::Index>(i);
-      const AxisErrors<double> wb = Lb_[i] * cb, wc = Lc_[i] * cc;
+      const auto Lb = Lb_.middleRows<6>(row * 2), Lc = Lc_.middleRows<6>(row * 2);  // 6 rows a sample
+      const AxisErrors<double> wb = Lb * cb, wc = Lc * cc;
       const Eigen::Vector3d zero = x.segment<3>(n_model + 3 * setup_[i]);
       const Eigen::Vector3d xyz = xyz_.col(static_cast<Eigen::Index>(i));
       const Eigen::Vector3d q = q_.col(static_cast<Eigen::Index>(i));
@@ -241,8 +243,8 @@ class RtestJointResiduals : public ResidualModel {
         G.row(a) = d[a].v.transpose();
       }
       J->block(row, 0, 3, 8) = G.leftCols<8>();
-      J->block(row, 8, 3, nb_).noalias() = G.middleCols<6>(8) * Lb_[i];
-      J->block(row, 8 + nb_, 3, nc_).noalias() = G.rightCols<6>() * Lc_[i];
+      J->block(row, 8, 3, nb_).noalias() = G.middleCols<6>(8) * Lb;
+      J->block(row, 8 + nb_, 3, nc_).noalias() = G.rightCols<6>() * Lc;
       J->block(row, n_model, 3, 3 * S_).setZero();
       J->block<3, 3>(row, n_model + 3 * setup_[i]).setIdentity();
     }
@@ -253,7 +255,8 @@ class RtestJointResiduals : public ResidualModel {
   std::vector<double> B_, C_;
   std::vector<int> setup_;
   Eigen::Matrix3Xd xyz_, q_, d_;
-  std::vector<Eigen::MatrixXd> Lb_, Lc_;  // per sample: w_BY = Lb cb, w_CB = Lc cc
+  // Basis values, 6 rows per sample (rows 6i..6i+5): w_BY = Lb cb, w_CB = Lc cc.
+  Eigen::MatrixXd Lb_, Lc_;
 };
 }  // namespace
 
