@@ -77,7 +77,7 @@ struct RtestJointModel {
                               Eigen::Vector3d* std = nullptr) const;
 };
 
-/// Templated evaluation of the joint model's table pose for Ceres: e -> 8 location errors,
+/// Templated evaluation of the joint model's table pose (any Scalar): e -> 8 location errors,
 /// cb -> B-map coefficients, cc -> C-map coefficients.
 template <typename Scalar>
 Pose<Scalar> rtest_joint_table_pose(const RtestBasis& basis, const Scalar* e, const Scalar* cb,
