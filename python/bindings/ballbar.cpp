@@ -3,6 +3,7 @@
 #include "rotacal/ballbar/compensate.hpp"
 #include "rotacal/ballbar/identify.hpp"
 #include "rotacal/ballbar/identify_paper.hpp"
+#include "rotacal/ballbar/monte_carlo.hpp"
 #include "rotacal/ballbar/simulate.hpp"
 
 namespace rotacal::py {
@@ -19,6 +20,18 @@ void bind_ballbar(pyb::module_& m) {
         return "ParameterEstimate(" + p.name + "=" + std::to_string(p.value) + " +- " +
                std::to_string(p.std) + " " + p.unit + (p.observable ? "" : ", unobservable") + ")";
       });
+
+  pyb::class_<FitSummary>(m, "FitSummary", "How a least-squares solve went (core/estimate.hpp).")
+      .def_readonly("converged", &FitSummary::converged)
+      .def_readonly("iterations", &FitSummary::iterations)
+      .def_readonly("jacobian_evaluations", &FitSummary::jacobian_evaluations)
+      .def_readonly("residual_evaluations", &FitSummary::residual_evaluations)
+      .def_readonly("num_residuals", &FitSummary::num_residuals)
+      .def_readonly("num_free", &FitSummary::num_free)
+      .def_readonly("chi2", &FitSummary::chi2)
+      .def_readonly("chi2_per_dof", &FitSummary::chi2_per_dof)
+      .def_readonly("whitened", &FitSummary::whitened)
+      .def_readonly("message", &FitSummary::message);
 
   pyb::class_<BallbarMachineModel>(m, "BallbarMachineModel",
                                    "Location errors, actual pivot and effects of a machine.")
@@ -62,7 +75,8 @@ void bind_ballbar(pyb::module_& m) {
       .def_readonly("converged", &BallbarIdentification::converged)
       .def_readonly("iterations", &BallbarIdentification::iterations)
       .def_readonly("unobservable", &BallbarIdentification::unobservable)
-      .def_readonly("notes", &BallbarIdentification::notes);
+      .def_readonly("notes", &BallbarIdentification::notes)
+      .def_readonly("summary", &BallbarIdentification::summary);
 
   m.def(
       "identify_joint",
@@ -77,7 +91,57 @@ void bind_ballbar(pyb::module_& m) {
       },
       pyb::arg("session"), pyb::arg("fit_length_offset") = false,
       pyb::arg("effects") = std::vector<std::string>{}, pyb::arg("tests") = std::vector<std::string>{},
-      "Joint Ceres fit of the 8 location errors and the actual pivot to every sample.");
+      "Joint fit of the 8 location errors and the actual pivot to every sample (core/joint_fit.hpp).");
+
+  pyb::class_<MonteCarloParameter>(m, "MonteCarloParameter")
+      .def_readonly("name", &MonteCarloParameter::name)
+      .def_readonly("unit", &MonteCarloParameter::unit)
+      .def_readonly("std_reported", &MonteCarloParameter::std_reported)
+      .def_readonly("std_mc", &MonteCarloParameter::std_mc)
+      .def_readonly("ratio", &MonteCarloParameter::ratio)
+      .def_readonly("bias", &MonteCarloParameter::bias);
+  pyb::class_<BallbarMonteCarlo>(m, "BallbarMonteCarlo")
+      .def_readonly("draws", &BallbarMonteCarlo::draws)
+      .def_readonly("noise_um", &BallbarMonteCarlo::noise_um)
+      .def_readonly("parameters", &BallbarMonteCarlo::parameters)
+      .def_readonly("values", &BallbarMonteCarlo::values)
+      .def_readonly("fresh_fits", &BallbarMonteCarlo::fresh_fits);
+  m.def(
+      "monte_carlo_joint",
+      [](const BallbarSession& session, const BallbarIdentification& result, int draws,
+         std::uint64_t seed, double noise_um, const std::vector<std::string>& tests,
+         const pyb::object& progress) {
+        BallbarMonteCarloOptions o;
+        o.draws = draws;
+        o.seed = seed;
+        o.noise_um = noise_um;
+        o.fit.tests = tests;
+        if (!progress.is_none())
+          o.progress = [&progress](int done, int total) {
+            pyb::gil_scoped_acquire acquire;
+            progress(done, total);
+          };
+        pyb::gil_scoped_release release;
+        return monte_carlo(session, result, o);
+      },
+      pyb::arg("session"), pyb::arg("result"), pyb::arg("draws") = 100, pyb::arg("seed") = 1,
+      pyb::arg("noise_um") = 0.0, pyb::arg("tests") = std::vector<std::string>{},
+      pyb::arg("progress") = pyb::none(),
+      R"doc(Monte Carlo check of a joint fit's 1-sigma (ballbar/monte_carlo.hpp).
+
+Parameters
+----------
+session : the session that was identified
+result : its joint identification
+draws : number of simulated sessions (>= 2); draw k uses seed + k, as simulate_ballbar
+noise_um : 1 sigma of the simulated noise (0: the fit's sigma_um)
+tests : the test labels the fit used (empty: all)
+progress : optional callable(done, total), called after every draw
+
+Returns
+-------
+BallbarMonteCarlo: per observable parameter std_reported, std_mc, ratio, bias; values
+(draws x parameters).)doc");
 
   m.def(
       "identify_paper",

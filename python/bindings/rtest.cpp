@@ -128,7 +128,8 @@ void bind_rtest(pyb::module_& m) {
       .def_readonly("converged", &RtestJointIdentification::converged)
       .def_readonly("iterations", &RtestJointIdentification::iterations)
       .def_readonly("unobservable", &RtestJointIdentification::unobservable)
-      .def_readonly("notes", &RtestJointIdentification::notes);
+      .def_readonly("notes", &RtestJointIdentification::notes)
+      .def_readonly("summary", &RtestJointIdentification::summary);
 
   pyb::class_<RtestPaperIdentification>(m, "RtestPaperIdentification")
       .def_readonly("method", &RtestPaperIdentification::method)
@@ -148,7 +149,7 @@ void bind_rtest(pyb::module_& m) {
         return identify_joint(session, o);
       },
       pyb::arg("session"), pyb::arg("basis") = RtestBasis{},
-      "Joint Ceres fit of an R-test session: location errors, smooth B and C maps, a probe zero "
+      "Joint fit of an R-test session: location errors, smooth B and C maps, a probe zero "
       "per set-up, with observability (rtest/identify_joint.hpp).");
   m.def(
       "identify_rtest_paper",

@@ -1,3 +1,4 @@
+// Compensated commands for identified location errors, and the measure-compensate-remeasure check.
 #include "rotacal/ballbar/compensate.hpp"
 
 #include <cmath>

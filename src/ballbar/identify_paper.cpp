@@ -1,3 +1,4 @@
+// Flynn et al.'s geometric identification chain: sphere, circle and plane fits, then transport.
 #include "rotacal/ballbar/identify_paper.hpp"
 
 #include <cmath>

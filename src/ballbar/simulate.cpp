@@ -1,3 +1,4 @@
+// Ballbar simulator: predicted lengths on a machine model plus Gaussian noise.
 #include "rotacal/ballbar/simulate.hpp"
 
 #include <cmath>

@@ -1,7 +1,7 @@
+// Observability and covariance of least-squares fits (no solver here: core/joint_fit.cpp).
 #include "rotacal/core/least_squares.hpp"
 
-#include <ceres/ceres.h>
-
+#include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 #include <cmath>
 #include <sstream>
@@ -9,37 +9,6 @@
 #include "rotacal/core/error.hpp"
 
 namespace rotacal {
-
-Eigen::MatrixXd evaluate_jacobian(ceres::Problem& problem, const std::vector<double*>& blocks,
-                                  Eigen::VectorXd* residuals) {
-  // Ceres reports Jacobians in each block's tangent space and none for constant blocks; lift
-  // both for this evaluation so that every column is there, then put them back.
-  std::vector<double*> made_variable;
-  std::vector<std::pair<double*, const ceres::Manifold*>> lifted;
-  for (double* b : blocks) {
-    if (problem.IsParameterBlockConstant(b)) {
-      problem.SetParameterBlockVariable(b);
-      made_variable.push_back(b);
-    }
-    if (const ceres::Manifold* m = problem.GetManifold(b)) {
-      lifted.emplace_back(b, m);
-      problem.SetManifold(b, nullptr);
-    }
-  }
-  ceres::Problem::EvaluateOptions opt;
-  opt.parameter_blocks = blocks;
-  ceres::CRSMatrix crs;
-  std::vector<double> r;
-  problem.Evaluate(opt, nullptr, &r, nullptr, &crs);
-  for (auto& [b, m] : lifted) problem.SetManifold(b, const_cast<ceres::Manifold*>(m));
-  for (double* b : made_variable) problem.SetParameterBlockConstant(b);
-  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
-  for (int i = 0; i < crs.num_rows; ++i)
-    for (int k = crs.rows[i]; k < crs.rows[i + 1]; ++k) J(i, crs.cols[k]) = crs.values[k];
-  if (residuals)
-    *residuals = Eigen::Map<Eigen::VectorXd>(r.data(), static_cast<Eigen::Index>(r.size()));
-  return J;
-}
 
 namespace {
 Eigen::VectorXd column_scales(const Eigen::MatrixXd& J) {
@@ -52,21 +21,39 @@ Eigen::VectorXd column_scales(const Eigen::MatrixXd& J) {
 
 Observability analyse_observability(const Eigen::MatrixXd& J, const Eigen::VectorXd& scales,
                                     double min_chi2_change) {
-  const Eigen::Index p = J.cols();
-  if (scales.size() != p)
+  if (scales.size() != J.cols())
+    throw InvalidArgument("analyse_observability: scales has " + std::to_string(scales.size()) +
+                          " entries for " + std::to_string(J.cols()) + " parameters");
+  Eigen::MatrixXd JtJ(J.cols(), J.cols());
+  JtJ.setZero();
+  JtJ.selfadjointView<Eigen::Lower>().rankUpdate(J.transpose());
+  JtJ.triangularView<Eigen::StrictlyUpper>() = JtJ.transpose();
+  return analyse_observability_normal(JtJ, scales, min_chi2_change);
+}
+
+Observability analyse_observability_normal(const Eigen::MatrixXd& JtJ, const Eigen::VectorXd& scales,
+                                           double min_chi2_change) {
+  const Eigen::Index p = JtJ.cols();
+  if (scales.size() != p || JtJ.rows() != p)
     throw InvalidArgument("analyse_observability: scales has " + std::to_string(scales.size()) +
                           " entries for " + std::to_string(p) + " parameters");
   Observability o;
   o.observable.assign(static_cast<std::size_t>(p), true);
   if (p == 0) return o;
-  const Eigen::MatrixXd Js = J * scales.asDiagonal();
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(Js, Eigen::ComputeFullV);
-  o.singular_values = Eigen::VectorXd::Zero(p);
-  o.singular_values.head(svd.singularValues().size()) = svd.singularValues();
+  // Eigenvalues of the scaled normal matrix are the squared singular values of J*diag(scales);
+  // their absolute error (~1e-16 of the largest) is far below the threshold of ~1 (chi2 units).
+  const Eigen::MatrixXd N = scales.asDiagonal() * JtJ * scales.asDiagonal();
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(N);
+  o.singular_values.resize(p);
+  Eigen::MatrixXd V(p, p);
+  for (Eigen::Index k = 0; k < p; ++k) {  // descending, as an SVD orders them
+    o.singular_values[k] = std::sqrt(std::max(0.0, es.eigenvalues()[p - 1 - k]));
+    V.col(k) = es.eigenvectors().col(p - 1 - k);
+  }
   const double limit = std::sqrt(min_chi2_change);
   for (Eigen::Index k = 0; k < p; ++k) {
     if (o.singular_values[k] >= limit) continue;
-    const Eigen::VectorXd vs = svd.matrixV().col(k);
+    const Eigen::VectorXd vs = V.col(k);
     o.null_space.push_back(vs.cwiseProduct(scales));
     int best = 0;
     for (Eigen::Index j = 0; j < p; ++j) {
@@ -109,23 +96,6 @@ std::string Observability::describe(int k, const std::vector<std::string>& names
   }
   out << " changes no reading measurably";
   return out.str();
-}
-
-void hold_fixed(ceres::Problem& problem, const std::vector<std::pair<double*, int>>& blocks,
-                const std::vector<bool>& free, std::vector<std::unique_ptr<ceres::Manifold>>& owned) {
-  std::size_t offset = 0;
-  for (const auto& [block, size] : blocks) {
-    std::vector<int> fixed;
-    for (int k = 0; k < size; ++k)
-      if (!free.at(offset + static_cast<std::size_t>(k))) fixed.push_back(k);
-    if (static_cast<int>(fixed.size()) == size) {
-      problem.SetParameterBlockConstant(block);
-    } else if (!fixed.empty()) {
-      owned.push_back(std::make_unique<ceres::SubsetManifold>(size, fixed));
-      problem.SetManifold(block, owned.back().get());
-    }
-    offset += static_cast<std::size_t>(size);
-  }
 }
 
 Eigen::MatrixXd covariance_from_jacobian(const Eigen::MatrixXd& J, const std::vector<bool>& free,

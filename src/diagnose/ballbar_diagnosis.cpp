@@ -1,3 +1,5 @@
+// The ballbar diagnosis problem: baseline + effects by the joint fit on arrays built once,
+// and the candidates' Jacobians by Jets of the one length model.
 #include "rotacal/diagnose/ballbar_diagnosis.hpp"
 
 #include <ceres/jet.h>
@@ -5,7 +7,7 @@
 namespace rotacal {
 
 BallbarDiagnosisProblem::BallbarDiagnosisProblem(BallbarSession session, BallbarSession reference)
-    : session_(std::move(session)), reference_(std::move(reference)) {
+    : session_(std::move(session)), arrays_(ballbar_arrays(session_)), reference_(std::move(reference)) {
   for (const BallbarSample& s : session_.samples) {
     groups_.push_back(s.test);
     times_.push_back(s.time);
@@ -23,7 +25,8 @@ std::vector<Effect> BallbarDiagnosisProblem::candidates(int max_harmonic) const 
 ModelFit BallbarDiagnosisProblem::fit(const EffectModel& effects) const {
   JointFitOptions o;
   o.effects = effects;
-  const BallbarIdentification id = identify_joint(session_, o);
+  o.whitener = whitener;
+  const BallbarIdentification id = identify_joint(arrays_, o);
   ModelFit f;
   f.effects = id.model.effects;
   f.parameters = id.parameters;

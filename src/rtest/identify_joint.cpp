@@ -1,13 +1,13 @@
+// R-test joint fit: smooth basis of the error maps, the joint model's readings with their
+// uncertainty, and the fit through the one joint-fit driver (core/joint_fit.hpp).
 #include "rotacal/rtest/identify_joint.hpp"
-
-#include <ceres/ceres.h>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
 
-#include "rotacal/core/least_squares.hpp"
+#include "rotacal/core/joint_fit.hpp"
 
 namespace rotacal {
 
@@ -154,9 +154,9 @@ Pose<double> RtestJointModel::table_pose(double B, double C) const {
 }
 Eigen::Vector3d RtestJointModel::reading(const Eigen::Vector3d& q, double B, double C,
                                          Eigen::Vector3d* std) const {
+  const Eigen::Vector3d xyz = rtest_commanded_xyz(MachineType::BC_trt, q, {B, C});
   auto f = [&](const RtestJointModel& m) {
-    const Eigen::Vector3d xyz = forward<double>(MachineType::BC_trt, LocationErrors<double>(), {B, C}, q);
-    return Eigen::Vector3d(m.table_pose(B, C).inverse() * xyz - q);
+    return Eigen::Vector3d(rtest_joint_reading<double>(m.errors(), m.w_BY(B), m.w_CB(B, C), B, C, xyz, q));
   };
   if (std) *std = propagate_fn(*this, f);
   return f(*this);
@@ -179,40 +179,84 @@ const ParameterEstimate& RtestJointIdentification::parameter(const std::string& 
 
 // ---------------------------------------------------------------- fit
 namespace {
-// r = (T^-1 xyz - q + zero - d_measured) / sigma, 3 residuals per sample (Eq. 4 with location
-// errors and the smooth maps). Blocks: location errors (8), B coefficients, C coefficients
-// (each at least 1 long; held constant when the basis is empty), probe zero (3).
-struct RtestReadingResidual {
-  RtestReadingResidual(const RtestBasis& basis, const RtestSample& s, const Eigen::Vector3d& q,
-                       double inv_sigma)
-      : basis_(basis), B_(s.angles_rad().tilt), C_(s.angles_rad().rot), xyz_(s.xyz), q_(q),
-        d_(*s.d), inv_sigma_(inv_sigma) {}
-
-  template <typename T>
-  bool operator()(T const* const* p, T* r) const {
-    const Pose<T> P = rtest_joint_table_pose<T>(basis_, p[0], p[1], p[2], B_, C_);
-    const Vec3<T> d = P.inverse() * xyz_.cast<T>() - q_.cast<T>();
-    for (int i = 0; i < 3; ++i) r[i] = (d[i] + p[3][i] - T(d_[i])) * T(inv_sigma_);
-    return true;
+// r = T^-1 xyz - q + zero - d_measured (mm), 3 residuals per sample (Eq. 4 with location errors
+// and the smooth maps). Parameters: location errors (8), B-map coefficients, C-map
+// coefficients, probe zero per set-up (3 each). Per sample, Jets of rtest_joint_reading with
+// respect to (e, w_BY, w_CB) (20 directions) are chained through the sample's basis values:
+// four times fewer directions than the ~70 coefficients.
+class RtestJointResiduals : public ResidualModel {
+ public:
+  RtestJointResiduals(const RtestSession& session, const std::vector<std::string>& setups,
+                      const RtestBasis& basis)
+      : nb_(basis.num_b_coefficients()), nc_(basis.num_c_coefficients()),
+        S_(static_cast<int>(setups.size())) {
+    const std::size_t n = session.samples.size();
+    B_.resize(n), C_.resize(n), setup_.resize(n);
+    Lb_ = Eigen::MatrixXd::Zero(6 * static_cast<Eigen::Index>(n), nb_);
+    Lc_ = Eigen::MatrixXd::Zero(6 * static_cast<Eigen::Index>(n), nc_);
+    xyz_.resize(3, static_cast<Eigen::Index>(n)), q_.resize(3, static_cast<Eigen::Index>(n));
+    d_.resize(3, static_cast<Eigen::Index>(n));
+    for (std::size_t i = 0; i < n; ++i) {
+      const RtestSample& s = session.samples[i];
+      const RotaryAngles<double> a = s.angles_rad();
+      B_[i] = a.tilt, C_[i] = a.rot;
+      setup_[i] = static_cast<int>(std::find(setups.begin(), setups.end(), s.setup) - setups.begin());
+      xyz_.col(static_cast<Eigen::Index>(i)) = s.xyz;
+      q_.col(static_cast<Eigen::Index>(i)) = session.nests.at(s.setup);
+      d_.col(static_cast<Eigen::Index>(i)) = *s.d;
+      const Eigen::Index r6 = 6 * static_cast<Eigen::Index>(i);
+      int o = 0;
+      for (int k = 0; k < 6; ++k)
+        for (double phi : basis.b_terms(k, a.tilt)) Lb_(r6 + k, o++) = phi;
+      o = 0;
+      for (const AxisErrors<double>& t : basis.c_terms(a.tilt, a.rot)) Lc_.block<6, 1>(r6, o++) = t;
+    }
   }
-
-  static ceres::CostFunction* Create(const RtestBasis& basis, const RtestSample& s,
-                                     const Eigen::Vector3d& q, double inv_sigma, int nb, int nc) {
-    auto* cost = new ceres::DynamicAutoDiffCostFunction<RtestReadingResidual, 16>(
-        new RtestReadingResidual(basis, s, q, inv_sigma));
-    cost->AddParameterBlock(8);
-    cost->AddParameterBlock(nb);
-    cost->AddParameterBlock(nc);
-    cost->AddParameterBlock(3);
-    cost->SetNumResiduals(3);
-    return cost;
+  Eigen::Index num_residuals() const override { return 3 * static_cast<Eigen::Index>(B_.size()); }
+  int num_parameters() const override { return 8 + nb_ + nc_ + 3 * S_; }
+  void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r,
+                Eigen::MatrixXd* J) const override {
+    using Jet = ceres::Jet<double, 20>;
+    const int n_model = 8 + nb_ + nc_;
+    const Eigen::VectorXd cb = x.segment(8, nb_), cc = x.segment(8 + nb_, nc_);
+    const LocationErrors<double> e = LocationErrors<double>::from_ptr(x.data());
+    LocationErrors<Jet> ej;
+    for (int k = 0; k < 8; ++k) ej.v[k] = Jet(x[k], k);
+    for (std::size_t i = 0; i < B_.size(); ++i) {
+      const Eigen::Index row = 3 * static_cast<Eigen::Index>(i);
+      const auto Lb = Lb_.middleRows<6>(row * 2), Lc = Lc_.middleRows<6>(row * 2);  // 6 rows a sample
+      const AxisErrors<double> wb = Lb * cb, wc = Lc * cc;
+      const Eigen::Vector3d zero = x.segment<3>(n_model + 3 * setup_[i]);
+      const Eigen::Vector3d xyz = xyz_.col(static_cast<Eigen::Index>(i));
+      const Eigen::Vector3d q = q_.col(static_cast<Eigen::Index>(i));
+      if (!J) {
+        r.segment<3>(row) = rtest_joint_reading<double>(e, wb, wc, B_[i], C_[i], xyz, q) + zero -
+                            d_.col(static_cast<Eigen::Index>(i));
+        continue;
+      }
+      AxisErrors<Jet> wbj, wcj;
+      for (int k = 0; k < 6; ++k) wbj[k] = Jet(wb[k], 8 + k), wcj[k] = Jet(wc[k], 14 + k);
+      const Vec3<Jet> d = rtest_joint_reading<Jet>(ej, wbj, wcj, B_[i], C_[i], xyz, q);
+      Eigen::Matrix<double, 3, 20> G;
+      for (int a = 0; a < 3; ++a) {
+        r[row + a] = d[a].a + zero[a] - d_(a, static_cast<Eigen::Index>(i));
+        G.row(a) = d[a].v.transpose();
+      }
+      J->block(row, 0, 3, 8) = G.leftCols<8>();
+      J->block(row, 8, 3, nb_).noalias() = G.middleCols<6>(8) * Lb;
+      J->block(row, 8 + nb_, 3, nc_).noalias() = G.rightCols<6>() * Lc;
+      J->block(row, n_model, 3, 3 * S_).setZero();
+      J->block<3, 3>(row, n_model + 3 * setup_[i]).setIdentity();
+    }
   }
 
  private:
-  RtestBasis basis_;
-  double B_, C_;
-  Eigen::Vector3d xyz_, q_, d_;
-  double inv_sigma_;
+  int nb_, nc_, S_;
+  std::vector<double> B_, C_;
+  std::vector<int> setup_;
+  Eigen::Matrix3Xd xyz_, q_, d_;
+  // Basis values, 6 rows per sample (rows 6i..6i+5): w_BY = Lb cb, w_CB = Lc cc.
+  Eigen::MatrixXd Lb_, Lc_;
 };
 }  // namespace
 
@@ -238,132 +282,55 @@ RtestJointIdentification identify_joint(const RtestSession& session,
     throw InvalidArgument("identify_joint: session: " + std::to_string(3 * session.samples.size()) +
                           " readings cannot determine " + std::to_string(n_par) + " unknowns");
 
-  const double sigma_mm = session.noise_um.value_or(1.0) * 1e-3;  // scales the cost only
-  Eigen::Matrix<double, 8, 1> e = Eigen::Matrix<double, 8, 1>::Zero();
-  std::vector<double> cb(static_cast<std::size_t>(std::max(nb, 1)), 0.0);
-  std::vector<double> cc(static_cast<std::size_t>(std::max(nc, 1)), 0.0);
-  // Start each probe zero at its set-up's mean reading (the closed-form answer for zero errors).
-  std::vector<Eigen::Vector3d> zeros(setups.size(), Eigen::Vector3d::Zero());
-  for (std::size_t k = 0; k < setups.size(); ++k) {
-    const auto idx = session.indices_of(setups[k]);
-    for (std::size_t i : idx) zeros[k] += *session.samples[i].d;
-    zeros[k] /= static_cast<double>(idx.size());
-  }
-
-  ceres::Problem::Options po;
-  po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;  // evaluate_jacobian detaches them
-  ceres::Problem problem(po);
-  std::vector<std::unique_ptr<ceres::Manifold>> manifolds;
-  for (const RtestSample& s : session.samples) {
-    const std::size_t k = static_cast<std::size_t>(
-        std::find(setups.begin(), setups.end(), s.setup) - setups.begin());
-    problem.AddResidualBlock(
-        RtestReadingResidual::Create(basis, s, session.nests.at(s.setup), 1.0 / sigma_mm,
-                                     static_cast<int>(cb.size()), static_cast<int>(cc.size())),
-        nullptr, {e.data(), cb.data(), cc.data(), zeros[k].data()});
-  }
-  if (nb == 0) problem.SetParameterBlockConstant(cb.data());
-  if (nc == 0) problem.SetParameterBlockConstant(cc.data());
-
-  std::vector<std::string> names, units;
-  for (int k = 0; k < 8; ++k) {
-    names.push_back(location_error_names(MachineType::BC_trt)[static_cast<std::size_t>(k)]);
-    units.push_back(location_error_is_angle(k) ? "rad" : "mm");
-  }
+  std::vector<FitParameter> params;
+  for (int k = 0; k < 8; ++k)
+    params.push_back({location_error_names(MachineType::BC_trt)[static_cast<std::size_t>(k)],
+                      location_error_is_angle(k) ? "rad" : "mm", 0.0});
   for (const std::string& n : basis.coefficient_names()) {
-    names.push_back(n);
     const std::string comp = n.substr(0, n.find('_'));
-    units.push_back(comp[0] == 'd' ? "mm" : "rad");
+    params.push_back({n, comp[0] == 'd' ? "mm" : "rad", 0.0});
   }
-  for (const std::string& s : setups)
-    for (const char* c : {"x", "y", "z"}) names.push_back("zero." + s + "." + c), units.push_back("mm");
+  // Start each probe zero at its set-up's mean reading (the closed-form answer for zero errors).
+  for (const std::string& s : setups) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    const auto idx = session.indices_of(s);
+    for (std::size_t i : idx) mean += *session.samples[i].d;
+    mean /= static_cast<double>(idx.size());
+    const char* axes[3] = {"x", "y", "z"};
+    for (int a = 0; a < 3; ++a) params.push_back({"zero." + s + "." + axes[a], "mm", mean[a]});
+  }
 
-  std::vector<double*> blocks = {e.data(), cb.data(), cc.data()};
-  for (auto& z : zeros) blocks.push_back(z.data());
-  // Columns of the Jacobian in `names` order (drop the dummy columns of empty bases).
-  auto columns = [&](const Eigen::MatrixXd& Jfull) {
-    Eigen::MatrixXd J(Jfull.rows(), n_par);
-    int c = 0, src = 0;
-    J.middleCols(c, 8) = Jfull.middleCols(src, 8), c += 8, src += 8;
-    if (nb > 0) J.middleCols(c, nb) = Jfull.middleCols(src, nb), c += nb;
-    src += static_cast<int>(cb.size());
-    if (nc > 0) J.middleCols(c, nc) = Jfull.middleCols(src, nc), c += nc;
-    src += static_cast<int>(cc.size());
-    J.rightCols(n_par - c) = Jfull.rightCols(Jfull.cols() - src);
-    return J;
-  };
-
-  // Observability at the start point (readings are linear in the um-sized errors): fix one
-  // parameter per invisible combination so that the solver cannot wander along it.
-  const Eigen::MatrixXd J0 = columns(evaluate_jacobian(problem, blocks));
-  Eigen::VectorXd scales(n_par);
-  for (int j = 0; j < n_par; ++j) scales[j] = plausible_magnitude(units[static_cast<std::size_t>(j)]);
-  const Observability obs = analyse_observability(J0, scales, options.observability_min_chi2);
-  std::vector<bool> free(static_cast<std::size_t>(n_par), true);
-  for (int j : obs.to_fix) free[static_cast<std::size_t>(j)] = false;
-  // `free` is in `names` order: location errors, B map, C map, then the zeros set-up by set-up.
-  std::vector<std::pair<double*, int>> sized = {{e.data(), 8}};
-  if (nb > 0) sized.emplace_back(cb.data(), nb);  // empty bases are constant already
-  if (nc > 0) sized.emplace_back(cc.data(), nc);
-  for (auto& z : zeros) sized.emplace_back(z.data(), 3);
-  hold_fixed(problem, sized, free, manifolds);
-
-  ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_QR;
-  so.max_num_iterations = options.max_iterations;
-  so.function_tolerance = 1e-12;
-  so.parameter_tolerance = 1e-12;
-  so.gradient_tolerance = 1e-14;
-  so.num_threads = 1;
-  ceres::Solver::Summary summary;
-  ceres::Solve(so, &problem, &summary);
+  JointFitSettings settings;
+  settings.max_iterations = options.max_iterations;
+  settings.observability_min_chi2 = options.observability_min_chi2;
+  settings.sigma = session.noise_um.value_or(1.0) * 1e-3;  // scales chi-square only
+  settings.whitener = options.whitener;
+  const RtestJointResiduals model(session, setups, basis);
+  JointFitOutcome fit = solve_joint(model, params, settings);
 
   RtestJointIdentification out;
-  out.converged = summary.IsSolutionUsable() && summary.termination_type == ceres::CONVERGENCE;
-  out.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  out.converged = fit.summary.converged;
+  out.iterations = fit.summary.iterations;
   out.n_samples = session.samples.size();
-
-  Eigen::VectorXd r;
-  const Eigen::MatrixXd J = columns(evaluate_jacobian(problem, blocks, &r));
   out.residuals.resize(session.samples.size());
-  double ss = 0.0;
-  for (std::size_t i = 0; i < session.samples.size(); ++i) {
-    out.residuals[i] = -r.segment<3>(3 * static_cast<Eigen::Index>(i)) * sigma_mm;
-    ss += out.residuals[i].squaredNorm();
-  }
+  for (std::size_t i = 0; i < session.samples.size(); ++i)
+    out.residuals[i] = fit.residuals.segment<3>(3 * static_cast<Eigen::Index>(i));
   const double n_res = 3.0 * static_cast<double>(session.samples.size());
-  out.residual_rms_um = std::sqrt(ss / n_res) * 1e3;
-  int n_free = 0;
-  for (bool f : free) n_free += f;
-  const double s2_mm = ss / std::max(n_res - n_free, 1.0);
-  out.sigma_um = std::sqrt(s2_mm) * 1e3;
-  out.covariance = covariance_from_jacobian(J, free, s2_mm / (sigma_mm * sigma_mm));
-
-  Eigen::VectorXd values(n_par);
-  values.head<8>() = e;
-  for (int j = 0; j < nb; ++j) values[8 + j] = cb[static_cast<std::size_t>(j)];
-  for (int j = 0; j < nc; ++j) values[8 + nb + j] = cc[static_cast<std::size_t>(j)];
-  for (std::size_t k = 0; k < zeros.size(); ++k) {
-    values.segment<3>(n_model + 3 * static_cast<Eigen::Index>(k)) = zeros[k];
-    out.probe_zeros[setups[k]] = zeros[k];
-  }
-  for (int j = 0; j < n_par; ++j) {
-    ParameterEstimate p;
-    p.name = names[static_cast<std::size_t>(j)];
-    p.unit = units[static_cast<std::size_t>(j)];
-    p.value = values[j];
-    p.std = std::sqrt(std::max(0.0, out.covariance(j, j)));
-    p.observable = obs.observable[static_cast<std::size_t>(j)];
-    out.parameters.push_back(p);
-  }
-  for (std::size_t k = 0; k < obs.null_space.size(); ++k)
-    out.unobservable.push_back(obs.describe(static_cast<int>(k), names, units));
+  out.residual_rms_um = std::sqrt(fit.residuals.squaredNorm() / n_res) * 1e3;
+  out.sigma_um = std::sqrt(fit.residuals.squaredNorm() / std::max(n_res - fit.summary.num_free, 1.0)) * 1e3;
+  out.covariance = fit.covariance;
+  for (std::size_t k = 0; k < setups.size(); ++k)
+    out.probe_zeros[setups[k]] = fit.values.segment<3>(n_model + 3 * static_cast<Eigen::Index>(k));
+  out.parameters = fit.estimates;
+  out.unobservable = fit.unobservable;
+  out.summary = fit.summary;
 
   out.model.machine = session.machine;
   out.model.basis = basis;
-  out.model.params = values.head(n_model);
+  out.model.params = fit.values.head(n_model);
   out.model.covariance = out.covariance.topLeftCorner(n_model, n_model);
-  out.model.observable.assign(obs.observable.begin(), obs.observable.begin() + n_model);
+  out.model.observable.clear();
+  for (int j = 0; j < n_model; ++j) out.model.observable.push_back(fit.estimates[static_cast<std::size_t>(j)].observable);
 
   out.notes.push_back("probe zero per set-up fitted: no reading is assumed to be zero");
   out.notes.push_back(
@@ -373,7 +340,7 @@ RtestJointIdentification identify_joint(const RtestSession& session,
   if (!basis.gamma_cb) out.notes.push_back("gamma_CB not fitted (assumed zero, as Oyama Sec. 4.2)");
   out.notes.push_back("rotary zero offsets E_B0B, E_C0C are not in the model: an R-test with the "
                       "probe zero unknown cannot see a constant C offset; E_B0B acts as E_B0C");
-  if (!out.converged) out.notes.push_back("Ceres did not converge: " + summary.message);
+  if (!out.converged) out.notes.push_back("the fit did not converge: " + fit.summary.message);
   return out;
 }
 

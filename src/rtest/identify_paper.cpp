@@ -1,3 +1,4 @@
+// Oyama & Ibaraki's two-step R-test identification (Eqs. 10-22).
 #include "rotacal/rtest/identify_paper.hpp"
 
 #include <Eigen/Dense>

@@ -1,3 +1,4 @@
+// Prediction of R-test readings from a model, with their 1 sigma.
 #include "rotacal/rtest/predict.hpp"
 
 #include <algorithm>

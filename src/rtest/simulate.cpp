@@ -1,3 +1,4 @@
+// R-test simulator: the one reading of rtest/model.hpp on a machine model, probe zeros and noise.
 #include "rotacal/rtest/simulate.hpp"
 
 #include <Eigen/Dense>
@@ -17,28 +18,10 @@ std::string fmt(double v, int prec) {
   return buf;
 }
 
-void check_truth(const RtestTruth& truth) {
-  if (static_cast<int>(truth.effect_params.size()) != truth.effects.num_params())
-    throw InvalidArgument("RtestTruth.effect_params: " + std::to_string(truth.effect_params.size()) +
-                          " values for an effect model of " +
-                          std::to_string(truth.effects.num_params()) + " parameters");
-  for (const Effect& f : truth.effects.effects)
-    if (!f.applies_to(truth.machine))
-      throw InvalidArgument("RtestTruth.effects: " + f.id() + " does not exist on a " +
-                            to_string(truth.machine));
-}
 }  // namespace
 
-Eigen::Vector3d rtest_reading(const RtestTruth& truth, const Eigen::Vector3d& q_nest,
-                              const RotaryAngles<double>& angles, double t) {
-  const double* p = truth.effect_params.empty() ? nullptr : truth.effect_params.data();
-  const Eigen::Vector3d xyz = forward<double>(truth.machine, LocationErrors<double>(), angles, q_nest);
-  const Pose<double> T = table_pose<double>(truth.machine, truth.errors, truth.effects, p, angles, t);
-  return T.inverse() * tool_position<double>(truth.effects, p, xyz, t) - q_nest;
-}
-
-RtestSimulation simulate_rtest(const RtestTruth& truth, const RtestSimOptions& o) {
-  check_truth(truth);
+RtestSimulation simulate_rtest(const MachineModel& truth, const RtestSimOptions& o) {
+  truth.validate("RtestTruth");
   if (o.pattern.b_deg.empty() || o.pattern.c_deg.empty() || o.pattern.nests.empty())
     throw InvalidArgument("simulate_rtest: options.pattern: b_deg, c_deg and nests must not be empty");
   if (o.noise_um < 0 || o.probe_zero_um < 0)
@@ -84,8 +67,10 @@ RtestSimulation simulate_rtest(const RtestTruth& truth, const RtestSimOptions& o
         r.tilt_deg = b;
         r.rot_deg = c;
         const RotaryAngles<double> a{b * kDeg, c * kDeg};
-        r.xyz = forward<double>(truth.machine, LocationErrors<double>(), a, q);
-        const Eigen::Vector3d d = rtest_reading(truth, q, a, t) + z;
+        r.xyz = rtest_commanded_xyz(truth.machine, q, a);
+        const Eigen::Vector3d d =
+            rtest_reading<double>(truth.machine, truth.errors, truth.effects, truth.effect_data(),
+                                  r.xyz, a, t, q) + z;
         const Eigen::Vector3d e(noise(rng), noise(rng), noise(rng));
         if (o.probe_dirs) {
           r.raw = (*o.probe_dirs) * d + e;

@@ -145,3 +145,38 @@ TEST_CASE("joint fit recovers C-axis error motions and reports them in words whe
   CHECK(id.sigma_um == Approx(0.3).epsilon(0.15));
   CHECK_THROWS_AS(identify_joint(RtestSession{}), InvalidArgument);
 }
+
+namespace {
+// W = I / s: white noise of a known sigma s as a noise model.
+class KnownWhiteNoise : public ResidualWhitener {
+ public:
+  KnownWhiteNoise(Eigen::Index n, double s) : n_(n), s_(s) {}
+  void apply(Eigen::Ref<Eigen::MatrixXd> c) const override { c /= s_; }
+  Eigen::Index size() const override { return n_; }
+
+ private:
+  Eigen::Index n_;
+  double s_;
+};
+}  // namespace
+
+TEST_CASE("R-test joint fit with a noise model: same solution, covariance in units of its sigma") {
+  RtestSimOptions o;
+  o.seed = 77;
+  o.noise_um = 0.3;
+  const RtestSimulation sim = simulate_rtest(oyama_truth(), o);
+  const RtestJointIdentification white = identify_joint(sim.session);
+  RtestJointOptions gls;
+  const double s = 0.6e-3;  // deliberately twice the true noise: chi2/dof must show it
+  gls.whitener = std::make_shared<KnownWhiteNoise>(3 * static_cast<Eigen::Index>(sim.session.samples.size()), s);
+  const RtestJointIdentification w = identify_joint(sim.session, gls);
+  REQUIRE(w.converged);
+  CHECK(w.summary.whitened);
+  CHECK(w.summary.chi2_per_dof == Approx(0.25).margin(0.05));
+  for (std::size_t j = 0; j < w.parameters.size(); ++j) {
+    if (!w.parameters[j].observable) continue;
+    CHECK(std::abs(w.parameters[j].value - white.parameters[j].value) <= 1e-3 * white.parameters[j].std);
+    // (J^T J)^-1 s^2, not rescaled by the residual variance (white.sigma_um):
+    CHECK(w.parameters[j].std == Approx(white.parameters[j].std * s * 1e3 / white.sigma_um).epsilon(1e-3));
+  }
+}

@@ -1,26 +1,20 @@
 #pragma once
 /// \file
 /// Identification of the eight location errors from a single set-up ballbar session:
-/// `identify_joint` fits the exact model (model.hpp) to every sample at once with Ceres;
-/// `identify_paper` (identify_paper.hpp) is Flynn et al.'s geometric chain.
+/// `identify_joint` fits the exact model (model.hpp) to every sample at once through the
+/// joint-fit driver (core/joint_fit.hpp); `identify_paper` (identify_paper.hpp) is Flynn et
+/// al.'s geometric chain.
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "rotacal/ballbar/model.hpp"
+#include "rotacal/core/estimate.hpp"  // ParameterEstimate (kept reachable from this header)
+#include "rotacal/core/whitener.hpp"
 
 namespace rotacal {
-
-/// One identified quantity. `observable == false` means the session's tests cannot determine
-/// it: value and std are then meaningless and are not reported by the writers.
-struct ParameterEstimate {
-  std::string name;
-  double value = 0.0;
-  double std = 0.0;  ///< 1 sigma
-  std::string unit;
-  bool observable = true;
-};
 
 struct BallbarIdentification {
   std::string method;                 ///< "joint" or "paper"
@@ -39,6 +33,7 @@ struct BallbarIdentification {
   int iterations = 0;
   std::vector<std::string> unobservable;  ///< combinations the tests cannot see, in words
   std::vector<std::string> notes;         ///< assumptions and warnings for the report
+  FitSummary summary;                     ///< solver figures; whitened chi2/dof with a whitener
 
   /// The estimate called `name`; throws InvalidArgument if there is none.
   const ParameterEstimate& parameter(const std::string& name) const;
@@ -52,14 +47,42 @@ struct JointFitOptions {
   /// A direction in parameter space is unobservable when moving along it by plausible
   /// magnitudes (1 mm, 1 mrad) changes chi-square by less than this.
   double observability_min_chi2 = 1.0;
+  /// Optional noise model (GLS): maps the residuals in mm of the fitted samples (session
+  /// order) to independent unit-variance ones. The covariance is then (Jw^T Jw)^-1 with no
+  /// rescaling, and summary.chi2_per_dof is the whitened one.
+  std::shared_ptr<const ResidualWhitener> whitener;
 };
 
+/// The samples a fit uses as contiguous arrays (structure of arrays): built once per session
+/// and reused by every refit (diagnosis candidates, Monte Carlo draws), no strings inside.
+struct BallbarArrays {
+  MachineType machine = MachineType::AC_trt;
+  Eigen::Vector3d pivot = Eigen::Vector3d::Zero();  ///< nominal pivot, table frame, mm
+  std::optional<double> noise_um;                   ///< declared noise of one reading
+  std::size_t session_size = 0;                     ///< samples in the whole session
+  std::vector<std::size_t> index;                   ///< session index of each row
+  Eigen::Matrix3Xd xyz;                             ///< commanded tool-side ball, mm
+  std::vector<RotaryAngles<double>> angles;         ///< rad
+  Eigen::VectorXd time;                             ///< s
+  Eigen::VectorXd length;                           ///< measured length, mm
+
+  Eigen::Index size() const { return time.size(); }
+};
+
+/// The rows of `session` whose test is in `tests` (all if empty), as arrays.
+BallbarArrays ballbar_arrays(const BallbarSession& session, const std::vector<std::string>& tests = {});
+
 /// Joint least-squares fit of location errors + actual pivot (+ dL, + effects) to every
-/// sample: residual_i = (L_model,i - L_i) / sigma, autodiff Jacobians. Starts from zero errors
-/// and the nominal pivot. The 1-sigma covariance is (J^T J)^-1 s^2 with s^2 the residual
-/// variance; parameters the tests cannot see are held at zero and reported as unobservable.
+/// sample: residual_i = (L_model,i - L_i) / sigma, Jacobians by Jets of the one model
+/// (model.hpp) over the whole batch. Starts from zero errors and the nominal pivot. The 1-sigma
+/// covariance is (J^T J)^-1 s^2 with s^2 the residual variance (GLS with options.whitener);
+/// parameters the tests cannot see are held at zero and reported as unobservable.
 /// Throws InvalidArgument for a session with fewer samples than unknowns.
 BallbarIdentification identify_joint(const BallbarSession& session,
                                      const JointFitOptions& options = {});
+
+/// The same fit on prepared arrays (options.tests was applied when they were built and is
+/// ignored here).
+BallbarIdentification identify_joint(const BallbarArrays& data, const JointFitOptions& options = {});
 
 }  // namespace rotacal

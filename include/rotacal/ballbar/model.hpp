@@ -6,29 +6,36 @@
 
 #include <vector>
 
+#include "rotacal/core/machine_model.hpp"
 #include "rotacal/io/session.hpp"
 #include "rotacal/kinematics/effects.hpp"
 
 namespace rotacal {
 
-/// Everything that determines a ballbar reading on a machine: location errors, the actual
-/// pivot position (table frame, mm) and optional effects with their parameters.
-struct BallbarMachineModel {
-  MachineType machine = MachineType::AC_trt;
-  LocationErrors<double> errors;
+/// Everything that determines a ballbar reading: the machine (core/machine_model.hpp) and
+/// the actual position of the centre-pivot ball on its table (table frame, mm), the one
+/// quantity the ballbar set-up adds.
+struct BallbarMachineModel : MachineModel {
   Eigen::Vector3d pivot = Eigen::Vector3d::Zero();
-  EffectModel effects;
-  std::vector<double> effect_params;  ///< effects.num_params() values
 };
 
-/// Predicted centre-to-centre length (mm) of one sample:
+/// Predicted centre-to-centre length (mm) for a commanded tool-side position xyz (mm) at
+/// rotary angles `angles` (rad) and time t (s):
 ///   L = | p_tool(xyz, t) - T(angles, t) * pivot | + reading error(t)
 template <typename Scalar>
 Scalar predicted_length(MachineType m, const LocationErrors<Scalar>& e, const Vec3<Scalar>& pivot,
+                        const EffectModel& fx, const Scalar* fx_params, const Eigen::Vector3d& xyz,
+                        const RotaryAngles<double>& angles, double t) {
+  const Vec3<Scalar> tool = tool_position(fx, fx_params, xyz, t);
+  const Vec3<Scalar> ball = table_point(m, e, fx, fx_params, angles, t, pivot);
+  return (tool - ball).norm() + ballbar_reading_error(fx, fx_params, t);
+}
+
+/// The same for one sample of a session.
+template <typename Scalar>
+Scalar predicted_length(MachineType m, const LocationErrors<Scalar>& e, const Vec3<Scalar>& pivot,
                         const EffectModel& fx, const Scalar* fx_params, const BallbarSample& s) {
-  const Vec3<Scalar> tool = tool_position(fx, fx_params, s.xyz, s.time);
-  const Vec3<Scalar> ball = table_point(m, e, fx, fx_params, s.angles_rad(), s.time, pivot);
-  return (tool - ball).norm() + ballbar_reading_error(fx, fx_params, s.time);
+  return predicted_length<Scalar>(m, e, pivot, fx, fx_params, s.xyz, s.angles_rad(), s.time);
 }
 
 /// Predicted lengths of every sample of a session on a machine model.

@@ -1,28 +1,14 @@
 #pragma once
 /// \file
-/// What every joint fit reports after Ceres has converged: the weighted Jacobian at the
-/// solution, which parameter combinations the data cannot see (SVD of the column-normalised
-/// Jacobian), and the 1-sigma covariance of the parameters that it can see.
+/// What every joint fit reports once it has converged: which parameter combinations the data
+/// cannot see (eigen-decomposition of the scaled normal matrix), and the 1-sigma covariance of
+/// the parameters that it can see. The driver that calls them is core/joint_fit.hpp.
 
 #include <Eigen/Core>
-#include <memory>
 #include <string>
-#include <utility>
 #include <vector>
 
-namespace ceres {
-class Problem;
-class Manifold;
-}
-
 namespace rotacal {
-
-/// Dense Jacobian of the problem's residuals with respect to `blocks` in their ambient
-/// coordinates (columns in block order; constant blocks and blocks with a manifold included),
-/// evaluated at the blocks' current values. Manifolds are detached and re-attached around the
-/// evaluation, so the problem must not own them (manifold_ownership = DO_NOT_TAKE_OWNERSHIP).
-Eigen::MatrixXd evaluate_jacobian(ceres::Problem& problem, const std::vector<double*>& blocks,
-                                  Eigen::VectorXd* residuals = nullptr);
 
 /// Which parameter combinations the data cannot determine. J is weighted (residuals in units
 /// of their sigma); `scales` holds a plausible magnitude of each parameter (e.g. 1 mm, 1 mrad).
@@ -41,16 +27,15 @@ struct Observability {
 };
 Observability analyse_observability(const Eigen::MatrixXd& J, const Eigen::VectorXd& scales,
                                     double min_chi2_change = 1.0);
+/// The same from the normal matrix J^T J (p x p), so that a fit over 10^6 residuals need not
+/// copy its Jacobian: the singular values of J*diag(scales) are the square roots of the
+/// eigenvalues of diag(scales) J^T J diag(scales).
+Observability analyse_observability_normal(const Eigen::MatrixXd& JtJ, const Eigen::VectorXd& scales,
+                                           double min_chi2_change = 1.0);
 
 /// Plausible magnitude of a parameter by its unit, for analyse_observability: 1 mm, 1 mrad,
 /// 1 um/s, 1e-3 for ratios (rad/rad, mm/mm). Throws InvalidArgument for an unknown unit.
 double plausible_magnitude(const std::string& unit);
-
-/// Hold the parameters marked false in `free` (flat, in block order) at their current values:
-/// a block fixed entirely becomes constant, a partly fixed one gets a SubsetManifold kept in
-/// `owned` (so the problem must use manifold_ownership = DO_NOT_TAKE_OWNERSHIP).
-void hold_fixed(ceres::Problem& problem, const std::vector<std::pair<double*, int>>& blocks,
-                const std::vector<bool>& free, std::vector<std::unique_ptr<ceres::Manifold>>& owned);
 
 /// 1-sigma covariance (J^T J)^-1 * sigma2 restricted to the parameters in `free` (others get
 /// zero rows/columns), computed by SVD of the column-normalised Jacobian for conditioning.

@@ -3,6 +3,10 @@
 /// The diagnosis of a ballbar session: the DiagnosisProblem for the exact ballbar model,
 /// baseline = location errors + actual pivot (identify_joint with no effects).
 
+#include <memory>
+
+#include "rotacal/ballbar/identify.hpp"
+#include "rotacal/core/whitener.hpp"
 #include "rotacal/diagnose/diagnosis.hpp"
 #include "rotacal/io/session.hpp"
 
@@ -13,6 +17,8 @@ class BallbarDiagnosisProblem : public DiagnosisProblem {
   /// `reference` is a complete standard test for the same machine (commanded rows; lengths
   /// unused), used to name the test that separates two ambiguous candidates; may be empty.
   explicit BallbarDiagnosisProblem(BallbarSession session, BallbarSession reference = {});
+  /// Optional noise model for every fit (GLS, core/joint_fit.hpp): one residual per sample.
+  std::shared_ptr<const ResidualWhitener> whitener;
 
   MachineType machine() const override { return session_.machine; }
   const std::vector<std::string>& groups() const override { return groups_; }
@@ -33,6 +39,7 @@ class BallbarDiagnosisProblem : public DiagnosisProblem {
   Eigen::MatrixXd jacobian_on(const std::vector<BallbarSample>& samples, const ModelFit& at,
                               const Effect& candidate) const;
   BallbarSession session_;
+  BallbarArrays arrays_;  // the samples as arrays, built once for every refit
   BallbarSession reference_;
   std::vector<std::string> groups_;
   std::vector<double> times_;

@@ -6,6 +6,9 @@
 /// catalogue's effects (kinematics/effects.hpp) as the candidate extensions. Every reading
 /// has three components (dx, dy, dz); each is one residual.
 
+#include <memory>
+
+#include "rotacal/core/whitener.hpp"
 #include "rotacal/diagnose/diagnosis.hpp"
 #include "rotacal/io/session.hpp"
 
@@ -15,6 +18,8 @@ class RtestDiagnosisProblem : public DiagnosisProblem {
  public:
   /// Throws InvalidArgument if the session has no dx,dy,dz (convert raw probe readings first).
   explicit RtestDiagnosisProblem(RtestSession session);
+  /// Optional noise model for every fit (GLS, core/joint_fit.hpp): 3 residuals per sample.
+  std::shared_ptr<const ResidualWhitener> whitener;
 
   MachineType machine() const override { return session_.machine; }
   const std::vector<std::string>& groups() const override { return groups_; }
@@ -33,6 +38,10 @@ class RtestDiagnosisProblem : public DiagnosisProblem {
   std::vector<std::string> groups_;  // per reading component
   std::vector<double> times_;
   std::vector<RotaryAngles<double>> angles_;
+  // The samples as arrays, built once for every refit: commanded xyz, nest, measured d.
+  Eigen::Matrix3Xd xyz_, nest_, d_;
+  std::vector<RotaryAngles<double>> pose_angles_;  // per sample
+  std::vector<double> pose_times_;
 };
 
 /// Diagnose an R-test session (see diagnosis.hpp).

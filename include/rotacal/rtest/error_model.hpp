@@ -20,6 +20,7 @@
 #include <Eigen/Core>
 
 #include "rotacal/kinematics/machine.hpp"
+#include "rotacal/rtest/model.hpp"
 
 namespace rotacal {
 
@@ -63,7 +64,8 @@ Vec3<Scalar> oyama_displacement(const AxisErrors<Scalar>& w_BY, const AxisErrors
                                 const Scalar& B, const Scalar& C, const Vec3<Scalar>& p_star) {
   const AxisErrors<Scalar> zero = AxisErrors<Scalar>::Zero();
   const Vec3<Scalar> p_machine = oyama_table_pose<Scalar>(zero, zero, B, C) * p_star;
-  return oyama_table_pose(w_BY, w_CB, B, C).inverse() * p_machine - p_star;
+  return rtest_displacement<Scalar>(oyama_table_pose(w_BY, w_CB, B, C), p_machine,
+                                    Eigen::Vector3d::Zero()) - p_star;
 }
 
 /// Eq. 9: small-angle table error twist (dX, dY, dZ, dA, dB, dC) in the table frame.

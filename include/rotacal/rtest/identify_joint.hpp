@@ -1,8 +1,9 @@
 #pragma once
 /// \file
-/// Joint identification of an R-test session: one Ceres problem for the 8 location errors, the
-/// position-dependent errors of both axes in a smooth basis, and an unknown probe zero per
-/// set-up, with autodiff Jacobians. The model (error_model.hpp, rtest_table_pose):
+/// Joint identification of an R-test session: one least-squares problem (core/joint_fit.hpp)
+/// for the 8 location errors, the position-dependent errors of both axes in a smooth basis,
+/// and an unknown probe zero per set-up, with Jacobians by Jets of the one reading
+/// (rtest/model.hpp). The model (error_model.hpp, rtest_table_pose):
 ///   T(B, C) = E(w_BY(B)) Rot(B line, B) E(w_CB(B, C)) Rot(C line, C)
 ///   d       = T^-1 xyz - q_nest + zero_setup
 /// w_BY, w_CB are the deviations beyond the rigid axis lines (Oyama's errors with the location
@@ -23,9 +24,13 @@
 #include <string>
 #include <vector>
 
-#include "rotacal/ballbar/identify.hpp"  // ParameterEstimate
+#include <memory>
+
+#include "rotacal/core/estimate.hpp"
+#include "rotacal/core/whitener.hpp"
 #include "rotacal/io/session.hpp"
 #include "rotacal/rtest/error_model.hpp"
+#include "rotacal/rtest/model.hpp"
 
 namespace rotacal {
 
@@ -72,7 +77,7 @@ struct RtestJointModel {
                               Eigen::Vector3d* std = nullptr) const;
 };
 
-/// Templated evaluation of the joint model's table pose for Ceres: e -> 8 location errors,
+/// Templated evaluation of the joint model's table pose (any Scalar): e -> 8 location errors,
 /// cb -> B-map coefficients, cc -> C-map coefficients.
 template <typename Scalar>
 Pose<Scalar> rtest_joint_table_pose(const RtestBasis& basis, const Scalar* e, const Scalar* cb,
@@ -90,12 +95,28 @@ Pose<Scalar> rtest_joint_table_pose(const RtestBasis& basis, const Scalar* e, co
   return rtest_table_pose<Scalar>(LocationErrors<Scalar>::from_ptr(e), wb, wc, Scalar(B), Scalar(C));
 }
 
+/// The joint model's R-test reading (rtest/model.hpp) for the sphere commanded to xyz (mm)
+/// over the nest at q_nest, at B, C (rad): location errors e and the maps' values w_BY, w_CB
+/// at this pose. The joint fit takes Jets of it with respect to (e, w_BY, w_CB); the map
+/// coefficients enter through the (linear) basis.
+template <typename Scalar>
+Vec3<Scalar> rtest_joint_reading(const LocationErrors<Scalar>& e, const AxisErrors<Scalar>& w_BY,
+                                 const AxisErrors<Scalar>& w_CB, double B, double C,
+                                 const Eigen::Vector3d& xyz, const Eigen::Vector3d& q_nest) {
+  return rtest_displacement<Scalar>(rtest_table_pose<Scalar>(e, w_BY, w_CB, Scalar(B), Scalar(C)),
+                                    xyz.cast<Scalar>(), q_nest);
+}
+
 struct RtestJointOptions {
   RtestBasis basis;
   int max_iterations = 50;
   /// A direction is unobservable when moving along it by plausible magnitudes (1 mm, 1 mrad)
   /// changes chi-square by less than this (core/least_squares.hpp).
   double observability_min_chi2 = 1.0;
+  /// Optional noise model (GLS): maps the residuals in mm (3 per sample, dx dy dz, session
+  /// order) to independent unit-variance ones; the covariance is then (Jw^T Jw)^-1 and
+  /// summary.chi2_per_dof the whitened one.
+  std::shared_ptr<const ResidualWhitener> whitener;
 };
 
 struct RtestJointIdentification {
@@ -112,6 +133,7 @@ struct RtestJointIdentification {
   int iterations = 0;
   std::vector<std::string> unobservable;  ///< combinations the nests cannot see, in words
   std::vector<std::string> notes;
+  FitSummary summary;  ///< solver figures; whitened chi2/dof with a whitener
 
   const ParameterEstimate& parameter(const std::string& name) const;
 };

@@ -11,8 +11,9 @@
 #include <optional>
 #include <vector>
 
+#include "rotacal/core/machine_model.hpp"
 #include "rotacal/io/session.hpp"
-#include "rotacal/kinematics/effects.hpp"
+#include "rotacal/rtest/model.hpp"
 
 namespace rotacal {
 
@@ -26,12 +27,11 @@ struct RtestPattern {
   double dwell_s = 6.0;  ///< time between readings, s
 };
 
-/// The machine the simulator measures.
-struct RtestTruth {
-  MachineType machine = MachineType::BC_trt;
-  LocationErrors<double> errors;
-  EffectModel effects;
-  std::vector<double> effect_params;  ///< effects.num_params() values
+/// The machine the simulator measures: a MachineModel whose default table is BC-trt (the
+/// R-test's), kept as a name for the callers that build one field by field.
+struct RtestTruth : MachineModel {
+  RtestTruth() { machine = MachineType::BC_trt; }
+  RtestTruth(const MachineModel& m) : MachineModel(m) {}  // NOLINT: a MachineModel is a truth
 };
 
 struct RtestSimOptions {
@@ -50,13 +50,9 @@ struct RtestSimulation {
   std::vector<Eigen::Vector3d> probe_zeros;  ///< per set-up (nest order), table frame, mm
 };
 
-/// Noise-free reading d (table frame, mm, no probe zero) of the nest at q_nest (table frame) at
-/// commanded angles (rad) and time t (s).
-Eigen::Vector3d rtest_reading(const RtestTruth& truth, const Eigen::Vector3d& q_nest,
-                              const RotaryAngles<double>& angles, double t);
-
-/// Simulate a whole session. Throws InvalidArgument for an empty pattern, negative noise or
-/// effect parameters that do not match the effect model.
-RtestSimulation simulate_rtest(const RtestTruth& truth, const RtestSimOptions& options = {});
+/// Simulate a whole session; each reading is rtest_reading (model.hpp). Throws
+/// InvalidArgument for an empty pattern, negative noise or effect parameters that do not
+/// match the effect model.
+RtestSimulation simulate_rtest(const MachineModel& truth, const RtestSimOptions& options = {});
 
 }  // namespace rotacal

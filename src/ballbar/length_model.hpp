@@ -1,0 +1,95 @@
+// The ballbar joint fit's residual model and set-up, shared by identify_joint and monte_carlo.
+#pragma once
+
+#include <type_traits>
+
+#include "rotacal/ballbar/identify.hpp"
+#include "rotacal/core/joint_fit.hpp"
+
+namespace rotacal {
+
+// r_i = L_model,i - L_i (mm). Parameters: 8 location errors, pivot (3), effect parameters.
+class BallbarLengthModel : public ResidualModel {
+ public:
+  BallbarLengthModel(const BallbarArrays& d, const EffectModel& fx)
+      : d_(d), fx_(fx), P_(fx.num_params()) {}
+  Eigen::Index num_residuals() const override { return d_.size(); }
+  int num_parameters() const override { return 11 + P_; }
+  void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r,
+                Eigen::MatrixXd* J) const override {
+    evaluate_with_jets([this](Eigen::Index i, const auto* p, auto* out) { sample(i, p, out); },
+                       d_.size(), 1, x, r, J);
+  }
+  bool evaluate_subset(const Eigen::VectorXd& x, Eigen::Index stride, Eigen::VectorXd& r,
+                       Eigen::MatrixXd* J) const override {
+    const Eigen::Index m = (d_.size() + stride - 1) / stride;
+    r.resize(m);
+    if (J) J->resize(m, num_parameters());
+    evaluate_with_jets(
+        [this, stride](Eigen::Index i, const auto* p, auto* out) { sample(i * stride, p, out); }, m, 1,
+        x, r, J);
+    return true;
+  }
+
+ private:
+  // L_model - L_measured of sample i, on double or Jets.
+  template <typename T>
+  void sample(Eigen::Index i, const T* p, T* out) const {
+    const Vec3<T> pivot(p[8], p[9], p[10]);
+    const Eigen::Vector3d xyz = d_.xyz.col(i);
+    out[0] = predicted_length<T>(d_.machine, LocationErrors<T>::from_ptr(p), pivot, fx_,
+                                 P_ > 0 ? p + 11 : nullptr, xyz, d_.angles[static_cast<std::size_t>(i)],
+                                 d_.time[i]) -
+             T(d_.length[i]);
+  }
+
+  const BallbarArrays& d_;
+  const EffectModel& fx_;
+  int P_;
+};
+
+
+/// The unknowns (names, units, start values), effects and solver settings of a ballbar joint
+/// fit. Throws InvalidArgument for an effect that does not exist on the machine or fewer
+/// samples than unknowns.
+struct BallbarFitSetup {
+  EffectModel effects;
+  std::vector<FitParameter> parameters;
+  JointFitSettings settings;
+};
+
+inline BallbarFitSetup ballbar_fit_setup(const BallbarArrays& data, const JointFitOptions& options) {
+  BallbarFitSetup out;
+  EffectModel& fx = out.effects;
+  fx = options.effects;
+  if (options.fit_length_offset)
+    fx.effects.insert(fx.effects.begin(), Effect::parse("ballbar_length_offset"));
+  for (const Effect& f : fx.effects)
+    if (!f.applies_to(data.machine))
+      throw InvalidArgument("effect " + f.id() + " does not exist on a " + to_string(data.machine));
+  const int n_par = 8 + 3 + fx.num_params();
+  if (static_cast<int>(data.size()) < n_par)
+    throw InvalidArgument("identify_joint: " + std::to_string(data.size()) +
+                          " samples cannot determine " + std::to_string(n_par) + " unknowns");
+  // Names, units and start values of the unknowns, in Jacobian column order: zero errors and
+  // the nominal pivot.
+  std::vector<FitParameter>& params = out.parameters;
+  for (int k = 0; k < 8; ++k)
+    params.push_back({location_error_names(data.machine)[static_cast<std::size_t>(k)],
+                      location_error_is_angle(k) ? "rad" : "mm", 0.0});
+  const char* pivot_names[3] = {"pivot_x", "pivot_y", "pivot_z"};
+  for (int k = 0; k < 3; ++k) params.push_back({pivot_names[k], "mm", data.pivot[k]});
+  for (const Effect& f : fx.effects) {
+    const auto pn = f.param_names(), pu = f.param_units();
+    for (std::size_t k = 0; k < pn.size(); ++k)
+      params.push_back({f.id() + (pn.size() > 1 ? "." + pn[k] : ""), pu[k], 0.0});
+  }
+  out.settings.max_iterations = options.max_iterations;
+  out.settings.observability_min_chi2 = options.observability_min_chi2;
+  // sigma scales chi-square (observability); the covariance uses the residual variance.
+  out.settings.sigma = data.noise_um.value_or(1.0) * 1e-3;
+  out.settings.whitener = options.whitener;
+  return out;
+}
+
+}  // namespace rotacal
