@@ -222,6 +222,11 @@ json parse_json(const std::string& text, const std::string& source) {
     if (colon != std::string::npos) what = what.substr(colon);
     if (what.size() > 160) what = what.substr(0, 157) + "...";
     throw ParseError(source, lc.first, lc.second, "not valid JSON: " + what);
+  } catch (const json::exception& e) {
+    // e.g. out_of_range 406, a number beyond double ("1e99999"): found by fuzz_file_readers.
+    std::string what = e.what();
+    if (what.size() > 160) what = what.substr(0, 157) + "...";
+    throw ParseError(source, 0, 0, "not valid JSON: " + what);
   }
 }
 
