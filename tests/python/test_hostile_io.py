@@ -108,3 +108,27 @@ def test_cli_exit_codes(tmp_path, args, code, words):
     assert r.returncode == code, r.stderr[-500:]
     assert words in r.stderr
     assert "Traceback" not in r.stderr
+
+
+def test_plausibility_names_the_cause(shared_data):
+    """The check the entry points run before fitting (rotacal/io/plausibility.hpp)."""
+    import numpy as np
+    s = rotacal.load(shared_data / "ballbar_ac_table2.csv")
+    assert _core.check_plausible(s, "s.csv").max_deviation_mm < 0.5
+    rad = s.__class__(s.machine, s.ballbar_length, s.pivot, s.tests, s.time, s.xyz,
+                      np.radians(s.angles_deg), s.length)
+    with pytest.raises(rotacal.InvalidArgument, match="angles look like radians"):
+        _core.check_plausible(rad, "s.csv")
+    still = s.__class__(s.machine, s.ballbar_length, s.pivot, s.tests, s.time, s.xyz,
+                        np.zeros_like(s.angles_deg), s.length)
+    with pytest.raises(rotacal.InvalidArgument, match="all rotary angles equal: the axes never move"):
+        _core.check_plausible(still, "s.csv")
+    l150 = s.__class__(s.machine, 150.0, s.pivot, s.tests, s.time, s.xyz, s.angles_deg, s.length)
+    with pytest.raises(rotacal.InvalidArgument, match="ballbar_length 150 but the data say ~100"):
+        _core.check_plausible(l150, "s.csv")
+    o = _core.PlausibilityOptions()
+    o.max_length_deviation_mm = 0.01
+    with pytest.raises(rotacal.InvalidArgument, match="max_length_deviation_mm"):
+        _core.check_plausible(s, "s.csv", o)
+    with pytest.raises(rotacal.InvalidArgument, match="session machine BC-trt, model AC-trt"):
+        _core.check_model_machine(_core.parse_machine_type("AC-trt"), _core.parse_machine_type("BC-trt"), "m.json")
