@@ -40,13 +40,19 @@ Raises rotacal.DegenerateGeometry for < 3, collinear points or a too short arc.)
   m.def(
       "hyper_circle_fit",
       [](const pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>& points, double sigma, bool refine) {
-        return hyper_circle_fit(rows_of<2>(points, "points"), {sigma, refine});
+        CircleFitOptions o;
+        o.sigma = sigma;
+        o.refine = refine;
+        return hyper_circle_fit(rows_of<2>(points, "points"), o);
       },
       pyb::arg("points"), pyb::arg("sigma") = 0.0, pyb::arg("refine") = false, circle_doc);
   m.def(
       "kasa_circle_fit",
       [](const pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>& points, double sigma, bool refine) {
-        return kasa_circle_fit(rows_of<2>(points, "points"), {sigma, refine});
+        CircleFitOptions o;
+        o.sigma = sigma;
+        o.refine = refine;
+        return kasa_circle_fit(rows_of<2>(points, "points"), o);
       },
       pyb::arg("points"), pyb::arg("sigma") = 0.0, pyb::arg("refine") = false, circle_doc);
   m.def(

@@ -3,6 +3,7 @@
 #include "rotacal/io/ballbar_file.hpp"
 #include "rotacal/io/model_file.hpp"
 #include "rotacal/io/output_file.hpp"
+#include "rotacal/io/plausibility.hpp"
 #include "rotacal/io/session_arrays.hpp"
 
 namespace rotacal::py {
@@ -167,6 +168,30 @@ void bind_io(pyb::module_& m) {
       "ballbar_model_document",
       [](const BallbarMachineModel& model) { return from_json(ballbar_model_document(model)); },
       pyb::arg("model"));
+
+  // Plausibility before fitting (rotacal/io/plausibility.hpp).
+  pyb::class_<PlausibilityOptions>(m, "PlausibilityOptions", "Limits of the plausibility checks (mm, deg).")
+      .def(pyb::init<>())
+      .def_readwrite("max_length_deviation_mm", &PlausibilityOptions::max_length_deviation_mm)
+      .def_readwrite("max_position_deviation_mm", &PlausibilityOptions::max_position_deviation_mm)
+      .def_readwrite("max_displacement_mm", &PlausibilityOptions::max_displacement_mm)
+      .def_readwrite("min_ballbar_length_mm", &PlausibilityOptions::min_ballbar_length_mm)
+      .def_readwrite("min_rotary_span_deg", &PlausibilityOptions::min_rotary_span_deg);
+  pyb::class_<PlausibilityReport>(m, "PlausibilityReport")
+      .def_readonly("median_deviation_mm", &PlausibilityReport::median_deviation_mm)
+      .def_readonly("max_deviation_mm", &PlausibilityReport::max_deviation_mm)
+      .def_readonly("worst_sample", &PlausibilityReport::worst_sample)
+      .def_readonly("tilt_span_deg", &PlausibilityReport::tilt_span_deg)
+      .def_readonly("rot_span_deg", &PlausibilityReport::rot_span_deg);
+  m.def("check_plausible",
+        pyb::overload_cast<const BallbarSession&, const std::string&, const PlausibilityOptions&>(&check_plausible),
+        pyb::arg("session"), pyb::arg("source"), pyb::arg("options") = PlausibilityOptions{},
+        "Refuse (InvalidArgument, likely cause named) a session the nominal kinematics cannot explain.");
+  m.def("check_plausible",
+        pyb::overload_cast<const RtestSession&, const std::string&, const PlausibilityOptions&>(&check_plausible),
+        pyb::arg("session"), pyb::arg("source"), pyb::arg("options") = PlausibilityOptions{});
+  m.def("check_model_machine", &check_model_machine, pyb::arg("model_machine"), pyb::arg("session_machine"),
+        pyb::arg("model_source"));
 
   // The output rule (rotacal/io/output_file.hpp). The GIL is released: a FIFO blocks until read.
   m.def(

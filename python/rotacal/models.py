@@ -9,7 +9,10 @@ can predict sessions it was not fitted on (``rotacal predict``) or compensate NC
      "effects": [{"id": "gravity_sag_A", "params": {"s": {"value": ..., "std": ..., "unit": "mm"}}}]}
 
 Unobservable parameters are written with ``"value": null`` and are taken as zero (nominal)
-when the model is used.
+when the model is used. Reading and writing go through the C++ implementation
+(``rotacal/io/model_file.hpp``; the format field by field: docs/model_file.md), so both
+languages read and write the same files: strict JSON (a non-finite number is written null,
+its reason under ``"null_reasons"``), versioned (a newer major version is refused by name).
 """
 from __future__ import annotations
 

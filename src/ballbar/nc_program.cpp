@@ -113,6 +113,15 @@ class Writer {
     return "F" + fixed(60.0 / dt_s, 4);  // G93: reciprocal of the block time in minutes
   }
 
+  // A block needs a positive duration (G93 feed = 1 / time); a hand-made or absurd plan whose
+  // successive samples share a time is refused rather than written with an infinite feed.
+  static void require_positive_time(double dt, double t) {
+    if (!(dt > 0.0) || !std::isfinite(dt))
+      throw InvalidArgument("write_nc_program: the move ending at t = " + std::to_string(t) +
+                            " s takes no time (samples coincide in time: a plan with coordinates too "
+                            "large or steps too small for the feeds)");
+  }
+
   const PlannedSample* first_sample() const {
     for (const PlanSegment& s : plan_.segments)
       if (!s.samples.empty()) return &s.samples.front();
@@ -144,7 +153,7 @@ class Writer {
   }
 
   void linear_block(const PlannedSample& s, double dt) {
-    ROTACAL_ASSERT(dt > 0.0);
+    require_positive_time(dt, s.time);
     const std::string words = axes_words(coords(s), s.tilt_deg, s.rot_deg);
     if (d_ == NcDialect::heidenhain)
       line("L " + words + " R0 " + feed_word(dt));
@@ -166,7 +175,7 @@ class Writer {
     ROTACAL_ASSERT((cur.xyz - a.start).norm() < kSamePose && cur.tilt == 0.0 && cur.rot == 0.0);
     const Eigen::Vector3d& e = a.end;
     const double dt = t_end - cur.time;
-    ROTACAL_ASSERT(dt > 0.0);
+    require_positive_time(dt, t_end);
     if (d_ == NcDialect::heidenhain) {
       line("CC " + std::string(1, names[lo]) + num(a.center[lo]) + " " + names[hi] +
            num(a.center[hi]));
@@ -388,6 +397,14 @@ NcDialect parse_nc_dialect(const std::string& text) {
 
 std::string write_nc_program(const BallbarPlan& plan, NcDialect dialect,
                              const NcProgramOptions& options) {
+  // A plan may be built by hand: every coordinate must be one a machine can be sent to.
+  for (const PlanSegment& seg : plan.segments)
+    for (const PlannedSample& s : seg.samples)
+      if (!s.xyz.allFinite() || s.xyz.cwiseAbs().maxCoeff() > 1.0e5 || !std::isfinite(s.tilt_deg) ||
+          !std::isfinite(s.rot_deg) || std::abs(s.rot_deg) > 1.0e6 || std::abs(s.tilt_deg) > 360.0 ||
+          !std::isfinite(s.time))
+        throw InvalidArgument("write_nc_program: a sample of " + seg.label + " at t = " + std::to_string(s.time) +
+                              " s has coordinates no machine can be sent to");
   return Writer(plan, dialect, options).run();
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "rotacal/core/error.hpp"
 
@@ -20,6 +21,12 @@ constexpr double kMaxSamplesPerSweep = 1e6;
 
 void require(bool ok, const std::string& what) {
   if (!ok) throw InvalidArgument("plan_ballbar_test: " + what);
+}
+
+std::string format_number_or_nan(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
 }
 
 bool finite3(const Eigen::Vector3d& v) { return v.allFinite(); }
@@ -51,23 +58,32 @@ void check_range(const std::array<double, 2>& r, const char* name, double step) 
   require(r[1] - r[0] <= 360.0 + kAngleTol,
           n + " spans " + std::to_string(r[1] - r[0]) + " deg, more than a full turn");
   require((r[1] - r[0]) / step <= kMaxSamplesPerSweep,
-          n + " / step_deg gives more than 1e6 samples per sweep");
+          n + " / step_deg (--step) gives more than 1e6 samples per sweep");
 }
 
+// Limits of a set-up that a machine tool can run; each message names the field and the
+// command-line option that sets it.
+constexpr double kMaxBallbarLength = 2000.0;  // mm: the longest ballbars are ~600 mm
+constexpr double kMaxPivot = 1.0e4;           // mm from the table origin
+constexpr double kMaxFeed = 1.0e6;            // mm/min and deg/min
+// Longest program accepted: a single set-up test runs for minutes to a few hours.
+constexpr double kMaxProgramSeconds = 24.0 * 3600.0;
+
 void validate(const BallbarSetup& s) {
-  require(std::isfinite(s.ballbar_length) && s.ballbar_length > 0.0,
-          "ballbar_length must be a positive finite length in mm");
-  require(finite3(s.pivot), "pivot must be finite");
+  require(std::isfinite(s.ballbar_length) && s.ballbar_length >= 1.0 && s.ballbar_length <= kMaxBallbarLength,
+          "ballbar_length (--length) must be within [1, 2000] mm, got " + format_number_or_nan(s.ballbar_length));
+  require(finite3(s.pivot) && s.pivot.cwiseAbs().maxCoeff() <= kMaxPivot,
+          "pivot (--pivot) must be finite and within 10000 mm of the table origin");
   require(std::isfinite(s.step_deg) && s.step_deg > 0.0 && s.step_deg <= 90.0,
-          "step_deg must be in (0, 90] deg");
-  require(std::isfinite(s.feed_mm_per_min) && s.feed_mm_per_min > 0.0,
-          "feed_mm_per_min must be positive and finite");
-  require(std::isfinite(s.feed_deg_per_min) && s.feed_deg_per_min > 0.0,
-          "feed_deg_per_min must be positive and finite");
-  check_range(s.tilt_range_deg, "tilt_range_deg", s.step_deg);
+          "step_deg (--step) must be in (0, 90] deg");
+  require(std::isfinite(s.feed_mm_per_min) && s.feed_mm_per_min > 0.0 && s.feed_mm_per_min <= kMaxFeed,
+          "feed_mm_per_min (--feed) must be in (0, 1e6] mm/min");
+  require(std::isfinite(s.feed_deg_per_min) && s.feed_deg_per_min > 0.0 && s.feed_deg_per_min <= kMaxFeed,
+          "feed_deg_per_min (--rotary-feed) must be in (0, 1e6] deg/min");
+  check_range(s.tilt_range_deg, "tilt_range_deg (--a-range/--b-range)", s.step_deg);
   require(s.tilt_range_deg[0] >= -180.0 && s.tilt_range_deg[1] <= 180.0,
-          "tilt_range_deg must lie within [-180, 180] deg");
-  check_range(s.rot_range_deg, "rot_range_deg", s.step_deg);
+          "tilt_range_deg (--a-range/--b-range) must lie within [-180, 180] deg");
+  check_range(s.rot_range_deg, "rot_range_deg (--c-range)", s.step_deg);
   require(!s.tests.empty(), "tests is empty");
   for (std::size_t i = 0; i < s.tests.size(); ++i)
     for (std::size_t j = 0; j < i; ++j)
@@ -387,6 +403,9 @@ BallbarPlan plan_ballbar_test(const BallbarSetup& setup,
       prev = &s;
     }
   }
+  require(plan.duration() <= kMaxProgramSeconds,
+          "the program would run " + format_number_or_nan(plan.duration() / 3600.0) +
+              " h (more than 24 h): check --length, --step and the feeds");
   return plan;
 }
 

@@ -13,17 +13,30 @@ namespace rotacal {
 
 namespace {
 
-void check_points(const Eigen::Ref<const Points2>& p, const char* who) {
-  if (!p.allFinite()) throw InvalidArgument(std::string(who) + ": points contain NaN or infinity");
+std::string with_context(const CircleFitOptions& o, const char* fit) {
+  return o.context.empty() ? std::string(fit) : o.context + ": " + fit;
+}
+
+Eigen::Index non_finite_row(const Eigen::Ref<const Points2>& p) {
+  for (Eigen::Index i = 0; i < p.rows(); ++i)
+    if (!p.row(i).allFinite()) return i;
+  return -1;
+}
+
+void check_points(const Eigen::Ref<const Points2>& p, const std::string& who) {
+  if (!p.allFinite())
+    throw InvalidArgument(who + ": point " + std::to_string(non_finite_row(p)) + " of " + std::to_string(p.rows()) +
+                          " contains NaN or infinity");
   if (p.rows() < 3)
-    throw DegenerateGeometry(std::string(who) + ": " + std::to_string(p.rows()) +
+    throw DegenerateGeometry(who + ": " + std::to_string(p.rows()) +
                              " points cannot determine a circle (need 3 or more)");
   const Eigen::RowVector2d mean = p.colwise().mean();
   const Eigen::MatrixXd c = p.rowwise() - mean;
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(c);
   const auto s = svd.singularValues();
   if (!(s[1] > 1e-9 * s[0]))
-    throw DegenerateGeometry(std::string(who) + ": the points are collinear; no circle passes through them");
+    throw DegenerateGeometry(who + ": the " + std::to_string(p.rows()) +
+                             " points are collinear (did the axis move?); no circle passes through them");
 }
 
 // r = |p - c| - R for one point (Ceres examples/circle_fit.cc shape, without its
@@ -44,7 +57,7 @@ struct CircleDistance {
 
 // Orthogonal residuals, covariance from their Jacobian, and the short-arc check.
 CircleFit finish(const Eigen::Ref<const Points2>& p, Eigen::Vector2d centre, double radius,
-                 const CircleFitOptions& o, const char* who) {
+                 const CircleFitOptions& o, const std::string& who) {
   if (o.refine) {
     ceres::Problem problem;
     for (Eigen::Index i = 0; i < p.rows(); ++i)
@@ -81,7 +94,7 @@ CircleFit finish(const Eigen::Ref<const Points2>& p, Eigen::Vector2d centre, dou
   const double sagitta = radius * (1.0 - std::cos(std::min(span, M_PI) / 2.0));
   const double scatter = p.rows() > 3 ? std::sqrt(ss / static_cast<double>(p.rows() - 3)) : 0.0;
   if (sagitta < o.min_sagitta_ratio * scatter)
-    throw DegenerateGeometry(std::string(who) + ": the arc is too short to fit: its sagitta " +
+    throw DegenerateGeometry(who + ": the arc is too short to fit: its sagitta " +
                              std::to_string(sagitta) + " is below " + std::to_string(o.min_sagitta_ratio) +
                              " x the scatter " + std::to_string(scatter));
   const double s2 = o.sigma > 0 ? o.sigma * o.sigma : (p.rows() > 3 ? ss / static_cast<double>(p.rows() - 3) : 0.0);
@@ -92,7 +105,8 @@ CircleFit finish(const Eigen::Ref<const Points2>& p, Eigen::Vector2d centre, dou
 }  // namespace
 
 CircleFit hyper_circle_fit(const Eigen::Ref<const Points2>& p, const CircleFitOptions& o) {
-  check_points(p, "hyper_circle_fit");
+  const std::string who = with_context(o, "hyper_circle_fit");
+  check_points(p, who);
   // Moments of the centred data (Al-Sharadqah & Chernov 2009; Chernov's reference "Hyper"
   // algorithm, solved by Newton's method on the characteristic polynomial).
   const Eigen::RowVector2d mean = p.colwise().mean();
@@ -120,12 +134,13 @@ CircleFit hyper_circle_fit(const Eigen::Ref<const Points2>& p, const CircleFitOp
   const double cx = (Mxz * (Myy - x) - Myz * Mxy) / det / 2.0;
   const double cy = (Myz * (Mxx - x) - Mxz * Mxy) / det / 2.0;
   const double r = std::sqrt(cx * cx + cy * cy + Mz - 2 * x);
-  if (!std::isfinite(r)) throw DegenerateGeometry("hyper_circle_fit: no circle fits these points");
-  return finish(p, Eigen::Vector2d(cx + mean.x(), cy + mean.y()), r, o, "hyper_circle_fit");
+  if (!std::isfinite(r)) throw DegenerateGeometry(who + ": no circle fits these " + std::to_string(p.rows()) + " points");
+  return finish(p, Eigen::Vector2d(cx + mean.x(), cy + mean.y()), r, o, who);
 }
 
 CircleFit kasa_circle_fit(const Eigen::Ref<const Points2>& p, const CircleFitOptions& o) {
-  check_points(p, "kasa_circle_fit");
+  const std::string who = with_context(o, "kasa_circle_fit");
+  check_points(p, who);
   const Eigen::RowVector2d mean = p.colwise().mean();
   Eigen::MatrixXd A(p.rows(), 3);
   Eigen::VectorXd b(p.rows());
@@ -137,8 +152,8 @@ CircleFit kasa_circle_fit(const Eigen::Ref<const Points2>& p, const CircleFitOpt
   const Eigen::Vector3d s = A.colPivHouseholderQr().solve(b);  // x^2+y^2 + D x + E y + F = 0
   const Eigen::Vector2d c(-s[0] / 2, -s[1] / 2);
   const double r = std::sqrt(c.squaredNorm() - s[2]);
-  if (!std::isfinite(r)) throw DegenerateGeometry("kasa_circle_fit: no circle fits these points");
-  return finish(p, c + mean.transpose(), r, o, "kasa_circle_fit");
+  if (!std::isfinite(r)) throw DegenerateGeometry(who + ": no circle fits these " + std::to_string(p.rows()) + " points");
+  return finish(p, c + mean.transpose(), r, o, who);
 }
 
 }  // namespace rotacal

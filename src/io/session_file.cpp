@@ -8,6 +8,7 @@
 #include <cstring>
 #include <fstream>
 #include <set>
+#include <string_view>
 #include <unordered_map>
 #include <sstream>
 
@@ -198,6 +199,16 @@ class LineSource {
     if (line_no_ == 1 && line.compare(0, 3, "\xEF\xBB\xBF") == 0)
       throw ParseError(name_, 1, 1, "the file starts with a UTF-8 byte-order mark (bytes EF BB BF); "
                                     "session files are UTF-8 without one: save it without the BOM");
+    // Fast path: plain printable ASCII needs no further look.
+    bool plain = true;
+    for (const char ch : line) {
+      const unsigned char c = static_cast<unsigned char>(ch);
+      if (c < 0x20 || c >= 0x7F) {
+        plain = false;
+        break;
+      }
+    }
+    if (plain) return true;
     for (std::size_t i = 0; i < line.size();) {
       const unsigned char c = static_cast<unsigned char>(line[i]);
       if (c == '\r')
@@ -361,15 +372,22 @@ std::vector<Field> row_fields(Reader& R, const std::pair<int, std::string>& row)
 // Rows that repeat an earlier row exactly (same label, time and values: a recorder or a
 // copy-paste wrote them twice). They are kept, as the file says, but reported: a fit would
 // otherwise count one measurement twice and shrink its sigma by sqrt(2) without a word.
+// Time never decreases in a valid file, so an exact repeat has the time of the rows just
+// before it: only rows of the current time are kept (views into the RawFile's rows, which
+// outlive this and are not modified), which keeps the check O(n) and cache-friendly.
 struct DuplicateRows {
-  std::unordered_map<std::string, int> first_line;
+  std::unordered_map<std::string_view, int> first_line;
+  double current_time = std::nan("");
   std::size_t count = 0;
   int example_line = 0, example_of = 0;
 
-  void add(const std::pair<int, std::string>& row, int line) {
-    std::string key;
-    for (const Field& f : split_fields(row.second)) key += f.text + ",";
-    const auto ins = first_line.emplace(std::move(key), line);
+  void add(const std::pair<int, std::string>& row, int line, double time) {
+    if (!(time == current_time)) {
+      if (first_line.bucket_count() > 1024) first_line = {};  // one large group: do not clear it again and again
+      first_line.clear();
+      current_time = time;
+    }
+    const auto ins = first_line.emplace(std::string_view(row.second), line);
     if (!ins.second && count++ == 0) example_line = line, example_of = ins.first->second;
   }
   void report(std::vector<std::string>& warnings) const {
@@ -563,7 +581,7 @@ BallbarSession parse_ballbar(std::istream& in, const std::string& name) {
     b.length = R.number(fl, "length");
     if (!(b.length > 0.0)) R.fail(R.line_no, fl.column, "length must be > 0");
     b.length = R.bounded(fl, "length", kMinLengthMm, kMaxLengthMm, "mm");
-    dups.add(row, R.line_no);
+    dups.add(row, R.line_no, b.time);
     for (int i : extra_idx) b.extra.push_back(f[static_cast<std::size_t>(i)].text);
     s.samples.push_back(std::move(b));
   }
@@ -686,7 +704,7 @@ RtestSession parse_rtest(std::istream& in, const std::string& name) {
     r.xyz = {pos(c_x, "X"), pos(c_y, "Y"), pos(c_z, "Z")};
     if (n_d == 3) r.d = Eigen::Vector3d(disp(c_dx, "dx"), disp(c_dy, "dy"), disp(c_dz, "dz"));
     if (n_raw == 3) r.raw = Eigen::Vector3d(disp(c_d1, "d1"), disp(c_d2, "d2"), disp(c_d3, "d3"));
-    dups.add(row, R.line_no);
+    dups.add(row, R.line_no, r.time);
     for (int i : extra_idx) r.extra.push_back(F(i).text);
     s.samples.push_back(std::move(r));
   }

@@ -186,8 +186,8 @@ RtestSession displacements_from_raw(const RtestSession& session, const Eigen::Ma
     RtestSample& s = out.samples[i];
     if (s.d) continue;
     if (!s.raw)
-      throw InvalidArgument("displacements_from_raw: sample " + std::to_string(i) +
-                            " has neither dx,dy,dz nor d1,d2,d3");
+      throw InvalidArgument("displacements_from_raw: pose " + std::to_string(i) + " (setup " + s.setup +
+                            ", time " + std::to_string(s.time) + " s) has neither dx,dy,dz nor d1,d2,d3");
     s.d = dirs.fullPivLu().solve(*s.raw);
   }
   return out;
@@ -201,8 +201,9 @@ RtestSession displacements_from_raw(const RtestSession& session) {
   for (int k = 1; k <= 3; ++k) {
     const auto it = session.probe_dirs.find(k);
     if (it == session.probe_dirs.end())
-      throw InvalidArgument("displacements_from_raw: session.probe_dirs: probe." +
-                            std::to_string(k) + ".dir is missing");
+      throw InvalidArgument("displacements_from_raw: the session has raw readings d1,d2,d3 but no probe." +
+                            std::to_string(k) + ".dir (the file needs a '# probe." + std::to_string(k) +
+                            ".dir: x, y, z' metadata line, or convert with calibrated directions)");
     dirs.row(k - 1) = it->second.transpose();
   }
   return displacements_from_raw(session, dirs);

@@ -259,3 +259,14 @@ TEST_CASE("options and dialect names", "[ballbar][nc]") {
   CHECK(to_string(NcDialect::heidenhain) == "heidenhain");
   CHECK_THROWS_WITH(parse_nc_dialect("mazak"), Catch::Contains("mazak"));
 }
+
+TEST_CASE("a hand-made plan with coordinates no machine has, or moves without time, is refused",
+          "[ballbar][nc]") {
+  BallbarPlan plan = plan_ballbar_test(BallbarSetup{});
+  BallbarPlan far = plan;
+  far.segments[0].samples[1].xyz.x() = 1e300;
+  CHECK_THROWS_WITH(write_nc_program(far, NcDialect::linuxcnc), Catch::Contains("no machine can be sent to"));
+  BallbarPlan still = plan;
+  still.segments[0].samples[1].time = still.segments[0].samples[0].time;
+  CHECK_THROWS_WITH(write_nc_program(still, NcDialect::linuxcnc), Catch::Contains("takes no time"));
+}

@@ -343,6 +343,27 @@ TEST_CASE("bad setups are refused with the option named", "[ballbar][plan]") {
   LocationErrors<double> bad;
   bad.v[3] = std::nan("");
   CHECK_THROWS_AS(plan_ballbar_test(BallbarSetup{}, bad), InvalidArgument);
+  // Huge finite values (issue 17 item 10: an internal error in the NC writer before): refused
+  // with the command-line option named.
+  s = {};
+  s.ballbar_length = 1e300;
+  CHECK(refused(s, "--length"));
+  s = {};
+  s.ballbar_length = 1e9;  // a 72-year program at the default feeds
+  CHECK(refused(s, "--length"));
+  s = {};
+  s.pivot = Eigen::Vector3d(1e300, 0.0, 60.0);
+  CHECK(refused(s, "--pivot"));
+  s = {};
+  s.step_deg = -1.0;
+  CHECK(refused(s, "--step"));
+  s = {};
+  s.feed_mm_per_min = 1e300;
+  CHECK(refused(s, "--feed"));
+  // A program longer than a day (slow feeds) is refused, naming the cause.
+  s = {};
+  s.feed_deg_per_min = 1e-3;
+  CHECK(refused(s, "more than 24 h"));
 }
 
 TEST_CASE("test labels parse per machine", "[ballbar][plan]") {

@@ -85,6 +85,12 @@ TEST_CASE("degenerate input is refused with a clear error", "[fit]") {
   Points2 nan = arc(0, 0, 10, 0, 3, 10, 0.0, rng);
   nan(3, 1) = std::numeric_limits<double>::quiet_NaN();
   CHECK_THROWS_AS(hyper_circle_fit(nan), InvalidArgument);
+  CHECK_THROWS_WITH(hyper_circle_fit(nan), Catch::Contains("point 3 of 10"));
+  // The caller's context names the data in every message.
+  CircleFitOptions o;
+  o.context = "s.csv: test radial_C";
+  CHECK_THROWS_WITH(hyper_circle_fit(line, o), Catch::StartsWith("s.csv: test radial_C: hyper_circle_fit: the 5 points"));
+  CHECK_THROWS_WITH(kasa_circle_fit(two, o), Catch::StartsWith("s.csv: test radial_C: kasa_circle_fit: 2 points"));
 }
 
 TEST_CASE("geometric refinement lowers the orthogonal residual", "[fit]") {

@@ -1,4 +1,5 @@
 #include <catch2/catch.hpp>
+#include <limits>
 
 #include <random>
 
@@ -44,4 +45,9 @@ TEST_CASE("plane fit: sign from the hint, degenerate input refused", "[fit]") {
   CHECK_THROWS_WITH(svd_plane_fit(line), Catch::Contains("collinear"));
   CHECK_THROWS_AS(svd_plane_fit(p.topRows(2)), DegenerateGeometry);
   CHECK_THROWS_AS(svd_plane_fit(p, Eigen::Vector3d::Zero()), InvalidArgument);
+  CHECK_THROWS_WITH(svd_plane_fit(line, Eigen::Vector3d::UnitZ(), 0.0, "s.csv: test axial_C"),
+                    Catch::StartsWith("s.csv: test axial_C: svd_plane_fit: the 4 points are collinear"));
+  Points3 nan = p;
+  nan(2, 0) = std::numeric_limits<double>::infinity();
+  CHECK_THROWS_WITH(svd_plane_fit(nan), Catch::Contains("point 2 of 4"));
 }

@@ -126,6 +126,8 @@ TEST_CASE("syntax errors, NaN tokens and unreadable paths are refused with file,
     CHECK(e.column() >= 8);
   }
   CHECK_THROWS_AS(parse_model("{\"a\": 1,}", "m.json"), ParseError);
+  // A number beyond double (nlohmann's out_of_range, not a parse_error: found by the fuzzer).
+  CHECK_THROWS_AS(parse_model("{\"format\": -4.8984835417456983e37252275}", "m.json"), ParseError);
   CHECK_THROWS_WITH(read_model("/tmp"), Catch::Contains("directory"));
   CHECK_THROWS_AS(read_model("/tmp"), IoError);
   CHECK_THROWS_AS(read_model("/nonexistent/m.json"), IoError);

@@ -96,6 +96,7 @@ TEST_CASE("sessions with raw readings are converted with probe.N.dir") {
   RtestSession missing = session;
   missing.probe_dirs.erase(2);
   CHECK_THROWS_AS(displacements_from_raw(missing), InvalidArgument);
+  CHECK_THROWS_WITH(displacements_from_raw(missing), Catch::Contains("'# probe.2.dir: x, y, z'"));
 }
 
 TEST_CASE("sphere offset compensation removes R^T o from every displacement") {

@@ -5,6 +5,7 @@
 /// improves on, and a geometric (orthogonal distance) refinement with Ceres.
 
 #include <Eigen/Core>
+#include <string>
 
 namespace rotacal {
 
@@ -24,6 +25,9 @@ struct CircleFitOptions {
   double sigma = 0.0;       ///< known 1-sigma noise of the points (same units); 0: estimate
   bool refine = false;      ///< polish the algebraic solution by orthogonal distances (Ceres)
   double min_sagitta_ratio = 3.0;  ///< refuse arcs whose sagitta is below this x the scatter
+  /// What the points are, put before every error message (e.g. "s.csv: test radial_A"), so a
+  /// refusal names the data rather than only the fit.
+  std::string context;
 };
 
 /// Hyper fit (Al-Sharadqah & Chernov 2009, Sec. 7): the algebraic fit whose essential bias

@@ -5,6 +5,7 @@
 /// through the centroid (Eq. 4).
 
 #include <Eigen/Core>
+#include <string>
 
 #include "rotacal/fit/sphere.hpp"
 
@@ -23,7 +24,9 @@ struct PlaneFit {
 
 /// Throws DegenerateGeometry for fewer than 3 points or (nearly) collinear points,
 /// InvalidArgument for non-finite input or a zero hint. `sigma` 0: estimated from residuals.
+/// `context` (e.g. "s.csv: test axial_C") is put before every error message.
 PlaneFit svd_plane_fit(const Eigen::Ref<const Points3>& points,
-                       const Eigen::Vector3d& normal_hint = Eigen::Vector3d::UnitZ(), double sigma = 0.0);
+                       const Eigen::Vector3d& normal_hint = Eigen::Vector3d::UnitZ(), double sigma = 0.0,
+                       const std::string& context = "");
 
 }  // namespace rotacal
