@@ -1,3 +1,4 @@
+// Pseudo-terminals for the virtual instruments (pseudo_terminal.hpp).
 #include "rotacal/hw/pseudo_terminal.hpp"
 
 #include <fcntl.h>

@@ -1,5 +1,7 @@
+// Recorders: one stream reader for the ballbar and the probe stream, the polled probe loop (recorder.hpp).
 #include "rotacal/hw/recorder.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -8,6 +10,7 @@
 #include <thread>
 
 #include "rotacal/hw/ballbar_protocol.hpp"
+#include "rotacal/hw/stream_protocol.hpp"
 #include "rotacal/io/ballbar_file.hpp"
 
 namespace rotacal::hw {
@@ -99,7 +102,7 @@ struct StreamGuard {
   ~StreamGuard() {
     if (!active) return;
     try {
-      port.write(format_command(BallbarCommand::stop), 200);
+      port.write(format_command(StreamCommand::stop), 200);
     } catch (const std::exception&) {
     }
   }
@@ -143,12 +146,12 @@ std::optional<std::pair<StopReason, std::string>> handshake(ByteTransport& port,
 // answer as it should; `guard` sends STOP later once START has gone out.
 bool start_stream(ByteTransport& port, FrameReader& reader, RecordSummary& sum, const RecordOptions& opt,
                   bool zero, StreamGuard& guard) {
-  auto fail = handshake(port, reader, sum, format_command(BallbarCommand::identify), "ID ", 1.0);
-  if (!fail && zero) fail = handshake(port, reader, sum, format_command(BallbarCommand::zero), "OK ZERO", 1.0);
-  if (!fail) fail = handshake(port, reader, sum, format_command(BallbarCommand::rate, opt.rate_hz), "OK RATE", 1.0);
+  auto fail = handshake(port, reader, sum, format_command(StreamCommand::identify), "ID ", 1.0);
+  if (!fail && zero) fail = handshake(port, reader, sum, format_command(StreamCommand::zero), "OK ZERO", 1.0);
+  if (!fail) fail = handshake(port, reader, sum, format_command(StreamCommand::rate, opt.rate_hz), "OK RATE", 1.0);
   if (!fail) {
     guard.active = true;
-    fail = handshake(port, reader, sum, format_command(BallbarCommand::start), "OK START", 1.0);
+    fail = handshake(port, reader, sum, format_command(StreamCommand::start), "OK START", 1.0);
   }
   if (!fail) return true;
   sum.reason = fail->first;
@@ -170,11 +173,114 @@ bool check_link(Writer& out, RecordSummary& sum, std::size_t new_crc, std::size_
   return true;
 }
 
-template <typename Writer>
-void finish(Writer& out, RecordSummary& sum) {
+// The progress callback, at most every progress_interval_s; false when it asks to stop.
+class ProgressGate {
+ public:
+  explicit ProgressGate(const RecordOptions& opt) : opt_(opt) {}
+  bool operator()(std::size_t rows, const RecordSummary& sum, double t, double duration) {
+    if (!opt_.progress) return true;
+    const double now = wall_seconds();
+    if (now - last_ < opt_.progress_interval_s) return true;
+    last_ = now;
+    return opt_.progress({rows, sum.lost, sum.crc_errors + sum.malformed, t, duration});
+  }
+
+ private:
+  const RecordOptions& opt_;
+  double last_ = 0.0;
+};
+
+bool over_range(const BallbarFrame& s) { return (s.status & kStatusOverRange) != 0; }
+bool over_range(const ProbeFrame& s) { return s.status != 0; }
+
+// The one stream reader of both recorders: ID?, [ZERO,] RATE, START; then sample frames until
+// END, silence, a dead link or a stop request, and STOP however it ends. Every valid sample
+// goes to use(t, sample) with its unwrapped instrument time; sequence gaps, checksum errors,
+// malformed frames, time going backwards and over-range readings are counted and marked in
+// the file. Returns true at END (the instrument ran its program to the end).
+template <typename Writer, typename Decode, typename Use>
+bool read_stream(ByteTransport& port, const RecordOptions& opt, bool zero, Writer& out, RecordSummary& sum,
+                 Decode decode, Use use, double duration) {
+  FrameReader reader;
+  StreamGuard guard{port};
+  try {
+    if (!start_stream(port, reader, sum, opt, zero, guard)) return false;
+    StreamPosition stream;
+    ProgressGate progress(opt);
+    double last_data = wall_seconds();
+    std::size_t garbage_since_data = 0;
+    std::uint8_t buf[4096];
+    for (;;) {
+      const std::size_t n = port.read(buf, sizeof buf, opt.read_timeout_ms);
+      const double now = wall_seconds();
+      if (n == 0) {
+        ++sum.timeouts;
+        if (now - last_data > opt.silence_timeout_s) {
+          sum.reason = StopReason::silence;
+          sum.detail = "nothing for " + fixed(opt.silence_timeout_s, 1) + " s";
+          return false;
+        }
+      } else {
+        last_data = now;
+      }
+      std::size_t new_crc = 0;
+      bool ended = false;
+      for (const Frame& f : reader.feed(buf, n, sum, garbage_since_data, new_crc)) {
+        if (const auto text = decode_text(f)) {
+          ended = ended || *text == "END";
+          continue;
+        }
+        const auto s = decode(f);
+        if (!s) {
+          ++sum.malformed;
+          out.annotate("malformed: frame of type " + std::to_string(f.type) + " and " +
+                       std::to_string(f.payload.size()) + " bytes near t=" + fixed(stream.last_t, 4) + " s");
+          continue;
+        }
+        ++sum.frames;
+        const auto t = stream.advance(s->seq, s->t_us, out, sum);
+        if (!t) continue;
+        if (over_range(*s)) {
+          ++sum.over_range;
+          out.annotate("over range: seq " + std::to_string(s->seq) + " at t=" + fixed(*t, 4) + " s");
+          continue;
+        }
+        use(*t, *s);
+      }
+      const bool link_lost = check_link(out, sum, new_crc, garbage_since_data, stream.last_t, opt);
+      if (ended) {
+        sum.reason = StopReason::end_of_program;
+        guard.active = false;
+        return true;
+      }
+      if (link_lost) return false;
+      if (!progress(out.rows(), sum, stream.last_t, duration)) {
+        sum.reason = StopReason::stopped;
+        return false;
+      }
+    }
+  } catch (const DeviceDisconnected&) {
+    guard.active = false;  // no STOP down a dead line
+    throw;
+  }
+}
+
+// Runs a recording into `out`: whatever stops it (the end, a stop request, an unplugged
+// device), the file is closed with its summary line and keeps every row written.
+template <typename Writer, typename Body>
+RecordSummary run_recording(ByteTransport& port, Writer& out, Body body) {
+  RecordSummary sum;
+  try {
+    port.flush_input();
+    body(sum);
+  } catch (const DeviceDisconnected& e) {
+    sum.reason = StopReason::disconnected;
+    sum.detail = e.what();
+  }
   sum.rows = out.rows();
   out.annotate("summary: " + sum.describe());
   out.close();
+  return sum;
 }
 
 }  // namespace
@@ -209,81 +315,16 @@ RecordSummary record_ballbar(ByteTransport& port, const ProgramTimeline& program
                      {"recorded_at", utc_now()},
                      {"sample_rate_hz", fixed(opt.rate_hz, 0)}};
   BallbarWriter out(path, header);
-  RecordSummary sum;
-  FrameReader reader;
-  StreamGuard guard{port};
-  const double L0 = program.header().ballbar_length;
-  try {
-    port.flush_input();
-    if (!start_stream(port, reader, sum, opt, opt.zero, guard)) {
-      finish(out, sum);
-      return sum;
-    }
-    StreamPosition stream;
-    double last_data = wall_seconds(), last_progress = 0.0;
-    std::size_t garbage_since_data = 0;
-    std::uint8_t buf[4096];
-    for (;;) {
-      const std::size_t n = port.read(buf, sizeof buf, opt.read_timeout_ms);
-      const double now = wall_seconds();
-      if (n == 0) {
-        ++sum.timeouts;
-        if (now - last_data > opt.silence_timeout_s) {
-          sum.reason = StopReason::silence;
-          sum.detail = "nothing for " + fixed(opt.silence_timeout_s, 1) + " s";
-          break;
-        }
-      } else {
-        last_data = now;
-      }
-      std::size_t new_crc = 0;
-      bool ended = false;
-      for (const Frame& f : reader.feed(buf, n, sum, garbage_since_data, new_crc)) {
-        if (const auto text = decode_text(f)) {
-          if (*text == "END") ended = true;
-          continue;
-        }
-        const auto s = decode_ballbar_sample(f);
-        if (!s) {
-          ++sum.malformed;
-          out.annotate("malformed: frame of type " + std::to_string(f.type) + " and " +
-                       std::to_string(f.payload.size()) + " bytes near t=" + fixed(stream.last_t, 4) + " s");
-          continue;
-        }
-        ++sum.frames;
-        const auto t = stream.advance(s->seq, s->t_us, out, sum);
-        if (!t) continue;
-        if (s->status & kStatusOverRange) {
-          ++sum.over_range;
-          out.annotate("over range: seq " + std::to_string(s->seq) + " at t=" + fixed(*t, 4) + " s");
-          continue;
-        }
-        BallbarSample row = program.at(*t);
-        row.length = L0 + 1e-6 * s->displacement_nm;
-        out.append(row);
-      }
-      const bool link_lost = check_link(out, sum, new_crc, garbage_since_data, stream.last_t, opt);
-      if (ended) {
-        sum.reason = StopReason::end_of_program;
-        guard.active = false;
-        break;
-      }
-      if (link_lost) break;
-      if (opt.progress && now - last_progress >= opt.progress_interval_s) {
-        last_progress = now;
-        if (!opt.progress({out.rows(), sum.lost, sum.crc_errors + sum.malformed, stream.last_t, program.duration()})) {
-          sum.reason = StopReason::stopped;
-          break;
-        }
-      }
-    }
-  } catch (const DeviceDisconnected& e) {
-    sum.reason = StopReason::disconnected;
-    sum.detail = e.what();
-    guard.active = false;
-  }
-  finish(out, sum);
-  return sum;
+  const double L0 = header.ballbar_length;
+  return run_recording(port, out, [&](RecordSummary& sum) {
+    read_stream(port, opt, opt.zero, out, sum, decode_ballbar_sample,
+                [&](double t, const BallbarFrame& s) {
+                  BallbarSample row = program.at(t);
+                  row.length = L0 + 1e-6 * s.displacement_nm;
+                  out.append(row);
+                },
+                program.duration());
+  });
 }
 
 // ---------------------------------------------------------------------------------- R-test
@@ -430,110 +471,51 @@ RecordSummary record_rtest(ByteTransport& port, ProbeMode mode, const RtestSessi
   header.probe_dirs.clear();
   for (int k = 0; k < 3; ++k) header.probe_dirs[k + 1] = probe_dirs.row(k).transpose();
   RtestWriter out(path, header, /*raw=*/true);
-  RecordSummary sum;
-  PoseAverager poses(program, dwell_s, out, sum);
-  StreamGuard guard{port};
-  double last_progress = 0.0;
-  auto progress = [&](double t) {
-    const double now = wall_seconds();
-    if (!opt.progress || now - last_progress < opt.progress_interval_s) return true;
-    last_progress = now;
-    return opt.progress({out.rows(), sum.lost, sum.crc_errors + sum.malformed, t, poses.end_time()});
-  };
-  try {
-    port.flush_input();
+  return run_recording(port, out, [&](RecordSummary& sum) {
+    PoseAverager poses(program, dwell_s, out, sum);
     if (mode == ProbeMode::stream) {
-      FrameReader reader;
-      if (!start_stream(port, reader, sum, opt, false, guard)) {
-        finish(out, sum);
-        return sum;
-      }
-      StreamPosition stream;
-      double last_data = wall_seconds();
-      std::size_t garbage_since_data = 0;
-      std::uint8_t buf[4096];
-      for (;;) {
-        const std::size_t n = port.read(buf, sizeof buf, opt.read_timeout_ms);
-        if (n == 0 && ++sum.timeouts && wall_seconds() - last_data > opt.silence_timeout_s) {
-          sum.reason = StopReason::silence;
-          sum.detail = "nothing for " + fixed(opt.silence_timeout_s, 1) + " s";
-          break;
-        }
-        if (n > 0) last_data = wall_seconds();
-        std::size_t new_crc = 0;
-        bool ended = false;
-        for (const Frame& f : reader.feed(buf, n, sum, garbage_since_data, new_crc)) {
-          if (const auto text = decode_text(f)) {
-            ended = ended || *text == "END";
-            continue;
-          }
-          const auto s = decode_probe_sample(f);
-          if (!s) {
-            ++sum.malformed;
-            continue;
-          }
-          ++sum.frames;
-          const auto t = stream.advance(s->seq, s->t_us, out, sum);
-          if (!t) continue;
-          if (s->status) {
-            ++sum.over_range;
-            continue;
-          }
-          poses.add(*t, Eigen::Vector3d(1e-6 * s->nm[0], 1e-6 * s->nm[1], 1e-6 * s->nm[2]));
-        }
-        const bool link_lost = check_link(out, sum, new_crc, garbage_since_data, stream.last_t, opt);
-        if (ended) {
-          guard.active = false;
-          poses.advance(1e300);
-          sum.reason = StopReason::end_of_program;
-          break;
-        }
-        if (link_lost) break;
-        if (!progress(stream.last_t)) {
-          sum.reason = StopReason::stopped;
-          break;
-        }
-      }
-    } else {
-      // Polled: the host clock paces the program; the instrument starts it at our first request.
-      LineReader lines;
-      const double t0 = wall_seconds();
-      std::size_t failures_in_row = 0;
-      for (;;) {
-        const double t_req = (wall_seconds() - t0) * opt.speed;
-        const auto r = poll_once(port, mode, lines, sum, opt.read_timeout_ms);
-        const double t = 0.5 * (t_req + (wall_seconds() - t0) * opt.speed);
-        if (r) {
-          failures_in_row = 0;
-          poses.add(t, *r);
-        } else if (++failures_in_row * static_cast<std::size_t>(opt.read_timeout_ms) >
-                       static_cast<std::size_t>(1e3 * opt.silence_timeout_s) &&
-                   sum.timeouts > 0) {
-          sum.reason = sum.garbage_bytes > 0 ? StopReason::no_valid_data : StopReason::silence;
-          sum.detail = "no valid reply for " + fixed(opt.silence_timeout_s, 1) + " s";
-          break;
-        }
-        poses.advance(t);
-        if (poses.done()) {
-          sum.reason = StopReason::end_of_program;
-          break;
-        }
-        if (!progress(t)) {
-          sum.reason = StopReason::stopped;
-          break;
-        }
-        // Sleep until the next pose's window if it is far ahead; else poll again soon.
-        const double wait = (poses.window_start() - (wall_seconds() - t0) * opt.speed) / opt.speed;
-        std::this_thread::sleep_for(std::chrono::duration<double>(std::clamp(wait, 0.002, 0.05)));
-      }
+      const bool ended = read_stream(
+          port, opt, false, out, sum, decode_probe_sample,
+          [&](double t, const ProbeFrame& s) {
+            poses.add(t, Eigen::Vector3d(1e-6 * s.nm[0], 1e-6 * s.nm[1], 1e-6 * s.nm[2]));
+          },
+          poses.end_time());
+      if (ended) poses.advance(1e300);
+      return;
     }
-  } catch (const DeviceDisconnected& e) {
-    sum.reason = StopReason::disconnected;
-    sum.detail = e.what();
-    guard.active = false;
-  }
-  finish(out, sum);
-  return sum;
+    // Polled: the host clock paces the program; the instrument starts it at our first request.
+    ProgressGate progress(opt);
+    LineReader lines;
+    const double t0 = wall_seconds();
+    std::size_t failures_in_row = 0;
+    for (;;) {
+      const double t_req = (wall_seconds() - t0) * opt.speed;
+      const auto r = poll_once(port, mode, lines, sum, opt.read_timeout_ms);
+      const double t = 0.5 * (t_req + (wall_seconds() - t0) * opt.speed);
+      if (r) {
+        failures_in_row = 0;
+        poses.add(t, *r);
+      } else if (++failures_in_row * static_cast<std::size_t>(opt.read_timeout_ms) >
+                     static_cast<std::size_t>(1e3 * opt.silence_timeout_s) &&
+                 sum.timeouts > 0) {
+        sum.reason = sum.garbage_bytes > 0 ? StopReason::no_valid_data : StopReason::silence;
+        sum.detail = "no valid reply for " + fixed(opt.silence_timeout_s, 1) + " s";
+        return;
+      }
+      poses.advance(t);
+      if (poses.done()) {
+        sum.reason = StopReason::end_of_program;
+        return;
+      }
+      if (!progress(out.rows(), sum, t, poses.end_time())) {
+        sum.reason = StopReason::stopped;
+        return;
+      }
+      // Sleep until the next pose's window if it is far ahead; else poll again soon.
+      const double wait = (poses.window_start() - (wall_seconds() - t0) * opt.speed) / opt.speed;
+      std::this_thread::sleep_for(std::chrono::duration<double>(std::clamp(wait, 0.002, 0.05)));
+    }
+  });
 }
 
 }  // namespace rotacal::hw
