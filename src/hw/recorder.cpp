@@ -2,14 +2,17 @@
 #include "rotacal/hw/recorder.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
+#include <limits>
 #include <optional>
 #include <thread>
 
 #include "rotacal/hw/ballbar_protocol.hpp"
+#include "rotacal/hw/pose_window.hpp"
 #include "rotacal/hw/stream_protocol.hpp"
 #include "rotacal/io/ballbar_file.hpp"
 
@@ -300,8 +303,9 @@ std::string RecordSummary::describe() const {
   std::string s = std::to_string(rows) + " rows; " + std::to_string(lost) + " lost, " +
                   std::to_string(crc_errors) + " checksum errors, " + std::to_string(malformed) +
                   " malformed, " + std::to_string(garbage_bytes) + " garbage bytes, " +
-                  std::to_string(over_range) + " over range, " + std::to_string(timeouts) +
-                  " timeouts; stopped: " + to_string(reason);
+                  std::to_string(over_range) + " over range, " + std::to_string(timeouts) + " timeouts";
+  if (outside_window > 0) s += ", " + std::to_string(outside_window) + " polled readings outside their pose's window";
+  s += "; stopped: " + to_string(reason);
   if (!detail.empty()) s += " (" + detail + ")";
   return s;
 }
@@ -331,75 +335,145 @@ RecordSummary record_ballbar(ByteTransport& port, const ProgramTimeline& program
 
 namespace {
 
-// Averages the at-rest readings of each pose in program order and writes its row.
+// Averages the readings of each pose taken inside its read window (pose_window.hpp), in
+// program order, and writes its row with the readings' mean time and smallest margin. A
+// polled reading that may have been taken outside the window is counted and marked, not used;
+// a pose without a reading inside its window is counted lost and marked.
 class PoseAverager {
  public:
   PoseAverager(const RtestSession& program, double dwell_s, RtestWriter& out, RecordSummary& sum)
-      : program_(program), half_window_(0.25 * dwell_s), out_(out), summary_(sum) {}
+      : program_(program), dwell_s_(dwell_s), out_(out), summary_(sum) {}
 
   bool done() const { return next_ >= program_.samples.size(); }
-  double window_start() const { return done() ? 1e300 : program_.samples[next_].time - half_window_; }
-  double end_time() const { return program_.samples.back().time + half_window_; }
+  /// The read window of the next pose to be written.
+  PoseWindow window() const { return pose_window(program_.samples[next_].time, dwell_s_); }
+  double end_time() const { return pose_window(program_.samples.back().time, dwell_s_).end; }
 
-  /// A reading at program time t: pose(s) whose window ended before t are written first.
-  void add(double t, const Eigen::Vector3d& r) {
-    advance(t);
-    if (done() || t < window_start()) return;
+  /// A reading taken somewhere in program time [a, b] (a == b for a timestamped stream sample).
+  /// Poses whose window ended before a are written first. `polled`: a reading that is not
+  /// surely inside the window is marked; stream samples between windows (the table moving) are
+  /// simply not used.
+  void add(double a, double b, const Eigen::Vector3d& r, bool polled) {
+    advance(a);
+    if (done()) return;
+    const PoseWindow w = window();
+    if (!w.contains(a, b)) {
+      if (polled) {
+        ++outside_;
+        worst_outside_ = std::min(worst_outside_, w.margin(a, b));
+      }
+      return;
+    }
     sum_ += r;
     sum_sq_ += r.cwiseProduct(r);
+    t_sum_ += 0.5 * (a + b);
+    margin_ = std::min(margin_, w.margin(a, b));
     ++n_;
   }
-  /// Write every pose whose window ends before t.
+  /// Write every pose whose window surely ended before program time t.
   void advance(double t) {
-    while (!done() && t > program_.samples[next_].time + half_window_) write_pose();
+    while (!done() && t > window().end) write_pose();
   }
 
  private:
   void write_pose() {
     const RtestSample& p = program_.samples[next_];
+    const PoseWindow w = window();
+    const std::string pose = "pose " + std::to_string(next_ + 1) + " (set-up " + p.setup + ", B/A=" +
+                             fixed(p.tilt_deg, 3) + ", C=" + fixed(p.rot_deg, 3) + ")";
+    const std::string span = "[" + fixed(w.begin, 3) + ", " + fixed(w.end, 3) + "] s";
+    const std::string late = std::to_string(outside_) + " reading" + (outside_ == 1 ? "" : "s") +
+                             " not surely inside it (margin down to " + fixed(worst_outside_, 3) + " s)";
+    summary_.outside_window += outside_;
     if (n_ == 0) {
       ++summary_.lost;
-      out_.annotate("missing: pose " + std::to_string(next_ + 1) + " (set-up " + p.setup + ", B/A=" +
-                    fixed(p.tilt_deg, 3) + ", C=" + fixed(p.rot_deg, 3) + "): no reading at rest");
+      out_.annotate("missing: " + pose + ": no reading inside its window " + span +
+                    (outside_ > 0 ? "; " + late : ""));
     } else {
+      if (outside_ > 0) out_.annotate("outside: " + pose + ", window " + span + ": " + late + ", not used");
       RtestSample row = p;
-      const Eigen::Vector3d mean = sum_ / static_cast<double>(n_);
+      const double n = static_cast<double>(n_);
+      const Eigen::Vector3d mean = sum_ / n;
       row.raw = mean;
       Eigen::Vector3d var = Eigen::Vector3d::Zero();
-      if (n_ > 1)
-        var = ((sum_sq_ - static_cast<double>(n_) * mean.cwiseProduct(mean)) / static_cast<double>(n_ - 1))
-                  .cwiseMax(0.0);
-      row.extra = {std::to_string(n_), fixed(1e3 * std::sqrt(var.maxCoeff()), 3)};
+      if (n_ > 1) var = ((sum_sq_ - n * mean.cwiseProduct(mean)) / (n - 1.0)).cwiseMax(0.0);
+      row.extra = {std::to_string(n_), fixed(1e3 * std::sqrt(var.maxCoeff()), 3), fixed(t_sum_ / n, 4),
+                   fixed(margin_, 4)};
       out_.append(row);
     }
     ++next_;
     n_ = 0;
+    outside_ = 0;
     sum_.setZero();
     sum_sq_.setZero();
+    t_sum_ = 0.0;
+    margin_ = worst_outside_ = std::numeric_limits<double>::infinity();
   }
   const RtestSession& program_;
-  double half_window_;
+  double dwell_s_;
   RtestWriter& out_;
   RecordSummary& summary_;
   std::size_t next_ = 0;
   std::size_t n_ = 0;
+  std::size_t outside_ = 0;
   Eigen::Vector3d sum_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d sum_sq_ = Eigen::Vector3d::Zero();
+  double t_sum_ = 0.0;
+  double margin_ = std::numeric_limits<double>::infinity();
+  double worst_outside_ = std::numeric_limits<double>::infinity();
 };
 
-// One polled reading of all three channels; nullopt (and counted) if any channel failed.
+// The program clock of a polled instrument as the host knows it. The instrument starts it
+// when our first request reaches it: after we sent that request, before its reply came back.
+// A host wall time w is therefore program time in [(w - replied) speed, (w - sent) speed].
+struct ProgramClock {
+  double sent = 0.0;
+  double replied = 0.0;
+  double speed = 1.0;
+  double earliest(double wall) const { return (wall - replied) * speed; }
+  double latest(double wall) const { return (wall - sent) * speed; }
+};
+
+// The typical (median) of the last 15 request-to-reply times, wall s: how long the host may
+// expect a reading to take. A median, so that one stall does not stop the host from reading.
+class RoundTrips {
+ public:
+  void add(double s) {
+    last_[next_++ % last_.size()] = s;
+    count_ = std::min(count_ + 1, last_.size());
+  }
+  double typical() const {
+    if (count_ == 0) return 0.0;
+    std::array<double, 15> v = last_;
+    std::nth_element(v.begin(), v.begin() + static_cast<long>(count_ / 2), v.begin() + static_cast<long>(count_));
+    return v[count_ / 2];
+  }
+
+ private:
+  std::array<double, 15> last_{};
+  std::size_t next_ = 0;
+  std::size_t count_ = 0;
+};
+
 // Reply lines across reads (a reply may arrive in pieces, or two at once).
 struct LineReader {
   Bytes pending;
   std::vector<std::string> lines;  // complete, not yet taken
   std::size_t next = 0;
-  std::optional<std::string> take(ByteTransport& port, RecordSummary& sum, int timeout_ms) {
-    const double t_end = wall_seconds() + 1e-3 * timeout_ms;
+  std::size_t taken = 0;  // lines returned so far
+  /// The next reply line. Each read_timeout_ms without one counts as a timeout; nullopt after
+  /// give_up_s (the device is silent).
+  std::optional<std::string> take(ByteTransport& port, RecordSummary& sum, int read_timeout_ms, double give_up_s) {
+    const double t_end = wall_seconds() + give_up_s;
     std::uint8_t buf[256];
     while (next >= lines.size()) {
       const double left = t_end - wall_seconds();
       if (left <= 0) return std::nullopt;
-      const std::size_t n = port.read(buf, sizeof buf, std::max(1, static_cast<int>(1e3 * left)));
+      const std::size_t n = port.read(buf, sizeof buf, std::clamp(static_cast<int>(1e3 * left), 1, read_timeout_ms));
+      if (n == 0) {
+        ++sum.timeouts;
+        continue;
+      }
       pending.insert(pending.end(), buf, buf + n);
       LineScan scan = split_lines(pending.data(), pending.size());
       pending.erase(pending.begin(), pending.begin() + static_cast<long>(scan.consumed));
@@ -408,50 +482,59 @@ struct LineReader {
       next = 0;
       lines.insert(lines.end(), scan.lines.begin(), scan.lines.end());
     }
+    ++taken;
     return lines[next++];
   }
 };
 
-// One polled reading of all three channels; nullopt (and counted) if any channel failed.
-std::optional<Eigen::Vector3d> poll_once(ByteTransport& port, ProbeMode mode, LineReader& lines,
-                                         RecordSummary& sum, int timeout_ms) {
-  auto read_line = [&] { return lines.take(port, sum, timeout_ms); };
+struct Poll {
+  std::optional<Eigen::Vector3d> reading;  ///< nullopt (and counted) if any channel failed
+  bool silent = false;                     ///< a request went unanswered for silence_timeout_s
+};
+
+// One polled reading of all three channels. A polled device answers every request once, so
+// the host waits for that answer (however late) rather than asking again: a second request
+// would pair every later reply with the wrong request, and the wrong time.
+Poll poll_once(ByteTransport& port, ProbeMode mode, LineReader& lines, RecordSummary& sum, const RecordOptions& opt) {
+  auto ask = [&](const std::string& request) {
+    port.write(request, 200);
+    return lines.take(port, sum, opt.read_timeout_ms, opt.silence_timeout_s);
+  };
   auto value_of = [&](const GaugeValue& v) -> std::optional<double> {
     if (v.ok()) return v.mm;
     if (v.kind == GaugeValue::Kind::error) ++sum.malformed;
     else ++sum.over_range;
     return std::nullopt;
   };
+  Poll failed;
   Eigen::Vector3d r;
   if (mode == ProbeMode::keyence) {
-    port.write(keyence_request(0), 200);
-    const auto line = read_line();
-    if (!line) return ++sum.timeouts, std::nullopt;
+    const auto line = ask(keyence_request(0));
+    if (!line) return failed.silent = true, failed;
     const auto reply = parse_keyence_reply(*line);
-    if (!reply) return ++sum.malformed, std::nullopt;
+    if (!reply) return ++sum.malformed, failed;
     if (reply->values.size() != 3) {
       value_of(reply->values.front());
-      return std::nullopt;
+      return failed;
     }
     for (int i = 0; i < 3; ++i) {
       const auto v = value_of(reply->values[static_cast<std::size_t>(i)]);
-      if (!v) return std::nullopt;
+      if (!v) return failed;
       r[i] = *v;
     }
   } else {
     for (int ch = 1; ch <= 3; ++ch) {
-      port.write(sylvac_request(ch), 200);
-      const auto line = read_line();
-      if (!line) return ++sum.timeouts, std::nullopt;
+      const auto line = ask(sylvac_request(ch));
+      if (!line) return failed.silent = true, failed;
       const auto reply = parse_sylvac_reply(*line);
-      if (!reply) return ++sum.malformed, std::nullopt;
+      if (!reply) return ++sum.malformed, failed;
       const auto v = value_of(*reply);
-      if (!v) return std::nullopt;
+      if (!v) return failed;
       r[ch - 1] = *v;
     }
   }
   ++sum.frames;
-  return r;
+  return Poll{r, false};
 }
 
 }  // namespace
@@ -464,7 +547,7 @@ RecordSummary record_rtest(ByteTransport& port, ProbeMode mode, const RtestSessi
   RtestSession header = program;
   header.samples.clear();
   header.noise_um.reset();  // what the program was simulated with is not what was measured
-  header.extra_columns = {"n", "std_um"};
+  header.extra_columns = {"n", "std_um", "t_s", "margin_s"};
   header.metadata = {{"recorded_from", port.path()},
                      {"recorded_at", utc_now()},
                      {"probe_mode", to_string(mode)}};
@@ -477,43 +560,60 @@ RecordSummary record_rtest(ByteTransport& port, ProbeMode mode, const RtestSessi
       const bool ended = read_stream(
           port, opt, false, out, sum, decode_probe_sample,
           [&](double t, const ProbeFrame& s) {
-            poses.add(t, Eigen::Vector3d(1e-6 * s.nm[0], 1e-6 * s.nm[1], 1e-6 * s.nm[2]));
+            poses.add(t, t, Eigen::Vector3d(1e-6 * s.nm[0], 1e-6 * s.nm[1], 1e-6 * s.nm[2]), false);
           },
           poses.end_time());
       if (ended) poses.advance(1e300);
       return;
     }
-    // Polled: the host clock paces the program; the instrument starts it at our first request.
+    // Polled: each reading is placed by the interval from its first request to its last reply,
+    // in program time as far as the clock is known (ProgramClock). The host reads while the
+    // next pose is surely in its window and a round trip still fits; a pose is written once its
+    // window has surely passed.
     ProgressGate progress(opt);
     LineReader lines;
-    const double t0 = wall_seconds();
-    std::size_t failures_in_row = 0;
+    std::optional<ProgramClock> clock;
+    const double first_sent = wall_seconds();
+    RoundTrips round_trips;
+    auto pause = [](double s) { std::this_thread::sleep_for(std::chrono::duration<double>(std::clamp(s, 0.001, 0.05))); };
     for (;;) {
-      const double t_req = (wall_seconds() - t0) * opt.speed;
-      const auto r = poll_once(port, mode, lines, sum, opt.read_timeout_ms);
-      const double t = 0.5 * (t_req + (wall_seconds() - t0) * opt.speed);
-      if (r) {
-        failures_in_row = 0;
-        poses.add(t, *r);
-      } else if (++failures_in_row * static_cast<std::size_t>(opt.read_timeout_ms) >
-                     static_cast<std::size_t>(1e3 * opt.silence_timeout_s) &&
-                 sum.timeouts > 0) {
+      if (clock) {
+        const double now = wall_seconds();
+        const double early = clock->earliest(now), late = clock->latest(now);
+        poses.advance(early);
+        if (poses.done()) {
+          sum.reason = StopReason::end_of_program;
+          return;
+        }
+        if (!progress(out.rows(), sum, late, poses.end_time())) {
+          sum.reason = StopReason::stopped;
+          return;
+        }
+        // Read only while the next pose is surely in its window and a round trip still fits.
+        const PoseWindow w = poses.window();
+        const double guard = std::max(3.0 * round_trips.typical() * opt.speed, 0.05 * (w.end - w.begin));
+        if (early < w.begin) {
+          pause((w.begin - early) / opt.speed);
+          continue;
+        }
+        if (late + guard > w.end) {
+          pause((w.end - early) / opt.speed + 1e-3);  // until it has surely passed: written then
+          continue;
+        }
+      }
+      const double sent = wall_seconds();
+      const std::size_t taken = lines.taken;
+      const Poll poll = poll_once(port, mode, lines, sum, opt);
+      const double received = wall_seconds();
+      if (poll.silent) {
         sum.reason = sum.garbage_bytes > 0 ? StopReason::no_valid_data : StopReason::silence;
         sum.detail = "no valid reply for " + fixed(opt.silence_timeout_s, 1) + " s";
         return;
       }
-      poses.advance(t);
-      if (poses.done()) {
-        sum.reason = StopReason::end_of_program;
-        return;
-      }
-      if (!progress(out.rows(), sum, t, poses.end_time())) {
-        sum.reason = StopReason::stopped;
-        return;
-      }
-      // Sleep until the next pose's window if it is far ahead; else poll again soon.
-      const double wait = (poses.window_start() - (wall_seconds() - t0) * opt.speed) / opt.speed;
-      std::this_thread::sleep_for(std::chrono::duration<double>(std::clamp(wait, 0.002, 0.05)));
+      if (!clock && lines.taken > taken) clock = ProgramClock{first_sent, received, opt.speed};
+      round_trips.add(received - sent);
+      if (poll.reading && clock) poses.add(clock->earliest(sent), clock->latest(received), *poll.reading, true);
+      pause(0.002);  // between readings inside a window
     }
   });
 }

@@ -282,30 +282,28 @@ VirtualRtest::VirtualRtest(const VirtualRtestOptions& options)
 Eigen::Vector3d VirtualRtest::readings_at(double t, bool* at_rest) {
   const auto& rows = program_.samples;
   const double dwell = options_.sim.pattern.dwell_s;
-  const double t0 = rows.front().time;
-  const double x = (t - t0) / dwell;
-  const long k = std::clamp(std::lround(x), 0L, static_cast<long>(rows.size()) - 1);
-  const double off = x - static_cast<double>(k);
+  const long last = static_cast<long>(rows.size()) - 1;
+  const long k = std::clamp(std::lround((t - rows.front().time) / dwell), 0L, last);
+  const PoseWindow w = pose_window(rows[static_cast<std::size_t>(k)].time, dwell);
   Eigen::Vector3d r;
-  if (std::abs(off) <= 0.5 * kRtestRestFraction || (k == 0 && off < 0) ||
-      (k + 1 == static_cast<long>(rows.size()) && off > 0)) {
+  if (w.contains(t, t) || (k == 0 && t < w.begin) || (k == last && t > w.end)) {
     *at_rest = true;
     r = exact_[static_cast<std::size_t>(k)];
   } else {
     // Moving between poses: the readings slide from one pose's to the next, with a
     // following-error bump that a recorder must not mistake for a measurement.
     *at_rest = false;
-    const long a = off > 0 ? k : k - 1;
-    const double u = (x - static_cast<double>(a) - 0.5 * kRtestRestFraction) / (1.0 - kRtestRestFraction);
-    const auto ia = static_cast<std::size_t>(a);
-    r = exact_[ia] + u * (exact_[ia + 1] - exact_[ia]) + Eigen::Vector3d::Constant(0.005 * std::sin(M_PI * u));
+    const auto a = static_cast<std::size_t>(t > w.end ? k : k - 1);
+    const double from = pose_window(rows[a].time, dwell).end, to = pose_window(rows[a + 1].time, dwell).begin;
+    const double u = (t - from) / (to - from);
+    r = exact_[a] + u * (exact_[a + 1] - exact_[a]) + Eigen::Vector3d::Constant(0.005 * std::sin(M_PI * u));
   }
   for (int i = 0; i < 3; ++i) r[i] += 1e-3 * options_.sim.noise_um * noise_->gauss(noise_->rng);
   return r;
 }
 
 double VirtualRtest::stream_end() const {
-  return program_.samples.back().time + 0.5 * options_.sim.pattern.dwell_s;
+  return program_.samples.back().time + 0.5 * options_.sim.pattern.dwell_s;  // the last dwell is over
 }
 
 void VirtualRtest::serve_once() {

@@ -114,15 +114,26 @@ def test_ctrl_c_stops_cleanly_and_keeps_the_rows(tmp_path):
 
 @pytest.mark.parametrize("mode", ["sylvac", "keyence", "stream"])
 def test_record_rtest_cli_end_to_end(tmp_path, mode):
-    # Polled modes pace on the host clock: slow enough that half a dwell is 50 ms of real time.
-    speed = "150" if mode == "stream" else "60"
-    v = Virtual("rtest", "--mode", mode, "--speed", speed, "--truth", tmp_path / "truth.json", "--exit-when-done")
-    r = rotacal_cli("record", "rtest", "--port", v.port, "--mode", mode, "--speed", speed,
+    # Polled modes pace on the host clock: 48 poses at speed 8, so that each pose's read window
+    # (80 % of its dwell) is 0.6 s of real time and a host starved of CPU still reads inside it.
+    pattern = [] if mode == "stream" else ["--b-step", "60", "--c-step", "60"]
+    speed = "150" if mode == "stream" else "8"
+    v = Virtual("rtest", "--mode", mode, "--speed", speed, *pattern, "--truth", tmp_path / "truth.json",
+                "--exit-when-done")
+    r = rotacal_cli("record", "rtest", "--port", v.port, "--mode", mode, "--speed", speed, *pattern,
                     "-o", tmp_path / "r.csv", "--json")
     v.close()
     assert r.returncode == 0, r.stderr
     s = json.loads(r.stdout)
-    assert s["reason"] == "end of program" and s["lost"] == 0 and s["rows"] == 168
+    assert s["reason"] == "end of program" and s["lost"] == 0 and s["rows"] == (168 if mode == "stream" else 48)
+    # Every row says when it was read and how far inside its pose's window (docs/protocols.md).
+    lines = [ln for ln in (tmp_path / "r.csv").read_text().splitlines() if ln and not ln.startswith("#")]
+    cols = lines[0].split(",")
+    assert cols[-4:] == ["n", "std_um", "t_s", "margin_s"]
+    for row in lines[1:]:
+        f = row.split(",")
+        assert int(f[-4]) >= 1 and float(f[-1]) >= 0.0, row
+        assert abs(float(f[-2]) - float(f[cols.index("time")])) <= 0.4 * 6.0, row
     ident = rotacal_cli("identify", tmp_path / "r.csv", "--json")
     assert ident.returncode == 0, ident.stderr
     truth = json.loads((tmp_path / "truth.json").read_text())

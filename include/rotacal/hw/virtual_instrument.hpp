@@ -18,6 +18,7 @@
 #include "rotacal/ballbar/model.hpp"
 #include "rotacal/ballbar/timeline.hpp"
 #include "rotacal/hw/frame.hpp"
+#include "rotacal/hw/pose_window.hpp"
 #include "rotacal/hw/probe_protocol.hpp"
 #include "rotacal/hw/pseudo_terminal.hpp"
 #include "rotacal/rtest/simulate.hpp"
@@ -157,8 +158,10 @@ struct VirtualRtestOptions {
   FaultInjection faults;
 };
 
-/// An R-test on a B/C table running the measurement pattern: pose k is held for the middle
-/// 80 % of its dwell around the time the simulator gives it; in between the table moves.
+/// An R-test on a B/C table running the measurement pattern: pose k is held at rest in its
+/// read window (pose_window.hpp: the middle 80 % of its dwell around the time the simulator
+/// gives it); in between the table moves. A polled reading is the probes at the instant the
+/// request arrives.
 /// Polled modes start the program at the first request, stream mode at START.
 class VirtualRtest final : public VirtualInstrument {
  public:
@@ -185,8 +188,5 @@ class VirtualRtest final : public VirtualInstrument {
   struct Noise;
   std::shared_ptr<Noise> noise_;
 };
-
-/// Fraction of a pose's dwell during which the table is at rest (centred on the pose time).
-inline constexpr double kRtestRestFraction = 0.8;
 
 }  // namespace rotacal::hw
