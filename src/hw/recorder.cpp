@@ -374,6 +374,12 @@ class PoseAverager {
   void advance(double t) {
     while (!done() && t > window().end) write_pose();
   }
+  /// The host could not take a reading in program time [a, b]: it did not run (between two
+  /// passes of its loop) or was waiting for a reply. Kept so that a pose lost to a late host
+  /// says for how long of its window that was.
+  void host_unavailable(double a, double b) {
+    if (b > a && !done() && b > window().begin) unavailable_.emplace_back(a, b);
+  }
 
  private:
   void write_pose() {
@@ -387,7 +393,17 @@ class PoseAverager {
     summary_.outside_window += outside_;
     if (n_ == 0) {
       ++summary_.lost;
-      out_.annotate("missing: " + pose + ": no reading inside its window " + span +
+      // The longest stretch of the window in which the host could not read.
+      double longest = 0.0;
+      std::pair<double, double> when;
+      for (const auto& [a, b] : unavailable_) {
+        const double overlap = std::min(w.end, b) - std::max(w.begin, a);
+        if (overlap > longest) longest = overlap, when = {a, b};
+      }
+      const std::string idle = longest > 0.0 ? "; the host could not read for " + fixed(longest, 3) + " s of it (" +
+                                                   fixed(when.first, 3) + " to " + fixed(when.second, 3) + " s)"
+                                             : "";
+      out_.annotate("missing: " + pose + ": no reading inside its window " + span + idle +
                     (outside_ > 0 ? "; " + late : ""));
     } else {
       if (outside_ > 0) out_.annotate("outside: " + pose + ", window " + span + ": " + late + ", not used");
@@ -408,6 +424,12 @@ class PoseAverager {
     sum_sq_.setZero();
     t_sum_ = 0.0;
     margin_ = worst_outside_ = std::numeric_limits<double>::infinity();
+    if (!done()) {  // keep what may still overlap the next window (a stall may span several)
+      const double begin = window().begin;
+      unavailable_.erase(std::remove_if(unavailable_.begin(), unavailable_.end(),
+                                        [&](const std::pair<double, double>& u) { return u.second <= begin; }),
+                         unavailable_.end());
+    }
   }
   const RtestSession& program_;
   double dwell_s_;
@@ -421,6 +443,7 @@ class PoseAverager {
   double t_sum_ = 0.0;
   double margin_ = std::numeric_limits<double>::infinity();
   double worst_outside_ = std::numeric_limits<double>::infinity();
+  std::vector<std::pair<double, double>> unavailable_;  ///< program s, since this window began
 };
 
 // The program clock of a polled instrument as the host knows it. The instrument starts it
@@ -576,10 +599,13 @@ RecordSummary record_rtest(ByteTransport& port, ProbeMode mode, const RtestSessi
     const double first_sent = wall_seconds();
     RoundTrips round_trips;
     auto pause = [](double s) { std::this_thread::sleep_for(std::chrono::duration<double>(std::clamp(s, 0.001, 0.05))); };
+    double last_ran = first_sent;  // when the loop last ran, wall s
     for (;;) {
       if (clock) {
         const double now = wall_seconds();
         const double early = clock->earliest(now), late = clock->latest(now);
+        poses.host_unavailable(clock->latest(last_ran), early);
+        last_ran = now;
         poses.advance(early);
         if (poses.done()) {
           sum.reason = StopReason::end_of_program;
@@ -612,7 +638,9 @@ RecordSummary record_rtest(ByteTransport& port, ProbeMode mode, const RtestSessi
       }
       if (!clock && lines.taken > taken) clock = ProgramClock{first_sent, received, opt.speed};
       round_trips.add(received - sent);
+      if (clock) poses.host_unavailable(clock->latest(sent), clock->earliest(received));
       if (poll.reading && clock) poses.add(clock->earliest(sent), clock->latest(received), *poll.reading, true);
+      last_ran = wall_seconds();
       pause(0.002);  // between readings inside a window
     }
   });

@@ -67,7 +67,23 @@ void VirtualInstrument::run() {
   } catch (const std::exception& e) {
     thread_error_ = e.what();
   }
+  thread_done_ = true;
   finished_ = true;
+}
+
+void VirtualInstrument::mark_finished() {
+  {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    stats_.finished = true;
+  }
+  finished_at_ = wall_seconds();
+  finished_ = true;
+}
+
+bool VirtualInstrument::finished() const {
+  if (!finished_.load()) return false;
+  if (thread_done_.load()) return true;
+  return pty_.unread() == 0 || wall_seconds() - finished_at_.load() > 10.0;
 }
 
 double VirtualInstrument::now() const {

@@ -125,9 +125,20 @@ def test_record_rtest_cli_end_to_end(tmp_path, mode):
     v.close()
     assert r.returncode == 0, r.stderr
     s = json.loads(r.stdout)
-    assert s["reason"] == "end of program" and s["lost"] == 0 and s["rows"] == (168 if mode == "stream" else 48)
+    assert s["reason"] == "end of program"
+    text = (tmp_path / "r.csv").read_text()
+    if mode == "stream":
+        assert s["lost"] == 0 and s["rows"] == 168
+    else:
+        # A pose may be lost only when the host really was late for it (it could not read for a
+        # quarter of the 4.8 s window or more, as when other processes hold both cores), and
+        # then it is counted and marked.
+        missing = [ln for ln in text.splitlines() if ln.startswith("# missing: pose")]
+        assert len(missing) == s["lost"] and s["rows"] + s["lost"] == 48 and s["rows"] >= 40, missing
+        for ln in missing:
+            assert float(ln.split("the host could not read for ")[1].split()[0]) >= 0.25 * 4.8, ln
     # Every row says when it was read and how far inside its pose's window (docs/protocols.md).
-    lines = [ln for ln in (tmp_path / "r.csv").read_text().splitlines() if ln and not ln.startswith("#")]
+    lines = [ln for ln in text.splitlines() if ln and not ln.startswith("#")]
     cols = lines[0].split(",")
     assert cols[-4:] == ["n", "std_um", "t_s", "margin_s"]
     for row in lines[1:]:

@@ -55,7 +55,10 @@ class VirtualInstrument {
   void start();
   /// Stop serving and join the thread (idempotent). Rethrows an error the thread died of.
   void stop();
-  bool finished() const { return finished_.load(); }
+  /// The program has run to its end and the host has read everything sent (or 10 s have
+  /// passed since the end, for a host that stopped reading), or the instrument has stopped.
+  /// A caller that hangs up when this turns true does not cut off the last samples and END.
+  bool finished() const;
   VirtualStats stats() const;
 
  protected:
@@ -86,7 +89,7 @@ class VirtualInstrument {
   /// A reply (text frame or ASCII line): never faulted, except by a wrong baud rate.
   void send_reply(const Bytes& bytes);
   void send_reply(const std::string& text) { send_reply(Bytes(text.begin(), text.end())); }
-  void mark_finished() { finished_ = true; stats_.finished = true; }
+  void mark_finished();
 
  private:
   /// Every sample frame due by now(), at most 200 a pass; END once past stream_end().
@@ -102,7 +105,9 @@ class VirtualInstrument {
   FaultInjection faults_;
   std::thread thread_;
   std::atomic<bool> stop_{false};
-  std::atomic<bool> finished_{false};
+  std::atomic<bool> finished_{false};      ///< the program has run to its end
+  std::atomic<bool> thread_done_{false};   ///< the serving thread has stopped
+  std::atomic<double> finished_at_{0.0};   ///< wall s
   bool hung_up_ = false;
   bool silent_ = false;
   bool clock_running_ = false;
