@@ -44,8 +44,11 @@ struct BallbarRun {
   std::string path;
 };
 
+// `silence_s`: long enough that a host starved of CPU for seconds (both cores busy, nice 19)
+// does not take its own stall for a silent instrument.
 BallbarRun run_ballbar(const std::string& name, const FaultInjection& faults, double rate_hz = 100.0,
-                       SerialSettings host = {}, std::function<bool(const RecordProgress&)> progress = {}) {
+                       SerialSettings host = {}, std::function<bool(const RecordProgress&)> progress = {},
+                       double silence_s = 10.0) {
   const BallbarPlan plan = small_plan();
   VirtualBallbarOptions o;
   o.truth = machine_with_errors(plan);
@@ -58,7 +61,7 @@ BallbarRun run_ballbar(const std::string& name, const FaultInjection& faults, do
   auto port = open_port(device.port(), host);
   RecordOptions ro;
   ro.rate_hz = rate_hz;
-  ro.silence_timeout_s = 0.5;
+  ro.silence_timeout_s = silence_s;
   ro.progress = std::move(progress);
   ro.progress_interval_s = 0.0;
   BallbarRun run{{}, {}, temp_file(name)};
@@ -132,7 +135,7 @@ TEST_CASE("ballbar: unplugged mid-stream, the file keeps every row read", "[hw]"
 TEST_CASE("ballbar: silence stops the recorder cleanly", "[hw]") {
   FaultInjection f;
   f.silence_after = 300;
-  const BallbarRun run = run_ballbar("silence.csv", f);
+  const BallbarRun run = run_ballbar("silence.csv", f, 100.0, {}, {}, 3.0);
   INFO(run.summary.describe());
   CHECK(run.summary.reason == StopReason::silence);
   CHECK(run.summary.rows == 300);
@@ -228,6 +231,7 @@ RtestRun run_rtest(ProbeMode mode, double speed, const RtestPattern& pattern = {
   RecordOptions ro;
   ro.rate_hz = o.rate_hz;
   ro.speed = o.speed;
+  ro.silence_timeout_s = 10.0;  // a starved host's stall is not a silent instrument
   const std::string path = temp_file("rtest-" + to_string(mode) + (host_stall_s > 0 ? "-late" : "") + ".csv");
   RtestRun run;
   run.summary = record_rtest(*port, mode, device.program(), o.sim.pattern.dwell_s, o.probe_dirs, path, ro);
