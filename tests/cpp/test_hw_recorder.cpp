@@ -8,6 +8,8 @@
 #include <random>
 #include <thread>
 
+#include <unistd.h>
+
 #include "rotacal/ballbar/identify.hpp"
 #include "rotacal/hw/recorder.hpp"
 #include "rotacal/hw/virtual_instrument.hpp"
@@ -20,8 +22,14 @@ using namespace rotacal::hw;
 
 namespace {
 
+// Unique per process: other test runs on the same machine write their own recordings.
 std::string temp_file(const std::string& name) {
-  return (std::filesystem::temp_directory_path() / ("rotacal-test-" + name)).string();
+  static const std::filesystem::path dir = [] {
+    auto d = std::filesystem::temp_directory_path() / ("rotacal-test-hw-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(d);
+    return d;
+  }();
+  return (dir / name).string();
 }
 
 BallbarPlan small_plan() {

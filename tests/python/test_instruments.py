@@ -102,7 +102,15 @@ def test_ctrl_c_stops_cleanly_and_keeps_the_rows(tmp_path):
     rec = subprocess.Popen([sys.executable, "-m", "rotacal", "record", "ballbar", "--port", v.port, *FAST,
                             "-o", tmp_path / "s.csv", "--json"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                            text=True)
-    time.sleep(4.0)
+    # Ctrl-C once the recording is under way (more than 100 rows in the file), however long a
+    # loaded machine takes to start the recorder.
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and rec.poll() is None:
+        rows = [ln for ln in (tmp_path / "s.csv").read_text().splitlines()[1:] if ln and not ln.startswith("#")] \
+            if (tmp_path / "s.csv").exists() else []
+        if len(rows) > 100:
+            break
+        time.sleep(0.2)
     rec.send_signal(signal.SIGINT)
     out, err = rec.communicate(timeout=30)
     v.close()

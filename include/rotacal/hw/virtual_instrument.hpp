@@ -31,7 +31,7 @@ struct FaultInjection {
   int corrupt_every = 0;   ///< every Nth frame has one bit flipped (checksum fails)
   int drop_every = 0;      ///< every Nth frame is not sent (sequence gap)
   bool split_frames = false;  ///< every frame in two writes, 1 ms apart
-  long close_after = -1;   ///< hang up the line after this many frames (device unplugged)
+  long close_after = -1;   ///< hang up the line after this many frames, once the host has read them (unplug)
   long silence_after = -1; ///< stop sending after this many frames, line stays open
 };
 
