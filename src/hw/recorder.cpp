@@ -380,6 +380,9 @@ class PoseAverager {
   void host_unavailable(double a, double b) {
     if (b > a && !done() && b > window().begin) unavailable_.emplace_back(a, b);
   }
+  /// How long, program s, one reading typically takes the host now (RoundTrips).
+  void reading_takes(double s) { reading_takes_ = s; }
+  bool has_reading() const { return n_ > 0; }
 
  private:
   void write_pose() {
@@ -400,9 +403,10 @@ class PoseAverager {
         const double overlap = std::min(w.end, b) - std::max(w.begin, a);
         if (overlap > longest) longest = overlap, when = {a, b};
       }
-      const std::string idle = longest > 0.0 ? "; the host could not read for " + fixed(longest, 3) + " s of it (" +
-                                                   fixed(when.first, 3) + " to " + fixed(when.second, 3) + " s)"
-                                             : "";
+      const std::string idle = (longest > 0.0 ? "; the host could not read for " + fixed(longest, 3) + " s of it (" +
+                                                    fixed(when.first, 3) + " to " + fixed(when.second, 3) + " s)"
+                                              : std::string()) +
+                               "; a reading took the host " + fixed(reading_takes_, 3) + " s";
       out_.annotate("missing: " + pose + ": no reading inside its window " + span + idle +
                     (outside_ > 0 ? "; " + late : ""));
     } else {
@@ -444,6 +448,7 @@ class PoseAverager {
   double margin_ = std::numeric_limits<double>::infinity();
   double worst_outside_ = std::numeric_limits<double>::infinity();
   std::vector<std::pair<double, double>> unavailable_;  ///< program s, since this window began
+  double reading_takes_ = 0.0;
 };
 
 // The program clock of a polled instrument as the host knows it. The instrument starts it
@@ -615,9 +620,12 @@ RecordSummary record_rtest(ByteTransport& port, ProbeMode mode, const RtestSessi
           sum.reason = StopReason::stopped;
           return;
         }
-        // Read only while the next pose is surely in its window and a round trip still fits.
+        // Read only while the next pose is surely in its window and a reading still fits: a
+        // first one if one typical reading does, more while three do (and 5 % of the window).
         const PoseWindow w = poses.window();
-        const double guard = std::max(3.0 * round_trips.typical() * opt.speed, 0.05 * (w.end - w.begin));
+        const double takes = round_trips.typical() * opt.speed;
+        poses.reading_takes(takes);
+        const double guard = poses.has_reading() ? std::max(3.0 * takes, 0.05 * (w.end - w.begin)) : takes;
         if (early < w.begin) {
           pause((w.begin - early) / opt.speed);
           continue;

@@ -141,13 +141,16 @@ def test_record_rtest_cli_end_to_end(tmp_path, mode):
     if mode == "stream":
         assert s["lost"] == 0 and s["rows"] == 168
     else:
-        # A pose may be lost only when the host really was late for it (it could not read for a
-        # quarter of the 4.8 s window or more, as when other processes hold both cores), and
-        # then it is counted and marked.
+        # A pose may be lost only when the host really was late for it (it could not read, or one
+        # reading took it, a quarter of the 4.8 s window or more, as when other processes hold
+        # both cores), and then it is counted and marked.
         missing = [ln for ln in text.splitlines() if ln.startswith("# missing: pose")]
         assert len(missing) == s["lost"] and s["rows"] + s["lost"] == 48 and s["rows"] >= 24, missing
+        def seconds_after(line, said):
+            return float(line.split(said)[1].split()[0]) if said in line else 0.0
         for ln in missing:
-            assert float(ln.split("the host could not read for ")[1].split()[0]) >= 0.25 * 4.8, ln
+            assert max(seconds_after(ln, "the host could not read for "),
+                       seconds_after(ln, "a reading took the host ")) >= 0.25 * 4.8, ln
     # Every row says when it was read and how far inside its pose's window (docs/protocols.md).
     lines = [ln for ln in text.splitlines() if ln and not ln.startswith("#")]
     cols = lines[0].split(",")
