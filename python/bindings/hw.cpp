@@ -131,6 +131,7 @@ void bind_hw(pyb::module_& m) {
       .def_readonly("garbage_bytes", &RecordSummary::garbage_bytes)
       .def_readonly("over_range", &RecordSummary::over_range)
       .def_readonly("timeouts", &RecordSummary::timeouts)
+      .def_readonly("outside_window", &RecordSummary::outside_window)
       .def_property_readonly("reason", [](const RecordSummary& s) { return to_string(s.reason); })
       .def_readonly("detail", &RecordSummary::detail)
       .def("describe", &RecordSummary::describe);

@@ -128,7 +128,11 @@ def record_rtest(port: str, program: _core.RtestSession, path: str, *, mode: str
                  silence_timeout_s: float = 3.0, progress: Progress | bool = True) -> _core.RecordSummary:
     """Record an R-test from ``port`` into ``path`` (rotacal-rtest/1 with raw d1,d2,d3 and the
     probe directions, so readers convert them to dx,dy,dz). One row per pose: the mean of the
-    readings in the middle half of its dwell, with their count ``n`` and spread ``std_um``."""
+    readings taken inside its read window (the middle 80 % of its dwell, when the program holds
+    the table at rest; docs/protocols.md), with their count ``n``, spread ``std_um``, mean
+    program time ``t_s`` and smallest margin to the window's edges ``margin_s``. A polled reading
+    not surely inside its window is counted (``summary.outside_window``), marked and not used; a
+    pose without a reading inside its window is counted lost and marked."""
     dirs = DEFAULT_PROBE_DIRS if probe_dirs is None else np.asarray(probe_dirs, dtype=float)
     return _record(lambda cb: _core.record_rtest(port, mode, program, dwell_s, dirs, str(path), baud, rate_hz,
                                                  speed, silence_timeout_s, cb), progress)

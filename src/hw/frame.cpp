@@ -1,3 +1,4 @@
+// Binary framing: CRC-16, frame encode and the resynchronising scanner (frame.hpp).
 #include "rotacal/hw/frame.hpp"
 
 #include "rotacal/core/error.hpp"

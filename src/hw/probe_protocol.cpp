@@ -1,3 +1,4 @@
+// The ASCII probe dialects (sylvac-, keyence-style) and the probe stream frame (probe_protocol.hpp).
 #include "rotacal/hw/probe_protocol.hpp"
 
 #include <cctype>
@@ -115,15 +116,23 @@ LineScan split_lines(const std::uint8_t* data, std::size_t n, std::size_t max_li
   return scan;
 }
 
-std::string sylvac_request(int channel) {
-  if (channel < 1 || channel > 3)
-    throw InvalidArgument("sylvac_request: channel " + std::to_string(channel) + " is not 1..3");
-  return "?" + std::to_string(channel) + "\r";
+namespace {
+// A request of either dialect: one prefix character and the channel digit.
+std::string request_line(const char* who, char prefix, int channel, int lo, int hi) {
+  if (channel < lo || channel > hi)
+    throw InvalidArgument(std::string(who) + ": channel " + std::to_string(channel) + " is not " +
+                          std::to_string(lo) + ".." + std::to_string(hi));
+  return prefix + std::to_string(channel) + "\r";
 }
 
-std::optional<int> parse_sylvac_request(const std::string& line) {
-  return line.size() == 2 && line[0] == '?' ? channel_digit(line, 1, 1, 3) : std::nullopt;
+std::optional<int> parse_request(const std::string& line, char prefix, int lo, int hi) {
+  return line.size() == 2 && line[0] == prefix ? channel_digit(line, 1, lo, hi) : std::nullopt;
 }
+}  // namespace
+
+std::string sylvac_request(int channel) { return request_line("sylvac_request", '?', channel, 1, 3); }
+
+std::optional<int> parse_sylvac_request(const std::string& line) { return parse_request(line, '?', 1, 3); }
 
 std::optional<GaugeValue> parse_sylvac_reply(const std::string& line) {
   if (line == "Err01") return GaugeValue{GaugeValue::Kind::over_range, 0.0, 1};
@@ -150,15 +159,9 @@ std::string format_sylvac_reply(const GaugeValue& v) {
   return "?\r";
 }
 
-std::string keyence_request(int channel) {
-  if (channel < 0 || channel > 3)
-    throw InvalidArgument("keyence_request: channel " + std::to_string(channel) + " is not 0..3");
-  return "M" + std::to_string(channel) + "\r";
-}
+std::string keyence_request(int channel) { return request_line("keyence_request", 'M', channel, 0, 3); }
 
-std::optional<int> parse_keyence_request(const std::string& line) {
-  return line.size() == 2 && line[0] == 'M' ? channel_digit(line, 1, 0, 3) : std::nullopt;
-}
+std::optional<int> parse_keyence_request(const std::string& line) { return parse_request(line, 'M', 0, 3); }
 
 std::optional<KeyenceReply> parse_keyence_reply(const std::string& line) {
   const auto f = split(line, ',');

@@ -1,6 +1,8 @@
+// Pseudo-terminals for the virtual instruments (pseudo_terminal.hpp).
 #include "rotacal/hw/pseudo_terminal.hpp"
 
 #include <fcntl.h>
+#include <sys/ioctl.h>
 #include <termios.h>
 #include <unistd.h>
 
@@ -59,6 +61,12 @@ int PseudoTerminal::host_baud() const {
   termios t{};
   if (::tcgetattr(slave_keepalive_, &t) != 0) return 0;
   return baud_of(::cfgetospeed(&t));
+}
+
+std::size_t PseudoTerminal::unread() const {
+  int n = 0;
+  if (slave_keepalive_ < 0 || ::ioctl(slave_keepalive_, FIONREAD, &n) != 0 || n < 0) return 0;
+  return static_cast<std::size_t>(n);
 }
 
 void PseudoTerminal::hang_up() {

@@ -1,13 +1,19 @@
+// Recorders: one stream reader for the ballbar and the probe stream, the polled probe loop (recorder.hpp).
 #include "rotacal/hw/recorder.hpp"
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
+#include <limits>
 #include <optional>
 #include <thread>
 
 #include "rotacal/hw/ballbar_protocol.hpp"
+#include "rotacal/hw/pose_window.hpp"
+#include "rotacal/hw/stream_protocol.hpp"
 #include "rotacal/io/ballbar_file.hpp"
 
 namespace rotacal::hw {
@@ -99,7 +105,7 @@ struct StreamGuard {
   ~StreamGuard() {
     if (!active) return;
     try {
-      port.write(format_command(BallbarCommand::stop), 200);
+      port.write(format_command(StreamCommand::stop), 200);
     } catch (const std::exception&) {
     }
   }
@@ -143,12 +149,12 @@ std::optional<std::pair<StopReason, std::string>> handshake(ByteTransport& port,
 // answer as it should; `guard` sends STOP later once START has gone out.
 bool start_stream(ByteTransport& port, FrameReader& reader, RecordSummary& sum, const RecordOptions& opt,
                   bool zero, StreamGuard& guard) {
-  auto fail = handshake(port, reader, sum, format_command(BallbarCommand::identify), "ID ", 1.0);
-  if (!fail && zero) fail = handshake(port, reader, sum, format_command(BallbarCommand::zero), "OK ZERO", 1.0);
-  if (!fail) fail = handshake(port, reader, sum, format_command(BallbarCommand::rate, opt.rate_hz), "OK RATE", 1.0);
+  auto fail = handshake(port, reader, sum, format_command(StreamCommand::identify), "ID ", 1.0);
+  if (!fail && zero) fail = handshake(port, reader, sum, format_command(StreamCommand::zero), "OK ZERO", 1.0);
+  if (!fail) fail = handshake(port, reader, sum, format_command(StreamCommand::rate, opt.rate_hz), "OK RATE", 1.0);
   if (!fail) {
     guard.active = true;
-    fail = handshake(port, reader, sum, format_command(BallbarCommand::start), "OK START", 1.0);
+    fail = handshake(port, reader, sum, format_command(StreamCommand::start), "OK START", 1.0);
   }
   if (!fail) return true;
   sum.reason = fail->first;
@@ -170,11 +176,114 @@ bool check_link(Writer& out, RecordSummary& sum, std::size_t new_crc, std::size_
   return true;
 }
 
-template <typename Writer>
-void finish(Writer& out, RecordSummary& sum) {
+// The progress callback, at most every progress_interval_s; false when it asks to stop.
+class ProgressGate {
+ public:
+  explicit ProgressGate(const RecordOptions& opt) : opt_(opt) {}
+  bool operator()(std::size_t rows, const RecordSummary& sum, double t, double duration) {
+    if (!opt_.progress) return true;
+    const double now = wall_seconds();
+    if (now - last_ < opt_.progress_interval_s) return true;
+    last_ = now;
+    return opt_.progress({rows, sum.lost, sum.crc_errors + sum.malformed, t, duration});
+  }
+
+ private:
+  const RecordOptions& opt_;
+  double last_ = 0.0;
+};
+
+bool over_range(const BallbarFrame& s) { return (s.status & kStatusOverRange) != 0; }
+bool over_range(const ProbeFrame& s) { return s.status != 0; }
+
+// The one stream reader of both recorders: ID?, [ZERO,] RATE, START; then sample frames until
+// END, silence, a dead link or a stop request, and STOP however it ends. Every valid sample
+// goes to use(t, sample) with its unwrapped instrument time; sequence gaps, checksum errors,
+// malformed frames, time going backwards and over-range readings are counted and marked in
+// the file. Returns true at END (the instrument ran its program to the end).
+template <typename Writer, typename Decode, typename Use>
+bool read_stream(ByteTransport& port, const RecordOptions& opt, bool zero, Writer& out, RecordSummary& sum,
+                 Decode decode, Use use, double duration) {
+  FrameReader reader;
+  StreamGuard guard{port};
+  try {
+    if (!start_stream(port, reader, sum, opt, zero, guard)) return false;
+    StreamPosition stream;
+    ProgressGate progress(opt);
+    double last_data = wall_seconds();
+    std::size_t garbage_since_data = 0;
+    std::uint8_t buf[4096];
+    for (;;) {
+      const std::size_t n = port.read(buf, sizeof buf, opt.read_timeout_ms);
+      const double now = wall_seconds();
+      if (n == 0) {
+        ++sum.timeouts;
+        if (now - last_data > opt.silence_timeout_s) {
+          sum.reason = StopReason::silence;
+          sum.detail = "nothing for " + fixed(opt.silence_timeout_s, 1) + " s";
+          return false;
+        }
+      } else {
+        last_data = now;
+      }
+      std::size_t new_crc = 0;
+      bool ended = false;
+      for (const Frame& f : reader.feed(buf, n, sum, garbage_since_data, new_crc)) {
+        if (const auto text = decode_text(f)) {
+          ended = ended || *text == "END";
+          continue;
+        }
+        const auto s = decode(f);
+        if (!s) {
+          ++sum.malformed;
+          out.annotate("malformed: frame of type " + std::to_string(f.type) + " and " +
+                       std::to_string(f.payload.size()) + " bytes near t=" + fixed(stream.last_t, 4) + " s");
+          continue;
+        }
+        ++sum.frames;
+        const auto t = stream.advance(s->seq, s->t_us, out, sum);
+        if (!t) continue;
+        if (over_range(*s)) {
+          ++sum.over_range;
+          out.annotate("over range: seq " + std::to_string(s->seq) + " at t=" + fixed(*t, 4) + " s");
+          continue;
+        }
+        use(*t, *s);
+      }
+      const bool link_lost = check_link(out, sum, new_crc, garbage_since_data, stream.last_t, opt);
+      if (ended) {
+        sum.reason = StopReason::end_of_program;
+        guard.active = false;
+        return true;
+      }
+      if (link_lost) return false;
+      if (!progress(out.rows(), sum, stream.last_t, duration)) {
+        sum.reason = StopReason::stopped;
+        return false;
+      }
+    }
+  } catch (const DeviceDisconnected&) {
+    guard.active = false;  // no STOP down a dead line
+    throw;
+  }
+}
+
+// Runs a recording into `out`: whatever stops it (the end, a stop request, an unplugged
+// device), the file is closed with its summary line and keeps every row written.
+template <typename Writer, typename Body>
+RecordSummary run_recording(ByteTransport& port, Writer& out, Body body) {
+  RecordSummary sum;
+  try {
+    port.flush_input();
+    body(sum);
+  } catch (const DeviceDisconnected& e) {
+    sum.reason = StopReason::disconnected;
+    sum.detail = e.what();
+  }
   sum.rows = out.rows();
   out.annotate("summary: " + sum.describe());
   out.close();
+  return sum;
 }
 
 }  // namespace
@@ -194,8 +303,9 @@ std::string RecordSummary::describe() const {
   std::string s = std::to_string(rows) + " rows; " + std::to_string(lost) + " lost, " +
                   std::to_string(crc_errors) + " checksum errors, " + std::to_string(malformed) +
                   " malformed, " + std::to_string(garbage_bytes) + " garbage bytes, " +
-                  std::to_string(over_range) + " over range, " + std::to_string(timeouts) +
-                  " timeouts; stopped: " + to_string(reason);
+                  std::to_string(over_range) + " over range, " + std::to_string(timeouts) + " timeouts";
+  if (outside_window > 0) s += ", " + std::to_string(outside_window) + " polled readings outside their pose's window";
+  s += "; stopped: " + to_string(reason);
   if (!detail.empty()) s += " (" + detail + ")";
   return s;
 }
@@ -209,156 +319,189 @@ RecordSummary record_ballbar(ByteTransport& port, const ProgramTimeline& program
                      {"recorded_at", utc_now()},
                      {"sample_rate_hz", fixed(opt.rate_hz, 0)}};
   BallbarWriter out(path, header);
-  RecordSummary sum;
-  FrameReader reader;
-  StreamGuard guard{port};
-  const double L0 = program.header().ballbar_length;
-  try {
-    port.flush_input();
-    if (!start_stream(port, reader, sum, opt, opt.zero, guard)) {
-      finish(out, sum);
-      return sum;
-    }
-    StreamPosition stream;
-    double last_data = wall_seconds(), last_progress = 0.0;
-    std::size_t garbage_since_data = 0;
-    std::uint8_t buf[4096];
-    for (;;) {
-      const std::size_t n = port.read(buf, sizeof buf, opt.read_timeout_ms);
-      const double now = wall_seconds();
-      if (n == 0) {
-        ++sum.timeouts;
-        if (now - last_data > opt.silence_timeout_s) {
-          sum.reason = StopReason::silence;
-          sum.detail = "nothing for " + fixed(opt.silence_timeout_s, 1) + " s";
-          break;
-        }
-      } else {
-        last_data = now;
-      }
-      std::size_t new_crc = 0;
-      bool ended = false;
-      for (const Frame& f : reader.feed(buf, n, sum, garbage_since_data, new_crc)) {
-        if (const auto text = decode_text(f)) {
-          if (*text == "END") ended = true;
-          continue;
-        }
-        const auto s = decode_ballbar_sample(f);
-        if (!s) {
-          ++sum.malformed;
-          out.annotate("malformed: frame of type " + std::to_string(f.type) + " and " +
-                       std::to_string(f.payload.size()) + " bytes near t=" + fixed(stream.last_t, 4) + " s");
-          continue;
-        }
-        ++sum.frames;
-        const auto t = stream.advance(s->seq, s->t_us, out, sum);
-        if (!t) continue;
-        if (s->status & kStatusOverRange) {
-          ++sum.over_range;
-          out.annotate("over range: seq " + std::to_string(s->seq) + " at t=" + fixed(*t, 4) + " s");
-          continue;
-        }
-        BallbarSample row = program.at(*t);
-        row.length = L0 + 1e-6 * s->displacement_nm;
-        out.append(row);
-      }
-      const bool link_lost = check_link(out, sum, new_crc, garbage_since_data, stream.last_t, opt);
-      if (ended) {
-        sum.reason = StopReason::end_of_program;
-        guard.active = false;
-        break;
-      }
-      if (link_lost) break;
-      if (opt.progress && now - last_progress >= opt.progress_interval_s) {
-        last_progress = now;
-        if (!opt.progress({out.rows(), sum.lost, sum.crc_errors + sum.malformed, stream.last_t, program.duration()})) {
-          sum.reason = StopReason::stopped;
-          break;
-        }
-      }
-    }
-  } catch (const DeviceDisconnected& e) {
-    sum.reason = StopReason::disconnected;
-    sum.detail = e.what();
-    guard.active = false;
-  }
-  finish(out, sum);
-  return sum;
+  const double L0 = header.ballbar_length;
+  return run_recording(port, out, [&](RecordSummary& sum) {
+    read_stream(port, opt, opt.zero, out, sum, decode_ballbar_sample,
+                [&](double t, const BallbarFrame& s) {
+                  BallbarSample row = program.at(t);
+                  row.length = L0 + 1e-6 * s.displacement_nm;
+                  out.append(row);
+                },
+                program.duration());
+  });
 }
 
 // ---------------------------------------------------------------------------------- R-test
 
 namespace {
 
-// Averages the at-rest readings of each pose in program order and writes its row.
+// Averages the readings of each pose taken inside its read window (pose_window.hpp), in
+// program order, and writes its row with the readings' mean time and smallest margin. A
+// polled reading that may have been taken outside the window is counted and marked, not used;
+// a pose without a reading inside its window is counted lost and marked.
 class PoseAverager {
  public:
   PoseAverager(const RtestSession& program, double dwell_s, RtestWriter& out, RecordSummary& sum)
-      : program_(program), half_window_(0.25 * dwell_s), out_(out), summary_(sum) {}
+      : program_(program), dwell_s_(dwell_s), out_(out), summary_(sum) {}
 
   bool done() const { return next_ >= program_.samples.size(); }
-  double window_start() const { return done() ? 1e300 : program_.samples[next_].time - half_window_; }
-  double end_time() const { return program_.samples.back().time + half_window_; }
+  /// The read window of the next pose to be written.
+  PoseWindow window() const { return pose_window(program_.samples[next_].time, dwell_s_); }
+  double end_time() const { return pose_window(program_.samples.back().time, dwell_s_).end; }
 
-  /// A reading at program time t: pose(s) whose window ended before t are written first.
-  void add(double t, const Eigen::Vector3d& r) {
-    advance(t);
-    if (done() || t < window_start()) return;
+  /// A reading taken somewhere in program time [a, b] (a == b for a timestamped stream sample).
+  /// Poses whose window ended before a are written first. `polled`: a reading that is not
+  /// surely inside the window is marked; stream samples between windows (the table moving) are
+  /// simply not used.
+  void add(double a, double b, const Eigen::Vector3d& r, bool polled) {
+    advance(a);
+    if (done()) return;
+    const PoseWindow w = window();
+    if (!w.contains(a, b)) {
+      if (polled) {
+        ++outside_;
+        worst_outside_ = std::min(worst_outside_, w.margin(a, b));
+      }
+      return;
+    }
     sum_ += r;
     sum_sq_ += r.cwiseProduct(r);
+    t_sum_ += 0.5 * (a + b);
+    margin_ = std::min(margin_, w.margin(a, b));
     ++n_;
   }
-  /// Write every pose whose window ends before t.
+  /// Write every pose whose window surely ended before program time t.
   void advance(double t) {
-    while (!done() && t > program_.samples[next_].time + half_window_) write_pose();
+    while (!done() && t > window().end) write_pose();
   }
+  /// The host could not take a reading in program time [a, b]: it did not run (between two
+  /// passes of its loop) or was waiting for a reply. Kept so that a pose lost to a late host
+  /// says for how long of its window that was.
+  void host_unavailable(double a, double b) {
+    if (b > a && !done() && b > window().begin) unavailable_.emplace_back(a, b);
+  }
+  /// How long, program s, one reading typically takes the host now (RoundTrips).
+  void reading_takes(double s) { reading_takes_ = s; }
+  bool has_reading() const { return n_ > 0; }
 
  private:
   void write_pose() {
     const RtestSample& p = program_.samples[next_];
+    const PoseWindow w = window();
+    const std::string pose = "pose " + std::to_string(next_ + 1) + " (set-up " + p.setup + ", B/A=" +
+                             fixed(p.tilt_deg, 3) + ", C=" + fixed(p.rot_deg, 3) + ")";
+    const std::string span = "[" + fixed(w.begin, 3) + ", " + fixed(w.end, 3) + "] s";
+    const std::string late = std::to_string(outside_) + " reading" + (outside_ == 1 ? "" : "s") +
+                             " not surely inside it (margin down to " + fixed(worst_outside_, 3) + " s)";
+    summary_.outside_window += outside_;
     if (n_ == 0) {
       ++summary_.lost;
-      out_.annotate("missing: pose " + std::to_string(next_ + 1) + " (set-up " + p.setup + ", B/A=" +
-                    fixed(p.tilt_deg, 3) + ", C=" + fixed(p.rot_deg, 3) + "): no reading at rest");
+      // The longest stretch of the window in which the host could not read.
+      double longest = 0.0;
+      std::pair<double, double> when;
+      for (const auto& [a, b] : unavailable_) {
+        const double overlap = std::min(w.end, b) - std::max(w.begin, a);
+        if (overlap > longest) longest = overlap, when = {a, b};
+      }
+      const std::string idle = (longest > 0.0 ? "; the host could not read for " + fixed(longest, 3) + " s of it (" +
+                                                    fixed(when.first, 3) + " to " + fixed(when.second, 3) + " s)"
+                                              : std::string()) +
+                               "; a reading took the host " + fixed(reading_takes_, 3) + " s";
+      out_.annotate("missing: " + pose + ": no reading inside its window " + span + idle +
+                    (outside_ > 0 ? "; " + late : ""));
     } else {
+      if (outside_ > 0) out_.annotate("outside: " + pose + ", window " + span + ": " + late + ", not used");
       RtestSample row = p;
-      const Eigen::Vector3d mean = sum_ / static_cast<double>(n_);
+      const double n = static_cast<double>(n_);
+      const Eigen::Vector3d mean = sum_ / n;
       row.raw = mean;
       Eigen::Vector3d var = Eigen::Vector3d::Zero();
-      if (n_ > 1)
-        var = ((sum_sq_ - static_cast<double>(n_) * mean.cwiseProduct(mean)) / static_cast<double>(n_ - 1))
-                  .cwiseMax(0.0);
-      row.extra = {std::to_string(n_), fixed(1e3 * std::sqrt(var.maxCoeff()), 3)};
+      if (n_ > 1) var = ((sum_sq_ - n * mean.cwiseProduct(mean)) / (n - 1.0)).cwiseMax(0.0);
+      row.extra = {std::to_string(n_), fixed(1e3 * std::sqrt(var.maxCoeff()), 3), fixed(t_sum_ / n, 4),
+                   fixed(margin_, 4)};
       out_.append(row);
     }
     ++next_;
     n_ = 0;
+    outside_ = 0;
     sum_.setZero();
     sum_sq_.setZero();
+    t_sum_ = 0.0;
+    margin_ = worst_outside_ = std::numeric_limits<double>::infinity();
+    if (!done()) {  // keep what may still overlap the next window (a stall may span several)
+      const double begin = window().begin;
+      unavailable_.erase(std::remove_if(unavailable_.begin(), unavailable_.end(),
+                                        [&](const std::pair<double, double>& u) { return u.second <= begin; }),
+                         unavailable_.end());
+    }
   }
   const RtestSession& program_;
-  double half_window_;
+  double dwell_s_;
   RtestWriter& out_;
   RecordSummary& summary_;
   std::size_t next_ = 0;
   std::size_t n_ = 0;
+  std::size_t outside_ = 0;
   Eigen::Vector3d sum_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d sum_sq_ = Eigen::Vector3d::Zero();
+  double t_sum_ = 0.0;
+  double margin_ = std::numeric_limits<double>::infinity();
+  double worst_outside_ = std::numeric_limits<double>::infinity();
+  std::vector<std::pair<double, double>> unavailable_;  ///< program s, since this window began
+  double reading_takes_ = 0.0;
 };
 
-// One polled reading of all three channels; nullopt (and counted) if any channel failed.
+// The program clock of a polled instrument as the host knows it. The instrument starts it
+// when our first request reaches it: after we sent that request, before its reply came back.
+// A host wall time w is therefore program time in [(w - replied) speed, (w - sent) speed].
+struct ProgramClock {
+  double sent = 0.0;
+  double replied = 0.0;
+  double speed = 1.0;
+  double earliest(double wall) const { return (wall - replied) * speed; }
+  double latest(double wall) const { return (wall - sent) * speed; }
+};
+
+// The typical (median) of the last 15 request-to-reply times, wall s: how long the host may
+// expect a reading to take. A median, so that one stall does not stop the host from reading.
+class RoundTrips {
+ public:
+  void add(double s) {
+    last_[next_++ % last_.size()] = s;
+    count_ = std::min(count_ + 1, last_.size());
+  }
+  double typical() const {
+    if (count_ == 0) return 0.0;
+    std::array<double, 15> v = last_;
+    std::nth_element(v.begin(), v.begin() + static_cast<long>(count_ / 2), v.begin() + static_cast<long>(count_));
+    return v[count_ / 2];
+  }
+
+ private:
+  std::array<double, 15> last_{};
+  std::size_t next_ = 0;
+  std::size_t count_ = 0;
+};
+
 // Reply lines across reads (a reply may arrive in pieces, or two at once).
 struct LineReader {
   Bytes pending;
   std::vector<std::string> lines;  // complete, not yet taken
   std::size_t next = 0;
-  std::optional<std::string> take(ByteTransport& port, RecordSummary& sum, int timeout_ms) {
-    const double t_end = wall_seconds() + 1e-3 * timeout_ms;
+  std::size_t taken = 0;  // lines returned so far
+  /// The next reply line. Each read_timeout_ms without one counts as a timeout; nullopt after
+  /// give_up_s (the device is silent).
+  std::optional<std::string> take(ByteTransport& port, RecordSummary& sum, int read_timeout_ms, double give_up_s) {
+    const double t_end = wall_seconds() + give_up_s;
     std::uint8_t buf[256];
     while (next >= lines.size()) {
       const double left = t_end - wall_seconds();
       if (left <= 0) return std::nullopt;
-      const std::size_t n = port.read(buf, sizeof buf, std::max(1, static_cast<int>(1e3 * left)));
+      const std::size_t n = port.read(buf, sizeof buf, std::clamp(static_cast<int>(1e3 * left), 1, read_timeout_ms));
+      if (n == 0) {
+        ++sum.timeouts;
+        continue;
+      }
       pending.insert(pending.end(), buf, buf + n);
       LineScan scan = split_lines(pending.data(), pending.size());
       pending.erase(pending.begin(), pending.begin() + static_cast<long>(scan.consumed));
@@ -367,50 +510,59 @@ struct LineReader {
       next = 0;
       lines.insert(lines.end(), scan.lines.begin(), scan.lines.end());
     }
+    ++taken;
     return lines[next++];
   }
 };
 
-// One polled reading of all three channels; nullopt (and counted) if any channel failed.
-std::optional<Eigen::Vector3d> poll_once(ByteTransport& port, ProbeMode mode, LineReader& lines,
-                                         RecordSummary& sum, int timeout_ms) {
-  auto read_line = [&] { return lines.take(port, sum, timeout_ms); };
+struct Poll {
+  std::optional<Eigen::Vector3d> reading;  ///< nullopt (and counted) if any channel failed
+  bool silent = false;                     ///< a request went unanswered for silence_timeout_s
+};
+
+// One polled reading of all three channels. A polled device answers every request once, so
+// the host waits for that answer (however late) rather than asking again: a second request
+// would pair every later reply with the wrong request, and the wrong time.
+Poll poll_once(ByteTransport& port, ProbeMode mode, LineReader& lines, RecordSummary& sum, const RecordOptions& opt) {
+  auto ask = [&](const std::string& request) {
+    port.write(request, 200);
+    return lines.take(port, sum, opt.read_timeout_ms, opt.silence_timeout_s);
+  };
   auto value_of = [&](const GaugeValue& v) -> std::optional<double> {
     if (v.ok()) return v.mm;
     if (v.kind == GaugeValue::Kind::error) ++sum.malformed;
     else ++sum.over_range;
     return std::nullopt;
   };
+  Poll failed;
   Eigen::Vector3d r;
   if (mode == ProbeMode::keyence) {
-    port.write(keyence_request(0), 200);
-    const auto line = read_line();
-    if (!line) return ++sum.timeouts, std::nullopt;
+    const auto line = ask(keyence_request(0));
+    if (!line) return failed.silent = true, failed;
     const auto reply = parse_keyence_reply(*line);
-    if (!reply) return ++sum.malformed, std::nullopt;
+    if (!reply) return ++sum.malformed, failed;
     if (reply->values.size() != 3) {
       value_of(reply->values.front());
-      return std::nullopt;
+      return failed;
     }
     for (int i = 0; i < 3; ++i) {
       const auto v = value_of(reply->values[static_cast<std::size_t>(i)]);
-      if (!v) return std::nullopt;
+      if (!v) return failed;
       r[i] = *v;
     }
   } else {
     for (int ch = 1; ch <= 3; ++ch) {
-      port.write(sylvac_request(ch), 200);
-      const auto line = read_line();
-      if (!line) return ++sum.timeouts, std::nullopt;
+      const auto line = ask(sylvac_request(ch));
+      if (!line) return failed.silent = true, failed;
       const auto reply = parse_sylvac_reply(*line);
-      if (!reply) return ++sum.malformed, std::nullopt;
+      if (!reply) return ++sum.malformed, failed;
       const auto v = value_of(*reply);
-      if (!v) return std::nullopt;
+      if (!v) return failed;
       r[ch - 1] = *v;
     }
   }
   ++sum.frames;
-  return r;
+  return Poll{r, false};
 }
 
 }  // namespace
@@ -423,117 +575,83 @@ RecordSummary record_rtest(ByteTransport& port, ProbeMode mode, const RtestSessi
   RtestSession header = program;
   header.samples.clear();
   header.noise_um.reset();  // what the program was simulated with is not what was measured
-  header.extra_columns = {"n", "std_um"};
+  header.extra_columns = {"n", "std_um", "t_s", "margin_s"};
   header.metadata = {{"recorded_from", port.path()},
                      {"recorded_at", utc_now()},
                      {"probe_mode", to_string(mode)}};
   header.probe_dirs.clear();
   for (int k = 0; k < 3; ++k) header.probe_dirs[k + 1] = probe_dirs.row(k).transpose();
   RtestWriter out(path, header, /*raw=*/true);
-  RecordSummary sum;
-  PoseAverager poses(program, dwell_s, out, sum);
-  StreamGuard guard{port};
-  double last_progress = 0.0;
-  auto progress = [&](double t) {
-    const double now = wall_seconds();
-    if (!opt.progress || now - last_progress < opt.progress_interval_s) return true;
-    last_progress = now;
-    return opt.progress({out.rows(), sum.lost, sum.crc_errors + sum.malformed, t, poses.end_time()});
-  };
-  try {
-    port.flush_input();
+  return run_recording(port, out, [&](RecordSummary& sum) {
+    PoseAverager poses(program, dwell_s, out, sum);
     if (mode == ProbeMode::stream) {
-      FrameReader reader;
-      if (!start_stream(port, reader, sum, opt, false, guard)) {
-        finish(out, sum);
-        return sum;
-      }
-      StreamPosition stream;
-      double last_data = wall_seconds();
-      std::size_t garbage_since_data = 0;
-      std::uint8_t buf[4096];
-      for (;;) {
-        const std::size_t n = port.read(buf, sizeof buf, opt.read_timeout_ms);
-        if (n == 0 && ++sum.timeouts && wall_seconds() - last_data > opt.silence_timeout_s) {
-          sum.reason = StopReason::silence;
-          sum.detail = "nothing for " + fixed(opt.silence_timeout_s, 1) + " s";
-          break;
-        }
-        if (n > 0) last_data = wall_seconds();
-        std::size_t new_crc = 0;
-        bool ended = false;
-        for (const Frame& f : reader.feed(buf, n, sum, garbage_since_data, new_crc)) {
-          if (const auto text = decode_text(f)) {
-            ended = ended || *text == "END";
-            continue;
-          }
-          const auto s = decode_probe_sample(f);
-          if (!s) {
-            ++sum.malformed;
-            continue;
-          }
-          ++sum.frames;
-          const auto t = stream.advance(s->seq, s->t_us, out, sum);
-          if (!t) continue;
-          if (s->status) {
-            ++sum.over_range;
-            continue;
-          }
-          poses.add(*t, Eigen::Vector3d(1e-6 * s->nm[0], 1e-6 * s->nm[1], 1e-6 * s->nm[2]));
-        }
-        const bool link_lost = check_link(out, sum, new_crc, garbage_since_data, stream.last_t, opt);
-        if (ended) {
-          guard.active = false;
-          poses.advance(1e300);
-          sum.reason = StopReason::end_of_program;
-          break;
-        }
-        if (link_lost) break;
-        if (!progress(stream.last_t)) {
-          sum.reason = StopReason::stopped;
-          break;
-        }
-      }
-    } else {
-      // Polled: the host clock paces the program; the instrument starts it at our first request.
-      LineReader lines;
-      const double t0 = wall_seconds();
-      std::size_t failures_in_row = 0;
-      for (;;) {
-        const double t_req = (wall_seconds() - t0) * opt.speed;
-        const auto r = poll_once(port, mode, lines, sum, opt.read_timeout_ms);
-        const double t = 0.5 * (t_req + (wall_seconds() - t0) * opt.speed);
-        if (r) {
-          failures_in_row = 0;
-          poses.add(t, *r);
-        } else if (++failures_in_row * static_cast<std::size_t>(opt.read_timeout_ms) >
-                       static_cast<std::size_t>(1e3 * opt.silence_timeout_s) &&
-                   sum.timeouts > 0) {
-          sum.reason = sum.garbage_bytes > 0 ? StopReason::no_valid_data : StopReason::silence;
-          sum.detail = "no valid reply for " + fixed(opt.silence_timeout_s, 1) + " s";
-          break;
-        }
-        poses.advance(t);
+      const bool ended = read_stream(
+          port, opt, false, out, sum, decode_probe_sample,
+          [&](double t, const ProbeFrame& s) {
+            poses.add(t, t, Eigen::Vector3d(1e-6 * s.nm[0], 1e-6 * s.nm[1], 1e-6 * s.nm[2]), false);
+          },
+          poses.end_time());
+      if (ended) poses.advance(1e300);
+      return;
+    }
+    // Polled: each reading is placed by the interval from its first request to its last reply,
+    // in program time as far as the clock is known (ProgramClock). The host reads while the
+    // next pose is surely in its window and a round trip still fits; a pose is written once its
+    // window has surely passed.
+    ProgressGate progress(opt);
+    LineReader lines;
+    std::optional<ProgramClock> clock;
+    const double first_sent = wall_seconds();
+    RoundTrips round_trips;
+    auto pause = [](double s) { std::this_thread::sleep_for(std::chrono::duration<double>(std::clamp(s, 0.001, 0.05))); };
+    double last_ran = first_sent;  // when the loop last ran, wall s
+    for (;;) {
+      if (clock) {
+        const double now = wall_seconds();
+        const double early = clock->earliest(now), late = clock->latest(now);
+        poses.host_unavailable(clock->latest(last_ran), early);
+        last_ran = now;
+        poses.advance(early);
         if (poses.done()) {
           sum.reason = StopReason::end_of_program;
-          break;
+          return;
         }
-        if (!progress(t)) {
+        if (!progress(out.rows(), sum, late, poses.end_time())) {
           sum.reason = StopReason::stopped;
-          break;
+          return;
         }
-        // Sleep until the next pose's window if it is far ahead; else poll again soon.
-        const double wait = (poses.window_start() - (wall_seconds() - t0) * opt.speed) / opt.speed;
-        std::this_thread::sleep_for(std::chrono::duration<double>(std::clamp(wait, 0.002, 0.05)));
+        // Read only while the next pose is surely in its window and a reading still fits: a
+        // first one if one typical reading does, more while three do (and 5 % of the window).
+        const PoseWindow w = poses.window();
+        const double takes = round_trips.typical() * opt.speed;
+        poses.reading_takes(takes);
+        const double guard = poses.has_reading() ? std::max(3.0 * takes, 0.05 * (w.end - w.begin)) : takes;
+        if (early < w.begin) {
+          pause((w.begin - early) / opt.speed);
+          continue;
+        }
+        if (late + guard > w.end) {
+          pause((w.end - early) / opt.speed + 1e-3);  // until it has surely passed: written then
+          continue;
+        }
       }
+      const double sent = wall_seconds();
+      const std::size_t taken = lines.taken;
+      const Poll poll = poll_once(port, mode, lines, sum, opt);
+      const double received = wall_seconds();
+      if (poll.silent) {
+        sum.reason = sum.garbage_bytes > 0 ? StopReason::no_valid_data : StopReason::silence;
+        sum.detail = "no valid reply for " + fixed(opt.silence_timeout_s, 1) + " s";
+        return;
+      }
+      if (!clock && lines.taken > taken) clock = ProgramClock{first_sent, received, opt.speed};
+      round_trips.add(received - sent);
+      if (clock) poses.host_unavailable(clock->latest(sent), clock->earliest(received));
+      if (poll.reading && clock) poses.add(clock->earliest(sent), clock->latest(received), *poll.reading, true);
+      last_ran = wall_seconds();
+      pause(0.002);  // between readings inside a window
     }
-  } catch (const DeviceDisconnected& e) {
-    sum.reason = StopReason::disconnected;
-    sum.detail = e.what();
-    guard.active = false;
-  }
-  finish(out, sum);
-  return sum;
+  });
 }
 
 }  // namespace rotacal::hw

@@ -1,3 +1,4 @@
+// ByteTransport: termios for pseudo-terminals, port listing and opening (transport.hpp).
 #include "rotacal/hw/transport.hpp"
 
 #include <fcntl.h>

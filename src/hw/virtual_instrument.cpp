@@ -1,8 +1,10 @@
+// Virtual instruments: the shared pty/stream/command base, the ballbar and the R-test (virtual_instrument.hpp).
 #include "rotacal/hw/virtual_instrument.hpp"
 
 #include <poll.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -23,10 +25,12 @@ double wall_seconds() {
 
 // --------------------------------------------------------------------------- common part
 
-VirtualInstrument::VirtualInstrument(int baud, double speed, const FaultInjection& faults)
-    : baud_(baud), speed_(speed), faults_(faults) {
+VirtualInstrument::VirtualInstrument(int baud, double speed, double rate_hz, const FaultInjection& faults)
+    : baud_(baud), speed_(speed), faults_(faults), rate_hz_(rate_hz) {
   if (!(speed > 0.0) || !std::isfinite(speed))
     throw InvalidArgument("virtual instrument: speed " + std::to_string(speed) + " must be positive");
+  if (!(rate_hz >= 1.0 && rate_hz <= 1000.0))
+    throw InvalidArgument("virtual instrument: rate_hz " + std::to_string(rate_hz) + " must be 1..1000");
 }
 
 VirtualInstrument::~VirtualInstrument() { halt(); }
@@ -63,7 +67,23 @@ void VirtualInstrument::run() {
   } catch (const std::exception& e) {
     thread_error_ = e.what();
   }
+  thread_done_ = true;
   finished_ = true;
+}
+
+void VirtualInstrument::mark_finished() {
+  {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    stats_.finished = true;
+  }
+  finished_at_ = wall_seconds();
+  finished_ = true;
+}
+
+bool VirtualInstrument::finished() const {
+  if (!finished_.load()) return false;
+  if (thread_done_.load()) return true;
+  return pty_.unread() == 0 || wall_seconds() - finished_at_.load() > 10.0;
 }
 
 double VirtualInstrument::now() const {
@@ -130,6 +150,9 @@ void VirtualInstrument::send_reply(const Bytes& bytes) {
 void VirtualInstrument::send_frame(Bytes frame) {
   const std::uint64_t k = ++stream_count_;  // 1-based frame count
   if (faults_.close_after >= 0 && static_cast<long>(k) > faults_.close_after) {
+    // Unplugged after frame close_after: let the host read what was sent first (up to 2 s), so
+    // that the frames before the unplug arrive however busy the host is.
+    for (int i = 0; i < 200 && pty_.unread() > 0 && !stop_; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
     pty_.hang_up();
     hung_up_ = true;
     return;
@@ -158,6 +181,57 @@ void VirtualInstrument::send_frame(Bytes frame) {
     write_all(Bytes{0x13, 0xAA, 0x37, 0x00, 0xFF, 0x55, 0x42});
 }
 
+void VirtualInstrument::serve_once() {
+  for (const std::string& line : read_lines()) answer(line);
+  serve_stream();
+}
+
+void VirtualInstrument::answer(const std::string& line) {
+  const auto cmd = parse_command(line);
+  if (!cmd) return send_reply(encode_text("ERR unknown command '" + line + "'"));
+  switch (cmd->command) {
+    case StreamCommand::identify: send_reply(encode_text("ID " + identity())); break;
+    case StreamCommand::rate:
+      if (streaming_) {
+        send_reply(encode_text("ERR RATE while streaming"));
+      } else {
+        rate_hz_ = cmd->rate_hz;
+        send_reply(encode_text("OK RATE " + std::to_string(static_cast<int>(rate_hz_))));
+      }
+      break;
+    case StreamCommand::zero:
+      send_reply(encode_text(zero() ? "OK ZERO" : "ERR unknown command '" + line + "'"));
+      break;
+    case StreamCommand::start:
+      streaming_ = true;
+      next_sample_ = 0;
+      clock_start();
+      send_reply(encode_text("OK START"));
+      break;
+    case StreamCommand::stop:
+      streaming_ = false;
+      send_reply(encode_text("OK STOP"));
+      break;
+  }
+}
+
+void VirtualInstrument::serve_stream() {
+  if (!streaming_) return;
+  const double t_now = now();
+  for (int batch = 0; streaming_ && !hung_up_ && batch < 200; ++batch) {
+    const double t = static_cast<double>(next_sample_) / rate_hz_;
+    if (t > t_now) break;
+    if (t > stream_end()) {
+      streaming_ = false;
+      send_reply(encode_text("END"));
+      mark_finished();
+      break;
+    }
+    send_frame(sample_frame(t, seq_++));
+    ++next_sample_;
+  }
+}
+
 // --------------------------------------------------------------------------- ballbar
 
 struct VirtualBallbar::Noise {
@@ -166,81 +240,34 @@ struct VirtualBallbar::Noise {
 };
 
 VirtualBallbar::VirtualBallbar(ProgramTimeline program, const VirtualBallbarOptions& options)
-    : VirtualInstrument(options.baud, options.speed, options.faults),
+    : VirtualInstrument(options.baud, options.speed, options.rate_hz, options.faults),
       program_(std::move(program)),
       options_(options),
-      noise_(std::make_shared<Noise>()),
-      rate_hz_(options.rate_hz) {
+      noise_(std::make_shared<Noise>()) {
   if (!(options.noise_um >= 0.0)) throw InvalidArgument("virtual ballbar: noise_um must be >= 0");
-  if (!(options.rate_hz >= 1.0 && options.rate_hz <= 1000.0))
-    throw InvalidArgument("virtual ballbar: rate_hz " + std::to_string(options.rate_hz) + " must be 1..1000");
   if (options.truth.machine != program_.header().machine)
     throw InvalidArgument("virtual ballbar: the machine model and the program are for different machines");
   noise_->rng.seed(options.seed);
 }
 
-void VirtualBallbar::serve_once() {
-  for (const std::string& line : read_lines()) {
-    const auto cmd = parse_command(line);
-    if (!cmd) {
-      send_reply(encode_text("ERR unknown command '" + line + "'"));
-      continue;
-    }
-    switch (cmd->command) {
-      case BallbarCommand::identify: send_reply(encode_text("ID rotacal-virtual-ballbar 1.0")); break;
-      case BallbarCommand::rate:
-        if (streaming_) {
-          send_reply(encode_text("ERR RATE while streaming"));
-        } else {
-          rate_hz_ = cmd->rate_hz;
-          send_reply(encode_text("OK RATE " + std::to_string(static_cast<int>(rate_hz_))));
-        }
-        break;
-      case BallbarCommand::zero: {
-        // Zero at the current pose (normally done in the calibrator, at L0, before START).
-        const BallbarSample s = program_.at(now());
-        zero_mm_ = predict_lengths(options_.truth, {s})[0] - program_.header().ballbar_length;
-        send_reply(encode_text("OK ZERO"));
-        break;
-      }
-      case BallbarCommand::start:
-        streaming_ = true;
-        next_sample_ = 0;
-        clock_start();
-        send_reply(encode_text("OK START"));
-        break;
-      case BallbarCommand::stop:
-        streaming_ = false;
-        send_reply(encode_text("OK STOP"));
-        break;
-    }
-  }
-  if (!streaming_) return;
-  const double t_now = now();
+bool VirtualBallbar::zero() {
+  // Zero at the current pose (normally done in the calibrator, at L0, before START).
+  const BallbarSample s = program_.at(now());
+  zero_mm_ = predict_lengths(options_.truth, {s})[0] - program_.header().ballbar_length;
+  return true;
+}
+
+Bytes VirtualBallbar::sample_frame(double t, std::uint16_t seq) {
   const double L0 = program_.header().ballbar_length;
-  int batch = 0;
-  while (streaming_ && line_up() && batch < 200) {
-    const double t = static_cast<double>(next_sample_) / rate_hz_;
-    if (t > t_now) break;
-    if (t > program_.duration()) {
-      streaming_ = false;
-      send_reply(encode_text("END"));
-      mark_finished();
-      break;
-    }
-    const BallbarSample s = program_.at(t);
-    const double length = predict_lengths(options_.truth, {s})[0] +
-                          1e-3 * options_.noise_um * noise_->gauss(noise_->rng);
-    BallbarFrame f;
-    f.seq = seq_++;
-    f.t_us = static_cast<std::uint32_t>(std::llround(t * 1e6));
-    const double nm = std::round((length - L0 - zero_mm_) * 1e6);
-    f.displacement_nm = static_cast<std::int32_t>(std::clamp(nm, -2.0e9, 2.0e9));
-    if (std::abs(length - L0 - zero_mm_) > 1.0) f.status |= kStatusOverRange;  // +-1 mm travel
-    send_frame(encode_ballbar_sample(f));
-    ++next_sample_;
-    ++batch;
-  }
+  const double length =
+      predict_lengths(options_.truth, {program_.at(t)})[0] + 1e-3 * options_.noise_um * noise_->gauss(noise_->rng);
+  BallbarFrame f;
+  f.seq = seq;
+  f.t_us = static_cast<std::uint32_t>(std::llround(t * 1e6));
+  const double nm = std::round((length - L0 - zero_mm_) * 1e6);
+  f.displacement_nm = static_cast<std::int32_t>(std::clamp(nm, -2.0e9, 2.0e9));
+  if (std::abs(length - L0 - zero_mm_) > 1.0) f.status |= kStatusOverRange;  // +-1 mm travel
+  return encode_ballbar_sample(f);
 }
 
 // --------------------------------------------------------------------------- R-test
@@ -251,7 +278,7 @@ struct VirtualRtest::Noise {
 };
 
 VirtualRtest::VirtualRtest(const VirtualRtestOptions& options)
-    : VirtualInstrument(options.baud, options.speed, options.faults),
+    : VirtualInstrument(options.baud, options.speed, options.rate_hz, options.faults),
       options_(options),
       noise_(std::make_shared<Noise>()) {
   // The simulator's noise-free raw readings are the exact readings of each pose at rest.
@@ -274,103 +301,75 @@ VirtualRtest::VirtualRtest(const VirtualRtestOptions& options)
 Eigen::Vector3d VirtualRtest::readings_at(double t, bool* at_rest) {
   const auto& rows = program_.samples;
   const double dwell = options_.sim.pattern.dwell_s;
-  const double t0 = rows.front().time;
-  const double x = (t - t0) / dwell;
-  const long k = std::clamp(std::lround(x), 0L, static_cast<long>(rows.size()) - 1);
-  const double off = x - static_cast<double>(k);
+  const long last = static_cast<long>(rows.size()) - 1;
+  const long k = std::clamp(std::lround((t - rows.front().time) / dwell), 0L, last);
+  const PoseWindow w = pose_window(rows[static_cast<std::size_t>(k)].time, dwell);
   Eigen::Vector3d r;
-  if (std::abs(off) <= 0.5 * kRtestRestFraction || (k == 0 && off < 0) ||
-      (k + 1 == static_cast<long>(rows.size()) && off > 0)) {
+  if (w.contains(t, t) || (k == 0 && t < w.begin) || (k == last && t > w.end)) {
     *at_rest = true;
     r = exact_[static_cast<std::size_t>(k)];
   } else {
     // Moving between poses: the readings slide from one pose's to the next, with a
     // following-error bump that a recorder must not mistake for a measurement.
     *at_rest = false;
-    const long a = off > 0 ? k : k - 1;
-    const double u = (x - static_cast<double>(a) - 0.5 * kRtestRestFraction) / (1.0 - kRtestRestFraction);
-    const auto ia = static_cast<std::size_t>(a);
-    r = exact_[ia] + u * (exact_[ia + 1] - exact_[ia]) + Eigen::Vector3d::Constant(0.005 * std::sin(M_PI * u));
+    const auto a = static_cast<std::size_t>(t > w.end ? k : k - 1);
+    const double from = pose_window(rows[a].time, dwell).end, to = pose_window(rows[a + 1].time, dwell).begin;
+    const double u = (t - from) / (to - from);
+    r = exact_[a] + u * (exact_[a + 1] - exact_[a]) + Eigen::Vector3d::Constant(0.005 * std::sin(M_PI * u));
   }
   for (int i = 0; i < 3; ++i) r[i] += 1e-3 * options_.sim.noise_um * noise_->gauss(noise_->rng);
   return r;
 }
 
+double VirtualRtest::stream_end() const {
+  return program_.samples.back().time + 0.5 * options_.sim.pattern.dwell_s;  // the last dwell is over
+}
+
 void VirtualRtest::serve_once() {
-  const double end = program_.samples.back().time + 0.5 * options_.sim.pattern.dwell_s;
+  VirtualInstrument::serve_once();
+  // Polled: the pattern has run once its last dwell is over, asked or not.
+  if (options_.mode != ProbeMode::stream && clock_running() && now() > stream_end()) mark_finished();
+}
+
+void VirtualRtest::answer(const std::string& line) {
+  if (options_.mode == ProbeMode::stream) return VirtualInstrument::answer(line);
+  if (!clock_running()) clock_start();  // polled: the program starts at the first request
   auto value = [](double mm) {
     if (mm > 2.0) return GaugeValue{GaugeValue::Kind::over_range, 0.0, 1};
     if (mm < -2.0) return GaugeValue{GaugeValue::Kind::under_range, 0.0, 1};
     return GaugeValue{GaugeValue::Kind::value, mm, 0};
   };
-  for (const std::string& line : read_lines()) {
-    if (options_.mode == ProbeMode::stream) {
-      const auto cmd = parse_command(line);
-      if (cmd && cmd->command == BallbarCommand::start) {
-        streaming_ = true;
-        next_sample_ = 0;
-        clock_start();
-        send_reply(encode_text("OK START"));
-      } else if (cmd && cmd->command == BallbarCommand::stop) {
-        streaming_ = false;
-        send_reply(encode_text("OK STOP"));
-      } else if (cmd && cmd->command == BallbarCommand::identify) {
-        send_reply(encode_text("ID rotacal-virtual-rtest 1.0"));
-      } else if (cmd && cmd->command == BallbarCommand::rate && !streaming_) {
-        options_.rate_hz = cmd->rate_hz;
-        send_reply(encode_text("OK RATE " + std::to_string(static_cast<int>(cmd->rate_hz))));
-      } else {
-        send_reply(encode_text("ERR unknown command '" + line + "'"));
-      }
-      continue;
-    }
-    if (!clock_running()) clock_start();  // polled: the program starts at the first request
-    bool rest = false;
-    const Eigen::Vector3d r = readings_at(now(), &rest);
-    if (options_.mode == ProbeMode::sylvac) {
-      const auto ch = parse_sylvac_request(line);
-      send_reply(ch ? format_sylvac_reply(value(r[*ch - 1]))
-                    : format_sylvac_reply(GaugeValue{GaugeValue::Kind::error, 0.0, -1}));
-    } else {
-      const auto ch = parse_keyence_request(line);
-      KeyenceReply reply;
-      if (!ch) {
-        reply = {0, {GaugeValue{GaugeValue::Kind::error, 0.0, 2}}};  // ER,M0,02: command error
-      } else if (*ch == 0) {
-        reply = {0, {value(r[0]), value(r[1]), value(r[2])}};
-      } else {
-        reply = {*ch, {value(r[*ch - 1])}};
-      }
-      send_reply(format_keyence_reply(reply));
-    }
+  bool rest = false;
+  const Eigen::Vector3d r = readings_at(now(), &rest);
+  if (options_.mode == ProbeMode::sylvac) {
+    const auto ch = parse_sylvac_request(line);
+    send_reply(ch ? format_sylvac_reply(value(r[*ch - 1]))
+                  : format_sylvac_reply(GaugeValue{GaugeValue::Kind::error, 0.0, -1}));
+    return;
   }
-  // Polled: the pattern has run once its last dwell is over, asked or not.
-  if (options_.mode != ProbeMode::stream && clock_running() && now() > end) mark_finished();
-  if (!streaming_) return;
-  const double t_now = now();
-  int batch = 0;
-  while (streaming_ && line_up() && batch < 200) {
-    const double t = static_cast<double>(next_sample_) / options_.rate_hz;
-    if (t > t_now) break;
-    if (t > end) {
-      streaming_ = false;
-      send_reply(encode_text("END"));
-      mark_finished();
-      break;
-    }
-    bool rest = false;
-    const Eigen::Vector3d r = readings_at(t, &rest);
-    ProbeFrame f;
-    f.seq = seq_++;
-    f.t_us = static_cast<std::uint32_t>(std::llround(t * 1e6));
-    for (int i = 0; i < 3; ++i) {
-      f.nm[i] = static_cast<std::int32_t>(std::llround(std::clamp(r[i], -2.0, 2.0) * 1e6));
-      if (std::abs(r[i]) > 2.0) f.status |= static_cast<std::uint8_t>(1u << i);
-    }
-    send_frame(encode_probe_sample(f));
-    ++next_sample_;
-    ++batch;
+  const auto ch = parse_keyence_request(line);
+  KeyenceReply reply;
+  if (!ch) {
+    reply = {0, {GaugeValue{GaugeValue::Kind::error, 0.0, 2}}};  // ER,M0,02: command error
+  } else if (*ch == 0) {
+    reply = {0, {value(r[0]), value(r[1]), value(r[2])}};
+  } else {
+    reply = {*ch, {value(r[*ch - 1])}};
   }
+  send_reply(format_keyence_reply(reply));
+}
+
+Bytes VirtualRtest::sample_frame(double t, std::uint16_t seq) {
+  bool rest = false;
+  const Eigen::Vector3d r = readings_at(t, &rest);
+  ProbeFrame f;
+  f.seq = seq;
+  f.t_us = static_cast<std::uint32_t>(std::llround(t * 1e6));
+  for (int i = 0; i < 3; ++i) {
+    f.nm[i] = static_cast<std::int32_t>(std::llround(std::clamp(r[i], -2.0, 2.0) * 1e6));
+    if (std::abs(r[i]) > 2.0) f.status |= static_cast<std::uint8_t>(1u << i);
+  }
+  return encode_probe_sample(f);
 }
 
 }  // namespace rotacal::hw

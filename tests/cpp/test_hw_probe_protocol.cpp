@@ -1,3 +1,4 @@
+// ASCII probe dialects and probe stream frames: parse/format agreement, refusals.
 #include <catch2/catch.hpp>
 
 #include "rotacal/core/error.hpp"

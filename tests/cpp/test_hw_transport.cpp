@@ -1,3 +1,4 @@
+// Transports: pseudo-terminal open, read timeouts, hang-up as a disconnect.
 #include <catch2/catch.hpp>
 
 #include <unistd.h>

@@ -10,7 +10,8 @@
 ///          host "M1\r" .. "M3\r"          ->  "M1,+01.2345\r"
 ///          a value "+FFFFFFF" / "-FFFFFFF" is over / under range; "ER,M1,02\r" is an error
 /// stream   frame type 0x03 (19 bytes): seq u16 | t_us u32 | d1,d2,d3 nm i32 | status u8
-///          (bit i: channel i+1 out of range); started and stopped like the ballbar stream.
+///          (bit i: channel i+1 out of range); started and stopped with the stream commands of
+///          stream_protocol.hpp, as the ballbar stream.
 
 #include <array>
 #include <cstdint>

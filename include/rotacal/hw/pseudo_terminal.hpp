@@ -4,6 +4,7 @@
 /// host opens `slave_path()` as if it were a serial port. Both sides are raw (no echo, no line
 /// editing) so binary frames pass unchanged.
 
+#include <cstddef>
 #include <string>
 
 namespace rotacal::hw {
@@ -22,6 +23,8 @@ class PseudoTerminal {
   /// rate, so a virtual instrument compares this with its own rate to act out a wrong-baud
   /// link (a real UART would deliver garbage). 0 if unknown.
   int host_baud() const;
+  /// Bytes written by the instrument that the host has not read yet (0 once hung up).
+  std::size_t unread() const;
   /// Close the master: the host's next read sees the line go away (an unplugged device).
   void hang_up();
 

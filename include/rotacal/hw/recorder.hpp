@@ -10,6 +10,7 @@
 #include <string>
 
 #include "rotacal/ballbar/timeline.hpp"
+#include "rotacal/hw/pose_window.hpp"
 #include "rotacal/hw/probe_protocol.hpp"
 #include "rotacal/hw/transport.hpp"
 #include "rotacal/io/session.hpp"
@@ -43,6 +44,9 @@ struct RecordSummary {
   std::size_t garbage_bytes = 0;  ///< bytes between frames that were not part of any frame
   std::size_t over_range = 0;     ///< readings the instrument flagged out of range (not written)
   std::size_t timeouts = 0;       ///< reads or requests that timed out
+  /// Polled R-test: readings that may have been taken outside their pose's read window
+  /// (the host was late), marked in the file and not used.
+  std::size_t outside_window = 0;
   StopReason reason = StopReason::end_of_program;
   std::string detail;             ///< the error text for disconnected / no_valid_data
   /// One line for the console and the file's last `#` line.
@@ -69,11 +73,17 @@ RecordSummary record_ballbar(ByteTransport& port, const ProgramTimeline& program
                              const std::string& path, const RecordOptions& options = {});
 
 /// Record an R-test. `program` holds the commanded rows (set-up, time, B, C, X, Y, Z) and the
-/// nests; `dwell_s` is the time between poses. Readings within the middle half of each dwell
-/// are averaged into one row of raw d1,d2,d3 (with probe.N.dir metadata from `probe_dirs`,
-/// so readers convert them to dx,dy,dz), with extra columns `n` (readings averaged) and
-/// `std_um` (their largest per-channel standard deviation). A pose with no reading at rest
-/// is marked `# missing: ...` and counted as lost.
+/// nests; `dwell_s` is the time between poses. The readings taken inside each pose's read
+/// window (pose_window.hpp: the middle 80 % of its dwell, when the program holds the table at
+/// rest) are averaged into one row of raw d1,d2,d3 (with probe.N.dir metadata from
+/// `probe_dirs`, so readers convert them to dx,dy,dz), with extra columns `n` (readings
+/// averaged), `std_um` (their largest per-channel standard deviation), `t_s` (their mean
+/// program time) and `margin_s` (the smallest distance, program s, between a reading and the
+/// window's edges). Polled modes place a reading by the whole interval in which it may have
+/// been taken (request sent .. reply received, widened by the uncertainty of the program
+/// clock's start); one not surely inside its window is counted in `outside_window`, marked
+/// `# outside: ...` and not used. A pose with no reading inside its window (the machine moved
+/// on before the host could read) is marked `# missing: ...` and counted as lost.
 RecordSummary record_rtest(ByteTransport& port, ProbeMode mode, const RtestSession& program,
                            double dwell_s, const Eigen::Matrix3d& probe_dirs,
                            const std::string& path, const RecordOptions& options = {});

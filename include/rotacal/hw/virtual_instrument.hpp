@@ -1,7 +1,8 @@
 #pragma once
 /// \file
 /// Virtual instruments: a ballbar and an R-test that open a pseudo-terminal and speak the
-/// protocols of ballbar_protocol.hpp and probe_protocol.hpp, driven by the machine simulator.
+/// protocols of stream_protocol.hpp, ballbar_protocol.hpp and probe_protocol.hpp, driven by the
+/// machine simulator.
 /// They run on their own thread until stopped, and can act out the faults a real link has
 /// (garbage, corrupt and lost frames, split writes, unplug, silence, wrong baud rate).
 
@@ -17,6 +18,7 @@
 #include "rotacal/ballbar/model.hpp"
 #include "rotacal/ballbar/timeline.hpp"
 #include "rotacal/hw/frame.hpp"
+#include "rotacal/hw/pose_window.hpp"
 #include "rotacal/hw/probe_protocol.hpp"
 #include "rotacal/hw/pseudo_terminal.hpp"
 #include "rotacal/rtest/simulate.hpp"
@@ -29,7 +31,7 @@ struct FaultInjection {
   int corrupt_every = 0;   ///< every Nth frame has one bit flipped (checksum fails)
   int drop_every = 0;      ///< every Nth frame is not sent (sequence gap)
   bool split_frames = false;  ///< every frame in two writes, 1 ms apart
-  long close_after = -1;   ///< hang up the line after this many frames (device unplugged)
+  long close_after = -1;   ///< hang up the line after this many frames, once the host has read them (unplug)
   long silence_after = -1; ///< stop sending after this many frames, line stays open
 };
 
@@ -42,7 +44,8 @@ struct VirtualStats {
   bool finished = false;           ///< the program ran to its end
 };
 
-/// Common part: the pty, the serving thread, pacing and fault injection.
+/// Common part: the pty, the serving thread, pacing, fault injection, and the stream protocol
+/// both instruments speak (stream_protocol.hpp: ID?, RATE, START, STOP, samples, END).
 class VirtualInstrument {
  public:
   virtual ~VirtualInstrument();
@@ -52,31 +55,47 @@ class VirtualInstrument {
   void start();
   /// Stop serving and join the thread (idempotent). Rethrows an error the thread died of.
   void stop();
-  bool finished() const { return finished_.load(); }
+  /// The program has run to its end and the host has read everything sent (or 10 s have
+  /// passed since the end, for a host that stopped reading), or the instrument has stopped.
+  /// A caller that hangs up when this turns true does not cut off the last samples and END.
+  bool finished() const;
   VirtualStats stats() const;
 
  protected:
-  VirtualInstrument(int baud, double speed, const FaultInjection& faults);
+  /// `rate_hz`: the stream's sample rate until the host sends RATE (1..1000 Hz).
+  VirtualInstrument(int baud, double speed, double rate_hz, const FaultInjection& faults);
   /// Stop and join the thread without throwing. Every derived destructor calls it first: the
   /// thread calls serve_once(), which must not outlive the derived object.
   void halt() noexcept;
-  /// One pass of the serving loop, called every millisecond or so.
-  virtual void serve_once() = 0;
+  /// One pass of the serving loop, called every millisecond or so: answer the lines that
+  /// arrived (answer()), then send the stream's samples that are due (serve_stream()).
+  virtual void serve_once();
+  /// One host line. Here: the stream protocol's commands; ZERO goes to zero().
+  virtual void answer(const std::string& line);
+  /// "<model> <firmware>" for the ID reply.
+  virtual std::string identity() const = 0;
+  /// ZERO at the current pose; false if the instrument has no such command (it answers ERR).
+  virtual bool zero() { return false; }
+  /// Program time after which the stream ends with END.
+  virtual double stream_end() const = 0;
+  /// The sample frame at program time t.
+  virtual Bytes sample_frame(double t, std::uint16_t seq) = 0;
   /// Virtual time, s, since `clock_start()` (wall time times speed).
   double now() const;
   void clock_start();
   bool clock_running() const { return clock_running_; }
   /// Command lines that arrived from the host since the last call.
   std::vector<std::string> read_lines();
-  /// A streamed frame: faults applied, counted.
-  void send_frame(Bytes frame);
   /// A reply (text frame or ASCII line): never faulted, except by a wrong baud rate.
   void send_reply(const Bytes& bytes);
   void send_reply(const std::string& text) { send_reply(Bytes(text.begin(), text.end())); }
-  void mark_finished() { finished_ = true; stats_.finished = true; }
-  bool line_up() const { return !hung_up_; }
+  void mark_finished();
 
  private:
+  /// Every sample frame due by now(), at most 200 a pass; END once past stream_end().
+  void serve_stream();
+  /// A streamed frame: faults applied, counted.
+  void send_frame(Bytes frame);
   void write_all(const Bytes& bytes);
   void run();
 
@@ -86,13 +105,19 @@ class VirtualInstrument {
   FaultInjection faults_;
   std::thread thread_;
   std::atomic<bool> stop_{false};
-  std::atomic<bool> finished_{false};
+  std::atomic<bool> finished_{false};      ///< the program has run to its end
+  std::atomic<bool> thread_done_{false};   ///< the serving thread has stopped
+  std::atomic<double> finished_at_{0.0};   ///< wall s
   bool hung_up_ = false;
   bool silent_ = false;
   bool clock_running_ = false;
   double clock_origin_ = 0.0;
   std::string line_buffer_;
   std::uint64_t stream_count_ = 0;
+  bool streaming_ = false;
+  double rate_hz_;
+  std::uint64_t next_sample_ = 0;
+  std::uint16_t seq_ = 0;
   mutable std::mutex stats_mutex_;
   VirtualStats stats_;
   std::string thread_error_;
@@ -116,15 +141,14 @@ class VirtualBallbar final : public VirtualInstrument {
   ~VirtualBallbar() override { halt(); }
 
  private:
-  void serve_once() override;
+  std::string identity() const override { return "rotacal-virtual-ballbar 1.0"; }
+  bool zero() override;
+  double stream_end() const override { return program_.duration(); }
+  Bytes sample_frame(double t, std::uint16_t seq) override;
   ProgramTimeline program_;
   VirtualBallbarOptions options_;
   struct Noise;
   std::shared_ptr<Noise> noise_;
-  bool streaming_ = false;
-  double rate_hz_;
-  std::uint64_t next_sample_ = 0;
-  std::uint16_t seq_ = 0;
   double zero_mm_ = 0.0;  ///< displacement subtracted after ZERO
 };
 
@@ -139,8 +163,10 @@ struct VirtualRtestOptions {
   FaultInjection faults;
 };
 
-/// An R-test on a B/C table running the measurement pattern: pose k is held for the middle
-/// 80 % of its dwell around the time the simulator gives it; in between the table moves.
+/// An R-test on a B/C table running the measurement pattern: pose k is held at rest in its
+/// read window (pose_window.hpp: the middle 80 % of its dwell around the time the simulator
+/// gives it); in between the table moves. A polled reading is the probes at the instant the
+/// request arrives.
 /// Polled modes start the program at the first request, stream mode at START.
 class VirtualRtest final : public VirtualInstrument {
  public:
@@ -153,6 +179,11 @@ class VirtualRtest final : public VirtualInstrument {
 
  private:
   void serve_once() override;
+  /// Polled modes answer requests; stream mode the stream protocol's commands.
+  void answer(const std::string& line) override;
+  std::string identity() const override { return "rotacal-virtual-rtest 1.0"; }
+  double stream_end() const override;
+  Bytes sample_frame(double t, std::uint16_t seq) override;
   /// Probe readings (mm) at virtual time t, and whether the table is at rest.
   Eigen::Vector3d readings_at(double t, bool* at_rest);
   VirtualRtestOptions options_;
@@ -161,12 +192,6 @@ class VirtualRtest final : public VirtualInstrument {
   std::vector<Eigen::Vector3d> exact_;  ///< noise-free readings per pose
   struct Noise;
   std::shared_ptr<Noise> noise_;
-  bool streaming_ = false;
-  std::uint64_t next_sample_ = 0;
-  std::uint16_t seq_ = 0;
 };
-
-/// Fraction of a pose's dwell during which the table is at rest (centred on the pose time).
-inline constexpr double kRtestRestFraction = 0.8;
 
 }  // namespace rotacal::hw
