@@ -36,6 +36,6 @@ from .models import ballbar_model_from_dict, load_model, save_model  # noqa: F40
 from .outputs import write_output  # noqa: F401
 from .results import DiagnosisResult, Identification  # noqa: F401
 from .rtest import identify_rtest  # noqa: F401
-from .sessions import load, save  # noqa: F401
+from .sessions import check_plausible, load, save  # noqa: F401
 
 __version__ = "0.1.0"

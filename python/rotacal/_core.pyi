@@ -6,7 +6,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Ambiguity', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'CandidateScore', 'CircleFit', 'CompensationReport', 'CompensationRow', 'DegenerateGeometry', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'FaultInjection', 'Finding', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'MachineType', 'ModelFit', 'NcDialect', 'NcProgramOptions', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestJointIdentification', 'RtestJointModel', 'RtestPaperIdentification', 'RtestSession', 'SegmentKind', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TransitionArc', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'ballbar_model_document', 'ballbar_model_from_document', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_output', 'compensate_commands', 'compensate_sphere_offset', 'default_ballbar_tests', 'default_calibration_moves', 'diagnose_ballbar', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'parse_ballbar_test', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'test_label', 'verify_compensation', 'write_ballbar', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
+__all__: list[str] = ['Ambiguity', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'CandidateScore', 'CircleFit', 'CompensationReport', 'CompensationRow', 'DegenerateGeometry', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'NcDialect', 'NcProgramOptions', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestJointIdentification', 'RtestJointModel', 'RtestPaperIdentification', 'RtestSession', 'SegmentKind', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TransitionArc', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'ballbar_model_document', 'ballbar_model_from_document', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_model_machine', 'check_output', 'check_plausible', 'compensate_commands', 'compensate_sphere_offset', 'default_ballbar_tests', 'default_calibration_moves', 'diagnose_ballbar', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'parse_ballbar_test', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'test_label', 'verify_compensation', 'write_ballbar', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
 class Ambiguity:
     @property
     def correlation(self) -> float:
@@ -55,6 +55,9 @@ class BallbarIdentification:
     def sigma_um(self) -> float:
         ...
     @property
+    def summary(self) -> FitSummary:
+        ...
+    @property
     def unobservable(self) -> list[str]:
         ...
 class BallbarMachineModel:
@@ -77,6 +80,22 @@ class BallbarMachineModel:
         ...
     @property
     def pivot(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+class BallbarMonteCarlo:
+    @property
+    def draws(self) -> int:
+        ...
+    @property
+    def fresh_fits(self) -> int:
+        ...
+    @property
+    def noise_um(self) -> float:
+        ...
+    @property
+    def parameters(self) -> list[MonteCarloParameter]:
+        ...
+    @property
+    def values(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
         ...
 class BallbarPlan:
     """
@@ -571,6 +590,40 @@ class Finding:
     @property
     def shifts(self) -> list[ParameterShift]:
         ...
+class FitSummary:
+    """
+    How a least-squares solve went (core/estimate.hpp).
+    """
+    @property
+    def chi2(self) -> float:
+        ...
+    @property
+    def chi2_per_dof(self) -> float:
+        ...
+    @property
+    def converged(self) -> bool:
+        ...
+    @property
+    def iterations(self) -> int:
+        ...
+    @property
+    def jacobian_evaluations(self) -> int:
+        ...
+    @property
+    def message(self) -> str:
+        ...
+    @property
+    def num_free(self) -> int:
+        ...
+    @property
+    def num_residuals(self) -> int:
+        ...
+    @property
+    def residual_evaluations(self) -> int:
+        ...
+    @property
+    def whitened(self) -> bool:
+        ...
 class Gain:
     @property
     def cv_rms_after_um(self) -> float:
@@ -679,6 +732,25 @@ class ModelFit:
         ...
     @property
     def residuals(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+class MonteCarloParameter:
+    @property
+    def bias(self) -> float:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def ratio(self) -> float:
+        ...
+    @property
+    def std_mc(self) -> float:
+        ...
+    @property
+    def std_reported(self) -> float:
+        ...
+    @property
+    def unit(self) -> str:
         ...
 class NcDialect:
     """
@@ -824,6 +896,58 @@ class PlaneFit:
         ...
     @property
     def singular_values(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+class PlausibilityOptions:
+    """
+    Limits of the plausibility checks (mm, deg).
+    """
+    def __init__(self) -> None:
+        ...
+    @property
+    def max_displacement_mm(self) -> float:
+        ...
+    @max_displacement_mm.setter
+    def max_displacement_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def max_length_deviation_mm(self) -> float:
+        ...
+    @max_length_deviation_mm.setter
+    def max_length_deviation_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def max_position_deviation_mm(self) -> float:
+        ...
+    @max_position_deviation_mm.setter
+    def max_position_deviation_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def min_ballbar_length_mm(self) -> float:
+        ...
+    @min_ballbar_length_mm.setter
+    def min_ballbar_length_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def min_rotary_span_deg(self) -> float:
+        ...
+    @min_rotary_span_deg.setter
+    def min_rotary_span_deg(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+class PlausibilityReport:
+    @property
+    def max_deviation_mm(self) -> float:
+        ...
+    @property
+    def median_deviation_mm(self) -> float:
+        ...
+    @property
+    def rot_span_deg(self) -> float:
+        ...
+    @property
+    def tilt_span_deg(self) -> float:
+        ...
+    @property
+    def worst_sample(self) -> int:
         ...
 class ProbeCalibration:
     """
@@ -1003,6 +1127,9 @@ class RtestJointIdentification:
         ...
     @property
     def sigma_um(self) -> float:
+        ...
+    @property
+    def summary(self) -> FitSummary:
         ...
     @property
     def unobservable(self) -> list[str]:
@@ -1306,10 +1433,20 @@ def calibrate_sphere_offset(dirs: typing.Annotated[numpy.typing.ArrayLike, numpy
     """
     Sphere offset from spindle indexing: angles (N,) rad, readings (N, 3) mm.
     """
+def check_model_machine(model_machine: MachineType, session_machine: MachineType, model_source: str) -> None:
+    ...
 def check_output(path: str, inputs: collections.abc.Sequence[str] = [], other_outputs: collections.abc.Sequence[str] = []) -> str:
     """
     Check an output path without writing: 'replace' or 'write-through'; raises IoError.
     """
+@typing.overload
+def check_plausible(session: BallbarSession, source: str, options: PlausibilityOptions = ...) -> PlausibilityReport:
+    """
+    Refuse (InvalidArgument, likely cause named) a session the nominal kinematics cannot explain.
+    """
+@typing.overload
+def check_plausible(session: RtestSession, source: str, options: PlausibilityOptions = ...) -> PlausibilityReport:
+    ...
 def compensate_commands(nominal: BallbarSession, identified: ..., machine: MachineType) -> BallbarSession:
     ...
 def compensate_sphere_offset(session: RtestSession, offset: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> RtestSession:
@@ -1377,7 +1514,7 @@ def hyper_circle_fit(points: typing.Annotated[numpy.typing.ArrayLike, numpy.floa
     """
 def identify_joint(session: BallbarSession, fit_length_offset: bool = False, effects: collections.abc.Sequence[str] = [], tests: collections.abc.Sequence[str] = []) -> BallbarIdentification:
     """
-    Joint Ceres fit of the 8 location errors and the actual pivot to every sample.
+    Joint fit of the 8 location errors and the actual pivot to every sample (core/joint_fit.hpp).
     """
 def identify_paper(session: BallbarSession) -> BallbarIdentification:
     """
@@ -1385,7 +1522,7 @@ def identify_paper(session: BallbarSession) -> BallbarIdentification:
     """
 def identify_rtest_joint(session: RtestSession, basis: RtestBasis = ...) -> RtestJointIdentification:
     """
-    Joint Ceres fit of an R-test session: location errors, smooth B and C maps, a probe zero per set-up, with observability (rtest/identify_joint.hpp).
+    Joint fit of an R-test session: location errors, smooth B and C maps, a probe zero per set-up, with observability (rtest/identify_joint.hpp).
     """
 def identify_rtest_paper(session: RtestSession) -> RtestPaperIdentification:
     """
@@ -1413,6 +1550,24 @@ def location_error_names(machine: MachineType) -> typing.Annotated[list[str], "F
     """
 def machine_name(machine: MachineType) -> str:
     ...
+def monte_carlo_joint(session: BallbarSession, result: BallbarIdentification, draws: typing.SupportsInt | typing.SupportsIndex = 100, seed: typing.SupportsInt | typing.SupportsIndex = 1, noise_um: typing.SupportsFloat | typing.SupportsIndex = 0.0, tests: collections.abc.Sequence[str] = [], progress: typing.Any = None) -> BallbarMonteCarlo:
+    """
+    Monte Carlo check of a joint fit's 1-sigma (ballbar/monte_carlo.hpp).
+    
+    Parameters
+    ----------
+    session : the session that was identified
+    result : its joint identification
+    draws : number of simulated sessions (>= 2); draw k uses seed + k, as simulate_ballbar
+    noise_um : 1 sigma of the simulated noise (0: the fit's sigma_um)
+    tests : the test labels the fit used (empty: all)
+    progress : optional callable(done, total), called after every draw
+    
+    Returns
+    -------
+    BallbarMonteCarlo: per observable parameter std_reported, std_mc, ratio, bias; values
+    (draws x parameters).
+    """
 def parse_ballbar_test(label: str, machine: MachineType) -> BallbarTest:
     """
     Test from its session label ('radial_B' only on a BC-trt machine).

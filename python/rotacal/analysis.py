@@ -33,6 +33,8 @@ def predict_session(model: Mapping, session: Any, probe_zeros: str = "none",
     """A session predicted by a model dict (rotacal.load_model), and a line saying how well it
     matches the measurement (None when the session has no readings to compare)."""
     def ballbar_predict():
+        if "machine" in model:  # a model of another machine predicts nonsense: refuse, naming both
+            _core.check_model_machine(_core.parse_machine_type(str(model["machine"])), session.machine, source)
         if probe_zeros != "none":
             raise _core.InvalidArgument("predict: --probe-zeros is for R-test sessions")
         out = ballbar.predict(ballbar_model_from_dict(dict(model), source), session)

@@ -18,7 +18,7 @@ from . import _core, jsontext, rtest
 from .diagnosis import MAX_HARMONIC
 from .machines import BALLBAR_NOISE_UM, PIVOT_ERROR_MM
 from .outputs import check_output, write_output
-from .sessions import BALLBAR, RTEST, by_kind, checked_path, load, save
+from .sessions import BALLBAR, RTEST, by_kind, check_plausible, checked_path, load, save
 
 EXIT_OK, EXIT_USAGE, EXIT_INPUT, EXIT_IO, EXIT_ERROR = 0, 2, 3, 4, 5
 
@@ -255,12 +255,22 @@ def cmd_simulate_rtest(a: argparse.Namespace) -> int:
 
 # ------------------------------------------------------------------------- analyse
 
-def _load(path: str) -> Any:
-    """The session of ``path``; what its reader warned about (e.g. repeated rows) on stderr."""
+def _load(path: str, a: argparse.Namespace | None = None) -> Any:
+    """The session of ``path``; what its reader warned about (e.g. repeated rows) on stderr.
+    With the command's arguments ``a``, the session is also checked against the nominal
+    kinematics before any fit (--max-deviation widens the limit)."""
     s = load(path)
     for w in s.warnings:
         _say(f"rotacal: warning: {path}: {w}")
+    if a is not None:
+        check_plausible(s, path, getattr(a, "max_deviation", None))
     return s
+
+
+def _add_plausibility_arg(q: argparse.ArgumentParser) -> None:
+    q.add_argument("--max-deviation", type=number("--max-deviation", 0.0, 1000.0, "mm", lo_open=True),
+                   metavar="MM", help="largest |measured - nominal| a reading may have before the session is "
+                   f"refused as implausible (default {_core.PlausibilityOptions().max_length_deviation_mm:g} mm)")
 
 
 def _print_identification(d: dict) -> None:
@@ -290,7 +300,7 @@ def _print_identification(d: dict) -> None:
 def cmd_identify(a: argparse.Namespace) -> int:
     from .analysis import identify
     check_outputs([a.save_model], [a.file])
-    s = _load(a.file)
+    s = _load(a.file, a)
     result = identify(s, a.method, fit_length_offset=a.length_offset)
     d = result.to_dict()
     if a.monte_carlo:
@@ -332,7 +342,7 @@ def _print_diagnosis(d: dict) -> None:
 def cmd_diagnose(a: argparse.Namespace) -> int:
     from .diagnosis import diagnose
     check_outputs([a.report], [a.file])
-    s = _load(a.file)
+    s = _load(a.file, a)
     result = diagnose(s, max_harmonic=a.max_harmonic)
     d = result.to_dict()
     if a.report:
@@ -351,7 +361,7 @@ def cmd_predict(a: argparse.Namespace) -> int:
     from .models import load_model
     check_outputs([a.output], [a.session, a.model])
     model_dict = load_model(a.model)
-    s = _load(a.session)
+    s = _load(a.session, a)
     out, line = predict_session(model_dict, s, a.probe_zeros, source=a.model)
     if line:
         _say(line)
@@ -392,7 +402,7 @@ def cmd_compensate(a: argparse.Namespace) -> int:
 def cmd_report(a: argparse.Namespace) -> int:
     from .analysis import write_report
     check_outputs([a.output], [a.file])
-    s = _load(a.file)
+    s = _load(a.file, a)
     out = write_report(a.output, s, a.method, with_diagnosis=not a.no_diagnosis, source=a.file, inputs=[a.file])
     print(Path(out).resolve())
     return EXIT_OK
@@ -413,6 +423,17 @@ def cmd_demo(a: argparse.Namespace) -> int:
         print("diagnosis found nothing significant")
     print(f"compensation reduced every location error by at least {-r['worst_change_percent']:.1f} %")
     print(f"report: {Path(r['report']).resolve()}")
+    return EXIT_OK
+
+
+def cmd_table2(a: argparse.Namespace) -> int:
+    """Measured before/after identifications (default: Flynn et al.'s Table 2) against the
+    simulated measure -> compensate -> measure-again chain: what falls outside, and why."""
+    from . import flynn_table2 as t2
+    table = t2.load_table2(a.table) if a.table else t2.load_table2()
+    assumptions = t2.Assumptions(noise_um=a.noise, noise_rho=a.rho, hours_between_runs=a.hours, method=a.method)
+    result = t2.analyse(table, assumptions, draws=a.draws, seed=a.seed, sweep=[] if a.no_sweep else None)
+    print(jsontext.dumps(result) if a.json else t2.render(result))
     return EXIT_OK
 
 
@@ -480,7 +501,7 @@ def _report_recording(summary, path: str, json_out: bool) -> int:
     if json_out:
         print(jsontext.dumps({k: getattr(summary, k) for k in ("rows", "frames", "lost", "crc_errors", "malformed",
                                                                   "garbage_bytes", "over_range", "timeouts",
-                                                                  "reason", "detail")} | {"path": path}, indent=None))
+                                                                  "outside_window", "reason", "detail")} | {"path": path}, indent=None))
     _say(f"wrote {path}: {summary.describe()}")
     return _RECORD_EXIT[summary.reason]
 
@@ -570,6 +591,7 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--monte-carlo", type=number("--monte-carlo", 0, 10_000, integer=True), default=0, metavar="N",
                    help="check the 1-sigma by N simulated repeats of the session (ballbar; progress bar)")
     q.add_argument("--seed", type=SEED, default=1, help="seed of the Monte Carlo draws")
+    _add_plausibility_arg(q)
     q.set_defaults(func=cmd_identify)
 
     q = sub.add_parser("diagnose", help="find what the model gets wrong and why", epilog=EPILOG)
@@ -578,6 +600,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help=f"highest harmonic order tried (1..{MAX_HARMONIC}; default {_core.DiagnosisOptions().max_harmonic})")
     q.add_argument("--json", action="store_true")
     q.add_argument("--report", metavar="OUT.html", type=path("--report"))
+    _add_plausibility_arg(q)
     q.set_defaults(func=cmd_diagnose)
 
     q = sub.add_parser("predict", help="predict a session with a fitted model", epilog=EPILOG)
@@ -588,6 +611,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "(default: a new set-up's zeros are unknown)")
     q.add_argument("-o", "--output", required=True, type=path("--output"),
                    help="the session with predicted lengths (ballbar) or dx,dy,dz and dx_std,dy_std,dz_std (R-test)")
+    _add_plausibility_arg(q)
     q.set_defaults(func=cmd_predict)
 
     q = sub.add_parser("compensate", help="compensated NC program, and its verification in simulation", epilog=EPILOG)
@@ -644,7 +668,28 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--method", default="joint", choices=["joint", "paper"])
     q.add_argument("--no-diagnosis", action="store_true")
     q.add_argument("-o", "--output", required=True, type=path("--output"))
+    _add_plausibility_arg(q)
     q.set_defaults(func=cmd_report)
+
+    q = sub.add_parser("table2", help="measured before/after compensation (Flynn et al. Table 2) against "
+                                      "the simulated chain: what falls outside, and which causes explain it",
+                       epilog=EPILOG)
+    q.add_argument("--table", type=path("--table"), metavar="FILE.json",
+                   help="before/after values in the layout of rotacal/data/flynn2016_table2.json "
+                        "(default: the paper's Table 2)")
+    q.add_argument("--method", default="paper", choices=["paper", "joint"],
+                   help="identification of both runs (the paper used its own chain)")
+    q.add_argument("--noise", type=number("--noise", 0.0, 100.0, "um", lo_open=True), default=0.5,
+                   help="assumed 1-sigma ballbar noise, um")
+    q.add_argument("--rho", type=number("--rho", 0.0, 0.999), default=0.0,
+                   help="assumed AR(1) correlation of successive samples")
+    q.add_argument("--hours", type=number("--hours", 0.0, 10_000.0, "h"), default=1.0,
+                   help="assumed time between the two runs, h")
+    q.add_argument("--draws", type=number("--draws", 10, 100_000, integer=True), default=200)
+    q.add_argument("--seed", type=SEED, default=1)
+    q.add_argument("--no-sweep", action="store_true", help="skip the sweep over the unstated assumptions")
+    q.add_argument("--json", action="store_true")
+    q.set_defaults(func=cmd_table2)
 
     q = sub.add_parser("demo", help="the whole job on a simulated machine: plan, simulate, identify, "
                                     "diagnose, compensate, report", epilog=EPILOG)
@@ -666,7 +711,9 @@ def _add_rtest_pattern_args(q: argparse.ArgumentParser) -> None:
     g.add_argument("--nest", action="append", metavar="X,Y,Z", type=numbers("--nest", 3, 1e4, "mm"),
                    help="nominal ball centre of a sensor nest, table frame, mm (repeatable; default "
                         "the paper's two: 100,0,60 and 0,-120,140)")
-    g.add_argument("--dwell", type=number("--dwell", 0.0, 3600.0, "s", lo_open=True), default=rtest.DEFAULT_DWELL_S, help="time between readings, s")
+    g.add_argument("--dwell", type=number("--dwell", 0.0, 3600.0, "s", lo_open=True), default=rtest.DEFAULT_DWELL_S,
+                   help="time between poses, s; each pose is held at rest and read in the middle 80 %% of it "
+                        "(docs/protocols.md)")
 
 
 def _add_rtest_machine_args(q: argparse.ArgumentParser, probe_dir_help: str) -> None:

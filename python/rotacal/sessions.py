@@ -142,6 +142,21 @@ def load(path: str | Path) -> Session:
     return session
 
 
+def check_plausible(session: Session, source: str = "<session>", max_deviation_mm: float | None = None) -> Any:
+    """Check a session against the nominal kinematics before any fit (C++ io/plausibility):
+    refuses, with the likely cause named ("angles look like radians", "lengths look like
+    inches", "all rotary angles equal", a wrong L0, ...), a session no machine with realistic
+    errors can have produced. ``max_deviation_mm`` widens the limit on |measured - nominal| of
+    a ballbar length or of an R-test centre for an unusual session. Returns the report."""
+    opts = _core.PlausibilityOptions()
+    if max_deviation_mm is not None:
+        if not (0.0 < max_deviation_mm <= 1000.0):
+            raise _core.InvalidArgument(f"--max-deviation {max_deviation_mm}: must be in (0, 1000] mm")
+        opts.max_length_deviation_mm = max_deviation_mm
+        opts.max_position_deviation_mm = max_deviation_mm
+    return _core.check_plausible(session, source, opts)
+
+
 def session_text(session: Session, what: str = "save") -> str:
     """The file text of a session, refused (InvalidArgument naming ``what``) unless ``load``
     reads it back: no file is written that rotacal would refuse to read."""

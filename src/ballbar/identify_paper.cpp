@@ -53,12 +53,14 @@ AxisEstimate axis_from_tests(const BallbarSession& s, const std::string& radial,
   Points2 in_plane(pr.rows(), 2);
   in_plane.col(0) = pr.col(i1);
   in_plane.col(1) = pr.col(i2);
-  *circle = hyper_circle_fit(in_plane);
+  CircleFitOptions circle_options;
+  circle_options.context = "test " + radial;  // a refused fit names the test it came from
+  *circle = hyper_circle_fit(in_plane, circle_options);
   // 3.3: axial test -> the radial coordinates stay nominal, the axial one comes from the bar.
   Points3 pa = pivot_estimates(s, need(s, axial), pivot, &nominal);
   pa.col(i1) = nominal.col(i1);
   pa.col(i2) = nominal.col(i2);
-  *plane = svd_plane_fit(pa, Eigen::Vector3d::Unit(k));
+  *plane = svd_plane_fit(pa, Eigen::Vector3d::Unit(k), 0.0, "test " + axial);
   AxisEstimate a;
   a.point[k] = pivot[k];
   a.point[i1] = circle->centre.x();

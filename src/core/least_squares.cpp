@@ -24,6 +24,10 @@ Observability analyse_observability(const Eigen::MatrixXd& J, const Eigen::Vecto
   if (scales.size() != J.cols())
     throw InvalidArgument("analyse_observability: scales has " + std::to_string(scales.size()) +
                           " entries for " + std::to_string(J.cols()) + " parameters");
+  // A non-finite Jacobian (readings far beyond any machine) would reach the eigensolver as
+  // NaN; the readers refuse such values, and this stops any other path to it.
+  if (!J.allFinite())
+    throw InvalidArgument("analyse_observability: the Jacobian is not finite (a reading or parameter is out of range)");
   Eigen::MatrixXd JtJ(J.cols(), J.cols());
   JtJ.setZero();
   JtJ.selfadjointView<Eigen::Lower>().rankUpdate(J.transpose());
@@ -40,6 +44,8 @@ Observability analyse_observability_normal(const Eigen::MatrixXd& JtJ, const Eig
   Observability o;
   o.observable.assign(static_cast<std::size_t>(p), true);
   if (p == 0) return o;
+  if (!JtJ.allFinite())
+    throw InvalidArgument("analyse_observability: the normal matrix is not finite (a reading or parameter is out of range)");
   // Eigenvalues of the scaled normal matrix are the squared singular values of J*diag(scales);
   // their absolute error (~1e-16 of the largest) is far below the threshold of ~1 (chi2 units).
   const Eigen::MatrixXd N = scales.asDiagonal() * JtJ * scales.asDiagonal();

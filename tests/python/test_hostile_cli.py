@@ -240,17 +240,21 @@ def test_diagnose_report_escapes_labels(files, tmp_path):
 
 
 def test_json_is_strict_on_identical_rows(files, tmp_path):
-    # Identical rows leave chi2 and p-values undetermined (NaN, infinity): strict JSON has
-    # null there and says why.
+    # The CLI checks plausibility first: identical rows never move the axes (exit 3, named).
     r = rotacal_cli("diagnose", files["same"], "--json")
-    assert r.returncode == 0, r.stderr
-    d = strict_json(r.stdout)
+    assert r.returncode == 3 and "axes never move" in r.stderr, r.stderr
+    # Through the API (which leaves that check to the caller) identical rows leave chi2 and
+    # p-values undetermined (NaN, infinity): strict JSON has null there and says why.
+    import rotacal
+    from rotacal import jsontext
+    s = rotacal.load(files["same"])
+    d = strict_json(jsontext.dumps(rotacal.diagnose(s).to_dict()))
     assert d["baseline"]["p_value"] is None
     assert "not determined" in d["null_reasons"]["/baseline/p_value"]
+    result = rotacal.identify(s)
+    assert strict_json(jsontext.dumps(result.to_dict()))["location_errors"]["E_Y0A"]["value"] is None
     model = tmp_path / "m.json"
-    r = rotacal_cli("identify", files["same"], "--json", "--save-model", model)
-    assert r.returncode == 0, r.stderr
-    assert strict_json(r.stdout)["location_errors"]["E_Y0A"]["value"] is None  # unobservable, said so
+    rotacal.save_model(result.model_dict(), model)
     strict_json(model.read_text())
 
 
@@ -458,3 +462,65 @@ def test_repeated_rows_are_reported(files, tmp_path):
     assert r.returncode == 0 and "warning" in r.stderr and "repeat" in r.stderr, r.stderr
     r = rotacal_cli("identify", files["good"])
     assert "warning" not in r.stderr
+
+
+# ------------------------------------------------------------------------- plausibility before fitting
+
+def _transformed(src, dst, angle=None, linear=None, meta=None):
+    """A copy of the ballbar session ``src`` with the angle columns (A, C) and/or the linear
+    columns and lengths mapped, and metadata lines replaced (``meta``: key -> value)."""
+    head, rows = _rows(src)
+    out_rows = []
+    for r in rows:
+        f = r.split(",")
+        if angle:
+            f[5], f[6] = (f"{angle(float(v)):.9f}" for v in f[5:7])
+        if linear:
+            f[2], f[3], f[4], f[7] = (f"{linear(float(v)):.9f}" for v in (f[2], f[3], f[4], f[7]))
+        out_rows.append(",".join(f))
+    for key, value in (meta or {}).items():
+        head = [f"# {key}: {value}" if ln.startswith(f"# {key}:") else ln for ln in head]
+    Path(dst).write_text("\n".join(head + out_rows) + "\n")
+    return dst
+
+
+@pytest.mark.parametrize("case, cause", [
+    ("radians", "radians"),
+    ("inches", "inches"),
+    ("long_l0", "ballbar_length 150"),
+])
+@pytest.mark.parametrize("command", ["identify", "diagnose"])
+def test_implausible_sessions_are_refused_with_the_cause(shared_data, tmp_path, case, cause, command):
+    src = shared_data / "ballbar_ac_table2.csv"
+    dst = tmp_path / f"{case}.csv"
+    if case == "radians":
+        _transformed(src, dst, angle=np.radians)
+    elif case == "inches":
+        _transformed(src, dst, linear=lambda v: v / 25.4,
+                     meta={"ballbar_length": f"{100 / 25.4:.6f}", "pivot": "4.724409, 0.000000, 2.362205"})
+    else:
+        _transformed(src, dst, meta={"ballbar_length": "150.0000"})
+    r = rotacal_cli(command, dst)
+    assert r.returncode == EXIT_INPUT, r.stdout + r.stderr
+    assert cause in r.stderr and str(dst) in r.stderr, r.stderr
+
+
+def test_max_deviation_widens_the_check_for_an_unusual_session(shared_data, tmp_path):
+    # A session 3 mm off its nominal lengths everywhere (a bar 3 mm longer than declared) is
+    # refused at the default limit and accepted when the user widens it.
+    dst = _transformed(shared_data / "ballbar_ac_table2.csv", tmp_path / "off.csv", meta={"ballbar_length": "97.0000"})
+    assert rotacal_cli("identify", dst).returncode == EXIT_INPUT
+    r = rotacal_cli("identify", dst, "--max-deviation", "5", "--length-offset")
+    assert r.returncode == 0, r.stderr
+    assert rotacal_cli("identify", dst, "--max-deviation", "0").returncode == EXIT_INPUT
+
+
+def test_predict_with_a_model_of_another_machine_is_refused(shared_data, tmp_path):
+    model, bc = tmp_path / "ac.json", tmp_path / "bc.csv"
+    assert rotacal_cli("identify", shared_data / "ballbar_ac_table2.csv", "--save-model", model).returncode == 0
+    assert rotacal_cli("simulate", "ballbar", "--machine", "BC-trt", "-o", bc, "--truth", tmp_path / "t.json",
+                       "--step", "5").returncode == 0
+    r = rotacal_cli("predict", bc, "--model", model, "-o", tmp_path / "p.csv")
+    assert r.returncode == EXIT_INPUT, r.stdout + r.stderr
+    assert "AC-trt" in r.stderr and "BC-trt" in r.stderr, r.stderr
+    assert not (tmp_path / "p.csv").exists()

@@ -24,7 +24,7 @@ struct RtestPattern {
   std::vector<double> c_deg = {0, 30, 60, 90, 120, 150, 180, 210, 240, 270, 300, 330};  ///< deg
   std::vector<Eigen::Vector3d> nests = {Eigen::Vector3d(100, 0, 60),
                                         Eigen::Vector3d(0, -120, 140)};  ///< table frame, mm
-  double dwell_s = 6.0;  ///< time between readings, s
+  double dwell_s = 6.0;  ///< time between poses, s; the program holds each pose at rest for the middle 80 % (hw/pose_window.hpp)
 };
 
 /// The machine the simulator measures: a MachineModel whose default table is BC-trt (the
