@@ -7,7 +7,7 @@ import sys
 import rotacal
 
 session = rotacal.load(sys.argv[1])
-result = rotacal.identify(session)  # joint Ceres fit of the exact model
+result = rotacal.identify(session)  # joint fit of the exact model (Gauss-Newton, Ceres Jets)
 for name, p in result.to_dict()["location_errors"].items():
     print(name, "unobservable" if p["value"] is None else f"{p['value']:.6g} +- {p['std']:.2g} {p['unit']}")
 

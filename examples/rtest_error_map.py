@@ -23,7 +23,7 @@ else:
     session, truth = rotacal.rtest.simulate_rtest("random", {"gravity_sag_B": 0.006, "coning_B": 1.45e-4}, seed=3)
     print("simulated:", ", ".join(f"{k} = {v}" for k, v in truth["effects"].items()))
 
-result = rotacal.identify(session)  # joint Ceres fit: location errors + smooth maps + probe zeros
+result = rotacal.identify(session)  # joint fit: location errors + smooth maps + probe zeros
 d = result.to_dict()
 print(f"{len(session)} poses, residual RMS {d['residual_rms_um']:.3f} um")
 for name, p in d["location_errors"].items():

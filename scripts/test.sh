@@ -36,6 +36,10 @@ step "Python package (pip install .) and pytest"
 "$PY" -m pip install -q --disable-pip-version-check --no-build-isolation .
 (cd tests/python && "$PY" -m pytest -q -p no:cacheprovider .)
 
+step "C++ example: a model file written by the Python CLI, read by C++ to compensate a point"
+"$PY" -m rotacal identify ../shared/data/ballbar_ac_table2.csv --save-model build/example/model.json > /dev/null
+./build/example/compensate_point build/example/model.json 30 45 10 20 30
+
 step "Benchmarks, once each as a smoke check (figures: run them without --smoke)"
 ./build/release/bench/ballbar_accuracy --smoke
 ./build/release/bench/diagnose_bench --smoke

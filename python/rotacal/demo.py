@@ -64,7 +64,7 @@ def run_demo(output: str | Path, seed: int = 2016, sag_mm: float = 0.004,
     truth["pivot_actual"] = machine.pivot.tolist()
     _write_json(out / "truth.json", truth)
 
-    step(3, "identifying the location errors (joint Ceres fit)")
+    step(3, "identifying the location errors (joint fit of the exact model)")
     ident = identify(session)
     save_model(ident.model_dict(), out / "model.json")
     _write_json(out / "identification.json", ident.to_dict())
