@@ -4,7 +4,7 @@
 /// catalogue (../shared/spec/effects.md), extend the model with it, measure the gain.
 ///
 /// The engine is independent of the instrument. A `DiagnosisProblem` (ballbar_diagnosis.hpp,
-/// R-test later) supplies the nonlinear fit of baseline + effects and each candidate's
+/// rtest_diagnosis.hpp) supplies the nonlinear fit of baseline + effects and each candidate's
 /// Jacobian; the engine does the statistics:
 ///  1. baseline fit; adequacy by chi-square against the noise (declared in the file, or
 ///     estimated from successive differences, which smooth systematic errors barely affect);
@@ -16,6 +16,9 @@
 ///     blocks of each group left out in turn, so the extension must predict unseen angles);
 ///  4. the best significant candidate is added, the model refitted (nonlinear), and 3 repeats
 ///     until nothing significant is left;
+/// Files: diagnosis.cpp (the search loop), scoring.cpp (linearised refit, F/BIC,
+/// cross-validation), harmonics.cpp (what the angular sampling resolves),
+/// residual_structure.cpp (per-group structure, noise), ambiguity.cpp (separating tests).
 ///  5. candidates the data cannot see, and *_hn candidates of an order the sampling of their
 ///     axis cannot resolve (aliased), are reported unobservable; candidates that explain the
 ///     data as well as the chosen one are reported ambiguous; significant structure that is

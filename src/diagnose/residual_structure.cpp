@@ -1,0 +1,136 @@
+// Residual structure per group (RMS, mean, harmonics in the swept angle, trend) and the
+// successive-difference noise estimate.
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+
+#include "rotacal/core/error.hpp"
+#include "scoring.hpp"
+
+namespace rotacal {
+
+using diagnosis_detail::rms_um;
+using diagnosis_detail::solve_ls;
+
+namespace diagnosis_detail {
+
+std::string describe_structure(const std::vector<GroupResidual>& groups) {
+  const GroupResidual* worst = nullptr;
+  for (const GroupResidual& g : groups)
+    if (!worst || g.rms_um > worst->rms_um) worst = &g;
+  if (!worst) return "";
+  std::ostringstream out;
+  out.precision(3);
+  out << "largest residual in '" << worst->group << "' (" << worst->rms_um << " um RMS";
+  if (!worst->harmonic_um.empty()) {
+    const auto it = std::max_element(worst->harmonic_um.begin(), worst->harmonic_um.end());
+    out << "; strongest order " << (it - worst->harmonic_um.begin()) + 1 << " in " << worst->angle_axis
+        << ", " << *it << " um";
+  }
+  out << "; trend " << worst->trend_um_per_s << " um/s)";
+  return out.str();
+}
+
+}  // namespace diagnosis_detail
+
+double estimate_noise_um(const DiagnosisProblem& P, const Eigen::VectorXd& r) {
+  const auto& g = P.groups();
+  const auto& t = P.times();
+  std::map<std::string, std::vector<std::size_t>> by_group;
+  for (std::size_t i = 0; i < g.size(); ++i) by_group[g[i]].push_back(i);
+  double ss = 0.0;
+  std::size_t n = 0;
+  for (auto& kv : by_group) {
+    auto& idx = kv.second;
+    std::stable_sort(idx.begin(), idx.end(), [&](std::size_t a, std::size_t b) { return t[a] < t[b]; });
+    for (std::size_t k = 1; k < idx.size(); ++k) {
+      const double d = r[static_cast<Eigen::Index>(idx[k])] - r[static_cast<Eigen::Index>(idx[k - 1])];
+      ss += d * d;
+      ++n;
+    }
+  }
+  if (n == 0) throw InvalidArgument("estimate_noise_um: no group has two readings");
+  return std::sqrt(ss / (2.0 * static_cast<double>(n))) * 1e3;
+}
+
+std::vector<GroupResidual> residual_structure(const DiagnosisProblem& P, const Eigen::VectorXd& r,
+                                              int max_order, double min_new_content) {
+  const auto& g = P.groups();
+  const auto& t = P.times();
+  const auto& a = P.angles();
+  std::vector<std::string> order;
+  for (const std::string& s : g)
+    if (std::find(order.begin(), order.end(), s) == order.end()) order.push_back(s);
+  std::vector<GroupResidual> out;
+  const char tilt = tilt_axis_letter(P.machine());
+  for (const std::string& name : order) {
+    std::vector<std::size_t> idx;
+    for (std::size_t i = 0; i < g.size(); ++i)
+      if (g[i] == name) idx.push_back(i);
+    GroupResidual G;
+    G.group = name;
+    G.n = idx.size();
+    double lo_t = 1e300, hi_t = -1e300, lo_r = 1e300, hi_r = -1e300;
+    Eigen::VectorXd y(static_cast<Eigen::Index>(idx.size()));
+    for (std::size_t k = 0; k < idx.size(); ++k) {
+      y[static_cast<Eigen::Index>(k)] = r[static_cast<Eigen::Index>(idx[k])];
+      lo_t = std::min(lo_t, a[idx[k]].tilt), hi_t = std::max(hi_t, a[idx[k]].tilt);
+      lo_r = std::min(lo_r, a[idx[k]].rot), hi_r = std::max(hi_r, a[idx[k]].rot);
+    }
+    G.rms_um = rms_um(y);
+    G.mean_um = y.mean() * 1e3;
+    // Trend against time.
+    Eigen::MatrixXd T(y.size(), 2);
+    for (Eigen::Index k = 0; k < y.size(); ++k) T(k, 0) = 1.0, T(k, 1) = t[idx[static_cast<std::size_t>(k)]];
+    if (y.size() >= 3) G.trend_um_per_s = solve_ls(T, y)[1] * 1e3;
+    // Harmonics in the swept angle: only over a (nearly) full turn. On a partial arc the
+    // cos/sin of different orders are nearly collinear and the "spectrum" means nothing.
+    const double span_t = hi_t - lo_t, span_r = hi_r - lo_r;
+    const bool use_rot = span_r >= span_t;
+    if (std::max(span_t, span_r) > 0.0) G.angle_axis = use_rot ? 'C' : tilt;
+    // Only the orders the group's angular sampling resolves are fitted: beyond them the design
+    // is rank-deficient (C every 30 deg: order 6 has a vanishing sine, 7 and 8 take the values
+    // of 5 and 4), and a fit would return rounding noise divided by ~1e-15 (1e14 um and more).
+    const double span = std::max(span_t, span_r);
+    if (span >= 330.0 * M_PI / 180.0 && y.size() >= 20 && max_order > 0) {
+      std::vector<double> th(idx.size());
+      for (std::size_t k = 0; k < idx.size(); ++k) th[k] = use_rot ? a[idx[k]].rot : a[idx[k]].tilt;
+      const HarmonicResolution res =
+          resolve_harmonics(th, G.angle_axis, max_order, min_new_content);
+      const int orders = res.resolved;
+      if (orders > 0) {
+        Eigen::MatrixXd H(y.size(), 1 + 2 * orders);
+        for (Eigen::Index k = 0; k < y.size(); ++k) {
+          H(k, 0) = 1.0;
+          for (int o = 1; o <= orders; ++o) {
+            H(k, 2 * o - 1) = std::cos(o * th[static_cast<std::size_t>(k)]);
+            H(k, 2 * o) = std::sin(o * th[static_cast<std::size_t>(k)]);
+          }
+        }
+        const Eigen::VectorXd c = solve_ls(H, y);
+        for (int o = 1; o <= orders; ++o)
+          G.harmonic_um.push_back(std::hypot(c[2 * o - 1], c[2 * o]) * 1e3);
+      }
+      if (orders < max_order) {
+        for (int o = orders + 1; o <= max_order; ++o) G.harmonics_left_out.push_back(o);
+        std::ostringstream note;
+        note << (orders + 1 == max_order ? "order " : "orders ") << orders + 1;
+        if (orders + 1 < max_order) note << "-" << max_order;
+        note << " in " << G.angle_axis << " left out: " << res.why_not(orders + 1);
+        G.harmonic_note = note.str();
+      }
+    } else if (G.angle_axis && max_order > 0) {
+      std::ostringstream note;
+      note.precision(3);
+      note << "no harmonics: ";
+      if (y.size() < 20) note << "only " << y.size() << " readings";
+      else note << G.angle_axis << " sweeps " << span * 180.0 / M_PI << " deg, not a full turn";
+      G.harmonic_note = note.str();
+    }
+    out.push_back(G);
+  }
+  return out;
+}
+
+}  // namespace rotacal
