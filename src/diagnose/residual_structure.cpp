@@ -37,6 +37,9 @@ std::string describe_structure(const std::vector<GroupResidual>& groups) {
 double estimate_noise_um(const DiagnosisProblem& P, const Eigen::VectorXd& r) {
   const auto& g = P.groups();
   const auto& t = P.times();
+  if (static_cast<std::size_t>(r.size()) != g.size())
+    throw InvalidArgument("estimate_noise_um: " + std::to_string(r.size()) +
+                          " residuals given for " + std::to_string(g.size()) + " readings");
   std::map<std::string, std::vector<std::size_t>> by_group;
   for (std::size_t i = 0; i < g.size(); ++i) by_group[g[i]].push_back(i);
   double ss = 0.0;
@@ -50,7 +53,10 @@ double estimate_noise_um(const DiagnosisProblem& P, const Eigen::VectorXd& r) {
       ++n;
     }
   }
-  if (n == 0) throw InvalidArgument("estimate_noise_um: no group has two readings");
+  if (n == 0)
+    throw InvalidArgument("estimate_noise_um: no group has two readings (given " +
+                          std::to_string(r.size()) + " residuals in " +
+                          std::to_string(by_group.size()) + " groups)");
   return std::sqrt(ss / (2.0 * static_cast<double>(n))) * 1e3;
 }
 
