@@ -19,9 +19,7 @@ std::string separating_test(const DiagnosisProblem& P, const ModelFit& fit, cons
   std::vector<std::string> rows_a, rows_b;
   const Eigen::MatrixXd Ra = P.reference_jacobian(fit, a.effect, &rows_a);
   const Eigen::MatrixXd Rb = P.reference_jacobian(fit, b.effect, &rows_b);
-  const Eigen::VectorXd pa = P.candidate_jacobian(fit, a.effect).jacobiSvd(Eigen::ComputeThinU | Eigen::ComputeThinV).solve(a.signature);
-  const Eigen::VectorXd pb = P.candidate_jacobian(fit, b.effect).jacobiSvd(Eigen::ComputeThinU | Eigen::ComputeThinV).solve(b.signature);
-  const Eigen::VectorXd diff = Ra * pa - Rb * pb;
+  const Eigen::VectorXd diff = Ra * a.params - Rb * b.params;
   std::map<std::string, std::pair<double, int>> per;
   for (std::size_t i = 0; i < rows_a.size(); ++i) {
     auto& acc = per[rows_a[i]];

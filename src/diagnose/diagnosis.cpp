@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <sstream>
 
 #include "rotacal/core/stats.hpp"
@@ -17,97 +18,99 @@ using namespace diagnosis_detail;
 
 namespace {
 
-Diagnosis diagnose_at_noise(const DiagnosisProblem& P, const DiagnosisOptions& options,
-                            std::optional<double> noise_override, const std::string& noise_source);
-
-}  // namespace
-
-Diagnosis diagnose(const DiagnosisProblem& P, const DiagnosisOptions& options) {
-  const auto t0 = std::chrono::steady_clock::now();
-  Diagnosis D = diagnose_at_noise(P, options, std::nullopt, "");
-  if (!P.declared_noise_um()) {
-    // Successive differences overestimate the noise when the sampling is sparse against the
-    // systematic errors (an R-test's 30 degree steps): if the extended model leaves less, that
-    // is the better estimate, and the statistics are redone with it.
-    const double n = static_cast<double>(D.final_fit.residuals.size());
-    const double s_final =
-        std::sqrt(D.final_fit.residuals.squaredNorm() / std::max(1.0, n - D.final_fit.num_free)) * 1e3;
-    if (s_final < 0.8 * D.baseline.noise_um) {
-      std::ostringstream why;
-      why.precision(3);
-      why << "estimated from the residuals of the extended model (successive differences gave "
-          << D.baseline.noise_um << " um: the sampling is too sparse for them)";
-      D = diagnose_at_noise(P, options, s_final, why.str());
-    }
+// How the noise enters every decision: white with one sigma, or whitened by an AR model.
+struct NoiseTreatment {
+  double sigma_mm = 0.0;  // white: the sigma; coloured: the marginal sigma (for wording)
+  std::string source;
+  std::shared_ptr<const ArWhitener> W;  // null: white
+  Eigen::MatrixXd whiten(const Eigen::MatrixXd& M) const {
+    if (!W) return M / sigma_mm;
+    Eigen::MatrixXd out = M;
+    W->apply(out);
+    return out;
   }
-  D.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return D;
+};
+
+std::vector<Effect> candidate_list(const DiagnosisProblem& P, const DiagnosisOptions& options) {
+  std::vector<Effect> candidates = P.candidates(options.max_harmonic);
+  if (options.only.empty()) return candidates;
+  std::vector<Effect> keep;
+  for (const std::string& id : options.only) {
+    const Effect e = Effect::parse(id);
+    if (std::find(candidates.begin(), candidates.end(), e) == candidates.end())
+      throw InvalidArgument("options.only: " + id + " is not a candidate for this session");
+    keep.push_back(e);
+  }
+  return keep;
 }
 
-namespace {
+// A *_hn candidate of an order its axis' sampling cannot resolve takes, at the sampled angles,
+// the values of lower orders (C every 30 deg: order 7 is order 5): scored, it would name an
+// order the data cannot tell. Judged on every reading's angle of that axis, since the effect's
+// parameters are shared by all of them. Returns the reason per candidate (empty: resolved).
+std::vector<std::string> unresolved_orders(const DiagnosisProblem& P, const std::vector<Effect>& candidates,
+                                           double min_new_content) {
+  std::vector<std::string> unresolved(candidates.size());
+  std::map<char, int> top;
+  for (const Effect& c : candidates)
+    if (c.harmonic > 0) top[c.axis] = std::max(top[c.axis], c.harmonic);
+  for (const auto& [axis, order] : top) {
+    std::vector<double> th;
+    for (const RotaryAngles<double>& r : P.angles()) th.push_back(axis == 'C' ? r.rot : r.tilt);
+    const HarmonicResolution res = resolve_harmonics(th, axis, order, min_new_content);
+    for (std::size_t c = 0; c < candidates.size(); ++c)
+      if (candidates[c].axis == axis && candidates[c].harmonic > res.resolved)
+        unresolved[c] = "the sampling cannot resolve its harmonic order: " +
+                        res.why_not(candidates[c].harmonic);
+  }
+  return unresolved;
+}
 
-Diagnosis diagnose_at_noise(const DiagnosisProblem& P, const DiagnosisOptions& options,
-                            std::optional<double> noise_override, const std::string& noise_source) {
+// The effect's parameters in a fit (named "id" or "id.name").
+std::vector<ParameterEstimate> parameters_of(const ModelFit& fit, const Effect& effect) {
+  std::vector<ParameterEstimate> out;
+  const std::string id = effect.id();
+  for (const ParameterEstimate& p : fit.parameters)
+    if (p.name == id || p.name.rfind(id + ".", 0) == 0) out.push_back(p);
+  return out;
+}
+
+// The search: score every candidate against the current model, add the best one that passes
+// the F-test (Bonferroni), BIC and blocked cross-validation and whose parameters the refit can
+// determine, refit, repeat; then judge what is left.
+// `baseline_jc`: the candidates' Jacobians at the baseline (round one), computed once.
+Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
+                 const std::vector<Effect>& candidates, const ModelFit& baseline,
+                 const std::vector<Eigen::MatrixXd>& baseline_jc, const NoiseTreatment& noise,
+                 const NoiseModel* model) {
   Diagnosis D;
   D.machine = P.machine();
-  std::vector<Effect> candidates = P.candidates(options.max_harmonic);
-  if (!options.only.empty()) {
-    std::vector<Effect> keep;
-    for (const std::string& id : options.only) {
-      const Effect e = Effect::parse(id);
-      if (std::find(candidates.begin(), candidates.end(), e) == candidates.end())
-        throw InvalidArgument("options.only: " + id + " is not a candidate for this session");
-      keep.push_back(e);
-    }
-    candidates = keep;
-  }
-
-  ModelFit fit = P.fit(EffectModel{});
+  ModelFit fit = baseline;
   D.baseline_fit = fit;
   const double n = static_cast<double>(fit.residuals.size());
-  const std::optional<double> declared = P.declared_noise_um();
-  const double noise_um = declared ? *declared : noise_override ? *noise_override : estimate_noise_um(P, fit.residuals);
-  const double sigma_mm = noise_um * 1e-3;
-  D.baseline.noise_um = noise_um;
-  D.baseline.noise_source = declared         ? "declared"
-                            : noise_override ? noise_source
-                                             : "estimated from successive differences";
+  D.baseline.noise_um = noise.sigma_mm * 1e3;
+  D.baseline.noise_source = noise.source;
   D.baseline.residual_rms_um = rms_um(fit.residuals);
   D.baseline.n = fit.residuals.size();
   D.baseline.dof = static_cast<int>(n) - fit.num_free;
-  const double chi2 = rss(fit.residuals) / (sigma_mm * sigma_mm);
+  const double chi2 = noise.whiten(fit.residuals).squaredNorm();
   D.baseline.chi2_per_dof = chi2 / D.baseline.dof;
   D.baseline.p_value = stats::chi2_sf(chi2, D.baseline.dof);
   D.structure_before = residual_structure(P, fit.residuals);
+  D.noise_whitened = static_cast<bool>(noise.W);
 
-  // A *_hn candidate of an order its axis' sampling cannot resolve takes, at the sampled
-  // angles, the values of lower orders (C every 30 deg: order 7 is order 5): scored, it would
-  // name an order the data cannot tell. Judged on every reading's angle of that axis, since the
-  // effect's parameters are shared by all of them.
-  std::vector<std::string> unresolved(candidates.size());
-  {
-    std::map<char, int> top;
-    for (const Effect& c : candidates)
-      if (c.harmonic > 0) top[c.axis] = std::max(top[c.axis], c.harmonic);
-    for (const auto& [axis, order] : top) {
-      std::vector<double> th;
-      for (const RotaryAngles<double>& r : P.angles()) th.push_back(axis == 'C' ? r.rot : r.tilt);
-      const HarmonicResolution res =
-          resolve_harmonics(th, axis, order, options.min_harmonic_new_content);
-      for (std::size_t c = 0; c < candidates.size(); ++c)
-        if (candidates[c].axis == axis && candidates[c].harmonic > res.resolved)
-          unresolved[c] = "the sampling cannot resolve its harmonic order: " +
-                          res.why_not(candidates[c].harmonic);
-    }
-  }
-
-  const std::vector<int> fold = cv_folds(P, options.cv_blocks);
-  EffectModel model;
+  const std::vector<std::string> unresolved =
+      unresolved_orders(P, candidates, options.min_harmonic_new_content);
+  const std::vector<int> fold = cv_folds(P, options.cv_blocks, noise.W ? model : nullptr);
+  EffectModel effects;
   std::vector<bool> done(candidates.size(), false);
   bool first_round = true;
-  for (int step = 0; step < options.max_findings; ++step) {
-    const Eigen::MatrixXd Jfree = free_columns(fit.jacobian);
-    const Eigen::MatrixXd Q = orthonormal_basis(Jfree);
+  while (static_cast<int>(D.findings.size()) < options.max_findings) {
+    ScoringInputs in;
+    in.Jfree = free_columns(fit.jacobian);
+    in.Q_w = orthonormal_basis(noise.whiten(in.Jfree));
+    in.r_w = noise.whiten(fit.residuals);
+    in.num_free = fit.num_free;
     std::vector<Score> scores;
     for (std::size_t c = 0; c < candidates.size(); ++c) {
       if (done[c]) continue;
@@ -116,7 +119,8 @@ Diagnosis diagnose_at_noise(const DiagnosisProblem& P, const DiagnosisOptions& o
         done[c] = true;
         continue;
       }
-      Score s = score(P, fit, Jfree, Q, candidates[c], sigma_mm, options.min_visible_chi2);
+      const Eigen::MatrixXd Jc = D.findings.empty() ? baseline_jc[c] : P.candidate_jacobian(fit, candidates[c]);
+      Score s = score(in, candidates[c], Jc, noise.whiten(Jc), options.min_visible_chi2);
       if (!s.observable) {
         if (first_round) D.unobservable.push_back({candidates[c].id(), s.why_not});
         done[c] = true;
@@ -126,8 +130,11 @@ Diagnosis diagnose_at_noise(const DiagnosisProblem& P, const DiagnosisOptions& o
     }
     first_round = false;
     std::vector<CandidateScore> table;
-    for (const Score& s : scores)
-      table.push_back({s.effect.id(), s.k, s.delta_bic, s.f_pvalue, std::sqrt(s.rss1 / n) * 1e3});
+    for (const Score& s : scores) {
+      // RMS after, in um: the whitened fraction applied to the raw RMS.
+      const double frac = std::sqrt(s.rss1 / std::max(in.r_w.squaredNorm(), 1e-300));
+      table.push_back({s.effect.id(), s.k, s.delta_bic, s.f_pvalue, rms_um(fit.residuals) * frac});
+    }
     std::sort(table.begin(), table.end(),
               [](const CandidateScore& a, const CandidateScore& b) { return a.delta_bic < b.delta_bic; });
     D.rounds.push_back(std::move(table));
@@ -137,54 +144,69 @@ Diagnosis diagnose_at_noise(const DiagnosisProblem& P, const DiagnosisOptions& o
       if (s.f_pvalue < options.alpha / m_tests && s.delta_bic < options.min_delta_bic) passing.push_back(&s);
     std::sort(passing.begin(), passing.end(),
               [](const Score* a, const Score* b) { return a->delta_bic < b->delta_bic; });
+
+    // The first passing candidate that also predicts left-out blocks better and whose
+    // parameters the nonlinear refit can determine.
     const Score* chosen = nullptr;
+    std::vector<const Score*> undetermined;  // passed, but no parameter determinable
+    const ModelFit before = fit;
     double cv_before = 0.0, cv_after = 0.0;
     for (const Score* s : passing) {
-      cv_before = cv_rms_um(Jfree, fit.residuals, fold, options.cv_blocks);
+      cv_before = cv_rms_um(in.Jfree, fit.residuals, fold, options.cv_blocks);
       cv_after = cv_rms_um(s->X, fit.residuals, fold, options.cv_blocks);
-      if (cv_after < cv_before) {
-        chosen = s;
-        break;
+      if (!(cv_after < cv_before)) continue;
+      EffectModel extended = effects;
+      extended.effects.push_back(s->effect);
+      ModelFit refit = P.fit(extended);
+      bool any_observable = false;
+      for (const ParameterEstimate& p : parameters_of(refit, s->effect)) any_observable |= p.observable;
+      for (std::size_t c = 0; c < candidates.size(); ++c)
+        if (candidates[c] == s->effect) done[c] = true;
+      if (!any_observable) {
+        // A cause with no number is no finding: the refit cannot determine any parameter.
+        D.unobservable.push_back(
+            {s->effect.id(), "it reduces the residual, but once it is in the model none of its "
+                             "parameters can be determined from these readings (they trade off "
+                             "against the location errors and the other effects)"});
+        undetermined.push_back(s);
+        continue;
       }
+      chosen = s;
+      effects = extended;
+      fit = std::move(refit);
+      break;
     }
     if (!chosen) break;
 
     // Candidates that explain the same signal about as well.
+    // Those passed over for undetermined parameters are listed too, as the data favoured them.
     Ambiguity amb;
     for (const Score* s : passing) {
       if (s == chosen) continue;
+      const bool passed_over = std::find(undetermined.begin(), undetermined.end(), s) != undetermined.end();
       const double dbic = s->delta_bic - chosen->delta_bic;
       const double corr = std::abs(correlation(s->signature, chosen->signature));
-      if (dbic < options.ambiguity_delta_bic && corr >= options.ambiguity_correlation) {
+      if ((dbic < options.ambiguity_delta_bic && corr >= options.ambiguity_correlation) || passed_over) {
         if (amb.effects.empty()) amb.effects.push_back(chosen->effect.id());
         amb.effects.push_back(s->effect.id());
         amb.delta_bic = std::max(amb.delta_bic, dbic);
         amb.correlation = amb.effects.size() == 2 ? corr : std::min(amb.correlation, corr);
-        amb.separating_test = separating_test(P, fit, *chosen, *s, sigma_mm);
+        amb.separating_test = separating_test(P, before, *chosen, *s, noise.sigma_mm);
       }
     }
     if (!amb.effects.empty()) D.ambiguous.push_back(amb);
 
-    // Add it and refit the whole model (nonlinear).
-    const Effect effect = chosen->effect;
-    for (std::size_t c = 0; c < candidates.size(); ++c)
-      if (candidates[c] == effect) done[c] = true;
-    model.effects.push_back(effect);
-    const double rss_before = rss(fit.residuals);
-    const double rms_before = rms_um(fit.residuals);
-    const double f_p = chosen->f_pvalue;
-    const ModelFit before = fit;
-    fit = P.fit(model);
     Finding F;
-    F.effect = effect;
-    F.cause = effect.cause();
-    F.gain.rms_before_um = rms_before;
+    F.effect = chosen->effect;
+    F.cause = chosen->effect.cause();
+    F.gain.rms_before_um = rms_um(before.residuals);
     F.gain.rms_after_um = rms_um(fit.residuals);
-    F.gain.delta_bic = n * std::log(std::max(rss(fit.residuals), 1e-300) / rss_before) +
-                       (fit.num_free - before.num_free) * std::log(n);
+    const double rss_before = noise.whiten(before.residuals).squaredNorm();
+    const double rss_after = std::max(noise.whiten(fit.residuals).squaredNorm(), 1e-300);
+    F.gain.delta_bic = n * std::log(rss_after / rss_before) + (fit.num_free - before.num_free) * std::log(n);
     F.gain.cv_rms_before_um = cv_before;
     F.gain.cv_rms_after_um = cv_after;
-    F.gain.f_pvalue = f_p;
+    F.gain.f_pvalue = chosen->f_pvalue;
     for (const ParameterEstimate& b : before.parameters) {
       for (const ParameterEstimate& a : fit.parameters) {
         if (a.name != b.name || !a.observable || !b.observable) continue;
@@ -195,23 +217,137 @@ Diagnosis diagnose_at_noise(const DiagnosisProblem& P, const DiagnosisOptions& o
     D.findings.push_back(F);
   }
 
-  // Effect parameters from the final fit.
-  for (Finding& F : D.findings) {
-    const std::string id = F.effect.id();
-    for (const ParameterEstimate& p : fit.parameters)
-      if (p.name == id || p.name.rfind(id + ".", 0) == 0) F.parameters.push_back(p);
-  }
+  for (Finding& F : D.findings) F.parameters = parameters_of(fit, F.effect);
   D.final_fit = fit;
   D.structure_after = residual_structure(P, fit.residuals);
   const int dof = static_cast<int>(n) - fit.num_free;
-  const double chi2_final = rss(fit.residuals) / (sigma_mm * sigma_mm);
+  const Eigen::VectorXd r_w = noise.whiten(fit.residuals);
+  const double chi2_final = r_w.squaredNorm();
   D.unexplained.chi2_per_dof = chi2_final / dof;
-  D.unexplained.p_value = stats::chi2_sf(chi2_final, dof);
+  if (!noise.W) {
+    D.unexplained.p_value = stats::chi2_sf(chi2_final, dof);
+    const GroupResidual* worst = nullptr;
+    for (const GroupResidual& g : D.structure_after)
+      if (!worst || g.rms_um > worst->rms_um) worst = &g;
+    if (worst) D.unexplained.group = worst->group;
+  } else {
+    // The AR model was fitted to these residuals, so their whitened chi-square is ~1 by
+    // construction: test for smooth structure in each group's swept angle instead.
+    const Eigen::MatrixXd Jfree = free_columns(fit.jacobian);
+    const StructureTest T = structure_test(
+        P, r_w, orthonormal_basis(noise.whiten(Jfree)), fit.num_free,
+        [&noise](const Eigen::MatrixXd& M) { return noise.whiten(M); });
+    D.unexplained.p_value = T.p_value;
+    D.unexplained.group = T.group;
+  }
   D.unexplained.present = D.unexplained.p_value < 1e-3;
-  if (D.unexplained.present) D.unexplained.signature = describe_structure(D.structure_after);
+  if (D.unexplained.present) {
+    D.unexplained.signature = describe_structure(D.structure_after);
+    if (!D.unexplained.group.empty()) {
+      const Location L = locate(P, fit.residuals, D.unexplained.group);
+      D.unexplained.axis = L.axis;
+      D.unexplained.range_from = L.from;
+      D.unexplained.range_to = L.to;
+      std::ostringstream where;
+      where.precision(4);
+      where << "; in '" << D.unexplained.group << "' the residual is largest at "
+            << (L.axis ? std::string(1, L.axis) + " " : std::string("t ")) << L.from << ".." << L.to
+            << (L.axis ? " deg" : " s") << " (" << L.peak_um << " um mean there)";
+      D.unexplained.signature += where.str();
+    }
+  }
   return D;
 }
 
+NoiseTreatment white_treatment(const DiagnosisProblem& P, const ModelFit& baseline) {
+  NoiseTreatment t;
+  if (const std::optional<double> declared = P.declared_noise_um()) {
+    t.sigma_mm = *declared * 1e-3;
+    t.source = "declared";
+  } else {
+    t.sigma_mm = estimate_noise_um(P, baseline.residuals) * 1e-3;
+    t.source = "estimated from successive differences";
+  }
+  return t;
+}
+
+NoiseTreatment coloured_treatment(const NoiseModel& m) {
+  NoiseTreatment t;
+  t.sigma_mm = m.sigma_um * 1e-3;
+  t.W = std::make_shared<ArWhitener>(m);
+  t.source = "AR noise model of the residuals: " + m.summary();
+  return t;
+}
+
+// White treatment, redone once with the extended model's residual when successive
+// differences overestimated the noise (sparse sampling against the systematic errors, as an
+// R-test's 30 degree steps): if the extended model leaves less, that is the better estimate.
+Diagnosis search_white(const DiagnosisProblem& P, const DiagnosisOptions& options,
+                       const std::vector<Effect>& candidates, const ModelFit& baseline,
+                       const std::vector<Eigen::MatrixXd>& baseline_jc) {
+  const NoiseTreatment white = white_treatment(P, baseline);
+  Diagnosis D = search(P, options, candidates, baseline, baseline_jc, white, nullptr);
+  if (!P.declared_noise_um()) {
+    const double n = static_cast<double>(D.final_fit.residuals.size());
+    const double s_final =
+        std::sqrt(D.final_fit.residuals.squaredNorm() / std::max(1.0, n - D.final_fit.num_free)) * 1e3;
+    if (s_final < 0.8 * D.baseline.noise_um) {
+      NoiseTreatment better;
+      better.sigma_mm = s_final * 1e-3;
+      std::ostringstream why;
+      why.precision(3);
+      why << "estimated from the residuals of the extended model (successive differences gave "
+          << D.baseline.noise_um << " um: the sampling is too sparse for them)";
+      better.source = why.str();
+      D = search(P, options, candidates, baseline, baseline_jc, better, nullptr);
+    }
+  }
+  return D;
+}
+
+// The noise model is estimated from the residuals of the saturated model: the baseline
+// extended (linearised) by every candidate at once. An effect hidden in the data is then not
+// mistaken for correlated noise (which would whiten its own signature away), while correlated
+// noise, which no candidate of a few parameters follows, stays. Variances are scaled by
+// n / (n - rank) for the dimensions the projection removed.
+NoiseModel saturated_noise_model(const DiagnosisProblem& P, const DiagnosisOptions& options,
+                                 const ModelFit& baseline, const std::vector<Eigen::MatrixXd>& jc) {
+  const Eigen::MatrixXd Jfree = free_columns(baseline.jacobian);
+  Eigen::Index cols = Jfree.cols();
+  for (const Eigen::MatrixXd& J : jc) cols += J.cols();
+  Eigen::MatrixXd X(Jfree.rows(), cols);
+  X.leftCols(Jfree.cols()) = Jfree;
+  Eigen::Index at = Jfree.cols();
+  for (const Eigen::MatrixXd& J : jc) X.middleCols(at, J.cols()) = J, at += J.cols();
+  const Eigen::MatrixXd Q = orthonormal_basis(X);
+  const Eigen::VectorXd r = baseline.residuals - Q * (Q.transpose() * baseline.residuals);
+  NoiseModel m = estimate_noise_model(P.groups(), P.times(), r, options.noise);
+  const double n = static_cast<double>(r.size()), rank = static_cast<double>(Q.cols());
+  const double f = n > rank ? std::sqrt(n / (n - rank)) : 1.0;
+  m.sigma_um *= f;
+  m.innovation_sigma_um *= f;
+  for (NoiseStream& st : m.streams) st.marginal_sigma_um *= f, st.innovation_sigma_um *= f;
+  return m;
+}
+
 }  // namespace
+
+Diagnosis diagnose(const DiagnosisProblem& P, const DiagnosisOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::vector<Effect> candidates = candidate_list(P, options);
+  const ModelFit baseline = P.fit(EffectModel{});
+  std::vector<Eigen::MatrixXd> baseline_jc;
+  for (const Effect& c : candidates) baseline_jc.push_back(P.candidate_jacobian(baseline, c));
+  NoiseModel model = saturated_noise_model(P, options, baseline, baseline_jc);
+  Diagnosis D;
+  if (!options.model_noise || model.white()) {
+    D = search_white(P, options, candidates, baseline, baseline_jc);
+  } else {
+    D = search(P, options, candidates, baseline, baseline_jc, coloured_treatment(model), &model);
+  }
+  D.noise = std::move(model);
+  D.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return D;
+}
 
 }  // namespace rotacal

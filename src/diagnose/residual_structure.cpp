@@ -2,10 +2,12 @@
 // successive-difference noise estimate.
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <sstream>
 
 #include "rotacal/core/error.hpp"
+#include "rotacal/core/stats.hpp"
 #include "scoring.hpp"
 
 namespace rotacal {
@@ -140,3 +142,116 @@ std::vector<GroupResidual> residual_structure(const DiagnosisProblem& P, const E
 }
 
 }  // namespace rotacal
+
+namespace rotacal::diagnosis_detail {
+
+namespace {
+// Rows of `group`, and the coordinate it sweeps (angle in rad with its axis, else time).
+std::vector<std::size_t> rows_of(const DiagnosisProblem& P, const std::string& group) {
+  std::vector<std::size_t> idx;
+  for (std::size_t i = 0; i < P.groups().size(); ++i)
+    if (P.groups()[i] == group) idx.push_back(i);
+  return idx;
+}
+std::vector<double> swept(const DiagnosisProblem& P, const std::vector<std::size_t>& idx, char* axis) {
+  double lo_t = 1e300, hi_t = -1e300, lo_r = 1e300, hi_r = -1e300;
+  for (std::size_t i : idx) {
+    const RotaryAngles<double>& a = P.angles()[i];
+    lo_t = std::min(lo_t, a.tilt), hi_t = std::max(hi_t, a.tilt);
+    lo_r = std::min(lo_r, a.rot), hi_r = std::max(hi_r, a.rot);
+  }
+  std::vector<double> x;
+  const bool rot = hi_r - lo_r >= hi_t - lo_t;
+  if (idx.empty() || std::max(hi_r - lo_r, hi_t - lo_t) <= 1e-9) {
+    *axis = 0;
+    for (std::size_t i : idx) x.push_back(P.times()[i]);
+  } else {
+    *axis = rot ? 'C' : tilt_axis_letter(P.machine());
+    for (std::size_t i : idx) x.push_back(rot ? P.angles()[i].rot : P.angles()[i].tilt);
+  }
+  return x;
+}
+}  // namespace
+
+Location locate(const DiagnosisProblem& P, const Eigen::VectorXd& r, const std::string& group) {
+  Location L;
+  const std::vector<std::size_t> idx = rows_of(P, group);
+  const std::vector<double> x = swept(P, idx, &L.axis);
+  if (x.empty()) return L;
+  const double lo = *std::min_element(x.begin(), x.end()), hi = *std::max_element(x.begin(), x.end());
+  constexpr int kBins = 12;
+  std::vector<double> sum(kBins, 0.0), cnt(kBins, 0.0);
+  for (std::size_t k = 0; k < idx.size(); ++k) {
+    const int b = hi > lo ? std::min(kBins - 1, static_cast<int>((x[k] - lo) / (hi - lo) * kBins)) : 0;
+    sum[static_cast<std::size_t>(b)] += r[static_cast<Eigen::Index>(idx[k])];
+    cnt[static_cast<std::size_t>(b)] += 1.0;
+  }
+  std::vector<double> mean(kBins, 0.0);
+  int peak = 0;
+  for (int b = 0; b < kBins; ++b) {
+    mean[static_cast<std::size_t>(b)] = cnt[static_cast<std::size_t>(b)] > 0 ? sum[static_cast<std::size_t>(b)] / cnt[static_cast<std::size_t>(b)] : 0.0;
+    if (std::abs(mean[static_cast<std::size_t>(b)]) > std::abs(mean[static_cast<std::size_t>(peak)])) peak = b;
+  }
+  const double half = 0.5 * std::abs(mean[static_cast<std::size_t>(peak)]);
+  int first = peak, last = peak;
+  while (first > 0 && std::abs(mean[static_cast<std::size_t>(first - 1)]) >= half &&
+         mean[static_cast<std::size_t>(first - 1)] * mean[static_cast<std::size_t>(peak)] > 0) --first;
+  while (last + 1 < kBins && std::abs(mean[static_cast<std::size_t>(last + 1)]) >= half &&
+         mean[static_cast<std::size_t>(last + 1)] * mean[static_cast<std::size_t>(peak)] > 0) ++last;
+  const double scale = L.axis ? 180.0 / M_PI : 1.0, w = (hi - lo) / kBins;
+  L.from = (lo + first * w) * scale;
+  L.to = (lo + (last + 1) * w) * scale;
+  L.peak_um = mean[static_cast<std::size_t>(peak)] * 1e3;
+  return L;
+}
+
+StructureTest structure_test(const DiagnosisProblem& P, const Eigen::VectorXd& r_w,
+                             const Eigen::MatrixXd& Q_w, int num_free,
+                             const std::function<Eigen::MatrixXd(const Eigen::MatrixXd&)>& whiten) {
+  std::vector<std::string> order;
+  for (const std::string& s : P.groups())
+    if (std::find(order.begin(), order.end(), s) == order.end()) order.push_back(s);
+  StructureTest out;
+  double best = 1.0;
+  const double n = static_cast<double>(r_w.size());
+  for (const std::string& group : order) {
+    const std::vector<std::size_t> idx = rows_of(P, group);
+    if (idx.size() < 20) continue;
+    char axis = 0;
+    const std::vector<double> x = swept(P, idx, &axis);
+    const double lo = *std::min_element(x.begin(), x.end()), hi = *std::max_element(x.begin(), x.end());
+    if (!(hi > lo)) continue;
+    std::vector<std::function<double(double)>> f;
+    int orders = 0;
+    if (axis && hi - lo >= 330.0 * M_PI / 180.0) {
+      orders = resolve_harmonics(x, axis, 8, 0.1).resolved;
+      for (int o = 1; o <= orders; ++o) {
+        f.push_back([o](double th) { return std::cos(o * th); });
+        f.push_back([o](double th) { return std::sin(o * th); });
+      }
+    } else {
+      for (int d = 1; d <= 4; ++d)
+        f.push_back([d, lo, hi](double v) { return std::pow(2.0 * (v - lo) / (hi - lo) - 1.0, d); });
+    }
+    if (f.empty()) continue;
+    Eigen::MatrixXd G = Eigen::MatrixXd::Zero(r_w.size(), static_cast<Eigen::Index>(f.size()));
+    for (std::size_t k = 0; k < idx.size(); ++k)
+      for (std::size_t j = 0; j < f.size(); ++j)
+        G(static_cast<Eigen::Index>(idx[k]), static_cast<Eigen::Index>(j)) = f[j](x[k]);
+    const Eigen::MatrixXd Gp = project_out(Q_w, whiten(G));
+    const Eigen::MatrixXd B = orthonormal_basis(Gp);
+    const auto q = static_cast<double>(B.cols());
+    if (q == 0) continue;
+    const Eigen::VectorXd fitted = B * (B.transpose() * r_w);
+    const double rss0 = r_w.squaredNorm(), rss1 = std::max((r_w - fitted).squaredNorm(), 1e-300);
+    const double dof = n - num_free - q;
+    if (dof <= 0) continue;
+    const double F = ((rss0 - rss1) / q) / (rss1 / dof);
+    const double p = stats::f_sf(std::max(F, 0.0), q, dof);
+    if (p < best) best = p, out.group = group;
+  }
+  out.p_value = std::min(1.0, best * static_cast<double>(order.size()));
+  return out;
+}
+
+}  // namespace rotacal::diagnosis_detail

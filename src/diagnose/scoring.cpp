@@ -62,17 +62,33 @@ Eigen::MatrixXd free_columns(const Eigen::MatrixXd& J) {
   return out;
 }
 
-std::vector<int> cv_folds(const DiagnosisProblem& P, int K) {
+std::vector<int> cv_folds(const DiagnosisProblem& P, int K, const NoiseModel* noise) {
   const auto& g = P.groups();
   const auto& t = P.times();
   std::map<std::string, std::vector<std::size_t>> by_group;
   for (std::size_t i = 0; i < g.size(); ++i) by_group[g[i]].push_back(i);
+  // Blocks at least one correlation time long (in the group's readings: a time stamp with
+  // three channels is three readings), so a left-out block's noise is nearly independent of
+  // the noise the refit saw.
+  std::map<std::string, double> min_block;
+  if (noise) {
+    std::map<std::string, int> channels;
+    for (const NoiseStream& s : noise->streams) {
+      channels[s.group] = std::max(channels[s.group], s.channel + 1);
+      min_block[s.group] = std::max(min_block[s.group], s.correlation_samples);
+    }
+    for (auto& kv : min_block) kv.second *= channels[kv.first];
+  }
   std::vector<int> fold(g.size(), 0);
   for (auto& kv : by_group) {
     auto& idx = kv.second;
     std::stable_sort(idx.begin(), idx.end(), [&](std::size_t a, std::size_t b) { return t[a] < t[b]; });
+    int blocks = K;
+    const auto it = min_block.find(kv.first);
+    if (it != min_block.end() && it->second > 1.0)
+      blocks = std::clamp(static_cast<int>(static_cast<double>(idx.size()) / it->second), 2, K);
     for (std::size_t k = 0; k < idx.size(); ++k)
-      fold[idx[k]] = static_cast<int>(k * static_cast<std::size_t>(K) / idx.size());
+      fold[idx[k]] = static_cast<int>(k * static_cast<std::size_t>(blocks) / idx.size());
   }
   return fold;
 }
@@ -102,14 +118,14 @@ double cv_rms_um(const Eigen::MatrixXd& X, const Eigen::VectorXd& r, const std::
   return n ? std::sqrt(ss / static_cast<double>(n)) * 1e3 : 0.0;
 }
 
-Score score(const DiagnosisProblem& P, const ModelFit& fit, const Eigen::MatrixXd& Jfree,
-            const Eigen::MatrixXd& Q, const Effect& c, double sigma_mm, double min_chi2) {
+Score score(const ScoringInputs& in, const Effect& c, const Eigen::MatrixXd& Jc,
+            const Eigen::MatrixXd& Jc_w, double min_chi2) {
   Score s;
   s.effect = c;
-  const Eigen::MatrixXd Jc = P.candidate_jacobian(fit, c);
   const Eigen::VectorXd m = magnitudes(c);
-  const Eigen::MatrixXd raw = Jc * m.asDiagonal() / sigma_mm;
-  const Eigen::MatrixXd perp = project_out(Q, Jc) * m.asDiagonal() / sigma_mm;
+  // Whitened columns per plausible size: their squared norms are chi-square changes.
+  const Eigen::MatrixXd raw = Jc_w * m.asDiagonal();
+  const Eigen::MatrixXd perp = project_out(in.Q_w, Jc_w) * m.asDiagonal();
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(perp, Eigen::ComputeThinV);
   const Eigen::VectorXd sv = svd.singularValues();
   std::vector<Eigen::Index> dirs;
@@ -130,16 +146,18 @@ Score score(const DiagnosisProblem& P, const ModelFit& fit, const Eigen::MatrixX
   s.k = static_cast<int>(dirs.size());
   Eigen::MatrixXd V(perp.cols(), s.k);
   for (int i = 0; i < s.k; ++i) V.col(i) = svd.matrixV().col(dirs[static_cast<std::size_t>(i)]);
-  s.A = perp * V * sigma_mm;  // back to mm per scaled unit
-  Eigen::MatrixXd Jc_obs = Jc * m.asDiagonal() * V;
-  s.X.resize(Jfree.rows(), Jfree.cols() + s.k);
-  s.X << Jfree, Jc_obs;
-  const Eigen::VectorXd d = solve_ls(s.A, fit.residuals);
+  s.A = perp * V;
+  s.X.resize(in.Jfree.rows(), in.Jfree.cols() + s.k);
+  s.X << in.Jfree, Jc * m.asDiagonal() * V;
+  const Eigen::VectorXd d = solve_ls(s.A, in.r_w);
   s.signature = s.A * d;
-  const double rss0 = rss(fit.residuals);
-  s.rss1 = std::max(rss(fit.residuals - s.signature), 1e-300);
-  const double n = static_cast<double>(fit.residuals.size());
-  const double dof = n - fit.num_free - s.k;
+  s.params = m.cwiseProduct(V * d);
+  // F and BIC on whitened residuals: independent with unit variance under the noise model,
+  // so the textbook tests hold with the full n (GLS).
+  const double rss0 = rss(in.r_w);
+  s.rss1 = std::max(rss(in.r_w - s.signature), 1e-300);
+  const double n = static_cast<double>(in.r_w.size());
+  const double dof = n - in.num_free - s.k;
   s.delta_bic = n * std::log(s.rss1 / rss0) + s.k * std::log(n);
   const double F = ((rss0 - s.rss1) / s.k) / (s.rss1 / dof);
   s.f_pvalue = stats::f_sf(std::max(F, 0.0), s.k, dof);

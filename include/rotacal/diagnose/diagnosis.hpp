@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "rotacal/ballbar/identify.hpp"
+#include "rotacal/core/noise_model.hpp"
 #include "rotacal/kinematics/effects.hpp"
 
 namespace rotacal {
@@ -89,6 +90,12 @@ struct DiagnosisOptions {
   /// unobservable. Lenient on purpose: how well a resolvable order stands apart from the
   /// others is judged with the noise, by the F-test, cross-validation and the ambiguity report.
   double min_harmonic_new_content = 0.01;
+  /// Estimate the residual noise's correlation (core/noise_model.hpp) from the baseline
+  /// residuals and, when it is not white, make every decision on whitened residuals and
+  /// Jacobians (F, BIC, visibility), cross-validate with blocks at least one correlation time
+  /// long and test for unexplained structure against it. False: treat the noise as white.
+  bool model_noise = true;
+  NoiseModelOptions noise;
 };
 
 /// Which harmonic orders of one rotary angle a set of readings resolves.
@@ -176,9 +183,15 @@ struct UnobservableEffect {
 
 struct Unexplained {
   bool present = false;
-  double chi2_per_dof = 0.0;
-  double p_value = 1.0;
-  std::string signature;  ///< the strongest remaining structure, in words
+  double chi2_per_dof = 0.0;  ///< of the whitened final residuals
+  double p_value = 1.0;       ///< white noise: chi-square test; coloured: the structure test
+  std::string signature;      ///< the strongest remaining structure, in words
+  /// Where (coloured noise: the group whose structure test fails; white: the group with the
+  /// largest residual), and the range of its swept angle where the residual is largest.
+  std::string group;
+  char axis = 0;                 ///< swept rotary axis of that group (0: none; range in time)
+  double range_from = 0.0;       ///< deg (or s when axis == 0)
+  double range_to = 0.0;
 };
 
 /// How one candidate scored against a model (linearised refit).
@@ -210,6 +223,11 @@ struct Diagnosis {
   std::vector<Ambiguity> ambiguous;
   std::vector<UnobservableEffect> unobservable;
   Unexplained unexplained;
+  /// The residual noise model the decisions were made with (estimated from the residuals of
+  /// the final model, after findings). white(): the noise was treated as white with
+  /// baseline.noise_um.
+  NoiseModel noise;
+  bool noise_whitened = false;  ///< decisions made on AR-whitened residuals
   ModelFit baseline_fit;
   ModelFit final_fit;
   double seconds = 0.0;  ///< wall time of the diagnosis
