@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <random>
 #include <sstream>
@@ -37,6 +38,36 @@ void burg(const std::vector<double>& x, int P, std::vector<double>* k, std::vect
       f[t] = ft - km * bt1;
       b[t] = bt1 - km * ft;
     }
+    k->push_back(km);
+    v->push_back(v->back() * (1.0 - km * km));
+  }
+}
+
+// Burg's recursion over several segments at once (one model for all): sums over segments.
+void burg_pooled(const std::vector<std::vector<double>>& xs, int P, std::vector<double>* k,
+                 std::vector<double>* v, std::size_t* n_total) {
+  std::vector<std::vector<double>> f(xs), b(xs);
+  double ss = 0.0;
+  std::size_t n = 0;
+  for (const auto& x : xs)
+    for (double xi : x) ss += xi * xi, ++n;
+  *n_total = n;
+  k->clear();
+  v->assign(1, n ? ss / static_cast<double>(n) : 0.0);
+  for (int m = 1; m <= P; ++m) {
+    double num = 0.0, den = 0.0;
+    for (std::size_t s = 0; s < xs.size(); ++s)
+      for (std::size_t t = static_cast<std::size_t>(m); t < xs[s].size(); ++t) {
+        num += f[s][t] * b[s][t - 1];
+        den += f[s][t] * f[s][t] + b[s][t - 1] * b[s][t - 1];
+      }
+    const double km = den > 0.0 ? 2.0 * num / den : 0.0;
+    for (std::size_t s = 0; s < xs.size(); ++s)
+      for (std::size_t t = xs[s].size(); t-- > static_cast<std::size_t>(m);) {
+        const double ft = f[s][t], bt1 = b[s][t - 1];
+        f[s][t] = ft - km * bt1;
+        b[s][t] = bt1 - km * ft;
+      }
     k->push_back(km);
     v->push_back(v->back() * (1.0 - km * km));
   }
@@ -136,6 +167,45 @@ NoiseModel estimate_noise_model(const std::vector<std::string>& groups,
   const auto streams = noise_streams(groups, times, &sg, &sc);
   NoiseModel M;
   M.n = groups.size();
+  // Each stream's readings in time order with its mean removed, and its sample interval.
+  std::vector<std::vector<double>> xs(streams.size());
+  std::vector<double> intervals(streams.size(), 0.0);
+  for (std::size_t s = 0; s < streams.size(); ++s) {
+    const std::size_t n = streams[s].size();
+    std::vector<double>& x = xs[s];
+    x.resize(n);
+    std::vector<double> dt;
+    double mean = 0.0;
+    for (std::size_t t = 0; t < n; ++t) mean += (x[t] = residuals_mm[streams[s][t]]);
+    mean /= static_cast<double>(n);
+    for (double& xi : x) xi -= mean;
+    for (std::size_t t = 1; t < n; ++t) {
+      const double d = times[static_cast<std::size_t>(streams[s][t])] -
+                       times[static_cast<std::size_t>(streams[s][t - 1])];
+      if (d > 0.0) dt.push_back(d);
+    }
+    intervals[s] = median(dt);
+  }
+  // BIC over orders 0..P of Burg's prediction error variances v_p for n readings.
+  const auto choose = [](const std::vector<double>& v, std::size_t n) {
+    int best = 0;
+    double best_bic = 0.0;
+    const double ln_n = std::log(static_cast<double>(std::max<std::size_t>(n, 2)));
+    for (std::size_t p = 0; p < v.size(); ++p) {
+      const double bic = static_cast<double>(n) * std::log(std::max(v[p], 1e-300)) + static_cast<double>(p) * ln_n;
+      if (p == 0 || bic < best_bic) best = static_cast<int>(p), best_bic = bic;
+    }
+    return best;
+  };
+  std::vector<double> pooled_k, pooled_v;
+  int pooled_order = 0;
+  if (options.pooled) {
+    std::size_t shortest = SIZE_MAX, total = 0;
+    for (const auto& x : xs) shortest = std::min(shortest, x.size());
+    const int P = streams.empty() ? 0 : std::min(options.max_order, static_cast<int>(shortest / 4));
+    burg_pooled(xs, std::max(P, 0), &pooled_k, &pooled_v, &total);
+    pooled_order = choose(pooled_v, total);
+  }
   double ss_marg = 0.0, ss_innov = 0.0;
   for (std::size_t s = 0; s < streams.size(); ++s) {
     NoiseStream S;
@@ -143,28 +213,17 @@ NoiseModel estimate_noise_model(const std::vector<std::string>& groups,
     S.channel = sc[s];
     S.rows = streams[s];
     const std::size_t n = S.rows.size();
-    std::vector<double> x(n), dt;
-    double mean = 0.0;
-    for (std::size_t t = 0; t < n; ++t) mean += (x[t] = residuals_mm[S.rows[t]]);
-    mean /= static_cast<double>(n);
-    for (double& xi : x) xi -= mean;
-    for (std::size_t t = 1; t < n; ++t) {
-      const double d = times[static_cast<std::size_t>(S.rows[t])] -
-                       times[static_cast<std::size_t>(S.rows[t - 1])];
-      if (d > 0.0) dt.push_back(d);
-    }
-    S.sample_interval_s = median(dt);
-    const int P = static_cast<int>(n) >= options.min_stream_size
-                      ? std::min(options.max_order, static_cast<int>(n / 4))
-                      : 0;
+    S.sample_interval_s = intervals[s];
     std::vector<double> k, v;
-    burg(x, P, &k, &v);
     int best = 0;
-    double best_bic = 0.0;
-    const double ln_n = std::log(static_cast<double>(std::max<std::size_t>(n, 2)));
-    for (int p = 0; p <= P; ++p) {
-      const double bic = static_cast<double>(n) * std::log(std::max(v[static_cast<std::size_t>(p)], 1e-300)) + p * ln_n;
-      if (p == 0 || bic < best_bic) best = p, best_bic = bic;
+    if (options.pooled) {
+      k = pooled_k, v = pooled_v, best = pooled_order;
+    } else {
+      const int P = static_cast<int>(n) >= options.min_stream_size
+                        ? std::min(options.max_order, static_cast<int>(n / 4))
+                        : 0;
+      burg(xs[s], P, &k, &v);
+      best = choose(v, n);
     }
     S.reflection.assign(k.begin(), k.begin() + best);
     S.ar = levinson(S.reflection).back();

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <functional>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -75,6 +76,31 @@ std::vector<ParameterEstimate> parameters_of(const ModelFit& fit, const Effect& 
   return out;
 }
 
+// One indicator column per noise stream (group, channel).
+Eigen::MatrixXd stream_levels(const DiagnosisProblem& P) {
+  const auto streams = noise_streams(P.groups(), P.times());
+  Eigen::MatrixXd L = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(P.groups().size()),
+                                            static_cast<Eigen::Index>(streams.size()));
+  for (std::size_t s = 0; s < streams.size(); ++s)
+    for (Eigen::Index i : streams[s]) L(i, static_cast<Eigen::Index>(s)) = 1e-3;  // 1 um
+  return L;
+}
+
+NoiseTreatment white_treatment(const DiagnosisProblem& P, const ModelFit& baseline);
+NoiseTreatment coloured_treatment(const NoiseModel& m);
+
+// The noise model of what the current model extended by candidate c (linearised) leaves;
+// white treatment if that is white.
+NoiseTreatment candidate_treatment(const DiagnosisProblem& P, const DiagnosisOptions& options,
+                                   const ModelFit& fit, const Eigen::MatrixXd& Q_raw,
+                                   const Eigen::MatrixXd& Jc, const Effect& c,
+                                   const NoiseTreatment& white, NoiseModel* model) {
+  const Eigen::MatrixXd perp = project_out(Q_raw, Jc) * magnitudes(c).asDiagonal();
+  const Eigen::VectorXd r = fit.residuals - perp * solve_ls(perp, fit.residuals);
+  *model = estimate_noise_model(P.groups(), P.times(), r, options.noise);
+  return model->white() ? white : coloured_treatment(*model);
+}
+
 // The search: score every candidate against the current model, add the best one that passes
 // the F-test (Bonferroni), BIC and blocked cross-validation and whose parameters the refit can
 // determine, refit, repeat; then judge what is left.
@@ -82,7 +108,7 @@ std::vector<ParameterEstimate> parameters_of(const ModelFit& fit, const Effect& 
 Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
                  const std::vector<Effect>& candidates, const ModelFit& baseline,
                  const std::vector<Eigen::MatrixXd>& baseline_jc, const NoiseTreatment& noise,
-                 const NoiseModel* model) {
+                 const NoiseModel* model, const NoiseTreatment& white) {
   Diagnosis D;
   D.machine = P.machine();
   ModelFit fit = baseline;
@@ -111,7 +137,19 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
     in.Q_w = orthonormal_basis(noise.whiten(in.Jfree));
     in.r_w = noise.whiten(fit.residuals);
     in.num_free = fit.num_free;
+    // Coloured: the free columns with one level column per stream appended, for candidates
+    // whose own noise model is 1/f-like (see below).
+    Eigen::MatrixXd Q_raw, J_levels;
+    int levels_rank = 0;
+    if (noise.W) {
+      Q_raw = orthonormal_basis(in.Jfree);
+      const Eigen::MatrixXd L = stream_levels(P);
+      J_levels.resize(in.Jfree.rows(), in.Jfree.cols() + L.cols());
+      J_levels << in.Jfree, L;
+      levels_rank = static_cast<int>(orthonormal_basis(J_levels).cols() - Q_raw.cols());
+    }
     std::vector<Score> scores;
+    std::vector<NoiseTreatment> treatment_of;  // per score: the noise it was judged with
     for (std::size_t c = 0; c < candidates.size(); ++c) {
       if (done[c]) continue;
       if (!unresolved[c].empty()) {
@@ -120,13 +158,49 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
         continue;
       }
       const Eigen::MatrixXd Jc = D.findings.empty() ? baseline_jc[c] : P.candidate_jacobian(fit, candidates[c]);
-      Score s = score(in, candidates[c], Jc, noise.whiten(Jc), options.min_visible_chi2);
+      Score s;
+      NoiseTreatment judged_with = noise;
+      if (!noise.W) {
+        s = score(in, candidates[c], Jc, noise.whiten(Jc), options.min_visible_chi2);
+      } else {
+        // As the classical F-test takes sigma from the larger model, the noise is modelled on
+        // what the model extended by this candidate leaves: correlated noise that no candidate
+        // follows stays correlated (so it is not taken for an effect), and an effect's own
+        // signature is not mistaken for correlated noise (which would whiten it away).
+        NoiseModel own_model;
+        const NoiseTreatment own = candidate_treatment(P, options, fit, Q_raw, Jc, candidates[c], white, &own_model);
+        ScoringInputs in_c;
+        in_c.Jfree = in.Jfree;
+        in_c.num_free = fit.num_free;
+        if (own_model.max_order >= 2) {
+          // Noise that AR(1) does not describe (BIC wants p >= 2) is taken as 1/f-like: it has
+          // no finite correlation time, and its lowest frequencies are indistinguishable from
+          // an offset per stream that no AR model of a few hundred readings captures, so the
+          // level of each stream becomes a nuisance parameter.
+          in_c.Jfree = J_levels;
+          in_c.num_free += levels_rank;
+        }
+        in_c.Q_w = orthonormal_basis(own.whiten(in_c.Jfree));
+        in_c.r_w = own.whiten(fit.residuals);
+        s = score(in_c, candidates[c], Jc, own.whiten(Jc), options.min_visible_chi2);
+        if (s.observable && s.X.cols() > in.Jfree.cols() + s.k) {
+          // Cross-validation compares with the model itself, without the level columns.
+          Eigen::MatrixXd X(s.X.rows(), in.Jfree.cols() + s.k);
+          X << in.Jfree, s.X.rightCols(s.k);
+          s.X = X;
+        }
+        // Scores are kept relative to the whitened residual of the current model, so the
+        // table's RMS-after stays comparable.
+        s.rss1 *= in.r_w.squaredNorm() / std::max(in_c.r_w.squaredNorm(), 1e-300);
+        judged_with = own;
+      }
       if (!s.observable) {
         if (first_round) D.unobservable.push_back({candidates[c].id(), s.why_not});
         done[c] = true;
         continue;
       }
       scores.push_back(std::move(s));
+      treatment_of.push_back(judged_with);
     }
     first_round = false;
     std::vector<CandidateScore> table;
@@ -201,8 +275,9 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
     F.cause = chosen->effect.cause();
     F.gain.rms_before_um = rms_um(before.residuals);
     F.gain.rms_after_um = rms_um(fit.residuals);
-    const double rss_before = noise.whiten(before.residuals).squaredNorm();
-    const double rss_after = std::max(noise.whiten(fit.residuals).squaredNorm(), 1e-300);
+    const NoiseTreatment& judged = treatment_of[static_cast<std::size_t>(chosen - scores.data())];
+    const double rss_before = judged.whiten(before.residuals).squaredNorm();
+    const double rss_after = std::max(judged.whiten(fit.residuals).squaredNorm(), 1e-300);
     F.gain.delta_bic = n * std::log(rss_after / rss_before) + (fit.num_free - before.num_free) * std::log(n);
     F.gain.cv_rms_before_um = cv_before;
     F.gain.cv_rms_after_um = cv_after;
@@ -231,12 +306,46 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
       if (!worst || g.rms_um > worst->rms_um) worst = &g;
     if (worst) D.unexplained.group = worst->group;
   } else {
-    // The AR model was fitted to these residuals, so their whitened chi-square is ~1 by
-    // construction: test for smooth structure in each group's swept angle instead.
-    const Eigen::MatrixXd Jfree = free_columns(fit.jacobian);
-    const StructureTest T = structure_test(
-        P, r_w, orthonormal_basis(noise.whiten(Jfree)), fit.num_free,
-        [&noise](const Eigen::MatrixXd& M) { return noise.whiten(M); });
+    // The noise of the group under test is modelled on the other groups (one AR model pooled
+    // over them: the same sensor at the same rate): modelled on the group itself, the AR
+    // model would take its structure for correlated noise and whiten it away, and with the
+    // tested structure fitted first it would lose the noise's low frequencies with it and find
+    // structure in every null session.
+    const NoiseModel final_model = estimate_noise_model(P.groups(), P.times(), fit.residuals, options.noise);
+    Eigen::MatrixXd Jfree = free_columns(fit.jacobian);
+    int num_free = fit.num_free;
+    if (final_model.max_order >= 2) {  // 1/f-like: stream levels are nuisance, as in scoring
+      const Eigen::MatrixXd L = stream_levels(P);
+      Eigen::MatrixXd X(Jfree.rows(), Jfree.cols() + L.cols());
+      X << Jfree, L;
+      num_free += static_cast<int>(orthonormal_basis(X).cols() - orthonormal_basis(Jfree).cols());
+      Jfree = X;
+    }
+    const auto whitener_for = [&](const std::string& group, const Eigen::MatrixXd&) {
+      std::vector<std::string> g;
+      std::vector<double> t;
+      std::vector<double> r;
+      for (std::size_t i = 0; i < P.groups().size(); ++i)
+        if (P.groups()[i] != group)
+          g.push_back(P.groups()[i]), t.push_back(P.times()[i]), r.push_back(fit.residuals[static_cast<Eigen::Index>(i)]);
+      NoiseModelOptions pooled = options.noise;
+      pooled.pooled = true;
+      NoiseTreatment t_noise = white;
+      if (!g.empty()) {
+        const NoiseModel others = estimate_noise_model(g, t, Eigen::Map<const Eigen::VectorXd>(r.data(), static_cast<Eigen::Index>(r.size())), pooled);
+        if (!others.white()) {
+          NoiseModel all = estimate_noise_model(P.groups(), P.times(), fit.residuals, pooled);
+          const NoiseStream& o = others.streams.front();
+          for (NoiseStream& st : all.streams) {
+            st.reflection = o.reflection, st.ar = o.ar;
+            st.marginal_sigma_um = o.marginal_sigma_um, st.innovation_sigma_um = o.innovation_sigma_um;
+          }
+          t_noise = coloured_treatment(all);
+        }
+      }
+      return Whiten([t_noise](const Eigen::MatrixXd& M) { return t_noise.whiten(M); });
+    };
+    const StructureTest T = structure_test(P, fit.residuals, Jfree, num_free, whitener_for);
     D.unexplained.p_value = T.p_value;
     D.unexplained.group = T.group;
   }
@@ -286,7 +395,7 @@ Diagnosis search_white(const DiagnosisProblem& P, const DiagnosisOptions& option
                        const std::vector<Effect>& candidates, const ModelFit& baseline,
                        const std::vector<Eigen::MatrixXd>& baseline_jc) {
   const NoiseTreatment white = white_treatment(P, baseline);
-  Diagnosis D = search(P, options, candidates, baseline, baseline_jc, white, nullptr);
+  Diagnosis D = search(P, options, candidates, baseline, baseline_jc, white, nullptr, white);
   if (!P.declared_noise_um()) {
     const double n = static_cast<double>(D.final_fit.residuals.size());
     const double s_final =
@@ -299,35 +408,10 @@ Diagnosis search_white(const DiagnosisProblem& P, const DiagnosisOptions& option
       why << "estimated from the residuals of the extended model (successive differences gave "
           << D.baseline.noise_um << " um: the sampling is too sparse for them)";
       better.source = why.str();
-      D = search(P, options, candidates, baseline, baseline_jc, better, nullptr);
+      D = search(P, options, candidates, baseline, baseline_jc, better, nullptr, better);
     }
   }
   return D;
-}
-
-// The noise model is estimated from the residuals of the saturated model: the baseline
-// extended (linearised) by every candidate at once. An effect hidden in the data is then not
-// mistaken for correlated noise (which would whiten its own signature away), while correlated
-// noise, which no candidate of a few parameters follows, stays. Variances are scaled by
-// n / (n - rank) for the dimensions the projection removed.
-NoiseModel saturated_noise_model(const DiagnosisProblem& P, const DiagnosisOptions& options,
-                                 const ModelFit& baseline, const std::vector<Eigen::MatrixXd>& jc) {
-  const Eigen::MatrixXd Jfree = free_columns(baseline.jacobian);
-  Eigen::Index cols = Jfree.cols();
-  for (const Eigen::MatrixXd& J : jc) cols += J.cols();
-  Eigen::MatrixXd X(Jfree.rows(), cols);
-  X.leftCols(Jfree.cols()) = Jfree;
-  Eigen::Index at = Jfree.cols();
-  for (const Eigen::MatrixXd& J : jc) X.middleCols(at, J.cols()) = J, at += J.cols();
-  const Eigen::MatrixXd Q = orthonormal_basis(X);
-  const Eigen::VectorXd r = baseline.residuals - Q * (Q.transpose() * baseline.residuals);
-  NoiseModel m = estimate_noise_model(P.groups(), P.times(), r, options.noise);
-  const double n = static_cast<double>(r.size()), rank = static_cast<double>(Q.cols());
-  const double f = n > rank ? std::sqrt(n / (n - rank)) : 1.0;
-  m.sigma_um *= f;
-  m.innovation_sigma_um *= f;
-  for (NoiseStream& st : m.streams) st.marginal_sigma_um *= f, st.innovation_sigma_um *= f;
-  return m;
 }
 
 }  // namespace
@@ -338,12 +422,30 @@ Diagnosis diagnose(const DiagnosisProblem& P, const DiagnosisOptions& options) {
   const ModelFit baseline = P.fit(EffectModel{});
   std::vector<Eigen::MatrixXd> baseline_jc;
   for (const Effect& c : candidates) baseline_jc.push_back(P.candidate_jacobian(baseline, c));
-  NoiseModel model = saturated_noise_model(P, options, baseline, baseline_jc);
+  // Correlated at all? Judged on the baseline residuals: if even they are white (nothing
+  // unmodelled, white noise), every decision is the white-noise one.
+  NoiseModel model = estimate_noise_model(P.groups(), P.times(), baseline.residuals, options.noise);
   Diagnosis D;
   if (!options.model_noise || model.white()) {
     D = search_white(P, options, candidates, baseline, baseline_jc);
   } else {
-    D = search(P, options, candidates, baseline, baseline_jc, coloured_treatment(model), &model);
+    D = search(P, options, candidates, baseline, baseline_jc, coloured_treatment(model), &model,
+               white_treatment(P, baseline));
+    // Reported: the noise model of what the final model leaves. If that is white, the
+    // correlation was the unmodelled effects': the white-noise diagnosis is the right one.
+    model = estimate_noise_model(P.groups(), P.times(), D.final_fit.residuals, options.noise);
+    if (model.white()) {
+      D = search_white(P, options, candidates, baseline, baseline_jc);
+    } else {
+      // The baseline's adequacy against the noise as the final model leaves it (the baseline
+      // model of the noise has the unmodelled effects in it).
+      const NoiseTreatment final_noise = coloured_treatment(model);
+      const double chi2 = final_noise.whiten(baseline.residuals).squaredNorm();
+      D.baseline.noise_um = model.sigma_um;
+      D.baseline.noise_source = final_noise.source;
+      D.baseline.chi2_per_dof = chi2 / D.baseline.dof;
+      D.baseline.p_value = stats::chi2_sf(chi2, D.baseline.dof);
+    }
   }
   D.noise = std::move(model);
   D.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -205,15 +205,15 @@ Location locate(const DiagnosisProblem& P, const Eigen::VectorXd& r, const std::
   return L;
 }
 
-StructureTest structure_test(const DiagnosisProblem& P, const Eigen::VectorXd& r_w,
-                             const Eigen::MatrixXd& Q_w, int num_free,
-                             const std::function<Eigen::MatrixXd(const Eigen::MatrixXd&)>& whiten) {
+StructureTest structure_test(
+    const DiagnosisProblem& P, const Eigen::VectorXd& r_mm, const Eigen::MatrixXd& Jfree,
+    int num_free, const std::function<Whiten(const std::string&, const Eigen::MatrixXd&)>& whitener_for) {
   std::vector<std::string> order;
   for (const std::string& s : P.groups())
     if (std::find(order.begin(), order.end(), s) == order.end()) order.push_back(s);
   StructureTest out;
   double best = 1.0;
-  const double n = static_cast<double>(r_w.size());
+  const double n = static_cast<double>(r_mm.size());
   for (const std::string& group : order) {
     const std::vector<std::size_t> idx = rows_of(P, group);
     if (idx.size() < 20) continue;
@@ -234,11 +234,13 @@ StructureTest structure_test(const DiagnosisProblem& P, const Eigen::VectorXd& r
         f.push_back([d, lo, hi](double v) { return std::pow(2.0 * (v - lo) / (hi - lo) - 1.0, d); });
     }
     if (f.empty()) continue;
-    Eigen::MatrixXd G = Eigen::MatrixXd::Zero(r_w.size(), static_cast<Eigen::Index>(f.size()));
+    Eigen::MatrixXd G = Eigen::MatrixXd::Zero(r_mm.size(), static_cast<Eigen::Index>(f.size()));
     for (std::size_t k = 0; k < idx.size(); ++k)
       for (std::size_t j = 0; j < f.size(); ++j)
         G(static_cast<Eigen::Index>(idx[k]), static_cast<Eigen::Index>(j)) = f[j](x[k]);
-    const Eigen::MatrixXd Gp = project_out(Q_w, whiten(G));
+    const Whiten whiten = whitener_for(group, G);
+    const Eigen::VectorXd r_w = whiten(r_mm);
+    const Eigen::MatrixXd Gp = project_out(orthonormal_basis(whiten(Jfree)), whiten(G));
     const Eigen::MatrixXd B = orthonormal_basis(Gp);
     const auto q = static_cast<double>(B.cols());
     if (q == 0) continue;

@@ -92,8 +92,11 @@ struct StructureTest {
   double p_value = 1.0;  ///< Bonferroni-corrected over the groups
   std::string group;     ///< the group with the smallest p-value
 };
-StructureTest structure_test(const DiagnosisProblem& P, const Eigen::VectorXd& r_w,
-                             const Eigen::MatrixXd& Q_w, int num_free,
-                             const std::function<Eigen::MatrixXd(const Eigen::MatrixXd&)>& whiten);
+using Whiten = std::function<Eigen::MatrixXd(const Eigen::MatrixXd&)>;
+/// `whitener_for(group, G)`: the whitening to test group's columns G with. r_mm: residuals
+/// of the model whose free columns are Jfree.
+StructureTest structure_test(
+    const DiagnosisProblem& P, const Eigen::VectorXd& r_mm, const Eigen::MatrixXd& Jfree,
+    int num_free, const std::function<Whiten(const std::string&, const Eigen::MatrixXd&)>& whitener_for);
 
 }  // namespace rotacal::diagnosis_detail

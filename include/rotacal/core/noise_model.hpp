@@ -28,6 +28,9 @@ namespace rotacal {
 struct NoiseModelOptions {
   int max_order = 8;        ///< largest AR order tried (limited further to n/4 per stream)
   int min_stream_size = 8;  ///< shorter streams are taken as white (too short for an AR fit)
+  /// One AR model shared by all streams (Burg's sums taken over every stream): the same
+  /// sensor at the same rate in every test. Each stream keeps its own rows and sample interval.
+  bool pooled = false;
 };
 
 /// The AR model of one stream.
