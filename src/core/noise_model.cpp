@@ -292,18 +292,20 @@ void ArWhitener::apply(Eigen::Ref<Eigen::MatrixXd> columns) const {
   if (static_cast<std::size_t>(columns.rows()) != n_)
     throw InvalidArgument("ArWhitener::apply: " + std::to_string(columns.rows()) +
                           " rows given, the noise model covers " + std::to_string(n_));
-  Eigen::MatrixXd x;
+  std::vector<double> x;
   for (const Stream& s : streams_) {
-    const auto n = static_cast<Eigen::Index>(s.rows.size());
-    x.resize(n, columns.cols());
-    for (Eigen::Index t = 0; t < n; ++t) x.row(t) = columns.row(s.rows[static_cast<std::size_t>(t)]);
-    const std::size_t p = s.phi.size() - 1;
-    for (Eigen::Index t = 0; t < n; ++t) {
+    const std::size_t n = s.rows.size(), p = s.phi.size() - 1;
+    x.resize(n);
+    for (Eigen::Index c = 0; c < columns.cols(); ++c) {
+      for (std::size_t t = 0; t < n; ++t) x[t] = columns(s.rows[t], c);
       // Start-up rows use the order t prediction (exact Cholesky factor), then order p.
-      const std::size_t m = std::min(static_cast<std::size_t>(t), p);
-      Eigen::RowVectorXd e = x.row(t);
-      for (std::size_t j = 1; j <= m; ++j) e -= s.phi[m][j - 1] * x.row(t - static_cast<Eigen::Index>(j));
-      columns.row(s.rows[static_cast<std::size_t>(t)]) = e * s.inv_sd[m];
+      for (std::size_t t = 0; t < n; ++t) {
+        const std::size_t m = std::min(t, p);
+        const std::vector<double>& phi = s.phi[m];
+        double e = x[t];
+        for (std::size_t j = 1; j <= m; ++j) e -= phi[j - 1] * x[t - j];
+        columns(s.rows[t], c) = e * s.inv_sd[m];
+      }
     }
   }
 }
