@@ -129,6 +129,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
       unresolved_orders(P, candidates, options.min_harmonic_new_content);
   const std::vector<int> fold = cv_folds(P, options.cv_blocks, noise.W ? model : nullptr);
   EffectModel effects;
+  effects.linear_reference = P.mean_commanded_xyz();
   std::vector<bool> done(candidates.size(), false);
   bool first_round = true;
   while (static_cast<int>(D.findings.size()) < options.max_findings) {
@@ -419,7 +420,9 @@ Diagnosis search_white(const DiagnosisProblem& P, const DiagnosisOptions& option
 Diagnosis diagnose(const DiagnosisProblem& P, const DiagnosisOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::vector<Effect> candidates = candidate_list(P, options);
-  const ModelFit baseline = P.fit(EffectModel{});
+  EffectModel none;
+  none.linear_reference = P.mean_commanded_xyz();
+  const ModelFit baseline = P.fit(none);
   std::vector<Eigen::MatrixXd> baseline_jc;
   for (const Effect& c : candidates) baseline_jc.push_back(P.candidate_jacobian(baseline, c));
   // Correlated at all? Judged on the baseline residuals: if even they are white (nothing

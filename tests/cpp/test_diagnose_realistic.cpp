@@ -211,3 +211,29 @@ TEST_CASE("R-test: gravity sag of B hidden in AR(1) noise with wandering zeros i
   REQUIRE_FALSE(D.findings.empty());
   CHECK(D.findings[0].effect.id() == "gravity_sag_B");
 }
+
+TEST_CASE("a straightness error of X in Y is named as straightness, not as a rotary error motion",
+          "[diagnose][realistic]") {
+  // Y of the tool grows with x^2 (ISO 230-1 E_YX), about 5 um over the session's X range, in
+  // AR(1) noise: the issue's case where radial_motion_C_h3 was named with confidence.
+  std::mt19937 rng(43);
+  BallbarMachineModel truth = random_machine(rng);
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  double lo = 1e300, hi = -1e300;
+  for (const BallbarSample& x : commanded().samples) mean += x.xyz, lo = std::min(lo, x.xyz.x()), hi = std::max(hi, x.xyz.x());
+  mean /= static_cast<double>(commanded().samples.size());
+  const double u_max = std::max(hi - mean.x(), mean.x() - lo) / 100.0;
+  truth.effects.effects = {Effect::parse("straightness_YX")};
+  truth.effects.linear_reference = mean;
+  truth.effect_params = {0.005 / (u_max * u_max), 0.0, 0.0};
+  const Diagnosis D = diagnose_ballbar(noisy_ballbar(truth, Noise::ar1_05, 61));
+  std::string amb;
+  for (const Ambiguity& a : D.ambiguous)
+    for (const std::string& id : a.effects) amb += id + " ";
+  INFO("findings " << names(D) << "; ambiguous " << amb << "; " << D.noise.summary());
+  REQUIRE_FALSE(D.findings.empty());
+  const Effect& first = D.findings[0].effect;
+  CHECK(first.kind == EffectKind::straightness);
+  CHECK(first.id() == "straightness_YX");
+  CHECK(first.kind != EffectKind::radial_motion);
+}

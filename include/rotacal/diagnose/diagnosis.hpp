@@ -65,6 +65,9 @@ class DiagnosisProblem {
   /// candidate Jacobian on it (used to name the test that separates two ambiguous
   /// candidates). Empty if the instrument has no standard test.
   virtual std::vector<std::string> reference_groups() const { return {}; }
+  /// The mean commanded xyz (mm) of the session: a_ref of the linear-axis polynomials
+  /// (straightness_DA, angular_error_*). Default: zero (then those polynomials are about 0).
+  virtual Eigen::Vector3d mean_commanded_xyz() const { return Eigen::Vector3d::Zero(); }
   virtual Eigen::MatrixXd reference_jacobian(const ModelFit& /*at*/, const Effect& /*c*/,
                                              std::vector<std::string>* /*row_groups*/) const {
     return {};
