@@ -364,6 +364,13 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
             << (L.axis ? std::string(1, L.axis) + " " : std::string("t ")) << L.from << ".." << L.to
             << (L.axis ? " deg" : " s") << " (" << L.peak_um << " um mean there)";
       D.unexplained.signature += where.str();
+      // A function of one rotary angle: offer the per-angle table as the extension.
+      if (L.axis) {
+        const NoiseModel left = estimate_noise_model(P.groups(), P.times(), fit.residuals, options.noise);
+        AngleTable T = angle_table(P, fit.residuals, D.unexplained.group, left, noise.sigma_mm * 1e3,
+                                   options.cv_blocks);
+        if (T.gain.cv_rms_after_um < T.gain.cv_rms_before_um) D.angle_tables.push_back(std::move(T));
+      }
     }
   }
   return D;

@@ -257,3 +257,109 @@ StructureTest structure_test(
 }
 
 }  // namespace rotacal::diagnosis_detail
+
+namespace rotacal {
+
+AngleTable angle_table(const DiagnosisProblem& P, const Eigen::VectorXd& r, const std::string& group,
+                       const NoiseModel& noise, double noise_um, int cv_blocks) {
+  std::vector<std::size_t> idx;
+  for (std::size_t i = 0; i < P.groups().size(); ++i)
+    if (P.groups()[i] == group) idx.push_back(i);
+  if (idx.empty()) throw InvalidArgument("angle_table: no group '" + group + "' in the session");
+  AngleTable T;
+  T.group = group;
+  std::vector<double> x;
+  {
+    double lo_t = 1e300, hi_t = -1e300, lo_r = 1e300, hi_r = -1e300;
+    for (std::size_t i : idx) {
+      lo_t = std::min(lo_t, P.angles()[i].tilt), hi_t = std::max(hi_t, P.angles()[i].tilt);
+      lo_r = std::min(lo_r, P.angles()[i].rot), hi_r = std::max(hi_r, P.angles()[i].rot);
+    }
+    if (std::max(hi_t - lo_t, hi_r - lo_r) <= 1e-9)
+      throw InvalidArgument("angle_table: group '" + group + "' sweeps no rotary angle");
+    const bool rot = hi_r - lo_r >= hi_t - lo_t;
+    T.axis = rot ? 'C' : tilt_axis_letter(P.machine());
+    for (std::size_t i : idx) x.push_back((rot ? P.angles()[i].rot : P.angles()[i].tilt) * 180.0 / M_PI);
+  }
+  // Bins: the distinct commanded angles (within 0.05 deg) if there are at most 72, else 36
+  // equal bins over the span.
+  std::vector<double> sorted(x);
+  std::sort(sorted.begin(), sorted.end());
+  std::vector<double> centres;
+  for (double a : sorted)
+    if (centres.empty() || a - centres.back() > 0.05) centres.push_back(a);
+  std::vector<int> bin(x.size());
+  if (centres.size() <= 72) {
+    for (std::size_t k = 0; k < x.size(); ++k)
+      bin[k] = static_cast<int>(std::min_element(centres.begin(), centres.end(), [&](double a, double b) {
+                                  return std::abs(a - x[k]) < std::abs(b - x[k]);
+                                }) - centres.begin());
+  } else {
+    const double lo = sorted.front(), hi = sorted.back(), w = (hi - lo) / 36.0;
+    centres.clear();
+    for (int b = 0; b < 36; ++b) centres.push_back(lo + (b + 0.5) * w);
+    for (std::size_t k = 0; k < x.size(); ++k) bin[k] = std::min(35, static_cast<int>((x[k] - lo) / w));
+  }
+  const std::size_t B = centres.size();
+  std::vector<double> sum(B, 0.0);
+  std::vector<int> cnt(B, 0);
+  for (std::size_t k = 0; k < idx.size(); ++k)
+    sum[static_cast<std::size_t>(bin[k])] += r[static_cast<Eigen::Index>(idx[k])], ++cnt[static_cast<std::size_t>(bin[k])];
+  // Noise per reading and its correlation within the group (largest over its streams).
+  double tau = 1.0;
+  for (const NoiseStream& st : noise.streams)
+    if (st.group == group) tau = std::max(tau, st.correlation_samples);
+  const double sigma = noise.white() || noise.sigma_um <= 0.0 ? noise_um : noise.sigma_um;
+  Eigen::VectorXd after = r;
+  int used = 0;
+  for (std::size_t b = 0; b < B; ++b) {
+    if (cnt[b] == 0) continue;
+    ++used;
+    T.angle_deg.push_back(centres[b]);
+    T.value_um.push_back(sum[b] / cnt[b] * 1e3);
+    T.std_um.push_back(sigma * std::sqrt(std::min(tau, static_cast<double>(cnt[b])) / cnt[b]));
+    T.count.push_back(cnt[b]);
+  }
+  for (std::size_t k = 0; k < idx.size(); ++k) {
+    const auto b = static_cast<std::size_t>(bin[k]);
+    after[static_cast<Eigen::Index>(idx[k])] -= sum[b] / cnt[b];
+  }
+  const double n = static_cast<double>(r.size());
+  const double n_eff = noise.white() ? n : std::max(noise.effective_samples, static_cast<double>(used) + 2.0);
+  const double rss0 = std::max(r.squaredNorm(), 1e-300), rss1 = std::max(after.squaredNorm(), 1e-300);
+  T.gain.rms_before_um = std::sqrt(rss0 / n) * 1e3;
+  T.gain.rms_after_um = std::sqrt(rss1 / n) * 1e3;
+  // The likelihood scale of correlated residuals is their effective number of samples.
+  T.gain.delta_bic = n_eff * std::log(rss1 / rss0) + used * std::log(n_eff);
+  const double dof = n_eff - used;
+  const double F = ((rss0 - rss1) / used) / (rss1 / dof);
+  T.gain.f_pvalue = dof > 0 ? stats::f_sf(std::max(F, 0.0), used, dof) : 1.0;
+  // Cross-validation: contiguous blocks of the group in time order; each block predicted by
+  // the bin means of the other blocks.
+  std::vector<std::size_t> order(idx.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return P.times()[idx[a]] < P.times()[idx[b]]; });
+  const int K = std::clamp(static_cast<int>(static_cast<double>(idx.size()) / tau), 2, std::max(2, cv_blocks));
+  std::vector<int> fold(idx.size());
+  for (std::size_t k = 0; k < order.size(); ++k) fold[order[k]] = static_cast<int>(k * static_cast<std::size_t>(K) / order.size());
+  double ss_before = 0.0, ss_after = 0.0;
+  for (int f = 0; f < K; ++f) {
+    std::vector<double> s(B, 0.0);
+    std::vector<int> c(B, 0);
+    for (std::size_t k = 0; k < idx.size(); ++k)
+      if (fold[k] != f) s[static_cast<std::size_t>(bin[k])] += r[static_cast<Eigen::Index>(idx[k])], ++c[static_cast<std::size_t>(bin[k])];
+    for (std::size_t k = 0; k < idx.size(); ++k) {
+      if (fold[k] != f) continue;
+      const double y = r[static_cast<Eigen::Index>(idx[k])];
+      const auto b = static_cast<std::size_t>(bin[k]);
+      const double pred = c[b] ? s[b] / c[b] : 0.0;
+      ss_before += y * y;
+      ss_after += (y - pred) * (y - pred);
+    }
+  }
+  T.gain.cv_rms_before_um = std::sqrt(ss_before / static_cast<double>(idx.size())) * 1e3;
+  T.gain.cv_rms_after_um = std::sqrt(ss_after / static_cast<double>(idx.size())) * 1e3;
+  return T;
+}
+
+}  // namespace rotacal

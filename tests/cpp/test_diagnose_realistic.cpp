@@ -179,6 +179,24 @@ TEST_CASE("a local defect outside the catalogue is reported as unexplained, wher
   // The located range overlaps the defect.
   CHECK(D.unexplained.range_from < 130.0);
   CHECK(D.unexplained.range_to > 90.0);
+  // Offered: the per-angle table of radial_C, which predicts left-out blocks better, and holds
+  // the bump where it is (mean of the defect's angles well above the rest).
+  REQUIRE(D.angle_tables.size() == 1);
+  const AngleTable& T = D.angle_tables[0];
+  CHECK(T.group == "radial_C");
+  CHECK(T.gain.cv_rms_after_um < T.gain.cv_rms_before_um);
+  CHECK(T.gain.rms_after_um < T.gain.rms_before_um);
+  double in = 0.0, out = 0.0;
+  int n_in = 0, n_out = 0;
+  for (std::size_t k = 0; k < T.angle_deg.size(); ++k) {
+    const double a = std::fmod(T.angle_deg[k] + 720.0, 360.0);
+    if (a > 100.0 && a < 120.0) in += T.value_um[k], ++n_in;
+    else if (a < 80.0 || a > 140.0) out += T.value_um[k], ++n_out;
+  }
+  REQUIRE(n_in > 0);
+  REQUIRE(n_out > 0);
+  // The bump is 4-5 um over 100..120 deg; the rest is noise around the fitted model.
+  CHECK(in / n_in - out / n_out > 2.0);
 }
 
 TEST_CASE("R-test null sessions with AR(1) noise and wandering probe zeros: no finding",

@@ -197,6 +197,30 @@ struct Unexplained {
   double range_to = 0.0;
 };
 
+/// Structure outside the catalogue as a function of one rotary angle: a non-parametric table of
+/// the error motion the instrument sees in one group (the mean residual of its reading per
+/// commanded angle: along the bar for a ballbar, the probe displacement for an R-test), what
+/// a controller's compensation table for that axis would hold, offered as a finding with its
+/// gain.
+struct AngleTable {
+  std::string group;
+  char axis = 0;                  ///< the rotary axis the table is in
+  std::vector<double> angle_deg;  ///< bin centres (the distinct commanded angles when <= 72)
+  std::vector<double> value_um;   ///< mean residual per bin
+  std::vector<double> std_um;     ///< its standard error under the noise model
+  std::vector<int> count;         ///< readings per bin
+  /// rms over the whole session before/after subtracting the table; delta BIC and F on the
+  /// noise model's effective samples; cross-validation by blocks of the group (bin means from
+  /// the other blocks).
+  Gain gain;
+};
+
+/// The per-angle table of `group` for `residuals` (mm); throws InvalidArgument if the group does
+/// not exist or sweeps no rotary angle.
+AngleTable angle_table(const DiagnosisProblem& problem, const Eigen::VectorXd& residuals,
+                       const std::string& group, const NoiseModel& noise, double noise_um,
+                       int cv_blocks = 5);
+
 /// How one candidate scored against a model (linearised refit).
 struct CandidateScore {
   std::string effect;
@@ -231,6 +255,9 @@ struct Diagnosis {
   /// baseline.noise_um.
   NoiseModel noise;
   bool noise_whitened = false;  ///< decisions made on AR-whitened residuals
+  /// When unexplained structure remains in a group that sweeps a rotary angle: its per-angle
+  /// table, offered as the extension (empty otherwise).
+  std::vector<AngleTable> angle_tables;
   ModelFit baseline_fit;
   ModelFit final_fit;
   double seconds = 0.0;  ///< wall time of the diagnosis
