@@ -13,7 +13,8 @@ void bind_diagnose(pyb::module_& m) {
       .def_readwrite("alpha", &DiagnosisOptions::alpha)
       .def_readwrite("min_delta_bic", &DiagnosisOptions::min_delta_bic)
       .def_readwrite("cv_blocks", &DiagnosisOptions::cv_blocks)
-      .def_readwrite("only", &DiagnosisOptions::only);
+      .def_readwrite("only", &DiagnosisOptions::only)
+      .def_readwrite("model_noise", &DiagnosisOptions::model_noise);
 
   pyb::class_<ModelFit>(m, "ModelFit")
       .def_property_readonly("effects",
@@ -75,7 +76,20 @@ void bind_diagnose(pyb::module_& m) {
       .def_readonly("present", &Unexplained::present)
       .def_readonly("chi2_per_dof", &Unexplained::chi2_per_dof)
       .def_readonly("p_value", &Unexplained::p_value)
-      .def_readonly("signature", &Unexplained::signature);
+      .def_readonly("signature", &Unexplained::signature)
+      .def_readonly("group", &Unexplained::group)
+      .def_property_readonly("axis", [](const Unexplained& u) { return u.axis ? std::string(1, u.axis) : std::string(); })
+      .def_readonly("range_from", &Unexplained::range_from)
+      .def_readonly("range_to", &Unexplained::range_to);
+
+  pyb::class_<AngleTable>(m, "AngleTable")
+      .def_readonly("group", &AngleTable::group)
+      .def_property_readonly("axis", [](const AngleTable& t) { return std::string(1, t.axis); })
+      .def_readonly("angle_deg", &AngleTable::angle_deg)
+      .def_readonly("value_um", &AngleTable::value_um)
+      .def_readonly("std_um", &AngleTable::std_um)
+      .def_readonly("count", &AngleTable::count)
+      .def_readonly("gain", &AngleTable::gain);
 
   pyb::class_<CandidateScore>(m, "CandidateScore")
       .def_readonly("effect", &CandidateScore::effect)
@@ -104,6 +118,9 @@ void bind_diagnose(pyb::module_& m) {
       .def_readonly("unexplained", &Diagnosis::unexplained)
       .def_readonly("baseline_fit", &Diagnosis::baseline_fit)
       .def_readonly("final_fit", &Diagnosis::final_fit)
+      .def_readonly("noise", &Diagnosis::noise)
+      .def_readonly("noise_whitened", &Diagnosis::noise_whitened)
+      .def_readonly("angle_tables", &Diagnosis::angle_tables)
       .def_readonly("rounds", &Diagnosis::rounds)
       .def_readonly("seconds", &Diagnosis::seconds);
 

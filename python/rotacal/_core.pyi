@@ -6,7 +6,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Ambiguity', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'CandidateScore', 'CircleFit', 'CompensationReport', 'CompensationRow', 'DegenerateGeometry', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'NcDialect', 'NcProgramOptions', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestJointIdentification', 'RtestJointModel', 'RtestPaperIdentification', 'RtestSession', 'SegmentKind', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TransitionArc', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'ballbar_model_document', 'ballbar_model_from_document', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_model_machine', 'check_output', 'check_plausible', 'compensate_commands', 'compensate_sphere_offset', 'default_ballbar_tests', 'default_calibration_moves', 'diagnose_ballbar', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'parse_ballbar_test', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'test_label', 'verify_compensation', 'write_ballbar', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
+__all__: list[str] = ['Ambiguity', 'AngleTable', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CompensationReport', 'CompensationRow', 'DegenerateGeometry', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestJointIdentification', 'RtestJointModel', 'RtestPaperIdentification', 'RtestSession', 'SegmentKind', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'ballbar_model_document', 'ballbar_model_from_document', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_model_machine', 'check_output', 'check_plausible', 'compensate_commands', 'compensate_sphere_offset', 'default_ballbar_tests', 'default_calibration_moves', 'diagnose_ballbar', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
 class Ambiguity:
     @property
     def correlation(self) -> float:
@@ -19,6 +19,28 @@ class Ambiguity:
         ...
     @property
     def separating_test(self) -> str:
+        ...
+class AngleTable:
+    @property
+    def angle_deg(self) -> list[float]:
+        ...
+    @property
+    def axis(self) -> str:
+        ...
+    @property
+    def count(self) -> list[int]:
+        ...
+    @property
+    def gain(self) -> Gain:
+        ...
+    @property
+    def group(self) -> str:
+        ...
+    @property
+    def std_um(self) -> list[float]:
+        ...
+    @property
+    def value_um(self) -> list[float]:
         ...
 class BallbarIdentification:
     @property
@@ -337,6 +359,25 @@ class BallbarTest:
     @property
     def value(self) -> int:
         ...
+class BudgetLine:
+    @property
+    def basis(self) -> str:
+        ...
+    @property
+    def bias_at_size(self) -> float:
+        ...
+    @property
+    def dof(self) -> float:
+        ...
+    @property
+    def effect(self) -> str:
+        ...
+    @property
+    def half_width(self) -> list[float]:
+        ...
+    @property
+    def u(self) -> float:
+        ...
 class CandidateScore:
     @property
     def delta_bic(self) -> float:
@@ -409,6 +450,9 @@ class Diagnosis:
     def ambiguous(self) -> list[Ambiguity]:
         ...
     @property
+    def angle_tables(self) -> list[AngleTable]:
+        ...
+    @property
     def baseline(self) -> DiagnosisBaseline:
         ...
     @property
@@ -422,6 +466,12 @@ class Diagnosis:
         ...
     @property
     def machine(self) -> MachineType:
+        ...
+    @property
+    def noise(self) -> NoiseModel:
+        ...
+    @property
+    def noise_whitened(self) -> bool:
         ...
     @property
     def rounds(self) -> list[list[CandidateScore]]:
@@ -464,6 +514,7 @@ class DiagnosisBaseline:
     def residual_rms_um(self) -> float:
         ...
 class DiagnosisOptions:
+    model_noise: bool
     def __init__(self) -> None:
         ...
     @property
@@ -675,6 +726,43 @@ class InvalidArgument(Error):
     pass
 class IoError(Error):
     pass
+class LocationBudget:
+    @property
+    def dof_a(self) -> float:
+        ...
+    @property
+    def dominant(self) -> list[str]:
+        ...
+    @property
+    def expanded(self) -> float:
+        ...
+    @property
+    def k(self) -> float:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def nu_eff(self) -> float:
+        ...
+    @property
+    def observable(self) -> bool:
+        ...
+    @property
+    def type_b(self) -> list[BudgetLine]:
+        ...
+    @property
+    def u_a(self) -> float:
+        ...
+    @property
+    def u_c(self) -> float:
+        ...
+    @property
+    def unit(self) -> str:
+        ...
+    @property
+    def value(self) -> float:
+        ...
 class MachineType:
     """
     Members:
@@ -826,6 +914,90 @@ class NcProgramOptions:
     @tool.setter
     def tool(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
+class NoiseModel:
+    def summary(self) -> str:
+        ...
+    def whiten(self, columns: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"], residual_unit_mm: typing.SupportsFloat | typing.SupportsIndex = 1.0) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        """
+        Whitened copy of `columns` (one row per reading): unit variance if the model holds.
+        """
+    @property
+    def correlation_samples(self) -> float:
+        ...
+    @property
+    def correlation_time_s(self) -> float:
+        ...
+    @property
+    def effective_samples(self) -> float:
+        ...
+    @property
+    def innovation_sigma_um(self) -> float:
+        ...
+    @property
+    def max_order(self) -> int:
+        ...
+    @property
+    def n(self) -> int:
+        ...
+    @property
+    def sigma_um(self) -> float:
+        ...
+    @property
+    def streams(self) -> list[NoiseStream]:
+        ...
+    @property
+    def white(self) -> bool:
+        ...
+class NoiseModelOptions:
+    pooled: bool
+    def __init__(self) -> None:
+        ...
+    @property
+    def max_order(self) -> int:
+        ...
+    @max_order.setter
+    def max_order(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def min_stream_size(self) -> int:
+        ...
+    @min_stream_size.setter
+    def min_stream_size(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+class NoiseStream:
+    @property
+    def ar(self) -> list[float]:
+        ...
+    @property
+    def channel(self) -> int:
+        ...
+    @property
+    def correlation_samples(self) -> float:
+        ...
+    @property
+    def correlation_time_s(self) -> float:
+        ...
+    @property
+    def effective_samples(self) -> float:
+        ...
+    @property
+    def group(self) -> str:
+        ...
+    @property
+    def innovation_sigma_um(self) -> float:
+        ...
+    @property
+    def marginal_sigma_um(self) -> float:
+        ...
+    @property
+    def n(self) -> int:
+        ...
+    @property
+    def reflection(self) -> list[float]:
+        ...
+    @property
+    def sample_interval_s(self) -> float:
+        ...
 class ParameterEstimate:
     def __repr__(self) -> str:
         ...
@@ -949,6 +1121,112 @@ class PlausibilityReport:
     @property
     def worst_sample(self) -> int:
         ...
+class PlausibleSizes:
+    use_session_bounds: bool
+    def __init__(self) -> None:
+        ...
+    @property
+    def angular_error_rad(self) -> float:
+        ...
+    @angular_error_rad.setter
+    def angular_error_rad(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def angular_positioning_rad(self) -> float:
+        ...
+    @angular_positioning_rad.setter
+    def angular_positioning_rad(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def bar_length_mm(self) -> float:
+        ...
+    @bar_length_mm.setter
+    def bar_length_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def coning(self) -> float:
+        ...
+    @coning.setter
+    def coning(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def drift_mm(self) -> float:
+        ...
+    @drift_mm.setter
+    def drift_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def error_motion_mm(self) -> float:
+        ...
+    @error_motion_mm.setter
+    def error_motion_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def gravity_sag_mm(self) -> float:
+        ...
+    @gravity_sag_mm.setter
+    def gravity_sag_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def overrides(self) -> dict[str, float]:
+        ...
+    @overrides.setter
+    def overrides(self, arg0: collections.abc.Mapping[str, typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def rotary_zero_rad(self) -> float:
+        ...
+    @rotary_zero_rad.setter
+    def rotary_zero_rad(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def scale(self) -> float:
+        ...
+    @scale.setter
+    def scale(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def squareness_rad(self) -> float:
+        ...
+    @squareness_rad.setter
+    def squareness_rad(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def straightness_length_mm(self) -> float:
+        ...
+    @straightness_length_mm.setter
+    def straightness_length_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def straightness_mm(self) -> float:
+        ...
+    @straightness_mm.setter
+    def straightness_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def tilt_motion_rad(self) -> float:
+        ...
+    @tilt_motion_rad.setter
+    def tilt_motion_rad(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def tool_length_mm(self) -> float:
+        ...
+    @tool_length_mm.setter
+    def tool_length_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def tool_offset_mm(self) -> float:
+        ...
+    @tool_offset_mm.setter
+    def tool_offset_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def warmup_mm(self) -> float:
+        ...
+    @warmup_mm.setter
+    def warmup_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
 class ProbeCalibration:
     """
     Probe directions from linear moves.
@@ -1048,6 +1326,9 @@ class RecordSummary:
         ...
     @property
     def malformed(self) -> int:
+        ...
+    @property
+    def outside_window(self) -> int:
         ...
     @property
     def over_range(self) -> int:
@@ -1357,15 +1638,34 @@ class TransitionArc:
     @property
     def start(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
         ...
+class UncertaintyBudget:
+    @property
+    def coverage(self) -> float:
+        ...
+    @property
+    def errors(self) -> list[LocationBudget]:
+        ...
 class Unexplained:
     @property
+    def axis(self) -> str:
+        ...
+    @property
     def chi2_per_dof(self) -> float:
+        ...
+    @property
+    def group(self) -> str:
         ...
     @property
     def p_value(self) -> float:
         ...
     @property
     def present(self) -> bool:
+        ...
+    @property
+    def range_from(self) -> float:
+        ...
+    @property
+    def range_to(self) -> float:
         ...
     @property
     def signature(self) -> str:
@@ -1477,6 +1777,10 @@ def effect_catalogue(machine: MachineType, max_harmonic: typing.SupportsInt | ty
     """
     Every catalogue entry that applies to the machine, harmonics 1..max_harmonic.
     """
+def estimate_noise_model(groups: collections.abc.Sequence[str], times: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], residuals_mm: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], options: NoiseModelOptions = ...) -> NoiseModel:
+    """
+    AR(p) model (Burg, BIC order) of the residuals per stream (group, channel).
+    """
 def format_ballbar(session: BallbarSession) -> str:
     ...
 def format_model_document(document: dict, source: str = 'model') -> str:
@@ -1568,6 +1872,14 @@ def monte_carlo_joint(session: BallbarSession, result: BallbarIdentification, dr
     BallbarMonteCarlo: per observable parameter std_reported, std_mc, ratio, bias; values
     (draws x parameters).
     """
+def noise_ar1(groups: collections.abc.Sequence[str], times: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], rho: typing.SupportsFloat | typing.SupportsIndex, sigma_mm: typing.SupportsFloat | typing.SupportsIndex, seed: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+    ...
+def noise_pink(groups: collections.abc.Sequence[str], times: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], sigma_mm: typing.SupportsFloat | typing.SupportsIndex, seed: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+    ...
+def noise_probe_zero_wander(groups: collections.abc.Sequence[str], times: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], step_mm: typing.SupportsFloat | typing.SupportsIndex, seed: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+    ...
+def noise_thermal_wander(times: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], amplitude_mm: typing.SupportsFloat | typing.SupportsIndex, period_s: typing.SupportsFloat | typing.SupportsIndex, seed: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+    ...
 def parse_ballbar_test(label: str, machine: MachineType) -> BallbarTest:
     """
     Test from its session label ('radial_B' only on a BC-trt machine).
@@ -1685,6 +1997,14 @@ def svd_plane_fit(points: typing.Annotated[numpy.typing.ArrayLike, numpy.float64
 def test_label(test: BallbarTest, machine: MachineType) -> str:
     """
     Session label of a test on a machine, e.g. 'radial_A'.
+    """
+def uncertainty_budget_ballbar(session: BallbarSession, diagnosis: ..., sizes: PlausibleSizes = ..., coverage: typing.SupportsFloat | typing.SupportsIndex = 0.95) -> UncertaintyBudget:
+    """
+    GUM budget of the location errors of diagnose_ballbar's result.
+    """
+def uncertainty_budget_rtest(session: RtestSession, diagnosis: ..., sizes: PlausibleSizes = ..., coverage: typing.SupportsFloat | typing.SupportsIndex = 0.95) -> UncertaintyBudget:
+    """
+    GUM budget of the location errors of diagnose_rtest's result.
     """
 def verify_compensation(commanded: BallbarSession, truth: BallbarMachineModel, noise_um: typing.SupportsFloat | typing.SupportsIndex = 0.5, seed: typing.SupportsInt | typing.SupportsIndex = 1) -> CompensationReport:
     """

@@ -47,10 +47,10 @@ const KindInfo kKinds[] = {
      "linear positioning scale error"},
     {EffectKind::thermal_drift, "thermal_drift", false, false, true, false, 1, "d", "mm/s",
      "the machine structure drifts while the test runs"},
-    // tau = 300 s * exp(q): q is dimensionless ("mm/mm"), 0 a sensible start for a test of
+    // tau = 300 s * exp(q): q is dimensionless (unit "1"), 0 a sensible start for a test of
     // minutes; the nonlinear refit moves it once d is non-zero.
     {EffectKind::thermal_warmup, "thermal_warmup", false, false, true, false, 2, "d,ln_tau_300s",
-     "mm,mm/mm", "the structure warms up towards a steady state"},
+     "mm,1", "the structure warms up towards a steady state"},
     {EffectKind::straightness, "straightness", false, false, true, false, 3, "c2,c3,c4",
      "mm,mm,mm", "the linear axis is not straight (ISO 230-1 straightness error)"},
     {EffectKind::tool_offset, "tool_offset", false, false, true, false, 1, "d", "mm",

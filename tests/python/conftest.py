@@ -1,3 +1,4 @@
+"""Fixtures shared by the Python tests: the shared sessions beside the repository and their truth files."""
 import json
 from pathlib import Path
 

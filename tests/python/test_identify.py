@@ -1,3 +1,4 @@
+"""Joint and paper identification of the shared ballbar sessions from Python, against their truth files."""
 import json
 
 import numpy as np

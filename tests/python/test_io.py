@@ -1,3 +1,4 @@
+"""Session files from Python: both formats, exact round trips, sessions built from arrays and validated."""
 import numpy as np
 import pytest
 

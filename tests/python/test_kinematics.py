@@ -1,3 +1,4 @@
+"""Kinematics from Python: nominal forward transforms, shapes, machine names."""
 import numpy as np
 import pytest
 

@@ -28,7 +28,7 @@
 #include <string>
 #include <vector>
 
-#include "rotacal/ballbar/identify.hpp"
+#include "rotacal/core/estimate.hpp"
 #include "rotacal/core/noise_model.hpp"
 #include "rotacal/kinematics/effects.hpp"
 
