@@ -43,6 +43,8 @@ step "C++ example: a model file written by the Python CLI, read by C++ to compen
 step "Benchmarks, once each as a smoke check (figures: run them without --smoke)"
 ./build/release/bench/ballbar_accuracy --smoke
 ./build/release/bench/diagnose_bench --smoke
+./build/release/bench/diagnose_realistic_bench --smoke
+./build/release/bench/ballbar_long --smoke
 ./build/release/bench/rtest_bench
 ./build/release/bench/hw_stream --smoke
 "$PY" bench/ballbar_speed.py --repeat 1
