@@ -17,6 +17,7 @@ void bind_fit(pyb::module_& m);
 void bind_rtest(pyb::module_& m);
 void bind_diagnose(pyb::module_& m);
 void bind_ballbar_plan(pyb::module_& m);
+void bind_noise(pyb::module_& m);
 #ifdef ROTACAL_WITH_HW
 void bind_hw(pyb::module_& m);
 #endif
@@ -38,6 +39,7 @@ PYBIND11_MODULE(_core, m) {
   rotacal::py::bind_io(m);
   rotacal::py::bind_ballbar(m);
   rotacal::py::bind_fit(m);
+  rotacal::py::bind_noise(m);
   rotacal::py::bind_rtest(m);
   rotacal::py::bind_diagnose(m);
   rotacal::py::bind_ballbar_plan(m);

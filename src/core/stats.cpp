@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "rotacal/core/error.hpp"
 
@@ -100,6 +101,24 @@ double f_sf(double f, double d1, double d2) {
   if (f <= 0.0) return 1.0;
   // P(F > f) = I_{d2 / (d2 + d1 f)}(d2 / 2, d1 / 2)
   return beta_i(0.5 * d2, 0.5 * d1, d2 / (d2 + d1 * f));
+}
+
+double t_coverage(double p, double nu) {
+  if (!(p > 0.0 && p < 1.0))
+    throw InvalidArgument("t_coverage: p is " + std::to_string(p) + ", must be in (0, 1)");
+  if (!(nu > 0.0)) throw InvalidArgument("t_coverage: nu is " + std::to_string(nu) + ", must be > 0");
+  // P(|T| > t) = I_{nu/(nu+t^2)}(nu/2, 1/2); for nu beyond 1e7 the normal limit,
+  // P(|Z| > z) = erfc(z / sqrt 2). Bisection: both tails fall monotonically in t.
+  const auto tail = [nu](double t) {
+    return nu > 1e7 ? std::erfc(t / std::sqrt(2.0)) : beta_i(nu / 2.0, 0.5, nu / (nu + t * t));
+  };
+  double lo = 0.0, hi = 1.0;
+  while (tail(hi) > 1.0 - p) hi *= 2.0;
+  for (int i = 0; i < 200 && hi - lo > 1e-12 * hi; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (tail(mid) > 1.0 - p ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
 }
 
 }  // namespace rotacal::stats

@@ -47,6 +47,17 @@ const KindInfo kKinds[] = {
      "linear positioning scale error"},
     {EffectKind::thermal_drift, "thermal_drift", false, false, true, false, 1, "d", "mm/s",
      "the machine structure drifts while the test runs"},
+    // tau = 300 s * exp(q): q is dimensionless ("mm/mm"), 0 a sensible start for a test of
+    // minutes; the nonlinear refit moves it once d is non-zero.
+    {EffectKind::thermal_warmup, "thermal_warmup", false, false, true, false, 2, "d,ln_tau_300s",
+     "mm,mm/mm", "the structure warms up towards a steady state"},
+    {EffectKind::straightness, "straightness", false, false, true, false, 3, "c2,c3,c4",
+     "mm,mm,mm", "the linear axis is not straight (ISO 230-1 straightness error)"},
+    {EffectKind::tool_offset, "tool_offset", false, false, true, false, 1, "d", "mm",
+     "the tool-side ball is off the spindle axis"},
+    {EffectKind::linear_pitch, "angular_error", false, false, true, false, 2, "e1,e2", "rad,rad",
+     "the linear axis' carriage pitches as it moves (ISO 230-1 angular error), seen through the "
+     "tool's height"},
 };
 
 const KindInfo& info(EffectKind k) {
@@ -72,6 +83,8 @@ std::string Effect::id() const {
   const KindInfo& k = info(kind);
   std::string s = k.stem;
   if (kind == EffectKind::linear_squareness) return s + "_" + squareness_plane(axis);
+  if (kind == EffectKind::straightness || kind == EffectKind::linear_pitch)
+    return s + "_" + direction + axis;
   if (k.rotary_axis || k.linear_axis) s += std::string("_") + axis;
   if (k.harmonic) s += "_h" + std::to_string(harmonic);
   return s;
@@ -87,6 +100,30 @@ Effect Effect::parse(const std::string& id) {
     if (!k.rotary_axis && !k.linear_axis) {
       if (rest.empty()) return f;
       continue;
+    }
+    if (k.kind == EffectKind::straightness) {  // straightness_DA, D != A
+      if (rest.size() == 3 && rest[0] == '_' && std::string("XYZ").find(rest[1]) != std::string::npos &&
+          std::string("XYZ").find(rest[2]) != std::string::npos && rest[1] != rest[2]) {
+        f.axis = rest[2];
+        f.direction = rest[1];
+        return f;
+      }
+      break;
+    }
+    if (k.kind == EffectKind::linear_pitch) {  // angular_error_BX, angular_error_AY
+      if (rest == "_BX" || rest == "_AY") {
+        f.axis = rest[2];
+        f.direction = rest[1];
+        return f;
+      }
+      break;
+    }
+    if (k.kind == EffectKind::tool_offset) {  // X or Y (tool_offset_Z is its own entry)
+      if (rest == "_X" || rest == "_Y") {
+        f.axis = rest[1];
+        return f;
+      }
+      break;
     }
     if (k.kind == EffectKind::linear_squareness) {
       for (char a : {'X', 'Y', 'Z'})
@@ -128,7 +165,16 @@ std::vector<Effect> effect_catalogue(MachineType m, int max_harmonic) {
   std::vector<Effect> out;
   const char T = tilt_axis_letter(m);
   for (const KindInfo& k : kKinds) {
-    if (k.linear_axis) {
+    if (k.kind == EffectKind::straightness) {
+      for (char a : {'X', 'Y', 'Z'})
+        for (char d : {'X', 'Y', 'Z'})
+          if (a != d) out.push_back({k.kind, a, 0, d});
+    } else if (k.kind == EffectKind::linear_pitch) {
+      out.push_back({k.kind, 'X', 0, 'B'});
+      out.push_back({k.kind, 'Y', 0, 'A'});
+    } else if (k.kind == EffectKind::tool_offset) {
+      for (char a : {'X', 'Y'}) out.push_back({k.kind, a, 0});
+    } else if (k.linear_axis) {
       for (char a : {'X', 'Y', 'Z'}) out.push_back({k.kind, a, 0});
     } else if (k.rotary_axis) {
       for (char a : {T, 'C'}) {

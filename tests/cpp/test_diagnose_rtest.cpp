@@ -114,7 +114,11 @@ TEST_CASE("every catalogue effect an R-test can see, hidden at 5 sigma, is found
     s.noise_um = noise_um;
     const Diagnosis D = diagnose_rtest(s);
     ++tried;
-    INFO(effect.id() << ": first finding " << (D.findings.empty() ? "none" : D.findings[0].effect.id()));
+    std::string also;
+    for (const Ambiguity& a : D.ambiguous)
+      for (const std::string& id : a.effects) also += id + " ";
+    INFO(effect.id() << ": first finding " << (D.findings.empty() ? "none" : D.findings[0].effect.id())
+                     << "; ambiguous with: " << also);
     REQUIRE_FALSE(D.findings.empty());
     bool named = D.findings[0].effect == effect;
     for (const Ambiguity& a : D.ambiguous)

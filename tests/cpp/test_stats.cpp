@@ -3,6 +3,8 @@
 #include "rotacal/core/error.hpp"
 #include "rotacal/core/stats.hpp"
 
+#include <limits>
+
 using namespace rotacal;
 using Catch::Matchers::WithinRel;
 
@@ -29,4 +31,14 @@ TEST_CASE("incomplete beta and gamma match SciPy; bad arguments throw", "[stats]
   CHECK_THROWS_AS(stats::beta_i(-1.0, 2.0, 0.5), InvalidArgument);
   CHECK_THROWS_AS(stats::gamma_p(1.0, -2.0), InvalidArgument);
   CHECK_THROWS_AS(stats::f_sf(1.0, 0.0, 3.0), InvalidArgument);
+}
+
+// Reference values from scipy.stats.t.ppf(0.975, nu) and scipy.stats.norm.ppf(0.975).
+TEST_CASE("Student-t coverage factor matches SciPy", "[stats]") {
+  CHECK_THAT(stats::t_coverage(0.95, 1), WithinRel(12.706204736174694, 1e-8));
+  CHECK_THAT(stats::t_coverage(0.95, 10), WithinRel(2.2281388519862744, 1e-8));
+  CHECK_THAT(stats::t_coverage(0.95, 50.5), WithinRel(2.0080664982950434, 1e-8));
+  CHECK_THAT(stats::t_coverage(0.95, std::numeric_limits<double>::infinity()), WithinRel(1.959963984540054, 1e-8));
+  CHECK_THROWS_WITH(stats::t_coverage(1.5, 3), Catch::Contains("p is 1.5"));
+  CHECK_THROWS_AS(stats::t_coverage(0.95, 0), InvalidArgument);
 }

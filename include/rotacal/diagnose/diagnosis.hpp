@@ -4,7 +4,7 @@
 /// catalogue (../shared/spec/effects.md), extend the model with it, measure the gain.
 ///
 /// The engine is independent of the instrument. A `DiagnosisProblem` (ballbar_diagnosis.hpp,
-/// R-test later) supplies the nonlinear fit of baseline + effects and each candidate's
+/// rtest_diagnosis.hpp) supplies the nonlinear fit of baseline + effects and each candidate's
 /// Jacobian; the engine does the statistics:
 ///  1. baseline fit; adequacy by chi-square against the noise (declared in the file, or
 ///     estimated from successive differences, which smooth systematic errors barely affect);
@@ -16,6 +16,9 @@
 ///     blocks of each group left out in turn, so the extension must predict unseen angles);
 ///  4. the best significant candidate is added, the model refitted (nonlinear), and 3 repeats
 ///     until nothing significant is left;
+/// Files: diagnosis.cpp (the search loop), scoring.cpp (linearised refit, F/BIC,
+/// cross-validation), harmonics.cpp (what the angular sampling resolves),
+/// residual_structure.cpp (per-group structure, noise), ambiguity.cpp (separating tests).
 ///  5. candidates the data cannot see, and *_hn candidates of an order the sampling of their
 ///     axis cannot resolve (aliased), are reported unobservable; candidates that explain the
 ///     data as well as the chosen one are reported ambiguous; significant structure that is
@@ -26,6 +29,7 @@
 #include <vector>
 
 #include "rotacal/ballbar/identify.hpp"
+#include "rotacal/core/noise_model.hpp"
 #include "rotacal/kinematics/effects.hpp"
 
 namespace rotacal {
@@ -61,6 +65,9 @@ class DiagnosisProblem {
   /// candidate Jacobian on it (used to name the test that separates two ambiguous
   /// candidates). Empty if the instrument has no standard test.
   virtual std::vector<std::string> reference_groups() const { return {}; }
+  /// The mean commanded xyz (mm) of the session: a_ref of the linear-axis polynomials
+  /// (straightness_DA, angular_error_*). Default: zero (then those polynomials are about 0).
+  virtual Eigen::Vector3d mean_commanded_xyz() const { return Eigen::Vector3d::Zero(); }
   virtual Eigen::MatrixXd reference_jacobian(const ModelFit& /*at*/, const Effect& /*c*/,
                                              std::vector<std::string>* /*row_groups*/) const {
     return {};
@@ -86,6 +93,12 @@ struct DiagnosisOptions {
   /// unobservable. Lenient on purpose: how well a resolvable order stands apart from the
   /// others is judged with the noise, by the F-test, cross-validation and the ambiguity report.
   double min_harmonic_new_content = 0.01;
+  /// Estimate the residual noise's correlation (core/noise_model.hpp) from the baseline
+  /// residuals and, when it is not white, make every decision on whitened residuals and
+  /// Jacobians (F, BIC, visibility), cross-validate with blocks at least one correlation time
+  /// long and test for unexplained structure against it. False: treat the noise as white.
+  bool model_noise = true;
+  NoiseModelOptions noise;
 };
 
 /// Which harmonic orders of one rotary angle a set of readings resolves.
@@ -173,10 +186,40 @@ struct UnobservableEffect {
 
 struct Unexplained {
   bool present = false;
-  double chi2_per_dof = 0.0;
-  double p_value = 1.0;
-  std::string signature;  ///< the strongest remaining structure, in words
+  double chi2_per_dof = 0.0;  ///< of the whitened final residuals
+  double p_value = 1.0;       ///< white noise: chi-square test; coloured: the structure test
+  std::string signature;      ///< the strongest remaining structure, in words
+  /// Where (coloured noise: the group whose structure test fails; white: the group with the
+  /// largest residual), and the range of its swept angle where the residual is largest.
+  std::string group;
+  char axis = 0;                 ///< swept rotary axis of that group (0: none; range in time)
+  double range_from = 0.0;       ///< deg (or s when axis == 0)
+  double range_to = 0.0;
 };
+
+/// Structure outside the catalogue as a function of one rotary angle: a non-parametric table of
+/// the error motion the instrument sees in one group (the mean residual of its reading per
+/// commanded angle: along the bar for a ballbar, the probe displacement for an R-test), what
+/// a controller's compensation table for that axis would hold, offered as a finding with its
+/// gain.
+struct AngleTable {
+  std::string group;
+  char axis = 0;                  ///< the rotary axis the table is in
+  std::vector<double> angle_deg;  ///< bin centres (the distinct commanded angles when <= 72)
+  std::vector<double> value_um;   ///< mean residual per bin
+  std::vector<double> std_um;     ///< its standard error under the noise model
+  std::vector<int> count;         ///< readings per bin
+  /// rms over the whole session before/after subtracting the table; delta BIC and F on the
+  /// noise model's effective samples; cross-validation by blocks of the group (bin means from
+  /// the other blocks).
+  Gain gain;
+};
+
+/// The per-angle table of `group` for `residuals` (mm); throws InvalidArgument if the group does
+/// not exist or sweeps no rotary angle.
+AngleTable angle_table(const DiagnosisProblem& problem, const Eigen::VectorXd& residuals,
+                       const std::string& group, const NoiseModel& noise, double noise_um,
+                       int cv_blocks = 5);
 
 /// How one candidate scored against a model (linearised refit).
 struct CandidateScore {
@@ -207,6 +250,14 @@ struct Diagnosis {
   std::vector<Ambiguity> ambiguous;
   std::vector<UnobservableEffect> unobservable;
   Unexplained unexplained;
+  /// The residual noise model the decisions were made with (estimated from the residuals of
+  /// the final model, after findings). white(): the noise was treated as white with
+  /// baseline.noise_um.
+  NoiseModel noise;
+  bool noise_whitened = false;  ///< decisions made on AR-whitened residuals
+  /// When unexplained structure remains in a group that sweeps a rotary angle: its per-angle
+  /// table, offered as the extension (empty otherwise).
+  std::vector<AngleTable> angle_tables;
   ModelFit baseline_fit;
   ModelFit final_fit;
   double seconds = 0.0;  ///< wall time of the diagnosis

@@ -42,6 +42,11 @@ enum class EffectKind {
   linear_squareness,       ///< axis X: x += s y ("XY"), Y: y += s z ("YZ"), Z: z += s x ("ZX")
   linear_scale,            ///< x += k x (likewise y, z)
   thermal_drift,           ///< table += d t along X, Y or Z (mm/s)
+  thermal_warmup,          ///< table += d (1 - exp(-t / tau)) along X, Y or Z; tau = 300 s e^q
+  straightness,            ///< E_DA: tool D += c2 u^2 + c3 u^3 + c4 u^4, u = (a - a_ref)/100 mm
+  tool_offset,             ///< tool-side ball += d along X or Y (mm)
+  linear_pitch,            ///< E_BX / E_AY seen through the Z arm: x += e(x) (z - z_ref),
+                           ///< y -= e(y) (z - z_ref), e(a) = e1 u + e2 u^2 (rad)
 };
 
 /// One catalogue entry, e.g. {angular_positioning, 'C', 1} = "angular_positioning_C_h1".
@@ -49,6 +54,9 @@ struct Effect {
   EffectKind kind = EffectKind::ballbar_length_offset;
   char axis = 0;     ///< 'A','B','C' (rotary), 'X','Y','Z' (linear); 0 when not applicable
   int harmonic = 0;  ///< n of the *_hn entries, else 0
+  /// straightness_DA: the error direction D ('X','Y','Z'; axis holds the moving axis A);
+  /// linear_pitch: the ISO 230-1 rotation letter ('B' for E_BX, 'A' for E_AY). Else 0.
+  char direction = 0;
 
   /// The effects.md id.
   std::string id() const;
@@ -63,7 +71,7 @@ struct Effect {
   /// True if the effect exists on this machine (A effects on an AC table, not on a BC one).
   bool applies_to(MachineType m) const;
   bool operator==(const Effect& o) const {
-    return kind == o.kind && axis == o.axis && harmonic == o.harmonic;
+    return kind == o.kind && axis == o.axis && harmonic == o.harmonic && direction == o.direction;
   }
 };
 
@@ -74,6 +82,9 @@ std::vector<Effect> effect_catalogue(MachineType m, int max_harmonic = 4);
 /// A set of effects and the layout of their parameters in one flat vector.
 struct EffectModel {
   std::vector<Effect> effects;
+  /// a_ref of the linear-axis polynomials (straightness_DA, linear_pitch): the mean commanded
+  /// xyz over the session (effects.md), mm. Whoever builds a model for a session sets it.
+  Eigen::Vector3d linear_reference = Eigen::Vector3d::Zero();
 
   int num_params() const;
   /// Offset of effect i's first parameter in the flat vector.
@@ -163,6 +174,12 @@ void walk_table_stages(MachineType m, const LocationErrors<Scalar>& e, const Eff
         if (!D) D = Vec3<Scalar>::Zero();
         (*D)[detail::axis_index(f.axis)] += q[0] * Scalar(t);
         break;
+      case EffectKind::thermal_warmup: {  // tau = 300 s * exp(q1): q1 = 0 is a sensible start
+        using std::exp;
+        if (!D) D = Vec3<Scalar>::Zero();
+        (*D)[detail::axis_index(f.axis)] += q[0] * (Scalar(1) - exp(-Scalar(t) / (Scalar(300) * exp(q[1]))));
+        break;
+      }
       default:  // tool-side and instrument effects do not move the table
         break;
     }
@@ -236,6 +253,23 @@ Vec3<Scalar> tool_position(const EffectModel& fx, const Scalar* p, const Eigen::
       case EffectKind::linear_scale:
         out[k] += q[0] * Scalar(xyz[k]);
         break;
+      case EffectKind::tool_offset:
+        out[k] += q[0];
+        break;
+      case EffectKind::straightness: {  // E_DA, u = (a - a_ref) / 100 mm
+        const double u = (xyz[k] - fx.linear_reference[k]) / 100.0;
+        out[detail::axis_index(f.direction)] += q[0] * Scalar(u * u) + q[1] * Scalar(u * u * u) +
+                                                q[2] * Scalar(u * u * u * u);
+        break;
+      }
+      case EffectKind::linear_pitch: {  // a rotation of the carriage, times the Z arm
+        const double u = (xyz[k] - fx.linear_reference[k]) / 100.0;
+        const double arm = xyz[2] - fx.linear_reference[2];
+        const Scalar e = q[0] * Scalar(u) + q[1] * Scalar(u * u);
+        // E_BX (about Y) moves a point above the guide by +e*arm in X; E_AY (about X) by -e*arm in Y.
+        out[k] += (f.direction == 'B' ? Scalar(arm) : Scalar(-arm)) * e;
+        break;
+      }
       default:
         break;
     }

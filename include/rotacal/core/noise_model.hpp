@@ -1,0 +1,126 @@
+#pragma once
+/// \file
+/// The residual noise as measured data have it: correlated in time (servo loops and sensor
+/// filters at 100 Hz - 1 kHz, thermal wander). One autoregressive model per stream of
+/// readings (a group, i.e. a ballbar test or an R-test nest, split into channels when several
+/// readings share a time stamp, as an R-test's dx, dy, dz do), its order chosen from the data;
+/// the whitener that makes the residuals independent with unit variance (generalised least
+/// squares); and generators of coloured noise for tests and benches.
+///
+/// Per stream x_0..x_{n-1} (time order, mean removed):
+///   x_t = phi_1 x_{t-1} + ... + phi_p x_{t-p} + e_t,  e_t ~ N(0, s_e^2)
+/// estimated by Burg's method (stable for correlations near 1, where Yule-Walker is biased),
+/// with p = argmin over 0..max_order of BIC(p) = n ln v_p + p ln n (v_p: Burg's prediction
+/// error variance of order p). White noise comes out p = 0.
+/// Integrated autocorrelation time (samples): tau = sum_k rho_k = s_e^2 / (s_x^2 (1 - sum phi)^2)
+/// (the long-run variance over the marginal one: AR(1) gives (1 + rho)/(1 - rho)); effective
+/// number of independent samples n_eff = n / tau.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "rotacal/core/whitener.hpp"
+
+namespace rotacal {
+
+struct NoiseModelOptions {
+  int max_order = 8;        ///< largest AR order tried (limited further to n/4 per stream)
+  int min_stream_size = 8;  ///< shorter streams are taken as white (too short for an AR fit)
+  /// One AR model shared by all streams (Burg's sums taken over every stream): the same
+  /// sensor at the same rate in every test. Each stream keeps its own rows and sample interval.
+  bool pooled = false;
+};
+
+/// The AR model of one stream.
+struct NoiseStream {
+  std::string group;
+  int channel = 0;                   ///< index among the group's readings that share a time
+  std::vector<Eigen::Index> rows;    ///< its readings' indices, in time order
+  std::vector<double> ar;            ///< phi_1..phi_p (empty: white)
+  std::vector<double> reflection;    ///< Burg's reflection coefficients k_1..k_p
+  double innovation_sigma_um = 0.0;  ///< s_e
+  double marginal_sigma_um = 0.0;    ///< s_x
+  double correlation_samples = 1.0;  ///< integrated autocorrelation time tau, in samples
+  double sample_interval_s = 0.0;    ///< median time between successive readings
+  double correlation_time_s = 0.0;   ///< tau * sample interval
+  double effective_samples = 0.0;    ///< n / tau (at most n)
+  int order() const { return static_cast<int>(ar.size()); }
+};
+
+/// The noise model of a whole set of residuals.
+struct NoiseModel {
+  std::vector<NoiseStream> streams;
+  std::size_t n = 0;                 ///< readings covered
+  double sigma_um = 0.0;             ///< pooled marginal sigma (RMS over streams, by size)
+  double innovation_sigma_um = 0.0;  ///< pooled innovation sigma
+  double correlation_samples = 1.0;  ///< largest over the streams
+  double correlation_time_s = 0.0;   ///< largest over the streams
+  double effective_samples = 0.0;    ///< sum over the streams
+  int max_order = 0;                 ///< largest AR order of any stream
+  bool white() const { return max_order == 0; }
+  /// e.g. "AR(1), rho 0.95, sigma 0.50 um, correlation time 0.39 s, 46 effective samples of 1800".
+  std::string summary() const;
+};
+
+/// Estimate the noise model of `residuals_mm` (one per reading) grouped by `groups`, with each
+/// group's readings put in order by `times` (s). Throws InvalidArgument if the sizes differ,
+/// a residual or time is not finite, or max_order < 0.
+NoiseModel estimate_noise_model(const std::vector<std::string>& groups,
+                                const std::vector<double>& times,
+                                const Eigen::VectorXd& residuals_mm,
+                                const NoiseModelOptions& options = {});
+
+/// Prewhitening by the AR filter of each stream, with its exact start-up rows (the first p
+/// readings are predicted from the orders 0..p-1 of Burg's recursion, so W is the inverse
+/// Cholesky factor of the model's covariance), scaled to unit variance. Columns hold values in
+/// units of `residual_unit_mm` (1: mm; pass sigma if the fit's residuals are already divided
+/// by a sigma).
+class ArWhitener : public ResidualWhitener {
+ public:
+  explicit ArWhitener(const NoiseModel& model, double residual_unit_mm = 1.0);
+  void apply(Eigen::Ref<Eigen::MatrixXd> columns) const override;
+  Eigen::Index size() const override { return static_cast<Eigen::Index>(n_); }
+
+ private:
+  struct Stream {
+    std::vector<Eigen::Index> rows;
+    std::vector<std::vector<double>> phi;  ///< phi[m]: coefficients of order m = 0..p
+    std::vector<double> inv_sd;            ///< 1 / sqrt(v_m) in column units
+  };
+  std::vector<Stream> streams_;
+  std::size_t n_ = 0;
+};
+
+/// Coloured noise for tests and benches, added per stream (group, channel) in time order, all
+/// seeded. Sizes in mm.
+namespace noise_gen {
+
+/// Stationary AR(1) with correlation rho per sample and marginal sigma.
+Eigen::VectorXd ar1(const std::vector<std::string>& groups, const std::vector<double>& times,
+                    double rho, double sigma_mm, std::uint64_t seed);
+/// 1/f-like noise: equal-variance AR(1) processes with correlation times 1, 10, 100, 1000
+/// samples summed (a flat spectrum per decade of frequency over three decades), scaled to
+/// marginal sigma.
+Eigen::VectorXd pink(const std::vector<std::string>& groups, const std::vector<double>& times,
+                     double sigma_mm, std::uint64_t seed);
+/// Slow thermal wander common to all readings: a sum of three sines with random phases and
+/// periods between period_s and 3 period_s, RMS amplitude_mm over a long record.
+Eigen::VectorXd thermal_wander(const std::vector<double>& times, double amplitude_mm,
+                               double period_s, std::uint64_t seed);
+/// R-test probe zeros wandering between poses: a random walk per stream that steps by
+/// N(0, step_mm) from one reading time to the next.
+Eigen::VectorXd probe_zero_wander(const std::vector<std::string>& groups,
+                                  const std::vector<double>& times, double step_mm,
+                                  std::uint64_t seed);
+
+}  // namespace noise_gen
+
+/// The streams of readings (group, channel) in time order, as the noise model splits them.
+std::vector<std::vector<Eigen::Index>> noise_streams(const std::vector<std::string>& groups,
+                                                     const std::vector<double>& times,
+                                                     std::vector<std::string>* stream_group = nullptr,
+                                                     std::vector<int>* stream_channel = nullptr);
+
+}  // namespace rotacal

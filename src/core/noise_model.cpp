@@ -1,0 +1,390 @@
+// Residual noise model: per-stream AR(p) by Burg with BIC order selection, the exact AR
+// prewhitener, and seeded coloured-noise generators.
+#include "rotacal/core/noise_model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <map>
+#include <random>
+#include <sstream>
+
+#include "rotacal/core/error.hpp"
+
+namespace rotacal {
+
+namespace {
+
+// Burg's recursion up to order P: reflection coefficients k_1..k_P and the prediction error
+// variances v_0..v_P (v_0 = mean square of x).
+void burg(const std::vector<double>& x, int P, std::vector<double>* k, std::vector<double>* v) {
+  const std::size_t n = x.size();
+  std::vector<double> f(x), b(x);
+  double v0 = 0.0;
+  for (double xi : x) v0 += xi * xi;
+  v0 /= static_cast<double>(n);
+  k->clear();
+  v->assign(1, v0);
+  for (int m = 1; m <= P; ++m) {
+    double num = 0.0, den = 0.0;
+    for (std::size_t t = static_cast<std::size_t>(m); t < n; ++t) {
+      num += f[t] * b[t - 1];
+      den += f[t] * f[t] + b[t - 1] * b[t - 1];
+    }
+    const double km = den > 0.0 ? 2.0 * num / den : 0.0;
+    // Descending t: b[t-1] is still the previous order's when f[t], b[t] are updated.
+    for (std::size_t t = n - 1; t >= static_cast<std::size_t>(m); --t) {
+      const double ft = f[t], bt1 = b[t - 1];
+      f[t] = ft - km * bt1;
+      b[t] = bt1 - km * ft;
+    }
+    k->push_back(km);
+    v->push_back(v->back() * (1.0 - km * km));
+  }
+}
+
+// Burg's recursion over several segments at once (one model for all): sums over segments.
+void burg_pooled(const std::vector<std::vector<double>>& xs, int P, std::vector<double>* k,
+                 std::vector<double>* v, std::size_t* n_total) {
+  std::vector<std::vector<double>> f(xs), b(xs);
+  double ss = 0.0;
+  std::size_t n = 0;
+  for (const auto& x : xs)
+    for (double xi : x) ss += xi * xi, ++n;
+  *n_total = n;
+  k->clear();
+  v->assign(1, n ? ss / static_cast<double>(n) : 0.0);
+  for (int m = 1; m <= P; ++m) {
+    double num = 0.0, den = 0.0;
+    for (std::size_t s = 0; s < xs.size(); ++s)
+      for (std::size_t t = static_cast<std::size_t>(m); t < xs[s].size(); ++t) {
+        num += f[s][t] * b[s][t - 1];
+        den += f[s][t] * f[s][t] + b[s][t - 1] * b[s][t - 1];
+      }
+    const double km = den > 0.0 ? 2.0 * num / den : 0.0;
+    for (std::size_t s = 0; s < xs.size(); ++s)
+      for (std::size_t t = xs[s].size(); t-- > static_cast<std::size_t>(m);) {
+        const double ft = f[s][t], bt1 = b[s][t - 1];
+        f[s][t] = ft - km * bt1;
+        b[s][t] = bt1 - km * ft;
+      }
+    k->push_back(km);
+    v->push_back(v->back() * (1.0 - km * km));
+  }
+}
+
+// Levinson: prediction coefficients of every order 0..p from the reflection coefficients
+// (phi_{m,m} = k_m, phi_{m,j} = phi_{m-1,j} - k_m phi_{m-1,m-j}).
+std::vector<std::vector<double>> levinson(const std::vector<double>& k) {
+  std::vector<std::vector<double>> phi(1);
+  for (std::size_t m = 1; m <= k.size(); ++m) {
+    const std::vector<double>& prev = phi.back();
+    std::vector<double> cur(m);
+    cur[m - 1] = k[m - 1];
+    for (std::size_t j = 0; j + 1 < m; ++j) cur[j] = prev[j] - k[m - 1] * prev[m - 2 - j];
+    phi.push_back(std::move(cur));
+  }
+  return phi;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+void check_sizes(const char* where, const std::vector<std::string>& groups,
+                 const std::vector<double>& times) {
+  if (groups.size() != times.size())
+    throw InvalidArgument(std::string(where) + ": groups has " + std::to_string(groups.size()) +
+                          " entries but times has " + std::to_string(times.size()));
+  for (std::size_t i = 0; i < times.size(); ++i)
+    if (!std::isfinite(times[i]))
+      throw InvalidArgument(std::string(where) + ": times[" + std::to_string(i) + "] is not finite");
+}
+
+}  // namespace
+
+std::vector<std::vector<Eigen::Index>> noise_streams(const std::vector<std::string>& groups,
+                                                     const std::vector<double>& times,
+                                                     std::vector<std::string>* stream_group,
+                                                     std::vector<int>* stream_channel) {
+  check_sizes("noise_streams", groups, times);
+  std::vector<std::string> order;
+  std::map<std::string, std::vector<Eigen::Index>> by_group;
+  for (std::size_t i = 0; i < groups.size(); ++i) {
+    auto& v = by_group[groups[i]];
+    if (v.empty()) order.push_back(groups[i]);
+    v.push_back(static_cast<Eigen::Index>(i));
+  }
+  std::vector<std::vector<Eigen::Index>> out;
+  if (stream_group) stream_group->clear();
+  if (stream_channel) stream_channel->clear();
+  for (const std::string& g : order) {
+    auto& idx = by_group[g];
+    std::stable_sort(idx.begin(), idx.end(), [&](Eigen::Index a, Eigen::Index b) {
+      return times[static_cast<std::size_t>(a)] < times[static_cast<std::size_t>(b)];
+    });
+    // Channel = position among the readings that share a time stamp (R-test dx, dy, dz).
+    std::vector<std::vector<Eigen::Index>> ch;
+    for (std::size_t k = 0; k < idx.size();) {
+      std::size_t e = k;
+      while (e < idx.size() && times[static_cast<std::size_t>(idx[e])] ==
+                                   times[static_cast<std::size_t>(idx[k])])
+        ++e;
+      for (std::size_t c = 0; c < e - k; ++c) {
+        if (ch.size() <= c) ch.emplace_back();
+        ch[c].push_back(idx[k + c]);
+      }
+      k = e;
+    }
+    for (std::size_t c = 0; c < ch.size(); ++c) {
+      out.push_back(std::move(ch[c]));
+      if (stream_group) stream_group->push_back(g);
+      if (stream_channel) stream_channel->push_back(static_cast<int>(c));
+    }
+  }
+  return out;
+}
+
+NoiseModel estimate_noise_model(const std::vector<std::string>& groups,
+                                const std::vector<double>& times,
+                                const Eigen::VectorXd& residuals_mm,
+                                const NoiseModelOptions& options) {
+  if (options.max_order < 0)
+    throw InvalidArgument("estimate_noise_model: options.max_order is " +
+                          std::to_string(options.max_order) + ", must be >= 0");
+  if (static_cast<std::size_t>(residuals_mm.size()) != groups.size())
+    throw InvalidArgument("estimate_noise_model: residuals has " +
+                          std::to_string(residuals_mm.size()) + " entries but groups has " +
+                          std::to_string(groups.size()));
+  for (Eigen::Index i = 0; i < residuals_mm.size(); ++i)
+    if (!std::isfinite(residuals_mm[i]))
+      throw InvalidArgument("estimate_noise_model: residuals[" + std::to_string(i) +
+                            "] is not finite");
+  std::vector<std::string> sg;
+  std::vector<int> sc;
+  const auto streams = noise_streams(groups, times, &sg, &sc);
+  NoiseModel M;
+  M.n = groups.size();
+  // Each stream's readings in time order with its mean removed, and its sample interval.
+  std::vector<std::vector<double>> xs(streams.size());
+  std::vector<double> intervals(streams.size(), 0.0);
+  for (std::size_t s = 0; s < streams.size(); ++s) {
+    const std::size_t n = streams[s].size();
+    std::vector<double>& x = xs[s];
+    x.resize(n);
+    std::vector<double> dt;
+    double mean = 0.0;
+    for (std::size_t t = 0; t < n; ++t) mean += (x[t] = residuals_mm[streams[s][t]]);
+    mean /= static_cast<double>(n);
+    for (double& xi : x) xi -= mean;
+    for (std::size_t t = 1; t < n; ++t) {
+      const double d = times[static_cast<std::size_t>(streams[s][t])] -
+                       times[static_cast<std::size_t>(streams[s][t - 1])];
+      if (d > 0.0) dt.push_back(d);
+    }
+    intervals[s] = median(dt);
+  }
+  // BIC over orders 0..P of Burg's prediction error variances v_p for n readings.
+  const auto choose = [](const std::vector<double>& v, std::size_t n) {
+    int best = 0;
+    double best_bic = 0.0;
+    const double ln_n = std::log(static_cast<double>(std::max<std::size_t>(n, 2)));
+    for (std::size_t p = 0; p < v.size(); ++p) {
+      const double bic = static_cast<double>(n) * std::log(std::max(v[p], 1e-300)) + static_cast<double>(p) * ln_n;
+      if (p == 0 || bic < best_bic) best = static_cast<int>(p), best_bic = bic;
+    }
+    return best;
+  };
+  std::vector<double> pooled_k, pooled_v;
+  int pooled_order = 0;
+  if (options.pooled) {
+    std::size_t shortest = SIZE_MAX, total = 0;
+    for (const auto& x : xs) shortest = std::min(shortest, x.size());
+    const int P = streams.empty() ? 0 : std::min(options.max_order, static_cast<int>(shortest / 4));
+    burg_pooled(xs, std::max(P, 0), &pooled_k, &pooled_v, &total);
+    pooled_order = choose(pooled_v, total);
+  }
+  double ss_marg = 0.0, ss_innov = 0.0;
+  for (std::size_t s = 0; s < streams.size(); ++s) {
+    NoiseStream S;
+    S.group = sg[s];
+    S.channel = sc[s];
+    S.rows = streams[s];
+    const std::size_t n = S.rows.size();
+    S.sample_interval_s = intervals[s];
+    std::vector<double> k, v;
+    int best = 0;
+    if (options.pooled) {
+      k = pooled_k, v = pooled_v, best = pooled_order;
+    } else {
+      const int P = static_cast<int>(n) >= options.min_stream_size
+                        ? std::min(options.max_order, static_cast<int>(n / 4))
+                        : 0;
+      burg(xs[s], P, &k, &v);
+      best = choose(v, n);
+    }
+    S.reflection.assign(k.begin(), k.begin() + best);
+    S.ar = levinson(S.reflection).back();
+    const double v0 = v[0], vp = v[static_cast<std::size_t>(best)];
+    S.marginal_sigma_um = std::sqrt(v0) * 1e3;
+    S.innovation_sigma_um = std::sqrt(vp) * 1e3;
+    double sum_phi = 0.0;
+    for (double a : S.ar) sum_phi += a;
+    const double gap = std::max(1.0 - sum_phi, 1e-6);
+    S.correlation_samples = v0 > 0.0 ? vp / (v0 * gap * gap) : 1.0;
+    S.correlation_samples = std::min(S.correlation_samples, static_cast<double>(n));
+    S.correlation_time_s = S.correlation_samples * S.sample_interval_s;
+    S.effective_samples = std::min(static_cast<double>(n), static_cast<double>(n) / S.correlation_samples);
+    ss_marg += v0 * static_cast<double>(n);
+    ss_innov += vp * static_cast<double>(n);
+    M.correlation_samples = std::max(M.correlation_samples, S.correlation_samples);
+    M.correlation_time_s = std::max(M.correlation_time_s, S.correlation_time_s);
+    M.effective_samples += S.effective_samples;
+    M.max_order = std::max(M.max_order, best);
+    M.streams.push_back(std::move(S));
+  }
+  if (M.n) {
+    M.sigma_um = std::sqrt(ss_marg / static_cast<double>(M.n)) * 1e3;
+    M.innovation_sigma_um = std::sqrt(ss_innov / static_cast<double>(M.n)) * 1e3;
+  }
+  return M;
+}
+
+std::string NoiseModel::summary() const {
+  std::ostringstream out;
+  out.precision(3);
+  if (white()) out << "white";
+  else {
+    out << "AR(" << max_order << ")";
+    // The coefficient of the largest stream, as the typical one.
+    const NoiseStream* big = nullptr;
+    for (const NoiseStream& s : streams)
+      if (!big || s.rows.size() > big->rows.size()) big = &s;
+    if (big && big->order() >= 1) out << ", phi_1 " << big->ar[0];
+  }
+  out << ", sigma " << sigma_um << " um (innovation " << innovation_sigma_um
+      << " um), correlation time " << correlation_time_s << " s (" << correlation_samples
+      << " samples), " << effective_samples << " effective samples of " << n;
+  return out.str();
+}
+
+ArWhitener::ArWhitener(const NoiseModel& model, double residual_unit_mm) : n_(model.n) {
+  if (!(residual_unit_mm > 0.0) || !std::isfinite(residual_unit_mm))
+    throw InvalidArgument("ArWhitener: residual_unit_mm must be positive and finite");
+  for (const NoiseStream& s : model.streams) {
+    Stream w;
+    w.rows = s.rows;
+    w.phi = levinson(s.reflection);
+    // v_m = v_0 prod (1 - k_j^2), in column units.
+    double v = std::pow(s.marginal_sigma_um * 1e-3 / residual_unit_mm, 2);
+    if (!(v > 0.0)) v = 1.0;  // a stream of zeros: nothing to scale
+    for (std::size_t m = 0; m < w.phi.size(); ++m) {
+      if (m > 0) v *= 1.0 - s.reflection[m - 1] * s.reflection[m - 1];
+      w.inv_sd.push_back(1.0 / std::sqrt(std::max(v, 1e-300)));
+    }
+    streams_.push_back(std::move(w));
+  }
+}
+
+void ArWhitener::apply(Eigen::Ref<Eigen::MatrixXd> columns) const {
+  if (static_cast<std::size_t>(columns.rows()) != n_)
+    throw InvalidArgument("ArWhitener::apply: " + std::to_string(columns.rows()) +
+                          " rows given, the noise model covers " + std::to_string(n_));
+  std::vector<double> x;
+  for (const Stream& s : streams_) {
+    const std::size_t n = s.rows.size(), p = s.phi.size() - 1;
+    x.resize(n);
+    for (Eigen::Index c = 0; c < columns.cols(); ++c) {
+      for (std::size_t t = 0; t < n; ++t) x[t] = columns(s.rows[t], c);
+      // Start-up rows use the order t prediction (exact Cholesky factor), then order p.
+      for (std::size_t t = 0; t < n; ++t) {
+        const std::size_t m = std::min(t, p);
+        const std::vector<double>& phi = s.phi[m];
+        double e = x[t];
+        for (std::size_t j = 1; j <= m; ++j) e -= phi[j - 1] * x[t - j];
+        columns(s.rows[t], c) = e * s.inv_sd[m];
+      }
+    }
+  }
+}
+
+namespace noise_gen {
+
+namespace {
+// AR(1) per stream with stationary start, unit... given marginal sigma.
+void add_ar1(const std::vector<std::vector<Eigen::Index>>& streams, double rho, double sigma,
+             std::mt19937_64& rng, Eigen::VectorXd& out) {
+  std::normal_distribution<double> N(0.0, 1.0);
+  const double innov = sigma * std::sqrt(std::max(0.0, 1.0 - rho * rho));
+  for (const auto& s : streams) {
+    double x = sigma * N(rng);
+    for (std::size_t t = 0; t < s.size(); ++t) {
+      if (t > 0) x = rho * x + innov * N(rng);
+      out[s[t]] += x;
+    }
+  }
+}
+}  // namespace
+
+Eigen::VectorXd ar1(const std::vector<std::string>& groups, const std::vector<double>& times,
+                    double rho, double sigma_mm, std::uint64_t seed) {
+  if (!(std::abs(rho) < 1.0)) throw InvalidArgument("noise_gen::ar1: rho must be in (-1, 1)");
+  if (!(sigma_mm >= 0.0)) throw InvalidArgument("noise_gen::ar1: sigma_mm must be >= 0");
+  std::mt19937_64 rng(seed);
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(groups.size()));
+  add_ar1(noise_streams(groups, times), rho, sigma_mm, rng, out);
+  return out;
+}
+
+Eigen::VectorXd pink(const std::vector<std::string>& groups, const std::vector<double>& times,
+                     double sigma_mm, std::uint64_t seed) {
+  if (!(sigma_mm >= 0.0)) throw InvalidArgument("noise_gen::pink: sigma_mm must be >= 0");
+  std::mt19937_64 rng(seed);
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(groups.size()));
+  const auto streams = noise_streams(groups, times);
+  // Four equal-variance terms: the total marginal variance is sigma^2.
+  for (double tau : {1.0, 10.0, 100.0, 1000.0})
+    add_ar1(streams, std::exp(-1.0 / tau), sigma_mm / 2.0, rng, out);
+  return out;
+}
+
+Eigen::VectorXd thermal_wander(const std::vector<double>& times, double amplitude_mm,
+                               double period_s, std::uint64_t seed) {
+  if (!(period_s > 0.0)) throw InvalidArgument("noise_gen::thermal_wander: period_s must be > 0");
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  double per[3], ph[3];
+  for (int i = 0; i < 3; ++i) per[i] = period_s * (1.0 + 2.0 * U(rng)), ph[i] = 2.0 * M_PI * U(rng);
+  Eigen::VectorXd out(static_cast<Eigen::Index>(times.size()));
+  // Three sines of RMS a/sqrt(3) each: RMS a in all.
+  const double a = amplitude_mm * std::sqrt(2.0 / 3.0);
+  for (std::size_t i = 0; i < times.size(); ++i) {
+    double v = 0.0;
+    for (int k = 0; k < 3; ++k) v += a * std::sin(2.0 * M_PI * times[i] / per[k] + ph[k]);
+    out[static_cast<Eigen::Index>(i)] = v;
+  }
+  return out;
+}
+
+Eigen::VectorXd probe_zero_wander(const std::vector<std::string>& groups,
+                                  const std::vector<double>& times, double step_mm,
+                                  std::uint64_t seed) {
+  if (!(step_mm >= 0.0)) throw InvalidArgument("noise_gen::probe_zero_wander: step_mm must be >= 0");
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> N(0.0, step_mm);
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(groups.size()));
+  for (const auto& s : noise_streams(groups, times)) {
+    double z = 0.0;
+    for (std::size_t t = 0; t < s.size(); ++t) {
+      if (t > 0) z += N(rng);
+      out[s[t]] = z;
+    }
+  }
+  return out;
+}
+
+}  // namespace noise_gen
+
+}  // namespace rotacal

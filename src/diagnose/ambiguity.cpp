@@ -1,0 +1,46 @@
+// Wording of ambiguities: which test of the standard set-up separates two candidates that
+// explain this session's residuals equally well.
+#include <map>
+#include <sstream>
+
+#include <Eigen/SVD>
+
+#include "scoring.hpp"
+
+namespace rotacal::diagnosis_detail {
+
+std::string separating_test(const DiagnosisProblem& P, const ModelFit& fit, const Score& a,
+                            const Score& b, double sigma_mm) {
+  if (P.reference_groups().empty())
+    return "no standard test is known for this instrument; none of this session's tests "
+           "separates them";
+  // Fit each candidate's full parameter vector to this session's residual, then compare what
+  // they predict on the standard test.
+  std::vector<std::string> rows_a, rows_b;
+  const Eigen::MatrixXd Ra = P.reference_jacobian(fit, a.effect, &rows_a);
+  const Eigen::MatrixXd Rb = P.reference_jacobian(fit, b.effect, &rows_b);
+  const Eigen::VectorXd diff = Ra * a.params - Rb * b.params;
+  std::map<std::string, std::pair<double, int>> per;
+  for (std::size_t i = 0; i < rows_a.size(); ++i) {
+    auto& acc = per[rows_a[i]];
+    acc.first += diff[static_cast<Eigen::Index>(i)] * diff[static_cast<Eigen::Index>(i)];
+    acc.second += 1;
+  }
+  std::string best;
+  double best_rms = 0.0;
+  for (auto& kv : per) {
+    const double r = std::sqrt(kv.second.first / kv.second.second);
+    if (r > best_rms) best_rms = r, best = kv.first;
+  }
+  std::ostringstream out;
+  out.precision(2);
+  if (best.empty() || best_rms < sigma_mm)
+    out << "no test of the standard single set-up separates them (their predictions differ by "
+           "less than the noise there): another set-up, e.g. another pivot position, is needed";
+  else
+    out << "a '" << best << "' test separates them: their predictions differ there by "
+        << std::fixed << best_rms * 1e3 << " um RMS";
+  return out.str();
+}
+
+}  // namespace rotacal::diagnosis_detail

@@ -1,0 +1,102 @@
+#pragma once
+// Internal to src/diagnose: the linear algebra, scoring and cross-validation the search loop
+// (diagnosis.cpp) uses, shared with the residual-structure and ambiguity files.
+
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "rotacal/core/noise_model.hpp"
+#include "rotacal/diagnose/diagnosis.hpp"
+
+namespace rotacal::diagnosis_detail {
+
+double rss(const Eigen::VectorXd& r);
+/// RMS in um of residuals in mm.
+double rms_um(const Eigen::VectorXd& r);
+/// Plausible magnitudes of a candidate's parameters (for observability and scaling).
+Eigen::VectorXd magnitudes(const Effect& c);
+/// Least squares y ~ X d, rank-revealing (directions the rows cannot see get no weight).
+Eigen::VectorXd solve_ls(const Eigen::MatrixXd& X, const Eigen::VectorXd& y);
+/// Orthonormal basis of span(J), rank-revealing.
+Eigen::MatrixXd orthonormal_basis(const Eigen::MatrixXd& J);
+/// Columns of C with their component in span(Q) removed (Q orthonormal).
+Eigen::MatrixXd project_out(const Eigen::MatrixXd& Q, const Eigen::MatrixXd& C);
+/// Free (non-zero) columns of a fit's Jacobian.
+Eigen::MatrixXd free_columns(const Eigen::MatrixXd& J);
+/// Blocked K-fold assignment: each group's readings in time order, cut into K contiguous blocks,
+/// fewer (at least 2) where the noise model's correlation time makes blocks of a K-th too short.
+std::vector<int> cv_folds(const DiagnosisProblem& P, int K, const NoiseModel* noise = nullptr);
+/// Cross-validated RMS (um) of predicting r from columns X (linearised refit on the rest).
+double cv_rms_um(const Eigen::MatrixXd& X, const Eigen::VectorXd& r, const std::vector<int>& fold,
+                 int K);
+
+/// One candidate scored against the current model by a linearised refit, in whitened units
+/// (residuals and columns multiplied by the noise model's W: unit variance, independent).
+struct Score {
+  Effect effect;
+  bool observable = false;
+  std::string why_not;
+  int k = 0;                  ///< observable directions
+  Eigen::MatrixXd A;          ///< whitened candidate columns along them, model projected out
+  Eigen::MatrixXd X;          ///< [J, candidate columns] in mm, for cross-validation
+  Eigen::VectorXd signature;  ///< fitted change of the whitened residuals
+  Eigen::VectorXd params;     ///< the candidate's fitted parameters (its units)
+  double rss1 = 0.0;          ///< whitened residual sum of squares after the refit
+  double delta_bic = 0.0;
+  double f_pvalue = 1.0;
+};
+
+/// What every candidate of a round is scored against.
+struct ScoringInputs {
+  Eigen::VectorXd r_w;    ///< whitened residuals of the current model
+  Eigen::MatrixXd Jfree;  ///< its free Jacobian columns, mm per unit
+  Eigen::MatrixXd Q_w;    ///< orthonormal basis of the whitened free columns
+  int num_free = 0;
+};
+
+/// Score candidate `c` (Jc: its Jacobian in mm per unit, Jc_w: whitened); directions whose
+/// plausible sizes change chi-square by less than min_chi2 are not visible.
+Score score(const ScoringInputs& in, const Effect& c, const Eigen::MatrixXd& Jc,
+            const Eigen::MatrixXd& Jc_w, double min_chi2);
+/// Cosine of the angle between two signatures (0 if either is zero).
+double correlation(const Eigen::VectorXd& a, const Eigen::VectorXd& b);
+
+/// Where the predictions of two ambiguous candidates differ most, in words (ambiguity.cpp);
+/// differences below sigma_mm are "less than the noise".
+std::string separating_test(const DiagnosisProblem& P, const ModelFit& fit, const Score& a,
+                            const Score& b, double sigma_mm);
+/// The strongest remaining structure, in words (residual_structure.cpp).
+std::string describe_structure(const std::vector<GroupResidual>& groups);
+
+}  // namespace rotacal::diagnosis_detail
+
+namespace rotacal::diagnosis_detail {
+
+/// Where in a group the residual is largest: the group's swept rotary axis (0: none, then the
+/// range is in time), and the contiguous range of 12 equal bins around the bin of largest
+/// |mean residual| whose |mean| is at least half of it (deg, or s).
+struct Location {
+  char axis = 0;
+  double from = 0.0, to = 0.0;
+  double peak_um = 0.0;  ///< the largest bin mean, um
+};
+Location locate(const DiagnosisProblem& P, const Eigen::VectorXd& r, const std::string& group);
+
+/// Test of structure left in the residuals against the noise model (residual_structure.cpp):
+/// per group, a smooth function of its swept angle (the harmonics its sampling resolves over
+/// a full turn; polynomials of degree 1..4 on an arc, or in time when no angle moves),
+/// whitened, the model's columns projected out, F-tested on the whitened residuals.
+struct StructureTest {
+  double p_value = 1.0;  ///< Bonferroni-corrected over the groups
+  std::string group;     ///< the group with the smallest p-value
+};
+using Whiten = std::function<Eigen::MatrixXd(const Eigen::MatrixXd&)>;
+/// `whitener_for(group, G)`: the whitening to test group's columns G with. r_mm: residuals
+/// of the model whose free columns are Jfree.
+StructureTest structure_test(
+    const DiagnosisProblem& P, const Eigen::VectorXd& r_mm, const Eigen::MatrixXd& Jfree,
+    int num_free, const std::function<Whiten(const std::string&, const Eigen::MatrixXd&)>& whitener_for);
+
+}  // namespace rotacal::diagnosis_detail

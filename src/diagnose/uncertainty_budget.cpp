@@ -1,0 +1,201 @@
+// GUM / ISO/TR 230-9 uncertainty budget of the identified location errors: type A from the
+// noise model, type B from the catalogue effects the final model leaves out.
+#include "rotacal/diagnose/uncertainty_budget.hpp"
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include "rotacal/core/error.hpp"
+#include "rotacal/core/stats.hpp"
+#include "scoring.hpp"
+
+namespace rotacal {
+
+using diagnosis_detail::free_columns;
+
+std::vector<double> plausible_sizes(const Effect& e, const PlausibleSizes& z, double duration_s) {
+  const double T = std::max(duration_s, 1.0);
+  std::vector<double> a(static_cast<std::size_t>(e.num_params()), 0.0);
+  switch (e.kind) {
+    case EffectKind::ballbar_length_offset: a = {z.bar_length_mm}; break;
+    case EffectKind::ballbar_thermal_drift: a = {z.drift_mm / T}; break;
+    case EffectKind::tool_offset_Z: a = {z.tool_length_mm}; break;
+    case EffectKind::rotary_zero_offset: a = {z.rotary_zero_rad}; break;
+    case EffectKind::angular_positioning: a = {z.angular_positioning_rad, z.angular_positioning_rad}; break;
+    case EffectKind::radial_motion: a.assign(4, z.error_motion_mm); break;
+    case EffectKind::axial_motion: a.assign(2, z.error_motion_mm); break;
+    case EffectKind::tilt_motion: a.assign(4, z.tilt_motion_rad); break;
+    case EffectKind::gravity_sag: a = {z.gravity_sag_mm}; break;
+    case EffectKind::coning: a = {z.coning}; break;
+    case EffectKind::linear_squareness: a = {z.squareness_rad}; break;
+    case EffectKind::linear_scale: a = {z.scale}; break;
+    case EffectKind::thermal_drift: a = {z.drift_mm / T}; break;
+    case EffectKind::thermal_warmup: a = {z.warmup_mm, 0.0}; break;  // tau moves nothing at d = 0
+    case EffectKind::straightness: {
+      // c_k u^k reaches the deviation at the end of the length: u = length / 2 / 100 mm.
+      const double u = z.straightness_length_mm / 200.0;
+      a = {z.straightness_mm / (u * u), z.straightness_mm / (u * u * u), z.straightness_mm / (u * u * u * u)};
+      break;
+    }
+    case EffectKind::tool_offset: a = {z.tool_offset_mm}; break;
+    case EffectKind::linear_pitch: a = {z.angular_error_rad, z.angular_error_rad}; break;
+  }
+  const auto names = e.param_names();
+  const auto it = z.overrides.find(e.id());
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    if (it != z.overrides.end()) a[k] = it->second;
+    const auto one = z.overrides.find(e.id() + "." + names[k]);
+    if (one != z.overrides.end()) a[k] = one->second;
+    if (!(a[k] >= 0.0) || !std::isfinite(a[k]))
+      throw InvalidArgument("plausible size of " + e.id() + "." + names[k] + " is " +
+                            std::to_string(a[k]) + ": must be finite and >= 0");
+  }
+  return a;
+}
+
+UncertaintyBudget uncertainty_budget(const DiagnosisProblem& P, const Diagnosis& D,
+                                     const PlausibleSizes& sizes, double coverage, int max_harmonic) {
+  if (!(coverage > 0.0 && coverage < 1.0))
+    throw InvalidArgument("uncertainty_budget: coverage is " + std::to_string(coverage) + ", must be in (0, 1)");
+  const ModelFit& fit = D.final_fit;
+  const auto n = fit.residuals.size();
+  if (n == 0 || fit.jacobian.rows() != n)
+    throw InvalidArgument("uncertainty_budget: the diagnosis has no final fit");
+  std::vector<Effect> candidates;
+  for (const Effect& c : P.candidates(max_harmonic))
+    if (std::find(fit.effects.effects.begin(), fit.effects.effects.end(), c) == fit.effects.effects.end())
+      candidates.push_back(c);
+  for (const auto& [key, value] : sizes.overrides) {
+    (void)value;
+    const Effect e = Effect::parse(key.substr(0, key.find('.')));
+    const auto all = P.candidates(max_harmonic);
+    if (std::find(all.begin(), all.end(), e) == all.end())
+      throw InvalidArgument("uncertainty_budget: override '" + key + "' names no candidate of this session");
+  }
+  const auto& times = P.times();
+  const double duration = times.empty() ? 0.0
+                                        : *std::max_element(times.begin(), times.end()) -
+                                              *std::min_element(times.begin(), times.end());
+
+  // Whitening by the noise model the diagnosis reports (white: 1/sigma).
+  std::unique_ptr<ArWhitener> W;
+  if (!D.noise.white() && D.noise.n == static_cast<std::size_t>(n)) W = std::make_unique<ArWhitener>(D.noise);
+  const double sigma_mm = std::max(D.baseline.noise_um, 1e-9) * 1e-3;
+  const auto whiten = [&](const Eigen::MatrixXd& M) {
+    Eigen::MatrixXd out = M;
+    if (W) W->apply(out);
+    else out /= sigma_mm;
+    return out;
+  };
+
+  // Free columns and where the location errors sit among them.
+  std::vector<Eigen::Index> free_index(static_cast<std::size_t>(fit.jacobian.cols()), -1);
+  Eigen::Index nf = 0;
+  for (Eigen::Index j = 0; j < fit.jacobian.cols(); ++j)
+    if (fit.jacobian.col(j).squaredNorm() > 0.0) free_index[static_cast<std::size_t>(j)] = nf++;
+  const Eigen::MatrixXd J = free_columns(fit.jacobian);
+  // Type A: GLS covariance (J_w^T J_w)^-1 by SVD (free parameters are determined: no null space).
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd_w(whiten(J), Eigen::ComputeThinV);
+  Eigen::VectorXd inv_s = svd_w.singularValues();
+  for (Eigen::Index i = 0; i < inv_s.size(); ++i)
+    inv_s[i] = inv_s[i] > 1e-12 * inv_s[0] ? 1.0 / inv_s[i] : 0.0;
+  const Eigen::MatrixXd cov_a = svd_w.matrixV() * inv_s.cwiseAbs2().asDiagonal() * svd_w.matrixV().transpose();
+  const double n_eff = W ? D.noise.effective_samples : static_cast<double>(n);
+  const double dof_a = std::max(1.0, n_eff - static_cast<double>(J.cols()));
+  // Unweighted least squares (what the fits do): bias = pinv(J) J_effect delta.
+  const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> ls(J);
+  const Eigen::VectorXd r_w = whiten(fit.residuals);
+
+  struct Contribution {
+    std::string effect, basis;
+    Eigen::VectorXd bias;  // per free parameter, at the half-widths (RSS over the effect's parameters)
+    Eigen::VectorXd u;
+    double dof;
+    std::vector<double> a;
+  };
+  std::vector<Contribution> lines;
+  for (const Effect& c : candidates) {
+    const Eigen::MatrixXd Jc = P.candidate_jacobian(fit, c);
+    const Eigen::MatrixXd B = ls.solve(Jc);  // d(free params) / d(effect params)
+    std::vector<double> a = plausible_sizes(c, sizes, duration);
+    // The session's own bound where it sees the effect: linearised estimate on the final
+    // residuals with the model projected out, |value| + 2 sigma.
+    bool bounded = false;
+    if (sizes.use_session_bounds) {
+      const Eigen::MatrixXd perp_w = whiten(Jc - J * B);
+      Eigen::JacobiSVD<Eigen::MatrixXd> svd(perp_w, Eigen::ComputeThinU | Eigen::ComputeThinV);
+      const Eigen::VectorXd s = svd.singularValues();
+      if (s.size() && s[s.size() - 1] > 1e-9 * std::max(1.0, s[0])) {
+        const Eigen::VectorXd est = svd.solve(r_w);
+        const Eigen::MatrixXd cov = svd.matrixV() * s.cwiseInverse().cwiseAbs2().asDiagonal() * svd.matrixV().transpose();
+        bool tighter = false;
+        std::vector<double> bound(a.size());
+        for (std::size_t k = 0; k < a.size(); ++k) {
+          bound[k] = std::abs(est[static_cast<Eigen::Index>(k)]) + 2.0 * std::sqrt(cov(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k)));
+          tighter = tighter || bound[k] < a[k];
+        }
+        if (tighter) {
+          for (std::size_t k = 0; k < a.size(); ++k) a[k] = std::min(a[k], bound[k]);
+          bounded = true;
+        }
+      }
+    }
+    Contribution L;
+    L.effect = c.id();
+    L.basis = bounded ? "session bound" : "default plausible size";
+    L.dof = bounded ? dof_a : std::numeric_limits<double>::infinity();
+    const Eigen::Map<const Eigen::VectorXd> av(a.data(), static_cast<Eigen::Index>(a.size()));
+    const Eigen::MatrixXd per = B * av.asDiagonal();  // bias of each parameter at each half-width
+    L.bias = per.rowwise().norm();
+    L.u = L.bias / std::sqrt(3.0);  // rectangular
+    L.a = a;
+    lines.push_back(std::move(L));
+  }
+
+  UncertaintyBudget out;
+  out.coverage = coverage;
+  const auto& names = location_error_names(P.machine());
+  for (int i = 0; i < 8; ++i) {
+    LocationBudget L;
+    L.name = names[static_cast<std::size_t>(i)];
+    L.unit = location_error_is_angle(i) ? "rad" : "mm";
+    const auto p = std::find_if(fit.parameters.begin(), fit.parameters.end(),
+                                [&](const ParameterEstimate& q) { return q.name == L.name; });
+    const auto col = p == fit.parameters.end() ? -1 : free_index[static_cast<std::size_t>(p - fit.parameters.begin())];
+    if (col < 0 || !p->observable) {
+      L.observable = false;
+      out.errors.push_back(L);
+      continue;
+    }
+    L.value = p->value;
+    L.u_a = std::sqrt(std::max(0.0, cov_a(col, col)));
+    L.dof_a = dof_a;
+    double uc2 = L.u_a * L.u_a, ws = std::pow(L.u_a, 4) / dof_a;
+    for (const Contribution& c : lines) {
+      BudgetLine b;
+      b.effect = c.effect;
+      b.basis = c.basis;
+      b.u = c.u[col];
+      b.bias_at_size = c.bias[col];
+      b.dof = c.dof;
+      b.half_width = c.a;
+      uc2 += b.u * b.u;
+      if (std::isfinite(b.dof)) ws += std::pow(b.u, 4) / b.dof;
+      L.type_b.push_back(b);
+    }
+    std::sort(L.type_b.begin(), L.type_b.end(), [](const BudgetLine& a, const BudgetLine& b) { return a.u > b.u; });
+    L.u_c = std::sqrt(uc2);
+    L.nu_eff = ws > 0.0 ? std::pow(L.u_c, 4) / ws : std::numeric_limits<double>::infinity();
+    L.k = stats::t_coverage(coverage, L.nu_eff);
+    L.expanded = L.k * L.u_c;
+    for (const BudgetLine& b : L.type_b)
+      if (b.u * b.u >= 0.1 * uc2) L.dominant.push_back(b.effect);
+    out.errors.push_back(std::move(L));
+  }
+  return out;
+}
+
+}  // namespace rotacal
