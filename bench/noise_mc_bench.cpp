@@ -79,13 +79,15 @@ Eigen::VectorXd coloured(const Noise& nz, const std::vector<std::string>& g, con
 
 int main(int argc, char** argv) {
   int draws = 200;
-  bool rtest = true;
+  bool rtest = true, ballbar = true, pooled = false;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--smoke")) draws = 8;
     else if (!std::strcmp(argv[i], "--draws") && i + 1 < argc) draws = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--no-rtest")) rtest = false;
+    else if (!std::strcmp(argv[i], "--no-ballbar")) ballbar = false;
+    else if (!std::strcmp(argv[i], "--pooled")) pooled = true;  // one AR model for all streams
     else {
-      std::fprintf(stderr, "usage: noise_mc_bench [--draws N] [--smoke] [--no-rtest]\n");
+      std::fprintf(stderr, "usage: noise_mc_bench [--draws N] [--smoke] [--no-rtest] [--no-ballbar] [--pooled]\n");
       return 2;
     }
   }
@@ -106,7 +108,10 @@ int main(int argc, char** argv) {
   for (const BallbarSample& x : clean.samples) g.push_back(x.test), t.push_back(x.time);
   JointFitOptions white;
   white.noise = NoiseHandling::white;
+  JointFitOptions automatic;
+  automatic.noise_options.pooled = pooled;
   for (const Noise& nz : kinds) {
+    if (!ballbar) break;
     const auto t0 = clock::now();
     Spread a, w;
     for (int k = 0; k < draws; ++k) {
@@ -114,7 +119,7 @@ int main(int argc, char** argv) {
       const Eigen::VectorXd e = coloured(nz, g, t, 0.5e-3, 1000 + static_cast<std::uint64_t>(k));
       for (std::size_t i = 0; i < s.samples.size(); ++i) s.samples[i].length += e[static_cast<Eigen::Index>(i)];
       s.noise_um = 0.5;
-      a.add(identify_joint(s), MachineType::AC_trt);
+      a.add(identify_joint(s, automatic), MachineType::AC_trt);
       w.add(identify_joint(s, white), MachineType::AC_trt);
     }
     print("ballbar", nz, a, w, MachineType::AC_trt, draws, std::chrono::duration<double>(clock::now() - t0).count());
@@ -133,6 +138,8 @@ int main(int argc, char** argv) {
     std::vector<double> rtm;
     for (const RtestSample& x : rclean.samples)
       for (int c = 0; c < 3; ++c) rg.push_back("nest " + x.setup), rtm.push_back(x.time);
+    RtestJointOptions rauto;
+    rauto.noise_options.pooled = pooled;
     RtestJointOptions rwhite;
     rwhite.noise = NoiseHandling::white;
     for (const Noise& nz : kinds) {
@@ -145,7 +152,7 @@ int main(int argc, char** argv) {
         for (std::size_t r = 0; r < s.samples.size(); ++r)
           for (int c = 0; c < 3; ++c) (*s.samples[r].d)[c] += e[3 * static_cast<Eigen::Index>(r) + c];
         s.noise_um = 0.3;
-        a.add(identify_joint(s), MachineType::BC_trt);
+        a.add(identify_joint(s, rauto), MachineType::BC_trt);
         w.add(identify_joint(s, rwhite), MachineType::BC_trt);
       }
       print("R-test", nz, a, w, MachineType::BC_trt, draws, std::chrono::duration<double>(clock::now() - t0).count());

@@ -129,7 +129,10 @@ void bind_rtest(pyb::module_& m) {
       .def_readonly("iterations", &RtestJointIdentification::iterations)
       .def_readonly("unobservable", &RtestJointIdentification::unobservable)
       .def_readonly("notes", &RtestJointIdentification::notes)
-      .def_readonly("summary", &RtestJointIdentification::summary);
+      .def_readonly("summary", &RtestJointIdentification::summary)
+      .def_readonly("noise", &RtestJointIdentification::noise)
+      .def_readonly("noise_refit", &RtestJointIdentification::noise_refit)
+      .def_readonly("noise_correction", &RtestJointIdentification::noise_correction);
 
   pyb::class_<RtestPaperIdentification>(m, "RtestPaperIdentification")
       .def_readonly("method", &RtestPaperIdentification::method)
@@ -142,15 +145,17 @@ void bind_rtest(pyb::module_& m) {
 
   m.def(
       "identify_rtest_joint",
-      [](const RtestSession& session, const RtestBasis& basis) {
-        pyb::gil_scoped_release release;
+      [](const RtestSession& session, const RtestBasis& basis, const std::string& noise) {
         RtestJointOptions o;
         o.basis = basis;
+        o.noise = noise_handling_from_string(noise);
+        pyb::gil_scoped_release release;
         return identify_joint(session, o);
       },
-      pyb::arg("session"), pyb::arg("basis") = RtestBasis{},
+      pyb::arg("session"), pyb::arg("basis") = RtestBasis{}, pyb::arg("noise") = "auto",
       "Joint fit of an R-test session: location errors, smooth B and C maps, a probe zero "
-      "per set-up, with observability (rtest/identify_joint.hpp).");
+      "per set-up, with observability (rtest/identify_joint.hpp); noise 'auto' (AR noise model, "
+      "GLS refit when correlated) or 'white'.");
   m.def(
       "identify_rtest_paper",
       [](const RtestSession& session) {

@@ -6,7 +6,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Ambiguity', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'CandidateScore', 'CircleFit', 'CompensationReport', 'CompensationRow', 'DegenerateGeometry', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'FaultInjection', 'Finding', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'MachineType', 'ModelFit', 'NcDialect', 'NcProgramOptions', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestJointIdentification', 'RtestJointModel', 'RtestPaperIdentification', 'RtestSession', 'SegmentKind', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TransitionArc', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'ballbar_model_document', 'ballbar_model_from_document', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_output', 'compensate_commands', 'compensate_sphere_offset', 'default_ballbar_tests', 'default_calibration_moves', 'diagnose_ballbar', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'parse_ballbar_test', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'test_label', 'verify_compensation', 'write_ballbar', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
+__all__: list[str] = ['Ambiguity', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CompensationReport', 'CompensationRow', 'DegenerateGeometry', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestJointIdentification', 'RtestJointModel', 'RtestPaperIdentification', 'RtestSession', 'SegmentKind', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'ballbar_model_document', 'ballbar_model_from_document', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_model_machine', 'check_output', 'check_plausible', 'compensate_commands', 'compensate_sphere_offset', 'default_ballbar_tests', 'default_calibration_moves', 'diagnose_ballbar', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
 class Ambiguity:
     @property
     def correlation(self) -> float:
@@ -40,6 +40,15 @@ class BallbarIdentification:
     def n_samples(self) -> int:
         ...
     @property
+    def noise(self) -> ...:
+        ...
+    @property
+    def noise_correction(self) -> float:
+        ...
+    @property
+    def noise_refit(self) -> bool:
+        ...
+    @property
     def notes(self) -> list[str]:
         ...
     @property
@@ -53,6 +62,9 @@ class BallbarIdentification:
         ...
     @property
     def sigma_um(self) -> float:
+        ...
+    @property
+    def summary(self) -> FitSummary:
         ...
     @property
     def unobservable(self) -> list[str]:
@@ -77,6 +89,22 @@ class BallbarMachineModel:
         ...
     @property
     def pivot(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+class BallbarMonteCarlo:
+    @property
+    def draws(self) -> int:
+        ...
+    @property
+    def fresh_fits(self) -> int:
+        ...
+    @property
+    def noise_um(self) -> float:
+        ...
+    @property
+    def parameters(self) -> list[MonteCarloParameter]:
+        ...
+    @property
+    def values(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
         ...
 class BallbarPlan:
     """
@@ -317,6 +345,25 @@ class BallbarTest:
         ...
     @property
     def value(self) -> int:
+        ...
+class BudgetLine:
+    @property
+    def basis(self) -> str:
+        ...
+    @property
+    def bias_at_size(self) -> float:
+        ...
+    @property
+    def dof(self) -> float:
+        ...
+    @property
+    def effect(self) -> str:
+        ...
+    @property
+    def half_width(self) -> list[float]:
+        ...
+    @property
+    def u(self) -> float:
         ...
 class CandidateScore:
     @property
@@ -571,6 +618,40 @@ class Finding:
     @property
     def shifts(self) -> list[ParameterShift]:
         ...
+class FitSummary:
+    """
+    How a least-squares solve went (core/estimate.hpp).
+    """
+    @property
+    def chi2(self) -> float:
+        ...
+    @property
+    def chi2_per_dof(self) -> float:
+        ...
+    @property
+    def converged(self) -> bool:
+        ...
+    @property
+    def iterations(self) -> int:
+        ...
+    @property
+    def jacobian_evaluations(self) -> int:
+        ...
+    @property
+    def message(self) -> str:
+        ...
+    @property
+    def num_free(self) -> int:
+        ...
+    @property
+    def num_residuals(self) -> int:
+        ...
+    @property
+    def residual_evaluations(self) -> int:
+        ...
+    @property
+    def whitened(self) -> bool:
+        ...
 class Gain:
     @property
     def cv_rms_after_um(self) -> float:
@@ -622,6 +703,43 @@ class InvalidArgument(Error):
     pass
 class IoError(Error):
     pass
+class LocationBudget:
+    @property
+    def dof_a(self) -> float:
+        ...
+    @property
+    def dominant(self) -> list[str]:
+        ...
+    @property
+    def expanded(self) -> float:
+        ...
+    @property
+    def k(self) -> float:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def nu_eff(self) -> float:
+        ...
+    @property
+    def observable(self) -> bool:
+        ...
+    @property
+    def type_b(self) -> list[BudgetLine]:
+        ...
+    @property
+    def u_a(self) -> float:
+        ...
+    @property
+    def u_c(self) -> float:
+        ...
+    @property
+    def unit(self) -> str:
+        ...
+    @property
+    def value(self) -> float:
+        ...
 class MachineType:
     """
     Members:
@@ -679,6 +797,25 @@ class ModelFit:
         ...
     @property
     def residuals(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+class MonteCarloParameter:
+    @property
+    def bias(self) -> float:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def ratio(self) -> float:
+        ...
+    @property
+    def std_mc(self) -> float:
+        ...
+    @property
+    def std_reported(self) -> float:
+        ...
+    @property
+    def unit(self) -> str:
         ...
 class NcDialect:
     """
@@ -754,6 +891,90 @@ class NcProgramOptions:
     @tool.setter
     def tool(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
+class NoiseModel:
+    def summary(self) -> str:
+        ...
+    def whiten(self, columns: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"], residual_unit_mm: typing.SupportsFloat | typing.SupportsIndex = 1.0) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        """
+        Whitened copy of `columns` (one row per reading): unit variance if the model holds.
+        """
+    @property
+    def correlation_samples(self) -> float:
+        ...
+    @property
+    def correlation_time_s(self) -> float:
+        ...
+    @property
+    def effective_samples(self) -> float:
+        ...
+    @property
+    def innovation_sigma_um(self) -> float:
+        ...
+    @property
+    def max_order(self) -> int:
+        ...
+    @property
+    def n(self) -> int:
+        ...
+    @property
+    def sigma_um(self) -> float:
+        ...
+    @property
+    def streams(self) -> list[NoiseStream]:
+        ...
+    @property
+    def white(self) -> bool:
+        ...
+class NoiseModelOptions:
+    pooled: bool
+    def __init__(self) -> None:
+        ...
+    @property
+    def max_order(self) -> int:
+        ...
+    @max_order.setter
+    def max_order(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def min_stream_size(self) -> int:
+        ...
+    @min_stream_size.setter
+    def min_stream_size(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+class NoiseStream:
+    @property
+    def ar(self) -> list[float]:
+        ...
+    @property
+    def channel(self) -> int:
+        ...
+    @property
+    def correlation_samples(self) -> float:
+        ...
+    @property
+    def correlation_time_s(self) -> float:
+        ...
+    @property
+    def effective_samples(self) -> float:
+        ...
+    @property
+    def group(self) -> str:
+        ...
+    @property
+    def innovation_sigma_um(self) -> float:
+        ...
+    @property
+    def marginal_sigma_um(self) -> float:
+        ...
+    @property
+    def n(self) -> int:
+        ...
+    @property
+    def reflection(self) -> list[float]:
+        ...
+    @property
+    def sample_interval_s(self) -> float:
+        ...
 class ParameterEstimate:
     def __repr__(self) -> str:
         ...
@@ -824,6 +1045,164 @@ class PlaneFit:
         ...
     @property
     def singular_values(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+class PlausibilityOptions:
+    """
+    Limits of the plausibility checks (mm, deg).
+    """
+    def __init__(self) -> None:
+        ...
+    @property
+    def max_displacement_mm(self) -> float:
+        ...
+    @max_displacement_mm.setter
+    def max_displacement_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def max_length_deviation_mm(self) -> float:
+        ...
+    @max_length_deviation_mm.setter
+    def max_length_deviation_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def max_position_deviation_mm(self) -> float:
+        ...
+    @max_position_deviation_mm.setter
+    def max_position_deviation_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def min_ballbar_length_mm(self) -> float:
+        ...
+    @min_ballbar_length_mm.setter
+    def min_ballbar_length_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def min_rotary_span_deg(self) -> float:
+        ...
+    @min_rotary_span_deg.setter
+    def min_rotary_span_deg(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+class PlausibilityReport:
+    @property
+    def max_deviation_mm(self) -> float:
+        ...
+    @property
+    def median_deviation_mm(self) -> float:
+        ...
+    @property
+    def rot_span_deg(self) -> float:
+        ...
+    @property
+    def tilt_span_deg(self) -> float:
+        ...
+    @property
+    def worst_sample(self) -> int:
+        ...
+class PlausibleSizes:
+    use_session_bounds: bool
+    def __init__(self) -> None:
+        ...
+    @property
+    def angular_error_rad(self) -> float:
+        ...
+    @angular_error_rad.setter
+    def angular_error_rad(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def angular_positioning_rad(self) -> float:
+        ...
+    @angular_positioning_rad.setter
+    def angular_positioning_rad(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def bar_length_mm(self) -> float:
+        ...
+    @bar_length_mm.setter
+    def bar_length_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def coning(self) -> float:
+        ...
+    @coning.setter
+    def coning(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def drift_mm(self) -> float:
+        ...
+    @drift_mm.setter
+    def drift_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def error_motion_mm(self) -> float:
+        ...
+    @error_motion_mm.setter
+    def error_motion_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def gravity_sag_mm(self) -> float:
+        ...
+    @gravity_sag_mm.setter
+    def gravity_sag_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def overrides(self) -> dict[str, float]:
+        ...
+    @overrides.setter
+    def overrides(self, arg0: collections.abc.Mapping[str, typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def rotary_zero_rad(self) -> float:
+        ...
+    @rotary_zero_rad.setter
+    def rotary_zero_rad(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def scale(self) -> float:
+        ...
+    @scale.setter
+    def scale(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def squareness_rad(self) -> float:
+        ...
+    @squareness_rad.setter
+    def squareness_rad(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def straightness_length_mm(self) -> float:
+        ...
+    @straightness_length_mm.setter
+    def straightness_length_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def straightness_mm(self) -> float:
+        ...
+    @straightness_mm.setter
+    def straightness_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def tilt_motion_rad(self) -> float:
+        ...
+    @tilt_motion_rad.setter
+    def tilt_motion_rad(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def tool_length_mm(self) -> float:
+        ...
+    @tool_length_mm.setter
+    def tool_length_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def tool_offset_mm(self) -> float:
+        ...
+    @tool_offset_mm.setter
+    def tool_offset_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def warmup_mm(self) -> float:
+        ...
+    @warmup_mm.setter
+    def warmup_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
         ...
 class ProbeCalibration:
     """
@@ -987,6 +1366,15 @@ class RtestJointIdentification:
     def n_samples(self) -> int:
         ...
     @property
+    def noise(self) -> NoiseModel:
+        ...
+    @property
+    def noise_correction(self) -> float:
+        ...
+    @property
+    def noise_refit(self) -> bool:
+        ...
+    @property
     def notes(self) -> list[str]:
         ...
     @property
@@ -1003,6 +1391,9 @@ class RtestJointIdentification:
         ...
     @property
     def sigma_um(self) -> float:
+        ...
+    @property
+    def summary(self) -> FitSummary:
         ...
     @property
     def unobservable(self) -> list[str]:
@@ -1230,6 +1621,13 @@ class TransitionArc:
     @property
     def start(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
         ...
+class UncertaintyBudget:
+    @property
+    def coverage(self) -> float:
+        ...
+    @property
+    def errors(self) -> list[LocationBudget]:
+        ...
 class Unexplained:
     @property
     def chi2_per_dof(self) -> float:
@@ -1306,10 +1704,20 @@ def calibrate_sphere_offset(dirs: typing.Annotated[numpy.typing.ArrayLike, numpy
     """
     Sphere offset from spindle indexing: angles (N,) rad, readings (N, 3) mm.
     """
+def check_model_machine(model_machine: MachineType, session_machine: MachineType, model_source: str) -> None:
+    ...
 def check_output(path: str, inputs: collections.abc.Sequence[str] = [], other_outputs: collections.abc.Sequence[str] = []) -> str:
     """
     Check an output path without writing: 'replace' or 'write-through'; raises IoError.
     """
+@typing.overload
+def check_plausible(session: BallbarSession, source: str, options: PlausibilityOptions = ...) -> PlausibilityReport:
+    """
+    Refuse (InvalidArgument, likely cause named) a session the nominal kinematics cannot explain.
+    """
+@typing.overload
+def check_plausible(session: RtestSession, source: str, options: PlausibilityOptions = ...) -> PlausibilityReport:
+    ...
 def compensate_commands(nominal: BallbarSession, identified: ..., machine: MachineType) -> BallbarSession:
     ...
 def compensate_sphere_offset(session: RtestSession, offset: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> RtestSession:
@@ -1339,6 +1747,10 @@ def displacements_from_raw(session: RtestSession, dirs: typing.Annotated[numpy.t
 def effect_catalogue(machine: MachineType, max_harmonic: typing.SupportsInt | typing.SupportsIndex = 4) -> list[Effect]:
     """
     Every catalogue entry that applies to the machine, harmonics 1..max_harmonic.
+    """
+def estimate_noise_model(groups: collections.abc.Sequence[str], times: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], residuals_mm: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], options: NoiseModelOptions = ...) -> NoiseModel:
+    """
+    AR(p) model (Burg, BIC order) of the residuals per stream (group, channel).
     """
 def format_ballbar(session: BallbarSession) -> str:
     ...
@@ -1375,17 +1787,17 @@ def hyper_circle_fit(points: typing.Annotated[numpy.typing.ArrayLike, numpy.floa
     
     Raises rotacal.DegenerateGeometry for < 3, collinear points or a too short arc.
     """
-def identify_joint(session: BallbarSession, fit_length_offset: bool = False, effects: collections.abc.Sequence[str] = [], tests: collections.abc.Sequence[str] = []) -> BallbarIdentification:
+def identify_joint(session: BallbarSession, fit_length_offset: bool = False, effects: collections.abc.Sequence[str] = [], tests: collections.abc.Sequence[str] = [], noise: str = 'auto') -> BallbarIdentification:
     """
-    Joint Ceres fit of the 8 location errors and the actual pivot to every sample.
+    Joint fit (noise 'auto': AR noise model of the residuals, GLS refit when correlated; 'white') of the 8 location errors and the actual pivot to every sample (core/joint_fit.hpp).
     """
 def identify_paper(session: BallbarSession) -> BallbarIdentification:
     """
     Flynn et al. 2016's chain: sphere fit, Hyper circle fits, SVD plane fits, transport.
     """
-def identify_rtest_joint(session: RtestSession, basis: RtestBasis = ...) -> RtestJointIdentification:
+def identify_rtest_joint(session: RtestSession, basis: RtestBasis = ..., noise: str = 'auto') -> RtestJointIdentification:
     """
-    Joint Ceres fit of an R-test session: location errors, smooth B and C maps, a probe zero per set-up, with observability (rtest/identify_joint.hpp).
+    Joint fit of an R-test session: location errors, smooth B and C maps, a probe zero per set-up, with observability (rtest/identify_joint.hpp); noise 'auto' (AR noise model, GLS refit when correlated) or 'white'.
     """
 def identify_rtest_paper(session: RtestSession) -> RtestPaperIdentification:
     """
@@ -1412,6 +1824,32 @@ def location_error_names(machine: MachineType) -> typing.Annotated[list[str], "F
     ISO 230-7 names of the 8 location errors, in the order of every errors vector.
     """
 def machine_name(machine: MachineType) -> str:
+    ...
+def monte_carlo_joint(session: BallbarSession, result: BallbarIdentification, draws: typing.SupportsInt | typing.SupportsIndex = 100, seed: typing.SupportsInt | typing.SupportsIndex = 1, noise_um: typing.SupportsFloat | typing.SupportsIndex = 0.0, tests: collections.abc.Sequence[str] = [], progress: typing.Any = None) -> BallbarMonteCarlo:
+    """
+    Monte Carlo check of a joint fit's 1-sigma (ballbar/monte_carlo.hpp).
+    
+    Parameters
+    ----------
+    session : the session that was identified
+    result : its joint identification
+    draws : number of simulated sessions (>= 2); draw k uses seed + k, as simulate_ballbar
+    noise_um : 1 sigma of the simulated noise (0: the fit's sigma_um)
+    tests : the test labels the fit used (empty: all)
+    progress : optional callable(done, total), called after every draw
+    
+    Returns
+    -------
+    BallbarMonteCarlo: per observable parameter std_reported, std_mc, ratio, bias; values
+    (draws x parameters).
+    """
+def noise_ar1(groups: collections.abc.Sequence[str], times: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], rho: typing.SupportsFloat | typing.SupportsIndex, sigma_mm: typing.SupportsFloat | typing.SupportsIndex, seed: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+    ...
+def noise_pink(groups: collections.abc.Sequence[str], times: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], sigma_mm: typing.SupportsFloat | typing.SupportsIndex, seed: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+    ...
+def noise_probe_zero_wander(groups: collections.abc.Sequence[str], times: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], step_mm: typing.SupportsFloat | typing.SupportsIndex, seed: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+    ...
+def noise_thermal_wander(times: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], amplitude_mm: typing.SupportsFloat | typing.SupportsIndex, period_s: typing.SupportsFloat | typing.SupportsIndex, seed: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
     ...
 def parse_ballbar_test(label: str, machine: MachineType) -> BallbarTest:
     """
@@ -1530,6 +1968,14 @@ def svd_plane_fit(points: typing.Annotated[numpy.typing.ArrayLike, numpy.float64
 def test_label(test: BallbarTest, machine: MachineType) -> str:
     """
     Session label of a test on a machine, e.g. 'radial_A'.
+    """
+def uncertainty_budget_ballbar(session: BallbarSession, diagnosis: ..., sizes: PlausibleSizes = ..., coverage: typing.SupportsFloat | typing.SupportsIndex = 0.95) -> UncertaintyBudget:
+    """
+    GUM budget of the location errors of diagnose_ballbar's result.
+    """
+def uncertainty_budget_rtest(session: RtestSession, diagnosis: ..., sizes: PlausibleSizes = ..., coverage: typing.SupportsFloat | typing.SupportsIndex = 0.95) -> UncertaintyBudget:
+    """
+    GUM budget of the location errors of diagnose_rtest's result.
     """
 def verify_compensation(commanded: BallbarSession, truth: BallbarMachineModel, noise_um: typing.SupportsFloat | typing.SupportsIndex = 0.5, seed: typing.SupportsInt | typing.SupportsIndex = 1) -> CompensationReport:
     """

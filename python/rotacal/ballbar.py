@@ -13,7 +13,7 @@ from .sessions import BALLBAR, require
 
 def identify(session: _core.BallbarSession, method: str = "joint", *,
              fit_length_offset: bool = False, effects: Sequence[str] = (),
-             tests: Sequence[str] = ()) -> Identification:
+             tests: Sequence[str] = (), noise: str = "auto") -> Identification:
     """Identify the 8 location errors (and the actual pivot) of a ballbar session
     (rotacal.identify takes either kind of session).
 
@@ -25,10 +25,13 @@ def identify(session: _core.BallbarSession, method: str = "joint", *,
     fit_length_offset : also fit an offset of the calibrated bar length (joint only).
     effects : catalogue ids to fit along (joint only), e.g. ["gravity_sag_A"].
     tests : restrict to these test labels (default: all).
+    noise : "auto" (default) estimates the AR noise model of the residuals per test and, when
+        it is correlated, refits by GLS so that the 1-sigma holds; "white" treats the readings
+        as independent. The noise model is in ``to_dict()["noise_model"]``.
     """
     require(session, BALLBAR, "identify")
     if method == "joint":
-        raw = _core.identify_joint(session, fit_length_offset, list(effects), list(tests))
+        raw = _core.identify_joint(session, fit_length_offset, list(effects), list(tests), noise)
     elif method == "paper":
         if fit_length_offset or effects:
             raise _core.InvalidArgument("identify: the paper method fits no length offset or effects")

@@ -10,6 +10,12 @@
 
 namespace rotacal {
 
+NoiseHandling noise_handling_from_string(const std::string& noise) {
+  if (noise == "auto") return NoiseHandling::automatic;
+  if (noise == "white") return NoiseHandling::white;
+  throw InvalidArgument("noise: expected 'auto' or 'white', got '" + noise + "'");
+}
+
 double long_run_variance(const NoiseModel& model) {
   double v = 0.0;
   for (const NoiseStream& s : model.streams) {

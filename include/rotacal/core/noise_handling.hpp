@@ -2,6 +2,8 @@
 /// \file
 /// How a joint fit (ballbar or R-test) treats correlated residual noise.
 
+#include <string>
+
 #include "rotacal/core/noise_model.hpp"
 
 namespace rotacal {
@@ -10,6 +12,9 @@ enum class NoiseHandling {
   automatic,  ///< fit, estimate the AR noise model per stream, refit by GLS if it is not white
   white       ///< residuals taken as independent (the covariance is (J^T J)^-1 s^2)
 };
+
+/// "auto" or "white" (the names of the CLI and Python); throws InvalidArgument naming `noise`.
+NoiseHandling noise_handling_from_string(const std::string& noise);
 
 }  // namespace rotacal
 
