@@ -109,6 +109,7 @@ void bind_ballbar(pyb::module_& m) {
   pyb::class_<BallbarMonteCarlo>(m, "BallbarMonteCarlo")
       .def_readonly("draws", &BallbarMonteCarlo::draws)
       .def_readonly("noise_um", &BallbarMonteCarlo::noise_um)
+      .def_readonly("noise", &BallbarMonteCarlo::noise)
       .def_readonly("parameters", &BallbarMonteCarlo::parameters)
       .def_readonly("values", &BallbarMonteCarlo::values)
       .def_readonly("fresh_fits", &BallbarMonteCarlo::fresh_fits);

@@ -98,6 +98,9 @@ class BallbarMonteCarlo:
     def fresh_fits(self) -> int:
         ...
     @property
+    def noise(self) -> str:
+        ...
+    @property
     def noise_um(self) -> float:
         ...
     @property

@@ -129,8 +129,10 @@ class DiagnosisResult:
             "final_model": fit_model_dict(d.machine, d.final_fit.parameters, d.final_fit.effects),
             "seconds": d.seconds,
         }
-        if getattr(d, "noise", None) is not None:
+        if getattr(d, "noise", None) is not None:  # bound by the diagnosis module
             out["noise_model"] = noise_model_dict(d.noise)
+        if getattr(d, "angle_tables", None) is not None:
+            out["angle_tables"] = [angle_table_dict(t) for t in d.angle_tables]
         if self.budget is not None:
             out["uncertainty_budget"] = budget_dict(self.budget)
         return out
@@ -168,6 +170,18 @@ def noise_model_dict(nm, refit: bool | None = None, correction: float | None = N
         out["gls_refit"] = bool(refit)
         out["covariance_factor"] = float(correction)
     return out
+
+
+def angle_table_dict(t) -> dict:
+    """A per-angle table (structure outside the catalogue): docs/json_schema.md#per-angle-table."""
+    g = t.gain
+    axis = t.axis if isinstance(t.axis, str) else chr(t.axis)
+    return {"group": t.group, "axis": axis,
+            "angle_deg": [float(v) for v in t.angle_deg], "value_um": [float(v) for v in t.value_um],
+            "std_um": [float(v) for v in t.std_um], "count": [int(v) for v in t.count],
+            "gain": {"rms_before_um": g.rms_before_um, "rms_after_um": g.rms_after_um,
+                     "delta_bic": g.delta_bic, "cv_rms_before_um": g.cv_rms_before_um,
+                     "cv_rms_after_um": g.cv_rms_after_um, "f_test_p": g.f_pvalue}}
 
 
 def budget_dict(b) -> dict:

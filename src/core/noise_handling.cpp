@@ -16,6 +16,29 @@ NoiseHandling noise_handling_from_string(const std::string& noise) {
   throw InvalidArgument("noise: expected 'auto' or 'white', got '" + noise + "'");
 }
 
+Eigen::VectorXd draw_noise(const NoiseModel& model, std::mt19937_64& rng) {
+  std::normal_distribution<double> N(0.0, 1.0);
+  Eigen::VectorXd e = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(model.n));
+  for (const NoiseStream& s : model.streams) {
+    const std::size_t p = s.ar.size();
+    const double se = s.innovation_sigma_um * 1e-3;
+    // Stationary start: run the recursion for many correlation times before the first row.
+    const std::size_t burn = p == 0 ? 0 : 200 + static_cast<std::size_t>(20.0 * s.correlation_samples);
+    std::vector<double> hist(p, 0.0);  // hist[k]: x_{t-1-k}
+    const std::size_t total = burn + s.rows.size();
+    for (std::size_t t = 0; t < total; ++t) {
+      double x = se * N(rng);
+      for (std::size_t k = 0; k < p; ++k) x += s.ar[k] * hist[k];
+      if (p > 0) {
+        std::rotate(hist.rbegin(), hist.rbegin() + 1, hist.rend());
+        hist[0] = x;
+      }
+      if (t >= burn) e[s.rows[t - burn]] = x;
+    }
+  }
+  return e;
+}
+
 double long_run_variance(const NoiseModel& model) {
   double v = 0.0;
   for (const NoiseStream& s : model.streams) {
@@ -43,28 +66,10 @@ double noise_model_bias_factor(const NoiseModel& model, const std::vector<std::s
   const Eigen::Index rank = qr.rank();
   const Eigen::MatrixXd Q = Eigen::MatrixXd(qr.householderQ()).leftCols(rank);
   std::mt19937_64 rng(seed);
-  std::normal_distribution<double> N(0.0, 1.0);
   Eigen::VectorXd e(n);
   double sum = 0.0;
   for (int d = 0; d < draws; ++d) {
-    e.setZero();
-    for (const NoiseStream& s : model.streams) {
-      const std::size_t p = s.ar.size();
-      const double se = s.innovation_sigma_um * 1e-3;
-      // Stationary start: run the recursion for many correlation times before the first row.
-      const std::size_t burn = 200 + static_cast<std::size_t>(20.0 * s.correlation_samples);
-      std::vector<double> hist(p, 0.0);  // hist[k]: x_{t-1-k}
-      const std::size_t total = burn + s.rows.size();
-      for (std::size_t t = 0; t < total; ++t) {
-        double x = se * N(rng);
-        for (std::size_t k = 0; k < p; ++k) x += s.ar[k] * hist[k];
-        if (p > 0) {
-          std::rotate(hist.rbegin(), hist.rbegin() + 1, hist.rend());
-          hist[0] = x;
-        }
-        if (t >= burn) e[s.rows[t - burn]] = x;
-      }
-    }
+    e = draw_noise(model, rng);
     const Eigen::VectorXd r = e - Q * (Q.transpose() * e);
     sum += long_run_variance(estimate_noise_model(groups, times, r, options));
   }

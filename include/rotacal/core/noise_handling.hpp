@@ -20,6 +20,7 @@ NoiseHandling noise_handling_from_string(const std::string& noise);
 
 #include <cmath>
 #include <cstdint>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,11 @@ double noise_model_bias_factor(const NoiseModel& model, const std::vector<std::s
                                const std::vector<double>& times, const Eigen::MatrixXd& jacobian_free,
                                const NoiseModelOptions& options, int draws = 32,
                                std::uint64_t seed = 1);
+
+/// One draw of the noise `model` describes (mm, one value per reading, its rows): per stream
+/// the AR recursion with Gaussian innovations of s_e, started stationary (burn-in of many
+/// correlation times). For Monte Carlo checks and the bias factor.
+Eigen::VectorXd draw_noise(const NoiseModel& model, std::mt19937_64& rng);
 
 /// Sum over streams of n_s s_e^2 / (1 - sum phi)^2 (mm^2 per reading x readings).
 double long_run_variance(const NoiseModel& model);
