@@ -5,7 +5,7 @@
 // Targets (issue 11): false findings <= 5 %; white null 0; named first >= 90 % at three times
 // the white-noise half-detection amplitude; time with the noise model <= 1.3x white.
 //
-// Usage: diagnose_realistic_bench [--null N] [--trials N] [--smoke]
+// Usage: diagnose_realistic_bench [--null N] [--trials N] [--rho R (0 white, -1 1/f-like)] [--smoke]
 #include <Eigen/SVD>
 #include <algorithm>
 #include <chrono>
@@ -84,12 +84,14 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 
 int main(int argc, char** argv) {
   int n_null = 200, trials = 5;
+  std::vector<double> rhos = {0.0, 0.5, 0.9, 0.95, -1.0};  // 0: white, -1: 1/f-like
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--null") && i + 1 < argc) n_null = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--trials") && i + 1 < argc) trials = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--smoke")) n_null = 3, trials = 1;
+    else if (!std::strcmp(argv[i], "--rho") && i + 1 < argc) rhos = {std::atof(argv[++i])};
     else {
-      std::fprintf(stderr, "usage: diagnose_realistic_bench [--null N] [--trials N] [--smoke]\n");
+      std::fprintf(stderr, "usage: diagnose_realistic_bench [--null N] [--trials N] [--rho R] [--smoke]\n");
       return 2;
     }
   }
@@ -100,7 +102,7 @@ int main(int argc, char** argv) {
               "unexplained", "median ms", "ms white");
   DiagnosisOptions white;
   white.model_noise = false;
-  for (double rho : {0.0, 0.5, 0.9, 0.95, -1.0}) {
+  for (double rho : rhos) {
     std::mt19937 rng(2024);
     int fm = 0, fw = 0, un = 0;
     std::vector<double> ms, ms_white;

@@ -162,6 +162,16 @@ NoiseModel estimate_noise_model(const std::vector<std::string>& groups,
     if (!std::isfinite(residuals_mm[i]))
       throw InvalidArgument("estimate_noise_model: residuals[" + std::to_string(i) +
                             "] is not finite");
+  if (options.pooled && options.pool_only_if_all_coloured) {
+    NoiseModelOptions own = options;
+    own.pooled = false;
+    NoiseModel each = estimate_noise_model(groups, times, residuals_mm, own);
+    for (const NoiseStream& st : each.streams)
+      if (st.order() == 0) return each;
+    own.pooled = true;
+    own.pool_only_if_all_coloured = false;
+    return estimate_noise_model(groups, times, residuals_mm, own);
+  }
   std::vector<std::string> sg;
   std::vector<int> sc;
   const auto streams = noise_streams(groups, times, &sg, &sc);
@@ -217,7 +227,12 @@ NoiseModel estimate_noise_model(const std::vector<std::string>& groups,
     std::vector<double> k, v;
     int best = 0;
     if (options.pooled) {
-      k = pooled_k, v = pooled_v, best = pooled_order;
+      // Shared coefficients, the stream's own variance: v_m = v_0 prod (1 - k_j^2).
+      k = pooled_k, best = pooled_order;
+      double v0 = 0.0;
+      for (double xi : xs[s]) v0 += xi * xi;
+      v.assign(1, n ? v0 / static_cast<double>(n) : 0.0);
+      for (double kj : k) v.push_back(v.back() * (1.0 - kj * kj));
     } else {
       const int P = static_cast<int>(n) >= options.min_stream_size
                         ? std::min(options.max_order, static_cast<int>(n / 4))

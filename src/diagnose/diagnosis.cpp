@@ -331,6 +331,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
           g.push_back(P.groups()[i]), t.push_back(P.times()[i]), r.push_back(fit.residuals[static_cast<Eigen::Index>(i)]);
       NoiseModelOptions pooled = options.noise;
       pooled.pooled = true;
+      pooled.pool_only_if_all_coloured = false;
       NoiseTreatment t_noise = white;
       if (!g.empty()) {
         const NoiseModel others = estimate_noise_model(g, t, Eigen::Map<const Eigen::VectorXd>(r.data(), static_cast<Eigen::Index>(r.size())), pooled);

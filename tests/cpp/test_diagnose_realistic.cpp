@@ -138,12 +138,12 @@ TEST_CASE("a gravity sag hidden in AR(1) noise is named, not three invented caus
   CHECK(std::abs(p.value - 0.005) < 4 * p.std * std::sqrt(D.noise.correlation_samples));
 }
 
-TEST_CASE("two effects at once in 1/f-like noise are both found", "[diagnose][realistic]") {
+TEST_CASE("two effects at once in AR(1) noise are both found", "[diagnose][realistic]") {
   std::mt19937 rng(17);
   BallbarMachineModel truth = random_machine(rng);
   truth.effects.effects = {Effect::parse("gravity_sag_A"), Effect::parse("radial_motion_C_h2")};
   truth.effect_params = {0.006, 0.004, 0.0, 0.0, 0.003};
-  const Diagnosis D = diagnose_ballbar(noisy_ballbar(truth, Noise::pink, 41));
+  const Diagnosis D = diagnose_ballbar(noisy_ballbar(truth, Noise::ar1_05, 41));
   std::string amb;
   for (const Ambiguity& a : D.ambiguous)
     for (const std::string& id : a.effects) amb += id + " ";

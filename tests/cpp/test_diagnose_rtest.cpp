@@ -1,6 +1,7 @@
 #include <catch2/catch.hpp>
 
 #include <Eigen/SVD>
+#include <algorithm>
 #include <random>
 
 #include "rotacal/core/least_squares.hpp"
@@ -119,6 +120,12 @@ TEST_CASE("every catalogue effect an R-test can see, hidden at 5 sigma, is found
       for (const std::string& id : a.effects) also += id + " ";
     INFO(effect.id() << ": first finding " << (D.findings.empty() ? "none" : D.findings[0].effect.id())
                      << "; ambiguous with: " << also);
+    // A cause whose refit determines none of its parameters is never named (issue 11): then
+    // it must be reported as such, and nothing else named in its place.
+    const bool undetermined = std::any_of(D.unobservable.begin(), D.unobservable.end(), [&](const UnobservableEffect& u) {
+      return u.effect == effect.id() && u.reason.find("none of its parameters can be determined") != std::string::npos;
+    });
+    if (undetermined && D.findings.empty()) continue;
     REQUIRE_FALSE(D.findings.empty());
     bool named = D.findings[0].effect == effect;
     for (const Ambiguity& a : D.ambiguous)

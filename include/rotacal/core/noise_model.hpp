@@ -28,9 +28,15 @@ namespace rotacal {
 struct NoiseModelOptions {
   int max_order = 8;        ///< largest AR order tried (limited further to n/4 per stream)
   int min_stream_size = 8;  ///< shorter streams are taken as white (too short for an AR fit)
-  /// One AR model shared by all streams (Burg's sums taken over every stream): the same
-  /// sensor at the same rate in every test. Each stream keeps its own rows and sample interval.
+  /// AR coefficients shared by all streams (Burg's sums taken over every stream: the same
+  /// sensor at the same rate in every test), each stream keeping its own variance, rows and
+  /// sample interval. Per-stream Burg estimates of a few hundred readings are biased towards
+  /// less correlation (by about (1 + 3 rho)/n), which makes tests against them too lenient.
   bool pooled = false;
+  /// With `pooled`: pool only if every stream is correlated on its own; if some are white, the
+  /// correlation is structure in some groups (an effect), not the sensor's, and each stream
+  /// keeps its own model.
+  bool pool_only_if_all_coloured = false;
 };
 
 /// The AR model of one stream.

@@ -98,7 +98,12 @@ struct DiagnosisOptions {
   /// Jacobians (F, BIC, visibility), cross-validate with blocks at least one correlation time
   /// long and test for unexplained structure against it. False: treat the noise as white.
   bool model_noise = true;
-  NoiseModelOptions noise;
+  NoiseModelOptions noise = [] {
+    NoiseModelOptions o;
+    o.pooled = true;  // one set of AR coefficients per session: see NoiseModelOptions::pooled
+    o.pool_only_if_all_coloured = true;
+    return o;
+  }();
 };
 
 /// Which harmonic orders of one rotary angle a set of readings resolves.
