@@ -79,15 +79,16 @@ Eigen::VectorXd coloured(const Noise& nz, const std::vector<std::string>& g, con
 
 int main(int argc, char** argv) {
   int draws = 200;
-  bool rtest = true, ballbar = true, pooled = false;
+  bool rtest = true, ballbar = true, pooled = false, bias = true;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--smoke")) draws = 8;
     else if (!std::strcmp(argv[i], "--draws") && i + 1 < argc) draws = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--no-rtest")) rtest = false;
     else if (!std::strcmp(argv[i], "--no-ballbar")) ballbar = false;
     else if (!std::strcmp(argv[i], "--pooled")) pooled = true;  // one AR model for all streams
+    else if (!std::strcmp(argv[i], "--no-bias-factor")) bias = false;
     else {
-      std::fprintf(stderr, "usage: noise_mc_bench [--draws N] [--smoke] [--no-rtest] [--no-ballbar] [--pooled]\n");
+      std::fprintf(stderr, "usage: noise_mc_bench [--draws N] [--smoke] [--no-rtest] [--no-ballbar] [--pooled] [--no-bias-factor]\n");
       return 2;
     }
   }
@@ -110,6 +111,7 @@ int main(int argc, char** argv) {
   white.noise = NoiseHandling::white;
   JointFitOptions automatic;
   automatic.noise_options.pooled = pooled;
+  automatic.noise_bias_correction = bias;
   for (const Noise& nz : kinds) {
     if (!ballbar) break;
     const auto t0 = clock::now();
@@ -140,6 +142,7 @@ int main(int argc, char** argv) {
       for (int c = 0; c < 3; ++c) rg.push_back("nest " + x.setup), rtm.push_back(x.time);
     RtestJointOptions rauto;
     rauto.noise_options.pooled = pooled;
+    rauto.noise_bias_correction = bias;
     RtestJointOptions rwhite;
     rwhite.noise = NoiseHandling::white;
     for (const Noise& nz : kinds) {

@@ -65,7 +65,7 @@ BallbarIdentification identify_joint(const BallbarArrays& data, const JointFitOp
     noise = estimate_noise_model(data.test, t, fit.residuals, options.noise_options);
     if (options.noise == NoiseHandling::automatic && !noise.white() &&
         noise.correlation_samples >= options.min_correlation_samples) {
-      scale = noise_correction(noise, data.test, t, fit, options.noise_options);
+      if (options.noise_bias_correction) scale = noise_correction(noise, data.test, t, fit, options.noise_options);
       setup.settings.whitener = std::make_shared<ArWhitener>(noise);
       fit = solve_joint(model, setup.parameters, setup.settings);
       apply_noise_correction(scale, &fit);

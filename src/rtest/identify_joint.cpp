@@ -328,7 +328,7 @@ RtestJointIdentification identify_joint(const RtestSession& session,
     noise = estimate_noise_model(groups, times, fit.residuals, options.noise_options);
     if (options.noise == NoiseHandling::automatic && !noise.white() &&
         noise.correlation_samples >= options.min_correlation_samples) {
-      scale = noise_correction(noise, groups, times, fit, options.noise_options);
+      if (options.noise_bias_correction) scale = noise_correction(noise, groups, times, fit, options.noise_options);
       settings.whitener = std::make_shared<ArWhitener>(noise);
       fit = solve_joint(model, params, settings);
       apply_noise_correction(scale, &fit);

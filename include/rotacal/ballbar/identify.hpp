@@ -67,7 +67,9 @@ struct JointFitOptions {
   /// The GLS refit is done only when some stream's integrated correlation time reaches this
   /// (samples): below it the white covariance is within ~10 % and BIC's rare spurious AR(1) of
   /// white noise (|phi| ~ 0.05) must not change the answer.
-  double min_correlation_samples = 1.2;  ///< AR order search of the noise model
+  double min_correlation_samples = 1.2;
+  /// Scale the GLS covariance by the bootstrap bias factor (core/noise_handling.hpp).
+  bool noise_bias_correction = true;  ///< AR order search of the noise model
 };
 
 /// The samples a fit uses as contiguous arrays (structure of arrays): built once per session

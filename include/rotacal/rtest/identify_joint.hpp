@@ -127,6 +127,8 @@ struct RtestJointOptions {
   /// (samples): below it the white covariance is within ~10 % and BIC's rare spurious AR(1) of
   /// white noise (|phi| ~ 0.05) must not change the answer.
   double min_correlation_samples = 1.2;
+  /// Scale the GLS covariance by the bootstrap bias factor (core/noise_handling.hpp).
+  bool noise_bias_correction = true;
 };
 
 struct RtestJointIdentification {
