@@ -343,7 +343,9 @@ def cmd_identify(a: argparse.Namespace) -> int:
     d = result.to_dict()
     if a.monte_carlo:
         from .ballbar import monte_carlo
-        d["monte_carlo"] = monte_carlo(by_kind(s, {BALLBAR: s}, "--monte-carlo"), result, a.monte_carlo, seed=a.seed)
+        d["monte_carlo"] = by_kind(s, {BALLBAR: lambda: monte_carlo(s, result, a.monte_carlo, seed=a.seed),
+                                       RTEST: lambda: _rtest.monte_carlo_rtest(s, result, a.monte_carlo, seed=a.seed)},
+                                   "--monte-carlo")()
     if a.save_model:
         from .models import save_model
         # The C++ model writer is strict: a non-finite number is written null with its reason.
@@ -616,7 +618,7 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--save-model", metavar="MODEL.json", type=path("--save-model"),
                    help="write the fitted model (ballbar, or R-test joint: location errors, maps, covariance)")
     q.add_argument("--monte-carlo", type=number("--monte-carlo", 0, 10_000, integer=True), default=0, metavar="N",
-                   help="check the 1-sigma by N simulated repeats of the session (ballbar; progress bar)")
+                   help="check the 1-sigma by N simulated repeats of the session with its fitted noise model (progress bar)")
     q.add_argument("--seed", type=SEED, default=1, help="seed of the Monte Carlo draws")
     q.add_argument("--noise", default="auto", choices=["auto", "white"],
                    help="auto (default): AR noise model of the residuals, GLS refit when correlated; "

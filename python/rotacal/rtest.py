@@ -119,6 +119,28 @@ def identify_rtest(session: _core.RtestSession, method: str = "joint",
     raise _core.InvalidArgument(f"identify_rtest: method must be 'joint' or 'paper', got {method!r}")
 
 
+def monte_carlo_rtest(session: _core.RtestSession, result: RtestIdentification, draws: int = 100, *,
+                      seed: int = 1, basis: Any | None = None, progress: bool = True) -> dict:
+    """Check an R-test joint fit's 1-sigma by Monte Carlo: the identified model's readings plus
+    noise drawn from the noise model fitted to the session (AR per nest and channel: probe
+    zeros that wander between poses are re-simulated) when the fit used it, else white; each
+    draw refitted the same way. Same dict as rotacal.ballbar.monte_carlo."""
+    from .progress import ProgressBar
+    if result.raw.method != "joint":
+        raise _core.InvalidArgument("monte_carlo: only an R-test joint fit is supported")
+    s, _ = with_displacements(session)
+    bar = ProgressBar("Monte Carlo", draws, " draws") if progress else None
+    mc = _core.monte_carlo_rtest(s, result.raw, draws, seed, basis if basis is not None else _core.RtestBasis(),
+                                 progress=(lambda done, total: bar.update(done)) if bar else None)
+    if bar:
+        bar.close()
+    out = {p.name: {"std_reported": float(p.std_reported), "std_mc": float(p.std_mc), "ratio": float(p.ratio),
+                    "bias": float(p.bias), "unit": p.unit}
+           for p in mc.parameters if p.name.startswith("E_")}
+    return {"draws": draws, "noise_um": float(result.raw.sigma_um), "noise": mc.noise, "method": "joint",
+            "parameters": out}
+
+
 # ------------------------------------------------------------------------- prediction
 
 def predict_rtest(model: Mapping, session: _core.RtestSession, probe_zeros: str = "none",
