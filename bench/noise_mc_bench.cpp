@@ -110,6 +110,7 @@ int main(int argc, char** argv) {
   JointFitOptions white;
   white.noise = NoiseHandling::white;
   JointFitOptions automatic;
+  automatic.noise = NoiseHandling::automatic;
   automatic.noise_options.pooled = pooled;
   automatic.noise_bias_correction = bias;
   for (const Noise& nz : kinds) {
@@ -141,6 +142,7 @@ int main(int argc, char** argv) {
     for (const RtestSample& x : rclean.samples)
       for (int c = 0; c < 3; ++c) rg.push_back("nest " + x.setup), rtm.push_back(x.time);
     RtestJointOptions rauto;
+    rauto.noise = NoiseHandling::automatic;
     rauto.noise_options.pooled = pooled;
     rauto.noise_bias_correction = bias;
     RtestJointOptions rwhite;
@@ -176,7 +178,7 @@ int main(int argc, char** argv) {
     const Eigen::VectorXd e = noise_gen::ar1(g, t, 0.95, 0.5e-3, 77 + static_cast<std::uint64_t>(k));
     for (std::size_t i = 0; i < s.samples.size(); ++i) s.samples[i].length += e[static_cast<Eigen::Index>(i)];
     s.noise_um = 0.5;
-    const BallbarIdentification a = identify_joint(s), w = identify_joint(s, white);
+    const BallbarIdentification a = identify_joint(s, automatic), w = identify_joint(s, white);
     for (int j = 0; j < 8; ++j) {
       const std::string& nm = location_error_names(MachineType::AC_trt)[static_cast<std::size_t>(j)];
       const double dz_a = (a.parameter(nm).value - m.errors.v[j]) / a.parameter(nm).std;

@@ -67,10 +67,11 @@ TEST_CASE("ballbar joint fit on AR(0.95) noise: white sigmas ~6x too small, GLS 
   for (int k = 0; k < 6; ++k) {
     const BallbarMachineModel truth = random_machine(rng);
     const BallbarSession s = ar_ballbar(truth, 0.95, 100 + k);
-    JointFitOptions white;
+    JointFitOptions white, automatic;
     white.noise = NoiseHandling::white;
+    automatic.noise = NoiseHandling::automatic;
     const BallbarIdentification w = identify_joint(s, white);
-    const BallbarIdentification a = identify_joint(s);
+    const BallbarIdentification a = identify_joint(s, automatic);
     // The white fit still estimates (and reports) the noise model, but does not use it.
     CHECK_FALSE(w.noise_refit);
     CHECK(w.noise.max_order >= 1);
@@ -97,9 +98,10 @@ TEST_CASE("ballbar joint fit on white noise: the noise model is white and the fi
   std::mt19937 rng(3);
   const BallbarMachineModel truth = random_machine(rng);
   const BallbarSession s = simulate_ballbar(commanded(), truth, {0.5, 7, false});
-  JointFitOptions white;
+  JointFitOptions white, automatic;
   white.noise = NoiseHandling::white;
-  const BallbarIdentification a = identify_joint(s), w = identify_joint(s, white);
+  automatic.noise = NoiseHandling::automatic;
+  const BallbarIdentification a = identify_joint(s, automatic), w = identify_joint(s, white);
   CHECK(a.noise.white());
   CHECK_FALSE(a.noise_refit);
   for (std::size_t j = 0; j < a.parameters.size(); ++j) {
@@ -131,10 +133,11 @@ TEST_CASE("R-test joint fit with AR(0.95) noise and probe zeros wandering betwee
     for (std::size_t r = 0; r < s.samples.size(); ++r)
       for (int a = 0; a < 3; ++a) (*s.samples[r].d)[a] += e[3 * static_cast<Eigen::Index>(r) + a];
     s.noise_um = 0.3;
-    RtestJointOptions white;
+    RtestJointOptions white, automatic;
     white.noise = NoiseHandling::white;
+    automatic.noise = NoiseHandling::automatic;
     const RtestJointIdentification w = identify_joint(s, white);
-    const RtestJointIdentification a = identify_joint(s);
+    const RtestJointIdentification a = identify_joint(s, automatic);
     REQUIRE(a.noise_refit);
     CHECK(a.noise.correlation_samples > 3.0);
     accumulate_z(w, truth.errors, MachineType::BC_trt, &s_white, &n_white);
@@ -163,7 +166,9 @@ TEST_CASE("R-test Monte Carlo re-simulates the fitted noise model (wandering pro
   for (std::size_t r = 0; r < s.samples.size(); ++r)
     for (int a = 0; a < 3; ++a) (*s.samples[r].d)[a] += e[3 * static_cast<Eigen::Index>(r) + a];
   s.noise_um = 0.3;
-  const RtestJointIdentification id = identify_joint(s);
+  RtestJointOptions automatic;
+  automatic.noise = NoiseHandling::automatic;
+  const RtestJointIdentification id = identify_joint(s, automatic);
   REQUIRE(id.noise_refit);
   RtestMonteCarloOptions mo;
   mo.draws = 40;

@@ -62,7 +62,9 @@ struct JointFitOptions {
   /// Without a whitener: `automatic` estimates the noise model of the first (white) fit's
   /// residuals and, when some stream is correlated (AR order > 0), refits with its ArWhitener
   /// so that the covariance holds on correlated data; white data are fitted once, as before.
-  NoiseHandling noise = NoiseHandling::automatic;
+  /// C++ default `white` (as before) because the diagnosis refits through identify_joint
+  /// with its own whitener decisions; the Python API and the CLI default to `auto`.
+  NoiseHandling noise = NoiseHandling::white;
   NoiseModelOptions noise_options;
   /// The GLS refit is done only when some stream's integrated correlation time reaches this
   /// (samples): below it the white covariance is within ~10 % and BIC's rare spurious AR(1) of

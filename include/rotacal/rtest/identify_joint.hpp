@@ -121,7 +121,9 @@ struct RtestJointOptions {
   /// Without a whitener: `automatic` estimates the noise model of the first fit's residuals
   /// (one AR stream per nest and channel dx, dy, dz, in time order; probe zeros that wander
   /// between poses show as correlation) and refits by GLS when it is not white.
-  NoiseHandling noise = NoiseHandling::automatic;
+  /// C++ default `white` (as before) because the diagnosis refits through identify_joint
+  /// with its own whitener decisions; the Python API and the CLI default to `auto`.
+  NoiseHandling noise = NoiseHandling::white;
   NoiseModelOptions noise_options;
   /// The GLS refit is done only when some stream's integrated correlation time reaches this
   /// (samples): below it the white covariance is within ~10 % and BIC's rare spurious AR(1) of
