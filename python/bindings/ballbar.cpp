@@ -76,22 +76,28 @@ void bind_ballbar(pyb::module_& m) {
       .def_readonly("iterations", &BallbarIdentification::iterations)
       .def_readonly("unobservable", &BallbarIdentification::unobservable)
       .def_readonly("notes", &BallbarIdentification::notes)
-      .def_readonly("summary", &BallbarIdentification::summary);
+      .def_readonly("summary", &BallbarIdentification::summary)
+      .def_readonly("noise", &BallbarIdentification::noise)
+      .def_readonly("noise_refit", &BallbarIdentification::noise_refit)
+      .def_readonly("noise_correction", &BallbarIdentification::noise_correction);
 
   m.def(
       "identify_joint",
       [](const BallbarSession& session, bool fit_length_offset,
-         const std::vector<std::string>& effects, const std::vector<std::string>& tests) {
+         const std::vector<std::string>& effects, const std::vector<std::string>& tests,
+         const std::string& noise) {
         JointFitOptions o;
         o.fit_length_offset = fit_length_offset;
         o.effects = effects_of(effects);
         o.tests = tests;
+        o.noise = noise_handling_from_string(noise);
         pyb::gil_scoped_release release;
         return identify_joint(session, o);
       },
       pyb::arg("session"), pyb::arg("fit_length_offset") = false,
       pyb::arg("effects") = std::vector<std::string>{}, pyb::arg("tests") = std::vector<std::string>{},
-      "Joint fit of the 8 location errors and the actual pivot to every sample (core/joint_fit.hpp).");
+      pyb::arg("noise") = "auto",
+      "Joint fit (noise 'auto': AR noise model of the residuals, GLS refit when correlated; 'white') of the 8 location errors and the actual pivot to every sample (core/joint_fit.hpp).");
 
   pyb::class_<MonteCarloParameter>(m, "MonteCarloParameter")
       .def_readonly("name", &MonteCarloParameter::name)
@@ -103,6 +109,7 @@ void bind_ballbar(pyb::module_& m) {
   pyb::class_<BallbarMonteCarlo>(m, "BallbarMonteCarlo")
       .def_readonly("draws", &BallbarMonteCarlo::draws)
       .def_readonly("noise_um", &BallbarMonteCarlo::noise_um)
+      .def_readonly("noise", &BallbarMonteCarlo::noise)
       .def_readonly("parameters", &BallbarMonteCarlo::parameters)
       .def_readonly("values", &BallbarMonteCarlo::values)
       .def_readonly("fresh_fits", &BallbarMonteCarlo::fresh_fits);

@@ -3,6 +3,7 @@
 #include "numpy.hpp"
 #include "rotacal/rtest/device.hpp"
 #include "rotacal/rtest/error_map.hpp"
+#include "rotacal/rtest/monte_carlo.hpp"
 #include "rotacal/rtest/predict.hpp"
 #include "rotacal/rtest/simulate.hpp"
 
@@ -129,7 +130,10 @@ void bind_rtest(pyb::module_& m) {
       .def_readonly("iterations", &RtestJointIdentification::iterations)
       .def_readonly("unobservable", &RtestJointIdentification::unobservable)
       .def_readonly("notes", &RtestJointIdentification::notes)
-      .def_readonly("summary", &RtestJointIdentification::summary);
+      .def_readonly("summary", &RtestJointIdentification::summary)
+      .def_readonly("noise", &RtestJointIdentification::noise)
+      .def_readonly("noise_refit", &RtestJointIdentification::noise_refit)
+      .def_readonly("noise_correction", &RtestJointIdentification::noise_correction);
 
   pyb::class_<RtestPaperIdentification>(m, "RtestPaperIdentification")
       .def_readonly("method", &RtestPaperIdentification::method)
@@ -142,15 +146,42 @@ void bind_rtest(pyb::module_& m) {
 
   m.def(
       "identify_rtest_joint",
-      [](const RtestSession& session, const RtestBasis& basis) {
-        pyb::gil_scoped_release release;
+      [](const RtestSession& session, const RtestBasis& basis, const std::string& noise) {
         RtestJointOptions o;
         o.basis = basis;
+        o.noise = noise_handling_from_string(noise);
+        pyb::gil_scoped_release release;
         return identify_joint(session, o);
       },
-      pyb::arg("session"), pyb::arg("basis") = RtestBasis{},
+      pyb::arg("session"), pyb::arg("basis") = RtestBasis{}, pyb::arg("noise") = "auto",
       "Joint fit of an R-test session: location errors, smooth B and C maps, a probe zero "
-      "per set-up, with observability (rtest/identify_joint.hpp).");
+      "per set-up, with observability (rtest/identify_joint.hpp); noise 'auto' (AR noise model, "
+      "GLS refit when correlated) or 'white'.");
+  pyb::class_<RtestMonteCarlo>(m, "RtestMonteCarlo")
+      .def_readonly("draws", &RtestMonteCarlo::draws)
+      .def_readonly("noise", &RtestMonteCarlo::noise)
+      .def_readonly("parameters", &RtestMonteCarlo::parameters)
+      .def_readonly("values", &RtestMonteCarlo::values);
+  m.def(
+      "monte_carlo_rtest",
+      [](const RtestSession& session, const RtestJointIdentification& result, int draws,
+         std::uint64_t seed, const RtestBasis& basis, const pyb::object& progress) {
+        RtestMonteCarloOptions o;
+        o.draws = draws;
+        o.seed = seed;
+        o.fit.basis = basis;
+        if (!progress.is_none())
+          o.progress = [&progress](int done, int total) {
+            pyb::gil_scoped_acquire acquire;
+            progress(done, total);
+          };
+        pyb::gil_scoped_release release;
+        return monte_carlo(session, result, o);
+      },
+      pyb::arg("session"), pyb::arg("result"), pyb::arg("draws") = 100, pyb::arg("seed") = 1,
+      pyb::arg("basis") = RtestBasis{}, pyb::arg("progress") = pyb::none(),
+      "Monte Carlo check of an R-test joint fit's 1-sigma with the noise model fitted to the "
+      "session (AR per nest and channel) when the fit used it, else white (rtest/monte_carlo.hpp).");
   m.def(
       "identify_rtest_paper",
       [](const RtestSession& session) {

@@ -6,7 +6,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Ambiguity', 'AngleTable', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CompensationReport', 'CompensationRow', 'DegenerateGeometry', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestJointIdentification', 'RtestJointModel', 'RtestPaperIdentification', 'RtestSession', 'SegmentKind', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'ballbar_model_document', 'ballbar_model_from_document', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_model_machine', 'check_output', 'check_plausible', 'compensate_commands', 'compensate_sphere_offset', 'default_ballbar_tests', 'default_calibration_moves', 'diagnose_ballbar', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
+__all__: list[str] = ['Ambiguity', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CompensationReport', 'CompensationRow', 'DegenerateGeometry', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestSession', 'SegmentKind', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'ballbar_model_document', 'ballbar_model_from_document', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_model_machine', 'check_output', 'check_plausible', 'compensate_commands', 'compensate_sphere_offset', 'default_ballbar_tests', 'default_calibration_moves', 'diagnose_ballbar', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_rtest', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
 class Ambiguity:
     @property
     def correlation(self) -> float:
@@ -19,28 +19,6 @@ class Ambiguity:
         ...
     @property
     def separating_test(self) -> str:
-        ...
-class AngleTable:
-    @property
-    def angle_deg(self) -> list[float]:
-        ...
-    @property
-    def axis(self) -> str:
-        ...
-    @property
-    def count(self) -> list[int]:
-        ...
-    @property
-    def gain(self) -> Gain:
-        ...
-    @property
-    def group(self) -> str:
-        ...
-    @property
-    def std_um(self) -> list[float]:
-        ...
-    @property
-    def value_um(self) -> list[float]:
         ...
 class BallbarIdentification:
     @property
@@ -60,6 +38,15 @@ class BallbarIdentification:
         ...
     @property
     def n_samples(self) -> int:
+        ...
+    @property
+    def noise(self) -> ...:
+        ...
+    @property
+    def noise_correction(self) -> float:
+        ...
+    @property
+    def noise_refit(self) -> bool:
         ...
     @property
     def notes(self) -> list[str]:
@@ -109,6 +96,9 @@ class BallbarMonteCarlo:
         ...
     @property
     def fresh_fits(self) -> int:
+        ...
+    @property
+    def noise(self) -> str:
         ...
     @property
     def noise_um(self) -> float:
@@ -450,9 +440,6 @@ class Diagnosis:
     def ambiguous(self) -> list[Ambiguity]:
         ...
     @property
-    def angle_tables(self) -> list[AngleTable]:
-        ...
-    @property
     def baseline(self) -> DiagnosisBaseline:
         ...
     @property
@@ -466,12 +453,6 @@ class Diagnosis:
         ...
     @property
     def machine(self) -> MachineType:
-        ...
-    @property
-    def noise(self) -> NoiseModel:
-        ...
-    @property
-    def noise_whitened(self) -> bool:
         ...
     @property
     def rounds(self) -> list[list[CandidateScore]]:
@@ -514,7 +495,6 @@ class DiagnosisBaseline:
     def residual_rms_um(self) -> float:
         ...
 class DiagnosisOptions:
-    model_noise: bool
     def __init__(self) -> None:
         ...
     @property
@@ -1328,9 +1308,6 @@ class RecordSummary:
     def malformed(self) -> int:
         ...
     @property
-    def outside_window(self) -> int:
-        ...
-    @property
     def over_range(self) -> int:
         ...
     @property
@@ -1390,6 +1367,15 @@ class RtestJointIdentification:
         ...
     @property
     def n_samples(self) -> int:
+        ...
+    @property
+    def noise(self) -> NoiseModel:
+        ...
+    @property
+    def noise_correction(self) -> float:
+        ...
+    @property
+    def noise_refit(self) -> bool:
         ...
     @property
     def notes(self) -> list[str]:
@@ -1456,6 +1442,19 @@ class RtestJointModel:
         """
         8 location errors, then the map coefficients (mm, rad)
         """
+class RtestMonteCarlo:
+    @property
+    def draws(self) -> int:
+        ...
+    @property
+    def noise(self) -> str:
+        ...
+    @property
+    def parameters(self) -> list[MonteCarloParameter]:
+        ...
+    @property
+    def values(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        ...
 class RtestPaperIdentification:
     @property
     def b_deg(self) -> list[float]:
@@ -1647,25 +1646,13 @@ class UncertaintyBudget:
         ...
 class Unexplained:
     @property
-    def axis(self) -> str:
-        ...
-    @property
     def chi2_per_dof(self) -> float:
-        ...
-    @property
-    def group(self) -> str:
         ...
     @property
     def p_value(self) -> float:
         ...
     @property
     def present(self) -> bool:
-        ...
-    @property
-    def range_from(self) -> float:
-        ...
-    @property
-    def range_to(self) -> float:
         ...
     @property
     def signature(self) -> str:
@@ -1816,17 +1803,17 @@ def hyper_circle_fit(points: typing.Annotated[numpy.typing.ArrayLike, numpy.floa
     
     Raises rotacal.DegenerateGeometry for < 3, collinear points or a too short arc.
     """
-def identify_joint(session: BallbarSession, fit_length_offset: bool = False, effects: collections.abc.Sequence[str] = [], tests: collections.abc.Sequence[str] = []) -> BallbarIdentification:
+def identify_joint(session: BallbarSession, fit_length_offset: bool = False, effects: collections.abc.Sequence[str] = [], tests: collections.abc.Sequence[str] = [], noise: str = 'auto') -> BallbarIdentification:
     """
-    Joint fit of the 8 location errors and the actual pivot to every sample (core/joint_fit.hpp).
+    Joint fit (noise 'auto': AR noise model of the residuals, GLS refit when correlated; 'white') of the 8 location errors and the actual pivot to every sample (core/joint_fit.hpp).
     """
 def identify_paper(session: BallbarSession) -> BallbarIdentification:
     """
     Flynn et al. 2016's chain: sphere fit, Hyper circle fits, SVD plane fits, transport.
     """
-def identify_rtest_joint(session: RtestSession, basis: RtestBasis = ...) -> RtestJointIdentification:
+def identify_rtest_joint(session: RtestSession, basis: RtestBasis = ..., noise: str = 'auto') -> RtestJointIdentification:
     """
-    Joint fit of an R-test session: location errors, smooth B and C maps, a probe zero per set-up, with observability (rtest/identify_joint.hpp).
+    Joint fit of an R-test session: location errors, smooth B and C maps, a probe zero per set-up, with observability (rtest/identify_joint.hpp); noise 'auto' (AR noise model, GLS refit when correlated) or 'white'.
     """
 def identify_rtest_paper(session: RtestSession) -> RtestPaperIdentification:
     """
@@ -1871,6 +1858,10 @@ def monte_carlo_joint(session: BallbarSession, result: BallbarIdentification, dr
     -------
     BallbarMonteCarlo: per observable parameter std_reported, std_mc, ratio, bias; values
     (draws x parameters).
+    """
+def monte_carlo_rtest(session: RtestSession, result: RtestJointIdentification, draws: typing.SupportsInt | typing.SupportsIndex = 100, seed: typing.SupportsInt | typing.SupportsIndex = 1, basis: RtestBasis = ..., progress: typing.Any = None) -> RtestMonteCarlo:
+    """
+    Monte Carlo check of an R-test joint fit's 1-sigma with the noise model fitted to the session (AR per nest and channel) when the fit used it, else white (rtest/monte_carlo.hpp).
     """
 def noise_ar1(groups: collections.abc.Sequence[str], times: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], rho: typing.SupportsFloat | typing.SupportsIndex, sigma_mm: typing.SupportsFloat | typing.SupportsIndex, seed: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
     ...

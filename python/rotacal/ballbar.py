@@ -13,7 +13,7 @@ from .sessions import BALLBAR, require
 
 def identify(session: _core.BallbarSession, method: str = "joint", *,
              fit_length_offset: bool = False, effects: Sequence[str] = (),
-             tests: Sequence[str] = ()) -> Identification:
+             tests: Sequence[str] = (), noise: str = "auto") -> Identification:
     """Identify the 8 location errors (and the actual pivot) of a ballbar session
     (rotacal.identify takes either kind of session).
 
@@ -25,10 +25,13 @@ def identify(session: _core.BallbarSession, method: str = "joint", *,
     fit_length_offset : also fit an offset of the calibrated bar length (joint only).
     effects : catalogue ids to fit along (joint only), e.g. ["gravity_sag_A"].
     tests : restrict to these test labels (default: all).
+    noise : "auto" (default) estimates the AR noise model of the residuals per test and, when
+        it is correlated, refits by GLS so that the 1-sigma holds; "white" treats the readings
+        as independent. The noise model is in ``to_dict()["noise_model"]``.
     """
     require(session, BALLBAR, "identify")
     if method == "joint":
-        raw = _core.identify_joint(session, fit_length_offset, list(effects), list(tests))
+        raw = _core.identify_joint(session, fit_length_offset, list(effects), list(tests), noise)
     elif method == "paper":
         if fit_length_offset or effects:
             raise _core.InvalidArgument("identify: the paper method fits no length offset or effects")
@@ -41,7 +44,8 @@ def identify(session: _core.BallbarSession, method: str = "joint", *,
 def monte_carlo(session: _core.BallbarSession, result: Identification, draws: int = 100, *,
                 seed: int = 1, progress: bool = True) -> dict:
     """Check the reported uncertainties by Monte Carlo (GUM Supplement 1 style): simulate
-    ``draws`` sessions of the same poses on the identified machine with the fitted noise,
+    ``draws`` sessions of the same poses on the identified machine with the fitted noise (the
+    AR noise model fitted to the session when the joint fit used it, else white noise),
     identify each the same way, and compare the spread with the reported 1-sigma.
 
     Returns {"draws", "noise_um", "method", "parameters": {name: {"std_reported", "std_mc",
@@ -53,15 +57,26 @@ def monte_carlo(session: _core.BallbarSession, result: Identification, draws: in
         raise _core.InvalidArgument(f"monte_carlo: draws must be at least 2, got {draws}")
     raw = result.raw
     method = raw.method
-    effects = list(raw.model.effects)
     fit_offset = any(p.name == "ballbar_length_offset" for p in raw.parameters)
     if fit_offset:
         raise _core.InvalidArgument("monte_carlo: a fit with a length offset is not supported")
     bar = ProgressBar("Monte Carlo", draws, " draws") if progress else None
-    values = []
+    if method == "joint":
+        # The C++ loop (ballbar/monte_carlo.hpp): draws from the noise model fitted to the
+        # session (AR per test) when the fit used it, refitted the same way; white otherwise.
+        mc = _core.monte_carlo_joint(session, raw, draws, seed,
+                                     progress=(lambda done, total: bar.update(done)) if bar else None)
+        if bar:
+            bar.close()
+        out = {p.name: {"std_reported": float(p.std_reported), "std_mc": float(p.std_mc),
+                        "ratio": float(p.ratio), "bias": float(p.bias), "unit": p.unit}
+               for p in mc.parameters}
+        return {"draws": draws, "noise_um": float(mc.noise_um), "noise": mc.noise, "method": method,
+                "parameters": out}
+    values = []  # the paper method: simulate and identify again, in Python
     for k in range(draws):
         sim = _core.simulate_ballbar(session, raw.model, float(raw.sigma_um), seed + k)
-        r = identify(sim, method, effects=effects if method == "joint" else ())
+        r = identify(sim, method)
         values.append([p.value for p in r.raw.parameters])
         if bar:
             bar.update(k + 1)
@@ -76,7 +91,8 @@ def monte_carlo(session: _core.BallbarSession, result: Identification, draws: in
         out[p.name] = {"std_reported": float(p.std), "std_mc": std_mc,
                        "ratio": std_mc / p.std if p.std > 0 else float("inf"),
                        "bias": float(np.mean(v[:, j]) - p.value), "unit": p.unit}
-    return {"draws": draws, "noise_um": float(raw.sigma_um), "method": method, "parameters": out}
+    return {"draws": draws, "noise_um": float(raw.sigma_um), "noise": "white noise", "method": method,
+            "parameters": out}
 
 
 def predict(model: _core.BallbarMachineModel, session: _core.BallbarSession) -> _core.BallbarSession:

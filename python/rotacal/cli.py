@@ -273,23 +273,58 @@ def _add_plausibility_arg(q: argparse.ArgumentParser) -> None:
                    f"refused as implausible (default {_core.PlausibilityOptions().max_length_deviation_mm:g} mm)")
 
 
+def _fmt_value(v, unit: str) -> str:
+    return f"{v * 1e6:+9.3f} urad" if unit == "rad" else f"{v * 1e3:+9.3f} um  "
+
+
+def _print_noise_model(nm: dict) -> None:
+    how = ""
+    if "gls_refit" in nm:
+        how = (f"; 1-sigma by GLS under it (covariance x {nm['covariance_factor']:.2f} for the correlation "
+               "the fit absorbs)" if nm["gls_refit"] else "; readings taken as independent")
+    print(f"noise model: {nm['summary']}{how}")
+
+
+def _print_budget(b: dict) -> None:
+    print(f"uncertainty budget (GUM; coverage {b['coverage'] * 100:.0f} %; um / urad):")
+    print(f"  {'':6s} {'value':>10s} {'type A':>8s} {'u_c':>8s} {'U':>8s} {'k':>5s} {'nu_eff':>7s}  dominant left-out effect")
+    for name, e in b["location_errors"].items():
+        if not e["observable"]:
+            print(f"  {name:6s} unobservable")
+            continue
+        f = 1e6 if e["unit"] == "rad" else 1e3
+        nu = "inf" if e["nu_eff"] is None else f"{e['nu_eff']:.0f}"
+        dom = e["dominant"][0] if e["dominant"] else (e["type_b"][0]["effect"] if e["type_b"] else "-")
+        line = e["type_b"][0] if e["type_b"] else None
+        dom_u = ""
+        if line is not None and dom == line["effect"]:
+            dom_u = f" ({line['u'] * f:.3f}, {line['basis']})"
+        print(f"  {name:6s} {e['value'] * f:+10.3f} {e['u_a'] * f:8.3f} {e['u_c'] * f:8.3f} "
+              f"{e['expanded'] * f:8.3f} {e['k']:5.2f} {nu:>7s}  {dom}{dom_u}")
+
+
 def _print_identification(d: dict) -> None:
     print(f"{d['method']} identification, {d['machine']}, {d['n_samples']} samples, "
           f"residual RMS {d['residual_rms_um']:.3f} um")
+    budget = d.get("uncertainty_budget")
     for name, p in d["location_errors"].items():
         if p["value"] is None:
             print(f"  {name:6s}  unobservable")
-        elif p["unit"] == "mm":
-            print(f"  {name:6s} {p['value'] * 1e3:+9.3f} um  +- {p['std'] * 1e3:.3f}")
-        else:
-            print(f"  {name:6s} {p['value'] * 1e6:+9.3f} urad +- {p['std'] * 1e6:.3f}")
-    for axis, p in d["pivot"].items():
+            continue
+        line = f"  {name:6s} {_fmt_value(p['value'], p['unit'])} +- {p['std'] * (1e6 if p['unit'] == 'rad' else 1e3):.3f}"
+        print(line)
+    for axis, p in d.get("pivot", {}).items():
         print(f"  pivot {axis}  " + ("unobservable" if p["value"] is None else f"{p['value']:.4f} mm +- {p['std'] * 1e3:.3f} um"))
     for u in d["unobservable"]:
         print(f"  not determined by these tests: {u}")
+    if "noise_model" in d:
+        _print_noise_model(d["noise_model"])
+    if budget:
+        _print_budget(budget)
     mc = d.get("monte_carlo")
     if mc:
-        print(f"Monte Carlo check of the 1-sigma, {mc['draws']} draws at {mc['noise_um']:.3f} um noise "
+        noise = mc.get("noise") or f"white noise, {mc['noise_um']:.3f} um"
+        print(f"Monte Carlo check of the 1-sigma, {mc['draws']} draws with {noise} "
               "(ratio = Monte Carlo sigma / reported sigma):")
         for name, m in mc["parameters"].items():
             scale, unit = (1e6, "urad") if m["unit"] == "rad" else (1e3, "um")
@@ -298,14 +333,29 @@ def _print_identification(d: dict) -> None:
 
 
 def cmd_identify(a: argparse.Namespace) -> int:
-    from .analysis import identify
+    from . import ballbar as _ballbar, rtest as _rtest
+    from .diagnosis import plausible_sizes, uncertainty_budget
     check_outputs([a.save_model], [a.file])
+    sizes = plausible_sizes(a.budget_sizes) if a.budget_sizes else None  # refused before any work
     s = _load(a.file, a)
-    result = identify(s, a.method, fit_length_offset=a.length_offset)
+
+    def rtest_identify():
+        if a.length_offset:
+            raise _core.InvalidArgument("identify: --length-offset is for ballbar sessions")
+        return _rtest.identify_rtest(s, a.method, noise=a.noise)
+
+    result = by_kind(s, {BALLBAR: lambda: _ballbar.identify(s, a.method, fit_length_offset=a.length_offset,
+                                                            noise=a.noise),
+                         RTEST: rtest_identify}, "identify")()
+    if a.method == "joint" and not a.no_budget:
+        # The budget rests on the diagnosis of what the model leaves out (diagnose/uncertainty_budget.hpp).
+        result.budget = uncertainty_budget(s, sizes=sizes)
     d = result.to_dict()
     if a.monte_carlo:
         from .ballbar import monte_carlo
-        d["monte_carlo"] = monte_carlo(by_kind(s, {BALLBAR: s}, "--monte-carlo"), result, a.monte_carlo, seed=a.seed)
+        d["monte_carlo"] = by_kind(s, {BALLBAR: lambda: monte_carlo(s, result, a.monte_carlo, seed=a.seed),
+                                       RTEST: lambda: _rtest.monte_carlo_rtest(s, result, a.monte_carlo, seed=a.seed)},
+                                   "--monte-carlo")()
     if a.save_model:
         from .models import save_model
         # The C++ model writer is strict: a non-finite number is written null with its reason.
@@ -589,9 +639,17 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--save-model", metavar="MODEL.json", type=path("--save-model"),
                    help="write the fitted model (ballbar, or R-test joint: location errors, maps, covariance)")
     q.add_argument("--monte-carlo", type=number("--monte-carlo", 0, 10_000, integer=True), default=0, metavar="N",
-                   help="check the 1-sigma by N simulated repeats of the session (ballbar; progress bar)")
+                   help="check the 1-sigma by N simulated repeats of the session with its fitted noise model (progress bar)")
     q.add_argument("--seed", type=SEED, default=1, help="seed of the Monte Carlo draws")
     _add_plausibility_arg(q)
+    q.add_argument("--noise", default="auto", choices=["auto", "white"],
+                   help="auto (default): AR noise model of the residuals, GLS refit when correlated; "
+                        "white: readings taken as independent")
+    q.add_argument("--budget-sizes", metavar="SIZES.json", type=path("--budget-sizes"),
+                   help="plausible sizes of left-out effects for the uncertainty budget (JSON object; "
+                        "docs/json_schema.md)")
+    q.add_argument("--no-budget", action="store_true",
+                   help="skip the uncertainty budget (it runs a diagnosis of the left-out effects)")
     q.set_defaults(func=cmd_identify)
 
     q = sub.add_parser("diagnose", help="find what the model gets wrong and why", epilog=EPILOG)

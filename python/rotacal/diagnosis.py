@@ -44,3 +44,61 @@ def diagnose(session: Any, *, reference: Any = None, **options: Any) -> Diagnosi
     run = by_kind(session, {BALLBAR: lambda: _core.diagnose_ballbar(session, o, reference),
                             RTEST: lambda: _core.diagnose_rtest(session, o)}, "diagnose")
     return DiagnosisResult(run())
+
+
+def plausible_sizes(sizes: Any = None) -> _core.PlausibleSizes:
+    """The budget's default plausible sizes (diagnose/uncertainty_budget.hpp, half-widths of
+    rectangular distributions) with overrides from ``sizes``: a mapping or the path of a JSON
+    file holding one, e.g. {"squareness_rad": 1e-5, "overrides": {"gravity_sag_A": 0.004}}.
+    Keys are PlausibleSizes fields (units in their names), "overrides" maps a catalogue id or
+    "id.parameter" to a size in the parameter's unit, "use_session_bounds" a bool. An unknown
+    key or a non-finite or negative size is refused by name (with the file's name)."""
+    import json
+    import math
+    from pathlib import Path
+    o = _core.PlausibleSizes()
+    if sizes is None:
+        return o
+    where = "sizes"
+    if isinstance(sizes, (str, Path)):
+        where = str(sizes)
+        try:
+            sizes = json.loads(Path(sizes).read_text(encoding="utf-8"))
+        except OSError as e:
+            raise _core.IoError(f"{where}: cannot read: {e.strerror}") from None
+        except json.JSONDecodeError as e:
+            raise _core.InvalidArgument(f"{where}: line {e.lineno}, column {e.colno}: {e.msg}") from None
+    if not isinstance(sizes, dict):
+        raise _core.InvalidArgument(f"{where}: expected a JSON object of plausible sizes")
+    for key, value in sizes.items():
+        if key.startswith("_") or not hasattr(o, key):
+            raise _core.InvalidArgument(f"{where}: unknown plausible size {key!r}")
+        if key == "use_session_bounds":
+            if not isinstance(value, bool):
+                raise _core.InvalidArgument(f"{where}: use_session_bounds must be true or false")
+            o.use_session_bounds = value
+            continue
+        items = value.items() if key == "overrides" and isinstance(value, dict) else [(key, value)]
+        if key == "overrides" and not isinstance(value, dict):
+            raise _core.InvalidArgument(f"{where}: overrides must be an object of sizes")
+        for name, v in items:
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v < 0:
+                raise _core.InvalidArgument(f"{where}: {name}: a size must be a finite number >= 0, got {v!r}")
+        if key == "overrides":
+            o.overrides = {str(k): float(v) for k, v in value.items()}
+        else:
+            setattr(o, key, float(value))
+    return o
+
+
+def uncertainty_budget(session: Any, diagnosis: DiagnosisResult | None = None, *, sizes: Any = None,
+                       coverage: float = 0.95) -> Any:
+    """GUM / ISO/TR 230-9 budget of the location errors (diagnose/uncertainty_budget.hpp):
+    type A from the noise model, type B per catalogue effect the diagnosed model leaves out.
+    Runs ``diagnose(session)`` if no diagnosis is given. ``sizes``: plausible_sizes() input."""
+    if diagnosis is None:
+        diagnosis = diagnose(session)
+    o = plausible_sizes(sizes)
+    return by_kind(session, {BALLBAR: lambda: _core.uncertainty_budget_ballbar(session, diagnosis.raw, o, coverage),
+                             RTEST: lambda: _core.uncertainty_budget_rtest(session, diagnosis.raw, o, coverage)},
+                   "uncertainty_budget")()

@@ -87,6 +87,55 @@ def location_error_table(errors: dict) -> str:
     return "\n".join(rows)
 
 
+def noise_budget_section(ident: dict) -> str:
+    """The noise model the 1-sigma rests on and the uncertainty budget (GUM / ISO/TR 230-9) of
+    each location error, from an identification's to_dict() (docs/json_schema.md)."""
+    out = ['<section id="uncertainty"><h2>Noise model and uncertainty budget</h2>']
+    nm = ident.get("noise_model")
+    if nm:
+        how = ("the fit was redone by GLS under it, covariance x "
+               f"{nm['covariance_factor']:.2f} for the correlation the fit absorbs" if nm.get("gls_refit")
+               else "the readings are taken as independent")
+        out.append(f"<p>Noise model of the residuals: {_e(nm['summary'])}; {_e(how)}.</p>")
+        out.append("<table><tr><th class=l>Stream</th><th>n</th><th>AR order</th><th>&sigma; (&micro;m)</th>"
+                   "<th>correlation (readings)</th><th>correlation time (s)</th><th>effective samples</th></tr>")
+        for st in nm["streams"]:
+            name = st["group"] + (f" ch {st['channel']}" if st["channel"] else "")
+            out.append(f"<tr><td class=l>{_e(name)}</td><td>{st['n']}</td><td>{st['order']}</td>"
+                       f"<td>{st['sigma_um']:.3f}</td><td>{st['correlation_samples']:.1f}</td>"
+                       f"<td>{st['correlation_time_s']:.3g}</td><td>{st['effective_samples']:.0f}</td></tr>")
+        out.append("</table>")
+    b = ident.get("uncertainty_budget")
+    if b:
+        out.append(f"<p>Uncertainty budget, coverage {b['coverage'] * 100:.0f} %: type A from the noise model, "
+                   "type B from each catalogue effect the model leaves out (its bias at the session's bound or a "
+                   "default plausible size, rectangular). Values in &micro;m or &micro;rad.</p>")
+        out.append("<table><tr><th class=l>Error</th><th>Value</th><th>Type A</th><th>u<sub>c</sub></th>"
+                   "<th>U</th><th>k</th><th>&nu;<sub>eff</sub></th><th class=l>Dominant left-out effects</th></tr>")
+        for name, e in b["location_errors"].items():
+            if not e["observable"]:
+                out.append(f"<tr><td class=l>{_e(name)}</td><td colspan=7 class=l>unobservable</td></tr>")
+                continue
+            f = 1e6 if e["unit"] == "rad" else 1e3
+            nu = "&infin;" if e["nu_eff"] is None else f"{e['nu_eff']:.0f}"
+            dom = ", ".join(_e(x) for x in e["dominant"]) or "none"
+            out.append(f"<tr><td class=l>{_e(name)}</td><td>{e['value'] * f:+.3f}</td><td>{e['u_a'] * f:.3f}</td>"
+                       f"<td>{e['u_c'] * f:.3f}</td><td>{e['expanded'] * f:.3f}</td><td>{e['k']:.2f}</td>"
+                       f"<td>{nu}</td><td class=l>{dom}</td></tr>")
+        out.append("</table>")
+    out.append("</section>")
+    return "".join(out) if (nm or b) else ""
+
+
+def _with_budget(identification: Any, session: Any, diagnosis: Any) -> None:
+    """Attach the budget of a given diagnosis to a joint identification that has none."""
+    if diagnosis is None or getattr(identification, "budget", "none") is not None \
+            or identification.raw.method != "joint":
+        return
+    from .diagnosis import uncertainty_budget
+    identification.budget = uncertainty_budget(session, diagnosis)
+
+
 def _swept_angle(angles_deg: np.ndarray) -> tuple[np.ndarray, int]:
     span = angles_deg.max(axis=0) - angles_deg.min(axis=0)
     k = int(np.argmax(span))
@@ -163,6 +212,7 @@ def ballbar_report(path: str | Path, session: Any, identification: Any,
     from . import _core
 
     path = Path(path)
+    _with_budget(identification, session, diagnosis)
     ident = identification.to_dict()
     tests = np.asarray(session.tests, dtype=object)  # object: a long label must not widen every row
     angles = np.asarray(session.angles_deg)
@@ -193,6 +243,7 @@ def ballbar_report(path: str | Path, session: Any, identification: Any,
         parts.append("<p class=warn>Not determined by this session's tests:</p><ul>" +
                      "".join(f"<li>{_e(u)}</li>" for u in ident["unobservable"]) + "</ul>")
     parts.append("</section>")
+    parts.append(noise_budget_section(ident))
 
     parts.append('<section id="polar"><h2>Ballbar plots: measured against model</h2>')
     for src, cap in polar_plots(tests, angles, measured, model, session.ballbar_length, axis_names):
@@ -363,6 +414,7 @@ def rtest_report(path: str | Path, session: Any, identification: Any, diagnosis:
     from . import _core
 
     path = Path(path)
+    _with_budget(identification, session, diagnosis)
     ident = identification.to_dict()
     if ident["method"] != "joint":
         raise _core.InvalidArgument("rtest_report: needs the joint identification (its model draws the map)")
@@ -404,6 +456,7 @@ def rtest_report(path: str | Path, session: Any, identification: Any, diagnosis:
     parts.append("</section>")
 
     map_csv = identification.error_map("csv", b_meas, c_meas)
+    parts.append(noise_budget_section(ident))
     parts.append('<section id="error-map"><h2>Error map (Oyama &amp; Ibaraki Sec. 5.2)</h2>'
                  "<p>Position-dependent errors of the B axis (w_BY, in front of the B rotation) and of "
                  "the C axis (w_CB, in the B-axis frame), beyond the rigid axis lines whose location "

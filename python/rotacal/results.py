@@ -2,6 +2,7 @@
 ``rotacal identify --json`` and ``rotacal diagnose --json`` print."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -14,6 +15,7 @@ class Identification:
     """Location errors (and pivot) identified from a ballbar session."""
 
     raw: Any  # _core.BallbarIdentification
+    budget: Any = None  # _core.UncertaintyBudget, attached by identify(..., budget=True)
 
     @property
     def machine(self):
@@ -53,6 +55,11 @@ class Identification:
         }
         if m["effects"]:
             out["effects"] = m["effects"]
+        if self.raw.method == "joint":
+            out["noise_model"] = noise_model_dict(self.raw.noise, self.raw.noise_refit,
+                                                  self.raw.noise_correction)
+        if self.budget is not None:
+            out["uncertainty_budget"] = budget_dict(self.budget)
         return out
 
 
@@ -61,6 +68,7 @@ class DiagnosisResult:
     """What the baseline model gets wrong, the causes found, and the gain."""
 
     raw: Any  # _core.Diagnosis
+    budget: Any = None  # _core.UncertaintyBudget of the final model, if computed
 
     @property
     def findings(self) -> list:
@@ -69,7 +77,7 @@ class DiagnosisResult:
     def to_dict(self) -> dict:
         d = self.raw
         b = d.baseline
-        return {
+        out = {
             "baseline": {
                 "residual_rms_um": b.residual_rms_um,
                 "noise_um": b.noise_um,
@@ -121,6 +129,84 @@ class DiagnosisResult:
             "final_model": fit_model_dict(d.machine, d.final_fit.parameters, d.final_fit.effects),
             "seconds": d.seconds,
         }
+        if getattr(d, "noise", None) is not None:  # bound by the diagnosis module
+            out["noise_model"] = noise_model_dict(d.noise)
+        if getattr(d, "angle_tables", None) is not None:
+            out["angle_tables"] = [angle_table_dict(t) for t in d.angle_tables]
+        if self.budget is not None:
+            out["uncertainty_budget"] = budget_dict(self.budget)
+        return out
+
+
+def _num(x: float):
+    """A JSON number, or None for infinity (no NaN/inf in the JSON: docs/json_schema.md)."""
+    return float(x) if math.isfinite(x) else None
+
+
+def noise_model_dict(nm, refit: bool | None = None, correction: float | None = None) -> dict:
+    """The noise model (core/noise_model.hpp) as JSON: docs/json_schema.md#noise-model."""
+    out = {
+        "white": bool(nm.white),
+        "summary": nm.summary(),
+        "n": int(nm.n),
+        "sigma_um": float(nm.sigma_um),
+        "innovation_sigma_um": float(nm.innovation_sigma_um),
+        "max_order": int(nm.max_order),
+        "correlation_samples": float(nm.correlation_samples),
+        "correlation_time_s": float(nm.correlation_time_s),
+        "effective_samples": float(nm.effective_samples),
+        "streams": [
+            {"group": st.group, "channel": int(st.channel), "n": int(st.n), "order": len(st.ar),
+             "ar": [float(v) for v in st.ar], "sigma_um": float(st.marginal_sigma_um),
+             "innovation_sigma_um": float(st.innovation_sigma_um),
+             "correlation_samples": float(st.correlation_samples),
+             "sample_interval_s": float(st.sample_interval_s),
+             "correlation_time_s": float(st.correlation_time_s),
+             "effective_samples": float(st.effective_samples)}
+            for st in nm.streams
+        ],
+    }
+    if refit is not None:
+        out["gls_refit"] = bool(refit)
+        out["covariance_factor"] = float(correction)
+    return out
+
+
+def angle_table_dict(t) -> dict:
+    """A per-angle table (structure outside the catalogue): docs/json_schema.md#per-angle-table."""
+    g = t.gain
+    axis = t.axis if isinstance(t.axis, str) else chr(t.axis)
+    return {"group": t.group, "axis": axis,
+            "angle_deg": [float(v) for v in t.angle_deg], "value_um": [float(v) for v in t.value_um],
+            "std_um": [float(v) for v in t.std_um], "count": [int(v) for v in t.count],
+            "gain": {"rms_before_um": g.rms_before_um, "rms_after_um": g.rms_after_um,
+                     "delta_bic": g.delta_bic, "cv_rms_before_um": g.cv_rms_before_um,
+                     "cv_rms_after_um": g.cv_rms_after_um, "f_test_p": g.f_pvalue}}
+
+
+def budget_dict(b) -> dict:
+    """The uncertainty budget (diagnose/uncertainty_budget.hpp): docs/json_schema.md#uncertainty-budget."""
+    return {
+        "coverage": float(b.coverage),
+        "location_errors": {
+            e.name: {
+                "unit": e.unit, "observable": bool(e.observable),
+                "value": float(e.value) if e.observable else None,
+                "u_a": _num(e.u_a) if e.observable else None,
+                "dof_a": _num(e.dof_a) if e.observable else None,
+                "u_c": _num(e.u_c) if e.observable else None,
+                "nu_eff": _num(e.nu_eff) if e.observable else None,
+                "k": _num(e.k) if e.observable else None,
+                "expanded": _num(e.expanded) if e.observable else None,
+                "dominant": list(e.dominant),
+                "type_b": [{"effect": line.effect, "basis": line.basis, "u": float(line.u),
+                            "bias_at_size": float(line.bias_at_size), "dof": _num(line.dof),
+                            "half_width": [float(h) for h in line.half_width]}
+                           for line in e.type_b],
+            }
+            for e in b.errors
+        },
+    }
 
 
 def _group(g) -> dict:

@@ -14,6 +14,7 @@ import numpy as np
 from . import _core
 from .machines import Errors, machine_truth  # noqa: F401  (rotacal.rtest.machine_truth)
 from .models import estimate_dict, rtest_model_dict, rtest_model_from_dict
+from .results import budget_dict, noise_model_dict
 
 # The measurement pattern of Oyama Sec. 3.3, used for the map grid by default.
 B_GRID = list(range(-90, 91, 30))
@@ -38,6 +39,7 @@ class RtestIdentification:
     machine: Any
     nests: dict = field(default_factory=dict)
     notes: list = field(default_factory=list)
+    budget: Any = None  # _core.UncertaintyBudget, attached by the CLI / uncertainty_budget
 
     def error_map(self, fmt: str = "json", b_deg: Sequence[float] = B_GRID,
                   c_deg: Sequence[float] = C_GRID) -> str:
@@ -68,6 +70,10 @@ class RtestIdentification:
             out["location_errors"] = {n: estimate_dict(by_name[n]) for n in names}
             out["probe_zeros"] = {k: np.asarray(v).tolist() for k, v in r.probe_zeros.items()}
             out["converged"] = bool(r.converged)
+            out["sigma_um"] = float(r.sigma_um)
+            out["noise_model"] = noise_model_dict(r.noise, r.noise_refit, r.noise_correction)
+        if self.budget is not None:
+            out["uncertainty_budget"] = budget_dict(self.budget)
         return out
 
 
@@ -95,21 +101,44 @@ def with_displacements(session: _core.RtestSession,
 
 
 def identify_rtest(session: _core.RtestSession, method: str = "joint",
-                   basis: Any | None = None) -> RtestIdentification:
+                   basis: Any | None = None, noise: str = "auto") -> RtestIdentification:
     """Identify an R-test session: method "joint" (Ceres fit with smooth maps, default) or
     "paper" (Oyama & Ibaraki's Eqs. 10-22). A session with raw d1,d2,d3 only is converted
     with its probe.N.dir first (said in the notes). ``basis``: a rotacal._core.RtestBasis for
-    the joint fit (default: B polynomial to b^6, C harmonics 1-2, degree 1 in B)."""
+    the joint fit (default: B polynomial to b^6, C harmonics 1-2, degree 1 in B). ``noise``:
+    "auto" (AR noise model per nest and channel, GLS refit when correlated) or "white"."""
     s, notes = with_displacements(session)
     nests = {k: np.asarray(v) for k, v in session.nests.items()}
     if method == "joint":
-        raw = _core.identify_rtest_joint(s, basis if basis is not None else _core.RtestBasis())
+        raw = _core.identify_rtest_joint(s, basis if basis is not None else _core.RtestBasis(), noise)
         return RtestIdentification(raw, session.machine, nests, notes)
     if basis is not None:
         raise _core.InvalidArgument("identify_rtest: the paper method takes no basis")
     if method == "paper":
         return RtestIdentification(_core.identify_rtest_paper(s), session.machine, nests, notes)
     raise _core.InvalidArgument(f"identify_rtest: method must be 'joint' or 'paper', got {method!r}")
+
+
+def monte_carlo_rtest(session: _core.RtestSession, result: RtestIdentification, draws: int = 100, *,
+                      seed: int = 1, basis: Any | None = None, progress: bool = True) -> dict:
+    """Check an R-test joint fit's 1-sigma by Monte Carlo: the identified model's readings plus
+    noise drawn from the noise model fitted to the session (AR per nest and channel: probe
+    zeros that wander between poses are re-simulated) when the fit used it, else white; each
+    draw refitted the same way. Same dict as rotacal.ballbar.monte_carlo."""
+    from .progress import ProgressBar
+    if result.raw.method != "joint":
+        raise _core.InvalidArgument("monte_carlo: only an R-test joint fit is supported")
+    s, _ = with_displacements(session)
+    bar = ProgressBar("Monte Carlo", draws, " draws") if progress else None
+    mc = _core.monte_carlo_rtest(s, result.raw, draws, seed, basis if basis is not None else _core.RtestBasis(),
+                                 progress=(lambda done, total: bar.update(done)) if bar else None)
+    if bar:
+        bar.close()
+    out = {p.name: {"std_reported": float(p.std_reported), "std_mc": float(p.std_mc), "ratio": float(p.ratio),
+                    "bias": float(p.bias), "unit": p.unit}
+           for p in mc.parameters if p.name.startswith("E_")}
+    return {"draws": draws, "noise_um": float(result.raw.sigma_um), "noise": mc.noise, "method": "joint",
+            "parameters": out}
 
 
 # ------------------------------------------------------------------------- prediction

@@ -2,9 +2,11 @@
 #include "rotacal/ballbar/monte_carlo.hpp"
 
 #include <cmath>
+#include <memory>
 #include <random>
 
 #include "length_model.hpp"
+#include "rotacal/core/noise_handling.hpp"
 #include "rotacal/ballbar/simulate.hpp"
 
 namespace rotacal {
@@ -22,6 +24,11 @@ BallbarMonteCarlo monte_carlo(const BallbarSession& session, const BallbarIdenti
   JointFitOptions fit_options = o.fit;
   fit_options.effects = result.model.effects;  // the identified model's effects, in its order
   fit_options.fit_length_offset = false;       // already among them if it was fitted
+  // A GLS identification is checked the way it was made: each draw refitted under the same
+  // noise model's whitener (its covariance factor is in the reported sigma).
+  const bool coloured = result.noise_refit && !fit_options.whitener && !o.noise;
+  if (result.noise_refit && !fit_options.whitener)
+    fit_options.whitener = std::make_shared<ArWhitener>(result.noise);
   BallbarArrays data = ballbar_arrays(session, fit_options.tests);
   if (static_cast<std::size_t>(data.size()) != result.n_samples ||
       result.residuals.size() != session.samples.size())
@@ -50,6 +57,8 @@ BallbarMonteCarlo monte_carlo(const BallbarSession& session, const BallbarIdenti
   BallbarMonteCarlo out;
   out.draws = o.draws;
   out.noise_um = noise_um;
+  out.noise = o.noise ? "the caller's noise" : coloured ? "the fitted noise model: " + result.noise.summary()
+                                                       : "white noise";
   out.values.resize(o.draws, p);
   Eigen::VectorXd noise(data.size());
   std::vector<double> all(session.samples.size());
@@ -57,6 +66,9 @@ BallbarMonteCarlo monte_carlo(const BallbarSession& session, const BallbarIdenti
     if (o.noise) {
       noise.setZero();
       o.noise(k, noise);
+    } else if (coloured) {  // AR draws per stream from the model fitted to the session
+      std::mt19937_64 rng(o.seed + static_cast<std::uint64_t>(k));
+      noise = draw_noise(result.noise, rng);
     } else {  // as simulate_ballbar(session, model, {noise_um, seed + k}) draws it
       std::mt19937_64 rng(o.seed + static_cast<std::uint64_t>(k));
       std::normal_distribution<double> g(0.0, noise_um * 1e-3);

@@ -308,6 +308,34 @@ RtestJointIdentification identify_joint(const RtestSession& session,
   const RtestJointResiduals model(session, setups, basis);
   JointFitOutcome fit = solve_joint(model, params, settings);
 
+  // Noise model of the residuals: one AR stream per nest and channel (dx, dy, dz share a
+  // time, so the estimator splits them), in time order. Probe zeros that wander between
+  // poses and servo/thermal noise make it correlated; then the white covariance is too small
+  // and the fit is redone by GLS under the model (one feasible-GLS step).
+  NoiseModel noise;
+  bool refit = false;
+  double scale = 1.0;
+  if (!options.whitener) {
+    std::vector<std::string> groups;
+    std::vector<double> times;
+    groups.reserve(3 * session.samples.size());
+    times.reserve(3 * session.samples.size());
+    for (const RtestSample& s : session.samples)
+      for (int a = 0; a < 3; ++a) {
+        groups.push_back("nest " + s.setup);
+        times.push_back(s.time);
+      }
+    noise = estimate_noise_model(groups, times, fit.residuals, options.noise_options);
+    if (options.noise == NoiseHandling::automatic && !noise.white() &&
+        noise.correlation_samples >= options.min_correlation_samples) {
+      if (options.noise_bias_correction) scale = noise_correction(noise, groups, times, fit, options.noise_options);
+      settings.whitener = std::make_shared<ArWhitener>(noise);
+      fit = solve_joint(model, params, settings);
+      apply_noise_correction(scale, &fit);
+      refit = true;
+    }
+  }
+
   RtestJointIdentification out;
   out.converged = fit.summary.converged;
   out.iterations = fit.summary.iterations;
@@ -324,6 +352,10 @@ RtestJointIdentification identify_joint(const RtestSession& session,
   out.parameters = fit.estimates;
   out.unobservable = fit.unobservable;
   out.summary = fit.summary;
+  out.noise = std::move(noise);
+  out.noise_refit = refit;
+  out.noise_correction = scale;
+  if (refit) out.notes.push_back("correlated noise (" + out.noise.summary() + "): covariance by GLS under this AR model, scaled by " + std::to_string(scale) + " for the correlation the fit absorbs from its residuals");
 
   out.model.machine = session.machine;
   out.model.basis = basis;

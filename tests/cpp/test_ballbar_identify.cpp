@@ -47,8 +47,12 @@ TEST_CASE("joint fit recovers random machines within 3 sigma, AC and BC", "[ball
     const BallbarSession cmd = commanded(m);
     for (std::uint64_t seed : {1u, 2u}) {
       const BallbarMachineModel t = random_machine(m, cmd.pivot, rng);
-      const BallbarIdentification id = identify_joint(simulate_ballbar(cmd, t, {0.5, seed, true}));
+      JointFitOptions automatic;  // the noise model estimated; white noise must come out white
+      automatic.noise = NoiseHandling::automatic;
+      const BallbarIdentification id = identify_joint(simulate_ballbar(cmd, t, {0.5, seed, true}), automatic);
+      INFO("noise model " << id.noise.summary());
       CHECK(id.converged);
+      CHECK_FALSE(id.noise_refit);  // white noise: fitted once, as before
       CHECK(id.unobservable.empty());
       CHECK(id.residual_rms_um == Approx(0.5).epsilon(0.1));
       check_recovered(id, t, 0.0, 0.0);
@@ -161,7 +165,9 @@ TEST_CASE("joint fit with a noise model (GLS): whitened chi2, honest sigma, reco
   JointFitOptions gls;
   gls.whitener = std::make_shared<Ar1>(static_cast<Eigen::Index>(s.samples.size()), phi, innov);
   const BallbarIdentification w = identify_joint(s, gls);
-  const BallbarIdentification white = identify_joint(s);
+  JointFitOptions as_white;  // the noise treated as white (no noise model, no GLS refit)
+  as_white.noise = NoiseHandling::white;
+  const BallbarIdentification white = identify_joint(s, as_white);
   CHECK(w.converged);
   CHECK(w.summary.whitened);
   CHECK_FALSE(white.summary.whitened);

@@ -12,6 +12,7 @@
 
 #include "rotacal/ballbar/model.hpp"
 #include "rotacal/core/estimate.hpp"  // ParameterEstimate (kept reachable from this header)
+#include "rotacal/core/noise_handling.hpp"
 #include "rotacal/core/whitener.hpp"
 
 namespace rotacal {
@@ -34,6 +35,13 @@ struct BallbarIdentification {
   std::vector<std::string> unobservable;  ///< combinations the tests cannot see, in words
   std::vector<std::string> notes;         ///< assumptions and warnings for the report
   FitSummary summary;                     ///< solver figures; whitened chi2/dof with a whitener
+  /// Noise model of the residuals (one stream per test), estimated after the fit; when it is
+  /// not white (and noise = automatic) the covariance is the GLS one under it.
+  NoiseModel noise;
+  /// Factor applied to the GLS covariance for the noise model's bias (estimated from
+  /// residuals that the fit has already taken the slow noise from): core/noise_handling.hpp.
+  double noise_correction = 1.0;
+  bool noise_refit = false;  ///< the fit was redone with the noise model's whitener (GLS)
 
   /// The estimate called `name`; throws InvalidArgument if there is none.
   const ParameterEstimate& parameter(const std::string& name) const;
@@ -51,10 +59,24 @@ struct JointFitOptions {
   /// order) to independent unit-variance ones. The covariance is then (Jw^T Jw)^-1 with no
   /// rescaling, and summary.chi2_per_dof is the whitened one.
   std::shared_ptr<const ResidualWhitener> whitener;
+  /// Without a whitener: `automatic` estimates the noise model of the first (white) fit's
+  /// residuals and, when some stream is correlated (AR order > 0), refits with its ArWhitener
+  /// so that the covariance holds on correlated data; white data are fitted once, as before.
+  /// C++ default `white` (as before) because the diagnosis refits through identify_joint
+  /// with its own whitener decisions; the Python API and the CLI default to `auto`.
+  NoiseHandling noise = NoiseHandling::white;
+  NoiseModelOptions noise_options;
+  /// The GLS refit is done only when some stream's integrated correlation time reaches this
+  /// (samples): below it the white covariance is within ~10 % and BIC's rare spurious AR(1) of
+  /// white noise (|phi| ~ 0.05) must not change the answer.
+  double min_correlation_samples = 1.2;
+  /// Scale the GLS covariance by the bootstrap bias factor (core/noise_handling.hpp).
+  bool noise_bias_correction = true;  ///< AR order search of the noise model
 };
 
 /// The samples a fit uses as contiguous arrays (structure of arrays): built once per session
-/// and reused by every refit (diagnosis candidates, Monte Carlo draws), no strings inside.
+/// and reused by every refit (diagnosis candidates, Monte Carlo draws); the test labels are only
+/// read by the noise model.
 struct BallbarArrays {
   MachineType machine = MachineType::AC_trt;
   Eigen::Vector3d pivot = Eigen::Vector3d::Zero();  ///< nominal pivot, table frame, mm
@@ -65,6 +87,7 @@ struct BallbarArrays {
   std::vector<RotaryAngles<double>> angles;         ///< rad
   Eigen::VectorXd time;                             ///< s
   Eigen::VectorXd length;                           ///< measured length, mm
+  std::vector<std::string> test;                    ///< test label of each row (noise streams)
 
   Eigen::Index size() const { return time.size(); }
 };

@@ -21,8 +21,11 @@ struct BallbarMonteCarloOptions {
   /// taken from the identified model.
   JointFitOptions fit;
   /// Optional noise model: fills `noise_mm` (one value per fitted sample, session order) for
-  /// draw k. Without it: white Gaussian noise of noise_um, drawn exactly as simulate_ballbar
-  /// draws it (std::mt19937_64(seed + k), one value per session sample in order).
+  /// draw k. Without it: when the identification was refitted under its noise model
+  /// (result.noise_refit), AR draws per stream from that model (std::mt19937_64(seed + k))
+  /// and each draw refitted under its whitener; else white Gaussian noise of noise_um, drawn
+  /// exactly as simulate_ballbar draws it (std::mt19937_64(seed + k), one value per session
+  /// sample in order).
   std::function<void(int k, Eigen::Ref<Eigen::VectorXd> noise_mm)> noise;
   /// Called after every draw with (draws done, draws); may be empty.
   std::function<void(int, int)> progress;
@@ -40,6 +43,7 @@ struct MonteCarloParameter {
 struct BallbarMonteCarlo {
   int draws = 0;
   double noise_um = 0.0;
+  std::string noise;  ///< what was simulated: "white noise", "the fitted noise model: ...", ...
   std::vector<MonteCarloParameter> parameters;  ///< observable parameters only
   Eigen::MatrixXd values;                       ///< draws x all parameters (identification order)
   int fresh_fits = 0;                           ///< draws that needed a fit from scratch

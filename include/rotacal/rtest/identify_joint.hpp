@@ -27,6 +27,7 @@
 #include <memory>
 
 #include "rotacal/core/estimate.hpp"
+#include "rotacal/core/noise_handling.hpp"
 #include "rotacal/core/whitener.hpp"
 #include "rotacal/io/session.hpp"
 #include "rotacal/rtest/error_model.hpp"
@@ -117,6 +118,19 @@ struct RtestJointOptions {
   /// order) to independent unit-variance ones; the covariance is then (Jw^T Jw)^-1 and
   /// summary.chi2_per_dof the whitened one.
   std::shared_ptr<const ResidualWhitener> whitener;
+  /// Without a whitener: `automatic` estimates the noise model of the first fit's residuals
+  /// (one AR stream per nest and channel dx, dy, dz, in time order; probe zeros that wander
+  /// between poses show as correlation) and refits by GLS when it is not white.
+  /// C++ default `white` (as before) because the diagnosis refits through identify_joint
+  /// with its own whitener decisions; the Python API and the CLI default to `auto`.
+  NoiseHandling noise = NoiseHandling::white;
+  NoiseModelOptions noise_options;
+  /// The GLS refit is done only when some stream's integrated correlation time reaches this
+  /// (samples): below it the white covariance is within ~10 % and BIC's rare spurious AR(1) of
+  /// white noise (|phi| ~ 0.05) must not change the answer.
+  double min_correlation_samples = 1.2;
+  /// Scale the GLS covariance by the bootstrap bias factor (core/noise_handling.hpp).
+  bool noise_bias_correction = true;
 };
 
 struct RtestJointIdentification {
@@ -134,6 +148,11 @@ struct RtestJointIdentification {
   std::vector<std::string> unobservable;  ///< combinations the nests cannot see, in words
   std::vector<std::string> notes;
   FitSummary summary;  ///< solver figures; whitened chi2/dof with a whitener
+  NoiseModel noise;          ///< noise model of the residuals (streams: nest x channel)
+  /// Factor applied to the GLS covariance for the noise model's bias (estimated from
+  /// residuals that the fit has already taken the slow noise from): core/noise_handling.hpp.
+  double noise_correction = 1.0;
+  bool noise_refit = false;  ///< the fit was redone by GLS under `noise`
 
   const ParameterEstimate& parameter(const std::string& name) const;
 };
