@@ -31,11 +31,11 @@ from ._core import BallbarPlan, BallbarSetup, BallbarTest, NcDialect, NcProgramO
 from .analysis import identify  # noqa: F401
 from .ballbar import predict  # noqa: F401
 from .machines import TABLE2_ERRORS, random_location_errors  # noqa: F401
-from .diagnosis import diagnose  # noqa: F401
+from .diagnosis import diagnose, plausible_sizes, uncertainty_budget  # noqa: F401
 from .models import ballbar_model_from_dict, load_model, save_model  # noqa: F401
 from .outputs import write_output  # noqa: F401
 from .results import DiagnosisResult, Identification  # noqa: F401
-from .rtest import identify_rtest  # noqa: F401
+from .rtest import identify_rtest, monte_carlo_rtest  # noqa: F401
 from .sessions import check_plausible, load, save  # noqa: F401
 
 __version__ = "0.1.0"

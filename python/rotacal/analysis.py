@@ -13,17 +13,18 @@ from .sessions import BALLBAR, RTEST, by_kind
 
 
 def identify(session: Any, method: str = "joint", *, fit_length_offset: bool = False,
-             effects: Sequence[str] = (), tests: Sequence[str] = ()) -> Any:
+             effects: Sequence[str] = (), tests: Sequence[str] = (), noise: str = "auto") -> Any:
     """Identify the location errors of a ballbar session (rotacal.ballbar.identify: options
     ``fit_length_offset``, ``effects``, ``tests``) or of an R-test session
-    (rotacal.identify_rtest: ``method`` only)."""
+    (rotacal.identify_rtest: ``method`` only). ``noise``: "auto" (AR noise model of the residuals,
+    GLS refit when correlated) or "white"."""
     def rtest_identify():
         if fit_length_offset or effects or tests:
             raise _core.InvalidArgument("identify: an R-test session takes only `method`")
-        return rtest.identify_rtest(session, method)
+        return rtest.identify_rtest(session, method, noise=noise)
 
     run = by_kind(session, {BALLBAR: lambda: ballbar.identify(session, method, fit_length_offset=fit_length_offset,
-                                                               effects=effects, tests=tests),
+                                                               effects=effects, tests=tests, noise=noise),
                             RTEST: rtest_identify}, "identify")
     return run()
 
@@ -33,11 +34,12 @@ def predict_session(model: Mapping, session: Any, probe_zeros: str = "none",
     """A session predicted by a model dict (rotacal.load_model), and a line saying how well it
     matches the measurement (None when the session has no readings to compare)."""
     def ballbar_predict():
-        if "machine" in model:  # a model of another machine predicts nonsense: refuse, naming both
-            _core.check_model_machine(_core.parse_machine_type(str(model["machine"])), session.machine, source)
         if probe_zeros != "none":
             raise _core.InvalidArgument("predict: --probe-zeros is for R-test sessions")
-        out = ballbar.predict(ballbar_model_from_dict(dict(model), source), session)
+        fitted = ballbar_model_from_dict(dict(model), source)  # refuses a model of another kind
+        # A model of another machine predicts nonsense: refuse, naming both.
+        _core.check_model_machine(fitted.machine, session.machine, source)
+        out = ballbar.predict(fitted, session)
         res = (np.asarray(session.length) - np.asarray(out.length)) * 1e3
         return out, f"measured - predicted: RMS {np.sqrt(np.mean(res ** 2)):.3f} um over {len(session)} samples"
 

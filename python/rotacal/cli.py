@@ -349,7 +349,9 @@ def cmd_identify(a: argparse.Namespace) -> int:
                          RTEST: rtest_identify}, "identify")()
     if a.method == "joint" and not a.no_budget:
         # The budget rests on the diagnosis of what the model leaves out (diagnose/uncertainty_budget.hpp).
-        result.budget = uncertainty_budget(s, sizes=sizes)
+        # R-test: raw d1,d2,d3 readings are converted as identify_rtest converts them.
+        fitted = by_kind(s, {BALLBAR: lambda: s, RTEST: lambda: _rtest.with_displacements(s)[0]}, "identify")()
+        result.budget = uncertainty_budget(fitted, sizes=sizes)
     d = result.to_dict()
     if a.monte_carlo:
         from .ballbar import monte_carlo
@@ -390,10 +392,13 @@ def _print_diagnosis(d: dict) -> None:
 
 
 def cmd_diagnose(a: argparse.Namespace) -> int:
-    from .diagnosis import diagnose
+    from .diagnosis import diagnose, plausible_sizes, uncertainty_budget
     check_outputs([a.report], [a.file])
+    sizes = plausible_sizes(a.budget_sizes) if a.budget_sizes else None  # refused before any work
     s = _load(a.file, a)
     result = diagnose(s, max_harmonic=a.max_harmonic)
+    if not a.no_budget:  # what the left-out effects could still put on each location error
+        result.budget = uncertainty_budget(s, result, sizes=sizes)
     d = result.to_dict()
     if a.report:
         from .analysis import write_diagnosis_report
@@ -658,6 +663,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help=f"highest harmonic order tried (1..{MAX_HARMONIC}; default {_core.DiagnosisOptions().max_harmonic})")
     q.add_argument("--json", action="store_true")
     q.add_argument("--report", metavar="OUT.html", type=path("--report"))
+    q.add_argument("--budget-sizes", metavar="SIZES.json", type=path("--budget-sizes"),
+                   help="plausible sizes of left-out effects for the uncertainty budget (docs/json_schema.md)")
+    q.add_argument("--no-budget", action="store_true", help="skip the uncertainty budget")
     _add_plausibility_arg(q)
     q.set_defaults(func=cmd_diagnose)
 

@@ -105,8 +105,8 @@ def test_identify_json_rtest(shared_data):
 def test_diagnose_json(shared_data):
     named = schemas()
     d = cli_json("diagnose", shared_data / "ballbar_ac_table2.csv")
-    if "noise_model" not in d or "angle_tables" not in d:
-        pytest.skip("the diagnosis binding does not expose noise / angle_tables yet")
+    assert "noise_model" in d and "angle_tables" in d and "uncertainty_budget" in d
     check(d["noise_model"], named["noise_model"], "noise_model", named)
     for i, t in enumerate(d["angle_tables"]):
         check(t, named["angle_table"], f"angle_tables[{i}]", named)
+    check(d["uncertainty_budget"], named["uncertainty_budget"], "uncertainty_budget", named)

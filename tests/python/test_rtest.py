@@ -161,6 +161,9 @@ def test_model_file_errors_name_file_and_key(held_out, tmp_path, shared_data):
     (tmp_path / "moved.csv").write_text(held.read_text().replace("# nest.2: 0, -120, 140", "# nest.2: 0, -120, 150"))
     r = rotacal_cli("predict", tmp_path / "moved.csv", "--model", tmp / "m.json", "--probe-zeros", "fitted",
                     "-o", tmp_path / "x.csv")
+    assert r.returncode == 3 and "nest.2" in r.stderr  # the plausibility check sees it first
+    r = rotacal_cli("predict", tmp_path / "moved.csv", "--model", tmp / "m.json", "--probe-zeros", "fitted",
+                    "--max-deviation", "20", "-o", tmp_path / "x.csv")
     assert r.returncode == 3 and "set-up '2'" in r.stderr
     # An R-test session with a ballbar model, and the other way round.
     (tmp_path / "ballbar.json").write_text(json.dumps(dict(good, kind="ballbar")))
