@@ -47,7 +47,8 @@ step "Benchmarks, once each as a smoke check (figures: run them without --smoke)
 ./build/release/bench/ballbar_long --smoke
 ./build/release/bench/rtest_bench
 ./build/release/bench/hw_stream --smoke
-"$PY" bench/ballbar_speed.py --repeat 1
+"$PY" bench/ballbar_speed.py --repeat 5 --draws 100
+./build/release/bench/noise_mc_bench --smoke
 
 step "libFuzzer targets of the instrument decoders, 20 s each (clang)"
 cmake -S fuzz -B build/fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DROTACAL_FUZZ_SECONDS=20
