@@ -3,9 +3,9 @@
 
 #include <cmath>
 #include <memory>
-#include <random>
 
 #include "length_model.hpp"
+#include "rotacal/core/monte_carlo.hpp"
 #include "rotacal/core/noise_handling.hpp"
 #include "rotacal/ballbar/simulate.hpp"
 
@@ -61,19 +61,17 @@ BallbarMonteCarlo monte_carlo(const BallbarSession& session, const BallbarIdenti
                                                        : "white noise";
   out.values.resize(o.draws, p);
   Eigen::VectorXd noise(data.size());
-  std::vector<double> all(session.samples.size());
   for (int k = 0; k < o.draws; ++k) {
     if (o.noise) {
       noise.setZero();
       o.noise(k, noise);
     } else if (coloured) {  // AR draws per stream from the model fitted to the session
-      std::mt19937_64 rng(o.seed + static_cast<std::uint64_t>(k));
-      noise = draw_noise(result.noise, rng);
-    } else {  // as simulate_ballbar(session, model, {noise_um, seed + k}) draws it
-      std::mt19937_64 rng(o.seed + static_cast<std::uint64_t>(k));
-      std::normal_distribution<double> g(0.0, noise_um * 1e-3);
-      for (double& v : all) v = noise_um > 0 ? g(rng) : 0.0;
-      for (Eigen::Index i = 0; i < data.size(); ++i) noise[i] = all[data.index[static_cast<std::size_t>(i)]];
+      noise = monte_carlo_noise(true, result.noise, noise_um, data.size(), o.seed, k);
+    } else {  // as simulate_ballbar(session, model, {noise_um, seed + k}) draws it: one value
+              // per session sample, in order, of which the fitted samples are taken
+      const Eigen::VectorXd all = monte_carlo_noise(
+          false, result.noise, noise_um, static_cast<Eigen::Index>(session.samples.size()), o.seed, k);
+      for (Eigen::Index i = 0; i < data.size(); ++i) noise[i] = all[static_cast<Eigen::Index>(data.index[static_cast<std::size_t>(i)])];
     }
     data.length = truth + noise;
     const JointRefitter::Result r = refitter.refit(model);
@@ -81,20 +79,7 @@ BallbarMonteCarlo monte_carlo(const BallbarSession& session, const BallbarIdenti
     out.values.row(k) = r.values.transpose();
     if (o.progress) o.progress(k + 1, o.draws);
   }
-  for (int j = 0; j < p; ++j) {
-    const ParameterEstimate& e = result.parameters[static_cast<std::size_t>(j)];
-    if (!e.observable) continue;
-    const Eigen::VectorXd v = out.values.col(j);
-    const double mean = v.mean();
-    MonteCarloParameter m;
-    m.name = e.name;
-    m.unit = e.unit;
-    m.std_reported = e.std;
-    m.std_mc = std::sqrt((v.array() - mean).square().sum() / (o.draws - 1));
-    m.ratio = e.std > 0 ? m.std_mc / e.std : std::numeric_limits<double>::infinity();
-    m.bias = mean - e.value;
-    out.parameters.push_back(m);
-  }
+  out.parameters = monte_carlo_summary(result.parameters, out.values);
   return out;
 }
 

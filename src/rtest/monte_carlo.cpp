@@ -1,12 +1,10 @@
 // Monte Carlo check of the R-test joint fit's 1-sigma with the session's fitted noise model.
 #include "rotacal/rtest/monte_carlo.hpp"
 
-#include <cmath>
-#include <limits>
 #include <memory>
-#include <random>
 
 #include "rotacal/core/error.hpp"
+#include "rotacal/core/monte_carlo.hpp"
 #include "rotacal/core/noise_handling.hpp"
 
 namespace rotacal {
@@ -37,14 +35,8 @@ RtestMonteCarlo monte_carlo(const RtestSession& session, const RtestJointIdentif
   out.values.resize(o.draws, p);
   RtestSession s = session;
   for (int k = 0; k < o.draws; ++k) {
-    std::mt19937_64 rng(o.seed + static_cast<std::uint64_t>(k));
-    Eigen::VectorXd e(3 * static_cast<Eigen::Index>(n));
-    if (coloured) {
-      e = draw_noise(result.noise, rng);
-    } else {
-      std::normal_distribution<double> g(0.0, result.sigma_um * 1e-3);
-      for (Eigen::Index i = 0; i < e.size(); ++i) e[i] = g(rng);
-    }
+    const Eigen::VectorXd e = monte_carlo_noise(coloured, result.noise, result.sigma_um,
+                                                3 * static_cast<Eigen::Index>(n), o.seed, k);
     for (std::size_t i = 0; i < n; ++i)
       s.samples[i].d = model[i] + e.segment<3>(3 * static_cast<Eigen::Index>(i));
     const RtestJointIdentification r = identify_joint(s, fit);
@@ -54,20 +46,10 @@ RtestMonteCarlo monte_carlo(const RtestSession& session, const RtestJointIdentif
     for (int j = 0; j < p; ++j) out.values(k, j) = r.parameters[static_cast<std::size_t>(j)].value;
     if (o.progress) o.progress(k + 1, o.draws);
   }
-  for (int j = 0; j < p; ++j) {
-    const ParameterEstimate& e = result.parameters[static_cast<std::size_t>(j)];
-    if (!e.observable || e.name.rfind("zero.", 0) == 0) continue;
-    const Eigen::VectorXd v = out.values.col(j);
-    const double mean = v.mean();
-    MonteCarloParameter m;
-    m.name = e.name;
-    m.unit = e.unit;
-    m.std_reported = e.std;
-    m.std_mc = std::sqrt((v.array() - mean).square().sum() / (o.draws - 1));
-    m.ratio = e.std > 0 ? m.std_mc / e.std : std::numeric_limits<double>::infinity();
-    m.bias = mean - e.value;
-    out.parameters.push_back(m);
-  }
+  // The probe zeros are nuisance parameters: not compared.
+  out.parameters = monte_carlo_summary(result.parameters, out.values, [](const ParameterEstimate& e) {
+    return e.name.rfind("zero.", 0) == 0;
+  });
   return out;
 }
 

@@ -10,6 +10,7 @@
 #include <functional>
 
 #include "rotacal/ballbar/identify.hpp"
+#include "rotacal/core/monte_carlo.hpp"
 
 namespace rotacal {
 
@@ -29,15 +30,6 @@ struct BallbarMonteCarloOptions {
   std::function<void(int k, Eigen::Ref<Eigen::VectorXd> noise_mm)> noise;
   /// Called after every draw with (draws done, draws); may be empty.
   std::function<void(int, int)> progress;
-};
-
-struct MonteCarloParameter {
-  std::string name;
-  std::string unit;
-  double std_reported = 0.0;
-  double std_mc = 0.0;   ///< sample standard deviation over the draws
-  double ratio = 0.0;    ///< std_mc / std_reported (near 1: the reported sigma is right)
-  double bias = 0.0;     ///< mean over the draws - identified value
 };
 
 struct BallbarMonteCarlo {

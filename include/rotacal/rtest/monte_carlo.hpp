@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <functional>
 
-#include "rotacal/ballbar/monte_carlo.hpp"  // MonteCarloParameter
+#include "rotacal/core/monte_carlo.hpp"
 #include "rotacal/rtest/identify_joint.hpp"
 
 namespace rotacal {
