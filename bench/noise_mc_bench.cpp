@@ -131,7 +131,7 @@ int main(int argc, char** argv) {
   // R-test: 0.3 um coloured noise per probe channel plus probe zeros that wander between poses
   // (random walk, 0.1 um per pose).
   if (rtest) {
-    RtestTruth rt;
+    MachineModel rt = MachineModel::nominal(MachineType::BC_trt);
     rt.machine = MachineType::BC_trt;
     for (int i = 0; i < 8; ++i) rt.errors.v[i] = location_error_is_angle(i) ? 3e-5 * N(rng) : 0.02 * N(rng);
     RtestSimOptions so;

@@ -20,7 +20,7 @@ double cpu_seconds() {
 }  // namespace
 
 int main() {
-  RtestTruth t;  // ../shared/data/rtest_bc_oyama.truth.json + a 2-lobe face runout of C
+  MachineModel t = MachineModel::nominal(MachineType::BC_trt);  // ../shared/data/rtest_bc_oyama.truth.json + a 2-lobe face runout of C
   t.errors.v << 0.01459190348066346, 0.014212100597282357, 3.1102339878434216e-05,
       -2.385536385835234e-05, -0.016912021691263143, 0.017858631217842532,
       1.1379169104710182e-05, -4.973692463737003e-05;

@@ -223,13 +223,31 @@ void bind_rtest(pyb::module_& m) {
       "RMS (um) of measured - predicted readings after one constant offset per set-up.");
 
   // ------------------------------------------------------------------ simulation
+  // Bound so that the Python layer reads the simulator's defaults instead of restating them.
+  pyb::class_<RtestPattern>(m, "RtestPattern", "The pose grid and nests of a simulated session.")
+      .def(pyb::init<>())
+      .def_readwrite("b_deg", &RtestPattern::b_deg, "B positions, deg (outer loop)")
+      .def_readwrite("c_deg", &RtestPattern::c_deg, "C positions, deg (inner loop)")
+      .def_property(
+          "nests", [](const RtestPattern& p) { return rows_from(p.nests); },
+          [](RtestPattern& p, const Array& a) { p.nests = vectors_of(a, "nests"); },
+          "(K, 3) nominal ball centres, table frame, mm")
+      .def_readwrite("dwell_s", &RtestPattern::dwell_s, "time between poses, s");
+  pyb::class_<RtestSimOptions>(m, "RtestSimOptions", "Options of simulate_rtest (defaults).")
+      .def(pyb::init<>())
+      .def_readwrite("pattern", &RtestSimOptions::pattern)
+      .def_readwrite("noise_um", &RtestSimOptions::noise_um, "1-sigma reading noise, um")
+      .def_readwrite("probe_zero_um", &RtestSimOptions::probe_zero_um,
+                     "1-sigma of each component of the per-set-up probe zero, um")
+      .def_readwrite("write_d", &RtestSimOptions::write_d)
+      .def_readwrite("seed", &RtestSimOptions::seed);
   m.def(
       "simulate_rtest",
       [](MachineType machine, const Array& errors, const std::vector<std::string>& effects,
          const std::vector<double>& effect_params, const std::vector<double>& b_deg,
          const std::vector<double>& c_deg, const Array& nests, double dwell_s, double noise_um,
          double probe_zero_um, std::optional<Array> probe_dirs, bool write_d, unsigned seed) {
-        RtestTruth t;
+        MachineModel t;
         t.machine = machine;
         t.errors = LocationErrors<double>(vec_of<8>(errors, "errors"));
         t.effects = effects_of(effects);
@@ -273,7 +291,7 @@ Returns
       [](MachineType machine, const Array& errors, const std::vector<std::string>& effects,
          const std::vector<double>& effect_params, const Array& q, const Array& angles,
          const Eigen::VectorXd& time) {
-        RtestTruth t;
+        MachineModel t;
         t.machine = machine;
         t.errors = LocationErrors<double>(vec_of<8>(errors, "errors"));
         t.effects = effects_of(effects);

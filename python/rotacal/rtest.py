@@ -16,16 +16,16 @@ from .machines import Errors, machine_truth  # noqa: F401  (rotacal.rtest.machin
 from .models import estimate_dict, rtest_model_dict, rtest_model_from_dict
 from .results import budget_dict, noise_model_dict
 
-# The measurement pattern of Oyama Sec. 3.3, used for the map grid by default.
-B_GRID = list(range(-90, 91, 30))
-C_GRID = list(range(0, 360, 30))
-# The two nests of the paper's set-up (as in ../shared/data/rtest_bc_oyama.csv), table frame, mm.
-DEFAULT_NESTS = [(100.0, 0.0, 60.0), (0.0, -120.0, 140.0)]
-# Defaults of the C++ simulator (rtest/simulate.hpp: RtestSimOptions, RtestPattern), restated
-# because those structs are not bound: bind them and read these from the extension.
-DEFAULT_NOISE_UM = 0.3
-DEFAULT_PROBE_ZERO_UM = 20.0
-DEFAULT_DWELL_S = 6.0
+# The C++ simulator's defaults (rtest/simulate.hpp: RtestSimOptions, RtestPattern): the
+# measurement pattern of Oyama Sec. 3.3 (also the map grid by default) and the two nests of
+# the paper's set-up (as in ../shared/data/rtest_bc_oyama.csv), table frame, mm.
+_SIM_DEFAULTS = _core.RtestSimOptions()
+B_GRID = [float(b) for b in _SIM_DEFAULTS.pattern.b_deg]
+C_GRID = [float(c) for c in _SIM_DEFAULTS.pattern.c_deg]
+DEFAULT_NESTS = [tuple(float(x) for x in row) for row in _SIM_DEFAULTS.pattern.nests]
+DEFAULT_NOISE_UM = _SIM_DEFAULTS.noise_um
+DEFAULT_PROBE_ZERO_UM = _SIM_DEFAULTS.probe_zero_um
+DEFAULT_DWELL_S = _SIM_DEFAULTS.pattern.dwell_s
 # Bounds of a pattern: positions per axis and poses in all (a day of 6-s dwells is 14400).
 MAX_GRID_POINTS = 3600
 MAX_POSES = 100_000

@@ -21,7 +21,7 @@ std::string fmt(double v, int prec) {
 }  // namespace
 
 RtestSimulation simulate_rtest(const MachineModel& truth, const RtestSimOptions& o) {
-  truth.validate("RtestTruth");
+  truth.validate("simulate_rtest: truth");
   if (o.pattern.b_deg.empty() || o.pattern.c_deg.empty() || o.pattern.nests.empty())
     throw InvalidArgument("simulate_rtest: options.pattern: b_deg, c_deg and nests must not be empty");
   if (o.noise_um < 0 || o.probe_zero_um < 0)

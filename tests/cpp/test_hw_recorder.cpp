@@ -181,8 +181,9 @@ struct RtestRun {
   std::vector<Eigen::Vector3d> zeros;
 };
 
-RtestTruth rtest_truth() {
-  RtestTruth truth;
+MachineModel rtest_truth() {
+  MachineModel truth;
+  truth.machine = MachineType::BC_trt;
   truth.errors.v << 0.02, -0.015, 3e-5, -4e-5, 0.01, 0.012, 2e-5, -3e-5;
   return truth;
 }
@@ -260,7 +261,7 @@ TEST_CASE("R-test stream: the recorded pattern identifies the machine within 3 s
   REQUIRE(run.recorded.samples.size() == run.program.samples.size());
   const RtestJointIdentification id = identify_joint(run.recorded);
   REQUIRE(id.converged);
-  const RtestTruth truth = rtest_truth();
+  const MachineModel truth = rtest_truth();
   int checked = 0;
   for (int j = 0; j < 8; ++j) {
     const ParameterEstimate& p = id.parameters[static_cast<std::size_t>(j)];
@@ -276,7 +277,7 @@ namespace {
 // The largest deviation, mm, of a recorded pose from the noise-free reading of the pose it is
 // labelled with (simulator, same machine and zeros); every row must be a commanded pose.
 double worst_deviation(const RtestRun& run) {
-  const RtestTruth truth = rtest_truth();
+  const MachineModel truth = rtest_truth();
   const std::vector<std::string> setups = run.program.setups();
   double worst = 0.0;
   for (const RtestSample& r : run.recorded.samples) {

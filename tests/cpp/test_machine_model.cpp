@@ -50,9 +50,10 @@ TEST_CASE("the ballbar and R-test truths are the same MachineModel", "[machine_m
   m.errors.v << 0.01, -0.02, 3e-5, -2e-5, 0.015, -0.01, 1e-5, -4e-5;
   m.effects.effects = {Effect::parse("gravity_sag_B")};
   m.effect_params = {0.005};
-  const RtestTruth rt(m);  // an R-test truth is a MachineModel
-  CHECK(rt.errors.v == m.errors.v);
-  CHECK(RtestTruth().machine == MachineType::BC_trt);
+  const MachineModel nominal = MachineModel::nominal(MachineType::BC_trt);
+  CHECK(nominal.machine == MachineType::BC_trt);
+  CHECK(nominal.errors.v.isZero());
+  CHECK(nominal.effects.effects.empty());
   BallbarMachineModel bb;
   static_cast<MachineModel&>(bb) = m;  // a ballbar model is a MachineModel and its pivot
   bb.pivot = Eigen::Vector3d(100, 0, 50);
@@ -60,7 +61,7 @@ TEST_CASE("the ballbar and R-test truths are the same MachineModel", "[machine_m
   MachineModel bad = m;
   bad.effect_params.clear();
   CHECK_THROWS_WITH(simulate_rtest(bad), Catch::Contains("effect_params"));
-  CHECK_NOTHROW(simulate_rtest(rt));
+  CHECK_NOTHROW(simulate_rtest(m));
   BallbarSample s;
   s.xyz = Eigen::Vector3d(100, 0, 150);
   const std::vector<double> L = predict_lengths(bb, {s});

@@ -13,8 +13,8 @@ constexpr double kDeg = M_PI / 180.0;
 const double s_sag = 0.006, k_con = 1.45e-4;  // gravity sag (mm), coning (rad/rad)
 const double ax = 0.002, tx = 20e-6, ty = -15e-6;  // C: axial sin 2C (mm), tilt sin 2C (rad)
 
-RtestTruth truth_b_and_c() {
-  RtestTruth t;
+MachineModel truth_b_and_c() {
+  MachineModel t = MachineModel::nominal(MachineType::BC_trt);
   t.effects.effects = {Effect::parse("gravity_sag_B"), Effect::parse("coning_B"),
                        Effect::parse("axial_motion_C_h2"), Effect::parse("tilt_motion_C_h2")};
   // axial: a cos + b sin; tilt: (a cos + b sin) about X, (c cos + d sin) about Y (turning frame)

@@ -23,6 +23,13 @@ struct MachineModel {
   EffectModel effects;
   std::vector<double> effect_params;   ///< effects.num_params() values, EffectModel layout
 
+  /// A machine of this kinematics without location errors or effects.
+  static MachineModel nominal(MachineType m) {
+    MachineModel model;
+    model.machine = m;
+    return model;
+  }
+
   /// Pointer to the effect parameters (nullptr when there are none), for the templated model.
   const double* effect_data() const { return effect_params.empty() ? nullptr : effect_params.data(); }
   /// ISO 230-7 names of the location errors, then "id.name" of every effect parameter.

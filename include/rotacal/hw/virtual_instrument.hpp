@@ -153,7 +153,7 @@ class VirtualBallbar final : public VirtualInstrument {
 };
 
 struct VirtualRtestOptions {
-  RtestTruth truth;
+  MachineModel truth = MachineModel::nominal(MachineType::BC_trt);  ///< the machine the probes measure
   RtestSimOptions sim;  ///< pattern (poses, dwell), noise, probe zeros sigma, seed
   Eigen::Matrix3d probe_dirs = Eigen::Matrix3d::Identity();  ///< rows: probe directions
   ProbeMode mode = ProbeMode::keyence;

@@ -27,13 +27,6 @@ struct RtestPattern {
   double dwell_s = 6.0;  ///< time between poses, s; the program holds each pose at rest for the middle 80 % (hw/pose_window.hpp)
 };
 
-/// The machine the simulator measures: a MachineModel whose default table is BC-trt (the
-/// R-test's), kept as a name for the callers that build one field by field.
-struct RtestTruth : MachineModel {
-  RtestTruth() { machine = MachineType::BC_trt; }
-  RtestTruth(const MachineModel& m) : MachineModel(m) {}  // NOLINT: a MachineModel is a truth
-};
-
 struct RtestSimOptions {
   RtestPattern pattern;
   double noise_um = 0.3;        ///< 1 sigma per probe reading (or per d component), um
