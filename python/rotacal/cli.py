@@ -563,6 +563,7 @@ def _report_recording(summary, path: str, json_out: bool) -> int:
 
 def cmd_record_ballbar(a: argparse.Namespace) -> int:
     from .instruments import record_ballbar
+    check_outputs([a.output], [a.port])  # before the port is opened
     plan = _core.plan_ballbar_test(_setup(a), None)
     summary = record_ballbar(a.port, plan, a.output, baud=a.baud, rate_hz=a.rate, zero=a.zero,
                              silence_timeout_s=a.silence, progress=not a.no_progress)
@@ -571,6 +572,7 @@ def cmd_record_ballbar(a: argparse.Namespace) -> int:
 
 def cmd_record_rtest(a: argparse.Namespace) -> int:
     from .instruments import record_rtest, rtest_program
+    check_outputs([a.output], [a.port])  # before the port is opened
     r = _rtest_inputs(a)
     program = rtest_program(r["machine"], r["b_deg"], r["c_deg"], r["nests"], r["dwell_s"])
     summary = record_rtest(a.port, program, a.output, mode=a.mode, dwell_s=r["dwell_s"], probe_dirs=r["probe_dirs"],

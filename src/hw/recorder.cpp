@@ -318,7 +318,7 @@ RecordSummary record_ballbar(ByteTransport& port, const ProgramTimeline& program
   header.metadata = {{"recorded_from", port.path()},
                      {"recorded_at", utc_now()},
                      {"sample_rate_hz", fixed(opt.rate_hz, 0)}};
-  BallbarWriter out(path, header);
+  BallbarWriter out(path, header, OutputOptions{{port.path()}, {}});
   const double L0 = header.ballbar_length;
   return run_recording(port, out, [&](RecordSummary& sum) {
     read_stream(port, opt, opt.zero, out, sum, decode_ballbar_sample,
@@ -581,7 +581,7 @@ RecordSummary record_rtest(ByteTransport& port, ProbeMode mode, const RtestSessi
                      {"probe_mode", to_string(mode)}};
   header.probe_dirs.clear();
   for (int k = 0; k < 3; ++k) header.probe_dirs[k + 1] = probe_dirs.row(k).transpose();
-  RtestWriter out(path, header, /*raw=*/true);
+  RtestWriter out(path, header, /*raw=*/true, OutputOptions{{port.path()}, {}});
   return run_recording(port, out, [&](RecordSummary& sum) {
     PoseAverager poses(program, dwell_s, out, sum);
     if (mode == ProbeMode::stream) {

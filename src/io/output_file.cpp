@@ -257,4 +257,54 @@ void write_output(const std::string& path, const std::function<std::string()>& p
   write_output(path, data, options);
 }
 
+OutputStream::OutputStream(const std::string& path, const OutputOptions& options) : path_(path) {
+  Resolved r;
+  const OutputKind kind = classify(path, options, r);
+  target_ = r.canonical;
+  directory_ = r.dir;
+  if (kind == OutputKind::WriteThrough) {
+    do {
+      fd_ = ::open(r.canonical.c_str(), O_WRONLY | O_NOCTTY | O_CLOEXEC);
+    } while (fd_ < 0 && errno == EINTR);
+    if (fd_ < 0) fail_errno(path, "cannot open for writing", errno);
+  } else {
+    fd_ = create_temporary(path, r, temporary_);
+  }
+}
+
+OutputStream::~OutputStream() {
+  try {
+    commit();
+  } catch (...) {  // NOLINT(bugprone-empty-catch): a destructor must not throw; commit() named it
+  }
+}
+
+void OutputStream::write(const std::string& text) {
+  if (fd_ < 0) fail(path_, "the output is already closed");
+  write_all(fd_, text, path_);
+}
+
+void OutputStream::commit() {
+  if (fd_ < 0) return;
+  const int fd = fd_;
+  fd_ = -1;
+  if (temporary_.empty()) {
+    if (::close(fd) != 0 && errno != EINTR) fail_errno(path_, "write failed", errno);
+    return;
+  }
+  const bool synced = ::fsync(fd) == 0;
+  const int sync_err = errno;
+  if (::close(fd) != 0 || !synced) {
+    // The rows are measurements: keep them under the temporary name rather than delete them.
+    fail_errno(path_, "write failed (the rows so far are in " + temporary_ + ")", synced ? errno : sync_err);
+  }
+  if (::rename(temporary_.c_str(), target_.c_str()) != 0)
+    fail_errno(path_, "cannot replace (the rows are in " + temporary_ + ")", errno);
+  const int dfd = ::open(directory_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd >= 0) {
+    (void)::fsync(dfd);
+    ::close(dfd);
+  }
+}
+
 }  // namespace rotacal

@@ -120,8 +120,8 @@ PlausibilityReport check_plausible(const BallbarSession& s, const std::string& s
                      " s): measured length " + fmt(w.length, 8) + " mm, nominal kinematics give " +
                      fmt(commanded[rep.worst_sample], 8) + " mm; " + fmt(rep.max_deviation_mm) +
                      " mm apart, more than the " + fmt(limit) +
-                     " mm a machine's errors and set-up explain (PlausibilityOptions::max_length_deviation_mm "
-                     "widens it)");
+                     " mm a machine's errors and set-up explain (rotacal's --max-deviation or "
+                     "PlausibilityOptions::max_length_deviation_mm widens it)");
 }
 
 PlausibilityReport check_plausible(const RtestSession& s, const std::string& source,
@@ -167,7 +167,7 @@ PlausibilityReport check_plausible(const RtestSession& s, const std::string& sou
                      " s): the commanded position is " + fmt(rep.max_deviation_mm) +
                      " mm from where the nominal axes carry nest." + w.setup + ", more than the " + fmt(limit) +
                      " mm a machine's errors explain: wrong nest metadata, wrong machine, or positions that "
-                     "are not the commanded axes (PlausibilityOptions::max_position_deviation_mm widens it)");
+                     "are not the commanded axes (rotacal's --max-deviation or PlausibilityOptions::max_position_deviation_mm widens it)");
 }
 
 void check_model_machine(MachineType model_machine, MachineType session_machine, const std::string& model_source) {

@@ -775,19 +775,9 @@ AnySession read_session(const std::string& path) {
 // ---------------------------------------------------------------- appending writers
 
 namespace {
-std::FILE* open_for_append(const std::string& path, const std::string& head) {
-  std::FILE* f = std::fopen(path.c_str(), "wb");
-  if (!f) throw IoError(path + ": cannot open for writing: " + std::strerror(errno));
-  if (std::fputs(head.c_str(), f) < 0 || std::fflush(f) != 0) {
-    std::fclose(f);
-    throw IoError(path + ": write failed: " + std::strerror(errno));
-  }
-  return f;
-}
-void put(std::FILE* f, const std::string& path, const std::string& text) {
+void put(const std::unique_ptr<OutputStream>& f, const std::string& path, const std::string& text) {
   if (!f) throw IoError(path + ": writer is closed");
-  if (std::fputs(text.c_str(), f) < 0 || std::fflush(f) != 0)
-    throw IoError(path + ": write failed: " + std::strerror(errno));
+  f->write(text);
 }
 std::string annotation_line(const std::string& text) {
   std::string t = text;
@@ -796,12 +786,9 @@ std::string annotation_line(const std::string& text) {
 }
 }  // namespace
 
-BallbarWriter::BallbarWriter(const std::string& path, const BallbarSession& header)
-    : path_(path), columns_(header.extra_columns.size()) {
-  file_ = open_for_append(path, ballbar_head(header));
-}
-BallbarWriter::~BallbarWriter() {
-  if (file_) std::fclose(file_);
+BallbarWriter::BallbarWriter(const std::string& path, const BallbarSession& header, const OutputOptions& options)
+    : file_(std::make_unique<OutputStream>(path, options)), path_(path), columns_(header.extra_columns.size()) {
+  file_->write(ballbar_head(header));
 }
 void BallbarWriter::append(const BallbarSample& s) {
   if (s.time < last_time_) throw InvalidArgument(path_ + ": sample time " + format_number(s.time) + " goes backwards");
@@ -811,23 +798,19 @@ void BallbarWriter::append(const BallbarSample& s) {
 }
 void BallbarWriter::annotate(const std::string& text) { put(file_, path_, annotation_line(text)); }
 void BallbarWriter::close() {
-  if (file_ && std::fclose(file_) != 0) {
-    file_ = nullptr;
-    throw IoError(path_ + ": close failed: " + std::strerror(errno));
-  }
-  file_ = nullptr;
+  if (!file_) return;
+  std::unique_ptr<OutputStream> f = std::move(file_);
+  f->commit();
 }
 
-RtestWriter::RtestWriter(const std::string& path, const RtestSession& header, bool raw)
+RtestWriter::RtestWriter(const std::string& path, const RtestSession& header, bool raw, const OutputOptions& options)
     : path_(path), raw_(raw), extra_(header.extra_columns.size()) {
   if (raw)
     for (int k = 1; k <= 3; ++k)
       if (!header.probe_dirs.count(k))
         throw InvalidArgument("RtestWriter: raw columns need probe." + std::to_string(k) + ".dir");
-  file_ = open_for_append(path, rtest_head(header, RtestColumns{!raw, raw}));
-}
-RtestWriter::~RtestWriter() {
-  if (file_) std::fclose(file_);
+  file_ = std::make_unique<OutputStream>(path, options);
+  file_->write(rtest_head(header, RtestColumns{!raw, raw}));
 }
 void RtestWriter::append(const RtestSample& s) {
   if (s.time < last_time_) throw InvalidArgument(path_ + ": sample time " + format_number(s.time) + " goes backwards");
@@ -837,11 +820,9 @@ void RtestWriter::append(const RtestSample& s) {
 }
 void RtestWriter::annotate(const std::string& text) { put(file_, path_, annotation_line(text)); }
 void RtestWriter::close() {
-  if (file_ && std::fclose(file_) != 0) {
-    file_ = nullptr;
-    throw IoError(path_ + ": close failed: " + std::strerror(errno));
-  }
-  file_ = nullptr;
+  if (!file_) return;
+  std::unique_ptr<OutputStream> f = std::move(file_);
+  f->commit();
 }
 
 }  // namespace rotacal

@@ -179,12 +179,24 @@ TEST_CASE("appending writer flushes every row and keeps gap markers", "[io]") {
   const BallbarSession s = random_ballbar(rng);
   const std::string path = "test_io_append.csv";
   {
+    std::ofstream old(path);
+    old << "the previous recording\n";
+  }
+  {
     BallbarWriter w(path, s);
     for (int i = 0; i < 5; ++i) w.append(s.samples[static_cast<std::size_t>(i)]);
     w.annotate("gap: seq 17-19 missing");
     w.append(s.samples[5]);
-    // Before close or destruction the rows are already in the file.
-    const BallbarSession partial = read_ballbar(path);
+    // Before close or destruction the rows are already on disk, in the temporary file; the
+    // previous file is replaced only when the writer ends (the output rule).
+    REQUIRE(w.writing_path() != path);
+    {
+      std::ifstream old(path);
+      std::string line;
+      std::getline(old, line);
+      CHECK(line == "the previous recording");
+    }
+    const BallbarSession partial = read_ballbar(w.writing_path());
     CHECK(partial.samples.size() == 6);
     REQUIRE(partial.annotations.size() == 1);
     CHECK(partial.annotations[0].before_sample == 5);

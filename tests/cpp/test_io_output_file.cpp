@@ -222,3 +222,42 @@ TEST_CASE("a write cut off mid-file (file size limit) keeps the old file and lea
   CHECK(slurp(d / "prog.ngc") == "G0 X0\nM30\n");
   CHECK(d.entries() == std::vector<std::string>{"prog.ngc"});
 }
+
+TEST_CASE("a stream (a recording) replaces the target when it ends, however it ends") {
+  TempDir d;
+  put(d / "rec.csv", "previous recording\n");
+  {
+    OutputStream out(d / "rec.csv");
+    out.write("row 1\n");
+    // Written as it comes, into the temporary file; the old file is untouched meanwhile.
+    CHECK(slurp(out.writing_path()) == "row 1\n");
+    CHECK(slurp(d / "rec.csv") == "previous recording\n");
+    out.write("row 2\n");
+  }  // destroyed without commit (an exception unwinding the recorder): still committed
+  CHECK(slurp(d / "rec.csv") == "row 1\nrow 2\n");
+  CHECK(d.entries() == std::vector<std::string>{"rec.csv"});
+
+  OutputStream twice(d / "rec.csv");
+  twice.write("again\n");
+  twice.commit();
+  twice.commit();  // a second commit does nothing
+  CHECK_THROWS_WITH(twice.write("late\n"), Catch::Contains("closed"));
+  CHECK(slurp(d / "rec.csv") == "again\n");
+}
+
+TEST_CASE("a stream refuses its inputs and writes devices through") {
+  TempDir d;
+  put(d / "port", "not a port");
+  OutputOptions o;
+  o.inputs = {d / "port"};
+  CHECK_THROWS_WITH(OutputStream(d / "port", o), Catch::Contains("input"));
+  CHECK_THROWS_WITH(OutputStream(d.path), Catch::Contains("directory"));
+  OutputStream null("/dev/null");
+  CHECK(null.writing_path() == "/dev/null");
+  null.write("discarded\n");
+  null.commit();
+  struct stat st {};
+  REQUIRE(::stat("/dev/null", &st) == 0);
+  CHECK(S_ISCHR(st.st_mode));
+  CHECK(d.entries() == std::vector<std::string>{"port"});
+}

@@ -79,8 +79,9 @@ TEST_CASE("R-test appending writer", "[io]") {
     RtestWriter w(path, s, false);
     for (int i = 0; i < 3; ++i) w.append(s.samples[static_cast<std::size_t>(i)]);
     w.annotate("probe 2 out of range");
-    CHECK(read_rtest(path).samples.size() == 3);
+    CHECK(read_rtest(w.writing_path()).samples.size() == 3);
     CHECK_THROWS_AS(RtestWriter("x.csv", s, true), InvalidArgument);  // raw needs probe dirs
   }
+  CHECK(read_rtest(path).samples.size() == 3);  // renamed over the target when destroyed
   std::remove(path.c_str());
 }

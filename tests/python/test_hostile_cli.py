@@ -330,6 +330,17 @@ def test_missing_output_folder_is_an_error(files, tmp_path):
     assert not (tmp_path / "no").exists()
 
 
+@pytest.mark.parametrize("kind", ["ballbar", "rtest"])
+def test_record_checks_its_output_before_opening_the_port(tmp_path, kind):
+    # The port does not exist either: the output is refused first, by the output rule.
+    out = tmp_path / "no" / "rec.csv"
+    r = rotacal_cli("record", kind, "--port", tmp_path / "ttyNONE", "-o", out, "--no-progress")
+    assert r.returncode == EXIT_IO, r.stderr
+    assert "does not exist" in r.stderr and "rec.csv" in r.stderr, r.stderr
+    r = rotacal_cli("record", kind, "--port", tmp_path / "ttyNONE", "-o", tmp_path, "--no-progress")
+    assert r.returncode == EXIT_IO and "directory" in r.stderr, r.stderr
+
+
 def test_devices_written_through_not_replaced(files):
     for args in (("simulate", "ballbar", "-o", "/dev/null"),
                  ("plan", "ballbar", "-o", "/dev/null"),
@@ -513,6 +524,18 @@ def test_max_deviation_widens_the_check_for_an_unusual_session(shared_data, tmp_
     r = rotacal_cli("identify", dst, "--max-deviation", "5", "--length-offset")
     assert r.returncode == 0, r.stderr
     assert rotacal_cli("identify", dst, "--max-deviation", "0").returncode == EXIT_INPUT
+
+
+def test_deviation_message_names_the_cli_option(shared_data, tmp_path):
+    # An R-test nest declared 3 mm from where the program put it: refused, and the message
+    # says how to widen the limit in the CLI's own words.
+    text = (shared_data / "rtest_bc_oyama.csv").read_text()
+    line = next(ln for ln in text.splitlines() if ln.startswith("# nest.1:"))
+    dst = tmp_path / "nest_off.csv"
+    dst.write_text(text.replace(line, "# nest.1: 103.0000, 0.0000, 60.0000"))
+    r = rotacal_cli("identify", dst)
+    assert r.returncode == EXIT_INPUT and "--max-deviation" in r.stderr, r.stderr
+    assert rotacal_cli("identify", dst, "--max-deviation", "4").returncode == 0
 
 
 def test_predict_with_a_model_of_another_machine_is_refused(shared_data, tmp_path):

@@ -102,13 +102,16 @@ def test_ctrl_c_stops_cleanly_and_keeps_the_rows(tmp_path):
     rec = subprocess.Popen([sys.executable, "-m", "rotacal", "record", "ballbar", "--port", v.port, *FAST,
                             "-o", tmp_path / "s.csv", "--json"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                            text=True)
-    # Ctrl-C once the recording is under way (more than 100 rows in the file), however long a
-    # loaded machine takes to start the recorder.
+    # Ctrl-C once the recording is under way (more than 100 rows on disk), however long a
+    # loaded machine takes to start the recorder. Until it ends, the rows are in the output
+    # rule's temporary file beside s.csv, which then replaces s.csv.
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and rec.poll() is None:
-        rows = [ln for ln in (tmp_path / "s.csv").read_text().splitlines()[1:] if ln and not ln.startswith("#")] \
-            if (tmp_path / "s.csv").exists() else []
+        parts = list(tmp_path.glob(".rotacal-*.part"))
+        rows = [ln for ln in parts[0].read_text().splitlines()[1:] if ln and not ln.startswith("#")] \
+            if parts else []
         if len(rows) > 100:
+            assert not (tmp_path / "s.csv").exists()
             break
         time.sleep(0.2)
     rec.send_signal(signal.SIGINT)
@@ -121,6 +124,7 @@ def test_ctrl_c_stops_cleanly_and_keeps_the_rows(tmp_path):
     session = rotacal.load(tmp_path / "s.csv")
     assert len(session) == s["rows"]
     assert "# summary:" in (tmp_path / "s.csv").read_text()
+    assert not list(tmp_path.glob(".rotacal-*.part"))  # renamed, nothing left behind
 
 
 @pytest.mark.parametrize("mode", ["sylvac", "keyence", "stream"])

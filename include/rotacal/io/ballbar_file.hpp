@@ -5,11 +5,12 @@
 /// bit-identical (shortest round-trip decimal for every double); appending writers for
 /// recorders, which flush every row so a crash never loses what was already read.
 
-#include <cstdio>
 #include <istream>
+#include <memory>
 #include <string>
 #include <variant>
 
+#include "rotacal/io/output_file.hpp"
 #include "rotacal/io/session.hpp"
 
 namespace rotacal {
@@ -48,22 +49,25 @@ using AnySession = std::variant<BallbarSession, RtestSession>;
 AnySession read_session(const std::string& path);
 
 /// Appending writer for recorders: writes the metadata and header at once, then one row per
-/// append(), flushed to the operating system before append() returns.
+/// append(), passed to the operating system before append() returns. The file follows the
+/// output rule (io/output_file.hpp, OutputStream): it replaces the target when the writer is
+/// closed or destroyed; `options` names the command's inputs and other outputs.
 class BallbarWriter {
  public:
   /// `header` supplies machine, metadata and extra columns; its samples are not written.
-  BallbarWriter(const std::string& path, const BallbarSession& header);
-  ~BallbarWriter();
+  BallbarWriter(const std::string& path, const BallbarSession& header, const OutputOptions& options = {});
   BallbarWriter(const BallbarWriter&) = delete;
   BallbarWriter& operator=(const BallbarWriter&) = delete;
   void append(const BallbarSample& sample);
   /// A `# text` line at this point of the file (e.g. a gap marker).
   void annotate(const std::string& text);
   std::size_t rows() const { return rows_; }
+  /// Where the rows are while the writer is open (io/output_file.hpp, OutputStream).
+  std::string writing_path() const { return file_ ? file_->writing_path() : path_; }
   void close();
 
  private:
-  std::FILE* file_ = nullptr;
+  std::unique_ptr<OutputStream> file_;
   std::string path_;
   std::size_t columns_ = 0;
   std::size_t rows_ = 0;
@@ -74,17 +78,19 @@ class RtestWriter {
  public:
   /// `header` supplies machine, nests, probe directions and metadata; `raw` selects d1,d2,d3
   /// columns (probe readings) instead of dx,dy,dz.
-  RtestWriter(const std::string& path, const RtestSession& header, bool raw);
-  ~RtestWriter();
+  RtestWriter(const std::string& path, const RtestSession& header, bool raw,
+              const OutputOptions& options = {});
   RtestWriter(const RtestWriter&) = delete;
   RtestWriter& operator=(const RtestWriter&) = delete;
   void append(const RtestSample& sample);
   void annotate(const std::string& text);
   std::size_t rows() const { return rows_; }
+  /// Where the rows are while the writer is open (io/output_file.hpp, OutputStream).
+  std::string writing_path() const { return file_ ? file_->writing_path() : path_; }
   void close();
 
  private:
-  std::FILE* file_ = nullptr;
+  std::unique_ptr<OutputStream> file_;
   std::string path_;
   bool raw_ = false;
   std::size_t extra_ = 0;

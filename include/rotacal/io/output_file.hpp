@@ -14,6 +14,10 @@
 ///   the same canonical path for files that do not exist yet).
 /// - Nothing is left behind on any failure, including an exception thrown while the content is
 ///   produced (the content is produced before anything is opened).
+/// - A file written as it comes (OutputStream, the recorders) follows the same rule: its rows
+///   go to the temporary file, which replaces the target when the stream ends, however it ends
+///   (a recording's rows are measurements that cannot be taken again). Only a process that is
+///   killed leaves its rows behind, in the hidden `.rotacal-<hex>.part` of the target's folder.
 
 #include <functional>
 #include <string>
@@ -44,5 +48,28 @@ void write_output(const std::string& path, const std::string& data, const Output
 /// file stays), then write it by the rule above.
 void write_output(const std::string& path, const std::function<std::string()>& produce,
                   const OutputOptions& options = {});
+
+/// A file written piece by piece by the rule above: each write() reaches the operating system
+/// before it returns; commit() (or the destructor) makes the file the target.
+class OutputStream {
+ public:
+  /// Checks the path (check_output) and opens the temporary file or the device.
+  OutputStream(const std::string& path, const OutputOptions& options = {});
+  ~OutputStream();  ///< commits if commit() was not called; errors are then swallowed
+  OutputStream(const OutputStream&) = delete;
+  OutputStream& operator=(const OutputStream&) = delete;
+  void write(const std::string& text);  ///< throws IoError naming the path
+  void commit();                        ///< fsync, rename over the target; throws IoError
+  const std::string& path() const { return path_; }
+  /// Where the rows are until commit(): the temporary file, or the device written through.
+  const std::string& writing_path() const { return temporary_.empty() ? target_ : temporary_; }
+
+ private:
+  std::string path_;       ///< as the caller named it
+  std::string target_;     ///< canonical target
+  std::string directory_;  ///< its directory (fsynced after the rename)
+  std::string temporary_;  ///< empty when written through
+  int fd_ = -1;
+};
 
 }  // namespace rotacal
