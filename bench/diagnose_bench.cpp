@@ -16,38 +16,14 @@
 #include "rotacal/ballbar/test_plan.hpp"
 #include "rotacal/core/least_squares.hpp"
 #include "rotacal/diagnose/ballbar_diagnosis.hpp"
+#include "../tests/support/detection_amplitude.hpp"
+#include "../tests/support/synthetic_sessions.hpp"
 
 using namespace rotacal;
 
 namespace {
 constexpr double kNoiseUm = 0.5;
 
-BallbarMachineModel random_machine(const BallbarSession& cmd, std::mt19937& rng) {
-  std::normal_distribution<double> N(0.0, 1.0);
-  BallbarMachineModel m;
-  m.machine = cmd.machine;
-  for (int i = 0; i < 8; ++i) m.errors.v[i] = location_error_is_angle(i) ? 5e-5 * N(rng) : 0.03 * N(rng);
-  m.pivot = cmd.pivot + 0.02 * Eigen::Vector3d(N(rng), N(rng), N(rng));
-  return m;
-}
-
-// Parameters giving k sigma RMS of unabsorbable signal, or empty beyond a plausible size.
-std::vector<double> amplitude(const BallbarSession& cmd, const BallbarMachineModel& truth, const Effect& e, double k) {
-  BallbarSession s = simulate_ballbar(cmd, truth, {0.0, 1, false});
-  s.noise_um = kNoiseUm;
-  BallbarDiagnosisProblem P(s);
-  const ModelFit at = P.fit(EffectModel{});
-  Eigen::VectorXd m(e.num_params());
-  for (int j = 0; j < m.size(); ++j) m[j] = plausible_magnitude(e.param_units()[static_cast<std::size_t>(j)]);
-  const Eigen::MatrixXd Jc = P.candidate_jacobian(at, e) * m.asDiagonal();
-  const Eigen::MatrixXd perp = Jc - at.jacobian * at.jacobian.completeOrthogonalDecomposition().solve(Jc);
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(perp, Eigen::ComputeThinV);
-  const double per_size = svd.singularValues()[0] / std::sqrt(static_cast<double>(perp.rows()));
-  const double sizes = k * kNoiseUm * 1e-3 / per_size;
-  if (!(per_size > 0) || sizes * svd.matrixV().col(0).cwiseAbs().maxCoeff() > 1.0) return {};
-  const Eigen::VectorXd p = m.cwiseProduct(svd.matrixV().col(0)) * sizes;
-  return std::vector<double>(p.data(), p.data() + p.size());
-}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -68,7 +44,7 @@ int main(int argc, char** argv) {
   int false_findings = 0;
   std::vector<double> ms;
   for (int k = 0; k < n_null; ++k) {
-    const BallbarSession s = simulate_ballbar(cmd, random_machine(cmd, rng), {kNoiseUm, static_cast<std::uint64_t>(k + 1), true});
+    const BallbarSession s = simulate_ballbar(cmd, synthetic::random_ballbar_machine(cmd, rng), {kNoiseUm, static_cast<std::uint64_t>(k + 1), true});
     const auto t0 = std::chrono::steady_clock::now();
     const Diagnosis D = diagnose_ballbar(s);
     ms.push_back(1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
@@ -97,8 +73,8 @@ int main(int argc, char** argv) {
     for (double a : amps) {
       int hits = 0, done = 0;
       for (int t = 0; t < trials; ++t) {
-        BallbarMachineModel truth = random_machine(cmd, rng);
-        const std::vector<double> p = amplitude(cmd, truth, e, a);
+        BallbarMachineModel truth = synthetic::random_ballbar_machine(cmd, rng);
+        const std::vector<double> p = synthetic::unabsorbable_amplitude(cmd, truth, e, a, kNoiseUm);
         if (p.empty()) break;
         truth.effects.effects = {e};
         truth.effect_params = p;

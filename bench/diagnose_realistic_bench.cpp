@@ -19,53 +19,13 @@
 #include "rotacal/core/least_squares.hpp"
 #include "rotacal/core/noise_model.hpp"
 #include "rotacal/diagnose/ballbar_diagnosis.hpp"
+#include "../tests/support/detection_amplitude.hpp"
+#include "../tests/support/synthetic_sessions.hpp"
 
 using namespace rotacal;
 
 namespace {
 constexpr double kNoiseUm = 0.5;
-
-BallbarMachineModel random_machine(const BallbarSession& cmd, std::mt19937& rng) {
-  std::normal_distribution<double> N(0.0, 1.0);
-  BallbarMachineModel m;
-  m.machine = cmd.machine;
-  for (int i = 0; i < 8; ++i) m.errors.v[i] = location_error_is_angle(i) ? 5e-5 * N(rng) : 0.03 * N(rng);
-  m.pivot = cmd.pivot + 0.02 * Eigen::Vector3d(N(rng), N(rng), N(rng));
-  return m;
-}
-
-// rho < 0: 1/f-like; rho == 0: white; else AR(1). Marginal sigma kNoiseUm, declared.
-BallbarSession session(const BallbarSession& cmd, const BallbarMachineModel& truth, double rho,
-                       std::uint64_t seed) {
-  BallbarSession s = simulate_ballbar(cmd, truth, {0.0, 1, false});
-  std::vector<std::string> g;
-  std::vector<double> t;
-  for (const BallbarSample& x : s.samples) g.push_back(x.test), t.push_back(x.time);
-  const Eigen::VectorXd e = rho < 0 ? noise_gen::pink(g, t, kNoiseUm * 1e-3, seed)
-                                    : noise_gen::ar1(g, t, rho, kNoiseUm * 1e-3, seed);
-  for (std::size_t i = 0; i < s.samples.size(); ++i) s.samples[i].length += e[static_cast<Eigen::Index>(i)];
-  s.noise_um = kNoiseUm;
-  return s;
-}
-
-// Parameters giving k sigma RMS of signal the baseline cannot absorb, or empty beyond a
-// plausible size (as diagnose_bench).
-std::vector<double> amplitude(const BallbarSession& cmd, const BallbarMachineModel& truth, const Effect& e, double k) {
-  BallbarSession s = simulate_ballbar(cmd, truth, {0.0, 1, false});
-  s.noise_um = kNoiseUm;
-  BallbarDiagnosisProblem P(s);
-  const ModelFit at = P.fit(EffectModel{});
-  Eigen::VectorXd m(e.num_params());
-  for (int j = 0; j < m.size(); ++j) m[j] = plausible_magnitude(e.param_units()[static_cast<std::size_t>(j)]);
-  const Eigen::MatrixXd Jc = P.candidate_jacobian(at, e) * m.asDiagonal();
-  const Eigen::MatrixXd perp = Jc - at.jacobian * at.jacobian.completeOrthogonalDecomposition().solve(Jc);
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(perp, Eigen::ComputeThinV);
-  const double per_size = svd.singularValues()[0] / std::sqrt(static_cast<double>(perp.rows()));
-  const double sizes = k * kNoiseUm * 1e-3 / per_size;
-  if (!(per_size > 0) || sizes * svd.matrixV().col(0).cwiseAbs().maxCoeff() > 1.0) return {};
-  const Eigen::VectorXd p = m.cwiseProduct(svd.matrixV().col(0)) * sizes;
-  return std::vector<double>(p.data(), p.data() + p.size());
-}
 
 bool named_first(const Diagnosis& D, const Effect& e) {
   if (D.findings.empty()) return false;
@@ -107,7 +67,7 @@ int main(int argc, char** argv) {
     int fm = 0, fw = 0, un = 0;
     std::vector<double> ms, ms_white;
     for (int k = 0; k < n_null; ++k) {
-      const BallbarSession s = session(cmd, random_machine(cmd, rng), rho, static_cast<std::uint64_t>(k + 1));
+      const BallbarSession s = synthetic::noisy_ballbar(cmd, synthetic::random_ballbar_machine(cmd, rng), rho, kNoiseUm, static_cast<std::uint64_t>(k + 1));
       auto t0 = std::chrono::steady_clock::now();
       const Diagnosis D = diagnose_ballbar(s);
       ms.push_back(ms_since(t0));
@@ -135,12 +95,12 @@ int main(int argc, char** argv) {
     for (const Effect& e : effect_catalogue(MachineType::AC_trt, 3)) {
       int h = 0, d = 0;
       for (int t = 0; t < trials; ++t) {
-        BallbarMachineModel truth = random_machine(cmd, rng);
-        const std::vector<double> p = amplitude(cmd, truth, e, 0.45);
+        BallbarMachineModel truth = synthetic::random_ballbar_machine(cmd, rng);
+        const std::vector<double> p = synthetic::unabsorbable_amplitude(cmd, truth, e, 0.45, kNoiseUm);
         if (p.empty()) break;
         truth.effects.effects = {e};
         truth.effect_params = p;
-        const Diagnosis D = diagnose_ballbar(session(cmd, truth, rho, static_cast<std::uint64_t>(900 + t)));
+        const Diagnosis D = diagnose_ballbar(synthetic::noisy_ballbar(cmd, truth, rho, kNoiseUm, static_cast<std::uint64_t>(900 + t)));
         ++d;
         h += named_first(D, e);
       }

@@ -7,26 +7,15 @@
 #include "rotacal/core/least_squares.hpp"
 #include "rotacal/diagnose/ballbar_diagnosis.hpp"
 #include "rotacal/io/ballbar_file.hpp"
+#include "../support/synthetic_sessions.hpp"
 
 using namespace rotacal;
 
 namespace {
 constexpr double kNoiseUm = 0.5;
 
-// The commanded rows of the independent implementation's complete single set-up test.
-const BallbarSession& commanded() {
-  static const BallbarSession s = read_ballbar(std::string(ROTACAL_SHARED_DIR) + "/data/ballbar_ac_table2.csv");
-  return s;
-}
-
-BallbarMachineModel random_machine(std::mt19937& rng) {
-  std::normal_distribution<double> N(0.0, 1.0);
-  BallbarMachineModel m;
-  m.machine = MachineType::AC_trt;
-  for (int i = 0; i < 8; ++i) m.errors.v[i] = location_error_is_angle(i) ? 5e-5 * N(rng) : 0.03 * N(rng);
-  m.pivot = commanded().pivot + Eigen::Vector3d(N(rng), N(rng), N(rng)) * 0.02;  // set-up error
-  return m;
-}
+const BallbarSession& commanded() { return synthetic::table2_commanded(); }
+BallbarMachineModel random_machine(std::mt19937& rng) { return synthetic::random_ballbar_machine(commanded(), rng); }
 
 // Parameters of `effect` whose reading change, after the baseline (location errors + pivot)
 // has absorbed what it can, is `k_sigma` noise sigmas RMS over the session; empty if that

@@ -14,52 +14,26 @@
 #include "rotacal/diagnose/rtest_diagnosis.hpp"
 #include "rotacal/io/ballbar_file.hpp"
 #include "rotacal/rtest/simulate.hpp"
+#include "../support/synthetic_sessions.hpp"
 
 using namespace rotacal;
 
 namespace {
 
-const BallbarSession& commanded() {
-  static const BallbarSession s =
-      read_ballbar(std::string(ROTACAL_SHARED_DIR) + "/data/ballbar_ac_table2.csv");
-  return s;
-}
-
-BallbarMachineModel random_machine(std::mt19937& rng) {
-  std::normal_distribution<double> N(0.0, 1.0);
-  BallbarMachineModel m;
-  m.machine = MachineType::AC_trt;
-  for (int i = 0; i < 8; ++i) m.errors.v[i] = location_error_is_angle(i) ? 5e-5 * N(rng) : 0.03 * N(rng);
-  m.pivot = commanded().pivot + Eigen::Vector3d(N(rng), N(rng), N(rng)) * 0.02;
-  return m;
-}
-
 enum class Noise { ar1_09, ar1_095, pink, ar1_05 };
 
-// A noise-free simulated session with coloured noise added to the readings; the file declares
-// 0.5 um, the marginal sigma, as a user who measured the noise at rest would.
-BallbarSession noisy_ballbar(const BallbarMachineModel& truth, Noise kind, std::uint64_t seed) {
-  BallbarSession s = simulate_ballbar(commanded(), truth, {0.0, 1, false});
-  std::vector<std::string> g;
-  std::vector<double> t;
-  for (const BallbarSample& x : s.samples) g.push_back(x.test), t.push_back(x.time);
-  const Eigen::VectorXd e = kind == Noise::pink ? noise_gen::pink(g, t, 0.5e-3, seed)
-                                                : noise_gen::ar1(g, t, kind == Noise::ar1_09 ? 0.9 : kind == Noise::ar1_05 ? 0.5 : 0.95, 0.5e-3, seed);
-  for (std::size_t i = 0; i < s.samples.size(); ++i) s.samples[i].length += e[static_cast<Eigen::Index>(i)];
-  s.noise_um = 0.5;
-  return s;
-}
+const BallbarSession& commanded() { return synthetic::table2_commanded(); }
+BallbarMachineModel random_machine(std::mt19937& rng) { return synthetic::random_ballbar_machine(commanded(), rng); }
+MachineModel random_table(std::mt19937& rng) { return synthetic::random_bc_table(rng); }
 
-RtestTruth random_table(std::mt19937& rng) {
-  std::normal_distribution<double> N(0.0, 1.0);
-  RtestTruth t;
-  t.machine = MachineType::BC_trt;
-  for (int i = 0; i < 8; ++i) t.errors.v[i] = location_error_is_angle(i) ? 3e-5 * N(rng) : 0.02 * N(rng);
-  return t;
+// Coloured noise of 0.5 um marginal sigma, which the file declares.
+BallbarSession noisy_ballbar(const BallbarMachineModel& truth, Noise kind, std::uint64_t seed) {
+  const double rho = kind == Noise::pink ? -1.0 : kind == Noise::ar1_09 ? 0.9 : kind == Noise::ar1_05 ? 0.5 : 0.95;
+  return synthetic::noisy_ballbar(commanded(), truth, rho, 0.5, seed);
 }
 
 // R-test session with AR(1) noise per probe channel and probe zeros wandering between poses.
-RtestSession noisy_rtest(const RtestTruth& truth, double rho, double wander_um, std::uint64_t seed) {
+RtestSession noisy_rtest(const MachineModel& truth, double rho, double wander_um, std::uint64_t seed) {
   RtestSimOptions o;
   o.noise_um = 0.0;
   RtestSession s = simulate_rtest(truth, o).session;
@@ -221,7 +195,7 @@ TEST_CASE("R-test null sessions with AR(1) noise and wandering probe zeros: no f
 TEST_CASE("R-test: gravity sag of B hidden in AR(1) noise with wandering zeros is named first",
           "[diagnose][realistic]") {
   std::mt19937 rng(37);
-  RtestTruth t = random_table(rng);
+  MachineModel t = random_table(rng);
   t.effects.effects = {Effect::parse("gravity_sag_B")};
   t.effect_params = {0.006};
   const Diagnosis D = diagnose_rtest(noisy_rtest(t, 0.8, 0.1, 99));

@@ -9,17 +9,12 @@
 #include "rotacal/diagnose/rtest_diagnosis.hpp"
 #include "rotacal/io/ballbar_file.hpp"
 #include "rotacal/rtest/simulate.hpp"
+#include "../support/synthetic_sessions.hpp"
 
 using namespace rotacal;
 
 namespace {
-RtestTruth random_table(std::mt19937& rng) {
-  std::normal_distribution<double> N(0.0, 1.0);
-  RtestTruth t;
-  t.machine = MachineType::BC_trt;
-  for (int i = 0; i < 8; ++i) t.errors.v[i] = location_error_is_angle(i) ? 3e-5 * N(rng) : 0.02 * N(rng);
-  return t;
-}
+MachineModel random_table(std::mt19937& rng) { return synthetic::random_bc_table(rng); }
 }  // namespace
 
 TEST_CASE("R-test diagnosis finds the effects hidden in the independent implementation's file", "[diagnose]") {
@@ -54,7 +49,7 @@ TEST_CASE("R-test diagnosis: null data gives no finding; a hidden runout is foun
     CHECK(D.findings.empty());
     CHECK_FALSE(D.unexplained.present);
   }
-  RtestTruth t = random_table(rng);
+  MachineModel t = random_table(rng);
   t.effects.effects = {Effect::parse("radial_motion_C_h2")};
   t.effect_params = {2e-3, 0.0, 0.0, 1e-3};  // a 2-lobe bearing track, 1-2 um
   RtestSimOptions o;
@@ -87,7 +82,7 @@ TEST_CASE("every catalogue effect an R-test can see, hidden at 5 sigma, is found
     return s;
   }());
   for (const Effect& effect : probe.candidates(2)) {
-    RtestTruth t = random_table(rng);
+    MachineModel t = random_table(rng);
     RtestSimOptions o;
     o.noise_um = 0.0;
     RtestSession clean = simulate_rtest(t, o).session;

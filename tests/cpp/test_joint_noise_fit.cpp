@@ -12,36 +12,17 @@
 #include "rotacal/rtest/identify_joint.hpp"
 #include "rotacal/rtest/monte_carlo.hpp"
 #include "rotacal/rtest/simulate.hpp"
+#include "../support/synthetic_sessions.hpp"
 
 using namespace rotacal;
 
 namespace {
 
-const BallbarSession& commanded() {
-  static const BallbarSession s =
-      read_ballbar(std::string(ROTACAL_SHARED_DIR) + "/data/ballbar_ac_table2.csv");
-  return s;
-}
-
-BallbarMachineModel random_machine(std::mt19937& rng) {
-  std::normal_distribution<double> N(0.0, 1.0);
-  BallbarMachineModel m;
-  m.machine = MachineType::AC_trt;
-  for (int i = 0; i < 8; ++i) m.errors.v[i] = location_error_is_angle(i) ? 5e-5 * N(rng) : 0.03 * N(rng);
-  m.pivot = commanded().pivot + Eigen::Vector3d(N(rng), N(rng), N(rng)) * 0.02;
-  return m;
-}
-
-// Noise-free simulation plus AR(1) noise per test (0.5 um marginal), as the issue's sessions.
+const BallbarSession& commanded() { return synthetic::table2_commanded(); }
+BallbarMachineModel random_machine(std::mt19937& rng) { return synthetic::random_ballbar_machine(commanded(), rng); }
+// AR(1) noise per test (0.5 um marginal), as the issue's sessions.
 BallbarSession ar_ballbar(const BallbarMachineModel& truth, double rho, std::uint64_t seed) {
-  BallbarSession s = simulate_ballbar(commanded(), truth, {0.0, 1, false});
-  std::vector<std::string> g;
-  std::vector<double> t;
-  for (const BallbarSample& x : s.samples) g.push_back(x.test), t.push_back(x.time);
-  const Eigen::VectorXd e = noise_gen::ar1(g, t, rho, 0.5e-3, seed);
-  for (std::size_t i = 0; i < s.samples.size(); ++i) s.samples[i].length += e[static_cast<Eigen::Index>(i)];
-  s.noise_um = 0.5;
-  return s;
+  return synthetic::noisy_ballbar(commanded(), truth, rho, 0.5, seed);
 }
 
 // RMS over sessions and location errors of (estimate - truth) / reported sigma.
@@ -117,7 +98,7 @@ TEST_CASE("R-test joint fit with AR(0.95) noise and probe zeros wandering betwee
   double s_white = 0, s_auto = 0;
   int n_white = 0, n_auto = 0;
   for (int k = 0; k < 4; ++k) {
-    RtestTruth truth;
+    MachineModel truth = MachineModel::nominal(MachineType::BC_trt);
     truth.machine = MachineType::BC_trt;
     for (int i = 0; i < 8; ++i) truth.errors.v[i] = location_error_is_angle(i) ? 3e-5 * N(rng) : 0.02 * N(rng);
     RtestSimOptions o;
@@ -152,7 +133,7 @@ TEST_CASE("R-test joint fit with AR(0.95) noise and probe zeros wandering betwee
 
 TEST_CASE("R-test Monte Carlo re-simulates the fitted noise model (wandering probe zeros)",
           "[rtest][noise]") {
-  RtestTruth truth;
+  MachineModel truth = MachineModel::nominal(MachineType::BC_trt);
   truth.machine = MachineType::BC_trt;
   truth.errors.v << 0.01, -0.02, 3e-5, 0.015, -0.01, 0.02, -2e-5, 1e-5;
   RtestSimOptions o;

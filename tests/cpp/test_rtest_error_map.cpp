@@ -6,21 +6,18 @@
 #include "rotacal/core/error.hpp"
 #include "rotacal/rtest/error_map.hpp"
 #include "rotacal/rtest/simulate.hpp"
+#include "../support/synthetic_sessions.hpp"
 
 using namespace rotacal;
 
 namespace {
-constexpr double kDeg = M_PI / 180.0;
-RtestTruth truth() {  // rtest_bc_oyama.truth.json + a C-axis face runout (2 lobes)
-  RtestTruth t;
-  t.errors.v << 0.01459190348066346, 0.014212100597282357, 3.1102339878434216e-05,
-      -2.385536385835234e-05, -0.016912021691263143, 0.017858631217842532,
-      1.1379169104710182e-05, -4.973692463737003e-05;
-  t.effects.effects = {Effect::parse("gravity_sag_B"), Effect::parse("coning_B"),
-                       Effect::parse("axial_motion_C_h2")};
-  t.effect_params = {0.006, 0.000145, 0.002, -0.001};
+MachineModel truth() {  // rtest_bc_oyama.truth.json + a C-axis face runout (2 lobes)
+  MachineModel t = synthetic::oyama_truth();
+  t.effects.effects.push_back(Effect::parse("axial_motion_C_h2"));
+  t.effect_params.insert(t.effect_params.end(), {0.002, -0.001});
   return t;
 }
+constexpr double kDeg = M_PI / 180.0;
 }  // namespace
 
 TEST_CASE("fit on C = 0, 30, ...; predict held-out C = 15, 45, ... to the noise level") {

@@ -7,31 +7,24 @@
 #include "rotacal/io/ballbar_file.hpp"
 #include "rotacal/rtest/identify_joint.hpp"
 #include "rotacal/rtest/simulate.hpp"
+#include "../support/synthetic_sessions.hpp"
 
 using namespace rotacal;
 
 namespace {
+using synthetic::oyama_truth;  // rtest_bc_oyama.truth.json
 constexpr double kDeg = M_PI / 180.0;
 
 RtestSession load_oyama() {
   return read_rtest(std::string(ROTACAL_SHARED_DIR) + "/data/rtest_bc_oyama.csv");
 }
 
-RtestTruth oyama_truth() {  // rtest_bc_oyama.truth.json
-  RtestTruth t;
-  t.errors.v << 0.01459190348066346, 0.014212100597282357, 3.1102339878434216e-05,
-      -2.385536385835234e-05, -0.016912021691263143, 0.017858631217842532,
-      1.1379169104710182e-05, -4.973692463737003e-05;
-  t.effects.effects = {Effect::parse("gravity_sag_B"), Effect::parse("coning_B")};
-  t.effect_params = {0.006, 0.000145};
-  return t;
-}
 }  // namespace
 
 TEST_CASE("joint map on rtest_bc_oyama.csv shows gravity sag and coning of B (Oyama Sec. 5.3)") {
   const RtestSession s = load_oyama();
   const RtestJointIdentification id = identify_joint(s);
-  const RtestTruth truth = oyama_truth();
+  const MachineModel truth = oyama_truth();
   REQUIRE(id.converged);
   CHECK(id.unobservable.empty());  // default basis, 2 nests at different heights
   // The file's noise is 0.3 um: 504 readings, ~70 unknowns -> sigma within 15%.
@@ -72,6 +65,7 @@ TEST_CASE("joint map on rtest_bc_oyama.csv shows gravity sag and coning of B (Oy
 }
 
 namespace {
+using synthetic::oyama_truth;  // rtest_bc_oyama.truth.json
 RtestJointIdentification fit_with(const std::vector<Eigen::Vector3d>& nests, bool gamma_cb) {
   RtestSimOptions o;
   o.pattern.nests = nests;
@@ -128,7 +122,7 @@ TEST_CASE("which nest arrangements see the C axis' orientation and angular posit
 }
 
 TEST_CASE("joint fit recovers C-axis error motions and reports them in words when hidden") {
-  RtestTruth t;
+  MachineModel t = MachineModel::nominal(MachineType::BC_trt);
   t.effects.effects = {Effect::parse("axial_motion_C_h2"), Effect::parse("radial_motion_C_h2")};
   t.effect_params = {0.002, -0.001, 0.0015, 0.0, 0.0, -0.001};
   RtestSimOptions o;
@@ -147,6 +141,7 @@ TEST_CASE("joint fit recovers C-axis error motions and reports them in words whe
 }
 
 namespace {
+using synthetic::oyama_truth;  // rtest_bc_oyama.truth.json
 // W = I / s: white noise of a known sigma s as a noise model.
 class KnownWhiteNoise : public ResidualWhitener {
  public:

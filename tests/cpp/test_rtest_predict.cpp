@@ -8,21 +8,17 @@
 #include "rotacal/io/ballbar_file.hpp"
 #include "rotacal/rtest/predict.hpp"
 #include "rotacal/rtest/simulate.hpp"
+#include "../support/synthetic_sessions.hpp"
 
 using namespace rotacal;
 
 namespace {
-RtestTruth truth() {  // rtest_bc_oyama.truth.json + a C-axis face runout (2 lobes)
-  RtestTruth t;
-  t.errors.v << 0.01459190348066346, 0.014212100597282357, 3.1102339878434216e-05,
-      -2.385536385835234e-05, -0.016912021691263143, 0.017858631217842532, 1.1379169104710182e-05,
-      -4.973692463737003e-05;
-  t.effects.effects = {Effect::parse("gravity_sag_B"), Effect::parse("coning_B"),
-                       Effect::parse("axial_motion_C_h2")};
-  t.effect_params = {0.006, 0.000145, 0.002, -0.001};
+MachineModel truth() {  // rtest_bc_oyama.truth.json + a C-axis face runout (2 lobes)
+  MachineModel t = synthetic::oyama_truth();
+  t.effects.effects.push_back(Effect::parse("axial_motion_C_h2"));
+  t.effect_params.insert(t.effect_params.end(), {0.002, -0.001});
   return t;
 }
-
 // Rows of `s` whose C is (or is not) a multiple of 30 deg.
 RtestSession rows_where(const RtestSession& s, bool on_30) {
   RtestSession out = s;
@@ -57,7 +53,7 @@ TEST_CASE("held-out C = 15, 45, ... predicted from a fit on C = 0, 30, ...") {
   o.seed = 31;
   o.pattern.c_deg.clear();
   for (int j = 0; j < 24; ++j) o.pattern.c_deg.push_back(15.0 * j);
-  const RtestTruth t = truth();
+  const MachineModel t = truth();
   const RtestSimulation sim = simulate_rtest(t, o);
   const RtestSession fit = rows_where(sim.session, true), held = rows_where(sim.session, false);
   REQUIRE(fit.samples.size() == 168);

@@ -5,21 +5,14 @@
 #include "rotacal/core/error.hpp"
 #include "rotacal/io/ballbar_file.hpp"
 #include "rotacal/rtest/simulate.hpp"
+#include "../support/synthetic_sessions.hpp"
 
 using namespace rotacal;
 
 namespace {
+using synthetic::oyama_truth;  // rtest_bc_oyama.truth.json
 std::vector<RtestSample> load_rows(const std::string& path) { return read_rtest(path).samples; }
 
-RtestTruth oyama_truth() {  // rtest_bc_oyama.truth.json
-  RtestTruth t;
-  t.errors.v << 0.01459190348066346, 0.014212100597282357, 3.1102339878434216e-05,
-      -2.385536385835234e-05, -0.016912021691263143, 0.017858631217842532,
-      1.1379169104710182e-05, -4.973692463737003e-05;
-  t.effects.effects = {Effect::parse("gravity_sag_B"), Effect::parse("coning_B")};
-  t.effect_params = {0.006, 0.000145};
-  return t;
-}
 }  // namespace
 
 TEST_CASE("simulated pattern and readings match the independent implementation's file") {
@@ -59,7 +52,7 @@ TEST_CASE("noise and probe zeros have the requested statistics") {
   o.noise_um = 0.5;
   o.probe_zero_um = 30.0;
   o.seed = 11;
-  const RtestTruth truth = oyama_truth();
+  const MachineModel truth = oyama_truth();
   const RtestSimulation sim = simulate_rtest(truth, o);
   REQUIRE(sim.probe_zeros.size() == 2);
   double ss = 0.0;
@@ -98,7 +91,7 @@ TEST_CASE("bad simulator input is refused") {
   RtestSimOptions o;
   o.pattern.nests.clear();
   CHECK_THROWS_AS(simulate_rtest(oyama_truth(), o), InvalidArgument);
-  RtestTruth t = oyama_truth();
+  MachineModel t = oyama_truth();
   t.effect_params.pop_back();
   CHECK_THROWS_AS(simulate_rtest(t, RtestSimOptions{}), InvalidArgument);
 }
