@@ -6,7 +6,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Ambiguity', 'AngleTable', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CompensationReport', 'CompensationRow', 'DegenerateGeometry', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'ballbar_model_document', 'ballbar_model_from_document', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_model_machine', 'check_output', 'check_plausible', 'compensate_commands', 'compensate_sphere_offset', 'default_ballbar_tests', 'default_calibration_moves', 'diagnose_ballbar', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_rtest', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
+__all__: list[str] = ['Ambiguity', 'AngleTable', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CompensationReport', 'CompensationRow', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'ballbar_model_document', 'ballbar_model_from_document', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_model_machine', 'check_output', 'check_plausible', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_ballbar_tests', 'default_calibration_moves', 'diagnose_ballbar', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'export_controller', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_rtest', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
 class Ambiguity:
     @property
     def correlation(self) -> float:
@@ -453,6 +453,66 @@ class CompensationRow:
     @property
     def unit(self) -> str:
         ...
+class ControllerExport:
+    """
+    A model's location errors in a controller's parameters.
+    """
+    @property
+    def controller(self) -> str:
+        ...
+    @property
+    def current_given(self) -> bool:
+        ...
+    @property
+    def errors(self) -> list[ErrorDisposition]:
+        ...
+    @property
+    def file_kind(self) -> str:
+        ...
+    @property
+    def kinematics(self) -> str:
+        ...
+    @property
+    def not_held(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        (8,) errors the controller cannot hold (mm, rad): NC compensation
+        """
+    @property
+    def text(self) -> str:
+        """
+        the file to load on the controller
+        """
+    @property
+    def values(self) -> list[ControllerValue]:
+        ...
+class ControllerValue:
+    """
+    One controller parameter as written.
+    """
+    @property
+    def corrected(self) -> float:
+        ...
+    @property
+    def current(self) -> float:
+        """
+        active while the test ran (0 when not given)
+        """
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def source(self) -> str:
+        """
+        the location errors it carries
+        """
+    @property
+    def std(self) -> float:
+        """
+        1 sigma of corrected, controller units
+        """
+    @property
+    def unit(self) -> str:
+        ...
 class DegenerateGeometry(Error):
     pass
 class DeviceDisconnected(SerialError):
@@ -600,6 +660,28 @@ class Effect:
         ...
 class Error(RuntimeError):
     pass
+class ErrorDisposition:
+    """
+    Whether a location error reaches the controller.
+    """
+    @property
+    def held(self) -> bool:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def observable(self) -> bool:
+        ...
+    @property
+    def std(self) -> float:
+        ...
+    @property
+    def value(self) -> float:
+        ...
+    @property
+    def where(self) -> str:
+        ...
 class FaultInjection:
     """
     Faults a virtual instrument acts out (counted in frames).
@@ -1855,6 +1937,10 @@ def compensate_sphere_offset(session: RtestSession, offset: typing.Annotated[num
     """
     The session with the sphere's offset (x, y) from the spindle axis taken out of every d.
     """
+def controller_parameter_names(controller: str, machine: MachineType, toolholder: typing.SupportsInt | typing.SupportsIndex = 1) -> list[str]:
+    """
+    The names of the current values an export reads, in the order it writes them.
+    """
 def default_ballbar_tests() -> list[BallbarTest]:
     """
     sphere_xy, sphere_yz, sphere_zx, radial tilt, axial C, radial C, axial tilt.
@@ -1882,6 +1968,10 @@ def effect_catalogue(machine: MachineType, max_harmonic: typing.SupportsInt | ty
 def estimate_noise_model(groups: collections.abc.Sequence[str], times: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], residuals_mm: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], options: NoiseModelOptions = ...) -> NoiseModel:
     """
     AR(p) model (Burg, BIC order) of the residuals per stream (group, channel).
+    """
+def export_controller(model_path: str, controller: str, current_text: str | None = None, current_source: str = '<current>', toolholder: typing.SupportsInt | typing.SupportsIndex = 1, generated_at: str = '') -> ControllerExport:
+    """
+    Export a model file's location errors into a controller's kinematic parameters (io/controller_export.hpp); current_text: the controller's current values (its HAL/MPF file or the documented JSON), None for zero offsets.
     """
 def format_ballbar(session: BallbarSession) -> str:
     ...

@@ -359,9 +359,9 @@ def cmd_identify(a: argparse.Namespace) -> int:
                                        RTEST: lambda: _rtest.monte_carlo_rtest(s, result, a.monte_carlo, seed=a.seed)},
                                    "--monte-carlo")()
     if a.save_model:
-        from .models import save_model
+        from .models import save_model, source_dict
         # The C++ model writer is strict: a non-finite number is written null with its reason.
-        save_model(result.model_dict(), a.save_model, inputs=(a.file,))
+        save_model(result.model_dict() | {"source": source_dict(a.file)}, a.save_model, inputs=(a.file,))
         _say(f"wrote {a.save_model}")
     if by_kind(s, {BALLBAR: a.json, RTEST: True}, "identify"):
         print(jsontext.dumps(d))
@@ -408,6 +408,29 @@ def cmd_diagnose(a: argparse.Namespace) -> int:
         print(jsontext.dumps(d))
     else:
         _print_diagnosis(d)
+    return EXIT_OK
+
+
+def cmd_export(a: argparse.Namespace) -> int:
+    from .exports import export_controller, export_dict, residual_model
+    from .models import load_model, save_model
+    check_outputs([a.output, a.residual_model], [a.model, a.current])
+    ex = export_controller(a.model, a.controller, current=a.current, toolholder=a.toolholder)
+    if a.residual_model:
+        save_model(residual_model(load_model(a.model), ex), a.residual_model, inputs=[a.model],
+                   other_outputs=[a.output] if a.output else [])
+        _say(f"wrote {a.residual_model}: the errors {ex.controller} cannot hold, for rotacal compensate --model")
+    held = [e.name for e in ex.errors if e.held]
+    left = [e.name for e in ex.errors if not e.held]
+    if a.output:
+        write_output(a.output, ex.text, inputs=[p for p in (a.model, a.current) if p])
+        _say(f"wrote {a.output} ({ex.file_kind} for {ex.kinematics})")
+    if a.json:
+        print(jsontext.dumps(export_dict(ex)))
+    elif not a.output:
+        print(ex.text, end="")
+    _say(f"held: {', '.join(held) or 'none'}; not held: {', '.join(left) or 'none'}"
+         + ("" if ex.current_given else "; no --current: zero offsets assumed, the values are the corrections"))
     return EXIT_OK
 
 
@@ -681,6 +704,21 @@ def build_parser() -> argparse.ArgumentParser:
                    help="the session with predicted lengths (ballbar) or dx,dy,dz and dx_std,dy_std,dz_std (R-test)")
     _add_plausibility_arg(q)
     q.set_defaults(func=cmd_predict)
+
+    q = sub.add_parser("export", help="write the identified location errors into a controller's kinematic parameters",
+                       epilog=EPILOG + "; the mapping field by field: docs/controller_exports.md")
+    q.add_argument("--model", required=True, type=path("--model"), help="model file (identify --save-model)")
+    q.add_argument("--controller", required=True, choices=["linuxcnc", "siemens", "isg", "heidenhain", "fanuc"])
+    q.add_argument("--current", type=path("--current"),
+                   help="the controller's values active during the test: its HAL file (linuxcnc), MPF (siemens) "
+                        "or JSON {\"controller\": ..., \"parameters\": {...}}; default: zero offsets")
+    q.add_argument("--toolholder", type=number("--toolholder", 1, 99, integer=True), default=1,
+                   help="siemens: the $TC_CARR data set (default 1)")
+    q.add_argument("-o", "--output", type=path("--output"), help="write the controller file here (default: print it)")
+    q.add_argument("--residual-model", type=path("--residual-model"),
+                   help="write a model of the errors the controller cannot hold (held ones zero), for compensate")
+    q.add_argument("--json", action="store_true", help="print the parameters and the errors held as JSON")
+    q.set_defaults(func=cmd_export)
 
     q = sub.add_parser("compensate", help="compensated NC program, and its verification in simulation", epilog=EPILOG)
     _add_setup_args(q)

@@ -57,6 +57,34 @@ def ballbar_model_dict(machine: Any, parameters: list, effects: list[str]) -> di
     return out
 
 
+def covariance_dict(parameters: list, covariance: Any) -> dict | None:
+    """``{"parameters": names, "matrix": rows}`` of a fit's covariance (parameter order), with
+    null for entries of unobservable parameters; None when the fit has no covariance."""
+    cov = np.asarray(covariance, dtype=float)
+    names = [p.name for p in parameters]
+    if cov.shape != (len(names), len(names)):
+        return None
+    ok = [bool(p.observable) for p in parameters]
+    rows = [[float(cov[i, j]) if ok[i] and ok[j] and math.isfinite(cov[i, j]) else None
+             for j in range(len(names))] for i in range(len(names))]
+    return {"parameters": names, "matrix": rows}
+
+
+def source_dict(session_path: str | Path) -> dict:
+    """The ``source`` member of a model file: the session it was identified from (as named, and
+    its SHA-256), when, and by which rotacal; exports and the history quote it."""
+    import datetime
+    import hashlib
+    from . import __version__
+    h = hashlib.sha256()
+    with open(session_path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return {"session": os.fspath(session_path), "session_sha256": h.hexdigest(),
+            "identified_at": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
+            "rotacal": __version__}
+
+
 def _value(d: dict, where: str) -> float:
     if "value" not in d:
         raise _core.InvalidArgument(f"{where}: missing 'value'")

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from . import _core
-from .models import ballbar_model_dict, estimate_dict, fit_model_dict
+from .models import ballbar_model_dict, covariance_dict, estimate_dict, fit_model_dict
 
 
 @dataclass
@@ -36,7 +36,11 @@ class Identification:
         return self.raw.residuals
 
     def model_dict(self) -> dict:
-        return ballbar_model_dict(self.machine, self.raw.parameters, self.raw.model.effects)
+        d = ballbar_model_dict(self.machine, self.raw.parameters, self.raw.model.effects)
+        cov = covariance_dict(self.raw.parameters, self.raw.covariance)
+        if cov is not None:
+            d["covariance"] = cov
+        return d
 
     def to_dict(self) -> dict:
         m = self.model_dict()
