@@ -123,11 +123,7 @@ void bind_ballbar(pyb::module_& m) {
         o.seed = seed;
         o.noise_um = noise_um;
         o.fit.tests = tests;
-        if (!progress.is_none())
-          o.progress = [&progress](int done, int total) {
-            pyb::gil_scoped_acquire acquire;
-            progress(done, total);
-          };
+        o.progress = progress_callback(progress);
         pyb::gil_scoped_release release;
         return monte_carlo(session, result, o);
       },

@@ -3,6 +3,8 @@
 /// The one place where numpy arrays become Eigen types and back. Binding files use these and
 /// nothing else, so shape checks and their messages are the same everywhere.
 
+#include <functional>
+
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -81,6 +83,16 @@ inline std::vector<std::string> ids_of(const EffectModel& fx) {
   std::vector<std::string> ids;
   for (const Effect& e : fx.effects) ids.push_back(e.id());
   return ids;
+}
+
+/// A (done, total) progress callback for long C++ work that calls a Python callable with the
+/// GIL taken (the work runs with it released); empty for None.
+inline std::function<void(int, int)> progress_callback(const pyb::object& progress) {
+  if (progress.is_none()) return {};
+  return [&progress](int done, int total) {
+    pyb::gil_scoped_acquire acquire;
+    progress(done, total);
+  };
 }
 
 }  // namespace rotacal::py

@@ -170,11 +170,7 @@ void bind_rtest(pyb::module_& m) {
         o.draws = draws;
         o.seed = seed;
         o.fit.basis = basis;
-        if (!progress.is_none())
-          o.progress = [&progress](int done, int total) {
-            pyb::gil_scoped_acquire acquire;
-            progress(done, total);
-          };
+        o.progress = progress_callback(progress);
         pyb::gil_scoped_release release;
         return monte_carlo(session, result, o);
       },

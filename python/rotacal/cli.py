@@ -411,11 +411,25 @@ def cmd_diagnose(a: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _comp_file(text: str) -> tuple[str, str]:
+    axis, sep, file = text.partition("=")
+    if not sep or axis not in ("B", "C") or not file:
+        raise _core.InvalidArgument(f"--comp-file {text!r}: expected AXIS=FILE with AXIS B or C")
+    return axis, checked_path(file, "--comp-file")
+
+
 def cmd_export(a: argparse.Namespace) -> int:
-    from .exports import export_controller, export_dict, residual_model
+    from .exports import export_controller, export_dict, linuxcnc_comp_table, residual_model
     from .models import load_model, save_model
-    check_outputs([a.output, a.residual_model], [a.model, a.current])
+    comp = dict(_comp_file(c) for c in a.comp_file or [])
+    if comp and a.controller != "linuxcnc":
+        raise _core.InvalidArgument("--comp-file: rotary compensation tables are written for linuxcnc")
+    check_outputs([a.output, a.residual_model, *comp.values()], [a.model, a.current])
     ex = export_controller(a.model, a.controller, current=a.current, toolholder=a.toolholder)
+    tables = {axis: linuxcnc_comp_table(load_model(a.model), axis, *a.comp_range, a.comp_step) for axis in comp}
+    for axis, (text, what) in tables.items():
+        write_output(comp[axis], text, inputs=[p for p in (a.model, a.current) if p])
+        _say(f"wrote {comp[axis]}: {what}")
     if a.residual_model:
         save_model(residual_model(load_model(a.model), ex), a.residual_model, inputs=[a.model],
                    other_outputs=[a.output] if a.output else [])
@@ -717,6 +731,13 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("-o", "--output", type=path("--output"), help="write the controller file here (default: print it)")
     q.add_argument("--residual-model", type=path("--residual-model"),
                    help="write a model of the errors the controller cannot hold (held ones zero), for compensate")
+    q.add_argument("--comp-file", action="append", metavar="AXIS=FILE",
+                   help="linuxcnc, R-test map of a BC-trt: the axis' positioning error as a [JOINT_n]COMP_FILE "
+                        "(type 0) table; AXIS B or C (C needs the map's gamma terms); may be repeated")
+    q.add_argument("--comp-range", type=numbers("--comp-range", 2, 720.0, "deg"), default=[-90.0, 90.0],
+                   help="angles of the table, deg (default -90,90; C: e.g. 0,360)")
+    q.add_argument("--comp-step", type=number("--comp-step", 0.01, 90.0, "deg"), default=1.0,
+                   help="step of the table, deg (default 1; LinuxCNC reads at most 256 lines)")
     q.add_argument("--json", action="store_true", help="print the parameters and the errors held as JSON")
     q.set_defaults(func=cmd_export)
 
@@ -860,7 +881,7 @@ def _add_truth_args(q: argparse.ArgumentParser) -> None:
 
 # Options whose values may start with '-' ("--a-range -90,90"): argparse would take the value
 # for an option, so such pairs are joined as "--a-range=-90,90" before parsing.
-_SIGNED_VALUE_OPTIONS = {"--a-range", "--b-range", "--c-range", "--pivot", "--errors", "--nest", "--probe-dir"}
+_SIGNED_VALUE_OPTIONS = {"--a-range", "--b-range", "--c-range", "--pivot", "--errors", "--nest", "--probe-dir", "--comp-range"}
 
 
 def _join_signed_values(argv: Sequence[str]) -> list[str]:

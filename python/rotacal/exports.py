@@ -9,6 +9,8 @@ import os
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from . import _core
 
 CONTROLLERS = ("linuxcnc", "siemens", "isg", "heidenhain", "fanuc")
@@ -71,3 +73,69 @@ def residual_model(model: dict, ex: Any) -> dict:
     out.pop("covariance", None)
     out["source"] = dict(model.get("source", {})) | {"residual_after": f"{ex.controller} export ({ex.kinematics})"}
     return out
+
+
+# LinuxCNC 2.9 reads a joint's COMP_FILE up to the first line that is not three numbers, and
+# holds at most 256 of them.
+MAX_COMP_LINES = 256
+
+
+def _map_value(coefficients: dict, prefix: str, b: float, c: float | None = None) -> tuple[float, bool]:
+    """Sum of an error-map component's terms (docs/model_file.md, the basis' definition) at
+    b = B / 90 deg and C (rad); also whether a term depending on B was left out (c given: only
+    the B-independent C terms are a function of the C joint alone)."""
+    total, dropped = 0.0, False
+    for name, est in coefficients.items():
+        if not name.startswith(prefix + "."):
+            continue
+        value = est.get("value")
+        if value is None:
+            continue
+        term = name[len(prefix) + 1:]
+        if c is None:  # "bP": value * b^P
+            total += value * b ** int(term[1:])
+            continue
+        harmonic, power = term.split(".")  # "cosN.bM" / "sinN.bM"
+        if power != "b0":
+            dropped = True
+            continue
+        n = int(harmonic[3:])
+        total += value * (np.cos(n * c) if harmonic.startswith("cos") else np.sin(n * c))
+    return total, dropped
+
+
+def linuxcnc_comp_table(model: dict, axis: str, lo_deg: float, hi_deg: float, step_deg: float) -> tuple[str, str]:
+    """A LinuxCNC ``[JOINT_n]COMP_FILE`` (``COMP_FILE_TYPE = 0``) of an R-test error map: lines
+    ``nominal actual actual`` in degrees, the actual angle being nominal + the map's positioning
+    error (B: beta_BY(B); C: gamma_CB(C) at B = 0), the same both ways (an R-test does not see
+    reversal). The file can carry no header (LinuxCNC stops at the first line that is not three
+    numbers): the second value returned says what it is, for the caller to print."""
+    if model.get("kind") != "rtest-joint" or model.get("machine") != "BC-trt":
+        raise _core.InvalidArgument("--comp-file: needs an R-test error map of a BC-trt machine "
+                                    f"(model kind {model.get('kind')!r}, machine {model.get('machine')!r})")
+    coefficients = model.get("map_coefficients", {})
+    prefix = {"B": "beta_BY", "C": "gamma_CB"}.get(axis)
+    if prefix is None:
+        raise _core.InvalidArgument(f"--comp-file {axis}: the axis must be B or C")
+    if not any(k.startswith(prefix + ".") for k in coefficients):
+        raise _core.InvalidArgument(f"--comp-file {axis}: the model's map has no {prefix} terms "
+                                    "(C positioning needs the basis with gamma_cb)")
+    if not (step_deg > 0 and hi_deg > lo_deg):
+        raise _core.InvalidArgument(f"--comp-range {lo_deg:g},{hi_deg:g} with step {step_deg:g}: need lo < hi, step > 0")
+    n = int(np.floor((hi_deg - lo_deg) / step_deg + 1e-9)) + 1
+    if n > MAX_COMP_LINES:
+        raise _core.InvalidArgument(f"--comp-range: {n} lines, LinuxCNC reads at most {MAX_COMP_LINES}; use a larger step")
+    lines, dropped_any = [], False
+    for k in range(n):
+        nominal = lo_deg + k * step_deg
+        if axis == "B":
+            err, dropped = _map_value(coefficients, prefix, nominal / 90.0)
+        else:
+            err, dropped = _map_value(coefficients, prefix, 0.0, np.radians(nominal))
+        dropped_any |= dropped
+        actual = nominal + np.degrees(err)
+        lines.append(f"{nominal:.6f} {actual:.6f} {actual:.6f}")
+    what = (f"{axis} positioning error from the R-test map ({prefix}), {lo_deg:g}..{hi_deg:g} deg every {step_deg:g}: "
+            f"[JOINT_n]COMP_FILE_TYPE = 0 (nominal, actual moving +, actual moving -, deg)"
+            + ("; terms that depend on B were left out (the table is for B = 0)" if dropped_any else ""))
+    return "\n".join(lines) + "\n", what

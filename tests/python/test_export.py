@@ -137,3 +137,26 @@ def test_export_refuses_bad_current_values_by_file_and_line(model, tmp_path):
     assert r.returncode == EXIT_IO
     r = rotacal_cli("export", "--model", model, "--controller", "linuxcnc", "-o", model)
     assert r.returncode == EXIT_IO and json.loads(model.read_text())["format"] == "rotacal-model/1"
+
+
+def test_linuxcnc_comp_file_of_an_rtest_map_holds_the_positioning_error(tmp_path):
+    # An R-test of a B axis whose actual angle is B + 2e-4 sin(B) rad (worm error, effects.md).
+    s, m = tmp_path / "ap.csv", tmp_path / "ap.json"
+    assert rotacal_cli("simulate", "rtest", "--effect", "angular_positioning_B_h1=0,0.0002", "--seed", "3",
+                       "-o", s).returncode == 0
+    assert rotacal_cli("identify", s, "--save-model", m).returncode == 0
+    comp = tmp_path / "b.comp"
+    r = rotacal_cli("export", "--model", m, "--controller", "linuxcnc", "--comp-file", f"B={comp}",
+                    "--comp-range", "-90,90", "--comp-step", "1")
+    assert r.returncode == 0, r.stderr
+    # As LinuxCNC 2.9 reads it: three numbers a line, nominal strictly increasing, <= 256 lines.
+    rows = np.array([[float(x) for x in line.split()] for line in comp.read_text().splitlines()])
+    assert rows.shape == (181, 3) and np.all(np.diff(rows[:, 0]) > 0)
+    err = np.radians(rows[:, 1] - rows[:, 0])
+    assert np.abs(err - 2e-4 * np.sin(np.radians(rows[:, 0]))).max() < 3e-6  # rad
+    assert np.array_equal(rows[:, 1], rows[:, 2])  # an R-test does not see reversal
+    # A ballbar model has no map: refused by name; so is a map term the model does not have.
+    assert rotacal_cli("export", "--model", m, "--controller", "linuxcnc", "--comp-file",
+                       f"C={tmp_path / 'c.comp'}").returncode == EXIT_INPUT
+    assert rotacal_cli("export", "--model", m, "--controller", "siemens", "--comp-file",
+                       f"B={tmp_path / 'x.comp'}").returncode == EXIT_INPUT
