@@ -157,6 +157,16 @@ struct Writer {
   void line(const std::string& s = "") { out << comment << (s.empty() ? "" : " " + s) << "\n"; }
 };
 
+ControllerExport new_export(Controller c, const std::string& kinematics, const std::string& file_kind,
+                            const ExportOptions& o) {
+  ControllerExport ex;
+  ex.controller = c;
+  ex.kinematics = kinematics;
+  ex.file_kind = file_kind;
+  ex.current_given = o.current_given;
+  return ex;
+}
+
 void header(Writer& w, const ControllerExport& ex, const ExportInput& in, const ExportOptions& o,
             const std::string& title) {
   w.line("rotacal export: " + title);
@@ -214,11 +224,7 @@ ControllerExport export_linuxcnc(const ExportInput& in, const ExportOptions& o) 
   const LineMaps L = line_maps(in.machine);
   const bool ac = in.machine == MachineType::AC_trt;
   const std::string kins = ac ? "xyzac-trt-kins" : "xyzbc-trt-kins";
-  ControllerExport ex;
-  ex.controller = Controller::linuxcnc;
-  ex.kinematics = kins;
-  ex.file_kind = "HAL";
-  ex.current_given = o.current_given;
+  ControllerExport ex = new_export(Controller::linuxcnc, kins, "HAL", o);
   std::vector<Param> ps = {
       {kins + ".x-rot-point", "mm", L.c_point.row(0)},
       {kins + ".y-rot-point", "mm", L.c_point.row(1)},
@@ -257,11 +263,7 @@ ControllerExport export_siemens(const ExportInput& in, const ExportOptions& o) {
   const LineMaps L = line_maps(in.machine);
   const std::string k = "[" + std::to_string(o.toolholder) + "]";
   auto name = [&](int n) { return "$TC_CARR" + std::to_string(n) + k; };
-  ControllerExport ex;
-  ex.controller = Controller::siemens;
-  ex.kinematics = "$TC_CARR" + k + " type P";
-  ex.file_kind = "MPF";
-  ex.current_given = o.current_given;
+  ControllerExport ex = new_export(Controller::siemens, "$TC_CARR" + k + " type P", "MPF", o);
   const char xyz[] = "xyz";
   auto vector_params = [&](int first, const Map3& coef, const std::string& what) {
     for (int c = 0; c < 3; ++c) {
@@ -309,11 +311,7 @@ ControllerExport export_siemens(const ExportInput& in, const ExportOptions& o) {
 // axis is its direction times -1 (a table turning right-handed about n moves the tool about -n).
 ControllerExport export_isg(const ExportInput& in, const ExportOptions& o) {
   const LineMaps L = line_maps(in.machine);
-  ControllerExport ex;
-  ex.controller = Controller::isg;
-  ex.kinematics = "universal kinematic (ID 91), chain C " + std::string(1, L.tilt) + " X Y Z";
-  ex.file_kind = "channel parameter list";
-  ex.current_given = o.current_given;
+  ControllerExport ex = new_export(Controller::isg, "universal kinematic (ID 91), chain C " + std::string(1, L.tilt) + " X Y Z", "channel parameter list", o);
   struct Axis { int index; const Map3* point; const Map3* dir; Eigen::Vector3d nominal; };
   const Axis axes[2] = {{0, &L.c_point, &L.c_dir, L.c_axis}, {1, &L.tilt_point, &L.tilt_dir, L.tilt_axis}};
   for (const Axis& a : axes) {
@@ -351,11 +349,7 @@ ControllerExport export_isg(const ExportInput& in, const ExportOptions& o) {
 ControllerExport export_heidenhain(const ExportInput& in, const ExportOptions& o) {
   const LineMaps L = line_maps(in.machine);
   const std::string t(1, L.tilt);
-  ControllerExport ex;
-  ex.controller = Controller::heidenhain;
-  ex.kinematics = "kinematics table (Trans rows before MachAxis " + t + " and MachAxis C)";
-  ex.file_kind = "mapping";
-  ex.current_given = o.current_given;
+  ControllerExport ex = new_export(Controller::heidenhain, "kinematics table (Trans rows before MachAxis " + t + " and MachAxis C)", "mapping", o);
   const int a0 = in.machine == MachineType::AC_trt ? 1 : 0;  // the tilt line's two position coordinates
   const char xyz[] = "XYZ";
   std::vector<Param> ps = {
@@ -380,11 +374,7 @@ ControllerExport export_heidenhain(const ExportInput& in, const ExportOptions& o
 
 ControllerExport export_fanuc(const ExportInput& in, const ExportOptions& o) {
   const LineMaps L = line_maps(in.machine);
-  ControllerExport ex;
-  ex.controller = Controller::fanuc;
-  ex.kinematics = "tool centre point control, two table axes (No. 19680 = 12)";
-  ex.file_kind = "mapping";
-  ex.current_given = o.current_given;
+  ControllerExport ex = new_export(Controller::fanuc, "tool centre point control, two table axes (No. 19680 = 12)", "mapping", o);
   const char xyz[] = "XYZ";
   for (int c = 0; c < 3; ++c) {
     Param p{"No. " + std::to_string(19700 + c) + " (rotary table position " + xyz[c] + ")", "mm", L.tilt_point.row(c)};
