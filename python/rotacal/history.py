@@ -295,7 +295,7 @@ class CalibrationHistory:
             raise _core.InvalidArgument(f"{where}: not a readable rotacal history store: {e}") from None
         except Exception as e:
             if type(e).__module__.startswith("psycopg"):
-                raise _core.IoError(f"{where}: {str(e).strip()}") from None
+                raise _core.IoError(f"{where}: {_one_line(e)}") from None
             raise
 
     def _tables(self) -> set[str]:
@@ -553,6 +553,10 @@ def open_history(location: str | None = None, create_folder: bool | None = None)
         raise
 
 
+def _one_line(e: BaseException) -> str:
+    return " ".join(str(e).split())
+
+
 def _open_postgresql(url: str) -> CalibrationHistory:
     shown = redact(url)
     scheme = url.split("://", 1)[0]
@@ -571,11 +575,11 @@ def _open_postgresql(url: str) -> CalibrationHistory:
     try:
         psycopg.conninfo.conninfo_to_dict(url)
     except psycopg.Error as e:
-        raise _core.InvalidArgument(f"--db: {shown}: malformed URL ({str(e).strip()})") from None
+        raise _core.InvalidArgument(f"--db: {shown}: malformed URL ({_one_line(e)})") from None
     try:
         conn = psycopg.connect(url, autocommit=True, connect_timeout=10)
     except psycopg.Error as e:
-        raise _core.IoError(f"{shown}: cannot connect: {str(e).strip()}") from None
+        raise _core.IoError(f"{shown}: cannot connect: {_one_line(e)}") from None
     try:
         return CalibrationHistory(conn, POSTGRESQL, url)
     except BaseException:
@@ -621,6 +625,23 @@ def drift_fit(t_months: Sequence[float], y: Sequence[float], std: Sequence[float
             "weighting": "1/std^2" if weighted else "equal (a calibration has no 1-sigma)"}
 
 
+def expand_tolerances(tolerances: Mapping[str, float], names: Sequence[str], machine_type: str) -> dict[str, float]:
+    """Tolerance by location error from keys that are error names or ``position`` (every
+    error in mm) or ``orientation`` (every error in rad); a name overrides its group."""
+    for k, v in tolerances.items():
+        if k not in names and k not in ("position", "orientation"):
+            raise _core.InvalidArgument(f"--tolerance: {k}: not a location error of a {machine_type} "
+                                        f"({' '.join(names)}), nor position or orientation")
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v <= 0:
+            raise _core.InvalidArgument(f"--tolerance {k}: must be a number > 0, got {v!r}")
+    out = {}
+    for n in names:
+        group = "position" if unit_of(n) == "mm" else "orientation"
+        if n in tolerances or group in tolerances:
+            out[n] = float(tolerances.get(n, tolerances.get(group)))
+    return out
+
+
 def summarize(machine_type: str, entries: Sequence[Entry], tolerances: Mapping[str, float] | None = None) -> dict:
     """Each location error over time: the values measured with their 1-sigma, the compensation
     the controller held at the time (the sum of the corrections recorded before), the machine's
@@ -629,14 +650,7 @@ def summarize(machine_type: str, entries: Sequence[Entry], tolerances: Mapping[s
     of the difference or the tolerance given for that error (same unit as the error), and the
     drift per month (weighted straight line through the machine's own values)."""
     names = list(_core.location_error_names(_core.parse_machine_type(machine_type)))
-    tol = dict(tolerances or {})
-    bad = [k for k in tol if k not in names]
-    if bad:
-        raise _core.InvalidArgument(f"--tolerance: {', '.join(bad)}: not a location error of a {machine_type} "
-                                    f"({' '.join(names)})")
-    for k, v in tol.items():
-        if not isinstance(v, (int, float)) or not math.isfinite(v) or v <= 0:
-            raise _core.InvalidArgument(f"--tolerance {k}: must be a number > 0, got {v!r}")
+    tol = expand_tolerances(tolerances or {}, names, machine_type)
     calibrations = [e for e in entries if e.kind == IDENTIFICATION]
     corrections = [e for e in entries if e.kind == CORRECTION]
     months = {e.id: _epoch_months(e.measured_at) for e in calibrations}
@@ -706,3 +720,95 @@ def summarize(machine_type: str, entries: Sequence[Entry], tolerances: Mapping[s
                                f"{DAYS_PER_MONTH:.4f} days",
         },
     }
+
+
+# ------------------------------------------------------------------------- plots
+
+def write_plot(summary: dict, path: str, inputs: Sequence[str] = ()) -> None:
+    """The history as figures: each observable location error over time, the machine's own
+    value with its 1-sigma band, corrections as vertical lines, flagged changes in red. A .png
+    file, or a .html page with the figure and the flags, written by the output rule."""
+    from .outputs import check_output, write_output
+    suffix = Path(path).suffix.lower()
+    if suffix not in (".png", ".html", ".htm"):
+        raise _core.InvalidArgument(f"--plot: {path}: give a .png or .html file")
+    check_output(path, inputs)
+    png = _history_png(summary)
+    if suffix == ".png":
+        write_output(path, png, inputs)
+        return
+    import base64
+    import html
+    e = lambda t: html.escape(str(t), quote=True)  # noqa: E731
+    rows = "".join(
+        f"<tr><td>{e(f['name'])}</td><td>{e(f['from_at'])}</td><td>{e(f['to_at'])}</td>"
+        f"<td>{f['change'] * _scale(f['unit']):+.3f}</td><td>{_fmt_opt(f['expanded_uncertainty'], f['unit'])}</td>"
+        f"<td>{_fmt_opt(f['tolerance'], f['unit'])}</td><td>{e(', '.join(f['why']))}</td></tr>"
+        for f in summary["flags"])
+    page = (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>History of {e(summary['machine_id'])}"
+            f"</title></head><body><h1>Calibration history of {e(summary['machine_id'])} "
+            f"({e(summary['machine_type'])})</h1><p>{summary['identifications']} identifications, "
+            f"{len(summary['corrections'])} corrections. Values are the machine's own (measured + compensation "
+            f"loaded); bands 1-sigma.</p><img alt='location errors over time' "
+            f"src='data:image/png;base64,{base64.b64encode(png).decode('ascii')}'>"
+            f"<h2>Changes flagged</h2><table border=1 cellpadding=3><tr><th>error</th><th>from</th><th>to</th>"
+            f"<th>change (um/urad)</th><th>U, k=2</th><th>tolerance</th><th>why</th></tr>{rows}</table>"
+            "</body></html>")
+    write_output(path, page, inputs)
+
+
+def _scale(unit: str) -> float:
+    return 1e3 if unit == "mm" else 1e6
+
+
+def _fmt_opt(v: float | None, unit: str) -> str:
+    return "-" if v is None else f"{v * _scale(unit):.3f}"
+
+
+def _history_png(summary: dict) -> bytes:
+    import io
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.dates as mdates
+    import matplotlib.pyplot as plt
+    names = [n for n, d in summary["location_errors"].items() if d["points"]]
+    if not names:
+        raise _core.InvalidArgument(f"{summary['machine_id']}: no observable location error to plot")
+
+    def when(at: str) -> datetime.datetime:
+        return datetime.datetime.strptime(at, "%Y-%m-%dT%H:%M:%SZ")
+
+    cols = 2
+    rows = (len(names) + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(11, 2.6 * rows), sharex=True, squeeze=False)
+    for ax, name in zip(axes.flat, names):
+        d = summary["location_errors"][name]
+        k = _scale(d["unit"])
+        t = [when(p["at"]) for p in d["points"]]
+        v = [p["value"] * k for p in d["points"]]
+        s = [(p["std"] or 0.0) * k for p in d["points"]]
+        ax.fill_between(t, [a - b for a, b in zip(v, s)], [a + b for a, b in zip(v, s)], color="C0", alpha=0.25,
+                        linewidth=0)
+        ax.plot(t, v, "o-", color="C0", markersize=3, linewidth=1)
+        for c in summary["corrections"]:
+            if name in c["amounts"]:
+                ax.axvline(when(c["at"]), color="C2", linestyle="--", linewidth=1)
+        by_entry = {p["entry"]: p for p in d["points"]}
+        hit = [by_entry[st["to"]] for st in d["steps"] if st["exceeds_uncertainty"] or st["exceeds_tolerance"]]
+        if hit:
+            ax.plot([when(p["at"]) for p in hit], [p["value"] * k for p in hit], "o", color="red", markersize=5)
+        dr = d["drift_per_month"]
+        title = name + (f"  drift {dr['value'] * k:+.3f}/month" if dr else "")
+        ax.set_title(title, fontsize=9)
+        ax.set_ylabel("um" if d["unit"] == "mm" else "urad")
+        ax.xaxis.set_major_formatter(mdates.ConciseDateFormatter(ax.xaxis.get_major_locator()))
+    for ax in list(axes.flat)[len(names):]:
+        ax.set_visible(False)
+    shown_id = str(summary["machine_id"]).replace("$", r"\$")  # never read as mathtext
+    fig.suptitle(f"{shown_id} ({summary['machine_type']}): 1-sigma band, corrections dashed green, "
+                 "changes beyond k=2 or tolerance red", fontsize=10)
+    fig.tight_layout()
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=90)
+    plt.close(fig)
+    return buf.getvalue()
