@@ -336,6 +336,17 @@ def cmd_identify(a: argparse.Namespace) -> int:
     from . import ballbar as _ballbar, rtest as _rtest
     from .diagnosis import plausible_sizes, uncertainty_budget
     check_outputs([a.save_model], [a.file])
+    if a.store or a.machine_id is not None:  # refused before any work
+        from .history import check_machine_id, parse_date
+        if not a.store:
+            raise OptionError("--machine-id: add --store to store the identification in the history")
+        check_machine_id(a.machine_id)
+        if a.date is not None:
+            parse_date(a.date, "--date")
+        from .history import open_history
+        open_history(a.db).close()  # a store that cannot be opened is refused before the fit
+    elif a.note is not None or a.date is not None or a.controller is not None or a.db is not None:
+        raise OptionError("--note, --date, --controller and --db go with --store --machine-id")
     sizes = plausible_sizes(a.budget_sizes) if a.budget_sizes else None  # refused before any work
     s = _load(a.file, a)
 
@@ -363,11 +374,179 @@ def cmd_identify(a: argparse.Namespace) -> int:
         # The C++ model writer is strict: a non-finite number is written null with its reason.
         save_model(result.model_dict() | {"source": source_dict(a.file)}, a.save_model, inputs=(a.file,))
         _say(f"wrote {a.save_model}")
+    if a.store:
+        from .models import source_dict
+        from .history import open_history, redact
+        controller = _controller_text(a.controller)
+        with open_history(a.db) as h:
+            entry = h.add_identification(a.machine_id, result.model_dict() | {"source": source_dict(a.file)},
+                                         note=a.note, measured_at=a.date, details={"identification": d},
+                                         controller=controller, where=a.file)
+            _say(f"stored as entry {entry} of machine {a.machine_id!r} in {redact(h.location)}")
     if by_kind(s, {BALLBAR: a.json, RTEST: True}, "identify"):
         print(jsontext.dumps(d))
     else:
         _print_identification(d)
     return EXIT_OK
+
+
+# ------------------------------------------------------------------------- history
+
+def _controller_text(path: str | None) -> str | None:
+    """The controller parameters active during the test, as the text of their file."""
+    if path is None:
+        return None
+    from .exports import read_current
+    return read_current(path)
+
+
+def _read_json(path: str, option: str) -> tuple[dict, str]:
+    """(object, sha256 of the bytes) of a JSON file: strict (no NaN), bounded, errors naming it."""
+    import hashlib
+    import json
+    from .exports import MAX_CURRENT_BYTES
+    if os.path.isdir(path):
+        raise _core.IoError(f"{path}: is a directory, not a file")
+    try:
+        with open(path, "rb") as f:
+            data = f.read(64 * MAX_CURRENT_BYTES + 1)
+    except OSError as e:
+        raise _core.IoError(f"{path}: cannot read: {e.strerror}") from None
+    if len(data) > 64 * MAX_CURRENT_BYTES:
+        raise _core.InvalidArgument(f"{option} {path}: larger than {64 * MAX_CURRENT_BYTES} bytes")
+
+    def refuse(c: str) -> None:
+        raise _core.ParseError(f"{option} {path}: {c} is not JSON")
+    try:
+        doc = json.loads(data.decode("utf-8"), parse_constant=refuse)
+    except (ValueError, UnicodeDecodeError) as e:
+        raise _core.ParseError(f"{option} {path}: not JSON: {e}") from None
+    if not isinstance(doc, dict):
+        raise _core.InvalidArgument(f"{option} {path}: expected a JSON object")
+    return doc, hashlib.sha256(data).hexdigest()
+
+
+def _tolerances(items: Sequence[str] | None) -> dict[str, float]:
+    """--tolerance NAME=VALUE (um for positions, urad for orientations) -> native units (mm, rad)."""
+    from .history import unit_of
+    out: dict[str, float] = {}
+    for item in items or []:
+        key, eq, val = item.partition("=")
+        key = key.strip()
+        if not eq:
+            raise OptionError(f"--tolerance: {item[:40]!r}: give NAME=VALUE, e.g. E_Y0A=5 or position=5 (um), "
+                              "orientation=20 (urad)")
+        v = number(f"--tolerance {key}", 0.0, 1e6, "um or urad", lo_open=True)(val)
+        unit = "mm" if key == "position" else "rad" if key == "orientation" else unit_of(key)
+        out[key] = v * (1e-3 if unit == "mm" else 1e-6)
+    return out
+
+
+def _um(v: float | None, unit: str, signed: bool = True) -> str:
+    if v is None:
+        return "-"
+    k = 1e3 if unit == "mm" else 1e6
+    return f"{v * k:+.3f}" if signed else f"{v * k:.3f}"
+
+
+def _print_history(h: dict, max_flags: int = 20) -> None:
+    cal = h["calibrations"]
+    span = f", {cal[0]['at'][:10]} .. {cal[-1]['at'][:10]}" if cal else ""
+    print(f"machine {h['machine_id']} ({h['machine_type']}): {h['identifications']} identifications, "
+          f"{len(h['corrections'])} corrections (controller changes){span}; store {h['store']}")
+    print("values: the machine's own (measured + compensation loaded), um / urad")
+    print(f"  {'error':6s} {'n':>5s} {'latest':>10s} {'1-sigma':>8s} {'drift/month':>11s} {'+-':>7s} {'chi2/dof':>8s}")
+    for name, e in h["location_errors"].items():
+        if not e["points"]:
+            print(f"  {name:6s} unobservable in every calibration")
+            continue
+        last = e["points"][-1]
+        dr = e["drift_per_month"] or {}
+        chi = dr.get("chi2_per_dof")
+        print(f"  {name:6s} {len(e['points']):5d} {_um(last['value'], e['unit']):>10s} "
+              f"{_um(last['std'], e['unit'], False):>8s} {_um(dr.get('value'), e['unit']):>11s} "
+              f"{_um(dr.get('std'), e['unit'], False):>7s} {'-' if chi is None else f'{chi:.2f}':>8s}")
+    for c in h["corrections"]:
+        amounts = ", ".join(f"{n} {_um(v, 'mm' if n[2] in 'XYZ' else 'rad')}" for n, v in c["amounts"].items())
+        print(f"correction {c['at'][:10]} (entry {c['entry']}, {c['controller']}): {amounts}"
+              + (f"  [{c['note']}]" if c["note"] else ""))
+    flags = h["flags"]
+    print(f"{len(flags)} changes between consecutive calibrations beyond the k=2 uncertainty or the tolerance"
+          + (":" if flags else ""))
+    for f in flags[:max_flags]:
+        limit = f"U {_um(f['expanded_uncertainty'], f['unit'], False)}" + (
+            f", tolerance {_um(f['tolerance'], f['unit'], False)}" if f["tolerance"] is not None else "")
+        print(f"  {f['name']:6s} {f['from_at'][:10]} -> {f['to_at'][:10]}: {_um(f['change'], f['unit'])} "
+              f"({limit}): {', '.join(f['why'])}")
+    if len(flags) > max_flags:
+        print(f"  ... {len(flags) - max_flags} more (--json lists them all)")
+
+
+def cmd_history_add(a: argparse.Namespace) -> int:
+    from .history import open_history, redact
+    if (a.model is None) == (a.correction is None):
+        raise OptionError("history add: give a model file (an identification) or --correction EXPORT.json")
+    if a.correction is not None:
+        if a.diagnosis or a.controller:
+            raise OptionError("history add --correction: --diagnosis and --controller belong to an identification")
+        export, sha = _read_json(a.correction, "--correction")
+        with open_history(a.db) as h:
+            entry = h.add_correction(a.machine_id, export, applied_at=a.date, note=a.note, source_sha256=sha,
+                                     where=a.correction)
+            _say(f"stored correction {a.correction} as entry {entry} of machine {a.machine_id!r} in {redact(h.location)}")
+        return EXIT_OK
+    from .models import load_model
+    model = load_model(a.model)
+    details = None
+    if a.diagnosis:
+        diag, _ = _read_json(a.diagnosis, "--diagnosis")
+        if not isinstance(diag.get("findings"), list):
+            raise _core.InvalidArgument(f"--diagnosis {a.diagnosis}: not the JSON of 'rotacal diagnose --json' (findings)")
+        details = {"diagnosis": diag}
+    controller = _controller_text(a.controller)
+    with open_history(a.db) as h:
+        entry = h.add_identification(a.machine_id, model, note=a.note, measured_at=a.date, details=details,
+                                     controller=controller, where=a.model)
+        _say(f"stored {a.model} as entry {entry} of machine {a.machine_id!r} in {redact(h.location)}")
+    return EXIT_OK
+
+
+def cmd_history_show(a: argparse.Namespace) -> int:
+    from .history import open_history, write_plot
+    tol = _tolerances(a.tolerance)
+    if a.plot:
+        check_outputs([a.plot])
+    with open_history(a.db) as h:
+        summary = h.show(a.machine_id, tol)
+    if a.plot:
+        write_plot(summary, a.plot)
+        _say(f"wrote {a.plot}")
+    if a.json:
+        print(jsontext.dumps(summary))
+    else:
+        _print_history(summary)
+    return EXIT_OK
+
+
+def cmd_history_list(a: argparse.Namespace) -> int:
+    from .history import open_history, redact
+    with open_history(a.db) as h:
+        machines, where = h.machines(), redact(h.location)
+    if a.json:
+        print(jsontext.dumps({"store": where, "machines": machines}))
+        return EXIT_OK
+    print(f"{len(machines)} machines in {where}")
+    for m in machines:
+        print(f"  {m['machine_id']:24s} {m['machine_type']:7s} {m['identifications']:6d} identifications "
+              f"{m['corrections']:4d} corrections  {(m['first'] or '')[:10]} .. {(m['last'] or '')[:10]}")
+    return EXIT_OK
+
+
+def _add_db_arg(q: argparse.ArgumentParser) -> None:
+    from .history import ENV_STORE
+    q.add_argument("--db", metavar="PATH|URL", type=path("--db"),
+                   help="the history store: a SQLite file, or a postgresql://user@host/dbname URL; default "
+                        f"${ENV_STORE}, else ~/.local/share/rotacal/history.sqlite (its folder is created)")
 
 
 def _print_diagnosis(d: dict) -> None:
@@ -694,7 +873,50 @@ def build_parser() -> argparse.ArgumentParser:
                         "docs/json_schema.md)")
     q.add_argument("--no-budget", action="store_true",
                    help="skip the uncertainty budget (it runs a diagnosis of the left-out effects)")
+    g = q.add_argument_group("calibration history (docs/history.md)")
+    g.add_argument("--store", action="store_true", help="store the identification in the history (needs --machine-id)")
+    g.add_argument("--machine-id", help="the physical machine, e.g. its serial number (the session's "
+                                        "'# machine:' stays its kinematic type)")
+    g.add_argument("--note", help="operator note stored with it")
+    g.add_argument("--date", help="when it was measured, ISO 8601 (default: now)")
+    g.add_argument("--controller", metavar="CURRENT", type=path("--controller"),
+                   help="the controller parameters active during the test (HAL, MPF or JSON file), stored with it")
+    _add_db_arg(g)
     q.set_defaults(func=cmd_identify)
+
+    q = sub.add_parser("history", help="calibration history of physical machines: store, list, show drift",
+                       epilog=EPILOG + "; docs/history.md")
+    hs = q.add_subparsers(dest="action", required=True)
+    k = hs.add_parser("add", help="store an identification (model file) or a correction loaded into the controller",
+                      epilog=EPILOG)
+    k.add_argument("model", nargs="?", type=path("MODEL"), help="model file (identify --save-model)")
+    k.add_argument("--correction", metavar="EXPORT.json", type=path("--correction"),
+                   help="instead of a model: the JSON of 'rotacal export --json' that was loaded into the "
+                        "controller; later changes of the errors it holds are then not counted as drift")
+    k.add_argument("--machine-id", required=True, help="the physical machine, e.g. its serial number")
+    k.add_argument("--note", help="operator note")
+    k.add_argument("--date", help="when it was measured (or the correction loaded), ISO 8601; default: the "
+                                  "model's source.identified_at, else now")
+    k.add_argument("--diagnosis", metavar="DIAG.json", type=path("--diagnosis"),
+                   help="the findings of 'rotacal diagnose --json' on the same session, stored with it")
+    k.add_argument("--controller", metavar="CURRENT", type=path("--controller"),
+                   help="the controller parameters active during the test (HAL, MPF or JSON file)")
+    _add_db_arg(k)
+    k.set_defaults(func=cmd_history_add)
+    k = hs.add_parser("show", help="each location error over time: 1-sigma, corrections, drift per month, flags",
+                      epilog=EPILOG)
+    k.add_argument("machine_id", metavar="MACHINE_ID")
+    k.add_argument("--tolerance", action="append", metavar="NAME=VALUE",
+                   help="also flag a change between two calibrations larger than VALUE (um for positions, urad "
+                        "for orientations); NAME a location error, or position / orientation for all (repeatable)")
+    k.add_argument("--plot", metavar="OUT.png|OUT.html", type=path("--plot"), help="write the history as figures")
+    k.add_argument("--json", action="store_true")
+    _add_db_arg(k)
+    k.set_defaults(func=cmd_history_show)
+    k = hs.add_parser("list", help="the machines in the store", epilog=EPILOG)
+    k.add_argument("--json", action="store_true")
+    _add_db_arg(k)
+    k.set_defaults(func=cmd_history_list)
 
     q = sub.add_parser("diagnose", help="find what the model gets wrong and why", epilog=EPILOG)
     q.add_argument("file", type=path("FILE"))
