@@ -54,15 +54,17 @@ def predict_session(model: Mapping, session: Any, probe_zeros: str = "none",
 
 
 def write_report(path: str | Path, session: Any, method: str = "joint", with_diagnosis: bool = True,
-                 source: str = "", inputs: Sequence[str] = ()) -> Path:
+                 source: str = "", inputs: Sequence[str] = (), extra_sections: Sequence[str] = ()) -> Path:
     """The HTML report of a session (rotacal.report): identification, plots and diagnosis,
-    written by the output rule (``inputs`` of the command are refused as the target)."""
+    written by the output rule (``inputs`` of the command are refused as the target);
+    ``extra_sections``: HTML sections appended (e.g. rotacal.history.history_section)."""
     from . import report  # draws: matplotlib is imported only here
 
     def ballbar_report():
         ident = ballbar.identify(session, method)
         d = diagnose(session) if with_diagnosis else None
-        return report.ballbar_report(path, session, ident, d, source=source, inputs=inputs)
+        return report.ballbar_report(path, session, ident, d, source=source, inputs=inputs,
+                                     extra_sections=extra_sections)
 
     def rtest_report():
         if method != "joint":
@@ -71,7 +73,7 @@ def write_report(path: str | Path, session: Any, method: str = "joint", with_dia
         s, _ = rtest.with_displacements(session)  # raw d1,d2,d3 with the file's probe.N.dir (identify notes it too)
         ident = rtest.identify_rtest(s, "joint")
         d = diagnose(s) if with_diagnosis else None
-        return report.rtest_report(path, s, ident, d, source=source, inputs=inputs)
+        return report.rtest_report(path, s, ident, d, source=source, inputs=inputs, extra_sections=extra_sections)
 
     return by_kind(session, {BALLBAR: ballbar_report, RTEST: rtest_report}, "report")()
 

@@ -673,8 +673,14 @@ def cmd_compensate(a: argparse.Namespace) -> int:
 def cmd_report(a: argparse.Namespace) -> int:
     from .analysis import write_report
     check_outputs([a.output], [a.file])
+    extra = []
+    if a.history:
+        from .history import history_section, open_history
+        with open_history(a.db) as h:  # an unknown machine id is refused before the fit
+            extra.append(history_section(h.show(a.history)))
     s = _load(a.file, a)
-    out = write_report(a.output, s, a.method, with_diagnosis=not a.no_diagnosis, source=a.file, inputs=[a.file])
+    out = write_report(a.output, s, a.method, with_diagnosis=not a.no_diagnosis, source=a.file, inputs=[a.file],
+                       extra_sections=extra)
     print(Path(out).resolve())
     return EXIT_OK
 
@@ -1016,6 +1022,9 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("file", type=path("FILE"))
     q.add_argument("--method", default="joint", choices=["joint", "paper"])
     q.add_argument("--no-diagnosis", action="store_true")
+    q.add_argument("--history", metavar="MACHINE_ID",
+                   help="add the machine's calibration history (rotacal history show) as plots and flags")
+    _add_db_arg(q)
     q.add_argument("-o", "--output", required=True, type=path("--output"))
     _add_plausibility_arg(q)
     q.set_defaults(func=cmd_report)

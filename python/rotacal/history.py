@@ -733,28 +733,36 @@ def write_plot(summary: dict, path: str, inputs: Sequence[str] = ()) -> None:
     if suffix not in (".png", ".html", ".htm"):
         raise _core.InvalidArgument(f"--plot: {path}: give a .png or .html file")
     check_output(path, inputs)
-    png = _history_png(summary)
     if suffix == ".png":
-        write_output(path, png, inputs)
+        write_output(path, _history_png(summary), inputs)
         return
+    import html
+    e = lambda t: html.escape(str(t), quote=True)  # noqa: E731
+    page = (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>History of {e(summary['machine_id'])}"
+            f"</title></head><body>{history_section(summary)}</body></html>")
+    write_output(path, page, inputs)
+
+
+def history_section(summary: dict) -> str:
+    """The history as an HTML section (figure and flagged changes), for ``history show --plot
+    X.html`` and ``rotacal report --history``. Every text from the store is escaped."""
     import base64
     import html
+    png = _history_png(summary)
     e = lambda t: html.escape(str(t), quote=True)  # noqa: E731
     rows = "".join(
         f"<tr><td>{e(f['name'])}</td><td>{e(f['from_at'])}</td><td>{e(f['to_at'])}</td>"
         f"<td>{f['change'] * _scale(f['unit']):+.3f}</td><td>{_fmt_opt(f['expanded_uncertainty'], f['unit'])}</td>"
         f"<td>{_fmt_opt(f['tolerance'], f['unit'])}</td><td>{e(', '.join(f['why']))}</td></tr>"
         for f in summary["flags"])
-    page = (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>History of {e(summary['machine_id'])}"
-            f"</title></head><body><h1>Calibration history of {e(summary['machine_id'])} "
-            f"({e(summary['machine_type'])})</h1><p>{summary['identifications']} identifications, "
+    return (f"<section id='history'><h2>Calibration history of {e(summary['machine_id'])} "
+            f"({e(summary['machine_type'])})</h2><p>{summary['identifications']} identifications, "
             f"{len(summary['corrections'])} corrections. Values are the machine's own (measured + compensation "
             f"loaded); bands 1-sigma.</p><img alt='location errors over time' "
             f"src='data:image/png;base64,{base64.b64encode(png).decode('ascii')}'>"
             f"<h2>Changes flagged</h2><table border=1 cellpadding=3><tr><th>error</th><th>from</th><th>to</th>"
             f"<th>change (um/urad)</th><th>U, k=2</th><th>tolerance</th><th>why</th></tr>{rows}</table>"
-            "</body></html>")
-    write_output(path, page, inputs)
+            "</section>")
 
 
 def _scale(unit: str) -> float:

@@ -408,7 +408,8 @@ def rtest_residual_plot(setups: np.ndarray, residuals: np.ndarray) -> str:
 
 
 def rtest_report(path: str | Path, session: Any, identification: Any, diagnosis: Any | None = None,
-                 title: str | None = None, source: str = "", inputs: Iterable[str] = ()) -> Path:
+                 title: str | None = None, source: str = "", inputs: Iterable[str] = (),
+                 extra_sections: Iterable[str] = ()) -> Path:
     """Write the HTML report of an R-test session: set-up, location errors (ISO 230-7 table),
     the error map against B and C with uncertainty bands, residuals and the diagnosis."""
     from . import _core
@@ -476,4 +477,5 @@ def rtest_report(path: str | Path, session: Any, identification: Any, diagnosis:
 
     if diagnosis is not None:
         parts.append(diagnosis_section(diagnosis.to_dict()))
+    parts.extend(extra_sections)
     return _write_page(path, parts, inputs)

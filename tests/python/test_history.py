@@ -446,6 +446,14 @@ def test_cli_end_to_end(shared_data, tmp_path):
     assert (tmp_path / "h.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert cli("history", "show", "DMU-1234", "--db", db, "--plot", tmp_path / "h.html").returncode == 0
     assert "data:image/png;base64," in (tmp_path / "h.html").read_text()
+    # The session report carries the same history section; an unknown machine is refused first.
+    rep = tmp_path / "report.html"
+    r = cli("report", sim, "--no-diagnosis", "--history", "DMU-1234", "--db", db, "-o", rep)
+    assert r.returncode == 0, r.stderr
+    page = rep.read_text()
+    assert "Calibration history of DMU-1234" in page and page.count("data:image/png;base64,") >= 3
+    r = cli("report", sim, "--no-diagnosis", "--history", "NOPE", "--db", db, "-o", tmp_path / "r2.html")
+    assert r.returncode == EXIT_INPUT and not (tmp_path / "r2.html").exists()
     r = cli("history", "list", "--json", "--db", db)
     assert json.loads(r.stdout)["machines"][0]["machine_id"] == "DMU-1234"
     # ROTACAL_HISTORY names the default store.
