@@ -71,6 +71,19 @@ def numbers(option: str, n: int, limit: float, unit: str = "") -> Callable[[str]
     return parse
 
 
+def number_list(option: str, lo: float, hi: float, unit: str = "", most: int = 50) -> Callable[[str], list[float]]:
+    """argparse type: 1 to `most` comma-separated finite numbers, each in [lo, hi]."""
+    def parse(text: str) -> list[float]:
+        try:
+            vals = [float(v) for v in text.split(",")]
+        except ValueError:
+            raise OptionError(f"{option}: '{text[:60]}' is not a comma-separated list of numbers") from None
+        if not 1 <= len(vals) <= most or not all(math.isfinite(v) and lo <= v <= hi for v in vals):
+            raise OptionError(f"{option}: '{text[:60]}': 1 to {most} values, each in [{lo:g}, {hi:g}] {unit}".rstrip())
+        return vals
+    return parse
+
+
 def path(option: str) -> Callable[[str], str]:
     """argparse type: a file name (not empty, no NUL byte)."""
     def parse(text: str) -> str:
@@ -597,6 +610,42 @@ def _comp_file(text: str) -> tuple[str, str]:
     return axis, checked_path(file, "--comp-file")
 
 
+def cmd_design_ballbar(a: argparse.Namespace) -> int:
+    from .ballbar import nc_program
+    from .design import design_ballbar, design_dict
+    check_outputs([a.output])
+    d = design_ballbar(_setup(a), lengths=a.lengths, pivot_x=a.pivot_x, pivot_z=a.pivot_z, travel=a.travel,
+                       time_s=a.time, rate_hz=a.rate, noise_um=a.noise, rho=a.rho,
+                       effects=[e.strip() for e in a.effects.split(",")] if a.effects else [])
+    if a.output:
+        plan, text = nc_program(d.best.setup, a.dialect, None, None)
+        write_output(a.output, text)
+        _say(f"wrote {a.output}: {a.dialect} program of the designed set-up, {plan.duration:.0f} s at the base feeds")
+    if a.json:
+        print(jsontext.dumps(design_dict(d)))
+        return EXIT_OK
+    feasible = sum(c.feasible for c in d.candidates)
+    print(f"{len(d.candidates)} set-ups tried, {feasible} within the limits; run time {d.time_budget_s:.0f} s, "
+          f"noise {a.noise:g} um at {a.rate:g} Hz" + (f", AR(1) rho {a.rho:g}" if a.rho else ""))
+    for label, c in (("designed", d.best), ("default", d.baseline)):
+        if not c.feasible:
+            print(f"{label:9s} L0 {c.setup.ballbar_length:g} mm, pivot {tuple(map(float, c.setup.pivot))}: {c.why_not}")
+            continue
+        print(f"{label:9s} L0 {c.setup.ballbar_length:g} mm, pivot ({c.setup.pivot[0]:g}, {c.setup.pivot[1]:g}, "
+              f"{c.setup.pivot[2]:g}) mm: largest expanded uncertainty (k=2) {c.worst_expanded_um:.3f} um "
+              f"({c.worst_error})")
+    if d.baseline.feasible:
+        print(f"ratio designed / default: {d.ratio:.3f}")
+    from .design import parameter_units
+    names, sig = d.best.names, d.best.sigma
+    print("predicted 1-sigma of the designed test (inf: this set-up cannot determine it):")
+    for n, s_, (unit, k) in zip(names, sig, parameter_units(names)):
+        print(f"  {n:24s} {s_ * k:10.4f} {unit}")
+    for n, a_, b_ in zip(names[11:], d.best.effect_vs_location, d.best.effect_vs_effects):
+        print(f"  {n}: largest correlation with a location error {a_:.2f}, with another effect {b_:.2f}")
+    return EXIT_OK
+
+
 def cmd_export(a: argparse.Namespace) -> int:
     from .exports import export_controller, export_dict, linuxcnc_comp_table, residual_model
     from .models import load_model, save_model
@@ -947,6 +996,34 @@ def build_parser() -> argparse.ArgumentParser:
     _add_plausibility_arg(q)
     q.set_defaults(func=cmd_predict)
 
+    q = sub.add_parser("design", help="design a test before the machine runs it", epilog=EPILOG + "; docs/design.md")
+    dk = q.add_subparsers(dest="kind", required=True)
+    k = dk.add_parser("ballbar", help="the pivot and bar length with the smallest predicted uncertainty",
+                      epilog=EPILOG + "; docs/design.md")
+    _add_setup_args(k)
+    k.add_argument("--lengths", type=number_list("--lengths", 1.0, 2000.0, "mm", 10), default=[100.0, 150.0],
+                   help="bar lengths available, mm (default 100,150)")
+    k.add_argument("--pivot-x", type=number_list("--pivot-x", 0.0, 2000.0, "mm", 30),
+                   help="pivot distances from the C axis to try, mm (default 60,90,120,150,180)")
+    k.add_argument("--pivot-z", type=number_list("--pivot-z", -2000.0, 2000.0, "mm", 30),
+                   help="pivot heights above the tilt axis to try, mm (default 20,40,60,90,120)")
+    k.add_argument("--travel", type=numbers("--travel", 6, 1e5, "mm"),
+                   help="xmin,xmax,ymin,ymax,zmin,zmax of X, Y, Z about the rotary axes' intersection, mm "
+                        "(default -400,400,-300,300,-300,400)")
+    k.add_argument("--time", type=number("--time", 0.0, 86400.0, "s"), default=0.0,
+                   help="run time to compare at, s (default: the default set-up's)")
+    k.add_argument("--rate", type=number("--rate", 0.0, 1e5, "Hz", lo_open=True), default=100.0,
+                   help="the recorder's sample rate, Hz (default 100)")
+    k.add_argument("--noise", type=number("--noise", 0.0, 1000.0, "um", lo_open=True), default=0.5,
+                   help="1-sigma noise per sample, um (default 0.5)")
+    k.add_argument("--rho", type=number("--rho", 0.0, 0.999, ""), default=0.0,
+                   help="AR(1) coefficient of the noise between samples (default 0: white)")
+    k.add_argument("--effects", help="effects of concern, fitted along: catalogue ids, comma separated")
+    k.add_argument("--dialect", default="linuxcnc", help="NC dialect of -o (as plan)")
+    k.add_argument("-o", "--output", type=path("--output"), help="write the designed test's NC program here")
+    k.add_argument("--json", action="store_true")
+    k.set_defaults(func=cmd_design_ballbar)
+
     q = sub.add_parser("export", help="write the identified location errors into a controller's kinematic parameters",
                        epilog=EPILOG + "; the mapping field by field: docs/controller_exports.md")
     q.add_argument("--model", required=True, type=path("--model"), help="model file (identify --save-model)")
@@ -1112,7 +1189,8 @@ def _add_truth_args(q: argparse.ArgumentParser) -> None:
 
 # Options whose values may start with '-' ("--a-range -90,90"): argparse would take the value
 # for an option, so such pairs are joined as "--a-range=-90,90" before parsing.
-_SIGNED_VALUE_OPTIONS = {"--a-range", "--b-range", "--c-range", "--pivot", "--errors", "--nest", "--probe-dir", "--comp-range"}
+_SIGNED_VALUE_OPTIONS = {"--a-range", "--b-range", "--c-range", "--pivot", "--errors", "--nest", "--probe-dir",
+                         "--comp-range", "--travel", "--pivot-z"}
 
 
 def _join_signed_values(argv: Sequence[str]) -> list[str]:
