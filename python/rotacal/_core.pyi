@@ -6,7 +6,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Ambiguity', 'AngleTable', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CompensationReport', 'CompensationRow', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'ballbar_model_document', 'ballbar_model_from_document', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_model_machine', 'check_output', 'check_plausible', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_ballbar_tests', 'default_calibration_moves', 'diagnose_ballbar', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'export_controller', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_rtest', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
+__all__: list[str] = ['Ambiguity', 'AngleTable', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CompensationReport', 'CompensationRow', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'ballbar_model_document', 'ballbar_model_from_document', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_model_machine', 'check_output', 'check_plausible', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_ballbar_tests', 'default_calibration_moves', 'design_ballbar_test', 'diagnose_ballbar', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'export_controller', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_rtest', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
 class Ambiguity:
     @property
     def correlation(self) -> float:
@@ -41,6 +41,111 @@ class AngleTable:
         ...
     @property
     def value_um(self) -> list[float]:
+        ...
+class BallbarDesign:
+    """
+    The chosen set-up and the default one.
+    """
+    @property
+    def baseline(self) -> DesignCandidate:
+        ...
+    @property
+    def best(self) -> DesignCandidate:
+        ...
+    @property
+    def candidates(self) -> list[DesignCandidate]:
+        ...
+    @property
+    def ratio(self) -> float:
+        ...
+    @property
+    def time_budget_s(self) -> float:
+        ...
+class BallbarDesignOptions:
+    """
+    Options of design_ballbar_test (defaults).
+    """
+    def __init__(self) -> None:
+        ...
+    @property
+    def bar_lengths_mm(self) -> list[float]:
+        ...
+    @bar_lengths_mm.setter
+    def bar_lengths_mm(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def base(self) -> BallbarSetup:
+        """
+        the default set-up: machine, tests, ranges, feeds
+        """
+    @base.setter
+    def base(self, arg0: BallbarSetup) -> None:
+        ...
+    @property
+    def effects_of_concern(self) -> list[str]:
+        ...
+    @effects_of_concern.setter
+    def effects_of_concern(self, arg1: collections.abc.Sequence[str]) -> None:
+        ...
+    @property
+    def noise_rho(self) -> float:
+        """
+        AR(1) coefficient between samples
+        """
+    @noise_rho.setter
+    def noise_rho(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def noise_um(self) -> float:
+        ...
+    @noise_um.setter
+    def noise_um(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def pivot_x_mm(self) -> list[float]:
+        ...
+    @pivot_x_mm.setter
+    def pivot_x_mm(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def pivot_z_mm(self) -> list[float]:
+        ...
+    @pivot_z_mm.setter
+    def pivot_z_mm(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def reference_radius_mm(self) -> float:
+        ...
+    @reference_radius_mm.setter
+    def reference_radius_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def sample_rate_hz(self) -> float:
+        ...
+    @sample_rate_hz.setter
+    def sample_rate_hz(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def time_budget_s(self) -> float:
+        """
+        0: the default set-up's run time
+        """
+    @time_budget_s.setter
+    def time_budget_s(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def travel_max(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @travel_max.setter
+    def travel_max(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+        ...
+    @property
+    def travel_min(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        """
+        X, Y, Z, mm (formats.md frame)
+        """
+    @travel_min.setter
+    def travel_min(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
         ...
 class BallbarIdentification:
     @property
@@ -515,6 +620,42 @@ class ControllerValue:
         ...
 class DegenerateGeometry(Error):
     pass
+class DesignCandidate:
+    """
+    One set-up, evaluated.
+    """
+    @property
+    def duration_s(self) -> float:
+        ...
+    @property
+    def effect_vs_effects(self) -> list[float]:
+        ...
+    @property
+    def effect_vs_location(self) -> list[float]:
+        ...
+    @property
+    def feasible(self) -> bool:
+        ...
+    @property
+    def names(self) -> list[str]:
+        ...
+    @property
+    def setup(self) -> BallbarSetup:
+        ...
+    @property
+    def sigma(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        predicted 1 sigma at the time budget (mm, rad)
+        """
+    @property
+    def why_not(self) -> str:
+        ...
+    @property
+    def worst_error(self) -> str:
+        ...
+    @property
+    def worst_expanded_um(self) -> float:
+        ...
 class DeviceDisconnected(SerialError):
     pass
 class Diagnosis:
@@ -1948,6 +2089,10 @@ def default_ballbar_tests() -> list[BallbarTest]:
 def default_calibration_moves(step_mm: typing.SupportsFloat | typing.SupportsIndex = 0.5) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
     """
     +-step along X, Y, Z and the 4 body diagonals (14, 3), mm.
+    """
+def design_ballbar_test(options: BallbarDesignOptions) -> BallbarDesign:
+    """
+    The pivot and bar length with the smallest predicted uncertainty (ballbar/design.hpp).
     """
 def diagnose_ballbar(session: BallbarSession, options: DiagnosisOptions = ..., reference: rotacal._core.BallbarSession | None = None) -> Diagnosis:
     """

@@ -28,7 +28,7 @@ std::string travel_violation(const BallbarPlan& plan, const BallbarDesignOptions
     for (const PlannedSample& s : seg.samples)
       for (int k = 0; k < 3; ++k)
         if (s.xyz[k] < o.travel_min[k] || s.xyz[k] > o.travel_max[k])
-          return std::string(1, axis[k]) + " = " + fmt(s.xyz[k]) + " mm in " + seg.label + " is outside the travel " +
+          return std::string(1, axis[k]) + " = " + fmt(s.xyz[k], 3) + " mm in " + seg.label + " is outside the travel " +
                  fmt(o.travel_min[k]) + ".." + fmt(o.travel_max[k]) + " mm";
   return {};
 }

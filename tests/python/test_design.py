@@ -1,0 +1,60 @@
+"""`rotacal design ballbar` as an engineer runs it: the designed set-up within the travel, its
+predicted uncertainty against the default's at the same run time, the NC program of the
+designed test, and refusals by option."""
+import json
+import subprocess
+import sys
+
+import pytest
+
+from rotacal import _core
+
+EXIT_INPUT = 3
+
+
+def rotacal_cli(*args):
+    r = subprocess.run([sys.executable, "-m", "rotacal", *map(str, args)], capture_output=True, text=True, timeout=300)
+    assert "Traceback" not in r.stderr, r.stderr
+    return r
+
+
+def test_design_within_travel_and_better_than_default(tmp_path):
+    prog = tmp_path / "designed.ngc"
+    r = rotacal_cli("design", "ballbar", "--step", "3", "--pivot-x", "60,120,180", "--pivot-z", "30,60,120",
+                    "--travel", "-400,400,-300,300,-300,260", "--time", "1800", "--json", "-o", prog)
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout)
+    assert d["time_budget_s"] == 1800
+    best, default = d["best"], d["default"]
+    assert best["feasible"] and default["feasible"]
+    assert best["worst_expanded_um"] <= default["worst_expanded_um"]
+    assert d["ratio_to_default"] == pytest.approx(best["worst_expanded_um"] / default["worst_expanded_um"])
+    # The travel in Z rules some set-ups out, by name.
+    out = [c for c in d["candidates"] if not c["feasible"]]
+    assert any("Z = " in c["why_not"] for c in out) and all(c["why_not"] for c in out)
+    # The program of the designed set-up is what `plan` writes for it.
+    L0, pivot = best["ballbar_length"], best["pivot"]
+    ref = tmp_path / "ref.ngc"
+    assert rotacal_cli("plan", "ballbar", "--step", "3", "--length", L0, "--pivot", ",".join(map(str, pivot)),
+                       "-o", ref).returncode == 0
+    assert prog.read_text() == ref.read_text()
+
+
+def test_a_pair_no_single_setup_separates_is_reported():
+    r = rotacal_cli("design", "ballbar", "--step", "3", "--pivot-x", "120", "--pivot-z", "60", "--lengths", "100",
+                    "--effects", "axial_motion_C_h2,tilt_motion_C_h2", "--json")
+    assert r.returncode == 0, r.stderr
+    corr = json.loads(r.stdout)["best"]["effect_correlation"]
+    assert max(v["max_with_other_effects"] for v in corr.values()) > 0.99
+
+
+@pytest.mark.parametrize("args,option", [
+    (("--travel", "1,0,-300,300,-300,400"), "--travel"),
+    (("--rho", "1.5"), "--rho"),
+    (("--lengths", "0"), "--lengths"),
+    (("--travel", "-1,1,-1,1,-1,1"), "no candidate"),
+    (("--effects", "no_such_effect"), "no_such_effect"),
+])
+def test_design_refuses_by_option(args, option):
+    r = rotacal_cli("design", "ballbar", "--step", "5", "--pivot-x", "120", "--pivot-z", "60", *args)
+    assert r.returncode in (2, EXIT_INPUT) and option in r.stderr, r.stderr
