@@ -358,8 +358,9 @@ def cmd_identify(a: argparse.Namespace) -> int:
             parse_date(a.date, "--date")
         from .history import open_history
         open_history(a.db).close()  # a store that cannot be opened is refused before the fit
-    elif a.note is not None or a.date is not None or a.controller is not None or a.db is not None:
-        raise OptionError("--note, --date, --controller and --db go with --store --machine-id")
+    elif a.note is not None or a.date is not None or a.db is not None or (a.controller and not a.save_model):
+        raise OptionError("--note, --date and --db go with --store --machine-id; --controller with --store or "
+                          "--save-model")
     sizes = plausible_sizes(a.budget_sizes) if a.budget_sizes else None  # refused before any work
     s = _load(a.file, a)
 
@@ -385,7 +386,10 @@ def cmd_identify(a: argparse.Namespace) -> int:
     if a.save_model:
         from .models import save_model, source_dict
         # The C++ model writer is strict: a non-finite number is written null with its reason.
-        save_model(result.model_dict() | {"source": source_dict(a.file)}, a.save_model, inputs=(a.file,))
+        source = source_dict(a.file)
+        if a.controller:  # the kinematics the errors are relative to, for the export and the history
+            source["controller_parameters"] = _controller_text(a.controller)
+        save_model(result.model_dict() | {"source": source}, a.save_model, inputs=(a.file,))
         _say(f"wrote {a.save_model}")
     if a.store:
         from .models import source_dict

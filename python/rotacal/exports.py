@@ -42,11 +42,16 @@ def export_controller(model: str | Path, controller: str, current: str | Path | 
     """A ``rotacal._core.ControllerExport`` of a model file: ``.text`` is the file for the
     controller, ``.values`` the parameters (current, corrected, 1-sigma), ``.errors`` which of
     the location errors it holds. ``current``: the controller's values active during the test
-    (its HAL or MPF file, or ``{"controller": ..., "parameters": {...}}`` JSON); without it zero
-    offsets are assumed and the output says so."""
-    text = read_current(current) if current is not None else None
-    return _core.export_controller(os.fspath(model), controller, text, os.fspath(current or "<current>"),
-                                   int(toolholder), generated_at)
+    (its HAL or MPF file, or ``{"controller": ..., "parameters": {...}}`` JSON); without it the
+    values the model keeps (``source.controller_parameters``, from ``identify --controller``),
+    else zero offsets, which the output says."""
+    if current is not None:
+        text, where = read_current(current), os.fspath(current)
+    else:  # the values the model says were active (identify --controller), if any
+        from .models import load_model
+        text = load_model(model).get("source", {}).get("controller_parameters")
+        where = f"{os.fspath(model)}: source.controller_parameters"
+    return _core.export_controller(os.fspath(model), controller, text, where, int(toolholder), generated_at)
 
 
 def export_dict(ex: Any) -> dict:

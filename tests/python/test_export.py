@@ -160,3 +160,18 @@ def test_linuxcnc_comp_file_of_an_rtest_map_holds_the_positioning_error(tmp_path
                        f"C={tmp_path / 'c.comp'}").returncode == EXIT_INPUT
     assert rotacal_cli("export", "--model", m, "--controller", "siemens", "--comp-file",
                        f"B={tmp_path / 'x.comp'}").returncode == EXIT_INPUT
+
+
+def test_the_model_keeps_the_active_parameters_for_the_export(shared_data, tmp_path):
+    cur = tmp_path / "machine.hal"
+    cur.write_text("setp xyzac-trt-kins.x-rot-point 250\nsetp xyzac-trt-kins.z-offset 80\n")
+    m = tmp_path / "m.json"
+    r = rotacal_cli("identify", shared_data / "ballbar_ac_table2.csv", "--save-model", m, "--controller", cur)
+    assert r.returncode == 0, r.stderr
+    assert "x-rot-point 250" in json.loads(m.read_text())["source"]["controller_parameters"]
+    r = rotacal_cli("export", "--model", m, "--controller", "linuxcnc", "--json")
+    assert r.returncode == 0, r.stderr
+    j = json.loads(r.stdout)
+    assert j["current_given"]
+    x = next(p for p in j["parameters"] if p["name"].endswith("x-rot-point"))
+    assert x["current"] == 250.0 and x["corrected"] == pytest.approx(250.0 + j["location_errors"][4]["value"])
