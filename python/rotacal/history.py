@@ -21,6 +21,7 @@ import math
 import os
 import re
 import sqlite3
+import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -538,7 +539,17 @@ def open_history(location: str | None = None, create_folder: bool | None = None)
         raise _core.IoError(f"{loc}: cannot open: {e}") from None
     try:
         # WAL: readers do not block the writer; FULL: a stored calibration survives a power cut.
-        conn.execute("PRAGMA journal_mode=WAL")
+        # Switching a new store to WAL takes an exclusive lock and SQLite does not wait for it
+        # (no busy handler there): two processes opening a new store at once retry.
+        deadline = time.monotonic() + BUSY_TIMEOUT_S
+        while True:
+            try:
+                conn.execute("PRAGMA journal_mode=WAL")
+                break
+            except sqlite3.OperationalError as e:
+                if "locked" not in str(e) or time.monotonic() > deadline:
+                    raise
+                time.sleep(0.05)
         conn.execute("PRAGMA synchronous=FULL")
         conn.execute("PRAGMA foreign_keys=ON")
     except sqlite3.DatabaseError as e:
