@@ -656,9 +656,17 @@ def cmd_export(a: argparse.Namespace) -> int:
     comp = dict(_comp_file(c) for c in a.comp_file or [])
     if comp and a.controller != "linuxcnc":
         raise _core.InvalidArgument("--comp-file: rotary compensation tables are written for linuxcnc")
-    check_outputs([a.output, a.residual_model, *comp.values()], [a.model, a.current])
+    if bool(a.centres) != bool(a.centres_output) or (a.centres and a.controller != "isg"):
+        raise _core.InvalidArgument("--centres and --centres-output go together, with --controller isg")
+    check_outputs([a.output, a.residual_model, a.centres_output, *comp.values()], [a.model, a.current, a.centres])
     ex = export_controller(a.model, a.controller, current=a.current, toolholder=a.toolholder)
     tables = {axis: linuxcnc_comp_table(load_model(a.model), axis, *a.comp_range, a.comp_step) for axis in comp}
+    if a.centres:
+        from .exports import isg_sphere_centres
+        text, what = isg_sphere_centres(load(a.centres), load_model(a.model), a.centres_setup,
+                                        (int(a.isg_kinematic[0]), int(a.isg_kinematic[1])), a.centres_origin)
+        write_output(a.centres_output, text, inputs=[p for p in (a.model, a.current, a.centres) if p])
+        _say(f"wrote {a.centres_output}: {what}")
     for axis, (text, what) in tables.items():
         write_output(comp[axis], text, inputs=[p for p in (a.model, a.current) if p])
         _say(f"wrote {comp[axis]}: {what}")
@@ -1040,6 +1048,16 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("-o", "--output", type=path("--output"), help="write the controller file here (default: print it)")
     q.add_argument("--residual-model", type=path("--residual-model"),
                    help="write a model of the errors the controller cannot hold (held ones zero), for compensate")
+    q.add_argument("--centres", metavar="RTEST.csv", type=path("--centres"),
+                   help="isg: the R-test session the model was fitted to; its measured sphere centres are written "
+                        "for the ISG kinematic optimisation (SysCalibFitAddRecord.ecy) to --centres-output")
+    q.add_argument("--centres-output", type=path("--centres-output"), help="isg: the NC program of the centres")
+    q.add_argument("--centres-setup", help="isg: the set-up (nest) whose centres are written (default: the first)")
+    q.add_argument("--centres-origin", type=numbers("--centres-origin", 3, 1e5, "mm"), default=[0.0, 0.0, 0.0],
+                   help="isg: the rotary axes' intersection in the controller's machine coordinates, mm")
+    q.add_argument("--isg-kinematic", type=numbers("--isg-kinematic", 2, 1e4), default=[80.0, 0.0],
+                   help="isg: kinematic type and variant for SysCalibFitInit.ecy (default 80,0 as TF5245's example; "
+                        "use your machine's)")
     q.add_argument("--comp-file", action="append", metavar="AXIS=FILE",
                    help="linuxcnc, R-test map of a BC-trt: the axis' positioning error as a [JOINT_n]COMP_FILE "
                         "(type 0) table; AXIS B or C (C needs the map's gamma terms); may be repeated")
@@ -1194,7 +1212,7 @@ def _add_truth_args(q: argparse.ArgumentParser) -> None:
 # Options whose values may start with '-' ("--a-range -90,90"): argparse would take the value
 # for an option, so such pairs are joined as "--a-range=-90,90" before parsing.
 _SIGNED_VALUE_OPTIONS = {"--a-range", "--b-range", "--c-range", "--pivot", "--errors", "--nest", "--probe-dir",
-                         "--comp-range", "--travel", "--pivot-z"}
+                         "--comp-range", "--travel", "--pivot-z", "--centres-origin"}
 
 
 def _join_signed_values(argv: Sequence[str]) -> list[str]:

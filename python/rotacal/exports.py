@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Any
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -144,3 +144,56 @@ def linuxcnc_comp_table(model: dict, axis: str, lo_deg: float, hi_deg: float, st
             f"[JOINT_n]COMP_FILE_TYPE = 0 (nominal, actual moving +, actual moving -, deg)"
             + ("; terms that depend on B were left out (the table is for B = 0)" if dropped_any else ""))
     return "\n".join(lines) + "\n", what
+
+
+def isg_sphere_centres(session: Any, model: dict, setup: str | None, kinematic: tuple[int, int],
+                       origin: Sequence[float] = (0.0, 0.0, 0.0), precision_mm: float = 0.06) -> tuple[str, str]:
+    """The measured sphere centres of an R-test set-up as the ISG kinematic optimisation takes
+    them from third-party measuring equipment (TF5245, "sphere centre points already
+    calculated"): an NC program that calls ``SysCalibFitInit.ecy`` (kinematic type, variant,
+    number of poses), ``SysCalibFitAddRecord.ecy`` once per pose (centre X, Y, Z in mm; A, B, C
+    in deg) and ``SysCalibFit.ecy`` (list format 1, precision).
+
+    The centre of the table-fixed nest at a pose is where the machine put it: the tool-side
+    sphere's commanded position minus the reading turned into the machine frame,
+    ``xyz - Ry(B) Rz(C) (d - zero)`` (to first order in the errors), with the set-up's probe zero
+    from the model (an rtest-joint fit of the same session), plus ``origin``: the rotary axes'
+    intersection in the controller's machine coordinates. Returns (program, description)."""
+    if model.get("kind") != "rtest-joint":
+        raise _core.InvalidArgument("--centres: needs the rtest-joint model of the same session (its probe zeros)")
+    s, _ = _rtest_displacements(session)
+    setups = list(dict.fromkeys(s.setups))
+    label = setup if setup is not None else setups[0]
+    if label not in setups:
+        raise _core.InvalidArgument(f"--centres-setup {label!r}: the session's set-ups are {', '.join(setups)}")
+    zeros = model.get("probe_zeros", {})
+    if label not in zeros:
+        raise _core.InvalidArgument(f"--centres: the model has no probe zero for set-up {label!r} "
+                                    "(fit the same session: rotacal identify RTEST --save-model)")
+    zero = np.array([zeros[label][a]["value"] or 0.0 for a in "xyz"])
+    rows = [i for i, x in enumerate(s.setups) if x == label]
+    xyz, ang, d = np.asarray(s.xyz)[rows], np.radians(np.asarray(s.angles_deg)[rows]), np.asarray(s.d)[rows]
+    o = np.asarray(origin, dtype=float)
+    lines = ["; rotacal export: measured sphere centres for the ISG kinematic optimisation (TF5245)",
+             f"; set-up {label}, {len(rows)} poses; centre = commanded sphere - Ry(B) Rz(C) (reading - probe zero)",
+             f"; origin (rotary axes' intersection, machine coordinates): {o[0]:.6f}, {o[1]:.6f}, {o[2]:.6f} mm",
+             "#VAR", f"V.L.KIN_TYP = {kinematic[0]}", f"V.L.KIN_VARIANT = {kinematic[1]}",
+             f"V.L.NUMBER_OF_POSES = {len(rows)}", "#ENDVAR",
+             'L CYCLE [NAME = "SysCalibFitInit.ecy" @P1 = V.L.KIN_TYP @P2 = V.L.KIN_VARIANT '
+             '@P3 = V.L.NUMBER_OF_POSES]']
+    for p, (b, c), dd in zip(xyz, ang, d):
+        cb, sb, cc, sc = np.cos(b), np.sin(b), np.cos(c), np.sin(c)
+        R = np.array([[cb, 0, sb], [0, 1, 0], [-sb, 0, cb]]) @ np.array([[cc, -sc, 0], [sc, cc, 0], [0, 0, 1]])
+        centre = o + p - R @ (dd - zero)
+        lines.append(f'L CYCLE [NAME = "SysCalibFitAddRecord.ecy" @P1 = {centre[0]:.6f} @P2 = {centre[1]:.6f} '
+                     f'@P3 = {centre[2]:.6f} @P4 = 0 @P5 = {np.degrees(b):.6f} @P6 = {np.degrees(c):.6f}]')
+    lines += ["#VAR", "V.P.MAX_PRECISION = " + f"{precision_mm:g}", "V.P.LIST_FORMAT = 1", "#ENDVAR",
+              'L CYCLE [NAME = "SysCalibFit.ecy" @P1 = V.P.LIST_FORMAT @P2 = V.P.MAX_PRECISION]', "M30"]
+    return "\n".join(lines) + "\n", f"{len(rows)} measured sphere centres of set-up {label} for SysCalibFitAddRecord.ecy"
+
+
+def _rtest_displacements(session: Any) -> tuple[Any, list]:
+    from .rtest import with_displacements
+    if session.machine != _core.MachineType.BC_trt:
+        raise _core.InvalidArgument("--centres: an R-test session of a BC-trt machine")
+    return with_displacements(session)

@@ -175,3 +175,55 @@ def test_the_model_keeps_the_active_parameters_for_the_export(shared_data, tmp_p
     assert j["current_given"]
     x = next(p for p in j["parameters"] if p["name"].endswith("x-rot-point"))
     assert x["current"] == 250.0 and x["corrected"] == pytest.approx(250.0 + j["location_errors"][4]["value"])
+
+
+def test_isg_measured_sphere_centres_are_where_the_machine_put_the_nest(tmp_path):
+    # An R-test of a machine with location errors; its nest centres, as the ISG kinematic
+    # optimisation takes them, must be the actual machine's table point at each pose.
+    s, m, truth = tmp_path / "r.csv", tmp_path / "r.json", tmp_path / "r.truth.json"
+    assert rotacal_cli("simulate", "rtest", "--errors", "random", "--seed", "4", "-o", s, "--truth", truth).returncode == 0
+    assert rotacal_cli("identify", s, "--save-model", m).returncode == 0
+    prog = tmp_path / "centres.nc"
+    r = rotacal_cli("export", "--model", m, "--controller", "isg", "--centres", s, "--centres-output", prog,
+                    "--centres-setup", "2", "--isg-kinematic", "81,0", "--centres-origin", "500,-200,300")
+    assert r.returncode == 0, r.stderr
+    text = prog.read_text()
+    assert "V.L.KIN_TYP = 81" in text and 'NAME = "SysCalibFit.ecy"' in text
+    recs = [[float(v) for v in re.findall(r"@P\d = ([-0-9.]+)", line)] for line in text.splitlines()
+            if "SysCalibFitAddRecord" in line]
+    recs = np.array(recs)
+    t = json.loads(truth.read_text())
+    names = list(_core.location_error_names(_core.MachineType.BC_trt))
+    e = np.array([t["errors"][n] for n in names])
+    nest = np.array(t["nests"][1])
+    ang = np.radians(recs[:, 4:6])
+    expected = np.array([500.0, -200.0, 300.0]) + _core.forward(_core.MachineType.BC_trt, e, ang, np.tile(nest, (len(recs), 1)))
+    assert len(recs) == 84
+    assert np.abs(recs[:, :3] - expected).max() < 2e-3  # mm: 0.3 um noise, fitted probe zeros
+    # Nominal positions would be tens of um away: the centres carry the errors.
+    nominal = np.array([500.0, -200.0, 300.0]) + _core.forward(_core.MachineType.BC_trt, np.zeros(8), ang,
+                                                               np.tile(nest, (len(recs), 1)))
+    assert np.abs(recs[:, :3] - nominal).max() > 5e-3
+    assert rotacal_cli("export", "--model", m, "--controller", "linuxcnc", "--centres", s, "--centres-output",
+                       tmp_path / "x.nc").returncode == EXIT_INPUT
+
+
+def test_heidenhain_and_fanuc_mappings(model, tmp_path):
+    # Where the formulas are not public the export is a mapping: each parameter carries the
+    # line-position changes of formats.md, from the values given as current.
+    e = {n: v["value"] for n, v in json.loads(model.read_text())["location_errors"].items()}
+    cur = tmp_path / "h.json"
+    cur.write_text(json.dumps({"controller": "heidenhain", "parameters": {"Trans Y before MachAxis A": 5.0,
+                                                                        "Trans X before MachAxis C": -300.0}}))
+    j = json.loads(rotacal_cli("export", "--model", model, "--controller", "heidenhain", "--current", cur,
+                               "--json").stdout)
+    v = {p["name"]: p for p in j["parameters"]}
+    assert v["Trans Y before MachAxis A"]["corrected"] == pytest.approx(5.0 + e["E_Y0A"])
+    assert v["Trans Z before MachAxis A"]["corrected"] == pytest.approx(e["E_Z0A"])
+    assert v["Trans X before MachAxis C"]["corrected"] == pytest.approx(-300.0 + e["E_X0C"])
+    assert v["Trans Y before MachAxis C"]["corrected"] == pytest.approx(e["E_Y0C"])
+    j = json.loads(rotacal_cli("export", "--model", model, "--controller", "fanuc", "--json").stdout)
+    v = {p["name"][:9]: p["corrected"] for p in j["parameters"]}
+    assert [v[f"No. {19700 + k}"] for k in range(3)] == pytest.approx([0.0, e["E_Y0A"], e["E_Z0A"]])
+    assert [v[f"No. {19703 + k}"] for k in range(3)] == pytest.approx(
+        [e["E_X0C"], e["E_Y0C"] - e["E_Y0A"], -e["E_Z0A"]])
