@@ -786,7 +786,16 @@ def _faults(a: argparse.Namespace):
 
 
 def _serve(dev, what: str, a: argparse.Namespace, detail: str) -> int:
-    """Print the device path, then serve until Ctrl-C (or the program's end with --exit-when-done)."""
+    """Print the device path, then serve until Ctrl-C or SIGTERM (or the program's end with
+    --exit-when-done)."""
+    import signal
+
+    def stop(*_: Any) -> None:
+        raise KeyboardInterrupt
+    # Installed explicitly: a process started in the background by a shell script inherits
+    # SIGINT ignored, and Python then leaves it ignored (the instrument never stopped).
+    signal.signal(signal.SIGINT, stop)
+    signal.signal(signal.SIGTERM, stop)
     print(dev.port, flush=True)
     _say(f"virtual {what} on {dev.port} ({detail}); Ctrl-C to stop")
     try:
