@@ -17,7 +17,7 @@ bash scripts/setup.sh
 step "C++ build and tests (Release)"
 cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release -DROTACAL_BUILD_BENCH=ON
 cmake --build build/release
-ctest --test-dir build/release --output-on-failure
+ctest --test-dir build/release --output-on-failure -j "$(nproc)"
 
 step "CMake package: find_package(rotacal CONFIG REQUIRED) from a separate project"
 rm -rf build/install build/consumer
@@ -63,4 +63,4 @@ cmake -S . -B build/asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEB
       -DROTACAL_SANITIZE=ON -DROTACAL_BUILD_BENCH=OFF
 cmake --build build/asan
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
-  ctest --test-dir build/asan --output-on-failure
+  ctest --test-dir build/asan --output-on-failure -j "$(nproc)"
