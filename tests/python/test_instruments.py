@@ -225,6 +225,11 @@ def test_virtual_instrument_stops_on_a_signal_even_when_started_with_sigint_igno
     v = Virtual("ballbar", *FAST, "--speed", "5", preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN))
     time.sleep(0.5)
     v.proc.send_signal(sig)
-    out, err = v.proc.communicate(timeout=60)
+    try:
+        out, err = v.proc.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        v.proc.kill()  # it ignored the signal: fail, and leave nothing running
+        v.proc.communicate()
+        raise
     assert v.proc.returncode == 0, err
     assert "frames" in err  # the summary it prints on stopping
