@@ -181,10 +181,11 @@ def isg_sphere_centres(session: Any, model: dict, setup: str | None, kinematic: 
              f"V.L.NUMBER_OF_POSES = {len(rows)}", "#ENDVAR",
              'L CYCLE [NAME = "SysCalibFitInit.ecy" @P1 = V.L.KIN_TYP @P2 = V.L.KIN_VARIANT '
              '@P3 = V.L.NUMBER_OF_POSES]']
-    for p, (b, c), dd in zip(xyz, ang, d):
-        cb, sb, cc, sc = np.cos(b), np.sin(b), np.cos(c), np.sin(c)
-        R = np.array([[cb, 0, sb], [0, 1, 0], [-sb, 0, cb]]) @ np.array([[cc, -sc, 0], [sc, cc, 0], [0, 0, 1]])
-        centre = o + p - R @ (dd - zero)
+    # The reading turned into the machine frame by the nominal table pose (the one forward
+    # kinematics, no errors: Ry(B) Rz(C)).
+    turned = _core.forward(session.machine, np.zeros(8), ang, d - zero)
+    for p, (b, c), t in zip(xyz, ang, turned):
+        centre = o + p - t
         lines.append(f'L CYCLE [NAME = "SysCalibFitAddRecord.ecy" @P1 = {centre[0]:.6f} @P2 = {centre[1]:.6f} '
                      f'@P3 = {centre[2]:.6f} @P4 = 0 @P5 = {np.degrees(b):.6f} @P6 = {np.degrees(c):.6f}]')
     lines += ["#VAR", "V.P.MAX_PRECISION = " + f"{precision_mm:g}", "V.P.LIST_FORMAT = 1", "#ENDVAR",

@@ -21,28 +21,30 @@ using Row = Eigen::Matrix<double, 1, 8>;
 using Map3 = Eigen::Matrix<double, 3, 8>;  // a 3-vector as a linear function of the 8 errors
 
 // The line offsets of ../shared/spec/formats.md as linear maps of the error vector: the tilt
-// axis (A or B) and C, their point offsets dp and direction offsets dn.
+// axis (A or B) and C, their point offsets dp and direction offsets dn. The lines are linear in
+// the errors, so each column is the one definition (kinematics/machine.hpp) at a unit error.
 struct LineMaps {
   Map3 tilt_point = Map3::Zero(), tilt_dir = Map3::Zero(), c_point = Map3::Zero(), c_dir = Map3::Zero();
-  Eigen::Vector3d tilt_axis, c_axis{0, 0, 1};
+  Eigen::Vector3d tilt_axis, c_axis;
   char tilt = 'A';
 };
 
 LineMaps line_maps(MachineType m) {
   LineMaps L;
-  if (m == MachineType::AC_trt) {  // A: dp = (0, E_Y0A, E_Z0A), dn = (0, E_C0A, -E_B0A)
-    L.tilt = 'A';
-    L.tilt_axis = Eigen::Vector3d::UnitX();
-    L.tilt_point(1, 0) = 1, L.tilt_point(2, 1) = 1;
-    L.tilt_dir(1, 3) = 1, L.tilt_dir(2, 2) = -1;
-  } else {  // B: dp = (E_X0B, 0, E_Z0B), dn = (-E_C0B, 0, E_A0B)
-    L.tilt = 'B';
-    L.tilt_axis = Eigen::Vector3d::UnitY();
-    L.tilt_point(0, 0) = 1, L.tilt_point(2, 1) = 1;
-    L.tilt_dir(0, 3) = -1, L.tilt_dir(2, 2) = 1;
+  L.tilt = m == MachineType::AC_trt ? 'A' : 'B';
+  const LocationErrors<double> none;
+  const AxisLine<double> T0 = tilt_axis_line(m, none), C0 = c_axis_line(m, none);
+  L.tilt_axis = T0.direction;
+  L.c_axis = C0.direction;
+  for (int i = 0; i < 8; ++i) {
+    LocationErrors<double> unit;
+    unit.v[i] = 1.0;
+    const AxisLine<double> T = tilt_axis_line(m, unit), C = c_axis_line(m, unit);
+    L.tilt_point.col(i) = T.point - T0.point;
+    L.tilt_dir.col(i) = T.direction - T0.direction;
+    L.c_point.col(i) = C.point - C0.point;
+    L.c_dir.col(i) = C.direction - C0.direction;
   }
-  L.c_point(0, 4) = 1, L.c_point(1, 5) = 1;  // C: dp = (E_X0C, E_Y0C, 0), dn = (E_B0C, -E_A0C, 0)
-  L.c_dir(0, 7) = 1, L.c_dir(1, 6) = -1;
   return L;
 }
 
