@@ -13,11 +13,46 @@ LocationErrors<double> errors_of(const pyb::array_t<double, pyb::array::c_style 
 }  // namespace
 
 void bind_kinematics(pyb::module_& m) {
-  pyb::enum_<MachineType>(m, "MachineType")
-      .value("AC_trt", MachineType::AC_trt)
-      .value("BC_trt", MachineType::BC_trt);
+  pyb::class_<MachineType>(m, "MachineType",
+                           "A 5-axis machine: a built-in (AC_trt, BC_trt, builtin(name)) or a "
+                           "rotacal-machine/1 description (from_description).")
+      .def_readonly_static("AC_trt", &MachineType::AC_trt)
+      .def_readonly_static("BC_trt", &MachineType::BC_trt)
+      .def_static("from_description",
+                  [](const std::string& json_text, const std::string& source) {
+                    return MachineType::from_description(parse_machine_description(json_text, source));
+                  },
+                  pyb::arg("json_text"), pyb::arg("source") = "machine description",
+                  "The machine of a rotacal-machine/1 JSON text; errors name `source` and the field.")
+      .def_property_readonly("name", [](MachineType t) { return to_string(t); })
+      .def_property_readonly("configuration", [](MachineType t) { return t.description().configuration(); })
+      .def_property_readonly("axis_names",
+                             [](MachineType t) {
+                               return std::string{t.description().axis(0).name, t.description().axis(1).name};
+                             },
+                             "Rotary axis letters in chain order (table axes, then head axes): the "
+                             "session's rotary columns.")
+      .def_property_readonly("tilt_axis", [](MachineType t) { return std::string(1, tilt_axis_letter(t)); })
+      .def_property_readonly("rot_axis", [](MachineType t) { return std::string(1, rot_axis_letter(t)); })
+      .def_property_readonly("has_head", &MachineType::has_head)
+      .def_property_readonly("is_builtin", &MachineType::is_builtin)
+      .def_property_readonly("description_json",
+                             [](MachineType t) { return machine_description_json(t.description()); })
+      .def("__eq__", [](MachineType a, MachineType b) { return a == b; })
+      .def("__ne__", [](MachineType a, MachineType b) { return a != b; })
+      .def("__hash__", [](MachineType t) { return t.id(); })
+      .def(pyb::pickle([](MachineType t) { return machine_description_json(t.description()); },
+                       [](const std::string& json_text) {
+                         return MachineType::from_description(parse_machine_description(json_text, "pickle"));
+                       }))
+      .def("__repr__", [](MachineType t) {
+        if (t == MachineType::AC_trt) return std::string("MachineType.AC_trt");
+        if (t == MachineType::BC_trt) return std::string("MachineType.BC_trt");
+        return "MachineType('" + to_string(t) + "')";
+      });
   m.def("parse_machine_type", &parse_machine_type, pyb::arg("text"),
-        "Machine type from its file name ('AC-trt' or 'BC-trt').");
+        "A built-in machine by its name ('AC-trt', 'BC-trt', 'B-head-C-table', ...).");
+  m.def("builtin_machine_names", &builtin_machine_names, "Names of the built-in machines.");
   m.def("machine_name", pyb::overload_cast<MachineType>(&to_string), pyb::arg("machine"));
   m.def("location_error_names", &location_error_names, pyb::arg("machine"),
         "ISO 230-7 names of the 8 location errors, in the order of every errors vector.");

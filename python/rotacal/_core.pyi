@@ -6,7 +6,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Ambiguity', 'AngleTable', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CompensationReport', 'CompensationRow', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'ballbar_model_document', 'ballbar_model_from_document', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_model_machine', 'check_output', 'check_plausible', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_ballbar_tests', 'default_calibration_moves', 'design_ballbar_test', 'diagnose_ballbar', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'export_controller', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_rtest', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
+__all__: list[str] = ['Ambiguity', 'AngleTable', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CompensationReport', 'CompensationRow', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'ballbar_model_document', 'ballbar_model_from_document', 'builtin_machine_names', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_model_machine', 'check_output', 'check_plausible', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_ballbar_tests', 'default_calibration_moves', 'design_ballbar_test', 'diagnose_ballbar', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'export_controller', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_rtest', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
 class Ambiguity:
     @property
     def correlation(self) -> float:
@@ -358,7 +358,7 @@ class BallbarSetup:
     """
     machine: MachineType
     radial_c_side: RadialSide
-    def __init__(self, machine: MachineType = MachineType.AC_trt, ballbar_length: typing.SupportsFloat | typing.SupportsIndex = 100.0, pivot: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ..., tilt_range_deg: typing.Annotated[collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], "FixedSize(2)"] = [-90.0, 90.0], rot_range_deg: typing.Annotated[collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], "FixedSize(2)"] = [0.0, 360.0], step_deg: typing.SupportsFloat | typing.SupportsIndex = 1.0, feed_mm_per_min: typing.SupportsFloat | typing.SupportsIndex = 1000.0, feed_deg_per_min: typing.SupportsFloat | typing.SupportsIndex = 3600.0, tests: collections.abc.Sequence[BallbarTest] = ..., radial_c_side: RadialSide = RadialSide.outside) -> None:
+    def __init__(self, machine: MachineType = ..., ballbar_length: typing.SupportsFloat | typing.SupportsIndex = 100.0, pivot: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ..., tilt_range_deg: typing.Annotated[collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], "FixedSize(2)"] = [-90.0, 90.0], rot_range_deg: typing.Annotated[collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], "FixedSize(2)"] = [0.0, 360.0], step_deg: typing.SupportsFloat | typing.SupportsIndex = 1.0, feed_mm_per_min: typing.SupportsFloat | typing.SupportsIndex = 1000.0, feed_deg_per_min: typing.SupportsFloat | typing.SupportsIndex = 3600.0, tests: collections.abc.Sequence[BallbarTest] = ..., radial_c_side: RadialSide = RadialSide.outside) -> None:
         ...
     @property
     def ballbar_length(self) -> float:
@@ -1000,48 +1000,52 @@ class LocationBudget:
         ...
 class MachineType:
     """
-    Members:
-    
-      AC_trt
-    
-      BC_trt
+    A 5-axis machine: a built-in (AC_trt, BC_trt, builtin(name)) or a rotacal-machine/1 description (from_description).
     """
-    AC_trt: typing.ClassVar[MachineType]  # value = <MachineType.AC_trt: 0>
-    BC_trt: typing.ClassVar[MachineType]  # value = <MachineType.BC_trt: 1>
-    __members__: typing.ClassVar[dict[str, MachineType]]  # value = {'AC_trt': <MachineType.AC_trt: 0>, 'BC_trt': <MachineType.BC_trt: 1>}
-    @typing.overload
-    def __eq__(self, other: MachineType) -> bool:
+    AC_trt: typing.ClassVar[MachineType]  # value = MachineType.AC_trt
+    BC_trt: typing.ClassVar[MachineType]  # value = MachineType.BC_trt
+    @staticmethod
+    def from_description(json_text: str, source: str = 'machine description') -> MachineType:
+        """
+        The machine of a rotacal-machine/1 JSON text; errors name `source` and the field.
+        """
+    def __eq__(self, arg0: MachineType) -> bool:
         ...
-    @typing.overload
-    def __eq__(self, other: typing.Any) -> bool:
-        ...
-    def __getstate__(self) -> int:
+    def __getstate__(self) -> str:
         ...
     def __hash__(self) -> int:
         ...
-    def __index__(self) -> int:
-        ...
-    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
-        ...
-    def __int__(self) -> int:
-        ...
-    @typing.overload
-    def __ne__(self, other: MachineType) -> bool:
-        ...
-    @typing.overload
-    def __ne__(self, other: typing.Any) -> bool:
+    def __ne__(self, arg0: MachineType) -> bool:
         ...
     def __repr__(self) -> str:
         ...
-    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None:
+    def __setstate__(self, arg0: str) -> None:
         ...
-    def __str__(self) -> str:
+    @property
+    def axis_names(self) -> str:
+        """
+        Rotary axis letters in chain order (table axes, then head axes): the session's rotary columns.
+        """
+    @property
+    def configuration(self) -> str:
+        ...
+    @property
+    def description_json(self) -> str:
+        ...
+    @property
+    def has_head(self) -> bool:
+        ...
+    @property
+    def is_builtin(self) -> bool:
         ...
     @property
     def name(self) -> str:
         ...
     @property
-    def value(self) -> int:
+    def rot_axis(self) -> str:
+        ...
+    @property
+    def tilt_axis(self) -> str:
         ...
 class ModelFit:
     @property
@@ -2050,6 +2054,10 @@ def ballbar_model_document(model: ...) -> typing.Any:
     ...
 def ballbar_model_from_document(document: dict, source: str = '<model>') -> ...:
     ...
+def builtin_machine_names() -> list[str]:
+    """
+    Names of the built-in machines.
+    """
 def calibrate_probe_directions(moves: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], readings: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> ProbeCalibration:
     """
     Probe directions, gains and zeros from commanded moves (N, 3) and readings (N, 3), mm.
@@ -2227,7 +2235,7 @@ def parse_ballbar_test(label: str, machine: MachineType) -> BallbarTest:
     """
 def parse_machine_type(text: str) -> MachineType:
     """
-    Machine type from its file name ('AC-trt' or 'BC-trt').
+    A built-in machine by its name ('AC-trt', 'BC-trt', 'B-head-C-table', ...).
     """
 def parse_model_document(text: str, source: str = '<model>') -> typing.Any:
     ...

@@ -16,7 +16,7 @@ BallbarSession compensate_commands(const BallbarSession& nominal,
     const RotaryAngles<double> a = s.angles_rad();
     // Table-frame target of the nominal (TCPM) command, then the command that reaches it on
     // the identified machine.
-    const Eigen::Vector3d q = table_pose(machine, zero, a).inverse() * s.xyz;
+    const Eigen::Vector3d q = ball_in_table(machine, zero, a, s.xyz);
     s.xyz = inverse(machine, identified, a, q).xyz;
   }
   return out;

@@ -142,9 +142,7 @@ class Writer {
   // the NOMINAL kinematics take to the planned machine axes (= p_table for a nominal plan).
   Eigen::Vector3d coords(const PlannedSample& s) const {
     if (!is_tcp_dialect() || !tcp_on_) return s.xyz;
-    const Pose<double> T =
-        table_pose(plan_.setup.machine, LocationErrors<double>(), s.angles_rad());
-    return T.inverse() * s.xyz;
+    return ball_in_table(plan_.setup.machine, LocationErrors<double>(), s.angles_rad(), s.xyz);
   }
 
   std::string axes_words(const Eigen::Vector3d& p, double tilt, double rot) const {

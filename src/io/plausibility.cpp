@@ -78,10 +78,12 @@ PlausibilityReport check_plausible(const BallbarSession& s, const std::string& s
   std::vector<double> dev_deg, dev_rad, measured, commanded;
   dev_deg.reserve(s.samples.size());
   for (const BallbarSample& b : s.samples) {
-    const double nominal_deg =
-        (b.xyz - forward(s.machine, nominal, angles_as(b.tilt_deg, b.rot_deg, false), s.pivot)).norm();
-    const double nominal_rad =
-        (b.xyz - forward(s.machine, nominal, angles_as(b.tilt_deg, b.rot_deg, true), s.pivot)).norm();
+    // The nominal bar: tool ball of the command against the nominal pivot (any machine).
+    auto bar = [&](bool radians) {
+      const RotaryAngles<double> a = angles_as(b.tilt_deg, b.rot_deg, radians);
+      return (tool_ball(s.machine, nominal, a, b.xyz) - forward(s.machine, nominal, a, s.pivot)).norm();
+    };
+    const double nominal_deg = bar(false), nominal_rad = bar(true);
     dev_deg.push_back(std::abs(b.length - nominal_deg));
     dev_rad.push_back(std::abs(b.length - nominal_rad));
     measured.push_back(b.length);
@@ -137,9 +139,13 @@ PlausibilityReport check_plausible(const RtestSession& s, const std::string& sou
     const auto it = s.nests.find(r.setup);
     if (it == s.nests.end()) refuse(source, "setup '" + r.setup + "' has no nest");
     const Eigen::Vector3d& q = it->second;
-    dev_deg.push_back((r.xyz - forward(s.machine, nominal, angles_as(r.tilt_deg, r.rot_deg, false), q)).norm());
-    dev_rad.push_back((r.xyz - forward(s.machine, nominal, angles_as(r.tilt_deg, r.rot_deg, true), q)).norm());
-    dev_inch.push_back((r.xyz * kInch - forward(s.machine, nominal, angles_as(r.tilt_deg, r.rot_deg, false), q)).norm());
+    // Commanded linear axes against where the nominal machine commands the nest (any machine).
+    auto off = [&](const Eigen::Vector3d& xyz, bool radians) {
+      return (xyz - inverse(s.machine, nominal, angles_as(r.tilt_deg, r.rot_deg, radians), q).xyz).norm();
+    };
+    dev_deg.push_back(off(r.xyz, false));
+    dev_rad.push_back(off(r.xyz, true));
+    dev_inch.push_back(off(r.xyz * kInch, false));
     if (r.d && r.d->cwiseAbs().maxCoeff() > o.max_displacement_mm) {
       const std::size_t i = dev_deg.size() - 1;
       refuse(source, "pose " + std::to_string(i) + " (setup " + r.setup + ", time " + fmt(r.time, 8) +

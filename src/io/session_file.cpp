@@ -323,13 +323,27 @@ int column_index(const Reader& R, const std::string& name, bool required) {
   return static_cast<int>(it - R.header.begin());
 }
 
+// `# machine:` names a built-in, or `# machine_description:` (one line of rotacal-machine/1
+// JSON) defines the machine, `# machine:` then being its free-text name (formats.md).
 MachineType read_machine(const Reader& R) {
   const std::string* m = R.meta("machine");
-  if (!m) R.fail(0, 0, "missing metadata 'machine' (AC-trt or BC-trt)");
+  if (const std::string* d = R.meta("machine_description")) {
+    const std::string where = R.name + ":" + std::to_string(R.meta_line("machine_description")) +
+                              ": machine_description";
+    try {
+      return MachineType::from_description(parse_machine_description(*d, where));
+    } catch (const InvalidArgument& e) {
+      R.fail(R.meta_line("machine_description"), 0, e.what());
+    }
+  }
+  if (!m) R.fail(0, 0, "missing metadata 'machine' (a built-in name such as AC-trt, or a machine_description)");
   try {
     return parse_machine_type(*m);
   } catch (const InvalidArgument&) {
-    R.fail(R.meta_line("machine"), 0, "unknown machine '" + excerpt(*m) + "' (known: AC-trt, BC-trt)");
+    std::string known;
+    for (const std::string& n : builtin_machine_names()) known += (known.empty() ? "" : ", ") + n;
+    R.fail(R.meta_line("machine"), 0, "unknown machine '" + excerpt(*m) + "' (built-in: " + known +
+                                          "; any other needs a '# machine_description:' line)");
   }
 }
 
@@ -351,13 +365,31 @@ std::optional<double> read_noise(const Reader& R) {
   return v;
 }
 
-// Rotary columns must be named after the machine's axes.
+// Rotary columns must be named after the machine's axes: a column named after another rotary
+// letter belongs to another machine.
 void check_rotary_columns(const Reader& R, MachineType m) {
-  const std::string tilt(1, tilt_axis_letter(m));
-  const std::string other = m == MachineType::AC_trt ? "B" : "A";
-  if (std::find(R.header.begin(), R.header.end(), other) != R.header.end())
-    R.fail(R.header_line, 0, "column '" + other + "' does not belong to a " + to_string(m) +
-                                 " machine (rotary columns are " + tilt + ", C)");
+  const std::string mine{m.description().axis(0).name, m.description().axis(1).name};
+  for (const char* other : {"A", "B", "C"})
+    if (mine.find(other[0]) == std::string::npos &&
+        std::find(R.header.begin(), R.header.end(), other) != R.header.end())
+      R.fail(R.header_line, 0, std::string("column '") + other + "' does not belong to a " + to_string(m) +
+                                   " machine (rotary columns are " + mine.substr(0, 1) + ", " + mine.substr(1) + ")");
+}
+
+// The machine lines of a header: the built-in's name, or a description with its name.
+std::string machine_lines(MachineType m) {
+  std::string out = "# machine: " + to_string(m) + "\n";
+  if (!m.is_builtin()) out += "# machine_description: " + machine_description_json(m.description()) + "\n";
+  return out;
+}
+
+// Rotary column names in chain order and the two angles of a sample in that order.
+std::string rotary_header(MachineType m) {
+  return std::string(1, m.description().axis(0).name) + "," + m.description().axis(1).name;
+}
+std::string rotary_values(MachineType m, double tilt_deg, double rot_deg) {
+  const bool rot_first = m.rot_index() == 0;
+  return format_number(rot_first ? rot_deg : tilt_deg) + "," + format_number(rot_first ? tilt_deg : rot_deg);
 }
 
 std::vector<Field> row_fields(Reader& R, const std::pair<int, std::string>& row) {
@@ -428,25 +460,25 @@ std::string vec_text(const Eigen::Vector3d& v) {
 }
 
 bool is_known_ballbar_key(const std::string& k) {
-  return k == "format" || k == "machine" || k == "units" || k == "ballbar_length" || k == "pivot" ||
-         k == "noise_um";
+  return k == "format" || k == "machine" || k == "machine_description" || k == "units" ||
+         k == "ballbar_length" || k == "pivot" || k == "noise_um";
 }
 
 bool is_known_rtest_key(const std::string& k) {
-  return k == "format" || k == "machine" || k == "units" || k == "noise_um" || k.rfind("nest.", 0) == 0 ||
+  return k == "format" || k == "machine" || k == "machine_description" || k == "units" ||
+         k == "noise_um" || k.rfind("nest.", 0) == 0 ||
          (k.rfind("probe.", 0) == 0 && k.size() > 4 && k.compare(k.size() - 4, 4, ".dir") == 0);
 }
 
 std::string ballbar_head(const BallbarSession& s) {
   std::string out = std::string("# format: ") + kBallbarFormat + "\n";
-  out += "# machine: " + to_string(s.machine) + "\n# units: mm, deg, s\n";
+  out += machine_lines(s.machine) + "# units: mm, deg, s\n";
   out += "# ballbar_length: " + format_number(s.ballbar_length) + "\n";
   out += "# pivot: " + vec_text(s.pivot) + "\n";
   if (s.noise_um) out += "# noise_um: " + format_number(*s.noise_um) + "\n";
   for (const auto& kv : s.metadata)
     if (!is_known_ballbar_key(kv.first)) out += "# " + kv.first + ": " + kv.second + "\n";
-  const char T = tilt_axis_letter(s.machine);
-  out += std::string("test,time,X,Y,Z,") + T + ",C,length";
+  out += "test,time,X,Y,Z," + rotary_header(s.machine) + ",length";
   for (const std::string& c : s.extra_columns) out += "," + c;
   return out + "\n";
 }
@@ -457,15 +489,14 @@ void check_label(const std::string& label, const char* what) {
                           "' cannot be written (empty, or contains a comma, '#', newline or edge spaces)");
 }
 
-std::string ballbar_row(const BallbarSample& r, std::size_t extra) {
+std::string ballbar_row(const BallbarSample& r, MachineType m, std::size_t extra) {
   check_label(r.test, "test label");
   if (r.extra.size() != extra)
     throw InvalidArgument("sample has " + std::to_string(r.extra.size()) + " extra values for " +
                           std::to_string(extra) + " extra columns");
   std::string out = r.test + "," + format_number(r.time) + "," + format_number(r.xyz.x()) + "," +
                     format_number(r.xyz.y()) + "," + format_number(r.xyz.z()) + "," +
-                    format_number(r.tilt_deg) + "," + format_number(r.rot_deg) + "," +
-                    format_number(r.length);
+                    rotary_values(m, r.tilt_deg, r.rot_deg) + "," + format_number(r.length);
   for (const std::string& e : r.extra) out += "," + e;
   return out + "\n";
 }
@@ -478,26 +509,25 @@ struct RtestColumns {
 
 std::string rtest_head(const RtestSession& s, RtestColumns cols) {
   std::string out = std::string("# format: ") + kRtestFormat + "\n";
-  out += "# machine: " + to_string(s.machine) + "\n# units: mm, deg, s\n";
+  out += machine_lines(s.machine) + "# units: mm, deg, s\n";
   for (const auto& n : s.nests) out += "# nest." + n.first + ": " + vec_text(n.second) + "\n";
   for (const auto& p : s.probe_dirs)
     out += "# probe." + std::to_string(p.first) + ".dir: " + vec_text(p.second) + "\n";
   if (s.noise_um) out += "# noise_um: " + format_number(*s.noise_um) + "\n";
   for (const auto& kv : s.metadata)
     if (!is_known_rtest_key(kv.first)) out += "# " + kv.first + ": " + kv.second + "\n";
-  const char T = tilt_axis_letter(s.machine);
-  out += std::string("setup,time,") + T + ",C,X,Y,Z";
+  out += "setup,time," + rotary_header(s.machine) + ",X,Y,Z";
   if (cols.d) out += ",dx,dy,dz";
   if (cols.raw) out += ",d1,d2,d3";
   for (const std::string& c : s.extra_columns) out += "," + c;
   return out + "\n";
 }
 
-std::string rtest_row(const RtestSample& r, RtestColumns cols, std::size_t extra) {
+std::string rtest_row(const RtestSample& r, MachineType m, RtestColumns cols, std::size_t extra) {
   check_label(r.setup, "setup label");
   if (r.extra.size() != extra) throw InvalidArgument("R-test sample: wrong number of extra values");
-  std::string out = r.setup + "," + format_number(r.time) + "," + format_number(r.tilt_deg) + "," +
-                    format_number(r.rot_deg) + "," + format_number(r.xyz.x()) + "," +
+  std::string out = r.setup + "," + format_number(r.time) + "," + rotary_values(m, r.tilt_deg, r.rot_deg) +
+                    "," + format_number(r.xyz.x()) + "," +
                     format_number(r.xyz.y()) + "," + format_number(r.xyz.z());
   auto add = [&](const std::optional<Eigen::Vector3d>& v, const char* names) {
     if (!v)
@@ -553,11 +583,11 @@ BallbarSession parse_ballbar(std::istream& in, const std::string& name) {
   s.noise_um = read_noise(R);
   s.metadata = R.metadata;
   check_rotary_columns(R, s.machine);
-  const std::string T(1, tilt_axis_letter(s.machine));
+  const std::string T(1, tilt_axis_letter(s.machine)), C(1, rot_axis_letter(s.machine));
   const int c_test = column_index(R, "test", true), c_time = column_index(R, "time", true),
             c_x = column_index(R, "X", true), c_y = column_index(R, "Y", true),
             c_z = column_index(R, "Z", true), c_t = column_index(R, T, true),
-            c_c = column_index(R, "C", true), c_len = column_index(R, "length", true);
+            c_c = column_index(R, C, true), c_len = column_index(R, "length", true);
   const std::set<int> known = {c_test, c_time, c_x, c_y, c_z, c_t, c_c, c_len};
   std::vector<int> extra_idx;
   for (int i = 0; i < static_cast<int>(R.header.size()); ++i)
@@ -576,7 +606,7 @@ BallbarSession parse_ballbar(std::istream& in, const std::string& name) {
              R.bounded(F(c_y), "Y", -kMaxAbsPositionMm, kMaxAbsPositionMm, "mm"),
              R.bounded(F(c_z), "Z", -kMaxAbsPositionMm, kMaxAbsPositionMm, "mm")};
     b.tilt_deg = R.bounded(F(c_t), T, -kMaxAbsAngleDeg, kMaxAbsAngleDeg, "deg");
-    b.rot_deg = R.bounded(F(c_c), "C", -kMaxAbsAngleDeg, kMaxAbsAngleDeg, "deg");
+    b.rot_deg = R.bounded(F(c_c), C, -kMaxAbsAngleDeg, kMaxAbsAngleDeg, "deg");
     const Field& fl = F(c_len);
     b.length = R.number(fl, "length");
     if (!(b.length > 0.0)) R.fail(R.line_no, fl.column, "length must be > 0");
@@ -613,7 +643,7 @@ void check_samples(const std::vector<Sample>& samples) {
     last = r.time;
     for (int k = 0; k < 3; ++k) check_writable(r.xyz[k], -kMaxAbsPositionMm, kMaxAbsPositionMm, "X/Y/Z", i);
     check_writable(r.tilt_deg, -kMaxAbsAngleDeg, kMaxAbsAngleDeg, "tilt angle", i);
-    check_writable(r.rot_deg, -kMaxAbsAngleDeg, kMaxAbsAngleDeg, "C", i);
+    check_writable(r.rot_deg, -kMaxAbsAngleDeg, kMaxAbsAngleDeg, "rotary angle", i);
   }
 }
 
@@ -624,7 +654,7 @@ std::string format_ballbar(const BallbarSession& s) {
   for (std::size_t i = 0; i < s.samples.size(); ++i)
     check_writable(s.samples[i].length, kMinLengthMm, kMaxLengthMm, "length", i);
   return ballbar_head(s) + with_annotations(s.samples, s.annotations, [&](const BallbarSample& r) {
-           return ballbar_row(r, s.extra_columns.size());
+           return ballbar_row(r, s.machine, s.extra_columns.size());
          });
 }
 
@@ -660,9 +690,9 @@ RtestSession parse_rtest(std::istream& in, const std::string& name) {
   }
   s.metadata = R.metadata;
   check_rotary_columns(R, s.machine);
-  const std::string T(1, tilt_axis_letter(s.machine));
+  const std::string T(1, tilt_axis_letter(s.machine)), C(1, rot_axis_letter(s.machine));
   const int c_setup = column_index(R, "setup", true), c_time = column_index(R, "time", true),
-            c_t = column_index(R, T, true), c_c = column_index(R, "C", true),
+            c_t = column_index(R, T, true), c_c = column_index(R, C, true),
             c_x = column_index(R, "X", true), c_y = column_index(R, "Y", true),
             c_z = column_index(R, "Z", true);
   const int c_dx = column_index(R, "dx", false), c_dy = column_index(R, "dy", false),
@@ -700,7 +730,7 @@ RtestSession parse_rtest(std::istream& in, const std::string& name) {
     r.time = R.bounded(F(c_time), "time", -kMaxAbsTimeS, kMaxAbsTimeS, "s");
     check_time(R, F(c_time), r.time, last);
     r.tilt_deg = R.bounded(F(c_t), T, -kMaxAbsAngleDeg, kMaxAbsAngleDeg, "deg");
-    r.rot_deg = R.bounded(F(c_c), "C", -kMaxAbsAngleDeg, kMaxAbsAngleDeg, "deg");
+    r.rot_deg = R.bounded(F(c_c), C, -kMaxAbsAngleDeg, kMaxAbsAngleDeg, "deg");
     r.xyz = {pos(c_x, "X"), pos(c_y, "Y"), pos(c_z, "Z")};
     if (n_d == 3) r.d = Eigen::Vector3d(disp(c_dx, "dx"), disp(c_dy, "dy"), disp(c_dz, "dz"));
     if (n_raw == 3) r.raw = Eigen::Vector3d(disp(c_d1, "d1"), disp(c_d2, "d2"), disp(c_d3, "d3"));
@@ -734,7 +764,7 @@ std::string format_rtest(const RtestSession& s) {
       throw InvalidArgument("every R-test sample must carry the same columns (dx,dy,dz and/or d1,d2,d3)");
   }
   return rtest_head(s, cols) + with_annotations(s.samples, s.annotations, [&](const RtestSample& r) {
-           return rtest_row(r, cols, s.extra_columns.size());
+           return rtest_row(r, s.machine, cols, s.extra_columns.size());
          });
 }
 
@@ -787,12 +817,13 @@ std::string annotation_line(const std::string& text) {
 }  // namespace
 
 BallbarWriter::BallbarWriter(const std::string& path, const BallbarSession& header, const OutputOptions& options)
-    : file_(std::make_unique<OutputStream>(path, options)), path_(path), columns_(header.extra_columns.size()) {
+    : file_(std::make_unique<OutputStream>(path, options)), path_(path), machine_(header.machine),
+      columns_(header.extra_columns.size()) {
   file_->write(ballbar_head(header));
 }
 void BallbarWriter::append(const BallbarSample& s) {
   if (s.time < last_time_) throw InvalidArgument(path_ + ": sample time " + format_number(s.time) + " goes backwards");
-  put(file_, path_, ballbar_row(s, columns_));
+  put(file_, path_, ballbar_row(s, machine_, columns_));
   last_time_ = s.time;
   ++rows_;
 }
@@ -804,7 +835,7 @@ void BallbarWriter::close() {
 }
 
 RtestWriter::RtestWriter(const std::string& path, const RtestSession& header, bool raw, const OutputOptions& options)
-    : path_(path), raw_(raw), extra_(header.extra_columns.size()) {
+    : path_(path), machine_(header.machine), raw_(raw), extra_(header.extra_columns.size()) {
   if (raw)
     for (int k = 1; k <= 3; ++k)
       if (!header.probe_dirs.count(k))
@@ -814,7 +845,7 @@ RtestWriter::RtestWriter(const std::string& path, const RtestSession& header, bo
 }
 void RtestWriter::append(const RtestSample& s) {
   if (s.time < last_time_) throw InvalidArgument(path_ + ": sample time " + format_number(s.time) + " goes backwards");
-  put(file_, path_, rtest_row(s, RtestColumns{!raw_, raw_}, extra_));
+  put(file_, path_, rtest_row(s, machine_, RtestColumns{!raw_, raw_}, extra_));
   last_time_ = s.time;
   ++rows_;
 }

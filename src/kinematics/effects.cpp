@@ -157,13 +157,15 @@ std::vector<std::string> Effect::param_units() const { return split(info(kind).u
 std::string Effect::cause() const { return info(kind).cause; }
 
 bool Effect::applies_to(MachineType m) const {
-  if (!info(kind).rotary_axis) return true;
-  return axis == 'C' || axis == tilt_axis_letter(m);
+  const KindInfo& k = info(kind);
+  if (!k.rotary_axis) return true;
+  // Tilt-only effects (sag, coning) belong to the tilt axis, on the table or in the head.
+  return k.tilt_only ? axis == tilt_axis_letter(m) : (axis == tilt_axis_letter(m) || axis == rot_axis_letter(m));
 }
 
 std::vector<Effect> effect_catalogue(MachineType m, int max_harmonic) {
   std::vector<Effect> out;
-  const char T = tilt_axis_letter(m);
+  const char T = tilt_axis_letter(m), C = rot_axis_letter(m);
   for (const KindInfo& k : kKinds) {
     if (k.kind == EffectKind::straightness) {
       for (char a : {'X', 'Y', 'Z'})
@@ -177,8 +179,8 @@ std::vector<Effect> effect_catalogue(MachineType m, int max_harmonic) {
     } else if (k.linear_axis) {
       for (char a : {'X', 'Y', 'Z'}) out.push_back({k.kind, a, 0});
     } else if (k.rotary_axis) {
-      for (char a : {T, 'C'}) {
-        if (k.tilt_only && a == 'C') continue;
+      for (char a : {T, C}) {
+        if (k.tilt_only && a != T) continue;
         if (!k.harmonic) {
           out.push_back({k.kind, a, 0});
           continue;

@@ -19,14 +19,16 @@ struct BallbarMachineModel : MachineModel {
   Eigen::Vector3d pivot = Eigen::Vector3d::Zero();
 };
 
-/// Predicted centre-to-centre length (mm) for a commanded tool-side position xyz (mm) at
-/// rotary angles `angles` (rad) and time t (s):
-///   L = | p_tool(xyz, t) - T(angles, t) * pivot | + reading error(t)
+/// Predicted centre-to-centre length (mm) for commanded linear axes xyz (mm) at rotary angles
+/// `angles` (rad) and time t (s):
+///   L = | p_tool(xyz, angles, t) - T(angles, t) * pivot | + reading error(t)
+/// `tool_length_error` (mm) lengthens the tool of a machine with head axes (ignored otherwise).
 template <typename Scalar>
 Scalar predicted_length(MachineType m, const LocationErrors<Scalar>& e, const Vec3<Scalar>& pivot,
                         const EffectModel& fx, const Scalar* fx_params, const Eigen::Vector3d& xyz,
-                        const RotaryAngles<double>& angles, double t) {
-  const Vec3<Scalar> tool = tool_position(fx, fx_params, xyz, t);
+                        const RotaryAngles<double>& angles, double t,
+                        const Scalar& tool_length_error = Scalar(0)) {
+  const Vec3<Scalar> tool = tool_position(m, e, fx, fx_params, xyz, angles, t, tool_length_error);
   const Vec3<Scalar> ball = table_point(m, e, fx, fx_params, angles, t, pivot);
   return (tool - ball).norm() + ballbar_reading_error(fx, fx_params, t);
 }
@@ -34,8 +36,10 @@ Scalar predicted_length(MachineType m, const LocationErrors<Scalar>& e, const Ve
 /// The same for one sample of a session.
 template <typename Scalar>
 Scalar predicted_length(MachineType m, const LocationErrors<Scalar>& e, const Vec3<Scalar>& pivot,
-                        const EffectModel& fx, const Scalar* fx_params, const BallbarSample& s) {
-  return predicted_length<Scalar>(m, e, pivot, fx, fx_params, s.xyz, s.angles_rad(), s.time);
+                        const EffectModel& fx, const Scalar* fx_params, const BallbarSample& s,
+                        const Scalar& tool_length_error = Scalar(0)) {
+  return predicted_length<Scalar>(m, e, pivot, fx, fx_params, s.xyz, s.angles_rad(), s.time,
+                                  tool_length_error);
 }
 
 /// Predicted lengths of every sample of a session on a machine model.

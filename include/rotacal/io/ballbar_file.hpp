@@ -69,6 +69,7 @@ class BallbarWriter {
  private:
   std::unique_ptr<OutputStream> file_;
   std::string path_;
+  MachineType machine_;  // rotary columns in its chain order
   std::size_t columns_ = 0;
   std::size_t rows_ = 0;
   double last_time_ = -1e300;
@@ -92,6 +93,7 @@ class RtestWriter {
  private:
   std::unique_ptr<OutputStream> file_;
   std::string path_;
+  MachineType machine_;
   bool raw_ = false;
   std::size_t extra_ = 0;
   std::size_t rows_ = 0;

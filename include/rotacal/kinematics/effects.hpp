@@ -102,94 +102,131 @@ Mat3<Scalar> small_rotation_xyz(const Scalar& ax, const Scalar& ay, const Scalar
          rotation_about_axis<Scalar>(Vec3<Scalar>::UnitZ(), az);
 }
 
-// Index of the rotary axis' direction and of the two perpendicular directions, in cyclic
-// order: C (Z) -> (X, Y); A (X) -> (Y, Z); B (Y) -> (Z, X).
+// Index of X, Y, Z for a linear axis letter (A, B, C map to their principal axes).
 inline int axis_index(char axis) { return axis == 'A' || axis == 'X' ? 0 : (axis == 'B' || axis == 'Y') ? 1 : 2; }
 
-}  // namespace detail
+// Chain index of the machine's rotary axis with this letter, -1 if it has none.
+inline int chain_index(MachineType m, char letter) {
+  for (int k = 0; k < 2; ++k)
+    if (m.description().axis(k).name == letter) return k;
+  return -1;
+}
 
-/// Walks the stages of the table's motion from the innermost (C error motion) to the
-/// outermost (machine-frame translations), handing each to `acc`: `acc.rigid(Pose)` for error
-/// motions and coning, `acc.about_line(AxisLine, angle)` for the two axis rotations,
-/// `acc.translate(Vec3)` for drift and sag. Identity stages are skipped. This is the one place
-/// that fixes the order of composition (see the file comment); table_pose and table_point
-/// below are its two accumulators.
-template <typename Scalar, typename Accumulator>
-void walk_table_stages(MachineType m, const LocationErrors<Scalar>& e, const EffectModel& fx,
-                       const Scalar* p, const RotaryAngles<double>& cmd, double t,
-                       Accumulator& acc) {
+// Axis about which coning turns the tilt axis: Y for an A axis, X for a B axis (formats and
+// effects.md), the first radial direction u of any other axis.
+inline Eigen::Vector3d coning_axis(const RotaryAxis& a) {
+  if (a.principal == 0) return Eigen::Vector3d::UnitY();
+  if (a.principal == 1) return Eigen::Vector3d::UnitX();
+  return a.radial1;
+}
+
+// Per chain axis: the actual angle and the optional error-motion pose; per side: coning and
+// translation stages. One pass over the effects fills both sides.
+template <typename Scalar>
+struct AxisStages {
+  Scalar angle[2];
+  std::optional<Pose<Scalar>> E[2];  // error motion of chain axis k, in its turning frame
+  std::optional<Pose<Scalar>> K[2];  // coning of the table side [0] and the head side [1]
+  std::optional<Vec3<Scalar>> D[2];  // translations of the table side [0] and the head side [1]
+};
+
+template <typename Scalar>
+AxisStages<Scalar> axis_stages(MachineType m, const EffectModel& fx, const Scalar* p,
+                               const RotaryAngles<double>& cmd, double t) {
   using std::cos;
-  using std::sin;
-  const char tilt_axis = tilt_axis_letter(m);
-  Scalar tilt(cmd.tilt), rot(cmd.rot);
-  // Error motions, coning and translations exist only when an effect asks for them (most
-  // fits have none, and identity Jets are not free).
-  std::optional<Pose<Scalar>> E_T, E_C, K;
-  std::optional<Vec3<Scalar>> D;
+  using std::exp;
+  const MachineDescription& d = m.description();
+  AxisStages<Scalar> st;
+  for (int k = 0; k < 2; ++k) st.angle[k] = Scalar(chain_angle(m, cmd, k));
   for (std::size_t i = 0; i < fx.effects.size(); ++i) {
     const Effect& f = fx.effects[i];
     const Scalar* q = p + fx.offset(i);
-    const bool on_c = f.axis == 'C';
-    const double R = on_c ? cmd.rot : cmd.tilt;  // the commanded angle of the effect's axis
-    const double c = std::cos(f.harmonic * R), s = std::sin(f.harmonic * R);
-    switch (f.kind) {
-      case EffectKind::rotary_zero_offset:
-        (on_c ? rot : tilt) += q[0];
-        break;
-      case EffectKind::angular_positioning:
-        (on_c ? rot : tilt) += q[0] * c + q[1] * s;
-        break;
-      case EffectKind::radial_motion:
-      case EffectKind::axial_motion:
-      case EffectKind::tilt_motion: {
-        std::optional<Pose<Scalar>>& Eo = on_c ? E_C : E_T;
-        if (!Eo) Eo.emplace();
-        Pose<Scalar>& E = *Eo;
-        const int k = detail::axis_index(f.axis), i1 = (k + 1) % 3, i2 = (k + 2) % 3;
-        if (f.kind == EffectKind::radial_motion) {
-          E.t[i1] += q[0] * c + q[1] * s;
-          E.t[i2] += q[2] * c + q[3] * s;
-        } else if (f.kind == EffectKind::axial_motion) {
-          E.t[k] += q[0] * c + q[1] * s;
-        } else {
-          Vec3<Scalar> w = Vec3<Scalar>::Zero();
-          w[i1] = q[0] * c + q[1] * s;
-          w[i2] = q[2] * c + q[3] * s;
-          E.R = detail::small_rotation_xyz(w[0], w[1], w[2]) * E.R;
+    const bool rotary = f.kind == EffectKind::rotary_zero_offset || f.kind == EffectKind::angular_positioning ||
+                        f.kind == EffectKind::radial_motion || f.kind == EffectKind::axial_motion ||
+                        f.kind == EffectKind::tilt_motion || f.kind == EffectKind::gravity_sag ||
+                        f.kind == EffectKind::coning;
+    if (rotary) {
+      const int k = chain_index(m, f.axis);
+      if (k < 0) continue;  // validated by the callers (Effect::applies_to)
+      const RotaryAxis& ax = d.axis(k);
+      const int side = ax.on_head ? 1 : 0;
+      const double R = chain_angle(m, cmd, k);  // the commanded angle of the effect's axis
+      const double c = std::cos(f.harmonic * R), s = std::sin(f.harmonic * R);
+      switch (f.kind) {
+        case EffectKind::rotary_zero_offset:
+          st.angle[k] += q[0];
+          break;
+        case EffectKind::angular_positioning:
+          st.angle[k] += q[0] * c + q[1] * s;
+          break;
+        case EffectKind::radial_motion:
+        case EffectKind::axial_motion:
+        case EffectKind::tilt_motion: {
+          if (!st.E[k]) st.E[k].emplace();
+          Pose<Scalar>& E = *st.E[k];
+          const Vec3<Scalar> d1 = ax.radial1.cast<Scalar>(), d2 = ax.radial2.cast<Scalar>();
+          if (f.kind == EffectKind::radial_motion) {
+            E.t += d1 * (q[0] * c + q[1] * s) + d2 * (q[2] * c + q[3] * s);
+          } else if (f.kind == EffectKind::axial_motion) {
+            E.t += ax.direction.cast<Scalar>() * (q[0] * c + q[1] * s);
+          } else if (ax.principal >= 0) {  // small rotations about the two radial directions
+            Vec3<Scalar> w = d1 * (q[0] * c + q[1] * s) + d2 * (q[2] * c + q[3] * s);
+            E.R = small_rotation_xyz(w[0], w[1], w[2]) * E.R;
+          } else {
+            E.R = rotation_about_axis<Scalar>(d1, q[0] * c + q[1] * s) *
+                  rotation_about_axis<Scalar>(d2, q[2] * c + q[3] * s) * E.R;
+          }
+          break;
         }
-        break;
+        case EffectKind::gravity_sag:  // the table (or the head) drops by s (1 - cos angle)
+          if (!st.D[side]) st.D[side] = Vec3<Scalar>::Zero();
+          st.D[side]->z() -= q[0] * (Scalar(1) - cos(Scalar(R)));
+          break;
+        case EffectKind::coning:
+          if (!st.K[side]) st.K[side].emplace();
+          st.K[side]->R = rotation_about_axis<Scalar>(coning_axis(ax).cast<Scalar>(), q[0] * Scalar(R)) * st.K[side]->R;
+          break;
+        default:
+          break;
       }
-      case EffectKind::gravity_sag:
-        if (!D) D = Vec3<Scalar>::Zero();
-        D->z() -= q[0] * (Scalar(1) - cos(Scalar(cmd.tilt)));
-        break;
-      case EffectKind::coning:
-        if (!K) K.emplace();
-        K->R = rotation_about_axis<Scalar>(
-                   tilt_axis == 'B' ? Vec3<Scalar>::UnitX() : Vec3<Scalar>::UnitY(),
-                   q[0] * Scalar(cmd.tilt)) *
-               K->R;
-        break;
+      continue;
+    }
+    switch (f.kind) {
       case EffectKind::thermal_drift:
-        if (!D) D = Vec3<Scalar>::Zero();
-        (*D)[detail::axis_index(f.axis)] += q[0] * Scalar(t);
+        if (!st.D[0]) st.D[0] = Vec3<Scalar>::Zero();
+        (*st.D[0])[axis_index(f.axis)] += q[0] * Scalar(t);
         break;
-      case EffectKind::thermal_warmup: {  // tau = 300 s * exp(q1): q1 = 0 is a sensible start
-        using std::exp;
-        if (!D) D = Vec3<Scalar>::Zero();
-        (*D)[detail::axis_index(f.axis)] += q[0] * (Scalar(1) - exp(-Scalar(t) / (Scalar(300) * exp(q[1]))));
+      case EffectKind::thermal_warmup:  // tau = 300 s * exp(q1): q1 = 0 is a sensible start
+        if (!st.D[0]) st.D[0] = Vec3<Scalar>::Zero();
+        (*st.D[0])[axis_index(f.axis)] += q[0] * (Scalar(1) - exp(-Scalar(t) / (Scalar(300) * exp(q[1]))));
         break;
-      }
       default:  // tool-side and instrument effects do not move the table
         break;
     }
   }
-  if (E_C) acc.rigid(*E_C);
-  acc.about_line(c_axis_line(m, e), rot);
-  if (E_T) acc.rigid(*E_T);
-  acc.about_line(tilt_axis_line(m, e), tilt);
-  if (K) acc.rigid(*K);
-  if (D) acc.translate(*D);
+  return st;
+}
+
+}  // namespace detail
+
+/// Walks the stages of the table's motion from the innermost (the workpiece-side axis' error
+/// motion) to the outermost (machine-frame translations), handing each to `acc`:
+/// `acc.rigid(Pose)` for error motions and coning, `acc.about_line(AxisLine, angle)` for the
+/// table axis rotations, `acc.translate(Vec3)` for drift and sag. Identity stages are
+/// skipped. This is the one place that fixes the order of composition (see the file comment);
+/// table_pose and table_point below are its two accumulators, and tool_position walks the
+/// head side the same way.
+template <typename Scalar, typename Accumulator>
+void walk_table_stages(MachineType m, const LocationErrors<Scalar>& e, const EffectModel& fx,
+                       const Scalar* p, const RotaryAngles<double>& cmd, double t,
+                       Accumulator& acc) {
+  const detail::AxisStages<Scalar> st = detail::axis_stages<Scalar>(m, fx, p, cmd, t);
+  for (int k = static_cast<int>(m.description().table_axes.size()) - 1; k >= 0; --k) {
+    if (st.E[k]) acc.rigid(*st.E[k]);
+    acc.about_line(axis_line(m, k, e), st.angle[k]);
+  }
+  if (st.K[0]) acc.rigid(*st.K[0]);
+  if (st.D[0]) acc.translate(*st.D[0]);
 }
 
 namespace detail {
@@ -234,27 +271,21 @@ Vec3<Scalar> table_point(MachineType m, const LocationErrors<Scalar>& e, const E
   return acc.q;
 }
 
-/// Actual position of the tool-side ball for a commanded xyz (mm) at time t.
+/// Actual position of the controlled point for a commanded xyz (mm): the linear-axis
+/// effects (squareness, scale, straightness, angular errors seen through the Z arm).
 template <typename Scalar>
-Vec3<Scalar> tool_position(const EffectModel& fx, const Scalar* p, const Eigen::Vector3d& xyz,
-                           double t) {
+Vec3<Scalar> linear_axes_position(const EffectModel& fx, const Scalar* p, const Eigen::Vector3d& xyz) {
   Vec3<Scalar> out = xyz.cast<Scalar>();
   for (std::size_t i = 0; i < fx.effects.size(); ++i) {
     const Effect& f = fx.effects[i];
     const Scalar* q = p + fx.offset(i);
     const int k = detail::axis_index(f.axis);
     switch (f.kind) {
-      case EffectKind::tool_offset_Z:
-        out.z() += q[0];
-        break;
       case EffectKind::linear_squareness:  // XY: x += s y; YZ: y += s z; ZX: z += s x
         out[k] += q[0] * Scalar(xyz[(k + 1) % 3]);
         break;
       case EffectKind::linear_scale:
         out[k] += q[0] * Scalar(xyz[k]);
-        break;
-      case EffectKind::tool_offset:
-        out[k] += q[0];
         break;
       case EffectKind::straightness: {  // E_DA, u = (a - a_ref) / 100 mm
         const double u = (xyz[k] - fx.linear_reference[k]) / 100.0;
@@ -275,6 +306,53 @@ Vec3<Scalar> tool_position(const EffectModel& fx, const Scalar* p, const Eigen::
     }
   }
   return out;
+}
+
+/// Offset of the ball from where it should be on the tool (tool_offset_Z, tool_offset_X/Y),
+/// mm: in the machine frame on a machine without head axes, in the spindle frame (it turns
+/// with the head) on a machine with head axes, where tool_offset_Z shortens the tool.
+template <typename Scalar>
+Vec3<Scalar> tool_offset(const EffectModel& fx, const Scalar* p) {
+  Vec3<Scalar> out = Vec3<Scalar>::Zero();
+  for (std::size_t i = 0; i < fx.effects.size(); ++i) {
+    const Effect& f = fx.effects[i];
+    if (f.kind == EffectKind::tool_offset_Z) out.z() += p[fx.offset(i)];
+    if (f.kind == EffectKind::tool_offset) out[detail::axis_index(f.axis)] += p[fx.offset(i)];
+  }
+  return out;
+}
+
+/// Actual position of the ball (machine frame, mm) for a commanded xyz (mm) at commanded
+/// rotary angles (rad) and time t (s), on a machine with location errors e and effects fx
+/// (parameters p). Without head axes: the controlled point with the linear-axis effects and
+/// the tool offset. With head axes, the head side is walked like the table side:
+///   ball = xyz' + D_h + K_h * Rot(H1) E_H1 * Rot(H2) E_H2 * (tool_vector + tool offset).
+template <typename Scalar>
+Vec3<Scalar> tool_position(MachineType m, const LocationErrors<Scalar>& e, const EffectModel& fx,
+                           const Scalar* p, const Eigen::Vector3d& xyz,
+                           const RotaryAngles<double>& cmd, double t,
+                           const Scalar& tool_length_error = Scalar(0)) {
+  const Vec3<Scalar> controlled = linear_axes_position<Scalar>(fx, p, xyz);
+  const MachineDescription& d = m.description();
+  if (!d.has_head()) return controlled + tool_offset<Scalar>(fx, p);
+  const detail::AxisStages<Scalar> st = detail::axis_stages<Scalar>(m, fx, p, cmd, t);
+  Vec3<Scalar> v = tool_vector<Scalar>(m, tool_length_error) + tool_offset<Scalar>(fx, p);
+  const int nt = static_cast<int>(d.table_axes.size());
+  for (int k = 1; k >= nt; --k) {
+    if (st.E[k]) v = *st.E[k] * v;
+    const AxisLine<Scalar> L = axis_line(m, k, e);
+    v = rotate_point_about_line(L.point, L.direction, st.angle[k], v);
+  }
+  if (st.K[1]) v = *st.K[1] * v;
+  if (st.D[1]) v += *st.D[1];
+  return controlled + v;
+}
+
+/// The ball on a machine without head axes (the table machines' tool side); kept for the
+/// callers that have no rotary angles at hand.
+template <typename Scalar>
+Vec3<Scalar> tool_position(const EffectModel& fx, const Scalar* p, const Eigen::Vector3d& xyz, double /*t*/) {
+  return linear_axes_position<Scalar>(fx, p, xyz) + tool_offset<Scalar>(fx, p);
 }
 
 /// Additive error of the ballbar's own reading (mm) at time t.

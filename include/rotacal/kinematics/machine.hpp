@@ -1,36 +1,73 @@
 #pragma once
 /// \file
-/// Kinematics of a tilting-rotary table (AC-trt, BC-trt) with the eight ISO 230-7 location
-/// errors, exactly as ../shared/spec/formats.md defines them. This is the one definition of
-/// the table's rigid motion: simulator, toolpaths, fits and compensation all call it.
+/// Kinematics of any 5-axis machine with two rotary axes (table-table, head-table, head-head)
+/// and the eight location errors of its two axes, exactly as ../shared/spec/formats.md ("Any
+/// 5-axis machine") defines them. This is the one definition of the rigid motion: simulators,
+/// toolpaths, fits, NC writers and compensation all call it. The machine itself is a
+/// MachineDescription (machine_description.hpp); `MachineType` is a cheap handle to one.
 ///
-/// Frames: machine frame with origin at the nominal intersection of the rotary axes; table
-/// frame fixed to the innermost (C) table, equal to the machine frame at all rotary axes 0.
+/// Frames: machine frame (axes parallel to X, Y, Z; origin as formats.md fixes it); table
+/// frame fixed to the innermost table, equal to the machine frame at all rotary axes 0.
 /// Angles in rad, lengths in mm.
 
 #include <array>
 #include <string>
 
 #include "rotacal/core/error.hpp"
+#include "rotacal/kinematics/machine_description.hpp"
 #include "rotacal/kinematics/rotation.hpp"
 
 namespace rotacal {
 
-/// Table kinematics. The tilt axis (A about X, or B about Y) carries the C table.
-enum class MachineType { AC_trt, BC_trt };
+/// Handle of a machine description, cheap to copy and compare (an index into a process-wide
+/// table that never forgets). `MachineType::AC_trt` and `BC_trt` name the two table machines
+/// of formats.md; `from_description` registers any other. Two handles are equal when their
+/// descriptions have the same name and kinematics.
+class MachineType {
+ public:
+  static const MachineType AC_trt;
+  static const MachineType BC_trt;
 
-/// "AC-trt" / "BC-trt".
+  constexpr MachineType() = default;  ///< AC-trt
+  /// The handle of a description (a built-in of the same name and kinematics keeps its own).
+  /// Throws InvalidArgument when the process already holds 4096 different machines.
+  static MachineType from_description(const MachineDescription& d);
+  const MachineDescription& description() const;
+  constexpr int id() const { return id_; }
+  constexpr bool operator==(const MachineType& o) const { return id_ == o.id_; }
+  constexpr bool operator!=(const MachineType& o) const { return id_ != o.id_; }
+
+  /// Chain index (0, 1) of the tilt axis and of the rotary axis (MachineDescription::rot_index).
+  int tilt_index() const;
+  int rot_index() const;
+  bool has_head() const { return description().has_head(); }
+  /// True for a built-in with a fixed `# machine:` name (files need no description line).
+  bool is_builtin() const;
+
+ private:
+  constexpr explicit MachineType(int id) : id_(id) {}
+  int id_ = 0;
+};
+constexpr MachineType MachineType::AC_trt{0};
+constexpr MachineType MachineType::BC_trt{1};
+
+/// The machine's name ("AC-trt", "B-head-C-table", the name of a description).
 std::string to_string(MachineType m);
-/// Inverse of to_string; throws InvalidArgument naming the unknown text.
+/// A built-in machine by name; throws InvalidArgument naming the unknown text and the
+/// built-in names.
 MachineType parse_machine_type(const std::string& s);
-/// 'A' for AC-trt, 'B' for BC-trt.
+/// Letter of the tilt axis ('A' on AC-trt, 'B' on BC-trt and on a B head) and of the rotary
+/// axis ('C' on every built-in).
 char tilt_axis_letter(MachineType m);
+char rot_axis_letter(MachineType m);
 
-/// The eight location errors of one machine, in a fixed order:
-///   index 0, 1: position of the tilt-axis line; 2, 3: orientation of the tilt axis;
-///   index 4, 5: position of the C-axis line;    6, 7: orientation of the C axis.
+/// The eight location errors of one machine, four per axis in chain order (table axes from
+/// the bed outwards, then head axes from the linear axes outwards):
+///   index 0, 1: position of the first axis' line; 2, 3: orientation of the first axis;
+///   index 4, 5: position of the second axis' line; 6, 7: orientation of the second axis.
 /// AC-trt: E_Y0A E_Z0A E_B0A E_C0A E_X0C E_Y0C E_A0C E_B0C (Flynn et al., Table 1 order)
 /// BC-trt: E_X0B E_Z0B E_A0B E_C0B E_X0C E_Y0C E_A0C E_B0C
+/// B-head-C-table: E_X0C E_Y0C E_A0C E_B0C E_X0B E_Z0B E_A0B E_C0B; nutating axes E_U0R...
 /// Positions in mm, orientations in rad.
 template <typename Scalar>
 struct LocationErrors {
@@ -49,9 +86,9 @@ struct LocationErrors {
   }
 };
 
-/// ISO 230-7 names in LocationErrors order for the given machine.
+/// Location error names in LocationErrors order for the given machine (formats.md).
 const std::array<std::string, 8>& location_error_names(MachineType m);
-/// Index of an ISO 230-7 name for the machine; throws InvalidArgument if it is not one of its 8.
+/// Index of a location error name for the machine; throws InvalidArgument if it is not one of its 8.
 int location_error_index(MachineType m, const std::string& name);
 /// True for the four orientation errors (rad), false for the four positions (mm).
 inline bool location_error_is_angle(int index) { return index == 2 || index == 3 || index >= 6; }
@@ -63,30 +100,51 @@ struct AxisLine {
   Vec3<Scalar> direction;
 };
 
-/// Actual tilt-axis line (A or B) in the machine frame at all rotary axes 0 (formats.md table).
+namespace detail {
+// v += B * (a, b) for a 3x2 basis of unit vectors, skipping zero entries (Jets are not free).
+template <typename Scalar>
+void add_basis(Vec3<Scalar>& v, const Eigen::Matrix<double, 3, 2>& B, const Scalar& a, const Scalar& b) {
+  for (int i = 0; i < 3; ++i) {
+    if (B(i, 0) != 0.0) v[i] += B(i, 0) == 1.0 ? a : B(i, 0) == -1.0 ? Scalar(-a) : Scalar(B(i, 0) * a);
+    if (B(i, 1) != 0.0) v[i] += B(i, 1) == 1.0 ? b : B(i, 1) == -1.0 ? Scalar(-b) : Scalar(B(i, 1) * b);
+  }
+}
+}  // namespace detail
+
+/// Actual line of chain axis k (0, 1) at all rotary axes 0: through p0 + dp along n + dn
+/// (formats.md). Table axes in the machine frame, head axes relative to the controlled point.
+template <typename Scalar>
+AxisLine<Scalar> axis_line(MachineType m, int k, const LocationErrors<Scalar>& e) {
+  const RotaryAxis& a = m.description().axis(k);
+  AxisLine<Scalar> L{a.point.cast<Scalar>(), a.direction.cast<Scalar>()};
+  detail::add_basis(L.point, a.position_basis, e.v[4 * k], e.v[4 * k + 1]);
+  detail::add_basis(L.direction, a.direction_basis, e.v[4 * k + 2], e.v[4 * k + 3]);
+  return L;
+}
+
+/// Actual line of the tilt axis (A or B on the table machines) and of the rotary axis (C).
 template <typename Scalar>
 AxisLine<Scalar> tilt_axis_line(MachineType m, const LocationErrors<Scalar>& e) {
-  const Scalar zero(0), one(1);
-  if (m == MachineType::AC_trt)  // through (0, E_Y0A, E_Z0A), along (1, E_C0A, -E_B0A)
-    return {Vec3<Scalar>(zero, e.v[0], e.v[1]), Vec3<Scalar>(one, e.v[3], -e.v[2])};
-  // BC-trt: through (E_X0B, 0, E_Z0B), along (-E_C0B, 1, E_A0B)
-  return {Vec3<Scalar>(e.v[0], zero, e.v[1]), Vec3<Scalar>(-e.v[3], one, e.v[2])};
+  return axis_line(m, m.tilt_index(), e);
 }
-
-/// Actual C-axis line in the machine frame at all rotary axes 0:
-/// through (E_X0C, E_Y0C, 0), along (E_B0C, -E_A0C, 1) for both machines.
 template <typename Scalar>
-AxisLine<Scalar> c_axis_line(MachineType /*m*/, const LocationErrors<Scalar>& e) {
-  return {Vec3<Scalar>(e.v[4], e.v[5], Scalar(0)), Vec3<Scalar>(e.v[7], -e.v[6], Scalar(1))};
+AxisLine<Scalar> c_axis_line(MachineType m, const LocationErrors<Scalar>& e) {
+  return axis_line(m, m.rot_index(), e);
 }
 
-/// Rotary axis positions of a tilting-rotary table (rad). `tilt` is A or B, `rot` is C
-/// (absolute: machine frame at tilt = 0).
+/// Rotary axis positions (rad): `tilt` of the tilt axis (A or B), `rot` of the rotary axis
+/// (C), whichever side of the chain they are on (MachineDescription::rot_index).
 template <typename Scalar>
 struct RotaryAngles {
   Scalar tilt = Scalar(0);
   Scalar rot = Scalar(0);
 };
+
+/// Angle of chain axis k.
+template <typename Scalar>
+const Scalar& chain_angle(MachineType m, const RotaryAngles<Scalar>& a, int k) {
+  return k == m.rot_index() ? a.rot : a.tilt;
+}
 
 /// Rigid motion of the tilt axis alone: exact rotation about its actual line.
 template <typename Scalar>
@@ -103,12 +161,45 @@ Pose<Scalar> c_axis_motion(MachineType m, const LocationErrors<Scalar>& e, const
 }
 
 /// Pose of the table frame in the machine frame: q_table -> p_machine =
-/// Rot(tilt line, tilt) * Rot(C line, rot) * q_table, exact rotations about the actual lines.
-/// (kinematics/effects.hpp inserts error motions between these two stages.)
+/// Rot(T1 line, t1) * Rot(T2 line, t2) * q_table, exact rotations about the actual lines of
+/// the table axes (identity without table axes). kinematics/effects.hpp inserts error
+/// motions between these stages.
 template <typename Scalar>
 Pose<Scalar> table_pose(MachineType m, const LocationErrors<Scalar>& e,
                         const RotaryAngles<Scalar>& angles) {
-  return tilt_axis_motion(m, e, angles.tilt) * c_axis_motion(m, e, angles.rot);
+  Pose<Scalar> T;
+  const int n = static_cast<int>(m.description().table_axes.size());
+  for (int k = 0; k < n; ++k) {
+    const AxisLine<Scalar> L = axis_line(m, k, e);
+    T = T * rotation_about_line(L.point, L.direction, chain_angle(m, angles, k));
+  }
+  return T;
+}
+
+/// Pose of the spindle relative to the controlled point X, Y, Z: Rot(H1 line, h1) *
+/// Rot(H2 line, h2), exact rotations about the actual lines of the head axes (identity
+/// without head axes).
+template <typename Scalar>
+Pose<Scalar> head_pose(MachineType m, const LocationErrors<Scalar>& e,
+                       const RotaryAngles<Scalar>& angles) {
+  Pose<Scalar> H;
+  const MachineDescription& d = m.description();
+  const int nt = static_cast<int>(d.table_axes.size()), n = nt + static_cast<int>(d.head_axes.size());
+  for (int k = nt; k < n; ++k) {
+    const AxisLine<Scalar> L = axis_line(m, k, e);
+    H = H * rotation_about_line(L.point, L.direction, chain_angle(m, angles, k));
+  }
+  return H;
+}
+
+/// Ball centre relative to the spindle at all head axes 0: (0, 0, -(pivot_length +
+/// tool_length + tool_length_error)); zero on a machine without head axes, where X, Y, Z is
+/// the ball itself.
+template <typename Scalar>
+Vec3<Scalar> tool_vector(MachineType m, const Scalar& tool_length_error) {
+  const MachineDescription& d = m.description();
+  if (!d.has_head()) return Vec3<Scalar>::Zero();
+  return Vec3<Scalar>(Scalar(0), Scalar(0), -(Scalar(d.pivot_length + d.tool_length) + tool_length_error));
 }
 
 /// Forward kinematics: machine-frame position of a point fixed on the table.
@@ -118,25 +209,51 @@ Vec3<Scalar> forward(MachineType m, const LocationErrors<Scalar>& e,
   return table_pose(m, e, angles) * q_table;
 }
 
-/// Machine axis command: linear axes X, Y, Z (mm) of the tool-side ball and rotary angles (rad).
+/// Forward kinematics of the tool: machine-frame position of the ball for commanded linear
+/// axes xyz (the controlled point) = xyz + head_pose * tool_vector (formats.md).
+template <typename Scalar>
+Vec3<Scalar> tool_ball(MachineType m, const LocationErrors<Scalar>& e,
+                       const RotaryAngles<Scalar>& angles, const Vec3<Scalar>& xyz,
+                       const Scalar& tool_length_error = Scalar(0)) {
+  if (!m.has_head()) return xyz;
+  return xyz + head_pose(m, e, angles) * tool_vector(m, tool_length_error);
+}
+
+/// Spindle direction (the tool's +Z) in the machine frame.
+template <typename Scalar>
+Vec3<Scalar> tool_direction(MachineType m, const LocationErrors<Scalar>& e,
+                            const RotaryAngles<Scalar>& angles) {
+  return head_pose(m, e, angles).R.col(2);
+}
+
+/// Machine axis command: linear axes X, Y, Z (mm; the ball on a table-table machine, the
+/// controlled point on a machine with head axes) and rotary angles (rad).
 struct MachineAxes {
   Eigen::Vector3d xyz = Eigen::Vector3d::Zero();
   RotaryAngles<double> angles;
 };
 
-/// Inverse kinematics for a ball tool (orientation does not matter): the machine axes that put
-/// the tool-side ball at `p_table` (table frame) with the table at `angles`, on a machine
-/// with location errors `e`. With e = 0 this is the nominal TCPM transform; with identified
-/// errors it is the compensated command.
+/// Inverse kinematics for a ball tool (orientation does not matter): the linear axes that
+/// put the ball at `p_table` (table frame) with the rotary axes at `angles`, on a machine
+/// with location errors `e`: xyz = table_pose * p_table - head_pose * tool_vector. With e = 0
+/// this is the nominal TCPM transform; with identified errors it is the compensated command.
 MachineAxes inverse(MachineType m, const LocationErrors<double>& e,
-                    const RotaryAngles<double>& angles, const Eigen::Vector3d& p_table);
+                    const RotaryAngles<double>& angles, const Eigen::Vector3d& p_table,
+                    double tool_length_error = 0.0);
+
+/// Where the ball of the command (xyz, angles) is, in the table frame:
+/// table_pose^-1 * tool_ball (the inverse of `inverse`).
+Eigen::Vector3d ball_in_table(MachineType m, const LocationErrors<double>& e,
+                              const RotaryAngles<double>& angles, const Eigen::Vector3d& xyz,
+                              double tool_length_error = 0.0);
 
 /// Inverse kinematics with tool orientation: rotary angles that align the table-frame
-/// direction `k_table` with the spindle (machine +Z) on the machine with errors `e`, and the
-/// linear axes that put the tool-side ball at `p_table`. `positive_tilt` picks the branch
-/// with tilt >= 0 (the other solution has the opposite tilt and C + pi). Throws
-/// InvalidArgument if k_table is zero; near the singular pose (k along C) C is kept at
-/// `rot_hint`. Solved in closed form for e = 0, refined by Gauss-Newton for e != 0.
+/// direction `k_table` with the spindle on the machine with errors `e`, and the linear axes
+/// that put the ball at `p_table`. `positive_tilt` picks the branch with tilt >= 0 (the other
+/// branch has the opposite tilt). Throws InvalidArgument if k_table is zero or no pose of
+/// the machine reaches it; at the singular pose (k along the rotary axis) the rotary angle
+/// is kept at `rot_hint`. Solved in closed form for e = 0 (Paden-Kahan subproblem 2), refined
+/// by Gauss-Newton for e != 0.
 MachineAxes inverse_with_tool_axis(MachineType m, const LocationErrors<double>& e,
                                    const Eigen::Vector3d& p_table, const Eigen::Vector3d& k_table,
                                    bool positive_tilt = true, double rot_hint = 0.0);

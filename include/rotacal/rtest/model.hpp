@@ -21,22 +21,23 @@ Vec3<Scalar> rtest_displacement(const Pose<Scalar>& T_machine_table, const Vec3<
   return T_machine_table.R.transpose() * (p_tool - T_machine_table.t) - q_nest.cast<Scalar>();
 }
 
-/// The commanded sphere centre for the nest at q_nest: the nominal machine puts it there.
+/// The commanded linear axes for the nest at q_nest: the nominal machine puts the sphere there.
 inline Eigen::Vector3d rtest_commanded_xyz(MachineType m, const Eigen::Vector3d& q_nest,
                                            const RotaryAngles<double>& angles) {
-  return forward<double>(m, LocationErrors<double>(), angles, q_nest);
+  return inverse(m, LocationErrors<double>(), angles, q_nest).xyz;
 }
 
 /// Reading on a machine with location errors e and effects fx (parameters fxp): the table
 /// pose of kinematics/effects.hpp at the commanded angles (rad) and time t (s), and the tool
-/// position for the commanded xyz (mm).
+/// position for the commanded xyz (mm); `tool_length_error` (mm) on a machine with head axes.
 template <typename Scalar>
 Vec3<Scalar> rtest_reading(MachineType m, const LocationErrors<Scalar>& e, const EffectModel& fx,
                            const Scalar* fxp, const Eigen::Vector3d& xyz,
                            const RotaryAngles<double>& angles, double t,
-                           const Eigen::Vector3d& q_nest) {
+                           const Eigen::Vector3d& q_nest, const Scalar& tool_length_error = Scalar(0)) {
   return rtest_displacement<Scalar>(table_pose<Scalar>(m, e, fx, fxp, angles, t),
-                                    tool_position<Scalar>(fx, fxp, xyz, t), q_nest);
+                                    tool_position<Scalar>(m, e, fx, fxp, xyz, angles, t, tool_length_error),
+                                    q_nest);
 }
 
 /// Noise-free reading d (table frame, mm, no probe zero) of the nest at q_nest (table frame)
@@ -44,7 +45,8 @@ Vec3<Scalar> rtest_reading(MachineType m, const LocationErrors<Scalar>& e, const
 inline Eigen::Vector3d rtest_reading(const MachineModel& model, const Eigen::Vector3d& q_nest,
                                      const RotaryAngles<double>& angles, double t) {
   return rtest_reading<double>(model.machine, model.errors, model.effects, model.effect_data(),
-                               rtest_commanded_xyz(model.machine, q_nest, angles), angles, t, q_nest);
+                               rtest_commanded_xyz(model.machine, q_nest, angles), angles, t, q_nest,
+                               model.tool_length_error);
 }
 
 }  // namespace rotacal
