@@ -79,7 +79,7 @@ Eigen::VectorXd coloured(const Noise& nz, const std::vector<std::string>& g, con
 
 int main(int argc, char** argv) {
   int draws = 200;
-  bool rtest = true, ballbar = true, pooled = false, bias = true;
+  bool rtest = true, ballbar = true, pooled = false, bias = true, oracle = false;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--smoke")) draws = 8;
     else if (!std::strcmp(argv[i], "--draws") && i + 1 < argc) draws = std::atoi(argv[++i]);
@@ -87,8 +87,9 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--no-ballbar")) ballbar = false;
     else if (!std::strcmp(argv[i], "--pooled")) pooled = true;  // one AR model for all streams
     else if (!std::strcmp(argv[i], "--no-bias-factor")) bias = false;
+    else if (!std::strcmp(argv[i], "--oracle")) oracle = true;  // R-test: GLS under the true covariance
     else {
-      std::fprintf(stderr, "usage: noise_mc_bench [--draws N] [--smoke] [--no-rtest] [--no-ballbar] [--pooled] [--no-bias-factor]\n");
+      std::fprintf(stderr, "usage: noise_mc_bench [--draws N] [--smoke] [--no-rtest] [--no-ballbar] [--pooled] [--no-bias-factor] [--oracle]\n");
       return 2;
     }
   }
@@ -147,7 +148,31 @@ int main(int argc, char** argv) {
     rauto.noise_bias_correction = bias;
     RtestJointOptions rwhite;
     rwhite.noise = NoiseHandling::white;
+    // The generating covariance as a noise model (AR(1) + random walk per stream), for
+    // --oracle: the best any estimated noise model can do.
+    const auto truth_model = [&](double rho) {
+      NoiseModel m;
+      m.n = rg.size();
+      std::vector<std::string> sg;
+      std::vector<int> sc;
+      const auto streams = noise_streams(rg, rtm, &sg, &sc);
+      for (std::size_t k = 0; k < streams.size(); ++k) {
+        NoiseStream st;
+        st.group = sg[k], st.channel = sc[k], st.rows = streams[k];
+        st.marginal_sigma_um = 0.3;
+        st.reflection = {rho};
+        st.ar = {rho};
+        st.random_walk_step_um = 0.1;
+        m.streams.push_back(st);
+      }
+      m.max_order = 1, m.random_walk_step_um = 0.1;
+      return m;
+    };
     for (const Noise& nz : kinds) {
+      if (oracle && nz.rho >= 0) {
+        rauto.noise = NoiseHandling::white;
+        rauto.whitener = std::make_shared<ArWhitener>(truth_model(nz.rho));
+      }
       const auto t0 = clock::now();
       Spread a, w;
       for (int k = 0; k < draws; ++k) {

@@ -35,6 +35,15 @@ Eigen::VectorXd draw_noise(const NoiseModel& model, std::mt19937_64& rng) {
       }
       if (t >= burn) e[s.rows[t - burn]] = x;
     }
+    // The random walk from the stream's first reading (its start is the stream's level).
+    if (s.random_walk_step_um > 0.0) {
+      const double q = s.random_walk_step_um * 1e-3;
+      double z = 0.0;
+      for (std::size_t t = 0; t < s.rows.size(); ++t) {
+        if (t > 0) z += q * N(rng);
+        e[s.rows[t]] += z;
+      }
+    }
   }
   return e;
 }

@@ -52,6 +52,11 @@ struct NoiseStream {
   double sample_interval_s = 0.0;    ///< median time between successive readings
   double correlation_time_s = 0.0;   ///< tau * sample interval
   double effective_samples = 0.0;    ///< n / tau (at most n)
+  /// 1 sigma of a random-walk step per reading, um (0: none). The stream's covariance is then
+  /// the AR part's plus q^2 min(i, j) (i, j: positions in the stream): a level that wanders
+  /// from reading to reading, as R-test probe zeros do between poses. The constant part of
+  /// the walk is the stream's mean, which the fits take as a nuisance (a probe zero).
+  double random_walk_step_um = 0.0;
   int order() const { return static_cast<int>(ar.size()); }
 };
 
@@ -65,7 +70,8 @@ struct NoiseModel {
   double correlation_time_s = 0.0;   ///< largest over the streams
   double effective_samples = 0.0;    ///< sum over the streams
   int max_order = 0;                 ///< largest AR order of any stream
-  bool white() const { return max_order == 0; }
+  double random_walk_step_um = 0.0;  ///< largest random-walk step of any stream (0: none)
+  bool white() const { return max_order == 0 && random_walk_step_um == 0.0; }
   /// e.g. "AR(1), rho 0.95, sigma 0.50 um, correlation time 0.39 s, 46 effective samples of 1800".
   std::string summary() const;
 };
@@ -78,9 +84,20 @@ NoiseModel estimate_noise_model(const std::vector<std::string>& groups,
                                 const Eigen::VectorXd& residuals_mm,
                                 const NoiseModelOptions& options = {});
 
+/// Autocovariance gamma_0..gamma_{n-1} (mm^2) of a stream's AR part, from its marginal
+/// variance and reflection coefficients (gamma_m = k_m v_{m-1} + sum_j phi_{m-1,j} gamma_{m-j}
+/// up to the order, then the AR recursion).
+std::vector<double> ar_autocovariance(const NoiseStream& stream, std::size_t n);
+
+/// The covariance (mm^2) of one stream's readings in its time order: AR autocovariance plus
+/// the random walk's q^2 min(i, j).
+Eigen::MatrixXd stream_covariance(const NoiseStream& stream);
+
 /// Prewhitening by the AR filter of each stream, with its exact start-up rows (the first p
 /// readings are predicted from the orders 0..p-1 of Burg's recursion, so W is the inverse
-/// Cholesky factor of the model's covariance), scaled to unit variance. Columns hold values in
+/// Cholesky factor of the model's covariance), scaled to unit variance. A stream with a random
+/// walk is whitened by the inverse Cholesky factor of its dense covariance (stream_covariance;
+/// O(n^3) once, meant for R-test streams of a few hundred readings). Columns hold values in
 /// units of `residual_unit_mm` (1: mm; pass sigma if the fit's residuals are already divided
 /// by a sigma).
 class ArWhitener : public ResidualWhitener {
@@ -94,6 +111,7 @@ class ArWhitener : public ResidualWhitener {
     std::vector<Eigen::Index> rows;
     std::vector<std::vector<double>> phi;  ///< phi[m]: coefficients of order m = 0..p
     std::vector<double> inv_sd;            ///< 1 / sqrt(v_m) in column units
+    Eigen::MatrixXd chol;                  ///< with a random walk: lower Cholesky factor, column units
   };
   std::vector<Stream> streams_;
   std::size_t n_ = 0;
