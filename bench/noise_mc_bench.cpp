@@ -79,7 +79,7 @@ Eigen::VectorXd coloured(const Noise& nz, const std::vector<std::string>& g, con
 
 int main(int argc, char** argv) {
   int draws = 200;
-  bool rtest = true, ballbar = true, pooled = false, bias = true, oracle = false;
+  bool rtest = true, ballbar = true, pooled = false, bias = true, oracle = false, reml = true;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--smoke")) draws = 8;
     else if (!std::strcmp(argv[i], "--draws") && i + 1 < argc) draws = std::atoi(argv[++i]);
@@ -87,9 +87,10 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--no-ballbar")) ballbar = false;
     else if (!std::strcmp(argv[i], "--pooled")) pooled = true;  // one AR model for all streams
     else if (!std::strcmp(argv[i], "--no-bias-factor")) bias = false;
-    else if (!std::strcmp(argv[i], "--oracle")) oracle = true;  // R-test: GLS under the true covariance
+    else if (!std::strcmp(argv[i], "--oracle")) oracle = true;
+    else if (!std::strcmp(argv[i], "--no-reml")) reml = false;  // R-test: Burg AR(p) + bias factor (before)  // R-test: GLS under the true covariance
     else {
-      std::fprintf(stderr, "usage: noise_mc_bench [--draws N] [--smoke] [--no-rtest] [--no-ballbar] [--pooled] [--no-bias-factor] [--oracle]\n");
+      std::fprintf(stderr, "usage: noise_mc_bench [--draws N] [--smoke] [--no-rtest] [--no-ballbar] [--pooled] [--no-bias-factor] [--oracle] [--no-reml]\n");
       return 2;
     }
   }
@@ -146,6 +147,7 @@ int main(int argc, char** argv) {
     rauto.noise = NoiseHandling::automatic;
     rauto.noise_options.pooled = pooled;
     rauto.noise_bias_correction = bias;
+    rauto.noise_options.reml_random_walk = reml;
     RtestJointOptions rwhite;
     rwhite.noise = NoiseHandling::white;
     // The generating covariance as a noise model (AR(1) + random walk per stream), for

@@ -37,6 +37,14 @@ struct NoiseModelOptions {
   /// correlation is structure in some groups (an effect), not the sensor's, and each stream
   /// keeps its own model.
   bool pool_only_if_all_coloured = false;
+  /// The R-test joint fit: when the residuals are correlated, estimate AR(1) + a random walk
+  /// per stream by REML over what the fit leaves (estimate_noise_model_reml in
+  /// core/noise_handling.hpp: probe zeros that wander between poses), instead of Burg's AR(p)
+  /// on the residuals scaled by the bootstrap bias factor. The ballbar fit does not read it.
+  bool reml_random_walk = true;
+  /// Streams longer than this (readings) fall back to Burg + bias factor: REML factors each
+  /// stream's dense covariance at every likelihood evaluation (O(n^3); ~0.1 s a fit at 84).
+  int reml_max_stream_size = 400;
 };
 
 /// The AR model of one stream.
