@@ -6,13 +6,9 @@
 #include <cmath>
 #include <random>
 
-#include <Eigen/Cholesky>
-
 #include <Eigen/QR>
 
 #include "rotacal/core/error.hpp"
-
-#include <limits>
 
 namespace rotacal {
 
@@ -107,34 +103,17 @@ class RemlCriterion {
     Eigen::VectorXd e;  // whitened GLS residuals (with `residuals`)
   };
 
-  // V_s / sigma^2 = a_s (rho^|i-j| + lambda min(i, j)).
-  static Eigen::MatrixXd shape(std::size_t n, double a, double rho, double lambda) {
-    const Eigen::Index m = static_cast<Eigen::Index>(n);
-    std::vector<double> pw(n, 1.0);  // rho^k
-    for (std::size_t k = 1; k < n; ++k) pw[k] = pw[k - 1] * rho;
-    Eigen::MatrixXd C(m, m);
-    for (Eigen::Index j = 0; j < m; ++j)
-      for (Eigen::Index i = j; i < m; ++i)  // lower triangle: what the LLT reads
-        C(i, j) = a * (pw[static_cast<std::size_t>(i - j)] + lambda * static_cast<double>(j));
-    return C;
-  }
-
   Value operator()(double rho, double lambda, bool residuals = false) const {
     const Eigen::Index n = y_.size(), p = X_.cols();
     Eigen::MatrixXd A(n, p + 1);  // [X y], whitened stream by stream
     A << X_, y_;
+    // V_s / sigma^2 = a_s (rho^|i-j| + lambda min(i, j)), whitened by its Kalman innovations.
     double logdet_v = 0.0;
-    Eigen::MatrixXd block;
     for (std::size_t s = 0; s < start_.streams.size(); ++s) {
       const std::vector<Eigen::Index>& rows = start_.streams[s].rows;
-      const Eigen::LLT<Eigen::MatrixXd> llt(shape(rows.size(), level_[s], rho, lambda));
-      if (llt.info() != Eigen::Success) return {std::numeric_limits<double>::infinity(), 0.0, 0, {}};
-      const Eigen::MatrixXd L = llt.matrixL();
-      logdet_v += 2.0 * L.diagonal().array().log().sum();
-      block.resize(static_cast<Eigen::Index>(rows.size()), p + 1);
-      for (std::size_t t = 0; t < rows.size(); ++t) block.row(static_cast<Eigen::Index>(t)) = A.row(rows[t]);
-      L.triangularView<Eigen::Lower>().solveInPlace(block);
-      for (std::size_t t = 0; t < rows.size(); ++t) A.row(rows[t]) = block.row(static_cast<Eigen::Index>(t));
+      const ArWalkFilter w(rows.size(), level_[s], rho, level_[s] * lambda);
+      logdet_v += w.log_det();
+      w.apply(rows, A);
     }
     const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A.leftCols(p));
     Value v;

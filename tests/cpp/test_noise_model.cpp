@@ -149,8 +149,32 @@ TEST_CASE("a stream with a random walk is whitened by its covariance's Cholesky 
       S(r, c) = 0.09e-6 * std::pow(0.6, std::abs(i - j)) + 0.01e-6 * std::min(i, j);
     }
   Eigen::MatrixXd W = Eigen::MatrixXd::Identity(30, 30);
-  ArWhitener(M).apply(W);
+  ArWhitener(M).apply(W);  // AR(1) + walk: the Kalman innovations (ArWalkFilter)
   CHECK((W * S * W.transpose() - Eigen::MatrixXd::Identity(30, 30)).cwiseAbs().maxCoeff() < 1e-8);
+  // In stream order the filter is causal (lower triangular) and its log-determinant is ln|S|.
+  const ArWalkFilter f(30, 0.09e-6, 0.6, 0.01e-6);
+  Eigen::MatrixXd Wf = Eigen::MatrixXd::Identity(30, 30);
+  std::vector<Eigen::Index> rows(30);
+  for (Eigen::Index i = 0; i < 30; ++i) rows[static_cast<std::size_t>(i)] = i;
+  f.apply(rows, Wf);
+  CHECK(Wf.triangularView<Eigen::StrictlyUpper>().toDenseMatrix().cwiseAbs().maxCoeff() == 0.0);
+  Eigen::MatrixXd Sf(30, 30);
+  for (int i = 0; i < 30; ++i)
+    for (int j = 0; j < 30; ++j) Sf(i, j) = 0.09e-6 * std::pow(0.6, std::abs(i - j)) + 0.01e-6 * std::min(i, j);
+  const Eigen::LLT<Eigen::MatrixXd> llt(Sf);
+  CHECK(f.log_det() == Approx(2.0 * Eigen::MatrixXd(llt.matrixL()).diagonal().array().log().sum()).epsilon(1e-10));
+  // AR(2) + walk: the dense Cholesky path.
+  st.reflection = {0.6, -0.3};
+  st.ar = {0.6 * 1.3, -0.3};
+  M.streams = {st};
+  M.max_order = 2;
+  Eigen::MatrixXd S2 = stream_covariance(st);  // in stream order; rows are reversed
+  Eigen::MatrixXd P = Eigen::MatrixXd::Zero(30, 30);
+  for (int i = 0; i < 30; ++i) P(29 - i, i) = 1.0;
+  S2 = P * S2 * P.transpose();
+  Eigen::MatrixXd W2 = Eigen::MatrixXd::Identity(30, 30);
+  ArWhitener(M).apply(W2);
+  CHECK((W2 * S2 * W2.transpose() - Eigen::MatrixXd::Identity(30, 30)).cwiseAbs().maxCoeff() < 1e-8);
 }
 
 namespace {

@@ -56,7 +56,8 @@ double noise_model_bias_factor(const NoiseModel& model, const std::vector<std::s
 /// R-test whose poses run B outer), which a model of the residuals alone misses (Burg on
 /// them sees a walk as a mild AR). (rho, ln lambda) by Nelder-Mead; a_s by the fixed-point
 /// step a_s <- a_s (|e_s|^2 / n_s) / (S / n) on the whitened GLS residuals e, then once more.
-/// Dense per-stream Cholesky factors: meant for streams of up to a few hundred readings.
+/// Each evaluation whitens by ArWalkFilter (O(n) per column) and takes a QR of the whitened
+/// Jacobian (O(n k^2)).
 /// Throws InvalidArgument if the sizes differ.
 NoiseModel estimate_noise_model_reml(const NoiseModel& start, const Eigen::VectorXd& residuals_mm,
                                      const Eigen::MatrixXd& jacobian_free);

@@ -42,9 +42,9 @@ struct NoiseModelOptions {
   /// core/noise_handling.hpp: probe zeros that wander between poses), instead of Burg's AR(p)
   /// on the residuals scaled by the bootstrap bias factor. The ballbar fit does not read it.
   bool reml_random_walk = true;
-  /// Streams longer than this (readings) fall back to Burg + bias factor: REML factors each
-  /// stream's dense covariance at every likelihood evaluation (O(n^3); ~0.1 s a fit at 84).
-  int reml_max_stream_size = 400;
+  /// Streams longer than this (readings) fall back to Burg + bias factor: each of REML's ~240
+  /// likelihood evaluations takes a QR of the whitened Jacobian (readings x free parameters).
+  int reml_max_stream_size = 2000;
 };
 
 /// The AR model of one stream.
@@ -101,11 +101,32 @@ std::vector<double> ar_autocovariance(const NoiseStream& stream, std::size_t n);
 /// the random walk's q^2 min(i, j).
 Eigen::MatrixXd stream_covariance(const NoiseStream& stream);
 
+/// Whitening of one AR(1) + random-walk stream in O(n): the innovations of the two-state
+/// Kalman filter (a_t = rho a_{t-1} + e_t started stationary with variance `marginal_var`;
+/// w_t = w_{t-1} + eta_t, Var eta = `step_var`, w_0 = 0; reading a_t + w_t, no further noise),
+/// each divided by its sd. The innovations are the readings minus their prediction from the
+/// earlier ones, so this is the inverse Cholesky factor of stream_covariance's matrix
+/// sigma^2 rho^|i-j| + q^2 min(i, j), without forming it.
+class ArWalkFilter {
+ public:
+  ArWalkFilter(std::size_t n, double marginal_var, double rho, double step_var);
+  /// Replace rows `rows[0..n-1]` (the stream's readings in time order) of every column by
+  /// their whitened values.
+  void apply(const std::vector<Eigen::Index>& rows, Eigen::Ref<Eigen::MatrixXd> columns) const;
+  double log_det() const { return log_det_; }  ///< ln |V| = sum_t ln F_t
+  std::size_t size() const { return inv_sd_.size(); }
+
+ private:
+  double rho_;
+  std::vector<double> gain_a_, gain_w_, inv_sd_;
+  double log_det_ = 0.0;
+};
+
 /// Prewhitening by the AR filter of each stream, with its exact start-up rows (the first p
 /// readings are predicted from the orders 0..p-1 of Burg's recursion, so W is the inverse
 /// Cholesky factor of the model's covariance), scaled to unit variance. A stream with a random
-/// walk is whitened by the inverse Cholesky factor of its dense covariance (stream_covariance;
-/// O(n^3) once, meant for R-test streams of a few hundred readings). Columns hold values in
+/// walk is whitened by ArWalkFilter when its AR order is 0 or 1, else by the inverse Cholesky
+/// factor of its dense covariance (stream_covariance; O(n^3) once). Columns hold values in
 /// units of `residual_unit_mm` (1: mm; pass sigma if the fit's residuals are already divided
 /// by a sigma).
 class ArWhitener : public ResidualWhitener {
@@ -119,7 +140,8 @@ class ArWhitener : public ResidualWhitener {
     std::vector<Eigen::Index> rows;
     std::vector<std::vector<double>> phi;  ///< phi[m]: coefficients of order m = 0..p
     std::vector<double> inv_sd;            ///< 1 / sqrt(v_m) in column units
-    Eigen::MatrixXd chol;                  ///< with a random walk: lower Cholesky factor, column units
+    Eigen::MatrixXd chol;                  ///< random walk, AR order >= 2: lower Cholesky factor, column units
+    std::vector<ArWalkFilter> walk;        ///< random walk, AR order 0 or 1 (one filter or none)
   };
   std::vector<Stream> streams_;
   std::size_t n_ = 0;
