@@ -90,9 +90,11 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--no-bias-factor")) bias = false;
     else if (!std::strcmp(argv[i], "--oracle")) oracle = true;  // R-test: GLS under the true covariance
     else if (!std::strcmp(argv[i], "--no-reml")) reml = false;  // R-test: Burg AR(p) x bias factor (before)
-    else if (!std::strcmp(argv[i], "--walk") && i + 1 < argc) walk_um = std::atof(argv[++i]);  // R-test probe-zero step per pose, um
+    else if (!std::strcmp(argv[i], "--walk") && i + 1 < argc)
+      walk_um = std::atof(argv[++i]);  // R-test probe-zero step per pose, um
     else {
-      std::fprintf(stderr, "usage: noise_mc_bench [--draws N] [--smoke] [--no-rtest] [--no-ballbar] [--pooled] [--no-bias-factor] [--oracle] [--no-reml] [--walk UM]\n");
+      std::fprintf(stderr, "usage: noise_mc_bench [--draws N] [--smoke] [--no-rtest] [--no-ballbar] [--pooled] "
+                           "[--no-bias-factor] [--oracle] [--no-reml] [--walk UM]\n");
       return 2;
     }
   }
@@ -187,7 +189,8 @@ int main(int argc, char** argv) {
       for (int k = 0; k < draws; ++k) {
         RtestSession s = rclean;
         const Eigen::VectorXd e = coloured(nz, rg, rtm, 0.3e-3, 5000 + static_cast<std::uint64_t>(k)) +
-                                  noise_gen::probe_zero_wander(rg, rtm, walk_um * 1e-3, 9000 + static_cast<std::uint64_t>(k));
+                                  noise_gen::probe_zero_wander(rg, rtm, walk_um * 1e-3,
+                                                               9000 + static_cast<std::uint64_t>(k));
         for (std::size_t r = 0; r < s.samples.size(); ++r)
           for (int c = 0; c < 3; ++c) (*s.samples[r].d)[c] += e[3 * static_cast<Eigen::Index>(r) + c];
         s.noise_um = 0.3;

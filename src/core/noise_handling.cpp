@@ -155,8 +155,11 @@ std::array<double, 2> nelder_mead_2d(F f, std::array<double, 2> x0, std::array<d
   };
   while (used < evals) {
     std::array<int, 3> o = {0, 1, 2};
-    std::sort(o.begin(), o.end(), [&](int a, int b) { return fx[static_cast<std::size_t>(a)] < fx[static_cast<std::size_t>(b)]; });
-    const std::size_t b = static_cast<std::size_t>(o[0]), m = static_cast<std::size_t>(o[1]), w = static_cast<std::size_t>(o[2]);
+    std::sort(o.begin(), o.end(), [&](int a, int b) {
+      return fx[static_cast<std::size_t>(a)] < fx[static_cast<std::size_t>(b)];
+    });
+    const std::size_t b = static_cast<std::size_t>(o[0]), m = static_cast<std::size_t>(o[1]),
+                      w = static_cast<std::size_t>(o[2]);
     if (fx[w] - fx[b] < ftol) break;
     const std::array<double, 2> c = mix(x[b], x[m], 0.5);
     const std::array<double, 2> r = mix(c, x[w], -1.0);

@@ -366,7 +366,8 @@ RtestJointIdentification identify_joint(const RtestSession& session,
   out.noise_refit = refit;
   out.noise_correction = scale;
   if (refit && reml)
-    out.notes.push_back("correlated noise (" + out.noise.summary() + ", REML over the fit's residual space): covariance by GLS under this model");
+    out.notes.push_back("correlated noise (" + out.noise.summary() +
+                        ", REML over the fit's residual space): covariance by GLS under this model");
   else if (refit) out.notes.push_back("correlated noise (" + out.noise.summary() + "): covariance by GLS under this AR model, scaled by " + std::to_string(scale) + " for the correlation the fit absorbs from its residuals");
 
   out.model.machine = session.machine;

@@ -244,10 +244,10 @@ TEST_CASE("R-test sigmas hold for every location error under AR(0.9) noise with 
   // the issue's 0.7-1.4, and the RMS of log ratios over the 8 errors (a shape figure, ~0.1 from
   // sampling alone) must stay under 0.25.
   for (int j = 0; j < 8; ++j) {
-    INFO(location_error_names(MachineType::BC_trt)[static_cast<std::size_t>(j)] << ": now " << rn[static_cast<std::size_t>(j)]
-         << ", old " << ro[static_cast<std::size_t>(j)]);
-    CHECK(rn[static_cast<std::size_t>(j)] > 0.6);
-    CHECK(rn[static_cast<std::size_t>(j)] < 1.6);
+    const std::size_t u = static_cast<std::size_t>(j);
+    INFO(location_error_names(MachineType::BC_trt)[u] << ": now " << rn[u] << ", old " << ro[u]);
+    CHECK(rn[u] > 0.6);
+    CHECK(rn[u] < 1.6);
   }
   INFO("RMS log ratio: now " << rms_log(rn) << ", old " << rms_log(ro));
   CHECK(rms_log(rn) < 0.25);
