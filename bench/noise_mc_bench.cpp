@@ -79,7 +79,8 @@ Eigen::VectorXd coloured(const Noise& nz, const std::vector<std::string>& g, con
 
 int main(int argc, char** argv) {
   int draws = 200;
-  bool rtest = true, ballbar = true, pooled = false, bias = true;
+  bool rtest = true, ballbar = true, pooled = false, bias = true, oracle = false, reml = true;
+  double walk_um = 0.1;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--smoke")) draws = 8;
     else if (!std::strcmp(argv[i], "--draws") && i + 1 < argc) draws = std::atoi(argv[++i]);
@@ -87,8 +88,13 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--no-ballbar")) ballbar = false;
     else if (!std::strcmp(argv[i], "--pooled")) pooled = true;  // one AR model for all streams
     else if (!std::strcmp(argv[i], "--no-bias-factor")) bias = false;
+    else if (!std::strcmp(argv[i], "--oracle")) oracle = true;  // R-test: GLS under the true covariance
+    else if (!std::strcmp(argv[i], "--no-reml")) reml = false;  // R-test: Burg AR(p) x bias factor (before)
+    else if (!std::strcmp(argv[i], "--walk") && i + 1 < argc)
+      walk_um = std::atof(argv[++i]);  // R-test probe-zero step per pose, um
     else {
-      std::fprintf(stderr, "usage: noise_mc_bench [--draws N] [--smoke] [--no-rtest] [--no-ballbar] [--pooled] [--no-bias-factor]\n");
+      std::fprintf(stderr, "usage: noise_mc_bench [--draws N] [--smoke] [--no-rtest] [--no-ballbar] [--pooled] "
+                           "[--no-bias-factor] [--oracle] [--no-reml] [--walk UM]\n");
       return 2;
     }
   }
@@ -129,7 +135,7 @@ int main(int argc, char** argv) {
   }
 
   // R-test: 0.3 um coloured noise per probe channel plus probe zeros that wander between poses
-  // (random walk, 0.1 um per pose).
+  // (random walk, --walk um per pose, 0.1 by default).
   if (rtest) {
     MachineModel rt = MachineModel::nominal(MachineType::BC_trt);
     rt.machine = MachineType::BC_trt;
@@ -145,15 +151,46 @@ int main(int argc, char** argv) {
     rauto.noise = NoiseHandling::automatic;
     rauto.noise_options.pooled = pooled;
     rauto.noise_bias_correction = bias;
+    rauto.noise_options.reml_random_walk = reml;
     RtestJointOptions rwhite;
     rwhite.noise = NoiseHandling::white;
+    // The generating covariance as a noise model (AR(1) + random walk per stream), for
+    // --oracle: the best any estimated noise model can do.
+    const auto truth_model = [&](double rho) {
+      NoiseModel m;
+      m.n = rg.size();
+      std::vector<std::string> sg;
+      std::vector<int> sc;
+      const auto streams = noise_streams(rg, rtm, &sg, &sc);
+      for (std::size_t k = 0; k < streams.size(); ++k) {
+        NoiseStream st;
+        st.group = sg[k], st.channel = sc[k], st.rows = streams[k];
+        st.marginal_sigma_um = 0.3;
+        st.reflection = {rho};
+        st.ar = {rho};
+        st.random_walk_step_um = walk_um;
+        m.streams.push_back(st);
+      }
+      m.max_order = 1, m.random_walk_step_um = walk_um;
+      return m;
+    };
+    std::printf("R-test, probe zeros walking %.2f um per pose; noise model: %s\n", walk_um,
+                oracle ? "the true covariance (AR(1) rho + the walk; 1/f: as estimated)"
+                                         : reml ? "AR(1) + random walk per stream by REML"
+                                                : "Burg AR(p) of the residuals x bias factor");
     for (const Noise& nz : kinds) {
+      rauto.whitener = nullptr;
+      if (oracle && nz.rho >= 0) {
+        rauto.noise = NoiseHandling::white;
+        rauto.whitener = std::make_shared<ArWhitener>(truth_model(nz.rho));
+      }
       const auto t0 = clock::now();
       Spread a, w;
       for (int k = 0; k < draws; ++k) {
         RtestSession s = rclean;
         const Eigen::VectorXd e = coloured(nz, rg, rtm, 0.3e-3, 5000 + static_cast<std::uint64_t>(k)) +
-                                  noise_gen::probe_zero_wander(rg, rtm, 0.1e-3, 9000 + static_cast<std::uint64_t>(k));
+                                  noise_gen::probe_zero_wander(rg, rtm, walk_um * 1e-3,
+                                                               9000 + static_cast<std::uint64_t>(k));
         for (std::size_t r = 0; r < s.samples.size(); ++r)
           for (int c = 0; c < 3; ++c) (*s.samples[r].d)[c] += e[3 * static_cast<Eigen::Index>(r) + c];
         s.noise_um = 0.3;

@@ -2,6 +2,8 @@
 #include "rotacal/core/noise_handling.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <random>
 
 #include <Eigen/QR>
@@ -34,6 +36,15 @@ Eigen::VectorXd draw_noise(const NoiseModel& model, std::mt19937_64& rng) {
         hist[0] = x;
       }
       if (t >= burn) e[s.rows[t - burn]] = x;
+    }
+    // The random walk from the stream's first reading (its start is the stream's level).
+    if (s.random_walk_step_um > 0.0) {
+      const double q = s.random_walk_step_um * 1e-3;
+      double z = 0.0;
+      for (std::size_t t = 0; t < s.rows.size(); ++t) {
+        if (t > 0) z += q * N(rng);
+        e[s.rows[t]] += z;
+      }
     }
   }
   return e;
@@ -75,6 +86,197 @@ double noise_model_bias_factor(const NoiseModel& model, const std::vector<std::s
   }
   const double mean = sum / draws;
   return mean > 0.0 ? std::max(1.0, target / mean) : 1.0;
+}
+
+namespace {
+
+// The REML criterion of an AR(1) + random-walk model (estimate_noise_model_reml).
+class RemlCriterion {
+ public:
+  RemlCriterion(const NoiseModel& start, const Eigen::VectorXd& y, const Eigen::MatrixXd& X)
+      : start_(start), y_(y), X_(X), level_(start.streams.size(), 1.0) {}
+
+  struct Value {
+    double m2l = 0.0;   // -2 l, profiled over sigma^2, up to a constant
+    double S = 0.0;     // whitened GLS residual sum of squares (sigma^2 = 1)
+    Eigen::Index k = 0; // rank of X
+    Eigen::VectorXd e;  // whitened GLS residuals (with `residuals`)
+  };
+
+  Value operator()(double rho, double lambda, bool residuals = false) const {
+    const Eigen::Index n = y_.size(), p = X_.cols();
+    Eigen::MatrixXd A(n, p + 1);  // [X y], whitened stream by stream
+    A << X_, y_;
+    // V_s / sigma^2 = a_s (rho^|i-j| + lambda min(i, j)), whitened by its Kalman innovations.
+    double logdet_v = 0.0;
+    for (std::size_t s = 0; s < start_.streams.size(); ++s) {
+      const std::vector<Eigen::Index>& rows = start_.streams[s].rows;
+      const ArWalkFilter w(rows.size(), level_[s], rho, level_[s] * lambda);
+      logdet_v += w.log_det();
+      w.apply(rows, A);
+    }
+    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A.leftCols(p));
+    Value v;
+    v.k = qr.rank();
+    Eigen::VectorXd c = qr.householderQ().adjoint() * A.col(p);
+    v.S = c.tail(n - v.k).squaredNorm();
+    double logdet_xvx = 0.0;
+    for (Eigen::Index i = 0; i < v.k; ++i) logdet_xvx += 2.0 * std::log(std::abs(qr.matrixQR()(i, i)));
+    const double dof = static_cast<double>(n - v.k);
+    v.m2l = dof * std::log(std::max(v.S, 1e-300) / dof) + logdet_v + logdet_xvx;
+    if (residuals) {
+      c.head(v.k).setZero();
+      v.e = qr.householderQ() * c;
+    }
+    return v;
+  }
+
+  std::vector<double>& level() { return level_; }
+
+ private:
+  const NoiseModel& start_;
+  const Eigen::VectorXd& y_;
+  const Eigen::MatrixXd& X_;
+  std::vector<double> level_;
+};
+
+// Nelder-Mead in two dimensions (standard coefficients), `evals` evaluations at most, stopped
+// when the simplex' values agree to `ftol`.
+template <typename F>
+std::array<double, 2> nelder_mead_2d(F f, std::array<double, 2> x0, std::array<double, 2> step,
+                                     int evals, double ftol) {
+  std::array<std::array<double, 2>, 3> x = {x0, x0, x0};
+  x[1][0] += step[0];
+  x[2][1] += step[1];
+  std::array<double, 3> fx = {f(x[0]), f(x[1]), f(x[2])};
+  int used = 3;
+  const auto mix = [](const std::array<double, 2>& a, const std::array<double, 2>& b, double t) {
+    return std::array<double, 2>{a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])};
+  };
+  while (used < evals) {
+    std::array<int, 3> o = {0, 1, 2};
+    std::sort(o.begin(), o.end(), [&](int a, int b) {
+      return fx[static_cast<std::size_t>(a)] < fx[static_cast<std::size_t>(b)];
+    });
+    const std::size_t b = static_cast<std::size_t>(o[0]), m = static_cast<std::size_t>(o[1]),
+                      w = static_cast<std::size_t>(o[2]);
+    if (fx[w] - fx[b] < ftol) break;
+    const std::array<double, 2> c = mix(x[b], x[m], 0.5);
+    const std::array<double, 2> r = mix(c, x[w], -1.0);
+    const double fr = f(r);
+    ++used;
+    if (fr < fx[b]) {
+      const std::array<double, 2> e = mix(c, x[w], -2.0);
+      const double fe = f(e);
+      ++used;
+      if (fe < fr) x[w] = e, fx[w] = fe;
+      else x[w] = r, fx[w] = fr;
+    } else if (fr < fx[m]) {
+      x[w] = r, fx[w] = fr;
+    } else {
+      const bool outside = fr < fx[w];
+      const std::array<double, 2> k = mix(c, outside ? r : x[w], 0.5);
+      const double fk = f(k);
+      ++used;
+      if (fk < std::min(fr, fx[w])) {
+        x[w] = k, fx[w] = fk;
+      } else {  // shrink towards the best
+        for (std::size_t i : {m, w}) x[i] = mix(x[b], x[i], 0.5), fx[i] = f(x[i]);
+        used += 2;
+      }
+    }
+  }
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < 3; ++i)
+    if (fx[i] < fx[best]) best = i;
+  return x[best];
+}
+
+}  // namespace
+
+NoiseModel estimate_noise_model_reml(const NoiseModel& start, const Eigen::VectorXd& y,
+                                     const Eigen::MatrixXd& X) {
+  const Eigen::Index n = y.size();
+  if (static_cast<Eigen::Index>(start.n) != n || X.rows() != n)
+    throw InvalidArgument("estimate_noise_model_reml: start.n, residuals and jacobian_free rows must agree (" +
+                          std::to_string(start.n) + ", " + std::to_string(n) + ", " + std::to_string(X.rows()) + ")");
+  std::size_t covered = 0;
+  for (const NoiseStream& s : start.streams) covered += s.rows.size();
+  if (covered != start.n) throw InvalidArgument("estimate_noise_model_reml: start's streams do not cover its readings");
+  RemlCriterion crit(start, y, X);
+  // rho = 0.995 tanh(u) (|rho| < 0.995: beyond it the AR part is a walk itself),
+  // lambda = exp(v) with v in [-18, 4] (e^-18: no walk; e^4: walk steps 7x the AR sigma).
+  const auto rho_of = [](double u) { return 0.995 * std::tanh(u); };
+  const auto lambda_of = [](double v) { return std::exp(std::min(4.0, std::max(-18.0, v))); };
+  const auto f = [&](const std::array<double, 2>& x) {
+    const double pen = std::max(0.0, x[1] - 4.0) + std::max(0.0, -18.0 - x[1]);  // keep v in range
+    return crit(rho_of(x[0]), lambda_of(x[1])).m2l + 10.0 * pen * pen;
+  };
+  // Start: the largest stream's phi_1 (biased low, a start only) and a small walk.
+  double phi1 = 0.0;
+  std::size_t big = 0;
+  for (const NoiseStream& s : start.streams)
+    if (s.rows.size() > big && s.order() >= 1) big = s.rows.size(), phi1 = s.ar[0];
+  std::array<double, 2> x = {std::atanh(std::max(-0.9, std::min(0.95, phi1)) / 0.995), std::log(1e-3)};
+  x = nelder_mead_2d(f, x, {0.5, 3.0}, 120, 1e-4);
+  // The streams' levels (dx, dy, dz probes may differ), then (rho, lambda) again.
+  if (start.streams.size() > 1) {
+    for (int round = 0; round < 2; ++round) {
+      const RemlCriterion::Value v = crit(rho_of(x[0]), lambda_of(x[1]), true);
+      const double mean_sq = v.S / static_cast<double>(n);
+      double log_mean = 0.0;
+      std::vector<double>& a = crit.level();
+      for (std::size_t s = 0; s < start.streams.size(); ++s) {
+        double ss = 0.0;
+        for (Eigen::Index r : start.streams[s].rows) ss += v.e[r] * v.e[r];
+        a[s] *= std::max(1e-6, ss / static_cast<double>(start.streams[s].rows.size()) / mean_sq);
+        log_mean += std::log(a[s]);
+      }
+      log_mean /= static_cast<double>(a.size());
+      for (double& as : a) as /= std::exp(log_mean);
+      x = nelder_mead_2d(f, x, {0.2, 1.0}, 60, 1e-4);
+    }
+  }
+  const double rho = rho_of(x[0]);
+  double lambda = lambda_of(x[1]);
+  const RemlCriterion::Value v = crit(rho, lambda);
+  const double sigma2 = v.S / static_cast<double>(n - v.k);  // REML: unbiased for sigma^2
+  std::size_t longest = 0;
+  for (const NoiseStream& s : start.streams) longest = std::max(longest, s.rows.size());
+  if (lambda * static_cast<double>(longest) < 1e-3) lambda = 0.0;  // a walk under 0.1 % of the variance
+
+  NoiseModel M;
+  M.n = start.n;
+  double ss_marg = 0.0, ss_innov = 0.0;
+  for (std::size_t s = 0; s < start.streams.size(); ++s) {
+    NoiseStream S = start.streams[s];
+    const double var = sigma2 * crit.level()[s];
+    const double ns = static_cast<double>(S.rows.size());
+    S.ar = {rho};
+    S.reflection = {rho};
+    S.marginal_sigma_um = std::sqrt(var) * 1e3;
+    S.innovation_sigma_um = S.marginal_sigma_um * std::sqrt(1.0 - rho * rho);
+    S.random_walk_step_um = std::sqrt(lambda * var) * 1e3;
+    // tau = 1^T V 1 / tr V: the AR definition (long-run over marginal variance) for a finite
+    // stream, which a walk makes grow with n.
+    const Eigen::MatrixXd C = stream_covariance(S);
+    S.correlation_samples = std::min(ns, std::max(1e-3, C.sum() / C.trace()));
+    S.correlation_time_s = S.correlation_samples * S.sample_interval_s;
+    S.effective_samples = std::min(ns, ns / S.correlation_samples);
+    ss_marg += var * ns;
+    ss_innov += var * (1.0 - rho * rho) * ns;
+    M.correlation_samples = std::max(M.correlation_samples, S.correlation_samples);
+    M.correlation_time_s = std::max(M.correlation_time_s, S.correlation_time_s);
+    M.effective_samples += S.effective_samples;
+    M.random_walk_step_um = std::max(M.random_walk_step_um, S.random_walk_step_um);
+    M.streams.push_back(std::move(S));
+  }
+  M.max_order = 1;
+  if (M.n) {
+    M.sigma_um = std::sqrt(ss_marg / static_cast<double>(M.n)) * 1e3;
+    M.innovation_sigma_um = std::sqrt(ss_innov / static_cast<double>(M.n)) * 1e3;
+  }
+  return M;
 }
 
 }  // namespace rotacal

@@ -9,6 +9,8 @@
 #include <random>
 #include <sstream>
 
+#include <Eigen/Cholesky>
+
 #include "rotacal/core/error.hpp"
 
 namespace rotacal {
@@ -278,11 +280,81 @@ std::string NoiseModel::summary() const {
     for (const NoiseStream& s : streams)
       if (!big || s.rows.size() > big->rows.size()) big = &s;
     if (big && big->order() >= 1) out << ", phi_1 " << big->ar[0];
+    if (random_walk_step_um > 0.0) out << " + random walk " << random_walk_step_um << " um per reading";
   }
   out << ", sigma " << sigma_um << " um (innovation " << innovation_sigma_um
       << " um), correlation time " << correlation_time_s << " s (" << correlation_samples
       << " samples), " << effective_samples << " effective samples of " << n;
   return out.str();
+}
+
+std::vector<double> ar_autocovariance(const NoiseStream& s, std::size_t n) {
+  std::vector<double> g(n, 0.0);
+  if (n == 0) return g;
+  const std::vector<std::vector<double>> phi = levinson(s.reflection);
+  double v = std::pow(s.marginal_sigma_um * 1e-3, 2);
+  g[0] = v;
+  const std::size_t p = s.reflection.size();
+  for (std::size_t m = 1; m < n; ++m) {
+    if (m <= p) {
+      // Levinson read backwards: k_m = (gamma_m - sum_j phi_{m-1,j} gamma_{m-j}) / v_{m-1}.
+      double acc = s.reflection[m - 1] * v;
+      for (std::size_t j = 1; j < m; ++j) acc += phi[m - 1][j - 1] * g[m - j];
+      g[m] = acc;
+      v *= 1.0 - s.reflection[m - 1] * s.reflection[m - 1];
+    } else {
+      double acc = 0.0;
+      for (std::size_t j = 1; j <= p; ++j) acc += phi[p][j - 1] * g[m - j];
+      g[m] = acc;
+    }
+  }
+  return g;
+}
+
+Eigen::MatrixXd stream_covariance(const NoiseStream& s) {
+  const Eigen::Index n = static_cast<Eigen::Index>(s.rows.size());
+  const std::vector<double> g = ar_autocovariance(s, s.rows.size());
+  const double q2 = std::pow(s.random_walk_step_um * 1e-3, 2);
+  Eigen::MatrixXd C(n, n);
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (Eigen::Index j = 0; j < n; ++j)
+      C(i, j) = g[static_cast<std::size_t>(std::abs(i - j))] + q2 * static_cast<double>(std::min(i, j));
+  return C;
+}
+
+ArWalkFilter::ArWalkFilter(std::size_t n, double marginal_var, double rho, double step_var) : rho_(rho) {
+  if (!(marginal_var > 0.0) || !(step_var >= 0.0) || !(std::abs(rho) < 1.0))
+    throw InvalidArgument("ArWalkFilter: needs marginal_var > 0, step_var >= 0 and |rho| < 1");
+  gain_a_.resize(n), gain_w_.resize(n), inv_sd_.resize(n);
+  // Predicted state covariance [[p00, p01], [p01, p11]] of (a_t, w_t): stationary a, w_0 = 0.
+  double p00 = marginal_var, p01 = 0.0, p11 = 0.0;
+  const double innov = marginal_var * (1.0 - rho * rho);
+  for (std::size_t t = 0; t < n; ++t) {
+    const double F = p00 + 2.0 * p01 + p11;  // Var of the reading's innovation (Z = [1 1])
+    const double ka = (p00 + p01) / F, kw = (p01 + p11) / F;
+    gain_a_[t] = ka, gain_w_[t] = kw, inv_sd_[t] = 1.0 / std::sqrt(F);
+    log_det_ += std::log(F);
+    // Update (P - F k k^T), then predict (T = diag(rho, 1), Q = diag(innov, step_var)).
+    const double f00 = p00 - F * ka * ka, f01 = p01 - F * ka * kw, f11 = p11 - F * kw * kw;
+    p00 = rho * rho * f00 + innov;
+    p01 = rho * f01;
+    p11 = f11 + step_var;
+  }
+}
+
+void ArWalkFilter::apply(const std::vector<Eigen::Index>& rows, Eigen::Ref<Eigen::MatrixXd> columns) const {
+  const std::size_t n = inv_sd_.size();
+  if (rows.size() != n) throw InvalidArgument("ArWalkFilter::apply: rows and filter sizes differ");
+  for (Eigen::Index c = 0; c < columns.cols(); ++c) {
+    double ma = 0.0, mw = 0.0;  // predicted state mean
+    for (std::size_t t = 0; t < n; ++t) {
+      double& y = columns(rows[t], c);
+      const double v = y - ma - mw;
+      y = v * inv_sd_[t];
+      ma = rho_ * (ma + gain_a_[t] * v);
+      mw += gain_w_[t] * v;
+    }
+  }
 }
 
 ArWhitener::ArWhitener(const NoiseModel& model, double residual_unit_mm) : n_(model.n) {
@@ -299,6 +371,18 @@ ArWhitener::ArWhitener(const NoiseModel& model, double residual_unit_mm) : n_(mo
       if (m > 0) v *= 1.0 - s.reflection[m - 1] * s.reflection[m - 1];
       w.inv_sd.push_back(1.0 / std::sqrt(std::max(v, 1e-300)));
     }
+    if (s.random_walk_step_um > 0.0 && !s.rows.empty() && s.order() <= 1) {
+      const double u2 = residual_unit_mm * residual_unit_mm;
+      w.walk.emplace_back(s.rows.size(), std::max(std::pow(s.marginal_sigma_um * 1e-3, 2) / u2, 1e-300),
+                          s.order() == 1 ? s.reflection[0] : 0.0, std::pow(s.random_walk_step_um * 1e-3, 2) / u2);
+    } else if (s.random_walk_step_um > 0.0 && !s.rows.empty()) {
+      const Eigen::MatrixXd C = stream_covariance(s) / (residual_unit_mm * residual_unit_mm);
+      const Eigen::LLT<Eigen::MatrixXd> llt(C);
+      if (llt.info() != Eigen::Success)
+        throw InvalidArgument("ArWhitener: the covariance of stream " + s.group + " channel " +
+                              std::to_string(s.channel) + " is not positive definite");
+      w.chol = llt.matrixL();
+    }
     streams_.push_back(std::move(w));
   }
 }
@@ -308,8 +392,21 @@ void ArWhitener::apply(Eigen::Ref<Eigen::MatrixXd> columns) const {
     throw InvalidArgument("ArWhitener::apply: " + std::to_string(columns.rows()) +
                           " rows given, the noise model covers " + std::to_string(n_));
   std::vector<double> x;
+  Eigen::MatrixXd block;
   for (const Stream& s : streams_) {
     const std::size_t n = s.rows.size(), p = s.phi.size() - 1;
+    if (!s.walk.empty()) {
+      s.walk.front().apply(s.rows, columns);
+      continue;
+    }
+    if (s.chol.size() > 0) {
+      // Dense: L^-1 x for every column at once (L L^T = the stream's covariance).
+      block.resize(static_cast<Eigen::Index>(n), columns.cols());
+      for (std::size_t t = 0; t < n; ++t) block.row(static_cast<Eigen::Index>(t)) = columns.row(s.rows[t]);
+      s.chol.triangularView<Eigen::Lower>().solveInPlace(block);
+      for (std::size_t t = 0; t < n; ++t) columns.row(s.rows[t]) = block.row(static_cast<Eigen::Index>(t));
+      continue;
+    }
     x.resize(n);
     for (Eigen::Index c = 0; c < columns.cols(); ++c) {
       for (std::size_t t = 0; t < n; ++t) x[t] = columns(s.rows[t], c);

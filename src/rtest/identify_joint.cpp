@@ -311,9 +311,12 @@ RtestJointIdentification identify_joint(const RtestSession& session,
   // Noise model of the residuals: one AR stream per nest and channel (dx, dy, dz share a
   // time, so the estimator splits them), in time order. Probe zeros that wander between
   // poses and servo/thermal noise make it correlated; then the white covariance is too small
-  // and the fit is redone by GLS under the model (one feasible-GLS step).
+  // and the fit is redone by GLS under the model (one feasible-GLS step). The model is AR(1)
+  // + a random walk per stream by REML (core/noise_handling.hpp): the probe zeros and the B
+  // polynomials (B runs outer) take most of a walk out of the residuals, which Burg's AR(p)
+  // of the residuals cannot see (docs/noise_model.md).
   NoiseModel noise;
-  bool refit = false;
+  bool refit = false, reml = false;
   double scale = 1.0;
   if (!options.whitener) {
     std::vector<std::string> groups;
@@ -328,7 +331,14 @@ RtestJointIdentification identify_joint(const RtestSession& session,
     noise = estimate_noise_model(groups, times, fit.residuals, options.noise_options);
     if (options.noise == NoiseHandling::automatic && !noise.white() &&
         noise.correlation_samples >= options.min_correlation_samples) {
-      if (options.noise_bias_correction) scale = noise_correction(noise, groups, times, fit, options.noise_options);
+      std::size_t longest = 0;
+      for (const NoiseStream& st : noise.streams) longest = std::max(longest, st.rows.size());
+      reml = options.noise_options.reml_random_walk &&
+             longest <= static_cast<std::size_t>(options.noise_options.reml_max_stream_size);
+      if (reml)
+        noise = estimate_noise_model_reml(noise, fit.residuals, free_jacobian(fit));  // no bias left to scale
+      else if (options.noise_bias_correction)
+        scale = noise_correction(noise, groups, times, fit, options.noise_options);
       settings.whitener = std::make_shared<ArWhitener>(noise);
       fit = solve_joint(model, params, settings);
       apply_noise_correction(scale, &fit);
@@ -355,7 +365,10 @@ RtestJointIdentification identify_joint(const RtestSession& session,
   out.noise = std::move(noise);
   out.noise_refit = refit;
   out.noise_correction = scale;
-  if (refit) out.notes.push_back("correlated noise (" + out.noise.summary() + "): covariance by GLS under this AR model, scaled by " + std::to_string(scale) + " for the correlation the fit absorbs from its residuals");
+  if (refit && reml)
+    out.notes.push_back("correlated noise (" + out.noise.summary() +
+                        ", REML over the fit's residual space): covariance by GLS under this model");
+  else if (refit) out.notes.push_back("correlated noise (" + out.noise.summary() + "): covariance by GLS under this AR model, scaled by " + std::to_string(scale) + " for the correlation the fit absorbs from its residuals");
 
   out.model.machine = session.machine;
   out.model.basis = basis;

@@ -4,10 +4,12 @@
 #include <catch2/catch.hpp>
 
 #include <Eigen/Cholesky>
+#include <Eigen/QR>
 #include <cmath>
 #include <random>
 
 #include "rotacal/core/error.hpp"
+#include "rotacal/core/noise_handling.hpp"
 #include "rotacal/core/noise_model.hpp"
 
 using namespace rotacal;
@@ -103,6 +105,160 @@ TEST_CASE("the whitener is the inverse Cholesky factor of the AR(1) covariance",
   CHECK((W * S * W.transpose() - Eigen::MatrixXd::Identity(6, 6)).cwiseAbs().maxCoeff() < 1e-9);
   // Lower triangular (a causal filter) like a Cholesky factor's inverse.
   CHECK(W.triangularView<Eigen::StrictlyUpper>().toDenseMatrix().cwiseAbs().maxCoeff() == 0.0);
+}
+
+TEST_CASE("AR(2) autocovariance from the reflection coefficients agrees with the whitener", "[noise_model]") {
+  // The autocovariance (Levinson read backwards, then the AR recursion) and the whitener (the
+  // forward recursion of prediction errors) are computed independently: W C W^T = I ties them.
+  NoiseModel M;
+  M.n = 40;
+  NoiseStream st;
+  for (Eigen::Index i = 0; i < 40; ++i) st.rows.push_back(i);
+  st.reflection = {0.7, -0.4};
+  st.ar = {0.7 * (1 + 0.4), -0.4};  // phi_1 = k_1 (1 - k_2), phi_2 = k_2
+  st.marginal_sigma_um = 2.0;
+  M.streams = {st};
+  M.max_order = 2;
+  const std::vector<double> g = ar_autocovariance(st, 40);
+  // Yule-Walker: gamma_k = phi_1 gamma_{k-1} + phi_2 gamma_{k-2} for k >= 1 (gamma_-1 = gamma_1).
+  CHECK(g[1] == Approx(st.ar[0] * g[0] + st.ar[1] * g[1]).epsilon(1e-12));
+  CHECK(g[5] == Approx(st.ar[0] * g[4] + st.ar[1] * g[3]).epsilon(1e-12));
+  const Eigen::MatrixXd C = stream_covariance(st);
+  Eigen::MatrixXd W = Eigen::MatrixXd::Identity(40, 40);
+  ArWhitener(M).apply(W);
+  CHECK((W * C * W.transpose() - Eigen::MatrixXd::Identity(40, 40)).cwiseAbs().maxCoeff() < 1e-9);
+}
+
+TEST_CASE("a stream with a random walk is whitened by its covariance's Cholesky factor", "[noise_model]") {
+  NoiseModel M;
+  M.n = 30;
+  NoiseStream st;
+  for (Eigen::Index i = 0; i < 30; ++i) st.rows.push_back(29 - i);  // reversed: rows map back
+  st.reflection = st.ar = {0.6};
+  st.marginal_sigma_um = 0.3;
+  st.random_walk_step_um = 0.1;
+  M.streams = {st};
+  M.max_order = 1;
+  M.random_walk_step_um = 0.1;
+  CHECK_FALSE(M.white());
+  // Covariance from the definition, in row order (row r is position 29 - r in the stream).
+  Eigen::MatrixXd S(30, 30);
+  for (int r = 0; r < 30; ++r)
+    for (int c = 0; c < 30; ++c) {
+      const int i = 29 - r, j = 29 - c;
+      S(r, c) = 0.09e-6 * std::pow(0.6, std::abs(i - j)) + 0.01e-6 * std::min(i, j);
+    }
+  Eigen::MatrixXd W = Eigen::MatrixXd::Identity(30, 30);
+  ArWhitener(M).apply(W);  // AR(1) + walk: the Kalman innovations (ArWalkFilter)
+  CHECK((W * S * W.transpose() - Eigen::MatrixXd::Identity(30, 30)).cwiseAbs().maxCoeff() < 1e-8);
+  // In stream order the filter is causal (lower triangular) and its log-determinant is ln|S|.
+  const ArWalkFilter f(30, 0.09e-6, 0.6, 0.01e-6);
+  Eigen::MatrixXd Wf = Eigen::MatrixXd::Identity(30, 30);
+  std::vector<Eigen::Index> rows(30);
+  for (Eigen::Index i = 0; i < 30; ++i) rows[static_cast<std::size_t>(i)] = i;
+  f.apply(rows, Wf);
+  CHECK(Wf.triangularView<Eigen::StrictlyUpper>().toDenseMatrix().cwiseAbs().maxCoeff() == 0.0);
+  Eigen::MatrixXd Sf(30, 30);
+  for (int i = 0; i < 30; ++i)
+    for (int j = 0; j < 30; ++j) Sf(i, j) = 0.09e-6 * std::pow(0.6, std::abs(i - j)) + 0.01e-6 * std::min(i, j);
+  const Eigen::LLT<Eigen::MatrixXd> llt(Sf);
+  CHECK(f.log_det() == Approx(2.0 * Eigen::MatrixXd(llt.matrixL()).diagonal().array().log().sum()).epsilon(1e-10));
+  // AR(2) + walk: the dense Cholesky path.
+  st.reflection = {0.6, -0.3};
+  st.ar = {0.6 * 1.3, -0.3};
+  M.streams = {st};
+  M.max_order = 2;
+  Eigen::MatrixXd S2 = stream_covariance(st);  // in stream order; rows are reversed
+  Eigen::MatrixXd P = Eigen::MatrixXd::Zero(30, 30);
+  for (int i = 0; i < 30; ++i) P(29 - i, i) = 1.0;
+  S2 = P * S2 * P.transpose();
+  Eigen::MatrixXd W2 = Eigen::MatrixXd::Identity(30, 30);
+  ArWhitener(M).apply(W2);
+  CHECK((W2 * S2 * W2.transpose() - Eigen::MatrixXd::Identity(30, 30)).cwiseAbs().maxCoeff() < 1e-8);
+}
+
+namespace {
+// An R-test-like layout: 6 streams of 84 readings; the fit takes a level per stream and five
+// smooth functions of the position shared by all streams (as an R-test's B polynomials, B
+// running outer), which absorb most of a random walk.
+struct RemlCase {
+  std::vector<std::string> groups;
+  std::vector<double> times;
+  Eigen::MatrixXd X;
+};
+RemlCase reml_case() {
+  RemlCase c;
+  const int S = 6, n = 84;
+  c.X = Eigen::MatrixXd::Zero(S * n, S + 5);
+  for (int s = 0; s < S; ++s)
+    for (int i = 0; i < n; ++i) {
+      const int r = s * n + i;
+      c.groups.push_back("nest" + std::to_string(s));
+      c.times.push_back(6.0 * i);
+      c.X(r, s) = 1.0;
+      const double b = (i / 12 - 3) / 3.0;  // B steps every 12 poses, -1..1
+      for (int k = 1; k <= 5; ++k) c.X(r, S + k - 1) = std::pow(b, k);
+    }
+  return c;
+}
+Eigen::VectorXd project_out(const Eigen::MatrixXd& X, const Eigen::VectorXd& e) {
+  return e - X * X.colPivHouseholderQr().solve(e);
+}
+}  // namespace
+
+// Var(x_{t+h} - x_t) of a stream model: 2 (gamma_0 - gamma_h) + q^2 h (um^2).
+double variogram(const NoiseStream& s, std::size_t h) {
+  const std::vector<double> g = ar_autocovariance(s, h + 1);
+  return (2.0 * (g[0] - g[h]) + std::pow(s.random_walk_step_um * 1e-3, 2) * static_cast<double>(h)) * 1e6;
+}
+
+TEST_CASE("REML recovers AR(1) + random walk from what a fit leaves; white stays white", "[noise_model]") {
+  // 84 readings per stream cannot tell a walk from an AR(1) near 1 session by session (the
+  // likelihood has a ridge along rho-lambda), but the covariance they imply can be checked:
+  // the variogram Var(x_{t+h} - x_t), which the parameters' sigmas rest on, at short and long
+  // lags. Truth: rho 0.9, sigma 0.3 um, step 0.1 um: 2 0.09 (1 - 0.9^h) + 0.01 h um^2.
+  const RemlCase c = reml_case();
+  const int K = 12;
+  const std::size_t lags[3] = {1, 10, 40};
+  double reml_v[3] = {0, 0, 0}, burg_v[3] = {0, 0, 0}, white_v40 = 0.0, q_white = 0.0, rho_white = 0.0;
+  for (int k = 0; k < K; ++k) {
+    const Eigen::VectorXd e = noise_gen::ar1(c.groups, c.times, 0.9, 0.3e-3, 100 + k) +
+                              noise_gen::probe_zero_wander(c.groups, c.times, 0.1e-3, 200 + k);
+    const Eigen::VectorXd r = project_out(c.X, e);
+    const NoiseModel burg = estimate_noise_model(c.groups, c.times, r);
+    const NoiseModel M = estimate_noise_model_reml(burg, r, c.X);
+    REQUIRE(M.streams.size() == 6);
+    for (int l = 0; l < 3; ++l)
+      for (int s = 0; s < 6; ++s) {
+        reml_v[l] += variogram(M.streams[static_cast<std::size_t>(s)], lags[l]) / (6 * K);
+        burg_v[l] += variogram(burg.streams[static_cast<std::size_t>(s)], lags[l]) / (6 * K);
+      }
+    // White noise: no walk, no correlation, the variogram flat at 2 sigma^2.
+    std::mt19937_64 rng(300 + k);
+    std::normal_distribution<double> N(0.0, 0.3e-3);
+    Eigen::VectorXd w(c.X.rows());
+    for (Eigen::Index i = 0; i < w.size(); ++i) w[i] = N(rng);
+    const Eigen::VectorXd rw = project_out(c.X, w);
+    const NoiseModel Mw = estimate_noise_model_reml(estimate_noise_model(c.groups, c.times, rw), rw, c.X);
+    q_white += Mw.random_walk_step_um / K, rho_white += Mw.streams[0].ar[0] / K;
+    white_v40 += variogram(Mw.streams[0], 40) / K;
+  }
+  double truth[3];
+  for (int l = 0; l < 3; ++l)
+    truth[l] = 2 * 0.09 * (1 - std::pow(0.9, static_cast<double>(lags[l]))) + 0.01 * static_cast<double>(lags[l]);
+  INFO("variogram at lags 1, 10, 40 (um^2): truth " << truth[0] << ", " << truth[1] << ", " << truth[2]
+       << "; REML " << reml_v[0] << ", " << reml_v[1] << ", " << reml_v[2] << "; Burg on the residuals "
+       << burg_v[0] << ", " << burg_v[1] << ", " << burg_v[2] << "; white: rho " << rho_white << ", walk "
+       << q_white << " um, lag 40 " << white_v40);
+  // Means over 12 sessions x 6 streams: within 25 % (the session-to-session spread is ~40 %).
+  for (int l = 0; l < 3; ++l) CHECK(reml_v[l] == Approx(truth[l]).epsilon(0.25));
+  // What the old estimate missed: the residuals' Burg model sees the long lags far too small.
+  CHECK(burg_v[2] < 0.6 * truth[2]);
+  CHECK(std::abs(rho_white) < 0.05);
+  CHECK(q_white < 0.02);
+  CHECK(white_v40 == Approx(2 * 0.09).epsilon(0.1));
+  CHECK_THROWS_WITH(estimate_noise_model_reml(NoiseModel{}, Eigen::VectorXd::Zero(3), Eigen::MatrixXd::Zero(3, 1)),
+                    Catch::Contains("must agree"));
 }
 
 TEST_CASE("whitened AR and 1/f-like data are white with unit variance", "[noise_model]") {

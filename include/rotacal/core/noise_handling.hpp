@@ -42,6 +42,26 @@ double noise_model_bias_factor(const NoiseModel& model, const std::vector<std::s
                                const NoiseModelOptions& options, int draws = 32,
                                std::uint64_t seed = 1);
 
+/// Restricted maximum likelihood (REML, Patterson & Thompson 1971) of an AR(1) + random-walk
+/// noise model on the streams of `start` (a Burg model of the same residuals: its streams,
+/// rows, sample intervals and phi_1 as the start point). Per stream s (time order, positions
+/// i, j):
+///   V_s = sigma^2 a_s [ rho^|i-j| + lambda min(i, j) ],
+/// rho and lambda (the walk's step variance over the AR marginal one) shared by all streams,
+/// a_s a stream's relative level (geometric mean 1) and sigma^2 profiled out. REML maximises
+/// the likelihood of the residuals' contrasts, i.e. of what the fit leaves, with
+///   -2 l = (n - k) ln(S / (n - k)) + ln|V| + ln|X^T V^-1 X|,  S = min_b |V^-1/2 (y - X b)|^2,
+/// X = `jacobian_free` (rows x free parameters, k its rank): it accounts for the slow noise
+/// that the fitted directions take from the residuals (a probe zero, polynomials of B in an
+/// R-test whose poses run B outer), which a model of the residuals alone misses (Burg on
+/// them sees a walk as a mild AR). (rho, ln lambda) by Nelder-Mead; a_s by the fixed-point
+/// step a_s <- a_s (|e_s|^2 / n_s) / (S / n) on the whitened GLS residuals e, then once more.
+/// Each evaluation whitens by ArWalkFilter (O(n) per column) and takes a QR of the whitened
+/// Jacobian (O(n k^2)).
+/// Throws InvalidArgument if the sizes differ.
+NoiseModel estimate_noise_model_reml(const NoiseModel& start, const Eigen::VectorXd& residuals_mm,
+                                     const Eigen::MatrixXd& jacobian_free);
+
 /// One draw of the noise `model` describes (mm, one value per reading, its rows): per stream
 /// the AR recursion with Gaussian innovations of s_e, started stationary (burn-in of many
 /// correlation times). For Monte Carlo checks and the bias factor.
@@ -56,16 +76,21 @@ double long_run_variance(const NoiseModel& model);
 
 namespace rotacal {
 
+/// The free columns of a fit's Jacobian (measurement units per parameter).
+inline Eigen::MatrixXd free_jacobian(const JointFitOutcome& fit) {
+  std::vector<Eigen::Index> cols;
+  for (std::size_t j = 0; j < fit.free.size(); ++j)
+    if (fit.free[j]) cols.push_back(static_cast<Eigen::Index>(j));
+  Eigen::MatrixXd J(fit.jacobian.rows(), static_cast<Eigen::Index>(cols.size()));
+  for (std::size_t k = 0; k < cols.size(); ++k) J.col(static_cast<Eigen::Index>(k)) = fit.jacobian.col(cols[k]);
+  return J;
+}
+
 /// noise_model_bias_factor with the free columns of a (white) fit's Jacobian.
 inline double noise_correction(const NoiseModel& model, const std::vector<std::string>& groups,
                                const std::vector<double>& times, const JointFitOutcome& white_fit,
                                const NoiseModelOptions& options) {
-  std::vector<Eigen::Index> cols;
-  for (std::size_t j = 0; j < white_fit.free.size(); ++j)
-    if (white_fit.free[j]) cols.push_back(static_cast<Eigen::Index>(j));
-  Eigen::MatrixXd J(white_fit.jacobian.rows(), static_cast<Eigen::Index>(cols.size()));
-  for (std::size_t k = 0; k < cols.size(); ++k) J.col(static_cast<Eigen::Index>(k)) = white_fit.jacobian.col(cols[k]);
-  return noise_model_bias_factor(model, groups, times, J, options);
+  return noise_model_bias_factor(model, groups, times, free_jacobian(white_fit), options);
 }
 
 /// Scale a fit's covariance and 1-sigma figures by `factor` (variance).

@@ -37,6 +37,14 @@ struct NoiseModelOptions {
   /// correlation is structure in some groups (an effect), not the sensor's, and each stream
   /// keeps its own model.
   bool pool_only_if_all_coloured = false;
+  /// The R-test joint fit: when the residuals are correlated, estimate AR(1) + a random walk
+  /// per stream by REML over what the fit leaves (estimate_noise_model_reml in
+  /// core/noise_handling.hpp: probe zeros that wander between poses), instead of Burg's AR(p)
+  /// on the residuals scaled by the bootstrap bias factor. The ballbar fit does not read it.
+  bool reml_random_walk = true;
+  /// Streams longer than this (readings) fall back to Burg + bias factor: each of REML's ~240
+  /// likelihood evaluations takes a QR of the whitened Jacobian (readings x free parameters).
+  int reml_max_stream_size = 2000;
 };
 
 /// The AR model of one stream.
@@ -52,6 +60,11 @@ struct NoiseStream {
   double sample_interval_s = 0.0;    ///< median time between successive readings
   double correlation_time_s = 0.0;   ///< tau * sample interval
   double effective_samples = 0.0;    ///< n / tau (at most n)
+  /// 1 sigma of a random-walk step per reading, um (0: none). The stream's covariance is then
+  /// the AR part's plus q^2 min(i, j) (i, j: positions in the stream): a level that wanders
+  /// from reading to reading, as R-test probe zeros do between poses. The constant part of
+  /// the walk is the stream's mean, which the fits take as a nuisance (a probe zero).
+  double random_walk_step_um = 0.0;
   int order() const { return static_cast<int>(ar.size()); }
 };
 
@@ -65,7 +78,8 @@ struct NoiseModel {
   double correlation_time_s = 0.0;   ///< largest over the streams
   double effective_samples = 0.0;    ///< sum over the streams
   int max_order = 0;                 ///< largest AR order of any stream
-  bool white() const { return max_order == 0; }
+  double random_walk_step_um = 0.0;  ///< largest random-walk step of any stream (0: none)
+  bool white() const { return max_order == 0 && random_walk_step_um == 0.0; }
   /// e.g. "AR(1), rho 0.95, sigma 0.50 um, correlation time 0.39 s, 46 effective samples of 1800".
   std::string summary() const;
 };
@@ -78,9 +92,41 @@ NoiseModel estimate_noise_model(const std::vector<std::string>& groups,
                                 const Eigen::VectorXd& residuals_mm,
                                 const NoiseModelOptions& options = {});
 
+/// Autocovariance gamma_0..gamma_{n-1} (mm^2) of a stream's AR part, from its marginal
+/// variance and reflection coefficients (gamma_m = k_m v_{m-1} + sum_j phi_{m-1,j} gamma_{m-j}
+/// up to the order, then the AR recursion).
+std::vector<double> ar_autocovariance(const NoiseStream& stream, std::size_t n);
+
+/// The covariance (mm^2) of one stream's readings in its time order: AR autocovariance plus
+/// the random walk's q^2 min(i, j).
+Eigen::MatrixXd stream_covariance(const NoiseStream& stream);
+
+/// Whitening of one AR(1) + random-walk stream in O(n): the innovations of the two-state
+/// Kalman filter (a_t = rho a_{t-1} + e_t started stationary with variance `marginal_var`;
+/// w_t = w_{t-1} + eta_t, Var eta = `step_var`, w_0 = 0; reading a_t + w_t, no further noise),
+/// each divided by its sd. The innovations are the readings minus their prediction from the
+/// earlier ones, so this is the inverse Cholesky factor of stream_covariance's matrix
+/// sigma^2 rho^|i-j| + q^2 min(i, j), without forming it.
+class ArWalkFilter {
+ public:
+  ArWalkFilter(std::size_t n, double marginal_var, double rho, double step_var);
+  /// Replace rows `rows[0..n-1]` (the stream's readings in time order) of every column by
+  /// their whitened values.
+  void apply(const std::vector<Eigen::Index>& rows, Eigen::Ref<Eigen::MatrixXd> columns) const;
+  double log_det() const { return log_det_; }  ///< ln |V| = sum_t ln F_t
+  std::size_t size() const { return inv_sd_.size(); }
+
+ private:
+  double rho_;
+  std::vector<double> gain_a_, gain_w_, inv_sd_;
+  double log_det_ = 0.0;
+};
+
 /// Prewhitening by the AR filter of each stream, with its exact start-up rows (the first p
 /// readings are predicted from the orders 0..p-1 of Burg's recursion, so W is the inverse
-/// Cholesky factor of the model's covariance), scaled to unit variance. Columns hold values in
+/// Cholesky factor of the model's covariance), scaled to unit variance. A stream with a random
+/// walk is whitened by ArWalkFilter when its AR order is 0 or 1, else by the inverse Cholesky
+/// factor of its dense covariance (stream_covariance; O(n^3) once). Columns hold values in
 /// units of `residual_unit_mm` (1: mm; pass sigma if the fit's residuals are already divided
 /// by a sigma).
 class ArWhitener : public ResidualWhitener {
@@ -94,6 +140,8 @@ class ArWhitener : public ResidualWhitener {
     std::vector<Eigen::Index> rows;
     std::vector<std::vector<double>> phi;  ///< phi[m]: coefficients of order m = 0..p
     std::vector<double> inv_sd;            ///< 1 / sqrt(v_m) in column units
+    Eigen::MatrixXd chol;                  ///< random walk, AR order >= 2: lower Cholesky factor, column units
+    std::vector<ArWalkFilter> walk;        ///< random walk, AR order 0 or 1 (one filter or none)
   };
   std::vector<Stream> streams_;
   std::size_t n_ = 0;

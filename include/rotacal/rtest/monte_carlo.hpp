@@ -2,9 +2,10 @@
 /// \file
 /// Monte Carlo check of the R-test joint fit's reported 1-sigma: the identified model's
 /// readings (measured - residual, probe zeros included) plus noise drawn from the noise model
-/// fitted to the session (AR per nest and channel, so probe zeros that wander between poses
-/// are re-simulated as such) or white noise of the fit's sigma, each draw refitted the way
-/// the identification was made (under the same whitener when it was a GLS fit).
+/// fitted to the session (AR(1) + random walk per nest and channel by REML, so probe zeros
+/// that wander between poses are re-simulated as such; Burg AR(p) with the REML option off)
+/// or white noise of the fit's sigma, each draw refitted the way the identification was made
+/// (under the same whitener when it was a GLS fit).
 
 #include <cstdint>
 #include <functional>
