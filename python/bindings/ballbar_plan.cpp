@@ -41,20 +41,24 @@ void bind_ballbar_plan(pyb::module_& m) {
   pyb::class_<BallbarSetup>(m, "BallbarSetup",
                             "Layout of the single set-up ballbar test (mm, deg, mm/min, deg/min).")
       .def(pyb::init([](MachineType machine, double ballbar_length, const Eigen::Vector3d& pivot,
-                        std::array<double, 2> tilt_range_deg, std::array<double, 2> rot_range_deg,
+                        std::optional<std::array<double, 2>> tilt_range_deg, std::array<double, 2> rot_range_deg,
                         double step_deg, double feed_mm_per_min, double feed_deg_per_min,
-                        std::vector<BallbarTest> tests, RadialSide radial_c_side) {
+                        std::vector<BallbarTest> tests, RadialSide radial_c_side,
+                        std::optional<double> axial_c_tilt_deg) {
              return BallbarSetup{machine,         ballbar_length,   pivot,
-                                 tilt_range_deg,  rot_range_deg,    step_deg,
+                                 tilt_range_deg.value_or(default_tilt_range_deg(machine)),
+                                 rot_range_deg,   step_deg,
                                  feed_mm_per_min, feed_deg_per_min, std::move(tests),
-                                 radial_c_side};
+                                 radial_c_side,   axial_c_tilt_deg};
            }),
            pyb::arg("machine") = d.machine, pyb::arg("ballbar_length") = d.ballbar_length,
-           pyb::arg("pivot") = d.pivot, pyb::arg("tilt_range_deg") = d.tilt_range_deg,
+           pyb::arg("pivot") = d.pivot, pyb::arg("tilt_range_deg") = pyb::none(),
            pyb::arg("rot_range_deg") = d.rot_range_deg, pyb::arg("step_deg") = d.step_deg,
            pyb::arg("feed_mm_per_min") = d.feed_mm_per_min,
            pyb::arg("feed_deg_per_min") = d.feed_deg_per_min, pyb::arg("tests") = d.tests,
-           pyb::arg("radial_c_side") = d.radial_c_side)
+           pyb::arg("radial_c_side") = d.radial_c_side, pyb::arg("axial_c_tilt_deg") = pyb::none(),
+           "tilt_range_deg None: default_tilt_range_deg(machine); axial_c_tilt_deg None: "
+           "default_axial_c_tilt_deg(machine).")
       .def_readwrite("machine", &BallbarSetup::machine)
       .def_readwrite("ballbar_length", &BallbarSetup::ballbar_length, "L0, mm")
       .def_readwrite("pivot", &BallbarSetup::pivot, "nominal pivot ball centre, table frame, mm")
@@ -65,7 +69,11 @@ void bind_ballbar_plan(pyb::module_& m) {
       .def_readwrite("feed_mm_per_min", &BallbarSetup::feed_mm_per_min)
       .def_readwrite("feed_deg_per_min", &BallbarSetup::feed_deg_per_min)
       .def_readwrite("tests", &BallbarSetup::tests)
-      .def_readwrite("radial_c_side", &BallbarSetup::radial_c_side);
+      .def_readwrite("radial_c_side", &BallbarSetup::radial_c_side)
+      .def_readwrite("axial_c_tilt_deg", &BallbarSetup::axial_c_tilt_deg,
+                     "tilt held during axial_c, deg; None: default_axial_c_tilt_deg(machine)");
+  m.def("default_tilt_range_deg", &default_tilt_range_deg, pyb::arg("machine"));
+  m.def("default_axial_c_tilt_deg", &default_axial_c_tilt_deg, pyb::arg("machine"));
 
   pyb::class_<TransitionArc>(m, "TransitionArc",
                              "Great-circle arc about the pivot at rotary zero (mm, rad).")

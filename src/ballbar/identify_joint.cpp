@@ -46,6 +46,39 @@ BallbarIdentification identify_joint(const BallbarSession& session, const JointF
   return identify_joint(ballbar_arrays(session, options.tests), options);
 }
 
+namespace {
+
+// The set-up change that would show what this plan cannot see (issue 13: observability per
+// machine), from the names in the unobservable combinations.
+std::vector<std::string> setup_advice(MachineType m, const std::vector<std::string>& unobservable) {
+  std::vector<std::string> out;
+  auto mentions = [&](const std::string& name) {
+    for (const std::string& u : unobservable)
+      if (u.find(name) != std::string::npos) return true;
+    return false;
+  };
+  if (mentions("tool_offset_Z"))
+    out.push_back("pivot_length + tool_length is seen together with the head axis' position along the "
+                  "spindle: a second tool length (a second ball position along the spindle) in the "
+                  "head tests separates them");
+  const auto& names = location_error_names(m);
+  for (int k = 0; k < 2; ++k) {
+    const RotaryAxis& a = m.description().axis(k);
+    const bool pos = mentions(names[4 * k]) || mentions(names[4 * k + 1]);
+    const bool tilt = mentions(names[4 * k + 2]) || mentions(names[4 * k + 3]);
+    if (pos && tilt)
+      out.push_back(std::string("the position and the tilt of ") + a.name +
+                    " are seen as one combination at the ball's height: a test of " + a.name +
+                    (a.on_head ? " with the ball at a second height (another tool length, or the tilt axis turned: "
+                                 "axial_c_tilt_deg)"
+                               : " with the pivot at a second height") +
+                    " separates them");
+  }
+  return out;
+}
+
+}  // namespace
+
 BallbarIdentification identify_joint(const BallbarArrays& data, const JointFitOptions& options) {
   BallbarFitSetup setup = ballbar_fit_setup(data, options);
   const EffectModel& fx = setup.effects;
@@ -96,6 +129,7 @@ BallbarIdentification identify_joint(const BallbarArrays& data, const JointFitOp
   for (bool f : fit.free) out.fixed.push_back(!f);
   out.parameters = std::move(fit.estimates);
   out.unobservable = std::move(fit.unobservable);
+  for (std::string& advice : setup_advice(data.machine, out.unobservable)) out.notes.push_back(std::move(advice));
   out.summary = fit.summary;
   out.noise = std::move(noise);
   out.noise_refit = refit;

@@ -1,6 +1,7 @@
 // The ballbar joint fit's residual model and set-up, shared by identify_joint and monte_carlo.
 #pragma once
 
+#include <algorithm>
 #include <type_traits>
 
 #include "rotacal/ballbar/identify.hpp"
@@ -64,6 +65,13 @@ inline BallbarFitSetup ballbar_fit_setup(const BallbarArrays& data, const JointF
   fx = options.effects;
   if (options.fit_length_offset)
     fx.effects.insert(fx.effects.begin(), Effect::parse("ballbar_length_offset"));
+  // On a machine with head axes the ball's distance from the controlled point,
+  // pivot_length + tool_length, is a location parameter of the head (formats.md): its error
+  // is fitted as tool_offset_Z, which there acts along the spindle (kinematics/effects.hpp).
+  const Effect tool_z = Effect::parse("tool_offset_Z");
+  if (data.machine.has_head() &&
+      std::find(fx.effects.begin(), fx.effects.end(), tool_z) == fx.effects.end())
+    fx.effects.insert(fx.effects.begin(), tool_z);
   for (const Effect& f : fx.effects)
     if (!f.applies_to(data.machine))
       throw InvalidArgument("effect " + f.id() + " does not exist on a " + to_string(data.machine));

@@ -49,7 +49,9 @@ bool same_pose(const Commanded& a, const PlannedSample& b) {
 class Writer {
  public:
   Writer(const BallbarPlan& plan, NcDialect d, const NcProgramOptions& o)
-      : plan_(plan), d_(d), o_(o), tilt_(1, tilt_axis_letter(plan.setup.machine)) {}
+      : plan_(plan), d_(d), o_(o), tilt_(1, tilt_axis_letter(plan.setup.machine)),
+        rot_(1, rot_axis_letter(plan.setup.machine)),
+        zero_shift_(-tool_vector<double>(plan.setup.machine, 0.0)) {}
 
   std::string run() {
     prologue();
@@ -147,7 +149,7 @@ class Writer {
 
   std::string axes_words(const Eigen::Vector3d& p, double tilt, double rot) const {
     return "X" + num(p.x()) + " Y" + num(p.y()) + " Z" + num(p.z()) + " " + tilt_ + num(tilt) +
-           " C" + num(rot);
+           " " + rot_ + num(rot);
   }
 
   void linear_block(const PlannedSample& s, double dt) {
@@ -169,19 +171,18 @@ class Writer {
     const char* names = "XYZ";
     const char* centre_names = "IJK";
     // At rotary zero machine and table frames coincide (rotations by 0 for any errors), so the
-    // planned arc is the machine-axis arc.
-    ROTACAL_ASSERT((cur.xyz - a.start).norm() < kSamePose && cur.tilt == 0.0 && cur.rot == 0.0);
-    const Eigen::Vector3d& e = a.end;
+    // planned arc, shifted by the tool vector on a head machine, is the machine-axis arc.
+    ROTACAL_ASSERT((cur.xyz - (a.start + zero_shift_)).norm() < kSamePose && cur.tilt == 0.0 && cur.rot == 0.0);
+    const Eigen::Vector3d e = a.end + zero_shift_, centre = a.center + zero_shift_;
     const double dt = t_end - cur.time;
     require_positive_time(dt, t_end);
     if (d_ == NcDialect::heidenhain) {
-      line("CC " + std::string(1, names[lo]) + num(a.center[lo]) + " " + names[hi] +
-           num(a.center[hi]));
+      line("CC " + std::string(1, names[lo]) + num(centre[lo]) + " " + names[hi] + num(centre[hi]));
       line("C " + std::string(1, names[lo]) + num(e[lo]) + " " + names[hi] + num(e[hi]) +
            (positive ? " DR+ " : " DR- ") + feed_word(dt));
     } else {
       static const char* planes[] = {"G19", "G18", "G17"};
-      const Eigen::Vector3d off = a.center - cur.xyz;  // I J K: centre relative to the start
+      const Eigen::Vector3d off = centre - cur.xyz;  // I J K: centre relative to the start
       line(std::string(planes[n]) + (positive ? " G3 " : " G2 ") + names[lo] + num(e[lo]) + " " +
            names[hi] + num(e[hi]) + " " + centre_names[lo] + num(off[lo]) + " " + centre_names[hi] +
            num(off[hi]) + " " + feed_word(dt));
@@ -303,7 +304,7 @@ class Writer {
   // Rapid to the first point, TCPM off, rotary axes first: no ballbar is mounted yet.
   void approach(const PlannedSample& s) {
     comment("approach: rotary axes, then linear axes, to the first point");
-    const std::string rot = tilt_ + num(s.tilt_deg) + " C" + num(s.rot_deg);
+    const std::string rot = tilt_ + num(s.tilt_deg) + " " + rot_ + num(s.rot_deg);
     const std::string lin = "X" + num(s.xyz.x()) + " Y" + num(s.xyz.y()) + " Z" + num(s.xyz.z());
     if (d_ == NcDialect::heidenhain) {
       line("L " + rot + " R0 FMAX");
@@ -363,7 +364,11 @@ class Writer {
   const BallbarPlan& plan_;
   NcDialect d_;
   NcProgramOptions o_;
-  std::string tilt_;
+  std::string tilt_, rot_;
+  // Machine axes minus table-frame ball at all rotary axes 0: zero on a table-table machine,
+  // minus the tool vector on a machine with head axes (rotations by 0 are the identity for
+  // any location errors).
+  Eigen::Vector3d zero_shift_;
   bool tcp_on_ = false;
   std::vector<std::string> lines_;
 };

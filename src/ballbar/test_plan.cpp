@@ -84,6 +84,22 @@ void validate(const BallbarSetup& s) {
   require(s.tilt_range_deg[0] >= -180.0 && s.tilt_range_deg[1] <= 180.0,
           "tilt_range_deg (--a-range/--b-range) must lie within [-180, 180] deg");
   check_range(s.rot_range_deg, "rot_range_deg (--c-range)", s.step_deg);
+  if (s.axial_c_tilt_deg)
+    require(std::isfinite(*s.axial_c_tilt_deg) && std::abs(*s.axial_c_tilt_deg) <= 180.0,
+            "axial_c_tilt_deg must lie within [-180, 180] deg");
+  // The machine's rotary limits (formats.md limits_deg) bound every angle the plan commands.
+  const MachineDescription& d = s.machine.description();
+  auto within = [&](int k, double lo, double hi, const std::string& what) {
+    const auto& lim = d.axis(k).limits_deg;
+    if (lim)
+      require(lo >= (*lim)[0] - kAngleTol && hi <= (*lim)[1] + kAngleTol,
+              what + " reaches " + std::string(1, d.axis(k).name) + " beyond its limits [" +
+                  format_number_or_nan((*lim)[0]) + ", " + format_number_or_nan((*lim)[1]) + "] deg");
+  };
+  within(s.machine.tilt_index(), std::min(0.0, s.tilt_range_deg[0]), std::max(0.0, s.tilt_range_deg[1]),
+         "tilt_range_deg (--a-range/--b-range) with the tests at tilt 0");
+  within(s.machine.rot_index(), std::min(0.0, s.rot_range_deg[0]), std::max(0.0, s.rot_range_deg[1]),
+         "rot_range_deg (--c-range) with the tests at 0");
   require(!s.tests.empty(), "tests is empty");
   for (std::size_t i = 0; i < s.tests.size(); ++i)
     for (std::size_t j = 0; j < i; ++j)
@@ -91,36 +107,43 @@ void validate(const BallbarSetup& s) {
               "test " + test_label(s.tests[i], s.machine) + " is listed twice");
 }
 
-// Unit vector from an axis through the origin with direction `axis` to the pivot, in the
-// plane normal to the axis. Throws if the pivot lies on the axis (no radial direction).
-Eigen::Vector3d radial_direction(const Eigen::Vector3d& pivot, const Eigen::Vector3d& axis,
+// Unit vector from the nominal line of a table axis to the pivot, in the plane normal to the
+// axis. Throws if the pivot lies on the axis (no radial direction).
+Eigen::Vector3d radial_direction(const Eigen::Vector3d& pivot, const RotaryAxis& axis,
                                  const std::string& test) {
-  const Eigen::Vector3d r = pivot - axis * axis.dot(pivot);
+  const Eigen::Vector3d d = pivot - axis.point;
+  const Eigen::Vector3d r = d - axis.direction * axis.direction.dot(d);
   require(r.norm() > 1e-6, test + " needs the pivot off the axis it turns about (pivot is " +
                                std::to_string(r.norm()) + " mm from it)");
   return r.normalized();
 }
 
-Eigen::Vector3d tilt_axis_direction(MachineType m) {
-  return m == MachineType::AC_trt ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+// A head axis moves the tool, not the pivot: the ball stays put on the table while the head
+// turns (TCPM), so any bar direction normal to the axis is radial. The horizontal one
+// normal to the axis (X for a vertical axis) keeps the tool cup's angles small.
+Eigen::Vector3d head_radial_direction(const RotaryAxis& axis) {
+  const Eigen::Vector3d h = axis.direction.cross(Eigen::Vector3d::UnitZ());
+  return h.norm() > 1e-9 ? Eigen::Vector3d(h.normalized()) : Eigen::Vector3d::UnitX();
 }
 
-// The table-frame tool point of a test that keeps the tool fixed on the table.
+// The table-frame tool point of a test that keeps the tool fixed on the table: the bar normal
+// to the axis under test (radial) or along it (axial), as Flynn et al. Secs. 3.2-3.3 lay it
+// out for the table axes.
 Eigen::Vector3d fixed_tool_point(const BallbarSetup& s, BallbarTest t) {
   const Eigen::Vector3d& p = s.pivot;
   const double L = s.ballbar_length;
   const std::string label = test_label(t, s.machine);
+  const MachineDescription& d = s.machine.description();
+  const bool tilt_test = t == BallbarTest::radial_tilt || t == BallbarTest::axial_tilt;
+  const RotaryAxis& axis = d.axis(tilt_test ? s.machine.tilt_index() : s.machine.rot_index());
+  const double sign = !tilt_test && s.radial_c_side == RadialSide::inside ? -1.0 : 1.0;
   switch (t) {
     case BallbarTest::radial_tilt:
-      return p + L * radial_direction(p, tilt_axis_direction(s.machine), label);
+    case BallbarTest::radial_c:
+      return p + sign * L * (axis.on_head ? head_radial_direction(axis) : radial_direction(p, axis, label));
     case BallbarTest::axial_tilt:
-      return p + L * tilt_axis_direction(s.machine);
-    case BallbarTest::radial_c: {
-      const double sign = s.radial_c_side == RadialSide::outside ? 1.0 : -1.0;
-      return p + sign * L * radial_direction(p, Eigen::Vector3d::UnitZ(), label);
-    }
     case BallbarTest::axial_c:
-      return p + L * Eigen::Vector3d::UnitZ();
+      return p + L * axis.direction;
     default:
       break;
   }
@@ -169,8 +192,9 @@ PlanSegment make_test(const BallbarSetup& s, BallbarTest t) {
     case BallbarTest::radial_c:
     case BallbarTest::axial_c: {
       const Eigen::Vector3d q = fixed_tool_point(s, t);
+      const double tilt = t == BallbarTest::axial_c ? s.axial_c_tilt_deg.value_or(default_axial_c_tilt_deg(s.machine)) : 0.0;
       for (double a : sweep(s.rot_range_deg[0], s.rot_range_deg[1], s.step_deg))
-        seg.samples.push_back(make_sample(q, 0.0, a));
+        seg.samples.push_back(make_sample(q, tilt, a));
       break;
     }
   }
@@ -306,9 +330,9 @@ std::string test_label(BallbarTest test, MachineType machine) {
     case BallbarTest::axial_tilt:
       return "axial_" + tilt;
     case BallbarTest::radial_c:
-      return "radial_C";
+      return "radial_" + std::string(1, rot_axis_letter(machine));
     case BallbarTest::axial_c:
-      return "axial_C";
+      return "axial_" + std::string(1, rot_axis_letter(machine));
   }
   ROTACAL_ASSERT(false);
   return {};
@@ -332,6 +356,19 @@ std::vector<BallbarTest> default_ballbar_tests() {
   return {BallbarTest::sphere_xy,   BallbarTest::sphere_yz, BallbarTest::sphere_zx,
           BallbarTest::radial_tilt, BallbarTest::axial_c,   BallbarTest::radial_c,
           BallbarTest::axial_tilt};
+}
+
+std::array<double, 2> default_tilt_range_deg(MachineType machine) {
+  std::array<double, 2> r = {-90.0, 90.0};
+  if (const auto& lim = machine.description().axis(machine.tilt_index()).limits_deg) {
+    r[0] = std::max(r[0], (*lim)[0]);
+    r[1] = std::min(r[1], (*lim)[1]);
+  }
+  return r;
+}
+
+double default_axial_c_tilt_deg(MachineType machine) {
+  return machine.description().head_axes.size() == 2 ? 45.0 : 0.0;
 }
 
 std::string to_string(RadialSide side) {

@@ -71,7 +71,19 @@ struct BallbarSetup {
   double feed_deg_per_min = 3600.0;  ///< rotary axes, deg/min
   std::vector<BallbarTest> tests = default_ballbar_tests();  ///< tests to run, in this order
   RadialSide radial_c_side = RadialSide::outside;            ///< Flynn's '±' of radial C
+  /// Tilt angle (deg) held during axial_c. Unset: 0, except on a head-head machine, where the
+  /// ball sits on the rotary (C) head axis at tilt 0 and its position and tilt errors are seen
+  /// only as one combination per ball height; 45 deg takes the ball off the axis, where the
+  /// axial bar reads the C tilt alone (default_axial_c_tilt_deg).
+  std::optional<double> axial_c_tilt_deg;
 };
+
+/// The default tilt sweep of a machine: -90..90 deg, within the tilt axis' limits (0..90 on
+/// the nutating B45C-trt, whose B turns 0..180).
+std::array<double, 2> default_tilt_range_deg(MachineType machine);
+
+/// The tilt held during axial_c when BallbarSetup::axial_c_tilt_deg is unset.
+double default_axial_c_tilt_deg(MachineType machine);
 
 /// One commanded point of the toolpath.
 struct PlannedSample {

@@ -20,11 +20,10 @@ namespace rotacal {
 struct MachineModel {
   MachineType machine = MachineType::AC_trt;
   LocationErrors<double> errors;       ///< mm / rad, location_error_names(machine) order
+  /// On a machine with head axes, tool_offset_Z among the effects is minus the error of
+  /// pivot_length + tool_length (only their sum is visible to a ball-ended instrument).
   EffectModel effects;
   std::vector<double> effect_params;   ///< effects.num_params() values, EffectModel layout
-  /// Error of pivot_length + tool_length (mm) of a machine with head axes: only their sum is
-  /// visible to a ball-ended instrument (formats.md). Zero and unused without head axes.
-  double tool_length_error = 0.0;
 
   /// A machine of this kinematics without location errors or effects.
   static MachineModel nominal(MachineType m) {

@@ -45,8 +45,7 @@ Vec3<Scalar> rtest_reading(MachineType m, const LocationErrors<Scalar>& e, const
 inline Eigen::Vector3d rtest_reading(const MachineModel& model, const Eigen::Vector3d& q_nest,
                                      const RotaryAngles<double>& angles, double t) {
   return rtest_reading<double>(model.machine, model.errors, model.effects, model.effect_data(),
-                               rtest_commanded_xyz(model.machine, q_nest, angles), angles, t, q_nest,
-                               model.tool_length_error);
+                               rtest_commanded_xyz(model.machine, q_nest, angles), angles, t, q_nest);
 }
 
 }  // namespace rotacal
