@@ -133,17 +133,21 @@ def check_outputs(outputs: Sequence[str | None], inputs: Sequence[str | None] = 
 def _add_setup_args(p: argparse.ArgumentParser) -> None:
     d = _core.BallbarSetup()  # the C++ defaults (ballbar/plan.hpp), shown in the help
     g = p.add_argument_group("test set-up (Flynn et al. 2016, Table 1)")
-    g.add_argument("--machine", help=f"AC-trt or BC-trt (default {_core.machine_name(d.machine)})")
+    g.add_argument("--machine", metavar="NAME|FILE",
+                   help=f"a built-in machine ({', '.join(_core.builtin_machine_names())}; rotacal machines) or a "
+                        f"rotacal-machine/1 JSON file (docs/machines.md); default {_core.machine_name(d.machine)}")
     g.add_argument("--length", type=number("--length", 1.0, 2000.0, "mm"),
                    help=f"calibrated ballbar length L0, mm (default {d.ballbar_length:g})")
     g.add_argument("--pivot", type=numbers("--pivot", 3, 1e4, "mm"),
                    help="nominal pivot x,y,z on the table, mm (O_x, 0, O_z; default "
                         f"{','.join(f'{v:g}' for v in d.pivot)})")
-    g.add_argument("--a-range", "--b-range", dest="tilt_range", type=numbers("--a-range/--b-range", 2, 360.0, "deg"),
-                   help="tilt axis range, deg (A for AC-trt, B for BC-trt; default "
-                        f"{','.join(f'{v:g}' for v in d.tilt_range_deg)})")
+    g.add_argument("--a-range", "--b-range", "--tilt-range", dest="tilt_range",
+                   type=numbers("--a-range/--b-range", 2, 360.0, "deg"),
+                   help="range of the tilt axis (A or B, on the table or in the head), deg (default: the "
+                        "machine's, rotacal machines show NAME; "
+                        f"{','.join(f'{v:g}' for v in _core.default_tilt_range_deg(d.machine))} on AC-trt)")
     g.add_argument("--c-range", default=CLI_C_RANGE, type=numbers("--c-range", 2, 720.0, "deg"),
-                   help=f"C range, deg (default {CLI_C_RANGE})")
+                   help=f"range of the rotary axis C, deg (default {CLI_C_RANGE})")
     g.add_argument("--step", type=number("--step", 0.01, 90.0, "deg", lo_open=False),
                    help=f"sample spacing, deg (default {d.step_deg:g})")
     g.add_argument("--feed", type=number("--feed", 1.0, 1e5, "mm/min"),
@@ -155,10 +159,10 @@ def _add_setup_args(p: argparse.ArgumentParser) -> None:
 
 
 def _setup(a: argparse.Namespace) -> Any:
-    """The C++ BallbarSetup with the options given laid over its defaults."""
-    s = _core.BallbarSetup()
-    if a.machine is not None:
-        s.machine = _core.parse_machine_type(a.machine)
+    """The C++ BallbarSetup with the options given laid over its defaults; the machine's own
+    defaults (default_tilt_range_deg, default_axial_c_tilt_deg) for what is not given."""
+    from .machines import load_machine
+    s = _core.BallbarSetup() if a.machine is None else _core.BallbarSetup(load_machine(a.machine))
     for option, field in (("length", "ballbar_length"), ("step", "step_deg"), ("feed", "feed_mm_per_min"),
                           ("rotary_feed", "feed_deg_per_min"), ("pivot", "pivot"), ("tilt_range", "tilt_range_deg"),
                           ("c_range", "rot_range_deg")):
@@ -189,6 +193,41 @@ def cmd_plan(a: argparse.Namespace) -> int:
     if a.session:
         save(plan.commanded_session(), a.session, [a.compensate], [a.output])
         _say(f"wrote {a.session}: the commanded rows as a session template")
+    return EXIT_OK
+
+
+# ------------------------------------------------------------------------- machines
+
+def cmd_machines(a: argparse.Namespace) -> int:
+    """List the built-in machines, or show one (built-in or file): drawing, error names, JSON."""
+    from .machines import load_machine, machine_dict, machine_drawing
+    if a.action == "list":
+        if a.machine is not None:
+            raise OptionError(f"machines: 'list' takes no machine (got {a.machine[:60]!r}); "
+                              "rotacal machines show NAME|FILE")
+        rows = [machine_dict(n) for n in _core.builtin_machine_names()]
+        if a.json:
+            print(jsontext.dumps([{k: r[k] for k in ("name", "configuration", "axis_names", "tilt_axis", "rot_axis",
+                                                     "axes", "location_error_names")} for r in rows]))
+            return EXIT_OK
+        print(f"{len(rows)} built-in machines (any other: a rotacal-machine/1 file, docs/machines.md):")
+        for r in rows:
+            sides = ", ".join(f"{ax['name']} {ax['side']}" for ax in r["axes"])
+            print(f"  {r['name']:16s} {r['configuration']:12s} axes {''.join(r['axis_names'])} ({sides})")
+        return EXIT_OK
+    if a.machine is None:
+        raise OptionError("machines show: give a built-in name or a rotacal-machine/1 file")
+    d = machine_dict(a.machine)
+    if a.json:
+        print(jsontext.dumps(d))
+        return EXIT_OK
+    print(machine_drawing(a.machine), end="")
+    print()
+    print(f"location errors (LocationErrors order): {' '.join(d['location_error_names'])}")
+    print(f"default test ranges: tilt {d['default_tilt_range_deg'][0]:g} .. {d['default_tilt_range_deg'][1]:g} deg, "
+          f"tilt held during axial_{d['rot_axis']} {d['default_axial_c_tilt_deg']:g} deg")
+    print("description (rotacal-machine/1, as a session's '# machine_description:' carries it):")
+    print(load_machine(a.machine).description_json)
     return EXIT_OK
 
 
@@ -328,8 +367,16 @@ def _print_identification(d: dict) -> None:
         print(line)
     for axis, p in d.get("pivot", {}).items():
         print(f"  pivot {axis}  " + ("unobservable" if p["value"] is None else f"{p['value']:.4f} mm +- {p['std'] * 1e3:.3f} um"))
+    for eff in d.get("effects", []):
+        for pname, p in eff["params"].items():
+            what = f"{eff['id']} ({eff['cause']})"
+            print(f"  {what}: " + ("unobservable" if p["value"] is None
+                                   else f"{pname} = {_fmt_value(p['value'], p['unit']).strip()} +- "
+                                        f"{p['std'] * (1e6 if p['unit'] == 'rad' else 1e3):.3f}"))
     for u in d["unobservable"]:
         print(f"  not determined by these tests: {u}")
+    for n in d.get("notes", []):
+        print(f"  note: {n}")
     if "noise_model" in d:
         _print_noise_model(d["noise_model"])
     if budget:
@@ -914,6 +961,14 @@ def build_parser() -> argparse.ArgumentParser:
                    help="also write the commanded rows as a session template")
     q.add_argument("-o", "--output", required=True, type=path("--output"))
     q.set_defaults(func=cmd_plan)
+
+    q = sub.add_parser("machines", help="the built-in machines; show one (or a rotacal-machine/1 file) as text",
+                       epilog=EPILOG + "; docs/machines.md")
+    q.add_argument("action", nargs="?", choices=["list", "show"], default="list",
+                   help="list (default): the built-ins; show NAME|FILE: drawing, location errors, description")
+    q.add_argument("machine", nargs="?", metavar="NAME|FILE")
+    q.add_argument("--json", action="store_true")
+    q.set_defaults(func=cmd_machines)
 
     q = sub.add_parser("simulate", help="simulate a measurement on a machine with errors", epilog=EPILOG)
     kinds = q.add_subparsers(dest="kind", required=True, metavar="{ballbar,rtest}")

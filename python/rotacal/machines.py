@@ -1,6 +1,10 @@
-"""Simulated machines: the paper's Table 2 machine, random location errors, effects, and the truth a simulation runs on."""
+"""Machines: loading one by built-in name or from a rotacal-machine/1 file, drawing it as text;
+simulated machines: the paper's Table 2 machine, random location errors, effects, and the truth
+a simulation runs on."""
 from __future__ import annotations
 
+import json
+import os
 from typing import Any, Mapping, Sequence, Union
 
 import numpy as np
@@ -10,6 +14,141 @@ from . import _core
 # Flynn et al. 2016, Table 2, uncompensated: the AC-trt machine of the paper's experiment (mm, rad).
 TABLE2_ERRORS = {"E_Y0A": 0.0726, "E_Z0A": -0.0202, "E_B0A": 1.1284e-05, "E_C0A": -0.000113006,
                  "E_X0C": 0.0283, "E_Y0C": 0.1041, "E_A0C": 5.1954e-06, "E_B0C": -4.1544e-05}
+
+# A machine description is a few hundred bytes; a larger file is not one (and is not read whole).
+MAX_DESCRIPTION_BYTES = 1 << 20
+
+
+def _looks_like_path(text: str) -> bool:
+    return os.path.exists(text) or text.lower().endswith(".json") or os.sep in text or "/" in text
+
+
+def load_machine(machine: Any) -> _core.MachineType:
+    """The machine ``machine`` names: a MachineType (returned as is), a built-in name
+    (``_core.builtin_machine_names()``: 'AC-trt', 'B-head-C-table', ...) or the path of a
+    rotacal-machine/1 JSON file (shared/spec/formats.md, "Any 5-axis machine"; docs/machines.md).
+
+    Raises InvalidArgument for an unknown name (the message lists the built-ins) or a
+    description that breaks the spec (the message names the file and the field), IoError for a
+    file that cannot be read. A built-in name wins over a file of the same name in the working
+    folder; write ./AC-trt to read such a file."""
+    if isinstance(machine, _core.MachineType):
+        return machine
+    if isinstance(machine, os.PathLike):
+        machine = os.fspath(machine)
+    if not isinstance(machine, str):
+        raise _core.InvalidArgument(f"machine: a built-in name or a file path, got {type(machine).__name__}")
+    if machine in _core.builtin_machine_names():
+        return _core.parse_machine_type(machine)
+    if not _looks_like_path(machine):
+        _core.parse_machine_type(machine)  # raises: unknown machine, the built-ins named
+    from .sessions import checked_path
+    path = checked_path(machine, "machine description")
+    if os.path.isdir(path):
+        raise _core.IoError(f"{path}: is a directory, not a machine description file")
+    try:
+        with open(path, "rb") as f:
+            data = f.read(MAX_DESCRIPTION_BYTES + 1)
+    except OSError as e:
+        raise _core.IoError(f"{path}: cannot read the machine description: {e.strerror}") from None
+    if len(data) > MAX_DESCRIPTION_BYTES:
+        raise _core.InvalidArgument(f"{path}: larger than {MAX_DESCRIPTION_BYTES} bytes, not a machine description")
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise _core.InvalidArgument(f"{path}: not UTF-8 text (byte {e.start + 1})") from None
+    return _core.MachineType.from_description(text, path)
+
+
+def machine_dict(machine: Any) -> dict:
+    """What ``rotacal machines show --json`` prints: names, configuration, the location error
+    names of each axis, the planner's defaults and the description itself."""
+    m = load_machine(machine)
+    desc = json.loads(m.description_json)
+    names = list(_core.location_error_names(m))
+    axes = []
+    for k, (side, ax) in enumerate(_chain_axes(desc)):
+        axes.append({"name": ax["name"], "side": side, "role": "rotary" if ax["name"] == m.rot_axis else "tilt",
+                     "location_errors": names[4 * k:4 * k + 4]})
+    return {"name": m.name, "configuration": m.configuration, "builtin": m.is_builtin,
+            "axis_names": list(m.axis_names), "tilt_axis": m.tilt_axis, "rot_axis": m.rot_axis,
+            "has_head": m.has_head, "axes": axes, "location_error_names": names,
+            "default_tilt_range_deg": list(_core.default_tilt_range_deg(m)),
+            "default_axial_c_tilt_deg": _core.default_axial_c_tilt_deg(m), "description": desc}
+
+
+def _chain_axes(desc: Mapping) -> list[tuple[str, dict]]:
+    """(side, axis) in chain order: table axes from the bed outwards, then head axes."""
+    return [("table", a) for a in desc["table_axes"]] + [("head", a) for a in desc["head_axes"]]
+
+
+def _vec(v: Sequence[float]) -> str:
+    return "(" + ", ".join(f"{x:.4g}" if abs(x) > 1e-12 else "0" for x in v) + ")"
+
+
+def _uv(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The u, v of a nutating axis (formats.md): e the first of +X, +Y, +Z with |e.n| <= 0.5,
+    u = unit(e x n), v = n x u."""
+    n = n / np.linalg.norm(n)
+    e = next(e for e in np.eye(3) if abs(e @ n) <= 0.5)
+    u = np.cross(e, n)
+    u /= np.linalg.norm(u)
+    return u, np.cross(n, u)
+
+
+def machine_drawing(machine: Any) -> str:
+    """The machine as text: its chain from the tool to the workpiece, each rotary axis with its
+    side, role, direction, point, limits and location error names (formats.md)."""
+    m = load_machine(machine)
+    d = json.loads(m.description_json)
+    names = list(_core.location_error_names(m))
+    chain = _chain_axes(d)
+    out = [f"{m.name}: {m.configuration}, rotary axes {', '.join(m.axis_names)} in chain order; "
+           f"tilt axis {m.tilt_axis}, rotary axis {m.rot_axis}", ""]
+
+    def axis_block(k: int, side: str, ax: dict, carries: str) -> list[str]:
+        n = np.asarray(ax["direction"], float)
+        frame = "relative to the controlled point" if side == "head" else "machine frame"
+        lim = ax.get("limits_deg")
+        e = names[4 * k:4 * k + 4]
+        role = "rotary" if ax["name"] == m.rot_axis else "tilt"
+        lines = [f"  [{ax['name']}]  {side} axis {'T' if side == 'table' else 'H'}"
+                 f"{1 + sum(1 for s, _ in chain[:k] if s == side)} ({role}), carries {carries}",
+                 f"   |    direction {_vec(n)}, through {_vec(ax.get('point', [0, 0, 0]))} mm ({frame}), "
+                 + (f"limits {lim[0]:g} .. {lim[1]:g} deg" if lim else "endless"),
+                 f"   |    location errors: {e[0]}, {e[1]} (line position, mm); {e[2]}, {e[3]} (direction, rad)"]
+        if e[0].startswith("E_U0"):
+            u, v = _uv(n)
+            lines.append(f"   |    nutating: u = {_vec(u)}, v = {_vec(v)}")
+        return lines
+
+    heads = [(k, a) for k, (s, a) in enumerate(chain) if s == "head"]
+    tables = [(k, a) for k, (s, a) in enumerate(chain) if s == "table"]
+    L = d["pivot_length"] + d["tool_length"]
+    if heads:
+        out.append(f"  (o)  tool ball: t = (0, 0, {-L:g}) mm from the controlled point "
+                   f"(pivot_length {d['pivot_length']:g} + tool_length {d['tool_length']:g})")
+        out.append("   |")
+        for i, (k, a) in reversed(list(enumerate(heads))):
+            carries = "the spindle" if i == len(heads) - 1 else f"head axis {heads[i + 1][1]['name']}"
+            out += axis_block(k, "head", a, carries) + ["   |"]
+    else:
+        out.append("  (o)  tool ball = the controlled point (no head axes)")
+        out.append("   |")
+    travel = d.get("travel_mm")
+    out.append("  XYZ  linear axes: the controlled point (the X, Y, Z of sessions and programs)"
+               + ("; travel " + ", ".join(f"{c} {lo:g} .. {hi:g}" for c, (lo, hi) in zip("XYZ", travel)) + " mm"
+                  if travel else ""))
+    out.append("   |")
+    out.append("  ===  bed")
+    for i, (k, a) in enumerate(tables):
+        out.append("   |")
+        carries = "the workpiece" if i == len(tables) - 1 else f"table axis {tables[i + 1][1]['name']}"
+        out += axis_block(k, "table", a, carries)
+    out.append("   |")
+    out.append("  [W]  workpiece (table frame" + (")" if tables else " = machine frame: no table axes)"))
+    return "\n".join(out) + "\n"
+
 
 # Defaults of a simulated ballbar machine: 1-sigma pivot placement error (mm) and reading noise (um).
 PIVOT_ERROR_MM = 0.02
@@ -80,7 +219,7 @@ def effect_parameters(effects: Mapping[str, Any] | None) -> tuple[list[str], lis
 def machine_truth(errors: Errors, effects: Mapping[str, Any] | None, machine: str, seed: int):
     """The simulated machine: (machine type, 8 location errors, effect ids, their parameters back
     to back, effects as given for the truth file). Random errors are drawn from ``seed``."""
-    mtype = _core.parse_machine_type(machine)
+    mtype = load_machine(machine)
     e = location_errors(errors, mtype, np.random.default_rng(seed))
     ids, params, values = effect_parameters(effects)
     return mtype, e, ids, params, {k: (v[0] if len(v) == 1 else v) for k, v in values.items()}

@@ -30,6 +30,30 @@ ERROR_WORDS = {
     "E_C0B": "orientation of B about Z (squareness B to X)",
 }
 
+# Words for the location errors of a nutating axis R (formats.md: u, v perpendicular to it).
+_UV_WORDS = {"E_U0": "position of {r} along its u", "E_V0": "position of {r} along its v",
+             "E_DU0": "direction of {r} tilted towards its u", "E_DV0": "direction of {r} tilted towards its v"}
+
+# How the two rotary axes sit, by MachineType.configuration.
+CONFIGURATION_WORDS = {"table-table": "tilting-rotary table", "head-table": "rotary table, tilting head",
+                       "head-head": "two-axis head"}
+
+
+def error_words(name: str) -> str:
+    """Meaning of a location error name: ISO 230-7 words, or the nutating axis' u/v words."""
+    if name in ERROR_WORDS:
+        return ERROR_WORDS[name]
+    for prefix, words in _UV_WORDS.items():
+        if name.startswith(prefix) and len(name) == len(prefix) + 1:
+            return words.format(r=name[-1])
+    return ""
+
+
+def machine_words(machine: Any) -> str:
+    """'AC-head (two-axis head)' from a MachineType."""
+    return f"{machine.name} ({CONFIGURATION_WORDS.get(machine.configuration, machine.configuration)})"
+
+
 _CSS = """
 body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;margin:2em auto;max-width:1100px;color:#222}
 h1{font-size:1.6em;border-bottom:2px solid #246;padding-bottom:.3em}
@@ -81,8 +105,26 @@ def location_error_table(errors: dict) -> str:
     for name, p in errors.items():
         scale, unit = (1e3, "&micro;m") if p["unit"] == "mm" else (1e6, "&micro;rad")
         v, s = _fmt(p, scale)
-        rows.append(f"<tr><td class=l>{_e(name)}</td><td class=l>{_e(ERROR_WORDS.get(name, ''))}</td>"
+        rows.append(f"<tr><td class=l>{_e(name)}</td><td class=l>{_e(error_words(name))}</td>"
                     f"<td>{v}</td><td>{s}</td><td>{unit}</td></tr>")
+    rows.append("</table>")
+    return "\n".join(rows)
+
+
+def fitted_effects_table(effects: list[dict]) -> str:
+    """The effects the fit carried along with the location errors (e.g. tool_offset_Z on a head
+    machine: the error of pivot_length + tool_length), or '' when there are none."""
+    if not effects:
+        return ""
+    rows = ["<p>Fitted along with the location errors:</p><table><tr><th class=l>Effect</th><th class=l>Cause</th>"
+            "<th class=l>Parameter</th><th>Value</th><th>1&sigma;</th><th>Unit</th></tr>"]
+    for eff in effects:
+        for pname, p in eff["params"].items():
+            scale, unit = (1e3, "&micro;m") if p["unit"] == "mm" else (1e6, "&micro;rad") if p["unit"] == "rad" \
+                else (1.0, _e(p["unit"]))
+            v, sd = _fmt(p, scale)
+            rows.append(f"<tr><td class=l>{_e(eff['id'])}</td><td class=l>{_e(eff['cause'])}</td>"
+                        f"<td class=l>{_e(pname)}</td><td>{v}</td><td>{sd}</td><td>{unit}</td></tr>")
     rows.append("</table>")
     return "\n".join(rows)
 
@@ -218,8 +260,9 @@ def ballbar_report(path: str | Path, session: Any, identification: Any,
     angles = np.asarray(session.angles_deg)
     measured = np.asarray(session.length)
     model = _core.predict_session_lengths(identification.raw.model, session)
-    machine = ident["machine"]
-    axis_names = (machine[0], "C")
+    machine = session.machine
+    # session.angles_deg holds (tilt, rotary) on every machine, whatever their chain order.
+    axis_names = (machine.tilt_axis, machine.rot_axis)
     parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{_e(title or 'rotacal report')}</title>"
              f"<style>{_CSS}</style></head><body>"]
     parts.append(f"<h1>{_e(title or 'Single set-up ballbar test')}</h1>")
@@ -229,7 +272,7 @@ def ballbar_report(path: str | Path, session: Any, identification: Any,
     pv = ident["pivot"]
     pivot_txt = ", ".join("unobservable" if pv[a]["value"] is None else f"{pv[a]['value']:.4f}" for a in "xyz")
     parts.append('<section id="setup"><h2>Machine and set-up</h2><table>'
-                 f"<tr><th class=l>Machine</th><td class=l>{_e(machine)} (tilting-rotary table)</td></tr>"
+                 f"<tr><th class=l>Machine</th><td class=l>{_e(machine_words(machine))}</td></tr>"
                  f"<tr><th class=l>Ballbar length L0</th><td class=l>{session.ballbar_length:.4f} mm</td></tr>"
                  f"<tr><th class=l>Nominal pivot (table frame)</th><td class=l>{', '.join(f'{v:.4f}' for v in session.pivot)} mm</td></tr>"
                  f"<tr><th class=l>Identified pivot</th><td class=l>{pivot_txt} mm</td></tr>"
@@ -239,9 +282,12 @@ def ballbar_report(path: str | Path, session: Any, identification: Any,
     parts.append(f'<section id="location-errors"><h2>Location errors (ISO 230-7), method: {_e(ident["method"])}</h2>')
     parts.append(location_error_table(ident["location_errors"]))
     parts.append(f"<p>Residual RMS {ident['residual_rms_um']:.3f} &micro;m over {ident['n_samples']} samples.</p>")
+    parts.append(fitted_effects_table(ident.get("effects", [])))
     if ident["unobservable"]:
         parts.append("<p class=warn>Not determined by this session's tests:</p><ul>" +
                      "".join(f"<li>{_e(u)}</li>" for u in ident["unobservable"]) + "</ul>")
+    if ident.get("notes"):
+        parts.append("<ul class=muted>" + "".join(f"<li>{_e(n)}</li>" for n in ident["notes"]) + "</ul>")
     parts.append("</section>")
     parts.append(noise_budget_section(ident))
 
@@ -430,7 +476,7 @@ def rtest_report(path: str | Path, session: Any, identification: Any, diagnosis:
              f"<p class=muted>rotacal {_e(_version())} &middot; "
              f"{_dt.datetime.now().strftime('%Y-%m-%d %H:%M')} &middot; {_e(source)}</p>"]
 
-    rows = [f"<tr><th class=l>Machine</th><td class=l>{_e(ident['machine'])} (tilting-rotary table)</td></tr>"]
+    rows = [f"<tr><th class=l>Machine</th><td class=l>{_e(machine_words(session.machine))}</td></tr>"]
     for label, q in sorted(session.nests.items()):
         rows.append(f"<tr><th class=l>Nest {_e(label)} (table frame)</th>"
                     f"<td class=l>{', '.join(f'{v:.4f}' for v in q)} mm</td></tr>")
