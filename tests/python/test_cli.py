@@ -15,7 +15,7 @@ def rotacal(*args, cwd=None):
                           cwd=cwd, timeout=600)
 
 
-@pytest.mark.parametrize("cmd", ["plan", "simulate", "identify", "diagnose", "predict", "compensate", "report", "demo",
+@pytest.mark.parametrize("cmd", ["plan", "simulate", "identify", "diagnose", "predict", "compensate", "report", "demo", "machines",
                                  "virtual", "record"])
 def test_help(cmd):
     r = rotacal(cmd, "--help")
