@@ -9,6 +9,7 @@ planned toolpath (every sample, 1e-4 mm / 1e-4 deg) and with the ballbar geometr
 independently (|tool - pivot| = L0 at every block end and all along the arcs), and the block
 times with the plan's time stamps.
 """
+import json
 import math
 import re
 import shutil
@@ -45,6 +46,39 @@ def ry(a):
 def rz(a):
     c, s = np.cos(a), np.sin(a)
     return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+
+
+SLOT = {"A": 3, "B": 4, "C": 5}  # rs274 prints x, y, z, a, b, c
+
+
+def rodrigues(n, a):
+    n = np.asarray(n, float) / np.linalg.norm(n)
+    K = np.array([[0, -n[2], n[1]], [n[2], 0, -n[0]], [-n[1], n[0], 0]])
+    return np.eye(3) + math.sin(a) * K + (1 - math.cos(a)) * K @ K
+
+
+class Chain:
+    """The nominal kinematics of formats.md ("Any 5-axis machine") written out here from the
+    machine's description, independently of rotacal's: p_table = Rot(T1) Rot(T2) q,
+    p_tool = (X, Y, Z) + Rot(H1) Rot(H2) t, each Rot about the axis line through its point."""
+
+    def __init__(self, machine):
+        d = json.loads(machine.description_json)
+        self.table = [(np.array(a.get("point", [0, 0, 0]), float), np.array(a["direction"], float), a["name"])
+                      for a in d["table_axes"]]
+        self.head = [(np.array(a.get("point", [0, 0, 0]), float), np.array(a["direction"], float), a["name"])
+                     for a in d["head_axes"]]
+        self.t = np.array([0.0, 0.0, -(d["pivot_length"] + d["tool_length"])])
+
+    @staticmethod
+    def _turn(axes, p6, x):
+        for p0, n, letter in reversed(axes):  # the outermost axis turns first
+            x = p0 + rodrigues(n, math.radians(p6[SLOT[letter]])) @ (x - p0)
+        return x
+
+    def ballbar_length(self, p6, pivot):
+        """|tool ball - pivot ball| at the rs274 pose p6 (x, y, z, a, b, c; mm, deg)."""
+        return np.linalg.norm(np.asarray(p6[:3]) + self._turn(self.head, p6, self.t) - self._turn(self.table, p6, pivot))
 
 
 def run_rs274(text, tmp_path):
@@ -131,25 +165,29 @@ def check_program(plan, text, tmp_path, actual_errors=None):
     table (rotations written out here), or a machine with `actual_errors` (rotacal.forward)."""
     machine = plan.setup.machine
     ac = machine == rotacal.MachineType.AC_trt
+    tilt_slot, rot_slot = SLOT[machine.tilt_axis], SLOT[machine.rot_axis]
+    chain = Chain(machine)
     pivot = np.asarray(plan.setup.pivot)
     L0 = plan.setup.ballbar_length
-    # Planned poses as rs274 prints them: x, y, z, a, b, c.
+    # Planned poses as rs274 prints them: x, y, z, a, b, c (machine_axes: X, Y, Z, tilt, rotary).
     ax = plan.machine_axes
     P = np.zeros((len(ax), 6))
     P[:, :3] = ax[:, :3]
-    P[:, 3 if ac else 4] = ax[:, 3]
-    P[:, 5] = ax[:, 4]
+    P[:, tilt_slot] = ax[:, 3]
+    P[:, rot_slot] = ax[:, 4]
     T = plan.time
     kinds = [plan.segments[i].kind.name for i in plan.segment_index]
     arc_kind = "arc_transition"
 
     def ballbar_length(p6):
-        tilt, c = math.radians(p6[3] if ac else p6[4]), math.radians(p6[5])
         if actual_errors is None:
-            pivot_m = (rx(tilt) if ac else ry(tilt)) @ rz(c) @ pivot
-        else:
-            pivot_m = rotacal.forward(machine, actual_errors, np.array([[tilt, c]]),
-                                      pivot[None, :])[0]
+            if machine in (rotacal.MachineType.AC_trt, rotacal.MachineType.BC_trt):
+                tilt, c = math.radians(p6[tilt_slot]), math.radians(p6[5])  # Flynn's two tables, by hand
+                return np.linalg.norm(p6[:3] - (rx(tilt) if ac else ry(tilt)) @ rz(c) @ pivot)
+            return chain.ballbar_length(p6, pivot)
+        assert not machine.has_head, "actual_errors: table machines only (rotacal.forward)"
+        tilt, c = math.radians(p6[tilt_slot]), math.radians(p6[rot_slot])
+        pivot_m = rotacal.forward(machine, actual_errors, np.array([[tilt, c]]), pivot[None, :])[0]
         return np.linalg.norm(p6[:3] - pivot_m)
 
     approach, moves = canonical_moves(run_rs274(text, tmp_path))
