@@ -25,6 +25,8 @@ void bind_noise(pyb::module_& m) {
       .def_readonly("sample_interval_s", &NoiseStream::sample_interval_s)
       .def_readonly("correlation_time_s", &NoiseStream::correlation_time_s)
       .def_readonly("effective_samples", &NoiseStream::effective_samples)
+      .def_readonly("random_walk_step_um", &NoiseStream::random_walk_step_um,
+                    "1 sigma of the random-walk step per reading, um (0: none; R-test REML)")
       .def_property_readonly("n", [](const NoiseStream& s) { return s.rows.size(); });
 
   pyb::class_<NoiseModel>(m, "NoiseModel")
@@ -36,6 +38,8 @@ void bind_noise(pyb::module_& m) {
       .def_readonly("correlation_time_s", &NoiseModel::correlation_time_s)
       .def_readonly("effective_samples", &NoiseModel::effective_samples)
       .def_readonly("max_order", &NoiseModel::max_order)
+      .def_readonly("random_walk_step_um", &NoiseModel::random_walk_step_um,
+                    "largest random-walk step of any stream, um (0: none)")
       .def_property_readonly("white", &NoiseModel::white)
       .def("summary", &NoiseModel::summary)
       .def(

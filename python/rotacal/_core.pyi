@@ -1189,6 +1189,11 @@ class NoiseModel:
     def n(self) -> int:
         ...
     @property
+    def random_walk_step_um(self) -> float:
+        """
+        largest random-walk step of any stream, um (0: none)
+        """
+    @property
     def sigma_um(self) -> float:
         ...
     @property
@@ -1241,6 +1246,11 @@ class NoiseStream:
     @property
     def n(self) -> int:
         ...
+    @property
+    def random_walk_step_um(self) -> float:
+        """
+        1 sigma of the random-walk step per reading, um (0: none; R-test REML)
+        """
     @property
     def reflection(self) -> list[float]:
         ...

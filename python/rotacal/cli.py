@@ -330,10 +330,8 @@ def _fmt_value(v, unit: str) -> str:
 
 
 def _print_noise_model(nm: dict) -> None:
-    how = ""
-    if "gls_refit" in nm:
-        how = (f"; 1-sigma by GLS under it (covariance x {nm['covariance_factor']:.2f} for the correlation "
-               "the fit absorbs)" if nm["gls_refit"] else "; readings taken as independent")
+    from .results import noise_handling_words
+    how = f"; {noise_handling_words(nm)}" if "gls_refit" in nm else ""
     print(f"noise model: {nm['summary']}{how}")
 
 

@@ -135,16 +135,19 @@ def noise_budget_section(ident: dict) -> str:
     out = ['<section id="uncertainty"><h2>Noise model and uncertainty budget</h2>']
     nm = ident.get("noise_model")
     if nm:
-        how = ("the fit was redone by GLS under it, covariance x "
-               f"{nm['covariance_factor']:.2f} for the correlation the fit absorbs" if nm.get("gls_refit")
-               else "the readings are taken as independent")
+        from .results import noise_handling_words
+        how = noise_handling_words(nm) if "gls_refit" in nm else "the readings are taken as independent"
         out.append(f"<p>Noise model of the residuals: {_e(nm['summary'])}; {_e(how)}.</p>")
+        walk = any(st.get("random_walk_step_um", 0.0) > 0.0 for st in nm["streams"])
         out.append("<table><tr><th class=l>Stream</th><th>n</th><th>AR order</th><th>&sigma; (&micro;m)</th>"
-                   "<th>correlation (readings)</th><th>correlation time (s)</th><th>effective samples</th></tr>")
+                   + ("<th>random-walk step (&micro;m per reading)</th>" if walk else "")
+                   + "<th>correlation (readings)</th><th>correlation time (s)</th><th>effective samples</th></tr>")
         for st in nm["streams"]:
             name = st["group"] + (f" ch {st['channel']}" if st["channel"] else "")
             out.append(f"<tr><td class=l>{_e(name)}</td><td>{st['n']}</td><td>{st['order']}</td>"
-                       f"<td>{st['sigma_um']:.3f}</td><td>{st['correlation_samples']:.1f}</td>"
+                       f"<td>{st['sigma_um']:.3f}</td>"
+                       + (f"<td>{st.get('random_walk_step_um', 0.0):.4f}</td>" if walk else "")
+                       + f"<td>{st['correlation_samples']:.1f}</td>"
                        f"<td>{st['correlation_time_s']:.3g}</td><td>{st['effective_samples']:.0f}</td></tr>")
         out.append("</table>")
     b = ident.get("uncertainty_budget")

@@ -156,6 +156,7 @@ def noise_model_dict(nm, refit: bool | None = None, correction: float | None = N
         "sigma_um": float(nm.sigma_um),
         "innovation_sigma_um": float(nm.innovation_sigma_um),
         "max_order": int(nm.max_order),
+        "random_walk_step_um": float(nm.random_walk_step_um),
         "correlation_samples": float(nm.correlation_samples),
         "correlation_time_s": float(nm.correlation_time_s),
         "effective_samples": float(nm.effective_samples),
@@ -166,7 +167,8 @@ def noise_model_dict(nm, refit: bool | None = None, correction: float | None = N
              "correlation_samples": float(st.correlation_samples),
              "sample_interval_s": float(st.sample_interval_s),
              "correlation_time_s": float(st.correlation_time_s),
-             "effective_samples": float(st.effective_samples)}
+             "effective_samples": float(st.effective_samples),
+             "random_walk_step_um": float(st.random_walk_step_um)}
             for st in nm.streams
         ],
     }
@@ -174,6 +176,23 @@ def noise_model_dict(nm, refit: bool | None = None, correction: float | None = N
         out["gls_refit"] = bool(refit)
         out["covariance_factor"] = float(correction)
     return out
+
+
+def noise_handling_words(nm: dict) -> str:
+    """How the 1-sigma of an identification rest on its noise model (a noise_model_dict with
+    gls_refit), in words: what the fit did, not more. A model holding a random walk is the
+    R-test's AR(1) + random walk per stream by REML over the fit's residual space, whose
+    covariance needs no factor (docs/noise_model.md); a factor other than 1 is the bootstrap
+    bias correction of Burg's AR model (core/noise_handling.hpp)."""
+    if not nm.get("gls_refit"):
+        return "readings taken as independent"
+    if nm.get("random_walk_step_um", 0.0) > 0.0:
+        return ("1-sigma by GLS under it: AR(1) + random walk per stream, estimated by REML over the "
+                "fit's residual space (no scale factor)")
+    factor = nm.get("covariance_factor", 1.0)
+    if factor != 1.0:
+        return f"1-sigma by GLS under it, covariance x {factor:.2f} for the correlation the fit absorbs"
+    return "1-sigma by GLS under it"
 
 
 def angle_table_dict(t) -> dict:

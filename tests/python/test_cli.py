@@ -135,3 +135,25 @@ def test_diagnose_rtest_file_names_gravity_and_coning(shared_data, tmp_path):
     assert abs(s["value"] - 0.006) <= 3 * s["std"]
     assert d["final_model"]["kind"] == "rtest-diagnosis" and set(d["final_model"]["probe_zeros"]) == {"1", "2"}
     assert 'id="diagnosis"' in (tmp_path / "r.html").read_text()
+
+
+def test_rtest_noise_model_json_has_the_walk(shared_data, tmp_path):
+    """identify --json of an R-test with wandering probe zeros: each stream's random-walk step
+    (docs/json_schema.md), no scale factor (REML), and the schema of the document holds."""
+    from test_json_schema import check, schemas
+    from test_report import walk_session
+    from rotacal.results import noise_handling_words
+    r = rotacal("identify", walk_session(shared_data, tmp_path / "walk.csv"), "--no-budget")
+    assert r.returncode == 0, r.stderr
+    nm = json.loads(r.stdout)["noise_model"]
+    named = schemas()
+    check(nm, named["noise_model"], "noise_model", named)
+    assert nm["gls_refit"] and nm["covariance_factor"] == 1.0
+    steps = [st["random_walk_step_um"] for st in nm["streams"]]
+    assert len(steps) == 6 and all(0.03 < v < 0.4 for v in steps), steps  # truth 0.1 um per pose
+    assert nm["random_walk_step_um"] == max(steps)
+    assert "REML" in noise_handling_words(nm) and "x 1.00" not in noise_handling_words(nm)
+    # The shared session itself (white readings): no walk, readings independent.
+    r = rotacal("identify", shared_data / "rtest_bc_oyama.csv", "--no-budget")
+    nm = json.loads(r.stdout)["noise_model"]
+    assert nm["random_walk_step_um"] == 0.0 and noise_handling_words(nm) == "readings taken as independent"

@@ -74,3 +74,44 @@ def test_rtest_report_renders_in_chromium(rtest_report, tmp_path):
     subprocess.run([CHROMIUM, *FLAGS, f"--user-data-dir={profile}", "--window-size=1200,2400",
                     f"--screenshot={png}", rtest_report.as_uri()], capture_output=True, timeout=120)
     assert png.stat().st_size > 50_000
+
+
+def walk_session(shared_data, path):
+    """The shared R-test session with AR(1) noise (rho 0.9, 0.3 um) and probe zeros that wander
+    0.1 um per pose added to each channel: the joint fit refits under REML AR(1) + walk."""
+    import numpy as np
+    import rotacal
+    from rotacal import _core
+    s = rotacal.load(shared_data / "rtest_bc_oyama.csv")
+    setups, t = list(s.setups), list(s.time)
+    e = np.zeros((len(t), 3))
+    for k in range(3):
+        g = [f"{u}:{k}" for u in setups]
+        e[:, k] = np.asarray(_core.noise_ar1(g, t, 0.9, 0.3e-3, 10 + k)) + \
+            np.asarray(_core.noise_probe_zero_wander(g, t, 0.1e-3, 20 + k))
+    rotacal.save(s.with_displacements(np.asarray(s.d) + e), path)
+    return path
+
+
+def test_rtest_report_says_reml_walk_not_a_factor(shared_data, tmp_path):
+    """The R-test's covariance is REML AR(1) + walk per stream, not a factor for what the fit
+    absorbs: the report says so and shows each stream's walk step."""
+    html = write_report(walk_session(shared_data, tmp_path / "walk.csv"), tmp_path / "w.html").read_text()
+    section = html[html.index('id="uncertainty"'):]
+    assert "AR(1) + random walk per stream, estimated by REML" in section
+    assert "for the correlation the fit absorbs" not in html
+    steps = re.findall(r"<td>(\d+\.\d{4})</td><td>[\d.]+</td><td>[\d.e+-]+</td><td>\d+</td></tr>", section)
+    assert len(steps) == 6 and all(0.03 < float(v) < 0.4 for v in steps), steps
+
+
+def test_ballbar_report_keeps_the_bias_factor_words(shared_data, tmp_path):
+    """The ballbar's Burg model is scaled by its bootstrap factor: that stays in the words."""
+    import numpy as np
+    import rotacal
+    from rotacal import _core
+    s = rotacal.load(shared_data / "ballbar_ac_table2.csv")
+    e = _core.noise_ar1(list(s.tests), list(s.time), 0.9, 0.5e-3, 3)
+    rotacal.save(s.with_lengths(np.asarray(s.length) + e), tmp_path / "ar.csv")
+    html = write_report(tmp_path / "ar.csv", tmp_path / "ar.html").read_text()
+    assert re.search(r"1-sigma by GLS under it, covariance x \d\.\d\d for the correlation the fit absorbs", html)
+    assert "random-walk step" not in html
