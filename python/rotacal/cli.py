@@ -148,6 +148,9 @@ def _add_setup_args(p: argparse.ArgumentParser) -> None:
                         f"{','.join(f'{v:g}' for v in _core.default_tilt_range_deg(d.machine))} on AC-trt)")
     g.add_argument("--c-range", default=CLI_C_RANGE, type=numbers("--c-range", 2, 720.0, "deg"),
                    help=f"range of the rotary axis C, deg (default {CLI_C_RANGE})")
+    g.add_argument("--axial-c-tilt", type=number("--axial-c-tilt", -360.0, 360.0, "deg"), metavar="DEG",
+                   help="tilt held during axial_C, deg (default: the machine's; 45 on a head-head machine, "
+                        "where at tilt 0 the ball sits on the C axis, else 0)")
     g.add_argument("--step", type=number("--step", 0.01, 90.0, "deg", lo_open=False),
                    help=f"sample spacing, deg (default {d.step_deg:g})")
     g.add_argument("--feed", type=number("--feed", 1.0, 1e5, "mm/min"),
@@ -165,7 +168,7 @@ def _setup(a: argparse.Namespace) -> Any:
     s = _core.BallbarSetup() if a.machine is None else _core.BallbarSetup(load_machine(a.machine))
     for option, field in (("length", "ballbar_length"), ("step", "step_deg"), ("feed", "feed_mm_per_min"),
                           ("rotary_feed", "feed_deg_per_min"), ("pivot", "pivot"), ("tilt_range", "tilt_range_deg"),
-                          ("c_range", "rot_range_deg")):
+                          ("c_range", "rot_range_deg"), ("axial_c_tilt", "axial_c_tilt_deg")):
         if getattr(a, option) is not None:
             setattr(s, field, getattr(a, option))
     if a.tests:
@@ -1273,7 +1276,7 @@ def _add_truth_args(q: argparse.ArgumentParser) -> None:
 
 # Options whose values may start with '-' ("--a-range -90,90"): argparse would take the value
 # for an option, so such pairs are joined as "--a-range=-90,90" before parsing.
-_SIGNED_VALUE_OPTIONS = {"--a-range", "--b-range", "--c-range", "--pivot", "--errors", "--nest", "--probe-dir",
+_SIGNED_VALUE_OPTIONS = {"--a-range", "--b-range", "--tilt-range", "--c-range", "--axial-c-tilt", "--pivot", "--errors", "--nest", "--probe-dir",
                          "--comp-range", "--travel", "--pivot-z", "--centres-origin"}
 
 

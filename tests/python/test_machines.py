@@ -297,3 +297,19 @@ def test_unreadable_or_unknown_machine(capsys, tmp_path):
     assert code == cli.EXIT_INPUT and "B-head-C-table" in err
     code, _, err = run(capsys, "machines", "show")
     assert code == cli.EXIT_INPUT and "machines show" in err
+
+
+def test_axial_c_tilt_on_a_head_head_machine(capsys, tmp_path):
+    """AC-head: at tilt 0 the ball sits on the C head's line, so its four errors are seen only in
+    one combination; the default 45 deg takes the ball off the line and all four are determined."""
+    seen = {}
+    for tilt in (None, 0):
+        extra = [] if tilt is None else ["--axial-c-tilt", tilt]
+        s = tmp_path / f"s{tilt}.csv"
+        code, _, err = run(capsys, "simulate", "ballbar", "--machine", "AC-head", "--seed", 1, *extra, "-o", s)
+        assert code == 0, err
+        code, out, err = run(capsys, "identify", s, "--json", "--no-budget")
+        assert code == 0, err
+        seen[tilt] = {n for n, p in json.loads(out)["location_errors"].items() if p["value"] is not None}
+    assert seen[None] == set(_core.location_error_names(load_machine("AC-head"))) - {"E_Z0A"}
+    assert seen[0] == {"E_Y0A", "E_B0A", "E_C0A"}
