@@ -6,6 +6,7 @@ import json
 import re
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -22,7 +23,7 @@ DIALECTS = ["linuxcnc", "heidenhain", "siemens", "fanuc"]
 CUSTOM = {
     "format": "rotacal-machine/1",
     "name": "shop-7 A-head C-table",
-    "table_axes": [{"name": "C", "direction": [0, 0, -1]}],
+    "table_axes": [{"name": "C", "direction": [0, 0, -1], "point": [0, 0, 0]}],
     "head_axes": [{"name": "A", "direction": [1, 0, 0], "point": [0, 0, -40], "limits_deg": [-100, 100]}],
     "pivot_length": 120.0,
     "tool_length": 80.0,
@@ -313,3 +314,27 @@ def test_axial_c_tilt_on_a_head_head_machine(capsys, tmp_path):
         seen[tilt] = {n for n, p in json.loads(out)["location_errors"].items() if p["value"] is not None}
     assert seen[None] == set(_core.location_error_names(load_machine("AC-head"))) - {"E_Z0A"}
     assert seen[0] == {"E_Y0A", "E_B0A", "E_C0A"}
+
+
+# ------------------------------------------------------------------------- docs/machines.md
+
+DOC = Path(__file__).resolve().parents[2] / "docs" / "machines.md"
+
+
+def test_doc_example_description_is_the_tested_one(tmp_path):
+    """The complete example of docs/machines.md is a valid description, the one tested above."""
+    block = re.search(r"```json\n(.*?)```", DOC.read_text(encoding="utf-8"), re.S).group(1)
+    assert json.loads(block) == CUSTOM
+    f = tmp_path / "shop7.json"
+    f.write_text(block)
+    assert load_machine(f).configuration == "head-table"
+
+
+def test_doc_table_of_builtins_matches_the_descriptions():
+    rows = re.findall(r"^\| (\S+) \| (table-table|head-table|head-head) \| ([A-C]), ([A-C]) \| ([E_A-Z0-9 ]+) \|$",
+                      DOC.read_text(encoding="utf-8"), re.M)
+    assert [r[0] for r in rows] == BUILTINS
+    for name, conf, a0, a1, names in rows:
+        m = _core.parse_machine_type(name)
+        assert (conf, a0 + a1) == (m.configuration, m.axis_names)
+        assert names.split() == list(_core.location_error_names(m))
