@@ -78,7 +78,8 @@ class Chain:
 
     def ballbar_length(self, p6, pivot):
         """|tool ball - pivot ball| at the rs274 pose p6 (x, y, z, a, b, c; mm, deg)."""
-        return np.linalg.norm(np.asarray(p6[:3]) + self._turn(self.head, p6, self.t) - self._turn(self.table, p6, pivot))
+        p_tool = np.asarray(p6[:3]) + self._turn(self.head, p6, self.t)
+        return np.linalg.norm(p_tool - self._turn(self.table, p6, pivot))
 
 
 def run_rs274(text, tmp_path):

@@ -10,7 +10,7 @@ import pytest
 
 import rotacal
 from rotacal import _core
-from test_linuxcnc import RS274, Chain, SLOT, check_program, run_rs274  # noqa: F401 (RS274: the skip)
+from test_linuxcnc import RS274, Chain, check_program
 
 pytestmark = pytest.mark.skipif(
     RS274 is None,

@@ -231,7 +231,8 @@ def test_tilt_range_defaults_to_the_machines(capsys, tmp_path):
     assert code == 0, err
     lo, hi = _core.default_tilt_range_deg(m)
     assert f"(B range: {lo:g} .. {hi:g} deg" in (tmp_path / "a.ngc").read_text()
-    code, _, err = run(capsys, "plan", "ballbar", "--machine", "B45C-trt", "--b-range", "-90,90", "-o", tmp_path / "b.ngc")
+    code, _, err = run(capsys, "plan", "ballbar", "--machine", "B45C-trt", "--b-range", "-90,90",
+                       "-o", tmp_path / "b.ngc")
     assert code == cli.EXIT_INPUT and "limits" in err
 
 
