@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 
 #include <random>
+#include <sstream>
 
 #include "rotacal/ballbar/identify.hpp"
 #include "rotacal/ballbar/nc_program.hpp"
@@ -103,5 +104,33 @@ TEST_CASE("machine-axis programs put the ball where the plan wants it on every m
     const std::string nc = write_nc_program(plan, NcDialect::linuxcnc);
     CHECK_THAT(nc, Catch::Contains(std::string(" ") + tilt_axis_letter(m)) &&
                        Catch::Contains(std::string(" ") + rot_axis_letter(m)));
+  }
+}
+
+TEST_CASE("a description written out for AC-trt identifies the shared sessions as the built-in does", "[any_machine]") {
+  for (const char* file : {"data/ballbar_ac_table2.csv", "data/ballbar_ac_random.csv"}) {
+    INFO(file);
+    const BallbarSession builtin = read_ballbar(synthetic::shared_file(file));
+    // The same machine as a rotacal-machine/1 description of another name, through a file:
+    // the session then carries '# machine_description:'.
+    MachineDescription d = parse_machine_description(machine_description_json(builtin.machine.description()), "copy");
+    d.name = "AC table described";
+    BallbarSession described = builtin;
+    described.machine = MachineType::from_description(d);
+    const std::string text = format_ballbar(described);
+    CHECK_THAT(text, Catch::Contains("# machine_description: {\"format\":\"rotacal-machine/1\""));
+    std::istringstream in(text);
+    const BallbarSession back = parse_ballbar(in, "described.csv");
+    REQUIRE(back.machine == described.machine);
+    REQUIRE(back.machine != builtin.machine);
+    JointFitOptions o;
+    o.noise = NoiseHandling::automatic;
+    const BallbarIdentification a = identify_joint(builtin, o), b = identify_joint(back, o);
+    REQUIRE(a.parameters.size() == b.parameters.size());
+    for (std::size_t k = 0; k < a.parameters.size(); ++k) {
+      CHECK(a.parameters[k].name == b.parameters[k].name);
+      CHECK(std::abs(a.parameters[k].value - b.parameters[k].value) < 1e-12);
+      CHECK(std::abs(a.parameters[k].std - b.parameters[k].std) < 1e-12);
+    }
   }
 }
