@@ -10,6 +10,7 @@
 #include "rotacal/ballbar/identify.hpp"
 #include "rotacal/ballbar/nc_program.hpp"
 #include "rotacal/ballbar/test_plan.hpp"
+#include "rotacal/diagnose/ballbar_diagnosis.hpp"
 #include "../support/synthetic_sessions.hpp"
 
 using namespace rotacal;
@@ -133,4 +134,22 @@ TEST_CASE("a description written out for AC-trt identifies the shared sessions a
       CHECK(std::abs(a.parameters[k].std - b.parameters[k].std) < 1e-12);
     }
   }
+}
+
+TEST_CASE("the diagnosis names a hidden effect of a head axis", "[any_machine]") {
+  // Coning of a fork head's B axis (30 urad/rad) and a tool 10 um short, in AR(0.5) noise.
+  const MachineType m = parse_machine_type("BC-head");
+  BallbarSetup setup;
+  setup.machine = m;
+  setup.step_deg = 2.0;
+  const BallbarSession cmd = commanded_session(plan_ballbar_test(setup));
+  BallbarMachineModel truth;
+  truth.machine = m;
+  truth.errors.v << 0.02, -0.01, 2e-5, -3e-5, 0.015, 0.01, 1e-5, -2e-5;
+  truth.pivot = cmd.pivot;
+  truth.effects.effects = {Effect::parse("coning_B"), Effect::parse("tool_offset_Z")};
+  truth.effect_params = {3e-5, 0.01};
+  const Diagnosis D = diagnose_ballbar(synthetic::noisy_ballbar(cmd, truth, 0.5, 0.5, 31));
+  REQUIRE(!D.findings.empty());
+  CHECK(D.findings[0].effect.id() == "coning_B");
 }
