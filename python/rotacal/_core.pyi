@@ -2090,8 +2090,10 @@ def check_plausible(session: BallbarSession, source: str, options: PlausibilityO
 @typing.overload
 def check_plausible(session: RtestSession, source: str, options: PlausibilityOptions = ...) -> PlausibilityReport:
     ...
-def compensate_commands(nominal: BallbarSession, identified: ..., machine: MachineType) -> BallbarSession:
-    ...
+def compensate_commands(nominal: BallbarSession, identified: ..., machine: MachineType, tool_length_error: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> BallbarSession:
+    """
+    Compensated commands; tool_length_error (mm): the error of pivot_length + tool_length of a head machine (minus the identified tool_offset_Z).
+    """
 def compensate_sphere_offset(session: RtestSession, offset: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> RtestSession:
     """
     The session with the sphere's offset (x, y) from the spindle axis taken out of every d.
