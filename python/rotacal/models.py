@@ -38,10 +38,10 @@ def estimate_dict(p: Any) -> dict:
 
 
 def machine_members(machine: Any) -> dict:
-    """``{"machine": name}``, with the ``machine_description`` of a machine that is not built in
-    (formats.md: the description then defines the machine)."""
+    """``{"machine": name}``, with the ``machine_description`` of every machine but the two
+    tables formats.md names (the description then defines the machine; other tools can read it)."""
     out: dict[str, Any] = {"machine": _core.machine_name(machine)}
-    if not machine.is_builtin:
+    if machine not in (_core.MachineType.AC_trt, _core.MachineType.BC_trt):
         out["machine_description"] = json.loads(machine.description_json)
     return out
 

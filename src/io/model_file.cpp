@@ -222,11 +222,12 @@ void check_envelope(const json& doc, const std::string& source, ModelFile& m) {
   }
 }
 
-// The machine members of a document: the name, and the description of a machine that is not
-// built in.
+// The machine members of a document: the name, and for every machine but the two tables of
+// formats.md its description (as in sessions).
 void put_machine(json& doc, MachineType m) {
   doc["machine"] = to_string(m);
-  if (!m.is_builtin()) doc["machine_description"] = json::parse(machine_description_json(m.description()));
+  if (m != MachineType::AC_trt && m != MachineType::BC_trt)
+    doc["machine_description"] = json::parse(machine_description_json(m.description()));
 }
 
 json parse_json(const std::string& text, const std::string& source) {

@@ -179,3 +179,19 @@ TEST_CASE("compensation removes what the ballbar sees on head machines", "[any_m
     CHECK(r.after.residual_rms_um < 0.6);
   }
 }
+
+TEST_CASE("files of the new built-ins carry their description and read back as the built-in", "[any_machine]") {
+  for (const std::string& name : builtin_machine_names()) {
+    INFO(name);
+    BallbarSetup setup;
+    setup.machine = parse_machine_type(name);
+    setup.tilt_range_deg = default_tilt_range_deg(setup.machine);
+    setup.step_deg = 10.0;
+    const BallbarSession s = commanded_session(plan_ballbar_test(setup));
+    const std::string text = format_ballbar(s);
+    const bool table_of_formats_md = name == "AC-trt" || name == "BC-trt";
+    CHECK((text.find("# machine_description:") != std::string::npos) == !table_of_formats_md);
+    std::istringstream in(text);
+    CHECK(parse_ballbar(in, "x.csv").machine == setup.machine);
+  }
+}
