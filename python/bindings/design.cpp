@@ -45,6 +45,83 @@ void bind_design(pyb::module_& m) {
         return design_ballbar_test(o);
       },
       pyb::arg("options"), "The pivot and bar length with the smallest predicted uncertainty (ballbar/design.hpp).");
+  pyb::class_<TableMotionOverlap>(m, "TableMotionOverlap",
+                                  "Whether two effects move the table alike (ballbar/design.hpp).")
+      .def_readonly("moves_table_first", &TableMotionOverlap::moves_table_first)
+      .def_readonly("moves_table_second", &TableMotionOverlap::moves_table_second)
+      .def_readonly("first_is_location", &TableMotionOverlap::first_is_location)
+      .def_readonly("second_is_location", &TableMotionOverlap::second_is_location)
+      .def_readonly("cosine", &TableMotionOverlap::cosine, "largest cosine of the principal angles")
+      .def_readonly("same_motion", &TableMotionOverlap::same_motion, "no instrument can separate them")
+      .def_readonly("why", &TableMotionOverlap::why);
+  m.def(
+      "table_motion_overlap",
+      [](MachineType machine, const std::string& a, const std::string& b, std::array<double, 2> tilt_limits_deg,
+         double duration_s, double reference_radius_mm) {
+        return table_motion_overlap(machine, Effect::parse(a), Effect::parse(b), tilt_limits_deg, duration_s,
+                                    reference_radius_mm);
+      },
+      pyb::arg("machine"), pyb::arg("a"), pyb::arg("b"), pyb::arg("tilt_limits_deg") = std::array<double, 2>{-90.0, 90.0},
+      pyb::arg("duration_s") = 3600.0, pyb::arg("reference_radius_mm") = 100.0,
+      "Compare the table motions of effects a and b (catalogue ids) on a machine.");
+  pyb::class_<SeparationOptions>(m, "SeparationOptions", "Options of design_ballbar_separation (defaults).")
+      .def(pyb::init<>())
+      .def_readwrite("added", &SeparationOptions::added, "step, feeds and C range of the added test")
+      .def_readwrite("bar_lengths_mm", &SeparationOptions::bar_lengths_mm)
+      .def_readwrite("pivot_radius_mm", &SeparationOptions::pivot_radius_mm)
+      .def_readwrite("pivot_angle_deg", &SeparationOptions::pivot_angle_deg)
+      .def_readwrite("pivot_z_mm", &SeparationOptions::pivot_z_mm)
+      .def_readwrite("travel_min", &SeparationOptions::travel_min)
+      .def_readwrite("travel_max", &SeparationOptions::travel_max)
+      .def_readwrite("tilt_limits_deg", &SeparationOptions::tilt_limits_deg)
+      .def_readwrite("max_added_time_s", &SeparationOptions::max_added_time_s)
+      .def_readwrite("max_correlation", &SeparationOptions::max_correlation)
+      .def_readwrite("noise_um", &SeparationOptions::noise_um, "0: the session's residual noise")
+      .def_readwrite("reference_radius_mm", &SeparationOptions::reference_radius_mm);
+  pyb::class_<SeparatingCandidate>(m, "SeparatingCandidate", "An added test, evaluated with the session.")
+      .def_readonly("setup", &SeparatingCandidate::setup)
+      .def_readonly("new_pivot", &SeparatingCandidate::new_pivot)
+      .def_readonly("description", &SeparatingCandidate::description)
+      .def_readonly("duration_s", &SeparatingCandidate::duration_s)
+      .def_readonly("slow_down", &SeparatingCandidate::slow_down)
+      .def_readonly("correlation", &SeparatingCandidate::correlation)
+      .def_readonly("determined", &SeparatingCandidate::determined);
+  pyb::class_<SeparationDesign>(m, "SeparationDesign", "The added test that separates two effects, or why none can.")
+      .def_readonly("effects", &SeparationDesign::effects)
+      .def_readonly("motion", &SeparationDesign::motion)
+      .def_readonly("names", &SeparationDesign::names)
+      .def_readonly("sigma_before", &SeparationDesign::sigma_before)
+      .def_readonly("sigma_after", &SeparationDesign::sigma_after)
+      .def_readonly("correlation_before", &SeparationDesign::correlation_before)
+      .def_readonly("found", &SeparationDesign::found)
+      .def_readonly("chosen", &SeparationDesign::chosen)
+      .def_readonly("candidates_tried", &SeparationDesign::candidates_tried)
+      .def_readonly("noise_um", &SeparationDesign::noise_um)
+      .def_readonly("effective_per_reading", &SeparationDesign::effective_per_reading)
+      .def_readonly("verdict", &SeparationDesign::verdict);
+  m.def(
+      "design_ballbar_separation",
+      [](const BallbarSession& session, const std::vector<std::string>& pair, const SeparationOptions& o) {
+        const EffectModel fx = effects_of(pair);
+        pyb::gil_scoped_release release;
+        return design_ballbar_separation(session, fx.effects, o);
+      },
+      pyb::arg("session"), pyb::arg("pair"), pyb::arg("options") = SeparationOptions{},
+      "The smallest added test that separates two effects after a session (ballbar/design.hpp).");
+  m.def(
+      "identify_joint_sessions",
+      [](const std::vector<BallbarSession>& sessions, const std::vector<std::string>& effects) {
+        const EffectModel fx = effects_of(effects);
+        JointFitOutcome f;
+        {
+          pyb::gil_scoped_release release;
+          f = identify_joint_sessions(sessions, fx);
+        }
+        return pyb::make_tuple(f.values, f.covariance, f.summary.converged);
+      },
+      pyb::arg("sessions"), pyb::arg("effects") = std::vector<std::string>{},
+      "Joint fit of several ballbar sessions (shared location errors and effects, one pivot each): "
+      "(values, covariance, converged) in the order 8 location errors, pivots, effect parameters.");
 }
 
 }  // namespace rotacal::py
