@@ -614,9 +614,50 @@ def _comp_file(text: str) -> tuple[str, str]:
     return axis, checked_path(file, "--comp-file")
 
 
+def cmd_design_separation(a: argparse.Namespace) -> int:
+    from .ballbar import nc_program
+    from .design import added_setup, design_separation, parameter_units, separation_dict
+    if not a.after:
+        raise OptionError("--separate: give the session it follows with --after SESSION")
+    check_outputs([a.output], [a.after])
+    session = _load(a.after)
+    if by_kind(session, {BALLBAR: False, RTEST: True}, "--after"):
+        raise OptionError(f"--after {a.after}: an R-test session; design ballbar --separate needs a ballbar session")
+    base = _setup(a)
+    d = design_separation(session, [e.strip() for e in a.separate.split(",")], base=base, lengths=a.lengths,
+                          pivot_r=a.pivot_r, pivot_angle=a.pivot_angle, pivot_z=a.pivot_z, travel=a.travel,
+                          tilt_limits=a.tilt_limits, max_time_s=a.max_time, max_correlation=a.max_correlation,
+                          noise_um=a.noise or 0.0)
+    if a.output and d.found:
+        plan, text = nc_program(added_setup(d), a.dialect, None, None)
+        write_output(a.output, text, [a.after])
+        _say(f"wrote {a.output}: {a.dialect} program of the added test, {plan.duration:.0f} s")
+    elif a.output:
+        _say(f"rotacal: {a.output} not written: no added test separates them")
+    if a.json:
+        print(jsontext.dumps(separation_dict(d)))
+        return EXIT_OK
+    print(d.verdict)
+    if d.motion.same_motion:
+        return EXIT_OK
+    print(f"noise {d.noise_um:.3f} um per reading, {d.effective_per_reading:.2f} effective samples per reading "
+          f"(from {a.after}); {d.candidates_tried} added tests tried")
+    print("predicted 1-sigma, session alone -> with the added test (inf: not determined):")
+    after = list(d.sigma_after) if d.candidates_tried else [math.nan] * len(d.names)
+    before = list(d.sigma_before) + [math.inf] * (len(d.names) - len(d.sigma_before))
+    for n, b_, a_, (unit, k) in zip(d.names, before, after, parameter_units(d.names)):
+        print(f"  {n:28s} {b_ * k:10.4f} -> {a_ * k:10.4f} {unit}")
+    return EXIT_OK
+
+
 def cmd_design_ballbar(a: argparse.Namespace) -> int:
     from .ballbar import nc_program
     from .design import design_ballbar, design_dict
+    if a.separate:
+        return cmd_design_separation(a)
+    if a.after:
+        raise OptionError("--after: goes with --separate EFFECT,EFFECT")
+    a.noise = 0.5 if a.noise is None else a.noise
     check_outputs([a.output])
     d = design_ballbar(_setup(a), lengths=a.lengths, pivot_x=a.pivot_x, pivot_z=a.pivot_z, travel=a.travel,
                        time_s=a.time, rate_hz=a.rate, noise_um=a.noise, rho=a.rho,
@@ -1035,13 +1076,29 @@ def build_parser() -> argparse.ArgumentParser:
                    help="run time to compare at, s (default: the default set-up's)")
     k.add_argument("--rate", type=number("--rate", 0.0, 1e5, "Hz", lo_open=True), default=100.0,
                    help="the recorder's sample rate, Hz (default 100)")
-    k.add_argument("--noise", type=number("--noise", 0.0, 1000.0, "um", lo_open=True), default=0.5,
-                   help="1-sigma noise per sample, um (default 0.5)")
+    k.add_argument("--noise", type=number("--noise", 0.0, 1000.0, "um", lo_open=True),
+                   help="1-sigma noise per sample, um (default 0.5; with --after: the session's residual noise)")
     k.add_argument("--rho", type=number("--rho", 0.0, 0.999, ""), default=0.0,
                    help="AR(1) coefficient of the noise between samples (default 0: white)")
     k.add_argument("--effects", help="effects of concern, fitted along: catalogue ids, comma separated")
+    g = k.add_argument_group("the test that separates two effects after a session (docs/design.md)")
+    g.add_argument("--separate", metavar="EFFECT,EFFECT",
+                   help="two catalogue ids the diagnosis could not tell apart: propose the smallest added test "
+                        "that brings their correlation below --max-correlation, or say why none can")
+    g.add_argument("--after", type=path("--after"), metavar="SESSION", help="the ballbar session they follow")
+    g.add_argument("--max-time", type=number("--max-time", 0.0, 86400.0, "s", lo_open=True), default=600.0,
+                   help="longest added test, s (default 600)")
+    g.add_argument("--max-correlation", type=number("--max-correlation", 0.0, 1.0, "", lo_open=True), default=0.5,
+                   help="target largest canonical correlation of the pair (default 0.5)")
+    g.add_argument("--pivot-r", type=number_list("--pivot-r", 0.0, 2000.0, "mm", 30),
+                   help="moved pivot: distances from the C axis, mm (default 0,60,120,180)")
+    g.add_argument("--pivot-angle", type=number_list("--pivot-angle", -360.0, 360.0, "deg", 12),
+                   help="moved pivot: angles about C from +X, deg (default 0,90)")
+    g.add_argument("--tilt-limits", type=numbers("--tilt-limits", 2, 360.0, "deg"),
+                   help="rotary limits of the tilt axis, deg (default -90,90)")
     k.add_argument("--dialect", default="linuxcnc", help="NC dialect of -o (as plan)")
-    k.add_argument("-o", "--output", type=path("--output"), help="write the designed test's NC program here")
+    k.add_argument("-o", "--output", type=path("--output"),
+                   help="write the designed test's NC program here (with --separate: the added test's)")
     k.add_argument("--json", action="store_true")
     k.set_defaults(func=cmd_design_ballbar)
 

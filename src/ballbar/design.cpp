@@ -13,6 +13,7 @@
 
 #include "rotacal/ballbar/identify.hpp"
 #include "rotacal/core/error.hpp"
+#include "rotacal/core/least_squares.hpp"
 
 namespace rotacal {
 
@@ -221,38 +222,50 @@ Eigen::MatrixXd table_motion_columns(MachineType m, const EffectModel& fx,
 
 std::string deg_range(std::array<double, 2> r) { return fmt(r[0], 0) + ".." + fmt(r[1], 0) + " deg"; }
 
-// Covariance of an information matrix that may be singular: parameters touching its null
-// space are undetermined (infinite sigma); the others get the pseudo-inverse's covariance,
-// which is theirs (they have no component along the null space).
+// Covariance of an information matrix with the parameters the joint fit would hold fixed
+// removed: those analyse_observability (core/least_squares.hpp) picks, one per combination
+// that moving by plausible magnitudes changes chi-square by less than 1, on the white
+// chi-square the fit tests (`white`: the information over the effective fraction, as the fit
+// counts every reading). The covariance of the rest is the inverse of their information
+// (a pseudo-inverse guards what is still singular, and that is held too).
 struct Inverted {
   Eigen::MatrixXd cov;
   std::vector<bool> determined;
   Eigen::VectorXd sigma;
 };
 
-Inverted invert_information(const Eigen::MatrixXd& I) {
+Inverted invert_information(const Eigen::MatrixXd& I, const Eigen::VectorXd& plausible, double white) {
   const Eigen::Index p = I.rows();
   Inverted out;
   out.determined.assign(static_cast<std::size_t>(p), true);
-  Eigen::VectorXd d(p);
-  for (Eigen::Index j = 0; j < p; ++j) d[j] = I(j, j) > 0.0 ? std::sqrt(I(j, j)) : 0.0;
-  Eigen::VectorXd dinv = d;
-  for (Eigen::Index j = 0; j < p; ++j) dinv[j] = d[j] > 0.0 ? 1.0 / d[j] : 0.0;
-  Eigen::MatrixXd N = dinv.asDiagonal() * I * dinv.asDiagonal();
+  const Observability obs = analyse_observability_normal(I * white, plausible, 1.0);
+  for (int j : obs.to_fix) out.determined[static_cast<std::size_t>(j)] = false;
   for (Eigen::Index j = 0; j < p; ++j)
-    if (d[j] == 0.0) N(j, j) = 0.0, out.determined[static_cast<std::size_t>(j)] = false;
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(N);
-  const double lmax = std::max(es.eigenvalues().maxCoeff(), 1e-300);
-  Eigen::MatrixXd pinv = Eigen::MatrixXd::Zero(p, p);
-  Eigen::VectorXd null_weight = Eigen::VectorXd::Zero(p);
-  for (Eigen::Index k = 0; k < p; ++k) {
-    const Eigen::VectorXd v = es.eigenvectors().col(k);
-    if (es.eigenvalues()[k] > 1e-10 * lmax) pinv += v * v.transpose() / es.eigenvalues()[k];
-    else null_weight += v.cwiseAbs2();
+    if (!(I(j, j) > 0.0)) out.determined[static_cast<std::size_t>(j)] = false;
+  std::vector<Eigen::Index> idx;
+  for (Eigen::Index j = 0; j < p; ++j)
+    if (out.determined[static_cast<std::size_t>(j)]) idx.push_back(j);
+  const Eigen::Index q = static_cast<Eigen::Index>(idx.size());
+  Eigen::VectorXd dinv(q);
+  for (Eigen::Index a = 0; a < q; ++a) dinv[a] = 1.0 / std::sqrt(I(idx[a], idx[a]));
+  const Eigen::MatrixXd N = dinv.asDiagonal() * I(idx, idx) * dinv.asDiagonal();
+  Eigen::MatrixXd pinv = Eigen::MatrixXd::Zero(q, q);
+  if (q > 0) {
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(N);
+    const double lmax = std::max(es.eigenvalues().maxCoeff(), 1e-300);
+    Eigen::VectorXd null_weight = Eigen::VectorXd::Zero(q);
+    for (Eigen::Index k = 0; k < q; ++k) {
+      const Eigen::VectorXd v = es.eigenvectors().col(k);
+      if (es.eigenvalues()[k] > 1e-12 * lmax) pinv += v * v.transpose() / es.eigenvalues()[k];
+      else null_weight += v.cwiseAbs2();
+    }
+    for (Eigen::Index a = 0; a < q; ++a)
+      if (null_weight[a] > 1e-8) out.determined[static_cast<std::size_t>(idx[a])] = false;
   }
-  for (Eigen::Index j = 0; j < p; ++j)
-    if (null_weight[j] > 1e-8) out.determined[static_cast<std::size_t>(j)] = false;
-  out.cov = dinv.asDiagonal() * pinv * dinv.asDiagonal();
+  const Eigen::MatrixXd cov_q = dinv.asDiagonal() * pinv * dinv.asDiagonal();
+  out.cov = Eigen::MatrixXd::Zero(p, p);
+  for (Eigen::Index a = 0; a < q; ++a)
+    for (Eigen::Index b = 0; b < q; ++b) out.cov(idx[a], idx[b]) = cov_q(a, b);
   out.sigma.resize(p);
   for (Eigen::Index j = 0; j < p; ++j)
     out.sigma[j] = out.determined[static_cast<std::size_t>(j)] ? std::sqrt(std::max(out.cov(j, j), 0.0))
@@ -260,17 +273,21 @@ Inverted invert_information(const Eigen::MatrixXd& I) {
   return out;
 }
 
-// Largest canonical correlation between the estimates of parameters [a0, a0 + na) and
-// [b0, b0 + nb): the largest correlation of any combination of one block with any of the
-// other (1 if a parameter of either is undetermined).
+// Largest canonical correlation between the estimates of the determined parameters among
+// [a0, a0 + na) and among [b0, b0 + nb): the largest correlation of any combination of one
+// block with any of the other (held parameters are fixed, as in the fit); 1 when no
+// parameter of a block is determined.
 double canonical_correlation(const Inverted& inv, int a0, int na, int b0, int nb) {
+  std::vector<Eigen::Index> ia, ib;
   for (int j = 0; j < na; ++j)
-    if (!inv.determined[static_cast<std::size_t>(a0 + j)]) return 1.0;
+    if (inv.determined[static_cast<std::size_t>(a0 + j)]) ia.push_back(a0 + j);
   for (int j = 0; j < nb; ++j)
-    if (!inv.determined[static_cast<std::size_t>(b0 + j)]) return 1.0;
-  const Eigen::LLT<Eigen::MatrixXd> la(inv.cov.block(a0, a0, na, na)), lb(inv.cov.block(b0, b0, nb, nb));
+    if (inv.determined[static_cast<std::size_t>(b0 + j)]) ib.push_back(b0 + j);
+  if (ia.empty() || ib.empty()) return 1.0;
+  const Eigen::MatrixXd Caa = inv.cov(ia, ia), Cbb = inv.cov(ib, ib), Cab = inv.cov(ia, ib);
+  const Eigen::LLT<Eigen::MatrixXd> la(Caa), lb(Cbb);
   if (la.info() != Eigen::Success || lb.info() != Eigen::Success) return 1.0;
-  Eigen::MatrixXd M = la.matrixL().solve(inv.cov.block(a0, b0, na, nb));
+  Eigen::MatrixXd M = la.matrixL().solve(Cab);
   M = lb.matrixL().solve(M.transpose()).transpose();
   const Eigen::JacobiSVD<Eigen::MatrixXd> svd(M);
   return std::min(1.0, svd.singularValues()[0]);
@@ -364,10 +381,12 @@ namespace {
 struct SessionsLengthModel : ResidualModel {
   const std::vector<BallbarArrays>& d;
   const EffectModel& fx;
-  int ns, P;
+  int ns, P;          // ns: pivots (columns 8 + 3 k), P: effect parameters
+  std::vector<int> pivot_of;  // pivot index of each session
   std::vector<std::pair<int, Eigen::Index>> rows;  // (session, row) of every residual
-  SessionsLengthModel(const std::vector<BallbarArrays>& d_, const EffectModel& fx_, int ns_, int P_) : d(d_), fx(fx_), ns(ns_), P(P_) {
-    for (int s = 0; s < ns; ++s)
+  SessionsLengthModel(const std::vector<BallbarArrays>& d_, const EffectModel& fx_, std::vector<int> pivot_of_, int P_)
+      : d(d_), fx(fx_), ns(*std::max_element(pivot_of_.begin(), pivot_of_.end()) + 1), P(P_), pivot_of(std::move(pivot_of_)) {
+    for (int s = 0; s < static_cast<int>(d.size()); ++s)
       for (Eigen::Index i = 0; i < d[static_cast<std::size_t>(s)].size(); ++i) rows.push_back({s, i});
   }
   Eigen::Index num_residuals() const override { return static_cast<Eigen::Index>(rows.size()); }
@@ -381,7 +400,8 @@ struct SessionsLengthModel : ResidualModel {
     const int s = rows[static_cast<std::size_t>(k)].first;
     const Eigen::Index i = rows[static_cast<std::size_t>(k)].second;
     const BallbarArrays& a = d[static_cast<std::size_t>(s)];
-    const Vec3<T> pivot(p[8 + 3 * s], p[9 + 3 * s], p[10 + 3 * s]);
+    const int piv = pivot_of[static_cast<std::size_t>(s)];
+    const Vec3<T> pivot(p[8 + 3 * piv], p[9 + 3 * piv], p[10 + 3 * piv]);
     const Eigen::Vector3d xyz = a.xyz.col(i);
     out[0] = predicted_length<T>(a.machine, LocationErrors<T>::from_ptr(p), pivot, fx, P > 0 ? p + 8 + 3 * ns : nullptr,
                                  xyz, a.angles[static_cast<std::size_t>(i)], a.time[i]) -
@@ -393,7 +413,7 @@ struct SessionsLengthModel : ResidualModel {
 // the joint fit's model without solving it (8 location errors, pivot, effects).
 Eigen::MatrixXd nominal_jacobian(const BallbarSession& s, const EffectModel& fx) {
   const std::vector<BallbarArrays> data = {ballbar_arrays(s)};
-  const SessionsLengthModel model(data, fx, 1, fx.num_params());
+  const SessionsLengthModel model(data, fx, {0}, fx.num_params());
   Eigen::VectorXd x = Eigen::VectorXd::Zero(model.num_parameters());
   x.segment<3>(8) = data[0].pivot;
   Eigen::VectorXd r(model.num_residuals());
@@ -429,7 +449,8 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session, const 
   D.motion = table_motion_overlap(m, pair[0], pair[1], o.tilt_limits_deg, t_end + o.max_added_time_s,
                                   o.reference_radius_mm);
 
-  // The session's information: its joint-fit Jacobian (pair included) over its noise.
+  // The session's information: its joint-fit Jacobian (pair included) over its noise, whose
+  // model comes from the residuals of the fit.
   JointFitOptions fo;
   fo.effects = fx;
   fo.noise = NoiseHandling::white;
@@ -444,9 +465,15 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session, const 
   if (id.noise.n > 0 && id.noise.effective_samples > 0.0)
     D.effective_per_reading = std::min(1.0, id.noise.effective_samples / static_cast<double>(id.noise.n));
   const double w = D.effective_per_reading / (sigma_um * sigma_um * 1e-6);
-  const Eigen::MatrixXd Is = id.jacobian.transpose() * id.jacobian * w;
+  // The Jacobian at the start point, where the fit judges what it can see (at its solution,
+  // location errors of 0.1 mm lend second-order sensitivity that the fit does not use).
+  const Eigen::MatrixXd Js = nominal_jacobian(session, fx);
+  const Eigen::MatrixXd Is = Js.transpose() * Js * w;
   for (const ParameterEstimate& e : id.parameters) D.names.push_back(e.name);
-  const Inverted before = invert_information(Is);
+  // Plausible magnitudes by unit (1 mm, 1 mrad, ...), as the fit's observability test uses.
+  Eigen::VectorXd plausible = Eigen::VectorXd::Constant(p0 + 3, plausible_magnitude("mm"));
+  for (int j = 0; j < p0; ++j) plausible[j] = plausible_magnitude(id.parameters[static_cast<std::size_t>(j)].unit);
+  const Inverted before = invert_information(Is, plausible.head(p0), 1.0 / D.effective_per_reading);
   D.sigma_before = before.sigma;
   D.correlation_before = canonical_correlation(before, 11, na, 11 + na, nb);
   D.sigma_after = D.sigma_before;
@@ -527,15 +554,16 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session, const 
     I0.topLeftCorner(p0, p0) = Is;
     for (double slow = 1.0; duration * slow <= o.max_added_time_s * (1 + 1e-12); slow *= 2.0) {
       const Eigen::MatrixXd I = I0 + slow * Ia;
-      const Inverted inv = invert_information(I);
+      const Inverted inv = invert_information(I, plausible.head(p), 1.0 / D.effective_per_reading);
       SeparatingCandidate c;
       c.setup = setup;
       c.new_pivot = moved;
       c.duration_s = duration;
       c.slow_down = slow;
       c.correlation = canonical_correlation(inv, 11, na, 11 + na, nb);
-      c.determined = c.correlation < 1.0;
-      const bool ok = c.determined && c.correlation < o.max_correlation;
+      c.determined = true;
+      for (int j = 11; j < 11 + ne; ++j) c.determined = c.determined && inv.determined[static_cast<std::size_t>(j)];
+      const bool ok = c.correlation < o.max_correlation;
       const double run = duration * slow;
       if (ok) {
         if (!have_best || run < D.chosen.duration_s * D.chosen.slow_down - 1e-9 ||
@@ -550,12 +578,6 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session, const 
         D.chosen = c;
         best_info = I;
         have_fallback = true;
-      }
-      if (!c.determined && slow == 1.0 && inv.determined.size() == static_cast<std::size_t>(p)) {
-        // More of the same geometry cannot determine what it does not see.
-        bool any_pair_undetermined = false;
-        for (int j = 11; j < 11 + ne; ++j) any_pair_undetermined |= !inv.determined[static_cast<std::size_t>(j)];
-        if (any_pair_undetermined) break;
       }
     }
   }
@@ -575,7 +597,7 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session, const 
       d << ", from the session's pivot " << vec_text(c.setup.pivot);
     if (c.slow_down > 1.0) d << ", at 1/" << fmt(c.slow_down, 0) << " of the feeds";
     c.description = d.str();
-    const Inverted after = invert_information(best_info);
+    const Inverted after = invert_information(best_info, plausible.head(best_info.rows()), 1.0 / D.effective_per_reading);
     D.sigma_after = after.sigma;
     if (c.new_pivot)
       for (const char* n : {"pivot_x#2", "pivot_y#2", "pivot_z#2"}) D.names.push_back(n);
@@ -594,6 +616,13 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session, const 
       << (D.candidates_tried ? "; the closest is " + D.chosen.description + " (correlation " +
                                    fmt(D.chosen.correlation, 2) + "): a longer test or another instrument may"
                              : std::string("; every candidate breaks a limit"));
+  if (D.candidates_tried) {
+    std::string held;
+    for (std::size_t j = 11; j < 11 + static_cast<std::size_t>(ne); ++j)
+      if (!std::isfinite(D.sigma_after[static_cast<Eigen::Index>(j)])) held += (held.empty() ? "" : ", ") + D.names[j];
+    if (!held.empty())
+      v << "; not determined even then (held at 0 by the fit, predicted 1 sigma beyond a plausible size): " << held;
+  }
   D.verdict = v.str();
   return D;
 }
@@ -607,14 +636,23 @@ JointFitOutcome identify_joint_sessions(const std::vector<BallbarSession>& sessi
     if (!f.applies_to(m)) throw InvalidArgument("effect " + f.id() + " does not exist on a " + to_string(m));
   std::vector<BallbarArrays> data;
   for (const BallbarSession& s : sessions) data.push_back(ballbar_arrays(s));
-  const int ns = static_cast<int>(sessions.size()), P = effects.num_params();
+  // Sessions with the same nominal pivot share it (the ball stayed in its cup).
+  std::vector<int> pivot_of;
+  std::vector<Eigen::Vector3d> pivots;
+  for (const BallbarSession& s : sessions) {
+    int k = 0;
+    while (k < static_cast<int>(pivots.size()) && (pivots[static_cast<std::size_t>(k)] - s.pivot).norm() > 1e-9) ++k;
+    if (k == static_cast<int>(pivots.size())) pivots.push_back(s.pivot);
+    pivot_of.push_back(k);
+  }
+  const int ns = static_cast<int>(pivots.size()), P = effects.num_params();
   std::vector<FitParameter> params;
   for (int k = 0; k < 8; ++k)
     params.push_back({location_error_names(m)[static_cast<std::size_t>(k)], location_error_is_angle(k) ? "rad" : "mm", 0.0});
   const char* axis = "xyz";
   for (int s = 0; s < ns; ++s)
     for (int k = 0; k < 3; ++k)
-      params.push_back({std::string("pivot_") + axis[k] + "#" + std::to_string(s + 1), "mm", data[static_cast<std::size_t>(s)].pivot[k]});
+      params.push_back({std::string("pivot_") + axis[k] + "#" + std::to_string(s + 1), "mm", pivots[static_cast<std::size_t>(s)][k]});
   for (const std::string& l : effects.param_labels()) params.push_back({l, "", 0.0});
   for (std::size_t j = 8 + 3 * static_cast<std::size_t>(ns); j < params.size(); ++j) {
     // Units of the effect parameters, in label order.
@@ -625,7 +663,7 @@ JointFitOutcome identify_joint_sessions(const std::vector<BallbarSession>& sessi
       k -= u.size();
     }
   }
-  const SessionsLengthModel model(data, effects, ns, P);
+  const SessionsLengthModel model(data, effects, pivot_of, P);
   JointFitSettings settings;
   settings.sigma = sessions.front().noise_um.value_or(1.0) * 1e-3;
   return solve_joint(model, params, settings);

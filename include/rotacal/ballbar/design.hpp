@@ -146,7 +146,11 @@ struct SeparatingCandidate {
   std::string description;         ///< in words
   double duration_s = 0.0;         ///< run time at the base feeds
   double slow_down = 1.0;          ///< feeds divided by this to gather data (run time x this)
-  double correlation = 1.0;        ///< largest canonical correlation of the pair afterwards
+  /// Largest canonical correlation of the pair's determined parameters afterwards (1: an
+  /// effect has none). A parameter is held as the joint fit holds it: one per combination
+  /// that moving by plausible magnitudes changes chi-square by less than 1
+  /// (analyse_observability, core/least_squares.hpp).
+  double correlation = 1.0;
   bool determined = false;         ///< every parameter of both effects is determined
 };
 
@@ -156,7 +160,7 @@ struct SeparationDesign {
   /// Parameters of the joint fit: 8 location errors, the session's pivot (3), the two effects'
   /// parameters, and the added set-up's pivot (3) when it moved (absent from sigma_before).
   std::vector<std::string> names;
-  Eigen::VectorXd sigma_before;  ///< session alone, 1 sigma, fit units; infinite: undetermined
+  Eigen::VectorXd sigma_before;  ///< session alone, 1 sigma, fit units; infinite: held (undetermined)
   Eigen::VectorXd sigma_after;   ///< session + the chosen test
   double correlation_before = 1.0;  ///< largest canonical correlation of the pair (1: undetermined)
   bool found = false;               ///< a test within max_added_time_s reaches max_correlation
@@ -182,9 +186,10 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session, const 
                                            const SeparationOptions& options = {});
 
 /// Joint fit of several ballbar sessions of one machine (e.g. a session and the test added to
-/// it): location errors and the effects shared, one pivot per session, lengths by the exact
+/// it): location errors and the effects shared, one pivot per distinct nominal pivot (sessions
+/// with the same nominal pivot share it: the ball stayed in its cup), lengths by the exact
 /// model (model.hpp) with Jets. Parameters: 8 location errors, then pivot x, y, z of each
-/// session ("pivot_x#k"), then the effect parameters. White least squares; the covariance is
+/// distinct pivot in order of first use ("pivot_x#k"), then the effect parameters. White least squares; the covariance is
 /// (J^T J)^-1 s^2. Throws InvalidArgument for no session, mixed machines or an effect that does
 /// not exist on the machine.
 JointFitOutcome identify_joint_sessions(const std::vector<BallbarSession>& sessions, const EffectModel& effects);
