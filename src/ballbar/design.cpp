@@ -621,7 +621,9 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session, const 
     for (std::size_t j = 11; j < 11 + static_cast<std::size_t>(ne); ++j)
       if (!std::isfinite(D.sigma_after[static_cast<Eigen::Index>(j)])) held += (held.empty() ? "" : ", ") + D.names[j];
     if (!held.empty())
-      v << "; not determined even then (held at 0 by the fit, predicted 1 sigma beyond a plausible size): " << held;
+      v << "; " << held
+        << " stay undetermined (no reading of these tests sees them: the joint fit holds them at 0, and "
+           "the correlation is that of the rest)";
   }
   D.verdict = v.str();
   return D;

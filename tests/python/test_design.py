@@ -58,3 +58,46 @@ def test_a_pair_no_single_setup_separates_is_reported():
 def test_design_refuses_by_option(args, option):
     r = rotacal_cli("design", "ballbar", "--step", "5", "--pivot-x", "120", "--pivot-z", "60", *args)
     assert r.returncode in (2, EXIT_INPUT) and option in r.stderr, r.stderr
+
+
+from conftest import SHARED  # noqa: E402
+
+TABLE2 = SHARED / "ballbar_ac_table2.csv"
+
+
+def test_separate_after_a_session_proposes_the_added_test(tmp_path):
+    prog = tmp_path / "added.ngc"
+    r = rotacal_cli("design", "ballbar", "--separate", "axial_motion_C_h2,tilt_motion_C_h2", "--after", TABLE2,
+                    "--json", "-o", prog)
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout)
+    assert d["separable"] and d["found"]
+    added = d["added_test"]
+    assert added["correlation_after"] < 0.5 < d["correlation_before"]
+    assert added["run_time_s"] <= 600
+    # Both effects come out better determined than from the session alone.
+    for name, after in d["predicted_std_after"].items():
+        before = d["predicted_std_before"].get(name)
+        if name.startswith(("axial_motion_C_h2", "tilt_motion_C_h2")) and after is not None:
+            assert before is None or after <= before * (1 + 1e-9)
+    # The program is that of the added test, at the slowed feeds.
+    text = prog.read_text()
+    assert added["tests"][-1] in text
+
+
+def test_separate_says_when_no_test_can():
+    r = rotacal_cli("design", "ballbar", "--separate", "gravity_sag_A,radial_motion_A_h2", "--after", TABLE2)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.startswith("no test can separate gravity_sag_A and radial_motion_A_h2")
+    assert "moves the table exactly as" in r.stdout
+
+
+@pytest.mark.parametrize("args,option", [
+    (("--separate", "axial_motion_C_h2,tilt_motion_C_h2"), "--after"),
+    (("--after", str(TABLE2)), "--separate"),
+    (("--separate", "axial_motion_C_h2", "--after", str(TABLE2)), "--separate"),
+    (("--separate", "axial_motion_C_h2,no_such_effect", "--after", str(TABLE2)), "no_such_effect"),
+])
+def test_separate_refuses_by_option(args, option):
+    r = rotacal_cli("design", "ballbar", *args)
+    assert r.returncode in (2, EXIT_INPUT) and option in r.stderr, r.stderr
