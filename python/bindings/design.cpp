@@ -1,6 +1,7 @@
 // Bindings for include/rotacal/ballbar/design.hpp: the ballbar test design.
 #include "numpy.hpp"
 #include "rotacal/ballbar/design.hpp"
+#include "rotacal/rtest/design.hpp"
 
 namespace rotacal::py {
 
@@ -122,6 +123,43 @@ void bind_design(pyb::module_& m) {
       pyb::arg("sessions"), pyb::arg("effects") = std::vector<std::string>{},
       "Joint fit of several ballbar sessions (shared location errors and effects, one pivot each): "
       "(values, covariance, converged) in the order 8 location errors, pivots, effect parameters.");
+  pyb::class_<RtestDesignOptions>(m, "RtestDesignOptions", "Options of design_rtest_test (defaults).")
+      .def(pyb::init<>())
+      .def_readwrite("base", &RtestDesignOptions::base, "the default pattern: nests, grid, dwell")
+      .def_readwrite("nest_radius_mm", &RtestDesignOptions::nest_radius_mm)
+      .def_readwrite("nest_height_mm", &RtestDesignOptions::nest_height_mm)
+      .def_readwrite("b_step_deg", &RtestDesignOptions::b_step_deg)
+      .def_readwrite("c_step_deg", &RtestDesignOptions::c_step_deg)
+      .def_readwrite("b_limits_deg", &RtestDesignOptions::b_limits_deg)
+      .def_readwrite("travel_min", &RtestDesignOptions::travel_min, "X, Y, Z, mm (formats.md frame)")
+      .def_readwrite("travel_max", &RtestDesignOptions::travel_max)
+      .def_readwrite("time_budget_s", &RtestDesignOptions::time_budget_s, "0: the base pattern's run time")
+      .def_readwrite("noise_um", &RtestDesignOptions::noise_um)
+      .def_readwrite("noise_rho", &RtestDesignOptions::noise_rho)
+      .def_readwrite("reference_radius_mm", &RtestDesignOptions::reference_radius_mm)
+      .def_readwrite("basis", &RtestDesignOptions::basis);
+  pyb::class_<RtestDesignCandidate>(m, "RtestDesignCandidate", "One R-test pattern, evaluated.")
+      .def_readonly("pattern", &RtestDesignCandidate::pattern)
+      .def_readonly("feasible", &RtestDesignCandidate::feasible)
+      .def_readonly("why_not", &RtestDesignCandidate::why_not)
+      .def_readonly("duration_s", &RtestDesignCandidate::duration_s)
+      .def_readonly("names", &RtestDesignCandidate::names)
+      .def_readonly("sigma", &RtestDesignCandidate::sigma, "predicted 1 sigma at the time budget (mm, rad)")
+      .def_readonly("worst_expanded_um", &RtestDesignCandidate::worst_expanded_um)
+      .def_readonly("worst_error", &RtestDesignCandidate::worst_error);
+  pyb::class_<RtestDesign>(m, "RtestDesign", "The chosen R-test pattern and the default one.")
+      .def_readonly("best", &RtestDesign::best)
+      .def_readonly("baseline", &RtestDesign::baseline)
+      .def_readonly("time_budget_s", &RtestDesign::time_budget_s)
+      .def_readonly("ratio", &RtestDesign::ratio)
+      .def_readonly("candidates", &RtestDesign::candidates);
+  m.def(
+      "design_rtest_test",
+      [](const RtestDesignOptions& o) {
+        pyb::gil_scoped_release release;
+        return design_rtest_test(o);
+      },
+      pyb::arg("options"), "The R-test nests and pose grid with the smallest predicted uncertainty (rtest/design.hpp).");
 }
 
 }  // namespace rotacal::py

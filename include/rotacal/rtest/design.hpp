@@ -1,0 +1,80 @@
+#pragma once
+/// \file
+/// Design of the R-test measurement before the machine runs it: the two nest positions
+/// (radius from the C axis, height above the B axis) and the pose grid (B and C steps within
+/// the rotary limits) whose joint fit (rtest/identify_joint.hpp: location errors, the smooth
+/// maps of both axes and a probe zero per nest) gives the smallest largest expanded uncertainty
+/// (k = 2) of the eight location errors at a time budget, within the machine's travel.
+///
+/// Information: the R-test joint fit is called on the noise-free readings of the nominal
+/// machine with a whitener that divides every residual by the noise sigma, so its covariance
+/// is exactly (J^T J)^-1 sigma^2, the inverse Fisher information of that fit. Run time: every
+/// pose of every nest takes `dwell_s` (hw/pose_window.hpp), so a pattern lasts
+/// poses x nests x dwell; a pattern shorter than the budget is repeated (or dwelt on longer)
+/// to fill it, which scales the information by budget / run time. AR(1) noise with
+/// coefficient rho between successive readings counts (1 - rho) / (1 + rho) effective readings
+/// per reading. Nests: the first on +X at (r1, 0, h1), the second on -Y at (0, -r2, h2), as in
+/// Oyama and Ibaraki's set-up; nests and grid are chosen one after the other (nests at the base
+/// grid, then the grid at the chosen nests), which keeps the design within a few seconds.
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "rotacal/rtest/identify_joint.hpp"
+#include "rotacal/rtest/simulate.hpp"
+
+namespace rotacal {
+
+struct RtestDesignOptions {
+  RtestPattern base;  ///< the default pattern (nests, grid, dwell) the design is compared with
+  std::vector<double> nest_radius_mm = {50.0, 100.0, 150.0};        ///< from the C axis
+  std::vector<double> nest_height_mm = {20.0, 60.0, 100.0, 140.0};  ///< above the B axis
+  std::vector<double> b_step_deg = {15.0, 30.0, 45.0};              ///< B grid steps tried
+  std::vector<double> c_step_deg = {30.0, 45.0, 60.0};              ///< C grid steps tried (full turn)
+  std::array<double, 2> b_limits_deg = {-90.0, 90.0};               ///< rotary limits of B
+  /// Travel of X, Y, Z (machine frame of formats.md: origin at the nominal intersection of B
+  /// and C), mm; every commanded sphere centre must lie within it.
+  Eigen::Vector3d travel_min = Eigen::Vector3d(-400, -300, -300);
+  Eigen::Vector3d travel_max = Eigen::Vector3d(400, 300, 400);
+  double time_budget_s = 0.0;          ///< 0: the base pattern's run time
+  double noise_um = 0.3;               ///< 1 sigma per reading component (dx, dy, dz)
+  double noise_rho = 0.0;              ///< AR(1) coefficient between readings, [0, 0.999]
+  double reference_radius_mm = 100.0; ///< an orientation error in rad counts as this lever arm
+  RtestBasis basis;                    ///< of the joint fit
+};
+
+struct RtestDesignCandidate {
+  RtestPattern pattern;
+  bool feasible = false;
+  std::string why_not;            ///< which limit, or which location error is not determined
+  double duration_s = 0.0;        ///< poses x nests x dwell
+  std::vector<std::string> names; ///< the fit's parameters (location errors, maps, zeros)
+  Eigen::VectorXd sigma;          ///< predicted 1 sigma at the budget (infinite: held by the fit)
+  double worst_expanded_um = 0.0; ///< max over the location errors of 2 sigma (rad x reference radius)
+  std::string worst_error;
+};
+
+struct RtestDesign {
+  RtestDesignCandidate best;
+  RtestDesignCandidate baseline;  ///< options.base, evaluated the same way
+  double time_budget_s = 0.0;
+  double ratio = 0.0;             ///< best / baseline worst expanded uncertainty
+  std::vector<RtestDesignCandidate> candidates;
+};
+
+/// Evaluate one pattern at a time budget (0: its own run time). A pattern beyond the budget,
+/// the travel or the B limits, or one whose fit cannot determine a location error or a map
+/// coefficient (a grid too coarse for the basis fits a smaller model, not comparable), is
+/// returned not feasible with the reason; never throws for those.
+RtestDesignCandidate evaluate_rtest_design(const RtestPattern& pattern, const RtestDesignOptions& options,
+                                           double time_budget_s);
+
+/// Choose nests, then grid. Throws InvalidArgument naming the option for empty grids,
+/// non-positive steps, noise, dwell or reference radius, rho outside [0, 0.999], reversed B
+/// limits, or when no candidate is feasible (the message gives reasons).
+RtestDesign design_rtest_test(const RtestDesignOptions& options);
+
+}  // namespace rotacal
