@@ -10,6 +10,10 @@ correlation < 0.5 with one added test of <= 10 min, design <= 10 s), its Monte C
 (session and added test simulated again and fitted jointly: realised / predicted sigma, target
 0.7-1.4), and gravity_sag_A against radial_motion_A_h2 (target: reported inseparable).
 
+R-test (Oyama and Ibaraki's B/C table and pattern): the designed nests and grid against the
+default pattern at the same run time, the design time, and the Monte Carlo check of the
+designed pattern under AR(1) noise (rho 0.4).
+
     PYTHONPATH=... python bench/design_bench.py            # the default grid, 100 draws
     PYTHONPATH=... python bench/design_bench.py --smoke    # a 2 x 2 grid, 10 draws
 """
@@ -64,6 +68,7 @@ def main() -> None:
     ratio = realised / predicted
     print(f"Monte Carlo sigma / predicted over {draws} draws: {ratio.min():.2f}-{ratio.max():.2f} (target 0.7-1.4)")
     separation(draws)
+    rtest_design(draws)
 
 
 SEPARATE = ["axial_motion_C_h2", "tilt_motion_C_h2"]
@@ -122,6 +127,48 @@ def separation(draws: int) -> None:
     print(f"gravity_sag_A / radial_motion_A_h2 in {time.perf_counter() - t0:.2f} s: "
           f"{'inseparable' if g.motion.same_motion else 'separable'} (target: inseparable)")
     print(f"  {g.verdict}")
+
+
+
+def rtest_design(draws: int) -> None:
+    t0 = time.perf_counter()
+    o = _core.RtestDesignOptions()
+    o.noise_um, o.noise_rho = 0.3, 0.4
+    d = _core.design_rtest_test(o)
+    elapsed = time.perf_counter() - t0
+    print(f"R-test design: {len(d.candidates)} patterns in {elapsed:.2f} s (target <= 10 s)")
+    for label, c in (("designed", d.best), ("default", d.baseline)):
+        p = c.pattern
+        print(f"  {label:9s} nests {[tuple(float(v) for v in n) for n in p.nests]}, B {len(p.b_deg)} x C {len(p.c_deg)}, "
+              f"{c.duration_s:.0f} s: largest U (k=2) {c.worst_expanded_um:.4f} um ({c.worst_error})")
+    print(f"  ratio designed / default at {d.time_budget_s:.0f} s: {d.ratio:.3f}")
+    # Monte Carlo of the designed pattern at its own run time (no repeats), AR(1) noise.
+    c = _core.evaluate_rtest_design(d.best.pattern, o, 0.0) if hasattr(_core, "evaluate_rtest_design") else None
+    if c is None:
+        return
+    p = c.pattern
+    est = []
+    for k in range(draws):
+        s, _ = rtest_session(p, k)
+        e = _core.noise_ar1(np.repeat(s.setups, 3).tolist(), np.repeat(s.time, 3).tolist(), o.noise_rho,
+                            o.noise_um * 1e-3, 900 + k).reshape(-1, 3)
+        s = s.with_displacements(np.asarray(s.d) + e)
+        ident = _core.identify_rtest_joint(s, noise="white")
+        est.append([p_.value for p_ in ident.parameters[:8]])
+    ratio = np.std(np.asarray(est), axis=0, ddof=1) / np.asarray(c.sigma)[:8]
+    print(f"  Monte Carlo sigma / predicted of the designed pattern over {draws} draws: "
+          f"{ratio.min():.2f}-{ratio.max():.2f} (target 0.7-1.4)")
+
+
+def rtest_session(p, k: int):
+    from rotacal import rtest
+    errors = {"E_X0B": 0.02, "E_Z0B": -0.015, "E_A0B": 3e-5, "E_C0B": -2e-5, "E_X0C": 0.01, "E_Y0C": 0.025,
+              "E_A0C": 1.5e-5, "E_B0C": -4e-5}
+    return rtest.simulate_rtest(errors, {}, machine="BC-trt", b_deg=list(p.b_deg), c_deg=list(p.c_deg),
+                                # the noise is added as AR(1) by the caller; 1e-6 um white here only
+                                # so that the session declares a noise level (the fit needs one)
+                                nests=[list(map(float, n)) for n in p.nests], noise_um=1e-6, probe_zero_um=20.0,
+                                probe_dirs=None, write_d=True, dwell_s=p.dwell_s, seed=100 + k)
 
 
 if __name__ == "__main__":

@@ -154,6 +154,14 @@ void bind_design(pyb::module_& m) {
       .def_readonly("ratio", &RtestDesign::ratio)
       .def_readonly("candidates", &RtestDesign::candidates);
   m.def(
+      "evaluate_rtest_design",
+      [](const RtestPattern& pattern, const RtestDesignOptions& o, double time_budget_s) {
+        pyb::gil_scoped_release release;
+        return evaluate_rtest_design(pattern, o, time_budget_s);
+      },
+      pyb::arg("pattern"), pyb::arg("options"), pyb::arg("time_budget_s") = 0.0,
+      "One R-test pattern evaluated at a time budget (0: its own run time).");
+  m.def(
       "design_rtest_test",
       [](const RtestDesignOptions& o) {
         pyb::gil_scoped_release release;

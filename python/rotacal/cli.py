@@ -691,6 +691,41 @@ def cmd_design_ballbar(a: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def cmd_design_rtest(a: argparse.Namespace) -> int:
+    from .design import rtest_design_dict, design_rtest
+    d = design_rtest(radii=a.radii, heights=a.heights, b_steps=a.b_steps, c_steps=a.c_steps, b_limits=a.b_limits,
+                     travel=a.travel, time_s=a.time, noise_um=a.noise, rho=a.rho, dwell_s=a.dwell)
+    if a.json:
+        print(jsontext.dumps(rtest_design_dict(d)))
+        return EXIT_OK
+    feasible = sum(c.feasible for c in d.candidates)
+    print(f"{len(d.candidates)} patterns tried, {feasible} within the limits; run time {d.time_budget_s:.0f} s, "
+          f"noise {a.noise:g} um per reading" + (f", AR(1) rho {a.rho:g}" if a.rho else ""))
+    for label, c in (("designed", d.best), ("default", d.baseline)):
+        p = c.pattern
+        nests = "; ".join(",".join(f"{v:g}" for v in n) for n in p.nests)
+        if not c.feasible:
+            print(f"{label:9s} nests {nests}: {c.why_not}")
+            continue
+        print(f"{label:9s} nests {nests} mm, B {len(p.b_deg)} x C {len(p.c_deg)} poses, {c.duration_s:.0f} s: "
+              f"largest expanded uncertainty (k=2) {c.worst_expanded_um:.3f} um ({c.worst_error})")
+    if d.baseline.feasible:
+        print(f"ratio designed / default: {d.ratio:.3f}")
+    p = d.best.pattern
+    b = list(p.b_deg)
+    c = list(p.c_deg)
+    step = lambda v: v[1] - v[0] if len(v) > 1 else 360.0  # noqa: E731
+    print("run it with: " + " ".join(f"--nest {','.join(f'{v:g}' for v in n)}" for n in p.nests)
+          + f" --b-range {b[0]:g},{b[-1]:g} --b-step {step(b):g} --c-step {step(c):g} --dwell {p.dwell_s:g}"
+          + (f" (repeat it {d.time_budget_s / d.best.duration_s:.2f} times, or dwell longer, to fill the run time)"
+             if d.best.duration_s < d.time_budget_s * 0.999 else ""))
+    print("predicted 1-sigma of the location errors:")
+    for i, (n, s_) in enumerate(zip(d.best.names[:8], d.best.sigma[:8])):
+        unit, k = ("urad", 1e6) if i in (2, 3, 6, 7) else ("um", 1e3)
+        print(f"  {n:8s} {s_ * k:10.4f} {unit}")
+    return EXIT_OK
+
+
 def cmd_export(a: argparse.Namespace) -> int:
     from .exports import export_controller, export_dict, linuxcnc_comp_table, residual_model
     from .models import load_model, save_model
@@ -1101,6 +1136,30 @@ def build_parser() -> argparse.ArgumentParser:
                    help="write the designed test's NC program here (with --separate: the added test's)")
     k.add_argument("--json", action="store_true")
     k.set_defaults(func=cmd_design_ballbar)
+    k = dk.add_parser("rtest", help="the R-test nests and B/C grid with the smallest predicted uncertainty",
+                      epilog=EPILOG + "; docs/design.md")
+    k.add_argument("--radii", type=number_list("--radii", 0.0, 2000.0, "mm", 20),
+                   help="nest distances from the C axis to try, mm (default 50,100,150)")
+    k.add_argument("--heights", type=number_list("--heights", -2000.0, 2000.0, "mm", 20),
+                   help="nest heights above the B axis to try, mm (default 20,60,100,140)")
+    k.add_argument("--b-steps", type=number_list("--b-steps", 0.1, 180.0, "deg", 20),
+                   help="B grid steps to try, deg (default 15,30,45)")
+    k.add_argument("--c-steps", type=number_list("--c-steps", 0.1, 359.0, "deg", 20),
+                   help="C grid steps to try over a full turn, deg (default 30,45,60)")
+    k.add_argument("--b-limits", type=numbers("--b-limits", 2, 360.0, "deg"), help="rotary limits of B, deg (default -90,90)")
+    k.add_argument("--travel", type=numbers("--travel", 6, 1e5, "mm"),
+                   help="xmin,xmax,ymin,ymax,zmin,zmax of X, Y, Z about the rotary axes' intersection, mm "
+                        "(default -400,400,-300,300,-300,400)")
+    k.add_argument("--time", type=number("--time", 0.0, 86400.0, "s"), default=0.0,
+                   help="run time to compare at, s (default: the default pattern's)")
+    k.add_argument("--dwell", type=number("--dwell", 0.0, 3600.0, "s", lo_open=True),
+                   help="time per pose, s (default 6)")
+    k.add_argument("--noise", type=number("--noise", 0.0, 1000.0, "um", lo_open=True), default=0.3,
+                   help="1-sigma noise per reading component, um (default 0.3)")
+    k.add_argument("--rho", type=number("--rho", 0.0, 0.999, ""), default=0.0,
+                   help="AR(1) coefficient of the noise between readings (default 0: white)")
+    k.add_argument("--json", action="store_true")
+    k.set_defaults(func=cmd_design_rtest)
 
     q = sub.add_parser("export", help="write the identified location errors into a controller's kinematic parameters",
                        epilog=EPILOG + "; the mapping field by field: docs/controller_exports.md")

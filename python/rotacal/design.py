@@ -142,3 +142,46 @@ def separation_dict(d: Any) -> dict:
                              "correlation_after": c.correlation}
         out["predicted_std_after"] = sig(d.sigma_after)
     return out
+
+
+def design_rtest(*, radii: Sequence[float] | None = None, heights: Sequence[float] | None = None,
+                 b_steps: Sequence[float] | None = None, c_steps: Sequence[float] | None = None,
+                 b_limits: Sequence[float] | None = None, travel: Sequence[float] | None = None,
+                 time_s: float = 0.0, noise_um: float = 0.3, rho: float = 0.0, dwell_s: float | None = None) -> Any:
+    """A ``_core.RtestDesign``: the two R-test nests and the B/C grid with the smallest
+    predicted largest expanded uncertainty of the location errors at the run time ``time_s``
+    (0: the default pattern's), against the default pattern (C++: ``rotacal/rtest/design.hpp``)."""
+    o = _core.RtestDesignOptions()
+    for value, field in ((radii, "nest_radius_mm"), (heights, "nest_height_mm"), (b_steps, "b_step_deg"),
+                         (c_steps, "c_step_deg")):
+        if value is not None:
+            setattr(o, field, [float(v) for v in value])
+    if b_limits is not None:
+        o.b_limits_deg = [float(v) for v in b_limits]
+    if travel is not None:
+        o.travel_min, o.travel_max = _travel(travel)
+    if dwell_s is not None:
+        base = o.base
+        base.dwell_s = float(dwell_s)
+        o.base = base
+    o.time_budget_s = float(time_s)
+    o.noise_um = float(noise_um)
+    o.noise_rho = float(rho)
+    return _core.design_rtest_test(o)
+
+
+def rtest_candidate_dict(c: Any) -> dict:
+    """One evaluated R-test pattern as JSON."""
+    p = c.pattern
+    out = {"nests": [list(map(float, n)) for n in p.nests], "b_deg": list(p.b_deg), "c_deg": list(p.c_deg),
+           "dwell_s": p.dwell_s, "feasible": c.feasible, "duration_s": c.duration_s}
+    if not c.feasible:
+        return out | {"why_not": c.why_not}
+    return out | {"predicted_std": {n: float(s) for n, s in zip(c.names, c.sigma)},
+                  "worst_expanded_um": c.worst_expanded_um, "worst_error": c.worst_error}
+
+
+def rtest_design_dict(d: Any) -> dict:
+    """The JSON of ``rotacal design rtest --json``."""
+    return {"time_budget_s": d.time_budget_s, "ratio_to_default": d.ratio, "best": rtest_candidate_dict(d.best),
+            "default": rtest_candidate_dict(d.baseline), "candidates": [rtest_candidate_dict(c) for c in d.candidates]}

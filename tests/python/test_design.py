@@ -101,3 +101,29 @@ def test_separate_says_when_no_test_can():
 def test_separate_refuses_by_option(args, option):
     r = rotacal_cli("design", "ballbar", *args)
     assert r.returncode in (2, EXIT_INPUT) and option in r.stderr, r.stderr
+
+
+def test_design_rtest_beats_the_default_pattern():
+    r = rotacal_cli("design", "rtest", "--radii", "50,150", "--heights", "20,100,140", "--b-steps", "30,45",
+                    "--c-steps", "30,60", "--travel", "-400,400,-300,300,-300,190", "--json")
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout)
+    best, default = d["best"], d["default"]
+    assert best["feasible"] and default["feasible"]
+    assert best["worst_expanded_um"] < default["worst_expanded_um"]
+    assert best["duration_s"] <= d["time_budget_s"] == default["duration_s"]
+    reasons = [c["why_not"] for c in d["candidates"] if not c["feasible"]]
+    assert any(w.startswith("Z = ") for w in reasons) and any("too coarse" in w for w in reasons)
+    text = rotacal_cli("design", "rtest", "--radii", "50,150", "--heights", "20,100", "--b-steps", "30",
+                       "--c-steps", "30").stdout
+    assert "run it with: --nest" in text
+
+
+@pytest.mark.parametrize("args,option", [
+    (("--rho", "1.5"), "--rho"),
+    (("--c-steps", "0"), "--c-steps"),
+    (("--travel", "-1,1,-1,1,-1,1"), "no nest pair"),
+])
+def test_design_rtest_refuses_by_option(args, option):
+    r = rotacal_cli("design", "rtest", "--radii", "100", "--heights", "60", "--b-steps", "30", "--c-steps", "30", *args)
+    assert r.returncode in (2, EXIT_INPUT) and option in r.stderr, r.stderr
