@@ -153,7 +153,7 @@ def rtest_design(draws: int) -> None:
         e = _core.noise_ar1(np.repeat(s.setups, 3).tolist(), np.repeat(s.time, 3).tolist(), o.noise_rho,
                             o.noise_um * 1e-3, 900 + k).reshape(-1, 3)
         s = s.with_displacements(np.asarray(s.d) + e)
-        ident = _core.identify_rtest_joint(s, noise="white")
+        ident = _core.identify_rtest_joint(s, noise="auto")  # GLS under the fitted AR model
         est.append([p_.value for p_ in ident.parameters[:8]])
     ratio = np.std(np.asarray(est), axis=0, ddof=1) / np.asarray(c.sigma)[:8]
     print(f"  Monte Carlo sigma / predicted of the designed pattern over {draws} draws: "

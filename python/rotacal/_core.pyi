@@ -6,7 +6,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Ambiguity', 'AngleTable', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CompensationReport', 'CompensationRow', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SeparatingCandidate', 'SeparationDesign', 'SeparationOptions', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TableMotionOverlap', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'ballbar_model_document', 'ballbar_model_from_document', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_model_machine', 'check_output', 'check_plausible', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_ballbar_tests', 'default_calibration_moves', 'design_ballbar_separation', 'design_ballbar_test', 'diagnose_ballbar', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'export_controller', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_joint_sessions', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_rtest', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'table_motion_overlap', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
+__all__: list[str] = ['Ambiguity', 'AngleTable', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CompensationReport', 'CompensationRow', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestDesign', 'RtestDesignCandidate', 'RtestDesignOptions', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SeparatingCandidate', 'SeparationDesign', 'SeparationOptions', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TableMotionOverlap', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'ballbar_model_document', 'ballbar_model_from_document', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_model_machine', 'check_output', 'check_plausible', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_ballbar_tests', 'default_calibration_moves', 'design_ballbar_separation', 'design_ballbar_test', 'design_rtest_test', 'diagnose_ballbar', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'evaluate_rtest_design', 'export_controller', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_joint_sessions', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_rtest', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'table_motion_overlap', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
 class Ambiguity:
     @property
     def correlation(self) -> float:
@@ -1607,6 +1607,140 @@ class RtestBasis:
         """
         gamma_CB (angular positioning of C) in the C map
         """
+class RtestDesign:
+    """
+    The chosen R-test pattern and the default one.
+    """
+    @property
+    def baseline(self) -> RtestDesignCandidate:
+        ...
+    @property
+    def best(self) -> RtestDesignCandidate:
+        ...
+    @property
+    def candidates(self) -> list[RtestDesignCandidate]:
+        ...
+    @property
+    def ratio(self) -> float:
+        ...
+    @property
+    def time_budget_s(self) -> float:
+        ...
+class RtestDesignCandidate:
+    """
+    One R-test pattern, evaluated.
+    """
+    @property
+    def duration_s(self) -> float:
+        ...
+    @property
+    def feasible(self) -> bool:
+        ...
+    @property
+    def names(self) -> list[str]:
+        ...
+    @property
+    def pattern(self) -> RtestPattern:
+        ...
+    @property
+    def sigma(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        predicted 1 sigma at the time budget (mm, rad)
+        """
+    @property
+    def why_not(self) -> str:
+        ...
+    @property
+    def worst_error(self) -> str:
+        ...
+    @property
+    def worst_expanded_um(self) -> float:
+        ...
+class RtestDesignOptions:
+    """
+    Options of design_rtest_test (defaults).
+    """
+    basis: RtestBasis
+    def __init__(self) -> None:
+        ...
+    @property
+    def b_limits_deg(self) -> typing.Annotated[list[float], "FixedSize(2)"]:
+        ...
+    @b_limits_deg.setter
+    def b_limits_deg(self, arg0: typing.Annotated[collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], "FixedSize(2)"]) -> None:
+        ...
+    @property
+    def b_step_deg(self) -> list[float]:
+        ...
+    @b_step_deg.setter
+    def b_step_deg(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def base(self) -> RtestPattern:
+        """
+        the default pattern: nests, grid, dwell
+        """
+    @base.setter
+    def base(self, arg0: RtestPattern) -> None:
+        ...
+    @property
+    def c_step_deg(self) -> list[float]:
+        ...
+    @c_step_deg.setter
+    def c_step_deg(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def nest_height_mm(self) -> list[float]:
+        ...
+    @nest_height_mm.setter
+    def nest_height_mm(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def nest_radius_mm(self) -> list[float]:
+        ...
+    @nest_radius_mm.setter
+    def nest_radius_mm(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def noise_rho(self) -> float:
+        ...
+    @noise_rho.setter
+    def noise_rho(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def noise_um(self) -> float:
+        ...
+    @noise_um.setter
+    def noise_um(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def reference_radius_mm(self) -> float:
+        ...
+    @reference_radius_mm.setter
+    def reference_radius_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def time_budget_s(self) -> float:
+        """
+        0: the base pattern's run time
+        """
+    @time_budget_s.setter
+    def time_budget_s(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def travel_max(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @travel_max.setter
+    def travel_max(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+        ...
+    @property
+    def travel_min(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        """
+        X, Y, Z, mm (formats.md frame)
+        """
+    @travel_min.setter
+    def travel_min(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+        ...
 class RtestJointIdentification:
     @property
     def converged(self) -> bool:
@@ -2274,6 +2408,10 @@ def design_ballbar_test(options: BallbarDesignOptions) -> BallbarDesign:
     """
     The pivot and bar length with the smallest predicted uncertainty (ballbar/design.hpp).
     """
+def design_rtest_test(options: RtestDesignOptions) -> RtestDesign:
+    """
+    The R-test nests and pose grid with the smallest predicted uncertainty (rtest/design.hpp).
+    """
 def diagnose_ballbar(session: BallbarSession, options: DiagnosisOptions = ..., reference: rotacal._core.BallbarSession | None = None) -> Diagnosis:
     """
     Diagnose a ballbar session: baseline fit, residual structure, catalogue candidates, findings with their gain.
@@ -2293,6 +2431,10 @@ def effect_catalogue(machine: MachineType, max_harmonic: typing.SupportsInt | ty
 def estimate_noise_model(groups: collections.abc.Sequence[str], times: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], residuals_mm: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], options: NoiseModelOptions = ...) -> NoiseModel:
     """
     AR(p) model (Burg, BIC order) of the residuals per stream (group, channel).
+    """
+def evaluate_rtest_design(pattern: RtestPattern, options: RtestDesignOptions, time_budget_s: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> RtestDesignCandidate:
+    """
+    One R-test pattern evaluated at a time budget (0: its own run time).
     """
 def export_controller(model_path: str, controller: str, current_text: str | None = None, current_source: str = '<current>', toolholder: typing.SupportsInt | typing.SupportsIndex = 1, generated_at: str = '') -> ControllerExport:
     """

@@ -2,7 +2,9 @@
 #include "rotacal/rtest/design.hpp"
 
 #include <cmath>
+#include <algorithm>
 #include <limits>
+#include <map>
 #include <memory>
 #include <sstream>
 
@@ -21,17 +23,43 @@ std::string fmt(double v, int digits = 1) {
   return s.str();
 }
 
-// W = I / sigma: the joint fit's covariance becomes (J^T J)^-1 sigma^2 with no rescaling by
-// the (zero) residual variance of noise-free readings.
-class ScaleWhitener : public ResidualWhitener {
+// The whitener of AR(1) noise with coefficient rho and marginal sigma per stream (one per nest
+// and component dx, dy, dz, in time order, as noise_gen::ar1 and the noise model split them):
+//   w_0 = x_0 / sigma,   w_t = (x_t - rho x_{t-1}) / (sigma sqrt(1 - rho^2))   (Prais-Winsten).
+// With it the joint fit's covariance is (J^T Sigma^-1 J)^-1, the GLS covariance under that
+// noise, with no rescaling by the (zero) residual variance of noise-free readings. rho = 0
+// gives W = I / sigma, i.e. (J^T J)^-1 sigma^2.
+class Ar1Whitener : public ResidualWhitener {
  public:
-  ScaleWhitener(Eigen::Index n, double sigma_mm) : n_(n), inv_(1.0 / sigma_mm) {}
-  void apply(Eigen::Ref<Eigen::MatrixXd> columns) const override { columns *= inv_; }
+  Ar1Whitener(const RtestSession& s, double sigma_mm, double rho) : n_(3 * static_cast<Eigen::Index>(s.samples.size())) {
+    inv_first_ = 1.0 / sigma_mm;
+    inv_next_ = 1.0 / (sigma_mm * std::sqrt(1.0 - rho * rho));
+    rho_ = rho;
+    std::map<std::string, std::vector<std::size_t>> by_nest;
+    for (std::size_t i = 0; i < s.samples.size(); ++i) by_nest[s.samples[i].setup].push_back(i);
+    for (auto& [nest, rows] : by_nest) {
+      std::stable_sort(rows.begin(), rows.end(),
+                       [&](std::size_t a, std::size_t b) { return s.samples[a].time < s.samples[b].time; });
+      for (int k = 0; k < 3; ++k) {
+        std::vector<Eigen::Index> stream;
+        for (std::size_t i : rows) stream.push_back(3 * static_cast<Eigen::Index>(i) + k);
+        streams_.push_back(std::move(stream));
+      }
+    }
+  }
+  void apply(Eigen::Ref<Eigen::MatrixXd> columns) const override {
+    for (const auto& st : streams_) {
+      for (std::size_t t = st.size(); t-- > 1;)
+        columns.row(st[t]) = (columns.row(st[t]) - rho_ * columns.row(st[t - 1])) * inv_next_;
+      columns.row(st[0]) *= inv_first_;
+    }
+  }
   Eigen::Index size() const override { return n_; }
 
  private:
   Eigen::Index n_;
-  double inv_;
+  double inv_first_ = 1.0, inv_next_ = 1.0, rho_ = 0.0;
+  std::vector<std::vector<Eigen::Index>> streams_;
 };
 
 // min, min + step, ..., up to max (the end added when off the grid).
@@ -90,7 +118,7 @@ RtestDesignCandidate evaluate_rtest_design(const RtestPattern& pattern, const Rt
   s.noise_um = o.noise_um;  // the fit's chi-square scale (observability), as a recorder declares it
   RtestJointOptions fit;
   fit.basis = o.basis;
-  fit.whitener = std::make_shared<ScaleWhitener>(3 * static_cast<Eigen::Index>(s.samples.size()), o.noise_um * 1e-3);
+  fit.whitener = std::make_shared<Ar1Whitener>(s, o.noise_um * 1e-3, o.noise_rho);
   RtestJointIdentification id;
   try {
     id = identify_joint(s, fit);
@@ -98,8 +126,9 @@ RtestDesignCandidate evaluate_rtest_design(const RtestPattern& pattern, const Rt
     c.why_not = e.what();
     return c;
   }
-  // Information at the budget: repeated to fill it, AR(1) effective readings.
-  const double var_scale = (c.duration_s / budget) * (1.0 + o.noise_rho) / (1.0 - o.noise_rho);
+  // Information at the budget: the pattern repeated to fill it (the AR(1) correlation between
+  // the end of one run and the start of the next is neglected).
+  const double var_scale = c.duration_s / budget;
   const Eigen::Index p = static_cast<Eigen::Index>(id.parameters.size());
   c.sigma.resize(p);
   for (Eigen::Index j = 0; j < p; ++j) {

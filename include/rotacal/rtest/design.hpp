@@ -7,13 +7,14 @@
 /// (k = 2) of the eight location errors at a time budget, within the machine's travel.
 ///
 /// Information: the R-test joint fit is called on the noise-free readings of the nominal
-/// machine with a whitener that divides every residual by the noise sigma, so its covariance
-/// is exactly (J^T J)^-1 sigma^2, the inverse Fisher information of that fit. Run time: every
-/// pose of every nest takes `dwell_s` (hw/pose_window.hpp), so a pattern lasts
-/// poses x nests x dwell; a pattern shorter than the budget is repeated (or dwelt on longer)
-/// to fill it, which scales the information by budget / run time. AR(1) noise with
-/// coefficient rho between successive readings counts (1 - rho) / (1 + rho) effective readings
-/// per reading. Nests: the first on +X at (r1, 0, h1), the second on -Y at (0, -r2, h2), as in
+/// machine with the whitener of the noise (AR(1) with coefficient rho between successive
+/// readings of one nest and component, marginal sigma; white for rho = 0), so its covariance
+/// is exactly (J^T Sigma^-1 J)^-1, the inverse Fisher information of that fit: what a GLS fit
+/// (identify --noise auto on correlated data) realises. Unlike the ballbar design's effective
+/// samples, this holds when successive poses are far apart (a coarse C step), where AR noise
+/// costs less than (1 + rho) / (1 - rho). Run time: every pose of every nest takes `dwell_s`
+/// (hw/pose_window.hpp), so a pattern lasts poses x nests x dwell; a pattern shorter than the
+/// budget is repeated to fill it, which scales the information by budget / run time. Nests: the first on +X at (r1, 0, h1), the second on -Y at (0, -r2, h2), as in
 /// Oyama and Ibaraki's set-up; nests and grid are chosen one after the other (nests at the base
 /// grid, then the grid at the chosen nests), which keeps the design within a few seconds.
 
