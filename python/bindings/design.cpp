@@ -94,6 +94,7 @@ void bind_design(pyb::module_& m) {
       .def_readonly("sigma_before", &SeparationDesign::sigma_before)
       .def_readonly("sigma_after", &SeparationDesign::sigma_after)
       .def_readonly("correlation_before", &SeparationDesign::correlation_before)
+      .def_readonly("already_separated", &SeparationDesign::already_separated)
       .def_readonly("found", &SeparationDesign::found)
       .def_readonly("chosen", &SeparationDesign::chosen)
       .def_readonly("candidates_tried", &SeparationDesign::candidates_tried)
@@ -168,6 +169,51 @@ void bind_design(pyb::module_& m) {
         return design_rtest_test(o);
       },
       pyb::arg("options"), "The R-test nests and pose grid with the smallest predicted uncertainty (rtest/design.hpp).");
+  pyb::class_<RtestSeparationOptions>(m, "RtestSeparationOptions", "Options of design_rtest_separation (defaults).")
+      .def(pyb::init<>())
+      .def_readwrite("nest_radius_mm", &RtestSeparationOptions::nest_radius_mm)
+      .def_readwrite("nest_angle_deg", &RtestSeparationOptions::nest_angle_deg)
+      .def_readwrite("nest_height_mm", &RtestSeparationOptions::nest_height_mm)
+      .def_readwrite("b_step_deg", &RtestSeparationOptions::b_step_deg)
+      .def_readwrite("c_step_deg", &RtestSeparationOptions::c_step_deg)
+      .def_readwrite("b_limits_deg", &RtestSeparationOptions::b_limits_deg)
+      .def_readwrite("travel_min", &RtestSeparationOptions::travel_min)
+      .def_readwrite("travel_max", &RtestSeparationOptions::travel_max)
+      .def_readwrite("dwell_s", &RtestSeparationOptions::dwell_s, "0: the session's")
+      .def_readwrite("max_added_time_s", &RtestSeparationOptions::max_added_time_s)
+      .def_readwrite("max_correlation", &RtestSeparationOptions::max_correlation)
+      .def_readwrite("noise_um", &RtestSeparationOptions::noise_um, "0: the session's residual noise")
+      .def_readwrite("reference_radius_mm", &RtestSeparationOptions::reference_radius_mm);
+  pyb::class_<RtestSeparatingCandidate>(m, "RtestSeparatingCandidate", "An added nest, evaluated with the session.")
+      .def_readonly("added", &RtestSeparatingCandidate::added)
+      .def_readonly("description", &RtestSeparatingCandidate::description)
+      .def_readonly("duration_s", &RtestSeparatingCandidate::duration_s)
+      .def_readonly("repeats", &RtestSeparatingCandidate::repeats)
+      .def_readonly("correlation", &RtestSeparatingCandidate::correlation)
+      .def_readonly("determined", &RtestSeparatingCandidate::determined);
+  pyb::class_<RtestSeparationDesign>(m, "RtestSeparationDesign", "The added nest that separates two effects, or why none can.")
+      .def_readonly("effects", &RtestSeparationDesign::effects)
+      .def_readonly("motion", &RtestSeparationDesign::motion)
+      .def_readonly("names", &RtestSeparationDesign::names)
+      .def_readonly("sigma_before", &RtestSeparationDesign::sigma_before)
+      .def_readonly("sigma_after", &RtestSeparationDesign::sigma_after)
+      .def_readonly("correlation_before", &RtestSeparationDesign::correlation_before)
+      .def_readonly("already_separated", &RtestSeparationDesign::already_separated)
+      .def_readonly("found", &RtestSeparationDesign::found)
+      .def_readonly("chosen", &RtestSeparationDesign::chosen)
+      .def_readonly("candidates_tried", &RtestSeparationDesign::candidates_tried)
+      .def_readonly("noise_um", &RtestSeparationDesign::noise_um)
+      .def_readonly("effective_per_reading", &RtestSeparationDesign::effective_per_reading)
+      .def_readonly("verdict", &RtestSeparationDesign::verdict);
+  m.def(
+      "design_rtest_separation",
+      [](const RtestSession& session, const std::vector<std::string>& pair, const RtestSeparationOptions& o) {
+        const EffectModel fx = effects_of(pair);
+        pyb::gil_scoped_release release;
+        return design_rtest_separation(session, fx.effects, o);
+      },
+      pyb::arg("session"), pyb::arg("pair"), pyb::arg("options") = RtestSeparationOptions{},
+      "The smallest added R-test nest that separates two effects after a session (rtest/design.hpp).");
 }
 
 }  // namespace rotacal::py

@@ -6,7 +6,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Ambiguity', 'AngleTable', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CompensationReport', 'CompensationRow', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestDesign', 'RtestDesignCandidate', 'RtestDesignOptions', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SeparatingCandidate', 'SeparationDesign', 'SeparationOptions', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TableMotionOverlap', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'ballbar_model_document', 'ballbar_model_from_document', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_model_machine', 'check_output', 'check_plausible', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_ballbar_tests', 'default_calibration_moves', 'design_ballbar_separation', 'design_ballbar_test', 'design_rtest_test', 'diagnose_ballbar', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'evaluate_rtest_design', 'export_controller', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_joint_sessions', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_rtest', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'table_motion_overlap', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
+__all__: list[str] = ['Ambiguity', 'AngleTable', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CompensationReport', 'CompensationRow', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestDesign', 'RtestDesignCandidate', 'RtestDesignOptions', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSeparatingCandidate', 'RtestSeparationDesign', 'RtestSeparationOptions', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SeparatingCandidate', 'SeparationDesign', 'SeparationOptions', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TableMotionOverlap', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'ballbar_model_document', 'ballbar_model_from_document', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_model_machine', 'check_output', 'check_plausible', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_ballbar_tests', 'default_calibration_moves', 'design_ballbar_separation', 'design_ballbar_test', 'design_rtest_separation', 'design_rtest_test', 'diagnose_ballbar', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'evaluate_rtest_design', 'export_controller', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_joint_sessions', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_rtest', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'table_motion_overlap', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
 class Ambiguity:
     @property
     def correlation(self) -> float:
@@ -1907,6 +1907,159 @@ class RtestPattern:
     @nests.setter
     def nests(self, arg1: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> None:
         ...
+class RtestSeparatingCandidate:
+    """
+    An added nest, evaluated with the session.
+    """
+    @property
+    def added(self) -> RtestPattern:
+        ...
+    @property
+    def correlation(self) -> float:
+        ...
+    @property
+    def description(self) -> str:
+        ...
+    @property
+    def determined(self) -> bool:
+        ...
+    @property
+    def duration_s(self) -> float:
+        ...
+    @property
+    def repeats(self) -> float:
+        ...
+class RtestSeparationDesign:
+    """
+    The added nest that separates two effects, or why none can.
+    """
+    @property
+    def already_separated(self) -> bool:
+        ...
+    @property
+    def candidates_tried(self) -> int:
+        ...
+    @property
+    def chosen(self) -> RtestSeparatingCandidate:
+        ...
+    @property
+    def correlation_before(self) -> float:
+        ...
+    @property
+    def effective_per_reading(self) -> float:
+        ...
+    @property
+    def effects(self) -> typing.Annotated[list[str], "FixedSize(2)"]:
+        ...
+    @property
+    def found(self) -> bool:
+        ...
+    @property
+    def motion(self) -> TableMotionOverlap:
+        ...
+    @property
+    def names(self) -> list[str]:
+        ...
+    @property
+    def noise_um(self) -> float:
+        ...
+    @property
+    def sigma_after(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def sigma_before(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def verdict(self) -> str:
+        ...
+class RtestSeparationOptions:
+    """
+    Options of design_rtest_separation (defaults).
+    """
+    def __init__(self) -> None:
+        ...
+    @property
+    def b_limits_deg(self) -> typing.Annotated[list[float], "FixedSize(2)"]:
+        ...
+    @b_limits_deg.setter
+    def b_limits_deg(self, arg0: typing.Annotated[collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], "FixedSize(2)"]) -> None:
+        ...
+    @property
+    def b_step_deg(self) -> list[float]:
+        ...
+    @b_step_deg.setter
+    def b_step_deg(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def c_step_deg(self) -> list[float]:
+        ...
+    @c_step_deg.setter
+    def c_step_deg(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def dwell_s(self) -> float:
+        """
+        0: the session's
+        """
+    @dwell_s.setter
+    def dwell_s(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def max_added_time_s(self) -> float:
+        ...
+    @max_added_time_s.setter
+    def max_added_time_s(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def max_correlation(self) -> float:
+        ...
+    @max_correlation.setter
+    def max_correlation(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def nest_angle_deg(self) -> list[float]:
+        ...
+    @nest_angle_deg.setter
+    def nest_angle_deg(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def nest_height_mm(self) -> list[float]:
+        ...
+    @nest_height_mm.setter
+    def nest_height_mm(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def nest_radius_mm(self) -> list[float]:
+        ...
+    @nest_radius_mm.setter
+    def nest_radius_mm(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def noise_um(self) -> float:
+        """
+        0: the session's residual noise
+        """
+    @noise_um.setter
+    def noise_um(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def reference_radius_mm(self) -> float:
+        ...
+    @reference_radius_mm.setter
+    def reference_radius_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def travel_max(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @travel_max.setter
+    def travel_max(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+        ...
+    @property
+    def travel_min(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @travel_min.setter
+    def travel_min(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+        ...
 class RtestSession:
     """
     A rotacal-rtest/1 session (mm, deg, s).
@@ -2063,6 +2216,9 @@ class SeparationDesign:
     """
     The added test that separates two effects, or why none can.
     """
+    @property
+    def already_separated(self) -> bool:
+        ...
     @property
     def candidates_tried(self) -> int:
         ...
@@ -2407,6 +2563,10 @@ def design_ballbar_separation(session: BallbarSession, pair: collections.abc.Seq
 def design_ballbar_test(options: BallbarDesignOptions) -> BallbarDesign:
     """
     The pivot and bar length with the smallest predicted uncertainty (ballbar/design.hpp).
+    """
+def design_rtest_separation(session: RtestSession, pair: collections.abc.Sequence[str], options: RtestSeparationOptions = ...) -> RtestSeparationDesign:
+    """
+    The smallest added R-test nest that separates two effects after a session (rtest/design.hpp).
     """
 def design_rtest_test(options: RtestDesignOptions) -> RtestDesign:
     """

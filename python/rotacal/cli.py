@@ -637,17 +637,22 @@ def cmd_design_separation(a: argparse.Namespace) -> int:
     if a.json:
         print(jsontext.dumps(separation_dict(d)))
         return EXIT_OK
+    _print_separation(d, a.after, parameter_units(d.names))
+    return EXIT_OK
+
+
+def _print_separation(d: Any, after_path: str, units: Sequence[tuple[str, float]]) -> None:
+    """The verdict of a --separate design and the predicted 1-sigma before and after."""
     print(d.verdict)
     if d.motion.same_motion:
-        return EXIT_OK
+        return
     print(f"noise {d.noise_um:.3f} um per reading, {d.effective_per_reading:.2f} effective samples per reading "
-          f"(from {a.after}); {d.candidates_tried} added tests tried")
+          f"(from {after_path}); {d.candidates_tried} added tests tried")
+    after = list(d.sigma_after) if d.candidates_tried else list(d.sigma_before)
     print("predicted 1-sigma, session alone -> with the added test (inf: not determined):")
-    after = list(d.sigma_after) if d.candidates_tried else [math.nan] * len(d.names)
     before = list(d.sigma_before) + [math.inf] * (len(d.names) - len(d.sigma_before))
-    for n, b_, a_, (unit, k) in zip(d.names, before, after, parameter_units(d.names)):
+    for n, b_, a_, (unit, k) in zip(d.names, before, after, units):
         print(f"  {n:28s} {b_ * k:10.4f} -> {a_ * k:10.4f} {unit}")
-    return EXIT_OK
 
 
 def cmd_design_ballbar(a: argparse.Namespace) -> int:
@@ -691,8 +696,37 @@ def cmd_design_ballbar(a: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def cmd_design_rtest_separation(a: argparse.Namespace) -> int:
+    from .design import design_rtest_separation, parameter_units, rtest_separation_dict
+    if not a.after:
+        raise OptionError("--separate: give the session it follows with --after SESSION")
+    session = _load(a.after)
+    if by_kind(session, {BALLBAR: True, RTEST: False}, "--after"):
+        raise OptionError(f"--after {a.after}: a ballbar session; design rtest --separate needs an R-test session")
+    d = design_rtest_separation(session, [e.strip() for e in a.separate.split(",")], radii=a.radii,
+                                angles=a.nest_angles, heights=a.heights, b_steps=a.b_steps, c_steps=a.c_steps,
+                                b_limits=a.b_limits, travel=a.travel, dwell_s=a.dwell or 0.0, max_time_s=a.max_time,
+                                max_correlation=a.max_correlation, noise_um=a.noise or 0.0)
+    if a.json:
+        print(jsontext.dumps(rtest_separation_dict(d)))
+        return EXIT_OK
+    _print_separation(d, a.after, parameter_units(d.names))
+    if d.found:
+        p = d.chosen.added
+        b, c = list(p.b_deg), list(p.c_deg)
+        print(f"run it with: --nest {','.join(f'{v:g}' for v in p.nests[0])} --b-range {b[0]:g},{b[-1]:g} "
+              f"--b-step {b[1] - b[0] if len(b) > 1 else 0:g} --c-step {c[1] - c[0] if len(c) > 1 else 360:g} "
+              f"--dwell {p.dwell_s:g}")
+    return EXIT_OK
+
+
 def cmd_design_rtest(a: argparse.Namespace) -> int:
     from .design import rtest_design_dict, design_rtest
+    if a.separate:
+        return cmd_design_rtest_separation(a)
+    if a.after:
+        raise OptionError("--after: goes with --separate EFFECT,EFFECT")
+    a.noise = 0.3 if a.noise is None else a.noise
     d = design_rtest(radii=a.radii, heights=a.heights, b_steps=a.b_steps, c_steps=a.c_steps, b_limits=a.b_limits,
                      travel=a.travel, time_s=a.time, noise_um=a.noise, rho=a.rho, dwell_s=a.dwell)
     if a.json:
@@ -1154,10 +1188,21 @@ def build_parser() -> argparse.ArgumentParser:
                    help="run time to compare at, s (default: the default pattern's)")
     k.add_argument("--dwell", type=number("--dwell", 0.0, 3600.0, "s", lo_open=True),
                    help="time per pose, s (default 6)")
-    k.add_argument("--noise", type=number("--noise", 0.0, 1000.0, "um", lo_open=True), default=0.3,
-                   help="1-sigma noise per reading component, um (default 0.3)")
+    k.add_argument("--noise", type=number("--noise", 0.0, 1000.0, "um", lo_open=True),
+                   help="1-sigma noise per reading component, um (default 0.3; with --after: the session's)")
     k.add_argument("--rho", type=number("--rho", 0.0, 0.999, ""), default=0.0,
                    help="AR(1) coefficient of the noise between readings (default 0: white)")
+    g = k.add_argument_group("the nest that separates two effects after a session (docs/design.md)")
+    g.add_argument("--separate", metavar="EFFECT,EFFECT",
+                   help="two catalogue ids the diagnosis could not tell apart: propose the smallest added nest "
+                        "that brings their correlation below --max-correlation, or say why none can")
+    g.add_argument("--after", type=path("--after"), metavar="SESSION", help="the R-test session they follow")
+    g.add_argument("--max-time", type=number("--max-time", 0.0, 86400.0, "s", lo_open=True), default=600.0,
+                   help="longest added nest, s (default 600)")
+    g.add_argument("--max-correlation", type=number("--max-correlation", 0.0, 1.0, "", lo_open=True), default=0.5,
+                   help="target largest canonical correlation of the pair (default 0.5)")
+    g.add_argument("--nest-angles", type=number_list("--nest-angles", -360.0, 360.0, "deg", 12),
+                   help="added nest: angles about C from +X, deg (default 0,90,180,270)")
     k.add_argument("--json", action="store_true")
     k.set_defaults(func=cmd_design_rtest)
 

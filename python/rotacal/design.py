@@ -44,7 +44,7 @@ def parameter_units(names: Sequence[str]) -> list[tuple[str, float]]:
         if i < 8:
             out.append(("urad", 1e6) if i in (2, 3, 6, 7) else ("um", 1e3))
             continue
-        if n.startswith("pivot_"):  # pivot_x, or pivot_x#2 of a second set-up
+        if n.startswith(("pivot_", "zero_")):  # pivot_x (pivot_x#2 of a second set-up), R-test probe zeros
             out.append(("um", 1e3))
             continue
         eid, _, pname = n.partition(".")
@@ -124,14 +124,7 @@ def added_setup(d: Any) -> Any:
 
 def separation_dict(d: Any) -> dict:
     """The JSON of ``rotacal design ballbar --separate ... --after SESSION``."""
-    def sig(v: Any) -> dict:
-        return {n: (float(s) if np.isfinite(s) else None) for n, s in zip(d.names, v)}
-    out = {"effects": list(d.effects), "separable": not d.motion.same_motion, "found": d.found,
-           "verdict": d.verdict, "table_motion": {"same_motion": d.motion.same_motion, "cosine": d.motion.cosine,
-                                                  "why": d.motion.why},
-           "correlation_before": d.correlation_before, "predicted_std_before": sig(d.sigma_before),
-           "noise_um": d.noise_um, "effective_samples_per_reading": d.effective_per_reading,
-           "candidates_tried": d.candidates_tried}
+    out = _separation_common(d)
     if d.candidates_tried:
         c = d.chosen
         out["added_test"] = {"description": c.description, "tests": [_core.test_label(t, c.setup.machine) for t in c.setup.tests],
@@ -140,7 +133,6 @@ def separation_dict(d: Any) -> dict:
                              "radial_c_side": c.setup.radial_c_side.name,
                              "run_time_s": c.duration_s * c.slow_down, "slow_down": c.slow_down,
                              "correlation_after": c.correlation}
-        out["predicted_std_after"] = sig(d.sigma_after)
     return out
 
 
@@ -185,3 +177,57 @@ def rtest_design_dict(d: Any) -> dict:
     """The JSON of ``rotacal design rtest --json``."""
     return {"time_budget_s": d.time_budget_s, "ratio_to_default": d.ratio, "best": rtest_candidate_dict(d.best),
             "default": rtest_candidate_dict(d.baseline), "candidates": [rtest_candidate_dict(c) for c in d.candidates]}
+
+
+def design_rtest_separation(session: Any, pair: Sequence[str], *, radii: Sequence[float] | None = None,
+                            angles: Sequence[float] | None = None, heights: Sequence[float] | None = None,
+                            b_steps: Sequence[float] | None = None, c_steps: Sequence[float] | None = None,
+                            b_limits: Sequence[float] | None = None, travel: Sequence[float] | None = None,
+                            dwell_s: float = 0.0, max_time_s: float = 600.0, max_correlation: float = 0.5,
+                            noise_um: float = 0.0) -> Any:
+    """A ``_core.RtestSeparationDesign``: the smallest R-test nest (position and grid) to add to
+    ``session`` (an ``RtestSession``) so that the two effects of ``pair`` come out of the joint
+    fit with a canonical correlation below ``max_correlation``, or why no test can."""
+    if len(pair) != 2:
+        raise _core.InvalidArgument(f"--separate: {','.join(pair)}: give two effects, EFFECT,EFFECT")
+    o = _core.RtestSeparationOptions()
+    for value, field in ((radii, "nest_radius_mm"), (angles, "nest_angle_deg"), (heights, "nest_height_mm"),
+                         (b_steps, "b_step_deg"), (c_steps, "c_step_deg")):
+        if value is not None:
+            setattr(o, field, [float(v) for v in value])
+    if b_limits is not None:
+        o.b_limits_deg = [float(v) for v in b_limits]
+    if travel is not None:
+        o.travel_min, o.travel_max = _travel(travel)
+    o.dwell_s = float(dwell_s)
+    o.max_added_time_s = float(max_time_s)
+    o.max_correlation = float(max_correlation)
+    o.noise_um = float(noise_um)
+    return _core.design_rtest_separation(session, list(pair), o)
+
+
+def _separation_common(d: Any) -> dict:
+    def sig(v: Any) -> dict:
+        return {n: (float(s) if np.isfinite(s) else None) for n, s in zip(d.names, v)}
+    out = {"effects": list(d.effects), "separable": not d.motion.same_motion,
+           "already_separated": d.already_separated, "found": d.found, "verdict": d.verdict,
+           "table_motion": {"same_motion": d.motion.same_motion, "cosine": d.motion.cosine, "why": d.motion.why},
+           "correlation_before": d.correlation_before, "predicted_std_before": sig(d.sigma_before),
+           "noise_um": d.noise_um, "effective_samples_per_reading": d.effective_per_reading,
+           "candidates_tried": d.candidates_tried}
+    if d.candidates_tried:
+        out["predicted_std_after"] = sig(d.sigma_after)
+    return out
+
+
+def rtest_separation_dict(d: Any) -> dict:
+    """The JSON of ``rotacal design rtest --separate ... --after SESSION``."""
+    out = _separation_common(d)
+    if d.candidates_tried:
+        c = d.chosen
+        p = c.added
+        out["added_nest"] = {"description": c.description, "nest": list(map(float, p.nests[0])),
+                             "b_deg": list(p.b_deg), "c_deg": list(p.c_deg), "dwell_s": p.dwell_s,
+                             "repeats": c.repeats, "run_time_s": c.duration_s * c.repeats,
+                             "correlation_after": c.correlation}
+    return out

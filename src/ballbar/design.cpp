@@ -222,18 +222,15 @@ Eigen::MatrixXd table_motion_columns(MachineType m, const EffectModel& fx,
 
 std::string deg_range(std::array<double, 2> r) { return fmt(r[0], 0) + ".." + fmt(r[1], 0) + " deg"; }
 
+}  // namespace
+
+namespace design_detail {
+
 // Covariance of an information matrix with the parameters the joint fit would hold fixed
 // removed: those analyse_observability (core/least_squares.hpp) picks, one per combination
 // that moving by plausible magnitudes changes chi-square by less than 1, on the white
 // chi-square the fit tests (`white`: the information over the effective fraction, as the fit
-// counts every reading). The covariance of the rest is the inverse of their information
-// (a pseudo-inverse guards what is still singular, and that is held too).
-struct Inverted {
-  Eigen::MatrixXd cov;
-  std::vector<bool> determined;
-  Eigen::VectorXd sigma;
-};
-
+// counts every reading). The covariance of the rest is the inverse of their information.
 Inverted invert_information(const Eigen::MatrixXd& I, const Eigen::VectorXd& plausible, double white) {
   const Eigen::Index p = I.rows();
   Inverted out;
@@ -242,27 +239,36 @@ Inverted invert_information(const Eigen::MatrixXd& I, const Eigen::VectorXd& pla
   for (int j : obs.to_fix) out.determined[static_cast<std::size_t>(j)] = false;
   for (Eigen::Index j = 0; j < p; ++j)
     if (!(I(j, j) > 0.0)) out.determined[static_cast<std::size_t>(j)] = false;
+  // What analyse_observability leaves exactly singular (one parameter fixed for two null
+  // directions that share it): fix the parameter with the largest share of each remaining
+  // null vector, one at a time, as a fit must.
+  Eigen::MatrixXd cov_q;
   std::vector<Eigen::Index> idx;
-  for (Eigen::Index j = 0; j < p; ++j)
-    if (out.determined[static_cast<std::size_t>(j)]) idx.push_back(j);
-  const Eigen::Index q = static_cast<Eigen::Index>(idx.size());
-  Eigen::VectorXd dinv(q);
-  for (Eigen::Index a = 0; a < q; ++a) dinv[a] = 1.0 / std::sqrt(I(idx[a], idx[a]));
-  const Eigen::MatrixXd N = dinv.asDiagonal() * I(idx, idx) * dinv.asDiagonal();
-  Eigen::MatrixXd pinv = Eigen::MatrixXd::Zero(q, q);
-  if (q > 0) {
+  for (;;) {
+    idx.clear();
+    for (Eigen::Index j = 0; j < p; ++j)
+      if (out.determined[static_cast<std::size_t>(j)]) idx.push_back(j);
+    const Eigen::Index q = static_cast<Eigen::Index>(idx.size());
+    Eigen::VectorXd dinv(q);
+    for (Eigen::Index a = 0; a < q; ++a) dinv[a] = 1.0 / std::sqrt(I(idx[a], idx[a]));
+    const Eigen::MatrixXd N = dinv.asDiagonal() * I(idx, idx) * dinv.asDiagonal();
+    if (q == 0) {
+      cov_q.resize(0, 0);
+      break;
+    }
     const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(N);
     const double lmax = std::max(es.eigenvalues().maxCoeff(), 1e-300);
-    Eigen::VectorXd null_weight = Eigen::VectorXd::Zero(q);
-    for (Eigen::Index k = 0; k < q; ++k) {
-      const Eigen::VectorXd v = es.eigenvectors().col(k);
-      if (es.eigenvalues()[k] > 1e-12 * lmax) pinv += v * v.transpose() / es.eigenvalues()[k];
-      else null_weight += v.cwiseAbs2();
+    if (es.eigenvalues()[0] <= 1e-12 * lmax) {
+      Eigen::Index worst = 0;
+      es.eigenvectors().col(0).cwiseAbs().maxCoeff(&worst);
+      out.determined[static_cast<std::size_t>(idx[worst])] = false;
+      continue;
     }
-    for (Eigen::Index a = 0; a < q; ++a)
-      if (null_weight[a] > 1e-8) out.determined[static_cast<std::size_t>(idx[a])] = false;
+    cov_q = dinv.asDiagonal() * es.eigenvectors() * es.eigenvalues().cwiseInverse().asDiagonal() *
+            es.eigenvectors().transpose() * dinv.asDiagonal();
+    break;
   }
-  const Eigen::MatrixXd cov_q = dinv.asDiagonal() * pinv * dinv.asDiagonal();
+  const Eigen::Index q = static_cast<Eigen::Index>(idx.size());
   out.cov = Eigen::MatrixXd::Zero(p, p);
   for (Eigen::Index a = 0; a < q; ++a)
     for (Eigen::Index b = 0; b < q; ++b) out.cov(idx[a], idx[b]) = cov_q(a, b);
@@ -293,7 +299,7 @@ double canonical_correlation(const Inverted& inv, int a0, int na, int b0, int nb
   return std::min(1.0, svd.singularValues()[0]);
 }
 
-}  // namespace
+}  // namespace design_detail
 
 TableMotionOverlap table_motion_overlap(MachineType m, const Effect& a, const Effect& b,
                                         std::array<double, 2> tilt, double duration_s, double r_ref) {
@@ -426,6 +432,9 @@ Eigen::MatrixXd nominal_jacobian(const BallbarSession& s, const EffectModel& fx)
 
 SeparationDesign design_ballbar_separation(const BallbarSession& session, const std::vector<Effect>& pair,
                                            const SeparationOptions& o) {
+  using design_detail::canonical_correlation;
+  using design_detail::invert_information;
+  using design_detail::Inverted;
   if (pair.size() != 2 || pair[0] == pair[1])
     throw InvalidArgument("design: --separate needs two different effects (EFFECT,EFFECT)");
   if (session.samples.empty()) throw InvalidArgument("design: --after: the session has no samples");
@@ -482,6 +491,15 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session, const 
     D.verdict = "no test can separate " + D.effects[0] + " and " + D.effects[1] + ": " + D.motion.why;
     return D;
   }
+  if (D.correlation_before < o.max_correlation) {
+    D.already_separated = true;
+    std::ostringstream v;
+    v.precision(2);
+    v << std::fixed << "the session alone separates " << D.effects[0] << " and " << D.effects[1]
+      << " (correlation " << D.correlation_before << " < " << o.max_correlation << "): no added test is needed";
+    D.verdict = v.str();
+    return D;
+  }
 
   // Candidates: from the session's pivot, one rotary test at each bar length and range (the
   // pivot is shared with the session); from a moved pivot, the sphere tests that locate it
@@ -513,7 +531,8 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session, const 
   for (double r : o.pivot_radius_mm)
     for (double ang : o.pivot_angle_deg)
       for (double z : o.pivot_z_mm) {
-        const Eigen::Vector3d pv(r * std::cos(ang * deg), r * std::sin(ang * deg), z);
+        Eigen::Vector3d pv(r * std::cos(ang * deg), r * std::sin(ang * deg), z);
+        pv = (pv * 1e9).array().round() / 1e9;  // cos 90 deg is 6e-17, not 0
         if ((pv - session.pivot).norm() < 1e-6) continue;
         if (r == 0.0 && ang != o.pivot_angle_deg.front()) continue;  // one pivot on the axis
         for (double L : o.bar_lengths_mm)
@@ -622,7 +641,7 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session, const 
       if (!std::isfinite(D.sigma_after[static_cast<Eigen::Index>(j)])) held += (held.empty() ? "" : ", ") + D.names[j];
     if (!held.empty())
       v << "; " << held
-        << " stay undetermined (no reading of these tests sees them: the joint fit holds them at 0, and "
+        << " remain undetermined (no reading of these tests sees them: the joint fit holds them at 0, and "
            "the correlation is that of the rest)";
   }
   D.verdict = v.str();

@@ -9,6 +9,8 @@
 #include <sstream>
 
 #include "rotacal/core/error.hpp"
+#include "rotacal/core/joint_fit.hpp"
+#include "rotacal/core/least_squares.hpp"
 #include "rotacal/rtest/model.hpp"
 
 namespace rotacal {
@@ -204,6 +206,271 @@ RtestDesign design_rtest_test(const RtestDesignOptions& o) {
     }
   if (out.baseline.feasible) out.ratio = out.best.worst_expanded_um / out.baseline.worst_expanded_um;
   return out;
+}
+
+}  // namespace rotacal
+
+// ------------------------------------------------------------------ separating two effects
+
+namespace rotacal {
+
+namespace {
+
+// R-test readings d = T(B, C, t)^-1 tool(xyz, t) - q_nest + zero_nest of several nests, 3 rows
+// per pose. Parameters: 8 location errors, 3 probe-zero components per nest, then effects.
+struct RtestPose {
+  int nest = 0;
+  Eigen::Vector3d q = Eigen::Vector3d::Zero(), xyz = Eigen::Vector3d::Zero();
+  RotaryAngles<double> angles;
+  double t = 0.0;
+};
+
+class RtestReadingsModel : public ResidualModel {
+ public:
+  RtestReadingsModel(std::vector<RtestPose> poses, int nests, const EffectModel& fx)
+      : poses_(std::move(poses)), nests_(nests), fx_(fx), P_(fx.num_params()) {}
+  Eigen::Index num_residuals() const override { return 3 * static_cast<Eigen::Index>(poses_.size()); }
+  int num_parameters() const override { return 8 + 3 * nests_ + P_; }
+  Eigen::Index num_items() const override { return static_cast<Eigen::Index>(poses_.size()); }
+  int rows_per_item() const override { return 3; }
+  void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r, Eigen::MatrixXd* J) const override {
+    evaluate_with_jets([this](Eigen::Index i, const auto* p, auto* out) { sample(i, p, out); }, num_items(), 3, x, r,
+                       J);
+  }
+
+ private:
+  template <typename T>
+  void sample(Eigen::Index i, const T* p, T* out) const {
+    const RtestPose& s = poses_[static_cast<std::size_t>(i)];
+    const Vec3<T> d = rtest_reading<T>(MachineType::BC_trt, LocationErrors<T>::from_ptr(p), fx_,
+                                       P_ > 0 ? p + 8 + 3 * nests_ : nullptr, s.xyz, s.angles, s.t, s.q);
+    for (int k = 0; k < 3; ++k) out[k] = d[k] + p[8 + 3 * s.nest + k];
+  }
+  std::vector<RtestPose> poses_;
+  int nests_;
+  const EffectModel& fx_;
+  int P_;
+};
+
+Eigen::MatrixXd nominal_rtest_jacobian(const std::vector<RtestPose>& poses, int nests, const EffectModel& fx) {
+  const RtestReadingsModel model(poses, nests, fx);
+  const Eigen::VectorXd x = Eigen::VectorXd::Zero(model.num_parameters());
+  Eigen::VectorXd r(model.num_residuals());
+  Eigen::MatrixXd J(model.num_residuals(), model.num_parameters());
+  model.evaluate(x, r, &J);
+  return J;
+}
+
+std::string v3(const Eigen::Vector3d& v) { return "(" + fmt(v[0]) + ", " + fmt(v[1]) + ", " + fmt(v[2]) + ") mm"; }
+
+}  // namespace
+
+RtestSeparationDesign design_rtest_separation(const RtestSession& session, const std::vector<Effect>& pair,
+                                              const RtestSeparationOptions& o) {
+  using design_detail::canonical_correlation;
+  using design_detail::invert_information;
+  using design_detail::Inverted;
+  if (pair.size() != 2 || pair[0] == pair[1])
+    throw InvalidArgument("design rtest: --separate needs two different effects (EFFECT,EFFECT)");
+  if (session.samples.empty()) throw InvalidArgument("design rtest: --after: the session has no samples");
+  if (session.machine != MachineType::BC_trt) throw InvalidArgument("design rtest: --after: the session is not of a BC-trt machine");
+  if (o.nest_radius_mm.empty() || o.nest_angle_deg.empty() || o.nest_height_mm.empty() || o.b_step_deg.empty() ||
+      o.c_step_deg.empty())
+    throw InvalidArgument("design rtest: --radii, --nest-angles, --heights, --b-steps and --c-steps need at least one value each");
+  for (double v : o.b_step_deg)
+    if (!(v > 0.0)) throw InvalidArgument("design rtest: --b-steps must be > 0 deg");
+  for (double v : o.c_step_deg)
+    if (!(v > 0.0 && v < 360.0)) throw InvalidArgument("design rtest: --c-steps must be in (0, 360) deg");
+  if (!(o.max_added_time_s > 0.0) || !std::isfinite(o.max_added_time_s))
+    throw InvalidArgument("design rtest: --max-time must be > 0 s");
+  if (!(o.max_correlation > 0.0 && o.max_correlation < 1.0))
+    throw InvalidArgument("design rtest: --max-correlation must be in (0, 1)");
+  if (!(o.noise_um >= 0.0) || !std::isfinite(o.noise_um)) throw InvalidArgument("design rtest: --noise must be >= 0 um");
+  if (!(o.dwell_s >= 0.0) || !std::isfinite(o.dwell_s)) throw InvalidArgument("design rtest: --dwell must be >= 0 s");
+  if (!(o.b_limits_deg[0] < o.b_limits_deg[1])) throw InvalidArgument("design rtest: --b-limits must be min < max deg");
+  const MachineType m = MachineType::BC_trt;
+  RtestSeparationDesign D;
+  D.effects = {pair[0].id(), pair[1].id()};
+  EffectModel fx;
+  fx.effects = pair;
+  for (const RtestSample& s : session.samples) fx.linear_reference += s.xyz;
+  fx.linear_reference /= static_cast<double>(session.samples.size());
+  const double t_end = session.samples.back().time;
+  D.motion = table_motion_overlap(m, pair[0], pair[1], o.b_limits_deg, t_end + o.max_added_time_s,
+                                  o.reference_radius_mm);
+
+  // The session's poses and noise (the R-test joint fit's residual noise model).
+  std::map<std::string, int> nest_index;
+  std::vector<RtestPose> poses;
+  for (const RtestSample& s : session.samples) {
+    const auto it = session.nests.find(s.setup);
+    if (it == session.nests.end()) throw InvalidArgument("design rtest: --after: nest '" + s.setup + "' has no position");
+    const int k = nest_index.emplace(s.setup, static_cast<int>(nest_index.size())).first->second;
+    poses.push_back({k, it->second, s.xyz, s.angles_rad(), s.time});
+  }
+  const int ns = static_cast<int>(nest_index.size()), na = pair[0].num_params(), nb = pair[1].num_params();
+  const int ne = na + nb, z0 = 8, e0 = 8 + 3 * ns, p0 = e0 + ne;
+  RtestJointOptions fo;
+  fo.noise = NoiseHandling::white;
+  const RtestJointIdentification id = identify_joint(session, fo);
+  double sigma_um = o.noise_um > 0.0 ? o.noise_um : id.noise.sigma_um;
+  if (!(sigma_um > 0.0)) sigma_um = id.sigma_um;
+  if (!(sigma_um > 0.0)) throw InvalidArgument("design rtest: --after: the session's residuals are zero; give --noise");
+  D.noise_um = sigma_um;
+  if (id.noise.n > 0 && id.noise.effective_samples > 0.0)
+    D.effective_per_reading = std::min(1.0, id.noise.effective_samples / static_cast<double>(id.noise.n));
+  const double w = D.effective_per_reading / (sigma_um * sigma_um * 1e-6);
+  const Eigen::MatrixXd Js = nominal_rtest_jacobian(poses, ns, fx);
+  const Eigen::MatrixXd Is = Js.transpose() * Js * w;
+  for (int k = 0; k < 8; ++k) D.names.push_back(location_error_names(m)[static_cast<std::size_t>(k)]);
+  std::vector<std::string> nest_names(static_cast<std::size_t>(ns));
+  for (const auto& [name, k] : nest_index) nest_names[static_cast<std::size_t>(k)] = name;
+  for (const std::string& n : nest_names)
+    for (const char* c : {"zero_x#", "zero_y#", "zero_z#"}) D.names.push_back(c + n);
+  for (const std::string& l : fx.param_labels()) D.names.push_back(l);
+  Eigen::VectorXd plausible = Eigen::VectorXd::Constant(p0 + 3, plausible_magnitude("mm"));
+  for (int k = 0; k < 8; ++k) plausible[k] = plausible_magnitude(location_error_is_angle(k) ? "rad" : "mm");
+  {
+    int j = e0;
+    for (const Effect& f : pair)
+      for (const std::string& u : f.param_units()) plausible[j++] = plausible_magnitude(u);
+  }
+  const double white = 1.0 / D.effective_per_reading;
+  const Inverted before = invert_information(Is, plausible.head(p0), white);
+  D.sigma_before = before.sigma;
+  D.correlation_before = canonical_correlation(before, e0, na, e0 + na, nb);
+  D.sigma_after = D.sigma_before;
+  D.chosen.correlation = D.correlation_before;
+  if (D.motion.same_motion) {
+    D.verdict = "no test can separate " + D.effects[0] + " and " + D.effects[1] + ": " + D.motion.why;
+    return D;
+  }
+  if (D.correlation_before < o.max_correlation) {
+    D.already_separated = true;
+    std::ostringstream v;
+    v.precision(2);
+    v << std::fixed << "the session alone separates " << D.effects[0] << " and " << D.effects[1]
+      << " (correlation " << D.correlation_before << " < " << o.max_correlation << "): no added test is needed";
+    D.verdict = v.str();
+    return D;
+  }
+  double dwell = o.dwell_s;
+  if (!(dwell > 0.0)) {
+    std::vector<double> dt;
+    for (std::size_t i = 1; i < session.samples.size(); ++i)
+      if (session.samples[i].setup == session.samples[i - 1].setup)
+        dt.push_back(session.samples[i].time - session.samples[i - 1].time);
+    std::sort(dt.begin(), dt.end());
+    dwell = dt.empty() || !(dt[dt.size() / 2] > 0.0) ? RtestPattern{}.dwell_s : dt[dt.size() / 2];
+  }
+
+  const double deg = M_PI / 180.0;
+  bool have_best = false, have_fallback = false;
+  Eigen::MatrixXd best_info;
+  for (double r : o.nest_radius_mm)
+    for (double ang : o.nest_angle_deg)
+      for (double h : o.nest_height_mm) {
+        if (r == 0.0 && ang != o.nest_angle_deg.front()) continue;  // one nest on the axis
+        Eigen::Vector3d q(r * std::cos(ang * deg), r * std::sin(ang * deg), h);
+        q = (q * 1e9).array().round() / 1e9;  // cos 90 deg is 6e-17, not 0
+        for (double bs : o.b_step_deg)
+          for (double cs : o.c_step_deg) {
+            RtestPattern pat;
+            pat.nests = {q};
+            pat.b_deg = steps(o.b_limits_deg[0], o.b_limits_deg[1], bs);
+            pat.c_deg = steps(0.0, 360.0 - cs, cs);
+            pat.dwell_s = dwell;
+            const double duration = static_cast<double>(pat.b_deg.size() * pat.c_deg.size()) * dwell;
+            if (duration > o.max_added_time_s) continue;
+            std::vector<RtestPose> added;
+            bool inside = true;
+            double t = t_end;
+            for (double b : pat.b_deg)
+              for (double c : pat.c_deg) {
+                const RotaryAngles<double> a{b * deg, c * deg};
+                const Eigen::Vector3d xyz = rtest_commanded_xyz(m, q, a);
+                for (int k = 0; k < 3; ++k) inside = inside && xyz[k] >= o.travel_min[k] && xyz[k] <= o.travel_max[k];
+                added.push_back({0, q, xyz, a, t += dwell});
+              }
+            if (!inside) continue;
+            ++D.candidates_tried;
+            // Added columns: 8 location, its probe zero, effects -> joint layout.
+            const Eigen::MatrixXd Ja = nominal_rtest_jacobian(added, 1, fx);
+            const int p = p0 + 3;
+            Eigen::MatrixXd Jm = Eigen::MatrixXd::Zero(Ja.rows(), p);
+            Jm.leftCols(8) = Ja.leftCols(8);
+            Jm.middleCols(p0, 3) = Ja.middleCols(8, 3);
+            Jm.middleCols(e0, ne) = Ja.middleCols(11, ne);
+            const Eigen::MatrixXd Ia = Jm.transpose() * Jm * w;
+            Eigen::MatrixXd I0 = Eigen::MatrixXd::Zero(p, p);
+            I0.topLeftCorner(p0, p0) = Is;
+            for (double rep = 1.0; duration * rep <= o.max_added_time_s * (1 + 1e-12); rep *= 2.0) {
+              const Eigen::MatrixXd I = I0 + rep * Ia;
+              const Inverted inv = invert_information(I, plausible, white);
+              RtestSeparatingCandidate c;
+              c.added = pat;
+              c.duration_s = duration;
+              c.repeats = rep;
+              c.correlation = canonical_correlation(inv, e0, na, e0 + na, nb);
+              c.determined = true;
+              for (int j = e0; j < e0 + ne; ++j) c.determined = c.determined && inv.determined[static_cast<std::size_t>(j)];
+              const double run = duration * rep;
+              if (c.correlation < o.max_correlation) {
+                const double best_run = D.chosen.duration_s * D.chosen.repeats;
+                if (!have_best || run < best_run - 1e-9 ||
+                    (std::abs(run - best_run) <= 1e-9 && c.correlation < D.chosen.correlation)) {
+                  D.chosen = c;
+                  best_info = I;
+                  have_best = true;
+                }
+                break;
+              }
+              if (!have_best && (!have_fallback || c.correlation < D.chosen.correlation)) {
+                D.chosen = c;
+                best_info = I;
+                have_fallback = true;
+              }
+            }
+          }
+      }
+  D.found = have_best;
+  if (have_best || have_fallback) {
+    RtestSeparatingCandidate& c = D.chosen;
+    const RtestPattern& pat = c.added;
+    std::ostringstream d;
+    d << "a nest at " << v3(pat.nests[0]) << ", B " << fmt(pat.b_deg.front(), 0) << ".." << fmt(pat.b_deg.back(), 0)
+      << " deg every " << fmt(pat.b_deg.size() > 1 ? pat.b_deg[1] - pat.b_deg[0] : 0.0, 0) << ", C every "
+      << fmt(pat.c_deg.size() > 1 ? pat.c_deg[1] - pat.c_deg[0] : 360.0, 0) << " deg, " << fmt(pat.dwell_s, 1)
+      << " s per pose";
+    if (c.repeats > 1.0) d << ", run " << fmt(c.repeats, 0) << " times";
+    c.description = d.str();
+    D.sigma_after = invert_information(best_info, plausible, white).sigma;
+    for (const char* n : {"zero_x#added", "zero_y#added", "zero_z#added"}) D.names.push_back(n);
+  }
+  std::ostringstream v;
+  v.precision(2);
+  v << std::fixed;
+  if (D.found)
+    v << "add " << D.chosen.description << ": " << fmt(D.chosen.duration_s * D.chosen.repeats, 0)
+      << " s; fitted with the session, the correlation of " << D.effects[0] << " and " << D.effects[1]
+      << " goes from " << D.correlation_before << " to " << D.chosen.correlation;
+  else
+    v << "none of " << D.candidates_tried << " added nests within " << fmt(o.max_added_time_s, 0)
+      << " s brings the correlation of " << D.effects[0] << " and " << D.effects[1] << " below " << o.max_correlation
+      << (D.candidates_tried ? "; the closest is " + D.chosen.description + " (correlation " +
+                                   fmt(D.chosen.correlation, 2) + ")"
+                             : std::string("; every candidate breaks a limit"));
+  if (D.candidates_tried) {
+    std::string held;
+    for (int j = e0; j < e0 + ne; ++j)
+      if (!std::isfinite(D.sigma_after[j])) held += (held.empty() ? "" : ", ") + D.names[static_cast<std::size_t>(j)];
+    if (!held.empty())
+      v << "; " << held
+        << " remain undetermined (no reading sees them: the joint fit holds them at 0, and the correlation is that of "
+           "the rest)";
+  }
+  D.verdict = v.str();
+  return D;
 }
 
 }  // namespace rotacal

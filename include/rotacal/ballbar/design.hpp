@@ -115,6 +115,21 @@ TableMotionOverlap table_motion_overlap(MachineType m, const Effect& a, const Ef
                                         std::array<double, 2> tilt_limits_deg = {-90.0, 90.0},
                                         double duration_s = 3600.0, double reference_radius_mm = 100.0);
 
+namespace design_detail {
+/// Covariance of an information matrix I (fit units) with the parameters the joint fit would
+/// hold removed: one per combination that moving by the plausible magnitudes changes the white
+/// chi-square (I x white) by less than 1 (analyse_observability), and any it still cannot see.
+struct Inverted {
+  Eigen::MatrixXd cov;              ///< zero rows and columns for held parameters
+  std::vector<bool> determined;
+  Eigen::VectorXd sigma;            ///< infinite for held parameters
+};
+Inverted invert_information(const Eigen::MatrixXd& I, const Eigen::VectorXd& plausible, double white);
+/// Largest canonical correlation between the determined parameters among [a0, a0 + na) and
+/// among [b0, b0 + nb) (1 when either block has none).
+double canonical_correlation(const Inverted& inv, int a0, int na, int b0, int nb);
+}  // namespace design_detail
+
 /// Options of the added test that separates two effects after a session.
 struct SeparationOptions {
   /// Step and feeds of the added test, and its C range; machine, pivot and bar length come
@@ -163,6 +178,7 @@ struct SeparationDesign {
   Eigen::VectorXd sigma_before;  ///< session alone, 1 sigma, fit units; infinite: held (undetermined)
   Eigen::VectorXd sigma_after;   ///< session + the chosen test
   double correlation_before = 1.0;  ///< largest canonical correlation of the pair (1: undetermined)
+  bool already_separated = false;  ///< the session alone is below max_correlation: nothing to add
   bool found = false;               ///< a test within max_added_time_s reaches max_correlation
   SeparatingCandidate chosen;       ///< the shortest that does; else the one of lowest correlation
   int candidates_tried = 0;

@@ -24,6 +24,7 @@
 
 #include <Eigen/Core>
 
+#include "rotacal/ballbar/design.hpp"  // table_motion_overlap, the information helpers
 #include "rotacal/rtest/identify_joint.hpp"
 #include "rotacal/rtest/simulate.hpp"
 
@@ -77,5 +78,64 @@ RtestDesignCandidate evaluate_rtest_design(const RtestPattern& pattern, const Rt
 /// non-positive steps, noise, dwell or reference radius, rho outside [0, 0.999], reversed B
 /// limits, or when no candidate is feasible (the message gives reasons).
 RtestDesign design_rtest_test(const RtestDesignOptions& options);
+
+// ------------------------------------------------------------------ separating two effects
+
+/// Options of the added nest that separates two effects after an R-test session.
+struct RtestSeparationOptions {
+  /// Nest candidates (cylindrical about the C axis, table frame): distance from the C axis,
+  /// angle from +X about +Z, height above the B axis.
+  std::vector<double> nest_radius_mm = {0.0, 50.0, 100.0, 150.0};
+  std::vector<double> nest_angle_deg = {0.0, 90.0, 180.0, 270.0};
+  std::vector<double> nest_height_mm = {20.0, 60.0, 100.0, 140.0};
+  std::vector<double> b_step_deg = {15.0, 30.0};   ///< grids of the added nest (C over a full turn)
+  std::vector<double> c_step_deg = {30.0, 60.0};
+  std::array<double, 2> b_limits_deg = {-90.0, 90.0};
+  Eigen::Vector3d travel_min = Eigen::Vector3d(-400, -300, -300);
+  Eigen::Vector3d travel_max = Eigen::Vector3d(400, 300, 400);
+  double dwell_s = 0.0;             ///< per pose; 0: the session's (median time between poses)
+  double max_added_time_s = 600.0;  ///< the added nest's poses, repeated to gather data, take at most this
+  double max_correlation = 0.5;
+  double noise_um = 0.0;            ///< 0: the session's residual noise (R-test joint fit's noise model)
+  double reference_radius_mm = 100.0;
+};
+
+struct RtestSeparatingCandidate {
+  RtestPattern added;        ///< one nest and its grid
+  std::string description;
+  double duration_s = 0.0;   ///< poses x dwell
+  double repeats = 1.0;      ///< the pattern run this many times to gather data
+  double correlation = 1.0;  ///< largest canonical correlation of the pair's determined parameters afterwards
+  bool determined = false;   ///< every parameter of both effects is determined
+};
+
+struct RtestSeparationDesign {
+  std::array<std::string, 2> effects;
+  TableMotionOverlap motion;
+  /// 8 location errors, the probe zero of each session nest ("zero_x#N"), the two effects'
+  /// parameters, and the added nest's probe zero (absent from sigma_before).
+  std::vector<std::string> names;
+  Eigen::VectorXd sigma_before, sigma_after;
+  double correlation_before = 1.0;
+  bool already_separated = false;  ///< the session alone is below max_correlation: nothing to add
+  bool found = false;
+  RtestSeparatingCandidate chosen;
+  int candidates_tried = 0;
+  double noise_um = 0.0;
+  double effective_per_reading = 1.0;
+  std::string verdict;
+};
+
+/// The smallest added R-test nest (position and grid) whose readings, fitted jointly with
+/// `session` (location errors and the pair's parameters shared, one probe zero per nest, the
+/// readings of kinematics/effects.hpp), bring the largest canonical correlation of the pair
+/// below options.max_correlation, and the predicted 1 sigma afterwards; or, when the pair moves
+/// the table alike (table_motion_overlap), why no test can. The session's noise (sigma and
+/// effective samples per reading) comes from the R-test joint fit's noise model (identify_joint
+/// with its default maps). Throws InvalidArgument naming the option for a pair that is not two
+/// different effects of the machine, empty grids, a session without displacements, or
+/// non-positive limits.
+RtestSeparationDesign design_rtest_separation(const RtestSession& session, const std::vector<Effect>& pair,
+                                              const RtestSeparationOptions& options = {});
 
 }  // namespace rotacal
