@@ -223,6 +223,7 @@ struct RtestPose {
   Eigen::Vector3d q = Eigen::Vector3d::Zero(), xyz = Eigen::Vector3d::Zero();
   RotaryAngles<double> angles;
   double t = 0.0;
+  Eigen::Vector3d d = Eigen::Vector3d::Zero();  ///< measured displacement (0 for a design)
 };
 
 class RtestReadingsModel : public ResidualModel {
@@ -244,7 +245,7 @@ class RtestReadingsModel : public ResidualModel {
     const RtestPose& s = poses_[static_cast<std::size_t>(i)];
     const Vec3<T> d = rtest_reading<T>(MachineType::BC_trt, LocationErrors<T>::from_ptr(p), fx_,
                                        P_ > 0 ? p + 8 + 3 * nests_ : nullptr, s.xyz, s.angles, s.t, s.q);
-    for (int k = 0; k < 3; ++k) out[k] = d[k] + p[8 + 3 * s.nest + k];
+    for (int k = 0; k < 3; ++k) out[k] = d[k] + p[8 + 3 * s.nest + k] - T(s.d[k]);
   }
   std::vector<RtestPose> poses_;
   int nests_;
@@ -306,7 +307,7 @@ RtestSeparationDesign design_rtest_separation(const RtestSession& session, const
     const auto it = session.nests.find(s.setup);
     if (it == session.nests.end()) throw InvalidArgument("design rtest: --after: nest '" + s.setup + "' has no position");
     const int k = nest_index.emplace(s.setup, static_cast<int>(nest_index.size())).first->second;
-    poses.push_back({k, it->second, s.xyz, s.angles_rad(), s.time});
+    poses.push_back({k, it->second, s.xyz, s.angles_rad(), s.time, Eigen::Vector3d::Zero()});
   }
   const int ns = static_cast<int>(nest_index.size()), na = pair[0].num_params(), nb = pair[1].num_params();
   const int ne = na + nb, z0 = 8, e0 = 8 + 3 * ns, p0 = e0 + ne;
@@ -390,7 +391,7 @@ RtestSeparationDesign design_rtest_separation(const RtestSession& session, const
                 const RotaryAngles<double> a{b * deg, c * deg};
                 const Eigen::Vector3d xyz = rtest_commanded_xyz(m, q, a);
                 for (int k = 0; k < 3; ++k) inside = inside && xyz[k] >= o.travel_min[k] && xyz[k] <= o.travel_max[k];
-                added.push_back({0, q, xyz, a, t += dwell});
+                added.push_back({0, q, xyz, a, t += dwell, Eigen::Vector3d::Zero()});
               }
             if (!inside) continue;
             ++D.candidates_tried;
@@ -471,6 +472,38 @@ RtestSeparationDesign design_rtest_separation(const RtestSession& session, const
   }
   D.verdict = v.str();
   return D;
+}
+
+JointFitOutcome identify_rtest_effects(const RtestSession& session, const EffectModel& effects) {
+  if (session.machine != MachineType::BC_trt) throw InvalidArgument("identify_rtest_effects: the session is not of a BC-trt machine");
+  for (const Effect& f : effects.effects)
+    if (!f.applies_to(session.machine)) throw InvalidArgument("effect " + f.id() + " does not exist on a BC-trt");
+  std::map<std::string, int> nest_index;
+  std::vector<RtestPose> poses;
+  for (const RtestSample& s : session.samples) {
+    const auto it = session.nests.find(s.setup);
+    if (it == session.nests.end()) throw InvalidArgument("identify_rtest_effects: nest '" + s.setup + "' has no position");
+    if (!s.d) throw InvalidArgument("identify_rtest_effects: a sample of nest '" + s.setup + "' has no dx, dy, dz");
+    const int k = nest_index.emplace(s.setup, static_cast<int>(nest_index.size())).first->second;
+    poses.push_back({k, it->second, s.xyz, s.angles_rad(), s.time, *s.d});
+  }
+  const int ns = static_cast<int>(nest_index.size());
+  std::vector<std::string> names(static_cast<std::size_t>(ns));
+  for (const auto& [name, k] : nest_index) names[static_cast<std::size_t>(k)] = name;
+  std::vector<FitParameter> params;
+  for (int k = 0; k < 8; ++k)
+    params.push_back({location_error_names(MachineType::BC_trt)[static_cast<std::size_t>(k)],
+                      location_error_is_angle(k) ? "rad" : "mm", 0.0});
+  for (const std::string& n : names)
+    for (const char* c : {"zero_x#", "zero_y#", "zero_z#"}) params.push_back({c + n, "mm", 0.0});
+  for (const Effect& f : effects.effects) {
+    const auto pn = f.param_names(), pu = f.param_units();
+    for (std::size_t k = 0; k < pn.size(); ++k) params.push_back({f.id() + (pn.size() > 1 ? "." + pn[k] : ""), pu[k], 0.0});
+  }
+  const RtestReadingsModel model(std::move(poses), ns, effects);
+  JointFitSettings settings;
+  settings.sigma = session.noise_um.value_or(1.0) * 1e-3;
+  return solve_joint(model, params, settings);
 }
 
 }  // namespace rotacal

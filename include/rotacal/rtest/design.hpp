@@ -138,4 +138,12 @@ struct RtestSeparationDesign {
 RtestSeparationDesign design_rtest_separation(const RtestSession& session, const std::vector<Effect>& pair,
                                               const RtestSeparationOptions& options = {});
 
+/// Joint fit of an R-test session with catalogue effects instead of the smooth maps (e.g. a
+/// session and the nest added to it, as one session): 8 location errors, a probe zero per nest
+/// ("zero_x#N"), then the effects' parameters, readings d = T^-1 tool - q + zero of
+/// kinematics/effects.hpp with Jets. White least squares; covariance (J^T J)^-1 s^2. Throws
+/// InvalidArgument for a non-BC-trt session, a nest without position, a sample without d, or an
+/// effect that does not exist on the machine.
+JointFitOutcome identify_rtest_effects(const RtestSession& session, const EffectModel& effects);
+
 }  // namespace rotacal
