@@ -158,6 +158,20 @@ def rtest_design(draws: int) -> None:
     ratio = np.std(np.asarray(est), axis=0, ddof=1) / np.asarray(c.sigma)[:8]
     print(f"  Monte Carlo sigma / predicted of the designed pattern over {draws} draws: "
           f"{ratio.min():.2f}-{ratio.max():.2f} (target 0.7-1.4)")
+    # After an R-test session of the default pattern (noise 0.3 um): the nest that separates
+    # axial from tilt motion of C, and gravity sag from the second radial harmonic of B.
+    s, _ = rtest_session(o.base, 0)
+    s = s.with_displacements(np.asarray(s.d) + np.random.default_rng(5).normal(0.0, 0.3e-3, np.asarray(s.d).shape))
+    for pair in (["axial_motion_C_h2", "tilt_motion_C_h2"], ["gravity_sag_B", "radial_motion_B_h2"]):
+        t0 = time.perf_counter()
+        sep = _core.design_rtest_separation(s, pair)
+        took = f"{sep.candidates_tried} added nests in {time.perf_counter() - t0:.2f} s"
+        if sep.motion.same_motion:
+            print(f"R-test separate {pair[0]} / {pair[1]}: inseparable (same table motion), {took}")
+        else:
+            print(f"R-test separate {pair[0]} / {pair[1]}: {took}; correlation {sep.correlation_before:.2f} -> "
+                  f"{sep.chosen.correlation:.2f} with {sep.chosen.duration_s * sep.chosen.repeats:.0f} s")
+        print(f"  {sep.verdict[:200]}")
 
 
 def rtest_session(p, k: int):

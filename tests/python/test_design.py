@@ -127,3 +127,19 @@ def test_design_rtest_beats_the_default_pattern():
 def test_design_rtest_refuses_by_option(args, option):
     r = rotacal_cli("design", "rtest", "--radii", "100", "--heights", "60", "--b-steps", "30", "--c-steps", "30", *args)
     assert r.returncode in (2, EXIT_INPUT) and option in r.stderr, r.stderr
+
+
+OYAMA = SHARED / "rtest_bc_oyama.csv"
+
+
+def test_design_rtest_separate_after_a_session():
+    r = rotacal_cli("design", "rtest", "--separate", "axial_motion_C_h2,tilt_motion_C_h2", "--after", OYAMA, "--json")
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout)
+    assert d["found"] and d["added_nest"]["correlation_after"] < 0.5 < d["correlation_before"]
+    assert d["added_nest"]["run_time_s"] <= 600
+    r = rotacal_cli("design", "rtest", "--separate", "gravity_sag_B,radial_motion_B_h2", "--after", OYAMA)
+    assert r.returncode == 0 and r.stdout.startswith("no test can separate gravity_sag_B and radial_motion_B_h2")
+    # The wrong kind of session is refused by option.
+    r = rotacal_cli("design", "rtest", "--separate", "axial_motion_C_h2,tilt_motion_C_h2", "--after", TABLE2)
+    assert r.returncode in (2, EXIT_INPUT) and "--after" in r.stderr
