@@ -28,14 +28,15 @@ std::string fmt(double v, int digits = 1) {
 }
 
 // The first plan sample whose machine axes leave the travel, in words; empty if none does.
-std::string travel_violation(const BallbarPlan& plan, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+std::string travel_violation(const BallbarPlan& plan, const Eigen::Vector3d& lo,
+                             const Eigen::Vector3d& hi) {
   const char* axis = "XYZ";
   for (const PlanSegment& seg : plan.segments)
     for (const PlannedSample& s : seg.samples)
       for (int k = 0; k < 3; ++k)
         if (s.xyz[k] < lo[k] || s.xyz[k] > hi[k])
-          return std::string(1, axis[k]) + " = " + fmt(s.xyz[k], 3) + " mm in " + seg.label + " is outside the travel " +
-                 fmt(lo[k]) + ".." + fmt(hi[k]) + " mm";
+          return std::string(1, axis[k]) + " = " + fmt(s.xyz[k], 3) + " mm in " + seg.label +
+                 " is outside the travel " + fmt(lo[k]) + ".." + fmt(hi[k]) + " mm";
   return {};
 }
 
@@ -49,7 +50,8 @@ double test_time(const BallbarPlan& plan) {
 
 }  // namespace
 
-DesignCandidate evaluate_design(const BallbarSetup& setup, const BallbarDesignOptions& o, double budget) {
+DesignCandidate evaluate_design(const BallbarSetup& setup, const BallbarDesignOptions& o,
+                                double budget) {
   DesignCandidate c;
   c.setup = setup;
   BallbarPlan plan;
@@ -80,7 +82,8 @@ DesignCandidate evaluate_design(const BallbarSetup& setup, const BallbarDesignOp
     if (!id.fixed[static_cast<std::size_t>(j)]) {
       free.push_back(j);
     } else if (j < 11) {
-      c.why_not = id.parameters[static_cast<std::size_t>(j)].name + " is not determined by this set-up";
+      c.why_not =
+          id.parameters[static_cast<std::size_t>(j)].name + " is not determined by this set-up";
       return c;
     }
   }
@@ -96,22 +99,27 @@ DesignCandidate evaluate_design(const BallbarSetup& setup, const BallbarDesignOp
   const double s2 = o.noise_um * o.noise_um * 1e-6;
   Eigen::MatrixXd info = Jf.transpose() * Jf * (scale / s2);
   const Eigen::VectorXd d = info.diagonal().cwiseSqrt();
-  const Eigen::MatrixXd normalised = d.cwiseInverse().asDiagonal() * info * d.cwiseInverse().asDiagonal();
+  const Eigen::MatrixXd normalised =
+      d.cwiseInverse().asDiagonal() * info * d.cwiseInverse().asDiagonal();
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(normalised);
   if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 1e-12)) {
     c.why_not = "the information matrix is singular";
     return c;
   }
   const Eigen::MatrixXd corr_inv = ldlt.solve(Eigen::MatrixXd::Identity(q, q));
-  const Eigen::MatrixXd cov_free = d.cwiseInverse().asDiagonal() * corr_inv * d.cwiseInverse().asDiagonal();
+  const Eigen::MatrixXd cov_free =
+      d.cwiseInverse().asDiagonal() * corr_inv * d.cwiseInverse().asDiagonal();
   const double inf = std::numeric_limits<double>::infinity();
   Eigen::MatrixXd cov = Eigen::MatrixXd::Constant(p, p, inf);
   for (int a = 0; a < q; ++a)
-    for (int b = 0; b < q; ++b) cov(free[static_cast<std::size_t>(a)], free[static_cast<std::size_t>(b)]) = cov_free(a, b);
+    for (int b = 0; b < q; ++b)
+      cov(free[static_cast<std::size_t>(a)], free[static_cast<std::size_t>(b)]) = cov_free(a, b);
   c.sigma = cov.diagonal().cwiseSqrt();
   for (int i = 0; i < 8; ++i) {
-    const double u = 2.0 * c.sigma[i] * (location_error_is_angle(i) ? o.reference_radius_mm * 1e3 : 1e3);
-    if (u > c.worst_expanded_um) c.worst_expanded_um = u, c.worst_error = c.names[static_cast<std::size_t>(i)];
+    const double u =
+        2.0 * c.sigma[i] * (location_error_is_angle(i) ? o.reference_radius_mm * 1e3 : 1e3);
+    if (u > c.worst_expanded_um)
+      c.worst_expanded_um = u, c.worst_error = c.names[static_cast<std::size_t>(i)];
   }
   const int first_effect = p - o.effects_of_concern.num_params();
   for (int j = first_effect; j < p; ++j) {
@@ -134,11 +142,14 @@ DesignCandidate evaluate_design(const BallbarSetup& setup, const BallbarDesignOp
 
 BallbarDesign design_ballbar_test(const BallbarDesignOptions& o) {
   if (o.bar_lengths_mm.empty() || o.pivot_x_mm.empty() || o.pivot_z_mm.empty())
-    throw InvalidArgument("design: --lengths, --pivot-x and --pivot-z need at least one value each");
+    throw InvalidArgument(
+        "design: --lengths, --pivot-x and --pivot-z need at least one value each");
   if (!(o.sample_rate_hz > 0.0)) throw InvalidArgument("design: --rate must be > 0 Hz");
   if (!(o.noise_um > 0.0)) throw InvalidArgument("design: --noise must be > 0 um");
-  if (!(o.reference_radius_mm > 0.0)) throw InvalidArgument("design: the reference radius must be > 0 mm");
-  if (!(o.noise_rho >= 0.0 && o.noise_rho <= 0.999)) throw InvalidArgument("design: --rho must be in [0, 0.999]");
+  if (!(o.reference_radius_mm > 0.0))
+    throw InvalidArgument("design: the reference radius must be > 0 mm");
+  if (!(o.noise_rho >= 0.0 && o.noise_rho <= 0.999))
+    throw InvalidArgument("design: --rho must be in [0, 0.999]");
   if (!(o.time_budget_s >= 0.0) || !std::isfinite(o.time_budget_s))
     throw InvalidArgument("design: --time must be >= 0 s");
   BallbarDesign out;
@@ -155,12 +166,16 @@ BallbarDesign design_ballbar_test(const BallbarDesignOptions& o) {
         s.ballbar_length = L;
         s.pivot = Eigen::Vector3d(x, 0.0, z);
         DesignCandidate c = evaluate_design(s, o, out.time_budget_s);
-        if (c.feasible && (!out.best.feasible || c.worst_expanded_um < out.best.worst_expanded_um)) out.best = c;
-        if (!c.feasible && reasons.size() < 400) reasons += "; L0 " + fmt(L) + ", pivot (" + fmt(x) + ", 0, " + fmt(z) + "): " + c.why_not;
+        if (c.feasible && (!out.best.feasible || c.worst_expanded_um < out.best.worst_expanded_um))
+          out.best = c;
+        if (!c.feasible && reasons.size() < 400)
+          reasons += "; L0 " + fmt(L) + ", pivot (" + fmt(x) + ", 0, " + fmt(z) + "): " + c.why_not;
         out.candidates.push_back(std::move(c));
       }
-  if (!out.best.feasible) throw InvalidArgument("design: no candidate set-up is feasible" + reasons);
-  if (out.baseline.feasible) out.ratio = out.best.worst_expanded_um / out.baseline.worst_expanded_um;
+  if (!out.best.feasible)
+    throw InvalidArgument("design: no candidate set-up is feasible" + reasons);
+  if (out.baseline.feasible)
+    out.ratio = out.best.worst_expanded_um / out.baseline.worst_expanded_um;
   return out;
 }
 
@@ -197,9 +212,12 @@ Eigen::MatrixXd table_motion_columns(MachineType m, const EffectModel& fx,
     LocationErrors<Jet1> e;
     Vec3<Jet1> dq = Vec3<Jet1>::Zero();
     std::vector<Jet1> q(static_cast<std::size_t>(std::max(P, 1)), Jet1(0.0));
-    if (c < 8) e.v[c].v[0] = 1.0;
-    else if (c < 11) dq[c - 8].v[0] = 1.0;
-    else q[static_cast<std::size_t>(c - 11)].v[0] = 1.0;
+    if (c < 8)
+      e.v[c].v[0] = 1.0;
+    else if (c < 11)
+      dq[c - 8].v[0] = 1.0;
+    else
+      q[static_cast<std::size_t>(c - 11)].v[0] = 1.0;
     for (std::size_t i = 0; i < poses.size(); ++i) {
       Pose<Jet1> T = table_pose<Jet1>(m, e, fx, q.data(), poses[i], times[i]);
       T.t += T.R * dq;  // the table point moved in the table frame
@@ -220,7 +238,9 @@ Eigen::MatrixXd table_motion_columns(MachineType m, const EffectModel& fx,
   return G;
 }
 
-std::string deg_range(std::array<double, 2> r) { return fmt(r[0], 0) + ".." + fmt(r[1], 0) + " deg"; }
+std::string deg_range(std::array<double, 2> r) {
+  return fmt(r[0], 0) + ".." + fmt(r[1], 0) + " deg";
+}
 
 }  // namespace
 
@@ -231,7 +251,8 @@ namespace design_detail {
 // that moving by plausible magnitudes changes chi-square by less than 1, on the white
 // chi-square the fit tests (`white`: the information over the effective fraction, as the fit
 // counts every reading). The covariance of the rest is the inverse of their information.
-Inverted invert_information(const Eigen::MatrixXd& I, const Eigen::VectorXd& plausible, double white) {
+Inverted invert_information(const Eigen::MatrixXd& I, const Eigen::VectorXd& plausible,
+                            double white) {
   const Eigen::Index p = I.rows();
   Inverted out;
   out.determined.assign(static_cast<std::size_t>(p), true);
@@ -274,8 +295,9 @@ Inverted invert_information(const Eigen::MatrixXd& I, const Eigen::VectorXd& pla
     for (Eigen::Index b = 0; b < q; ++b) out.cov(idx[a], idx[b]) = cov_q(a, b);
   out.sigma.resize(p);
   for (Eigen::Index j = 0; j < p; ++j)
-    out.sigma[j] = out.determined[static_cast<std::size_t>(j)] ? std::sqrt(std::max(out.cov(j, j), 0.0))
-                                                               : std::numeric_limits<double>::infinity();
+    out.sigma[j] = out.determined[static_cast<std::size_t>(j)]
+                       ? std::sqrt(std::max(out.cov(j, j), 0.0))
+                       : std::numeric_limits<double>::infinity();
   return out;
 }
 
@@ -302,13 +324,17 @@ double canonical_correlation(const Inverted& inv, int a0, int na, int b0, int nb
 }  // namespace design_detail
 
 TableMotionOverlap table_motion_overlap(MachineType m, const Effect& a, const Effect& b,
-                                        std::array<double, 2> tilt, double duration_s, double r_ref) {
+                                        std::array<double, 2> tilt, double duration_s,
+                                        double r_ref) {
   for (const Effect* f : {&a, &b})
-    if (!f->applies_to(m)) throw InvalidArgument("effect " + f->id() + " does not exist on a " + to_string(m));
-  if (!(tilt[0] < tilt[1])) throw InvalidArgument("table_motion_overlap: the tilt limits must be min < max deg");
+    if (!f->applies_to(m))
+      throw InvalidArgument("effect " + f->id() + " does not exist on a " + to_string(m));
+  if (!(tilt[0] < tilt[1]))
+    throw InvalidArgument("table_motion_overlap: the tilt limits must be min < max deg");
   if (!(duration_s >= 0.0) || !std::isfinite(duration_s))
     throw InvalidArgument("table_motion_overlap: the duration must be >= 0 s");
-  if (!(r_ref > 0.0)) throw InvalidArgument("table_motion_overlap: the reference radius must be > 0 mm");
+  if (!(r_ref > 0.0))
+    throw InvalidArgument("table_motion_overlap: the reference radius must be > 0 mm");
   // 19 tilt angles x 24 C angles x 3 times: every harmonic up to 4 is resolved on both axes.
   std::vector<RotaryAngles<double>> poses;
   std::vector<double> times;
@@ -328,11 +354,13 @@ TableMotionOverlap table_motion_overlap(MachineType m, const Effect& a, const Ef
   TableMotionOverlap out;
   out.moves_table_first = n1 > 1e-12 * scale;
   out.moves_table_second = n2 > 1e-12 * scale;
-  const std::string range = "tilt " + deg_range(tilt) + ", C over a full turn, time 0.." + fmt(duration_s, 0) + " s";
+  const std::string range =
+      "tilt " + deg_range(tilt) + ", C over a full turn, time 0.." + fmt(duration_s, 0) + " s";
   if (!out.moves_table_first || !out.moves_table_second) {
-    out.why = (out.moves_table_first ? b : a).id() +
-              " does not move the table (it acts on the tool side or in the instrument), so the table "
-              "motion cannot decide: an added test is searched";
+    out.why =
+        (out.moves_table_first ? b : a).id() +
+        " does not move the table (it acts on the tool side or in the instrument), so the table "
+        "motion cannot decide: an added test is searched";
     return out;
   }
   const Eigen::MatrixXd Q = basis(G.leftCols(11), 1e-10 * G.leftCols(11).norm());
@@ -344,10 +372,12 @@ TableMotionOverlap table_motion_overlap(MachineType m, const Effect& a, const Ef
     out.same_motion = true;
     out.cosine = 1.0;
     const Effect& loc = out.first_is_location ? a : b;
-    out.why = "at every pose (" + range + ") " + loc.id() +
-              " moves the table only as the location errors and the set-up's table point do: every "
-              "instrument reads the table's motion and fits those, so no test determines it, whatever "
-              "the other effect; only changing its cause can (" + loc.cause() + ")";
+    out.why =
+        "at every pose (" + range + ") " + loc.id() +
+        " moves the table only as the location errors and the set-up's table point do: every "
+        "instrument reads the table's motion and fits those, so no test determines it, whatever "
+        "the other effect; only changing its cause can (" +
+        loc.cause() + ")";
     return out;
   }
   const Eigen::JacobiSVD<Eigen::MatrixXd> svd(U1.transpose() * U2);
@@ -361,7 +391,8 @@ TableMotionOverlap table_motion_overlap(MachineType m, const Effect& a, const Ef
       << "'s does, together with the location errors and the set-up's table point (cosine of their "
          "table motions "
       << std::fixed << out.cosine
-      << "): every instrument reads the table's motion, so no test can tell them apart; only changing "
+      << "): every instrument reads the table's motion, so no test can tell them apart; only "
+         "changing "
          "the cause of one of them can ("
       << a.id() << ": " << a.cause() << "; " << b.id() << ": " << b.cause() << ")";
   } else {
@@ -387,19 +418,26 @@ namespace {
 struct SessionsLengthModel : ResidualModel {
   const std::vector<BallbarArrays>& d;
   const EffectModel& fx;
-  int ns, P;          // ns: pivots (columns 8 + 3 k), P: effect parameters
+  int ns, P;                  // ns: pivots (columns 8 + 3 k), P: effect parameters
   std::vector<int> pivot_of;  // pivot index of each session
   std::vector<std::pair<int, Eigen::Index>> rows;  // (session, row) of every residual
-  SessionsLengthModel(const std::vector<BallbarArrays>& d_, const EffectModel& fx_, std::vector<int> pivot_of_, int P_)
-      : d(d_), fx(fx_), ns(*std::max_element(pivot_of_.begin(), pivot_of_.end()) + 1), P(P_), pivot_of(std::move(pivot_of_)) {
+  SessionsLengthModel(const std::vector<BallbarArrays>& d_, const EffectModel& fx_,
+                      std::vector<int> pivot_of_, int P_)
+      : d(d_),
+        fx(fx_),
+        ns(*std::max_element(pivot_of_.begin(), pivot_of_.end()) + 1),
+        P(P_),
+        pivot_of(std::move(pivot_of_)) {
     for (int s = 0; s < static_cast<int>(d.size()); ++s)
-      for (Eigen::Index i = 0; i < d[static_cast<std::size_t>(s)].size(); ++i) rows.push_back({s, i});
+      for (Eigen::Index i = 0; i < d[static_cast<std::size_t>(s)].size(); ++i)
+        rows.push_back({s, i});
   }
   Eigen::Index num_residuals() const override { return static_cast<Eigen::Index>(rows.size()); }
   int num_parameters() const override { return 8 + 3 * ns + P; }
-  void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r, Eigen::MatrixXd* J) const override {
-    evaluate_with_jets([this](Eigen::Index k, const auto* p, auto* out) { sample(k, p, out); }, num_residuals(), 1,
-                       x, r, J);
+  void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r,
+                Eigen::MatrixXd* J) const override {
+    evaluate_with_jets([this](Eigen::Index k, const auto* p, auto* out) { sample(k, p, out); },
+                       num_residuals(), 1, x, r, J);
   }
   template <typename T>
   void sample(Eigen::Index k, const T* p, T* out) const {
@@ -409,8 +447,9 @@ struct SessionsLengthModel : ResidualModel {
     const int piv = pivot_of[static_cast<std::size_t>(s)];
     const Vec3<T> pivot(p[8 + 3 * piv], p[9 + 3 * piv], p[10 + 3 * piv]);
     const Eigen::Vector3d xyz = a.xyz.col(i);
-    out[0] = predicted_length<T>(a.machine, LocationErrors<T>::from_ptr(p), pivot, fx, P > 0 ? p + 8 + 3 * ns : nullptr,
-                                 xyz, a.angles[static_cast<std::size_t>(i)], a.time[i]) -
+    out[0] = predicted_length<T>(a.machine, LocationErrors<T>::from_ptr(p), pivot, fx,
+                                 P > 0 ? p + 8 + 3 * ns : nullptr, xyz,
+                                 a.angles[static_cast<std::size_t>(i)], a.time[i]) -
              T(a.length[i]);
   }
 };
@@ -430,7 +469,8 @@ Eigen::MatrixXd nominal_jacobian(const BallbarSession& s, const EffectModel& fx)
 
 }  // namespace
 
-SeparationDesign design_ballbar_separation(const BallbarSession& session, const std::vector<Effect>& pair,
+SeparationDesign design_ballbar_separation(const BallbarSession& session,
+                                           const std::vector<Effect>& pair,
                                            const SeparationOptions& o) {
   using design_detail::canonical_correlation;
   using design_detail::invert_information;
@@ -438,13 +478,16 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session, const 
   if (pair.size() != 2 || pair[0] == pair[1])
     throw InvalidArgument("design: --separate needs two different effects (EFFECT,EFFECT)");
   if (session.samples.empty()) throw InvalidArgument("design: --after: the session has no samples");
-  if (o.bar_lengths_mm.empty() || o.pivot_radius_mm.empty() || o.pivot_angle_deg.empty() || o.pivot_z_mm.empty())
-    throw InvalidArgument("design: --lengths, --pivot-r, --pivot-angle and --pivot-z need at least one value each");
+  if (o.bar_lengths_mm.empty() || o.pivot_radius_mm.empty() || o.pivot_angle_deg.empty() ||
+      o.pivot_z_mm.empty())
+    throw InvalidArgument(
+        "design: --lengths, --pivot-r, --pivot-angle and --pivot-z need at least one value each");
   if (!(o.max_added_time_s > 0.0) || !std::isfinite(o.max_added_time_s))
     throw InvalidArgument("design: --max-time must be > 0 s");
   if (!(o.max_correlation > 0.0 && o.max_correlation < 1.0))
     throw InvalidArgument("design: --max-correlation must be in (0, 1)");
-  if (!(o.noise_um >= 0.0) || !std::isfinite(o.noise_um)) throw InvalidArgument("design: --noise must be >= 0 um");
+  if (!(o.noise_um >= 0.0) || !std::isfinite(o.noise_um))
+    throw InvalidArgument("design: --noise must be >= 0 um");
   if (!(o.tilt_limits_deg[0] < o.tilt_limits_deg[1]))
     throw InvalidArgument("design: --tilt-limits must be min < max deg");
   const MachineType m = session.machine;
@@ -455,8 +498,8 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session, const 
   for (const BallbarSample& s : session.samples) fx.linear_reference += s.xyz;
   fx.linear_reference /= static_cast<double>(session.samples.size());
   const double t_end = session.samples.back().time;
-  D.motion = table_motion_overlap(m, pair[0], pair[1], o.tilt_limits_deg, t_end + o.max_added_time_s,
-                                  o.reference_radius_mm);
+  D.motion = table_motion_overlap(m, pair[0], pair[1], o.tilt_limits_deg,
+                                  t_end + o.max_added_time_s, o.reference_radius_mm);
 
   // The session's information: its joint-fit Jacobian (pair included) over its noise, whose
   // model comes from the residuals of the fit.
@@ -469,10 +512,12 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session, const 
   double sigma_um = o.noise_um > 0.0 ? o.noise_um : id.noise.sigma_um;
   if (!(sigma_um > 0.0)) sigma_um = id.sigma_um;
   if (!(sigma_um > 0.0))
-    throw InvalidArgument("design: --after: the session's residuals are zero (commanded data?); give --noise");
+    throw InvalidArgument(
+        "design: --after: the session's residuals are zero (commanded data?); give --noise");
   D.noise_um = sigma_um;
   if (id.noise.n > 0 && id.noise.effective_samples > 0.0)
-    D.effective_per_reading = std::min(1.0, id.noise.effective_samples / static_cast<double>(id.noise.n));
+    D.effective_per_reading =
+        std::min(1.0, id.noise.effective_samples / static_cast<double>(id.noise.n));
   const double w = D.effective_per_reading / (sigma_um * sigma_um * 1e-6);
   // The Jacobian at the start point, where the fit judges what it can see (at its solution,
   // location errors of 0.1 mm lend second-order sensitivity that the fit does not use).
@@ -481,14 +526,16 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session, const 
   for (const ParameterEstimate& e : id.parameters) D.names.push_back(e.name);
   // Plausible magnitudes by unit (1 mm, 1 mrad, ...), as the fit's observability test uses.
   Eigen::VectorXd plausible = Eigen::VectorXd::Constant(p0 + 3, plausible_magnitude("mm"));
-  for (int j = 0; j < p0; ++j) plausible[j] = plausible_magnitude(id.parameters[static_cast<std::size_t>(j)].unit);
+  for (int j = 0; j < p0; ++j)
+    plausible[j] = plausible_magnitude(id.parameters[static_cast<std::size_t>(j)].unit);
   const Inverted before = invert_information(Is, plausible.head(p0), 1.0 / D.effective_per_reading);
   D.sigma_before = before.sigma;
   D.correlation_before = canonical_correlation(before, 11, na, 11 + na, nb);
   D.sigma_after = D.sigma_before;
   D.chosen.correlation = D.correlation_before;
   if (D.motion.same_motion) {
-    D.verdict = "no test can separate " + D.effects[0] + " and " + D.effects[1] + ": " + D.motion.why;
+    D.verdict =
+        "no test can separate " + D.effects[0] + " and " + D.effects[1] + ": " + D.motion.why;
     return D;
   }
   if (D.correlation_before < o.max_correlation) {
@@ -496,7 +543,8 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session, const 
     std::ostringstream v;
     v.precision(2);
     v << std::fixed << "the session alone separates " << D.effects[0] << " and " << D.effects[1]
-      << " (correlation " << D.correlation_before << " < " << o.max_correlation << "): no added test is needed";
+      << " (correlation " << D.correlation_before << " < " << o.max_correlation
+      << "): no added test is needed";
     D.verdict = v.str();
     return D;
   }
@@ -505,19 +553,22 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session, const 
   // pivot is shared with the session); from a moved pivot, the sphere tests that locate it
   // and one rotary test.
   std::vector<std::pair<BallbarSetup, bool>> cands;
-  const std::vector<BallbarTest> rotary = {BallbarTest::radial_c, BallbarTest::axial_c, BallbarTest::radial_tilt,
-                                           BallbarTest::axial_tilt};
+  const std::vector<BallbarTest> rotary = {BallbarTest::radial_c, BallbarTest::axial_c,
+                                           BallbarTest::radial_tilt, BallbarTest::axial_tilt};
   const std::array<double, 2> lim = o.tilt_limits_deg;
   std::vector<std::array<double, 2>> tilt_ranges = {lim};
-  if (lim[0] < 0.0 && lim[1] > 0.0) tilt_ranges.push_back({lim[0], 0.0}), tilt_ranges.push_back({0.0, lim[1]});
+  if (lim[0] < 0.0 && lim[1] > 0.0)
+    tilt_ranges.push_back({lim[0], 0.0}), tilt_ranges.push_back({0.0, lim[1]});
   BallbarSetup base = o.added;
   base.machine = m;
   for (double L : o.bar_lengths_mm)
     for (BallbarTest t : rotary) {
       const bool tilt_test = t == BallbarTest::radial_tilt || t == BallbarTest::axial_tilt;
       for (const auto& tr : tilt_test ? tilt_ranges : std::vector<std::array<double, 2>>{lim})
-        for (RadialSide side : t == BallbarTest::radial_c ? std::vector<RadialSide>{RadialSide::outside, RadialSide::inside}
-                                                          : std::vector<RadialSide>{RadialSide::outside}) {
+        for (RadialSide side :
+             t == BallbarTest::radial_c
+                 ? std::vector<RadialSide>{RadialSide::outside, RadialSide::inside}
+                 : std::vector<RadialSide>{RadialSide::outside}) {
           BallbarSetup s = base;
           s.ballbar_length = L;
           s.pivot = session.pivot;
@@ -581,12 +632,14 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session, const 
       c.slow_down = slow;
       c.correlation = canonical_correlation(inv, 11, na, 11 + na, nb);
       c.determined = true;
-      for (int j = 11; j < 11 + ne; ++j) c.determined = c.determined && inv.determined[static_cast<std::size_t>(j)];
+      for (int j = 11; j < 11 + ne; ++j)
+        c.determined = c.determined && inv.determined[static_cast<std::size_t>(j)];
       const bool ok = c.correlation < o.max_correlation;
       const double run = duration * slow;
       if (ok) {
         if (!have_best || run < D.chosen.duration_s * D.chosen.slow_down - 1e-9 ||
-            (std::abs(run - D.chosen.duration_s * D.chosen.slow_down) <= 1e-9 && c.correlation < D.chosen.correlation)) {
+            (std::abs(run - D.chosen.duration_s * D.chosen.slow_down) <= 1e-9 &&
+             c.correlation < D.chosen.correlation)) {
           D.chosen = c;
           best_info = I;
           have_best = true;
@@ -605,18 +658,22 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session, const 
     SeparatingCandidate& c = D.chosen;
     std::ostringstream d;
     const std::string label = test_label(c.setup.tests.back(), m);
-    const bool tilt_test = c.setup.tests.back() == BallbarTest::radial_tilt || c.setup.tests.back() == BallbarTest::axial_tilt;
+    const bool tilt_test = c.setup.tests.back() == BallbarTest::radial_tilt ||
+                           c.setup.tests.back() == BallbarTest::axial_tilt;
     d << label;
     if (tilt_test) d << " over " << deg_range(c.setup.tilt_range_deg);
-    if (c.setup.tests.back() == BallbarTest::radial_c) d << " (tool circle " << to_string(c.setup.radial_c_side) << ")";
+    if (c.setup.tests.back() == BallbarTest::radial_c)
+      d << " (tool circle " << to_string(c.setup.radial_c_side) << ")";
     d << " with the " << fmt(c.setup.ballbar_length, 0) << " mm bar";
     if (c.new_pivot)
-      d << ", pivot moved to " << vec_text(c.setup.pivot) << " (after sphere_xy, sphere_yz, sphere_zx to locate it)";
+      d << ", pivot moved to " << vec_text(c.setup.pivot)
+        << " (after sphere_xy, sphere_yz, sphere_zx to locate it)";
     else
       d << ", from the session's pivot " << vec_text(c.setup.pivot);
     if (c.slow_down > 1.0) d << ", at 1/" << fmt(c.slow_down, 0) << " of the feeds";
     c.description = d.str();
-    const Inverted after = invert_information(best_info, plausible.head(best_info.rows()), 1.0 / D.effective_per_reading);
+    const Inverted after = invert_information(best_info, plausible.head(best_info.rows()),
+                                              1.0 / D.effective_per_reading);
     D.sigma_after = after.sigma;
     if (c.new_pivot)
       for (const char* n : {"pivot_x#2", "pivot_y#2", "pivot_z#2"}) D.names.push_back(n);
@@ -626,35 +683,41 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session, const 
   v << std::fixed;
   if (D.found)
     v << "add " << D.chosen.description << ": " << fmt(D.chosen.duration_s * D.chosen.slow_down, 0)
-      << " s; fitted with the session, the correlation of " << D.effects[0] << " and " << D.effects[1]
-      << " goes from " << D.correlation_before << " to " << D.chosen.correlation;
+      << " s; fitted with the session, the correlation of " << D.effects[0] << " and "
+      << D.effects[1] << " goes from " << D.correlation_before << " to " << D.chosen.correlation;
   else
     v << "none of " << D.candidates_tried << " added tests within " << fmt(o.max_added_time_s, 0)
       << " s brings the correlation of " << D.effects[0] << " and " << D.effects[1] << " below "
       << o.max_correlation
-      << (D.candidates_tried ? "; the closest is " + D.chosen.description + " (correlation " +
-                                   fmt(D.chosen.correlation, 2) + "): a longer test or another instrument may"
-                             : std::string("; every candidate breaks a limit"));
+      << (D.candidates_tried
+              ? "; the closest is " + D.chosen.description + " (correlation " +
+                    fmt(D.chosen.correlation, 2) + "): a longer test or another instrument may"
+              : std::string("; every candidate breaks a limit"));
   if (D.candidates_tried) {
     std::string held;
     for (std::size_t j = 11; j < 11 + static_cast<std::size_t>(ne); ++j)
-      if (!std::isfinite(D.sigma_after[static_cast<Eigen::Index>(j)])) held += (held.empty() ? "" : ", ") + D.names[j];
+      if (!std::isfinite(D.sigma_after[static_cast<Eigen::Index>(j)]))
+        held += (held.empty() ? "" : ", ") + D.names[j];
     if (!held.empty())
       v << "; " << held
-        << " remain undetermined (no reading of these tests sees them: the joint fit holds them at 0, and "
+        << " remain undetermined (no reading of these tests sees them: the joint fit holds them at "
+           "0, and "
            "the correlation is that of the rest)";
   }
   D.verdict = v.str();
   return D;
 }
 
-JointFitOutcome identify_joint_sessions(const std::vector<BallbarSession>& sessions, const EffectModel& effects) {
+JointFitOutcome identify_joint_sessions(const std::vector<BallbarSession>& sessions,
+                                        const EffectModel& effects) {
   if (sessions.empty()) throw InvalidArgument("identify_joint_sessions: no session");
   const MachineType m = sessions.front().machine;
   for (const BallbarSession& s : sessions)
-    if (s.machine != m) throw InvalidArgument("identify_joint_sessions: the sessions are of different machines");
+    if (s.machine != m)
+      throw InvalidArgument("identify_joint_sessions: the sessions are of different machines");
   for (const Effect& f : effects.effects)
-    if (!f.applies_to(m)) throw InvalidArgument("effect " + f.id() + " does not exist on a " + to_string(m));
+    if (!f.applies_to(m))
+      throw InvalidArgument("effect " + f.id() + " does not exist on a " + to_string(m));
   std::vector<BallbarArrays> data;
   for (const BallbarSession& s : sessions) data.push_back(ballbar_arrays(s));
   // Sessions with the same nominal pivot share it (the ball stayed in its cup).
@@ -662,25 +725,32 @@ JointFitOutcome identify_joint_sessions(const std::vector<BallbarSession>& sessi
   std::vector<Eigen::Vector3d> pivots;
   for (const BallbarSession& s : sessions) {
     int k = 0;
-    while (k < static_cast<int>(pivots.size()) && (pivots[static_cast<std::size_t>(k)] - s.pivot).norm() > 1e-9) ++k;
+    while (k < static_cast<int>(pivots.size()) &&
+           (pivots[static_cast<std::size_t>(k)] - s.pivot).norm() > 1e-9)
+      ++k;
     if (k == static_cast<int>(pivots.size())) pivots.push_back(s.pivot);
     pivot_of.push_back(k);
   }
   const int ns = static_cast<int>(pivots.size()), P = effects.num_params();
   std::vector<FitParameter> params;
   for (int k = 0; k < 8; ++k)
-    params.push_back({location_error_names(m)[static_cast<std::size_t>(k)], location_error_is_angle(k) ? "rad" : "mm", 0.0});
+    params.push_back({location_error_names(m)[static_cast<std::size_t>(k)],
+                      location_error_is_angle(k) ? "rad" : "mm", 0.0});
   const char* axis = "xyz";
   for (int s = 0; s < ns; ++s)
     for (int k = 0; k < 3; ++k)
-      params.push_back({std::string("pivot_") + axis[k] + "#" + std::to_string(s + 1), "mm", pivots[static_cast<std::size_t>(s)][k]});
+      params.push_back({std::string("pivot_") + axis[k] + "#" + std::to_string(s + 1), "mm",
+                        pivots[static_cast<std::size_t>(s)][k]});
   for (const std::string& l : effects.param_labels()) params.push_back({l, "", 0.0});
   for (std::size_t j = 8 + 3 * static_cast<std::size_t>(ns); j < params.size(); ++j) {
     // Units of the effect parameters, in label order.
     std::size_t k = j - 8 - 3 * static_cast<std::size_t>(ns);
     for (const Effect& f : effects.effects) {
       const auto u = f.param_units();
-      if (k < u.size()) { params[j].unit = u[k]; break; }
+      if (k < u.size()) {
+        params[j].unit = u[k];
+        break;
+      }
       k -= u.size();
     }
   }

@@ -1,8 +1,8 @@
 // Test design: the R-test nests and pose grid with the smallest predicted uncertainty.
 #include "rotacal/rtest/design.hpp"
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <map>
 #include <memory>
@@ -33,15 +33,17 @@ std::string fmt(double v, int digits = 1) {
 // gives W = I / sigma, i.e. (J^T J)^-1 sigma^2.
 class Ar1Whitener : public ResidualWhitener {
  public:
-  Ar1Whitener(const RtestSession& s, double sigma_mm, double rho) : n_(3 * static_cast<Eigen::Index>(s.samples.size())) {
+  Ar1Whitener(const RtestSession& s, double sigma_mm, double rho)
+      : n_(3 * static_cast<Eigen::Index>(s.samples.size())) {
     inv_first_ = 1.0 / sigma_mm;
     inv_next_ = 1.0 / (sigma_mm * std::sqrt(1.0 - rho * rho));
     rho_ = rho;
     std::map<std::string, std::vector<std::size_t>> by_nest;
     for (std::size_t i = 0; i < s.samples.size(); ++i) by_nest[s.samples[i].setup].push_back(i);
     for (auto& [nest, rows] : by_nest) {
-      std::stable_sort(rows.begin(), rows.end(),
-                       [&](std::size_t a, std::size_t b) { return s.samples[a].time < s.samples[b].time; });
+      std::stable_sort(rows.begin(), rows.end(), [&](std::size_t a, std::size_t b) {
+        return s.samples[a].time < s.samples[b].time;
+      });
       for (int k = 0; k < 3; ++k) {
         std::vector<Eigen::Index> stream;
         for (std::size_t i : rows) stream.push_back(3 * static_cast<Eigen::Index>(i) + k);
@@ -99,9 +101,10 @@ RtestDesignCandidate evaluate_rtest_design(const RtestPattern& pattern, const Rt
         const Eigen::Vector3d xyz = rtest_commanded_xyz(m, pattern.nests[n], {b * deg, cc * deg});
         for (int k = 0; k < 3; ++k)
           if (xyz[k] < o.travel_min[k] || xyz[k] > o.travel_max[k]) {
-            c.why_not = std::string(1, axis[k]) + " = " + fmt(xyz[k], 3) + " mm for nest " + std::to_string(n + 1) +
-                        " at B " + fmt(b) + ", C " + fmt(cc) + " deg is outside the travel " + fmt(o.travel_min[k]) +
-                        ".." + fmt(o.travel_max[k]) + " mm";
+            c.why_not = std::string(1, axis[k]) + " = " + fmt(xyz[k], 3) + " mm for nest " +
+                        std::to_string(n + 1) + " at B " + fmt(b) + ", C " + fmt(cc) +
+                        " deg is outside the travel " + fmt(o.travel_min[k]) + ".." +
+                        fmt(o.travel_max[k]) + " mm";
             return c;
           }
       }
@@ -144,8 +147,10 @@ RtestDesignCandidate evaluate_rtest_design(const RtestPattern& pattern, const Rt
       c.why_not = c.names[static_cast<std::size_t>(i)] + " is not determined by this pattern";
       return c;
     }
-    const double u = 2.0 * c.sigma[i] * (location_error_is_angle(i) ? o.reference_radius_mm * 1e3 : 1e3);
-    if (u > c.worst_expanded_um) c.worst_expanded_um = u, c.worst_error = c.names[static_cast<std::size_t>(i)];
+    const double u =
+        2.0 * c.sigma[i] * (location_error_is_angle(i) ? o.reference_radius_mm * 1e3 : 1e3);
+    if (u > c.worst_expanded_um)
+      c.worst_expanded_um = u, c.worst_error = c.names[static_cast<std::size_t>(i)];
   }
   // A pattern whose fit holds map coefficients fits a smaller model: its location errors
   // look better only because the maps are assumed zero. Such a pattern is not comparable.
@@ -160,19 +165,25 @@ RtestDesignCandidate evaluate_rtest_design(const RtestPattern& pattern, const Rt
 }
 
 RtestDesign design_rtest_test(const RtestDesignOptions& o) {
-  if (o.nest_radius_mm.empty() || o.nest_height_mm.empty() || o.b_step_deg.empty() || o.c_step_deg.empty())
-    throw InvalidArgument("design rtest: --radii, --heights, --b-steps and --c-steps need at least one value each");
+  if (o.nest_radius_mm.empty() || o.nest_height_mm.empty() || o.b_step_deg.empty() ||
+      o.c_step_deg.empty())
+    throw InvalidArgument(
+        "design rtest: --radii, --heights, --b-steps and --c-steps need at least one value each");
   for (double v : o.b_step_deg)
     if (!(v > 0.0)) throw InvalidArgument("design rtest: --b-steps must be > 0 deg");
   for (double v : o.c_step_deg)
-    if (!(v > 0.0 && v < 360.0)) throw InvalidArgument("design rtest: --c-steps must be in (0, 360) deg");
+    if (!(v > 0.0 && v < 360.0))
+      throw InvalidArgument("design rtest: --c-steps must be in (0, 360) deg");
   for (double v : o.nest_radius_mm)
     if (!(v >= 0.0)) throw InvalidArgument("design rtest: --radii must be >= 0 mm");
   if (!(o.noise_um > 0.0)) throw InvalidArgument("design rtest: --noise must be > 0 um");
-  if (!(o.noise_rho >= 0.0 && o.noise_rho <= 0.999)) throw InvalidArgument("design rtest: --rho must be in [0, 0.999]");
-  if (!(o.reference_radius_mm > 0.0)) throw InvalidArgument("design rtest: the reference radius must be > 0 mm");
+  if (!(o.noise_rho >= 0.0 && o.noise_rho <= 0.999))
+    throw InvalidArgument("design rtest: --rho must be in [0, 0.999]");
+  if (!(o.reference_radius_mm > 0.0))
+    throw InvalidArgument("design rtest: the reference radius must be > 0 mm");
   if (!(o.base.dwell_s > 0.0)) throw InvalidArgument("design rtest: --dwell must be > 0 s");
-  if (!(o.b_limits_deg[0] < o.b_limits_deg[1])) throw InvalidArgument("design rtest: --b-limits must be min < max deg");
+  if (!(o.b_limits_deg[0] < o.b_limits_deg[1]))
+    throw InvalidArgument("design rtest: --b-limits must be min < max deg");
   if (!(o.time_budget_s >= 0.0) || !std::isfinite(o.time_budget_s))
     throw InvalidArgument("design rtest: --time must be >= 0 s");
   RtestDesign out;
@@ -181,7 +192,8 @@ RtestDesign design_rtest_test(const RtestDesignOptions& o) {
   std::string reasons;
   const auto consider = [&](const RtestPattern& p) {
     RtestDesignCandidate c = evaluate_rtest_design(p, o, out.time_budget_s);
-    if (c.feasible && (!out.best.feasible || c.worst_expanded_um < out.best.worst_expanded_um)) out.best = c;
+    if (c.feasible && (!out.best.feasible || c.worst_expanded_um < out.best.worst_expanded_um))
+      out.best = c;
     if (!c.feasible && reasons.size() < 400) reasons += "; " + c.why_not;
     out.candidates.push_back(std::move(c));
   };
@@ -204,7 +216,8 @@ RtestDesign design_rtest_test(const RtestDesignOptions& o) {
       p.c_deg = steps(0.0, 360.0 - cs, cs);
       consider(p);
     }
-  if (out.baseline.feasible) out.ratio = out.best.worst_expanded_um / out.baseline.worst_expanded_um;
+  if (out.baseline.feasible)
+    out.ratio = out.best.worst_expanded_um / out.baseline.worst_expanded_um;
   return out;
 }
 
@@ -230,21 +243,25 @@ class RtestReadingsModel : public ResidualModel {
  public:
   RtestReadingsModel(std::vector<RtestPose> poses, int nests, const EffectModel& fx)
       : poses_(std::move(poses)), nests_(nests), fx_(fx), P_(fx.num_params()) {}
-  Eigen::Index num_residuals() const override { return 3 * static_cast<Eigen::Index>(poses_.size()); }
+  Eigen::Index num_residuals() const override {
+    return 3 * static_cast<Eigen::Index>(poses_.size());
+  }
   int num_parameters() const override { return 8 + 3 * nests_ + P_; }
   Eigen::Index num_items() const override { return static_cast<Eigen::Index>(poses_.size()); }
   int rows_per_item() const override { return 3; }
-  void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r, Eigen::MatrixXd* J) const override {
-    evaluate_with_jets([this](Eigen::Index i, const auto* p, auto* out) { sample(i, p, out); }, num_items(), 3, x, r,
-                       J);
+  void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r,
+                Eigen::MatrixXd* J) const override {
+    evaluate_with_jets([this](Eigen::Index i, const auto* p, auto* out) { sample(i, p, out); },
+                       num_items(), 3, x, r, J);
   }
 
  private:
   template <typename T>
   void sample(Eigen::Index i, const T* p, T* out) const {
     const RtestPose& s = poses_[static_cast<std::size_t>(i)];
-    const Vec3<T> d = rtest_reading<T>(MachineType::BC_trt, LocationErrors<T>::from_ptr(p), fx_,
-                                       P_ > 0 ? p + 8 + 3 * nests_ : nullptr, s.xyz, s.angles, s.t, s.q);
+    const Vec3<T> d =
+        rtest_reading<T>(MachineType::BC_trt, LocationErrors<T>::from_ptr(p), fx_,
+                         P_ > 0 ? p + 8 + 3 * nests_ : nullptr, s.xyz, s.angles, s.t, s.q);
     for (int k = 0; k < 3; ++k) out[k] = d[k] + p[8 + 3 * s.nest + k] - T(s.d[k]);
   }
   std::vector<RtestPose> poses_;
@@ -253,7 +270,8 @@ class RtestReadingsModel : public ResidualModel {
   int P_;
 };
 
-Eigen::MatrixXd nominal_rtest_jacobian(const std::vector<RtestPose>& poses, int nests, const EffectModel& fx) {
+Eigen::MatrixXd nominal_rtest_jacobian(const std::vector<RtestPose>& poses, int nests,
+                                       const EffectModel& fx) {
   const RtestReadingsModel model(poses, nests, fx);
   const Eigen::VectorXd x = Eigen::VectorXd::Zero(model.num_parameters());
   Eigen::VectorXd r(model.num_residuals());
@@ -262,33 +280,44 @@ Eigen::MatrixXd nominal_rtest_jacobian(const std::vector<RtestPose>& poses, int 
   return J;
 }
 
-std::string v3(const Eigen::Vector3d& v) { return "(" + fmt(v[0]) + ", " + fmt(v[1]) + ", " + fmt(v[2]) + ") mm"; }
+std::string v3(const Eigen::Vector3d& v) {
+  return "(" + fmt(v[0]) + ", " + fmt(v[1]) + ", " + fmt(v[2]) + ") mm";
+}
 
 }  // namespace
 
-RtestSeparationDesign design_rtest_separation(const RtestSession& session, const std::vector<Effect>& pair,
+RtestSeparationDesign design_rtest_separation(const RtestSession& session,
+                                              const std::vector<Effect>& pair,
                                               const RtestSeparationOptions& o) {
   using design_detail::canonical_correlation;
   using design_detail::invert_information;
   using design_detail::Inverted;
   if (pair.size() != 2 || pair[0] == pair[1])
     throw InvalidArgument("design rtest: --separate needs two different effects (EFFECT,EFFECT)");
-  if (session.samples.empty()) throw InvalidArgument("design rtest: --after: the session has no samples");
-  if (session.machine != MachineType::BC_trt) throw InvalidArgument("design rtest: --after: the session is not of a BC-trt machine");
-  if (o.nest_radius_mm.empty() || o.nest_angle_deg.empty() || o.nest_height_mm.empty() || o.b_step_deg.empty() ||
-      o.c_step_deg.empty())
-    throw InvalidArgument("design rtest: --radii, --nest-angles, --heights, --b-steps and --c-steps need at least one value each");
+  if (session.samples.empty())
+    throw InvalidArgument("design rtest: --after: the session has no samples");
+  if (session.machine != MachineType::BC_trt)
+    throw InvalidArgument("design rtest: --after: the session is not of a BC-trt machine");
+  if (o.nest_radius_mm.empty() || o.nest_angle_deg.empty() || o.nest_height_mm.empty() ||
+      o.b_step_deg.empty() || o.c_step_deg.empty())
+    throw InvalidArgument(
+        "design rtest: --radii, --nest-angles, --heights, --b-steps and --c-steps need at least "
+        "one value each");
   for (double v : o.b_step_deg)
     if (!(v > 0.0)) throw InvalidArgument("design rtest: --b-steps must be > 0 deg");
   for (double v : o.c_step_deg)
-    if (!(v > 0.0 && v < 360.0)) throw InvalidArgument("design rtest: --c-steps must be in (0, 360) deg");
+    if (!(v > 0.0 && v < 360.0))
+      throw InvalidArgument("design rtest: --c-steps must be in (0, 360) deg");
   if (!(o.max_added_time_s > 0.0) || !std::isfinite(o.max_added_time_s))
     throw InvalidArgument("design rtest: --max-time must be > 0 s");
   if (!(o.max_correlation > 0.0 && o.max_correlation < 1.0))
     throw InvalidArgument("design rtest: --max-correlation must be in (0, 1)");
-  if (!(o.noise_um >= 0.0) || !std::isfinite(o.noise_um)) throw InvalidArgument("design rtest: --noise must be >= 0 um");
-  if (!(o.dwell_s >= 0.0) || !std::isfinite(o.dwell_s)) throw InvalidArgument("design rtest: --dwell must be >= 0 s");
-  if (!(o.b_limits_deg[0] < o.b_limits_deg[1])) throw InvalidArgument("design rtest: --b-limits must be min < max deg");
+  if (!(o.noise_um >= 0.0) || !std::isfinite(o.noise_um))
+    throw InvalidArgument("design rtest: --noise must be >= 0 um");
+  if (!(o.dwell_s >= 0.0) || !std::isfinite(o.dwell_s))
+    throw InvalidArgument("design rtest: --dwell must be >= 0 s");
+  if (!(o.b_limits_deg[0] < o.b_limits_deg[1]))
+    throw InvalidArgument("design rtest: --b-limits must be min < max deg");
   const MachineType m = MachineType::BC_trt;
   RtestSeparationDesign D;
   D.effects = {pair[0].id(), pair[1].id()};
@@ -305,32 +334,38 @@ RtestSeparationDesign design_rtest_separation(const RtestSession& session, const
   std::vector<RtestPose> poses;
   for (const RtestSample& s : session.samples) {
     const auto it = session.nests.find(s.setup);
-    if (it == session.nests.end()) throw InvalidArgument("design rtest: --after: nest '" + s.setup + "' has no position");
+    if (it == session.nests.end())
+      throw InvalidArgument("design rtest: --after: nest '" + s.setup + "' has no position");
     const int k = nest_index.emplace(s.setup, static_cast<int>(nest_index.size())).first->second;
     poses.push_back({k, it->second, s.xyz, s.angles_rad(), s.time, Eigen::Vector3d::Zero()});
   }
-  const int ns = static_cast<int>(nest_index.size()), na = pair[0].num_params(), nb = pair[1].num_params();
+  const int ns = static_cast<int>(nest_index.size()), na = pair[0].num_params(),
+            nb = pair[1].num_params();
   const int ne = na + nb, z0 = 8, e0 = 8 + 3 * ns, p0 = e0 + ne;
   RtestJointOptions fo;
   fo.noise = NoiseHandling::white;
   const RtestJointIdentification id = identify_joint(session, fo);
   double sigma_um = o.noise_um > 0.0 ? o.noise_um : id.noise.sigma_um;
   if (!(sigma_um > 0.0)) sigma_um = id.sigma_um;
-  if (!(sigma_um > 0.0)) throw InvalidArgument("design rtest: --after: the session's residuals are zero; give --noise");
+  if (!(sigma_um > 0.0))
+    throw InvalidArgument("design rtest: --after: the session's residuals are zero; give --noise");
   D.noise_um = sigma_um;
   if (id.noise.n > 0 && id.noise.effective_samples > 0.0)
-    D.effective_per_reading = std::min(1.0, id.noise.effective_samples / static_cast<double>(id.noise.n));
+    D.effective_per_reading =
+        std::min(1.0, id.noise.effective_samples / static_cast<double>(id.noise.n));
   const double w = D.effective_per_reading / (sigma_um * sigma_um * 1e-6);
   const Eigen::MatrixXd Js = nominal_rtest_jacobian(poses, ns, fx);
   const Eigen::MatrixXd Is = Js.transpose() * Js * w;
-  for (int k = 0; k < 8; ++k) D.names.push_back(location_error_names(m)[static_cast<std::size_t>(k)]);
+  for (int k = 0; k < 8; ++k)
+    D.names.push_back(location_error_names(m)[static_cast<std::size_t>(k)]);
   std::vector<std::string> nest_names(static_cast<std::size_t>(ns));
   for (const auto& [name, k] : nest_index) nest_names[static_cast<std::size_t>(k)] = name;
   for (const std::string& n : nest_names)
     for (const char* c : {"zero_x#", "zero_y#", "zero_z#"}) D.names.push_back(c + n);
   for (const std::string& l : fx.param_labels()) D.names.push_back(l);
   Eigen::VectorXd plausible = Eigen::VectorXd::Constant(p0 + 3, plausible_magnitude("mm"));
-  for (int k = 0; k < 8; ++k) plausible[k] = plausible_magnitude(location_error_is_angle(k) ? "rad" : "mm");
+  for (int k = 0; k < 8; ++k)
+    plausible[k] = plausible_magnitude(location_error_is_angle(k) ? "rad" : "mm");
   {
     int j = e0;
     for (const Effect& f : pair)
@@ -343,7 +378,8 @@ RtestSeparationDesign design_rtest_separation(const RtestSession& session, const
   D.sigma_after = D.sigma_before;
   D.chosen.correlation = D.correlation_before;
   if (D.motion.same_motion) {
-    D.verdict = "no test can separate " + D.effects[0] + " and " + D.effects[1] + ": " + D.motion.why;
+    D.verdict =
+        "no test can separate " + D.effects[0] + " and " + D.effects[1] + ": " + D.motion.why;
     return D;
   }
   if (D.correlation_before < o.max_correlation) {
@@ -351,7 +387,8 @@ RtestSeparationDesign design_rtest_separation(const RtestSession& session, const
     std::ostringstream v;
     v.precision(2);
     v << std::fixed << "the session alone separates " << D.effects[0] << " and " << D.effects[1]
-      << " (correlation " << D.correlation_before << " < " << o.max_correlation << "): no added test is needed";
+      << " (correlation " << D.correlation_before << " < " << o.max_correlation
+      << "): no added test is needed";
     D.verdict = v.str();
     return D;
   }
@@ -381,7 +418,8 @@ RtestSeparationDesign design_rtest_separation(const RtestSession& session, const
             pat.b_deg = steps(o.b_limits_deg[0], o.b_limits_deg[1], bs);
             pat.c_deg = steps(0.0, 360.0 - cs, cs);
             pat.dwell_s = dwell;
-            const double duration = static_cast<double>(pat.b_deg.size() * pat.c_deg.size()) * dwell;
+            const double duration =
+                static_cast<double>(pat.b_deg.size() * pat.c_deg.size()) * dwell;
             if (duration > o.max_added_time_s) continue;
             std::vector<RtestPose> added;
             bool inside = true;
@@ -390,7 +428,8 @@ RtestSeparationDesign design_rtest_separation(const RtestSession& session, const
               for (double c : pat.c_deg) {
                 const RotaryAngles<double> a{b * deg, c * deg};
                 const Eigen::Vector3d xyz = rtest_commanded_xyz(m, q, a);
-                for (int k = 0; k < 3; ++k) inside = inside && xyz[k] >= o.travel_min[k] && xyz[k] <= o.travel_max[k];
+                for (int k = 0; k < 3; ++k)
+                  inside = inside && xyz[k] >= o.travel_min[k] && xyz[k] <= o.travel_max[k];
                 added.push_back({0, q, xyz, a, t += dwell, Eigen::Vector3d::Zero()});
               }
             if (!inside) continue;
@@ -414,7 +453,8 @@ RtestSeparationDesign design_rtest_separation(const RtestSession& session, const
               c.repeats = rep;
               c.correlation = canonical_correlation(inv, e0, na, e0 + na, nb);
               c.determined = true;
-              for (int j = e0; j < e0 + ne; ++j) c.determined = c.determined && inv.determined[static_cast<std::size_t>(j)];
+              for (int j = e0; j < e0 + ne; ++j)
+                c.determined = c.determined && inv.determined[static_cast<std::size_t>(j)];
               const double run = duration * rep;
               if (c.correlation < o.max_correlation) {
                 const double best_run = D.chosen.duration_s * D.chosen.repeats;
@@ -439,10 +479,11 @@ RtestSeparationDesign design_rtest_separation(const RtestSession& session, const
     RtestSeparatingCandidate& c = D.chosen;
     const RtestPattern& pat = c.added;
     std::ostringstream d;
-    d << "a nest at " << v3(pat.nests[0]) << ", B " << fmt(pat.b_deg.front(), 0) << ".." << fmt(pat.b_deg.back(), 0)
-      << " deg every " << fmt(pat.b_deg.size() > 1 ? pat.b_deg[1] - pat.b_deg[0] : 0.0, 0) << ", C every "
-      << fmt(pat.c_deg.size() > 1 ? pat.c_deg[1] - pat.c_deg[0] : 360.0, 0) << " deg, " << fmt(pat.dwell_s, 1)
-      << " s per pose";
+    d << "a nest at " << v3(pat.nests[0]) << ", B " << fmt(pat.b_deg.front(), 0) << ".."
+      << fmt(pat.b_deg.back(), 0) << " deg every "
+      << fmt(pat.b_deg.size() > 1 ? pat.b_deg[1] - pat.b_deg[0] : 0.0, 0) << ", C every "
+      << fmt(pat.c_deg.size() > 1 ? pat.c_deg[1] - pat.c_deg[0] : 360.0, 0) << " deg, "
+      << fmt(pat.dwell_s, 1) << " s per pose";
     if (c.repeats > 1.0) d << ", run " << fmt(c.repeats, 0) << " times";
     c.description = d.str();
     D.sigma_after = invert_information(best_info, plausible, white).sigma;
@@ -453,21 +494,24 @@ RtestSeparationDesign design_rtest_separation(const RtestSession& session, const
   v << std::fixed;
   if (D.found)
     v << "add " << D.chosen.description << ": " << fmt(D.chosen.duration_s * D.chosen.repeats, 0)
-      << " s; fitted with the session, the correlation of " << D.effects[0] << " and " << D.effects[1]
-      << " goes from " << D.correlation_before << " to " << D.chosen.correlation;
+      << " s; fitted with the session, the correlation of " << D.effects[0] << " and "
+      << D.effects[1] << " goes from " << D.correlation_before << " to " << D.chosen.correlation;
   else
     v << "none of " << D.candidates_tried << " added nests within " << fmt(o.max_added_time_s, 0)
-      << " s brings the correlation of " << D.effects[0] << " and " << D.effects[1] << " below " << o.max_correlation
+      << " s brings the correlation of " << D.effects[0] << " and " << D.effects[1] << " below "
+      << o.max_correlation
       << (D.candidates_tried ? "; the closest is " + D.chosen.description + " (correlation " +
                                    fmt(D.chosen.correlation, 2) + ")"
                              : std::string("; every candidate breaks a limit"));
   if (D.candidates_tried) {
     std::string held;
     for (int j = e0; j < e0 + ne; ++j)
-      if (!std::isfinite(D.sigma_after[j])) held += (held.empty() ? "" : ", ") + D.names[static_cast<std::size_t>(j)];
+      if (!std::isfinite(D.sigma_after[j]))
+        held += (held.empty() ? "" : ", ") + D.names[static_cast<std::size_t>(j)];
     if (!held.empty())
       v << "; " << held
-        << " remain undetermined (no reading sees them: the joint fit holds them at 0, and the correlation is that of "
+        << " remain undetermined (no reading sees them: the joint fit holds them at 0, and the "
+           "correlation is that of "
            "the rest)";
   }
   D.verdict = v.str();
@@ -475,15 +519,20 @@ RtestSeparationDesign design_rtest_separation(const RtestSession& session, const
 }
 
 JointFitOutcome identify_rtest_effects(const RtestSession& session, const EffectModel& effects) {
-  if (session.machine != MachineType::BC_trt) throw InvalidArgument("identify_rtest_effects: the session is not of a BC-trt machine");
+  if (session.machine != MachineType::BC_trt)
+    throw InvalidArgument("identify_rtest_effects: the session is not of a BC-trt machine");
   for (const Effect& f : effects.effects)
-    if (!f.applies_to(session.machine)) throw InvalidArgument("effect " + f.id() + " does not exist on a BC-trt");
+    if (!f.applies_to(session.machine))
+      throw InvalidArgument("effect " + f.id() + " does not exist on a BC-trt");
   std::map<std::string, int> nest_index;
   std::vector<RtestPose> poses;
   for (const RtestSample& s : session.samples) {
     const auto it = session.nests.find(s.setup);
-    if (it == session.nests.end()) throw InvalidArgument("identify_rtest_effects: nest '" + s.setup + "' has no position");
-    if (!s.d) throw InvalidArgument("identify_rtest_effects: a sample of nest '" + s.setup + "' has no dx, dy, dz");
+    if (it == session.nests.end())
+      throw InvalidArgument("identify_rtest_effects: nest '" + s.setup + "' has no position");
+    if (!s.d)
+      throw InvalidArgument("identify_rtest_effects: a sample of nest '" + s.setup +
+                            "' has no dx, dy, dz");
     const int k = nest_index.emplace(s.setup, static_cast<int>(nest_index.size())).first->second;
     poses.push_back({k, it->second, s.xyz, s.angles_rad(), s.time, *s.d});
   }
@@ -498,7 +547,8 @@ JointFitOutcome identify_rtest_effects(const RtestSession& session, const Effect
     for (const char* c : {"zero_x#", "zero_y#", "zero_z#"}) params.push_back({c + n, "mm", 0.0});
   for (const Effect& f : effects.effects) {
     const auto pn = f.param_names(), pu = f.param_units();
-    for (std::size_t k = 0; k < pn.size(); ++k) params.push_back({f.id() + (pn.size() > 1 ? "." + pn[k] : ""), pu[k], 0.0});
+    for (std::size_t k = 0; k < pn.size(); ++k)
+      params.push_back({f.id() + (pn.size() > 1 ? "." + pn[k] : ""), pu[k], 0.0});
   }
   const RtestReadingsModel model(std::move(poses), ns, effects);
   JointFitSettings settings;

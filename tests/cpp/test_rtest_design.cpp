@@ -2,18 +2,18 @@
 // simulated R-tests with coloured noise realise, limits and coarse grids exclude patterns by
 // name, and the design beats the default pattern at the same run time.
 #include <catch2/catch.hpp>
-
 #include <cmath>
+#include <map>
 
 #include "rotacal/core/error.hpp"
 #include "rotacal/core/noise_model.hpp"
 #include "rotacal/rtest/design.hpp"
 
-#include <map>
-
 using namespace rotacal;
 
-TEST_CASE("the predicted sigma of an R-test pattern is what simulated sessions with AR(1) noise realise") {
+TEST_CASE(
+    "the predicted sigma of an R-test pattern is what simulated sessions with AR(1) noise "
+    "realise") {
   RtestDesignOptions o;
   o.noise_um = 0.3;
   o.noise_rho = 0.4;
@@ -43,25 +43,29 @@ TEST_CASE("the predicted sigma of an R-test pattern is what simulated sessions w
     std::vector<double> times;
     for (const RtestSample& x : s.samples)
       for (int a = 0; a < 3; ++a) groups.push_back(x.setup), times.push_back(x.time);
-    const Eigen::VectorXd e = noise_gen::ar1(groups, times, o.noise_rho, o.noise_um * 1e-3, 900 + k);
+    const Eigen::VectorXd e =
+        noise_gen::ar1(groups, times, o.noise_rho, o.noise_um * 1e-3, 900 + k);
     for (std::size_t i = 0; i < s.samples.size(); ++i)
       *s.samples[i].d += e.segment<3>(3 * static_cast<Eigen::Index>(i));
     s.noise_um = o.noise_um;
     RtestJointOptions fit;
-    fit.noise = NoiseHandling::automatic;  // AR noise model of the residuals, GLS refit, as the CLI fits
+    fit.noise =
+        NoiseHandling::automatic;  // AR noise model of the residuals, GLS refit, as the CLI fits
     const RtestJointIdentification id = identify_joint(s, fit);
     for (int i = 0; i < 8; ++i) est(k, i) = id.parameters[static_cast<std::size_t>(i)].value;
   }
   for (int i = 0; i < 8; ++i) {
     const Eigen::VectorXd v = est.col(i);
     const double sd = std::sqrt((v.array() - v.mean()).square().sum() / (draws - 1));
-    INFO(c.names[static_cast<std::size_t>(i)] << ": realised " << sd << ", predicted " << c.sigma[i]);
+    INFO(c.names[static_cast<std::size_t>(i)] << ": realised " << sd << ", predicted "
+                                              << c.sigma[i]);
     CHECK(sd / c.sigma[i] > 0.7);
     CHECK(sd / c.sigma[i] < 1.4);
   }
 }
 
-TEST_CASE("the R-test design beats the default at the same run time, within travel and grid limits") {
+TEST_CASE(
+    "the R-test design beats the default at the same run time, within travel and grid limits") {
   RtestDesignOptions o;
   o.nest_radius_mm = {50.0, 150.0};
   o.nest_height_mm = {20.0, 100.0, 140.0};
@@ -85,7 +89,8 @@ TEST_CASE("the R-test design beats the default at the same run time, within trav
   CHECK(by_grid);  // B every 45 deg cannot carry the B map of degree 6
   // Twice the time, sigma / sqrt(2). AR(1) noise with rho 0.5 costs information, at most
   // the (1 + rho) / (1 - rho) = 3 of slowly varying readings in variance.
-  const RtestDesignCandidate twice = evaluate_rtest_design(d.best.pattern, o, 2.0 * d.time_budget_s);
+  const RtestDesignCandidate twice =
+      evaluate_rtest_design(d.best.pattern, o, 2.0 * d.time_budget_s);
   CHECK(twice.worst_expanded_um == Approx(d.best.worst_expanded_um / std::sqrt(2.0)).epsilon(1e-6));
   RtestDesignOptions ar = o;
   ar.noise_rho = 0.5;
@@ -110,7 +115,8 @@ TEST_CASE("R-test design options are refused by name") {
   CHECK_THROWS_WITH(design_rtest_test(o), Catch::Contains("--heights"));
   o = RtestDesignOptions{};
   o.travel_max = Eigen::Vector3d(10, 10, 10);
-  CHECK_THROWS_WITH(design_rtest_test(o), Catch::Contains("no nest pair") && Catch::Contains("travel"));
+  CHECK_THROWS_WITH(design_rtest_test(o),
+                    Catch::Contains("no nest pair") && Catch::Contains("travel"));
 }
 
 // ------------------------------------------------------------------ separating two effects
@@ -127,8 +133,8 @@ MachineModel oyama_like(const std::vector<Effect>& effects, const std::vector<do
 
 // The readings of `truth` over `pattern` with AR(1) noise per nest and component (coloured),
 // nests labelled from `first_label`, times from t0.
-RtestSession recorded(const MachineModel& truth, const RtestPattern& pattern, double rho, unsigned seed,
-                      int first_label = 1, double t0 = 0.0) {
+RtestSession recorded(const MachineModel& truth, const RtestPattern& pattern, double rho,
+                      unsigned seed, int first_label = 1, double t0 = 0.0) {
   RtestSimOptions sim;
   sim.pattern = pattern;
   sim.noise_um = 0.0;
@@ -140,7 +146,8 @@ RtestSession recorded(const MachineModel& truth, const RtestPattern& pattern, do
     for (int a = 0; a < 3; ++a) groups.push_back(x.setup), times.push_back(x.time);
   const Eigen::VectorXd e = noise_gen::ar1(groups, times, rho, 0.3e-3, 7 * seed + 1);
   std::map<std::string, Eigen::Vector3d> nests;
-  for (const auto& [label, q] : s.nests) nests[std::to_string(std::stoi(label) - 1 + first_label)] = q;
+  for (const auto& [label, q] : s.nests)
+    nests[std::to_string(std::stoi(label) - 1 + first_label)] = q;
   s.nests = nests;
   for (std::size_t i = 0; i < s.samples.size(); ++i) {
     *s.samples[i].d += e.segment<3>(3 * static_cast<Eigen::Index>(i));
@@ -154,7 +161,8 @@ RtestSession recorded(const MachineModel& truth, const RtestPattern& pattern, do
 }  // namespace
 
 TEST_CASE("R-test: the added nest separates axial from tilt motion of C; Monte Carlo agrees") {
-  const std::vector<Effect> pair = {Effect::parse("axial_motion_C_h2"), Effect::parse("tilt_motion_C_h2")};
+  const std::vector<Effect> pair = {Effect::parse("axial_motion_C_h2"),
+                                    Effect::parse("tilt_motion_C_h2")};
   const MachineModel truth = oyama_like(pair, {1e-3, -0.6e-3, 2e-6, 0.0, 3e-6, -2e-6});
   const double rho = 0.4;
   const RtestPattern base;
@@ -170,11 +178,13 @@ TEST_CASE("R-test: the added nest separates axial from tilt motion of C; Monte C
   // jointly with the effects; every determined parameter's spread against its prediction.
   RtestPattern added = d.chosen.added;
   std::vector<double> b;
-  for (int r = 0; r < static_cast<int>(d.chosen.repeats); ++r) b.insert(b.end(), added.b_deg.begin(), added.b_deg.end());
+  for (int r = 0; r < static_cast<int>(d.chosen.repeats); ++r)
+    b.insert(b.end(), added.b_deg.begin(), added.b_deg.end());
   added.b_deg = b;
   EffectModel fx;
   fx.effects = pair;
-  const int draws = 80, p = static_cast<int>(d.names.size()), ns = static_cast<int>(session.nests.size());
+  const int draws = 80, p = static_cast<int>(d.names.size()),
+            ns = static_cast<int>(session.nests.size());
   const int e0 = 8 + 3 * ns, ne = fx.num_params();
   Eigen::MatrixXd est(draws, p);
   for (int k = 0; k < draws; ++k) {
@@ -185,7 +195,8 @@ TEST_CASE("R-test: the added nest separates axial from tilt motion of C; Monte C
     both.samples.insert(both.samples.end(), more.samples.begin(), more.samples.end());
     const JointFitOutcome f = identify_rtest_effects(both, fx);
     REQUIRE(f.values.size() == p);
-    // fit: 8 location, zeros (session nests, added), effects; design: 8, session zeros, effects, added zeros.
+    // fit: 8 location, zeros (session nests, added), effects; design: 8, session zeros, effects,
+    // added zeros.
     est.row(k).head(e0) = f.values.head(e0);
     est.row(k).segment(e0, ne) = f.values.tail(ne);
     est.row(k).tail(3) = f.values.segment(e0, 3);
@@ -193,10 +204,13 @@ TEST_CASE("R-test: the added nest separates axial from tilt motion of C; Monte C
   int checked = 0;
   for (int j = 0; j < p; ++j) {
     // Probe zeros are drawn anew with each simulated session (20 um): not an estimation error.
-    if (!std::isfinite(d.sigma_after[j]) || d.names[static_cast<std::size_t>(j)].rfind("zero_", 0) == 0) continue;
+    if (!std::isfinite(d.sigma_after[j]) ||
+        d.names[static_cast<std::size_t>(j)].rfind("zero_", 0) == 0)
+      continue;
     const Eigen::VectorXd v = est.col(j);
     const double sd = std::sqrt((v.array() - v.mean()).square().sum() / (draws - 1));
-    INFO(d.names[static_cast<std::size_t>(j)] << ": realised " << sd << ", predicted " << d.sigma_after[j]);
+    INFO(d.names[static_cast<std::size_t>(j)] << ": realised " << sd << ", predicted "
+                                              << d.sigma_after[j]);
     CHECK(sd / d.sigma_after[j] > 0.7);
     CHECK(sd / d.sigma_after[j] < 1.4);
     ++checked;
@@ -206,16 +220,19 @@ TEST_CASE("R-test: the added nest separates axial from tilt motion of C; Monte C
 
 TEST_CASE("R-test: gravity sag and the second radial harmonic of B are reported inseparable") {
   const RtestSession session = recorded(oyama_like({}, {}), RtestPattern{}, 0.2, 9);
-  const RtestSeparationDesign d =
-      design_rtest_separation(session, {Effect::parse("gravity_sag_B"), Effect::parse("radial_motion_B_h2")});
+  const RtestSeparationDesign d = design_rtest_separation(
+      session, {Effect::parse("gravity_sag_B"), Effect::parse("radial_motion_B_h2")});
   CHECK(d.motion.same_motion);
   CHECK_FALSE(d.found);
   CHECK(d.candidates_tried == 0);
   CHECK(d.verdict.find("no test can separate") == 0);
-  CHECK_THROWS_WITH(design_rtest_separation(session, {Effect::parse("gravity_sag_A"), Effect::parse("coning_B")}),
-                    Catch::Contains("gravity_sag_A"));
+  CHECK_THROWS_WITH(
+      design_rtest_separation(session, {Effect::parse("gravity_sag_A"), Effect::parse("coning_B")}),
+      Catch::Contains("gravity_sag_A"));
   RtestSeparationOptions bad;
   bad.max_added_time_s = 0.0;
-  CHECK_THROWS_WITH(design_rtest_separation(session, {Effect::parse("coning_B"), Effect::parse("tilt_motion_B_h1")}, bad),
-                    Catch::Contains("--max-time"));
+  CHECK_THROWS_WITH(
+      design_rtest_separation(session,
+                              {Effect::parse("coning_B"), Effect::parse("tilt_motion_B_h1")}, bad),
+      Catch::Contains("--max-time"));
 }

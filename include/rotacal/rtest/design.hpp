@@ -14,15 +14,15 @@
 /// samples, this holds when successive poses are far apart (a coarse C step), where AR noise
 /// costs less than (1 + rho) / (1 - rho). Run time: every pose of every nest takes `dwell_s`
 /// (hw/pose_window.hpp), so a pattern lasts poses x nests x dwell; a pattern shorter than the
-/// budget is repeated to fill it, which scales the information by budget / run time. Nests: the first on +X at (r1, 0, h1), the second on -Y at (0, -r2, h2), as in
-/// Oyama and Ibaraki's set-up; nests and grid are chosen one after the other (nests at the base
-/// grid, then the grid at the chosen nests), which keeps the design within a few seconds.
+/// budget is repeated to fill it, which scales the information by budget / run time. Nests: the
+/// first on +X at (r1, 0, h1), the second on -Y at (0, -r2, h2), as in Oyama and Ibaraki's set-up;
+/// nests and grid are chosen one after the other (nests at the base grid, then the grid at the
+/// chosen nests), which keeps the design within a few seconds.
 
+#include <Eigen/Core>
 #include <array>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "rotacal/ballbar/design.hpp"  // table_motion_overlap, the information helpers
 #include "rotacal/rtest/identify_joint.hpp"
@@ -35,8 +35,8 @@ struct RtestDesignOptions {
   std::vector<double> nest_radius_mm = {50.0, 100.0, 150.0};        ///< from the C axis
   std::vector<double> nest_height_mm = {20.0, 60.0, 100.0, 140.0};  ///< above the B axis
   std::vector<double> b_step_deg = {15.0, 30.0, 45.0};              ///< B grid steps tried
-  std::vector<double> c_step_deg = {30.0, 45.0, 60.0};              ///< C grid steps tried (full turn)
-  std::array<double, 2> b_limits_deg = {-90.0, 90.0};               ///< rotary limits of B
+  std::vector<double> c_step_deg = {30.0, 45.0, 60.0};  ///< C grid steps tried (full turn)
+  std::array<double, 2> b_limits_deg = {-90.0, 90.0};   ///< rotary limits of B
   /// Travel of X, Y, Z (machine frame of formats.md: origin at the nominal intersection of B
   /// and C), mm; every commanded sphere centre must lie within it.
   Eigen::Vector3d travel_min = Eigen::Vector3d(-400, -300, -300);
@@ -44,18 +44,19 @@ struct RtestDesignOptions {
   double time_budget_s = 0.0;          ///< 0: the base pattern's run time
   double noise_um = 0.3;               ///< 1 sigma per reading component (dx, dy, dz)
   double noise_rho = 0.0;              ///< AR(1) coefficient between readings, [0, 0.999]
-  double reference_radius_mm = 100.0; ///< an orientation error in rad counts as this lever arm
+  double reference_radius_mm = 100.0;  ///< an orientation error in rad counts as this lever arm
   RtestBasis basis;                    ///< of the joint fit
 };
 
 struct RtestDesignCandidate {
   RtestPattern pattern;
   bool feasible = false;
-  std::string why_not;            ///< which limit, or which location error is not determined
-  double duration_s = 0.0;        ///< poses x nests x dwell
-  std::vector<std::string> names; ///< the fit's parameters (location errors, maps, zeros)
-  Eigen::VectorXd sigma;          ///< predicted 1 sigma at the budget (infinite: held by the fit)
-  double worst_expanded_um = 0.0; ///< max over the location errors of 2 sigma (rad x reference radius)
+  std::string why_not;             ///< which limit, or which location error is not determined
+  double duration_s = 0.0;         ///< poses x nests x dwell
+  std::vector<std::string> names;  ///< the fit's parameters (location errors, maps, zeros)
+  Eigen::VectorXd sigma;           ///< predicted 1 sigma at the budget (infinite: held by the fit)
+  double worst_expanded_um =
+      0.0;  ///< max over the location errors of 2 sigma (rad x reference radius)
   std::string worst_error;
 };
 
@@ -63,7 +64,7 @@ struct RtestDesign {
   RtestDesignCandidate best;
   RtestDesignCandidate baseline;  ///< options.base, evaluated the same way
   double time_budget_s = 0.0;
-  double ratio = 0.0;             ///< best / baseline worst expanded uncertainty
+  double ratio = 0.0;  ///< best / baseline worst expanded uncertainty
   std::vector<RtestDesignCandidate> candidates;
 };
 
@@ -71,8 +72,8 @@ struct RtestDesign {
 /// the travel or the B limits, or one whose fit cannot determine a location error or a map
 /// coefficient (a grid too coarse for the basis fits a smaller model, not comparable), is
 /// returned not feasible with the reason; never throws for those.
-RtestDesignCandidate evaluate_rtest_design(const RtestPattern& pattern, const RtestDesignOptions& options,
-                                           double time_budget_s);
+RtestDesignCandidate evaluate_rtest_design(const RtestPattern& pattern,
+                                           const RtestDesignOptions& options, double time_budget_s);
 
 /// Choose nests, then grid. Throws InvalidArgument naming the option for empty grids,
 /// non-positive steps, noise, dwell or reference radius, rho outside [0, 0.999], reversed B
@@ -88,25 +89,27 @@ struct RtestSeparationOptions {
   std::vector<double> nest_radius_mm = {0.0, 50.0, 100.0, 150.0};
   std::vector<double> nest_angle_deg = {0.0, 90.0, 180.0, 270.0};
   std::vector<double> nest_height_mm = {20.0, 60.0, 100.0, 140.0};
-  std::vector<double> b_step_deg = {15.0, 30.0};   ///< grids of the added nest (C over a full turn)
+  std::vector<double> b_step_deg = {15.0, 30.0};  ///< grids of the added nest (C over a full turn)
   std::vector<double> c_step_deg = {30.0, 60.0};
   std::array<double, 2> b_limits_deg = {-90.0, 90.0};
   Eigen::Vector3d travel_min = Eigen::Vector3d(-400, -300, -300);
   Eigen::Vector3d travel_max = Eigen::Vector3d(400, 300, 400);
-  double dwell_s = 0.0;             ///< per pose; 0: the session's (median time between poses)
-  double max_added_time_s = 600.0;  ///< the added nest's poses, repeated to gather data, take at most this
+  double dwell_s = 0.0;  ///< per pose; 0: the session's (median time between poses)
+  double max_added_time_s =
+      600.0;  ///< the added nest's poses, repeated to gather data, take at most this
   double max_correlation = 0.5;
-  double noise_um = 0.0;            ///< 0: the session's residual noise (R-test joint fit's noise model)
+  double noise_um = 0.0;  ///< 0: the session's residual noise (R-test joint fit's noise model)
   double reference_radius_mm = 100.0;
 };
 
 struct RtestSeparatingCandidate {
-  RtestPattern added;        ///< one nest and its grid
+  RtestPattern added;  ///< one nest and its grid
   std::string description;
-  double duration_s = 0.0;   ///< poses x dwell
-  double repeats = 1.0;      ///< the pattern run this many times to gather data
-  double correlation = 1.0;  ///< largest canonical correlation of the pair's determined parameters afterwards
-  bool determined = false;   ///< every parameter of both effects is determined
+  double duration_s = 0.0;  ///< poses x dwell
+  double repeats = 1.0;     ///< the pattern run this many times to gather data
+  double correlation =
+      1.0;  ///< largest canonical correlation of the pair's determined parameters afterwards
+  bool determined = false;  ///< every parameter of both effects is determined
 };
 
 struct RtestSeparationDesign {
@@ -135,7 +138,8 @@ struct RtestSeparationDesign {
 /// with its default maps). Throws InvalidArgument naming the option for a pair that is not two
 /// different effects of the machine, empty grids, a session without displacements, or
 /// non-positive limits.
-RtestSeparationDesign design_rtest_separation(const RtestSession& session, const std::vector<Effect>& pair,
+RtestSeparationDesign design_rtest_separation(const RtestSession& session,
+                                              const std::vector<Effect>& pair,
                                               const RtestSeparationOptions& options = {});
 
 /// Joint fit of an R-test session with catalogue effects instead of the smooth maps (e.g. a
