@@ -12,8 +12,10 @@ namespace rotacal::diagnosis_detail {
 std::string separating_test(const DiagnosisProblem& P, const ModelFit& fit, const Score& a,
                             const Score& b, double sigma_mm) {
   if (P.reference_groups().empty())
-    return "none of this session's tests separates them; `rotacal design rtest --separate " + a.effect.id() +
-           "," + b.effect.id() + " --after SESSION` proposes the test that does, or says why none can";
+    return "none of this session's tests separates them; `rotacal design ballbar|rtest --separate " +
+           a.effect.id() + "," + b.effect.id() +
+           " --after SESSION` (the instrument of this session) proposes the test that does, or says why none "
+           "can";
   // Fit each candidate's full parameter vector to this session's residual, then compare what
   // they predict on the standard test.
   std::vector<std::string> rows_a, rows_b;
