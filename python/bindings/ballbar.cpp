@@ -175,7 +175,9 @@ BallbarMonteCarlo: per observable parameter std_reported, std_mc, ratio, bias; v
       "Predicted centre-to-centre lengths (mm) of every sample of the session on the model.");
 
   m.def("compensate_commands", &compensate_commands, pyb::arg("nominal"), pyb::arg("identified"),
-        pyb::arg("machine"));
+        pyb::arg("machine"), pyb::arg("tool_length_error") = 0.0,
+        "Compensated commands; tool_length_error (mm): the error of pivot_length + tool_length of a "
+        "head machine (minus the identified tool_offset_Z).");
 
   pyb::class_<CompensationRow>(m, "CompensationRow")
       .def_readonly("name", &CompensationRow::name)

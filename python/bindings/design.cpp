@@ -1,33 +1,44 @@
 // Bindings for include/rotacal/ballbar/design.hpp: the ballbar test design.
-#include "numpy.hpp"
 #include "rotacal/ballbar/design.hpp"
+
+#include "numpy.hpp"
+#include "rotacal/rtest/design.hpp"
 
 namespace rotacal::py {
 
 void bind_design(pyb::module_& m) {
-  pyb::class_<BallbarDesignOptions>(m, "BallbarDesignOptions", "Options of design_ballbar_test (defaults).")
+  pyb::class_<BallbarDesignOptions>(m, "BallbarDesignOptions",
+                                    "Options of design_ballbar_test (defaults).")
       .def(pyb::init<>())
-      .def_readwrite("base", &BallbarDesignOptions::base, "the default set-up: machine, tests, ranges, feeds")
+      .def_readwrite("base", &BallbarDesignOptions::base,
+                     "the default set-up: machine, tests, ranges, feeds")
       .def_readwrite("bar_lengths_mm", &BallbarDesignOptions::bar_lengths_mm)
       .def_readwrite("pivot_x_mm", &BallbarDesignOptions::pivot_x_mm)
       .def_readwrite("pivot_z_mm", &BallbarDesignOptions::pivot_z_mm)
-      .def_readwrite("travel_min", &BallbarDesignOptions::travel_min, "X, Y, Z, mm (formats.md frame)")
+      .def_readwrite("travel_min", &BallbarDesignOptions::travel_min,
+                     "X, Y, Z, mm (formats.md frame)")
       .def_readwrite("travel_max", &BallbarDesignOptions::travel_max)
-      .def_readwrite("time_budget_s", &BallbarDesignOptions::time_budget_s, "0: the default set-up's run time")
+      .def_readwrite("time_budget_s", &BallbarDesignOptions::time_budget_s,
+                     "0: the default set-up's run time")
       .def_readwrite("sample_rate_hz", &BallbarDesignOptions::sample_rate_hz)
       .def_readwrite("noise_um", &BallbarDesignOptions::noise_um)
-      .def_readwrite("noise_rho", &BallbarDesignOptions::noise_rho, "AR(1) coefficient between samples")
+      .def_readwrite("noise_rho", &BallbarDesignOptions::noise_rho,
+                     "AR(1) coefficient between samples")
       .def_readwrite("reference_radius_mm", &BallbarDesignOptions::reference_radius_mm)
       .def_property(
-          "effects_of_concern", [](const BallbarDesignOptions& o) { return ids_of(o.effects_of_concern); },
-          [](BallbarDesignOptions& o, const std::vector<std::string>& ids) { o.effects_of_concern = effects_of(ids); });
+          "effects_of_concern",
+          [](const BallbarDesignOptions& o) { return ids_of(o.effects_of_concern); },
+          [](BallbarDesignOptions& o, const std::vector<std::string>& ids) {
+            o.effects_of_concern = effects_of(ids);
+          });
   pyb::class_<DesignCandidate>(m, "DesignCandidate", "One set-up, evaluated.")
       .def_readonly("setup", &DesignCandidate::setup)
       .def_readonly("feasible", &DesignCandidate::feasible)
       .def_readonly("why_not", &DesignCandidate::why_not)
       .def_readonly("duration_s", &DesignCandidate::duration_s)
       .def_readonly("names", &DesignCandidate::names)
-      .def_readonly("sigma", &DesignCandidate::sigma, "predicted 1 sigma at the time budget (mm, rad)")
+      .def_readonly("sigma", &DesignCandidate::sigma,
+                    "predicted 1 sigma at the time budget (mm, rad)")
       .def_readonly("worst_expanded_um", &DesignCandidate::worst_expanded_um)
       .def_readonly("worst_error", &DesignCandidate::worst_error)
       .def_readonly("effect_vs_location", &DesignCandidate::effect_vs_location)
@@ -44,7 +55,194 @@ void bind_design(pyb::module_& m) {
         pyb::gil_scoped_release release;
         return design_ballbar_test(o);
       },
-      pyb::arg("options"), "The pivot and bar length with the smallest predicted uncertainty (ballbar/design.hpp).");
+      pyb::arg("options"),
+      "The pivot and bar length with the smallest predicted uncertainty (ballbar/design.hpp).");
+  pyb::class_<TableMotionOverlap>(m, "TableMotionOverlap",
+                                  "Whether two effects move the table alike (ballbar/design.hpp).")
+      .def_readonly("moves_table_first", &TableMotionOverlap::moves_table_first)
+      .def_readonly("moves_table_second", &TableMotionOverlap::moves_table_second)
+      .def_readonly("first_is_location", &TableMotionOverlap::first_is_location)
+      .def_readonly("second_is_location", &TableMotionOverlap::second_is_location)
+      .def_readonly("cosine", &TableMotionOverlap::cosine, "largest cosine of the principal angles")
+      .def_readonly("same_motion", &TableMotionOverlap::same_motion,
+                    "no instrument can separate them")
+      .def_readonly("why", &TableMotionOverlap::why);
+  m.def(
+      "table_motion_overlap",
+      [](MachineType machine, const std::string& a, const std::string& b,
+         std::array<double, 2> tilt_limits_deg, double duration_s, double reference_radius_mm) {
+        return table_motion_overlap(machine, Effect::parse(a), Effect::parse(b), tilt_limits_deg,
+                                    duration_s, reference_radius_mm);
+      },
+      pyb::arg("machine"), pyb::arg("a"), pyb::arg("b"),
+      pyb::arg("tilt_limits_deg") = std::array<double, 2>{-90.0, 90.0},
+      pyb::arg("duration_s") = 3600.0, pyb::arg("reference_radius_mm") = 100.0,
+      "Compare the table motions of effects a and b (catalogue ids) on a machine.");
+  pyb::class_<SeparationOptions>(m, "SeparationOptions",
+                                 "Options of design_ballbar_separation (defaults).")
+      .def(pyb::init<>())
+      .def_readwrite("added", &SeparationOptions::added,
+                     "step, feeds and C range of the added test")
+      .def_readwrite("bar_lengths_mm", &SeparationOptions::bar_lengths_mm)
+      .def_readwrite("pivot_radius_mm", &SeparationOptions::pivot_radius_mm)
+      .def_readwrite("pivot_angle_deg", &SeparationOptions::pivot_angle_deg)
+      .def_readwrite("pivot_z_mm", &SeparationOptions::pivot_z_mm)
+      .def_readwrite("travel_min", &SeparationOptions::travel_min)
+      .def_readwrite("travel_max", &SeparationOptions::travel_max)
+      .def_readwrite("tilt_limits_deg", &SeparationOptions::tilt_limits_deg)
+      .def_readwrite("max_added_time_s", &SeparationOptions::max_added_time_s)
+      .def_readwrite("max_correlation", &SeparationOptions::max_correlation)
+      .def_readwrite("noise_um", &SeparationOptions::noise_um, "0: the session's residual noise")
+      .def_readwrite("reference_radius_mm", &SeparationOptions::reference_radius_mm);
+  pyb::class_<SeparatingCandidate>(m, "SeparatingCandidate",
+                                   "An added test, evaluated with the session.")
+      .def_readonly("setup", &SeparatingCandidate::setup)
+      .def_readonly("new_pivot", &SeparatingCandidate::new_pivot)
+      .def_readonly("description", &SeparatingCandidate::description)
+      .def_readonly("duration_s", &SeparatingCandidate::duration_s)
+      .def_readonly("slow_down", &SeparatingCandidate::slow_down)
+      .def_readonly("correlation", &SeparatingCandidate::correlation)
+      .def_readonly("determined", &SeparatingCandidate::determined);
+  pyb::class_<SeparationDesign>(m, "SeparationDesign",
+                                "The added test that separates two effects, or why none can.")
+      .def_readonly("effects", &SeparationDesign::effects)
+      .def_readonly("motion", &SeparationDesign::motion)
+      .def_readonly("names", &SeparationDesign::names)
+      .def_readonly("sigma_before", &SeparationDesign::sigma_before)
+      .def_readonly("sigma_after", &SeparationDesign::sigma_after)
+      .def_readonly("correlation_before", &SeparationDesign::correlation_before)
+      .def_readonly("already_separated", &SeparationDesign::already_separated)
+      .def_readonly("found", &SeparationDesign::found)
+      .def_readonly("chosen", &SeparationDesign::chosen)
+      .def_readonly("candidates_tried", &SeparationDesign::candidates_tried)
+      .def_readonly("noise_um", &SeparationDesign::noise_um)
+      .def_readonly("effective_per_reading", &SeparationDesign::effective_per_reading)
+      .def_readonly("verdict", &SeparationDesign::verdict);
+  m.def(
+      "design_ballbar_separation",
+      [](const BallbarSession& session, const std::vector<std::string>& pair,
+         const SeparationOptions& o) {
+        const EffectModel fx = effects_of(pair);
+        pyb::gil_scoped_release release;
+        return design_ballbar_separation(session, fx.effects, o);
+      },
+      pyb::arg("session"), pyb::arg("pair"), pyb::arg("options") = SeparationOptions{},
+      "The smallest added test that separates two effects after a session (ballbar/design.hpp).");
+  m.def(
+      "identify_joint_sessions",
+      [](const std::vector<BallbarSession>& sessions, const std::vector<std::string>& effects) {
+        const EffectModel fx = effects_of(effects);
+        JointFitOutcome f;
+        {
+          pyb::gil_scoped_release release;
+          f = identify_joint_sessions(sessions, fx);
+        }
+        return pyb::make_tuple(f.values, f.covariance, f.summary.converged);
+      },
+      pyb::arg("sessions"), pyb::arg("effects") = std::vector<std::string>{},
+      "Joint fit of several ballbar sessions (shared location errors and effects, one pivot each): "
+      "(values, covariance, converged) in the order 8 location errors, pivots, effect parameters.");
+  pyb::class_<RtestDesignOptions>(m, "RtestDesignOptions",
+                                  "Options of design_rtest_test (defaults).")
+      .def(pyb::init<>())
+      .def_readwrite("base", &RtestDesignOptions::base, "the default pattern: nests, grid, dwell")
+      .def_readwrite("nest_radius_mm", &RtestDesignOptions::nest_radius_mm)
+      .def_readwrite("nest_height_mm", &RtestDesignOptions::nest_height_mm)
+      .def_readwrite("b_step_deg", &RtestDesignOptions::b_step_deg)
+      .def_readwrite("c_step_deg", &RtestDesignOptions::c_step_deg)
+      .def_readwrite("b_limits_deg", &RtestDesignOptions::b_limits_deg)
+      .def_readwrite("travel_min", &RtestDesignOptions::travel_min,
+                     "X, Y, Z, mm (formats.md frame)")
+      .def_readwrite("travel_max", &RtestDesignOptions::travel_max)
+      .def_readwrite("time_budget_s", &RtestDesignOptions::time_budget_s,
+                     "0: the base pattern's run time")
+      .def_readwrite("noise_um", &RtestDesignOptions::noise_um)
+      .def_readwrite("noise_rho", &RtestDesignOptions::noise_rho)
+      .def_readwrite("reference_radius_mm", &RtestDesignOptions::reference_radius_mm)
+      .def_readwrite("basis", &RtestDesignOptions::basis);
+  pyb::class_<RtestDesignCandidate>(m, "RtestDesignCandidate", "One R-test pattern, evaluated.")
+      .def_readonly("pattern", &RtestDesignCandidate::pattern)
+      .def_readonly("feasible", &RtestDesignCandidate::feasible)
+      .def_readonly("why_not", &RtestDesignCandidate::why_not)
+      .def_readonly("duration_s", &RtestDesignCandidate::duration_s)
+      .def_readonly("names", &RtestDesignCandidate::names)
+      .def_readonly("sigma", &RtestDesignCandidate::sigma,
+                    "predicted 1 sigma at the time budget (mm, rad)")
+      .def_readonly("worst_expanded_um", &RtestDesignCandidate::worst_expanded_um)
+      .def_readonly("worst_error", &RtestDesignCandidate::worst_error);
+  pyb::class_<RtestDesign>(m, "RtestDesign", "The chosen R-test pattern and the default one.")
+      .def_readonly("best", &RtestDesign::best)
+      .def_readonly("baseline", &RtestDesign::baseline)
+      .def_readonly("time_budget_s", &RtestDesign::time_budget_s)
+      .def_readonly("ratio", &RtestDesign::ratio)
+      .def_readonly("candidates", &RtestDesign::candidates);
+  m.def(
+      "evaluate_rtest_design",
+      [](const RtestPattern& pattern, const RtestDesignOptions& o, double time_budget_s) {
+        pyb::gil_scoped_release release;
+        return evaluate_rtest_design(pattern, o, time_budget_s);
+      },
+      pyb::arg("pattern"), pyb::arg("options"), pyb::arg("time_budget_s") = 0.0,
+      "One R-test pattern evaluated at a time budget (0: its own run time).");
+  m.def(
+      "design_rtest_test",
+      [](const RtestDesignOptions& o) {
+        pyb::gil_scoped_release release;
+        return design_rtest_test(o);
+      },
+      pyb::arg("options"),
+      "The R-test nests and pose grid with the smallest predicted uncertainty (rtest/design.hpp).");
+  pyb::class_<RtestSeparationOptions>(m, "RtestSeparationOptions",
+                                      "Options of design_rtest_separation (defaults).")
+      .def(pyb::init<>())
+      .def_readwrite("nest_radius_mm", &RtestSeparationOptions::nest_radius_mm)
+      .def_readwrite("nest_angle_deg", &RtestSeparationOptions::nest_angle_deg)
+      .def_readwrite("nest_height_mm", &RtestSeparationOptions::nest_height_mm)
+      .def_readwrite("b_step_deg", &RtestSeparationOptions::b_step_deg)
+      .def_readwrite("c_step_deg", &RtestSeparationOptions::c_step_deg)
+      .def_readwrite("b_limits_deg", &RtestSeparationOptions::b_limits_deg)
+      .def_readwrite("travel_min", &RtestSeparationOptions::travel_min)
+      .def_readwrite("travel_max", &RtestSeparationOptions::travel_max)
+      .def_readwrite("dwell_s", &RtestSeparationOptions::dwell_s, "0: the session's")
+      .def_readwrite("max_added_time_s", &RtestSeparationOptions::max_added_time_s)
+      .def_readwrite("max_correlation", &RtestSeparationOptions::max_correlation)
+      .def_readwrite("noise_um", &RtestSeparationOptions::noise_um,
+                     "0: the session's residual noise")
+      .def_readwrite("reference_radius_mm", &RtestSeparationOptions::reference_radius_mm);
+  pyb::class_<RtestSeparatingCandidate>(m, "RtestSeparatingCandidate",
+                                        "An added nest, evaluated with the session.")
+      .def_readonly("added", &RtestSeparatingCandidate::added)
+      .def_readonly("description", &RtestSeparatingCandidate::description)
+      .def_readonly("duration_s", &RtestSeparatingCandidate::duration_s)
+      .def_readonly("repeats", &RtestSeparatingCandidate::repeats)
+      .def_readonly("correlation", &RtestSeparatingCandidate::correlation)
+      .def_readonly("determined", &RtestSeparatingCandidate::determined);
+  pyb::class_<RtestSeparationDesign>(m, "RtestSeparationDesign",
+                                     "The added nest that separates two effects, or why none can.")
+      .def_readonly("effects", &RtestSeparationDesign::effects)
+      .def_readonly("motion", &RtestSeparationDesign::motion)
+      .def_readonly("names", &RtestSeparationDesign::names)
+      .def_readonly("sigma_before", &RtestSeparationDesign::sigma_before)
+      .def_readonly("sigma_after", &RtestSeparationDesign::sigma_after)
+      .def_readonly("correlation_before", &RtestSeparationDesign::correlation_before)
+      .def_readonly("already_separated", &RtestSeparationDesign::already_separated)
+      .def_readonly("found", &RtestSeparationDesign::found)
+      .def_readonly("chosen", &RtestSeparationDesign::chosen)
+      .def_readonly("candidates_tried", &RtestSeparationDesign::candidates_tried)
+      .def_readonly("noise_um", &RtestSeparationDesign::noise_um)
+      .def_readonly("effective_per_reading", &RtestSeparationDesign::effective_per_reading)
+      .def_readonly("verdict", &RtestSeparationDesign::verdict);
+  m.def(
+      "design_rtest_separation",
+      [](const RtestSession& session, const std::vector<std::string>& pair,
+         const RtestSeparationOptions& o) {
+        const EffectModel fx = effects_of(pair);
+        pyb::gil_scoped_release release;
+        return design_rtest_separation(session, fx.effects, o);
+      },
+      pyb::arg("session"), pyb::arg("pair"), pyb::arg("options") = RtestSeparationOptions{},
+      "The smallest added R-test nest that separates two effects after a session "
+      "(rtest/design.hpp).");
 }
 
 }  // namespace rotacal::py

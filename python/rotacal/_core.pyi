@@ -6,7 +6,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Ambiguity', 'AngleTable', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CompensationReport', 'CompensationRow', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'ballbar_model_document', 'ballbar_model_from_document', 'builtin_machine_names', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_model_machine', 'check_output', 'check_plausible', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_axial_c_tilt_deg', 'default_ballbar_tests', 'default_calibration_moves', 'default_tilt_range_deg', 'design_ballbar_test', 'diagnose_ballbar', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'export_controller', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_rtest', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
+__all__: list[str] = ['Ambiguity', 'AngleTable', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CompensationReport', 'CompensationRow', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestDesign', 'RtestDesignCandidate', 'RtestDesignOptions', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSeparatingCandidate', 'RtestSeparationDesign', 'RtestSeparationOptions', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SeparatingCandidate', 'SeparationDesign', 'SeparationOptions', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TableMotionOverlap', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'ballbar_model_document', 'ballbar_model_from_document', 'builtin_machine_names', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_model_machine', 'check_output', 'check_plausible', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_axial_c_tilt_deg', 'default_ballbar_tests', 'default_calibration_moves', 'default_tilt_range_deg', 'design_ballbar_separation', 'design_ballbar_test', 'design_rtest_separation', 'design_rtest_test', 'diagnose_ballbar', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'evaluate_rtest_design', 'export_controller', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_joint_sessions', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_rtest', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'table_motion_overlap', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
 class Ambiguity:
     @property
     def correlation(self) -> float:
@@ -1631,6 +1631,140 @@ class RtestBasis:
         """
         gamma_CB (angular positioning of C) in the C map
         """
+class RtestDesign:
+    """
+    The chosen R-test pattern and the default one.
+    """
+    @property
+    def baseline(self) -> RtestDesignCandidate:
+        ...
+    @property
+    def best(self) -> RtestDesignCandidate:
+        ...
+    @property
+    def candidates(self) -> list[RtestDesignCandidate]:
+        ...
+    @property
+    def ratio(self) -> float:
+        ...
+    @property
+    def time_budget_s(self) -> float:
+        ...
+class RtestDesignCandidate:
+    """
+    One R-test pattern, evaluated.
+    """
+    @property
+    def duration_s(self) -> float:
+        ...
+    @property
+    def feasible(self) -> bool:
+        ...
+    @property
+    def names(self) -> list[str]:
+        ...
+    @property
+    def pattern(self) -> RtestPattern:
+        ...
+    @property
+    def sigma(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        predicted 1 sigma at the time budget (mm, rad)
+        """
+    @property
+    def why_not(self) -> str:
+        ...
+    @property
+    def worst_error(self) -> str:
+        ...
+    @property
+    def worst_expanded_um(self) -> float:
+        ...
+class RtestDesignOptions:
+    """
+    Options of design_rtest_test (defaults).
+    """
+    basis: RtestBasis
+    def __init__(self) -> None:
+        ...
+    @property
+    def b_limits_deg(self) -> typing.Annotated[list[float], "FixedSize(2)"]:
+        ...
+    @b_limits_deg.setter
+    def b_limits_deg(self, arg0: typing.Annotated[collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], "FixedSize(2)"]) -> None:
+        ...
+    @property
+    def b_step_deg(self) -> list[float]:
+        ...
+    @b_step_deg.setter
+    def b_step_deg(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def base(self) -> RtestPattern:
+        """
+        the default pattern: nests, grid, dwell
+        """
+    @base.setter
+    def base(self, arg0: RtestPattern) -> None:
+        ...
+    @property
+    def c_step_deg(self) -> list[float]:
+        ...
+    @c_step_deg.setter
+    def c_step_deg(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def nest_height_mm(self) -> list[float]:
+        ...
+    @nest_height_mm.setter
+    def nest_height_mm(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def nest_radius_mm(self) -> list[float]:
+        ...
+    @nest_radius_mm.setter
+    def nest_radius_mm(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def noise_rho(self) -> float:
+        ...
+    @noise_rho.setter
+    def noise_rho(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def noise_um(self) -> float:
+        ...
+    @noise_um.setter
+    def noise_um(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def reference_radius_mm(self) -> float:
+        ...
+    @reference_radius_mm.setter
+    def reference_radius_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def time_budget_s(self) -> float:
+        """
+        0: the base pattern's run time
+        """
+    @time_budget_s.setter
+    def time_budget_s(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def travel_max(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @travel_max.setter
+    def travel_max(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+        ...
+    @property
+    def travel_min(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        """
+        X, Y, Z, mm (formats.md frame)
+        """
+    @travel_min.setter
+    def travel_min(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+        ...
 class RtestJointIdentification:
     @property
     def converged(self) -> bool:
@@ -1797,6 +1931,159 @@ class RtestPattern:
     @nests.setter
     def nests(self, arg1: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> None:
         ...
+class RtestSeparatingCandidate:
+    """
+    An added nest, evaluated with the session.
+    """
+    @property
+    def added(self) -> RtestPattern:
+        ...
+    @property
+    def correlation(self) -> float:
+        ...
+    @property
+    def description(self) -> str:
+        ...
+    @property
+    def determined(self) -> bool:
+        ...
+    @property
+    def duration_s(self) -> float:
+        ...
+    @property
+    def repeats(self) -> float:
+        ...
+class RtestSeparationDesign:
+    """
+    The added nest that separates two effects, or why none can.
+    """
+    @property
+    def already_separated(self) -> bool:
+        ...
+    @property
+    def candidates_tried(self) -> int:
+        ...
+    @property
+    def chosen(self) -> RtestSeparatingCandidate:
+        ...
+    @property
+    def correlation_before(self) -> float:
+        ...
+    @property
+    def effective_per_reading(self) -> float:
+        ...
+    @property
+    def effects(self) -> typing.Annotated[list[str], "FixedSize(2)"]:
+        ...
+    @property
+    def found(self) -> bool:
+        ...
+    @property
+    def motion(self) -> TableMotionOverlap:
+        ...
+    @property
+    def names(self) -> list[str]:
+        ...
+    @property
+    def noise_um(self) -> float:
+        ...
+    @property
+    def sigma_after(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def sigma_before(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def verdict(self) -> str:
+        ...
+class RtestSeparationOptions:
+    """
+    Options of design_rtest_separation (defaults).
+    """
+    def __init__(self) -> None:
+        ...
+    @property
+    def b_limits_deg(self) -> typing.Annotated[list[float], "FixedSize(2)"]:
+        ...
+    @b_limits_deg.setter
+    def b_limits_deg(self, arg0: typing.Annotated[collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], "FixedSize(2)"]) -> None:
+        ...
+    @property
+    def b_step_deg(self) -> list[float]:
+        ...
+    @b_step_deg.setter
+    def b_step_deg(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def c_step_deg(self) -> list[float]:
+        ...
+    @c_step_deg.setter
+    def c_step_deg(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def dwell_s(self) -> float:
+        """
+        0: the session's
+        """
+    @dwell_s.setter
+    def dwell_s(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def max_added_time_s(self) -> float:
+        ...
+    @max_added_time_s.setter
+    def max_added_time_s(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def max_correlation(self) -> float:
+        ...
+    @max_correlation.setter
+    def max_correlation(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def nest_angle_deg(self) -> list[float]:
+        ...
+    @nest_angle_deg.setter
+    def nest_angle_deg(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def nest_height_mm(self) -> list[float]:
+        ...
+    @nest_height_mm.setter
+    def nest_height_mm(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def nest_radius_mm(self) -> list[float]:
+        ...
+    @nest_radius_mm.setter
+    def nest_radius_mm(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def noise_um(self) -> float:
+        """
+        0: the session's residual noise
+        """
+    @noise_um.setter
+    def noise_um(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def reference_radius_mm(self) -> float:
+        ...
+    @reference_radius_mm.setter
+    def reference_radius_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def travel_max(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @travel_max.setter
+    def travel_max(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+        ...
+    @property
+    def travel_min(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @travel_min.setter
+    def travel_min(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+        ...
 class RtestSession:
     """
     A rotacal-rtest/1 session (mm, deg, s).
@@ -1924,6 +2211,156 @@ class SegmentKind:
     @property
     def value(self) -> int:
         ...
+class SeparatingCandidate:
+    """
+    An added test, evaluated with the session.
+    """
+    @property
+    def correlation(self) -> float:
+        ...
+    @property
+    def description(self) -> str:
+        ...
+    @property
+    def determined(self) -> bool:
+        ...
+    @property
+    def duration_s(self) -> float:
+        ...
+    @property
+    def new_pivot(self) -> bool:
+        ...
+    @property
+    def setup(self) -> BallbarSetup:
+        ...
+    @property
+    def slow_down(self) -> float:
+        ...
+class SeparationDesign:
+    """
+    The added test that separates two effects, or why none can.
+    """
+    @property
+    def already_separated(self) -> bool:
+        ...
+    @property
+    def candidates_tried(self) -> int:
+        ...
+    @property
+    def chosen(self) -> SeparatingCandidate:
+        ...
+    @property
+    def correlation_before(self) -> float:
+        ...
+    @property
+    def effective_per_reading(self) -> float:
+        ...
+    @property
+    def effects(self) -> typing.Annotated[list[str], "FixedSize(2)"]:
+        ...
+    @property
+    def found(self) -> bool:
+        ...
+    @property
+    def motion(self) -> TableMotionOverlap:
+        ...
+    @property
+    def names(self) -> list[str]:
+        ...
+    @property
+    def noise_um(self) -> float:
+        ...
+    @property
+    def sigma_after(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def sigma_before(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def verdict(self) -> str:
+        ...
+class SeparationOptions:
+    """
+    Options of design_ballbar_separation (defaults).
+    """
+    def __init__(self) -> None:
+        ...
+    @property
+    def added(self) -> BallbarSetup:
+        """
+        step, feeds and C range of the added test
+        """
+    @added.setter
+    def added(self, arg0: BallbarSetup) -> None:
+        ...
+    @property
+    def bar_lengths_mm(self) -> list[float]:
+        ...
+    @bar_lengths_mm.setter
+    def bar_lengths_mm(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def max_added_time_s(self) -> float:
+        ...
+    @max_added_time_s.setter
+    def max_added_time_s(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def max_correlation(self) -> float:
+        ...
+    @max_correlation.setter
+    def max_correlation(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def noise_um(self) -> float:
+        """
+        0: the session's residual noise
+        """
+    @noise_um.setter
+    def noise_um(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def pivot_angle_deg(self) -> list[float]:
+        ...
+    @pivot_angle_deg.setter
+    def pivot_angle_deg(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def pivot_radius_mm(self) -> list[float]:
+        ...
+    @pivot_radius_mm.setter
+    def pivot_radius_mm(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def pivot_z_mm(self) -> list[float]:
+        ...
+    @pivot_z_mm.setter
+    def pivot_z_mm(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def reference_radius_mm(self) -> float:
+        ...
+    @reference_radius_mm.setter
+    def reference_radius_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def tilt_limits_deg(self) -> typing.Annotated[list[float], "FixedSize(2)"]:
+        ...
+    @tilt_limits_deg.setter
+    def tilt_limits_deg(self, arg0: typing.Annotated[collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], "FixedSize(2)"]) -> None:
+        ...
+    @property
+    def travel_max(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @travel_max.setter
+    def travel_max(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+        ...
+    @property
+    def travel_min(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @travel_min.setter
+    def travel_min(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+        ...
 class SerialError(IoError):
     pass
 class SphereFit:
@@ -1964,6 +2401,35 @@ class SphereOffsetCalibration:
         ...
     @property
     def residual_rms_um(self) -> float:
+        ...
+class TableMotionOverlap:
+    """
+    Whether two effects move the table alike (ballbar/design.hpp).
+    """
+    @property
+    def cosine(self) -> float:
+        """
+        largest cosine of the principal angles
+        """
+    @property
+    def first_is_location(self) -> bool:
+        ...
+    @property
+    def moves_table_first(self) -> bool:
+        ...
+    @property
+    def moves_table_second(self) -> bool:
+        ...
+    @property
+    def same_motion(self) -> bool:
+        """
+        no instrument can separate them
+        """
+    @property
+    def second_is_location(self) -> bool:
+        ...
+    @property
+    def why(self) -> str:
         ...
 class TransitionArc:
     """
@@ -2100,8 +2566,10 @@ def check_plausible(session: BallbarSession, source: str, options: PlausibilityO
 @typing.overload
 def check_plausible(session: RtestSession, source: str, options: PlausibilityOptions = ...) -> PlausibilityReport:
     ...
-def compensate_commands(nominal: BallbarSession, identified: ..., machine: MachineType) -> BallbarSession:
-    ...
+def compensate_commands(nominal: BallbarSession, identified: ..., machine: MachineType, tool_length_error: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> BallbarSession:
+    """
+    Compensated commands; tool_length_error (mm): the error of pivot_length + tool_length of a head machine (minus the identified tool_offset_Z).
+    """
 def compensate_sphere_offset(session: RtestSession, offset: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> RtestSession:
     """
     The session with the sphere's offset (x, y) from the spindle axis taken out of every d.
@@ -2122,9 +2590,21 @@ def default_calibration_moves(step_mm: typing.SupportsFloat | typing.SupportsInd
     """
 def default_tilt_range_deg(machine: MachineType) -> typing.Annotated[list[float], "FixedSize(2)"]:
     ...
+def design_ballbar_separation(session: BallbarSession, pair: collections.abc.Sequence[str], options: SeparationOptions = ...) -> SeparationDesign:
+    """
+    The smallest added test that separates two effects after a session (ballbar/design.hpp).
+    """
 def design_ballbar_test(options: BallbarDesignOptions) -> BallbarDesign:
     """
     The pivot and bar length with the smallest predicted uncertainty (ballbar/design.hpp).
+    """
+def design_rtest_separation(session: RtestSession, pair: collections.abc.Sequence[str], options: RtestSeparationOptions = ...) -> RtestSeparationDesign:
+    """
+    The smallest added R-test nest that separates two effects after a session (rtest/design.hpp).
+    """
+def design_rtest_test(options: RtestDesignOptions) -> RtestDesign:
+    """
+    The R-test nests and pose grid with the smallest predicted uncertainty (rtest/design.hpp).
     """
 def diagnose_ballbar(session: BallbarSession, options: DiagnosisOptions = ..., reference: rotacal._core.BallbarSession | None = None) -> Diagnosis:
     """
@@ -2145,6 +2625,10 @@ def effect_catalogue(machine: MachineType, max_harmonic: typing.SupportsInt | ty
 def estimate_noise_model(groups: collections.abc.Sequence[str], times: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], residuals_mm: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], options: NoiseModelOptions = ...) -> NoiseModel:
     """
     AR(p) model (Burg, BIC order) of the residuals per stream (group, channel).
+    """
+def evaluate_rtest_design(pattern: RtestPattern, options: RtestDesignOptions, time_budget_s: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> RtestDesignCandidate:
+    """
+    One R-test pattern evaluated at a time budget (0: its own run time).
     """
 def export_controller(model_path: str, controller: str, current_text: str | None = None, current_source: str = '<current>', toolholder: typing.SupportsInt | typing.SupportsIndex = 1, generated_at: str = '') -> ControllerExport:
     """
@@ -2188,6 +2672,10 @@ def hyper_circle_fit(points: typing.Annotated[numpy.typing.ArrayLike, numpy.floa
 def identify_joint(session: BallbarSession, fit_length_offset: bool = False, effects: collections.abc.Sequence[str] = [], tests: collections.abc.Sequence[str] = [], noise: str = 'auto') -> BallbarIdentification:
     """
     Joint fit (noise 'auto': AR noise model of the residuals, GLS refit when correlated; 'white') of the 8 location errors and the actual pivot to every sample (core/joint_fit.hpp).
+    """
+def identify_joint_sessions(sessions: collections.abc.Sequence[BallbarSession], effects: collections.abc.Sequence[str] = []) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], bool]:
+    """
+    Joint fit of several ballbar sessions (shared location errors and effects, one pivot each): (values, covariance, converged) in the order 8 location errors, pivots, effect parameters.
     """
 def identify_paper(session: BallbarSession) -> BallbarIdentification:
     """
@@ -2366,6 +2854,10 @@ def sphere_fit(points: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], 
 def svd_plane_fit(points: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], normal_hint: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] = ..., sigma: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> PlaneFit:
     """
     Total-least-squares plane (Flynn et al. Eq. 3).
+    """
+def table_motion_overlap(machine: MachineType, a: str, b: str, tilt_limits_deg: typing.Annotated[collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], "FixedSize(2)"] = [-90.0, 90.0], duration_s: typing.SupportsFloat | typing.SupportsIndex = 3600.0, reference_radius_mm: typing.SupportsFloat | typing.SupportsIndex = 100.0) -> TableMotionOverlap:
+    """
+    Compare the table motions of effects a and b (catalogue ids) on a machine.
     """
 def test_label(test: BallbarTest, machine: MachineType) -> str:
     """

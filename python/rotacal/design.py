@@ -27,10 +27,7 @@ def design_ballbar(base: Any, *, lengths: Sequence[float] = (100.0, 150.0),
     if pivot_z is not None:
         o.pivot_z_mm = [float(v) for v in pivot_z]
     if travel is not None:
-        t = np.asarray(travel, dtype=float).reshape(3, 2)
-        if np.any(t[:, 0] >= t[:, 1]):
-            raise _core.InvalidArgument("--travel: each axis needs min < max (xmin,xmax,ymin,ymax,zmin,zmax)")
-        o.travel_min, o.travel_max = t[:, 0], t[:, 1]
+        o.travel_min, o.travel_max = _travel(travel)
     o.time_budget_s = float(time_s)
     o.sample_rate_hz = float(rate_hz)
     o.noise_um = float(noise_um)
@@ -44,8 +41,11 @@ def parameter_units(names: Sequence[str]) -> list[tuple[str, float]]:
     um for mm, urad for rad, the effect's own unit otherwise."""
     out = []
     for i, n in enumerate(names):
-        if i < 11:
+        if i < 8:
             out.append(("urad", 1e6) if i in (2, 3, 6, 7) else ("um", 1e3))
+            continue
+        if n.startswith(("pivot_", "zero_")):  # pivot_x (pivot_x#2 of a second set-up), R-test probe zeros
+            out.append(("um", 1e3))
             continue
         eid, _, pname = n.partition(".")
         eff = _core.Effect(eid)
@@ -75,3 +75,159 @@ def design_dict(d: Any) -> dict:
     return {"time_budget_s": d.time_budget_s, "ratio_to_default": d.ratio,
             "best": candidate_dict(d.best), "default": candidate_dict(d.baseline),
             "candidates": [candidate_dict(c) for c in d.candidates]}
+
+
+def design_separation(session: Any, pair: Sequence[str], *, base: Any | None = None,
+                      lengths: Sequence[float] = (100.0, 150.0), pivot_r: Sequence[float] | None = None,
+                      pivot_angle: Sequence[float] | None = None, pivot_z: Sequence[float] | None = None,
+                      travel: Sequence[float] | None = None, tilt_limits: Sequence[float] | None = None,
+                      max_time_s: float = 600.0, max_correlation: float = 0.5, noise_um: float = 0.0) -> Any:
+    """A ``_core.SeparationDesign``: the smallest ballbar test to add to ``session`` (a
+    ``BallbarSession``) so that the two effects of ``pair`` (catalogue ids) come out of the
+    joint fit with a canonical correlation below ``max_correlation``, the predicted 1-sigma of
+    every parameter before and after, or the reason no test can (their table motions are the
+    same). ``base``: a ``BallbarSetup`` whose step, feeds and C range the added test uses."""
+    if len(pair) != 2:
+        raise _core.InvalidArgument(f"--separate: {','.join(pair)}: give two effects, EFFECT,EFFECT")
+    o = _core.SeparationOptions()
+    if base is not None:
+        o.added = base
+    o.bar_lengths_mm = [float(v) for v in lengths]
+    for value, field in ((pivot_r, "pivot_radius_mm"), (pivot_angle, "pivot_angle_deg"), (pivot_z, "pivot_z_mm")):
+        if value is not None:
+            setattr(o, field, [float(v) for v in value])
+    if travel is not None:
+        o.travel_min, o.travel_max = _travel(travel)
+    if tilt_limits is not None:
+        o.tilt_limits_deg = [float(v) for v in tilt_limits]
+    o.max_added_time_s = float(max_time_s)
+    o.max_correlation = float(max_correlation)
+    o.noise_um = float(noise_um)
+    return _core.design_ballbar_separation(session, list(pair), o)
+
+
+def _travel(travel: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
+    t = np.asarray(travel, dtype=float).reshape(3, 2)
+    if np.any(t[:, 0] >= t[:, 1]):
+        raise _core.InvalidArgument("--travel: each axis needs min < max (xmin,xmax,ymin,ymax,zmin,zmax)")
+    return t[:, 0], t[:, 1]
+
+
+def added_setup(d: Any) -> Any:
+    """The set-up of the chosen added test with its feeds divided by the slow-down (what its
+    NC program runs)."""
+    s = d.chosen.setup
+    s.feed_mm_per_min = s.feed_mm_per_min / d.chosen.slow_down
+    s.feed_deg_per_min = s.feed_deg_per_min / d.chosen.slow_down
+    return s
+
+
+def separation_dict(d: Any) -> dict:
+    """The JSON of ``rotacal design ballbar --separate ... --after SESSION``."""
+    out = _separation_common(d)
+    if d.candidates_tried:
+        c = d.chosen
+        out["added_test"] = {"description": c.description, "tests": [_core.test_label(t, c.setup.machine) for t in c.setup.tests],
+                             "ballbar_length": c.setup.ballbar_length, "pivot": list(map(float, c.setup.pivot)),
+                             "new_pivot": c.new_pivot, "tilt_range_deg": list(c.setup.tilt_range_deg),
+                             "radial_c_side": c.setup.radial_c_side.name,
+                             "run_time_s": c.duration_s * c.slow_down, "slow_down": c.slow_down,
+                             "correlation_after": c.correlation}
+    return out
+
+
+def design_rtest(*, radii: Sequence[float] | None = None, heights: Sequence[float] | None = None,
+                 b_steps: Sequence[float] | None = None, c_steps: Sequence[float] | None = None,
+                 b_limits: Sequence[float] | None = None, travel: Sequence[float] | None = None,
+                 time_s: float = 0.0, noise_um: float = 0.3, rho: float = 0.0, dwell_s: float | None = None) -> Any:
+    """A ``_core.RtestDesign``: the two R-test nests and the B/C grid with the smallest
+    predicted largest expanded uncertainty of the location errors at the run time ``time_s``
+    (0: the default pattern's), against the default pattern (C++: ``rotacal/rtest/design.hpp``)."""
+    o = _core.RtestDesignOptions()
+    for value, field in ((radii, "nest_radius_mm"), (heights, "nest_height_mm"), (b_steps, "b_step_deg"),
+                         (c_steps, "c_step_deg")):
+        if value is not None:
+            setattr(o, field, [float(v) for v in value])
+    if b_limits is not None:
+        o.b_limits_deg = [float(v) for v in b_limits]
+    if travel is not None:
+        o.travel_min, o.travel_max = _travel(travel)
+    if dwell_s is not None:
+        base = o.base
+        base.dwell_s = float(dwell_s)
+        o.base = base
+    o.time_budget_s = float(time_s)
+    o.noise_um = float(noise_um)
+    o.noise_rho = float(rho)
+    return _core.design_rtest_test(o)
+
+
+def rtest_candidate_dict(c: Any) -> dict:
+    """One evaluated R-test pattern as JSON."""
+    p = c.pattern
+    out = {"nests": [list(map(float, n)) for n in p.nests], "b_deg": list(p.b_deg), "c_deg": list(p.c_deg),
+           "dwell_s": p.dwell_s, "feasible": c.feasible, "duration_s": c.duration_s}
+    if not c.feasible:
+        return out | {"why_not": c.why_not}
+    return out | {"predicted_std": {n: float(s) for n, s in zip(c.names, c.sigma)},
+                  "worst_expanded_um": c.worst_expanded_um, "worst_error": c.worst_error}
+
+
+def rtest_design_dict(d: Any) -> dict:
+    """The JSON of ``rotacal design rtest --json``."""
+    return {"time_budget_s": d.time_budget_s, "ratio_to_default": d.ratio, "best": rtest_candidate_dict(d.best),
+            "default": rtest_candidate_dict(d.baseline), "candidates": [rtest_candidate_dict(c) for c in d.candidates]}
+
+
+def design_rtest_separation(session: Any, pair: Sequence[str], *, radii: Sequence[float] | None = None,
+                            angles: Sequence[float] | None = None, heights: Sequence[float] | None = None,
+                            b_steps: Sequence[float] | None = None, c_steps: Sequence[float] | None = None,
+                            b_limits: Sequence[float] | None = None, travel: Sequence[float] | None = None,
+                            dwell_s: float = 0.0, max_time_s: float = 600.0, max_correlation: float = 0.5,
+                            noise_um: float = 0.0) -> Any:
+    """A ``_core.RtestSeparationDesign``: the smallest R-test nest (position and grid) to add to
+    ``session`` (an ``RtestSession``) so that the two effects of ``pair`` come out of the joint
+    fit with a canonical correlation below ``max_correlation``, or why no test can."""
+    if len(pair) != 2:
+        raise _core.InvalidArgument(f"--separate: {','.join(pair)}: give two effects, EFFECT,EFFECT")
+    o = _core.RtestSeparationOptions()
+    for value, field in ((radii, "nest_radius_mm"), (angles, "nest_angle_deg"), (heights, "nest_height_mm"),
+                         (b_steps, "b_step_deg"), (c_steps, "c_step_deg")):
+        if value is not None:
+            setattr(o, field, [float(v) for v in value])
+    if b_limits is not None:
+        o.b_limits_deg = [float(v) for v in b_limits]
+    if travel is not None:
+        o.travel_min, o.travel_max = _travel(travel)
+    o.dwell_s = float(dwell_s)
+    o.max_added_time_s = float(max_time_s)
+    o.max_correlation = float(max_correlation)
+    o.noise_um = float(noise_um)
+    return _core.design_rtest_separation(session, list(pair), o)
+
+
+def _separation_common(d: Any) -> dict:
+    def sig(v: Any) -> dict:
+        return {n: (float(s) if np.isfinite(s) else None) for n, s in zip(d.names, v)}
+    out = {"effects": list(d.effects), "separable": not d.motion.same_motion,
+           "already_separated": d.already_separated, "found": d.found, "verdict": d.verdict,
+           "table_motion": {"same_motion": d.motion.same_motion, "cosine": d.motion.cosine, "why": d.motion.why},
+           "correlation_before": d.correlation_before, "predicted_std_before": sig(d.sigma_before),
+           "noise_um": d.noise_um, "effective_samples_per_reading": d.effective_per_reading,
+           "candidates_tried": d.candidates_tried}
+    if d.candidates_tried:
+        out["predicted_std_after"] = sig(d.sigma_after)
+    return out
+
+
+def rtest_separation_dict(d: Any) -> dict:
+    """The JSON of ``rotacal design rtest --separate ... --after SESSION``."""
+    out = _separation_common(d)
+    if d.candidates_tried:
+        c = d.chosen
+        p = c.added
+        out["added_nest"] = {"description": c.description, "nest": list(map(float, p.nests[0])),
+                             "b_deg": list(p.b_deg), "c_deg": list(p.c_deg), "dwell_s": p.dwell_s,
+                             "repeats": c.repeats, "run_time_s": c.duration_s * c.repeats,
+                             "correlation_after": c.correlation}
+    return out

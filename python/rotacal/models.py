@@ -16,6 +16,8 @@ its reason under ``"null_reasons"``), versioned (a newer major version is refuse
 """
 from __future__ import annotations
 
+import json
+
 import math
 import os
 from pathlib import Path
@@ -35,6 +37,29 @@ def estimate_dict(p: Any) -> dict:
     return {"value": float(p.value), "std": float(p.std), "unit": p.unit}
 
 
+def machine_members(machine: Any) -> dict:
+    """``{"machine": name}``, with the ``machine_description`` of every machine but the two
+    tables formats.md names (the description then defines the machine; other tools can read it)."""
+    out: dict[str, Any] = {"machine": _core.machine_name(machine)}
+    if machine not in (_core.MachineType.AC_trt, _core.MachineType.BC_trt):
+        out["machine_description"] = json.loads(machine.description_json)
+    return out
+
+
+def machine_of(d: dict, source: str) -> Any:
+    """The machine a model dict names: its ``machine_description`` if it has one, else the
+    built-in called ``machine``; errors name the file and the key."""
+    if "machine_description" in d:
+        desc = d["machine_description"]
+        if not isinstance(desc, dict):
+            raise _core.InvalidArgument(f"{source}: machine_description: must be a rotacal-machine/1 object")
+        return _core.MachineType.from_description(json.dumps(desc), f"{source}: machine_description")
+    try:
+        return _core.parse_machine_type(str(d.get("machine", "")))
+    except _core.InvalidArgument as e:
+        raise _core.InvalidArgument(f"{source}: machine: {e}") from None
+
+
 def ballbar_model_dict(machine: Any, parameters: list, effects: list[str]) -> dict:
     """Model dict from the parameter list of a ballbar fit (8 errors, pivot x y z, effects)."""
     names = list(_core.location_error_names(machine))
@@ -42,7 +67,7 @@ def ballbar_model_dict(machine: Any, parameters: list, effects: list[str]) -> di
     out: dict[str, Any] = {
         "format": FORMAT,
         "kind": "ballbar",
-        "machine": _core.machine_name(machine),
+        **machine_members(machine),
         "location_errors": {n: estimate_dict(by_name[n]) for n in names},
         "pivot": {a: estimate_dict(by_name["pivot_" + a]) for a in "xyz"},
         "effects": [],
@@ -130,7 +155,7 @@ def fit_model_dict(machine: Any, parameters: list, effects: list[str]) -> dict:
         if p.name.startswith("zero."):
             _, setup, axis = p.name.split(".")
             zeros.setdefault(setup, {})[axis] = estimate_dict(p)
-    out = {"format": FORMAT, "kind": "rtest-diagnosis", "machine": _core.machine_name(machine),
+    out = {"format": FORMAT, "kind": "rtest-diagnosis", **machine_members(machine),
            "location_errors": {n: estimate_dict(by_name[n]) for n in names},
            "probe_zeros": zeros, "effects": []}
     for eid in effects:
@@ -173,7 +198,7 @@ def rtest_model_dict(ident: Any, nests: dict) -> dict:
     return {
         "format": FORMAT,
         "kind": RTEST_KIND,
-        "machine": _core.machine_name(machine),
+        **machine_members(machine),
         "basis": {"b_degree": basis.b_degree, "c_harmonics": basis.c_harmonics,
                   "c_b_degree": basis.c_b_degree, "gamma_cb": bool(basis.gamma_cb),
                   "definition": RTEST_BASIS_DEFINITION},
@@ -205,7 +230,7 @@ def rtest_model_from_dict(d: dict, source: str = "<model>") -> tuple[Any, dict, 
     if d.get("kind") != RTEST_KIND:
         raise _core.InvalidArgument(f"{source}: kind {d.get('kind')!r} is not an R-test joint model "
                                     f"('{RTEST_KIND}')")
-    machine = _core.parse_machine_type(d.get("machine", ""))
+    machine = machine_of(d, source)
     b = d.get("basis")
     if not isinstance(b, dict):
         raise _core.InvalidArgument(f"{source}: missing 'basis'")

@@ -6,7 +6,8 @@
 namespace rotacal {
 
 BallbarSession compensate_commands(const BallbarSession& nominal,
-                                   const LocationErrors<double>& identified, MachineType machine) {
+                                   const LocationErrors<double>& identified, MachineType machine,
+                                   double tool_length_error) {
   if (machine != nominal.machine)
     throw InvalidArgument("compensate_commands: identified model is for " + to_string(machine) +
                           " but the program is for " + to_string(nominal.machine));
@@ -17,9 +18,18 @@ BallbarSession compensate_commands(const BallbarSession& nominal,
     // Table-frame target of the nominal (TCPM) command, then the command that reaches it on
     // the identified machine.
     const Eigen::Vector3d q = ball_in_table(machine, zero, a, s.xyz);
-    s.xyz = inverse(machine, identified, a, q).xyz;
+    s.xyz = inverse(machine, identified, a, q, tool_length_error).xyz;
   }
   return out;
+}
+
+double identified_tool_length_error(const BallbarMachineModel& model) {
+  if (!model.machine.has_head()) return 0.0;
+  const Effect tool_z = Effect::parse("tool_offset_Z");
+  for (std::size_t i = 0; i < model.effects.effects.size(); ++i)
+    if (model.effects.effects[i] == tool_z)
+      return -model.effect_params[static_cast<std::size_t>(model.effects.offset(i))];
+  return 0.0;
 }
 
 CompensationReport verify_compensation(const BallbarSession& commanded,
@@ -31,7 +41,8 @@ CompensationReport verify_compensation(const BallbarSession& commanded,
   r.before = identify_joint(first, fit);
 
   // The machine runs the compensated program; the ballbar software still holds the nominal one.
-  const BallbarSession program = compensate_commands(commanded, r.before.model.errors, truth.machine);
+  const BallbarSession program = compensate_commands(commanded, r.before.model.errors, truth.machine,
+                                                     identified_tool_length_error(r.before.model));
   BallbarSimulationOptions second_options = options;
   second_options.seed = options.seed + 1;
   BallbarSession second = simulate_ballbar(program, truth, second_options);

@@ -66,6 +66,14 @@ Observability analyse_observability_normal(const Eigen::MatrixXd& JtJ, const Eig
       if (std::abs(vs[j]) > 0.05) o.observable[static_cast<std::size_t>(j)] = false;
       if (std::abs(vs[j]) > std::abs(vs[best])) best = static_cast<int>(j);
     }
+    // Equal shares (e.g. a head's tool length, its axis' position along the spindle and the
+    // pivot height, 1/sqrt(3) each) would leave the choice to rounding: hold the last of them,
+    // the parameter a model adds on top of the base ones, so that repeated fits agree.
+    for (Eigen::Index j = p - 1; j > best; --j)
+      if (std::abs(vs[j]) >= (1.0 - 1e-3) * std::abs(vs[best])) {
+        best = static_cast<int>(j);
+        break;
+      }
     o.to_fix.push_back(best);
   }
   return o;

@@ -204,11 +204,30 @@ void check_envelope(const json& doc, const std::string& source, ModelFile& m) {
   m.kind = kind.get<std::string>();
   const json& machine = member(doc, "machine", source, "");
   if (!machine.is_string()) bad(source, "machine", "must be a string such as \"AC-trt\", got " + shown(machine));
+  // As in sessions: a machine_description defines the machine, `machine` is then its name.
+  if (doc.contains("machine_description")) {
+    const json& d = doc["machine_description"];
+    if (!d.is_object()) bad(source, "machine_description", "must be a rotacal-machine/1 object, got " + shown(d));
+    try {
+      m.machine = MachineType::from_description(parse_machine_description(d.dump(), source + ": machine_description"));
+    } catch (const InvalidArgument& e) {
+      bad(source, "machine_description", e.what());
+    }
+    return;
+  }
   try {
     m.machine = parse_machine_type(machine.get<std::string>());
   } catch (const InvalidArgument& e) {
     bad(source, "machine", e.what());
   }
+}
+
+// The machine members of a document: the name, and for every machine but the two tables of
+// formats.md its description (as in sessions).
+void put_machine(json& doc, MachineType m) {
+  doc["machine"] = to_string(m);
+  if (m != MachineType::AC_trt && m != MachineType::BC_trt)
+    doc["machine_description"] = json::parse(machine_description_json(m.description()));
 }
 
 json parse_json(const std::string& text, const std::string& source) {
@@ -365,7 +384,8 @@ void write_model(const json& document, const std::string& path, const OutputOpti
 }
 
 json ballbar_model_document(const BallbarMachineModel& model) {
-  json doc = {{"format", kModelFormat}, {"kind", "ballbar"}, {"machine", to_string(model.machine)}};
+  json doc = {{"format", kModelFormat}, {"kind", "ballbar"}};
+  put_machine(doc, model.machine);
   json le = json::object();
   const auto& names = location_error_names(model.machine);
   for (int k = 0; k < 8; ++k)

@@ -376,10 +376,13 @@ void check_rotary_columns(const Reader& R, MachineType m) {
                                    " machine (rotary columns are " + mine.substr(0, 1) + ", " + mine.substr(1) + ")");
 }
 
-// The machine lines of a header: the built-in's name, or a description with its name.
+// The machine lines of a header: the name, and for every machine but the two tables that
+// formats.md names, its description (so that other tools can read the file; rotacal's own
+// built-ins are recognised from it).
 std::string machine_lines(MachineType m) {
   std::string out = "# machine: " + to_string(m) + "\n";
-  if (!m.is_builtin()) out += "# machine_description: " + machine_description_json(m.description()) + "\n";
+  if (m != MachineType::AC_trt && m != MachineType::BC_trt)
+    out += "# machine_description: " + machine_description_json(m.description()) + "\n";
   return out;
 }
 

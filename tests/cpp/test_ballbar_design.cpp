@@ -2,7 +2,6 @@
 // one a simulated test realises, limits exclude set-ups by name, and the design beats the
 // default set-up at the same run time.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <random>
 
@@ -10,6 +9,7 @@
 #include "rotacal/ballbar/identify.hpp"
 #include "rotacal/ballbar/simulate.hpp"
 #include "rotacal/core/error.hpp"
+#include "rotacal/core/noise_model.hpp"
 
 using namespace rotacal;
 
@@ -22,7 +22,8 @@ TEST_CASE("the predicted sigma is what simulated tests of the set-up realise") {
   // A recorder rate that records exactly the plan's samples in the plan's own run time.
   double t_tests = 0.0;
   for (const PlanSegment& seg : plan.segments)
-    if (seg.kind == SegmentKind::test) t_tests += seg.samples.back().time - seg.samples.front().time;
+    if (seg.kind == SegmentKind::test)
+      t_tests += seg.samples.back().time - seg.samples.front().time;
   o.sample_rate_hz = static_cast<double>(cmd.samples.size()) / t_tests;
   const DesignCandidate c = evaluate_design(o.base, o, 0.0);
   REQUIRE(c.feasible);
@@ -35,20 +36,23 @@ TEST_CASE("the predicted sigma is what simulated tests of the set-up realise") {
   const int draws = 60;
   Eigen::MatrixXd est(draws, 8);
   for (int k = 0; k < draws; ++k) {
-    const BallbarSession s = simulate_ballbar(cmd, truth, {o.noise_um, static_cast<std::uint64_t>(100 + k), true});
+    const BallbarSession s =
+        simulate_ballbar(cmd, truth, {o.noise_um, static_cast<std::uint64_t>(100 + k), true});
     const BallbarIdentification id = identify_joint(s);
     for (int i = 0; i < 8; ++i) est(k, i) = id.parameters[static_cast<std::size_t>(i)].value;
   }
   for (int i = 0; i < 8; ++i) {
     const Eigen::VectorXd v = est.col(i);
     const double sd = std::sqrt((v.array() - v.mean()).square().sum() / (draws - 1));
-    INFO(c.names[static_cast<std::size_t>(i)] << ": realised " << sd << ", predicted " << c.sigma[i]);
+    INFO(c.names[static_cast<std::size_t>(i)] << ": realised " << sd << ", predicted "
+                                              << c.sigma[i]);
     CHECK(sd / c.sigma[i] > 0.7);
     CHECK(sd / c.sigma[i] < 1.4);
   }
 }
 
-TEST_CASE("travel limits exclude set-ups by name; the design beats the default at the same run time") {
+TEST_CASE(
+    "travel limits exclude set-ups by name; the design beats the default at the same run time") {
   BallbarDesignOptions o;
   o.base.step_deg = 3.0;
   o.pivot_x_mm = {60.0, 120.0, 180.0};
@@ -92,5 +96,165 @@ TEST_CASE("effects of concern are fitted along and their correlations reported")
   CHECK_THROWS_WITH(design_ballbar_test(bad), Catch::Contains("--rho"));
   bad = o;
   bad.travel_max = Eigen::Vector3d(10, 10, 10);
-  CHECK_THROWS_WITH(design_ballbar_test(bad), Catch::Contains("no candidate") && Catch::Contains("travel"));
+  CHECK_THROWS_WITH(design_ballbar_test(bad),
+                    Catch::Contains("no candidate") && Catch::Contains("travel"));
+}
+
+// ------------------------------------------------------------------ separating two effects
+
+namespace {
+
+// The Table 2 machine (shared/data/ballbar_ac_table2.truth.json) with hidden C error motions.
+BallbarMachineModel hidden_machine(const BallbarSession& cmd) {
+  BallbarMachineModel truth;
+  truth.machine = cmd.machine;
+  truth.pivot = cmd.pivot;
+  truth.errors.v << 0.0726, -0.0202, 1.1284e-05, -0.000113006, 0.0283, 0.1041, 5.1954e-06,
+      -4.1544e-05;
+  truth.effects.effects = {Effect::parse("axial_motion_C_h2"), Effect::parse("tilt_motion_C_h2")};
+  truth.effect_params = {1.0e-3, -0.6e-3, 0.0, 0.0, 3e-6, -2e-6};
+  return truth;
+}
+
+// A recorded session: the exact readings of `truth` plus AR(1) noise per test (coloured).
+BallbarSession recorded(const BallbarSession& cmd, BallbarMachineModel truth, double rho,
+                        std::uint64_t seed) {
+  truth.pivot = cmd.pivot;
+  BallbarSession s = simulate_ballbar(cmd, truth, {0.0, seed, false});
+  std::vector<std::string> groups;
+  std::vector<double> times;
+  for (const BallbarSample& x : s.samples) groups.push_back(x.test), times.push_back(x.time);
+  const Eigen::VectorXd e = noise_gen::ar1(groups, times, rho, 0.5e-3, seed);
+  for (std::size_t i = 0; i < s.samples.size(); ++i)
+    s.samples[i].length += e[static_cast<Eigen::Index>(i)];
+  s.noise_um = 0.5;  // declared, as a recorder states it: the fit's observability test uses it
+  return s;
+}
+
+BallbarSession table2_command(double step_deg) {
+  BallbarSetup setup;
+  setup.step_deg = step_deg;
+  return commanded_session(plan_ballbar_test(setup));
+}
+
+}  // namespace
+
+TEST_CASE("the table motion decides which effects no instrument can separate") {
+  // gravity sag and the second radial harmonic of the same tilt axis are one translation of
+  // the table depending on the tilt angle alone, with location errors; on both machine types.
+  const TableMotionOverlap ac = table_motion_overlap(
+      MachineType::AC_trt, Effect::parse("gravity_sag_A"), Effect::parse("radial_motion_A_h2"));
+  CHECK(ac.same_motion);
+  CHECK(ac.cosine > 1.0 - 1e-6);
+  CHECK(ac.why.find("no test can tell them apart") != std::string::npos);
+  const TableMotionOverlap bc = table_motion_overlap(
+      MachineType::BC_trt, Effect::parse("gravity_sag_B"), Effect::parse("radial_motion_B_h2"));
+  CHECK(bc.same_motion);
+  // The third harmonic holds none of the sag's 1 - cos A: a test can separate those.
+  const TableMotionOverlap h3 = table_motion_overlap(
+      MachineType::AC_trt, Effect::parse("gravity_sag_A"), Effect::parse("radial_motion_A_h3"));
+  CHECK_FALSE(h3.same_motion);
+  CHECK(h3.cosine < 0.9);
+  // The axial and tilt motions of C differ by the lever arm of the table point.
+  const TableMotionOverlap c2 = table_motion_overlap(
+      MachineType::AC_trt, Effect::parse("axial_motion_C_h2"), Effect::parse("tilt_motion_C_h2"));
+  CHECK_FALSE(c2.same_motion);
+  // A zero offset of the tilt axis and its first positioning harmonic: different motions.
+  CHECK_FALSE(table_motion_overlap(MachineType::AC_trt, Effect::parse("rotary_zero_offset_A"),
+                                   Effect::parse("angular_positioning_A_h1"))
+                  .same_motion);
+  // A tool-side effect does not move the table: the table motion cannot decide.
+  const TableMotionOverlap tool = table_motion_overlap(
+      MachineType::AC_trt, Effect::parse("tool_offset_Z"), Effect::parse("axial_motion_C_h2"));
+  CHECK_FALSE(tool.moves_table_first);
+  CHECK_FALSE(tool.same_motion);
+  CHECK_THROWS_WITH(table_motion_overlap(MachineType::AC_trt, Effect::parse("gravity_sag_B"),
+                                         Effect::parse("radial_motion_A_h2")),
+                    Catch::Contains("gravity_sag_B"));
+}
+
+TEST_CASE("the added test separates axial and tilt motion of C; its predicted sigma is realised") {
+  const BallbarSession cmd = table2_command(2.0);
+  const BallbarMachineModel truth = hidden_machine(cmd);
+  const double rho = 0.5;
+  const BallbarSession session = recorded(cmd, truth, rho, 7);
+  const std::vector<Effect> pair = {Effect::parse("axial_motion_C_h2"),
+                                    Effect::parse("tilt_motion_C_h2")};
+  SeparationOptions o;
+  o.added.step_deg = 2.0;
+  const SeparationDesign d = design_ballbar_separation(session, pair, o);
+  INFO(d.verdict);
+  REQUIRE_FALSE(d.motion.same_motion);
+  CHECK(d.correlation_before > 0.85);
+  REQUIRE(d.found);
+  CHECK(d.chosen.correlation < 0.5);
+  CHECK(d.chosen.duration_s * d.chosen.slow_down <= 600.0);
+  // The noise model of the session: AR(1) with rho 0.5 leaves about 1/3 effective readings.
+  CHECK(d.effective_per_reading == Approx(1.0 / 3.0).epsilon(0.35));
+  const int first = 11, ne = 6;
+  for (int j = first; j < first + ne; ++j)
+    CHECK(d.sigma_after[j] <= d.sigma_before[j] * (1 + 1e-9));
+  for (int j = 0; j < 8; ++j) CHECK(std::isfinite(d.sigma_after[j]));
+
+  // Monte Carlo: new noise on the session and on the added test (run slower: s times the
+  // readings), both fitted jointly; the spread of the estimates against the prediction.
+  BallbarSetup added = d.chosen.setup;
+  added.step_deg /= d.chosen.slow_down;
+  BallbarSession added_cmd = commanded_session(plan_ballbar_test(added));
+  for (BallbarSample& s : added_cmd.samples) s.time += session.samples.back().time;
+  EffectModel fx;
+  fx.effects = pair;
+  const int draws = 80;
+  const int p = static_cast<int>(d.names.size());
+  Eigen::MatrixXd est(draws, p);
+  for (int k = 0; k < draws; ++k) {
+    const std::vector<BallbarSession> both = {recorded(cmd, truth, rho, 1000 + k),
+                                              recorded(added_cmd, truth, rho, 5000 + k)};
+    const JointFitOutcome f = identify_joint_sessions(both, fx);
+    REQUIRE(f.summary.converged);
+    // identify_joint_sessions: 8 location, pivots (3 per distinct pivot), effects; the design's
+    // order: 8 location, session pivot, effects, moved pivot.
+    est.row(k).head(11) = f.values.head(11);
+    est.row(k).segment(11, ne) = f.values.tail(ne);
+    if (p > 11 + ne) est.row(k).tail(3) = f.values.segment(11, 3);
+    REQUIRE(f.values.size() == p);
+  }
+  for (int j = 0; j < p; ++j) {
+    if (!std::isfinite(d.sigma_after[j])) continue;  // held by the design: the fit holds it too
+    const Eigen::VectorXd v = est.col(j);
+    const double sd = std::sqrt((v.array() - v.mean()).square().sum() / (draws - 1));
+    INFO(d.names[static_cast<std::size_t>(j)] << ": realised " << sd << ", predicted "
+                                              << d.sigma_after[j]);
+    CHECK(sd / d.sigma_after[j] > 0.7);
+    CHECK(sd / d.sigma_after[j] < 1.4);
+  }
+}
+
+TEST_CASE("gravity sag and the second radial harmonic of A: no test is proposed, and why") {
+  const BallbarSession cmd = table2_command(3.0);
+  BallbarMachineModel truth = hidden_machine(cmd);
+  truth.effects.effects.clear();
+  truth.effect_params.clear();
+  const BallbarSession session = recorded(cmd, truth, 0.3, 11);
+  const SeparationDesign d = design_ballbar_separation(
+      session, {Effect::parse("gravity_sag_A"), Effect::parse("radial_motion_A_h2")});
+  CHECK(d.motion.same_motion);
+  CHECK_FALSE(d.found);
+  CHECK(d.candidates_tried == 0);
+  CHECK(d.verdict.find("no test can separate gravity_sag_A and radial_motion_A_h2") == 0);
+  // Bad input names the option.
+  CHECK_THROWS_WITH(design_ballbar_separation(session, {Effect::parse("gravity_sag_A")}),
+                    Catch::Contains("--separate"));
+  SeparationOptions bad;
+  bad.max_correlation = 1.0;
+  CHECK_THROWS_WITH(
+      design_ballbar_separation(
+          session, {Effect::parse("axial_motion_C_h2"), Effect::parse("tilt_motion_C_h2")}, bad),
+      Catch::Contains("--max-correlation"));
+  bad = SeparationOptions{};
+  bad.pivot_z_mm.clear();
+  CHECK_THROWS_WITH(
+      design_ballbar_separation(
+          session, {Effect::parse("axial_motion_C_h2"), Effect::parse("tilt_motion_C_h2")}, bad),
+      Catch::Contains("--pivot-z"));
 }

@@ -58,3 +58,88 @@ def test_a_pair_no_single_setup_separates_is_reported():
 def test_design_refuses_by_option(args, option):
     r = rotacal_cli("design", "ballbar", "--step", "5", "--pivot-x", "120", "--pivot-z", "60", *args)
     assert r.returncode in (2, EXIT_INPUT) and option in r.stderr, r.stderr
+
+
+from conftest import SHARED  # noqa: E402
+
+TABLE2 = SHARED / "ballbar_ac_table2.csv"
+
+
+def test_separate_after_a_session_proposes_the_added_test(tmp_path):
+    prog = tmp_path / "added.ngc"
+    r = rotacal_cli("design", "ballbar", "--separate", "axial_motion_C_h2,tilt_motion_C_h2", "--after", TABLE2,
+                    "--json", "-o", prog)
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout)
+    assert d["separable"] and d["found"]
+    added = d["added_test"]
+    assert added["correlation_after"] < 0.5 < d["correlation_before"]
+    assert added["run_time_s"] <= 600
+    # Both effects come out better determined than from the session alone.
+    for name, after in d["predicted_std_after"].items():
+        before = d["predicted_std_before"].get(name)
+        if name.startswith(("axial_motion_C_h2", "tilt_motion_C_h2")) and after is not None:
+            assert before is None or after <= before * (1 + 1e-9)
+    # The program is that of the added test, at the slowed feeds.
+    text = prog.read_text()
+    assert added["tests"][-1] in text
+
+
+def test_separate_says_when_no_test_can():
+    r = rotacal_cli("design", "ballbar", "--separate", "gravity_sag_A,radial_motion_A_h2", "--after", TABLE2)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.startswith("no test can separate gravity_sag_A and radial_motion_A_h2")
+    assert "moves the table exactly as" in r.stdout
+
+
+@pytest.mark.parametrize("args,option", [
+    (("--separate", "axial_motion_C_h2,tilt_motion_C_h2"), "--after"),
+    (("--after", str(TABLE2)), "--separate"),
+    (("--separate", "axial_motion_C_h2", "--after", str(TABLE2)), "--separate"),
+    (("--separate", "axial_motion_C_h2,no_such_effect", "--after", str(TABLE2)), "no_such_effect"),
+])
+def test_separate_refuses_by_option(args, option):
+    r = rotacal_cli("design", "ballbar", *args)
+    assert r.returncode in (2, EXIT_INPUT) and option in r.stderr, r.stderr
+
+
+def test_design_rtest_beats_the_default_pattern():
+    r = rotacal_cli("design", "rtest", "--radii", "50,150", "--heights", "20,100,140", "--b-steps", "30,45",
+                    "--c-steps", "30,60", "--travel", "-400,400,-300,300,-300,190", "--json")
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout)
+    best, default = d["best"], d["default"]
+    assert best["feasible"] and default["feasible"]
+    assert best["worst_expanded_um"] < default["worst_expanded_um"]
+    assert best["duration_s"] <= d["time_budget_s"] == default["duration_s"]
+    reasons = [c["why_not"] for c in d["candidates"] if not c["feasible"]]
+    assert any(w.startswith("Z = ") for w in reasons) and any("too coarse" in w for w in reasons)
+    text = rotacal_cli("design", "rtest", "--radii", "50,150", "--heights", "20,100", "--b-steps", "30",
+                       "--c-steps", "30").stdout
+    assert "run it with: --nest" in text
+
+
+@pytest.mark.parametrize("args,option", [
+    (("--rho", "1.5"), "--rho"),
+    (("--c-steps", "0"), "--c-steps"),
+    (("--travel", "-1,1,-1,1,-1,1"), "no nest pair"),
+])
+def test_design_rtest_refuses_by_option(args, option):
+    r = rotacal_cli("design", "rtest", "--radii", "100", "--heights", "60", "--b-steps", "30", "--c-steps", "30", *args)
+    assert r.returncode in (2, EXIT_INPUT) and option in r.stderr, r.stderr
+
+
+OYAMA = SHARED / "rtest_bc_oyama.csv"
+
+
+def test_design_rtest_separate_after_a_session():
+    r = rotacal_cli("design", "rtest", "--separate", "axial_motion_C_h2,tilt_motion_C_h2", "--after", OYAMA, "--json")
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout)
+    assert d["found"] and d["added_nest"]["correlation_after"] < 0.5 < d["correlation_before"]
+    assert d["added_nest"]["run_time_s"] <= 600
+    r = rotacal_cli("design", "rtest", "--separate", "gravity_sag_B,radial_motion_B_h2", "--after", OYAMA)
+    assert r.returncode == 0 and r.stdout.startswith("no test can separate gravity_sag_B and radial_motion_B_h2")
+    # The wrong kind of session is refused by option.
+    r = rotacal_cli("design", "rtest", "--separate", "axial_motion_C_h2,tilt_motion_C_h2", "--after", TABLE2)
+    assert r.returncode in (2, EXIT_INPUT) and "--after" in r.stderr

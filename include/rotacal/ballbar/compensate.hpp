@@ -15,10 +15,16 @@
 namespace rotacal {
 
 /// The same session with every commanded X,Y,Z replaced by the compensated command for the
-/// identified machine (location errors only; effects and pivot play no part in the command).
+/// identified machine (location errors, and on a machine with head axes the error of
+/// pivot_length + tool_length, mm; effects and pivot play no part in the command).
 /// Throws InvalidArgument if the machines differ.
 BallbarSession compensate_commands(const BallbarSession& nominal,
-                                   const LocationErrors<double>& identified, MachineType machine);
+                                   const LocationErrors<double>& identified, MachineType machine,
+                                   double tool_length_error = 0.0);
+
+/// The error of pivot_length + tool_length of an identified model: minus its tool_offset_Z on
+/// a machine with head axes (kinematics/effects.hpp), else 0.
+double identified_tool_length_error(const BallbarMachineModel& model);
 
 /// One location error before and after compensation.
 struct CompensationRow {

@@ -14,12 +14,14 @@
 /// AR(1) with coefficient `noise_rho` between recorded samples, i.e. (1 - rho) / (1 + rho)
 /// effective samples per sample (the large-sample GLS information of a slowly varying model).
 
+#include <Eigen/Core>
+#include <array>
 #include <string>
 #include <vector>
 
-#include <Eigen/Core>
-
+#include "rotacal/ballbar/identify.hpp"
 #include "rotacal/ballbar/test_plan.hpp"
+#include "rotacal/core/joint_fit.hpp"
 #include "rotacal/kinematics/effects.hpp"
 
 namespace rotacal {
@@ -37,23 +39,25 @@ struct BallbarDesignOptions {
   /// intersection of the rotary axes), mm: min and max per axis.
   Eigen::Vector3d travel_min = Eigen::Vector3d(-400, -300, -300);
   Eigen::Vector3d travel_max = Eigen::Vector3d(400, 300, 400);
-  double time_budget_s = 0.0;       ///< 0: the default design's run time
-  double sample_rate_hz = 100.0;    ///< of the recorder
-  double noise_um = 0.5;            ///< 1 sigma per sample
-  double noise_rho = 0.0;           ///< AR(1) coefficient between samples, [0, 0.999]
+  double time_budget_s = 0.0;          ///< 0: the default design's run time
+  double sample_rate_hz = 100.0;       ///< of the recorder
+  double noise_um = 0.5;               ///< 1 sigma per sample
+  double noise_rho = 0.0;              ///< AR(1) coefficient between samples, [0, 0.999]
   double reference_radius_mm = 100.0;  ///< an orientation error in rad counts as this lever arm
-  EffectModel effects_of_concern;   ///< fitted with the location errors in every candidate
+  EffectModel effects_of_concern;      ///< fitted with the location errors in every candidate
 };
 
 struct DesignCandidate {
   BallbarSetup setup;
   bool feasible = false;
-  std::string why_not;           ///< when not feasible: which limit, or what is unobservable
-  double duration_s = 0.0;       ///< at the base feeds
+  std::string why_not;             ///< when not feasible: which limit, or what is unobservable
+  double duration_s = 0.0;         ///< at the base feeds
   std::vector<std::string> names;  ///< the fit's parameters (location errors, pivot, effects)
-  Eigen::VectorXd sigma;           ///< predicted 1 sigma at the time budget, parameter order; infinite: not determined
-  double worst_expanded_um = 0.0;  ///< max over the location errors of 2 sigma, um (rad x reference radius)
-  std::string worst_error;         ///< its name
+  Eigen::VectorXd
+      sigma;  ///< predicted 1 sigma at the time budget, parameter order; infinite: not determined
+  double worst_expanded_um =
+      0.0;  ///< max over the location errors of 2 sigma, um (rad x reference radius)
+  std::string worst_error;  ///< its name
   /// Largest |correlation| of each effect parameter with any location error, and with the
   /// other effects' parameters, in effects_of_concern order.
   std::vector<double> effect_vs_location;
@@ -62,19 +66,156 @@ struct DesignCandidate {
 
 struct BallbarDesign {
   DesignCandidate best;
-  DesignCandidate baseline;                ///< options.base, evaluated the same way
+  DesignCandidate baseline;  ///< options.base, evaluated the same way
   double time_budget_s = 0.0;
-  double ratio = 0.0;                      ///< best.worst_expanded_um / baseline.worst_expanded_um
-  std::vector<DesignCandidate> candidates; ///< every set-up tried, feasible or not
+  double ratio = 0.0;                       ///< best.worst_expanded_um / baseline.worst_expanded_um
+  std::vector<DesignCandidate> candidates;  ///< every set-up tried, feasible or not
 };
 
 /// Evaluate one set-up at a time budget (0: its own run time). Never throws for a set-up that
 /// breaks a limit: the candidate says why it is not feasible.
-DesignCandidate evaluate_design(const BallbarSetup& setup, const BallbarDesignOptions& options, double time_budget_s);
+DesignCandidate evaluate_design(const BallbarSetup& setup, const BallbarDesignOptions& options,
+                                double time_budget_s);
 
 /// Try every pivot and bar length. Throws InvalidArgument naming the option for an empty grid,
 /// a non-positive rate, noise or reference radius, rho outside [0, 0.999], or when no candidate
 /// is feasible (the message gives the reasons).
 BallbarDesign design_ballbar_test(const BallbarDesignOptions& options);
+
+// ------------------------------------------------------------------ separating two effects
+
+/// Whether two effects can be told apart by any instrument at all, decided from the motion of
+/// the table they cause. Every instrument of the library reads the table through points fixed
+/// on it (ballbar pivot, R-test nests) whose positions are fitted, and every fit estimates the
+/// location errors; so when some combination of one effect's parameters moves the table, at
+/// every pose, exactly as a combination of the other's does together with location errors and
+/// a shift of the table point, no test can separate them (e.g. gravity_sag_A and
+/// radial_motion_A_h2: translations of the table that depend on A alone).
+///
+/// The table motion of a parameter is the derivative of the table pose (effects.hpp,
+/// table_pose) as a spatial twist, rotation first: (omega x r_ref, v) with
+/// omega = vee(dR R^T) (rad, times the reference radius to give mm) and v = dt - omega x t
+/// (mm), at zero errors, on a grid over the tilt limits, a full turn of C and three times in
+/// [0, duration]. The location errors and the table point (a translation in the table frame,
+/// R dq) are projected out; the largest cosine of the principal angles between what is left of
+/// the two effects is 1 when they share a motion.
+struct TableMotionOverlap {
+  bool moves_table_first = false;  ///< the first effect moves the table at all
+  bool moves_table_second = false;
+  bool first_is_location = false;  ///< all its motion is location errors + table point
+  bool second_is_location = false;
+  double cosine = 0.0;       ///< largest cosine of the principal angles, [0, 1]
+  bool same_motion = false;  ///< cosine >= 1 - 1e-6, or an effect is all location
+  std::string why;           ///< in words, for reports
+};
+
+/// Compare the table motions of `a` and `b` on machine `m` over tilt in `tilt_limits_deg`, C
+/// over a full turn and time over [0, duration_s]. Throws InvalidArgument naming the effect
+/// that does not exist on the machine, or for a reversed tilt range or negative duration.
+TableMotionOverlap table_motion_overlap(MachineType m, const Effect& a, const Effect& b,
+                                        std::array<double, 2> tilt_limits_deg = {-90.0, 90.0},
+                                        double duration_s = 3600.0,
+                                        double reference_radius_mm = 100.0);
+
+namespace design_detail {
+/// Covariance of an information matrix I (fit units) with the parameters the joint fit would
+/// hold removed: one per combination that moving by the plausible magnitudes changes the white
+/// chi-square (I x white) by less than 1 (analyse_observability), and any it still cannot see.
+struct Inverted {
+  Eigen::MatrixXd cov;  ///< zero rows and columns for held parameters
+  std::vector<bool> determined;
+  Eigen::VectorXd sigma;  ///< infinite for held parameters
+};
+Inverted invert_information(const Eigen::MatrixXd& I, const Eigen::VectorXd& plausible,
+                            double white);
+/// Largest canonical correlation between the determined parameters among [a0, a0 + na) and
+/// among [b0, b0 + nb) (1 when either block has none).
+double canonical_correlation(const Inverted& inv, int a0, int na, int b0, int nb);
+}  // namespace design_detail
+
+/// Options of the added test that separates two effects after a session.
+struct SeparationOptions {
+  /// Step and feeds of the added test, and its C range; machine, pivot and bar length come
+  /// from the session.
+  BallbarSetup added;
+  std::vector<double> bar_lengths_mm = {100.0, 150.0};  ///< the bars available
+  /// Pivot candidates of a new set-up (cylindrical about the C axis, table frame): distance
+  /// from the C axis, angle from +X about +Z, height above the tilt axis. A pivot on the C
+  /// axis (radius 0) reads the axial motion of C with no lever arm for its tilt motion; the
+  /// radial tests cannot be planned there and are left out.
+  std::vector<double> pivot_radius_mm = {0.0, 60.0, 120.0, 180.0};
+  std::vector<double> pivot_angle_deg = {0.0, 90.0};
+  std::vector<double> pivot_z_mm = {20.0, 60.0, 120.0};
+  Eigen::Vector3d travel_min =
+      Eigen::Vector3d(-400, -300, -300);  ///< X, Y, Z, mm (formats.md frame)
+  Eigen::Vector3d travel_max = Eigen::Vector3d(400, 300, 400);
+  std::array<double, 2> tilt_limits_deg = {-90.0, 90.0};  ///< rotary limits of the tilt axis, deg
+  double max_added_time_s =
+      600.0;                     ///< the added test, slowed down to gather data, takes at most this
+  double max_correlation = 0.5;  ///< target: largest canonical correlation of the pair
+  /// 1 sigma per reading, um; 0: the session's residual noise (its noise model). The
+  /// session's effective samples per reading (AR model) apply to the added test too.
+  double noise_um = 0.0;
+  double reference_radius_mm = 100.0;  ///< lever arm of the table-motion comparison
+};
+
+/// One added test, evaluated jointly with the session.
+struct SeparatingCandidate {
+  BallbarSetup setup;       ///< the added test (tests, pivot, bar, ranges)
+  bool new_pivot = false;   ///< the pivot moved: the sphere tests locate it again
+  std::string description;  ///< in words
+  double duration_s = 0.0;  ///< run time at the base feeds
+  double slow_down = 1.0;   ///< feeds divided by this to gather data (run time x this)
+  /// Largest canonical correlation of the pair's determined parameters afterwards (1: an
+  /// effect has none). A parameter is held as the joint fit holds it: one per combination
+  /// that moving by plausible magnitudes changes chi-square by less than 1
+  /// (analyse_observability, core/least_squares.hpp).
+  double correlation = 1.0;
+  bool determined = false;  ///< every parameter of both effects is determined
+};
+
+struct SeparationDesign {
+  std::array<std::string, 2> effects;
+  TableMotionOverlap motion;
+  /// Parameters of the joint fit: 8 location errors, the session's pivot (3), the two effects'
+  /// parameters, and the added set-up's pivot (3) when it moved (absent from sigma_before).
+  std::vector<std::string> names;
+  Eigen::VectorXd
+      sigma_before;  ///< session alone, 1 sigma, fit units; infinite: held (undetermined)
+  Eigen::VectorXd sigma_after;      ///< session + the chosen test
+  double correlation_before = 1.0;  ///< largest canonical correlation of the pair (1: undetermined)
+  bool already_separated = false;   ///< the session alone is below max_correlation: nothing to add
+  bool found = false;               ///< a test within max_added_time_s reaches max_correlation
+  SeparatingCandidate chosen;       ///< the shortest that does; else the one of lowest correlation
+  int candidates_tried = 0;
+  double noise_um = 0.0;               ///< used
+  double effective_per_reading = 1.0;  ///< effective samples per reading (session's noise model)
+  std::string verdict;                 ///< what to do, or why nothing can separate them
+};
+
+/// The smallest additional ballbar test (same pivot: one rotary test at another bar length or
+/// range; moved pivot: the sphere tests and one rotary test) whose readings, fitted jointly
+/// with `session` (location errors and the effects shared, one pivot per set-up), bring the
+/// largest canonical correlation between the parameters of `pair` below
+/// options.max_correlation, and the predicted 1 sigma of every parameter afterwards. The
+/// session's information is its joint-fit Jacobian (fit with the pair included) over its noise
+/// (sigma and effective samples per reading from its AR noise model); the added test is read
+/// as the session was (one reading per plan step) and slowing it down by s gathers s times the
+/// readings. When the pair moves the table alike (table_motion_overlap) no test is searched:
+/// the verdict says why. Throws InvalidArgument naming the option for a pair that is not two
+/// different effects of the machine, empty grids, or non-positive limits.
+SeparationDesign design_ballbar_separation(const BallbarSession& session,
+                                           const std::vector<Effect>& pair,
+                                           const SeparationOptions& options = {});
+
+/// Joint fit of several ballbar sessions of one machine (e.g. a session and the test added to
+/// it): location errors and the effects shared, one pivot per distinct nominal pivot (sessions
+/// with the same nominal pivot share it: the ball stayed in its cup), lengths by the exact
+/// model (model.hpp) with Jets. Parameters: 8 location errors, then pivot x, y, z of each
+/// distinct pivot in order of first use ("pivot_x#k"), then the effect parameters. White least
+/// squares; the covariance is (J^T J)^-1 s^2. Throws InvalidArgument for no session, mixed machines
+/// or an effect that does not exist on the machine.
+JointFitOutcome identify_joint_sessions(const std::vector<BallbarSession>& sessions,
+                                        const EffectModel& effects);
 
 }  // namespace rotacal
