@@ -132,7 +132,12 @@ def test_single_setup_chain_on_every_builtin(capsys, tmp_path, name):
     assert code == 0, err
     header = session.read_text().splitlines()[:9]
     assert f"# machine: {name}" in header
-    assert not any(l.startswith("# machine_description:") for l in header)  # a built-in needs none
+    # formats.md's two tables are named; every other machine's file carries its description.
+    described = [l for l in header if l.startswith("# machine_description: ")]
+    if name in ("AC-trt", "BC-trt"):
+        assert not described
+    else:
+        assert json.loads(described[0].split(": ", 1)[1]) == json.loads(m.description_json)
     cols = next(l for l in header if l.startswith("test,")).split(",")
     assert cols[5:7] == list(m.axis_names)  # rotary columns in chain order
     code, out, err = run(capsys, "identify", session, "--json", "--no-budget")
@@ -203,8 +208,8 @@ def test_custom_description_round_trip(capsys, tmp_path, custom_file):
     assert "shop-7 A-head C-table (rotary table, tilting head)" in (tmp_path / "c.html").read_text()
 
 
-@pytest.mark.xfail(strict=True, reason="rotacal-model/1 files name the machine only (src/io/model_file.cpp): "
-                   "a described machine's model cannot be read back until they carry its description")
+@pytest.mark.xfail(strict=True, reason="src/io/model_file.cpp reads an unobservable pivot component (pivot z "
+                   "on every head machine) as 0 mm, not the nominal pivot: predict is off by the pivot height")
 def test_model_file_of_a_described_machine(capsys, tmp_path, custom_file):
     session = tmp_path / "c.csv"
     assert run(capsys, "simulate", "ballbar", "--machine", custom_file, "--seed", 5, "-o", session)[0] == 0
