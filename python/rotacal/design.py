@@ -4,6 +4,7 @@ errors at a run time, within the machine's travel, from the Fisher information o
 model (C++: ``rotacal/ballbar/design.hpp``; docs/design.md)."""
 from __future__ import annotations
 
+import json
 from typing import Any, Sequence
 
 import numpy as np
@@ -26,6 +27,8 @@ def design_ballbar(base: Any, *, lengths: Sequence[float] = (100.0, 150.0),
         o.pivot_x_mm = [float(v) for v in pivot_x]
     if pivot_z is not None:
         o.pivot_z_mm = [float(v) for v in pivot_z]
+    if travel is None:  # the machine's own travel, when its description gives one
+        travel = machine_travel(base.machine)
     if travel is not None:
         o.travel_min, o.travel_max = _travel(travel)
     o.time_budget_s = float(time_s)
@@ -96,6 +99,8 @@ def design_separation(session: Any, pair: Sequence[str], *, base: Any | None = N
     for value, field in ((pivot_r, "pivot_radius_mm"), (pivot_angle, "pivot_angle_deg"), (pivot_z, "pivot_z_mm")):
         if value is not None:
             setattr(o, field, [float(v) for v in value])
+    if travel is None:
+        travel = machine_travel(session.machine)
     if travel is not None:
         o.travel_min, o.travel_max = _travel(travel)
     if tilt_limits is not None:
@@ -104,6 +109,12 @@ def design_separation(session: Any, pair: Sequence[str], *, base: Any | None = N
     o.max_correlation = float(max_correlation)
     o.noise_um = float(noise_um)
     return _core.design_ballbar_separation(session, list(pair), o)
+
+
+def machine_travel(machine: Any) -> list[float] | None:
+    """xmin, xmax, ymin, ymax, zmin, zmax of the machine's description (travel_mm), if it has one."""
+    t = json.loads(machine.description_json).get("travel_mm")
+    return None if t is None else [float(v) for row in t for v in row]
 
 
 def _travel(travel: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:

@@ -60,16 +60,31 @@ def machine_of(d: dict, source: str) -> Any:
         raise _core.InvalidArgument(f"{source}: machine: {e}") from None
 
 
-def ballbar_model_dict(machine: Any, parameters: list, effects: list[str]) -> dict:
-    """Model dict from the parameter list of a ballbar fit (8 errors, pivot x y z, effects)."""
+def convention_estimate_dict(p: Any) -> dict:
+    """As estimate_dict, but a parameter of an unobservable combination keeps the value the fit
+    gave it under its convention (the one it held keeps its start value), flagged
+    ``observable: false`` with no std: what a model file needs to predict the readings as the
+    fit did (on a head machine pivot z, the head's position along the spindle and the tool
+    length are one such combination). It is not a measurement of that parameter."""
+    if not p.observable:
+        return {"value": float(p.value), "std": None, "unit": p.unit, "observable": False}
+    return estimate_dict(p)
+
+
+def ballbar_model_dict(machine: Any, parameters: list, effects: list[str], *,
+                       convention_values: bool = False) -> dict:
+    """Model dict from the parameter list of a ballbar fit (8 errors, pivot x y z, effects).
+    ``convention_values``: keep the values of unobservable parameters (model files, see
+    convention_estimate_dict); otherwise they are null."""
+    est = convention_estimate_dict if convention_values else estimate_dict
     names = list(_core.location_error_names(machine))
     by_name = {p.name: p for p in parameters}
     out: dict[str, Any] = {
         "format": FORMAT,
         "kind": "ballbar",
         **machine_members(machine),
-        "location_errors": {n: estimate_dict(by_name[n]) for n in names},
-        "pivot": {a: estimate_dict(by_name["pivot_" + a]) for a in "xyz"},
+        "location_errors": {n: est(by_name[n]) for n in names},
+        "pivot": {a: est(by_name["pivot_" + a]) for a in "xyz"},
         "effects": [],
     }
     for eid in effects:
@@ -77,7 +92,7 @@ def ballbar_model_dict(machine: Any, parameters: list, effects: list[str]) -> di
         params = {}
         for pname in eff.param_names:
             key = eid if eff.num_params == 1 else f"{eid}.{pname}"
-            params[pname] = estimate_dict(by_name[key])
+            params[pname] = est(by_name[key])
         out["effects"].append({"id": eid, "cause": eff.cause, "params": params})
     return out
 

@@ -36,14 +36,17 @@ class Identification:
         return self.raw.residuals
 
     def model_dict(self) -> dict:
-        d = ballbar_model_dict(self.machine, self.raw.parameters, self.raw.model.effects)
+        """The model file's content: values of unobservable parameters under the fit's
+        convention, so that predictions from the file match the fit."""
+        d = ballbar_model_dict(self.machine, self.raw.parameters, self.raw.model.effects,
+                               convention_values=True)
         cov = covariance_dict(self.raw.parameters, self.raw.covariance)
         if cov is not None:
             d["covariance"] = cov
         return d
 
     def to_dict(self) -> dict:
-        m = self.model_dict()
+        m = ballbar_model_dict(self.machine, self.raw.parameters, self.raw.model.effects)
         out = {
             "method": self.raw.method,
             "machine": m["machine"],

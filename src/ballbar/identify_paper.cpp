@@ -94,7 +94,7 @@ BallbarIdentification identify_paper(const BallbarSession& s) {
   const MachineType m = s.machine;
   if (m != MachineType::AC_trt && m != MachineType::BC_trt)
     throw InvalidArgument("identify_paper: Flynn et al.'s chain is written for the AC-trt and BC-trt "
-                          "tables; a " + to_string(m) + " machine is identified by the joint fit "
+                          "tables; the " + to_string(m) + " machine is identified by the joint fit "
                           "(identify_joint, --method joint)");
   const char T = tilt_axis_letter(m);
   const int k_tilt = m == MachineType::AC_trt ? 0 : 1;

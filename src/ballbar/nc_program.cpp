@@ -244,12 +244,22 @@ class Writer {
     } else {
       comment("kinematics: nominal");
     }
-    comment("datum: table frame, origin at the nominal intersection of the rotary axes");
+    const MachineDescription& md = s.machine.description();
+    comment("machine: " + md.name + " (" + md.configuration() + ")");
+    comment(md.has_table() ? "datum: table frame, origin as formats.md fixes it (table axes at 0)"
+                           : "datum: the machine's own zero (no table axes)");
     if (is_tcp_dialect())
       comment("coordinates: tool-cup ball centre in the table frame, under TCPM");
+    else if (md.has_head())
+      comment("coordinates: machine axes of the controlled point (the ball is " +
+              general(md.pivot_length + md.tool_length) +
+              " mm from it along the spindle) - rotacal inverse kinematics");
     else
       comment("coordinates: machine axes of the tool-cup ball centre - rotacal inverse kinematics");
-    if (o_.tool > 0)
+    if (md.has_head() && !is_tcp_dialect())
+      comment("the head's pivot_length + tool_length is in the coordinates: no tool length "
+              "compensation (G49) in this program");
+    else if (o_.tool > 0)
       comment("tool " + std::to_string(o_.tool) + ": ballbar tool cup, length to its ball centre");
     comment("every feed block turns a rotary axis by at most " + general(s.step_deg) +
             " deg: shortest-way and linear rotary axes run it alike");
@@ -269,7 +279,8 @@ class Writer {
       case NcDialect::linuxcnc:
         header();
         line("G21 G90 G94 G17 G40 G49 G80");
-        if (o_.tool > 0) line("G43 H" + std::to_string(o_.tool));
+        // A head machine's machine-axis program already holds the tool vector (formats.md).
+        if (o_.tool > 0 && !plan_.setup.machine.has_head()) line("G43 H" + std::to_string(o_.tool));
         break;
       case NcDialect::heidenhain: {
         if (o_.program_name.empty() || o_.program_name.find_first_of(" \t\n;") != std::string::npos)

@@ -222,7 +222,9 @@ MachineDescription parse_machine_description(const std::string& json_text, const
 }
 
 std::string machine_description_json(const MachineDescription& d) {
-  auto vec = [](const Eigen::Vector3d& v) { return json::array({v[0], v[1], v[2]}); };
+  auto vec = [](const Eigen::Vector3d& v) {  // + 0.0 turns -0 into 0 (a cleaner file, same value)
+    return json::array({v[0] + 0.0, v[1] + 0.0, v[2] + 0.0});
+  };
   auto axes_json = [&](const std::vector<RotaryAxis>& list) {
     json out = json::array();
     for (const RotaryAxis& a : list) {

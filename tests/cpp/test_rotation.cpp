@@ -77,3 +77,25 @@ TEST_CASE("rotate_point_about_line is the Pose form applied to a point", "[rotat
               .norm() < 1e-12);
   }
 }
+
+TEST_CASE("rotate_point_about_line_derivatives agree with Jets of rotate_point_about_line", "[rotation][jet]") {
+  using J = ceres::Jet<double, 9>;
+  std::mt19937 rng(5);
+  std::normal_distribution<double> N(0.0, 1.0);
+  for (int trial = 0; trial < 50; ++trial) {
+    const Eigen::Vector3d a(N(rng), N(rng), N(rng)), d(N(rng), N(rng), N(rng)), q(100 * N(rng), 100 * N(rng), 100 * N(rng));
+    const double theta = 3.0 * N(rng);
+    Vec3<J> aj, dj, qj;
+    for (int k = 0; k < 3; ++k) aj[k] = J(a[k], k), dj[k] = J(d[k], 3 + k), qj[k] = J(q[k], 6 + k);
+    const Vec3<J> f = rotate_point_about_line<J>(aj, dj, J(theta), qj);
+    const LineRotationDerivatives D = rotate_point_about_line_derivatives(a, d, theta, q);
+    for (int r = 0; r < 3; ++r) {
+      CHECK(std::abs(D.f[r] - f[r].a) < 1e-12 * (1 + std::abs(f[r].a)));
+      for (int k = 0; k < 3; ++k) {
+        CHECK(std::abs(D.d_point(r, k) - f[r].v[k]) < 1e-10);
+        CHECK(std::abs(D.d_direction(r, k) - f[r].v[3 + k]) < 1e-9 * (1 + q.norm()));
+        CHECK(std::abs(D.d_q(r, k) - f[r].v[6 + k]) < 1e-12);
+      }
+    }
+  }
+}

@@ -208,8 +208,6 @@ def test_custom_description_round_trip(capsys, tmp_path, custom_file):
     assert "shop-7 A-head C-table (rotary table, tilting head)" in (tmp_path / "c.html").read_text()
 
 
-@pytest.mark.xfail(strict=True, reason="src/io/model_file.cpp reads an unobservable pivot component (pivot z "
-                   "on every head machine) as 0 mm, not the nominal pivot: predict is off by the pivot height")
 def test_model_file_of_a_described_machine(capsys, tmp_path, custom_file):
     session = tmp_path / "c.csv"
     assert run(capsys, "simulate", "ballbar", "--machine", custom_file, "--seed", 5, "-o", session)[0] == 0
