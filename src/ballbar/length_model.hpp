@@ -10,14 +10,24 @@
 namespace rotacal {
 
 // r_i = L_model,i - L_i (mm). Parameters: 8 location errors, pivot (3), effect parameters.
+// Residuals always come from the one templated model (predicted_length). The Jacobian of the
+// base model (location errors, pivot, and the tool length and ballbar length offsets) is
+// analytic: the chain rule over rotate_point_about_line_derivatives along the machine's axes,
+// checked against the Jets in tests/cpp/test_ballbar_identify.cpp. Jets of one sample with
+// 12 parameters were about half of a fit's time (perf, ballbar_ac_table2.csv); any other
+// effect takes the Jets.
 class BallbarLengthModel : public ResidualModel {
  public:
   BallbarLengthModel(const BallbarArrays& d, const EffectModel& fx)
-      : d_(d), fx_(fx), P_(fx.num_params()) {}
+      : d_(d), fx_(fx), P_(fx.num_params()), analytic_(analytic_supported(fx)) {}
   Eigen::Index num_residuals() const override { return d_.size(); }
   int num_parameters() const override { return 11 + P_; }
   void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r,
                 Eigen::MatrixXd* J) const override {
+    if (J && analytic_) {
+      for (Eigen::Index i = 0; i < d_.size(); ++i) analytic_row(i, x, r[i], J->row(i));
+      return;
+    }
     evaluate_with_jets([this](Eigen::Index i, const auto* p, auto* out) { sample(i, p, out); },
                        d_.size(), 1, x, r, J);
   }
@@ -26,10 +36,83 @@ class BallbarLengthModel : public ResidualModel {
     const Eigen::Index m = (d_.size() + stride - 1) / stride;
     r.resize(m);
     if (J) J->resize(m, num_parameters());
+    if (J && analytic_) {
+      for (Eigen::Index k = 0; k < m; ++k) analytic_row(k * stride, x, r[k], J->row(k));
+      return true;
+    }
     evaluate_with_jets(
         [this, stride](Eigen::Index i, const auto* p, auto* out) { sample(i * stride, p, out); }, m, 1,
         x, r, J);
     return true;
+  }
+  /// Whether the Jacobian comes from the analytic path (tests compare it with the Jets).
+  bool analytic() const { return analytic_; }
+  /// The Jets' Jacobian, for that comparison.
+  void evaluate_jets(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r, Eigen::MatrixXd* J) const {
+    evaluate_with_jets([this](Eigen::Index i, const auto* p, auto* out) { sample(i, p, out); },
+                       d_.size(), 1, x, r, J);
+  }
+
+ private:
+  static bool analytic_supported(const EffectModel& fx) {
+    for (const Effect& f : fx.effects)
+      if (f.kind != EffectKind::tool_offset_Z && f.kind != EffectKind::ballbar_length_offset) return false;
+    return true;
+  }
+
+  // Residual and Jacobian row of sample i by the chain rule (see the class comment).
+  template <typename Row>
+  void analytic_row(Eigen::Index i, const Eigen::VectorXd& x, double& r, Row J) const {
+    const MachineType m = d_.machine;
+    const MachineDescription& md = m.description();
+    const LocationErrors<double> e(x.head<8>());
+    const RotaryAngles<double>& cmd = d_.angles[static_cast<std::size_t>(i)];
+    double tool_z = 0.0, length_offset = 0.0;
+    int tool_z_col = -1, length_col = -1;
+    for (std::size_t k = 0; k < fx_.effects.size(); ++k) {
+      const int col = 11 + fx_.offset(k);
+      if (fx_.effects[k].kind == EffectKind::tool_offset_Z) tool_z += x[col], tool_z_col = col;
+      else length_offset += x[col], length_col = col;
+    }
+    const int nt = static_cast<int>(md.table_axes.size());
+    LineRotationDerivatives D[2];
+    // Table side: the pivot through the table axes, innermost first.
+    Eigen::Vector3d P = x.segment<3>(8);
+    for (int k = nt - 1; k >= 0; --k) {
+      const AxisLine<double> L = axis_line(m, k, e);
+      D[k] = rotate_point_about_line_derivatives(L.point, L.direction, chain_angle(m, cmd, k), P);
+      P = D[k].f;
+    }
+    // Tool side: the tool vector through the head axes, innermost first.
+    Eigen::Vector3d v = tool_vector<double>(m, 0.0) + Eigen::Vector3d(0.0, 0.0, tool_z);
+    for (int k = 1; k >= nt; --k) {
+      const AxisLine<double> L = axis_line(m, k, e);
+      D[k] = rotate_point_about_line_derivatives(L.point, L.direction, chain_angle(m, cmd, k), v);
+      v = D[k].f;
+    }
+    const Eigen::Vector3d b = d_.xyz.col(i) + v;
+    const double len = (b - P).norm();
+    const Eigen::Vector3d u = (b - P) / len;
+    r = len + length_offset - d_.length[i];
+    J.setZero();
+    // dL/d(line k) = +-u^T (outer rotations) dD_k; the table side enters with a minus.
+    Eigen::RowVector3d w = -u.transpose();
+    for (int k = 0; k < nt; ++k) {
+      const RotaryAxis& a = md.axis(k);
+      J.template segment<2>(4 * k) = w * D[k].d_point * a.position_basis;
+      J.template segment<2>(4 * k + 2) = w * D[k].d_direction * a.direction_basis;
+      w = w * D[k].d_q;
+    }
+    J.template segment<3>(8) = w;  // d/dpivot
+    w = u.transpose();
+    for (int k = nt; k < 2; ++k) {
+      const RotaryAxis& a = md.axis(k);
+      J.template segment<2>(4 * k) = w * D[k].d_point * a.position_basis;
+      J.template segment<2>(4 * k + 2) = w * D[k].d_direction * a.direction_basis;
+      w = w * D[k].d_q;
+    }
+    if (tool_z_col >= 0) J[tool_z_col] = w.z();
+    if (length_col >= 0) J[length_col] = 1.0;
   }
 
  private:
@@ -47,6 +130,7 @@ class BallbarLengthModel : public ResidualModel {
   const BallbarArrays& d_;
   const EffectModel& fx_;
   int P_;
+  bool analytic_;
 };
 
 

@@ -8,6 +8,7 @@
 #include "rotacal/ballbar/identify_paper.hpp"
 #include "rotacal/ballbar/simulate.hpp"
 #include "rotacal/ballbar/test_plan.hpp"
+#include "../../src/ballbar/length_model.hpp"  // the fit's model, to compare its two Jacobians
 
 using namespace rotacal;
 
@@ -181,4 +182,33 @@ TEST_CASE("joint fit with a noise model (GLS): whitened chi2, honest sigma, reco
   JointFitOptions wrong;
   wrong.whitener = std::make_shared<Ar1>(10, phi, innov);
   CHECK_THROWS_WITH(identify_joint(s, wrong), Catch::Contains("whitener"));
+}
+
+TEST_CASE("the analytic Jacobian of the length model equals the Jets on every machine", "[identify][jacobian]") {
+  std::mt19937 rng(99);
+  std::normal_distribution<double> N(0.0, 1.0);
+  for (const std::string& name : builtin_machine_names()) {
+    INFO(name);
+    BallbarSetup setup;
+    setup.machine = parse_machine_type(name);
+    setup.tilt_range_deg = default_tilt_range_deg(setup.machine);
+    setup.step_deg = 7.0;
+    const BallbarSession s = commanded_session(plan_ballbar_test(setup));
+    const BallbarArrays a = ballbar_arrays(s);
+    EffectModel fx;
+    fx.effects = {Effect::parse("ballbar_length_offset"), Effect::parse("tool_offset_Z")};
+    const BallbarLengthModel model(a, fx);
+    REQUIRE(model.analytic());
+    Eigen::VectorXd x(13);
+    for (int k = 0; k < 8; ++k) x[k] = location_error_is_angle(k) ? 1e-3 * N(rng) : 0.5 * N(rng);
+    x.segment<3>(8) = s.pivot + Eigen::Vector3d(N(rng), N(rng), N(rng));
+    x[11] = 0.01 * N(rng);
+    x[12] = 0.3 * N(rng);
+    Eigen::VectorXd r1(a.size()), r2(a.size());
+    Eigen::MatrixXd J1(a.size(), 13), J2(a.size(), 13);
+    model.evaluate(x, r1, &J1);
+    model.evaluate_jets(x, r2, &J2);
+    CHECK((r1 - r2).cwiseAbs().maxCoeff() < 1e-12);
+    CHECK((J1 - J2).cwiseAbs().maxCoeff() < 1e-9 * (1.0 + J2.cwiseAbs().maxCoeff()));
+  }
 }
