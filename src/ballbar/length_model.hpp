@@ -99,17 +99,17 @@ class BallbarLengthModel : public ResidualModel {
     Eigen::RowVector3d w = -u.transpose();
     for (int k = 0; k < nt; ++k) {
       const RotaryAxis& a = md.axis(k);
-      J.template segment<2>(4 * k) = w * D[k].d_point * a.position_basis;
-      J.template segment<2>(4 * k + 2) = w * D[k].d_direction * a.direction_basis;
-      w = w * D[k].d_q;
+      J.template segment<2>(4 * k) = D[k].times_point(w) * a.position_basis;
+      J.template segment<2>(4 * k + 2) = D[k].times_direction(w) * a.direction_basis;
+      w = D[k].times_q(w);
     }
     J.template segment<3>(8) = w;  // d/dpivot
     w = u.transpose();
     for (int k = nt; k < 2; ++k) {
       const RotaryAxis& a = md.axis(k);
-      J.template segment<2>(4 * k) = w * D[k].d_point * a.position_basis;
-      J.template segment<2>(4 * k + 2) = w * D[k].d_direction * a.direction_basis;
-      w = w * D[k].d_q;
+      J.template segment<2>(4 * k) = D[k].times_point(w) * a.position_basis;
+      J.template segment<2>(4 * k + 2) = D[k].times_direction(w) * a.direction_basis;
+      w = D[k].times_q(w);
     }
     if (tool_z_col >= 0) J[tool_z_col] = w.z();
     if (length_col >= 0) J[length_col] = 1.0;

@@ -92,9 +92,9 @@ TEST_CASE("rotate_point_about_line_derivatives agree with Jets of rotate_point_a
     for (int r = 0; r < 3; ++r) {
       CHECK(std::abs(D.f[r] - f[r].a) < 1e-12 * (1 + std::abs(f[r].a)));
       for (int k = 0; k < 3; ++k) {
-        CHECK(std::abs(D.d_point(r, k) - f[r].v[k]) < 1e-10);
-        CHECK(std::abs(D.d_direction(r, k) - f[r].v[3 + k]) < 1e-9 * (1 + q.norm()));
-        CHECK(std::abs(D.d_q(r, k) - f[r].v[6 + k]) < 1e-12);
+        CHECK(std::abs(D.d_point()(r, k) - f[r].v[k]) < 1e-10);
+        CHECK(std::abs(D.d_direction()(r, k) - f[r].v[3 + k]) < 1e-9 * (1 + q.norm()));
+        CHECK(std::abs(D.d_q()(r, k) - f[r].v[6 + k]) < 1e-12);
       }
     }
   }

@@ -83,28 +83,50 @@ Vec3<Scalar> rotate_point_about_line(const Vec3<Scalar>& point, const Vec3<Scala
 ///   f = a + R(u, theta) (q - a),  u = d / |d|,  v = q - a
 ///   df/dq = R,  df/da = I - R,
 ///   df/dd = [-sin(theta) [v]x + (1 - cos(theta)) ((u . v) I + u v^T)] (I - u u^T) / |d|.
+/// A chain rule runs from the reading backwards, so the derivatives are applied to row vectors
+/// w (w df/dq and so on, a few cross products each); the matrices are for tests.
 struct LineRotationDerivatives {
-  Eigen::Vector3d f;
-  Eigen::Matrix3d d_q, d_point, d_direction;
+  Eigen::Vector3d f, u, v;
+  double c = 1.0, s = 0.0, inv_norm = 1.0;
+
+  /// w R, with w K = w x u for the row w and K = [u]x.
+  Eigen::RowVector3d times_q(const Eigen::RowVector3d& w) const {
+    const Eigen::Vector3d wk = w.transpose().cross(u);
+    return w + (s * wk + (1.0 - c) * wk.cross(u)).transpose();
+  }
+  Eigen::RowVector3d times_point(const Eigen::RowVector3d& w) const { return w - times_q(w); }
+  Eigen::RowVector3d times_direction(const Eigen::RowVector3d& w) const {
+    const Eigen::Vector3d wt = w.transpose();
+    const Eigen::Vector3d g = -s * wt.cross(v) + (1.0 - c) * (u.dot(v) * wt + wt.dot(u) * v);
+    return ((g - g.dot(u) * u) * inv_norm).transpose();
+  }
+  Eigen::Matrix3d d_q() const { return rows([this](const Eigen::RowVector3d& w) { return times_q(w); }); }
+  Eigen::Matrix3d d_point() const { return rows([this](const Eigen::RowVector3d& w) { return times_point(w); }); }
+  Eigen::Matrix3d d_direction() const {
+    return rows([this](const Eigen::RowVector3d& w) { return times_direction(w); });
+  }
+
+ private:
+  template <typename F>
+  static Eigen::Matrix3d rows(const F& times) {
+    Eigen::Matrix3d M;
+    for (int r = 0; r < 3; ++r) M.row(r) = times(Eigen::RowVector3d::Unit(r));
+    return M;
+  }
 };
 
 inline LineRotationDerivatives rotate_point_about_line_derivatives(const Eigen::Vector3d& point,
                                                                    const Eigen::Vector3d& direction,
                                                                    double theta, const Eigen::Vector3d& q) {
-  const double dn = direction.norm();
-  const Eigen::Vector3d u = direction / dn, v = q - point;
-  const double c = std::cos(theta), s = std::sin(theta), uv = u.dot(v);
-  Eigen::Matrix3d K;  // [u]x
-  K << 0.0, -u.z(), u.y(), u.z(), 0.0, -u.x(), -u.y(), u.x(), 0.0;
-  Eigen::Matrix3d Vx;  // [v]x
-  Vx << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  LineRotationDerivatives out;
-  out.d_q = Eigen::Matrix3d::Identity() + s * K + (1.0 - c) * (K * K);
-  out.f = point + out.d_q * v;
-  out.d_point = Eigen::Matrix3d::Identity() - out.d_q;
-  const Eigen::Matrix3d d_unit = -s * Vx + (1.0 - c) * (uv * Eigen::Matrix3d::Identity() + u * v.transpose());
-  out.d_direction = d_unit * (Eigen::Matrix3d::Identity() - u * u.transpose()) / dn;
-  return out;
+  LineRotationDerivatives D;
+  const double n = direction.norm();
+  D.inv_norm = 1.0 / n;
+  D.u = direction * D.inv_norm;
+  D.v = q - point;
+  D.c = std::cos(theta);
+  D.s = std::sin(theta);
+  D.f = point + D.v * D.c + D.u.cross(D.v) * D.s + D.u * (D.u.dot(D.v) * (1.0 - D.c));
+  return D;
 }
 
 /// Flynn et al. 2016, Eq. 1 written out component by component: rotates q = (x, y, z) about
