@@ -1,5 +1,8 @@
 // Bindings for include/rotacal/rtest: device calibration, simulation, identification, error
 // map and prediction. Thin: numpy in and out, the C++ module does the work.
+#include <pybind11/stl.h>
+#include <optional>
+
 #include "numpy.hpp"
 #include "rotacal/rtest/device.hpp"
 #include "rotacal/rtest/error_map.hpp"
@@ -49,12 +52,26 @@ void bind_rtest(pyb::module_& m) {
       .def_readonly("c_b_degree", &RtestBasis::c_b_degree, "degree in b of the C-map coefficients")
       .def_readonly("gamma_cb", &RtestBasis::gamma_cb,
                     "gamma_CB (angular positioning of C) in the C map")
-      .def("coefficient_names", &RtestBasis::coefficient_names,
-           "Names of the map coefficients, B map first, in parameter order.");
+      .def("coefficient_names",
+           [](const RtestBasis& b, std::optional<MachineType> machine) {
+             return machine ? b.coefficient_names(*machine) : b.coefficient_names();
+           },
+           pyb::arg("machine") = pyb::none(),
+           "Names of the map coefficients, tilt-axis map first, in parameter order, with the "
+           "machine's map names (rtest_map_names; BC-trt's 'BY', 'CB' when no machine is given).");
+  m.def("rtest_map_names",
+        [](MachineType machine) {
+          const auto n = rtest_map_names(machine);
+          return std::vector<std::string>(n.begin(), n.end());
+        },
+        pyb::arg("machine"),
+        "Names of a machine's two R-test error maps, [tilt axis' map, rotary axis' map], e.g. "
+        "['BY', 'CB'] on BC-trt, ['BZ', 'CY'] on B-head-C-table.");
 
   pyb::class_<RtestJointModel>(
       m, "RtestJointModel",
-      "Location errors and smooth error maps of a B/C table, with covariance.")
+      "Location errors, tool_offset_Z (machines with head axes) and smooth error maps of the tilt "
+      "and the rotary axis of any machine, with covariance.")
       .def(pyb::init([](MachineType machine, const RtestBasis& basis, const Eigen::VectorXd& params,
                         const Eigen::MatrixXd& covariance, const std::vector<bool>& observable) {
              return make_rtest_joint_model(machine, basis, params, covariance, observable);
@@ -65,7 +82,11 @@ void bind_rtest(pyb::module_& m) {
       .def_readonly("machine", &RtestJointModel::machine)
       .def_readonly("basis", &RtestJointModel::basis)
       .def_readonly("params", &RtestJointModel::params,
-                    "8 location errors, then the map coefficients (mm, rad)")
+                    "8 location errors, tool_offset_Z (machines with head axes), then the map "
+                    "coefficients (mm, rad): parameter_names() order")
+      .def("parameter_names", &RtestJointModel::parameter_names,
+           "Names of params in order: location errors, 'tool_offset_Z' on a machine with head "
+           "axes, then the map coefficients.")
       .def_readonly("covariance", &RtestJointModel::covariance)
       .def_readonly("observable", &RtestJointModel::observable)
       .def(

@@ -36,7 +36,19 @@ TEST_CASE("make_rtest_joint_model checks the parts against the basis") {
   const Eigen::MatrixXd C = Eigen::MatrixXd::Zero(n, n);
   const std::vector<bool> obs(static_cast<std::size_t>(n), true);
   CHECK_NOTHROW(make_rtest_joint_model(MachineType::BC_trt, b, p, C, obs));
-  CHECK_THROWS_AS(make_rtest_joint_model(MachineType::AC_trt, b, p, C, obs), InvalidArgument);
+  // Any machine: a table machine has the same layout; a machine with head axes adds
+  // tool_offset_Z after the location errors, so the table layout is one short there.
+  CHECK_NOTHROW(make_rtest_joint_model(MachineType::AC_trt, b, p, C, obs));
+  const MachineType head = parse_machine_type("B-head-C-table");
+  CHECK_THROWS_WITH(make_rtest_joint_model(head, b, p, C, obs), Catch::Contains("tool_offset_Z"));
+  {
+    const Eigen::VectorXd ph = Eigen::VectorXd::Zero(n + 1);
+    const Eigen::MatrixXd Ch = Eigen::MatrixXd::Zero(n + 1, n + 1);
+    const RtestJointModel mh =
+        make_rtest_joint_model(head, b, ph, Ch, std::vector<bool>(static_cast<std::size_t>(n + 1), true));
+    CHECK(mh.parameter_names()[8] == "tool_offset_Z");
+    CHECK(mh.parameter_names()[9] == "dx_BZ.b2");
+  }
   CHECK_THROWS_AS(make_rtest_joint_model(MachineType::BC_trt, b, p.head(n - 1), C, obs),
                   InvalidArgument);
   CHECK_THROWS_AS(make_rtest_joint_model(MachineType::BC_trt, b, p, C.topLeftCorner(n - 1, n), obs),
