@@ -31,7 +31,8 @@ namespace {
 template <typename F>
 void for_each_c_term(const RtestBasis& bs, double B, double C, const std::string& map, F f) {
   const double b = B / (M_PI / 2.0);
-  for (int k = 0; k < (bs.gamma_cb ? 6 : 5); ++k)
+  for (int k = 0; k < (bs.gamma_cb ? 6 : 5); ++k) {
+    if (k >= 3 && !bs.c_rotations) break;
     for (int n = 1; n <= bs.c_harmonics; ++n) {
       double bm = 1.0;
       for (int m = 0; m <= bs.c_b_degree; ++m, bm *= b)
@@ -53,6 +54,7 @@ void for_each_c_term(const RtestBasis& bs, double B, double C, const std::string
             t);
         }
     }
+  }
 }
 }  // namespace
 std::vector<AxisErrors<double>> RtestBasis::c_terms(double B, double C) const {
@@ -63,20 +65,31 @@ std::vector<AxisErrors<double>> RtestBasis::c_terms(double B, double C) const {
 std::vector<double> RtestBasis::b_terms(int k, double B) const {
   const double b = B / (M_PI / 2.0);
   std::vector<double> out;
+  if (k >= 3 && !b_rotations) return out;
   for (int p = (k < 3 ? 2 : 1); p <= b_degree; p += 2) out.push_back(std::pow(b, p));
   return out;
 }
-std::vector<std::string> RtestBasis::coefficient_names() const {
-  return coefficient_names(MachineType::BC_trt);
-}
-std::vector<std::string> RtestBasis::coefficient_names(MachineType m) const {
-  const std::array<std::string, 2> maps = rtest_map_names(m);
+namespace {
+// Names of this basis' coefficients (its own rotation flags) with the given map names.
+std::vector<std::string> basis_names(const RtestBasis& bs, const std::array<std::string, 2>& maps) {
   std::vector<std::string> out;
-  for (int k = 0; k < 6; ++k)
-    for (int p = (k < 3 ? 2 : 1); p <= b_degree; p += 2)
+  for (int k = 0; k < (bs.b_rotations ? 6 : 3); ++k)
+    for (int p = (k < 3 ? 2 : 1); p <= bs.b_degree; p += 2)
       out.push_back(std::string(kCompNames[k]) + "_" + maps[0] + ".b" + std::to_string(p));
-  for_each_c_term(*this, 0.3, 0.7, maps[1],
+  for_each_c_term(bs, 0.3, 0.7, maps[1],
                   [&](const std::string& n, const AxisErrors<double>&) { out.push_back(n); });
+  return out;
+}
+}  // namespace
+std::vector<std::string> RtestBasis::coefficient_names() const { return basis_names(*this, {"BY", "CB"}); }
+std::vector<std::string> RtestBasis::coefficient_names(MachineType m) const {
+  return basis_names(for_machine(m), rtest_map_names(m));
+}
+
+RtestBasis RtestBasis::for_machine(MachineType m) const {
+  RtestBasis out = *this;
+  out.b_rotations = !m.description().axis(m.tilt_index()).on_head;
+  out.c_rotations = !m.description().axis(m.rot_index()).on_head;
   return out;
 }
 
@@ -348,7 +361,7 @@ std::vector<std::string> rtest_setup_advice(MachineType m, const std::vector<std
 RtestJointIdentification identify_joint(const RtestSession& session,
                                         const RtestJointOptions& options) {
   const MachineType machine = session.machine;
-  const RtestBasis& basis = options.basis;
+  const RtestBasis basis = options.basis.for_machine(machine);
   if (basis.b_degree < 0 || basis.c_harmonics < 0 || basis.c_b_degree < 0)
     throw InvalidArgument("identify_joint: options.basis: degrees and harmonics must be >= 0");
   const std::vector<std::string> setups = session.setups();

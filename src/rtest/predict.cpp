@@ -9,10 +9,11 @@
 
 namespace rotacal {
 
-RtestJointModel make_rtest_joint_model(MachineType machine, const RtestBasis& basis,
+RtestJointModel make_rtest_joint_model(MachineType machine, const RtestBasis& basis_in,
                                        const Eigen::VectorXd& params,
                                        const Eigen::MatrixXd& covariance,
                                        const std::vector<bool>& observable) {
+  const RtestBasis basis = basis_in.for_machine(machine);  // head axes' maps have no rotations
   if (basis.b_degree < 0 || basis.c_harmonics < 0 || basis.c_b_degree < 0)
     throw InvalidArgument("R-test joint model: basis: degrees and harmonics must be >= 0");
   const int nl = rtest_num_location_parameters(machine);

@@ -68,11 +68,19 @@ struct RtestBasis {
   /// assumes: two nests see 5 of the table's 6 degrees of freedom per pose, and gamma_CB's first
   /// harmonic is then confounded with the C axis' orientation (needs 3 nests).
   bool gamma_cb = false;
+  /// Rotations (alpha, beta, gamma) in the tilt map and in the rotary map. Not options: set from
+  /// the machine by for_machine (false for an axis on the head: the sphere is one point, so a
+  /// head map's rotations only move it, which the map's translations already carry).
+  bool b_rotations = true;
+  bool c_rotations = true;
 
+  /// This basis with b_rotations / c_rotations set for machine m (head axes: no rotations).
+  RtestBasis for_machine(MachineType m) const;
   int num_b_coefficients() const;
   int num_c_coefficients() const;
   /// Names "dz_BY.b2", "dx_CB.cos1.b0", ... in coefficient order (tilt map first), with the
-  /// machine's map names (rtest_map_names; BC-trt's without a machine).
+  /// machine's map names (rtest_map_names) and its for_machine basis; without a machine,
+  /// BC-trt's names of this basis.
   std::vector<std::string> coefficient_names() const;
   std::vector<std::string> coefficient_names(MachineType m) const;
   /// Basis values of w_BY component k (0..5) at B (rad): coefficients of that component.
