@@ -316,6 +316,12 @@ class RtestJointResiduals : public ResidualModel {
   Eigen::MatrixXd Lb_, Lc_;
 };
 
+// True when the tilt axis carries the rotary axis on the same side of the chain.
+bool m_tilt_carries_rot(MachineType m) {
+  const MachineDescription& d = m.description();
+  return d.axis(0).on_head == d.axis(1).on_head && m.tilt_index() == 0;
+}
+
 // Which set-up change would show what this session cannot (the unobservable combinations in
 // words, core/least_squares.hpp), in the spirit of the ballbar's advice.
 std::vector<std::string> rtest_setup_advice(MachineType m, const std::vector<std::string>& unobservable) {
@@ -483,14 +489,21 @@ RtestJointIdentification identify_joint(const RtestSession& session,
   const std::array<std::string, 2> maps = rtest_map_names(machine);
   const std::string tl(1, tilt_axis_letter(machine)), rl(1, rot_axis_letter(machine));
   out.notes.push_back(
-      tl + " map (" + maps[0] + "): even powers of " + tl + " for translations, odd for rotations (separates it from the " +
-      tl + " axis' location errors); " + rl + " map (" + maps[1] + "): harmonics 1.." + std::to_string(basis.c_harmonics) +
-      " of " + rl + ", polynomial of degree " + std::to_string(basis.c_b_degree) + " in " + tl);
-  if (!basis.gamma_cb)
+      tl + " map (" + maps[0] + "): " +
+      (basis.b_rotations ? "even powers of " + tl + " for translations, odd for rotations (separates it from the " +
+                               tl + " axis' location errors)"
+                         : "even powers of " + tl + " for translations only (a head axis: the sphere is one point)") +
+      "; " + rl + " map (" + maps[1] + "): harmonics 1.." + std::to_string(basis.c_harmonics) + " of " + rl +
+      (basis.c_rotations ? "" : ", translations only (a head axis)") + ", polynomial of degree " +
+      std::to_string(basis.c_b_degree) + " in " + tl);
+  if (!basis.gamma_cb && basis.c_rotations)
     out.notes.push_back("gamma_" + maps[1] + " not fitted (assumed zero, as Oyama Sec. 4.2)");
+  // A constant offset of the tilt axis turns the rotary axis it carries: a tilt of that axis.
+  const bool tilt_carries_rot = m_tilt_carries_rot(machine);
   out.notes.push_back("rotary zero offsets E_" + tl + "0" + tl + ", E_" + rl + "0" + rl +
                       " are not in the model: an R-test with the probe zero unknown cannot see a constant " +
-                      rl + " offset; E_" + tl + "0" + tl + " acts as a tilt of the " + rl + " axis");
+                      rl + " offset" +
+                      (tilt_carries_rot ? "; E_" + tl + "0" + tl + " acts as a tilt of the " + rl + " axis" : ""));
   if (machine.has_head())
     out.notes.push_back("tool_offset_Z: minus the error of pivot_length + tool_length, along the spindle");
   if (!out.converged) out.notes.push_back("the fit did not converge: " + fit.summary.message);
