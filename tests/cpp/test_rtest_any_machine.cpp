@@ -8,9 +8,11 @@
 #include <random>
 
 #include "rotacal/core/noise_model.hpp"
+#include "rotacal/diagnose/rtest_diagnosis.hpp"
 #include "rotacal/rtest/error_map.hpp"
 #include "rotacal/rtest/identify_joint.hpp"
 #include "rotacal/rtest/identify_paper.hpp"
+#include "rotacal/rtest/monte_carlo.hpp"
 #include "rotacal/rtest/predict.hpp"
 #include "rotacal/rtest/simulate.hpp"
 
@@ -193,4 +195,76 @@ TEST_CASE("error maps and predictions carry each machine's axis names", "[rtest]
     return id.model.reading(q, B, C);
   });
   CHECK(rms < 0.45);  // noise 0.3 um per component
+}
+
+TEST_CASE("R-test diagnosis on any machine: null data gives no finding, a bearing track is found",
+          "[rtest][any_machine][diagnose]") {
+  std::mt19937 rng(77);
+  std::normal_distribution<double> N(0.0, 1.0);
+  for (const MachineType m : {parse_machine_type("B-head-C-table"), parse_machine_type("AC-head"),
+                              parse_machine_type("B45C-trt"),
+                              MachineType::from_description(parse_machine_description(kCustom, "custom"))}) {
+    INFO(to_string(m));
+    MachineModel truth = MachineModel::nominal(m);
+    for (int i = 0; i < 8; ++i) truth.errors.v[i] = location_error_is_angle(i) ? 5e-5 * N(rng) : 0.03 * N(rng);
+    if (m.has_head()) {  // in the baseline on a head: not a finding
+      truth.effects.effects.push_back(Effect::parse("tool_offset_Z"));
+      truth.effect_params.push_back(0.015);
+    }
+    RtestSimOptions o;
+    o.pattern = default_rtest_pattern(m);
+    o.seed = 5;
+    RtestSession s = simulate_rtest(truth, o).session;
+    DiagnosisOptions d;
+    d.max_harmonic = 3;
+    const Diagnosis null = diagnose_rtest(s, d);
+    CHECK(null.findings.empty());
+    for (const auto& round : null.rounds)
+      for (const CandidateScore& c : round) CHECK((!m.has_head() || c.effect != "tool_offset_Z"));
+    // A 2-lobe track of the rotary axis' bearing, 2 um: found first, its size within 3 sigma.
+    truth.effects.effects.push_back(Effect::parse("radial_motion_C_h2"));
+    for (double v : {2e-3, 0.0, 0.0, 1e-3}) truth.effect_params.push_back(v);
+    o.seed = 6;
+    s = simulate_rtest(truth, o).session;
+    const Diagnosis D = diagnose_rtest(s, d);
+    REQUIRE_FALSE(D.findings.empty());
+    CHECK(D.findings[0].effect.id() == "radial_motion_C_h2");
+    const std::size_t off = truth.effect_params.size() - 4;
+    for (std::size_t k = 0; k < 4; ++k) {
+      const ParameterEstimate& p = D.findings[0].parameters[k];
+      INFO(p.name << " " << p.value << " +- " << p.std);
+      if (p.observable) CHECK(std::abs(p.value - truth.effect_params[off + k]) <= 3 * p.std);
+    }
+  }
+}
+
+TEST_CASE("R-test Monte Carlo on a head machine re-simulates the fitted noise", "[rtest][any_machine][mc]") {
+  const MachineType m = parse_machine_type("B-head-C-table");
+  MachineModel truth = MachineModel::nominal(m);
+  truth.errors.v << 0.01, -0.02, 3e-5, 1e-5, 0.015, -0.01, -2e-5, 1e-5;
+  truth.effects.effects.push_back(Effect::parse("tool_offset_Z"));
+  truth.effect_params.push_back(0.015);
+  RtestSimOptions o;
+  o.pattern = default_rtest_pattern(m);
+  o.noise_um = 0.0;
+  RtestSession s = simulate_rtest(truth, o).session;
+  add_coloured_noise(s, 41);
+  RtestJointOptions jo;
+  jo.noise = NoiseHandling::automatic;
+  const RtestJointIdentification id = identify_joint(s, jo);
+  REQUIRE(id.noise_refit);
+  RtestMonteCarloOptions mo;
+  mo.draws = 40;
+  const RtestMonteCarlo mc = monte_carlo(s, id, mo);
+  int checked = 0;
+  for (const MonteCarloParameter& p : mc.parameters) {
+    if (p.name.rfind("E_", 0) != 0 && p.name != "tool_offset_Z") continue;
+    // 40 draws: the sample sd within +-35 % of the reported one at 3 sigma.
+    const double r = p.ratio * std::sqrt(id.noise_correction);
+    INFO(p.name << " ratio " << p.ratio);
+    CHECK(r > 0.65);
+    CHECK(r < 1.35);
+    ++checked;
+  }
+  CHECK(checked >= 6);  // the observable location errors (tool_offset_Z goes with E_Z0B)
 }
