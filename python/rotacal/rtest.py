@@ -342,6 +342,7 @@ def calibrate_sphere_offset(dirs: np.ndarray, spindle_deg: Sequence[float], read
 
 
 def compensate_sphere_offset(session: _core.RtestSession, offset: Sequence[float]) -> _core.RtestSession:
-    """The session with a sphere offset (x, y, mm, machine frame) taken out of every dx,dy,dz."""
+    """The session with a sphere offset (x, y, mm, spindle frame: it turns with a head) taken out
+    of every dx,dy,dz, on any machine."""
     s, _ = with_displacements(session)
     return _core.compensate_sphere_offset(s, np.asarray(offset, dtype=float))
