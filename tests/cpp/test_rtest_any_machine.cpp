@@ -268,3 +268,43 @@ TEST_CASE("R-test Monte Carlo on a head machine re-simulates the fitted noise", 
   }
   CHECK(checked >= 6);  // the observable location errors (tool_offset_Z goes with E_Z0B)
 }
+
+TEST_CASE("the joint reading passes Jets: derivatives match central differences on every machine",
+          "[rtest][any_machine]") {
+  using Jet = ceres::Jet<double, 21>;
+  std::mt19937 rng(3);
+  std::normal_distribution<double> N(0.0, 1.0);
+  for (const MachineType m : machines()) {
+    INFO(to_string(m));
+    Eigen::Matrix<double, 21, 1> x;  // e (8), w_BY (6), w_CB (6), tool_offset_Z
+    for (int k = 0; k < 21; ++k) x[k] = (k < 8 ? (location_error_is_angle(k) ? 1e-4 : 0.05) : k < 20 ? 1e-3 : 0.02) * N(rng);
+    const RotaryAngles<double> a{0.7, -2.1};
+    const Eigen::Vector3d q(80, -30, 50);
+    const Eigen::Vector3d xyz = rtest_commanded_xyz(m, q, a);
+    auto eval = [&](const auto& v) {
+      using T = typename std::decay_t<decltype(v)>::Scalar;
+      LocationErrors<T> e;
+      AxisErrors<T> wb, wc;
+      for (int k = 0; k < 8; ++k) e.v[k] = v[k];
+      for (int k = 0; k < 6; ++k) wb[k] = v[8 + k], wc[k] = v[14 + k];
+      return rtest_joint_reading<T>(m, e, wb, wc, v[20], a, xyz, q);
+    };
+    Eigen::Matrix<Jet, 21, 1> xj;
+    for (int k = 0; k < 21; ++k) xj[k] = Jet(x[k], k);
+    const Vec3<Jet> dj = eval(xj);
+    for (int k = 0; k < 21; ++k) {
+      Eigen::Matrix<double, 21, 1> xp = x, xm = x;
+      const double h = 1e-6;
+      xp[k] += h, xm[k] -= h;
+      const Eigen::Vector3d fd = (eval(xp) - eval(xm)) / (2 * h);
+      for (int r = 0; r < 3; ++r) {
+        INFO("parameter " << k << " component " << r);
+        CHECK(dj[r].v[k] == Approx(fd[r]).margin(1e-6 * std::max(1.0, std::abs(fd[r]))));
+      }
+    }
+    // Without head axes tool_offset_Z changes nothing; with them it moves the sphere along the spindle.
+    double dtz = 0.0;
+    for (int r = 0; r < 3; ++r) dtz += dj[r].v[20] * dj[r].v[20];
+    CHECK((m.has_head() ? std::abs(std::sqrt(dtz) - 1.0) < 1e-9 : dtz == 0.0));
+  }
+}
