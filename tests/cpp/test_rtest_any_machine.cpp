@@ -308,3 +308,20 @@ TEST_CASE("the joint reading passes Jets: derivatives match central differences 
     CHECK((m.has_head() ? std::abs(std::sqrt(dtz) - 1.0) < 1e-9 : dtz == 0.0));
   }
 }
+
+TEST_CASE("one nest cannot show a table axis' tilt: named with the second-nest advice", "[rtest][any_machine]") {
+  for (const MachineType m : {MachineType::BC_trt, parse_machine_type("B-head-C-table")}) {
+    INFO(to_string(m));
+    RtestSimOptions o;
+    o.pattern = default_rtest_pattern(m);
+    o.pattern.nests = {Eigen::Vector3d(100, 0, 60)};
+    const RtestJointIdentification id = identify_joint(simulate_rtest(MachineModel::nominal(m), o).session);
+    bool c_tilt = false;
+    for (const std::string& u : id.unobservable) c_tilt |= u.find("E_A0C") != std::string::npos;
+    CHECK(c_tilt);
+    CHECK(!id.parameter("E_A0C").observable);
+    bool advised = false;
+    for (const std::string& n : id.notes) advised |= n.find("a nest at a second height") != std::string::npos;
+    CHECK(advised);
+  }
+}
