@@ -41,7 +41,8 @@ void for_each_c_term(const RtestBasis& bs, double B, double C, const std::string
           const bool pair = k == 0 || k == 1 || k == 3 || k == 4;
           if (pair && n == 1 && m == 0) {
             if (k == 1 || k == 4) continue;  // carried by the pair's first component
-            const double c = std::cos(C), s = std::sin(C);
+            // Backward relative to the axis' own turning: about -Z that is +C in X, Y.
+            const double c = std::cos(C), s = bs.c_reversed ? -std::sin(C) : std::sin(C);
             t[k] = cs == 0 ? c : s;
             t[k + 1] = cs == 0 ? -s : c;
             f(std::string(k == 0 ? "dxy" : "alphabeta") + "_" + map + ".back1." + (cs == 0 ? "u" : "v") + ".b0",
@@ -90,6 +91,7 @@ RtestBasis RtestBasis::for_machine(MachineType m) const {
   RtestBasis out = *this;
   out.b_rotations = !m.description().axis(m.tilt_index()).on_head;
   out.c_rotations = !m.description().axis(m.rot_index()).on_head;
+  out.c_reversed = m.description().axis(m.rot_index()).direction.z() < 0.0;
   return out;
 }
 

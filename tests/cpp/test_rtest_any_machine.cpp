@@ -29,10 +29,16 @@ const char* kCustom = R"({"format": "rotacal-machine/1", "name": "A-head-C-table
   "head_axes": [{"name": "A", "direction": [1, 0, 0], "point": [0, 0, 40], "limits_deg": [-100, 100]}],
   "pivot_length": 120, "tool_length": 60})";
 
+// A table-table machine whose C turns clockwise seen from +Z (described with n = -Z).
+const char* kReversedC = R"({"format": "rotacal-machine/1", "name": "AC-trt reversed C",
+  "table_axes": [{"name": "A", "direction": [1, 0, 0], "limits_deg": [-100, 100]},
+                 {"name": "C", "direction": [0, 0, -1]}]})";
+
 std::vector<MachineType> machines() {
   std::vector<MachineType> out;
   for (const std::string& n : builtin_machine_names()) out.push_back(parse_machine_type(n));
   out.push_back(MachineType::from_description(parse_machine_description(kCustom, "custom")));
+  out.push_back(MachineType::from_description(parse_machine_description(kReversedC, "reversed C")));
   return out;
 }
 

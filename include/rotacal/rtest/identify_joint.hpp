@@ -73,8 +73,12 @@ struct RtestBasis {
   /// head map's rotations only move it, which the map's translations already carry).
   bool b_rotations = true;
   bool c_rotations = true;
+  /// The rotary axis points along -Z (it turns clockwise seen from +Z): its first harmonic's
+  /// backward-turning pair turns the other way in X, Y. Set by for_machine.
+  bool c_reversed = false;
 
-  /// This basis with b_rotations / c_rotations set for machine m (head axes: no rotations).
+  /// This basis with b_rotations / c_rotations / c_reversed set for machine m (head axes: no
+  /// rotations).
   RtestBasis for_machine(MachineType m) const;
   int num_b_coefficients() const;
   int num_c_coefficients() const;
