@@ -1,5 +1,8 @@
 // Bindings for include/rotacal/rtest: device calibration, simulation, identification, error
 // map and prediction. Thin: numpy in and out, the C++ module does the work.
+#include <pybind11/stl.h>
+#include <optional>
+
 #include "numpy.hpp"
 #include "rotacal/rtest/device.hpp"
 #include "rotacal/rtest/error_map.hpp"
@@ -49,12 +52,32 @@ void bind_rtest(pyb::module_& m) {
       .def_readonly("c_b_degree", &RtestBasis::c_b_degree, "degree in b of the C-map coefficients")
       .def_readonly("gamma_cb", &RtestBasis::gamma_cb,
                     "gamma_CB (angular positioning of C) in the C map")
-      .def("coefficient_names", &RtestBasis::coefficient_names,
-           "Names of the map coefficients, B map first, in parameter order.");
+      .def_readonly("b_rotations", &RtestBasis::b_rotations,
+                    "rotations in the tilt map (false for a head axis: for_machine)")
+      .def_readonly("c_rotations", &RtestBasis::c_rotations,
+                    "rotations in the rotary map (false for a head axis: for_machine)")
+      .def("for_machine", &RtestBasis::for_machine, pyb::arg("machine"),
+           "This basis with the rotations of head axes' maps left out (the sphere is one point).")
+      .def("coefficient_names",
+           [](const RtestBasis& b, std::optional<MachineType> machine) {
+             return machine ? b.coefficient_names(*machine) : b.coefficient_names();
+           },
+           pyb::arg("machine") = pyb::none(),
+           "Names of the map coefficients, tilt-axis map first, in parameter order, with the "
+           "machine's map names (rtest_map_names; BC-trt's 'BY', 'CB' when no machine is given).");
+  m.def("rtest_map_names",
+        [](MachineType machine) {
+          const auto n = rtest_map_names(machine);
+          return std::vector<std::string>(n.begin(), n.end());
+        },
+        pyb::arg("machine"),
+        "Names of a machine's two R-test error maps, [tilt axis' map, rotary axis' map], e.g. "
+        "['BY', 'CB'] on BC-trt, ['BZ', 'CY'] on B-head-C-table.");
 
   pyb::class_<RtestJointModel>(
       m, "RtestJointModel",
-      "Location errors and smooth error maps of a B/C table, with covariance.")
+      "Location errors, tool_offset_Z (machines with head axes) and smooth error maps of the tilt "
+      "and the rotary axis of any machine, with covariance.")
       .def(pyb::init([](MachineType machine, const RtestBasis& basis, const Eigen::VectorXd& params,
                         const Eigen::MatrixXd& covariance, const std::vector<bool>& observable) {
              return make_rtest_joint_model(machine, basis, params, covariance, observable);
@@ -65,7 +88,11 @@ void bind_rtest(pyb::module_& m) {
       .def_readonly("machine", &RtestJointModel::machine)
       .def_readonly("basis", &RtestJointModel::basis)
       .def_readonly("params", &RtestJointModel::params,
-                    "8 location errors, then the map coefficients (mm, rad)")
+                    "8 location errors, tool_offset_Z (machines with head axes), then the map "
+                    "coefficients (mm, rad): parameter_names() order")
+      .def("parameter_names", &RtestJointModel::parameter_names,
+           "Names of params in order: location errors, 'tool_offset_Z' on a machine with head "
+           "axes, then the map coefficients.")
       .def_readonly("covariance", &RtestJointModel::covariance)
       .def_readonly("observable", &RtestJointModel::observable)
       .def(
@@ -93,6 +120,19 @@ void bind_rtest(pyb::module_& m) {
           pyb::arg("q"), pyb::arg("angles"),
           "Error T q - T_nominal q (N, 3) of the table point q (mm) at angles (N, 2) in rad, "
           "machine frame, mm, and its 1-sigma.")
+      .def(
+          "tool_errors",
+          [](const RtestJointModel& mo, const Array& xyz, const Array& angles) {
+            const auto p = rows_of<3>(xyz, "xyz");
+            const auto a = rows_of<2>(angles, "angles");
+            if (p.rows() != a.rows()) throw InvalidArgument("tool_errors: xyz and angles need the same rows");
+            return evaluate_rows<3>(a.rows(), [&](Eigen::Index i, Eigen::Vector3d& sd) {
+              return mo.tool_error(p.row(i).transpose(), a(i, 0), a(i, 1), &sd);
+            });
+          },
+          pyb::arg("xyz"), pyb::arg("angles"),
+          "Error of the sphere (N, 3), actual - nominal, machine frame, mm, for commanded xyz (N, 3) "
+          "at angles (N, 2) = (tilt, rotary) in rad, and its 1-sigma; zero without head axes.")
       .def(
           "w_by",
           [](const RtestJointModel& mo, const Eigen::VectorXd& B) {
@@ -229,6 +269,23 @@ void bind_rtest(pyb::module_& m) {
           [](RtestPattern& p, const Array& a) { p.nests = vectors_of(a, "nests"); },
           "(K, 3) nominal ball centres, table frame, mm")
       .def_readwrite("dwell_s", &RtestPattern::dwell_s, "time between poses, s");
+  m.def("default_rtest_pattern", &default_rtest_pattern, pyb::arg("machine"),
+        "The paper's pattern fitted to a machine: tilt angles inside its limits (-90..90 every 30 "
+        "deg where they allow), the rotary axis every 30 deg, the two paper nests halved until "
+        "every commanded X, Y, Z is inside the travel (rtest/simulate.hpp).");
+  m.def("check_rtest_pattern",
+        [](MachineType machine, const std::vector<double>& b_deg, const std::vector<double>& c_deg,
+           const Array& nests) {
+          RtestPattern p;
+          p.b_deg = b_deg;
+          p.c_deg = c_deg;
+          p.nests = vectors_of(nests, "nests");
+          check_rtest_pattern(machine, p, "R-test pattern");
+        },
+        pyb::arg("machine"), pyb::arg("b_deg"), pyb::arg("c_deg"), pyb::arg("nests"),
+        "Raise InvalidArgument naming the axis and its limits (or the travel) when a tilt (b_deg) "
+        "or rotary (c_deg) angle, deg, or a commanded X, Y, Z of a nest (K, 3) is outside the "
+        "machine's limits.");
   pyb::class_<RtestSimOptions>(m, "RtestSimOptions", "Options of simulate_rtest (defaults).")
       .def(pyb::init<>())
       .def_readwrite("pattern", &RtestSimOptions::pattern)
@@ -269,10 +326,10 @@ void bind_rtest(pyb::module_& m) {
 
 Parameters
 ----------
-machine : MachineType (BC_trt)
+machine : MachineType (any; the pattern must fit its limits: default_rtest_pattern)
 errors : (8,) location errors (mm, rad)
 effects, effect_params : catalogue ids and their parameters back to back
-b_deg, c_deg : the grid, B outer and C inner (deg)
+b_deg, c_deg : the grid, tilt axis outer and rotary axis inner (deg)
 nests : (K, 3) nominal ball centres, table frame (mm)
 dwell_s : time between readings (s)
 noise_um, probe_zero_um : 1-sigma reading noise and per-set-up probe zero (um)

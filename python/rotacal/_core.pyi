@@ -6,7 +6,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Ambiguity', 'AngleTable', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CompensationReport', 'CompensationRow', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestDesign', 'RtestDesignCandidate', 'RtestDesignOptions', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSeparatingCandidate', 'RtestSeparationDesign', 'RtestSeparationOptions', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SeparatingCandidate', 'SeparationDesign', 'SeparationOptions', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TableMotionOverlap', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'ballbar_model_document', 'ballbar_model_from_document', 'builtin_machine_names', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_model_machine', 'check_output', 'check_plausible', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_axial_c_tilt_deg', 'default_ballbar_tests', 'default_calibration_moves', 'default_tilt_range_deg', 'design_ballbar_separation', 'design_ballbar_test', 'design_rtest_separation', 'design_rtest_test', 'diagnose_ballbar', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'evaluate_rtest_design', 'export_controller', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_joint_sessions', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_rtest', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'table_motion_overlap', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
+__all__: list[str] = ['Ambiguity', 'AngleTable', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CompensationReport', 'CompensationRow', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestDesign', 'RtestDesignCandidate', 'RtestDesignOptions', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSeparatingCandidate', 'RtestSeparationDesign', 'RtestSeparationOptions', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SeparatingCandidate', 'SeparationDesign', 'SeparationOptions', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TableMotionOverlap', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'ballbar_model_document', 'ballbar_model_from_document', 'builtin_machine_names', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_model_machine', 'check_output', 'check_plausible', 'check_rtest_pattern', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_axial_c_tilt_deg', 'default_ballbar_tests', 'default_calibration_moves', 'default_rtest_pattern', 'default_tilt_range_deg', 'design_ballbar_separation', 'design_ballbar_test', 'design_rtest_separation', 'design_rtest_test', 'diagnose_ballbar', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'evaluate_rtest_design', 'export_controller', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_joint_sessions', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_rtest', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_map_names', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'table_motion_overlap', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
 class Ambiguity:
     @property
     def correlation(self) -> float:
@@ -1607,14 +1607,23 @@ class RtestBasis:
     """
     def __init__(self, b_degree: typing.SupportsInt | typing.SupportsIndex = 6, c_harmonics: typing.SupportsInt | typing.SupportsIndex = 2, c_b_degree: typing.SupportsInt | typing.SupportsIndex = 1, gamma_cb: bool = False) -> None:
         ...
-    def coefficient_names(self) -> list[str]:
+    def coefficient_names(self, machine: rotacal._core.MachineType | None = None) -> list[str]:
         """
-        Names of the map coefficients, B map first, in parameter order.
+        Names of the map coefficients, tilt-axis map first, in parameter order, with the machine's map names (rtest_map_names; BC-trt's 'BY', 'CB' when no machine is given).
+        """
+    def for_machine(self, machine: MachineType) -> RtestBasis:
+        """
+        This basis with the rotations of head axes' maps left out (the sphere is one point).
         """
     @property
     def b_degree(self) -> int:
         """
         highest power of b = B / 90 deg in the B map
+        """
+    @property
+    def b_rotations(self) -> bool:
+        """
+        rotations in the tilt map (false for a head axis: for_machine)
         """
     @property
     def c_b_degree(self) -> int:
@@ -1625,6 +1634,11 @@ class RtestBasis:
     def c_harmonics(self) -> int:
         """
         harmonics 1..K of C in the C map
+        """
+    @property
+    def c_rotations(self) -> bool:
+        """
+        rotations in the rotary map (false for a head axis: for_machine)
         """
     @property
     def gamma_cb(self) -> bool:
@@ -1819,11 +1833,15 @@ class RtestJointIdentification:
         ...
 class RtestJointModel:
     """
-    Location errors and smooth error maps of a B/C table, with covariance.
+    Location errors, tool_offset_Z (machines with head axes) and smooth error maps of the tilt and the rotary axis of any machine, with covariance.
     """
     def __init__(self, machine: MachineType, basis: RtestBasis, params: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], covariance: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"], observable: collections.abc.Sequence[bool]) -> None:
         """
         Rebuild a model from its parts (checked against the basis: rtest/predict.hpp).
+        """
+    def parameter_names(self) -> list[str]:
+        """
+        Names of params in order: location errors, 'tool_offset_Z' on a machine with head axes, then the map coefficients.
         """
     def readings(self, q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], angles: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]]:
         """
@@ -1832,6 +1850,10 @@ class RtestJointModel:
     def table_errors(self, q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], angles: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]]:
         """
         Error T q - T_nominal q (N, 3) of the table point q (mm) at angles (N, 2) in rad, machine frame, mm, and its 1-sigma.
+        """
+    def tool_errors(self, xyz: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], angles: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]]:
+        """
+        Error of the sphere (N, 3), actual - nominal, machine frame, mm, for commanded xyz (N, 3) at angles (N, 2) = (tilt, rotary) in rad, and its 1-sigma; zero without head axes.
         """
     def w_by(self, B: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 6]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 6]"]]:
         """
@@ -1856,7 +1878,7 @@ class RtestJointModel:
     @property
     def params(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
-        8 location errors, then the map coefficients (mm, rad)
+        8 location errors, tool_offset_Z (machines with head axes), then the map coefficients (mm, rad): parameter_names() order
         """
 class RtestMonteCarlo:
     @property
@@ -2566,6 +2588,10 @@ def check_plausible(session: BallbarSession, source: str, options: PlausibilityO
 @typing.overload
 def check_plausible(session: RtestSession, source: str, options: PlausibilityOptions = ...) -> PlausibilityReport:
     ...
+def check_rtest_pattern(machine: MachineType, b_deg: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], c_deg: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], nests: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> None:
+    """
+    Raise InvalidArgument naming the axis and its limits (or the travel) when a tilt (b_deg) or rotary (c_deg) angle, deg, or a commanded X, Y, Z of a nest (K, 3) is outside the machine's limits.
+    """
 def compensate_commands(nominal: BallbarSession, identified: ..., machine: MachineType, tool_length_error: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> BallbarSession:
     """
     Compensated commands; tool_length_error (mm): the error of pivot_length + tool_length of a head machine (minus the identified tool_offset_Z).
@@ -2587,6 +2613,10 @@ def default_ballbar_tests() -> list[BallbarTest]:
 def default_calibration_moves(step_mm: typing.SupportsFloat | typing.SupportsIndex = 0.5) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
     """
     +-step along X, Y, Z and the 4 body diagonals (14, 3), mm.
+    """
+def default_rtest_pattern(machine: MachineType) -> RtestPattern:
+    """
+    The paper's pattern fitted to a machine: tilt angles inside its limits (-90..90 every 30 deg where they allow), the rotary axis every 30 deg, the two paper nests halved until every commanded X, Y, Z is inside the travel (rtest/simulate.hpp).
     """
 def default_tilt_range_deg(machine: MachineType) -> typing.Annotated[list[float], "FixedSize(2)"]:
     ...
@@ -2807,6 +2837,10 @@ def rtest_error_map(identification: RtestPaperIdentification, format: str = 'jso
     """
     The paper method's error map at its measured grid, as JSON or CSV text.
     """
+def rtest_map_names(machine: MachineType) -> list[str]:
+    """
+    Names of a machine's two R-test error maps, [tilt axis' map, rotary axis' map], e.g. ['BY', 'CB'] on BC-trt, ['BZ', 'CY'] on B-head-C-table.
+    """
 def rtest_prediction_rms_um(model: RtestJointModel, session: RtestSession) -> float:
     """
     RMS (um) of measured - predicted readings after one constant offset per set-up.
@@ -2829,10 +2863,10 @@ def simulate_rtest(machine: MachineType, errors: typing.Annotated[numpy.typing.A
     
     Parameters
     ----------
-    machine : MachineType (BC_trt)
+    machine : MachineType (any; the pattern must fit its limits: default_rtest_pattern)
     errors : (8,) location errors (mm, rad)
     effects, effect_params : catalogue ids and their parameters back to back
-    b_deg, c_deg : the grid, B outer and C inner (deg)
+    b_deg, c_deg : the grid, tilt axis outer and rotary axis inner (deg)
     nests : (K, 3) nominal ball centres, table frame (mm)
     dwell_s : time between readings (s)
     noise_um, probe_zero_um : 1-sigma reading noise and per-set-up probe zero (um)

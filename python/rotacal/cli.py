@@ -297,14 +297,24 @@ def cmd_simulate_rtest(a: argparse.Namespace) -> int:
     b_deg, c_deg, nests, dirs = r["b_deg"], r["c_deg"], r["nests"], r["probe_dirs"]
     if dirs is None and a.raw_only:
         raise OptionError("--raw-only needs the probe directions (--probe-dir x3)")
+    # Any machine: a grid or nests left at the paper's defaults become the machine's own default
+    # (inside its rotary limits and travel: rtest.default_pattern); given ones are checked.
+    mtype = _core.parse_machine_type(a.machine)
+    default = rtest.default_pattern(mtype)
+    if list(a.tilt_range) == [-90.0, 90.0] and a.b_step == 30.0:
+        b_deg = default["b_deg"]
+    if list(a.c_range) == [0.0, 360.0] and a.c_step == 30.0:
+        c_deg = default["c_deg"]
+    if not a.nest:
+        nests = default["nests"]
     session, truth = rtest.simulate_rtest(r["errors"], r["effects"], machine=a.machine, b_deg=b_deg, c_deg=c_deg,
                                           nests=nests, noise_um=a.noise, probe_zero_um=a.probe_zero,
                                           probe_dirs=dirs, write_d=not a.raw_only, dwell_s=a.dwell,
                                           seed=a.seed)
     save(session, a.output, other_outputs=[truth_path])
     rtest.save_truth(truth, truth_path, other_outputs=[a.output])
-    _say(f"wrote {a.output}: {len(session)} poses ({len(b_deg)} B x {len(c_deg)} C x {len(nests)} nests) "
-         f"on a simulated {a.machine}, truth in {truth_path}")
+    _say(f"wrote {a.output}: {len(session)} poses ({len(b_deg)} {mtype.tilt_axis} x {len(c_deg)} "
+         f"{mtype.rot_axis} x {len(nests)} nests) on a simulated {_core.machine_name(mtype)}, truth in {truth_path}")
     return EXIT_OK
 
 

@@ -1,6 +1,8 @@
 """R-test (Oyama & Ibaraki): simulation, probe calibration, identification of the location
-errors and error map of a B/C table, model files and prediction, on numpy-backed
-RtestSession objects. Angles are in degrees here (as in the files); the C++ core takes radians.
+errors and error maps of the two rotary axes of any machine (table-table, head-table,
+head-head; "B" and "C" name the tilt and the rotary axis), model files and prediction, on
+numpy-backed RtestSession objects. Angles are in degrees here (as in the files); the C++ core
+takes radians.
 """
 from __future__ import annotations
 
@@ -41,11 +43,15 @@ class RtestIdentification:
     notes: list = field(default_factory=list)
     budget: Any = None  # _core.UncertaintyBudget, attached by the CLI / uncertainty_budget
 
-    def error_map(self, fmt: str = "json", b_deg: Sequence[float] = B_GRID,
-                  c_deg: Sequence[float] = C_GRID) -> str:
-        """The error map as JSON or CSV text: on the grid (deg) for the joint model, at the
-        measured grid for the paper's method."""
+    def error_map(self, fmt: str = "json", b_deg: Sequence[float] | None = None,
+                  c_deg: Sequence[float] | None = None) -> str:
+        """The error map as JSON or CSV text: on the grid (deg; tilt and rotary axis, default
+        the machine's default pattern) for the joint model, at the measured grid for the paper's
+        method."""
         if self.raw.method == "joint":
+            grid = default_pattern(self.machine)
+            b_deg = grid["b_deg"] if b_deg is None else b_deg
+            c_deg = grid["c_deg"] if c_deg is None else c_deg
             return _core.rtest_error_map(self.raw, list(b_deg), list(c_deg), fmt)
         return _core.rtest_error_map(self.raw, fmt)
 
@@ -68,6 +74,8 @@ class RtestIdentification:
             names = list(_core.location_error_names(self.machine))
             by_name = {p.name: p for p in r.parameters}
             out["location_errors"] = {n: estimate_dict(by_name[n]) for n in names}
+            if self.machine.has_head:  # minus the error of pivot_length + tool_length
+                out["tool_offset_Z"] = estimate_dict(by_name["tool_offset_Z"])
             out["probe_zeros"] = {k: np.asarray(v).tolist() for k, v in r.probe_zeros.items()}
             out["converged"] = bool(r.converged)
             out["sigma_um"] = float(r.sigma_um)
@@ -195,9 +203,18 @@ def angle_grid(start: float, stop: float, step: float, what: str, full_turn: boo
     return [round(g, 9) for g in grid]
 
 
+def default_pattern(machine: str | Any) -> dict:
+    """The default pattern of a machine (name or MachineType): ``b_deg`` (tilt axis), ``c_deg``
+    (rotary axis), ``nests``, fitted to its rotary limits and travel (the paper's on BC-trt)."""
+    mtype = machine if isinstance(machine, _core.MachineType) else _core.parse_machine_type(machine)
+    p = _core.default_rtest_pattern(mtype)
+    return {"b_deg": [float(b) for b in p.b_deg], "c_deg": [float(c) for c in p.c_deg],
+            "nests": [tuple(float(x) for x in row) for row in p.nests]}
+
+
 def simulate_rtest(errors: Errors = "random", effects: Mapping[str, Any] | None = None, *,
-                   machine: str = "BC-trt", b_deg: Sequence[float] = B_GRID,
-                   c_deg: Sequence[float] = C_GRID, nests: Sequence[Sequence[float]] = DEFAULT_NESTS,
+                   machine: str = "BC-trt", b_deg: Sequence[float] | None = None,
+                   c_deg: Sequence[float] | None = None, nests: Sequence[Sequence[float]] | None = None,
                    noise_um: float = DEFAULT_NOISE_UM, probe_zero_um: float = DEFAULT_PROBE_ZERO_UM,
                    probe_dirs: np.ndarray | None = None, write_d: bool = True,
                    dwell_s: float = DEFAULT_DWELL_S, seed: int = 1) -> tuple[_core.RtestSession, dict]:
@@ -210,7 +227,11 @@ def simulate_rtest(errors: Errors = "random", effects: Mapping[str, Any] | None 
         (mm, rad; others zero) or the 8 values in location_error_names order.
     effects : catalogue id -> parameter value (one-parameter effects) or list of values,
         e.g. {"gravity_sag_B": 0.006, "coning_B": 1.45e-4, "axial_motion_C_h2": [0.002, -0.001]}.
-    b_deg, c_deg : the grid (deg). nests : nominal ball centres, table frame (mm).
+    machine : a built-in name (``rotacal._core.builtin_machine_names()``); on a machine with
+        head axes ``effects`` may hold ``tool_offset_Z`` (minus the error of pivot + tool length).
+    b_deg, c_deg : the grid (deg) of the tilt and the rotary axis. nests : nominal ball centres,
+        table frame (mm). Each left out is the machine's default (``default_pattern``); a pattern
+        outside the machine's rotary limits or travel is refused, naming the axis.
     noise_um : 1-sigma per reading (um). probe_zero_um : 1-sigma of each set-up's probe zero.
     probe_dirs : (3, 3), rows = unit probe directions: raw d1,d2,d3 with probe.N.dir are written
         (and dx,dy,dz unless ``write_d`` is False).
@@ -222,6 +243,10 @@ def simulate_rtest(errors: Errors = "random", effects: Mapping[str, Any] | None 
     nests, noise_um, plus probe_zeros (mm per set-up), the pattern, seed and probe_dirs.
     """
     mtype, e, ids, params, effects_out = machine_truth(errors, effects, machine, seed)
+    default = default_pattern(mtype)
+    b_deg = default["b_deg"] if b_deg is None else b_deg
+    c_deg = default["c_deg"] if c_deg is None else c_deg
+    nests = default["nests"] if nests is None else nests
     nest_arr = np.asarray(nests, dtype=float).reshape(-1, 3)
     n_poses = len(b_deg) * len(c_deg) * len(nest_arr)
     if n_poses > MAX_POSES:
@@ -317,6 +342,7 @@ def calibrate_sphere_offset(dirs: np.ndarray, spindle_deg: Sequence[float], read
 
 
 def compensate_sphere_offset(session: _core.RtestSession, offset: Sequence[float]) -> _core.RtestSession:
-    """The session with a sphere offset (x, y, mm, machine frame) taken out of every dx,dy,dz."""
+    """The session with a sphere offset (x, y, mm, spindle frame: it turns with a head) taken out
+    of every dx,dy,dz, on any machine."""
     s, _ = with_displacements(session)
     return _core.compensate_sphere_offset(s, np.asarray(offset, dtype=float))

@@ -14,7 +14,9 @@ namespace rotacal {
 namespace {
 
 // r = d_model + zero_setup - d_measured (mm), three per pose. Parameters: location errors (8),
-// probe zero per set-up (3 each), effect parameters.
+// on a machine with head axes tool_offset_Z (minus the error of pivot_length + tool_length,
+// a location parameter of the head as in the joint fit), probe zero per set-up (3 each),
+// effect parameters.
 class RtestEffectResiduals : public ResidualModel {
  public:
   RtestEffectResiduals(MachineType m, const Eigen::Matrix3Xd& xyz, const Eigen::Matrix3Xd& nest,
@@ -22,18 +24,18 @@ class RtestEffectResiduals : public ResidualModel {
                        const std::vector<double>& times, const std::vector<int>& setup_of, int S,
                        const EffectModel& fx)
       : m_(m), xyz_(xyz), nest_(nest), d_(d), angles_(angles), times_(times), setup_of_(setup_of),
-        S_(S), fx_(fx), P_(fx.num_params()) {}
+        S_(S), fx_(fx), P_(fx.num_params()), L_(m.has_head() ? 9 : 8) {}
   Eigen::Index num_residuals() const override { return 3 * xyz_.cols(); }
-  int num_parameters() const override { return 8 + 3 * S_ + P_; }
+  int num_parameters() const override { return L_ + 3 * S_ + P_; }
   void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r,
                 Eigen::MatrixXd* J) const override {
     const auto f = [this](Eigen::Index i, const auto* p, auto* out) {
       using T = std::remove_const_t<std::remove_pointer_t<decltype(p)>>;
       const std::size_t k = static_cast<std::size_t>(i);
-      const T* zero = p + 8 + 3 * setup_of_[k];
+      const T* zero = p + L_ + 3 * setup_of_[k];
       const Vec3<T> d = rtest_reading<T>(m_, LocationErrors<T>::from_ptr(p), fx_,
-                                         P_ > 0 ? p + 8 + 3 * S_ : nullptr, xyz_.col(i), angles_[k],
-                                         times_[k], nest_.col(i));
+                                         P_ > 0 ? p + L_ + 3 * S_ : nullptr, xyz_.col(i), angles_[k],
+                                         times_[k], nest_.col(i), L_ > 8 ? T(-p[8]) : T(0));
       for (int a = 0; a < 3; ++a) out[a] = d[a] + zero[a] - T(d_(a, i));
     };
     evaluate_with_jets(f, xyz_.cols(), 3, x, r, J);
@@ -48,6 +50,7 @@ class RtestEffectResiduals : public ResidualModel {
   int S_;
   const EffectModel& fx_;
   int P_;
+  int L_;  // location parameters: 8, or 9 with tool_offset_Z on a head machine
 };
 
 }  // namespace
@@ -77,8 +80,12 @@ RtestDiagnosisProblem::RtestDiagnosisProblem(RtestSession session) : session_(st
 
 std::vector<Effect> RtestDiagnosisProblem::candidates(int max_harmonic) const {
   std::vector<Effect> out;
+  // On a head machine tool_offset_Z is in the baseline (a location parameter of the head).
+  const bool head = session_.machine.has_head();
   for (const Effect& e : effect_catalogue(session_.machine, max_harmonic))
-    if (e.kind != EffectKind::ballbar_length_offset && e.kind != EffectKind::ballbar_thermal_drift) out.push_back(e);
+    if (e.kind != EffectKind::ballbar_length_offset && e.kind != EffectKind::ballbar_thermal_drift &&
+        !(head && e.kind == EffectKind::tool_offset_Z))
+      out.push_back(e);
   return out;
 }
 
@@ -88,6 +95,7 @@ ModelFit RtestDiagnosisProblem::fit(const EffectModel& fx) const {
   for (int k = 0; k < 8; ++k)
     params.push_back({location_error_names(session_.machine)[static_cast<std::size_t>(k)],
                       location_error_is_angle(k) ? "rad" : "mm", 0.0});
+  if (session_.machine.has_head()) params.push_back({"tool_offset_Z", "mm", 0.0});
   for (const std::string& s : setups_)
     for (const char* a : {"x", "y", "z"}) params.push_back({"zero." + s + "." + a, "mm", 0.0});
   for (const Effect& f : fx.effects) {
@@ -121,15 +129,17 @@ Eigen::MatrixXd RtestDiagnosisProblem::candidate_jacobian(const ModelFit& at, co
   fx.effects.push_back(candidate);
   LocationErrors<J4> e;
   for (int i = 0; i < 8; ++i) e.v[i] = J4(at.parameters[static_cast<std::size_t>(i)].value);
+  const std::size_t L = session_.machine.has_head() ? 9 : 8;
+  const J4 tool_length_error(L > 8 ? -at.parameters[8].value : 0.0);
   std::vector<J4> p;
-  for (std::size_t i = 8 + 3 * S; i < at.parameters.size(); ++i) p.emplace_back(at.parameters[i].value);
+  for (std::size_t i = L + 3 * S; i < at.parameters.size(); ++i) p.emplace_back(at.parameters[i].value);
   for (int i = 0; i < k; ++i) p.emplace_back(0.0, i);
   // The probe zeros are additive: they do not change the derivative.
   Eigen::MatrixXd out(3 * xyz_.cols(), k);
   for (Eigen::Index r = 0; r < xyz_.cols(); ++r) {
     const std::size_t ri = static_cast<std::size_t>(r);
     const Vec3<J4> d = rtest_reading<J4>(session_.machine, e, fx, p.data(), xyz_.col(r),
-                                         pose_angles_[ri], pose_times_[ri], nest_.col(r));
+                                         pose_angles_[ri], pose_times_[ri], nest_.col(r), tool_length_error);
     for (int a = 0; a < 3; ++a)
       for (int i = 0; i < k; ++i) out(3 * r + a, i) = d[a].v[i];
   }

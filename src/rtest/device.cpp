@@ -165,16 +165,17 @@ std::vector<SpindleIndexSample> simulate_spindle_indexing(const Eigen::Matrix3d&
 }
 
 RtestSession compensate_sphere_offset(const RtestSession& session, const Eigen::Vector2d& offset) {
-  if (session.machine != MachineType::BC_trt)
-    throw InvalidArgument("compensate_sphere_offset: session.machine: only BC-trt is supported");
   RtestSession out = session;
   const Eigen::Vector3d o(offset.x(), offset.y(), 0.0);
+  const MachineType m = session.machine;
   for (RtestSample& s : out.samples) {
     if (!s.d) throw InvalidArgument("compensate_sphere_offset: a sample has no dx,dy,dz");
-    const Eigen::Matrix3d R =
-        rotation_about_axis<double>(Eigen::Vector3d::UnitY(), s.tilt_deg * kDeg) *
-        rotation_about_axis<double>(Eigen::Vector3d::UnitZ(), s.rot_deg * kDeg);
-    *s.d -= R.transpose() * o;
+    // The offset turns with the spindle (the head's nominal rotation; none without head axes)
+    // and the table frame sees it through the table's nominal rotation.
+    const RotaryAngles<double> a = s.angles_rad();
+    const Eigen::Matrix3d R = table_pose<double>(m, LocationErrors<double>(), a).R;
+    const Eigen::Matrix3d H = head_pose<double>(m, LocationErrors<double>(), a).R;
+    *s.d -= R.transpose() * (H * o);
   }
   return out;
 }

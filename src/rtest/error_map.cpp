@@ -28,6 +28,9 @@ RtestErrorMap error_map(const RtestJointIdentification& id, const std::vector<do
   RtestErrorMap m;
   m.method = id.method;
   m.notes = id.notes;
+  m.machine = id.model.machine;
+  m.maps = rtest_map_names(m.machine);
+  m.letters = {tilt_axis_letter(m.machine), rot_axis_letter(m.machine)};
   for (double b : b_deg)
     for (double c : c_deg) {
       RtestErrorMapEntry e;
@@ -61,9 +64,9 @@ RtestErrorMap error_map(const RtestPaperIdentification& id) {
 
 std::string error_map_csv(const RtestErrorMap& map) {
   std::ostringstream o;
-  o << "B,C";
+  o << map.letters[0] << "," << map.letters[1];
   for (const char* suffix : {"", "_std"})
-    for (const char* ax : {"BY", "CB"})
+    for (const std::string& ax : map.maps)
       for (int k = 0; k < 6; ++k) o << "," << oyama_error_name(k, ax) << suffix;
   o << "\n";
   for (const RtestErrorMapEntry& e : map.entries) {
@@ -94,6 +97,9 @@ std::string error_map_json(const RtestErrorMap& map) {
   };
   ojson head;
   head["method"] = map.method;
+  head["machine"] = to_string(map.machine);
+  head["angles"] = {std::string(1, map.letters[0]), std::string(1, map.letters[1])};
+  head["maps"] = {map.maps[0], map.maps[1]};
   head["order"] = {"dx", "dy", "dz", "alpha", "beta", "gamma"};
   head["units"] = {"mm", "mm", "mm", "rad", "rad", "rad"};
   head["notes"] = map.notes;
@@ -102,12 +108,12 @@ std::string error_map_json(const RtestErrorMap& map) {
     if (!std::isfinite(e.b_deg) || !std::isfinite(e.c_deg))
       throw InvalidArgument("error_map_json: an entry's B or C is not finite");
     ojson row;
-    row["B"] = e.b_deg;
-    row["C"] = e.c_deg;
-    row["BY"] = vec(e.w_BY);
-    row["BY_std"] = vec(e.w_BY_std);
-    row["CB"] = vec(e.w_CB);
-    row["CB_std"] = vec(e.w_CB_std);
+    row[std::string(1, map.letters[0])] = e.b_deg;
+    row[std::string(1, map.letters[1])] = e.c_deg;
+    row[map.maps[0]] = vec(e.w_BY);
+    row[map.maps[0] + "_std"] = vec(e.w_BY_std);
+    row[map.maps[1]] = vec(e.w_CB);
+    row[map.maps[1] + "_std"] = vec(e.w_CB_std);
     rows.push_back(row.dump());
   }
   if (any_null)

@@ -29,9 +29,10 @@ namespace {
 // (dx, dy) and (alpha, beta) at n = 1, m = 0 only the backward-turning motion
 // (u cos C + v sin C, -u sin C + v cos C) is kept (see the header). Calls f(name, term).
 template <typename F>
-void for_each_c_term(const RtestBasis& bs, double B, double C, F f) {
+void for_each_c_term(const RtestBasis& bs, double B, double C, const std::string& map, F f) {
   const double b = B / (M_PI / 2.0);
-  for (int k = 0; k < (bs.gamma_cb ? 6 : 5); ++k)
+  for (int k = 0; k < (bs.gamma_cb ? 6 : 5); ++k) {
+    if (k >= 3 && !bs.c_rotations) break;
     for (int n = 1; n <= bs.c_harmonics; ++n) {
       double bm = 1.0;
       for (int m = 0; m <= bs.c_b_degree; ++m, bm *= b)
@@ -40,46 +41,84 @@ void for_each_c_term(const RtestBasis& bs, double B, double C, F f) {
           const bool pair = k == 0 || k == 1 || k == 3 || k == 4;
           if (pair && n == 1 && m == 0) {
             if (k == 1 || k == 4) continue;  // carried by the pair's first component
-            const double c = std::cos(C), s = std::sin(C);
+            // Backward relative to the axis' own turning: about -Z that is +C in X, Y.
+            const double c = std::cos(C), s = bs.c_reversed ? -std::sin(C) : std::sin(C);
             t[k] = cs == 0 ? c : s;
             t[k + 1] = cs == 0 ? -s : c;
-            f(std::string(k == 0 ? "dxy" : "alphabeta") + "_CB.back1." + (cs == 0 ? "u" : "v") + ".b0",
+            f(std::string(k == 0 ? "dxy" : "alphabeta") + "_" + map + ".back1." + (cs == 0 ? "u" : "v") + ".b0",
               t);
             continue;
           }
           t[k] = bm * (cs == 0 ? std::cos(n * C) : std::sin(n * C));
-          f(std::string(kCompNames[k]) + "_CB." + (cs == 0 ? "cos" : "sin") + std::to_string(n) +
+          f(std::string(kCompNames[k]) + "_" + map + "." + (cs == 0 ? "cos" : "sin") + std::to_string(n) +
                 ".b" + std::to_string(m),
             t);
         }
     }
+  }
 }
 }  // namespace
 std::vector<AxisErrors<double>> RtestBasis::c_terms(double B, double C) const {
   std::vector<AxisErrors<double>> out;
-  for_each_c_term(*this, B, C, [&](const std::string&, const AxisErrors<double>& t) { out.push_back(t); });
+  for_each_c_term(*this, B, C, "CB", [&](const std::string&, const AxisErrors<double>& t) { out.push_back(t); });
   return out;
 }
 std::vector<double> RtestBasis::b_terms(int k, double B) const {
   const double b = B / (M_PI / 2.0);
   std::vector<double> out;
+  if (k >= 3 && !b_rotations) return out;
   for (int p = (k < 3 ? 2 : 1); p <= b_degree; p += 2) out.push_back(std::pow(b, p));
   return out;
 }
-std::vector<std::string> RtestBasis::coefficient_names() const {
+namespace {
+// Names of this basis' coefficients (its own rotation flags) with the given map names.
+std::vector<std::string> basis_names(const RtestBasis& bs, const std::array<std::string, 2>& maps) {
   std::vector<std::string> out;
-  for (int k = 0; k < 6; ++k)
-    for (int p = (k < 3 ? 2 : 1); p <= b_degree; p += 2)
-      out.push_back(std::string(kCompNames[k]) + "_BY.b" + std::to_string(p));
-  for_each_c_term(*this, 0.3, 0.7,
+  for (int k = 0; k < (bs.b_rotations ? 6 : 3); ++k)
+    for (int p = (k < 3 ? 2 : 1); p <= bs.b_degree; p += 2)
+      out.push_back(std::string(kCompNames[k]) + "_" + maps[0] + ".b" + std::to_string(p));
+  for_each_c_term(bs, 0.3, 0.7, maps[1],
                   [&](const std::string& n, const AxisErrors<double>&) { out.push_back(n); });
   return out;
 }
+}  // namespace
+std::vector<std::string> RtestBasis::coefficient_names() const { return basis_names(*this, {"BY", "CB"}); }
+std::vector<std::string> RtestBasis::coefficient_names(MachineType m) const {
+  return basis_names(for_machine(m), rtest_map_names(m));
+}
+
+RtestBasis RtestBasis::for_machine(MachineType m) const {
+  RtestBasis out = *this;
+  out.b_rotations = !m.description().axis(m.tilt_index()).on_head;
+  out.c_rotations = !m.description().axis(m.rot_index()).on_head;
+  out.c_reversed = m.description().axis(m.rot_index()).direction.z() < 0.0;
+  return out;
+}
+
+std::array<std::string, 2> rtest_map_names(MachineType m) {
+  const MachineDescription& d = m.description();
+  const int nt = static_cast<int>(d.table_axes.size());
+  auto name = [&](int k) {
+    const RotaryAxis& a = d.axis(k);
+    char carrier = a.on_head ? 'Z' : 'Y';
+    if (k != 0 && k != nt) carrier = d.axis(k - 1).name;  // the axis before it on its side
+    return std::string(1, a.name) + carrier;
+  };
+  return {name(m.tilt_index()), name(m.rot_index())};
+}
 
 // ---------------------------------------------------------------- model
+std::vector<std::string> RtestJointModel::parameter_names() const {
+  const auto& le = location_error_names(machine);
+  std::vector<std::string> out(le.begin(), le.end());
+  if (machine.has_head()) out.push_back("tool_offset_Z");
+  for (std::string& n : basis.coefficient_names(machine)) out.push_back(std::move(n));
+  return out;
+}
 LocationErrors<double> RtestJointModel::errors() const {
   return LocationErrors<double>(params.head<8>());
 }
+double RtestJointModel::tool_offset_z() const { return machine.has_head() ? params[8] : 0.0; }
 
 namespace {
 // Linear map from params to w_BY (6 x P) and w_CB (6 x P) at (B, C).
@@ -87,12 +126,13 @@ void map_rows(const RtestJointModel& m, double B, double C, Eigen::MatrixXd& Lb,
               Eigen::MatrixXd& Lc) {
   const int P = static_cast<int>(m.params.size());
   const int nb = m.basis.num_b_coefficients();
+  const int nl = rtest_num_location_parameters(m.machine);
   Lb = Eigen::MatrixXd::Zero(6, P);
   Lc = Eigen::MatrixXd::Zero(6, P);
-  int o = 8;
+  int o = nl;
   for (int k = 0; k < 6; ++k)
     for (double phi : m.basis.b_terms(k, B)) Lb(k, o++) = phi;
-  o = 8 + nb;
+  o = nl + nb;
   for (const AxisErrors<double>& t : m.basis.c_terms(B, C)) Lc.col(o++) = t;
 }
 
@@ -148,15 +188,16 @@ AxisErrors<double> RtestJointModel::w_CB(double B, double C, AxisErrors<double>*
   return Lc * params;
 }
 Pose<double> RtestJointModel::table_pose(double B, double C) const {
-  const int nb = basis.num_b_coefficients();
-  return rtest_joint_table_pose<double>(basis, params.data(), params.data() + 8,
-                                        params.data() + 8 + nb, B, C);
+  const int nb = basis.num_b_coefficients(), nl = rtest_num_location_parameters(machine);
+  return rtest_joint_table_pose<double>(machine, basis, params.data(), params.data() + nl,
+                                        params.data() + nl + nb, B, C);
 }
 Eigen::Vector3d RtestJointModel::reading(const Eigen::Vector3d& q, double B, double C,
                                          Eigen::Vector3d* std) const {
-  const Eigen::Vector3d xyz = rtest_commanded_xyz(MachineType::BC_trt, q, {B, C});
+  const Eigen::Vector3d xyz = rtest_commanded_xyz(machine, q, {B, C});
   auto f = [&](const RtestJointModel& m) {
-    return Eigen::Vector3d(rtest_joint_reading<double>(m.errors(), m.w_BY(B), m.w_CB(B, C), B, C, xyz, q));
+    return Eigen::Vector3d(rtest_joint_reading<double>(machine, m.errors(), m.w_BY(B), m.w_CB(B, C),
+                                                       m.tool_offset_z(), {B, C}, xyz, q));
   };
   if (std) *std = propagate_fn(*this, f);
   return f(*this);
@@ -165,7 +206,19 @@ Eigen::Vector3d RtestJointModel::table_error(const Eigen::Vector3d& q, double B,
                                              Eigen::Vector3d* std) const {
   auto f = [&](const RtestJointModel& m) {
     return Eigen::Vector3d(m.table_pose(B, C) * q -
-                           forward<double>(MachineType::BC_trt, LocationErrors<double>(), {B, C}, q));
+                           forward<double>(machine, LocationErrors<double>(), {B, C}, q));
+  };
+  if (std) *std = propagate_fn(*this, f);
+  return f(*this);
+}
+Eigen::Vector3d RtestJointModel::tool_error(const Eigen::Vector3d& xyz, double B, double C,
+                                            Eigen::Vector3d* std) const {
+  auto f = [&](const RtestJointModel& m) -> Eigen::Vector3d {
+    if (!machine.has_head()) return Eigen::Vector3d::Zero();
+    const Pose<double> H =
+        rtest_joint_side_pose<double>(machine, m.errors(), m.w_BY(B), m.w_CB(B, C), {B, C}, true);
+    return xyz + H * tool_vector<double>(machine, -m.tool_offset_z()) -
+           tool_ball<double>(machine, LocationErrors<double>(), {B, C}, xyz);
   };
   if (std) *std = propagate_fn(*this, f);
   return f(*this);
@@ -179,19 +232,21 @@ const ParameterEstimate& RtestJointIdentification::parameter(const std::string& 
 
 // ---------------------------------------------------------------- fit
 namespace {
-// r = T^-1 xyz - q + zero - d_measured (mm), 3 residuals per sample (Eq. 4 with location errors
-// and the smooth maps). Parameters: location errors (8), B-map coefficients, C-map
-// coefficients, probe zero per set-up (3 each). Per sample, Jets of rtest_joint_reading with
-// respect to (e, w_BY, w_CB) (20 directions) are chained through the sample's basis values:
-// four times fewer directions than the ~70 coefficients.
+// r = T^-1 (xyz + H t) - q + zero - d_measured (mm), 3 residuals per sample (Eq. 4 with
+// location errors and the smooth maps, on either side of the chain). Parameters: location
+// errors (8), tool_offset_Z (head machines), tilt-map coefficients, rotary-map coefficients,
+// probe zero per set-up (3 each). Per sample, Jets of rtest_joint_reading with respect to
+// (e, w_BY, w_CB, tool_offset_Z) (21 directions) are chained through the sample's basis
+// values: four times fewer directions than the ~70 coefficients.
 class RtestJointResiduals : public ResidualModel {
  public:
   RtestJointResiduals(const RtestSession& session, const std::vector<std::string>& setups,
                       const RtestBasis& basis)
-      : nb_(basis.num_b_coefficients()), nc_(basis.num_c_coefficients()),
+      : m_(session.machine), nl_(rtest_num_location_parameters(session.machine)),
+        nb_(basis.num_b_coefficients()), nc_(basis.num_c_coefficients()),
         S_(static_cast<int>(setups.size())) {
     const std::size_t n = session.samples.size();
-    B_.resize(n), C_.resize(n), setup_.resize(n);
+    a_.resize(n), setup_.resize(n);
     Lb_ = Eigen::MatrixXd::Zero(6 * static_cast<Eigen::Index>(n), nb_);
     Lc_ = Eigen::MatrixXd::Zero(6 * static_cast<Eigen::Index>(n), nc_);
     xyz_.resize(3, static_cast<Eigen::Index>(n)), q_.resize(3, static_cast<Eigen::Index>(n));
@@ -199,7 +254,7 @@ class RtestJointResiduals : public ResidualModel {
     for (std::size_t i = 0; i < n; ++i) {
       const RtestSample& s = session.samples[i];
       const RotaryAngles<double> a = s.angles_rad();
-      B_[i] = a.tilt, C_[i] = a.rot;
+      a_[i] = a;
       setup_[i] = static_cast<int>(std::find(setups.begin(), setups.end(), s.setup) - setups.begin());
       xyz_.col(static_cast<Eigen::Index>(i)) = s.xyz;
       q_.col(static_cast<Eigen::Index>(i)) = session.nests.at(s.setup);
@@ -212,17 +267,19 @@ class RtestJointResiduals : public ResidualModel {
       for (const AxisErrors<double>& t : basis.c_terms(a.tilt, a.rot)) Lc_.block<6, 1>(r6, o++) = t;
     }
   }
-  Eigen::Index num_residuals() const override { return 3 * static_cast<Eigen::Index>(B_.size()); }
-  int num_parameters() const override { return 8 + nb_ + nc_ + 3 * S_; }
+  Eigen::Index num_residuals() const override { return 3 * static_cast<Eigen::Index>(a_.size()); }
+  int num_parameters() const override { return nl_ + nb_ + nc_ + 3 * S_; }
   void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r,
                 Eigen::MatrixXd* J) const override {
-    using Jet = ceres::Jet<double, 20>;
-    const int n_model = 8 + nb_ + nc_;
-    const Eigen::VectorXd cb = x.segment(8, nb_), cc = x.segment(8 + nb_, nc_);
+    using Jet = ceres::Jet<double, 21>;  // e (8), w_BY (6), w_CB (6), tool_offset_Z
+    const int n_model = nl_ + nb_ + nc_;
+    const Eigen::VectorXd cb = x.segment(nl_, nb_), cc = x.segment(nl_ + nb_, nc_);
     const LocationErrors<double> e = LocationErrors<double>::from_ptr(x.data());
+    const double tz = nl_ > 8 ? x[8] : 0.0;
     LocationErrors<Jet> ej;
     for (int k = 0; k < 8; ++k) ej.v[k] = Jet(x[k], k);
-    for (std::size_t i = 0; i < B_.size(); ++i) {
+    const Jet tzj(tz, 20);
+    for (std::size_t i = 0; i < a_.size(); ++i) {
       const Eigen::Index row = 3 * static_cast<Eigen::Index>(i);
       const auto Lb = Lb_.middleRows<6>(row * 2), Lc = Lc_.middleRows<6>(row * 2);  // 6 rows a sample
       const AxisErrors<double> wb = Lb * cb, wc = Lc * cc;
@@ -230,41 +287,89 @@ class RtestJointResiduals : public ResidualModel {
       const Eigen::Vector3d xyz = xyz_.col(static_cast<Eigen::Index>(i));
       const Eigen::Vector3d q = q_.col(static_cast<Eigen::Index>(i));
       if (!J) {
-        r.segment<3>(row) = rtest_joint_reading<double>(e, wb, wc, B_[i], C_[i], xyz, q) + zero -
+        r.segment<3>(row) = rtest_joint_reading<double>(m_, e, wb, wc, tz, a_[i], xyz, q) + zero -
                             d_.col(static_cast<Eigen::Index>(i));
         continue;
       }
       AxisErrors<Jet> wbj, wcj;
       for (int k = 0; k < 6; ++k) wbj[k] = Jet(wb[k], 8 + k), wcj[k] = Jet(wc[k], 14 + k);
-      const Vec3<Jet> d = rtest_joint_reading<Jet>(ej, wbj, wcj, B_[i], C_[i], xyz, q);
-      Eigen::Matrix<double, 3, 20> G;
+      const Vec3<Jet> d = rtest_joint_reading<Jet>(m_, ej, wbj, wcj, tzj, a_[i], xyz, q);
+      Eigen::Matrix<double, 3, 21> G;
       for (int a = 0; a < 3; ++a) {
         r[row + a] = d[a].a + zero[a] - d_(a, static_cast<Eigen::Index>(i));
         G.row(a) = d[a].v.transpose();
       }
       J->block(row, 0, 3, 8) = G.leftCols<8>();
-      J->block(row, 8, 3, nb_).noalias() = G.middleCols<6>(8) * Lb;
-      J->block(row, 8 + nb_, 3, nc_).noalias() = G.rightCols<6>() * Lc;
+      if (nl_ > 8) J->block(row, 8, 3, 1) = G.col(20);
+      J->block(row, nl_, 3, nb_).noalias() = G.middleCols<6>(8) * Lb;
+      J->block(row, nl_ + nb_, 3, nc_).noalias() = G.middleCols<6>(14) * Lc;
       J->block(row, n_model, 3, 3 * S_).setZero();
       J->block<3, 3>(row, n_model + 3 * setup_[i]).setIdentity();
     }
   }
 
  private:
-  int nb_, nc_, S_;
-  std::vector<double> B_, C_;
+  MachineType m_;
+  int nl_, nb_, nc_, S_;
+  std::vector<RotaryAngles<double>> a_;
   std::vector<int> setup_;
   Eigen::Matrix3Xd xyz_, q_, d_;
   // Basis values, 6 rows per sample (rows 6i..6i+5): w_BY = Lb cb, w_CB = Lc cc.
   Eigen::MatrixXd Lb_, Lc_;
 };
+
+// True when the tilt axis carries the rotary axis on the same side of the chain.
+bool m_tilt_carries_rot(MachineType m) {
+  const MachineDescription& d = m.description();
+  return d.axis(0).on_head == d.axis(1).on_head && m.tilt_index() == 0;
+}
+
+// Which set-up change would show what this session cannot (the unobservable combinations in
+// words, core/least_squares.hpp), in the spirit of the ballbar's advice.
+std::vector<std::string> rtest_setup_advice(MachineType m, const std::vector<std::string>& unobservable) {
+  std::vector<std::string> out;
+  if (unobservable.empty()) return out;
+  auto mentions = [&](const std::string& name) {
+    for (const std::string& u : unobservable)
+      if (u.find(name) != std::string::npos) return true;
+    return false;
+  };
+  const auto& names = location_error_names(m);
+  const std::array<std::string, 2> maps = rtest_map_names(m);
+  const MachineDescription& d = m.description();
+  bool head_advised = false;
+  if (mentions("tool_offset_Z")) {
+    out.push_back("pivot_length + tool_length (tool_offset_Z) is seen together with a head axis' position "
+                  "along the spindle: a second tool length (the sphere at a second distance from the "
+                  "head) separates them");
+    head_advised = true;
+  }
+  for (int k = 0; k < 2; ++k) {
+    const RotaryAxis& a = d.axis(k);
+    const std::string map = maps[k == m.tilt_index() ? 0 : 1];
+    bool seen = mentions("_" + map + ".");
+    for (int j = 0; j < 4; ++j) seen |= mentions(names[static_cast<std::size_t>(4 * k + j)]);
+    if (!seen) continue;
+    if (a.on_head) {
+      if (!head_advised)
+        out.push_back(std::string("errors of the head axis ") + a.name + " (location errors, map " + map +
+                      ") are seen as one movement of the sphere at one tool length: a second tool length "
+                      "(the rotations' effect scales with it, a translation's does not) separates them");
+      head_advised = true;
+    } else {
+      out.push_back(std::string("errors of the table axis ") + a.name + " (location errors, map " + map +
+                    ") are seen together at these nests: a nest at a second height and a second distance "
+                    "from the " + a.name + " line separates them");
+    }
+  }
+  return out;
+}
 }  // namespace
 
 RtestJointIdentification identify_joint(const RtestSession& session,
                                         const RtestJointOptions& options) {
-  if (session.machine != MachineType::BC_trt)
-    throw InvalidArgument("identify_joint: session.machine: the R-test model is for BC-trt tables");
-  const RtestBasis& basis = options.basis;
+  const MachineType machine = session.machine;
+  const RtestBasis basis = options.basis.for_machine(machine);
   if (basis.b_degree < 0 || basis.c_harmonics < 0 || basis.c_b_degree < 0)
     throw InvalidArgument("identify_joint: options.basis: degrees and harmonics must be >= 0");
   const std::vector<std::string> setups = session.setups();
@@ -276,7 +381,8 @@ RtestJointIdentification identify_joint(const RtestSession& session,
       throw InvalidArgument("identify_joint: session.nests: no nest." + session.samples[i].setup);
   }
   const int nb = basis.num_b_coefficients(), nc = basis.num_c_coefficients();
-  const int n_model = 8 + nb + nc;
+  const int nl = rtest_num_location_parameters(machine);
+  const int n_model = nl + nb + nc;
   const int n_par = n_model + 3 * static_cast<int>(setups.size());
   if (3 * static_cast<int>(session.samples.size()) <= n_par)
     throw InvalidArgument("identify_joint: session: " + std::to_string(3 * session.samples.size()) +
@@ -284,9 +390,12 @@ RtestJointIdentification identify_joint(const RtestSession& session,
 
   std::vector<FitParameter> params;
   for (int k = 0; k < 8; ++k)
-    params.push_back({location_error_names(MachineType::BC_trt)[static_cast<std::size_t>(k)],
+    params.push_back({location_error_names(machine)[static_cast<std::size_t>(k)],
                       location_error_is_angle(k) ? "rad" : "mm", 0.0});
-  for (const std::string& n : basis.coefficient_names()) {
+  // On a machine with head axes the sphere's distance from the controlled point, pivot_length
+  // + tool_length, is a parameter of the head (formats.md): its error as tool_offset_Z.
+  if (machine.has_head()) params.push_back({"tool_offset_Z", "mm", 0.0});
+  for (const std::string& n : basis.coefficient_names(machine)) {
     const std::string comp = n.substr(0, n.find('_'));
     params.push_back({n, comp[0] == 'd' ? "mm" : "rad", 0.0});
   }
@@ -361,6 +470,7 @@ RtestJointIdentification identify_joint(const RtestSession& session,
     out.probe_zeros[setups[k]] = fit.values.segment<3>(n_model + 3 * static_cast<Eigen::Index>(k));
   out.parameters = fit.estimates;
   out.unobservable = fit.unobservable;
+  for (std::string& advice : rtest_setup_advice(machine, out.unobservable)) out.notes.push_back(std::move(advice));
   out.summary = fit.summary;
   out.noise = std::move(noise);
   out.noise_refit = refit;
@@ -370,7 +480,7 @@ RtestJointIdentification identify_joint(const RtestSession& session,
                         ", REML over the fit's residual space): covariance by GLS under this model");
   else if (refit) out.notes.push_back("correlated noise (" + out.noise.summary() + "): covariance by GLS under this AR model, scaled by " + std::to_string(scale) + " for the correlation the fit absorbs from its residuals");
 
-  out.model.machine = session.machine;
+  out.model.machine = machine;
   out.model.basis = basis;
   out.model.params = fit.values.head(n_model);
   out.model.covariance = out.covariance.topLeftCorner(n_model, n_model);
@@ -378,13 +488,26 @@ RtestJointIdentification identify_joint(const RtestSession& session,
   for (int j = 0; j < n_model; ++j) out.model.observable.push_back(fit.estimates[static_cast<std::size_t>(j)].observable);
 
   out.notes.push_back("probe zero per set-up fitted: no reading is assumed to be zero");
+  const std::array<std::string, 2> maps = rtest_map_names(machine);
+  const std::string tl(1, tilt_axis_letter(machine)), rl(1, rot_axis_letter(machine));
   out.notes.push_back(
-      "B map: even powers of B for translations, odd for rotations (separates it from the B "
-      "axis' location errors); C map: harmonics 1.." + std::to_string(basis.c_harmonics) +
-      " of C, polynomial of degree " + std::to_string(basis.c_b_degree) + " in B");
-  if (!basis.gamma_cb) out.notes.push_back("gamma_CB not fitted (assumed zero, as Oyama Sec. 4.2)");
-  out.notes.push_back("rotary zero offsets E_B0B, E_C0C are not in the model: an R-test with the "
-                      "probe zero unknown cannot see a constant C offset; E_B0B acts as E_B0C");
+      tl + " map (" + maps[0] + "): " +
+      (basis.b_rotations ? "even powers of " + tl + " for translations, odd for rotations (separates it from the " +
+                               tl + " axis' location errors)"
+                         : "even powers of " + tl + " for translations only (a head axis: the sphere is one point)") +
+      "; " + rl + " map (" + maps[1] + "): harmonics 1.." + std::to_string(basis.c_harmonics) + " of " + rl +
+      (basis.c_rotations ? "" : ", translations only (a head axis)") + ", polynomial of degree " +
+      std::to_string(basis.c_b_degree) + " in " + tl);
+  if (!basis.gamma_cb && basis.c_rotations)
+    out.notes.push_back("gamma_" + maps[1] + " not fitted (assumed zero, as Oyama Sec. 4.2)");
+  // A constant offset of the tilt axis turns the rotary axis it carries: a tilt of that axis.
+  const bool tilt_carries_rot = m_tilt_carries_rot(machine);
+  out.notes.push_back("rotary zero offsets E_" + tl + "0" + tl + ", E_" + rl + "0" + rl +
+                      " are not in the model: an R-test with the probe zero unknown cannot see a constant " +
+                      rl + " offset" +
+                      (tilt_carries_rot ? "; E_" + tl + "0" + tl + " acts as a tilt of the " + rl + " axis" : ""));
+  if (machine.has_head())
+    out.notes.push_back("tool_offset_Z: minus the error of pivot_length + tool_length, along the spindle");
   if (!out.converged) out.notes.push_back("the fit did not converge: " + fit.summary.message);
   return out;
 }

@@ -94,7 +94,10 @@ Eigen::Vector3d RtestPaperIdentification::predict_reading(const Eigen::Vector3d&
 
 RtestPaperIdentification identify_paper(const RtestSession& session) {
   if (session.machine != MachineType::BC_trt)
-    throw InvalidArgument("identify_paper: session.machine: the method is for BC-trt tables");
+    throw InvalidArgument("identify_paper: session.machine: Oyama's two-step method is written for a "
+                          "BC-trt table, this session is a " + to_string(session.machine) +
+                          "; use the joint fit (identify_joint, `rotacal identify --method joint`), which "
+                          "works on any machine");
   const std::vector<std::string> setups = session.setups();
   if (setups.size() < 2)
     throw InvalidArgument("identify_paper: session: the C-axis step needs >= 2 nests, got " +

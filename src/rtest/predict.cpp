@@ -9,20 +9,19 @@
 
 namespace rotacal {
 
-RtestJointModel make_rtest_joint_model(MachineType machine, const RtestBasis& basis,
+RtestJointModel make_rtest_joint_model(MachineType machine, const RtestBasis& basis_in,
                                        const Eigen::VectorXd& params,
                                        const Eigen::MatrixXd& covariance,
                                        const std::vector<bool>& observable) {
-  if (machine != MachineType::BC_trt)
-    throw InvalidArgument("R-test joint model: machine: the model is for BC-trt tables, got " +
-                          to_string(machine));
+  const RtestBasis basis = basis_in.for_machine(machine);  // head axes' maps have no rotations
   if (basis.b_degree < 0 || basis.c_harmonics < 0 || basis.c_b_degree < 0)
     throw InvalidArgument("R-test joint model: basis: degrees and harmonics must be >= 0");
-  const Eigen::Index n = 8 + basis.num_b_coefficients() + basis.num_c_coefficients();
+  const int nl = rtest_num_location_parameters(machine);
+  const Eigen::Index n = nl + basis.num_b_coefficients() + basis.num_c_coefficients();
   if (params.size() != n)
     throw InvalidArgument("R-test joint model: params: " + std::to_string(params.size()) +
-                          " values, the basis needs " + std::to_string(n) +
-                          " (8 location errors + map coefficients)");
+                          " values, the basis needs " + std::to_string(n) + " (8 location errors" +
+                          (nl > 8 ? ", tool_offset_Z" : "") + " + map coefficients)");
   if (covariance.rows() != n || covariance.cols() != n)
     throw InvalidArgument("R-test joint model: covariance: " + std::to_string(covariance.rows()) +
                           " x " + std::to_string(covariance.cols()) + ", expected " +
@@ -30,11 +29,11 @@ RtestJointModel make_rtest_joint_model(MachineType machine, const RtestBasis& ba
   if (static_cast<Eigen::Index>(observable.size()) != n)
     throw InvalidArgument("R-test joint model: observable: " + std::to_string(observable.size()) +
                           " flags, expected " + std::to_string(n));
-  const std::vector<std::string> coef = basis.coefficient_names();
-  const auto name_of = [&](Eigen::Index j) {
-    return j < 8 ? location_error_names(machine)[static_cast<std::size_t>(j)]
-                 : coef[static_cast<std::size_t>(j - 8)];
-  };
+  RtestJointModel named;
+  named.machine = machine;
+  named.basis = basis;
+  const std::vector<std::string> names = named.parameter_names();
+  const auto name_of = [&](Eigen::Index j) { return names[static_cast<std::size_t>(j)]; };
   for (Eigen::Index j = 0; j < n; ++j) {
     if (!std::isfinite(params[j]))
       throw InvalidArgument("R-test joint model: params: " + name_of(j) + " is not finite");

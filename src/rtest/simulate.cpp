@@ -2,6 +2,7 @@
 #include "rotacal/rtest/simulate.hpp"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cstdio>
 #include <random>
 
@@ -18,12 +19,86 @@ std::string fmt(double v, int prec) {
   return buf;
 }
 
+std::string limits_text(const std::array<double, 2>& l) {
+  char buf[80];
+  std::snprintf(buf, sizeof buf, "[%g, %g]", l[0], l[1]);
+  return buf;
+}
+
+// First offending commanded X, Y, Z of the nest q over the pattern's poses, as text; empty
+// when every pose is inside the travel (or the machine gives none).
+std::string travel_violation(MachineType m, const Eigen::Vector3d& q, const std::vector<double>& tilt_deg,
+                             const std::vector<double>& rot_deg) {
+  const auto& travel = m.description().travel_mm;
+  if (!travel) return "";
+  const char* names = "XYZ";
+  for (double b : tilt_deg)
+    for (double c : rot_deg) {
+      const Eigen::Vector3d xyz = rtest_commanded_xyz(m, q, {b * kDeg, c * kDeg});
+      for (int k = 0; k < 3; ++k)
+        if (xyz[k] < (*travel)(k, 0) - 1e-9 || xyz[k] > (*travel)(k, 1) + 1e-9)
+          return std::string(1, names[k]) + " = " + fmt(xyz[k], 3) + " mm at " + tilt_axis_letter(m) + " " +
+                 fmt(b, 3) + ", " + rot_axis_letter(m) + " " + fmt(c, 3) + " deg is outside the travel [" +
+                 fmt((*travel)(k, 0), 1) + ", " + fmt((*travel)(k, 1), 1) + "]";
+    }
+  return "";
+}
+
 }  // namespace
+
+RtestPattern default_rtest_pattern(MachineType m) {
+  const MachineDescription& d = m.description();
+  RtestPattern p;
+  if (const auto& l = d.axis(m.tilt_index()).limits_deg) {
+    const double span = std::min(180.0, (*l)[1] - (*l)[0]);
+    const double centre = std::clamp(0.0, (*l)[0] + span / 2, (*l)[1] - span / 2);
+    p.b_deg.clear();
+    for (int i = 0; i < 7; ++i) p.b_deg.push_back(centre - span / 2 + span * i / 6.0);
+  }
+  if (const auto& l = d.axis(m.rot_index()).limits_deg) {
+    const double span = (*l)[1] - (*l)[0];
+    p.c_deg.clear();
+    for (int i = 0; i < 12; ++i) p.c_deg.push_back(span >= 360.0 ? (*l)[0] + 30.0 * i : (*l)[0] + span * i / 11.0);
+  }
+  for (std::size_t n = 0; n < p.nests.size(); ++n) {
+    Eigen::Vector3d& q = p.nests[n];
+    int halvings = 0;
+    std::string why;
+    while (!(why = travel_violation(m, q, p.b_deg, p.c_deg)).empty() && halvings < 4) q *= 0.5, ++halvings;
+    if (!why.empty())
+      throw InvalidArgument("default_rtest_pattern: " + to_string(m) + ": nest " + std::to_string(n + 1) +
+                            " does not fit the travel even at 1/16 of its default position: " + why);
+  }
+  return p;
+}
+
+void check_rtest_pattern(MachineType m, const RtestPattern& pattern, const std::string& context) {
+  const MachineDescription& d = m.description();
+  const struct {
+    int k;
+    const std::vector<double>& deg;
+  } axes[2] = {{m.tilt_index(), pattern.b_deg}, {m.rot_index(), pattern.c_deg}};
+  for (const auto& a : axes) {
+    const RotaryAxis& ax = d.axis(a.k);
+    if (!ax.limits_deg) continue;
+    for (double v : a.deg)
+      if (v < (*ax.limits_deg)[0] - 1e-9 || v > (*ax.limits_deg)[1] + 1e-9)
+        throw InvalidArgument(context + ": " + std::string(1, ax.name) + " " + fmt(v, 3) +
+                              " deg is beyond its limits " + limits_text(*ax.limits_deg) + " on " +
+                              to_string(m) + " (default_rtest_pattern fits the machine)");
+  }
+  for (std::size_t n = 0; n < pattern.nests.size(); ++n) {
+    const std::string why = travel_violation(m, pattern.nests[n], pattern.b_deg, pattern.c_deg);
+    if (!why.empty())
+      throw InvalidArgument(context + ": nest " + std::to_string(n + 1) + ": " + why + " on " + to_string(m));
+  }
+}
 
 RtestSimulation simulate_rtest(const MachineModel& truth, const RtestSimOptions& o) {
   truth.validate("simulate_rtest: truth");
   if (o.pattern.b_deg.empty() || o.pattern.c_deg.empty() || o.pattern.nests.empty())
     throw InvalidArgument("simulate_rtest: options.pattern: b_deg, c_deg and nests must not be empty");
+  check_rtest_pattern(truth.machine, o.pattern, "simulate_rtest: options.pattern");
   if (o.noise_um < 0 || o.probe_zero_um < 0)
     throw InvalidArgument("simulate_rtest: options.noise_um and probe_zero_um must be >= 0");
   if (o.probe_dirs && std::abs(o.probe_dirs->determinant()) < 1e-6)

@@ -4,6 +4,7 @@
 
 #include "rotacal/core/error.hpp"
 #include "rotacal/rtest/device.hpp"
+#include "rotacal/rtest/simulate.hpp"
 
 using namespace rotacal;
 
@@ -110,4 +111,25 @@ TEST_CASE("sphere offset compensation removes R^T o from every displacement") {
   const RtestSession out = compensate_sphere_offset(session, Eigen::Vector2d(0.01, 0.0));
   // Ry(90)^T e_x = e_z: a sphere shifted by +x appears at +z in the table frame; it is removed.
   CHECK((*out.samples[0].d - Eigen::Vector3d(0, 0, -0.01)).norm() < 1e-15);
+}
+
+TEST_CASE("sphere offset compensation on a head machine follows the spindle", "[any_machine]") {
+  // A sphere 10 um off the spindle axis along the spindle's X (tool_offset_X turns with the
+  // head there): compensating it gives the session of a centred sphere.
+  for (const char* name : {"B-head-C-table", "AC-head", "B45C-trt"}) {
+    INFO(name);
+    const MachineType m = parse_machine_type(name);
+    MachineModel centred = MachineModel::nominal(m), off = MachineModel::nominal(m);
+    off.effects.effects.push_back(Effect::parse("tool_offset_X"));
+    off.effect_params.push_back(0.01);
+    RtestSimOptions o;
+    o.pattern = default_rtest_pattern(m);
+    o.noise_um = 0.0;
+    const RtestSession a = simulate_rtest(centred, o).session;
+    const RtestSession b = compensate_sphere_offset(simulate_rtest(off, o).session, Eigen::Vector2d(0.01, 0.0));
+    double worst = 0.0;
+    for (std::size_t i = 0; i < a.samples.size(); ++i)
+      worst = std::max(worst, (*a.samples[i].d - *b.samples[i].d).norm());
+    CHECK(worst < 1e-12);
+  }
 }

@@ -36,7 +36,23 @@ TEST_CASE("make_rtest_joint_model checks the parts against the basis") {
   const Eigen::MatrixXd C = Eigen::MatrixXd::Zero(n, n);
   const std::vector<bool> obs(static_cast<std::size_t>(n), true);
   CHECK_NOTHROW(make_rtest_joint_model(MachineType::BC_trt, b, p, C, obs));
-  CHECK_THROWS_AS(make_rtest_joint_model(MachineType::AC_trt, b, p, C, obs), InvalidArgument);
+  // Any machine: a table machine has the same layout; a machine with head axes adds
+  // tool_offset_Z after the location errors and its head axis' map has no rotations.
+  CHECK_NOTHROW(make_rtest_joint_model(MachineType::AC_trt, b, p, C, obs));
+  const MachineType head = parse_machine_type("B-head-C-table");
+  CHECK_THROWS_WITH(make_rtest_joint_model(head, b, p, C, obs), Catch::Contains("tool_offset_Z"));
+  {
+    const RtestBasis bh = b.for_machine(head);
+    CHECK(!bh.b_rotations);  // B is on the head
+    CHECK(bh.c_rotations);   // C is on the table
+    const Eigen::Index nh = 9 + bh.num_b_coefficients() + bh.num_c_coefficients();
+    CHECK(nh == n + 1 - 9);  // 9 odd-power rotation coefficients of the B map are not there
+    const RtestJointModel mh = make_rtest_joint_model(head, b, Eigen::VectorXd::Zero(nh), Eigen::MatrixXd::Zero(nh, nh),
+                                                      std::vector<bool>(static_cast<std::size_t>(nh), true));
+    CHECK(mh.parameter_names().size() == static_cast<std::size_t>(nh));
+    CHECK(mh.parameter_names()[8] == "tool_offset_Z");
+    CHECK(mh.parameter_names()[9] == "dx_BZ.b2");
+  }
   CHECK_THROWS_AS(make_rtest_joint_model(MachineType::BC_trt, b, p.head(n - 1), C, obs),
                   InvalidArgument);
   CHECK_THROWS_AS(make_rtest_joint_model(MachineType::BC_trt, b, p, C.topLeftCorner(n - 1, n), obs),

@@ -288,3 +288,70 @@ def test_diagnosis_json_says_which_harmonics_the_sampling_cannot_resolve(shared_
         assert len(g["harmonic_um"]) == 5 and g["harmonics_left_out"] == [6, 7, 8]
         assert all(0 <= a < 1.0 for a in g["harmonic_um"])  # um, finite
         assert "left out" in g["harmonic_note"] and "12 distinct angles" in g["harmonic_note"]
+
+
+# ------------------------------------------------------------------------- any machine (issue 13)
+
+@pytest.mark.parametrize("machine", ["AC-trt", "B45C-trt", "B-head-C-table", "AC-head", "BC-head"])
+def test_simulate_and_identify_on_any_machine(machine):
+    from rotacal import rtest
+    mtype = rotacal._core.parse_machine_type(machine)
+    effects = {"tool_offset_Z": 0.015} if mtype.has_head else None
+    s, t = rtest.simulate_rtest("random", effects, machine=machine, noise_um=0.3, seed=7)
+    pattern = rtest.default_pattern(machine)
+    assert len(s) == len(pattern["b_deg"]) * len(pattern["c_deg"]) * len(pattern["nests"])
+    d = rtest.identify_rtest(s).to_dict()
+    assert d["machine"] == machine and d["converged"]
+    assert abs(d["residual_rms_um"] - 0.3) < 0.1
+    seen = 0
+    for n, v in d["location_errors"].items():
+        if v["value"] is None:
+            continue
+        seen += 1
+        assert abs(v["value"] - t["errors"][n]) <= 3 * v["std"], (n, v, t["errors"][n])
+    maps = rotacal._core.rtest_map_names(mtype)
+    assert d["error_map"]["maps"] == maps
+    if mtype.has_head:
+        # One tool length: the head's tilt axis position along the spindle goes with the tool
+        # length error, and the advice says which set-up separates them.
+        assert seen >= 6 and "tool_offset_Z" in d
+        assert any("tool_offset_Z" in u for u in d["unobservable"])
+        assert any("second tool length" in n for n in d["notes"])
+    else:
+        assert seen == 8 and d["unobservable"] == []
+    # Oyama's method stays on BC-trt and names the method that works here.
+    with pytest.raises(rotacal.InvalidArgument, match="joint fit"):
+        rtest.identify_rtest(s, method="paper")
+
+
+def test_default_pattern_follows_the_limits():
+    from rotacal import rtest
+    p = rtest.default_pattern("B45C-trt")  # B turns 0..180
+    assert p["b_deg"][0] == pytest.approx(0.0) and p["b_deg"][-1] == pytest.approx(180.0)
+    assert rtest.default_pattern("BC-trt")["b_deg"] == rtest.B_GRID
+    with pytest.raises(rotacal.InvalidArgument, match=r"beyond its limits \[0, 180\]"):
+        rtest.simulate_rtest("zero", machine="B45C-trt", b_deg=[-90, 0, 90])
+
+
+def test_cli_simulate_and_identify_head_machine(tmp_path):
+    out = tmp_path / "head.csv"
+    r = rotacal_cli("simulate", "rtest", "--machine", "B-head-C-table", "-o", out, "--seed", "4")
+    assert r.returncode == 0, r.stderr
+    assert "7 B x 12 C x 2 nests" in r.stderr + r.stdout
+    text = out.read_text()
+    assert "# machine: B-head-C-table" in text
+    r = rotacal_cli("identify", out)
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout)
+    assert d["machine"] == "B-head-C-table" and set(d["location_errors"]) >= {"E_X0C", "E_X0B"}
+    assert "tool_offset_Z" in d and d["error_map"]["maps"] == ["BZ", "CY"]
+    truth_errors = json.loads((tmp_path / "head.truth.json").read_text())["errors"]
+    for n, v in d["location_errors"].items():
+        if v["value"] is not None:
+            assert abs(v["value"] - truth_errors[n]) <= 3 * v["std"], n
+    r = rotacal_cli("identify", out, "--method", "paper")
+    assert r.returncode != 0 and "joint fit" in r.stderr
+    # A grid the machine cannot turn to is refused, naming the axis and its limits.
+    r = rotacal_cli("simulate", "rtest", "--machine", "B45C-trt", "--b-range", "-90,90", "--b-step", "45",
+                    "-o", tmp_path / "nut.csv")
+    assert r.returncode != 0 and "beyond its limits [0, 180]" in r.stderr

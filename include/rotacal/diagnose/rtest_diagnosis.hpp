@@ -2,8 +2,10 @@
 /// \file
 /// The diagnosis of an R-test session: the DiagnosisProblem for the exact R-test reading,
 ///   d = T(B, C, t)^-1 * p_tool(xyz, t) - q_nest + zero_setup      (Oyama Eq. 4, in the table frame)
-/// with baseline = the 8 location errors + an unknown probe zero per set-up, and the
-/// catalogue's effects (kinematics/effects.hpp) as the candidate extensions. Every reading
+/// with baseline = the 8 location errors (+ tool_offset_Z, minus the error of pivot_length +
+/// tool_length, on a machine with head axes) + an unknown probe zero per set-up, and the
+/// catalogue's effects (kinematics/effects.hpp) that exist on the machine as the candidate
+/// extensions; on any machine of kinematics/machine_description.hpp. Every reading
 /// has three components (dx, dy, dz); each is one residual.
 
 #include <memory>
@@ -26,7 +28,8 @@ class RtestDiagnosisProblem : public DiagnosisProblem {
   const std::vector<double>& times() const override { return times_; }
   const std::vector<RotaryAngles<double>>& angles() const override { return angles_; }
   std::optional<double> declared_noise_um() const override { return session_.noise_um; }
-  /// The catalogue less the ballbar's own entries.
+  /// The catalogue less the ballbar's own entries (and tool_offset_Z on a head machine, where
+  /// it is in the baseline).
   std::vector<Effect> candidates(int max_harmonic) const override;
   ModelFit fit(const EffectModel& effects) const override;
   Eigen::MatrixXd candidate_jacobian(const ModelFit& at, const Effect& candidate) const override;

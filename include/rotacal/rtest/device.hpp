@@ -102,8 +102,10 @@ std::vector<SpindleIndexSample> simulate_spindle_indexing(const Eigen::Matrix3d&
                                                           double noise_um, unsigned seed);
 
 /// The sphere offset o (x, y, at the spindle orientation used during the R-test) displaces the
-/// actual sphere by (o, 0) in the machine frame, which the table frame sees as R^T (o, 0)
-/// (nominal R = Ry(B) Rz(C)): returns the session with that subtracted from every d.
+/// actual sphere by H (o, 0) in the machine frame (H the head's nominal rotation at the pose,
+/// identity without head axes), which the table frame sees as R^T H (o, 0) (R the table's
+/// nominal rotation, Ry(B) Rz(C) on BC-trt): returns the session with that subtracted from
+/// every d. Any machine.
 RtestSession compensate_sphere_offset(const RtestSession& session, const Eigen::Vector2d& offset);
 
 /// Fill dx,dy,dz from raw d1,d2,d3 with the session's probe.N.dir (N = 1..3), d = Dirs^-1 raw.

@@ -1,11 +1,14 @@
 #pragma once
 /// \file
-/// The error map of a B/C table per angle (Oyama Sec. 5.2, Figs. 6-7) from either identification,
-/// its JSON/CSV writers, and the held-out check of a predictor.
+/// The error map per angle (Oyama Sec. 5.2, Figs. 6-7) from either identification, its JSON/CSV
+/// writers, and the held-out check of a predictor. On any machine "B" is the tilt axis and "C"
+/// the rotary axis; the columns carry the machine's letters and map names (rtest_map_names).
 ///
-/// CSV columns: B, C (deg), then dx_BY .. gamma_BY, dx_CB .. gamma_CB (mm, rad), then the same
-/// with suffix _std (1 sigma; empty where the data cannot determine the value).
+/// CSV columns: B, C (deg; the machine's tilt and rotary letters), then dx_BY .. gamma_BY,
+/// dx_CB .. gamma_CB (mm, rad; the machine's map names), then the same with suffix _std
+/// (1 sigma; empty where the data cannot determine the value).
 
+#include <array>
 #include <functional>
 #include <string>
 #include <vector>
@@ -23,6 +26,9 @@ struct RtestErrorMapEntry {
 
 struct RtestErrorMap {
   std::string method;  ///< "joint" or "paper"
+  MachineType machine = MachineType::BC_trt;
+  std::array<std::string, 2> maps = {"BY", "CB"};  ///< names of the tilt and rotary maps
+  std::array<char, 2> letters = {'B', 'C'};        ///< tilt and rotary axis letters
   std::vector<RtestErrorMapEntry> entries;  ///< B outer, C inner
   std::vector<std::string> notes;
 };

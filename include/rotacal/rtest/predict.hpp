@@ -11,10 +11,12 @@
 
 namespace rotacal {
 
-/// A joint model from its parts (as a model file stores them). Throws InvalidArgument naming
-/// the part when the machine is not BC-trt, a basis degree is negative, the sizes disagree with
-/// the basis (params: 8 + num_b_coefficients + num_c_coefficients; covariance square of that
-/// size; one observable flag per parameter), or a value is not finite.
+/// A joint model from its parts (as a model file stores them), on any machine. Throws
+/// InvalidArgument naming the part when a basis degree is negative, the sizes disagree with
+/// the basis (params: rtest_num_location_parameters(machine) + num_b_coefficients +
+/// num_c_coefficients, i.e. 8 location errors, tool_offset_Z on a machine with head axes, then
+/// the map coefficients; covariance square of that size; one observable flag per parameter), or
+/// a value is not finite.
 RtestJointModel make_rtest_joint_model(MachineType machine, const RtestBasis& basis,
                                        const Eigen::VectorXd& params,
                                        const Eigen::MatrixXd& covariance,
@@ -26,8 +28,9 @@ inline const std::vector<std::string>& rtest_prediction_std_columns() {
   return names;
 }
 
-/// The session with every dx,dy,dz replaced by the model's reading of its nest at its (B, C):
-///   d = T(B, C)^-1 xyz_nominal(B, C, q_nest) - q_nest + zero_setup
+/// The session with every dx,dy,dz replaced by the model's reading of its nest at its angles
+/// (tilt B, rotary C; RtestJointModel::reading):
+///   d = T(B, C)^-1 (xyz_nominal + H t) - q_nest + zero_setup
 /// where zero_setup is probe_zeros[setup] if `probe_zeros` is not empty (every set-up must then
 /// have one) and 0 otherwise (a new set-up's probe zero is unknown). Raw d1,d2,d3 are dropped
 /// (they were measured, not predicted). The 1-sigma of each predicted component (parameter

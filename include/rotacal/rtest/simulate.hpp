@@ -9,6 +9,7 @@
 ///   d   = T(B, C, t)^-1 * tool_position(xyz, t) - q_nest + zero_setup + noise
 
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "rotacal/core/machine_model.hpp"
@@ -19,13 +20,29 @@ namespace rotacal {
 
 /// Measurement pattern. Defaults: the paper's B = -90..90 every 30 deg, C = 0..330 every 30 deg
 /// (84 poses per nest), and the two nests of rtest_bc_oyama.csv. Poses run B outer, C inner.
+/// On any machine b_deg are the tilt axis' angles and c_deg the rotary axis' (RotaryAngles);
+/// default_rtest_pattern fits them and the nests to a machine's limits.
 struct RtestPattern {
-  std::vector<double> b_deg = {-90, -60, -30, 0, 30, 60, 90};                      ///< deg
-  std::vector<double> c_deg = {0, 30, 60, 90, 120, 150, 180, 210, 240, 270, 300, 330};  ///< deg
+  std::vector<double> b_deg = {-90, -60, -30, 0, 30, 60, 90};                      ///< tilt, deg
+  std::vector<double> c_deg = {0, 30, 60, 90, 120, 150, 180, 210, 240, 270, 300, 330};  ///< rotary, deg
   std::vector<Eigen::Vector3d> nests = {Eigen::Vector3d(100, 0, 60),
                                         Eigen::Vector3d(0, -120, 140)};  ///< table frame, mm
   double dwell_s = 6.0;  ///< time between poses, s; the program holds each pose at rest for the middle 80 % (hw/pose_window.hpp)
 };
+
+/// The paper's pattern fitted to machine m: seven tilt angles over the widest span of at most
+/// 180 deg inside the tilt axis' limits, centred on 0 where the limits allow (-90..90 every 30
+/// deg when they do; 0..180 on a nutating table whose B turns 0..180); twelve rotary angles
+/// every 30 deg (spread over the limits of a rotary axis that turns less than a full turn);
+/// the two nests of rtest_bc_oyama.csv, each halved (up to four times) until every commanded
+/// X, Y, Z lies inside the machine's travel. Throws InvalidArgument naming the nest when no
+/// halving fits.
+RtestPattern default_rtest_pattern(MachineType m);
+
+/// Throws InvalidArgument, naming `context`, the axis and its limits (or the travel), when a
+/// pattern angle lies outside the machine's rotary limits or a commanded X, Y, Z outside its
+/// travel.
+void check_rtest_pattern(MachineType m, const RtestPattern& pattern, const std::string& context);
 
 struct RtestSimOptions {
   RtestPattern pattern;
@@ -43,9 +60,11 @@ struct RtestSimulation {
   std::vector<Eigen::Vector3d> probe_zeros;  ///< per set-up (nest order), table frame, mm
 };
 
-/// Simulate a whole session; each reading is rtest_reading (model.hpp). Throws
-/// InvalidArgument for an empty pattern, negative noise or effect parameters that do not
-/// match the effect model.
+/// Simulate a whole session on any machine; each reading is rtest_reading (model.hpp), with the
+/// tool-length error of a head machine taken from tool_offset_Z among the effects. Throws
+/// InvalidArgument for an empty pattern, a pattern outside the machine's limits
+/// (check_rtest_pattern), negative noise or effect parameters that do not match the effect
+/// model.
 RtestSimulation simulate_rtest(const MachineModel& truth, const RtestSimOptions& options = {});
 
 }  // namespace rotacal
