@@ -206,6 +206,13 @@ def rtest_model_dict(ident: Any, nests: dict) -> dict:
     basis = model.basis
     le_names = list(_core.location_error_names(machine))
     coef_names = list(basis.coefficient_names())
+    if list(model.parameter_names()) != le_names + coef_names:
+        # The file layout (docs/model_file.md) is the B/C table's: location errors, then the
+        # basis' coefficients. Other machines' maps (and a head's tool_offset_Z) are not in it.
+        raise _core.InvalidArgument(
+            f"the R-test model of the {_core.machine_name(machine)} machine cannot be saved as "
+            f"rotacal-model/1 {RTEST_KIND} yet (its parameters are not the file's location errors "
+            "+ B/C map coefficients); its numbers are in identify --json")
     by_name = {p.name: p for p in raw.parameters}
     zeros: dict[str, dict] = {}
     for setup in raw.probe_zeros:

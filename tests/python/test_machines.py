@@ -342,3 +342,17 @@ def test_doc_table_of_builtins_matches_the_descriptions():
         m = _core.parse_machine_type(name)
         assert (conf, a0 + a1) == (m.configuration, m.axis_names)
         assert names.split() == list(_core.location_error_names(m))
+
+
+def test_rtest_model_file_refused_where_its_layout_does_not_fit(capsys, tmp_path):
+    """rtest-joint model files hold the B/C map layout: other machines are refused by name, not
+    written wrong (their numbers stay in identify --json)."""
+    session = tmp_path / "r.csv"
+    assert run(capsys, "simulate", "rtest", "--machine", "B-head-C-table", "-o", session)[0] == 0
+    code, _, err = run(capsys, "identify", session, "--no-budget", "--save-model", tmp_path / "m.json")
+    assert code == 3, err
+    assert "B-head-C-table machine cannot be saved" in err
+    assert not (tmp_path / "m.json").exists()
+    code, out, err = run(capsys, "identify", session, "--no-budget", "--json")
+    assert code == 0, err
+    assert "tool_offset_Z" in out
