@@ -51,6 +51,7 @@ step "Benchmarks, once each as a smoke check (figures: run them without --smoke)
 "$PY" bench/history_bench.py --smoke
 "$PY" bench/design_bench.py --smoke
 ./build/release/bench/noise_mc_bench --smoke
+./build/release/bench/any_machine_bench --smoke
 
 step "libFuzzer targets of the instrument decoders, 20 s each (clang)"
 cmake -S fuzz -B build/fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DROTACAL_FUZZ_SECONDS=20
