@@ -63,5 +63,7 @@ step "C++ tests under AddressSanitizer + UBSan"
 cmake -S . -B build/asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" \
       -DROTACAL_SANITIZE=ON -DROTACAL_BUILD_BENCH=OFF
 cmake --build build/asan
+# The two Monte Carlo studies (hundreds of refits of code the other tests run too) are left to the
+# Release run: under ASan they took 219 s and 122 s of a 694 s run, and CI has 45 minutes.
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
-  ctest --test-dir build/asan --output-on-failure -j "$(nproc)"
+  ctest --test-dir build/asan --output-on-failure -j "$(nproc)" -E '^(test_rtest_design|test_joint_noise_fit)$'
