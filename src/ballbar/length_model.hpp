@@ -67,12 +67,12 @@ class BallbarLengthModel : public ResidualModel {
     const MachineDescription& md = m.description();
     const LocationErrors<double> e(x.head<8>());
     const RotaryAngles<double>& cmd = d_.angles[static_cast<std::size_t>(i)];
-    double tool_z = 0.0, length_offset = 0.0;
+    double tool_z = 0.0;
     int tool_z_col = -1, length_col = -1;
     for (std::size_t k = 0; k < fx_.effects.size(); ++k) {
       const int col = 11 + fx_.offset(k);
       if (fx_.effects[k].kind == EffectKind::tool_offset_Z) tool_z += x[col], tool_z_col = col;
-      else length_offset += x[col], length_col = col;
+      else length_col = col;
     }
     const int nt = static_cast<int>(md.table_axes.size());
     LineRotationDerivatives D[2];
@@ -91,9 +91,8 @@ class BallbarLengthModel : public ResidualModel {
       v = D[k].f;
     }
     const Eigen::Vector3d b = d_.xyz.col(i) + v;
-    const double len = (b - P).norm();
-    const Eigen::Vector3d u = (b - P) / len;
-    r = len + length_offset - d_.length[i];
+    const Eigen::Vector3d u = (b - P).normalized();
+    sample<double>(i, x.data(), &r);  // the residual itself from the one model
     J.setZero();
     // dL/d(line k) = +-u^T (outer rotations) dD_k; the table side enters with a minus.
     Eigen::RowVector3d w = -u.transpose();

@@ -341,7 +341,7 @@ RtestSeparationDesign design_rtest_separation(const RtestSession& session,
   }
   const int ns = static_cast<int>(nest_index.size()), na = pair[0].num_params(),
             nb = pair[1].num_params();
-  const int ne = na + nb, z0 = 8, e0 = 8 + 3 * ns, p0 = e0 + ne;
+  const int ne = na + nb, e0 = 8 + 3 * ns, p0 = e0 + ne;  // errors, probe zeros (3 per nest), effects
   RtestJointOptions fo;
   fo.noise = NoiseHandling::white;
   const RtestJointIdentification id = identify_joint(session, fo);

@@ -25,6 +25,15 @@ const char* kCustom = R"({"format": "rotacal-machine/1", "name": "A-head-C-table
   "head_axes": [{"name": "A", "direction": [1, 0, 0], "point": [0, 0, 40], "limits_deg": [-100, 100]}],
   "pivot_length": 120, "tool_length": 60})";
 
+// The default single set-up plan of a machine (tilt range within its limits), sampled every step.
+BallbarSetup default_setup(MachineType m, double step_deg) {
+  BallbarSetup setup;
+  setup.machine = m;
+  setup.tilt_range_deg = default_tilt_range_deg(m);
+  setup.step_deg = step_deg;
+  return setup;
+}
+
 std::vector<MachineType> machines() {
   std::vector<MachineType> out;
   for (const std::string& n : builtin_machine_names()) out.push_back(parse_machine_type(n));
@@ -40,10 +49,7 @@ TEST_CASE("hidden location errors are identified within 3 sigma on every machine
   std::uint64_t seed = 100;
   for (const MachineType m : machines()) {
     INFO(to_string(m));
-    BallbarSetup setup;
-    setup.machine = m;
-    setup.tilt_range_deg = default_tilt_range_deg(m);
-    setup.step_deg = 2.0;
+    const BallbarSetup setup = default_setup(m, 2.0);
     const BallbarSession cmd = commanded_session(plan_ballbar_test(setup));
     BallbarMachineModel truth;
     truth.machine = m;
@@ -92,11 +98,7 @@ TEST_CASE("the plan keeps every rotary angle inside the machine's limits", "[any
 TEST_CASE("machine-axis programs put the ball where the plan wants it on every machine", "[any_machine]") {
   for (const MachineType m : machines()) {
     INFO(to_string(m));
-    BallbarSetup setup;
-    setup.machine = m;
-    setup.tilt_range_deg = default_tilt_range_deg(m);
-    setup.step_deg = 5.0;
-    const BallbarPlan plan = plan_ballbar_test(setup);
+    const BallbarPlan plan = plan_ballbar_test(default_setup(m, 5.0));
     double worst = 0.0;
     for (const PlanSegment& seg : plan.segments)
       for (const PlannedSample& s : seg.samples)
@@ -140,10 +142,7 @@ TEST_CASE("a description written out for AC-trt identifies the shared sessions a
 TEST_CASE("the diagnosis names a hidden effect of a head axis", "[any_machine]") {
   // Coning of a fork head's B axis (30 urad/rad) and a tool 10 um short, in AR(0.5) noise.
   const MachineType m = parse_machine_type("BC-head");
-  BallbarSetup setup;
-  setup.machine = m;
-  setup.step_deg = 2.0;
-  const BallbarSession cmd = commanded_session(plan_ballbar_test(setup));
+  const BallbarSession cmd = commanded_session(plan_ballbar_test(default_setup(m, 2.0)));
   BallbarMachineModel truth;
   truth.machine = m;
   truth.errors.v << 0.02, -0.01, 2e-5, -3e-5, 0.015, 0.01, 1e-5, -2e-5;
@@ -159,10 +158,7 @@ TEST_CASE("compensation removes what the ballbar sees on head machines", "[any_m
   for (const char* name : {"B-head-C-table", "BC-head"}) {
     INFO(name);
     const MachineType m = parse_machine_type(name);
-    BallbarSetup setup;
-    setup.machine = m;
-    setup.step_deg = 2.0;
-    const BallbarSession cmd = commanded_session(plan_ballbar_test(setup));
+    const BallbarSession cmd = commanded_session(plan_ballbar_test(default_setup(m, 2.0)));
     BallbarMachineModel truth;
     truth.machine = m;
     truth.errors.v << 0.03, -0.02, 4e-5, -3e-5, 0.025, 0.02, 3e-5, -4e-5;
@@ -183,10 +179,7 @@ TEST_CASE("compensation removes what the ballbar sees on head machines", "[any_m
 TEST_CASE("files of the new built-ins carry their description and read back as the built-in", "[any_machine]") {
   for (const std::string& name : builtin_machine_names()) {
     INFO(name);
-    BallbarSetup setup;
-    setup.machine = parse_machine_type(name);
-    setup.tilt_range_deg = default_tilt_range_deg(setup.machine);
-    setup.step_deg = 10.0;
+    const BallbarSetup setup = default_setup(parse_machine_type(name), 10.0);
     const BallbarSession s = commanded_session(plan_ballbar_test(setup));
     const std::string text = format_ballbar(s);
     const bool table_of_formats_md = name == "AC-trt" || name == "BC-trt";

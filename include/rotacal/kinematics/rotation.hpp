@@ -125,7 +125,7 @@ inline LineRotationDerivatives rotate_point_about_line_derivatives(const Eigen::
   D.v = q - point;
   D.c = std::cos(theta);
   D.s = std::sin(theta);
-  D.f = point + D.v * D.c + D.u.cross(D.v) * D.s + D.u * (D.u.dot(D.v) * (1.0 - D.c));
+  D.f = rotate_point_about_line<double>(point, direction, theta, q);  // the one definition
   return D;
 }
 
