@@ -98,6 +98,9 @@ double chi2_sf(double x, double k) {
 
 double f_sf(double f, double d1, double d2) {
   if (!(d1 > 0.0) || !(d2 > 0.0)) throw InvalidArgument("f_sf: degrees of freedom must be > 0");
+  // An undetermined statistic (0/0 from residuals that are exactly zero) has an undetermined
+  // p-value: NaN, which no threshold passes and JSON writes as null with its reason.
+  if (std::isnan(f)) return f;
   if (f <= 0.0) return 1.0;
   // P(F > f) = I_{d2 / (d2 + d1 f)}(d2 / 2, d1 / 2)
   return beta_i(0.5 * d2, 0.5 * d1, d2 / (d2 + d1 * f));

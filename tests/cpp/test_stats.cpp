@@ -3,6 +3,7 @@
 #include "rotacal/core/error.hpp"
 #include "rotacal/core/stats.hpp"
 
+#include <cmath>
 #include <limits>
 
 using namespace rotacal;
@@ -31,6 +32,9 @@ TEST_CASE("incomplete beta and gamma match SciPy; bad arguments throw", "[stats]
   CHECK_THROWS_AS(stats::beta_i(-1.0, 2.0, 0.5), InvalidArgument);
   CHECK_THROWS_AS(stats::gamma_p(1.0, -2.0), InvalidArgument);
   CHECK_THROWS_AS(stats::f_sf(1.0, 0.0, 3.0), InvalidArgument);
+  // 0/0 (residuals exactly zero, as identical rows give on some CPUs): undetermined, not a throw.
+  CHECK(std::isnan(stats::f_sf(std::nan(""), 2, 100)));
+  CHECK(stats::f_sf(std::numeric_limits<double>::infinity(), 2, 100) == 0.0);
 }
 
 // Reference values from scipy.stats.t.ppf(0.975, nu) and scipy.stats.norm.ppf(0.975).
