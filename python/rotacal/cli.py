@@ -266,14 +266,27 @@ def cmd_simulate(a: argparse.Namespace) -> int:
 
 
 def _rtest_inputs(a: argparse.Namespace) -> dict:
-    """The pattern and simulated machine of `simulate rtest` / `virtual rtest` / `record rtest`."""
+    """The pattern and simulated machine of `simulate rtest` / `virtual rtest` / `record rtest`:
+    a grid or nests not given are the machine's default pattern (inside its rotary limits and
+    travel: rtest.default_pattern; the paper's on BC-trt); given ones are checked later."""
     from . import rtest
-    b0, b1 = a.tilt_range
-    c0, c1 = a.c_range
-    out = {"machine": a.machine,
-           "b_deg": rtest.angle_grid(b0, b1, a.b_step, "--b-range/--b-step"),
-           "c_deg": rtest.angle_grid(c0, c1, a.c_step, "--c-range/--c-step", full_turn=True),
-           "nests": a.nest if a.nest else rtest.DEFAULT_NESTS,
+    from .machines import load_machine
+    mtype = load_machine(a.machine)
+    default = rtest.default_pattern(mtype)
+
+    def grid(given_range, step, fallback, what, full_turn=False):
+        if given_range is None and step is None:
+            return fallback
+        lo, hi = min(fallback), max(fallback)
+        if full_turn and len(fallback) > 1 and abs(hi + (fallback[1] - fallback[0]) - lo - 360.0) < 1e-9:
+            hi = lo + 360.0  # the default turns a full circle: so does a new step
+        lo, hi = given_range if given_range is not None else (lo, hi)
+        return rtest.angle_grid(lo, hi, 30.0 if step is None else step, what, full_turn=full_turn)
+
+    out = {"machine": mtype,
+           "b_deg": grid(a.tilt_range, a.b_step, default["b_deg"], "--b-range/--b-step"),
+           "c_deg": grid(a.c_range, a.c_step, default["c_deg"], "--c-range/--c-step", full_turn=True),
+           "nests": a.nest if a.nest else default["nests"],
            "dwell_s": a.dwell, "probe_dirs": None}
     if getattr(a, "errors", None) is not None:
         out["errors"] = errors_option(a.errors)
@@ -297,17 +310,8 @@ def cmd_simulate_rtest(a: argparse.Namespace) -> int:
     b_deg, c_deg, nests, dirs = r["b_deg"], r["c_deg"], r["nests"], r["probe_dirs"]
     if dirs is None and a.raw_only:
         raise OptionError("--raw-only needs the probe directions (--probe-dir x3)")
-    # Any machine: a grid or nests left at the paper's defaults become the machine's own default
-    # (inside its rotary limits and travel: rtest.default_pattern); given ones are checked.
-    mtype = _core.parse_machine_type(a.machine)
-    default = rtest.default_pattern(mtype)
-    if list(a.tilt_range) == [-90.0, 90.0] and a.b_step == 30.0:
-        b_deg = default["b_deg"]
-    if list(a.c_range) == [0.0, 360.0] and a.c_step == 30.0:
-        c_deg = default["c_deg"]
-    if not a.nest:
-        nests = default["nests"]
-    session, truth = rtest.simulate_rtest(r["errors"], r["effects"], machine=a.machine, b_deg=b_deg, c_deg=c_deg,
+    mtype = r["machine"]
+    session, truth = rtest.simulate_rtest(r["errors"], r["effects"], machine=mtype, b_deg=b_deg, c_deg=c_deg,
                                           nests=nests, noise_um=a.noise, probe_zero_um=a.probe_zero,
                                           probe_dirs=dirs, write_d=not a.raw_only, dwell_s=a.dwell,
                                           seed=a.seed)
@@ -1394,13 +1398,19 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _add_rtest_pattern_args(q: argparse.ArgumentParser) -> None:
-    g = q.add_argument_group("measurement pattern (Oyama & Ibaraki Sec. 3.3)")
-    g.add_argument("--machine", default="BC-trt", help="BC-trt (the R-test model's machine) or AC-trt")
-    g.add_argument("--b-range", dest="tilt_range", default="-90,90", type=numbers("--b-range", 2, 360.0, "deg"), help="tilt axis range, deg (inclusive)")
-    g.add_argument("--b-step", type=number("--b-step", 0.0, 360.0, "deg"), default=30.0, help="tilt step, deg")
-    g.add_argument("--c-range", default="0,360", type=numbers("--c-range", 2, 720.0, "deg"),
-                   help="C range, deg (inclusive; an end one full turn after the start is left out)")
-    g.add_argument("--c-step", type=number("--c-step", 0.0, 360.0, "deg"), default=30.0, help="C step, deg")
+    g = q.add_argument_group("measurement pattern (Oyama & Ibaraki Sec. 3.3; left out: the machine's "
+                             "default pattern inside its limits and travel, the paper's on BC-trt)")
+    g.add_argument("--machine", default="BC-trt", type=path("--machine"), metavar="NAME|FILE",
+                   help="a built-in (`rotacal machines`) or a rotacal-machine/1 description file (default BC-trt)")
+    g.add_argument("--b-range", dest="tilt_range", default=None, type=numbers("--b-range", 2, 360.0, "deg"),
+                   help="tilt axis range, deg (inclusive; default the machine's, -90,90 on BC-trt)")
+    g.add_argument("--b-step", type=number("--b-step", 0.0, 360.0, "deg"), default=None,
+                   help="tilt step, deg (default 30)")
+    g.add_argument("--c-range", default=None, type=numbers("--c-range", 2, 720.0, "deg"),
+                   help="rotary axis range, deg (inclusive; an end one full turn after the start is left out; "
+                        "default 0,360)")
+    g.add_argument("--c-step", type=number("--c-step", 0.0, 360.0, "deg"), default=None,
+                   help="rotary axis step, deg (default 30)")
     g.add_argument("--nest", action="append", metavar="X,Y,Z", type=numbers("--nest", 3, 1e4, "mm"),
                    help="nominal ball centre of a sensor nest, table frame, mm (repeatable; default "
                         "the paper's two: 100,0,60 and 0,-120,140)")

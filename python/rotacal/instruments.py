@@ -18,6 +18,7 @@ import numpy as np
 
 from . import _core, rtest
 from .progress import ProgressBar
+from .models import machine_members
 
 # A tripod of probes, each 45 deg off the vertical, as R-test nests are commonly built.
 DEFAULT_PROBE_DIRS = np.array([[1.0, 0.0, -1.0], [0.0, 1.0, -1.0], [-1.0, -1.0, -1.0]])
@@ -115,7 +116,7 @@ def virtual_rtest(errors: Any = "random", effects: Mapping[str, Any] | None = No
     dev.start()
     truth = {"errors": dict(zip(_core.location_error_names(mtype), e.tolist())), "effects": effects_out,
              "nests": nest_arr.tolist(), "noise_um": float(noise_um), "probe_zeros": dev.probe_zeros.tolist(),
-             "probe_zero_um": float(probe_zero_um), "machine": _core.machine_name(mtype),
+             "probe_zero_um": float(probe_zero_um), **machine_members(mtype),
              "pattern": {"b_deg": list(map(float, b_deg)), "c_deg": list(map(float, c_deg)),
                          "dwell_s": float(dwell_s)},
              "probe_dirs": dirs.tolist(), "mode": mode, "seed": int(seed)}

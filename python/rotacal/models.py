@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from . import _core
+from . import _core, jsontext
 
 FORMAT = "rotacal-model/1"
 
@@ -193,41 +193,46 @@ RTEST_BASIS_DEFINITION = (
     "b^P (even P >= 2); rotations: odd P >= 1. w_CB component k: 'k_CB.cosN.bM' multiplies "
     "b^M cos(N C), 'k_CB.sinN.bM' b^M sin(N C); 'dxy_CB.back1.u.b0' adds (cos C, -sin C) to "
     "(dx, dy)_CB and '.v.b0' (sin C, cos C), likewise 'alphabeta_CB.back1' for (alpha, beta)_CB. "
-    "R-test reading of the nest at q: d = T^-1 (Ry(B) Rz(C) q) - q + probe zero. Units mm, rad.")
+    "R-test reading of the nest at q: d = T^-1 (Ry(B) Rz(C) q) - q + probe zero. Units mm, rad. "
+    "On another machine B is its tilt axis and C its rotary axis; basis.maps names their maps "
+    "(coefficients 'dz_<tilt map>.b2', 'dx_<rotary map>.cos1.b0', ...), each E(w) stands in front "
+    "of its own axis' rotation in the machine's chain (docs/machines.md), an axis on the head has "
+    "translations only, and the tool ball is at (0, 0, -(pivot + tool length) + tool_offset_Z) in "
+    "the spindle frame.")
 
 
 def rtest_model_dict(ident: Any, nests: dict) -> dict:
-    """Model dict (``kind: rtest-joint``) of a joint R-test identification: location errors,
-    map coefficients and their covariance, the basis and its definition, the nests and the
-    fitted probe zero of each set-up."""
+    """Model dict (``kind: rtest-joint``) of a joint R-test identification on any machine:
+    location errors, on a machine with head axes tool_offset_Z, the two maps' coefficients
+    (named after the machine's axes, e.g. ``dz_BY.b2``, ``dx_CZ.cos2.b0``) and their covariance,
+    the basis and its definition, the nests and the fitted probe zero of each set-up.
+    Parameters of an unobservable combination keep the value the fit gave them under its
+    convention (``observable: false``, no std), so that the file predicts as the fit did."""
     raw = ident
     model = raw.model
     machine = model.machine
     basis = model.basis
     le_names = list(_core.location_error_names(machine))
-    coef_names = list(basis.coefficient_names())
-    if list(model.parameter_names()) != le_names + coef_names:
-        # The file layout (docs/model_file.md) is the B/C table's: location errors, then the
-        # basis' coefficients. Other machines' maps (and a head's tool_offset_Z) are not in it.
-        raise _core.InvalidArgument(
-            f"the R-test model of the {_core.machine_name(machine)} machine cannot be saved as "
-            f"rotacal-model/1 {RTEST_KIND} yet (its parameters are not the file's location errors "
-            "+ B/C map coefficients); its numbers are in identify --json")
+    names = list(model.parameter_names())
+    head = ["tool_offset_Z"] if machine.has_head else []
+    coef_names = names[len(le_names) + len(head):]
     by_name = {p.name: p for p in raw.parameters}
+    est = convention_estimate_dict
     zeros: dict[str, dict] = {}
     for setup in raw.probe_zeros:
-        zeros[setup] = {a: estimate_dict(by_name[f"zero.{setup}.{a}"]) for a in "xyz"}
+        zeros[setup] = {a: est(by_name[f"zero.{setup}.{a}"]) for a in "xyz"}
     return {
         "format": FORMAT,
         "kind": RTEST_KIND,
         **machine_members(machine),
         "basis": {"b_degree": basis.b_degree, "c_harmonics": basis.c_harmonics,
                   "c_b_degree": basis.c_b_degree, "gamma_cb": bool(basis.gamma_cb),
+                  "maps": list(_core.rtest_map_names(machine)),
                   "definition": RTEST_BASIS_DEFINITION},
-        "location_errors": {n: estimate_dict(by_name[n]) for n in le_names},
-        "map_coefficients": {n: estimate_dict(by_name[n]) for n in coef_names},
-        "covariance": {"parameters": le_names + coef_names,
-                       "matrix": np.asarray(model.covariance).tolist()},
+        "location_errors": {n: est(by_name[n]) for n in le_names},
+        **{n: est(by_name[n]) for n in head},
+        "map_coefficients": {n: est(by_name[n]) for n in coef_names},
+        "covariance": {"parameters": names, "matrix": np.asarray(model.covariance).tolist()},
         "nests": {k: np.asarray(v, dtype=float).tolist() for k, v in nests.items()},
         "probe_zeros": zeros,
         "fit": {"residual_rms_um": float(raw.residual_rms_um), "sigma_um": float(raw.sigma_um),
@@ -245,8 +250,9 @@ def _int_field(d: dict, key: str, where: str) -> int:
 
 def rtest_model_from_dict(d: dict, source: str = "<model>") -> tuple[Any, dict, dict]:
     """(RtestJointModel, nests, probe zeros) from a ``rtest-joint`` model dict; errors name the
-    file and the key. Unobservable values (null) are taken as zero and flagged unobservable,
-    so that predictions they enter carry no uncertainty (NaN)."""
+    file and the key. Unobservable parameters (``observable: false``) keep the value written
+    (null: zero) and are flagged unobservable, so that predictions they enter carry no
+    uncertainty (NaN)."""
     if d.get("format") != FORMAT:
         raise _core.InvalidArgument(f"{source}: not a {FORMAT} file (format: {d.get('format')!r})")
     if d.get("kind") != RTEST_KIND:
@@ -261,8 +267,16 @@ def rtest_model_from_dict(d: dict, source: str = "<model>") -> tuple[Any, dict, 
     basis = _core.RtestBasis(_int_field(b, "b_degree", f"{source}: basis"),
                              _int_field(b, "c_harmonics", f"{source}: basis"),
                              _int_field(b, "c_b_degree", f"{source}: basis"), b["gamma_cb"])
-    names = list(_core.location_error_names(machine)) + list(basis.coefficient_names())
+    head = ["tool_offset_Z"] if machine.has_head else []
+    if not head and "tool_offset_Z" in d:
+        raise _core.InvalidArgument(f"{source}: tool_offset_Z: only a machine with head axes has it; "
+                                    f"{_core.machine_name(machine)} has none")
+    names = list(_core.location_error_names(machine)) + head + list(basis.coefficient_names(machine))
     values: dict[str, dict] = {}
+    for n in head:
+        if not isinstance(d.get(n), dict):
+            raise _core.InvalidArgument(f"{source}: {n}: a machine with head axes needs its estimate")
+        values[n] = d[n]
     for key in ("location_errors", "map_coefficients"):
         part = d.get(key, {})
         if not isinstance(part, dict):
@@ -277,11 +291,13 @@ def rtest_model_from_dict(d: dict, source: str = "<model>") -> tuple[Any, dict, 
             f"{b['c_b_degree']}" + (f"; missing: {', '.join(missing[:5])}" if missing else "")
             + (f"; unknown: {', '.join(unknown[:5])}" if unknown else ""))
     params = np.array([_value(values[n], f"{source}: {n}") for n in names])
-    observable = [values[n].get("value") is not None for n in names]
+    observable = [values[n].get("value") is not None and values[n].get("observable", True) is not False
+                  for n in names]
     cov = d.get("covariance", {})
     if not isinstance(cov, dict) or cov.get("parameters") != names:
         raise _core.InvalidArgument(f"{source}: covariance.parameters must list the {len(names)} "
-                                    "parameters in basis order")
+                                    "parameters in model order (location errors, tool_offset_Z on a "
+                                    "machine with head axes, map coefficients)")
     try:
         matrix = np.array(cov.get("matrix"), dtype=float)
     except (TypeError, ValueError):
@@ -289,6 +305,9 @@ def rtest_model_from_dict(d: dict, source: str = "<model>") -> tuple[Any, dict, 
     if matrix.shape != (len(names), len(names)):
         raise _core.InvalidArgument(f"{source}: covariance.matrix: shape {matrix.shape}, expected "
                                     f"({len(names)}, {len(names)})")
+    # Then the C++ reader's full check (units, bounds, basis.maps), so both languages refuse the
+    # same files; the checks above name the commoner mistakes more precisely.
+    _core.parse_model_document(jsontext.dumps(d), source)
     model = _core.RtestJointModel(machine, basis, params, matrix, observable)
     nests = {str(k): np.array(_floats_of(v, 3, f"{source}: nests.{k}")) for k, v in d.get("nests", {}).items()}
     zeros = {}

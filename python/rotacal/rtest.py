@@ -15,7 +15,7 @@ import numpy as np
 
 from . import _core
 from .machines import Errors, machine_truth  # noqa: F401  (rotacal.rtest.machine_truth)
-from .models import estimate_dict, rtest_model_dict, rtest_model_from_dict
+from .models import estimate_dict, machine_members, machine_of, rtest_model_dict, rtest_model_from_dict
 from .results import budget_dict, noise_model_dict
 
 # The C++ simulator's defaults (rtest/simulate.hpp: RtestSimOptions, RtestPattern): the
@@ -269,7 +269,7 @@ def simulate_rtest(errors: Errors = "random", effects: Mapping[str, Any] | None 
              "noise_um": float(noise_um),
              "probe_zeros": np.asarray(zeros).tolist(),
              "probe_zero_um": float(probe_zero_um),
-             "machine": _core.machine_name(mtype),
+             **machine_members(mtype),
              "pattern": {"b_deg": list(map(float, b_deg)), "c_deg": list(map(float, c_deg)),
                          "dwell_s": float(dwell_s)},
              "seed": int(seed)}
@@ -282,7 +282,7 @@ def truth_readings(truth: Mapping, session: _core.RtestSession, probe_zeros: boo
     """Noise-free dx,dy,dz (N, 3) of every row of a session on the machine of a truth dict
     (``simulate_rtest``), with the truth's probe zero of each set-up (set-up "k" is nest k)
     unless ``probe_zeros`` is False."""
-    mtype = _core.parse_machine_type(truth.get("machine", "BC-trt"))
+    mtype = machine_of({"machine": "BC-trt", **truth}, "truth")
     names = list(_core.location_error_names(mtype))
     e = np.array([truth["errors"][n] for n in names])
     ids = list(truth.get("effects", {}))

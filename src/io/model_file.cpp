@@ -11,6 +11,7 @@
 #include <set>
 
 #include "rotacal/core/error.hpp"
+#include "rotacal/rtest/identify_joint.hpp"
 
 namespace rotacal {
 
@@ -110,7 +111,20 @@ void check_rtest_joint(const json& doc, MachineType machine, const std::string& 
   }
   const json& g = member(b, "gamma_cb", source, "basis");
   if (!g.is_boolean()) bad(source, "basis.gamma_cb", "must be true or false, got " + shown(g));
+  if (b.contains("maps")) {
+    const auto maps = rtest_map_names(machine);
+    if (b["maps"] != json(std::vector<std::string>(maps.begin(), maps.end())))
+      bad(source, "basis.maps", shown(b["maps"]) + " are not the " + to_string(machine) + " machine's maps [\"" +
+                                     maps[0] + "\", \"" + maps[1] + "\"]");
+  }
   std::vector<std::string> names(location_error_names(machine).begin(), location_error_names(machine).end());
+  // A machine with head axes also fits tool_offset_Z (minus the error of pivot + tool length).
+  if (machine.has_head()) {
+    estimate(member(doc, "tool_offset_Z", source, ""), "tool_offset_Z", "mm", kMaxModelPositionError, source);
+    names.push_back("tool_offset_Z");
+  } else if (doc.contains("tool_offset_Z")) {
+    bad(source, "tool_offset_Z", "only a machine with head axes has it; " + to_string(machine) + " has none");
+  }
   const json& mc = object_member(doc, "map_coefficients", source);
   for (auto it = mc.begin(); it != mc.end(); ++it) {
     const std::string& n = it.key();
@@ -124,7 +138,8 @@ void check_rtest_joint(const json& doc, MachineType machine, const std::string& 
   const json& params = member(cov, "parameters", source, "covariance");
   if (params != json(names))
     bad(source, "covariance.parameters", "must list the " + std::to_string(names.size()) +
-                                             " parameters (location errors, then map_coefficients in order)");
+                                             " parameters (location errors, tool_offset_Z on a machine with head "
+                                             "axes, then map_coefficients in order)");
   const json& m = member(cov, "matrix", source, "covariance");
   if (!m.is_array() || m.size() != names.size())
     bad(source, "covariance.matrix", "must be " + std::to_string(names.size()) + " rows");

@@ -344,15 +344,88 @@ def test_doc_table_of_builtins_matches_the_descriptions():
         assert names.split() == list(_core.location_error_names(m))
 
 
-def test_rtest_model_file_refused_where_its_layout_does_not_fit(capsys, tmp_path):
-    """rtest-joint model files hold the B/C map layout: other machines are refused by name, not
-    written wrong (their numbers stay in identify --json)."""
+def _split_by_c(path, step):
+    """Two files from one session: rows with C on multiples of `step` deg, and the others."""
+    lines = path.read_text().splitlines()
+    meta = [ln for ln in lines if ln.startswith("#")]
+    header, *rows = [ln for ln in lines if ln and not ln.startswith("#")]
+    c_col = header.split(",").index("C")
+    out = []
+    for name, keep in (("fit", True), ("held", False)):
+        p = path.with_name(f"{path.stem}.{name}.csv")
+        p.write_text("\n".join(meta + [header] + [r for r in rows if (float(r.split(",")[c_col]) % step == 0) == keep]) + "\n")
+        out.append(p)
+    return out
+
+
+@pytest.mark.parametrize("name", ["B-head-C-table", "AC-head", "B45C-trt", "AC-trt", "custom"])
+def test_rtest_model_file_predicts_held_out_poses_on_any_machine(capsys, tmp_path, custom_file, name):
+    """Fit on C = 0, 30, ...; save the rtest-joint model; predict C = 15, 45, ... from the file.
+    The prediction (the file's probe zeros added) matches the simulated machine's noise-free
+    readings to well under the noise: the maps, tool_offset_Z of a head and the convention
+    values of unobservable combinations (a head's probe zero z with its position along the
+    spindle) all travel through the file."""
+    machine = str(custom_file) if name == "custom" else name
+    session = tmp_path / "r.csv"
+    code, _, err = run(capsys, "simulate", "rtest", "--machine", machine, "--c-step", 15, "--seed", 3,
+                       "--effect", "gravity_sag_" + load_machine(machine).tilt_axis + "=0.004", "-o", session)
+    assert code == 0, err
+    fit, held = _split_by_c(session, 30)
+    code, _, err = run(capsys, "identify", fit, "--no-budget", "--save-model", tmp_path / "m.json")
+    assert code == 0, err
+    code, _, err = run(capsys, "predict", held, "--model", tmp_path / "m.json", "--probe-zeros", "fitted",
+                       "-o", tmp_path / "p.csv")
+    assert code == 0, err
+    saved = rotacal.load_model(tmp_path / "m.json")
+    m = load_machine(machine)
+    assert ("tool_offset_Z" in saved) == m.has_head
+    assert saved["basis"]["maps"] == list(_core.rtest_map_names(m))
+    truth = json.loads((tmp_path / "r.truth.json").read_text())
+    s_held = rotacal.load(held)
+    err_mm = np.asarray(rotacal.load(tmp_path / "p.csv").d) - rotacal.rtest.truth_readings(truth, s_held)
+    noise_mm = truth["noise_um"] * 1e-3
+    # The model's own error ~ noise * sqrt(p / n) (about 0.35 noise here); 2x margin.
+    assert np.sqrt(np.mean(err_mm ** 2)) < 0.7 * noise_mm
+    # The file predicts exactly as the fit in memory does.
+    ident = rotacal.identify_rtest(rotacal.load(fit))
+    in_memory = rotacal.rtest.predict_rtest(ident.model_dict(), s_held, probe_zeros="fitted")
+    assert np.allclose(np.asarray(in_memory.d), np.asarray(rotacal.load(tmp_path / "p.csv").d), atol=1e-12)
+
+
+def test_rtest_model_file_layout_is_checked_per_machine(capsys, tmp_path):
+    """A head machine's file without tool_offset_Z, a table machine's with one, and maps that are
+    not the machine's are refused, naming the member."""
     session = tmp_path / "r.csv"
     assert run(capsys, "simulate", "rtest", "--machine", "B-head-C-table", "-o", session)[0] == 0
-    code, _, err = run(capsys, "identify", session, "--no-budget", "--save-model", tmp_path / "m.json")
-    assert code == 3, err
-    assert "B-head-C-table machine cannot be saved" in err
-    assert not (tmp_path / "m.json").exists()
-    code, out, err = run(capsys, "identify", session, "--no-budget", "--json")
+    assert run(capsys, "identify", session, "--no-budget", "--save-model", tmp_path / "m.json")[0] == 0
+    good = json.loads((tmp_path / "m.json").read_text())
+    for change, member in ((lambda d: d.pop("tool_offset_Z"), "tool_offset_Z"),
+                           (lambda d: d["basis"].update(maps=["BY", "CB"]), "basis.maps")):
+        d = json.loads(json.dumps(good))
+        change(d)
+        bad = tmp_path / "bad.json"
+        bad.write_text(json.dumps(d))
+        code, _, err = run(capsys, "predict", session, "--model", bad, "-o", tmp_path / "p.csv")
+        assert code != 0 and member in err, err
+    d = json.loads(json.dumps(good))
+    d.pop("machine_description")
+    d["machine"] = "BC-trt"
+    d["basis"].pop("maps")
+    with pytest.raises(_core.InvalidArgument, match="tool_offset_Z: only a machine with head axes"):
+        rotacal.rtest.predict_rtest(d, rotacal.load(session))
+
+
+def test_rtest_pattern_options_start_from_the_machines_default(capsys, tmp_path):
+    """A step given without a range keeps the machine's default range: B45C-trt tilts 0..180
+    (its nutating B), so --b-step 45 gives 0, 45, ..., 180, not the paper's -90..90 (refused
+    there); --c-step 15 keeps the full turn."""
+    s = tmp_path / "r.csv"
+    code, out, err = run(capsys, "simulate", "rtest", "--machine", "B45C-trt", "--b-step", 45, "--c-step", 15,
+                         "-o", s)
     assert code == 0, err
-    assert "tool_offset_Z" in out
+    angles = np.asarray(rotacal.load(s).angles_deg)
+    assert sorted(set(angles[:, 0])) == [0.0, 45.0, 90.0, 135.0, 180.0]
+    assert sorted(set(angles[:, 1])) == [15.0 * k for k in range(24)]
+    # A range outside the limits is still refused, naming the axis.
+    code, _, err = run(capsys, "simulate", "rtest", "--machine", "B45C-trt", "--b-range", "-90,90", "-o", s)
+    assert code != 0 and "B" in err, err
