@@ -269,6 +269,31 @@ NoiseModel estimate_noise_model(const std::vector<std::string>& groups,
   return M;
 }
 
+NoiseModel with_mean_bias_corrected(const NoiseModel& model) {
+  NoiseModel M = model;
+  double ss_innov = 0.0;
+  M.correlation_samples = 1.0, M.correlation_time_s = 0.0, M.effective_samples = 0.0;
+  for (NoiseStream& S : M.streams) {
+    const double n = static_cast<double>(S.rows.size());
+    if (S.order() == 1 && S.random_walk_step_um == 0.0 && n > 0) {
+      const double k = S.reflection[0];
+      const double kc = std::min(0.995, k + (1.0 + 3.0 * k) / n);
+      S.reflection[0] = S.ar[0] = kc;
+      S.innovation_sigma_um = S.marginal_sigma_um * std::sqrt(1.0 - kc * kc);
+      // AR(1): tau = s_e^2 / (s_x^2 (1 - phi)^2) = (1 + phi) / (1 - phi).
+      S.correlation_samples = std::min((1.0 + kc) / (1.0 - kc), n);
+      S.correlation_time_s = S.correlation_samples * S.sample_interval_s;
+      S.effective_samples = std::min(n, n / S.correlation_samples);
+    }
+    ss_innov += std::pow(S.innovation_sigma_um, 2) * n;
+    M.correlation_samples = std::max(M.correlation_samples, S.correlation_samples);
+    M.correlation_time_s = std::max(M.correlation_time_s, S.correlation_time_s);
+    M.effective_samples += S.effective_samples;
+  }
+  if (M.n) M.innovation_sigma_um = std::sqrt(ss_innov / static_cast<double>(M.n));
+  return M;
+}
+
 std::string NoiseModel::summary() const {
   std::ostringstream out;
   out.precision(3);

@@ -87,6 +87,42 @@ TEST_CASE("AR(1) coefficient, marginal sigma and correlation time recovered", "[
   }
 }
 
+TEST_CASE("the mean-removal bias of a short stream's AR(1) coefficient is corrected", "[noise_model]") {
+  // 400 streams of 250 readings (a ballbar test) at rho 0.95: Burg with the mean removed is
+  // about (1 + 3 rho) / n = 0.015 low on average; corrected, the mean is within its standard
+  // error sqrt((1 - rho^2) / n) / sqrt(400) = 0.001 (4 of them allowed) of rho.
+  const double rho = 0.95;
+  const int n = 250, draws = 400;
+  const Layout L = layout(1, n, 100.0);
+  double raw = 0.0, corrected = 0.0;
+  int ar1 = 0;
+  for (int d = 0; d < draws; ++d) {
+    const Eigen::VectorXd r = noise_gen::ar1(L.groups, L.times, rho, 0.5e-3, 1000 + d);
+    const NoiseModel M = estimate_noise_model(L.groups, L.times, r);
+    if (M.streams[0].order() != 1) continue;
+    ++ar1;
+    const NoiseModel C = with_mean_bias_corrected(M);
+    raw += M.streams[0].ar[0];
+    corrected += C.streams[0].ar[0];
+    CHECK(C.streams[0].reflection[0] == C.streams[0].ar[0]);
+    const double k = C.streams[0].ar[0];
+    CHECK(C.streams[0].correlation_samples == Approx(std::min((1 + k) / (1 - k), static_cast<double>(n))));
+    CHECK(C.streams[0].innovation_sigma_um < M.streams[0].innovation_sigma_um);
+  }
+  REQUIRE(ar1 > draws * 9 / 10);
+  raw /= ar1, corrected /= ar1;
+  const double se = std::sqrt((1 - rho * rho) / n) / std::sqrt(static_cast<double>(ar1));
+  INFO("mean raw " << raw << ", corrected " << corrected << ", standard error " << se);
+  CHECK(rho - raw > 0.5 * (1 + 3 * rho) / n);  // the bias is there to correct
+  CHECK(std::abs(corrected - rho) < 4 * se);
+  // White streams and AR(2) streams are left alone.
+  const Layout W = layout(2, 500, 100.0);
+  const Eigen::VectorXd w = noise_gen::ar1(W.groups, W.times, 0.0, 0.5e-3, 3);
+  const NoiseModel MW = estimate_noise_model(W.groups, W.times, w);
+  const NoiseModel CW = with_mean_bias_corrected(MW);
+  for (std::size_t k = 0; k < MW.streams.size(); ++k) CHECK(CW.streams[k].ar == MW.streams[k].ar);
+}
+
 TEST_CASE("the whitener is the inverse Cholesky factor of the AR(1) covariance", "[noise_model]") {
   const Layout L = layout(1, 3000, 100.0);
   const NoiseModel M = estimate_noise_model(L.groups, L.times, noise_gen::ar1(L.groups, L.times, 0.8, 1e-3, 3));
