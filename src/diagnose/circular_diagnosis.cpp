@@ -388,6 +388,7 @@ struct Scored {
   double rss1 = 0.0, delta_bic = 0.0, p = 1.0;
   bool visible = false;
   bool absorbed = false;  // visible on its own, not once the model is projected out
+  bool physical = true;   // a spike sticks outward: h > 0
 };
 
 Scored score_one(const CircularEffect& e, const Eigen::MatrixXd& Jw, const Eigen::MatrixXd& Q,
@@ -415,6 +416,8 @@ Scored score_one(const CircularEffect& e, const Eigen::MatrixXd& Jw, const Eigen
   for (int i = 0; i < s.k; ++i) V.col(i) = svd.matrixV().col(dirs[static_cast<std::size_t>(i)]);
   const Eigen::MatrixXd A = perp * V;
   const Eigen::VectorXd d = solve_ls(A, r_w);
+  const Eigen::VectorXd params = m.cwiseProduct(V * d);  // in the entry's units
+  if (e.kind == CircularEffectKind::reversal_spike) s.physical = params[0] > 0.0;
   const double rss0 = r_w.squaredNorm();
   s.rss1 = std::max((r_w - A * d).squaredNorm(), 1e-300);
   const double n = static_cast<double>(r_w.size());
@@ -476,55 +479,98 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
 
   std::vector<Chosen> chosen;
   Whitening W;
-  Gls fit = gls(B, R.y, W);  // ordinary least squares first: the residuals the noise is modelled from
+  Gls fit = gls(B, R.y, W);  // ordinary least squares first
   out.baseline_rms_um = rms_um(fit.r_mm);
   std::set<std::string> absorbed;   // ids absorbed by the model at the last round
   std::set<std::string> invisible;  // ids too small to see at plausible sizes
-  for (int round = 0;; ++round) {
-    Eigen::MatrixXd M = model_columns(R, B, chosen, o.screw_pitch);
-    if (o.model_noise) {
-      // Noise from the current model's residuals, then the GLS refit under it.
-      NoiseModel nm = noise_of(R, fit.r_mm);
-      W.w = nm.white() ? nullptr : std::make_unique<ArWhitener>(nm);
-      fit = gls(M, R.y, W);
-    }
-    const Eigen::MatrixXd Q = orthonormal_basis(W(M));
-    const int num_free = static_cast<int>(Q.cols());
-    std::vector<Scored> scores;
-    absorbed.clear();
-    invisible.clear();
-    for (const CircularEffect& e : cands) {
-      if (std::any_of(chosen.begin(), chosen.end(), [&](const Chosen& c) { return c.effect.id() == e.id(); }))
-        continue;
-      Scored best;
-      bool have = false;
-      const auto& cs = cols[e.id()];
-      for (std::size_t g = 0; g < cs.size(); ++g) {
-        Scored s = score_one(e, W(cs[g]), Q, fit.r_w, num_free, o.min_visible_chi2);
-        if (e.kind == CircularEffectKind::reversal_spike) s.tau = kSpikeTauGrid[g];
-        if (!have || (s.visible && (!best.visible || s.rss1 < best.rss1))) best = s, have = true;
-      }
-      if (!best.visible) {
-        (best.absorbed ? absorbed : invisible).insert(e.id());
-        continue;
-      }
-      scores.push_back(best);
-    }
-    std::sort(scores.begin(), scores.end(), [](const Scored& a, const Scored& b) { return a.delta_bic < b.delta_bic; });
-    if (round == 0)
-      for (const Scored& s : scores)
-        out.first_round.push_back({s.effect.id(), s.k, s.delta_bic, s.p, std::sqrt(s.rss1 / static_cast<double>(R.n))});
-    if (static_cast<int>(chosen.size()) >= o.max_findings) break;
-    const double m = static_cast<double>(std::max<std::size_t>(scores.size(), 1));
-    const Scored* pick = nullptr;
-    for (const Scored& s : scores)
-      if (s.p * m < o.alpha && s.delta_bic < o.min_delta_bic) {
-        pick = &s;
-        break;
-      }
-    if (!pick) break;
-    chosen.push_back({pick->effect, pick->tau});
+  const auto refit_noise = [&]() {
+    if (!o.model_noise) return;
+    NoiseModel nm = noise_of(R, fit.r_mm);
+    W.w = nm.white() ? nullptr : std::make_unique<ArWhitener>(nm);
     fit = gls(model_columns(R, B, chosen, o.screw_pitch), R.y, W);
+  };
+  const auto is_chosen = [&](const std::string& id) {
+    return std::any_of(chosen.begin(), chosen.end(), [&](const Chosen& c) { return c.effect.id() == id; });
+  };
+  // Forward selection under the current whitening; `ar`: re-estimate the noise every round.
+  const auto forward = [&](bool ar, int limit, bool record) {
+    for (int round = 0;; ++round) {
+      if (ar) refit_noise();
+      const Eigen::MatrixXd Q = orthonormal_basis(W(model_columns(R, B, chosen, o.screw_pitch)));
+      const int num_free = static_cast<int>(Q.cols());
+      std::vector<Scored> scores;
+      absorbed.clear();
+      invisible.clear();
+      for (const CircularEffect& e : cands) {
+        if (is_chosen(e.id())) continue;
+        Scored best;
+        bool have = false;
+        const auto& cs = cols[e.id()];
+        for (std::size_t g = 0; g < cs.size(); ++g) {
+          Scored sc = score_one(e, W(cs[g]), Q, fit.r_w, num_free, o.min_visible_chi2);
+          if (e.kind == CircularEffectKind::reversal_spike) sc.tau = kSpikeTauGrid[g];
+          if (!have || (sc.visible && (!best.visible || sc.rss1 < best.rss1))) best = sc, have = true;
+        }
+        if (!best.visible) {
+          (best.absorbed ? absorbed : invisible).insert(e.id());
+          continue;
+        }
+        scores.push_back(best);
+      }
+      std::sort(scores.begin(), scores.end(), [](const Scored& x, const Scored& y) { return x.delta_bic < y.delta_bic; });
+      if (record && round == 0)
+        for (const Scored& sc : scores)
+          out.first_round.push_back(
+              {sc.effect.id(), sc.k, sc.delta_bic, sc.p, std::sqrt(sc.rss1 / static_cast<double>(R.n))});
+      if (static_cast<int>(chosen.size()) >= limit) return;
+      const double m = static_cast<double>(std::max<std::size_t>(scores.size(), 1));
+      const Scored* pick = nullptr;
+      for (const Scored& sc : scores)
+        if (sc.p * m < o.alpha && sc.delta_bic < o.min_delta_bic && sc.physical) {
+          pick = &sc;
+          break;
+        }
+      if (!pick) return;
+      chosen.push_back({pick->effect, pick->tau});
+      fit = gls(model_columns(R, B, chosen, o.screw_pitch), R.y, W);
+    }
+  };
+  // 1. Forward with the noise taken as white: the residuals of the baseline hold the large
+  //    signatures, and an AR model fitted to them would take those for noise and whiten them
+  //    away. White-noise tests are too lenient on coloured noise; step 2 corrects that.
+  forward(false, o.max_findings + 6, true);
+  if (o.model_noise) {
+    // 2. Noise modelled from what the model leaves; backward elimination of every entry whose
+    //    drop-one test fails under it (Bonferroni over the catalogue), the noise re-estimated
+    //    after each removal.
+    refit_noise();
+    const double m = static_cast<double>(std::max<std::size_t>(cands.size(), 1));
+    while (!chosen.empty()) {
+      const double n = static_cast<double>(R.n);
+      std::size_t worst = chosen.size();
+      double worst_p = -1.0;
+      for (std::size_t k = 0; k < chosen.size(); ++k) {
+        std::vector<Chosen> others = chosen;
+        others.erase(others.begin() + static_cast<std::ptrdiff_t>(k));
+        const Eigen::MatrixXd Mk = model_columns(R, B, chosen, o.screw_pitch);
+        const Eigen::MatrixXd Mo = model_columns(R, B, others, o.screw_pitch);
+        const Gls without = gls(Mo, R.y, W);
+        const int kk = static_cast<int>(Mk.cols() - Mo.cols()) +
+                       (chosen[k].effect.kind == CircularEffectKind::reversal_spike ? 1 : 0);
+        const double dof = n - static_cast<double>(Mk.cols()) - 1.0;
+        const double F = ((without.rss_w - fit.rss_w) / kk) / (fit.rss_w / dof);
+        const double p = stats::f_sf(std::max(F, 0.0), kk, dof);
+        const double dbic = n * std::log(std::max(fit.rss_w, 1e-300) / without.rss_w) + kk * std::log(n);
+        const double score = (p * m < o.alpha && dbic < o.min_delta_bic) ? -1.0 : p + (dbic >= o.min_delta_bic ? 1.0 : 0.0);
+        if (score > worst_p) worst_p = score, worst = k;
+      }
+      if (worst_p < 0.0) break;
+      chosen.erase(chosen.begin() + static_cast<std::ptrdiff_t>(worst));
+      fit = gls(model_columns(R, B, chosen, o.screw_pitch), R.y, W);
+      refit_noise();
+    }
+    // 3. Forward again under the AR model, re-estimated every round.
+    forward(true, o.max_findings, false);
   }
 
   // Spike time constants: golden section on ln tau around the grid value, the rest refitted.
