@@ -6,6 +6,8 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <set>
@@ -73,9 +75,9 @@ std::vector<std::string> CircularEffect::param_names() const {
     case CircularEffectKind::straightness:
       return {"c2"};
     case CircularEffectKind::backlash:
-      return {"b"};
+      return {"b", "delay"};
     case CircularEffectKind::reversal_spike:
-      return {"h", "tau"};
+      return {"h", "tau", "delay"};
     case CircularEffectKind::servo_mismatch:
       return {"dtau"};
     case CircularEffectKind::cyclic_error:
@@ -91,10 +93,11 @@ std::vector<std::string> CircularEffect::param_units() const {
     case CircularEffectKind::scale_mismatch:
       return {"mm/mm"};
     case CircularEffectKind::straightness:
-    case CircularEffectKind::backlash:
       return {"mm"};
-    case CircularEffectKind::reversal_spike:
+    case CircularEffectKind::backlash:
       return {"mm", "s"};
+    case CircularEffectKind::reversal_spike:
+      return {"mm", "s", "s"};
     case CircularEffectKind::servo_mismatch:
       return {"s"};
     case CircularEffectKind::cyclic_error:
@@ -242,10 +245,11 @@ Eigen::MatrixXd baseline_columns(const Rows& R) {
   return B;
 }
 
-// d reading / d parameter (mm per parameter unit) of an entry; a spike's h column at `tau`,
-// and with `dtau` its derivative in tau at height h_for_dtau instead.
+// d reading / d parameter (mm per parameter unit) of an entry's linear parameters; backlash and
+// spikes with the axis reversing `delay` (s) after the commanded reversal (its servo lag), a
+// spike decaying with `tau` (s).
 Eigen::MatrixXd effect_columns(const Rows& R, const CircularEffect& e, const Eigen::Vector3d& pitch,
-                               double tau = 0.0, bool dtau = false, double h_for_dtau = 0.0) {
+                               double tau = 0.0, double delay = 0.0) {
   const Eigen::Index n = static_cast<Eigen::Index>(R.n);
   const int k = e.kind == CircularEffectKind::cyclic_error ? 2 : 1;
   Eigen::MatrixXd J = Eigen::MatrixXd::Zero(n, k);
@@ -271,16 +275,15 @@ Eigen::MatrixXd effect_columns(const Rows& R, const CircularEffect& e, const Eig
       case CircularEffectKind::backlash: {
         double psi, s, since;
         if (!axis_phase(R, i, e.axis, &psi)) break;
-        travel(R, i, psi, &s, &since);
+        travel(R, i, psi - R.omega[i] * delay, &s, &since);
         J(r, 0) = -0.5 * s * er[e.axis];
         break;
       }
       case CircularEffectKind::reversal_spike: {
         double psi, s, since;
         if (!axis_phase(R, i, e.axis, &psi)) break;
-        travel(R, i, psi, &s, &since);
-        const double decay = std::exp(-since / tau);
-        J(r, 0) = -s * decay * er[e.axis] * (dtau ? h_for_dtau * since / (tau * tau) : 1.0);
+        travel(R, i, psi - R.omega[i] * delay, &s, &since);
+        J(r, 0) = -s * std::exp(-since / tau) * er[e.axis];
         break;
       }
       case CircularEffectKind::servo_mismatch:
@@ -340,7 +343,8 @@ NoiseModel noise_of(const Rows& R, const Eigen::VectorXd& r) {
 // The model's columns for a list of chosen entries (spikes at their tau).
 struct Chosen {
   CircularEffect effect;
-  double tau = 0.0;  // spike
+  double tau = 0.0;    // spike
+  double delay = 0.0;  // backlash, spike
 };
 
 Eigen::MatrixXd model_columns(const Rows& R, const Eigen::MatrixXd& B, const std::vector<Chosen>& chosen,
@@ -348,7 +352,7 @@ Eigen::MatrixXd model_columns(const Rows& R, const Eigen::MatrixXd& B, const std
   Eigen::Index cols = B.cols();
   std::vector<Eigen::MatrixXd> parts;
   for (const Chosen& c : chosen) {
-    parts.push_back(effect_columns(R, c.effect, pitch, c.tau));
+    parts.push_back(effect_columns(R, c.effect, pitch, c.tau, c.delay));
     if (offsets) offsets->push_back(cols);
     cols += parts.back().cols();
   }
@@ -379,11 +383,19 @@ Gls gls(const Eigen::MatrixXd& M, const Eigen::VectorXd& y, const Whitening& W) 
 }
 
 const std::vector<double> kSpikeTauGrid = {0.003, 0.006, 0.012, 0.025, 0.05, 0.1, 0.2};
+const std::vector<double> kDelayGrid = {0.0, 0.0005, 0.001, 0.002, 0.004, 0.008, 0.016};
+
+// Nonlinear parameters of an entry (they are profiled, not in the linear model).
+int nonlinear_params(const CircularEffect& e) {
+  if (e.kind == CircularEffectKind::backlash) return 1;
+  if (e.kind == CircularEffectKind::reversal_spike) return 2;
+  return 0;
+}
 
 // A candidate scored against the current model.
 struct Scored {
   CircularEffect effect;
-  double tau = 0.0;
+  double tau = 0.0, delay = 0.0;
   int k = 0;  // visible directions
   double rss1 = 0.0, delta_bic = 0.0, p = 1.0;
   bool visible = false;
@@ -421,7 +433,7 @@ Scored score_one(const CircularEffect& e, const Eigen::MatrixXd& Jw, const Eigen
   const double rss0 = r_w.squaredNorm();
   s.rss1 = std::max((r_w - A * d).squaredNorm(), 1e-300);
   const double n = static_cast<double>(r_w.size());
-  const int k_bic = s.k + (e.kind == CircularEffectKind::reversal_spike ? 1 : 0);  // + tau
+  const int k_bic = s.k + nonlinear_params(e);
   s.delta_bic = n * std::log(s.rss1 / rss0) + k_bic * std::log(n);
   const double dof = n - num_free - k_bic;
   const double F = ((rss0 - s.rss1) / s.k) / (s.rss1 / dof);
@@ -468,13 +480,23 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
          "a circle sees only the difference of its two axes' scales (scale_mismatch_*); their common "
          "part changes the radius, which cannot be told from the bar length's calibration"});
 
-  // Candidate columns, computed once (spikes: one per tau of the grid).
-  std::map<std::string, std::vector<Eigen::MatrixXd>> cols;
+  // Candidate columns, computed once: backlash over the delay grid, spikes over tau x delay.
+  struct Variant {
+    double tau = 0.0, delay = 0.0;
+    Eigen::MatrixXd J;
+  };
+  std::map<std::string, std::vector<Variant>> cols;
   for (const CircularEffect& e : cands) {
-    if (e.kind == CircularEffectKind::reversal_spike)
-      for (double tau : kSpikeTauGrid) cols[e.id()].push_back(effect_columns(R, e, o.screw_pitch, tau));
-    else
-      cols[e.id()].push_back(effect_columns(R, e, o.screw_pitch));
+    if (e.kind == CircularEffectKind::reversal_spike) {
+      for (double tau : kSpikeTauGrid)
+        for (double delay : kDelayGrid)
+          cols[e.id()].push_back({tau, delay, effect_columns(R, e, o.screw_pitch, tau, delay)});
+    } else if (e.kind == CircularEffectKind::backlash) {
+      for (double delay : kDelayGrid)
+        cols[e.id()].push_back({0.0, delay, effect_columns(R, e, o.screw_pitch, 0.0, delay)});
+    } else {
+      cols[e.id()].push_back({0.0, 0.0, effect_columns(R, e, o.screw_pitch)});
+    }
   }
 
   std::vector<Chosen> chosen;
@@ -507,8 +529,9 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
         bool have = false;
         const auto& cs = cols[e.id()];
         for (std::size_t g = 0; g < cs.size(); ++g) {
-          Scored sc = score_one(e, W(cs[g]), Q, fit.r_w, num_free, o.min_visible_chi2);
-          if (e.kind == CircularEffectKind::reversal_spike) sc.tau = kSpikeTauGrid[g];
+          Scored sc = score_one(e, W(cs[g].J), Q, fit.r_w, num_free, o.min_visible_chi2);
+          sc.tau = cs[g].tau;
+          sc.delay = cs[g].delay;
           if (!have || (sc.visible && (!best.visible || sc.rss1 < best.rss1))) best = sc, have = true;
         }
         if (!best.visible) {
@@ -531,7 +554,7 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
           break;
         }
       if (!pick) return;
-      chosen.push_back({pick->effect, pick->tau});
+      chosen.push_back({pick->effect, pick->tau, pick->delay});
       fit = gls(model_columns(R, B, chosen, o.screw_pitch), R.y, W);
     }
   };
@@ -555,8 +578,7 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
         const Eigen::MatrixXd Mk = model_columns(R, B, chosen, o.screw_pitch);
         const Eigen::MatrixXd Mo = model_columns(R, B, others, o.screw_pitch);
         const Gls without = gls(Mo, R.y, W);
-        const int kk = static_cast<int>(Mk.cols() - Mo.cols()) +
-                       (chosen[k].effect.kind == CircularEffectKind::reversal_spike ? 1 : 0);
+        const int kk = static_cast<int>(Mk.cols() - Mo.cols()) + nonlinear_params(chosen[k].effect);
         const double dof = n - static_cast<double>(Mk.cols()) - 1.0;
         const double F = ((without.rss_w - fit.rss_w) / kk) / (fit.rss_w / dof);
         const double p = stats::f_sf(std::max(F, 0.0), kk, dof);
@@ -573,31 +595,89 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
     forward(true, o.max_findings, false);
   }
 
-  // Spike time constants: golden section on ln tau around the grid value, the rest refitted.
-  for (Chosen& c : chosen) {
-    if (c.effect.kind != CircularEffectKind::reversal_spike) continue;
-    const auto rss_at = [&](double ln_tau) {
-      const double keep = c.tau;
-      c.tau = std::exp(ln_tau);
-      const double v = gls(model_columns(R, B, chosen, o.screw_pitch), R.y, W).rss_w;
-      c.tau = keep;
-      return v;
-    };
-    double a = std::log(c.tau) - 0.7, b = std::log(c.tau) + 0.7;
+  // Nonlinear parameters (a spike's ln tau, a reversal delay): golden section about the grid
+  // value, every linear parameter refitted at each trial (a profile), two sweeps.
+  const auto rss_with = [&](Chosen& c, double* field, double value) {
+    const double keep = *field;
+    *field = value;
+    const double v = gls(model_columns(R, B, chosen, o.screw_pitch), R.y, W).rss_w;
+    *field = keep;
+    return v;
+  };
+  const auto golden = [](const std::function<double(double)>& f, double a, double b) {
     const double g = 0.5 * (std::sqrt(5.0) - 1.0);
-    double x1 = b - g * (b - a), x2 = a + g * (b - a), f1 = rss_at(x1), f2 = rss_at(x2);
-    for (int it = 0; it < 30 && b - a > 1e-4; ++it) {
-      if (f1 < f2) {
-        b = x2, x2 = x1, f2 = f1, x1 = b - g * (b - a), f1 = rss_at(x1);
+    double x1 = b - g * (b - a), x2 = a + g * (b - a), f1 = f(x1), f2 = f(x2);
+    for (int it = 0; it < 30 && b - a > 1e-6 * (1.0 + std::abs(a)); ++it) {
+      if (f1 <= f2) {
+        b = x2, x2 = x1, f2 = f1, x1 = b - g * (b - a), f1 = f(x1);
       } else {
-        a = x1, x1 = x2, f1 = f2, x2 = a + g * (b - a), f2 = rss_at(x2);
+        a = x1, x1 = x2, f1 = f2, x2 = a + g * (b - a), f2 = f(x2);
       }
     }
-    c.tau = std::exp(0.5 * (a + b));
-  }
+    return 0.5 * (a + b);
+  };
+  // A reversal delay moves a step in time: the model changes only when a step crosses a
+  // reading, so the profile is a staircase. Scan it (0..20 ms by 0.5 ms, then +-0.5 ms by
+  // 0.05 ms) and take the middle of the lowest stair; its width is the resolution.
+  std::vector<double> delay_width(chosen.size(), 0.0);  // 1 sigma of each delay
+  std::vector<std::pair<double, double>> delay_interval(chosen.size(), {0.0, 0.0});
+  // The profile of entry k's nonlinear parameters with the rest of the model fixed in
+  // structure: whitened residual of y on the other columns, then the entry's columns projected
+  // on what is left (Frisch-Waugh), O(n p) per trial instead of a full refit.
+  const auto profile_of = [&](std::size_t k) {
+    std::vector<Chosen> others = chosen;
+    others.erase(others.begin() + static_cast<std::ptrdiff_t>(k));
+    const Eigen::MatrixXd Q = orthonormal_basis(W(model_columns(R, B, others, o.screw_pitch)));
+    const Eigen::VectorXd yw = W(Eigen::MatrixXd(R.y)).col(0);
+    const Eigen::VectorXd r0 = yw - Q * (Q.transpose() * yw);
+    const CircularEffect e = chosen[k].effect;
+    return [&, Q, r0, e](double tau, double delay) {
+      const Eigen::MatrixXd A = project_out(Q, W(effect_columns(R, e, o.screw_pitch, tau, delay)));
+      const Eigen::VectorXd d = solve_ls(A, r0);
+      return (r0 - A * d).squaredNorm();
+    };
+  };
+  const auto scan_delay = [&](std::size_t k, const std::function<double(double, double)>& f) {
+    Chosen& c = chosen[k];
+    double best = c.delay, fbest = f(c.tau, c.delay);
+    for (double x = 0.0; x <= 0.020 + 1e-12; x += 0.0005) {
+      const double v = f(c.tau, x);
+      if (v < fbest) fbest = v, best = x;
+    }
+    std::vector<double> xs, fs;
+    for (double x = std::max(0.0, best - 0.002); x <= best + 0.002 + 1e-12; x += 0.00005) {
+      xs.push_back(x);
+      fs.push_back(f(c.tau, x));
+    }
+    const double fmin = *std::min_element(fs.begin(), fs.end());
+    std::size_t i0 = 0;
+    while (fs[i0] > fmin * (1.0 + 1e-12)) ++i0;
+    std::size_t i1 = i0;
+    while (i1 + 1 < fs.size() && fs[i1 + 1] <= fmin * (1.0 + 1e-12)) ++i1;
+    c.delay = 0.5 * (xs[i0] + xs[i1]);
+    // 1 sigma: half the range where the profile stays within delta chi-square 1 of its minimum
+    // (whitened residuals have unit variance: s2 = fmin / dof), at least the stair's own
+    // uniform spread.
+    const double s2p = fmin / static_cast<double>(R.n);
+    std::size_t j0 = i0, j1 = i1;
+    while (j0 > 0 && fs[j0 - 1] <= fmin + s2p) --j0;
+    while (j1 + 1 < fs.size() && fs[j1 + 1] <= fmin + s2p) ++j1;
+    delay_interval[k] = {xs[j0], xs[j1]};
+    delay_width[k] = std::max(std::max(xs[i1] - xs[i0], 0.00005) / std::sqrt(12.0), 0.5 * (xs[j1] - xs[j0]));
+  };
+  for (int sweep = 0; sweep < 2; ++sweep)
+    for (std::size_t k = 0; k < chosen.size(); ++k) {
+      Chosen& c = chosen[k];
+      if (!nonlinear_params(c.effect)) continue;
+      const std::function<double(double, double)> f = profile_of(k);
+      if (c.effect.kind == CircularEffectKind::reversal_spike)
+        c.tau = std::exp(golden([&](double x) { return f(std::exp(x), c.delay); }, std::log(c.tau) - 0.7,
+                                std::log(c.tau) + 0.7));
+      scan_delay(k, f);
+    }
 
-  // Final model: noise from its residuals, GLS, covariance from the whitened Jacobian (a spike's
-  // tau column included, the model being nonlinear in it).
+  // Final model: noise from its residuals, GLS; linear parameters' 1-sigma from the whitened
+  // Jacobian, the nonlinear ones' from the curvature of the profile (delta chi-square 1).
   std::vector<Eigen::Index> offsets;
   Eigen::MatrixXd M = model_columns(R, B, chosen, o.screw_pitch, &offsets);
   fit = gls(M, R.y, W);
@@ -611,17 +691,11 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
   out.noise_whitened = W.w != nullptr;
   out.residuals_mm = fit.r_mm;
   out.final_rms_um = rms_um(fit.r_mm);
-  Eigen::MatrixXd Jfull = M;
-  std::vector<Eigen::Index> tau_col(chosen.size(), -1);
-  for (std::size_t k = 0; k < chosen.size(); ++k) {
-    if (chosen[k].effect.kind != CircularEffectKind::reversal_spike) continue;
-    const double h = fit.beta[offsets[k]];
-    Jfull.conservativeResize(Eigen::NoChange, Jfull.cols() + 1);
-    Jfull.col(Jfull.cols() - 1) = effect_columns(R, chosen[k].effect, o.screw_pitch, chosen[k].tau, true, h);
-    tau_col[k] = Jfull.cols() - 1;
-  }
+  const Eigen::MatrixXd& Jfull = M;
   const Eigen::MatrixXd Jw = W(Jfull);
-  const double dof = static_cast<double>(R.n) - static_cast<double>(Jw.cols());
+  int n_nonlinear = 0;
+  for (const Chosen& c : chosen) n_nonlinear += nonlinear_params(c.effect);
+  const double dof = static_cast<double>(R.n) - static_cast<double>(Jw.cols()) - n_nonlinear;
   const double s2 = fit.rss_w / dof;
   // Column-scaled inverse of the normal matrix: the baseline's columns are O(1), the effects'
   // up to O(R^2); scaling keeps the inverse accurate.
@@ -631,6 +705,19 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
   const Eigen::MatrixXd Js = Jw * sc.cwiseInverse().asDiagonal();
   const Eigen::MatrixXd Ninv = (Js.transpose() * Js).ldlt().solve(Eigen::MatrixXd::Identity(Js.cols(), Js.cols()));
   const auto std_of = [&](Eigen::Index j) { return std::sqrt(std::max(Ninv(j, j), 0.0) * s2) / sc[j]; };
+  // 1-sigma of a profiled parameter: rss_w(x) ~ rss_w(x0) + f'' (x - x0)^2 / 2, chi-square
+  // rss_w / s2, so sigma = sqrt(2 s2 / f''); not determined (observable false) if f'' <= 0.
+  const auto profile_std = [&](Chosen& c, double* field, double h, bool log_scale) -> std::pair<double, bool> {
+    const double x0 = *field;
+    const auto at = [&](double x) { return rss_with(c, field, log_scale ? std::exp(x) : x); };
+    const double c0 = log_scale ? std::log(x0) : x0;
+    const double lo = log_scale ? c0 - h : std::max(0.0, c0 - h), hi = lo + 2.0 * h;
+    const double mid = 0.5 * (lo + hi);
+    const double f2 = (at(hi) - 2.0 * at(mid) + at(lo)) / (h * h);
+    if (!(f2 > 0.0)) return {std::numeric_limits<double>::quiet_NaN(), false};
+    const double sd = std::sqrt(2.0 * s2 / f2);
+    return {log_scale ? sd * x0 : sd, true};
+  };
 
   const std::vector<int> fold = [&] {
     std::vector<int> f(R.n);
@@ -647,6 +734,35 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
     return f;
   }();
   const double cv_all = diagnosis_detail::cv_rms_um(M, R.y, fold, o.cv_blocks);
+  // The nonlinear parameters' uncertainty moves the linear ones (a spike's height trades with
+  // its delay and tau): each linear parameter's variance gets the square of its half change
+  // between the nonlinear parameter's -1 and +1 sigma, refitted.
+  std::vector<std::pair<double, bool>> tau_sd(chosen.size(), {0.0, false});
+  Eigen::VectorXd extra_var = Eigen::VectorXd::Zero(M.cols());
+  const auto beta_at = [&](std::size_t k, double tau, double delay) {
+    const Chosen keep = chosen[k];
+    chosen[k].tau = tau;
+    chosen[k].delay = delay;
+    const Eigen::VectorXd b = gls(model_columns(R, B, chosen, o.screw_pitch), R.y, W).beta;
+    chosen[k] = keep;
+    return b;
+  };
+  for (std::size_t k = 0; k < chosen.size(); ++k) {
+    const Chosen c = chosen[k];
+    if (c.effect.kind == CircularEffectKind::reversal_spike) {
+      tau_sd[k] = profile_std(chosen[k], &chosen[k].tau, 0.05, true);
+      if (tau_sd[k].second && tau_sd[k].first < c.tau) {
+        const Eigen::VectorXd d =
+            0.5 * (beta_at(k, c.tau + tau_sd[k].first, c.delay) - beta_at(k, c.tau - tau_sd[k].first, c.delay));
+        extra_var += d.cwiseAbs2();
+      }
+    }
+    if (nonlinear_params(c.effect)) {
+      const double lo = std::max(0.0, c.delay - delay_width[k]), hi = c.delay + delay_width[k];
+      const Eigen::VectorXd d = (beta_at(k, c.tau, hi) - beta_at(k, c.tau, lo)) * (delay_width[k] / (hi - lo));
+      extra_var += d.cwiseAbs2();
+    }
+  }
   for (std::size_t k = 0; k < chosen.size(); ++k) {
     CircularFinding f;
     f.effect = chosen[k].effect.id();
@@ -659,11 +775,15 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
       p.unit = units[j];
       if (names[j] == "tau") {
         p.value = chosen[k].tau;
-        p.std = std_of(tau_col[k]);
+        p.std = tau_sd[k].first;
+        p.observable = tau_sd[k].second;
+      } else if (names[j] == "delay") {
+        p.value = chosen[k].delay;
+        p.std = delay_width[k];
       } else {
         const Eigen::Index c = offsets[k] + static_cast<Eigen::Index>(j);
         p.value = fit.beta[c];
-        p.std = std_of(c);
+        p.std = std::sqrt(std_of(c) * std_of(c) + extra_var[c]);
       }
       f.parameters.push_back(p);
     }
@@ -673,7 +793,7 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
     const Eigen::MatrixXd Mo = model_columns(R, B, others, o.screw_pitch);
     const Gls without = gls(Mo, R.y, W);
     const double n = static_cast<double>(R.n);
-    const int kk = static_cast<int>(M.cols() - Mo.cols()) + (tau_col[k] >= 0 ? 1 : 0);
+    const int kk = static_cast<int>(M.cols() - Mo.cols()) + nonlinear_params(chosen[k].effect);
     f.gain.rms_before_um = rms_um(without.r_mm);
     f.gain.rms_after_um = out.final_rms_um;
     f.gain.delta_bic = n * std::log(std::max(fit.rss_w, 1e-300) / without.rss_w) + kk * std::log(n);
@@ -690,7 +810,7 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
   const Eigen::MatrixXd Qb = orthonormal_basis(W(B));
   for (const CircularEffect& e : cands) {
     if (!absorbed.count(e.id())) continue;
-    const Eigen::MatrixXd Jc = W(cols[e.id()].front());
+    const Eigen::MatrixXd Jc = W(cols[e.id()].front().J);
     Scored vs_base = score_one(e, Jc, Qb, Eigen::VectorXd::Zero(Jc.rows()), static_cast<int>(Qb.cols()),
                                o.min_visible_chi2);
     std::string why;
