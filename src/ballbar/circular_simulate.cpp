@@ -35,7 +35,9 @@ Eigen::Vector3d moving_axes(const CircularTestPlan& plan, const CircularRun& run
     const double gain = 1.0 / std::sqrt(1.0 + w * w * tau * tau);
     const double psi = theta - lag - phi;  // the axis follows R cos(psi)
     a[i] += plan.radius * gain * std::cos(psi);
-    const double s = sign(-std::sin(psi) * w);  // direction of travel of the axis
+    // Direction of travel of the axis; 0 at the turning point itself (|sin psi| < 1e-9: a
+    // reading exactly at the reversal), where the lost motion is half taken up.
+    const double s = std::abs(std::sin(psi)) < 1e-9 ? 0.0 : sign(-std::sin(psi) * w);
     a[i] -= 0.5 * e.backlash[i] * s;
     if (e.spike[i] != 0.0) {
       // Angle travelled since the axis last reversed (psi a multiple of pi).

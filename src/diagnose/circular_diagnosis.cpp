@@ -229,7 +229,10 @@ bool axis_phase(const Rows& R, std::size_t i, int a, double* psi) {
 // Direction of travel of axis a (+1, -1) and the time since it last reversed (s).
 void travel(const Rows& R, std::size_t i, double psi, double* s, double* since) {
   const double w = R.omega[i];
-  *s = -std::sin(psi) * w > 0.0 ? 1.0 : -1.0;
+  // At the turning point itself (a reading exactly at the reversal, e.g. a data arc that
+  // starts there) the axis is at rest: no direction, as in the simulator.
+  const double v = -std::sin(psi) * w;
+  *s = std::abs(std::sin(psi)) < 1e-9 ? 0.0 : (v > 0.0 ? 1.0 : -1.0);
   const double ang = std::fmod(std::fmod(w > 0.0 ? psi : -psi, kPi) + kPi, kPi);
   *since = ang / std::abs(w);
 }
@@ -736,7 +739,7 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
   const double cv_all = diagnosis_detail::cv_rms_um(M, R.y, fold, o.cv_blocks);
   // The nonlinear parameters' uncertainty moves the linear ones (a spike's height trades with
   // its delay and tau): each linear parameter's variance gets the square of its half change
-  // between the nonlinear parameter's -1 and +1 sigma, refitted.
+  // across the nonlinear parameter's range (tau: +-1 sigma), refitted.
   std::vector<std::pair<double, bool>> tau_sd(chosen.size(), {0.0, false});
   Eigen::VectorXd extra_var = Eigen::VectorXd::Zero(M.cols());
   const auto beta_at = [&](std::size_t k, double tau, double delay) {
@@ -757,9 +760,11 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
         extra_var += d.cwiseAbs2();
       }
     }
-    if (nonlinear_params(c.effect)) {
-      const double lo = std::max(0.0, c.delay - delay_width[k]), hi = c.delay + delay_width[k];
-      const Eigen::VectorXd d = (beta_at(k, c.tau, hi) - beta_at(k, c.tau, lo)) * (delay_width[k] / (hi - lo));
+    // A delay: between the ends of its delta-chi-square-1 range (readings inside it; the model
+    // jumps where a step crosses a reading, so +-1 sigma could land beyond a stair's edge).
+    if (nonlinear_params(c.effect) && delay_interval[k].second > delay_interval[k].first) {
+      const Eigen::VectorXd d =
+          0.5 * (beta_at(k, c.tau, delay_interval[k].second) - beta_at(k, c.tau, delay_interval[k].first));
       extra_var += d.cwiseAbs2();
     }
   }

@@ -181,3 +181,34 @@ TEST_CASE("Backlash and a reversal spike on lagging axes: height, decay and the 
   CHECK(param(d, "backlash_X.b").std < 0.1 * 0.004);
   CHECK(param(d, "reversal_spike_Y.h").std < 0.1 * 0.005);
 }
+
+TEST_CASE("Three planes: scale mismatches close around the three axes, straightness by plane", "[circular]") {
+  // k_X = 20, k_Y = 0, k_Z = -15 um/m: each plane sees only the difference of its two axes,
+  // XY: k_X - k_Y = 20, YZ: k_Y - k_Z = 15, ZX: k_Z - k_X = -35 (they sum to 0).
+  CircularTestPlan p;
+  p.feeds_mm_per_min = {1000.0, 3000.0};
+  p.sample_rate_hz = 125.0;
+  CircularSimulationOptions o;
+  o.errors.scale = Eigen::Vector3d(20e-6, 0.0, -15e-6);
+  o.errors.straightness(1, 0) = 0.003;   // E_YX: y += c2 ((x - x_c) / 100)^2
+  o.errors.straightness(0, 2) = -0.002;  // E_XZ
+  o.errors.backlash = Eigen::Vector3d(0.0, 0.0, 0.003);
+  o.centring_error = Eigen::Vector3d(0.006, -0.004, 0.003);
+  o.noise_um = 0.3;
+  o.noise_rho = 0.8;
+  o.seed = 5;
+  const BallbarSession s = simulate_circular(plan_circular_test(p), o);
+  const CircularDiagnosis d = diagnose_circular(s);
+  CHECK(found(d) == std::vector<std::string>{"backlash_Z", "scale_mismatch_XY", "scale_mismatch_YZ",
+                                             "scale_mismatch_ZX", "straightness_XZ", "straightness_YX"});
+  const std::map<std::string, double> truth = {{"scale_mismatch_XY.dk", 20e-6}, {"scale_mismatch_YZ.dk", 15e-6},
+                                               {"scale_mismatch_ZX.dk", -35e-6}, {"straightness_YX.c2", 0.003},
+                                               {"straightness_XZ.c2", -0.002},  {"backlash_Z.b", 0.003}};
+  for (const auto& [name, value] : truth) {
+    const ParameterEstimate& e = param(d, name);
+    INFO(name << " = " << e.value << " +- " << e.std << " (truth " << value << ")");
+    CHECK(std::abs(e.value - value) < 3.0 * e.std);
+    CHECK(e.std < 0.1 * std::abs(value));
+  }
+  CHECK(reason(d, "squareness_XY").empty());  // all three planes run: nothing plane-bound is unseen
+}

@@ -13,15 +13,24 @@
 ///   reading - L0 = sum over runs [c0 + c1 cos theta + c2 sin theta]      (baseline: centre
 ///                  offset and radius of each run, what ISO 230-4's LSQ circle removes)
 ///                + sum over entries  e_r . delta_entry(theta, omega, t)  + noise
-/// with delta as in circular_simulate.hpp, at the commanded positions and reversals. The
-/// model is linear in every parameter except a spike's time constant, which is profiled
-/// (a grid, then golden section on its log).
+/// with delta as in circular_simulate.hpp, at the commanded positions. The model is linear in
+/// every parameter except two, which are profiled (every linear parameter refitted at each
+/// trial): a spike's time constant (grid, then golden section on its log; 1-sigma from the
+/// profile's curvature) and the reversal delay of backlash and spikes, the time from the
+/// commanded reversal to the axis' own (its servo lag; the reversal is a step, so the profile
+/// is a staircase: scanned, the middle of its lowest stair, 1-sigma half the range within
+/// delta chi-square 1). Their uncertainty is carried into the linear parameters (half their
+/// change between -1 and +1 sigma, added in quadrature).
 ///
-/// Selection, with the thresholds of the rotary diagnosis (diagnosis.hpp): the noise is
-/// modelled as AR (core/noise_model.hpp, pooled over the runs) from the current residuals and
-/// every decision is made on whitened residuals (GLS); each round the candidate with the most
-/// negative delta BIC is added if its F-test p-value, Bonferroni-corrected over the
-/// candidates, is below alpha and its delta BIC below min_delta_bic; until none is left.
+/// Selection, with the thresholds of the rotary diagnosis (diagnosis.hpp): each round the
+/// candidate with the most negative delta BIC is added if its F-test p-value,
+/// Bonferroni-corrected over the candidates, is below alpha and its delta BIC below
+/// min_delta_bic, until none is left; (1) first with the noise taken as white (an AR model of
+/// the baseline's residuals would take the large signatures for noise and whiten them away),
+/// (2) then the noise modelled as AR (core/noise_model.hpp, pooled over the runs) from what
+/// that model leaves, every entry whose drop-one test fails under it removed, (3) and forward
+/// again under the AR model re-estimated each round: every decision that stands is made on
+/// whitened residuals (GLS). A spike must stick outward (h > 0).
 /// Parameters get 1-sigma from the final GLS fit. Entries the runs cannot determine are
 /// reported unobservable with the reason: a plane or axis the session does not move, a
 /// signature the baseline absorbs, or one that equals a finding's in these runs (squareness
@@ -43,8 +52,8 @@ enum class CircularEffectKind {
   squareness,      ///< plane P = (u, v): u += s v (XY: x += s y; YZ: y += s z; ZX: z += s x); s rad
   scale_mismatch,  ///< plane P: u += dk/2 u, v -= dk/2 v; dk = k_u - k_v, mm/mm
   straightness,    ///< E_DA: D += c2 ((a_A - centre_A) / 100 mm)^2; c2 mm
-  backlash,        ///< axis A trails by b/2 in its direction of travel; b mm
-  reversal_spike,  ///< axis A stays behind by h exp(-dt/tau) after reversing; h mm, tau s
+  backlash,        ///< axis A trails by b/2 in its direction of travel; b mm, delay s
+  reversal_spike,  ///< axis A stays behind by h exp(-dt/tau) after reversing; h mm, tau s, delay s
   servo_mismatch,  ///< plane P: lag time constants differ, dtau = tau_u - tau_v, s
   cyclic_error,    ///< axis A += c cos(2 pi a / p) + d sin(2 pi a / p); c, d mm
 };
@@ -101,7 +110,8 @@ struct CircularDiagnosis {
   bool noise_whitened = false;
   std::vector<CircularFinding> findings;  ///< in the order they were added
   std::vector<UnobservableEffect> unobservable;
-  /// Every visible candidate scored against the baseline, best (most negative delta BIC) first.
+  /// Every visible candidate scored against the baseline with the noise taken as white (step 1),
+  /// best (most negative delta BIC) first.
   std::vector<CandidateScore> first_round;
   Eigen::VectorXd residuals_mm;  ///< final model, one per circular reading in run order
 };
