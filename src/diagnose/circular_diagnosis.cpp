@@ -327,13 +327,37 @@ std::string not_moved(const Rows& R, const CircularEffect& e) {
 }
 
 // Whitening of columns by the current noise model (identity when none).
+// Whitening of columns (mm) to unit-variance units: the AR whitener of a coloured noise model,
+// or 1 / sigma of a white one, so that squared norms are chi-squares (visibility, F, BIC).
 struct Whitening {
   std::unique_ptr<ArWhitener> w;
+  double scale = 1.0;  // 1 / sigma (mm) when w is null
   Eigen::MatrixXd operator()(Eigen::MatrixXd M) const {
     if (w && M.cols() > 0) w->apply(M);
+    else M *= scale;
     return M;
   }
+  void set(const NoiseModel& nm) {
+    w = nm.white() ? nullptr : std::make_unique<ArWhitener>(nm);
+    scale = nm.white() && nm.sigma_um > 0.0 ? 1.0 / (nm.sigma_um * 1e-3) : 1.0;
+  }
 };
+
+// Noise sigma (mm) from successive differences within each run: sigma^2 = sum (r_{i+1} -
+// r_i)^2 / (2 (n - 1)). Smooth systematic errors barely move it (the rotary diagnosis' rule);
+// correlated noise makes it smaller than the marginal sigma, so tests on it are lenient,
+// which the AR steps after it correct.
+double difference_sigma(const Rows& R, const Eigen::VectorXd& r) {
+  double ss = 0.0;
+  std::size_t n = 0;
+  for (std::size_t i = 1; i < R.n; ++i)
+    if (R.run[i] == R.run[i - 1]) {
+      const double d = r[static_cast<Eigen::Index>(i)] - r[static_cast<Eigen::Index>(i - 1)];
+      ss += d * d;
+      ++n;
+    }
+  return n ? std::sqrt(ss / (2.0 * static_cast<double>(n))) : 0.0;
+}
 
 NoiseModel noise_of(const Rows& R, const Eigen::VectorXd& r) {
   NoiseModelOptions o;
@@ -348,6 +372,8 @@ struct Chosen {
   CircularEffect effect;
   double tau = 0.0;    // spike
   double delay = 0.0;  // backlash, spike
+  double delay_sd = 0.0;                   // its 1 sigma (after the scan)
+  std::pair<double, double> delay_range;   // its delta-chi-square-1 range
 };
 
 Eigen::MatrixXd model_columns(const Rows& R, const Eigen::MatrixXd& B, const std::vector<Chosen>& chosen,
@@ -511,7 +537,7 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
   const auto refit_noise = [&]() {
     if (!o.model_noise) return;
     NoiseModel nm = noise_of(R, fit.r_mm);
-    W.w = nm.white() ? nullptr : std::make_unique<ArWhitener>(nm);
+    W.set(nm);
     fit = gls(model_columns(R, B, chosen, o.screw_pitch), R.y, W);
   };
   const auto is_chosen = [&](const std::string& id) {
@@ -561,24 +587,21 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
       fit = gls(model_columns(R, B, chosen, o.screw_pitch), R.y, W);
     }
   };
-  // 1. Forward with the noise taken as white: the residuals of the baseline hold the large
-  //    signatures, and an AR model fitted to them would take those for noise and whiten them
-  //    away. White-noise tests are too lenient on coloured noise; step 2 corrects that.
-  forward(false, o.max_findings + 6, true);
-  if (o.model_noise) {
-    // 2. Noise modelled from what the model leaves; backward elimination of every entry whose
-    //    drop-one test fails under it (Bonferroni over the catalogue), the noise re-estimated
-    //    after each removal.
-    refit_noise();
+  // Backward elimination under the current noise model: drop the entry whose drop-one test
+  // fails worst (Bonferroni over the catalogue; a spike that does not stick outward fails),
+  // refit and re-estimate the noise, until every entry left passes.
+  const auto eliminate = [&]() {
     const double m = static_cast<double>(std::max<std::size_t>(cands.size(), 1));
     while (!chosen.empty()) {
       const double n = static_cast<double>(R.n);
+      const Eigen::MatrixXd Mk = model_columns(R, B, chosen, o.screw_pitch);
       std::size_t worst = chosen.size();
-      double worst_p = -1.0;
+      double worst_score = -1.0;
+      std::vector<Eigen::Index> offs;
+      model_columns(R, B, chosen, o.screw_pitch, &offs);
       for (std::size_t k = 0; k < chosen.size(); ++k) {
         std::vector<Chosen> others = chosen;
         others.erase(others.begin() + static_cast<std::ptrdiff_t>(k));
-        const Eigen::MatrixXd Mk = model_columns(R, B, chosen, o.screw_pitch);
         const Eigen::MatrixXd Mo = model_columns(R, B, others, o.screw_pitch);
         const Gls without = gls(Mo, R.y, W);
         const int kk = static_cast<int>(Mk.cols() - Mo.cols()) + nonlinear_params(chosen[k].effect);
@@ -586,14 +609,34 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
         const double F = ((without.rss_w - fit.rss_w) / kk) / (fit.rss_w / dof);
         const double p = stats::f_sf(std::max(F, 0.0), kk, dof);
         const double dbic = n * std::log(std::max(fit.rss_w, 1e-300) / without.rss_w) + kk * std::log(n);
-        const double score = (p * m < o.alpha && dbic < o.min_delta_bic) ? -1.0 : p + (dbic >= o.min_delta_bic ? 1.0 : 0.0);
-        if (score > worst_p) worst_p = score, worst = k;
+        const bool outward = chosen[k].effect.kind != CircularEffectKind::reversal_spike || fit.beta[offs[k]] > 0.0;
+        const double score = (p * m < o.alpha && dbic < o.min_delta_bic && outward)
+                                 ? -1.0
+                                 : p + (dbic >= o.min_delta_bic ? 1.0 : 0.0) + (outward ? 0.0 : 2.0);
+        if (score > worst_score) worst_score = score, worst = k;
       }
-      if (worst_p < 0.0) break;
+      if (worst_score < 0.0) break;
       chosen.erase(chosen.begin() + static_cast<std::ptrdiff_t>(worst));
       fit = gls(model_columns(R, B, chosen, o.screw_pitch), R.y, W);
       refit_noise();
     }
+  };
+  // 1. Forward with the noise taken as white, sigma from successive differences: the residuals
+  //    of the baseline hold the large signatures, and an AR model fitted to them would take
+  //    those for noise and whiten them away. White-noise tests are too lenient on coloured
+  //    noise; step 2 corrects that.
+  {
+    const double sd = difference_sigma(R, fit.r_mm);
+    W.scale = sd > 0.0 ? 1.0 / sd : 1.0;
+    fit = gls(B, R.y, W);
+  }
+  forward(false, o.max_findings + 6, true);
+  if (o.model_noise) {
+    // 2. Noise modelled from what the model leaves; backward elimination of every entry whose
+    //    drop-one test fails under it (Bonferroni over the catalogue), the noise re-estimated
+    //    after each removal.
+    refit_noise();
+    eliminate();
     // 3. Forward again under the AR model, re-estimated every round.
     forward(true, o.max_findings, false);
   }
@@ -622,8 +665,6 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
   // A reversal delay moves a step in time: the model changes only when a step crosses a
   // reading, so the profile is a staircase. Scan it (0..20 ms by 0.5 ms, then +-0.5 ms by
   // 0.05 ms) and take the middle of the lowest stair; its width is the resolution.
-  std::vector<double> delay_width(chosen.size(), 0.0);  // 1 sigma of each delay
-  std::vector<std::pair<double, double>> delay_interval(chosen.size(), {0.0, 0.0});
   // The profile of entry k's nonlinear parameters with the rest of the model fixed in
   // structure: whitened residual of y on the other columns, then the entry's columns projected
   // on what is left (Frisch-Waugh), O(n p) per trial instead of a full refit.
@@ -665,8 +706,8 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
     std::size_t j0 = i0, j1 = i1;
     while (j0 > 0 && fs[j0 - 1] <= fmin + s2p) --j0;
     while (j1 + 1 < fs.size() && fs[j1 + 1] <= fmin + s2p) ++j1;
-    delay_interval[k] = {xs[j0], xs[j1]};
-    delay_width[k] = std::max(std::max(xs[i1] - xs[i0], 0.00005) / std::sqrt(12.0), 0.5 * (xs[j1] - xs[j0]));
+    c.delay_range = {xs[j0], xs[j1]};
+    c.delay_sd = std::max(std::max(xs[i1] - xs[i0], 0.00005) / std::sqrt(12.0), 0.5 * (xs[j1] - xs[j0]));
   };
   for (int sweep = 0; sweep < 2; ++sweep)
     for (std::size_t k = 0; k < chosen.size(); ++k) {
@@ -679,6 +720,13 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
       scan_delay(k, f);
     }
 
+  // What the refinement moved may no longer pass (or a spike may no longer stick outward).
+  if (o.model_noise) {
+    fit = gls(model_columns(R, B, chosen, o.screw_pitch), R.y, W);
+    refit_noise();
+    eliminate();
+  }
+
   // Final model: noise from its residuals, GLS; linear parameters' 1-sigma from the whitened
   // Jacobian, the nonlinear ones' from the curvature of the profile (delta chi-square 1).
   std::vector<Eigen::Index> offsets;
@@ -686,7 +734,7 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
   fit = gls(M, R.y, W);
   if (o.model_noise) {
     out.noise = noise_of(R, fit.r_mm);
-    W.w = out.noise.white() ? nullptr : std::make_unique<ArWhitener>(out.noise);
+    W.set(out.noise);
     fit = gls(M, R.y, W);
   } else {
     out.noise = noise_of(R, fit.r_mm);
@@ -762,9 +810,9 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
     }
     // A delay: between the ends of its delta-chi-square-1 range (readings inside it; the model
     // jumps where a step crosses a reading, so +-1 sigma could land beyond a stair's edge).
-    if (nonlinear_params(c.effect) && delay_interval[k].second > delay_interval[k].first) {
+    if (nonlinear_params(c.effect) && c.delay_range.second > c.delay_range.first) {
       const Eigen::VectorXd d =
-          0.5 * (beta_at(k, c.tau, delay_interval[k].second) - beta_at(k, c.tau, delay_interval[k].first));
+          0.5 * (beta_at(k, c.tau, c.delay_range.second) - beta_at(k, c.tau, c.delay_range.first));
       extra_var += d.cwiseAbs2();
     }
   }
@@ -784,7 +832,7 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
         p.observable = tau_sd[k].second;
       } else if (names[j] == "delay") {
         p.value = chosen[k].delay;
-        p.std = delay_width[k];
+        p.std = chosen[k].delay_sd;
       } else {
         const Eigen::Index c = offsets[k] + static_cast<Eigen::Index>(j);
         p.value = fit.beta[c];
