@@ -25,12 +25,14 @@
 /// Selection, with the thresholds of the rotary diagnosis (diagnosis.hpp): each round the
 /// candidate with the most negative delta BIC is added if its F-test p-value,
 /// Bonferroni-corrected over the candidates, is below alpha and its delta BIC below
-/// min_delta_bic, until none is left; (1) first with the noise taken as white (an AR model of
-/// the baseline's residuals would take the large signatures for noise and whiten them away),
+/// min_delta_bic, until none is left; (1) first with the noise taken as white, its sigma from
+/// successive differences (an AR model of the baseline's residuals would take the large
+/// signatures for noise and whiten them away),
 /// (2) then the noise modelled as AR (core/noise_model.hpp, pooled over the runs) from what
 /// that model leaves, every entry whose drop-one test fails under it removed, (3) and forward
-/// again under the AR model re-estimated each round: every decision that stands is made on
-/// whitened residuals (GLS). A spike must stick outward (h > 0).
+/// again under the AR model re-estimated each round, (4) once more backward after the
+/// nonlinear parameters are refined: every decision that stands is made on whitened residuals
+/// (GLS). A spike must stick outward (h > 0).
 /// Parameters get 1-sigma from the final GLS fit. Entries the runs cannot determine are
 /// reported unobservable with the reason: a plane or axis the session does not move, a
 /// signature the baseline absorbs, or one that equals a finding's in these runs (squareness
