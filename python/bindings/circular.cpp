@@ -15,11 +15,13 @@ Eigen::VectorXd vec(const std::vector<double>& v) {
 }  // namespace
 
 void bind_circular(pyb::module_& m) {
-  pyb::enum_<CircularPlane>(m, "CircularPlane", "Plane of an ISO 230-4 circular test: (u, v) = XY, YZ, ZX.")
+  pyb::enum_<CircularPlane>(m, "CircularPlane",
+                            "Plane of an ISO 230-4 circular test: (u, v) = XY, YZ, ZX.")
       .value("XY", CircularPlane::XY)
       .value("YZ", CircularPlane::YZ)
       .value("ZX", CircularPlane::ZX);
-  pyb::enum_<CircularDirection>(m, "CircularDirection", "ccw: G3, the path angle increases; cw: G2.")
+  pyb::enum_<CircularDirection>(m, "CircularDirection",
+                                "ccw: G3, the path angle increases; cw: G2.")
       .value("ccw", CircularDirection::ccw)
       .value("cw", CircularDirection::cw);
   m.def("parse_circular_plane", &parse_circular_plane, pyb::arg("text"));
@@ -28,22 +30,32 @@ void bind_circular(pyb::module_& m) {
         pyb::arg("feed_mm_per_min"), pyb::arg("with_feed"));
 
   const CircularTestPlan d;
-  pyb::class_<CircularTestPlan>(m, "CircularTestPlan",
-                                "ISO 230-4 circular tests with the ballbar (mm, deg, mm/min, Hz, s).")
+  pyb::class_<CircularTestPlan>(
+      m, "CircularTestPlan", "ISO 230-4 circular tests with the ballbar (mm, deg, mm/min, Hz, s).")
       .def(pyb::init([](MachineType machine, double radius, const Eigen::Vector3d& centre,
                         std::vector<CircularPlane> planes, std::vector<double> feeds_mm_per_min,
-                        std::vector<CircularDirection> directions, double start_deg, double span_deg,
-                        double run_in_deg, double overshoot_deg, double sample_rate_hz, double remount_s) {
-             return CircularTestPlan{machine,    radius,        centre,         std::move(planes),
-                                     std::move(feeds_mm_per_min), std::move(directions), start_deg, span_deg,
-                                     run_in_deg, overshoot_deg, sample_rate_hz, remount_s};
+                        std::vector<CircularDirection> directions, double start_deg,
+                        double span_deg, double run_in_deg, double overshoot_deg,
+                        double sample_rate_hz, double remount_s) {
+             return CircularTestPlan{machine,
+                                     radius,
+                                     centre,
+                                     std::move(planes),
+                                     std::move(feeds_mm_per_min),
+                                     std::move(directions),
+                                     start_deg,
+                                     span_deg,
+                                     run_in_deg,
+                                     overshoot_deg,
+                                     sample_rate_hz,
+                                     remount_s};
            }),
-           pyb::arg("machine") = d.machine, pyb::arg("radius") = d.radius, pyb::arg("centre") = d.centre,
-           pyb::arg("planes") = d.planes, pyb::arg("feeds_mm_per_min") = d.feeds_mm_per_min,
-           pyb::arg("directions") = d.directions, pyb::arg("start_deg") = d.start_deg,
-           pyb::arg("span_deg") = d.span_deg, pyb::arg("run_in_deg") = d.run_in_deg,
-           pyb::arg("overshoot_deg") = d.overshoot_deg, pyb::arg("sample_rate_hz") = d.sample_rate_hz,
-           pyb::arg("remount_s") = d.remount_s)
+           pyb::arg("machine") = d.machine, pyb::arg("radius") = d.radius,
+           pyb::arg("centre") = d.centre, pyb::arg("planes") = d.planes,
+           pyb::arg("feeds_mm_per_min") = d.feeds_mm_per_min, pyb::arg("directions") = d.directions,
+           pyb::arg("start_deg") = d.start_deg, pyb::arg("span_deg") = d.span_deg,
+           pyb::arg("run_in_deg") = d.run_in_deg, pyb::arg("overshoot_deg") = d.overshoot_deg,
+           pyb::arg("sample_rate_hz") = d.sample_rate_hz, pyb::arg("remount_s") = d.remount_s)
       .def_readwrite("machine", &CircularTestPlan::machine)
       .def_readwrite("radius", &CircularTestPlan::radius)
       .def_readwrite("centre", &CircularTestPlan::centre)
@@ -79,11 +91,13 @@ void bind_circular(pyb::module_& m) {
         "The runs of an ISO 230-4 circular test plan (planes x feeds x directions).");
   m.def("circular_commanded_session", &circular_commanded_session, pyb::arg("plan"),
         "The commanded rotacal-ballbar/1 session of a circular plan (length = L0).");
-  m.def("write_circular_nc_program", &write_circular_nc_program, pyb::arg("plan"), pyb::arg("dialect"),
-        pyb::arg("options") = NcProgramOptions{}, "NC program text of a circular plan.");
+  m.def("write_circular_nc_program", &write_circular_nc_program, pyb::arg("plan"),
+        pyb::arg("dialect"), pyb::arg("options") = NcProgramOptions{},
+        "NC program text of a circular plan.");
 
-  pyb::class_<LinearAxisErrors>(m, "LinearAxisErrors",
-                                "Errors of the linear axes X, Y, Z (mm, rad, s); see circular_simulate.hpp.")
+  pyb::class_<LinearAxisErrors>(
+      m, "LinearAxisErrors",
+      "Errors of the linear axes X, Y, Z (mm, rad, s); see circular_simulate.hpp.")
       .def(pyb::init<>())
       .def_readwrite("squareness", &LinearAxisErrors::squareness)
       .def_readwrite("scale", &LinearAxisErrors::scale)
@@ -121,8 +135,10 @@ void bind_circular(pyb::module_& m) {
       .def_readonly("G_um", &CircularRunResult::G_um)
       .def_readonly("max_um", &CircularRunResult::max_um)
       .def_readonly("min_um", &CircularRunResult::min_um)
-      .def_property_readonly("angle_deg", [](const CircularRunResult& r) { return vec(r.angle_deg); })
-      .def_property_readonly("radial_um", [](const CircularRunResult& r) { return vec(r.radial_um); });
+      .def_property_readonly("angle_deg",
+                             [](const CircularRunResult& r) { return vec(r.angle_deg); })
+      .def_property_readonly("radial_um",
+                             [](const CircularRunResult& r) { return vec(r.radial_um); });
 
   pyb::class_<CircularPairResult>(m, "CircularPairResult")
       .def_readonly("plane", &CircularPairResult::plane)
@@ -140,7 +156,8 @@ void bind_circular(pyb::module_& m) {
       .def_readonly("pairs", &CircularAnalysis::pairs)
       .def_readonly("ignored_tests", &CircularAnalysis::ignored_tests);
 
-  m.def("analyze_circular", &analyze_circular, pyb::arg("session"), pyb::call_guard<pyb::gil_scoped_release>(),
+  m.def("analyze_circular", &analyze_circular, pyb::arg("session"),
+        pyb::call_guard<pyb::gil_scoped_release>(),
         "ISO 230-4 circular deviation G per run, G(b) and hysteresis H per cw/ccw pair.");
 
   pyb::class_<CircularEffect>(m, "CircularEffect", "An entry of the circular-test catalogue.")
@@ -180,7 +197,8 @@ void bind_circular(pyb::module_& m) {
       .def_readonly("residuals_mm", &CircularDiagnosis::residuals_mm);
 
   m.def("diagnose_circular", &diagnose_circular, pyb::arg("session"),
-        pyb::arg("options") = CircularDiagnosisOptions{}, pyb::call_guard<pyb::gil_scoped_release>(),
+        pyb::arg("options") = CircularDiagnosisOptions{},
+        pyb::call_guard<pyb::gil_scoped_release>(),
         "The classic causes the circular runs support, each with parameters, 1-sigma and gain.");
 }
 

@@ -106,14 +106,16 @@ std::vector<CircularRunData> circular_runs(const BallbarSession& s) {
     for (std::size_t k = 0; k < n; ++k) {
       const BallbarSample& b = s.samples[r.rows[k]];
       if (std::abs(b.tilt_deg) > 1e-6 || std::abs(b.rot_deg) > 1e-6)
-        throw InvalidArgument("test " + label + ": the rotary axes must be at 0 in a circular run (row at t = " +
+        throw InvalidArgument("test " + label +
+                              ": the rotary axes must be at 0 in a circular run (row at t = " +
                               std::to_string(b.time) + " s)");
       const Eigen::Vector3d rel = b.xyz + tv - s.pivot;
       const double ru = rel[ax[0]], rv = rel[ax[1]];
       if (std::abs(rel[nrm]) > 0.01 * L0 || std::abs(std::hypot(ru, rv) - L0) > 0.01 * L0)
-        throw InvalidArgument("test " + label + ": the commanded point at t = " + std::to_string(b.time) +
-                              " s is not on the circle of radius ballbar_length about the pivot in the " +
-                              to_string(r.plane) + " plane");
+        throw InvalidArgument(
+            "test " + label + ": the commanded point at t = " + std::to_string(b.time) +
+            " s is not on the circle of radius ballbar_length about the pivot in the " +
+            to_string(r.plane) + " plane");
       double th = std::atan2(rv, ru);
       if (k > 0) th = r.theta_rad[k - 1] + std::remainder(th - r.theta_rad[k - 1], 2.0 * kPi);
       r.time[k] = b.time;
@@ -125,18 +127,21 @@ std::vector<CircularRunData> circular_runs(const BallbarSession& s) {
     for (std::size_t k = 1; k < n; ++k)
       if (sense * (r.theta_rad[k] - r.theta_rad[k - 1]) < -1e-9)
         throw InvalidArgument("test " + label + ": the path angle " +
-                              (sense > 0 ? "decreases" : "increases") + " at t = " +
-                              std::to_string(r.time[k]) + " s, but the label says " + to_string(r.direction));
+                              (sense > 0 ? "decreases" : "increases") +
+                              " at t = " + std::to_string(r.time[k]) + " s, but the label says " +
+                              to_string(r.direction));
     // theta = theta0 + omega (t - t0), least squares.
     const double tm = std::accumulate(r.time.begin(), r.time.end(), 0.0) / static_cast<double>(n);
-    const double thm = std::accumulate(r.theta_rad.begin(), r.theta_rad.end(), 0.0) / static_cast<double>(n);
+    const double thm =
+        std::accumulate(r.theta_rad.begin(), r.theta_rad.end(), 0.0) / static_cast<double>(n);
     double stt = 0.0, sth = 0.0;
     for (std::size_t k = 0; k < n; ++k) {
       stt += (r.time[k] - tm) * (r.time[k] - tm);
       sth += (r.time[k] - tm) * (r.theta_rad[k] - thm);
     }
     if (!(stt > 0.0) || !(sense * sth > 0.0))
-      throw InvalidArgument("test " + label + ": time or path angle does not advance; a circular run "
+      throw InvalidArgument("test " + label +
+                            ": time or path angle does not advance; a circular run "
                             "needs both to, in the labelled direction");
     r.omega_rad_s = sth / stt;
     r.t0 = tm;
@@ -152,7 +157,8 @@ std::vector<CircularRunData> circular_runs(const BallbarSession& s) {
     out.push_back(std::move(r));
   }
   if (out.empty())
-    throw InvalidArgument("the session has no circular run (tests labelled circular_<XY|YZ|ZX>_<ccw|cw>)");
+    throw InvalidArgument(
+        "the session has no circular run (tests labelled circular_<XY|YZ|ZX>_<ccw|cw>)");
   return out;
 }
 
@@ -162,7 +168,8 @@ CircularAnalysis analyze_circular(const BallbarSession& session) {
   CircularAnalysis out;
   out.ballbar_length = L0;
   for (const std::string& t : session.tests())
-    if (std::none_of(runs.begin(), runs.end(), [&](const CircularRunData& r) { return r.label == t; }))
+    if (std::none_of(runs.begin(), runs.end(),
+                     [&](const CircularRunData& r) { return r.label == t; }))
       out.ignored_tests.push_back(t);
   std::vector<Points2> points;
   for (const CircularRunData& r : runs) {
@@ -216,8 +223,10 @@ CircularAnalysis analyze_circular(const BallbarSession& session) {
       std::vector<std::pair<double, double>> cw;
       for (std::size_t k = 0; k < rb.size(); ++k) cw.emplace_back(b.theta_rad[k] + shift, rb[k]);
       std::sort(cw.begin(), cw.end());
-      const double lo = std::max(std::min(a.theta_rad.front(), a.theta_rad.back()), cw.front().first);
-      const double hi = std::min(std::max(a.theta_rad.front(), a.theta_rad.back()), cw.back().first);
+      const double lo =
+          std::max(std::min(a.theta_rad.front(), a.theta_rad.back()), cw.front().first);
+      const double hi =
+          std::min(std::max(a.theta_rad.front(), a.theta_rad.back()), cw.back().first);
       p.common_span_deg = std::max(0.0, hi - lo) * kRad;
       for (std::size_t k = 0; k < ra.size(); ++k) {
         const double th = a.theta_rad[k];

@@ -21,8 +21,9 @@ double sign(double v) { return v > 0.0 ? 1.0 : (v < 0.0 ? -1.0 : 0.0); }
 
 // Actual machine-axis positions (mm) of the run's reading at time t, before the geometric
 // errors: servo lag, backlash and reversal spikes of the two moving axes.
-Eigen::Vector3d moving_axes(const CircularTestPlan& plan, const CircularRun& run, const LinearAxisErrors& e,
-                            const Eigen::Vector3d& centre_axes, double t) {
+Eigen::Vector3d moving_axes(const CircularTestPlan& plan, const CircularRun& run,
+                            const LinearAxisErrors& e, const Eigen::Vector3d& centre_axes,
+                            double t) {
   const auto ax = plane_axes(run.plane);
   const double theta = run.angle_at(t) * kPi / 180.0;
   const double w = run.omega_rad_s();
@@ -50,7 +51,8 @@ Eigen::Vector3d moving_axes(const CircularTestPlan& plan, const CircularRun& run
 }
 
 // Geometric errors of the axes at positions a (mm).
-Eigen::Vector3d geometric(const LinearAxisErrors& e, const Eigen::Vector3d& a, const Eigen::Vector3d& centre_axes) {
+Eigen::Vector3d geometric(const LinearAxisErrors& e, const Eigen::Vector3d& a,
+                          const Eigen::Vector3d& centre_axes) {
   Eigen::Vector3d p = a;
   p.x() += e.squareness[0] * a.y();
   p.y() += e.squareness[1] * a.z();
@@ -69,7 +71,8 @@ Eigen::Vector3d geometric(const LinearAxisErrors& e, const Eigen::Vector3d& a, c
 
 }  // namespace
 
-BallbarSession simulate_circular(const CircularPlanResult& plan, const CircularSimulationOptions& o) {
+BallbarSession simulate_circular(const CircularPlanResult& plan,
+                                 const CircularSimulationOptions& o) {
   const LinearAxisErrors& e = o.errors;
   check(e.squareness.allFinite() && e.scale.allFinite() && e.straightness.allFinite() &&
             e.backlash.allFinite() && e.spike.allFinite() && e.spike_tau.allFinite() &&

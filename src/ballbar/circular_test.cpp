@@ -76,12 +76,15 @@ std::string to_string(CircularDirection direction) {
 CircularDirection parse_circular_direction(const std::string& text) {
   if (text == "ccw" || text == "CCW") return CircularDirection::ccw;
   if (text == "cw" || text == "CW") return CircularDirection::cw;
-  throw InvalidArgument("direction: unknown circular-test direction '" + text + "' (known: ccw, cw)");
+  throw InvalidArgument("direction: unknown circular-test direction '" + text +
+                        "' (known: ccw, cw)");
 }
 
 double CircularRun::omega_rad_s() const { return rate_deg_s * kDeg; }
 
-double CircularRun::angle_at(double t) const { return run_in_from_deg + rate_deg_s * (t - t_start); }
+double CircularRun::angle_at(double t) const {
+  return run_in_from_deg + rate_deg_s * (t - t_start);
+}
 
 std::size_t CircularPlanResult::num_samples() const {
   std::size_t n = 0;
@@ -100,7 +103,8 @@ std::string circular_label(CircularPlane plane, CircularDirection direction, dou
   return s;
 }
 
-Eigen::Vector3d circular_point(const CircularTestPlan& plan, CircularPlane plane, double theta_deg) {
+Eigen::Vector3d circular_point(const CircularTestPlan& plan, CircularPlane plane,
+                               double theta_deg) {
   const auto ax = plane_axes(plane);
   Eigen::Vector3d p = plan.centre;
   p[ax[0]] += plan.radius * std::cos(theta_deg * kDeg);
@@ -116,8 +120,9 @@ CircularPlanResult plan_circular_test(const CircularTestPlan& plan) {
   require(!plan.planes.empty(), "planes: at least one plane (XY, YZ, ZX) is needed");
   require(!plan.feeds_mm_per_min.empty(), "feeds_mm_per_min: at least one feed is needed");
   require(!plan.directions.empty(), "directions: at least one direction (ccw, cw) is needed");
-  require(std::set<CircularPlane>(plan.planes.begin(), plan.planes.end()).size() == plan.planes.size(),
-          "planes: a plane is repeated");
+  require(
+      std::set<CircularPlane>(plan.planes.begin(), plan.planes.end()).size() == plan.planes.size(),
+      "planes: a plane is repeated");
   require(std::set<CircularDirection>(plan.directions.begin(), plan.directions.end()).size() ==
               plan.directions.size(),
           "directions: a direction is repeated");
@@ -133,10 +138,12 @@ CircularPlanResult plan_circular_test(const CircularTestPlan& plan) {
           "start_deg must be finite and within +-3600, got " + general(plan.start_deg));
   require(std::isfinite(plan.run_in_deg) && plan.run_in_deg >= 0.0 && plan.run_in_deg <= 360.0,
           "run_in_deg must be in [0, 360], got " + general(plan.run_in_deg));
-  require(std::isfinite(plan.overshoot_deg) && plan.overshoot_deg >= 0.0 && plan.overshoot_deg <= 360.0,
-          "overshoot_deg must be in [0, 360], got " + general(plan.overshoot_deg));
-  require(std::isfinite(plan.sample_rate_hz) && plan.sample_rate_hz > 0.0 && plan.sample_rate_hz <= 1e5,
-          "sample_rate_hz must be in (0, 100000], got " + general(plan.sample_rate_hz));
+  require(
+      std::isfinite(plan.overshoot_deg) && plan.overshoot_deg >= 0.0 && plan.overshoot_deg <= 360.0,
+      "overshoot_deg must be in [0, 360], got " + general(plan.overshoot_deg));
+  require(
+      std::isfinite(plan.sample_rate_hz) && plan.sample_rate_hz > 0.0 && plan.sample_rate_hz <= 1e5,
+      "sample_rate_hz must be in (0, 100000], got " + general(plan.sample_rate_hz));
   require(std::isfinite(plan.remount_s) && plan.remount_s >= 0.0 && plan.remount_s <= 86400.0,
           "remount_s must be in [0, 86400], got " + general(plan.remount_s));
 
@@ -150,7 +157,7 @@ CircularPlanResult plan_circular_test(const CircularTestPlan& plan) {
     double angle_now = 0.0;
     bool first_in_plane = true;
     for (double feed : plan.feeds_mm_per_min) {
-      const double speed = feed / 60.0;  // mm/s
+      const double speed = feed / 60.0;                    // mm/s
       const double rate_deg = speed / plan.radius / kDeg;  // deg/s
       for (CircularDirection d : plan.directions) {
         CircularRun r;
@@ -183,8 +190,9 @@ CircularPlanResult plan_circular_test(const CircularTestPlan& plan) {
                                 general(plan.sample_rate_hz) + " (at least 36 are needed)");
         total += n;
         if (total > kMaxReadings)
-          throw InvalidArgument("plan_circular_test: the plan has more than 2,000,000 readings "
-                                "(lower sample_rate_hz, raise feeds_mm_per_min or plan fewer runs)");
+          throw InvalidArgument(
+              "plan_circular_test: the plan has more than 2,000,000 readings "
+              "(lower sample_rate_hz, raise feeds_mm_per_min or plan fewer runs)");
         r.time.resize(n);
         r.angle_deg.resize(n);
         for (std::size_t k = 0; k < n; ++k) {
@@ -226,8 +234,13 @@ namespace {
 class CircularNcWriter {
  public:
   CircularNcWriter(const CircularPlanResult& r, NcDialect d, const NcProgramOptions& o)
-      : res_(r), plan_(r.plan), d_(d), o_(o), tv_(zero_tool_vector(r.plan.machine)),
-        tilt_(1, tilt_axis_letter(r.plan.machine)), rot_(1, rot_axis_letter(r.plan.machine)) {}
+      : res_(r),
+        plan_(r.plan),
+        d_(d),
+        o_(o),
+        tv_(zero_tool_vector(r.plan.machine)),
+        tilt_(1, tilt_axis_letter(r.plan.machine)),
+        rot_(1, rot_axis_letter(r.plan.machine)) {}
 
   std::string run() {
     prologue();
@@ -241,10 +254,10 @@ class CircularNcWriter {
         }
         approach(r);
       }
-      comment("RUN " + r.label + ": " + to_string(r.direction) + " at " + general(r.feed_mm_per_min) +
-              " mm/min; run-in from " + general(r.run_in_from_deg) + " deg, data arc " +
-              general(r.data_from_deg) + " .. " + general(r.data_to_deg) + " deg, overshoot to " +
-              general(r.overshoot_to_deg) + " deg");
+      comment("RUN " + r.label + ": " + to_string(r.direction) + " at " +
+              general(r.feed_mm_per_min) + " mm/min; run-in from " + general(r.run_in_from_deg) +
+              " deg, data arc " + general(r.data_from_deg) + " .. " + general(r.data_to_deg) +
+              " deg, overshoot to " + general(r.overshoot_to_deg) + " deg");
       if (!new_plane) {  // along the circle, the short way, to the run-in start
         const double move = std::remainder(r.run_in_from_deg - angle_, 360.0);
         if (std::abs(move) > 1e-9) arcs(r.plane, angle_, angle_ + move, r.feed_mm_per_min);
@@ -271,7 +284,8 @@ class CircularNcWriter {
       for (char& c : text) {
         if (c == '(') c = '[';
         if (c == ')') c = ']';
-        if (d_ == NcDialect::fanuc) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+        if (d_ == NcDialect::fanuc)
+          c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
       }
       line("(" + text + ")");
     } else {
@@ -349,16 +363,18 @@ class CircularNcWriter {
     comment("rotacal ISO 230-4 circular tests of the linear axes - ballbar");
     comment("machine: " + to_string(plan_.machine) + ", rotary axes held at 0");
     comment("radius = ballbar length L0: " + fixed(plan_.radius, 4) + " mm");
-    comment("centre = pivot: " + fixed(plan_.centre.x(), 4) + ", " + fixed(plan_.centre.y(), 4) + ", " +
-            fixed(plan_.centre.z(), 4) + " mm");
+    comment("centre = pivot: " + fixed(plan_.centre.x(), 4) + ", " + fixed(plan_.centre.y(), 4) +
+            ", " + fixed(plan_.centre.z(), 4) + " mm");
     comment("data arc: " + general(plan_.span_deg) + " deg from " + general(plan_.start_deg) +
             " deg, run-in " + general(plan_.run_in_deg) + " deg, overshoot " +
             general(plan_.overshoot_deg) + " deg");
     std::string labels;
     for (const CircularRun& r : res_.runs) labels += (labels.empty() ? "" : ", ") + r.label;
     comment("runs: " + labels);
-    comment("angle from the plane's first axis towards its second: XY from +X, YZ from +Y, ZX from +Z");
-    comment("G3 / DR+ is counter-clockwise = a positive rotation about +Z [G17], +X [G19], +Y [G18]");
+    comment(
+        "angle from the plane's first axis towards its second: XY from +X, YZ from +Y, ZX from +Z");
+    comment(
+        "G3 / DR+ is counter-clockwise = a positive rotation about +Z [G17], +X [G19], +Y [G18]");
     if (d_ == NcDialect::linuxcnc && plan_.machine.has_head())
       comment("coordinates: machine axes of the controlled point - no tool length compensation");
     else if (o_.tool > 0)

@@ -62,7 +62,8 @@ CircularEffect CircularEffect::parse(const std::string& id) {
   for (const CircularEffect& e : circular_catalogue())
     if (e.id() == id) return e;
   std::string known;
-  for (const CircularEffect& e : circular_catalogue()) known += (known.empty() ? "" : ", ") + e.id();
+  for (const CircularEffect& e : circular_catalogue())
+    known += (known.empty() ? "" : ", ") + e.id();
   throw InvalidArgument("unknown circular-test effect '" + id + "' (known: " + known + ")");
 }
 
@@ -111,10 +112,11 @@ std::string CircularEffect::cause() const {
   const std::string u = axis_name(ax[0]), v = axis_name(ax[1]);
   switch (kind) {
     case CircularEffectKind::squareness:
-      return "axes " + u + " and " + v + " are not perpendicular (" + u + " moves by s per mm of " + v +
-             "): an ellipse at 45 deg, the same in both directions";
+      return "axes " + u + " and " + v + " are not perpendicular (" + u + " moves by s per mm of " +
+             v + "): an ellipse at 45 deg, the same in both directions";
     case CircularEffectKind::scale_mismatch:
-      return "axes " + u + " and " + v + " scale differently (screw pitch error, encoder, thermal "
+      return "axes " + u + " and " + v +
+             " scale differently (screw pitch error, encoder, thermal "
              "expansion of one axis): an ellipse along the axes";
     case CircularEffectKind::straightness:
       return "axis " + axis_name(axis) + " is not straight in " + axis_name(direction) +
@@ -124,13 +126,17 @@ std::string CircularEffect::cause() const {
              " at reversal (screw or nut backlash, worn drive): a step at its reversal points, "
              "opposite in the two directions";
     case CircularEffectKind::reversal_spike:
-      return "axis " + axis_name(axis) + " sticks when it reverses (friction, the servo's integral "
+      return "axis " + axis_name(axis) +
+             " sticks when it reverses (friction, the servo's integral "
              "action catching up): an outward spike decaying after its reversal points";
     case CircularEffectKind::servo_mismatch:
-      return "the position loops of " + u + " and " + v + " lag differently (unequal servo gains): a "
-             "45 deg ellipse that tilts the other way when the direction reverses, growing with feed";
+      return "the position loops of " + u + " and " + v +
+             " lag differently (unequal servo gains): a "
+             "45 deg ellipse that tilts the other way when the direction reverses, growing with "
+             "feed";
     case CircularEffectKind::cyclic_error:
-      return "cyclic error of axis " + axis_name(axis) + " periodic with its screw lead (screw "
+      return "cyclic error of axis " + axis_name(axis) +
+             " periodic with its screw lead (screw "
              "runout, thrust bearing, encoder interpolation)";
   }
   return {};
@@ -147,7 +153,8 @@ std::vector<CircularEffect> circular_catalogue() {
   for (CircularEffectKind k : {CircularEffectKind::backlash, CircularEffectKind::reversal_spike})
     for (int a = 0; a < 3; ++a) out.push_back({k, CircularPlane::XY, a, 0});
   for (CircularPlane p : planes) out.push_back({CircularEffectKind::servo_mismatch, p, 0, 0});
-  for (int a = 0; a < 3; ++a) out.push_back({CircularEffectKind::cyclic_error, CircularPlane::XY, a, 0});
+  for (int a = 0; a < 3; ++a)
+    out.push_back({CircularEffectKind::cyclic_error, CircularPlane::XY, a, 0});
   return out;
 }
 
@@ -238,7 +245,8 @@ void travel(const Rows& R, std::size_t i, double psi, double* s, double* since) 
 }
 
 Eigen::MatrixXd baseline_columns(const Rows& R) {
-  Eigen::MatrixXd B = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(R.n), static_cast<Eigen::Index>(3 * R.runs));
+  Eigen::MatrixXd B =
+      Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(R.n), static_cast<Eigen::Index>(3 * R.runs));
   for (std::size_t i = 0; i < R.n; ++i) {
     const Eigen::Index c = 3 * R.run[i], r = static_cast<Eigen::Index>(i);
     B(r, c) = 1.0;
@@ -268,7 +276,8 @@ Eigen::MatrixXd effect_columns(const Rows& R, const CircularEffect& e, const Eig
         break;
       }
       case CircularEffectKind::scale_mismatch:
-        if (R.plane[i] == e.plane) J(r, 0) = 0.5 * (a[pax[0]] * er[pax[0]] - a[pax[1]] * er[pax[1]]);
+        if (R.plane[i] == e.plane)
+          J(r, 0) = 0.5 * (a[pax[0]] * er[pax[0]] - a[pax[1]] * er[pax[1]]);
         break;
       case CircularEffectKind::straightness: {
         const double uu = (a[e.axis] - R.centre_axes[e.axis]) / 100.0;
@@ -311,17 +320,21 @@ std::string not_moved(const Rows& R, const CircularEffect& e) {
     case CircularEffectKind::scale_mismatch:
     case CircularEffectKind::servo_mismatch:
       if (!R.planes.count(e.plane))
-        return "no circular run in the " + to_string(e.plane) + " plane: only that plane's runs see it";
+        return "no circular run in the " + to_string(e.plane) +
+               " plane: only that plane's runs see it";
       return {};
     case CircularEffectKind::straightness:
       for (CircularPlane p : R.planes) {
         const auto ax = plane_axes(p);
-        if ((ax[0] == e.axis && ax[1] == e.direction) || (ax[1] == e.axis && ax[0] == e.direction)) return {};
+        if ((ax[0] == e.axis && ax[1] == e.direction) || (ax[1] == e.axis && ax[0] == e.direction))
+          return {};
       }
-      return "no circular run in the plane of " + axis_name(e.axis) + " and " + axis_name(e.direction) +
-             ": only there does the bar read " + axis_name(e.direction) + " while " + axis_name(e.axis) + " moves";
+      return "no circular run in the plane of " + axis_name(e.axis) + " and " +
+             axis_name(e.direction) + ": only there does the bar read " + axis_name(e.direction) +
+             " while " + axis_name(e.axis) + " moves";
     default:
-      if (!R.moving_axes.count(e.axis)) return "axis " + axis_name(e.axis) + " does not move in any run";
+      if (!R.moving_axes.count(e.axis))
+        return "axis " + axis_name(e.axis) + " does not move in any run";
       return {};
   }
 }
@@ -333,8 +346,10 @@ struct Whitening {
   std::unique_ptr<ArWhitener> w;
   double scale = 1.0;  // 1 / sigma (mm) when w is null
   Eigen::MatrixXd operator()(Eigen::MatrixXd M) const {
-    if (w && M.cols() > 0) w->apply(M);
-    else M *= scale;
+    if (w && M.cols() > 0)
+      w->apply(M);
+    else
+      M *= scale;
     return M;
   }
   void set(const NoiseModel& nm) {
@@ -370,14 +385,15 @@ NoiseModel noise_of(const Rows& R, const Eigen::VectorXd& r) {
 // The model's columns for a list of chosen entries (spikes at their tau).
 struct Chosen {
   CircularEffect effect;
-  double tau = 0.0;    // spike
-  double delay = 0.0;  // backlash, spike
-  double delay_sd = 0.0;                   // its 1 sigma (after the scan)
-  std::pair<double, double> delay_range;   // its delta-chi-square-1 range
+  double tau = 0.0;                       // spike
+  double delay = 0.0;                     // backlash, spike
+  double delay_sd = 0.0;                  // its 1 sigma (after the scan)
+  std::pair<double, double> delay_range;  // its delta-chi-square-1 range
 };
 
-Eigen::MatrixXd model_columns(const Rows& R, const Eigen::MatrixXd& B, const std::vector<Chosen>& chosen,
-                              const Eigen::Vector3d& pitch, std::vector<Eigen::Index>* offsets = nullptr) {
+Eigen::MatrixXd model_columns(const Rows& R, const Eigen::MatrixXd& B,
+                              const std::vector<Chosen>& chosen, const Eigen::Vector3d& pitch,
+                              std::vector<Eigen::Index>* offsets = nullptr) {
   Eigen::Index cols = B.cols();
   std::vector<Eigen::MatrixXd> parts;
   for (const Chosen& c : chosen) {
@@ -474,9 +490,11 @@ double rms_um(const Eigen::VectorXd& r) { return diagnosis_detail::rms_um(r); }
 
 }  // namespace
 
-CircularDiagnosis diagnose_circular(const BallbarSession& session, const CircularDiagnosisOptions& o) {
+CircularDiagnosis diagnose_circular(const BallbarSession& session,
+                                    const CircularDiagnosisOptions& o) {
   if (!(o.alpha > 0.0 && o.alpha < 1.0))
-    throw InvalidArgument("diagnose_circular: alpha must be in (0, 1), got " + std::to_string(o.alpha));
+    throw InvalidArgument("diagnose_circular: alpha must be in (0, 1), got " +
+                          std::to_string(o.alpha));
   if (!o.screw_pitch.allFinite() || !(o.screw_pitch.array() > 0.0).all())
     throw InvalidArgument("diagnose_circular: screw_pitch must be positive (X, Y, Z), mm");
   if (o.max_findings < 0) throw InvalidArgument("diagnose_circular: max_findings must be >= 0");
@@ -506,7 +524,8 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
   for (int a = 0; a < 3; ++a)
     out.unobservable.push_back(
         {"scale_" + axis_name(a),
-         "a circle sees only the difference of its two axes' scales (scale_mismatch_*); their common "
+         "a circle sees only the difference of its two axes' scales (scale_mismatch_*); their "
+         "common "
          "part changes the radius, which cannot be told from the bar length's calibration"});
 
   // Candidate columns, computed once: backlash over the delay grid, spikes over tau x delay.
@@ -541,7 +560,8 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
     fit = gls(model_columns(R, B, chosen, o.screw_pitch), R.y, W);
   };
   const auto is_chosen = [&](const std::string& id) {
-    return std::any_of(chosen.begin(), chosen.end(), [&](const Chosen& c) { return c.effect.id() == id; });
+    return std::any_of(chosen.begin(), chosen.end(),
+                       [&](const Chosen& c) { return c.effect.id() == id; });
   };
   // Forward selection under the current whitening; `ar`: re-estimate the noise every round.
   const auto forward = [&](bool ar, int limit, bool record) {
@@ -561,7 +581,8 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
           Scored sc = score_one(e, W(cs[g].J), Q, fit.r_w, num_free, o.min_visible_chi2);
           sc.tau = cs[g].tau;
           sc.delay = cs[g].delay;
-          if (!have || (sc.visible && (!best.visible || sc.rss1 < best.rss1))) best = sc, have = true;
+          if (!have || (sc.visible && (!best.visible || sc.rss1 < best.rss1)))
+            best = sc, have = true;
         }
         if (!best.visible) {
           (best.absorbed ? absorbed : invisible).insert(e.id());
@@ -569,11 +590,12 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
         }
         scores.push_back(best);
       }
-      std::sort(scores.begin(), scores.end(), [](const Scored& x, const Scored& y) { return x.delta_bic < y.delta_bic; });
+      std::sort(scores.begin(), scores.end(),
+                [](const Scored& x, const Scored& y) { return x.delta_bic < y.delta_bic; });
       if (record && round == 0)
         for (const Scored& sc : scores)
-          out.first_round.push_back(
-              {sc.effect.id(), sc.k, sc.delta_bic, sc.p, std::sqrt(sc.rss1 / static_cast<double>(R.n))});
+          out.first_round.push_back({sc.effect.id(), sc.k, sc.delta_bic, sc.p,
+                                     std::sqrt(sc.rss1 / static_cast<double>(R.n))});
       if (static_cast<int>(chosen.size()) >= limit) return;
       const double m = static_cast<double>(std::max<std::size_t>(scores.size(), 1));
       const Scored* pick = nullptr;
@@ -608,11 +630,14 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
         const double dof = n - static_cast<double>(Mk.cols()) - 1.0;
         const double F = ((without.rss_w - fit.rss_w) / kk) / (fit.rss_w / dof);
         const double p = stats::f_sf(std::max(F, 0.0), kk, dof);
-        const double dbic = n * std::log(std::max(fit.rss_w, 1e-300) / without.rss_w) + kk * std::log(n);
-        const bool outward = chosen[k].effect.kind != CircularEffectKind::reversal_spike || fit.beta[offs[k]] > 0.0;
-        const double score = (p * m < o.alpha && dbic < o.min_delta_bic && outward)
-                                 ? -1.0
-                                 : p + (dbic >= o.min_delta_bic ? 1.0 : 0.0) + (outward ? 0.0 : 2.0);
+        const double dbic =
+            n * std::log(std::max(fit.rss_w, 1e-300) / without.rss_w) + kk * std::log(n);
+        const bool outward =
+            chosen[k].effect.kind != CircularEffectKind::reversal_spike || fit.beta[offs[k]] > 0.0;
+        const double score =
+            (p * m < o.alpha && dbic < o.min_delta_bic && outward)
+                ? -1.0
+                : p + (dbic >= o.min_delta_bic ? 1.0 : 0.0) + (outward ? 0.0 : 2.0);
         if (score > worst_score) worst_score = score, worst = k;
       }
       if (worst_score < 0.0) break;
@@ -707,7 +732,8 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
     while (j0 > 0 && fs[j0 - 1] <= fmin + s2p) --j0;
     while (j1 + 1 < fs.size() && fs[j1 + 1] <= fmin + s2p) ++j1;
     c.delay_range = {xs[j0], xs[j1]};
-    c.delay_sd = std::max(std::max(xs[i1] - xs[i0], 0.00005) / std::sqrt(12.0), 0.5 * (xs[j1] - xs[j0]));
+    c.delay_sd =
+        std::max(std::max(xs[i1] - xs[i0], 0.00005) / std::sqrt(12.0), 0.5 * (xs[j1] - xs[j0]));
   };
   for (int sweep = 0; sweep < 2; ++sweep)
     for (std::size_t k = 0; k < chosen.size(); ++k) {
@@ -715,8 +741,8 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
       if (!nonlinear_params(c.effect)) continue;
       const std::function<double(double, double)> f = profile_of(k);
       if (c.effect.kind == CircularEffectKind::reversal_spike)
-        c.tau = std::exp(golden([&](double x) { return f(std::exp(x), c.delay); }, std::log(c.tau) - 0.7,
-                                std::log(c.tau) + 0.7));
+        c.tau = std::exp(golden([&](double x) { return f(std::exp(x), c.delay); },
+                                std::log(c.tau) - 0.7, std::log(c.tau) + 0.7));
       scan_delay(k, f);
     }
 
@@ -754,11 +780,15 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
   for (Eigen::Index j = 0; j < sc.size(); ++j)
     if (!(sc[j] > 0.0)) sc[j] = 1.0;
   const Eigen::MatrixXd Js = Jw * sc.cwiseInverse().asDiagonal();
-  const Eigen::MatrixXd Ninv = (Js.transpose() * Js).ldlt().solve(Eigen::MatrixXd::Identity(Js.cols(), Js.cols()));
-  const auto std_of = [&](Eigen::Index j) { return std::sqrt(std::max(Ninv(j, j), 0.0) * s2) / sc[j]; };
+  const Eigen::MatrixXd Ninv =
+      (Js.transpose() * Js).ldlt().solve(Eigen::MatrixXd::Identity(Js.cols(), Js.cols()));
+  const auto std_of = [&](Eigen::Index j) {
+    return std::sqrt(std::max(Ninv(j, j), 0.0) * s2) / sc[j];
+  };
   // 1-sigma of a profiled parameter: rss_w(x) ~ rss_w(x0) + f'' (x - x0)^2 / 2, chi-square
   // rss_w / s2, so sigma = sqrt(2 s2 / f''); not determined (observable false) if f'' <= 0.
-  const auto profile_std = [&](Chosen& c, double* field, double h, bool log_scale) -> std::pair<double, bool> {
+  const auto profile_std = [&](Chosen& c, double* field, double h,
+                               bool log_scale) -> std::pair<double, bool> {
     const double x0 = *field;
     const auto at = [&](double x) { return rss_with(c, field, log_scale ? std::exp(x) : x); };
     const double c0 = log_scale ? std::log(x0) : x0;
@@ -775,8 +805,10 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
     std::map<int, std::pair<std::size_t, std::size_t>> span;  // run -> first row, count
     for (std::size_t i = 0; i < R.n; ++i) {
       auto it = span.find(R.run[i]);
-      if (it == span.end()) span[R.run[i]] = {i, 1};
-      else ++it->second.second;
+      if (it == span.end())
+        span[R.run[i]] = {i, 1};
+      else
+        ++it->second.second;
     }
     for (std::size_t i = 0; i < R.n; ++i) {
       const auto& sp = span[R.run[i]];
@@ -803,8 +835,8 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
     if (c.effect.kind == CircularEffectKind::reversal_spike) {
       tau_sd[k] = profile_std(chosen[k], &chosen[k].tau, 0.05, true);
       if (tau_sd[k].second && tau_sd[k].first < c.tau) {
-        const Eigen::VectorXd d =
-            0.5 * (beta_at(k, c.tau + tau_sd[k].first, c.delay) - beta_at(k, c.tau - tau_sd[k].first, c.delay));
+        const Eigen::VectorXd d = 0.5 * (beta_at(k, c.tau + tau_sd[k].first, c.delay) -
+                                         beta_at(k, c.tau - tau_sd[k].first, c.delay));
         extra_var += d.cwiseAbs2();
       }
     }
@@ -858,14 +890,15 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
   }
 
   for (const std::string& id : invisible)
-    out.unobservable.push_back({id, "at plausible sizes it changes these readings by less than 5 sigma in all"});
+    out.unobservable.push_back(
+        {id, "at plausible sizes it changes these readings by less than 5 sigma in all"});
   // Entries left out that the final model makes invisible: name what absorbs them.
   const Eigen::MatrixXd Qb = orthonormal_basis(W(B));
   for (const CircularEffect& e : cands) {
     if (!absorbed.count(e.id())) continue;
     const Eigen::MatrixXd Jc = W(cols[e.id()].front().J);
-    Scored vs_base = score_one(e, Jc, Qb, Eigen::VectorXd::Zero(Jc.rows()), static_cast<int>(Qb.cols()),
-                               o.min_visible_chi2);
+    Scored vs_base = score_one(e, Jc, Qb, Eigen::VectorXd::Zero(Jc.rows()),
+                               static_cast<int>(Qb.cols()), o.min_visible_chi2);
     std::string why;
     if (!vs_base.visible) {
       why = "the centre offset and radius of each run absorb its signature in these runs";
@@ -879,8 +912,10 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session, const Circula
                  .visible)
           by += (by.empty() ? "" : ", ") + c.effect.id();
       }
-      why = "in these runs its signature is that of " + (by.empty() ? std::string("the findings together") : by);
-      const bool sq_servo = (e.kind == CircularEffectKind::squareness || e.kind == CircularEffectKind::servo_mismatch);
+      why = "in these runs its signature is that of " +
+            (by.empty() ? std::string("the findings together") : by);
+      const bool sq_servo = (e.kind == CircularEffectKind::squareness ||
+                             e.kind == CircularEffectKind::servo_mismatch);
       if (sq_servo && (R.directions.size() < 2))
         why += ": a cw and a ccw run (or two feeds) separate squareness from servo mismatch";
     }

@@ -1,6 +1,5 @@
-#include <catch2/catch.hpp>
-
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 
 #include "rotacal/ballbar/circular_analysis.hpp"
@@ -117,7 +116,8 @@ TEST_CASE("Circular runs: labels, directions and geometry are checked", "[circul
 
   BallbarSession t = empty_session();
   add_run(t, "circular_YZ_cw", 100, false, 0.0, [](double) { return 100.0; });  // XY points
-  CHECK_THAT(message_of([&] { circular_runs(t); }), Catch::Contains("circular_YZ_cw") && Catch::Contains("YZ plane"));
+  CHECK_THAT(message_of([&] { circular_runs(t); }),
+             Catch::Contains("circular_YZ_cw") && Catch::Contains("YZ plane"));
 
   BallbarSession u = empty_session();
   add_run(u, "circular_XZ_cw", 100, false, 0.0, [](double) { return 100.0; });

@@ -1,5 +1,4 @@
 #include <catch2/catch.hpp>
-
 #include <cmath>
 
 #include "rotacal/ballbar/circular_simulate.hpp"
@@ -25,7 +24,8 @@ double theta_of(const BallbarSession& s, const BallbarSample& b) {
 
 }  // namespace
 
-TEST_CASE("Simulated squareness, scale and centring follow their first-order closed forms", "[circular]") {
+TEST_CASE("Simulated squareness, scale and centring follow their first-order closed forms",
+          "[circular]") {
   // x += s y, x += k_X x, y += k_Y y, pivot off by e: along the bar (theta from +X),
   //   dr = s y cos th + k_X x cos th + k_Y y sin th - e . (cos th, sin th)   (+ O(err^2 / R))
   const CircularPlanResult plan = xy_plan();
@@ -40,13 +40,15 @@ TEST_CASE("Simulated squareness, scale and centring follow their first-order clo
   for (const BallbarSample& b : s.samples) {
     const double th = theta_of(s, b), c = std::cos(th), sn = std::sin(th);
     const double x = b.xyz.x(), y = b.xyz.y();
-    const double dr = 40e-6 * y * c + 30e-6 * x * c - 20e-6 * y * sn - (0.004 * c - 0.003 * sn) + 0.0015;
+    const double dr =
+        40e-6 * y * c + 30e-6 * x * c - 20e-6 * y * sn - (0.004 * c - 0.003 * sn) + 0.0015;
     worst = std::max(worst, std::abs(b.length - s.ballbar_length - dr));
   }
   CHECK(worst < 2e-6);  // second order: (30 um)^2 / 100 mm and the like, 1e-5 um
 }
 
-TEST_CASE("Simulated servo mismatch: a 45 deg ellipse whose sign follows the direction", "[circular]") {
+TEST_CASE("Simulated servo mismatch: a 45 deg ellipse whose sign follows the direction",
+          "[circular]") {
   // Steady state of first-order loops: x = R cos th + R w tau_X sin th, y = R sin th - R w tau_Y
   // cos th (first order in w tau), so dr = R w (tau_X - tau_Y) sin th cos th.
   const CircularPlanResult plan = xy_plan({3000.0});
@@ -69,7 +71,8 @@ TEST_CASE("Simulated servo mismatch: a 45 deg ellipse whose sign follows the dir
   }
 }
 
-TEST_CASE("Simulated reversal spikes decay from the reversal; noise is AR(1) at the sample rate", "[circular]") {
+TEST_CASE("Simulated reversal spikes decay from the reversal; noise is AR(1) at the sample rate",
+          "[circular]") {
   const CircularPlanResult plan = xy_plan();
   CircularSimulationOptions o;
   o.errors.spike = Eigen::Vector3d(0.008, 0.0, 0.0);
@@ -81,7 +84,9 @@ TEST_CASE("Simulated reversal spikes decay from the reversal; noise is AR(1) at 
   for (const BallbarSample& b : s.samples) {
     if (b.test != "circular_XY_ccw") continue;
     double th = theta_of(s, b);
-    if (th > 0.0 && th < 0.2) CHECK(b.length - 100.0 == Approx(0.008 * std::exp(-th / w / 0.05) * std::cos(th)).margin(1e-7));
+    if (th > 0.0 && th < 0.2)
+      CHECK(b.length - 100.0 ==
+            Approx(0.008 * std::exp(-th / w / 0.05) * std::cos(th)).margin(1e-7));
   }
 
   CircularSimulationOptions n;

@@ -1,5 +1,4 @@
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <map>
 #include <regex>
@@ -50,13 +49,16 @@ TEST_CASE("Circular plan: runs, labels, timing and geometry from the options", "
     const double sense = run.direction == CircularDirection::ccw ? 1.0 : -1.0;
     CHECK(run.angle_deg.front() == Approx(run.direction == CircularDirection::ccw ? -20.0 : 200.0));
     CHECK(sense * (run.angle_deg.back() - run.angle_deg.front()) <= 220.0 + 1e-9);
-    CHECK(sense * (run.angle_deg.back() - run.angle_deg.front()) > 220.0 - 360.0 * run.feed_mm_per_min / 60.0 / 150.0 / (2 * M_PI) / 100.0 * 1.01);
+    CHECK(sense * (run.angle_deg.back() - run.angle_deg.front()) >
+          220.0 - 360.0 * run.feed_mm_per_min / 60.0 / 150.0 / (2 * M_PI) / 100.0 * 1.01);
     // Run-in: the data arc starts run_in_deg after the run-in start, at the feed.
-    CHECK(run.time[0] - run.t_start == Approx(45.0 * M_PI / 180.0 * 150.0 / (run.feed_mm_per_min / 60.0)));
+    CHECK(run.time[0] - run.t_start ==
+          Approx(45.0 * M_PI / 180.0 * 150.0 / (run.feed_mm_per_min / 60.0)));
     CHECK(run.angle_at(run.time[5]) == Approx(run.angle_deg[5]));
   }
   // Time never goes back across runs.
-  for (std::size_t k = 1; k < r.runs.size(); ++k) CHECK(r.runs[k].t_start > r.runs[k - 1].time.back());
+  for (std::size_t k = 1; k < r.runs.size(); ++k)
+    CHECK(r.runs[k].t_start > r.runs[k - 1].time.back());
   // ZX: theta from +Z towards +X.
   const Eigen::Vector3d q = circular_point(p, CircularPlane::ZX, 90.0);
   CHECK((q - Eigen::Vector3d(10.0 + 150.0, -20.0, 30.0)).norm() < 1e-12);
@@ -64,10 +66,12 @@ TEST_CASE("Circular plan: runs, labels, timing and geometry from the options", "
   CHECK(s.samples.size() == r.num_samples());
   CHECK(s.ballbar_length == 150.0);
   CHECK(s.tests().size() == 8);
-  for (const BallbarSample& b : s.samples) CHECK(((b.xyz - p.centre).norm() - 150.0) == Approx(0.0).margin(1e-9));
+  for (const BallbarSample& b : s.samples)
+    CHECK(((b.xyz - p.centre).norm() - 150.0) == Approx(0.0).margin(1e-9));
 }
 
-TEST_CASE("Circular plan: one feed gives labels without a feed suffix; the session round-trips", "[circular]") {
+TEST_CASE("Circular plan: one feed gives labels without a feed suffix; the session round-trips",
+          "[circular]") {
   CircularTestPlan p;
   p.planes = {CircularPlane::YZ};
   p.feeds_mm_per_min = {2000.0};
@@ -94,10 +98,12 @@ TEST_CASE("Circular plan: bad options are refused naming the option", "[circular
              Catch::Contains("planes: a plane is repeated"));
   CHECK_THAT(with([](CircularTestPlan& p) { p.feeds_mm_per_min = {1000.0, -5.0}; }),
              Catch::Contains("feeds_mm_per_min"));
-  CHECK_THAT(with([](CircularTestPlan& p) { p.feeds_mm_per_min.clear(); }), Catch::Contains("feeds_mm_per_min"));
+  CHECK_THAT(with([](CircularTestPlan& p) { p.feeds_mm_per_min.clear(); }),
+             Catch::Contains("feeds_mm_per_min"));
   CHECK_THAT(with([](CircularTestPlan& p) { p.feeds_mm_per_min = {1000.0, 1000.0}; }),
              Catch::Contains("feeds_mm_per_min"));
-  CHECK_THAT(with([](CircularTestPlan& p) { p.directions.clear(); }), Catch::Contains("directions"));
+  CHECK_THAT(with([](CircularTestPlan& p) { p.directions.clear(); }),
+             Catch::Contains("directions"));
   CHECK_THAT(with([](CircularTestPlan& p) {
                p.directions = {CircularDirection::cw, CircularDirection::cw};
              }),
@@ -106,14 +112,16 @@ TEST_CASE("Circular plan: bad options are refused naming the option", "[circular
   CHECK_THAT(with([](CircularTestPlan& p) { p.radius = 0.0; }), Catch::Contains("radius"));
   CHECK_THAT(with([](CircularTestPlan& p) { p.radius = NAN; }), Catch::Contains("radius"));
   CHECK_THAT(with([](CircularTestPlan& p) { p.run_in_deg = -1.0; }), Catch::Contains("run_in_deg"));
-  CHECK_THAT(with([](CircularTestPlan& p) { p.sample_rate_hz = 0.0; }), Catch::Contains("sample_rate_hz"));
+  CHECK_THAT(with([](CircularTestPlan& p) { p.sample_rate_hz = 0.0; }),
+             Catch::Contains("sample_rate_hz"));
   // Too fast for the sample rate: fewer than 36 readings over the arc.
   CHECK_THAT(with([](CircularTestPlan& p) {
                p.feeds_mm_per_min = {60000.0};
                p.sample_rate_hz = 1.0;
              }),
              Catch::Contains("feeds_mm_per_min"));
-  CHECK_THAT(message_of([] { parse_circular_plane("XZ"); }), Catch::Contains("plane") && Catch::Contains("XZ"));
+  CHECK_THAT(message_of([] { parse_circular_plane("XZ"); }),
+             Catch::Contains("plane") && Catch::Contains("XZ"));
   CHECK_THAT(message_of([] { parse_circular_direction("up"); }), Catch::Contains("direction"));
   CHECK(parse_circular_plane("zx") == CircularPlane::ZX);
 }
@@ -127,7 +135,8 @@ TEST_CASE("Circular NC program: G2/G3 arcs in G17/G18/G19 that stay on the circl
   const CircularPlanResult r = plan_circular_test(p);
   const std::string nc = write_circular_nc_program(r, NcDialect::linuxcnc);
   // Every arc block: its end point on the circle, and the centre (start + I J K) at the pivot.
-  const std::regex arc(R"((G17|G18|G19) (G2|G3) ([XYZ])(-?[0-9.]+) ([XYZ])(-?[0-9.]+) ([IJK])(-?[0-9.]+) ([IJK])(-?[0-9.]+) F([0-9.]+))");
+  const std::regex arc(
+      R"((G17|G18|G19) (G2|G3) ([XYZ])(-?[0-9.]+) ([XYZ])(-?[0-9.]+) ([IJK])(-?[0-9.]+) ([IJK])(-?[0-9.]+) F([0-9.]+))");
   std::istringstream lines(nc);
   std::string line;
   int arcs = 0, g3 = 0, g2 = 0;

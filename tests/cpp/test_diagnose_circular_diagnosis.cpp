@@ -1,6 +1,5 @@
-#include <catch2/catch.hpp>
-
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <map>
 
@@ -74,7 +73,8 @@ TEST_CASE("Hidden squareness, backlash and cyclic error in AR(1) noise are named
   const CircularDiagnosis d = diagnose_circular(s, opt);
   INFO("baseline rms " << d.baseline_rms_um << " um, final " << d.final_rms_um << " um, noise "
                        << d.noise.summary());
-  CHECK(found(d) == std::vector<std::string>{"backlash_X", "backlash_Y", "cyclic_error_X", "squareness_XY"});
+  CHECK(found(d) ==
+        std::vector<std::string>{"backlash_X", "backlash_Y", "cyclic_error_X", "squareness_XY"});
   const std::map<std::string, double> truth = {{"squareness_XY.s", 35e-6},
                                                {"backlash_X.b", 0.004},
                                                {"backlash_Y.b", 0.0025},
@@ -111,8 +111,10 @@ TEST_CASE("One direction at one feed cannot tell servo mismatch from squareness"
   const CircularDiagnosis d = diagnose_circular(s);
   REQUIRE(d.findings.size() == 1);
   // Either name explains the 45 deg ellipse; the other is reported as indistinguishable.
-  const std::string other = d.findings[0].effect == "squareness_XY" ? "servo_mismatch_XY" : "squareness_XY";
-  CHECK_THAT(reason(d, other), Catch::Contains(d.findings[0].effect) && Catch::Contains("cw and a ccw"));
+  const std::string other =
+      d.findings[0].effect == "squareness_XY" ? "servo_mismatch_XY" : "squareness_XY";
+  CHECK_THAT(reason(d, other),
+             Catch::Contains(d.findings[0].effect) && Catch::Contains("cw and a ccw"));
 }
 
 TEST_CASE("Both directions separate servo mismatch from squareness", "[circular]") {
@@ -120,7 +122,7 @@ TEST_CASE("Both directions separate servo mismatch from squareness", "[circular]
   p.planes = {CircularPlane::YZ};
   p.feeds_mm_per_min = {2500.0};
   CircularSimulationOptions o;
-  o.errors.squareness = Eigen::Vector3d(0.0, -25e-6, 0.0);  // y += s z
+  o.errors.squareness = Eigen::Vector3d(0.0, -25e-6, 0.0);    // y += s z
   o.errors.servo_tau = Eigen::Vector3d(0.0, 0.0021, 0.0015);  // dtau = tau_Y - tau_Z
   o.noise_um = 0.3;
   o.seed = 5;
@@ -169,8 +171,10 @@ TEST_CASE("Backlash and a reversal spike on lagging axes: height, decay and the 
   const BallbarSession s = simulate_circular(plan_circular_test(p), o);
   const CircularDiagnosis d = diagnose_circular(s);
   CHECK(found(d) == std::vector<std::string>{"backlash_X", "reversal_spike_Y"});
-  const std::map<std::string, double> truth = {{"backlash_X.b", 0.004},          {"backlash_X.delay", 0.0015},
-                                               {"reversal_spike_Y.h", 0.005},    {"reversal_spike_Y.tau", 0.02},
+  const std::map<std::string, double> truth = {{"backlash_X.b", 0.004},
+                                               {"backlash_X.delay", 0.0015},
+                                               {"reversal_spike_Y.h", 0.005},
+                                               {"reversal_spike_Y.tau", 0.02},
                                                {"reversal_spike_Y.delay", 0.0015}};
   for (const auto& [name, value] : truth) {
     const ParameterEstimate& e = param(d, name);
@@ -182,7 +186,8 @@ TEST_CASE("Backlash and a reversal spike on lagging axes: height, decay and the 
   CHECK(param(d, "reversal_spike_Y.h").std < 0.1 * 0.005);
 }
 
-TEST_CASE("Three planes: scale mismatches close around the three axes, straightness by plane", "[circular]") {
+TEST_CASE("Three planes: scale mismatches close around the three axes, straightness by plane",
+          "[circular]") {
   // k_X = 20, k_Y = 0, k_Z = -15 um/m: each plane sees only the difference of its two axes,
   // XY: k_X - k_Y = 20, YZ: k_Y - k_Z = 15, ZX: k_Z - k_X = -35 (they sum to 0).
   CircularTestPlan p;
@@ -200,10 +205,12 @@ TEST_CASE("Three planes: scale mismatches close around the three axes, straightn
   const BallbarSession s = simulate_circular(plan_circular_test(p), o);
   const CircularDiagnosis d = diagnose_circular(s);
   CHECK(found(d) == std::vector<std::string>{"backlash_Z", "scale_mismatch_XY", "scale_mismatch_YZ",
-                                             "scale_mismatch_ZX", "straightness_XZ", "straightness_YX"});
-  const std::map<std::string, double> truth = {{"scale_mismatch_XY.dk", 20e-6}, {"scale_mismatch_YZ.dk", 15e-6},
-                                               {"scale_mismatch_ZX.dk", -35e-6}, {"straightness_YX.c2", 0.003},
-                                               {"straightness_XZ.c2", -0.002},  {"backlash_Z.b", 0.003}};
+                                             "scale_mismatch_ZX", "straightness_XZ",
+                                             "straightness_YX"});
+  const std::map<std::string, double> truth = {
+      {"scale_mismatch_XY.dk", 20e-6},  {"scale_mismatch_YZ.dk", 15e-6},
+      {"scale_mismatch_ZX.dk", -35e-6}, {"straightness_YX.c2", 0.003},
+      {"straightness_XZ.c2", -0.002},   {"backlash_Z.b", 0.003}};
   for (const auto& [name, value] : truth) {
     const ParameterEstimate& e = param(d, name);
     INFO(name << " = " << e.value << " +- " << e.std << " (truth " << value << ")");

@@ -41,9 +41,9 @@ struct CircularRunData {
   double omega_rad_s = 0.0;      ///< signed d theta / dt (line fit)
   double t0 = 0.0;               ///< intercept of the line fit: theta = theta0 + omega (t - t0)
   double theta0_rad = 0.0;
-  std::vector<std::size_t> rows;  ///< session sample indices
-  std::vector<double> time;       ///< s
-  std::vector<double> theta_rad;  ///< commanded path angle, unwrapped
+  std::vector<std::size_t> rows;     ///< session sample indices
+  std::vector<double> time;          ///< s
+  std::vector<double> theta_rad;     ///< commanded path angle, unwrapped
   std::vector<double> deviation_mm;  ///< reading - L0
   Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> xyz;  ///< commanded machine axes, mm
   double span_deg() const;
@@ -62,20 +62,20 @@ struct CircularRunResult {
   double span_deg = 0.0;
   std::size_t n = 0;
   Eigen::Vector2d centre_um = Eigen::Vector2d::Zero();  ///< LSQ centre - pivot, (u, v), um
-  double radius_deviation_um = 0.0;  ///< LSQ radius - L0, um
-  double G_um = 0.0;                 ///< circular deviation
-  double max_um = 0.0, min_um = 0.0;  ///< largest and smallest radial deviation
-  std::vector<double> angle_deg;     ///< path angle of each reading, in [0, 360)
-  std::vector<double> radial_um;     ///< radial deviation of each reading from the LSQ circle
+  double radius_deviation_um = 0.0;                     ///< LSQ radius - L0, um
+  double G_um = 0.0;                                    ///< circular deviation
+  double max_um = 0.0, min_um = 0.0;                    ///< largest and smallest radial deviation
+  std::vector<double> angle_deg;                        ///< path angle of each reading, in [0, 360)
+  std::vector<double> radial_um;  ///< radial deviation of each reading from the LSQ circle
 };
 
 struct CircularPairResult {
   CircularPlane plane = CircularPlane::XY;
   double feed_mm_per_min = 0.0;  ///< mean of the two runs'
   std::string ccw_label, cw_label;
-  double G_b_um = 0.0;      ///< bidirectional circular deviation
-  double H_um = 0.0;        ///< circular hysteresis
-  double H_angle_deg = 0.0;  ///< where H is reached, [0, 360)
+  double G_b_um = 0.0;           ///< bidirectional circular deviation
+  double H_um = 0.0;             ///< circular hysteresis
+  double H_angle_deg = 0.0;      ///< where H is reached, [0, 360)
   double common_span_deg = 0.0;  ///< arc both runs cover
 };
 

@@ -37,12 +37,12 @@ struct LinearAxisErrors {
   Eigen::Vector3d scale = Eigen::Vector3d::Zero();       ///< k_X, k_Y, k_Z, mm/mm
   /// c2_DA at row D, column A (mm at 100 mm from the centre); the diagonal must be 0.
   Eigen::Matrix3d straightness = Eigen::Matrix3d::Zero();
-  Eigen::Vector3d backlash = Eigen::Vector3d::Zero();    ///< b_i, mm
-  Eigen::Vector3d spike = Eigen::Vector3d::Zero();       ///< h_i, mm
-  Eigen::Vector3d spike_tau = Eigen::Vector3d::Constant(0.015);  ///< tau_s_i, s
-  Eigen::Vector3d servo_tau = Eigen::Vector3d::Zero();   ///< tau_i = 1 / Kv_i, s
-  Eigen::Vector3d cyclic_cos = Eigen::Vector3d::Zero();  ///< c_i, mm
-  Eigen::Vector3d cyclic_sin = Eigen::Vector3d::Zero();  ///< d_i, mm
+  Eigen::Vector3d backlash = Eigen::Vector3d::Zero();             ///< b_i, mm
+  Eigen::Vector3d spike = Eigen::Vector3d::Zero();                ///< h_i, mm
+  Eigen::Vector3d spike_tau = Eigen::Vector3d::Constant(0.015);   ///< tau_s_i, s
+  Eigen::Vector3d servo_tau = Eigen::Vector3d::Zero();            ///< tau_i = 1 / Kv_i, s
+  Eigen::Vector3d cyclic_cos = Eigen::Vector3d::Zero();           ///< c_i, mm
+  Eigen::Vector3d cyclic_sin = Eigen::Vector3d::Zero();           ///< d_i, mm
   Eigen::Vector3d screw_pitch = Eigen::Vector3d::Constant(10.0);  ///< p_i, mm
 };
 

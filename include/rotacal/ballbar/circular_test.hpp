@@ -75,7 +75,7 @@ struct CircularRun {
   /// Path angles (deg, unwrapped) where the run's run-in starts, the data arc starts and ends,
   /// and the overshoot ends: in the order the machine passes them (decreasing for cw).
   double run_in_from_deg = 0.0, data_from_deg = 0.0, data_to_deg = 0.0, overshoot_to_deg = 0.0;
-  double t_start = 0.0;  ///< s: time at run_in_from (the machine starts from rest there)
+  double t_start = 0.0;     ///< s: time at run_in_from (the machine starts from rest there)
   double rate_deg_s = 0.0;  ///< signed d theta / dt = +-feed / R, deg/s
   /// Time and path angle of every reading of the data arc, at the sample rate, from the data
   /// arc's start (t = t_start + run-in time) to its end.

@@ -82,7 +82,7 @@ struct CircularEffect {
 std::vector<CircularEffect> circular_catalogue();
 
 struct CircularDiagnosisOptions {
-  double alpha = 0.01;          ///< family-wise false-finding rate per round (Bonferroni)
+  double alpha = 0.01;           ///< family-wise false-finding rate per round (Bonferroni)
   double min_delta_bic = -10.0;  ///< "very strong" on the Kass-Raftery scale
   int max_findings = 10;
   /// Lead of each axis' screw (X, Y, Z), mm: the period of its cyclic error.
@@ -108,7 +108,7 @@ struct CircularDiagnosis {
   std::size_t n = 0;
   double baseline_rms_um = 0.0;  ///< residual RMS of centre + radius per run
   double final_rms_um = 0.0;
-  NoiseModel noise;              ///< of the final residuals
+  NoiseModel noise;  ///< of the final residuals
   bool noise_whitened = false;
   std::vector<CircularFinding> findings;  ///< in the order they were added
   std::vector<UnobservableEffect> unobservable;
