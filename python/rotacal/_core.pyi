@@ -6,7 +6,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Ambiguity', 'AngleTable', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CompensationReport', 'CompensationRow', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestDesign', 'RtestDesignCandidate', 'RtestDesignOptions', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSeparatingCandidate', 'RtestSeparationDesign', 'RtestSeparationOptions', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SeparatingCandidate', 'SeparationDesign', 'SeparationOptions', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TableMotionOverlap', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'ballbar_model_document', 'ballbar_model_from_document', 'builtin_machine_names', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_model_machine', 'check_output', 'check_plausible', 'check_rtest_pattern', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_axial_c_tilt_deg', 'default_ballbar_tests', 'default_calibration_moves', 'default_rtest_pattern', 'default_tilt_range_deg', 'design_ballbar_separation', 'design_ballbar_test', 'design_rtest_separation', 'design_rtest_test', 'diagnose_ballbar', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'evaluate_rtest_design', 'export_controller', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_joint_sessions', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_rtest', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_map_names', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'table_motion_overlap', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
+__all__: list[str] = ['Ambiguity', 'AngleTable', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CircularAnalysis', 'CircularDiagnosis', 'CircularDiagnosisOptions', 'CircularDirection', 'CircularEffect', 'CircularFinding', 'CircularPairResult', 'CircularPlanResult', 'CircularPlane', 'CircularRun', 'CircularRunResult', 'CircularSimulationOptions', 'CircularTestPlan', 'CompensationReport', 'CompensationRow', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LinearAxisErrors', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestDesign', 'RtestDesignCandidate', 'RtestDesignOptions', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSeparatingCandidate', 'RtestSeparationDesign', 'RtestSeparationOptions', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SeparatingCandidate', 'SeparationDesign', 'SeparationOptions', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TableMotionOverlap', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'analyze_circular', 'ballbar_model_document', 'ballbar_model_from_document', 'builtin_machine_names', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_model_machine', 'check_output', 'check_plausible', 'check_rtest_pattern', 'circular_catalogue', 'circular_commanded_session', 'circular_label', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_axial_c_tilt_deg', 'default_ballbar_tests', 'default_calibration_moves', 'default_rtest_pattern', 'default_tilt_range_deg', 'design_ballbar_separation', 'design_ballbar_test', 'design_rtest_separation', 'design_rtest_test', 'diagnose_ballbar', 'diagnose_circular', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'evaluate_rtest_design', 'export_controller', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_joint_sessions', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_rtest', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_circular_direction', 'parse_circular_plane', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'plan_circular_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_map_names', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_circular', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'table_motion_overlap', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_circular_nc_program', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
 class Ambiguity:
     @property
     def correlation(self) -> float:
@@ -539,6 +539,436 @@ class CircleFit:
     @property
     def rms(self) -> float:
         ...
+class CircularAnalysis:
+    @property
+    def ballbar_length(self) -> float:
+        ...
+    @property
+    def ignored_tests(self) -> list[str]:
+        ...
+    @property
+    def pairs(self) -> list[CircularPairResult]:
+        ...
+    @property
+    def runs(self) -> list[CircularRunResult]:
+        ...
+class CircularDiagnosis:
+    @property
+    def baseline_rms_um(self) -> float:
+        ...
+    @property
+    def final_rms_um(self) -> float:
+        ...
+    @property
+    def findings(self) -> list[CircularFinding]:
+        ...
+    @property
+    def first_round(self) -> list[CandidateScore]:
+        ...
+    @property
+    def n(self) -> int:
+        ...
+    @property
+    def noise(self) -> NoiseModel:
+        ...
+    @property
+    def noise_whitened(self) -> bool:
+        ...
+    @property
+    def residuals_mm(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def unobservable(self) -> list[UnobservableEffect]:
+        ...
+class CircularDiagnosisOptions:
+    model_noise: bool
+    def __init__(self) -> None:
+        ...
+    @property
+    def alpha(self) -> float:
+        ...
+    @alpha.setter
+    def alpha(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def cv_blocks(self) -> int:
+        ...
+    @cv_blocks.setter
+    def cv_blocks(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def max_findings(self) -> int:
+        ...
+    @max_findings.setter
+    def max_findings(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def min_delta_bic(self) -> float:
+        ...
+    @min_delta_bic.setter
+    def min_delta_bic(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def min_visible_chi2(self) -> float:
+        ...
+    @min_visible_chi2.setter
+    def min_visible_chi2(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def only(self) -> list[str]:
+        ...
+    @only.setter
+    def only(self, arg0: collections.abc.Sequence[str]) -> None:
+        ...
+    @property
+    def screw_pitch(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @screw_pitch.setter
+    def screw_pitch(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+        ...
+class CircularDirection:
+    """
+    ccw: G3, the path angle increases; cw: G2.
+    
+    Members:
+    
+      ccw
+    
+      cw
+    """
+    __members__: typing.ClassVar[dict[str, CircularDirection]]  # value = {'ccw': <CircularDirection.ccw: 0>, 'cw': <CircularDirection.cw: 1>}
+    ccw: typing.ClassVar[CircularDirection]  # value = <CircularDirection.ccw: 0>
+    cw: typing.ClassVar[CircularDirection]  # value = <CircularDirection.cw: 1>
+    @typing.overload
+    def __eq__(self, other: CircularDirection) -> bool:
+        ...
+    @typing.overload
+    def __eq__(self, other: typing.Any) -> bool:
+        ...
+    def __getstate__(self) -> int:
+        ...
+    def __hash__(self) -> int:
+        ...
+    def __index__(self) -> int:
+        ...
+    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __int__(self) -> int:
+        ...
+    @typing.overload
+    def __ne__(self, other: CircularDirection) -> bool:
+        ...
+    @typing.overload
+    def __ne__(self, other: typing.Any) -> bool:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __str__(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def value(self) -> int:
+        ...
+class CircularEffect:
+    """
+    An entry of the circular-test catalogue.
+    """
+    def __init__(self, id: str) -> None:
+        ...
+    @property
+    def cause(self) -> str:
+        ...
+    @property
+    def id(self) -> str:
+        ...
+    @property
+    def param_names(self) -> list[str]:
+        ...
+    @property
+    def param_units(self) -> list[str]:
+        ...
+class CircularFinding:
+    @property
+    def cause(self) -> str:
+        ...
+    @property
+    def effect(self) -> str:
+        ...
+    @property
+    def gain(self) -> Gain:
+        ...
+    @property
+    def parameters(self) -> list[ParameterEstimate]:
+        ...
+class CircularPairResult:
+    @property
+    def G_b_um(self) -> float:
+        ...
+    @property
+    def H_angle_deg(self) -> float:
+        ...
+    @property
+    def H_um(self) -> float:
+        ...
+    @property
+    def ccw_label(self) -> str:
+        ...
+    @property
+    def common_span_deg(self) -> float:
+        ...
+    @property
+    def cw_label(self) -> str:
+        ...
+    @property
+    def feed_mm_per_min(self) -> float:
+        ...
+    @property
+    def plane(self) -> CircularPlane:
+        ...
+class CircularPlanResult:
+    def num_samples(self) -> int:
+        ...
+    @property
+    def plan(self) -> CircularTestPlan:
+        ...
+    @property
+    def runs(self) -> list[CircularRun]:
+        ...
+class CircularPlane:
+    """
+    Plane of an ISO 230-4 circular test: (u, v) = XY, YZ, ZX.
+    
+    Members:
+    
+      XY
+    
+      YZ
+    
+      ZX
+    """
+    XY: typing.ClassVar[CircularPlane]  # value = <CircularPlane.XY: 0>
+    YZ: typing.ClassVar[CircularPlane]  # value = <CircularPlane.YZ: 1>
+    ZX: typing.ClassVar[CircularPlane]  # value = <CircularPlane.ZX: 2>
+    __members__: typing.ClassVar[dict[str, CircularPlane]]  # value = {'XY': <CircularPlane.XY: 0>, 'YZ': <CircularPlane.YZ: 1>, 'ZX': <CircularPlane.ZX: 2>}
+    @typing.overload
+    def __eq__(self, other: CircularPlane) -> bool:
+        ...
+    @typing.overload
+    def __eq__(self, other: typing.Any) -> bool:
+        ...
+    def __getstate__(self) -> int:
+        ...
+    def __hash__(self) -> int:
+        ...
+    def __index__(self) -> int:
+        ...
+    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __int__(self) -> int:
+        ...
+    @typing.overload
+    def __ne__(self, other: CircularPlane) -> bool:
+        ...
+    @typing.overload
+    def __ne__(self, other: typing.Any) -> bool:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __str__(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def value(self) -> int:
+        ...
+class CircularRun:
+    @property
+    def angle_deg(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def data_from_deg(self) -> float:
+        ...
+    @property
+    def data_to_deg(self) -> float:
+        ...
+    @property
+    def direction(self) -> CircularDirection:
+        ...
+    @property
+    def feed_mm_per_min(self) -> float:
+        ...
+    @property
+    def label(self) -> str:
+        ...
+    @property
+    def overshoot_to_deg(self) -> float:
+        ...
+    @property
+    def plane(self) -> CircularPlane:
+        ...
+    @property
+    def run_in_from_deg(self) -> float:
+        ...
+    @property
+    def t_start(self) -> float:
+        ...
+    @property
+    def time(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+class CircularRunResult:
+    @property
+    def G_um(self) -> float:
+        ...
+    @property
+    def angle_deg(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def centre_um(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[2, 1]"]:
+        ...
+    @property
+    def direction(self) -> CircularDirection:
+        ...
+    @property
+    def feed_mm_per_min(self) -> float:
+        ...
+    @property
+    def label(self) -> str:
+        ...
+    @property
+    def max_um(self) -> float:
+        ...
+    @property
+    def min_um(self) -> float:
+        ...
+    @property
+    def n(self) -> int:
+        ...
+    @property
+    def plane(self) -> CircularPlane:
+        ...
+    @property
+    def radial_um(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def radius_deviation_um(self) -> float:
+        ...
+    @property
+    def span_deg(self) -> float:
+        ...
+class CircularSimulationOptions:
+    errors: LinearAxisErrors
+    def __init__(self) -> None:
+        ...
+    @property
+    def centring_error(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @centring_error.setter
+    def centring_error(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+        ...
+    @property
+    def length_error(self) -> float:
+        ...
+    @length_error.setter
+    def length_error(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def noise_rho(self) -> float:
+        ...
+    @noise_rho.setter
+    def noise_rho(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def noise_um(self) -> float:
+        ...
+    @noise_um.setter
+    def noise_um(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def seed(self) -> int:
+        ...
+    @seed.setter
+    def seed(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+class CircularTestPlan:
+    """
+    ISO 230-4 circular tests with the ballbar (mm, deg, mm/min, Hz, s).
+    """
+    machine: MachineType
+    def __init__(self, machine: MachineType = ..., radius: typing.SupportsFloat | typing.SupportsIndex = 100.0, centre: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ..., planes: collections.abc.Sequence[CircularPlane] = ..., feeds_mm_per_min: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] = [1000.0, 3000.0], directions: collections.abc.Sequence[CircularDirection] = ..., start_deg: typing.SupportsFloat | typing.SupportsIndex = 0.0, span_deg: typing.SupportsFloat | typing.SupportsIndex = 360.0, run_in_deg: typing.SupportsFloat | typing.SupportsIndex = 45.0, overshoot_deg: typing.SupportsFloat | typing.SupportsIndex = 45.0, sample_rate_hz: typing.SupportsFloat | typing.SupportsIndex = 250.0, remount_s: typing.SupportsFloat | typing.SupportsIndex = 30.0) -> None:
+        ...
+    @property
+    def centre(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @centre.setter
+    def centre(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+        ...
+    @property
+    def directions(self) -> list[CircularDirection]:
+        ...
+    @directions.setter
+    def directions(self, arg0: collections.abc.Sequence[CircularDirection]) -> None:
+        ...
+    @property
+    def feeds_mm_per_min(self) -> list[float]:
+        ...
+    @feeds_mm_per_min.setter
+    def feeds_mm_per_min(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def overshoot_deg(self) -> float:
+        ...
+    @overshoot_deg.setter
+    def overshoot_deg(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def planes(self) -> list[CircularPlane]:
+        ...
+    @planes.setter
+    def planes(self, arg0: collections.abc.Sequence[CircularPlane]) -> None:
+        ...
+    @property
+    def radius(self) -> float:
+        ...
+    @radius.setter
+    def radius(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def remount_s(self) -> float:
+        ...
+    @remount_s.setter
+    def remount_s(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def run_in_deg(self) -> float:
+        ...
+    @run_in_deg.setter
+    def run_in_deg(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def sample_rate_hz(self) -> float:
+        ...
+    @sample_rate_hz.setter
+    def sample_rate_hz(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def span_deg(self) -> float:
+        ...
+    @span_deg.setter
+    def span_deg(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def start_deg(self) -> float:
+        ...
+    @start_deg.setter
+    def start_deg(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
 class CompensationReport:
     @property
     def after(self) -> BallbarIdentification:
@@ -971,6 +1401,72 @@ class InvalidArgument(Error):
     pass
 class IoError(Error):
     pass
+class LinearAxisErrors:
+    """
+    Errors of the linear axes X, Y, Z (mm, rad, s); see circular_simulate.hpp.
+    """
+    def __init__(self) -> None:
+        ...
+    @property
+    def backlash(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @backlash.setter
+    def backlash(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+        ...
+    @property
+    def cyclic_cos(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @cyclic_cos.setter
+    def cyclic_cos(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+        ...
+    @property
+    def cyclic_sin(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @cyclic_sin.setter
+    def cyclic_sin(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+        ...
+    @property
+    def scale(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @scale.setter
+    def scale(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+        ...
+    @property
+    def screw_pitch(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @screw_pitch.setter
+    def screw_pitch(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+        ...
+    @property
+    def servo_tau(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @servo_tau.setter
+    def servo_tau(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+        ...
+    @property
+    def spike(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @spike.setter
+    def spike(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+        ...
+    @property
+    def spike_tau(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @spike_tau.setter
+    def spike_tau(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+        ...
+    @property
+    def squareness(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @squareness.setter
+    def squareness(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+        ...
+    @property
+    def straightness(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
+        ...
+    @straightness.setter
+    def straightness(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 3]"]) -> None:
+        ...
 class LocationBudget:
     @property
     def dof_a(self) -> float:
@@ -2558,6 +3054,10 @@ class VirtualRtest:
         """
         Commanded rows (set-up, time, B, C, X, Y, Z) and nests.
         """
+def analyze_circular(session: BallbarSession) -> CircularAnalysis:
+    """
+    ISO 230-4 circular deviation G per run, G(b) and hysteresis H per cw/ccw pair.
+    """
 def ballbar_model_document(model: ...) -> typing.Any:
     ...
 def ballbar_model_from_document(document: dict, source: str = '<model>') -> ...:
@@ -2592,6 +3092,14 @@ def check_rtest_pattern(machine: MachineType, b_deg: collections.abc.Sequence[ty
     """
     Raise InvalidArgument naming the axis and its limits (or the travel) when a tilt (b_deg) or rotary (c_deg) angle, deg, or a commanded X, Y, Z of a nest (K, 3) is outside the machine's limits.
     """
+def circular_catalogue() -> list[CircularEffect]:
+    ...
+def circular_commanded_session(plan: CircularPlanResult) -> BallbarSession:
+    """
+    The commanded rotacal-ballbar/1 session of a circular plan (length = L0).
+    """
+def circular_label(plane: CircularPlane, direction: CircularDirection, feed_mm_per_min: typing.SupportsFloat | typing.SupportsIndex, with_feed: bool) -> str:
+    ...
 def compensate_commands(nominal: BallbarSession, identified: ..., machine: MachineType, tool_length_error: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> BallbarSession:
     """
     Compensated commands; tool_length_error (mm): the error of pivot_length + tool_length of a head machine (minus the identified tool_offset_Z).
@@ -2639,6 +3147,10 @@ def design_rtest_test(options: RtestDesignOptions) -> RtestDesign:
 def diagnose_ballbar(session: BallbarSession, options: DiagnosisOptions = ..., reference: rotacal._core.BallbarSession | None = None) -> Diagnosis:
     """
     Diagnose a ballbar session: baseline fit, residual structure, catalogue candidates, findings with their gain.
+    """
+def diagnose_circular(session: BallbarSession, options: CircularDiagnosisOptions = ...) -> CircularDiagnosis:
+    """
+    The classic causes the circular runs support, each with parameters, 1-sigma and gain.
     """
 def diagnose_rtest(session: RtestSession, options: DiagnosisOptions = ...) -> Diagnosis:
     """
@@ -2775,6 +3287,10 @@ def parse_ballbar_test(label: str, machine: MachineType) -> BallbarTest:
     """
     Test from its session label ('radial_B' only on a BC-trt machine).
     """
+def parse_circular_direction(text: str) -> CircularDirection:
+    ...
+def parse_circular_plane(text: str) -> CircularPlane:
+    ...
 def parse_machine_type(text: str) -> MachineType:
     """
     A built-in machine by its name ('AC-trt', 'BC-trt', 'B-head-C-table', ...).
@@ -2798,6 +3314,10 @@ def plan_ballbar_test(setup: BallbarSetup = ..., identified: typing.Annotated[nu
     Returns
     -------
     BallbarPlan: labels, time (N,), p_table (N, 3), angles_deg (N, 2), machine_axes (N, 5)
+    """
+def plan_circular_test(plan: CircularTestPlan) -> CircularPlanResult:
+    """
+    The runs of an ISO 230-4 circular test plan (planes x feeds x directions).
     """
 def predict_rtest_session(model: RtestJointModel, session: RtestSession, probe_zeros: collections.abc.Mapping[str, typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]] = {}) -> RtestSession:
     """
@@ -2852,6 +3372,10 @@ def rtest_readings(machine: MachineType, errors: typing.Annotated[numpy.typing.A
 def simulate_ballbar(commanded: BallbarSession, truth: BallbarMachineModel, noise_um: typing.SupportsFloat | typing.SupportsIndex = 0.5, seed: typing.SupportsInt | typing.SupportsIndex = 1, declare_noise: bool = True) -> BallbarSession:
     """
     The session as the machine `truth` would measure it (lengths filled in, Gaussian noise).
+    """
+def simulate_circular(plan: CircularPlanResult, options: CircularSimulationOptions) -> BallbarSession:
+    """
+    The session a ballbar records on a machine with linear-axis errors.
     """
 def simulate_probe_calibration(dirs: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], zeros: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], moves: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], noise_um: typing.SupportsFloat | typing.SupportsIndex, seed: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
     """
@@ -2911,6 +3435,10 @@ def verify_compensation(commanded: BallbarSession, truth: BallbarMachineModel, n
     """
 def write_ballbar(session: BallbarSession, path: str) -> None:
     ...
+def write_circular_nc_program(plan: CircularPlanResult, dialect: NcDialect, options: NcProgramOptions = ...) -> str:
+    """
+    NC program text of a circular plan.
+    """
 def write_model_document(document: dict, path: str, inputs: collections.abc.Sequence[str] = [], other_outputs: collections.abc.Sequence[str] = []) -> None:
     ...
 @typing.overload

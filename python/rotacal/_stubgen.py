@@ -9,7 +9,7 @@ from pathlib import Path
 # The generator's output changes between versions: the stubs are generated with this one only
 # (scripts/setup.sh installs it) so that regenerating never shows a difference the bindings did not make.
 STUBGEN_VERSION = "2.5.5"
-ENUMS = ("RadialSide", "BallbarTest", "NcDialect", "SegmentKind")
+ENUMS = ("RadialSide", "BallbarTest", "NcDialect", "SegmentKind", "CircularPlane", "CircularDirection")
 STUB = Path(__file__).with_name("_core.pyi")
 
 

@@ -1394,6 +1394,9 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--seed", type=SEED, default=2016)
     q.add_argument("--sag", type=number("--sag", -1.0, 1.0, "mm"), default=0.004, help="hidden gravity sag of the A table, mm")
     q.set_defaults(func=cmd_demo)
+
+    from .circular import add_cli as add_circular_cli
+    add_circular_cli(sub)  # rotacal circular plan|simulate|analyze (circular.py)
     return p
 
 

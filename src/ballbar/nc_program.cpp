@@ -6,6 +6,7 @@
 #include <sstream>
 #include <vector>
 
+#include "nc_words.hpp"
 #include "rotacal/core/error.hpp"
 
 namespace rotacal {
@@ -16,23 +17,8 @@ constexpr double kPi = 3.14159265358979323846;
 // Two commanded poses closer than this (mm, deg) are the same: no block is written.
 constexpr double kSamePose = 1e-9;
 
-std::string fixed(double v, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  std::string s = buf;
-  // "-0.0000" is 0: print it without the sign.
-  bool all_zero = true;
-  for (char c : s)
-    if (c != '-' && c != '0' && c != '.') all_zero = false;
-  if (all_zero && !s.empty() && s[0] == '-') s.erase(0, 1);
-  return s;
-}
-
-std::string general(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
-}
+using nc_detail::fixed;
+using nc_detail::general;
 
 // The commanded state after a block.
 struct Commanded {
