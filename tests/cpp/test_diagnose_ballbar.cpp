@@ -134,7 +134,10 @@ TEST_CASE("two hidden effects are both found", "[diagnose]") {
     const Diagnosis D = diagnose_hidden(truth, 5);
     std::vector<std::string> found;
     for (const Finding& F : D.findings) found.push_back(F.effect.id());
-    INFO(a << " + " << b);
+    std::string said;
+    for (const std::string& f : found) said += f + " ";
+    for (const UnobservableEffect& u : D.unobservable) said += "[" + u.effect + ": " + u.reason.substr(0, 40) + "] ";
+    INFO(a << " + " << b << "; found " << said << "; noise " << D.noise.summary());
     CHECK(std::find(found.begin(), found.end(), a) != found.end());
     CHECK(std::find(found.begin(), found.end(), b) != found.end());
     CHECK(found.size() == 2);
