@@ -215,17 +215,21 @@ def analyze(session: Any, *, diagnose: bool = True, screw_pitch_mm: Sequence[flo
     return CircularResult(analysis, diag, source)
 
 
-def polar_plot(result: CircularResult, path: str, inputs: Sequence[str] = ()) -> None:
-    """Polar plot of every run's radial deviation (one panel per plane), as ballbar software
-    shows it: the path about the least-squares centre with the deviation magnified; written by
-    the output rule."""
-    import io
+def is_circular(session: Any) -> bool:
+    """True for a ballbar session whose tests are all ISO 230-4 circular runs (``circular_*``
+    labels): the linear axes' test, which the rotary-axis commands cannot analyse."""
+    from .sessions import BALLBAR, kind
+    tests = set(session.tests) if kind(session) == BALLBAR else set()
+    return bool(tests) and all(str(t).startswith("circular_") for t in tests)
 
+
+def polar_figure(result: CircularResult) -> Any:
+    """The polar plot of every run's radial deviation (one panel per plane), as ballbar software
+    shows it: the path about the least-squares centre with the deviation magnified."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from .outputs import write_output
     runs = result.analysis.runs
     planes = [p for p in PLANES if any(r.plane.name == p for r in runs)]
     fig, axes = plt.subplots(1, len(planes), subplot_kw={"projection": "polar"}, figsize=(4.6 * len(planes), 4.8))
@@ -249,6 +253,17 @@ def polar_plot(result: CircularResult, path: str, inputs: Sequence[str] = ()) ->
         ax.tick_params(labelsize=7)
         ax.legend(fontsize=7, loc="lower left", bbox_to_anchor=(-0.15, -0.15))
     fig.tight_layout()
+    return fig
+
+
+def polar_plot(result: CircularResult, path: str, inputs: Sequence[str] = ()) -> None:
+    """polar_figure as a PNG file, written by the output rule."""
+    import io
+
+    import matplotlib.pyplot as plt
+
+    from .outputs import write_output
+    fig = polar_figure(result)
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=110)
     plt.close(fig)

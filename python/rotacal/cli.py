@@ -332,7 +332,14 @@ def _load(path: str, a: argparse.Namespace | None = None) -> Any:
     for w in s.warnings:
         _say(f"rotacal: warning: {path}: {w}")
     if a is not None:
-        check_plausible(s, path, getattr(a, "max_deviation", None))
+        from .circular import is_circular
+        if is_circular(s) and getattr(a, "func", None) is not cmd_report:
+            raise _core.InvalidArgument(
+                f"{path}: holds ISO 230-4 circular tests of the linear axes ({', '.join(sorted(set(s.tests))[:3])}"
+                f"{', ...' if len(set(s.tests)) > 3 else ''}), not a rotary-axis test: `rotacal circular analyze "
+                f"{path}` gives G, G(b), H and their causes, `rotacal report {path} -o OUT.html` the report")
+        if not is_circular(s):
+            check_plausible(s, path, getattr(a, "max_deviation", None))
     return s
 
 
@@ -912,8 +919,14 @@ def cmd_report(a: argparse.Namespace) -> int:
         with open_history(a.db) as h:  # an unknown machine id is refused before the fit
             extra.append(history_section(h.show(a.history)))
     s = _load(a.file, a)
-    out = write_report(a.output, s, a.method, with_diagnosis=not a.no_diagnosis, source=a.file, inputs=[a.file],
-                       extra_sections=extra)
+    from .circular import analyze as analyze_circular, is_circular
+    if is_circular(s):  # ISO 230-4 runs of the linear axes: their own report
+        from .report import circular_report
+        out = circular_report(a.output, analyze_circular(s, diagnose=not a.no_diagnosis, source=a.file),
+                              source=a.file, inputs=[a.file], extra_sections=extra)
+    else:
+        out = write_report(a.output, s, a.method, with_diagnosis=not a.no_diagnosis, source=a.file,
+                           inputs=[a.file], extra_sections=extra)
     print(Path(out).resolve())
     return EXIT_OK
 

@@ -105,3 +105,29 @@ def test_python_api_partial_arcs():
     assert np.all(np.isfinite(res.analysis.runs[0].radial_um))
     with pytest.raises(rotacal.InvalidArgument, match="plane"):
         circular.plan(["XQ"])
+
+
+def test_rotary_commands_point_to_circular_and_report_draws_it(tmp_path):
+    """A circular-test session given to the rotary-axis commands is refused with the command that
+    analyses it (exit 3), not as "the axes never move"; `rotacal report` writes its own report:
+    G per run, G(b) and H, the polar plot and the named causes."""
+    s = tmp_path / "c.csv"
+    r = rotacal_cli("circular", "simulate", "--planes", "XY", "--squareness", "XY=35", "--backlash", "X=4",
+                    "--seed", "3", "-o", s)
+    assert r.returncode == 0, r.stderr
+    for cmd in ("identify", "diagnose"):
+        r = rotacal_cli(cmd, s)
+        assert r.returncode == 3 and "rotacal circular analyze" in r.stderr and "never move" not in r.stderr, r.stderr
+    r = rotacal_cli("report", s, "-o", tmp_path / "c.html")
+    assert r.returncode == 0, r.stderr
+    page = (tmp_path / "c.html").read_text()
+    for section in ('id="circular-deviation"', 'id="polar"', 'id="diagnosis"', "data:image/png;base64,"):
+        assert section in page
+    # The report's numbers are the analysis': G of each run and the causes named.
+    res = circular.analyze(rotacal.load(s))
+    for run in res.analysis.runs:
+        assert f"<td>{run.G_um:.2f}</td>" in page
+    named = {f.effect for f in res.diagnosis.findings}
+    assert {"squareness_XY", "backlash_X"} <= named
+    for eff in named:
+        assert f"<b>{eff}</b>" in page
