@@ -12,6 +12,7 @@
 
 #include "rotacal/core/stats.hpp"
 #include "scoring.hpp"
+#include "rotacal/core/noise_handling.hpp"
 
 namespace rotacal {
 
@@ -150,6 +151,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
       levels_rank = static_cast<int>(orthonormal_basis(J_levels).cols() - Q_raw.cols());
     }
     std::vector<Score> scores;
+    NoiseTreatment wander_noise;  // 1/f-like: AR(1) + random walk by REML, once per round
     std::vector<NoiseTreatment> treatment_of;  // per score: the noise it was judged with
     for (std::size_t c = 0; c < candidates.size(); ++c) {
       if (done[c]) continue;
@@ -169,7 +171,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
         // follows stays correlated (so it is not taken for an effect), and an effect's own
         // signature is not mistaken for correlated noise (which would whiten it away).
         NoiseModel own_model;
-        const NoiseTreatment own = candidate_treatment(P, options, fit, Q_raw, Jc, candidates[c], white, &own_model);
+        NoiseTreatment own = candidate_treatment(P, options, fit, Q_raw, Jc, candidates[c], white, &own_model);
         ScoringInputs in_c;
         in_c.Jfree = in.Jfree;
         in_c.num_free = fit.num_free;
@@ -177,9 +179,19 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
           // Noise that AR(1) does not describe (BIC wants p >= 2) is taken as 1/f-like: it has
           // no finite correlation time, and its lowest frequencies are indistinguishable from
           // an offset per stream that no AR model of a few hundred readings captures, so the
-          // level of each stream becomes a nuisance parameter.
+          // level of each stream becomes a nuisance parameter. Its slow wander within a test
+          // is modelled as a random walk: AR(1) + walk by REML over what the current model and
+          // the levels leave (core/noise_handling.hpp), once per round. Burg's AR(p) of a
+          // stream of a few hundred readings misses that wander and took it for drifts (23
+          // false findings in 200 1/f-like null sessions; with the walk: bench/
+          // diagnose_realistic_bench --rho -1).
           in_c.Jfree = J_levels;
           in_c.num_free += levels_rank;
+          if (!wander_noise.W) {
+            const NoiseModel start = estimate_noise_model(P.groups(), P.times(), fit.residuals, options.noise);
+            wander_noise = coloured_treatment(estimate_noise_model_reml(start, fit.residuals, J_levels));
+          }
+          own = wander_noise;
         }
         in_c.Q_w = orthonormal_basis(own.whiten(in_c.Jfree));
         in_c.r_w = own.whiten(fit.residuals);
