@@ -11,7 +11,6 @@
 #include <set>
 
 #include "rotacal/core/error.hpp"
-#include "rotacal/rtest/identify_joint.hpp"
 
 namespace rotacal {
 

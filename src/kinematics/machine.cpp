@@ -1,10 +1,12 @@
 #include "rotacal/kinematics/machine.hpp"
 
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <string>
 #include <vector>
 
 namespace rotacal {
@@ -201,6 +203,18 @@ MachineAxes inverse_with_tool_axis(MachineType m, const LocationErrors<double>& 
     a.rot += step[1];
   }
   return inverse(m, e, a, p_table);
+}
+
+std::array<std::string, 2> rtest_map_names(MachineType m) {
+  const MachineDescription& d = m.description();
+  const int nt = static_cast<int>(d.table_axes.size());
+  auto name = [&](int k) {
+    const RotaryAxis& a = d.axis(k);
+    char carrier = a.on_head ? 'Z' : 'Y';
+    if (k != 0 && k != nt) carrier = d.axis(k - 1).name;  // the axis before it on its side
+    return std::string(1, a.name) + carrier;
+  };
+  return {name(m.tilt_index()), name(m.rot_index())};
 }
 
 }  // namespace rotacal

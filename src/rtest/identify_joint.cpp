@@ -95,18 +95,6 @@ RtestBasis RtestBasis::for_machine(MachineType m) const {
   return out;
 }
 
-std::array<std::string, 2> rtest_map_names(MachineType m) {
-  const MachineDescription& d = m.description();
-  const int nt = static_cast<int>(d.table_axes.size());
-  auto name = [&](int k) {
-    const RotaryAxis& a = d.axis(k);
-    char carrier = a.on_head ? 'Z' : 'Y';
-    if (k != 0 && k != nt) carrier = d.axis(k - 1).name;  // the axis before it on its side
-    return std::string(1, a.name) + carrier;
-  };
-  return {name(m.tilt_index()), name(m.rot_index())};
-}
-
 // ---------------------------------------------------------------- model
 std::vector<std::string> RtestJointModel::parameter_names() const {
   const auto& le = location_error_names(machine);

@@ -88,6 +88,13 @@ struct LocationErrors {
 
 /// Location error names in LocationErrors order for the given machine (formats.md).
 const std::array<std::string, 8>& location_error_names(MachineType m);
+
+/// Names of the two R-test error maps of a machine (rtest/identify_joint.hpp), {tilt axis' map, rotary axis' map}: the axis letter and
+/// the letter of what carries it (Oyama's "BY": B on the Y slide, "CB": C on B). The axis
+/// nearest the bed rides the Y slide ("Y"), the head axis nearest the linear axes the Z slide
+/// ("Z"), any other the axis before it on its side. BC-trt: {"BY", "CB"}; AC-trt: {"AY", "CA"};
+/// B-head-C-table: {"BZ", "CY"}; AC-head: {"AC", "CZ"}.
+std::array<std::string, 2> rtest_map_names(MachineType m);
 /// Index of a location error name for the machine; throws InvalidArgument if it is not one of its 8.
 int location_error_index(MachineType m, const std::string& name);
 /// True for the four orientation errors (rad), false for the four positions (mm).

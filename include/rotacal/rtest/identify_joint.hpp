@@ -47,12 +47,6 @@
 
 namespace rotacal {
 
-/// Names of the two maps of a machine, {tilt axis' map, rotary axis' map}: the axis letter and
-/// the letter of what carries it (Oyama's "BY": B on the Y slide, "CB": C on B). The axis
-/// nearest the bed rides the Y slide ("Y"), the head axis nearest the linear axes the Z slide
-/// ("Z"), any other the axis before it on its side. BC-trt: {"BY", "CB"}; AC-trt: {"AY", "CA"};
-/// B-head-C-table: {"BZ", "CY"}; AC-head: {"AC", "CZ"}.
-std::array<std::string, 2> rtest_map_names(MachineType m);
 
 /// Number of the model's non-map parameters: the 8 location errors, and on a machine with head
 /// axes tool_offset_Z (minus the error of pivot_length + tool_length, along the spindle).
