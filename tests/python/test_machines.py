@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 import rotacal
+from conftest import split_by_c
 from rotacal import _core, cli
 from rotacal.machines import load_machine, machine_dict, machine_drawing
 
@@ -344,20 +345,6 @@ def test_doc_table_of_builtins_matches_the_descriptions():
         assert names.split() == list(_core.location_error_names(m))
 
 
-def _split_by_c(path, step):
-    """Two files from one session: rows with C on multiples of `step` deg, and the others."""
-    lines = path.read_text().splitlines()
-    meta = [ln for ln in lines if ln.startswith("#")]
-    header, *rows = [ln for ln in lines if ln and not ln.startswith("#")]
-    c_col = header.split(",").index("C")
-    out = []
-    for name, keep in (("fit", True), ("held", False)):
-        p = path.with_name(f"{path.stem}.{name}.csv")
-        p.write_text("\n".join(meta + [header] + [r for r in rows if (float(r.split(",")[c_col]) % step == 0) == keep]) + "\n")
-        out.append(p)
-    return out
-
-
 @pytest.mark.parametrize("name", ["B-head-C-table", "AC-head", "B45C-trt", "AC-trt", "custom"])
 def test_rtest_model_file_predicts_held_out_poses_on_any_machine(capsys, tmp_path, custom_file, name):
     """Fit on C = 0, 30, ...; save the rtest-joint model; predict C = 15, 45, ... from the file.
@@ -370,7 +357,7 @@ def test_rtest_model_file_predicts_held_out_poses_on_any_machine(capsys, tmp_pat
     code, _, err = run(capsys, "simulate", "rtest", "--machine", machine, "--c-step", 15, "--seed", 3,
                        "--effect", "gravity_sag_" + load_machine(machine).tilt_axis + "=0.004", "-o", session)
     assert code == 0, err
-    fit, held = _split_by_c(session, 30)
+    fit, held = split_by_c(session, 30)
     code, _, err = run(capsys, "identify", fit, "--no-budget", "--save-model", tmp_path / "m.json")
     assert code == 0, err
     code, _, err = run(capsys, "predict", held, "--model", tmp_path / "m.json", "--probe-zeros", "fitted",

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import rotacal
-from conftest import truth
+from conftest import split_by_c, truth
 
 
 @pytest.fixture(scope="module")
@@ -59,22 +59,6 @@ def test_cli_identify_rtest(shared_data, tmp_path):
 def rotacal_cli(*args, cwd=None):
     return subprocess.run([sys.executable, "-m", "rotacal", *map(str, args)], capture_output=True, text=True,
                           timeout=300, cwd=cwd)
-
-
-def split_by_c(path, step):
-    """Two files from one session: rows with C on multiples of `step` deg, and the others."""
-    lines = path.read_text().splitlines()
-    meta = [ln for ln in lines if ln.startswith("#")]
-    header, *rows = [ln for ln in lines if ln and not ln.startswith("#")]
-    c_col = header.split(",").index("C")
-    on = [r for r in rows if float(r.split(",")[c_col]) % step == 0]
-    off = [r for r in rows if float(r.split(",")[c_col]) % step != 0]
-    out = []
-    for name, part in (("fit", on), ("held", off)):
-        p = path.with_name(f"{path.stem}.{name}.csv")
-        p.write_text("\n".join(meta + [header] + part) + "\n")
-        out.append(p)
-    return out
 
 
 EFFECTS = ["--effect", "gravity_sag_B=0.006", "--effect", "coning_B=0.000145",
