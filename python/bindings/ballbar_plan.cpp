@@ -14,7 +14,12 @@ void bind_ballbar_plan(pyb::module_& m) {
       .value("radial_tilt", BallbarTest::radial_tilt)
       .value("axial_tilt", BallbarTest::axial_tilt)
       .value("radial_c", BallbarTest::radial_c)
-      .value("axial_c", BallbarTest::axial_c);
+      .value("axial_c", BallbarTest::axial_c)
+      .value("tangential_tilt", BallbarTest::tangential_tilt)
+      .value("tangential_c", BallbarTest::tangential_c);
+  pyb::enum_<SweepDirection>(m, "SweepDirection", "ccw: towards increasing angles; cw: back.")
+      .value("ccw", SweepDirection::ccw)
+      .value("cw", SweepDirection::cw);
   pyb::enum_<RadialSide>(m, "RadialSide", "Flynn's +-L0 of the radial C test.")
       .value("outside", RadialSide::outside)
       .value("inside", RadialSide::inside);
@@ -35,6 +40,10 @@ void bind_ballbar_plan(pyb::module_& m) {
   m.def("default_ballbar_tests", &default_ballbar_tests,
         "sphere_xy, sphere_yz, sphere_zx, radial tilt, axial C, radial C, axial tilt.");
   m.def("parse_radial_side", &parse_radial_side, pyb::arg("text"));
+  m.def("parse_sweep_direction", &parse_sweep_direction, pyb::arg("text"));
+  m.def("is_rotary_test", &is_rotary_test, pyb::arg("test"));
+  m.def("run_label", &run_label, pyb::arg("test"), pyb::arg("direction"), pyb::arg("feed_factor"),
+        pyb::arg("setup"), "Label of one run: test label, '_cw', '_f<feed>'.");
   m.def("parse_nc_dialect", &parse_nc_dialect, pyb::arg("text"));
 
   const BallbarSetup d;
@@ -44,12 +53,23 @@ void bind_ballbar_plan(pyb::module_& m) {
                         std::optional<std::array<double, 2>> tilt_range_deg, std::array<double, 2> rot_range_deg,
                         double step_deg, double feed_mm_per_min, double feed_deg_per_min,
                         std::vector<BallbarTest> tests, RadialSide radial_c_side,
-                        std::optional<double> axial_c_tilt_deg) {
-             return BallbarSetup{machine,         ballbar_length,   pivot,
-                                 tilt_range_deg.value_or(default_tilt_range_deg(machine)),
-                                 rot_range_deg,   step_deg,
-                                 feed_mm_per_min, feed_deg_per_min, std::move(tests),
-                                 radial_c_side,   axial_c_tilt_deg};
+                        std::optional<double> axial_c_tilt_deg, std::vector<SweepDirection> directions,
+                        std::vector<double> feed_factors) {
+             BallbarSetup s;
+             s.machine = machine;
+             s.ballbar_length = ballbar_length;
+             s.pivot = pivot;
+             s.tilt_range_deg = tilt_range_deg.value_or(default_tilt_range_deg(machine));
+             s.rot_range_deg = rot_range_deg;
+             s.step_deg = step_deg;
+             s.feed_mm_per_min = feed_mm_per_min;
+             s.feed_deg_per_min = feed_deg_per_min;
+             s.tests = std::move(tests);
+             s.radial_c_side = radial_c_side;
+             s.axial_c_tilt_deg = axial_c_tilt_deg;
+             s.directions = std::move(directions);
+             s.feed_factors = std::move(feed_factors);
+             return s;
            }),
            pyb::arg("machine") = d.machine, pyb::arg("ballbar_length") = d.ballbar_length,
            pyb::arg("pivot") = d.pivot, pyb::arg("tilt_range_deg") = pyb::none(),
@@ -57,6 +77,7 @@ void bind_ballbar_plan(pyb::module_& m) {
            pyb::arg("feed_mm_per_min") = d.feed_mm_per_min,
            pyb::arg("feed_deg_per_min") = d.feed_deg_per_min, pyb::arg("tests") = d.tests,
            pyb::arg("radial_c_side") = d.radial_c_side, pyb::arg("axial_c_tilt_deg") = pyb::none(),
+           pyb::arg("directions") = d.directions, pyb::arg("feed_factors") = d.feed_factors,
            "tilt_range_deg None: default_tilt_range_deg(machine); axial_c_tilt_deg None: "
            "default_axial_c_tilt_deg(machine).")
       .def_readwrite("machine", &BallbarSetup::machine)
@@ -70,6 +91,9 @@ void bind_ballbar_plan(pyb::module_& m) {
       .def_readwrite("feed_deg_per_min", &BallbarSetup::feed_deg_per_min)
       .def_readwrite("tests", &BallbarSetup::tests)
       .def_readwrite("radial_c_side", &BallbarSetup::radial_c_side)
+      .def_readwrite("directions", &BallbarSetup::directions, "directions of every rotary test, in order")
+      .def_readwrite("feed_factors", &BallbarSetup::feed_factors,
+                     "feeds of every rotary test as factors of the set-up's feeds; the first is 1")
       .def_readwrite("axial_c_tilt_deg", &BallbarSetup::axial_c_tilt_deg,
                      "tilt held during axial_c, deg; None: default_axial_c_tilt_deg(machine)");
   m.def("default_tilt_range_deg", &default_tilt_range_deg, pyb::arg("machine"));
@@ -88,6 +112,8 @@ void bind_ballbar_plan(pyb::module_& m) {
       .def_readonly("label", &PlanSegment::label)
       .def_readonly("kind", &PlanSegment::kind)
       .def_readonly("test", &PlanSegment::test)
+      .def_readonly("direction", &PlanSegment::direction)
+      .def_readonly("feed_factor", &PlanSegment::feed_factor)
       .def_readonly("arc", &PlanSegment::arc)
       .def_property_readonly("num_samples", [](const PlanSegment& s) { return s.samples.size(); });
 

@@ -89,6 +89,9 @@ void bind_noise(pyb::module_& m) {
       .def_readwrite("tilt_motion_rad", &PlausibleSizes::tilt_motion_rad)
       .def_readwrite("gravity_sag_mm", &PlausibleSizes::gravity_sag_mm)
       .def_readwrite("coning", &PlausibleSizes::coning)
+      .def_readwrite("backlash_rad", &PlausibleSizes::backlash_rad)
+      .def_readwrite("servo_lag_s", &PlausibleSizes::servo_lag_s)
+      .def_readwrite("reversal_spike_rad", &PlausibleSizes::reversal_spike_rad)
       .def_readwrite("overrides", &PlausibleSizes::overrides)
       .def_readwrite("use_session_bounds", &PlausibleSizes::use_session_bounds);
 

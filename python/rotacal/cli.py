@@ -157,8 +157,15 @@ def _add_setup_args(p: argparse.ArgumentParser) -> None:
                    help=f"linear feed, mm/min (default {d.feed_mm_per_min:g})")
     g.add_argument("--rotary-feed", type=number("--rotary-feed", 1.0, 1e6, "deg/min"),
                    help=f"rotary feed, deg/min (default {d.feed_deg_per_min:g})")
-    g.add_argument("--tests", default="", help="comma-separated test labels (default: all seven)")
+    g.add_argument("--tests", default="", help="comma-separated test labels (default: the seven of Flynn et al.; "
+                                              "tangential_A/B/C put the bar along the pivot's circle)")
     g.add_argument("--radial-c", help="radial C tool circle outside or inside the pivot's (default outside)")
+    g.add_argument("--directions", default="",
+                   help="directions every rotary test runs in, e.g. ccw,cw (default ccw; cw runs are "
+                        "labelled _cw)")
+    g.add_argument("--feed-factors", default="",
+                   help="feeds every rotary test runs at, as factors of --feed/--rotary-feed starting "
+                        "with 1, e.g. 1,2 (runs at other feeds are labelled _f<mm/min>)")
 
 
 def _setup(a: argparse.Namespace) -> Any:
@@ -175,7 +182,19 @@ def _setup(a: argparse.Namespace) -> Any:
         s.tests = [_core.parse_ballbar_test(t.strip(), s.machine) for t in a.tests.split(",")]
     if a.radial_c is not None:
         s.radial_c_side = _core.parse_radial_side(a.radial_c)
+    if a.directions:
+        s.directions = [_core.parse_sweep_direction(t.strip()) for t in a.directions.split(",")]
+    if a.feed_factors:
+        s.feed_factors = [_float_list_item("--feed-factors", t) for t in a.feed_factors.split(",")]
     return s
+
+
+def _float_list_item(option: str, text: str) -> float:
+    """One number of a comma-separated option; refused by name (the plan checks its range)."""
+    try:
+        return float(text.strip())
+    except ValueError:
+        raise _core.InvalidArgument(f"{option}: '{text.strip()}' is not a number") from None
 
 
 def _model(path: str | None) -> Any:

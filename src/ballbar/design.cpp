@@ -449,7 +449,8 @@ struct SessionsLengthModel : ResidualModel {
     const Eigen::Vector3d xyz = a.xyz.col(i);
     out[0] = predicted_length<T>(a.machine, LocationErrors<T>::from_ptr(p), pivot, fx,
                                  P > 0 ? p + 8 + 3 * ns : nullptr, xyz,
-                                 a.angles[static_cast<std::size_t>(i)], a.time[i]) -
+                                 a.angles[static_cast<std::size_t>(i)], a.time[i],
+                                 a.motion[static_cast<std::size_t>(i)]) -
              T(a.length[i]);
   }
 };

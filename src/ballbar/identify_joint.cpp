@@ -31,6 +31,9 @@ BallbarArrays ballbar_arrays(const BallbarSession& session, const std::vector<st
   a.time.resize(n);
   a.length.resize(n);
   a.test.resize(a.index.size());
+  a.motion.resize(a.index.size());
+  // Motion from every row of the session: a test left out still moved the axes.
+  const std::vector<RotaryMotion> motion = rotary_motion(session.samples);
   for (Eigen::Index k = 0; k < n; ++k) {
     const BallbarSample& s = session.samples[a.index[static_cast<std::size_t>(k)]];
     a.xyz.col(k) = s.xyz;
@@ -38,6 +41,7 @@ BallbarArrays ballbar_arrays(const BallbarSession& session, const std::vector<st
     a.time[k] = s.time;
     a.length[k] = s.length;
     a.test[static_cast<std::size_t>(k)] = s.test;
+    a.motion[static_cast<std::size_t>(k)] = motion[a.index[static_cast<std::size_t>(k)]];
   }
   return a;
 }

@@ -122,7 +122,7 @@ class BallbarLengthModel : public ResidualModel {
     const Eigen::Vector3d xyz = d_.xyz.col(i);
     out[0] = predicted_length<T>(d_.machine, LocationErrors<T>::from_ptr(p), pivot, fx_,
                                  P_ > 0 ? p + 11 : nullptr, xyz, d_.angles[static_cast<std::size_t>(i)],
-                                 d_.time[i]) -
+                                 d_.time[i], d_.motion[static_cast<std::size_t>(i)]) -
              T(d_.length[i]);
   }
 

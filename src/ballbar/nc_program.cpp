@@ -49,6 +49,7 @@ class Writer {
     for (std::size_t i = 0; i < segs.size(); ++i) {
       const PlanSegment& seg = segs[i];
       segment_comment(seg);
+      feed_factor_ = seg.feed_factor;
       if (seg.kind == SegmentKind::arc_transition && seg.arc.principal_axis >= 0) {
         tcp(false);
         arc_block(seg, end_time_of_arc(i), cur);
@@ -97,7 +98,7 @@ class Writer {
   }
 
   std::string feed_word(double dt_s) const {
-    if (d_ == NcDialect::heidenhain) return "F" + fixed(plan_.setup.feed_mm_per_min, 0);
+    if (d_ == NcDialect::heidenhain) return "F" + fixed(plan_.setup.feed_mm_per_min * feed_factor_, 0);
     return "F" + fixed(60.0 / dt_s, 4);  // G93: reciprocal of the block time in minutes
   }
 
@@ -211,6 +212,13 @@ class Writer {
     std::string order;
     for (BallbarTest t : s.tests) order += (order.empty() ? "" : ", ") + test_label(t, s.machine);
     comment("test order: " + order);
+    if (s.directions.size() > 1 || s.feed_factors.size() > 1) {
+      std::string runs;
+      for (SweepDirection d : s.directions) runs += (runs.empty() ? "" : ", ") + to_string(d);
+      std::string feeds;
+      for (double k : s.feed_factors) feeds += (feeds.empty() ? "" : ", ") + general(s.feed_mm_per_min * k);
+      comment("each rotary test runs " + runs + " at " + feeds + " mm/min (labels _cw, _f<feed>)");
+    }
     comment(tilt_ + " range: " + general(s.tilt_range_deg[0]) + " .. " +
             general(s.tilt_range_deg[1]) + " deg, C range: " + general(s.rot_range_deg[0]) +
             " .. " + general(s.rot_range_deg[1]) + " deg, step: " + general(s.step_deg) +
@@ -367,6 +375,7 @@ class Writer {
   // any location errors).
   Eigen::Vector3d zero_shift_;
   bool tcp_on_ = false;
+  double feed_factor_ = 1.0;  // of the segment being written (BallbarSetup::feed_factors)
   std::vector<std::string> lines_;
 };
 

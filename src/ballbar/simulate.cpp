@@ -12,11 +12,12 @@ std::vector<double> predict_lengths(const BallbarMachineModel& model,
     throw InvalidArgument("effect_params: expected " + std::to_string(model.effects.num_params()) +
                           " values for the model's effects, got " +
                           std::to_string(model.effect_params.size()));
+  const std::vector<RotaryMotion> motion = rotary_motion(samples);
   std::vector<double> out;
   out.reserve(samples.size());
-  for (const BallbarSample& s : samples)
+  for (std::size_t i = 0; i < samples.size(); ++i)
     out.push_back(predicted_length<double>(model.machine, model.errors, model.pivot, model.effects,
-                                           model.effect_params.data(), s));
+                                           model.effect_params.data(), samples[i], motion[i]));
   return out;
 }
 

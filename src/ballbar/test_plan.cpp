@@ -105,6 +105,27 @@ void validate(const BallbarSetup& s) {
     for (std::size_t j = 0; j < i; ++j)
       require(s.tests[i] != s.tests[j],
               "test " + test_label(s.tests[i], s.machine) + " is listed twice");
+  for (BallbarTest t : s.tests)
+    if (t == BallbarTest::tangential_tilt || t == BallbarTest::tangential_c)
+      require(!d.axis(t == BallbarTest::tangential_tilt ? s.machine.tilt_index() : s.machine.rot_index()).on_head,
+              "test " + test_label(t, s.machine) +
+                  " is planned for table axes only: a head axis turns the bar's direction with it");
+  require(!s.directions.empty(), "directions (--directions) is empty");
+  for (std::size_t i = 0; i < s.directions.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      require(s.directions[i] != s.directions[j],
+              "direction " + to_string(s.directions[i]) + " is listed twice (--directions)");
+  require(!s.feed_factors.empty() && s.feed_factors[0] == 1.0,
+          "feed_factors (--feed-factors) must start with 1: the first run of a test is at the set-up's feeds");
+  for (std::size_t i = 0; i < s.feed_factors.size(); ++i) {
+    const double k = s.feed_factors[i];
+    require(std::isfinite(k) && k > 0.0 && k <= 100.0 && k * s.feed_mm_per_min <= kMaxFeed &&
+                k * s.feed_deg_per_min <= kMaxFeed,
+            "feed factor " + format_number_or_nan(k) +
+                " (--feed-factors) must be in (0, 100] with the feeds within 1e6 per min");
+    for (std::size_t j = 0; j < i; ++j)
+      require(s.feed_factors[j] != k, "feed factor " + format_number_or_nan(k) + " is listed twice (--feed-factors)");
+  }
 }
 
 // Unit vector from the nominal line of a table axis to the pivot, in the plane normal to the
@@ -134,7 +155,8 @@ Eigen::Vector3d fixed_tool_point(const BallbarSetup& s, BallbarTest t) {
   const double L = s.ballbar_length;
   const std::string label = test_label(t, s.machine);
   const MachineDescription& d = s.machine.description();
-  const bool tilt_test = t == BallbarTest::radial_tilt || t == BallbarTest::axial_tilt;
+  const bool tilt_test = t == BallbarTest::radial_tilt || t == BallbarTest::axial_tilt ||
+                         t == BallbarTest::tangential_tilt;
   const RotaryAxis& axis = d.axis(tilt_test ? s.machine.tilt_index() : s.machine.rot_index());
   const double sign = !tilt_test && s.radial_c_side == RadialSide::inside ? -1.0 : 1.0;
   switch (t) {
@@ -144,6 +166,9 @@ Eigen::Vector3d fixed_tool_point(const BallbarSetup& s, BallbarTest t) {
     case BallbarTest::axial_tilt:
     case BallbarTest::axial_c:
       return p + L * axis.direction;
+    case BallbarTest::tangential_tilt:  // along the circle the pivot follows (validate: table axes)
+    case BallbarTest::tangential_c:
+      return p + L * axis.direction.cross(radial_direction(p, axis, label)).normalized();
     default:
       break;
   }
@@ -159,11 +184,13 @@ PlannedSample make_sample(const Eigen::Vector3d& p_table, double tilt_deg, doubl
   return s;
 }
 
-PlanSegment make_test(const BallbarSetup& s, BallbarTest t) {
+PlanSegment make_test(const BallbarSetup& s, BallbarTest t, SweepDirection direction, double feed_factor) {
   PlanSegment seg;
-  seg.label = test_label(t, s.machine);
+  seg.label = run_label(t, direction, feed_factor, s);
   seg.kind = SegmentKind::test;
   seg.test = t;
+  seg.direction = direction;
+  seg.feed_factor = feed_factor;
   const Eigen::Vector3d& p = s.pivot;
   const double L = s.ballbar_length;
   switch (t) {
@@ -183,14 +210,16 @@ PlanSegment make_test(const BallbarSetup& s, BallbarTest t) {
             p + L * Eigen::Vector3d(std::cos(a * kDeg), 0.0, std::sin(a * kDeg)), 0, 0));
       break;
     case BallbarTest::radial_tilt:
-    case BallbarTest::axial_tilt: {
+    case BallbarTest::axial_tilt:
+    case BallbarTest::tangential_tilt: {
       const Eigen::Vector3d q = fixed_tool_point(s, t);
       for (double a : sweep(s.tilt_range_deg[0], s.tilt_range_deg[1], s.step_deg))
         seg.samples.push_back(make_sample(q, a, 0.0));
       break;
     }
     case BallbarTest::radial_c:
-    case BallbarTest::axial_c: {
+    case BallbarTest::axial_c:
+    case BallbarTest::tangential_c: {
       const Eigen::Vector3d q = fixed_tool_point(s, t);
       const double tilt = t == BallbarTest::axial_c ? s.axial_c_tilt_deg.value_or(default_axial_c_tilt_deg(s.machine)) : 0.0;
       for (double a : sweep(s.rot_range_deg[0], s.rot_range_deg[1], s.step_deg))
@@ -198,6 +227,8 @@ PlanSegment make_test(const BallbarSetup& s, BallbarTest t) {
       break;
     }
   }
+  // A cw run is the same poses swept back, from the end of the ccw one.
+  if (direction == SweepDirection::cw) std::reverse(seg.samples.begin(), seg.samples.end());
   return seg;
 }
 
@@ -333,16 +364,45 @@ std::string test_label(BallbarTest test, MachineType machine) {
       return "radial_" + std::string(1, rot_axis_letter(machine));
     case BallbarTest::axial_c:
       return "axial_" + std::string(1, rot_axis_letter(machine));
+    case BallbarTest::tangential_tilt:
+      return "tangential_" + tilt;
+    case BallbarTest::tangential_c:
+      return "tangential_" + std::string(1, rot_axis_letter(machine));
   }
   ROTACAL_ASSERT(false);
   return {};
 }
 
+bool is_rotary_test(BallbarTest test) {
+  return test != BallbarTest::sphere_xy && test != BallbarTest::sphere_yz && test != BallbarTest::sphere_zx;
+}
+
+std::string run_label(BallbarTest test, SweepDirection direction, double feed_factor,
+                      const BallbarSetup& setup) {
+  std::string out = test_label(test, setup.machine);
+  if (direction == SweepDirection::cw) out += "_cw";
+  if (feed_factor != 1.0) {
+    char b[40];
+    std::snprintf(b, sizeof b, "_f%g", setup.feed_mm_per_min * feed_factor);
+    out += b;
+  }
+  return out;
+}
+
+std::string to_string(SweepDirection d) { return d == SweepDirection::ccw ? "ccw" : "cw"; }
+
+SweepDirection parse_sweep_direction(const std::string& text) {
+  if (text == "ccw") return SweepDirection::ccw;
+  if (text == "cw") return SweepDirection::cw;
+  throw InvalidArgument("unknown sweep direction '" + text + "' (known: ccw, cw)");
+}
+
 BallbarTest parse_ballbar_test(const std::string& label, MachineType machine) {
-  static const BallbarTest all[] = {BallbarTest::sphere_xy,  BallbarTest::sphere_yz,
-                                    BallbarTest::sphere_zx,  BallbarTest::radial_tilt,
-                                    BallbarTest::axial_tilt, BallbarTest::radial_c,
-                                    BallbarTest::axial_c};
+  static const BallbarTest all[] = {BallbarTest::sphere_xy,       BallbarTest::sphere_yz,
+                                    BallbarTest::sphere_zx,       BallbarTest::radial_tilt,
+                                    BallbarTest::axial_tilt,      BallbarTest::radial_c,
+                                    BallbarTest::axial_c,         BallbarTest::tangential_tilt,
+                                    BallbarTest::tangential_c};
   std::string known;
   for (BallbarTest t : all) {
     if (test_label(t, machine) == label) return t;
@@ -405,19 +465,35 @@ BallbarPlan plan_ballbar_test(const BallbarSetup& setup,
   plan.compensation = identified;
 
   for (BallbarTest t : setup.tests) {
-    PlanSegment test = make_test(setup, t);
-    ROTACAL_ASSERT(!test.samples.empty());
-    if (!plan.segments.empty()) {
-      const PlannedSample& last = plan.segments.back().samples.back();
-      // segments.back() is the previous test here, never a transition.
-      for (PlanSegment& tr : transitions(setup, last, test.samples.front())) {
-        // A rotary move of one step has no point of its own: the next test's first sample is
-        // its end. An arc without points still is a move (it carries its geometry).
-        if (tr.kind == SegmentKind::rotary_transition && tr.samples.empty()) continue;
-        plan.segments.push_back(std::move(tr));
+    const std::vector<double> feeds = is_rotary_test(t) ? setup.feed_factors : std::vector<double>{1.0};
+    const std::vector<SweepDirection> dirs =
+        is_rotary_test(t) ? setup.directions : std::vector<SweepDirection>{SweepDirection::ccw};
+    for (double f : feeds) {
+      for (SweepDirection dir : dirs) {
+        PlanSegment test = make_test(setup, t, dir, f);
+        if (!plan.segments.empty()) {
+          // A run that starts where the previous one ended (a cw run after its ccw one, the
+          // axis reversing there) begins one step on: that pose was read by the previous run.
+          const PlannedSample& end = plan.segments.back().samples.back();
+          const PlannedSample& start = test.samples.front();
+          if ((end.p_table - start.p_table).norm() < kLengthTol && end.tilt_deg == start.tilt_deg &&
+              end.rot_deg == start.rot_deg && test.samples.size() > 1)
+            test.samples.erase(test.samples.begin());
+        }
+        ROTACAL_ASSERT(!test.samples.empty());
+        if (!plan.segments.empty()) {
+          const PlannedSample& last = plan.segments.back().samples.back();
+          // segments.back() is the previous test here, never a transition.
+          for (PlanSegment& tr : transitions(setup, last, test.samples.front())) {
+            // A rotary move of one step has no point of its own: the next test's first sample
+            // is its end. An arc without points still is a move (it carries its geometry).
+            if (tr.kind == SegmentKind::rotary_transition && tr.samples.empty()) continue;
+            plan.segments.push_back(std::move(tr));
+          }
+        }
+        plan.segments.push_back(std::move(test));
       }
     }
-    plan.segments.push_back(std::move(test));
   }
 
   // Machine axes (inverse kinematics on the nominal or identified model) and time stamps.
@@ -429,10 +505,11 @@ BallbarPlan plan_ballbar_test(const BallbarSetup& setup,
       if (prev == nullptr) {
         s.time = 0.0;
       } else {
-        const double linear = (s.xyz - prev->xyz).norm() / setup.feed_mm_per_min;
+        // The move to a sample runs at the feeds of the segment the sample belongs to.
+        const double linear = (s.xyz - prev->xyz).norm() / (setup.feed_mm_per_min * seg.feed_factor);
         const double rotary =
             std::max(std::abs(s.tilt_deg - prev->tilt_deg), std::abs(s.rot_deg - prev->rot_deg)) /
-            setup.feed_deg_per_min;
+            (setup.feed_deg_per_min * seg.feed_factor);
         const double dt = 60.0 * std::max(linear, rotary);
         ROTACAL_ASSERT(dt > 0.0);
         s.time = prev->time + dt;

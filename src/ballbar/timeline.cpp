@@ -44,8 +44,11 @@ BallbarSample ProgramTimeline::at(double t) const {
   s.tilt_deg = a.tilt_deg + w * (b.tilt_deg - a.tilt_deg);
   s.rot_deg = a.rot_deg + w * (b.rot_deg - a.rot_deg);
   s.length = header_.ballbar_length;
-  const bool same_test = segment_[i - 1] == segment_[i] && a.test != "transition";
-  s.test = w == 0.0 ? a.test : same_test ? a.test : "transition";
+  // Between two points of one test, or from the end of one run into the next run that
+  // continues from it with no transition between (a cw run after its ccw one): that test.
+  const bool same_test = b.test != "transition" && (segment_[i - 1] == segment_[i] ||
+                                                    (segment_[i - 1] + 1 == segment_[i] && a.test != "transition"));
+  s.test = w == 0.0 ? a.test : same_test ? b.test : "transition";
   return s;
 }
 

@@ -84,6 +84,7 @@ double plausible_magnitude(const std::string& unit) {
   if (unit == "rad") return 1e-3;
   if (unit == "mm/s") return 1e-3;
   if (unit == "rad/rad" || unit == "mm/mm") return 1e-3;
+  if (unit == "s") return 1e-3;  // a servo lag: 1 ms is a gain mismatch of a few percent
   if (unit == "1") return 1.0;  // dimensionless, e.g. the log of a time constant: a factor e
   throw InvalidArgument("plausible_magnitude: unknown unit '" + unit + "'");
 }

@@ -7,7 +7,10 @@
 namespace rotacal {
 
 BallbarDiagnosisProblem::BallbarDiagnosisProblem(BallbarSession session, BallbarSession reference)
-    : session_(std::move(session)), arrays_(ballbar_arrays(session_)), reference_(std::move(reference)) {
+    : session_(std::move(session)),
+      arrays_(ballbar_arrays(session_)),
+      reference_(std::move(reference)),
+      reference_motion_(rotary_motion(reference_.samples)) {
   for (const BallbarSample& s : session_.samples) {
     groups_.push_back(s.test);
     times_.push_back(s.time);
@@ -19,7 +22,24 @@ BallbarDiagnosisProblem::BallbarDiagnosisProblem(BallbarSession session, Ballbar
 }
 
 std::vector<Effect> BallbarDiagnosisProblem::candidates(int max_harmonic) const {
-  return effect_catalogue(session_.machine, max_harmonic);
+  // An axis' motion effects are candidates only where it moved both ways: in one direction
+  // (every test of the standard plan) each is a constant angle offset, the zero offset that
+  // no radial or axial test sees, and testing them would only cost time.
+  bool both_ways[2] = {false, false};
+  for (int k = 0; k < 2; ++k) {
+    bool up = false, down = false;
+    for (const RotaryMotion& m : arrays_.motion) {
+      const double d = k == 0 ? m.direction.tilt : m.direction.rot;
+      up = up || d > 0.0;
+      down = down || d < 0.0;
+    }
+    both_ways[k] = up && down;
+  }
+  std::vector<Effect> out;
+  for (const Effect& e : effect_catalogue(session_.machine, max_harmonic))
+    if (!e.depends_on_motion() || both_ways[e.axis == rot_axis_letter(session_.machine) ? 1 : 0])
+      out.push_back(e);
+  return out;
 }
 
 ModelFit BallbarDiagnosisProblem::fit(const EffectModel& effects) const {
@@ -41,6 +61,7 @@ ModelFit BallbarDiagnosisProblem::fit(const EffectModel& effects) const {
 }
 
 Eigen::MatrixXd BallbarDiagnosisProblem::jacobian_on(const std::vector<BallbarSample>& samples,
+                                                     const std::vector<RotaryMotion>& motion,
                                                      const ModelFit& at,
                                                      const Effect& candidate) const {
   using J4 = ceres::Jet<double, 4>;
@@ -57,7 +78,7 @@ Eigen::MatrixXd BallbarDiagnosisProblem::jacobian_on(const std::vector<BallbarSa
   for (int i = 0; i < k; ++i) p.emplace_back(0.0, i);
   Eigen::MatrixXd out(static_cast<Eigen::Index>(samples.size()), k);
   for (std::size_t r = 0; r < samples.size(); ++r) {
-    const J4 L = predicted_length<J4>(session_.machine, e, pivot, fx, p.data(), samples[r]);
+    const J4 L = predicted_length<J4>(session_.machine, e, pivot, fx, p.data(), samples[r], motion[r]);
     for (int i = 0; i < k; ++i) out(static_cast<Eigen::Index>(r), i) = L.v[i];
   }
   return out;
@@ -65,7 +86,7 @@ Eigen::MatrixXd BallbarDiagnosisProblem::jacobian_on(const std::vector<BallbarSa
 
 Eigen::MatrixXd BallbarDiagnosisProblem::candidate_jacobian(const ModelFit& at,
                                                             const Effect& candidate) const {
-  return jacobian_on(session_.samples, at, candidate);
+  return jacobian_on(session_.samples, arrays_.motion, at, candidate);
 }
 
 std::vector<std::string> BallbarDiagnosisProblem::reference_groups() const {
@@ -79,7 +100,7 @@ Eigen::MatrixXd BallbarDiagnosisProblem::reference_jacobian(const ModelFit& at,
     rows->clear();
     for (const BallbarSample& s : reference_.samples) rows->push_back(s.test);
   }
-  return jacobian_on(reference_.samples, at, candidate);
+  return jacobian_on(reference_.samples, reference_motion_, at, candidate);
 }
 
 Diagnosis diagnose_ballbar(const BallbarSession& session, const DiagnosisOptions& options,

@@ -83,8 +83,9 @@ std::vector<Effect> RtestDiagnosisProblem::candidates(int max_harmonic) const {
   // On a head machine tool_offset_Z is in the baseline (a location parameter of the head).
   const bool head = session_.machine.has_head();
   for (const Effect& e : effect_catalogue(session_.machine, max_harmonic))
+    // The probes read static poses: the effects of the motion itself are zero there.
     if (e.kind != EffectKind::ballbar_length_offset && e.kind != EffectKind::ballbar_thermal_drift &&
-        !(head && e.kind == EffectKind::tool_offset_Z))
+        !(head && e.kind == EffectKind::tool_offset_Z) && !e.depends_on_motion())
       out.push_back(e);
   return out;
 }

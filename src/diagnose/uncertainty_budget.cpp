@@ -42,6 +42,9 @@ std::vector<double> plausible_sizes(const Effect& e, const PlausibleSizes& z, do
     }
     case EffectKind::tool_offset: a = {z.tool_offset_mm}; break;
     case EffectKind::linear_pitch: a = {z.angular_error_rad, z.angular_error_rad}; break;
+    case EffectKind::rotary_backlash: a = {z.backlash_rad}; break;
+    case EffectKind::servo_lag: a = {z.servo_lag_s}; break;
+    case EffectKind::reversal_spike: a = {z.reversal_spike_rad, 0.0}; break;  // tau moves nothing at h = 0
   }
   const auto names = e.param_names();
   const auto it = z.overrides.find(e.id());

@@ -55,6 +55,16 @@ const KindInfo kKinds[] = {
      "mm,mm,mm", "the linear axis is not straight (ISO 230-1 straightness error)"},
     {EffectKind::tool_offset, "tool_offset", false, false, true, false, 1, "d", "mm",
      "the tool-side ball is off the spindle axis"},
+    {EffectKind::rotary_backlash, "backlash", true, false, false, false, 1, "b", "rad",
+     "lost motion in the rotary axis' drive (backlash of the worm or gear, or wind-up): the "
+     "axis trails by half of it in its direction of travel"},
+    {EffectKind::servo_lag, "servo_lag", true, false, false, false, 1, "tau", "s",
+     "the rotary axis' position loop lags behind the linear axes' (unequal servo gains): the "
+     "angle trails in proportion to the angular speed"},
+    // tau_s = 0.05 s * exp(q): a few tens of ms, as friction at a reversal releases.
+    {EffectKind::reversal_spike, "reversal_spike", true, false, false, false, 2, "h,ln_tau_50ms",
+     "rad,1", "the rotary axis sticks when it reverses (static friction) and catches up over a "
+     "short time"},
     {EffectKind::linear_pitch, "angular_error", false, false, true, false, 2, "e1,e2", "rad,rad",
      "the linear axis' carriage pitches as it moves (ISO 230-1 angular error), seen through the "
      "tool's height"},
@@ -155,6 +165,11 @@ int Effect::num_params() const { return info(kind).params; }
 std::vector<std::string> Effect::param_names() const { return split(info(kind).names); }
 std::vector<std::string> Effect::param_units() const { return split(info(kind).units); }
 std::string Effect::cause() const { return info(kind).cause; }
+
+bool Effect::depends_on_motion() const {
+  return kind == EffectKind::rotary_backlash || kind == EffectKind::servo_lag ||
+         kind == EffectKind::reversal_spike;
+}
 
 bool Effect::applies_to(MachineType m) const {
   const KindInfo& k = info(kind);

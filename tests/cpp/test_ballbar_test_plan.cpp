@@ -398,3 +398,85 @@ TEST_CASE("tabulate and commanded_session flatten the plan in order", "[ballbar]
   std::istringstream in(text);
   CHECK(parse_ballbar(in, "plan").samples.size() == session.samples.size());
 }
+
+TEST_CASE("tangential tests: the bar along the pivot's circle, at L0 throughout", "[ballbar][plan]") {
+  for (MachineType m : {MachineType::AC_trt, MachineType::BC_trt}) {
+    BallbarSetup s;
+    s.machine = m;
+    s.pivot = Eigen::Vector3d(110.0, -35.0, 70.0);
+    s.tests = {BallbarTest::tangential_c, BallbarTest::tangential_tilt};
+    const BallbarPlan plan = plan_ballbar_test(s);
+    const std::string tilt(1, tilt_axis_letter(m));
+    const PlanSegment& tc = segment_of(plan, "tangential_C");
+    const PlanSegment& tt = segment_of(plan, "tangential_" + tilt);
+    // Bar normal to the C axis and to the C radius through the pivot, written out by hand.
+    const Eigen::Vector3d rc = Eigen::Vector3d(110.0, -35.0, 0.0).normalized();
+    const Eigen::Vector3d bar_c = tc.samples.front().p_table - s.pivot;
+    CHECK((bar_c - 100.0 * Eigen::Vector3d::UnitZ().cross(rc)).norm() < 1e-9);
+    // Tilt axis X (A) or Y (B) through the origin: radius in the plane normal to it.
+    const Eigen::Vector3d a = m == MachineType::AC_trt ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+    const Eigen::Vector3d rt = (s.pivot - a * a.dot(s.pivot)).normalized();
+    CHECK(((tt.samples.front().p_table - s.pivot) - 100.0 * a.cross(rt)).norm() < 1e-9);
+    for (const auto& seg : plan.segments)
+      for (const auto& p : seg.samples) {
+        const Eigen::Vector3d pivot_m = nominal_machine(m, p.tilt_deg, p.rot_deg, s.pivot);
+        CHECK(std::abs((p.xyz - pivot_m).norm() - 100.0) < 1e-9);
+      }
+  }
+  // A head axis turns the bar with it: refused by name.
+  BallbarSetup h;
+  h.machine = parse_machine_type("B-head-C-table");
+  h.tilt_range_deg = default_tilt_range_deg(h.machine);
+  h.tests = {BallbarTest::tangential_tilt};
+  CHECK_THROWS_WITH(plan_ballbar_test(h), Catch::Contains("tangential_B") && Catch::Contains("table axes"));
+}
+
+TEST_CASE("both directions and two feeds: runs, labels, reversals and times", "[ballbar][plan]") {
+  BallbarSetup s;
+  s.tests = {BallbarTest::radial_c, BallbarTest::tangential_tilt};
+  s.directions = {SweepDirection::ccw, SweepDirection::cw};
+  s.feed_factors = {1.0, 2.0};
+  const BallbarPlan plan = plan_ballbar_test(s);
+  std::vector<std::string> runs;
+  for (const auto& seg : plan.segments)
+    if (seg.kind == SegmentKind::test) runs.push_back(seg.label);
+  CHECK(runs == std::vector<std::string>{"radial_C", "radial_C_cw", "radial_C_f2000", "radial_C_cw_f2000",
+                                         "tangential_A", "tangential_A_cw", "tangential_A_f2000",
+                                         "tangential_A_cw_f2000"});
+  // The cw run sweeps the same poses back from where the ccw run ended, without its
+  // repeated first pose; no transition between them.
+  const PlanSegment& ccw = segment_of(plan, "radial_C");
+  const PlanSegment& cw = segment_of(plan, "radial_C_cw");
+  REQUIRE(ccw.samples.size() == 360);
+  REQUIRE(cw.samples.size() == 359);
+  CHECK(ccw.samples.back().rot_deg == 359.0);
+  CHECK(cw.samples.front().rot_deg == 358.0);
+  CHECK(cw.samples.back().rot_deg == 0.0);
+  CHECK(cw.direction == SweepDirection::cw);
+  CHECK(&plan.segments[1] == &cw);
+  // At twice the feed a run takes half the time per step.
+  const PlanSegment& fast = segment_of(plan, "radial_C_f2000");
+  CHECK(fast.feed_factor == 2.0);
+  const double slow_step = ccw.samples[11].time - ccw.samples[10].time;
+  const double fast_step = fast.samples[11].time - fast.samples[10].time;
+  CHECK(std::abs(fast_step - 0.5 * slow_step) < 1e-12);
+  // Sphere tests run once.
+  BallbarSetup sp = s;
+  sp.tests = {BallbarTest::sphere_xy, BallbarTest::radial_c};
+  std::size_t spheres = 0;
+  for (const auto& seg : plan_ballbar_test(sp).segments) spheres += seg.label.rfind("sphere", 0) == 0;
+  CHECK(spheres == 1);
+
+  BallbarSetup bad = s;
+  bad.feed_factors = {2.0, 1.0};
+  CHECK_THROWS_WITH(plan_ballbar_test(bad), Catch::Contains("--feed-factors"));
+  bad.feed_factors = {1.0, 1.0};
+  CHECK_THROWS_WITH(plan_ballbar_test(bad), Catch::Contains("twice"));
+  bad = s;
+  bad.directions = {SweepDirection::cw, SweepDirection::cw};
+  CHECK_THROWS_WITH(plan_ballbar_test(bad), Catch::Contains("--directions"));
+  bad.directions = {};
+  CHECK_THROWS_WITH(plan_ballbar_test(bad), Catch::Contains("--directions"));
+  CHECK(parse_sweep_direction("cw") == SweepDirection::cw);
+  CHECK_THROWS_WITH(parse_sweep_direction("clockwise"), Catch::Contains("clockwise"));
+}

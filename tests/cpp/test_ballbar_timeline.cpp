@@ -26,3 +26,21 @@ TEST_CASE("the timeline passes through every planned point and labels transition
   CHECK((tl.at(-1.0).xyz - first.samples.front().xyz).norm() < 1e-12);
   CHECK((tl.at(1e9).xyz - plan.segments.back().samples.back().xyz).norm() < 1e-12);
 }
+
+TEST_CASE("the move from a ccw run into its cw run belongs to the cw run", "[ballbar]") {
+  BallbarSetup s;
+  s.tests = {BallbarTest::tangential_c, BallbarTest::radial_c};
+  s.directions = {SweepDirection::ccw, SweepDirection::cw};
+  const BallbarPlan plan = plan_ballbar_test(s);
+  const ProgramTimeline tl(plan);
+  REQUIRE(plan.segments[0].label == "tangential_C");
+  REQUIRE(plan.segments[1].label == "tangential_C_cw");
+  const double t_end = plan.segments[0].samples.back().time, t_next = plan.segments[1].samples.front().time;
+  const BallbarSample between = tl.at(0.5 * (t_end + t_next));
+  CHECK(between.test == "tangential_C_cw");
+  CHECK(between.rot_deg == Approx(358.5));
+  // Into the next test through an arc: a transition.
+  const double t_last = plan.segments[1].samples.back().time;
+  CHECK(plan.segments[2].kind == SegmentKind::arc_transition);
+  CHECK(tl.at(t_last + 1e-3).test == "transition");
+}

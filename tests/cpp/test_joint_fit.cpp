@@ -84,7 +84,8 @@ TEST_CASE("batched Jets give the Jacobian of the one ballbar model, over several
     using T = std::remove_const_t<std::remove_pointer_t<decltype(x)>>;
     const std::size_t k = static_cast<std::size_t>(i);
     out[0] = predicted_length<T>(MachineType::AC_trt, LocationErrors<T>::from_ptr(x),
-                                 Vec3<T>(x[8], x[9], x[10]), fx, x + 11, xyz[k], ang[k], 10.0 * i);
+                                 Vec3<T>(x[8], x[9], x[10]), fx, x + 11, xyz[k], ang[k], 10.0 * i,
+                                 RotaryMotion{});
   };
   Eigen::VectorXd x(p);
   for (int j = 0; j < p; ++j) x[j] = 1e-4 * U(rng);

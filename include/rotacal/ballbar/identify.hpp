@@ -85,6 +85,7 @@ struct BallbarArrays {
   std::vector<std::size_t> index;                   ///< session index of each row
   Eigen::Matrix3Xd xyz;                             ///< commanded tool-side ball, mm
   std::vector<RotaryAngles<double>> angles;         ///< rad
+  std::vector<RotaryMotion> motion;                 ///< rotary_motion of the whole session
   Eigen::VectorXd time;                             ///< s
   Eigen::VectorXd length;                           ///< measured length, mm
   std::vector<std::string> test;                    ///< test label of each row (noise streams)

@@ -25,7 +25,10 @@
 namespace rotacal {
 
 /// The tests of the single set-up method. `radial_tilt` / `axial_tilt` are labelled radial_A /
-/// axial_A on an AC-trt machine and radial_B / axial_B on a BC-trt machine.
+/// axial_A on an AC-trt machine and radial_B / axial_B on a BC-trt machine. The tangential
+/// tests (issue 16) put the bar along the circle the pivot follows, so they read the axis'
+/// angle itself (positioning, backlash, servo lag), which radial and axial tests see only to
+/// second order; they are planned for table axes.
 enum class BallbarTest {
   sphere_xy,
   sphere_yz,
@@ -33,10 +36,16 @@ enum class BallbarTest {
   radial_tilt,
   axial_tilt,
   radial_c,
-  axial_c
+  axial_c,
+  tangential_tilt,
+  tangential_c
 };
 
-/// Session label of a test on a machine: "sphere_xy", ..., "radial_A" or "radial_B", "axial_C".
+/// True for the tests that sweep a rotary axis (every test but the three sphere arcs).
+bool is_rotary_test(BallbarTest test);
+
+/// Session label of a test on a machine: "sphere_xy", ..., "radial_A" or "radial_B", "axial_C",
+/// "tangential_C".
 std::string test_label(BallbarTest test, MachineType machine);
 /// Inverse of test_label; throws InvalidArgument naming the label and the labels known for the
 /// machine (e.g. "radial_B" on an AC-trt machine is refused).
@@ -44,6 +53,14 @@ BallbarTest parse_ballbar_test(const std::string& label, MachineType machine);
 /// The order of the reference sessions in shared/data: sphere_xy, sphere_yz, sphere_zx,
 /// radial tilt, axial C, radial C, axial tilt.
 std::vector<BallbarTest> default_ballbar_tests();
+
+/// Direction of a rotary test's sweep. `ccw` turns the axis towards increasing angles (a
+/// right-handed, counter-clockwise turn about the axis direction, as G3 is for a circle);
+/// `cw` back. A ccw run keeps the test's label, a cw run appends "_cw" (radial_C_cw).
+enum class SweepDirection { ccw, cw };
+std::string to_string(SweepDirection d);
+/// "ccw" / "cw"; throws InvalidArgument otherwise.
+SweepDirection parse_sweep_direction(const std::string& text);
 
 /// The '±' of Flynn's radial C test (Sec. 3.2): the tool-cup circle is outside (+L0, larger
 /// radius than the pivot circle) or inside (-L0) the circle the pivot follows.
@@ -70,6 +87,13 @@ struct BallbarSetup {
   double feed_mm_per_min = 1000.0;   ///< linear axes (machine X, Y, Z path), mm/min
   double feed_deg_per_min = 3600.0;  ///< rotary axes, deg/min
   std::vector<BallbarTest> tests = default_ballbar_tests();  ///< tests to run, in this order
+  /// Directions every rotary test runs in, one run each, in this order; a cw run right after
+  /// the ccw one starts where it ended, so the axis reverses there.
+  std::vector<SweepDirection> directions = {SweepDirection::ccw};
+  /// Feeds every rotary test runs at, as factors of feed_mm_per_min and feed_deg_per_min; the
+  /// first must be 1. A run at factor k != 1 appends "_f<feed_mm_per_min * k>" to its label
+  /// (radial_C_cw_f2000). Two feeds tell servo lag (proportional to the speed) from backlash.
+  std::vector<double> feed_factors = {1.0};
   RadialSide radial_c_side = RadialSide::outside;            ///< Flynn's '±' of radial C
   /// Tilt angle (deg) held during axial_c. Unset: 0, except on a head-head machine, where the
   /// ball sits on the rotary (C) head axis at tilt 0 and its position and tilt errors are seen
@@ -120,9 +144,11 @@ struct TransitionArc {
 /// segment's last sample and the next test's first sample (the tool moves from one to the
 /// other through them); an arc transition may hold none and is then the arc alone.
 struct PlanSegment {
-  std::string label;  ///< test label (test_label) or "transition"
+  std::string label;  ///< run label (run_label) or "transition"
   SegmentKind kind = SegmentKind::test;
   std::optional<BallbarTest> test;  ///< set for kind == test
+  SweepDirection direction = SweepDirection::ccw;  ///< of a rotary test
+  double feed_factor = 1.0;                        ///< of the feeds during this segment
   TransitionArc arc;                ///< meaningful for kind == arc_transition
   std::vector<PlannedSample> samples;
 };
@@ -139,6 +165,11 @@ struct BallbarPlan {
   double duration() const;
 };
 
+/// Label of one run of a test: test_label, then "_cw" for a cw run and "_f<feed>" for a feed
+/// factor other than 1 (feed = feed_mm_per_min * factor, as %g).
+std::string run_label(BallbarTest test, SweepDirection direction, double feed_factor,
+                      const BallbarSetup& setup);
+
 /// Plan the single set-up ballbar test.
 ///
 /// Tests (p = pivot, L = L0, t over the sweep):
@@ -148,7 +179,9 @@ struct BallbarPlan {
 ///   axial_tilt   tool at p + L a, a = tilt-axis direction (+X for A, +Y for B),
 ///   radial_c     tool at p +- L r, r = unit vector from the C axis to p (Flynn: x = +-L0),
 ///   axial_c      tool at p + L (0, 0, 1);
+///   tangential_tilt / tangential_c  tool at p + L (a x r), a the axis direction, r as radial;
 /// each fixed on the table while the axis sweeps (the machine moves it by Flynn Eq. 1).
+/// Each rotary test runs once per feed factor and, within that, once per direction.
 /// Between tests the tool goes, with |tool - pivot| = L0 throughout: rotary axes to 0 with the
 /// tool fixed on the table, a great-circle arc about the pivot (shortest, over the top when
 /// the ends are opposite), rotary axes to the next start with the tool fixed on the table;

@@ -22,8 +22,10 @@ class ProgramTimeline {
   /// Program duration, s.
   double duration() const { return points_.empty() ? 0.0 : points_.back().time; }
   /// Commanded sample at time t (clamped to the program): axes interpolated linearly between
-  /// the bracketing points; `test` is their test label if both belong to the same test,
-  /// otherwise "transition"; `length` is L0.
+  /// the bracketing points; `test` is their test label if both belong to the same test, the
+  /// later one's if its run follows the earlier's with no transition between (the move into
+  /// a cw run from the end of its ccw run is that run's first step), otherwise "transition";
+  /// `length` is L0.
   BallbarSample at(double t) const;
   /// The session header (machine, L0, nominal pivot) of the program, without samples.
   const BallbarSession& header() const { return header_; }

@@ -34,7 +34,8 @@ Observability analyse_observability_normal(const Eigen::MatrixXd& JtJ, const Eig
                                            double min_chi2_change = 1.0);
 
 /// Plausible magnitude of a parameter by its unit, for analyse_observability: 1 mm, 1 mrad,
-/// 1 um/s, 1e-3 for ratios (rad/rad, mm/mm), 1 for a dimensionless "1" (e.g. a log time constant).
+/// 1 um/s, 1e-3 for ratios (rad/rad, mm/mm), 1 ms for a time (s, a servo lag), 1 for a
+/// dimensionless "1" (e.g. a log time constant).
 /// Throws InvalidArgument for an unknown unit.
 double plausible_magnitude(const std::string& unit);
 

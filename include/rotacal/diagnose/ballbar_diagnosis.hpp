@@ -36,11 +36,13 @@ class BallbarDiagnosisProblem : public DiagnosisProblem {
   const BallbarSession& session() const { return session_; }
 
  private:
-  Eigen::MatrixXd jacobian_on(const std::vector<BallbarSample>& samples, const ModelFit& at,
+  Eigen::MatrixXd jacobian_on(const std::vector<BallbarSample>& samples,
+                              const std::vector<RotaryMotion>& motion, const ModelFit& at,
                               const Effect& candidate) const;
   BallbarSession session_;
   BallbarArrays arrays_;  // the samples as arrays, built once for every refit
   BallbarSession reference_;
+  std::vector<RotaryMotion> reference_motion_;
   std::vector<std::string> groups_;
   std::vector<double> times_;
   std::vector<RotaryAngles<double>> angles_;

@@ -43,6 +43,9 @@ struct PlausibleSizes {
   double tilt_motion_rad = 10e-6;         ///< tilt_motion_*_hn
   double gravity_sag_mm = 2e-3;           ///< gravity_sag_*
   double coning = 20e-6;                  ///< coning_* (rad/rad)
+  double backlash_rad = 20e-6;            ///< backlash_* (lost motion of a rotary drive)
+  double servo_lag_s = 1e-3;              ///< servo_lag_* (gain mismatch of a few percent)
+  double reversal_spike_rad = 20e-6;      ///< reversal_spike_*: h
   std::map<std::string, double> overrides;
   /// Use the session's bound where it is tighter than the default (false: defaults only).
   bool use_session_bounds = true;

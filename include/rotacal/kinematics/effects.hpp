@@ -8,7 +8,8 @@
 /// Composition (one definition, used by simulators, fits and the diagnosis):
 ///   table:  T(tilt, rot, t) = D(t) * K(tilt) * M_T(tilt') * E_T(tilt) * M_C(rot') * E_C(rot)
 ///     M_T, M_C   rotations about the actual axis lines (machine.hpp), at the actual angles
-///                tilt' = tilt + zero offset + angular positioning (same for rot')
+///                tilt' = tilt + zero offset + angular positioning - backlash, servo lag
+///                and reversal spike terms of the axis' motion (same for rot')
 ///     E_T, E_C   error motions of each axis in its turning frame (radial, axial, tilt
 ///                motion harmonics), applied before that axis' rotation (effects.md)
 ///     K          coning of the tilt axis: rotation k*tilt about X (B machines) or Y (A)
@@ -19,6 +20,7 @@
 /// ../shared/data/rtest_bc_oyama.csv (0.31 um residual RMS for 0.3 um noise; applying it in
 /// the B turning frame instead leaves 8-14 um).
 
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -47,6 +49,13 @@ enum class EffectKind {
   tool_offset,             ///< tool-side ball += d along X or Y (mm)
   linear_pitch,            ///< E_BX / E_AY seen through the Z arm: x += e(x) (z - z_ref),
                            ///< y -= e(y) (z - z_ref), e(a) = e1 u + e2 u^2 (rad)
+  // Effects of the motion itself (RotaryMotion): a sweep in one direction at one speed sees
+  // each as a constant angle offset, i.e. as the zero offset; both directions and two feeds
+  // of a tangential test tell them apart (docs/effects.md).
+  rotary_backlash,         ///< actual angle -= b/2 * direction (lost motion b, rad)
+  servo_lag,               ///< actual angle -= tau * rate (lag behind the linear axes, s)
+  reversal_spike,          ///< actual angle -= direction * h exp(-dt / tau_s) after a reversal;
+                           ///< tau_s = 0.05 s e^q (h rad, q 1)
 };
 
 /// One catalogue entry, e.g. {angular_positioning, 'C', 1} = "angular_positioning_C_h1".
@@ -70,6 +79,9 @@ struct Effect {
   std::string cause() const;
   /// True if the effect exists on this machine (A effects on an AC table, not on a BC one).
   bool applies_to(MachineType m) const;
+  /// True for the effects of the motion itself (backlash, servo lag, reversal spikes): zero
+  /// at a static pose.
+  bool depends_on_motion() const;
   bool operator==(const Effect& o) const {
     return kind == o.kind && axis == o.axis && harmonic == o.harmonic && direction == o.direction;
   }
@@ -132,7 +144,7 @@ struct AxisStages {
 
 template <typename Scalar>
 AxisStages<Scalar> axis_stages(MachineType m, const EffectModel& fx, const Scalar* p,
-                               const RotaryAngles<double>& cmd, double t) {
+                               const RotaryAngles<double>& cmd, double t, const RotaryMotion& motion) {
   using std::cos;
   using std::exp;
   const MachineDescription& d = m.description();
@@ -144,7 +156,7 @@ AxisStages<Scalar> axis_stages(MachineType m, const EffectModel& fx, const Scala
     const bool rotary = f.kind == EffectKind::rotary_zero_offset || f.kind == EffectKind::angular_positioning ||
                         f.kind == EffectKind::radial_motion || f.kind == EffectKind::axial_motion ||
                         f.kind == EffectKind::tilt_motion || f.kind == EffectKind::gravity_sag ||
-                        f.kind == EffectKind::coning;
+                        f.kind == EffectKind::coning || f.depends_on_motion();
     if (rotary) {
       const int k = chain_index(m, f.axis);
       if (k < 0) continue;  // validated by the callers (Effect::applies_to)
@@ -159,6 +171,19 @@ AxisStages<Scalar> axis_stages(MachineType m, const EffectModel& fx, const Scala
         case EffectKind::angular_positioning:
           st.angle[k] += q[0] * c + q[1] * s;
           break;
+        case EffectKind::rotary_backlash:  // trails by b/2 on the side it last moved from
+          st.angle[k] -= Scalar(0.5 * chain_angle(m, motion.direction, k)) * q[0];
+          break;
+        case EffectKind::servo_lag:
+          st.angle[k] -= Scalar(chain_angle(m, motion.rate, k)) * q[0];
+          break;
+        case EffectKind::reversal_spike: {  // sticks after reversing: tau_s = 0.05 s e^q
+          const double dt = chain_angle(m, motion.since_reversal, k);
+          if (std::isfinite(dt) && dt >= 0.0)
+            st.angle[k] -= Scalar(chain_angle(m, motion.direction, k)) * q[0] *
+                           exp(-Scalar(dt) / (Scalar(0.05) * exp(q[1])));
+          break;
+        }
         case EffectKind::radial_motion:
         case EffectKind::axial_motion:
         case EffectKind::tilt_motion: {
@@ -219,8 +244,8 @@ AxisStages<Scalar> axis_stages(MachineType m, const EffectModel& fx, const Scala
 template <typename Scalar, typename Accumulator>
 void walk_table_stages(MachineType m, const LocationErrors<Scalar>& e, const EffectModel& fx,
                        const Scalar* p, const RotaryAngles<double>& cmd, double t,
-                       Accumulator& acc) {
-  const detail::AxisStages<Scalar> st = detail::axis_stages<Scalar>(m, fx, p, cmd, t);
+                       const RotaryMotion& motion, Accumulator& acc) {
+  const detail::AxisStages<Scalar> st = detail::axis_stages<Scalar>(m, fx, p, cmd, t, motion);
   for (int k = static_cast<int>(m.description().table_axes.size()) - 1; k >= 0; --k) {
     if (st.E[k]) acc.rigid(*st.E[k]);
     acc.about_line(axis_line(m, k, e), st.angle[k]);
@@ -251,12 +276,14 @@ struct PointAccumulator {  // q <- stage(q)
 }  // namespace detail
 
 /// Pose of the table in the machine frame with location errors and effects, at commanded
-/// rotary angles (rad) and time t (s). `p` points at EffectModel::num_params() values.
+/// rotary angles (rad), time t (s) and motion of the axes (at rest if not given). `p` points
+/// at EffectModel::num_params() values.
 template <typename Scalar>
 Pose<Scalar> table_pose(MachineType m, const LocationErrors<Scalar>& e, const EffectModel& fx,
-                        const Scalar* p, const RotaryAngles<double>& cmd, double t) {
+                        const Scalar* p, const RotaryAngles<double>& cmd, double t,
+                        const RotaryMotion& motion = {}) {
   detail::PoseAccumulator<Scalar> acc;
-  walk_table_stages(m, e, fx, p, cmd, t, acc);
+  walk_table_stages(m, e, fx, p, cmd, t, motion, acc);
   return acc.T;
 }
 
@@ -265,9 +292,9 @@ Pose<Scalar> table_pose(MachineType m, const LocationErrors<Scalar>& e, const Ef
 template <typename Scalar>
 Vec3<Scalar> table_point(MachineType m, const LocationErrors<Scalar>& e, const EffectModel& fx,
                          const Scalar* p, const RotaryAngles<double>& cmd, double t,
-                         const Vec3<Scalar>& q) {
+                         const Vec3<Scalar>& q, const RotaryMotion& motion = {}) {
   detail::PointAccumulator<Scalar> acc{q};
-  walk_table_stages(m, e, fx, p, cmd, t, acc);
+  walk_table_stages(m, e, fx, p, cmd, t, motion, acc);
   return acc.q;
 }
 
@@ -323,7 +350,7 @@ Vec3<Scalar> tool_offset(const EffectModel& fx, const Scalar* p) {
 }
 
 /// Actual position of the ball (machine frame, mm) for a commanded xyz (mm) at commanded
-/// rotary angles (rad) and time t (s), on a machine with location errors e and effects fx
+/// rotary angles (rad), time t (s) and motion of the axes (at rest if not given), on a machine with location errors e and effects fx
 /// (parameters p). Without head axes: the controlled point with the linear-axis effects and
 /// the tool offset. With head axes, the head side is walked like the table side:
 ///   ball = xyz' + D_h + K_h * Rot(H1) E_H1 * Rot(H2) E_H2 * (tool_vector + tool offset).
@@ -331,11 +358,12 @@ template <typename Scalar>
 Vec3<Scalar> tool_position(MachineType m, const LocationErrors<Scalar>& e, const EffectModel& fx,
                            const Scalar* p, const Eigen::Vector3d& xyz,
                            const RotaryAngles<double>& cmd, double t,
-                           const Scalar& tool_length_error = Scalar(0)) {
+                           const Scalar& tool_length_error = Scalar(0),
+                           const RotaryMotion& motion = {}) {
   const Vec3<Scalar> controlled = linear_axes_position<Scalar>(fx, p, xyz);
   const MachineDescription& d = m.description();
   if (!d.has_head()) return controlled + tool_offset<Scalar>(fx, p);
-  const detail::AxisStages<Scalar> st = detail::axis_stages<Scalar>(m, fx, p, cmd, t);
+  const detail::AxisStages<Scalar> st = detail::axis_stages<Scalar>(m, fx, p, cmd, t, motion);
   Vec3<Scalar> v = tool_vector<Scalar>(m, tool_length_error) + tool_offset<Scalar>(fx, p);
   const int nt = static_cast<int>(d.table_axes.size());
   for (int k = 1; k >= nt; --k) {

@@ -11,6 +11,7 @@
 /// Angles in rad, lengths in mm.
 
 #include <array>
+#include <limits>
 #include <string>
 
 #include "rotacal/core/error.hpp"
@@ -152,6 +153,20 @@ template <typename Scalar>
 const Scalar& chain_angle(MachineType m, const RotaryAngles<Scalar>& a, int k) {
   return k == m.rot_index() ? a.rot : a.tilt;
 }
+
+/// How the rotary axes move at a sample (issue 16: effects that depend on the direction and
+/// speed of motion). `rate`: commanded angular velocity of each axis, rad/s; `direction`: +1 or
+/// -1, the sign of the current motion, or of the last one when the axis is at rest (it stays
+/// on that side of its lost motion), 0 when no motion is on record; `since_reversal`: time
+/// since the axis last reversed its direction, s (infinity when no reversal is on record).
+/// The default, at rest with no history, is what a static pose (R-test) or a caller without
+/// motion information gets: every motion effect is zero there.
+struct RotaryMotion {
+  RotaryAngles<double> rate;
+  RotaryAngles<double> direction;
+  RotaryAngles<double> since_reversal{std::numeric_limits<double>::infinity(),
+                                      std::numeric_limits<double>::infinity()};
+};
 
 /// Rigid motion of the tilt axis alone: exact rotation about its actual line.
 template <typename Scalar>
