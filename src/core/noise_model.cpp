@@ -112,37 +112,50 @@ std::vector<std::vector<Eigen::Index>> noise_streams(const std::vector<std::stri
                                                      std::vector<std::string>* stream_group,
                                                      std::vector<int>* stream_channel) {
   check_sizes("noise_streams", groups, times);
+  // Rows by group in order of first appearance. Sessions hold long runs of one label, so the
+  // map is searched only where the label changes (one string compare per reading otherwise).
   std::vector<std::string> order;
-  std::map<std::string, std::vector<Eigen::Index>> by_group;
+  std::vector<std::vector<Eigen::Index>> by_group;
+  std::map<std::string, std::size_t> slot;
+  std::size_t cur = 0;
   for (std::size_t i = 0; i < groups.size(); ++i) {
-    auto& v = by_group[groups[i]];
-    if (v.empty()) order.push_back(groups[i]);
-    v.push_back(static_cast<Eigen::Index>(i));
+    if (i == 0 || groups[i] != groups[i - 1]) {
+      const auto it = slot.emplace(groups[i], order.size()).first;
+      if (it->second == order.size()) order.push_back(groups[i]), by_group.emplace_back();
+      cur = it->second;
+    }
+    by_group[cur].push_back(static_cast<Eigen::Index>(i));
   }
   std::vector<std::vector<Eigen::Index>> out;
   if (stream_group) stream_group->clear();
   if (stream_channel) stream_channel->clear();
-  for (const std::string& g : order) {
-    auto& idx = by_group[g];
-    std::stable_sort(idx.begin(), idx.end(), [&](Eigen::Index a, Eigen::Index b) {
-      return times[static_cast<std::size_t>(a)] < times[static_cast<std::size_t>(b)];
-    });
+  const auto time_of = [&](Eigen::Index row) { return times[static_cast<std::size_t>(row)]; };
+  for (std::size_t g = 0; g < order.size(); ++g) {
+    std::vector<Eigen::Index>& idx = by_group[g];
+    // Rows come in time order in a session file: the (stable) sort is needed only when not.
+    const auto earlier = [&](Eigen::Index a, Eigen::Index b) { return time_of(a) < time_of(b); };
+    if (!std::is_sorted(idx.begin(), idx.end(), earlier)) std::stable_sort(idx.begin(), idx.end(), earlier);
     // Channel = position among the readings that share a time stamp (R-test dx, dy, dz).
+    // Distinct time stamps (a ballbar test): one channel, the rows themselves.
     std::vector<std::vector<Eigen::Index>> ch;
-    for (std::size_t k = 0; k < idx.size();) {
-      std::size_t e = k;
-      while (e < idx.size() && times[static_cast<std::size_t>(idx[e])] ==
-                                   times[static_cast<std::size_t>(idx[k])])
-        ++e;
-      for (std::size_t c = 0; c < e - k; ++c) {
-        if (ch.size() <= c) ch.emplace_back();
-        ch[c].push_back(idx[k + c]);
+    if (std::adjacent_find(idx.begin(), idx.end(), [&](Eigen::Index a, Eigen::Index b) {
+          return time_of(a) == time_of(b);
+        }) == idx.end()) {
+      if (!idx.empty()) ch.push_back(std::move(idx));
+    } else {
+      for (std::size_t k = 0; k < idx.size();) {
+        std::size_t e = k;
+        while (e < idx.size() && time_of(idx[e]) == time_of(idx[k])) ++e;
+        for (std::size_t c = 0; c < e - k; ++c) {
+          if (ch.size() <= c) ch.emplace_back();
+          ch[c].push_back(idx[k + c]);
+        }
+        k = e;
       }
-      k = e;
     }
     for (std::size_t c = 0; c < ch.size(); ++c) {
       out.push_back(std::move(ch[c]));
-      if (stream_group) stream_group->push_back(g);
+      if (stream_group) stream_group->push_back(order[g]);
       if (stream_channel) stream_channel->push_back(static_cast<int>(c));
     }
   }

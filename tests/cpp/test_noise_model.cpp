@@ -340,6 +340,23 @@ TEST_CASE("readings that share a time stamp are separate channels", "[noise_mode
   CHECK(M.correlation_time_s > 2 * 2.0);
 }
 
+TEST_CASE("streams: groups in order of first appearance, rows in time order", "[noise_model]") {
+  // A label that comes back after another one, rows out of time order within a group, and
+  // a time stamp shared by two readings (channels) in the group that comes back.
+  const std::vector<std::string> g = {"b", "b", "a", "a", "b", "a", "a", "b"};
+  const std::vector<double> t = {3.0, 1.0, 0.5, 1.5, 2.0, 1.5, 0.2, 4.0};
+  std::vector<std::string> sg;
+  std::vector<int> sc;
+  const auto streams = noise_streams(g, t, &sg, &sc);
+  CHECK(sg == std::vector<std::string>{"b", "a", "a"});
+  CHECK(sc == std::vector<int>{0, 0, 1});
+  REQUIRE(streams.size() == 3);
+  // b at 1, 2, 3, 4 s; a at 0.2, 0.5, 1.5 (first of the pair, file order), and the second 1.5.
+  CHECK(streams[0] == std::vector<Eigen::Index>{1, 4, 0, 7});
+  CHECK(streams[1] == std::vector<Eigen::Index>{6, 2, 3});
+  CHECK(streams[2] == std::vector<Eigen::Index>{5});
+}
+
 TEST_CASE("bad input to the noise model names what was wrong", "[noise_model]") {
   const Layout L = layout(1, 10, 100.0);
   Eigen::VectorXd r = Eigen::VectorXd::Zero(9);
