@@ -6,7 +6,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Ambiguity', 'AngleTable', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CircularAnalysis', 'CircularDiagnosis', 'CircularDiagnosisOptions', 'CircularDirection', 'CircularEffect', 'CircularFinding', 'CircularPairResult', 'CircularPlanResult', 'CircularPlane', 'CircularRun', 'CircularRunResult', 'CircularSimulationOptions', 'CircularTestPlan', 'CompensationReport', 'CompensationRow', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LinearAxisErrors', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestDesign', 'RtestDesignCandidate', 'RtestDesignOptions', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSeparatingCandidate', 'RtestSeparationDesign', 'RtestSeparationOptions', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SeparatingCandidate', 'SeparationDesign', 'SeparationOptions', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'TableMotionOverlap', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'analyze_circular', 'ballbar_model_document', 'ballbar_model_from_document', 'builtin_machine_names', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_model_machine', 'check_output', 'check_plausible', 'check_rtest_pattern', 'circular_catalogue', 'circular_commanded_session', 'circular_label', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_axial_c_tilt_deg', 'default_ballbar_tests', 'default_calibration_moves', 'default_rtest_pattern', 'default_tilt_range_deg', 'design_ballbar_separation', 'design_ballbar_test', 'design_rtest_separation', 'design_rtest_test', 'diagnose_ballbar', 'diagnose_circular', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'evaluate_rtest_design', 'export_controller', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_joint_sessions', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_rtest', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_circular_direction', 'parse_circular_plane', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'plan_ballbar_test', 'plan_circular_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_map_names', 'rtest_prediction_rms_um', 'rtest_readings', 'simulate_ballbar', 'simulate_circular', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'table_motion_overlap', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_circular_nc_program', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
+__all__: list[str] = ['Ambiguity', 'AngleTable', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CircularAnalysis', 'CircularDiagnosis', 'CircularDiagnosisOptions', 'CircularDirection', 'CircularEffect', 'CircularFinding', 'CircularPairResult', 'CircularPlanResult', 'CircularPlane', 'CircularRun', 'CircularRunResult', 'CircularSimulationOptions', 'CircularTestPlan', 'CompensationReport', 'CompensationRow', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LinearAxisErrors', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestDesign', 'RtestDesignCandidate', 'RtestDesignOptions', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSeparatingCandidate', 'RtestSeparationDesign', 'RtestSeparationOptions', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SeparatingCandidate', 'SeparationDesign', 'SeparationOptions', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'SweepDirection', 'TableMotionOverlap', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualRtest', 'analyze_circular', 'ballbar_model_document', 'ballbar_model_from_document', 'builtin_machine_names', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_model_machine', 'check_output', 'check_plausible', 'check_rtest_pattern', 'circular_catalogue', 'circular_commanded_session', 'circular_label', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_axial_c_tilt_deg', 'default_ballbar_tests', 'default_calibration_moves', 'default_rtest_pattern', 'default_tilt_range_deg', 'design_ballbar_separation', 'design_ballbar_test', 'design_rtest_separation', 'design_rtest_test', 'diagnose_ballbar', 'diagnose_circular', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'evaluate_rtest_design', 'export_controller', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_joint_sessions', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'is_rotary_test', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_rtest', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_circular_direction', 'parse_circular_plane', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'parse_sweep_direction', 'plan_ballbar_test', 'plan_circular_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_map_names', 'rtest_prediction_rms_um', 'rtest_readings', 'run_label', 'simulate_ballbar', 'simulate_circular', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'table_motion_overlap', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_circular_nc_program', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
 class Ambiguity:
     @property
     def correlation(self) -> float:
@@ -358,7 +358,7 @@ class BallbarSetup:
     """
     machine: MachineType
     radial_c_side: RadialSide
-    def __init__(self, machine: MachineType = ..., ballbar_length: typing.SupportsFloat | typing.SupportsIndex = 100.0, pivot: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ..., tilt_range_deg: typing.Annotated[collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], "FixedSize(2)"] | None = None, rot_range_deg: typing.Annotated[collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], "FixedSize(2)"] = [0.0, 360.0], step_deg: typing.SupportsFloat | typing.SupportsIndex = 1.0, feed_mm_per_min: typing.SupportsFloat | typing.SupportsIndex = 1000.0, feed_deg_per_min: typing.SupportsFloat | typing.SupportsIndex = 3600.0, tests: collections.abc.Sequence[BallbarTest] = ..., radial_c_side: RadialSide = RadialSide.outside, axial_c_tilt_deg: typing.SupportsFloat | typing.SupportsIndex | None = None) -> None:
+    def __init__(self, machine: MachineType = ..., ballbar_length: typing.SupportsFloat | typing.SupportsIndex = 100.0, pivot: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ..., tilt_range_deg: typing.Annotated[collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], "FixedSize(2)"] | None = None, rot_range_deg: typing.Annotated[collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], "FixedSize(2)"] = [0.0, 360.0], step_deg: typing.SupportsFloat | typing.SupportsIndex = 1.0, feed_mm_per_min: typing.SupportsFloat | typing.SupportsIndex = 1000.0, feed_deg_per_min: typing.SupportsFloat | typing.SupportsIndex = 3600.0, tests: collections.abc.Sequence[BallbarTest] = ..., radial_c_side: RadialSide = RadialSide.outside, axial_c_tilt_deg: typing.SupportsFloat | typing.SupportsIndex | None = None, directions: collections.abc.Sequence[SweepDirection] = ..., feed_factors: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] = [1.0]) -> None:
         """
         tilt_range_deg None: default_tilt_range_deg(machine); axial_c_tilt_deg None: default_axial_c_tilt_deg(machine).
         """
@@ -379,10 +379,26 @@ class BallbarSetup:
     def ballbar_length(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
         ...
     @property
+    def directions(self) -> list[SweepDirection]:
+        """
+        directions of every rotary test, in order
+        """
+    @directions.setter
+    def directions(self, arg0: collections.abc.Sequence[SweepDirection]) -> None:
+        ...
+    @property
     def feed_deg_per_min(self) -> float:
         ...
     @feed_deg_per_min.setter
     def feed_deg_per_min(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def feed_factors(self) -> list[float]:
+        """
+        feeds of every rotary test as factors of the set-up's feeds; the first is 1
+        """
+    @feed_factors.setter
+    def feed_factors(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
         ...
     @property
     def feed_mm_per_min(self) -> float:
@@ -443,8 +459,12 @@ class BallbarTest:
       radial_c
     
       axial_c
+    
+      tangential_tilt
+    
+      tangential_c
     """
-    __members__: typing.ClassVar[dict[str, BallbarTest]]  # value = {'sphere_xy': <BallbarTest.sphere_xy: 0>, 'sphere_yz': <BallbarTest.sphere_yz: 1>, 'sphere_zx': <BallbarTest.sphere_zx: 2>, 'radial_tilt': <BallbarTest.radial_tilt: 3>, 'axial_tilt': <BallbarTest.axial_tilt: 4>, 'radial_c': <BallbarTest.radial_c: 5>, 'axial_c': <BallbarTest.axial_c: 6>}
+    __members__: typing.ClassVar[dict[str, BallbarTest]]  # value = {'sphere_xy': <BallbarTest.sphere_xy: 0>, 'sphere_yz': <BallbarTest.sphere_yz: 1>, 'sphere_zx': <BallbarTest.sphere_zx: 2>, 'radial_tilt': <BallbarTest.radial_tilt: 3>, 'axial_tilt': <BallbarTest.axial_tilt: 4>, 'radial_c': <BallbarTest.radial_c: 5>, 'axial_c': <BallbarTest.axial_c: 6>, 'tangential_tilt': <BallbarTest.tangential_tilt: 7>, 'tangential_c': <BallbarTest.tangential_c: 8>}
     axial_c: typing.ClassVar[BallbarTest]  # value = <BallbarTest.axial_c: 6>
     axial_tilt: typing.ClassVar[BallbarTest]  # value = <BallbarTest.axial_tilt: 4>
     radial_c: typing.ClassVar[BallbarTest]  # value = <BallbarTest.radial_c: 5>
@@ -452,6 +472,8 @@ class BallbarTest:
     sphere_xy: typing.ClassVar[BallbarTest]  # value = <BallbarTest.sphere_xy: 0>
     sphere_yz: typing.ClassVar[BallbarTest]  # value = <BallbarTest.sphere_yz: 1>
     sphere_zx: typing.ClassVar[BallbarTest]  # value = <BallbarTest.sphere_zx: 2>
+    tangential_c: typing.ClassVar[BallbarTest]  # value = <BallbarTest.tangential_c: 8>
+    tangential_tilt: typing.ClassVar[BallbarTest]  # value = <BallbarTest.tangential_tilt: 7>
     @typing.overload
     def __eq__(self, other: BallbarTest) -> bool:
         ...
@@ -1794,6 +1816,12 @@ class PlanSegment:
     def arc(self) -> TransitionArc:
         ...
     @property
+    def direction(self) -> SweepDirection:
+        ...
+    @property
+    def feed_factor(self) -> float:
+        ...
+    @property
     def kind(self) -> SegmentKind:
         ...
     @property
@@ -1893,6 +1921,12 @@ class PlausibleSizes:
     def angular_positioning_rad(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
         ...
     @property
+    def backlash_rad(self) -> float:
+        ...
+    @backlash_rad.setter
+    def backlash_rad(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
     def bar_length_mm(self) -> float:
         ...
     @bar_length_mm.setter
@@ -1929,6 +1963,12 @@ class PlausibleSizes:
     def overrides(self, arg0: collections.abc.Mapping[str, typing.SupportsFloat | typing.SupportsIndex]) -> None:
         ...
     @property
+    def reversal_spike_rad(self) -> float:
+        ...
+    @reversal_spike_rad.setter
+    def reversal_spike_rad(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
     def rotary_zero_rad(self) -> float:
         ...
     @rotary_zero_rad.setter
@@ -1939,6 +1979,12 @@ class PlausibleSizes:
         ...
     @scale.setter
     def scale(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def servo_lag_s(self) -> float:
+        ...
+    @servo_lag_s.setter
+    def servo_lag_s(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
         ...
     @property
     def squareness_rad(self) -> float:
@@ -2920,6 +2966,53 @@ class SphereOffsetCalibration:
     @property
     def residual_rms_um(self) -> float:
         ...
+class SweepDirection:
+    """
+    ccw: towards increasing angles; cw: back.
+    
+    Members:
+    
+      ccw
+    
+      cw
+    """
+    __members__: typing.ClassVar[dict[str, SweepDirection]]  # value = {'ccw': <SweepDirection.ccw: 0>, 'cw': <SweepDirection.cw: 1>}
+    ccw: typing.ClassVar[SweepDirection]  # value = <SweepDirection.ccw: 0>
+    cw: typing.ClassVar[SweepDirection]  # value = <SweepDirection.cw: 1>
+    @typing.overload
+    def __eq__(self, other: SweepDirection) -> bool:
+        ...
+    @typing.overload
+    def __eq__(self, other: typing.Any) -> bool:
+        ...
+    def __getstate__(self) -> int:
+        ...
+    def __hash__(self) -> int:
+        ...
+    def __index__(self) -> int:
+        ...
+    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __int__(self) -> int:
+        ...
+    @typing.overload
+    def __ne__(self, other: SweepDirection) -> bool:
+        ...
+    @typing.overload
+    def __ne__(self, other: typing.Any) -> bool:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __str__(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def value(self) -> int:
+        ...
 class TableMotionOverlap:
     """
     Whether two effects move the table alike (ballbar/design.hpp).
@@ -3231,6 +3324,8 @@ def identify_rtest_paper(session: RtestSession) -> RtestPaperIdentification:
     """
     Oyama & Ibaraki's method, Eqs. 10-22 (rtest/identify_paper.hpp).
     """
+def is_rotary_test(test: BallbarTest) -> bool:
+    ...
 def kasa_circle_fit(points: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], sigma: typing.SupportsFloat | typing.SupportsIndex = 0.0, refine: bool = False) -> CircleFit:
     """
     Circle fit to (N, 2) points.
@@ -3301,6 +3396,8 @@ def parse_nc_dialect(text: str) -> NcDialect:
     ...
 def parse_radial_side(text: str) -> RadialSide:
     ...
+def parse_sweep_direction(text: str) -> SweepDirection:
+    ...
 def plan_ballbar_test(setup: BallbarSetup = ..., identified: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] | None = None) -> BallbarPlan:
     """
     Plan the single set-up ballbar test (Flynn et al. 2016, Sec. 3).
@@ -3368,6 +3465,10 @@ def rtest_prediction_rms_um(model: RtestJointModel, session: RtestSession) -> fl
 def rtest_readings(machine: MachineType, errors: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], effects: collections.abc.Sequence[str], effect_params: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], angles: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], time: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
     """
     Noise-free readings (N, 3) of the nest at q (mm) at angles (N, 2) in rad and time (N,) s, no probe zero: the simulator's truth.
+    """
+def run_label(test: BallbarTest, direction: SweepDirection, feed_factor: typing.SupportsFloat | typing.SupportsIndex, setup: ...) -> str:
+    """
+    Label of one run: test label, '_cw', '_f<feed>'.
     """
 def simulate_ballbar(commanded: BallbarSession, truth: BallbarMachineModel, noise_um: typing.SupportsFloat | typing.SupportsIndex = 0.5, seed: typing.SupportsInt | typing.SupportsIndex = 1, declare_noise: bool = True) -> BallbarSession:
     """

@@ -83,12 +83,33 @@ std::vector<std::string> setup_advice(MachineType m, const std::vector<std::stri
 
 }  // namespace
 
+namespace {
+
+// A time constant (the log of one, unit "1": thermal_warmup, reversal_spike) moves nothing
+// while its amplitude is 0, where every fit starts, so the observability analysis at the
+// start would hold it there. Such a fit runs twice: with the time constants held, then from
+// that solution with them free.
+JointFitOutcome solve_with_time_constants(const ResidualModel& model, std::vector<FitParameter> params,
+                                          const JointFitSettings& settings) {
+  std::vector<std::size_t> gated;
+  for (std::size_t j = 0; j < params.size(); ++j)
+    if (params[j].unit == "1" && !params[j].held) gated.push_back(j);
+  if (gated.empty()) return solve_joint(model, params, settings);
+  for (std::size_t j : gated) params[j].held = true;
+  const JointFitOutcome first = solve_joint(model, params, settings);
+  for (std::size_t j = 0; j < params.size(); ++j) params[j].start = first.values[static_cast<Eigen::Index>(j)];
+  for (std::size_t j : gated) params[j].held = false;
+  return solve_joint(model, params, settings);
+}
+
+}  // namespace
+
 BallbarIdentification identify_joint(const BallbarArrays& data, const JointFitOptions& options) {
   BallbarFitSetup setup = ballbar_fit_setup(data, options);
   const EffectModel& fx = setup.effects;
   const int P = fx.num_params();
   const BallbarLengthModel model(data, fx);
-  JointFitOutcome fit = solve_joint(model, setup.parameters, setup.settings);
+  JointFitOutcome fit = solve_with_time_constants(model, setup.parameters, setup.settings);
 
   // The noise model of what the fit leaves, one AR stream per test in time order. With
   // correlated noise the white covariance is too small by about sqrt(tau) (issue 11: 6x at
@@ -104,7 +125,7 @@ BallbarIdentification identify_joint(const BallbarArrays& data, const JointFitOp
         noise.correlation_samples >= options.min_correlation_samples) {
       if (options.noise_bias_correction) scale = noise_correction(noise, data.test, t, fit, options.noise_options);
       setup.settings.whitener = std::make_shared<ArWhitener>(noise);
-      fit = solve_joint(model, setup.parameters, setup.settings);
+      fit = solve_with_time_constants(model, setup.parameters, setup.settings);
       apply_noise_correction(scale, &fit);
       refit = true;
     }

@@ -389,6 +389,16 @@ std::string run_label(BallbarTest test, SweepDirection direction, double feed_fa
   return out;
 }
 
+std::string test_of_run(const std::string& label) {
+  std::string out = label;
+  const std::size_t f = out.rfind("_f");
+  if (f != std::string::npos && f + 2 < out.size() &&
+      out.find_first_not_of("0123456789.e+-", f + 2) == std::string::npos)
+    out.erase(f);
+  if (out.size() > 3 && out.compare(out.size() - 3, 3, "_cw") == 0) out.erase(out.size() - 3);
+  return out;
+}
+
 std::string to_string(SweepDirection d) { return d == SweepDirection::ccw ? "ccw" : "cw"; }
 
 SweepDirection parse_sweep_direction(const std::string& text) {

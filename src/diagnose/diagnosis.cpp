@@ -10,6 +10,7 @@
 #include <memory>
 #include <sstream>
 
+#include "rotacal/ballbar/test_plan.hpp"
 #include "rotacal/core/stats.hpp"
 #include "scoring.hpp"
 #include "rotacal/core/noise_handling.hpp"
@@ -78,12 +79,24 @@ std::vector<ParameterEstimate> parameters_of(const ModelFit& fit, const Effect& 
 }
 
 // One indicator column per noise stream (group, channel).
+// One level per noise stream, shared by the runs of one test (radial_C, radial_C_cw,
+// radial_C_f2000, test_of_run): they follow each other with the bar in place, so a wander does
+// not start afresh between them, and a step between them (backlash, servo lag) is a signal.
 Eigen::MatrixXd stream_levels(const DiagnosisProblem& P) {
   const auto streams = noise_streams(P.groups(), P.times());
+  std::map<std::string, int> column;  // test of the stream's group, and its k-th stream there
+  std::map<std::string, int> seen;
+  std::vector<int> col_of(streams.size());
+  for (std::size_t s = 0; s < streams.size(); ++s) {
+    const std::string& g = P.groups()[static_cast<std::size_t>(streams[s].front())];
+    const std::string key = test_of_run(g) + "#" + std::to_string(seen[g]++);
+    const auto it = column.emplace(key, static_cast<int>(column.size())).first;
+    col_of[s] = it->second;
+  }
   Eigen::MatrixXd L = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(P.groups().size()),
-                                            static_cast<Eigen::Index>(streams.size()));
+                                            static_cast<Eigen::Index>(column.size()));
   for (std::size_t s = 0; s < streams.size(); ++s)
-    for (Eigen::Index i : streams[s]) L(i, static_cast<Eigen::Index>(s)) = 1e-3;  // 1 um
+    for (Eigen::Index i : streams[s]) L(i, col_of[s]) = 1e-3;  // 1 um
   return L;
 }
 

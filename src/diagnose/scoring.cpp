@@ -33,6 +33,9 @@ Eigen::VectorXd solve_ls(const Eigen::MatrixXd& X, const Eigen::VectorXd& y) {
   const Eigen::MatrixXd Xs = X * s.cwiseInverse().asDiagonal();
   Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Xs);
   qr.setThreshold(1e-9);
+  // No column the data see (a candidate of an axis that never moves in this session): the
+  // least-squares answer is zero, where Eigen's solve of a rank-0 QR gives NaN.
+  if (qr.rank() == 0) return Eigen::VectorXd::Zero(X.cols());
   return (qr.solve(y)).cwiseQuotient(s);
 }
 
@@ -80,7 +83,11 @@ std::vector<int> cv_folds(const DiagnosisProblem& P, int K, const NoiseModel* no
     for (auto& kv : min_block) kv.second *= channels[kv.first];
   }
   std::vector<int> fold(g.size(), 0);
+  // Group j's blocks go to folds j, j+1, ...: no fold holds the start of every test, so a
+  // signal that sits at each test's start (a reversal spike) is never left out all at once.
+  int group_index = 0;
   for (auto& kv : by_group) {
+    const int shift = group_index++;
     auto& idx = kv.second;
     std::stable_sort(idx.begin(), idx.end(), [&](std::size_t a, std::size_t b) { return t[a] < t[b]; });
     int blocks = K;
@@ -88,7 +95,7 @@ std::vector<int> cv_folds(const DiagnosisProblem& P, int K, const NoiseModel* no
     if (it != min_block.end() && it->second > 1.0)
       blocks = std::clamp(static_cast<int>(static_cast<double>(idx.size()) / it->second), 2, K);
     for (std::size_t k = 0; k < idx.size(); ++k)
-      fold[idx[k]] = static_cast<int>(k * static_cast<std::size_t>(blocks) / idx.size());
+      fold[idx[k]] = (static_cast<int>(k * static_cast<std::size_t>(blocks) / idx.size()) + shift) % blocks;
   }
   return fold;
 }

@@ -157,3 +157,30 @@ def test_rtest_noise_model_json_has_the_walk(shared_data, tmp_path):
     r = rotacal("identify", shared_data / "rtest_bc_oyama.csv", "--no-budget")
     nm = json.loads(r.stdout)["noise_model"]
     assert nm["random_walk_step_um"] == 0.0 and noise_handling_words(nm) == "readings taken as independent"
+
+
+def test_rotary_tests_both_ways_at_two_feeds_find_backlash_and_servo_lag(tmp_path):
+    # Tangential C ccw and cw at two feeds: lost motion flips with the direction, lag scales
+    # with the speed (docs/effects.md); the standard tests beside them, a sag of A as well.
+    tests = "sphere_xy,sphere_yz,sphere_zx,radial_A,axial_C,radial_C,axial_A,tangential_C"
+    r = rotacal("simulate", "ballbar", "--errors", "table2", "--tests", tests, "--directions", "ccw,cw",
+                "--feed-factors", "1,2", "--step", "2", "--effect", "backlash_C=4e-5", "--effect", "servo_lag_C=3e-4",
+                "--effect", "gravity_sag_A=0.004", "--seed", "5", "-o", tmp_path / "s.csv", "--truth", tmp_path / "t.json")
+    assert r.returncode == 0, r.stderr
+    labels = {line.split(",")[0] for line in (tmp_path / "s.csv").read_text().splitlines() if not line.startswith("#")}
+    assert {"tangential_C", "tangential_C_cw", "tangential_C_f2000", "tangential_C_cw_f2000", "radial_A_cw"} <= labels
+    d = json.loads(rotacal("diagnose", tmp_path / "s.csv", "--json", "--no-budget").stdout)
+    found = {f["effect"]: next(iter(f["parameters"].values())) for f in d["findings"]}
+    for effect, value in (("backlash_C", 4e-5), ("servo_lag_C", 3e-4), ("gravity_sag_A", 0.004)):
+        assert effect in found, list(found)
+        assert abs(found[effect]["value"] - value) <= 3 * found[effect]["std"], effect
+    # The program says what it runs.
+    r = rotacal("plan", "ballbar", "--tests", "tangential_C", "--directions", "ccw,cw", "--feed-factors", "1,2",
+                "-o", tmp_path / "p.ngc")
+    assert r.returncode == 0, r.stderr
+    text = (tmp_path / "p.ngc").read_text()
+    assert "TEST tangential_C_cw_f2000" in text and "runs ccw, cw at 1000, 2000 mm/min" in text
+    # Refused by name.
+    for option, value in (("--feed-factors", "2,1"), ("--directions", "up"), ("--feed-factors", "1,x")):
+        r = rotacal("plan", "ballbar", option, value, "-o", tmp_path / "bad.ngc")
+        assert r.returncode == 3 and (option in r.stderr or value in r.stderr), r.stderr

@@ -170,6 +170,10 @@ struct BallbarPlan {
 std::string run_label(BallbarTest test, SweepDirection direction, double feed_factor,
                       const BallbarSetup& setup);
 
+/// The test label of a run label: run_label without its "_cw" and "_f<feed>" suffixes
+/// ("radial_C_cw_f2000" -> "radial_C"); any other label unchanged.
+std::string test_of_run(const std::string& label);
+
 /// Plan the single set-up ballbar test.
 ///
 /// Tests (p = pivot, L = L0, t over the sweep):

@@ -179,9 +179,12 @@ AxisStages<Scalar> axis_stages(MachineType m, const EffectModel& fx, const Scala
           break;
         case EffectKind::reversal_spike: {  // sticks after reversing: tau_s = 0.05 s e^q
           const double dt = chain_angle(m, motion.since_reversal, k);
+          // q held within [-6, 6] (tau_s 0.12 ms .. 20 s): a fit that wanders while h is
+          // still near 0 would otherwise overflow e^q into a NaN Jacobian.
+          const Scalar q1 = q[1] < Scalar(-6) ? Scalar(-6) : q[1] > Scalar(6) ? Scalar(6) : q[1];
           if (std::isfinite(dt) && dt >= 0.0)
             st.angle[k] -= Scalar(chain_angle(m, motion.direction, k)) * q[0] *
-                           exp(-Scalar(dt) / (Scalar(0.05) * exp(q[1])));
+                           exp(-Scalar(dt) / (Scalar(0.05) * exp(q1)));
           break;
         }
         case EffectKind::radial_motion:
