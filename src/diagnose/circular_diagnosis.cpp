@@ -240,13 +240,18 @@ bool axis_phase(const Rows& R, std::size_t i, int a, double* psi) {
   return false;
 }
 
+// Direction of travel (+1, -1) of the axis at phase psi in row i.
+double travel_sign(const Rows& R, std::size_t i, double psi) {
+  // At the turning point itself (a reading exactly at the reversal, e.g. a data arc that
+  // starts there) the axis is at rest: no direction, as in the simulator.
+  const double v = -std::sin(psi) * R.omega[i];
+  return std::abs(std::sin(psi)) < 1e-9 ? 0.0 : (v > 0.0 ? 1.0 : -1.0);
+}
+
 // Direction of travel of axis a (+1, -1) and the time since it last reversed (s).
 void travel(const Rows& R, std::size_t i, double psi, double* s, double* since) {
   const double w = R.omega[i];
-  // At the turning point itself (a reading exactly at the reversal, e.g. a data arc that
-  // starts there) the axis is at rest: no direction, as in the simulator.
-  const double v = -std::sin(psi) * w;
-  *s = std::abs(std::sin(psi)) < 1e-9 ? 0.0 : (v > 0.0 ? 1.0 : -1.0);
+  *s = travel_sign(R, i, psi);
   const double ang = std::fmod(std::fmod(w > 0.0 ? psi : -psi, kPi) + kPi, kPi);
   *since = ang / std::abs(w);
 }
@@ -292,10 +297,9 @@ Eigen::MatrixXd effect_columns(const Rows& R, const CircularEffect& e, const Eig
         break;
       }
       case CircularEffectKind::backlash: {
-        double psi, s, since;
+        double psi;
         if (!axis_phase(R, i, e.axis, &psi)) break;
-        travel(R, i, psi - R.omega[i] * delay, &s, &since);
-        J(r, 0) = -0.5 * s * er[e.axis];
+        J(r, 0) = -0.5 * travel_sign(R, i, psi - R.omega[i] * delay) * er[e.axis];
         break;
       }
       case CircularEffectKind::reversal_spike: {
@@ -626,27 +630,27 @@ struct Scored {
   bool physical = true;   // a spike sticks outward: h > 0
 };
 
-// Visibility, F and BIC of entry e (whitened columns Jw) against the model spanned by Q, whose
-// whitened residuals are r_w. The entry's columns per plausible size with the model projected
-// out, perp, have at most two columns: their singular values and right vectors come from the
-// 2 x 2 Gram matrix perp' perp, and the refit along the visible directions A = perp V (orthogonal
-// columns, squared norms the eigenvalues) is a projection on each column in turn.
-Scored score_one(const CircularEffect& e, const Eigen::MatrixXd& Jw, const ModelBasis& Q,
-                 const Eigen::VectorXd& r_w, int num_free, double min_chi2) {
+// Visibility, F and BIC of entry e against a model whose whitened residuals r_w leave rss0,
+// from the entry's Gram quantities (k <= 2 columns, per unit parameter): G = perp' perp and
+// g = perp' r_w, perp its whitened columns with the model projected out, and Graw = Jw' Jw
+// without. Per plausible size (m) the singular values and right vectors of perp are the square
+// roots and eigenvectors of m G m; the refit along the visible directions A = perp m V
+// (orthogonal columns, squared norms the eigenvalues lambda) removes (v' m g)^2 / lambda each.
+Scored score_gram(const CircularEffect& e, const Eigen::MatrixXd& G, const Eigen::VectorXd& g,
+                  const Eigen::MatrixXd& Graw, double rss0, double n, int num_free,
+                  double min_chi2) {
   Scored s;
   s.effect = e;
   const auto units = e.param_units();
-  Eigen::VectorXd m(Jw.cols());
-  for (Eigen::Index j = 0; j < Jw.cols(); ++j) m[j] = magnitude(units[static_cast<std::size_t>(j)]);
-  const Eigen::MatrixXd perp = Q.project_out(Jw) * m.asDiagonal();
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(perp.transpose() * perp);
+  Eigen::VectorXd m(G.cols());
+  for (Eigen::Index j = 0; j < G.cols(); ++j) m[j] = magnitude(units[static_cast<std::size_t>(j)]);
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(m.asDiagonal() * G * m.asDiagonal());
   const double limit = std::sqrt(min_chi2);
   std::vector<Eigen::Index> dirs;
   for (Eigen::Index i = 0; i < eig.eigenvalues().size(); ++i)
     if (std::sqrt(std::max(eig.eigenvalues()[i], 0.0)) >= limit) dirs.push_back(i);
   if (dirs.empty()) {
-    const Eigen::MatrixXd raw = Jw * m.asDiagonal();
-    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> er(raw.transpose() * raw,
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> er(m.asDiagonal() * Graw * m.asDiagonal(),
                                                             Eigen::EigenvaluesOnly);
     s.absorbed = er.eigenvalues().size() &&
                  std::sqrt(std::max(er.eigenvalues().maxCoeff(), 0.0)) >= limit;
@@ -654,16 +658,20 @@ Scored score_one(const CircularEffect& e, const Eigen::MatrixXd& Jw, const Model
   }
   s.visible = true;
   s.k = static_cast<int>(dirs.size());
-  Eigen::MatrixXd V(perp.cols(), s.k);
-  for (int i = 0; i < s.k; ++i) V.col(i) = eig.eigenvectors().col(dirs[static_cast<std::size_t>(i)]);
-  const Eigen::MatrixXd A = perp * V;
+  const Eigen::VectorXd mg = m.cwiseProduct(g);
   Eigen::VectorXd d(s.k);
-  for (int i = 0; i < s.k; ++i) d[i] = A.col(i).dot(r_w) / A.col(i).squaredNorm();
+  Eigen::MatrixXd V(G.cols(), s.k);
+  double explained = 0.0;
+  for (int i = 0; i < s.k; ++i) {
+    const Eigen::Index j = dirs[static_cast<std::size_t>(i)];
+    V.col(i) = eig.eigenvectors().col(j);
+    const double at_r = V.col(i).dot(mg);
+    d[i] = at_r / eig.eigenvalues()[j];
+    explained += at_r * d[i];
+  }
   const Eigen::VectorXd params = m.cwiseProduct(V * d);  // in the entry's units
   if (e.kind == CircularEffectKind::reversal_spike) s.physical = params[0] > 0.0;
-  const double rss0 = r_w.squaredNorm();
-  s.rss1 = std::max((r_w - A * d).squaredNorm(), 1e-300);
-  const double n = static_cast<double>(r_w.size());
+  s.rss1 = std::max(rss0 - explained, 1e-300);
   const int k_bic = s.k + nonlinear_params(e);
   s.delta_bic = n * std::log(s.rss1 / rss0) + k_bic * std::log(n);
   const double dof = n - num_free - k_bic;
@@ -671,6 +679,81 @@ Scored score_one(const CircularEffect& e, const Eigen::MatrixXd& Jw, const Model
   s.p = stats::f_sf(std::max(F, 0.0), s.k, dof);
   return s;
 }
+
+// score_gram of entry e (whitened columns Jw) against the model spanned by Q.
+Scored score_one(const CircularEffect& e, const Eigen::MatrixXd& Jw, const ModelBasis& Q,
+                 const Eigen::VectorXd& r_w, int num_free, double min_chi2) {
+  const Eigen::MatrixXd perp = Q.project_out(Jw);
+  return score_gram(e, perp.transpose() * perp, perp.transpose() * r_w, Jw.transpose() * Jw,
+                    r_w.squaredNorm(), static_cast<double>(r_w.size()), num_free, min_chi2);
+}
+
+// The candidates of a forward selection under one whitening. Each variant's whitened columns
+// with the baseline projected out (jb) are computed once; the chosen entries' columns enter an
+// orthonormal basis q one entry at a time (baseline projected out, Gram-Schmidt twice against
+// q, a remainder below 1e-9 of the column dropped as in ModelBasis), and every variant keeps
+// q' jb, so a round costs O(n k) per variant for the new basis vectors and the residuals
+// instead of a projection on the whole model: perp' perp = jb' jb - (q' jb)' (q' jb).
+class ScoringPool {
+ public:
+  ScoringPool(const Rows& R, const Whitening& W, const Eigen::MatrixXd& B,
+              const std::vector<const Eigen::MatrixXd*>& variants)
+      : R_(&R), W_(&W) {
+    const Eigen::MatrixXd Bw = W(B);
+    qb_ = baseline_bases(R.run_first, R.run_count, Bw);
+    for (const Eigen::MatrixXd& q : qb_) rank_ += static_cast<int>(q.cols());
+    q_.resize(static_cast<Eigen::Index>(R.n), 0);
+    for (const Eigen::MatrixXd* J : variants) {
+      Eigen::MatrixXd jw = W(*J);
+      graw_.push_back(jw.transpose() * jw);
+      remove_baseline(qb_, R.run_first, R.run_count, jw);
+      gb_.push_back(jw.transpose() * jw);
+      c_.emplace_back(0, jw.cols());
+      jb_.push_back(std::move(jw));
+    }
+  }
+  /// Add a chosen entry's (unwhitened) columns to the model.
+  void add_to_model(const Eigen::MatrixXd& J) {
+    Eigen::MatrixXd E = (*W_)(J);
+    const Eigen::VectorXd norms = E.colwise().norm().transpose();
+    remove_baseline(qb_, R_->run_first, R_->run_count, E);
+    drop_absorbed(E, norms);
+    for (Eigen::Index j = 0; j < E.cols(); ++j) {
+      Eigen::VectorXd v = E.col(j);
+      const double before = v.norm();
+      for (int pass = 0; pass < 2; ++pass)
+        if (q_.cols() > 0) v -= q_ * (q_.transpose() * v);
+      if (!(before > 0.0) || !(v.norm() > 1e-9 * norms[j])) continue;
+      v.normalize();
+      q_.conservativeResize(Eigen::NoChange, q_.cols() + 1);
+      q_.col(q_.cols() - 1) = v;
+      ++rank_;
+      for (std::size_t i = 0; i < jb_.size(); ++i) {
+        c_[i].conservativeResize(c_[i].rows() + 1, Eigen::NoChange);
+        c_[i].row(c_[i].rows() - 1) = v.transpose() * jb_[i];
+      }
+    }
+  }
+  /// Dimension of the model's span (baseline and chosen entries).
+  int rank() const { return rank_; }
+  /// Variant i of entry e against the model, whose whitened residuals are r_w.
+  Scored score(std::size_t i, const CircularEffect& e, const Eigen::VectorXd& r_w,
+               double min_chi2) const {
+    const Eigen::VectorXd qr = q_.transpose() * r_w;
+    const Eigen::MatrixXd G = gb_[i] - c_[i].transpose() * c_[i];
+    const Eigen::VectorXd g = jb_[i].transpose() * r_w - c_[i].transpose() * qr;
+    return score_gram(e, G, g, graw_[i], r_w.squaredNorm(), static_cast<double>(r_w.size()),
+                      rank_, min_chi2);
+  }
+
+ private:
+  const Rows* R_;
+  const Whitening* W_;
+  std::vector<Eigen::MatrixXd> qb_;
+  Eigen::MatrixXd q_;
+  int rank_ = 0;
+  std::vector<Eigen::MatrixXd> jb_, c_, gb_, graw_;
+};
 
 double rms_um(const Eigen::VectorXd& r) { return diagnosis_detail::rms_um(r); }
 
@@ -750,21 +833,34 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session,
                        [&](const Chosen& c) { return c.effect.id() == id; });
   };
   // Forward selection under the current whitening; `ar`: re-estimate the noise every round.
+  // Every variant's columns, in the order of cands (a pool's variant index).
+  std::vector<const Eigen::MatrixXd*> variant_columns;
+  for (const CircularEffect& e : cands)
+    for (const auto& v : cols[e.id()]) variant_columns.push_back(&v.J);
+  const auto pool_for_model = [&] {
+    auto pool = std::make_unique<ScoringPool>(R, W, B, variant_columns);
+    for (const Chosen& c : chosen)
+      pool->add_to_model(effect_columns(R, c.effect, o.screw_pitch, c.tau, c.delay));
+    return pool;
+  };
   const auto forward = [&](bool ar, int limit, bool record) {
+    std::unique_ptr<ScoringPool> pool;
     for (int round = 0;; ++round) {
       if (ar) refit_noise();
-      const ModelBasis Q(R, W(model_columns(R, B, chosen, o.screw_pitch)));
-      const int num_free = Q.rank();
+      if (ar || !pool) pool = pool_for_model();  // the whitening changed, or first round
       std::vector<Scored> scores;
       absorbed.clear();
       invisible.clear();
+      std::size_t variant_index = 0;
       for (const CircularEffect& e : cands) {
+        const auto& cs = cols[e.id()];
+        const std::size_t first_variant = variant_index;
+        variant_index += cs.size();
         if (is_chosen(e.id())) continue;
         Scored best;
         bool have = false;
-        const auto& cs = cols[e.id()];
         for (std::size_t g = 0; g < cs.size(); ++g) {
-          Scored sc = score_one(e, W(cs[g].J), Q, fit.r_w, num_free, o.min_visible_chi2);
+          Scored sc = pool->score(first_variant + g, e, fit.r_w, o.min_visible_chi2);
           sc.tau = cs[g].tau;
           sc.delay = cs[g].delay;
           if (!have || (sc.visible && (!best.visible || sc.rss1 < best.rss1)))
@@ -793,6 +889,7 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session,
       if (!pick) return;
       chosen.push_back({pick->effect, pick->tau, pick->delay});
       fit = gls(R, model_columns(R, B, chosen, o.screw_pitch), R.y, W);
+      if (!ar) pool->add_to_model(effect_columns(R, pick->effect, o.screw_pitch, pick->tau, pick->delay));
     }
   };
   // Backward elimination under the current noise model: drop the entry whose drop-one test
@@ -885,10 +982,16 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session,
     const ModelBasis Q(R, W(model_columns(R, B, others, o.screw_pitch)));
     const Eigen::VectorXd r0 = Q.project_out(W(Eigen::MatrixXd(R.y))).col(0);
     const CircularEffect e = chosen[k].effect;
-    return [&, Q, r0, e](double tau, double delay) {
-      const Eigen::MatrixXd A = Q.project_out(W(effect_columns(R, e, o.screw_pitch, tau, delay)));
+    // A trial whose columns equal the previous trial's (a delay step that crosses no reading)
+    // has its value: the same computation on the same numbers.
+    auto last = std::make_shared<std::pair<Eigen::MatrixXd, double>>();
+    return [&, Q, r0, e, last](double tau, double delay) {
+      Eigen::MatrixXd J = effect_columns(R, e, o.screw_pitch, tau, delay);
+      if (last->first.size() == J.size() && last->first == J) return last->second;
+      const Eigen::MatrixXd A = Q.project_out(W(J));
       const Eigen::VectorXd d = solve_ls(A, r0);
-      return (r0 - A * d).squaredNorm();
+      *last = {std::move(J), (r0 - A * d).squaredNorm()};
+      return last->second;
     };
   };
   const auto scan_delay = [&](std::size_t k, const std::function<double(double, double)>& f) {
