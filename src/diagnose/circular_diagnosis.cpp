@@ -366,7 +366,26 @@ struct Whitening {
   void set(const NoiseModel& nm) {
     w = nm.white() ? nullptr : std::make_unique<ArWhitener>(nm);
     scale = nm.white() && nm.sigma_um > 0.0 ? 1.0 / (nm.sigma_um * 1e-3) : 1.0;
+    ++version;
   }
+  /// White noise of sigma 1 / s (mm).
+  void set_scale(double s) {
+    w.reset();
+    scale = s;
+    ++version;
+  }
+  int version = 0;  ///< changes with the whitening (keys the baseline cache)
+  /// The whitened baseline B_w and its per-run orthonormal bases under this whitening: B is the
+  /// same in every fit, so they are computed once per whitening (baseline()).
+  struct Baseline {
+    int version = -1;
+    Eigen::MatrixXd Bw;
+    std::vector<Eigen::MatrixXd> qb;
+  };
+  const Baseline& baseline(const struct Rows& R, const Eigen::Ref<const Eigen::MatrixXd>& B) const;
+
+ private:
+  mutable Baseline baseline_;
 };
 
 // Least squares against the model's columns M = [B | E] exploits the baseline's structure: B
@@ -394,6 +413,16 @@ std::vector<Eigen::MatrixXd> baseline_bases(const std::vector<Eigen::Index>& fir
   return q;
 }
 
+const Whitening::Baseline& Whitening::baseline(const Rows& R,
+                                               const Eigen::Ref<const Eigen::MatrixXd>& B) const {
+  if (baseline_.version != version) {
+    baseline_.Bw = (*this)(Eigen::MatrixXd(B));
+    baseline_.qb = baseline_bases(R.run_first, R.run_count, baseline_.Bw);
+    baseline_.version = version;
+  }
+  return baseline_;
+}
+
 void remove_baseline(const std::vector<Eigen::MatrixXd>& qb, const std::vector<Eigen::Index>& first,
                      const std::vector<Eigen::Index>& count, Eigen::MatrixXd& X) {
   for (std::size_t k = 0; k < qb.size(); ++k) {
@@ -402,30 +431,39 @@ void remove_baseline(const std::vector<Eigen::MatrixXd>& qb, const std::vector<E
   }
 }
 
-// Least-squares coefficients of y on M = [B | E] (both already whitened), rows of run k at
-// [first[k], first[k] + count[k]).
+// Least-squares coefficients of y on [B | E] (both already whitened; qb: B's per-run bases),
+// rows of run k at [first[k], first[k] + count[k]).
 Eigen::VectorXd block_solve(const std::vector<Eigen::Index>& first,
-                            const std::vector<Eigen::Index>& count, const Eigen::MatrixXd& M,
+                            const std::vector<Eigen::Index>& count, const Eigen::MatrixXd& B,
+                            const std::vector<Eigen::MatrixXd>& qb, const Eigen::MatrixXd& E,
                             const Eigen::VectorXd& y) {
-  const Eigen::Index nb = static_cast<Eigen::Index>(3 * first.size()), ne = M.cols() - nb;
-  const std::vector<Eigen::MatrixXd> qb = baseline_bases(first, count, M);
-  Eigen::VectorXd beta(M.cols());
+  const Eigen::Index nb = B.cols(), ne = E.cols();
+  Eigen::VectorXd beta(nb + ne);
   Eigen::VectorXd r = y;
   if (ne > 0) {
-    Eigen::MatrixXd E = M.rightCols(ne);
-    const Eigen::VectorXd norms = E.colwise().norm().transpose();
+    Eigen::MatrixXd Ep = E;
+    const Eigen::VectorXd norms = Ep.colwise().norm().transpose();
     Eigen::MatrixXd yp = y;
-    remove_baseline(qb, first, count, E);
+    remove_baseline(qb, first, count, Ep);
     remove_baseline(qb, first, count, yp);
-    drop_absorbed(E, norms);
-    beta.tail(ne) = solve_ls(E, yp.col(0));
-    r -= M.rightCols(ne) * beta.tail(ne);
+    drop_absorbed(Ep, norms);
+    beta.tail(ne) = solve_ls(Ep, yp.col(0));
+    r -= E * beta.tail(ne);
   }
   for (std::size_t k = 0; k < first.size(); ++k)
     beta.segment(static_cast<Eigen::Index>(3 * k), 3) =
-        solve_ls(M.block(first[k], static_cast<Eigen::Index>(3 * k), count[k], 3),
+        solve_ls(B.block(first[k], static_cast<Eigen::Index>(3 * k), count[k], 3),
                  r.segment(first[k], count[k]));
   return beta;
+}
+
+// The same for M = [B | E] in one matrix.
+Eigen::VectorXd block_solve(const std::vector<Eigen::Index>& first,
+                            const std::vector<Eigen::Index>& count, const Eigen::MatrixXd& M,
+                            const Eigen::VectorXd& y) {
+  const Eigen::Index nb = static_cast<Eigen::Index>(3 * first.size());
+  return block_solve(first, count, M.leftCols(nb), baseline_bases(first, count, M),
+                     M.rightCols(M.cols() - nb), y);
 }
 
 // Orthonormal basis of the span of whitened model columns [B | E], kept as the per-run bases
@@ -598,12 +636,20 @@ struct Gls {
   Eigen::VectorXd beta, r_mm, r_w;
   double rss_w = 0.0;
 };
+// M = [B | E], B the baseline (whitened once per whitening: Whitening::baseline).
 Gls gls(const Rows& R, const Eigen::MatrixXd& M, const Eigen::VectorXd& y, const Whitening& W) {
   Gls g;
-  const Eigen::MatrixXd Mw = W(M);
+  const Eigen::Index nb = static_cast<Eigen::Index>(3 * R.runs), ne = M.cols() - nb;
+  const Whitening::Baseline& base = W.baseline(R, M.leftCols(nb));
+  const Eigen::MatrixXd Ew = W(M.rightCols(ne));
   const Eigen::VectorXd yw = W(Eigen::MatrixXd(y)).col(0);
-  g.beta = block_solve(R.run_first, R.run_count, Mw, yw);
-  g.r_w = yw - Mw * g.beta;
+  g.beta = block_solve(R.run_first, R.run_count, base.Bw, base.qb, Ew, yw);
+  g.r_w = yw - Ew * g.beta.tail(ne);
+  for (std::size_t k = 0; k < R.runs; ++k) {
+    const Eigen::Index c = static_cast<Eigen::Index>(3 * k);
+    g.r_w.segment(R.run_first[k], R.run_count[k]) -=
+        base.Bw.block(R.run_first[k], c, R.run_count[k], 3) * g.beta.segment(c, 3);
+  }
   g.r_mm = y - M * g.beta;
   g.rss_w = g.r_w.squaredNorm();
   return g;
@@ -688,28 +734,29 @@ Scored score_one(const CircularEffect& e, const Eigen::MatrixXd& Jw, const Model
                     r_w.squaredNorm(), static_cast<double>(r_w.size()), num_free, min_chi2);
 }
 
-// The candidates of a forward selection under one whitening. Each variant's whitened columns
-// with the baseline projected out (jb) are computed once; the chosen entries' columns enter an
-// orthonormal basis q one entry at a time (baseline projected out, Gram-Schmidt twice against
-// q, a remainder below 1e-9 of the column dropped as in ModelBasis), and every variant keeps
-// q' jb, so a round costs O(n k) per variant for the new basis vectors and the residuals
-// instead of a projection on the whole model: perp' perp = jb' jb - (q' jb)' (q' jb).
+// The candidates of a forward selection with the noise taken as white (whitening = a scale
+// s), where a round's model grows by one entry. Per variant only k x k and e x k numbers are
+// kept, no column: the model's effect columns enter an orthonormal basis q one entry at a time
+// (baseline projected out, Gram-Schmidt twice against q, a remainder below 1e-9 of the column
+// dropped as in ModelBasis), each variant keeps c = q' s J, and since r_w and q are orthogonal to
+// the baseline, perp' perp = gb - c' c and perp' r_w = s J' r_w - c' (q' r_w), gb = (P s J)' (P s J)
+// with P the baseline's projector. A round costs O(n k) per variant instead of a projection on
+// the whole model.
 class ScoringPool {
  public:
   ScoringPool(const Rows& R, const Whitening& W, const Eigen::MatrixXd& B,
               const std::vector<const Eigen::MatrixXd*>& variants)
-      : R_(&R), W_(&W) {
-    const Eigen::MatrixXd Bw = W(B);
-    qb_ = baseline_bases(R.run_first, R.run_count, Bw);
+      : R_(&R), W_(&W), scale_(W.scale), variants_(variants) {
+    ROTACAL_ASSERT(!W.w);
+    qb_ = W.baseline(R, B).qb;
     for (const Eigen::MatrixXd& q : qb_) rank_ += static_cast<int>(q.cols());
     q_.resize(static_cast<Eigen::Index>(R.n), 0);
     for (const Eigen::MatrixXd* J : variants) {
-      Eigen::MatrixXd jw = W(*J);
-      graw_.push_back(jw.transpose() * jw);
-      remove_baseline(qb_, R.run_first, R.run_count, jw);
-      gb_.push_back(jw.transpose() * jw);
-      c_.emplace_back(0, jw.cols());
-      jb_.push_back(std::move(jw));
+      Eigen::MatrixXd jb = scale_ * *J;
+      graw_.push_back(jb.transpose() * jb);
+      remove_baseline(qb_, R.run_first, R.run_count, jb);
+      gb_.push_back(jb.transpose() * jb);
+      c_.emplace_back(0, jb.cols());
     }
   }
   /// Add a chosen entry's (unwhitened) columns to the model.
@@ -720,17 +767,16 @@ class ScoringPool {
     drop_absorbed(E, norms);
     for (Eigen::Index j = 0; j < E.cols(); ++j) {
       Eigen::VectorXd v = E.col(j);
-      const double before = v.norm();
       for (int pass = 0; pass < 2; ++pass)
         if (q_.cols() > 0) v -= q_ * (q_.transpose() * v);
-      if (!(before > 0.0) || !(v.norm() > 1e-9 * norms[j])) continue;
+      if (!(norms[j] > 0.0) || !(v.norm() > 1e-9 * norms[j])) continue;
       v.normalize();
       q_.conservativeResize(Eigen::NoChange, q_.cols() + 1);
       q_.col(q_.cols() - 1) = v;
       ++rank_;
-      for (std::size_t i = 0; i < jb_.size(); ++i) {
+      for (std::size_t i = 0; i < variants_.size(); ++i) {
         c_[i].conservativeResize(c_[i].rows() + 1, Eigen::NoChange);
-        c_[i].row(c_[i].rows() - 1) = v.transpose() * jb_[i];
+        c_[i].row(c_[i].rows() - 1) = scale_ * (v.transpose() * *variants_[i]);
       }
     }
   }
@@ -741,7 +787,8 @@ class ScoringPool {
                double min_chi2) const {
     const Eigen::VectorXd qr = q_.transpose() * r_w;
     const Eigen::MatrixXd G = gb_[i] - c_[i].transpose() * c_[i];
-    const Eigen::VectorXd g = jb_[i].transpose() * r_w - c_[i].transpose() * qr;
+    const Eigen::VectorXd g =
+        scale_ * (variants_[i]->transpose() * r_w) - c_[i].transpose() * qr;
     return score_gram(e, G, g, graw_[i], r_w.squaredNorm(), static_cast<double>(r_w.size()),
                       rank_, min_chi2);
   }
@@ -749,10 +796,12 @@ class ScoringPool {
  private:
   const Rows* R_;
   const Whitening* W_;
+  double scale_;
+  std::vector<const Eigen::MatrixXd*> variants_;
   std::vector<Eigen::MatrixXd> qb_;
   Eigen::MatrixXd q_;
   int rank_ = 0;
-  std::vector<Eigen::MatrixXd> jb_, c_, gb_, graw_;
+  std::vector<Eigen::MatrixXd> c_, gb_, graw_;
 };
 
 double rms_um(const Eigen::VectorXd& r) { return diagnosis_detail::rms_um(r); }
@@ -837,17 +886,24 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session,
   std::vector<const Eigen::MatrixXd*> variant_columns;
   for (const CircularEffect& e : cands)
     for (const auto& v : cols[e.id()]) variant_columns.push_back(&v.J);
-  const auto pool_for_model = [&] {
-    auto pool = std::make_unique<ScoringPool>(R, W, B, variant_columns);
-    for (const Chosen& c : chosen)
-      pool->add_to_model(effect_columns(R, c.effect, o.screw_pitch, c.tau, c.delay));
-    return pool;
-  };
+  // Forward selection; under white noise (a whitening that stays for every round) through a
+  // ScoringPool, under the AR model (re-estimated every round) by projecting each variant.
   const auto forward = [&](bool ar, int limit, bool record) {
     std::unique_ptr<ScoringPool> pool;
     for (int round = 0;; ++round) {
       if (ar) refit_noise();
-      if (ar || !pool) pool = pool_for_model();  // the whitening changed, or first round
+      std::unique_ptr<ModelBasis> Q;
+      if (W.w) {
+        Q = std::make_unique<ModelBasis>(R, W(model_columns(R, B, chosen, o.screw_pitch)));
+      } else if (!pool) {
+        pool = std::make_unique<ScoringPool>(R, W, B, variant_columns);
+        for (const Chosen& c : chosen)
+          pool->add_to_model(effect_columns(R, c.effect, o.screw_pitch, c.tau, c.delay));
+      }
+      const auto score_variant = [&](std::size_t i, const CircularEffect& e) {
+        return Q ? score_one(e, W(*variant_columns[i]), *Q, fit.r_w, Q->rank(), o.min_visible_chi2)
+                 : pool->score(i, e, fit.r_w, o.min_visible_chi2);
+      };
       std::vector<Scored> scores;
       absorbed.clear();
       invisible.clear();
@@ -860,7 +916,7 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session,
         Scored best;
         bool have = false;
         for (std::size_t g = 0; g < cs.size(); ++g) {
-          Scored sc = pool->score(first_variant + g, e, fit.r_w, o.min_visible_chi2);
+          Scored sc = score_variant(first_variant + g, e);
           sc.tau = cs[g].tau;
           sc.delay = cs[g].delay;
           if (!have || (sc.visible && (!best.visible || sc.rss1 < best.rss1)))
@@ -889,7 +945,7 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session,
       if (!pick) return;
       chosen.push_back({pick->effect, pick->tau, pick->delay});
       fit = gls(R, model_columns(R, B, chosen, o.screw_pitch), R.y, W);
-      if (!ar) pool->add_to_model(effect_columns(R, pick->effect, o.screw_pitch, pick->tau, pick->delay));
+      if (pool) pool->add_to_model(effect_columns(R, pick->effect, o.screw_pitch, pick->tau, pick->delay));
     }
   };
   // Backward elimination under the current noise model: drop the entry whose drop-one test
@@ -935,7 +991,7 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session,
   //    noise; step 2 corrects that.
   {
     const double sd = difference_sigma(R, fit.r_mm);
-    W.scale = sd > 0.0 ? 1.0 / sd : 1.0;
+    W.set_scale(sd > 0.0 ? 1.0 / sd : 1.0);
     fit = gls(R, B, R.y, W);
   }
   forward(false, o.max_findings + 6, true);
