@@ -56,6 +56,18 @@ void instrument_methods(pyb::class_<Instrument>& c) {
       .def("stats", [](const Instrument& v) { return stats_dict(v.stats()); });
 }
 
+// A ballbar recording of `plan` (a BallbarPlan or a CircularPlanResult, played as Program) from
+// a serial port, the GIL released while it reads.
+template <typename Program, typename Plan>
+RecordSummary record_plan(const std::string& port, const Plan& plan, const std::string& path, int baud,
+                          double rate_hz, bool zero, double silence_timeout_s,
+                          const std::optional<pyb::function>& progress) {
+  const RecordOptions o = record_options(rate_hz, 1.0, silence_timeout_s, zero, progress);
+  pyb::gil_scoped_release release;
+  auto transport = open_port(port, settings_of(baud));
+  return record_ballbar(*transport, Program(plan), path, o);
+}
+
 }  // namespace
 
 void bind_hw(pyb::module_& m) {
@@ -93,13 +105,9 @@ void bind_hw(pyb::module_& m) {
       "served on a pseudo-terminal; the machine and noise as simulate_circular's options.");
   circular.def(pyb::init([](const CircularPlanResult& plan, const CircularSimulationOptions& sim,
                             double rate_hz, double speed, int baud, const FaultInjection& faults) {
-                 VirtualCircularBallbarOptions o;
-                 o.sim = sim;
-                 o.rate_hz = rate_hz;
-                 o.speed = speed;
-                 o.baud = baud;
-                 o.faults = faults;
-                 return std::make_unique<VirtualCircularBallbar>(CircularTimeline(plan), o);
+                 return std::make_unique<VirtualCircularBallbar>(
+                     CircularTimeline(plan),
+                     VirtualCircularBallbarOptions{sim, rate_hz, speed, baud, faults});
                }),
                pyb::arg("plan"), pyb::arg("options"), pyb::arg("rate_hz") = 250.0,
                pyb::arg("speed") = 1.0, pyb::arg("baud") = 115200,
@@ -158,14 +166,7 @@ void bind_hw(pyb::module_& m) {
       .def("describe", &RecordSummary::describe);
 
   m.def(
-      "record_ballbar",
-      [](const std::string& port, const BallbarPlan& plan, const std::string& path, int baud, double rate_hz,
-         bool zero, double silence_timeout_s, const std::optional<pyb::function>& progress) {
-        const RecordOptions o = record_options(rate_hz, 1.0, silence_timeout_s, zero, progress);
-        pyb::gil_scoped_release release;
-        auto transport = open_port(port, settings_of(baud));
-        return record_ballbar(*transport, ProgramTimeline(plan), path, o);
-      },
+      "record_ballbar", &record_plan<ProgramTimeline, BallbarPlan>,
       pyb::arg("port"), pyb::arg("plan"), pyb::arg("path"), pyb::arg("baud") = 115200,
       pyb::arg("rate_hz") = 1000.0, pyb::arg("zero") = false, pyb::arg("silence_timeout_s") = 3.0,
       pyb::arg("progress") = std::nullopt,
@@ -173,15 +174,7 @@ void bind_hw(pyb::module_& m) {
       "progress(rows, lost, corrupt, t_s, duration_s) -> bool is called a few times a second; "
       "returning False stops the recording.");
   m.def(
-      "record_circular_ballbar",
-      [](const std::string& port, const CircularPlanResult& plan, const std::string& path, int baud,
-         double rate_hz, bool zero, double silence_timeout_s,
-         const std::optional<pyb::function>& progress) {
-        const RecordOptions o = record_options(rate_hz, 1.0, silence_timeout_s, zero, progress);
-        pyb::gil_scoped_release release;
-        auto transport = open_port(port, settings_of(baud));
-        return record_ballbar(*transport, CircularTimeline(plan), path, o);
-      },
+      "record_circular_ballbar", &record_plan<CircularTimeline, CircularPlanResult>,
       pyb::arg("port"), pyb::arg("plan"), pyb::arg("path"), pyb::arg("baud") = 115200,
       pyb::arg("rate_hz") = 250.0, pyb::arg("zero") = false, pyb::arg("silence_timeout_s") = 3.0,
       pyb::arg("progress") = std::nullopt,

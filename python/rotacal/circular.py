@@ -506,29 +506,29 @@ def add_cli(sub: Any) -> None:
     k.add_argument("-o", "--output", required=True, type=path("--output"))
     k.set_defaults(func=_cmd_simulate)
 
-    k = acts.add_parser("virtual", help="a virtual ballbar on a pseudo-terminal playing the circular program",
-                        description="Serves the ballbar protocol (docs/protocols.md) on a pseudo-terminal while a "
-                                    "simulated machine with the given linear-axis errors runs the planned circular "
-                                    "program (the options of plan and simulate); prints the port. Record it with "
-                                    "`rotacal circular record --port PORT` and the same plan options.",
-                        epilog=EPILOG)
-    _add_plan_args(k)
-    _add_machine_args(k)
-    k.add_argument("--baud", type=number("--baud", 50, 4_000_000, integer=True), default=115200, help="baud rate (default 115200)")
-    _add_virtual_args(k)
-    k.set_defaults(func=_cmd_virtual)
-
-    k = acts.add_parser("record", help="record a circular test from a ballbar on a serial port",
-                        description="Reads the ballbar on --port while the machine runs the planned circular program "
-                                    "(the same plan options as `plan`; --rate is the requested sample rate) and writes "
-                                    "a rotacal-ballbar/1 file as it goes: rows on a data arc labelled with their run "
-                                    "(circular_XY_ccw, ...), the others 'transition'. `rotacal circular analyze` reads it.",
-                        epilog=EPILOG)
-    _add_plan_args(k)
-    k.add_argument("--baud", type=number("--baud", 50, 4_000_000, integer=True), default=115200, help="baud rate (default 115200)")
-    k.add_argument("--zero", action="store_true", help="send ZERO before START")
-    _add_record_args(k)
-    k.set_defaults(func=_cmd_record)
+    # The two ends of a serial line: the plan's options (and --rate as the stream's rate) and a baud rate.
+    for name, summary, text in (
+            ("virtual", "a virtual ballbar on a pseudo-terminal playing the circular program",
+             "Serves the ballbar protocol (docs/protocols.md) on a pseudo-terminal while a simulated machine with the "
+             "given linear-axis errors runs the planned circular program (the options of plan and simulate); prints "
+             "the port. Record it with `rotacal circular record --port PORT` and the same plan options."),
+            ("record", "record a circular test from a ballbar on a serial port",
+             "Reads the ballbar on --port while the machine runs the planned circular program (the same plan options "
+             "as `plan`; --rate is the requested sample rate) and writes a rotacal-ballbar/1 file as it goes: rows on "
+             "a data arc labelled with their run (circular_XY_ccw, ...), the others 'transition'. `rotacal circular "
+             "analyze` reads it.")):
+        k = acts.add_parser(name, help=summary, description=text, epilog=EPILOG)
+        _add_plan_args(k)
+        k.add_argument("--baud", type=number("--baud", 50, 4_000_000, integer=True), default=115200,
+                       help="baud rate (default 115200)")
+        if name == "virtual":
+            _add_machine_args(k)
+            _add_virtual_args(k)
+            k.set_defaults(func=_cmd_virtual)
+        else:
+            k.add_argument("--zero", action="store_true", help="send ZERO before START")
+            _add_record_args(k)
+            k.set_defaults(func=_cmd_record)
 
     k = acts.add_parser("analyze", help="G, G(b), H per plane and the causes the data support", epilog=EPILOG)
     k.add_argument("file", type=path("FILE"))
