@@ -59,8 +59,8 @@ void instrument_methods(pyb::class_<Instrument>& c) {
 // A ballbar recording of `plan` (a BallbarPlan or a CircularPlanResult, played as Program) from
 // a serial port, the GIL released while it reads.
 template <typename Program, typename Plan>
-RecordSummary record_plan(const std::string& port, const Plan& plan, const std::string& path, int baud,
-                          double rate_hz, bool zero, double silence_timeout_s,
+RecordSummary record_plan(const std::string& port, const Plan& plan, const std::string& path,
+                          int baud, double rate_hz, bool zero, double silence_timeout_s,
                           const std::optional<pyb::function>& progress) {
   const RecordOptions o = record_options(rate_hz, 1.0, silence_timeout_s, zero, progress);
   pyb::gil_scoped_release release;

@@ -382,9 +382,10 @@ class CircularNcWriter {
   }
 
   void prologue() {
+    const nc_detail::Preamble preamble{"write_circular_nc_program", "program", "ROTACAL CIRCULAR",
+                                       plan_.machine.has_head()};
     nc_detail::write_preamble(
-        d_, o_, {"write_circular_nc_program", "program", "ROTACAL CIRCULAR", plan_.machine.has_head()},
-        [this](const std::string& s) { line(s); }, [this] { header(); });
+        d_, o_, preamble, [this](const std::string& s) { line(s); }, [this] { header(); });
     // The rotary test's fanuc program calls the tool with TCPM on; this one calls it here.
     if (d_ == NcDialect::fanuc) line("G43 H" + std::to_string(o_.tool));
   }

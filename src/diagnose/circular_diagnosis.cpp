@@ -472,7 +472,9 @@ Eigen::VectorXd block_solve(const std::vector<Eigen::Index>& first,
 class ModelBasis {
  public:
   ModelBasis(const Rows& R, const Eigen::MatrixXd& Mw)
-      : first_(&R.run_first), count_(&R.run_count), qb_(baseline_bases(R.run_first, R.run_count, Mw)) {
+      : first_(&R.run_first),
+        count_(&R.run_count),
+        qb_(baseline_bases(R.run_first, R.run_count, Mw)) {
     const Eigen::Index nb = static_cast<Eigen::Index>(3 * R.runs);
     Eigen::MatrixXd E = Mw.rightCols(Mw.cols() - nb);
     const Eigen::VectorXd norms = E.colwise().norm().transpose();
@@ -739,9 +741,9 @@ Scored score_one(const CircularEffect& e, const Eigen::MatrixXd& Jw, const Model
 // kept, no column: the model's effect columns enter an orthonormal basis q one entry at a time
 // (baseline projected out, Gram-Schmidt twice against q, a remainder below 1e-9 of the column
 // dropped as in ModelBasis), each variant keeps c = q' s J, and since r_w and q are orthogonal to
-// the baseline, perp' perp = gb - c' c and perp' r_w = s J' r_w - c' (q' r_w), gb = (P s J)' (P s J)
-// with P the baseline's projector. A round costs O(n k) per variant instead of a projection on
-// the whole model.
+// the baseline, perp' perp = gb - c' c and perp' r_w = s J' r_w - c' (q' r_w), with
+// gb = (P s J)' (P s J) and P the baseline's projector. A round costs O(n k) per variant
+// instead of a projection on the whole model.
 class ScoringPool {
  public:
   ScoringPool(const Rows& R, const Whitening& W, const Eigen::MatrixXd& B,
@@ -945,7 +947,8 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session,
       if (!pick) return;
       chosen.push_back({pick->effect, pick->tau, pick->delay});
       fit = gls(R, model_columns(R, B, chosen, o.screw_pitch), R.y, W);
-      if (pool) pool->add_to_model(effect_columns(R, pick->effect, o.screw_pitch, pick->tau, pick->delay));
+      if (pool)
+        pool->add_to_model(effect_columns(R, pick->effect, o.screw_pitch, pick->tau, pick->delay));
     }
   };
   // Backward elimination under the current noise model: drop the entry whose drop-one test

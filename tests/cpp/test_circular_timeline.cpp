@@ -88,7 +88,8 @@ TEST_CASE("circular exact reading: simulate_circular's readings on the runs, geo
   o.noise_um = 0.0;
   const BallbarSession sim = simulate_circular(plan, o);
   const CircularBar bar(plan.plan, o);
-  for (const BallbarSample& s : sim.samples) CHECK(circular_exact_reading(tl, bar, s.time) == s.length);
+  for (const BallbarSample& s : sim.samples)
+    CHECK(circular_exact_reading(tl, bar, s.time) == s.length);
   // At rest between runs: the commanded point with the geometric errors only.
   const CircularRun& second = plan.runs[1];
   const double t = second.t_start - 0.5;
