@@ -6,6 +6,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -173,6 +174,7 @@ struct Rows {
   std::vector<double> time;
   std::vector<int> run;
   std::vector<CircularPlane> plane;
+  std::vector<std::array<int, 2>> axes_uv;  // plane_axes of each row's plane
   std::vector<double> theta, omega;
   std::vector<double> cos_theta, sin_theta;  // of theta, computed once: every column uses them
   std::vector<Eigen::Vector3d> axes;         // commanded machine axes, mm
@@ -207,6 +209,7 @@ Rows gather(const BallbarSession& s, const std::vector<CircularRunData>& runs) {
       R.time.push_back(r.time[j]);
       R.run.push_back(static_cast<int>(k));
       R.plane.push_back(r.plane);
+      R.axes_uv.push_back(plane_axes(r.plane));
       R.theta.push_back(r.theta_rad[j]);
       R.cos_theta.push_back(std::cos(r.theta_rad[j]));
       R.sin_theta.push_back(std::sin(r.theta_rad[j]));
@@ -219,7 +222,7 @@ Rows gather(const BallbarSession& s, const std::vector<CircularRunData>& runs) {
 
 // Unit vector along the bar, machine axes.
 Eigen::Vector3d bar_direction(const Rows& R, std::size_t i) {
-  const auto ax = plane_axes(R.plane[i]);
+  const std::array<int, 2>& ax = R.axes_uv[i];
   Eigen::Vector3d e = Eigen::Vector3d::Zero();
   e[ax[0]] = R.cos_theta[i];
   e[ax[1]] = R.sin_theta[i];
@@ -228,7 +231,7 @@ Eigen::Vector3d bar_direction(const Rows& R, std::size_t i) {
 
 // Axis a's phase in row i: the commanded axis is centre + R cos(psi); -1 if a does not move.
 bool axis_phase(const Rows& R, std::size_t i, int a, double* psi) {
-  const auto ax = plane_axes(R.plane[i]);
+  const std::array<int, 2>& ax = R.axes_uv[i];
   if (ax[0] == a) {
     *psi = R.theta[i];
     return true;
@@ -244,8 +247,9 @@ bool axis_phase(const Rows& R, std::size_t i, int a, double* psi) {
 double travel_sign(const Rows& R, std::size_t i, double psi) {
   // At the turning point itself (a reading exactly at the reversal, e.g. a data arc that
   // starts there) the axis is at rest: no direction, as in the simulator.
-  const double v = -std::sin(psi) * R.omega[i];
-  return std::abs(std::sin(psi)) < 1e-9 ? 0.0 : (v > 0.0 ? 1.0 : -1.0);
+  const double sin_psi = std::sin(psi);
+  const double v = -sin_psi * R.omega[i];
+  return std::abs(sin_psi) < 1e-9 ? 0.0 : (v > 0.0 ? 1.0 : -1.0);
 }
 
 // Direction of travel of axis a (+1, -1) and the time since it last reversed (s).
