@@ -568,18 +568,10 @@ double cv_rms_um(const Rows& R, const Eigen::MatrixXd& M, const Eigen::VectorXd&
       }
     }
     if (te.empty() || tr.empty()) continue;
-    Eigen::MatrixXd Mt(static_cast<Eigen::Index>(tr.size()), M.cols());
-    Eigen::VectorXd yt(static_cast<Eigen::Index>(tr.size()));
-    for (std::size_t i = 0; i < tr.size(); ++i) {
-      Mt.row(static_cast<Eigen::Index>(i)) = M.row(tr[i]);
-      yt[static_cast<Eigen::Index>(i)] = y[tr[i]];
-    }
-    const Eigen::VectorXd d = block_solve(first, count, Mt, yt);
-    for (Eigen::Index i : te) {
-      const double e = y[i] - M.row(i).dot(d);
-      ss += e * e;
-      ++n;
-    }
+    const Eigen::VectorXd d =
+        block_solve(first, count, M(tr, Eigen::placeholders::all), y(tr));
+    ss += (y(te) - M(te, Eigen::placeholders::all) * d).squaredNorm();
+    n += te.size();
   }
   return n ? std::sqrt(ss / static_cast<double>(n)) * 1e3 : 0.0;
 }
