@@ -46,6 +46,28 @@ RecordOptions record_options(double rate_hz, double speed, double silence_timeou
   return o;
 }
 
+// What every virtual instrument offers: its port, start, stop, finished, stats.
+template <typename Instrument>
+void instrument_methods(pyb::class_<Instrument>& c) {
+  c.def_property_readonly("port", &Instrument::port)
+      .def("start", &Instrument::start)
+      .def("stop", &Instrument::stop, pyb::call_guard<pyb::gil_scoped_release>())
+      .def_property_readonly("finished", &Instrument::finished)
+      .def("stats", [](const Instrument& v) { return stats_dict(v.stats()); });
+}
+
+// A ballbar recording of `plan` (a BallbarPlan or a CircularPlanResult, played as Program) from
+// a serial port, the GIL released while it reads.
+template <typename Program, typename Plan>
+RecordSummary record_plan(const std::string& port, const Plan& plan, const std::string& path,
+                          int baud, double rate_hz, bool zero, double silence_timeout_s,
+                          const std::optional<pyb::function>& progress) {
+  const RecordOptions o = record_options(rate_hz, 1.0, silence_timeout_s, zero, progress);
+  pyb::gil_scoped_release release;
+  auto transport = open_port(port, settings_of(baud));
+  return record_ballbar(*transport, Program(plan), path, o);
+}
+
 }  // namespace
 
 void bind_hw(pyb::module_& m) {
@@ -58,9 +80,9 @@ void bind_hw(pyb::module_& m) {
       .def_readwrite("close_after", &FaultInjection::close_after)
       .def_readwrite("silence_after", &FaultInjection::silence_after);
 
-  pyb::class_<VirtualBallbar>(m, "VirtualBallbar",
-                              "A ballbar on a simulated machine, served on a pseudo-terminal.")
-      .def(pyb::init([](const BallbarPlan& plan, const BallbarMachineModel& truth, double noise_um,
+  pyb::class_<VirtualBallbar> ballbar(m, "VirtualBallbar",
+                                      "A ballbar on a simulated machine, served on a pseudo-terminal.");
+  ballbar.def(pyb::init([](const BallbarPlan& plan, const BallbarMachineModel& truth, double noise_um,
                         std::uint64_t seed, double rate_hz, double speed, int baud, const FaultInjection& faults) {
              VirtualBallbarOptions o;
              o.truth = truth;
@@ -74,16 +96,28 @@ void bind_hw(pyb::module_& m) {
            }),
            pyb::arg("plan"), pyb::arg("truth"), pyb::arg("noise_um") = 0.5, pyb::arg("seed") = 1,
            pyb::arg("rate_hz") = 1000.0, pyb::arg("speed") = 1.0, pyb::arg("baud") = 115200,
-           pyb::arg("faults") = FaultInjection{})
-      .def_property_readonly("port", &VirtualBallbar::port)
-      .def("start", &VirtualBallbar::start)
-      .def("stop", &VirtualBallbar::stop, pyb::call_guard<pyb::gil_scoped_release>())
-      .def_property_readonly("finished", &VirtualBallbar::finished)
-      .def("stats", [](const VirtualBallbar& v) { return stats_dict(v.stats()); });
+           pyb::arg("faults") = FaultInjection{});
+  instrument_methods(ballbar);
 
-  pyb::class_<VirtualRtest>(m, "VirtualRtest",
-                            "An R-test on a simulated B/C table, served on a pseudo-terminal.")
-      .def(pyb::init([](MachineType machine, const Array& errors, const std::vector<std::string>& effects,
+  pyb::class_<VirtualCircularBallbar> circular(
+      m, "VirtualCircularBallbar",
+      "A ballbar on a machine running an ISO 230-4 circular program (circular_timeline.hpp), "
+      "served on a pseudo-terminal; the machine and noise as simulate_circular's options.");
+  circular.def(pyb::init([](const CircularPlanResult& plan, const CircularSimulationOptions& sim,
+                            double rate_hz, double speed, int baud, const FaultInjection& faults) {
+                 return std::make_unique<VirtualCircularBallbar>(
+                     CircularTimeline(plan),
+                     VirtualCircularBallbarOptions{sim, rate_hz, speed, baud, faults});
+               }),
+               pyb::arg("plan"), pyb::arg("options"), pyb::arg("rate_hz") = 250.0,
+               pyb::arg("speed") = 1.0, pyb::arg("baud") = 115200,
+               pyb::arg("faults") = FaultInjection{});
+  instrument_methods(circular);
+
+  pyb::class_<VirtualRtest> rtest(m, "VirtualRtest",
+                                  "An R-test on a simulated B/C table, served on a pseudo-terminal.");
+  instrument_methods(rtest);
+  rtest.def(pyb::init([](MachineType machine, const Array& errors, const std::vector<std::string>& effects,
                         const std::vector<double>& effect_params, const std::vector<double>& b_deg,
                         const std::vector<double>& c_deg, const Array& nests, double dwell_s, double noise_um,
                         double probe_zero_um, const Array& probe_dirs, unsigned seed, const std::string& mode,
@@ -113,11 +147,6 @@ void bind_hw(pyb::module_& m) {
            pyb::arg("noise_um"), pyb::arg("probe_zero_um"), pyb::arg("probe_dirs"), pyb::arg("seed"),
            pyb::arg("mode") = "keyence", pyb::arg("rate_hz") = 100.0, pyb::arg("speed") = 1.0,
            pyb::arg("baud") = 115200, pyb::arg("faults") = FaultInjection{})
-      .def_property_readonly("port", &VirtualRtest::port)
-      .def("start", &VirtualRtest::start)
-      .def("stop", &VirtualRtest::stop, pyb::call_guard<pyb::gil_scoped_release>())
-      .def_property_readonly("finished", &VirtualRtest::finished)
-      .def("stats", [](const VirtualRtest& v) { return stats_dict(v.stats()); })
       .def_property_readonly("program", &VirtualRtest::program,
                              "Commanded rows (set-up, time, B, C, X, Y, Z) and nests.")
       .def_property_readonly("probe_zeros", [](const VirtualRtest& v) { return rows_from(v.probe_zeros()); });
@@ -137,20 +166,21 @@ void bind_hw(pyb::module_& m) {
       .def("describe", &RecordSummary::describe);
 
   m.def(
-      "record_ballbar",
-      [](const std::string& port, const BallbarPlan& plan, const std::string& path, int baud, double rate_hz,
-         bool zero, double silence_timeout_s, const std::optional<pyb::function>& progress) {
-        const RecordOptions o = record_options(rate_hz, 1.0, silence_timeout_s, zero, progress);
-        pyb::gil_scoped_release release;
-        auto transport = open_port(port, settings_of(baud));
-        return record_ballbar(*transport, ProgramTimeline(plan), path, o);
-      },
+      "record_ballbar", &record_plan<ProgramTimeline, BallbarPlan>,
       pyb::arg("port"), pyb::arg("plan"), pyb::arg("path"), pyb::arg("baud") = 115200,
       pyb::arg("rate_hz") = 1000.0, pyb::arg("zero") = false, pyb::arg("silence_timeout_s") = 3.0,
       pyb::arg("progress") = std::nullopt,
       "Record a ballbar test from a serial port into a rotacal-ballbar/1 file (hw/recorder.hpp). "
       "progress(rows, lost, corrupt, t_s, duration_s) -> bool is called a few times a second; "
       "returning False stops the recording.");
+  m.def(
+      "record_circular_ballbar", &record_plan<CircularTimeline, CircularPlanResult>,
+      pyb::arg("port"), pyb::arg("plan"), pyb::arg("path"), pyb::arg("baud") = 115200,
+      pyb::arg("rate_hz") = 250.0, pyb::arg("zero") = false, pyb::arg("silence_timeout_s") = 3.0,
+      pyb::arg("progress") = std::nullopt,
+      "Record an ISO 230-4 circular test from a serial port into a rotacal-ballbar/1 file: rows "
+      "on a data arc labelled with the run (circular_XY_ccw, ...), the rest 'transition' "
+      "(hw/recorder.hpp); progress as for record_ballbar.");
   m.def(
       "record_rtest",
       [](const std::string& port, const std::string& mode, const RtestSession& program, double dwell_s,

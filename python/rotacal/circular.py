@@ -95,17 +95,52 @@ def errors(squareness_urad: Mapping[str, float] | None = None, scale_um_per_m: M
     return e
 
 
-def simulate(planned: Any, machine_errors: Any = None, *, centring_error_mm: Sequence[float] = (0.0, 0.0, 0.0),
-             length_error_mm: float = 0.0, noise_um: float = 0.3, noise_rho: float = 0.9, seed: int = 1) -> Any:
-    """The session a ballbar records on a machine with ``machine_errors`` (see ``errors``), with
-    AR(1) noise at the sample rate."""
+def simulation_options(machine_errors: Any = None, *, centring_error_mm: Sequence[float] = (0.0, 0.0, 0.0),
+                       length_error_mm: float = 0.0, noise_um: float = 0.3, noise_rho: float = 0.9,
+                       seed: int = 1) -> Any:
+    """``_core.CircularSimulationOptions``: the machine (see ``errors``), its set-up and the
+    ballbar's AR(1) noise (rho between successive readings, marginal sigma)."""
     o = _core.CircularSimulationOptions()
     if machine_errors is not None:
         o.errors = machine_errors
     o.centring_error = np.asarray(centring_error_mm, dtype=float)
     o.length_error = float(length_error_mm)
     o.noise_um, o.noise_rho, o.seed = float(noise_um), float(noise_rho), int(seed)
+    return o
+
+
+def simulate(planned: Any, machine_errors: Any = None, *, centring_error_mm: Sequence[float] = (0.0, 0.0, 0.0),
+             length_error_mm: float = 0.0, noise_um: float = 0.3, noise_rho: float = 0.9, seed: int = 1) -> Any:
+    """The session a ballbar records on a machine with ``machine_errors`` (see ``errors``), with
+    AR(1) noise at the sample rate."""
+    o = simulation_options(machine_errors, centring_error_mm=centring_error_mm, length_error_mm=length_error_mm,
+                           noise_um=noise_um, noise_rho=noise_rho, seed=seed)
     return _core.simulate_circular(planned, o)
+
+
+def virtual_ballbar(planned: Any, options: Any, *, rate_hz: float | None = None, speed: float = 1.0,
+                    baud: int = 115200, faults: Any = None) -> Any:
+    """Start a virtual ballbar on a pseudo-terminal that plays the circular program ``planned``
+    on the machine of ``options`` (``simulation_options``); streams at ``rate_hz`` (default: the
+    plan's sample rate) until the host asks for another. Returns the running instrument: open
+    ``.port`` like a serial port; ``.stop()`` ends it."""
+    rate = planned.plan.sample_rate_hz if rate_hz is None else float(rate_hz)
+    dev = _core.VirtualCircularBallbar(planned, options, rate, float(speed), int(baud),
+                                       faults or _core.FaultInjection())
+    dev.start()
+    return dev
+
+
+def record_ballbar(port: str, planned: Any, path: str, *, baud: int = 115200, rate_hz: float | None = None,
+                   zero: bool = False, silence_timeout_s: float = 3.0, progress: Any = True) -> Any:
+    """Record the circular program ``planned`` from ``port`` into ``path`` (rotacal-ballbar/1):
+    rows on a data arc get the run's label, the rest ``transition``, so ``analyze`` reads the
+    file. ``rate_hz`` defaults to the plan's sample rate; ``progress`` as
+    ``instruments.record_ballbar``'s; Ctrl-C stops cleanly."""
+    from .instruments import _record
+    rate = planned.plan.sample_rate_hz if rate_hz is None else float(rate_hz)
+    return _record(lambda cb: _core.record_circular_ballbar(port, planned, str(path), baud, rate, zero,
+                                                            silence_timeout_s, cb), progress)
 
 
 def truth_dict(machine_errors: Any, centring_error_mm: Sequence[float], length_error_mm: float,
@@ -216,11 +251,13 @@ def analyze(session: Any, *, diagnose: bool = True, screw_pitch_mm: Sequence[flo
 
 
 def is_circular(session: Any) -> bool:
-    """True for a ballbar session whose tests are all ISO 230-4 circular runs (``circular_*``
-    labels): the linear axes' test, which the rotary-axis commands cannot analyse."""
+    """True for a ballbar session whose tests are ISO 230-4 circular runs (``circular_*``
+    labels), beside at most the ``transition`` rows of a recording: the linear axes' test,
+    which the rotary-axis commands cannot analyse."""
     from .sessions import BALLBAR, kind
     tests = set(session.tests) if kind(session) == BALLBAR else set()
-    return bool(tests) and all(str(t).startswith("circular_") for t in tests)
+    runs = {str(t) for t in tests if str(t).startswith("circular_")}
+    return bool(runs) and tests <= runs | {"transition"}
 
 
 def polar_figure(result: CircularResult) -> Any:
@@ -325,6 +362,44 @@ def _add_plan_args(q: argparse.ArgumentParser) -> None:
     g.add_argument("--rate", type=number("--rate", 0.0, 1e5, "Hz", lo_open=True), default=250.0, help="ballbar sample rate, Hz")
 
 
+def _add_machine_args(k: argparse.ArgumentParser) -> None:
+    from .cli import number, numbers
+    g = k.add_argument_group("simulated machine (units as named; default: no error)")
+    g.add_argument("--squareness", type=_axis_values("--squareness", PLANES, -1e4, 1e4), metavar="XY=S,...",
+                   help="urad; XY: x += s y, YZ: y += s z, ZX: z += s x")
+    g.add_argument("--scale", type=_axis_values("--scale", AXES, -1e4, 1e4), metavar="X=K,...", help="um/m")
+    g.add_argument("--straightness", type=_axis_values("--straightness", ["XY", "XZ", "YX", "YZ", "ZX", "ZY"], -1e3, 1e3),
+                   metavar="YX=C,...", help="um at 100 mm from the centre (DA: error direction D, moving axis A)")
+    g.add_argument("--backlash", type=_axis_values("--backlash", AXES, 0.0, 1e3), metavar="X=B,...", help="lost motion, um")
+    g.add_argument("--spike", type=_axis_values("--spike", AXES, 0.0, 1e3), metavar="X=H,...", help="reversal spike height, um")
+    g.add_argument("--spike-tau", type=_axis_values("--spike-tau", AXES, 0.1, 1e4), metavar="X=T,...",
+                   help="reversal spike decay time, ms (default 15)")
+    g.add_argument("--servo-lag", type=_axis_values("--servo-lag", AXES, 0.0, 1e3), metavar="X=T,...",
+                   help="position-loop time constant 1/Kv, ms")
+    g.add_argument("--cyclic", type=_axis_values("--cyclic", AXES, -1e3, 1e3, per_key=2), metavar="X=C:S,...",
+                   help="cyclic error, um: cos and sin amplitudes over the screw lead")
+    g.add_argument("--pitch", type=_axis_values("--pitch", AXES, 0.01, 1e4), metavar="X=P,...", help="screw leads, mm (default 10)")
+    g.add_argument("--centring-error", type=numbers("--centring-error", 3, 10.0, "mm"), default=None,
+                   help="pivot ball off the commanded centre, mm (default: random, 5 um 1-sigma, seeded)")
+    g.add_argument("--length-error", type=number("--length-error", -1e4, 1e4, "um"), default=0.0, help="bar calibration error, um")
+    g.add_argument("--noise", type=number("--noise", 0.0, 1000.0, "um"), default=0.3, help="1-sigma reading noise, um")
+    g.add_argument("--rho", type=number("--rho", 0.0, 0.999, ""), default=0.9, help="AR(1) correlation between readings")
+    g.add_argument("--seed", type=number("--seed", 0, 2**32 - 1, integer=True), default=1)
+
+
+def _machine_options(a: argparse.Namespace) -> tuple[Any, Any]:
+    """The simulated machine of the options (``errors``, ``simulation_options``) and its truth JSON."""
+    e = errors(squareness_urad=a.squareness, scale_um_per_m=a.scale, straightness_um=a.straightness,
+               backlash_um=a.backlash, spike_um=a.spike, spike_tau_ms=a.spike_tau, servo_lag_ms=a.servo_lag,
+               cyclic_um=a.cyclic, screw_pitch_mm=a.pitch)
+    rng = np.random.default_rng(a.seed)
+    centring = (a.centring_error if a.centring_error is not None
+                else (rng.normal(0.0, 0.005, 3)).tolist())  # a pivot set by hand: ~5 um
+    o = simulation_options(e, centring_error_mm=centring, length_error_mm=a.length_error * 1e-3,
+                           noise_um=a.noise, noise_rho=a.rho, seed=a.seed)
+    return o, truth_dict(e, centring, a.length_error * 1e-3, a.noise, a.rho, a.seed)
+
+
 def _planned(a: argparse.Namespace) -> Any:
     return plan(a.planes, a.feeds, a.directions, machine=a.machine, radius=a.length, centre=a.pivot,
                 start_deg=a.start, span_deg=a.span, run_in_deg=a.run_in, overshoot_deg=a.overshoot,
@@ -353,21 +428,37 @@ def _cmd_simulate(a: argparse.Namespace) -> int:
     from .sessions import save
     check_outputs([a.output, a.truth])
     planned = _planned(a)
-    e = errors(squareness_urad=a.squareness, scale_um_per_m=a.scale, straightness_um=a.straightness,
-               backlash_um=a.backlash, spike_um=a.spike, spike_tau_ms=a.spike_tau, servo_lag_ms=a.servo_lag,
-               cyclic_um=a.cyclic, screw_pitch_mm=a.pitch)
-    rng = np.random.default_rng(a.seed)
-    centring = (a.centring_error if a.centring_error is not None
-                else (rng.normal(0.0, 0.005, 3)).tolist())  # a pivot set by hand: ~5 um
-    session = simulate(planned, e, centring_error_mm=centring, length_error_mm=a.length_error * 1e-3,
-                       noise_um=a.noise, noise_rho=a.rho, seed=a.seed)
+    o, data = _machine_options(a)
+    session = _core.simulate_circular(planned, o)
     save(session, a.output, [], [a.truth] if a.truth else [])
     _say(f"wrote {a.output}: {len(planned.runs)} circular runs, {planned.num_samples()} readings")
     if a.truth:
-        data = truth_dict(e, centring, a.length_error * 1e-3, a.noise, a.rho, a.seed)
         write_output(a.truth, jsontext.dumps(data) + "\n", [], [a.output])
         _say(f"wrote {a.truth}: the simulated machine")
     return EXIT_OK
+
+
+def _cmd_virtual(a: argparse.Namespace) -> int:
+    from .cli import _faults, _serve, check_outputs
+    from .outputs import write_output
+    check_outputs([a.truth])
+    planned = _planned(a)
+    o, data = _machine_options(a)
+    if a.truth:
+        write_output(a.truth, jsontext.dumps(data) + "\n")
+    dev = virtual_ballbar(planned, o, speed=a.speed, baud=a.baud, faults=_faults(a))
+    last = planned.runs[-1]
+    return _serve(dev, "ballbar", a, f"circular program, {len(planned.runs)} runs, {last.time[-1]:.0f} s, "
+                                     f"{a.rate:g} Hz, speed x{a.speed:g}")
+
+
+def _cmd_record(a: argparse.Namespace) -> int:
+    from .cli import _report_recording, check_outputs
+    check_outputs([a.output], [a.port])  # before the port is opened
+    planned = _planned(a)
+    summary = record_ballbar(a.port, planned, a.output, baud=a.baud, zero=a.zero, silence_timeout_s=a.silence,
+                             progress=not a.no_progress)
+    return _report_recording(summary, a.output, a.json)
 
 
 def _cmd_analyze(a: argparse.Namespace) -> int:
@@ -390,12 +481,14 @@ def _cmd_analyze(a: argparse.Namespace) -> int:
 
 
 def add_cli(sub: Any) -> None:
-    """Register ``rotacal circular plan|simulate|analyze`` on the CLI's subparsers."""
-    from .cli import EPILOG, number, numbers, path
+    """Register ``rotacal circular plan|simulate|virtual|record|analyze`` on the CLI's subparsers."""
+    from .cli import EPILOG, _add_record_args, _add_virtual_args, number, path
     q = sub.add_parser("circular", help="ISO 230-4 circular tests of the linear axes with the ballbar",
                        description="Circular tests of the linear axes (ISO 230-4) with the same ballbar, set-up and "
                                    "rotacal-ballbar/1 files as the rotary test: plan writes the NC program, simulate a "
-                                   "session with circular_* tests, analyze prints G, G(b), H and the named causes.",
+                                   "session with circular_* tests, virtual serves a simulated ballbar playing the "
+                                   "program on a pseudo-terminal, record reads a ballbar into a session, analyze "
+                                   "prints G, G(b), H and the named causes.",
                        epilog=EPILOG)
     acts = q.add_subparsers(dest="action", required=True)
 
@@ -408,30 +501,34 @@ def add_cli(sub: Any) -> None:
 
     k = acts.add_parser("simulate", help="simulate the ballbar on a machine with linear-axis errors", epilog=EPILOG)
     _add_plan_args(k)
-    g = k.add_argument_group("simulated machine (units as named; default: no error)")
-    g.add_argument("--squareness", type=_axis_values("--squareness", PLANES, -1e4, 1e4), metavar="XY=S,...",
-                   help="urad; XY: x += s y, YZ: y += s z, ZX: z += s x")
-    g.add_argument("--scale", type=_axis_values("--scale", AXES, -1e4, 1e4), metavar="X=K,...", help="um/m")
-    g.add_argument("--straightness", type=_axis_values("--straightness", ["XY", "XZ", "YX", "YZ", "ZX", "ZY"], -1e3, 1e3),
-                   metavar="YX=C,...", help="um at 100 mm from the centre (DA: error direction D, moving axis A)")
-    g.add_argument("--backlash", type=_axis_values("--backlash", AXES, 0.0, 1e3), metavar="X=B,...", help="lost motion, um")
-    g.add_argument("--spike", type=_axis_values("--spike", AXES, 0.0, 1e3), metavar="X=H,...", help="reversal spike height, um")
-    g.add_argument("--spike-tau", type=_axis_values("--spike-tau", AXES, 0.1, 1e4), metavar="X=T,...",
-                   help="reversal spike decay time, ms (default 15)")
-    g.add_argument("--servo-lag", type=_axis_values("--servo-lag", AXES, 0.0, 1e3), metavar="X=T,...",
-                   help="position-loop time constant 1/Kv, ms")
-    g.add_argument("--cyclic", type=_axis_values("--cyclic", AXES, -1e3, 1e3, per_key=2), metavar="X=C:S,...",
-                   help="cyclic error, um: cos and sin amplitudes over the screw lead")
-    g.add_argument("--pitch", type=_axis_values("--pitch", AXES, 0.01, 1e4), metavar="X=P,...", help="screw leads, mm (default 10)")
-    g.add_argument("--centring-error", type=numbers("--centring-error", 3, 10.0, "mm"), default=None,
-                   help="pivot ball off the commanded centre, mm (default: random, 5 um 1-sigma, seeded)")
-    g.add_argument("--length-error", type=number("--length-error", -1e4, 1e4, "um"), default=0.0, help="bar calibration error, um")
-    g.add_argument("--noise", type=number("--noise", 0.0, 1000.0, "um"), default=0.3, help="1-sigma reading noise, um")
-    g.add_argument("--rho", type=number("--rho", 0.0, 0.999, ""), default=0.9, help="AR(1) correlation between readings")
-    g.add_argument("--seed", type=number("--seed", 0, 2**32 - 1, integer=True), default=1)
+    _add_machine_args(k)
     k.add_argument("--truth", metavar="JSON", type=path("--truth"), help="write the simulated machine here")
     k.add_argument("-o", "--output", required=True, type=path("--output"))
     k.set_defaults(func=_cmd_simulate)
+
+    # The two ends of a serial line: the plan's options (and --rate as the stream's rate) and a baud rate.
+    for name, summary, text in (
+            ("virtual", "a virtual ballbar on a pseudo-terminal playing the circular program",
+             "Serves the ballbar protocol (docs/protocols.md) on a pseudo-terminal while a simulated machine with the "
+             "given linear-axis errors runs the planned circular program (the options of plan and simulate); prints "
+             "the port. Record it with `rotacal circular record --port PORT` and the same plan options."),
+            ("record", "record a circular test from a ballbar on a serial port",
+             "Reads the ballbar on --port while the machine runs the planned circular program (the same plan options "
+             "as `plan`; --rate is the requested sample rate) and writes a rotacal-ballbar/1 file as it goes: rows on "
+             "a data arc labelled with their run (circular_XY_ccw, ...), the others 'transition'. `rotacal circular "
+             "analyze` reads it.")):
+        k = acts.add_parser(name, help=summary, description=text, epilog=EPILOG)
+        _add_plan_args(k)
+        k.add_argument("--baud", type=number("--baud", 50, 4_000_000, integer=True), default=115200,
+                       help="baud rate (default 115200)")
+        if name == "virtual":
+            _add_machine_args(k)
+            _add_virtual_args(k)
+            k.set_defaults(func=_cmd_virtual)
+        else:
+            k.add_argument("--zero", action="store_true", help="send ZERO before START")
+            _add_record_args(k)
+            k.set_defaults(func=_cmd_record)
 
     k = acts.add_parser("analyze", help="G, G(b), H per plane and the causes the data support", epilog=EPILOG)
     k.add_argument("file", type=path("FILE"))

@@ -14,7 +14,7 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 void check(bool ok, const std::string& what) {
-  if (!ok) throw InvalidArgument("simulate_circular: " + what);
+  if (!ok) throw InvalidArgument("circular simulation: " + what);
 }
 
 double sign(double v) { return v > 0.0 ? 1.0 : (v < 0.0 ? -1.0 : 0.0); }
@@ -71,8 +71,7 @@ Eigen::Vector3d geometric(const LinearAxisErrors& e, const Eigen::Vector3d& a,
 
 }  // namespace
 
-BallbarSession simulate_circular(const CircularPlanResult& plan,
-                                 const CircularSimulationOptions& o) {
+void check_circular_simulation(const CircularSimulationOptions& o) {
   const LinearAxisErrors& e = o.errors;
   check(e.squareness.allFinite() && e.scale.allFinite() && e.straightness.allFinite() &&
             e.backlash.allFinite() && e.spike.allFinite() && e.spike_tau.allFinite() &&
@@ -94,11 +93,34 @@ BallbarSession simulate_circular(const CircularPlanResult& plan,
   check(std::isfinite(o.noise_rho) && o.noise_rho >= 0.0 && o.noise_rho < 1.0,
         "noise_rho must be in [0, 1)");
 
+}
+
+// Reading (mm, noise-free) of the bar on the plan's machine: ball at actual axes `a`.
+double CircularBar::reading(const Eigen::Vector3d& a) const {
+  const Eigen::Vector3d ball = geometric(options.errors, a, centre_axes) + tool;
+  return (ball - pivot).norm() + options.length_error;
+}
+
+CircularBar::CircularBar(const CircularTestPlan& plan, const CircularSimulationOptions& o)
+    : options(o),
+      tool(tool_vector<double>(plan.machine, 0.0)),
+      centre_axes(plan.centre - tool),
+      pivot(plan.centre + o.centring_error) {}
+
+double circular_exact_reading(const CircularTimeline& timeline, const CircularBar& bar, double t) {
+  const CircularTimeline::Position p = timeline.position(t);
+  const CircularTestPlan& plan = timeline.plan().plan;
+  const CircularRun& run = timeline.plan().runs[p.run];
+  if (p.on_run) return bar.reading(moving_axes(plan, run, bar.options.errors, bar.centre_axes, t));
+  return bar.reading(circular_point(plan, run.plane, p.angle_deg) - bar.tool);
+}
+
+BallbarSession simulate_circular(const CircularPlanResult& plan,
+                                 const CircularSimulationOptions& o) {
+  check_circular_simulation(o);
   BallbarSession session = circular_commanded_session(plan);
   const CircularTestPlan& p = plan.plan;
-  const Eigen::Vector3d tv = tool_vector<double>(p.machine, 0.0);
-  const Eigen::Vector3d centre_axes = p.centre - tv;
-  const Eigen::Vector3d pivot = p.centre + o.centring_error;
+  const CircularBar bar(p, o);
   std::vector<std::string> groups;
   std::vector<double> times;
   groups.reserve(session.samples.size());
@@ -106,10 +128,8 @@ BallbarSession simulate_circular(const CircularPlanResult& plan,
   std::size_t row = 0;
   for (const CircularRun& run : plan.runs)
     for (double t : run.time) {
-      const Eigen::Vector3d a = moving_axes(p, run, e, centre_axes, t);
-      const Eigen::Vector3d ball = geometric(e, a, centre_axes) + tv;
       BallbarSample& s = session.samples[row++];
-      s.length = (ball - pivot).norm() + o.length_error;
+      s.length = bar.reading(moving_axes(p, run, o.errors, bar.centre_axes, t));
       groups.push_back(run.label);
       times.push_back(t);
     }

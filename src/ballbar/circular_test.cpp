@@ -382,47 +382,12 @@ class CircularNcWriter {
   }
 
   void prologue() {
-    if (o_.decimals < 0 || o_.decimals > 9)
-      throw InvalidArgument("write_circular_nc_program: decimals must be in 0..9, got " +
-                            std::to_string(o_.decimals));
-    if (o_.tool < 0) throw InvalidArgument("write_circular_nc_program: tool must be >= 0");
-    if ((d_ == NcDialect::heidenhain || d_ == NcDialect::fanuc) && o_.tool == 0)
-      throw InvalidArgument("write_circular_nc_program: the " + to_string(d_) +
-                            " program needs a tool number (tool = 0 given)");
-    switch (d_) {
-      case NcDialect::linuxcnc:
-        header();
-        line("G21 G90 G94 G17 G40 G49 G80");
-        if (o_.tool > 0 && !plan_.machine.has_head()) line("G43 H" + std::to_string(o_.tool));
-        break;
-      case NcDialect::heidenhain:
-        if (o_.program_name.empty() || o_.program_name.find_first_of(" \t\n;") != std::string::npos)
-          throw InvalidArgument("write_circular_nc_program: program_name must be one word, got '" +
-                                o_.program_name + "'");
-        line("BEGIN PGM " + o_.program_name + " MM");
-        header();
-        line("FUNCTION RESET TCPM");
-        line("TOOL CALL " + std::to_string(o_.tool) + " Z");
-        break;
-      case NcDialect::siemens:
-        header();
-        line("TRAFOOF");
-        line("G71 G90 G94 G17 G40 G64");
-        if (o_.tool > 0) line("T" + std::to_string(o_.tool) + " D1");
-        break;
-      case NcDialect::fanuc: {
-        if (o_.program_number < 1 || o_.program_number > 9999)
-          throw InvalidArgument("write_circular_nc_program: program_number must be in 1..9999");
-        line("%");
-        char o[16];
-        std::snprintf(o, sizeof o, "O%04d", o_.program_number);
-        line(std::string(o) + " (ROTACAL CIRCULAR)");
-        header();
-        line("G21 G90 G94 G17 G40 G49 G80");
-        line("G43 H" + std::to_string(o_.tool));
-        break;
-      }
-    }
+    const nc_detail::Preamble preamble{"write_circular_nc_program", "program", "ROTACAL CIRCULAR",
+                                       plan_.machine.has_head()};
+    nc_detail::write_preamble(
+        d_, o_, preamble, [this](const std::string& s) { line(s); }, [this] { header(); });
+    // The rotary test's fanuc program calls the tool with TCPM on; this one calls it here.
+    if (d_ == NcDialect::fanuc) line("G43 H" + std::to_string(o_.tool));
   }
 
   void epilogue() {

@@ -3,8 +3,10 @@
 // with the thresholds of the rotary diagnosis.
 #include "rotacal/diagnose/circular_diagnosis.hpp"
 
-#include <Eigen/SVD>
+#include <Eigen/Eigenvalues>
+#include <Eigen/QR>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -163,7 +165,6 @@ std::vector<CircularEffect> circular_catalogue() {
 namespace {
 
 using diagnosis_detail::orthonormal_basis;
-using diagnosis_detail::project_out;
 using diagnosis_detail::solve_ls;
 
 struct Rows {
@@ -173,8 +174,12 @@ struct Rows {
   std::vector<double> time;
   std::vector<int> run;
   std::vector<CircularPlane> plane;
+  std::vector<std::array<int, 2>> axes_uv;  // plane_axes of each row's plane
   std::vector<double> theta, omega;
-  std::vector<Eigen::Vector3d> axes;  // commanded machine axes, mm
+  std::vector<double> cos_theta, sin_theta;  // of theta, computed once: every column uses them
+  std::vector<Eigen::Vector3d> axes;         // commanded machine axes, mm
+  // Rows of run k: [run_first[k], run_first[k] + run_count[k]) (gather appends runs in order).
+  std::vector<Eigen::Index> run_first, run_count;
   Eigen::Vector3d centre_axes = Eigen::Vector3d::Zero();
   double radius = 0.0;
   std::set<CircularPlane> planes;
@@ -196,13 +201,18 @@ Rows gather(const BallbarSession& s, const std::vector<CircularRunData>& runs) {
     R.planes.insert(r.plane);
     R.directions.insert(r.direction);
     for (int a : plane_axes(r.plane)) R.moving_axes.insert(a);
+    R.run_first.push_back(static_cast<Eigen::Index>(i));
+    R.run_count.push_back(static_cast<Eigen::Index>(r.time.size()));
     for (std::size_t j = 0; j < r.time.size(); ++j, ++i) {
       R.y[static_cast<Eigen::Index>(i)] = r.deviation_mm[j];
       R.group.push_back(r.label);
       R.time.push_back(r.time[j]);
       R.run.push_back(static_cast<int>(k));
       R.plane.push_back(r.plane);
+      R.axes_uv.push_back(plane_axes(r.plane));
       R.theta.push_back(r.theta_rad[j]);
+      R.cos_theta.push_back(std::cos(r.theta_rad[j]));
+      R.sin_theta.push_back(std::sin(r.theta_rad[j]));
       R.omega.push_back(r.omega_rad_s);
       R.axes.push_back(r.xyz.row(static_cast<Eigen::Index>(j)).transpose());
     }
@@ -212,16 +222,16 @@ Rows gather(const BallbarSession& s, const std::vector<CircularRunData>& runs) {
 
 // Unit vector along the bar, machine axes.
 Eigen::Vector3d bar_direction(const Rows& R, std::size_t i) {
-  const auto ax = plane_axes(R.plane[i]);
+  const std::array<int, 2>& ax = R.axes_uv[i];
   Eigen::Vector3d e = Eigen::Vector3d::Zero();
-  e[ax[0]] = std::cos(R.theta[i]);
-  e[ax[1]] = std::sin(R.theta[i]);
+  e[ax[0]] = R.cos_theta[i];
+  e[ax[1]] = R.sin_theta[i];
   return e;
 }
 
 // Axis a's phase in row i: the commanded axis is centre + R cos(psi); -1 if a does not move.
 bool axis_phase(const Rows& R, std::size_t i, int a, double* psi) {
-  const auto ax = plane_axes(R.plane[i]);
+  const std::array<int, 2>& ax = R.axes_uv[i];
   if (ax[0] == a) {
     *psi = R.theta[i];
     return true;
@@ -233,13 +243,19 @@ bool axis_phase(const Rows& R, std::size_t i, int a, double* psi) {
   return false;
 }
 
+// Direction of travel (+1, -1) of the axis at phase psi in row i.
+double travel_sign(const Rows& R, std::size_t i, double psi) {
+  // At the turning point itself (a reading exactly at the reversal, e.g. a data arc that
+  // starts there) the axis is at rest: no direction, as in the simulator.
+  const double sin_psi = std::sin(psi);
+  const double v = -sin_psi * R.omega[i];
+  return std::abs(sin_psi) < 1e-9 ? 0.0 : (v > 0.0 ? 1.0 : -1.0);
+}
+
 // Direction of travel of axis a (+1, -1) and the time since it last reversed (s).
 void travel(const Rows& R, std::size_t i, double psi, double* s, double* since) {
   const double w = R.omega[i];
-  // At the turning point itself (a reading exactly at the reversal, e.g. a data arc that
-  // starts there) the axis is at rest: no direction, as in the simulator.
-  const double v = -std::sin(psi) * w;
-  *s = std::abs(std::sin(psi)) < 1e-9 ? 0.0 : (v > 0.0 ? 1.0 : -1.0);
+  *s = travel_sign(R, i, psi);
   const double ang = std::fmod(std::fmod(w > 0.0 ? psi : -psi, kPi) + kPi, kPi);
   *since = ang / std::abs(w);
 }
@@ -250,8 +266,8 @@ Eigen::MatrixXd baseline_columns(const Rows& R) {
   for (std::size_t i = 0; i < R.n; ++i) {
     const Eigen::Index c = 3 * R.run[i], r = static_cast<Eigen::Index>(i);
     B(r, c) = 1.0;
-    B(r, c + 1) = std::cos(R.theta[i]);
-    B(r, c + 2) = std::sin(R.theta[i]);
+    B(r, c + 1) = R.cos_theta[i];
+    B(r, c + 2) = R.sin_theta[i];
   }
   return B;
 }
@@ -285,10 +301,9 @@ Eigen::MatrixXd effect_columns(const Rows& R, const CircularEffect& e, const Eig
         break;
       }
       case CircularEffectKind::backlash: {
-        double psi, s, since;
+        double psi;
         if (!axis_phase(R, i, e.axis, &psi)) break;
-        travel(R, i, psi - R.omega[i] * delay, &s, &since);
-        J(r, 0) = -0.5 * s * er[e.axis];
+        J(r, 0) = -0.5 * travel_sign(R, i, psi - R.omega[i] * delay) * er[e.axis];
         break;
       }
       case CircularEffectKind::reversal_spike: {
@@ -300,7 +315,7 @@ Eigen::MatrixXd effect_columns(const Rows& R, const CircularEffect& e, const Eig
       }
       case CircularEffectKind::servo_mismatch:
         if (R.plane[i] == e.plane)
-          J(r, 0) = R.radius * R.omega[i] * std::sin(R.theta[i]) * std::cos(R.theta[i]);
+          J(r, 0) = R.radius * R.omega[i] * R.sin_theta[i] * R.cos_theta[i];
         break;
       case CircularEffectKind::cyclic_error: {
         const double q = 2.0 * kPi * a[e.axis] / pitch[e.axis];
@@ -355,8 +370,211 @@ struct Whitening {
   void set(const NoiseModel& nm) {
     w = nm.white() ? nullptr : std::make_unique<ArWhitener>(nm);
     scale = nm.white() && nm.sigma_um > 0.0 ? 1.0 / (nm.sigma_um * 1e-3) : 1.0;
+    ++version;
   }
+  /// White noise of sigma 1 / s (mm).
+  void set_scale(double s) {
+    w.reset();
+    scale = s;
+    ++version;
+  }
+  int version = 0;  ///< changes with the whitening (keys the baseline cache)
+  /// The whitened baseline B_w and its per-run orthonormal bases under this whitening: B is the
+  /// same in every fit, so they are computed once per whitening (baseline()).
+  struct Baseline {
+    int version = -1;
+    Eigen::MatrixXd Bw;
+    std::vector<Eigen::MatrixXd> qb;
+  };
+  const Baseline& baseline(const struct Rows& R, const Eigen::Ref<const Eigen::MatrixXd>& B) const;
+
+ private:
+  mutable Baseline baseline_;
 };
+
+// Least squares against the model's columns M = [B | E] exploits the baseline's structure: B
+// holds three columns per run that are zero outside that run's rows, and stay so whitened (the
+// whitener works within each run's stream). The baseline is projected out run by run (an
+// n_k x 3 QR each), then only the few effect columns E need a QR over all n rows: O(n e^2)
+// instead of O(n (3 runs + e)^2), the same least-squares solution and span (Frisch-Waugh).
+//
+// An effect column that the baseline absorbs leaves a remainder of rounding size; the QR would
+// scale it back up to unit norm and take it for a direction, so a remainder below 1e-9 of the
+// column's norm (the rank threshold of solve_ls / orthonormal_basis) is set to zero.
+void drop_absorbed(Eigen::MatrixXd& E, const Eigen::VectorXd& norm_before) {
+  for (Eigen::Index j = 0; j < E.cols(); ++j)
+    if (!(E.col(j).norm() > 1e-9 * norm_before[j])) E.col(j).setZero();
+}
+
+// Per-run orthonormal bases of the baseline columns of (whitened) M, rows by `first`/`count`.
+std::vector<Eigen::MatrixXd> baseline_bases(const std::vector<Eigen::Index>& first,
+                                            const std::vector<Eigen::Index>& count,
+                                            const Eigen::MatrixXd& M) {
+  ROTACAL_ASSERT(M.cols() >= static_cast<Eigen::Index>(3 * first.size()));
+  std::vector<Eigen::MatrixXd> q(first.size());
+  for (std::size_t k = 0; k < first.size(); ++k)
+    q[k] = orthonormal_basis(M.block(first[k], static_cast<Eigen::Index>(3 * k), count[k], 3));
+  return q;
+}
+
+const Whitening::Baseline& Whitening::baseline(const Rows& R,
+                                               const Eigen::Ref<const Eigen::MatrixXd>& B) const {
+  if (baseline_.version != version) {
+    baseline_.Bw = (*this)(Eigen::MatrixXd(B));
+    baseline_.qb = baseline_bases(R.run_first, R.run_count, baseline_.Bw);
+    baseline_.version = version;
+  }
+  return baseline_;
+}
+
+void remove_baseline(const std::vector<Eigen::MatrixXd>& qb, const std::vector<Eigen::Index>& first,
+                     const std::vector<Eigen::Index>& count, Eigen::MatrixXd& X) {
+  for (std::size_t k = 0; k < qb.size(); ++k) {
+    auto block = X.middleRows(first[k], count[k]);
+    block -= qb[k] * (qb[k].transpose() * block);
+  }
+}
+
+// Least-squares coefficients of y on [B | E] (both already whitened; qb: B's per-run bases),
+// rows of run k at [first[k], first[k] + count[k]).
+Eigen::VectorXd block_solve(const std::vector<Eigen::Index>& first,
+                            const std::vector<Eigen::Index>& count, const Eigen::MatrixXd& B,
+                            const std::vector<Eigen::MatrixXd>& qb, const Eigen::MatrixXd& E,
+                            const Eigen::VectorXd& y) {
+  const Eigen::Index nb = B.cols(), ne = E.cols();
+  Eigen::VectorXd beta(nb + ne);
+  Eigen::VectorXd r = y;
+  if (ne > 0) {
+    Eigen::MatrixXd Ep = E;
+    const Eigen::VectorXd norms = Ep.colwise().norm().transpose();
+    Eigen::MatrixXd yp = y;
+    remove_baseline(qb, first, count, Ep);
+    remove_baseline(qb, first, count, yp);
+    drop_absorbed(Ep, norms);
+    beta.tail(ne) = solve_ls(Ep, yp.col(0));
+    r -= E * beta.tail(ne);
+  }
+  for (std::size_t k = 0; k < first.size(); ++k)
+    beta.segment(static_cast<Eigen::Index>(3 * k), 3) =
+        solve_ls(B.block(first[k], static_cast<Eigen::Index>(3 * k), count[k], 3),
+                 r.segment(first[k], count[k]));
+  return beta;
+}
+
+// The same for M = [B | E] in one matrix.
+Eigen::VectorXd block_solve(const std::vector<Eigen::Index>& first,
+                            const std::vector<Eigen::Index>& count, const Eigen::MatrixXd& M,
+                            const Eigen::VectorXd& y) {
+  const Eigen::Index nb = static_cast<Eigen::Index>(3 * first.size());
+  return block_solve(first, count, M.leftCols(nb), baseline_bases(first, count, M),
+                     M.rightCols(M.cols() - nb), y);
+}
+
+// Orthonormal basis of the span of whitened model columns [B | E], kept as the per-run bases
+// of the baseline and one of the effect columns with the baseline projected out (orthogonal to
+// them): projecting a column out costs O(n (3 + e)), not O(n (3 runs + e)).
+class ModelBasis {
+ public:
+  ModelBasis(const Rows& R, const Eigen::MatrixXd& Mw)
+      : first_(&R.run_first),
+        count_(&R.run_count),
+        qb_(baseline_bases(R.run_first, R.run_count, Mw)) {
+    const Eigen::Index nb = static_cast<Eigen::Index>(3 * R.runs);
+    Eigen::MatrixXd E = Mw.rightCols(Mw.cols() - nb);
+    const Eigen::VectorXd norms = E.colwise().norm().transpose();
+    remove_baseline(qb_, *first_, *count_, E);
+    drop_absorbed(E, norms);
+    qe_ = orthonormal_basis(E);
+  }
+  /// Dimension of the span.
+  int rank() const {
+    Eigen::Index r = qe_.cols();
+    for (const Eigen::MatrixXd& q : qb_) r += q.cols();
+    return static_cast<int>(r);
+  }
+  /// X less its projection on the span.
+  Eigen::MatrixXd project_out(Eigen::MatrixXd X) const {
+    remove_baseline(qb_, *first_, *count_, X);
+    if (qe_.cols() > 0) X -= qe_ * (qe_.transpose() * X);
+    return X;
+  }
+
+ private:
+  const std::vector<Eigen::Index>* first_;
+  const std::vector<Eigen::Index>* count_;
+  std::vector<Eigen::MatrixXd> qb_;
+  Eigen::MatrixXd qe_;
+};
+
+// Least-squares fits of y on the baseline and subsets of the effect columns, all from one QR:
+// with P the whitened baseline projected out run by run, [P E_w | P y_w] = Q Rf, and the fit on
+// effect columns S leaves |Rf_S x - rf_y|^2 minimised (Q has orthonormal columns), a problem of
+// e + 1 rows instead of n.
+class CompressedFit {
+ public:
+  CompressedFit(const Rows& R, const Eigen::MatrixXd& Mw, const Eigen::VectorXd& yw)
+      : nb_(static_cast<Eigen::Index>(3 * R.runs)) {
+    const std::vector<Eigen::MatrixXd> qb = baseline_bases(R.run_first, R.run_count, Mw);
+    const Eigen::Index e = Mw.cols() - nb_;
+    Eigen::MatrixXd X(Mw.rows(), e + 1);
+    X.leftCols(e) = Mw.rightCols(e);
+    X.col(e) = yw;
+    const Eigen::VectorXd norms = X.colwise().norm().transpose();
+    remove_baseline(qb, R.run_first, R.run_count, X);
+    Eigen::MatrixXd E = X.leftCols(e);
+    drop_absorbed(E, norms.head(e));
+    X.leftCols(e) = E;
+    const Eigen::HouseholderQR<Eigen::MatrixXd> qr(X);
+    const Eigen::Index rows = std::min<Eigen::Index>(X.rows(), e + 1);
+    rf_ = qr.matrixQR().topRows(rows).triangularView<Eigen::Upper>();
+  }
+  /// Whitened residual sum of squares of the fit without the model columns [from, from + count)
+  /// (indices into Mw; effect columns only).
+  double rss_without(Eigen::Index from, Eigen::Index count) const {
+    const Eigen::Index e = rf_.cols() - 1;
+    ROTACAL_ASSERT(from >= nb_ && from + count <= nb_ + e);
+    Eigen::MatrixXd S(rf_.rows(), e - count);
+    Eigen::Index c = 0;
+    for (Eigen::Index j = 0; j < e; ++j)
+      if (j < from - nb_ || j >= from - nb_ + count) S.col(c++) = rf_.col(j);
+    const Eigen::VectorXd ry = rf_.col(e);
+    if (S.cols() == 0) return ry.squaredNorm();
+    return (S * solve_ls(S, ry) - ry).squaredNorm();
+  }
+
+ private:
+  Eigen::Index nb_;
+  Eigen::MatrixXd rf_;
+};
+
+// Blocked cross-validated RMS (um) of predicting y from the columns M = [B | E] (unwhitened,
+// as diagnosis_detail::cv_rms_um, which it equals): refit on all blocks but one of every run
+// by block_solve, predict the left-out rows.
+double cv_rms_um(const Rows& R, const Eigen::MatrixXd& M, const Eigen::VectorXd& y,
+                 const std::vector<int>& fold, int K) {
+  double ss = 0.0;
+  std::size_t n = 0;
+  for (int k = 0; k < K; ++k) {
+    std::vector<Eigen::Index> tr, te;
+    std::vector<Eigen::Index> first(R.runs, 0), count(R.runs, 0);
+    for (std::size_t i = 0; i < fold.size(); ++i) {
+      if (fold[i] == k) {
+        te.push_back(static_cast<Eigen::Index>(i));
+      } else {
+        const std::size_t run = static_cast<std::size_t>(R.run[i]);
+        if (count[run] == 0) first[run] = static_cast<Eigen::Index>(tr.size());
+        ++count[run];
+        tr.push_back(static_cast<Eigen::Index>(i));
+      }
+    }
+    if (te.empty() || tr.empty()) continue;
+    const Eigen::VectorXd d =
+        block_solve(first, count, M(tr, Eigen::placeholders::all), y(tr));
+    ss += (y(te) - M(te, Eigen::placeholders::all) * d).squaredNorm();
+    n += te.size();
+  }
+  return n ? std::sqrt(ss / static_cast<double>(n)) * 1e3 : 0.0;
+}
 
 // Noise sigma (mm) from successive differences within each run: sigma^2 = sum (r_{i+1} -
 // r_i)^2 / (2 (n - 1)). Smooth systematic errors barely move it (the rotary diagnosis' rule);
@@ -388,7 +606,7 @@ struct Chosen {
   double tau = 0.0;                       // spike
   double delay = 0.0;                     // backlash, spike
   double delay_sd = 0.0;                  // its 1 sigma (after the scan)
-  std::pair<double, double> delay_range;  // its delta-chi-square-1 range
+  std::pair<double, double> delay_range = {0.0, 0.0};  // its delta-chi-square-1 range
 };
 
 Eigen::MatrixXd model_columns(const Rows& R, const Eigen::MatrixXd& B,
@@ -416,12 +634,20 @@ struct Gls {
   Eigen::VectorXd beta, r_mm, r_w;
   double rss_w = 0.0;
 };
-Gls gls(const Eigen::MatrixXd& M, const Eigen::VectorXd& y, const Whitening& W) {
+// M = [B | E], B the baseline (whitened once per whitening: Whitening::baseline).
+Gls gls(const Rows& R, const Eigen::MatrixXd& M, const Eigen::VectorXd& y, const Whitening& W) {
   Gls g;
-  const Eigen::MatrixXd Mw = W(M);
+  const Eigen::Index nb = static_cast<Eigen::Index>(3 * R.runs), ne = M.cols() - nb;
+  const Whitening::Baseline& base = W.baseline(R, M.leftCols(nb));
+  const Eigen::MatrixXd Ew = W(M.rightCols(ne));
   const Eigen::VectorXd yw = W(Eigen::MatrixXd(y)).col(0);
-  g.beta = solve_ls(Mw, yw);
-  g.r_w = yw - Mw * g.beta;
+  g.beta = block_solve(R.run_first, R.run_count, base.Bw, base.qb, Ew, yw);
+  g.r_w = yw - Ew * g.beta.tail(ne);
+  for (std::size_t k = 0; k < R.runs; ++k) {
+    const Eigen::Index c = static_cast<Eigen::Index>(3 * k);
+    g.r_w.segment(R.run_first[k], R.run_count[k]) -=
+        base.Bw.block(R.run_first[k], c, R.run_count[k], 3) * g.beta.segment(c, 3);
+  }
   g.r_mm = y - M * g.beta;
   g.rss_w = g.r_w.squaredNorm();
   return g;
@@ -448,36 +674,48 @@ struct Scored {
   bool physical = true;   // a spike sticks outward: h > 0
 };
 
-Scored score_one(const CircularEffect& e, const Eigen::MatrixXd& Jw, const Eigen::MatrixXd& Q,
-                 const Eigen::VectorXd& r_w, int num_free, double min_chi2) {
+// Visibility, F and BIC of entry e against a model whose whitened residuals r_w leave rss0,
+// from the entry's Gram quantities (k <= 2 columns, per unit parameter): G = perp' perp and
+// g = perp' r_w, perp its whitened columns with the model projected out, and Graw = Jw' Jw
+// without. Per plausible size (m) the singular values and right vectors of perp are the square
+// roots and eigenvectors of m G m; the refit along the visible directions A = perp m V
+// (orthogonal columns, squared norms the eigenvalues lambda) removes (v' m g)^2 / lambda each.
+Scored score_gram(const CircularEffect& e, const Eigen::MatrixXd& G, const Eigen::VectorXd& g,
+                  const Eigen::MatrixXd& Graw, double rss0, double n, int num_free,
+                  double min_chi2) {
   Scored s;
   s.effect = e;
   const auto units = e.param_units();
-  Eigen::VectorXd m(Jw.cols());
-  for (Eigen::Index j = 0; j < Jw.cols(); ++j) m[j] = magnitude(units[static_cast<std::size_t>(j)]);
-  const Eigen::MatrixXd raw = Jw * m.asDiagonal();
-  const Eigen::MatrixXd perp = project_out(Q, Jw) * m.asDiagonal();
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(perp, Eigen::ComputeThinV);
+  Eigen::VectorXd m(G.cols());
+  for (Eigen::Index j = 0; j < G.cols(); ++j) m[j] = magnitude(units[static_cast<std::size_t>(j)]);
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(m.asDiagonal() * G * m.asDiagonal());
   const double limit = std::sqrt(min_chi2);
   std::vector<Eigen::Index> dirs;
-  for (Eigen::Index i = 0; i < svd.singularValues().size(); ++i)
-    if (svd.singularValues()[i] >= limit) dirs.push_back(i);
+  for (Eigen::Index i = 0; i < eig.eigenvalues().size(); ++i)
+    if (std::sqrt(std::max(eig.eigenvalues()[i], 0.0)) >= limit) dirs.push_back(i);
   if (dirs.empty()) {
-    Eigen::JacobiSVD<Eigen::MatrixXd> sr(raw);
-    s.absorbed = sr.singularValues().size() && sr.singularValues()[0] >= limit;
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> er(m.asDiagonal() * Graw * m.asDiagonal(),
+                                                            Eigen::EigenvaluesOnly);
+    s.absorbed = er.eigenvalues().size() &&
+                 std::sqrt(std::max(er.eigenvalues().maxCoeff(), 0.0)) >= limit;
     return s;
   }
   s.visible = true;
   s.k = static_cast<int>(dirs.size());
-  Eigen::MatrixXd V(perp.cols(), s.k);
-  for (int i = 0; i < s.k; ++i) V.col(i) = svd.matrixV().col(dirs[static_cast<std::size_t>(i)]);
-  const Eigen::MatrixXd A = perp * V;
-  const Eigen::VectorXd d = solve_ls(A, r_w);
+  const Eigen::VectorXd mg = m.cwiseProduct(g);
+  Eigen::VectorXd d(s.k);
+  Eigen::MatrixXd V(G.cols(), s.k);
+  double explained = 0.0;
+  for (int i = 0; i < s.k; ++i) {
+    const Eigen::Index j = dirs[static_cast<std::size_t>(i)];
+    V.col(i) = eig.eigenvectors().col(j);
+    const double at_r = V.col(i).dot(mg);
+    d[i] = at_r / eig.eigenvalues()[j];
+    explained += at_r * d[i];
+  }
   const Eigen::VectorXd params = m.cwiseProduct(V * d);  // in the entry's units
   if (e.kind == CircularEffectKind::reversal_spike) s.physical = params[0] > 0.0;
-  const double rss0 = r_w.squaredNorm();
-  s.rss1 = std::max((r_w - A * d).squaredNorm(), 1e-300);
-  const double n = static_cast<double>(r_w.size());
+  s.rss1 = std::max(rss0 - explained, 1e-300);
   const int k_bic = s.k + nonlinear_params(e);
   s.delta_bic = n * std::log(s.rss1 / rss0) + k_bic * std::log(n);
   const double dof = n - num_free - k_bic;
@@ -485,6 +723,84 @@ Scored score_one(const CircularEffect& e, const Eigen::MatrixXd& Jw, const Eigen
   s.p = stats::f_sf(std::max(F, 0.0), s.k, dof);
   return s;
 }
+
+// score_gram of entry e (whitened columns Jw) against the model spanned by Q.
+Scored score_one(const CircularEffect& e, const Eigen::MatrixXd& Jw, const ModelBasis& Q,
+                 const Eigen::VectorXd& r_w, int num_free, double min_chi2) {
+  const Eigen::MatrixXd perp = Q.project_out(Jw);
+  return score_gram(e, perp.transpose() * perp, perp.transpose() * r_w, Jw.transpose() * Jw,
+                    r_w.squaredNorm(), static_cast<double>(r_w.size()), num_free, min_chi2);
+}
+
+// The candidates of a forward selection with the noise taken as white (whitening = a scale
+// s), where a round's model grows by one entry. Per variant only k x k and e x k numbers are
+// kept, no column: the model's effect columns enter an orthonormal basis q one entry at a time
+// (baseline projected out, Gram-Schmidt twice against q, a remainder below 1e-9 of the column
+// dropped as in ModelBasis), each variant keeps c = q' s J, and since r_w and q are orthogonal to
+// the baseline, perp' perp = gb - c' c and perp' r_w = s J' r_w - c' (q' r_w), with
+// gb = (P s J)' (P s J) and P the baseline's projector. A round costs O(n k) per variant
+// instead of a projection on the whole model.
+class ScoringPool {
+ public:
+  ScoringPool(const Rows& R, const Whitening& W, const Eigen::MatrixXd& B,
+              const std::vector<const Eigen::MatrixXd*>& variants)
+      : R_(&R), W_(&W), scale_(W.scale), variants_(variants) {
+    ROTACAL_ASSERT(!W.w);
+    qb_ = W.baseline(R, B).qb;
+    for (const Eigen::MatrixXd& q : qb_) rank_ += static_cast<int>(q.cols());
+    q_.resize(static_cast<Eigen::Index>(R.n), 0);
+    for (const Eigen::MatrixXd* J : variants) {
+      Eigen::MatrixXd jb = scale_ * *J;
+      graw_.push_back(jb.transpose() * jb);
+      remove_baseline(qb_, R.run_first, R.run_count, jb);
+      gb_.push_back(jb.transpose() * jb);
+      c_.emplace_back(0, jb.cols());
+    }
+  }
+  /// Add a chosen entry's (unwhitened) columns to the model.
+  void add_to_model(const Eigen::MatrixXd& J) {
+    Eigen::MatrixXd E = (*W_)(J);
+    const Eigen::VectorXd norms = E.colwise().norm().transpose();
+    remove_baseline(qb_, R_->run_first, R_->run_count, E);
+    drop_absorbed(E, norms);
+    for (Eigen::Index j = 0; j < E.cols(); ++j) {
+      Eigen::VectorXd v = E.col(j);
+      for (int pass = 0; pass < 2; ++pass)
+        if (q_.cols() > 0) v -= q_ * (q_.transpose() * v);
+      if (!(norms[j] > 0.0) || !(v.norm() > 1e-9 * norms[j])) continue;
+      v.normalize();
+      q_.conservativeResize(Eigen::NoChange, q_.cols() + 1);
+      q_.col(q_.cols() - 1) = v;
+      ++rank_;
+      for (std::size_t i = 0; i < variants_.size(); ++i) {
+        c_[i].conservativeResize(c_[i].rows() + 1, Eigen::NoChange);
+        c_[i].row(c_[i].rows() - 1) = scale_ * (v.transpose() * *variants_[i]);
+      }
+    }
+  }
+  /// Dimension of the model's span (baseline and chosen entries).
+  int rank() const { return rank_; }
+  /// Variant i of entry e against the model, whose whitened residuals are r_w.
+  Scored score(std::size_t i, const CircularEffect& e, const Eigen::VectorXd& r_w,
+               double min_chi2) const {
+    const Eigen::VectorXd qr = q_.transpose() * r_w;
+    const Eigen::MatrixXd G = gb_[i] - c_[i].transpose() * c_[i];
+    const Eigen::VectorXd g =
+        scale_ * (variants_[i]->transpose() * r_w) - c_[i].transpose() * qr;
+    return score_gram(e, G, g, graw_[i], r_w.squaredNorm(), static_cast<double>(r_w.size()),
+                      rank_, min_chi2);
+  }
+
+ private:
+  const Rows* R_;
+  const Whitening* W_;
+  double scale_;
+  std::vector<const Eigen::MatrixXd*> variants_;
+  std::vector<Eigen::MatrixXd> qb_;
+  Eigen::MatrixXd q_;
+  int rank_ = 0;
+  std::vector<Eigen::MatrixXd> c_, gb_, graw_;
+};
 
 double rms_um(const Eigen::VectorXd& r) { return diagnosis_detail::rms_um(r); }
 
@@ -549,7 +865,7 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session,
 
   std::vector<Chosen> chosen;
   Whitening W;
-  Gls fit = gls(B, R.y, W);  // ordinary least squares first
+  Gls fit = gls(R, B, R.y, W);  // ordinary least squares first
   out.baseline_rms_um = rms_um(fit.r_mm);
   std::set<std::string> absorbed;   // ids absorbed by the model at the last round
   std::set<std::string> invisible;  // ids too small to see at plausible sizes
@@ -557,28 +873,48 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session,
     if (!o.model_noise) return;
     NoiseModel nm = noise_of(R, fit.r_mm);
     W.set(nm);
-    fit = gls(model_columns(R, B, chosen, o.screw_pitch), R.y, W);
+    fit = gls(R, model_columns(R, B, chosen, o.screw_pitch), R.y, W);
   };
   const auto is_chosen = [&](const std::string& id) {
     return std::any_of(chosen.begin(), chosen.end(),
                        [&](const Chosen& c) { return c.effect.id() == id; });
   };
   // Forward selection under the current whitening; `ar`: re-estimate the noise every round.
+  // Every variant's columns, in the order of cands (a pool's variant index).
+  std::vector<const Eigen::MatrixXd*> variant_columns;
+  for (const CircularEffect& e : cands)
+    for (const auto& v : cols[e.id()]) variant_columns.push_back(&v.J);
+  // Forward selection; under white noise (a whitening that stays for every round) through a
+  // ScoringPool, under the AR model (re-estimated every round) by projecting each variant.
   const auto forward = [&](bool ar, int limit, bool record) {
+    std::unique_ptr<ScoringPool> pool;
     for (int round = 0;; ++round) {
       if (ar) refit_noise();
-      const Eigen::MatrixXd Q = orthonormal_basis(W(model_columns(R, B, chosen, o.screw_pitch)));
-      const int num_free = static_cast<int>(Q.cols());
+      std::unique_ptr<ModelBasis> Q;
+      if (W.w) {
+        Q = std::make_unique<ModelBasis>(R, W(model_columns(R, B, chosen, o.screw_pitch)));
+      } else if (!pool) {
+        pool = std::make_unique<ScoringPool>(R, W, B, variant_columns);
+        for (const Chosen& c : chosen)
+          pool->add_to_model(effect_columns(R, c.effect, o.screw_pitch, c.tau, c.delay));
+      }
+      const auto score_variant = [&](std::size_t i, const CircularEffect& e) {
+        return Q ? score_one(e, W(*variant_columns[i]), *Q, fit.r_w, Q->rank(), o.min_visible_chi2)
+                 : pool->score(i, e, fit.r_w, o.min_visible_chi2);
+      };
       std::vector<Scored> scores;
       absorbed.clear();
       invisible.clear();
+      std::size_t variant_index = 0;
       for (const CircularEffect& e : cands) {
+        const auto& cs = cols[e.id()];
+        const std::size_t first_variant = variant_index;
+        variant_index += cs.size();
         if (is_chosen(e.id())) continue;
         Scored best;
         bool have = false;
-        const auto& cs = cols[e.id()];
         for (std::size_t g = 0; g < cs.size(); ++g) {
-          Scored sc = score_one(e, W(cs[g].J), Q, fit.r_w, num_free, o.min_visible_chi2);
+          Scored sc = score_variant(first_variant + g, e);
           sc.tau = cs[g].tau;
           sc.delay = cs[g].delay;
           if (!have || (sc.visible && (!best.visible || sc.rss1 < best.rss1)))
@@ -606,7 +942,9 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session,
         }
       if (!pick) return;
       chosen.push_back({pick->effect, pick->tau, pick->delay});
-      fit = gls(model_columns(R, B, chosen, o.screw_pitch), R.y, W);
+      fit = gls(R, model_columns(R, B, chosen, o.screw_pitch), R.y, W);
+      if (pool)
+        pool->add_to_model(effect_columns(R, pick->effect, o.screw_pitch, pick->tau, pick->delay));
     }
   };
   // Backward elimination under the current noise model: drop the entry whose drop-one test
@@ -616,22 +954,22 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session,
     const double m = static_cast<double>(std::max<std::size_t>(cands.size(), 1));
     while (!chosen.empty()) {
       const double n = static_cast<double>(R.n);
-      const Eigen::MatrixXd Mk = model_columns(R, B, chosen, o.screw_pitch);
+      std::vector<Eigen::Index> offs;
+      const Eigen::MatrixXd Mk = model_columns(R, B, chosen, o.screw_pitch, &offs);
       std::size_t worst = chosen.size();
       double worst_score = -1.0;
-      std::vector<Eigen::Index> offs;
-      model_columns(R, B, chosen, o.screw_pitch, &offs);
+      // Every drop-one refit from one QR of the whitened model (CompressedFit).
+      const CompressedFit drop(R, W(Mk), W(Eigen::MatrixXd(R.y)).col(0));
       for (std::size_t k = 0; k < chosen.size(); ++k) {
-        std::vector<Chosen> others = chosen;
-        others.erase(others.begin() + static_cast<std::ptrdiff_t>(k));
-        const Eigen::MatrixXd Mo = model_columns(R, B, others, o.screw_pitch);
-        const Gls without = gls(Mo, R.y, W);
-        const int kk = static_cast<int>(Mk.cols() - Mo.cols()) + nonlinear_params(chosen[k].effect);
+        const Eigen::Index width =
+            (k + 1 < chosen.size() ? offs[k + 1] : Mk.cols()) - offs[k];
+        const double rss_without = drop.rss_without(offs[k], width);
+        const int kk = static_cast<int>(width) + nonlinear_params(chosen[k].effect);
         const double dof = n - static_cast<double>(Mk.cols()) - 1.0;
-        const double F = ((without.rss_w - fit.rss_w) / kk) / (fit.rss_w / dof);
+        const double F = ((rss_without - fit.rss_w) / kk) / (fit.rss_w / dof);
         const double p = stats::f_sf(std::max(F, 0.0), kk, dof);
         const double dbic =
-            n * std::log(std::max(fit.rss_w, 1e-300) / without.rss_w) + kk * std::log(n);
+            n * std::log(std::max(fit.rss_w, 1e-300) / rss_without) + kk * std::log(n);
         const bool outward =
             chosen[k].effect.kind != CircularEffectKind::reversal_spike || fit.beta[offs[k]] > 0.0;
         const double score =
@@ -642,7 +980,7 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session,
       }
       if (worst_score < 0.0) break;
       chosen.erase(chosen.begin() + static_cast<std::ptrdiff_t>(worst));
-      fit = gls(model_columns(R, B, chosen, o.screw_pitch), R.y, W);
+      fit = gls(R, model_columns(R, B, chosen, o.screw_pitch), R.y, W);
       refit_noise();
     }
   };
@@ -652,8 +990,8 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session,
   //    noise; step 2 corrects that.
   {
     const double sd = difference_sigma(R, fit.r_mm);
-    W.scale = sd > 0.0 ? 1.0 / sd : 1.0;
-    fit = gls(B, R.y, W);
+    W.set_scale(sd > 0.0 ? 1.0 / sd : 1.0);
+    fit = gls(R, B, R.y, W);
   }
   forward(false, o.max_findings + 6, true);
   if (o.model_noise) {
@@ -671,7 +1009,7 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session,
   const auto rss_with = [&](Chosen& c, double* field, double value) {
     const double keep = *field;
     *field = value;
-    const double v = gls(model_columns(R, B, chosen, o.screw_pitch), R.y, W).rss_w;
+    const double v = gls(R, model_columns(R, B, chosen, o.screw_pitch), R.y, W).rss_w;
     *field = keep;
     return v;
   };
@@ -696,14 +1034,19 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session,
   const auto profile_of = [&](std::size_t k) {
     std::vector<Chosen> others = chosen;
     others.erase(others.begin() + static_cast<std::ptrdiff_t>(k));
-    const Eigen::MatrixXd Q = orthonormal_basis(W(model_columns(R, B, others, o.screw_pitch)));
-    const Eigen::VectorXd yw = W(Eigen::MatrixXd(R.y)).col(0);
-    const Eigen::VectorXd r0 = yw - Q * (Q.transpose() * yw);
+    const ModelBasis Q(R, W(model_columns(R, B, others, o.screw_pitch)));
+    const Eigen::VectorXd r0 = Q.project_out(W(Eigen::MatrixXd(R.y))).col(0);
     const CircularEffect e = chosen[k].effect;
-    return [&, Q, r0, e](double tau, double delay) {
-      const Eigen::MatrixXd A = project_out(Q, W(effect_columns(R, e, o.screw_pitch, tau, delay)));
+    // A trial whose columns equal the previous trial's (a delay step that crosses no reading)
+    // has its value: the same computation on the same numbers.
+    auto last = std::make_shared<std::pair<Eigen::MatrixXd, double>>();
+    return [&, Q, r0, e, last](double tau, double delay) {
+      Eigen::MatrixXd J = effect_columns(R, e, o.screw_pitch, tau, delay);
+      if (last->first.size() == J.size() && last->first == J) return last->second;
+      const Eigen::MatrixXd A = Q.project_out(W(J));
       const Eigen::VectorXd d = solve_ls(A, r0);
-      return (r0 - A * d).squaredNorm();
+      *last = {std::move(J), (r0 - A * d).squaredNorm()};
+      return last->second;
     };
   };
   const auto scan_delay = [&](std::size_t k, const std::function<double(double, double)>& f) {
@@ -748,7 +1091,7 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session,
 
   // What the refinement moved may no longer pass (or a spike may no longer stick outward).
   if (o.model_noise) {
-    fit = gls(model_columns(R, B, chosen, o.screw_pitch), R.y, W);
+    fit = gls(R, model_columns(R, B, chosen, o.screw_pitch), R.y, W);
     refit_noise();
     eliminate();
   }
@@ -757,11 +1100,11 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session,
   // Jacobian, the nonlinear ones' from the curvature of the profile (delta chi-square 1).
   std::vector<Eigen::Index> offsets;
   Eigen::MatrixXd M = model_columns(R, B, chosen, o.screw_pitch, &offsets);
-  fit = gls(M, R.y, W);
+  fit = gls(R, M, R.y, W);
   if (o.model_noise) {
     out.noise = noise_of(R, fit.r_mm);
     W.set(out.noise);
-    fit = gls(M, R.y, W);
+    fit = gls(R, M, R.y, W);
   } else {
     out.noise = noise_of(R, fit.r_mm);
   }
@@ -816,7 +1159,7 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session,
     }
     return f;
   }();
-  const double cv_all = diagnosis_detail::cv_rms_um(M, R.y, fold, o.cv_blocks);
+  const double cv_all = cv_rms_um(R, M, R.y, fold, o.cv_blocks);
   // The nonlinear parameters' uncertainty moves the linear ones (a spike's height trades with
   // its delay and tau): each linear parameter's variance gets the square of its half change
   // across the nonlinear parameter's range (tau: +-1 sigma), refitted.
@@ -826,7 +1169,7 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session,
     const Chosen keep = chosen[k];
     chosen[k].tau = tau;
     chosen[k].delay = delay;
-    const Eigen::VectorXd b = gls(model_columns(R, B, chosen, o.screw_pitch), R.y, W).beta;
+    const Eigen::VectorXd b = gls(R, model_columns(R, B, chosen, o.screw_pitch), R.y, W).beta;
     chosen[k] = keep;
     return b;
   };
@@ -876,7 +1219,7 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session,
     std::vector<Chosen> others = chosen;
     others.erase(others.begin() + static_cast<std::ptrdiff_t>(k));
     const Eigen::MatrixXd Mo = model_columns(R, B, others, o.screw_pitch);
-    const Gls without = gls(Mo, R.y, W);
+    const Gls without = gls(R, Mo, R.y, W);
     const double n = static_cast<double>(R.n);
     const int kk = static_cast<int>(M.cols() - Mo.cols()) + nonlinear_params(chosen[k].effect);
     f.gain.rms_before_um = rms_um(without.r_mm);
@@ -884,7 +1227,7 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session,
     f.gain.delta_bic = n * std::log(std::max(fit.rss_w, 1e-300) / without.rss_w) + kk * std::log(n);
     const double F = ((without.rss_w - fit.rss_w) / kk) / (fit.rss_w / dof);
     f.gain.f_pvalue = stats::f_sf(std::max(F, 0.0), kk, dof);
-    f.gain.cv_rms_before_um = diagnosis_detail::cv_rms_um(Mo, R.y, fold, o.cv_blocks);
+    f.gain.cv_rms_before_um = cv_rms_um(R, Mo, R.y, fold, o.cv_blocks);
     f.gain.cv_rms_after_um = cv_all;
     out.findings.push_back(std::move(f));
   }
@@ -893,12 +1236,12 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session,
     out.unobservable.push_back(
         {id, "at plausible sizes it changes these readings by less than 5 sigma in all"});
   // Entries left out that the final model makes invisible: name what absorbs them.
-  const Eigen::MatrixXd Qb = orthonormal_basis(W(B));
+  const ModelBasis Qb(R, W(B));
   for (const CircularEffect& e : cands) {
     if (!absorbed.count(e.id())) continue;
     const Eigen::MatrixXd Jc = W(cols[e.id()].front().J);
-    Scored vs_base = score_one(e, Jc, Qb, Eigen::VectorXd::Zero(Jc.rows()),
-                               static_cast<int>(Qb.cols()), o.min_visible_chi2);
+    Scored vs_base = score_one(e, Jc, Qb, Eigen::VectorXd::Zero(Jc.rows()), Qb.rank(),
+                               o.min_visible_chi2);
     std::string why;
     if (!vs_base.visible) {
       why = "the centre offset and radius of each run absorb its signature in these runs";
@@ -906,9 +1249,8 @@ CircularDiagnosis diagnose_circular(const BallbarSession& session,
       std::string by;
       for (const Chosen& c : chosen) {
         std::vector<Chosen> one = {c};
-        const Eigen::MatrixXd Q1 = orthonormal_basis(W(model_columns(R, B, one, o.screw_pitch)));
-        if (!score_one(e, Jc, Q1, Eigen::VectorXd::Zero(Jc.rows()), static_cast<int>(Q1.cols()),
-                       o.min_visible_chi2)
+        const ModelBasis Q1(R, W(model_columns(R, B, one, o.screw_pitch)));
+        if (!score_one(e, Jc, Q1, Eigen::VectorXd::Zero(Jc.rows()), Q1.rank(), o.min_visible_chi2)
                  .visible)
           by += (by.empty() ? "" : ", ") + c.effect.id();
       }

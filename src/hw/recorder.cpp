@@ -312,8 +312,12 @@ std::string RecordSummary::describe() const {
 
 // ---------------------------------------------------------------------------------- ballbar
 
-RecordSummary record_ballbar(ByteTransport& port, const ProgramTimeline& program, const std::string& path,
-                             const RecordOptions& opt) {
+namespace {
+
+// A ballbar recording against any program with header(), at(t) and duration().
+template <typename Program>
+RecordSummary record_ballbar_program(ByteTransport& port, const Program& program,
+                                     const std::string& path, const RecordOptions& opt) {
   BallbarSession header = program.header();
   header.metadata = {{"recorded_from", port.path()},
                      {"recorded_at", utc_now()},
@@ -329,6 +333,18 @@ RecordSummary record_ballbar(ByteTransport& port, const ProgramTimeline& program
                 },
                 program.duration());
   });
+}
+
+}  // namespace
+
+RecordSummary record_ballbar(ByteTransport& port, const ProgramTimeline& program, const std::string& path,
+                             const RecordOptions& opt) {
+  return record_ballbar_program(port, program, path, opt);
+}
+
+RecordSummary record_ballbar(ByteTransport& port, const CircularTimeline& program,
+                             const std::string& path, const RecordOptions& opt) {
+  return record_ballbar_program(port, program, path, opt);
 }
 
 // ---------------------------------------------------------------------------------- R-test

@@ -257,17 +257,73 @@ bool VirtualBallbar::zero() {
   return true;
 }
 
+namespace {
+
+// The sample frame of a transducer reading `displacement` (mm, from L0 after ZERO) at t.
+Bytes ballbar_sample(double t, std::uint16_t seq, double displacement) {
+  BallbarFrame f;
+  f.seq = seq;
+  f.t_us = static_cast<std::uint32_t>(std::llround(t * 1e6));
+  const double nm = std::round(displacement * 1e6);
+  f.displacement_nm = static_cast<std::int32_t>(std::clamp(nm, -2.0e9, 2.0e9));
+  if (std::abs(displacement) > 1.0) f.status |= kStatusOverRange;  // +-1 mm travel
+  return encode_ballbar_sample(f);
+}
+
+}  // namespace
+
 Bytes VirtualBallbar::sample_frame(double t, std::uint16_t seq) {
   const double L0 = program_.header().ballbar_length;
   const double length =
       predict_lengths(options_.truth, {program_.at(t)})[0] + 1e-3 * options_.noise_um * noise_->gauss(noise_->rng);
-  BallbarFrame f;
-  f.seq = seq;
-  f.t_us = static_cast<std::uint32_t>(std::llround(t * 1e6));
-  const double nm = std::round((length - L0 - zero_mm_) * 1e6);
-  f.displacement_nm = static_cast<std::int32_t>(std::clamp(nm, -2.0e9, 2.0e9));
-  if (std::abs(length - L0 - zero_mm_) > 1.0) f.status |= kStatusOverRange;  // +-1 mm travel
-  return encode_ballbar_sample(f);
+  return ballbar_sample(t, seq, length - L0 - zero_mm_);
+}
+
+// --------------------------------------------------------------------------- circular ballbar
+
+namespace {
+
+const CircularSimulationOptions& checked(const CircularSimulationOptions& o) {
+  check_circular_simulation(o);
+  return o;
+}
+
+}  // namespace
+
+// AR(1) noise, one step per streamed reading: e_k = rho e_{k-1} + sqrt(1 - rho^2) sigma z_k,
+// started from its stationary distribution.
+struct VirtualCircularBallbar::Noise {
+  std::mt19937_64 rng;
+  std::normal_distribution<double> gauss{0.0, 1.0};
+  bool started = false;
+  double e = 0.0;  // mm
+  double next(double rho, double sigma_mm) {
+    const double z = gauss(rng);
+    e = started ? rho * e + std::sqrt(1.0 - rho * rho) * sigma_mm * z : sigma_mm * z;
+    started = true;
+    return e;
+  }
+};
+
+VirtualCircularBallbar::VirtualCircularBallbar(CircularTimeline program,
+                                               const VirtualCircularBallbarOptions& options)
+    : VirtualInstrument(options.baud, options.speed, options.rate_hz, options.faults),
+      program_(std::move(program)),
+      bar_(program_.plan().plan, checked(options.sim)),
+      noise_(std::make_shared<Noise>()) {
+  noise_->rng.seed(options.sim.seed);
+}
+
+bool VirtualCircularBallbar::zero() {
+  zero_mm_ = circular_exact_reading(program_, bar_, now()) - program_.header().ballbar_length;
+  return true;
+}
+
+Bytes VirtualCircularBallbar::sample_frame(double t, std::uint16_t seq) {
+  const CircularSimulationOptions& o = bar_.options;
+  const double length =
+      circular_exact_reading(program_, bar_, t) + noise_->next(o.noise_rho, 1e-3 * o.noise_um);
+  return ballbar_sample(t, seq, length - program_.header().ballbar_length - zero_mm_);
 }
 
 // --------------------------------------------------------------------------- R-test

@@ -27,6 +27,7 @@
 #include <cstdint>
 
 #include "rotacal/ballbar/circular_test.hpp"
+#include "rotacal/ballbar/circular_timeline.hpp"
 
 namespace rotacal {
 
@@ -61,5 +62,26 @@ struct CircularSimulationOptions {
 /// constant, a negative servo time constant, noise outside [0, 1000] um or rho outside [0, 1).
 BallbarSession simulate_circular(const CircularPlanResult& plan,
                                  const CircularSimulationOptions& options);
+
+/// The checks simulate_circular makes of its options (InvalidArgument naming the field).
+void check_circular_simulation(const CircularSimulationOptions& options);
+
+/// The bar between the actual pivot and the ball on a machine with `options`' errors.
+struct CircularBar {
+  CircularBar(const CircularTestPlan& plan, const CircularSimulationOptions& options);
+  /// Noise-free reading (mm) with the linear axes at actual positions a (mm, before the
+  /// geometric errors): |ball - pivot| + length error.
+  double reading(const Eigen::Vector3d& a) const;
+  CircularSimulationOptions options;
+  Eigen::Vector3d tool;         ///< ball - commanded axes at rotary zero, mm
+  Eigen::Vector3d centre_axes;  ///< commanded axes at the circle's centre, mm
+  Eigen::Vector3d pivot;        ///< actual pivot (nominal centre + centring error), mm
+};
+
+/// Noise-free reading (mm) at program time t of the circular program: on a run (run-in, data
+/// arc, overshoot) exactly simulate_circular's reading at that time; elsewhere (moves between
+/// runs, dwells, remounts) the axes at the commanded point with the geometric errors only
+/// (no servo lag, backlash or spike). What a virtual ballbar plays (hw/virtual_instrument.hpp).
+double circular_exact_reading(const CircularTimeline& timeline, const CircularBar& bar, double t);
 
 }  // namespace rotacal

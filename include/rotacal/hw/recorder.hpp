@@ -9,6 +9,7 @@
 #include <functional>
 #include <string>
 
+#include "rotacal/ballbar/circular_timeline.hpp"
 #include "rotacal/ballbar/timeline.hpp"
 #include "rotacal/hw/pose_window.hpp"
 #include "rotacal/hw/probe_protocol.hpp"
@@ -70,6 +71,11 @@ struct RecordOptions {
 /// length = L0 + displacement. Metadata names the port; stops at END, on the callback's
 /// request, on disconnect or silence, always leaving a valid file at `path`.
 RecordSummary record_ballbar(ByteTransport& port, const ProgramTimeline& program,
+                             const std::string& path, const RecordOptions& options = {});
+/// The same for an ISO 230-4 circular program: rows on a data arc get the run's label
+/// (circular_XY_ccw, ...), every other row "transition" (circular_timeline.hpp), so the file is
+/// what `rotacal circular analyze` reads.
+RecordSummary record_ballbar(ByteTransport& port, const CircularTimeline& program,
                              const std::string& path, const RecordOptions& options = {});
 
 /// Record an R-test. `program` holds the commanded rows (set-up, time, B, C, X, Y, Z) and the

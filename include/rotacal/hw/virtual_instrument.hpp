@@ -15,6 +15,8 @@
 #include <string>
 #include <thread>
 
+#include "rotacal/ballbar/circular_simulate.hpp"
+#include "rotacal/ballbar/circular_timeline.hpp"
 #include "rotacal/ballbar/model.hpp"
 #include "rotacal/ballbar/timeline.hpp"
 #include "rotacal/hw/frame.hpp"
@@ -147,6 +149,37 @@ class VirtualBallbar final : public VirtualInstrument {
   Bytes sample_frame(double t, std::uint16_t seq) override;
   ProgramTimeline program_;
   VirtualBallbarOptions options_;
+  struct Noise;
+  std::shared_ptr<Noise> noise_;
+  double zero_mm_ = 0.0;  ///< displacement subtracted after ZERO
+};
+
+struct VirtualCircularBallbarOptions {
+  /// The machine's linear-axis errors, centring error, bar length error, and the noise: AR(1)
+  /// with correlation noise_rho between successive streamed readings and marginal sigma
+  /// noise_um, seeded (circular_simulate.hpp).
+  CircularSimulationOptions sim;
+  double rate_hz = 250.0;  ///< default sample rate (the host may send RATE)
+  double speed = 1.0;      ///< virtual seconds per wall-clock second
+  int baud = 115200;
+  FaultInjection faults;
+};
+
+/// The same ballbar transducer on a machine running an ISO 230-4 circular program
+/// (circular_timeline.hpp): every sample is circular_exact_reading at that instant plus the
+/// AR(1) noise. Throws InvalidArgument for the options simulate_circular refuses.
+class VirtualCircularBallbar final : public VirtualInstrument {
+ public:
+  VirtualCircularBallbar(CircularTimeline program, const VirtualCircularBallbarOptions& options);
+  ~VirtualCircularBallbar() override { halt(); }
+
+ private:
+  std::string identity() const override { return "rotacal-virtual-ballbar 1.0"; }
+  bool zero() override;
+  double stream_end() const override { return program_.duration(); }
+  Bytes sample_frame(double t, std::uint16_t seq) override;
+  CircularTimeline program_;
+  CircularBar bar_;
   struct Noise;
   std::shared_ptr<Noise> noise_;
   double zero_mm_ = 0.0;  ///< displacement subtracted after ZERO
