@@ -262,48 +262,9 @@ class Writer {
   }
 
   void prologue() {
-    if (o_.decimals < 0 || o_.decimals > 9)
-      throw InvalidArgument("write_nc_program: decimals must be in 0..9, got " +
-                            std::to_string(o_.decimals));
-    if (o_.tool < 0) throw InvalidArgument("write_nc_program: tool must be >= 0");
-    if ((d_ == NcDialect::heidenhain || d_ == NcDialect::fanuc) && o_.tool == 0)
-      throw InvalidArgument("write_nc_program: the " + to_string(d_) +
-                            " TCP program needs a tool number (tool = 0 given)");
-    switch (d_) {
-      case NcDialect::linuxcnc:
-        header();
-        line("G21 G90 G94 G17 G40 G49 G80");
-        // A head machine's machine-axis program already holds the tool vector (formats.md).
-        if (o_.tool > 0 && !plan_.setup.machine.has_head()) line("G43 H" + std::to_string(o_.tool));
-        break;
-      case NcDialect::heidenhain: {
-        if (o_.program_name.empty() || o_.program_name.find_first_of(" \t\n;") != std::string::npos)
-          throw InvalidArgument("write_nc_program: program_name must be one word, got '" +
-                                o_.program_name + "'");
-        line("BEGIN PGM " + o_.program_name + " MM");
-        header();
-        line("FUNCTION RESET TCPM");
-        line("TOOL CALL " + std::to_string(o_.tool) + " Z");
-        break;
-      }
-      case NcDialect::siemens:
-        header();
-        line("TRAFOOF");
-        line("G71 G90 G94 G17 G40 G64");
-        if (o_.tool > 0) line("T" + std::to_string(o_.tool) + " D1");
-        break;
-      case NcDialect::fanuc: {
-        if (o_.program_number < 1 || o_.program_number > 9999)
-          throw InvalidArgument("write_nc_program: program_number must be in 1..9999");
-        line("%");
-        char o[16];
-        std::snprintf(o, sizeof o, "O%04d", o_.program_number);
-        line(std::string(o) + " (ROTACAL BALLBAR)");
-        header();
-        line("G21 G90 G94 G17 G40 G49 G80");
-        break;
-      }
-    }
+    nc_detail::write_preamble(
+        d_, o_, {"write_nc_program", "TCP program", "ROTACAL BALLBAR", plan_.setup.machine.has_head()},
+        [this](const std::string& s) { line(s); }, [this] { header(); });
   }
 
   // Rapid to the first point, TCPM off, rotary axes first: no ballbar is mounted yet.

@@ -247,6 +247,13 @@ VirtualBallbar::VirtualBallbar(ProgramTimeline program, const VirtualBallbarOpti
   if (!(options.noise_um >= 0.0)) throw InvalidArgument("virtual ballbar: noise_um must be >= 0");
   if (options.truth.machine != program_.header().machine)
     throw InvalidArgument("virtual ballbar: the machine model and the program are for different machines");
+  // It reads one commanded pose at a time, without the motion that led there: an effect of
+  // the motion itself would be played as zero, so it is refused rather than left out.
+  for (const Effect& f : options.truth.effects.effects)
+    if (f.depends_on_motion())
+      throw InvalidArgument("virtual ballbar: " + f.id() +
+                            " depends on the motion, which the virtual ballbar does not play yet; "
+                            "rotacal simulate ballbar does");
   noise_->rng.seed(options.seed);
 }
 

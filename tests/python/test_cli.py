@@ -184,3 +184,9 @@ def test_rotary_tests_both_ways_at_two_feeds_find_backlash_and_servo_lag(tmp_pat
     for option, value in (("--feed-factors", "2,1"), ("--directions", "up"), ("--feed-factors", "1,x")):
         r = rotacal("plan", "ballbar", option, value, "-o", tmp_path / "bad.ngc")
         assert r.returncode == 3 and (option in r.stderr or value in r.stderr), r.stderr
+
+
+def test_virtual_ballbar_refuses_motion_effects(tmp_path):
+    # It plays one commanded pose at a time: backlash would silently read as zero.
+    r = rotacal("virtual", "ballbar", "--effect", "backlash_C=4e-5", "--exit-when-done")
+    assert r.returncode == 3 and "backlash_C" in r.stderr, r.stderr
