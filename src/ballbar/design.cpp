@@ -579,6 +579,24 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session,
           cands.push_back({s, false});
         }
     }
+  // Effects of the motion itself show in a tangential test run both ways (backlash and lag
+  // against the zero offset) and at a second feed (servo lag, proportional to the speed,
+  // against backlash): those runs from the session's pivot.
+  bool motion_pair = false;
+  for (const std::string& id : D.effects) motion_pair = motion_pair || Effect::parse(id).depends_on_motion();
+  if (motion_pair)
+    for (double L : o.bar_lengths_mm)
+      for (BallbarTest t : {BallbarTest::tangential_c, BallbarTest::tangential_tilt})
+        for (const std::vector<double>& feeds : {std::vector<double>{1.0}, std::vector<double>{1.0, 2.0}}) {
+          BallbarSetup s = base;
+          s.ballbar_length = L;
+          s.pivot = session.pivot;
+          s.tests = {t};
+          s.tilt_range_deg = lim;
+          s.directions = {SweepDirection::ccw, SweepDirection::cw};
+          s.feed_factors = feeds;
+          cands.push_back({s, false});
+        }
   const double deg = M_PI / 180.0;
   for (double r : o.pivot_radius_mm)
     for (double ang : o.pivot_angle_deg)
@@ -623,7 +641,11 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session,
     const Eigen::MatrixXd Ia = Jm.transpose() * Jm * w;
     Eigen::MatrixXd I0 = Eigen::MatrixXd::Zero(p, p);
     I0.topLeftCorner(p0, p0) = Is;
-    for (double slow = 1.0; duration * slow <= o.max_added_time_s * (1 + 1e-12); slow *= 2.0) {
+    // Slowing a test down gathers more readings of the same signature, except where the
+    // signature depends on the speed: runs at set feeds are taken as planned.
+    const bool set_feeds = setup.directions.size() > 1 || setup.feed_factors.size() > 1;
+    for (double slow = 1.0; duration * slow <= o.max_added_time_s * (1 + 1e-12) && (slow == 1.0 || !set_feeds);
+         slow *= 2.0) {
       const Eigen::MatrixXd I = I0 + slow * Ia;
       const Inverted inv = invert_information(I, plausible.head(p), 1.0 / D.effective_per_reading);
       SeparatingCandidate c;
@@ -660,11 +682,19 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session,
     std::ostringstream d;
     const std::string label = test_label(c.setup.tests.back(), m);
     const bool tilt_test = c.setup.tests.back() == BallbarTest::radial_tilt ||
-                           c.setup.tests.back() == BallbarTest::axial_tilt;
+                           c.setup.tests.back() == BallbarTest::axial_tilt ||
+                           c.setup.tests.back() == BallbarTest::tangential_tilt;
     d << label;
     if (tilt_test) d << " over " << deg_range(c.setup.tilt_range_deg);
     if (c.setup.tests.back() == BallbarTest::radial_c)
       d << " (tool circle " << to_string(c.setup.radial_c_side) << ")";
+    if (c.setup.directions.size() > 1) d << " ccw and cw";
+    if (c.setup.feed_factors.size() > 1) {
+      d << " at";
+      for (std::size_t k = 0; k < c.setup.feed_factors.size(); ++k)
+        d << (k ? ", " : " ") << fmt(c.setup.feed_mm_per_min * c.setup.feed_factors[k], 0);
+      d << " mm/min";
+    }
     d << " with the " << fmt(c.setup.ballbar_length, 0) << " mm bar";
     if (c.new_pivot)
       d << ", pivot moved to " << vec_text(c.setup.pivot)

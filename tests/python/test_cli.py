@@ -190,3 +190,17 @@ def test_virtual_ballbar_refuses_motion_effects(tmp_path):
     # It plays one commanded pose at a time: backlash would silently read as zero.
     r = rotacal("virtual", "ballbar", "--effect", "backlash_C=4e-5", "--exit-when-done")
     assert r.returncode == 3 and "backlash_C" in r.stderr, r.stderr
+
+
+def test_design_tries_both_ways_and_two_feeds_for_backlash_against_servo_lag(tmp_path):
+    # One feed both ways: the pair is one signature. A second feed separates them only to a
+    # correlation of (1 + k) / sqrt(2 (1 + k^2)) (docs/effects.md), so the design names the
+    # closest test and says that none reaches 0.5.
+    tests = "sphere_xy,sphere_yz,sphere_zx,radial_A,axial_C,radial_C,axial_A,tangential_C"
+    assert rotacal("simulate", "ballbar", "--errors", "table2", "--tests", tests, "--directions", "ccw,cw",
+                   "--step", "2", "--effect", "backlash_C=4e-5", "--seed", "5", "-o", tmp_path / "one.csv").returncode == 0
+    r = rotacal("design", "ballbar", "--separate", "backlash_C,servo_lag_C", "--after", tmp_path / "one.csv")
+    assert r.returncode == 0, r.stderr
+    assert "none of" in r.stdout and "ccw and cw at 1000, 2000 mm/min" in r.stdout, r.stdout
+    corr = float(re.search(r"correlation (\d\.\d+)\)", r.stdout).group(1))
+    assert 0.9 <= corr <= 0.99, corr
