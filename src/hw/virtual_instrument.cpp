@@ -247,20 +247,23 @@ VirtualBallbar::VirtualBallbar(ProgramTimeline program, const VirtualBallbarOpti
   if (!(options.noise_um >= 0.0)) throw InvalidArgument("virtual ballbar: noise_um must be >= 0");
   if (options.truth.machine != program_.header().machine)
     throw InvalidArgument("virtual ballbar: the machine model and the program are for different machines");
-  // It reads one commanded pose at a time, without the motion that led there: an effect of
-  // the motion itself would be played as zero, so it is refused rather than left out.
-  for (const Effect& f : options.truth.effects.effects)
-    if (f.depends_on_motion())
-      throw InvalidArgument("virtual ballbar: " + f.id() +
-                            " depends on the motion, which the virtual ballbar does not play yet; "
-                            "rotacal simulate ballbar does");
+  if (static_cast<int>(options.truth.effect_params.size()) != options.truth.effects.num_params())
+    throw InvalidArgument("virtual ballbar: the machine model has " +
+                          std::to_string(options.truth.effect_params.size()) + " effect parameters, its effects need " +
+                          std::to_string(options.truth.effects.num_params()));
   noise_->rng.seed(options.seed);
+}
+
+double VirtualBallbar::exact_length(double t) const {
+  // The pose the program commands at t, moving as it moves there (backlash, servo lag).
+  const BallbarMachineModel& m = options_.truth;
+  return predicted_length<double>(m.machine, m.errors, m.pivot, m.effects, m.effect_params.data(),
+                                  program_.at(t), program_.motion_at(t));
 }
 
 bool VirtualBallbar::zero() {
   // Zero at the current pose (normally done in the calibrator, at L0, before START).
-  const BallbarSample s = program_.at(now());
-  zero_mm_ = predict_lengths(options_.truth, {s})[0] - program_.header().ballbar_length;
+  zero_mm_ = exact_length(now()) - program_.header().ballbar_length;
   return true;
 }
 
@@ -282,7 +285,7 @@ Bytes ballbar_sample(double t, std::uint16_t seq, double displacement) {
 Bytes VirtualBallbar::sample_frame(double t, std::uint16_t seq) {
   const double L0 = program_.header().ballbar_length;
   const double length =
-      predict_lengths(options_.truth, {program_.at(t)})[0] + 1e-3 * options_.noise_um * noise_->gauss(noise_->rng);
+      exact_length(t) + 1e-3 * options_.noise_um * noise_->gauss(noise_->rng);
   return ballbar_sample(t, seq, length - L0 - zero_mm_);
 }
 

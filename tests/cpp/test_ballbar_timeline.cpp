@@ -1,5 +1,8 @@
 #include <catch2/catch.hpp>
 
+#include <cmath>
+
+#include "rotacal/ballbar/motion.hpp"
 #include "rotacal/ballbar/timeline.hpp"
 
 using namespace rotacal;
@@ -43,4 +46,42 @@ TEST_CASE("the move from a ccw run into its cw run belongs to the cw run", "[bal
   const double t_last = plan.segments[1].samples.back().time;
   CHECK(plan.segments[2].kind == SegmentKind::arc_transition);
   CHECK(tl.at(t_last + 1e-3).test == "transition");
+}
+
+TEST_CASE("the program's motion agrees with the motion read back from its recorded rows", "[ballbar][motion]") {
+  // What the virtual ballbar plays (motion_at) and what the fit reads from the file
+  // (rotary_motion of the rows) must be the same motion, or a recorded backlash would be
+  // fitted against a different signature than the one played.
+  BallbarSetup s;
+  s.tests = {BallbarTest::radial_c, BallbarTest::tangential_c, BallbarTest::radial_tilt};
+  s.directions = {SweepDirection::ccw, SweepDirection::cw};
+  s.feed_factors = {1.0, 2.0};
+  s.step_deg = 5.0;
+  const ProgramTimeline tl(plan_ballbar_test(s));
+  std::vector<BallbarSample> rows;
+  for (double t = 0.0; t <= tl.duration(); t += 0.01) {
+    BallbarSample x = tl.at(t);
+    if (x.test != "transition") rows.push_back(x);
+  }
+  const std::vector<RotaryMotion> read = rotary_motion(rows);
+  int compared = 0, reversals = 0;
+  for (std::size_t i = 1; i + 1 < rows.size(); ++i) {
+    // Away from the ends of a run, where the rows' one-sided differences see one block only.
+    if (rows[i - 1].test != rows[i].test || rows[i + 1].test != rows[i].test) continue;
+    const RotaryMotion played = tl.motion_at(rows[i].time);
+    INFO(rows[i].test << " at t = " << rows[i].time);
+    CHECK(played.direction.rot == read[i].direction.rot);
+    CHECK(played.direction.tilt == read[i].direction.tilt);
+    CHECK(played.rate.rot == Approx(read[i].rate.rot).margin(1e-9));
+    CHECK(played.rate.tilt == Approx(read[i].rate.tilt).margin(1e-9));
+    // The rows place a reversal at the first row after it: up to one row interval late.
+    if (std::isfinite(played.since_reversal.rot)) {
+      ++reversals;
+      CHECK(played.since_reversal.rot - read[i].since_reversal.rot >= -1e-9);
+      CHECK(played.since_reversal.rot - read[i].since_reversal.rot <= 0.01 + 1e-9);
+    }
+    ++compared;
+  }
+  CHECK(compared > 1000);
+  CHECK(reversals > 100);
 }

@@ -186,12 +186,6 @@ def test_rotary_tests_both_ways_at_two_feeds_find_backlash_and_servo_lag(tmp_pat
         assert r.returncode == 3 and (option in r.stderr or value in r.stderr), r.stderr
 
 
-def test_virtual_ballbar_refuses_motion_effects(tmp_path):
-    # It plays one commanded pose at a time: backlash would silently read as zero.
-    r = rotacal("virtual", "ballbar", "--effect", "backlash_C=4e-5", "--exit-when-done")
-    assert r.returncode == 3 and "backlash_C" in r.stderr, r.stderr
-
-
 def test_design_tries_both_ways_and_two_feeds_for_backlash_against_servo_lag(tmp_path):
     # One feed both ways: the pair is one signature. A second feed separates them only to a
     # correlation of (1 + k) / sqrt(2 (1 + k^2)) (docs/effects.md), so the design names the

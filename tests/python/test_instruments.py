@@ -233,3 +233,24 @@ def test_virtual_instrument_stops_on_a_signal_even_when_started_with_sigint_igno
         raise
     assert v.proc.returncode == 0, err
     assert "frames" in err  # the summary it prints on stopping
+
+
+def test_recorded_backlash_and_servo_lag_are_found(tmp_path):
+    # The virtual ballbar plays the motion (ProgramTimeline::motion_at); the fit reads it back
+    # from the recorded time and angle columns (rotary_motion): the same backlash and lag.
+    plan = ["--tests", "sphere_xy,sphere_yz,sphere_zx,radial_A,axial_C,radial_C,axial_A,tangential_C",
+            "--directions", "ccw,cw", "--feed-factors", "1,2", "--step", "5", "--rate", "20"]
+    v = Virtual("ballbar", *plan, "--speed", "60", "--effect", "backlash_C=4e-5", "--effect", "servo_lag_C=3e-4",
+                "--exit-when-done")
+    r = rotacal_cli("record", "ballbar", "--port", v.port, *plan, *PATIENT, "-o", tmp_path / "s.csv", "--json",
+                    "--no-progress")
+    v.close()
+    assert r.returncode == 0, r.stderr
+    assert json.loads(r.stdout)["lost"] == 0
+    d = rotacal_cli("diagnose", tmp_path / "s.csv", "--json", "--no-budget")
+    assert d.returncode == 0, d.stderr
+    found = {f["effect"]: next(iter(f["parameters"].values())) for f in json.loads(d.stdout)["findings"]}
+    # 4 sigma: the rows depend on the host's timing, so the noise draw is not reproducible.
+    for effect, value in (("backlash_C", 4e-5), ("servo_lag_C", 3e-4)):
+        assert effect in found, list(found)
+        assert abs(found[effect]["value"] - value) <= 4 * found[effect]["std"], (effect, found[effect])

@@ -147,6 +147,7 @@ class VirtualBallbar final : public VirtualInstrument {
   bool zero() override;
   double stream_end() const override { return program_.duration(); }
   Bytes sample_frame(double t, std::uint16_t seq) override;
+  double exact_length(double t) const;  ///< noise-free reading of the program at t, mm
   ProgramTimeline program_;
   VirtualBallbarOptions options_;
   struct Noise;
