@@ -368,8 +368,19 @@ def _add_plausibility_arg(q: argparse.ArgumentParser) -> None:
                    f"refused as implausible (default {_core.PlausibilityOptions().max_length_deviation_mm:g} mm)")
 
 
+# How identify prints a parameter of each unit: (factor, shown unit). Effects bring units
+# other than mm and rad (a servo lag in s, a log time constant in 1, a drift in mm/s).
+_SHOWN = {"rad": (1e6, "urad"), "mm": (1e3, "um  "), "s": (1e3, "ms  "), "mm/s": (1e3, "um/s"),
+          "rad/rad": (1e6, "urad/rad"), "mm/mm": (1e6, "um/m"), "1": (1.0, "    ")}
+
+
+def _shown(unit: str) -> tuple[float, str]:
+    return _SHOWN.get(unit, (1.0, unit))
+
+
 def _fmt_value(v, unit: str) -> str:
-    return f"{v * 1e6:+9.3f} urad" if unit == "rad" else f"{v * 1e3:+9.3f} um  "
+    factor, shown = _shown(unit)
+    return f"{v * factor:+9.3f} {shown}"
 
 
 def _print_noise_model(nm: dict) -> None:
@@ -404,7 +415,7 @@ def _print_identification(d: dict) -> None:
         if p["value"] is None:
             print(f"  {name:6s}  unobservable")
             continue
-        line = f"  {name:6s} {_fmt_value(p['value'], p['unit'])} +- {p['std'] * (1e6 if p['unit'] == 'rad' else 1e3):.3f}"
+        line = f"  {name:6s} {_fmt_value(p['value'], p['unit'])} +- {p['std'] * _shown(p['unit'])[0]:.3f}"
         print(line)
     for axis, p in d.get("pivot", {}).items():
         print(f"  pivot {axis}  " + ("unobservable" if p["value"] is None else f"{p['value']:.4f} mm +- {p['std'] * 1e3:.3f} um"))
@@ -413,7 +424,7 @@ def _print_identification(d: dict) -> None:
             what = f"{eff['id']} ({eff['cause']})"
             print(f"  {what}: " + ("unobservable" if p["value"] is None
                                    else f"{pname} = {_fmt_value(p['value'], p['unit']).strip()} +- "
-                                        f"{p['std'] * (1e6 if p['unit'] == 'rad' else 1e3):.3f}"))
+                                        f"{p['std'] * _shown(p['unit'])[0]:.3f}"))
     for u in d["unobservable"]:
         print(f"  not determined by these tests: {u}")
     for n in d.get("notes", []):

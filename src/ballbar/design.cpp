@@ -148,6 +148,13 @@ BallbarDesign design_ballbar_test(const BallbarDesignOptions& o) {
   if (!(o.noise_um > 0.0)) throw InvalidArgument("design: --noise must be > 0 um");
   if (!(o.reference_radius_mm > 0.0))
     throw InvalidArgument("design: the reference radius must be > 0 mm");
+  // The design runs each path slower to fill the time budget, which changes what a motion
+  // effect does: those are refused here rather than predicted wrongly.
+  for (const Effect& f : o.effects_of_concern.effects)
+    if (f.depends_on_motion())
+      throw InvalidArgument("design: " + f.id() +
+                            " depends on the speed, which the design changes to fill the time; it is "
+                            "not designed for yet (use --separate after a session with both directions)");
   if (!(o.noise_rho >= 0.0 && o.noise_rho <= 0.999))
     throw InvalidArgument("design: --rho must be in [0, 0.999]");
   if (!(o.time_budget_s >= 0.0) || !std::isfinite(o.time_budget_s))

@@ -124,7 +124,10 @@ void validate(const BallbarSetup& s) {
             "feed factor " + format_number_or_nan(k) +
                 " (--feed-factors) must be in (0, 100] with the feeds within 1e6 per min");
     for (std::size_t j = 0; j < i; ++j)
-      require(s.feed_factors[j] != k, "feed factor " + format_number_or_nan(k) + " is listed twice (--feed-factors)");
+      require(run_label(BallbarTest::radial_c, SweepDirection::ccw, s.feed_factors[j], s) !=
+                  run_label(BallbarTest::radial_c, SweepDirection::ccw, k, s),
+              "feed factor " + format_number_or_nan(k) +
+                  " is listed twice or gives the same run label as another (--feed-factors)");
   }
 }
 

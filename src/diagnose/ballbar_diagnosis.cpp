@@ -25,11 +25,14 @@ std::vector<Effect> BallbarDiagnosisProblem::candidates(int max_harmonic) const 
   // An axis' motion effects are candidates only where it moved both ways: in one direction
   // (every test of the standard plan) each is a constant angle offset, the zero offset that
   // no radial or axial test sees, and testing them would only cost time.
+  // Only the tests count: a recording keeps its transitions, which turn the axes back to 0.
   bool both_ways[2] = {false, false};
   for (int k = 0; k < 2; ++k) {
     bool up = false, down = false;
-    for (const RotaryMotion& m : arrays_.motion) {
-      const double d = k == 0 ? m.direction.tilt : m.direction.rot;
+    for (std::size_t i = 0; i < arrays_.motion.size(); ++i) {
+      if (arrays_.test[i] == "transition") continue;
+      const RotaryMotion& m = arrays_.motion[i];
+      const double d = k == 0 ? m.rate.tilt : m.rate.rot;
       up = up || d > 0.0;
       down = down || d < 0.0;
     }

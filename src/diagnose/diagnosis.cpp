@@ -7,6 +7,7 @@
 #include <functional>
 #include <cmath>
 #include <map>
+#include <set>
 #include <memory>
 #include <sstream>
 
@@ -82,14 +83,18 @@ std::vector<ParameterEstimate> parameters_of(const ModelFit& fit, const Effect& 
 // One level per noise stream, shared by the runs of one test (radial_C, radial_C_cw,
 // radial_C_f2000, test_of_run): they follow each other with the bar in place, so a wander does
 // not start afresh between them, and a step between them (backlash, servo lag) is a signal.
+// A label is taken for a run only where the test it names is itself a group of the session
+// (a user's "sphere_f1" or an R-test set-up "nest_cw" keeps its own level).
 Eigen::MatrixXd stream_levels(const DiagnosisProblem& P) {
   const auto streams = noise_streams(P.groups(), P.times());
+  const std::set<std::string> groups(P.groups().begin(), P.groups().end());
   std::map<std::string, int> column;  // test of the stream's group, and its k-th stream there
   std::map<std::string, int> seen;
   std::vector<int> col_of(streams.size());
   for (std::size_t s = 0; s < streams.size(); ++s) {
     const std::string& g = P.groups()[static_cast<std::size_t>(streams[s].front())];
-    const std::string key = test_of_run(g) + "#" + std::to_string(seen[g]++);
+    const std::string test = test_of_run(g);
+    const std::string key = (groups.count(test) ? test : g) + "#" + std::to_string(seen[g]++);
     const auto it = column.emplace(key, static_cast<int>(column.size())).first;
     col_of[s] = it->second;
   }

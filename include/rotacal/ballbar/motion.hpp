@@ -19,9 +19,9 @@ namespace rotacal {
 ///    is one continuous move and the rows between tests are not on record;
 ///  - direction: the sign of the rate, carried over rows at rest (the axis stays on the side of
 ///    its lost motion it last moved to);
-///  - since_reversal: time since the first row of the last move whose direction was opposite
-///    to the one before it; the reversal is placed there because the recorded rows are all
-///    that is known of the path.
+///  - since_reversal: time since the axis last turned round: where the lines through the last
+///    row of the old direction and the first of the new, at their rates, meet (the vertex of a
+///    program's piecewise-linear path), within those two rows' times.
 /// A rate below 1e-9 rad/s counts as rest.
 std::vector<RotaryMotion> rotary_motion(const std::vector<BallbarSample>& samples);
 
