@@ -4,6 +4,9 @@
 
 #include <ceres/jet.h>
 
+
+#include "candidate_jets.hpp"
+
 namespace rotacal {
 
 BallbarDiagnosisProblem::BallbarDiagnosisProblem(BallbarSession session, BallbarSession reference)
@@ -63,33 +66,68 @@ ModelFit BallbarDiagnosisProblem::fit(const EffectModel& effects) const {
   return f;
 }
 
-Eigen::MatrixXd BallbarDiagnosisProblem::jacobian_on(const std::vector<BallbarSample>& samples,
-                                                     const std::vector<RotaryMotion>& motion,
-                                                     const ModelFit& at,
-                                                     const Effect& candidate) const {
-  using J4 = ceres::Jet<double, 4>;
-  const int k = candidate.num_params();
-  // Current model with its parameter values as constants, the candidate's at zero, seeded.
+namespace {
+
+// d L / d (the seeded parameters of `candidate`) on `samples`: Jets of width N through the
+// one length model, the current model's values as constants, the candidate appended with its
+// parameters at 0 (candidate_jets.hpp).
+template <int N>
+Eigen::MatrixXd length_jets(MachineType m, const std::vector<BallbarSample>& samples,
+                            const std::vector<RotaryMotion>& motion, const ModelFit& at,
+                            const Effect& candidate, const std::vector<int>& seed) {
+  using Jet = ceres::Jet<double, N>;
   EffectModel fx = at.effects;
   fx.effects.push_back(candidate);
-  std::vector<J4> p;
-  LocationErrors<J4> e;
-  for (int i = 0; i < 8; ++i) e.v[i] = J4(at.parameters[static_cast<std::size_t>(i)].value);
-  const Vec3<J4> pivot(J4(at.parameters[8].value), J4(at.parameters[9].value),
-                       J4(at.parameters[10].value));
+  LocationErrors<Jet> e;
+  for (int i = 0; i < 8; ++i) e.v[i] = Jet(at.parameters[static_cast<std::size_t>(i)].value);
+  const Vec3<Jet> pivot(Jet(at.parameters[8].value), Jet(at.parameters[9].value), Jet(at.parameters[10].value));
+  std::vector<Jet> p;
   for (std::size_t i = 11; i < at.parameters.size(); ++i) p.emplace_back(at.parameters[i].value);
-  for (int i = 0; i < k; ++i) p.emplace_back(0.0, i);
-  Eigen::MatrixXd out(static_cast<Eigen::Index>(samples.size()), k);
+  const std::size_t first = p.size();
+  p.resize(first + static_cast<std::size_t>(candidate.num_params()), Jet(0.0));
+  for (std::size_t k = 0; k < seed.size(); ++k) p[first + static_cast<std::size_t>(seed[k])] = Jet(0.0, static_cast<int>(k));
+  Eigen::MatrixXd out(static_cast<Eigen::Index>(samples.size()), static_cast<Eigen::Index>(seed.size()));
   for (std::size_t r = 0; r < samples.size(); ++r) {
-    const J4 L = predicted_length<J4>(session_.machine, e, pivot, fx, p.data(), samples[r], motion[r]);
-    for (int i = 0; i < k; ++i) out(static_cast<Eigen::Index>(r), i) = L.v[i];
+    const Jet L = predicted_length<Jet>(m, e, pivot, fx, p.data(), samples[r], motion[r]);
+    for (std::size_t k = 0; k < seed.size(); ++k)
+      out(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(k)) = L.v[static_cast<Eigen::Index>(k)];
   }
   return out;
+}
+
+// jets(width, effect, seed) for candidate_jets.hpp.
+auto jets_on(MachineType m, const std::vector<BallbarSample>& samples, const std::vector<RotaryMotion>& motion,
+             const ModelFit& at) {
+  return [&, m](auto width, const Effect& effect, const std::vector<int>& seed) {
+    return length_jets<decltype(width)::value>(m, samples, motion, at, effect, seed);
+  };
+}
+
+}  // namespace
+
+Eigen::MatrixXd BallbarDiagnosisProblem::jacobian_on(const std::vector<BallbarSample>& samples,
+                                                     const std::vector<RotaryMotion>& motion,
+                                                     const ModelFit& at, const Effect& candidate) const {
+  return diagnosis_detail::candidate_jacobian_by_jets(session_.machine, candidate, jets_on(session_.machine, samples, motion, at),
+                                                      [&](Eigen::Index r) { return samples[static_cast<std::size_t>(r)].angles_rad(); });
+}
+
+std::vector<Eigen::MatrixXd> BallbarDiagnosisProblem::candidate_jacobians(
+    const ModelFit& at, const std::vector<Effect>& candidates) const {
+  return diagnosis_detail::candidate_jacobians_by_jets(session_.machine, candidates,
+                                                       jets_on(session_.machine, session_.samples, arrays_.motion, at),
+                                                       [&](Eigen::Index r) { return arrays_.angles[static_cast<std::size_t>(r)]; });
 }
 
 Eigen::MatrixXd BallbarDiagnosisProblem::candidate_jacobian(const ModelFit& at,
                                                             const Effect& candidate) const {
   return jacobian_on(session_.samples, arrays_.motion, at, candidate);
+}
+
+Eigen::MatrixXd BallbarDiagnosisProblem::candidate_jacobian_by_jets(const ModelFit& at,
+                                                                    const Effect& candidate) const {
+  return diagnosis_detail::jets_of_width(candidate, diagnosis_detail::all_parameters(candidate),
+                                         jets_on(session_.machine, session_.samples, arrays_.motion, at));
 }
 
 std::vector<std::string> BallbarDiagnosisProblem::reference_groups() const {

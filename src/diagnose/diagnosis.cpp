@@ -168,6 +168,16 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
       J_levels << in.Jfree, L;
       levels_rank = static_cast<int>(orthonormal_basis(J_levels).cols() - Q_raw.cols());
     }
+    // This round's candidate Jacobians at the current fit, in one batch (the first round's
+    // are the baseline's).
+    std::vector<Eigen::MatrixXd> round_jc;
+    std::vector<std::size_t> round_index(candidates.size(), 0);
+    if (!D.findings.empty()) {
+      std::vector<Effect> todo;
+      for (std::size_t c = 0; c < candidates.size(); ++c)
+        if (!done[c] && unresolved[c].empty()) round_index[c] = todo.size(), todo.push_back(candidates[c]);
+      round_jc = P.candidate_jacobians(fit, todo);
+    }
     std::vector<Score> scores;
     NoiseTreatment wander_noise;  // 1/f-like: AR(1) + random walk by REML, once per round
     std::vector<NoiseTreatment> treatment_of;  // per score: the noise it was judged with
@@ -178,7 +188,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
         done[c] = true;
         continue;
       }
-      const Eigen::MatrixXd Jc = D.findings.empty() ? baseline_jc[c] : P.candidate_jacobian(fit, candidates[c]);
+      const Eigen::MatrixXd& Jc = D.findings.empty() ? baseline_jc[c] : round_jc[round_index[c]];
       Score s;
       NoiseTreatment judged_with = noise;
       if (!noise.W) {
@@ -473,8 +483,7 @@ Diagnosis diagnose(const DiagnosisProblem& P, const DiagnosisOptions& options) {
   EffectModel none;
   none.linear_reference = P.mean_commanded_xyz();
   const ModelFit baseline = P.fit(none);
-  std::vector<Eigen::MatrixXd> baseline_jc;
-  for (const Effect& c : candidates) baseline_jc.push_back(P.candidate_jacobian(baseline, c));
+  const std::vector<Eigen::MatrixXd> baseline_jc = P.candidate_jacobians(baseline, candidates);
   // Correlated at all? Judged on the baseline residuals: if even they are white (nothing
   // unmodelled, white noise), every decision is the white-noise one.
   NoiseModel model = estimate_noise_model(P.groups(), P.times(), baseline.residuals, options.noise);

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <type_traits>
 
+#include "candidate_jets.hpp"
 #include "rotacal/core/joint_fit.hpp"
 #include "rotacal/rtest/model.hpp"
 
@@ -122,30 +123,65 @@ ModelFit RtestDiagnosisProblem::fit(const EffectModel& fx) const {
   return out;
 }
 
-Eigen::MatrixXd RtestDiagnosisProblem::candidate_jacobian(const ModelFit& at, const Effect& candidate) const {
-  using J4 = ceres::Jet<double, 4>;
-  const int k = candidate.num_params();
-  const std::size_t S = setups_.size();
+namespace {
+
+// d reading / d (the seeded parameters of `candidate`), three rows per pose: Jets of width N
+// through the one R-test model, the current model's values as constants, the candidate
+// appended with its parameters at 0 (candidate_jets.hpp). The probe zeros are additive: they
+// do not change the derivative.
+template <int N>
+Eigen::MatrixXd reading_jets(MachineType m, const Eigen::Matrix3Xd& xyz, const Eigen::Matrix3Xd& nest,
+                             const std::vector<RotaryAngles<double>>& angles, const std::vector<double>& times,
+                             std::size_t setups, const ModelFit& at, const Effect& candidate,
+                             const std::vector<int>& seed) {
+  using Jet = ceres::Jet<double, N>;
   EffectModel fx = at.effects;
   fx.effects.push_back(candidate);
-  LocationErrors<J4> e;
-  for (int i = 0; i < 8; ++i) e.v[i] = J4(at.parameters[static_cast<std::size_t>(i)].value);
-  const std::size_t L = session_.machine.has_head() ? 9 : 8;
-  const J4 tool_length_error(L > 8 ? -at.parameters[8].value : 0.0);
-  std::vector<J4> p;
-  for (std::size_t i = L + 3 * S; i < at.parameters.size(); ++i) p.emplace_back(at.parameters[i].value);
-  for (int i = 0; i < k; ++i) p.emplace_back(0.0, i);
-  // The probe zeros are additive: they do not change the derivative.
-  Eigen::MatrixXd out(3 * xyz_.cols(), k);
-  for (Eigen::Index r = 0; r < xyz_.cols(); ++r) {
+  LocationErrors<Jet> e;
+  for (int i = 0; i < 8; ++i) e.v[i] = Jet(at.parameters[static_cast<std::size_t>(i)].value);
+  const std::size_t L = m.has_head() ? 9 : 8;
+  const Jet tool_length_error(L > 8 ? -at.parameters[8].value : 0.0);
+  std::vector<Jet> p;
+  for (std::size_t i = L + 3 * setups; i < at.parameters.size(); ++i) p.emplace_back(at.parameters[i].value);
+  const std::size_t first = p.size();
+  p.resize(first + static_cast<std::size_t>(candidate.num_params()), Jet(0.0));
+  for (std::size_t k = 0; k < seed.size(); ++k) p[first + static_cast<std::size_t>(seed[k])] = Jet(0.0, static_cast<int>(k));
+  Eigen::MatrixXd out(3 * xyz.cols(), static_cast<Eigen::Index>(seed.size()));
+  for (Eigen::Index r = 0; r < xyz.cols(); ++r) {
     const std::size_t ri = static_cast<std::size_t>(r);
-    const Vec3<J4> d = rtest_reading<J4>(session_.machine, e, fx, p.data(), xyz_.col(r),
-                                         pose_angles_[ri], pose_times_[ri], nest_.col(r), tool_length_error);
+    const Vec3<Jet> d = rtest_reading<Jet>(m, e, fx, p.data(), xyz.col(r), angles[ri], times[ri], nest.col(r),
+                                           tool_length_error);
     for (int a = 0; a < 3; ++a)
-      for (int i = 0; i < k; ++i) out(3 * r + a, i) = d[a].v[i];
+      for (std::size_t k = 0; k < seed.size(); ++k) out(3 * r + a, static_cast<Eigen::Index>(k)) = d[a].v[static_cast<Eigen::Index>(k)];
   }
   return out;
 }
+
+}  // namespace
+
+// jets(width, effect, seed) for candidate_jets.hpp.
+auto RtestDiagnosisProblem::jets_at(const ModelFit& at) const {
+  return [this, &at](auto width, const Effect& effect, const std::vector<int>& seed) {
+    return reading_jets<decltype(width)::value>(session_.machine, xyz_, nest_, pose_angles_, pose_times_,
+                                                setups_.size(), at, effect, seed);
+  };
+}
+
+Eigen::MatrixXd RtestDiagnosisProblem::candidate_jacobian(const ModelFit& at, const Effect& candidate) const {
+  return candidate_jacobians(at, {candidate}).front();
+}
+
+std::vector<Eigen::MatrixXd> RtestDiagnosisProblem::candidate_jacobians(const ModelFit& at,
+                                                                        const std::vector<Effect>& candidates) const {
+  return diagnosis_detail::candidate_jacobians_by_jets(
+      session_.machine, candidates, jets_at(at),
+      [&](Eigen::Index row) { return pose_angles_[static_cast<std::size_t>(row / 3)]; });
+}
+
+Eigen::MatrixXd RtestDiagnosisProblem::candidate_jacobian_by_jets(const ModelFit& at, const Effect& candidate) const {
+  return diagnosis_detail::jets_of_width(candidate, diagnosis_detail::all_parameters(candidate), jets_at(at));
+}
+
 
 Diagnosis diagnose_rtest(const RtestSession& session, const DiagnosisOptions& options) {
   return diagnose(RtestDiagnosisProblem(session), options);

@@ -120,8 +120,10 @@ UncertaintyBudget uncertainty_budget(const DiagnosisProblem& P, const Diagnosis&
     std::vector<double> a;
   };
   std::vector<Contribution> lines;
-  for (const Effect& c : candidates) {
-    const Eigen::MatrixXd Jc = P.candidate_jacobian(fit, c);
+  const std::vector<Eigen::MatrixXd> jacobians = P.candidate_jacobians(fit, candidates);
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    const Effect& c = candidates[i];
+    const Eigen::MatrixXd& Jc = jacobians[i];
     const Eigen::MatrixXd B = ls.solve(Jc);  // d(free params) / d(effect params)
     std::vector<double> a = plausible_sizes(c, sizes, duration);
     // The session's own bound where it sees the effect: linearised estimate on the final

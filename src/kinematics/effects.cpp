@@ -171,6 +171,8 @@ bool Effect::depends_on_motion() const {
          kind == EffectKind::reversal_spike;
 }
 
+bool Effect::is_harmonic() const { return info(kind).harmonic; }
+
 bool Effect::applies_to(MachineType m) const {
   const KindInfo& k = info(kind);
   if (!k.rotary_axis) return true;

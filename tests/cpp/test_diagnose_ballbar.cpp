@@ -170,3 +170,34 @@ TEST_CASE("ballbar residual harmonics: full C turns keep every order, half A tur
     CHECK(u.reason.find("cannot resolve its harmonic order") == std::string::npos);
   }
 }
+
+TEST_CASE("candidate Jacobians: the harmonic shortcut equals Jets of every parameter", "[diagnose]") {
+  // At a fit that already holds harmonic effects of the same kinds (their channels then
+  // compose with the candidate's), on a machine where both axes have errors.
+  std::mt19937 rng(7);
+  BallbarMachineModel truth = random_machine(rng);
+  truth.effects.effects = {Effect::parse("tilt_motion_C_h1"), Effect::parse("radial_motion_A_h2"),
+                           Effect::parse("gravity_sag_A")};
+  truth.effect_params = {4e-6, -3e-6, 2e-6, 1e-6, 0.002, -0.001, 0.0015, 0.0005, 0.004};
+  BallbarDiagnosisProblem P(simulate_ballbar(commanded(), truth, {kNoiseUm, 3, true}));
+  EffectModel fx;
+  fx.effects = {Effect::parse("tilt_motion_C_h1"), Effect::parse("radial_motion_A_h2")};
+  const ModelFit at = P.fit(fx);
+  std::vector<Effect> candidates;
+  for (const Effect& c : P.candidates(4))
+    if (std::find(fx.effects.begin(), fx.effects.end(), c) == fx.effects.end()) candidates.push_back(c);
+  const std::vector<Eigen::MatrixXd> batch = P.candidate_jacobians(at, candidates);
+  REQUIRE(batch.size() == candidates.size());
+  int harmonic = 0;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    INFO(candidates[i].id());
+    const Eigen::MatrixXd jets = P.candidate_jacobian_by_jets(at, candidates[i]);
+    REQUIRE(batch[i].rows() == jets.rows());
+    REQUIRE(batch[i].cols() == jets.cols());
+    REQUIRE(jets.cwiseAbs().maxCoeff() > 0.0);
+    CHECK((batch[i] - jets).cwiseAbs().maxCoeff() <= 1e-12 * jets.cwiseAbs().maxCoeff());
+    CHECK((P.candidate_jacobian(at, candidates[i]) - jets).cwiseAbs().maxCoeff() <= 1e-12 * jets.cwiseAbs().maxCoeff());
+    harmonic += candidates[i].is_harmonic();
+  }
+  CHECK(harmonic >= 20);  // angular, radial, axial and tilt motions of both axes, orders 1-4
+}

@@ -246,3 +246,27 @@ TEST_CASE("harmonic resolution: Nyquist on even turns, rank and conditioning oth
   CHECK(sv[0] / sv[sv.size() - 1] < 1e3);
   CHECK_THROWS_AS(resolve_harmonics(uneven, 'C', 8, 0.0), InvalidArgument);
 }
+
+TEST_CASE("R-test candidate Jacobians: the harmonic shortcut equals Jets of every parameter", "[diagnose]") {
+  // At a fit holding effects of the same harmonic kinds, three rows per pose.
+  RtestDiagnosisProblem P(read_rtest(std::string(ROTACAL_SHARED_DIR) + "/data/rtest_bc_oyama.csv"));
+  EffectModel fx;
+  fx.effects = {Effect::parse("radial_motion_C_h2"), Effect::parse("tilt_motion_B_h1"), Effect::parse("coning_B")};
+  const ModelFit at = P.fit(fx);
+  std::vector<Effect> candidates;
+  for (const Effect& c : P.candidates(4))
+    if (std::find(fx.effects.begin(), fx.effects.end(), c) == fx.effects.end()) candidates.push_back(c);
+  const std::vector<Eigen::MatrixXd> batch = P.candidate_jacobians(at, candidates);
+  REQUIRE(batch.size() == candidates.size());
+  int harmonic = 0;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    INFO(candidates[i].id());
+    const Eigen::MatrixXd jets = P.candidate_jacobian_by_jets(at, candidates[i]);
+    REQUIRE(batch[i].rows() == jets.rows());
+    REQUIRE(batch[i].cols() == jets.cols());
+    const double scale = std::max(jets.cwiseAbs().maxCoeff(), 1e-300);
+    CHECK((batch[i] - jets).cwiseAbs().maxCoeff() <= 1e-12 * scale);
+    harmonic += candidates[i].is_harmonic();
+  }
+  CHECK(harmonic >= 20);
+}

@@ -28,6 +28,11 @@ class BallbarDiagnosisProblem : public DiagnosisProblem {
   std::vector<Effect> candidates(int max_harmonic) const override;
   ModelFit fit(const EffectModel& effects) const override;
   Eigen::MatrixXd candidate_jacobian(const ModelFit& at, const Effect& candidate) const override;
+  std::vector<Eigen::MatrixXd> candidate_jacobians(const ModelFit& at,
+                                                   const std::vector<Effect>& candidates) const override;
+  /// The candidate's Jacobian by Jets of all its parameters, without the harmonic shortcut
+  /// (tests compare the two).
+  Eigen::MatrixXd candidate_jacobian_by_jets(const ModelFit& at, const Effect& candidate) const;
   std::vector<std::string> reference_groups() const override;
   Eigen::MatrixXd reference_jacobian(const ModelFit& at, const Effect& candidate,
                                      std::vector<std::string>* row_groups) const override;

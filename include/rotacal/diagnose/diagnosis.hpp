@@ -61,6 +61,15 @@ class DiagnosisProblem {
   virtual ModelFit fit(const EffectModel& effects) const = 0;
   /// d model / d (parameters of `candidate`) at `at`, one row per reading.
   virtual Eigen::MatrixXd candidate_jacobian(const ModelFit& at, const Effect& candidate) const = 0;
+  /// candidate_jacobian of each of `candidates`, in order; an instrument may share work
+  /// between them (the ballbar: one evaluation per harmonic kind and axis).
+  virtual std::vector<Eigen::MatrixXd> candidate_jacobians(const ModelFit& at,
+                                                           const std::vector<Effect>& candidates) const {
+    std::vector<Eigen::MatrixXd> out;
+    out.reserve(candidates.size());
+    for (const Effect& c : candidates) out.push_back(candidate_jacobian(at, c));
+    return out;
+  }
   /// The group names of a complete standard test for this machine and instrument, and the
   /// candidate Jacobian on it (used to name the test that separates two ambiguous
   /// candidates). Empty if the instrument has no standard test.

@@ -33,6 +33,11 @@ class RtestDiagnosisProblem : public DiagnosisProblem {
   std::vector<Effect> candidates(int max_harmonic) const override;
   ModelFit fit(const EffectModel& effects) const override;
   Eigen::MatrixXd candidate_jacobian(const ModelFit& at, const Effect& candidate) const override;
+  std::vector<Eigen::MatrixXd> candidate_jacobians(const ModelFit& at,
+                                                   const std::vector<Effect>& candidates) const override;
+  /// The candidate's Jacobian by Jets of all its parameters, without the harmonic shortcut
+  /// (tests compare the two).
+  Eigen::MatrixXd candidate_jacobian_by_jets(const ModelFit& at, const Effect& candidate) const;
 
  private:
   RtestSession session_;
@@ -43,6 +48,7 @@ class RtestDiagnosisProblem : public DiagnosisProblem {
   std::vector<RotaryAngles<double>> angles_;
   // The samples as arrays, built once for every refit: commanded xyz, nest, measured d.
   Eigen::Matrix3Xd xyz_, nest_, d_;
+  auto jets_at(const ModelFit& at) const;  // for src/diagnose/candidate_jets.hpp
   std::vector<RotaryAngles<double>> pose_angles_;  // per sample
   std::vector<double> pose_times_;
 };

@@ -82,6 +82,11 @@ struct Effect {
   /// True for the effects of the motion itself (backlash, servo lag, reversal spikes): zero
   /// at a static pose.
   bool depends_on_motion() const;
+  /// True for the *_hn entries. Each enters axis_stages through channels of the form
+  /// q[2j] cos(nR) + q[2j+1] sin(nR), R the commanded angle of its axis (harmonic_angle), so
+  /// the derivative of any reading with respect to its parameters at order n is the
+  /// derivative with respect to the cos parameters at order 0 times cos(nR) and sin(nR).
+  bool is_harmonic() const;
   bool operator==(const Effect& o) const {
     return kind == o.kind && axis == o.axis && harmonic == o.harmonic && direction == o.direction;
   }
@@ -106,6 +111,22 @@ struct EffectModel {
 };
 
 namespace detail {
+// Chain index of the machine's rotary axis with this letter, -1 if it has none.
+inline int chain_index(MachineType m, char letter) {
+  for (int k = 0; k < 2; ++k)
+    if (m.description().axis(k).name == letter) return k;
+  return -1;
+}
+}  // namespace detail
+
+/// nR of a rotary effect: the argument of its cos and sin in axis_stages, R the commanded
+/// angle of its axis (0 on a machine without that axis).
+inline double harmonic_angle(MachineType m, const Effect& f, const RotaryAngles<double>& cmd) {
+  const int k = detail::chain_index(m, f.axis);
+  return k < 0 ? 0.0 : f.harmonic * chain_angle(m, cmd, k);
+}
+
+namespace detail {
 
 template <typename Scalar>
 Mat3<Scalar> small_rotation_xyz(const Scalar& ax, const Scalar& ay, const Scalar& az) {
@@ -116,13 +137,6 @@ Mat3<Scalar> small_rotation_xyz(const Scalar& ax, const Scalar& ay, const Scalar
 
 // Index of X, Y, Z for a linear axis letter (A, B, C map to their principal axes).
 inline int axis_index(char axis) { return axis == 'A' || axis == 'X' ? 0 : (axis == 'B' || axis == 'Y') ? 1 : 2; }
-
-// Chain index of the machine's rotary axis with this letter, -1 if it has none.
-inline int chain_index(MachineType m, char letter) {
-  for (int k = 0; k < 2; ++k)
-    if (m.description().axis(k).name == letter) return k;
-  return -1;
-}
 
 // Axis about which coning turns the tilt axis: Y for an A axis, X for a B axis (formats and
 // effects.md), the first radial direction u of any other axis.
@@ -163,7 +177,7 @@ AxisStages<Scalar> axis_stages(MachineType m, const EffectModel& fx, const Scala
       const RotaryAxis& ax = d.axis(k);
       const int side = ax.on_head ? 1 : 0;
       const double R = chain_angle(m, cmd, k);  // the commanded angle of the effect's axis
-      const double c = std::cos(f.harmonic * R), s = std::sin(f.harmonic * R);
+      const double nR = harmonic_angle(m, f, cmd), c = std::cos(nR), s = std::sin(nR);
       switch (f.kind) {
         case EffectKind::rotary_zero_offset:
           st.angle[k] += q[0];
