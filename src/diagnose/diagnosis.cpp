@@ -120,6 +120,54 @@ NoiseTreatment candidate_treatment(const DiagnosisProblem& P, const DiagnosisOpt
   return model->white() ? white : coloured_treatment(*model);
 }
 
+// What the searches of one diagnosis share: a diagnosis may search twice (with the noise
+// model, then white when the final model leaves white residuals) through the same models, and
+// a model's refit and its candidates' Jacobians depend on the model alone. Jacobians are kept
+// up to kMaxCachedValues doubles (64 MB), beyond that recomputed.
+struct SearchCache {
+  static constexpr std::size_t kMaxCachedValues = std::size_t{8} << 20;
+  std::map<std::string, ModelFit> fits;
+  std::map<std::string, std::map<std::string, Eigen::MatrixXd>> jacobians;
+  std::size_t cached_values = 0;
+
+  static std::string key(const EffectModel& m) {
+    std::string k;
+    for (const Effect& e : m.effects) k += e.id() + ";";
+    return k;
+  }
+  const ModelFit& fit(const DiagnosisProblem& P, const EffectModel& m) {
+    const std::string k = key(m);
+    auto it = fits.find(k);
+    if (it == fits.end()) it = fits.emplace(k, P.fit(m)).first;
+    return it->second;
+  }
+  // The Jacobians of `todo` at `at` (the fit of model `m`).
+  std::vector<Eigen::MatrixXd> candidate_jacobians(const DiagnosisProblem& P, const EffectModel& m,
+                                                   const ModelFit& at, const std::vector<Effect>& todo) {
+    std::map<std::string, Eigen::MatrixXd>& known = jacobians[key(m)];
+    std::vector<Effect> missing;
+    for (const Effect& c : todo)
+      if (!known.count(c.id())) missing.push_back(c);
+    std::vector<Eigen::MatrixXd> fresh = P.candidate_jacobians(at, missing);
+    std::vector<Eigen::MatrixXd> out;
+    for (const Effect& c : todo) {
+      const auto it = known.find(c.id());
+      if (it != known.end()) {
+        out.push_back(it->second);
+        continue;
+      }
+      const std::size_t i = static_cast<std::size_t>(
+          std::find(missing.begin(), missing.end(), c) - missing.begin());
+      out.push_back(fresh[i]);
+      if (cached_values + static_cast<std::size_t>(fresh[i].size()) <= kMaxCachedValues) {
+        cached_values += static_cast<std::size_t>(fresh[i].size());
+        known.emplace(c.id(), std::move(fresh[i]));
+      }
+    }
+    return out;
+  }
+};
+
 // The search: score every candidate against the current model, add the best one that passes
 // the F-test (Bonferroni), BIC and blocked cross-validation and whose parameters the refit can
 // determine, refit, repeat; then judge what is left.
@@ -127,7 +175,7 @@ NoiseTreatment candidate_treatment(const DiagnosisProblem& P, const DiagnosisOpt
 Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
                  const std::vector<Effect>& candidates, const ModelFit& baseline,
                  const std::vector<Eigen::MatrixXd>& baseline_jc, const NoiseTreatment& noise,
-                 const NoiseModel* model, const NoiseTreatment& white) {
+                 const NoiseModel* model, const NoiseTreatment& white, SearchCache& cache) {
   Diagnosis D;
   D.machine = P.machine();
   ModelFit fit = baseline;
@@ -176,7 +224,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
       std::vector<Effect> todo;
       for (std::size_t c = 0; c < candidates.size(); ++c)
         if (!done[c] && unresolved[c].empty()) round_index[c] = todo.size(), todo.push_back(candidates[c]);
-      round_jc = P.candidate_jacobians(fit, todo);
+      round_jc = cache.candidate_jacobians(P, effects, fit, todo);
     }
     std::vector<Score> scores;
     NoiseTreatment wander_noise;  // 1/f-like: AR(1) + random walk by REML, once per round
@@ -272,7 +320,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
       if (!(cv_after < cv_before)) continue;
       EffectModel extended = effects;
       extended.effects.push_back(s->effect);
-      ModelFit refit = P.fit(extended);
+      ModelFit refit = cache.fit(P, extended);
       bool any_observable = false;
       for (const ParameterEstimate& p : parameters_of(refit, s->effect)) any_observable |= p.observable;
       for (std::size_t c = 0; c < candidates.size(); ++c)
@@ -454,9 +502,9 @@ NoiseTreatment coloured_treatment(const NoiseModel& estimated) {
 // R-test's 30 degree steps): if the extended model leaves less, that is the better estimate.
 Diagnosis search_white(const DiagnosisProblem& P, const DiagnosisOptions& options,
                        const std::vector<Effect>& candidates, const ModelFit& baseline,
-                       const std::vector<Eigen::MatrixXd>& baseline_jc) {
+                       const std::vector<Eigen::MatrixXd>& baseline_jc, SearchCache& cache) {
   const NoiseTreatment white = white_treatment(P, baseline);
-  Diagnosis D = search(P, options, candidates, baseline, baseline_jc, white, nullptr, white);
+  Diagnosis D = search(P, options, candidates, baseline, baseline_jc, white, nullptr, white, cache);
   if (!P.declared_noise_um()) {
     const double n = static_cast<double>(D.final_fit.residuals.size());
     const double s_final =
@@ -469,7 +517,7 @@ Diagnosis search_white(const DiagnosisProblem& P, const DiagnosisOptions& option
       why << "estimated from the residuals of the extended model (successive differences gave "
           << D.baseline.noise_um << " um: the sampling is too sparse for them)";
       better.source = why.str();
-      D = search(P, options, candidates, baseline, baseline_jc, better, nullptr, better);
+      D = search(P, options, candidates, baseline, baseline_jc, better, nullptr, better, cache);
     }
   }
   return D;
@@ -484,20 +532,21 @@ Diagnosis diagnose(const DiagnosisProblem& P, const DiagnosisOptions& options) {
   none.linear_reference = P.mean_commanded_xyz();
   const ModelFit baseline = P.fit(none);
   const std::vector<Eigen::MatrixXd> baseline_jc = P.candidate_jacobians(baseline, candidates);
+  SearchCache cache;
   // Correlated at all? Judged on the baseline residuals: if even they are white (nothing
   // unmodelled, white noise), every decision is the white-noise one.
   NoiseModel model = estimate_noise_model(P.groups(), P.times(), baseline.residuals, options.noise);
   Diagnosis D;
   if (!options.model_noise || model.white()) {
-    D = search_white(P, options, candidates, baseline, baseline_jc);
+    D = search_white(P, options, candidates, baseline, baseline_jc, cache);
   } else {
     D = search(P, options, candidates, baseline, baseline_jc, coloured_treatment(model), &model,
-               white_treatment(P, baseline));
+               white_treatment(P, baseline), cache);
     // Reported: the noise model of what the final model leaves. If that is white, the
     // correlation was the unmodelled effects': the white-noise diagnosis is the right one.
     model = estimate_noise_model(P.groups(), P.times(), D.final_fit.residuals, options.noise);
     if (model.white()) {
-      D = search_white(P, options, candidates, baseline, baseline_jc);
+      D = search_white(P, options, candidates, baseline, baseline_jc, cache);
     } else {
       // The baseline's adequacy against the noise as the final model leaves it (the baseline
       // model of the noise has the unmodelled effects in it).

@@ -67,15 +67,20 @@ Pose<Scalar> rotation_about_line(const Vec3<Scalar>& point, const Vec3<Scalar>& 
 /// non-zero length): the vector form of Flynn et al. 2016, Eq. 1,
 ///   q' = a + v cos(theta) + (u x v) sin(theta) + u (u . v) (1 - cos(theta)),  v = q - a.
 /// Cheaper than building the Pose when only one point is needed (the ballbar's pivot).
+/// The same with cos(theta) and sin(theta) given (the analytic Jacobian has them already).
+template <typename Scalar>
+Vec3<Scalar> rotate_point_about_line(const Vec3<Scalar>& point, const Vec3<Scalar>& direction,
+                                     const Scalar& c, const Scalar& s, const Vec3<Scalar>& q) {
+  const Vec3<Scalar> u = direction / direction.norm();
+  const Vec3<Scalar> v = q - point;
+  return point + v * c + u.cross(v) * s + u * (u.dot(v) * (Scalar(1) - c));
+}
 template <typename Scalar>
 Vec3<Scalar> rotate_point_about_line(const Vec3<Scalar>& point, const Vec3<Scalar>& direction,
                                      const Scalar& theta, const Vec3<Scalar>& q) {
   using std::cos;
   using std::sin;
-  const Vec3<Scalar> u = direction / direction.norm();
-  const Vec3<Scalar> v = q - point;
-  const Scalar c = cos(theta), s = sin(theta);
-  return point + v * c + u.cross(v) * s + u * (u.dot(v) * (Scalar(1) - c));
+  return rotate_point_about_line<Scalar>(point, direction, Scalar(cos(theta)), Scalar(sin(theta)), q);
 }
 
 /// rotate_point_about_line with its first derivatives (double only; the fits' fast path, checked
@@ -125,7 +130,7 @@ inline LineRotationDerivatives rotate_point_about_line_derivatives(const Eigen::
   D.v = q - point;
   D.c = std::cos(theta);
   D.s = std::sin(theta);
-  D.f = rotate_point_about_line<double>(point, direction, theta, q);  // the one definition
+  D.f = rotate_point_about_line<double>(point, direction, D.c, D.s, q);  // the one definition
   return D;
 }
 
