@@ -7,6 +7,7 @@
 #include "rotacal/core/least_squares.hpp"
 #include "rotacal/diagnose/ballbar_diagnosis.hpp"
 #include "rotacal/io/ballbar_file.hpp"
+#include "../support/candidate_jacobians.hpp"
 #include "../support/synthetic_sessions.hpp"
 
 using namespace rotacal;
@@ -182,22 +183,6 @@ TEST_CASE("candidate Jacobians: the harmonic shortcut equals Jets of every param
   BallbarDiagnosisProblem P(simulate_ballbar(commanded(), truth, {kNoiseUm, 3, true}));
   EffectModel fx;
   fx.effects = {Effect::parse("tilt_motion_C_h1"), Effect::parse("radial_motion_A_h2")};
-  const ModelFit at = P.fit(fx);
-  std::vector<Effect> candidates;
-  for (const Effect& c : P.candidates(4))
-    if (std::find(fx.effects.begin(), fx.effects.end(), c) == fx.effects.end()) candidates.push_back(c);
-  const std::vector<Eigen::MatrixXd> batch = P.candidate_jacobians(at, candidates);
-  REQUIRE(batch.size() == candidates.size());
-  int harmonic = 0;
-  for (std::size_t i = 0; i < candidates.size(); ++i) {
-    INFO(candidates[i].id());
-    const Eigen::MatrixXd jets = P.candidate_jacobian_by_jets(at, candidates[i]);
-    REQUIRE(batch[i].rows() == jets.rows());
-    REQUIRE(batch[i].cols() == jets.cols());
-    REQUIRE(jets.cwiseAbs().maxCoeff() > 0.0);
-    CHECK((batch[i] - jets).cwiseAbs().maxCoeff() <= 1e-12 * jets.cwiseAbs().maxCoeff());
-    CHECK((P.candidate_jacobian(at, candidates[i]) - jets).cwiseAbs().maxCoeff() <= 1e-12 * jets.cwiseAbs().maxCoeff());
-    harmonic += candidates[i].is_harmonic();
-  }
+  const int harmonic = synthetic::check_candidate_jacobians(P, fx);
   CHECK(harmonic >= 20);  // angular, radial, axial and tilt motions of both axes, orders 1-4
 }

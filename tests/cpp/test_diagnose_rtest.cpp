@@ -9,6 +9,7 @@
 #include "rotacal/diagnose/rtest_diagnosis.hpp"
 #include "rotacal/io/ballbar_file.hpp"
 #include "rotacal/rtest/simulate.hpp"
+#include "../support/candidate_jacobians.hpp"
 #include "../support/synthetic_sessions.hpp"
 
 using namespace rotacal;
@@ -252,21 +253,6 @@ TEST_CASE("R-test candidate Jacobians: the harmonic shortcut equals Jets of ever
   RtestDiagnosisProblem P(read_rtest(std::string(ROTACAL_SHARED_DIR) + "/data/rtest_bc_oyama.csv"));
   EffectModel fx;
   fx.effects = {Effect::parse("radial_motion_C_h2"), Effect::parse("tilt_motion_B_h1"), Effect::parse("coning_B")};
-  const ModelFit at = P.fit(fx);
-  std::vector<Effect> candidates;
-  for (const Effect& c : P.candidates(4))
-    if (std::find(fx.effects.begin(), fx.effects.end(), c) == fx.effects.end()) candidates.push_back(c);
-  const std::vector<Eigen::MatrixXd> batch = P.candidate_jacobians(at, candidates);
-  REQUIRE(batch.size() == candidates.size());
-  int harmonic = 0;
-  for (std::size_t i = 0; i < candidates.size(); ++i) {
-    INFO(candidates[i].id());
-    const Eigen::MatrixXd jets = P.candidate_jacobian_by_jets(at, candidates[i]);
-    REQUIRE(batch[i].rows() == jets.rows());
-    REQUIRE(batch[i].cols() == jets.cols());
-    const double scale = std::max(jets.cwiseAbs().maxCoeff(), 1e-300);
-    CHECK((batch[i] - jets).cwiseAbs().maxCoeff() <= 1e-12 * scale);
-    harmonic += candidates[i].is_harmonic();
-  }
+  const int harmonic = synthetic::check_candidate_jacobians(P, fx);
   CHECK(harmonic >= 20);
 }

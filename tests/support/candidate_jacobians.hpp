@@ -1,0 +1,38 @@
+#pragma once
+// Test support: the candidate Jacobians of a diagnosis problem (the harmonic shortcut of
+// src/diagnose/candidate_jets.hpp) against Jets of every parameter of each candidate.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <vector>
+
+#include "rotacal/diagnose/diagnosis.hpp"
+
+namespace rotacal::synthetic {
+
+/// At the fit of model `fx`, every candidate the model does not hold; returns how many of them
+/// are harmonic.
+template <typename Problem>
+int check_candidate_jacobians(const Problem& P, const EffectModel& fx) {
+  const ModelFit at = P.fit(fx);
+  std::vector<Effect> candidates;
+  for (const Effect& c : P.candidates(4))
+    if (std::find(fx.effects.begin(), fx.effects.end(), c) == fx.effects.end()) candidates.push_back(c);
+  const std::vector<Eigen::MatrixXd> batch = P.candidate_jacobians(at, candidates);
+  REQUIRE(batch.size() == candidates.size());
+  int harmonic = 0;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    INFO(candidates[i].id());
+    const Eigen::MatrixXd jets = P.candidate_jacobian_by_jets(at, candidates[i]);
+    REQUIRE(batch[i].rows() == jets.rows());
+    REQUIRE(batch[i].cols() == jets.cols());
+    const double scale = jets.cwiseAbs().maxCoeff();
+    REQUIRE(scale > 0.0);
+    CHECK((batch[i] - jets).cwiseAbs().maxCoeff() <= 1e-12 * scale);
+    CHECK((P.candidate_jacobian(at, candidates[i]) - jets).cwiseAbs().maxCoeff() <= 1e-12 * scale);
+    harmonic += candidates[i].is_harmonic();
+  }
+  return harmonic;
+}
+
+}  // namespace rotacal::synthetic
