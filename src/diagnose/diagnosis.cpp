@@ -269,7 +269,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
           }
           own = wander_noise;
         }
-        in_c.Q_w = orthonormal_basis(own.whiten(in_c.Jfree));
+        in_c.Q_w = orthonormal_basis_full_rank(own.whiten(in_c.Jfree));
         in_c.r_w = own.whiten(fit.residuals);
         s = score(in_c, candidates[c], Jc, own.whiten(Jc), options.min_visible_chi2);
         if (s.observable && s.X.cols() > in.Jfree.cols() + s.k) {

@@ -1,5 +1,6 @@
 // Scoring of candidate effects: least-squares helpers, the linearised refit with its delta
 // BIC and F-test, and blocked cross-validation.
+#include <Eigen/Cholesky>
 #include <Eigen/QR>
 #include <Eigen/SVD>
 #include <algorithm>
@@ -49,6 +50,28 @@ Eigen::MatrixXd orthonormal_basis(const Eigen::MatrixXd& J) {
   const Eigen::Index r = qr.rank();
   Eigen::MatrixXd Q = Eigen::MatrixXd::Identity(J.rows(), r);
   return qr.householderQ() * Q;
+}
+
+Eigen::MatrixXd orthonormal_basis_full_rank(const Eigen::MatrixXd& J) {
+  const Eigen::Index p = J.cols();
+  if (p == 0) return Eigen::MatrixXd(J.rows(), 0);
+  Eigen::MatrixXd Q = J;
+  for (int pass = 0; pass < 2; ++pass) {  // CholeskyQR2: the second pass restores orthogonality
+    Eigen::MatrixXd G = Eigen::MatrixXd::Zero(p, p);
+    G.selfadjointView<Eigen::Lower>().rankUpdate(Q.transpose());
+    const Eigen::VectorXd d = G.diagonal().cwiseSqrt();
+    if (!(d.minCoeff() > 0.0) || !d.allFinite()) return orthonormal_basis(J);
+    const Eigen::MatrixXd Gn = d.cwiseInverse().asDiagonal() *
+                               Eigen::MatrixXd(G.selfadjointView<Eigen::Lower>()) * d.cwiseInverse().asDiagonal();
+    const Eigen::LLT<Eigen::MatrixXd> llt(Gn);
+    // Near rank deficiency (condition of the normalised columns above ~1e6) the rank-revealing
+    // QR decides, as everywhere else.
+    if (llt.info() != Eigen::Success || !(llt.matrixLLT().diagonal().minCoeff() > 1e-6))
+      return orthonormal_basis(J);
+    Q = Q * d.cwiseInverse().asDiagonal();
+    llt.matrixU().solveInPlace<Eigen::OnTheRight>(Q);
+  }
+  return Q;
 }
 
 Eigen::MatrixXd project_out(const Eigen::MatrixXd& Q, const Eigen::MatrixXd& C) {
