@@ -4,7 +4,6 @@
 
 #include <ceres/jet.h>
 
-
 #include "candidate_jets.hpp"
 
 namespace rotacal {
@@ -108,13 +107,13 @@ auto jets_on(MachineType m, const std::vector<BallbarSample>& samples, const std
 Eigen::MatrixXd BallbarDiagnosisProblem::jacobian_on(const std::vector<BallbarSample>& samples,
                                                      const std::vector<RotaryMotion>& motion,
                                                      const ModelFit& at, const Effect& candidate) const {
-  return diagnosis_detail::candidate_jacobian_by_jets(session_.machine, candidate, jets_on(session_.machine, samples, motion, at),
+  return diagnosis_detail::jacobian_of_candidate(session_.machine, candidate, jets_on(session_.machine, samples, motion, at),
                                                       [&](Eigen::Index r) { return samples[static_cast<std::size_t>(r)].angles_rad(); });
 }
 
 std::vector<Eigen::MatrixXd> BallbarDiagnosisProblem::candidate_jacobians(
     const ModelFit& at, const std::vector<Effect>& candidates) const {
-  return diagnosis_detail::candidate_jacobians_by_jets(session_.machine, candidates,
+  return diagnosis_detail::jacobians_of_candidates(session_.machine, candidates,
                                                        jets_on(session_.machine, session_.samples, arrays_.motion, at),
                                                        [&](Eigen::Index r) { return arrays_.angles[static_cast<std::size_t>(r)]; });
 }

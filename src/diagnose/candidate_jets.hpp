@@ -72,7 +72,7 @@ Eigen::MatrixXd expand_harmonic(MachineType m, const Effect& candidate, const Ei
 /// Jacobians of every candidate at one fit, the channels of each harmonic kind and axis
 /// evaluated once.
 template <typename Jets, typename AnglesOfRow>
-std::vector<Eigen::MatrixXd> candidate_jacobians_by_jets(MachineType m, const std::vector<Effect>& candidates,
+std::vector<Eigen::MatrixXd> jacobians_of_candidates(MachineType m, const std::vector<Effect>& candidates,
                                                          Jets&& jets, AnglesOfRow&& angles_of_row) {
   std::vector<std::pair<Effect, Eigen::MatrixXd>> channels;
   std::vector<Eigen::MatrixXd> out;
@@ -96,7 +96,7 @@ std::vector<Eigen::MatrixXd> candidate_jacobians_by_jets(MachineType m, const st
 
 /// One candidate's Jacobian (its own channels when harmonic).
 template <typename Jets, typename AnglesOfRow>
-Eigen::MatrixXd candidate_jacobian_by_jets(MachineType m, const Effect& c, Jets&& jets, AnglesOfRow&& angles_of_row) {
+Eigen::MatrixXd jacobian_of_candidate(MachineType m, const Effect& c, Jets&& jets, AnglesOfRow&& angles_of_row) {
   if (!c.is_harmonic()) return jets_of_width(c, all_parameters(c), jets);
   return expand_harmonic(m, c, harmonic_channels(c, jets), angles_of_row);
 }

@@ -173,7 +173,7 @@ Eigen::MatrixXd RtestDiagnosisProblem::candidate_jacobian(const ModelFit& at, co
 
 std::vector<Eigen::MatrixXd> RtestDiagnosisProblem::candidate_jacobians(const ModelFit& at,
                                                                         const std::vector<Effect>& candidates) const {
-  return diagnosis_detail::candidate_jacobians_by_jets(
+  return diagnosis_detail::jacobians_of_candidates(
       session_.machine, candidates, jets_at(at),
       [&](Eigen::Index row) { return pose_angles_[static_cast<std::size_t>(row / 3)]; });
 }
@@ -181,7 +181,6 @@ std::vector<Eigen::MatrixXd> RtestDiagnosisProblem::candidate_jacobians(const Mo
 Eigen::MatrixXd RtestDiagnosisProblem::candidate_jacobian_by_jets(const ModelFit& at, const Effect& candidate) const {
   return diagnosis_detail::jets_of_width(candidate, diagnosis_detail::all_parameters(candidate), jets_at(at));
 }
-
 
 Diagnosis diagnose_rtest(const RtestSession& session, const DiagnosisOptions& options) {
   return diagnose(RtestDiagnosisProblem(session), options);

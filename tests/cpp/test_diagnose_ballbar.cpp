@@ -7,6 +7,7 @@
 #include "rotacal/core/least_squares.hpp"
 #include "rotacal/diagnose/ballbar_diagnosis.hpp"
 #include "rotacal/io/ballbar_file.hpp"
+#include "../../src/diagnose/scoring.hpp"
 #include "../support/candidate_jacobians.hpp"
 #include "../support/synthetic_sessions.hpp"
 
@@ -185,4 +186,23 @@ TEST_CASE("candidate Jacobians: the harmonic shortcut equals Jets of every param
   fx.effects = {Effect::parse("tilt_motion_C_h1"), Effect::parse("radial_motion_A_h2")};
   const int harmonic = synthetic::check_candidate_jacobians(P, fx);
   CHECK(harmonic >= 20);  // angular, radial, axial and tilt motions of both axes, orders 1-4
+}
+
+TEST_CASE("orthonormal_basis_full_rank spans what the rank-revealing QR spans", "[diagnose]") {
+  using diagnosis_detail::orthonormal_basis;
+  using diagnosis_detail::orthonormal_basis_full_rank;
+  std::mt19937 rng(3);
+  std::normal_distribution<double> N(0.0, 1.0);
+  Eigen::MatrixXd J(600, 11);
+  for (Eigen::Index i = 0; i < J.size(); ++i) J.data()[i] = N(rng);
+  J.col(3) *= 1e4;  // columns of very different sizes, as mm and rad columns are
+  const auto projector = [](const Eigen::MatrixXd& Q) { return Eigen::MatrixXd(Q * Q.transpose()); };
+  const Eigen::MatrixXd Q = orthonormal_basis_full_rank(J);
+  REQUIRE(Q.cols() == 11);
+  CHECK((Q.transpose() * Q - Eigen::MatrixXd::Identity(11, 11)).cwiseAbs().maxCoeff() < 1e-12);
+  CHECK((projector(Q) - projector(orthonormal_basis(J))).cwiseAbs().maxCoeff() < 1e-10);
+  // A column that repeats another: the rank-revealing QR decides the rank.
+  J.col(10) = 2.0 * J.col(4);
+  CHECK(orthonormal_basis_full_rank(J).cols() == 10);
+  CHECK((projector(orthonormal_basis_full_rank(J)) - projector(orthonormal_basis(J))).cwiseAbs().maxCoeff() < 1e-10);
 }

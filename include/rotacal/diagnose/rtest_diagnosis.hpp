@@ -40,6 +40,7 @@ class RtestDiagnosisProblem : public DiagnosisProblem {
   Eigen::MatrixXd candidate_jacobian_by_jets(const ModelFit& at, const Effect& candidate) const;
 
  private:
+  auto jets_at(const ModelFit& at) const;  // for src/diagnose/candidate_jets.hpp
   RtestSession session_;
   std::vector<std::string> setups_;  // distinct, in order
   std::vector<int> setup_of_;        // per sample
@@ -48,7 +49,6 @@ class RtestDiagnosisProblem : public DiagnosisProblem {
   std::vector<RotaryAngles<double>> angles_;
   // The samples as arrays, built once for every refit: commanded xyz, nest, measured d.
   Eigen::Matrix3Xd xyz_, nest_, d_;
-  auto jets_at(const ModelFit& at) const;  // for src/diagnose/candidate_jets.hpp
   std::vector<RotaryAngles<double>> pose_angles_;  // per sample
   std::vector<double> pose_times_;
 };

@@ -67,7 +67,8 @@ Pose<Scalar> rotation_about_line(const Vec3<Scalar>& point, const Vec3<Scalar>& 
 /// non-zero length): the vector form of Flynn et al. 2016, Eq. 1,
 ///   q' = a + v cos(theta) + (u x v) sin(theta) + u (u . v) (1 - cos(theta)),  v = q - a.
 /// Cheaper than building the Pose when only one point is needed (the ballbar's pivot).
-/// The same with cos(theta) and sin(theta) given (the analytic Jacobian has them already).
+/// This form takes c = cos(theta) and s = sin(theta) (the analytic Jacobian has them already);
+/// the form below takes theta.
 template <typename Scalar>
 Vec3<Scalar> rotate_point_about_line(const Vec3<Scalar>& point, const Vec3<Scalar>& direction,
                                      const Scalar& c, const Scalar& s, const Vec3<Scalar>& q) {
