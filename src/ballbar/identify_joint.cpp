@@ -16,7 +16,8 @@ const ParameterEstimate& BallbarIdentification::parameter(const std::string& nam
   throw InvalidArgument("no identified parameter named '" + name + "'");
 }
 
-BallbarArrays ballbar_arrays(const BallbarSession& session, const std::vector<std::string>& tests) {
+BallbarArrays ballbar_arrays(const BallbarSession& session, const std::vector<std::string>& tests,
+                             bool with_motion) {
   BallbarArrays a;
   a.machine = session.machine;
   a.pivot = session.pivot;
@@ -31,9 +32,9 @@ BallbarArrays ballbar_arrays(const BallbarSession& session, const std::vector<st
   a.time.resize(n);
   a.length.resize(n);
   a.test.resize(a.index.size());
-  a.motion.resize(a.index.size());
   // Motion from every row of the session: a test left out still moved the axes.
-  const std::vector<RotaryMotion> motion = rotary_motion(session.samples);
+  const std::vector<RotaryMotion> motion = with_motion ? rotary_motion(session.samples) : std::vector<RotaryMotion>{};
+  if (with_motion) a.motion.resize(a.index.size());
   for (Eigen::Index k = 0; k < n; ++k) {
     const BallbarSample& s = session.samples[a.index[static_cast<std::size_t>(k)]];
     a.xyz.col(k) = s.xyz;
@@ -41,13 +42,16 @@ BallbarArrays ballbar_arrays(const BallbarSession& session, const std::vector<st
     a.time[k] = s.time;
     a.length[k] = s.length;
     a.test[static_cast<std::size_t>(k)] = s.test;
-    a.motion[static_cast<std::size_t>(k)] = motion[a.index[static_cast<std::size_t>(k)]];
+    if (with_motion) a.motion[static_cast<std::size_t>(k)] = motion[a.index[static_cast<std::size_t>(k)]];
   }
   return a;
 }
 
 BallbarIdentification identify_joint(const BallbarSession& session, const JointFitOptions& options) {
-  return identify_joint(ballbar_arrays(session, options.tests), options);
+  // The motion of the axes (rotary_motion) only for effects of the motion.
+  const bool with_motion = std::any_of(options.effects.effects.begin(), options.effects.effects.end(),
+                                       [](const Effect& f) { return f.depends_on_motion(); });
+  return identify_joint(ballbar_arrays(session, options.tests, with_motion), options);
 }
 
 namespace {

@@ -10,22 +10,34 @@
 namespace rotacal {
 
 // r_i = L_model,i - L_i (mm). Parameters: 8 location errors, pivot (3), effect parameters.
-// Residuals alone come from the one templated model (predicted_length); the Jacobian of the
-// base model (location errors, pivot, and the tool length and ballbar length offsets) is
-// analytic: the chain rule over rotate_point_about_line_derivatives along the machine's axes,
-// checked against the Jets in tests/cpp/test_ballbar_identify.cpp. Jets of one sample with
-// 12 parameters were about half of a fit's time (perf, ballbar_ac_table2.csv); any other
-// effect takes the Jets.
+// The base model (location errors, pivot, and the tool length and ballbar length offsets)
+// has an analytic path: the one model's rotations (rotate_point_about_unit_line) composed
+// along the machine's axes for the residual, and the chain rule over their derivatives for
+// the Jacobian row, checked against the Jets (r and J) in tests/cpp/test_ballbar_identify.cpp.
+// Jets of one sample with 12 parameters were about half of a fit's time (perf,
+// ballbar_ac_table2.csv). Any other effect takes the templated model (predicted_length) on
+// doubles or Jets.
 class BallbarLengthModel : public ResidualModel {
  public:
   BallbarLengthModel(const BallbarArrays& d, const EffectModel& fx)
-      : d_(d), fx_(fx), P_(fx.num_params()), analytic_(analytic_supported(fx)) {}
+      : d_(d), fx_(fx), P_(fx.num_params()), analytic_(analytic_supported(fx)),
+        nt_(static_cast<int>(d.machine.description().table_axes.size())) {
+    if (analytic_) commanded_sincos();
+    for (const Effect& f : fx.effects)
+      if (f.depends_on_motion() && d.motion.size() != static_cast<std::size_t>(d.size()))
+        throw InvalidArgument("ballbar fit: effect " + f.id() + " needs the motion of the axes, which these "
+                              "arrays were built without (ballbar_arrays with_motion)");
+  }
   Eigen::Index num_residuals() const override { return d_.size(); }
   int num_parameters() const override { return 11 + P_; }
   void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r,
                 Eigen::MatrixXd* J) const override {
-    if (J && analytic_) {
-      for (Eigen::Index i = 0; i < d_.size(); ++i) analytic_row(i, x, r[i], J->row(i));
+    if (analytic_) {
+      const Chain chain = chain_at(x);
+      if (J)
+        for (Eigen::Index i = 0; i < d_.size(); ++i) r[i] = analytic_row<true>(chain, i, J->row(i));
+      else
+        for (Eigen::Index i = 0; i < d_.size(); ++i) r[i] = analytic_row<false>(chain, i, NoRow{});
       return;
     }
     evaluate_with_jets([this](Eigen::Index i, const auto* p, auto* out) { sample(i, p, out); },
@@ -36,8 +48,12 @@ class BallbarLengthModel : public ResidualModel {
     const Eigen::Index m = (d_.size() + stride - 1) / stride;
     r.resize(m);
     if (J) J->resize(m, num_parameters());
-    if (J && analytic_) {
-      for (Eigen::Index k = 0; k < m; ++k) analytic_row(k * stride, x, r[k], J->row(k));
+    if (analytic_) {
+      const Chain chain = chain_at(x);
+      if (J)
+        for (Eigen::Index k = 0; k < m; ++k) r[k] = analytic_row<true>(chain, k * stride, J->row(k));
+      else
+        for (Eigen::Index k = 0; k < m; ++k) r[k] = analytic_row<false>(chain, k * stride, NoRow{});
       return true;
     }
     evaluate_with_jets(
@@ -45,77 +61,134 @@ class BallbarLengthModel : public ResidualModel {
         x, r, J);
     return true;
   }
-  /// Whether the Jacobian comes from the analytic path (tests compare it with the Jets).
+  /// Whether the residuals and Jacobian come from the analytic path (tests compare it with the Jets).
   bool analytic() const { return analytic_; }
-  /// The Jets' Jacobian, for that comparison.
+  /// The Jets' residuals and Jacobian, for that comparison.
   void evaluate_jets(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r, Eigen::MatrixXd* J) const {
     evaluate_with_jets([this](Eigen::Index i, const auto* p, auto* out) { sample(i, p, out); },
                        d_.size(), 1, x, r, J);
   }
 
  private:
+  // At most one tool length and one bar length offset (analytic_row writes one column each).
   static bool analytic_supported(const EffectModel& fx) {
-    for (const Effect& f : fx.effects)
-      if (f.kind != EffectKind::tool_offset_Z && f.kind != EffectKind::ballbar_length_offset) return false;
-    return true;
+    int tool = 0, length = 0;
+    for (const Effect& f : fx.effects) {
+      if (f.kind == EffectKind::tool_offset_Z) ++tool;
+      else if (f.kind == EffectKind::ballbar_length_offset) ++length;
+      else return false;
+    }
+    return tool <= 1 && length <= 1;
   }
 
-  // Residual and Jacobian row of sample i by the chain rule (see the class comment).
-  template <typename Row>
-  void analytic_row(Eigen::Index i, const Eigen::VectorXd& x, double& r, Row J) const {
-    const MachineType m = d_.machine;
-    const MachineDescription& md = m.description();
-    const LocationErrors<double> e(x.head<8>());
-    const RotaryAngles<double>& cmd = d_.angles[static_cast<std::size_t>(i)];
-    double tool_z = 0.0;
+  // cos and sin of every sample's commanded angle of chain axes 0 and 1 (rows c0, s0, c1, s1):
+  // they do not depend on the parameters, and were a quarter of a fit's time (perf, table2).
+  // In a test one axis mostly stands still, so an angle equal to the previous sample's is copied.
+  void commanded_sincos() {
+    const Eigen::Index n = d_.size();
+    cs_.resize(4, n);
+    const int rot = d_.machine.rot_index();
+    for (int k = 0; k < 2; ++k) {
+      double last = 0.0, c = 1.0, s = 0.0;
+      for (Eigen::Index i = 0; i < n; ++i) {
+        const RotaryAngles<double>& a = d_.angles[static_cast<std::size_t>(i)];
+        const double angle = k == rot ? a.rot : a.tilt;  // chain_angle
+        if (i == 0 || angle != last) last = angle, c = std::cos(angle), s = std::sin(angle);
+        cs_(2 * k, i) = c;
+        cs_(2 * k + 1, i) = s;
+      }
+    }
+  }
+
+  // What the chain takes from the parameter vector, evaluated once per evaluation: the actual
+  // lines of both axes (point, unit direction, 1 / |direction|), the pivot and the tool vector.
+  struct Chain {
+    Eigen::Vector3d point[2], u[2];
+    double inv_norm[2] = {1.0, 1.0};
+    // d(line point)/d(position errors) and d(unit direction)/d(direction errors) =
+    // (I - u u^T) / |direction| * direction_basis, 3 x 2 each.
+    Eigen::Matrix<double, 3, 2> d_point[2], d_unit[2];
+    Eigen::Vector3d pivot, tool;
+    double length_offset = 0.0;
     int tool_z_col = -1, length_col = -1;
+  };
+  struct NoRow {};  // analytic_row without a Jacobian row
+
+  Chain chain_at(const Eigen::VectorXd& x) const {
+    const MachineType m = d_.machine;
+    const LocationErrors<double> e(x.head<8>());
+    Chain ch;
+    double tool_z = 0.0;
     for (std::size_t k = 0; k < fx_.effects.size(); ++k) {
       const int col = 11 + fx_.offset(k);
-      if (fx_.effects[k].kind == EffectKind::tool_offset_Z) tool_z += x[col], tool_z_col = col;
-      else length_col = col;
+      if (fx_.effects[k].kind == EffectKind::tool_offset_Z) tool_z += x[col], ch.tool_z_col = col;
+      else ch.length_offset = x[col], ch.length_col = col;
     }
-    const int nt = static_cast<int>(md.table_axes.size());
+    for (int k = 0; k < 2; ++k) {
+      const AxisLine<double> L = axis_line(m, k, e);
+      ch.point[k] = L.point;
+      ch.inv_norm[k] = 1.0 / L.direction.norm();
+      ch.u[k] = L.direction * ch.inv_norm[k];
+      const RotaryAxis& a = m.description().axis(k);
+      ch.d_point[k] = a.position_basis;
+      ch.d_unit[k] = (Eigen::Matrix3d::Identity() - ch.u[k] * ch.u[k].transpose()) * ch.inv_norm[k] *
+                     a.direction_basis;
+    }
+    ch.pivot = x.segment<3>(8);
+    ch.tool = tool_vector<double>(m, 0.0) + Eigen::Vector3d(0.0, 0.0, tool_z);
+    return ch;
+  }
+
+  // Residual of sample i, and with WithJacobian its Jacobian row by the chain rule (see the
+  // class comment).
+  template <bool WithJacobian, typename Row>
+  double analytic_row(const Chain& ch, Eigen::Index i, Row J) const {
+    const int nt = nt_;
     LineRotationDerivatives D[2];
+    const auto rotate = [&](int k, const Eigen::Vector3d& q) -> Eigen::Vector3d {
+      if constexpr (WithJacobian)
+        return (D[k] = rotate_point_about_unit_line_derivatives(ch.point[k], ch.u[k], ch.inv_norm[k],
+                                                                cs_(2 * k, i), cs_(2 * k + 1, i), q))
+            .f;
+      else
+        return rotate_point_about_unit_line<double>(ch.point[k], ch.u[k], cs_(2 * k, i), cs_(2 * k + 1, i), q);
+    };
     // Table side: the pivot through the table axes, innermost first.
-    Eigen::Vector3d P = x.segment<3>(8);
-    for (int k = nt - 1; k >= 0; --k) {
-      const AxisLine<double> L = axis_line(m, k, e);
-      D[k] = rotate_point_about_line_derivatives(L.point, L.direction, chain_angle(m, cmd, k), P);
-      P = D[k].f;
-    }
+    Eigen::Vector3d P = ch.pivot;
+    for (int k = nt - 1; k >= 0; --k) P = rotate(k, P);
     // Tool side: the tool vector through the head axes, innermost first.
-    Eigen::Vector3d v = tool_vector<double>(m, 0.0) + Eigen::Vector3d(0.0, 0.0, tool_z);
-    for (int k = 1; k >= nt; --k) {
-      const AxisLine<double> L = axis_line(m, k, e);
-      D[k] = rotate_point_about_line_derivatives(L.point, L.direction, chain_angle(m, cmd, k), v);
-      v = D[k].f;
-    }
+    Eigen::Vector3d v = ch.tool;
+    for (int k = 1; k >= nt; --k) v = rotate(k, v);
     const Eigen::Vector3d b = d_.xyz.col(i) + v;
     const double length = (b - P).norm();
-    const Eigen::Vector3d u = (b - P) / length;
     // The residual from the same chain: the ball points above are the one model's rotations
-    // composed as predicted_length composes them (the Jets test checks r as well as J). Taking
-    // it from sample() instead evaluated every rotation twice (~0.3 ms of a 1.3 ms fit).
-    r = length + (length_col >= 0 ? x[length_col] : 0.0) - d_.length[i];
-    J.setZero();
-    // dL/d(line k) = +-u^T (outer rotations) dD_k; the table side enters with a minus.
-    Eigen::RowVector3d w = -u.transpose();
-    for (int k = 0; k < nt; ++k) {
-      const RotaryAxis& a = md.axis(k);
-      J.template segment<2>(4 * k) = D[k].times_point(w) * a.position_basis;
-      J.template segment<2>(4 * k + 2) = D[k].times_direction(w) * a.direction_basis;
-      w = D[k].times_q(w);
+    // composed as predicted_length composes them (the Jets test checks r as well as J).
+    const double r = length + ch.length_offset - d_.length[i];
+    if constexpr (WithJacobian) {
+      const Eigen::Vector3d u = (b - P) / length;
+      // dL/d(line k) = +-u^T (outer rotations) dD_k; the table side enters with a minus. Every
+      // column is written: the 8 location errors, the pivot, and the offsets this model has.
+      const auto line_columns = [&](int k, const Eigen::RowVector3d& w, const Eigen::RowVector3d& wq) {
+        J.template segment<2>(4 * k) = D[k].times_point(w, wq) * ch.d_point[k];
+        J.template segment<2>(4 * k + 2) = D[k].times_unit_direction(w) * ch.d_unit[k];
+      };
+      Eigen::RowVector3d w = -u.transpose();
+      for (int k = 0; k < nt; ++k) {
+        const Eigen::RowVector3d wq = D[k].times_q(w);
+        line_columns(k, w, wq);
+        w = wq;
+      }
+      J.template segment<3>(8) = w;  // d/dpivot
+      w = u.transpose();
+      for (int k = nt; k < 2; ++k) {
+        const Eigen::RowVector3d wq = D[k].times_q(w);
+        line_columns(k, w, wq);
+        w = wq;
+      }
+      if (ch.tool_z_col >= 0) J[ch.tool_z_col] = w.z();
+      if (ch.length_col >= 0) J[ch.length_col] = 1.0;
     }
-    J.template segment<3>(8) = w;  // d/dpivot
-    w = u.transpose();
-    for (int k = nt; k < 2; ++k) {
-      const RotaryAxis& a = md.axis(k);
-      J.template segment<2>(4 * k) = D[k].times_point(w) * a.position_basis;
-      J.template segment<2>(4 * k + 2) = D[k].times_direction(w) * a.direction_basis;
-      w = D[k].times_q(w);
-    }
-    if (tool_z_col >= 0) J[tool_z_col] = w.z();
-    if (length_col >= 0) J[length_col] = 1.0;
+    return r;
   }
 
  private:
@@ -126,7 +199,7 @@ class BallbarLengthModel : public ResidualModel {
     const Eigen::Vector3d xyz = d_.xyz.col(i);
     out[0] = predicted_length<T>(d_.machine, LocationErrors<T>::from_ptr(p), pivot, fx_,
                                  P_ > 0 ? p + 11 : nullptr, xyz, d_.angles[static_cast<std::size_t>(i)],
-                                 d_.time[i], d_.motion[static_cast<std::size_t>(i)]) -
+                                 d_.time[i], d_.motion.empty() ? RotaryMotion{} : d_.motion[static_cast<std::size_t>(i)]) -
              T(d_.length[i]);
   }
 
@@ -134,6 +207,8 @@ class BallbarLengthModel : public ResidualModel {
   const EffectModel& fx_;
   int P_;
   bool analytic_;
+  int nt_;  // table axes: chain axes 0 .. nt_ - 1 carry the pivot, the others the tool
+  Eigen::Matrix<double, 4, Eigen::Dynamic> cs_;  // commanded_sincos
 };
 
 

@@ -210,5 +210,23 @@ TEST_CASE("the analytic Jacobian of the length model equals the Jets on every ma
     model.evaluate_jets(x, r2, &J2);
     CHECK((r1 - r2).cwiseAbs().maxCoeff() < 1e-12);
     CHECK((J1 - J2).cwiseAbs().maxCoeff() < 1e-9 * (1.0 + J2.cwiseAbs().maxCoeff()));
+    // The residuals alone (the fit's steps) take the same chain without the derivatives.
+    Eigen::VectorXd r3(a.size());
+    model.evaluate(x, r3, nullptr);
+    CHECK((r3 - r2).cwiseAbs().maxCoeff() < 1e-12);
   }
+}
+
+TEST_CASE("arrays built without the motion refuse an effect of the motion", "[identify]") {
+  BallbarSetup setup;
+  setup.step_deg = 10.0;
+  const BallbarSession s = commanded_session(plan_ballbar_test(setup));
+  EffectModel fx;
+  fx.effects = {Effect::parse("backlash_C")};
+  const BallbarArrays without = ballbar_arrays(s, {}, false);
+  CHECK(without.motion.empty());
+  CHECK_THROWS_WITH(BallbarLengthModel(without, fx), Catch::Contains("backlash_C") && Catch::Contains("motion"));
+  const BallbarArrays with = ballbar_arrays(s);
+  CHECK(with.motion.size() == static_cast<std::size_t>(with.size()));
+  CHECK_NOTHROW(BallbarLengthModel(with, fx));
 }

@@ -85,7 +85,7 @@ struct BallbarArrays {
   std::vector<std::size_t> index;                   ///< session index of each row
   Eigen::Matrix3Xd xyz;                             ///< commanded tool-side ball, mm
   std::vector<RotaryAngles<double>> angles;         ///< rad
-  std::vector<RotaryMotion> motion;                 ///< rotary_motion of the whole session
+  std::vector<RotaryMotion> motion;                 ///< rotary_motion of the whole session (empty: not built)
   Eigen::VectorXd time;                             ///< s
   Eigen::VectorXd length;                           ///< measured length, mm
   std::vector<std::string> test;                    ///< test label of each row (noise streams)
@@ -93,8 +93,10 @@ struct BallbarArrays {
   Eigen::Index size() const { return time.size(); }
 };
 
-/// The rows of `session` whose test is in `tests` (all if empty), as arrays.
-BallbarArrays ballbar_arrays(const BallbarSession& session, const std::vector<std::string>& tests = {});
+/// The rows of `session` whose test is in `tests` (all if empty), as arrays. `with_motion`
+/// false leaves `motion` empty, for a fit none of whose effects depends on the motion.
+BallbarArrays ballbar_arrays(const BallbarSession& session, const std::vector<std::string>& tests = {},
+                             bool with_motion = true);
 
 /// Joint least-squares fit of location errors + actual pivot (+ dL, + effects) to every
 /// sample: residual_i = (L_model,i - L_i) / sigma, Jacobians by Jets of the one model

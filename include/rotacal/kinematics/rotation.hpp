@@ -69,12 +69,17 @@ Pose<Scalar> rotation_about_line(const Vec3<Scalar>& point, const Vec3<Scalar>& 
 /// Cheaper than building the Pose when only one point is needed (the ballbar's pivot).
 /// This form takes c = cos(theta) and s = sin(theta) (the analytic Jacobian has them already);
 /// the form below takes theta.
+/// The form with a unit direction u is the one body; the others normalise and call it.
+template <typename Scalar>
+Vec3<Scalar> rotate_point_about_unit_line(const Vec3<Scalar>& point, const Vec3<Scalar>& u, const Scalar& c,
+                                          const Scalar& s, const Vec3<Scalar>& q) {
+  const Vec3<Scalar> v = q - point;
+  return point + v * c + u.cross(v) * s + u * (u.dot(v) * (Scalar(1) - c));
+}
 template <typename Scalar>
 Vec3<Scalar> rotate_point_about_line(const Vec3<Scalar>& point, const Vec3<Scalar>& direction,
                                      const Scalar& c, const Scalar& s, const Vec3<Scalar>& q) {
-  const Vec3<Scalar> u = direction / direction.norm();
-  const Vec3<Scalar> v = q - point;
-  return point + v * c + u.cross(v) * s + u * (u.dot(v) * (Scalar(1) - c));
+  return rotate_point_about_unit_line<Scalar>(point, Vec3<Scalar>(direction / direction.norm()), c, s, q);
 }
 template <typename Scalar>
 Vec3<Scalar> rotate_point_about_line(const Vec3<Scalar>& point, const Vec3<Scalar>& direction,
@@ -100,11 +105,20 @@ struct LineRotationDerivatives {
     const Eigen::Vector3d wk = w.transpose().cross(u);
     return w + (s * wk + (1.0 - c) * wk.cross(u)).transpose();
   }
+  /// w (I - R): pass w R when the caller has it (a chain rule needs both).
   Eigen::RowVector3d times_point(const Eigen::RowVector3d& w) const { return w - times_q(w); }
+  Eigen::RowVector3d times_point(const Eigen::RowVector3d& w, const Eigen::RowVector3d& w_times_q) const {
+    return w - w_times_q;
+  }
   Eigen::RowVector3d times_direction(const Eigen::RowVector3d& w) const {
-    const Eigen::Vector3d wt = w.transpose();
-    const Eigen::Vector3d g = -s * wt.cross(v) + (1.0 - c) * (u.dot(v) * wt + wt.dot(u) * v);
+    const Eigen::Vector3d g = times_unit_direction(w).transpose();
     return ((g - g.dot(u) * u) * inv_norm).transpose();
+  }
+  /// w df/du for the unit direction u itself; times_direction is this times
+  /// du/dd = (I - u u^T) / |d|, which a caller with many points on one line applies once.
+  Eigen::RowVector3d times_unit_direction(const Eigen::RowVector3d& w) const {
+    const Eigen::Vector3d wt = w.transpose();
+    return (-s * wt.cross(v) + (1.0 - c) * (u.dot(v) * wt + wt.dot(u) * v)).transpose();
   }
   Eigen::Matrix3d d_q() const { return rows([this](const Eigen::RowVector3d& w) { return times_q(w); }); }
   Eigen::Matrix3d d_point() const { return rows([this](const Eigen::RowVector3d& w) { return times_point(w); }); }
@@ -121,18 +135,27 @@ struct LineRotationDerivatives {
   }
 };
 
+/// The form for a line given as its point, unit direction u = d / |d| and 1 / |d|, and the
+/// angle as c = cos(theta), s = sin(theta): a fit evaluates the line once per parameter vector
+/// and the commanded angles' sines once per session.
+inline LineRotationDerivatives rotate_point_about_unit_line_derivatives(const Eigen::Vector3d& point,
+                                                                        const Eigen::Vector3d& u, double inv_norm,
+                                                                        double c, double s, const Eigen::Vector3d& q) {
+  LineRotationDerivatives D;
+  D.inv_norm = inv_norm;
+  D.u = u;
+  D.v = q - point;
+  D.c = c;
+  D.s = s;
+  D.f = rotate_point_about_unit_line<double>(point, u, c, s, q);  // the one definition
+  return D;
+}
 inline LineRotationDerivatives rotate_point_about_line_derivatives(const Eigen::Vector3d& point,
                                                                    const Eigen::Vector3d& direction,
                                                                    double theta, const Eigen::Vector3d& q) {
-  LineRotationDerivatives D;
-  const double n = direction.norm();
-  D.inv_norm = 1.0 / n;
-  D.u = direction * D.inv_norm;
-  D.v = q - point;
-  D.c = std::cos(theta);
-  D.s = std::sin(theta);
-  D.f = rotate_point_about_line<double>(point, direction, D.c, D.s, q);  // the one definition
-  return D;
+  const double inv_norm = 1.0 / direction.norm();
+  return rotate_point_about_unit_line_derivatives(point, direction * inv_norm, inv_norm, std::cos(theta),
+                                                  std::sin(theta), q);
 }
 
 /// Flynn et al. 2016, Eq. 1 written out component by component: rotates q = (x, y, z) about
