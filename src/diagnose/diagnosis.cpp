@@ -171,11 +171,10 @@ struct SearchCache {
 // The search: score every candidate against the current model, add the best one that passes
 // the F-test (Bonferroni), BIC and blocked cross-validation and whose parameters the refit can
 // determine, refit, repeat; then judge what is left.
-// `baseline_jc`: the candidates' Jacobians at the baseline (round one), computed once.
 Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
                  const std::vector<Effect>& candidates, const ModelFit& baseline,
-                 const std::vector<Eigen::MatrixXd>& baseline_jc, const NoiseTreatment& noise,
-                 const NoiseModel* model, const NoiseTreatment& white, SearchCache& cache) {
+                 const NoiseTreatment& noise, const NoiseModel* model, const NoiseTreatment& white,
+                 SearchCache& cache) {
   Diagnosis D;
   D.machine = P.machine();
   ModelFit fit = baseline;
@@ -216,16 +215,29 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
       J_levels << in.Jfree, L;
       levels_rank = static_cast<int>(orthonormal_basis(J_levels).cols() - Q_raw.cols());
     }
-    // This round's candidate Jacobians at the current fit, in one batch (the first round's
-    // are the baseline's).
-    std::vector<Eigen::MatrixXd> round_jc;
-    std::vector<std::size_t> round_index(candidates.size(), 0);
-    if (!D.findings.empty()) {
-      std::vector<Effect> todo;
-      for (std::size_t c = 0; c < candidates.size(); ++c)
-        if (!done[c] && unresolved[c].empty()) round_index[c] = todo.size(), todo.push_back(candidates[c]);
-      round_jc = cache.candidate_jacobians(P, effects, fit, todo);
-    }
+    // This round's candidate Jacobians at the current fit, in batches of at most
+    // kChunkValues doubles: one batch for a session of a few thousand readings, and a long
+    // session holds one batch at a time (the cache keeps what fits its limit).
+    constexpr std::size_t kChunkValues = std::size_t{8} << 20;
+    const std::size_t rows = static_cast<std::size_t>(fit.residuals.size());
+    std::vector<Eigen::MatrixXd> chunk_jc;
+    std::vector<std::size_t> chunk_of(candidates.size(), SIZE_MAX);  // index in chunk_jc
+    const auto jacobian_of = [&](std::size_t c) -> const Eigen::MatrixXd& {
+      if (chunk_of[c] == SIZE_MAX) {
+        std::vector<Effect> todo;
+        std::size_t values = 0;
+        for (std::size_t d = c; d < candidates.size(); ++d) {
+          if (done[d] || !unresolved[d].empty()) continue;
+          const std::size_t v = rows * static_cast<std::size_t>(candidates[d].num_params());
+          if (!todo.empty() && values + v > kChunkValues) break;
+          chunk_of[d] = todo.size();
+          todo.push_back(candidates[d]);
+          values += v;
+        }
+        chunk_jc = cache.candidate_jacobians(P, effects, fit, todo);
+      }
+      return chunk_jc[chunk_of[c]];
+    };
     std::vector<Score> scores;
     NoiseTreatment wander_noise;  // 1/f-like: AR(1) + random walk by REML, once per round
     std::vector<NoiseTreatment> treatment_of;  // per score: the noise it was judged with
@@ -236,7 +248,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
         done[c] = true;
         continue;
       }
-      const Eigen::MatrixXd& Jc = D.findings.empty() ? baseline_jc[c] : round_jc[round_index[c]];
+      const Eigen::MatrixXd& Jc = jacobian_of(c);
       Score s;
       NoiseTreatment judged_with = noise;
       if (!noise.W) {
@@ -287,6 +299,14 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
         if (first_round) D.unobservable.push_back({candidates[c].id(), s.why_not});
         done[c] = true;
         continue;
+      }
+      // The columns (cross-validation) and signature (ambiguity) serve only a candidate that
+      // can pass: the others' would hold n x (p + k + 1) doubles each, 8 KB per reading over
+      // the catalogue, which a 1 kHz recording of a whole test cannot afford.
+      if (!(s.delta_bic < options.min_delta_bic)) {
+        s.A.resize(0, 0);
+        s.X.resize(0, 0);
+        s.signature.resize(0);
       }
       scores.push_back(std::move(s));
       treatment_of.push_back(judged_with);
@@ -501,10 +521,9 @@ NoiseTreatment coloured_treatment(const NoiseModel& estimated) {
 // differences overestimated the noise (sparse sampling against the systematic errors, as an
 // R-test's 30 degree steps): if the extended model leaves less, that is the better estimate.
 Diagnosis search_white(const DiagnosisProblem& P, const DiagnosisOptions& options,
-                       const std::vector<Effect>& candidates, const ModelFit& baseline,
-                       const std::vector<Eigen::MatrixXd>& baseline_jc, SearchCache& cache) {
+                       const std::vector<Effect>& candidates, const ModelFit& baseline, SearchCache& cache) {
   const NoiseTreatment white = white_treatment(P, baseline);
-  Diagnosis D = search(P, options, candidates, baseline, baseline_jc, white, nullptr, white, cache);
+  Diagnosis D = search(P, options, candidates, baseline, white, nullptr, white, cache);
   if (!P.declared_noise_um()) {
     const double n = static_cast<double>(D.final_fit.residuals.size());
     const double s_final =
@@ -517,7 +536,7 @@ Diagnosis search_white(const DiagnosisProblem& P, const DiagnosisOptions& option
       why << "estimated from the residuals of the extended model (successive differences gave "
           << D.baseline.noise_um << " um: the sampling is too sparse for them)";
       better.source = why.str();
-      D = search(P, options, candidates, baseline, baseline_jc, better, nullptr, better, cache);
+      D = search(P, options, candidates, baseline, better, nullptr, better, cache);
     }
   }
   return D;
@@ -531,22 +550,21 @@ Diagnosis diagnose(const DiagnosisProblem& P, const DiagnosisOptions& options) {
   EffectModel none;
   none.linear_reference = P.mean_commanded_xyz();
   const ModelFit baseline = P.fit(none);
-  const std::vector<Eigen::MatrixXd> baseline_jc = P.candidate_jacobians(baseline, candidates);
   SearchCache cache;
   // Correlated at all? Judged on the baseline residuals: if even they are white (nothing
   // unmodelled, white noise), every decision is the white-noise one.
   NoiseModel model = estimate_noise_model(P.groups(), P.times(), baseline.residuals, options.noise);
   Diagnosis D;
   if (!options.model_noise || model.white()) {
-    D = search_white(P, options, candidates, baseline, baseline_jc, cache);
+    D = search_white(P, options, candidates, baseline, cache);
   } else {
-    D = search(P, options, candidates, baseline, baseline_jc, coloured_treatment(model), &model,
-               white_treatment(P, baseline), cache);
+    D = search(P, options, candidates, baseline, coloured_treatment(model), &model, white_treatment(P, baseline),
+               cache);
     // Reported: the noise model of what the final model leaves. If that is white, the
     // correlation was the unmodelled effects': the white-noise diagnosis is the right one.
     model = estimate_noise_model(P.groups(), P.times(), D.final_fit.residuals, options.noise);
     if (model.white()) {
-      D = search_white(P, options, candidates, baseline, baseline_jc, cache);
+      D = search_white(P, options, candidates, baseline, cache);
     } else {
       // The baseline's adequacy against the noise as the final model leaves it (the baseline
       // model of the noise has the unmodelled effects in it).
