@@ -1,4 +1,6 @@
 // Bindings for include/rotacal/diagnose.
+#include <pybind11/functional.h>
+
 #include "numpy.hpp"
 #include "rotacal/diagnose/ballbar_diagnosis.hpp"
 #include "rotacal/diagnose/rtest_diagnosis.hpp"
@@ -14,7 +16,9 @@ void bind_diagnose(pyb::module_& m) {
       .def_readwrite("min_delta_bic", &DiagnosisOptions::min_delta_bic)
       .def_readwrite("cv_blocks", &DiagnosisOptions::cv_blocks)
       .def_readwrite("only", &DiagnosisOptions::only)
-      .def_readwrite("model_noise", &DiagnosisOptions::model_noise);
+      .def_readwrite("model_noise", &DiagnosisOptions::model_noise)
+      .def_readwrite("progress", &DiagnosisOptions::progress,
+                     "callable(stage, done, total) after each scored candidate, or None");
 
   pyb::class_<ModelFit>(m, "ModelFit")
       .def_property_readonly("effects",

@@ -1228,6 +1228,14 @@ class DiagnosisOptions:
     @only.setter
     def only(self, arg0: collections.abc.Sequence[str]) -> None:
         ...
+    @property
+    def progress(self) -> collections.abc.Callable[[str, typing.SupportsInt | typing.SupportsIndex, typing.SupportsInt | typing.SupportsIndex], None]:
+        """
+        callable(stage, done, total) after each scored candidate, or None
+        """
+    @progress.setter
+    def progress(self, arg0: collections.abc.Callable[[str, int, int], None]) -> None:
+        ...
 class Effect:
     """
     One entry of the effects catalogue (shared/spec/effects.md).

@@ -686,12 +686,34 @@ def _print_diagnosis(d: dict) -> None:
           "(--json lists them with reasons)")
 
 
+def _diagnosis_progress(a: argparse.Namespace):
+    """A progress bar for a diagnosis that takes more than a second (a long recording), one
+    fill per search round, and its callback; (None, None) with --no-progress."""
+    from .progress import ProgressBar
+    if a.no_progress:
+        return None, None
+    bar = ProgressBar("Diagnosis", 1, " candidates", delay_s=1.0)
+    stage_now = [""]
+
+    def update(stage: str, done: int, total: int) -> None:
+        if stage != stage_now[0]:
+            stage_now[0] = stage
+            bar.reset(total)
+        bar.update(done, note=stage)
+    return bar, update
+
+
 def cmd_diagnose(a: argparse.Namespace) -> int:
     from .diagnosis import diagnose, plausible_sizes, uncertainty_budget
     check_outputs([a.report], [a.file])
     sizes = plausible_sizes(a.budget_sizes) if a.budget_sizes else None  # refused before any work
     s = _load(a.file, a)
-    result = diagnose(s, max_harmonic=a.max_harmonic)
+    bar, progress = _diagnosis_progress(a)
+    try:
+        result = diagnose(s, max_harmonic=a.max_harmonic, progress=progress)
+    finally:
+        if bar:
+            bar.close()
     if not a.no_budget:  # what the left-out effects could still put on each location error
         result.budget = uncertainty_budget(s, result, sizes=sizes)
     d = result.to_dict()
@@ -1226,6 +1248,7 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--budget-sizes", metavar="SIZES.json", type=path("--budget-sizes"),
                    help="plausible sizes of left-out effects for the uncertainty budget (docs/json_schema.md)")
     q.add_argument("--no-budget", action="store_true", help="skip the uncertainty budget")
+    q.add_argument("--no-progress", action="store_true", help="no progress bar (drawn after 1 s of work)")
     _add_plausibility_arg(q)
     q.set_defaults(func=cmd_diagnose)
 

@@ -238,6 +238,10 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
       }
       return chunk_jc[chunk_of[c]];
     };
+    int round_total = 0, round_done = 0;  // candidates to score in this round (progress)
+    for (std::size_t c = 0; c < candidates.size(); ++c) round_total += !done[c] && unresolved[c].empty();
+    const std::string stage = std::string(noise.W ? "search with the noise model" : "search (white noise)") +
+                              ", round " + std::to_string(D.rounds.size() + 1);
     std::vector<Score> scores;
     NoiseTreatment wander_noise;  // 1/f-like: AR(1) + random walk by REML, once per round
     std::vector<NoiseTreatment> treatment_of;  // per score: the noise it was judged with
@@ -249,6 +253,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
         continue;
       }
       const Eigen::MatrixXd& Jc = jacobian_of(c);
+      if (options.progress) options.progress(stage, round_done++, round_total);
       Score s;
       NoiseTreatment judged_with = noise;
       if (!noise.W) {
@@ -311,6 +316,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
       scores.push_back(std::move(s));
       treatment_of.push_back(judged_with);
     }
+    if (options.progress) options.progress(stage, round_total, round_total);
     first_round = false;
     std::vector<CandidateScore> table;
     for (const Score& s : scores) {

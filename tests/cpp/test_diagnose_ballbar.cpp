@@ -121,6 +121,42 @@ TEST_CASE("effects no plausible size makes visible are reported unobservable", "
     CHECK(std::find(ids.begin(), ids.end(), id) != ids.end());
 }
 
+TEST_CASE("the progress callback counts every round's candidates to its end", "[diagnose]") {
+  std::mt19937 rng(404);
+  BallbarMachineModel truth = random_machine(rng);
+  const Effect sag = Effect::parse("gravity_sag_A");
+  const std::vector<double> p = hidden_amplitude(truth, sag, 6.0);
+  REQUIRE_FALSE(p.empty());
+  truth.effects.effects = {sag};
+  truth.effect_params = p;
+  struct Call {
+    std::string stage;
+    int done, total;
+  };
+  std::vector<Call> calls;
+  DiagnosisOptions o;
+  o.progress = [&](const std::string& stage, int done, int total) { calls.push_back({stage, done, total}); };
+  const Diagnosis D = diagnose_ballbar(simulate_ballbar(commanded(), truth, {kNoiseUm, 7, true}), o);
+  REQUIRE(D.findings.size() == 1);
+  // Per stage: 0, 1, ..., total, in order, and a round after the finding with fewer candidates.
+  std::vector<std::string> stages;
+  for (std::size_t i = 0; i < calls.size(); ++i) {
+    const Call& c = calls[i];
+    if (stages.empty() || stages.back() != c.stage) {
+      stages.push_back(c.stage);
+      CHECK(c.done == 0);
+    } else {
+      CHECK(c.done == calls[i - 1].done + 1);
+      CHECK(c.total == calls[i - 1].total);
+    }
+    if (i + 1 == calls.size() || calls[i + 1].stage != c.stage) CHECK(c.done == c.total);
+  }
+  REQUIRE(stages.size() >= 2);
+  CHECK(stages[0].find("round 1") != std::string::npos);
+  CHECK(stages[1].find("round 2") != std::string::npos);
+  CHECK(calls.front().total > calls.back().total);
+}
+
 TEST_CASE("two hidden effects are both found", "[diagnose]") {
   std::mt19937 rng(303);
   const std::vector<std::pair<std::string, std::string>> pairs = {

@@ -211,6 +211,30 @@ def test_progress_bar_prints_deciles_to_a_log(capsys):
     assert len(lines) == 11 and lines[-1].startswith("work [" + "#" * 30 + "] 100.0%")
 
 
+def test_progress_bar_waits_its_delay_and_refills_on_reset():
+    import io
+    import time
+    buf = io.StringIO()
+    bar = ProgressBar("work", 4, stream=buf, delay_s=0.2)
+    bar.update(2)
+    assert buf.getvalue() == ""  # short work stays quiet
+    time.sleep(0.25)
+    bar.update(4)
+    bar.reset(10)
+    bar.update(5)
+    lines = buf.getvalue().splitlines()
+    assert [line.split("]")[1].split()[0] for line in lines] == ["100.0%", "50.0%"]
+
+
+def test_diagnosis_reports_progress_to_python(shared_data):
+    s = rotacal.load(shared_data / "ballbar_ac_table2.csv")
+    calls = []
+    rotacal.diagnose(s, progress=lambda stage, done, total: calls.append((stage, done, total)))
+    assert calls and calls[0][1] == 0 and "round 1" in calls[0][0]
+    assert all(0 <= done <= total for _, done, total in calls)
+    assert calls[-1][1] == calls[-1][2]
+
+
 def test_example_records_from_a_virtual_ballbar(tmp_path):
     r = subprocess.run([sys.executable, str(ROOT / "examples" / "record_virtual_ballbar.py"), tmp_path / "s.csv"],
                        capture_output=True, text=True, timeout=300)

@@ -25,6 +25,7 @@
 ///     left is reported unexplained with its signature.
 
 #include <optional>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -107,6 +108,10 @@ struct DiagnosisOptions {
   /// Jacobians (F, BIC, visibility), cross-validate with blocks at least one correlation time
   /// long and test for unexplained structure against it. False: treat the noise as white.
   bool model_noise = true;
+  /// Called after each candidate of a search round is scored (empty: silent): `stage` names
+  /// the search and round, `done` of `total` counts that round's candidates. A 10-minute
+  /// recording at 1 kHz takes tens of seconds; the CLI draws it as a progress bar.
+  std::function<void(const std::string& stage, int done, int total)> progress;
   NoiseModelOptions noise = [] {
     NoiseModelOptions o;
     o.pooled = true;  // one set of AR coefficients per session: see NoiseModelOptions::pooled
