@@ -179,6 +179,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
   D.machine = P.machine();
   ModelFit fit = baseline;
   D.baseline_fit = fit;
+  D.baseline_fit.jacobian.resize(0, 0);  // what callers read of it: residuals and parameters
   const double n = static_cast<double>(fit.residuals.size());
   D.baseline.noise_um = noise.sigma_mm * 1e3;
   D.baseline.noise_source = noise.source;
@@ -338,7 +339,8 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
     // parameters the nonlinear refit can determine.
     const Score* chosen = nullptr;
     std::vector<const Score*> undetermined;  // passed, but no parameter determinable
-    const ModelFit before = fit;
+    ModelFit before;  // the current model's fit, once a candidate is chosen (moved, not copied:
+                      // a fit holds an n x p Jacobian)
     double cv_before = 0.0, cv_after = 0.0;
     for (const Score* s : passing) {
       cv_before = cv_rms_um(in.Jfree, fit.residuals, fold, options.cv_blocks);
@@ -346,7 +348,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
       if (!(cv_after < cv_before)) continue;
       EffectModel extended = effects;
       extended.effects.push_back(s->effect);
-      ModelFit refit = cache.fit(P, extended);
+      const ModelFit& refit = cache.fit(P, extended);
       bool any_observable = false;
       for (const ParameterEstimate& p : parameters_of(refit, s->effect)) any_observable |= p.observable;
       for (std::size_t c = 0; c < candidates.size(); ++c)
@@ -362,7 +364,8 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
       }
       chosen = s;
       effects = extended;
-      fit = std::move(refit);
+      before = std::move(fit);
+      fit = refit;
       break;
     }
     if (!chosen) break;
@@ -570,6 +573,7 @@ Diagnosis diagnose(const DiagnosisProblem& P, const DiagnosisOptions& options) {
     // correlation was the unmodelled effects': the white-noise diagnosis is the right one.
     model = estimate_noise_model(P.groups(), P.times(), D.final_fit.residuals, options.noise);
     if (model.white()) {
+      D = Diagnosis{};  // released before the white search builds its own
       D = search_white(P, options, candidates, baseline, cache);
     } else {
       // The baseline's adequacy against the noise as the final model leaves it (the baseline

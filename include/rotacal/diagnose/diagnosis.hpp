@@ -277,7 +277,7 @@ struct Diagnosis {
   /// When unexplained structure remains in a group that sweeps a rotary angle: its per-angle
   /// table, offered as the extension (empty otherwise).
   std::vector<AngleTable> angle_tables;
-  ModelFit baseline_fit;
+  ModelFit baseline_fit;  ///< without its Jacobian (n x p, which a long session cannot keep twice)
   ModelFit final_fit;
   double seconds = 0.0;  ///< wall time of the diagnosis
 };
