@@ -17,59 +17,47 @@ namespace rotacal {
 
 namespace {
 
-// Burg's recursion up to order P: reflection coefficients k_1..k_P and the prediction error
-// variances v_0..v_P (v_0 = mean square of x).
-void burg(const std::vector<double>& x, int P, std::vector<double>* k, std::vector<double>* v) {
-  const std::size_t n = x.size();
-  std::vector<double> f(x), b(x);
-  double v0 = 0.0;
-  for (double xi : x) v0 += xi * xi;
-  v0 /= static_cast<double>(n);
-  k->clear();
-  v->assign(1, v0);
-  for (int m = 1; m <= P; ++m) {
-    double num = 0.0, den = 0.0;
-    for (std::size_t t = static_cast<std::size_t>(m); t < n; ++t) {
-      num += f[t] * b[t - 1];
-      den += f[t] * f[t] + b[t - 1] * b[t - 1];
-    }
-    const double km = den > 0.0 ? 2.0 * num / den : 0.0;
-    // Descending t: b[t-1] is still the previous order's when f[t], b[t] are updated.
-    for (std::size_t t = n - 1; t >= static_cast<std::size_t>(m); --t) {
-      const double ft = f[t], bt1 = b[t - 1];
-      f[t] = ft - km * bt1;
-      b[t] = bt1 - km * ft;
-    }
-    k->push_back(km);
-    v->push_back(v->back() * (1.0 - km * km));
-  }
+// One order m of Burg's recursion on a segment's forward and backward prediction errors f, b:
+// adds its sums of f_t b_{t-1} and f_t^2 + b_{t-1}^2 over t = m..n-1. Written on Eigen
+// segments so that they vectorise: the diagnosis models the residual of every candidate.
+void burg_sums(const Eigen::VectorXd& f, const Eigen::VectorXd& b, Eigen::Index m, double* num, double* den) {
+  const Eigen::Index len = f.size() - m;
+  if (len <= 0) return;
+  const auto fs = f.segment(m, len);
+  const auto bs = b.segment(m - 1, len);
+  *num += fs.dot(bs);
+  *den += fs.squaredNorm() + bs.squaredNorm();
 }
 
-// Burg's recursion over several segments at once (one model for all): sums over segments.
-void burg_pooled(const std::vector<std::vector<double>>& xs, int P, std::vector<double>* k,
-                 std::vector<double>* v, std::size_t* n_total) {
-  std::vector<std::vector<double>> f(xs), b(xs);
+// f_t <- f_t - k b_{t-1} and b_t <- b_{t-1} - k f_t for t = m..n-1, both from order m-1's values.
+void burg_update(Eigen::VectorXd& f, Eigen::VectorXd& b, Eigen::Index m, double km) {
+  const Eigen::Index len = f.size() - m;
+  if (len <= 0) return;
+  const Eigen::VectorXd bs = b.segment(m - 1, len);  // a copy: b_t is overwritten before b_{t+1} reads it
+  b.segment(m, len) = bs - km * f.segment(m, len);
+  f.segment(m, len) -= km * bs;
+}
+
+// Burg's recursion up to order P over one or more segments (one model for all: the sums run
+// over every segment): reflection coefficients k_1..k_P and the prediction error variances
+// v_0..v_P (v_0 = mean square of the readings).
+void burg_pooled(std::vector<Eigen::VectorXd> f, int P, std::vector<double>* k, std::vector<double>* v,
+                 std::size_t* n_total = nullptr) {
   double ss = 0.0;
   std::size_t n = 0;
-  for (const auto& x : xs)
-    for (double xi : x) ss += xi * xi, ++n;
-  *n_total = n;
+  for (const Eigen::VectorXd& x : f) {
+    ss += x.squaredNorm();
+    n += static_cast<std::size_t>(x.size());
+  }
+  std::vector<Eigen::VectorXd> b = f;
+  if (n_total) *n_total = n;
   k->clear();
   v->assign(1, n ? ss / static_cast<double>(n) : 0.0);
   for (int m = 1; m <= P; ++m) {
     double num = 0.0, den = 0.0;
-    for (std::size_t s = 0; s < xs.size(); ++s)
-      for (std::size_t t = static_cast<std::size_t>(m); t < xs[s].size(); ++t) {
-        num += f[s][t] * b[s][t - 1];
-        den += f[s][t] * f[s][t] + b[s][t - 1] * b[s][t - 1];
-      }
+    for (std::size_t s = 0; s < f.size(); ++s) burg_sums(f[s], b[s], m, &num, &den);
     const double km = den > 0.0 ? 2.0 * num / den : 0.0;
-    for (std::size_t s = 0; s < xs.size(); ++s)
-      for (std::size_t t = xs[s].size(); t-- > static_cast<std::size_t>(m);) {
-        const double ft = f[s][t], bt1 = b[s][t - 1];
-        f[s][t] = ft - km * bt1;
-        b[s][t] = bt1 - km * ft;
-      }
+    for (std::size_t s = 0; s < f.size(); ++s) burg_update(f[s], b[s], m, km);
     k->push_back(km);
     v->push_back(v->back() * (1.0 - km * km));
   }
@@ -162,17 +150,55 @@ std::vector<std::vector<Eigen::Index>> noise_streams(const std::vector<std::stri
   return out;
 }
 
+NoiseStreamLayout::NoiseStreamLayout(const std::vector<std::string>& groups,
+                                     const std::vector<double>& times)
+    : n(groups.size()) {
+  rows = noise_streams(groups, times, &group, &channel);
+  sample_interval_s.reserve(rows.size());
+  std::vector<double> dt;
+  for (const std::vector<Eigen::Index>& s : rows) {
+    dt.clear();
+    for (std::size_t t = 1; t < s.size(); ++t) {
+      const double d = times[static_cast<std::size_t>(s[t])] - times[static_cast<std::size_t>(s[t - 1])];
+      if (d > 0.0) dt.push_back(d);
+    }
+    sample_interval_s.push_back(median(dt));
+  }
+}
+
+NoiseStreamLayout NoiseStreamLayout::except_group(const std::string& name) const {
+  NoiseStreamLayout out;
+  out.n = n;
+  for (std::size_t s = 0; s < rows.size(); ++s) {
+    if (group[s] == name) continue;
+    out.rows.push_back(rows[s]);
+    out.group.push_back(group[s]);
+    out.channel.push_back(channel[s]);
+    out.sample_interval_s.push_back(sample_interval_s[s]);
+  }
+  return out;
+}
+
 NoiseModel estimate_noise_model(const std::vector<std::string>& groups,
                                 const std::vector<double>& times,
                                 const Eigen::VectorXd& residuals_mm,
                                 const NoiseModelOptions& options) {
-  if (options.max_order < 0)
-    throw InvalidArgument("estimate_noise_model: options.max_order is " +
-                          std::to_string(options.max_order) + ", must be >= 0");
   if (static_cast<std::size_t>(residuals_mm.size()) != groups.size())
     throw InvalidArgument("estimate_noise_model: residuals has " +
                           std::to_string(residuals_mm.size()) + " entries but groups has " +
                           std::to_string(groups.size()));
+  return estimate_noise_model(NoiseStreamLayout(groups, times), residuals_mm, options);
+}
+
+NoiseModel estimate_noise_model(const NoiseStreamLayout& layout, const Eigen::VectorXd& residuals_mm,
+                                const NoiseModelOptions& options) {
+  if (options.max_order < 0)
+    throw InvalidArgument("estimate_noise_model: options.max_order is " +
+                          std::to_string(options.max_order) + ", must be >= 0");
+  if (static_cast<std::size_t>(residuals_mm.size()) != layout.n)
+    throw InvalidArgument("estimate_noise_model: residuals has " +
+                          std::to_string(residuals_mm.size()) + " entries but the session has " +
+                          std::to_string(layout.n) + " readings");
   for (Eigen::Index i = 0; i < residuals_mm.size(); ++i)
     if (!std::isfinite(residuals_mm[i]))
       throw InvalidArgument("estimate_noise_model: residuals[" + std::to_string(i) +
@@ -180,36 +206,24 @@ NoiseModel estimate_noise_model(const std::vector<std::string>& groups,
   if (options.pooled && options.pool_only_if_all_coloured) {
     NoiseModelOptions own = options;
     own.pooled = false;
-    NoiseModel each = estimate_noise_model(groups, times, residuals_mm, own);
+    NoiseModel each = estimate_noise_model(layout, residuals_mm, own);
     for (const NoiseStream& st : each.streams)
       if (st.order() == 0) return each;
     own.pooled = true;
     own.pool_only_if_all_coloured = false;
-    return estimate_noise_model(groups, times, residuals_mm, own);
+    return estimate_noise_model(layout, residuals_mm, own);
   }
-  std::vector<std::string> sg;
-  std::vector<int> sc;
-  const auto streams = noise_streams(groups, times, &sg, &sc);
+  const auto& streams = layout.rows;
+  const auto& sg = layout.group;
+  const auto& sc = layout.channel;
+  const auto& intervals = layout.sample_interval_s;
   NoiseModel M;
-  M.n = groups.size();
-  // Each stream's readings in time order with its mean removed, and its sample interval.
-  std::vector<std::vector<double>> xs(streams.size());
-  std::vector<double> intervals(streams.size(), 0.0);
+  M.n = layout.n;
+  // Each stream's readings in time order with its mean removed.
+  std::vector<Eigen::VectorXd> xs(streams.size());
   for (std::size_t s = 0; s < streams.size(); ++s) {
-    const std::size_t n = streams[s].size();
-    std::vector<double>& x = xs[s];
-    x.resize(n);
-    std::vector<double> dt;
-    double mean = 0.0;
-    for (std::size_t t = 0; t < n; ++t) mean += (x[t] = residuals_mm[streams[s][t]]);
-    mean /= static_cast<double>(n);
-    for (double& xi : x) xi -= mean;
-    for (std::size_t t = 1; t < n; ++t) {
-      const double d = times[static_cast<std::size_t>(streams[s][t])] -
-                       times[static_cast<std::size_t>(streams[s][t - 1])];
-      if (d > 0.0) dt.push_back(d);
-    }
-    intervals[s] = median(dt);
+    xs[s] = residuals_mm(streams[s]);
+    xs[s].array() -= xs[s].mean();
   }
   // BIC over orders 0..P of Burg's prediction error variances v_p for n readings.
   const auto choose = [](const std::vector<double>& v, std::size_t n) {
@@ -226,7 +240,7 @@ NoiseModel estimate_noise_model(const std::vector<std::string>& groups,
   int pooled_order = 0;
   if (options.pooled) {
     std::size_t shortest = SIZE_MAX, total = 0;
-    for (const auto& x : xs) shortest = std::min(shortest, x.size());
+    for (const auto& x : xs) shortest = std::min(shortest, static_cast<std::size_t>(x.size()));
     const int P = streams.empty() ? 0 : std::min(options.max_order, static_cast<int>(shortest / 4));
     burg_pooled(xs, std::max(P, 0), &pooled_k, &pooled_v, &total);
     pooled_order = choose(pooled_v, total);
@@ -252,7 +266,9 @@ NoiseModel estimate_noise_model(const std::vector<std::string>& groups,
       const int P = static_cast<int>(n) >= options.min_stream_size
                         ? std::min(options.max_order, static_cast<int>(n / 4))
                         : 0;
-      burg(xs[s], P, &k, &v);
+      std::vector<Eigen::VectorXd> one(1);
+      one[0] = std::move(xs[s]);  // not read again
+      burg_pooled(std::move(one), P, &k, &v);
       best = choose(v, n);
     }
     S.reflection.assign(k.begin(), k.begin() + best);
@@ -458,6 +474,86 @@ void ArWhitener::apply(Eigen::Ref<Eigen::MatrixXd> columns) const {
       }
     }
   }
+}
+
+bool ArWhitener::ar1_only() const {
+  for (const Stream& s : streams_)
+    if (!s.walk.empty() || s.chol.size() > 0 || s.phi.size() > 2) return false;
+  return true;
+}
+
+void ArWhitener::apply_inverse_covariance(Eigen::Ref<Eigen::MatrixXd> columns) const {
+  if (!ar1_only())
+    throw InvalidArgument("ArWhitener::apply_inverse_covariance: needs AR order <= 1 without a random walk");
+  apply(columns);
+  // W^T of the start-up row e_0 = a x_0 and the rows e_t = b (x_t - phi x_{t-1}) (apply()).
+  for (const Stream& s : streams_) {
+    const std::size_t n = s.rows.size();
+    if (n == 0) continue;
+    const double a = s.inv_sd[0];
+    if (s.phi.size() < 2) {
+      for (Eigen::Index c = 0; c < columns.cols(); ++c)
+        for (const Eigen::Index r : s.rows) columns(r, c) *= a;
+      continue;
+    }
+    const double b = s.inv_sd[1], phi = s.phi[1][0];
+    for (Eigen::Index c = 0; c < columns.cols(); ++c) {
+      double next = 0.0;  // e_{t+1}, in place of which the loop writes (W^T e)_{t+1}
+      for (std::size_t t = n; t-- > 0;) {
+        double& y = columns(s.rows[t], c);
+        const double e = y;
+        y = (t == 0 ? a : b) * e - (t + 1 < n ? b * phi * next : 0.0);
+        next = e;
+      }
+    }
+  }
+}
+
+StreamLagProducts::StreamLagProducts(const Eigen::MatrixXd& J, std::vector<std::vector<Eigen::Index>> stream_rows)
+    : rows(std::move(stream_rows)) {
+  const Eigen::Index p = J.cols();
+  std::vector<char> covered(static_cast<std::size_t>(J.rows()), 0);
+  Eigen::MatrixXd block;
+  for (const std::vector<Eigen::Index>& r : rows) {
+    const Eigen::Index m = static_cast<Eigen::Index>(r.size());
+    block.resize(m, p);
+    for (Eigen::Index t = 0; t < m; ++t) {
+      block.row(t) = J.row(r[static_cast<std::size_t>(t)]);
+      covered[static_cast<std::size_t>(r[static_cast<std::size_t>(t)])] = 1;
+    }
+    S.push_back(block.transpose() * block);
+    U.push_back(m > 1 ? Eigen::MatrixXd(block.bottomRows(m - 1).transpose() * block.topRows(m - 1))
+                      : Eigen::MatrixXd::Zero(p, p));
+    first.push_back(m ? Eigen::MatrixXd(block.row(0).transpose() * block.row(0)) : Eigen::MatrixXd::Zero(p, p));
+    last.push_back(m ? Eigen::MatrixXd(block.row(m - 1).transpose() * block.row(m - 1)) : Eigen::MatrixXd::Zero(p, p));
+  }
+  rest = Eigen::MatrixXd::Zero(p, p);
+  for (Eigen::Index i = 0; i < J.rows(); ++i)
+    if (!covered[static_cast<std::size_t>(i)]) rest += J.row(i).transpose() * J.row(i);
+}
+
+Eigen::MatrixXd ArWhitener::gram(const StreamLagProducts& lags) const {
+  if (!ar1_only()) throw InvalidArgument("ArWhitener::gram: needs AR order <= 1 without a random walk");
+  if (lags.rows.size() != streams_.size())
+    throw InvalidArgument("ArWhitener::gram: the lag products have " + std::to_string(lags.rows.size()) +
+                          " streams, the noise model " + std::to_string(streams_.size()));
+  Eigen::MatrixXd G = lags.rest;
+  for (std::size_t k = 0; k < streams_.size(); ++k) {
+    const Stream& s = streams_[k];
+    if (s.rows != lags.rows[k])
+      throw InvalidArgument("ArWhitener::gram: stream " + std::to_string(k) + " has other rows than the lag products");
+    if (s.rows.empty()) continue;
+    const double a2 = s.inv_sd[0] * s.inv_sd[0];
+    if (s.phi.size() < 2) {
+      G += a2 * lags.S[k];
+      continue;
+    }
+    const double b2 = s.inv_sd[1] * s.inv_sd[1], phi = s.phi[1][0];
+    G += a2 * lags.first[k] +
+         b2 * ((1.0 + phi * phi) * lags.S[k] - lags.first[k] - phi * phi * lags.last[k] -
+               phi * (lags.U[k] + lags.U[k].transpose()));
+  }
+  return G;
 }
 
 namespace noise_gen {

@@ -9,6 +9,7 @@
 #include <map>
 #include <set>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "rotacal/ballbar/test_plan.hpp"
@@ -110,13 +111,15 @@ NoiseTreatment coloured_treatment(const NoiseModel& m);
 
 // The noise model of what the current model extended by candidate c (linearised) leaves;
 // white treatment if that is white.
-NoiseTreatment candidate_treatment(const DiagnosisProblem& P, const DiagnosisOptions& options,
+NoiseTreatment candidate_treatment(const NoiseStreamLayout& layout, const DiagnosisOptions& options,
                                    const ModelFit& fit, const Eigen::MatrixXd& Q_raw,
                                    const Eigen::MatrixXd& Jc, const Effect& c,
                                    const NoiseTreatment& white, NoiseModel* model) {
-  const Eigen::MatrixXd perp = project_out(Q_raw, Jc) * magnitudes(c).asDiagonal();
-  const Eigen::VectorXd r = fit.residuals - perp * solve_ls(perp, fit.residuals);
-  *model = estimate_noise_model(P.groups(), P.times(), r, options.noise);
+  // What the candidate adds to the model's span, orthonormalised (CholeskyQR2; the rank-revealing
+  // QR where it is near rank-deficient): r minus its projection on that.
+  const Eigen::MatrixXd B = orthonormal_basis_full_rank(project_out(Q_raw, Jc));
+  const Eigen::VectorXd r = fit.residuals - B * (B.transpose() * fit.residuals);
+  *model = estimate_noise_model(layout, r, options.noise);
   return model->white() ? white : coloured_treatment(*model);
 }
 
@@ -194,6 +197,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
 
   const std::vector<std::string> unresolved =
       unresolved_orders(P, candidates, options.min_harmonic_new_content);
+  const NoiseStreamLayout layout(P.groups(), P.times());  // every noise model of this search
   const std::vector<int> fold = cv_folds(P, options.cv_blocks, noise.W ? model : nullptr);
   EffectModel effects;
   effects.linear_reference = P.mean_commanded_xyz();
@@ -245,6 +249,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
                               ", round " + std::to_string(D.rounds.size() + 1);
     std::vector<Score> scores;
     NoiseTreatment wander_noise;  // 1/f-like: AR(1) + random walk by REML, once per round
+    std::unique_ptr<ModelProducts> round_products;  // white or AR(1) candidates' Gram matrices
     std::vector<NoiseTreatment> treatment_of;  // per score: the noise it was judged with
     for (std::size_t c = 0; c < candidates.size(); ++c) {
       if (done[c]) continue;
@@ -265,7 +270,30 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
         // follows stays correlated (so it is not taken for an effect), and an effect's own
         // signature is not mistaken for correlated noise (which would whiten it away).
         NoiseModel own_model;
-        NoiseTreatment own = candidate_treatment(P, options, fit, Q_raw, Jc, candidates[c], white, &own_model);
+        NoiseTreatment own = candidate_treatment(layout, options, fit, Q_raw, Jc, candidates[c], white, &own_model);
+        if (own_model.max_order < 2 && (!own.W || own.W->ar1_only())) {
+          // White or AR(1): scored from inner products; only a candidate that may pass is
+          // scored again below with its columns (the margin of 1 is far beyond rounding).
+          if (!round_products)
+            round_products = std::make_unique<ModelProducts>(in.Jfree, layout.rows);
+          const CandidateProducts g =
+              candidate_products(own.W.get(), own.sigma_mm, *round_products, in.Jfree, Jc, fit.residuals);
+          std::optional<Score> quick =
+              score_from_products(g, candidates[c], fit.num_free, options.min_visible_chi2);
+          if (quick && !(quick->observable && quick->delta_bic < options.min_delta_bic + 1.0)) {
+            s = std::move(*quick);
+            s.rss1 *= in.r_w.squaredNorm() / std::max(g.rr, 1e-300);
+            judged_with = own;
+            if (!s.observable) {
+              if (first_round) D.unobservable.push_back({candidates[c].id(), s.why_not});
+              done[c] = true;
+              continue;
+            }
+            scores.push_back(std::move(s));
+            treatment_of.push_back(judged_with);
+            continue;
+          }
+        }
         ScoringInputs in_c;
         in_c.Jfree = in.Jfree;
         in_c.num_free = fit.num_free;
@@ -282,7 +310,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
           in_c.Jfree = J_levels;
           in_c.num_free += levels_rank;
           if (!wander_noise.W) {
-            const NoiseModel start = estimate_noise_model(P.groups(), P.times(), fit.residuals, options.noise);
+            const NoiseModel start = estimate_noise_model(layout, fit.residuals, options.noise);
             wander_noise = coloured_treatment(estimate_noise_model_reml(start, fit.residuals, J_levels));
           }
           own = wander_noise;
@@ -429,7 +457,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
     // model would take its structure for correlated noise and whiten it away, and with the
     // tested structure fitted first it would lose the noise's low frequencies with it and find
     // structure in every null session.
-    const NoiseModel final_model = estimate_noise_model(P.groups(), P.times(), fit.residuals, options.noise);
+    const NoiseModel final_model = estimate_noise_model(layout, fit.residuals, options.noise);
     Eigen::MatrixXd Jfree = free_columns(fit.jacobian);
     int num_free = fit.num_free;
     // 1/f-like: stream levels are nuisance and the noise is AR(1) + a random walk by REML, as
@@ -445,22 +473,18 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
       Jfree = X;
       wander = coloured_treatment(estimate_noise_model_reml(final_model, fit.residuals, Jfree));
     }
+    NoiseModelOptions pooled = options.noise;
+    pooled.pooled = true;
+    pooled.pool_only_if_all_coloured = false;
+    const NoiseModel pooled_all = estimate_noise_model(layout, fit.residuals, pooled);  // its streams
     const auto whitener_for = [&](const std::string& group, const Eigen::MatrixXd&) {
       if (wander.W) return Whiten([wander](const Eigen::MatrixXd& M) { return wander.whiten(M); });
-      std::vector<std::string> g;
-      std::vector<double> t;
-      std::vector<double> r;
-      for (std::size_t i = 0; i < P.groups().size(); ++i)
-        if (P.groups()[i] != group)
-          g.push_back(P.groups()[i]), t.push_back(P.times()[i]), r.push_back(fit.residuals[static_cast<Eigen::Index>(i)]);
-      NoiseModelOptions pooled = options.noise;
-      pooled.pooled = true;
-      pooled.pool_only_if_all_coloured = false;
       NoiseTreatment t_noise = white;
-      if (!g.empty()) {
-        const NoiseModel others = estimate_noise_model(g, t, Eigen::Map<const Eigen::VectorXd>(r.data(), static_cast<Eigen::Index>(r.size())), pooled);
+      const NoiseStreamLayout others_layout = layout.except_group(group);
+      if (!others_layout.rows.empty()) {
+        const NoiseModel others = estimate_noise_model(others_layout, fit.residuals, pooled);
         if (!others.white()) {
-          NoiseModel all = estimate_noise_model(P.groups(), P.times(), fit.residuals, pooled);
+          NoiseModel all = pooled_all;
           const NoiseStream& o = others.streams.front();
           for (NoiseStream& st : all.streams) {
             st.reflection = o.reflection, st.ar = o.ar;
@@ -491,7 +515,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
       D.unexplained.signature += where.str();
       // A function of one rotary angle: offer the per-angle table as the extension.
       if (L.axis) {
-        const NoiseModel left = estimate_noise_model(P.groups(), P.times(), fit.residuals, options.noise);
+        const NoiseModel left = estimate_noise_model(layout, fit.residuals, options.noise);
         AngleTable T = angle_table(P, fit.residuals, D.unexplained.group, left, noise.sigma_mm * 1e3,
                                    options.cv_blocks);
         if (T.gain.cv_rms_after_um < T.gain.cv_rms_before_um) D.angle_tables.push_back(std::move(T));

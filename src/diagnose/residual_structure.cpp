@@ -240,7 +240,9 @@ StructureTest structure_test(
         G(static_cast<Eigen::Index>(idx[k]), static_cast<Eigen::Index>(j)) = f[j](x[k]);
     const Whiten whiten = whitener_for(group, G);
     const Eigen::VectorXd r_w = whiten(r_mm);
-    const Eigen::MatrixXd Gp = project_out(orthonormal_basis(whiten(Jfree)), whiten(G));
+    // The model's columns are full rank here (free columns of a fit): CholeskyQR2, which falls
+    // back to the rank-revealing QR where they are not.
+    const Eigen::MatrixXd Gp = project_out(orthonormal_basis_full_rank(whiten(Jfree)), whiten(G));
     const Eigen::MatrixXd B = orthonormal_basis(Gp);
     const auto q = static_cast<double>(B.cols());
     if (q == 0) continue;

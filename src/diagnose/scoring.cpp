@@ -2,6 +2,7 @@
 // BIC and F-test, and blocked cross-validation.
 #include <Eigen/Cholesky>
 #include <Eigen/QR>
+#include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
@@ -188,6 +189,103 @@ Score score(const ScoringInputs& in, const Effect& c, const Eigen::MatrixXd& Jc,
   s.rss1 = std::max(rss(in.r_w - s.signature), 1e-300);
   const double n = static_cast<double>(in.r_w.size());
   const double dof = n - in.num_free - s.k;
+  s.delta_bic = n * std::log(s.rss1 / rss0) + s.k * std::log(n);
+  const double F = ((rss0 - s.rss1) / s.k) / (s.rss1 / dof);
+  s.f_pvalue = stats::f_sf(std::max(F, 0.0), s.k, dof);
+  return s;
+}
+
+ModelProducts::ModelProducts(const Eigen::MatrixXd& Jf, std::vector<std::vector<Eigen::Index>> streams)
+    : lags(Jf, std::move(streams)), gram(Jf.transpose() * Jf) {}
+
+CandidateProducts candidate_products(const ArWhitener* W, double sigma_mm, const ModelProducts& model,
+                                     const Eigen::MatrixXd& Jf, const Eigen::MatrixXd& Jc,
+                                     const Eigen::VectorXd& r) {
+  const Eigen::Index k = Jc.cols();
+  Eigen::MatrixXd MX(Jc.rows(), k + 1);  // V^-1 [Jc r]
+  MX << Jc, r;
+  CandidateProducts g;
+  if (W) {
+    W->apply_inverse_covariance(MX);
+    g.G_ff = W->gram(model.lags);
+  } else {
+    const double inv_var = 1.0 / (sigma_mm * sigma_mm);
+    MX *= inv_var;
+    g.G_ff = model.gram * inv_var;
+  }
+  const Eigen::MatrixXd fX = Jf.transpose() * MX;
+  g.g_fc = fX.leftCols(k);
+  g.g_fr = fX.col(k);
+  g.G_cc = Jc.transpose() * MX.leftCols(k);
+  g.g_cr = Jc.transpose() * MX.col(k);
+  g.rr = r.dot(MX.col(k));
+  g.n = r.size();
+  return g;
+}
+
+std::optional<Score> score_from_products(const CandidateProducts& g, const Effect& c, int num_free,
+                                         double min_chi2) {
+  Score s;
+  s.effect = c;
+  const Eigen::VectorXd m = magnitudes(c);
+  // Y = L^-1 D^-1 g_fc with D^-1 G_ff D^-1 = L L^T: then Y^T Y is the part of the candidate's
+  // Gram matrix that the model's columns explain (the normalised Cholesky test is
+  // orthonormal_basis_full_rank's, stricter: cancellation in G_cc - Y^T Y grows with the
+  // condition number, which rounding must not let decide a threshold).
+  Eigen::MatrixXd Y = g.g_fc;
+  Eigen::VectorXd yr = g.g_fr;
+  if (g.G_ff.rows() > 0) {
+    const Eigen::VectorXd d = g.G_ff.diagonal().cwiseSqrt();
+    if (!(d.minCoeff() > 0.0) || !d.allFinite()) return std::nullopt;
+    const Eigen::VectorXd di = d.cwiseInverse();
+    const Eigen::LLT<Eigen::MatrixXd> llt(di.asDiagonal() * g.G_ff * di.asDiagonal());
+    if (llt.info() != Eigen::Success || !(llt.matrixLLT().diagonal().minCoeff() > 1e-3)) return std::nullopt;
+    Y = di.asDiagonal() * Y;
+    llt.matrixL().solveInPlace(Y);
+    yr = di.asDiagonal() * yr;
+    llt.matrixL().solveInPlace(yr);
+  }
+  // Per plausible size: raw = the candidate's whitened Gram matrix, perp = after projecting
+  // out the model; their eigenvalues are score()'s squared singular values (chi-square changes).
+  const Eigen::MatrixXd raw = m.asDiagonal() * g.G_cc * m.asDiagonal();
+  const Eigen::MatrixXd perp = m.asDiagonal() * (g.G_cc - Y.transpose() * Y) * m.asDiagonal();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(perp);
+  if (es.info() != Eigen::Success) return std::nullopt;
+  const Eigen::VectorXd ev = es.eigenvalues();
+  const double tol = 1e-8 * std::max(raw.norm(), min_chi2);
+  std::vector<Eigen::Index> dirs;
+  for (Eigen::Index i = 0; i < ev.size(); ++i) {
+    if (std::abs(ev[i] - min_chi2) < tol) return std::nullopt;
+    if (ev[i] >= min_chi2) dirs.push_back(i);
+  }
+  if (dirs.empty()) {
+    const Eigen::VectorXd ev_raw = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(raw, Eigen::EigenvaluesOnly).eigenvalues();
+    const double top = ev_raw.size() ? ev_raw.maxCoeff() : 0.0;
+    if (std::abs(top - min_chi2) < tol) return std::nullopt;
+    const bool absorbed = top >= min_chi2;
+    s.why_not = absorbed
+                    ? "its effect on these readings is indistinguishable from the location "
+                      "errors and set-up parameters already in the model"
+                    : "at any plausible size it changes these readings by less than 5 sigma "
+                      "in all (e.g. a motion perpendicular to the bar)";
+    return s;
+  }
+  s.observable = true;
+  s.k = static_cast<int>(dirs.size());
+  Eigen::MatrixXd V(m.size(), s.k);
+  Eigen::VectorXd lambda(s.k);
+  for (int i = 0; i < s.k; ++i) {
+    V.col(i) = es.eigenvectors().col(dirs[static_cast<std::size_t>(i)]);
+    lambda[i] = ev[dirs[static_cast<std::size_t>(i)]];
+  }
+  // A = perp V has orthogonal columns of squared norms lambda: d = A^T r_w / lambda.
+  const Eigen::VectorXd Atr = V.transpose() * (m.asDiagonal() * (g.g_cr - Y.transpose() * yr));
+  const Eigen::VectorXd d = Atr.cwiseQuotient(lambda);
+  s.params = m.cwiseProduct(V * d);
+  const double rss0 = g.rr;
+  s.rss1 = std::max(rss0 - Atr.dot(d), 1e-300);
+  const double n = static_cast<double>(g.n);
+  const double dof = n - num_free - s.k;
   s.delta_bic = n * std::log(s.rss1 / rss0) + s.k * std::log(n);
   const double F = ((rss0 - s.rss1) / s.k) / (s.rss1 / dof);
   s.f_pvalue = stats::f_sf(std::max(F, 0.0), s.k, dof);

@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -64,6 +65,35 @@ struct ScoringInputs {
 /// plausible sizes change chi-square by less than min_chi2 are not visible.
 Score score(const ScoringInputs& in, const Effect& c, const Eigen::MatrixXd& Jc,
             const Eigen::MatrixXd& Jc_w, double min_chi2);
+/// The inner products score() works from, in the noise model's metric <x, y> = x^T V^-1 y:
+/// f the current model's free columns, c the candidate's (mm per unit), r the residuals.
+struct CandidateProducts {
+  Eigen::MatrixXd G_ff, g_fc, G_cc;
+  Eigen::VectorXd g_fr, g_cr;
+  double rr = 0.0;  ///< <r, r>
+  Eigen::Index n = 0;  ///< readings
+};
+/// The current model's free columns Jf as any white or AR(1) noise model of the given streams
+/// sees them (each candidate of a coloured round has its own): lag products per stream, and
+/// the plain Gram matrix. O(n p^2) once a round.
+struct ModelProducts {
+  StreamLagProducts lags;
+  Eigen::MatrixXd gram;
+  ModelProducts(const Eigen::MatrixXd& Jf, std::vector<std::vector<Eigen::Index>> streams);
+};
+/// The products for candidate columns Jc and residuals r (mm) under whitener W (AR order <= 1,
+/// no random walk), or white noise of sigma_mm where W is null. O(n p k).
+CandidateProducts candidate_products(const ArWhitener* W, double sigma_mm, const ModelProducts& model,
+                                     const Eigen::MatrixXd& Jf, const Eigen::MatrixXd& Jc,
+                                     const Eigen::VectorXd& r);
+/// score() from inner products alone: O(p^3) per candidate where score() needs a basis of the
+/// whitened model columns, O(n p^2), for each candidate's own noise model (most of the
+/// coloured search's cost at rho 0.5). Returns what the round's table needs (observability,
+/// parameters, rss1, delta BIC, F-test) without the columns A, X and signature, which only a
+/// candidate able to pass needs. Empty where the products cannot decide as the columns would:
+/// the model's columns near rank-deficient, or a chi-square change within rounding of min_chi2.
+std::optional<Score> score_from_products(const CandidateProducts& g, const Effect& c, int num_free,
+                                         double min_chi2);
 /// Cosine of the angle between two signatures (0 if either is zero).
 double correlation(const Eigen::VectorXd& a, const Eigen::VectorXd& b);
 

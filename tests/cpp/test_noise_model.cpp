@@ -5,6 +5,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/QR>
+#include <Eigen/LU>
 #include <cmath>
 #include <random>
 
@@ -15,6 +16,12 @@
 using namespace rotacal;
 
 namespace {
+
+std::vector<std::vector<Eigen::Index>> noise_streams_of(const NoiseModel& M) {
+  std::vector<std::vector<Eigen::Index>> rows;
+  for (const NoiseStream& s : M.streams) rows.push_back(s.rows);
+  return rows;
+}
 
 struct Layout {
   std::vector<std::string> groups;
@@ -141,6 +148,57 @@ TEST_CASE("the whitener is the inverse Cholesky factor of the AR(1) covariance",
   CHECK((W * S * W.transpose() - Eigen::MatrixXd::Identity(6, 6)).cwiseAbs().maxCoeff() < 1e-9);
   // Lower triangular (a causal filter) like a Cholesky factor's inverse.
   CHECK(W.triangularView<Eigen::StrictlyUpper>().toDenseMatrix().cwiseAbs().maxCoeff() == 0.0);
+}
+
+TEST_CASE("AR(1) inverse covariance and lag-product Gram matrix equal the whitened products", "[noise_model]") {
+  // Two AR(1) streams with interleaved rows, a white one, and a row in no stream (the whitener
+  // leaves it as it is). V^-1 is written from the definition (the inverse of each stream's
+  // sigma^2 phi^|i-j| covariance), independently of the whitener's recursion.
+  NoiseModel M;
+  M.n = 21;
+  NoiseStream a, b, w;
+  for (Eigen::Index i = 0; i < 16; i += 2) a.rows.push_back(i);
+  for (Eigen::Index i = 1; i < 16; i += 2) b.rows.push_back(i);
+  for (Eigen::Index i = 16; i < 20; ++i) w.rows.push_back(i);
+  a.reflection = a.ar = {0.8};
+  a.marginal_sigma_um = 1.5;
+  b.reflection = b.ar = {-0.3};
+  b.marginal_sigma_um = 0.7;
+  w.marginal_sigma_um = 2.0;
+  M.streams = {a, b, w};
+  M.max_order = 1;
+  Eigen::MatrixXd Vinv = Eigen::MatrixXd::Identity(21, 21);
+  for (const NoiseStream& s : M.streams) {
+    const Eigen::Index m = static_cast<Eigen::Index>(s.rows.size());
+    const double phi = s.ar.empty() ? 0.0 : s.ar[0], sx = s.marginal_sigma_um * 1e-3;
+    Eigen::MatrixXd C(m, m);
+    for (Eigen::Index i = 0; i < m; ++i)
+      for (Eigen::Index j = 0; j < m; ++j) C(i, j) = sx * sx * std::pow(phi, std::abs(static_cast<double>(i - j)));
+    const Eigen::MatrixXd Ci = C.inverse();
+    for (Eigen::Index i = 0; i < m; ++i)
+      for (Eigen::Index j = 0; j < m; ++j) Vinv(s.rows[static_cast<std::size_t>(i)], s.rows[static_cast<std::size_t>(j)]) = Ci(i, j);
+  }
+  std::mt19937 rng(5);
+  std::normal_distribution<double> N(0.0, 1.0);
+  Eigen::MatrixXd J(21, 4);
+  for (Eigen::Index i = 0; i < J.size(); ++i) J.data()[i] = N(rng);
+  J.col(2) *= 1e-3;  // columns of different units
+  const ArWhitener W(M);
+  REQUIRE(W.ar1_only());
+  Eigen::MatrixXd VJ = J;
+  W.apply_inverse_covariance(VJ);
+  const Eigen::MatrixXd expect = Vinv * J;
+  CHECK((VJ - expect).cwiseAbs().maxCoeff() < 1e-9 * expect.cwiseAbs().maxCoeff());
+  const Eigen::MatrixXd G = W.gram(StreamLagProducts(J, noise_streams_of(M)));
+  const Eigen::MatrixXd G_expect = J.transpose() * Vinv * J;
+  CHECK((G - G_expect).cwiseAbs().maxCoeff() < 1e-9 * G_expect.cwiseAbs().maxCoeff());
+  // Lag products of other streams, and models it does not cover, are refused by name.
+  CHECK_THROWS_WITH(W.gram(StreamLagProducts(J, {a.rows, b.rows})), Catch::Contains("streams"));
+  NoiseModel ar2 = M;
+  ar2.streams[0].reflection = {0.5, 0.2};
+  ar2.max_order = 2;
+  CHECK_FALSE(ArWhitener(ar2).ar1_only());
+  CHECK_THROWS_AS(ArWhitener(ar2).apply_inverse_covariance(VJ), InvalidArgument);
 }
 
 TEST_CASE("AR(2) autocovariance from the reflection coefficients agrees with the whitener", "[noise_model]") {
@@ -372,4 +430,69 @@ TEST_CASE("bad input to the noise model names what was wrong", "[noise_model]") 
   Eigen::MatrixXd wrong(4, 1);
   CHECK_THROWS_WITH(ArWhitener(M).apply(wrong), Catch::Contains("4 rows given"));
   CHECK_THROWS_AS(noise_gen::ar1(L.groups, L.times, 1.0, 1e-3, 1), InvalidArgument);
+}
+
+TEST_CASE("Burg's reflection coefficients agree with the textbook recursion", "[noise_model]") {
+  // The library's Burg runs on vector segments; this is the per-sample recursion (Burg 1975,
+  // as in Kay, Modern Spectral Estimation, Sec. 7.4) on one AR(2) stream of 400 readings.
+  const Layout L = layout(1, 400, 100.0);
+  Eigen::VectorXd x(400);
+  std::mt19937 rng(17);
+  std::normal_distribution<double> N(0.0, 1e-3);
+  x[0] = N(rng), x[1] = N(rng);
+  for (Eigen::Index t = 2; t < x.size(); ++t) x[t] = 1.2 * x[t - 1] - 0.5 * x[t - 2] + N(rng);
+  const NoiseModel M = estimate_noise_model(L.groups, L.times, x);
+  REQUIRE(M.streams.size() == 1);
+  const std::vector<double>& k = M.streams[0].reflection;
+  REQUIRE(k.size() == 2);  // BIC picks the simulated order
+  std::vector<double> f(x.data(), x.data() + x.size());
+  for (double& v : f) v -= x.mean();
+  std::vector<double> b = f;
+  for (std::size_t m = 1; m <= k.size(); ++m) {
+    double num = 0.0, den = 0.0;
+    for (std::size_t t = m; t < f.size(); ++t) num += f[t] * b[t - 1], den += f[t] * f[t] + b[t - 1] * b[t - 1];
+    const double km = 2.0 * num / den;
+    CHECK(k[m - 1] == Approx(km).epsilon(1e-12));
+    for (std::size_t t = f.size() - 1; t >= m; --t) {
+      const double ft = f[t], bt1 = b[t - 1];
+      f[t] = ft - km * bt1, b[t] = bt1 - km * ft;
+    }
+  }
+}
+
+TEST_CASE("a noise model on a stream layout built once equals the one from groups and times", "[noise_model]") {
+  // The diagnosis builds the layout once and models many residual vectors on it; the structure
+  // test models the other groups' residuals on layout.except_group(g).
+  Layout L = layout(3, 120, 200.0);
+  const Eigen::VectorXd r = noise_gen::ar1(L.groups, L.times, 0.7, 0.5e-3, 23);
+  const NoiseStreamLayout layout_all(L.groups, L.times);
+  for (bool pooled : {false, true}) {
+    NoiseModelOptions o;
+    o.pooled = pooled;
+    const NoiseModel a = estimate_noise_model(L.groups, L.times, r, o);
+    const NoiseModel b = estimate_noise_model(layout_all, r, o);
+    REQUIRE(a.streams.size() == b.streams.size());
+    for (std::size_t s = 0; s < a.streams.size(); ++s) {
+      CHECK(a.streams[s].rows == b.streams[s].rows);
+      CHECK(a.streams[s].reflection == b.streams[s].reflection);
+      CHECK(a.streams[s].sample_interval_s == b.streams[s].sample_interval_s);
+    }
+    // Without test1: as if the session had only test0 and test2.
+    std::vector<std::string> g;
+    std::vector<double> t;
+    std::vector<double> rv;
+    for (std::size_t i = 0; i < L.groups.size(); ++i)
+      if (L.groups[i] != "test1") g.push_back(L.groups[i]), t.push_back(L.times[i]), rv.push_back(r[static_cast<Eigen::Index>(i)]);
+    const NoiseModel c = estimate_noise_model(g, t, Eigen::Map<const Eigen::VectorXd>(rv.data(), static_cast<Eigen::Index>(rv.size())), o);
+    const NoiseModel d = estimate_noise_model(layout_all.except_group("test1"), r, o);
+    REQUIRE(c.streams.size() == 2);
+    REQUIRE(d.streams.size() == 2);
+    for (std::size_t s = 0; s < 2; ++s) {
+      CHECK(c.streams[s].group == d.streams[s].group);
+      CHECK(c.streams[s].reflection == d.streams[s].reflection);
+      CHECK(c.streams[s].marginal_sigma_um == Approx(d.streams[s].marginal_sigma_um).epsilon(1e-12));
+    }
+  }
+  CHECK_THROWS_WITH(estimate_noise_model(layout_all, Eigen::VectorXd::Zero(5)),
+                    Catch::Contains("residuals has 5 entries but the session has 360 readings"));
 }

@@ -92,6 +92,32 @@ NoiseModel estimate_noise_model(const std::vector<std::string>& groups,
                                 const Eigen::VectorXd& residuals_mm,
                                 const NoiseModelOptions& options = {});
 
+/// What estimate_noise_model needs of a session besides its residuals: its streams (group,
+/// channel) in time order and their sample intervals. Built once where many residual vectors of
+/// one session are modelled (the diagnosis models what each candidate leaves): splitting the
+/// readings into streams compares labels and sorts times, which costs as much as the AR fit.
+struct NoiseStreamLayout {
+  std::vector<std::vector<Eigen::Index>> rows;  ///< per stream, its rows in time order
+  std::vector<std::string> group;               ///< per stream
+  std::vector<int> channel;                     ///< per stream
+  std::vector<double> sample_interval_s;        ///< per stream: median of its time steps
+  std::size_t n = 0;                            ///< readings in the session
+
+  /// Throws InvalidArgument if the sizes differ or a time is not finite.
+  NoiseStreamLayout(const std::vector<std::string>& groups, const std::vector<double>& times);
+  /// The streams of every group but `group`, over the same readings (models fitted to the other
+  /// groups' residuals alone, as the layout of the session without that group would give).
+  NoiseStreamLayout except_group(const std::string& group) const;
+
+ private:
+  NoiseStreamLayout() = default;
+};
+
+/// estimate_noise_model on a layout built once. Throws InvalidArgument if `residuals_mm` does not
+/// hold layout.n values, one is not finite, or max_order < 0.
+NoiseModel estimate_noise_model(const NoiseStreamLayout& layout, const Eigen::VectorXd& residuals_mm,
+                                const NoiseModelOptions& options = {});
+
 /// `model` with the lag-1 coefficient of every AR(1) stream corrected for the bias that removing
 /// the stream's mean puts into it (Kendall 1954; Burg's estimate has it too): with n readings,
 /// E[rho_hat] = rho - (1 + 3 rho) / n, so rho_hat + (1 + 3 rho_hat) / n (at most 0.995). It
@@ -132,6 +158,17 @@ class ArWalkFilter {
   double log_det_ = 0.0;
 };
 
+/// Per stream (rows in time order) of a matrix J with rows j_t: S = sum_t j_t j_t^T,
+/// U = sum_{t>=1} j_t j_{t-1}^T, and the first and last rows' outer products F and L. Under
+/// AR(1) with coefficient phi, start-up scale a and innovation scale b (ArWhitener), the
+/// whitened Gram matrix of the stream is a^2 F + b^2 ((1 + phi^2) S - F - phi^2 L - phi (U + U^T)).
+struct StreamLagProducts {
+  std::vector<std::vector<Eigen::Index>> rows;
+  std::vector<Eigen::MatrixXd> S, U, first, last;
+  Eigen::MatrixXd rest;  ///< sum of j_t j_t^T over rows in no stream (the whitener leaves them)
+  StreamLagProducts(const Eigen::MatrixXd& J, std::vector<std::vector<Eigen::Index>> stream_rows);
+};
+
 /// Prewhitening by the AR filter of each stream, with its exact start-up rows (the first p
 /// readings are predicted from the orders 0..p-1 of Burg's recursion, so W is the inverse
 /// Cholesky factor of the model's covariance), scaled to unit variance. A stream with a random
@@ -144,6 +181,18 @@ class ArWhitener : public ResidualWhitener {
   explicit ArWhitener(const NoiseModel& model, double residual_unit_mm = 1.0);
   void apply(Eigen::Ref<Eigen::MatrixXd> columns) const override;
   Eigen::Index size() const override { return static_cast<Eigen::Index>(n_); }
+
+  /// Whether every stream is a plain AR filter of order 0 or 1 (no random walk): the models
+  /// for which gram() and apply_inverse_covariance() hold.
+  bool ar1_only() const;
+  /// Replace each column c by W^T W c (the inverse covariance times c), so that the GLS inner
+  /// product x^T V^-1 y is a plain one, x^T (W^T W y). Requires ar1_only().
+  void apply_inverse_covariance(Eigen::Ref<Eigen::MatrixXd> columns) const;
+  /// J^T W^T W J from lag products of J taken once (StreamLagProducts), in O(streams p^2):
+  /// a search that scores many candidates, each with its own AR(1) model of the same streams,
+  /// pays the n p^2 of the Gram matrix once. Requires ar1_only() and the same streams (rows)
+  /// as the lag products; throws InvalidArgument otherwise.
+  Eigen::MatrixXd gram(const StreamLagProducts& lags) const;
 
  private:
   struct Stream {
