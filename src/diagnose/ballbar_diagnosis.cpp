@@ -51,13 +51,13 @@ ModelFit BallbarDiagnosisProblem::fit(const EffectModel& effects) const {
   JointFitOptions o;
   o.effects = effects;
   o.whitener = whitener;
-  const BallbarIdentification id = identify_joint(arrays_, o);
+  BallbarIdentification id = identify_joint(arrays_, o);  // its Jacobian is moved, not copied
   ModelFit f;
   f.effects = id.model.effects;
   f.parameters = id.parameters;
   f.residuals = Eigen::Map<const Eigen::VectorXd>(id.residuals.data(),
                                                   static_cast<Eigen::Index>(id.residuals.size()));
-  f.jacobian = id.jacobian;
+  f.jacobian = std::move(id.jacobian);
   for (std::size_t j = 0; j < id.fixed.size(); ++j) {
     if (id.fixed[j]) f.jacobian.col(static_cast<Eigen::Index>(j)).setZero();
     else ++f.num_free;

@@ -126,11 +126,14 @@ NoiseTreatment candidate_treatment(const NoiseStreamLayout& layout, const Diagno
 // What the searches of one diagnosis share: a diagnosis may search twice (with the noise
 // model, then white when the final model leaves white residuals) through the same models, and
 // a model's refit and its candidates' Jacobians depend on the model alone. Jacobians are kept
-// up to kMaxCachedValues doubles (64 MB), beyond that recomputed.
+// up to kMaxCachedValues doubles (16 MB), beyond that recomputed; a cached Jacobian and the
+// batch that handed it out share one matrix (a copy of each doubled the diagnosis' peak memory
+// on a 1 kHz recording: bench/ballbar_long --diagnose).
+using SharedMatrix = std::shared_ptr<const Eigen::MatrixXd>;
 struct SearchCache {
-  static constexpr std::size_t kMaxCachedValues = std::size_t{8} << 20;
+  static constexpr std::size_t kMaxCachedValues = std::size_t{2} << 20;
   std::map<std::string, ModelFit> fits;
-  std::map<std::string, std::map<std::string, Eigen::MatrixXd>> jacobians;
+  std::map<std::string, std::map<std::string, SharedMatrix>> jacobians;
   std::size_t cached_values = 0;
 
   static std::string key(const EffectModel& m) {
@@ -145,14 +148,14 @@ struct SearchCache {
     return it->second;
   }
   // The Jacobians of `todo` at `at` (the fit of model `m`).
-  std::vector<Eigen::MatrixXd> candidate_jacobians(const DiagnosisProblem& P, const EffectModel& m,
-                                                   const ModelFit& at, const std::vector<Effect>& todo) {
-    std::map<std::string, Eigen::MatrixXd>& known = jacobians[key(m)];
+  std::vector<SharedMatrix> candidate_jacobians(const DiagnosisProblem& P, const EffectModel& m,
+                                                const ModelFit& at, const std::vector<Effect>& todo) {
+    std::map<std::string, SharedMatrix>& known = jacobians[key(m)];
     std::vector<Effect> missing;
     for (const Effect& c : todo)
       if (!known.count(c.id())) missing.push_back(c);
     std::vector<Eigen::MatrixXd> fresh = P.candidate_jacobians(at, missing);
-    std::vector<Eigen::MatrixXd> out;
+    std::vector<SharedMatrix> out;
     for (const Effect& c : todo) {
       const auto it = known.find(c.id());
       if (it != known.end()) {
@@ -161,10 +164,11 @@ struct SearchCache {
       }
       const std::size_t i = static_cast<std::size_t>(
           std::find(missing.begin(), missing.end(), c) - missing.begin());
-      out.push_back(fresh[i]);
-      if (cached_values + static_cast<std::size_t>(fresh[i].size()) <= kMaxCachedValues) {
-        cached_values += static_cast<std::size_t>(fresh[i].size());
-        known.emplace(c.id(), std::move(fresh[i]));
+      const std::size_t values = static_cast<std::size_t>(fresh[i].size());
+      out.push_back(std::make_shared<const Eigen::MatrixXd>(std::move(fresh[i])));
+      if (cached_values + values <= kMaxCachedValues) {
+        cached_values += values;
+        known.emplace(c.id(), out.back());
       }
     }
     return out;
@@ -181,8 +185,11 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
   Diagnosis D;
   D.machine = P.machine();
   ModelFit fit = baseline;
-  D.baseline_fit = fit;
-  D.baseline_fit.jacobian.resize(0, 0);  // what callers read of it: residuals and parameters
+  // What callers read of the baseline fit: residuals and parameters (not its n x p Jacobian).
+  D.baseline_fit.effects = fit.effects;
+  D.baseline_fit.parameters = fit.parameters;
+  D.baseline_fit.residuals = fit.residuals;
+  D.baseline_fit.num_free = fit.num_free;
   const double n = static_cast<double>(fit.residuals.size());
   D.baseline.noise_um = noise.sigma_mm * 1e3;
   D.baseline.noise_source = noise.source;
@@ -211,21 +218,23 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
     in.num_free = fit.num_free;
     // Coloured: the free columns with one level column per stream appended, for candidates
     // whose own noise model is 1/f-like (see below).
+    // Built when a candidate first needs them (n x (p + streams) each: AR(1) noise never does).
     Eigen::MatrixXd Q_raw, J_levels;
     int levels_rank = 0;
-    if (noise.W) {
-      Q_raw = orthonormal_basis(in.Jfree);
+    if (noise.W) Q_raw = orthonormal_basis(in.Jfree);
+    const auto need_levels = [&] {
+      if (J_levels.size()) return;
       const Eigen::MatrixXd L = stream_levels(P);
       J_levels.resize(in.Jfree.rows(), in.Jfree.cols() + L.cols());
       J_levels << in.Jfree, L;
       levels_rank = static_cast<int>(orthonormal_basis(J_levels).cols() - Q_raw.cols());
-    }
+    };
     // This round's candidate Jacobians at the current fit, in batches of at most
     // kChunkValues doubles: one batch for a session of a few thousand readings, and a long
     // session holds one batch at a time (the cache keeps what fits its limit).
-    constexpr std::size_t kChunkValues = std::size_t{8} << 20;
+    constexpr std::size_t kChunkValues = std::size_t{4} << 20;  // 32 MB
     const std::size_t rows = static_cast<std::size_t>(fit.residuals.size());
-    std::vector<Eigen::MatrixXd> chunk_jc;
+    std::vector<SharedMatrix> chunk_jc;
     std::vector<std::size_t> chunk_of(candidates.size(), SIZE_MAX);  // index in chunk_jc
     const auto jacobian_of = [&](std::size_t c) -> const Eigen::MatrixXd& {
       if (chunk_of[c] == SIZE_MAX) {
@@ -239,9 +248,10 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
           todo.push_back(candidates[d]);
           values += v;
         }
+        chunk_jc.clear();  // the previous batch goes before the next is made
         chunk_jc = cache.candidate_jacobians(P, effects, fit, todo);
       }
-      return chunk_jc[chunk_of[c]];
+      return *chunk_jc[chunk_of[c]];
     };
     int round_total = 0, round_done = 0;  // candidates to score in this round (progress)
     for (std::size_t c = 0; c < candidates.size(); ++c) round_total += !done[c] && unresolved[c].empty();
@@ -307,6 +317,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
           // stream of a few hundred readings misses that wander and took it for drifts (23
           // false findings in 200 1/f-like null sessions; with the walk: bench/
           // diagnose_realistic_bench --rho -1).
+          need_levels();
           in_c.Jfree = J_levels;
           in_c.num_free += levels_rank;
           if (!wander_noise.W) {
@@ -318,12 +329,6 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
         in_c.Q_w = orthonormal_basis_full_rank(own.whiten(in_c.Jfree));
         in_c.r_w = own.whiten(fit.residuals);
         s = score(in_c, candidates[c], Jc, own.whiten(Jc), options.min_visible_chi2);
-        if (s.observable && s.X.cols() > in.Jfree.cols() + s.k) {
-          // Cross-validation compares with the model itself, without the level columns.
-          Eigen::MatrixXd X(s.X.rows(), in.Jfree.cols() + s.k);
-          X << in.Jfree, s.X.rightCols(s.k);
-          s.X = X;
-        }
         // Scores are kept relative to the whitened residual of the current model, so the
         // table's RMS-after stays comparable.
         s.rss1 *= in.r_w.squaredNorm() / std::max(in_c.r_w.squaredNorm(), 1e-300);
@@ -337,9 +342,12 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
       // The columns (cross-validation) and signature (ambiguity) serve only a candidate that
       // can pass: the others' would hold n x (p + k + 1) doubles each, 8 KB per reading over
       // the catalogue, which a 1 kHz recording of a whole test cannot afford.
-      if (!(s.delta_bic < options.min_delta_bic)) {
+      if (s.delta_bic < options.min_delta_bic) {
+        // Cross-validation compares with the model itself (without any level columns).
+        s.X.resize(in.Jfree.rows(), in.Jfree.cols() + s.k);
+        s.X << in.Jfree, Jc * s.directions;
+      } else {
         s.A.resize(0, 0);
-        s.X.resize(0, 0);
         s.signature.resize(0);
       }
       scores.push_back(std::move(s));
@@ -439,10 +447,11 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
   }
 
   for (Finding& F : D.findings) F.parameters = parameters_of(fit, F.effect);
-  D.final_fit = fit;
-  D.structure_after = residual_structure(P, fit.residuals);
-  const int dof = static_cast<int>(n) - fit.num_free;
-  const Eigen::VectorXd r_w = noise.whiten(fit.residuals);
+  D.final_fit = std::move(fit);  // the last use of the search's fit: its Jacobian is n x p
+  const ModelFit& final_fit = D.final_fit;
+  D.structure_after = residual_structure(P, final_fit.residuals);
+  const int dof = static_cast<int>(n) - final_fit.num_free;
+  const Eigen::VectorXd r_w = noise.whiten(final_fit.residuals);
   const double chi2_final = r_w.squaredNorm();
   D.unexplained.chi2_per_dof = chi2_final / dof;
   if (!noise.W) {
@@ -457,9 +466,9 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
     // model would take its structure for correlated noise and whiten it away, and with the
     // tested structure fitted first it would lose the noise's low frequencies with it and find
     // structure in every null session.
-    const NoiseModel final_model = estimate_noise_model(layout, fit.residuals, options.noise);
-    Eigen::MatrixXd Jfree = free_columns(fit.jacobian);
-    int num_free = fit.num_free;
+    const NoiseModel final_model = estimate_noise_model(layout, final_fit.residuals, options.noise);
+    Eigen::MatrixXd Jfree = free_columns(final_fit.jacobian);
+    int num_free = final_fit.num_free;
     // 1/f-like: stream levels are nuisance and the noise is AR(1) + a random walk by REML, as
     // in scoring; the Burg AR(p) of each group missed the wander and took it for structure
     // (31 of 200 1/f-like null sessions flagged). Pooled over every stream (three parameters),
@@ -471,18 +480,18 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
       X << Jfree, L;
       num_free += static_cast<int>(orthonormal_basis(X).cols() - orthonormal_basis(Jfree).cols());
       Jfree = X;
-      wander = coloured_treatment(estimate_noise_model_reml(final_model, fit.residuals, Jfree));
+      wander = coloured_treatment(estimate_noise_model_reml(final_model, final_fit.residuals, Jfree));
     }
     NoiseModelOptions pooled = options.noise;
     pooled.pooled = true;
     pooled.pool_only_if_all_coloured = false;
-    const NoiseModel pooled_all = estimate_noise_model(layout, fit.residuals, pooled);  // its streams
+    const NoiseModel pooled_all = estimate_noise_model(layout, final_fit.residuals, pooled);  // its streams
     const auto whitener_for = [&](const std::string& group, const Eigen::MatrixXd&) {
       if (wander.W) return Whiten([wander](const Eigen::MatrixXd& M) { return wander.whiten(M); });
       NoiseTreatment t_noise = white;
       const NoiseStreamLayout others_layout = layout.except_group(group);
       if (!others_layout.rows.empty()) {
-        const NoiseModel others = estimate_noise_model(others_layout, fit.residuals, pooled);
+        const NoiseModel others = estimate_noise_model(others_layout, final_fit.residuals, pooled);
         if (!others.white()) {
           NoiseModel all = pooled_all;
           const NoiseStream& o = others.streams.front();
@@ -495,7 +504,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
       }
       return Whiten([t_noise](const Eigen::MatrixXd& M) { return t_noise.whiten(M); });
     };
-    const StructureTest T = structure_test(P, fit.residuals, Jfree, num_free, whitener_for);
+    const StructureTest T = structure_test(P, final_fit.residuals, Jfree, num_free, whitener_for);
     D.unexplained.p_value = T.p_value;
     D.unexplained.group = T.group;
   }
@@ -503,7 +512,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
   if (D.unexplained.present) {
     D.unexplained.signature = describe_structure(D.structure_after);
     if (!D.unexplained.group.empty()) {
-      const Location L = locate(P, fit.residuals, D.unexplained.group);
+      const Location L = locate(P, final_fit.residuals, D.unexplained.group);
       D.unexplained.axis = L.axis;
       D.unexplained.range_from = L.from;
       D.unexplained.range_to = L.to;
@@ -515,8 +524,8 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
       D.unexplained.signature += where.str();
       // A function of one rotary angle: offer the per-angle table as the extension.
       if (L.axis) {
-        const NoiseModel left = estimate_noise_model(layout, fit.residuals, options.noise);
-        AngleTable T = angle_table(P, fit.residuals, D.unexplained.group, left, noise.sigma_mm * 1e3,
+        const NoiseModel left = estimate_noise_model(layout, final_fit.residuals, options.noise);
+        AngleTable T = angle_table(P, final_fit.residuals, D.unexplained.group, left, noise.sigma_mm * 1e3,
                                    options.cv_blocks);
         if (T.gain.cv_rms_after_um < T.gain.cv_rms_before_um) D.angle_tables.push_back(std::move(T));
       }

@@ -155,7 +155,6 @@ Score score(const ScoringInputs& in, const Effect& c, const Eigen::MatrixXd& Jc,
   s.effect = c;
   const Eigen::VectorXd m = magnitudes(c);
   // Whitened columns per plausible size: their squared norms are chi-square changes.
-  const Eigen::MatrixXd raw = Jc_w * m.asDiagonal();
   const Eigen::MatrixXd perp = project_out(in.Q_w, Jc_w) * m.asDiagonal();
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(perp, Eigen::ComputeThinV);
   const Eigen::VectorXd sv = svd.singularValues();
@@ -164,7 +163,7 @@ Score score(const ScoringInputs& in, const Effect& c, const Eigen::MatrixXd& Jc,
   for (Eigen::Index i = 0; i < sv.size(); ++i)
     if (sv[i] >= limit) dirs.push_back(i);  // plausible sizes change chi-square by >= min_chi2
   if (dirs.empty()) {
-    Eigen::JacobiSVD<Eigen::MatrixXd> svd_raw(raw);
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd_raw(Jc_w * m.asDiagonal());
     const bool absorbed = svd_raw.singularValues().size() && svd_raw.singularValues()[0] >= limit;
     s.why_not = absorbed
                     ? "its effect on these readings is indistinguishable from the location "
@@ -178,8 +177,7 @@ Score score(const ScoringInputs& in, const Effect& c, const Eigen::MatrixXd& Jc,
   Eigen::MatrixXd V(perp.cols(), s.k);
   for (int i = 0; i < s.k; ++i) V.col(i) = svd.matrixV().col(dirs[static_cast<std::size_t>(i)]);
   s.A = perp * V;
-  s.X.resize(in.Jfree.rows(), in.Jfree.cols() + s.k);
-  s.X << in.Jfree, Jc * m.asDiagonal() * V;
+  s.directions = m.asDiagonal() * V;
   const Eigen::VectorXd d = solve_ls(s.A, in.r_w);
   s.signature = s.A * d;
   s.params = m.cwiseProduct(V * d);

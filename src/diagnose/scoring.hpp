@@ -45,7 +45,9 @@ struct Score {
   std::string why_not;
   int k = 0;                  ///< observable directions
   Eigen::MatrixXd A;          ///< whitened candidate columns along them, model projected out
-  Eigen::MatrixXd X;          ///< [J, candidate columns] in mm, for cross-validation
+  Eigen::MatrixXd directions; ///< the candidate's parameters (its units) per observable direction
+  Eigen::MatrixXd X;          ///< [J, Jc * directions] in mm, for cross-validation (set by the
+                              ///< search, only for a candidate that can pass)
   Eigen::VectorXd signature;  ///< fitted change of the whitened residuals
   Eigen::VectorXd params;     ///< the candidate's fitted parameters (its units)
   double rss1 = 0.0;          ///< whitened residual sum of squares after the refit
