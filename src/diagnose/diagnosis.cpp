@@ -184,22 +184,24 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
                  SearchCache& cache) {
   Diagnosis D;
   D.machine = P.machine();
-  ModelFit fit = baseline;
+  // The current model's fit: the baseline's, then a refit held by the cache (never copied: a
+  // fit holds an n x p Jacobian).
+  const ModelFit* fit = &baseline;
   // What callers read of the baseline fit: residuals and parameters (not its n x p Jacobian).
-  D.baseline_fit.effects = fit.effects;
-  D.baseline_fit.parameters = fit.parameters;
-  D.baseline_fit.residuals = fit.residuals;
-  D.baseline_fit.num_free = fit.num_free;
-  const double n = static_cast<double>(fit.residuals.size());
+  D.baseline_fit.effects = fit->effects;
+  D.baseline_fit.parameters = fit->parameters;
+  D.baseline_fit.residuals = fit->residuals;
+  D.baseline_fit.num_free = fit->num_free;
+  const double n = static_cast<double>(fit->residuals.size());
   D.baseline.noise_um = noise.sigma_mm * 1e3;
   D.baseline.noise_source = noise.source;
-  D.baseline.residual_rms_um = rms_um(fit.residuals);
-  D.baseline.n = fit.residuals.size();
-  D.baseline.dof = static_cast<int>(n) - fit.num_free;
-  const double chi2 = noise.whiten(fit.residuals).squaredNorm();
+  D.baseline.residual_rms_um = rms_um(fit->residuals);
+  D.baseline.n = fit->residuals.size();
+  D.baseline.dof = static_cast<int>(n) - fit->num_free;
+  const double chi2 = noise.whiten(fit->residuals).squaredNorm();
   D.baseline.chi2_per_dof = chi2 / D.baseline.dof;
   D.baseline.p_value = stats::chi2_sf(chi2, D.baseline.dof);
-  D.structure_before = residual_structure(P, fit.residuals);
+  D.structure_before = residual_structure(P, fit->residuals);
   D.noise_whitened = static_cast<bool>(noise.W);
 
   const std::vector<std::string> unresolved =
@@ -212,10 +214,10 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
   bool first_round = true;
   while (static_cast<int>(D.findings.size()) < options.max_findings) {
     ScoringInputs in;
-    in.Jfree = free_columns(fit.jacobian);
+    in.Jfree = free_columns(fit->jacobian);
     in.Q_w = orthonormal_basis(noise.whiten(in.Jfree));
-    in.r_w = noise.whiten(fit.residuals);
-    in.num_free = fit.num_free;
+    in.r_w = noise.whiten(fit->residuals);
+    in.num_free = fit->num_free;
     // Coloured: the free columns with one level column per stream appended, for candidates
     // whose own noise model is 1/f-like (see below).
     // Built when a candidate first needs them (n x (p + streams) each: AR(1) noise never does).
@@ -233,7 +235,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
     // kChunkValues doubles: one batch for a session of a few thousand readings, and a long
     // session holds one batch at a time (the cache keeps what fits its limit).
     constexpr std::size_t kChunkValues = std::size_t{4} << 20;  // 32 MB
-    const std::size_t rows = static_cast<std::size_t>(fit.residuals.size());
+    const std::size_t rows = static_cast<std::size_t>(fit->residuals.size());
     std::vector<SharedMatrix> chunk_jc;
     std::vector<std::size_t> chunk_of(candidates.size(), SIZE_MAX);  // index in chunk_jc
     const auto jacobian_of = [&](std::size_t c) -> const Eigen::MatrixXd& {
@@ -249,7 +251,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
           values += v;
         }
         chunk_jc.clear();  // the previous batch goes before the next is made
-        chunk_jc = cache.candidate_jacobians(P, effects, fit, todo);
+        chunk_jc = cache.candidate_jacobians(P, effects, *fit, todo);
       }
       return *chunk_jc[chunk_of[c]];
     };
@@ -280,16 +282,16 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
         // follows stays correlated (so it is not taken for an effect), and an effect's own
         // signature is not mistaken for correlated noise (which would whiten it away).
         NoiseModel own_model;
-        NoiseTreatment own = candidate_treatment(layout, options, fit, Q_raw, Jc, candidates[c], white, &own_model);
+        NoiseTreatment own = candidate_treatment(layout, options, *fit, Q_raw, Jc, candidates[c], white, &own_model);
         if (own_model.max_order < 2 && (!own.W || own.W->ar1_only())) {
           // White or AR(1): scored from inner products; only a candidate that may pass is
           // scored again below with its columns (the margin of 1 is far beyond rounding).
           if (!round_products)
             round_products = std::make_unique<ModelProducts>(in.Jfree, layout.rows);
           const CandidateProducts g =
-              candidate_products(own.W.get(), own.sigma_mm, *round_products, in.Jfree, Jc, fit.residuals);
+              candidate_products(own.W.get(), own.sigma_mm, *round_products, in.Jfree, Jc, fit->residuals);
           std::optional<Score> quick =
-              score_from_products(g, candidates[c], fit.num_free, options.min_visible_chi2);
+              score_from_products(g, candidates[c], fit->num_free, options.min_visible_chi2);
           if (quick && !(quick->observable && quick->delta_bic < options.min_delta_bic + 1.0)) {
             s = std::move(*quick);
             s.rss1 *= in.r_w.squaredNorm() / std::max(g.rr, 1e-300);
@@ -306,7 +308,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
         }
         ScoringInputs in_c;
         in_c.Jfree = in.Jfree;
-        in_c.num_free = fit.num_free;
+        in_c.num_free = fit->num_free;
         if (own_model.max_order >= 2) {
           // Noise that AR(1) does not describe (BIC wants p >= 2) is taken as 1/f-like: it has
           // no finite correlation time, and its lowest frequencies are indistinguishable from
@@ -321,13 +323,13 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
           in_c.Jfree = J_levels;
           in_c.num_free += levels_rank;
           if (!wander_noise.W) {
-            const NoiseModel start = estimate_noise_model(layout, fit.residuals, options.noise);
-            wander_noise = coloured_treatment(estimate_noise_model_reml(start, fit.residuals, J_levels));
+            const NoiseModel start = estimate_noise_model(layout, fit->residuals, options.noise);
+            wander_noise = coloured_treatment(estimate_noise_model_reml(start, fit->residuals, J_levels));
           }
           own = wander_noise;
         }
         in_c.Q_w = orthonormal_basis_full_rank(own.whiten(in_c.Jfree));
-        in_c.r_w = own.whiten(fit.residuals);
+        in_c.r_w = own.whiten(fit->residuals);
         s = score(in_c, candidates[c], Jc, own.whiten(Jc), options.min_visible_chi2);
         // Scores are kept relative to the whitened residual of the current model, so the
         // table's RMS-after stays comparable.
@@ -359,7 +361,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
     for (const Score& s : scores) {
       // RMS after, in um: the whitened fraction applied to the raw RMS.
       const double frac = std::sqrt(s.rss1 / std::max(in.r_w.squaredNorm(), 1e-300));
-      table.push_back({s.effect.id(), s.k, s.delta_bic, s.f_pvalue, rms_um(fit.residuals) * frac});
+      table.push_back({s.effect.id(), s.k, s.delta_bic, s.f_pvalue, rms_um(fit->residuals) * frac});
     }
     std::sort(table.begin(), table.end(),
               [](const CandidateScore& a, const CandidateScore& b) { return a.delta_bic < b.delta_bic; });
@@ -375,12 +377,11 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
     // parameters the nonlinear refit can determine.
     const Score* chosen = nullptr;
     std::vector<const Score*> undetermined;  // passed, but no parameter determinable
-    ModelFit before;  // the current model's fit, once a candidate is chosen (moved, not copied:
-                      // a fit holds an n x p Jacobian)
+    const ModelFit* before = nullptr;  // the current model's fit, once a candidate is chosen
     double cv_before = 0.0, cv_after = 0.0;
     for (const Score* s : passing) {
-      cv_before = cv_rms_um(in.Jfree, fit.residuals, fold, options.cv_blocks);
-      cv_after = cv_rms_um(s->X, fit.residuals, fold, options.cv_blocks);
+      cv_before = cv_rms_um(in.Jfree, fit->residuals, fold, options.cv_blocks);
+      cv_after = cv_rms_um(s->X, fit->residuals, fold, options.cv_blocks);
       if (!(cv_after < cv_before)) continue;
       EffectModel extended = effects;
       extended.effects.push_back(s->effect);
@@ -400,8 +401,8 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
       }
       chosen = s;
       effects = extended;
-      before = std::move(fit);
-      fit = refit;
+      before = fit;
+      fit = &refit;
       break;
     }
     if (!chosen) break;
@@ -419,7 +420,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
         amb.effects.push_back(s->effect.id());
         amb.delta_bic = std::max(amb.delta_bic, dbic);
         amb.correlation = amb.effects.size() == 2 ? corr : std::min(amb.correlation, corr);
-        amb.separating_test = separating_test(P, before, *chosen, *s, noise.sigma_mm);
+        amb.separating_test = separating_test(P, *before, *chosen, *s, noise.sigma_mm);
       }
     }
     if (!amb.effects.empty()) D.ambiguous.push_back(amb);
@@ -427,17 +428,17 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
     Finding F;
     F.effect = chosen->effect;
     F.cause = chosen->effect.cause();
-    F.gain.rms_before_um = rms_um(before.residuals);
-    F.gain.rms_after_um = rms_um(fit.residuals);
+    F.gain.rms_before_um = rms_um(before->residuals);
+    F.gain.rms_after_um = rms_um(fit->residuals);
     const NoiseTreatment& judged = treatment_of[static_cast<std::size_t>(chosen - scores.data())];
-    const double rss_before = judged.whiten(before.residuals).squaredNorm();
-    const double rss_after = std::max(judged.whiten(fit.residuals).squaredNorm(), 1e-300);
-    F.gain.delta_bic = n * std::log(rss_after / rss_before) + (fit.num_free - before.num_free) * std::log(n);
+    const double rss_before = judged.whiten(before->residuals).squaredNorm();
+    const double rss_after = std::max(judged.whiten(fit->residuals).squaredNorm(), 1e-300);
+    F.gain.delta_bic = n * std::log(rss_after / rss_before) + (fit->num_free - before->num_free) * std::log(n);
     F.gain.cv_rms_before_um = cv_before;
     F.gain.cv_rms_after_um = cv_after;
     F.gain.f_pvalue = chosen->f_pvalue;
-    for (const ParameterEstimate& b : before.parameters) {
-      for (const ParameterEstimate& a : fit.parameters) {
+    for (const ParameterEstimate& b : before->parameters) {
+      for (const ParameterEstimate& a : fit->parameters) {
         if (a.name != b.name || !a.observable || !b.observable) continue;
         if (std::abs(a.value - b.value) > std::max(a.std, 1e-15))
           F.shifts.push_back({a.name, b.value, a.value, a.std, a.unit});
@@ -446,9 +447,8 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
     D.findings.push_back(F);
   }
 
-  for (Finding& F : D.findings) F.parameters = parameters_of(fit, F.effect);
-  D.final_fit = std::move(fit);  // the last use of the search's fit: its Jacobian is n x p
-  const ModelFit& final_fit = D.final_fit;
+  for (Finding& F : D.findings) F.parameters = parameters_of(*fit, F.effect);
+  const ModelFit& final_fit = *fit;  // copied into the result last, after the structure test's peak
   D.structure_after = residual_structure(P, final_fit.residuals);
   const int dof = static_cast<int>(n) - final_fit.num_free;
   const Eigen::VectorXd r_w = noise.whiten(final_fit.residuals);
@@ -531,6 +531,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
       }
     }
   }
+  D.final_fit = final_fit;
   return D;
 }
 
