@@ -66,7 +66,8 @@ int main(int argc, char** argv) {
   truth.machine = MachineType::AC_trt;
   truth.errors.v << 0.0726, -0.0202, 1.1284e-5, -1.13006e-4, 0.0283, 0.1041, 5.1954e-6, -4.1544e-5;
   truth.pivot = commanded.pivot + Eigen::Vector3d(0.012, -0.008, 0.015);
-  const BallbarSession session = simulate_ballbar(commanded, truth, {0.5, 1, true});
+  BallbarSession session = simulate_ballbar(commanded, truth, {0.5, 1, true});
+  const std::size_t n_samples = session.samples.size();
   commanded.samples.clear();
   commanded.samples.shrink_to_fit();
   const double rss_before = peak_rss_mb();
@@ -74,9 +75,9 @@ int main(int argc, char** argv) {
   const auto t0 = std::chrono::steady_clock::now();
   const double c0 = cpu_seconds();
   if (diagnose) {
-    const Diagnosis D = diagnose_ballbar(session);
+    const Diagnosis D = diagnose_ballbar(std::move(session));  // as a caller done with it would
     std::printf("ballbar_long: %zu samples; diagnose_ballbar: %.2f s wall, %.2f s CPU, %zu finding(s)%s%s\n",
-                session.samples.size(), std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+                n_samples, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
                 cpu_seconds() - c0, D.findings.size(), D.findings.empty() ? "" : ", first ",
                 D.findings.empty() ? "" : D.findings[0].effect.id().c_str());
     std::printf("  peak RSS: %.0f MB after building the session, %.0f MB after the diagnosis\n", rss_before,

@@ -13,11 +13,7 @@ BallbarDiagnosisProblem::BallbarDiagnosisProblem(BallbarSession session, Ballbar
       arrays_(ballbar_arrays(session_)),
       reference_(std::move(reference)),
       reference_motion_(rotary_motion(reference_.samples)) {
-  for (const BallbarSample& s : session_.samples) {
-    groups_.push_back(s.test);
-    times_.push_back(s.time);
-    angles_.push_back(s.angles_rad());
-  }
+  times_.assign(arrays_.time.data(), arrays_.time.data() + arrays_.time.size());
   if (!reference_.samples.empty() && reference_.machine != session_.machine)
     throw InvalidArgument("reference test is for " + to_string(reference_.machine) +
                           " but the session is for " + to_string(session_.machine));
@@ -143,9 +139,9 @@ Eigen::MatrixXd BallbarDiagnosisProblem::reference_jacobian(const ModelFit& at,
   return jacobian_on(reference_.samples, reference_motion_, at, candidate);
 }
 
-Diagnosis diagnose_ballbar(const BallbarSession& session, const DiagnosisOptions& options,
-                           const BallbarSession& reference) {
-  return diagnose(BallbarDiagnosisProblem(session, reference), options);
+Diagnosis diagnose_ballbar(BallbarSession session, const DiagnosisOptions& options,
+                           BallbarSession reference) {
+  return diagnose(BallbarDiagnosisProblem(std::move(session), std::move(reference)), options);
 }
 
 }  // namespace rotacal

@@ -234,7 +234,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
     // This round's candidate Jacobians at the current fit, in batches of at most
     // kChunkValues doubles: one batch for a session of a few thousand readings, and a long
     // session holds one batch at a time (the cache keeps what fits its limit).
-    constexpr std::size_t kChunkValues = std::size_t{4} << 20;  // 32 MB
+    constexpr std::size_t kChunkValues = std::size_t{2} << 20;  // 16 MB
     const std::size_t rows = static_cast<std::size_t>(fit->residuals.size());
     std::vector<SharedMatrix> chunk_jc;
     std::vector<std::size_t> chunk_of(candidates.size(), SIZE_MAX);  // index in chunk_jc
@@ -275,7 +275,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
       Score s;
       NoiseTreatment judged_with = noise;
       if (!noise.W) {
-        s = score(in, candidates[c], Jc, noise.whiten(Jc), options.min_visible_chi2);
+        s = score(in, candidates[c], noise.whiten(Jc), options.min_visible_chi2, options.min_delta_bic);
       } else {
         // As the classical F-test takes sigma from the larger model, the noise is modelled on
         // what the model extended by this candidate leaves: correlated noise that no candidate
@@ -330,7 +330,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
         }
         in_c.Q_w = orthonormal_basis_full_rank(own.whiten(in_c.Jfree));
         in_c.r_w = own.whiten(fit->residuals);
-        s = score(in_c, candidates[c], Jc, own.whiten(Jc), options.min_visible_chi2);
+        s = score(in_c, candidates[c], own.whiten(Jc), options.min_visible_chi2, options.min_delta_bic);
         // Scores are kept relative to the whitened residual of the current model, so the
         // table's RMS-after stays comparable.
         s.rss1 *= in.r_w.squaredNorm() / std::max(in_c.r_w.squaredNorm(), 1e-300);
@@ -348,9 +348,6 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
         // Cross-validation compares with the model itself (without any level columns).
         s.X.resize(in.Jfree.rows(), in.Jfree.cols() + s.k);
         s.X << in.Jfree, Jc * s.directions;
-      } else {
-        s.A.resize(0, 0);
-        s.signature.resize(0);
       }
       scores.push_back(std::move(s));
       treatment_of.push_back(judged_with);

@@ -41,16 +41,20 @@ Eigen::VectorXd solve_ls(const Eigen::MatrixXd& X, const Eigen::VectorXd& y) {
   return (qr.solve(y)).cwiseQuotient(s);
 }
 
-Eigen::MatrixXd orthonormal_basis(const Eigen::MatrixXd& J) {
+Eigen::MatrixXd orthonormal_basis(Eigen::MatrixXd J) {
   if (J.cols() == 0) return Eigen::MatrixXd(J.rows(), 0);
   Eigen::VectorXd s = J.colwise().norm().transpose();
   for (Eigen::Index j = 0; j < s.size(); ++j)
     if (!(s[j] > 0.0)) s[j] = 1.0;
-  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(J * s.cwiseInverse().asDiagonal());
+  // In place (J by value: a caller's temporary is taken over): J's columns scaled, then J holds
+  // the factors. An n x p copy each saved, which a 1 kHz recording's round start needs.
+  J.array().rowwise() /= s.transpose().array();
+  Eigen::ColPivHouseholderQR<Eigen::Ref<Eigen::MatrixXd>> qr(J);
   qr.setThreshold(1e-9);
   const Eigen::Index r = qr.rank();
   Eigen::MatrixXd Q = Eigen::MatrixXd::Identity(J.rows(), r);
-  return qr.householderQ() * Q;
+  qr.householderQ().applyThisOnTheLeft(Q);
+  return Q;
 }
 
 Eigen::MatrixXd orthonormal_basis_full_rank(const Eigen::MatrixXd& J) {
@@ -149,22 +153,27 @@ double cv_rms_um(const Eigen::MatrixXd& X, const Eigen::VectorXd& r, const std::
   return n ? std::sqrt(ss / static_cast<double>(n)) * 1e3 : 0.0;
 }
 
-Score score(const ScoringInputs& in, const Effect& c, const Eigen::MatrixXd& Jc,
-            const Eigen::MatrixXd& Jc_w, double min_chi2) {
+Score score(const ScoringInputs& in, const Effect& c, Eigen::MatrixXd Jc_w, double min_chi2,
+            double columns_below_delta_bic) {
   Score s;
   s.effect = c;
   const Eigen::VectorXd m = magnitudes(c);
-  // Whitened columns per plausible size: their squared norms are chi-square changes.
-  const Eigen::MatrixXd perp = project_out(in.Q_w, Jc_w) * m.asDiagonal();
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(perp, Eigen::ComputeThinV);
-  const Eigen::VectorXd sv = svd.singularValues();
+  // Per plausible size (columns scaled by m), the whitened columns' Gram matrix before and after
+  // the model is projected out: its eigenvalues are the chi-square changes of unit directions.
+  // Eigenvalues rather than an SVD of the n x k columns: the threshold min_chi2 sits far above
+  // their rounding (eps times the largest), and a 1 kHz recording cannot afford the SVD's copies.
+  const Eigen::MatrixXd raw = m.asDiagonal() * (Jc_w.transpose() * Jc_w) * m.asDiagonal();
+  Jc_w -= in.Q_w * (in.Q_w.transpose() * Jc_w);  // in place: the model projected out
+  Jc_w *= m.asDiagonal();
+  const Eigen::MatrixXd& perp = Jc_w;
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(perp.transpose() * perp);
+  const Eigen::VectorXd ev = es.eigenvalues();
   std::vector<Eigen::Index> dirs;
-  const double limit = std::sqrt(min_chi2);
-  for (Eigen::Index i = 0; i < sv.size(); ++i)
-    if (sv[i] >= limit) dirs.push_back(i);  // plausible sizes change chi-square by >= min_chi2
+  for (Eigen::Index i = 0; i < ev.size(); ++i)
+    if (ev[i] >= min_chi2) dirs.push_back(i);  // plausible sizes change chi-square by >= min_chi2
   if (dirs.empty()) {
-    Eigen::JacobiSVD<Eigen::MatrixXd> svd_raw(Jc_w * m.asDiagonal());
-    const bool absorbed = svd_raw.singularValues().size() && svd_raw.singularValues()[0] >= limit;
+    const Eigen::VectorXd ev_raw = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(raw, Eigen::EigenvaluesOnly).eigenvalues();
+    const bool absorbed = ev_raw.size() && ev_raw.maxCoeff() >= min_chi2;
     s.why_not = absorbed
                     ? "its effect on these readings is indistinguishable from the location "
                       "errors and set-up parameters already in the model"
@@ -175,21 +184,29 @@ Score score(const ScoringInputs& in, const Effect& c, const Eigen::MatrixXd& Jc,
   s.observable = true;
   s.k = static_cast<int>(dirs.size());
   Eigen::MatrixXd V(perp.cols(), s.k);
-  for (int i = 0; i < s.k; ++i) V.col(i) = svd.matrixV().col(dirs[static_cast<std::size_t>(i)]);
-  s.A = perp * V;
+  Eigen::VectorXd lambda(s.k);
+  for (int i = 0; i < s.k; ++i) {
+    V.col(i) = es.eigenvectors().col(dirs[static_cast<std::size_t>(i)]);
+    lambda[i] = ev[dirs[static_cast<std::size_t>(i)]];
+  }
   s.directions = m.asDiagonal() * V;
-  const Eigen::VectorXd d = solve_ls(s.A, in.r_w);
-  s.signature = s.A * d;
+  // A = perp V has orthogonal columns of squared norms lambda: d = A^T r_w / lambda.
+  const Eigen::VectorXd Atr = V.transpose() * (perp.transpose() * in.r_w);
+  const Eigen::VectorXd d = Atr.cwiseQuotient(lambda);
   s.params = m.cwiseProduct(V * d);
   // F and BIC on whitened residuals: independent with unit variance under the noise model,
   // so the textbook tests hold with the full n (GLS).
   const double rss0 = rss(in.r_w);
-  s.rss1 = std::max(rss(in.r_w - s.signature), 1e-300);
+  s.rss1 = std::max(rss0 - Atr.dot(d), 1e-300);
   const double n = static_cast<double>(in.r_w.size());
   const double dof = n - in.num_free - s.k;
   s.delta_bic = n * std::log(s.rss1 / rss0) + s.k * std::log(n);
   const double F = ((rss0 - s.rss1) / s.k) / (s.rss1 / dof);
   s.f_pvalue = stats::f_sf(std::max(F, 0.0), s.k, dof);
+  if (s.delta_bic < columns_below_delta_bic) {
+    s.A = perp * V;
+    s.signature = s.A * d;
+  }
   return s;
 }
 

@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -20,8 +21,9 @@ double rms_um(const Eigen::VectorXd& r);
 Eigen::VectorXd magnitudes(const Effect& c);
 /// Least squares y ~ X d, rank-revealing (directions the rows cannot see get no weight).
 Eigen::VectorXd solve_ls(const Eigen::MatrixXd& X, const Eigen::VectorXd& y);
-/// Orthonormal basis of span(J), rank-revealing.
-Eigen::MatrixXd orthonormal_basis(const Eigen::MatrixXd& J);
+/// Orthonormal basis of span(J), rank-revealing. J is taken by value and factorised in place:
+/// pass a temporary (or std::move) to spare the n x p copy.
+Eigen::MatrixXd orthonormal_basis(Eigen::MatrixXd J);
 /// The same span by CholeskyQR2 (~2 n p^2 flops against ~4 n p^2 for the Householder QR and
 /// its Q; the per-candidate bases of the coloured search were a quarter of a diagnosis at
 /// rho 0.5), falling back to orthonormal_basis where J is near rank-deficient.
@@ -63,10 +65,12 @@ struct ScoringInputs {
   int num_free = 0;
 };
 
-/// Score candidate `c` (Jc: its Jacobian in mm per unit, Jc_w: whitened); directions whose
-/// plausible sizes change chi-square by less than min_chi2 are not visible.
-Score score(const ScoringInputs& in, const Effect& c, const Eigen::MatrixXd& Jc,
-            const Eigen::MatrixXd& Jc_w, double min_chi2);
+/// Score candidate `c` (Jc_w: its whitened Jacobian, mm per unit, taken by value and worked on
+/// in place); directions whose plausible sizes change chi-square by less than min_chi2 are not
+/// visible. The columns A and the signature are kept only if delta BIC < columns_below_delta_bic
+/// (only a candidate that can pass needs them).
+Score score(const ScoringInputs& in, const Effect& c, Eigen::MatrixXd Jc_w, double min_chi2,
+            double columns_below_delta_bic = std::numeric_limits<double>::infinity());
 /// The inner products score() works from, in the noise model's metric <x, y> = x^T V^-1 y:
 /// f the current model's free columns, c the candidate's (mm per unit), r the residuals.
 struct CandidateProducts {

@@ -281,7 +281,7 @@ TEST_CASE("scoring from inner products agrees with scoring from whitened columns
     in.num_free = fit.num_free;
     for (const Effect& e : P.candidates(3)) {
       const Eigen::MatrixXd Jc = P.candidate_jacobian(fit, e);
-      const Score full = score(in, e, Jc, whiten(Jc), min_chi2);
+      const Score full = score(in, e, whiten(Jc), min_chi2);
       const std::optional<Score> quick =
           score_from_products(candidate_products(w, sigma_mm, products, Jf, Jc, fit.residuals), e, fit.num_free, min_chi2);
       if (!quick) continue;  // left to the columns (near a threshold or near rank-deficient)
