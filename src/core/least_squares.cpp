@@ -57,24 +57,56 @@ Observability analyse_observability_normal(const Eigen::MatrixXd& JtJ, const Eig
     V.col(k) = es.eigenvectors().col(p - 1 - k);
   }
   const double limit = std::sqrt(min_chi2_change);
-  for (Eigen::Index k = 0; k < p; ++k) {
-    if (o.singular_values[k] >= limit) continue;
-    const Eigen::VectorXd vs = V.col(k);
-    o.null_space.push_back(vs.cwiseProduct(scales));
-    int best = 0;
-    for (Eigen::Index j = 0; j < p; ++j) {
-      if (std::abs(vs[j]) > 0.05) o.observable[static_cast<std::size_t>(j)] = false;
-      if (std::abs(vs[j]) > std::abs(vs[best])) best = static_cast<int>(j);
-    }
-    // Equal shares (e.g. a head's tool length, its axis' position along the spindle and the
-    // pivot height, 1/sqrt(3) each) would leave the choice to rounding: hold the last of them,
-    // the parameter a model adds on top of the base ones, so that repeated fits agree.
+  Eigen::Index k_null = 0;
+  while (k_null < p && o.singular_values[p - 1 - k_null] < limit) ++k_null;
+  if (k_null == 0) return o;
+  // The null space as one subspace: when several directions are below the limit (a session
+  // that lacks whole poses, e.g. a tilt polynomial of degree 6 over four B angles), their
+  // eigenvalues are (nearly) equal and the eigensolver's basis of that subspace is arbitrary.
+  // So nothing below may depend on that basis. Parameter j takes part in the null space when
+  // its share in it, the norm of row j of the orthonormal basis, is above 0.05; judged per basis
+  // vector instead, a parameter could have a share under 0.05 in each of several directions
+  // and still be free to move, and be reported determined.
+  const Eigen::MatrixXd Vn = V.rightCols(k_null);  // ascending singular values: the null space
+  for (Eigen::Index j = 0; j < p; ++j)
+    if (Vn.row(j).norm() > 0.05) o.observable[static_cast<std::size_t>(j)] = false;
+  // Parameters to hold: greedy column-pivoted QR of Vn^T, which picks k_null distinct
+  // parameters whose rows span the null space, so that holding them leaves the rest
+  // determined. (One per direction, each the largest share of its own direction, could pick
+  // the same parameter twice: the free set was then still singular and its covariance
+  // meaningless, e.g. a parameter reported with a 1-sigma of exactly 0.) The residual row
+  // norms are independent of the basis of the subspace. Equal shares (e.g. a head's tool
+  // length, its axis' position along the spindle and the pivot height, 1/sqrt(3) each) would
+  // leave the choice to rounding: hold the last of them, the parameter a model adds on top of
+  // the base ones, so that repeated fits agree.
+  Eigen::MatrixXd R = Vn;
+  std::vector<bool> taken(static_cast<std::size_t>(p), false);
+  for (Eigen::Index k = 0; k < k_null; ++k) {
+    int best = -1;
+    for (Eigen::Index j = 0; j < p; ++j)
+      if (!taken[static_cast<std::size_t>(j)] && (best < 0 || R.row(j).norm() > R.row(best).norm()))
+        best = static_cast<int>(j);
     for (Eigen::Index j = p - 1; j > best; --j)
-      if (std::abs(vs[j]) >= (1.0 - 1e-3) * std::abs(vs[best])) {
+      if (!taken[static_cast<std::size_t>(j)] && R.row(j).norm() >= (1.0 - 1e-3) * R.row(best).norm()) {
         best = static_cast<int>(j);
         break;
       }
+    taken[static_cast<std::size_t>(best)] = true;
     o.to_fix.push_back(best);
+    // A held parameter is not determined by the data, whatever its share.
+    o.observable[static_cast<std::size_t>(best)] = false;
+    const Eigen::RowVectorXd u = R.row(best) / R.row(best).norm();
+    R -= (R * u.transpose()) * u;
+  }
+  // The directions reported, in a basis fixed by the held parameters: direction k moves held
+  // parameter k alone among them (reduced echelon form of the null space), so that repeated
+  // fits describe them alike.
+  Eigen::MatrixXd F(k_null, k_null);
+  for (Eigen::Index k = 0; k < k_null; ++k) F.row(k) = Vn.row(o.to_fix[static_cast<std::size_t>(k)]);
+  const Eigen::MatrixXd E = Vn * F.inverse();
+  for (Eigen::Index k = 0; k < k_null; ++k) {
+    const Eigen::VectorXd vs = E.col(k).normalized();
+    o.null_space.push_back(vs.cwiseProduct(scales));
   }
   return o;
 }

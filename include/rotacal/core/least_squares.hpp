@@ -15,11 +15,15 @@ namespace rotacal {
 /// A direction is unobservable when moving along it by those magnitudes changes chi-square by
 /// less than `min_chi2_change`: singular value of J*diag(scales) below its square root.
 struct Observability {
-  std::vector<bool> observable;             ///< per parameter: takes part in no null direction
-  std::vector<Eigen::VectorXd> null_space;  ///< directions in parameter space (original units)
+  /// Per parameter: its share in the null space (norm of its row in an orthonormal basis of it,
+  /// scaled) is at most 0.05, and it is not held. Independent of the basis of the null space.
+  std::vector<bool> observable;
+  /// Directions in parameter space (original units); direction k moves to_fix[k] and no other
+  /// held parameter.
+  std::vector<Eigen::VectorXd> null_space;
   Eigen::VectorXd singular_values;          ///< of J*diag(scales), descending
-  /// Parameters to hold fixed so that the rest is determined: one per null direction, the one
-  /// with the largest (scaled) share in it.
+  /// Parameters to hold fixed so that the rest is determined: one per null direction, all
+  /// distinct, chosen by largest remaining (scaled) share in the null space (pivoted QR).
   std::vector<int> to_fix;
   /// Null direction k in words, e.g. "E_X0C +1 mm with E_B0C +0.0167 rad changes no reading".
   std::string describe(int k, const std::vector<std::string>& names,
