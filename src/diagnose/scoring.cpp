@@ -3,11 +3,11 @@
 #include <Eigen/Cholesky>
 #include <Eigen/QR>
 #include <Eigen/Eigenvalues>
-#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <map>
 
+#include "rotacal/core/error.hpp"
 #include "rotacal/core/least_squares.hpp"
 #include "rotacal/core/stats.hpp"
 #include "scoring.hpp"
@@ -153,28 +153,33 @@ double cv_rms_um(const Eigen::MatrixXd& X, const Eigen::VectorXd& r, const std::
   return n ? std::sqrt(ss / static_cast<double>(n)) * 1e3 : 0.0;
 }
 
-Score score(const ScoringInputs& in, const Effect& c, Eigen::MatrixXd Jc_w, double min_chi2,
-            double columns_below_delta_bic) {
+namespace {
+
+// The score of candidate c from its Gram matrices per plausible size (columns scaled by its
+// magnitudes m): raw before the model is projected out, perp after; perp_r = the projected
+// columns' products with the whitened residual, rr = its squared norm, n readings. The
+// eigenvalues of perp are the chi-square changes of unit directions. tol > 0: nullopt where an
+// eigenvalue lies within tol of the threshold (the products path leaves that to the columns).
+// V and d: the observable directions and their coefficients.
+std::optional<Score> score_from_grams(const Effect& c, const Eigen::VectorXd& m, const Eigen::MatrixXd& raw,
+                                      const Eigen::MatrixXd& perp, const Eigen::VectorXd& perp_r, double rr,
+                                      double n, int num_free, double min_chi2, double tol,
+                                      Eigen::MatrixXd* V_out = nullptr, Eigen::VectorXd* d_out = nullptr) {
   Score s;
   s.effect = c;
-  const Eigen::VectorXd m = magnitudes(c);
-  // Per plausible size (columns scaled by m), the whitened columns' Gram matrix before and after
-  // the model is projected out: its eigenvalues are the chi-square changes of unit directions.
-  // Eigenvalues rather than an SVD of the n x k columns: the threshold min_chi2 sits far above
-  // their rounding (eps times the largest), and a 1 kHz recording cannot afford the SVD's copies.
-  const Eigen::MatrixXd raw = m.asDiagonal() * (Jc_w.transpose() * Jc_w) * m.asDiagonal();
-  Jc_w -= in.Q_w * (in.Q_w.transpose() * Jc_w);  // in place: the model projected out
-  Jc_w *= m.asDiagonal();
-  const Eigen::MatrixXd& perp = Jc_w;
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(perp.transpose() * perp);
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(perp);
+  if (es.info() != Eigen::Success) return std::nullopt;
   const Eigen::VectorXd ev = es.eigenvalues();
   std::vector<Eigen::Index> dirs;
-  for (Eigen::Index i = 0; i < ev.size(); ++i)
+  for (Eigen::Index i = 0; i < ev.size(); ++i) {
+    if (std::abs(ev[i] - min_chi2) < tol) return std::nullopt;
     if (ev[i] >= min_chi2) dirs.push_back(i);  // plausible sizes change chi-square by >= min_chi2
+  }
   if (dirs.empty()) {
     const Eigen::VectorXd ev_raw = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(raw, Eigen::EigenvaluesOnly).eigenvalues();
-    const bool absorbed = ev_raw.size() && ev_raw.maxCoeff() >= min_chi2;
-    s.why_not = absorbed
+    const double top = ev_raw.size() ? ev_raw.maxCoeff() : 0.0;
+    if (std::abs(top - min_chi2) < tol) return std::nullopt;
+    s.why_not = top >= min_chi2
                     ? "its effect on these readings is indistinguishable from the location "
                       "errors and set-up parameters already in the model"
                     : "at any plausible size it changes these readings by less than 5 sigma "
@@ -183,7 +188,7 @@ Score score(const ScoringInputs& in, const Effect& c, Eigen::MatrixXd Jc_w, doub
   }
   s.observable = true;
   s.k = static_cast<int>(dirs.size());
-  Eigen::MatrixXd V(perp.cols(), s.k);
+  Eigen::MatrixXd V(m.size(), s.k);
   Eigen::VectorXd lambda(s.k);
   for (int i = 0; i < s.k; ++i) {
     V.col(i) = es.eigenvectors().col(dirs[static_cast<std::size_t>(i)]);
@@ -191,19 +196,43 @@ Score score(const ScoringInputs& in, const Effect& c, Eigen::MatrixXd Jc_w, doub
   }
   s.directions = m.asDiagonal() * V;
   // A = perp V has orthogonal columns of squared norms lambda: d = A^T r_w / lambda.
-  const Eigen::VectorXd Atr = V.transpose() * (perp.transpose() * in.r_w);
+  const Eigen::VectorXd Atr = V.transpose() * perp_r;
   const Eigen::VectorXd d = Atr.cwiseQuotient(lambda);
   s.params = m.cwiseProduct(V * d);
   // F and BIC on whitened residuals: independent with unit variance under the noise model,
   // so the textbook tests hold with the full n (GLS).
-  const double rss0 = rss(in.r_w);
-  s.rss1 = std::max(rss0 - Atr.dot(d), 1e-300);
-  const double n = static_cast<double>(in.r_w.size());
-  const double dof = n - in.num_free - s.k;
-  s.delta_bic = n * std::log(s.rss1 / rss0) + s.k * std::log(n);
-  const double F = ((rss0 - s.rss1) / s.k) / (s.rss1 / dof);
+  s.rss1 = std::max(rr - Atr.dot(d), 1e-300);
+  const double dof = n - num_free - s.k;
+  s.delta_bic = n * std::log(s.rss1 / rr) + s.k * std::log(n);
+  const double F = ((rr - s.rss1) / s.k) / (s.rss1 / dof);
   s.f_pvalue = stats::f_sf(std::max(F, 0.0), s.k, dof);
-  if (s.delta_bic < columns_below_delta_bic) {
+  if (V_out) *V_out = std::move(V);
+  if (d_out) *d_out = d;
+  return s;
+}
+
+}  // namespace
+
+Score score(const ScoringInputs& in, const Effect& c, Eigen::MatrixXd Jc_w, double min_chi2,
+            double columns_below_delta_bic) {
+  const Eigen::VectorXd m = magnitudes(c);
+  // Per plausible size (columns scaled by m), the whitened columns' Gram matrix before and after
+  // the model is projected out. Eigenvalues rather than an SVD of the n x k columns: the
+  // threshold min_chi2 sits far above their rounding (eps times the largest), and a 1 kHz
+  // recording cannot afford the SVD's copies.
+  const Eigen::MatrixXd raw = m.asDiagonal() * (Jc_w.transpose() * Jc_w) * m.asDiagonal();
+  Jc_w -= in.Q_w * (in.Q_w.transpose() * Jc_w);  // in place: the model projected out
+  Jc_w *= m.asDiagonal();
+  const Eigen::MatrixXd& perp = Jc_w;
+  Eigen::MatrixXd V;
+  Eigen::VectorXd d;
+  std::optional<Score> got = score_from_grams(c, m, raw, perp.transpose() * perp, perp.transpose() * in.r_w,
+                                              rss(in.r_w), static_cast<double>(in.r_w.size()), in.num_free,
+                                              min_chi2, 0.0, &V, &d);
+  if (!got)  // only with non-finite columns, which the fit would have refused
+    throw DegenerateGeometry("score: the Gram matrix of candidate " + c.id() + " has no eigen decomposition");
+  Score s = std::move(*got);
+  if (s.observable && s.delta_bic < columns_below_delta_bic) {
     s.A = perp * V;
     s.signature = s.A * d;
   }
@@ -240,8 +269,6 @@ CandidateProducts candidate_products(const ArWhitener* W, double sigma_mm, const
 
 std::optional<Score> score_from_products(const CandidateProducts& g, const Effect& c, int num_free,
                                          double min_chi2) {
-  Score s;
-  s.effect = c;
   const Eigen::VectorXd m = magnitudes(c);
   // Y = L^-1 D^-1 g_fc with D^-1 G_ff D^-1 = L L^T: then Y^T Y is the part of the candidate's
   // Gram matrix that the model's columns explain (the normalised Cholesky test is
@@ -261,50 +288,12 @@ std::optional<Score> score_from_products(const CandidateProducts& g, const Effec
     llt.matrixL().solveInPlace(yr);
   }
   // Per plausible size: raw = the candidate's whitened Gram matrix, perp = after projecting
-  // out the model; their eigenvalues are score()'s squared singular values (chi-square changes).
+  // out the model (as score() forms them from the columns).
   const Eigen::MatrixXd raw = m.asDiagonal() * g.G_cc * m.asDiagonal();
   const Eigen::MatrixXd perp = m.asDiagonal() * (g.G_cc - Y.transpose() * Y) * m.asDiagonal();
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(perp);
-  if (es.info() != Eigen::Success) return std::nullopt;
-  const Eigen::VectorXd ev = es.eigenvalues();
   const double tol = 1e-8 * std::max(raw.norm(), min_chi2);
-  std::vector<Eigen::Index> dirs;
-  for (Eigen::Index i = 0; i < ev.size(); ++i) {
-    if (std::abs(ev[i] - min_chi2) < tol) return std::nullopt;
-    if (ev[i] >= min_chi2) dirs.push_back(i);
-  }
-  if (dirs.empty()) {
-    const Eigen::VectorXd ev_raw = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(raw, Eigen::EigenvaluesOnly).eigenvalues();
-    const double top = ev_raw.size() ? ev_raw.maxCoeff() : 0.0;
-    if (std::abs(top - min_chi2) < tol) return std::nullopt;
-    const bool absorbed = top >= min_chi2;
-    s.why_not = absorbed
-                    ? "its effect on these readings is indistinguishable from the location "
-                      "errors and set-up parameters already in the model"
-                    : "at any plausible size it changes these readings by less than 5 sigma "
-                      "in all (e.g. a motion perpendicular to the bar)";
-    return s;
-  }
-  s.observable = true;
-  s.k = static_cast<int>(dirs.size());
-  Eigen::MatrixXd V(m.size(), s.k);
-  Eigen::VectorXd lambda(s.k);
-  for (int i = 0; i < s.k; ++i) {
-    V.col(i) = es.eigenvectors().col(dirs[static_cast<std::size_t>(i)]);
-    lambda[i] = ev[dirs[static_cast<std::size_t>(i)]];
-  }
-  // A = perp V has orthogonal columns of squared norms lambda: d = A^T r_w / lambda.
-  const Eigen::VectorXd Atr = V.transpose() * (m.asDiagonal() * (g.g_cr - Y.transpose() * yr));
-  const Eigen::VectorXd d = Atr.cwiseQuotient(lambda);
-  s.params = m.cwiseProduct(V * d);
-  const double rss0 = g.rr;
-  s.rss1 = std::max(rss0 - Atr.dot(d), 1e-300);
-  const double n = static_cast<double>(g.n);
-  const double dof = n - num_free - s.k;
-  s.delta_bic = n * std::log(s.rss1 / rss0) + s.k * std::log(n);
-  const double F = ((rss0 - s.rss1) / s.k) / (s.rss1 / dof);
-  s.f_pvalue = stats::f_sf(std::max(F, 0.0), s.k, dof);
-  return s;
+  return score_from_grams(c, m, raw, perp, m.asDiagonal() * (g.g_cr - Y.transpose() * yr), g.rr,
+                          static_cast<double>(g.n), num_free, min_chi2, tol);
 }
 
 double correlation(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
