@@ -271,6 +271,11 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
         continue;
       }
       const Eigen::MatrixXd& Jc = jacobian_of(c);
+      if (!Jc.allFinite()) {  // e.g. a time constant over readings that share one time stamp
+        if (first_round) D.unobservable.push_back({candidates[c].id(), kUndefinedOnReadings});
+        done[c] = true;
+        continue;
+      }
       if (options.progress) options.progress(stage, round_done++, round_total);
       Score s;
       NoiseTreatment judged_with = noise;

@@ -216,6 +216,12 @@ std::optional<Score> score_from_grams(const Effect& c, const Eigen::VectorXd& m,
 Score score(const ScoringInputs& in, const Effect& c, Eigen::MatrixXd Jc_w, double min_chi2,
             double columns_below_delta_bic) {
   const Eigen::VectorXd m = magnitudes(c);
+  if (!Jc_w.allFinite()) {  // e.g. a time constant over readings that all share one time stamp
+    Score s;
+    s.effect = c;
+    s.why_not = kUndefinedOnReadings;
+    return s;
+  }
   // Per plausible size (columns scaled by m), the whitened columns' Gram matrix before and after
   // the model is projected out. Eigenvalues rather than an SVD of the n x k columns: the
   // threshold min_chi2 sits far above their rounding (eps times the largest), and a 1 kHz
@@ -229,7 +235,7 @@ Score score(const ScoringInputs& in, const Effect& c, Eigen::MatrixXd Jc_w, doub
   std::optional<Score> got = score_from_grams(c, m, raw, perp.transpose() * perp, perp.transpose() * in.r_w,
                                               rss(in.r_w), static_cast<double>(in.r_w.size()), in.num_free,
                                               min_chi2, 0.0, &V, &d);
-  if (!got)  // only with non-finite columns, which the fit would have refused
+  if (!got)  // not with finite columns
     throw DegenerateGeometry("score: the Gram matrix of candidate " + c.id() + " has no eigen decomposition");
   Score s = std::move(*got);
   if (s.observable && s.delta_bic < columns_below_delta_bic) {

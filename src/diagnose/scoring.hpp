@@ -65,6 +65,11 @@ struct ScoringInputs {
   int num_free = 0;
 };
 
+/// Why a candidate whose Jacobian is not finite on the readings is not scored.
+inline constexpr const char* kUndefinedOnReadings =
+    "its effect on these readings is undefined (its derivatives are not finite: the readings do "
+    "not span what it depends on)";
+
 /// Score candidate `c` (Jc_w: its whitened Jacobian, mm per unit, taken by value and worked on
 /// in place); directions whose plausible sizes change chi-square by less than min_chi2 are not
 /// visible. The columns A and the signature are kept only if delta BIC < columns_below_delta_bic
