@@ -6,6 +6,15 @@
 
 #include "rotacal/ballbar/identify.hpp"
 #include "rotacal/core/joint_fit.hpp"
+#include "rotacal/core/lanes.hpp"
+
+// Inline every call in the row kernel: GCC otherwise keeps the rotation and its derivative
+// products as calls that pass Lanes vectors through memory.
+#if defined(__GNUC__)
+#define ROTACAL_FLATTEN __attribute__((flatten))
+#else
+#define ROTACAL_FLATTEN
+#endif
 
 namespace rotacal {
 
@@ -33,11 +42,7 @@ class BallbarLengthModel : public ResidualModel {
   void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r,
                 Eigen::MatrixXd* J) const override {
     if (analytic_) {
-      const Chain chain = chain_at(x);
-      if (J)
-        for (Eigen::Index i = 0; i < d_.size(); ++i) r[i] = analytic_row<true>(chain, i, J->row(i));
-      else
-        for (Eigen::Index i = 0; i < d_.size(); ++i) r[i] = analytic_row<false>(chain, i, NoRow{});
+      evaluate_rows(chain_at(x), d_.size(), [](Eigen::Index k) { return k; }, r, J);
       return;
     }
     evaluate_with_jets([this](Eigen::Index i, const auto* p, auto* out) { sample(i, p, out); },
@@ -49,11 +54,7 @@ class BallbarLengthModel : public ResidualModel {
     r.resize(m);
     if (J) J->resize(m, num_parameters());
     if (analytic_) {
-      const Chain chain = chain_at(x);
-      if (J)
-        for (Eigen::Index k = 0; k < m; ++k) r[k] = analytic_row<true>(chain, k * stride, J->row(k));
-      else
-        for (Eigen::Index k = 0; k < m; ++k) r[k] = analytic_row<false>(chain, k * stride, NoRow{});
+      evaluate_rows(chain_at(x), m, [stride](Eigen::Index k) { return k * stride; }, r, J);
       return true;
     }
     evaluate_with_jets(
@@ -70,7 +71,7 @@ class BallbarLengthModel : public ResidualModel {
   }
 
  private:
-  // At most one tool length and one bar length offset (analytic_row writes one column each).
+  // At most one tool length and one bar length offset (analytic_lanes writes one column each).
   static bool analytic_supported(const EffectModel& fx) {
     int tool = 0, length = 0;
     for (const Effect& f : fx.effects) {
@@ -101,23 +102,64 @@ class BallbarLengthModel : public ResidualModel {
   }
 
   // What the chain takes from the parameter vector, evaluated once per evaluation: the actual
-  // lines of both axes (point, unit direction, 1 / |direction|), the pivot and the tool vector.
+  // lines of both axes (point, unit direction, 1 / |direction|), the pivot and the tool vector;
+  // on doubles, then the same in every lane (Lanes) for the rows.
+  template <typename S>
   struct Chain {
-    Eigen::Vector3d point[2], u[2];
-    double inv_norm[2] = {1.0, 1.0};
+    Vec3<S> point[2], u[2];
+    S inv_norm[2] = {S(1.0), S(1.0)};
     // d(line point)/d(position errors) and d(unit direction)/d(direction errors) =
     // (I - u u^T) / |direction| * direction_basis, 3 x 2 each.
-    Eigen::Matrix<double, 3, 2> d_point[2], d_unit[2];
-    Eigen::Vector3d pivot, tool;
-    double length_offset = 0.0;
+    Eigen::Matrix<S, 3, 2> d_point[2], d_unit[2];
+    Vec3<S> pivot, tool;
+    S length_offset = S(0.0);
     int tool_z_col = -1, length_col = -1;
   };
-  struct NoRow {};  // analytic_row without a Jacobian row
+  // The 8 location errors, the pivot, a tool length and a bar length offset at most.
+  static constexpr int kMaxColumns = 13;
+  using JacobianLanes = Eigen::Matrix<Lanes, 1, kMaxColumns>;
 
-  Chain chain_at(const Eigen::VectorXd& x) const {
+  static Chain<Lanes> in_lanes(const Chain<double>& c) {
+    Chain<Lanes> out;
+    for (int k = 0; k < 2; ++k) {
+      out.point[k] = c.point[k].cast<Lanes>();
+      out.u[k] = c.u[k].cast<Lanes>();
+      out.inv_norm[k] = Lanes(c.inv_norm[k]);
+      out.d_point[k] = c.d_point[k].cast<Lanes>();
+      out.d_unit[k] = c.d_unit[k].cast<Lanes>();
+    }
+    out.pivot = c.pivot.cast<Lanes>();
+    out.tool = c.tool.cast<Lanes>();
+    out.length_offset = Lanes(c.length_offset);
+    out.tool_z_col = c.tool_z_col, out.length_col = c.length_col;
+    return out;
+  }
+
+  // Residuals (and Jacobian rows) of samples sample_of(0 .. m-1), four at a time in Lanes (a
+  // sample at a time on doubles, 1,804 Jacobian rows took 139 us, the largest part of a fit of
+  // ballbar_ac_table2.csv). A short last block repeats its last sample in the unused lanes.
+  template <typename SampleOf>
+  void evaluate_rows(const Chain<double>& chain, Eigen::Index m, SampleOf sample_of, Eigen::Ref<Eigen::VectorXd> r,
+                     Eigen::MatrixXd* J) const {
+    const Chain<Lanes> ch = in_lanes(chain);
+    const int cols = num_parameters();
+    JacobianLanes row;
+    Eigen::Index idx[Lanes::kSize];
+    for (Eigen::Index k0 = 0; k0 < m; k0 += Lanes::kSize) {
+      const int count = static_cast<int>(std::min<Eigen::Index>(Lanes::kSize, m - k0));
+      for (int l = 0; l < Lanes::kSize; ++l) idx[l] = sample_of(k0 + std::min(l, count - 1));
+      const Lanes rl = J ? analytic_lanes<true>(ch, idx, &row) : analytic_lanes<false>(ch, idx, nullptr);
+      for (int l = 0; l < count; ++l) r[k0 + l] = rl[l];
+      if (J)
+        for (int c = 0; c < cols; ++c)
+          for (int l = 0; l < count; ++l) (*J)(k0 + l, c) = row[c][l];
+    }
+  }
+
+  Chain<double> chain_at(const Eigen::VectorXd& x) const {
     const MachineType m = d_.machine;
     const LocationErrors<double> e(x.head<8>());
-    Chain ch;
+    Chain<double> ch;
     double tool_z = 0.0;
     for (std::size_t k = 0; k < fx_.effects.size(); ++k) {
       const int col = 11 + fx_.offset(k);
@@ -139,54 +181,63 @@ class BallbarLengthModel : public ResidualModel {
     return ch;
   }
 
-  // Residual of sample i, and with WithJacobian its Jacobian row by the chain rule (see the
-  // class comment).
-  template <bool WithJacobian, typename Row>
-  double analytic_row(const Chain& ch, Eigen::Index i, Row J) const {
+  // Residuals of the four samples idx, and with WithJacobian their Jacobian rows by the chain
+  // rule (see the class comment).
+  template <bool WithJacobian>
+  ROTACAL_FLATTEN Lanes analytic_lanes(const Chain<Lanes>& ch, const Eigen::Index (&idx)[Lanes::kSize], JacobianLanes* J) const {
+    using Row = Eigen::Matrix<Lanes, 1, 3>;
+    Lanes cs[4], measured;
+    Vec3<Lanes> xyz;
+    for (int l = 0; l < Lanes::kSize; ++l) {
+      const Eigen::Index i = idx[l];
+      for (int c = 0; c < 4; ++c) cs[c][l] = cs_(c, i);
+      for (int a = 0; a < 3; ++a) xyz[a][l] = d_.xyz(a, i);
+      measured[l] = d_.length[i];
+    }
     const int nt = nt_;
-    LineRotationDerivatives D[2];
-    const auto rotate = [&](int k, const Eigen::Vector3d& q) -> Eigen::Vector3d {
+    LineRotationDerivatives<Lanes> D[2];
+    const auto rotate = [&](int k, const Vec3<Lanes>& q) -> Vec3<Lanes> {
       if constexpr (WithJacobian)
-        return (D[k] = rotate_point_about_unit_line_derivatives(ch.point[k], ch.u[k], ch.inv_norm[k],
-                                                                cs_(2 * k, i), cs_(2 * k + 1, i), q))
+        return (D[k] = rotate_point_about_unit_line_derivatives<Lanes>(ch.point[k], ch.u[k], ch.inv_norm[k],
+                                                                       cs[2 * k], cs[2 * k + 1], q))
             .f;
       else
-        return rotate_point_about_unit_line<double>(ch.point[k], ch.u[k], cs_(2 * k, i), cs_(2 * k + 1, i), q);
+        return rotate_point_about_unit_line<Lanes>(ch.point[k], ch.u[k], cs[2 * k], cs[2 * k + 1], q);
     };
     // Table side: the pivot through the table axes, innermost first.
-    Eigen::Vector3d P = ch.pivot;
+    Vec3<Lanes> P = ch.pivot;
     for (int k = nt - 1; k >= 0; --k) P = rotate(k, P);
     // Tool side: the tool vector through the head axes, innermost first.
-    Eigen::Vector3d v = ch.tool;
+    Vec3<Lanes> v = ch.tool;
     for (int k = 1; k >= nt; --k) v = rotate(k, v);
-    const Eigen::Vector3d b = d_.xyz.col(i) + v;
-    const double length = (b - P).norm();
+    const Vec3<Lanes> b = xyz + v;
+    const Lanes length = (b - P).norm();
     // The residual from the same chain: the ball points above are the one model's rotations
     // composed as predicted_length composes them (the Jets test checks r as well as J).
-    const double r = length + ch.length_offset - d_.length[i];
+    const Lanes r = length + ch.length_offset - measured;
     if constexpr (WithJacobian) {
-      const Eigen::Vector3d u = (b - P) / length;
+      const Vec3<Lanes> u = (b - P) / length;
       // dL/d(line k) = +-u^T (outer rotations) dD_k; the table side enters with a minus. Every
       // column is written: the 8 location errors, the pivot, and the offsets this model has.
-      const auto line_columns = [&](int k, const Eigen::RowVector3d& w, const Eigen::RowVector3d& wq) {
-        J.template segment<2>(4 * k) = D[k].times_point(w, wq) * ch.d_point[k];
-        J.template segment<2>(4 * k + 2) = D[k].times_unit_direction(w) * ch.d_unit[k];
+      const auto line_columns = [&](int k, const Row& w, const Row& wq) {
+        J->template segment<2>(4 * k) = D[k].times_point(w, wq) * ch.d_point[k];
+        J->template segment<2>(4 * k + 2) = D[k].times_unit_direction(w) * ch.d_unit[k];
       };
-      Eigen::RowVector3d w = -u.transpose();
+      Row w = -u.transpose();
       for (int k = 0; k < nt; ++k) {
-        const Eigen::RowVector3d wq = D[k].times_q(w);
+        const Row wq = D[k].times_q(w);
         line_columns(k, w, wq);
         w = wq;
       }
-      J.template segment<3>(8) = w;  // d/dpivot
+      J->template segment<3>(8) = w;  // d/dpivot
       w = u.transpose();
       for (int k = nt; k < 2; ++k) {
-        const Eigen::RowVector3d wq = D[k].times_q(w);
+        const Row wq = D[k].times_q(w);
         line_columns(k, w, wq);
         w = wq;
       }
-      if (ch.tool_z_col >= 0) J[ch.tool_z_col] = w.z();
-      if (ch.length_col >= 0) J[ch.length_col] = 1.0;
+      if (ch.tool_z_col >= 0) (*J)[ch.tool_z_col] = w.z();
+      if (ch.length_col >= 0) (*J)[ch.length_col] = Lanes(1.0);
     }
     return r;
   }

@@ -90,9 +90,11 @@ JointFitOutcome solve_joint(const ResidualModel& model, const std::vector<FitPar
                           " residuals, the fit has " + std::to_string(n));
   if (!(s.sigma > 0.0) || !std::isfinite(s.sigma))
     throw InvalidArgument("solve_joint: sigma must be finite and > 0");
+  // 1 / sigma as a product: a division of every Jacobian entry cost ~13 us on table2.
+  const double inv_sigma = 1.0 / s.sigma;
   const auto weigh = [&](auto&& cols) {
     if (s.whitener) s.whitener->apply(cols);
-    else cols /= s.sigma;
+    else cols *= inv_sigma;
   };
 
   JointFitOutcome out;
@@ -136,8 +138,8 @@ JointFitOutcome solve_joint(const ResidualModel& model, const std::vector<FitPar
     Eigen::VectorXd rs, rs_t;
     Eigen::MatrixXd Js;
     if (model.evaluate_subset(x, stride, rs, &Js) && rs.allFinite() && Js.allFinite()) {
-      rs /= s.sigma;
-      Js /= s.sigma;
+      rs *= inv_sigma;
+      Js *= inv_sigma;
       Observability obs;
       const Eigen::MatrixXd Gs = gram(Js);
       // Information of the whole session ~ stride times the subsample's.
@@ -166,7 +168,7 @@ JointFitOutcome solve_joint(const ResidualModel& model, const std::vector<FitPar
         for (Eigen::Index a = 0; a < dx.size(); ++a) xt[idx[static_cast<std::size_t>(a)]] += dx[a];
         model.evaluate_subset(xt, stride, rs_t, nullptr);
         ++sum.residual_evaluations;
-        rs_t /= s.sigma;
+        rs_t *= inv_sigma;
         const double cost_t = rs_t.squaredNorm();
         if (!std::isfinite(cost_t) || cost_t > cost) break;
         x = xt, rs.swap(rs_t), cost = cost_t;

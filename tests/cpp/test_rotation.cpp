@@ -88,7 +88,7 @@ TEST_CASE("rotate_point_about_line_derivatives agree with Jets of rotate_point_a
     Vec3<J> aj, dj, qj;
     for (int k = 0; k < 3; ++k) aj[k] = J(a[k], k), dj[k] = J(d[k], 3 + k), qj[k] = J(q[k], 6 + k);
     const Vec3<J> f = rotate_point_about_line<J>(aj, dj, J(theta), qj);
-    const LineRotationDerivatives D = rotate_point_about_line_derivatives(a, d, theta, q);
+    const LineRotationDerivatives<double> D = rotate_point_about_line_derivatives(a, d, theta, q);
     for (int r = 0; r < 3; ++r) {
       CHECK(std::abs(D.f[r] - f[r].a) < 1e-12 * (1 + std::abs(f[r].a)));
       for (int k = 0; k < 3; ++k) {

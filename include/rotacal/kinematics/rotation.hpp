@@ -89,73 +89,74 @@ Vec3<Scalar> rotate_point_about_line(const Vec3<Scalar>& point, const Vec3<Scala
   return rotate_point_about_line<Scalar>(point, direction, Scalar(cos(theta)), Scalar(sin(theta)), q);
 }
 
-/// rotate_point_about_line with its first derivatives (double only; the fits' fast path, checked
-/// against Jets of rotate_point_about_line in tests/cpp/test_rotation.cpp):
+/// rotate_point_about_line with its first derivatives (double, or Lanes of four samples: the
+/// fits' fast path, checked against Jets of rotate_point_about_line in tests/cpp/test_rotation.cpp):
 ///   f = a + R(u, theta) (q - a),  u = d / |d|,  v = q - a
 ///   df/dq = R,  df/da = I - R,
 ///   df/dd = [-sin(theta) [v]x + (1 - cos(theta)) ((u . v) I + u v^T)] (I - u u^T) / |d|.
 /// A chain rule runs from the reading backwards, so the derivatives are applied to row vectors
 /// w (w df/dq and so on, a few cross products each); the matrices are for tests.
+template <typename Scalar = double>
 struct LineRotationDerivatives {
-  Eigen::Vector3d f, u, v;
-  double c = 1.0, s = 0.0, inv_norm = 1.0;
+  using Row = Eigen::Matrix<Scalar, 1, 3>;
+  Vec3<Scalar> f, u, v;
+  Scalar c = Scalar(1), s = Scalar(0), inv_norm = Scalar(1);
 
   /// w R, with w K = w x u for the row w and K = [u]x.
-  Eigen::RowVector3d times_q(const Eigen::RowVector3d& w) const {
-    const Eigen::Vector3d wk = w.transpose().cross(u);
-    return w + (s * wk + (1.0 - c) * wk.cross(u)).transpose();
+  Row times_q(const Row& w) const {
+    const Vec3<Scalar> wk = w.transpose().cross(u);
+    return w + (s * wk + (Scalar(1) - c) * wk.cross(u)).transpose();
   }
   /// w (I - R): pass w R when the caller has it (a chain rule needs both).
-  Eigen::RowVector3d times_point(const Eigen::RowVector3d& w) const { return w - times_q(w); }
-  Eigen::RowVector3d times_point(const Eigen::RowVector3d& w, const Eigen::RowVector3d& w_times_q) const {
-    return w - w_times_q;
-  }
-  Eigen::RowVector3d times_direction(const Eigen::RowVector3d& w) const {
-    const Eigen::Vector3d g = times_unit_direction(w).transpose();
+  Row times_point(const Row& w) const { return w - times_q(w); }
+  Row times_point(const Row& w, const Row& w_times_q) const { return w - w_times_q; }
+  Row times_direction(const Row& w) const {
+    const Vec3<Scalar> g = times_unit_direction(w).transpose();
     return ((g - g.dot(u) * u) * inv_norm).transpose();
   }
   /// w df/du for the unit direction u itself; times_direction is this times
   /// du/dd = (I - u u^T) / |d|, which a caller with many points on one line applies once.
-  Eigen::RowVector3d times_unit_direction(const Eigen::RowVector3d& w) const {
-    const Eigen::Vector3d wt = w.transpose();
-    return (-s * wt.cross(v) + (1.0 - c) * (u.dot(v) * wt + wt.dot(u) * v)).transpose();
+  Row times_unit_direction(const Row& w) const {
+    const Vec3<Scalar> wt = w.transpose();
+    return (-s * wt.cross(v) + (Scalar(1) - c) * (u.dot(v) * wt + wt.dot(u) * v)).transpose();
   }
-  Eigen::Matrix3d d_q() const { return rows([this](const Eigen::RowVector3d& w) { return times_q(w); }); }
-  Eigen::Matrix3d d_point() const { return rows([this](const Eigen::RowVector3d& w) { return times_point(w); }); }
-  Eigen::Matrix3d d_direction() const {
-    return rows([this](const Eigen::RowVector3d& w) { return times_direction(w); });
-  }
+  Mat3<Scalar> d_q() const { return rows([this](const Row& w) { return times_q(w); }); }
+  Mat3<Scalar> d_point() const { return rows([this](const Row& w) { return times_point(w); }); }
+  Mat3<Scalar> d_direction() const { return rows([this](const Row& w) { return times_direction(w); }); }
 
  private:
   template <typename F>
-  static Eigen::Matrix3d rows(const F& times) {
-    Eigen::Matrix3d M;
-    for (int r = 0; r < 3; ++r) M.row(r) = times(Eigen::RowVector3d::Unit(r));
+  static Mat3<Scalar> rows(const F& times) {
+    Mat3<Scalar> M;
+    for (int r = 0; r < 3; ++r) M.row(r) = times(Row::Unit(r));
     return M;
   }
 };
 
 /// The form for a line given as its point, unit direction u = d / |d| and 1 / |d|, and the
 /// angle as c = cos(theta), s = sin(theta): a fit evaluates the line once per parameter vector
-/// and the commanded angles' sines once per session.
-inline LineRotationDerivatives rotate_point_about_unit_line_derivatives(const Eigen::Vector3d& point,
-                                                                        const Eigen::Vector3d& u, double inv_norm,
-                                                                        double c, double s, const Eigen::Vector3d& q) {
-  LineRotationDerivatives D;
+/// and the commanded angles' sines once per session. Scalar double, or Lanes (core/lanes.hpp)
+/// for four samples at once.
+template <typename Scalar>
+LineRotationDerivatives<Scalar> rotate_point_about_unit_line_derivatives(const Vec3<Scalar>& point,
+                                                                         const Vec3<Scalar>& u,
+                                                                         const Scalar& inv_norm, const Scalar& c,
+                                                                         const Scalar& s, const Vec3<Scalar>& q) {
+  LineRotationDerivatives<Scalar> D;
   D.inv_norm = inv_norm;
   D.u = u;
   D.v = q - point;
   D.c = c;
   D.s = s;
-  D.f = rotate_point_about_unit_line<double>(point, u, c, s, q);  // the one definition
+  D.f = rotate_point_about_unit_line<Scalar>(point, u, c, s, q);  // the one definition
   return D;
 }
-inline LineRotationDerivatives rotate_point_about_line_derivatives(const Eigen::Vector3d& point,
-                                                                   const Eigen::Vector3d& direction,
-                                                                   double theta, const Eigen::Vector3d& q) {
+inline LineRotationDerivatives<double> rotate_point_about_line_derivatives(const Eigen::Vector3d& point,
+                                                                           const Eigen::Vector3d& direction,
+                                                                           double theta, const Eigen::Vector3d& q) {
   const double inv_norm = 1.0 / direction.norm();
-  return rotate_point_about_unit_line_derivatives(point, direction * inv_norm, inv_norm, std::cos(theta),
-                                                  std::sin(theta), q);
+  return rotate_point_about_unit_line_derivatives<double>(point, direction * inv_norm, inv_norm, std::cos(theta),
+                                                          std::sin(theta), q);
 }
 
 /// Flynn et al. 2016, Eq. 1 written out component by component: rotates q = (x, y, z) about
