@@ -214,6 +214,20 @@ TEST_CASE("the analytic Jacobian of the length model equals the Jets on every ma
     Eigen::VectorXd r3(a.size());
     model.evaluate(x, r3, nullptr);
     CHECK((r3 - r2).cwiseAbs().maxCoeff() < 1e-12);
+    // Every k-th sample (the start on long sessions): rows are evaluated four at a time, so
+    // these strides also leave last blocks of 1, 2 and 3 samples.
+    for (Eigen::Index stride = 2; stride <= 7; ++stride) {
+      Eigen::VectorXd rs, rs_only;
+      Eigen::MatrixXd Js;
+      REQUIRE(model.evaluate_subset(x, stride, rs, &Js));
+      REQUIRE(model.evaluate_subset(x, stride, rs_only, nullptr));
+      REQUIRE(rs.size() == (a.size() + stride - 1) / stride);
+      for (Eigen::Index k = 0; k < rs.size(); ++k) {
+        CHECK(std::abs(rs[k] - r2[k * stride]) < 1e-12);
+        CHECK(std::abs(rs_only[k] - r2[k * stride]) < 1e-12);
+        CHECK((Js.row(k) - J2.row(k * stride)).cwiseAbs().maxCoeff() < 1e-9 * (1.0 + J2.cwiseAbs().maxCoeff()));
+      }
+    }
   }
 }
 
