@@ -25,13 +25,17 @@ namespace rotacal {
 
 namespace {
 
-// J^T J (p x p) of a weighted Jacobian, by Eigen's blocked product (at ~30 us for table2's
-// 1,804 x 11 it is the largest cost of the driver itself: it is computed once per Jacobian).
+// J^T J (p x p) of a weighted Jacobian, one matrix-vector product per column (the lower
+// triangle, mirrored). Measured against Eigen's rankUpdate (a blocked, packed product): table2's
+// 1,804 x 11 17 us instead of 34-46 us, where it was the largest cost of the driver itself;
+// 20,000 x 40 2.7 ms instead of 3.3; 600,000 x 11 15.3 ms instead of 15.8.
 Eigen::MatrixXd gram(const Eigen::MatrixXd& J) {
-  Eigen::MatrixXd G(J.cols(), J.cols());
-  G.setZero();
-  G.selfadjointView<Eigen::Lower>().rankUpdate(J.transpose());
-  G.triangularView<Eigen::StrictlyUpper>() = G.transpose();
+  const Eigen::Index p = J.cols();
+  Eigen::MatrixXd G(p, p);
+  for (Eigen::Index a = 0; a < p; ++a) {
+    G.col(a).tail(p - a).noalias() = J.rightCols(p - a).transpose() * J.col(a);
+    G.row(a).tail(p - a) = G.col(a).tail(p - a).transpose();
+  }
   return G;
 }
 
@@ -357,11 +361,7 @@ JointRefitter::JointRefitter(const JointFitOutcome& reference, std::vector<FitPa
   for (Eigen::Index a = 0; a < q; ++a) Jw_free_.col(a) = reference.jacobian.col(idx_[static_cast<std::size_t>(a)]);
   if (settings_.whitener) settings_.whitener->apply(Jw_free_);
   else Jw_free_ /= settings_.sigma;
-  Eigen::MatrixXd A(q, q);
-  A.setZero();
-  A.selfadjointView<Eigen::Lower>().rankUpdate(Jw_free_.transpose());
-  A.triangularView<Eigen::StrictlyUpper>() = A.transpose();
-  ldlt_.compute(A);
+  ldlt_.compute(gram(Jw_free_));
   sigma_ = ldlt_.solve(Eigen::MatrixXd::Identity(q, q)).diagonal().cwiseMax(0.0).cwiseSqrt();
 }
 
