@@ -25,19 +25,8 @@ namespace rotacal {
 
 namespace {
 
-// J^T J (p x p) of a weighted Jacobian, one matrix-vector product per column (the lower
-// triangle, mirrored). Measured against Eigen's rankUpdate (a blocked, packed product): table2's
-// 1,804 x 11 17 us instead of 34-46 us, where it was the largest cost of the driver itself;
-// 20,000 x 40 2.7 ms instead of 3.3; 600,000 x 11 15.3 ms instead of 15.8.
-Eigen::MatrixXd gram(const Eigen::MatrixXd& J) {
-  const Eigen::Index p = J.cols();
-  Eigen::MatrixXd G(p, p);
-  for (Eigen::Index a = 0; a < p; ++a) {
-    G.col(a).tail(p - a).noalias() = J.rightCols(p - a).transpose() * J.col(a);
-    G.row(a).tail(p - a) = G.col(a).tail(p - a).transpose();
-  }
-  return G;
-}
+// J^T J (p x p) of a weighted Jacobian (gram_matrix: it was the largest cost of the driver itself).
+Eigen::MatrixXd gram(const Eigen::MatrixXd& J) { return gram_matrix(J); }
 
 // Normal equations of the free columns, column-normalised for conditioning. With every column
 // free the normal matrix is gram(Jw), taken from `G` when the caller has computed it already.

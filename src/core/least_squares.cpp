@@ -19,6 +19,16 @@ Eigen::VectorXd column_scales(const Eigen::MatrixXd& J) {
 }
 }  // namespace
 
+Eigen::MatrixXd gram_matrix(const Eigen::Ref<const Eigen::MatrixXd>& J) {
+  const Eigen::Index p = J.cols();
+  Eigen::MatrixXd G(p, p);
+  for (Eigen::Index a = 0; a < p; ++a) {
+    G.col(a).tail(p - a).noalias() = J.rightCols(p - a).transpose() * J.col(a);
+    G.row(a).tail(p - a) = G.col(a).tail(p - a).transpose();
+  }
+  return G;
+}
+
 Observability analyse_observability(const Eigen::MatrixXd& J, const Eigen::VectorXd& scales,
                                     double min_chi2_change) {
   if (scales.size() != J.cols())
@@ -28,11 +38,7 @@ Observability analyse_observability(const Eigen::MatrixXd& J, const Eigen::Vecto
   // NaN; the readers refuse such values, and this stops any other path to it.
   if (!J.allFinite())
     throw InvalidArgument("analyse_observability: the Jacobian is not finite (a reading or parameter is out of range)");
-  Eigen::MatrixXd JtJ(J.cols(), J.cols());
-  JtJ.setZero();
-  JtJ.selfadjointView<Eigen::Lower>().rankUpdate(J.transpose());
-  JtJ.triangularView<Eigen::StrictlyUpper>() = JtJ.transpose();
-  return analyse_observability_normal(JtJ, scales, min_chi2_change);
+  return analyse_observability_normal(gram_matrix(J), scales, min_chi2_change);
 }
 
 Observability analyse_observability_normal(const Eigen::MatrixXd& JtJ, const Eigen::VectorXd& scales,

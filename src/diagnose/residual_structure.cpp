@@ -242,8 +242,12 @@ StructureTest structure_test(
     const Eigen::VectorXd r_w = whiten(r_mm);
     // The model's columns are full rank here (free columns of a fit): CholeskyQR2, which falls
     // back to the rank-revealing QR where they are not.
+    // The test columns after that projection are full rank in most groups too; where they are
+    // near rank-deficient (a harmonic the model's columns already hold) CholeskyQR2 hands the
+    // rank decision to the rank-revealing QR. Its Householder QR of every group's columns was
+    // most of this test's time.
     const Eigen::MatrixXd Gp = project_out(orthonormal_basis_full_rank(whiten(Jfree)), whiten(G));
-    const Eigen::MatrixXd B = orthonormal_basis(Gp);
+    const Eigen::MatrixXd B = orthonormal_basis_full_rank(Gp);
     const auto q = static_cast<double>(B.cols());
     if (q == 0) continue;
     const Eigen::VectorXd fitted = B * (B.transpose() * r_w);

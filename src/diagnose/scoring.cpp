@@ -62,12 +62,10 @@ Eigen::MatrixXd orthonormal_basis_full_rank(const Eigen::MatrixXd& J) {
   if (p == 0) return Eigen::MatrixXd(J.rows(), 0);
   Eigen::MatrixXd Q = J;
   for (int pass = 0; pass < 2; ++pass) {  // CholeskyQR2: the second pass restores orthogonality
-    Eigen::MatrixXd G = Eigen::MatrixXd::Zero(p, p);
-    G.selfadjointView<Eigen::Lower>().rankUpdate(Q.transpose());
+    const Eigen::MatrixXd G = gram_matrix(Q);
     const Eigen::VectorXd d = G.diagonal().cwiseSqrt();
     if (!(d.minCoeff() > 0.0) || !d.allFinite()) return orthonormal_basis(J);
-    const Eigen::MatrixXd Gn = d.cwiseInverse().asDiagonal() *
-                               Eigen::MatrixXd(G.selfadjointView<Eigen::Lower>()) * d.cwiseInverse().asDiagonal();
+    const Eigen::MatrixXd Gn = d.cwiseInverse().asDiagonal() * G * d.cwiseInverse().asDiagonal();
     const Eigen::LLT<Eigen::MatrixXd> llt(Gn);
     // Near rank deficiency (condition of the normalised columns above ~1e6) the rank-revealing
     // QR decides, as everywhere else.
