@@ -28,8 +28,10 @@ namespace {
 // J^T J (p x p) of a weighted Jacobian (gram_matrix: it was the largest cost of the driver itself).
 Eigen::MatrixXd gram(const Eigen::MatrixXd& J) { return gram_matrix(J); }
 
-// Normal equations of the free columns, column-normalised for conditioning. With every column
-// free the normal matrix is gram(Jw), taken from `G` when the caller has computed it already.
+// Normal equations of the free columns, column-normalised for conditioning, of the weighted
+// Jacobian scale * J (scale 1/sigma for white noise: J itself need not be scaled and back). With
+// every column free the normal matrix is gram(Jw) scale^2, taken from `G` when the caller has
+// computed it already.
 struct NormalEquations {
   Eigen::VectorXd D;         // column norms of the weighted Jacobian (free columns)
   Eigen::MatrixXd A;         // (J D^-1)^T (J D^-1)
@@ -38,18 +40,18 @@ struct NormalEquations {
   Eigen::LDLT<Eigen::MatrixXd> ldlt;
 };
 
-NormalEquations normal_equations(const Eigen::MatrixXd& Jw, const std::vector<Eigen::Index>& idx,
+NormalEquations normal_equations(const Eigen::MatrixXd& Jw, double scale, const std::vector<Eigen::Index>& idx,
                                  const Eigen::MatrixXd* G = nullptr) {
   const Eigen::Index q = static_cast<Eigen::Index>(idx.size());
   NormalEquations ne;
   ne.A.setZero(q, q);
   if (q == Jw.cols()) {  // all columns free
-    ne.A = G ? *G : gram(Jw);
+    ne.A = G ? *G : Eigen::MatrixXd(gram(Jw) * (scale * scale));
   } else {
     for (Eigen::Index a = 0; a < q; ++a)
       for (Eigen::Index b = a; b < q; ++b)
         ne.A(a, b) = ne.A(b, a) =
-            Jw.col(idx[static_cast<std::size_t>(a)]).dot(Jw.col(idx[static_cast<std::size_t>(b)]));
+            Jw.col(idx[static_cast<std::size_t>(a)]).dot(Jw.col(idx[static_cast<std::size_t>(b)])) * (scale * scale);
   }
   ne.D = ne.A.diagonal().cwiseSqrt();
   for (Eigen::Index a = 0; a < q; ++a)
@@ -88,6 +90,13 @@ JointFitOutcome solve_joint(const ResidualModel& model, const std::vector<FitPar
   const auto weigh = [&](auto&& cols) {
     if (s.whitener) s.whitener->apply(cols);
     else cols *= inv_sigma;
+  };
+  // The full Jacobian Jw is stored as J_weighted / jw_scale: whitened in place under a
+  // whitener, left as J under white noise (1/sigma goes into its products instead, which saves
+  // scaling the n x p array and scaling it back for the caller).
+  const double jw_scale = s.whitener ? 1.0 : inv_sigma;
+  const auto weigh_jacobian = [&](Eigen::MatrixXd& J) {
+    if (s.whitener) s.whitener->apply(J);
   };
 
   JointFitOutcome out;
@@ -140,7 +149,7 @@ JointFitOutcome solve_joint(const ResidualModel& model, const std::vector<FitPar
       std::vector<Eigen::Index> idx;
       for (int j = 0; j < p; ++j)
         if (free_subset[static_cast<std::size_t>(j)]) idx.push_back(j);
-      NormalEquations ne = normal_equations(Js, idx, &Gs);
+      NormalEquations ne = normal_equations(Js, 1.0, idx, &Gs);
       // Only where the subsample pins every free parameter to 1 % of its plausible size: a
       // weakly determined direction would wander there (the problem is not linear over that
       // range), and where the full analysis and solve start would then matter.
@@ -182,8 +191,8 @@ JointFitOutcome solve_joint(const ResidualModel& model, const std::vector<FitPar
         throw InvalidArgument("solve_joint: residual " + std::to_string(i) + " is not finite at the start point");
     rw = r;
     weigh(rw);
-    weigh(Jw);
-    G = gram(Jw);
+    weigh_jacobian(Jw);
+    G = gram(Jw) * (jw_scale * jw_scale);
   };
   evaluate_full();
 
@@ -221,7 +230,7 @@ JointFitOutcome solve_joint(const ResidualModel& model, const std::vector<FitPar
   // contracts slowly. At convergence a stale Jacobian moves the solution by about
   // (J_ref - J)^T r: relative change of J (~ the contraction ratio rho of the chord steps)
   // times sqrt(chi2) sigma at most; it is accepted below 0.01 sigma, else refreshed.
-  NormalEquations ne = normal_equations(Jw, idx, &G);
+  NormalEquations ne = normal_equations(Jw, jw_scale, idx, &G);
   bool at_J = true;
   double cost = rw.squaredNorm();
   double lambda = 0.0, last_step = -1.0;
@@ -234,8 +243,8 @@ JointFitOutcome solve_joint(const ResidualModel& model, const std::vector<FitPar
     ++sum.jacobian_evaluations;
     rw = r;
     weigh(rw);
-    weigh(Jw);
-    ne = normal_equations(Jw, idx);
+    weigh_jacobian(Jw);
+    ne = normal_equations(Jw, jw_scale, idx);
     at_J = true;
     cost = rw.squaredNorm();
     last_step = -1.0;
@@ -244,7 +253,8 @@ JointFitOutcome solve_joint(const ResidualModel& model, const std::vector<FitPar
   sum.message = "reached max_iterations";
   while (sum.iterations < s.max_iterations) {
     Eigen::VectorXd g(q);
-    for (Eigen::Index a = 0; a < q; ++a) g[a] = Jw.col(idx[static_cast<std::size_t>(a)]).dot(rw) / ne.D[a];
+    for (Eigen::Index a = 0; a < q; ++a)
+      g[a] = Jw.col(idx[static_cast<std::size_t>(a)]).dot(rw) * jw_scale / ne.D[a];
     Eigen::VectorXd y;
     if (lambda > 0.0) {
       Eigen::MatrixXd Al = ne.A;
@@ -324,8 +334,7 @@ JointFitOutcome solve_joint(const ResidualModel& model, const std::vector<FitPar
     Eigen::VectorXd tmp(n);
     model.evaluate(x, tmp, &out.jacobian);
   } else {
-    out.jacobian = std::move(Jw);
-    out.jacobian *= s.sigma;
+    out.jacobian = std::move(Jw);  // J itself (jw_scale above)
   }
   for (int j = 0; j < p; ++j) {
     ParameterEstimate e;
