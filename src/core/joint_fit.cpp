@@ -12,9 +12,10 @@
 // it still contracts the step (chord iteration, residuals only), and on a long session the
 // first steps are taken on every k-th sample (k ~ n / 32p), so that one full Jacobian,
 // evaluated near the solution, serves the last step and the covariance. Measured on the 2-core
-// machine (CPU time): table2 0.4-0.5 ms with the ballbar's analytic Jacobian (a full evaluation
-// from the start point instead of the subsample start: about twice that), R-test 2 x 84 poses
-// 5.1 ms, 600,000 ballbar samples 0.22 s and 227 MB peak for the process.
+// machine (wall, in a loop): table2 0.24-0.34 ms with the ballbar's analytic Jacobian evaluated
+// four samples at a time (0.4-0.5 ms a sample at a time; a full evaluation from the start point
+// instead of the subsample start: about twice that), R-test 2 x 84 poses 5.1 ms, 600,000
+// ballbar samples 0.21-0.25 s and 221-227 MB peak for the process.
 #include "rotacal/core/joint_fit.hpp"
 
 #include <Eigen/Cholesky>
