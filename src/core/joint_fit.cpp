@@ -26,7 +26,8 @@ namespace rotacal {
 
 namespace {
 
-// J^T J (p x p) of a weighted Jacobian (gram_matrix: it was the largest cost of the driver itself).
+// J^T J (p x p) of a weighted Jacobian: gram_matrix (least_squares.hpp), named here as the
+// driver reads it.
 Eigen::MatrixXd gram(const Eigen::MatrixXd& J) { return gram_matrix(J); }
 
 // Normal equations of the free columns, column-normalised for conditioning, of the weighted
@@ -86,7 +87,7 @@ JointFitOutcome solve_joint(const ResidualModel& model, const std::vector<FitPar
                           " residuals, the fit has " + std::to_string(n));
   if (!(s.sigma > 0.0) || !std::isfinite(s.sigma))
     throw InvalidArgument("solve_joint: sigma must be finite and > 0");
-  // 1 / sigma as a product: a division of every Jacobian entry cost ~13 us on table2.
+  // 1 / sigma once, applied as a product to residual vectors and the subsample's Jacobian.
   const double inv_sigma = 1.0 / s.sigma;
   const auto weigh = [&](auto&& cols) {
     if (s.whitener) s.whitener->apply(cols);
