@@ -569,8 +569,8 @@ double cv_rms_um(const Rows& R, const Eigen::MatrixXd& M, const Eigen::VectorXd&
     }
     if (te.empty() || tr.empty()) continue;
     const Eigen::VectorXd d =
-        block_solve(first, count, M(tr, Eigen::placeholders::all), y(tr));
-    ss += (y(te) - M(te, Eigen::placeholders::all) * d).squaredNorm();
+        block_solve(first, count, M(tr, Eigen::all), y(tr));
+    ss += (y(te) - M(te, Eigen::all) * d).squaredNorm();
     n += te.size();
   }
   return n ? std::sqrt(ss / static_cast<double>(n)) * 1e3 : 0.0;
