@@ -107,20 +107,27 @@ Eigen::MatrixXd stream_levels(const DiagnosisProblem& P) {
 }
 
 NoiseTreatment white_treatment(const DiagnosisProblem& P, const ModelFit& baseline);
-NoiseTreatment coloured_treatment(const NoiseModel& m);
+// `described`: with the model's summary as the source (the candidates' own models and the
+// structure test's are never reported, and formatting a summary per candidate is wasted).
+NoiseTreatment coloured_treatment(const NoiseModel& m, bool described = true);
 
 // The noise model of what the current model extended by candidate c (linearised) leaves;
-// white treatment if that is white.
-NoiseTreatment candidate_treatment(const NoiseStreamLayout& layout, const DiagnosisOptions& options,
-                                   const ModelFit& fit, const Eigen::MatrixXd& Q_raw,
-                                   const Eigen::MatrixXd& Jc, const Effect& c,
-                                   const NoiseTreatment& white, NoiseModel* model) {
-  // What the candidate adds to the model's span, orthonormalised (CholeskyQR2; the rank-revealing
-  // QR where it is near rank-deficient): r minus its projection on that.
-  const Eigen::MatrixXd B = orthonormal_basis_full_rank(project_out(Q_raw, Jc));
-  const Eigen::VectorXd r = fit.residuals - B * (B.transpose() * fit.residuals);
-  *model = estimate_noise_model(layout, r, options.noise);
-  return model->white() ? white : coloured_treatment(*model);
+// white treatment if that is white. Its AR order is looked for up to `max_order` (the search's
+// noise model's order + 2: the candidate's residual differs from the current model's in the k
+// directions it adds, which do not raise the order of the noise's correlation; Burg's recursion
+// through all 8 orders for every candidate was most of this function's time).
+NoiseTreatment candidate_treatment(const NoiseStreamLayout& layout, const NoiseModelOptions& noise_options,
+                                   const ModelFit& fit, const Eigen::MatrixXd& Q_raw, const Eigen::VectorXd& Qr,
+                                   const Eigen::MatrixXd& Jc, const NoiseTreatment& white, NoiseModel* model) {
+  Eigen::VectorXd r = residual_without(Q_raw, fit.residuals, Qr, Jc);
+  if (r.size() == 0) {
+    // What the candidate adds to the model's span, orthonormalised (CholeskyQR2; the
+    // rank-revealing QR where it is near rank-deficient): r minus its projection on that.
+    const Eigen::MatrixXd B = orthonormal_basis_full_rank(project_out(Q_raw, Jc));
+    r = fit.residuals - B * (B.transpose() * fit.residuals);
+  }
+  *model = estimate_noise_model(layout, r, noise_options);
+  return model->white() ? white : coloured_treatment(*model, false);
 }
 
 // What the searches of one diagnosis share: a diagnosis may search twice (with the noise
@@ -223,7 +230,13 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
     // Built when a candidate first needs them (n x (p + streams) each: AR(1) noise never does).
     Eigen::MatrixXd Q_raw, J_levels;
     int levels_rank = 0;
-    if (noise.W) Q_raw = orthonormal_basis(in.Jfree);
+    Eigen::VectorXd Qr;  // Q_raw^T r (zero but for the fit's convergence)
+    NoiseModelOptions own_noise = options.noise;  // each candidate's own noise model (see candidate_treatment)
+    if (noise.W) {
+      Q_raw = orthonormal_basis(in.Jfree);
+      Qr = Q_raw.transpose() * fit->residuals;
+      if (model) own_noise.max_order = std::min(own_noise.max_order, model->max_order + 2);
+    }
     const auto need_levels = [&] {
       if (J_levels.size()) return;
       const Eigen::MatrixXd L = stream_levels(P);
@@ -287,7 +300,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
         // follows stays correlated (so it is not taken for an effect), and an effect's own
         // signature is not mistaken for correlated noise (which would whiten it away).
         NoiseModel own_model;
-        NoiseTreatment own = candidate_treatment(layout, options, *fit, Q_raw, Jc, candidates[c], white, &own_model);
+        NoiseTreatment own = candidate_treatment(layout, own_noise, *fit, Q_raw, Qr, Jc, white, &own_model);
         if (own_model.max_order < 2 && (!own.W || own.W->ar1_only())) {
           // White or AR(1): scored from inner products; only a candidate that may pass is
           // scored again below with its columns (the margin of 1 is far beyond rounding).
@@ -501,7 +514,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
             st.reflection = o.reflection, st.ar = o.ar;
             st.marginal_sigma_um = o.marginal_sigma_um, st.innovation_sigma_um = o.innovation_sigma_um;
           }
-          t_noise = coloured_treatment(all);
+          t_noise = coloured_treatment(all, false);
         }
       }
       return Whiten([t_noise](const Eigen::MatrixXd& M) { return t_noise.whiten(M); });
@@ -553,12 +566,12 @@ NoiseTreatment white_treatment(const DiagnosisProblem& P, const ModelFit& baseli
 // long-run variance, which the mean-removal bias of each stream's AR(1) coefficient makes too
 // small near rho = 1 (10 false findings in 100 AR(1) rho 0.95 null sessions without the
 // correction, 3 with it: bench/diagnose_realistic_bench).
-NoiseTreatment coloured_treatment(const NoiseModel& estimated) {
+NoiseTreatment coloured_treatment(const NoiseModel& estimated, bool described) {
   const NoiseModel m = with_mean_bias_corrected(estimated);
   NoiseTreatment t;
   t.sigma_mm = m.sigma_um * 1e-3;
   t.W = std::make_shared<ArWhitener>(m);
-  t.source = "AR noise model of the residuals: " + m.summary();
+  if (described) t.source = "AR noise model of the residuals: " + m.summary();
   return t;
 }
 

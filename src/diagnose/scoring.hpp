@@ -26,10 +26,19 @@ Eigen::VectorXd solve_ls(const Eigen::MatrixXd& X, const Eigen::VectorXd& y);
 Eigen::MatrixXd orthonormal_basis(Eigen::MatrixXd J);
 /// The same span by CholeskyQR2 (~2 n p^2 flops against ~4 n p^2 for the Householder QR and
 /// its Q; the per-candidate bases of the coloured search were a quarter of a diagnosis at
-/// rho 0.5), falling back to orthonormal_basis where J is near rank-deficient.
+/// rho 0.5), one pass where the normalised columns are well conditioned (Q^T Q = I to ~1e-12),
+/// falling back to orthonormal_basis where J is near rank-deficient.
 Eigen::MatrixXd orthonormal_basis_full_rank(const Eigen::MatrixXd& J);
 /// Columns of C with their component in span(Q) removed (Q orthonormal).
 Eigen::MatrixXd project_out(const Eigen::MatrixXd& Q, const Eigen::MatrixXd& C);
+/// What the columns of Q (orthonormal) extended by Jc leave of r: r - Jp b with Jp = Jc - Q A,
+/// A = Q^T Jc, the least-squares b from k x k products (Jp^T Jp = Jc^T Jc - A^T A,
+/// Jp^T r = Jc^T r - A^T Qr; Qr = Q^T r, given once per round): about half the work of
+/// orthonormalising Jp, which each candidate's noise model needs. Empty where a column of Jc
+/// keeps under 1e-5 of its norm outside span(Q), or Jp is near rank-deficient: there the
+/// subtraction loses the digits that decide, and the caller orthonormalises Jp instead.
+Eigen::VectorXd residual_without(const Eigen::MatrixXd& Q, const Eigen::VectorXd& r, const Eigen::VectorXd& Qr,
+                                 const Eigen::MatrixXd& Jc);
 /// Free (non-zero) columns of a fit's Jacobian.
 Eigen::MatrixXd free_columns(const Eigen::MatrixXd& J);
 /// Blocked K-fold assignment: each group's readings in time order, cut into K contiguous blocks,

@@ -243,6 +243,37 @@ TEST_CASE("orthonormal_basis_full_rank spans what the rank-revealing QR spans", 
   CHECK((projector(orthonormal_basis_full_rank(J)) - projector(orthonormal_basis(J))).cwiseAbs().maxCoeff() < 1e-10);
 }
 
+TEST_CASE("residual_without equals the projection on orthonormalised columns, or declines", "[diagnose]") {
+  using namespace diagnosis_detail;
+  std::mt19937 rng(5);
+  std::normal_distribution<double> N(0.0, 1.0);
+  Eigen::MatrixXd J(800, 11), Jc(800, 3);
+  Eigen::VectorXd y(800);
+  for (Eigen::Index i = 0; i < J.size(); ++i) J.data()[i] = N(rng);
+  for (Eigen::Index i = 0; i < Jc.size(); ++i) Jc.data()[i] = N(rng);
+  for (Eigen::Index i = 0; i < y.size(); ++i) y[i] = N(rng);
+  const Eigen::MatrixXd Q = orthonormal_basis(J);
+  const Eigen::VectorXd r = y - Q * (Q.transpose() * y);  // a fit's residual
+  const auto reference = [&](const Eigen::MatrixXd& C) {
+    const Eigen::MatrixXd B = orthonormal_basis(project_out(Q, C));
+    return Eigen::VectorXd(r - B * (B.transpose() * r));
+  };
+  // Columns of very different sizes, one of them mostly inside span(Q) (keeps 1e-4 of its norm).
+  Jc.col(0) *= 1e3;
+  Jc.col(2) = J * Eigen::VectorXd::Ones(11) + 1e-4 * std::sqrt(11.0) * Jc.col(2);
+  const Eigen::VectorXd out = residual_without(Q, r, Q.transpose() * r, Jc);
+  REQUIRE(out.size() == r.size());
+  CHECK((out - reference(Jc)).norm() < 1e-9 * r.norm());
+  // A residual not orthogonal to Q (a fit that stopped early): Q^T r enters.
+  const Eigen::VectorXd y_out = residual_without(Q, y, Q.transpose() * y, Jc);
+  const Eigen::MatrixXd QJ = orthonormal_basis((Eigen::MatrixXd(800, 14) << J, Jc).finished());
+  const Eigen::VectorXd y_ref = y - Q * (Q.transpose() * y);
+  CHECK((y_out - Q * (Q.transpose() * y_out) - (y_ref - QJ * (QJ.transpose() * y_ref))).norm() < 1e-9 * y.norm());
+  // A column inside span(Q) up to 1e-8 of its norm: the products would decide on rounding.
+  Jc.col(1) = J.col(4) + 1e-8 * Jc.col(1);
+  CHECK(residual_without(Q, r, Q.transpose() * r, Jc).size() == 0);
+}
+
 TEST_CASE("scoring from inner products agrees with scoring from whitened columns", "[diagnose]") {
   // The coloured search scores white and AR(1) candidates from inner products (O(p^3) each)
   // and falls back to the columns only where a candidate may pass. Both must agree on every

@@ -151,11 +151,12 @@ TEST_CASE("the whitener is the inverse Cholesky factor of the AR(1) covariance",
 }
 
 TEST_CASE("AR(1) inverse covariance and lag-product Gram matrix equal the whitened products", "[noise_model]") {
-  // Two AR(1) streams with interleaved rows, a white one, and a row in no stream (the whitener
-  // leaves it as it is). V^-1 is written from the definition (the inverse of each stream's
-  // sigma^2 phi^|i-j| covariance), independently of the whitener's recursion.
+  // Two AR(1) streams with interleaved rows, a white one, an AR(1) one of a single reading,
+  // and a row in no stream (the whitener leaves it as it is). V^-1 is written from the
+  // definition (the inverse of each stream's sigma^2 phi^|i-j| covariance), independently of
+  // the whitener's recursion.
   NoiseModel M;
-  M.n = 21;
+  M.n = 22;
   NoiseStream a, b, w;
   for (Eigen::Index i = 0; i < 16; i += 2) a.rows.push_back(i);
   for (Eigen::Index i = 1; i < 16; i += 2) b.rows.push_back(i);
@@ -165,9 +166,13 @@ TEST_CASE("AR(1) inverse covariance and lag-product Gram matrix equal the whiten
   b.reflection = b.ar = {-0.3};
   b.marginal_sigma_um = 0.7;
   w.marginal_sigma_um = 2.0;
-  M.streams = {a, b, w};
+  NoiseStream one;  // an AR(1) stream of a single reading: its marginal variance alone
+  one.rows = {21};
+  one.reflection = one.ar = {0.5};
+  one.marginal_sigma_um = 0.9;
+  M.streams = {a, b, w, one};
   M.max_order = 1;
-  Eigen::MatrixXd Vinv = Eigen::MatrixXd::Identity(21, 21);
+  Eigen::MatrixXd Vinv = Eigen::MatrixXd::Identity(22, 22);
   for (const NoiseStream& s : M.streams) {
     const Eigen::Index m = static_cast<Eigen::Index>(s.rows.size());
     const double phi = s.ar.empty() ? 0.0 : s.ar[0], sx = s.marginal_sigma_um * 1e-3;
@@ -180,7 +185,7 @@ TEST_CASE("AR(1) inverse covariance and lag-product Gram matrix equal the whiten
   }
   std::mt19937 rng(5);
   std::normal_distribution<double> N(0.0, 1.0);
-  Eigen::MatrixXd J(21, 4);
+  Eigen::MatrixXd J(22, 4);
   for (Eigen::Index i = 0; i < J.size(); ++i) J.data()[i] = N(rng);
   J.col(2) *= 1e-3;  // columns of different units
   const ArWhitener W(M);
