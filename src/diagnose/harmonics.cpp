@@ -1,6 +1,6 @@
 // Which harmonic orders of a rotary angle a set of readings resolves (Nyquist and aliasing on
 // the sampled angles), and why an order is left out, in words.
-#include <Eigen/SVD>
+#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -9,6 +9,28 @@
 #include "rotacal/diagnose/diagnosis.hpp"
 
 namespace rotacal {
+
+namespace {
+// The smaller singular value of an n x 2 matrix [a b]: from its QR factor R = [r11 r12; 0 r22]
+// (Gram-Schmidt twice, so r22 is accurate to rounding of |b|), |det R| / sigma_max.
+double smaller_singular_value(const Eigen::MatrixXd& ab) {
+  const double r11 = ab.col(0).norm();
+  if (!(r11 > 0.0)) return 0.0;
+  const Eigen::VectorXd q = ab.col(0) / r11;
+  Eigen::VectorXd b = ab.col(1);
+  double r12 = 0.0;
+  for (int pass = 0; pass < 2; ++pass) {
+    const double c = q.dot(b);
+    b -= c * q;
+    r12 += c;
+  }
+  const double r22 = b.norm();
+  // sigma_max^2: the larger eigenvalue of R^T R.
+  const double t = r11 * r11 + r12 * r12 + r22 * r22, det = r11 * r22;
+  const double smax2 = 0.5 * (t + std::sqrt(std::max(t * t - 4.0 * det * det, 0.0)));
+  return smax2 > 0.0 ? std::abs(det) / std::sqrt(smax2) : 0.0;
+}
+}  // namespace
 
 HarmonicResolution resolve_harmonics(const std::vector<double>& angles_rad, char axis,
                                      int max_order, double min_new_content) {
@@ -65,24 +87,35 @@ HarmonicResolution resolve_harmonics(const std::vector<double>& angles_rad, char
     }
   }
   R.resolved = max_order;
+  // Orthonormal basis of the span of orders 0..k-1, grown one column at a time by Gram-Schmidt
+  // applied twice (orthogonal to rounding); a column with less than 1e-9 of it outside the
+  // span is dependent (once an order is unresolvable the lower columns may be) and is left
+  // out. A rank-revealing SVD of all lower columns per order took 8 SVDs per call, and the
+  // diagnosis calls this for every group several times.
+  Eigen::MatrixXd U(N, 1 + 2 * max_order);
+  Eigen::Index rank = 0;
+  const auto outside = [&](Eigen::MatrixXd C) {
+    for (int pass = 0; pass < 2; ++pass) C -= U.leftCols(rank) * (U.leftCols(rank).transpose() * C);
+    return C;
+  };
+  const auto grow = [&](Eigen::Index col) {
+    const Eigen::VectorXd v = outside(H.col(col));
+    const double norm = v.norm();
+    if (norm > 1e-9 * std::max(1.0, H.col(col).norm()) && rank < N) U.col(rank++) = v / norm;
+  };
+  grow(0);
   for (int k = 1; k <= max_order; ++k) {
-    // Orthonormal basis of the span of orders 0..k-1 (rank-revealing: once an order is
-    // unresolvable the lower columns may be dependent), then what of order k lies outside it.
-    Eigen::JacobiSVD<Eigen::MatrixXd> lower(H.leftCols(2 * k - 1), Eigen::ComputeThinU);
-    Eigen::Index rank = 0;
-    for (Eigen::Index i = 0; i < lower.singularValues().size(); ++i)
-      rank += lower.singularValues()[i] > 1e-9 * std::max(1.0, lower.singularValues()[0]);
-    const Eigen::MatrixXd U = lower.matrixU().leftCols(rank);
-    const Eigen::MatrixXd pair = H.middleCols(2 * k - 1, 2);
-    const Eigen::MatrixXd rest = pair - U * (U.transpose() * pair);
+    // What of order k lies outside the span of the orders below it.
+    const Eigen::MatrixXd rest = outside(H.middleCols(2 * k - 1, 2));
     double nc = 0.0;
     if (N - rank >= 2) {  // two new directions are needed at all (2k + 1 <= N)
-      Eigen::JacobiSVD<Eigen::MatrixXd> svd(rest);
-      nc = svd.singularValues()[1];
+      nc = smaller_singular_value(rest);
       if (nc < 1e-9) nc = 0.0;  // rounding of an exactly dependent pair
     }
     R.new_content.push_back(nc);
     if (nc < min_new_content && R.resolved == max_order) R.resolved = k - 1;
+    grow(2 * k - 1);
+    grow(2 * k);
   }
   return R;
 }
