@@ -461,6 +461,23 @@ void ArWhitener::apply(Eigen::Ref<Eigen::MatrixXd> columns) const {
       for (std::size_t t = 0; t < n; ++t) columns.row(s.rows[t]) = block.row(static_cast<Eigen::Index>(t));
       continue;
     }
+    if (p <= 1 && n > 0) {
+      // White or AR(1), the common streams: the recursion below without its per-reading
+      // lookups (the same arithmetic, in the same order).
+      const double a = s.inv_sd[0], b = p == 1 ? s.inv_sd[1] : a, phi = p == 1 ? s.phi[1][0] : 0.0;
+      for (Eigen::Index c = 0; c < columns.cols(); ++c) {
+        double& y0 = columns(s.rows[0], c);
+        double prev = y0;
+        y0 = prev * a;
+        for (std::size_t t = 1; t < n; ++t) {
+          double& y = columns(s.rows[t], c);
+          const double xt = y;
+          y = (xt - phi * prev) * b;
+          prev = xt;
+        }
+      }
+      continue;
+    }
     x.resize(n);
     for (Eigen::Index c = 0; c < columns.cols(); ++c) {
       for (std::size_t t = 0; t < n; ++t) x[t] = columns(s.rows[t], c);

@@ -501,12 +501,16 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
     pooled.pooled = true;
     pooled.pool_only_if_all_coloured = false;
     const NoiseModel pooled_all = estimate_noise_model(layout, final_fit.residuals, pooled);  // its streams
+    // The other groups' pooled model, one per group tested: the same residual without one
+    // group, its order searched up to the pooled order of all groups + 2 (as for the candidates).
+    NoiseModelOptions others_options = pooled;
+    others_options.max_order = std::min(pooled.max_order, pooled_all.max_order + 2);
     const auto whitener_for = [&](const std::string& group, const Eigen::MatrixXd&) {
       if (wander.W) return Whiten([wander](const Eigen::MatrixXd& M) { return wander.whiten(M); });
       NoiseTreatment t_noise = white;
       const NoiseStreamLayout others_layout = layout.except_group(group);
       if (!others_layout.rows.empty()) {
-        const NoiseModel others = estimate_noise_model(others_layout, final_fit.residuals, pooled);
+        const NoiseModel others = estimate_noise_model(others_layout, final_fit.residuals, others_options);
         if (!others.white()) {
           NoiseModel all = pooled_all;
           const NoiseStream& o = others.streams.front();
