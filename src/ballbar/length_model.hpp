@@ -9,8 +9,18 @@
 #include "rotacal/core/lanes.hpp"
 
 // Inline every call in the row kernel: GCC otherwise keeps the rotation and its derivative
-// products as calls that pass Lanes vectors through memory.
-#if defined(__GNUC__)
+// products as calls that pass Lanes vectors through memory. Not under AddressSanitizer: the
+// flattened kernel, instrumented, is what made identify_joint.cpp and monte_carlo.cpp take
+// minutes to compile in the sanitizer build, where speed does not matter.
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define ROTACAL_SANITIZED 1
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__)
+#define ROTACAL_SANITIZED 1
+#endif
+#if defined(__GNUC__) && !defined(ROTACAL_SANITIZED)
 #define ROTACAL_FLATTEN __attribute__((flatten))
 #else
 #define ROTACAL_FLATTEN
