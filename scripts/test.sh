@@ -48,7 +48,7 @@ cmake --build build/example
 
 step "Python package (pip install .) and pytest"
 # The extension only, linked against the library installed above: compiling the library again
-# inside pip took about 9 of CI's 45 minutes. A plain `pip install .` builds everything.
+# inside pip took about 4.5 of CI's 45 minutes. A plain `pip install .` builds everything.
 "$PY" -m pip install -q --disable-pip-version-check --no-build-isolation \
   -C cmake.define.ROTACAL_PYTHON_FROM_INSTALLED=ON -C cmake.define.CMAKE_PREFIX_PATH="$ROOT/build/install" .
 (cd tests/python && "$PY" -m pytest -q -p no:cacheprovider .)

@@ -1,6 +1,6 @@
 // Which harmonic orders of a rotary angle a set of readings resolves (Nyquist and aliasing on
 // the sampled angles), and why an order is left out, in words.
-#include <Eigen/Core>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -9,28 +9,6 @@
 #include "rotacal/diagnose/diagnosis.hpp"
 
 namespace rotacal {
-
-namespace {
-// The smaller singular value of an n x 2 matrix [a b]: from its QR factor R = [r11 r12; 0 r22]
-// (Gram-Schmidt twice, so r22 is accurate to rounding of |b|), |det R| / sigma_max.
-double smaller_singular_value(const Eigen::MatrixXd& ab) {
-  const double r11 = ab.col(0).norm();
-  if (!(r11 > 0.0)) return 0.0;
-  const Eigen::VectorXd q = ab.col(0) / r11;
-  Eigen::VectorXd b = ab.col(1);
-  double r12 = 0.0;
-  for (int pass = 0; pass < 2; ++pass) {
-    const double c = q.dot(b);
-    b -= c * q;
-    r12 += c;
-  }
-  const double r22 = b.norm();
-  // sigma_max^2: the larger eigenvalue of R^T R.
-  const double t = r11 * r11 + r12 * r12 + r22 * r22, det = r11 * r22;
-  const double smax2 = 0.5 * (t + std::sqrt(std::max(t * t - 4.0 * det * det, 0.0)));
-  return smax2 > 0.0 ? std::abs(det) / std::sqrt(smax2) : 0.0;
-}
-}  // namespace
 
 HarmonicResolution resolve_harmonics(const std::vector<double>& angles_rad, char axis,
                                      int max_order, double min_new_content) {
@@ -109,7 +87,7 @@ HarmonicResolution resolve_harmonics(const std::vector<double>& angles_rad, char
     const Eigen::MatrixXd rest = outside(H.middleCols(2 * k - 1, 2));
     double nc = 0.0;
     if (N - rank >= 2) {  // two new directions are needed at all (2k + 1 <= N)
-      nc = smaller_singular_value(rest);
+      nc = Eigen::JacobiSVD<Eigen::MatrixXd>(rest).singularValues()[1];
       if (nc < 1e-9) nc = 0.0;  // rounding of an exactly dependent pair
     }
     R.new_content.push_back(nc);
