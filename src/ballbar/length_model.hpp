@@ -310,10 +310,13 @@ inline BallbarFitSetup ballbar_fit_setup(const BallbarArrays& data, const JointF
                       location_error_is_angle(k) ? "rad" : "mm", 0.0});
   const char* pivot_names[3] = {"pivot_x", "pivot_y", "pivot_z"};
   for (int k = 0; k < 3; ++k) params.push_back({pivot_names[k], "mm", data.pivot[k]});
+  // Catalogue effects yield to the baseline where they share directions with it
+  // (core/yield_convention.hpp); the head's tool length is part of the baseline.
   for (const Effect& f : fx.effects) {
     const auto pn = f.param_names(), pu = f.param_units();
+    const bool yields = !(data.machine.has_head() && f == tool_z);
     for (std::size_t k = 0; k < pn.size(); ++k)
-      params.push_back({f.id() + (pn.size() > 1 ? "." + pn[k] : ""), pu[k], 0.0});
+      params.push_back({f.id() + (pn.size() > 1 ? "." + pn[k] : ""), pu[k], 0.0, 0.0, false, yields});
   }
   out.settings.max_iterations = options.max_iterations;
   out.settings.observability_min_chi2 = options.observability_min_chi2;

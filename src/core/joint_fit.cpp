@@ -18,6 +18,8 @@
 // ballbar samples 0.21-0.25 s and 221-227 MB peak for the process.
 #include "rotacal/core/joint_fit.hpp"
 
+#include "rotacal/core/yield_convention.hpp"
+
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
@@ -71,6 +73,40 @@ double max_sigma_step(const NormalEquations& ne, const Eigen::VectorXd& dx_free)
   for (Eigen::Index a = 0; a < dx_free.size(); ++a)
     if (ne.sigma_y[a] > 0.0) m = std::max(m, std::abs(dx_free[a] * ne.D[a]) / ne.sigma_y[a]);
   return m;
+}
+
+}  // namespace
+
+namespace {
+
+// Reports the solution under the yield convention (core/yield_convention.hpp) where a null
+// direction moves a parameter with FitParameter::yields: values and covariance are mapped,
+// the null directions it resolves are no longer listed, `observable` is updated.
+void apply_yield_convention(const std::vector<FitParameter>& params, const std::vector<int>& analysed,
+                            const Eigen::VectorXd& scales, JointFitOutcome& out, std::vector<bool>& observable) {
+  std::vector<bool> yields;
+  for (int j : analysed) yields.push_back(params[static_cast<std::size_t>(j)].yields);
+  std::vector<bool> obs_a = out.observability.observable;
+  const Eigen::MatrixXd Ma = yield_convention(out.observability, yields, scales, &obs_a);
+  if (Ma.size() == 0) return;
+  const Eigen::Index p = out.values.size();
+  Eigen::MatrixXd M = Eigen::MatrixXd::Identity(p, p);
+  for (std::size_t a = 0; a < analysed.size(); ++a)
+    for (std::size_t b = 0; b < analysed.size(); ++b)
+      M(analysed[a], analysed[b]) = Ma(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
+  out.values = M * out.values;
+  out.covariance = M * out.covariance * M.transpose();
+  out.convention = std::move(M);
+  for (std::size_t k = 0; k < analysed.size(); ++k) observable[static_cast<std::size_t>(analysed[k])] = obs_a[k];
+  // A null direction the convention resolves no longer moves the reported solution: it is a
+  // direction of the old, held convention, and is dropped from the words.
+  std::vector<std::string> kept;
+  for (std::size_t k = 0; k < out.observability.null_space.size(); ++k) {
+    const Eigen::VectorXd& v = out.observability.null_space[k];
+    const Eigen::VectorXd moved = Ma * v;  // zero where the convention fixes this direction
+    if (moved.cwiseQuotient(scales).norm() > 0.5 * v.cwiseQuotient(scales).norm()) kept.push_back(out.unobservable[k]);
+  }
+  out.unobservable = std::move(kept);
 }
 
 }  // namespace
@@ -338,6 +374,8 @@ JointFitOutcome solve_joint(const ResidualModel& model, const std::vector<FitPar
   } else {
     out.jacobian = std::move(Jw);  // J itself (jw_scale above)
   }
+  apply_yield_convention(params, analysed, scales_of(), out, observable);
+  x = out.values;
   for (int j = 0; j < p; ++j) {
     ParameterEstimate e;
     e.name = params[static_cast<std::size_t>(j)].name;
@@ -352,7 +390,8 @@ JointFitOutcome solve_joint(const ResidualModel& model, const std::vector<FitPar
 
 JointRefitter::JointRefitter(const JointFitOutcome& reference, std::vector<FitParameter> parameters,
                              JointFitSettings settings)
-    : start_(reference.values), parameters_(std::move(parameters)), settings_(std::move(settings)) {
+    : start_(reference.values), parameters_(std::move(parameters)), settings_(std::move(settings)),
+      convention_(reference.convention) {
   ROTACAL_ASSERT(static_cast<Eigen::Index>(parameters_.size()) == start_.size());
   for (std::size_t j = 0; j < reference.free.size(); ++j)
     if (reference.free[j]) idx_.push_back(static_cast<Eigen::Index>(j));
@@ -384,6 +423,7 @@ JointRefitter::Result JointRefitter::refit(const ResidualModel& model) const {
     for (Eigen::Index a = 0; a < dx.size(); ++a) res.values[idx_[static_cast<std::size_t>(a)]] += dx[a];
     if (step < settings_.step_tolerance_sigma) {
       res.converged = true;
+      if (convention_.size()) res.values = convention_ * res.values;  // as the reference reports
       return res;
     }
   }

@@ -100,10 +100,12 @@ ModelFit RtestDiagnosisProblem::fit(const EffectModel& fx) const {
   if (session_.machine.has_head()) params.push_back({"tool_offset_Z", "mm", 0.0});
   for (const std::string& s : setups_)
     for (const char* a : {"x", "y", "z"}) params.push_back({"zero." + s + "." + a, "mm", 0.0});
+  // Catalogue effects yield to the baseline where they share directions with it
+  // (core/yield_convention.hpp: a first-order wobble of C is half an axis tilt).
   for (const Effect& f : fx.effects) {
     const auto pn = f.param_names(), pu = f.param_units();
     for (std::size_t k = 0; k < pn.size(); ++k)
-      params.push_back({f.id() + (pn.size() > 1 ? "." + pn[k] : ""), pu[k], 0.0});
+      params.push_back({f.id() + (pn.size() > 1 ? "." + pn[k] : ""), pu[k], 0.0, 0.0, false, true});
   }
   JointFitSettings settings;
   settings.sigma = session_.noise_um.value_or(1.0) * 1e-3;

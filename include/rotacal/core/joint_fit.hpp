@@ -61,6 +61,10 @@ struct FitParameter {
   double scale = 0.0;
   /// Held at `start` whatever the data say (e.g. the coefficient of an empty basis).
   bool held = false;
+  /// Where it trades off against parameters that do not yield, it takes only the part they
+  /// cannot express (core/yield_convention.hpp): set for catalogue effects fitted on top of a
+  /// baseline, so that a partly shared effect leaves both determined.
+  bool yields = false;
 };
 
 struct JointFitSettings {
@@ -86,6 +90,9 @@ struct JointFitOutcome {
                                                ///< (unweighted, measurement units)
   std::vector<bool> free;                      ///< per parameter: estimated (not held or fixed)
   Observability observability;                 ///< at the start point
+  /// x_reported = convention * x_solved (p x p; empty: none): the yield convention of the
+  /// parameters with FitParameter::yields. A refit of the same model applies it too.
+  Eigen::MatrixXd convention;
   std::vector<std::string> unobservable;       ///< null directions in words
   double residual_variance = 0.0;              ///< s^2 used for the covariance (1 when whitened)
   FitSummary summary;
@@ -126,6 +133,7 @@ class JointRefitter {
   Eigen::MatrixXd Jw_free_;        // weighted Jacobian of the free parameters
   Eigen::LDLT<Eigen::MatrixXd> ldlt_;
   Eigen::VectorXd sigma_;          // 1 sigma of each free parameter (chi2 units)
+  Eigen::MatrixXd convention_;     // the reference's yield convention (empty: none)
 };
 
 // ------------------------------------------------------------------ Jets over batches
