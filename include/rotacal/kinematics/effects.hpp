@@ -146,13 +146,14 @@ inline Eigen::Vector3d coning_axis(const RotaryAxis& a) {
   return a.radial1;
 }
 
-// Per chain axis: the actual angle and the optional error-motion pose; per side: coning and
+// Per chain axis: the actual angle and the optional error-motion and coning poses; per side:
 // translation stages. One pass over the effects fills both sides.
 template <typename Scalar>
 struct AxisStages {
   Scalar angle[2];
   std::optional<Pose<Scalar>> E[2];  // error motion of chain axis k, in its turning frame
-  std::optional<Pose<Scalar>> K[2];  // coning of the table side [0] and the head side [1]
+  std::optional<Pose<Scalar>> K[2];  // coning of chain axis k, applied after its rotation (in
+                                     // the frame of the axis that carries it: effects.md coning)
   std::optional<Vec3<Scalar>> D[2];  // translations of the table side [0] and the head side [1]
 };
 
@@ -225,8 +226,8 @@ AxisStages<Scalar> axis_stages(MachineType m, const EffectModel& fx, const Scala
           st.D[side]->z() -= q[0] * (Scalar(1) - cos(Scalar(R)));
           break;
         case EffectKind::coning:
-          if (!st.K[side]) st.K[side].emplace();
-          st.K[side]->R = rotation_about_axis<Scalar>(coning_axis(ax).cast<Scalar>(), q[0] * Scalar(R)) * st.K[side]->R;
+          if (!st.K[k]) st.K[k].emplace();
+          st.K[k]->R = rotation_about_axis<Scalar>(coning_axis(ax).cast<Scalar>(), q[0] * Scalar(R)) * st.K[k]->R;
           break;
         default:
           break;
@@ -266,8 +267,8 @@ void walk_table_stages(MachineType m, const LocationErrors<Scalar>& e, const Eff
   for (int k = static_cast<int>(m.description().table_axes.size()) - 1; k >= 0; --k) {
     if (st.E[k]) acc.rigid(*st.E[k]);
     acc.about_line(axis_line(m, k, e), st.angle[k]);
+    if (st.K[k]) acc.rigid(*st.K[k]);
   }
-  if (st.K[0]) acc.rigid(*st.K[0]);
   if (st.D[0]) acc.translate(*st.D[0]);
 }
 
@@ -317,8 +318,11 @@ Vec3<Scalar> table_point(MachineType m, const LocationErrors<Scalar>& e, const E
 
 /// Actual position of the controlled point for a commanded xyz (mm): the linear-axis
 /// effects (squareness, scale, straightness, angular errors seen through the Z arm).
+/// `ball_dz`: the height of the ball above the controlled point (a head's tool vector turned by
+/// its axes; 0 without head axes): the angular errors act through the ball's height.
 template <typename Scalar>
-Vec3<Scalar> linear_axes_position(const EffectModel& fx, const Scalar* p, const Eigen::Vector3d& xyz) {
+Vec3<Scalar> linear_axes_position(const EffectModel& fx, const Scalar* p, const Eigen::Vector3d& xyz,
+                                  const Scalar& ball_dz = Scalar(0)) {
   Vec3<Scalar> out = xyz.cast<Scalar>();
   for (std::size_t i = 0; i < fx.effects.size(); ++i) {
     const Effect& f = fx.effects[i];
@@ -339,10 +343,10 @@ Vec3<Scalar> linear_axes_position(const EffectModel& fx, const Scalar* p, const 
       }
       case EffectKind::linear_pitch: {  // a rotation of the carriage, times the Z arm
         const double u = (xyz[k] - fx.linear_reference[k]) / 100.0;
-        const double arm = xyz[2] - fx.linear_reference[2];
+        const Scalar arm = Scalar(xyz[2] - fx.linear_reference[2]) + ball_dz;
         const Scalar e = q[0] * Scalar(u) + q[1] * Scalar(u * u);
         // E_BX (about Y) moves a point above the guide by +e*arm in X; E_AY (about X) by -e*arm in Y.
-        out[k] += (f.direction == 'B' ? Scalar(arm) : Scalar(-arm)) * e;
+        out[k] += (f.direction == 'B' ? arm : Scalar(-arm)) * e;
         break;
       }
       default:
@@ -370,16 +374,17 @@ Vec3<Scalar> tool_offset(const EffectModel& fx, const Scalar* p) {
 /// rotary angles (rad), time t (s) and motion of the axes (at rest if not given), on a machine with location errors e and effects fx
 /// (parameters p). Without head axes: the controlled point with the linear-axis effects and
 /// the tool offset. With head axes, the head side is walked like the table side:
-///   ball = xyz' + D_h + K_h * Rot(H1) E_H1 * Rot(H2) E_H2 * (tool_vector + tool offset).
+///   ball = xyz' + D_h + K_H1 Rot(H1) E_H1 * K_H2 Rot(H2) E_H2 * (tool_vector + tool offset),
+/// a coning K after its own axis' rotation, in the frame of the axis that carries it (on a
+/// head-head machine the C head turns the A axis' coning with it).
 template <typename Scalar>
 Vec3<Scalar> tool_position(MachineType m, const LocationErrors<Scalar>& e, const EffectModel& fx,
                            const Scalar* p, const Eigen::Vector3d& xyz,
                            const RotaryAngles<double>& cmd, double t,
                            const Scalar& tool_length_error = Scalar(0),
                            const RotaryMotion& motion = {}) {
-  const Vec3<Scalar> controlled = linear_axes_position<Scalar>(fx, p, xyz);
   const MachineDescription& d = m.description();
-  if (!d.has_head()) return controlled + tool_offset<Scalar>(fx, p);
+  if (!d.has_head()) return linear_axes_position<Scalar>(fx, p, xyz) + tool_offset<Scalar>(fx, p);
   const detail::AxisStages<Scalar> st = detail::axis_stages<Scalar>(m, fx, p, cmd, t, motion);
   Vec3<Scalar> v = tool_vector<Scalar>(m, tool_length_error) + tool_offset<Scalar>(fx, p);
   const int nt = static_cast<int>(d.table_axes.size());
@@ -387,10 +392,11 @@ Vec3<Scalar> tool_position(MachineType m, const LocationErrors<Scalar>& e, const
     if (st.E[k]) v = *st.E[k] * v;
     const AxisLine<Scalar> L = axis_line(m, k, e);
     v = rotate_point_about_line(L.point, L.direction, st.angle[k], v);
+    if (st.K[k]) v = *st.K[k] * v;
   }
-  if (st.K[1]) v = *st.K[1] * v;
   if (st.D[1]) v += *st.D[1];
-  return controlled + v;
+  // The ball's height above the controlled point is the Abbe arm of the angular errors.
+  return linear_axes_position<Scalar>(fx, p, xyz, v.z()) + v;
 }
 
 /// The ball on a machine without head axes (the table machines' tool side); kept for the
