@@ -17,6 +17,9 @@ void bind_diagnose(pyb::module_& m) {
       .def_readwrite("cv_blocks", &DiagnosisOptions::cv_blocks)
       .def_readwrite("only", &DiagnosisOptions::only)
       .def_readwrite("model_noise", &DiagnosisOptions::model_noise)
+      .def_readwrite("min_weight", &DiagnosisOptions::min_weight)
+      .def_readwrite("rival_correlation", &DiagnosisOptions::rival_correlation)
+      .def_readwrite("min_determined_sigma", &DiagnosisOptions::min_determined_sigma)
       .def_readwrite("progress", &DiagnosisOptions::progress,
                      "callable(stage, done, total) after each scored candidate, or None");
 
@@ -59,9 +62,19 @@ void bind_diagnose(pyb::module_& m) {
       .def_readonly("std_after", &Finding::Shift::std_after)
       .def_readonly("unit", &Finding::Shift::unit);
 
+  pyb::class_<Alternative>(m, "Alternative")
+      .def_readonly("effect", &Alternative::effect)
+      .def_readonly("weight", &Alternative::weight)
+      .def_readonly("delta_bic", &Alternative::delta_bic)
+      .def_readonly("correlation", &Alternative::correlation)
+      .def_readonly("in_group", &Alternative::in_group);
+
   pyb::class_<Finding>(m, "Finding")
       .def_property_readonly("effect", [](const Finding& f) { return f.effect.id(); })
       .def_readonly("cause", &Finding::cause)
+      .def_readonly("weight", &Finding::weight)
+      .def_readonly("rivals", &Finding::rivals)
+      .def_property_readonly("named_alone", &Finding::named_alone)
       .def_readonly("parameters", &Finding::parameters)
       .def_readonly("gain", &Finding::gain)
       .def_readonly("shifts", &Finding::shifts);

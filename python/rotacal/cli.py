@@ -14,7 +14,7 @@ import time
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
-from . import _core, jsontext, rtest
+from . import _core, jsontext, rtest, units
 from .diagnosis import MAX_HARMONIC
 from .machines import BALLBAR_NOISE_UM, PIVOT_ERROR_MM
 from .outputs import check_output, write_output
@@ -368,14 +368,10 @@ def _add_plausibility_arg(q: argparse.ArgumentParser) -> None:
                    f"refused as implausible (default {_core.PlausibilityOptions().max_length_deviation_mm:g} mm)")
 
 
-# How identify prints a parameter of each unit: (factor, shown unit). Effects bring units
-# other than mm and rad (a servo lag in s, a log time constant in 1, a drift in mm/s).
-_SHOWN = {"rad": (1e6, "urad"), "mm": (1e3, "um  "), "s": (1e3, "ms  "), "mm/s": (1e3, "um/s"),
-          "rad/rad": (1e6, "urad/rad"), "mm/mm": (1e6, "um/m"), "1": (1.0, "    ")}
-
-
 def _shown(unit: str) -> tuple[float, str]:
-    return _SHOWN.get(unit, (1.0, unit))
+    """(factor, unit padded to 4) as identify's table prints a parameter of `unit`."""
+    factor, shown = units.shown(unit)
+    return factor, f"{shown:4s}"
 
 
 def _fmt_value(v, unit: str) -> str:
@@ -673,11 +669,20 @@ def _print_diagnosis(d: dict) -> None:
         print("no effect of the catalogue is significant")
     for i, f in enumerate(d["findings"], 1):
         g = f["gain"]
-        print(f"{i}. {f['effect']}: {f['cause']}")
+        if f["named"]:
+            print(f"{i}. {f['effect']} (weight {f['weight']:.2f}): {f['cause']}")
+        else:
+            group = ", ".join(f"{m['effect']} ({m['weight']:.2f})" for m in f["group"])
+            print(f"{i}. one of: {group}; this session cannot separate them (BIC weights). "
+                  f"If it is {f['effect']}:")
         for name, p in f["parameters"].items():
-            print(f"     {name} = " + ("unobservable" if p["value"] is None else f"{p['value']:.4g} +- {p['std']:.2g} {p['unit']}"))
+            print(f"     {name} = {units.estimate_text(p['value'], p['std'], p['unit'])}")
         print(f"     RMS {g['rms_before_um']:.3f} -> {g['rms_after_um']:.3f} um, delta BIC {g['delta_bic']:.1f}, "
               f"CV RMS {g['cv_rms_before_um']:.3f} -> {g['cv_rms_after_um']:.3f} um")
+        for r in f["rivals"]:
+            if not r["in_group"]:
+                print(f"     rather than {r['effect']}: that fits worse by delta BIC {r['delta_bic']:.1f} "
+                      f"(weight {r['weight']:.2g})")
     for amb in d["ambiguous"]:
         print(f"cannot be told apart with this data: {', '.join(amb['effects'])} ({amb['separating_test']})")
     if d["unexplained"]["present"]:

@@ -97,6 +97,16 @@ class DiagnosisResult:
                 {
                     "effect": f.effect,
                     "cause": f.cause,
+                    # How sure the name is (issue 29): the BIC weight among the finding's rivals;
+                    # named is False when the finding is the group, best first, that holds
+                    # DiagnosisOptions.min_weight together, and "effect" is then only its best.
+                    "weight": f.weight,
+                    "named": bool(f.named_alone),
+                    "group": [{"effect": f.effect, "weight": f.weight}] + [
+                        {"effect": r.effect, "weight": r.weight} for r in f.rivals if r.in_group],
+                    "rivals": [{"effect": r.effect, "weight": r.weight, "delta_bic": r.delta_bic,
+                                "correlation": r.correlation, "in_group": bool(r.in_group)}
+                               for r in f.rivals],
                     "parameters": {p.name: estimate_dict(p) for p in f.parameters},
                     "gain": {
                         "rms_before_um": f.gain.rms_before_um,

@@ -1,6 +1,7 @@
 // Wording of ambiguities: which test of the standard set-up separates two candidates that
 // explain this session's residuals equally well.
 #include <map>
+#include <set>
 #include <sstream>
 
 #include <Eigen/SVD>
@@ -22,8 +23,13 @@ std::string separating_test(const DiagnosisProblem& P, const ModelFit& fit, cons
   const Eigen::MatrixXd Ra = P.reference_jacobian(fit, a.effect, &rows_a);
   const Eigen::MatrixXd Rb = P.reference_jacobian(fit, b.effect, &rows_b);
   const Eigen::VectorXd diff = Ra * a.params - Rb * b.params;
+  // A test this session already holds cannot be the one that separates them: the session's
+  // fit saw it and could not tell them apart (there the location errors and the set-up absorb
+  // what differs; the raw difference of the two predictions below does not know that).
+  const std::set<std::string> held(P.groups().begin(), P.groups().end());
   std::map<std::string, std::pair<double, int>> per;
   for (std::size_t i = 0; i < rows_a.size(); ++i) {
+    if (held.count(rows_a[i])) continue;
     auto& acc = per[rows_a[i]];
     acc.first += diff[static_cast<Eigen::Index>(i)] * diff[static_cast<Eigen::Index>(i)];
     acc.second += 1;
@@ -37,8 +43,8 @@ std::string separating_test(const DiagnosisProblem& P, const ModelFit& fit, cons
   std::ostringstream out;
   out.precision(2);
   if (best.empty() || best_rms < sigma_mm)
-    out << "no test of the standard single set-up separates them (their predictions differ by "
-           "less than the noise there); `rotacal design ballbar --separate "
+    out << "no test of the standard single set-up that this session lacks separates them (their "
+           "predictions differ by less than the noise there); `rotacal design ballbar --separate "
         << a.effect.id() << "," << b.effect.id()
         << " --after SESSION` proposes the smallest added test that does, or says why none can";
   else

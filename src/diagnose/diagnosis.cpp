@@ -6,6 +6,7 @@
 #include <chrono>
 #include <functional>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <set>
 #include <memory>
@@ -14,6 +15,7 @@
 
 #include "rotacal/ballbar/test_plan.hpp"
 #include "rotacal/core/stats.hpp"
+#include "rivals.hpp"
 #include "scoring.hpp"
 #include "rotacal/core/noise_handling.hpp"
 
@@ -276,6 +278,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
     NoiseTreatment wander_noise;  // 1/f-like: AR(1) + random walk by REML, once per round
     std::unique_ptr<ModelProducts> round_products;  // white or AR(1) candidates' Gram matrices
     std::vector<NoiseTreatment> treatment_of;  // per score: the noise it was judged with
+    std::vector<bool> levels_of;               // per score: judged with the stream levels
     for (std::size_t c = 0; c < candidates.size(); ++c) {
       if (done[c]) continue;
       if (!unresolved[c].empty()) {
@@ -292,6 +295,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
       if (options.progress) options.progress(stage, round_done++, round_total);
       Score s;
       NoiseTreatment judged_with = noise;
+      bool with_levels = false;
       if (!noise.W) {
         s = score(in, candidates[c], noise.whiten(Jc), options.min_visible_chi2, options.min_delta_bic);
       } else {
@@ -321,6 +325,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
             }
             scores.push_back(std::move(s));
             treatment_of.push_back(judged_with);
+            levels_of.push_back(false);
             continue;
           }
         }
@@ -338,6 +343,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
           // false findings in 200 1/f-like null sessions; with the walk: bench/
           // diagnose_realistic_bench --rho -1).
           need_levels();
+          with_levels = true;
           in_c.Jfree = J_levels;
           in_c.num_free += levels_rank;
           if (!wander_noise.W) {
@@ -369,6 +375,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
       }
       scores.push_back(std::move(s));
       treatment_of.push_back(judged_with);
+      levels_of.push_back(with_levels);
     }
     if (options.progress) options.progress(stage, round_total, round_total);
     first_round = false;
@@ -391,7 +398,6 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
     // The first passing candidate that also predicts left-out blocks better and whose
     // parameters the nonlinear refit can determine.
     const Score* chosen = nullptr;
-    std::vector<const Score*> undetermined;  // passed, but no parameter determinable
     const ModelFit* before = nullptr;  // the current model's fit, once a candidate is chosen
     double cv_before = 0.0, cv_after = 0.0;
     for (const Score* s : passing) {
@@ -401,17 +407,19 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
       EffectModel extended = effects;
       extended.effects.push_back(s->effect);
       const ModelFit& refit = cache.fit(P, extended);
-      bool any_observable = false;
-      for (const ParameterEstimate& p : parameters_of(refit, s->effect)) any_observable |= p.observable;
+      // A cause with no number is no finding: at least one parameter must be determined
+      // (|value| >= min_determined_sigma std), not merely estimable with a huge 1-sigma.
+      bool any_determined = false;
+      for (const ParameterEstimate& p : parameters_of(refit, s->effect))
+        any_determined |= p.observable && std::abs(p.value) >= options.min_determined_sigma * p.std;
       for (std::size_t c = 0; c < candidates.size(); ++c)
         if (candidates[c] == s->effect) done[c] = true;
-      if (!any_observable) {
-        // A cause with no number is no finding: the refit cannot determine any parameter.
+      if (!any_determined) {
         D.unobservable.push_back(
             {s->effect.id(), "it reduces the residual, but once it is in the model none of its "
-                             "parameters can be determined from these readings (they trade off "
-                             "against the location errors and the other effects)"});
-        undetermined.push_back(s);
+                             "parameters can be determined from these readings (none reaches " +
+                                 std::to_string(static_cast<int>(options.min_determined_sigma)) +
+                                 " sigma: they trade off against the location errors and the other effects)"});
         continue;
       }
       chosen = s;
@@ -422,27 +430,51 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
     }
     if (!chosen) break;
 
-    // Candidates that explain the same signal about as well.
-    // Those passed over for undetermined parameters are listed too, as the data favoured them.
-    Ambiguity amb;
-    for (const Score* s : passing) {
-      if (s == chosen) continue;
-      const bool passed_over = std::find(undetermined.begin(), undetermined.end(), s) != undetermined.end();
-      const double dbic = s->delta_bic - chosen->delta_bic;
-      const double corr = std::abs(correlation(s->signature, chosen->signature));
-      if ((dbic < options.ambiguity_delta_bic && corr >= options.ambiguity_correlation) || passed_over) {
-        if (amb.effects.empty()) amb.effects.push_back(chosen->effect.id());
-        amb.effects.push_back(s->effect.id());
-        amb.delta_bic = std::max(amb.delta_bic, dbic);
-        amb.correlation = amb.effects.size() == 2 ? corr : std::min(amb.correlation, corr);
-        amb.separating_test = separating_test(P, *before, *chosen, *s, noise.sigma_mm);
+    // How sure the name is: BIC weights against the candidates that explain the same signal.
+    // Below min_weight the finding is the group the data cannot separate, reported ambiguous.
+    // In coloured noise the field is weighed under one noise model, the chosen candidate's own
+    // (each candidate's own model is estimated after removing it: a flexible one that takes
+    // some of the noise's low frequencies with it whitens its own residual more, and its BIC
+    // flatters it against a rival judged under another model).
+    std::vector<double> field_bic;
+    for (const Score* s : passing) field_bic.push_back(s->delta_bic);
+    if (noise.W) {
+      const std::size_t ci = static_cast<std::size_t>(chosen - scores.data());
+      const NoiseTreatment& common = treatment_of[ci];
+      ScoringInputs in_common;
+      in_common.Jfree = levels_of[ci] ? J_levels : in.Jfree;
+      in_common.num_free = before->num_free + (levels_of[ci] ? levels_rank : 0);
+      in_common.Q_w = orthonormal_basis_full_rank(common.whiten(in_common.Jfree));
+      in_common.r_w = common.whiten(before->residuals);
+      EffectModel before_effects = effects;
+      before_effects.effects.pop_back();
+      for (std::size_t i = 0; i < passing.size(); ++i) {
+        const SharedMatrix Jc = cache.candidate_jacobians(P, before_effects, *before, {passing[i]->effect}).front();
+        const Score r = score(in_common, passing[i]->effect, common.whiten(*Jc), options.min_visible_chi2);
+        field_bic[i] = r.observable ? r.delta_bic : std::numeric_limits<double>::infinity();
       }
     }
-    if (!amb.effects.empty()) D.ambiguous.push_back(amb);
+    const double tempering = noise.W && model ? evidence_tempering(*model) : 1.0;
+    const RivalJudgement judged_rivals =
+        weigh_rivals(*chosen, passing, field_bic, tempering, options.rival_correlation, options.min_weight);
+    if (judged_rivals.group.size() > 1) {
+      Ambiguity amb;
+      for (const Score* g : judged_rivals.group) amb.effects.push_back(g->effect.id());
+      amb.correlation = 1.0;
+      for (const Alternative& a : judged_rivals.rivals)
+        if (a.in_group) {
+          amb.delta_bic = std::max(amb.delta_bic, a.delta_bic);
+          amb.correlation = std::min(amb.correlation, a.correlation);
+        }
+      amb.separating_test = separating_test(P, *before, *chosen, *judged_rivals.group[1], noise.sigma_mm);
+      D.ambiguous.push_back(amb);
+    }
 
     Finding F;
     F.effect = chosen->effect;
     F.cause = chosen->effect.cause();
+    F.weight = judged_rivals.weight;
+    F.rivals = judged_rivals.rivals;
     F.gain.rms_before_um = rms_um(before->residuals);
     F.gain.rms_after_um = rms_um(fit->residuals);
     const NoiseTreatment& judged = treatment_of[static_cast<std::size_t>(chosen - scores.data())];

@@ -109,4 +109,11 @@ def test_diagnose_json(shared_data):
     check(d["noise_model"], named["noise_model"], "noise_model", named)
     for i, t in enumerate(d["angle_tables"]):
         check(t, named["angle_table"], f"angle_tables[{i}]", named)
+    # The shared R-test session hides a sag and a coning of B: findings to check.
+    findings = cli_json("diagnose", shared_data / "rtest_bc_oyama.csv")["findings"]
+    assert findings
+    for i, f in enumerate(findings):
+        check(f, named["finding"], f"findings[{i}]", named)
+        assert 0.0 < f["weight"] <= 1.0 and f["group"][0]["effect"] == f["effect"]
+        assert f["named"] == (len(f["group"]) == 1)
     check(d["uncertainty_budget"], named["uncertainty_budget"], "uncertainty_budget", named)

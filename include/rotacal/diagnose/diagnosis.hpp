@@ -90,8 +90,17 @@ struct DiagnosisOptions {
   double alpha = 0.01;         ///< family-wise false-finding rate per step (Bonferroni)
   double min_delta_bic = -10;  ///< "very strong" evidence on the Kass-Raftery scale
   int cv_blocks = 5;           ///< contiguous blocks per group for cross-validation
-  double ambiguity_delta_bic = 10.0;  ///< candidates within this BIC of the best ...
-  double ambiguity_correlation = 0.95;  ///< ... whose fitted signatures correlate this well
+  /// A cause is named alone only when its BIC weight among itself and its rivals (the
+  /// candidates of its round whose fitted signatures correlate with its own by at least
+  /// rival_correlation) is at least min_weight; otherwise the finding is the group of
+  /// candidates, best first, that holds min_weight together ("one of these"), and those are
+  /// reported as ambiguous. 0.9: the chosen cause is 9 times as probable as all its rivals
+  /// together (a BIC margin of 2 ln 9 = 4.4 over a single rival).
+  double min_weight = 0.9;
+  double rival_correlation = 0.5;
+  /// A finding has at least one parameter determined to this many sigma (|value| >= k std);
+  /// a candidate whose refit determines none is reported unobservable, not named.
+  double min_determined_sigma = 3.0;
   std::vector<std::string> only;  ///< restrict candidates to these ids (empty: all)
   /// A candidate is visible when moving its parameters by plausible sizes (1 mm, 1 mrad,
   /// 1 um/s, 1e-3 for ratios) beyond what the model absorbs changes chi-square by at least
@@ -174,9 +183,27 @@ struct Gain {
   double f_pvalue = 1.0;
 };
 
+/// A rival of a finding: a candidate of its round that explains the same signal.
+struct Alternative {
+  std::string effect;
+  double weight = 0.0;       ///< BIC weight among the finding and its rivals
+  double delta_bic = 0.0;    ///< BIC(this) - BIC(the finding's effect); > 0: fits worse
+  double correlation = 0.0;  ///< |cosine| of the two fitted signatures
+  bool in_group = false;     ///< one of the group the data cannot separate
+};
+
 struct Finding {
-  Effect effect;
+  Effect effect;             ///< the best of its group (the one the model is extended with)
   std::string cause;
+  /// BIC weight of `effect` among itself and its rivals; below DiagnosisOptions::min_weight
+  /// the finding is the group of `rivals` with in_group set, not `effect` alone.
+  double weight = 1.0;
+  std::vector<Alternative> rivals;  ///< best first
+  bool named_alone() const {
+    for (const Alternative& a : rivals)
+      if (a.in_group) return false;
+    return true;
+  }
   std::vector<ParameterEstimate> parameters;  ///< of the effect, from the final fit
   Gain gain;
   /// Baseline parameters that moved by more than their uncertainty once the effect was
