@@ -17,6 +17,8 @@ import matplotlib
 matplotlib.use("Agg")  # files only, never a window
 import matplotlib.pyplot as plt  # noqa: E402
 
+from . import units  # noqa: E402
+
 # Words for the ISO 230-7 location errors of a tilting-rotary table (Flynn et al., Table 1).
 ERROR_WORDS = {
     "E_X0C": "position of C in X", "E_Y0C": "position of C in Y",
@@ -98,17 +100,64 @@ def _fmt(p: dict, scale: float) -> tuple[str, str]:
     return f"{p['value'] * scale:+.2f}", f"{p['std'] * scale:.2f}"
 
 
-def location_error_table(errors: dict) -> str:
-    """ISO 230-7 style table; positions in um, orientations in urad."""
+def location_error_table(errors: dict, baseline: dict | None = None) -> str:
+    """ISO 230-7 style table; positions in um, orientations in urad. With ``baseline`` (the
+    location errors of the model without the diagnosis' findings), its value and the shift to
+    ``errors`` stand beside each value, labelled as such."""
+    extra = "<th>Baseline</th><th>Shift</th>" if baseline else ""
     rows = ["<table><tr><th class=l>Error</th><th class=l>Meaning</th><th>Value</th>"
-            "<th>1&sigma;</th><th>Unit</th></tr>"]
+            f"<th>1&sigma;</th>{extra}<th>Unit</th></tr>"]
     for name, p in errors.items():
         scale, unit = (1e3, "&micro;m") if p["unit"] == "mm" else (1e6, "&micro;rad")
         v, s = _fmt(p, scale)
+        cells = ""
+        if baseline:
+            b = baseline.get(name, {})
+            bv, _ = _fmt(b, scale) if b else ("", "")
+            shift = (f"{(p['value'] - b['value']) * scale:+.2f}"
+                     if p.get("value") is not None and b.get("value") is not None else "")
+            cells = f"<td>{bv}</td><td>{shift}</td>"
         rows.append(f"<tr><td class=l>{_e(name)}</td><td class=l>{_e(error_words(name))}</td>"
-                    f"<td>{v}</td><td>{s}</td><td>{unit}</td></tr>")
+                    f"<td>{v}</td><td>{s}</td>{cells}<td>{unit}</td></tr>")
     rows.append("</table>")
     return "\n".join(rows)
+
+
+def extended_identification(session: Any, identification: Any, diagnosis: Any) -> Any | None:
+    """The joint identification of the model the diagnosis extended (its findings' effects
+    fitted along), or None when there is nothing to extend: no finding, or a paper-method
+    identification. Where the diagnosis found an effect, this is the result a user loads
+    (the baseline's location errors carry the effect's bias); issue 29, one value per quantity."""
+    if diagnosis is None or not diagnosis.findings or identification.raw.method != "joint":
+        return None
+    from .ballbar import identify
+    effects = list(diagnosis.raw.final_fit.effects)
+    noise = "white" if identification.raw.noise.white else "auto"
+    return identify(session, "joint", effects=effects, noise=noise)
+
+
+def location_errors_section(ident: dict, baseline: dict | None, diagnosis: Any) -> list[str]:
+    """The location-error section: the result, and where the diagnosis extended the model,
+    which model that is and the baseline's values beside it."""
+    if baseline is None:
+        parts = [f'<section id="location-errors"><h2>Location errors (ISO 230-7), method: {_e(ident["method"])}</h2>',
+                 location_error_table(ident["location_errors"])]
+    else:
+        found = [f.effect for f in diagnosis.findings]
+        parts = [f'<section id="location-errors"><h2>Location errors (ISO 230-7) of the extended model: '
+                 f'location errors + {_e(", ".join(found))}</h2>',
+                 "<p>These are the values to load into the controller: the diagnosis found "
+                 f"{_e(', '.join(found))} in this session, and a model without it biases the location errors "
+                 "(Baseline: the fit of the location errors alone, shown for comparison; Shift: result - baseline). "
+                 "The uncertainty budget below is of this model too.</p>",
+                 location_error_table(ident["location_errors"], baseline["location_errors"])]
+        for f in diagnosis.findings:
+            if not f.named_alone:
+                others = ", ".join(r.effect for r in f.rivals if r.in_group)
+                parts.append(f"<p class=warn>{_e(f.effect)} is one of a group this session cannot separate "
+                             f"({_e(others)}); with another member of the group the location errors above would "
+                             "differ. `rotacal design ballbar --separate` proposes the test that decides.</p>")
+    return parts
 
 
 def fitted_effects_table(effects: list[dict]) -> str:
@@ -257,6 +306,10 @@ def ballbar_report(path: str | Path, session: Any, identification: Any,
     from . import _core
 
     path = Path(path)
+    baseline, location_only = None, identification
+    extended = extended_identification(session, identification, diagnosis)
+    if extended is not None:
+        baseline, identification = identification.to_dict(), extended
     _with_budget(identification, session, diagnosis)
     ident = identification.to_dict()
     tests = np.asarray(session.tests, dtype=object)  # object: a long label must not widen every row
@@ -282,8 +335,7 @@ def ballbar_report(path: str | Path, session: Any, identification: Any,
                  f"<tr><th class=l>Samples / tests</th><td class=l>{len(tests)} / {_e(', '.join(dict.fromkeys(tests)))}</td></tr>"
                  "</table></section>")
 
-    parts.append(f'<section id="location-errors"><h2>Location errors (ISO 230-7), method: {_e(ident["method"])}</h2>')
-    parts.append(location_error_table(ident["location_errors"]))
+    parts.extend(location_errors_section(ident, baseline, diagnosis))
     parts.append(f"<p>Residual RMS {ident['residual_rms_um']:.3f} &micro;m over {ident['n_samples']} samples.</p>")
     parts.append(fitted_effects_table(ident.get("effects", [])))
     if ident["unobservable"]:
@@ -299,7 +351,7 @@ def ballbar_report(path: str | Path, session: Any, identification: Any,
         parts.append(_img(src, cap, "polar"))
     parts.append("</section>")
 
-    residuals = [("location-error model", np.asarray(identification.residuals))]
+    residuals = [("location-error model", np.asarray(location_only.residuals))]
     if diagnosis is not None and diagnosis.findings:
         residuals.append(("extended model", np.asarray(diagnosis.raw.final_fit.residuals)))
     parts.append('<section id="residuals"><h2>Residuals</h2>')
@@ -349,18 +401,25 @@ def diagnosis_section(d: dict) -> str:
         out.append("<p class=ok>No effect of the catalogue is significant: the location-error model "
                    "explains the data to the noise.</p>")
     else:
-        out.append("<table><tr><th class=l>#</th><th class=l>Effect</th><th class=l>Cause</th>"
+        out.append("<table><tr><th class=l>#</th><th class=l>Effect</th><th>Weight</th><th class=l>Cause</th>"
                    "<th class=l>Parameters</th><th>RMS before</th><th>RMS after</th><th>&Delta;BIC</th>"
                    "<th>CV RMS before</th><th>CV RMS after</th></tr>")
         for i, f in enumerate(d["findings"], 1):
-            params = "<br>".join(
-                f"{_e(k)} = {v['value']:.4g} &plusmn; {v['std']:.2g} {_e(v['unit'])}"
-                if v["value"] is not None else f"{_e(k)}: unobservable" for k, v in f["parameters"].items())
+            params = "<br>".join(f"{_e(k)} = {_e(units.estimate_text(v['value'], v['std'], v['unit']))}"
+                                 for k, v in f["parameters"].items())
+            if f["named"]:
+                effect = _e(f["effect"])
+            else:  # the group the data cannot separate, with the parameters of its best
+                effect = "one of: " + ", ".join(f"{_e(m['effect'])} ({m['weight']:.2f})" for m in f["group"])
+                params = f"if {_e(f['effect'])}:<br>" + params
             g = f["gain"]
-            out.append(f"<tr><td class=l>{i}</td><td class=l>{_e(f['effect'])}</td><td class=l>{_e(f['cause'])}</td>"
+            out.append(f"<tr><td class=l>{i}</td><td class=l>{effect}</td><td>{f['weight']:.2f}</td>"
+                       f"<td class=l>{_e(f['cause'])}</td>"
                        f"<td class=l>{params}</td><td>{g['rms_before_um']:.3f}</td><td>{g['rms_after_um']:.3f}</td>"
                        f"<td>{g['delta_bic']:.1f}</td><td>{g['cv_rms_before_um']:.3f}</td><td>{g['cv_rms_after_um']:.3f}</td></tr>")
-        out.append("</table><p class=muted>RMS in &micro;m; CV: blocked cross-validation.</p>")
+        out.append("</table><p class=muted>RMS in &micro;m; CV: blocked cross-validation. Weight: the BIC "
+                   "weight of the effect against the candidates that explain the same signal; below 0.9 the "
+                   "finding is the group the data cannot separate, not one name.</p>")
     for a in d["ambiguous"]:
         out.append(f"<p class=warn>Cannot be told apart with this data: {_e(', '.join(a['effects']))} "
                    f"({_e(a['separating_test'])}).</p>")
