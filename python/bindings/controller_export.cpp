@@ -1,7 +1,9 @@
-// Bindings for include/rotacal/io/controller_export.hpp: controller exports of a model file.
+// Bindings for include/rotacal/io/controller_export.hpp (controller exports of a model file)
+// and io/controller_comment.hpp (free text as comments of the files a controller executes).
 #include <pybind11/stl.h>
 
 #include "numpy.hpp"
+#include "rotacal/io/controller_comment.hpp"
 #include "rotacal/io/controller_export.hpp"
 
 namespace rotacal::py {
@@ -51,6 +53,15 @@ void bind_controller_export(pyb::module_& m) {
       "Export a model file's location errors into a controller's kinematic parameters "
       "(io/controller_export.hpp); current_text: the controller's current values (its HAL/MPF file "
       "or the documented JSON), None for zero offsets.");
+  m.def(
+      "comment_lines",
+      [](const std::string& dialect, const std::string& text) {
+        return comment_lines(parse_comment_dialect(dialect), text);
+      },
+      pyb::arg("dialect"), pyb::arg("text"),
+      "text as whole comment lines of a file a controller executes (io/controller_comment.hpp), "
+      "without line ends; dialect: linuxcnc, fanuc, heidenhain, siemens, isg or hash (HAL, "
+      "parameter lists). Every free text written into such a file goes through it.");
   m.def(
       "controller_parameter_names",
       [](const std::string& controller, MachineType machine, int toolholder) {

@@ -174,13 +174,16 @@ def isg_sphere_centres(session: Any, model: dict, setup: str | None, kinematic: 
     rows = [i for i, x in enumerate(s.setups) if x == label]
     xyz, ang, d = np.asarray(s.xyz)[rows], np.radians(np.asarray(s.angles_deg)[rows]), np.asarray(s.d)[rows]
     o = np.asarray(origin, dtype=float)
-    lines = ["; rotacal export: measured sphere centres for the ISG kinematic optimisation (TF5245)",
-             f"; set-up {label}, {len(rows)} poses; centre = commanded sphere - Ry(B) Rz(C) (reading - probe zero)",
-             f"; origin (rotary axes' intersection, machine coordinates): {o[0]:.6f}, {o[1]:.6f}, {o[2]:.6f} mm",
-             "#VAR", f"V.L.KIN_TYP = {kinematic[0]}", f"V.L.KIN_VARIANT = {kinematic[1]}",
-             f"V.L.NUMBER_OF_POSES = {len(rows)}", "#ENDVAR",
-             'L CYCLE [NAME = "SysCalibFitInit.ecy" @P1 = V.L.KIN_TYP @P2 = V.L.KIN_VARIANT '
-             '@P3 = V.L.NUMBER_OF_POSES]']
+    # The set-up label is the session's text: comments only through the ISG comment writer.
+    lines = [line for text in (
+        "rotacal export: measured sphere centres for the ISG kinematic optimisation (TF5245)",
+        f"set-up {label}, {len(rows)} poses; centre = commanded sphere - Ry(B) Rz(C) (reading - probe zero)",
+        f"origin (rotary axes' intersection, machine coordinates): {o[0]:.6f}, {o[1]:.6f}, {o[2]:.6f} mm")
+        for line in _core.comment_lines("isg", text)]
+    lines += ["#VAR", f"V.L.KIN_TYP = {int(kinematic[0])}", f"V.L.KIN_VARIANT = {int(kinematic[1])}",
+              f"V.L.NUMBER_OF_POSES = {len(rows)}", "#ENDVAR",
+              'L CYCLE [NAME = "SysCalibFitInit.ecy" @P1 = V.L.KIN_TYP @P2 = V.L.KIN_VARIANT '
+              '@P3 = V.L.NUMBER_OF_POSES]']
     # The reading turned into the machine frame by the nominal table pose (the one forward
     # kinematics, no errors: Ry(B) Rz(C)).
     turned = _core.forward(session.machine, np.zeros(8), ang, d - zero)

@@ -279,18 +279,9 @@ class CircularNcWriter {
  private:
   void line(const std::string& s) { lines_.push_back(s); }
 
-  void comment(std::string text) {
-    if (d_ == NcDialect::linuxcnc || d_ == NcDialect::fanuc) {
-      for (char& c : text) {
-        if (c == '(') c = '[';
-        if (c == ')') c = ']';
-        if (d_ == NcDialect::fanuc)
-          c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-      }
-      line("(" + text + ")");
-    } else {
-      line("; " + text);
-    }
+  // Every comment, fixed or free text (a machine's name), through the dialect's writer.
+  void comment(const std::string& text) {
+    for (const std::string& l : comment_lines(nc_detail::comment_dialect(d_), text)) line(l);
   }
 
   std::string num(double v) const {

@@ -1,7 +1,7 @@
 #pragma once
-// Internal to src/ballbar: number formatting of NC words and comments, and the program
-// preamble per dialect, shared by the NC writer of the rotary-axis test (nc_program.cpp) and
-// of the circular tests (circular_test.cpp).
+// Internal to src/ballbar: number formatting of NC words, each dialect's comment writer, and
+// the program preamble per dialect, shared by the NC writer of the rotary-axis test
+// (nc_program.cpp) and of the circular tests (circular_test.cpp).
 
 #include <cstdio>
 #include <functional>
@@ -9,6 +9,7 @@
 
 #include "rotacal/ballbar/nc_program.hpp"
 #include "rotacal/core/error.hpp"
+#include "rotacal/io/controller_comment.hpp"
 
 namespace rotacal::nc_detail {
 
@@ -31,6 +32,19 @@ inline std::string general(double v) {
   return buf;
 }
 
+/// The comment writer of an NC dialect (io/controller_comment.hpp): every comment of a program,
+/// fixed or free text, goes through it.
+inline CommentDialect comment_dialect(NcDialect d) {
+  switch (d) {
+    case NcDialect::linuxcnc: return CommentDialect::linuxcnc;
+    case NcDialect::heidenhain: return CommentDialect::heidenhain;
+    case NcDialect::siemens: return CommentDialect::siemens;
+    case NcDialect::fanuc: return CommentDialect::fanuc;
+  }
+  ROTACAL_ASSERT(false);
+  return CommentDialect::linuxcnc;
+}
+
 /// What differs between the programs that share write_preamble.
 struct Preamble {
   std::string writer;       ///< function named in error messages, e.g. "write_nc_program"
@@ -42,9 +56,10 @@ struct Preamble {
 };
 
 /// Checks the options the preamble uses (decimals 0..9, tool >= 0 and > 0 for heidenhain and
-/// fanuc, heidenhain program_name one word, fanuc program_number 1..9999; InvalidArgument
-/// naming `p.writer` and the option) and writes, through `line`, each dialect's opening blocks
-/// with the header comments (`header`) where the dialect puts them:
+/// fanuc, heidenhain program_name one word of letters, digits, '_' and '-', fanuc
+/// program_number 1..9999; InvalidArgument naming `p.writer` and the option) and writes,
+/// through `line`, each dialect's opening blocks with the header comments (`header`) where
+/// the dialect puts them:
 ///   linuxcnc:   header, G21 G90 G94 G17 G40 G49 G80, G43 H<tool> (tool > 0, table machine)
 ///   heidenhain: BEGIN PGM <name> MM, header, FUNCTION RESET TCPM, TOOL CALL <tool> Z
 ///   siemens:    header, TRAFOOF, G71 G90 G94 G17 G40 G64, T<tool> D1 (tool > 0)
@@ -66,8 +81,11 @@ inline void write_preamble(NcDialect d, const NcProgramOptions& o, const Preambl
       if (o.tool > 0 && !p.head_machine) line("G43 H" + std::to_string(o.tool));
       break;
     case NcDialect::heidenhain:
-      if (o.program_name.empty() || o.program_name.find_first_of(" \t\n;") != std::string::npos)
-        throw InvalidArgument(p.writer + ": program_name must be one word, got '" +
+      // It is written outside any comment (BEGIN PGM / END PGM): only a plain name.
+      if (o.program_name.empty() || o.program_name.size() > 64 ||
+          o.program_name.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_-") !=
+              std::string::npos)
+        throw InvalidArgument(p.writer + ": program_name must be one word of letters, digits, '_' and '-', got '" +
                               o.program_name + "'");
       line("BEGIN PGM " + o.program_name + " MM");
       header();
@@ -86,7 +104,7 @@ inline void write_preamble(NcDialect d, const NcProgramOptions& o, const Preambl
       line("%");
       char number[16];
       std::snprintf(number, sizeof number, "O%04d", o.program_number);
-      line(std::string(number) + " (" + p.fanuc_title + ")");
+      line(std::string(number) + " " + comment_lines(CommentDialect::fanuc, p.fanuc_title).front());
       header();
       line("G21 G90 G94 G17 G40 G49 G80");
       break;

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "rotacal/core/error.hpp"
+#include "rotacal/io/controller_comment.hpp"
 
 namespace rotacal {
 
@@ -153,10 +154,15 @@ ControllerValue vector_component(const std::string& name, const AxisVector& a, i
   return v;
 }
 
+// The file: comment lines through the dialect's comment writer (a model path, a session or
+// a date may hold any text), then the values.
 struct Writer {
-  std::string comment;  // "#" or ";"
+  explicit Writer(CommentDialect d) : dialect(d) {}
+  CommentDialect dialect;
   std::ostringstream out;
-  void line(const std::string& s = "") { out << comment << (s.empty() ? "" : " " + s) << "\n"; }
+  void line(const std::string& s = "") {
+    for (const std::string& l : comment_lines(dialect, s)) out << l << "\n";
+  }
 };
 
 ControllerExport new_export(Controller c, const std::string& kinematics, const std::string& file_kind,
@@ -244,7 +250,7 @@ ControllerExport export_linuxcnc(const ExportInput& in, const ExportOptions& o) 
                 "x-rot-point (and " + off + ", which is relative to it)",
                 ac ? "y-rot-point (and y-offset, which is relative to it)" : "y-rot-point", no_orient, no_orient},
                {true, true, false, false, true, true, false, false});
-  Writer w{"#"};
+  Writer w(CommentDialect::hash);
   header(w, ex, in, o,
          "LinuxCNC " + kins + " HAL pins (src/emc/kinematics/trtfuncs.c), linear units mm ([TRAJ]LINEAR_UNITS), "
          "angles as the module's default directions (right-handed table rotation)");
@@ -293,7 +299,7 @@ ControllerExport export_siemens(const ExportInput& in, const ExportOptions& o) {
                 "v1 (" + t + " direction)", "l3, l4 (C line through l2 + l3)", "l3, l4 (C line through l2 + l3)",
                 "v2 (C direction)", "v2 (C direction)"},
                {true, true, true, true, true, true, true, true});
-  Writer w{";"};
+  Writer w(CommentDialect::siemens);
   header(w, ex, in, o,
          "SINUMERIK orientable toolholder " + ex.kinematics + " (W1 function manual: type P, chain l2 v1 l3 v2 l4), "
          "basic values in mm, axis vectors as unit vectors; fine offsets ($TC_CARR41..65) are not changed");
@@ -335,7 +341,7 @@ ControllerExport export_isg(const ExportInput& in, const ExportOptions& o) {
                {"axis[1].point", "axis[1].point", "axis[1].orientation", "axis[1].orientation", "axis[0].point",
                 "axis[0].point", "axis[0].orientation", "axis[0].orientation"},
                {true, true, true, true, true, true, true, true});
-  Writer w{"#"};
+  Writer w(CommentDialect::hash);
   header(w, ex, in, o,
          "ISG/Beckhoff " + ex.kinematics + " (P-CHAN-00290..00293), points in 0.1 um, orientations "
          "as unit vectors, workpiece-side orientations negated");
@@ -365,7 +371,7 @@ ControllerExport export_heidenhain(const ExportInput& in, const ExportOptions& o
   dispositions(ex, in,
                {ps[0].name, ps[1].name, comp, comp, ps[2].name, ps[3].name, comp, comp},
                {true, true, false, false, true, true, false, false});
-  Writer w{"#"};
+  Writer w(CommentDialect::hash);
   header(w, ex, in, o,
          "HEIDENHAIN TNC kinematics table, MAPPING ONLY: the TNC's formulas are not public. The values are "
          "the rotary-axis line positions in machine coordinates (mm); check the sign of the Trans rows of "
@@ -392,7 +398,7 @@ ControllerExport export_fanuc(const ExportInput& in, const ExportOptions& o) {
                {"No. 19700-19702 and 19703-19705", "No. 19700-19702 and 19703-19705", none, none, "No. 19703-19705",
                 "No. 19703-19705", none, none},
                {true, true, false, false, true, true, false, false});
-  Writer w{"#"};
+  Writer w(CommentDialect::hash);
   header(w, ex, in, o,
          "FANUC 30i tool centre point parameters, MAPPING ONLY: the formulas are not public. No. 19703-19705 are "
          "documented (30i-A manual A-79348E); that 19700-19702 hold the rotary table position is inferred from "

@@ -6,6 +6,7 @@
 
 #include "rotacal/ballbar/nc_program.hpp"
 #include "rotacal/io/ballbar_file.hpp"
+#include "rotacal/kinematics/machine_description.hpp"
 
 using namespace rotacal;
 
@@ -269,4 +270,58 @@ TEST_CASE("a hand-made plan with coordinates no machine has, or moves without ti
   BallbarPlan still = plan;
   still.segments[0].samples[1].time = still.segments[0].samples[0].time;
   CHECK_THROWS_WITH(write_nc_program(still, NcDialect::linuxcnc), Catch::Contains("takes no time"));
+}
+
+namespace {
+
+// A line of `d` that is a whole comment ("N " block numbers of heidenhain taken off).
+bool is_comment(NcDialect d, const std::string& l) {
+  if (d == NcDialect::linuxcnc || d == NcDialect::fanuc)
+    return l.size() >= 2 && l.front() == '(' && l.back() == ')' &&
+           l.find_first_of("()", 1) == l.size() - 1;
+  return starts_with(l, ";");
+}
+
+// The blocks of a program that are not comments, in order.
+std::vector<std::string> blocks(NcDialect d, const std::string& text) {
+  std::vector<std::string> out;
+  for (std::string l : lines_of(text)) {
+    if (d == NcDialect::heidenhain && !l.empty() && std::isdigit(static_cast<unsigned char>(l[0])))  // block number
+      l = l.substr(l.find(' ') + 1);
+    if (!is_comment(d, l)) out.push_back(l);
+  }
+  return out;
+}
+
+MachineType renamed(MachineType m, const std::string& name) {
+  MachineDescription d = m.description();
+  d.name = name;
+  return MachineType::from_description(d);
+}
+
+}  // namespace
+
+TEST_CASE("a machine's name cannot add a block to the program, in any dialect", "[ballbar][nc]") {
+  // The name is free text from a description file; it is written in the header comments.
+  const std::string hostile[] = {"x\nG0 Z-500\n", "x\r\nG0 Z-500\r\n", "x) G0 Z-500 (", "x; G0 Z-500",
+                                 "%\nG0 Z-500\n%", "MSG, G0 Z-500", "\n$TC_CARR4[1]=500\nM30",
+                                 std::string(400, 'n') + "\nG0 Z-500"};
+  for (MachineType base : {MachineType::AC_trt, MachineType::BC_trt}) {
+    BallbarSetup s;
+    s.tests = {BallbarTest::sphere_xy, BallbarTest::radial_c};
+    s.machine = renamed(base, "plain");
+    if (base == MachineType::BC_trt) s.pivot = Eigen::Vector3d(0.0, 120.0, 60.0);
+    const BallbarPlan plain = plan_ballbar_test(s);
+    for (const std::string& name : hostile) {
+      s.machine = renamed(base, name);
+      const BallbarPlan plan = plan_ballbar_test(s);
+      for (NcDialect d : {NcDialect::linuxcnc, NcDialect::heidenhain, NcDialect::siemens, NcDialect::fanuc}) {
+        INFO(to_string(d) << ", machine named '" << name << "'");
+        const std::string text = write_nc_program(plan, d);
+        // The same blocks as for a plain name, every other line a whole comment.
+        CHECK(blocks(d, text) == blocks(d, write_nc_program(plain, d)));
+        CHECK_FALSE(contains(text, "\r"));
+      }
+    }
+  }
 }

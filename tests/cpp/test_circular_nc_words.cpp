@@ -114,7 +114,13 @@ TEST_CASE("preamble: bad options are refused in the writer's name") {
   o = {};
   o.program_name = "TWO WORDS";
   CHECK_THROWS_WITH(write_circular_nc_program(circular, NcDialect::heidenhain, o),
-                    "write_circular_nc_program: program_name must be one word, got 'TWO WORDS'");
+                    "write_circular_nc_program: program_name must be one word of letters, digits, '_' and '-', "
+                    "got 'TWO WORDS'");
+  // It is written outside any comment (BEGIN PGM, END PGM): a line end or ';' is refused.
+  for (const char* name : {"P\nL Z-500 FMAX", "P\rM30", "P;X", "P~", "P(1)"}) {
+    o.program_name = name;
+    CHECK_THROWS_AS(write_circular_nc_program(circular, NcDialect::heidenhain, o), InvalidArgument);
+  }
   o = {};
   o.program_number = 0;
   CHECK_THROWS_AS(write_circular_nc_program(circular, NcDialect::fanuc, o), InvalidArgument);

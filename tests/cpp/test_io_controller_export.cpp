@@ -229,3 +229,49 @@ TEST_CASE("current values are read from the controller's own files and refused b
   o.current = {{"$TC_CARR7[1]", 0.0}, {"$TC_CARR9[1]", 1.0}};
   CHECK_THROWS_WITH(export_kinematics(Controller::siemens, ExportInput{}, o), Catch::Contains("v1"));
 }
+
+TEST_CASE("free text in the header cannot add a line the controller reads, for every controller") {
+  // The model path, the session and date the model names and the time stamp are any text.
+  const std::string hostile[] = {"s.csv\nloadusr -w touch X\n", "s.csv\r\nsetp xyzac-trt-kins.z-offset 500\r",
+                                 "s.csv\n$TC_CARR4[1]=500\nM17\n", "s.csv\ntrafo[0].axis[0].point[0]  5000",
+                                 "s.csv\n%\nG0 Z-500", std::string(2000, 'p') + "loadusr -w touch X"};
+  auto lines_of = [](const std::string& text) {
+    std::vector<std::string> out;
+    std::istringstream in(text);
+    for (std::string l; std::getline(in, l);) out.push_back(l);
+    return out;
+  };
+  // The lines a controller reads: all but whole comment lines ('#', or ';' in the MPF).
+  auto read_lines = [&](Controller c, const std::string& text) {
+    std::vector<std::string> out;
+    for (const std::string& l : lines_of(text))
+      if (l.empty() || l[0] != (c == Controller::siemens ? ';' : '#')) out.push_back(l);
+    return out;
+  };
+  std::mt19937 rng(5);
+  for (MachineType m : {MachineType::AC_trt, MachineType::BC_trt}) {
+    ExportInput in = random_identification(m, rng, true);
+    ExportOptions o;
+    o.generated_at = "2026-01-01T00:00:00Z";
+    for (Controller c : {Controller::linuxcnc, Controller::siemens, Controller::isg, Controller::heidenhain,
+                         Controller::fanuc}) {
+      ExportInput plain = in;
+      plain.model_path = "model.json";
+      const std::vector<std::string> expected = read_lines(c, export_kinematics(c, plain, o).text);
+      for (const std::string& text : hostile) {
+        INFO(to_string(c) << ": '" << text.substr(0, 60) << "'");
+        ExportInput bad = in;
+        bad.source = text;
+        bad.model_path = text;
+        ExportOptions bad_o = o;
+        bad_o.generated_at = text;
+        const std::string out = export_kinematics(c, bad, bad_o).text;
+        CHECK(read_lines(c, out) == expected);
+        CHECK(out.find('\r') == std::string::npos);
+        for (const std::string& l : lines_of(out)) CHECK(l.size() <= 1000);  // halcmd reads 1023 a line
+      }
+      if (c == Controller::linuxcnc)
+        for (const std::string& l : expected) CHECK(l.rfind("setp " + std::string(m == MachineType::AC_trt ? "xyzac" : "xyzbc") + "-trt-kins.", 0) == 0);
+    }
+  }
+}
