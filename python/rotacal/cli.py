@@ -15,9 +15,10 @@ from pathlib import Path
 from typing import Any, Callable, Sequence
 
 from . import _core, jsontext, rtest
+from .command_files import check_command_files, rtest_truth_path
 from .diagnosis import MAX_HARMONIC
 from .machines import BALLBAR_NOISE_UM, PIVOT_ERROR_MM
-from .outputs import check_output, write_output
+from .outputs import write_output
 from .sessions import BALLBAR, RTEST, by_kind, check_plausible, checked_path, load, save
 
 EXIT_OK, EXIT_USAGE, EXIT_INPUT, EXIT_IO, EXIT_ERROR = 0, 2, 3, 4, 5
@@ -119,15 +120,6 @@ def errors_option(text: str) -> Any:
     return out
 
 
-def check_outputs(outputs: Sequence[str | None], inputs: Sequence[str | None] = ()) -> None:
-    """Refuse, before any work, an output path the output rule refuses (rotacal.outputs): a
-    directory, a missing folder, one of the command's inputs or another of its outputs."""
-    ins = [i for i in inputs if i]
-    outs = [o for o in outputs if o]
-    for k, o in enumerate(outs):
-        check_output(o, ins, outs[:k] + outs[k + 1:])
-
-
 # ------------------------------------------------------------------------- plan and set-up
 
 def _add_setup_args(p: argparse.ArgumentParser) -> None:
@@ -207,7 +199,6 @@ def _model(path: str | None) -> Any:
 
 def cmd_plan(a: argparse.Namespace) -> int:
     from .ballbar import nc_program
-    check_outputs([a.output, a.session], [a.compensate])
     plan, text = nc_program(_setup(a), a.dialect, _model(a.compensate), a.compensate)
     write_output(a.output, text, [a.compensate] if a.compensate else [], [a.session] if a.session else [])
     _say(f"wrote {a.output}: {a.dialect} program, {plan.num_samples} points, {plan.duration:.0f} s"
@@ -271,7 +262,6 @@ def _write_truth(truth: dict, path: str, other_outputs: Sequence[str | None] = (
 
 def cmd_simulate(a: argparse.Namespace) -> int:
     from .machines import simulate_ballbar_test
-    check_outputs([a.output, a.truth])
     setup = _setup(a)
     truth = _truth(a, setup)
     session, model = simulate_ballbar_test(setup, truth)
@@ -323,8 +313,7 @@ def _rtest_inputs(a: argparse.Namespace) -> dict:
 
 
 def cmd_simulate_rtest(a: argparse.Namespace) -> int:
-    truth_path = a.truth if a.truth else str(Path(a.output).with_suffix(".truth.json"))
-    check_outputs([a.output, truth_path])
+    truth_path = rtest_truth_path(a)
     r = _rtest_inputs(a)
     b_deg, c_deg, nests, dirs = r["b_deg"], r["c_deg"], r["nests"], r["probe_dirs"]
     if dirs is None and a.raw_only:
@@ -447,7 +436,6 @@ def _print_identification(d: dict) -> None:
 def cmd_identify(a: argparse.Namespace) -> int:
     from . import ballbar as _ballbar, rtest as _rtest
     from .diagnosis import plausible_sizes, uncertainty_budget
-    check_outputs([a.save_model], [a.file])
     if a.store or a.machine_id is not None:  # refused before any work
         from .history import check_machine_id, parse_date
         if not a.store:
@@ -630,8 +618,6 @@ def cmd_history_add(a: argparse.Namespace) -> int:
 def cmd_history_show(a: argparse.Namespace) -> int:
     from .history import open_history, write_plot
     tol = _tolerances(a.tolerance)
-    if a.plot:
-        check_outputs([a.plot])
     with open_history(a.db) as h:
         summary = h.show(a.machine_id, tol)
     if a.plot:
@@ -705,7 +691,6 @@ def _diagnosis_progress(a: argparse.Namespace):
 
 def cmd_diagnose(a: argparse.Namespace) -> int:
     from .diagnosis import diagnose, plausible_sizes, uncertainty_budget
-    check_outputs([a.report], [a.file])
     sizes = plausible_sizes(a.budget_sizes) if a.budget_sizes else None  # refused before any work
     s = _load(a.file, a)
     bar, progress = _diagnosis_progress(a)
@@ -740,7 +725,6 @@ def cmd_design_separation(a: argparse.Namespace) -> int:
     from .design import added_setup, design_separation, parameter_units, separation_dict
     if not a.after:
         raise OptionError("--separate: give the session it follows with --after SESSION")
-    check_outputs([a.output], [a.after])
     session = _load(a.after)
     if by_kind(session, {BALLBAR: False, RTEST: True}, "--after"):
         raise OptionError(f"--after {a.after}: an R-test session; design ballbar --separate needs a ballbar session")
@@ -784,7 +768,6 @@ def cmd_design_ballbar(a: argparse.Namespace) -> int:
     if a.after:
         raise OptionError("--after: goes with --separate EFFECT,EFFECT")
     a.noise = 0.5 if a.noise is None else a.noise
-    check_outputs([a.output])
     d = design_ballbar(_setup(a), lengths=a.lengths, pivot_x=a.pivot_x, pivot_z=a.pivot_z, travel=a.travel,
                        time_s=a.time, rate_hz=a.rate, noise_um=a.noise, rho=a.rho,
                        effects=[e.strip() for e in a.effects.split(",")] if a.effects else [])
@@ -889,7 +872,6 @@ def cmd_export(a: argparse.Namespace) -> int:
         raise _core.InvalidArgument("--comp-file: rotary compensation tables are written for linuxcnc")
     if bool(a.centres) != bool(a.centres_output) or (a.centres and a.controller != "isg"):
         raise _core.InvalidArgument("--centres and --centres-output go together, with --controller isg")
-    check_outputs([a.output, a.residual_model, a.centres_output, *comp.values()], [a.model, a.current, a.centres])
     ex = export_controller(a.model, a.controller, current=a.current, toolholder=a.toolholder)
     tables = {axis: linuxcnc_comp_table(load_model(a.model), axis, *a.comp_range, a.comp_step) for axis in comp}
     if a.centres:
@@ -922,7 +904,6 @@ def cmd_export(a: argparse.Namespace) -> int:
 def cmd_predict(a: argparse.Namespace) -> int:
     from .analysis import predict_session
     from .models import load_model
-    check_outputs([a.output], [a.session, a.model])
     model_dict = load_model(a.model)
     s = _load(a.session, a)
     out, line = predict_session(model_dict, s, a.probe_zeros, source=a.model)
@@ -943,8 +924,6 @@ def _print_compensation(rows: list[dict]) -> None:
 def cmd_compensate(a: argparse.Namespace) -> int:
     if not a.model and not a.verify:
         raise OptionError("compensate: give --model MODEL.json (write a program) and/or --verify")
-    if a.model:
-        check_outputs([a.output], [a.model])
     setup = _setup(a)
     from .ballbar import nc_program, verify_compensation
     if a.model:
@@ -964,7 +943,6 @@ def cmd_compensate(a: argparse.Namespace) -> int:
 
 def cmd_report(a: argparse.Namespace) -> int:
     from .analysis import write_report
-    check_outputs([a.output], [a.file])
     extra = []
     if a.history:
         from .history import history_section, open_history
@@ -1092,7 +1070,6 @@ def _report_recording(summary, path: str, json_out: bool) -> int:
 
 def cmd_record_ballbar(a: argparse.Namespace) -> int:
     from .instruments import record_ballbar
-    check_outputs([a.output], [a.port])  # before the port is opened
     plan = _core.plan_ballbar_test(_setup(a), None)
     summary = record_ballbar(a.port, plan, a.output, baud=a.baud, rate_hz=a.rate, zero=a.zero,
                              silence_timeout_s=a.silence, progress=not a.no_progress)
@@ -1101,7 +1078,6 @@ def cmd_record_ballbar(a: argparse.Namespace) -> int:
 
 def cmd_record_rtest(a: argparse.Namespace) -> int:
     from .instruments import record_rtest, rtest_program
-    check_outputs([a.output], [a.port])  # before the port is opened
     r = _rtest_inputs(a)
     program = rtest_program(r["machine"], r["b_deg"], r["c_deg"], r["nests"], r["dwell_s"])
     summary = record_rtest(a.port, program, a.output, mode=a.mode, dwell_s=r["dwell_s"], probe_dirs=r["probe_dirs"],
@@ -1554,6 +1530,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     try:
         args = build_parser().parse_args(_join_signed_values(argv))
+        check_command_files(args)  # every output against every input and output, before any work
         return args.func(args)
     except (OptionError, _core.ParseError, _core.InvalidArgument, _core.DegenerateGeometry) as e:
         _say(f"rotacal: error: {_message(e)}")
