@@ -435,7 +435,7 @@ def _print_identification(d: dict) -> None:
 
 def cmd_identify(a: argparse.Namespace) -> int:
     from . import ballbar as _ballbar, rtest as _rtest
-    from .diagnosis import plausible_sizes, uncertainty_budget
+    from .diagnosis import uncertainty_budget
     if a.store or a.machine_id is not None:  # refused before any work
         from .history import check_machine_id, parse_date
         if not a.store:
@@ -448,7 +448,7 @@ def cmd_identify(a: argparse.Namespace) -> int:
     elif a.note is not None or a.date is not None or a.db is not None or (a.controller and not a.save_model):
         raise OptionError("--note, --date and --db go with --store --machine-id; --controller with --store or "
                           "--save-model")
-    sizes = plausible_sizes(a.budget_sizes) if a.budget_sizes else None  # refused before any work
+    sizes = _budget_sizes(a.budget_sizes)  # refused before any work
     s = _load(a.file, a)
 
     def rtest_identify():
@@ -505,29 +505,28 @@ def _controller_text(path: str | None) -> str | None:
 
 
 def _read_json(path: str, option: str) -> tuple[dict, str]:
-    """(object, sha256 of the bytes) of a JSON file: strict (no NaN), bounded, errors naming it."""
+    """(object, sha256 of the bytes) of a JSON file: strict, bounded (jsonfile), errors naming it."""
     import hashlib
-    import json
     from .exports import MAX_CURRENT_BYTES
-    if os.path.isdir(path):
-        raise _core.IoError(f"{path}: is a directory, not a file")
-    try:
-        with open(path, "rb") as f:
-            data = f.read(64 * MAX_CURRENT_BYTES + 1)
-    except OSError as e:
-        raise _core.IoError(f"{path}: cannot read: {e.strerror}") from None
-    if len(data) > 64 * MAX_CURRENT_BYTES:
-        raise _core.InvalidArgument(f"{option} {path}: larger than {64 * MAX_CURRENT_BYTES} bytes")
-
-    def refuse(c: str) -> None:
-        raise _core.ParseError(f"{option} {path}: {c} is not JSON")
-    try:
-        doc = json.loads(data.decode("utf-8"), parse_constant=refuse)
-    except (ValueError, UnicodeDecodeError) as e:
-        raise _core.ParseError(f"{option} {path}: not JSON: {e}") from None
+    from .jsonfile import read_json
+    doc, data = read_json(path, option, 64 * MAX_CURRENT_BYTES)  # a diagnosis of a long recording is large
     if not isinstance(doc, dict):
         raise _core.InvalidArgument(f"{option} {path}: expected a JSON object")
     return doc, hashlib.sha256(data).hexdigest()
+
+
+def _budget_sizes(path: str | None) -> dict | None:
+    """The --budget-sizes object, read once (bounded) and checked before any work; the budget
+    then takes the object (a second reading of the file was refused: issue 32)."""
+    if not path:
+        return None
+    from .diagnosis import plausible_sizes
+    doc, _ = _read_json(path, "--budget-sizes")
+    try:
+        plausible_sizes(doc)
+    except _core.InvalidArgument as e:
+        raise _core.InvalidArgument(f"--budget-sizes {path}: {e}") from None
+    return doc
 
 
 def _tolerances(items: Sequence[str] | None) -> dict[str, float]:
@@ -690,8 +689,8 @@ def _diagnosis_progress(a: argparse.Namespace):
 
 
 def cmd_diagnose(a: argparse.Namespace) -> int:
-    from .diagnosis import diagnose, plausible_sizes, uncertainty_budget
-    sizes = plausible_sizes(a.budget_sizes) if a.budget_sizes else None  # refused before any work
+    from .diagnosis import diagnose, uncertainty_budget
+    sizes = _budget_sizes(a.budget_sizes)  # refused before any work
     s = _load(a.file, a)
     bar, progress = _diagnosis_progress(a)
     try:
