@@ -1063,6 +1063,9 @@ def _report_recording(summary, path: str, json_out: bool) -> int:
         print(jsontext.dumps({k: getattr(summary, k) for k in ("rows", "frames", "lost", "crc_errors", "malformed",
                                                                   "garbage_bytes", "over_range", "timeouts",
                                                                   "outside_window", "reason", "detail")} | {"path": path}, indent=None))
+    if summary.rows == 0:  # nothing measured: the recorder left an existing file as it was
+        _say(f"rotacal: {path} not written, no row was recorded: {summary.describe()}")
+        return EXIT_IO
     _say(f"wrote {path}: {summary.describe()}")
     return _RECORD_EXIT[summary.reason]
 
