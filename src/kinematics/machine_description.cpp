@@ -24,7 +24,7 @@ RotaryAxis make_rotary_axis(char name, const Eigen::Vector3d& direction,
                             const std::string& where) {
   if (!direction.allFinite() || !point.allFinite())
     throw InvalidArgument(where + ": direction and point must be finite numbers");
-  const double len = direction.norm();
+  const double len = direction.stableNorm();  // norm() overflows for [1e200, 1e200, 0]: then 0 after dividing
   if (!(len > 1e-9)) throw InvalidArgument(where + ".direction is zero: an axis needs a direction");
   RotaryAxis a;
   a.name = name;
