@@ -98,6 +98,15 @@ def path(option: str) -> Callable[[str], str]:
 SEED = number("--seed", 0, 2**32 - 1, integer=True)
 
 
+def _run_time(text: str) -> float:
+    """design --time: 0 (the default set-up's run time) or 1 s to 24 h; the predicted sigmas
+    scale as 1/sqrt(time), so 1e-300 s printed 1e146 mm (issue 32)."""
+    v = number("--time", 0.0, 86400.0, "s")(text)
+    if 0.0 < v < 1.0:
+        raise OptionError(f"--time: {text[:40]} s is no run time (0: the default set-up's, else 1 to 86400 s)")
+    return v
+
+
 def effects_option(items: Sequence[str] | None) -> dict[str, list[float]]:
     """--effect ID=P1,P2 (repeatable) -> {id: [values]}, counts checked against the catalogue."""
     out: dict[str, list[float]] = {}
@@ -942,12 +951,16 @@ def cmd_compensate(a: argparse.Namespace) -> int:
 
 def cmd_report(a: argparse.Namespace) -> int:
     from .analysis import write_report
-    extra = []
+    extra, history = [], None
     if a.history:
         from .history import history_section, open_history
         with open_history(a.db) as h:  # an unknown machine id is refused before the fit
-            extra.append(history_section(h.show(a.history)))
+            history = h.show(a.history)
+        extra.append(history_section(history))
     s = _load(a.file, a)
+    if history is not None and history["machine_type"] != _core.machine_name(s.machine):
+        raise _core.InvalidArgument(f"--history {a.history}: a {history['machine_type']} in the store, but {a.file} "
+                                    f"is a session of a {_core.machine_name(s.machine)}: not the same machine")
     from .circular import analyze as analyze_circular, is_circular
     if is_circular(s):  # ISO 230-4 runs of the linear axes: their own report
         from .report import circular_report
@@ -1255,7 +1268,7 @@ def build_parser() -> argparse.ArgumentParser:
     k.add_argument("--travel", type=numbers("--travel", 6, 1e5, "mm"),
                    help="xmin,xmax,ymin,ymax,zmin,zmax of X, Y, Z about the rotary axes' intersection, mm "
                         "(default -400,400,-300,300,-300,400)")
-    k.add_argument("--time", type=number("--time", 0.0, 86400.0, "s"), default=0.0,
+    k.add_argument("--time", type=_run_time, default=0.0,
                    help="run time to compare at, s (default: the default set-up's)")
     k.add_argument("--rate", type=number("--rate", 0.0, 1e5, "Hz", lo_open=True), default=100.0,
                    help="the recorder's sample rate, Hz (default 100)")
@@ -1298,7 +1311,7 @@ def build_parser() -> argparse.ArgumentParser:
     k.add_argument("--travel", type=numbers("--travel", 6, 1e5, "mm"),
                    help="xmin,xmax,ymin,ymax,zmin,zmax of X, Y, Z about the rotary axes' intersection, mm "
                         "(default -400,400,-300,300,-300,400)")
-    k.add_argument("--time", type=number("--time", 0.0, 86400.0, "s"), default=0.0,
+    k.add_argument("--time", type=_run_time, default=0.0,
                    help="run time to compare at, s (default: the default pattern's)")
     k.add_argument("--dwell", type=number("--dwell", 0.0, 3600.0, "s", lo_open=True),
                    help="time per pose, s (default 6)")
@@ -1533,10 +1546,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         args = build_parser().parse_args(_join_signed_values(argv))
         check_command_files(args)  # every output against every input and output, before any work
-        return args.func(args)
+        code = args.func(args)
+        sys.stdout.flush()  # a reader that went away is seen here, inside the handlers below
+        return code
     except (OptionError, _core.ParseError, _core.InvalidArgument, _core.DegenerateGeometry) as e:
         _say(f"rotacal: error: {_message(e)}")
         return EXIT_INPUT
+    except BrokenPipeError:  # `rotacal history show M | head`: the reader has what it wanted
+        try:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error at exit
+        except OSError:
+            pass
+        return EXIT_OK
     except UnicodeError as e:  # text that is not UTF-8 where the reader did not say so itself
         _say(f"rotacal: error: input is not UTF-8 text: {_message(e)}")
         return EXIT_INPUT

@@ -38,6 +38,9 @@ DAYS_PER_MONTH = 365.2425 / 12
 # Coverage factor of the expanded uncertainty a change is compared with (GUM, about 95 %).
 K_EXPANDED = 2.0
 MAX_MACHINE_ID = 100
+# The largest location error a model file may hold (io/model_file.hpp, kMaxModelPositionError
+# and kMaxModelAngleError): a correction beyond it is a typo or wrong units, not a machine.
+MAX_ERROR = {"mm": 100.0, "rad": 0.5}
 MAX_NOTE = 2000
 
 IDENTIFICATION, CORRECTION = "identification", "correction"
@@ -225,6 +228,10 @@ def correction_amounts(export: Mapping[str, Any], where: str = "<export>") -> di
             continue  # not loaded, or unobservable (the export leaves it at its current value)
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
             raise _core.InvalidArgument(f"{where}: location_errors[{i}].value: must be a finite number, got {v!r}")
+        limit = MAX_ERROR.get(unit_of(e["name"]))
+        if limit is not None and abs(v) > limit:
+            raise _core.InvalidArgument(f"{where}: location_errors[{i}].value: {v:g} {unit_of(e['name'])} is beyond "
+                                        f"+-{limit:g}: no machine tool has such a location error")
         out[e["name"]] = float(v)
     if not out:
         raise _core.InvalidArgument(f"{where}: the export holds none of the location errors: no correction to record")
