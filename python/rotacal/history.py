@@ -323,7 +323,12 @@ class CalibrationHistory:
                     f"{', '.join(sorted(tables)[:5])})")
             return None
         row = self._x("SELECT MAX(version) FROM rotacal_history_schema").fetchone()
-        return int(row[0]) if row and row[0] is not None else 0
+        if not row or row[0] is None:
+            return 0
+        if isinstance(row[0], bool) or not isinstance(row[0], int) or row[0] < 1:
+            raise _core.InvalidArgument(f"{redact(self.location)}: schema version {str(row[0])[:40]!r} is not one "
+                                        f"rotacal writes (1 .. {SCHEMA_VERSION}): not a rotacal history store")
+        return row[0]
 
     def _migrate(self) -> None:
         with self._errors():
@@ -540,6 +545,8 @@ def open_history(location: str | None = None, create_folder: bool | None = None)
             raise _core.IoError(f"{loc}: the folder {folder} does not exist")
     if Path(loc).is_dir():
         raise _core.IoError(f"{loc}: is a directory, not a history store")
+    if Path(loc).exists() and not Path(loc).is_file():  # SQLite would create loc-journal beside /dev/null
+        raise _core.IoError(f"{loc}: is a device or FIFO, not a history store (a SQLite file)")
     try:
         conn = sqlite3.connect(loc, timeout=BUSY_TIMEOUT_S, isolation_level=None, check_same_thread=False)
     except sqlite3.Error as e:
@@ -562,13 +569,40 @@ def open_history(location: str | None = None, create_folder: bool | None = None)
     except sqlite3.DatabaseError as e:
         conn.close()
         if isinstance(e, sqlite3.OperationalError) and ("locked" in str(e) or "readonly" in str(e)):
-            raise _core.IoError(f"{loc}: {e}") from None
+            raise _core.IoError(f"{loc}: {e}{_why_not_writable(loc)}") from None
+        if _is_sqlite_file(loc):  # a valid store that cannot be opened: the file system's doing
+            raise _core.IoError(f"{loc}: cannot open the history store: {e}{_why_not_writable(loc)}") from None
         raise _core.InvalidArgument(f"{loc}: not a rotacal history store (not an SQLite database: {e})") from None
     try:
         return CalibrationHistory(conn, SQLITE, loc)
     except BaseException:
         conn.close()
         raise
+
+
+def _is_sqlite_file(loc: str) -> bool:
+    """Whether the file starts with the SQLite header (or is empty: SQLite makes it a database)."""
+    try:
+        with open(loc, "rb") as f:
+            head = f.read(16)
+    except OSError:
+        return False
+    return head in (b"", b"SQLite format 3\x00")
+
+
+def _why_not_writable(loc: str) -> str:
+    """The cause, when the store's folder or file cannot be written (a store writes beside itself)."""
+    folder = str(Path(loc).parent)
+    try:
+        if os.statvfs(folder).f_flag & os.ST_RDONLY:
+            return f" ({folder} is on a read-only file system)"
+    except OSError:
+        return ""
+    if not os.access(folder, os.W_OK):
+        return f" (the folder {folder} is not writable: SQLite writes its journal there)"
+    if os.path.exists(loc) and not os.access(loc, os.W_OK):
+        return " (the file is not writable)"
+    return ""
 
 
 def _one_line(e: BaseException) -> str:
