@@ -403,6 +403,24 @@ def _print_budget(b: dict) -> None:
             dom_u = f" ({line['u'] * f:.3f}, {line['basis']})"
         print(f"  {name:6s} {e['value'] * f:+10.3f} {e['u_a'] * f:8.3f} {e['u_c'] * f:8.3f} "
               f"{e['expanded'] * f:8.3f} {e['k']:5.2f} {nu:>7s}  {dom}{dom_u}")
+    _print_budget_why(b)
+
+
+def _print_budget_why(b: dict) -> None:
+    """Why U can be far above type A, and what shrinks it: type B is the size each left-out
+    effect plausibly has, assumed (default sizes) until measured and given by --budget-sizes."""
+    rows = [(n, e) for n, e in b["location_errors"].items() if e["observable"] and e["type_b"] and e["u_a"] > 0]
+    if not rows:
+        return
+    name, e = max(rows, key=lambda r: r[1]["u_c"] / r[1]["u_a"])
+    if e["u_c"] < 2 * e["u_a"]:
+        return
+    line = e["type_b"][0]
+    f, unit = (1e6, "urad") if e["unit"] == "rad" else (1e3, "um")
+    print(f"  U is mostly type B: effects the fit leaves out, at plausible sizes that are assumed, not measured "
+          f"(largest on {name}: {line['effect']}, {line['u'] * f:.3f} {unit}, {line['basis']}). Measure it and "
+          f"give the value with --budget-sizes SIZES.json holding {{\"overrides\": {{\"{line['effect']}\": SIZE}}}} "
+          "(SIZE in the effect parameter's unit, mm or rad; docs/json_schema.md)")
 
 
 def _print_identification(d: dict) -> None:
@@ -578,6 +596,9 @@ def _print_history(h: dict, max_flags: int = 20) -> None:
         print(f"  {name:6s} {len(e['points']):5d} {_um(last['value'], e['unit']):>10s} "
               f"{_um(last['std'], e['unit'], False):>8s} {_um(dr.get('value'), e['unit']):>11s} "
               f"{_um(dr.get('std'), e['unit'], False):>7s} {'-' if chi is None else f'{chi:.2f}':>8s}")
+    from .history import DRIFT_SPAN_WHY, MIN_DRIFT_SPAN_DAYS
+    if any(len(e["points"]) >= 2 and e["drift_per_month"] is None for e in h["location_errors"].values()):
+        print(f"  drift '-': the calibrations span less than {MIN_DRIFT_SPAN_DAYS:g} days ({DRIFT_SPAN_WHY})")
     for c in h["corrections"]:
         amounts = ", ".join(f"{n} {_um(v, 'mm' if n[2] in 'XYZ' else 'rad')}" for n, v in c["amounts"].items())
         print(f"correction {c['at'][:10]} (entry {c['entry']}, {c['controller']}): {amounts}"

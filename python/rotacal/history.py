@@ -35,6 +35,11 @@ ENV_STORE = "ROTACAL_HISTORY"
 BUSY_TIMEOUT_S = 60.0
 # Drift is given per mean Gregorian month.
 DAYS_PER_MONTH = 365.2425 / 12
+# No drift per month from calibrations closer than this: their difference is repeatability and
+# the machine's thermal state, and a month's rate from two taken a second apart scales it by
+# 2.6 million (issue 32: -230,541,381 um/month).
+MIN_DRIFT_SPAN_DAYS = 7.0
+DRIFT_SPAN_WHY = "closer calibrations measure repeatability and warm-up, not a rate per month"
 # Coverage factor of the expanded uncertainty a change is compared with (GUM, about 95 %).
 K_EXPANDED = 2.0
 MAX_MACHINE_ID = 100
@@ -623,7 +628,8 @@ def _open_postgresql(url: str) -> CalibrationHistory:
     try:
         import psycopg
     except ImportError:
-        raise _core.Error("a PostgreSQL history store needs psycopg 3: pip install 'psycopg[binary]'") from None
+        raise _core.Error("a PostgreSQL history store needs psycopg 3: pip install 'rotacal[postgresql]' "
+                          "(or 'psycopg[binary]')") from None
     try:
         psycopg.conninfo.conninfo_to_dict(url)
     except psycopg.Error as e:
@@ -751,6 +757,8 @@ def summarize(machine_type: str, entries: Sequence[Entry], tolerances: Mapping[s
             t0 = months[points[0]["entry"]]
             drift = drift_fit([months[p["entry"]] - t0 for p in points], [p["value"] for p in points],
                               [p["std"] for p in points])
+        if drift is not None and drift["span_months"] * DAYS_PER_MONTH < MIN_DRIFT_SPAN_DAYS:
+            drift = None  # the difference of two close calibrations is not a rate per month
         errors[name] = {"unit": unit, "points": points, "steps": steps, "unobservable_in": unobservable,
                         "drift_per_month": drift}
     return {
@@ -769,7 +777,8 @@ def summarize(machine_type: str, entries: Sequence[Entry], tolerances: Mapping[s
             "change": "value minus the previous calibration's value: drift, corrections taken out",
             "expanded_uncertainty": f"{K_EXPANDED:g} * sqrt(std1^2 + std2^2)",
             "drift_per_month": f"slope of value over time, least squares weighted by 1/std^2, per "
-                               f"{DAYS_PER_MONTH:.4f} days",
+                               f"{DAYS_PER_MONTH:.4f} days; null when the calibrations span less than "
+                               f"{MIN_DRIFT_SPAN_DAYS:g} days ({DRIFT_SPAN_WHY})",
         },
     }
 
