@@ -1,6 +1,7 @@
 // core/json_text.hpp: strict JSON, bounded in nesting and in objects and arrays per byte.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <string>
 
 #include "rotacal/core/error.hpp"
@@ -67,4 +68,16 @@ TEST_CASE("syntax errors and NaN are ParseErrors with the line and column") {
     CHECK_THAT(e.what(), Catch::Contains("not valid JSON"));
   }
   CHECK_THROWS_AS(parse_json("{\"a\": 1e99999}", "big.json"), ParseError);
+}
+
+TEST_CASE("a byte that is not UTF-8 is named in printable text") {
+  // nlohmann quotes the bytes it stopped at; raw, they made the message itself undecodable.
+  try {
+    parse_json("{\"kind\": \"\xff\"}", "u.json");
+    FAIL("accepted");
+  } catch (const ParseError& e) {
+    const std::string what = e.what();
+    CHECK_THAT(what, Catch::Contains("u.json:1:") && Catch::Contains("\\xFF"));
+    CHECK(std::all_of(what.begin(), what.end(), [](char c) { return static_cast<unsigned char>(c) < 0x80; }));
+  }
 }
