@@ -158,6 +158,30 @@ def test_an_output_is_never_another_file_of_its_command(sources, tmp_path, capsy
         assert not victim.exists()
 
 
+def _output_cases():
+    return [(key, k, o) for key, templates in TEMPLATES.items() for k, t in enumerate(templates)
+            for o in SLOT.findall(" ".join(t)) if o in _roles(key)[1]]
+
+
+@pytest.mark.parametrize("where", ["a directory", "a missing folder"])
+@pytest.mark.parametrize("key,k,target", _output_cases())
+def test_an_output_in_no_place_to_write_is_refused_first(sources, tmp_path, capsys, monkeypatch, key, k, target, where):
+    monkeypatch.setattr(cli, "_serve", lambda *a: 0)
+    template = TEMPLATES[key][k]
+    ins, _ = _roles(key)
+    paths = {s: sources[s] if s in ins or s == "--db" else tmp_path / f"out{n}{s.strip('-')}"
+             for n, s in enumerate(SLOT.findall(" ".join(template)))}
+    if where == "a directory":
+        paths[target] = tmp_path / "a_folder"
+        paths[target].mkdir()
+    else:
+        paths[target] = tmp_path / "no" / "such" / "out"
+    code = cli.main(_argv(template, paths))
+    err = capsys.readouterr().err
+    assert code == EXIT_IO and target in err, err
+    assert [p.name for p in tmp_path.iterdir()] in (["a_folder"], []), "an output was written before the refusal"
+
+
 def test_simulate_rtest_default_truth_is_checked(sources, tmp_path, capsys):
     # -o m.csv writes its truth to m.truth.json: a machine description of that name is an input.
     machine = tmp_path / "m.truth.json"
