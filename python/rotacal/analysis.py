@@ -49,8 +49,8 @@ def predict_session(model: Mapping, session: Any, probe_zeros: str = "none",
         if not shift <= MAX_PIVOT_SHIFT_MM:
             raise _core.InvalidArgument(
                 f"predict: the session's pivot ({', '.join(f'{v:g}' for v in pivot)}) mm is {shift:.3f} mm from the "
-                f"model's ({', '.join(f'{v:.3f}' for v in model_pivot)}; {source}): a ballbar model predicts the set-up "
-                "it was fitted on; identify this session instead")
+                f"model's ({', '.join(f'{v:.3f}' for v in model_pivot)}; {source}): a ballbar model predicts the "
+                "set-up it was fitted on; identify this session instead")
         out = ballbar.predict(fitted, session)
         res = (np.asarray(session.length) - np.asarray(out.length)) * 1e3
         return out, f"measured - predicted: RMS {np.sqrt(np.mean(res ** 2)):.3f} um over {len(session)} samples"

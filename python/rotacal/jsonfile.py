@@ -43,7 +43,8 @@ def loads(data: Union[bytes, str], where: str) -> Any:
         raise _core.ParseError(f"{where}: not valid JSON: {e}") from None
 
 
-def read_json(path: Union[str, "os.PathLike[str]"], what: str = "", max_bytes: int = MAX_JSON_BYTES) -> tuple[Any, bytes]:
+def read_json(path: Union[str, "os.PathLike[str]"], what: str = "",
+              max_bytes: int = MAX_JSON_BYTES) -> tuple[Any, bytes]:
     """(document, bytes) of the JSON file ``path``; ``what`` (e.g. the option) prefixes its name
     in errors. IoError if it cannot be read, InvalidArgument if larger than ``max_bytes``,
     ParseError if it is not strict JSON within the bounds."""

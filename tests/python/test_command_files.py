@@ -20,7 +20,8 @@ SLOT = re.compile(r"\{([^{}]+)\}")
 TEMPLATES = {
     ("plan", "ballbar"): [["plan", "ballbar", "--machine", "{--machine}", "--compensate", "{--compensate}",
                            "--session", "{--session}", "-o", "{-o}"]],
-    ("simulate", "ballbar"): [["simulate", "ballbar", "--machine", "{--machine}", "--truth", "{--truth}", "-o", "{-o}"]],
+    ("simulate", "ballbar"): [["simulate", "ballbar", "--machine", "{--machine}", "--truth", "{--truth}",
+                               "-o", "{-o}"]],
     ("simulate", "rtest"): [["simulate", "rtest", "--machine", "{--machine}", "--truth", "{--truth}", "-o", "{-o}"]],
     ("identify",): [["identify", "{FILE}", "--budget-sizes", "{--budget-sizes}", "--controller", "{--controller}",
                      "--save-model", "{--save-model}", "--store", "--machine-id", "M1", "--db", "{--db}"]],

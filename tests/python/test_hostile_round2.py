@@ -10,7 +10,6 @@ import resource
 import sqlite3
 import subprocess
 import sys
-import time
 
 import pytest
 
@@ -78,7 +77,8 @@ def _write(path, text):
 JSON_OPTIONS = [
     ("--budget-sizes", lambda f, p: ["diagnose", f["session"], "--budget-sizes", p]),
     ("--budget-sizes", lambda f, p: ["identify", f["session"], "--budget-sizes", p]),
-    ("--correction", lambda f, p: ["history", "add", "--correction", p, "--machine-id", "M", "--db", f["dir"] / "h1.sqlite"]),
+    ("--correction", lambda f, p: ["history", "add", "--correction", p, "--machine-id", "M",
+                                   "--db", f["dir"] / "h1.sqlite"]),
     ("--diagnosis", lambda f, p: ["history", "add", f["model"], "--diagnosis", p, "--machine-id", "M",
                                   "--db", f["dir"] / "h1.sqlite"]),
     ("--table", lambda f, p: ["table2", "--table", p, "--draws", "10", "--no-sweep"]),
