@@ -1,5 +1,6 @@
 // Bindings for include/rotacal/io: session classes with numpy columns, readers and writers.
 #include "numpy.hpp"
+#include "rotacal/core/json_text.hpp"
 #include "rotacal/io/ballbar_file.hpp"
 #include "rotacal/io/model_file.hpp"
 #include "rotacal/io/output_file.hpp"
@@ -217,6 +218,9 @@ void bind_io(pyb::module_& m) {
       pyb::arg("path"), pyb::arg("inputs") = std::vector<std::string>{},
       pyb::arg("other_outputs") = std::vector<std::string>{},
       "Check an output path without writing: 'replace' or 'write-through'; raises IoError.");
+  m.def("check_json_bounds", &check_json_bounds, pyb::arg("text"), pyb::arg("source"),
+        "Refuse JSON text nested deeper than 64 levels or with more objects and arrays than its size "
+        "allows (core/json_text.hpp): ParseError naming source, line and column. The syntax is not checked.");
 }
 
 }  // namespace rotacal::py

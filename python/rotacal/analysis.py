@@ -11,6 +11,11 @@ from .diagnosis import diagnose
 from .models import ballbar_model_from_dict
 from .sessions import BALLBAR, RTEST, by_kind
 
+# A ballbar model holds the pivot where its own session's ball sat (nominal + a set-up error of
+# some 10 um): a session whose nominal pivot is farther from it was set up elsewhere, and its
+# lengths would be predicted from the wrong ball position (issue 32: 114-270 mm for a 150 mm bar).
+MAX_PIVOT_SHIFT_MM = 1.0
+
 
 def identify(session: Any, method: str = "joint", *, fit_length_offset: bool = False,
              effects: Sequence[str] = (), tests: Sequence[str] = (), noise: str = "auto") -> Any:
@@ -39,6 +44,13 @@ def predict_session(model: Mapping, session: Any, probe_zeros: str = "none",
         fitted = ballbar_model_from_dict(dict(model), source)  # refuses a model of another kind
         # A model of another machine predicts nonsense: refuse, naming both.
         _core.check_model_machine(fitted.machine, session.machine, source)
+        model_pivot, pivot = np.asarray(fitted.pivot).ravel(), np.asarray(session.pivot).ravel()
+        shift = float(np.linalg.norm(model_pivot - pivot))
+        if not shift <= MAX_PIVOT_SHIFT_MM:
+            raise _core.InvalidArgument(
+                f"predict: the session's pivot ({', '.join(f'{v:g}' for v in pivot)}) mm is {shift:.3f} mm from the "
+                f"model's ({', '.join(f'{v:.3f}' for v in model_pivot)}; {source}): a ballbar model predicts the "
+                "set-up it was fitted on; identify this session instead")
         out = ballbar.predict(fitted, session)
         res = (np.asarray(session.length) - np.asarray(out.length)) * 1e3
         return out, f"measured - predicted: RMS {np.sqrt(np.mean(res ** 2)):.3f} um over {len(session)} samples"

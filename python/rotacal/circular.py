@@ -407,10 +407,9 @@ def _planned(a: argparse.Namespace) -> Any:
 
 
 def _cmd_plan(a: argparse.Namespace) -> int:
-    from .cli import EXIT_OK, _say, check_outputs
+    from .cli import EXIT_OK, _say
     from .outputs import write_output
     from .sessions import save
-    check_outputs([a.output, a.session])
     planned = _planned(a)
     write_output(a.output, nc_program(planned, a.dialect), [], [a.session] if a.session else [])
     last = planned.runs[-1]
@@ -423,10 +422,9 @@ def _cmd_plan(a: argparse.Namespace) -> int:
 
 
 def _cmd_simulate(a: argparse.Namespace) -> int:
-    from .cli import EXIT_OK, _say, check_outputs
+    from .cli import EXIT_OK, _say
     from .outputs import write_output
     from .sessions import save
-    check_outputs([a.output, a.truth])
     planned = _planned(a)
     o, data = _machine_options(a)
     session = _core.simulate_circular(planned, o)
@@ -439,9 +437,8 @@ def _cmd_simulate(a: argparse.Namespace) -> int:
 
 
 def _cmd_virtual(a: argparse.Namespace) -> int:
-    from .cli import _faults, _serve, check_outputs
+    from .cli import _faults, _serve
     from .outputs import write_output
-    check_outputs([a.truth])
     planned = _planned(a)
     o, data = _machine_options(a)
     if a.truth:
@@ -453,8 +450,7 @@ def _cmd_virtual(a: argparse.Namespace) -> int:
 
 
 def _cmd_record(a: argparse.Namespace) -> int:
-    from .cli import _report_recording, check_outputs
-    check_outputs([a.output], [a.port])  # before the port is opened
+    from .cli import _report_recording
     planned = _planned(a)
     summary = record_ballbar(a.port, planned, a.output, baud=a.baud, zero=a.zero, silence_timeout_s=a.silence,
                              progress=not a.no_progress)
@@ -462,9 +458,8 @@ def _cmd_record(a: argparse.Namespace) -> int:
 
 
 def _cmd_analyze(a: argparse.Namespace) -> int:
-    from .cli import EXIT_OK, _say, check_outputs
+    from .cli import EXIT_OK, _say
     from .sessions import load
-    check_outputs([a.plot], [a.file])
     session = load(a.file)
     pitch = [10.0, 10.0, 10.0]
     for k, v in (a.pitch or {}).items():

@@ -15,9 +15,10 @@ from pathlib import Path
 from typing import Any, Callable, Sequence
 
 from . import _core, jsontext, rtest, units
+from .command_files import check_command_files, rtest_truth_path
 from .diagnosis import MAX_HARMONIC
 from .machines import BALLBAR_NOISE_UM, PIVOT_ERROR_MM
-from .outputs import check_output, write_output
+from .outputs import write_output
 from .sessions import BALLBAR, RTEST, by_kind, check_plausible, checked_path, load, save
 
 EXIT_OK, EXIT_USAGE, EXIT_INPUT, EXIT_IO, EXIT_ERROR = 0, 2, 3, 4, 5
@@ -97,6 +98,15 @@ def path(option: str) -> Callable[[str], str]:
 SEED = number("--seed", 0, 2**32 - 1, integer=True)
 
 
+def _run_time(text: str) -> float:
+    """design --time: 0 (the default set-up's run time) or 1 s to 24 h; the predicted sigmas
+    scale as 1/sqrt(time), so 1e-300 s printed 1e146 mm (issue 32)."""
+    v = number("--time", 0.0, 86400.0, "s")(text)
+    if 0.0 < v < 1.0:
+        raise OptionError(f"--time: {text[:40]} s is no run time (0: the default set-up's, else 1 to 86400 s)")
+    return v
+
+
 def effects_option(items: Sequence[str] | None) -> dict[str, list[float]]:
     """--effect ID=P1,P2 (repeatable) -> {id: [values]}, counts checked against the catalogue."""
     out: dict[str, list[float]] = {}
@@ -117,15 +127,6 @@ def errors_option(text: str) -> Any:
         key, _, val = item.partition("=")
         out[key.strip()] = numbers(f"--errors {key.strip()}", 1, 10.0)(val)[0]
     return out
-
-
-def check_outputs(outputs: Sequence[str | None], inputs: Sequence[str | None] = ()) -> None:
-    """Refuse, before any work, an output path the output rule refuses (rotacal.outputs): a
-    directory, a missing folder, one of the command's inputs or another of its outputs."""
-    ins = [i for i in inputs if i]
-    outs = [o for o in outputs if o]
-    for k, o in enumerate(outs):
-        check_output(o, ins, outs[:k] + outs[k + 1:])
 
 
 # ------------------------------------------------------------------------- plan and set-up
@@ -207,7 +208,6 @@ def _model(path: str | None) -> Any:
 
 def cmd_plan(a: argparse.Namespace) -> int:
     from .ballbar import nc_program
-    check_outputs([a.output, a.session], [a.compensate])
     plan, text = nc_program(_setup(a), a.dialect, _model(a.compensate), a.compensate)
     write_output(a.output, text, [a.compensate] if a.compensate else [], [a.session] if a.session else [])
     _say(f"wrote {a.output}: {a.dialect} program, {plan.num_samples} points, {plan.duration:.0f} s"
@@ -271,7 +271,6 @@ def _write_truth(truth: dict, path: str, other_outputs: Sequence[str | None] = (
 
 def cmd_simulate(a: argparse.Namespace) -> int:
     from .machines import simulate_ballbar_test
-    check_outputs([a.output, a.truth])
     setup = _setup(a)
     truth = _truth(a, setup)
     session, model = simulate_ballbar_test(setup, truth)
@@ -323,8 +322,7 @@ def _rtest_inputs(a: argparse.Namespace) -> dict:
 
 
 def cmd_simulate_rtest(a: argparse.Namespace) -> int:
-    truth_path = a.truth if a.truth else str(Path(a.output).with_suffix(".truth.json"))
-    check_outputs([a.output, truth_path])
+    truth_path = rtest_truth_path(a)
     r = _rtest_inputs(a)
     b_deg, c_deg, nests, dirs = r["b_deg"], r["c_deg"], r["nests"], r["probe_dirs"]
     if dirs is None and a.raw_only:
@@ -401,6 +399,24 @@ def _print_budget(b: dict) -> None:
             dom_u = f" ({line['u'] * f:.3f}, {line['basis']})"
         print(f"  {name:6s} {e['value'] * f:+10.3f} {e['u_a'] * f:8.3f} {e['u_c'] * f:8.3f} "
               f"{e['expanded'] * f:8.3f} {e['k']:5.2f} {nu:>7s}  {dom}{dom_u}")
+    _print_budget_why(b)
+
+
+def _print_budget_why(b: dict) -> None:
+    """Why U can be far above type A, and what shrinks it: type B is the size each left-out
+    effect plausibly has, assumed (default sizes) until measured and given by --budget-sizes."""
+    rows = [(n, e) for n, e in b["location_errors"].items() if e["observable"] and e["type_b"] and e["u_a"] > 0]
+    if not rows:
+        return
+    name, e = max(rows, key=lambda r: r[1]["u_c"] / r[1]["u_a"])
+    if e["u_c"] < 2 * e["u_a"]:
+        return
+    line = e["type_b"][0]
+    f, unit = (1e6, "urad") if e["unit"] == "rad" else (1e3, "um")
+    print(f"  U is mostly type B: effects the fit leaves out, at plausible sizes that are assumed, not measured "
+          f"(largest on {name}: {line['effect']}, {line['u'] * f:.3f} {unit}, {line['basis']}). Measure it and "
+          f"give the value with --budget-sizes SIZES.json holding {{\"overrides\": {{\"{line['effect']}\": SIZE}}}} "
+          "(SIZE in the effect parameter's unit, mm or rad; docs/json_schema.md)")
 
 
 def _print_identification(d: dict) -> None:
@@ -442,8 +458,7 @@ def _print_identification(d: dict) -> None:
 
 def cmd_identify(a: argparse.Namespace) -> int:
     from . import ballbar as _ballbar, rtest as _rtest
-    from .diagnosis import plausible_sizes, uncertainty_budget
-    check_outputs([a.save_model], [a.file])
+    from .diagnosis import uncertainty_budget
     if a.store or a.machine_id is not None:  # refused before any work
         from .history import check_machine_id, parse_date
         if not a.store:
@@ -456,7 +471,7 @@ def cmd_identify(a: argparse.Namespace) -> int:
     elif a.note is not None or a.date is not None or a.db is not None or (a.controller and not a.save_model):
         raise OptionError("--note, --date and --db go with --store --machine-id; --controller with --store or "
                           "--save-model")
-    sizes = plausible_sizes(a.budget_sizes) if a.budget_sizes else None  # refused before any work
+    sizes = _budget_sizes(a.budget_sizes)  # refused before any work
     s = _load(a.file, a)
 
     def rtest_identify():
@@ -513,29 +528,28 @@ def _controller_text(path: str | None) -> str | None:
 
 
 def _read_json(path: str, option: str) -> tuple[dict, str]:
-    """(object, sha256 of the bytes) of a JSON file: strict (no NaN), bounded, errors naming it."""
+    """(object, sha256 of the bytes) of a JSON file: strict, bounded (jsonfile), errors naming it."""
     import hashlib
-    import json
     from .exports import MAX_CURRENT_BYTES
-    if os.path.isdir(path):
-        raise _core.IoError(f"{path}: is a directory, not a file")
-    try:
-        with open(path, "rb") as f:
-            data = f.read(64 * MAX_CURRENT_BYTES + 1)
-    except OSError as e:
-        raise _core.IoError(f"{path}: cannot read: {e.strerror}") from None
-    if len(data) > 64 * MAX_CURRENT_BYTES:
-        raise _core.InvalidArgument(f"{option} {path}: larger than {64 * MAX_CURRENT_BYTES} bytes")
-
-    def refuse(c: str) -> None:
-        raise _core.ParseError(f"{option} {path}: {c} is not JSON")
-    try:
-        doc = json.loads(data.decode("utf-8"), parse_constant=refuse)
-    except (ValueError, UnicodeDecodeError) as e:
-        raise _core.ParseError(f"{option} {path}: not JSON: {e}") from None
+    from .jsonfile import read_json
+    doc, data = read_json(path, option, 64 * MAX_CURRENT_BYTES)  # a diagnosis of a long recording is large
     if not isinstance(doc, dict):
         raise _core.InvalidArgument(f"{option} {path}: expected a JSON object")
     return doc, hashlib.sha256(data).hexdigest()
+
+
+def _budget_sizes(path: str | None) -> dict | None:
+    """The --budget-sizes object, read once (bounded) and checked before any work; the budget
+    then takes the object (a second reading of the file was refused: issue 32)."""
+    if not path:
+        return None
+    from .diagnosis import plausible_sizes
+    doc, _ = _read_json(path, "--budget-sizes")
+    try:
+        plausible_sizes(doc)
+    except _core.InvalidArgument as e:
+        raise _core.InvalidArgument(f"--budget-sizes {path}: {e}") from None
+    return doc
 
 
 def _tolerances(items: Sequence[str] | None) -> dict[str, float]:
@@ -578,6 +592,9 @@ def _print_history(h: dict, max_flags: int = 20) -> None:
         print(f"  {name:6s} {len(e['points']):5d} {_um(last['value'], e['unit']):>10s} "
               f"{_um(last['std'], e['unit'], False):>8s} {_um(dr.get('value'), e['unit']):>11s} "
               f"{_um(dr.get('std'), e['unit'], False):>7s} {'-' if chi is None else f'{chi:.2f}':>8s}")
+    from .history import DRIFT_SPAN_WHY, MIN_DRIFT_SPAN_DAYS
+    if any(len(e["points"]) >= 2 and e["drift_per_month"] is None for e in h["location_errors"].values()):
+        print(f"  drift '-': the calibrations span less than {MIN_DRIFT_SPAN_DAYS:g} days ({DRIFT_SPAN_WHY})")
     for c in h["corrections"]:
         amounts = ", ".join(f"{n} {_um(v, 'mm' if n[2] in 'XYZ' else 'rad')}" for n, v in c["amounts"].items())
         print(f"correction {c['at'][:10]} (entry {c['entry']}, {c['controller']}): {amounts}"
@@ -626,8 +643,6 @@ def cmd_history_add(a: argparse.Namespace) -> int:
 def cmd_history_show(a: argparse.Namespace) -> int:
     from .history import open_history, write_plot
     tol = _tolerances(a.tolerance)
-    if a.plot:
-        check_outputs([a.plot])
     with open_history(a.db) as h:
         summary = h.show(a.machine_id, tol)
     if a.plot:
@@ -709,9 +724,8 @@ def _diagnosis_progress(a: argparse.Namespace):
 
 
 def cmd_diagnose(a: argparse.Namespace) -> int:
-    from .diagnosis import diagnose, plausible_sizes, uncertainty_budget
-    check_outputs([a.report], [a.file])
-    sizes = plausible_sizes(a.budget_sizes) if a.budget_sizes else None  # refused before any work
+    from .diagnosis import diagnose, uncertainty_budget
+    sizes = _budget_sizes(a.budget_sizes)  # refused before any work
     s = _load(a.file, a)
     bar, progress = _diagnosis_progress(a)
     try:
@@ -745,7 +759,6 @@ def cmd_design_separation(a: argparse.Namespace) -> int:
     from .design import added_setup, design_separation, parameter_units, separation_dict
     if not a.after:
         raise OptionError("--separate: give the session it follows with --after SESSION")
-    check_outputs([a.output], [a.after])
     session = _load(a.after)
     if by_kind(session, {BALLBAR: False, RTEST: True}, "--after"):
         raise OptionError(f"--after {a.after}: an R-test session; design ballbar --separate needs a ballbar session")
@@ -789,7 +802,6 @@ def cmd_design_ballbar(a: argparse.Namespace) -> int:
     if a.after:
         raise OptionError("--after: goes with --separate EFFECT,EFFECT")
     a.noise = 0.5 if a.noise is None else a.noise
-    check_outputs([a.output])
     d = design_ballbar(_setup(a), lengths=a.lengths, pivot_x=a.pivot_x, pivot_z=a.pivot_z, travel=a.travel,
                        time_s=a.time, rate_hz=a.rate, noise_um=a.noise, rho=a.rho,
                        effects=[e.strip() for e in a.effects.split(",")] if a.effects else [])
@@ -894,7 +906,6 @@ def cmd_export(a: argparse.Namespace) -> int:
         raise _core.InvalidArgument("--comp-file: rotary compensation tables are written for linuxcnc")
     if bool(a.centres) != bool(a.centres_output) or (a.centres and a.controller != "isg"):
         raise _core.InvalidArgument("--centres and --centres-output go together, with --controller isg")
-    check_outputs([a.output, a.residual_model, a.centres_output, *comp.values()], [a.model, a.current, a.centres])
     ex = export_controller(a.model, a.controller, current=a.current, toolholder=a.toolholder)
     tables = {axis: linuxcnc_comp_table(load_model(a.model), axis, *a.comp_range, a.comp_step) for axis in comp}
     if a.centres:
@@ -927,7 +938,6 @@ def cmd_export(a: argparse.Namespace) -> int:
 def cmd_predict(a: argparse.Namespace) -> int:
     from .analysis import predict_session
     from .models import load_model
-    check_outputs([a.output], [a.session, a.model])
     model_dict = load_model(a.model)
     s = _load(a.session, a)
     out, line = predict_session(model_dict, s, a.probe_zeros, source=a.model)
@@ -948,8 +958,6 @@ def _print_compensation(rows: list[dict]) -> None:
 def cmd_compensate(a: argparse.Namespace) -> int:
     if not a.model and not a.verify:
         raise OptionError("compensate: give --model MODEL.json (write a program) and/or --verify")
-    if a.model:
-        check_outputs([a.output], [a.model])
     setup = _setup(a)
     from .ballbar import nc_program, verify_compensation
     if a.model:
@@ -969,13 +977,16 @@ def cmd_compensate(a: argparse.Namespace) -> int:
 
 def cmd_report(a: argparse.Namespace) -> int:
     from .analysis import write_report
-    check_outputs([a.output], [a.file])
-    extra = []
+    extra, history = [], None
     if a.history:
         from .history import history_section, open_history
         with open_history(a.db) as h:  # an unknown machine id is refused before the fit
-            extra.append(history_section(h.show(a.history)))
+            history = h.show(a.history)
+        extra.append(history_section(history))
     s = _load(a.file, a)
+    if history is not None and history["machine_type"] != _core.machine_name(s.machine):
+        raise _core.InvalidArgument(f"--history {a.history}: a {history['machine_type']} in the store, but {a.file} "
+                                    f"is a session of a {_core.machine_name(s.machine)}: not the same machine")
     from .circular import analyze as analyze_circular, is_circular
     if is_circular(s):  # ISO 230-4 runs of the linear axes: their own report
         from .report import circular_report
@@ -1091,13 +1102,15 @@ def _report_recording(summary, path: str, json_out: bool) -> int:
         print(jsontext.dumps({k: getattr(summary, k) for k in ("rows", "frames", "lost", "crc_errors", "malformed",
                                                                   "garbage_bytes", "over_range", "timeouts",
                                                                   "outside_window", "reason", "detail")} | {"path": path}, indent=None))
+    if summary.rows == 0:  # nothing measured: the recorder left an existing file as it was
+        _say(f"rotacal: {path} not written, no row was recorded: {summary.describe()}")
+        return EXIT_IO
     _say(f"wrote {path}: {summary.describe()}")
     return _RECORD_EXIT[summary.reason]
 
 
 def cmd_record_ballbar(a: argparse.Namespace) -> int:
     from .instruments import record_ballbar
-    check_outputs([a.output], [a.port])  # before the port is opened
     plan = _core.plan_ballbar_test(_setup(a), None)
     summary = record_ballbar(a.port, plan, a.output, baud=a.baud, rate_hz=a.rate, zero=a.zero,
                              silence_timeout_s=a.silence, progress=not a.no_progress)
@@ -1106,7 +1119,6 @@ def cmd_record_ballbar(a: argparse.Namespace) -> int:
 
 def cmd_record_rtest(a: argparse.Namespace) -> int:
     from .instruments import record_rtest, rtest_program
-    check_outputs([a.output], [a.port])  # before the port is opened
     r = _rtest_inputs(a)
     program = rtest_program(r["machine"], r["b_deg"], r["c_deg"], r["nests"], r["dwell_s"])
     summary = record_rtest(a.port, program, a.output, mode=a.mode, dwell_s=r["dwell_s"], probe_dirs=r["probe_dirs"],
@@ -1282,7 +1294,7 @@ def build_parser() -> argparse.ArgumentParser:
     k.add_argument("--travel", type=numbers("--travel", 6, 1e5, "mm"),
                    help="xmin,xmax,ymin,ymax,zmin,zmax of X, Y, Z about the rotary axes' intersection, mm "
                         "(default -400,400,-300,300,-300,400)")
-    k.add_argument("--time", type=number("--time", 0.0, 86400.0, "s"), default=0.0,
+    k.add_argument("--time", type=_run_time, default=0.0,
                    help="run time to compare at, s (default: the default set-up's)")
     k.add_argument("--rate", type=number("--rate", 0.0, 1e5, "Hz", lo_open=True), default=100.0,
                    help="the recorder's sample rate, Hz (default 100)")
@@ -1325,7 +1337,7 @@ def build_parser() -> argparse.ArgumentParser:
     k.add_argument("--travel", type=numbers("--travel", 6, 1e5, "mm"),
                    help="xmin,xmax,ymin,ymax,zmin,zmax of X, Y, Z about the rotary axes' intersection, mm "
                         "(default -400,400,-300,300,-300,400)")
-    k.add_argument("--time", type=number("--time", 0.0, 86400.0, "s"), default=0.0,
+    k.add_argument("--time", type=_run_time, default=0.0,
                    help="run time to compare at, s (default: the default pattern's)")
     k.add_argument("--dwell", type=number("--dwell", 0.0, 3600.0, "s", lo_open=True),
                    help="time per pose, s (default 6)")
@@ -1559,10 +1571,19 @@ def main(argv: Sequence[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     try:
         args = build_parser().parse_args(_join_signed_values(argv))
-        return args.func(args)
+        check_command_files(args)  # every output against every input and output, before any work
+        code = args.func(args)
+        sys.stdout.flush()  # a reader that went away is seen here, inside the handlers below
+        return code
     except (OptionError, _core.ParseError, _core.InvalidArgument, _core.DegenerateGeometry) as e:
         _say(f"rotacal: error: {_message(e)}")
         return EXIT_INPUT
+    except BrokenPipeError:  # `rotacal history show M | head`: the reader has what it wanted
+        try:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error at exit
+        except OSError:
+            pass
+        return EXIT_OK
     except UnicodeError as e:  # text that is not UTF-8 where the reader did not say so itself
         _say(f"rotacal: error: input is not UTF-8 text: {_message(e)}")
         return EXIT_INPUT

@@ -12,7 +12,6 @@ the paper is used but Table 2 (data/flynn2016_table2.json); every other number i
 """
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
@@ -54,13 +53,11 @@ def load_table2(path: str | Path | None = None, reading: str = "printed") -> dic
     Raises rotacal.IoError if the file cannot be read, rotacal.ParseError if it is not the
     table, rotacal.InvalidArgument for a value that is not a number.
     """
+    from .jsonfile import read_json
     p = Path(path) if path is not None else TABLE2_PATH
-    try:
-        d = json.loads(p.read_text())
-    except OSError as e:
-        raise _core.IoError(f"{p}: cannot read Table 2: {e}") from None
-    except json.JSONDecodeError as e:
-        raise _core.ParseError(f"{p}:{e.lineno}:{e.colno}: {e.msg}") from None
+    d, _ = read_json(p)  # strict and bounded: deep nesting is a ParseError, not a RecursionError
+    if not isinstance(d, dict):
+        raise _core.ParseError(f"{p}: Table 2 is a JSON object with 'rows'")
     if reading not in ("printed", "percent_consistent"):
         raise _core.InvalidArgument(f"load_table2: reading must be 'printed' or 'percent_consistent', got {reading!r}")
     rows = d.get("rows")

@@ -35,9 +35,17 @@ ENV_STORE = "ROTACAL_HISTORY"
 BUSY_TIMEOUT_S = 60.0
 # Drift is given per mean Gregorian month.
 DAYS_PER_MONTH = 365.2425 / 12
+# No drift per month from calibrations closer than this: their difference is repeatability and
+# the machine's thermal state, and a month's rate from two taken a second apart scales it by
+# 2.6 million (issue 32: -230,541,381 um/month).
+MIN_DRIFT_SPAN_DAYS = 7.0
+DRIFT_SPAN_WHY = "closer calibrations measure repeatability and warm-up, not a rate per month"
 # Coverage factor of the expanded uncertainty a change is compared with (GUM, about 95 %).
 K_EXPANDED = 2.0
 MAX_MACHINE_ID = 100
+# The largest location error a model file may hold (io/model_file.hpp, kMaxModelPositionError
+# and kMaxModelAngleError): a correction beyond it is a typo or wrong units, not a machine.
+MAX_ERROR = {"mm": 100.0, "rad": 0.5}
 MAX_NOTE = 2000
 
 IDENTIFICATION, CORRECTION = "identification", "correction"
@@ -225,6 +233,10 @@ def correction_amounts(export: Mapping[str, Any], where: str = "<export>") -> di
             continue  # not loaded, or unobservable (the export leaves it at its current value)
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
             raise _core.InvalidArgument(f"{where}: location_errors[{i}].value: must be a finite number, got {v!r}")
+        limit = MAX_ERROR.get(unit_of(e["name"]))
+        if limit is not None and abs(v) > limit:
+            raise _core.InvalidArgument(f"{where}: location_errors[{i}].value: {v:g} {unit_of(e['name'])} is beyond "
+                                        f"+-{limit:g}: no machine tool has such a location error")
         out[e["name"]] = float(v)
     if not out:
         raise _core.InvalidArgument(f"{where}: the export holds none of the location errors: no correction to record")
@@ -316,7 +328,12 @@ class CalibrationHistory:
                     f"{', '.join(sorted(tables)[:5])})")
             return None
         row = self._x("SELECT MAX(version) FROM rotacal_history_schema").fetchone()
-        return int(row[0]) if row and row[0] is not None else 0
+        if not row or row[0] is None:
+            return 0
+        if isinstance(row[0], bool) or not isinstance(row[0], int) or row[0] < 1:
+            raise _core.InvalidArgument(f"{redact(self.location)}: schema version {str(row[0])[:40]!r} is not one "
+                                        f"rotacal writes (1 .. {SCHEMA_VERSION}): not a rotacal history store")
+        return row[0]
 
     def _migrate(self) -> None:
         with self._errors():
@@ -533,6 +550,8 @@ def open_history(location: str | None = None, create_folder: bool | None = None)
             raise _core.IoError(f"{loc}: the folder {folder} does not exist")
     if Path(loc).is_dir():
         raise _core.IoError(f"{loc}: is a directory, not a history store")
+    if Path(loc).exists() and not Path(loc).is_file():  # SQLite would create loc-journal beside /dev/null
+        raise _core.IoError(f"{loc}: is a device or FIFO, not a history store (a SQLite file)")
     try:
         conn = sqlite3.connect(loc, timeout=BUSY_TIMEOUT_S, isolation_level=None, check_same_thread=False)
     except sqlite3.Error as e:
@@ -555,13 +574,40 @@ def open_history(location: str | None = None, create_folder: bool | None = None)
     except sqlite3.DatabaseError as e:
         conn.close()
         if isinstance(e, sqlite3.OperationalError) and ("locked" in str(e) or "readonly" in str(e)):
-            raise _core.IoError(f"{loc}: {e}") from None
+            raise _core.IoError(f"{loc}: {e}{_why_not_writable(loc)}") from None
+        if _is_sqlite_file(loc):  # a valid store that cannot be opened: the file system's doing
+            raise _core.IoError(f"{loc}: cannot open the history store: {e}{_why_not_writable(loc)}") from None
         raise _core.InvalidArgument(f"{loc}: not a rotacal history store (not an SQLite database: {e})") from None
     try:
         return CalibrationHistory(conn, SQLITE, loc)
     except BaseException:
         conn.close()
         raise
+
+
+def _is_sqlite_file(loc: str) -> bool:
+    """Whether the file starts with the SQLite header (or is empty: SQLite makes it a database)."""
+    try:
+        with open(loc, "rb") as f:
+            head = f.read(16)
+    except OSError:
+        return False
+    return head in (b"", b"SQLite format 3\x00")
+
+
+def _why_not_writable(loc: str) -> str:
+    """The cause, when the store's folder or file cannot be written (a store writes beside itself)."""
+    folder = str(Path(loc).parent)
+    try:
+        if os.statvfs(folder).f_flag & os.ST_RDONLY:
+            return f" ({folder} is on a read-only file system)"
+    except OSError:
+        return ""
+    if not os.access(folder, os.W_OK):
+        return f" (the folder {folder} is not writable: SQLite writes its journal there)"
+    if os.path.exists(loc) and not os.access(loc, os.W_OK):
+        return " (the file is not writable)"
+    return ""
 
 
 def _one_line(e: BaseException) -> str:
@@ -582,7 +628,8 @@ def _open_postgresql(url: str) -> CalibrationHistory:
     try:
         import psycopg
     except ImportError:
-        raise _core.Error("a PostgreSQL history store needs psycopg 3: pip install 'psycopg[binary]'") from None
+        raise _core.Error("a PostgreSQL history store needs psycopg 3: pip install 'rotacal[postgresql]' "
+                          "(or 'psycopg[binary]')") from None
     try:
         psycopg.conninfo.conninfo_to_dict(url)
     except psycopg.Error as e:
@@ -710,6 +757,8 @@ def summarize(machine_type: str, entries: Sequence[Entry], tolerances: Mapping[s
             t0 = months[points[0]["entry"]]
             drift = drift_fit([months[p["entry"]] - t0 for p in points], [p["value"] for p in points],
                               [p["std"] for p in points])
+        if drift is not None and drift["span_months"] * DAYS_PER_MONTH < MIN_DRIFT_SPAN_DAYS:
+            drift = None  # the difference of two close calibrations is not a rate per month
         errors[name] = {"unit": unit, "points": points, "steps": steps, "unobservable_in": unobservable,
                         "drift_per_month": drift}
     return {
@@ -728,7 +777,8 @@ def summarize(machine_type: str, entries: Sequence[Entry], tolerances: Mapping[s
             "change": "value minus the previous calibration's value: drift, corrections taken out",
             "expanded_uncertainty": f"{K_EXPANDED:g} * sqrt(std1^2 + std2^2)",
             "drift_per_month": f"slope of value over time, least squares weighted by 1/std^2, per "
-                               f"{DAYS_PER_MONTH:.4f} days",
+                               f"{DAYS_PER_MONTH:.4f} days; null when the calibrations span less than "
+                               f"{MIN_DRIFT_SPAN_DAYS:g} days ({DRIFT_SPAN_WHY})",
         },
     }
 

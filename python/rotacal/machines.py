@@ -57,7 +57,14 @@ def load_machine(machine: Any) -> _core.MachineType:
         text = data.decode("utf-8")
     except UnicodeDecodeError as e:
         raise _core.InvalidArgument(f"{path}: not UTF-8 text (byte {e.start + 1})") from None
-    return _core.MachineType.from_description(text, path)
+    m = _core.MachineType.from_description(text, path)
+    name = _core.machine_name(m)
+    if not m.is_builtin and name in _core.builtin_machine_names():
+        # Sessions, models and the history know a machine by its name: this one would be taken
+        # for the built-in (its history merged into the built-in's).
+        raise _core.InvalidArgument(f"{path}: name: '{name}' is a built-in machine's, whose kinematics differ from "
+                                    "this description's: give the machine a name of its own")
+    return m
 
 
 def machine_dict(machine: Any) -> dict:

@@ -14,6 +14,10 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kRad = 180.0 / kPi;
+// The shortest data arc whose circle is determined: the least-squares centre of an arc of
+// span s moves ~ noise / (1 - cos(s/2)) along its bisector, so a 2-5 deg arc (issue 32) put the
+// centre millimetres off and the radius deviation hundreds of um while looking like a result.
+constexpr double kMinCircularSpanDeg = 30.0;
 
 // "circular_XY_ccw[_suffix]" -> plane, direction, suffix; false if not "circular_".
 bool parse_label(const std::string& label, CircularPlane* plane, CircularDirection* dir,
@@ -173,6 +177,11 @@ CircularAnalysis analyze_circular(const BallbarSession& session) {
       out.ignored_tests.push_back(t);
   std::vector<Points2> points;
   for (const CircularRunData& r : runs) {
+    if (!(r.span_deg() >= kMinCircularSpanDeg))
+      throw InvalidArgument("test " + r.label + ": its data arc spans " + std::to_string(r.span_deg()).substr(0, 6) +
+                            " deg; an arc shorter than " + std::to_string(static_cast<int>(kMinCircularSpanDeg)) +
+                            " deg cannot determine the circle's centre (ISO 230-4: a full circle, or a partial "
+                            "arc of a few tens of degrees at least)");
     points.push_back(run_points(r, L0));
     const RadialFit f = lsq_circle(points.back(), "test " + r.label);
     const std::vector<double> rad = radial(points.back(), f);

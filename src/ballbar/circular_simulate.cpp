@@ -139,7 +139,7 @@ BallbarSession simulate_circular(const CircularPlanResult& plan,
     for (std::size_t i = 0; i < session.samples.size(); ++i)
       session.samples[i].length += n[static_cast<Eigen::Index>(i)];
   }
-  session.noise_um = o.noise_um;
+  if (o.noise_um > 0.0) session.noise_um = o.noise_um;  // noiseless: none declared (a 1-sigma of 0 is refused)
   return session;
 }
 

@@ -37,7 +37,9 @@ BallbarSession simulate_ballbar(const BallbarSession& commanded, const BallbarMa
   std::normal_distribution<double> noise(0.0, options.noise_um * 1e-3);
   for (std::size_t i = 0; i < L.size(); ++i)
     out.samples[i].length = L[i] + (options.noise_um > 0 ? noise(rng) : 0.0);
-  if (options.declare_noise) {
+  // A noiseless simulation declares no noise: a 1-sigma of 0 would give each reading infinite
+  // weight, and the session readers refuse it (the fit then takes the residuals' scatter).
+  if (options.declare_noise && options.noise_um > 0.0) {
     out.noise_um = options.noise_um;
     bool found = false;
     for (auto& kv : out.metadata)

@@ -269,7 +269,9 @@ bool read_stream(ByteTransport& port, const RecordOptions& opt, bool zero, Write
 }
 
 // Runs a recording into `out`: whatever stops it (the end, a stop request, an unplugged
-// device), the file is closed with its summary line and keeps every row written.
+// device), the file is closed with its summary line and keeps every row written. A recording
+// that ends with no row measured nothing: the target is left as it was (a previous session
+// of that name stays), as after any failed write.
 template <typename Writer, typename Body>
 RecordSummary run_recording(ByteTransport& port, Writer& out, Body body) {
   RecordSummary sum;
@@ -279,8 +281,15 @@ RecordSummary run_recording(ByteTransport& port, Writer& out, Body body) {
   } catch (const DeviceDisconnected& e) {
     sum.reason = StopReason::disconnected;
     sum.detail = e.what();
+  } catch (...) {
+    if (out.rows() == 0) out.discard();
+    throw;
   }
   sum.rows = out.rows();
+  if (sum.rows == 0) {
+    out.discard();
+    return sum;
+  }
   out.annotate("summary: " + sum.describe());
   out.close();
   return sum;

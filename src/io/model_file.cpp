@@ -11,6 +11,7 @@
 #include <set>
 
 #include "rotacal/core/error.hpp"
+#include "rotacal/core/json_text.hpp"
 
 namespace rotacal {
 
@@ -173,19 +174,6 @@ void probe_zeros(const json& doc, const std::string& source) {
   }
 }
 
-std::pair<int, int> line_column(const std::string& text, std::size_t byte) {
-  int line = 1, col = 1;
-  for (std::size_t i = 0; i < byte && i < text.size(); ++i) {
-    if (text[i] == '\n') {
-      ++line;
-      col = 1;
-    } else {
-      ++col;
-    }
-  }
-  return {line, col};
-}
-
 void nullify(json& v, const std::string& pointer, json& reasons) {
   if (v.is_number_float()) {
     const double x = v.get<double>();
@@ -242,25 +230,6 @@ void put_machine(json& doc, MachineType m) {
   doc["machine"] = to_string(m);
   if (m != MachineType::AC_trt && m != MachineType::BC_trt)
     doc["machine_description"] = json::parse(machine_description_json(m.description()));
-}
-
-json parse_json(const std::string& text, const std::string& source) {
-  try {
-    // Strict RFC 8259: NaN/Infinity tokens, comments and trailing commas are syntax errors.
-    return json::parse(text);
-  } catch (const json::parse_error& e) {
-    const auto lc = line_column(text, e.byte > 0 ? e.byte - 1 : 0);
-    std::string what = e.what();
-    const std::size_t colon = what.find("syntax error");
-    if (colon != std::string::npos) what = what.substr(colon);
-    if (what.size() > 160) what = what.substr(0, 157) + "...";
-    throw ParseError(source, lc.first, lc.second, "not valid JSON: " + what);
-  } catch (const json::exception& e) {
-    // e.g. out_of_range 406, a number beyond double ("1e99999"): found by fuzz_file_readers.
-    std::string what = e.what();
-    if (what.size() > 160) what = what.substr(0, 157) + "...";
-    throw ParseError(source, 0, 0, "not valid JSON: " + what);
-  }
 }
 
 std::string read_text(const std::string& path) {

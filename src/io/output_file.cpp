@@ -284,6 +284,13 @@ void OutputStream::write(const std::string& text) {
   write_all(fd_, text, path_);
 }
 
+void OutputStream::discard() {
+  if (fd_ < 0) return;
+  ::close(fd_);
+  fd_ = -1;
+  if (!temporary_.empty()) ::unlink(temporary_.c_str());
+}
+
 void OutputStream::commit() {
   if (fd_ < 0) return;
   const int fd = fd_;

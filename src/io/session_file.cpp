@@ -836,6 +836,11 @@ void BallbarWriter::close() {
   std::unique_ptr<OutputStream> f = std::move(file_);
   f->commit();
 }
+void BallbarWriter::discard() {
+  if (!file_) return;
+  std::unique_ptr<OutputStream> f = std::move(file_);
+  f->discard();
+}
 
 RtestWriter::RtestWriter(const std::string& path, const RtestSession& header, bool raw, const OutputOptions& options)
     : path_(path), machine_(header.machine), raw_(raw), extra_(header.extra_columns.size()) {
@@ -857,6 +862,11 @@ void RtestWriter::close() {
   if (!file_) return;
   std::unique_ptr<OutputStream> f = std::move(file_);
   f->commit();
+}
+void RtestWriter::discard() {
+  if (!file_) return;
+  std::unique_ptr<OutputStream> f = std::move(file_);
+  f->discard();
 }
 
 }  // namespace rotacal

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "rotacal/core/error.hpp"
+#include "rotacal/core/json_text.hpp"
 
 namespace rotacal {
 
@@ -23,7 +24,7 @@ RotaryAxis make_rotary_axis(char name, const Eigen::Vector3d& direction,
                             const std::string& where) {
   if (!direction.allFinite() || !point.allFinite())
     throw InvalidArgument(where + ": direction and point must be finite numbers");
-  const double len = direction.norm();
+  const double len = direction.stableNorm();  // norm() overflows for [1e200, 1e200, 0]: then 0 after dividing
   if (!(len > 1e-9)) throw InvalidArgument(where + ".direction is zero: an axis needs a direction");
   RotaryAxis a;
   a.name = name;
@@ -174,9 +175,9 @@ std::vector<RotaryAxis> axes(const json& doc, const char* key, bool on_head, con
 MachineDescription parse_machine_description(const std::string& json_text, const std::string& source) {
   json doc;
   try {
-    doc = json::parse(json_text);
-  } catch (const json::exception& e) {  // syntax, and numbers beyond double (1e999)
-    throw InvalidArgument(source + ": not valid JSON (" + std::string(e.what()).substr(0, 160) + ")");
+    doc = parse_json(json_text, source);  // strict, bounded in depth and size (core/json_text.hpp)
+  } catch (const ParseError& e) {  // syntax, depth, and numbers beyond double (1e999)
+    throw InvalidArgument(e.what());
   }
   if (!doc.is_object()) throw InvalidArgument(source + ": a machine description is a JSON object");
   if (!doc.contains("format") || doc["format"] != "rotacal-machine/1")

@@ -66,6 +66,21 @@ class Ar1Whitener : public ResidualWhitener {
   std::vector<std::vector<Eigen::Index>> streams_;
 };
 
+// BC-trt with the design's travel and B limits: the user's machine, which may be larger than
+// the built-in description, whose travel would refuse the readings of a pattern the design
+// allows (issue 32: --travel could not widen it).
+MachineType design_machine(const RtestDesignOptions& o) {
+  MachineDescription d = MachineType(MachineType::BC_trt).description();
+  d.name = "BC-trt within the design's travel";
+  Eigen::Matrix<double, 3, 2> travel;
+  travel.col(0) = o.travel_min;
+  travel.col(1) = o.travel_max;
+  d.travel_mm = travel;
+  for (RotaryAxis& a : d.table_axes)
+    if (a.name == 'B') a.limits_deg = o.b_limits_deg;
+  return MachineType::from_description(d);
+}
+
 // min, min + step, ..., up to max (the end added when off the grid).
 std::vector<double> steps(double lo, double hi, double step) {
   std::vector<double> v;
@@ -115,11 +130,12 @@ RtestDesignCandidate evaluate_rtest_design(const RtestPattern& pattern, const Rt
   sim.probe_zero_um = 0.0;
   RtestSession s;
   try {
-    s = simulate_rtest(MachineModel::nominal(m), sim).session;
+    s = simulate_rtest(MachineModel::nominal(design_machine(o)), sim).session;
   } catch (const InvalidArgument& e) {
     c.why_not = e.what();
     return c;
   }
+  s.machine = m;  // the same readings: the fit is of the BC-trt error model
   s.noise_um = o.noise_um;  // the fit's chi-square scale (observability), as a recorder declares it
   RtestJointOptions fit;
   fit.basis = o.basis;

@@ -111,7 +111,7 @@ RtestSimulation simulate_rtest(const MachineModel& truth, const RtestSimOptions&
   RtestSimulation out;
   RtestSession& s = out.session;
   s.machine = truth.machine;
-  s.noise_um = o.noise_um;
+  if (o.noise_um > 0.0) s.noise_um = o.noise_um;  // noiseless: none declared (a 1-sigma of 0 is refused)
   s.metadata = {{"format", "rotacal-rtest/1"}, {"machine", to_string(truth.machine)},
                 {"units", "mm, deg, s"}};
   for (std::size_t n = 0; n < o.pattern.nests.size(); ++n) {
@@ -127,7 +127,7 @@ RtestSimulation simulate_rtest(const MachineModel& truth, const RtestSimOptions&
       s.metadata.push_back({"probe." + std::to_string(k + 1) + ".dir",
                             fmt(u.x(), 6) + ", " + fmt(u.y(), 6) + ", " + fmt(u.z(), 6)});
     }
-  s.metadata.push_back({"noise_um", fmt(o.noise_um, 4)});
+  if (o.noise_um > 0.0) s.metadata.push_back({"noise_um", fmt(o.noise_um, 4)});
 
   double t = 0.0;
   for (std::size_t n = 0; n < o.pattern.nests.size(); ++n) {

@@ -158,11 +158,23 @@ TEST_CASE("ballbar: a host at the wrong baud rate gets no valid data and says so
   CHECK(run.summary.reason == StopReason::no_valid_data);
   CHECK_THAT(run.summary.detail, Catch::Contains("baud"));
   CHECK(run.summary.rows == 0);
-  // The file holds the header and the reason; the reader refuses it for having no rows.
-  CHECK_THROWS_WITH(read_ballbar(run.path), Catch::Contains("no data rows"));
-  std::ifstream in(run.path);
+  // Nothing measured, nothing written: the reason is in the summary.
+  CHECK_FALSE(std::filesystem::exists(run.path));
+}
+
+TEST_CASE("ballbar: a recording with no row leaves the previous file as it was", "[hw]") {
+  // Issue 32: an instrument that never answers replaced a 1,804-row session with an empty file.
+  const std::string path = temp_file("previous.csv");
+  { std::ofstream(path) << "the previous session\n"; }
+  SerialSettings host;
+  host.baud = 9600;
+  const BallbarRun run = run_ballbar("previous.csv", {}, 100.0, host, {}, 1.0);
+  CHECK(run.summary.rows == 0);
+  std::ifstream in(path);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  CHECK_THAT(text, Catch::Contains("# summary: 0 rows") && Catch::Contains("wrong baud rate"));
+  CHECK(text == "the previous session\n");
+  for (const auto& e : std::filesystem::directory_iterator(std::filesystem::path(path).parent_path()))
+    CHECK(e.path().extension() != ".part");
 }
 
 TEST_CASE("ballbar: the progress callback stops the recording (Ctrl-C)", "[hw]") {

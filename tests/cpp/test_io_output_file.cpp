@@ -245,6 +245,22 @@ TEST_CASE("a stream (a recording) replaces the target when it ends, however it e
   CHECK(slurp(d / "rec.csv") == "again\n");
 }
 
+TEST_CASE("a discarded stream leaves the target as it was and nothing behind") {
+  // A recording that measured nothing (issue 32) must not replace the previous file.
+  TempDir d;
+  put(d / "rec.csv", "previous recording\n");
+  OutputStream out(d / "rec.csv");
+  out.write("# header only\n");
+  out.discard();
+  out.discard();  // a second discard does nothing
+  out.commit();   // nor does a commit after it
+  CHECK(slurp(d / "rec.csv") == "previous recording\n");
+  CHECK(d.entries() == std::vector<std::string>{"rec.csv"});
+  OutputStream fresh(d / "new.csv");
+  fresh.discard();
+  CHECK(d.entries() == std::vector<std::string>{"rec.csv"});
+}
+
 TEST_CASE("a stream refuses its inputs and writes devices through") {
   TempDir d;
   put(d / "port", "not a port");

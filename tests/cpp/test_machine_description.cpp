@@ -88,6 +88,18 @@ TEST_CASE("an axis along -X keeps the meaning of its error names", "[machine_des
   CHECK(plus.error_names == minus.error_names);
 }
 
+TEST_CASE("a huge direction is normalised, not overflowed to zero", "[machine_description]") {
+  // Issue 32: [1e200, 1e200, 0] had norm() = inf, so direction / norm was the zero vector.
+  const RotaryAxis a = make_rotary_axis('A', Eigen::Vector3d(1e200, 0, 0), Eigen::Vector3d::Zero(), false, std::nullopt, "t");
+  CHECK(a.direction == Eigen::Vector3d::UnitX());
+  CHECK(a.principal == 0);
+  const RotaryAxis u = make_rotary_axis('B', Eigen::Vector3d(1e200, 1e200, 0), Eigen::Vector3d::Zero(), false, std::nullopt, "t");
+  CHECK(std::abs(u.direction.norm() - 1.0) < 1e-15);
+  CHECK(std::abs(u.direction.x() - std::sqrt(0.5)) < 1e-15);
+  CHECK_THROWS_AS(make_rotary_axis('A', Eigen::Vector3d(1e-300, 0, 0), Eigen::Vector3d::Zero(), false, std::nullopt, "t"),
+                  InvalidArgument);
+}
+
 TEST_CASE("a description written out for AC-trt and BC-trt moves exactly like the built-in", "[machine_description]") {
   std::mt19937 rng(7);
   for (MachineType b : {MachineType::AC_trt, MachineType::BC_trt}) {

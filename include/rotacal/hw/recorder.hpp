@@ -4,6 +4,8 @@
 /// Every row is flushed before the next read, so stopping (Ctrl-C, crash, unplug) never loses
 /// what was read. Lost, corrupt and garbled data are counted and marked in the file with `#`
 /// lines (`# gap: ...`, `# corrupt: ...`), never silently skipped.
+/// A recording that ends with no row (an instrument that never answers) writes nothing: a
+/// previous file at the path is left as it was (RecordSummary::rows is 0).
 
 #include <Eigen/Core>
 #include <functional>
@@ -69,7 +71,7 @@ struct RecordOptions {
 
 /// Record a ballbar test. Rows get the commanded pose of `program` at each sample's time and
 /// length = L0 + displacement. Metadata names the port; stops at END, on the callback's
-/// request, on disconnect or silence, always leaving a valid file at `path`.
+/// request, on disconnect or silence, leaving a valid file at `path` if a row was read.
 RecordSummary record_ballbar(ByteTransport& port, const ProgramTimeline& program,
                              const std::string& path, const RecordOptions& options = {});
 /// The same for an ISO 230-4 circular program: rows on a data arc get the run's label

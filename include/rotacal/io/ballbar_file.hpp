@@ -65,6 +65,8 @@ class BallbarWriter {
   /// Where the rows are while the writer is open (io/output_file.hpp, OutputStream).
   std::string writing_path() const { return file_ ? file_->writing_path() : path_; }
   void close();
+  /// Close without replacing the target (OutputStream::discard): the old file stays.
+  void discard();
 
  private:
   std::unique_ptr<OutputStream> file_;
@@ -89,6 +91,8 @@ class RtestWriter {
   /// Where the rows are while the writer is open (io/output_file.hpp, OutputStream).
   std::string writing_path() const { return file_ ? file_->writing_path() : path_; }
   void close();
+  /// Close without replacing the target (OutputStream::discard): the old file stays.
+  void discard();
 
  private:
   std::unique_ptr<OutputStream> file_;

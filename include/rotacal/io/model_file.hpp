@@ -29,8 +29,9 @@ namespace rotacal {
 inline constexpr const char* kModelFormat = "rotacal-model/1";
 inline constexpr int kModelFormatMajor = 1;
 
-/// Largest model file read (bytes): a model is a few hundred kB at most.
-inline constexpr std::size_t kMaxModelFileBytes = 64u << 20;
+/// Largest model file read (bytes): a model is a few hundred kB at most (a covariance of 200
+/// parameters is 1 MB); with the bounds of core/json_text.hpp it parses within ~0.5 GB.
+inline constexpr std::size_t kMaxModelFileBytes = 16u << 20;
 
 /// Limits on a model's values beyond which it cannot describe a machine tool (a typo, wrong
 /// units, or a broken fit): position errors mm, orientation errors rad, pivot mm.

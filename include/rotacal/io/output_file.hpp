@@ -16,8 +16,10 @@
 ///   produced (the content is produced before anything is opened).
 /// - A file written as it comes (OutputStream, the recorders) follows the same rule: its rows
 ///   go to the temporary file, which replaces the target when the stream ends, however it ends
-///   (a recording's rows are measurements that cannot be taken again). Only a process that is
-///   killed leaves its rows behind, in the hidden `.rotacal-<hex>.part` of the target's folder.
+///   (a recording's rows are measurements that cannot be taken again), unless the writer
+///   discards it (a recording that ended with no row: the old file stays, as after any failed
+///   write). Only a process that is killed leaves its rows behind, in the hidden
+///   `.rotacal-<hex>.part` of the target's folder.
 
 #include <functional>
 #include <string>
@@ -60,6 +62,9 @@ class OutputStream {
   OutputStream& operator=(const OutputStream&) = delete;
   void write(const std::string& text);  ///< throws IoError naming the path
   void commit();                        ///< fsync, rename over the target; throws IoError
+  /// Close without touching the target: the temporary file is removed (a device written
+  /// through keeps what it was sent). After commit() or discard(), does nothing.
+  void discard();
   const std::string& path() const { return path_; }
   /// Where the rows are until commit(): the temporary file, or the device written through.
   const std::string& writing_path() const { return temporary_.empty() ? target_ : temporary_; }
