@@ -67,7 +67,8 @@ void bind_diagnose(pyb::module_& m) {
       .def_readonly("weight", &Alternative::weight)
       .def_readonly("delta_bic", &Alternative::delta_bic)
       .def_readonly("correlation", &Alternative::correlation)
-      .def_readonly("in_group", &Alternative::in_group);
+      .def_readonly("in_group", &Alternative::in_group)
+      .def_readonly("aliased", &Alternative::aliased);
 
   pyb::class_<Finding>(m, "Finding")
       .def_property_readonly("effect", [](const Finding& f) { return f.effect.id(); })

@@ -687,7 +687,8 @@ def _print_diagnosis(d: dict) -> None:
         if f["named"]:
             print(f"{i}. {f['effect']} (weight {f['weight']:.2f}): {f['cause']}")
         else:
-            group = ", ".join(f"{m['effect']} ({m['weight']:.2f})" for m in f["group"])
+            group = ", ".join(f"{m['effect']} ({'aliased' if m.get('aliased') else format(m['weight'], '.2f')})"
+                              for m in f["group"])
             print(f"{i}. one of: {group}; this session cannot separate them (BIC weights). "
                   f"If it is {f['effect']}:")
         for name, p in f["parameters"].items():

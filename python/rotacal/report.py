@@ -410,7 +410,9 @@ def diagnosis_section(d: dict) -> str:
             if f["named"]:
                 effect = _e(f["effect"])
             else:  # the group the data cannot separate, with the parameters of its best
-                effect = "one of: " + ", ".join(f"{_e(m['effect'])} ({m['weight']:.2f})" for m in f["group"])
+                effect = "one of: " + ", ".join(
+                    f"{_e(m['effect'])} ({'aliased' if m.get('aliased') else format(m['weight'], '.2f')})"
+                    for m in f["group"])
                 params = f"if {_e(f['effect'])}:<br>" + params
             g = f["gain"]
             out.append(f"<tr><td class=l>{i}</td><td class=l>{effect}</td><td>{f['weight']:.2f}</td>"

@@ -103,9 +103,11 @@ class DiagnosisResult:
                     "weight": f.weight,
                     "named": bool(f.named_alone),
                     "group": [{"effect": f.effect, "weight": f.weight}] + [
-                        {"effect": r.effect, "weight": r.weight} for r in f.rivals if r.in_group],
+                        {"effect": r.effect, "weight": r.weight, **({"aliased": True} if r.aliased else {})}
+                        for r in f.rivals if r.in_group],
                     "rivals": [{"effect": r.effect, "weight": r.weight, "delta_bic": r.delta_bic,
-                                "correlation": r.correlation, "in_group": bool(r.in_group)}
+                                "correlation": r.correlation, "in_group": bool(r.in_group),
+                                "aliased": bool(r.aliased)}
                                for r in f.rivals],
                     "parameters": {p.name: estimate_dict(p) for p in f.parameters},
                     "gain": {

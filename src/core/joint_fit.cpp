@@ -97,7 +97,13 @@ void apply_yield_convention(const std::vector<FitParameter>& params, const std::
   out.values = M * out.values;
   out.covariance = M * out.covariance * M.transpose();
   out.convention = std::move(M);
-  for (std::size_t k = 0; k < analysed.size(); ++k) observable[static_cast<std::size_t>(analysed[k])] = obs_a[k];
+  // A parameter left with a 1-sigma below 1e-6 of its plausible magnitude is fixed by the
+  // convention, not by the data.
+  for (std::size_t k = 0; k < analysed.size(); ++k) {
+    const Eigen::Index j = analysed[k];
+    observable[static_cast<std::size_t>(j)] =
+        obs_a[k] && std::sqrt(std::max(0.0, out.covariance(j, j))) > 1e-6 * scales[static_cast<Eigen::Index>(k)];
+  }
   // A null direction the convention resolves no longer moves the reported solution: it is a
   // direction of the old, held convention, and is dropped from the words.
   std::vector<std::string> kept;

@@ -73,6 +73,42 @@ std::vector<std::string> unresolved_orders(const DiagnosisProblem& P, const std:
   return unresolved;
 }
 
+// How many sigma from zero the best-determined combination of `effect`'s observable free
+// parameters is in `refit`, under noise treatment t: sqrt(v^T C_ee^-1 v), C the refit's
+// covariance of its free parameters (the whitened Gram matrix's inverse), e the effect's.
+double determined_sigmas(const ModelFit& refit, const Effect& effect, const NoiseTreatment& t) {
+  const std::string id = effect.id();
+  std::vector<Eigen::Index> free, mine;
+  for (Eigen::Index j = 0; j < refit.jacobian.cols(); ++j) {
+    if (refit.jacobian.col(j).squaredNorm() == 0.0) continue;
+    const ParameterEstimate& p = refit.parameters[static_cast<std::size_t>(j)];
+    if ((p.name == id || p.name.rfind(id + ".", 0) == 0) && p.observable) mine.push_back(static_cast<Eigen::Index>(free.size()));
+    free.push_back(j);
+  }
+  if (mine.empty()) return 0.0;
+  Eigen::MatrixXd Jf(refit.jacobian.rows(), static_cast<Eigen::Index>(free.size()));
+  for (std::size_t a = 0; a < free.size(); ++a) Jf.col(static_cast<Eigen::Index>(a)) = refit.jacobian.col(free[a]);
+  const Eigen::MatrixXd Jw = t.whiten(Jf);
+  const Eigen::MatrixXd C = (Jw.transpose() * Jw).ldlt().solve(Eigen::MatrixXd::Identity(Jf.cols(), Jf.cols()));
+  const Eigen::Index k = static_cast<Eigen::Index>(mine.size());
+  Eigen::MatrixXd Cee(k, k);
+  Eigen::VectorXd v(k);
+  for (Eigen::Index a = 0; a < k; ++a) {
+    v[a] = refit.parameters[static_cast<std::size_t>(free[static_cast<std::size_t>(mine[static_cast<std::size_t>(a)])])].value;
+    for (Eigen::Index b = 0; b < k; ++b) Cee(a, b) = C(mine[static_cast<std::size_t>(a)], mine[static_cast<std::size_t>(b)]);
+  }
+  const double chi2 = v.dot(Cee.ldlt().solve(v));
+  return std::isfinite(chi2) && chi2 > 0.0 ? std::sqrt(chi2) : 0.0;
+}
+
+// Why the first of `aliases` is not resolved (the sampling's words).
+std::string unresolved_reason(const std::vector<Effect>& candidates, const std::vector<std::string>& unresolved,
+                              const std::vector<Alternative>& aliases) {
+  for (std::size_t c = 0; c < candidates.size(); ++c)
+    if (!aliases.empty() && candidates[c].id() == aliases.front().effect) return unresolved[c];
+  return "";
+}
+
 // The effect's parameters in a fit (named "id" or "id.name").
 std::vector<ParameterEstimate> parameters_of(const ModelFit& fit, const Effect& effect) {
   std::vector<ParameterEstimate> out;
@@ -407,11 +443,12 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
       EffectModel extended = effects;
       extended.effects.push_back(s->effect);
       const ModelFit& refit = cache.fit(P, extended);
-      // A cause with no number is no finding: at least one parameter must be determined
-      // (|value| >= min_determined_sigma std), not merely estimable with a huge 1-sigma.
-      bool any_determined = false;
-      for (const ParameterEstimate& p : parameters_of(refit, s->effect))
-        any_determined |= p.observable && std::abs(p.value) >= options.min_determined_sigma * p.std;
+      // A cause with no number is no finding: at least one combination of its parameters must
+      // be determined, min_determined_sigma from zero in the refit (a polynomial's correlated
+      // coefficients can be so jointly while none is alone), not merely estimable.
+      const bool any_determined =
+          determined_sigmas(refit, s->effect, treatment_of[static_cast<std::size_t>(s - scores.data())]) >=
+          options.min_determined_sigma;
       for (std::size_t c = 0; c < candidates.size(); ++c)
         if (candidates[c] == s->effect) done[c] = true;
       if (!any_determined) {
@@ -457,16 +494,35 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
     const double tempering = noise.W && model ? evidence_tempering(*model) : 1.0;
     const RivalJudgement judged_rivals =
         weigh_rivals(*chosen, passing, field_bic, tempering, options.rival_correlation, options.min_weight);
-    if (judged_rivals.group.size() > 1) {
+    // A harmonic of an order the sampling cannot resolve takes, at the sampled angles, the
+    // values of lower orders: a finding of order n of that kind and axis may be it.
+    std::vector<Alternative> aliases;
+    for (std::size_t c = 0; c < candidates.size(); ++c) {
+      const Effect& e = candidates[c];
+      if (chosen->effect.harmonic > 0 && e.kind == chosen->effect.kind && e.axis == chosen->effect.axis &&
+          e.harmonic > chosen->effect.harmonic && !unresolved[c].empty()) {
+        Alternative a;
+        a.effect = e.id();
+        a.in_group = true;
+        a.aliased = true;
+        aliases.push_back(a);
+      }
+    }
+    if (judged_rivals.group.size() > 1 || !aliases.empty()) {
       Ambiguity amb;
       for (const Score* g : judged_rivals.group) amb.effects.push_back(g->effect.id());
+      for (const Alternative& a : aliases) amb.effects.push_back(a.effect);
       amb.correlation = 1.0;
       for (const Alternative& a : judged_rivals.rivals)
         if (a.in_group) {
           amb.delta_bic = std::max(amb.delta_bic, a.delta_bic);
           amb.correlation = std::min(amb.correlation, a.correlation);
         }
-      amb.separating_test = separating_test(P, *before, *chosen, *judged_rivals.group[1], noise.sigma_mm);
+      amb.separating_test =
+          judged_rivals.group.size() > 1
+              ? separating_test(P, *before, *chosen, *judged_rivals.group[1], noise.sigma_mm)
+              : "a finer step of axis " + std::string(1, chosen->effect.axis) +
+                    " resolves the higher orders (" + unresolved_reason(candidates, unresolved, aliases) + ")";
       D.ambiguous.push_back(amb);
     }
 
@@ -475,6 +531,7 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
     F.cause = chosen->effect.cause();
     F.weight = judged_rivals.weight;
     F.rivals = judged_rivals.rivals;
+    F.rivals.insert(F.rivals.end(), aliases.begin(), aliases.end());
     F.gain.rms_before_um = rms_um(before->residuals);
     F.gain.rms_after_um = rms_um(fit->residuals);
     const NoiseTreatment& judged = treatment_of[static_cast<std::size_t>(chosen - scores.data())];

@@ -21,9 +21,11 @@ namespace rotacal {
 /// The linear map M (m x m, m = number of analysed parameters) that takes a solution with
 /// Observability::to_fix held to the yield convention: x' = M x. `yields[j]`: parameter j
 /// yields; `scales`: plausible magnitudes (as for the observability). A null direction is
-/// resolved by the convention when its yielding part (in scaled units, of an orthonormal basis
-/// of the null space) has a singular value above 0.05, the share at which a parameter counts as
-/// taking part. `observable` (in: Observability::observable) is updated: a parameter is
+/// resolved by the convention when it is a trade-off: both its yielding part and its other part
+/// (in scaled units, over an orthonormal basis of the null space split by the SVD of the
+/// yielding part) are at least 0.3 of it. A null
+/// direction within the yielding parameters alone (a component of an effect the instrument
+/// cannot see) is not a trade-off and stays unobservable. `observable` (in: Observability::observable) is updated: a parameter is
 /// observable when it takes no part (share <= 0.05) in the null directions left unresolved.
 /// Returns an empty matrix when no null direction moves a yielding parameter.
 Eigen::MatrixXd yield_convention(const Observability& o, const std::vector<bool>& yields,

@@ -98,8 +98,10 @@ struct DiagnosisOptions {
   /// together (a BIC margin of 2 ln 9 = 4.4 over a single rival).
   double min_weight = 0.9;
   double rival_correlation = 0.5;
-  /// A finding has at least one parameter determined to this many sigma (|value| >= k std);
-  /// a candidate whose refit determines none is reported unobservable, not named.
+  /// A finding has at least one combination of its parameters determined to this many sigma
+  /// from zero in its refit (sqrt(v^T C^-1 v) of its observable parameters: a single one at
+  /// |value| >= k std, or correlated coefficients jointly); a candidate whose refit determines
+  /// none is reported unobservable, not named.
   double min_determined_sigma = 3.0;
   std::vector<std::string> only;  ///< restrict candidates to these ids (empty: all)
   /// A candidate is visible when moving its parameters by plausible sizes (1 mm, 1 mrad,
@@ -190,6 +192,10 @@ struct Alternative {
   double delta_bic = 0.0;    ///< BIC(this) - BIC(the finding's effect); > 0: fits worse
   double correlation = 0.0;  ///< |cosine| of the two fitted signatures
   bool in_group = false;     ///< one of the group the data cannot separate
+  /// A higher harmonic order of the same kind and axis that this session's sampling cannot
+  /// resolve (it takes the values of lower orders at the sampled angles): not scored, so its
+  /// weight is 0 and unknown, but it is in the group, since the data cannot exclude it.
+  bool aliased = false;
 };
 
 struct Finding {

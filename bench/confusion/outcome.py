@@ -1,0 +1,113 @@
+"""One benchmark session: draw, diagnose with rotacal, classify the first finding, the oracle,
+the coverage of the parameters of a right finding."""
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from refsim import effects as rfx
+
+from . import stats
+from .setup import Setup, half_detection, stable_int
+
+MIN_WEIGHT = 0.9  # DiagnosisOptions.min_weight
+
+
+def to_rotacal_params(eid: str, p: np.ndarray) -> list:
+    """rotacal parameterises thermal_warmup's tau as ln(tau / 300 s) (docs/effects.md)."""
+    if rfx.parse(eid).kind == "thermal_warmup":
+        return [float(p[0]), float(math.log(p[1] / 300.0))]
+    return [float(x) for x in p]
+
+
+def classify(findings: list, truth: str | None) -> str:
+    """right: named alone and correct; ambiguous: not named, the truth in its group, and the best's
+    BIC weight < 0.9; nothing: no finding; wrong: named alone and wrong, or a group without the
+    truth (a group holding the truth with a best weight >= 0.9, which the schema rules out, is
+    'bad_group'). On a null session (truth None) any finding is 'false'."""
+    if not findings:
+        return "nothing"
+    if truth is None:
+        return "false"
+    f = findings[0]
+    if f["named"]:
+        return "right" if f["effect"] == truth else "wrong"
+    if truth not in [g["effect"] for g in f["group"]]:
+        return "wrong"
+    return "ambiguous" if f["weight"] < MIN_WEIGHT else "bad_group"
+
+
+def coverage(finding: dict, eid: str, true_params: np.ndarray) -> list:
+    """[hit] per determined parameter: |estimate - truth| <= 2 std (rotacal's units)."""
+    truth = to_rotacal_params(eid, true_params)
+    out = []
+    for est, t in zip(finding["parameters"].values(), truth):
+        if est.get("value") is not None and est.get("std"):
+            out.append(bool(abs(est["value"] - t) <= 2.0 * est["std"]))
+    return out
+
+
+class CellCache:
+    """Per-process caches: set-ups, effect Jacobians and amplitudes, oracles, clean readings."""
+
+    def __init__(self, workdir):
+        self.workdir = workdir
+        self.setups, self.entries, self.oracles, self.clean = {}, {}, {}, {}
+
+    def setup(self, machine: str, instrument: str) -> Setup:
+        key = (machine, instrument)
+        if key not in self.setups:
+            self.setups[key] = Setup(machine, instrument, self.workdir)
+        return self.setups[key]
+
+    def entry(self, st: Setup, eid: str) -> dict:
+        key = (st.name, st.instrument, eid)
+        if key not in self.entries:
+            je = st.effect_jacobian(eid)
+            self.entries[key] = {"je": je, **half_detection(st, eid, je)}
+        return self.entries[key]
+
+    def oracle(self, st: Setup, eid: str, noise: str) -> stats.Oracle:
+        key = (st.name, st.instrument, eid, noise)
+        if key not in self.oracles:
+            w = stats.Whitener(st.streams, noise, st.sigma)
+            self.oracles[key] = stats.Oracle(w, st.j0, self.entry(st, eid)["je_visible"], st.n_candidates)
+        return self.oracles[key]
+
+    def reading(self, st: Setup, eid: str, params: np.ndarray) -> np.ndarray:
+        key = (st.name, st.instrument, eid, tuple(np.round(params, 15)))
+        if key not in self.clean:
+            self.clean[key] = st.reading({eid: params})
+        return self.clean[key]
+
+
+def run_session(cache: CellCache, task: dict, diagnose) -> dict:
+    """task: machine, instrument, entry (None: null), noise, amp, draw, seed. Returns the record."""
+    st = cache.setup(task["machine"], task["instrument"])
+    rng = np.random.default_rng(stable_int(task["seed"], task["machine"], task["instrument"], task["entry"],
+                                           task["noise"], task["amp"], task["draw"]))
+    rec = dict(task)
+    eid = task["entry"]
+    if eid is None:
+        clean = st.base
+    else:
+        ent = cache.entry(st, eid)
+        sign = 1.0 if rng.random() < 0.5 else -1.0
+        free = sign * task["amp"] * ent["a_half"] * np.asarray(ent["direction"])
+        params = st.full_params(eid, free)
+        clean = cache.reading(st, eid, params)
+        rec["true_params"] = to_rotacal_params(eid, params)
+    y = clean + st.noise(task["noise"], rng)
+    if eid is not None:
+        rec["oracle"] = bool(cache.oracle(st, eid, task["noise"]).detects(y - st.base))
+    t0 = time.perf_counter()
+    findings = diagnose(st.session(y)).to_dict()["findings"]
+    rec["time_ms"] = 1e3 * (time.perf_counter() - t0)
+    rec["outcome"] = classify(findings, eid)
+    rec["findings"] = [{"effect": f["effect"], "weight": f["weight"], "named": f["named"],
+                        "group": [g["effect"] for g in f["group"]]} for f in findings]
+    if rec["outcome"] == "right":
+        rec["coverage"] = coverage(findings[0], eid, params)
+    return rec
