@@ -24,7 +24,8 @@ def to_rotacal_params(eid: str, p: np.ndarray) -> list:
 
 def classify(findings: list, truth: str | None) -> str:
     """right: named alone and correct; ambiguous: not named, the truth in its group, and the best's
-    BIC weight < 0.9; nothing: no finding; wrong: named alone and wrong, or a group without the
+    BIC weight < 0.9 or the group holding aliased members (orders the sampling cannot resolve);
+    nothing: no finding; wrong: named alone and wrong, or a group without the
     truth (a group holding the truth with a best weight >= 0.9, which the schema rules out, is
     'bad_group'). On a null session (truth None) any finding is 'false'."""
     if not findings:
@@ -34,8 +35,13 @@ def classify(findings: list, truth: str | None) -> str:
     f = findings[0]
     if f["named"]:
         return "right" if f["effect"] == truth else "wrong"
-    if truth not in [g["effect"] for g in f["group"]]:
+    member = {g["effect"]: g for g in f["group"]}
+    if truth not in member:
         return "wrong"
+    # A group with aliased members (harmonic orders the sampling cannot resolve, which cannot be
+    # scored at all) is ambiguous whatever the weights of the members that were scored.
+    if any(g.get("aliased") for g in f["group"]):
+        return "ambiguous"
     return "ambiguous" if f["weight"] < MIN_WEIGHT else "bad_group"
 
 
@@ -107,7 +113,8 @@ def run_session(cache: CellCache, task: dict, diagnose) -> dict:
     rec["time_ms"] = 1e3 * (time.perf_counter() - t0)
     rec["outcome"] = classify(findings, eid)
     rec["findings"] = [{"effect": f["effect"], "weight": f["weight"], "named": f["named"],
-                        "group": [g["effect"] for g in f["group"]]} for f in findings]
+                        "group": [g["effect"] for g in f["group"]],
+                        "aliased": [g["effect"] for g in f["group"] if g.get("aliased")]} for f in findings]
     if rec["outcome"] == "right":
         rec["coverage"] = coverage(findings[0], eid, params)
     return rec

@@ -495,12 +495,12 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
     const RivalJudgement judged_rivals =
         weigh_rivals(*chosen, passing, field_bic, tempering, options.rival_correlation, options.min_weight);
     // A harmonic of an order the sampling cannot resolve takes, at the sampled angles, the
-    // values of lower orders: a finding of order n of that kind and axis may be it.
+    // values of lower orders: a finding of a harmonic of that axis may be it, of its own kind or
+    // another (on the R-test's 7 tilt angles an axial h4 came out as a tilt h3).
     std::vector<Alternative> aliases;
     for (std::size_t c = 0; c < candidates.size(); ++c) {
       const Effect& e = candidates[c];
-      if (chosen->effect.harmonic > 0 && e.kind == chosen->effect.kind && e.axis == chosen->effect.axis &&
-          e.harmonic > chosen->effect.harmonic && !unresolved[c].empty()) {
+      if (chosen->effect.harmonic > 0 && e.harmonic > 0 && e.axis == chosen->effect.axis && !unresolved[c].empty()) {
         Alternative a;
         a.effect = e.id();
         a.in_group = true;

@@ -192,9 +192,9 @@ struct Alternative {
   double delta_bic = 0.0;    ///< BIC(this) - BIC(the finding's effect); > 0: fits worse
   double correlation = 0.0;  ///< |cosine| of the two fitted signatures
   bool in_group = false;     ///< one of the group the data cannot separate
-  /// A higher harmonic order of the same kind and axis that this session's sampling cannot
-  /// resolve (it takes the values of lower orders at the sampled angles): not scored, so its
-  /// weight is 0 and unknown, but it is in the group, since the data cannot exclude it.
+  /// A harmonic of the finding's axis of an order this session's sampling cannot resolve (it
+  /// takes the values of lower orders at the sampled angles): not scored, so its weight is 0
+  /// and unknown, but it is in the group, since the data cannot exclude it.
   bool aliased = false;
 };
 
