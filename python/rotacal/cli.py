@@ -1008,9 +1008,13 @@ def cmd_demo(a: argparse.Namespace) -> int:
     print(f"hidden effect: gravity_sag_A, s = {a.sag * 1e3:.1f} um")
     f = r["finding"]
     if f:
-        p = next(iter(f["parameters"].values()))
-        print(f"diagnosis found: {f['effect']} ({f['cause']}), "
-              + (f"s = {p['value'] * 1e3:.2f} +- {p['std'] * 1e3:.2f} um" if p["value"] is not None else "unobservable"))
+        name, p = next(iter(f["parameters"].items()))
+        size = f"{name} = {units.estimate_text(p['value'], p['std'], p['unit'])}"
+        if f["named"]:
+            print(f"diagnosis found: {f['effect']} ({f['cause']}, weight {f['weight']:.2f}), {size}")
+        else:
+            group = ", ".join(f"{g['effect']} ({g['weight']:.2f})" for g in f["group"])
+            print(f"diagnosis found one of: {group}, which this session cannot separate; if {f['effect']}: {size}")
     else:
         print("diagnosis found nothing significant")
     print(f"compensation reduced every location error by at least {-r['worst_change_percent']:.1f} %")
