@@ -42,7 +42,7 @@ std::vector<std::string> hostile_texts() {
       "word,comma",
       "ends in a backslash \\",
       "ends in a tilde ~",
-      std::string("nul \0 byte\x1b[31m\x7f", 19),
+      std::string("nul \0 byte\x1b[31m\x7f", 16),  // 16 characters, the NUL among them
       "utf-8 \xc3\xa9 and a line separator \xe2\x80\xa8 G0 Z-500",
       std::string(300, 'a') + "\nG0 Z-500",
       std::string(1500, 'b') + "loadusr -w touch X",
