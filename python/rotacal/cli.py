@@ -403,20 +403,10 @@ def _print_budget(b: dict) -> None:
 
 
 def _print_budget_why(b: dict) -> None:
-    """Why U can be far above type A, and what shrinks it: type B is the size each left-out
-    effect plausibly has, assumed (default sizes) until measured and given by --budget-sizes."""
-    rows = [(n, e) for n, e in b["location_errors"].items() if e["observable"] and e["type_b"] and e["u_a"] > 0]
-    if not rows:
-        return
-    name, e = max(rows, key=lambda r: r[1]["u_c"] / r[1]["u_a"])
-    if e["u_c"] < 2 * e["u_a"]:
-        return
-    line = e["type_b"][0]
-    f, unit = (1e6, "urad") if e["unit"] == "rad" else (1e3, "um")
-    print(f"  U is mostly type B: effects the fit leaves out, at plausible sizes that are assumed, not measured "
-          f"(largest on {name}: {line['effect']}, {line['u'] * f:.3f} {unit}, {line['basis']}). Measure it and "
-          f"give the value with --budget-sizes SIZES.json holding {{\"overrides\": {{\"{line['effect']}\": SIZE}}}} "
-          "(SIZE in the effect parameter's unit, mm or rad; docs/json_schema.md)")
+    from .results import budget_why
+    why = budget_why(b)
+    if why:
+        print("  " + why)
 
 
 def _print_identification(d: dict) -> None:
@@ -911,8 +901,10 @@ def cmd_export(a: argparse.Namespace) -> int:
     tables = {axis: linuxcnc_comp_table(load_model(a.model), axis, *a.comp_range, a.comp_step) for axis in comp}
     if a.centres:
         from .exports import isg_sphere_centres
+        from .models import file_sha256
         text, what = isg_sphere_centres(load(a.centres), load_model(a.model), a.centres_setup,
-                                        (int(a.isg_kinematic[0]), int(a.isg_kinematic[1])), a.centres_origin)
+                                        (int(a.isg_kinematic[0]), int(a.isg_kinematic[1])), a.centres_origin,
+                                        session_sha256=file_sha256(a.centres))
         write_output(a.centres_output, text, inputs=[p for p in (a.model, a.current, a.centres) if p])
         _say(f"wrote {a.centres_output}: {what}")
     for axis, (text, what) in tables.items():

@@ -147,7 +147,8 @@ def linuxcnc_comp_table(model: dict, axis: str, lo_deg: float, hi_deg: float, st
 
 
 def isg_sphere_centres(session: Any, model: dict, setup: str | None, kinematic: tuple[int, int],
-                       origin: Sequence[float] = (0.0, 0.0, 0.0), precision_mm: float = 0.06) -> tuple[str, str]:
+                       origin: Sequence[float] = (0.0, 0.0, 0.0), precision_mm: float = 0.06,
+                       session_sha256: str | None = None) -> tuple[str, str]:
     """The measured sphere centres of an R-test set-up as the ISG kinematic optimisation takes
     them from third-party measuring equipment (TF5245, "sphere centre points already
     calculated"): an NC program that calls ``SysCalibFitInit.ecy`` (kinematic type, variant,
@@ -158,9 +159,17 @@ def isg_sphere_centres(session: Any, model: dict, setup: str | None, kinematic: 
     sphere's commanded position minus the reading turned into the machine frame,
     ``xyz - Ry(B) Rz(C) (d - zero)`` (to first order in the errors), with the set-up's probe zero
     from the model (an rtest-joint fit of the same session), plus ``origin``: the rotary axes'
-    intersection in the controller's machine coordinates. Returns (program, description)."""
+    intersection in the controller's machine coordinates. Returns (program, description).
+
+    The probe zeros hold only for the session the model was fitted to: a session of other bytes
+    (``session_sha256`` against the model's ``source``) or other nests is refused."""
     if model.get("kind") != "rtest-joint":
         raise _core.InvalidArgument("--centres: needs the rtest-joint model of the same session (its probe zeros)")
+    fitted = (model.get("source") or {}).get("session_sha256")
+    if session_sha256 is not None and fitted is not None and fitted != session_sha256:
+        raise _core.InvalidArgument("--centres: the model was fitted to another session "
+                                    f"({(model.get('source') or {}).get('session', '?')}, SHA-256 {fitted[:12]}...): "
+                                    "its probe zeros do not hold for this one")
     s, _ = _rtest_displacements(session)
     setups = list(dict.fromkeys(s.setups))
     label = setup if setup is not None else setups[0]
@@ -170,6 +179,13 @@ def isg_sphere_centres(session: Any, model: dict, setup: str | None, kinematic: 
     if label not in zeros:
         raise _core.InvalidArgument(f"--centres: the model has no probe zero for set-up {label!r} "
                                     "(fit the same session: rotacal identify RTEST --save-model)")
+    nest = (model.get("nests") or {}).get(label)
+    here = np.asarray(session.nests[label], dtype=float)
+    if nest is None or not np.allclose(np.asarray(nest, dtype=float), here, rtol=0.0, atol=1e-3):
+        raise _core.InvalidArgument(
+            f"--centres: set-up {label!r} has its nest at {', '.join(f'{v:.3f}' for v in here)} mm, the model's "
+            + ("has none" if nest is None else "at " + ", ".join(f"{float(v):.3f}" for v in nest) + " mm")
+            + ": the probe zeros are of another session")
     zero = np.array([zeros[label][a]["value"] or 0.0 for a in "xyz"])
     rows = [i for i, x in enumerate(s.setups) if x == label]
     xyz, ang, d = np.asarray(s.xyz)[rows], np.radians(np.asarray(s.angles_deg)[rows]), np.asarray(s.d)[rows]

@@ -110,17 +110,22 @@ def covariance_dict(parameters: list, covariance: Any) -> dict | None:
     return {"parameters": names, "matrix": rows}
 
 
+def file_sha256(path: str | Path) -> str:
+    """The SHA-256 of a file's bytes, read in blocks (a session can be large)."""
+    import hashlib
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
 def source_dict(session_path: str | Path) -> dict:
     """The ``source`` member of a model file: the session it was identified from (as named, and
     its SHA-256), when, and by which rotacal; exports and the history quote it."""
     import datetime
-    import hashlib
     from . import __version__
-    h = hashlib.sha256()
-    with open(session_path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            h.update(block)
-    return {"session": os.fspath(session_path), "session_sha256": h.hexdigest(),
+    return {"session": os.fspath(session_path), "session_sha256": file_sha256(session_path),
             "identified_at": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
             "rotacal": __version__}
 

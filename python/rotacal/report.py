@@ -217,6 +217,10 @@ def noise_budget_section(ident: dict) -> str:
                        f"<td>{e['u_c'] * f:.3f}</td><td>{e['expanded'] * f:.3f}</td><td>{e['k']:.2f}</td>"
                        f"<td>{nu}</td><td class=l>{dom}</td></tr>")
         out.append("</table>")
+        from .results import budget_why
+        why = budget_why(b)
+        if why:
+            out.append(f"<p>{_e(why)}</p>")
     out.append("</section>")
     return "".join(out) if (nm or b) else ""
 

@@ -252,3 +252,21 @@ def _group(g) -> dict:
             "angle_axis": g.angle_axis, "harmonic_um": list(g.harmonic_um),
             "harmonics_left_out": list(g.harmonics_left_out), "harmonic_note": g.harmonic_note,
             "trend_um_per_s": g.trend_um_per_s}
+
+
+def budget_why(b: dict) -> str | None:
+    """Why U can be far above type A, and what shrinks it (None when type A dominates): type B
+    is the size each left-out effect plausibly has, assumed (default sizes) until measured and
+    given by --budget-sizes. One sentence, for the CLI and the report alike."""
+    rows = [(n, e) for n, e in b["location_errors"].items() if e["observable"] and e["type_b"] and e["u_a"] > 0]
+    if not rows:
+        return None
+    name, e = max(rows, key=lambda r: r[1]["u_c"] / r[1]["u_a"])
+    if e["u_c"] < 2 * e["u_a"]:
+        return None
+    line = e["type_b"][0]
+    f, unit = (1e6, "urad") if e["unit"] == "rad" else (1e3, "um")
+    return (f"U is mostly type B: effects the fit leaves out, at plausible sizes that are assumed, not measured "
+            f"(largest on {name}: {line['effect']}, {line['u'] * f:.3f} {unit}, {line['basis']}). Measure it and "
+            f"give the value with --budget-sizes SIZES.json holding {{\"overrides\": {{\"{line['effect']}\": SIZE}}}} "
+            "(SIZE in the effect parameter's unit, mm or rad; docs/json_schema.md)")

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "rotacal/core/error.hpp"
+#include "rotacal/core/json_text.hpp"
 #include "rotacal/io/controller_comment.hpp"
 
 namespace rotacal {
@@ -537,6 +538,14 @@ std::vector<std::string> current_parameter_names(Controller c, MachineType machi
   return names;
 }
 
+namespace {
+// A controller's offsets and pivots are within a machine's size: a kilometre (or 1e6 deg) is
+// no value a controller holds, and 1e308 would be written back as a 309-digit number.
+constexpr double kMaxCurrent = 1e6;
+const char* const kMaxCurrentText = "1e6";
+bool plausible_current(double v) { return std::isfinite(v) && std::abs(v) <= kMaxCurrent; }
+}  // namespace
+
 std::map<std::string, double> parse_current_parameters(Controller c, MachineType machine, const std::string& text,
                                                        const std::string& source, int toolholder) {
   const std::vector<std::string> known = current_parameter_names(c, machine, toolholder);
@@ -544,20 +553,16 @@ std::map<std::string, double> parse_current_parameters(Controller c, MachineType
   std::map<std::string, double> out;
   const std::size_t first = text.find_first_not_of(" \t\r\n");
   if (first != std::string::npos && text[first] == '{') {  // the documented JSON
-    nlohmann::json j;
-    try {
-      j = nlohmann::json::parse(text);
-    } catch (const nlohmann::json::parse_error& e) {
-      throw InvalidArgument(source + ": not valid JSON: " + e.what());
-    }
+    const nlohmann::ordered_json j = parse_json(text, source);  // bounded, strict; ParseError names the line
     if (!j.is_object() || !j.contains("parameters") || !j["parameters"].is_object())
       throw InvalidArgument(source + ": expected {\"controller\": ..., \"parameters\": {name: value}}");
     if (j.contains("controller") && j["controller"] != to_string(c))
       throw InvalidArgument(source + ": values of controller " + j["controller"].dump() + ", export for " + to_string(c));
     for (const auto& [name, value] : j["parameters"].items()) {
       if (!is_known(name)) throw InvalidArgument(source + ": parameters." + name + ": not a parameter of this export");
-      if (!value.is_number() || !std::isfinite(value.get<double>()))
-        throw InvalidArgument(source + ": parameters." + name + ": must be a finite number");
+      if (!value.is_number() || !plausible_current(value.get<double>()))
+        throw InvalidArgument(source + ": parameters." + name + ": must be a finite number of at most " +
+                              kMaxCurrentText + " (mm or deg)");
       out[name] = value.get<double>();
     }
     return out;
@@ -599,8 +604,9 @@ std::map<std::string, double> parse_current_parameters(Controller c, MachineType
     if (!is_known(name)) throw InvalidArgument(where + ": " + name + " is not a parameter of this export");
     char* end = nullptr;
     const double v = std::strtod(value.c_str(), &end);
-    if (end == value.c_str() || *end != '\0' || !std::isfinite(v))
-      throw InvalidArgument(where + ": " + name + ": '" + value + "' is not a finite number");
+    if (end == value.c_str() || *end != '\0' || !plausible_current(v))
+      throw InvalidArgument(where + ": " + name + ": '" + value + "' is not a finite number of at most " +
+                            kMaxCurrentText + " (mm or deg)");
     out[name] = v;
   }
   if (out.empty()) throw InvalidArgument(source + ": no current values of " + to_string(c) + " found");

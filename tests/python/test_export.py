@@ -208,6 +208,30 @@ def test_isg_measured_sphere_centres_are_where_the_machine_put_the_nest(tmp_path
                        tmp_path / "x.nc").returncode == EXIT_INPUT
 
 
+def test_isg_centres_refuse_probe_zeros_of_another_session(tmp_path):
+    # The probe zeros of one R-test do not hold for another: other nests, or the same nests
+    # measured again (other bytes), are refused instead of written as centres.
+    m = tmp_path / "r.json"
+    sessions = {}
+    for name, extra in (("r", []), ("other_nests", ["--nest", "90,10,50", "--nest", "0,-100,120"]),
+                        ("again", ["--seed", "9"])):
+        sessions[name] = tmp_path / f"{name}.csv"
+        assert rotacal_cli("simulate", "rtest", "--errors", "random", "--seed", "4", *extra,
+                           "-o", sessions[name]).returncode == 0
+    assert rotacal_cli("identify", sessions["r"], "--save-model", m).returncode == 0
+    anonymous = tmp_path / "no_source.json"  # a model saved without its source: the nests decide
+    doc = json.loads(m.read_text())
+    del doc["source"]
+    anonymous.write_text(json.dumps(doc))
+    for name, model, words in (("other_nests", anonymous, "has its nest at"),
+                               ("again", m, "fitted to another session")):
+        prog = tmp_path / f"{name}.nc"
+        r = rotacal_cli("export", "--model", model, "--controller", "isg", "--centres", sessions[name],
+                        "--centres-output", prog)
+        assert r.returncode == EXIT_INPUT and words in r.stderr, r.stderr
+        assert not prog.exists()
+
+
 def test_heidenhain_and_fanuc_mappings(model, tmp_path):
     # Where the formulas are not public the export is a mapping: each parameter carries the
     # line-position changes of formats.md, from the values given as current.

@@ -9,6 +9,7 @@ comment; LinuxCNC's own interpreter (rs274) must run the program with the same c
 commands. Lines are split as str.splitlines() does (also at U+2028, form feed, NEL, ...): a
 reader that breaks lines there must not find a command either.
 """
+import hashlib
 import json
 import re
 import shutil
@@ -167,6 +168,8 @@ def test_isg_centres_program_holds_only_its_blocks_whatever_the_setup_label(tmp_
     hs.write_text("\n".join(rows), encoding="utf-8")
     doc = json.loads(m.read_text())
     doc["probe_zeros"][label] = doc["probe_zeros"].pop("2")
+    doc["nests"][label] = doc["nests"].pop("2")
+    doc["source"]["session_sha256"] = hashlib.sha256(hs.read_bytes()).hexdigest()  # fitted to hs, as it were
     hm.write_text(json.dumps(doc))
 
     def program(model, session, setup):
