@@ -343,7 +343,7 @@ Returns
       "rtest_readings",
       [](MachineType machine, const Array& errors, const std::vector<std::string>& effects,
          const std::vector<double>& effect_params, const Array& q, const Array& angles,
-         const Eigen::VectorXd& time) {
+         const Eigen::VectorXd& time, std::optional<Array> linear_reference) {
         MachineModel t;
         t.machine = machine;
         t.errors = LocationErrors<double>(vec_of<8>(errors, "errors"));
@@ -355,15 +355,16 @@ Returns
         const Eigen::Vector3d qv = vec_of<3>(q, "q");
         const auto a = rows_of<2>(angles, "angles");
         if (time.size() != a.rows()) throw InvalidArgument("time: one value per row of angles");
-        Rows3 d(a.rows(), 3);
-        for (Eigen::Index i = 0; i < a.rows(); ++i)
-          d.row(i) = rtest_reading(t, qv, {a(i, 0), a(i, 1)}, time[i]).transpose();
-        return d;
+        std::vector<RotaryAngles<double>> poses;
+        for (Eigen::Index i = 0; i < a.rows(); ++i) poses.push_back({a(i, 0), a(i, 1)});
+        if (linear_reference) t.effects.linear_reference = vec_of<3>(*linear_reference, "linear_reference");
+        return rows_from(rtest_readings(t, qv, poses, std::vector<double>(time.data(), time.data() + time.size())));
       },
       pyb::arg("machine"), pyb::arg("errors"), pyb::arg("effects"), pyb::arg("effect_params"),
-      pyb::arg("q"), pyb::arg("angles"), pyb::arg("time"),
+      pyb::arg("q"), pyb::arg("angles"), pyb::arg("time"), pyb::arg("linear_reference") = std::nullopt,
       "Noise-free readings (N, 3) of the nest at q (mm) at angles (N, 2) in rad and time (N,) s, "
-      "no probe zero: the simulator's truth.");
+      "no probe zero: the simulator's truth. linear_reference (3,) mm: the session's mean commanded "
+      "xyz, about which the linear-axis polynomials are taken (None: the mean of these poses).");
 
   // ------------------------------------------------------------------ device (Sec. 3.1-3.2)
   pyb::class_<ProbeCalibration>(m, "ProbeCalibration", "Probe directions from linear moves.")

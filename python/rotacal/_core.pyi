@@ -3546,9 +3546,9 @@ def rtest_prediction_rms_um(model: RtestJointModel, session: RtestSession) -> fl
     """
     RMS (um) of measured - predicted readings after one constant offset per set-up.
     """
-def rtest_readings(machine: MachineType, errors: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], effects: collections.abc.Sequence[str], effect_params: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], angles: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], time: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
+def rtest_readings(machine: MachineType, errors: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], effects: collections.abc.Sequence[str], effect_params: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], angles: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], time: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], linear_reference: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] | None = None) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
     """
-    Noise-free readings (N, 3) of the nest at q (mm) at angles (N, 2) in rad and time (N,) s, no probe zero: the simulator's truth.
+    Noise-free readings (N, 3) of the nest at q (mm) at angles (N, 2) in rad and time (N,) s, no probe zero: the simulator's truth. linear_reference (3,) mm: the session's mean commanded xyz, about which the linear-axis polynomials are taken (None: the mean of these poses).
     """
 def run_label(test: BallbarTest, direction: SweepDirection, feed_factor: typing.SupportsFloat | typing.SupportsIndex, setup: ...) -> str:
     """

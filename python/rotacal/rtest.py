@@ -291,10 +291,11 @@ def truth_readings(truth: Mapping, session: _core.RtestSession, probe_zeros: boo
     angles = np.radians(np.asarray(session.angles_deg))
     time = np.asarray(session.time)
     out = np.zeros((len(setups), 3))
+    a_ref = np.asarray(session.xyz).mean(axis=0)  # effects.md: the session's mean commanded xyz
     for setup in dict.fromkeys(setups):
         sel = setups == setup
         q = np.asarray(session.nests[setup])
-        out[sel] = _core.rtest_readings(mtype, e, ids, params, q, angles[sel], time[sel])
+        out[sel] = _core.rtest_readings(mtype, e, ids, params, q, angles[sel], time[sel], a_ref)
         if probe_zeros:
             out[sel] += np.asarray(truth["probe_zeros"][int(setup) - 1])
     return out

@@ -503,8 +503,7 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session,
   D.effects = {pair[0].id(), pair[1].id()};
   EffectModel fx;
   fx.effects = pair;
-  for (const BallbarSample& s : session.samples) fx.linear_reference += s.xyz;
-  fx.linear_reference /= static_cast<double>(session.samples.size());
+  fx.linear_reference = mean_commanded_xyz(session.samples);
   const double t_end = session.samples.back().time;
   D.motion = table_motion_overlap(m, pair[0], pair[1], o.tilt_limits_deg,
                                   t_end + o.max_added_time_s, o.reference_radius_mm);

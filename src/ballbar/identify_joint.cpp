@@ -51,7 +51,10 @@ BallbarIdentification identify_joint(const BallbarSession& session, const JointF
   // The motion of the axes (rotary_motion) only for effects of the motion.
   const bool with_motion = std::any_of(options.effects.effects.begin(), options.effects.effects.end(),
                                        [](const Effect& f) { return f.depends_on_motion(); });
-  return identify_joint(ballbar_arrays(session, options.tests, with_motion), options);
+  // The linear-axis polynomials are about the mean of the whole session, not of the tests fitted.
+  JointFitOptions o = options;
+  o.effects = centred_on(options.effects, session.samples);
+  return identify_joint(ballbar_arrays(session, options.tests, with_motion), o);
 }
 
 namespace {

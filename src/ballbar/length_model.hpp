@@ -286,6 +286,7 @@ inline BallbarFitSetup ballbar_fit_setup(const BallbarArrays& data, const JointF
   BallbarFitSetup out;
   EffectModel& fx = out.effects;
   fx = options.effects;
+  if (!fx.linear_reference && data.size() > 0) fx.linear_reference = Eigen::Vector3d(data.xyz.rowwise().mean());
   if (options.fit_length_offset)
     fx.effects.insert(fx.effects.begin(), Effect::parse("ballbar_length_offset"));
   // On a machine with head axes the ball's distance from the controlled point,

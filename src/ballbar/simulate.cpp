@@ -13,10 +13,11 @@ std::vector<double> predict_lengths(const BallbarMachineModel& model,
                           " values for the model's effects, got " +
                           std::to_string(model.effect_params.size()));
   const std::vector<RotaryMotion> motion = rotary_motion(samples);
+  const EffectModel fx = centred_on(model.effects, samples);  // unset a_ref: these samples' mean
   std::vector<double> out;
   out.reserve(samples.size());
   for (std::size_t i = 0; i < samples.size(); ++i)
-    out.push_back(predicted_length<double>(model.machine, model.errors, model.pivot, model.effects,
+    out.push_back(predicted_length<double>(model.machine, model.errors, model.pivot, fx,
                                            model.effect_params.data(), samples[i], motion[i]));
   return out;
 }
@@ -32,7 +33,7 @@ BallbarSession simulate_ballbar(const BallbarSession& commanded, const BallbarMa
     if (!f.applies_to(truth.machine))
       throw InvalidArgument("effect " + f.id() + " does not exist on a " + to_string(truth.machine));
   BallbarSession out = commanded;
-  const std::vector<double> L = predict_lengths(truth, commanded.samples);
+  const std::vector<double> L = predict_lengths(truth, commanded.samples);  // about the session's mean
   std::mt19937_64 rng(options.seed);
   std::normal_distribution<double> noise(0.0, options.noise_um * 1e-3);
   for (std::size_t i = 0; i < L.size(); ++i)

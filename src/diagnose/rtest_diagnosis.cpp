@@ -91,7 +91,8 @@ std::vector<Effect> RtestDiagnosisProblem::candidates(int max_harmonic) const {
   return out;
 }
 
-ModelFit RtestDiagnosisProblem::fit(const EffectModel& fx) const {
+ModelFit RtestDiagnosisProblem::fit(const EffectModel& effects) const {
+  const EffectModel fx = centred_on(effects, session_.samples);
   const int S = static_cast<int>(setups_.size());
   std::vector<FitParameter> params;
   for (int k = 0; k < 8; ++k)

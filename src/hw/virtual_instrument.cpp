@@ -252,6 +252,14 @@ VirtualBallbar::VirtualBallbar(ProgramTimeline program, const VirtualBallbarOpti
                           std::to_string(options.truth.effect_params.size()) + " effect parameters, its effects need " +
                           std::to_string(options.truth.effects.num_params()));
   noise_->rng.seed(options.seed);
+  // effects.md: the linear-axis polynomials are about the session's mean commanded xyz; the
+  // recording samples the program at a steady rate, so its mean is the program's time mean.
+  if (!options_.truth.effects.linear_reference) {
+    const int n = 4096;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (int i = 0; i < n; ++i) sum += program_.at(program_.duration() * (i + 0.5) / n).xyz;
+    options_.truth.effects.linear_reference = sum / n;
+  }
 }
 
 double VirtualBallbar::exact_length(double t) const {

@@ -257,8 +257,9 @@ struct RtestPose {
 
 class RtestReadingsModel : public ResidualModel {
  public:
-  RtestReadingsModel(std::vector<RtestPose> poses, int nests, const EffectModel& fx)
-      : poses_(std::move(poses)), nests_(nests), fx_(fx), P_(fx.num_params()) {}
+  // fx by value: callers pass a model centred on the session (a temporary).
+  RtestReadingsModel(std::vector<RtestPose> poses, int nests, EffectModel fx)
+      : poses_(std::move(poses)), nests_(nests), fx_(std::move(fx)), P_(fx_.num_params()) {}
   Eigen::Index num_residuals() const override {
     return 3 * static_cast<Eigen::Index>(poses_.size());
   }
@@ -282,7 +283,7 @@ class RtestReadingsModel : public ResidualModel {
   }
   std::vector<RtestPose> poses_;
   int nests_;
-  const EffectModel& fx_;
+  EffectModel fx_;
   int P_;
 };
 
@@ -339,8 +340,7 @@ RtestSeparationDesign design_rtest_separation(const RtestSession& session,
   D.effects = {pair[0].id(), pair[1].id()};
   EffectModel fx;
   fx.effects = pair;
-  for (const RtestSample& s : session.samples) fx.linear_reference += s.xyz;
-  fx.linear_reference /= static_cast<double>(session.samples.size());
+  fx.linear_reference = mean_commanded_xyz(session.samples);
   const double t_end = session.samples.back().time;
   D.motion = table_motion_overlap(m, pair[0], pair[1], o.b_limits_deg, t_end + o.max_added_time_s,
                                   o.reference_radius_mm);
@@ -566,7 +566,7 @@ JointFitOutcome identify_rtest_effects(const RtestSession& session, const Effect
     for (std::size_t k = 0; k < pn.size(); ++k)
       params.push_back({f.id() + (pn.size() > 1 ? "." + pn[k] : ""), pu[k], 0.0});
   }
-  const RtestReadingsModel model(std::move(poses), ns, effects);
+  const RtestReadingsModel model(std::move(poses), ns, centred_on(effects, session.samples));
   JointFitSettings settings;
   settings.sigma = session.noise_um.value_or(1.0) * 1e-3;
   return solve_joint(model, params, settings);

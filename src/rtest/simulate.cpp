@@ -129,6 +129,16 @@ RtestSimulation simulate_rtest(const MachineModel& truth, const RtestSimOptions&
     }
   if (o.noise_um > 0.0) s.metadata.push_back({"noise_um", fmt(o.noise_um, 4)});
 
+  // effects.md: the linear-axis polynomials are about the session's mean commanded xyz.
+  EffectModel fx = truth.effects;
+  if (!fx.linear_reference) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3d& q : o.pattern.nests)
+      for (double b : o.pattern.b_deg)
+        for (double c : o.pattern.c_deg) sum += rtest_commanded_xyz(truth.machine, q, {b * kDeg, c * kDeg});
+    fx.linear_reference = sum / static_cast<double>(o.pattern.nests.size() * o.pattern.b_deg.size() *
+                                                    o.pattern.c_deg.size());
+  }
   double t = 0.0;
   for (std::size_t n = 0; n < o.pattern.nests.size(); ++n) {
     const Eigen::Vector3d& q = o.pattern.nests[n];
@@ -144,7 +154,7 @@ RtestSimulation simulate_rtest(const MachineModel& truth, const RtestSimOptions&
         const RotaryAngles<double> a{b * kDeg, c * kDeg};
         r.xyz = rtest_commanded_xyz(truth.machine, q, a);
         const Eigen::Vector3d d =
-            rtest_reading<double>(truth.machine, truth.errors, truth.effects, truth.effect_data(),
+            rtest_reading<double>(truth.machine, truth.errors, fx, truth.effect_data(),
                                   r.xyz, a, t, q) + z;
         const Eigen::Vector3d e(noise(rng), noise(rng), noise(rng));
         if (o.probe_dirs) {

@@ -45,7 +45,8 @@ Scalar predicted_length(MachineType m, const LocationErrors<Scalar>& e, const Ve
 }
 
 /// Predicted lengths of every sample of a session on a machine model, the axes moving as the
-/// samples' time and angle columns say (rotary_motion).
+/// samples' time and angle columns say (rotary_motion); the linear-axis polynomials about the
+/// model's a_ref, unset: the mean commanded xyz of these samples (effects.md).
 std::vector<double> predict_lengths(const BallbarMachineModel& model,
                                     const std::vector<BallbarSample>& samples);
 

@@ -25,6 +25,7 @@ class BallbarDiagnosisProblem : public DiagnosisProblem {
   const std::vector<double>& times() const override { return times_; }
   const std::vector<RotaryAngles<double>>& angles() const override { return arrays_.angles; }
   std::optional<double> declared_noise_um() const override { return session_.noise_um; }
+  Eigen::Vector3d mean_commanded_xyz() const override { return rotacal::mean_commanded_xyz(session_.samples); }
   std::vector<Effect> candidates(int max_harmonic) const override;
   ModelFit fit(const EffectModel& effects) const override;
   Eigen::MatrixXd candidate_jacobian(const ModelFit& at, const Effect& candidate) const override;

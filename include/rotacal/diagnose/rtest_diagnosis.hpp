@@ -28,6 +28,7 @@ class RtestDiagnosisProblem : public DiagnosisProblem {
   const std::vector<double>& times() const override { return times_; }
   const std::vector<RotaryAngles<double>>& angles() const override { return angles_; }
   std::optional<double> declared_noise_um() const override { return session_.noise_um; }
+  Eigen::Vector3d mean_commanded_xyz() const override { return rotacal::mean_commanded_xyz(session_.samples); }
   /// The catalogue less the ballbar's own entries (and tool_offset_Z on a head machine, where
   /// it is in the baseline).
   std::vector<Effect> candidates(int max_harmonic) const override;

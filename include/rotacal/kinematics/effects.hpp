@@ -100,8 +100,9 @@ std::vector<Effect> effect_catalogue(MachineType m, int max_harmonic = 4);
 struct EffectModel {
   std::vector<Effect> effects;
   /// a_ref of the linear-axis polynomials (straightness_DA, linear_pitch): the mean commanded
-  /// xyz over the session (effects.md), mm. Whoever builds a model for a session sets it.
-  Eigen::Vector3d linear_reference = Eigen::Vector3d::Zero();
+  /// xyz over the session (effects.md), mm. Unset, the simulators and fits take the mean of the
+  /// session they are given (centred_on); evaluating an unset model takes the machine zero.
+  std::optional<Eigen::Vector3d> linear_reference;
 
   int num_params() const;
   /// Offset of effect i's first parameter in the flat vector.
@@ -109,6 +110,21 @@ struct EffectModel {
   /// "id.name" for every parameter, in flat order.
   std::vector<std::string> param_labels() const;
 };
+
+/// ā of effects.md: the mean commanded xyz (mm) of a session's samples (anything with `.xyz`).
+template <typename Sample>
+Eigen::Vector3d mean_commanded_xyz(const std::vector<Sample>& samples) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (const Sample& s : samples) sum += s.xyz;
+  return samples.empty() ? sum : Eigen::Vector3d(sum / static_cast<double>(samples.size()));
+}
+
+/// `fx` with its linear-axis polynomials about the session's mean, unless the caller set a_ref.
+template <typename Sample>
+EffectModel centred_on(EffectModel fx, const std::vector<Sample>& samples) {
+  if (!fx.linear_reference) fx.linear_reference = mean_commanded_xyz(samples);
+  return fx;
+}
 
 namespace detail {
 // Chain index of the machine's rotary axis with this letter, -1 if it has none.
@@ -324,6 +340,7 @@ template <typename Scalar>
 Vec3<Scalar> linear_axes_position(const EffectModel& fx, const Scalar* p, const Eigen::Vector3d& xyz,
                                   const Scalar& ball_dz = Scalar(0)) {
   Vec3<Scalar> out = xyz.cast<Scalar>();
+  const Eigen::Vector3d a_ref = fx.linear_reference.value_or(Eigen::Vector3d::Zero());
   for (std::size_t i = 0; i < fx.effects.size(); ++i) {
     const Effect& f = fx.effects[i];
     const Scalar* q = p + fx.offset(i);
@@ -336,14 +353,14 @@ Vec3<Scalar> linear_axes_position(const EffectModel& fx, const Scalar* p, const 
         out[k] += q[0] * Scalar(xyz[k]);
         break;
       case EffectKind::straightness: {  // E_DA, u = (a - a_ref) / 100 mm
-        const double u = (xyz[k] - fx.linear_reference[k]) / 100.0;
+        const double u = (xyz[k] - a_ref[k]) / 100.0;
         out[detail::axis_index(f.direction)] += q[0] * Scalar(u * u) + q[1] * Scalar(u * u * u) +
                                                 q[2] * Scalar(u * u * u * u);
         break;
       }
       case EffectKind::linear_pitch: {  // a rotation of the carriage, times the Z arm
-        const double u = (xyz[k] - fx.linear_reference[k]) / 100.0;
-        const Scalar arm = Scalar(xyz[2] - fx.linear_reference[2]) + ball_dz;
+        const double u = (xyz[k] - a_ref[k]) / 100.0;
+        const Scalar arm = Scalar(xyz[2] - a_ref[2]) + ball_dz;
         const Scalar e = q[0] * Scalar(u) + q[1] * Scalar(u * u);
         // E_BX (about Y) moves a point above the guide by +e*arm in X; E_AY (about X) by -e*arm in Y.
         out[k] += (f.direction == 'B' ? arm : Scalar(-arm)) * e;

@@ -10,6 +10,9 @@
 /// location errors + Oyama's smooth error maps (joint fit, identify_joint.hpp), or Oyama's
 /// Eqs. 5-7 alone (error_model.hpp).
 
+#include <algorithm>
+#include <vector>
+
 #include "rotacal/core/machine_model.hpp"
 
 namespace rotacal {
@@ -46,6 +49,22 @@ inline Eigen::Vector3d rtest_reading(const MachineModel& model, const Eigen::Vec
                                      const RotaryAngles<double>& angles, double t) {
   return rtest_reading<double>(model.machine, model.errors, model.effects, model.effect_data(),
                                rtest_commanded_xyz(model.machine, q_nest, angles), angles, t, q_nest);
+}
+
+/// Noise-free readings of the nest at q_nest at each pose (rad) and time (s). The linear-axis
+/// polynomials are about the model's a_ref, unset: the mean commanded xyz of these poses.
+inline std::vector<Eigen::Vector3d> rtest_readings(const MachineModel& model, const Eigen::Vector3d& q_nest,
+                                                   const std::vector<RotaryAngles<double>>& angles,
+                                                   const std::vector<double>& times) {
+  MachineModel m = model;
+  if (!m.effects.linear_reference) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (const RotaryAngles<double>& a : angles) sum += rtest_commanded_xyz(m.machine, q_nest, a);
+    m.effects.linear_reference = sum / static_cast<double>(std::max<std::size_t>(angles.size(), 1));
+  }
+  std::vector<Eigen::Vector3d> out;
+  for (std::size_t i = 0; i < angles.size(); ++i) out.push_back(rtest_reading(m, q_nest, angles[i], times[i]));
+  return out;
 }
 
 }  // namespace rotacal
