@@ -45,14 +45,11 @@ def classify(findings: list, truth: str | None) -> str:
     return "ambiguous" if f["weight"] < MIN_WEIGHT else "bad_group"
 
 
-def coverage(finding: dict, eid: str, true_params: np.ndarray) -> list:
-    """[hit] per determined parameter: |estimate - truth| <= 2 std (rotacal's units)."""
+def z_scores(finding: dict, eid: str, true_params: np.ndarray) -> list:
+    """(estimate - truth) / std per determined parameter (rotacal's units)."""
     truth = to_rotacal_params(eid, true_params)
-    out = []
-    for est, t in zip(finding["parameters"].values(), truth):
-        if est.get("value") is not None and est.get("std"):
-            out.append(bool(abs(est["value"] - t) <= 2.0 * est["std"]))
-    return out
+    return [float((est["value"] - t) / est["std"]) for est, t in zip(finding["parameters"].values(), truth)
+            if est.get("value") is not None and est.get("std")]
 
 
 class CellCache:
@@ -116,5 +113,6 @@ def run_session(cache: CellCache, task: dict, diagnose) -> dict:
                         "group": [g["effect"] for g in f["group"]],
                         "aliased": [g["effect"] for g in f["group"] if g.get("aliased")]} for f in findings]
     if rec["outcome"] == "right":
-        rec["coverage"] = coverage(findings[0], eid, params)
+        rec["z"] = z_scores(findings[0], eid, params)
+        rec["coverage"] = [abs(z) <= 2.0 for z in rec["z"]]
     return rec

@@ -43,10 +43,11 @@ std::vector<Effect> BallbarDiagnosisProblem::candidates(int max_harmonic) const 
   return out;
 }
 
-ModelFit BallbarDiagnosisProblem::fit(const EffectModel& effects) const {
+ModelFit BallbarDiagnosisProblem::fit_gls(const EffectModel& effects,
+                                          std::shared_ptr<const ResidualWhitener> noise) const {
   JointFitOptions o;
   o.effects = effects;
-  o.whitener = whitener;
+  o.whitener = std::move(noise);
   BallbarIdentification id = identify_joint(arrays_, o);  // its Jacobian is moved, not copied
   ModelFit f;
   f.effects = id.model.effects;

@@ -91,7 +91,8 @@ std::vector<Effect> RtestDiagnosisProblem::candidates(int max_harmonic) const {
   return out;
 }
 
-ModelFit RtestDiagnosisProblem::fit(const EffectModel& effects) const {
+ModelFit RtestDiagnosisProblem::fit_gls(const EffectModel& effects,
+                                        std::shared_ptr<const ResidualWhitener> noise) const {
   const EffectModel fx = centred_on(effects, session_.samples);
   const int S = static_cast<int>(setups_.size());
   std::vector<FitParameter> params;
@@ -110,7 +111,7 @@ ModelFit RtestDiagnosisProblem::fit(const EffectModel& effects) const {
   }
   JointFitSettings settings;
   settings.sigma = session_.noise_um.value_or(1.0) * 1e-3;
-  settings.whitener = whitener;
+  settings.whitener = std::move(noise);
   const RtestEffectResiduals model(session_.machine, xyz_, nest_, d_, pose_angles_, pose_times_,
                                    setup_of_, S, fx);
   JointFitOutcome fit = solve_joint(model, params, settings);

@@ -26,11 +26,13 @@
 
 #include <optional>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "rotacal/core/estimate.hpp"
 #include "rotacal/core/noise_model.hpp"
+#include "rotacal/core/whitener.hpp"
 #include "rotacal/kinematics/effects.hpp"
 
 namespace rotacal {
@@ -60,6 +62,9 @@ class DiagnosisProblem {
   virtual std::vector<Effect> candidates(int max_harmonic) const = 0;
   /// Full nonlinear fit of the baseline extended by `effects`.
   virtual ModelFit fit(const EffectModel& effects) const = 0;
+  /// The same fit by GLS under `noise` (one residual per scalar reading, in reading order):
+  /// the final model's numbers when the noise is correlated.
+  virtual ModelFit fit_gls(const EffectModel& effects, std::shared_ptr<const ResidualWhitener> noise) const = 0;
   /// d model / d (parameters of `candidate`) at `at`, one row per reading.
   virtual Eigen::MatrixXd candidate_jacobian(const ModelFit& at, const Effect& candidate) const = 0;
   /// candidate_jacobian of each of `candidates`, in order; an instrument may share work

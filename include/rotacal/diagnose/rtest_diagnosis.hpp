@@ -32,7 +32,8 @@ class RtestDiagnosisProblem : public DiagnosisProblem {
   /// The catalogue less the ballbar's own entries (and tool_offset_Z on a head machine, where
   /// it is in the baseline).
   std::vector<Effect> candidates(int max_harmonic) const override;
-  ModelFit fit(const EffectModel& effects) const override;
+  ModelFit fit(const EffectModel& effects) const override { return fit_gls(effects, whitener); }
+  ModelFit fit_gls(const EffectModel& effects, std::shared_ptr<const ResidualWhitener> noise) const override;
   Eigen::MatrixXd candidate_jacobian(const ModelFit& at, const Effect& candidate) const override;
   std::vector<Eigen::MatrixXd> candidate_jacobians(const ModelFit& at,
                                                    const std::vector<Effect>& candidates) const override;
