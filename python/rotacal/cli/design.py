@@ -8,7 +8,7 @@ from typing import Any, Sequence
 
 from .. import jsontext
 from ..outputs import write_output
-from ..sessions import BALLBAR, RTEST, by_kind
+from ..sessions import BALLBAR, RTEST, kind
 from .options import EPILOG, EXIT_OK, OptionError, number, number_list, numbers, path, say
 from .setups import add_setup_args, ballbar_setup, load_session
 
@@ -22,14 +22,22 @@ def _run_time(text: str) -> float:
     return v
 
 
-def cmd_design_separation(a: argparse.Namespace) -> int:
-    from ..ballbar import nc_program
-    from ..design import added_setup, design_separation, parameter_units, separation_dict
+def _session_after(a: argparse.Namespace, wanted: str) -> Any:
+    """The session of --after that a --separate design follows, of the instrument designed."""
     if not a.after:
         raise OptionError("--separate: give the session it follows with --after SESSION")
     session = load_session(a.after)
-    if by_kind(session, {BALLBAR: False, RTEST: True}, "--after"):
-        raise OptionError(f"--after {a.after}: an R-test session; design ballbar --separate needs a ballbar session")
+    if kind(session) != wanted:
+        words = {BALLBAR: ("a ballbar session", "ballbar"), RTEST: ("an R-test session", "rtest")}
+        raise OptionError(f"--after {a.after}: {words[kind(session)][0]}; design {words[wanted][1]} --separate "
+                          f"needs {words[wanted][0]}")
+    return session
+
+
+def cmd_design_separation(a: argparse.Namespace) -> int:
+    from ..ballbar import nc_program
+    from ..design import added_setup, design_separation, parameter_units, separation_dict
+    session = _session_after(a, BALLBAR)
     base = ballbar_setup(a)
     d = design_separation(session, [e.strip() for e in a.separate.split(",")], base=base, lengths=a.lengths,
                           pivot_r=a.pivot_r, pivot_angle=a.pivot_angle, pivot_z=a.pivot_z, travel=a.travel,
@@ -104,11 +112,7 @@ def cmd_design_ballbar(a: argparse.Namespace) -> int:
 
 def cmd_design_rtest_separation(a: argparse.Namespace) -> int:
     from ..design import design_rtest_separation, parameter_units, rtest_separation_dict
-    if not a.after:
-        raise OptionError("--separate: give the session it follows with --after SESSION")
-    session = load_session(a.after)
-    if by_kind(session, {BALLBAR: True, RTEST: False}, "--after"):
-        raise OptionError(f"--after {a.after}: a ballbar session; design rtest --separate needs an R-test session")
+    session = _session_after(a, RTEST)
     d = design_rtest_separation(session, [e.strip() for e in a.separate.split(",")], radii=a.radii,
                                 angles=a.nest_angles, heights=a.heights, b_steps=a.b_steps, c_steps=a.c_steps,
                                 b_limits=a.b_limits, travel=a.travel, dwell_s=a.dwell or 0.0, max_time_s=a.max_time,
