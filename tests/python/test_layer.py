@@ -186,3 +186,26 @@ def test_identify_does_not_load_matplotlib(shared_data):
                         str(shared_data / "ballbar_ac_table2.csv")], capture_output=True, text=True, timeout=120)
     assert r.returncode == 0 and "rotacal.cli" in r.stderr
     assert "matplotlib" not in r.stderr
+
+
+def test_a_module_adds_its_kind_to_another_modules_command(monkeypatch):
+    # The seam a new instrument uses (`simulate probe`): a module with KINDS listed in MODULES.
+    import types
+
+    from rotacal.cli import parser
+
+    def add(kinds):
+        k = kinds.add_parser("gauge", help="a made-up instrument")
+        k.add_argument("-o", "--output", required=True)
+        k.set_defaults(func=lambda a: 0)
+
+    extra = types.SimpleNamespace(COMMANDS={}, KINDS={"simulate": add})
+    monkeypatch.setattr(parser, "MODULES", parser.MODULES + (extra,))
+    p = parser.build_parser()
+    assert p.parse_args(["simulate", "gauge", "-o", "x"]).kind == "gauge"
+    assert "{ballbar,rtest,gauge}" in _subparser(p, "simulate").format_help()
+    assert p.parse_args(["simulate", "rtest", "-o", "x.csv"]).kind == "rtest"
+
+
+def _subparser(p, name):
+    return next(a for a in p._actions if a.dest == "command").choices[name]
