@@ -48,7 +48,7 @@ def monte_carlo(session: Any, identification: Any, draws: int, *, seed: int = 1)
     fitted noise model (rotacal.ballbar.monte_carlo, rotacal.rtest.monte_carlo_rtest)."""
     return by_kind(session, {BALLBAR: lambda: ballbar.monte_carlo(session, identification, draws, seed=seed),
                              RTEST: lambda: rtest.monte_carlo_rtest(session, identification, draws, seed=seed)},
-                   "--monte-carlo")()
+                   "monte_carlo")()
 
 
 def identification_document(identification: Any, session_path: str | Path, controller: str | None = None) -> dict:

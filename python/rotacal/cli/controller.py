@@ -54,7 +54,7 @@ def cmd_export(a: argparse.Namespace) -> int:
     elif not a.output:
         print(ex.text, end="")
     say(f"held: {', '.join(held) or 'none'}; not held: {', '.join(left) or 'none'}"
-         + ("" if ex.current_given else "; no --current: zero offsets assumed, the values are the corrections"))
+        + ("" if ex.current_given else "; no --current: zero offsets assumed, the values are the corrections"))
     return EXIT_OK
 
 
