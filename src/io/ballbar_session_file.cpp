@@ -129,15 +129,7 @@ void BallbarWriter::append(const BallbarSample& s) {
   ++rows_;
 }
 void BallbarWriter::annotate(const std::string& text) { put(file_, path_, annotation_line(text)); }
-void BallbarWriter::close() {
-  if (!file_) return;
-  std::unique_ptr<OutputStream> f = std::move(file_);
-  f->commit();
-}
-void BallbarWriter::discard() {
-  if (!file_) return;
-  std::unique_ptr<OutputStream> f = std::move(file_);
-  f->discard();
-}
+void BallbarWriter::close() { end_stream(file_, true); }
+void BallbarWriter::discard() { end_stream(file_, false); }
 
 }  // namespace rotacal

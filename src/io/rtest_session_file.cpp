@@ -181,15 +181,7 @@ void RtestWriter::append(const RtestSample& s) {
   ++rows_;
 }
 void RtestWriter::annotate(const std::string& text) { put(file_, path_, annotation_line(text)); }
-void RtestWriter::close() {
-  if (!file_) return;
-  std::unique_ptr<OutputStream> f = std::move(file_);
-  f->commit();
-}
-void RtestWriter::discard() {
-  if (!file_) return;
-  std::unique_ptr<OutputStream> f = std::move(file_);
-  f->discard();
-}
+void RtestWriter::close() { end_stream(file_, true); }
+void RtestWriter::discard() { end_stream(file_, false); }
 
 }  // namespace rotacal

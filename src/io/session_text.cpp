@@ -61,5 +61,14 @@ std::string annotation_line(const std::string& text) {
   return "# " + trim(t) + "\n";
 }
 
+void end_stream(std::unique_ptr<OutputStream>& file, bool commit) {
+  if (!file) return;
+  std::unique_ptr<OutputStream> f = std::move(file);
+  if (commit)
+    f->commit();
+  else
+    f->discard();
+}
+
 }  // namespace io_detail
 }  // namespace rotacal

@@ -58,5 +58,8 @@ void check_samples(const std::vector<Sample>& samples) {
 void put(const std::unique_ptr<OutputStream>& f, const std::string& path, const std::string& text);
 // A `# text` annotation line (newlines in the text become spaces).
 std::string annotation_line(const std::string& text);
+// Ends an appending writer's stream once: commits it (the file replaces the target) or
+// discards it (the old file stays); nothing when it has ended already.
+void end_stream(std::unique_ptr<OutputStream>& f, bool commit);
 
 }  // namespace rotacal::io_detail
