@@ -304,9 +304,9 @@ class CircularSearch {
   // and the column-scaled inverse normal matrix.
   std::vector<Eigen::Index> offsets;
   Eigen::MatrixXd M;
-  double dof = 0.0;
+  double final_dof = 0.0;
   double s2 = 0.0;
-  Eigen::VectorXd sc;
+  Eigen::VectorXd col_scale;
   Eigen::MatrixXd Ninv;
 };
 

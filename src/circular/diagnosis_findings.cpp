@@ -33,14 +33,14 @@ void CircularSearch::final_model() {
   const Eigen::MatrixXd Jw = W(Jfull);
   int n_nonlinear = 0;
   for (const Chosen& c : chosen) n_nonlinear += nonlinear_params(c.effect);
-  dof = static_cast<double>(R.n) - static_cast<double>(Jw.cols()) - n_nonlinear;
-  s2 = fit.rss_w / dof;
+  final_dof = static_cast<double>(R.n) - static_cast<double>(Jw.cols()) - n_nonlinear;
+  s2 = fit.rss_w / final_dof;
   // Column-scaled inverse of the normal matrix: the baseline's columns are O(1), the effects'
   // up to O(R^2); scaling keeps the inverse accurate.
-  sc = Jw.colwise().norm().transpose();
-  for (Eigen::Index j = 0; j < sc.size(); ++j)
-    if (!(sc[j] > 0.0)) sc[j] = 1.0;
-  const Eigen::MatrixXd Js = Jw * sc.cwiseInverse().asDiagonal();
+  col_scale = Jw.colwise().norm().transpose();
+  for (Eigen::Index j = 0; j < col_scale.size(); ++j)
+    if (!(col_scale[j] > 0.0)) col_scale[j] = 1.0;
+  const Eigen::MatrixXd Js = Jw * col_scale.cwiseInverse().asDiagonal();
   Ninv = (Js.transpose() * Js).ldlt().solve(Eigen::MatrixXd::Identity(Js.cols(), Js.cols()));
 }
 
@@ -70,7 +70,7 @@ Eigen::VectorXd CircularSearch::beta_at(std::size_t k, double tau, double delay)
 
 void CircularSearch::add_findings() {
   const auto std_of = [&](Eigen::Index j) {
-    return std::sqrt(std::max(Ninv(j, j), 0.0) * s2) / sc[j];
+    return std::sqrt(std::max(Ninv(j, j), 0.0) * s2) / col_scale[j];
   };
   const std::vector<int> fold = run_folds(R, o_.cv_blocks);
   const double cv_all = cv_rms_um(R, M, R.y, fold, o_.cv_blocks);
@@ -131,8 +131,8 @@ void CircularSearch::add_findings() {
     f.gain.rms_before_um = rms_um(without.r_mm);
     f.gain.rms_after_um = out.final_rms_um;
     f.gain.delta_bic = n * std::log(std::max(fit.rss_w, 1e-300) / without.rss_w) + kk * std::log(n);
-    const double F = ((without.rss_w - fit.rss_w) / kk) / (fit.rss_w / dof);
-    f.gain.f_pvalue = stats::f_sf(std::max(F, 0.0), kk, dof);
+    const double F = ((without.rss_w - fit.rss_w) / kk) / (fit.rss_w / final_dof);
+    f.gain.f_pvalue = stats::f_sf(std::max(F, 0.0), kk, final_dof);
     f.gain.cv_rms_before_um = cv_rms_um(R, Mo, R.y, fold, o_.cv_blocks);
     f.gain.cv_rms_after_um = cv_all;
     out.findings.push_back(std::move(f));

@@ -182,7 +182,8 @@ RtestJointModelContent sample_rtest_content(MachineType machine) {
   for (const std::string& n : {"dz_" + maps[0] + ".b2", "alpha_" + maps[0] + ".b1", "dx_" + maps[1] + ".cos1.b0"})
     names.push_back(n);
   for (std::size_t i = 0; i < names.size(); ++i) {
-    const bool angle = i < 8 ? location_error_is_angle(static_cast<int>(i)) : names[i].rfind("d", 0) != 0;
+    const bool angle = i < 8 ? location_error_is_angle(static_cast<int>(i))
+                             : names[i] != "tool_offset_Z" && names[i].rfind("d", 0) != 0;
     c.parameters.push_back({names[i], (i % 2 ? -1.0 : 1.0) * (angle ? 3.1e-5 : 0.0123) * (1.0 + 0.137 * i),
                             angle ? 1.7e-6 : 4.3e-4, angle ? "rad" : "mm", true});
   }
