@@ -1,4 +1,4 @@
-#include "rotacal/ballbar/circular_analysis.hpp"
+#include "rotacal/circular/analysis.hpp"
 
 #include <algorithm>
 #include <cmath>

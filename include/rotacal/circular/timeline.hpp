@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// The circular-test program (circular_test.hpp) as a function of time: the counterpart of
+/// The circular-test program (circular/plan.hpp) as a function of time: the counterpart of
 /// ProgramTimeline (timeline.hpp) for the ISO 230-4 runs, so that a virtual ballbar can play a
 /// circular plan and a recorder can label what it reads with the runs' labels.
 ///
@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "rotacal/ballbar/circular_test.hpp"
+#include "rotacal/circular/plan.hpp"
 #include "rotacal/io/session.hpp"
 
 namespace rotacal {

@@ -5,7 +5,7 @@
 #include <regex>
 #include <sstream>
 
-#include "rotacal/ballbar/circular_test.hpp"
+#include "rotacal/circular/plan.hpp"
 #include "rotacal/core/error.hpp"
 #include "rotacal/io/ballbar_file.hpp"
 #include "rotacal/kinematics/machine_description.hpp"

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// ISO 230-4 results of ballbar circular tests (circular_test.hpp) from a `rotacal-ballbar/1`
+/// ISO 230-4 results of ballbar circular tests (circular/plan.hpp) from a `rotacal-ballbar/1`
 /// session: per run the circular deviation G, per plane and feed the bidirectional circular
 /// deviation G(b) and the circular hysteresis H.
 ///
@@ -27,7 +27,7 @@
 #include <string>
 #include <vector>
 
-#include "rotacal/ballbar/circular_test.hpp"
+#include "rotacal/circular/plan.hpp"
 #include "rotacal/io/session.hpp"
 
 namespace rotacal {

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// Simulated ballbar readings of the ISO 230-4 circular tests (circular_test.hpp) on a machine
+/// Simulated ballbar readings of the ISO 230-4 circular tests (circular/plan.hpp) on a machine
 /// whose linear axes have the classic errors, with the instrument's coloured noise.
 ///
 /// Actual position of linear axis i (X, Y, Z; a_i its commanded position, theta the commanded
@@ -26,8 +26,8 @@
 #include <Eigen/Core>
 #include <cstdint>
 
-#include "rotacal/ballbar/circular_test.hpp"
-#include "rotacal/ballbar/circular_timeline.hpp"
+#include "rotacal/circular/plan.hpp"
+#include "rotacal/circular/timeline.hpp"
 
 namespace rotacal {
 

@@ -3,9 +3,9 @@
 #include <cmath>
 #include <map>
 
-#include "rotacal/ballbar/circular_simulate.hpp"
+#include "rotacal/circular/simulate.hpp"
 #include "rotacal/core/error.hpp"
-#include "rotacal/diagnose/circular_diagnosis.hpp"
+#include "rotacal/circular/diagnosis.hpp"
 
 using namespace rotacal;
 

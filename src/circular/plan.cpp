@@ -1,4 +1,4 @@
-#include "rotacal/ballbar/circular_test.hpp"
+#include "rotacal/circular/plan.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <set>
 
-#include "nc_words.hpp"
+#include "../ballbar/nc_words.hpp"
 #include "rotacal/core/error.hpp"
 
 namespace rotacal {

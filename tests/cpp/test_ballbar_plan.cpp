@@ -3,7 +3,7 @@
 #include <map>
 #include <sstream>
 
-#include "rotacal/ballbar/test_plan.hpp"
+#include "rotacal/ballbar/plan.hpp"
 #include "rotacal/io/ballbar_file.hpp"
 
 using namespace rotacal;

@@ -2,8 +2,8 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
-#include "rotacal/ballbar/circular_analysis.hpp"
-#include "rotacal/ballbar/circular_simulate.hpp"
+#include "rotacal/circular/analysis.hpp"
+#include "rotacal/circular/simulate.hpp"
 #include "rotacal/core/error.hpp"
 
 using namespace rotacal;

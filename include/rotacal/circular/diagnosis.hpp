@@ -13,7 +13,7 @@
 ///   reading - L0 = sum over runs [c0 + c1 cos theta + c2 sin theta]      (baseline: centre
 ///                  offset and radius of each run, what ISO 230-4's LSQ circle removes)
 ///                + sum over entries  e_r . delta_entry(theta, omega, t)  + noise
-/// with delta as in circular_simulate.hpp, at the commanded positions. The model is linear in
+/// with delta as in circular/simulate.hpp, at the commanded positions. The model is linear in
 /// every parameter except two, which are profiled (every linear parameter refitted at each
 /// trial): a spike's time constant (grid, then golden section on its log; 1-sigma from the
 /// profile's curvature) and the reversal delay of backlash and spikes, the time from the
@@ -43,7 +43,7 @@
 #include <string>
 #include <vector>
 
-#include "rotacal/ballbar/circular_analysis.hpp"
+#include "rotacal/circular/analysis.hpp"
 #include "rotacal/core/estimate.hpp"
 #include "rotacal/core/noise_model.hpp"
 #include "rotacal/diagnose/diagnosis.hpp"
@@ -118,7 +118,7 @@ struct CircularDiagnosis {
   Eigen::VectorXd residuals_mm;  ///< final model, one per circular reading in run order
 };
 
-/// Diagnose the circular runs of a session (circular_analysis.hpp names the runs). Throws
+/// Diagnose the circular runs of a session (circular/analysis.hpp names the runs). Throws
 /// InvalidArgument for unknown ids in options.only, a non-positive screw pitch, alpha outside
 /// (0, 1), and the errors of circular_runs.
 CircularDiagnosis diagnose_circular(const BallbarSession& session,

@@ -1,4 +1,4 @@
-#include "rotacal/ballbar/circular_simulate.hpp"
+#include "rotacal/circular/simulate.hpp"
 
 #include <cmath>
 #include <string>

@@ -1,4 +1,4 @@
-#include "rotacal/ballbar/circular_timeline.hpp"
+#include "rotacal/circular/timeline.hpp"
 
 #include <algorithm>
 #include <cmath>

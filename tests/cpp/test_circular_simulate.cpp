@@ -1,7 +1,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
-#include "rotacal/ballbar/circular_simulate.hpp"
+#include "rotacal/circular/simulate.hpp"
 #include "rotacal/core/error.hpp"
 
 using namespace rotacal;

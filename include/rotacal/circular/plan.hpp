@@ -4,7 +4,7 @@
 /// radius = bar length, feeds, directions, data arc with run-in and overshoot arcs), its
 /// toolpath at the ballbar's sample rate, the commanded `rotacal-ballbar/1` session and the NC
 /// program. The same instrument, set-up and files as the rotary-axis test
-/// (test_plan.hpp): every rotary axis stays at 0, the pivot ball is the circle's centre.
+/// (ballbar/plan.hpp): every rotary axis stays at 0, the pivot ball is the circle's centre.
 ///
 /// Plane axes (u, v) and angle: XY = (X, Y), YZ = (Y, Z), ZX = (Z, X). The path angle theta
 /// turns u towards v, so a counter-clockwise (ccw) run is a positive rotation about the plane's
@@ -49,7 +49,7 @@ struct CircularTestPlan {
   MachineType machine = MachineType::AC_trt;
   double radius = 100.0;  ///< circle radius = calibrated bar length L0, mm
   /// Centre = nominal pivot ball, table frame at rotary zero (= machine frame there), mm. The
-  /// default is the rotary test's pivot (test_plan.hpp), so one set-up serves both tests.
+  /// default is the rotary test's pivot (ballbar/plan.hpp), so one set-up serves both tests.
   Eigen::Vector3d centre = Eigen::Vector3d(120.0, 0.0, 60.0);
   std::vector<CircularPlane> planes = {CircularPlane::XY, CircularPlane::YZ, CircularPlane::ZX};
   std::vector<double> feeds_mm_per_min = {1000.0, 3000.0};  ///< path feeds, each run at one
