@@ -124,7 +124,7 @@ def source_dict(session_path: str | Path) -> dict:
     """The ``source`` member of a model file: the session it was identified from (as named, and
     its SHA-256), when, and by which rotacal; exports and the history quote it."""
     import datetime
-    from . import __version__
+    from .version import __version__
     return {"session": os.fspath(session_path), "session_sha256": file_sha256(session_path),
             "identified_at": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
             "rotacal": __version__}
