@@ -85,6 +85,18 @@ TEST_CASE("an item of the zeros block is the nest's three components") {
   CHECK_THROWS_AS(zeros.item(-1), InvalidArgument);
 }
 
+TEST_CASE("a part of a block is a block at the part's offset, with its names") {
+  const ParameterLayout L = example();
+  const ParameterBlock second = L.block("effects").part(1, 2, "second");
+  CHECK(second.offset == 18);
+  CHECK(second.size == 2);
+  CHECK(second.name == "second");
+  CHECK(second.names == std::vector<std::string>{"effects[1]", "effects[2]"});
+  CHECK(L.block("effects").part(3, 0, "none").empty());
+  CHECK_THROWS_WITH(L.block("effects").part(2, 2, "x"), Catch::Contains("effects: parameters 2..4 of 3"));
+  CHECK_THROWS_AS(L.block("effects").part(-1, 1, "x"), InvalidArgument);
+}
+
 TEST_CASE("raw pointers serve doubles and Jets alike, and an empty block gives nullptr") {
   const ParameterLayout L = example();
   std::vector<double> p(20);

@@ -100,6 +100,23 @@ struct ParameterBlock {
                    units.begin() + static_cast<std::ptrdiff_t>(first + static_cast<std::size_t>(item_size)));
     return b;
   }
+  /// Parameters [first, first + count) of this block (first counted from the block's start) as
+  /// a block of its own called `part_name`, e.g. one effect's parameters within the effects.
+  /// Throws InvalidArgument when they are not inside the block.
+  ParameterBlock part(Eigen::Index first, Eigen::Index count, const std::string& part_name) const {
+    if (first < 0 || count < 0 || first + count > size)
+      throw InvalidArgument("parameter block " + name + ": parameters " + std::to_string(first) + ".." +
+                            std::to_string(first + count) + " of " + std::to_string(size));
+    ParameterBlock b;
+    b.name = part_name;
+    b.offset = offset + first;
+    b.size = count;
+    const auto f = names.begin() + static_cast<std::ptrdiff_t>(first);
+    b.names.assign(f, f + static_cast<std::ptrdiff_t>(count));
+    const auto u = units.begin() + static_cast<std::ptrdiff_t>(first);
+    b.units.assign(u, u + static_cast<std::ptrdiff_t>(count));
+    return b;
+  }
   /// Offset of item k without building the block (hot loops).
   Eigen::Index item_offset(Eigen::Index k) const { return offset + k * item_size; }
 
