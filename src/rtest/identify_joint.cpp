@@ -108,36 +108,24 @@ RtestBasis RtestBasis::for_machine(MachineType m) const {
 }
 
 // ---------------------------------------------------------------- model
-std::vector<std::string> RtestJointModel::parameter_names() const {
-  const auto& le = location_error_names(machine);
-  std::vector<std::string> out(le.begin(), le.end());
-  if (machine.has_head()) out.push_back("tool_offset_Z");
-  for (std::string& n : basis.coefficient_names(machine)) out.push_back(std::move(n));
-  return out;
-}
 namespace {
 // The model's params: the R-test problem's layout without probe zeros and effects.
 RtestLayout model_layout(const RtestJointModel& m) {
   return rtest_layout(m.machine, {}, &m.basis, EffectModel{});
 }
-}  // namespace
-
-LocationErrors<double> RtestJointModel::errors() const {
-  return LocationErrors<double>(model_layout(*this).errors.of<8>(params));
+LocationErrors<double> errors_at(const RtestLayout& L, const Eigen::VectorXd& p) {
+  return LocationErrors<double>(L.errors.of<8>(p));
 }
-double RtestJointModel::tool_offset_z() const {
-  const ParameterBlock tool = model_layout(*this).tool;
-  return tool.empty() ? 0.0 : params[tool.offset];
+double tool_offset_z_at(const RtestLayout& L, const Eigen::VectorXd& p) {
+  return L.tool.empty() ? 0.0 : p[L.tool.offset];
 }
 
-namespace {
 // Linear map from params to w_BY (6 x P) and w_CB (6 x P) at (B, C).
-void map_rows(const RtestJointModel& m, double B, double C, Eigen::MatrixXd& Lb,
+void map_rows(const RtestJointModel& m, const RtestLayout& L, double B, double C, Eigen::MatrixXd& Lb,
               Eigen::MatrixXd& Lc) {
-  const RtestLayout L = model_layout(m);
   Lb = Eigen::MatrixXd::Zero(6, m.params.size());
   Lc = Eigen::MatrixXd::Zero(6, m.params.size());
-  m.basis.map_rows(B, C, L.map_tilt.columns(Lb), L.map_rot.columns(Lc));
+  m.basis.for_machine(m.machine).map_rows(B, C, L.map_tilt.columns(Lb), L.map_rot.columns(Lc));
 }
 
 AxisErrors<double> propagate(const RtestJointModel& m, const Eigen::MatrixXd& L) {
@@ -152,20 +140,20 @@ AxisErrors<double> propagate(const RtestJointModel& m, const Eigen::MatrixXd& L)
   return s;
 }
 
-// 1-sigma of a function of the params by central differences (the model is linear to well
-// below the noise over the identified magnitudes).
+// 1-sigma of a function f(params) by central differences (the model is linear to well below
+// the noise over the identified magnitudes).
 template <typename F>
-Eigen::Vector3d propagate_fn(const RtestJointModel& m, F f) {
+Eigen::Vector3d propagate_fn(const RtestJointModel& m, const RtestLayout& L, F f) {
   const int P = static_cast<int>(m.params.size());
-  const ParameterBlock errors = model_layout(m).errors;
   Eigen::MatrixXd J(3, P);
-  RtestJointModel t = m;
+  Eigen::VectorXd t = m.params;
   for (int j = 0; j < P; ++j) {
-    const double h = errors.contains(j) && location_error_is_angle(static_cast<int>(j - errors.offset)) ? 1e-7 : 1e-5;
-    t.params = m.params;
-    t.params[j] += h;
+    const bool angle = L.errors.contains(j) && location_error_is_angle(static_cast<int>(j - L.errors.offset));
+    const double h = angle ? 1e-7 : 1e-5;
+    t = m.params;
+    t[j] += h;
     const Eigen::Vector3d fp = f(t);
-    t.params[j] -= 2 * h;
+    t[j] -= 2 * h;
     J.col(j) = (fp - f(t)) / (2 * h);
   }
   Eigen::Vector3d s;
@@ -178,56 +166,71 @@ Eigen::Vector3d propagate_fn(const RtestJointModel& m, F f) {
   }
   return s;
 }
+
+Pose<double> table_pose_at(const RtestJointModel& m, const RtestLayout& L, const Eigen::VectorXd& params,
+                           double B, double C) {
+  const double* p = params.data();
+  return rtest_joint_table_pose<double>(m.machine, m.basis, L.errors.ptr(p), p + L.map_tilt.offset,
+                                        p + L.map_rot.offset, B, C);
+}
 }  // namespace
+
+std::vector<std::string> RtestJointModel::parameter_names() const { return model_layout(*this).all.names(); }
+LocationErrors<double> RtestJointModel::errors() const { return errors_at(model_layout(*this), params); }
+double RtestJointModel::tool_offset_z() const { return tool_offset_z_at(model_layout(*this), params); }
 
 AxisErrors<double> RtestJointModel::w_BY(double B, AxisErrors<double>* std) const {
   Eigen::MatrixXd Lb, Lc;
-  map_rows(*this, B, 0.0, Lb, Lc);
+  map_rows(*this, model_layout(*this), B, 0.0, Lb, Lc);
   if (std) *std = propagate(*this, Lb);
   return Lb * params;
 }
 AxisErrors<double> RtestJointModel::w_CB(double B, double C, AxisErrors<double>* std) const {
   Eigen::MatrixXd Lb, Lc;
-  map_rows(*this, B, C, Lb, Lc);
+  map_rows(*this, model_layout(*this), B, C, Lb, Lc);
   if (std) *std = propagate(*this, Lc);
   return Lc * params;
 }
 Pose<double> RtestJointModel::table_pose(double B, double C) const {
-  const RtestLayout L = model_layout(*this);
-  const double* p = params.data();
-  return rtest_joint_table_pose<double>(machine, basis, L.errors.ptr(p), p + L.map_tilt.offset,
-                                        p + L.map_rot.offset, B, C);
+  return table_pose_at(*this, model_layout(*this), params, B, C);
 }
 Eigen::Vector3d RtestJointModel::reading(const Eigen::Vector3d& q, double B, double C,
                                          Eigen::Vector3d* std) const {
   const Eigen::Vector3d xyz = rtest_commanded_xyz(machine, q, {B, C});
-  auto f = [&](const RtestJointModel& m) {
-    return Eigen::Vector3d(rtest_joint_reading<double>(machine, m.errors(), m.w_BY(B), m.w_CB(B, C),
-                                                       m.tool_offset_z(), {B, C}, xyz, q));
+  const RtestLayout L = model_layout(*this);
+  Eigen::MatrixXd Lb, Lc;  // the maps' rows at (B, C), once for every difference
+  map_rows(*this, L, B, C, Lb, Lc);
+  auto f = [&](const Eigen::VectorXd& p) {
+    return Eigen::Vector3d(rtest_joint_reading<double>(machine, errors_at(L, p), Lb * p, Lc * p,
+                                                       tool_offset_z_at(L, p), {B, C}, xyz, q));
   };
-  if (std) *std = propagate_fn(*this, f);
-  return f(*this);
+  if (std) *std = propagate_fn(*this, L, f);
+  return f(params);
 }
 Eigen::Vector3d RtestJointModel::table_error(const Eigen::Vector3d& q, double B, double C,
                                              Eigen::Vector3d* std) const {
-  auto f = [&](const RtestJointModel& m) {
-    return Eigen::Vector3d(m.table_pose(B, C) * q -
+  const RtestLayout L = model_layout(*this);
+  auto f = [&](const Eigen::VectorXd& p) {
+    return Eigen::Vector3d(table_pose_at(*this, L, p, B, C) * q -
                            forward<double>(machine, LocationErrors<double>(), {B, C}, q));
   };
-  if (std) *std = propagate_fn(*this, f);
-  return f(*this);
+  if (std) *std = propagate_fn(*this, L, f);
+  return f(params);
 }
 Eigen::Vector3d RtestJointModel::tool_error(const Eigen::Vector3d& xyz, double B, double C,
                                             Eigen::Vector3d* std) const {
-  auto f = [&](const RtestJointModel& m) -> Eigen::Vector3d {
+  const RtestLayout L = model_layout(*this);
+  Eigen::MatrixXd Lb, Lc;
+  map_rows(*this, L, B, C, Lb, Lc);
+  auto f = [&](const Eigen::VectorXd& p) -> Eigen::Vector3d {
     if (!machine.has_head()) return Eigen::Vector3d::Zero();
     const Pose<double> H =
-        rtest_joint_side_pose<double>(machine, m.errors(), m.w_BY(B), m.w_CB(B, C), {B, C}, true);
-    return xyz + H * tool_vector<double>(machine, -m.tool_offset_z()) -
+        rtest_joint_side_pose<double>(machine, errors_at(L, p), Lb * p, Lc * p, {B, C}, true);
+    return xyz + H * tool_vector<double>(machine, -tool_offset_z_at(L, p)) -
            tool_ball<double>(machine, LocationErrors<double>(), {B, C}, xyz);
   };
-  if (std) *std = propagate_fn(*this, f);
-  return f(*this);
+  if (std) *std = propagate_fn(*this, L, f);
+  return f(params);
 }
 
 const ParameterEstimate& RtestJointIdentification::parameter(const std::string& name) const {

@@ -18,8 +18,10 @@ RtestLayout rtest_layout(MachineType m, const std::vector<std::string>& setups, 
                         : L.all.add("tool_offset_Z", std::vector<std::string>{}, std::vector<std::string>{});
   std::vector<std::string> b_names, b_units, c_names, c_units;
   if (basis) {
-    const std::vector<std::string> names = basis->coefficient_names(m);
-    const std::size_t nb = static_cast<std::size_t>(basis->num_b_coefficients());
+    // The basis as the machine has it (no rotations in a head axis' map): names and counts alike.
+    const RtestBasis b = basis->for_machine(m);
+    const std::vector<std::string> names = b.coefficient_names(m);
+    const std::size_t nb = static_cast<std::size_t>(b.num_b_coefficients());
     for (std::size_t k = 0; k < names.size(); ++k) {
       const std::string comp = names[k].substr(0, names[k].find('_'));
       (k < nb ? b_names : c_names).push_back(names[k]);
@@ -66,12 +68,13 @@ RtestProblem::RtestProblem(const RtestArrays& d, const RtestBasis* basis, Effect
     throw InvalidArgument("R-test problem: the smooth maps and catalogue effects are two models of the table "
                           "pose; give one");
   if (!maps_) return;
+  const RtestBasis b = basis->for_machine(d_.machine);  // as the layout counts its coefficients
   const Eigen::Index n = d_.size(), nb = L_.map_tilt.size, nc = L_.map_rot.size;
   Lb_.resize(6 * n, nb);
   Lc_.resize(6 * n, nc);
   for (Eigen::Index i = 0; i < n; ++i) {
     const RotaryAngles<double>& a = d_.angles[static_cast<std::size_t>(i)];
-    basis->map_rows(a.tilt, a.rot, Lb_.middleRows<6>(6 * i), Lc_.middleRows<6>(6 * i));
+    b.map_rows(a.tilt, a.rot, Lb_.middleRows<6>(6 * i), Lc_.middleRows<6>(6 * i));
   }
 }
 
