@@ -9,20 +9,13 @@
 #include <limits>
 #include <sstream>
 
+#include "rotacal/design/format.hpp"
 #include "rotacal/ballbar/problem.hpp"
 #include "rotacal/core/error.hpp"
 
 namespace rotacal {
 
 namespace {
-
-std::string fmt(double v, int digits = 1) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(digits);
-  s << v;
-  return s.str();
-}
 
 double test_time(const BallbarPlan& plan) {
   double t = 0.0;
@@ -41,8 +34,8 @@ std::string travel_violation(const BallbarPlan& plan, const Eigen::Vector3d& lo,
     for (const PlannedSample& s : seg.samples)
       for (int k = 0; k < 3; ++k)
         if (s.xyz[k] < lo[k] || s.xyz[k] > hi[k])
-          return std::string(1, axis[k]) + " = " + fmt(s.xyz[k], 3) + " mm in " + seg.label +
-                 " is outside the travel " + fmt(lo[k]) + ".." + fmt(hi[k]) + " mm";
+          return std::string(1, axis[k]) + " = " + fixed_text(s.xyz[k], 3) + " mm in " + seg.label +
+                 " is outside the travel " + fixed_text(lo[k]) + ".." + fixed_text(hi[k]) + " mm";
   return {};
 }
 
@@ -174,7 +167,7 @@ BallbarDesign design_ballbar_test(const BallbarDesignOptions& o) {
         if (c.feasible && (!out.best.feasible || c.worst_expanded_um < out.best.worst_expanded_um))
           out.best = c;
         if (!c.feasible && reasons.size() < 400)
-          reasons += "; L0 " + fmt(L) + ", pivot (" + fmt(x) + ", 0, " + fmt(z) + "): " + c.why_not;
+          reasons += "; L0 " + fixed_text(L) + ", pivot (" + fixed_text(x) + ", 0, " + fixed_text(z) + "): " + c.why_not;
         out.candidates.push_back(std::move(c));
       }
   if (!out.best.feasible)

@@ -5,26 +5,18 @@
 #include <sstream>
 
 #include "length_model.hpp"
+#include "rotacal/design/format.hpp"
 #include "rotacal/ballbar/design.hpp"
 #include "rotacal/ballbar/problem.hpp"
 #include "rotacal/core/error.hpp"
-#include "rotacal/core/least_squares.hpp"
 #include "rotacal/design/separation.hpp"
 
 namespace rotacal {
 
 namespace {
 
-std::string fmt(double v, int digits = 1) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(digits);
-  s << v;
-  return s.str();
-}
-
 std::string vec_text(const Eigen::Vector3d& v) {
-  return "(" + fmt(v[0]) + ", " + fmt(v[1]) + ", " + fmt(v[2]) + ") mm";
+  return "(" + fixed_text(v[0]) + ", " + fixed_text(v[1]) + ", " + fixed_text(v[2]) + ") mm";
 }
 
 // The candidates: from the session's pivot, one rotary test at each bar length and range (the
@@ -108,23 +100,23 @@ std::string describe(const SeparatingCandidate& c, MachineType m) {
                          c.setup.tests.back() == BallbarTest::axial_tilt ||
                          c.setup.tests.back() == BallbarTest::tangential_tilt;
   d << label;
-  if (tilt_test) d << " over " << fmt(c.setup.tilt_range_deg[0], 0) << ".." << fmt(c.setup.tilt_range_deg[1], 0) << " deg";
+  if (tilt_test) d << " over " << fixed_text(c.setup.tilt_range_deg[0], 0) << ".." << fixed_text(c.setup.tilt_range_deg[1], 0) << " deg";
   if (c.setup.tests.back() == BallbarTest::radial_c)
     d << " (tool circle " << to_string(c.setup.radial_c_side) << ")";
   if (c.setup.directions.size() > 1) d << " ccw and cw";
   if (c.setup.feed_factors.size() > 1) {
     d << " at";
     for (std::size_t k = 0; k < c.setup.feed_factors.size(); ++k)
-      d << (k ? ", " : " ") << fmt(c.setup.feed_mm_per_min * c.setup.feed_factors[k], 0);
+      d << (k ? ", " : " ") << fixed_text(c.setup.feed_mm_per_min * c.setup.feed_factors[k], 0);
     d << " mm/min";
   }
-  d << " with the " << fmt(c.setup.ballbar_length, 0) << " mm bar";
+  d << " with the " << fixed_text(c.setup.ballbar_length, 0) << " mm bar";
   if (c.new_pivot)
     d << ", pivot moved to " << vec_text(c.setup.pivot)
       << " (after sphere_xy, sphere_yz, sphere_zx to locate it)";
   else
     d << ", from the session's pivot " << vec_text(c.setup.pivot);
-  if (c.slow_down > 1.0) d << ", at 1/" << fmt(c.slow_down, 0) << " of the feeds";
+  if (c.slow_down > 1.0) d << ", at 1/" << fixed_text(c.slow_down, 0) << " of the feeds";
   return d.str();
 }
 
@@ -213,34 +205,17 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session,
   fo.effects = fx;
   fo.noise = NoiseHandling::white;
   const BallbarIdentification id = identify_joint(session, fo);
-  double sigma_um = o.noise_um > 0.0 ? o.noise_um : id.noise.sigma_um;
-  if (!(sigma_um > 0.0)) sigma_um = id.sigma_um;
-  if (!(sigma_um > 0.0))
-    throw InvalidArgument(
-        "design: --after: the session's residuals are zero (commanded data?); give --noise");
-  D.noise_um = sigma_um;
-  if (id.noise.n > 0 && id.noise.effective_samples > 0.0)
-    D.effective_per_reading =
-        std::min(1.0, id.noise.effective_samples / static_cast<double>(id.noise.n));
-  const double w = D.effective_per_reading / (sigma_um * sigma_um * 1e-6);
+  const double w = session_weight(o.noise_um, id.noise, id.sigma_um,
+                                  "design: --after: the session's residuals are zero (commanded data?); give --noise", D);
   const BallbarLayout L = ballbar_layout(m, fx);
   ParameterLayout joint = L.all;
   const ParameterBlock moved_pivot = joint.add("pivot#2", {"pivot_x#2", "pivot_y#2", "pivot_z#2"}, {"mm"});
-  SeparationProblem S;
+  D.names = L.all.names();
   // The Jacobian at the start point, where the fit judges what it can see (at its solution,
   // location errors of 0.1 mm lend second-order sensitivity that the fit does not use).
-  const Eigen::MatrixXd Js = nominal_jacobian(session, fx);
-  S.session_information = Js.transpose() * Js * w;
-  D.names = L.all.names();
-  // Plausible magnitudes by unit (1 mm, 1 mrad, ...), as the fit's observability test uses.
-  const std::vector<std::string> units = joint.units();
-  S.plausible.resize(joint.size());
-  for (Eigen::Index j = 0; j < joint.size(); ++j) S.plausible[j] = plausible_magnitude(units[static_cast<std::size_t>(j)]);
-  S.white = 1.0 / D.effective_per_reading;
-  S.first = effect_block(L.effects, fx, 0);
-  S.second = effect_block(L.effects, fx, 1);
-  S.max_correlation = o.max_correlation;
-  S.max_added_time_s = o.max_added_time_s;
+  const SeparationProblem S = separation_problem(nominal_jacobian(session, fx), w, joint, effect_block(L.effects, fx, 0),
+                                                 effect_block(L.effects, fx, 1), o.max_correlation,
+                                                 o.max_added_time_s, D);
   const bool search = separation_needed(S, D);
   D.chosen.correlation = D.correlation_before;
   if (!search) return D;

@@ -10,6 +10,7 @@
 #include <limits>
 #include <sstream>
 
+#include "rotacal/design/format.hpp"
 #include "rotacal/core/error.hpp"
 #include "rotacal/core/least_squares.hpp"
 
@@ -101,17 +102,32 @@ Eigen::MatrixXd in_layout(const Eigen::MatrixXd& J, const std::vector<ParameterB
   return out;
 }
 
-namespace {
-
-std::string fmt(double v, int digits = 1) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(digits);
-  s << v;
-  return s.str();
+double session_weight(double noise_um_option, const NoiseModel& noise, double fit_sigma_um,
+                      const std::string& zero_noise, SeparationResult& D) {
+  double sigma_um = noise_um_option > 0.0 ? noise_um_option : noise.sigma_um;
+  if (!(sigma_um > 0.0)) sigma_um = fit_sigma_um;
+  if (!(sigma_um > 0.0)) throw InvalidArgument(zero_noise);
+  D.noise_um = sigma_um;
+  if (noise.n > 0 && noise.effective_samples > 0.0)
+    D.effective_per_reading = std::min(1.0, noise.effective_samples / static_cast<double>(noise.n));
+  return D.effective_per_reading / (sigma_um * sigma_um * 1e-6);
 }
 
-}  // namespace
+SeparationProblem separation_problem(const Eigen::MatrixXd& Js, double w, const ParameterLayout& joint,
+                                     const ParameterBlock& first, const ParameterBlock& second,
+                                     double max_correlation, double max_added_time_s, const SeparationResult& D) {
+  SeparationProblem S;
+  S.session_information = Js.transpose() * Js * w;
+  const std::vector<std::string> units = joint.units();
+  S.plausible.resize(joint.size());
+  for (Eigen::Index j = 0; j < joint.size(); ++j) S.plausible[j] = plausible_magnitude(units[static_cast<std::size_t>(j)]);
+  S.white = 1.0 / D.effective_per_reading;
+  S.first = first;
+  S.second = second;
+  S.max_correlation = max_correlation;
+  S.max_added_time_s = max_added_time_s;
+  return S;
+}
 
 bool separation_needed(const SeparationProblem& S, SeparationResult& D) {
   const Eigen::Index p0 = S.session_information.rows();
@@ -188,12 +204,12 @@ void finish_separation(const SeparationProblem& S, const SeparationChoice& c, co
   v.precision(2);
   v << std::fixed;
   if (D.found)
-    v << "add " << description << ": " << fmt(run_s, 0) << " s; fitted with the session, the correlation of "
+    v << "add " << description << ": " << fixed_text(run_s, 0) << " s; fitted with the session, the correlation of "
       << D.effects[0] << " and " << D.effects[1] << " goes from " << D.correlation_before << " to " << correlation;
   else
-    v << "none of " << D.candidates_tried << " " << w.added << " within " << fmt(S.max_added_time_s, 0)
+    v << "none of " << D.candidates_tried << " " << w.added << " within " << fixed_text(S.max_added_time_s, 0)
       << " s brings the correlation of " << D.effects[0] << " and " << D.effects[1] << " below " << S.max_correlation
-      << (D.candidates_tried ? "; the closest is " + description + " (correlation " + fmt(correlation, 2) + ")" +
+      << (D.candidates_tried ? "; the closest is " + description + " (correlation " + fixed_text(correlation, 2) + ")" +
                                    w.closest_note
                              : std::string("; every candidate breaks a limit"));
   if (D.candidates_tried) {

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <vector>
 
+#include "rotacal/design/format.hpp"
 #include "rotacal/core/error.hpp"
 #include "rotacal/core/parameter_layout.hpp"
 #include "rotacal/kinematics/parameter_blocks.hpp"
@@ -17,14 +18,6 @@
 namespace rotacal {
 
 namespace {
-
-std::string fmt(double v, int digits = 1) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(digits);
-  s << v;
-  return s.str();
-}
 
 using Jet1 = ceres::Jet<double, 1>;
 
@@ -90,7 +83,7 @@ Eigen::MatrixXd table_motion_columns(const MotionLayout& L, MachineType m, const
 }
 
 std::string deg_range(std::array<double, 2> r) {
-  return fmt(r[0], 0) + ".." + fmt(r[1], 0) + " deg";
+  return fixed_text(r[0], 0) + ".." + fixed_text(r[1], 0) + " deg";
 }
 
 }  // namespace
@@ -130,7 +123,7 @@ TableMotionOverlap table_motion_overlap(MachineType m, const Effect& a, const Ef
   out.moves_table_first = n1 > 1e-12 * scale;
   out.moves_table_second = n2 > 1e-12 * scale;
   const std::string range =
-      "tilt " + deg_range(tilt) + ", C over a full turn, time 0.." + fmt(duration_s, 0) + " s";
+      "tilt " + deg_range(tilt) + ", C over a full turn, time 0.." + fixed_text(duration_s, 0) + " s";
   if (!out.moves_table_first || !out.moves_table_second) {
     out.why =
         (out.moves_table_first ? b : a).id() +

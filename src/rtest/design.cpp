@@ -9,6 +9,7 @@
 #include <optional>
 #include <sstream>
 
+#include "rotacal/design/format.hpp"
 #include "rotacal/core/error.hpp"
 #include "rotacal/core/joint_fit.hpp"
 #include "rotacal/core/least_squares.hpp"
@@ -19,14 +20,6 @@
 namespace rotacal {
 
 namespace {
-
-std::string fmt(double v, int digits = 1) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(digits);
-  s << v;
-  return s.str();
-}
 
 // The whitener of AR(1) noise with coefficient rho and marginal sigma per stream (one per nest
 // and component dx, dy, dz, in time order, as noise_gen::ar1 and the noise model split them):
@@ -103,14 +96,14 @@ RtestDesignCandidate evaluate_rtest_design(const RtestPattern& pattern, const Rt
   c.duration_s = static_cast<double>(poses * pattern.nests.size()) * pattern.dwell_s;
   if (budget <= 0.0) budget = c.duration_s;
   if (c.duration_s > budget * (1 + 1e-12)) {
-    c.why_not = fmt(c.duration_s, 0) + " s is over the time budget of " + fmt(budget, 0) + " s";
+    c.why_not = fixed_text(c.duration_s, 0) + " s is over the time budget of " + fixed_text(budget, 0) + " s";
     return c;
   }
   const double deg = M_PI / 180.0;
   const char* axis = "XYZ";
   for (double b : pattern.b_deg)
     if (b < o.b_limits_deg[0] - 1e-9 || b > o.b_limits_deg[1] + 1e-9) {
-      c.why_not = "B = " + fmt(b) + " deg is outside the B limits";
+      c.why_not = "B = " + fixed_text(b) + " deg is outside the B limits";
       return c;
     }
   for (std::size_t n = 0; n < pattern.nests.size(); ++n)
@@ -119,10 +112,10 @@ RtestDesignCandidate evaluate_rtest_design(const RtestPattern& pattern, const Rt
         const Eigen::Vector3d xyz = rtest_commanded_xyz(m, pattern.nests[n], {b * deg, cc * deg});
         for (int k = 0; k < 3; ++k)
           if (xyz[k] < o.travel_min[k] || xyz[k] > o.travel_max[k]) {
-            c.why_not = std::string(1, axis[k]) + " = " + fmt(xyz[k], 3) + " mm for nest " +
-                        std::to_string(n + 1) + " at B " + fmt(b) + ", C " + fmt(cc) +
-                        " deg is outside the travel " + fmt(o.travel_min[k]) + ".." +
-                        fmt(o.travel_max[k]) + " mm";
+            c.why_not = std::string(1, axis[k]) + " = " + fixed_text(xyz[k], 3) + " mm for nest " +
+                        std::to_string(n + 1) + " at B " + fixed_text(b) + ", C " + fixed_text(cc) +
+                        " deg is outside the travel " + fixed_text(o.travel_min[k]) + ".." +
+                        fixed_text(o.travel_max[k]) + " mm";
             return c;
           }
       }
@@ -272,7 +265,7 @@ Eigen::MatrixXd nominal_rtest_jacobian(const RtestArrays& poses, const EffectMod
 }
 
 std::string v3(const Eigen::Vector3d& v) {
-  return "(" + fmt(v[0]) + ", " + fmt(v[1]) + ", " + fmt(v[2]) + ") mm";
+  return "(" + fixed_text(v[0]) + ", " + fixed_text(v[1]) + ", " + fixed_text(v[2]) + ") mm";
 }
 
 
@@ -327,12 +320,12 @@ std::optional<RtestArrays> added_poses(const RtestPattern& pat, const RtestSepar
 std::string describe(const RtestSeparatingCandidate& c) {
   const RtestPattern& pat = c.added;
   std::ostringstream d;
-  d << "a nest at " << v3(pat.nests[0]) << ", B " << fmt(pat.b_deg.front(), 0) << ".."
-    << fmt(pat.b_deg.back(), 0) << " deg every "
-    << fmt(pat.b_deg.size() > 1 ? pat.b_deg[1] - pat.b_deg[0] : 0.0, 0) << ", C every "
-    << fmt(pat.c_deg.size() > 1 ? pat.c_deg[1] - pat.c_deg[0] : 360.0, 0) << " deg, "
-    << fmt(pat.dwell_s, 1) << " s per pose";
-  if (c.repeats > 1.0) d << ", run " << fmt(c.repeats, 0) << " times";
+  d << "a nest at " << v3(pat.nests[0]) << ", B " << fixed_text(pat.b_deg.front(), 0) << ".."
+    << fixed_text(pat.b_deg.back(), 0) << " deg every "
+    << fixed_text(pat.b_deg.size() > 1 ? pat.b_deg[1] - pat.b_deg[0] : 0.0, 0) << ", C every "
+    << fixed_text(pat.c_deg.size() > 1 ? pat.c_deg[1] - pat.c_deg[0] : 360.0, 0) << " deg, "
+    << fixed_text(pat.dwell_s, 1) << " s per pose";
+  if (c.repeats > 1.0) d << ", run " << fixed_text(c.repeats, 0) << " times";
   return d.str();
 }
 
@@ -383,33 +376,18 @@ RtestSeparationDesign design_rtest_separation(const RtestSession& session,
   RtestJointOptions fo;
   fo.noise = NoiseHandling::white;
   const RtestJointIdentification id = identify_joint(session, fo);
-  double sigma_um = o.noise_um > 0.0 ? o.noise_um : id.noise.sigma_um;
-  if (!(sigma_um > 0.0)) sigma_um = id.sigma_um;
-  if (!(sigma_um > 0.0))
-    throw InvalidArgument("design rtest: --after: the session's residuals are zero; give --noise");
-  D.noise_um = sigma_um;
-  if (id.noise.n > 0 && id.noise.effective_samples > 0.0)
-    D.effective_per_reading =
-        std::min(1.0, id.noise.effective_samples / static_cast<double>(id.noise.n));
-  const double w = D.effective_per_reading / (sigma_um * sigma_um * 1e-6);
+  const double w = session_weight(o.noise_um, id.noise, id.sigma_um,
+                                  "design rtest: --after: the session's residuals are zero; give --noise", D);
   // Joint layout: the R-test problem's (location errors, a probe zero per session nest, the
   // pair), then the added nest's probe zero.
   const RtestLayout L = rtest_layout(m, poses.setups, nullptr, fx, RtestZeroNames::numbered);
   const RtestLayout La = rtest_layout(m, {"added"}, nullptr, fx, RtestZeroNames::numbered);
   ParameterLayout joint = L.all;
   const ParameterBlock added_zero = joint.add("zero#added", La.zeros.names, {"mm"}, 3);
-  SeparationProblem S;
-  const Eigen::MatrixXd Js = nominal_rtest_jacobian(poses, fx);
-  S.session_information = Js.transpose() * Js * w;
   D.names = L.all.names();
-  const std::vector<std::string> units = joint.units();
-  S.plausible.resize(joint.size());
-  for (Eigen::Index j = 0; j < joint.size(); ++j) S.plausible[j] = plausible_magnitude(units[static_cast<std::size_t>(j)]);
-  S.white = 1.0 / D.effective_per_reading;
-  S.first = effect_block(L.effects, fx, 0);
-  S.second = effect_block(L.effects, fx, 1);
-  S.max_correlation = o.max_correlation;
-  S.max_added_time_s = o.max_added_time_s;
+  const SeparationProblem S = separation_problem(nominal_rtest_jacobian(poses, fx), w, joint,
+                                                 effect_block(L.effects, fx, 0), effect_block(L.effects, fx, 1),
+                                                 o.max_correlation, o.max_added_time_s, D);
   const bool search = separation_needed(S, D);
   D.chosen.correlation = D.correlation_before;
   if (!search) return D;

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "rotacal/core/noise_model.hpp"
 #include "rotacal/core/parameter_layout.hpp"
 #include "rotacal/design/table_motion.hpp"
 
@@ -72,6 +73,20 @@ struct SeparationProblem {
   double max_correlation = 0.5;
   double max_added_time_s = 600.0;
 };
+
+/// The session's noise per reading into D (noise_um: `noise_um_option` when > 0, else the
+/// noise model's sigma, else the fit's residual sigma; effective_per_reading from the noise
+/// model) and the weight of its information, effective / sigma^2 (1 / mm^2). Throws
+/// InvalidArgument with `zero_noise` when every sigma is zero.
+double session_weight(double noise_um_option, const NoiseModel& noise, double fit_sigma_um,
+                      const std::string& zero_noise, SeparationResult& D);
+
+/// The problem of a session whose nominal Jacobian Js (session layout: the first columns of
+/// `joint`) is weighted by w: plausible magnitudes by the units of `joint` (1 mm, 1 mrad, ...,
+/// as the fit's observability test uses them), and D's effective samples per reading.
+SeparationProblem separation_problem(const Eigen::MatrixXd& Js, double w, const ParameterLayout& joint,
+                                     const ParameterBlock& first, const ParameterBlock& second,
+                                     double max_correlation, double max_added_time_s, const SeparationResult& D);
 
 /// One added measurement, in the joint layout (p >= p0 parameters; the session's first).
 struct AddedInformation {

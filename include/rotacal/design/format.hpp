@@ -1,0 +1,19 @@
+#pragma once
+/// \file
+/// The designs' number format in words: fixed point with a given number of digits.
+
+#include <sstream>
+#include <string>
+
+namespace rotacal {
+
+/// v in fixed point with `digits` decimals ("12.5").
+inline std::string fixed_text(double v, int digits = 1) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(digits);
+  s << v;
+  return s.str();
+}
+
+}  // namespace rotacal
