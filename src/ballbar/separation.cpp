@@ -15,10 +15,6 @@ namespace rotacal {
 
 namespace {
 
-std::string vec_text(const Eigen::Vector3d& v) {
-  return "(" + fixed_text(v[0]) + ", " + fixed_text(v[1]) + ", " + fixed_text(v[2]) + ") mm";
-}
-
 // The candidates: from the session's pivot, one rotary test at each bar length and range (the
 // pivot is shared with the session); from a moved pivot (second: true), the sphere tests that
 // locate it and one rotary test.
@@ -112,10 +108,10 @@ std::string describe(const SeparatingCandidate& c, MachineType m) {
   }
   d << " with the " << fixed_text(c.setup.ballbar_length, 0) << " mm bar";
   if (c.new_pivot)
-    d << ", pivot moved to " << vec_text(c.setup.pivot)
+    d << ", pivot moved to " << point_text(c.setup.pivot)
       << " (after sphere_xy, sphere_yz, sphere_zx to locate it)";
   else
-    d << ", from the session's pivot " << vec_text(c.setup.pivot);
+    d << ", from the session's pivot " << point_text(c.setup.pivot);
   if (c.slow_down > 1.0) d << ", at 1/" << fixed_text(c.slow_down, 0) << " of the feeds";
   return d.str();
 }

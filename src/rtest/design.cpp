@@ -264,10 +264,6 @@ Eigen::MatrixXd nominal_rtest_jacobian(const RtestArrays& poses, const EffectMod
   return J;
 }
 
-std::string v3(const Eigen::Vector3d& v) {
-  return "(" + fixed_text(v[0]) + ", " + fixed_text(v[1]) + ", " + fixed_text(v[2]) + ") mm";
-}
-
 
 // The added nests: one at each radius, angle and height, with each grid of B and C steps.
 std::vector<RtestPattern> separating_nests(const RtestSeparationOptions& o, double dwell) {
@@ -320,7 +316,7 @@ std::optional<RtestArrays> added_poses(const RtestPattern& pat, const RtestSepar
 std::string describe(const RtestSeparatingCandidate& c) {
   const RtestPattern& pat = c.added;
   std::ostringstream d;
-  d << "a nest at " << v3(pat.nests[0]) << ", B " << fixed_text(pat.b_deg.front(), 0) << ".."
+  d << "a nest at " << point_text(pat.nests[0]) << ", B " << fixed_text(pat.b_deg.front(), 0) << ".."
     << fixed_text(pat.b_deg.back(), 0) << " deg every "
     << fixed_text(pat.b_deg.size() > 1 ? pat.b_deg[1] - pat.b_deg[0] : 0.0, 0) << ", C every "
     << fixed_text(pat.c_deg.size() > 1 ? pat.c_deg[1] - pat.c_deg[0] : 360.0, 0) << " deg, "

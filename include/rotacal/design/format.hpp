@@ -2,6 +2,7 @@
 /// \file
 /// The designs' number format in words: fixed point with a given number of digits.
 
+#include <Eigen/Core>
 #include <sstream>
 #include <string>
 
@@ -14,6 +15,11 @@ inline std::string fixed_text(double v, int digits = 1) {
   s.precision(digits);
   s << v;
   return s.str();
+}
+
+/// A point in mm with one decimal: "(x, y, z) mm".
+inline std::string point_text(const Eigen::Vector3d& v) {
+  return "(" + fixed_text(v[0]) + ", " + fixed_text(v[1]) + ", " + fixed_text(v[2]) + ") mm";
 }
 
 }  // namespace rotacal
