@@ -6,6 +6,7 @@
 #include <type_traits>
 
 #include "rotacal/ballbar/identify.hpp"
+#include "rotacal/core/fit_with_noise.hpp"
 #include "length_model.hpp"
 
 namespace rotacal {
@@ -112,39 +113,28 @@ JointFitOutcome solve_with_time_constants(const ResidualModel& model, std::vecto
 }  // namespace
 
 BallbarIdentification identify_joint(const BallbarArrays& data, const JointFitOptions& options) {
-  BallbarFitSetup setup = ballbar_fit_setup(data, options);
-  const EffectModel& fx = setup.effects;
-  const int P = fx.num_params();
-  const BallbarLengthModel model(data, fx);
-  JointFitOutcome fit = solve_with_time_constants(model, setup.parameters, setup.settings);
+  const BallbarFitSetup setup = ballbar_fit_setup(data, options);
+  const BallbarLengthModel model(data, setup.effects);
 
-  // The noise model of what the fit leaves, one AR stream per test in time order. With
-  // correlated noise the white covariance is too small by about sqrt(tau) (issue 11: 6x at
-  // rho 0.95), so the fit is redone by GLS under that model; it starts again from the same
-  // start values, and the noise model is not re-estimated (one GLS step, as feasible GLS).
-  NoiseModel noise;
-  bool refit = false;
-  double scale = 1.0;
-  if (!options.whitener && static_cast<std::size_t>(data.size()) == data.test.size()) {
-    const std::vector<double> t(data.time.data(), data.time.data() + data.time.size());
-    noise = estimate_noise_model(data.test, t, fit.residuals, options.noise_options);
-    if (options.noise == NoiseHandling::automatic && !noise.white() &&
-        noise.correlation_samples >= options.min_correlation_samples) {
-      if (options.noise_bias_correction) scale = noise_correction(noise, data.test, t, fit, options.noise_options);
-      setup.settings.whitener = std::make_shared<ArWhitener>(noise);
-      fit = solve_with_time_constants(model, setup.parameters, setup.settings);
-      apply_noise_correction(scale, &fit);
-      refit = true;
-    }
-  }
+  // The noise model of what the fit leaves, one AR stream per test in time order; with
+  // correlated noise the fit is redone by GLS under it (core/fit_with_noise.hpp).
+  NoiseFitOptions no;
+  no.noise = options.noise;
+  no.noise_options = options.noise_options;
+  no.min_correlation_samples = options.min_correlation_samples;
+  no.noise_bias_correction = options.noise_bias_correction;
+  const bool streams = static_cast<std::size_t>(data.size()) == data.test.size();
+  const std::vector<double> t(data.time.data(), data.time.data() + data.time.size());
+  NoiseFit nf = fit_with_noise(
+      [&](const JointFitSettings& s) { return solve_with_time_constants(model, setup.parameters, s); },
+      setup.settings, streams ? data.test : std::vector<std::string>{}, t, no);
+  JointFitOutcome& fit = nf.fit;
+  const bool refit = nf.refit;
+  const double scale = nf.scale;
 
   BallbarIdentification out;
   out.method = "joint";
-  out.model.machine = data.machine;
-  out.model.errors = LocationErrors<double>(fit.values.head<8>());
-  out.model.pivot = fit.values.segment<3>(8);
-  out.model.effects = fx;
-  out.model.effect_params.assign(fit.values.data() + 11, fit.values.data() + 11 + P);
+  out.model = ballbar_model_at(setup, data.machine, fit.values);
   out.converged = fit.summary.converged;
   out.iterations = fit.summary.iterations;
   out.n_samples = static_cast<std::size_t>(data.size());
@@ -163,7 +153,7 @@ BallbarIdentification identify_joint(const BallbarArrays& data, const JointFitOp
   out.unobservable = std::move(fit.unobservable);
   for (std::string& advice : setup_advice(data.machine, out.unobservable)) out.notes.push_back(std::move(advice));
   out.summary = fit.summary;
-  out.noise = std::move(noise);
+  out.noise = std::move(nf.noise);
   out.noise_refit = refit;
   out.noise_correction = scale;
   if (refit) out.notes.push_back("correlated noise (" + out.noise.summary() + "): covariance by GLS under this AR model, scaled by " + std::to_string(scale) + " for the correlation the fit absorbs from its residuals");

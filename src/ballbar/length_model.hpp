@@ -1,11 +1,11 @@
-// The ballbar joint fit's residual model and set-up, shared by identify_joint and monte_carlo.
+// The ballbar problem's residual model over arrays (ballbar/problem.hpp: its layout and its one
+// residual), shared by identify_joint, monte_carlo and the design.
 #pragma once
 
 #include <algorithm>
 #include <type_traits>
 
-#include "rotacal/ballbar/identify.hpp"
-#include "rotacal/core/joint_fit.hpp"
+#include "rotacal/ballbar/problem.hpp"
 #include "rotacal/core/lanes.hpp"
 
 // Inline every call in the row kernel: GCC otherwise keeps the rotation and its derivative
@@ -28,7 +28,8 @@
 
 namespace rotacal {
 
-// r_i = L_model,i - L_i (mm). Parameters: 8 location errors, pivot (3), effect parameters.
+// r_i = L_model,i - L_i (mm), parameters in the ballbar layout (ballbar/problem.hpp). Several
+// centre pivots (the design's sessions back to back): `pivot_of_row` gives each row's pivot.
 // The base model (location errors, pivot, and the tool length and ballbar length offsets)
 // has an analytic path: the one model's rotations (rotate_point_about_unit_line) composed
 // along the machine's axes for the residual, and the chain rule over their derivatives for
@@ -38,9 +39,14 @@ namespace rotacal {
 // doubles or Jets.
 class BallbarLengthModel : public ResidualModel {
  public:
-  BallbarLengthModel(const BallbarArrays& d, const EffectModel& fx)
-      : d_(d), fx_(fx), P_(fx.num_params()), analytic_(analytic_supported(fx)),
+  BallbarLengthModel(const BallbarArrays& d, const EffectModel& fx, std::vector<int> pivot_of_row = {},
+                     int pivots = 1)
+      : d_(d), fx_(fx), L_(ballbar_layout(d.machine, fx, pivots)), pivot_of_(std::move(pivot_of_row)),
+        analytic_(pivot_of_.empty() && analytic_supported(fx)),
         nt_(static_cast<int>(d.machine.description().table_axes.size())) {
+    if (!pivot_of_.empty() && static_cast<Eigen::Index>(pivot_of_.size()) != d.size())
+      throw InvalidArgument("ballbar fit: " + std::to_string(pivot_of_.size()) + " pivot indices for " +
+                            std::to_string(d.size()) + " rows");
     if (analytic_) commanded_sincos();
     for (const Effect& f : fx.effects)
       if (f.depends_on_motion() && d.motion.size() != static_cast<std::size_t>(d.size()))
@@ -48,7 +54,8 @@ class BallbarLengthModel : public ResidualModel {
                               "arrays were built without (ballbar_arrays with_motion)");
   }
   Eigen::Index num_residuals() const override { return d_.size(); }
-  int num_parameters() const override { return 11 + P_; }
+  int num_parameters() const override { return static_cast<int>(L_.all.size()); }
+  const BallbarLayout& layout() const { return L_; }
   void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r,
                 Eigen::MatrixXd* J) const override {
     if (analytic_) {
@@ -60,6 +67,8 @@ class BallbarLengthModel : public ResidualModel {
   }
   bool evaluate_subset(const Eigen::VectorXd& x, Eigen::Index stride, Eigen::VectorXd& r,
                        Eigen::MatrixXd* J) const override {
+    // Sessions back to back: every k-th row may miss a short session, and its pivot with it.
+    if (!pivot_of_.empty()) return false;
     const Eigen::Index m = (d_.size() + stride - 1) / stride;
     r.resize(m);
     if (J) J->resize(m, num_parameters());
@@ -168,11 +177,11 @@ class BallbarLengthModel : public ResidualModel {
 
   Chain<double> chain_at(const Eigen::VectorXd& x) const {
     const MachineType m = d_.machine;
-    const LocationErrors<double> e(x.head<8>());
+    const LocationErrors<double> e(L_.errors.of<8>(x));
     Chain<double> ch;
     double tool_z = 0.0;
     for (std::size_t k = 0; k < fx_.effects.size(); ++k) {
-      const int col = 11 + fx_.offset(k);
+      const int col = static_cast<int>(L_.effects.offset) + fx_.offset(k);
       if (fx_.effects[k].kind == EffectKind::tool_offset_Z) tool_z += x[col], ch.tool_z_col = col;
       else ch.length_offset = x[col], ch.length_col = col;
     }
@@ -186,7 +195,7 @@ class BallbarLengthModel : public ResidualModel {
       ch.d_unit[k] = (Eigen::Matrix3d::Identity() - ch.u[k] * ch.u[k].transpose()) * ch.inv_norm[k] *
                      a.direction_basis;
     }
-    ch.pivot = x.segment<3>(8);
+    ch.pivot = L_.pivots.of<3>(x);
     ch.tool = tool_vector<double>(m, 0.0) + Eigen::Vector3d(0.0, 0.0, tool_z);
     return ch;
   }
@@ -228,10 +237,12 @@ class BallbarLengthModel : public ResidualModel {
     if constexpr (WithJacobian) {
       const Vec3<Lanes> u = (b - P) / length;
       // dL/d(line k) = +-u^T (outer rotations) dD_k; the table side enters with a minus. Every
-      // column is written: the 8 location errors, the pivot, and the offsets this model has.
+      // column is written: the 8 location errors (axis k's position pair, then its direction
+      // pair), the pivot, and the offsets this model has.
+      const Eigen::Index e0 = L_.errors.offset;
       const auto line_columns = [&](int k, const Row& w, const Row& wq) {
-        J->template segment<2>(4 * k) = D[k].times_point(w, wq) * ch.d_point[k];
-        J->template segment<2>(4 * k + 2) = D[k].times_unit_direction(w) * ch.d_unit[k];
+        J->template segment<2>(e0 + 4 * k) = D[k].times_point(w, wq) * ch.d_point[k];
+        J->template segment<2>(e0 + 4 * k + 2) = D[k].times_unit_direction(w) * ch.d_unit[k];
       };
       Row w = -u.transpose();
       for (int k = 0; k < nt; ++k) {
@@ -239,7 +250,7 @@ class BallbarLengthModel : public ResidualModel {
         line_columns(k, w, wq);
         w = wq;
       }
-      J->template segment<3>(8) = w;  // d/dpivot
+      J->template segment<3>(L_.pivots.offset) = w;  // d/dpivot
       w = u.transpose();
       for (int k = nt; k < 2; ++k) {
         const Row wq = D[k].times_q(w);
@@ -253,78 +264,20 @@ class BallbarLengthModel : public ResidualModel {
   }
 
  private:
-  // L_model - L_measured of sample i, on double or Jets.
+  // L_model - L_measured of sample i, on double or Jets: the problem's one residual.
   template <typename T>
   void sample(Eigen::Index i, const T* p, T* out) const {
-    const Vec3<T> pivot(p[8], p[9], p[10]);
-    const Eigen::Vector3d xyz = d_.xyz.col(i);
-    out[0] = predicted_length<T>(d_.machine, LocationErrors<T>::from_ptr(p), pivot, fx_,
-                                 P_ > 0 ? p + 11 : nullptr, xyz, d_.angles[static_cast<std::size_t>(i)],
-                                 d_.time[i], d_.motion.empty() ? RotaryMotion{} : d_.motion[static_cast<std::size_t>(i)]) -
-             T(d_.length[i]);
+    out[0] = ballbar_residual<T>(L_, d_, fx_, p, i, pivot_of_.empty() ? 0 : pivot_of_[static_cast<std::size_t>(i)]);
   }
 
   const BallbarArrays& d_;
   const EffectModel& fx_;
-  int P_;
+  BallbarLayout L_;
+  std::vector<int> pivot_of_;  // pivot of each row (empty: one pivot)
   bool analytic_;
   int nt_;  // table axes: chain axes 0 .. nt_ - 1 carry the pivot, the others the tool
   Eigen::Matrix<double, 4, Eigen::Dynamic> cs_;  // commanded_sincos
 };
 
-
-/// The unknowns (names, units, start values), effects and solver settings of a ballbar joint
-/// fit. Throws InvalidArgument for an effect that does not exist on the machine or fewer
-/// samples than unknowns.
-struct BallbarFitSetup {
-  EffectModel effects;
-  std::vector<FitParameter> parameters;
-  JointFitSettings settings;
-};
-
-inline BallbarFitSetup ballbar_fit_setup(const BallbarArrays& data, const JointFitOptions& options) {
-  BallbarFitSetup out;
-  EffectModel& fx = out.effects;
-  fx = options.effects;
-  if (!fx.linear_reference && data.size() > 0) fx.linear_reference = Eigen::Vector3d(data.xyz.rowwise().mean());
-  if (options.fit_length_offset)
-    fx.effects.insert(fx.effects.begin(), Effect::parse("ballbar_length_offset"));
-  // On a machine with head axes the ball's distance from the controlled point,
-  // pivot_length + tool_length, is a location parameter of the head (formats.md): its error
-  // is fitted as tool_offset_Z, which there acts along the spindle (kinematics/effects.hpp).
-  const Effect tool_z = Effect::parse("tool_offset_Z");
-  if (data.machine.has_head() &&
-      std::find(fx.effects.begin(), fx.effects.end(), tool_z) == fx.effects.end())
-    fx.effects.insert(fx.effects.begin(), tool_z);
-  for (const Effect& f : fx.effects)
-    if (!f.applies_to(data.machine))
-      throw InvalidArgument("effect " + f.id() + " does not exist on a " + to_string(data.machine));
-  const int n_par = 8 + 3 + fx.num_params();
-  if (static_cast<int>(data.size()) < n_par)
-    throw InvalidArgument("identify_joint: " + std::to_string(data.size()) +
-                          " samples cannot determine " + std::to_string(n_par) + " unknowns");
-  // Names, units and start values of the unknowns, in Jacobian column order: zero errors and
-  // the nominal pivot.
-  std::vector<FitParameter>& params = out.parameters;
-  for (int k = 0; k < 8; ++k)
-    params.push_back({location_error_names(data.machine)[static_cast<std::size_t>(k)],
-                      location_error_is_angle(k) ? "rad" : "mm", 0.0});
-  const char* pivot_names[3] = {"pivot_x", "pivot_y", "pivot_z"};
-  for (int k = 0; k < 3; ++k) params.push_back({pivot_names[k], "mm", data.pivot[k]});
-  // Catalogue effects yield to the baseline where they share directions with it
-  // (core/yield_convention.hpp); the head's tool length is part of the baseline.
-  for (const Effect& f : fx.effects) {
-    const auto pn = f.param_names(), pu = f.param_units();
-    const bool yields = !(data.machine.has_head() && f == tool_z);
-    for (std::size_t k = 0; k < pn.size(); ++k)
-      params.push_back({f.id() + (pn.size() > 1 ? "." + pn[k] : ""), pu[k], 0.0, 0.0, false, yields});
-  }
-  out.settings.max_iterations = options.max_iterations;
-  out.settings.observability_min_chi2 = options.observability_min_chi2;
-  // sigma scales chi-square (observability); the covariance uses the residual variance.
-  out.settings.sigma = data.noise_um.value_or(1.0) * 1e-3;
-  out.settings.whitener = options.whitener;
-  return out;
-}
 
 }  // namespace rotacal

@@ -5,6 +5,7 @@
 #include <ceres/jet.h>
 
 #include "candidate_jets.hpp"
+#include "rotacal/ballbar/problem.hpp"
 
 namespace rotacal {
 
@@ -65,8 +66,8 @@ ModelFit BallbarDiagnosisProblem::fit_gls(const EffectModel& effects,
 namespace {
 
 // d L / d (the seeded parameters of `candidate`) on `samples`: Jets of width N through the
-// one length model, the current model's values as constants, the candidate appended with its
-// parameters at 0 (candidate_jets.hpp).
+// problem's one residual, the current model's values as constants, the candidate appended
+// with its parameters at 0 (candidate_jets.hpp).
 template <int N>
 Eigen::MatrixXd length_jets(MachineType m, const std::vector<BallbarSample>& samples,
                             const std::vector<RotaryMotion>& motion, const ModelFit& at,
@@ -74,19 +75,17 @@ Eigen::MatrixXd length_jets(MachineType m, const std::vector<BallbarSample>& sam
   using Jet = ceres::Jet<double, N>;
   EffectModel fx = at.effects;
   fx.effects.push_back(candidate);
-  LocationErrors<Jet> e;
-  for (int i = 0; i < 8; ++i) e.v[i] = Jet(at.parameters[static_cast<std::size_t>(i)].value);
-  const Vec3<Jet> pivot(Jet(at.parameters[8].value), Jet(at.parameters[9].value), Jet(at.parameters[10].value));
-  std::vector<Jet> p;
-  for (std::size_t i = 11; i < at.parameters.size(); ++i) p.emplace_back(at.parameters[i].value);
-  const std::size_t first = p.size();
-  p.resize(first + static_cast<std::size_t>(candidate.num_params()), Jet(0.0));
+  const BallbarLayout L = ballbar_layout(m, fx);
+  std::vector<Jet> p(static_cast<std::size_t>(L.all.size()), Jet(0.0));
+  for (std::size_t i = 0; i < at.parameters.size(); ++i) p[i] = Jet(at.parameters[i].value);
+  const std::size_t first = at.parameters.size();  // the candidate's parameters: the layout's last
   for (std::size_t k = 0; k < seed.size(); ++k) p[first + static_cast<std::size_t>(seed[k])] = Jet(0.0, static_cast<int>(k));
   Eigen::MatrixXd out(static_cast<Eigen::Index>(samples.size()), static_cast<Eigen::Index>(seed.size()));
   for (std::size_t r = 0; r < samples.size(); ++r) {
-    const Jet L = predicted_length<Jet>(m, e, pivot, fx, p.data(), samples[r], motion[r]);
+    const BallbarSample& s = samples[r];
+    const Jet L_r = ballbar_residual<Jet>(L, m, fx, p.data(), 0, s.xyz, s.angles_rad(), s.time, motion[r], 0.0);
     for (std::size_t k = 0; k < seed.size(); ++k)
-      out(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(k)) = L.v[static_cast<Eigen::Index>(k)];
+      out(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(k)) = L_r.v[static_cast<Eigen::Index>(k)];
   }
   return out;
 }

@@ -10,6 +10,7 @@
 
 #include "rotacal/core/error.hpp"
 #include "rotacal/core/stats.hpp"
+#include "rotacal/kinematics/parameter_blocks.hpp"
 #include "scoring.hpp"
 
 namespace rotacal {
@@ -162,11 +163,12 @@ UncertaintyBudget uncertainty_budget(const DiagnosisProblem& P, const Diagnosis&
 
   UncertaintyBudget out;
   out.coverage = coverage;
-  const auto& names = location_error_names(P.machine());
-  for (int i = 0; i < 8; ++i) {
+  ParameterLayout location;  // the location errors' names and units, as every problem lays them out
+  const ParameterBlock errors = add_location_errors(location, P.machine());
+  for (std::size_t i = 0; i < errors.names.size(); ++i) {
     LocationBudget L;
-    L.name = names[static_cast<std::size_t>(i)];
-    L.unit = location_error_is_angle(i) ? "rad" : "mm";
+    L.name = errors.names[i];
+    L.unit = errors.units[i];
     const auto p = std::find_if(fit.parameters.begin(), fit.parameters.end(),
                                 [&](const ParameterEstimate& q) { return q.name == L.name; });
     const auto col = p == fit.parameters.end() ? -1 : free_index[static_cast<std::size_t>(p - fit.parameters.begin())];

@@ -6,24 +6,20 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 
+#include "rotacal/design/format.hpp"
 #include "rotacal/core/error.hpp"
 #include "rotacal/core/joint_fit.hpp"
 #include "rotacal/core/least_squares.hpp"
+#include "rotacal/design/separation.hpp"
 #include "rotacal/rtest/model.hpp"
+#include "rotacal/rtest/problem.hpp"
 
 namespace rotacal {
 
 namespace {
-
-std::string fmt(double v, int digits = 1) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(digits);
-  s << v;
-  return s.str();
-}
 
 // The whitener of AR(1) noise with coefficient rho and marginal sigma per stream (one per nest
 // and component dx, dy, dz, in time order, as noise_gen::ar1 and the noise model split them):
@@ -100,14 +96,14 @@ RtestDesignCandidate evaluate_rtest_design(const RtestPattern& pattern, const Rt
   c.duration_s = static_cast<double>(poses * pattern.nests.size()) * pattern.dwell_s;
   if (budget <= 0.0) budget = c.duration_s;
   if (c.duration_s > budget * (1 + 1e-12)) {
-    c.why_not = fmt(c.duration_s, 0) + " s is over the time budget of " + fmt(budget, 0) + " s";
+    c.why_not = fixed_text(c.duration_s, 0) + " s is over the time budget of " + fixed_text(budget, 0) + " s";
     return c;
   }
   const double deg = M_PI / 180.0;
   const char* axis = "XYZ";
   for (double b : pattern.b_deg)
     if (b < o.b_limits_deg[0] - 1e-9 || b > o.b_limits_deg[1] + 1e-9) {
-      c.why_not = "B = " + fmt(b) + " deg is outside the B limits";
+      c.why_not = "B = " + fixed_text(b) + " deg is outside the B limits";
       return c;
     }
   for (std::size_t n = 0; n < pattern.nests.size(); ++n)
@@ -116,10 +112,10 @@ RtestDesignCandidate evaluate_rtest_design(const RtestPattern& pattern, const Rt
         const Eigen::Vector3d xyz = rtest_commanded_xyz(m, pattern.nests[n], {b * deg, cc * deg});
         for (int k = 0; k < 3; ++k)
           if (xyz[k] < o.travel_min[k] || xyz[k] > o.travel_max[k]) {
-            c.why_not = std::string(1, axis[k]) + " = " + fmt(xyz[k], 3) + " mm for nest " +
-                        std::to_string(n + 1) + " at B " + fmt(b) + ", C " + fmt(cc) +
-                        " deg is outside the travel " + fmt(o.travel_min[k]) + ".." +
-                        fmt(o.travel_max[k]) + " mm";
+            c.why_not = std::string(1, axis[k]) + " = " + fixed_text(xyz[k], 3) + " mm for nest " +
+                        std::to_string(n + 1) + " at B " + fixed_text(b) + ", C " + fixed_text(cc) +
+                        " deg is outside the travel " + fixed_text(o.travel_min[k]) + ".." +
+                        fixed_text(o.travel_max[k]) + " mm";
             return c;
           }
       }
@@ -158,19 +154,21 @@ RtestDesignCandidate evaluate_rtest_design(const RtestPattern& pattern, const Rt
     c.sigma[j] = e.observable ? std::sqrt(std::max(id.covariance(j, j), 0.0) * var_scale)
                               : std::numeric_limits<double>::infinity();
   }
-  for (int i = 0; i < 8; ++i) {
+  const RtestBasis basis = fit.basis.for_machine(m);
+  const RtestLayout L = rtest_layout(m, s.setups(), &basis, EffectModel{});
+  for (Eigen::Index i = L.errors.offset; i < L.errors.end(); ++i) {
     if (!std::isfinite(c.sigma[i])) {
       c.why_not = c.names[static_cast<std::size_t>(i)] + " is not determined by this pattern";
       return c;
     }
-    const double u =
-        2.0 * c.sigma[i] * (location_error_is_angle(i) ? o.reference_radius_mm * 1e3 : 1e3);
+    const double u = 2.0 * c.sigma[i] *
+                     (location_error_is_angle(static_cast<int>(i - L.errors.offset)) ? o.reference_radius_mm * 1e3 : 1e3);
     if (u > c.worst_expanded_um)
       c.worst_expanded_um = u, c.worst_error = c.names[static_cast<std::size_t>(i)];
   }
   // A pattern whose fit holds map coefficients fits a smaller model: its location errors
   // look better only because the maps are assumed zero. Such a pattern is not comparable.
-  for (Eigen::Index j = 8; j < p; ++j)
+  for (Eigen::Index j = L.errors.end(); j < p; ++j)
     if (!std::isfinite(c.sigma[j])) {
       c.why_not = c.names[static_cast<std::size_t>(j)] +
                   " is not determined: the pose grid is too coarse for the joint fit's basis";
@@ -245,51 +243,20 @@ namespace rotacal {
 
 namespace {
 
-// R-test readings d = T(B, C, t)^-1 tool(xyz, t) - q_nest + zero_nest of several nests, 3 rows
-// per pose. Parameters: 8 location errors, 3 probe-zero components per nest, then effects.
-struct RtestPose {
-  int nest = 0;
-  Eigen::Vector3d q = Eigen::Vector3d::Zero(), xyz = Eigen::Vector3d::Zero();
-  RotaryAngles<double> angles;
-  double t = 0.0;
-  Eigen::Vector3d d = Eigen::Vector3d::Zero();  ///< measured displacement (0 for a design)
-};
+// R-test poses as the problem's arrays (machine model, no maps): one set-up per nest.
+RtestArrays pose_arrays(std::size_t n) {
+  RtestArrays a;
+  a.machine = MachineType::BC_trt;
+  a.xyz.resize(3, static_cast<Eigen::Index>(n));
+  a.nest.resize(3, static_cast<Eigen::Index>(n));
+  a.d = Eigen::Matrix3Xd::Zero(3, static_cast<Eigen::Index>(n));
+  return a;
+}
 
-class RtestReadingsModel : public ResidualModel {
- public:
-  // fx by value: callers pass a model centred on the session (a temporary).
-  RtestReadingsModel(std::vector<RtestPose> poses, int nests, EffectModel fx)
-      : poses_(std::move(poses)), nests_(nests), fx_(std::move(fx)), P_(fx_.num_params()) {}
-  Eigen::Index num_residuals() const override {
-    return 3 * static_cast<Eigen::Index>(poses_.size());
-  }
-  int num_parameters() const override { return 8 + 3 * nests_ + P_; }
-  Eigen::Index num_items() const override { return static_cast<Eigen::Index>(poses_.size()); }
-  int rows_per_item() const override { return 3; }
-  void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r,
-                Eigen::MatrixXd* J) const override {
-    evaluate_with_jets([this](Eigen::Index i, const auto* p, auto* out) { sample(i, p, out); },
-                       num_items(), 3, x, r, J);
-  }
-
- private:
-  template <typename T>
-  void sample(Eigen::Index i, const T* p, T* out) const {
-    const RtestPose& s = poses_[static_cast<std::size_t>(i)];
-    const Vec3<T> d =
-        rtest_reading<T>(MachineType::BC_trt, LocationErrors<T>::from_ptr(p), fx_,
-                         P_ > 0 ? p + 8 + 3 * nests_ : nullptr, s.xyz, s.angles, s.t, s.q);
-    for (int k = 0; k < 3; ++k) out[k] = d[k] + p[8 + 3 * s.nest + k] - T(s.d[k]);
-  }
-  std::vector<RtestPose> poses_;
-  int nests_;
-  EffectModel fx_;
-  int P_;
-};
-
-Eigen::MatrixXd nominal_rtest_jacobian(const std::vector<RtestPose>& poses, int nests,
-                                       const EffectModel& fx) {
-  const RtestReadingsModel model(poses, nests, fx);
+// d reading / d parameter at zero errors and zeros (the joint fit's start), in the problem's
+// layout (location errors, a probe zero per nest, effects).
+Eigen::MatrixXd nominal_rtest_jacobian(const RtestArrays& poses, const EffectModel& fx) {
+  const RtestProblem model(poses, nullptr, fx, RtestZeroNames::numbered);
   const Eigen::VectorXd x = Eigen::VectorXd::Zero(model.num_parameters());
   Eigen::VectorXd r(model.num_residuals());
   Eigen::MatrixXd J(model.num_residuals(), model.num_parameters());
@@ -297,8 +264,65 @@ Eigen::MatrixXd nominal_rtest_jacobian(const std::vector<RtestPose>& poses, int 
   return J;
 }
 
-std::string v3(const Eigen::Vector3d& v) {
-  return "(" + fmt(v[0]) + ", " + fmt(v[1]) + ", " + fmt(v[2]) + ") mm";
+
+// The added nests: one at each radius, angle and height, with each grid of B and C steps.
+std::vector<RtestPattern> separating_nests(const RtestSeparationOptions& o, double dwell) {
+  const double deg = M_PI / 180.0;
+  std::vector<RtestPattern> out;
+  for (double r : o.nest_radius_mm)
+    for (double ang : o.nest_angle_deg)
+      for (double h : o.nest_height_mm) {
+        if (r == 0.0 && ang != o.nest_angle_deg.front()) continue;  // one nest on the axis
+        Eigen::Vector3d q(r * std::cos(ang * deg), r * std::sin(ang * deg), h);
+        q = (q * 1e9).array().round() / 1e9;  // cos 90 deg is 6e-17, not 0
+        for (double bs : o.b_step_deg)
+          for (double cs : o.c_step_deg) {
+            RtestPattern pat;
+            pat.nests = {q};
+            pat.b_deg = steps(o.b_limits_deg[0], o.b_limits_deg[1], bs);
+            pat.c_deg = steps(0.0, 360.0 - cs, cs);
+            pat.dwell_s = dwell;
+            out.push_back(pat);
+          }
+      }
+  return out;
+}
+
+// The added nest's poses after the session (B outer, C inner, one dwell each), or nothing when
+// a pose leaves the travel.
+std::optional<RtestArrays> added_poses(const RtestPattern& pat, const RtestSeparationOptions& o, double t_end) {
+  const double deg = M_PI / 180.0;
+  RtestArrays a = pose_arrays(pat.b_deg.size() * pat.c_deg.size());
+  a.setups = {"added"};
+  const Eigen::Vector3d& q = pat.nests[0];
+  Eigen::Index i = 0;
+  double t = t_end;
+  for (double b : pat.b_deg)
+    for (double c : pat.c_deg) {
+      const RotaryAngles<double> angles{b * deg, c * deg};
+      const Eigen::Vector3d xyz = rtest_commanded_xyz(a.machine, q, angles);
+      for (int k = 0; k < 3; ++k)
+        if (xyz[k] < o.travel_min[k] || xyz[k] > o.travel_max[k]) return std::nullopt;
+      a.xyz.col(i) = xyz;
+      a.nest.col(i++) = q;
+      a.angles.push_back(angles);
+      a.time.push_back(t += pat.dwell_s);
+      a.setup_of.push_back(0);
+    }
+  return a;
+}
+
+// The chosen nest in words.
+std::string describe(const RtestSeparatingCandidate& c) {
+  const RtestPattern& pat = c.added;
+  std::ostringstream d;
+  d << "a nest at " << point_text(pat.nests[0]) << ", B " << fixed_text(pat.b_deg.front(), 0) << ".."
+    << fixed_text(pat.b_deg.back(), 0) << " deg every "
+    << fixed_text(pat.b_deg.size() > 1 ? pat.b_deg[1] - pat.b_deg[0] : 0.0, 0) << ", C every "
+    << fixed_text(pat.c_deg.size() > 1 ? pat.c_deg[1] - pat.c_deg[0] : 360.0, 0) << " deg, "
+    << fixed_text(pat.dwell_s, 1) << " s per pose";
+  if (c.repeats > 1.0) d << ", run " << fixed_text(c.repeats, 0) << " times";
+  return d.str();
 }
 
 }  // namespace
@@ -306,9 +330,6 @@ std::string v3(const Eigen::Vector3d& v) {
 RtestSeparationDesign design_rtest_separation(const RtestSession& session,
                                               const std::vector<Effect>& pair,
                                               const RtestSeparationOptions& o) {
-  using design_detail::canonical_correlation;
-  using design_detail::invert_information;
-  using design_detail::Inverted;
   if (pair.size() != 2 || pair[0] == pair[1])
     throw InvalidArgument("design rtest: --separate needs two different effects (EFFECT,EFFECT)");
   if (session.samples.empty())
@@ -346,68 +367,26 @@ RtestSeparationDesign design_rtest_separation(const RtestSession& session,
                                   o.reference_radius_mm);
 
   // The session's poses and noise (the R-test joint fit's residual noise model).
-  std::map<std::string, int> nest_index;
-  std::vector<RtestPose> poses;
-  for (const RtestSample& s : session.samples) {
-    const auto it = session.nests.find(s.setup);
-    if (it == session.nests.end())
-      throw InvalidArgument("design rtest: --after: nest '" + s.setup + "' has no position");
-    const int k = nest_index.emplace(s.setup, static_cast<int>(nest_index.size())).first->second;
-    poses.push_back({k, it->second, s.xyz, s.angles_rad(), s.time, Eigen::Vector3d::Zero()});
-  }
-  const int ns = static_cast<int>(nest_index.size()), na = pair[0].num_params(),
-            nb = pair[1].num_params();
-  const int ne = na + nb, e0 = 8 + 3 * ns, p0 = e0 + ne;  // errors, probe zeros (3 per nest), effects
+  RtestArrays poses = rtest_arrays(session, "design rtest: --after", false);
+  poses.machine = m;
   RtestJointOptions fo;
   fo.noise = NoiseHandling::white;
   const RtestJointIdentification id = identify_joint(session, fo);
-  double sigma_um = o.noise_um > 0.0 ? o.noise_um : id.noise.sigma_um;
-  if (!(sigma_um > 0.0)) sigma_um = id.sigma_um;
-  if (!(sigma_um > 0.0))
-    throw InvalidArgument("design rtest: --after: the session's residuals are zero; give --noise");
-  D.noise_um = sigma_um;
-  if (id.noise.n > 0 && id.noise.effective_samples > 0.0)
-    D.effective_per_reading =
-        std::min(1.0, id.noise.effective_samples / static_cast<double>(id.noise.n));
-  const double w = D.effective_per_reading / (sigma_um * sigma_um * 1e-6);
-  const Eigen::MatrixXd Js = nominal_rtest_jacobian(poses, ns, fx);
-  const Eigen::MatrixXd Is = Js.transpose() * Js * w;
-  for (int k = 0; k < 8; ++k)
-    D.names.push_back(location_error_names(m)[static_cast<std::size_t>(k)]);
-  std::vector<std::string> nest_names(static_cast<std::size_t>(ns));
-  for (const auto& [name, k] : nest_index) nest_names[static_cast<std::size_t>(k)] = name;
-  for (const std::string& n : nest_names)
-    for (const char* c : {"zero_x#", "zero_y#", "zero_z#"}) D.names.push_back(c + n);
-  for (const std::string& l : fx.param_labels()) D.names.push_back(l);
-  Eigen::VectorXd plausible = Eigen::VectorXd::Constant(p0 + 3, plausible_magnitude("mm"));
-  for (int k = 0; k < 8; ++k)
-    plausible[k] = plausible_magnitude(location_error_is_angle(k) ? "rad" : "mm");
-  {
-    int j = e0;
-    for (const Effect& f : pair)
-      for (const std::string& u : f.param_units()) plausible[j++] = plausible_magnitude(u);
-  }
-  const double white = 1.0 / D.effective_per_reading;
-  const Inverted before = invert_information(Is, plausible.head(p0), white);
-  D.sigma_before = before.sigma;
-  D.correlation_before = canonical_correlation(before, e0, na, e0 + na, nb);
-  D.sigma_after = D.sigma_before;
+  const double w = session_weight(o.noise_um, id.noise, id.sigma_um,
+                                  "design rtest: --after: the session's residuals are zero; give --noise", D);
+  // Joint layout: the R-test problem's (location errors, a probe zero per session nest, the
+  // pair), then the added nest's probe zero.
+  const RtestLayout L = rtest_layout(m, poses.setups, nullptr, fx, RtestZeroNames::numbered);
+  const RtestLayout La = rtest_layout(m, {"added"}, nullptr, fx, RtestZeroNames::numbered);
+  ParameterLayout joint = L.all;
+  const ParameterBlock added_zero = joint.add("zero#added", La.zeros.names, {"mm"}, 3);
+  D.names = L.all.names();
+  const SeparationProblem S = separation_problem(nominal_rtest_jacobian(poses, fx), w, joint,
+                                                 effect_block(L.effects, fx, 0), effect_block(L.effects, fx, 1),
+                                                 o.max_correlation, o.max_added_time_s, D);
+  const bool search = separation_needed(S, D);
   D.chosen.correlation = D.correlation_before;
-  if (D.motion.same_motion) {
-    D.verdict =
-        "no test can separate " + D.effects[0] + " and " + D.effects[1] + ": " + D.motion.why;
-    return D;
-  }
-  if (D.correlation_before < o.max_correlation) {
-    D.already_separated = true;
-    std::ostringstream v;
-    v.precision(2);
-    v << std::fixed << "the session alone separates " << D.effects[0] << " and " << D.effects[1]
-      << " (correlation " << D.correlation_before << " < " << o.max_correlation
-      << "): no added test is needed";
-    D.verdict = v.str();
-    return D;
-  }
+  if (!search) return D;
   double dwell = o.dwell_s;
   if (!(dwell > 0.0)) {
     std::vector<double> dt;
@@ -418,119 +397,39 @@ RtestSeparationDesign design_rtest_separation(const RtestSession& session,
     dwell = dt.empty() || !(dt[dt.size() / 2] > 0.0) ? RtestPattern{}.dwell_s : dt[dt.size() / 2];
   }
 
-  const double deg = M_PI / 180.0;
-  bool have_best = false, have_fallback = false;
-  Eigen::MatrixXd best_info;
-  for (double r : o.nest_radius_mm)
-    for (double ang : o.nest_angle_deg)
-      for (double h : o.nest_height_mm) {
-        if (r == 0.0 && ang != o.nest_angle_deg.front()) continue;  // one nest on the axis
-        Eigen::Vector3d q(r * std::cos(ang * deg), r * std::sin(ang * deg), h);
-        q = (q * 1e9).array().round() / 1e9;  // cos 90 deg is 6e-17, not 0
-        for (double bs : o.b_step_deg)
-          for (double cs : o.c_step_deg) {
-            RtestPattern pat;
-            pat.nests = {q};
-            pat.b_deg = steps(o.b_limits_deg[0], o.b_limits_deg[1], bs);
-            pat.c_deg = steps(0.0, 360.0 - cs, cs);
-            pat.dwell_s = dwell;
-            const double duration =
-                static_cast<double>(pat.b_deg.size() * pat.c_deg.size()) * dwell;
-            if (duration > o.max_added_time_s) continue;
-            std::vector<RtestPose> added;
-            bool inside = true;
-            double t = t_end;
-            for (double b : pat.b_deg)
-              for (double c : pat.c_deg) {
-                const RotaryAngles<double> a{b * deg, c * deg};
-                const Eigen::Vector3d xyz = rtest_commanded_xyz(m, q, a);
-                for (int k = 0; k < 3; ++k)
-                  inside = inside && xyz[k] >= o.travel_min[k] && xyz[k] <= o.travel_max[k];
-                added.push_back({0, q, xyz, a, t += dwell, Eigen::Vector3d::Zero()});
-              }
-            if (!inside) continue;
-            ++D.candidates_tried;
-            // Added columns: 8 location, its probe zero, effects -> joint layout.
-            const Eigen::MatrixXd Ja = nominal_rtest_jacobian(added, 1, fx);
-            const int p = p0 + 3;
-            Eigen::MatrixXd Jm = Eigen::MatrixXd::Zero(Ja.rows(), p);
-            Jm.leftCols(8) = Ja.leftCols(8);
-            Jm.middleCols(p0, 3) = Ja.middleCols(8, 3);
-            Jm.middleCols(e0, ne) = Ja.middleCols(11, ne);
-            const Eigen::MatrixXd Ia = Jm.transpose() * Jm * w;
-            Eigen::MatrixXd I0 = Eigen::MatrixXd::Zero(p, p);
-            I0.topLeftCorner(p0, p0) = Is;
-            for (double rep = 1.0; duration * rep <= o.max_added_time_s * (1 + 1e-12); rep *= 2.0) {
-              const Eigen::MatrixXd I = I0 + rep * Ia;
-              const Inverted inv = invert_information(I, plausible, white);
-              RtestSeparatingCandidate c;
-              c.added = pat;
-              c.duration_s = duration;
-              c.repeats = rep;
-              c.correlation = canonical_correlation(inv, e0, na, e0 + na, nb);
-              c.determined = true;
-              for (int j = e0; j < e0 + ne; ++j)
-                c.determined = c.determined && inv.determined[static_cast<std::size_t>(j)];
-              const double run = duration * rep;
-              if (c.correlation < o.max_correlation) {
-                const double best_run = D.chosen.duration_s * D.chosen.repeats;
-                if (!have_best || run < best_run - 1e-9 ||
-                    (std::abs(run - best_run) <= 1e-9 && c.correlation < D.chosen.correlation)) {
-                  D.chosen = c;
-                  best_info = I;
-                  have_best = true;
-                }
-                break;
-              }
-              if (!have_best && (!have_fallback || c.correlation < D.chosen.correlation)) {
-                D.chosen = c;
-                best_info = I;
-                have_fallback = true;
-              }
-            }
-          }
-      }
-  D.found = have_best;
-  if (have_best || have_fallback) {
-    RtestSeparatingCandidate& c = D.chosen;
-    const RtestPattern& pat = c.added;
-    std::ostringstream d;
-    d << "a nest at " << v3(pat.nests[0]) << ", B " << fmt(pat.b_deg.front(), 0) << ".."
-      << fmt(pat.b_deg.back(), 0) << " deg every "
-      << fmt(pat.b_deg.size() > 1 ? pat.b_deg[1] - pat.b_deg[0] : 0.0, 0) << ", C every "
-      << fmt(pat.c_deg.size() > 1 ? pat.c_deg[1] - pat.c_deg[0] : 360.0, 0) << " deg, "
-      << fmt(pat.dwell_s, 1) << " s per pose";
-    if (c.repeats > 1.0) d << ", run " << fmt(c.repeats, 0) << " times";
-    c.description = d.str();
-    D.sigma_after = invert_information(best_info, plausible, white).sigma;
-    for (const char* n : {"zero_x#added", "zero_y#added", "zero_z#added"}) D.names.push_back(n);
+  // Candidates: one nest at each position and grid, its information in the joint layout.
+  const std::vector<RtestPattern> patterns = separating_nests(o, dwell);
+  std::vector<std::size_t> pattern_of;
+  std::vector<AddedInformation> added;
+  for (std::size_t k = 0; k < patterns.size(); ++k) {
+    const RtestPattern& pat = patterns[k];
+    const double duration = static_cast<double>(pat.b_deg.size() * pat.c_deg.size()) * dwell;
+    if (duration > o.max_added_time_s) continue;
+    std::optional<RtestArrays> nest = added_poses(pat, o, t_end);
+    if (!nest) continue;
+    const Eigen::MatrixXd Jm = in_layout(nominal_rtest_jacobian(*nest, fx), {La.errors, La.zeros, La.effects},
+                                         {L.errors, added_zero, L.effects}, joint.size());
+    added.push_back({duration, Jm.transpose() * Jm * w, true});
+    pattern_of.push_back(k);
   }
-  std::ostringstream v;
-  v.precision(2);
-  v << std::fixed;
-  if (D.found)
-    v << "add " << D.chosen.description << ": " << fmt(D.chosen.duration_s * D.chosen.repeats, 0)
-      << " s; fitted with the session, the correlation of " << D.effects[0] << " and "
-      << D.effects[1] << " goes from " << D.correlation_before << " to " << D.chosen.correlation;
-  else
-    v << "none of " << D.candidates_tried << " added nests within " << fmt(o.max_added_time_s, 0)
-      << " s brings the correlation of " << D.effects[0] << " and " << D.effects[1] << " below "
-      << o.max_correlation
-      << (D.candidates_tried ? "; the closest is " + D.chosen.description + " (correlation " +
-                                   fmt(D.chosen.correlation, 2) + ")"
-                             : std::string("; every candidate breaks a limit"));
-  if (D.candidates_tried) {
-    std::string held;
-    for (int j = e0; j < e0 + ne; ++j)
-      if (!std::isfinite(D.sigma_after[j]))
-        held += (held.empty() ? "" : ", ") + D.names[static_cast<std::size_t>(j)];
-    if (!held.empty())
-      v << "; " << held
-        << " remain undetermined (no reading sees them: the joint fit holds them at 0, and the "
-           "correlation is that of "
-           "the rest)";
+  D.candidates_tried = static_cast<int>(added.size());
+  const SeparationChoice c = search_separation(S, added);
+  std::vector<std::string> added_names;
+  if (c.index != SeparationChoice::none) {
+    RtestSeparatingCandidate& chosen = D.chosen;
+    chosen.added = patterns[pattern_of[c.index]];
+    chosen.duration_s = added[c.index].duration_s;
+    chosen.repeats = c.repeats;
+    chosen.correlation = c.correlation;
+    chosen.determined = c.determined;
+    chosen.description = describe(chosen);
+    added_names = added_zero.names;
   }
-  D.verdict = v.str();
+  SeparationWording wording;
+  wording.added = "added nests";
+  wording.seen_by = "";
+  wording.closest_note = "";
+  finish_separation(S, c, D.chosen.description, D.chosen.duration_s * D.chosen.repeats, added_names, wording, D);
   return D;
 }
 
@@ -540,33 +439,12 @@ JointFitOutcome identify_rtest_effects(const RtestSession& session, const Effect
   for (const Effect& f : effects.effects)
     if (!f.applies_to(session.machine))
       throw InvalidArgument("effect " + f.id() + " does not exist on a BC-trt");
-  std::map<std::string, int> nest_index;
-  std::vector<RtestPose> poses;
-  for (const RtestSample& s : session.samples) {
-    const auto it = session.nests.find(s.setup);
-    if (it == session.nests.end())
-      throw InvalidArgument("identify_rtest_effects: nest '" + s.setup + "' has no position");
-    if (!s.d)
-      throw InvalidArgument("identify_rtest_effects: a sample of nest '" + s.setup +
-                            "' has no dx, dy, dz");
-    const int k = nest_index.emplace(s.setup, static_cast<int>(nest_index.size())).first->second;
-    poses.push_back({k, it->second, s.xyz, s.angles_rad(), s.time, *s.d});
-  }
-  const int ns = static_cast<int>(nest_index.size());
-  std::vector<std::string> names(static_cast<std::size_t>(ns));
-  for (const auto& [name, k] : nest_index) names[static_cast<std::size_t>(k)] = name;
+  RtestArrays poses = rtest_arrays(session, "identify_rtest_effects");
+  poses.machine = MachineType::BC_trt;
+  const RtestProblem model(poses, nullptr, centred_on(effects, session.samples), RtestZeroNames::numbered);
+  const std::vector<std::string> names = model.layout().all.names(), units = model.layout().all.units();
   std::vector<FitParameter> params;
-  for (int k = 0; k < 8; ++k)
-    params.push_back({location_error_names(MachineType::BC_trt)[static_cast<std::size_t>(k)],
-                      location_error_is_angle(k) ? "rad" : "mm", 0.0});
-  for (const std::string& n : names)
-    for (const char* c : {"zero_x#", "zero_y#", "zero_z#"}) params.push_back({c + n, "mm", 0.0});
-  for (const Effect& f : effects.effects) {
-    const auto pn = f.param_names(), pu = f.param_units();
-    for (std::size_t k = 0; k < pn.size(); ++k)
-      params.push_back({f.id() + (pn.size() > 1 ? "." + pn[k] : ""), pu[k], 0.0});
-  }
-  const RtestReadingsModel model(std::move(poses), ns, centred_on(effects, session.samples));
+  for (std::size_t j = 0; j < names.size(); ++j) params.push_back({names[j], units[j], 0.0});
   JointFitSettings settings;
   settings.sigma = session.noise_um.value_or(1.0) * 1e-3;
   return solve_joint(model, params, settings);

@@ -7,7 +7,9 @@
 #include <limits>
 #include <memory>
 
+#include "rotacal/core/fit_with_noise.hpp"
 #include "rotacal/core/joint_fit.hpp"
+#include "rotacal/rtest/problem.hpp"
 
 namespace rotacal {
 
@@ -87,6 +89,16 @@ std::vector<std::string> RtestBasis::coefficient_names(MachineType m) const {
   return basis_names(for_machine(m), rtest_map_names(m));
 }
 
+void RtestBasis::map_rows(double B, double C, Eigen::Ref<Eigen::MatrixXd> Lb, Eigen::Ref<Eigen::MatrixXd> Lc) const {
+  Lb.setZero();
+  Lc.setZero();
+  Eigen::Index o = 0;
+  for (int k = 0; k < 6; ++k)
+    for (double phi : b_terms(k, B)) Lb(k, o++) = phi;
+  o = 0;
+  for (const AxisErrors<double>& t : c_terms(B, C)) Lc.col(o++) = t;
+}
+
 RtestBasis RtestBasis::for_machine(MachineType m) const {
   RtestBasis out = *this;
   out.b_rotations = !m.description().axis(m.tilt_index()).on_head;
@@ -96,32 +108,24 @@ RtestBasis RtestBasis::for_machine(MachineType m) const {
 }
 
 // ---------------------------------------------------------------- model
-std::vector<std::string> RtestJointModel::parameter_names() const {
-  const auto& le = location_error_names(machine);
-  std::vector<std::string> out(le.begin(), le.end());
-  if (machine.has_head()) out.push_back("tool_offset_Z");
-  for (std::string& n : basis.coefficient_names(machine)) out.push_back(std::move(n));
-  return out;
-}
-LocationErrors<double> RtestJointModel::errors() const {
-  return LocationErrors<double>(params.head<8>());
-}
-double RtestJointModel::tool_offset_z() const { return machine.has_head() ? params[8] : 0.0; }
-
 namespace {
+// The model's params: the R-test problem's layout without probe zeros and effects.
+RtestLayout model_layout(const RtestJointModel& m) {
+  return rtest_layout(m.machine, {}, &m.basis, EffectModel{});
+}
+LocationErrors<double> errors_at(const RtestLayout& L, const Eigen::VectorXd& p) {
+  return LocationErrors<double>(L.errors.of<8>(p));
+}
+double tool_offset_z_at(const RtestLayout& L, const Eigen::VectorXd& p) {
+  return L.tool.empty() ? 0.0 : p[L.tool.offset];
+}
+
 // Linear map from params to w_BY (6 x P) and w_CB (6 x P) at (B, C).
-void map_rows(const RtestJointModel& m, double B, double C, Eigen::MatrixXd& Lb,
+void map_rows(const RtestJointModel& m, const RtestLayout& L, double B, double C, Eigen::MatrixXd& Lb,
               Eigen::MatrixXd& Lc) {
-  const int P = static_cast<int>(m.params.size());
-  const int nb = m.basis.num_b_coefficients();
-  const int nl = rtest_num_location_parameters(m.machine);
-  Lb = Eigen::MatrixXd::Zero(6, P);
-  Lc = Eigen::MatrixXd::Zero(6, P);
-  int o = nl;
-  for (int k = 0; k < 6; ++k)
-    for (double phi : m.basis.b_terms(k, B)) Lb(k, o++) = phi;
-  o = nl + nb;
-  for (const AxisErrors<double>& t : m.basis.c_terms(B, C)) Lc.col(o++) = t;
+  Lb = Eigen::MatrixXd::Zero(6, m.params.size());
+  Lc = Eigen::MatrixXd::Zero(6, m.params.size());
+  m.basis.for_machine(m.machine).map_rows(B, C, L.map_tilt.columns(Lb), L.map_rot.columns(Lc));
 }
 
 AxisErrors<double> propagate(const RtestJointModel& m, const Eigen::MatrixXd& L) {
@@ -136,19 +140,20 @@ AxisErrors<double> propagate(const RtestJointModel& m, const Eigen::MatrixXd& L)
   return s;
 }
 
-// 1-sigma of a function of the params by central differences (the model is linear to well
-// below the noise over the identified magnitudes).
+// 1-sigma of a function f(params) by central differences (the model is linear to well below
+// the noise over the identified magnitudes).
 template <typename F>
-Eigen::Vector3d propagate_fn(const RtestJointModel& m, F f) {
+Eigen::Vector3d propagate_fn(const RtestJointModel& m, const RtestLayout& L, F f) {
   const int P = static_cast<int>(m.params.size());
   Eigen::MatrixXd J(3, P);
-  RtestJointModel t = m;
+  Eigen::VectorXd t = m.params;
   for (int j = 0; j < P; ++j) {
-    const double h = location_error_is_angle(j) && j < 8 ? 1e-7 : 1e-5;
-    t.params = m.params;
-    t.params[j] += h;
+    const bool angle = L.errors.contains(j) && location_error_is_angle(static_cast<int>(j - L.errors.offset));
+    const double h = angle ? 1e-7 : 1e-5;
+    t = m.params;
+    t[j] += h;
     const Eigen::Vector3d fp = f(t);
-    t.params[j] -= 2 * h;
+    t[j] -= 2 * h;
     J.col(j) = (fp - f(t)) / (2 * h);
   }
   Eigen::Vector3d s;
@@ -161,55 +166,71 @@ Eigen::Vector3d propagate_fn(const RtestJointModel& m, F f) {
   }
   return s;
 }
+
+Pose<double> table_pose_at(const RtestJointModel& m, const RtestLayout& L, const Eigen::VectorXd& params,
+                           double B, double C) {
+  const double* p = params.data();
+  return rtest_joint_table_pose<double>(m.machine, m.basis, L.errors.ptr(p), p + L.map_tilt.offset,
+                                        p + L.map_rot.offset, B, C);
+}
 }  // namespace
+
+std::vector<std::string> RtestJointModel::parameter_names() const { return model_layout(*this).all.names(); }
+LocationErrors<double> RtestJointModel::errors() const { return errors_at(model_layout(*this), params); }
+double RtestJointModel::tool_offset_z() const { return tool_offset_z_at(model_layout(*this), params); }
 
 AxisErrors<double> RtestJointModel::w_BY(double B, AxisErrors<double>* std) const {
   Eigen::MatrixXd Lb, Lc;
-  map_rows(*this, B, 0.0, Lb, Lc);
+  map_rows(*this, model_layout(*this), B, 0.0, Lb, Lc);
   if (std) *std = propagate(*this, Lb);
   return Lb * params;
 }
 AxisErrors<double> RtestJointModel::w_CB(double B, double C, AxisErrors<double>* std) const {
   Eigen::MatrixXd Lb, Lc;
-  map_rows(*this, B, C, Lb, Lc);
+  map_rows(*this, model_layout(*this), B, C, Lb, Lc);
   if (std) *std = propagate(*this, Lc);
   return Lc * params;
 }
 Pose<double> RtestJointModel::table_pose(double B, double C) const {
-  const int nb = basis.num_b_coefficients(), nl = rtest_num_location_parameters(machine);
-  return rtest_joint_table_pose<double>(machine, basis, params.data(), params.data() + nl,
-                                        params.data() + nl + nb, B, C);
+  return table_pose_at(*this, model_layout(*this), params, B, C);
 }
 Eigen::Vector3d RtestJointModel::reading(const Eigen::Vector3d& q, double B, double C,
                                          Eigen::Vector3d* std) const {
   const Eigen::Vector3d xyz = rtest_commanded_xyz(machine, q, {B, C});
-  auto f = [&](const RtestJointModel& m) {
-    return Eigen::Vector3d(rtest_joint_reading<double>(machine, m.errors(), m.w_BY(B), m.w_CB(B, C),
-                                                       m.tool_offset_z(), {B, C}, xyz, q));
+  const RtestLayout L = model_layout(*this);
+  Eigen::MatrixXd Lb, Lc;  // the maps' rows at (B, C), once for every difference
+  map_rows(*this, L, B, C, Lb, Lc);
+  auto f = [&](const Eigen::VectorXd& p) {
+    return Eigen::Vector3d(rtest_joint_reading<double>(machine, errors_at(L, p), Lb * p, Lc * p,
+                                                       tool_offset_z_at(L, p), {B, C}, xyz, q));
   };
-  if (std) *std = propagate_fn(*this, f);
-  return f(*this);
+  if (std) *std = propagate_fn(*this, L, f);
+  return f(params);
 }
 Eigen::Vector3d RtestJointModel::table_error(const Eigen::Vector3d& q, double B, double C,
                                              Eigen::Vector3d* std) const {
-  auto f = [&](const RtestJointModel& m) {
-    return Eigen::Vector3d(m.table_pose(B, C) * q -
+  const RtestLayout L = model_layout(*this);
+  auto f = [&](const Eigen::VectorXd& p) {
+    return Eigen::Vector3d(table_pose_at(*this, L, p, B, C) * q -
                            forward<double>(machine, LocationErrors<double>(), {B, C}, q));
   };
-  if (std) *std = propagate_fn(*this, f);
-  return f(*this);
+  if (std) *std = propagate_fn(*this, L, f);
+  return f(params);
 }
 Eigen::Vector3d RtestJointModel::tool_error(const Eigen::Vector3d& xyz, double B, double C,
                                             Eigen::Vector3d* std) const {
-  auto f = [&](const RtestJointModel& m) -> Eigen::Vector3d {
+  const RtestLayout L = model_layout(*this);
+  Eigen::MatrixXd Lb, Lc;
+  map_rows(*this, L, B, C, Lb, Lc);
+  auto f = [&](const Eigen::VectorXd& p) -> Eigen::Vector3d {
     if (!machine.has_head()) return Eigen::Vector3d::Zero();
     const Pose<double> H =
-        rtest_joint_side_pose<double>(machine, m.errors(), m.w_BY(B), m.w_CB(B, C), {B, C}, true);
-    return xyz + H * tool_vector<double>(machine, -m.tool_offset_z()) -
+        rtest_joint_side_pose<double>(machine, errors_at(L, p), Lb * p, Lc * p, {B, C}, true);
+    return xyz + H * tool_vector<double>(machine, -tool_offset_z_at(L, p)) -
            tool_ball<double>(machine, LocationErrors<double>(), {B, C}, xyz);
   };
-  if (std) *std = propagate_fn(*this, f);
-  return f(*this);
+  if (std) *std = propagate_fn(*this, L, f);
+  return f(params);
 }
 
 const ParameterEstimate& RtestJointIdentification::parameter(const std::string& name) const {
@@ -220,92 +241,6 @@ const ParameterEstimate& RtestJointIdentification::parameter(const std::string& 
 
 // ---------------------------------------------------------------- fit
 namespace {
-// r = T^-1 (xyz + H t) - q + zero - d_measured (mm), 3 residuals per sample (Eq. 4 with
-// location errors and the smooth maps, on either side of the chain). Parameters: location
-// errors (8), tool_offset_Z (head machines), tilt-map coefficients, rotary-map coefficients,
-// probe zero per set-up (3 each). Per sample, Jets of rtest_joint_reading with respect to
-// (e, w_BY, w_CB, tool_offset_Z) (21 directions) are chained through the sample's basis
-// values: four times fewer directions than the ~70 coefficients.
-class RtestJointResiduals : public ResidualModel {
- public:
-  RtestJointResiduals(const RtestSession& session, const std::vector<std::string>& setups,
-                      const RtestBasis& basis)
-      : m_(session.machine), nl_(rtest_num_location_parameters(session.machine)),
-        nb_(basis.num_b_coefficients()), nc_(basis.num_c_coefficients()),
-        S_(static_cast<int>(setups.size())) {
-    const std::size_t n = session.samples.size();
-    a_.resize(n), setup_.resize(n);
-    Lb_ = Eigen::MatrixXd::Zero(6 * static_cast<Eigen::Index>(n), nb_);
-    Lc_ = Eigen::MatrixXd::Zero(6 * static_cast<Eigen::Index>(n), nc_);
-    xyz_.resize(3, static_cast<Eigen::Index>(n)), q_.resize(3, static_cast<Eigen::Index>(n));
-    d_.resize(3, static_cast<Eigen::Index>(n));
-    for (std::size_t i = 0; i < n; ++i) {
-      const RtestSample& s = session.samples[i];
-      const RotaryAngles<double> a = s.angles_rad();
-      a_[i] = a;
-      setup_[i] = static_cast<int>(std::find(setups.begin(), setups.end(), s.setup) - setups.begin());
-      xyz_.col(static_cast<Eigen::Index>(i)) = s.xyz;
-      q_.col(static_cast<Eigen::Index>(i)) = session.nests.at(s.setup);
-      d_.col(static_cast<Eigen::Index>(i)) = *s.d;
-      const Eigen::Index r6 = 6 * static_cast<Eigen::Index>(i);
-      int o = 0;
-      for (int k = 0; k < 6; ++k)
-        for (double phi : basis.b_terms(k, a.tilt)) Lb_(r6 + k, o++) = phi;
-      o = 0;
-      for (const AxisErrors<double>& t : basis.c_terms(a.tilt, a.rot)) Lc_.block<6, 1>(r6, o++) = t;
-    }
-  }
-  Eigen::Index num_residuals() const override { return 3 * static_cast<Eigen::Index>(a_.size()); }
-  int num_parameters() const override { return nl_ + nb_ + nc_ + 3 * S_; }
-  void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r,
-                Eigen::MatrixXd* J) const override {
-    using Jet = ceres::Jet<double, 21>;  // e (8), w_BY (6), w_CB (6), tool_offset_Z
-    const int n_model = nl_ + nb_ + nc_;
-    const Eigen::VectorXd cb = x.segment(nl_, nb_), cc = x.segment(nl_ + nb_, nc_);
-    const LocationErrors<double> e = LocationErrors<double>::from_ptr(x.data());
-    const double tz = nl_ > 8 ? x[8] : 0.0;
-    LocationErrors<Jet> ej;
-    for (int k = 0; k < 8; ++k) ej.v[k] = Jet(x[k], k);
-    const Jet tzj(tz, 20);
-    for (std::size_t i = 0; i < a_.size(); ++i) {
-      const Eigen::Index row = 3 * static_cast<Eigen::Index>(i);
-      const auto Lb = Lb_.middleRows<6>(row * 2), Lc = Lc_.middleRows<6>(row * 2);  // 6 rows a sample
-      const AxisErrors<double> wb = Lb * cb, wc = Lc * cc;
-      const Eigen::Vector3d zero = x.segment<3>(n_model + 3 * setup_[i]);
-      const Eigen::Vector3d xyz = xyz_.col(static_cast<Eigen::Index>(i));
-      const Eigen::Vector3d q = q_.col(static_cast<Eigen::Index>(i));
-      if (!J) {
-        r.segment<3>(row) = rtest_joint_reading<double>(m_, e, wb, wc, tz, a_[i], xyz, q) + zero -
-                            d_.col(static_cast<Eigen::Index>(i));
-        continue;
-      }
-      AxisErrors<Jet> wbj, wcj;
-      for (int k = 0; k < 6; ++k) wbj[k] = Jet(wb[k], 8 + k), wcj[k] = Jet(wc[k], 14 + k);
-      const Vec3<Jet> d = rtest_joint_reading<Jet>(m_, ej, wbj, wcj, tzj, a_[i], xyz, q);
-      Eigen::Matrix<double, 3, 21> G;
-      for (int a = 0; a < 3; ++a) {
-        r[row + a] = d[a].a + zero[a] - d_(a, static_cast<Eigen::Index>(i));
-        G.row(a) = d[a].v.transpose();
-      }
-      J->block(row, 0, 3, 8) = G.leftCols<8>();
-      if (nl_ > 8) J->block(row, 8, 3, 1) = G.col(20);
-      J->block(row, nl_, 3, nb_).noalias() = G.middleCols<6>(8) * Lb;
-      J->block(row, nl_ + nb_, 3, nc_).noalias() = G.middleCols<6>(14) * Lc;
-      J->block(row, n_model, 3, 3 * S_).setZero();
-      J->block<3, 3>(row, n_model + 3 * setup_[i]).setIdentity();
-    }
-  }
-
- private:
-  MachineType m_;
-  int nl_, nb_, nc_, S_;
-  std::vector<RotaryAngles<double>> a_;
-  std::vector<int> setup_;
-  Eigen::Matrix3Xd xyz_, q_, d_;
-  // Basis values, 6 rows per sample (rows 6i..6i+5): w_BY = Lb cb, w_CB = Lc cc.
-  Eigen::MatrixXd Lb_, Lc_;
-};
-
 // True when the tilt axis carries the rotary axis on the same side of the chain.
 bool m_tilt_carries_rot(MachineType m) {
   const MachineDescription& d = m.description();
@@ -360,41 +295,27 @@ RtestJointIdentification identify_joint(const RtestSession& session,
   const RtestBasis basis = options.basis.for_machine(machine);
   if (basis.b_degree < 0 || basis.c_harmonics < 0 || basis.c_b_degree < 0)
     throw InvalidArgument("identify_joint: options.basis: degrees and harmonics must be >= 0");
-  const std::vector<std::string> setups = session.setups();
-  for (std::size_t i = 0; i < session.samples.size(); ++i) {
-    if (!session.samples[i].d)
-      throw InvalidArgument("identify_joint: session: sample " + std::to_string(i) +
-                            " has no dx,dy,dz (convert raw readings with displacements_from_raw)");
-    if (!session.nests.count(session.samples[i].setup))
-      throw InvalidArgument("identify_joint: session.nests: no nest." + session.samples[i].setup);
-  }
-  const int nb = basis.num_b_coefficients(), nc = basis.num_c_coefficients();
-  const int nl = rtest_num_location_parameters(machine);
-  const int n_model = nl + nb + nc;
-  const int n_par = n_model + 3 * static_cast<int>(setups.size());
-  if (3 * static_cast<int>(session.samples.size()) <= n_par)
+  const RtestArrays data = rtest_arrays(session, "identify_joint");
+  const std::vector<std::string>& setups = data.setups;
+  const RtestProblem model(data, &basis, EffectModel{});
+  const RtestLayout& L = model.layout();
+  const Eigen::Index n_par = L.all.size(), n_model = L.zeros.offset;
+  if (3 * static_cast<Eigen::Index>(session.samples.size()) <= n_par)
     throw InvalidArgument("identify_joint: session: " + std::to_string(3 * session.samples.size()) +
                           " readings cannot determine " + std::to_string(n_par) + " unknowns");
 
+  // The unknowns start at zero, except each probe zero: at its set-up's mean reading (the
+  // closed-form answer for zero errors).
   std::vector<FitParameter> params;
-  for (int k = 0; k < 8; ++k)
-    params.push_back({location_error_names(machine)[static_cast<std::size_t>(k)],
-                      location_error_is_angle(k) ? "rad" : "mm", 0.0});
-  // On a machine with head axes the sphere's distance from the controlled point, pivot_length
-  // + tool_length, is a parameter of the head (formats.md): its error as tool_offset_Z.
-  if (machine.has_head()) params.push_back({"tool_offset_Z", "mm", 0.0});
-  for (const std::string& n : basis.coefficient_names(machine)) {
-    const std::string comp = n.substr(0, n.find('_'));
-    params.push_back({n, comp[0] == 'd' ? "mm" : "rad", 0.0});
-  }
-  // Start each probe zero at its set-up's mean reading (the closed-form answer for zero errors).
-  for (const std::string& s : setups) {
+  const std::vector<std::string> names = L.all.names(), units = L.all.units();
+  for (std::size_t j = 0; j < names.size(); ++j) params.push_back({names[j], units[j], 0.0});
+  for (std::size_t k = 0; k < setups.size(); ++k) {
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    const auto idx = session.indices_of(s);
+    const auto idx = session.indices_of(setups[k]);
     for (std::size_t i : idx) mean += *session.samples[i].d;
     mean /= static_cast<double>(idx.size());
-    const char* axes[3] = {"x", "y", "z"};
-    for (int a = 0; a < 3; ++a) params.push_back({"zero." + s + "." + axes[a], "mm", mean[a]});
+    for (int a = 0; a < 3; ++a)
+      params[static_cast<std::size_t>(L.zeros.item_offset(static_cast<Eigen::Index>(k)) + a)].start = mean[a];
   }
 
   JointFitSettings settings;
@@ -402,46 +323,33 @@ RtestJointIdentification identify_joint(const RtestSession& session,
   settings.observability_min_chi2 = options.observability_min_chi2;
   settings.sigma = session.noise_um.value_or(1.0) * 1e-3;  // scales chi-square only
   settings.whitener = options.whitener;
-  const RtestJointResiduals model(session, setups, basis);
-  JointFitOutcome fit = solve_joint(model, params, settings);
 
   // Noise model of the residuals: one AR stream per nest and channel (dx, dy, dz share a
   // time, so the estimator splits them), in time order. Probe zeros that wander between
-  // poses and servo/thermal noise make it correlated; then the white covariance is too small
-  // and the fit is redone by GLS under the model (one feasible-GLS step). The model is AR(1)
-  // + a random walk per stream by REML (core/noise_handling.hpp): the probe zeros and the B
-  // polynomials (B runs outer) take most of a walk out of the residuals, which Burg's AR(p)
-  // of the residuals cannot see (docs/noise_model.md).
-  NoiseModel noise;
-  bool refit = false, reml = false;
-  double scale = 1.0;
-  if (!options.whitener) {
-    std::vector<std::string> groups;
-    std::vector<double> times;
-    groups.reserve(3 * session.samples.size());
-    times.reserve(3 * session.samples.size());
-    for (const RtestSample& s : session.samples)
-      for (int a = 0; a < 3; ++a) {
-        groups.push_back("nest " + s.setup);
-        times.push_back(s.time);
-      }
-    noise = estimate_noise_model(groups, times, fit.residuals, options.noise_options);
-    if (options.noise == NoiseHandling::automatic && !noise.white() &&
-        noise.correlation_samples >= options.min_correlation_samples) {
-      std::size_t longest = 0;
-      for (const NoiseStream& st : noise.streams) longest = std::max(longest, st.rows.size());
-      reml = options.noise_options.reml_random_walk &&
-             longest <= static_cast<std::size_t>(options.noise_options.reml_max_stream_size);
-      if (reml)
-        noise = estimate_noise_model_reml(noise, fit.residuals, free_jacobian(fit));  // no bias left to scale
-      else if (options.noise_bias_correction)
-        scale = noise_correction(noise, groups, times, fit, options.noise_options);
-      settings.whitener = std::make_shared<ArWhitener>(noise);
-      fit = solve_joint(model, params, settings);
-      apply_noise_correction(scale, &fit);
-      refit = true;
+  // poses and servo/thermal noise make it correlated; then the fit is redone by GLS under the
+  // model (core/fit_with_noise.hpp), AR(1) + a random walk per stream by REML: the probe zeros
+  // and the B polynomials (B runs outer) take most of a walk out of the residuals, which
+  // Burg's AR(p) of the residuals cannot see (docs/noise_model.md).
+  std::vector<std::string> groups;
+  std::vector<double> times;
+  groups.reserve(3 * session.samples.size());
+  times.reserve(3 * session.samples.size());
+  for (const RtestSample& s : session.samples)
+    for (int a = 0; a < 3; ++a) {
+      groups.push_back("nest " + s.setup);
+      times.push_back(s.time);
     }
-  }
+  NoiseFitOptions no;
+  no.noise = options.noise;
+  no.noise_options = options.noise_options;
+  no.min_correlation_samples = options.min_correlation_samples;
+  no.noise_bias_correction = options.noise_bias_correction;
+  no.allow_reml = true;
+  NoiseFit nf = fit_with_noise([&](const JointFitSettings& s) { return solve_joint(model, params, s); },
+                               settings, groups, times, no);
+  JointFitOutcome& fit = nf.fit;
+  const bool refit = nf.refit, reml = nf.reml;
+  const double scale = nf.scale;
 
   RtestJointIdentification out;
   out.converged = fit.summary.converged;
@@ -455,12 +363,12 @@ RtestJointIdentification identify_joint(const RtestSession& session,
   out.sigma_um = std::sqrt(fit.residuals.squaredNorm() / std::max(n_res - fit.summary.num_free, 1.0)) * 1e3;
   out.covariance = fit.covariance;
   for (std::size_t k = 0; k < setups.size(); ++k)
-    out.probe_zeros[setups[k]] = fit.values.segment<3>(n_model + 3 * static_cast<Eigen::Index>(k));
+    out.probe_zeros[setups[k]] = fit.values.segment<3>(L.zeros.item_offset(static_cast<Eigen::Index>(k)));
   out.parameters = fit.estimates;
   out.unobservable = fit.unobservable;
   for (std::string& advice : rtest_setup_advice(machine, out.unobservable)) out.notes.push_back(std::move(advice));
   out.summary = fit.summary;
-  out.noise = std::move(noise);
+  out.noise = std::move(nf.noise);
   out.noise_refit = refit;
   out.noise_correction = scale;
   if (refit && reml)
@@ -473,7 +381,7 @@ RtestJointIdentification identify_joint(const RtestSession& session,
   out.model.params = fit.values.head(n_model);
   out.model.covariance = out.covariance.topLeftCorner(n_model, n_model);
   out.model.observable.clear();
-  for (int j = 0; j < n_model; ++j) out.model.observable.push_back(fit.estimates[static_cast<std::size_t>(j)].observable);
+  for (Eigen::Index j = 0; j < n_model; ++j) out.model.observable.push_back(fit.estimates[static_cast<std::size_t>(j)].observable);
 
   out.notes.push_back("probe zero per set-up fitted: no reading is assumed to be zero");
   const std::array<std::string, 2> maps = rtest_map_names(machine);

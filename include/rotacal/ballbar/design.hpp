@@ -22,6 +22,8 @@
 #include "rotacal/ballbar/identify.hpp"
 #include "rotacal/ballbar/plan.hpp"
 #include "rotacal/core/joint_fit.hpp"
+#include "rotacal/design/separation.hpp"
+#include "rotacal/design/table_motion.hpp"
 #include "rotacal/kinematics/effects.hpp"
 
 namespace rotacal {
@@ -72,6 +74,10 @@ struct BallbarDesign {
   std::vector<DesignCandidate> candidates;  ///< every set-up tried, feasible or not
 };
 
+/// The first sample of `plan` whose machine axes leave the travel [lo, hi] (mm), in words;
+/// empty if none does.
+std::string travel_violation(const BallbarPlan& plan, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
+
 /// Evaluate one set-up at a time budget (0: its own run time). Never throws for a set-up that
 /// breaks a limit: the candidate says why it is not feasible.
 DesignCandidate evaluate_design(const BallbarSetup& setup, const BallbarDesignOptions& options,
@@ -83,55 +89,6 @@ DesignCandidate evaluate_design(const BallbarSetup& setup, const BallbarDesignOp
 BallbarDesign design_ballbar_test(const BallbarDesignOptions& options);
 
 // ------------------------------------------------------------------ separating two effects
-
-/// Whether two effects can be told apart by any instrument at all, decided from the motion of
-/// the table they cause. Every instrument of the library reads the table through points fixed
-/// on it (ballbar pivot, R-test nests) whose positions are fitted, and every fit estimates the
-/// location errors; so when some combination of one effect's parameters moves the table, at
-/// every pose, exactly as a combination of the other's does together with location errors and
-/// a shift of the table point, no test can separate them (e.g. gravity_sag_A and
-/// radial_motion_A_h2: translations of the table that depend on A alone).
-///
-/// The table motion of a parameter is the derivative of the table pose (effects.hpp,
-/// table_pose) as a spatial twist, rotation first: (omega x r_ref, v) with
-/// omega = vee(dR R^T) (rad, times the reference radius to give mm) and v = dt - omega x t
-/// (mm), at zero errors, on a grid over the tilt limits, a full turn of C and three times in
-/// [0, duration]. The location errors and the table point (a translation in the table frame,
-/// R dq) are projected out; the largest cosine of the principal angles between what is left of
-/// the two effects is 1 when they share a motion.
-struct TableMotionOverlap {
-  bool moves_table_first = false;  ///< the first effect moves the table at all
-  bool moves_table_second = false;
-  bool first_is_location = false;  ///< all its motion is location errors + table point
-  bool second_is_location = false;
-  double cosine = 0.0;       ///< largest cosine of the principal angles, [0, 1]
-  bool same_motion = false;  ///< cosine >= 1 - 1e-6, or an effect is all location
-  std::string why;           ///< in words, for reports
-};
-
-/// Compare the table motions of `a` and `b` on machine `m` over tilt in `tilt_limits_deg`, C
-/// over a full turn and time over [0, duration_s]. Throws InvalidArgument naming the effect
-/// that does not exist on the machine, or for a reversed tilt range or negative duration.
-TableMotionOverlap table_motion_overlap(MachineType m, const Effect& a, const Effect& b,
-                                        std::array<double, 2> tilt_limits_deg = {-90.0, 90.0},
-                                        double duration_s = 3600.0,
-                                        double reference_radius_mm = 100.0);
-
-namespace design_detail {
-/// Covariance of an information matrix I (fit units) with the parameters the joint fit would
-/// hold removed: one per combination that moving by the plausible magnitudes changes the white
-/// chi-square (I x white) by less than 1 (analyse_observability), and any it still cannot see.
-struct Inverted {
-  Eigen::MatrixXd cov;  ///< zero rows and columns for held parameters
-  std::vector<bool> determined;
-  Eigen::VectorXd sigma;  ///< infinite for held parameters
-};
-Inverted invert_information(const Eigen::MatrixXd& I, const Eigen::VectorXd& plausible,
-                            double white);
-/// Largest canonical correlation between the determined parameters among [a0, a0 + na) and
-/// among [b0, b0 + nb) (1 when either block has none).
-double canonical_correlation(const Inverted& inv, int a0, int na, int b0, int nb);
-}  // namespace design_detail
 
 /// Options of the added test that separates two effects after a session.
 struct SeparationOptions {
@@ -174,23 +131,11 @@ struct SeparatingCandidate {
   bool determined = false;  ///< every parameter of both effects is determined
 };
 
-struct SeparationDesign {
-  std::array<std::string, 2> effects;
-  TableMotionOverlap motion;
-  /// Parameters of the joint fit: 8 location errors, the session's pivot (3), the two effects'
-  /// parameters, and the added set-up's pivot (3) when it moved (absent from sigma_before).
-  std::vector<std::string> names;
-  Eigen::VectorXd
-      sigma_before;  ///< session alone, 1 sigma, fit units; infinite: held (undetermined)
-  Eigen::VectorXd sigma_after;      ///< session + the chosen test
-  double correlation_before = 1.0;  ///< largest canonical correlation of the pair (1: undetermined)
-  bool already_separated = false;   ///< the session alone is below max_correlation: nothing to add
-  bool found = false;               ///< a test within max_added_time_s reaches max_correlation
-  SeparatingCandidate chosen;       ///< the shortest that does; else the one of lowest correlation
-  int candidates_tried = 0;
-  double noise_um = 0.0;               ///< used
-  double effective_per_reading = 1.0;  ///< effective samples per reading (session's noise model)
-  std::string verdict;                 ///< what to do, or why nothing can separate them
+/// The engine's result (design/separation.hpp) with the ballbar's chosen test. Parameters of
+/// the joint fit (names): 8 location errors, the session's pivot (3), the two effects'
+/// parameters, and the added set-up's pivot (3) when it moved (absent from sigma_before).
+struct SeparationDesign : SeparationResult {
+  SeparatingCandidate chosen;  ///< the shortest that does; else the one of lowest correlation
 };
 
 /// The smallest additional ballbar test (same pivot: one rotary test at another bar length or

@@ -16,6 +16,8 @@
 
 namespace rotacal {
 
+struct RtestArrays;
+
 class RtestDiagnosisProblem : public DiagnosisProblem {
  public:
   /// Throws InvalidArgument if the session has no dx,dy,dz (convert raw probe readings first).
@@ -44,15 +46,11 @@ class RtestDiagnosisProblem : public DiagnosisProblem {
  private:
   auto jets_at(const ModelFit& at) const;  // for src/diagnose/candidate_jets.hpp
   RtestSession session_;
-  std::vector<std::string> setups_;  // distinct, in order
-  std::vector<int> setup_of_;        // per sample
+  // The samples as the R-test problem's arrays (rtest/problem.hpp), built once for every refit.
+  std::shared_ptr<const RtestArrays> arrays_;
   std::vector<std::string> groups_;  // per reading component
   std::vector<double> times_;
   std::vector<RotaryAngles<double>> angles_;
-  // The samples as arrays, built once for every refit: commanded xyz, nest, measured d.
-  Eigen::Matrix3Xd xyz_, nest_, d_;
-  std::vector<RotaryAngles<double>> pose_angles_;  // per sample
-  std::vector<double> pose_times_;
 };
 
 /// Diagnose an R-test session (see diagnosis.hpp).

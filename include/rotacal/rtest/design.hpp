@@ -24,7 +24,9 @@
 #include <string>
 #include <vector>
 
-#include "rotacal/ballbar/design.hpp"  // table_motion_overlap, the information helpers
+#include "rotacal/core/joint_fit.hpp"
+#include "rotacal/design/separation.hpp"
+#include "rotacal/design/table_motion.hpp"
 #include "rotacal/rtest/identify_joint.hpp"
 #include "rotacal/rtest/simulate.hpp"
 
@@ -112,21 +114,11 @@ struct RtestSeparatingCandidate {
   bool determined = false;  ///< every parameter of both effects is determined
 };
 
-struct RtestSeparationDesign {
-  std::array<std::string, 2> effects;
-  TableMotionOverlap motion;
-  /// 8 location errors, the probe zero of each session nest ("zero_x#N"), the two effects'
-  /// parameters, and the added nest's probe zero (absent from sigma_before).
-  std::vector<std::string> names;
-  Eigen::VectorXd sigma_before, sigma_after;
-  double correlation_before = 1.0;
-  bool already_separated = false;  ///< the session alone is below max_correlation: nothing to add
-  bool found = false;
+/// The engine's result (design/separation.hpp) with the R-test's chosen nest. Parameters of
+/// the joint fit (names): 8 location errors, the probe zero of each session nest ("zero_x#N"),
+/// the two effects' parameters, and the added nest's probe zero (absent from sigma_before).
+struct RtestSeparationDesign : SeparationResult {
   RtestSeparatingCandidate chosen;
-  int candidates_tried = 0;
-  double noise_um = 0.0;
-  double effective_per_reading = 1.0;
-  std::string verdict;
 };
 
 /// The smallest added R-test nest (position and grid) whose readings, fitted jointly with

@@ -85,6 +85,10 @@ struct RtestBasis {
   std::vector<double> b_terms(int k, double B) const;
   /// Contribution of each C-map coefficient (in order) to w_CB at (B, C) (rad).
   std::vector<AxisErrors<double>> c_terms(double B, double C) const;
+  /// Basis values at (B, C) as matrices: w_BY = Lb * (tilt-map coefficients), w_CB = Lc *
+  /// (rotary-map coefficients); Lb 6 x num_b_coefficients, Lc 6 x num_c_coefficients. The one
+  /// evaluation of the basis, for the fit (rtest/problem.hpp) and the error maps.
+  void map_rows(double B, double C, Eigen::Ref<Eigen::MatrixXd> Lb, Eigen::Ref<Eigen::MatrixXd> Lc) const;
 };
 
 /// Everything needed to predict: location errors, map coefficients and their covariance.
@@ -146,19 +150,19 @@ Pose<Scalar> rtest_joint_side_pose(MachineType m, const LocationErrors<Scalar>& 
 }
 
 /// Templated evaluation of the joint model's table pose (any Scalar): e -> 8 location errors,
-/// cb -> tilt-map coefficients, cc -> rotary-map coefficients.
+/// cb -> tilt-map coefficients, cc -> rotary-map coefficients; the maps w = L c from the
+/// basis rows (RtestBasis::map_rows), term by term in coefficient order.
 template <typename Scalar>
 Pose<Scalar> rtest_joint_table_pose(MachineType m, const RtestBasis& basis, const Scalar* e,
                                     const Scalar* cb, const Scalar* cc, double B, double C) {
+  Eigen::MatrixXd Lb(6, basis.num_b_coefficients()), Lc(6, basis.num_c_coefficients());
+  basis.map_rows(B, C, Lb, Lc);
   AxisErrors<Scalar> wb = AxisErrors<Scalar>::Zero(), wc = AxisErrors<Scalar>::Zero();
-  int o = 0;
-  for (int k = 0; k < 6; ++k)
-    for (double phi : basis.b_terms(k, B)) wb[k] += cb[o++] * Scalar(phi);
-  o = 0;
-  for (const AxisErrors<double>& t : basis.c_terms(B, C)) {
-    for (int k = 0; k < 6; ++k)
-      if (t[k] != 0.0) wc[k] += cc[o] * Scalar(t[k]);
-    ++o;
+  for (int k = 0; k < 6; ++k) {
+    for (Eigen::Index o = 0; o < Lb.cols(); ++o)
+      if (Lb(k, o) != 0.0) wb[k] += cb[o] * Scalar(Lb(k, o));
+    for (Eigen::Index o = 0; o < Lc.cols(); ++o)
+      if (Lc(k, o) != 0.0) wc[k] += cc[o] * Scalar(Lc(k, o));
   }
   return rtest_joint_side_pose<Scalar>(m, LocationErrors<Scalar>::from_ptr(e), wb, wc, {B, C}, false);
 }

@@ -1,0 +1,34 @@
+// The feasible-GLS sequence of the joint fits (core/fit_with_noise.hpp).
+#include "rotacal/core/fit_with_noise.hpp"
+
+#include <algorithm>
+#include <memory>
+
+namespace rotacal {
+
+NoiseFit fit_with_noise(const std::function<JointFitOutcome(const JointFitSettings&)>& solve,
+                        JointFitSettings settings, const std::vector<std::string>& groups,
+                        const std::vector<double>& times, const NoiseFitOptions& o) {
+  NoiseFit out;
+  out.fit = solve(settings);
+  if (settings.whitener || groups.empty()) return out;
+  out.noise = estimate_noise_model(groups, times, out.fit.residuals, o.noise_options);
+  if (o.noise != NoiseHandling::automatic || out.noise.white() ||
+      out.noise.correlation_samples < o.min_correlation_samples)
+    return out;
+  std::size_t longest = 0;
+  for (const NoiseStream& st : out.noise.streams) longest = std::max(longest, st.rows.size());
+  out.reml = o.allow_reml && o.noise_options.reml_random_walk &&
+             longest <= static_cast<std::size_t>(o.noise_options.reml_max_stream_size);
+  if (out.reml)
+    out.noise = estimate_noise_model_reml(out.noise, out.fit.residuals, free_jacobian(out.fit));
+  else if (o.noise_bias_correction)
+    out.scale = noise_correction(out.noise, groups, times, out.fit, o.noise_options);
+  settings.whitener = std::make_shared<ArWhitener>(out.noise);
+  out.fit = solve(settings);
+  apply_noise_correction(out.scale, &out.fit);
+  out.refit = true;
+  return out;
+}
+
+}  // namespace rotacal
