@@ -73,6 +73,7 @@ void bind_probe(pyb::module_& m) {
 
   pyb::class_<ProbeIdentification>(m, "ProbeIdentification")
       .def_readonly("method", &ProbeIdentification::method)
+      .def_property_readonly("machine", [](const ProbeIdentification& r) { return r.model.machine; })
       .def_property_readonly("errors", [](const ProbeIdentification& r) { return Eigen::VectorXd(r.model.errors.v); })
       .def_property_readonly("effects", [](const ProbeIdentification& r) { return ids_of(r.model.effects); })
       .def_property_readonly("effect_params", [](const ProbeIdentification& r) { return r.model.effect_params; })

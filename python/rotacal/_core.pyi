@@ -2137,6 +2137,9 @@ class ProbeIdentification:
     def iterations(self) -> int:
         ...
     @property
+    def machine(self) -> MachineType:
+        ...
+    @property
     def method(self) -> str:
         ...
     @property

@@ -11,31 +11,23 @@ import numpy as np
 
 from . import _core
 from .models import estimate_dict, machine_members
-from .results import noise_model_dict
+from .results import Identification, noise_model_dict
 
 METHODS = ("joint", "cycles", "cycles-free-radius")
 
 
 @dataclass
-class ProbeIdentification:
-    """Location errors and the sphere's table position identified from a touch-probe session."""
-
-    raw: Any  # _core.ProbeIdentification
-    machine: Any  # _core.MachineType
+class ProbeIdentification(Identification):
+    """Location errors and the sphere's table position identified from a touch-probe session
+    (parameter access as rotacal.Identification)."""
 
     @property
-    def parameters(self) -> list:
-        return list(self.raw.parameters)
+    def machine(self):
+        return self.raw.machine
 
-    def parameter(self, name: str):
-        for p in self.raw.parameters:
-            if p.name == name:
-                return p
-        raise KeyError(name)
-
-    @property
-    def residuals(self):
-        return self.raw.residuals
+    def model_dict(self) -> dict:
+        raise _core.InvalidArgument("a touch-probe fit has no model file yet (rotacal-model holds ballbar and "
+                                    "R-test models)")
 
     def to_dict(self) -> dict:
         def est(p):
@@ -76,7 +68,7 @@ def identify_probe(session: _core.ProbeSession, method: str = "joint", *, effect
         raw = _core.identify_probe_cycles(session, method == "cycles")
     else:
         raise _core.InvalidArgument(f"identify_probe: method must be one of {', '.join(METHODS)}, got {method!r}")
-    return ProbeIdentification(raw, session.machine)
+    return ProbeIdentification(raw)
 
 
 def simulate_probe(machine: str | Any, errors: Sequence[float] | None = None,
