@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "numpy.hpp"
+#include "rotacal/diagnose/probe_diagnosis.hpp"
 #include "rotacal/io/probe_file.hpp"
 #include "rotacal/probe/identify.hpp"
 #include "rotacal/probe/simulate.hpp"
@@ -119,6 +120,15 @@ void bind_probe(pyb::module_& m) {
       pyb::arg("session"), pyb::arg("radius_known") = true,
       "The controller cycles' method: sphere per pose, plane and circle of the centres per table axis.");
 
+  m.def(
+      "diagnose_probe",
+      [](const ProbeSession& session, const DiagnosisOptions& options) {
+        pyb::gil_scoped_release release;
+        return diagnose_probe(session, options);
+      },
+      pyb::arg("session"), pyb::arg("options") = DiagnosisOptions{},
+      "Diagnose a touch-probe session (diagnose/probe_diagnosis.hpp): catalogue effects and the probe's "
+      "stylus_radius_offset and probe_lobing over the joint fit's baseline.");
   m.def(
       "default_probe_poses_deg",
       [](MachineType machine) {

@@ -136,3 +136,18 @@ def test_bad_probe_files_are_refused_naming_file_line_and_column(tmp_path):
         rotacal.load(SHARED / "ballbar_ac_table2.csv", format="probe")
     with pytest.raises(rotacal.InvalidArgument, match="format"):
         rotacal.load(TABLE2, format="gcode")
+
+
+def test_a_wrong_stylus_radius_in_a_reference_session_is_named(tmp_path):
+    """The diagnosis on data from the reference simulator: a stylus 3 um larger than its
+    calibration is named stylus_radius_offset with its size; the same session without it names
+    nothing."""
+    names = refsim.builtin("AC-trt").error_names()
+    errors = dict(zip(names, [0.0726, -0.0202, 1.1284e-05, -0.000113006, 0.0283, 0.1041, 5.1954e-06, -4.1544e-05]))
+    path, _ = refsim_session(tmp_path, "AC-trt", errors, {"stylus_radius_offset": 3e-3}, rho=0.0, seed=31)
+    d = rotacal.diagnose(rotacal.load(path), max_harmonic=2)
+    assert d.raw.findings and d.raw.findings[0].effect == "stylus_radius_offset"
+    p = d.raw.findings[0].parameters[0]
+    assert abs(p.value - 3e-3) <= 3 * p.std
+    path, _ = refsim_session(tmp_path, "AC-trt", errors, {}, rho=0.0, seed=32)
+    assert not rotacal.diagnose(rotacal.load(path), max_harmonic=2).raw.findings
