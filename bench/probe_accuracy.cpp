@@ -82,7 +82,7 @@ int main(int argc, char** argv) {
   for (int k = 0; k < 8; ++k) {
     const bool angle = location_error_is_angle(k);
     const double u = angle ? 1e6 : 1e3;  // urad, um
-    std::printf("%-7s %5s %10.4f %10.4f %9.3f %12.4f %12.4f %10.3f %10.3f\n", names[static_cast<std::size_t>(k)].c_str(),
+    std::printf("%-7s %5s %10.4f %10.4f %9.3f %12.4f %12.4f %10.4f %10.3f\n", names[static_cast<std::size_t>(k)].c_str(),
                 angle ? "urad" : "um", u * crb[k], u * rj[k], rj[k] / crb[k], u * rk[k], u * rf[k], rj[k] / rk[k],
                 rk[k] / crb[k]);
   }
