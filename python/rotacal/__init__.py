@@ -39,5 +39,5 @@ from .results import DiagnosisResult, Identification  # noqa: F401
 from .probe import identify_probe, simulate_probe  # noqa: F401
 from .rtest import identify_rtest, monte_carlo_rtest  # noqa: F401
 from .sessions import check_plausible, load, save  # noqa: F401
+from .version import __version__  # noqa: F401
 
-__version__ = "0.1.0"

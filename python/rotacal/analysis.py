@@ -7,7 +7,7 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from . import _core, ballbar, probe, rtest
-from .diagnosis import diagnose
+from .diagnosis import diagnose, uncertainty_budget
 from .models import ballbar_model_from_dict
 from .sessions import BALLBAR, PROBE, RTEST, by_kind
 
@@ -38,6 +38,35 @@ def identify(session: Any, method: str = "joint", *, fit_length_offset: bool = F
                                                                effects=effects, tests=tests, noise=noise),
                             RTEST: rtest_identify, PROBE: probe_identify}, "identify")
     return run()
+
+
+def identification_budget(session: Any, sizes: Any = None) -> Any:
+    """The GUM budget of a joint identification of ``session`` (diagnose/uncertainty_budget.hpp):
+    it rests on the diagnosis of what the model leaves out. An R-test session's raw d1,d2,d3
+    readings are converted as identify_rtest converts them. ``sizes``: plausible_sizes() input."""
+    fitted = by_kind(session, {BALLBAR: lambda: session, RTEST: lambda: rtest.with_displacements(session)[0]},
+                     "identify")()
+    return uncertainty_budget(fitted, sizes=sizes)
+
+
+def monte_carlo(session: Any, identification: Any, draws: int, *, seed: int = 1) -> dict:
+    """Check an identification's 1-sigma by ``draws`` simulated repeats of the session with its
+    fitted noise model (rotacal.ballbar.monte_carlo, rotacal.rtest.monte_carlo_rtest)."""
+    return by_kind(session, {BALLBAR: lambda: ballbar.monte_carlo(session, identification, draws, seed=seed),
+                             RTEST: lambda: rtest.monte_carlo_rtest(session, identification, draws, seed=seed)},
+                   "monte_carlo")()
+
+
+def identification_document(identification: Any, session_path: str | Path, controller: str | None = None) -> dict:
+    """What a model file and a history entry hold of an identification: its model with the
+    ``source`` (the session as named, its SHA-256, when, by which rotacal) and, when given, the
+    text of the controller parameters active during the test (the kinematics the errors are
+    relative to, for the export and the history)."""
+    from .models import source_dict
+    source = source_dict(session_path)
+    if controller is not None:
+        source["controller_parameters"] = controller
+    return identification.model_dict() | {"source": source}
 
 
 def predict_session(model: Mapping, session: Any, probe_zeros: str = "none",

@@ -85,28 +85,18 @@ def residual_model(model: dict, ex: Any) -> dict:
 MAX_COMP_LINES = 256
 
 
-def _map_value(coefficients: dict, prefix: str, b: float, c: float | None = None) -> tuple[float, bool]:
-    """Sum of an error-map component's terms (docs/model_file.md, the basis' definition) at
-    b = B / 90 deg and C (rad); also whether a term depending on B was left out (c given: only
-    the B-independent C terms are a function of the C joint alone)."""
-    total, dropped = 0.0, False
-    for name, est in coefficients.items():
-        if not name.startswith(prefix + "."):
-            continue
-        value = est.get("value")
-        if value is None:
-            continue
-        term = name[len(prefix) + 1:]
-        if c is None:  # "bP": value * b^P
-            total += value * b ** int(term[1:])
-            continue
-        harmonic, power = term.split(".")  # "cosN.bM" / "sinN.bM"
-        if power != "b0":
-            dropped = True
-            continue
-        n = int(harmonic[3:])
-        total += value * (np.cos(n * c) if harmonic.startswith("cos") else np.sin(n * c))
-    return total, dropped
+def _positioning_error(model: dict, axis: str, nominal_deg: np.ndarray) -> np.ndarray:
+    """The axis' positioning error (rad) at the nominal angles from the R-test map, evaluated by
+    the C++ model (rtest/error_model.hpp; the basis of docs/model_file.md): beta_BY(B) for B,
+    gamma_CB(C) at B = 0 for C."""
+    from .models import rtest_model_from_dict
+    fitted, _, _ = rtest_model_from_dict(model)
+    rad = np.radians(nominal_deg)
+    if axis == "B":
+        values, _ = fitted.w_by(rad)
+        return np.asarray(values)[:, 4]
+    values, _ = fitted.w_cb(np.column_stack([np.zeros_like(rad), rad]))
+    return np.asarray(values)[:, 5]
 
 
 def linuxcnc_comp_table(model: dict, axis: str, lo_deg: float, hi_deg: float, step_deg: float) -> tuple[str, str]:
@@ -130,16 +120,13 @@ def linuxcnc_comp_table(model: dict, axis: str, lo_deg: float, hi_deg: float, st
     n = int(np.floor((hi_deg - lo_deg) / step_deg + 1e-9)) + 1
     if n > MAX_COMP_LINES:
         raise _core.InvalidArgument(f"--comp-range: {n} lines, LinuxCNC reads at most {MAX_COMP_LINES}; use a larger step")
-    lines, dropped_any = [], False
-    for k in range(n):
-        nominal = lo_deg + k * step_deg
-        if axis == "B":
-            err, dropped = _map_value(coefficients, prefix, nominal / 90.0)
-        else:
-            err, dropped = _map_value(coefficients, prefix, 0.0, np.radians(nominal))
-        dropped_any |= dropped
-        actual = nominal + np.degrees(err)
-        lines.append(f"{nominal:.6f} {actual:.6f} {actual:.6f}")
+    nominal = lo_deg + np.arange(n) * step_deg
+    actual = nominal + np.degrees(_positioning_error(model, axis, nominal))
+    lines = [f"{a:.6f} {b:.6f} {b:.6f}" for a, b in zip(nominal, actual)]
+    # The C map at B = 0: its terms in b^M (M > 0) vanish there; said so when the model has any.
+    dropped_any = axis == "C" and any(k.startswith(prefix + ".") and not k.endswith(".b0")
+                                      and isinstance(v, dict) and v.get("value") is not None
+                                      for k, v in coefficients.items())
     what = (f"{axis} positioning error from the R-test map ({prefix}), {lo_deg:g}..{hi_deg:g} deg every {step_deg:g}: "
             f"[JOINT_n]COMP_FILE_TYPE = 0 (nominal, actual moving +, actual moving -, deg)"
             + ("; terms that depend on B were left out (the table is for B = 0)" if dropped_any else ""))

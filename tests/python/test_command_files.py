@@ -10,6 +10,7 @@ import pytest
 
 import rotacal
 from rotacal import cli, command_files
+from rotacal.cli import serial_link
 from rotacal.history import open_history
 from rotacal.machines import load_machine
 
@@ -136,7 +137,7 @@ def _cases():
 @pytest.mark.parametrize("key,k,target,other", _cases())
 def test_an_output_is_never_another_file_of_its_command(sources, tmp_path, capsys, monkeypatch, key, k, target,
                                                          other):
-    monkeypatch.setattr(cli, "_serve", lambda *a: 0)  # a virtual instrument not refused must not wait for a host
+    monkeypatch.setattr(serial_link, "serve", lambda *a: 0)  # a virtual instrument not refused must not wait for a host
     template = TEMPLATES[key][k]
     ins, outs = _roles(key)
     paths = {s: sources[s] if s in ins or s == "--db" else tmp_path / f"out{n}{s.strip('-')}"
@@ -167,7 +168,7 @@ def _output_cases():
 @pytest.mark.parametrize("where", ["a directory", "a missing folder"])
 @pytest.mark.parametrize("key,k,target", _output_cases())
 def test_an_output_in_no_place_to_write_is_refused_first(sources, tmp_path, capsys, monkeypatch, key, k, target, where):
-    monkeypatch.setattr(cli, "_serve", lambda *a: 0)
+    monkeypatch.setattr(serial_link, "serve", lambda *a: 0)
     template = TEMPLATES[key][k]
     ins, _ = _roles(key)
     paths = {s: sources[s] if s in ins or s == "--db" else tmp_path / f"out{n}{s.strip('-')}"

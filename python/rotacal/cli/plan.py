@@ -1,0 +1,36 @@
+"""``rotacal plan``: the NC program of a test (and its commanded rows as a session template)."""
+from __future__ import annotations
+
+import argparse
+
+from ..outputs import write_output
+from ..sessions import save
+from .options import EPILOG, EXIT_OK, path, say
+from .setups import add_setup_args, ballbar_model, ballbar_setup
+
+
+def cmd_plan(a: argparse.Namespace) -> int:
+    from ..ballbar import nc_program
+    plan, text = nc_program(ballbar_setup(a), a.dialect, ballbar_model(a.compensate), a.compensate)
+    write_output(a.output, text, [a.compensate] if a.compensate else [], [a.session] if a.session else [])
+    say(f"wrote {a.output}: {a.dialect} program, {plan.num_samples} points, {plan.duration:.0f} s"
+        + (" (compensated)" if a.compensate else ""))
+    if a.session:
+        save(plan.commanded_session(), a.session, [a.compensate], [a.output])
+        say(f"wrote {a.session}: the commanded rows as a session template")
+    return EXIT_OK
+
+
+def add_plan(sub: argparse._SubParsersAction) -> None:
+    q = sub.add_parser("plan", help="plan a test and write its NC program", epilog=EPILOG)
+    q.add_argument("kind", choices=["ballbar"])
+    add_setup_args(q)
+    q.add_argument("--dialect", default="linuxcnc", help="linuxcnc (machine axes), heidenhain, siemens, fanuc")
+    q.add_argument("--compensate", metavar="MODEL.json", type=path("--compensate"), help="emit the program compensated for a fitted model")
+    q.add_argument("--session", metavar="CSV", type=path("--session"),
+                   help="also write the commanded rows as a session template")
+    q.add_argument("-o", "--output", required=True, type=path("--output"))
+    q.set_defaults(func=cmd_plan)
+
+
+COMMANDS = {"plan": add_plan}
