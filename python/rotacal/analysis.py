@@ -1,4 +1,4 @@
-"""What each command does with each kind of session: identify, predict and report a ballbar or an R-test session."""
+"""What each command does with each kind of session: identify, predict and report a ballbar, an R-test or a touch-probe session."""
 from __future__ import annotations
 
 from pathlib import Path
