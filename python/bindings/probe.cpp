@@ -6,6 +6,7 @@
 
 #include "numpy.hpp"
 #include "rotacal/diagnose/probe_diagnosis.hpp"
+#include "rotacal/diagnose/uncertainty_budget.hpp"
 #include "rotacal/io/probe_file.hpp"
 #include "rotacal/probe/identify.hpp"
 #include "rotacal/probe/simulate.hpp"
@@ -129,6 +130,15 @@ void bind_probe(pyb::module_& m) {
       pyb::arg("session"), pyb::arg("options") = DiagnosisOptions{},
       "Diagnose a touch-probe session (diagnose/probe_diagnosis.hpp): catalogue effects and the probe's "
       "stylus_radius_offset and probe_lobing over the joint fit's baseline.");
+  m.def(
+      "uncertainty_budget_probe",
+      [](const ProbeSession& session, const Diagnosis& diagnosis, const PlausibleSizes& sizes, double coverage) {
+        pyb::gil_scoped_release release;
+        return uncertainty_budget(ProbeDiagnosisProblem(session), diagnosis, sizes, coverage);
+      },
+      pyb::arg("session"), pyb::arg("diagnosis"), pyb::arg("sizes") = PlausibleSizes{}, pyb::arg("coverage") = 0.95,
+      "GUM budget of the location errors of diagnose_probe's result (the probe's entries: stylus calibration, "
+      "lobing).");
   m.def(
       "default_probe_poses_deg",
       [](MachineType machine) {

@@ -101,5 +101,6 @@ def uncertainty_budget(session: Any, diagnosis: DiagnosisResult | None = None, *
         diagnosis = diagnose(session)
     o = plausible_sizes(sizes)
     return by_kind(session, {BALLBAR: lambda: _core.uncertainty_budget_ballbar(session, diagnosis.raw, o, coverage),
-                             RTEST: lambda: _core.uncertainty_budget_rtest(session, diagnosis.raw, o, coverage)},
+                             RTEST: lambda: _core.uncertainty_budget_rtest(session, diagnosis.raw, o, coverage),
+                             PROBE: lambda: _core.uncertainty_budget_probe(session, diagnosis.raw, o, coverage)},
                    "uncertainty_budget")()

@@ -151,3 +151,22 @@ def test_a_wrong_stylus_radius_in_a_reference_session_is_named(tmp_path):
     assert abs(p.value - 3e-3) <= 3 * p.std
     path, _ = refsim_session(tmp_path, "AC-trt", errors, {}, rho=0.0, seed=32)
     assert not rotacal.diagnose(rotacal.load(path), max_harmonic=2).raw.findings
+
+
+def test_the_budget_of_a_probe_session_carries_the_stylus_calibration():
+    """The GUM budget of the shared session: every location error has a type-A part and type-B
+    lines, among them the probe's own stylus_radius_offset; a larger plausible stylus error
+    gives a larger line."""
+    s = rotacal.load(TABLE2)
+    d = rotacal.diagnose(s, max_harmonic=2)
+    b = rotacal.uncertainty_budget(s, d)
+    assert len(b.errors) == 8
+    stylus = {}
+    for e in b.errors:
+        assert e.u_a > 0 and e.u_c >= e.u_a
+        stylus[e.name] = sum(line.u for line in e.type_b if line.effect == "stylus_radius_offset")
+    assert any(v > 0 for v in stylus.values())
+    wide = rotacal.uncertainty_budget(s, d, sizes={"stylus_radius_mm": 5e-3})
+    for e in wide.errors:
+        u = sum(line.u for line in e.type_b if line.effect == "stylus_radius_offset")
+        assert u >= stylus[e.name] - 1e-15
