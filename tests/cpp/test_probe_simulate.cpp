@@ -78,7 +78,7 @@ TEST_CASE("simulated touches lie on the truth's sphere, noise as asked", "[probe
     MachineModel m = MachineModel::nominal(parse_machine_type(name));
     m.errors.v << 0.03, -0.02, 2e-5, -3e-5, 0.01, 0.04, -1e-5, 2e-5;
     m.effects = EffectModel{{Effect::parse("stylus_radius_offset"), Effect::parse("probe_lobing"),
-                             Effect::parse("angular_positioning_C_h1")}};
+                             Effect::parse("angular_positioning_C_h1")}, std::nullopt};
     m.effect_params = {2e-3, 0.8e-3, -0.4e-3, 2e-5, 1e-5};
     ProbeSimOptions o;
     o.pattern = default_probe_pattern(m.machine);

@@ -14,7 +14,7 @@ constexpr double kRadius = 15.5;
 
 EffectModel probe_effects() {
   return EffectModel{{Effect::parse("stylus_radius_offset"), Effect::parse("probe_lobing"),
-                      Effect::parse("angular_positioning_C_h1"), Effect::parse("gravity_sag_A")}};
+                      Effect::parse("angular_positioning_C_h1"), Effect::parse("gravity_sag_A")}, std::nullopt};
 }
 
 ProbeTouch ideal_touch(MachineType m, const Eigen::Vector3d& q, const RotaryAngles<double>& a, Eigen::Vector3d n) {
@@ -44,7 +44,7 @@ TEST_CASE("stylus_radius_offset and probe_lobing act as effects.md says", "[prob
   const Eigen::Vector3d q(150, 0, 80);
   const double s = 0.5, c = std::sqrt(3.0) / 2.0;
   const ProbeTouch t = ideal_touch(m, q, {0.0, 0.0}, Eigen::Vector3d(-c, 0, -s));
-  const EffectModel fx{{Effect::parse("stylus_radius_offset"), Effect::parse("probe_lobing")}};
+  const EffectModel fx{{Effect::parse("stylus_radius_offset"), Effect::parse("probe_lobing")}, std::nullopt};
   const double d = 2e-3, lc = 1e-3, ls = 0.7e-3;
   // The trigger distance grows by d: an ideal touch then reads d short.
   const std::vector<double> stylus{d, 0.0, 0.0};
