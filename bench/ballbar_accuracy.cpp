@@ -13,7 +13,7 @@
 #include "rotacal/ballbar/identify.hpp"
 #include "rotacal/ballbar/identify_paper.hpp"
 #include "rotacal/ballbar/simulate.hpp"
-#include "rotacal/ballbar/test_plan.hpp"
+#include "rotacal/ballbar/plan.hpp"
 
 using namespace rotacal;
 

@@ -13,7 +13,7 @@
 #include <string>
 
 #include "rotacal/ballbar/simulate.hpp"
-#include "rotacal/ballbar/test_plan.hpp"
+#include "rotacal/ballbar/plan.hpp"
 #include "rotacal/core/least_squares.hpp"
 #include "rotacal/diagnose/ballbar_diagnosis.hpp"
 #include "../tests/support/detection_amplitude.hpp"

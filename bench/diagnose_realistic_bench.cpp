@@ -16,7 +16,7 @@
 #include <string>
 
 #include "rotacal/ballbar/simulate.hpp"
-#include "rotacal/ballbar/test_plan.hpp"
+#include "rotacal/ballbar/plan.hpp"
 #include "rotacal/core/least_squares.hpp"
 #include "rotacal/core/noise_model.hpp"
 #include "rotacal/diagnose/ballbar_diagnosis.hpp"

@@ -1,7 +1,7 @@
-// Bindings for include/rotacal/ballbar/{test_plan,nc_program}.hpp: thin wrappers, numpy out.
+// Bindings for include/rotacal/ballbar/{plan,nc_program}.hpp: thin wrappers, numpy out.
 #include "numpy.hpp"
 #include "rotacal/ballbar/nc_program.hpp"
-#include "rotacal/ballbar/test_plan.hpp"
+#include "rotacal/ballbar/plan.hpp"
 
 namespace rotacal::py {
 

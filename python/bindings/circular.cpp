@@ -1,10 +1,10 @@
-// Bindings for include/rotacal/ballbar/circular_{test,simulate,analysis}.hpp and
-// include/rotacal/diagnose/circular_diagnosis.hpp: thin wrappers, numpy out.
+// Bindings for include/rotacal/circular/{plan,simulate,analysis,diagnosis}.hpp: thin wrappers,
+// numpy out.
 #include "numpy.hpp"
-#include "rotacal/ballbar/circular_analysis.hpp"
-#include "rotacal/ballbar/circular_simulate.hpp"
-#include "rotacal/ballbar/circular_test.hpp"
-#include "rotacal/diagnose/circular_diagnosis.hpp"
+#include "rotacal/circular/analysis.hpp"
+#include "rotacal/circular/simulate.hpp"
+#include "rotacal/circular/plan.hpp"
+#include "rotacal/circular/diagnosis.hpp"
 
 namespace rotacal::py {
 
@@ -97,7 +97,7 @@ void bind_circular(pyb::module_& m) {
 
   pyb::class_<LinearAxisErrors>(
       m, "LinearAxisErrors",
-      "Errors of the linear axes X, Y, Z (mm, rad, s); see circular_simulate.hpp.")
+      "Errors of the linear axes X, Y, Z (mm, rad, s); see circular/simulate.hpp.")
       .def(pyb::init<>())
       .def_readwrite("squareness", &LinearAxisErrors::squareness)
       .def_readwrite("scale", &LinearAxisErrors::scale)

@@ -101,7 +101,7 @@ void bind_hw(pyb::module_& m) {
 
   pyb::class_<VirtualCircularBallbar> circular(
       m, "VirtualCircularBallbar",
-      "A ballbar on a machine running an ISO 230-4 circular program (circular_timeline.hpp), "
+      "A ballbar on a machine running an ISO 230-4 circular program (circular/timeline.hpp), "
       "served on a pseudo-terminal; the machine and noise as simulate_circular's options.");
   circular.def(pyb::init([](const CircularPlanResult& plan, const CircularSimulationOptions& sim,
                             double rate_hz, double speed, int baud, const FaultInjection& faults) {

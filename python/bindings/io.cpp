@@ -6,6 +6,7 @@
 #include "rotacal/io/output_file.hpp"
 #include "rotacal/io/plausibility.hpp"
 #include "rotacal/io/session_arrays.hpp"
+#include "rotacal/rtest/model_document.hpp"
 
 namespace rotacal::py {
 
@@ -169,6 +170,14 @@ void bind_io(pyb::module_& m) {
       "ballbar_model_document",
       [](const BallbarMachineModel& model) { return from_json(ballbar_model_document(model)); },
       pyb::arg("model"));
+  m.def(
+      "rtest_joint_model_document",
+      [](const RtestJointIdentification& identification, const std::map<std::string, Eigen::Vector3d>& nests) {
+        return from_json(rtest_joint_model_document(identification, nests));
+      },
+      pyb::arg("identification"), pyb::arg("nests"),
+      "The rotacal-model/1 document (kind rtest-joint) of a joint R-test identification "
+      "(rotacal/rtest/model_document.hpp); nests: label -> nominal ball centre, mm.");
 
   // Plausibility before fitting (rotacal/io/plausibility.hpp).
   pyb::class_<PlausibilityOptions>(m, "PlausibilityOptions", "Limits of the plausibility checks (mm, deg).")

@@ -124,7 +124,7 @@ def source_dict(session_path: str | Path) -> dict:
     """The ``source`` member of a model file: the session it was identified from (as named, and
     its SHA-256), when, and by which rotacal; exports and the history quote it."""
     import datetime
-    from . import __version__
+    from .version import __version__
     return {"session": os.fspath(session_path), "session_sha256": file_sha256(session_path),
             "identified_at": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
             "rotacal": __version__}
@@ -189,61 +189,15 @@ def fit_model_dict(machine: Any, parameters: list, effects: list[str]) -> dict:
 
 RTEST_KIND = "rtest-joint"
 
-# What the basis' coefficients mean (rotacal/rtest/identify_joint.hpp), written into the file
-# so that a reader without the library can evaluate the maps.
-RTEST_BASIS_DEFINITION = (
-    "b = B / 90 deg. Table pose T(B, C) = E(w_BY(B)) Rot(B line, B) E(w_CB(B, C)) Rot(C line, C), "
-    "E(w) = Dx(dx) Dy(dy) Dz(dz) Da(alpha) Db(beta) Dc(gamma) (Oyama & Ibaraki Eq. 1), axis lines "
-    "from the location errors (ISO 230-7). w_BY translations: coefficient 'k_BY.bP' multiplies "
-    "b^P (even P >= 2); rotations: odd P >= 1. w_CB component k: 'k_CB.cosN.bM' multiplies "
-    "b^M cos(N C), 'k_CB.sinN.bM' b^M sin(N C); 'dxy_CB.back1.u.b0' adds (cos C, -sin C) to "
-    "(dx, dy)_CB and '.v.b0' (sin C, cos C), likewise 'alphabeta_CB.back1' for (alpha, beta)_CB. "
-    "R-test reading of the nest at q: d = T^-1 (Ry(B) Rz(C) q) - q + probe zero. Units mm, rad. "
-    "On another machine B is its tilt axis and C its rotary axis; basis.maps names their maps "
-    "(coefficients 'dz_<tilt map>.b2', 'dx_<rotary map>.cos1.b0', ...), each E(w) stands in front "
-    "of its own axis' rotation in the machine's chain (docs/machines.md), an axis on the head has "
-    "translations only, and the tool ball is at (0, 0, -(pivot + tool length) + tool_offset_Z) in "
-    "the spindle frame.")
-
-
 def rtest_model_dict(ident: Any, nests: dict) -> dict:
     """Model dict (``kind: rtest-joint``) of a joint R-test identification on any machine:
     location errors, on a machine with head axes tool_offset_Z, the two maps' coefficients
     (named after the machine's axes, e.g. ``dz_BY.b2``, ``dx_CZ.cos2.b0``) and their covariance,
     the basis and its definition, the nests and the fitted probe zero of each set-up.
     Parameters of an unobservable combination keep the value the fit gave them under its
-    convention (``observable: false``, no std), so that the file predicts as the fit did."""
-    raw = ident
-    model = raw.model
-    machine = model.machine
-    basis = model.basis
-    le_names = list(_core.location_error_names(machine))
-    names = list(model.parameter_names())
-    head = ["tool_offset_Z"] if machine.has_head else []
-    coef_names = names[len(le_names) + len(head):]
-    by_name = {p.name: p for p in raw.parameters}
-    est = convention_estimate_dict
-    zeros: dict[str, dict] = {}
-    for setup in raw.probe_zeros:
-        zeros[setup] = {a: est(by_name[f"zero.{setup}.{a}"]) for a in "xyz"}
-    return {
-        "format": FORMAT,
-        "kind": RTEST_KIND,
-        **machine_members(machine),
-        "basis": {"b_degree": basis.b_degree, "c_harmonics": basis.c_harmonics,
-                  "c_b_degree": basis.c_b_degree, "gamma_cb": bool(basis.gamma_cb),
-                  "maps": list(_core.rtest_map_names(machine)),
-                  "definition": RTEST_BASIS_DEFINITION},
-        "location_errors": {n: est(by_name[n]) for n in le_names},
-        **{n: est(by_name[n]) for n in head},
-        "map_coefficients": {n: est(by_name[n]) for n in coef_names},
-        "covariance": {"parameters": names, "matrix": np.asarray(model.covariance).tolist()},
-        "nests": {k: np.asarray(v, dtype=float).tolist() for k, v in nests.items()},
-        "probe_zeros": zeros,
-        "fit": {"residual_rms_um": float(raw.residual_rms_um), "sigma_um": float(raw.sigma_um),
-                "n_samples": int(raw.n_samples), "converged": bool(raw.converged),
-                "unobservable": list(raw.unobservable), "notes": list(raw.notes)},
-    }
+    convention (``observable: false``, no std), so that the file predicts as the fit did.
+    Written by the C++ implementation (rotacal/rtest/model_document.hpp)."""
+    return _core.rtest_joint_model_document(ident, {str(k): np.asarray(v, dtype=float) for k, v in nests.items()})
 
 
 def _int_field(d: dict, key: str, where: str) -> int:

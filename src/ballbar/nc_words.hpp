@@ -1,7 +1,7 @@
 #pragma once
-// Internal to src/ballbar: number formatting of NC words, each dialect's comment writer, and
+// Internal to src/ballbar and src/circular: number formatting of NC words, each dialect's comment writer, and
 // the program preamble per dialect, shared by the NC writer of the rotary-axis test
-// (nc_program.cpp) and of the circular tests (circular_test.cpp).
+// (nc_program.cpp) and of the circular tests (src/circular/plan.cpp).
 
 #include <cstdio>
 #include <functional>

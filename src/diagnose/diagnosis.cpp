@@ -13,7 +13,7 @@
 #include <optional>
 #include <sstream>
 
-#include "rotacal/ballbar/test_plan.hpp"
+#include "rotacal/ballbar/plan.hpp"
 #include "rotacal/core/stats.hpp"
 #include "rivals.hpp"
 #include "scoring.hpp"

@@ -393,6 +393,72 @@ json ballbar_model_document(const BallbarMachineModel& model) {
   return doc;
 }
 
+namespace {
+
+// What the basis' coefficients mean (rotacal/rtest/identify_joint.hpp), written into the file
+// so that a reader without the library can evaluate the maps.
+const char* const kRtestBasisDefinition =
+    "b = B / 90 deg. Table pose T(B, C) = E(w_BY(B)) Rot(B line, B) E(w_CB(B, C)) Rot(C line, C), "
+    "E(w) = Dx(dx) Dy(dy) Dz(dz) Da(alpha) Db(beta) Dc(gamma) (Oyama & Ibaraki Eq. 1), axis lines "
+    "from the location errors (ISO 230-7). w_BY translations: coefficient 'k_BY.bP' multiplies "
+    "b^P (even P >= 2); rotations: odd P >= 1. w_CB component k: 'k_CB.cosN.bM' multiplies "
+    "b^M cos(N C), 'k_CB.sinN.bM' b^M sin(N C); 'dxy_CB.back1.u.b0' adds (cos C, -sin C) to "
+    "(dx, dy)_CB and '.v.b0' (sin C, cos C), likewise 'alphabeta_CB.back1' for (alpha, beta)_CB. "
+    "R-test reading of the nest at q: d = T^-1 (Ry(B) Rz(C) q) - q + probe zero. Units mm, rad. "
+    "On another machine B is its tilt axis and C its rotary axis; basis.maps names their maps "
+    "(coefficients 'dz_<tilt map>.b2', 'dx_<rotary map>.cos1.b0', ...), each E(w) stands in front "
+    "of its own axis' rotation in the machine's chain (docs/machines.md), an axis on the head has "
+    "translations only, and the tool ball is at (0, 0, -(pivot + tool length) + tool_offset_Z) in "
+    "the spindle frame.";
+
+// {"value", "std", "unit"}; an unobservable parameter keeps its convention value, no std.
+json convention_estimate(const ParameterEstimate& p) {
+  if (!p.observable) return {{"value", p.value}, {"std", nullptr}, {"unit", p.unit}, {"observable", false}};
+  return {{"value", p.value}, {"std", p.std}, {"unit", p.unit}};
+}
+
+}  // namespace
+
+json rtest_joint_model_document(const RtestJointModelContent& c) {
+  const std::size_t n_le = 8, n_head = c.machine.has_head() ? 1 : 0, n = c.parameters.size();
+  if (n < n_le + n_head)
+    throw InvalidArgument("rtest_joint_model_document: " + std::to_string(n) + " parameters, fewer than the " +
+                          std::to_string(n_le + n_head) + " of the machine");
+  if (c.covariance.rows() != static_cast<Eigen::Index>(n) || c.covariance.cols() != static_cast<Eigen::Index>(n))
+    throw InvalidArgument("rtest_joint_model_document: the covariance is not " + std::to_string(n) + " x " +
+                          std::to_string(n));
+  json doc = {{"format", kModelFormat}, {"kind", "rtest-joint"}};
+  put_machine(doc, c.machine);
+  json maps = json::array();
+  for (const std::string& m : rtest_map_names(c.machine)) maps.push_back(m);
+  doc["basis"] = {{"b_degree", c.b_degree}, {"c_harmonics", c.c_harmonics}, {"c_b_degree", c.c_b_degree},
+                  {"gamma_cb", c.gamma_cb}, {"maps", maps}, {"definition", kRtestBasisDefinition}};
+  json le = json::object(), coefficients = json::object(), names = json::array(), matrix = json::array();
+  for (std::size_t i = 0; i < n_le; ++i) le[c.parameters[i].name] = convention_estimate(c.parameters[i]);
+  doc["location_errors"] = le;
+  if (n_head) doc[c.parameters[n_le].name] = convention_estimate(c.parameters[n_le]);
+  for (std::size_t i = n_le + n_head; i < n; ++i)
+    coefficients[c.parameters[i].name] = convention_estimate(c.parameters[i]);
+  doc["map_coefficients"] = coefficients;
+  for (std::size_t i = 0; i < n; ++i) {
+    names.push_back(c.parameters[i].name);
+    json row = json::array();
+    for (std::size_t j = 0; j < n; ++j)
+      row.push_back(c.covariance(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)));
+    matrix.push_back(row);
+  }
+  doc["covariance"] = {{"parameters", names}, {"matrix", matrix}};
+  json nests = json::object(), zeros = json::object();
+  for (const auto& [label, q] : c.nests) nests[label] = {q.x(), q.y(), q.z()};
+  doc["nests"] = nests;
+  for (const auto& [setup, z] : c.probe_zeros)
+    zeros[setup] = {{"x", convention_estimate(z[0])}, {"y", convention_estimate(z[1])}, {"z", convention_estimate(z[2])}};
+  doc["probe_zeros"] = zeros;
+  doc["fit"] = {{"residual_rms_um", c.residual_rms_um}, {"sigma_um", c.sigma_um}, {"n_samples", c.n_samples},
+                {"converged", c.converged}, {"unobservable", c.unobservable}, {"notes", c.notes}};
+  return doc;
+}
+
 BallbarMachineModel ballbar_machine_model(const ModelFile& model) {
   if (model.kind != "ballbar" || !model.pivot)
     throw InvalidArgument("ballbar_machine_model: a " + model.kind + " model is not a ballbar model");

@@ -6,11 +6,12 @@
 #include <set>
 
 #include "rotacal/io/output_file.hpp"
-#include "text_reader.hpp"
+#include "session_text.hpp"
+#include "strict_reader.hpp"
 
 namespace rotacal {
 
-using namespace text_io;
+using namespace io_detail;
 
 namespace {
 

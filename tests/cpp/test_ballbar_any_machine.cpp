@@ -10,7 +10,7 @@
 #include "rotacal/ballbar/compensate.hpp"
 #include "rotacal/ballbar/identify.hpp"
 #include "rotacal/ballbar/nc_program.hpp"
-#include "rotacal/ballbar/test_plan.hpp"
+#include "rotacal/ballbar/plan.hpp"
 #include "rotacal/diagnose/ballbar_diagnosis.hpp"
 #include "../support/synthetic_sessions.hpp"
 

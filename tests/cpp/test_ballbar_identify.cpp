@@ -7,7 +7,7 @@
 #include "rotacal/ballbar/identify.hpp"
 #include "rotacal/ballbar/identify_paper.hpp"
 #include "rotacal/ballbar/simulate.hpp"
-#include "rotacal/ballbar/test_plan.hpp"
+#include "rotacal/ballbar/plan.hpp"
 #include "../../src/ballbar/length_model.hpp"  // the fit's model, to compare its two Jacobians
 
 using namespace rotacal;

@@ -8,7 +8,7 @@
 #include "rotacal/ballbar/identify_paper.hpp"
 #include "rotacal/ballbar/monte_carlo.hpp"
 #include "rotacal/ballbar/simulate.hpp"
-#include "rotacal/ballbar/test_plan.hpp"
+#include "rotacal/ballbar/plan.hpp"
 
 using namespace rotacal;
 

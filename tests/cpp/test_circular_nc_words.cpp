@@ -6,9 +6,9 @@
 #include <sstream>
 
 #include "../../src/ballbar/nc_words.hpp"
-#include "rotacal/ballbar/circular_test.hpp"
+#include "rotacal/circular/plan.hpp"
 #include "rotacal/ballbar/nc_program.hpp"
-#include "rotacal/ballbar/test_plan.hpp"
+#include "rotacal/ballbar/plan.hpp"
 
 using namespace rotacal;
 

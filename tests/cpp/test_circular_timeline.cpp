@@ -1,10 +1,10 @@
-// The circular program as a function of time (circular_timeline.hpp) and the noise-free
-// reading a virtual ballbar plays from it (circular_simulate.hpp).
+// The circular program as a function of time (circular/timeline.hpp) and the noise-free
+// reading a virtual ballbar plays from it (circular/simulate.hpp).
 #include <catch2/catch.hpp>
 #include <cmath>
 
-#include "rotacal/ballbar/circular_simulate.hpp"
-#include "rotacal/ballbar/circular_timeline.hpp"
+#include "rotacal/circular/simulate.hpp"
+#include "rotacal/circular/timeline.hpp"
 
 using namespace rotacal;
 

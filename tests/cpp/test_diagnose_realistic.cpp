@@ -9,7 +9,7 @@
 #include <random>
 
 #include "rotacal/ballbar/simulate.hpp"
-#include "rotacal/ballbar/test_plan.hpp"
+#include "rotacal/ballbar/plan.hpp"
 #include "rotacal/ballbar/timeline.hpp"
 #include "rotacal/core/noise_model.hpp"
 #include "rotacal/diagnose/ballbar_diagnosis.hpp"

@@ -163,3 +163,111 @@ TEST_CASE("a file as the Python writer made it before the C++ one existed is rea
   CHECK(f.pivot->y() == 120.002);
   CHECK(f.effect_params == std::vector<double>{0.0021});
 }
+
+namespace {
+
+// An R-test joint model's content on a machine, values of the size a fit gives (mm, rad), not
+// round numbers; the map coefficients named as the format names them (d* translations, others
+// rotations); one parameter unobservable under its convention.
+RtestJointModelContent sample_rtest_content(MachineType machine) {
+  RtestJointModelContent c;
+  c.machine = machine;
+  c.b_degree = 2;
+  c.c_harmonics = 1;
+  c.c_b_degree = 0;
+  c.gamma_cb = false;
+  const auto maps = rtest_map_names(machine);
+  std::vector<std::string> names(location_error_names(machine).begin(), location_error_names(machine).end());
+  if (machine.has_head()) names.push_back("tool_offset_Z");
+  for (const std::string& n : {"dz_" + maps[0] + ".b2", "alpha_" + maps[0] + ".b1", "dx_" + maps[1] + ".cos1.b0"})
+    names.push_back(n);
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const bool angle = i < 8 ? location_error_is_angle(static_cast<int>(i))
+                             : names[i] != "tool_offset_Z" && names[i].rfind("d", 0) != 0;
+    c.parameters.push_back({names[i], (i % 2 ? -1.0 : 1.0) * (angle ? 3.1e-5 : 0.0123) * (1.0 + 0.137 * i),
+                            angle ? 1.7e-6 : 4.3e-4, angle ? "rad" : "mm", true});
+  }
+  c.parameters[3].observable = false;  // kept at its convention value, written without a std
+  const auto n = static_cast<Eigen::Index>(names.size());
+  c.covariance = Eigen::MatrixXd::Zero(n, n);
+  for (Eigen::Index i = 0; i < n; ++i) c.covariance(i, i) = std::pow(c.parameters[static_cast<std::size_t>(i)].std, 2);
+  c.covariance(0, 1) = c.covariance(1, 0) = -1.234567e-8;
+  c.nests = {{"1", Eigen::Vector3d(100.125, 0.0, 50.0)}, {"2", Eigen::Vector3d(-0.3, 99.875, 120.0)}};
+  for (const char* setup : {"1", "2"}) {
+    std::array<ParameterEstimate, 3> z;
+    for (int a = 0; a < 3; ++a)
+      z[static_cast<std::size_t>(a)] = {std::string("zero.") + setup + "." + "xyz"[a], 0.00213 * (a + 1), 1.1e-4, "mm", true};
+    c.probe_zeros[setup] = z;
+  }
+  c.residual_rms_um = 0.8123;
+  c.sigma_um = 0.79;
+  c.n_samples = 432;
+  c.converged = true;
+  c.unobservable = {"a combination in words"};
+  c.notes = {"a note"};
+  return c;
+}
+
+}  // namespace
+
+TEST_CASE("an R-test joint model is written in C++ and reads back member by member") {
+  for (MachineType machine : {MachineType::BC_trt, MachineType::AC_trt, parse_machine_type("B-head-C-table")}) {
+    CAPTURE(to_string(machine));
+    const RtestJointModelContent c = sample_rtest_content(machine);
+    const std::string path = tmp_path("rtest.json");
+    write_model(rtest_joint_model_document(c), path);
+    const ModelFile f = read_model(path);  // the reader's full check of kind rtest-joint
+    ::unlink(path.c_str());
+    CHECK(f.kind == "rtest-joint");
+    CHECK(f.machine == machine);
+    const json& d = f.document;
+    CHECK(d["basis"]["b_degree"] == 2);
+    CHECK(d["basis"]["c_harmonics"] == 1);
+    CHECK(d["basis"]["c_b_degree"] == 0);
+    CHECK(d["basis"]["gamma_cb"] == false);
+    const auto maps = rtest_map_names(machine);
+    CHECK(d["basis"]["maps"] == json({maps[0], maps[1]}));
+    CHECK(d["basis"]["definition"].get<std::string>().find("Oyama & Ibaraki Eq. 1") != std::string::npos);
+    // Every parameter where the format puts it, its value bit for bit.
+    const std::size_t n_head = machine.has_head() ? 1 : 0;
+    std::vector<std::string> names;
+    for (std::size_t i = 0; i < c.parameters.size(); ++i) {
+      const ParameterEstimate& p = c.parameters[i];
+      names.push_back(p.name);
+      const json& e = i < 8 ? d["location_errors"][p.name] : i < 8 + n_head ? d[p.name] : d["map_coefficients"][p.name];
+      CAPTURE(p.name);
+      CHECK(e["value"].get<double>() == p.value);
+      CHECK(e["unit"] == p.unit);
+      if (p.observable) {
+        CHECK(e["std"].get<double>() == p.std);
+        CHECK_FALSE(e.contains("observable"));
+      } else {
+        CHECK(e["std"].is_null());
+        CHECK(e["observable"] == false);
+      }
+    }
+    CHECK(d["map_coefficients"].size() == 3);
+    CHECK(machine.has_head() == d.contains("tool_offset_Z"));
+    CHECK(d["covariance"]["parameters"] == json(names));
+    for (std::size_t i = 0; i < names.size(); ++i)
+      for (std::size_t j = 0; j < names.size(); ++j)
+        CHECK(d["covariance"]["matrix"][i][j].get<double>() ==
+              c.covariance(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)));
+    CHECK(d["nests"]["2"] == json({-0.3, 99.875, 120.0}));
+    CHECK(d["probe_zeros"]["2"]["z"]["value"].get<double>() == 0.00213 * 3);
+    CHECK(d["fit"]["n_samples"] == 432);
+    CHECK(d["fit"]["converged"] == true);
+    CHECK(d["fit"]["residual_rms_um"].get<double>() == 0.8123);
+    CHECK(d["fit"]["unobservable"] == json({"a combination in words"}));
+    // Read and written again: the same text (nothing lost or reordered on the way).
+    CHECK(format_model(d, "again") == format_model(rtest_joint_model_document(c), "first"));
+  }
+}
+
+TEST_CASE("the R-test joint writer refuses content that does not fit the machine") {
+  RtestJointModelContent c = sample_rtest_content(MachineType::BC_trt);
+  c.covariance = Eigen::MatrixXd::Zero(2, 2);
+  CHECK_THROWS_WITH(rtest_joint_model_document(c), Catch::Contains("covariance is not 11 x 11"));
+  c.parameters.resize(5);
+  CHECK_THROWS_WITH(rtest_joint_model_document(c), Catch::Contains("5 parameters, fewer than the 8"));
+}

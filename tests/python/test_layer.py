@@ -104,19 +104,11 @@ def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
     return out
 
 
-# models.py reads __version__ through the package (`from . import __version__`), whose
-# __init__ imports models: the one import of the package's facade by a module of it. models.py
-# belongs to the model-file work of issue 30; its import is to read rotacal.version instead.
-FACADE_READERS = {"rotacal.models"}
-
-
 def test_the_package_has_no_import_cycle():
     graph = _import_graph()
     assert "rotacal.diagnosis" in graph["rotacal.analysis"] and "rotacal.sessions" in graph["rotacal.diagnosis"]
     readers = {m for m, targets in graph.items() if "rotacal" in targets}
-    assert readers <= FACADE_READERS, f"modules importing the package facade: {sorted(readers - FACADE_READERS)}"
-    for m in FACADE_READERS & readers:
-        graph[m].discard("rotacal")
+    assert not readers, f"modules importing the package facade: {sorted(readers)}"
     assert _cycles(graph) == []
 
 

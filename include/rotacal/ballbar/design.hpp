@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "rotacal/ballbar/identify.hpp"
-#include "rotacal/ballbar/test_plan.hpp"
+#include "rotacal/ballbar/plan.hpp"
 #include "rotacal/core/joint_fit.hpp"
 #include "rotacal/kinematics/effects.hpp"
 

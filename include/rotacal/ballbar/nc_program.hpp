@@ -25,7 +25,7 @@
 
 #include <string>
 
-#include "rotacal/ballbar/test_plan.hpp"
+#include "rotacal/ballbar/plan.hpp"
 
 namespace rotacal {
 

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "rotacal/ballbar/test_plan.hpp"
+#include "rotacal/ballbar/plan.hpp"
 #include "rotacal/io/session.hpp"
 
 namespace rotacal {

@@ -11,7 +11,7 @@
 #include <functional>
 #include <string>
 
-#include "rotacal/ballbar/circular_timeline.hpp"
+#include "rotacal/circular/timeline.hpp"
 #include "rotacal/ballbar/timeline.hpp"
 #include "rotacal/hw/pose_window.hpp"
 #include "rotacal/hw/probe_protocol.hpp"
@@ -75,7 +75,7 @@ struct RecordOptions {
 RecordSummary record_ballbar(ByteTransport& port, const ProgramTimeline& program,
                              const std::string& path, const RecordOptions& options = {});
 /// The same for an ISO 230-4 circular program: rows on a data arc get the run's label
-/// (circular_XY_ccw, ...), every other row "transition" (circular_timeline.hpp), so the file is
+/// (circular_XY_ccw, ...), every other row "transition" (circular/timeline.hpp), so the file is
 /// what `rotacal circular analyze` reads.
 RecordSummary record_ballbar(ByteTransport& port, const CircularTimeline& program,
                              const std::string& path, const RecordOptions& options = {});

@@ -15,8 +15,8 @@
 #include <string>
 #include <thread>
 
-#include "rotacal/ballbar/circular_simulate.hpp"
-#include "rotacal/ballbar/circular_timeline.hpp"
+#include "rotacal/circular/simulate.hpp"
+#include "rotacal/circular/timeline.hpp"
 #include "rotacal/ballbar/model.hpp"
 #include "rotacal/ballbar/timeline.hpp"
 #include "rotacal/hw/frame.hpp"
@@ -158,7 +158,7 @@ class VirtualBallbar final : public VirtualInstrument {
 struct VirtualCircularBallbarOptions {
   /// The machine's linear-axis errors, centring error, bar length error, and the noise: AR(1)
   /// with correlation noise_rho between successive streamed readings and marginal sigma
-  /// noise_um, seeded (circular_simulate.hpp).
+  /// noise_um, seeded (circular/simulate.hpp).
   CircularSimulationOptions sim;
   double rate_hz = 250.0;  ///< default sample rate (the host may send RATE)
   double speed = 1.0;      ///< virtual seconds per wall-clock second
@@ -167,7 +167,7 @@ struct VirtualCircularBallbarOptions {
 };
 
 /// The same ballbar transducer on a machine running an ISO 230-4 circular program
-/// (circular_timeline.hpp): every sample is circular_exact_reading at that instant plus the
+/// (circular/timeline.hpp): every sample is circular_exact_reading at that instant plus the
 /// AR(1) noise. Throws InvalidArgument for the options simulate_circular refuses.
 class VirtualCircularBallbar final : public VirtualInstrument {
  public:

@@ -12,6 +12,8 @@
 /// number is written as null and its JSON pointer listed in "null_reasons" with why.
 
 #include <array>
+#include <cstddef>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -19,6 +21,7 @@
 #include <nlohmann/json.hpp>
 
 #include "rotacal/ballbar/model.hpp"
+#include "rotacal/core/estimate.hpp"
 #include "rotacal/io/output_file.hpp"
 #include "rotacal/kinematics/machine.hpp"
 
@@ -80,5 +83,33 @@ void write_model(const nlohmann::ordered_json& document, const std::string& path
 nlohmann::ordered_json ballbar_model_document(const BallbarMachineModel& model);
 /// The machine model of a "ballbar" model file (InvalidArgument for other kinds).
 BallbarMachineModel ballbar_machine_model(const ModelFile& model);
+
+/// What a "rtest-joint" model file holds (docs/model_file.md), in plain values: the joint
+/// R-test identification (rtest/identify_joint.hpp) as the file writes it. rtest/model_document.hpp
+/// fills it from an identification.
+struct RtestJointModelContent {
+  MachineType machine = MachineType::BC_trt;
+  int b_degree = 0, c_harmonics = 0, c_b_degree = 0;  ///< the basis (RtestBasis)
+  bool gamma_cb = false;
+  /// In model order: the 8 location errors, "tool_offset_Z" on a machine with head axes, the
+  /// map coefficients. An unobservable one keeps the value the fit gave it under its convention
+  /// (written with "observable": false and no std), so that the file predicts as the fit did.
+  std::vector<ParameterEstimate> parameters;
+  Eigen::MatrixXd covariance;  ///< of `parameters`, mm and rad
+  std::map<std::string, Eigen::Vector3d> nests;  ///< nominal ball centre per nest, table frame, mm
+  std::map<std::string, std::array<ParameterEstimate, 3>> probe_zeros;  ///< x, y, z per set-up, mm
+  double residual_rms_um = 0.0;
+  double sigma_um = 0.0;
+  std::size_t n_samples = 0;
+  bool converged = false;
+  std::vector<std::string> unobservable;  ///< combinations the nests cannot see, in words
+  std::vector<std::string> notes;
+};
+
+/// The document of an R-test joint model (kind "rtest-joint"): basis with its definition,
+/// location errors, tool_offset_Z on a machine with head axes, map coefficients, covariance,
+/// nests, probe zeros and the fit's summary. InvalidArgument when the parameters or the
+/// covariance do not match the machine (fewer than its location errors, a wrong size).
+nlohmann::ordered_json rtest_joint_model_document(const RtestJointModelContent& content);
 
 }  // namespace rotacal

@@ -1,0 +1,134 @@
+// The scoring of the circular-test diagnosis: visibility at plausible sizes, F-test and BIC
+// of an entry against the current model, one by one or from a pool of every variant.
+#include "diagnosis_detail.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+
+#include "rotacal/core/error.hpp"
+#include "rotacal/core/stats.hpp"
+
+namespace rotacal::circular_detail {
+
+// Nonlinear parameters of an entry (they are profiled, not in the linear model).
+int nonlinear_params(const CircularEffect& e) {
+  if (e.kind == CircularEffectKind::backlash) return 1;
+  if (e.kind == CircularEffectKind::reversal_spike) return 2;
+  return 0;
+}
+
+// Visibility, F and BIC of entry e against a model whose whitened residuals r_w leave rss0,
+// from the entry's Gram quantities (k <= 2 columns, per unit parameter): G = perp' perp and
+// g = perp' r_w, perp its whitened columns with the model projected out, and Graw = Jw' Jw
+// without. Per plausible size (m) the singular values and right vectors of perp are the square
+// roots and eigenvectors of m G m; the refit along the visible directions A = perp m V
+// (orthogonal columns, squared norms the eigenvalues lambda) removes (v' m g)^2 / lambda each.
+Scored score_gram(const CircularEffect& e, const Eigen::MatrixXd& G, const Eigen::VectorXd& g,
+                  const Eigen::MatrixXd& Graw, double rss0, double n, int num_free,
+                  double min_chi2) {
+  Scored s;
+  s.effect = e;
+  const auto units = e.param_units();
+  Eigen::VectorXd m(G.cols());
+  for (Eigen::Index j = 0; j < G.cols(); ++j) m[j] = magnitude(units[static_cast<std::size_t>(j)]);
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(m.asDiagonal() * G * m.asDiagonal());
+  const double limit = std::sqrt(min_chi2);
+  std::vector<Eigen::Index> dirs;
+  for (Eigen::Index i = 0; i < eig.eigenvalues().size(); ++i)
+    if (std::sqrt(std::max(eig.eigenvalues()[i], 0.0)) >= limit) dirs.push_back(i);
+  if (dirs.empty()) {
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> er(m.asDiagonal() * Graw * m.asDiagonal(),
+                                                            Eigen::EigenvaluesOnly);
+    s.absorbed = er.eigenvalues().size() &&
+                 std::sqrt(std::max(er.eigenvalues().maxCoeff(), 0.0)) >= limit;
+    return s;
+  }
+  s.visible = true;
+  s.k = static_cast<int>(dirs.size());
+  const Eigen::VectorXd mg = m.cwiseProduct(g);
+  Eigen::VectorXd d(s.k);
+  Eigen::MatrixXd V(G.cols(), s.k);
+  double explained = 0.0;
+  for (int i = 0; i < s.k; ++i) {
+    const Eigen::Index j = dirs[static_cast<std::size_t>(i)];
+    V.col(i) = eig.eigenvectors().col(j);
+    const double at_r = V.col(i).dot(mg);
+    d[i] = at_r / eig.eigenvalues()[j];
+    explained += at_r * d[i];
+  }
+  const Eigen::VectorXd params = m.cwiseProduct(V * d);  // in the entry's units
+  if (e.kind == CircularEffectKind::reversal_spike) s.physical = params[0] > 0.0;
+  s.rss1 = std::max(rss0 - explained, 1e-300);
+  const int k_bic = s.k + nonlinear_params(e);
+  s.delta_bic = n * std::log(s.rss1 / rss0) + k_bic * std::log(n);
+  const double dof = n - num_free - k_bic;
+  const double F = ((rss0 - s.rss1) / s.k) / (s.rss1 / dof);
+  s.p = stats::f_sf(std::max(F, 0.0), s.k, dof);
+  return s;
+}
+
+// score_gram of entry e (whitened columns Jw) against the model spanned by Q.
+Scored score_one(const CircularEffect& e, const Eigen::MatrixXd& Jw, const ModelBasis& Q,
+                 const Eigen::VectorXd& r_w, int num_free, double min_chi2) {
+  const Eigen::MatrixXd perp = Q.project_out(Jw);
+  return score_gram(e, perp.transpose() * perp, perp.transpose() * r_w, Jw.transpose() * Jw,
+                    r_w.squaredNorm(), static_cast<double>(r_w.size()), num_free, min_chi2);
+}
+
+// The candidates of a forward selection with the noise taken as white (whitening = a scale
+// s), where a round's model grows by one entry. Per variant only k x k and e x k numbers are
+// kept, no column: the model's effect columns enter an orthonormal basis q one entry at a time
+// (baseline projected out, Gram-Schmidt twice against q, a remainder below 1e-9 of the column
+// dropped as in ModelBasis), each variant keeps c = q' s J, and since r_w and q are orthogonal to
+// the baseline, perp' perp = gb - c' c and perp' r_w = s J' r_w - c' (q' r_w), with
+// gb = (P s J)' (P s J) and P the baseline's projector. A round costs O(n k) per variant
+// instead of a projection on the whole model.
+ScoringPool::ScoringPool(const Rows& R, const Whitening& W, const Eigen::MatrixXd& B,
+                         const std::vector<const Eigen::MatrixXd*>& variants)
+    : R_(&R), W_(&W), scale_(W.scale), variants_(variants) {
+  ROTACAL_ASSERT(!W.w);
+  qb_ = W.baseline(R, B).qb;
+  for (const Eigen::MatrixXd& q : qb_) rank_ += static_cast<int>(q.cols());
+  q_.resize(static_cast<Eigen::Index>(R.n), 0);
+  for (const Eigen::MatrixXd* J : variants) {
+    Eigen::MatrixXd jb = scale_ * *J;
+    graw_.push_back(jb.transpose() * jb);
+    remove_baseline(qb_, R.run_first, R.run_count, jb);
+    gb_.push_back(jb.transpose() * jb);
+    c_.emplace_back(0, jb.cols());
+  }
+}
+
+void ScoringPool::add_to_model(const Eigen::MatrixXd& J) {
+  Eigen::MatrixXd E = (*W_)(J);
+  const Eigen::VectorXd norms = E.colwise().norm().transpose();
+  remove_baseline(qb_, R_->run_first, R_->run_count, E);
+  drop_absorbed(E, norms);
+  for (Eigen::Index j = 0; j < E.cols(); ++j) {
+    Eigen::VectorXd v = E.col(j);
+    for (int pass = 0; pass < 2; ++pass)
+      if (q_.cols() > 0) v -= q_ * (q_.transpose() * v);
+    if (!(norms[j] > 0.0) || !(v.norm() > 1e-9 * norms[j])) continue;
+    v.normalize();
+    q_.conservativeResize(Eigen::NoChange, q_.cols() + 1);
+    q_.col(q_.cols() - 1) = v;
+    ++rank_;
+    for (std::size_t i = 0; i < variants_.size(); ++i) {
+      c_[i].conservativeResize(c_[i].rows() + 1, Eigen::NoChange);
+      c_[i].row(c_[i].rows() - 1) = scale_ * (v.transpose() * *variants_[i]);
+    }
+  }
+}
+
+Scored ScoringPool::score(std::size_t i, const CircularEffect& e, const Eigen::VectorXd& r_w,
+                          double min_chi2) const {
+  const Eigen::VectorXd qr = q_.transpose() * r_w;
+  const Eigen::MatrixXd G = gb_[i] - c_[i].transpose() * c_[i];
+  const Eigen::VectorXd g =
+      scale_ * (variants_[i]->transpose() * r_w) - c_[i].transpose() * qr;
+  return score_gram(e, G, g, graw_[i], r_w.squaredNorm(), static_cast<double>(r_w.size()),
+                    rank_, min_chi2);
+}
+
+}  // namespace rotacal::circular_detail
