@@ -21,6 +21,7 @@ void bind_noise(pyb::module_& m);
 void bind_controller_export(pyb::module_& m);
 void bind_design(pyb::module_& m);
 void bind_circular(pyb::module_& m);
+void bind_probe(pyb::module_& m);
 #ifdef ROTACAL_WITH_HW
 void bind_hw(pyb::module_& m);
 #endif
@@ -49,6 +50,7 @@ PYBIND11_MODULE(_core, m) {
   rotacal::py::bind_controller_export(m);
   rotacal::py::bind_design(m);
   rotacal::py::bind_circular(m);
+  rotacal::py::bind_probe(m);
 #ifdef ROTACAL_WITH_HW
   auto serial = pyb::register_exception<rotacal::hw::SerialError>(m, "SerialError", io_error.ptr());
   pyb::register_exception<rotacal::hw::DeviceDisconnected>(m, "DeviceDisconnected", serial.ptr());

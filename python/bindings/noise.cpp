@@ -92,6 +92,8 @@ void bind_noise(pyb::module_& m) {
       .def_readwrite("backlash_rad", &PlausibleSizes::backlash_rad)
       .def_readwrite("servo_lag_s", &PlausibleSizes::servo_lag_s)
       .def_readwrite("reversal_spike_rad", &PlausibleSizes::reversal_spike_rad)
+      .def_readwrite("stylus_radius_mm", &PlausibleSizes::stylus_radius_mm)
+      .def_readwrite("probe_lobing_mm", &PlausibleSizes::probe_lobing_mm)
       .def_readwrite("overrides", &PlausibleSizes::overrides)
       .def_readwrite("use_session_bounds", &PlausibleSizes::use_session_bounds);
 

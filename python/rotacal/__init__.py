@@ -13,6 +13,7 @@ from ._core import (  # noqa: F401
     IoError,
     MachineType,
     ParseError,
+    ProbeSession,
     RtestSession,
     compensate_commands,
     effect_catalogue,
@@ -35,6 +36,7 @@ from .diagnosis import diagnose, plausible_sizes, uncertainty_budget  # noqa: F4
 from .models import ballbar_model_from_dict, load_model, save_model  # noqa: F401
 from .outputs import write_output  # noqa: F401
 from .results import DiagnosisResult, Identification  # noqa: F401
+from .probe import identify_probe, simulate_probe  # noqa: F401
 from .rtest import identify_rtest, monte_carlo_rtest  # noqa: F401
 from .sessions import check_plausible, load, save  # noqa: F401
 from .version import __version__  # noqa: F401

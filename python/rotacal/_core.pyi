@@ -6,7 +6,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Alternative', 'Ambiguity', 'AngleTable', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CircularAnalysis', 'CircularDiagnosis', 'CircularDiagnosisOptions', 'CircularDirection', 'CircularEffect', 'CircularFinding', 'CircularPairResult', 'CircularPlanResult', 'CircularPlane', 'CircularRun', 'CircularRunResult', 'CircularSimulationOptions', 'CircularTestPlan', 'CompensationReport', 'CompensationRow', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LinearAxisErrors', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestDesign', 'RtestDesignCandidate', 'RtestDesignOptions', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSeparatingCandidate', 'RtestSeparationDesign', 'RtestSeparationOptions', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SeparatingCandidate', 'SeparationDesign', 'SeparationOptions', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'SweepDirection', 'TableMotionOverlap', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualCircularBallbar', 'VirtualRtest', 'analyze_circular', 'ballbar_model_document', 'ballbar_model_from_document', 'builtin_machine_names', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_json_bounds', 'check_model_machine', 'check_output', 'check_plausible', 'check_rtest_pattern', 'circular_catalogue', 'circular_commanded_session', 'circular_label', 'comment_lines', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_axial_c_tilt_deg', 'default_ballbar_tests', 'default_calibration_moves', 'default_rtest_pattern', 'default_tilt_range_deg', 'design_ballbar_separation', 'design_ballbar_test', 'design_rtest_separation', 'design_rtest_test', 'diagnose_ballbar', 'diagnose_circular', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'evaluate_rtest_design', 'export_controller', 'format_ballbar', 'format_model_document', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_joint_sessions', 'identify_paper', 'identify_rtest_joint', 'identify_rtest_paper', 'is_rotary_test', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_rtest', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_circular_direction', 'parse_circular_plane', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'parse_sweep_direction', 'plan_ballbar_test', 'plan_circular_test', 'predict_rtest_session', 'predict_session_lengths', 'read_ballbar', 'read_model_document', 'read_rtest', 'read_session', 'record_ballbar', 'record_circular_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_joint_model_document', 'rtest_map_names', 'rtest_prediction_rms_um', 'rtest_readings', 'run_label', 'simulate_ballbar', 'simulate_circular', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'table_motion_overlap', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_circular_nc_program', 'write_model_document', 'write_nc_program', 'write_output', 'write_rtest']
+__all__: list[str] = ['Alternative', 'Ambiguity', 'AngleTable', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CircularAnalysis', 'CircularDiagnosis', 'CircularDiagnosisOptions', 'CircularDirection', 'CircularEffect', 'CircularFinding', 'CircularPairResult', 'CircularPlanResult', 'CircularPlane', 'CircularRun', 'CircularRunResult', 'CircularSimulationOptions', 'CircularTestPlan', 'CompensationReport', 'CompensationRow', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LinearAxisErrors', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'ProbeIdentification', 'ProbeSession', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestDesign', 'RtestDesignCandidate', 'RtestDesignOptions', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSeparatingCandidate', 'RtestSeparationDesign', 'RtestSeparationOptions', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SeparatingCandidate', 'SeparationDesign', 'SeparationOptions', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'SweepDirection', 'TableMotionOverlap', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualCircularBallbar', 'VirtualRtest', 'analyze_circular', 'ballbar_model_document', 'ballbar_model_from_document', 'builtin_machine_names', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_json_bounds', 'check_model_machine', 'check_output', 'check_plausible', 'check_rtest_pattern', 'circular_catalogue', 'circular_commanded_session', 'circular_label', 'comment_lines', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_axial_c_tilt_deg', 'default_ballbar_tests', 'default_calibration_moves', 'default_probe_poses_deg', 'default_rtest_pattern', 'default_tilt_range_deg', 'design_ballbar_separation', 'design_ballbar_test', 'design_rtest_separation', 'design_rtest_test', 'diagnose_ballbar', 'diagnose_circular', 'diagnose_probe', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'evaluate_rtest_design', 'export_controller', 'format_ballbar', 'format_model_document', 'format_probe', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_joint_sessions', 'identify_paper', 'identify_probe', 'identify_probe_cycles', 'identify_rtest_joint', 'identify_rtest_paper', 'is_rotary_test', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_rtest', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_circular_direction', 'parse_circular_plane', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'parse_sweep_direction', 'plan_ballbar_test', 'plan_circular_test', 'predict_rtest_session', 'predict_session_lengths', 'probe_effect_catalogue', 'read_ballbar', 'read_instrument_session', 'read_model_document', 'read_probe', 'read_rtest', 'read_session', 'record_ballbar', 'record_circular_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_joint_model_document', 'rtest_map_names', 'rtest_prediction_rms_um', 'rtest_readings', 'run_label', 'simulate_ballbar', 'simulate_circular', 'simulate_probe', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'table_motion_overlap', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_probe', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_circular_nc_program', 'write_model_document', 'write_nc_program', 'write_output', 'write_probe', 'write_rtest']
 class Alternative:
     @property
     def aliased(self) -> bool:
@@ -2017,6 +2017,12 @@ class PlausibleSizes:
     def overrides(self, arg0: collections.abc.Mapping[str, typing.SupportsFloat | typing.SupportsIndex]) -> None:
         ...
     @property
+    def probe_lobing_mm(self) -> float:
+        ...
+    @probe_lobing_mm.setter
+    def probe_lobing_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
     def reversal_spike_rad(self) -> float:
         ...
     @reversal_spike_rad.setter
@@ -2057,6 +2063,12 @@ class PlausibleSizes:
         ...
     @straightness_mm.setter
     def straightness_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def stylus_radius_mm(self) -> float:
+        ...
+    @stylus_radius_mm.setter
+    def stylus_radius_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
         ...
     @property
     def tilt_motion_rad(self) -> float:
@@ -2113,6 +2125,137 @@ class ProbeCalibration:
     def zeros(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
         """
         probe zero offsets, mm
+        """
+class ProbeIdentification:
+    @property
+    def converged(self) -> bool:
+        ...
+    @property
+    def covariance(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        ...
+    @property
+    def dispersion_um(self) -> float:
+        ...
+    @property
+    def effect_params(self) -> list[float]:
+        ...
+    @property
+    def effects(self) -> list[str]:
+        ...
+    @property
+    def errors(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def iterations(self) -> int:
+        ...
+    @property
+    def machine(self) -> MachineType:
+        ...
+    @property
+    def method(self) -> str:
+        ...
+    @property
+    def n_samples(self) -> int:
+        ...
+    @property
+    def noise(self) -> NoiseModel:
+        ...
+    @property
+    def noise_correction(self) -> float:
+        ...
+    @property
+    def noise_refit(self) -> bool:
+        ...
+    @property
+    def notes(self) -> list[str]:
+        ...
+    @property
+    def parameters(self) -> list[ParameterEstimate]:
+        ...
+    @property
+    def pose_centres(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
+        ...
+    @property
+    def pose_labels(self) -> list[str]:
+        ...
+    @property
+    def residual_rms_um(self) -> float:
+        ...
+    @property
+    def residuals(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def sigma_um(self) -> float:
+        ...
+    @property
+    def sphere(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @property
+    def summary(self) -> FitSummary:
+        ...
+    @property
+    def unobservable(self) -> list[str]:
+        ...
+class ProbeSession:
+    """
+    A rotacal-probe/1 touch-probe session (mm, deg, s).
+    """
+    def __len__(self) -> int:
+        ...
+    def __repr__(self) -> str:
+        ...
+    @property
+    def angles_deg(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        """
+        tilt and rotary angle of every touch (N, 2), deg
+        """
+    @property
+    def machine(self) -> MachineType:
+        ...
+    @property
+    def n(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        """
+        unit approach directions (N, 3), machine frame
+        """
+    @property
+    def noise_um(self) -> float | None:
+        ...
+    @property
+    def pose_names(self) -> list[str]:
+        """
+        distinct pose labels, in order
+        """
+    @property
+    def poses(self) -> list[str]:
+        """
+        pose label of every touch
+        """
+    @property
+    def sphere(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        """
+        nominal sphere centre, table frame, mm
+        """
+    @property
+    def sphere_diameter(self) -> float:
+        ...
+    @property
+    def stylus_diameter(self) -> float:
+        ...
+    @property
+    def time(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def trigger_radius(self) -> float:
+        ...
+    @property
+    def warnings(self) -> list[str]:
+        """
+        what the reader found suspicious but kept
+        """
+    @property
+    def xyz(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        """
+        latched X, Y, Z (N, 3), mm
         """
 class RadialSide:
     """
@@ -3295,6 +3438,10 @@ def default_calibration_moves(step_mm: typing.SupportsFloat | typing.SupportsInd
     """
     +-step along X, Y, Z and the 4 body diagonals (14, 3), mm.
     """
+def default_probe_poses_deg(machine: MachineType) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 2]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]]:
+    """
+    (poses (P, 2) tilt and rotary deg, directions (K, 3)) of default_probe_pattern.
+    """
 def default_rtest_pattern(machine: MachineType) -> RtestPattern:
     """
     The paper's pattern fitted to a machine: tilt angles inside its limits (-90..90 every 30 deg where they allow), the rotary axis every 30 deg, the two paper nests halved until every commanded X, Y, Z is inside the travel (rtest/simulate.hpp).
@@ -3324,6 +3471,10 @@ def diagnose_ballbar(session: BallbarSession, options: DiagnosisOptions = ..., r
 def diagnose_circular(session: BallbarSession, options: CircularDiagnosisOptions = ...) -> CircularDiagnosis:
     """
     The classic causes the circular runs support, each with parameters, 1-sigma and gain.
+    """
+def diagnose_probe(session: ProbeSession, options: DiagnosisOptions = ...) -> Diagnosis:
+    """
+    Diagnose a touch-probe session (diagnose/probe_diagnosis.hpp): catalogue effects and the probe's stylus_radius_offset and probe_lobing over the joint fit's baseline.
     """
 def diagnose_rtest(session: RtestSession, options: DiagnosisOptions = ...) -> Diagnosis:
     """
@@ -3355,6 +3506,8 @@ def format_model_document(document: dict, source: str = 'model') -> str:
     """
     Strict JSON text of a model document (non-finite numbers as null with a reason), validated.
     """
+def format_probe(session: ProbeSession) -> str:
+    ...
 def format_rtest(session: RtestSession) -> str:
     ...
 def forward(machine: MachineType, errors: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], angles: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], q_table: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
@@ -3395,6 +3548,14 @@ def identify_joint_sessions(sessions: collections.abc.Sequence[BallbarSession], 
 def identify_paper(session: BallbarSession) -> BallbarIdentification:
     """
     Flynn et al. 2016's chain: sphere fit, Hyper circle fits, SVD plane fits, transport.
+    """
+def identify_probe(session: ProbeSession, effects: collections.abc.Sequence[str] = [], noise: str = 'auto') -> ProbeIdentification:
+    """
+    Joint fit of every touch: location errors, the sphere's table position (and effects), with observability and the noise model (probe/identify.hpp); noise 'auto' or 'white'.
+    """
+def identify_probe_cycles(session: ProbeSession, radius_known: bool = True) -> ProbeIdentification:
+    """
+    The controller cycles' method: sphere per pose, plane and circle of the centres per table axis.
     """
 def identify_rtest_joint(session: RtestSession, basis: RtestBasis = ..., noise: str = 'auto') -> RtestJointIdentification:
     """
@@ -3504,11 +3665,23 @@ def predict_session_lengths(model: BallbarMachineModel, session: BallbarSession)
     """
     Predicted centre-to-centre lengths (mm) of every sample of the session on the model.
     """
+def probe_effect_catalogue(machine: MachineType, max_harmonic: typing.SupportsInt | typing.SupportsIndex = 4) -> list[Effect]:
+    """
+    The catalogue entries of a probe session: effect_catalogue and stylus_radius_offset, probe_lobing.
+    """
 def read_ballbar(path: str) -> BallbarSession:
     ...
+def read_instrument_session(path: str) -> rotacal._core.BallbarSession | rotacal._core.RtestSession | rotacal._core.ProbeSession:
+    """
+    Read a ballbar, R-test or touch-probe session (chosen by its format line).
+    """
 def read_model_document(path: str) -> typing.Any:
     """
     Read a rotacal-model file (strict JSON, version, kind, machine checked); the document as a dict. ParseError (syntax), InvalidArgument (content), IoError.
+    """
+def read_probe(path: str) -> ProbeSession:
+    """
+    Read a rotacal-probe/1 file (io/probe_file.hpp).
     """
 def read_rtest(path: str) -> RtestSession:
     ...
@@ -3566,6 +3739,10 @@ def simulate_circular(plan: CircularPlanResult, options: CircularSimulationOptio
     """
     The session a ballbar records on a machine with linear-axis errors.
     """
+def simulate_probe(machine: MachineType, errors: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], effects: collections.abc.Sequence[str] = [], effect_params: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] = [], sphere_offset: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] = ..., noise_um: typing.SupportsFloat | typing.SupportsIndex = 0.5, ar1_rho: typing.SupportsFloat | typing.SupportsIndex = 0.0, seed: typing.SupportsInt | typing.SupportsIndex = 1, poses_deg: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] | None = None, directions: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] | None = None, sphere: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] = ..., sphere_diameter: typing.SupportsFloat | typing.SupportsIndex = 25.0, stylus_diameter: typing.SupportsFloat | typing.SupportsIndex = 6.0) -> tuple[ProbeSession, typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]]:
+    """
+    Simulate a touch-probe session (probe/simulate.hpp): (session, actual sphere centre). Poses default to default_probe_pattern's.
+    """
 def simulate_probe_calibration(dirs: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], zeros: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], moves: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], noise_um: typing.SupportsFloat | typing.SupportsIndex, seed: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
     """
     Simulated readings (N, 3) of the direction calibration.
@@ -3614,6 +3791,10 @@ def uncertainty_budget_ballbar(session: BallbarSession, diagnosis: ..., sizes: P
     """
     GUM budget of the location errors of diagnose_ballbar's result.
     """
+def uncertainty_budget_probe(session: ProbeSession, diagnosis: Diagnosis, sizes: PlausibleSizes = ..., coverage: typing.SupportsFloat | typing.SupportsIndex = 0.95) -> UncertaintyBudget:
+    """
+    GUM budget of the location errors of diagnose_probe's result (the probe's entries: stylus calibration, lobing).
+    """
 def uncertainty_budget_rtest(session: RtestSession, diagnosis: ..., sizes: PlausibleSizes = ..., coverage: typing.SupportsFloat | typing.SupportsIndex = 0.95) -> UncertaintyBudget:
     """
     GUM budget of the location errors of diagnose_rtest's result.
@@ -3642,5 +3823,7 @@ def write_output(path: str, data: bytes, inputs: collections.abc.Sequence[str] =
     """
     Write bytes to path: regular files replaced atomically, devices and FIFOs written through; a directory, an input or another output is refused (IoError).
     """
+def write_probe(session: ProbeSession, path: str) -> None:
+    ...
 def write_rtest(session: RtestSession, path: str) -> None:
     ...

@@ -1,4 +1,4 @@
-"""What each command does with each kind of session: identify, predict and report a ballbar or an R-test session."""
+"""What each command does with each kind of session: identify, predict and report a ballbar, an R-test or a touch-probe session."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -6,10 +6,10 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from . import _core, ballbar, rtest
+from . import _core, ballbar, probe, rtest
 from .diagnosis import diagnose, uncertainty_budget
 from .models import ballbar_model_from_dict
-from .sessions import BALLBAR, RTEST, by_kind
+from .sessions import BALLBAR, PROBE, RTEST, by_kind
 
 # A ballbar model holds the pivot where its own session's ball sat (nominal + a set-up error of
 # some 10 um): a session whose nominal pivot is farther from it was set up elsewhere, and its
@@ -20,17 +20,23 @@ MAX_PIVOT_SHIFT_MM = 1.0
 def identify(session: Any, method: str = "joint", *, fit_length_offset: bool = False,
              effects: Sequence[str] = (), tests: Sequence[str] = (), noise: str = "auto") -> Any:
     """Identify the location errors of a ballbar session (rotacal.ballbar.identify: options
-    ``fit_length_offset``, ``effects``, ``tests``) or of an R-test session
-    (rotacal.identify_rtest: ``method`` only). ``noise``: "auto" (AR noise model of the residuals,
-    GLS refit when correlated) or "white"."""
+    ``fit_length_offset``, ``effects``, ``tests``), of an R-test session
+    (rotacal.identify_rtest: ``method`` only) or of a touch-probe session (rotacal.identify_probe:
+    ``method`` "joint", "cycles" or "cycles-free-radius", ``effects``). ``noise``: "auto" (AR noise
+    model of the residuals, GLS refit when correlated) or "white"."""
     def rtest_identify():
         if fit_length_offset or effects or tests:
             raise _core.InvalidArgument("identify: an R-test session takes only `method`")
         return rtest.identify_rtest(session, method, noise=noise)
 
+    def probe_identify():
+        if fit_length_offset or tests:
+            raise _core.InvalidArgument("identify: a touch-probe session takes `method`, `effects` and `noise`")
+        return probe.identify_probe(session, method, effects=effects, noise=noise)
+
     run = by_kind(session, {BALLBAR: lambda: ballbar.identify(session, method, fit_length_offset=fit_length_offset,
                                                                effects=effects, tests=tests, noise=noise),
-                            RTEST: rtest_identify}, "identify")
+                            RTEST: rtest_identify, PROBE: probe_identify}, "identify")
     return run()
 
 

@@ -5,7 +5,7 @@ from typing import Any
 
 from . import _core
 from .results import DiagnosisResult
-from .sessions import BALLBAR, RTEST, by_kind
+from .sessions import BALLBAR, PROBE, RTEST, by_kind
 
 # Highest harmonic order a diagnosis tries: the candidates grow with it, and no session
 # resolves orders this high (a ballbar test samples each circle at ~360 points, R-test 12 C angles).
@@ -32,7 +32,7 @@ def diagnose(session: Any, *, reference: Any = None, **options: Any) -> Diagnosi
 
     Parameters
     ----------
-    session : a BallbarSession or an RtestSession (with dx,dy,dz)
+    session : a BallbarSession, an RtestSession (with dx,dy,dz) or a ProbeSession
     reference : a complete standard test for the machine (commanded rows) used to name the
         test that separates ambiguous candidates (ballbar only)
     options : fields of DiagnosisOptions over its C++ defaults, e.g. ``max_harmonic`` (highest
@@ -42,7 +42,8 @@ def diagnose(session: Any, *, reference: Any = None, **options: Any) -> Diagnosi
     """
     o = diagnosis_options(**options)
     run = by_kind(session, {BALLBAR: lambda: _core.diagnose_ballbar(session, o, reference),
-                            RTEST: lambda: _core.diagnose_rtest(session, o)}, "diagnose")
+                            RTEST: lambda: _core.diagnose_rtest(session, o),
+                            PROBE: lambda: _core.diagnose_probe(session, o)}, "diagnose")
     return DiagnosisResult(run())
 
 
@@ -100,5 +101,6 @@ def uncertainty_budget(session: Any, diagnosis: DiagnosisResult | None = None, *
         diagnosis = diagnose(session)
     o = plausible_sizes(sizes)
     return by_kind(session, {BALLBAR: lambda: _core.uncertainty_budget_ballbar(session, diagnosis.raw, o, coverage),
-                             RTEST: lambda: _core.uncertainty_budget_rtest(session, diagnosis.raw, o, coverage)},
+                             RTEST: lambda: _core.uncertainty_budget_rtest(session, diagnosis.raw, o, coverage),
+                             PROBE: lambda: _core.uncertainty_budget_probe(session, diagnosis.raw, o, coverage)},
                    "uncertainty_budget")()

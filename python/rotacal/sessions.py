@@ -1,4 +1,4 @@
-"""Session files, and the one place that tells a ballbar session from an R-test session."""
+"""Session files, and the one place that tells a ballbar, an R-test and a touch-probe session apart."""
 from __future__ import annotations
 
 import codecs
@@ -10,14 +10,15 @@ from typing import Any, Iterable, Mapping, TypeVar, Union
 from . import _core
 from .outputs import write_output
 
-Session = Union[_core.BallbarSession, _core.RtestSession]
+Session = Union[_core.BallbarSession, _core.RtestSession, _core.ProbeSession]
 
-BALLBAR, RTEST = "ballbar", "rtest"
-FORMATS = {BALLBAR: "rotacal-ballbar/1", RTEST: "rotacal-rtest/1"}
-_KINDS = {_core.BallbarSession: BALLBAR, _core.RtestSession: RTEST}
-_FORMATTERS = {BALLBAR: _core.format_ballbar, RTEST: _core.format_rtest}
+BALLBAR, RTEST, PROBE = "ballbar", "rtest", "probe"
+FORMATS = {BALLBAR: "rotacal-ballbar/1", RTEST: "rotacal-rtest/1", PROBE: "rotacal-probe/1"}
+_KINDS = {_core.BallbarSession: BALLBAR, _core.RtestSession: RTEST, _core.ProbeSession: PROBE}
+_FORMATTERS = {BALLBAR: _core.format_ballbar, RTEST: _core.format_rtest, PROBE: _core.format_probe}
+_READERS = {BALLBAR: _core.read_ballbar, RTEST: _core.read_rtest, PROBE: _core.read_probe}
 # Labels of each kind: reading them converts every one to Python text.
-_LABELS = {BALLBAR: "tests", RTEST: "setups"}
+_LABELS = {BALLBAR: "tests", RTEST: "setups", PROBE: "poses"}
 # How far into a file the search for the first byte that is not UTF-8 goes.
 _SCAN_LIMIT = 256 << 20
 
@@ -25,10 +26,11 @@ T = TypeVar("T")
 
 
 def kind(session: Any) -> str:
-    """"ballbar" or "rtest"; InvalidArgument for anything that is not a session."""
+    """"ballbar", "rtest" or "probe"; InvalidArgument for anything that is not a session."""
     k = _KINDS.get(type(session))
     if k is None:
-        raise _core.InvalidArgument(f"not a session: {type(session).__name__} (BallbarSession or RtestSession)")
+        raise _core.InvalidArgument(f"not a session: {type(session).__name__} (BallbarSession, RtestSession or "
+                                    "ProbeSession)")
     return k
 
 
@@ -121,8 +123,10 @@ def _not_utf8(path: str) -> _core.Error:
     return _core.ParseError(f"{path}:{line}:{col}: byte 0x{byte:02X} is not UTF-8 (session files are UTF-8 text)")
 
 
-def load(path: str | Path) -> Session:
-    """Read a ``rotacal-ballbar/1`` or ``rotacal-rtest/1`` file.
+def load(path: str | Path, format: str | None = None) -> Session:
+    """Read a ``rotacal-ballbar/1``, ``rotacal-rtest/1`` or ``rotacal-probe/1`` file, chosen by its
+    format line, or by ``format`` ("ballbar", "rtest", "probe" or the format's name), which the
+    file must then be.
 
     Raises rotacal.ParseError naming file, line and column for a malformed file (bytes that
     are not UTF-8 included), and rotacal.IoError if it cannot be read.
@@ -130,8 +134,14 @@ def load(path: str | Path) -> Session:
     p = checked_path(path, "load")
     if os.path.isdir(p):
         raise _core.IoError(f"{p}: is a directory, not a session file")
+    wanted = None
+    if format is not None:
+        wanted = {v: k for k, v in FORMATS.items()}.get(format, format)
+        if wanted not in _READERS:
+            raise _core.InvalidArgument(f"load: format must be one of {', '.join(FORMATS)} (or "
+                                        f"{', '.join(FORMATS.values())}), got {format!r}")
     try:
-        session = _core.read_session(p)
+        session = _READERS[wanted](p) if wanted else _core.read_instrument_session(p)
         getattr(session, _LABELS[kind(session)])  # every label must be text Python can hold
     except UnicodeDecodeError:
         raise _not_utf8(p) from None
@@ -166,7 +176,7 @@ def session_text(session: Session, what: str = "save") -> str:
         with open(probe, "w", encoding="utf-8") as f:
             f.write(text)
         try:
-            _core.read_session(probe)
+            _core.read_instrument_session(probe)
         except _core.ParseError as e:
             reason = str(e).replace(probe, "the session")
             raise _core.InvalidArgument(f"{what}: this session would make a file that load refuses: {reason}") from None

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <string>
 
 namespace rotacal {
 
@@ -12,6 +13,11 @@ NoiseFit fit_with_noise(const std::function<JointFitOutcome(const JointFitSettin
   NoiseFit out;
   out.fit = solve(settings);
   if (settings.whitener || groups.empty()) return out;
+  const auto n = static_cast<std::size_t>(out.fit.residuals.size());
+  if (groups.size() != n || times.size() != n)
+    throw InvalidArgument("fit_with_noise: groups and times must hold one value per residual (" +
+                          std::to_string(n) + "), got " + std::to_string(groups.size()) + " and " +
+                          std::to_string(times.size()));
   out.noise = estimate_noise_model(groups, times, out.fit.residuals, o.noise_options);
   if (o.noise != NoiseHandling::automatic || out.noise.white() ||
       out.noise.correlation_samples < o.min_correlation_samples)

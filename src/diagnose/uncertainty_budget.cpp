@@ -46,6 +46,8 @@ std::vector<double> plausible_sizes(const Effect& e, const PlausibleSizes& z, do
     case EffectKind::rotary_backlash: a = {z.backlash_rad}; break;
     case EffectKind::servo_lag: a = {z.servo_lag_s}; break;
     case EffectKind::reversal_spike: a = {z.reversal_spike_rad, 0.0}; break;  // tau moves nothing at h = 0
+    case EffectKind::stylus_radius_offset: a = {z.stylus_radius_mm}; break;
+    case EffectKind::probe_lobing: a = {z.probe_lobing_mm, z.probe_lobing_mm}; break;
   }
   const auto names = e.param_names();
   const auto it = z.overrides.find(e.id());

@@ -166,4 +166,15 @@ void check_time(Reader& R, const Field& f, double t, double& last);
 std::vector<Annotation> annotations_of(const RawFile& raw);
 std::ifstream open_for_reading(const std::string& path);
 
+// The first 4 kB of a file (`head`, bounded whatever the file) and its first non-blank line in
+// them (`line`, untrimmed), with `in` rewound (opened again when it cannot seek): how the
+// readers tell the formats apart (session_file.cpp).
+struct FormatLine {
+  std::string head;
+  std::string line;
+};
+FormatLine sniff_format_line(std::ifstream& in, const std::string& path);
+// read_session on a file already opened and sniffed (session_file.cpp).
+AnySession read_sniffed_session(std::ifstream& in, const std::string& path, const FormatLine& sniffed);
+
 }  // namespace rotacal::io_detail

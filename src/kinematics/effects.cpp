@@ -65,6 +65,11 @@ const KindInfo kKinds[] = {
     {EffectKind::reversal_spike, "reversal_spike", true, false, false, false, 2, "h,ln_tau_50ms",
      "rad,1", "the rotary axis sticks when it reverses (static friction) and catches up over a "
      "short time"},
+    {EffectKind::stylus_radius_offset, "stylus_radius_offset", false, false, false, false, 1, "d", "mm",
+     "the stylus' effective radius differs from its calibration (touch probe)"},
+    {EffectKind::probe_lobing, "probe_lobing", false, false, false, false, 2, "lc,ls", "mm,mm",
+     "the touch probe's pretravel depends on the direction of approach (three-lobed, as "
+     "kinematic-seat probes are)"},
     {EffectKind::linear_pitch, "angular_error", false, false, true, false, 2, "e1,e2", "rad,rad",
      "the linear axis' carriage pitches as it moves (ISO 230-1 angular error), seen through the "
      "tool's height"},
@@ -184,6 +189,7 @@ std::vector<Effect> effect_catalogue(MachineType m, int max_harmonic) {
   std::vector<Effect> out;
   const char T = tilt_axis_letter(m), C = rot_axis_letter(m);
   for (const KindInfo& k : kKinds) {
+    if (k.kind == EffectKind::stylus_radius_offset || k.kind == EffectKind::probe_lobing) continue;
     if (k.kind == EffectKind::straightness) {
       for (char a : {'X', 'Y', 'Z'})
         for (char d : {'X', 'Y', 'Z'})

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "rotacal/ballbar/problem.hpp"
-#include "rotacal/ballbar/test_plan.hpp"
+#include "rotacal/ballbar/plan.hpp"
 
 using namespace rotacal;
 

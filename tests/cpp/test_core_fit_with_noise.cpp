@@ -96,3 +96,13 @@ TEST_CASE("a caller's whitener or no streams: one fit, no noise model") {
   CHECK_FALSE(none.refit);
   CHECK(none.noise.n == 0);
 }
+
+TEST_CASE("streams that do not name every residual are refused") {
+  const Case c = line_case(0.0, 17);
+  const Line model(c.t, c.y);
+  const std::vector<FitParameter> params = {{"a", "mm", 0.0}, {"b", "mm", 0.0}};
+  const auto solve = [&](const JointFitSettings& s) { return solve_joint(model, params, s); };
+  const std::vector<std::string> short_groups(c.groups.begin() + 1, c.groups.end());
+  CHECK_THROWS_AS(fit_with_noise(solve, JointFitSettings{}, short_groups, c.times, NoiseFitOptions{}),
+                  InvalidArgument);
+}

@@ -46,6 +46,8 @@ struct PlausibleSizes {
   double backlash_rad = 20e-6;            ///< backlash_* (lost motion of a rotary drive)
   double servo_lag_s = 1e-3;              ///< servo_lag_* (gain mismatch of a few percent)
   double reversal_spike_rad = 20e-6;      ///< reversal_spike_*: h
+  double stylus_radius_mm = 0.5e-3;       ///< stylus_radius_offset (stylus calibration)
+  double probe_lobing_mm = 0.5e-3;        ///< probe_lobing: lc, ls (after the probe's calibration)
   std::map<std::string, double> overrides;
   /// Use the session's bound where it is tighter than the default (false: defaults only).
   bool use_session_bounds = true;

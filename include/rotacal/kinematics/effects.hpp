@@ -56,6 +56,10 @@ enum class EffectKind {
   servo_lag,               ///< actual angle -= tau * rate (lag behind the linear axes, s)
   reversal_spike,          ///< actual angle -= direction * h exp(-dt / tau_s) after a reversal;
                            ///< tau_s = 0.05 s e^q (h rad, q 1)
+  // The touch probe's own effects (probe/touch_model.hpp evaluates them): effect_catalogue
+  // leaves them out, probe_effect_catalogue (probe/touch_model.hpp) adds them.
+  stylus_radius_offset,    ///< trigger distance from the sphere centre += d (mm)
+  probe_lobing,            ///< latched position += (lc cos 3phi + ls sin 3phi) sqrt(1 - nz^2) n (mm)
 };
 
 /// One catalogue entry, e.g. {angular_positioning, 'C', 1} = "angular_positioning_C_h1".
@@ -93,7 +97,7 @@ struct Effect {
 };
 
 /// The candidate list for a machine: every catalogue entry that applies to it, with harmonic
-/// orders 1..max_harmonic (radial motion from 2).
+/// orders 1..max_harmonic (radial motion from 2), without the touch probe's own entries.
 std::vector<Effect> effect_catalogue(MachineType m, int max_harmonic = 4);
 
 /// A set of effects and the layout of their parameters in one flat vector.

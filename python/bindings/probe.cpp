@@ -1,0 +1,187 @@
+// Bindings for the touch probe (include/rotacal/probe, io/probe_file.hpp): session, reader and
+// writer, simulation, the joint fit and the cycles' method. Thin: numpy in and out.
+#include <pybind11/stl.h>
+
+#include <optional>
+
+#include "numpy.hpp"
+#include "rotacal/diagnose/probe_diagnosis.hpp"
+#include "rotacal/diagnose/uncertainty_budget.hpp"
+#include "rotacal/io/probe_file.hpp"
+#include "rotacal/probe/identify.hpp"
+#include "rotacal/probe/simulate.hpp"
+#include "rotacal/probe/touch_model.hpp"
+
+namespace rotacal::py {
+
+namespace {
+template <typename F>
+Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> columns(const ProbeSession& s, int k, F f) {
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> m(static_cast<Eigen::Index>(s.samples.size()), k);
+  for (std::size_t i = 0; i < s.samples.size(); ++i) m.row(static_cast<Eigen::Index>(i)) = f(s.samples[i]);
+  return m;
+}
+
+std::vector<RotaryAngles<double>> angles_of(const Array& a) {
+  const auto m = rows_of<2>(a, "poses_deg");
+  std::vector<RotaryAngles<double>> out;
+  for (Eigen::Index i = 0; i < m.rows(); ++i) out.push_back({m(i, 0), m(i, 1)});
+  return out;
+}
+}  // namespace
+
+void bind_probe(pyb::module_& m) {
+  pyb::class_<ProbeSession>(m, "ProbeSession", "A rotacal-probe/1 touch-probe session (mm, deg, s).")
+      .def_readonly("machine", &ProbeSession::machine)
+      .def_property_readonly("sphere", [](const ProbeSession& s) { return Eigen::Vector3d(s.sphere); },
+                             "nominal sphere centre, table frame, mm")
+      .def_readonly("sphere_diameter", &ProbeSession::sphere_diameter)
+      .def_readonly("stylus_diameter", &ProbeSession::stylus_diameter)
+      .def_property_readonly("trigger_radius", &ProbeSession::trigger_radius)
+      .def_readonly("noise_um", &ProbeSession::noise_um)
+      .def_readonly("warnings", &ProbeSession::warnings, "what the reader found suspicious but kept")
+      .def_property_readonly("poses", [](const ProbeSession& s) {
+        std::vector<std::string> out;
+        for (const ProbeSample& x : s.samples) out.push_back(x.pose);
+        return out;
+      }, "pose label of every touch")
+      .def_property_readonly("pose_names", &ProbeSession::poses, "distinct pose labels, in order")
+      .def_property_readonly("time", [](const ProbeSession& s) {
+        Eigen::VectorXd t(static_cast<Eigen::Index>(s.samples.size()));
+        for (std::size_t i = 0; i < s.samples.size(); ++i) t[static_cast<Eigen::Index>(i)] = s.samples[i].time;
+        return t;
+      })
+      .def_property_readonly("xyz", [](const ProbeSession& s) {
+        return columns(s, 3, [](const ProbeSample& x) { return x.xyz.transpose(); });
+      }, "latched X, Y, Z (N, 3), mm")
+      .def_property_readonly("angles_deg", [](const ProbeSession& s) {
+        return columns(s, 2, [](const ProbeSample& x) { return Eigen::RowVector2d(x.tilt_deg, x.rot_deg); });
+      }, "tilt and rotary angle of every touch (N, 2), deg")
+      .def_property_readonly("n", [](const ProbeSession& s) {
+        return columns(s, 3, [](const ProbeSample& x) { return x.n.transpose(); });
+      }, "unit approach directions (N, 3), machine frame")
+      .def("__len__", [](const ProbeSession& s) { return s.samples.size(); })
+      .def("__repr__", [](const ProbeSession& s) {
+        return "<ProbeSession " + to_string(s.machine) + ", " + std::to_string(s.samples.size()) + " touches at " +
+               std::to_string(s.poses().size()) + " poses>";
+      });
+  m.def("read_probe", &read_probe, pyb::arg("path"), "Read a rotacal-probe/1 file (io/probe_file.hpp).");
+  m.def("write_probe", &write_probe, pyb::arg("session"), pyb::arg("path"));
+  m.def("format_probe", &format_probe, pyb::arg("session"));
+  m.def("read_instrument_session", &read_instrument_session, pyb::arg("path"),
+        "Read a ballbar, R-test or touch-probe session (chosen by its format line).");
+  m.def("probe_effect_catalogue", &probe_effect_catalogue, pyb::arg("machine"), pyb::arg("max_harmonic") = 4,
+        "The catalogue entries of a probe session: effect_catalogue and stylus_radius_offset, probe_lobing.");
+
+  pyb::class_<ProbeIdentification>(m, "ProbeIdentification")
+      .def_readonly("method", &ProbeIdentification::method)
+      .def_property_readonly("machine", [](const ProbeIdentification& r) { return r.model.machine; })
+      .def_property_readonly("errors", [](const ProbeIdentification& r) { return Eigen::VectorXd(r.model.errors.v); })
+      .def_property_readonly("effects", [](const ProbeIdentification& r) { return ids_of(r.model.effects); })
+      .def_property_readonly("effect_params", [](const ProbeIdentification& r) { return r.model.effect_params; })
+      .def_property_readonly("sphere", [](const ProbeIdentification& r) { return Eigen::Vector3d(r.sphere); })
+      .def_readonly("parameters", &ProbeIdentification::parameters)
+      .def_readonly("covariance", &ProbeIdentification::covariance)
+      .def_property_readonly("residuals", [](const ProbeIdentification& r) {
+        return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(r.residuals.data(), static_cast<Eigen::Index>(r.residuals.size())));
+      })
+      .def_readonly("residual_rms_um", &ProbeIdentification::residual_rms_um)
+      .def_readonly("sigma_um", &ProbeIdentification::sigma_um)
+      .def_readonly("n_samples", &ProbeIdentification::n_samples)
+      .def_readonly("converged", &ProbeIdentification::converged)
+      .def_readonly("iterations", &ProbeIdentification::iterations)
+      .def_readonly("unobservable", &ProbeIdentification::unobservable)
+      .def_readonly("notes", &ProbeIdentification::notes)
+      .def_readonly("summary", &ProbeIdentification::summary)
+      .def_readonly("noise", &ProbeIdentification::noise)
+      .def_readonly("noise_refit", &ProbeIdentification::noise_refit)
+      .def_readonly("noise_correction", &ProbeIdentification::noise_correction)
+      .def_property_readonly("pose_centres", [](const ProbeIdentification& r) { return rows_from(r.pose_centres); })
+      .def_readonly("pose_labels", &ProbeIdentification::pose_labels)
+      .def_readonly("dispersion_um", &ProbeIdentification::dispersion_um);
+
+  m.def(
+      "identify_probe",
+      [](const ProbeSession& session, const std::vector<std::string>& effects, const std::string& noise) {
+        ProbeFitOptions o;
+        o.effects = effects_of(effects);
+        o.noise.noise = noise_handling_from_string(noise);
+        pyb::gil_scoped_release release;
+        return identify_probe(session, o);
+      },
+      pyb::arg("session"), pyb::arg("effects") = std::vector<std::string>{}, pyb::arg("noise") = "auto",
+      "Joint fit of every touch: location errors, the sphere's table position (and effects), with "
+      "observability and the noise model (probe/identify.hpp); noise 'auto' or 'white'.");
+  m.def(
+      "identify_probe_cycles",
+      [](const ProbeSession& session, bool radius_known) {
+        pyb::gil_scoped_release release;
+        return identify_probe_cycles(session, ProbeCyclesOptions{radius_known});
+      },
+      pyb::arg("session"), pyb::arg("radius_known") = true,
+      "The controller cycles' method: sphere per pose, plane and circle of the centres per table axis.");
+
+  m.def(
+      "diagnose_probe",
+      [](const ProbeSession& session, const DiagnosisOptions& options) {
+        pyb::gil_scoped_release release;
+        return diagnose_probe(session, options);
+      },
+      pyb::arg("session"), pyb::arg("options") = DiagnosisOptions{},
+      "Diagnose a touch-probe session (diagnose/probe_diagnosis.hpp): catalogue effects and the probe's "
+      "stylus_radius_offset and probe_lobing over the joint fit's baseline.");
+  m.def(
+      "uncertainty_budget_probe",
+      [](const ProbeSession& session, const Diagnosis& diagnosis, const PlausibleSizes& sizes, double coverage) {
+        pyb::gil_scoped_release release;
+        return uncertainty_budget(ProbeDiagnosisProblem(session), diagnosis, sizes, coverage);
+      },
+      pyb::arg("session"), pyb::arg("diagnosis"), pyb::arg("sizes") = PlausibleSizes{}, pyb::arg("coverage") = 0.95,
+      "GUM budget of the location errors of diagnose_probe's result (the probe's entries: stylus calibration, "
+      "lobing).");
+  m.def(
+      "default_probe_poses_deg",
+      [](MachineType machine) {
+        const ProbePattern p = default_probe_pattern(machine);
+        Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor> a(static_cast<Eigen::Index>(p.poses_deg.size()), 2);
+        for (std::size_t i = 0; i < p.poses_deg.size(); ++i)
+          a.row(static_cast<Eigen::Index>(i)) << p.poses_deg[i].tilt, p.poses_deg[i].rot;
+        return std::make_pair(a, rows_from(p.directions));
+      },
+      pyb::arg("machine"), "(poses (P, 2) tilt and rotary deg, directions (K, 3)) of default_probe_pattern.");
+  m.def(
+      "simulate_probe",
+      [](MachineType machine, const Array& errors, const std::vector<std::string>& effects,
+         const std::vector<double>& effect_params, const Array& sphere_offset, double noise_um, double ar1_rho,
+         std::uint64_t seed, std::optional<Array> poses_deg, std::optional<Array> directions, const Array& sphere,
+         double sphere_diameter, double stylus_diameter) {
+        MachineModel t;
+        t.machine = machine;
+        t.errors = LocationErrors<double>(vec_of<8>(errors, "errors"));
+        t.effects = effects_of(effects);
+        t.effect_params = effect_params;
+        ProbeSimOptions o;
+        o.pattern = default_probe_pattern(machine);
+        if (poses_deg) o.pattern.poses_deg = angles_of(*poses_deg);
+        if (directions) o.pattern.directions = vectors_of(*directions, "directions");
+        o.pattern.sphere = vec_of<3>(sphere, "sphere");
+        o.pattern.sphere_diameter = sphere_diameter;
+        o.pattern.stylus_diameter = stylus_diameter;
+        o.sphere_offset = vec_of<3>(sphere_offset, "sphere_offset");
+        o.noise_um = noise_um;
+        o.ar1_rho = ar1_rho;
+        o.seed = seed;
+        pyb::gil_scoped_release release;
+        const ProbeSimulation sim = simulate_probe(t, o);
+        return std::make_pair(sim.session, Eigen::Vector3d(sim.sphere_actual));
+      },
+      pyb::arg("machine"), pyb::arg("errors"), pyb::arg("effects") = std::vector<std::string>{},
+      pyb::arg("effect_params") = std::vector<double>{}, pyb::arg("sphere_offset") = Eigen::Vector3d::Zero().eval(),
+      pyb::arg("noise_um") = 0.5, pyb::arg("ar1_rho") = 0.0, pyb::arg("seed") = 1, pyb::arg("poses_deg") = pyb::none(),
+      pyb::arg("directions") = pyb::none(), pyb::arg("sphere") = Eigen::Vector3d(150.0, 0.0, 80.0).eval(),
+      pyb::arg("sphere_diameter") = 25.0, pyb::arg("stylus_diameter") = 6.0,
+      "Simulate a touch-probe session (probe/simulate.hpp): (session, actual sphere centre). Poses default "
+      "to default_probe_pattern's.");
+}
+
+}  // namespace rotacal::py

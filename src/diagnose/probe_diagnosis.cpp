@@ -1,0 +1,60 @@
+// The touch probe as an instrument of the diagnosis engine (diagnose/probe_diagnosis.hpp).
+#include "rotacal/diagnose/probe_diagnosis.hpp"
+
+#include "rotacal/probe/identify.hpp"
+#include "rotacal/probe/problem.hpp"
+
+namespace rotacal {
+
+ProbeDiagnosisProblem::ProbeDiagnosisProblem(ProbeSession session) : session_(std::move(session)) {
+  for (const ProbeSample& s : session_.samples) {
+    groups_.push_back("touches");
+    times_.push_back(s.time);
+    angles_.push_back(s.angles_rad());
+  }
+}
+
+std::vector<Effect> ProbeDiagnosisProblem::candidates(int max_harmonic) const {
+  std::vector<Effect> out;
+  const bool head = session_.machine.has_head();
+  for (const Effect& e : probe_effect_catalogue(session_.machine, max_harmonic))
+    if (e.kind != EffectKind::ballbar_length_offset && e.kind != EffectKind::ballbar_thermal_drift &&
+        !(head && e.kind == EffectKind::tool_offset_Z) && !e.depends_on_motion())
+      out.push_back(e);
+  return out;
+}
+
+ModelFit ProbeDiagnosisProblem::fit_gls(const EffectModel& effects, std::shared_ptr<const ResidualWhitener> noise) const {
+  ProbeFitOptions o;
+  o.effects = effects;
+  o.whitener = std::move(noise);
+  ProbeIdentification id = identify_probe(session_, o);
+  ModelFit f;
+  f.effects = id.model.effects;
+  f.parameters = std::move(id.parameters);
+  f.residuals = Eigen::Map<const Eigen::VectorXd>(id.residuals.data(), static_cast<Eigen::Index>(id.residuals.size()));
+  f.jacobian = std::move(id.jacobian);
+  for (std::size_t j = 0; j < id.fixed.size(); ++j) {
+    if (id.fixed[j]) f.jacobian.col(static_cast<Eigen::Index>(j)).setZero();
+    else ++f.num_free;
+  }
+  return f;
+}
+
+Eigen::MatrixXd ProbeDiagnosisProblem::candidate_jacobian(const ModelFit& at, const Effect& candidate) const {
+  EffectModel fx = at.effects;
+  fx.effects.push_back(candidate);
+  const ProbeProblem problem(session_, fx);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(problem.num_parameters());
+  for (std::size_t j = 0; j < at.parameters.size(); ++j) x[static_cast<Eigen::Index>(j)] = at.parameters[j].value;
+  Eigen::VectorXd r(problem.num_residuals());
+  Eigen::MatrixXd J(problem.num_residuals(), problem.num_parameters());
+  problem.evaluate(x, r, &J);
+  return J.rightCols(candidate.num_params());
+}
+
+Diagnosis diagnose_probe(ProbeSession session, const DiagnosisOptions& options) {
+  return diagnose(ProbeDiagnosisProblem(std::move(session)), options);
+}
+
+}  // namespace rotacal
