@@ -467,33 +467,49 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
     }
     if (!chosen) break;
 
-    // How sure the name is: BIC weights against the candidates that explain the same signal.
-    // Below min_weight the finding is the group the data cannot separate, reported ambiguous.
-    // In coloured noise the field is weighed under one noise model, the chosen candidate's own
-    // (each candidate's own model is estimated after removing it: a flexible one that takes
-    // some of the noise's low frequencies with it whitens its own residual more, and its BIC
-    // flatters it against a rival judged under another model).
-    std::vector<double> field_bic;
-    for (const Score* s : passing) field_bic.push_back(s->delta_bic);
+    // How sure the name is: posterior weights against the candidates that explain the same
+    // signal (rivals.hpp). Below min_weight the finding is the group the data cannot separate,
+    // reported ambiguous. The field is every observable candidate of the round that could hold
+    // any weight, passed or not (the one that failed the F-test or BIC by a little may still fit
+    // as well as the chosen one). It is weighed under one noise model, in coloured noise the
+    // chosen candidate's own (each candidate's own model is estimated after removing it: a
+    // flexible one that takes some of the noise's low frequencies with it whitens its own
+    // residual more, and its BIC flatters it against a rival judged under another model).
+    const std::size_t ci = static_cast<std::size_t>(chosen - scores.data());
+    const double tempering = noise.W && model ? evidence_tempering(*model) : 1.0;
+    const NoiseTreatment& common = noise.W ? treatment_of[ci] : noise;
+    ScoringInputs in_common;
     if (noise.W) {
-      const std::size_t ci = static_cast<std::size_t>(chosen - scores.data());
-      const NoiseTreatment& common = treatment_of[ci];
-      ScoringInputs in_common;
       in_common.Jfree = levels_of[ci] ? J_levels : in.Jfree;
       in_common.num_free = before->num_free + (levels_of[ci] ? levels_rank : 0);
       in_common.Q_w = orthonormal_basis_full_rank(common.whiten(in_common.Jfree));
       in_common.r_w = common.whiten(before->residuals);
-      EffectModel before_effects = effects;
-      before_effects.effects.pop_back();
-      for (std::size_t i = 0; i < passing.size(); ++i) {
-        const SharedMatrix Jc = cache.candidate_jacobians(P, before_effects, *before, {passing[i]->effect}).front();
-        const Score r = score(in_common, passing[i]->effect, common.whiten(*Jc), options.min_visible_chi2);
-        field_bic[i] = r.observable ? r.delta_bic : std::numeric_limits<double>::infinity();
-      }
     }
-    const double tempering = noise.W && model ? evidence_tempering(*model) : 1.0;
-    const RivalJudgement judged_rivals =
-        weigh_rivals(*chosen, passing, field_bic, tempering, options.rival_correlation, options.min_weight);
+    const ScoringInputs& judged_in = noise.W ? in_common : in;
+    std::vector<Effect> near;  // within kFieldMargin of the chosen one at either Occam term
+    constexpr double kFieldMargin = 40.0;  // a weight of e^-20 at most, before tempering
+    for (const Score& s : scores) {
+      const double d_bic = s.delta_bic - chosen->delta_bic;
+      const double d_aic = d_bic - (s.k - chosen->k) * (std::log(n) - 2.0);
+      if (&s == chosen || std::min(d_bic, d_aic) < kFieldMargin) near.push_back(s.effect);
+    }
+    EffectModel before_effects = effects;
+    before_effects.effects.pop_back();
+    const std::vector<SharedMatrix> near_jc = cache.candidate_jacobians(P, before_effects, *before, near);
+    std::vector<Score> field_scores;
+    field_scores.reserve(near.size());
+    for (std::size_t i = 0; i < near.size(); ++i)
+      field_scores.push_back(score(judged_in, near[i], common.whiten(*near_jc[i]), options.min_visible_chi2));
+    std::vector<const Score*> field;
+    std::vector<double> field_bic;
+    const Score* chosen_judged = chosen;
+    for (const Score& s : field_scores) {
+      field.push_back(&s);
+      field_bic.push_back(s.observable ? s.delta_bic : std::numeric_limits<double>::infinity());
+      if (s.effect == chosen->effect && s.observable) chosen_judged = &s;
+    }
+    const RivalJudgement judged_rivals = weigh_rivals(*chosen_judged, field, field_bic, n, tempering,
+                                                      options.rival_correlation, options.min_weight);
     // A harmonic of an order the sampling cannot resolve takes, at the sampled angles, the
     // values of lower orders: a finding of a harmonic of that axis may be it, of its own kind or
     // another (on the R-test's 7 tilt angles an axial h4 came out as a tilt h3).
