@@ -53,13 +53,19 @@ RivalJudgement weigh_rivals(const Score& chosen, const std::vector<const Score*>
   std::vector<std::size_t> order(who.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin() + 1, order.end(), [&](std::size_t a, std::size_t b) { return w[a] > w[b]; });
-  // The group: the chosen candidate, then rivals by weight until min_weight is held.
+  // The group: the chosen candidate, then rivals by weight until min_weight is held, and every
+  // rival the best of the field cannot be told apart from (the best's weight against it alone
+  // below min_weight, as an ambiguity claim means): a rival just outside the weight that
+  // completes min_weight is no less a candidate than the last one inside it.
+  const double w_best = *std::max_element(w.begin(), w.end());
   double held = w[0];
   std::vector<bool> member(who.size(), false);
   member[0] = true;
-  for (std::size_t j = 1; j < order.size() && held < min_weight; ++j) {
-    member[order[j]] = true;
-    held += w[order[j]];
+  for (std::size_t j = 1; j < order.size(); ++j) {
+    const std::size_t i = order[j];
+    if (held >= min_weight && w_best / (w_best + w[i]) >= min_weight) break;
+    member[i] = true;
+    held += w[i];
   }
   out.group.push_back(&chosen);
   for (std::size_t j = 1; j < order.size(); ++j) {

@@ -40,8 +40,10 @@ struct RivalJudgement {
 /// named the simpler wrong cause in 4-6 % of white-noise sessions at 1x the half-detection
 /// amplitude.
 ///
-/// The group is the smallest set of them, best first, whose weights add up to `min_weight`;
-/// it holds the chosen candidate alone when that one's weight reaches `min_weight`.
+/// The group is the smallest set of them, best first, whose weights add up to `min_weight`,
+/// and any further rival whose weight against the best of the field alone is above
+/// 1 - min_weight (the two cannot be told apart, DiagnosisOptions::min_weight); it holds the
+/// chosen candidate alone when that one's weight reaches `min_weight`.
 /// `bic[i]`: the delta BIC of field[i] under the noise model the field is weighed with (one for
 /// all of them; +inf: not visible under it, not a rival); `n`: the readings (BIC's ln n).
 /// `tempering` (>= 1) divides the differences before they become weights (evidence_tempering).
