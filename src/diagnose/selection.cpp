@@ -49,8 +49,12 @@ std::string unresolved_reason(const std::vector<Effect>& candidates, const std::
 }
 
 // The field of a finding, weighed under one noise model (`common`, against the inputs `in` of the
-// model before it): every observable candidate of the round within kFieldMargin of the chosen
-// one at either Occam term, rescored with its columns (their signatures tell rivals apart).
+// model before it), rescored with its columns (their signatures tell rivals apart): every
+// observable candidate of the round within kFieldMargin of the chosen one at either Occam term,
+// and every one that passed the BIC threshold. In coloured noise each candidate was scored under
+// its own noise model, so the margin on those scores is only a guide: a harmonic whose own
+// 1/f-like model whitened it away can be far from the chosen one there and the best under the
+// chosen one's model (the R-test's tilt-axis harmonics in 1/f-like noise at 10x).
 struct Field {
   std::vector<Score> scores;
   RivalJudgement judged;  // its pointers are into `scores`
@@ -63,7 +67,8 @@ Field weigh_field(const SearchContext& S, const Round& R, const Score& chosen, c
   for (const Score& s : R.scores) {
     const double d_bic = s.delta_bic - chosen.delta_bic;
     const double d_aic = d_bic - (s.k - chosen.k) * (std::log(n) - 2.0);
-    if (&s == &chosen || std::min(d_bic, d_aic) < kFieldMargin) near.push_back(s.effect);
+    if (&s == &chosen || std::min(d_bic, d_aic) < kFieldMargin || s.delta_bic < S.options.min_delta_bic)
+      near.push_back(s.effect);
   }
   const std::vector<SharedMatrix> near_jc = S.cache.candidate_jacobians(S.P, before_effects, before, near);
   Field F;
