@@ -31,8 +31,9 @@ random. Entries with s = 0 (absorbed) or needing more than a plausible size (1 m
 1e-3) at 10x get no cell and are listed.
 
 Per session: rotacal's first finding is right (named alone, the truth), ambiguous (not named, the
-truth in its group, the best's BIC weight < 0.9), nothing (no finding) or wrong (named alone and
-wrong, or a group without the truth). The oracle: the same session's readings minus the truth's
+truth in its group, the best's posterior weight < 0.9: DiagnosisOptions.min_weight, the smaller
+of its BIC and AIC weights), nothing (no finding) or wrong (named alone and wrong, or a group
+without the truth). The oracle: the same session's readings minus the truth's
 baseline readings, GLS with the true noise covariance on J0 against J0 + Je (its k visible
 directions), the same two thresholds (BIC with the covariance known: chi2 + parameters x ln n). Coverage: |estimate - truth| <= 2 std for each determined parameter of right findings
 (rotacal's units: thermal_warmup tau as ln(tau / 300 s)).

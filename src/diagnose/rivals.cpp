@@ -1,4 +1,4 @@
-// BIC weights of a finding against its rivals (rivals.hpp).
+// Posterior weights of a finding against its rivals (rivals.hpp).
 #include "rivals.hpp"
 
 #include <algorithm>
@@ -6,61 +6,78 @@
 
 namespace rotacal::diagnosis_detail {
 
-RivalJudgement weigh_rivals(const Score& chosen, const std::vector<const Score*>& passing,
-                            const std::vector<double>& bic, double tempering, double rival_correlation,
-                            double min_weight) {
-  struct Entry {
-    const Score* s;
-    double corr;
-    double bic;
-  };
-  double chosen_bic = chosen.delta_bic;
-  for (std::size_t i = 0; i < passing.size(); ++i)
-    if (passing[i] == &chosen && std::isfinite(bic[i])) chosen_bic = bic[i];
-  std::vector<Entry> field{{&chosen, 1.0, chosen_bic}};
-  for (std::size_t i = 0; i < passing.size(); ++i) {
-    const Score* s = passing[i];
-    if (s == &chosen || !std::isfinite(bic[i])) continue;
-    const double corr = std::abs(correlation(s->signature, chosen.signature));
-    if (corr >= rival_correlation) field.push_back({s, corr, bic[i]});
-  }
-  // BIC weights relative to the best of the field (a rival may fit better than the chosen
-  // one: the search passes over candidates that fail cross-validation or whose parameters
-  // the refit cannot determine).
-  double best_bic = chosen_bic;
-  for (const Entry& e : field) best_bic = std::min(best_bic, e.bic);
-  std::vector<double> w;
+namespace {
+
+// Normalised weights exp(-(IC_i - min IC) / (2 tempering)), IC_i = bic_i - k_i (ln n - c): the
+// Occam term per parameter c instead of BIC's ln n.
+std::vector<double> weights_at(const std::vector<double>& bic, const std::vector<int>& k, double n, double c,
+                               double tempering) {
+  std::vector<double> ic(bic.size());
+  for (std::size_t i = 0; i < bic.size(); ++i) ic[i] = bic[i] - k[i] * (std::log(n) - c);
+  const double best = *std::min_element(ic.begin(), ic.end());
+  std::vector<double> w(ic.size());
   double total = 0.0;
-  for (const Entry& e : field) {
-    w.push_back(std::exp(-0.5 * (e.bic - best_bic) / tempering));
-    total += w.back();
-  }
+  for (std::size_t i = 0; i < ic.size(); ++i) total += (w[i] = std::exp(-0.5 * (ic[i] - best) / tempering));
   for (double& x : w) x /= total;
+  return w;
+}
+
+}  // namespace
+
+RivalJudgement weigh_rivals(const Score& chosen, const std::vector<const Score*>& field,
+                            const std::vector<double>& bic, double n, double tempering, double rival_correlation,
+                            double min_weight) {
+  std::vector<const Score*> who{&chosen};
+  std::vector<double> corr{1.0};
+  double chosen_bic = chosen.delta_bic;
+  for (std::size_t i = 0; i < field.size(); ++i)
+    if (field[i] == &chosen && std::isfinite(bic[i])) chosen_bic = bic[i];
+  std::vector<double> ic_bic{chosen_bic};
+  std::vector<int> k{chosen.k};
+  for (std::size_t i = 0; i < field.size(); ++i) {
+    const Score* s = field[i];
+    if (s == &chosen || !std::isfinite(bic[i])) continue;
+    const double c = std::abs(correlation(s->signature, chosen.signature));
+    if (c < rival_correlation) continue;
+    who.push_back(s), corr.push_back(c), ic_bic.push_back(bic[i]), k.push_back(s->k);
+  }
+  // Weights relative to the best of the field (a rival may fit better than the chosen one: the
+  // search passes over candidates that fail cross-validation or whose parameters the refit
+  // cannot determine), at both ends of the Occam term; the chosen one stands by the worse.
+  const std::vector<double> w_bic = weights_at(ic_bic, k, n, std::log(n), tempering);
+  const std::vector<double> w_aic = weights_at(ic_bic, k, n, 2.0, tempering);
+  const std::vector<double>& w = w_aic[0] < w_bic[0] ? w_aic : w_bic;
 
   RivalJudgement out;
   out.weight = w[0];
-  std::vector<std::size_t> order(field.size());
+  std::vector<std::size_t> order(who.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin() + 1, order.end(), [&](std::size_t a, std::size_t b) { return w[a] > w[b]; });
-  // The group: the chosen candidate, then rivals by weight until min_weight is held.
+  // The group: the chosen candidate, then rivals by weight until min_weight is held, and every
+  // rival the best of the field cannot be told apart from (the best's weight against it alone
+  // below min_weight, as an ambiguity claim means): a rival just outside the weight that
+  // completes min_weight is no less a candidate than the last one inside it.
+  const double w_best = *std::max_element(w.begin(), w.end());
   double held = w[0];
-  std::vector<bool> member(field.size(), false);
+  std::vector<bool> member(who.size(), false);
   member[0] = true;
-  for (std::size_t k = 1; k < order.size() && held < min_weight; ++k) {
-    member[order[k]] = true;
-    held += w[order[k]];
+  for (std::size_t j = 1; j < order.size(); ++j) {
+    const std::size_t i = order[j];
+    if (held >= min_weight && w_best / (w_best + w[i]) >= min_weight) break;
+    member[i] = true;
+    held += w[i];
   }
   out.group.push_back(&chosen);
-  for (std::size_t k = 1; k < order.size(); ++k) {
-    const std::size_t i = order[k];
+  for (std::size_t j = 1; j < order.size(); ++j) {
+    const std::size_t i = order[j];
     Alternative a;
-    a.effect = field[i].s->effect.id();
+    a.effect = who[i]->effect.id();
     a.weight = w[i];
-    a.delta_bic = field[i].bic - chosen_bic;
-    a.correlation = field[i].corr;
+    a.delta_bic = ic_bic[i] - chosen_bic;
+    a.correlation = corr[i];
     a.in_group = member[i];
     out.rivals.push_back(a);
-    if (member[i]) out.group.push_back(field[i].s);
+    if (member[i]) out.group.push_back(who[i]);
   }
   return out;
 }

@@ -16,8 +16,10 @@
 ///     blocks of each group left out in turn, so the extension must predict unseen angles);
 ///  4. the best significant candidate is added, the model refitted (nonlinear), and 3 repeats
 ///     until nothing significant is left;
-/// Files: diagnosis.cpp (the search loop), scoring.cpp (linearised refit, F/BIC,
-/// cross-validation), harmonics.cpp (what the angular sampling resolves),
+/// Files: diagnosis.cpp (the search loop, the final GLS refit), search_round.cpp (one round's
+/// scoring), selection.cpp (the choice of a finding, its rivals and group), rivals.cpp
+/// (posterior weights), final_test.cpp (what the final model leaves), scoring.cpp (linearised
+/// refit, F/BIC, cross-validation), harmonics.cpp (what the angular sampling resolves),
 /// residual_structure.cpp (per-group structure, noise), ambiguity.cpp (separating tests).
 ///  5. candidates the data cannot see, and *_hn candidates of an order the sampling of their
 ///     axis cannot resolve (aliased), are reported unobservable; candidates that explain the
@@ -95,12 +97,14 @@ struct DiagnosisOptions {
   double alpha = 0.01;         ///< family-wise false-finding rate per step (Bonferroni)
   double min_delta_bic = -10;  ///< "very strong" evidence on the Kass-Raftery scale
   int cv_blocks = 5;           ///< contiguous blocks per group for cross-validation
-  /// A cause is named alone only when its BIC weight among itself and its rivals (the
-  /// candidates of its round whose fitted signatures correlate with its own by at least
-  /// rival_correlation) is at least min_weight; otherwise the finding is the group of
-  /// candidates, best first, that holds min_weight together ("one of these"), and those are
-  /// reported as ambiguous. 0.9: the chosen cause is 9 times as probable as all its rivals
-  /// together (a BIC margin of 2 ln 9 = 4.4 over a single rival).
+  /// A cause is named alone only when its posterior weight among itself and its rivals (the
+  /// observable candidates of its round, passed or not, whose fitted signatures correlate with
+  /// its own by at least rival_correlation) is at least min_weight, at BIC's Occam term of
+  /// ln n per parameter and at AIC's of 2 alike (src/diagnose/rivals.hpp: the smaller of the
+  /// two weights); otherwise the finding is the group of candidates, best first, that holds
+  /// min_weight together, with every rival the best cannot be told apart from ("one of
+  /// these"), and those are reported as ambiguous. 0.9: the chosen cause is 9 times as
+  /// probable as all its rivals together (a margin of 2 ln 9 = 4.4 over a single rival).
   double min_weight = 0.9;
   double rival_correlation = 0.5;
   /// A finding has at least one combination of its parameters determined to this many sigma
@@ -193,7 +197,7 @@ struct Gain {
 /// A rival of a finding: a candidate of its round that explains the same signal.
 struct Alternative {
   std::string effect;
-  double weight = 0.0;       ///< BIC weight among the finding and its rivals
+  double weight = 0.0;       ///< posterior weight among the finding and its rivals (min_weight)
   double delta_bic = 0.0;    ///< BIC(this) - BIC(the finding's effect); > 0: fits worse
   double correlation = 0.0;  ///< |cosine| of the two fitted signatures
   bool in_group = false;     ///< one of the group the data cannot separate
@@ -206,7 +210,8 @@ struct Alternative {
 struct Finding {
   Effect effect;             ///< the best of its group (the one the model is extended with)
   std::string cause;
-  /// BIC weight of `effect` among itself and its rivals; below DiagnosisOptions::min_weight
+  /// Posterior weight of `effect` among itself and its rivals (DiagnosisOptions::min_weight:
+  /// the smaller of its BIC and AIC weights); below DiagnosisOptions::min_weight
   /// the finding is the group of `rivals` with in_group set, not `effect` alone.
   double weight = 1.0;
   std::vector<Alternative> rivals;  ///< best first

@@ -1,0 +1,149 @@
+#pragma once
+// Internal to src/diagnose: the pieces of the diagnosis search (diagnosis.cpp, the loop and its
+// entry point): how the noise enters every decision, what the searches of one diagnosis share,
+// one round's scoring of the candidates (search_round.cpp), the choice and naming of a
+// finding (selection.cpp) and the test of what the final model leaves (final_test.cpp).
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rotacal/core/noise_handling.hpp"
+#include "rotacal/diagnose/diagnosis.hpp"
+#include "scoring.hpp"
+
+namespace rotacal::diagnosis_detail {
+
+// How the noise enters every decision: white with one sigma, or whitened by an AR model.
+struct NoiseTreatment {
+  double sigma_mm = 0.0;  // white: the sigma; coloured: the marginal sigma (for wording)
+  std::string source;
+  std::shared_ptr<const ArWhitener> W;  // null: white
+  Eigen::MatrixXd whiten(const Eigen::MatrixXd& M) const {
+    if (!W) return M / sigma_mm;
+    Eigen::MatrixXd out = M;
+    W->apply(out);
+    return out;
+  }
+};
+
+NoiseTreatment white_treatment(const DiagnosisProblem& P, const ModelFit& baseline);
+/// `described`: with the model's summary as the source (the candidates' own models and the
+/// structure test's are never reported, and formatting a summary per candidate is wasted).
+NoiseTreatment coloured_treatment(const NoiseModel& m, bool described = true);
+
+// One indicator column per noise stream (group, channel).
+// One level per noise stream, shared by the runs of one test (radial_C, radial_C_cw,
+// radial_C_f2000, test_of_run): they follow each other with the bar in place, so a wander does
+// not start afresh between them, and a step between them (backlash, servo lag) is a signal.
+// A label is taken for a run only where the test it names is itself a group of the session
+// (a user's "sphere_f1" or an R-test set-up "nest_cw" keeps its own level).
+Eigen::MatrixXd stream_levels(const DiagnosisProblem& P);
+
+// The effect's parameters in a fit (named "id" or "id.name").
+std::vector<ParameterEstimate> parameters_of(const ModelFit& fit, const Effect& effect);
+
+// What the searches of one diagnosis share: a diagnosis may search twice (with the noise
+// model, then white when the final model leaves white residuals) through the same models, and
+// a model's refit and its candidates' Jacobians depend on the model alone. Jacobians are kept
+// up to kMaxCachedValues doubles (16 MB), beyond that recomputed; a cached Jacobian and the
+// batch that handed it out share one matrix (a copy of each doubled the diagnosis' peak memory
+// on a 1 kHz recording: bench/ballbar_long --diagnose).
+using SharedMatrix = std::shared_ptr<const Eigen::MatrixXd>;
+struct SearchCache {
+  static constexpr std::size_t kMaxCachedValues = std::size_t{2} << 20;
+  std::map<std::string, ModelFit> fits;
+  std::map<std::string, std::map<std::string, SharedMatrix>> jacobians;
+  std::size_t cached_values = 0;
+
+  static std::string key(const EffectModel& m) {
+    std::string k;
+    for (const Effect& e : m.effects) k += e.id() + ";";
+    return k;
+  }
+  const ModelFit& fit(const DiagnosisProblem& P, const EffectModel& m) {
+    const std::string k = key(m);
+    auto it = fits.find(k);
+    if (it == fits.end()) it = fits.emplace(k, P.fit(m)).first;
+    return it->second;
+  }
+  // The Jacobians of `todo` at `at` (the fit of model `m`).
+  std::vector<SharedMatrix> candidate_jacobians(const DiagnosisProblem& P, const EffectModel& m,
+                                                const ModelFit& at, const std::vector<Effect>& todo) {
+    std::map<std::string, SharedMatrix>& known = jacobians[key(m)];
+    std::vector<Effect> missing;
+    for (const Effect& c : todo)
+      if (!known.count(c.id())) missing.push_back(c);
+    std::vector<Eigen::MatrixXd> fresh = P.candidate_jacobians(at, missing);
+    std::vector<SharedMatrix> out;
+    for (const Effect& c : todo) {
+      const auto it = known.find(c.id());
+      if (it != known.end()) {
+        out.push_back(it->second);
+        continue;
+      }
+      const std::size_t i = static_cast<std::size_t>(
+          std::find(missing.begin(), missing.end(), c) - missing.begin());
+      const std::size_t values = static_cast<std::size_t>(fresh[i].size());
+      out.push_back(std::make_shared<const Eigen::MatrixXd>(std::move(fresh[i])));
+      if (cached_values + values <= kMaxCachedValues) {
+        cached_values += values;
+        known.emplace(c.id(), out.back());
+      }
+    }
+    return out;
+  }
+};
+
+/// What one search holds fixed over its rounds.
+struct SearchContext {
+  const DiagnosisProblem& P;
+  const DiagnosisOptions& options;
+  const std::vector<Effect>& candidates;
+  const std::vector<std::string>& unresolved;  ///< per candidate: why its order is not resolved
+                                               ///< (empty: it is; then it is scored)
+  const NoiseTreatment& noise;                 ///< the search's noise treatment
+  const NoiseModel* model;                     ///< the search's noise model (null: white)
+  const NoiseTreatment& white;
+  const NoiseStreamLayout& layout;             ///< every noise model of this search
+  SearchCache& cache;
+};
+
+/// One round: every candidate not yet done scored against the current model.
+struct Round {
+  ScoringInputs in;        ///< the current model under the search's noise treatment
+  Eigen::MatrixXd J_levels;  ///< coloured: the free columns and one level column per stream
+                             ///< (only when a 1/f-like candidate needed them; else empty)
+  int levels_rank = 0;       ///< what the level columns add to the model's rank
+  std::vector<Score> scores;                 ///< the observable candidates
+  std::vector<NoiseTreatment> treatment_of;  ///< per score: the noise it was judged with
+  std::vector<bool> levels_of;               ///< per score: judged with the stream levels
+};
+
+/// Score every candidate not `done` against `fit` (the fit of `effects`). Candidates that are
+/// unresolved, undefined on the readings or not visible are marked done (and, in the first
+/// round, reported unobservable in D); the round's table is appended to D.rounds.
+Round score_round(const SearchContext& S, const ModelFit& fit, const EffectModel& effects,
+                  std::vector<bool>& done, bool first_round, Diagnosis& D);
+
+/// The candidate a round adds: the best that passes the F-test (Bonferroni) and BIC, predicts
+/// left-out blocks better and whose refit determines a parameter; null: none.
+struct Choice {
+  const Score* chosen = nullptr;
+  const ModelFit* refit = nullptr;  ///< of the extended model, held by the cache
+  double cv_before = 0.0, cv_after = 0.0;
+};
+Choice choose(const SearchContext& S, const Round& R, const ModelFit& fit, const EffectModel& effects,
+              const std::vector<int>& fold, std::vector<bool>& done, Diagnosis& D);
+
+/// The finding of `choice` against the round R scored at `before` (the fit of `before_effects`):
+/// its weight among its rivals, its group, and the ambiguity it leaves (appended to D).
+Finding name_finding(const SearchContext& S, const Round& R, const Choice& choice, const ModelFit& before,
+                     const EffectModel& before_effects, Diagnosis& D);
+
+/// What the final model leaves: structure after, the unexplained-structure test and, where
+/// structure remains as a function of one rotary angle, its per-angle table (into D).
+void judge_remainder(const SearchContext& S, const ModelFit& final_fit, Diagnosis& D);
+
+}  // namespace rotacal::diagnosis_detail

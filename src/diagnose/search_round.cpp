@@ -1,0 +1,210 @@
+// One round of the diagnosis search: every candidate not yet done scored against the current
+// model by a linearised refit (scoring.hpp), in white noise with the search's sigma, in coloured
+// noise under each candidate's own noise model.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <optional>
+
+#include "search.hpp"
+
+namespace rotacal::diagnosis_detail {
+
+namespace {
+
+// The noise model of what the current model extended by candidate c (linearised) leaves;
+// white treatment if that is white. Its AR order is looked for up to `max_order` (the search's
+// noise model's order + 2: the candidate's residual differs from the current model's in the k
+// directions it adds, which do not raise the order of the noise's correlation; Burg's recursion
+// through all 8 orders for every candidate was most of this function's time).
+NoiseTreatment candidate_treatment(const NoiseStreamLayout& layout, const NoiseModelOptions& noise_options,
+                                   const ModelFit& fit, const Eigen::MatrixXd& Q_raw, const Eigen::VectorXd& Qr,
+                                   const Eigen::MatrixXd& Jc, const NoiseTreatment& white, NoiseModel* model) {
+  Eigen::VectorXd r = residual_without(Q_raw, fit.residuals, Qr, Jc);
+  if (r.size() == 0) {
+    // What the candidate adds to the model's span, orthonormalised (CholeskyQR2; the
+    // rank-revealing QR where it is near rank-deficient): r minus its projection on that.
+    const Eigen::MatrixXd B = orthonormal_basis_full_rank(project_out(Q_raw, Jc));
+    r = fit.residuals - B * (B.transpose() * fit.residuals);
+  }
+  *model = estimate_noise_model(layout, r, noise_options);
+  return model->white() ? white : coloured_treatment(*model, false);
+}
+
+// What a coloured round shares between its candidates: the free columns' basis, the level
+// columns (built when a 1/f-like candidate first needs them), the white or AR(1) candidates'
+// Gram matrices, the 1/f-like noise model (once per round).
+struct ColouredRound {
+  Eigen::MatrixXd Q_raw;  // orthonormal basis of the free columns
+  Eigen::VectorXd Qr;     // Q_raw^T r (zero but for the fit's convergence)
+  NoiseModelOptions own_noise;  // each candidate's own noise model (see candidate_treatment)
+  NoiseTreatment wander_noise;  // 1/f-like: AR(1) + random walk by REML, once per round
+  std::unique_ptr<ModelProducts> products;  // white or AR(1) candidates' Gram matrices
+};
+
+// Candidate c scored in coloured noise. Returns false where it is not observable (s.why_not
+// says why); else `s`, the noise it was judged with and whether with the stream levels.
+void score_coloured(const SearchContext& S, const ModelFit& fit, Round& R, ColouredRound& C, const Effect& c,
+                    const Eigen::MatrixXd& Jc, Score& s, NoiseTreatment& judged_with, bool& with_levels) {
+  const DiagnosisOptions& options = S.options;
+  // As the classical F-test takes sigma from the larger model, the noise is modelled on
+  // what the model extended by this candidate leaves: correlated noise that no candidate
+  // follows stays correlated (so it is not taken for an effect), and an effect's own
+  // signature is not mistaken for correlated noise (which would whiten it away).
+  NoiseModel own_model;
+  NoiseTreatment own = candidate_treatment(S.layout, C.own_noise, fit, C.Q_raw, C.Qr, Jc, S.white, &own_model);
+  if (own_model.max_order < 2 && (!own.W || own.W->ar1_only())) {
+    // White or AR(1): scored from inner products; only a candidate that may pass is
+    // scored again below with its columns (the margin of 1 is far beyond rounding).
+    if (!C.products) C.products = std::make_unique<ModelProducts>(R.in.Jfree, S.layout.rows);
+    const CandidateProducts g = candidate_products(own.W.get(), own.sigma_mm, *C.products, R.in.Jfree, Jc, fit.residuals);
+    std::optional<Score> quick = score_from_products(g, c, fit.num_free, options.min_visible_chi2);
+    if (quick && !(quick->observable && quick->delta_bic < options.min_delta_bic + 1.0)) {
+      s = std::move(*quick);
+      s.rss1 *= R.in.r_w.squaredNorm() / std::max(g.rr, 1e-300);
+      judged_with = own;
+      return;
+    }
+  }
+  ScoringInputs in_c;
+  in_c.Jfree = R.in.Jfree;
+  in_c.num_free = fit.num_free;
+  if (own_model.max_order >= 2) {
+    // Noise that AR(1) does not describe (BIC wants p >= 2) is taken as 1/f-like: it has
+    // no finite correlation time, and its lowest frequencies are indistinguishable from
+    // an offset per stream that no AR model of a few hundred readings captures, so the
+    // level of each stream becomes a nuisance parameter. Its slow wander within a test
+    // is modelled as a random walk: AR(1) + walk by REML over what the current model and
+    // the levels leave (core/noise_handling.hpp), once per round. Burg's AR(p) of a
+    // stream of a few hundred readings misses that wander and took it for drifts (23
+    // false findings in 200 1/f-like null sessions; with the walk: bench/
+    // diagnose_realistic_bench --rho -1).
+    if (!R.J_levels.size()) {
+      const Eigen::MatrixXd L = stream_levels(S.P);
+      R.J_levels.resize(R.in.Jfree.rows(), R.in.Jfree.cols() + L.cols());
+      R.J_levels << R.in.Jfree, L;
+      R.levels_rank = static_cast<int>(orthonormal_basis(R.J_levels).cols() - C.Q_raw.cols());
+    }
+    with_levels = true;
+    in_c.Jfree = R.J_levels;
+    in_c.num_free += R.levels_rank;
+    if (!C.wander_noise.W) {
+      const NoiseModel start = estimate_noise_model(S.layout, fit.residuals, options.noise);
+      C.wander_noise = coloured_treatment(estimate_noise_model_reml(start, fit.residuals, R.J_levels));
+    }
+    own = C.wander_noise;
+  }
+  in_c.Q_w = orthonormal_basis_full_rank(own.whiten(in_c.Jfree));
+  in_c.r_w = own.whiten(fit.residuals);
+  s = score(in_c, c, own.whiten(Jc), options.min_visible_chi2, options.min_delta_bic);
+  // Scores are kept relative to the whitened residual of the current model, so the
+  // table's RMS-after stays comparable.
+  s.rss1 *= R.in.r_w.squaredNorm() / std::max(in_c.r_w.squaredNorm(), 1e-300);
+  judged_with = own;
+}
+
+// The round's table (every observable candidate, best first) for D.rounds.
+std::vector<CandidateScore> round_table(const Round& R, const ModelFit& fit) {
+  std::vector<CandidateScore> table;
+  for (const Score& s : R.scores) {
+    // RMS after, in um: the whitened fraction applied to the raw RMS.
+    const double frac = std::sqrt(s.rss1 / std::max(R.in.r_w.squaredNorm(), 1e-300));
+    table.push_back({s.effect.id(), s.k, s.delta_bic, s.f_pvalue, rms_um(fit.residuals) * frac});
+  }
+  std::sort(table.begin(), table.end(),
+            [](const CandidateScore& a, const CandidateScore& b) { return a.delta_bic < b.delta_bic; });
+  return table;
+}
+
+}  // namespace
+
+Round score_round(const SearchContext& S, const ModelFit& fit, const EffectModel& effects,
+                  std::vector<bool>& done, bool first_round, Diagnosis& D) {
+  const DiagnosisOptions& options = S.options;
+  const std::vector<Effect>& candidates = S.candidates;
+  const NoiseTreatment& noise = S.noise;
+  Round R;
+  R.in.Jfree = free_columns(fit.jacobian);
+  R.in.Q_w = orthonormal_basis(noise.whiten(R.in.Jfree));
+  R.in.r_w = noise.whiten(fit.residuals);
+  R.in.num_free = fit.num_free;
+  ColouredRound C;
+  C.own_noise = options.noise;
+  if (noise.W) {
+    C.Q_raw = orthonormal_basis(R.in.Jfree);
+    C.Qr = C.Q_raw.transpose() * fit.residuals;
+    if (S.model) C.own_noise.max_order = std::min(C.own_noise.max_order, S.model->max_order + 2);
+  }
+  // This round's candidate Jacobians at the current fit, in batches of at most
+  // kChunkValues doubles: one batch for a session of a few thousand readings, and a long
+  // session holds one batch at a time (the cache keeps what fits its limit).
+  constexpr std::size_t kChunkValues = std::size_t{2} << 20;  // 16 MB
+  const std::size_t rows = static_cast<std::size_t>(fit.residuals.size());
+  std::vector<SharedMatrix> chunk_jc;
+  std::vector<std::size_t> chunk_of(candidates.size(), SIZE_MAX);  // index in chunk_jc
+  const auto jacobian_of = [&](std::size_t c) -> const Eigen::MatrixXd& {
+    if (chunk_of[c] == SIZE_MAX) {
+      std::vector<Effect> todo;
+      std::size_t values = 0;
+      for (std::size_t d = c; d < candidates.size(); ++d) {
+        if (done[d] || !S.unresolved[d].empty()) continue;
+        const std::size_t v = rows * static_cast<std::size_t>(candidates[d].num_params());
+        if (!todo.empty() && values + v > kChunkValues) break;
+        chunk_of[d] = todo.size();
+        todo.push_back(candidates[d]);
+        values += v;
+      }
+      chunk_jc.clear();  // the previous batch goes before the next is made
+      chunk_jc = S.cache.candidate_jacobians(S.P, effects, fit, todo);
+    }
+    return *chunk_jc[chunk_of[c]];
+  };
+  int round_total = 0, round_done = 0;  // candidates to score in this round (progress)
+  for (std::size_t c = 0; c < candidates.size(); ++c) round_total += !done[c] && S.unresolved[c].empty();
+  const std::string stage = std::string(noise.W ? "search with the noise model" : "search (white noise)") +
+                            ", round " + std::to_string(D.rounds.size() + 1);
+  for (std::size_t c = 0; c < candidates.size(); ++c) {
+    if (done[c]) continue;
+    if (!S.unresolved[c].empty()) {
+      D.unobservable.push_back({candidates[c].id(), S.unresolved[c]});
+      done[c] = true;
+      continue;
+    }
+    const Eigen::MatrixXd& Jc = jacobian_of(c);
+    if (!Jc.allFinite()) {  // e.g. a time constant over readings that share one time stamp
+      if (first_round) D.unobservable.push_back({candidates[c].id(), kUndefinedOnReadings});
+      done[c] = true;
+      continue;
+    }
+    if (options.progress) options.progress(stage, round_done++, round_total);
+    Score s;
+    NoiseTreatment judged_with = noise;
+    bool with_levels = false;
+    if (!noise.W)
+      s = score(R.in, candidates[c], noise.whiten(Jc), options.min_visible_chi2, options.min_delta_bic);
+    else
+      score_coloured(S, fit, R, C, candidates[c], Jc, s, judged_with, with_levels);
+    if (!s.observable) {
+      if (first_round) D.unobservable.push_back({candidates[c].id(), s.why_not});
+      done[c] = true;
+      continue;
+    }
+    // The columns (cross-validation) and signature (ambiguity) serve only a candidate that
+    // can pass: the others' would hold n x (p + k + 1) doubles each, 8 KB per reading over
+    // the catalogue, which a 1 kHz recording of a whole test cannot afford.
+    if (s.delta_bic < options.min_delta_bic) {
+      // Cross-validation compares with the model itself (without any level columns).
+      s.X.resize(R.in.Jfree.rows(), R.in.Jfree.cols() + s.k);
+      s.X << R.in.Jfree, Jc * s.directions;
+    }
+    R.scores.push_back(std::move(s));
+    R.treatment_of.push_back(judged_with);
+    R.levels_of.push_back(with_levels);
+  }
+  if (options.progress) options.progress(stage, round_total, round_total);
+  D.rounds.push_back(round_table(R, fit));
+  return R;
+}
+
+}  // namespace rotacal::diagnosis_detail
