@@ -85,6 +85,7 @@ COMMANDS: dict[tuple[str, ...], Files] = {
     ("machines", "show"): Files((arg("NAME|FILE", "machine"),)),
     ("simulate", "ballbar"): Files((MACHINE,), (OUTPUT, arg("--truth"))),
     ("simulate", "rtest"): Files((MACHINE,), (OUTPUT, Slot("--truth", lambda a: [rtest_truth_path(a)]))),
+    ("simulate", "probe"): Files((MACHINE,), (OUTPUT, arg("--truth"))),
     ("identify",): Files((arg("FILE", "file"), arg("--budget-sizes"), arg("--controller")),
                          (arg("--save-model"),), writes_store=lambda a: bool(a.store)),
     ("history", "add"): Files((arg("MODEL", "model"), arg("--correction"), arg("--diagnosis"), arg("--controller")),

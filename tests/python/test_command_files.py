@@ -24,6 +24,7 @@ TEMPLATES = {
     ("simulate", "ballbar"): [["simulate", "ballbar", "--machine", "{--machine}", "--truth", "{--truth}",
                                "-o", "{-o}"]],
     ("simulate", "rtest"): [["simulate", "rtest", "--machine", "{--machine}", "--truth", "{--truth}", "-o", "{-o}"]],
+    ("simulate", "probe"): [["simulate", "probe", "--machine", "{--machine}", "--truth", "{--truth}", "-o", "{-o}"]],
     ("identify",): [["identify", "{FILE}", "--budget-sizes", "{--budget-sizes}", "--controller", "{--controller}",
                      "--save-model", "{--save-model}", "--store", "--machine-id", "M1", "--db", "{--db}"]],
     ("history", "add"): [["history", "add", "{MODEL}", "--diagnosis", "{--diagnosis}", "--controller", "{--controller}",
