@@ -81,6 +81,7 @@ def _always(a: argparse.Namespace) -> bool:
 # Keyed by the words of the command: (command,) or (command, kind|action).
 COMMANDS: dict[tuple[str, ...], Files] = {
     ("plan", "ballbar"): Files((MACHINE, arg("--compensate")), (OUTPUT, arg("--session"))),
+    ("plan", "probe"): Files((MACHINE,), (OUTPUT, arg("--session"))),
     ("machines", "list"): Files(),
     ("machines", "show"): Files((arg("NAME|FILE", "machine"),)),
     ("simulate", "ballbar"): Files((MACHINE,), (OUTPUT, arg("--truth"))),
@@ -104,6 +105,7 @@ COMMANDS: dict[tuple[str, ...], Files] = {
     ("virtual", "rtest"): Files((MACHINE,), (arg("--truth"),)),
     ("record", "ballbar"): Files((MACHINE, arg("--port")), (OUTPUT,)),
     ("record", "rtest"): Files((MACHINE, arg("--port")), (OUTPUT,)),
+    ("import", "probe"): Files((arg("LOG", "log"), arg("--plan")), (OUTPUT,)),
     ("report",): Files((arg("FILE", "file"),), (OUTPUT,), reads_store=lambda a: bool(a.history)),
     ("table2",): Files((arg("--table"),)),
     ("demo",): Files(),  # -o is a folder of its own files; the command reads none

@@ -1,5 +1,5 @@
 #pragma once
-// Internal to src/ballbar and src/circular: number formatting of NC words, each dialect's comment writer, and
+// Internal to src/ballbar, src/circular and src/probe: number formatting of NC words, each dialect's comment writer, and
 // the program preamble per dialect, shared by the NC writer of the rotary-axis test
 // (nc_program.cpp) and of the circular tests (src/circular/plan.cpp).
 

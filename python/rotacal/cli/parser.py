@@ -29,7 +29,7 @@ MODULES = (plan, machines, simulate, identify, history, diagnose, design, contro
 
 # The order `rotacal --help` lists the commands in.
 ORDER = ("plan", "machines", "simulate", "identify", "history", "diagnose", "predict", "design", "export",
-         "compensate", "virtual", "record", "report", "table2", "demo", "circular")
+         "compensate", "virtual", "record", "import", "report", "table2", "demo", "circular")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -52,7 +52,7 @@ def build_parser() -> argparse.ArgumentParser:
 # Options whose values may start with '-' ("--a-range -90,90"): argparse would take the value
 # for an option, so such pairs are joined as "--a-range=-90,90" before parsing.
 _SIGNED_VALUE_OPTIONS = {"--a-range", "--sphere", "--b-range", "--tilt-range", "--c-range", "--axial-c-tilt", "--pivot", "--errors", "--nest", "--probe-dir",
-                         "--comp-range", "--travel", "--pivot-z", "--centres-origin"}
+                         "--comp-range", "--travel", "--poses", "--pivot-z", "--centres-origin"}
 
 
 def _join_signed_values(argv: Sequence[str]) -> list[str]:

@@ -62,18 +62,23 @@ def cmd_simulate_probe(a: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def add_simulate_probe(kinds: argparse._SubParsersAction) -> None:
-    k = kinds.add_parser("probe", help="touches of a spindle probe on a calibration sphere (the controller cycles' "
-                                       "test; ../shared/spec/formats.md rotacal-probe/1)", epilog=EPILOG)
-    g = k.add_argument_group("set-up (the default poses and touch directions of the simulator)")
-    g.add_argument("--machine", default="AC-trt", type=path("--machine"), metavar="NAME|FILE",
-                   help="a built-in (`rotacal machines`) or a rotacal-machine/1 description file (default AC-trt)")
+def add_sphere_args(g) -> None:
+    """The artefact: nominal sphere centre, sphere and stylus diameters (simulate and plan probe)."""
     g.add_argument("--sphere", type=numbers("--sphere", 3, 1e4, "mm"), metavar="X,Y,Z",
                    help=f"nominal sphere centre, table frame, mm (default {','.join(f'{v:g}' for v in DEFAULT_SPHERE)})")
     g.add_argument("--sphere-diameter", type=number("--sphere-diameter", 1.0, 500.0, "mm"),
                    default=DEFAULT_SPHERE_DIAMETER, help="calibrated sphere diameter D, mm")
     g.add_argument("--stylus-diameter", type=number("--stylus-diameter", 0.1, 100.0, "mm"),
                    default=DEFAULT_STYLUS_DIAMETER, help="calibrated stylus ball diameter d, mm")
+
+
+def add_simulate_probe(kinds: argparse._SubParsersAction) -> None:
+    k = kinds.add_parser("probe", help="touches of a spindle probe on a calibration sphere (the controller cycles' "
+                                       "test; ../shared/spec/formats.md rotacal-probe/1)", epilog=EPILOG)
+    g = k.add_argument_group("set-up (the default poses and touch directions of the simulator)")
+    g.add_argument("--machine", default="AC-trt", type=path("--machine"), metavar="NAME|FILE",
+                   help="a built-in (`rotacal machines`) or a rotacal-machine/1 description file (default AC-trt)")
+    add_sphere_args(g)
     g = k.add_argument_group("simulated machine")
     g.add_argument("--errors", default="random",
                    help="location errors: random (seeded), table2 (Flynn et al.), zero, or NAME=VALUE,... (mm, rad)")
@@ -143,5 +148,82 @@ def identify_probe_session(a: argparse.Namespace, s: _core.ProbeSession, sizes: 
     return d
 
 
-COMMANDS: dict = {}
+# ------------------------------------------------------------------------- plan probe, import probe
+
+# `plan`'s ballbar set-up options: refused with `plan probe`, which has its own.
+_BALLBAR_ONLY = ("length", "pivot", "tilt_range", "axial_c_tilt", "step", "feed", "rotary_feed", "tests", "radial_c",
+                 "directions", "feed_factors", "compensate")
+
+
+def _poses(text: str | None) -> np.ndarray | None:
+    """--poses "TILT,ROT;TILT,ROT;..." (deg) -> (P, 2), or None for the default poses."""
+    if text is None:
+        return None
+    rows = [numbers("--poses", 2, 720.0, "deg")(item) for item in text.split(";") if item.strip()]
+    if not rows:
+        raise OptionError("--poses: no pose given (TILT,ROT;TILT,ROT;... deg)")
+    return np.asarray(rows, float)
+
+
+def _plan_template(a: argparse.Namespace, mtype, poses) -> _core.ProbeSession:
+    """The commanded rows of `plan probe` as a session template: the nominal machine's touches
+    (no errors, no noise), in the program's order."""
+    sphere = np.asarray(a.sphere if a.sphere is not None else DEFAULT_SPHERE, float)
+    session, _ = _core.simulate_probe(mtype, np.zeros(8), [], [], np.zeros(3), 0.0, 0.0, 1, poses, None, sphere,
+                                      a.sphere_diameter, a.stylus_diameter)
+    return session
+
+
+def cmd_plan_probe(a: argparse.Namespace) -> int:
+    from ..outputs import write_output
+    given = [f"--{d.replace('_', '-')}" for d in _BALLBAR_ONLY if getattr(a, d, None) not in (None, "", [])]
+    if given:
+        raise OptionError(f"plan probe: {', '.join(given)} belong to plan ballbar")
+    mtype = load_machine(a.machine) if a.machine else _core.MachineType.AC_trt
+    poses = _poses(a.poses)
+    sphere = np.asarray(a.sphere if a.sphere is not None else DEFAULT_SPHERE, float)
+    text = _core.write_probe_nc_program(mtype, a.dialect, poses, sphere, a.sphere_diameter, a.stylus_diameter,
+                                        a.log_file)
+    write_output(a.output, text, [], [a.session] if a.session else [])
+    template = _plan_template(a, mtype, poses)
+    say(f"wrote {a.output}: {a.dialect} probing program, {len(template)} touches at {len(template.pose_names)} poses, "
+        f"latched positions logged to {a.log_file} on the controller")
+    if a.session:
+        save(template, a.session, [], [a.output])
+        say(f"wrote {a.session}: the commanded touches as a session template (rotacal import probe --plan)")
+    return EXIT_OK
+
+
+def add_plan_probe_args(q: argparse.ArgumentParser) -> None:
+    g = q.add_argument_group("touch probe (plan probe; --machine and --dialect as above)")
+    add_sphere_args(g)
+    g.add_argument("--poses", metavar="T,R;T,R;...",
+                   help="tilt,rotary pairs, deg (default: the pattern of the controller cycles, rotacal simulate probe's)")
+    g.add_argument("--log-file", default="rotacal_probe.log",
+                   help="the file on the controller that (LOGOPEN,...) writes the latched positions to")
+
+
+def cmd_import_probe(a: argparse.Namespace) -> int:
+    from ..sessions import load
+    plan = load(a.plan, format="probe")
+    session = _core.read_linuxcnc_probe_log(a.log, plan)
+    save(session, a.output, [a.log, a.plan])
+    say(f"wrote {a.output}: {len(session)} touches at {len(session.pose_names)} poses from {a.log}")
+    return EXIT_OK
+
+
+def add_import(sub: argparse._SubParsersAction) -> argparse._SubParsersAction:
+    q = sub.add_parser("import", help="a session from what a controller logged", epilog=EPILOG)
+    kinds = q.add_subparsers(dest="kind", required=True)
+    k = kinds.add_parser("probe", help="the LinuxCNC log of `rotacal plan probe`'s program (lines: pose touch X Y Z)",
+                         epilog=EPILOG)
+    k.add_argument("log", metavar="LOG", type=path("LOG"))
+    k.add_argument("--plan", required=True, metavar="TEMPLATE.csv", type=path("--plan"),
+                   help="the session template `plan probe --session` wrote with the program")
+    k.add_argument("-o", "--output", required=True, type=path("--output"))
+    k.set_defaults(func=cmd_import_probe)
+    return kinds
+
+
+COMMANDS = {"import": add_import}
 KINDS = {"simulate": add_simulate_probe}
