@@ -106,6 +106,8 @@ def test_other_dialects_and_limits_are_refused(tmp_path):
     assert r.returncode == 3 and "travel" in r.stderr
     r = run("plan", "probe", "--length", "150", "-o", out)
     assert r.returncode == 3 and "--length" in r.stderr
+    r = run("plan", "ballbar", "--sphere", "1,2,3", "-o", out)
+    assert r.returncode == 3 and "--sphere belong to plan probe" in r.stderr
     assert not out.exists()
 
 

@@ -6,7 +6,7 @@ import argparse
 from ..outputs import write_output
 from ..sessions import save
 from .options import EPILOG, EXIT_OK, path, say
-from .probe import add_plan_probe_args
+from .probe import add_plan_probe_args, refuse_probe_options
 from .setups import add_setup_args, ballbar_model, ballbar_setup
 
 
@@ -15,6 +15,7 @@ def cmd_plan(a: argparse.Namespace) -> int:
         from .probe import cmd_plan_probe
         return cmd_plan_probe(a)
     from ..ballbar import nc_program
+    refuse_probe_options(a)
     plan, text = nc_program(ballbar_setup(a), a.dialect, ballbar_model(a.compensate), a.compensate)
     write_output(a.output, text, [a.compensate] if a.compensate else [], [a.session] if a.session else [])
     say(f"wrote {a.output}: {a.dialect} program, {plan.num_samples} points, {plan.duration:.0f} s"

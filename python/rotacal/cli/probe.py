@@ -19,6 +19,7 @@ DEFAULT_SPHERE = (150.0, 0.0, 80.0)
 DEFAULT_SPHERE_DIAMETER = 25.0
 DEFAULT_STYLUS_DIAMETER = 6.0
 DEFAULT_NOISE_UM = 0.5
+DEFAULT_LOG_FILE = "rotacal_probe.log"
 
 # What a touch-probe identification cannot do yet, refused before the fit.
 NO_MODEL_FILE = ("--save-model/--store: the model file (rotacal-model/1, docs/model_file.md) holds kinds "
@@ -199,8 +200,18 @@ def add_plan_probe_args(q: argparse.ArgumentParser) -> None:
     add_sphere_args(g)
     g.add_argument("--poses", metavar="T,R;T,R;...",
                    help="tilt,rotary pairs, deg (default: the pattern of the controller cycles, rotacal simulate probe's)")
-    g.add_argument("--log-file", default="rotacal_probe.log",
+    g.add_argument("--log-file", default=DEFAULT_LOG_FILE,
                    help="the file on the controller that (LOGOPEN,...) writes the latched positions to")
+
+
+def refuse_probe_options(a: argparse.Namespace) -> None:
+    """`plan ballbar` with an option of `plan probe`: refused, not ignored."""
+    given = [o for o, v in (("--sphere", a.sphere), ("--poses", a.poses)) if v is not None]
+    given += [o for o, v, d in (("--sphere-diameter", a.sphere_diameter, DEFAULT_SPHERE_DIAMETER),
+                                ("--stylus-diameter", a.stylus_diameter, DEFAULT_STYLUS_DIAMETER),
+                                ("--log-file", a.log_file, DEFAULT_LOG_FILE)) if v != d]
+    if given:
+        raise OptionError(f"plan ballbar: {', '.join(given)} belong to plan probe")
 
 
 def cmd_import_probe(a: argparse.Namespace) -> int:
