@@ -30,13 +30,13 @@ Eigen::VectorXd cramer_rao(const ProbeSession& s, const MachineModel& t, const E
   const ProbeProblem problem(s);
   const ProbeParameterLayout& L = problem.layout();
   Eigen::VectorXd x = Eigen::VectorXd::Zero(L.size());
-  x.segment(L.errors.offset, L.errors.size) = t.errors.v;
-  x.segment<3>(L.sphere.offset) = sphere;
+  L.errors.of<8>(x) = t.errors.v;
+  L.sphere.of<3>(x) = sphere;
   Eigen::VectorXd r(problem.num_residuals());
   Eigen::MatrixXd J(problem.num_residuals(), problem.num_parameters());
   problem.evaluate(x, r, &J);
   const Eigen::MatrixXd C = (J.transpose() * J).inverse() * sigma_mm * sigma_mm;
-  return C.diagonal().segment(L.errors.offset, L.errors.size).cwiseSqrt();
+  return L.errors.of(C.diagonal()).cwiseSqrt();
 }
 }  // namespace
 

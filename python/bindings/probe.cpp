@@ -1,5 +1,6 @@
 // Bindings for the touch probe (include/rotacal/probe, io/probe_file.hpp): session, reader and
-// writer, simulation, the joint fit and the cycles' method. Thin: numpy in and out.
+// writer, simulation, the joint fit and the cycles' method, the probing program and its log.
+// Thin: numpy in and out.
 #include <pybind11/stl.h>
 
 #include <optional>
@@ -9,6 +10,7 @@
 #include "rotacal/diagnose/uncertainty_budget.hpp"
 #include "rotacal/io/probe_file.hpp"
 #include "rotacal/probe/identify.hpp"
+#include "rotacal/probe/nc_program.hpp"
 #include "rotacal/probe/simulate.hpp"
 #include "rotacal/probe/touch_model.hpp"
 
@@ -139,6 +141,29 @@ void bind_probe(pyb::module_& m) {
       pyb::arg("session"), pyb::arg("diagnosis"), pyb::arg("sizes") = PlausibleSizes{}, pyb::arg("coverage") = 0.95,
       "GUM budget of the location errors of diagnose_probe's result (the probe's entries: stylus calibration, "
       "lobing).");
+  m.def(
+      "write_probe_nc_program",
+      [](MachineType machine, const std::string& dialect, std::optional<Array> poses_deg, const Array& sphere,
+         double sphere_diameter, double stylus_diameter, const std::string& log_file, int tool, int decimals) {
+        ProbePattern p = default_probe_pattern(machine);
+        if (poses_deg) p.poses_deg = angles_of(*poses_deg);
+        p.sphere = vec_of<3>(sphere, "sphere");
+        p.sphere_diameter = sphere_diameter;
+        p.stylus_diameter = stylus_diameter;
+        ProbeProgramOptions o;
+        o.log_file = log_file;
+        o.tool = tool;
+        o.decimals = decimals;
+        return write_probe_nc_program(machine, p, parse_nc_dialect(dialect), o);
+      },
+      pyb::arg("machine"), pyb::arg("dialect"), pyb::arg("poses_deg") = pyb::none(),
+      pyb::arg("sphere") = Eigen::Vector3d(150.0, 0.0, 80.0).eval(), pyb::arg("sphere_diameter") = 25.0,
+      pyb::arg("stylus_diameter") = 6.0, pyb::arg("log_file") = ProbeProgramOptions().log_file,
+      pyb::arg("tool") = 1, pyb::arg("decimals") = 4,
+      "The probing program of the default pattern's directions at `poses_deg` (default: its poses) "
+      "(probe/nc_program.hpp); linuxcnc only.");
+  m.def("read_linuxcnc_probe_log", &read_linuxcnc_probe_log, pyb::arg("path"), pyb::arg("plan"),
+        "The session of a LinuxCNC probing log: its latched X Y Z in the plan's rows (probe/nc_program.hpp).");
   m.def(
       "default_probe_poses_deg",
       [](MachineType machine) {

@@ -81,10 +81,12 @@ def _always(a: argparse.Namespace) -> bool:
 # Keyed by the words of the command: (command,) or (command, kind|action).
 COMMANDS: dict[tuple[str, ...], Files] = {
     ("plan", "ballbar"): Files((MACHINE, arg("--compensate")), (OUTPUT, arg("--session"))),
+    ("plan", "probe"): Files((MACHINE,), (OUTPUT, arg("--session"))),
     ("machines", "list"): Files(),
     ("machines", "show"): Files((arg("NAME|FILE", "machine"),)),
     ("simulate", "ballbar"): Files((MACHINE,), (OUTPUT, arg("--truth"))),
     ("simulate", "rtest"): Files((MACHINE,), (OUTPUT, Slot("--truth", lambda a: [rtest_truth_path(a)]))),
+    ("simulate", "probe"): Files((MACHINE,), (OUTPUT, arg("--truth"))),
     ("identify",): Files((arg("FILE", "file"), arg("--budget-sizes"), arg("--controller")),
                          (arg("--save-model"),), writes_store=lambda a: bool(a.store)),
     ("history", "add"): Files((arg("MODEL", "model"), arg("--correction"), arg("--diagnosis"), arg("--controller")),
@@ -103,6 +105,7 @@ COMMANDS: dict[tuple[str, ...], Files] = {
     ("virtual", "rtest"): Files((MACHINE,), (arg("--truth"),)),
     ("record", "ballbar"): Files((MACHINE, arg("--port")), (OUTPUT,)),
     ("record", "rtest"): Files((MACHINE, arg("--port")), (OUTPUT,)),
+    ("import", "probe"): Files((arg("LOG", "log"), arg("--plan")), (OUTPUT,)),
     ("report",): Files((arg("FILE", "file"),), (OUTPUT,), reads_store=lambda a: bool(a.history)),
     ("table2",): Files((arg("--table"),)),
     ("demo",): Files(),  # -o is a folder of its own files; the command reads none

@@ -1,7 +1,8 @@
 #pragma once
-// Internal to src/ballbar and src/circular: number formatting of NC words, each dialect's comment writer, and
-// the program preamble per dialect, shared by the NC writer of the rotary-axis test
-// (nc_program.cpp) and of the circular tests (src/circular/plan.cpp).
+// Internal to src/ballbar, src/circular and src/probe: number formatting of NC words, each
+// dialect's comment writer, and the program preamble per dialect, shared by the NC writer of the
+// rotary-axis test (nc_program.cpp), of the circular tests (src/circular/plan.cpp) and of the
+// touch probe (src/probe/nc_program.cpp).
 
 #include <cstdio>
 #include <functional>

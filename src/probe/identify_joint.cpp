@@ -32,11 +32,11 @@ ProbeIdentification identify_probe(const ProbeSession& session, const ProbeFitOp
   ProbeIdentification out;
   out.method = "joint";
   out.model.machine = session.machine;
-  out.model.errors = LocationErrors<double>(fit.values.segment(L.errors.offset, L.errors.size));
+  out.model.errors = LocationErrors<double>(L.errors.of<8>(fit.values));
   out.model.effects = problem.effects();
-  out.model.effect_params.assign(fit.values.data() + L.effects.offset,
-                                 fit.values.data() + L.effects.offset + L.effects.size);
-  out.sphere = fit.values.segment<3>(L.sphere.offset);
+  const auto fx = L.effects.of(fit.values);
+  out.model.effect_params.assign(fx.data(), fx.data() + fx.size());
+  out.sphere = L.sphere.of<3>(fit.values);
   out.converged = fit.summary.converged;
   out.iterations = fit.summary.iterations;
   out.n_samples = session.samples.size();

@@ -12,10 +12,12 @@ std::vector<Effect> probe_effect_catalogue(MachineType m, int max_harmonic) {
 
 ProbeParameterLayout ProbeParameterLayout::make(MachineType m, const EffectModel& fx) {
   ProbeParameterLayout L;
-  L.errors = {0, LocationErrors<double>::kSize};
-  L.tool_length = {L.errors.offset + L.errors.size, m.has_head() ? 1 : 0};
-  L.sphere = {L.tool_length.offset + L.tool_length.size, 3};
-  L.effects = {L.sphere.offset + L.sphere.size, fx.num_params()};
+  L.errors = add_location_errors(L.all, m);
+  L.tool_length = L.all.add("tool_length", m.has_head() ? std::vector<std::string>{"tool_offset_Z"}
+                                                        : std::vector<std::string>{},
+                            {"mm"});
+  L.sphere = L.all.add("sphere", {"sphere.x", "sphere.y", "sphere.z"}, {"mm"});
+  L.effects = add_effects(L.all, fx);
   return L;
 }
 
@@ -50,16 +52,13 @@ ProbeProblem::ProbeProblem(const ProbeSession& session, const EffectModel& effec
 
 std::vector<FitParameter> ProbeProblem::parameters() const {
   std::vector<FitParameter> out;
-  const auto& names = location_error_names(machine_);
-  for (int k = 0; k < layout_.errors.size; ++k)
-    out.push_back({names[static_cast<std::size_t>(k)], location_error_is_angle(k) ? "rad" : "mm", 0.0});
-  if (layout_.tool_length.size) out.push_back({"tool_offset_Z", "mm", 0.0});
-  const char* axes[3] = {"x", "y", "z"};
-  for (int k = 0; k < 3; ++k) out.push_back({std::string("sphere.") + axes[k], "mm", sphere_nominal_[k]});
-  for (const Effect& f : fx_.effects) {
-    const auto pn = f.param_names(), pu = f.param_units();
-    for (std::size_t k = 0; k < pn.size(); ++k)
-      out.push_back({f.id() + (pn.size() > 1 ? "." + pn[k] : ""), pu[k], 0.0, 0.0, false, true});
+  const std::vector<std::string> names = layout_.all.names(), units = layout_.all.units();
+  for (Eigen::Index j = 0; j < layout_.size(); ++j) {
+    const std::size_t k = static_cast<std::size_t>(j);
+    FitParameter p{names[k], units[k], 0.0};
+    if (layout_.sphere.contains(j)) p.start = sphere_nominal_[j - layout_.sphere.offset];
+    if (layout_.effects.contains(j)) p.yields = true;  // catalogue effects yield to the baseline
+    out.push_back(p);
   }
   return out;
 }
@@ -68,10 +67,10 @@ void ProbeProblem::evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd
   const ProbeParameterLayout& L = layout_;
   const auto one = [&](Eigen::Index i, const auto* p, auto* out) {
     using T = std::remove_const_t<std::remove_pointer_t<decltype(p)>>;
-    const LocationErrors<T> e = LocationErrors<T>::from_ptr(ProbeParameterLayout::at(L.errors, p));
-    const T* q = ProbeParameterLayout::at(L.sphere, p);
-    const T tool = L.tool_length.size ? T(-ProbeParameterLayout::at(L.tool_length, p)[0]) : T(0);
-    out[0] = touch_residual<T>(machine_, e, fx_, ProbeParameterLayout::at(L.effects, p), Vec3<T>(q[0], q[1], q[2]),
+    const LocationErrors<T> e = LocationErrors<T>::from_ptr(L.errors.ptr(p));
+    const T* q = L.sphere.ptr(p);
+    const T tool = L.tool_length.empty() ? T(0) : T(-L.tool_length.ptr(p)[0]);
+    out[0] = touch_residual<T>(machine_, e, fx_, L.effects.ptr(p), Vec3<T>(q[0], q[1], q[2]),
                                touches_[static_cast<std::size_t>(i)], radius_, tool);
   };
   evaluate_with_jets(one, num_residuals(), 1, x, r, J);

@@ -6,6 +6,7 @@ import argparse
 import json
 import re
 
+import numpy as np
 import pytest
 
 import rotacal
@@ -21,9 +22,12 @@ SLOT = re.compile(r"\{([^{}]+)\}")
 TEMPLATES = {
     ("plan", "ballbar"): [["plan", "ballbar", "--machine", "{--machine}", "--compensate", "{--compensate}",
                            "--session", "{--session}", "-o", "{-o}"]],
+    ("plan", "probe"): [["plan", "probe", "--machine", "{--machine}", "--session", "{--session}", "-o", "{-o}"]],
+    ("import", "probe"): [["import", "probe", "{LOG}", "--plan", "{--plan}", "-o", "{-o}"]],
     ("simulate", "ballbar"): [["simulate", "ballbar", "--machine", "{--machine}", "--truth", "{--truth}",
                                "-o", "{-o}"]],
     ("simulate", "rtest"): [["simulate", "rtest", "--machine", "{--machine}", "--truth", "{--truth}", "-o", "{-o}"]],
+    ("simulate", "probe"): [["simulate", "probe", "--machine", "{--machine}", "--truth", "{--truth}", "-o", "{-o}"]],
     ("identify",): [["identify", "{FILE}", "--budget-sizes", "{--budget-sizes}", "--controller", "{--controller}",
                      "--save-model", "{--save-model}", "--store", "--machine-id", "M1", "--db", "{--db}"]],
     ("history", "add"): [["history", "add", "{MODEL}", "--diagnosis", "{--diagnosis}", "--controller", "{--controller}",
@@ -109,9 +113,16 @@ def sources(shared_data, tmp_path_factory):
     diag.write_text(json.dumps({"findings": []}))
     port = d / "port"
     port.write_text("not a device\n")
+    probe_plan = d / "probe_plan.csv"  # a touch-probe session as `import probe --plan` template, and its log
+    probe_plan.write_bytes((shared_data / "probe_ac_table2.csv").read_bytes())
+    probe = rotacal.load(probe_plan)
+    probe_log = d / "probe.log"
+    probe_log.write_text("".join(f"{k // 5 + 1} {k % 5 + 1} {x:f} {y:f} {z:f}\n"
+                                 for k, (x, y, z) in enumerate(np.asarray(probe.xyz))))
     return {"FILE": session, "SESSION": session, "--after": session, "--centres": rsession, "--model": model,
             "--compensate": model, "MODEL": model, "--machine": machine, "--db": store, "--controller": hal,
-            "--current": hal, "--budget-sizes": empty, "--correction": empty, "--diagnosis": diag, "--port": port}
+            "--current": hal, "--budget-sizes": empty, "--correction": empty, "--diagnosis": diag, "--port": port,
+            "LOG": probe_log, "--plan": probe_plan}
 
 
 def _argv(template, paths):

@@ -4,43 +4,37 @@
 /// (probe/touch_model.hpp), used by the identification, the Monte Carlo bench and the
 /// diagnosis alike.
 ///
-/// Parameters in named blocks (ProbeParameterLayout): the 8 location errors, on a machine with
-/// head axes tool_offset_Z (minus the error of pivot_length + tool_length, as the R-test fit
-/// has it), the actual sphere centre q_sphere (table frame, mm: a set-up error, identified like
-/// the ballbar's pivot), and the parameters of any catalogue effects fitted along. The
-/// calibrated radius (D + d)/2 is taken as given, as the controller cycles take it; a wrong one
-/// is the diagnosis' stylus_radius_offset.
-///
-/// ProbeParameterLayout is local to the probe until core/parameter_layout.hpp (issue 30,
-/// item 1) is on main: each block is an offset and a size, and no code here indexes the
-/// parameter vector otherwise.
+/// Parameters in named blocks (core/parameter_layout.hpp), in vector order:
+///   location_errors  8, location_error_names(machine) order (mm, rad)
+///   tool_length      tool_offset_Z on a machine with head axes (minus the error of
+///                    pivot_length + tool_length, as the R-test fit has it), mm; absent without
+///   sphere           the actual sphere centre (table frame, mm: a set-up error, identified like
+///                    the ballbar's pivot), sphere.x, sphere.y, sphere.z
+///   effects          the parameters of any catalogue effects fitted along (kinematics/effects.hpp)
+/// The calibrated radius (D + d)/2 is taken as given, as the controller cycles take it; a wrong
+/// one is the diagnosis' stylus_radius_offset. No code here indexes the vector otherwise.
 
 #include <string>
 #include <vector>
 
 #include "rotacal/core/joint_fit.hpp"
 #include "rotacal/io/probe_session.hpp"
+#include "rotacal/kinematics/parameter_blocks.hpp"
 #include "rotacal/probe/touch_model.hpp"
 
 namespace rotacal {
 
-/// Named blocks of the probe problem's parameter vector.
+/// The blocks of a probe parameter vector.
 struct ProbeParameterLayout {
-  struct Block {
-    int offset = 0;
-    int size = 0;
-  };
-  Block errors;       ///< location errors, location_error_names(machine) order (mm, rad)
-  Block tool_length;  ///< tool_offset_Z on a machine with head axes (size 0 without), mm
-  Block sphere;       ///< actual sphere centre, table frame, mm
-  Block effects;      ///< EffectModel parameters, its layout
+  ParameterLayout all;
+  ParameterBlock errors;       ///< "location_errors"
+  ParameterBlock tool_length;  ///< "tool_length": tool_offset_Z with head axes (size 0 without)
+  ParameterBlock sphere;       ///< "sphere": actual sphere centre, table frame, mm
+  ParameterBlock effects;      ///< "effects"
 
   /// The blocks in this order for machine m and effects fx.
   static ProbeParameterLayout make(MachineType m, const EffectModel& fx);
-  int size() const { return effects.offset + effects.size; }
-  /// Pointer to a block's first value within a parameter vector x.
-  template <typename T>
-  static const T* at(const Block& b, const T* x) { return x + b.offset; }
+  Eigen::Index size() const { return all.size(); }
 };
 
 /// The probe problem of one session with a set of effects: the residual of every touch
@@ -63,7 +57,7 @@ class ProbeProblem : public ResidualModel {
   Eigen::VectorXd residuals(const Eigen::VectorXd& x) const;
 
   Eigen::Index num_residuals() const override { return static_cast<Eigen::Index>(touches_.size()); }
-  int num_parameters() const override { return layout_.size(); }
+  int num_parameters() const override { return static_cast<int>(layout_.size()); }
   void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r, Eigen::MatrixXd* J) const override;
 
   /// Noise streams of the residuals: one group (the session), touches in time order.

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from .. import _core, jsontext, units
-from ..sessions import BALLBAR, RTEST, by_kind, kind, save
+from ..sessions import BALLBAR, PROBE, RTEST, by_kind, kind, save
 from .options import (EPILOG, EXIT_OK, SEED, OptionError, budget_sizes, controller_text, number, path, say)
 from .setups import add_db_arg, add_plausibility_arg, load_session
 
@@ -106,6 +106,18 @@ def cmd_identify(a: argparse.Namespace) -> int:
     _refuse_history_options(a)
     sizes = budget_sizes(a.budget_sizes)  # refused before any work
     s = load_session(a.file, a)
+    if kind(s) == PROBE:  # the touch probe's options and fit: cli/probe.py
+        from .probe import identify_probe_session, print_probe_identification
+        d = identify_probe_session(a, s, sizes)
+        if a.json:
+            print(jsontext.dumps(d))
+        else:
+            print_probe_identification(d)
+            if "noise_model" in d:
+                print_noise_model(d["noise_model"])
+            if d.get("uncertainty_budget"):
+                print_budget(d["uncertainty_budget"])
+        return EXIT_OK
     if a.length_offset and kind(s) == RTEST:
         raise _core.InvalidArgument("identify: --length-offset is for ballbar sessions")
     result = identify(s, a.method, fit_length_offset=a.length_offset, noise=a.noise)
@@ -151,7 +163,9 @@ def cmd_predict(a: argparse.Namespace) -> int:
 def add_identify(sub: argparse._SubParsersAction) -> None:
     q = sub.add_parser("identify", help="identify location errors from a session", epilog=EPILOG)
     q.add_argument("file", type=path("FILE"))
-    q.add_argument("--method", default="joint", choices=["joint", "paper"])
+    q.add_argument("--method", default="joint", choices=["joint", "paper", "cycles", "cycles-free-radius"],
+                   help="joint (default); paper (ballbar, R-test); cycles, cycles-free-radius (touch probe: the "
+                        "controller cycles' method, radius known or fitted per pose)")
     q.add_argument("--length-offset", action="store_true", help="also fit an offset of L0 (joint)")
     q.add_argument("--json", action="store_true", help="print the result as JSON")
     q.add_argument("--save-model", metavar="MODEL.json", type=path("--save-model"),

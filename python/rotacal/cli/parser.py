@@ -20,14 +20,16 @@ from typing import Sequence
 
 from .. import _core
 from ..command_files import check_command_files
-from . import circular, controller, demo, design, diagnose, history, identify, instruments, machines, plan, simulate
+from . import (circular, controller, demo, design, diagnose, history, identify, instruments, machines, plan, probe,
+               simulate)
 from .options import EPILOG, EXIT_ERROR, EXIT_INPUT, EXIT_IO, EXIT_OK, OptionError, say
 
-MODULES = (plan, machines, simulate, identify, history, diagnose, design, controller, instruments, demo, circular)
+MODULES = (plan, machines, simulate, identify, history, diagnose, design, controller, instruments, demo, circular,
+           probe)
 
 # The order `rotacal --help` lists the commands in.
 ORDER = ("plan", "machines", "simulate", "identify", "history", "diagnose", "predict", "design", "export",
-         "compensate", "virtual", "record", "report", "table2", "demo", "circular")
+         "compensate", "virtual", "record", "import", "report", "table2", "demo", "circular")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -49,8 +51,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 # Options whose values may start with '-' ("--a-range -90,90"): argparse would take the value
 # for an option, so such pairs are joined as "--a-range=-90,90" before parsing.
-_SIGNED_VALUE_OPTIONS = {"--a-range", "--b-range", "--tilt-range", "--c-range", "--axial-c-tilt", "--pivot", "--errors", "--nest", "--probe-dir",
-                         "--comp-range", "--travel", "--pivot-z", "--centres-origin"}
+_SIGNED_VALUE_OPTIONS = {"--a-range", "--sphere", "--b-range", "--tilt-range", "--c-range", "--axial-c-tilt", "--pivot", "--errors", "--nest", "--probe-dir",
+                         "--comp-range", "--travel", "--poses", "--pivot-z", "--centres-origin"}
 
 
 def _join_signed_values(argv: Sequence[str]) -> list[str]:

@@ -6,11 +6,16 @@ import argparse
 from ..outputs import write_output
 from ..sessions import save
 from .options import EPILOG, EXIT_OK, path, say
+from .probe import add_plan_probe_args, refuse_probe_options
 from .setups import add_setup_args, ballbar_model, ballbar_setup
 
 
 def cmd_plan(a: argparse.Namespace) -> int:
+    if a.kind == "probe":  # the touch probe's program: cli/probe.py
+        from .probe import cmd_plan_probe
+        return cmd_plan_probe(a)
     from ..ballbar import nc_program
+    refuse_probe_options(a)
     plan, text = nc_program(ballbar_setup(a), a.dialect, ballbar_model(a.compensate), a.compensate)
     write_output(a.output, text, [a.compensate] if a.compensate else [], [a.session] if a.session else [])
     say(f"wrote {a.output}: {a.dialect} program, {plan.num_samples} points, {plan.duration:.0f} s"
@@ -23,8 +28,9 @@ def cmd_plan(a: argparse.Namespace) -> int:
 
 def add_plan(sub: argparse._SubParsersAction) -> None:
     q = sub.add_parser("plan", help="plan a test and write its NC program", epilog=EPILOG)
-    q.add_argument("kind", choices=["ballbar"])
+    q.add_argument("kind", choices=["ballbar", "probe"])
     add_setup_args(q)
+    add_plan_probe_args(q)
     q.add_argument("--dialect", default="linuxcnc", help="linuxcnc (machine axes), heidenhain, siemens, fanuc")
     q.add_argument("--compensate", metavar="MODEL.json", type=path("--compensate"), help="emit the program compensated for a fitted model")
     q.add_argument("--session", metavar="CSV", type=path("--session"),

@@ -9,7 +9,7 @@ from typing import Any, Sequence
 from .. import _core, jsontext, rtest
 from ..machines import BALLBAR_NOISE_UM, PIVOT_ERROR_MM
 from ..outputs import write_output
-from ..sessions import check_plausible, load
+from ..sessions import PROBE, check_plausible, kind, load
 from .options import (SEED, OptionError, effects_option, errors_option, float_list_item, number, numbers, path,
                       say)
 
@@ -213,7 +213,7 @@ def load_session(path: str, a: argparse.Namespace | None = None, circular_tests:
                 f"{path}: holds ISO 230-4 circular tests of the linear axes ({', '.join(sorted(set(s.tests))[:3])}"
                 f"{', ...' if len(set(s.tests)) > 3 else ''}), not a rotary-axis test: `rotacal circular analyze "
                 f"{path}` gives G, G(b), H and their causes, `rotacal report {path} -o OUT.html` the report")
-        if not is_circular(s):
+        if not is_circular(s) and kind(s) != PROBE:  # io/plausibility has no touch-probe check yet
             check_plausible(s, path, getattr(a, "max_deviation", None))
     return s
 
