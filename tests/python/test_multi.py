@@ -3,6 +3,8 @@ sessions made by the independent reference simulator (tests/reference/refsim, AR
 machine with several location errors) -- ballbar + probe, and ballbar + R-test -- are identified
 jointly by rotacal.identify([...]) within 3 sigma of the truth, each session with its own
 nuisances; sessions of two machine types are refused by name. The truth comes from refsim."""
+import json
+import subprocess
 import sys
 from pathlib import Path
 
@@ -93,3 +95,25 @@ def test_sessions_of_two_machine_types_are_refused(tmp_path):
     b = rotacal.load(probe_file(tmp_path, "BC-trt", truth_errors("BC-trt"), 2))
     with pytest.raises(rotacal.InvalidArgument, match="session 2"):
         rotacal.identify([a, b])
+
+
+def run_cli(*args, cwd):
+    return subprocess.run([sys.executable, "-m", "rotacal", *map(str, args)], capture_output=True, text=True, cwd=cwd)
+
+
+def test_cli_joint_identification_reports_a_planted_disagreement(tmp_path):
+    errors = truth_errors(MACHINE)
+    moved = dict(errors, E_X0C=errors["E_X0C"] + 0.030)  # the probe's machine, 30 um off in one error
+    bb, pr = ballbar_file(tmp_path, MACHINE, errors, 7), probe_file(tmp_path, MACHINE, moved, 8)
+    r = run_cli("identify", bb, pr, "--json", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout)
+    assert [s["name"] for s in d["sessions"]] == [str(bb), str(pr)]
+    found = [g for g in d["disagreements"] if g["parameter"] == "E_X0C"]
+    assert found and found[0]["sessions"] == [str(bb), str(pr)], d["disagreements"]
+    assert abs(found[0]["difference"] + 0.030) <= 3 * found[0]["sigma"]
+    assert abs(found[0]["z"]) > 3
+    text = run_cli("identify", bb, pr, cwd=tmp_path)
+    assert text.returncode == 0 and "DISAGREE E_X0C" in text.stdout, text.stdout + text.stderr
+    refused = run_cli("identify", bb, pr, "--save-model", tmp_path / "m.json", cwd=tmp_path)
+    assert refused.returncode != 0 and "--save-model" in refused.stderr
