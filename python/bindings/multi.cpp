@@ -34,6 +34,7 @@ void bind_multi(pyb::module_& m) {
   pyb::class_<MultiIdentification>(m, "MultiIdentification")
       .def_readonly("machine", &MultiIdentification::machine)
       .def_readonly("location_errors", &MultiIdentification::location_errors)
+      .def_readonly("effects", &MultiIdentification::effects)
       .def_readonly("sessions", &MultiIdentification::sessions)
       .def_readonly("disagreements", &MultiIdentification::disagreements)
       .def_readonly("parameter_names", &MultiIdentification::parameter_names)
@@ -45,7 +46,8 @@ void bind_multi(pyb::module_& m) {
 
   m.def(
       "identify_multi",
-      [](const std::vector<std::pair<std::string, pyb::object>>& sessions, const std::string& noise) {
+      [](const std::vector<std::pair<std::string, pyb::object>>& sessions, const std::string& noise,
+         const std::vector<std::string>& effects) {
         std::vector<MultiSessionInput> in;
         for (const auto& [name, s] : sessions) {
           if (pyb::isinstance<BallbarSession>(s)) in.push_back(MultiSessionInput::of(name, s.cast<BallbarSession>()));
@@ -55,12 +57,14 @@ void bind_multi(pyb::module_& m) {
         }
         MultiFitOptions o;
         o.noise = noise_handling_from_string(noise);
+        o.effects = effects_of(effects);
         pyb::gil_scoped_release release;
         return identify_multi(in, o);
       },
-      pyb::arg("sessions"), pyb::arg("noise") = "auto",
+      pyb::arg("sessions"), pyb::arg("noise") = "auto", pyb::arg("effects") = std::vector<std::string>{},
       "One identification from several (name, session) pairs of one machine (multi/identify.hpp): "
-      "one set of location errors, each session's own nuisances and noise model, and the "
+      "one set of location errors (and of the catalogue effects `effects`), each session's own "
+      "nuisances and noise model, and the "
       "disagreements between the sessions fitted alone; noise 'auto' or 'white'.");
 }
 

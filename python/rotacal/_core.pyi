@@ -1700,6 +1700,9 @@ class MultiIdentification:
     def disagreements(self) -> list[MultiDisagreement]:
         ...
     @property
+    def effects(self) -> list[ParameterEstimate]:
+        ...
+    @property
     def location_errors(self) -> list[ParameterEstimate]:
         ...
     @property
@@ -3632,9 +3635,9 @@ def identify_joint_sessions(sessions: collections.abc.Sequence[BallbarSession], 
     """
     Joint fit of several ballbar sessions (shared location errors and effects, one pivot each): (values, covariance, converged) in the order 8 location errors, pivots, effect parameters.
     """
-def identify_multi(sessions: collections.abc.Sequence[tuple[str, typing.Any]], noise: str = 'auto') -> MultiIdentification:
+def identify_multi(sessions: collections.abc.Sequence[tuple[str, typing.Any]], noise: str = 'auto', effects: collections.abc.Sequence[str] = []) -> MultiIdentification:
     """
-    One identification from several (name, session) pairs of one machine (multi/identify.hpp): one set of location errors, each session's own nuisances and noise model, and the disagreements between the sessions fitted alone; noise 'auto' or 'white'.
+    One identification from several (name, session) pairs of one machine (multi/identify.hpp): one set of location errors (and of the catalogue effects `effects`), each session's own nuisances and noise model, and the disagreements between the sessions fitted alone; noise 'auto' or 'white'.
     """
 def identify_paper(session: BallbarSession) -> BallbarIdentification:
     """

@@ -25,11 +25,11 @@ def identify(session: Any, method: str = "joint", *, fit_length_offset: bool = F
     ``method`` "joint", "cycles" or "cycles-free-radius", ``effects``). ``noise``: "auto" (AR noise
     model of the residuals, GLS refit when correlated) or "white".
     A list of sessions of one machine is identified jointly (rotacal.multi.identify_sessions:
-    ``noise`` only)."""
+    ``effects`` shared by every session, ``noise``)."""
     if isinstance(session, (list, tuple)):
-        if method != "joint" or fit_length_offset or effects or tests:
-            raise _core.InvalidArgument("identify: a list of sessions takes only `noise`")
-        return multi.identify_sessions(session, noise=noise)
+        if method != "joint" or fit_length_offset or tests:
+            raise _core.InvalidArgument("identify: a list of sessions takes only `effects` and `noise`")
+        return multi.identify_sessions(session, noise=noise, effects=effects)
 
     def rtest_identify():
         if fit_length_offset or effects or tests:

@@ -1,5 +1,5 @@
 """One identification from several sessions of one machine (ballbar, R-test, touch probe):
-one set of location errors, each session's own nuisances and noise model, and the parameters on
+one set of location errors (and of catalogue effects where asked), each session's own nuisances and noise model, and the parameters on
 which the sessions fitted alone disagree. C++ computes (include/rotacal/multi); this module only
 composes."""
 from __future__ import annotations
@@ -35,6 +35,7 @@ class MultiIdentification:
             "method": "joint-multi",
             **machine_members(r.machine),
             "location_errors": {p.name: estimate_dict(p) for p in r.location_errors},
+            "effects": {p.name: estimate_dict(p) for p in r.effects},
             "sessions": [{
                 "name": s.name,
                 "instrument": s.instrument,
@@ -56,13 +57,14 @@ class MultiIdentification:
 
 
 def identify_sessions(sessions: Sequence[Any], names: Sequence[str] | None = None, *,
-                      noise: str = "auto") -> MultiIdentification:
+                      noise: str = "auto", effects: Sequence[str] = ()) -> MultiIdentification:
     """Identify several sessions of one machine jointly (rotacal.identify with a list).
-    ``names`` name the sessions in the result (default "session 1", ...); an R-test session's
-    raw d1,d2,d3 readings are converted as identify_rtest converts them."""
+    ``names`` name the sessions in the result (default "session 1", ...); ``effects``: catalogue
+    ids of the machine fitted along, one set shared by every session (about the machine zero);
+    an R-test session's raw d1,d2,d3 readings are converted as identify_rtest converts them."""
     sessions = list(sessions)
     names = [f"session {k + 1}" for k in range(len(sessions))] if names is None else list(names)
     if len(names) != len(sessions):
         raise _core.InvalidArgument(f"identify: {len(names)} names for {len(sessions)} sessions")
     ready = [rtest.with_displacements(s)[0] if kind(s) == RTEST else s for s in sessions]
-    return MultiIdentification(_core.identify_multi(list(zip(names, ready)), noise))
+    return MultiIdentification(_core.identify_multi(list(zip(names, ready)), noise, list(effects)))

@@ -1,6 +1,7 @@
 // One identification from several sessions of one machine (multi/identify.hpp).
 #include "rotacal/multi/identify.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -51,26 +52,34 @@ const ParameterEstimate& MultiIdentification::location_error(const std::string& 
 
 namespace {
 
-// The sessions' residual models stacked row-wise over one parameter vector: ONE
-// "location_errors" block, then each session's other parameters as a block named after it.
-// Each session's own model computes its rows and Jacobian; its location-error columns land on
-// the shared block, its other columns on its own.
+// The sessions' residual models stacked row-wise over one parameter vector: the shared blocks
+// "location_errors" and "effects" (the catalogue effects fitted for the machine, empty unless
+// asked), then each session's own parameters as a block named after it. Each session's own
+// model computes its rows and Jacobian; its shared columns land on the shared blocks, its other
+// columns on its own.
 class StackedModel : public ResidualModel {
  public:
-  StackedModel(const std::vector<SessionPart>& parts, MachineType m) : parts_(parts) {
+  StackedModel(const std::vector<SessionPart>& parts, MachineType m, const EffectModel& fx) : parts_(parts) {
     const auto& arr = location_error_names(m);
-    const std::vector<std::string> names(arr.begin(), arr.end());
-    std::vector<std::string> err_units;
-    for (std::size_t j = 0; j < names.size(); ++j)
-      err_units.push_back(parts.front().parameters[static_cast<std::size_t>(parts.front().errors_offset) + j].unit);
-    errors_ = layout_.add("location_errors", names, err_units);
+    std::vector<std::string> names(arr.begin(), arr.end()), units(names.size());
+    for (const Effect& f : fx.effects)
+      for (std::size_t k = 0; k < static_cast<std::size_t>(f.num_params()); ++k) {
+        names.push_back(effect_parameter_name(f, k));
+        units.push_back(f.param_units()[k]);
+      }
+    for (std::size_t j = 0; j < parts.front().parameters.size(); ++j)
+      if (parts.front().shared[j] >= 0 && parts.front().shared[j] < 8)
+        units[static_cast<std::size_t>(parts.front().shared[j])] = parts.front().parameters[j].unit;
+    errors_ = layout_.add("location_errors", {names.begin(), names.begin() + 8}, {units.begin(), units.begin() + 8});
+    effects_ = layout_.add("effects", {names.begin() + 8, names.end()}, {units.begin() + 8, units.end()});
     for (const SessionPart& p : parts) {
-      if (p.errors_size != errors_.size)
-        throw InvalidArgument("identify: session " + p.name + " has " + std::to_string(p.errors_size) +
-                              " location errors, not " + std::to_string(errors_.size));
+      if (std::count_if(p.shared.begin(), p.shared.end(), [](Eigen::Index i) { return i >= 0; }) !=
+          static_cast<std::ptrdiff_t>(names.size()))
+        throw InvalidArgument("identify: session " + p.name + " does not hold the " + std::to_string(names.size()) +
+                              " shared parameters (location errors and effects)");
       std::vector<std::string> own, own_units;
       for (std::size_t j = 0; j < p.parameters.size(); ++j)
-        if (!in_errors(p, j)) {
+        if (p.shared[j] < 0) {
           own.push_back(p.name + ":" + p.parameters[j].name);
           own_units.push_back(p.parameters[j].unit);
         }
@@ -78,16 +87,17 @@ class StackedModel : public ResidualModel {
       std::vector<Eigen::Index> map;
       Eigen::Index next = b.offset;
       for (std::size_t j = 0; j < p.parameters.size(); ++j)
-        map.push_back(in_errors(p, j) ? errors_.offset + static_cast<Eigen::Index>(j) - p.errors_offset : next++);
+        map.push_back(p.shared[j] < 0 ? next++ : shared_index(p.shared[j]));
       maps_.push_back(std::move(map));
       blocks_.push_back(b);
       rows_ += p.model->num_residuals();
     }
   }
-  static bool in_errors(const SessionPart& p, std::size_t j) {
-    const auto i = static_cast<Eigen::Index>(j);
-    return i >= p.errors_offset && i < p.errors_offset + p.errors_size;
+  /// Index in the joint vector of shared parameter i (location errors, then effects).
+  Eigen::Index shared_index(Eigen::Index i) const {
+    return i < errors_.size ? errors_.offset + i : effects_.offset + i - errors_.size;
   }
+  Eigen::Index num_shared() const { return errors_.size + effects_.size; }
   Eigen::Index num_residuals() const override { return rows_; }
   int num_parameters() const override { return static_cast<int>(layout_.size()); }
   void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r, Eigen::MatrixXd* J) const override {
@@ -112,13 +122,14 @@ class StackedModel : public ResidualModel {
   }
   const ParameterLayout& layout() const { return layout_; }
   const ParameterBlock& errors() const { return errors_; }
+  const ParameterBlock& effects() const { return effects_; }
   const ParameterBlock& block(std::size_t k) const { return blocks_[k]; }
   const std::vector<Eigen::Index>& map(std::size_t k) const { return maps_[k]; }
 
  private:
   const std::vector<SessionPart>& parts_;
   ParameterLayout layout_;
-  ParameterBlock errors_;
+  ParameterBlock errors_, effects_;
   std::vector<ParameterBlock> blocks_;
   std::vector<std::vector<Eigen::Index>> maps_;
   Eigen::Index rows_ = 0;
@@ -191,13 +202,22 @@ std::vector<MultiDisagreement> disagreements(const std::vector<MultiSessionResul
   return out;
 }
 
+// The shared catalogue effects as every session fits them: their linear-axis polynomials about
+// the caller's a_ref, else about the machine zero, the same for every session.
+EffectModel shared_effects(const MultiFitOptions& o) {
+  EffectModel fx = o.effects;
+  if (!fx.linear_reference) fx.linear_reference = Eigen::Vector3d::Zero();
+  return fx;
+}
+
 }  // namespace
 
 MultiIdentification identify_multi(const std::vector<MultiSessionInput>& sessions, const MultiFitOptions& o) {
   check_sessions(sessions);
+  const EffectModel fx = shared_effects(o);
   std::vector<SessionPart> parts;
-  for (const MultiSessionInput& s : sessions) parts.push_back(multi_detail::session_part(s));
-  const StackedModel model(parts, sessions.front().machine());
+  for (const MultiSessionInput& s : sessions) parts.push_back(multi_detail::session_part(s, fx));
+  const StackedModel model(parts, sessions.front().machine(), fx);
 
   MultiIdentification out;
   out.machine = sessions.front().machine();
@@ -205,23 +225,26 @@ MultiIdentification identify_multi(const std::vector<MultiSessionInput>& session
   std::vector<FitParameter> params(static_cast<std::size_t>(model.num_parameters()));
   const std::vector<std::string> names = model.layout().names(), units = model.layout().units();
   for (std::size_t j = 0; j < params.size(); ++j) params[j] = {names[j], units[j], 0.0};
+  std::vector<bool> set(params.size(), false);
   for (std::size_t k = 0; k < parts.size(); ++k) {
     const SessionPart& p = parts[k];
     const NoiseFit nf = fit_alone(p, o);
     wblocks.push_back(whitener_block(p, nf));
-    // Own parameters start at the session's solution alone; the shared errors at zero.
+    MultiSessionResult r;
+    r.alone.resize(static_cast<std::size_t>(model.num_shared()));
+    // Own parameters start at the session's solution alone; the shared ones at zero, with the
+    // first session's settings (scale, yield convention of the effects).
     for (std::size_t j = 0; j < p.parameters.size(); ++j) {
       const auto J = static_cast<std::size_t>(model.map(k)[j]);
-      if (StackedModel::in_errors(p, j)) continue;
+      if (p.shared[j] >= 0) r.alone[static_cast<std::size_t>(p.shared[j])] = nf.fit.estimates[j];
+      if (set[J]) continue;
       params[J] = p.parameters[j];
       params[J].name = names[J];
-      params[J].start = nf.fit.values[static_cast<Eigen::Index>(j)];
+      params[J].start = p.shared[j] >= 0 ? 0.0 : nf.fit.values[static_cast<Eigen::Index>(j)];
+      set[J] = true;
     }
-    MultiSessionResult r;
     r.name = p.name;
     r.instrument = p.instrument;
-    r.alone.assign(nf.fit.estimates.begin() + p.errors_offset,
-                   nf.fit.estimates.begin() + p.errors_offset + p.errors_size);
     r.noise = nf.noise;
     r.noise_refit = nf.refit;
     r.noise_correction = nf.scale;
@@ -237,6 +260,8 @@ MultiIdentification identify_multi(const std::vector<MultiSessionInput>& session
 
   const ParameterBlock& E = model.errors();
   out.location_errors.assign(fit.estimates.begin() + E.offset, fit.estimates.begin() + E.end());
+  const ParameterBlock& F = model.effects();
+  out.effects.assign(fit.estimates.begin() + F.offset, fit.estimates.begin() + F.end());
   Eigen::Index row = 0;
   for (std::size_t k = 0; k < parts.size(); ++k) {
     const ParameterBlock& b = model.block(k);

@@ -2,10 +2,13 @@
 // Only this layer includes the three instrument problems; they do not include each other.
 #include "session_parts.hpp"
 
+#include <algorithm>
+
 #include "../ballbar/length_model.hpp"
 #include "rotacal/ballbar/problem.hpp"
 #include "rotacal/io/probe_session.hpp"
 #include "rotacal/io/session.hpp"
+#include "rotacal/kinematics/parameter_blocks.hpp"
 #include "rotacal/probe/problem.hpp"
 #include "rotacal/rtest/problem.hpp"
 
@@ -18,11 +21,13 @@ struct BallbarData {
   BallbarFitSetup setup;
 };
 
-SessionPart ballbar_part(const MultiSessionInput& in) {
+SessionPart ballbar_part(const MultiSessionInput& in, const EffectModel& fx) {
   SessionPart p;
   auto data = std::make_shared<BallbarData>();
   data->arrays = ballbar_arrays(*in.ballbar);
-  data->setup = ballbar_fit_setup(data->arrays, JointFitOptions{});
+  JointFitOptions options;
+  options.effects = fx;
+  data->setup = ballbar_fit_setup(data->arrays, options);
   const BallbarArrays* arrays = &data->arrays;
   const BallbarFitSetup& setup = data->setup;
   p.model = std::make_unique<BallbarLengthModel>(*arrays, setup.effects);
@@ -36,10 +41,10 @@ SessionPart ballbar_part(const MultiSessionInput& in) {
   return p;
 }
 
-SessionPart rtest_part(const MultiSessionInput& in) {
+SessionPart rtest_part(const MultiSessionInput& in, const EffectModel& fx) {
   SessionPart p;
   auto arrays = std::make_shared<RtestArrays>(rtest_arrays(*in.rtest, "identify: " + in.name));
-  auto problem = std::make_unique<RtestProblem>(*arrays, nullptr, EffectModel{});
+  auto problem = std::make_unique<RtestProblem>(*arrays, nullptr, fx);
   const RtestLayout& L = problem->layout();
   const std::vector<std::string> names = L.all.names(), units = L.all.units();
   for (std::size_t j = 0; j < names.size(); ++j) p.parameters.push_back({names[j], units[j], 0.0});
@@ -68,9 +73,9 @@ SessionPart rtest_part(const MultiSessionInput& in) {
   return p;
 }
 
-SessionPart probe_part(const MultiSessionInput& in) {
+SessionPart probe_part(const MultiSessionInput& in, const EffectModel& fx) {
   SessionPart p;
-  auto problem = std::make_unique<ProbeProblem>(*in.probe);
+  auto problem = std::make_unique<ProbeProblem>(*in.probe, fx);
   p.parameters = problem->parameters();
   p.errors_offset = static_cast<Eigen::Index>(problem->layout().errors.offset);
   p.errors_size = static_cast<Eigen::Index>(problem->layout().errors.size);
@@ -84,17 +89,27 @@ SessionPart probe_part(const MultiSessionInput& in) {
 
 }  // namespace
 
-SessionPart session_part(const MultiSessionInput& in) {
+SessionPart session_part(const MultiSessionInput& in, const EffectModel& fx) {
   SessionPart p;
-  if (in.instrument == "ballbar" && in.ballbar) p = ballbar_part(in);
-  else if (in.instrument == "rtest" && in.rtest) p = rtest_part(in);
-  else if (in.instrument == "probe" && in.probe) p = probe_part(in);
+  if (in.instrument == "ballbar" && in.ballbar) p = ballbar_part(in, fx);
+  else if (in.instrument == "rtest" && in.rtest) p = rtest_part(in, fx);
+  else if (in.instrument == "probe" && in.probe) p = probe_part(in, fx);
   else throw InvalidArgument("identify: session " + in.name + " has no " + in.instrument + " data");
   p.name = in.name;
   p.instrument = in.instrument;
   if (p.model->num_residuals() <= static_cast<Eigen::Index>(p.parameters.size()))
     throw InvalidArgument("identify: session " + in.name + ": " + std::to_string(p.model->num_residuals()) +
                           " residuals cannot determine its " + std::to_string(p.parameters.size()) + " unknowns");
+  std::vector<std::string> shared_names;
+  for (Eigen::Index j = 0; j < p.errors_size; ++j)
+    shared_names.push_back(p.parameters[static_cast<std::size_t>(p.errors_offset + j)].name);
+  for (const Effect& f : fx.effects)
+    for (std::size_t k = 0; k < static_cast<std::size_t>(f.num_params()); ++k)
+      shared_names.push_back(effect_parameter_name(f, k));
+  for (const FitParameter& f : p.parameters) {
+    const auto at = std::find(shared_names.begin(), shared_names.end(), f.name);
+    p.shared.push_back(at == shared_names.end() ? -1 : static_cast<Eigen::Index>(at - shared_names.begin()));
+  }
   return p;
 }
 

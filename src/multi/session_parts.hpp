@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "rotacal/core/fit_with_noise.hpp"
+#include "rotacal/kinematics/effects.hpp"
 #include "rotacal/multi/identify.hpp"
 
 namespace rotacal::multi_detail {
@@ -19,14 +20,19 @@ struct SessionPart {
   std::vector<FitParameter> parameters;   // its unknowns, its own vector order
   Eigen::Index errors_offset = 0;         // its location-error block
   Eigen::Index errors_size = 0;
+  // Per parameter: its index among the shared ones (the location errors, then the shared
+  // effects' parameters, by name), or -1 for the session's own.
+  std::vector<Eigen::Index> shared;
   JointFitSettings settings;              // sigma of the declared noise
   std::vector<std::string> groups;        // noise stream of every residual
   std::vector<double> times;              // time (s) of every residual
   bool allow_reml = false;                // the R-test's wandering zeros (rtest/identify_joint.cpp)
 };
 
-/// The part of one session. Throws InvalidArgument (naming the session) for a session
-/// without data.
-SessionPart session_part(const MultiSessionInput& input);
+/// The part of one session with the shared catalogue effects `fx` fitted along (their
+/// linear-axis polynomials about fx's linear_reference: set by the caller, the same for every
+/// session). Throws InvalidArgument (naming the session) for a session without data or an
+/// effect its instrument does not model on its machine.
+SessionPart session_part(const MultiSessionInput& input, const EffectModel& fx);
 
 }  // namespace rotacal::multi_detail

@@ -107,3 +107,30 @@ TEST_CASE("sessions of different machine types are refused by name", "[multi]") 
   }
   CHECK_THROWS_AS(identify_multi({MultiSessionInput::of("bb", ballbar_session(t, 1))}), InvalidArgument);
 }
+
+TEST_CASE("a catalogue effect shared by both sessions is fitted once, within 3 sigma", "[multi]") {
+  MachineModel t = machine_truth();
+  t.effects = EffectModel{{Effect::parse("gravity_sag_A")}, std::nullopt};
+  t.effect_params = {0.004};
+  MultiFitOptions o;
+  o.effects = EffectModel{{Effect::parse("gravity_sag_A")}, std::nullopt};
+  const MultiIdentification id = identify_multi(
+      {MultiSessionInput::of("bb", ballbar_session(t, 31)), MultiSessionInput::of("probe", probe_session(t, 32))}, o);
+  CHECK(id.converged);
+  REQUIRE(id.effects.size() == 1);
+  INFO("gravity_sag_A = " << id.effects[0].value << " +- " << id.effects[0].std);
+  CHECK(id.effects[0].observable);
+  CHECK(id.effects[0].std < 0.0005);  // determined, not merely within a wide sigma
+  CHECK(std::abs(id.effects[0].value - 0.004) <= 3.0 * id.effects[0].std);
+  const auto& names = location_error_names(MachineType::AC_trt);
+  for (std::size_t j = 0; j < names.size(); ++j) {
+    const ParameterEstimate& p = id.location_errors[j];
+    INFO(p.name << " = " << p.value << " +- " << p.std);
+    if (p.observable) CHECK(std::abs(p.value - t.errors.v[static_cast<Eigen::Index>(j)]) <= 3.0 * p.std);
+  }
+  for (const MultiSessionResult& s : id.sessions) {
+    REQUIRE(s.alone.size() == 9);  // the location errors, then the shared effect, each session alone
+    CHECK(s.alone[8].name == "gravity_sag_A");
+    for (const ParameterEstimate& n : s.nuisances) CHECK(n.name != "gravity_sag_A");
+  }
+}

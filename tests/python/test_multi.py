@@ -117,3 +117,24 @@ def test_cli_joint_identification_reports_a_planted_disagreement(tmp_path):
     assert text.returncode == 0 and "DISAGREE E_X0C" in text.stdout, text.stdout + text.stderr
     refused = run_cli("identify", bb, pr, "--save-model", tmp_path / "m.json", cwd=tmp_path)
     assert refused.returncode != 0 and "--save-model" in refused.stderr
+
+
+def test_shared_effect_within_3_sigma(tmp_path):
+    """A gravity sag of A on the machine, fitted once for both sessions (refsim truth)."""
+    errors = truth_errors(MACHINE)
+    sag = {"gravity_sag_A": 0.004}
+    m = refsim.builtin(MACHINE)
+    s = poses.ballbar_single_setup(m)
+    length = refsim.ballbar_lengths(refsim.Model(m, errors, sag), s["pivot"], s["xyz"], np.radians(s["angles_deg"]),
+                                    s["time"]) + noise.ar1(s["test"], 0.5, 5e-4, np.random.default_rng(11))
+    bb = writers.write_ballbar(tmp_path / "bb_sag.csv", m, s, length, noise_um=0.5)
+    ses = poses.probe_poses(m)
+    latched = refsim.probe_touches(refsim.Model(m, errors, sag), ses["sphere"], ses["sphere"], 25.0, 6.0, ses["n"],
+                                   np.radians(ses["angles_deg"]), ses["time"])
+    latched = latched + np.random.default_rng(12).normal(0.0, 5e-4, latched.shape)
+    pr = writers.write_probe(tmp_path / "probe_sag.csv", m, ses, latched, 25.0, 6.0, noise_um=0.5)
+    d = rotacal.identify([rotacal.load(bb), rotacal.load(pr)], effects=["gravity_sag_A"]).to_dict()
+    e = d["effects"]["gravity_sag_A"]
+    assert e["std"] < 0.001 and abs(e["value"] - 0.004) <= 3 * e["std"], e
+    assert not off_by_more_than_3_sigma(d, errors), off_by_more_than_3_sigma(d, errors)
+    assert all("gravity_sag_A" not in s["nuisances"] for s in d["sessions"])

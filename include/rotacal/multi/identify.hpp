@@ -23,6 +23,7 @@
 
 #include "rotacal/core/estimate.hpp"
 #include "rotacal/core/noise_handling.hpp"
+#include "rotacal/kinematics/effects.hpp"
 #include "rotacal/kinematics/machine.hpp"
 
 namespace rotacal {
@@ -46,6 +47,10 @@ struct MultiSessionInput {
 };
 
 struct MultiFitOptions {
+  /// Catalogue effects of the machine fitted along, ONE set shared by every session (each
+  /// session's instrument must model them). Their linear-axis polynomials are about
+  /// effects.linear_reference, the machine zero when unset, the same for every session.
+  EffectModel effects;
   /// `automatic`: a session whose residuals are correlated is whitened by its AR model (GLS),
   /// as in its single-instrument fit; `white`: each session weighted by its residual sigma.
   NoiseHandling noise = NoiseHandling::automatic;
@@ -58,7 +63,7 @@ struct MultiFitOptions {
   double disagreement_z = 3.0;
 };
 
-/// Two sessions alone disagree on one location error.
+/// Two sessions alone disagree on one location error (or shared effect parameter).
 struct MultiDisagreement {
   std::string parameter, unit;
   std::string session_a, session_b;
@@ -72,7 +77,7 @@ struct MultiDisagreement {
 struct MultiSessionResult {
   std::string name, instrument;
   std::vector<ParameterEstimate> nuisances;  ///< its own parameters in the joint fit
-  std::vector<ParameterEstimate> alone;      ///< its location errors fitted alone
+  std::vector<ParameterEstimate> alone;      ///< its location errors (then shared effects) fitted alone
   NoiseModel noise;                          ///< noise model of its residuals alone
   bool noise_refit = false;                  ///< whitened by `noise` (GLS) in the joint fit
   double noise_correction = 1.0;             ///< bias factor on its share of the covariance
@@ -83,6 +88,7 @@ struct MultiSessionResult {
 struct MultiIdentification {
   MachineType machine = MachineType::AC_trt;
   std::vector<ParameterEstimate> location_errors;  ///< the one shared set, joint fit
+  std::vector<ParameterEstimate> effects;          ///< the shared catalogue effects' parameters
   std::vector<MultiSessionResult> sessions;        ///< in input order
   std::vector<MultiDisagreement> disagreements;
   std::vector<std::string> parameter_names;        ///< joint vector order

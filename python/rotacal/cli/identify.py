@@ -114,6 +114,9 @@ def print_joint_identification(d: dict) -> None:
                                                f"{s['alone'][name]['value'] * f:+.3f} +- {s['alone'][name]['std'] * f:.3f}")
                           for s in d["sessions"])
         print(f"  {name:6s} {_fmt_value(p['value'], p['unit'])} +- {p['std'] * f:.3f}   (alone: {alone})")
+    for name, p in d["effects"].items():
+        print(f"  {name} (shared): " + ("unobservable" if p["value"] is None else
+                                        f"{_fmt_value(p['value'], p['unit']).strip()} +- {p['std'] * _shown(p['unit'])[0]:.3f}"))
     for s in d["sessions"]:
         own = ", ".join(f"{n} = " + ("unobservable" if p["value"] is None else f"{p['value']:.4f} {p['unit']}")
                         for n, p in s["nuisances"].items())
