@@ -1,10 +1,13 @@
 // One identification from a ballbar and a touch-probe session of one AC-trt machine
 // (multi/identify.hpp): the joint values lie within 3 sigma of the simulated machine, the joint
 // sigma is no larger than either session's alone, a session of another machine is refused by
-// name, and a session whose machine differs by 30 um in one error is reported as disagreeing.
+// name, a session whose machine differs by 30 um in one error is reported as disagreeing, a shared
+// effect is fitted once, and the block-diagonal whitener whitens each session by its own model.
 #include <catch2/catch.hpp>
 
 #include "rotacal/ballbar/plan.hpp"
+#include "rotacal/core/block_whitener.hpp"
+#include "rotacal/core/noise_model.hpp"
 #include "rotacal/ballbar/simulate.hpp"
 #include "rotacal/multi/identify.hpp"
 #include "rotacal/probe/simulate.hpp"
@@ -132,5 +135,40 @@ TEST_CASE("a catalogue effect shared by both sessions is fitted once, within 3 s
     REQUIRE(s.alone.size() == 9);  // the location errors, then the shared effect, each session alone
     CHECK(s.alone[8].name == "gravity_sag_A");
     for (const ParameterEstimate& n : s.nuisances) CHECK(n.name != "gravity_sag_A");
+  }
+}
+
+TEST_CASE("the block-diagonal whitener whitens each session's rows by its own model", "[multi]") {
+  // Block 1: 1 / sigma = 2 (white, 2 rows); block 2: an AR whitener of 3 rows, then factor 0.5.
+  NoiseModel white3;
+  const std::vector<std::string> g(3, "s");
+  const std::vector<double> t{0.0, 1.0, 2.0};
+  white3 = estimate_noise_model(g, t, Eigen::Vector3d(0.1, -0.2, 0.15), NoiseModelOptions{});
+  auto ar = std::make_shared<ArWhitener>(white3);
+  const BlockDiagonalWhitener W({{2, nullptr, 2.0}, {3, ar, 0.5}});
+  CHECK(W.size() == 5);
+  Eigen::MatrixXd c = Eigen::MatrixXd::Ones(5, 2);
+  Eigen::MatrixXd lower = Eigen::MatrixXd::Ones(3, 2);
+  ar->apply(lower);
+  W.apply(c);
+  CHECK(c.topRows(2).isApprox(Eigen::MatrixXd::Constant(2, 2, 2.0)));
+  CHECK(c.bottomRows(3).isApprox(0.5 * lower));
+  CHECK_THROWS_AS(BlockDiagonalWhitener({{4, ar, 1.0}}), InvalidArgument);   // 3-row whitener on 4 rows
+  CHECK_THROWS_AS(BlockDiagonalWhitener({{2, nullptr, 0.0}}), InvalidArgument);
+}
+
+TEST_CASE("white noise handling weights each session by its own residual sigma", "[multi]") {
+  const MachineModel t = machine_truth();
+  MultiFitOptions o;
+  o.noise = NoiseHandling::white;
+  const MultiIdentification id = identify_multi(
+      {MultiSessionInput::of("bb", ballbar_session(t, 41)), MultiSessionInput::of("probe", probe_session(t, 42))}, o);
+  CHECK(id.converged);
+  for (const MultiSessionResult& s : id.sessions) CHECK_FALSE(s.noise_refit);
+  // Whitened to unit variance per session: the joint chi2/dof is near 1.
+  CHECK(id.summary.chi2_per_dof == Approx(1.0).margin(0.1));
+  for (std::size_t j = 0; j < 8; ++j) {
+    const ParameterEstimate& p = id.location_errors[j];
+    if (p.observable) CHECK(std::abs(p.value - t.errors.v[static_cast<Eigen::Index>(j)]) <= 3.0 * p.std);
   }
 }
