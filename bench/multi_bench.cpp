@@ -84,7 +84,8 @@ int main(int argc, char** argv) {
     auto alone = [&](const Moments& m) { return m.n > 0 ? std::sqrt(m.mean()) * f : NAN; };
     // The sessions alone: Monte Carlo sigma / reported sigma (what the disagreement test rests on).
     auto ratio = [&](const Moments& v, const Moments& m) { return v.n > 1 ? v.sd() / std::sqrt(m.mean()) : NAN; };
-    std::printf("%-6s %10.4f %10.4f %7.3f | %10.4f %10.4f %10.4f | %9.3f %9.3f\n", names[static_cast<std::size_t>(j)].c_str(),
+    std::printf("%-6s %10.4f %10.4f %7.3f | %10.4f %10.4f %10.4f | %9.3f %9.3f\n",
+                names[static_cast<std::size_t>(j)].c_str(),
                 value[j].sd() * f, rep * f, value[j].sd() / rep, rep * f, alone(alone_bb[j]), alone(alone_pr[j]),
                 ratio(value_bb[j], alone_bb[j]), ratio(value_pr[j], alone_pr[j]));
   }

@@ -1,5 +1,6 @@
 """One identification from several sessions of one machine (ballbar, R-test, touch probe):
-one set of location errors (and of catalogue effects where asked), each session's own nuisances and noise model, and the parameters on
+one set of location errors (and of catalogue effects where asked), each session's own nuisances
+and noise model, and the parameters on
 which the sessions fitted alone disagree. C++ computes (include/rotacal/multi); this module only
 composes."""
 from __future__ import annotations

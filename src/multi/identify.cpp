@@ -268,7 +268,8 @@ MultiIdentification identify_multi(const std::vector<MultiSessionInput>& session
     out.sessions[k].nuisances.assign(fit.estimates.begin() + b.offset, fit.estimates.begin() + b.end());
     for (ParameterEstimate& e : out.sessions[k].nuisances) e.name = e.name.substr(parts[k].name.size() + 1);
     const Eigen::Index n = static_cast<Eigen::Index>(out.sessions[k].n_residuals);
-    out.sessions[k].residual_rms_um = std::sqrt(fit.residuals.segment(row, n).squaredNorm() / static_cast<double>(n)) * 1e3;
+    const double ms = fit.residuals.segment(row, n).squaredNorm() / static_cast<double>(n);
+    out.sessions[k].residual_rms_um = std::sqrt(ms) * 1e3;
     row += n;
   }
   out.disagreements = disagreements(out.sessions, o.disagreement_z);

@@ -62,10 +62,11 @@ SessionPart rtest_part(const MultiSessionInput& in, const EffectModel& fx) {
   p.errors_offset = L.errors.offset;
   p.errors_size = L.errors.size;
   p.settings.sigma = in.rtest->noise_um.value_or(1.0) * 1e-3;
-  for (Eigen::Index i = 0; i < arrays->size(); ++i)
+  // Noise streams as the R-test's own fit has them: one per nest and channel, in time order.
+  for (std::size_t i = 0; i < arrays->setup_of.size(); ++i)
     for (int a = 0; a < 3; ++a) {
-      p.groups.push_back("nest " + arrays->setups[static_cast<std::size_t>(arrays->setup_of[static_cast<std::size_t>(i)])]);
-      p.times.push_back(arrays->time[static_cast<std::size_t>(i)]);
+      p.groups.push_back("nest " + arrays->setups[static_cast<std::size_t>(arrays->setup_of[i])]);
+      p.times.push_back(arrays->time[i]);
     }
   p.allow_reml = true;
   p.model = std::move(problem);

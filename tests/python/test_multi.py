@@ -72,7 +72,8 @@ def off_by_more_than_3_sigma(result: dict, errors: dict) -> list:
 def test_joint_identification_within_3_sigma(tmp_path, second):
     errors = truth_errors(MACHINE)
     make = probe_file if second == "probe" else rtest_file
-    sessions = [rotacal.load(ballbar_file(tmp_path, MACHINE, errors, 5)), rotacal.load(make(tmp_path, MACHINE, errors, 6))]
+    sessions = [rotacal.load(ballbar_file(tmp_path, MACHINE, errors, 5)),
+                rotacal.load(make(tmp_path, MACHINE, errors, 6))]
     r = rotacal.identify(sessions)
     d = r.to_dict()
     assert d["converged"]

@@ -110,13 +110,14 @@ def print_joint_identification(d: dict) -> None:
             print(f"  {name:6s}  unobservable")
             continue
         f = _shown(p["unit"])[0]
-        alone = "  ".join(f"{s['name']}: " + ("unobservable" if s["alone"][name]["value"] is None else
-                                               f"{s['alone'][name]['value'] * f:+.3f} +- {s['alone'][name]['std'] * f:.3f}")
-                          for s in d["sessions"])
+        alone = "  ".join(f"{s['name']}: " + ("unobservable" if a["value"] is None else
+                                               f"{a['value'] * f:+.3f} +- {a['std'] * f:.3f}")
+                          for s in d["sessions"] for a in (s["alone"][name],))
         print(f"  {name:6s} {_fmt_value(p['value'], p['unit'])} +- {p['std'] * f:.3f}   (alone: {alone})")
     for name, p in d["effects"].items():
-        print(f"  {name} (shared): " + ("unobservable" if p["value"] is None else
-                                        f"{_fmt_value(p['value'], p['unit']).strip()} +- {p['std'] * _shown(p['unit'])[0]:.3f}"))
+        shown = "unobservable" if p["value"] is None else \
+            f"{_fmt_value(p['value'], p['unit']).strip()} +- {p['std'] * _shown(p['unit'])[0]:.3f}"
+        print(f"  {name} (shared): {shown}")
     for s in d["sessions"]:
         own = ", ".join(f"{n} = " + ("unobservable" if p["value"] is None else f"{p['value']:.4f} {p['unit']}")
                         for n, p in s["nuisances"].items())
