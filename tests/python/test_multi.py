@@ -16,6 +16,7 @@ import refsim  # noqa: E402
 from refsim import noise, poses, writers  # noqa: E402
 
 import rotacal  # noqa: E402
+from test_json_schema import check, schemas  # noqa: E402
 
 MACHINE = "AC-trt"
 
@@ -109,6 +110,10 @@ def test_cli_joint_identification_reports_a_planted_disagreement(tmp_path):
     r = run_cli("identify", bb, pr, "--json", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     d = json.loads(r.stdout)
+    named = schemas()  # the documented JSON (docs/json_schema.md), its noise model by name
+    schema = named["joint_identification"]
+    schema["sessions"][0]["noise_model"] = named["noise_model"]
+    check(d, schema, "joint", named)
     assert [s["name"] for s in d["sessions"]] == [str(bb), str(pr)]
     found = [g for g in d["disagreements"] if g["parameter"] == "E_X0C"]
     assert found and found[0]["sessions"] == [str(bb), str(pr)], d["disagreements"]
