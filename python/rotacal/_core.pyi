@@ -6,7 +6,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Alternative', 'Ambiguity', 'AngleTable', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CircularAnalysis', 'CircularDiagnosis', 'CircularDiagnosisOptions', 'CircularDirection', 'CircularEffect', 'CircularFinding', 'CircularPairResult', 'CircularPlanResult', 'CircularPlane', 'CircularRun', 'CircularRunResult', 'CircularSimulationOptions', 'CircularTestPlan', 'CompensationReport', 'CompensationRow', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LinearAxisErrors', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'ProbeIdentification', 'ProbeSession', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestDesign', 'RtestDesignCandidate', 'RtestDesignOptions', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSeparatingCandidate', 'RtestSeparationDesign', 'RtestSeparationOptions', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SeparatingCandidate', 'SeparationDesign', 'SeparationOptions', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'SweepDirection', 'TableMotionOverlap', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualCircularBallbar', 'VirtualRtest', 'analyze_circular', 'ballbar_model_document', 'ballbar_model_from_document', 'builtin_machine_names', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_json_bounds', 'check_model_machine', 'check_output', 'check_plausible', 'check_rtest_pattern', 'circular_catalogue', 'circular_commanded_session', 'circular_label', 'comment_lines', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_axial_c_tilt_deg', 'default_ballbar_tests', 'default_calibration_moves', 'default_probe_poses_deg', 'default_rtest_pattern', 'default_tilt_range_deg', 'design_ballbar_separation', 'design_ballbar_test', 'design_rtest_separation', 'design_rtest_test', 'diagnose_ballbar', 'diagnose_circular', 'diagnose_probe', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'evaluate_rtest_design', 'export_controller', 'format_ballbar', 'format_model_document', 'format_probe', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_joint_sessions', 'identify_paper', 'identify_probe', 'identify_probe_cycles', 'identify_rtest_joint', 'identify_rtest_paper', 'is_rotary_test', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_rtest', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_circular_direction', 'parse_circular_plane', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'parse_sweep_direction', 'plan_ballbar_test', 'plan_circular_test', 'predict_rtest_session', 'predict_session_lengths', 'probe_effect_catalogue', 'read_ballbar', 'read_instrument_session', 'read_linuxcnc_probe_log', 'read_model_document', 'read_probe', 'read_rtest', 'read_session', 'record_ballbar', 'record_circular_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_joint_model_document', 'rtest_map_names', 'rtest_prediction_rms_um', 'rtest_readings', 'run_label', 'simulate_ballbar', 'simulate_circular', 'simulate_probe', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'table_motion_overlap', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_probe', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_circular_nc_program', 'write_model_document', 'write_nc_program', 'write_output', 'write_probe', 'write_probe_nc_program', 'write_rtest']
+__all__: list[str] = ['Alternative', 'Ambiguity', 'AngleTable', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CircularAnalysis', 'CircularDiagnosis', 'CircularDiagnosisOptions', 'CircularDirection', 'CircularEffect', 'CircularFinding', 'CircularPairResult', 'CircularPlanResult', 'CircularPlane', 'CircularRun', 'CircularRunResult', 'CircularSimulationOptions', 'CircularTestPlan', 'CompensationReport', 'CompensationRow', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LinearAxisErrors', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'MultiDisagreement', 'MultiIdentification', 'MultiSessionResult', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'ProbeIdentification', 'ProbeSession', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestDesign', 'RtestDesignCandidate', 'RtestDesignOptions', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSeparatingCandidate', 'RtestSeparationDesign', 'RtestSeparationOptions', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SeparatingCandidate', 'SeparationDesign', 'SeparationOptions', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'SweepDirection', 'TableMotionOverlap', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualCircularBallbar', 'VirtualRtest', 'analyze_circular', 'ballbar_model_document', 'ballbar_model_from_document', 'builtin_machine_names', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_json_bounds', 'check_model_machine', 'check_output', 'check_plausible', 'check_rtest_pattern', 'circular_catalogue', 'circular_commanded_session', 'circular_label', 'comment_lines', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_axial_c_tilt_deg', 'default_ballbar_tests', 'default_calibration_moves', 'default_probe_poses_deg', 'default_rtest_pattern', 'default_tilt_range_deg', 'design_ballbar_separation', 'design_ballbar_test', 'design_rtest_separation', 'design_rtest_test', 'diagnose_ballbar', 'diagnose_circular', 'diagnose_probe', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'evaluate_rtest_design', 'export_controller', 'format_ballbar', 'format_model_document', 'format_probe', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_joint_sessions', 'identify_multi', 'identify_paper', 'identify_probe', 'identify_probe_cycles', 'identify_rtest_joint', 'identify_rtest_paper', 'is_rotary_test', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_rtest', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_circular_direction', 'parse_circular_plane', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'parse_sweep_direction', 'plan_ballbar_test', 'plan_circular_test', 'predict_rtest_session', 'predict_session_lengths', 'probe_effect_catalogue', 'read_ballbar', 'read_instrument_session', 'read_model_document', 'read_probe', 'read_rtest', 'read_session', 'record_ballbar', 'record_circular_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_joint_model_document', 'rtest_map_names', 'rtest_prediction_rms_um', 'rtest_readings', 'run_label', 'simulate_ballbar', 'simulate_circular', 'simulate_probe', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'table_motion_overlap', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_probe', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_circular_nc_program', 'write_model_document', 'write_nc_program', 'write_output', 'write_probe', 'write_rtest']
 class Alternative:
     @property
     def aliased(self) -> bool:
@@ -1660,6 +1660,96 @@ class MonteCarloParameter:
         ...
     @property
     def unit(self) -> str:
+        ...
+class MultiDisagreement:
+    @property
+    def difference(self) -> float:
+        ...
+    @property
+    def parameter(self) -> str:
+        ...
+    @property
+    def session_a(self) -> str:
+        ...
+    @property
+    def session_b(self) -> str:
+        ...
+    @property
+    def sigma(self) -> float:
+        ...
+    @property
+    def unit(self) -> str:
+        ...
+    @property
+    def value_a(self) -> float:
+        ...
+    @property
+    def value_b(self) -> float:
+        ...
+    @property
+    def z(self) -> float:
+        ...
+class MultiIdentification:
+    @property
+    def converged(self) -> bool:
+        ...
+    @property
+    def covariance(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        ...
+    @property
+    def disagreements(self) -> list[MultiDisagreement]:
+        ...
+    @property
+    def effects(self) -> list[ParameterEstimate]:
+        ...
+    @property
+    def location_errors(self) -> list[ParameterEstimate]:
+        ...
+    @property
+    def machine(self) -> MachineType:
+        ...
+    @property
+    def notes(self) -> list[str]:
+        ...
+    @property
+    def parameter_names(self) -> list[str]:
+        ...
+    @property
+    def sessions(self) -> list[MultiSessionResult]:
+        ...
+    @property
+    def summary(self) -> FitSummary:
+        ...
+    @property
+    def unobservable(self) -> list[str]:
+        ...
+class MultiSessionResult:
+    @property
+    def alone(self) -> list[ParameterEstimate]:
+        ...
+    @property
+    def instrument(self) -> str:
+        ...
+    @property
+    def n_residuals(self) -> int:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def noise(self) -> NoiseModel:
+        ...
+    @property
+    def noise_correction(self) -> float:
+        ...
+    @property
+    def noise_refit(self) -> bool:
+        ...
+    @property
+    def nuisances(self) -> list[ParameterEstimate]:
+        ...
+    @property
+    def residual_rms_um(self) -> float:
         ...
 class NcDialect:
     """
@@ -3545,6 +3635,10 @@ def identify_joint_sessions(sessions: collections.abc.Sequence[BallbarSession], 
     """
     Joint fit of several ballbar sessions (shared location errors and effects, one pivot each): (values, covariance, converged) in the order 8 location errors, pivots, effect parameters.
     """
+def identify_multi(sessions: collections.abc.Sequence[tuple[str, typing.Any]], noise: str = 'auto', effects: collections.abc.Sequence[str] = []) -> MultiIdentification:
+    """
+    One identification from several (name, session) pairs of one machine (multi/identify.hpp): one set of location errors (and of the catalogue effects `effects`), each session's own nuisances and noise model, and the disagreements between the sessions fitted alone; noise 'auto' or 'white'.
+    """
 def identify_paper(session: BallbarSession) -> BallbarIdentification:
     """
     Flynn et al. 2016's chain: sphere fit, Hyper circle fits, SVD plane fits, transport.
@@ -3674,10 +3768,6 @@ def read_ballbar(path: str) -> BallbarSession:
 def read_instrument_session(path: str) -> rotacal._core.BallbarSession | rotacal._core.RtestSession | rotacal._core.ProbeSession:
     """
     Read a ballbar, R-test or touch-probe session (chosen by its format line).
-    """
-def read_linuxcnc_probe_log(path: str, plan: ProbeSession) -> ProbeSession:
-    """
-    The session of a LinuxCNC probing log: its latched X Y Z in the plan's rows (probe/nc_program.hpp).
     """
 def read_model_document(path: str) -> typing.Any:
     """
@@ -3829,9 +3919,5 @@ def write_output(path: str, data: bytes, inputs: collections.abc.Sequence[str] =
     """
 def write_probe(session: ProbeSession, path: str) -> None:
     ...
-def write_probe_nc_program(machine: MachineType, dialect: str, poses_deg: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] | None = None, sphere: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] = ..., sphere_diameter: typing.SupportsFloat | typing.SupportsIndex = 25.0, stylus_diameter: typing.SupportsFloat | typing.SupportsIndex = 6.0, log_file: str = 'rotacal_probe.log', tool: typing.SupportsInt | typing.SupportsIndex = 1, decimals: typing.SupportsInt | typing.SupportsIndex = 4) -> str:
-    """
-    The probing program of the default pattern's directions at `poses_deg` (default: its poses) (probe/nc_program.hpp); linuxcnc only.
-    """
 def write_rtest(session: RtestSession, path: str) -> None:
     ...

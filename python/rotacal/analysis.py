@@ -6,7 +6,7 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from . import _core, ballbar, probe, rtest
+from . import _core, ballbar, multi, probe, rtest
 from .diagnosis import diagnose, uncertainty_budget
 from .models import ballbar_model_from_dict
 from .sessions import BALLBAR, PROBE, RTEST, by_kind
@@ -23,7 +23,14 @@ def identify(session: Any, method: str = "joint", *, fit_length_offset: bool = F
     ``fit_length_offset``, ``effects``, ``tests``), of an R-test session
     (rotacal.identify_rtest: ``method`` only) or of a touch-probe session (rotacal.identify_probe:
     ``method`` "joint", "cycles" or "cycles-free-radius", ``effects``). ``noise``: "auto" (AR noise
-    model of the residuals, GLS refit when correlated) or "white"."""
+    model of the residuals, GLS refit when correlated) or "white".
+    A list of sessions of one machine is identified jointly (rotacal.multi.identify_sessions:
+    ``effects`` shared by every session, ``noise``)."""
+    if isinstance(session, (list, tuple)):
+        if method != "joint" or fit_length_offset or tests:
+            raise _core.InvalidArgument("identify: a list of sessions takes only `effects` and `noise`")
+        return multi.identify_sessions(session, noise=noise, effects=effects)
+
     def rtest_identify():
         if fit_length_offset or effects or tests:
             raise _core.InvalidArgument("identify: an R-test session takes only `method`")

@@ -101,8 +101,63 @@ def _refuse_history_options(a: argparse.Namespace) -> None:
                           "--save-model")
 
 
+def print_joint_identification(d: dict) -> None:
+    """The joint result of several sessions (rotacal.multi): the one set of location errors, each
+    session's own parameters and its location errors alone, and where the sessions disagree."""
+    print(f"joint identification, {d['machine']}, {len(d['sessions'])} sessions")
+    for name, p in d["location_errors"].items():
+        if p["value"] is None:
+            print(f"  {name:6s}  unobservable")
+            continue
+        f = _shown(p["unit"])[0]
+        alone = "  ".join(f"{s['name']}: " + ("unobservable" if a["value"] is None else
+                                               f"{a['value'] * f:+.3f} +- {a['std'] * f:.3f}")
+                          for s in d["sessions"] for a in (s["alone"][name],))
+        print(f"  {name:6s} {_fmt_value(p['value'], p['unit'])} +- {p['std'] * f:.3f}   (alone: {alone})")
+    for name, p in d["effects"].items():
+        shown = "unobservable" if p["value"] is None else \
+            f"{_fmt_value(p['value'], p['unit']).strip()} +- {p['std'] * _shown(p['unit'])[0]:.3f}"
+        print(f"  {name} (shared): {shown}")
+    for s in d["sessions"]:
+        own = ", ".join(f"{n} = " + ("unobservable" if p["value"] is None else f"{p['value']:.4f} {p['unit']}")
+                        for n, p in s["nuisances"].items())
+        print(f"  session {s['name']} ({s['instrument']}, {s['n_residuals']} residuals, RMS "
+              f"{s['residual_rms_um']:.3f} um): {own}")
+        print("    ", end="")
+        print_noise_model(s["noise_model"])
+    for g in d["disagreements"]:
+        f, shown = _shown(g["unit"])
+        print(f"  DISAGREE {g['parameter']}: {g['sessions'][0]} - {g['sessions'][1]} = {g['difference'] * f:+.3f} "
+              f"+- {g['sigma'] * f:.3f} {shown.strip()} (z = {g['z']:+.1f})")
+    for u in d["unobservable"]:
+        print(f"  not determined by these sessions: {u}")
+    for n in d["notes"]:
+        print(f"  note: {n}")
+
+
+def _cmd_identify_joint(a: argparse.Namespace) -> int:
+    """Several sessions of one machine: one joint identification (rotacal.multi)."""
+    from ..multi import identify_sessions
+    given = [o for o, on in ((f"--method {a.method}", a.method != "joint"), ("--length-offset", a.length_offset),
+                             ("--save-model", a.save_model), ("--monte-carlo", a.monte_carlo),
+                             ("--budget-sizes", a.budget_sizes), ("--store", a.store),
+                             ("--machine-id", a.machine_id is not None), ("--controller", a.controller)) if on]
+    if given:
+        raise OptionError(f"{', '.join(given)}: not available for a joint identification of several sessions")
+    sessions = [load_session(f, a) for f in a.file]
+    d = identify_sessions(sessions, list(a.file), noise=a.noise).to_dict()
+    if a.json:
+        print(jsontext.dumps(d))
+    else:
+        print_joint_identification(d)
+    return EXIT_OK
+
+
 def cmd_identify(a: argparse.Namespace) -> int:
     from ..analysis import identification_budget, identification_document, identify, monte_carlo
+    if len(a.file) > 1:
+        return _cmd_identify_joint(a)
+    a.file = a.file[0]
     _refuse_history_options(a)
     sizes = budget_sizes(a.budget_sizes)  # refused before any work
     s = load_session(a.file, a)
@@ -161,8 +216,10 @@ def cmd_predict(a: argparse.Namespace) -> int:
 
 
 def add_identify(sub: argparse._SubParsersAction) -> None:
-    q = sub.add_parser("identify", help="identify location errors from a session", epilog=EPILOG)
-    q.add_argument("file", type=path("FILE"))
+    q = sub.add_parser("identify", help="identify location errors from a session, or jointly from several "
+                                        "sessions of one machine", epilog=EPILOG)
+    q.add_argument("file", type=path("FILE"), nargs="+",
+                   help="a session; several (ballbar, R-test, touch probe) of one machine are identified jointly")
     q.add_argument("--method", default="joint", choices=["joint", "paper", "cycles", "cycles-free-radius"],
                    help="joint (default); paper (ballbar, R-test); cycles, cycles-free-radius (touch probe: the "
                         "controller cycles' method, radius known or fitted per pose)")

@@ -1,0 +1,108 @@
+#pragma once
+/// \file
+/// One identification from several sessions of one machine (issue 31, item 5): ballbar,
+/// R-test and touch-probe sessions fitted together for ONE set of location errors, each session
+/// keeping its own nuisance parameters (ballbar pivot; R-test probe zeros and tool offset;
+/// probe sphere) and its own noise model.
+///
+/// The layer sits above the instrument problems (ballbar/problem.hpp, rtest/problem.hpp,
+/// probe/problem.hpp), which do not know each other: each session's residual model is the
+/// instrument's own, and the stacked model only maps its location-error columns onto the one
+/// shared block (core/parameter_layout.hpp). The sequence per session is the instruments'
+/// (core/fit_with_noise.hpp): white fit alone -> noise model of its residuals -> [GLS]; the
+/// joint fit then whitens each session's rows by that session's model (core/block_whitener.hpp).
+///
+/// The sessions alone are also compared: a location error seen by two sessions whose
+/// difference exceeds `disagreement_z` sigma of the difference is reported as a disagreement
+/// (which parameter, which sessions, by how much) rather than averaged silently.
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rotacal/core/estimate.hpp"
+#include "rotacal/core/noise_handling.hpp"
+#include "rotacal/kinematics/effects.hpp"
+#include "rotacal/kinematics/machine.hpp"
+
+namespace rotacal {
+
+struct BallbarSession;
+struct RtestSession;
+struct ProbeSession;
+
+/// One session of a multi-session identification, by instrument. Build with the factories.
+struct MultiSessionInput {
+  std::string name;        ///< how the session is named in the result (e.g. its file)
+  std::string instrument;  ///< "ballbar", "rtest" or "probe"
+  std::shared_ptr<const BallbarSession> ballbar;
+  std::shared_ptr<const RtestSession> rtest;
+  std::shared_ptr<const ProbeSession> probe;
+
+  static MultiSessionInput of(std::string name, BallbarSession session);
+  static MultiSessionInput of(std::string name, RtestSession session);
+  static MultiSessionInput of(std::string name, ProbeSession session);
+  MachineType machine() const;
+};
+
+struct MultiFitOptions {
+  /// Catalogue effects of the machine fitted along, ONE set shared by every session (each
+  /// session's instrument must model them). Their linear-axis polynomials are about
+  /// effects.linear_reference, the machine zero when unset, the same for every session.
+  EffectModel effects;
+  /// `automatic`: a session whose residuals are correlated is whitened by its AR model (GLS),
+  /// as in its single-instrument fit; `white`: each session weighted by its residual sigma.
+  NoiseHandling noise = NoiseHandling::automatic;
+  NoiseModelOptions noise_options;
+  double min_correlation_samples = 1.2;
+  bool noise_bias_correction = true;
+  int max_iterations = 100;
+  double observability_min_chi2 = 1.0;
+  /// |difference| / sigma of the difference beyond which two sessions disagree.
+  double disagreement_z = 3.0;
+};
+
+/// Two sessions alone disagree on one location error (or shared effect parameter).
+struct MultiDisagreement {
+  std::string parameter, unit;
+  std::string session_a, session_b;
+  double value_a = 0.0, value_b = 0.0;
+  double difference = 0.0;  ///< value_a - value_b
+  double sigma = 0.0;       ///< 1 sigma of the difference (independent sessions)
+  double z = 0.0;           ///< difference / sigma
+};
+
+/// What one session contributes.
+struct MultiSessionResult {
+  std::string name, instrument;
+  std::vector<ParameterEstimate> nuisances;  ///< its own parameters in the joint fit
+  std::vector<ParameterEstimate> alone;      ///< its location errors (then shared effects) fitted alone
+  NoiseModel noise;                          ///< noise model of its residuals alone
+  bool noise_refit = false;                  ///< whitened by `noise` (GLS) in the joint fit
+  double noise_correction = 1.0;             ///< bias factor on its share of the covariance
+  double residual_rms_um = 0.0;              ///< of the joint fit, this session's rows
+  std::size_t n_residuals = 0;
+};
+
+struct MultiIdentification {
+  MachineType machine = MachineType::AC_trt;
+  std::vector<ParameterEstimate> location_errors;  ///< the one shared set, joint fit
+  std::vector<ParameterEstimate> effects;          ///< the shared catalogue effects' parameters
+  std::vector<MultiSessionResult> sessions;        ///< in input order
+  std::vector<MultiDisagreement> disagreements;
+  std::vector<std::string> parameter_names;        ///< joint vector order
+  Eigen::MatrixXd covariance;                      ///< joint, 1 sigma^2
+  std::vector<std::string> unobservable;
+  bool converged = false;
+  FitSummary summary;
+  std::vector<std::string> notes;
+  const ParameterEstimate& location_error(const std::string& name) const;
+};
+
+/// The joint identification. Throws InvalidArgument for fewer than two sessions, sessions of
+/// different machine types (naming them), a session without data, or repeated names.
+MultiIdentification identify_multi(const std::vector<MultiSessionInput>& sessions,
+                                   const MultiFitOptions& options = {});
+
+}  // namespace rotacal

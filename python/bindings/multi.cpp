@@ -1,0 +1,71 @@
+// Bindings for one identification from several sessions of one machine (multi/identify.hpp).
+// Thin: the sessions in, the result's fields out.
+#include <pybind11/eigen.h>
+#include <pybind11/stl.h>
+
+#include "numpy.hpp"
+#include "rotacal/io/probe_session.hpp"
+#include "rotacal/io/session.hpp"
+#include "rotacal/multi/identify.hpp"
+
+namespace rotacal::py {
+
+void bind_multi(pyb::module_& m) {
+  pyb::class_<MultiDisagreement>(m, "MultiDisagreement")
+      .def_readonly("parameter", &MultiDisagreement::parameter)
+      .def_readonly("unit", &MultiDisagreement::unit)
+      .def_readonly("session_a", &MultiDisagreement::session_a)
+      .def_readonly("session_b", &MultiDisagreement::session_b)
+      .def_readonly("value_a", &MultiDisagreement::value_a)
+      .def_readonly("value_b", &MultiDisagreement::value_b)
+      .def_readonly("difference", &MultiDisagreement::difference)
+      .def_readonly("sigma", &MultiDisagreement::sigma)
+      .def_readonly("z", &MultiDisagreement::z);
+  pyb::class_<MultiSessionResult>(m, "MultiSessionResult")
+      .def_readonly("name", &MultiSessionResult::name)
+      .def_readonly("instrument", &MultiSessionResult::instrument)
+      .def_readonly("nuisances", &MultiSessionResult::nuisances)
+      .def_readonly("alone", &MultiSessionResult::alone)
+      .def_readonly("noise", &MultiSessionResult::noise)
+      .def_readonly("noise_refit", &MultiSessionResult::noise_refit)
+      .def_readonly("noise_correction", &MultiSessionResult::noise_correction)
+      .def_readonly("residual_rms_um", &MultiSessionResult::residual_rms_um)
+      .def_readonly("n_residuals", &MultiSessionResult::n_residuals);
+  pyb::class_<MultiIdentification>(m, "MultiIdentification")
+      .def_readonly("machine", &MultiIdentification::machine)
+      .def_readonly("location_errors", &MultiIdentification::location_errors)
+      .def_readonly("effects", &MultiIdentification::effects)
+      .def_readonly("sessions", &MultiIdentification::sessions)
+      .def_readonly("disagreements", &MultiIdentification::disagreements)
+      .def_readonly("parameter_names", &MultiIdentification::parameter_names)
+      .def_readonly("covariance", &MultiIdentification::covariance)
+      .def_readonly("unobservable", &MultiIdentification::unobservable)
+      .def_readonly("converged", &MultiIdentification::converged)
+      .def_readonly("summary", &MultiIdentification::summary)
+      .def_readonly("notes", &MultiIdentification::notes);
+
+  m.def(
+      "identify_multi",
+      [](const std::vector<std::pair<std::string, pyb::object>>& sessions, const std::string& noise,
+         const std::vector<std::string>& effects) {
+        std::vector<MultiSessionInput> in;
+        for (const auto& [name, s] : sessions) {
+          if (pyb::isinstance<BallbarSession>(s)) in.push_back(MultiSessionInput::of(name, s.cast<BallbarSession>()));
+          else if (pyb::isinstance<RtestSession>(s)) in.push_back(MultiSessionInput::of(name, s.cast<RtestSession>()));
+          else if (pyb::isinstance<ProbeSession>(s)) in.push_back(MultiSessionInput::of(name, s.cast<ProbeSession>()));
+          else throw InvalidArgument("identify: session " + name + " is not a ballbar, R-test or touch-probe session");
+        }
+        MultiFitOptions o;
+        o.noise = noise_handling_from_string(noise);
+        o.effects = effects_of(effects);
+        pyb::gil_scoped_release release;
+        return identify_multi(in, o);
+      },
+      pyb::arg("sessions"), pyb::arg("noise") = "auto", pyb::arg("effects") = std::vector<std::string>{},
+      "One identification from several (name, session) pairs of one machine (multi/identify.hpp): "
+      "one set of location errors (and of the catalogue effects `effects`), each session's own "
+      "nuisances and noise model, and the "
+      "disagreements between the sessions fitted alone; noise 'auto' or 'white'.");
+}
+
+}  // namespace rotacal::py

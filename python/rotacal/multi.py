@@ -1,0 +1,71 @@
+"""One identification from several sessions of one machine (ballbar, R-test, touch probe):
+one set of location errors (and of catalogue effects where asked), each session's own nuisances
+and noise model, and the parameters on
+which the sessions fitted alone disagree. C++ computes (include/rotacal/multi); this module only
+composes."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Sequence
+
+from . import _core, rtest
+from .models import estimate_dict, machine_members
+from .results import noise_model_dict
+from .sessions import RTEST, kind
+
+
+@dataclass
+class MultiIdentification:
+    """The joint result (``raw``: _core.MultiIdentification)."""
+
+    raw: Any
+
+    @property
+    def machine(self):
+        return self.raw.machine
+
+    def location_error(self, name: str) -> Any:
+        for p in self.raw.location_errors:
+            if p.name == name:
+                return p
+        raise _core.InvalidArgument(f"no location error named {name!r}")
+
+    def to_dict(self) -> dict:
+        r = self.raw
+        return {
+            "method": "joint-multi",
+            **machine_members(r.machine),
+            "location_errors": {p.name: estimate_dict(p) for p in r.location_errors},
+            "effects": {p.name: estimate_dict(p) for p in r.effects},
+            "sessions": [{
+                "name": s.name,
+                "instrument": s.instrument,
+                "nuisances": {p.name: estimate_dict(p) for p in s.nuisances},
+                "alone": {p.name: estimate_dict(p) for p in s.alone},
+                "residual_rms_um": float(s.residual_rms_um),
+                "n_residuals": int(s.n_residuals),
+                "noise_model": noise_model_dict(s.noise, s.noise_refit, s.noise_correction),
+            } for s in r.sessions],
+            "disagreements": [{
+                "parameter": d.parameter, "unit": d.unit, "sessions": [d.session_a, d.session_b],
+                "values": [float(d.value_a), float(d.value_b)], "difference": float(d.difference),
+                "sigma": float(d.sigma), "z": float(d.z),
+            } for d in r.disagreements],
+            "converged": bool(r.converged),
+            "unobservable": list(r.unobservable),
+            "notes": list(r.notes),
+        }
+
+
+def identify_sessions(sessions: Sequence[Any], names: Sequence[str] | None = None, *,
+                      noise: str = "auto", effects: Sequence[str] = ()) -> MultiIdentification:
+    """Identify several sessions of one machine jointly (rotacal.identify with a list).
+    ``names`` name the sessions in the result (default "session 1", ...); ``effects``: catalogue
+    ids of the machine fitted along, one set shared by every session (about the machine zero);
+    an R-test session's raw d1,d2,d3 readings are converted as identify_rtest converts them."""
+    sessions = list(sessions)
+    names = [f"session {k + 1}" for k in range(len(sessions))] if names is None else list(names)
+    if len(names) != len(sessions):
+        raise _core.InvalidArgument(f"identify: {len(names)} names for {len(sessions)} sessions")
+    ready = [rtest.with_displacements(s)[0] if kind(s) == RTEST else s for s in sessions]
+    return MultiIdentification(_core.identify_multi(list(zip(names, ready)), noise, list(effects)))

@@ -1,0 +1,288 @@
+// One identification from several sessions of one machine (multi/identify.hpp).
+#include "rotacal/multi/identify.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "rotacal/core/block_whitener.hpp"
+#include "rotacal/core/parameter_layout.hpp"
+#include "rotacal/io/probe_session.hpp"
+#include "rotacal/io/session.hpp"
+#include "rotacal/kinematics/parameter_blocks.hpp"
+#include "session_parts.hpp"
+
+namespace rotacal {
+
+using multi_detail::SessionPart;
+
+MultiSessionInput MultiSessionInput::of(std::string name, BallbarSession session) {
+  MultiSessionInput in;
+  in.name = std::move(name);
+  in.instrument = "ballbar";
+  in.ballbar = std::make_shared<const BallbarSession>(std::move(session));
+  return in;
+}
+MultiSessionInput MultiSessionInput::of(std::string name, RtestSession session) {
+  MultiSessionInput in;
+  in.name = std::move(name);
+  in.instrument = "rtest";
+  in.rtest = std::make_shared<const RtestSession>(std::move(session));
+  return in;
+}
+MultiSessionInput MultiSessionInput::of(std::string name, ProbeSession session) {
+  MultiSessionInput in;
+  in.name = std::move(name);
+  in.instrument = "probe";
+  in.probe = std::make_shared<const ProbeSession>(std::move(session));
+  return in;
+}
+MachineType MultiSessionInput::machine() const {
+  if (ballbar) return ballbar->machine;
+  if (rtest) return rtest->machine;
+  if (probe) return probe->machine;
+  throw InvalidArgument("identify: session " + name + " holds no data");
+}
+
+const ParameterEstimate& MultiIdentification::location_error(const std::string& name) const {
+  for (const ParameterEstimate& e : location_errors)
+    if (e.name == name) return e;
+  throw InvalidArgument("no location error named '" + name + "'");
+}
+
+namespace {
+
+// The sessions' residual models stacked row-wise over one parameter vector: the shared blocks
+// "location_errors" and "effects" (the catalogue effects fitted for the machine, empty unless
+// asked), then each session's own parameters as a block named after it. Each session's own
+// model computes its rows and Jacobian; its shared columns land on the shared blocks, its other
+// columns on its own.
+class StackedModel : public ResidualModel {
+ public:
+  StackedModel(const std::vector<SessionPart>& parts, MachineType m, const EffectModel& fx) : parts_(parts) {
+    const auto& arr = location_error_names(m);
+    std::vector<std::string> names(arr.begin(), arr.end()), units(names.size());
+    for (const Effect& f : fx.effects)
+      for (std::size_t k = 0; k < static_cast<std::size_t>(f.num_params()); ++k) {
+        names.push_back(effect_parameter_name(f, k));
+        units.push_back(f.param_units()[k]);
+      }
+    for (std::size_t j = 0; j < parts.front().parameters.size(); ++j)
+      if (parts.front().shared[j] >= 0 && parts.front().shared[j] < 8)
+        units[static_cast<std::size_t>(parts.front().shared[j])] = parts.front().parameters[j].unit;
+    errors_ = layout_.add("location_errors", {names.begin(), names.begin() + 8}, {units.begin(), units.begin() + 8});
+    effects_ = layout_.add("effects", {names.begin() + 8, names.end()}, {units.begin() + 8, units.end()});
+    for (const SessionPart& p : parts) {
+      if (std::count_if(p.shared.begin(), p.shared.end(), [](Eigen::Index i) { return i >= 0; }) !=
+          static_cast<std::ptrdiff_t>(names.size()))
+        throw InvalidArgument("identify: session " + p.name + " does not hold the " + std::to_string(names.size()) +
+                              " shared parameters (location errors and effects)");
+      std::vector<std::string> own, own_units;
+      for (std::size_t j = 0; j < p.parameters.size(); ++j)
+        if (p.shared[j] < 0) {
+          own.push_back(p.name + ":" + p.parameters[j].name);
+          own_units.push_back(p.parameters[j].unit);
+        }
+      const ParameterBlock b = layout_.add(p.name, own, own_units);
+      std::vector<Eigen::Index> map;
+      Eigen::Index next = b.offset;
+      for (std::size_t j = 0; j < p.parameters.size(); ++j)
+        map.push_back(p.shared[j] < 0 ? next++ : shared_index(p.shared[j]));
+      maps_.push_back(std::move(map));
+      blocks_.push_back(b);
+      rows_ += p.model->num_residuals();
+    }
+  }
+  /// Index in the joint vector of shared parameter i (location errors, then effects).
+  Eigen::Index shared_index(Eigen::Index i) const {
+    return i < errors_.size ? errors_.offset + i : effects_.offset + i - errors_.size;
+  }
+  Eigen::Index num_shared() const { return errors_.size + effects_.size; }
+  Eigen::Index num_residuals() const override { return rows_; }
+  int num_parameters() const override { return static_cast<int>(layout_.size()); }
+  void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r, Eigen::MatrixXd* J) const override {
+    Eigen::Index row = 0;
+    if (J) J->setZero();
+    for (std::size_t k = 0; k < parts_.size(); ++k) {
+      const ResidualModel& m = *parts_[k].model;
+      const std::vector<Eigen::Index>& map = maps_[k];
+      const Eigen::Index n = m.num_residuals();
+      Eigen::VectorXd xk(static_cast<Eigen::Index>(map.size()));
+      for (std::size_t j = 0; j < map.size(); ++j) xk[static_cast<Eigen::Index>(j)] = x[map[j]];
+      if (!J) {
+        m.evaluate(xk, r.segment(row, n), nullptr);
+      } else {
+        Eigen::MatrixXd Jk(n, xk.size());
+        m.evaluate(xk, r.segment(row, n), &Jk);
+        for (std::size_t j = 0; j < map.size(); ++j)
+          J->col(map[j]).segment(row, n) += Jk.col(static_cast<Eigen::Index>(j));
+      }
+      row += n;
+    }
+  }
+  const ParameterLayout& layout() const { return layout_; }
+  const ParameterBlock& errors() const { return errors_; }
+  const ParameterBlock& effects() const { return effects_; }
+  const ParameterBlock& block(std::size_t k) const { return blocks_[k]; }
+  const std::vector<Eigen::Index>& map(std::size_t k) const { return maps_[k]; }
+
+ private:
+  const std::vector<SessionPart>& parts_;
+  ParameterLayout layout_;
+  ParameterBlock errors_, effects_;
+  std::vector<ParameterBlock> blocks_;
+  std::vector<std::vector<Eigen::Index>> maps_;
+  Eigen::Index rows_ = 0;
+};
+
+void check_sessions(const std::vector<MultiSessionInput>& sessions) {
+  if (sessions.size() < 2)
+    throw InvalidArgument("identify: a joint identification needs at least two sessions, got " +
+                          std::to_string(sessions.size()));
+  std::set<std::string> names;
+  for (const MultiSessionInput& s : sessions)
+    if (!names.insert(s.name).second) throw InvalidArgument("identify: session name " + s.name + " given twice");
+  const MachineType m = sessions.front().machine();
+  for (const MultiSessionInput& s : sessions)
+    if (s.machine() != m)
+      throw InvalidArgument("identify: sessions of different machine types: " + sessions.front().name + " is " +
+                            to_string(m) + ", " + s.name + " is " + to_string(s.machine()) +
+                            "; a joint identification is of one machine");
+}
+
+// The session alone: white fit -> its noise model -> [GLS], as its instrument's own fit.
+NoiseFit fit_alone(const SessionPart& p, const MultiFitOptions& o) {
+  NoiseFitOptions no;
+  no.noise = o.noise;
+  no.noise_options = o.noise_options;
+  no.min_correlation_samples = o.min_correlation_samples;
+  no.noise_bias_correction = o.noise_bias_correction;
+  no.allow_reml = p.allow_reml;
+  JointFitSettings s = p.settings;
+  s.max_iterations = o.max_iterations;
+  s.observability_min_chi2 = o.observability_min_chi2;
+  return fit_with_noise([&](const JointFitSettings& st) { return solve_joint(*p.model, p.parameters, st); }, s,
+                        p.groups, p.times, no);
+}
+
+// The session's block of the joint whitener: its GLS model (scaled by the bias factor) when its
+// fit alone was redone by GLS, else 1 / its residual sigma.
+BlockDiagonalWhitener::Block whitener_block(const SessionPart& p, const NoiseFit& nf) {
+  BlockDiagonalWhitener::Block b;
+  b.rows = p.model->num_residuals();
+  if (nf.refit) {
+    b.whitener = std::make_shared<ArWhitener>(nf.noise);
+    b.factor = 1.0 / nf.scale;
+    return b;
+  }
+  const double dof = std::max(1.0, static_cast<double>(b.rows - nf.fit.summary.num_free));
+  b.factor = 1.0 / std::sqrt(nf.fit.residuals.squaredNorm() / dof);
+  return b;
+}
+
+std::vector<MultiDisagreement> disagreements(const std::vector<MultiSessionResult>& s, double z_max) {
+  std::vector<MultiDisagreement> out;
+  for (std::size_t a = 0; a < s.size(); ++a)
+    for (std::size_t b = a + 1; b < s.size(); ++b)
+      for (std::size_t j = 0; j < s[a].alone.size(); ++j) {
+        const ParameterEstimate &ea = s[a].alone[j], &eb = s[b].alone[j];
+        if (!ea.observable || !eb.observable) continue;
+        MultiDisagreement d;
+        d.parameter = ea.name;
+        d.unit = ea.unit;
+        d.session_a = s[a].name;
+        d.session_b = s[b].name;
+        d.value_a = ea.value;
+        d.value_b = eb.value;
+        d.difference = ea.value - eb.value;
+        d.sigma = std::hypot(ea.std, eb.std);
+        d.z = d.sigma > 0.0 ? d.difference / d.sigma : 0.0;
+        if (std::abs(d.z) > z_max) out.push_back(d);
+      }
+  return out;
+}
+
+// The shared catalogue effects as every session fits them: their linear-axis polynomials about
+// the caller's a_ref, else about the machine zero, the same for every session.
+EffectModel shared_effects(const MultiFitOptions& o) {
+  EffectModel fx = o.effects;
+  if (!fx.linear_reference) fx.linear_reference = Eigen::Vector3d::Zero();
+  return fx;
+}
+
+}  // namespace
+
+MultiIdentification identify_multi(const std::vector<MultiSessionInput>& sessions, const MultiFitOptions& o) {
+  check_sessions(sessions);
+  const EffectModel fx = shared_effects(o);
+  std::vector<SessionPart> parts;
+  for (const MultiSessionInput& s : sessions) parts.push_back(multi_detail::session_part(s, fx));
+  const StackedModel model(parts, sessions.front().machine(), fx);
+
+  MultiIdentification out;
+  out.machine = sessions.front().machine();
+  std::vector<BlockDiagonalWhitener::Block> wblocks;
+  std::vector<FitParameter> params(static_cast<std::size_t>(model.num_parameters()));
+  const std::vector<std::string> names = model.layout().names(), units = model.layout().units();
+  for (std::size_t j = 0; j < params.size(); ++j) params[j] = {names[j], units[j], 0.0};
+  std::vector<bool> set(params.size(), false);
+  for (std::size_t k = 0; k < parts.size(); ++k) {
+    const SessionPart& p = parts[k];
+    const NoiseFit nf = fit_alone(p, o);
+    wblocks.push_back(whitener_block(p, nf));
+    MultiSessionResult r;
+    r.alone.resize(static_cast<std::size_t>(model.num_shared()));
+    // Own parameters start at the session's solution alone; the shared ones at zero, with the
+    // first session's settings (scale, yield convention of the effects).
+    for (std::size_t j = 0; j < p.parameters.size(); ++j) {
+      const auto J = static_cast<std::size_t>(model.map(k)[j]);
+      if (p.shared[j] >= 0) r.alone[static_cast<std::size_t>(p.shared[j])] = nf.fit.estimates[j];
+      if (set[J]) continue;
+      params[J] = p.parameters[j];
+      params[J].name = names[J];
+      params[J].start = p.shared[j] >= 0 ? 0.0 : nf.fit.values[static_cast<Eigen::Index>(j)];
+      set[J] = true;
+    }
+    r.name = p.name;
+    r.instrument = p.instrument;
+    r.noise = nf.noise;
+    r.noise_refit = nf.refit;
+    r.noise_correction = nf.scale;
+    r.n_residuals = static_cast<std::size_t>(p.model->num_residuals());
+    out.sessions.push_back(std::move(r));
+  }
+
+  JointFitSettings settings;
+  settings.max_iterations = o.max_iterations;
+  settings.observability_min_chi2 = o.observability_min_chi2;
+  settings.whitener = std::make_shared<BlockDiagonalWhitener>(std::move(wblocks));
+  JointFitOutcome fit = solve_joint(model, params, settings);
+
+  const ParameterBlock& E = model.errors();
+  out.location_errors.assign(fit.estimates.begin() + E.offset, fit.estimates.begin() + E.end());
+  const ParameterBlock& F = model.effects();
+  out.effects.assign(fit.estimates.begin() + F.offset, fit.estimates.begin() + F.end());
+  Eigen::Index row = 0;
+  for (std::size_t k = 0; k < parts.size(); ++k) {
+    const ParameterBlock& b = model.block(k);
+    out.sessions[k].nuisances.assign(fit.estimates.begin() + b.offset, fit.estimates.begin() + b.end());
+    for (ParameterEstimate& e : out.sessions[k].nuisances) e.name = e.name.substr(parts[k].name.size() + 1);
+    const Eigen::Index n = static_cast<Eigen::Index>(out.sessions[k].n_residuals);
+    const double ms = fit.residuals.segment(row, n).squaredNorm() / static_cast<double>(n);
+    out.sessions[k].residual_rms_um = std::sqrt(ms) * 1e3;
+    row += n;
+  }
+  out.disagreements = disagreements(out.sessions, o.disagreement_z);
+  for (const MultiDisagreement& d : out.disagreements)
+    out.notes.push_back("sessions " + d.session_a + " and " + d.session_b + " disagree on " + d.parameter +
+                        " (z = " + std::to_string(d.z) + "): the joint value averages them");
+  out.parameter_names = names;
+  out.covariance = std::move(fit.covariance);
+  out.unobservable = std::move(fit.unobservable);
+  out.converged = fit.summary.converged;
+  out.summary = fit.summary;
+  if (!out.converged) out.notes.push_back("the joint fit did not converge: " + fit.summary.message);
+  return out;
+}
+
+}  // namespace rotacal
