@@ -2,6 +2,7 @@
 #include "numpy.hpp"
 #include "rotacal/core/json_text.hpp"
 #include "rotacal/io/ballbar_file.hpp"
+#include "rotacal/ballbar/model_document.hpp"
 #include "rotacal/io/model_file.hpp"
 #include "rotacal/io/output_file.hpp"
 #include "rotacal/io/plausibility.hpp"

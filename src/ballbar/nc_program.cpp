@@ -5,7 +5,7 @@
 #include <sstream>
 #include <vector>
 
-#include "nc_words.hpp"
+#include "../io/nc_words.hpp"
 #include "rotacal/core/error.hpp"
 
 namespace rotacal {
@@ -330,29 +330,6 @@ class Writer {
 };
 
 }  // namespace
-
-std::string to_string(NcDialect dialect) {
-  switch (dialect) {
-    case NcDialect::linuxcnc:
-      return "linuxcnc";
-    case NcDialect::heidenhain:
-      return "heidenhain";
-    case NcDialect::siemens:
-      return "siemens";
-    case NcDialect::fanuc:
-      return "fanuc";
-  }
-  ROTACAL_ASSERT(false);
-  return {};
-}
-
-NcDialect parse_nc_dialect(const std::string& text) {
-  for (NcDialect d :
-       {NcDialect::linuxcnc, NcDialect::heidenhain, NcDialect::siemens, NcDialect::fanuc})
-    if (to_string(d) == text) return d;
-  throw InvalidArgument("unknown NC dialect '" + text +
-                        "' (known: linuxcnc, heidenhain, siemens, fanuc)");
-}
 
 std::string write_nc_program(const BallbarPlan& plan, NcDialect dialect,
                              const NcProgramOptions& options) {

@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <set>
 
-#include "../ballbar/nc_words.hpp"
+#include "../io/nc_words.hpp"
 #include "rotacal/core/error.hpp"
 
 namespace rotacal {

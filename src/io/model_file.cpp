@@ -366,30 +366,9 @@ void write_model(const json& document, const std::string& path, const OutputOpti
   write_output(path, [&] { return format_model(document, path); }, options);
 }
 
-json ballbar_model_document(const BallbarMachineModel& model) {
-  json doc = {{"format", kModelFormat}, {"kind", "ballbar"}};
-  put_machine(doc, model.machine);
-  json le = json::object();
-  const auto& names = location_error_names(model.machine);
-  for (int k = 0; k < 8; ++k)
-    le[names[k]] = {{"value", model.errors.v[k]}, {"unit", location_error_is_angle(k) ? "rad" : "mm"}};
-  doc["location_errors"] = le;
-  doc["pivot"] = json::object();
-  for (int a = 0; a < 3; ++a) doc["pivot"][std::string(1, "xyz"[a])] = {{"value", model.pivot[a]}, {"unit", "mm"}};
-  json fx = json::array();
-  std::size_t offset = 0;
-  for (const Effect& e : model.effects.effects) {
-    json params = json::object();
-    const auto pn = e.param_names();
-    const auto pu = e.param_units();
-    for (std::size_t k = 0; k < pn.size(); ++k) {
-      if (offset >= model.effect_params.size())
-        throw InvalidArgument("ballbar_model_document: effect_params has fewer values than the effects need");
-      params[pn[k]] = {{"value", model.effect_params[offset++]}, {"unit", pu[k]}};
-    }
-    fx.push_back({{"id", e.id()}, {"cause", e.cause()}, {"params", params}});
-  }
-  doc["effects"] = fx;
+json model_document_header(const std::string& kind, MachineType machine) {
+  json doc = {{"format", kModelFormat}, {"kind", kind}};
+  put_machine(doc, machine);
   return doc;
 }
 
@@ -427,8 +406,7 @@ json rtest_joint_model_document(const RtestJointModelContent& c) {
   if (c.covariance.rows() != static_cast<Eigen::Index>(n) || c.covariance.cols() != static_cast<Eigen::Index>(n))
     throw InvalidArgument("rtest_joint_model_document: the covariance is not " + std::to_string(n) + " x " +
                           std::to_string(n));
-  json doc = {{"format", kModelFormat}, {"kind", "rtest-joint"}};
-  put_machine(doc, c.machine);
+  json doc = model_document_header("rtest-joint", c.machine);
   json maps = json::array();
   for (const std::string& m : rtest_map_names(c.machine)) maps.push_back(m);
   doc["basis"] = {{"b_degree", c.b_degree}, {"c_harmonics", c.c_harmonics}, {"c_b_degree", c.c_b_degree},
@@ -457,18 +435,6 @@ json rtest_joint_model_document(const RtestJointModelContent& c) {
   doc["fit"] = {{"residual_rms_um", c.residual_rms_um}, {"sigma_um", c.sigma_um}, {"n_samples", c.n_samples},
                 {"converged", c.converged}, {"unobservable", c.unobservable}, {"notes", c.notes}};
   return doc;
-}
-
-BallbarMachineModel ballbar_machine_model(const ModelFile& model) {
-  if (model.kind != "ballbar" || !model.pivot)
-    throw InvalidArgument("ballbar_machine_model: a " + model.kind + " model is not a ballbar model");
-  BallbarMachineModel m;
-  m.machine = model.machine;
-  m.errors = model.location_errors;
-  m.pivot = *model.pivot;
-  m.effects = model.effects;
-  m.effect_params = model.effect_params;
-  return m;
 }
 
 }  // namespace rotacal

@@ -1,5 +1,5 @@
 // The probing program of a touch-probe session and the reader of its LinuxCNC log
-// (probe/nc_program.hpp). NC words and comments: src/ballbar/nc_words.hpp, as the ballbar's
+// (probe/nc_program.hpp). NC words and comments: src/io/nc_words.hpp, as the ballbar's
 // and the circular tests' programs write them.
 #include "rotacal/probe/nc_program.hpp"
 
@@ -8,7 +8,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "../ballbar/nc_words.hpp"
+#include "../io/nc_words.hpp"
 #include "rotacal/core/error.hpp"
 
 namespace rotacal {

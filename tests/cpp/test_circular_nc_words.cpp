@@ -1,11 +1,11 @@
 // The NC program preamble shared by the rotary-axis and the circular-test writers
-// (src/ballbar/nc_words.hpp): what it writes per dialect, that it is what both programs open
+// (src/io/nc_words.hpp): what it writes per dialect, that it is what both programs open
 // with, and the errors it raises in each writer's name.
 #include <catch2/catch.hpp>
 #include <algorithm>
 #include <sstream>
 
-#include "../../src/ballbar/nc_words.hpp"
+#include "../../src/io/nc_words.hpp"
 #include "rotacal/circular/plan.hpp"
 #include "rotacal/ballbar/nc_program.hpp"
 #include "rotacal/ballbar/plan.hpp"

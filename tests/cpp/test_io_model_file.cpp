@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "rotacal/core/error.hpp"
+#include "rotacal/ballbar/model_document.hpp"
 #include "rotacal/io/model_file.hpp"
 
 using namespace rotacal;

@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "rotacal/ballbar/simulate.hpp"
-#include "rotacal/core/machine_model.hpp"
+#include "rotacal/kinematics/machine_model.hpp"
 #include "rotacal/rtest/simulate.hpp"
 
 using namespace rotacal;

@@ -15,7 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "rotacal/ballbar/simulate.hpp"
-#include "rotacal/core/machine_model.hpp"
+#include "rotacal/kinematics/machine_model.hpp"
 #include "rotacal/core/noise_model.hpp"
 #include "rotacal/io/ballbar_file.hpp"
 

@@ -7,13 +7,13 @@
 #include <vector>
 
 #include "rotacal/ballbar/motion.hpp"
-#include "rotacal/core/machine_model.hpp"
+#include "rotacal/kinematics/machine_model.hpp"
 #include "rotacal/io/session.hpp"
 #include "rotacal/kinematics/effects.hpp"
 
 namespace rotacal {
 
-/// Everything that determines a ballbar reading: the machine (core/machine_model.hpp) and
+/// Everything that determines a ballbar reading: the machine (kinematics/machine_model.hpp) and
 /// the actual position of the centre-pivot ball on its table (table frame, mm), the one
 /// quantity the ballbar set-up adds.
 struct BallbarMachineModel : MachineModel {

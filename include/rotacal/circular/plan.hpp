@@ -23,7 +23,7 @@
 #include <string>
 #include <vector>
 
-#include "rotacal/ballbar/nc_program.hpp"
+#include "rotacal/io/nc_dialect.hpp"
 #include "rotacal/io/session.hpp"
 #include "rotacal/kinematics/machine.hpp"
 

@@ -20,9 +20,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "rotacal/ballbar/model.hpp"
 #include "rotacal/core/estimate.hpp"
 #include "rotacal/io/output_file.hpp"
+#include "rotacal/kinematics/effects.hpp"
 #include "rotacal/kinematics/machine.hpp"
 
 namespace rotacal {
@@ -78,11 +78,10 @@ std::string format_model(const nlohmann::ordered_json& document, const std::stri
 void write_model(const nlohmann::ordered_json& document, const std::string& path,
                  const OutputOptions& options = {});
 
-/// The document of a ballbar model with the given values (no uncertainties): what a C++
-/// program that fitted or edited a model writes.
-nlohmann::ordered_json ballbar_model_document(const BallbarMachineModel& model);
-/// The machine model of a "ballbar" model file (InvalidArgument for other kinds).
-BallbarMachineModel ballbar_machine_model(const ModelFile& model);
+/// The members every model document starts with: format, kind, machine (and the description of
+/// a machine that is not a built-in table-table one). The instruments' writers
+/// (ballbar/model_document.hpp, rtest/model_document.hpp) add their own members to it.
+nlohmann::ordered_json model_document_header(const std::string& kind, MachineType machine);
 
 /// What a "rtest-joint" model file holds (docs/model_file.md), in plain values: the joint
 /// R-test identification (rtest/identify_joint.hpp) as the file writes it. rtest/model_document.hpp

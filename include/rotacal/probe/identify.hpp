@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "rotacal/core/fit_with_noise.hpp"
-#include "rotacal/core/machine_model.hpp"
+#include "rotacal/kinematics/machine_model.hpp"
 #include "rotacal/io/probe_session.hpp"
 
 namespace rotacal {

@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "rotacal/ballbar/nc_program.hpp"
+#include "rotacal/io/nc_dialect.hpp"
 #include "rotacal/io/probe_session.hpp"
 #include "rotacal/probe/simulate.hpp"
 

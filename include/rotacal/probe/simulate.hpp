@@ -11,7 +11,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "rotacal/core/machine_model.hpp"
+#include "rotacal/kinematics/machine_model.hpp"
 #include "rotacal/io/probe_session.hpp"
 
 namespace rotacal {

@@ -13,7 +13,7 @@
 #include <algorithm>
 #include <vector>
 
-#include "rotacal/core/machine_model.hpp"
+#include "rotacal/kinematics/machine_model.hpp"
 
 namespace rotacal {
 

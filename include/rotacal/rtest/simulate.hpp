@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "rotacal/core/machine_model.hpp"
+#include "rotacal/kinematics/machine_model.hpp"
 #include "rotacal/io/session.hpp"
 #include "rotacal/rtest/model.hpp"
 

@@ -1,5 +1,5 @@
 #pragma once
-// Internal to src/ballbar, src/circular and src/probe: number formatting of NC words, each
+// Internal to src/ballbar, src/circular and src/probe (kept in src/io, below all three): number formatting of NC words, each
 // dialect's comment writer, and the program preamble per dialect, shared by the NC writer of the
 // rotary-axis test (nc_program.cpp), of the circular tests (src/circular/plan.cpp) and of the
 // touch probe (src/probe/nc_program.cpp).
@@ -8,7 +8,7 @@
 #include <functional>
 #include <string>
 
-#include "rotacal/ballbar/nc_program.hpp"
+#include "rotacal/io/nc_dialect.hpp"
 #include "rotacal/core/error.hpp"
 #include "rotacal/io/controller_comment.hpp"
 

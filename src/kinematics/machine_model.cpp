@@ -1,5 +1,5 @@
 // MachineModel: parameter names and validation shared by the ballbar and the R-test.
-#include "rotacal/core/machine_model.hpp"
+#include "rotacal/kinematics/machine_model.hpp"
 
 #include <cmath>
 

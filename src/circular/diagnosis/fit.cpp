@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "rotacal/core/error.hpp"
-#include "../diagnose/scoring.hpp"
+#include "../../diagnose/scoring.hpp"
 
 namespace rotacal::circular_detail {
 

@@ -6,7 +6,7 @@
 #include <memory>
 
 #include "diagnosis_detail.hpp"
-#include "../diagnose/scoring.hpp"
+#include "../../diagnose/scoring.hpp"
 
 namespace rotacal::circular_detail {
 
