@@ -8,8 +8,10 @@
 
 namespace rotacal::py {
 
+namespace {
 
-void bind_ballbar(pyb::module_& m) {
+// Parameter estimates, fit summaries, the machine model and the identification.
+void bind_ballbar_results(pyb::module_& m) {
   pyb::class_<ParameterEstimate>(m, "ParameterEstimate")
       .def_readonly("name", &ParameterEstimate::name)
       .def_readonly("value", &ParameterEstimate::value)
@@ -80,7 +82,10 @@ void bind_ballbar(pyb::module_& m) {
       .def_readonly("noise", &BallbarIdentification::noise)
       .def_readonly("noise_refit", &BallbarIdentification::noise_refit)
       .def_readonly("noise_correction", &BallbarIdentification::noise_correction);
+}
 
+// The joint fit, its Monte Carlo check and the paper's method.
+void bind_ballbar_identification(pyb::module_& m) {
   m.def(
       "identify_joint",
       [](const BallbarSession& session, bool fit_length_offset,
@@ -154,7 +159,10 @@ BallbarMonteCarlo: per observable parameter std_reported, std_mc, ratio, bias; v
       },
       pyb::arg("session"),
       "Flynn et al. 2016's chain: sphere fit, Hyper circle fits, SVD plane fits, transport.");
+}
 
+// Simulation, predicted lengths and compensation.
+void bind_ballbar_simulation(pyb::module_& m) {
   m.def(
       "simulate_ballbar",
       [](const BallbarSession& commanded, const BallbarMachineModel& truth, double noise_um,
@@ -199,6 +207,14 @@ BallbarMonteCarlo: per observable parameter std_reported, std_mc, ratio, bias; v
       },
       pyb::arg("commanded"), pyb::arg("truth"), pyb::arg("noise_um") = 0.5, pyb::arg("seed") = 1,
       "Measure, identify, compensate, measure again, identify again (Flynn et al., Table 2).");
+}
+
+}  // namespace
+
+void bind_ballbar(pyb::module_& m) {
+  bind_ballbar_results(m);
+  bind_ballbar_identification(m);
+  bind_ballbar_simulation(m);
 }
 
 }  // namespace rotacal::py

@@ -5,7 +5,10 @@
 
 namespace rotacal::py {
 
-void bind_ballbar_plan(pyb::module_& m) {
+namespace {
+
+// The tests, directions, segment kinds and dialects, and their labels.
+void bind_ballbar_tests(pyb::module_& m) {
   pyb::enum_<BallbarTest>(m, "BallbarTest",
                           "Tests of the single set-up method; *_tilt are A or B by machine.")
       .value("sphere_xy", BallbarTest::sphere_xy)
@@ -45,7 +48,10 @@ void bind_ballbar_plan(pyb::module_& m) {
   m.def("run_label", &run_label, pyb::arg("test"), pyb::arg("direction"), pyb::arg("feed_factor"),
         pyb::arg("setup"), "Label of one run: test label, '_cw', '_f<feed>'.");
   m.def("parse_nc_dialect", &parse_nc_dialect, pyb::arg("text"));
+}
 
+// The set-up of the single set-up test.
+void bind_ballbar_setup(pyb::module_& m) {
   const BallbarSetup d;
   pyb::class_<BallbarSetup>(m, "BallbarSetup",
                             "Layout of the single set-up ballbar test (mm, deg, mm/min, deg/min).")
@@ -98,7 +104,10 @@ void bind_ballbar_plan(pyb::module_& m) {
                      "tilt held during axial_c, deg; None: default_axial_c_tilt_deg(machine)");
   m.def("default_tilt_range_deg", &default_tilt_range_deg, pyb::arg("machine"));
   m.def("default_axial_c_tilt_deg", &default_axial_c_tilt_deg, pyb::arg("machine"));
+}
 
+// The planned toolpath and the planner.
+void bind_ballbar_toolpath(pyb::module_& m) {
   pyb::class_<TransitionArc>(m, "TransitionArc",
                              "Great-circle arc about the pivot at rotary zero (mm, rad).")
       .def_readonly("start", &TransitionArc::start)
@@ -171,7 +180,10 @@ identified : (8,) location errors (mm, rad; order of location_error_names), opti
 Returns
 -------
 BallbarPlan: labels, time (N,), p_table (N, 3), angles_deg (N, 2), machine_axes (N, 5))doc");
+}
 
+// NC program options and writer.
+void bind_nc_program(pyb::module_& m) {
   const NcProgramOptions o;
   pyb::class_<NcProgramOptions>(m, "NcProgramOptions")
       .def(pyb::init([](int decimals, int tool, bool stop_to_mount, std::string program_name,
@@ -198,6 +210,15 @@ BallbarPlan: labels, time (N,), p_table (N, 3), angles_deg (N, 2), machine_axes 
         return write_nc_program(plan, parse_nc_dialect(dialect), options);
       },
       pyb::arg("plan"), pyb::arg("dialect"), pyb::arg("options") = NcProgramOptions{});
+}
+
+}  // namespace
+
+void bind_ballbar_plan(pyb::module_& m) {
+  bind_ballbar_tests(m);
+  bind_ballbar_setup(m);
+  bind_ballbar_toolpath(m);
+  bind_nc_program(m);
 }
 
 }  // namespace rotacal::py

@@ -12,9 +12,9 @@ namespace {
 Eigen::VectorXd vec(const std::vector<double>& v) {
   return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
 }
-}  // namespace
 
-void bind_circular(pyb::module_& m) {
+// The test plan, its runs and its NC program.
+void bind_circular_plan(pyb::module_& m) {
   pyb::enum_<CircularPlane>(m, "CircularPlane",
                             "Plane of an ISO 230-4 circular test: (u, v) = XY, YZ, ZX.")
       .value("XY", CircularPlane::XY)
@@ -94,7 +94,10 @@ void bind_circular(pyb::module_& m) {
   m.def("write_circular_nc_program", &write_circular_nc_program, pyb::arg("plan"),
         pyb::arg("dialect"), pyb::arg("options") = NcProgramOptions{},
         "NC program text of a circular plan.");
+}
 
+// The linear-axis errors and the simulation.
+void bind_circular_simulation(pyb::module_& m) {
   pyb::class_<LinearAxisErrors>(
       m, "LinearAxisErrors",
       "Errors of the linear axes X, Y, Z (mm, rad, s); see circular/simulate.hpp.")
@@ -122,7 +125,10 @@ void bind_circular(pyb::module_& m) {
   m.def("simulate_circular", &simulate_circular, pyb::arg("plan"), pyb::arg("options"),
         pyb::call_guard<pyb::gil_scoped_release>(),
         "The session a ballbar records on a machine with linear-axis errors.");
+}
 
+// The ISO 230-4 analysis.
+void bind_circular_analysis(pyb::module_& m) {
   pyb::class_<CircularRunResult>(m, "CircularRunResult")
       .def_readonly("label", &CircularRunResult::label)
       .def_readonly("plane", &CircularRunResult::plane)
@@ -159,7 +165,10 @@ void bind_circular(pyb::module_& m) {
   m.def("analyze_circular", &analyze_circular, pyb::arg("session"),
         pyb::call_guard<pyb::gil_scoped_release>(),
         "ISO 230-4 circular deviation G per run, G(b) and hysteresis H per cw/ccw pair.");
+}
 
+// The circular-test catalogue and diagnosis.
+void bind_circular_diagnosis(pyb::module_& m) {
   pyb::class_<CircularEffect>(m, "CircularEffect", "An entry of the circular-test catalogue.")
       .def(pyb::init(&CircularEffect::parse), pyb::arg("id"))
       .def_property_readonly("id", &CircularEffect::id)
@@ -200,6 +209,15 @@ void bind_circular(pyb::module_& m) {
         pyb::arg("options") = CircularDiagnosisOptions{},
         pyb::call_guard<pyb::gil_scoped_release>(),
         "The classic causes the circular runs support, each with parameters, 1-sigma and gain.");
+}
+
+}  // namespace
+
+void bind_circular(pyb::module_& m) {
+  bind_circular_plan(m);
+  bind_circular_simulation(m);
+  bind_circular_analysis(m);
+  bind_circular_diagnosis(m);
 }
 
 }  // namespace rotacal::py

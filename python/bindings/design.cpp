@@ -6,7 +6,10 @@
 
 namespace rotacal::py {
 
-void bind_design(pyb::module_& m) {
+namespace {
+
+// The ballbar set-up design.
+void bind_ballbar_design(pyb::module_& m) {
   pyb::class_<BallbarDesignOptions>(m, "BallbarDesignOptions",
                                     "Options of design_ballbar_test (defaults).")
       .def(pyb::init<>())
@@ -57,6 +60,11 @@ void bind_design(pyb::module_& m) {
       },
       pyb::arg("options"),
       "The pivot and bar length with the smallest predicted uncertainty (ballbar/design.hpp).");
+}
+
+// Which effects move the table alike, the added ballbar test that separates two, and
+// the joint fit of several sessions.
+void bind_ballbar_separation(pyb::module_& m) {
   pyb::class_<TableMotionOverlap>(m, "TableMotionOverlap",
                                   "Whether two effects move the table alike (ballbar/design.hpp).")
       .def_readonly("moves_table_first", &TableMotionOverlap::moves_table_first)
@@ -142,6 +150,10 @@ void bind_design(pyb::module_& m) {
       pyb::arg("sessions"), pyb::arg("effects") = std::vector<std::string>{},
       "Joint fit of several ballbar sessions (shared location errors and effects, one pivot each): "
       "(values, covariance, converged) in the order 8 location errors, pivots, effect parameters.");
+}
+
+// The R-test pattern design.
+void bind_rtest_design(pyb::module_& m) {
   pyb::class_<RtestDesignOptions>(m, "RtestDesignOptions",
                                   "Options of design_rtest_test (defaults).")
       .def(pyb::init<>())
@@ -192,6 +204,10 @@ void bind_design(pyb::module_& m) {
       },
       pyb::arg("options"),
       "The R-test nests and pose grid with the smallest predicted uncertainty (rtest/design.hpp).");
+}
+
+// The added R-test nest that separates two effects.
+void bind_rtest_separation(pyb::module_& m) {
   pyb::class_<RtestSeparationOptions>(m, "RtestSeparationOptions",
                                       "Options of design_rtest_separation (defaults).")
       .def(pyb::init<>())
@@ -243,6 +259,15 @@ void bind_design(pyb::module_& m) {
       pyb::arg("session"), pyb::arg("pair"), pyb::arg("options") = RtestSeparationOptions{},
       "The smallest added R-test nest that separates two effects after a session "
       "(rtest/design.hpp).");
+}
+
+}  // namespace
+
+void bind_design(pyb::module_& m) {
+  bind_ballbar_design(m);
+  bind_ballbar_separation(m);
+  bind_rtest_design(m);
+  bind_rtest_separation(m);
 }
 
 }  // namespace rotacal::py

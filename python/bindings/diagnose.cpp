@@ -7,7 +7,10 @@
 
 namespace rotacal::py {
 
-void bind_diagnose(pyb::module_& m) {
+namespace {
+
+// The options, fits, gains and findings of a diagnosis.
+void bind_diagnosis_findings(pyb::module_& m) {
   pyb::class_<DiagnosisOptions>(m, "DiagnosisOptions")
       .def(pyb::init<>())
       .def_readwrite("max_harmonic", &DiagnosisOptions::max_harmonic)
@@ -99,7 +102,10 @@ void bind_diagnose(pyb::module_& m) {
       .def_property_readonly("axis", [](const Unexplained& u) { return u.axis ? std::string(1, u.axis) : std::string(); })
       .def_readonly("range_from", &Unexplained::range_from)
       .def_readonly("range_to", &Unexplained::range_to);
+}
 
+// The diagnosis report and the diagnose functions.
+void bind_diagnosis_report(pyb::module_& m) {
   pyb::class_<AngleTable>(m, "AngleTable")
       .def_readonly("group", &AngleTable::group)
       .def_property_readonly("axis", [](const AngleTable& t) { return std::string(1, t.axis); })
@@ -162,6 +168,13 @@ void bind_diagnose(pyb::module_& m) {
       },
       pyb::arg("session"), pyb::arg("options") = DiagnosisOptions{},
       "Diagnose an R-test session (baseline: location errors and a probe zero per set-up).");
+}
+
+}  // namespace
+
+void bind_diagnose(pyb::module_& m) {
+  bind_diagnosis_findings(m);
+  bind_diagnosis_report(m);
 }
 
 }  // namespace rotacal::py

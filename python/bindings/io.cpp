@@ -73,9 +73,8 @@ pyb::object from_json(const nlohmann::ordered_json& j) {
   }
 }
 
-}  // namespace
-
-void bind_io(pyb::module_& m) {
+// The session classes, their readers and writers.
+void bind_sessions(pyb::module_& m) {
   pyb::class_<BallbarSession>(m, "BallbarSession", "A rotacal-ballbar/1 session (mm, deg, s).")
       .def(pyb::init(&make_ballbar_session), pyb::arg("machine"), pyb::arg("ballbar_length"),
            pyb::arg("pivot"), pyb::arg("tests"), pyb::arg("time"), pyb::arg("xyz"),
@@ -135,8 +134,10 @@ void bind_io(pyb::module_& m) {
   m.def("write_rtest", &write_rtest, pyb::arg("session"), pyb::arg("path"));
   m.def("format_ballbar", &format_ballbar, pyb::arg("session"));
   m.def("format_rtest", &format_rtest, pyb::arg("session"));
+}
 
-  // Model files (rotacal/io/model_file.hpp): documents as dicts, validated and written in C++.
+// Model files (rotacal/io/model_file.hpp): documents as dicts, validated and written in C++.
+void bind_model_documents(pyb::module_& m) {
   m.def(
       "read_model_document",
       [](const std::string& path) { return from_json(read_model_document(path)); }, pyb::arg("path"),
@@ -179,7 +180,10 @@ void bind_io(pyb::module_& m) {
       pyb::arg("identification"), pyb::arg("nests"),
       "The rotacal-model/1 document (kind rtest-joint) of a joint R-test identification "
       "(rotacal/rtest/model_document.hpp); nests: label -> nominal ball centre, mm.");
+}
 
+// The checks before fitting and before writing.
+void bind_checks(pyb::module_& m) {
   // Plausibility before fitting (rotacal/io/plausibility.hpp).
   pyb::class_<PlausibilityOptions>(m, "PlausibilityOptions", "Limits of the plausibility checks (mm, deg).")
       .def(pyb::init<>())
@@ -231,6 +235,14 @@ void bind_io(pyb::module_& m) {
   m.def("check_json_bounds", &check_json_bounds, pyb::arg("text"), pyb::arg("source"),
         "Refuse JSON text nested deeper than 64 levels or with more objects and arrays than its size "
         "allows (core/json_text.hpp): ParseError naming source, line and column. The syntax is not checked.");
+}
+
+}  // namespace
+
+void bind_io(pyb::module_& m) {
+  bind_sessions(m);
+  bind_model_documents(m);
+  bind_checks(m);
 }
 
 }  // namespace rotacal::py

@@ -30,9 +30,9 @@ std::vector<RotaryAngles<double>> angles_of(const Array& a) {
   for (Eigen::Index i = 0; i < m.rows(); ++i) out.push_back({m(i, 0), m(i, 1)});
   return out;
 }
-}  // namespace
 
-void bind_probe(pyb::module_& m) {
+// The session, its reader and writer, and the probe's catalogue entries.
+void bind_probe_session(pyb::module_& m) {
   pyb::class_<ProbeSession>(m, "ProbeSession", "A rotacal-probe/1 touch-probe session (mm, deg, s).")
       .def_readonly("machine", &ProbeSession::machine)
       .def_property_readonly("sphere", [](const ProbeSession& s) { return Eigen::Vector3d(s.sphere); },
@@ -74,7 +74,10 @@ void bind_probe(pyb::module_& m) {
         "Read a ballbar, R-test or touch-probe session (chosen by its format line).");
   m.def("probe_effect_catalogue", &probe_effect_catalogue, pyb::arg("machine"), pyb::arg("max_harmonic") = 4,
         "The catalogue entries of a probe session: effect_catalogue and stylus_radius_offset, probe_lobing.");
+}
 
+// The joint fit, the cycles' method, the diagnosis and its uncertainty budget.
+void bind_probe_identification(pyb::module_& m) {
   pyb::class_<ProbeIdentification>(m, "ProbeIdentification")
       .def_readonly("method", &ProbeIdentification::method)
       .def_property_readonly("machine", [](const ProbeIdentification& r) { return r.model.machine; })
@@ -141,6 +144,10 @@ void bind_probe(pyb::module_& m) {
       pyb::arg("session"), pyb::arg("diagnosis"), pyb::arg("sizes") = PlausibleSizes{}, pyb::arg("coverage") = 0.95,
       "GUM budget of the location errors of diagnose_probe's result (the probe's entries: stylus calibration, "
       "lobing).");
+}
+
+// The probing program, its log, the default pattern and the simulation.
+void bind_probe_program(pyb::module_& m) {
   m.def(
       "write_probe_nc_program",
       [](MachineType machine, const std::string& dialect, std::optional<Array> poses_deg, const Array& sphere,
@@ -207,6 +214,14 @@ void bind_probe(pyb::module_& m) {
       pyb::arg("sphere_diameter") = 25.0, pyb::arg("stylus_diameter") = 6.0,
       "Simulate a touch-probe session (probe/simulate.hpp): (session, actual sphere centre). Poses default "
       "to default_probe_pattern's.");
+}
+
+}  // namespace
+
+void bind_probe(pyb::module_& m) {
+  bind_probe_session(m);
+  bind_probe_identification(m);
+  bind_probe_program(m);
 }
 
 }  // namespace rotacal::py

@@ -28,10 +28,9 @@ evaluate_rows(Eigen::Index n, F f) {
   }
   return {v, s};
 }
-}  // namespace
 
-void bind_rtest(pyb::module_& m) {
-  // ------------------------------------------------------------------ model
+// The basis of the smooth error maps and the machines' map names.
+void bind_rtest_basis(pyb::module_& m) {
   pyb::class_<RtestBasis>(
       m, "RtestBasis", "Smooth basis of the position-dependent errors (rtest/identify_joint.hpp).")
       .def(pyb::init([](int b_degree, int c_harmonics, int c_b_degree, bool gamma_cb) {
@@ -73,7 +72,10 @@ void bind_rtest(pyb::module_& m) {
         pyb::arg("machine"),
         "Names of a machine's two R-test error maps, [tilt axis' map, rotary axis' map], e.g. "
         "['BY', 'CB'] on BC-trt, ['BZ', 'CY'] on B-head-C-table.");
+}
 
+// The joint model: readings, table and tool errors and the maps, with 1-sigma.
+void bind_rtest_joint_model(pyb::module_& m) {
   pyb::class_<RtestJointModel>(
       m, "RtestJointModel",
       "Location errors, tool_offset_Z (machines with head axes) and smooth error maps of the tilt "
@@ -153,8 +155,10 @@ void bind_rtest(pyb::module_& m) {
           },
           pyb::arg("angles"),
           "C-axis map (N, 6) at angles (N, 2) = (B, C) in rad, and its 1-sigma.");
+}
 
-  // ------------------------------------------------------------------ identification
+// The joint fit, the paper's method, Monte Carlo and the error maps.
+void bind_rtest_identification(pyb::module_& m) {
   pyb::class_<RtestJointIdentification>(m, "RtestJointIdentification")
       .def_readonly("method", &RtestJointIdentification::method)
       .def_readonly("model", &RtestJointIdentification::model)
@@ -242,8 +246,10 @@ void bind_rtest(pyb::module_& m) {
       },
       pyb::arg("identification"), pyb::arg("format") = "json",
       "The paper method's error map at its measured grid, as JSON or CSV text.");
+}
 
-  // ------------------------------------------------------------------ prediction
+// Predicted sessions and their RMS.
+void bind_rtest_prediction(pyb::module_& m) {
   m.def("predict_rtest_session", &predict_session, pyb::arg("model"), pyb::arg("session"),
         pyb::arg("probe_zeros") = std::map<std::string, Eigen::Vector3d>{},
         "The session with dx,dy,dz predicted by the model and 1-sigma columns dx_std, dy_std, "
@@ -257,8 +263,10 @@ void bind_rtest(pyb::module_& m) {
       },
       pyb::arg("model"), pyb::arg("session"),
       "RMS (um) of measured - predicted readings after one constant offset per set-up.");
+}
 
-  // ------------------------------------------------------------------ simulation
+// The simulated pattern and session, and the simulator's noise-free readings.
+void bind_rtest_simulation(pyb::module_& m) {
   // Bound so that the Python layer reads the simulator's defaults instead of restating them.
   pyb::class_<RtestPattern>(m, "RtestPattern", "The pose grid and nests of a simulated session.")
       .def(pyb::init<>())
@@ -365,8 +373,10 @@ Returns
       "Noise-free readings (N, 3) of the nest at q (mm) at angles (N, 2) in rad and time (N,) s, "
       "no probe zero: the simulator's truth. linear_reference (3,) mm: the session's mean commanded "
       "xyz, about which the linear-axis polynomials are taken (None: the mean of these poses).");
+}
 
-  // ------------------------------------------------------------------ device (Sec. 3.1-3.2)
+// The device's calibration (Sec. 3.1-3.2): probe directions and the sphere's offset.
+void bind_rtest_device(pyb::module_& m) {
   pyb::class_<ProbeCalibration>(m, "ProbeCalibration", "Probe directions from linear moves.")
       .def_readonly("dirs", &ProbeCalibration::dirs, "unit directions (rows), table frame")
       .def_readonly("gains", &ProbeCalibration::gains)
@@ -459,6 +469,17 @@ Returns
       },
       pyb::arg("session"), pyb::arg("offset"),
       "The session with the sphere's offset (x, y) from the spindle axis taken out of every d.");
+}
+
+}  // namespace
+
+void bind_rtest(pyb::module_& m) {
+  bind_rtest_basis(m);
+  bind_rtest_joint_model(m);
+  bind_rtest_identification(m);
+  bind_rtest_prediction(m);
+  bind_rtest_simulation(m);
+  bind_rtest_device(m);
 }
 
 }  // namespace rotacal::py
