@@ -1,4 +1,5 @@
 // Uses the installed package: where does a table point go on an AC-trt table with an E_X0C?
+#include <rotacal/ballbar/model_document.hpp>
 #include <rotacal/io/model_file.hpp>
 #include <rotacal/kinematics/machine.hpp>
 
