@@ -7,6 +7,8 @@
 #include "rotacal/io/output_file.hpp"
 #include "rotacal/io/plausibility.hpp"
 #include "rotacal/io/session_arrays.hpp"
+#include "rotacal/multi/model_document.hpp"
+#include "rotacal/probe/model_document.hpp"
 #include "rotacal/rtest/model_document.hpp"
 
 namespace rotacal::py {
@@ -180,6 +182,19 @@ void bind_model_documents(pyb::module_& m) {
       pyb::arg("identification"), pyb::arg("nests"),
       "The rotacal-model/1 document (kind rtest-joint) of a joint R-test identification "
       "(rotacal/rtest/model_document.hpp); nests: label -> nominal ball centre, mm.");
+  m.def(
+      "probe_model_document",
+      [](const ProbeIdentification& identification, const std::string& session_name) {
+        return from_json(probe_model_document(identification, session_name));
+      },
+      pyb::arg("identification"), pyb::arg("session_name"),
+      "The rotacal-model/1 document (kind probe) of a joint touch-probe fit (rotacal/probe/model_document.hpp).");
+  m.def(
+      "multi_model_document",
+      [](const MultiIdentification& identification) { return from_json(multi_model_document(identification)); },
+      pyb::arg("identification"),
+      "The rotacal-model/1 document (kind multi) of one identification from several sessions "
+      "(rotacal/multi/model_document.hpp).");
 }
 
 // The checks before fitting and before writing.

@@ -45,7 +45,7 @@ inline constexpr double kMaxModelPivot = 1.0e4;
 /// A validated model file.
 struct ModelFile {
   int format_minor = 0;   ///< N of rotacal-model/1.N (0 for "rotacal-model/1")
-  std::string kind;       ///< "ballbar", "rtest-joint" or "rtest-diagnosis"
+  std::string kind;       ///< "ballbar", "rtest-joint", "rtest-diagnosis", "probe" or "multi" (io/fitted_model.hpp)
   MachineType machine = MachineType::AC_trt;
   /// Location errors in location_error_names(machine) order (mm, rad); an unobservable one
   /// (value null) is nominal, 0, and flagged in `observable`.
