@@ -1,4 +1,5 @@
 // Bindings for include/rotacal/io: session classes with numpy columns, readers and writers.
+#include "json_value.hpp"
 #include "numpy.hpp"
 #include "rotacal/core/json_text.hpp"
 #include "rotacal/io/ballbar_file.hpp"
@@ -7,11 +8,31 @@
 #include "rotacal/io/output_file.hpp"
 #include "rotacal/io/plausibility.hpp"
 #include "rotacal/io/session_arrays.hpp"
-#include "rotacal/multi/model_document.hpp"
-#include "rotacal/probe/model_document.hpp"
 #include "rotacal/rtest/model_document.hpp"
 
 namespace rotacal::py {
+
+pyb::object from_json(const nlohmann::ordered_json& j) {
+  switch (j.type()) {
+    case nlohmann::ordered_json::value_t::null: return pyb::none();
+    case nlohmann::ordered_json::value_t::boolean: return pyb::bool_(j.get<bool>());
+    case nlohmann::ordered_json::value_t::number_integer: return pyb::int_(j.get<long long>());
+    case nlohmann::ordered_json::value_t::number_unsigned: return pyb::int_(j.get<unsigned long long>());
+    case nlohmann::ordered_json::value_t::number_float: return pyb::float_(j.get<double>());
+    case nlohmann::ordered_json::value_t::string: return pyb::str(j.get<std::string>());
+    case nlohmann::ordered_json::value_t::array: {
+      pyb::list out;
+      for (const auto& x : j) out.append(from_json(x));
+      return std::move(out);
+    }
+    case nlohmann::ordered_json::value_t::object: {
+      pyb::dict out;
+      for (auto it = j.begin(); it != j.end(); ++it) out[pyb::str(it.key())] = from_json(it.value());
+      return std::move(out);
+    }
+    default: throw InvalidArgument("model document: a JSON value of an unsupported type");
+  }
+}
 
 namespace {
 pyb::dict metadata_dict(const Metadata& m) {
@@ -51,28 +72,6 @@ nlohmann::ordered_json to_json(const pyb::handle& o, const std::string& where, i
   if (pyb::hasattr(o, "tolist")) return to_json(o.attr("tolist")(), where, depth + 1);  // numpy
   throw InvalidArgument(where + ": a " + std::string(pyb::str(o.get_type().attr("__name__"))) +
                         " cannot be written as JSON");
-}
-
-pyb::object from_json(const nlohmann::ordered_json& j) {
-  switch (j.type()) {
-    case nlohmann::ordered_json::value_t::null: return pyb::none();
-    case nlohmann::ordered_json::value_t::boolean: return pyb::bool_(j.get<bool>());
-    case nlohmann::ordered_json::value_t::number_integer: return pyb::int_(j.get<long long>());
-    case nlohmann::ordered_json::value_t::number_unsigned: return pyb::int_(j.get<unsigned long long>());
-    case nlohmann::ordered_json::value_t::number_float: return pyb::float_(j.get<double>());
-    case nlohmann::ordered_json::value_t::string: return pyb::str(j.get<std::string>());
-    case nlohmann::ordered_json::value_t::array: {
-      pyb::list out;
-      for (const auto& x : j) out.append(from_json(x));
-      return std::move(out);
-    }
-    case nlohmann::ordered_json::value_t::object: {
-      pyb::dict out;
-      for (auto it = j.begin(); it != j.end(); ++it) out[pyb::str(it.key())] = from_json(it.value());
-      return std::move(out);
-    }
-    default: throw InvalidArgument("model document: a JSON value of an unsupported type");
-  }
 }
 
 // The session classes, their readers and writers.
@@ -182,19 +181,6 @@ void bind_model_documents(pyb::module_& m) {
       pyb::arg("identification"), pyb::arg("nests"),
       "The rotacal-model/1 document (kind rtest-joint) of a joint R-test identification "
       "(rotacal/rtest/model_document.hpp); nests: label -> nominal ball centre, mm.");
-  m.def(
-      "probe_model_document",
-      [](const ProbeIdentification& identification, const std::string& session_name) {
-        return from_json(probe_model_document(identification, session_name));
-      },
-      pyb::arg("identification"), pyb::arg("session_name"),
-      "The rotacal-model/1 document (kind probe) of a joint touch-probe fit (rotacal/probe/model_document.hpp).");
-  m.def(
-      "multi_model_document",
-      [](const MultiIdentification& identification) { return from_json(multi_model_document(identification)); },
-      pyb::arg("identification"),
-      "The rotacal-model/1 document (kind multi) of one identification from several sessions "
-      "(rotacal/multi/model_document.hpp).");
 }
 
 // The checks before fitting and before writing.

@@ -5,11 +5,13 @@
 
 #include <optional>
 
+#include "json_value.hpp"
 #include "numpy.hpp"
 #include "rotacal/diagnose/probe_diagnosis.hpp"
 #include "rotacal/diagnose/uncertainty_budget.hpp"
 #include "rotacal/io/probe_file.hpp"
 #include "rotacal/probe/identify.hpp"
+#include "rotacal/probe/model_document.hpp"
 #include "rotacal/probe/nc_program.hpp"
 #include "rotacal/probe/simulate.hpp"
 #include "rotacal/probe/touch_model.hpp"
@@ -125,6 +127,13 @@ void bind_probe_identification(pyb::module_& m) {
       },
       pyb::arg("session"), pyb::arg("radius_known") = true,
       "The controller cycles' method: sphere per pose, plane and circle of the centres per table axis.");
+  m.def(
+      "probe_model_document",
+      [](const ProbeIdentification& identification, const std::string& session_name) {
+        return from_json(probe_model_document(identification, session_name));
+      },
+      pyb::arg("identification"), pyb::arg("session_name"),
+      "The rotacal-model/1 document (kind probe) of a joint touch-probe fit (rotacal/probe/model_document.hpp).");
 
   m.def(
       "diagnose_probe",

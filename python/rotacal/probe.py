@@ -25,9 +25,12 @@ class ProbeIdentification(Identification):
     def machine(self):
         return self.raw.machine
 
-    def model_dict(self) -> dict:
-        raise _core.InvalidArgument("a touch-probe fit has no model file yet (rotacal-model holds ballbar and "
-                                    "R-test models)")
+    def model_dict(self, session_name: str = "session") -> dict:
+        """The model file's content (``kind: probe``, docs/model_file.md), written by the C++
+        implementation (rotacal/probe/model_document.hpp): location errors with their 1-sigma
+        and covariance, the effects fitted along, the session (``session_name``) with its sphere
+        and noise model. Only the joint fit has one: the cycles' method gives no uncertainty."""
+        return _core.probe_model_document(self.raw, session_name)
 
     def to_dict(self) -> dict:
         def est(p):

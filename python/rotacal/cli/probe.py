@@ -21,10 +21,11 @@ DEFAULT_STYLUS_DIAMETER = 6.0
 DEFAULT_NOISE_UM = 0.5
 DEFAULT_LOG_FILE = "rotacal_probe.log"
 
-# What a touch-probe identification cannot do yet, refused before the fit.
-NO_MODEL_FILE = ("--save-model/--store: the model file (rotacal-model/1, docs/model_file.md) holds kinds "
-                 "ballbar, rtest-joint and rtest-diagnosis only; a touch-probe identification has no model "
-                 "file yet (print it with --json instead)")
+# What a touch-probe identification cannot do, refused before the fit.
+NO_CYCLES_MODEL = ("--save-model/--store: the model file holds a fit with its uncertainties and covariance; the "
+                   "cycles' method gives none (identify with --method joint, the default)")
+NO_MONTE_CARLO = ("identify: --monte-carlo is not implemented for touch-probe sessions yet (the joint fit's RMSE "
+                  "against its Cramer-Rao bound over simulated draws: build/release/bench/probe_accuracy)")
 
 
 # ------------------------------------------------------------------------- simulate probe
@@ -126,27 +127,29 @@ def print_probe_identification(d: dict) -> None:
         print(f"  note: {n}")
 
 
-def identify_probe_session(a: argparse.Namespace, s: _core.ProbeSession, sizes: dict | None) -> dict:
-    """The document `rotacal identify` prints of a rotacal-probe/1 session: --method joint (the
-    default; with the uncertainty budget unless --no-budget), cycles or cycles-free-radius (the
-    controller cycles' method, radius known or fitted per pose). What a probe fit cannot do
-    (a model file, the history, the Monte Carlo check) is refused before the fit."""
+def identify_probe_session(a: argparse.Namespace, s: _core.ProbeSession,
+                           sizes: dict | None) -> tuple[probe.ProbeIdentification, dict]:
+    """The identification and the document `rotacal identify` prints of a rotacal-probe/1
+    session: --method joint (the default; with the uncertainty budget unless --no-budget),
+    cycles or cycles-free-radius (the controller cycles' method, radius known or fitted per
+    pose). What a probe fit cannot do (a model file of the cycles' method, the Monte Carlo
+    check) is refused before the fit."""
     if a.method == "paper":
         raise OptionError("identify: --method paper is the ballbar's and the R-test's; a touch-probe session "
                           "takes joint, cycles or cycles-free-radius")
     if a.length_offset:
         raise OptionError("identify: --length-offset is for ballbar sessions")
-    if a.save_model or a.store:
-        raise OptionError(NO_MODEL_FILE)
+    if (a.save_model or a.store) and a.method != "joint":
+        raise OptionError(NO_CYCLES_MODEL)
     if a.monte_carlo:
-        raise OptionError("identify: --monte-carlo is not implemented for touch-probe sessions")
+        raise OptionError(NO_MONTE_CARLO)
     result = probe.identify_probe(s, a.method, noise=a.noise)
     d = result.to_dict()
     if a.method == "joint" and not a.no_budget:
         from ..diagnosis import uncertainty_budget
         from ..results import budget_dict
         d["uncertainty_budget"] = budget_dict(uncertainty_budget(s, sizes=sizes))
-    return d
+    return result, d
 
 
 # ------------------------------------------------------------------------- plan probe, import probe
