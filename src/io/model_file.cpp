@@ -227,6 +227,8 @@ json read_model_document(const std::string& path) {
   json doc = parse_json(read_text(path), path);
   ModelFile envelope;
   check_envelope(doc, path, envelope);
+  // Nothing later reads a probe or multi model's own members member by member: all checked now.
+  if (envelope.kind == "probe" || envelope.kind == "multi") model_from_json(doc, path);
   return doc;
 }
 

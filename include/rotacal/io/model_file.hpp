@@ -64,8 +64,8 @@ ModelFile model_from_json(const nlohmann::ordered_json& document, const std::str
 ModelFile parse_model(const std::string& text, const std::string& source);
 /// Read a model file; IoError if it cannot be read (a directory, missing, too large).
 ModelFile read_model(const std::string& path);
-/// Read a model file checking only what every use needs (strict JSON, format version, kind,
-/// machine); the kind's own members are checked where the model is used (model_from_json).
+/// Read a model file checking what every use needs (strict JSON, format version, kind, machine; all
+/// of a probe or multi model); other kinds' members are checked where used (model_from_json).
 nlohmann::ordered_json read_model_document(const std::string& path);
 
 /// Replace every non-finite number by null and record why under "null_reasons"
