@@ -155,7 +155,8 @@ def write_joint_report(path: str | Path, sessions: Sequence[Any], names: Sequenc
 
 def write_diagnosis_report(path: str | Path, session: Any, result: Any, source: str = "",
                            inputs: Sequence[str] = ()) -> Path:
-    """``diagnose --report``: the ballbar report with this diagnosis, or the diagnosis alone (R-test)."""
+    """``diagnose --report``: the ballbar or touch-probe report with this diagnosis, or the
+    diagnosis alone (R-test)."""
     from . import report
 
     return by_kind(session, {
@@ -163,4 +164,6 @@ def write_diagnosis_report(path: str | Path, session: Any, result: Any, source: 
                                                inputs=inputs),
         RTEST: lambda: report.diagnosis_report(path, result.to_dict(), title="R-test diagnosis", source=source,
                                                inputs=inputs),
+        PROBE: lambda: report.probe_report(path, session, probe.identify_probe(session), result, source=source,
+                                           inputs=inputs),
     }, "diagnose --report")()

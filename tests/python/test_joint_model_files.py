@@ -201,3 +201,21 @@ def test_what_has_no_model_file_is_refused_before_the_fit(shared_data, tmp_path)
     assert r.returncode == EXIT_INPUT and "--monte-carlo" in r.stderr and not model.exists()
     with pytest.raises(rotacal.InvalidArgument, match="no uncertainty or covariance"):
         rotacal.identify(rotacal.load(probe), "cycles").model_dict()
+
+
+def test_a_probe_report_shows_the_model_the_diagnosis_extended(tmp_path):
+    """A stylus 2 um larger than calibrated (reference simulator): the report's location errors are
+    the extended model's, within 3 sigma of the truth, with the baseline's beside them."""
+    from test_probe import refsim_session
+    from test_probe_cli import outside_3_sigma, reference_errors
+    errors = reference_errors("AC-trt", 7)
+    path, _ = refsim_session(tmp_path, "AC-trt", errors, {"stylus_radius_offset": 2e-3}, rho=0.0, seed=7)
+    out = tmp_path / "r.html"
+    r = cli("diagnose", path, "--no-progress", "--report", out)
+    assert r.returncode == 0, r.stderr
+    page = out.read_text()
+    assert "extended model: location errors + stylus_radius_offset" in page and "Baseline" in page
+    s = rotacal.load(path)
+    extended = rotacal.identify(s, effects=["stylus_radius_offset"]).to_dict()["location_errors"]
+    assert not outside_3_sigma(extended, errors)
+    assert f"{extended['E_Y0A']['value'] * 1e3:+.2f}" in page
