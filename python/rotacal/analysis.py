@@ -58,9 +58,11 @@ def identification_budget(session: Any, sizes: Any = None) -> Any:
 
 def monte_carlo(session: Any, identification: Any, draws: int, *, seed: int = 1) -> dict:
     """Check an identification's 1-sigma by ``draws`` simulated repeats of the session with its
-    fitted noise model (rotacal.ballbar.monte_carlo, rotacal.rtest.monte_carlo_rtest)."""
+    fitted noise model (rotacal.ballbar.monte_carlo, rotacal.rtest.monte_carlo_rtest,
+    rotacal.probe.monte_carlo_probe)."""
     return by_kind(session, {BALLBAR: lambda: ballbar.monte_carlo(session, identification, draws, seed=seed),
-                             RTEST: lambda: rtest.monte_carlo_rtest(session, identification, draws, seed=seed)},
+                             RTEST: lambda: rtest.monte_carlo_rtest(session, identification, draws, seed=seed),
+                             PROBE: lambda: probe.monte_carlo_probe(session, identification, draws, seed=seed)},
                    "monte_carlo")()
 
 

@@ -74,6 +74,24 @@ def identify_probe(session: _core.ProbeSession, method: str = "joint", *, effect
     return ProbeIdentification(raw)
 
 
+def monte_carlo_probe(session: _core.ProbeSession, result: ProbeIdentification, draws: int = 100, *,
+                      seed: int = 1, noise: str = "auto", progress: bool = True) -> dict:
+    """Check a touch-probe joint fit's 1-sigma by Monte Carlo (probe/monte_carlo.hpp): each draw
+    moves every touch along its approach direction to the identified machine plus noise drawn
+    from the fit's noise model (AR when the fit was refitted under it, else white), refitted the
+    same way (``noise`` as the fit: "auto" or "white"). Same dict as rotacal.ballbar.monte_carlo."""
+    from .progress import ProgressBar
+    from .results import monte_carlo_dict
+    if result.raw.method != "joint":
+        raise _core.InvalidArgument("monte_carlo: the cycles' method reports no uncertainty to check; use the joint fit")
+    bar = ProgressBar("Monte Carlo", draws, " draws") if progress else None
+    mc = _core.monte_carlo_probe(session, result.raw, draws, seed, noise,
+                                 progress=(lambda done, total: bar.update(done)) if bar else None)
+    if bar:
+        bar.close()
+    return monte_carlo_dict(mc, draws, mc.noise_um)
+
+
 def simulate_probe(machine: str | Any, errors: Sequence[float] | None = None,
                    effects: Mapping[str, Sequence[float] | float] | None = None, *,
                    sphere_offset: Sequence[float] = (0.0, 0.0, 0.0), noise_um: float = 0.5, ar1_rho: float = 0.0,

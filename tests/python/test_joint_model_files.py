@@ -190,13 +190,27 @@ def test_a_malformed_model_is_refused_naming_the_member(made, tmp_path, pointer,
         assert r.returncode == EXIT_INPUT and named in r.stderr, r.stderr
 
 
+def test_probe_monte_carlo_checks_the_reported_sigma(shared_data):
+    r = cli("identify", shared_data / "probe_ac_table2.csv", "--monte-carlo", "200", "--seed", "3", "--json",
+            "--no-budget")
+    assert r.returncode == 0, r.stderr
+    mc = json.loads(r.stdout)["monte_carlo"]
+    assert mc["draws"] == 200 and mc["noise"] == "white noise"
+    assert set(NAMES) <= set(mc["parameters"])
+    for name, p in mc["parameters"].items():  # 200 draws: the sample sigma within ~5 % (1 sigma)
+        assert 0.8 < p["ratio"] < 1.2, name
+        assert abs(p["bias"]) < 4 * p["std_mc"] / np.sqrt(200), name
+    text = cli("identify", shared_data / "probe_ac_table2.csv", "--monte-carlo", "20", "--no-budget").stdout
+    assert "Monte Carlo check of the 1-sigma, 20 draws" in text
+
+
 def test_what_has_no_model_file_is_refused_before_the_fit(shared_data, tmp_path):
     probe = shared_data / "probe_ac_table2.csv"
     model = tmp_path / "m.json"
     r = cli("identify", probe, "--method", "cycles", "--save-model", model)
     assert r.returncode == EXIT_INPUT and "cycles' method gives none" in r.stderr and not model.exists()
-    r = cli("identify", probe, "--monte-carlo", "10")
-    assert r.returncode == EXIT_INPUT and "not implemented for touch-probe sessions" in r.stderr
+    r = cli("identify", probe, "--method", "cycles", "--monte-carlo", "10")
+    assert r.returncode == EXIT_INPUT and "reports none" in r.stderr and r.stdout == ""
     r = cli("identify", shared_data / "ballbar_ac_table2.csv", probe, "--monte-carlo", "10", "--save-model", model)
     assert r.returncode == EXIT_INPUT and "--monte-carlo" in r.stderr and not model.exists()
     with pytest.raises(rotacal.InvalidArgument, match="no uncertainty or covariance"):

@@ -195,6 +195,8 @@ def cmd_identify(a: argparse.Namespace) -> int:
                 print_noise_model(d["noise_model"])
             if d.get("uncertainty_budget"):
                 print_budget(d["uncertainty_budget"])
+            if d.get("monte_carlo"):
+                _print_monte_carlo(d["monte_carlo"])
         return EXIT_OK
     if a.length_offset and kind(s) == RTEST:
         raise _core.InvalidArgument("identify: --length-offset is for ballbar sessions")

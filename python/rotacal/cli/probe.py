@@ -24,8 +24,6 @@ DEFAULT_LOG_FILE = "rotacal_probe.log"
 # What a touch-probe identification cannot do, refused before the fit.
 NO_CYCLES_MODEL = ("--save-model/--store: the model file holds a fit with its uncertainties and covariance; the "
                    "cycles' method gives none (identify with --method joint, the default)")
-NO_MONTE_CARLO = ("identify: --monte-carlo is not implemented for touch-probe sessions yet (the joint fit's RMSE "
-                  "against its Cramer-Rao bound over simulated draws: build/release/bench/probe_accuracy)")
 
 
 # ------------------------------------------------------------------------- simulate probe
@@ -132,8 +130,8 @@ def identify_probe_session(a: argparse.Namespace, s: _core.ProbeSession,
     """The identification and the document `rotacal identify` prints of a rotacal-probe/1
     session: --method joint (the default; with the uncertainty budget unless --no-budget),
     cycles or cycles-free-radius (the controller cycles' method, radius known or fitted per
-    pose). What a probe fit cannot do (a model file of the cycles' method, the Monte Carlo
-    check) is refused before the fit."""
+    pose). What the cycles' method cannot do (a model file, the Monte Carlo check: it reports no
+    uncertainty) is refused before the fit."""
     if a.method == "paper":
         raise OptionError("identify: --method paper is the ballbar's and the R-test's; a touch-probe session "
                           "takes joint, cycles or cycles-free-radius")
@@ -141,14 +139,16 @@ def identify_probe_session(a: argparse.Namespace, s: _core.ProbeSession,
         raise OptionError("identify: --length-offset is for ballbar sessions")
     if (a.save_model or a.store) and a.method != "joint":
         raise OptionError(NO_CYCLES_MODEL)
-    if a.monte_carlo:
-        raise OptionError(NO_MONTE_CARLO)
+    if a.monte_carlo and a.method != "joint":
+        raise OptionError("identify: --monte-carlo checks a reported 1-sigma; the cycles' method reports none")
     result = probe.identify_probe(s, a.method, noise=a.noise)
     d = result.to_dict()
     if a.method == "joint" and not a.no_budget:
         from ..diagnosis import uncertainty_budget
         from ..results import budget_dict
         d["uncertainty_budget"] = budget_dict(uncertainty_budget(s, sizes=sizes))
+    if a.monte_carlo:
+        d["monte_carlo"] = probe.monte_carlo_probe(s, result, a.monte_carlo, seed=a.seed, noise=a.noise)
     return result, d
 
 
