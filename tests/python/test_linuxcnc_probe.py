@@ -12,8 +12,9 @@ radius that scatters from touch to touch (AR(1), 0.5 um). LinuxCNC's log of the 
 #5061-#5063 is read back with `rotacal import probe` and identified with `rotacal identify`:
 every location error within 3 sigma of the simulated machine's. On the same run: every touch
 latched on its commanded line, at most one servo period's travel past the contact (the
-pretravel, measured); no contact outside the G38.2 moves (counted in realtime) and the traverses
-clear of the sphere (polled).
+pretravel, measured); no contact outside the G38.2 moves (counted in realtime; LinuxCNC stops
+the program at one itself, as a program with a G1 into the sphere shows) and the traverses clear
+of the sphere (polled).
 """
 import json
 import re
@@ -23,6 +24,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from linuxcnc_session import requires_linuxcnc, run_linuxcnc
 
@@ -94,36 +96,72 @@ def test_plan_probe_feeds_and_approach(tmp_path):
     assert bad.returncode != 0 and "--probe-feed" in bad.stderr
 
 
-@requires_linuxcnc
-def test_linuxcnc_runs_the_probing_program_and_the_log_identifies_the_machine(shared_data, tmp_path):
-    t_start = time.monotonic()
+def simulated_machine(shared_data):
+    """(location errors, sphere's actual centre, trigger radius deviation per touch (mm)) of the
+    simulated machine: Table 2 errors (../shared/data), a sphere set-up error, AR(1) noise."""
     errors = json.loads((shared_data / "probe_ac_table2.truth.json").read_text())["errors"]
     rng = np.random.default_rng(31)
     sphere_actual = np.array(SPHERE) + rng.normal(0.0, SPHERE_ERROR_MM, 3)
-    n = 5 * len(POSES)  # the program's five directions per pose
-    eps = noise.ar1(["touch"] * n, RHO, NOISE_UM * 1e-3, rng)  # mm, trigger radius per touch
-    period_travel = PROBE_FEED / 60.0 * SERVO_PERIOD_S  # mm
+    eps = noise.ar1(["touch"] * 5 * len(POSES), RHO, NOISE_UM * 1e-3, rng)  # five directions per pose
+    return errors, sphere_actual, eps
 
+
+def plan(tmp_path, poses, log):
+    """`rotacal plan probe` of `poses`: (program text, session template path)."""
     # The stylus as calibrated on the machine, at the same feed: the mean pretravel (half a
     # period's travel) is part of its effective radius (docs/probe.md, "A real client").
-    stylus_calibrated = STYLUS_D - period_travel
-    run_dir = tmp_path / "lcnc"
-    log = run_dir / "probe.log"
+    stylus_calibrated = STYLUS_D - PROBE_FEED / 60.0 * SERVO_PERIOD_S
     ngc, template = tmp_path / "probe.ngc", tmp_path / "template.csv"
     rotacal_cli("plan", "probe", "--machine", "AC-trt", "--sphere", ",".join(map(str, SPHERE)),
                 "--sphere-diameter", SPHERE_D, "--stylus-diameter", f"{stylus_calibrated:.7f}",
-                "--poses", ";".join(f"{a},{c}" for a, c in POSES), "--approach", APPROACH_MM,
-                "--probe-feed", PROBE_FEED, "--positioning-feed", POSITIONING_FEED, "--log-file", log, "-o", ngc, "--session", template)
-    program = ngc.read_text()
-    assert program.count("G38.2 ") == n and f"F{PROBE_FEED:.1f}" in program
+                "--poses", ";".join(f"{a},{c}" for a, c in poses), "--approach", APPROACH_MM,
+                "--probe-feed", PROBE_FEED, "--positioning-feed", POSITIONING_FEED, "--log-file", log,
+                "-o", ngc, "--session", template)
+    return ngc.read_text(), template
 
+
+def run_probe(run_dir, program, errors, sphere_actual, eps):
+    """LinuxCNC runs `program` on the simulated machine: (display's result, probe's record)."""
     truth = {"refsim": str(REFSIM), "machine": "AC-trt", "errors": errors, "sphere_actual": sphere_actual.tolist(),
              "sphere_diameter": SPHERE_D, "stylus_diameter": STYLUS_D, "trigger_noise_mm": eps.tolist(),
              "record": str(run_dir / "contact.json")}
     result = run_linuxcnc(run_dir, "probe-sim.ini", {"probe.ngc": program, "truth.json": json.dumps(truth)},
                           "result.json", RUN_TIMEOUT)
-    contact = json.loads((run_dir / "contact.json").read_text())
     print(f"LinuxCNC: program {result['program_s']:.1f} s, session {result['elapsed']:.1f} s")
+    return result, json.loads((run_dir / "contact.json").read_text())
+
+
+@requires_linuxcnc
+def test_a_contact_outside_probing_is_counted(shared_data, tmp_path):
+    # The check of the next test can fail: one pose's program with a G1 (not G38.2) into the
+    # sphere after the first touch, from its start to its target, is a stray contact.
+    errors, sphere_actual, eps = simulated_machine(shared_data)
+    run_dir = tmp_path / "lcnc"
+    program, _ = plan(tmp_path, POSES[:1], run_dir / "probe.log")
+    lines = program.splitlines()
+    first = next(i for i, line in enumerate(lines) if line.startswith("G38.2 "))
+    retract = first + 2  # G38.2, (LOG,...), then the G1 back to the start
+    assert lines[retract].startswith("G1 X")
+    crash = re.sub(r" F\S+$", f" F{POSITIONING_FEED:.1f}", lines[first].replace("G38.2 ", "G1 ", 1))
+    lines[retract + 1:retract + 1] = [crash, lines[retract]]
+    # LinuxCNC stops the program itself, and the realtime count has it.
+    with pytest.raises(AssertionError, match="Probe tripped during non-probe move"):
+        run_probe(run_dir, "\n".join(lines) + "\n", errors, sphere_actual, eps)
+    contact = json.loads((run_dir / "contact.json").read_text())
+    assert contact["strays"] == 1 and len(contact["touches"]) == 2, contact
+
+
+@requires_linuxcnc
+def test_linuxcnc_runs_the_probing_program_and_the_log_identifies_the_machine(shared_data, tmp_path):
+    t_start = time.monotonic()
+    errors, sphere_actual, eps = simulated_machine(shared_data)
+    n = len(eps)
+    period_travel = PROBE_FEED / 60.0 * SERVO_PERIOD_S  # mm
+    run_dir = tmp_path / "lcnc"
+    log = run_dir / "probe.log"
+    program, template = plan(tmp_path, POSES, log)
+    assert program.count("G38.2 ") == n and f"F{PROBE_FEED:.1f}" in program
+    result, contact = run_probe(run_dir, program, errors, sphere_actual, eps)
 
     # Every touch a G38.2 contact, none elsewhere; the traverses clear of the sphere.
     assert result["touches"] == n and len(contact["touches"]) == n, (result, len(contact["touches"]))
