@@ -24,6 +24,7 @@ The record (JSON, rewritten after every touch and on exit):
   clearance_mm: {motion type: the smallest |tip - centre| - radius polled while that type
            moved, outside contact and outside the retract that follows each touch (until the
            stylus is LEFT_MM out)}
+  extent:  {joint: [min, max]} of the polled X, Y, Z (mm), A, C (deg)
   poll_s:  {mean, max, over_10ms}: this loop's period, the latency a userspace trigger would
            have (why the contact is decided in realtime instead)
 """
@@ -81,7 +82,8 @@ def main():
     signal.signal(signal.SIGTERM, stop)
     signal.signal(signal.SIGINT, stop)
 
-    record = {"touches": [], "strays": 0, "clearance_mm": {}, "poll_s": {"mean": 0.0, "max": 0.0, "over_10ms": 0}}
+    record = {"touches": [], "strays": 0, "clearance_mm": {}, "poll_s": {"mean": 0.0, "max": 0.0, "over_10ms": 0},
+              "extent": {k: [math.inf, -math.inf] for k in "xyzac"}}
     polls, t_last, t_first = 0, None, None
 
     def save():
@@ -105,6 +107,8 @@ def main():
         else:
             t_first = now
         t_last = now
+        for k, (lo, hi) in record["extent"].items():
+            record["extent"][k] = [min(lo, c[k]), max(hi, c[k])]
         ac = (c["a"], c["c"])
         if ac != last_ac:
             centre = sphere.centre(*ac)

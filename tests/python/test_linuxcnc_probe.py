@@ -171,6 +171,15 @@ def test_linuxcnc_runs_the_probing_program_and_the_log_identifies_the_machine(sh
     assert min(clearance.values()) > 0.0, clearance
     print("smallest polled clearance outside the touches (mm): "
           + ", ".join(f"{k} {v:.3f}" for k, v in sorted(clearance.items())))
+    # Within the machine's travel (its built-in description) and the poses' A, C all along.
+    travel = json.loads(rotacal_cli("machines", "show", "AC-trt", "--json"))["description"]["travel_mm"]
+    extent = contact["extent"]
+    for k, (lo, hi) in zip("xyz", travel):
+        assert lo <= extent[k][0] <= extent[k][1] <= hi, (k, extent[k], (lo, hi))
+    for k, i in (("a", 0), ("c", 1)):
+        angles = [p[i] for p in POSES] + [0.0]  # the machine starts homed at 0
+        assert min(angles) - 1e-9 <= extent[k][0] <= extent[k][1] <= max(angles) + 1e-9, (k, extent[k])
+    print("polled extent: " + ", ".join(f"{k} {lo:.3f}..{hi:.3f}" for k, (lo, hi) in extent.items()))
 
     # Each latched position on its commanded line, past the contact by at most one period's travel.
     model = refsim.Model("AC-trt", errors)
