@@ -1,4 +1,5 @@
 // Bindings for include/rotacal/io: session classes with numpy columns, readers and writers.
+#include "json_value.hpp"
 #include "numpy.hpp"
 #include "rotacal/core/json_text.hpp"
 #include "rotacal/io/ballbar_file.hpp"
@@ -10,6 +11,28 @@
 #include "rotacal/rtest/model_document.hpp"
 
 namespace rotacal::py {
+
+pyb::object from_json(const nlohmann::ordered_json& j) {
+  switch (j.type()) {
+    case nlohmann::ordered_json::value_t::null: return pyb::none();
+    case nlohmann::ordered_json::value_t::boolean: return pyb::bool_(j.get<bool>());
+    case nlohmann::ordered_json::value_t::number_integer: return pyb::int_(j.get<long long>());
+    case nlohmann::ordered_json::value_t::number_unsigned: return pyb::int_(j.get<unsigned long long>());
+    case nlohmann::ordered_json::value_t::number_float: return pyb::float_(j.get<double>());
+    case nlohmann::ordered_json::value_t::string: return pyb::str(j.get<std::string>());
+    case nlohmann::ordered_json::value_t::array: {
+      pyb::list out;
+      for (const auto& x : j) out.append(from_json(x));
+      return std::move(out);
+    }
+    case nlohmann::ordered_json::value_t::object: {
+      pyb::dict out;
+      for (auto it = j.begin(); it != j.end(); ++it) out[pyb::str(it.key())] = from_json(it.value());
+      return std::move(out);
+    }
+    default: throw InvalidArgument("model document: a JSON value of an unsupported type");
+  }
+}
 
 namespace {
 pyb::dict metadata_dict(const Metadata& m) {
@@ -49,28 +72,6 @@ nlohmann::ordered_json to_json(const pyb::handle& o, const std::string& where, i
   if (pyb::hasattr(o, "tolist")) return to_json(o.attr("tolist")(), where, depth + 1);  // numpy
   throw InvalidArgument(where + ": a " + std::string(pyb::str(o.get_type().attr("__name__"))) +
                         " cannot be written as JSON");
-}
-
-pyb::object from_json(const nlohmann::ordered_json& j) {
-  switch (j.type()) {
-    case nlohmann::ordered_json::value_t::null: return pyb::none();
-    case nlohmann::ordered_json::value_t::boolean: return pyb::bool_(j.get<bool>());
-    case nlohmann::ordered_json::value_t::number_integer: return pyb::int_(j.get<long long>());
-    case nlohmann::ordered_json::value_t::number_unsigned: return pyb::int_(j.get<unsigned long long>());
-    case nlohmann::ordered_json::value_t::number_float: return pyb::float_(j.get<double>());
-    case nlohmann::ordered_json::value_t::string: return pyb::str(j.get<std::string>());
-    case nlohmann::ordered_json::value_t::array: {
-      pyb::list out;
-      for (const auto& x : j) out.append(from_json(x));
-      return std::move(out);
-    }
-    case nlohmann::ordered_json::value_t::object: {
-      pyb::dict out;
-      for (auto it = j.begin(); it != j.end(); ++it) out[pyb::str(it.key())] = from_json(it.value());
-      return std::move(out);
-    }
-    default: throw InvalidArgument("model document: a JSON value of an unsupported type");
-  }
 }
 
 // The session classes, their readers and writers.

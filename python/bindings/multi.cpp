@@ -3,10 +3,12 @@
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
+#include "json_value.hpp"
 #include "numpy.hpp"
 #include "rotacal/io/probe_session.hpp"
 #include "rotacal/io/session.hpp"
 #include "rotacal/multi/identify.hpp"
+#include "rotacal/multi/model_document.hpp"
 
 namespace rotacal::py {
 
@@ -66,6 +68,12 @@ void bind_multi(pyb::module_& m) {
       "one set of location errors (and of the catalogue effects `effects`), each session's own "
       "nuisances and noise model, and the "
       "disagreements between the sessions fitted alone; noise 'auto' or 'white'.");
+  m.def(
+      "multi_model_document",
+      [](const MultiIdentification& identification) { return from_json(multi_model_document(identification)); },
+      pyb::arg("identification"),
+      "The rotacal-model/1 document (kind multi) of one identification from several sessions "
+      "(rotacal/multi/model_document.hpp).");
 }
 
 }  // namespace rotacal::py

@@ -5,11 +5,14 @@
 
 #include <optional>
 
+#include "json_value.hpp"
 #include "numpy.hpp"
 #include "rotacal/diagnose/probe_diagnosis.hpp"
 #include "rotacal/diagnose/uncertainty_budget.hpp"
 #include "rotacal/io/probe_file.hpp"
 #include "rotacal/probe/identify.hpp"
+#include "rotacal/probe/model_document.hpp"
+#include "rotacal/probe/monte_carlo.hpp"
 #include "rotacal/probe/nc_program.hpp"
 #include "rotacal/probe/simulate.hpp"
 #include "rotacal/probe/touch_model.hpp"
@@ -125,6 +128,36 @@ void bind_probe_identification(pyb::module_& m) {
       },
       pyb::arg("session"), pyb::arg("radius_known") = true,
       "The controller cycles' method: sphere per pose, plane and circle of the centres per table axis.");
+  pyb::class_<ProbeMonteCarlo>(m, "ProbeMonteCarlo")
+      .def_readonly("draws", &ProbeMonteCarlo::draws)
+      .def_readonly("noise_um", &ProbeMonteCarlo::noise_um)
+      .def_readonly("noise", &ProbeMonteCarlo::noise)
+      .def_readonly("parameters", &ProbeMonteCarlo::parameters)
+      .def_readonly("values", &ProbeMonteCarlo::values);
+  m.def(
+      "monte_carlo_probe",
+      [](const ProbeSession& session, const ProbeIdentification& result, int draws, std::uint64_t seed,
+         const std::string& noise, const pyb::object& progress) {
+        ProbeMonteCarloOptions o;
+        o.draws = draws;
+        o.seed = seed;
+        o.noise = noise_handling_from_string(noise);
+        o.progress = progress_callback(progress);
+        pyb::gil_scoped_release release;
+        return monte_carlo_probe(session, result, o);
+      },
+      pyb::arg("session"), pyb::arg("result"), pyb::arg("draws") = 100, pyb::arg("seed") = 1,
+      pyb::arg("noise") = "auto", pyb::arg("progress") = pyb::none(),
+      "Monte Carlo check of a touch-probe joint fit's 1-sigma (probe/monte_carlo.hpp): draw k (seed + k) moves "
+      "every touch along its direction to the identified machine plus the fit's noise, refitted with `noise` "
+      "('auto' or 'white', as the fit was); progress: optional callable(done, total).");
+  m.def(
+      "probe_model_document",
+      [](const ProbeIdentification& identification, const std::string& session_name) {
+        return from_json(probe_model_document(identification, session_name));
+      },
+      pyb::arg("identification"), pyb::arg("session_name"),
+      "The rotacal-model/1 document (kind probe) of a joint touch-probe fit (rotacal/probe/model_document.hpp).");
 
   m.def(
       "diagnose_probe",

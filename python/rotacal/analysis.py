@@ -58,21 +58,27 @@ def identification_budget(session: Any, sizes: Any = None) -> Any:
 
 def monte_carlo(session: Any, identification: Any, draws: int, *, seed: int = 1) -> dict:
     """Check an identification's 1-sigma by ``draws`` simulated repeats of the session with its
-    fitted noise model (rotacal.ballbar.monte_carlo, rotacal.rtest.monte_carlo_rtest)."""
+    fitted noise model (rotacal.ballbar.monte_carlo, rotacal.rtest.monte_carlo_rtest,
+    rotacal.probe.monte_carlo_probe)."""
     return by_kind(session, {BALLBAR: lambda: ballbar.monte_carlo(session, identification, draws, seed=seed),
-                             RTEST: lambda: rtest.monte_carlo_rtest(session, identification, draws, seed=seed)},
+                             RTEST: lambda: rtest.monte_carlo_rtest(session, identification, draws, seed=seed),
+                             PROBE: lambda: probe.monte_carlo_probe(session, identification, draws, seed=seed)},
                    "monte_carlo")()
 
 
-def identification_document(identification: Any, session_path: str | Path, controller: str | None = None) -> dict:
+def identification_document(identification: Any, session_path: str | Path | Sequence[str | Path],
+                            controller: str | None = None) -> dict:
     """What a model file and a history entry hold of an identification: its model with the
-    ``source`` (the session as named, its SHA-256, when, by which rotacal) and, when given, the
+    ``source`` (the session as named, its SHA-256, when, by which rotacal; for a joint
+    identification of several sessions, ``session_path`` lists them) and, when given, the
     text of the controller parameters active during the test (the kinematics the errors are
     relative to, for the export and the history)."""
     from .models import source_dict
     source = source_dict(session_path)
     if controller is not None:
         source["controller_parameters"] = controller
+    if isinstance(identification, probe.ProbeIdentification):
+        return identification.model_dict(source["session"]) | {"source": source}
     return identification.model_dict() | {"source": source}
 
 
@@ -129,12 +135,30 @@ def write_report(path: str | Path, session: Any, method: str = "joint", with_dia
         d = diagnose(s) if with_diagnosis else None
         return report.rtest_report(path, s, ident, d, source=source, inputs=inputs, extra_sections=extra_sections)
 
-    return by_kind(session, {BALLBAR: ballbar_report, RTEST: rtest_report}, "report")()
+    def probe_report():
+        if method != "joint":
+            raise _core.InvalidArgument("report: a touch-probe report draws the joint fit; the cycles' method is "
+                                        "in `rotacal identify --method cycles`")
+        d = diagnose(session) if with_diagnosis else None
+        return report.probe_report(path, session, probe.identify_probe(session, "joint"), d, source=source,
+                                   inputs=inputs, extra_sections=extra_sections)
+
+    return by_kind(session, {BALLBAR: ballbar_report, RTEST: rtest_report, PROBE: probe_report}, "report")()
+
+
+def write_joint_report(path: str | Path, sessions: Sequence[Any], names: Sequence[str], source: str = "",
+                       inputs: Sequence[str] = (), extra_sections: Sequence[str] = ()) -> Path:
+    """The HTML report of one identification from several sessions of one machine
+    (rotacal.multi.identify_sessions; ``names`` name them, e.g. their files)."""
+    from . import report
+    result = multi.identify_sessions(sessions, names)
+    return report.multi_report(path, result, source=source, inputs=inputs, extra_sections=extra_sections)
 
 
 def write_diagnosis_report(path: str | Path, session: Any, result: Any, source: str = "",
                            inputs: Sequence[str] = ()) -> Path:
-    """``diagnose --report``: the ballbar report with this diagnosis, or the diagnosis alone (R-test)."""
+    """``diagnose --report``: the ballbar or touch-probe report with this diagnosis, or the
+    diagnosis alone (R-test)."""
     from . import report
 
     return by_kind(session, {
@@ -142,4 +166,6 @@ def write_diagnosis_report(path: str | Path, session: Any, result: Any, source: 
                                                inputs=inputs),
         RTEST: lambda: report.diagnosis_report(path, result.to_dict(), title="R-test diagnosis", source=source,
                                                inputs=inputs),
+        PROBE: lambda: report.probe_report(path, session, probe.identify_probe(session), result, source=source,
+                                           inputs=inputs),
     }, "diagnose --report")()

@@ -68,11 +68,8 @@ def monte_carlo(session: _core.BallbarSession, result: Identification, draws: in
                                      progress=(lambda done, total: bar.update(done)) if bar else None)
         if bar:
             bar.close()
-        out = {p.name: {"std_reported": float(p.std_reported), "std_mc": float(p.std_mc),
-                        "ratio": float(p.ratio), "bias": float(p.bias), "unit": p.unit}
-               for p in mc.parameters}
-        return {"draws": draws, "noise_um": float(mc.noise_um), "noise": mc.noise, "method": method,
-                "parameters": out}
+        from .results import monte_carlo_dict
+        return monte_carlo_dict(mc, draws, mc.noise_um)
     values = []  # the paper method: simulate and identify again, in Python
     for k in range(draws):
         sim = _core.simulate_ballbar(session, raw.model, float(raw.sigma_um), seed + k)

@@ -120,14 +120,21 @@ def file_sha256(path: str | Path) -> str:
     return h.hexdigest()
 
 
-def source_dict(session_path: str | Path) -> dict:
+def source_dict(session_path: str | Path | list | tuple) -> dict:
     """The ``source`` member of a model file: the session it was identified from (as named, and
-    its SHA-256), when, and by which rotacal; exports and the history quote it."""
+    its SHA-256), when, and by which rotacal; exports and the history quote it. Several sessions
+    (a joint identification): ``session`` names them all (", "), ``session_sha256`` is the
+    SHA-256 of their SHA-256s in order, and ``sessions`` lists each with its own."""
     import datetime
+    import hashlib
     from .version import __version__
-    return {"session": os.fspath(session_path), "session_sha256": file_sha256(session_path),
-            "identified_at": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
+    when = {"identified_at": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
             "rotacal": __version__}
+    if not isinstance(session_path, (list, tuple)):
+        return {"session": os.fspath(session_path), "session_sha256": file_sha256(session_path)} | when
+    each = [{"session": os.fspath(p), "session_sha256": file_sha256(p)} for p in session_path]
+    joint = hashlib.sha256("".join(s["session_sha256"] for s in each).encode()).hexdigest()
+    return {"session": ", ".join(s["session"] for s in each), "session_sha256": joint} | when | {"sessions": each}
 
 
 def _value(d: dict, where: str) -> float:

@@ -30,6 +30,13 @@ class MultiIdentification:
                 return p
         raise _core.InvalidArgument(f"no location error named {name!r}")
 
+    def model_dict(self) -> dict:
+        """The model file's content (``kind: multi``, docs/model_file.md), written by the C++
+        implementation (rotacal/multi/model_document.hpp): the shared location errors and effects
+        with the joint covariance, each session with its own parameters, its values alone and its
+        noise model, and the disagreements."""
+        return _core.multi_model_document(self.raw)
+
     def to_dict(self) -> dict:
         r = self.raw
         return {

@@ -25,9 +25,12 @@ class ProbeIdentification(Identification):
     def machine(self):
         return self.raw.machine
 
-    def model_dict(self) -> dict:
-        raise _core.InvalidArgument("a touch-probe fit has no model file yet (rotacal-model holds ballbar and "
-                                    "R-test models)")
+    def model_dict(self, session_name: str = "session") -> dict:
+        """The model file's content (``kind: probe``, docs/model_file.md), written by the C++
+        implementation (rotacal/probe/model_document.hpp): location errors with their 1-sigma
+        and covariance, the effects fitted along, the session (``session_name``) with its sphere
+        and noise model. Only the joint fit has one: the cycles' method gives no uncertainty."""
+        return _core.probe_model_document(self.raw, session_name)
 
     def to_dict(self) -> dict:
         def est(p):
@@ -69,6 +72,24 @@ def identify_probe(session: _core.ProbeSession, method: str = "joint", *, effect
     else:
         raise _core.InvalidArgument(f"identify_probe: method must be one of {', '.join(METHODS)}, got {method!r}")
     return ProbeIdentification(raw)
+
+
+def monte_carlo_probe(session: _core.ProbeSession, result: ProbeIdentification, draws: int = 100, *,
+                      seed: int = 1, noise: str = "auto", progress: bool = True) -> dict:
+    """Check a touch-probe joint fit's 1-sigma by Monte Carlo (probe/monte_carlo.hpp): each draw
+    moves every touch along its approach direction to the identified machine plus noise drawn
+    from the fit's noise model (AR when the fit was refitted under it, else white), refitted the
+    same way (``noise`` as the fit: "auto" or "white"). Same dict as rotacal.ballbar.monte_carlo."""
+    from .progress import ProgressBar
+    from .results import monte_carlo_dict
+    if result.raw.method != "joint":
+        raise _core.InvalidArgument("monte_carlo: the cycles' method reports no uncertainty to check; use the joint fit")
+    bar = ProgressBar("Monte Carlo", draws, " draws") if progress else None
+    mc = _core.monte_carlo_probe(session, result.raw, draws, seed, noise,
+                                 progress=(lambda done, total: bar.update(done)) if bar else None)
+    if bar:
+        bar.close()
+    return monte_carlo_dict(mc, draws, mc.noise_um)
 
 
 def simulate_probe(machine: str | Any, errors: Sequence[float] | None = None,

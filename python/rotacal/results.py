@@ -162,6 +162,17 @@ def _num(x: float):
     return float(x) if math.isfinite(x) else None
 
 
+def monte_carlo_dict(mc: Any, draws: int, noise_um: float, keep: Any = None) -> dict:
+    """What ``identify --monte-carlo`` prints of a C++ Monte Carlo check (its ``parameters``:
+    core/monte_carlo.hpp; ``keep``: which parameter names to show, default all):
+    {"draws", "noise_um", "noise", "method", "parameters": {name: {"std_reported", "std_mc",
+    "ratio", "bias", "unit"}}}."""
+    out = {p.name: {"std_reported": float(p.std_reported), "std_mc": float(p.std_mc), "ratio": float(p.ratio),
+                    "bias": float(p.bias), "unit": p.unit}
+           for p in mc.parameters if keep is None or keep(p.name)}
+    return {"draws": draws, "noise_um": float(noise_um), "noise": mc.noise, "method": "joint", "parameters": out}
+
+
 def noise_model_dict(nm, refit: bool | None = None, correction: float | None = None) -> dict:
     """The noise model (core/noise_model.hpp) as JSON: docs/json_schema.md#noise-model."""
     out = {

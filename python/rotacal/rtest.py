@@ -142,11 +142,8 @@ def monte_carlo_rtest(session: _core.RtestSession, result: RtestIdentification, 
                                  progress=(lambda done, total: bar.update(done)) if bar else None)
     if bar:
         bar.close()
-    out = {p.name: {"std_reported": float(p.std_reported), "std_mc": float(p.std_mc), "ratio": float(p.ratio),
-                    "bias": float(p.bias), "unit": p.unit}
-           for p in mc.parameters if p.name.startswith("E_")}
-    return {"draws": draws, "noise_um": float(result.raw.sigma_um), "noise": mc.noise, "method": "joint",
-            "parameters": out}
+    from .results import monte_carlo_dict
+    return monte_carlo_dict(mc, draws, result.raw.sigma_um, keep=lambda name: name.startswith("E_"))
 
 
 # ------------------------------------------------------------------------- prediction

@@ -12,25 +12,21 @@
 
 #include "rotacal/core/error.hpp"
 #include "rotacal/core/json_text.hpp"
+#include "rotacal/io/fitted_model.hpp"
+#include "model_checks.hpp"
 
 namespace rotacal {
 
 namespace {
 
 using json = nlohmann::ordered_json;
+using model_checks::bad;
+using model_checks::estimate;
+using model_checks::member;
+using model_checks::object_member;
+using model_checks::shown;
 
-const std::set<std::string> kKinds = {"ballbar", "rtest-joint", "rtest-diagnosis"};
-
-[[noreturn]] void bad(const std::string& source, const std::string& where, const std::string& what) {
-  throw InvalidArgument(source + ": " + (where.empty() ? "" : where + ": ") + what);
-}
-
-// At most ~80 characters of a value in a message.
-std::string shown(const json& v) {
-  std::string s = v.dump();
-  if (s.size() > 80) s = s.substr(0, 77) + "...";
-  return s;
-}
+const std::set<std::string> kKinds = {"ballbar", "rtest-joint", "rtest-diagnosis", "probe", "multi"};
 
 // Reads `rotacal-model/M` or `rotacal-model/M.N`; refuses another major version by name.
 int format_minor(const json& doc, const std::string& source) {
@@ -59,44 +55,6 @@ int format_minor(const json& doc, const std::string& source) {
         f + " was written by a newer rotacal; this one reads " + kModelFormat + ": upgrade rotacal");
   if (major < kModelFormatMajor) bad(source, "format", f + " is older than any rotacal wrote");
   return minor;
-}
-
-const json& member(const json& obj, const std::string& key, const std::string& source,
-                   const std::string& where) {
-  const auto it = obj.find(key);
-  if (it == obj.end()) bad(source, where.empty() ? key : where + "." + key, "missing");
-  return *it;
-}
-
-const json& object_member(const json& obj, const std::string& key, const std::string& source,
-                          const std::string& where = "") {
-  const json& v = member(obj, key, source, where);
-  if (!v.is_object()) bad(source, where.empty() ? key : where + "." + key, "must be an object, got " + shown(v));
-  return v;
-}
-
-// One {"value", "std", "unit"} entry; returns the value (null -> nullopt: unobservable).
-std::optional<double> estimate(const json& e, const std::string& where, const std::string& unit,
-                               double limit, const std::string& source) {
-  if (!e.is_object()) bad(source, where, "must be an object {\"value\", \"std\", \"unit\"}, got " + shown(e));
-  const json& v = member(e, "value", source, where);
-  if (e.contains("unit")) {
-    const json& u = e["unit"];
-    if (!u.is_string() || u.get<std::string>() != unit)
-      bad(source, where + ".unit", shown(u) + ": this parameter is in " + unit);
-  }
-  if (e.contains("std")) {
-    const json& s = e["std"];
-    if (!s.is_null() && (!s.is_number() || !(s.get<double>() >= 0.0)))
-      bad(source, where + ".std", "must be a number >= 0 or null, got " + shown(s));
-  }
-  if (v.is_null()) return std::nullopt;
-  if (!v.is_number()) bad(source, where + ".value", "must be a number or null, got " + shown(v));
-  const double x = v.get<double>();
-  if (!std::isfinite(x) || std::fabs(x) > limit)
-    bad(source, where + ".value",
-        shown(v) + " " + unit + " is beyond " + json(limit).dump() + " " + unit + ", which no machine tool has");
-  return x;
 }
 
 // The R-test joint model's own members. Coefficient names are checked for their unit (d* are
@@ -202,7 +160,7 @@ void check_envelope(const json& doc, const std::string& source, ModelFile& m) {
   m.format_minor = format_minor(doc, source);
   const json& kind = member(doc, "kind", source, "");
   if (!kind.is_string() || !kKinds.count(kind.get<std::string>()))
-    bad(source, "kind", shown(kind) + " is not one of ballbar, rtest-joint, rtest-diagnosis");
+    bad(source, "kind", shown(kind) + " is not one of ballbar, rtest-joint, rtest-diagnosis, probe, multi");
   m.kind = kind.get<std::string>();
   const json& machine = member(doc, "machine", source, "");
   if (!machine.is_string()) bad(source, "machine", "must be a string such as \"AC-trt\", got " + shown(machine));
@@ -269,6 +227,8 @@ json read_model_document(const std::string& path) {
   json doc = parse_json(read_text(path), path);
   ModelFile envelope;
   check_envelope(doc, path, envelope);
+  // Nothing later reads a probe or multi model's own members member by member: all checked now.
+  if (envelope.kind == "probe" || envelope.kind == "multi") model_from_json(doc, path);
   return doc;
 }
 
@@ -332,6 +292,7 @@ ModelFile model_from_json(const json& doc, const std::string& source) {
     }
   }
   if (m.kind == "rtest-joint") check_rtest_joint(doc, m.machine, source);
+  if (m.kind == "probe" || m.kind == "multi") fitted_model_from_json(doc, m.machine, source);
   probe_zeros(doc, source);
   if (doc.contains("null_reasons") && !doc["null_reasons"].is_object())
     bad(source, "null_reasons", "must be an object (JSON pointer -> reason)");

@@ -221,6 +221,7 @@ MultiIdentification identify_multi(const std::vector<MultiSessionInput>& session
 
   MultiIdentification out;
   out.machine = sessions.front().machine();
+  out.effect_model = fx;
   std::vector<BlockDiagonalWhitener::Block> wblocks;
   std::vector<FitParameter> params(static_cast<std::size_t>(model.num_parameters()));
   const std::vector<std::string> names = model.layout().names(), units = model.layout().units();

@@ -121,8 +121,8 @@ def test_cli_joint_identification_reports_a_planted_disagreement(tmp_path):
     assert abs(found[0]["z"]) > 3
     text = run_cli("identify", bb, pr, cwd=tmp_path)
     assert text.returncode == 0 and "DISAGREE E_X0C" in text.stdout, text.stdout + text.stderr
-    refused = run_cli("identify", bb, pr, "--save-model", tmp_path / "m.json", cwd=tmp_path)
-    assert refused.returncode != 0 and "--save-model" in refused.stderr
+    refused = run_cli("identify", bb, pr, "--monte-carlo", "10", cwd=tmp_path)
+    assert refused.returncode != 0 and "--monte-carlo" in refused.stderr
 
 
 def test_shared_effect_within_3_sigma(tmp_path):

@@ -104,9 +104,9 @@ def test_identify_prints_a_table_with_the_budget_and_refuses_what_a_probe_fit_la
     r = run("identify", path, "--method", "cycles-free-radius")
     assert r.returncode == 0 and "dispersion of the sphere centres" in r.stdout
     model = tmp_path / "m.json"
-    r = run("identify", path, "--save-model", model)
-    assert r.returncode == 3 and "no model file" in r.stderr and not model.exists()
-    for bad in (["--method", "paper"], ["--length-offset"], ["--monte-carlo", "10"]):
+    r = run("identify", path, "--method", "cycles", "--save-model", model)
+    assert r.returncode == 3 and "gives none" in r.stderr and not model.exists()
+    for bad in (["--method", "paper"], ["--length-offset"], ["--method", "cycles", "--monte-carlo", "10"]):
         r = run("identify", path, *bad)
         assert r.returncode == 3 and r.stdout == "", bad
     # The cycles' method is the touch probe's: a ballbar session refuses it.

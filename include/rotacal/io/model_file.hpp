@@ -45,7 +45,7 @@ inline constexpr double kMaxModelPivot = 1.0e4;
 /// A validated model file.
 struct ModelFile {
   int format_minor = 0;   ///< N of rotacal-model/1.N (0 for "rotacal-model/1")
-  std::string kind;       ///< "ballbar", "rtest-joint" or "rtest-diagnosis"
+  std::string kind;       ///< "ballbar", "rtest-joint", "rtest-diagnosis", "probe" or "multi" (io/fitted_model.hpp)
   MachineType machine = MachineType::AC_trt;
   /// Location errors in location_error_names(machine) order (mm, rad); an unobservable one
   /// (value null) is nominal, 0, and flagged in `observable`.
@@ -64,8 +64,8 @@ ModelFile model_from_json(const nlohmann::ordered_json& document, const std::str
 ModelFile parse_model(const std::string& text, const std::string& source);
 /// Read a model file; IoError if it cannot be read (a directory, missing, too large).
 ModelFile read_model(const std::string& path);
-/// Read a model file checking only what every use needs (strict JSON, format version, kind,
-/// machine); the kind's own members are checked where the model is used (model_from_json).
+/// Read a model file checking what every use needs (strict JSON, format version, kind, machine; all
+/// of a probe or multi model); other kinds' members are checked where used (model_from_json).
 nlohmann::ordered_json read_model_document(const std::string& path);
 
 /// Replace every non-finite number by null and record why under "null_reasons"

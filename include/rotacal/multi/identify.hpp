@@ -89,6 +89,7 @@ struct MultiIdentification {
   MachineType machine = MachineType::AC_trt;
   std::vector<ParameterEstimate> location_errors;  ///< the one shared set, joint fit
   std::vector<ParameterEstimate> effects;          ///< the shared catalogue effects' parameters
+  EffectModel effect_model;                        ///< the shared catalogue effects (options.effects)
   std::vector<MultiSessionResult> sessions;        ///< in input order
   std::vector<MultiDisagreement> disagreements;
   std::vector<std::string> parameter_names;        ///< joint vector order

@@ -83,6 +83,20 @@ def cmd_diagnose(a: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _joint_report(a: argparse.Namespace, extra: list, history: dict | None) -> int:
+    from ..analysis import write_joint_report
+    if a.method != "joint":
+        raise _core.InvalidArgument("report: several sessions are reported by their joint fit (--method joint)")
+    sessions = [load_session(f, a) for f in a.file]
+    if history is not None and history["machine_type"] != _core.machine_name(sessions[0].machine):
+        raise _core.InvalidArgument(f"--history {a.history}: a {history['machine_type']} in the store, but the "
+                                    f"sessions are of a {_core.machine_name(sessions[0].machine)}: not the same machine")
+    out = write_joint_report(a.output, sessions, list(a.file), source=", ".join(a.file), inputs=list(a.file),
+                             extra_sections=extra)
+    print(Path(out).resolve())
+    return EXIT_OK
+
+
 def cmd_report(a: argparse.Namespace) -> int:
     from ..analysis import write_report
     extra, history = [], None
@@ -91,6 +105,9 @@ def cmd_report(a: argparse.Namespace) -> int:
         with open_history(a.db) as h:  # an unknown machine id is refused before the fit
             history = h.show(a.history)
         extra.append(history_section(history))
+    if len(a.file) > 1:  # one identification from several sessions of one machine
+        return _joint_report(a, extra, history)
+    a.file = a.file[0]
     s = load_session(a.file, a, circular_tests=True)
     if history is not None and history["machine_type"] != _core.machine_name(s.machine):
         raise _core.InvalidArgument(f"--history {a.history}: a {history['machine_type']} in the store, but {a.file} "
@@ -123,8 +140,10 @@ def add_diagnose(sub: argparse._SubParsersAction) -> None:
 
 
 def add_report(sub: argparse._SubParsersAction) -> None:
-    q = sub.add_parser("report", help="self-contained HTML report of a session", epilog=EPILOG)
-    q.add_argument("file", type=path("FILE"))
+    q = sub.add_parser("report", help="self-contained HTML report of a session, or of the joint identification of "
+                                      "several sessions of one machine", epilog=EPILOG)
+    q.add_argument("file", type=path("FILE"), nargs="+",
+                   help="a session; several (ballbar, R-test, touch probe) of one machine are reported jointly")
     q.add_argument("--method", default="joint", choices=["joint", "paper"])
     q.add_argument("--no-diagnosis", action="store_true")
     q.add_argument("--history", metavar="MACHINE_ID",

@@ -50,6 +50,9 @@ def print_history(h: dict, max_flags: int = 20) -> None:
     span = f", {cal[0]['at'][:10]} .. {cal[-1]['at'][:10]}" if cal else ""
     print(f"machine {h['machine_id']} ({h['machine_type']}): {h['identifications']} identifications, "
           f"{len(h['corrections'])} corrections (controller changes){span}; store {h['store']}")
+    for c in cal:  # the identifications, whatever their test (ballbar, rtest-joint, probe, multi, ...)
+        print(f"  entry {c['entry']:<4d} {c['at']}  {c['test']:16s} {c['session'] or '-'}"
+              + (f"  [{c['note']}]" if c["note"] else ""))
     print("values: the machine's own (measured + compensation loaded), um / urad")
     print(f"  {'error':6s} {'n':>5s} {'latest':>10s} {'1-sigma':>8s} {'drift/month':>11s} {'+-':>7s} {'chi2/dof':>8s}")
     for name, e in h["location_errors"].items():

@@ -135,17 +135,39 @@ def print_joint_identification(d: dict) -> None:
         print(f"  note: {n}")
 
 
+def _keep(a: argparse.Namespace, result, d: dict, files) -> None:
+    """--save-model and --store of any identification: the model file (rotacal-model/1, written
+    by the C++ writer, strict: a non-finite number is written null with its reason) and the
+    history entry. ``files``: the session, or the list of sessions of a joint identification."""
+    from ..analysis import identification_document
+    inputs = tuple(files) if isinstance(files, list) else (files,)
+    if a.save_model:
+        from ..models import save_model
+        save_model(identification_document(result, files, controller_text(a.controller)), a.save_model,
+                   inputs=inputs)
+        say(f"wrote {a.save_model}")
+    if a.store:
+        from ..history import open_history, redact
+        controller = controller_text(a.controller)
+        with open_history(a.db) as h:
+            entry = h.add_identification(a.machine_id, identification_document(result, files), note=a.note,
+                                         measured_at=a.date, details={"identification": d},
+                                         controller=controller, where=", ".join(inputs))
+            say(f"stored as entry {entry} of machine {a.machine_id!r} in {redact(h.location)}")
+
+
 def _cmd_identify_joint(a: argparse.Namespace) -> int:
     """Several sessions of one machine: one joint identification (rotacal.multi)."""
     from ..multi import identify_sessions
     given = [o for o, on in ((f"--method {a.method}", a.method != "joint"), ("--length-offset", a.length_offset),
-                             ("--save-model", a.save_model), ("--monte-carlo", a.monte_carlo),
-                             ("--budget-sizes", a.budget_sizes), ("--store", a.store),
-                             ("--machine-id", a.machine_id is not None), ("--controller", a.controller)) if on]
+                             ("--monte-carlo", a.monte_carlo), ("--budget-sizes", a.budget_sizes)) if on]
     if given:
         raise OptionError(f"{', '.join(given)}: not available for a joint identification of several sessions")
+    _refuse_history_options(a)
     sessions = [load_session(f, a) for f in a.file]
-    d = identify_sessions(sessions, list(a.file), noise=a.noise).to_dict()
+    result = identify_sessions(sessions, list(a.file), noise=a.noise)
+    d = result.to_dict()
+    _keep(a, result, d, list(a.file))
     if a.json:
         print(jsontext.dumps(d))
     else:
@@ -154,7 +176,7 @@ def _cmd_identify_joint(a: argparse.Namespace) -> int:
 
 
 def cmd_identify(a: argparse.Namespace) -> int:
-    from ..analysis import identification_budget, identification_document, identify, monte_carlo
+    from ..analysis import identification_budget, identify, monte_carlo
     if len(a.file) > 1:
         return _cmd_identify_joint(a)
     a.file = a.file[0]
@@ -163,7 +185,8 @@ def cmd_identify(a: argparse.Namespace) -> int:
     s = load_session(a.file, a)
     if kind(s) == PROBE:  # the touch probe's options and fit: cli/probe.py
         from .probe import identify_probe_session, print_probe_identification
-        d = identify_probe_session(a, s, sizes)
+        result, d = identify_probe_session(a, s, sizes)
+        _keep(a, result, d, a.file)
         if a.json:
             print(jsontext.dumps(d))
         else:
@@ -172,6 +195,8 @@ def cmd_identify(a: argparse.Namespace) -> int:
                 print_noise_model(d["noise_model"])
             if d.get("uncertainty_budget"):
                 print_budget(d["uncertainty_budget"])
+            if d.get("monte_carlo"):
+                _print_monte_carlo(d["monte_carlo"])
         return EXIT_OK
     if a.length_offset and kind(s) == RTEST:
         raise _core.InvalidArgument("identify: --length-offset is for ballbar sessions")
@@ -181,20 +206,7 @@ def cmd_identify(a: argparse.Namespace) -> int:
     d = result.to_dict()
     if a.monte_carlo:
         d["monte_carlo"] = monte_carlo(s, result, a.monte_carlo, seed=a.seed)
-    if a.save_model:
-        from ..models import save_model
-        # The C++ model writer is strict: a non-finite number is written null with its reason.
-        save_model(identification_document(result, a.file, controller_text(a.controller)), a.save_model,
-                   inputs=(a.file,))
-        say(f"wrote {a.save_model}")
-    if a.store:
-        from ..history import open_history, redact
-        controller = controller_text(a.controller)
-        with open_history(a.db) as h:
-            entry = h.add_identification(a.machine_id, identification_document(result, a.file), note=a.note,
-                                         measured_at=a.date, details={"identification": d},
-                                         controller=controller, where=a.file)
-            say(f"stored as entry {entry} of machine {a.machine_id!r} in {redact(h.location)}")
+    _keep(a, result, d, a.file)
     if by_kind(s, {BALLBAR: a.json, RTEST: True}, "identify"):
         print(jsontext.dumps(d))
     else:
@@ -226,7 +238,8 @@ def add_identify(sub: argparse._SubParsersAction) -> None:
     q.add_argument("--length-offset", action="store_true", help="also fit an offset of L0 (joint)")
     q.add_argument("--json", action="store_true", help="print the result as JSON")
     q.add_argument("--save-model", metavar="MODEL.json", type=path("--save-model"),
-                   help="write the fitted model (ballbar, or R-test joint: location errors, maps, covariance)")
+                   help="write the fitted model (ballbar; R-test joint: location errors, maps, covariance; touch probe "
+                        "joint fit; several sessions' joint identification)")
     q.add_argument("--monte-carlo", type=number("--monte-carlo", 0, 10_000, integer=True), default=0, metavar="N",
                    help="check the 1-sigma by N simulated repeats of the session with its fitted noise model (progress bar)")
     q.add_argument("--seed", type=SEED, default=1, help="seed of the Monte Carlo draws")

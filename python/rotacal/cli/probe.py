@@ -24,10 +24,9 @@ DEFAULT_APPROACH_MM = 5.0   # probe/nc_program.hpp ProbeProgramOptions
 DEFAULT_PROBE_FEED = 50.0   # mm/min, likewise
 DEFAULT_POSITIONING_FEED = 1000.0  # mm/min, likewise
 
-# What a touch-probe identification cannot do yet, refused before the fit.
-NO_MODEL_FILE = ("--save-model/--store: the model file (rotacal-model/1, docs/model_file.md) holds kinds "
-                 "ballbar, rtest-joint and rtest-diagnosis only; a touch-probe identification has no model "
-                 "file yet (print it with --json instead)")
+# What a touch-probe identification cannot do, refused before the fit.
+NO_CYCLES_MODEL = ("--save-model/--store: the model file holds a fit with its uncertainties and covariance; the "
+                   "cycles' method gives none (identify with --method joint, the default)")
 
 
 # ------------------------------------------------------------------------- simulate probe
@@ -129,27 +128,31 @@ def print_probe_identification(d: dict) -> None:
         print(f"  note: {n}")
 
 
-def identify_probe_session(a: argparse.Namespace, s: _core.ProbeSession, sizes: dict | None) -> dict:
-    """The document `rotacal identify` prints of a rotacal-probe/1 session: --method joint (the
-    default; with the uncertainty budget unless --no-budget), cycles or cycles-free-radius (the
-    controller cycles' method, radius known or fitted per pose). What a probe fit cannot do
-    (a model file, the history, the Monte Carlo check) is refused before the fit."""
+def identify_probe_session(a: argparse.Namespace, s: _core.ProbeSession,
+                           sizes: dict | None) -> tuple[probe.ProbeIdentification, dict]:
+    """The identification and the document `rotacal identify` prints of a rotacal-probe/1
+    session: --method joint (the default; with the uncertainty budget unless --no-budget),
+    cycles or cycles-free-radius (the controller cycles' method, radius known or fitted per
+    pose). What the cycles' method cannot do (a model file, the Monte Carlo check: it reports no
+    uncertainty) is refused before the fit."""
     if a.method == "paper":
         raise OptionError("identify: --method paper is the ballbar's and the R-test's; a touch-probe session "
                           "takes joint, cycles or cycles-free-radius")
     if a.length_offset:
         raise OptionError("identify: --length-offset is for ballbar sessions")
-    if a.save_model or a.store:
-        raise OptionError(NO_MODEL_FILE)
-    if a.monte_carlo:
-        raise OptionError("identify: --monte-carlo is not implemented for touch-probe sessions")
+    if (a.save_model or a.store) and a.method != "joint":
+        raise OptionError(NO_CYCLES_MODEL)
+    if a.monte_carlo and a.method != "joint":
+        raise OptionError("identify: --monte-carlo checks a reported 1-sigma; the cycles' method reports none")
     result = probe.identify_probe(s, a.method, noise=a.noise)
     d = result.to_dict()
     if a.method == "joint" and not a.no_budget:
         from ..diagnosis import uncertainty_budget
         from ..results import budget_dict
         d["uncertainty_budget"] = budget_dict(uncertainty_budget(s, sizes=sizes))
-    return d
+    if a.monte_carlo:
+        d["monte_carlo"] = probe.monte_carlo_probe(s, result, a.monte_carlo, seed=a.seed, noise=a.noise)
+    return result, d
 
 
 # ------------------------------------------------------------------------- plan probe, import probe

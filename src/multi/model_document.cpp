@@ -1,0 +1,50 @@
+// A joint identification of several sessions as a model document (multi/model_document.hpp).
+#include "rotacal/multi/model_document.hpp"
+
+#include "rotacal/core/error.hpp"
+
+namespace rotacal {
+
+FittedModelContent multi_model_content(const MultiIdentification& ident) {
+  const std::size_t n = ident.parameter_names.size();
+  if (ident.covariance.rows() != static_cast<Eigen::Index>(n) || ident.covariance.cols() != static_cast<Eigen::Index>(n))
+    throw InvalidArgument("multi_model_content: the covariance is not " + std::to_string(n) + " x " + std::to_string(n));
+  if (ident.effects.size() != static_cast<std::size_t>(ident.effect_model.num_params()))
+    throw InvalidArgument("multi_model_content: " + std::to_string(ident.effects.size()) +
+                          " effect parameters, the effect model has " + std::to_string(ident.effect_model.num_params()));
+  FittedModelContent c;
+  c.kind = "multi";
+  c.machine = ident.machine;
+  c.location_errors = ident.location_errors;
+  c.effects = ident.effect_model;
+  c.effect_parameters = ident.effects;
+  c.covariance_parameters = ident.parameter_names;
+  c.covariance = ident.covariance;
+  for (const MultiSessionResult& r : ident.sessions) {
+    FittedSessionContent s;
+    s.name = r.name;
+    s.instrument = r.instrument;
+    s.nuisances = r.nuisances;
+    s.alone = r.alone;
+    s.noise = r.noise;
+    s.noise_refit = r.noise_refit;
+    s.noise_correction = r.noise_correction;
+    s.residual_rms_um = r.residual_rms_um;
+    s.n_residuals = r.n_residuals;
+    c.sessions.push_back(std::move(s));
+  }
+  for (const MultiDisagreement& d : ident.disagreements)
+    c.disagreements.push_back({d.parameter, d.unit, d.session_a, d.session_b, d.value_a, d.value_b, d.difference,
+                               d.sigma, d.z});
+  c.converged = ident.converged;
+  c.chi2_per_dof = ident.summary.chi2_per_dof;
+  c.unobservable = ident.unobservable;
+  c.notes = ident.notes;
+  return c;
+}
+
+nlohmann::ordered_json multi_model_document(const MultiIdentification& ident) {
+  return fitted_model_document(multi_model_content(ident));
+}
+
+}  // namespace rotacal
