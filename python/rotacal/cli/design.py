@@ -8,7 +8,7 @@ from typing import Any, Sequence
 
 from .. import jsontext
 from ..outputs import write_output
-from ..sessions import BALLBAR, RTEST, kind
+from ..sessions import BALLBAR, PROBE, RTEST, kind
 from .options import EPILOG, EXIT_OK, OptionError, number, number_list, numbers, path, say
 from .setups import add_setup_args, ballbar_setup, load_session
 
@@ -28,7 +28,8 @@ def _session_after(a: argparse.Namespace, wanted: str) -> Any:
         raise OptionError("--separate: give the session it follows with --after SESSION")
     session = load_session(a.after)
     if kind(session) != wanted:
-        words = {BALLBAR: ("a ballbar session", "ballbar"), RTEST: ("an R-test session", "rtest")}
+        words = {BALLBAR: ("a ballbar session", "ballbar"), RTEST: ("an R-test session", "rtest"),
+                 PROBE: ("a touch-probe session", "probe")}
         raise OptionError(f"--after {a.after}: {words[kind(session)][0]}; design {words[wanted][1]} --separate "
                           f"needs {words[wanted][0]}")
     return session
