@@ -9,6 +9,23 @@ namespace rotacal::py {
 
 namespace {
 
+// The members every separation design shares (design/separation.hpp SeparationResult).
+template <typename D>
+void separation_members(pyb::class_<D>& c) {
+  c.def_readonly("effects", &D::effects)
+      .def_readonly("motion", &D::motion)
+      .def_readonly("names", &D::names)
+      .def_readonly("sigma_before", &D::sigma_before)
+      .def_readonly("sigma_after", &D::sigma_after)
+      .def_readonly("correlation_before", &D::correlation_before)
+      .def_readonly("already_separated", &D::already_separated)
+      .def_readonly("found", &D::found)
+      .def_readonly("candidates_tried", &D::candidates_tried)
+      .def_readonly("noise_um", &D::noise_um)
+      .def_readonly("effective_per_reading", &D::effective_per_reading)
+      .def_readonly("verdict", &D::verdict);
+}
+
 // The ballbar set-up design.
 void bind_ballbar_design(pyb::module_& m) {
   pyb::class_<BallbarDesignOptions>(m, "BallbarDesignOptions",
@@ -112,21 +129,10 @@ void bind_ballbar_separation(pyb::module_& m) {
       .def_readonly("slow_down", &SeparatingCandidate::slow_down)
       .def_readonly("correlation", &SeparatingCandidate::correlation)
       .def_readonly("determined", &SeparatingCandidate::determined);
-  pyb::class_<SeparationDesign>(m, "SeparationDesign",
-                                "The added test that separates two effects, or why none can.")
-      .def_readonly("effects", &SeparationDesign::effects)
-      .def_readonly("motion", &SeparationDesign::motion)
-      .def_readonly("names", &SeparationDesign::names)
-      .def_readonly("sigma_before", &SeparationDesign::sigma_before)
-      .def_readonly("sigma_after", &SeparationDesign::sigma_after)
-      .def_readonly("correlation_before", &SeparationDesign::correlation_before)
-      .def_readonly("already_separated", &SeparationDesign::already_separated)
-      .def_readonly("found", &SeparationDesign::found)
-      .def_readonly("chosen", &SeparationDesign::chosen)
-      .def_readonly("candidates_tried", &SeparationDesign::candidates_tried)
-      .def_readonly("noise_um", &SeparationDesign::noise_um)
-      .def_readonly("effective_per_reading", &SeparationDesign::effective_per_reading)
-      .def_readonly("verdict", &SeparationDesign::verdict);
+  auto ballbar_separation = pyb::class_<SeparationDesign>(m, "SeparationDesign",
+                                 "The added test that separates two effects, or why none can.");
+  separation_members(ballbar_separation);
+  ballbar_separation.def_readonly("chosen", &SeparationDesign::chosen);
   m.def(
       "design_ballbar_separation",
       [](const BallbarSession& session, const std::vector<std::string>& pair,
@@ -234,21 +240,10 @@ void bind_rtest_separation(pyb::module_& m) {
       .def_readonly("repeats", &RtestSeparatingCandidate::repeats)
       .def_readonly("correlation", &RtestSeparatingCandidate::correlation)
       .def_readonly("determined", &RtestSeparatingCandidate::determined);
-  pyb::class_<RtestSeparationDesign>(m, "RtestSeparationDesign",
-                                     "The added nest that separates two effects, or why none can.")
-      .def_readonly("effects", &RtestSeparationDesign::effects)
-      .def_readonly("motion", &RtestSeparationDesign::motion)
-      .def_readonly("names", &RtestSeparationDesign::names)
-      .def_readonly("sigma_before", &RtestSeparationDesign::sigma_before)
-      .def_readonly("sigma_after", &RtestSeparationDesign::sigma_after)
-      .def_readonly("correlation_before", &RtestSeparationDesign::correlation_before)
-      .def_readonly("already_separated", &RtestSeparationDesign::already_separated)
-      .def_readonly("found", &RtestSeparationDesign::found)
-      .def_readonly("chosen", &RtestSeparationDesign::chosen)
-      .def_readonly("candidates_tried", &RtestSeparationDesign::candidates_tried)
-      .def_readonly("noise_um", &RtestSeparationDesign::noise_um)
-      .def_readonly("effective_per_reading", &RtestSeparationDesign::effective_per_reading)
-      .def_readonly("verdict", &RtestSeparationDesign::verdict);
+  auto rtestballbar_separation = pyb::class_<RtestSeparationDesign>(m, "RtestSeparationDesign",
+                                 "The added nest that separates two effects, or why none can.");
+  separation_members(rtestballbar_separation);
+  rtestballbar_separation.def_readonly("chosen", &RtestSeparationDesign::chosen);
   m.def(
       "design_rtest_separation",
       [](const RtestSession& session, const std::vector<std::string>& pair,
@@ -330,20 +325,10 @@ void bind_probe_design(pyb::module_& m) {
       .def_readonly("repeats", &ProbeSeparatingCandidate::repeats)
       .def_readonly("correlation", &ProbeSeparatingCandidate::correlation)
       .def_readonly("determined", &ProbeSeparatingCandidate::determined);
-  pyb::class_<ProbeSeparationDesign>(m, "ProbeSeparationDesign", "The added poses that separate two effects, or why none can.")
-      .def_readonly("effects", &ProbeSeparationDesign::effects)
-      .def_readonly("motion", &ProbeSeparationDesign::motion)
-      .def_readonly("names", &ProbeSeparationDesign::names)
-      .def_readonly("sigma_before", &ProbeSeparationDesign::sigma_before)
-      .def_readonly("sigma_after", &ProbeSeparationDesign::sigma_after)
-      .def_readonly("correlation_before", &ProbeSeparationDesign::correlation_before)
-      .def_readonly("already_separated", &ProbeSeparationDesign::already_separated)
-      .def_readonly("found", &ProbeSeparationDesign::found)
-      .def_readonly("chosen", &ProbeSeparationDesign::chosen)
-      .def_readonly("candidates_tried", &ProbeSeparationDesign::candidates_tried)
-      .def_readonly("noise_um", &ProbeSeparationDesign::noise_um)
-      .def_readonly("effective_per_reading", &ProbeSeparationDesign::effective_per_reading)
-      .def_readonly("verdict", &ProbeSeparationDesign::verdict);
+  auto probeballbar_separation = pyb::class_<ProbeSeparationDesign>(m, "ProbeSeparationDesign",
+                                 "The added poses that separate two effects, or why none can.");
+  separation_members(probeballbar_separation);
+  probeballbar_separation.def_readonly("chosen", &ProbeSeparationDesign::chosen);
   m.def(
       "design_probe_separation",
       [](const ProbeSession& session, const std::vector<std::string>& pair, const ProbeSeparationOptions& o) {

@@ -92,8 +92,7 @@ def design_separation(session: Any, pair: Sequence[str], *, base: Any | None = N
     joint fit with a canonical correlation below ``max_correlation``, the predicted 1-sigma of
     every parameter before and after, or the reason no test can (their table motions are the
     same). ``base``: a ``BallbarSetup`` whose step, feeds and C range the added test uses."""
-    if len(pair) != 2:
-        raise _core.InvalidArgument(f"--separate: {','.join(pair)}: give two effects, EFFECT,EFFECT")
+    _check_pair(pair)
     o = _core.SeparationOptions()
     if base is not None:
         o.added = base
@@ -107,10 +106,20 @@ def design_separation(session: Any, pair: Sequence[str], *, base: Any | None = N
         o.travel_min, o.travel_max = _travel(travel)
     if tilt_limits is not None:
         o.tilt_limits_deg = [float(v) for v in tilt_limits]
+    _search_limits(o, max_time_s, max_correlation, noise_um)
+    return _core.design_ballbar_separation(session, list(pair), o)
+
+
+def _check_pair(pair: Sequence[str]) -> None:
+    if len(pair) != 2:
+        raise _core.InvalidArgument(f"--separate: {','.join(pair)}: give two effects, EFFECT,EFFECT")
+
+
+def _search_limits(o: Any, max_time_s: float, max_correlation: float, noise_um: float) -> None:
+    """The limits every separation search takes (design/separation.hpp)."""
     o.max_added_time_s = float(max_time_s)
     o.max_correlation = float(max_correlation)
     o.noise_um = float(noise_um)
-    return _core.design_ballbar_separation(session, list(pair), o)
 
 
 def machine_travel(machine: Any) -> list[float] | None:
@@ -201,8 +210,7 @@ def design_rtest_separation(session: Any, pair: Sequence[str], *, radii: Sequenc
     """A ``_core.RtestSeparationDesign``: the smallest R-test nest (position and grid) to add to
     ``session`` (an ``RtestSession``) so that the two effects of ``pair`` come out of the joint
     fit with a canonical correlation below ``max_correlation``, or why no test can."""
-    if len(pair) != 2:
-        raise _core.InvalidArgument(f"--separate: {','.join(pair)}: give two effects, EFFECT,EFFECT")
+    _check_pair(pair)
     o = _core.RtestSeparationOptions()
     for value, field in ((radii, "nest_radius_mm"), (angles, "nest_angle_deg"), (heights, "nest_height_mm"),
                          (b_steps, "b_step_deg"), (c_steps, "c_step_deg")):
@@ -213,9 +221,7 @@ def design_rtest_separation(session: Any, pair: Sequence[str], *, radii: Sequenc
     if travel is not None:
         o.travel_min, o.travel_max = _travel(travel)
     o.dwell_s = float(dwell_s)
-    o.max_added_time_s = float(max_time_s)
-    o.max_correlation = float(max_correlation)
-    o.noise_um = float(noise_um)
+    _search_limits(o, max_time_s, max_correlation, noise_um)
     return _core.design_rtest_separation(session, list(pair), o)
 
 
@@ -298,15 +304,12 @@ def design_probe_separation(session: Any, pair: Sequence[str], *, tilt_step: flo
     pose, repeated) to add to ``session`` (a ``ProbeSession``) so that the two effects of
     ``pair`` come out of the joint fit with a canonical correlation below ``max_correlation``,
     or why no test can."""
-    if len(pair) != 2:
-        raise _core.InvalidArgument(f"--separate: {','.join(pair)}: give two effects, EFFECT,EFFECT")
+    _check_pair(pair)
     o = _core.ProbeSeparationOptions()
     o.tilt_step_deg = float(tilt_step)
     o.rot_step_deg = float(rot_step)
     o.pose_time_s = float(pose_time_s)
-    o.max_added_time_s = float(max_time_s)
-    o.max_correlation = float(max_correlation)
-    o.noise_um = float(noise_um)
+    _search_limits(o, max_time_s, max_correlation, noise_um)
     return _core.design_probe_separation(session, list(pair), o)
 
 

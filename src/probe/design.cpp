@@ -164,7 +164,8 @@ ProbeDesign design_probe_test(const ProbeDesignOptions& o) {
   const Candidates c = candidates(o);
   ProbeDesign out;
   out.poses_tried = static_cast<int>(c.poses.size());
-  out.refused.assign(c.refused.begin(), c.refused.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(c.refused.size(), 5)));
+  const std::size_t shown = std::min<std::size_t>(c.refused.size(), 5);
+  out.refused.assign(c.refused.begin(), c.refused.begin() + static_cast<std::ptrdiff_t>(shown));
   const ProbePattern base = base_pattern(o);
   const int K = static_cast<int>(base.directions.size());
   out.touches = o.touches > 0 ? o.touches : static_cast<int>(base.poses_deg.size()) * K;

@@ -16,7 +16,7 @@ from ..design import (design_probe, design_probe_separation, parameter_units, po
 from ..machines import load_machine
 from ..outputs import write_output
 from ..sessions import PROBE, save
-from .design import _print_separation, _session_after
+from .design import _print_separation, _session_after, add_separation_group
 from .options import EPILOG, EXIT_OK, OptionError, number, path, say
 from .probe import DEFAULT_LOG_FILE, DEFAULT_SPHERE, _plan_template, add_sphere_args
 
@@ -105,15 +105,7 @@ def add_design_probe(kinds: argparse._SubParsersAction) -> None:
                    help="candidate rotary angles over a full turn every this, deg (default 30)")
     k.add_argument("--noise", type=number("--noise", 0.0, 1000.0, "um", lo_open=True),
                    help="1-sigma noise per latched coordinate, um (default 0.5; with --after: the session's)")
-    g = k.add_argument_group("the poses that separate two effects after a session (docs/design.md)")
-    g.add_argument("--separate", metavar="EFFECT,EFFECT",
-                   help="two catalogue ids the diagnosis could not tell apart: propose the smallest set of added "
-                        "poses that brings their correlation below --max-correlation, or say why none can")
-    g.add_argument("--after", type=path("--after"), metavar="SESSION", help="the touch-probe session they follow")
-    g.add_argument("--max-time", type=number("--max-time", 0.0, 86400.0, "s", lo_open=True), default=600.0,
-                   help="longest added poses, s (default 600)")
-    g.add_argument("--max-correlation", type=number("--max-correlation", 0.0, 1.0, "", lo_open=True), default=0.5,
-                   help="target largest canonical correlation of the pair (default 0.5)")
+    g = add_separation_group(k, "set of poses", "touch-probe session")
     g.add_argument("--pose-time", type=number("--pose-time", 0.0, 3600.0, "s", lo_open=True),
                    help="time per added pose, s (default: the session's)")
     k.add_argument("--log-file", default=DEFAULT_LOG_FILE, help="-o: the controller's file of the latched positions")
