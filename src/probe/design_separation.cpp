@@ -91,12 +91,14 @@ ProbeSeparationDesign design_probe_separation(const ProbeSession& session, const
                                   o.reference_radius_mm);
 
   // The session's information: the probe problem with the pair at the fit's start point, over
-  // the noise of the white fit's residuals. The sphere stays on the table: one layout.
+  // the white fit's sigma (residuals over n - p: with 120 touches and 19 parameters the noise
+  // model's RMS is 8 % low) and its noise model's effective samples. The sphere stays on the
+  // table: one layout.
   ProbeFitOptions fo;
   fo.effects = fx;
   fo.noise.noise = NoiseHandling::white;
   const ProbeIdentification id = identify_probe(session, fo);
-  const double w = session_weight(o.noise_um, id.noise, id.sigma_um,
+  const double w = session_weight(o.noise_um > 0.0 ? o.noise_um : id.sigma_um, id.noise, id.sigma_um,
                                   "design probe: --after: the session's residuals are zero (commanded touches?); "
                                   "give --noise", D);
   const ProbeParameterLayout L = ProbeParameterLayout::make(m, fx);

@@ -185,3 +185,39 @@ TEST_CASE("separation: gravity sag and the second radial harmonic of A, no probe
     CHECK(std::string(e.what()).find("backlash_C") != std::string::npos);
   }
 }
+
+TEST_CASE("separation: the joint fit of the session and the added poses realises the predicted sigma",
+          "[probe][design][separation]") {
+  MachineModel t = MachineModel::nominal(MachineType::AC_trt);
+  t.effects = EffectModel{{Effect::parse("radial_motion_A_h2"), Effect::parse("tilt_motion_A_h2")}, std::nullopt};
+  t.effect_params = {0.002, -0.001, 0.0015, 0.0, 1e-5, 0.0, -2e-5, 1e-5};
+  ProbeSimOptions so;
+  so.pattern = default_probe_pattern(t.machine);
+  const ProbeSeparationDesign D = design_probe_separation(simulate_probe(t, so).session, t.effects.effects);
+  REQUIRE(D.found);
+  // The session's poses, then the added ones as often as the design runs them.
+  for (int r = 0; r < static_cast<int>(D.chosen.repeats); ++r)
+    so.pattern.poses_deg.insert(so.pattern.poses_deg.end(), D.chosen.added.poses_deg.begin(),
+                                D.chosen.added.poses_deg.end());
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> g(0.0, 1.0);
+  ProbeFitOptions fo;
+  fo.effects = EffectModel{t.effects.effects, std::nullopt};
+  std::vector<double> sum(8, 0.0);
+  const int draws = 100;
+  for (int d = 0; d < draws; ++d) {
+    MachineModel m = t;
+    for (int k = 0; k < 8; ++k) m.errors.v[k] = g(rng) * (location_error_is_angle(k) ? 5e-5 : 0.02);
+    so.seed = 300 + static_cast<std::uint64_t>(d);
+    const ProbeIdentification id = identify_probe(simulate_probe(m, so).session, fo);
+    for (std::size_t k = 0; k < 8; ++k) sum[k] += std::pow(id.model.effect_params[k] - t.effect_params[k], 2);
+  }
+  const std::size_t first = D.names.size() - 8;  // the pair's parameters close the layout
+  for (std::size_t k = 0; k < 8; ++k) {
+    const double predicted = D.sigma_after[static_cast<Eigen::Index>(first + k)];
+    INFO(D.names[first + k] << ": realised " << std::sqrt(sum[k] / draws) << ", predicted " << predicted);
+    REQUIRE(std::isfinite(predicted));
+    CHECK(std::sqrt(sum[k] / draws) / predicted >= 0.7);
+    CHECK(std::sqrt(sum[k] / draws) / predicted <= 1.4);
+  }
+}
