@@ -97,7 +97,7 @@ ProbeDesignCandidate judge(const ProbePattern& P, const Eigen::MatrixXd& I, cons
   }
   out.feasible = true;
   out.worst_expanded_um = u.worst;
-  out.worst_error = out.names[static_cast<std::size_t>(u.worst_index)];
+  if (u.worst_index >= 0) out.worst_error = out.names[static_cast<std::size_t>(u.worst_index)];
   return out;
 }
 
@@ -191,7 +191,9 @@ ProbeDesign design_probe_test(const ProbeDesignOptions& o) {
   Eigen::MatrixXd I = Eigen::MatrixXd::Zero(c.layout.size(), c.layout.size());
   for (std::size_t k = 0; k < c.poses.size(); ++k) I += a.counts[k] * c.info[k];
   out.best = judge(best, I, c, ap.runs * K);
-  if (!out.best.feasible) throw InvalidArgument("design probe: no feasible design: " + out.best.why_not);
+  if (!out.best.feasible)
+    throw InvalidArgument("design probe: --touches " + std::to_string(out.touches) + " (" +
+                          std::to_string(ap.runs) + " poses): " + out.best.why_not + "; give more touches");
   if (out.baseline.feasible) out.ratio = out.best.worst_expanded_um / out.baseline.worst_expanded_um;
   return out;
 }

@@ -125,6 +125,8 @@ TEST_CASE("invalid options are refused naming the option", "[probe][design]") {
   refused(o, "--touches");
   o.touches = 4;  // fewer than the five touches of one pose
   refused(o, "--touches");
+  o.touches = 15;  // three poses: nine coordinates of the sphere's centre for eleven parameters
+  refused(o, "--touches");
   o = {};
   o.tilt_step_deg = 0.0;
   refused(o, "--tilt-step");
