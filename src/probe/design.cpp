@@ -169,9 +169,9 @@ ProbeDesign design_probe_test(const ProbeDesignOptions& o) {
   const ProbePattern base = base_pattern(o);
   const int K = static_cast<int>(base.directions.size());
   out.touches = o.touches > 0 ? o.touches : static_cast<int>(base.poses_deg.size()) * K;
-  if (out.touches < K)
-    throw InvalidArgument("design probe: --touches " + std::to_string(out.touches) + " is fewer than the " +
-                          std::to_string(K) + " touches of one pose");
+  if (out.touches < K || out.touches % K != 0)
+    throw InvalidArgument("design probe: --touches " + std::to_string(out.touches) + " is not a multiple of the " +
+                          std::to_string(K) + " touches of a pose");
   out.baseline = evaluate(base, o, c, out.touches);
 
   AllocationProblem ap;

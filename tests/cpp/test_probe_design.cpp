@@ -125,6 +125,8 @@ TEST_CASE("invalid options are refused naming the option", "[probe][design]") {
   refused(o, "--touches");
   o.touches = 4;  // fewer than the five touches of one pose
   refused(o, "--touches");
+  o.touches = 123;  // not whole poses: the default could not be compared at the same touches
+  refused(o, "--touches");
   o.touches = 15;  // three poses: nine coordinates of the sphere's centre for eleven parameters
   refused(o, "--touches");
   o = {};

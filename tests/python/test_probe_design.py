@@ -119,7 +119,8 @@ def test_printed_poses_are_what_plan_probe_takes(tmp_path):
 
 
 @pytest.mark.parametrize("args,option", [(["--touches", "2"], "--touches"), (["--touches", "-5"], "--touches"),
-                                         (["--touches", "4"], "--touches"), (["--tilt-step", "0"], "--tilt-step"),
+                                         (["--touches", "4"], "--touches"), (["--touches", "123"], "--touches"),
+                                         (["--tilt-step", "0"], "--tilt-step"),
                                          (["--noise", "0"], "--noise"), (["--after", "x.csv"], "--after")])
 def test_invalid_options_are_refused_by_name(args, option):
     r = rotacal_cli("design", "probe", *args)

@@ -67,8 +67,9 @@ struct ProbeDesign {
   std::vector<std::string> refused;  ///< candidate poses that are not, with the reason (first few)
 };
 
-/// Choose the poses and touches. Throws InvalidArgument naming the option for touches < 3 or
-/// above 100000, non-positive steps, noise, diameters or reference radius, or no plannable pose.
+/// Choose the poses and touches. Throws InvalidArgument naming the option for touches < 3,
+/// above 100000, not a multiple of the directions or too few to determine the location errors,
+/// non-positive steps, noise, diameters or reference radius, or no plannable pose.
 ProbeDesign design_probe_test(const ProbeDesignOptions& options);
 
 /// The predicted uncertainty of `pattern` at `touches` touches (0: its own). Never throws for

@@ -98,7 +98,8 @@ def add_design_probe(kinds: argparse._SubParsersAction) -> None:
                    help="a built-in (`rotacal machines`) or a rotacal-machine/1 description file (default AC-trt)")
     add_sphere_args(k)
     k.add_argument("--touches", type=number("--touches", 0, 100000, integer=True), default=0,
-                   help="total touches to design for (default 0: those of plan probe's default poses)")
+                   help="total touches to design for, a multiple of the 5 per pose (default 0: those of plan probe's "
+                        "default poses, 120)")
     k.add_argument("--tilt-step", type=number("--tilt-step", 0.0, 180.0, "deg", lo_open=True), default=15.0,
                    help="candidate tilt angles over the axis limits every this, deg (default 15)")
     k.add_argument("--rot-step", type=number("--rot-step", 1.0, 359.0, "deg"), default=30.0,
