@@ -151,7 +151,8 @@ void bind_probe_program(pyb::module_& m) {
   m.def(
       "write_probe_nc_program",
       [](MachineType machine, const std::string& dialect, std::optional<Array> poses_deg, const Array& sphere,
-         double sphere_diameter, double stylus_diameter, const std::string& log_file, int tool, int decimals) {
+         double sphere_diameter, double stylus_diameter, const std::string& log_file, int tool, int decimals,
+         double approach_mm, double probe_feed, double positioning_feed) {
         ProbePattern p = default_probe_pattern(machine);
         if (poses_deg) p.poses_deg = angles_of(*poses_deg);
         p.sphere = vec_of<3>(sphere, "sphere");
@@ -161,14 +162,20 @@ void bind_probe_program(pyb::module_& m) {
         o.log_file = log_file;
         o.tool = tool;
         o.decimals = decimals;
+        o.approach_mm = approach_mm;
+        o.probe_feed_mm_per_min = probe_feed;
+        o.feed_mm_per_min = positioning_feed;
         return write_probe_nc_program(machine, p, parse_nc_dialect(dialect), o);
       },
       pyb::arg("machine"), pyb::arg("dialect"), pyb::arg("poses_deg") = pyb::none(),
       pyb::arg("sphere") = Eigen::Vector3d(150.0, 0.0, 80.0).eval(), pyb::arg("sphere_diameter") = 25.0,
       pyb::arg("stylus_diameter") = 6.0, pyb::arg("log_file") = ProbeProgramOptions().log_file,
-      pyb::arg("tool") = 1, pyb::arg("decimals") = 4,
+      pyb::arg("tool") = 1, pyb::arg("decimals") = 4, pyb::arg("approach_mm") = ProbeProgramOptions().approach_mm,
+      pyb::arg("probe_feed") = ProbeProgramOptions().probe_feed_mm_per_min,
+      pyb::arg("positioning_feed") = ProbeProgramOptions().feed_mm_per_min,
       "The probing program of the default pattern's directions at `poses_deg` (default: its poses) "
-      "(probe/nc_program.hpp); linuxcnc only.");
+      "(probe/nc_program.hpp); linuxcnc only. approach_mm: the G38.2 starts this far outside the trigger "
+      "sphere; probe_feed: its feed, positioning_feed: the G1 moves' to and from its start, mm/min.");
   m.def("read_linuxcnc_probe_log", &read_linuxcnc_probe_log, pyb::arg("path"), pyb::arg("plan"),
         "The session of a LinuxCNC probing log: its latched X Y Z in the plan's rows (probe/nc_program.hpp).");
   m.def(

@@ -4178,9 +4178,9 @@ def write_output(path: str, data: bytes, inputs: collections.abc.Sequence[str] =
     """
 def write_probe(session: ProbeSession, path: str) -> None:
     ...
-def write_probe_nc_program(machine: MachineType, dialect: str, poses_deg: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] | None = None, sphere: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] = ..., sphere_diameter: typing.SupportsFloat | typing.SupportsIndex = 25.0, stylus_diameter: typing.SupportsFloat | typing.SupportsIndex = 6.0, log_file: str = 'rotacal_probe.log', tool: typing.SupportsInt | typing.SupportsIndex = 1, decimals: typing.SupportsInt | typing.SupportsIndex = 4) -> str:
+def write_probe_nc_program(machine: MachineType, dialect: str, poses_deg: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] | None = None, sphere: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] = ..., sphere_diameter: typing.SupportsFloat | typing.SupportsIndex = 25.0, stylus_diameter: typing.SupportsFloat | typing.SupportsIndex = 6.0, log_file: str = 'rotacal_probe.log', tool: typing.SupportsInt | typing.SupportsIndex = 1, decimals: typing.SupportsInt | typing.SupportsIndex = 4, approach_mm: typing.SupportsFloat | typing.SupportsIndex = 5.0, probe_feed: typing.SupportsFloat | typing.SupportsIndex = 50.0, positioning_feed: typing.SupportsFloat | typing.SupportsIndex = 1000.0) -> str:
     """
-    The probing program of the default pattern's directions at `poses_deg` (default: its poses) (probe/nc_program.hpp); linuxcnc only.
+    The probing program of the default pattern's directions at `poses_deg` (default: its poses) (probe/nc_program.hpp); linuxcnc only. approach_mm: the G38.2 starts this far outside the trigger sphere; probe_feed: its feed, positioning_feed: the G1 moves' to and from its start, mm/min.
     """
 def write_rtest(session: RtestSession, path: str) -> None:
     ...

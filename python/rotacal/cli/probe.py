@@ -20,6 +20,9 @@ DEFAULT_SPHERE_DIAMETER = 25.0
 DEFAULT_STYLUS_DIAMETER = 6.0
 DEFAULT_NOISE_UM = 0.5
 DEFAULT_LOG_FILE = "rotacal_probe.log"
+DEFAULT_APPROACH_MM = 5.0   # probe/nc_program.hpp ProbeProgramOptions
+DEFAULT_PROBE_FEED = 50.0   # mm/min, likewise
+DEFAULT_POSITIONING_FEED = 1000.0  # mm/min, likewise
 
 # What a touch-probe identification cannot do yet, refused before the fit.
 NO_MODEL_FILE = ("--save-model/--store: the model file (rotacal-model/1, docs/model_file.md) holds kinds "
@@ -184,7 +187,8 @@ def cmd_plan_probe(a: argparse.Namespace) -> int:
     poses = _poses(a.poses)
     sphere = np.asarray(a.sphere if a.sphere is not None else DEFAULT_SPHERE, float)
     text = _core.write_probe_nc_program(mtype, a.dialect, poses, sphere, a.sphere_diameter, a.stylus_diameter,
-                                        a.log_file)
+                                        a.log_file, approach_mm=a.approach, probe_feed=a.probe_feed,
+                                        positioning_feed=a.positioning_feed)
     write_output(a.output, text, [], [a.session] if a.session else [])
     template = _plan_template(a, mtype, poses)
     say(f"wrote {a.output}: {a.dialect} probing program, {len(template)} touches at {len(template.pose_names)} poses, "
@@ -202,6 +206,15 @@ def add_plan_probe_args(q: argparse.ArgumentParser) -> None:
                    help="tilt,rotary pairs, deg (default: the pattern of the controller cycles, rotacal simulate probe's)")
     g.add_argument("--log-file", default=DEFAULT_LOG_FILE,
                    help="the file on the controller that (LOGOPEN,...) writes the latched positions to")
+    g.add_argument("--approach", type=number("--approach", 0.01, 100.0, "mm"), default=DEFAULT_APPROACH_MM,
+                   help="each G38.2 starts this far outside the trigger sphere, mm (more than the sphere's "
+                        "set-up error and the machine's location errors move it)")
+    g.add_argument("--probe-feed", type=number("--probe-feed", 0.1, 10000.0, "mm/min"), default=DEFAULT_PROBE_FEED,
+                   help="feed of the G38.2 moves, mm/min: the latch is quantised by the servo period, so the "
+                        "pretravel is up to feed x period (docs/probe.md)")
+    g.add_argument("--positioning-feed", type=number("--positioning-feed", 1.0, 100000.0, "mm/min"),
+                   default=DEFAULT_POSITIONING_FEED,
+                   help="feed of the G1 moves down to each G38.2's start and back, mm/min")
 
 
 def refuse_probe_options(a: argparse.Namespace) -> None:
@@ -209,7 +222,10 @@ def refuse_probe_options(a: argparse.Namespace) -> None:
     given = [o for o, v in (("--sphere", a.sphere), ("--poses", a.poses)) if v is not None]
     given += [o for o, v, d in (("--sphere-diameter", a.sphere_diameter, DEFAULT_SPHERE_DIAMETER),
                                 ("--stylus-diameter", a.stylus_diameter, DEFAULT_STYLUS_DIAMETER),
-                                ("--log-file", a.log_file, DEFAULT_LOG_FILE)) if v != d]
+                                ("--log-file", a.log_file, DEFAULT_LOG_FILE),
+                                ("--approach", a.approach, DEFAULT_APPROACH_MM),
+                                ("--probe-feed", a.probe_feed, DEFAULT_PROBE_FEED),
+                                ("--positioning-feed", a.positioning_feed, DEFAULT_POSITIONING_FEED)) if v != d]
     if given:
         raise OptionError(f"plan ballbar: {', '.join(given)} belong to plan probe")
 
