@@ -14,6 +14,9 @@ R-test (Oyama and Ibaraki's B/C table and pattern): the designed nests and grid 
 default pattern at the same run time, the design time, and the Monte Carlo check of the
 designed pattern under AR(1) noise (rho 0.4).
 
+Touch probe: the designed poses against `plan probe`'s default poses at the same 120 touches on
+the built-in machines (target <= 0.7 on the table machines), and the design time.
+
     PYTHONPATH=... python bench/design_bench.py            # the default grid, 100 draws
     PYTHONPATH=... python bench/design_bench.py --smoke    # a 2 x 2 grid, 10 draws
 """
@@ -69,6 +72,7 @@ def main() -> None:
     print(f"Monte Carlo sigma / predicted over {draws} draws: {ratio.min():.2f}-{ratio.max():.2f} (target 0.7-1.4)")
     separation(draws)
     rtest_design(draws)
+    probe_design()
 
 
 SEPARATE = ["axial_motion_C_h2", "tilt_motion_C_h2"]
@@ -172,6 +176,19 @@ def rtest_design(draws: int) -> None:
             print(f"R-test separate {pair[0]} / {pair[1]}: {took}; correlation {sep.correlation_before:.2f} -> "
                   f"{sep.chosen.correlation:.2f} with {sep.chosen.duration_s * sep.chosen.repeats:.0f} s")
         print(f"  {sep.verdict[:200]}")
+
+
+def probe_design() -> None:
+    from rotacal.design import design_probe
+    from rotacal.machines import load_machine
+    for name in ("AC-trt", "BC-trt", "B45C-trt", "B-head-C-table", "AC-head"):
+        t0 = time.perf_counter()
+        d = design_probe(load_machine(name))
+        took = time.perf_counter() - t0
+        b = d.baseline
+        default = f"{b.worst_expanded_um:.3f} um ({b.worst_error})" if b.feasible else b.why_not
+        print(f"probe design {name}: {d.poses_tried} poses in {took:.2f} s; {d.touches} touches, designed "
+              f"{d.best.worst_expanded_um:.3f} um ({d.best.worst_error}) / default {default}: ratio {d.ratio:.3f}")
 
 
 def rtest_session(p, k: int):

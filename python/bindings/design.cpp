@@ -1,12 +1,30 @@
-// Bindings for include/rotacal/ballbar/design.hpp: the ballbar test design.
+// Bindings for the test designs: ballbar/design.hpp, rtest/design.hpp, probe/design.hpp.
 #include "rotacal/ballbar/design.hpp"
 
 #include "numpy.hpp"
+#include "rotacal/probe/design.hpp"
 #include "rotacal/rtest/design.hpp"
 
 namespace rotacal::py {
 
 namespace {
+
+// The members every separation design shares (design/separation.hpp SeparationResult).
+template <typename D>
+void separation_members(pyb::class_<D>& c) {
+  c.def_readonly("effects", &D::effects)
+      .def_readonly("motion", &D::motion)
+      .def_readonly("names", &D::names)
+      .def_readonly("sigma_before", &D::sigma_before)
+      .def_readonly("sigma_after", &D::sigma_after)
+      .def_readonly("correlation_before", &D::correlation_before)
+      .def_readonly("already_separated", &D::already_separated)
+      .def_readonly("found", &D::found)
+      .def_readonly("candidates_tried", &D::candidates_tried)
+      .def_readonly("noise_um", &D::noise_um)
+      .def_readonly("effective_per_reading", &D::effective_per_reading)
+      .def_readonly("verdict", &D::verdict);
+}
 
 // The ballbar set-up design.
 void bind_ballbar_design(pyb::module_& m) {
@@ -111,21 +129,10 @@ void bind_ballbar_separation(pyb::module_& m) {
       .def_readonly("slow_down", &SeparatingCandidate::slow_down)
       .def_readonly("correlation", &SeparatingCandidate::correlation)
       .def_readonly("determined", &SeparatingCandidate::determined);
-  pyb::class_<SeparationDesign>(m, "SeparationDesign",
-                                "The added test that separates two effects, or why none can.")
-      .def_readonly("effects", &SeparationDesign::effects)
-      .def_readonly("motion", &SeparationDesign::motion)
-      .def_readonly("names", &SeparationDesign::names)
-      .def_readonly("sigma_before", &SeparationDesign::sigma_before)
-      .def_readonly("sigma_after", &SeparationDesign::sigma_after)
-      .def_readonly("correlation_before", &SeparationDesign::correlation_before)
-      .def_readonly("already_separated", &SeparationDesign::already_separated)
-      .def_readonly("found", &SeparationDesign::found)
-      .def_readonly("chosen", &SeparationDesign::chosen)
-      .def_readonly("candidates_tried", &SeparationDesign::candidates_tried)
-      .def_readonly("noise_um", &SeparationDesign::noise_um)
-      .def_readonly("effective_per_reading", &SeparationDesign::effective_per_reading)
-      .def_readonly("verdict", &SeparationDesign::verdict);
+  auto ballbar_separation = pyb::class_<SeparationDesign>(m, "SeparationDesign",
+                                 "The added test that separates two effects, or why none can.");
+  separation_members(ballbar_separation);
+  ballbar_separation.def_readonly("chosen", &SeparationDesign::chosen);
   m.def(
       "design_ballbar_separation",
       [](const BallbarSession& session, const std::vector<std::string>& pair,
@@ -233,21 +240,10 @@ void bind_rtest_separation(pyb::module_& m) {
       .def_readonly("repeats", &RtestSeparatingCandidate::repeats)
       .def_readonly("correlation", &RtestSeparatingCandidate::correlation)
       .def_readonly("determined", &RtestSeparatingCandidate::determined);
-  pyb::class_<RtestSeparationDesign>(m, "RtestSeparationDesign",
-                                     "The added nest that separates two effects, or why none can.")
-      .def_readonly("effects", &RtestSeparationDesign::effects)
-      .def_readonly("motion", &RtestSeparationDesign::motion)
-      .def_readonly("names", &RtestSeparationDesign::names)
-      .def_readonly("sigma_before", &RtestSeparationDesign::sigma_before)
-      .def_readonly("sigma_after", &RtestSeparationDesign::sigma_after)
-      .def_readonly("correlation_before", &RtestSeparationDesign::correlation_before)
-      .def_readonly("already_separated", &RtestSeparationDesign::already_separated)
-      .def_readonly("found", &RtestSeparationDesign::found)
-      .def_readonly("chosen", &RtestSeparationDesign::chosen)
-      .def_readonly("candidates_tried", &RtestSeparationDesign::candidates_tried)
-      .def_readonly("noise_um", &RtestSeparationDesign::noise_um)
-      .def_readonly("effective_per_reading", &RtestSeparationDesign::effective_per_reading)
-      .def_readonly("verdict", &RtestSeparationDesign::verdict);
+  auto rtestballbar_separation = pyb::class_<RtestSeparationDesign>(m, "RtestSeparationDesign",
+                                 "The added nest that separates two effects, or why none can.");
+  separation_members(rtestballbar_separation);
+  rtestballbar_separation.def_readonly("chosen", &RtestSeparationDesign::chosen);
   m.def(
       "design_rtest_separation",
       [](const RtestSession& session, const std::vector<std::string>& pair,
@@ -261,6 +257,89 @@ void bind_rtest_separation(pyb::module_& m) {
       "(rtest/design.hpp).");
 }
 
+// Poses (P, 2: tilt, rotary deg) of a probe pattern.
+Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor> poses_of(const ProbePattern& p) {
+  Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor> a(static_cast<Eigen::Index>(p.poses_deg.size()), 2);
+  for (std::size_t i = 0; i < p.poses_deg.size(); ++i)
+    a.row(static_cast<Eigen::Index>(i)) << p.poses_deg[i].tilt, p.poses_deg[i].rot;
+  return a;
+}
+
+// The touch-probe design: poses and touches, and the added poses that separate two effects.
+void bind_probe_design(pyb::module_& m) {
+  pyb::class_<ProbeDesignOptions>(m, "ProbeDesignOptions", "Options of design_probe_test (defaults).")
+      .def(pyb::init<>())
+      .def_readwrite("machine", &ProbeDesignOptions::machine)
+      .def_readwrite("sphere", &ProbeDesignOptions::sphere, "nominal centre, table frame, mm")
+      .def_readwrite("sphere_diameter", &ProbeDesignOptions::sphere_diameter)
+      .def_readwrite("stylus_diameter", &ProbeDesignOptions::stylus_diameter)
+      .def_readwrite("touches", &ProbeDesignOptions::touches, "0: the default poses'")
+      .def_property(
+          "directions", [](const ProbeDesignOptions& o) { return rows_from(o.directions); },
+          [](ProbeDesignOptions& o, const Array& a) { o.directions = vectors_of(a, "directions"); },
+          "approach directions (K, 3), machine frame; empty: the default pattern's")
+      .def_readwrite("tilt_step_deg", &ProbeDesignOptions::tilt_step_deg)
+      .def_readwrite("rot_step_deg", &ProbeDesignOptions::rot_step_deg)
+      .def_readwrite("noise_um", &ProbeDesignOptions::noise_um)
+      .def_readwrite("reference_radius_mm", &ProbeDesignOptions::reference_radius_mm);
+  pyb::class_<ProbeDesignCandidate>(m, "ProbeDesignCandidate", "Poses and touches, evaluated.")
+      .def_property_readonly("poses_deg", [](const ProbeDesignCandidate& c) { return poses_of(c.pattern); },
+                             "pose visits (P, 2): tilt, rotary, deg, in program order")
+      .def_property_readonly("directions", [](const ProbeDesignCandidate& c) { return rows_from(c.pattern.directions); })
+      .def_readonly("feasible", &ProbeDesignCandidate::feasible)
+      .def_readonly("why_not", &ProbeDesignCandidate::why_not)
+      .def_readonly("touches", &ProbeDesignCandidate::touches)
+      .def_readonly("names", &ProbeDesignCandidate::names)
+      .def_readonly("sigma", &ProbeDesignCandidate::sigma, "predicted 1 sigma (mm, rad); inf: held")
+      .def_readonly("worst_expanded_um", &ProbeDesignCandidate::worst_expanded_um)
+      .def_readonly("worst_error", &ProbeDesignCandidate::worst_error)
+      .def_readonly("undetermined", &ProbeDesignCandidate::undetermined);
+  pyb::class_<ProbeDesign>(m, "ProbeDesign", "The designed poses and the default ones at the same touches.")
+      .def_readonly("best", &ProbeDesign::best)
+      .def_readonly("baseline", &ProbeDesign::baseline)
+      .def_readonly("touches", &ProbeDesign::touches)
+      .def_readonly("ratio", &ProbeDesign::ratio)
+      .def_readonly("poses_tried", &ProbeDesign::poses_tried)
+      .def_readonly("refused", &ProbeDesign::refused);
+  m.def(
+      "design_probe_test",
+      [](const ProbeDesignOptions& o) {
+        pyb::gil_scoped_release release;
+        return design_probe_test(o);
+      },
+      pyb::arg("options"), "The poses and touches with the smallest predicted uncertainty (probe/design.hpp).");
+  pyb::class_<ProbeSeparationOptions>(m, "ProbeSeparationOptions", "Options of design_probe_separation (defaults).")
+      .def(pyb::init<>())
+      .def_readwrite("tilt_step_deg", &ProbeSeparationOptions::tilt_step_deg)
+      .def_readwrite("rot_step_deg", &ProbeSeparationOptions::rot_step_deg)
+      .def_readwrite("pose_time_s", &ProbeSeparationOptions::pose_time_s, "0: the session's")
+      .def_readwrite("max_added_time_s", &ProbeSeparationOptions::max_added_time_s)
+      .def_readwrite("max_correlation", &ProbeSeparationOptions::max_correlation)
+      .def_readwrite("noise_um", &ProbeSeparationOptions::noise_um, "0: the session's residual noise")
+      .def_readwrite("reference_radius_mm", &ProbeSeparationOptions::reference_radius_mm);
+  pyb::class_<ProbeSeparatingCandidate>(m, "ProbeSeparatingCandidate", "Added poses, evaluated with the session.")
+      .def_property_readonly("poses_deg", [](const ProbeSeparatingCandidate& c) { return poses_of(c.added); })
+      .def_property_readonly("directions", [](const ProbeSeparatingCandidate& c) { return rows_from(c.added.directions); })
+      .def_readonly("description", &ProbeSeparatingCandidate::description)
+      .def_readonly("duration_s", &ProbeSeparatingCandidate::duration_s)
+      .def_readonly("repeats", &ProbeSeparatingCandidate::repeats)
+      .def_readonly("correlation", &ProbeSeparatingCandidate::correlation)
+      .def_readonly("determined", &ProbeSeparatingCandidate::determined);
+  auto probeballbar_separation = pyb::class_<ProbeSeparationDesign>(m, "ProbeSeparationDesign",
+                                 "The added poses that separate two effects, or why none can.");
+  separation_members(probeballbar_separation);
+  probeballbar_separation.def_readonly("chosen", &ProbeSeparationDesign::chosen);
+  m.def(
+      "design_probe_separation",
+      [](const ProbeSession& session, const std::vector<std::string>& pair, const ProbeSeparationOptions& o) {
+        const EffectModel fx = effects_of(pair);
+        pyb::gil_scoped_release release;
+        return design_probe_separation(session, fx.effects, o);
+      },
+      pyb::arg("session"), pyb::arg("pair"), pyb::arg("options") = ProbeSeparationOptions{},
+      "The smallest added set of poses that separates two effects after a touch-probe session (probe/design.hpp).");
+}
+
 }  // namespace
 
 void bind_design(pyb::module_& m) {
@@ -269,5 +348,8 @@ void bind_design(pyb::module_& m) {
   bind_rtest_design(m);
   bind_rtest_separation(m);
 }
+
+// After bind_probe: its signatures name ProbeSession.
+void bind_probe_design_module(pyb::module_& m) { bind_probe_design(m); }
 
 }  // namespace rotacal::py

@@ -22,6 +22,7 @@ void bind_controller_export(pyb::module_& m);
 void bind_design(pyb::module_& m);
 void bind_circular(pyb::module_& m);
 void bind_probe(pyb::module_& m);
+void bind_probe_design_module(pyb::module_& m);
 void bind_multi(pyb::module_& m);
 #ifdef ROTACAL_WITH_HW
 void bind_hw(pyb::module_& m);
@@ -52,6 +53,7 @@ PYBIND11_MODULE(_core, m) {
   rotacal::py::bind_design(m);
   rotacal::py::bind_circular(m);
   rotacal::py::bind_probe(m);
+  rotacal::py::bind_probe_design_module(m);
   rotacal::py::bind_multi(m);
 #ifdef ROTACAL_WITH_HW
   auto serial = pyb::register_exception<rotacal::hw::SerialError>(m, "SerialError", io_error.ptr());

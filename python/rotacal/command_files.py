@@ -97,6 +97,7 @@ COMMANDS: dict[tuple[str, ...], Files] = {
     ("predict",): Files((arg("SESSION", "session"), arg("--model")), (OUTPUT,)),
     ("design", "ballbar"): Files((MACHINE, arg("--after")), (OUTPUT,)),
     ("design", "rtest"): Files((arg("--after"),)),
+    ("design", "probe"): Files((MACHINE, arg("--after")), (OUTPUT, arg("--session"))),
     ("export",): Files((arg("--model"), arg("--current"), arg("--centres")),
                        (OUTPUT, arg("--residual-model"), arg("--centres-output"), Slot("--comp-file", _comp_files))),
     # Without --model nothing is written (-o has a default): --verify alone prints.

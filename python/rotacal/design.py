@@ -1,7 +1,8 @@
-"""Test design before the machine runs it (``rotacal design ballbar``): the pivot and bar length
-whose single set-up test gives the smallest largest expanded uncertainty of the location
-errors at a run time, within the machine's travel, from the Fisher information of the joint
-model (C++: ``rotacal/ballbar/design.hpp``; docs/design.md)."""
+"""Test design before the machine runs it (``rotacal design ballbar|rtest|probe``): the pivot and
+bar length whose single set-up test gives the smallest largest expanded uncertainty of the
+location errors at a run time, within the machine's travel, from the Fisher information of the
+joint model (C++: ``rotacal/ballbar/design.hpp``; docs/design.md); the R-test's nests and grid,
+the touch probe's poses."""
 from __future__ import annotations
 
 import json
@@ -47,7 +48,8 @@ def parameter_units(names: Sequence[str]) -> list[tuple[str, float]]:
         if i < 8:
             out.append(("urad", 1e6) if i in (2, 3, 6, 7) else ("um", 1e3))
             continue
-        if n.startswith(("pivot_", "zero_")):  # pivot_x (pivot_x#2 of a second set-up), R-test probe zeros
+        if n.startswith(("pivot_", "zero_", "sphere.", "tool_offset_")):  # pivot_x (pivot_x#2 of a second set-up),
+            # R-test probe zeros, the touch probe's sphere and a head's tool length
             out.append(("um", 1e3))
             continue
         eid, _, pname = n.partition(".")
@@ -90,8 +92,7 @@ def design_separation(session: Any, pair: Sequence[str], *, base: Any | None = N
     joint fit with a canonical correlation below ``max_correlation``, the predicted 1-sigma of
     every parameter before and after, or the reason no test can (their table motions are the
     same). ``base``: a ``BallbarSetup`` whose step, feeds and C range the added test uses."""
-    if len(pair) != 2:
-        raise _core.InvalidArgument(f"--separate: {','.join(pair)}: give two effects, EFFECT,EFFECT")
+    _check_pair(pair)
     o = _core.SeparationOptions()
     if base is not None:
         o.added = base
@@ -105,10 +106,20 @@ def design_separation(session: Any, pair: Sequence[str], *, base: Any | None = N
         o.travel_min, o.travel_max = _travel(travel)
     if tilt_limits is not None:
         o.tilt_limits_deg = [float(v) for v in tilt_limits]
+    _search_limits(o, max_time_s, max_correlation, noise_um)
+    return _core.design_ballbar_separation(session, list(pair), o)
+
+
+def _check_pair(pair: Sequence[str]) -> None:
+    if len(pair) != 2:
+        raise _core.InvalidArgument(f"--separate: {','.join(pair)}: give two effects, EFFECT,EFFECT")
+
+
+def _search_limits(o: Any, max_time_s: float, max_correlation: float, noise_um: float) -> None:
+    """The limits every separation search takes (design/separation.hpp)."""
     o.max_added_time_s = float(max_time_s)
     o.max_correlation = float(max_correlation)
     o.noise_um = float(noise_um)
-    return _core.design_ballbar_separation(session, list(pair), o)
 
 
 def machine_travel(machine: Any) -> list[float] | None:
@@ -199,8 +210,7 @@ def design_rtest_separation(session: Any, pair: Sequence[str], *, radii: Sequenc
     """A ``_core.RtestSeparationDesign``: the smallest R-test nest (position and grid) to add to
     ``session`` (an ``RtestSession``) so that the two effects of ``pair`` come out of the joint
     fit with a canonical correlation below ``max_correlation``, or why no test can."""
-    if len(pair) != 2:
-        raise _core.InvalidArgument(f"--separate: {','.join(pair)}: give two effects, EFFECT,EFFECT")
+    _check_pair(pair)
     o = _core.RtestSeparationOptions()
     for value, field in ((radii, "nest_radius_mm"), (angles, "nest_angle_deg"), (heights, "nest_height_mm"),
                          (b_steps, "b_step_deg"), (c_steps, "c_step_deg")):
@@ -211,9 +221,7 @@ def design_rtest_separation(session: Any, pair: Sequence[str], *, radii: Sequenc
     if travel is not None:
         o.travel_min, o.travel_max = _travel(travel)
     o.dwell_s = float(dwell_s)
-    o.max_added_time_s = float(max_time_s)
-    o.max_correlation = float(max_correlation)
-    o.noise_um = float(noise_um)
+    _search_limits(o, max_time_s, max_correlation, noise_um)
     return _core.design_rtest_separation(session, list(pair), o)
 
 
@@ -241,4 +249,76 @@ def rtest_separation_dict(d: Any) -> dict:
                              "b_deg": list(p.b_deg), "c_deg": list(p.c_deg), "dwell_s": p.dwell_s,
                              "repeats": c.repeats, "run_time_s": c.duration_s * c.repeats,
                              "correlation_after": c.correlation}
+    return out
+
+
+# ------------------------------------------------------------------------- touch probe
+
+def design_probe(machine: Any, *, sphere: Sequence[float] = (150.0, 0.0, 80.0), sphere_diameter: float = 25.0,
+                 stylus_diameter: float = 6.0, touches: int = 0, tilt_step: float = 15.0, rot_step: float = 30.0,
+                 noise_um: float = 0.5) -> Any:
+    """A ``_core.ProbeDesign``: the rotary poses (visits, in program order; ``.best.poses_deg``)
+    whose touches along the default directions give the smallest largest expanded uncertainty
+    (k = 2) of the location errors at ``touches`` touches (0: the default poses'), within the
+    machine's axis limits, against ``plan probe``'s default poses at the same number of touches
+    (``.baseline``, ``.ratio``). C++: ``rotacal/probe/design.hpp``."""
+    o = _core.ProbeDesignOptions()
+    o.machine = machine
+    o.sphere = np.asarray(sphere, dtype=float)
+    o.sphere_diameter = float(sphere_diameter)
+    o.stylus_diameter = float(stylus_diameter)
+    o.touches = int(touches)
+    o.tilt_step_deg = float(tilt_step)
+    o.rot_step_deg = float(rot_step)
+    o.noise_um = float(noise_um)
+    return _core.design_probe_test(o)
+
+
+def poses_text(poses_deg: Any) -> str:
+    """Pose visits (P, 2) as ``plan probe --poses`` takes them: "T,R;T,R;..." (deg)."""
+    return ";".join(f"{t:g},{r:g}" for t, r in np.asarray(poses_deg, dtype=float))
+
+
+def probe_candidate_dict(c: Any) -> dict:
+    """One evaluated set of probe poses as JSON."""
+    out = {"poses_deg": np.asarray(c.poses_deg).tolist(), "directions": np.asarray(c.directions).tolist(),
+           "feasible": c.feasible, "touches": c.touches, "undetermined": list(c.undetermined)}
+    if not c.feasible:
+        return out | {"why_not": c.why_not}
+    return out | {"predicted_std": {n: (float(s) if np.isfinite(s) else None) for n, s in zip(c.names, c.sigma)},
+                  "worst_expanded_um": c.worst_expanded_um, "worst_error": c.worst_error,
+                  "poses_option": poses_text(c.poses_deg)}
+
+
+def probe_design_dict(d: Any) -> dict:
+    """The JSON of ``rotacal design probe --json``."""
+    return {"touches": d.touches, "ratio_to_default": d.ratio, "poses_tried": d.poses_tried,
+            "best": probe_candidate_dict(d.best), "default": probe_candidate_dict(d.baseline),
+            "refused_poses": list(d.refused)}
+
+
+def design_probe_separation(session: Any, pair: Sequence[str], *, tilt_step: float = 15.0, rot_step: float = 30.0,
+                            pose_time_s: float = 0.0, max_time_s: float = 600.0, max_correlation: float = 0.5,
+                            noise_um: float = 0.0) -> Any:
+    """A ``_core.ProbeSeparationDesign``: the smallest set of poses (a sweep of one axis, or one
+    pose, repeated) to add to ``session`` (a ``ProbeSession``) so that the two effects of
+    ``pair`` come out of the joint fit with a canonical correlation below ``max_correlation``,
+    or why no test can."""
+    _check_pair(pair)
+    o = _core.ProbeSeparationOptions()
+    o.tilt_step_deg = float(tilt_step)
+    o.rot_step_deg = float(rot_step)
+    o.pose_time_s = float(pose_time_s)
+    _search_limits(o, max_time_s, max_correlation, noise_um)
+    return _core.design_probe_separation(session, list(pair), o)
+
+
+def probe_separation_dict(d: Any) -> dict:
+    """The JSON of ``rotacal design probe --separate ... --after SESSION``."""
+    out = _separation_common(d)
+    if d.candidates_tried:
+        c = d.chosen
+        out["added_poses"] = {"description": c.description, "poses_deg": np.asarray(c.poses_deg).tolist(),
+                              "poses_option": poses_text(c.poses_deg), "repeats": c.repeats,
+                              "run_time_s": c.duration_s * c.repeats, "correlation_after": c.correlation}
     return out

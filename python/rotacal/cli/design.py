@@ -8,7 +8,7 @@ from typing import Any, Sequence
 
 from .. import jsontext
 from ..outputs import write_output
-from ..sessions import BALLBAR, RTEST, kind
+from ..sessions import BALLBAR, PROBE, RTEST, kind
 from .options import EPILOG, EXIT_OK, OptionError, number, number_list, numbers, path, say
 from .setups import add_setup_args, ballbar_setup, load_session
 
@@ -28,7 +28,8 @@ def _session_after(a: argparse.Namespace, wanted: str) -> Any:
         raise OptionError("--separate: give the session it follows with --after SESSION")
     session = load_session(a.after)
     if kind(session) != wanted:
-        words = {BALLBAR: ("a ballbar session", "ballbar"), RTEST: ("an R-test session", "rtest")}
+        words = {BALLBAR: ("a ballbar session", "ballbar"), RTEST: ("an R-test session", "rtest"),
+                 PROBE: ("a touch-probe session", "probe")}
         raise OptionError(f"--after {a.after}: {words[kind(session)][0]}; design {words[wanted][1]} --separate "
                           f"needs {words[wanted][0]}")
     return session
@@ -170,6 +171,20 @@ def cmd_design_rtest(a: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def add_separation_group(k: argparse.ArgumentParser, added: str, session: str) -> Any:
+    """--separate, --after, --max-time, --max-correlation of `design KIND` (docs/design.md)."""
+    g = k.add_argument_group(f"the {added} that separates two effects after a session (docs/design.md)")
+    g.add_argument("--separate", metavar="EFFECT,EFFECT",
+                   help=f"two catalogue ids the diagnosis could not tell apart: propose the smallest added {added} "
+                        "that brings their correlation below --max-correlation, or say why none can")
+    g.add_argument("--after", type=path("--after"), metavar="SESSION", help=f"the {session} they follow")
+    g.add_argument("--max-time", type=number("--max-time", 0.0, 86400.0, "s", lo_open=True), default=600.0,
+                   help=f"longest added {added}, s (default 600)")
+    g.add_argument("--max-correlation", type=number("--max-correlation", 0.0, 1.0, "", lo_open=True), default=0.5,
+                   help="target largest canonical correlation of the pair (default 0.5)")
+    return g
+
+
 def add_design(sub: argparse._SubParsersAction) -> argparse._SubParsersAction:
     q = sub.add_parser("design", help="design a test before the machine runs it", epilog=EPILOG + "; docs/design.md")
     dk = q.add_subparsers(dest="kind", required=True)
@@ -194,15 +209,7 @@ def add_design(sub: argparse._SubParsersAction) -> argparse._SubParsersAction:
     k.add_argument("--rho", type=number("--rho", 0.0, 0.999, ""), default=0.0,
                    help="AR(1) coefficient of the noise between samples (default 0: white)")
     k.add_argument("--effects", help="effects of concern, fitted along: catalogue ids, comma separated")
-    g = k.add_argument_group("the test that separates two effects after a session (docs/design.md)")
-    g.add_argument("--separate", metavar="EFFECT,EFFECT",
-                   help="two catalogue ids the diagnosis could not tell apart: propose the smallest added test "
-                        "that brings their correlation below --max-correlation, or say why none can")
-    g.add_argument("--after", type=path("--after"), metavar="SESSION", help="the ballbar session they follow")
-    g.add_argument("--max-time", type=number("--max-time", 0.0, 86400.0, "s", lo_open=True), default=600.0,
-                   help="longest added test, s (default 600)")
-    g.add_argument("--max-correlation", type=number("--max-correlation", 0.0, 1.0, "", lo_open=True), default=0.5,
-                   help="target largest canonical correlation of the pair (default 0.5)")
+    g = add_separation_group(k, "test", "ballbar session")
     g.add_argument("--pivot-r", type=number_list("--pivot-r", 0.0, 2000.0, "mm", 30),
                    help="moved pivot: distances from the C axis, mm (default 0,60,120,180)")
     g.add_argument("--pivot-angle", type=number_list("--pivot-angle", -360.0, 360.0, "deg", 12),
@@ -236,15 +243,7 @@ def add_design(sub: argparse._SubParsersAction) -> argparse._SubParsersAction:
                    help="1-sigma noise per reading component, um (default 0.3; with --after: the session's)")
     k.add_argument("--rho", type=number("--rho", 0.0, 0.999, ""), default=0.0,
                    help="AR(1) coefficient of the noise between readings (default 0: white)")
-    g = k.add_argument_group("the nest that separates two effects after a session (docs/design.md)")
-    g.add_argument("--separate", metavar="EFFECT,EFFECT",
-                   help="two catalogue ids the diagnosis could not tell apart: propose the smallest added nest "
-                        "that brings their correlation below --max-correlation, or say why none can")
-    g.add_argument("--after", type=path("--after"), metavar="SESSION", help="the R-test session they follow")
-    g.add_argument("--max-time", type=number("--max-time", 0.0, 86400.0, "s", lo_open=True), default=600.0,
-                   help="longest added nest, s (default 600)")
-    g.add_argument("--max-correlation", type=number("--max-correlation", 0.0, 1.0, "", lo_open=True), default=0.5,
-                   help="target largest canonical correlation of the pair (default 0.5)")
+    g = add_separation_group(k, "nest", "R-test session")
     g.add_argument("--nest-angles", type=number_list("--nest-angles", -360.0, 360.0, "deg", 12),
                    help="added nest: angles about C from +X, deg (default 0,90,180,270)")
     k.add_argument("--json", action="store_true")

@@ -20,12 +20,12 @@ from typing import Sequence
 
 from .. import _core
 from ..command_files import check_command_files
-from . import (circular, controller, demo, design, diagnose, history, identify, instruments, machines, plan, probe,
-               simulate)
+from . import (circular, controller, demo, design, design_probe, diagnose, history, identify, instruments, machines,
+               plan, probe, simulate)
 from .options import EPILOG, EXIT_ERROR, EXIT_INPUT, EXIT_IO, EXIT_OK, OptionError, say
 
 MODULES = (plan, machines, simulate, identify, history, diagnose, design, controller, instruments, demo, circular,
-           probe)
+           probe, design_probe)
 
 # The order `rotacal --help` lists the commands in.
 ORDER = ("plan", "machines", "simulate", "identify", "history", "diagnose", "predict", "design", "export",

@@ -1,0 +1,33 @@
+#pragma once
+// The touch probe's candidates for the design engine, shared by the design of a test and the
+// separation search (probe/design.hpp): the pose grid within the axis limits that the probing
+// program accepts, and the probe problem's Jacobian at the fit's start on nominal touches.
+
+#include <Eigen/Core>
+#include <array>
+#include <string>
+#include <vector>
+
+#include "rotacal/probe/nc_program.hpp"
+#include "rotacal/probe/problem.hpp"
+
+namespace rotacal::probe_design {
+
+/// The tilt axis' limits within -90..90 deg (-90..90 without limits), as default_probe_pattern.
+std::array<double, 2> tilt_range(MachineType m);
+
+/// Poses of the grid (tilt over tilt_range every tilt_step, the rotary axis over a full turn or
+/// its limits every rot_step) that probe_moves accepts one by one with P's sphere and
+/// directions; the others' reasons in `refused` (when given).
+std::vector<RotaryAngles<double>> plannable_poses(MachineType m, const ProbePattern& P, double tilt_step,
+                                                  double rot_step, const ProbeProgramOptions& program,
+                                                  std::vector<std::string>* refused);
+
+/// The commanded touches of P on the nominal machine (no errors, no noise), times from t0.
+ProbeSession nominal_touches(MachineType m, const ProbePattern& P, double t0 = 0.0);
+
+/// d residual / d parameter of the probe problem of `session` with effects fx (rows: touches,
+/// columns: ProbeParameterLayout), at the fit's start point.
+Eigen::MatrixXd start_jacobian(const ProbeSession& session, const EffectModel& fx);
+
+}  // namespace rotacal::probe_design
