@@ -6,7 +6,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Alternative', 'Ambiguity', 'AngleTable', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CircularAnalysis', 'CircularDiagnosis', 'CircularDiagnosisOptions', 'CircularDirection', 'CircularEffect', 'CircularFinding', 'CircularPairResult', 'CircularPlanResult', 'CircularPlane', 'CircularRun', 'CircularRunResult', 'CircularSimulationOptions', 'CircularTestPlan', 'CompensationReport', 'CompensationRow', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LinearAxisErrors', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'MultiDisagreement', 'MultiIdentification', 'MultiSessionResult', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'ProbeIdentification', 'ProbeMonteCarlo', 'ProbeSession', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestDesign', 'RtestDesignCandidate', 'RtestDesignOptions', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSeparatingCandidate', 'RtestSeparationDesign', 'RtestSeparationOptions', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SeparatingCandidate', 'SeparationDesign', 'SeparationOptions', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'SweepDirection', 'TableMotionOverlap', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualCircularBallbar', 'VirtualRtest', 'analyze_circular', 'ballbar_model_document', 'ballbar_model_from_document', 'builtin_machine_names', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_json_bounds', 'check_model_machine', 'check_output', 'check_plausible', 'check_rtest_pattern', 'circular_catalogue', 'circular_commanded_session', 'circular_label', 'comment_lines', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_axial_c_tilt_deg', 'default_ballbar_tests', 'default_calibration_moves', 'default_probe_poses_deg', 'default_rtest_pattern', 'default_tilt_range_deg', 'design_ballbar_separation', 'design_ballbar_test', 'design_rtest_separation', 'design_rtest_test', 'diagnose_ballbar', 'diagnose_circular', 'diagnose_probe', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'evaluate_rtest_design', 'export_controller', 'format_ballbar', 'format_model_document', 'format_probe', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_joint_sessions', 'identify_multi', 'identify_paper', 'identify_probe', 'identify_probe_cycles', 'identify_rtest_joint', 'identify_rtest_paper', 'is_rotary_test', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_probe', 'monte_carlo_rtest', 'multi_model_document', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_circular_direction', 'parse_circular_plane', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'parse_sweep_direction', 'plan_ballbar_test', 'plan_circular_test', 'predict_rtest_session', 'predict_session_lengths', 'probe_effect_catalogue', 'probe_model_document', 'read_ballbar', 'read_instrument_session', 'read_linuxcnc_probe_log', 'read_model_document', 'read_probe', 'read_rtest', 'read_session', 'record_ballbar', 'record_circular_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_joint_model_document', 'rtest_map_names', 'rtest_prediction_rms_um', 'rtest_readings', 'run_label', 'simulate_ballbar', 'simulate_circular', 'simulate_probe', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'table_motion_overlap', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_probe', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_circular_nc_program', 'write_model_document', 'write_nc_program', 'write_output', 'write_probe', 'write_probe_nc_program', 'write_rtest']
+__all__: list[str] = ['Alternative', 'Ambiguity', 'AngleTable', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CircularAnalysis', 'CircularDiagnosis', 'CircularDiagnosisOptions', 'CircularDirection', 'CircularEffect', 'CircularFinding', 'CircularPairResult', 'CircularPlanResult', 'CircularPlane', 'CircularRun', 'CircularRunResult', 'CircularSimulationOptions', 'CircularTestPlan', 'CompensationReport', 'CompensationRow', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LinearAxisErrors', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'MultiDisagreement', 'MultiIdentification', 'MultiSessionResult', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'ProbeDesign', 'ProbeDesignCandidate', 'ProbeDesignOptions', 'ProbeIdentification', 'ProbeMonteCarlo', 'ProbeSeparatingCandidate', 'ProbeSeparationDesign', 'ProbeSeparationOptions', 'ProbeSession', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestDesign', 'RtestDesignCandidate', 'RtestDesignOptions', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSeparatingCandidate', 'RtestSeparationDesign', 'RtestSeparationOptions', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SeparatingCandidate', 'SeparationDesign', 'SeparationOptions', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'SweepDirection', 'TableMotionOverlap', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualCircularBallbar', 'VirtualRtest', 'analyze_circular', 'ballbar_model_document', 'ballbar_model_from_document', 'builtin_machine_names', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_json_bounds', 'check_model_machine', 'check_output', 'check_plausible', 'check_rtest_pattern', 'circular_catalogue', 'circular_commanded_session', 'circular_label', 'comment_lines', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_axial_c_tilt_deg', 'default_ballbar_tests', 'default_calibration_moves', 'default_probe_poses_deg', 'default_rtest_pattern', 'default_tilt_range_deg', 'design_ballbar_separation', 'design_ballbar_test', 'design_probe_separation', 'design_probe_test', 'design_rtest_separation', 'design_rtest_test', 'diagnose_ballbar', 'diagnose_circular', 'diagnose_probe', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'evaluate_rtest_design', 'export_controller', 'format_ballbar', 'format_model_document', 'format_probe', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_joint_sessions', 'identify_multi', 'identify_paper', 'identify_probe', 'identify_probe_cycles', 'identify_rtest_joint', 'identify_rtest_paper', 'is_rotary_test', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_probe', 'monte_carlo_rtest', 'multi_model_document', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_circular_direction', 'parse_circular_plane', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'parse_sweep_direction', 'plan_ballbar_test', 'plan_circular_test', 'predict_rtest_session', 'predict_session_lengths', 'probe_effect_catalogue', 'probe_model_document', 'read_ballbar', 'read_instrument_session', 'read_linuxcnc_probe_log', 'read_model_document', 'read_probe', 'read_rtest', 'read_session', 'record_ballbar', 'record_circular_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_joint_model_document', 'rtest_map_names', 'rtest_prediction_rms_um', 'rtest_readings', 'run_label', 'simulate_ballbar', 'simulate_circular', 'simulate_probe', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'table_motion_overlap', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_probe', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_circular_nc_program', 'write_model_document', 'write_nc_program', 'write_output', 'write_probe', 'write_probe_nc_program', 'write_rtest']
 class Alternative:
     @property
     def aliased(self) -> bool:
@@ -2216,6 +2216,133 @@ class ProbeCalibration:
         """
         probe zero offsets, mm
         """
+class ProbeDesign:
+    """
+    The designed poses and the default ones at the same touches.
+    """
+    @property
+    def baseline(self) -> ProbeDesignCandidate:
+        ...
+    @property
+    def best(self) -> ProbeDesignCandidate:
+        ...
+    @property
+    def poses_tried(self) -> int:
+        ...
+    @property
+    def ratio(self) -> float:
+        ...
+    @property
+    def refused(self) -> list[str]:
+        ...
+    @property
+    def touches(self) -> int:
+        ...
+class ProbeDesignCandidate:
+    """
+    Poses and touches, evaluated.
+    """
+    @property
+    def directions(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
+        ...
+    @property
+    def feasible(self) -> bool:
+        ...
+    @property
+    def names(self) -> list[str]:
+        ...
+    @property
+    def poses_deg(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 2]"]:
+        """
+        pose visits (P, 2): tilt, rotary, deg, in program order
+        """
+    @property
+    def sigma(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        predicted 1 sigma (mm, rad); inf: held
+        """
+    @property
+    def touches(self) -> int:
+        ...
+    @property
+    def undetermined(self) -> list[str]:
+        ...
+    @property
+    def why_not(self) -> str:
+        ...
+    @property
+    def worst_error(self) -> str:
+        ...
+    @property
+    def worst_expanded_um(self) -> float:
+        ...
+class ProbeDesignOptions:
+    """
+    Options of design_probe_test (defaults).
+    """
+    machine: MachineType
+    def __init__(self) -> None:
+        ...
+    @property
+    def directions(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
+        """
+        approach directions (K, 3), machine frame; empty: the default pattern's
+        """
+    @directions.setter
+    def directions(self, arg1: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> None:
+        ...
+    @property
+    def noise_um(self) -> float:
+        ...
+    @noise_um.setter
+    def noise_um(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def reference_radius_mm(self) -> float:
+        ...
+    @reference_radius_mm.setter
+    def reference_radius_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def rot_step_deg(self) -> float:
+        ...
+    @rot_step_deg.setter
+    def rot_step_deg(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def sphere(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        """
+        nominal centre, table frame, mm
+        """
+    @sphere.setter
+    def sphere(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+        ...
+    @property
+    def sphere_diameter(self) -> float:
+        ...
+    @sphere_diameter.setter
+    def sphere_diameter(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def stylus_diameter(self) -> float:
+        ...
+    @stylus_diameter.setter
+    def stylus_diameter(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def tilt_step_deg(self) -> float:
+        ...
+    @tilt_step_deg.setter
+    def tilt_step_deg(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def touches(self) -> int:
+        """
+        0: the default poses'
+        """
+    @touches.setter
+    def touches(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
 class ProbeIdentification:
     @property
     def converged(self) -> bool:
@@ -2301,6 +2428,126 @@ class ProbeMonteCarlo:
         ...
     @property
     def values(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        ...
+class ProbeSeparatingCandidate:
+    """
+    Added poses, evaluated with the session.
+    """
+    @property
+    def correlation(self) -> float:
+        ...
+    @property
+    def description(self) -> str:
+        ...
+    @property
+    def determined(self) -> bool:
+        ...
+    @property
+    def directions(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
+        ...
+    @property
+    def duration_s(self) -> float:
+        ...
+    @property
+    def poses_deg(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 2]"]:
+        ...
+    @property
+    def repeats(self) -> float:
+        ...
+class ProbeSeparationDesign:
+    """
+    The added poses that separate two effects, or why none can.
+    """
+    @property
+    def already_separated(self) -> bool:
+        ...
+    @property
+    def candidates_tried(self) -> int:
+        ...
+    @property
+    def chosen(self) -> ProbeSeparatingCandidate:
+        ...
+    @property
+    def correlation_before(self) -> float:
+        ...
+    @property
+    def effective_per_reading(self) -> float:
+        ...
+    @property
+    def effects(self) -> typing.Annotated[list[str], "FixedSize(2)"]:
+        ...
+    @property
+    def found(self) -> bool:
+        ...
+    @property
+    def motion(self) -> TableMotionOverlap:
+        ...
+    @property
+    def names(self) -> list[str]:
+        ...
+    @property
+    def noise_um(self) -> float:
+        ...
+    @property
+    def sigma_after(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def sigma_before(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def verdict(self) -> str:
+        ...
+class ProbeSeparationOptions:
+    """
+    Options of design_probe_separation (defaults).
+    """
+    def __init__(self) -> None:
+        ...
+    @property
+    def max_added_time_s(self) -> float:
+        ...
+    @max_added_time_s.setter
+    def max_added_time_s(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def max_correlation(self) -> float:
+        ...
+    @max_correlation.setter
+    def max_correlation(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def noise_um(self) -> float:
+        """
+        0: the session's residual noise
+        """
+    @noise_um.setter
+    def noise_um(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def pose_time_s(self) -> float:
+        """
+        0: the session's
+        """
+    @pose_time_s.setter
+    def pose_time_s(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def reference_radius_mm(self) -> float:
+        ...
+    @reference_radius_mm.setter
+    def reference_radius_mm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def rot_step_deg(self) -> float:
+        ...
+    @rot_step_deg.setter
+    def rot_step_deg(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def tilt_step_deg(self) -> float:
+        ...
+    @tilt_step_deg.setter
+    def tilt_step_deg(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
         ...
 class ProbeSession:
     """
@@ -3561,6 +3808,14 @@ def design_ballbar_separation(session: BallbarSession, pair: collections.abc.Seq
 def design_ballbar_test(options: BallbarDesignOptions) -> BallbarDesign:
     """
     The pivot and bar length with the smallest predicted uncertainty (ballbar/design.hpp).
+    """
+def design_probe_separation(session: ProbeSession, pair: collections.abc.Sequence[str], options: ProbeSeparationOptions = ...) -> ProbeSeparationDesign:
+    """
+    The smallest added set of poses that separates two effects after a touch-probe session (probe/design.hpp).
+    """
+def design_probe_test(options: ProbeDesignOptions) -> ProbeDesign:
+    """
+    The poses and touches with the smallest predicted uncertainty (probe/design.hpp).
     """
 def design_rtest_separation(session: RtestSession, pair: collections.abc.Sequence[str], options: RtestSeparationOptions = ...) -> RtestSeparationDesign:
     """
