@@ -4,7 +4,8 @@ the readings, refsim.writers the file rotacal reads, refsim.noise the noise; rot
 diagnoses (rotacal.diagnose with its default DiagnosisOptions), in this process.
 
 Cells: machine (AC-trt, BC-trt, B-head-C-table by default) x instrument (ballbar single set-up,
-R-test 2-nest grid; refsim.poses) x every entry of refsim's catalogue that applies x noise
+R-test 2-nest grid; refsim.poses; with --instruments ...,probe also the touch probe, 24 poses x 5
+touches of plan probe's default layout: confusion/probe.py) x every entry of refsim's catalogue that applies x noise
 (white, AR(1) rho 0.5 and 0.9, 1/f-like "pink", one stream per ballbar test / per R-test set-up
 and channel) x amplitude (1x, 3x, 10x the entry's half-detection amplitude); N draws per cell,
 M null sessions (no effect) per noise kind, spread over the machines and instruments. Motion-only
@@ -12,11 +13,13 @@ entries (backlash_*, servo_lag_*, reversal_spike_*) are skipped: refsim models s
 
 Truth of every session of a machine x instrument: location errors drawn once (uniform +-30 um,
 +-80 urad, seeded by the machine's name), the ballbar pivot off by (12, -8, 15) um, R-test probe
-zeros uniform +-5 um per nest and channel; noise 1-sigma (marginal) 0.5 um ballbar, 0.3 um R-test,
-declared in the file (noise_um). thermal_warmup's tau is fixed at a third of the session.
+zeros uniform +-5 um per nest and channel, the probe's sphere off by (21, -17, 12) um; noise
+1-sigma (marginal) 0.5 um ballbar, 0.3 um R-test, 0.5 um probe (along each touch's approach, one
+stream per session), declared in the file (noise_um). thermal_warmup's tau is fixed at a third of the session.
 
 Half-detection amplitude of an entry (machine, instrument): J0 is the baseline Jacobian (the 8
-location errors, and the ballbar pivot or the R-test probe zeros of each nest and channel), Je the
+location errors, and the ballbar pivot, the R-test probe zeros of each nest and channel or the
+probe's sphere position and, on a head, tool_offset_Z), Je the
 entry's (its parameters; thermal_warmup: d only), both by central differences of refsim at the
 truth. P = (I - Q0 Q0^T) with Q0 an orthonormal basis of J0; the least-absorbable direction u is
 the first right singular vector of P Je (unit norm in the entry's native units), s its singular
@@ -61,7 +64,7 @@ from confusion.outcome import CellCache, run_session  # noqa: E402
 from confusion.setup import motion_only_entries, tempdir  # noqa: E402
 from confusion.stats import NOISE_KINDS  # noqa: E402
 
-SMOKE = {"machines": ["BC-trt"], "instruments": ["ballbar", "rtest"],
+SMOKE = {"machines": ["BC-trt"], "instruments": ["ballbar", "rtest", "probe"],
          "entries": ["gravity_sag", "tilt_motion_C_h1", "thermal_warmup_Z"],
          "noise": ["white", "ar1_0.9"], "amplitudes": [3.0], "draws": 2, "null": 4}
 CACHE: CellCache | None = None
@@ -74,7 +77,7 @@ def parse_args(argv) -> argparse.Namespace:
     p.add_argument("--null", type=int, default=100, help="null sessions per noise kind (default 100)")
     p.add_argument("--noise", default="white,ar1_0.5,ar1_0.9,pink", help=f"of {','.join(NOISE_KINDS)}")
     p.add_argument("--machines", default="AC-trt,BC-trt,B-head-C-table")
-    p.add_argument("--instruments", default="ballbar,rtest")
+    p.add_argument("--instruments", default="ballbar,rtest", help="of ballbar,rtest,probe (default ballbar,rtest)")
     p.add_argument("--amplitudes", default="1,3,10", help="multiples of the half-detection amplitude")
     p.add_argument("--entries", default="", help="comma-separated substrings of catalogue ids (default: all)")
     p.add_argument("--seed", type=int, default=29)
@@ -92,8 +95,8 @@ def parse_args(argv) -> argparse.Namespace:
         if nz not in NOISE_KINDS:
             p.error(f"--noise: unknown kind {nz!r} (known: {', '.join(NOISE_KINDS)})")
     for inst in cfg["instruments"]:
-        if inst not in ("ballbar", "rtest"):
-            p.error(f"--instruments: {inst!r} is neither ballbar nor rtest")
+        if inst not in ("ballbar", "rtest", "probe"):
+            p.error(f"--instruments: {inst!r} is none of ballbar, rtest, probe")
     cfg["seed"] = a.seed
     a.cfg = cfg
     return a

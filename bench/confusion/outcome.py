@@ -10,6 +10,7 @@ import numpy as np
 from refsim import effects as rfx
 
 from . import stats
+from .probe import ProbeSetup
 from .setup import Setup, half_detection, stable_int
 
 MIN_WEIGHT = 0.9  # DiagnosisOptions.min_weight
@@ -62,7 +63,7 @@ class CellCache:
     def setup(self, machine: str, instrument: str) -> Setup:
         key = (machine, instrument)
         if key not in self.setups:
-            self.setups[key] = Setup(machine, instrument, self.workdir)
+            self.setups[key] = (ProbeSetup if instrument == "probe" else Setup)(machine, instrument, self.workdir)
         return self.setups[key]
 
     def entry(self, st: Setup, eid: str) -> dict:

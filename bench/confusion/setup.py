@@ -18,7 +18,7 @@ from refsim import poses, writers
 
 from . import stats
 
-SIGMA_MM = {"ballbar": 5e-4, "rtest": 3e-4}     # white-equivalent marginal 1-sigma of the readings
+SIGMA_MM = {"ballbar": 5e-4, "rtest": 3e-4, "probe": 5e-4}  # white-equivalent marginal 1-sigma of the readings
 PIVOT_SHIFT = np.array([0.012, -0.008, 0.015])  # ballbar pivot set-up error, mm
 MOTION_PREFIXES = ("backlash_", "servo_lag_", "reversal_spike_")
 # A step for the central differences and the largest plausible size (1 mm, 1 mrad, 1 um/s,
@@ -27,7 +27,8 @@ _UNIT = {"ballbar_length_offset": "mm", "ballbar_thermal_drift": "mm/s", "tool_o
          "rotary_zero_offset": "rad", "angular_positioning": "rad", "axial_motion": "mm",
          "radial_motion": "mm", "tilt_motion": "rad", "gravity_sag": "mm", "coning": "ratio",
          "linear_squareness": "rad", "linear_scale": "ratio", "thermal_drift": "mm/s",
-         "thermal_warmup": "mm", "straightness": "mm", "angular_error": "rad"}
+         "thermal_warmup": "mm", "straightness": "mm", "angular_error": "rad",
+         "stylus_radius_offset": "mm", "probe_lobing": "mm"}
 _STEP = {"mm": 1e-3, "rad": 1e-5, "mm/s": 1e-5, "ratio": 1e-5}
 PLAUSIBLE = {"mm": 1.0, "rad": 1e-3, "mm/s": 1e-3, "ratio": 1e-3}
 
@@ -55,33 +56,40 @@ class Setup:
         rng = np.random.default_rng(stable_int("baseline", machine))
         self.errors = np.array([rng.uniform(-0.03, 0.03) if i % 4 < 2 else rng.uniform(-8e-5, 8e-5)
                                 for i in range(8)])
-        path = Path(workdir) / f"{machine}_{instrument}.csv"
-        if instrument == "ballbar":
+        self.path, self._template = Path(workdir) / f"{machine}_{instrument}.csv", None
+        self._make_poses(rng)
+        self.angles = np.radians(self.s["angles_deg"])
+        self.base = self.reading({})
+        self.j0 = self._baseline_jacobian()
+        self.catalogue = self._catalogue()
+        self.n_candidates = len(self.catalogue)
+        self.q0 = stats.orth(self.j0)
+
+    def _make_poses(self, rng: np.random.Generator) -> None:
+        """Poses, labels, noise streams and n of the instrument; the template file of them."""
+        if self.instrument == "ballbar":
             pivot = (120.0, 0.0, 60.0) if self.machine.table_axes else (0.0, 0.0, 0.0)
             self.s = _round_poses(poses.ballbar_single_setup(self.machine, pivot=pivot))
             self.labels = list(self.s["test"])
             self.pivot_actual = self.s["pivot"] + PIVOT_SHIFT
-            writers.write_ballbar(path, self.machine, self.s, np.full(len(self.labels), self.s["ballbar_length"]),
+            writers.write_ballbar(self.path, self.machine, self.s, np.full(len(self.labels), self.s["ballbar_length"]),
                                   noise_um=self.sigma * 1e3)
             self.streams = [np.flatnonzero(np.array(self.labels) == g) for g in dict.fromkeys(self.labels)]
-        else:
-            nests = ((100.0, 0.0, 60.0), (0.0, -120.0, 140.0)) if self.machine.table_axes else \
-                ((100.0, 0.0, 0.0), (0.0, -80.0, 40.0))
-            self.s = _round_poses(poses.rtest_grid(self.machine, nests=nests))
-            self.labels = list(self.s["setup"])
-            self.zeros = {k: rng.uniform(-0.005, 0.005, 3) for k in self.s["nests"]}
-            writers.write_rtest(path, self.machine, self.s, np.zeros((len(self.labels), 3)), noise_um=self.sigma * 1e3)
-            n = len(self.labels)
-            per = [np.flatnonzero(np.array(self.labels) == g) for g in dict.fromkeys(self.labels)]
-            self.streams = [c * n + idx for c in range(3) for idx in per]
-        self.path, self._template = path, None
-        self.angles = np.radians(self.s["angles_deg"])
-        self.n = len(self.labels) * (1 if instrument == "ballbar" else 3)
-        self.base = self.reading({})
-        self.j0 = self._baseline_jacobian()
-        self.catalogue = rfx.catalogue(self.machine, 4, instrument)
-        self.n_candidates = len(self.catalogue)
-        self.q0 = stats.orth(self.j0)
+            self.n = len(self.labels)
+            return
+        nests = ((100.0, 0.0, 60.0), (0.0, -120.0, 140.0)) if self.machine.table_axes else \
+            ((100.0, 0.0, 0.0), (0.0, -80.0, 40.0))
+        self.s = _round_poses(poses.rtest_grid(self.machine, nests=nests))
+        self.labels = list(self.s["setup"])
+        self.zeros = {k: rng.uniform(-0.005, 0.005, 3) for k in self.s["nests"]}
+        writers.write_rtest(self.path, self.machine, self.s, np.zeros((len(self.labels), 3)), noise_um=self.sigma * 1e3)
+        n = len(self.labels)
+        per = [np.flatnonzero(np.array(self.labels) == g) for g in dict.fromkeys(self.labels)]
+        self.streams = [c * n + idx for c in range(3) for idx in per]
+        self.n = 3 * n
+
+    def _catalogue(self) -> list:
+        return rfx.catalogue(self.machine, 4, self.instrument)
 
     # ----------------------------------------------------------------- readings
     def reading(self, effects: dict, errors=None, pivot_shift=None) -> np.ndarray:
@@ -132,20 +140,25 @@ class Setup:
             e = np.zeros(8)
             e[k] = h
             cols.append((self.reading({}, self.errors + e) - self.reading({}, self.errors - e)) / (2 * h))
+        return np.column_stack(cols + self._nuisance_columns())
+
+    def _nuisance_columns(self) -> list:
+        """The ballbar pivot's columns, or the R-test probe zeros' (exact indicators)."""
+        cols = []
         if self.instrument == "ballbar":
             for k in range(3):
                 d = np.zeros(3)
                 d[k] = 1e-3
                 cols.append((self.reading({}, pivot_shift=d) - self.reading({}, pivot_shift=-d)) / 2e-3)
-        else:
-            n = len(self.labels)
-            for key in self.s["nests"]:
-                rows = np.array(self.labels) == key
-                for c in range(3):
-                    col = np.zeros(self.n)
-                    col[c * n:(c + 1) * n][rows] = 1.0
-                    cols.append(col)
-        return np.column_stack(cols)
+            return cols
+        n = len(self.labels)
+        for key in self.s["nests"]:
+            rows = np.array(self.labels) == key
+            for c in range(3):
+                col = np.zeros(self.n)
+                col[c * n:(c + 1) * n][rows] = 1.0
+                cols.append(col)
+        return cols
 
     def warmup_tau(self) -> float:
         """thermal_warmup's time constant in every session: a third of the session's duration."""

@@ -201,6 +201,44 @@ Diagnosis search_white(const DiagnosisProblem& P, const DiagnosisOptions& option
   return D;
 }
 
+// The numbers of the final model by GLS under the noise the final model leaves (`model`): the
+// white fit's covariance of AR(1) 0.9 readings is some 4x too small (2-sigma coverage of the
+// ballbar's findings 32 %, bench/diagnosis_confusion.py). The noise for it by REML over what the
+// fit leaves (Burg on the residuals misses the slow noise the fitted directions took: 84 % with
+// it, 89 % by REML), and the covariance scaled by the whitened chi-square per dof where that
+// exceeds 1. A finding none of whose parameters is then determined (min_determined_sigma, as in
+// the search) is no finding (issue 29 item 6): it and the findings after it (chosen given it)
+// are reported unobservable, and the rest refitted.
+void final_gls(const DiagnosisProblem& P, const DiagnosisOptions& options, const NoiseModel& model, Diagnosis& D) {
+  if (D.findings.empty()) return;
+  const NoiseTreatment gls_noise = coloured_treatment(
+      estimate_noise_model_reml(model, D.final_fit.residuals, free_columns(D.final_fit.jacobian)), false);
+  for (;;) {
+    EffectModel found;
+    found.linear_reference = P.mean_commanded_xyz();
+    for (const Finding& F : D.findings) found.effects.push_back(F.effect);
+    D.final_fit = P.fit_gls(found, gls_noise.W);
+    const double scale = std::sqrt(std::max(1.0, gls_noise.whiten(D.final_fit.residuals).squaredNorm() /
+                                   std::max(1.0, static_cast<double>(D.final_fit.residuals.size() - D.final_fit.num_free))));
+    std::size_t keep = D.findings.size();
+    for (std::size_t i = 0; i < D.findings.size() && keep == D.findings.size(); ++i)
+      if (determined_sigmas(D.final_fit, D.findings[i].effect, gls_noise) / scale < options.min_determined_sigma) keep = i;
+    if (keep == D.findings.size()) {
+      for (Finding& F : D.findings) {
+        F.parameters = parameters_of(D.final_fit, F.effect);
+        for (ParameterEstimate& q : F.parameters) q.std *= scale;
+      }
+      return;
+    }
+    for (std::size_t i = keep; i < D.findings.size(); ++i)
+      D.unobservable.push_back({D.findings[i].effect.id(),
+                                "the search named it, but by GLS under the noise the final model leaves none of its "
+                                "parameters reaches " + std::to_string(static_cast<int>(options.min_determined_sigma)) +
+                                " sigma"});
+    D.findings.resize(keep);
+  }
+}
+
 }  // namespace
 
 Diagnosis diagnose(const DiagnosisProblem& P, const DiagnosisOptions& options) {
@@ -234,25 +272,7 @@ Diagnosis diagnose(const DiagnosisProblem& P, const DiagnosisOptions& options) {
       D.baseline.noise_source = final_noise.source;
       D.baseline.chi2_per_dof = chi2 / D.baseline.dof;
       D.baseline.p_value = stats::chi2_sf(chi2, D.baseline.dof);
-      // The numbers of the final model by GLS under that noise: the white fit's covariance of
-      // AR(1) 0.9 readings is some 4x too small (2-sigma coverage of the ballbar's findings 32 %,
-      // bench/diagnosis_confusion.py). The noise for it by REML over what the fit leaves (Burg on
-      // the residuals misses the slow noise the fitted directions took: 84 % with it, 89 % by
-      // REML), and the covariance scaled by the whitened chi-square per dof where that exceeds 1.
-      if (!D.findings.empty()) {
-        EffectModel found;
-        found.linear_reference = P.mean_commanded_xyz();
-        for (const Finding& F : D.findings) found.effects.push_back(F.effect);
-        const NoiseTreatment gls_noise = coloured_treatment(
-            estimate_noise_model_reml(model, D.final_fit.residuals, free_columns(D.final_fit.jacobian)), false);
-        D.final_fit = P.fit_gls(found, gls_noise.W);
-        const double chi2_per_dof = gls_noise.whiten(D.final_fit.residuals).squaredNorm() /
-                                    std::max(1.0, static_cast<double>(D.final_fit.residuals.size() - D.final_fit.num_free));
-        for (Finding& F : D.findings) {
-          F.parameters = parameters_of(D.final_fit, F.effect);
-          for (ParameterEstimate& q : F.parameters) q.std *= std::sqrt(std::max(1.0, chi2_per_dof));
-        }
-      }
+      final_gls(P, options, model, D);  // the final model's numbers by GLS under that noise
     }
   }
   D.noise = std::move(model);

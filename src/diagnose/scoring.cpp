@@ -19,11 +19,16 @@ double rms_um(const Eigen::VectorXd& r) {
   return r.size() ? std::sqrt(r.squaredNorm() / static_cast<double>(r.size())) * 1e3 : 0.0;
 }
 
+// The plausible size of each parameter (DiagnosisOptions::min_visible_chi2): the unit's
+// (1 mm, 1 mrad, ...), but 10 um for a touch probe's lobing: a kinematic probe's three-lobed
+// pretravel variation is a few um before its calibration (the budget's default after it is
+// 0.5 um, uncertainty_budget.hpp), and at 1 mm a lobing the touch layout turns into a sphere
+// shift (four horizontal touches 90 deg apart) stayed "visible" through its remainder.
 Eigen::VectorXd magnitudes(const Effect& c) {
   const auto units = c.param_units();
   Eigen::VectorXd m(static_cast<Eigen::Index>(units.size()));
   for (std::size_t k = 0; k < units.size(); ++k)
-    m[static_cast<Eigen::Index>(k)] = plausible_magnitude(units[k]);
+    m[static_cast<Eigen::Index>(k)] = c.kind == EffectKind::probe_lobing ? 10e-3 : plausible_magnitude(units[k]);
   return m;
 }
 

@@ -110,6 +110,10 @@ struct SearchContext {
   SearchCache& cache;
 };
 
+/// How many sigma from zero the best-determined combination of `effect`'s observable free
+/// parameters is in `refit` under noise treatment t (selection.cpp).
+double determined_sigmas(const ModelFit& refit, const Effect& effect, const NoiseTreatment& t);
+
 /// One round: every candidate not yet done scored against the current model.
 struct Round {
   ScoringInputs in;        ///< the current model under the search's noise treatment

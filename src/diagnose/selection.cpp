@@ -10,8 +10,6 @@
 
 namespace rotacal::diagnosis_detail {
 
-namespace {
-
 // How many sigma from zero the best-determined combination of `effect`'s observable free
 // parameters is in `refit`, under noise treatment t: sqrt(v^T C_ee^-1 v), C the refit's
 // covariance of its free parameters (the whitened Gram matrix's inverse), e the effect's.
@@ -39,6 +37,8 @@ double determined_sigmas(const ModelFit& refit, const Effect& effect, const Nois
   const double chi2 = v.dot(Cee.ldlt().solve(v));
   return std::isfinite(chi2) && chi2 > 0.0 ? std::sqrt(chi2) : 0.0;
 }
+
+namespace {
 
 // Why the first of `aliases` is not resolved (the sampling's words).
 std::string unresolved_reason(const std::vector<Effect>& candidates, const std::vector<std::string>& unresolved,

@@ -113,9 +113,9 @@ struct DiagnosisOptions {
   /// none is reported unobservable, not named.
   double min_determined_sigma = 3.0;
   std::vector<std::string> only;  ///< restrict candidates to these ids (empty: all)
-  /// A candidate is visible when moving its parameters by plausible sizes (1 mm, 1 mrad,
-  /// 1 um/s, 1e-3 for ratios) beyond what the model absorbs changes chi-square by at least
-  /// this much (25: a 5-sigma change); others are reported unobservable.
+  /// A candidate is visible when moving its parameters by plausible sizes (1 mm, 1 mrad, 1 um/s,
+  /// 1e-3 for ratios, 10 um for a probe's lobing) beyond what the model absorbs changes
+  /// chi-square by at least this much (25: a 5-sigma change); others are reported unobservable.
   double min_visible_chi2 = 25.0;
   /// A *_hn candidate is scored only if its axis' sampled angles resolve order n (see
   /// HarmonicResolution) with at least this new content: below it the order aliases onto the
