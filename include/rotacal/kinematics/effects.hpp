@@ -111,7 +111,7 @@ struct EffectModel {
   int num_params() const;
   /// Offset of effect i's first parameter in the flat vector. O(i): a loop over every effect
   /// keeps a running offset instead (the evaluators below), else a model of n effects costs
-  /// n^2 per sample (38 effects: 17 -> 0.5 ms to simulate one ballbar session).
+  /// n^2 per sample.
   int offset(std::size_t i) const;
   /// "id.name" for every parameter, in flat order.
   std::vector<std::string> param_labels() const;
