@@ -1,5 +1,6 @@
 // Bindings for include/rotacal/fit.
 #include "numpy.hpp"
+#include "rotacal/fit/box_least_squares.hpp"
 #include "rotacal/fit/circle.hpp"
 #include "rotacal/fit/plane.hpp"
 #include "rotacal/fit/sphere.hpp"
@@ -71,6 +72,25 @@ Raises rotacal.DegenerateGeometry for < 3, collinear points or a too short arc.)
       },
       pyb::arg("points"), pyb::arg("normal_hint") = pyb::array_t<double>(3, std::array<double, 3>{0, 0, 1}.data()),
       pyb::arg("sigma") = 0.0, "Total-least-squares plane (Flynn et al. Eq. 3).");
+  m.def(
+      "box_least_squares",
+      [](const Eigen::MatrixXd& R, const Eigen::VectorXd& d, const Eigen::VectorXd& w, const Eigen::VectorXd& bounds,
+         int max_sweeps, double tolerance) {
+        return box_least_squares(R, d, w, bounds, {max_sweeps, tolerance});
+      },
+      pyb::arg("R"), pyb::arg("d"), pyb::arg("w"), pyb::arg("bounds"), pyb::arg("max_sweeps") = 200,
+      pyb::arg("tolerance") = 1e-9,
+      R"doc(min sum w (d - R s)^2 with |s_j| <= bounds_j, by cyclic coordinate descent.
+
+Parameters
+----------
+R : (N, K) array
+d, w : (N,) arrays, w >= 0
+bounds : (K,) array, >= 0
+max_sweeps, tolerance : stop after max_sweeps passes, or when no s_j moves by more than
+    tolerance * bounds_j
+
+Returns s (K,). Raises rotacal.InvalidArgument for mismatched sizes or non-finite input.)doc");
 }
 
 }  // namespace rotacal::py

@@ -117,180 +117,197 @@ void apply_yield_convention(const std::vector<FitParameter>& params, const std::
 
 }  // namespace
 
-JointFitOutcome solve_joint(const ResidualModel& model, const std::vector<FitParameter>& params,
-                            const JointFitSettings& s) {
-  const int p = static_cast<int>(params.size());
-  if (model.num_parameters() != p)
-    throw InvalidArgument("solve_joint: the model has " + std::to_string(model.num_parameters()) +
-                          " parameters but " + std::to_string(p) + " were described");
-  const Eigen::Index n = model.num_residuals();
-  if (s.whitener && s.whitener->size() != n)
-    throw InvalidArgument("solve_joint: whitener was built for " + std::to_string(s.whitener->size()) +
-                          " residuals, the fit has " + std::to_string(n));
-  if (!(s.sigma > 0.0) || !std::isfinite(s.sigma))
-    throw InvalidArgument("solve_joint: sigma must be finite and > 0");
-  // 1 / sigma once, applied as a product to residual vectors and the subsample's Jacobian.
-  const double inv_sigma = 1.0 / s.sigma;
-  const auto weigh = [&](auto&& cols) {
-    if (s.whitener) s.whitener->apply(cols);
-    else cols *= inv_sigma;
-  };
+namespace {
+
+// What every stage of solve_joint reads: the model, its parameters, the settings and the
+// weighting they imply.
+struct JointProblem {
+  const ResidualModel& model;
+  const std::vector<FitParameter>& params;
+  const JointFitSettings& s;
+  int p = 0;
+  Eigen::Index n = 0;
+  double inv_sigma = 1.0;      // 1 / sigma once, applied as a product to residual vectors
   // The full Jacobian Jw is stored as J_weighted / jw_scale: whitened in place under a
   // whitener, left as J under white noise (1/sigma goes into its products instead, which saves
   // scaling the n x p array and scaling it back for the caller).
-  const double jw_scale = s.whitener ? 1.0 : inv_sigma;
-  const auto weigh_jacobian = [&](Eigen::MatrixXd& J) {
+  double jw_scale = 1.0;
+  std::vector<int> analysed;   // the parameters not held
+
+  JointProblem(const ResidualModel& m, const std::vector<FitParameter>& ps, const JointFitSettings& settings)
+      : model(m), params(ps), s(settings) {
+    p = static_cast<int>(params.size());
+    if (model.num_parameters() != p)
+      throw InvalidArgument("solve_joint: the model has " + std::to_string(model.num_parameters()) +
+                            " parameters but " + std::to_string(p) + " were described");
+    n = model.num_residuals();
+    if (s.whitener && s.whitener->size() != n)
+      throw InvalidArgument("solve_joint: whitener was built for " + std::to_string(s.whitener->size()) +
+                            " residuals, the fit has " + std::to_string(n));
+    if (!(s.sigma > 0.0) || !std::isfinite(s.sigma))
+      throw InvalidArgument("solve_joint: sigma must be finite and > 0");
+    inv_sigma = 1.0 / s.sigma;
+    jw_scale = s.whitener ? 1.0 : inv_sigma;
+    for (int j = 0; j < p; ++j)
+      if (!params[static_cast<std::size_t>(j)].held) analysed.push_back(j);
+  }
+  void weigh(Eigen::VectorXd& r) const {
+    if (s.whitener) s.whitener->apply(r);
+    else r *= inv_sigma;
+  }
+  void weigh_jacobian(Eigen::MatrixXd& J) const {
     if (s.whitener) s.whitener->apply(J);
-  };
-
-  JointFitOutcome out;
-  FitSummary& sum = out.summary;
-  sum.whitened = static_cast<bool>(s.whitener);
-  sum.num_residuals = static_cast<std::size_t>(n);
-  Eigen::VectorXd x(p);
-  for (int j = 0; j < p; ++j) x[j] = params[static_cast<std::size_t>(j)].start;
-
-  // A start on every k-th sample for long sessions without a whitener (the whitener acts on
-  // the whole residual vector): Gauss-Newton there is cheap and lands within ~sqrt(k) sigma of
-  // the solution, so that the full Jacobian below is evaluated where it is used.
-  std::vector<int> analysed;
-  for (int j = 0; j < p; ++j)
-    if (!params[static_cast<std::size_t>(j)].held) analysed.push_back(j);
-  const auto scales_of = [&] {
+  }
+  Eigen::VectorXd scales() const {
     Eigen::VectorXd sc(static_cast<Eigen::Index>(analysed.size()));
     for (std::size_t k = 0; k < analysed.size(); ++k) {
       const FitParameter& fp = params[static_cast<std::size_t>(analysed[k])];
       sc[static_cast<Eigen::Index>(k)] = fp.scale > 0.0 ? fp.scale : plausible_magnitude(fp.unit);
     }
     return sc;
-  };
-  const auto free_set = [&](const Eigen::MatrixXd& G, Observability* obs) {
+  }
+  // Observability of the analysed parameters from a Gram matrix; per parameter: free or not.
+  std::vector<bool> free_set(const Eigen::MatrixXd& G, Observability* obs) const {
     const Eigen::Index m = static_cast<Eigen::Index>(analysed.size());
     Eigen::MatrixXd Ga(m, m);
     for (Eigen::Index a = 0; a < m; ++a)
       for (Eigen::Index b = 0; b < m; ++b)
         Ga(a, b) = G(analysed[static_cast<std::size_t>(a)], analysed[static_cast<std::size_t>(b)]);
-    *obs = analyse_observability_normal(Ga, scales_of(), s.observability_min_chi2);
+    *obs = analyse_observability_normal(Ga, scales(), s.observability_min_chi2);
     std::vector<bool> free(static_cast<std::size_t>(p), false);
     for (int j : analysed) free[static_cast<std::size_t>(j)] = true;
     for (int k : obs->to_fix) free[static_cast<std::size_t>(analysed[static_cast<std::size_t>(k)])] = false;
     return free;
-  };
-  const Eigen::VectorXd x0 = x;
-  const Eigen::Index items = model.num_items();
-  const Eigen::Index stride = items / std::max<Eigen::Index>(32 * std::max(p, 8), 1);
-  std::vector<bool> free_subset;
-  if (!s.whitener && stride >= 2) {
-    Eigen::VectorXd rs, rs_t;
-    Eigen::MatrixXd Js;
-    if (model.evaluate_subset(x, stride, rs, &Js) && rs.allFinite() && Js.allFinite()) {
-      rs *= inv_sigma;
-      Js *= inv_sigma;
-      Observability obs;
-      const Eigen::MatrixXd Gs = gram(Js);
-      // Information of the whole session ~ stride times the subsample's.
-      free_subset = free_set(Gs * static_cast<double>(stride), &obs);
-      std::vector<Eigen::Index> idx;
-      for (int j = 0; j < p; ++j)
-        if (free_subset[static_cast<std::size_t>(j)]) idx.push_back(j);
-      NormalEquations ne = normal_equations(Js, 1.0, idx, &Gs);
-      // Only where the subsample pins every free parameter to 1 % of its plausible size: a
-      // weakly determined direction would wander there (the problem is not linear over that
-      // range), and where the full analysis and solve start would then matter.
-      bool well_determined = true;
-      const Eigen::VectorXd sc = scales_of();
-      for (std::size_t a = 0; a < idx.size(); ++a) {
-        const auto k = std::find(analysed.begin(), analysed.end(), static_cast<int>(idx[a])) - analysed.begin();
-        const double sigma_param = ne.sigma_y[static_cast<Eigen::Index>(a)] / ne.D[static_cast<Eigen::Index>(a)];
-        if (!(sigma_param < 0.01 * sc[k])) well_determined = false;
-      }
-      if (!well_determined) free_subset.clear();
-      double cost = rs.squaredNorm();
-      for (int it = 0; it < 20 && well_determined && !idx.empty(); ++it) {
-        Eigen::VectorXd g(static_cast<Eigen::Index>(idx.size()));
-        for (Eigen::Index a = 0; a < g.size(); ++a) g[a] = Js.col(idx[static_cast<std::size_t>(a)]).dot(rs) / ne.D[a];
-        const Eigen::VectorXd dx = ne.D.cwiseInverse().cwiseProduct(-ne.ldlt.solve(g));
-        Eigen::VectorXd xt = x;
-        for (Eigen::Index a = 0; a < dx.size(); ++a) xt[idx[static_cast<std::size_t>(a)]] += dx[a];
-        model.evaluate_subset(xt, stride, rs_t, nullptr);
-        ++sum.residual_evaluations;
-        rs_t *= inv_sigma;
-        const double cost_t = rs_t.squaredNorm();
-        if (!std::isfinite(cost_t) || cost_t > cost) break;
-        x = xt, rs.swap(rs_t), cost = cost_t;
-        if (max_sigma_step(ne, dx) < 1e-2) break;  // well inside the full fit's basin
-      }
-    }
   }
+};
 
-  // Full residuals and Jacobian, weighted, and their Gram matrix (observability and the
-  // normal equations both start from it).
-  Eigen::VectorXd r(n), rw(n);
-  Eigen::MatrixXd Jw(n, p), G;
-  const auto evaluate_full = [&] {
-    model.evaluate(x, r, &Jw);
+std::vector<Eigen::Index> free_indices(const std::vector<bool>& free) {
+  std::vector<Eigen::Index> idx;
+  for (std::size_t j = 0; j < free.size(); ++j)
+    if (free[j]) idx.push_back(static_cast<Eigen::Index>(j));
+  return idx;
+}
+
+// A start on every k-th sample for long sessions without a whitener (the whitener acts on
+// the whole residual vector): Gauss-Newton there is cheap and lands within ~sqrt(k) sigma of
+// the solution, so that the full Jacobian is evaluated where it is used. Moves x; returns the
+// free set the subsample judged (empty: no subsample start).
+std::vector<bool> subsample_start(const JointProblem& pr, Eigen::VectorXd& x, FitSummary& sum) {
+  const Eigen::Index items = pr.model.num_items();
+  const Eigen::Index stride = items / std::max<Eigen::Index>(32 * std::max(pr.p, 8), 1);
+  std::vector<bool> free_subset;
+  if (pr.s.whitener || stride < 2) return free_subset;
+  Eigen::VectorXd rs, rs_t;
+  Eigen::MatrixXd Js;
+  if (!(pr.model.evaluate_subset(x, stride, rs, &Js) && rs.allFinite() && Js.allFinite())) return free_subset;
+  rs *= pr.inv_sigma;
+  Js *= pr.inv_sigma;
+  Observability obs;
+  const Eigen::MatrixXd Gs = gram(Js);
+  // Information of the whole session ~ stride times the subsample's.
+  free_subset = pr.free_set(Gs * static_cast<double>(stride), &obs);
+  const std::vector<Eigen::Index> idx = free_indices(free_subset);
+  NormalEquations ne = normal_equations(Js, 1.0, idx, &Gs);
+  // Only where the subsample pins every free parameter to 1 % of its plausible size: a
+  // weakly determined direction would wander there (the problem is not linear over that
+  // range), and where the full analysis and solve start would then matter.
+  const Eigen::VectorXd sc = pr.scales();
+  for (std::size_t a = 0; a < idx.size(); ++a) {
+    const auto k = std::find(pr.analysed.begin(), pr.analysed.end(), static_cast<int>(idx[a])) - pr.analysed.begin();
+    const double sigma_param = ne.sigma_y[static_cast<Eigen::Index>(a)] / ne.D[static_cast<Eigen::Index>(a)];
+    if (!(sigma_param < 0.01 * sc[k])) return {};
+  }
+  double cost = rs.squaredNorm();
+  for (int it = 0; it < 20 && !idx.empty(); ++it) {
+    Eigen::VectorXd g(static_cast<Eigen::Index>(idx.size()));
+    for (Eigen::Index a = 0; a < g.size(); ++a) g[a] = Js.col(idx[static_cast<std::size_t>(a)]).dot(rs) / ne.D[a];
+    const Eigen::VectorXd dx = ne.D.cwiseInverse().cwiseProduct(-ne.ldlt.solve(g));
+    Eigen::VectorXd xt = x;
+    for (Eigen::Index a = 0; a < dx.size(); ++a) xt[idx[static_cast<std::size_t>(a)]] += dx[a];
+    pr.model.evaluate_subset(xt, stride, rs_t, nullptr);
+    ++sum.residual_evaluations;
+    rs_t *= pr.inv_sigma;
+    const double cost_t = rs_t.squaredNorm();
+    if (!std::isfinite(cost_t) || cost_t > cost) break;
+    x = xt, rs.swap(rs_t), cost = cost_t;
+    if (max_sigma_step(ne, dx) < 1e-2) break;  // well inside the full fit's basin
+  }
+  return free_subset;
+}
+
+// Residuals and Jacobian at x, weighted, and their Gram matrix (observability and the normal
+// equations both start from it).
+struct FullEvaluation {
+  Eigen::VectorXd r, rw;
+  Eigen::MatrixXd Jw, G;
+
+  explicit FullEvaluation(const JointProblem& pr) : r(pr.n), rw(pr.n), Jw(pr.n, pr.p) {}
+  void evaluate(const JointProblem& pr, const Eigen::VectorXd& x, FitSummary& sum) {
+    pr.model.evaluate(x, r, &Jw);
     ++sum.jacobian_evaluations;
-    for (Eigen::Index i = 0; i < n; ++i)
+    for (Eigen::Index i = 0; i < pr.n; ++i)
       if (!std::isfinite(r[i]))
         throw InvalidArgument("solve_joint: residual " + std::to_string(i) + " is not finite at the start point");
     rw = r;
-    weigh(rw);
-    weigh_jacobian(Jw);
-    G = gram(Jw) * (jw_scale * jw_scale);
-  };
-  evaluate_full();
+    pr.weigh(rw);
+    pr.weigh_jacobian(Jw);
+    G = gram(Jw) * (pr.jw_scale * pr.jw_scale);
+  }
+};
 
-  // Observability on the full Jacobian: fix one parameter per invisible combination. The
-  // models are nearly linear over um-sized errors, so it matters little where; but when the
-  // subsample judged otherwise, a direction is near the threshold and the analysis is redone
-  // at the start point, where every fit makes it.
-  out.free = free_set(G, &out.observability);
+// Observability on the full Jacobian: fix one parameter per invisible combination. The
+// models are nearly linear over um-sized errors, so it matters little where; but when the
+// subsample judged otherwise, a direction is near the threshold and the analysis is redone
+// at the start point x0, where every fit makes it. Fills out.free, out.observability and
+// out.unobservable; returns each parameter's observability.
+std::vector<bool> analyse_full(const JointProblem& pr, const std::vector<bool>& free_subset,
+                               const Eigen::VectorXd& x0, Eigen::VectorXd& x, FullEvaluation& ev,
+                               JointFitOutcome& out) {
+  out.free = pr.free_set(ev.G, &out.observability);
   if (!free_subset.empty() && free_subset != out.free) {
     x = x0;
-    evaluate_full();
-    out.free = free_set(G, &out.observability);
+    ev.evaluate(pr, x, out.summary);
+    out.free = pr.free_set(ev.G, &out.observability);
   }
-  {
-    std::vector<std::string> names, units;
-    for (int j : analysed)
-      names.push_back(params[static_cast<std::size_t>(j)].name), units.push_back(params[static_cast<std::size_t>(j)].unit);
-    for (std::size_t k = 0; k < out.observability.null_space.size(); ++k)
-      out.unobservable.push_back(out.observability.describe(static_cast<int>(k), names, units));
-  }
-  std::vector<bool> observable(static_cast<std::size_t>(p), false);
-  for (std::size_t k = 0; k < analysed.size(); ++k)
-    observable[static_cast<std::size_t>(analysed[k])] = out.observability.observable[k];
-  std::vector<Eigen::Index> idx;
-  for (int j = 0; j < p; ++j)
-    if (out.free[static_cast<std::size_t>(j)]) idx.push_back(j);
-  const Eigen::Index q = static_cast<Eigen::Index>(idx.size());
-  sum.num_free = static_cast<int>(q);
-  if (n < q)
-    throw InvalidArgument("solve_joint: " + std::to_string(n) + " residuals cannot determine " +
-                          std::to_string(q) + " unknowns");
+  std::vector<std::string> names, units;
+  for (int j : pr.analysed)
+    names.push_back(pr.params[static_cast<std::size_t>(j)].name), units.push_back(pr.params[static_cast<std::size_t>(j)].unit);
+  for (std::size_t k = 0; k < out.observability.null_space.size(); ++k)
+    out.unobservable.push_back(out.observability.describe(static_cast<int>(k), names, units));
+  std::vector<bool> observable(static_cast<std::size_t>(pr.p), false);
+  for (std::size_t k = 0; k < pr.analysed.size(); ++k)
+    observable[static_cast<std::size_t>(pr.analysed[k])] = out.observability.observable[k];
+  return observable;
+}
 
-  // Gauss-Newton: the Jacobian is reused (chord steps, residuals only) while the step keeps
-  // shrinking by 10x per iteration, and refreshed when a step does not reduce the cost or
-  // contracts slowly. At convergence a stale Jacobian moves the solution by about
-  // (J_ref - J)^T r: relative change of J (~ the contraction ratio rho of the chord steps)
-  // times sqrt(chi2) sigma at most; it is accepted below 0.01 sigma, else refreshed.
-  NormalEquations ne = normal_equations(Jw, jw_scale, idx, &G);
+// Gauss-Newton: the Jacobian is reused (chord steps, residuals only) while the step keeps
+// shrinking by 10x per iteration, and refreshed when a step does not reduce the cost or
+// contracts slowly. At convergence a stale Jacobian moves the solution by about
+// (J_ref - J)^T r: relative change of J (~ the contraction ratio rho of the chord steps)
+// times sqrt(chi2) sigma at most; it is accepted below 0.01 sigma, else refreshed. Moves x
+// and ev to the solution; returns the last normal equations (Jacobian within 0.01 sigma of
+// the solution) and sets `cost`.
+NormalEquations gauss_newton(const JointProblem& pr, const std::vector<Eigen::Index>& idx, Eigen::VectorXd& x,
+                             FullEvaluation& ev, FitSummary& sum, double& cost) {
+  const JointFitSettings& s = pr.s;
+  const Eigen::Index q = static_cast<Eigen::Index>(idx.size());
+  NormalEquations ne = normal_equations(ev.Jw, pr.jw_scale, idx, &ev.G);
   bool at_J = true;
-  double cost = rw.squaredNorm();
+  cost = ev.rw.squaredNorm();
   double lambda = 0.0, last_step = -1.0;
   // Largest contraction ratio of chord steps since the last refresh, from steps above 1e-3
   // sigma (below that the ratio measures round-off, not the Jacobian); 0: none measured yet.
   double rho = 0.0;
-  Eigen::VectorXd r_t(n), rw_t(n), x_t(p);
+  Eigen::VectorXd r_t(pr.n), rw_t(pr.n), x_t(pr.p);
   const auto refresh = [&] {
-    model.evaluate(x, r, &Jw);
+    pr.model.evaluate(x, ev.r, &ev.Jw);
     ++sum.jacobian_evaluations;
-    rw = r;
-    weigh(rw);
-    weigh_jacobian(Jw);
-    ne = normal_equations(Jw, jw_scale, idx);
+    ev.rw = ev.r;
+    pr.weigh(ev.rw);
+    pr.weigh_jacobian(ev.Jw);
+    ne = normal_equations(ev.Jw, pr.jw_scale, idx);
     at_J = true;
-    cost = rw.squaredNorm();
+    cost = ev.rw.squaredNorm();
     last_step = -1.0;
     rho = 0.0;
   };
@@ -298,7 +315,7 @@ JointFitOutcome solve_joint(const ResidualModel& model, const std::vector<FitPar
   while (sum.iterations < s.max_iterations) {
     Eigen::VectorXd g(q);
     for (Eigen::Index a = 0; a < q; ++a)
-      g[a] = Jw.col(idx[static_cast<std::size_t>(a)]).dot(rw) * jw_scale / ne.D[a];
+      g[a] = ev.Jw.col(idx[static_cast<std::size_t>(a)]).dot(ev.rw) * pr.jw_scale / ne.D[a];
     Eigen::VectorXd y;
     if (lambda > 0.0) {
       Eigen::MatrixXd Al = ne.A;
@@ -325,16 +342,16 @@ JointFitOutcome solve_joint(const ResidualModel& model, const std::vector<FitPar
     }
     x_t = x;
     for (Eigen::Index a = 0; a < q; ++a) x_t[idx[static_cast<std::size_t>(a)]] += dx[a];
-    model.evaluate(x_t, r_t, nullptr);
+    pr.model.evaluate(x_t, r_t, nullptr);
     ++sum.residual_evaluations;
     rw_t = r_t;
-    weigh(rw_t);
+    pr.weigh(rw_t);
     const double cost_t = rw_t.squaredNorm();
     // A step below 1e-3 sigma changes chi2 by < 1e-6: its sign is round-off, so it is taken.
     if (std::isfinite(cost_t) && (cost_t <= cost * (1.0 + 1e-12) || (step < 1e-3 && cost_t <= cost + 1e-6))) {
       x.swap(x_t);
-      r.swap(r_t);
-      rw.swap(rw_t);
+      ev.r.swap(r_t);
+      ev.rw.swap(rw_t);
       cost = cost_t;
       ++sum.iterations;
       lambda = 0.0;
@@ -356,16 +373,24 @@ JointFitOutcome solve_joint(const ResidualModel& model, const std::vector<FitPar
       break;
     }
   }
+  return ne;
+}
 
-  // Covariance and outputs at the solution (the Jacobian of the last normal equations).
+// Covariance and outputs at the solution x, from the last normal equations `ne`.
+void finish_outcome(const JointProblem& pr, const std::vector<Eigen::Index>& idx, const NormalEquations& ne,
+                    double cost, Eigen::VectorXd& x, FullEvaluation& ev, std::vector<bool>& observable,
+                    JointFitOutcome& out) {
+  const JointFitSettings& s = pr.s;
+  const Eigen::Index q = static_cast<Eigen::Index>(idx.size()), n = pr.n, p = pr.p;
+  FitSummary& sum = out.summary;
   const double dof = std::max(1.0, static_cast<double>(n - q));
   sum.chi2 = cost;
   sum.chi2_per_dof = cost / dof;
   out.values = x;
-  out.residuals = -r;
+  out.residuals = -ev.r;
   // (Jw^T Jw)^-1 of the free parameters from the last normal equations (Jacobian within 0.01
   // sigma of the solution), scaled by s^2 / sigma^2 without a whitener.
-  out.residual_variance = s.whitener ? 1.0 : r.squaredNorm() / dof;
+  out.residual_variance = s.whitener ? 1.0 : ev.r.squaredNorm() / dof;
   const double ratio = s.whitener ? 1.0 : out.residual_variance / (s.sigma * s.sigma);
   out.covariance = Eigen::MatrixXd::Zero(p, p);
   for (Eigen::Index a = 0; a < q; ++a)
@@ -376,21 +401,49 @@ JointFitOutcome solve_joint(const ResidualModel& model, const std::vector<FitPar
     // The unwhitened Jacobian for the caller (Jw was whitened in place).
     out.jacobian.resize(n, p);
     Eigen::VectorXd tmp(n);
-    model.evaluate(x, tmp, &out.jacobian);
+    pr.model.evaluate(x, tmp, &out.jacobian);
   } else {
-    out.jacobian = std::move(Jw);  // J itself (jw_scale above)
+    out.jacobian = std::move(ev.Jw);  // J itself (jw_scale above)
   }
-  apply_yield_convention(params, analysed, scales_of(), out, observable);
+  apply_yield_convention(pr.params, pr.analysed, pr.scales(), out, observable);
   x = out.values;
   for (int j = 0; j < p; ++j) {
     ParameterEstimate e;
-    e.name = params[static_cast<std::size_t>(j)].name;
-    e.unit = params[static_cast<std::size_t>(j)].unit;
+    e.name = pr.params[static_cast<std::size_t>(j)].name;
+    e.unit = pr.params[static_cast<std::size_t>(j)].unit;
     e.value = x[j];
     e.std = std::sqrt(std::max(0.0, out.covariance(j, j)));
     e.observable = observable[static_cast<std::size_t>(j)];
     out.estimates.push_back(std::move(e));
   }
+}
+
+}  // namespace
+
+JointFitOutcome solve_joint(const ResidualModel& model, const std::vector<FitParameter>& params,
+                            const JointFitSettings& s) {
+  const JointProblem pr(model, params, s);
+  JointFitOutcome out;
+  FitSummary& sum = out.summary;
+  sum.whitened = static_cast<bool>(s.whitener);
+  sum.num_residuals = static_cast<std::size_t>(pr.n);
+  Eigen::VectorXd x(pr.p);
+  for (int j = 0; j < pr.p; ++j) x[j] = params[static_cast<std::size_t>(j)].start;
+  const Eigen::VectorXd x0 = x;
+  const std::vector<bool> free_subset = subsample_start(pr, x, sum);
+
+  FullEvaluation ev(pr);
+  ev.evaluate(pr, x, sum);
+  std::vector<bool> observable = analyse_full(pr, free_subset, x0, x, ev, out);
+  const std::vector<Eigen::Index> idx = free_indices(out.free);
+  sum.num_free = static_cast<int>(idx.size());
+  if (pr.n < static_cast<Eigen::Index>(idx.size()))
+    throw InvalidArgument("solve_joint: " + std::to_string(pr.n) + " residuals cannot determine " +
+                          std::to_string(idx.size()) + " unknowns");
+
+  double cost = 0.0;
+  const NormalEquations ne = gauss_newton(pr, idx, x, ev, sum, cost);
+  finish_outcome(pr, idx, ne, cost, x, ev, observable, out);
   return out;
 }
 

@@ -1,6 +1,7 @@
 #include "rotacal/kinematics/effects.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 
 namespace rotacal {
@@ -20,7 +21,7 @@ struct KindInfo {
   const char* cause;
 };
 
-const KindInfo kKinds[] = {
+constexpr KindInfo kKinds[] = {
     {EffectKind::ballbar_length_offset, "ballbar_length_offset", false, false, false, false, 1,
      "dL", "mm", "the calibrated ballbar length L0 is wrong"},
     {EffectKind::ballbar_thermal_drift, "ballbar_thermal_drift", false, false, false, false, 1,
@@ -75,10 +76,21 @@ const KindInfo kKinds[] = {
      "tool's height"},
 };
 
+// info() is called for every effect of every sample inside the fits and simulators
+// (EffectModel::offset, Effect::num_params): a table indexed by the kind, built at compile
+// time, not a search.
+constexpr std::size_t kKindSlots = 64;
+constexpr std::array<const KindInfo*, kKindSlots> kByKind = [] {
+  std::array<const KindInfo*, kKindSlots> t{};
+  for (const KindInfo& i : kKinds) t[static_cast<std::size_t>(i.kind)] = &i;
+  return t;
+}();
+
 const KindInfo& info(EffectKind k) {
-  for (const KindInfo& i : kKinds)
-    if (i.kind == k) return i;
-  throw Error("internal error: effect kind without catalogue entry");
+  const auto slot = static_cast<std::size_t>(k);
+  if (slot >= kKindSlots || kByKind[slot] == nullptr)
+    throw Error("internal error: effect kind without catalogue entry");
+  return *kByKind[slot];
 }
 
 std::vector<std::string> split(const std::string& s) {
@@ -220,13 +232,13 @@ std::vector<Effect> effect_catalogue(MachineType m, int max_harmonic) {
 
 int EffectModel::num_params() const {
   int n = 0;
-  for (const Effect& f : effects) n += f.num_params();
+  for (const Effect& f : effects) n += info(f.kind).params;
   return n;
 }
 
 int EffectModel::offset(std::size_t i) const {
   int n = 0;
-  for (std::size_t k = 0; k < i; ++k) n += effects[k].num_params();
+  for (std::size_t k = 0; k < i; ++k) n += info(effects[k].kind).params;
   return n;
 }
 

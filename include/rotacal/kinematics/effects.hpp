@@ -109,7 +109,9 @@ struct EffectModel {
   std::optional<Eigen::Vector3d> linear_reference;
 
   int num_params() const;
-  /// Offset of effect i's first parameter in the flat vector.
+  /// Offset of effect i's first parameter in the flat vector. O(i): a loop over every effect
+  /// keeps a running offset instead (the evaluators below), else a model of n effects costs
+  /// n^2 per sample.
   int offset(std::size_t i) const;
   /// "id.name" for every parameter, in flat order.
   std::vector<std::string> param_labels() const;
@@ -185,9 +187,9 @@ AxisStages<Scalar> axis_stages(MachineType m, const EffectModel& fx, const Scala
   const MachineDescription& d = m.description();
   AxisStages<Scalar> st;
   for (int k = 0; k < 2; ++k) st.angle[k] = Scalar(chain_angle(m, cmd, k));
-  for (std::size_t i = 0; i < fx.effects.size(); ++i) {
+  for (std::size_t i = 0, off = 0; i < fx.effects.size(); off += fx.effects[i].num_params(), ++i) {
     const Effect& f = fx.effects[i];
-    const Scalar* q = p + fx.offset(i);
+    const Scalar* q = p + off;
     const bool rotary = f.kind == EffectKind::rotary_zero_offset || f.kind == EffectKind::angular_positioning ||
                         f.kind == EffectKind::radial_motion || f.kind == EffectKind::axial_motion ||
                         f.kind == EffectKind::tilt_motion || f.kind == EffectKind::gravity_sag ||
@@ -345,9 +347,9 @@ Vec3<Scalar> linear_axes_position(const EffectModel& fx, const Scalar* p, const 
                                   const Scalar& ball_dz = Scalar(0)) {
   Vec3<Scalar> out = xyz.cast<Scalar>();
   const Eigen::Vector3d a_ref = fx.linear_reference.value_or(Eigen::Vector3d::Zero());
-  for (std::size_t i = 0; i < fx.effects.size(); ++i) {
+  for (std::size_t i = 0, off = 0; i < fx.effects.size(); off += fx.effects[i].num_params(), ++i) {
     const Effect& f = fx.effects[i];
-    const Scalar* q = p + fx.offset(i);
+    const Scalar* q = p + off;
     const int k = detail::axis_index(f.axis);
     switch (f.kind) {
       case EffectKind::linear_squareness:  // XY: x += s y; YZ: y += s z; ZX: z += s x
@@ -383,10 +385,10 @@ Vec3<Scalar> linear_axes_position(const EffectModel& fx, const Scalar* p, const 
 template <typename Scalar>
 Vec3<Scalar> tool_offset(const EffectModel& fx, const Scalar* p) {
   Vec3<Scalar> out = Vec3<Scalar>::Zero();
-  for (std::size_t i = 0; i < fx.effects.size(); ++i) {
+  for (std::size_t i = 0, off = 0; i < fx.effects.size(); off += fx.effects[i].num_params(), ++i) {
     const Effect& f = fx.effects[i];
-    if (f.kind == EffectKind::tool_offset_Z) out.z() += p[fx.offset(i)];
-    if (f.kind == EffectKind::tool_offset) out[detail::axis_index(f.axis)] += p[fx.offset(i)];
+    if (f.kind == EffectKind::tool_offset_Z) out.z() += p[off];
+    if (f.kind == EffectKind::tool_offset) out[detail::axis_index(f.axis)] += p[off];
   }
   return out;
 }
@@ -431,8 +433,8 @@ Vec3<Scalar> tool_position(const EffectModel& fx, const Scalar* p, const Eigen::
 template <typename Scalar>
 Scalar ballbar_reading_error(const EffectModel& fx, const Scalar* p, double t) {
   Scalar out(0);
-  for (std::size_t i = 0; i < fx.effects.size(); ++i) {
-    const Scalar* q = p + fx.offset(i);
+  for (std::size_t i = 0, off = 0; i < fx.effects.size(); off += fx.effects[i].num_params(), ++i) {
+    const Scalar* q = p + off;
     if (fx.effects[i].kind == EffectKind::ballbar_length_offset) out += q[0];
     if (fx.effects[i].kind == EffectKind::ballbar_thermal_drift) out += q[0] * Scalar(t);
   }

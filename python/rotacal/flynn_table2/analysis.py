@@ -161,13 +161,13 @@ def _extended_model(sc: dict, after: np.ndarray) -> dict:
 
 
 def _sweep(a: Assumptions, before: np.ndarray, after: np.ndarray, sweep: Sequence[tuple[str, dict]] | None,
-           draws: int, seed: int, max_causes: int) -> list[dict]:
+           draws: int, seed: int, max_causes: int, cache: dict) -> list[dict]:
     """One scenario per changed assumption: what falls outside, the first causes, what the
     extended model leaves."""
     sweeps = []
     for label, changes in (DEFAULT_SWEEP if sweep is None else sweep):
         b = replace(a, **changes)
-        s2 = scenario(b, before, after, draws, seed, max_causes, False)
+        s2 = scenario(b, before, after, draws, seed, max_causes, False, cache)
         out_n = [n for k, n in enumerate(NAMES) if after[k] < s2["lo"][k] or after[k] > s2["hi"][k]]
         top3 = [{"id": x["c"].id, **_size_dict(x["c"], x["size"], x["size_std"]),
                  "plausible_size": bool(abs(x["size"]) <= x["c"].plausible)} for x in s2["rows"][:3]]
@@ -210,7 +210,8 @@ def analyse(table: dict | None = None, assumptions: Assumptions | None = None, *
     if not (np.all(np.isfinite(before)) and np.all(np.isfinite(after))):
         raise _core.InvalidArgument("analyse: before and after values must be finite")
 
-    sc = scenario(a, before, after, draws, seed, max_causes, True)
+    cache: dict = {}  # noise-free runs, shared by the scenarios (Chain)
+    sc = scenario(a, before, after, draws, seed, max_causes, True, cache)
     prediction = _prediction(sc, before, after)
     per_value = _per_value(sc)
     result = {
@@ -228,7 +229,7 @@ def analyse(table: dict | None = None, assumptions: Assumptions | None = None, *
         "ranked_causes": _ranked(sc, top),
         "ambiguous": _ambiguous(sc, a.noise_um, top),
         "extended_model": _extended_model(sc, after),
-        "sweep": _sweep(a, before, after, sweep, sweep_draws, seed, max_causes),
+        "sweep": _sweep(a, before, after, sweep, sweep_draws, seed, max_causes, cache),
     }
     result["conclusions"] = conclusions(result)
     _check_finite(result, "result")

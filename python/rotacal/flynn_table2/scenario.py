@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 
+from .. import _core
 from .causes import Assumptions, candidates
 from .chain import Chain
 from .table import SCALE as _SCALE
@@ -20,24 +21,10 @@ def _chi2_95(df: int) -> float:
     return df * (1.0 - h + 1.6449 * math.sqrt(h)) ** 3
 
 
-def _box_lsq(R: np.ndarray, d: np.ndarray, w: np.ndarray, bounds: np.ndarray, iters: int = 200) -> np.ndarray:
-    """min sum w (d - R s)^2 with |s_j| <= bounds_j, by cyclic coordinate descent (convex)."""
-    s = np.zeros(R.shape[1])
-    for _ in range(iters):
-        old = s.copy()
-        for j in range(R.shape[1]):
-            r = R[:, j]
-            res = d - R @ s + r * s[j]
-            den = np.sum(w * r * r)
-            s[j] = float(np.clip(np.sum(w * r * res) / den, -bounds[j], bounds[j])) if den > 0 else 0.0
-        if np.max(np.abs(s - old) / np.maximum(bounds, 1e-300)) < 1e-9:
-            break
-    return s
-
-
 def scenario(a: Assumptions, before: np.ndarray, after: np.ndarray, draws: int, seed: int,
-              max_causes: int, want_details: bool) -> dict:
-    ch = Chain(a)
+              max_causes: int, want_details: bool, cache: dict | None = None) -> dict:
+    """`cache`: the noise-free runs of the analysis' other scenarios (Chain)."""
+    ch = Chain(a, cache)
     truth = ch.truth_for(before)
     cands = candidates(a, ch.duration)
     rng = np.random.default_rng(seed)
@@ -76,8 +63,8 @@ def scenario(a: Assumptions, before: np.ndarray, after: np.ndarray, draws: int, 
         if want_details:
             # A repeated uncompensated run after the same interval: run 1 on run 2's machine,
             # minus run 1 (zero for a constant effect, the change itself otherwise).
-            rp = ch.run(truth, p2, p2)[0] - ep[0]
-            rn = ch.run(truth, n2, n2)[0] - en[0]
+            rp = ch.before(truth, p2) - ep[0]
+            rn = ch.before(truth, n2) - en[0]
             Rb[:, j] = (rp - rn) / (2 * h)
 
     chi2_0 = float(np.sum(w * d * d))
@@ -110,7 +97,7 @@ def scenario(a: Assumptions, before: np.ndarray, after: np.ndarray, draws: int, 
             if j in chosen or x["size_std"] is None:
                 continue
             idx = chosen + [j]
-            sv = _box_lsq(R[:, idx], d, w, np.array([cands[i].plausible for i in idx]))
+            sv = _core.box_least_squares(R[:, idx], d, w, np.array([cands[i].plausible for i in idx]))
             c2 = float(np.sum(w * (d - R[:, idx] @ sv) ** 2))
             if best is None or c2 < best[0]:
                 best = (c2, j, sv)
