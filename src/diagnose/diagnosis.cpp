@@ -201,24 +201,6 @@ Diagnosis search_white(const DiagnosisProblem& P, const DiagnosisOptions& option
   return D;
 }
 
-// The noise's lowest frequencies, which the fit hides. What stays put over a stream (1/f-like
-// noise whose slowest parts outlast the session) moves every reading of the stream alike, so
-// the fit's stream-wide parameters take it (a touch probe's stylus_radius_offset is exactly the
-// level of its one stream) and no model of the residuals can see it: of refsim's 1/f-like
-// noise at 0.5 um, a probe session's residuals show AR(1) at 0.30-0.38 um, and the stylus
-// offset's sigma by GLS under REML's AR(1) + walk was 0.09-0.19 um where the Monte Carlo's is
-// 0.34 um (9 of 25 null sessions named the offset; the walk, pinned at the stream's first
-// reading, even makes the level look known from the session's start). The residuals tell how
-// the readings vary about their stream's level, not where the level sits. The declared noise
-// (noise_um: the 1-sigma of one reading) tells how much variance the readings have, and
-// Var x_t averaged over the stream = E (x_t - mean)^2 averaged + Var(mean): so what the
-// declared variance holds beyond the model's variation within stream s,
-// d_s = noise_um^2 - tr(C V_s C) / n_s (C: removing the mean), is given to a level of the
-// stream: V + d_s 1_s 1_s^T (on top of whatever level V_s has: conservative). With W the
-// model's whitener and u_s = W 1_s (disjoint supports), V_total^-1 = W^T (I + sum d_s u_s
-// u_s^T)^-1 W, so W_total = (I - sum c_s e_s e_s^T) W, e_s = u_s / |u_s|,
-// c_s = 1 - 1 / sqrt(1 + d_s |u_s|^2). Without a declared noise there is nothing to compare
-// with, and the model is taken as it is.
 // tr(C V C) / n of one AR + walk stream (noise_model.hpp): the mean of its variances less the
 // variance of its mean, 1^T V 1 / n^2, in O(n).
 double within_stream_variance(const NoiseStream& s) {
@@ -233,10 +215,29 @@ double within_stream_variance(const NoiseStream& s) {
   return mean_var - total / (nd * nd);
 }
 
+// The noise's lowest frequencies, which the fit hides. What stays put over a stream (1/f-like
+// noise whose slowest parts outlast the session) moves every reading of the stream alike, so
+// the fit's stream-wide parameters take it (a touch probe's stylus_radius_offset is exactly the
+// level of its one stream) and no model of the residuals can see it: of refsim's 1/f-like
+// noise at 0.5 um, a probe session's residuals show AR(1) at 0.30-0.38 um, and the stylus
+// offset's sigma by GLS under REML's AR(1) + walk was 0.09-0.19 um where the Monte Carlo's is
+// 0.34 um (9 of 25 null sessions named the offset). The residuals tell how the readings vary
+// about their stream's level, not where the level sits. The declared noise (noise_um: the
+// 1-sigma of one reading) tells how much variance the readings have, and Var x_t averaged over
+// the stream = E (x_t - mean)^2 averaged + Var(mean): so what the declared variance holds
+// beyond the model's variation within stream s, noise_um^2 - tr(C V_s C) / n_s (C: removing
+// the mean; at least 0), is given to a level of the stream, and so is the walk's mean variance
+// q^2 (n_s - 1) / 2: the walk is pinned at the stream's first reading, which made the level
+// look known from the session's start (0.19 um where 0.34 um is right), and where it starts
+// is as unknown as where it goes. V + d_s 1_s 1_s^T, on top of whatever level V_s has
+// (conservative: in AR(1) 0.9 the offset's sigma is 0.34-0.42 um, test_probe_diagnosis, where the
+// bench layout's Monte Carlo spread is 0.20 um). With W the model's whitener and u_s = W 1_s
+// (disjoint supports), V_total^-1 = W^T (I + sum d_s u_s u_s^T)^-1 W, so
+// W_total = (I - sum c_s e_s e_s^T) W, e_s = u_s / |u_s|, c_s = 1 - 1 / sqrt(1 + d_s |u_s|^2).
+// Without a declared noise there is nothing to compare with, and the model is taken as it is.
 class HiddenLevels : public ResidualWhitener {
  public:
   HiddenLevels(std::shared_ptr<const ArWhitener> W, const NoiseModel& m, double declared_mm) : W_(std::move(W)) {
-    std::vector<Eigen::Index> cols;
     Eigen::MatrixXd ones = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(m.n), static_cast<Eigen::Index>(m.streams.size()));
     std::vector<double> d;
     for (const NoiseStream& s : m.streams) {
