@@ -20,10 +20,14 @@ struct NoiseTreatment {
   double sigma_mm = 0.0;  // white: the sigma; coloured: the marginal sigma (for wording)
   std::string source;
   std::shared_ptr<const ArWhitener> W;  // null: white
+  // Coloured, when set: W and more (the final refit's hidden stream levels, diagnosis.cpp),
+  // the whitener every decision under this treatment uses instead of W.
+  std::shared_ptr<const ResidualWhitener> full;
   Eigen::MatrixXd whiten(const Eigen::MatrixXd& M) const {
     if (!W) return M / sigma_mm;
     Eigen::MatrixXd out = M;
-    W->apply(out);
+    if (full) full->apply(out);
+    else W->apply(out);
     return out;
   }
 };
