@@ -91,22 +91,25 @@ def pattern_information(G: np.ndarray, directions) -> np.ndarray:
     return np.einsum("kai,ab,kbj->ij", G, D, G) / SIGMA_MM**2
 
 
-def minimax_bound(G: np.ndarray, names: list[str], touches: int, directions=None, iterations: int = 300):
-    """(U reached by a continuous design, certified lower bound on U) in um over every allocation
-    of `touches` touches to the poses of G: each visit touched once along each of `directions`,
-    or (None) each touch along any direction of its own."""
+def candidate_information(G: np.ndarray, touches: int, directions=None) -> tuple[np.ndarray, float]:
+    """The information of one run of each candidate and the number of runs: a pose of G touched
+    once along each of `directions`, or (None) one touch along one of SEARCH_DIRECTIONS."""
     if directions is None:
         rows = np.einsum("da,kaj->kdj", SEARCH_DIRECTIONS, G).reshape(-1, G.shape[2])
-        info = np.einsum("ki,kj->kij", rows, rows) / SIGMA_MM**2
-        runs = float(touches)
-    else:
-        D = sum(np.outer(d, d) for d in np.asarray(directions, float))
-        info = np.einsum("kai,ab,kbj->kij", G, D, G) / SIGMA_MM**2
-        runs = touches / len(directions)
+        return np.einsum("ki,kj->kij", rows, rows) / SIGMA_MM**2, float(touches)
+    D = sum(np.outer(d, d) for d in np.asarray(directions, float))
+    return np.einsum("kai,ab,kbj->kij", G, D, G) / SIGMA_MM**2, touches / len(directions)
+
+
+def minimax_bound(G: np.ndarray, names: list[str], touches: int, directions=None, iterations: int = 300):
+    """(U reached by a continuous design, certified lower bound on U, the design's runs per
+    candidate) in um over every allocation of `touches` touches to the poses of G: each visit
+    touched once along each of `directions`, or (None) each touch along any direction of its own."""
+    info, runs = candidate_information(G, touches, directions)
     s2 = scales(names) ** 2
     w = np.full(len(info), runs / len(info))
     lam = np.full(8, 1.0 / 8)
-    upper, lower = np.inf, 0.0
+    upper, lower, best = np.inf, 0.0, w
     for _ in range(iterations):
         for _ in range(40):  # the multiplicative algorithm for the weighted A-criterion
             C = np.linalg.inv(np.einsum("k,kij->ij", w, info))
@@ -122,10 +125,49 @@ def minimax_bound(G: np.ndarray, names: list[str], touches: int, directions=None
         else:
             dmax = np.einsum("kij,ij->k", info, A).max()
         lower = max(lower, (lam @ v) ** 2 / (runs * dmax))
-        upper = min(upper, v.max())
+        if v.max() < upper:
+            upper, best = v.max(), w.copy()
         lam = lam * np.exp(2.0 * (v / v.max() - 1.0))
         lam /= lam.sum()
-    return float(np.sqrt(upper)), float(np.sqrt(lower))
+    return float(np.sqrt(upper)), float(np.sqrt(lower)), best
+
+
+def rounded_u_um(G: np.ndarray, names: list[str], touches: int, weights: np.ndarray, directions=None) -> float:
+    """The largest U (um) of the continuous design `weights` rounded to whole runs (Pukelsheim and
+    Rieder's efficient rounding on its support), then single runs moved between its candidates
+    while that decreases."""
+    info, runs = candidate_information(G, touches, directions)
+    support = np.where(weights > 1e-3 * runs / len(weights))[0]
+    share = weights[support] / weights[support].sum()
+    n = np.ceil((round(runs) - len(support) / 2) * share).astype(int)
+    while n.sum() != round(runs):
+        j = np.argmin(n / share) if n.sum() < runs else np.argmax((n - 1) / share)
+        n[j] += 1 if n.sum() < runs else -1
+    s2 = scales(names) ** 2
+
+    def u(counts):
+        M = np.einsum("k,kij->ij", counts, info[support])
+        return np.sqrt((np.diag(np.linalg.inv(M))[:8] * s2).max()) if np.linalg.cond(M) < 1e14 else np.inf
+
+    def better_move() -> bool:  # the first single run moved that lowers the value, made
+        nonlocal value
+        for i in np.where(n > 0)[0]:
+            for j in range(len(support)):
+                if i == j:
+                    continue
+                n[i] -= 1
+                n[j] += 1
+                if u(n) < value - 1e-12:
+                    value = u(n)
+                    return True
+                n[i] += 1
+                n[j] -= 1
+        return False
+
+    value = u(n)
+    while better_move():
+        pass
+    return float(value)
 
 
 def grid(machine: str, tilt_step: float = 15.0, rot_step: float = 30.0, tilt_limit: float = 90.0) -> list:
