@@ -6,7 +6,7 @@
 #include "rotacal/ballbar/model_document.hpp"
 #include "rotacal/io/model_file.hpp"
 #include "rotacal/io/output_file.hpp"
-#include "rotacal/io/plausibility.hpp"
+#include "rotacal/session/plausibility.hpp"
 #include "rotacal/io/session_arrays.hpp"
 #include "rotacal/rtest/model_document.hpp"
 
@@ -185,7 +185,7 @@ void bind_model_documents(pyb::module_& m) {
 
 // The checks before fitting and before writing.
 void bind_checks(pyb::module_& m) {
-  // Plausibility before fitting (rotacal/io/plausibility.hpp).
+  // Plausibility before fitting (rotacal/session/plausibility.hpp).
   pyb::class_<PlausibilityOptions>(m, "PlausibilityOptions", "Limits of the plausibility checks (mm, deg).")
       .def(pyb::init<>())
       .def_readwrite("max_length_deviation_mm", &PlausibilityOptions::max_length_deviation_mm)

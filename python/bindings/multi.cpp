@@ -5,8 +5,8 @@
 
 #include "json_value.hpp"
 #include "numpy.hpp"
-#include "rotacal/io/probe_session.hpp"
-#include "rotacal/io/session.hpp"
+#include "rotacal/session/probe_session.hpp"
+#include "rotacal/session/session.hpp"
 #include "rotacal/multi/identify.hpp"
 #include "rotacal/multi/model_document.hpp"
 

@@ -153,7 +153,7 @@ def load(path: str | Path, format: str | None = None) -> Session:
 
 
 def check_plausible(session: Session, source: str = "<session>", max_deviation_mm: float | None = None) -> Any:
-    """Check a session against the nominal kinematics before any fit (C++ io/plausibility):
+    """Check a session against the nominal kinematics before any fit (C++ session/plausibility):
     refuses, with the likely cause named ("angles look like radians", "lengths look like
     inches", "all rotary angles equal", a wrong L0, ...), a session no machine with realistic
     errors can have produced. ``max_deviation_mm`` widens the limit on |measured - nominal| of

@@ -7,8 +7,8 @@
 
 #include "rotacal/core/block_whitener.hpp"
 #include "rotacal/core/parameter_layout.hpp"
-#include "rotacal/io/probe_session.hpp"
-#include "rotacal/io/session.hpp"
+#include "rotacal/session/probe_session.hpp"
+#include "rotacal/session/session.hpp"
 #include "rotacal/kinematics/parameter_blocks.hpp"
 #include "session_parts.hpp"
 

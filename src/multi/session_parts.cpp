@@ -6,8 +6,8 @@
 
 #include "../ballbar/length_model.hpp"
 #include "rotacal/ballbar/problem.hpp"
-#include "rotacal/io/probe_session.hpp"
-#include "rotacal/io/session.hpp"
+#include "rotacal/session/probe_session.hpp"
+#include "rotacal/session/session.hpp"
 #include "rotacal/kinematics/parameter_blocks.hpp"
 #include "rotacal/probe/problem.hpp"
 #include "rotacal/rtest/problem.hpp"

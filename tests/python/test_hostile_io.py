@@ -111,7 +111,7 @@ def test_cli_exit_codes(tmp_path, args, code, words):
 
 
 def test_plausibility_names_the_cause(shared_data):
-    """The check the entry points run before fitting (rotacal/io/plausibility.hpp)."""
+    """The check the entry points run before fitting (rotacal/session/plausibility.hpp)."""
     import numpy as np
     s = rotacal.load(shared_data / "ballbar_ac_table2.csv")
     assert _core.check_plausible(s, "s.csv").max_deviation_mm < 0.5

@@ -1,6 +1,6 @@
 """The C++ layer order of the README, checked on every #include of include/ and src/.
 
-core < kinematics < fit < io < design < instrument problems (ballbar, rtest, probe) <
+core < kinematics < fit < session < io < design < instrument problems (ballbar, rtest, probe) <
 circular (the ballbar's tests of the linear axes) < diagnose < multi < hw.
 
 A file may include its own layer and the layers below it, never one above, and no instrument
@@ -11,7 +11,7 @@ import re
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
-ORDER = ["core", "kinematics", "fit", "io", "design", "instrument", "circular", "diagnose", "multi", "hw"]
+ORDER = ["core", "kinematics", "fit", "session", "io", "design", "instrument", "circular", "diagnose", "multi", "hw"]
 INSTRUMENTS = {"ballbar", "rtest", "probe"}
 INCLUDE = re.compile(r'^\s*#\s*include\s+"(?:rotacal/)?([^"]+)"', re.M)
 

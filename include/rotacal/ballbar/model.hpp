@@ -8,7 +8,7 @@
 
 #include "rotacal/ballbar/motion.hpp"
 #include "rotacal/kinematics/machine_model.hpp"
-#include "rotacal/io/session.hpp"
+#include "rotacal/session/session.hpp"
 #include "rotacal/kinematics/effects.hpp"
 
 namespace rotacal {

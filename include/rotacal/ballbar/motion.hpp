@@ -7,7 +7,7 @@
 
 #include <vector>
 
-#include "rotacal/io/session.hpp"
+#include "rotacal/session/session.hpp"
 #include "rotacal/kinematics/machine.hpp"
 
 namespace rotacal {

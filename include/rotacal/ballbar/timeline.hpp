@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "rotacal/ballbar/plan.hpp"
-#include "rotacal/io/session.hpp"
+#include "rotacal/session/session.hpp"
 
 namespace rotacal {
 

@@ -24,7 +24,7 @@
 #include <vector>
 
 #include "rotacal/io/nc_dialect.hpp"
-#include "rotacal/io/session.hpp"
+#include "rotacal/session/session.hpp"
 #include "rotacal/kinematics/machine.hpp"
 
 namespace rotacal {

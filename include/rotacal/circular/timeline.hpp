@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "rotacal/circular/plan.hpp"
-#include "rotacal/io/session.hpp"
+#include "rotacal/session/session.hpp"
 
 namespace rotacal {
 

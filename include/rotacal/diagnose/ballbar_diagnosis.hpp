@@ -8,7 +8,7 @@
 #include "rotacal/ballbar/identify.hpp"
 #include "rotacal/core/whitener.hpp"
 #include "rotacal/diagnose/diagnosis.hpp"
-#include "rotacal/io/session.hpp"
+#include "rotacal/session/session.hpp"
 
 namespace rotacal {
 

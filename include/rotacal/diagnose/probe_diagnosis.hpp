@@ -9,7 +9,7 @@
 #include <memory>
 
 #include "rotacal/diagnose/diagnosis.hpp"
-#include "rotacal/io/probe_session.hpp"
+#include "rotacal/session/probe_session.hpp"
 
 namespace rotacal {
 

@@ -12,7 +12,7 @@
 
 #include "rotacal/core/whitener.hpp"
 #include "rotacal/diagnose/diagnosis.hpp"
-#include "rotacal/io/session.hpp"
+#include "rotacal/session/session.hpp"
 
 namespace rotacal {
 

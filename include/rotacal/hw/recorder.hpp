@@ -16,7 +16,7 @@
 #include "rotacal/hw/pose_window.hpp"
 #include "rotacal/hw/probe_protocol.hpp"
 #include "rotacal/hw/transport.hpp"
-#include "rotacal/io/session.hpp"
+#include "rotacal/session/session.hpp"
 
 namespace rotacal::hw {
 

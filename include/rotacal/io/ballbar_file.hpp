@@ -11,7 +11,7 @@
 #include <variant>
 
 #include "rotacal/io/output_file.hpp"
-#include "rotacal/io/session.hpp"
+#include "rotacal/session/session.hpp"
 
 namespace rotacal {
 

@@ -10,7 +10,7 @@
 #include <variant>
 
 #include "rotacal/io/ballbar_file.hpp"
-#include "rotacal/io/probe_session.hpp"
+#include "rotacal/session/probe_session.hpp"
 
 namespace rotacal {
 

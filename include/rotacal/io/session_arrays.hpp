@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "rotacal/io/session.hpp"
+#include "rotacal/session/session.hpp"
 
 namespace rotacal {
 

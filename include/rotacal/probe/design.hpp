@@ -24,7 +24,7 @@
 #include <vector>
 
 #include "rotacal/design/separation.hpp"
-#include "rotacal/io/probe_session.hpp"
+#include "rotacal/session/probe_session.hpp"
 #include "rotacal/probe/nc_program.hpp"
 #include "rotacal/probe/simulate.hpp"
 

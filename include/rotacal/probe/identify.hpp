@@ -16,7 +16,7 @@
 
 #include "rotacal/core/fit_with_noise.hpp"
 #include "rotacal/kinematics/machine_model.hpp"
-#include "rotacal/io/probe_session.hpp"
+#include "rotacal/session/probe_session.hpp"
 
 namespace rotacal {
 

@@ -22,7 +22,7 @@
 #include <vector>
 
 #include "rotacal/io/nc_dialect.hpp"
-#include "rotacal/io/probe_session.hpp"
+#include "rotacal/session/probe_session.hpp"
 #include "rotacal/probe/simulate.hpp"
 
 namespace rotacal {

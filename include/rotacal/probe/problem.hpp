@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "rotacal/core/joint_fit.hpp"
-#include "rotacal/io/probe_session.hpp"
+#include "rotacal/session/probe_session.hpp"
 #include "rotacal/kinematics/parameter_blocks.hpp"
 #include "rotacal/probe/touch_model.hpp"
 

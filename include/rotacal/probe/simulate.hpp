@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "rotacal/kinematics/machine_model.hpp"
-#include "rotacal/io/probe_session.hpp"
+#include "rotacal/session/probe_session.hpp"
 
 namespace rotacal {
 

@@ -24,7 +24,7 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "rotacal/io/session.hpp"
+#include "rotacal/session/session.hpp"
 #include "rotacal/kinematics/rotation.hpp"
 
 namespace rotacal {

@@ -41,7 +41,7 @@
 #include "rotacal/core/estimate.hpp"
 #include "rotacal/core/noise_handling.hpp"
 #include "rotacal/core/whitener.hpp"
-#include "rotacal/io/session.hpp"
+#include "rotacal/session/session.hpp"
 #include "rotacal/rtest/error_model.hpp"
 #include "rotacal/rtest/model.hpp"
 

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "rotacal/io/session.hpp"
+#include "rotacal/session/session.hpp"
 #include "rotacal/rtest/error_model.hpp"
 
 namespace rotacal {

@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "rotacal/core/joint_fit.hpp"
-#include "rotacal/io/session.hpp"
+#include "rotacal/session/session.hpp"
 #include "rotacal/kinematics/parameter_blocks.hpp"
 #include "rotacal/rtest/identify_joint.hpp"
 #include "rotacal/rtest/model.hpp"

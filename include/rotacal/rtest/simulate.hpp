@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "rotacal/kinematics/machine_model.hpp"
-#include "rotacal/io/session.hpp"
+#include "rotacal/session/session.hpp"
 #include "rotacal/rtest/model.hpp"
 
 namespace rotacal {

@@ -213,7 +213,7 @@ def load_session(path: str, a: argparse.Namespace | None = None, circular_tests:
                 f"{path}: holds ISO 230-4 circular tests of the linear axes ({', '.join(sorted(set(s.tests))[:3])}"
                 f"{', ...' if len(set(s.tests)) > 3 else ''}), not a rotary-axis test: `rotacal circular analyze "
                 f"{path}` gives G, G(b), H and their causes, `rotacal report {path} -o OUT.html` the report")
-        if not is_circular(s) and kind(s) != PROBE:  # io/plausibility has no touch-probe check yet
+        if not is_circular(s) and kind(s) != PROBE:  # session/plausibility has no touch-probe check yet
             check_plausible(s, path, getattr(a, "max_deviation", None))
     return s
 

@@ -1,5 +1,5 @@
 // Plausibility of sessions against the nominal kinematics, with the likely cause of a misfit named.
-#include "rotacal/io/plausibility.hpp"
+#include "rotacal/session/plausibility.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-// Tests of io/plausibility.hpp: the shared sessions pass; sessions with the careless mistakes
+// Tests of session/plausibility.hpp: the shared sessions pass; sessions with the careless mistakes
 // of issue 17 item 5 are refused with the cause named.
 #include <catch2/catch.hpp>
 
@@ -6,7 +6,7 @@
 
 #include "rotacal/core/error.hpp"
 #include "rotacal/io/ballbar_file.hpp"
-#include "rotacal/io/plausibility.hpp"
+#include "rotacal/session/plausibility.hpp"
 
 using namespace rotacal;
 

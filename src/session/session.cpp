@@ -1,4 +1,4 @@
-#include "rotacal/io/session.hpp"
+#include "rotacal/session/session.hpp"
 
 #include <algorithm>
 #include <cmath>
