@@ -75,8 +75,9 @@ def sensitivities(machine: str, poses_deg, sphere) -> tuple[np.ndarray, list[str
 
 
 def scales(names: list[str]) -> np.ndarray:
-    """um of 2 sigma per unit of each location error (the first 8): rad x 100 mm, mm."""
-    return np.array([2e5 if nm[2] in "ABC" else 2e3 for nm in names[:8]])
+    """um of 2 sigma per unit of each location error (the first 8): rad x 100 mm, mm. Orientation
+    errors: E_A0C-like (about an axis) and E_DU0B-like (a direction error of an inclined axis)."""
+    return np.array([2e5 if nm[2] in "ABC" or nm.startswith("E_D") else 2e3 for nm in names[:8]])
 
 
 def largest_u_um(info: np.ndarray, names: list[str]) -> tuple[float, str]:

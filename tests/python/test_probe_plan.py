@@ -20,6 +20,7 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "reference"))
 import refsim  # noqa: E402
 from refsim import noise  # noqa: E402
+from refsim import poses as refposes  # noqa: E402
 
 import rotacal  # noqa: E402
 from test_linuxcnc import RS274, run_rs274  # noqa: E402  (the interpreter's canonical commands)
@@ -34,9 +35,12 @@ def run(*args):
 
 
 def nominal_centre(machine: str, angles_deg, sphere=(150.0, 0.0, 80.0)) -> np.ndarray:
-    """The sphere's nominal centre in machine axes at a pose (refsim, as in its probe_touches)."""
+    """The sphere's nominal centre in machine axes at a pose (tilt, rotary; deg) (refsim, as in its
+    probe_touches)."""
     nominal = refsim.Model(machine).nominal()
-    a = np.radians(np.atleast_2d(angles_deg))
+    i_tilt, i_rot = refposes.rotary_roles(refsim.load_machine(machine))
+    a = np.zeros((1, 2))
+    a[0, i_tilt], a[0, i_rot] = np.radians(np.ravel(angles_deg))  # refsim's axis order
     c = nominal.p_table(np.atleast_2d(np.asarray(sphere, float)), a, np.zeros(1))
     return nominal.commanded_xyz(c, a)[0]
 

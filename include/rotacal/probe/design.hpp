@@ -6,7 +6,7 @@
 /// a head, the sphere) gives the smallest largest expanded uncertainty (k = 2) of the location
 /// errors at a given number of touches, and the same for `plan probe`'s default poses.
 ///
-/// Touch by touch (`touch_directions`, the default): each candidate is one touch at a grid pose
+/// Touch by touch (`touch_directions`; the CLI's default): each candidate is one touch at a grid pose
 /// along one direction of contact_directions (the contact point within `max_contact_angle_deg`
 /// of the stylus axis, polar every `contact_step_deg`, azimuth every 45 deg), each checked alone
 /// by probe_moves (travel, the way up clear of the sphere); the engine allocates the touches, and
@@ -52,7 +52,9 @@ struct ProbeDesignOptions {
   double noise_um = 0.5;               ///< 1 sigma per latched coordinate (white)
   double reference_radius_mm = 100.0;  ///< an orientation error in rad counts as this lever arm
   ProbeProgramOptions program;         ///< approach, overtravel, clearance: what makes a pose plannable
-  bool touch_directions = true;        ///< each touch its own direction (false: every visit along `directions`)
+  /// Each touch its own direction (`rotacal design probe` and rotacal.design.design_probe set it);
+  /// false: every visit of a pose along `directions`.
+  bool touch_directions = false;
   double max_contact_angle_deg = 80.0; ///< candidate contact points within this of the stylus axis, deg
   double contact_step_deg = 30.0;      ///< their polar angle every this, deg (azimuth every 45)
   std::vector<Eigen::Vector3d> sphere_candidates;  ///< other places of the sphere to try, table frame, mm
