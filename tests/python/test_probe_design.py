@@ -89,6 +89,24 @@ def test_designed_test_reaches_the_target_by_refsim(machine):
     assert d.ratio == pytest.approx(ratio, rel=0.01)
 
 
+def test_head_machine_design_is_near_the_bound_of_its_candidates():
+    """The engine's design on B-head-C-table against what its candidates allow, by refsim alone:
+    the certified lower bound over every allocation of 120 touches to the 156 grid poses, each
+    along any of the 25 contact directions within 80 deg of the stylus axis (plannable or not: a
+    superset of the design's candidates), with the sphere where the design put it. The design
+    cannot be below it, and lies within 5 % above it."""
+    machine = "B-head-C-table"
+    d = design_probe(rotacal.machines.load_machine(machine))
+    s_best, names = refsim_sigma(machine, d.best)
+    u_design = (s_best[:8] * probe_bound.scales(names)).max()
+    poses = probe_bound.grid(machine)
+    G, _ = probe_bound.sensitivities(machine, poses, np.asarray(d.sphere))
+    dirs = [probe_bound.contact_directions(machine, t, r) for t, r in poses]
+    reached, bound, _ = probe_bound.minimax_bound(G, names, 120, iterations=60, touch_directions=dirs)
+    print("design", u_design, "bound", bound, "reached", reached)
+    assert bound <= u_design <= 1.05 * bound, (u_design, bound, reached)
+
+
 def test_designed_test_monte_carlo_realises_the_predicted_sigma(tmp_path):
     """The designed B-head-C-table test as an engineer runs it: `design probe --json` ->
     `plan probe --design` (program and session template) -> 100 sessions of refsim's latched
