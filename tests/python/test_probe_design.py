@@ -103,7 +103,6 @@ def test_head_machine_design_is_near_the_bound_of_its_candidates():
     G, _ = probe_bound.sensitivities(machine, poses, np.asarray(d.sphere))
     dirs = [probe_bound.contact_directions(machine, t, r) for t, r in poses]
     reached, bound, _ = probe_bound.minimax_bound(G, names, 120, iterations=60, touch_directions=dirs)
-    print("design", u_design, "bound", bound, "reached", reached)
     assert bound <= u_design <= 1.05 * bound, (u_design, bound, reached)
 
 
@@ -154,7 +153,6 @@ def test_designed_test_monte_carlo_realises_the_predicted_sigma(tmp_path):
     assert not misses
     realised = np.sqrt(np.mean(np.square(numbers), axis=0))
     ratio = realised / predicted
-    print("realised / predicted", dict(zip(names, ratio.round(3))))
     assert np.all((ratio > 0.75) & (ratio < 1.3)), dict(zip(names, ratio.round(3)))
 
 
