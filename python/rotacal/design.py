@@ -313,8 +313,8 @@ def probe_design_dict(d: Any) -> dict:
     return {"touches": d.touches, "ratio_to_default": d.ratio, "poses_tried": d.poses_tried,
             "touches_tried": d.touches_tried, "sphere": np.asarray(d.sphere).tolist(),
             "spheres_tried": [{"sphere": np.asarray(t.sphere).tolist(), "plannable": t.plannable,
-                               **({"worst_expanded_um": t.worst_expanded_um} if t.plannable else {"why_not": t.why_not})}
-                              for t in d.spheres],
+                               **({"worst_expanded_um": t.worst_expanded_um} if t.plannable
+                                  else {"why_not": t.why_not})} for t in d.spheres],
             "best": probe_candidate_dict(d.best), "default": probe_candidate_dict(d.baseline),
             "refused_poses": list(d.refused)}
 

@@ -86,6 +86,8 @@ Eigen::VectorXd continuous_design(const Reduced& R) {
   double best = std::numeric_limits<double>::infinity();
   Eigen::VectorXd root(first[C]), d(static_cast<Eigen::Index>(C)), v(T);
   Eigen::MatrixXd inv, W(T, q);
+  const auto target = [&](Eigen::Index t) { return R.target[static_cast<std::size_t>(t)]; };
+  const auto scale2 = [&](Eigen::Index t) { return R.scale2[static_cast<std::size_t>(t)]; };
   const auto information = [&]() {
     for (std::size_t k = 0; k < C; ++k)
       root.segment(first[k], first[k + 1] - first[k]).setConstant(std::sqrt(w[static_cast<Eigen::Index>(k)]));
@@ -95,18 +97,17 @@ Eigen::VectorXd continuous_design(const Reduced& R) {
   for (int outer = 0; outer < 40; ++outer) {
     for (int it = 0; it < 10; ++it) {
       if (!information()) return best < std::numeric_limits<double>::infinity() ? best_w : w;
-      for (Eigen::Index t = 0; t < T; ++t)
-        W.row(t) = inv.row(R.target[static_cast<std::size_t>(t)]) * std::sqrt(lam[t] * R.scale2[static_cast<std::size_t>(t)]);
+      for (Eigen::Index t = 0; t < T; ++t) W.row(t) = inv.row(target(t)) * std::sqrt(lam[t] * scale2(t));
       const Eigen::RowVectorXd col = (W * F).colwise().squaredNorm();
-      for (std::size_t k = 0; k < C; ++k) d[static_cast<Eigen::Index>(k)] = col.segment(first[k], first[k + 1] - first[k]).sum();
+      for (std::size_t k = 0; k < C; ++k)
+        d[static_cast<Eigen::Index>(k)] = col.segment(first[k], first[k + 1] - first[k]).sum();
       const double mean = w.dot(d);
       if (!(mean > 0.0)) return w;
       w = w.cwiseProduct((d / mean).cwiseMax(0.0).cwiseSqrt());
       w /= w.sum();
     }
     if (!information()) break;
-    for (Eigen::Index t = 0; t < T; ++t)
-      v[t] = R.scale2[static_cast<std::size_t>(t)] * inv(R.target[static_cast<std::size_t>(t)], R.target[static_cast<std::size_t>(t)]);
+    for (Eigen::Index t = 0; t < T; ++t) v[t] = scale2(t) * inv(target(t), target(t));
     if (v.maxCoeff() < best) best = v.maxCoeff(), best_w = w;
     lam = lam.cwiseProduct((2.0 * (v / v.maxCoeff()).array() - 2.0).exp().matrix());
     lam /= lam.sum();
@@ -222,9 +223,10 @@ Allocation allocate_runs(const AllocationProblem& P) {
     if (C > kMany) {
       const Eigen::VectorXd d = R.derivative(M);
       if (d.size() == 0) break;
-      std::partial_sort(receivers.begin(), receivers.begin() + kReceivers, receivers.end(), [&](std::size_t a, std::size_t b) {
+      const auto larger = [&](std::size_t a, std::size_t b) {
         return d[static_cast<Eigen::Index>(a)] > d[static_cast<Eigen::Index>(b)];
-      });
+      };
+      std::partial_sort(receivers.begin(), receivers.begin() + kReceivers, receivers.end(), larger);
       receivers.resize(kReceivers);
     }
     for (std::size_t a = 0; a < C; ++a) {

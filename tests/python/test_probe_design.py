@@ -142,8 +142,9 @@ def test_designed_test_monte_carlo_realises_the_predicted_sigma(tmp_path):
     for _ in range(100):
         truth = np.array([rng.normal(0, 0.03) if k % 4 < 2 else rng.normal(0, 4e-5) for k in range(8)])
         model = refsim.Model(machine, dict(zip(names, truth)), {})
-        latched = refsim.probe_touches(model, sphere + np.r_[rng.normal(0, 0.02, 2), 0.0], sphere, 25.0, 6.0, np.asarray(plan.n),
-                                       np.radians(angles), np.asarray(plan.time))
+        actual = sphere + np.r_[rng.normal(0, 0.02, 2), 0.0]
+        latched = refsim.probe_touches(model, actual, sphere, 25.0, 6.0, np.asarray(plan.n), np.radians(angles),
+                                       np.asarray(plan.time))
         latched = latched + rng.normal(0, 0.5e-3, latched.shape)
         log.write_text("".join(f"{p} {t} {x:.7f} {y:.7f} {z:.7f}\n" for (p, t), (x, y, z) in zip(pose, latched)))
         fit = identify_probe(rotacal._core.read_linuxcnc_probe_log(str(log), plan), noise="white")
@@ -208,7 +209,8 @@ def test_printed_poses_are_what_plan_probe_takes(tmp_path):
 
 
 @pytest.mark.parametrize("args,option", [(["--touches", "2"], "--touches"), (["--touches", "-5"], "--touches"),
-                                         (["--touches", "4"], "--touches"), (["--touches", "123", "--same-directions"], "--touches"),
+                                         (["--touches", "4"], "--touches"),
+                                         (["--touches", "123", "--same-directions"], "--touches"),
                                          (["--tilt-step", "0"], "--tilt-step"),
                                          (["--noise", "0"], "--noise"), (["--after", "x.csv"], "--after")])
 def test_invalid_options_are_refused_by_name(args, option):

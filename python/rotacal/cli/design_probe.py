@@ -80,7 +80,8 @@ def cmd_design_probe(a: argparse.Namespace) -> int:
         print(jsontext.dumps(probe_design_dict(d)))
         return EXIT_OK
     tried = f" ({d.touches_tried} candidate touches)" if not a.same_directions else ""
-    print(f"{d.poses_tried} candidate poses within the limits{tried}; {d.touches} touches, noise {noise:g} um per touch")
+    print(f"{d.poses_tried} candidate poses within the limits{tried}; {d.touches} touches, "
+          f"noise {noise:g} um per touch")
     for t in d.spheres:
         where = ", ".join(f"{v:g}" for v in t.sphere)
         print(f"  sphere at {where} mm: " + (f"designed largest U {t.worst_expanded_um:.3f} um" if t.plannable
