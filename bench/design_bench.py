@@ -14,8 +14,9 @@ R-test (Oyama and Ibaraki's B/C table and pattern): the designed nests and grid 
 default pattern at the same run time, the design time, and the Monte Carlo check of the
 designed pattern under AR(1) noise (rho 0.4).
 
-Touch probe: the designed poses against `plan probe`'s default poses at the same 120 touches on
-the built-in machines (target <= 0.7 on the table machines), and the design time.
+Touch probe: the designed poses, touch directions and sphere place against `plan probe`'s
+default poses at the default sphere and the same 120 touches on the built-in machines (target
+<= 0.7), and the design time (CPU and wall).
 
     PYTHONPATH=... python bench/design_bench.py            # the default grid, 100 draws
     PYTHONPATH=... python bench/design_bench.py --smoke    # a 2 x 2 grid, 10 draws
@@ -182,12 +183,14 @@ def probe_design() -> None:
     from rotacal.design import design_probe
     from rotacal.machines import load_machine
     for name in ("AC-trt", "BC-trt", "B45C-trt", "B-head-C-table", "AC-head"):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         d = design_probe(load_machine(name))
-        took = time.perf_counter() - t0
+        took, cpu = time.perf_counter() - t0, time.process_time() - c0
         b = d.baseline
         default = f"{b.worst_expanded_um:.3f} um ({b.worst_error})" if b.feasible else b.why_not
-        print(f"probe design {name}: {d.poses_tried} poses in {took:.2f} s; {d.touches} touches, designed "
+        sphere = ", ".join(f"{v:g}" for v in d.sphere)
+        print(f"probe design {name}: {d.poses_tried} poses, {d.touches_tried} touches tried, {len(d.spheres)} sphere "
+              f"places in {cpu:.2f} s CPU ({took:.2f} s wall); sphere at {sphere}; {d.touches} touches, designed "
               f"{d.best.worst_expanded_um:.3f} um ({d.best.worst_error}) / default {default}: ratio {d.ratio:.3f}")
 
 

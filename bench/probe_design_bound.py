@@ -4,7 +4,8 @@ reach 0.7 of the default poses there), from the reference simulator alone
 (tests/python/probe_bound.py): for each candidate set (pose grid, sphere position, touch
 directions shared by every pose or chosen touch by touch) the value a continuous design reaches
 and the certified bound no design of 120 touches can beat, against the default poses at the
-default sphere (0.5 um per touch), and on the 15 / 30 deg grid the continuous design rounded
+default sphere (0.5 um per touch; the candidate directions of `rotacal design probe`, contact
+points within 80 deg of the stylus axis, as a third set), and on the 15 / 30 deg grid the continuous design rounded
 to 120 touches (whole pose visits, or single touches when each has its own direction).
 
     python bench/probe_design_bound.py            # ~15 min on the loaded 2-core machine
@@ -42,9 +43,17 @@ def main() -> None:
         for sphere in spheres if tilt_step == 15.0 else [SPHERE]:
             G, _ = pb.sensitivities(m, pb.grid(m, tilt_step, rot_step, limit), sphere)
             where = f"tilt +-{limit:g} every {tilt_step:g}, rotary every {rot_step:g} ({len(G)})"
-            for label, dirs in (("default 5, every pose", refposes.probe_directions()), ("any, touch by touch", None)):
-                up, low, w = pb.minimax_bound(G, names, 120, dirs)
-                whole = f"{pb.rounded_u_um(G, names, 120, w, dirs) / u0:.3f}" if len(G) < 200 else ""
+            contact = [pb.contact_directions(m, t, r) for t, r in pb.grid(m, tilt_step, rot_step, limit)]
+            for label, dirs in (("default 5, every pose", refposes.probe_directions()), ("any, touch by touch", None),
+                                ("contact within 80 deg of the stylus, touch by touch", "contact")):
+                if isinstance(dirs, str) and len(G) > 200:
+                    continue  # the design's grid only (27,000 candidate touches on the fine one)
+                if isinstance(dirs, str):  # the design's candidate directions (rounded: rotacal design probe)
+                    up, low, w = pb.minimax_bound(G, names, 120, iterations=60, touch_directions=contact)
+                    whole = ""
+                else:
+                    up, low, w = pb.minimax_bound(G, names, 120, dirs)
+                    whole = f"{pb.rounded_u_um(G, names, 120, w, dirs) / u0:.3f}" if len(G) < 200 else ""
                 print(f"| {where} | {sphere} | {label} | {up:.4f} | {low:.4f} | {low / u0:.3f} | {whole} |",
                       flush=True)
 

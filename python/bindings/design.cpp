@@ -281,11 +281,33 @@ void bind_probe_design(pyb::module_& m) {
       .def_readwrite("tilt_step_deg", &ProbeDesignOptions::tilt_step_deg)
       .def_readwrite("rot_step_deg", &ProbeDesignOptions::rot_step_deg)
       .def_readwrite("noise_um", &ProbeDesignOptions::noise_um)
-      .def_readwrite("reference_radius_mm", &ProbeDesignOptions::reference_radius_mm);
+      .def_readwrite("reference_radius_mm", &ProbeDesignOptions::reference_radius_mm)
+      .def_readwrite("touch_directions", &ProbeDesignOptions::touch_directions, "each touch its own direction")
+      .def_readwrite("max_contact_angle_deg", &ProbeDesignOptions::max_contact_angle_deg)
+      .def_readwrite("contact_step_deg", &ProbeDesignOptions::contact_step_deg)
+      .def_property(
+          "sphere_candidates", [](const ProbeDesignOptions& o) { return rows_from(o.sphere_candidates); },
+          [](ProbeDesignOptions& o, const Array& a) { o.sphere_candidates = vectors_of(a, "sphere_candidates"); },
+          "other places of the sphere (S, 3), table frame, mm")
+      .def_readwrite("sphere_gain", &ProbeDesignOptions::sphere_gain);
+  pyb::class_<ProbeSphereTrial>(m, "ProbeSphereTrial", "One place of the sphere the design tried.")
+      .def_readonly("sphere", &ProbeSphereTrial::sphere)
+      .def_readonly("plannable", &ProbeSphereTrial::plannable)
+      .def_readonly("worst_expanded_um", &ProbeSphereTrial::worst_expanded_um)
+      .def_readonly("why_not", &ProbeSphereTrial::why_not);
   pyb::class_<ProbeDesignCandidate>(m, "ProbeDesignCandidate", "Poses and touches, evaluated.")
       .def_property_readonly("poses_deg", [](const ProbeDesignCandidate& c) { return poses_of(c.pattern); },
                              "pose visits (P, 2): tilt, rotary, deg, in program order")
       .def_property_readonly("directions", [](const ProbeDesignCandidate& c) { return rows_from(c.pattern.directions); })
+      .def_property_readonly(
+          "pose_directions",
+          [](const ProbeDesignCandidate& c) {
+            std::vector<Rows3> out;
+            for (const auto& d : c.pattern.pose_directions) out.push_back(rows_from(d));
+            return out;
+          },
+          "each pose's own directions (K_i, 3); empty: `directions` at every pose")
+      .def_property_readonly("sphere", [](const ProbeDesignCandidate& c) { return Eigen::Vector3d(c.pattern.sphere); })
       .def_readonly("feasible", &ProbeDesignCandidate::feasible)
       .def_readonly("why_not", &ProbeDesignCandidate::why_not)
       .def_readonly("touches", &ProbeDesignCandidate::touches)
@@ -300,7 +322,10 @@ void bind_probe_design(pyb::module_& m) {
       .def_readonly("touches", &ProbeDesign::touches)
       .def_readonly("ratio", &ProbeDesign::ratio)
       .def_readonly("poses_tried", &ProbeDesign::poses_tried)
-      .def_readonly("refused", &ProbeDesign::refused);
+      .def_readonly("touches_tried", &ProbeDesign::touches_tried)
+      .def_readonly("refused", &ProbeDesign::refused)
+      .def_readonly("sphere", &ProbeDesign::sphere)
+      .def_readonly("spheres", &ProbeDesign::spheres);
   m.def(
       "design_probe_test",
       [](const ProbeDesignOptions& o) {

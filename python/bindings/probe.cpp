@@ -185,9 +185,11 @@ void bind_probe_program(pyb::module_& m) {
       "write_probe_nc_program",
       [](MachineType machine, const std::string& dialect, std::optional<Array> poses_deg, const Array& sphere,
          double sphere_diameter, double stylus_diameter, const std::string& log_file, int tool, int decimals,
-         double approach_mm, double probe_feed, double positioning_feed) {
+         double approach_mm, double probe_feed, double positioning_feed,
+         const std::vector<Array>& pose_directions) {
         ProbePattern p = default_probe_pattern(machine);
         if (poses_deg) p.poses_deg = angles_of(*poses_deg);
+        for (const Array& d : pose_directions) p.pose_directions.push_back(vectors_of(d, "pose_directions"));
         p.sphere = vec_of<3>(sphere, "sphere");
         p.sphere_diameter = sphere_diameter;
         p.stylus_diameter = stylus_diameter;
@@ -206,7 +208,9 @@ void bind_probe_program(pyb::module_& m) {
       pyb::arg("tool") = 1, pyb::arg("decimals") = 4, pyb::arg("approach_mm") = ProbeProgramOptions().approach_mm,
       pyb::arg("probe_feed") = ProbeProgramOptions().probe_feed_mm_per_min,
       pyb::arg("positioning_feed") = ProbeProgramOptions().feed_mm_per_min,
-      "The probing program of the default pattern's directions at `poses_deg` (default: its poses) "
+      pyb::arg("pose_directions") = std::vector<Array>{},
+      "The probing program of the default pattern's directions (or each pose's `pose_directions`, (K_i, 3)) "
+      "at `poses_deg` (default: its poses) "
       "(probe/nc_program.hpp); linuxcnc only. approach_mm: the G38.2 starts this far outside the trigger "
       "sphere; probe_feed: its feed, positioning_feed: the G1 moves' to and from its start, mm/min.");
   m.def("read_linuxcnc_probe_log", &read_linuxcnc_probe_log, pyb::arg("path"), pyb::arg("plan"),
@@ -226,7 +230,7 @@ void bind_probe_program(pyb::module_& m) {
       [](MachineType machine, const Array& errors, const std::vector<std::string>& effects,
          const std::vector<double>& effect_params, const Array& sphere_offset, double noise_um, double ar1_rho,
          std::uint64_t seed, std::optional<Array> poses_deg, std::optional<Array> directions, const Array& sphere,
-         double sphere_diameter, double stylus_diameter) {
+         double sphere_diameter, double stylus_diameter, const std::vector<Array>& pose_directions) {
         MachineModel t;
         t.machine = machine;
         t.errors = LocationErrors<double>(vec_of<8>(errors, "errors"));
@@ -236,6 +240,7 @@ void bind_probe_program(pyb::module_& m) {
         o.pattern = default_probe_pattern(machine);
         if (poses_deg) o.pattern.poses_deg = angles_of(*poses_deg);
         if (directions) o.pattern.directions = vectors_of(*directions, "directions");
+        for (const Array& d : pose_directions) o.pattern.pose_directions.push_back(vectors_of(d, "pose_directions"));
         o.pattern.sphere = vec_of<3>(sphere, "sphere");
         o.pattern.sphere_diameter = sphere_diameter;
         o.pattern.stylus_diameter = stylus_diameter;
@@ -252,6 +257,7 @@ void bind_probe_program(pyb::module_& m) {
       pyb::arg("noise_um") = 0.5, pyb::arg("ar1_rho") = 0.0, pyb::arg("seed") = 1, pyb::arg("poses_deg") = pyb::none(),
       pyb::arg("directions") = pyb::none(), pyb::arg("sphere") = Eigen::Vector3d(150.0, 0.0, 80.0).eval(),
       pyb::arg("sphere_diameter") = 25.0, pyb::arg("stylus_diameter") = 6.0,
+      pyb::arg("pose_directions") = std::vector<Array>{},
       "Simulate a touch-probe session (probe/simulate.hpp): (session, actual sphere centre). Poses default "
       "to default_probe_pattern's.");
 }

@@ -6,7 +6,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Alternative', 'Ambiguity', 'AngleTable', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CircularAnalysis', 'CircularDiagnosis', 'CircularDiagnosisOptions', 'CircularDirection', 'CircularEffect', 'CircularFinding', 'CircularPairResult', 'CircularPlanResult', 'CircularPlane', 'CircularRun', 'CircularRunResult', 'CircularSimulationOptions', 'CircularTestPlan', 'CompensationReport', 'CompensationRow', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LinearAxisErrors', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'MultiDisagreement', 'MultiIdentification', 'MultiSessionResult', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'ProbeDesign', 'ProbeDesignCandidate', 'ProbeDesignOptions', 'ProbeIdentification', 'ProbeMonteCarlo', 'ProbeSeparatingCandidate', 'ProbeSeparationDesign', 'ProbeSeparationOptions', 'ProbeSession', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestDesign', 'RtestDesignCandidate', 'RtestDesignOptions', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSeparatingCandidate', 'RtestSeparationDesign', 'RtestSeparationOptions', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SeparatingCandidate', 'SeparationDesign', 'SeparationOptions', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'SweepDirection', 'TableMotionOverlap', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualCircularBallbar', 'VirtualRtest', 'analyze_circular', 'ballbar_model_document', 'ballbar_model_from_document', 'box_least_squares', 'builtin_machine_names', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_json_bounds', 'check_model_machine', 'check_output', 'check_plausible', 'check_rtest_pattern', 'circular_catalogue', 'circular_commanded_session', 'circular_label', 'comment_lines', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_axial_c_tilt_deg', 'default_ballbar_tests', 'default_calibration_moves', 'default_probe_poses_deg', 'default_rtest_pattern', 'default_tilt_range_deg', 'design_ballbar_separation', 'design_ballbar_test', 'design_probe_separation', 'design_probe_test', 'design_rtest_separation', 'design_rtest_test', 'diagnose_ballbar', 'diagnose_circular', 'diagnose_probe', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'evaluate_rtest_design', 'export_controller', 'format_ballbar', 'format_model_document', 'format_probe', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_joint_sessions', 'identify_multi', 'identify_paper', 'identify_probe', 'identify_probe_cycles', 'identify_rtest_joint', 'identify_rtest_paper', 'is_rotary_test', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_probe', 'monte_carlo_rtest', 'multi_model_document', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_circular_direction', 'parse_circular_plane', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'parse_sweep_direction', 'plan_ballbar_test', 'plan_circular_test', 'predict_rtest_session', 'predict_session_lengths', 'probe_effect_catalogue', 'probe_model_document', 'read_ballbar', 'read_instrument_session', 'read_linuxcnc_probe_log', 'read_model_document', 'read_probe', 'read_rtest', 'read_session', 'record_ballbar', 'record_circular_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_joint_model_document', 'rtest_map_names', 'rtest_prediction_rms_um', 'rtest_readings', 'run_label', 'simulate_ballbar', 'simulate_circular', 'simulate_probe', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'table_motion_overlap', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_probe', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_circular_nc_program', 'write_model_document', 'write_nc_program', 'write_output', 'write_probe', 'write_probe_nc_program', 'write_rtest']
+__all__: list[str] = ['Alternative', 'Ambiguity', 'AngleTable', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CircularAnalysis', 'CircularDiagnosis', 'CircularDiagnosisOptions', 'CircularDirection', 'CircularEffect', 'CircularFinding', 'CircularPairResult', 'CircularPlanResult', 'CircularPlane', 'CircularRun', 'CircularRunResult', 'CircularSimulationOptions', 'CircularTestPlan', 'CompensationReport', 'CompensationRow', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LinearAxisErrors', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'MultiDisagreement', 'MultiIdentification', 'MultiSessionResult', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'ProbeDesign', 'ProbeDesignCandidate', 'ProbeDesignOptions', 'ProbeIdentification', 'ProbeMonteCarlo', 'ProbeSeparatingCandidate', 'ProbeSeparationDesign', 'ProbeSeparationOptions', 'ProbeSession', 'ProbeSphereTrial', 'RadialSide', 'RecordSummary', 'RtestBasis', 'RtestDesign', 'RtestDesignCandidate', 'RtestDesignOptions', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSeparatingCandidate', 'RtestSeparationDesign', 'RtestSeparationOptions', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SeparatingCandidate', 'SeparationDesign', 'SeparationOptions', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'SweepDirection', 'TableMotionOverlap', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualCircularBallbar', 'VirtualRtest', 'analyze_circular', 'ballbar_model_document', 'ballbar_model_from_document', 'box_least_squares', 'builtin_machine_names', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_json_bounds', 'check_model_machine', 'check_output', 'check_plausible', 'check_rtest_pattern', 'circular_catalogue', 'circular_commanded_session', 'circular_label', 'comment_lines', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_axial_c_tilt_deg', 'default_ballbar_tests', 'default_calibration_moves', 'default_probe_poses_deg', 'default_rtest_pattern', 'default_tilt_range_deg', 'design_ballbar_separation', 'design_ballbar_test', 'design_probe_separation', 'design_probe_test', 'design_rtest_separation', 'design_rtest_test', 'diagnose_ballbar', 'diagnose_circular', 'diagnose_probe', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'evaluate_rtest_design', 'export_controller', 'format_ballbar', 'format_model_document', 'format_probe', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_joint_sessions', 'identify_multi', 'identify_paper', 'identify_probe', 'identify_probe_cycles', 'identify_rtest_joint', 'identify_rtest_paper', 'is_rotary_test', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_probe', 'monte_carlo_rtest', 'multi_model_document', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_circular_direction', 'parse_circular_plane', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'parse_sweep_direction', 'plan_ballbar_test', 'plan_circular_test', 'predict_rtest_session', 'predict_session_lengths', 'probe_effect_catalogue', 'probe_model_document', 'read_ballbar', 'read_instrument_session', 'read_linuxcnc_probe_log', 'read_model_document', 'read_probe', 'read_rtest', 'read_session', 'record_ballbar', 'record_circular_ballbar', 'record_rtest', 'rtest_error_map', 'rtest_joint_model_document', 'rtest_map_names', 'rtest_prediction_rms_um', 'rtest_readings', 'run_label', 'simulate_ballbar', 'simulate_circular', 'simulate_probe', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'table_motion_overlap', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_probe', 'uncertainty_budget_rtest', 'verify_compensation', 'write_ballbar', 'write_circular_nc_program', 'write_model_document', 'write_nc_program', 'write_output', 'write_probe', 'write_probe_nc_program', 'write_rtest']
 class Alternative:
     @property
     def aliased(self) -> bool:
@@ -2236,7 +2236,16 @@ class ProbeDesign:
     def refused(self) -> list[str]:
         ...
     @property
+    def sphere(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @property
+    def spheres(self) -> list[ProbeSphereTrial]:
+        ...
+    @property
     def touches(self) -> int:
+        ...
+    @property
+    def touches_tried(self) -> int:
         ...
 class ProbeDesignCandidate:
     """
@@ -2252,6 +2261,11 @@ class ProbeDesignCandidate:
     def names(self) -> list[str]:
         ...
     @property
+    def pose_directions(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]]:
+        """
+        each pose's own directions (K_i, 3); empty: `directions` at every pose
+        """
+    @property
     def poses_deg(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 2]"]:
         """
         pose visits (P, 2): tilt, rotary, deg, in program order
@@ -2261,6 +2275,9 @@ class ProbeDesignCandidate:
         """
         predicted 1 sigma (mm, rad); inf: held
         """
+    @property
+    def sphere(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
     @property
     def touches(self) -> int:
         ...
@@ -2284,12 +2301,24 @@ class ProbeDesignOptions:
     def __init__(self) -> None:
         ...
     @property
+    def contact_step_deg(self) -> float:
+        ...
+    @contact_step_deg.setter
+    def contact_step_deg(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
     def directions(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
         """
         approach directions (K, 3), machine frame; empty: the default pattern's
         """
     @directions.setter
     def directions(self, arg1: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> None:
+        ...
+    @property
+    def max_contact_angle_deg(self) -> float:
+        ...
+    @max_contact_angle_deg.setter
+    def max_contact_angle_deg(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
         ...
     @property
     def noise_um(self) -> float:
@@ -2318,10 +2347,24 @@ class ProbeDesignOptions:
     def sphere(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
         ...
     @property
+    def sphere_candidates(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
+        """
+        other places of the sphere (S, 3), table frame, mm
+        """
+    @sphere_candidates.setter
+    def sphere_candidates(self, arg1: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> None:
+        ...
+    @property
     def sphere_diameter(self) -> float:
         ...
     @sphere_diameter.setter
     def sphere_diameter(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def sphere_gain(self) -> float:
+        ...
+    @sphere_gain.setter
+    def sphere_gain(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
         ...
     @property
     def stylus_diameter(self) -> float:
@@ -2334,6 +2377,14 @@ class ProbeDesignOptions:
         ...
     @tilt_step_deg.setter
     def tilt_step_deg(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def touch_directions(self) -> bool:
+        """
+        each touch its own direction
+        """
+    @touch_directions.setter
+    def touch_directions(self, arg0: bool) -> None:
         ...
     @property
     def touches(self) -> int:
@@ -2610,6 +2661,22 @@ class ProbeSession:
         """
         latched X, Y, Z (N, 3), mm
         """
+class ProbeSphereTrial:
+    """
+    One place of the sphere the design tried.
+    """
+    @property
+    def plannable(self) -> bool:
+        ...
+    @property
+    def sphere(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @property
+    def why_not(self) -> str:
+        ...
+    @property
+    def worst_expanded_um(self) -> float:
+        ...
 class RadialSide:
     """
     Flynn's +-L0 of the radial C test.
@@ -4134,7 +4201,7 @@ def simulate_circular(plan: CircularPlanResult, options: CircularSimulationOptio
     """
     The session a ballbar records on a machine with linear-axis errors.
     """
-def simulate_probe(machine: MachineType, errors: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], effects: collections.abc.Sequence[str] = [], effect_params: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] = [], sphere_offset: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] = ..., noise_um: typing.SupportsFloat | typing.SupportsIndex = 0.5, ar1_rho: typing.SupportsFloat | typing.SupportsIndex = 0.0, seed: typing.SupportsInt | typing.SupportsIndex = 1, poses_deg: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] | None = None, directions: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] | None = None, sphere: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] = ..., sphere_diameter: typing.SupportsFloat | typing.SupportsIndex = 25.0, stylus_diameter: typing.SupportsFloat | typing.SupportsIndex = 6.0) -> tuple[ProbeSession, typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]]:
+def simulate_probe(machine: MachineType, errors: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], effects: collections.abc.Sequence[str] = [], effect_params: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] = [], sphere_offset: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] = ..., noise_um: typing.SupportsFloat | typing.SupportsIndex = 0.5, ar1_rho: typing.SupportsFloat | typing.SupportsIndex = 0.0, seed: typing.SupportsInt | typing.SupportsIndex = 1, poses_deg: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] | None = None, directions: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] | None = None, sphere: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] = ..., sphere_diameter: typing.SupportsFloat | typing.SupportsIndex = 25.0, stylus_diameter: typing.SupportsFloat | typing.SupportsIndex = 6.0, pose_directions: collections.abc.Sequence[typing.Annotated[numpy.typing.ArrayLike, numpy.float64]] = []) -> tuple[ProbeSession, typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]]:
     """
     Simulate a touch-probe session (probe/simulate.hpp): (session, actual sphere centre). Poses default to default_probe_pattern's.
     """
@@ -4220,9 +4287,9 @@ def write_output(path: str, data: bytes, inputs: collections.abc.Sequence[str] =
     """
 def write_probe(session: ProbeSession, path: str) -> None:
     ...
-def write_probe_nc_program(machine: MachineType, dialect: str, poses_deg: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] | None = None, sphere: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] = ..., sphere_diameter: typing.SupportsFloat | typing.SupportsIndex = 25.0, stylus_diameter: typing.SupportsFloat | typing.SupportsIndex = 6.0, log_file: str = 'rotacal_probe.log', tool: typing.SupportsInt | typing.SupportsIndex = 1, decimals: typing.SupportsInt | typing.SupportsIndex = 4, approach_mm: typing.SupportsFloat | typing.SupportsIndex = 5.0, probe_feed: typing.SupportsFloat | typing.SupportsIndex = 50.0, positioning_feed: typing.SupportsFloat | typing.SupportsIndex = 1000.0) -> str:
+def write_probe_nc_program(machine: MachineType, dialect: str, poses_deg: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] | None = None, sphere: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] = ..., sphere_diameter: typing.SupportsFloat | typing.SupportsIndex = 25.0, stylus_diameter: typing.SupportsFloat | typing.SupportsIndex = 6.0, log_file: str = 'rotacal_probe.log', tool: typing.SupportsInt | typing.SupportsIndex = 1, decimals: typing.SupportsInt | typing.SupportsIndex = 4, approach_mm: typing.SupportsFloat | typing.SupportsIndex = 5.0, probe_feed: typing.SupportsFloat | typing.SupportsIndex = 50.0, positioning_feed: typing.SupportsFloat | typing.SupportsIndex = 1000.0, pose_directions: collections.abc.Sequence[typing.Annotated[numpy.typing.ArrayLike, numpy.float64]] = []) -> str:
     """
-    The probing program of the default pattern's directions at `poses_deg` (default: its poses) (probe/nc_program.hpp); linuxcnc only. approach_mm: the G38.2 starts this far outside the trigger sphere; probe_feed: its feed, positioning_feed: the G1 moves' to and from its start, mm/min.
+    The probing program of the default pattern's directions (or each pose's `pose_directions`, (K_i, 3)) at `poses_deg` (default: its poses) (probe/nc_program.hpp); linuxcnc only. approach_mm: the G38.2 starts this far outside the trigger sphere; probe_feed: its feed, positioning_feed: the G1 moves' to and from its start, mm/min.
     """
 def write_rtest(session: RtestSession, path: str) -> None:
     ...

@@ -254,14 +254,26 @@ def rtest_separation_dict(d: Any) -> dict:
 
 # ------------------------------------------------------------------------- touch probe
 
+# Where the engineer may place the sphere on the table instead of plan probe's (150, 0, 80), table
+# frame, mm: farther out on the rotary table (a longer lever for its orientation errors) and
+# lower (docs/design.md, "Touch probe"); `design probe` takes one when the design there pays.
+# Along +X only: the rotary table turns a place along +Y into one along +X (the same poses a
+# quarter turn apart), so those would repeat them.
+SPHERE_CANDIDATES = ((250.0, 0.0, 80.0), (300.0, 0.0, 40.0))
+
+
 def design_probe(machine: Any, *, sphere: Sequence[float] = (150.0, 0.0, 80.0), sphere_diameter: float = 25.0,
                  stylus_diameter: float = 6.0, touches: int = 0, tilt_step: float = 15.0, rot_step: float = 30.0,
-                 noise_um: float = 0.5) -> Any:
-    """A ``_core.ProbeDesign``: the rotary poses (visits, in program order; ``.best.poses_deg``)
-    whose touches along the default directions give the smallest largest expanded uncertainty
+                 noise_um: float = 0.5, touch_directions: bool = True, max_contact_angle: float = 80.0,
+                 sphere_candidates: Any = SPHERE_CANDIDATES, sphere_gain: float = 0.05) -> Any:
+    """A ``_core.ProbeDesign``: the rotary poses (in program order; ``.best.poses_deg``) and each
+    touch's approach direction (``.best.pose_directions``; with ``touch_directions=False`` every
+    visit along the default directions) that give the smallest largest expanded uncertainty
     (k = 2) of the location errors at ``touches`` touches (0: the default poses'), within the
-    machine's axis limits, against ``plan probe``'s default poses at the same number of touches
-    (``.baseline``, ``.ratio``). C++: ``rotacal/probe/design.hpp``."""
+    machine's axis limits, with the sphere at ``sphere`` or, when that lowers it by
+    ``sphere_gain``, at one of ``sphere_candidates`` (``.sphere``); against ``plan probe``'s default
+    poses at ``sphere`` and the same number of touches (``.baseline``, ``.ratio``). C++:
+    ``rotacal/probe/design.hpp``."""
     o = _core.ProbeDesignOptions()
     o.machine = machine
     o.sphere = np.asarray(sphere, dtype=float)
@@ -271,6 +283,10 @@ def design_probe(machine: Any, *, sphere: Sequence[float] = (150.0, 0.0, 80.0), 
     o.tilt_step_deg = float(tilt_step)
     o.rot_step_deg = float(rot_step)
     o.noise_um = float(noise_um)
+    o.touch_directions = bool(touch_directions)
+    o.max_contact_angle_deg = float(max_contact_angle)
+    o.sphere_candidates = np.asarray(sphere_candidates, dtype=float).reshape(-1, 3)
+    o.sphere_gain = float(sphere_gain)
     return _core.design_probe_test(o)
 
 
@@ -282,7 +298,9 @@ def poses_text(poses_deg: Any) -> str:
 def probe_candidate_dict(c: Any) -> dict:
     """One evaluated set of probe poses as JSON."""
     out = {"poses_deg": np.asarray(c.poses_deg).tolist(), "directions": np.asarray(c.directions).tolist(),
-           "feasible": c.feasible, "touches": c.touches, "undetermined": list(c.undetermined)}
+           "pose_directions": [np.asarray(d).tolist() for d in c.pose_directions],
+           "sphere": np.asarray(c.sphere).tolist(), "feasible": c.feasible, "touches": c.touches,
+           "undetermined": list(c.undetermined)}
     if not c.feasible:
         return out | {"why_not": c.why_not}
     return out | {"predicted_std": {n: (float(s) if np.isfinite(s) else None) for n, s in zip(c.names, c.sigma)},
@@ -293,6 +311,10 @@ def probe_candidate_dict(c: Any) -> dict:
 def probe_design_dict(d: Any) -> dict:
     """The JSON of ``rotacal design probe --json``."""
     return {"touches": d.touches, "ratio_to_default": d.ratio, "poses_tried": d.poses_tried,
+            "touches_tried": d.touches_tried, "sphere": np.asarray(d.sphere).tolist(),
+            "spheres_tried": [{"sphere": np.asarray(t.sphere).tolist(), "plannable": t.plannable,
+                               **({"worst_expanded_um": t.worst_expanded_um} if t.plannable
+                                  else {"why_not": t.why_not})} for t in d.spheres],
             "best": probe_candidate_dict(d.best), "default": probe_candidate_dict(d.baseline),
             "refused_poses": list(d.refused)}
 

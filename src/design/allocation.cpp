@@ -2,6 +2,7 @@
 #include "rotacal/design/allocation.hpp"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -31,6 +32,21 @@ struct Reduced {
     out = s.asDiagonal() * llt.solve(Eigen::MatrixXd::Identity(M.rows(), M.cols())) * s.asDiagonal();
     return true;
   }
+  // The derivative d_k of the smooth maximum (sum_j v_j^64)^(1/64) along each candidate at M:
+  // how much one more run of it lowers the smooth maximum; empty when M is singular.
+  Eigen::VectorXd derivative(const Eigen::MatrixXd& M) const {
+    Eigen::MatrixXd inv;
+    if (!inverse(M, inv)) return {};
+    double vmax = 0.0;
+    for (std::size_t t = 0; t < target.size(); ++t) vmax = std::max(vmax, scale2[t] * inv(target[t], target[t]));
+    Eigen::VectorXd L = Eigen::VectorXd::Zero(M.rows());
+    for (std::size_t t = 0; t < target.size(); ++t)
+      L[target[t]] = scale2[t] * std::pow(scale2[t] * inv(target[t], target[t]) / vmax, 63.0);
+    const Eigen::MatrixXd B = inv * L.asDiagonal() * inv;
+    Eigen::VectorXd d(static_cast<Eigen::Index>(A.size()));
+    for (std::size_t k = 0; k < A.size(); ++k) d[static_cast<Eigen::Index>(k)] = B.cwiseProduct(A[k]).sum();
+    return d;
+  }
   double worst(const Eigen::MatrixXd& M) const {
     Eigen::MatrixXd inv;
     if (!inverse(M, inv)) return std::numeric_limits<double>::infinity();
@@ -40,32 +56,63 @@ struct Reduced {
   }
 };
 
-// The continuous design: weights over the candidates (summing to 1) minimising the smooth
-// maximum of the scaled variances, by the multiplicative algorithm of the file comment.
+// The continuous minimax design: weights w over the candidates (summing to 1) minimising the
+// largest scaled variance v_j = s_j^2 [M(w)^-1]_jj, M(w) = sum w_k A_k, by the file comment's
+// Lagrangian: for weights lam over the target, the lam-weighted A-optimal w by the
+// multiplicative algorithm, then lam moved towards the largest variances; the w with the smallest
+// max v is kept. Each A_k enters as a factor F_k (A_k = F_k F_k^T, its eigenvectors times the
+// square roots of its eigenvalues), so that every derivative is one matrix product:
+// d_k = |W F_k|_F^2, W = L^(1/2) M^-1 restricted to the target rows.
 Eigen::VectorXd continuous_design(const Reduced& R) {
   const std::size_t C = R.A.size();
+  const Eigen::Index q = R.A.front().rows(), T = static_cast<Eigen::Index>(R.target.size());
+  std::vector<Eigen::Index> first(C + 1, 0);
+  std::vector<Eigen::MatrixXd> factors(C);
+  for (std::size_t k = 0; k < C; ++k) {
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(R.A[k]);
+    const Eigen::VectorXd& ev = es.eigenvalues();
+    Eigen::Index r = 0;
+    factors[k].resize(q, q);
+    for (Eigen::Index i = 0; i < q; ++i)
+      if (ev[i] > 1e-12 * std::max(ev.maxCoeff(), 0.0) && ev[i] > 0.0)
+        factors[k].col(r++) = es.eigenvectors().col(i) * std::sqrt(ev[i]);
+    factors[k].conservativeResize(q, r);
+    first[k + 1] = first[k] + r;
+  }
+  Eigen::MatrixXd F(q, first[C]);
+  for (std::size_t k = 0; k < C; ++k) F.middleCols(first[k], first[k + 1] - first[k]) = factors[k];
   Eigen::VectorXd w = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(C), 1.0 / static_cast<double>(C));
-  const Eigen::Index q = R.A.front().rows();
-  for (const double p : {1.0, 4.0, 16.0, 64.0}) {
-    for (int it = 0; it < 150; ++it) {
-      Eigen::MatrixXd M = Eigen::MatrixXd::Zero(q, q), inv;
-      for (std::size_t k = 0; k < C; ++k) M += w[static_cast<Eigen::Index>(k)] * R.A[k];
-      if (!Reduced::inverse(M, inv)) return w;
-      double vmax = 0.0;
-      for (std::size_t t = 0; t < R.target.size(); ++t) vmax = std::max(vmax, R.scale2[t] * inv(R.target[t], R.target[t]));
-      Eigen::VectorXd L = Eigen::VectorXd::Zero(q);
-      for (std::size_t t = 0; t < R.target.size(); ++t)
-        L[R.target[t]] = R.scale2[t] * std::pow(R.scale2[t] * inv(R.target[t], R.target[t]) / vmax, p - 1.0);
-      const Eigen::MatrixXd B = inv * L.asDiagonal() * inv;
-      Eigen::VectorXd d(static_cast<Eigen::Index>(C));
-      for (std::size_t k = 0; k < C; ++k) d[static_cast<Eigen::Index>(k)] = B.cwiseProduct(R.A[k]).sum();
+  Eigen::VectorXd lam = Eigen::VectorXd::Constant(T, 1.0 / static_cast<double>(T)), best_w = w;
+  double best = std::numeric_limits<double>::infinity();
+  Eigen::VectorXd root(first[C]), d(static_cast<Eigen::Index>(C)), v(T);
+  Eigen::MatrixXd inv, W(T, q);
+  const auto target = [&](Eigen::Index t) { return R.target[static_cast<std::size_t>(t)]; };
+  const auto scale2 = [&](Eigen::Index t) { return R.scale2[static_cast<std::size_t>(t)]; };
+  const auto information = [&]() {
+    for (std::size_t k = 0; k < C; ++k)
+      root.segment(first[k], first[k + 1] - first[k]).setConstant(std::sqrt(w[static_cast<Eigen::Index>(k)]));
+    const Eigen::MatrixXd Fw = F * root.asDiagonal();
+    return Reduced::inverse(Fw * Fw.transpose(), inv);
+  };
+  for (int outer = 0; outer < 40; ++outer) {
+    for (int it = 0; it < 10; ++it) {
+      if (!information()) return best < std::numeric_limits<double>::infinity() ? best_w : w;
+      for (Eigen::Index t = 0; t < T; ++t) W.row(t) = inv.row(target(t)) * std::sqrt(lam[t] * scale2(t));
+      const Eigen::RowVectorXd col = (W * F).colwise().squaredNorm();
+      for (std::size_t k = 0; k < C; ++k)
+        d[static_cast<Eigen::Index>(k)] = col.segment(first[k], first[k + 1] - first[k]).sum();
       const double mean = w.dot(d);
       if (!(mean > 0.0)) return w;
       w = w.cwiseProduct((d / mean).cwiseMax(0.0).cwiseSqrt());
       w /= w.sum();
     }
+    if (!information()) break;
+    for (Eigen::Index t = 0; t < T; ++t) v[t] = scale2(t) * inv(target(t), target(t));
+    if (v.maxCoeff() < best) best = v.maxCoeff(), best_w = w;
+    lam = lam.cwiseProduct((2.0 * (v / v.maxCoeff()).array() - 2.0).exp().matrix());
+    lam /= lam.sum();
   }
-  return w;
+  return best_w;
 }
 
 // Pukelsheim and Rieder's efficient rounding of weights w to n runs.
@@ -161,16 +208,31 @@ Allocation allocate_runs(const AllocationProblem& P) {
   out.uncertainty = judge(out.counts, out.inverted);
 
   // Exchange: the move of one run from a candidate in use to another that the screening on F
-  // finds best, kept while the engine's largest expanded uncertainty decreases.
+  // finds best, kept while the engine's largest expanded uncertainty decreases. Among more than
+  // kMany candidates only the kReceivers with the largest derivative of the criterion are tried
+  // as the receiving one (the others lower it less to first order): the touch probe's single
+  // touches are thousands, and every pair would cost seconds per move.
+  constexpr std::size_t kMany = 400, kReceivers = 16;
   Eigen::MatrixXd M = information(out.counts)(F, F);
   for (int move = 0; move < 4 * P.runs; ++move) {
     const double now = R.worst(M);
     double best = now;
     std::size_t from = C, to = C;
+    std::vector<std::size_t> receivers(C);
+    std::iota(receivers.begin(), receivers.end(), std::size_t{0});
+    if (C > kMany) {
+      const Eigen::VectorXd d = R.derivative(M);
+      if (d.size() == 0) break;
+      const auto larger = [&](std::size_t a, std::size_t b) {
+        return d[static_cast<Eigen::Index>(a)] > d[static_cast<Eigen::Index>(b)];
+      };
+      std::partial_sort(receivers.begin(), receivers.begin() + kReceivers, receivers.end(), larger);
+      receivers.resize(kReceivers);
+    }
     for (std::size_t a = 0; a < C; ++a) {
       if (!out.counts[a]) continue;
       const Eigen::MatrixXd Ma = M - R.A[a];
-      for (std::size_t b = 0; b < C; ++b) {
+      for (std::size_t b : receivers) {
         if (b == a) continue;
         const double v = R.worst(Ma + R.A[b]);
         if (v < best) best = v, from = a, to = b;

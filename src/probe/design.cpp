@@ -28,11 +28,15 @@ ProbePattern base_pattern(const ProbeDesignOptions& o) {
   return P;
 }
 
-// The candidate poses, the information of one visit of each (fit units, 1 / mm^2 weights),
-// and what they determine together.
+// The candidates at one place of the sphere: a plannable grid pose with the directions of one
+// run (touch by touch: one direction; else the pattern's), the information of one run (fit
+// units, 1 / mm^2 weights), and what they determine together.
 struct Candidates {
   ProbeParameterLayout layout;
-  std::vector<RotaryAngles<double>> poses;
+  Eigen::Vector3d sphere;
+  std::vector<RotaryAngles<double>> poses;          // the plannable poses
+  std::vector<std::size_t> pose_of;                 // per candidate
+  std::vector<std::vector<Eigen::Vector3d>> dirs;   // per candidate: its touches' directions
   std::vector<Eigen::MatrixXd> info;
   std::vector<std::string> refused;
   Eigen::VectorXd plausible, scale;  // per parameter; per location error (um of 2 sigma per mm or rad)
@@ -44,22 +48,64 @@ Eigen::MatrixXd touch_jacobian(const ProbeDesignOptions& o, const ProbePattern& 
   return probe_design::start_jacobian(probe_design::nominal_touches(o.machine, P), EffectModel{});
 }
 
-Candidates candidates(const ProbeDesignOptions& o) {
+// Touch by touch: each grid pose's contact directions that probe_moves accepts one by one.
+void touch_candidates(const ProbeDesignOptions& o, const ProbePattern& base, Candidates& c) {
+  for (const RotaryAngles<double>& pose : probe_design::pose_grid(o.machine, o.tilt_step_deg, o.rot_step_deg)) {
+    ProbePattern one = base;
+    one.poses_deg = {pose};
+    std::string why;
+    bool any = false;
+    for (const Eigen::Vector3d& n : probe_design::contact_directions(o.machine, pose, o.max_contact_angle_deg,
+                                                                      o.contact_step_deg)) {
+      one.directions = {n};
+      try {
+        probe_moves(o.machine, one, o.program);
+      } catch (const InvalidArgument& e) {
+        why = e.what();
+        continue;
+      }
+      if (!any) c.poses.push_back(pose), any = true;
+      c.pose_of.push_back(c.poses.size() - 1);
+      c.dirs.push_back({n});
+    }
+    if (!any)
+      c.refused.push_back("tilt " + fixed_text(pose.tilt, 1) + ", rotary " + fixed_text(pose.rot, 1) + " deg: " + why);
+  }
+}
+
+Candidates candidates(const ProbeDesignOptions& o, const Eigen::Vector3d& sphere) {
   Candidates c;
+  c.sphere = sphere;
   c.layout = ProbeParameterLayout::make(o.machine, EffectModel{});
   ProbePattern P = base_pattern(o);
-  c.poses = plannable_poses(o.machine, P, o.tilt_step_deg, o.rot_step_deg, o.program, &c.refused);
+  P.sphere = sphere;
+  if (o.touch_directions) {
+    touch_candidates(o, P, c);
+  } else {
+    c.poses = plannable_poses(o.machine, P, o.tilt_step_deg, o.rot_step_deg, o.program, &c.refused);
+    for (std::size_t k = 0; k < c.poses.size(); ++k) c.pose_of.push_back(k), c.dirs.push_back(P.directions);
+  }
   if (c.poses.empty())
     throw InvalidArgument("design probe: no candidate pose can be planned" +
                           (c.refused.empty() ? std::string() : " (" + c.refused.front() + ")"));
+  // One pattern of every candidate's touches: pose k touched along its candidates' directions.
   P.poses_deg = c.poses;
+  P.pose_directions.assign(c.poses.size(), {});
+  for (std::size_t i = 0; i < c.dirs.size(); ++i)
+    for (const Eigen::Vector3d& n : c.dirs[i]) P.pose_directions[c.pose_of[i]].push_back(n);
   const Eigen::MatrixXd J = touch_jacobian(o, P);
-  const Eigen::Index K = static_cast<Eigen::Index>(P.directions.size());
   const double w = 1.0 / (o.noise_um * o.noise_um * 1e-6);
   const Eigen::Index p = c.layout.size();
   Eigen::MatrixXd all = Eigen::MatrixXd::Zero(p, p);
-  for (std::size_t k = 0; k < c.poses.size(); ++k) {
-    const auto rows = J.middleRows(static_cast<Eigen::Index>(k) * K, K);
+  // The rows of J follow the poses, and within a pose its candidates in order.
+  std::vector<Eigen::Index> first(c.poses.size() + 1, 0);
+  for (std::size_t k = 0; k < c.poses.size(); ++k)
+    first[k + 1] = first[k] + static_cast<Eigen::Index>(P.pose_directions[k].size());
+  std::vector<Eigen::Index> next(first.begin(), first.end() - 1);
+  for (std::size_t i = 0; i < c.dirs.size(); ++i) {
+    const Eigen::Index K = static_cast<Eigen::Index>(c.dirs[i].size());
+    const auto rows = J.middleRows(next[c.pose_of[i]], K);
+    next[c.pose_of[i]] += K;
     c.info.push_back(rows.transpose() * rows * w);
     all += c.info.back();
   }
@@ -111,7 +157,7 @@ ProbeDesignCandidate evaluate(const ProbePattern& P, const ProbeDesignOptions& o
     out.why_not = e.what();
     return out;
   }
-  const int own = static_cast<int>(P.poses_deg.size() * P.directions.size());
+  const int own = static_cast<int>(P.touch_count());
   if (touches <= 0) touches = own;
   const Eigen::MatrixXd J = touch_jacobian(o, P);
   const double w = 1.0 / (o.noise_um * o.noise_um * 1e-6);
@@ -132,68 +178,119 @@ void check(const ProbeDesignOptions& o) {
     throw InvalidArgument("design probe: --sphere-diameter and --stylus-diameter must be > 0 mm");
   for (const Eigen::Vector3d& n : o.directions)
     if (!(n.norm() > 0.0) || !n.allFinite()) throw InvalidArgument("design probe: a zero approach direction");
+  if (!(o.max_contact_angle_deg > 0.0 && o.max_contact_angle_deg <= 90.0))
+    throw InvalidArgument("design probe: --max-contact-angle must be in (0, 90] deg");
+  if (!(o.contact_step_deg > 0.0 && o.contact_step_deg <= 90.0))
+    throw InvalidArgument("design probe: the contact step must be in (0, 90] deg");
+  if (!(o.sphere_gain >= 0.0 && o.sphere_gain < 1.0))
+    throw InvalidArgument("design probe: the sphere gain must be in [0, 1)");
+  for (const Eigen::Vector3d& s : o.sphere_candidates)
+    if (!s.allFinite()) throw InvalidArgument("design probe: --sphere-candidates: a place that is not a number");
 }
 
-// Pose visits in program order: by tilt, the rotary angle back and forth (fewer turns).
-std::vector<RotaryAngles<double>> ordered_visits(const std::vector<RotaryAngles<double>>& poses,
-                                                 const std::vector<int>& counts) {
+// The designed pattern of `counts` runs of the candidates, in program order: by tilt, the rotary
+// angle back and forth (fewer turns). Touch by touch, a pose is visited once along the
+// directions of its chosen touches; else each run is a visit along the pattern's directions.
+ProbePattern designed_pattern(const ProbePattern& base, const Candidates& c, const std::vector<int>& counts,
+                              bool touch_by_touch) {
+  std::vector<std::vector<Eigen::Vector3d>> dirs(c.poses.size());
+  std::vector<int> visits(c.poses.size(), 0);
+  for (std::size_t i = 0; i < counts.size(); ++i)
+    for (int r = 0; r < counts[i]; ++r) {
+      dirs[c.pose_of[i]].insert(dirs[c.pose_of[i]].end(), c.dirs[i].begin(), c.dirs[i].end());
+      visits[c.pose_of[i]] = touch_by_touch ? 1 : visits[c.pose_of[i]] + 1;
+    }
   std::map<double, std::vector<std::size_t>> by_tilt;
-  for (std::size_t k = 0; k < poses.size(); ++k)
-    if (counts[k] > 0) by_tilt[poses[k].tilt].push_back(k);
-  std::vector<RotaryAngles<double>> out;
+  for (std::size_t k = 0; k < c.poses.size(); ++k)
+    if (visits[k] > 0) by_tilt[c.poses[k].tilt].push_back(k);
+  ProbePattern out = base;
+  out.sphere = c.sphere;
+  out.poses_deg.clear();
   bool forward = true;
   for (auto& [tilt, ks] : by_tilt) {
     std::sort(ks.begin(), ks.end(), [&](std::size_t a, std::size_t b) {
-      return forward ? poses[a].rot < poses[b].rot : poses[a].rot > poses[b].rot;
+      return forward ? c.poses[a].rot < c.poses[b].rot : c.poses[a].rot > c.poses[b].rot;
     });
-    for (std::size_t k : ks) out.insert(out.end(), static_cast<std::size_t>(counts[k]), poses[k]);
+    for (std::size_t k : ks) {
+      out.poses_deg.insert(out.poses_deg.end(), static_cast<std::size_t>(visits[k]), c.poses[k]);
+      if (touch_by_touch) out.pose_directions.push_back(dirs[k]);
+    }
     forward = !forward;
   }
   return out;
 }
 
-}  // namespace
-
-ProbeDesignCandidate evaluate_probe_pattern(const ProbePattern& pattern, const ProbeDesignOptions& o, int touches) {
-  check(o);
-  return evaluate(pattern, o, candidates(o), touches);
-}
-
-ProbeDesign design_probe_test(const ProbeDesignOptions& o) {
-  check(o);
-  const Candidates c = candidates(o);
-  ProbeDesign out;
-  out.poses_tried = static_cast<int>(c.poses.size());
-  const std::size_t shown = std::min<std::size_t>(c.refused.size(), 5);
-  out.refused.assign(c.refused.begin(), c.refused.begin() + static_cast<std::ptrdiff_t>(shown));
-  const ProbePattern base = base_pattern(o);
-  const int K = static_cast<int>(base.directions.size());
-  out.touches = o.touches > 0 ? o.touches : static_cast<int>(base.poses_deg.size()) * K;
-  if (out.touches < K || out.touches % K != 0)
-    throw InvalidArgument("design probe: --touches " + std::to_string(out.touches) + " is not a multiple of the " +
-                          std::to_string(K) + " touches of a pose");
-  out.baseline = evaluate(base, o, c, out.touches);
-
+// The design at the sphere of candidates c: the engine's allocation of `touches`, checked as a
+// whole program.
+ProbeDesignCandidate design_at(const ProbeDesignOptions& o, const Candidates& c, int touches, int per_run) {
   AllocationProblem ap;
   ap.candidates = c.info;
-  ap.runs = out.touches / K;
+  ap.runs = touches / per_run;
   ap.target = c.layout.errors;
   ap.scale = c.scale;
   ap.plausible = c.plausible;
   const Allocation a = allocate_runs(ap);
-  ProbePattern best = base;
-  best.poses_deg = ordered_visits(c.poses, a.counts);
+  const ProbePattern best = designed_pattern(base_pattern(o), c, a.counts, o.touch_directions);
   try {
     probe_moves(o.machine, best, o.program);
   } catch (const InvalidArgument& e) {
     throw InvalidArgument(std::string("design probe: the designed poses cannot be planned together: ") + e.what());
   }
   Eigen::MatrixXd I = Eigen::MatrixXd::Zero(c.layout.size(), c.layout.size());
-  for (std::size_t k = 0; k < c.poses.size(); ++k) I += a.counts[k] * c.info[k];
-  out.best = judge(best, I, c, ap.runs * K);
-  if (!out.best.feasible)
-    throw InvalidArgument("design probe: --touches " + std::to_string(out.touches) + " (" +
-                          std::to_string(ap.runs) + " poses): " + out.best.why_not + "; give more touches");
+  for (std::size_t k = 0; k < c.info.size(); ++k) I += a.counts[k] * c.info[k];
+  return judge(best, I, c, ap.runs * per_run);
+}
+
+}  // namespace
+
+ProbeDesignCandidate evaluate_probe_pattern(const ProbePattern& pattern, const ProbeDesignOptions& o, int touches) {
+  check(o);
+  return evaluate(pattern, o, candidates(o, o.sphere), touches);
+}
+
+ProbeDesign design_probe_test(const ProbeDesignOptions& o) {
+  check(o);
+  const Candidates c0 = candidates(o, o.sphere);
+  ProbeDesign out;
+  const ProbePattern base = base_pattern(o);
+  const int K = o.touch_directions ? 1 : static_cast<int>(base.directions.size());
+  out.touches = o.touches > 0 ? o.touches : static_cast<int>(base.touch_count());
+  if (out.touches < K || out.touches % K != 0)
+    throw InvalidArgument("design probe: --touches " + std::to_string(out.touches) + " is not a multiple of the " +
+                          std::to_string(K) + " touches of a pose");
+  out.baseline = evaluate(base, o, c0, out.touches);
+  const auto infeasible = [&](const ProbeDesignCandidate& d) {
+    return InvalidArgument("design probe: --touches " + std::to_string(out.touches) + " (" +
+                           std::to_string(out.touches / K) + (K == 1 ? " touches" : " poses") + "): " + d.why_not +
+                           "; give more touches");
+  };
+  out.best = design_at(o, c0, out.touches, K);
+  if (!out.best.feasible) throw infeasible(out.best);
+  const Candidates* chosen = &c0;
+  out.spheres.push_back({o.sphere, true, out.best.worst_expanded_um, ""});
+  // The other places of the sphere: the best taken when it pays by sphere_gain.
+  Candidates moved;
+  for (const Eigen::Vector3d& s : o.sphere_candidates) {
+    ProbeSphereTrial t{s, false, 0.0, ""};
+    try {
+      Candidates c = candidates(o, s);
+      const ProbeDesignCandidate d = design_at(o, c, out.touches, K);
+      if (!d.feasible) throw infeasible(d);
+      t.plannable = true;
+      t.worst_expanded_um = d.worst_expanded_um;
+      const double now = chosen == &c0 ? (1.0 - o.sphere_gain) * out.best.worst_expanded_um
+                                       : out.best.worst_expanded_um;
+      if (d.worst_expanded_um < now) out.best = d, moved = std::move(c), chosen = &moved;
+    } catch (const InvalidArgument& e) {
+      t.why_not = e.what();
+    }
+    out.spheres.push_back(t);
+  }
+  out.sphere = chosen->sphere;
+  out.poses_tried = static_cast<int>(chosen->poses.size());
+  out.touches_tried = static_cast<int>(chosen->info.size());
+  const std::size_t shown = std::min<std::size_t>(chosen->refused.size(), 5);
+  out.refused.assign(chosen->refused.begin(), chosen->refused.begin() + static_cast<std::ptrdiff_t>(shown));
   if (out.baseline.feasible) out.ratio = out.best.worst_expanded_um / out.baseline.worst_expanded_um;
   return out;
 }

@@ -16,9 +16,7 @@ std::array<double, 2> tilt_range(MachineType m) {
   return t;
 }
 
-std::vector<RotaryAngles<double>> plannable_poses(MachineType m, const ProbePattern& P, double tilt_step,
-                                                  double rot_step, const ProbeProgramOptions& program,
-                                                  std::vector<std::string>* refused) {
+std::vector<RotaryAngles<double>> pose_grid(MachineType m, double tilt_step, double rot_step) {
   const std::array<double, 2> t = tilt_range(m);
   std::vector<double> tilts, rots;
   for (int k = 0; t[0] + k * tilt_step <= t[1] + 1e-9; ++k) tilts.push_back(t[0] + k * tilt_step);
@@ -30,17 +28,45 @@ std::vector<RotaryAngles<double>> plannable_poses(MachineType m, const ProbePatt
     rots.push_back(r[0] + k * rot_step);
   std::vector<RotaryAngles<double>> out;
   for (double tilt : tilts)
-    for (double rot : rots) {
-      ProbePattern one = P;
-      one.poses_deg = {{tilt, rot}};
-      try {
-        probe_moves(m, one, program);
-        out.push_back(one.poses_deg[0]);
-      } catch (const InvalidArgument& e) {
-        if (refused)
-          refused->push_back("tilt " + fixed_text(tilt, 1) + ", rotary " + fixed_text(rot, 1) + " deg: " + e.what());
-      }
+    for (double rot : rots) out.push_back({tilt, rot});
+  return out;
+}
+
+std::vector<Eigen::Vector3d> contact_directions(MachineType m, const RotaryAngles<double>& pose_deg,
+                                                double max_angle_deg, double step_deg) {
+  constexpr double kDeg = M_PI / 180.0;
+  const RotaryAngles<double> a{pose_deg.tilt * kDeg, pose_deg.rot * kDeg};
+  const Eigen::Matrix3d R = m.has_head() ? head_pose<double>(m, LocationErrors<double>(), a).R
+                                         : Eigen::Matrix3d::Identity().eval();
+  std::vector<double> polar;
+  for (int k = 0; k * step_deg < max_angle_deg - 1e-9; ++k) polar.push_back(k * step_deg);
+  polar.push_back(max_angle_deg);
+  std::vector<Eigen::Vector3d> out;
+  for (double th : polar)
+    for (int k = 0; k < (th > 0.0 ? 8 : 1); ++k) {
+      const double phi = 45.0 * k * kDeg, t = th * kDeg;
+      const Eigen::Vector3d contact(std::sin(t) * std::cos(phi), std::sin(t) * std::sin(phi), std::cos(t));
+      out.push_back(-(R * contact));  // the stylus moves against the contact normal
     }
+  return out;
+}
+
+std::vector<RotaryAngles<double>> plannable_poses(MachineType m, const ProbePattern& P, double tilt_step,
+                                                  double rot_step, const ProbeProgramOptions& program,
+                                                  std::vector<std::string>* refused) {
+  std::vector<RotaryAngles<double>> out;
+  for (const RotaryAngles<double>& pose : pose_grid(m, tilt_step, rot_step)) {
+    ProbePattern one = P;
+    one.poses_deg = {pose};
+    try {
+      probe_moves(m, one, program);
+      out.push_back(pose);
+    } catch (const InvalidArgument& e) {
+      if (refused)
+        refused->push_back("tilt " + fixed_text(pose.tilt, 1) + ", rotary " + fixed_text(pose.rot, 1) +
+                           " deg: " + e.what());
+    }
+  }
   return out;
 }
 

@@ -16,6 +16,18 @@ namespace rotacal::probe_design {
 /// The tilt axis' limits within -90..90 deg (-90..90 without limits), as default_probe_pattern.
 std::array<double, 2> tilt_range(MachineType m);
 
+/// The grid: tilt over tilt_range every tilt_step (and its end), the rotary axis over a full
+/// turn (or its limits, both ends) every rot_step.
+std::vector<RotaryAngles<double>> pose_grid(MachineType m, double tilt_step, double rot_step);
+
+/// Candidate approach directions (machine frame, unit) at a pose (deg): the contact point's
+/// normal -n within max_angle_deg of the stylus axis (the spindle's +z turned by the nominal head:
+/// the hemisphere the stylus sees, less the shank's margin), at polar angles 0, step, 2 step, ...
+/// and max_angle_deg, azimuth every 45 deg in the spindle's frame. On a table machine with the
+/// default step and 60 deg among them, the default pattern's five directions are candidates.
+std::vector<Eigen::Vector3d> contact_directions(MachineType m, const RotaryAngles<double>& pose_deg,
+                                                double max_angle_deg, double step_deg);
+
 /// Poses of the grid (tilt over tilt_range every tilt_step, the rotary axis over a full turn or
 /// its limits every rot_step) that probe_moves accepts one by one with P's sphere and
 /// directions; the others' reasons in `refused` (when given).

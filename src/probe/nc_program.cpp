@@ -57,7 +57,10 @@ std::vector<ProbeMove> probe_moves(MachineType m, const ProbePattern& P, const P
                                    double* retract_z) {
   const double r = 0.5 * (P.sphere_diameter + P.stylus_diameter);
   require(P.sphere_diameter > 0.0 && P.stylus_diameter > 0.0, "sphere and stylus diameters must be > 0");
-  require(!P.poses_deg.empty() && !P.directions.empty(), "the pattern has no poses or no directions");
+  require(!P.poses_deg.empty() && (!P.directions.empty() || !P.pose_directions.empty()),
+          "the pattern has no poses or no directions");
+  require(P.pose_directions.empty() || P.pose_directions.size() == P.poses_deg.size(),
+          "the per-pose directions must hold one list per pose");
   require(o.approach_mm > 0.0 && o.clearance_mm > 0.0, "approach and clearance must be > 0 mm");
   require(o.overtravel_mm > 0.0 && o.overtravel_mm < r, "overtravel must be in (0, " + nc_detail::general(r) + ") mm");
   require(o.probe_feed_mm_per_min > 0.0 && o.feed_mm_per_min > 0.0, "feeds must be > 0");
@@ -70,13 +73,15 @@ std::vector<ProbeMove> probe_moves(MachineType m, const ProbePattern& P, const P
     const RotaryAngles<double> a{P.poses_deg[k].tilt * kDeg, P.poses_deg[k].rot * kDeg};
     const Eigen::Vector3d c = inverse(m, LocationErrors<double>(), a, P.sphere).xyz;  // as simulate_probe
     top = std::max(top, c.z() + r);
-    for (std::size_t j = 0; j < P.directions.size(); ++j) {
-      require(P.directions[j].norm() > 0.0, "a zero approach direction");
+    const std::vector<Eigen::Vector3d>& dirs = P.directions_at(k);
+    require(!dirs.empty(), "pose " + std::to_string(pose) + " has no approach direction");
+    for (std::size_t j = 0; j < dirs.size(); ++j) {
+      require(dirs[j].norm() > 0.0, "a zero approach direction");
       ProbeMove mv;
       mv.pose = pose;
       mv.touch = static_cast<int>(j) + 1;
       mv.angles_deg = P.poses_deg[k];
-      mv.n = P.directions[j].normalized();
+      mv.n = dirs[j].normalized();
       mv.start = c - (r + o.approach_mm) * mv.n;
       mv.target = c - (r - o.overtravel_mm) * mv.n;
       out.push_back(mv);
@@ -131,8 +136,11 @@ std::string write_probe_nc_program(MachineType m, const ProbePattern& P, NcDiale
     comment("sphere " + nc_detail::general(P.sphere.x()) + ", " + nc_detail::general(P.sphere.y()) + ", " +
             nc_detail::general(P.sphere.z()) + " mm (table frame), D " + nc_detail::general(P.sphere_diameter) +
             " mm, stylus d " + nc_detail::general(P.stylus_diameter) + " mm");
-    comment(std::to_string(P.poses_deg.size()) + " poses x " + std::to_string(P.directions.size()) +
-            " touches; the log holds one line per touch: pose touch X Y Z (latched)");
+    comment((P.pose_directions.empty()
+                 ? std::to_string(P.poses_deg.size()) + " poses x " + std::to_string(P.directions.size()) + " touches"
+                 : std::to_string(P.poses_deg.size()) + " poses, " + std::to_string(P.touch_count()) +
+                       " touches along each pose's own directions") +
+            "; the log holds one line per touch: pose touch X Y Z (latched)");
     comment("start with the stylus clear of the sphere: Z goes to the retract plane, then the rotary axes turn");
   });
   if (o.log_file.empty() || o.log_file.find_first_of("()\r\n") != std::string::npos)

@@ -63,8 +63,12 @@ ProbePattern default_probe_pattern(MachineType m) {
 ProbeSimulation simulate_probe(const MachineModel& truth, const ProbeSimOptions& o) {
   truth.validate("simulate_probe: truth");
   const ProbePattern& P = o.pattern;
-  if (P.poses_deg.empty() || P.directions.empty())
+  if (P.poses_deg.empty() || (P.directions.empty() && P.pose_directions.empty()))
     throw InvalidArgument("simulate_probe: options.pattern: poses_deg and directions must not be empty");
+  if (!P.pose_directions.empty() && P.pose_directions.size() != P.poses_deg.size())
+    throw InvalidArgument("simulate_probe: options.pattern: pose_directions must hold one list per pose");
+  for (const auto& d : P.pose_directions)
+    if (d.empty()) throw InvalidArgument("simulate_probe: options.pattern: a pose without approach directions");
   if (!(o.noise_um >= 0.0) || !std::isfinite(o.noise_um)) throw InvalidArgument("simulate_probe: options.noise_um must be >= 0");
   if (!(std::abs(o.ar1_rho) < 1.0)) throw InvalidArgument("simulate_probe: options.ar1_rho must be in (-1, 1)");
   if (!(P.sphere_diameter > 0.0) || !(P.stylus_diameter >= 0.0))
@@ -85,19 +89,22 @@ ProbeSimulation simulate_probe(const MachineModel& truth, const ProbeSimOptions&
   // The touches: nominal start x0 (the tip at the nominal centre), direction and time.
   std::vector<ProbeTouch> touches;
   std::vector<Eigen::Vector3d> x0;
+  std::vector<std::size_t> pose_of;
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (std::size_t k = 0; k < P.poses_deg.size(); ++k) {
     const RotaryAngles<double> a{P.poses_deg[k].tilt * kDeg, P.poses_deg[k].rot * kDeg};
     const Eigen::Vector3d start = inverse(m, LocationErrors<double>(), a, P.sphere).xyz;
-    for (std::size_t j = 0; j < P.directions.size(); ++j) {
-      if (!(P.directions[j].norm() > 0.0)) throw InvalidArgument("simulate_probe: options.pattern: a zero direction");
+    const std::vector<Eigen::Vector3d>& dirs = P.directions_at(k);
+    for (std::size_t j = 0; j < dirs.size(); ++j) {
+      if (!(dirs[j].norm() > 0.0)) throw InvalidArgument("simulate_probe: options.pattern: a zero direction");
       ProbeTouch t;
-      t.n = P.directions[j].normalized();
+      t.n = dirs[j].normalized();
       t.angles = a;
       t.n_spindle = spindle_frame_direction(m, a, t.n);
       t.time = static_cast<double>(k) * P.pose_dt_s + static_cast<double>(j) * P.touch_dt_s;
       touches.push_back(t);
       x0.push_back(start);
+      pose_of.push_back(k);
       mean += start - radius * t.n;
     }
   }
@@ -112,10 +119,10 @@ ProbeSimulation simulate_probe(const MachineModel& truth, const ProbeSimOptions&
     const ProbeTouch& t = touches[i];
     const double lambda = trigger_lambda(m, truth, fx, out.sphere_actual, t, x0[i], radius);
     ProbeSample r;
-    r.pose = std::to_string(i / P.directions.size() + 1);
+    r.pose = std::to_string(pose_of[i] + 1);
     r.time = t.time;
-    r.tilt_deg = P.poses_deg[i / P.directions.size()].tilt;
-    r.rot_deg = P.poses_deg[i / P.directions.size()].rot;
+    r.tilt_deg = P.poses_deg[pose_of[i]].tilt;
+    r.rot_deg = P.poses_deg[pose_of[i]].rot;
     r.n = t.n;
     r.xyz = x0[i] + (lambda + lobing_shift<double>(fx, truth.effect_data(), t.n_spindle)) * t.n +
             noise.segment<3>(3 * static_cast<Eigen::Index>(i));

@@ -59,6 +59,32 @@ TEST_CASE("the design beats the default poses at the same number of touches", "[
   }
 }
 
+TEST_CASE("touch by touch, with the sphere's place: each pose its own directions, plannable", "[probe][design]") {
+  ProbeDesignOptions o = options_for("B-head-C-table");
+  o.touch_directions = true;
+  o.sphere_candidates = {Eigen::Vector3d(300.0, 0.0, 40.0)};
+  const ProbeDesign d = design_probe_test(o);
+  REQUIRE(d.best.feasible);
+  REQUIRE(d.baseline.feasible);
+  INFO("designed " << d.best.worst_expanded_um << " um, default " << d.baseline.worst_expanded_um << " um");
+  CHECK(d.ratio <= 0.7);  // 0.93 with the default directions at the default sphere (docs/design.md)
+  CHECK(d.sphere.isApprox(Eigen::Vector3d(300.0, 0.0, 40.0)));
+  CHECK(d.best.pattern.sphere.isApprox(d.sphere));
+  REQUIRE(d.spheres.size() == 2);
+  CHECK(d.spheres[1].worst_expanded_um < d.spheres[0].worst_expanded_um);
+  CHECK(d.best.pattern.pose_directions.size() == d.best.pattern.poses_deg.size());
+  CHECK(d.best.pattern.touch_count() == 120);
+  CHECK(probe_moves(o.machine, d.best.pattern, o.program).size() == 120);
+  // The simulator touches each pose along its own directions, and refuses lists that do not fit.
+  ProbeSimOptions so;
+  so.pattern = d.best.pattern;
+  const ProbeSession s = simulate_probe(MachineModel::nominal(o.machine), so).session;
+  REQUIRE(s.samples.size() == 120);
+  CHECK(s.samples.front().n.isApprox(d.best.pattern.pose_directions.front().front().normalized()));
+  so.pattern.pose_directions.pop_back();
+  CHECK_THROWS_AS(simulate_probe(MachineModel::nominal(o.machine), so), InvalidArgument);
+}
+
 TEST_CASE("the designed poses are within the axis limits, plannable, and their sigma is realised", "[probe][design]") {
   for (const char* name : {"AC-trt", "BC-trt"}) {
     ProbeDesignOptions o = options_for(name);

@@ -28,6 +28,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "reference"))
 import refsim  # noqa: E402
 from refsim import poses as refposes  # noqa: E402
+from refsim.instruments import _spindle_frame_dirs  # noqa: E402  (the nominal head's rotation)
 
 SIGMA_MM = 0.5e-3
 # Touch directions the inner search may use when every touch has its own (n and -n inform
@@ -75,8 +76,9 @@ def sensitivities(machine: str, poses_deg, sphere) -> tuple[np.ndarray, list[str
 
 
 def scales(names: list[str]) -> np.ndarray:
-    """um of 2 sigma per unit of each location error (the first 8): rad x 100 mm, mm."""
-    return np.array([2e5 if nm[2] in "ABC" else 2e3 for nm in names[:8]])
+    """um of 2 sigma per unit of each location error (the first 8): rad x 100 mm, mm. Orientation
+    errors: E_A0C-like (about an axis) and E_DU0B-like (a direction error of an inclined axis)."""
+    return np.array([2e5 if nm[2] in "ABC" or nm.startswith("E_D") else 2e3 for nm in names[:8]])
 
 
 def largest_u_um(info: np.ndarray, names: list[str]) -> tuple[float, str]:
@@ -91,9 +93,33 @@ def pattern_information(G: np.ndarray, directions) -> np.ndarray:
     return np.einsum("kai,ab,kbj->ij", G, D, G) / SIGMA_MM**2
 
 
-def candidate_information(G: np.ndarray, touches: int, directions=None) -> tuple[np.ndarray, float]:
+def contact_directions(machine: str, tilt: float, rot: float, max_angle: float = 80.0,
+                       step: float = 30.0) -> np.ndarray:
+    """Approach directions (machine frame) whose contact point lies within `max_angle` deg of the
+    stylus axis (the spindle's +z turned by refsim's nominal head) at a pose (deg): polar angles
+    0, step, ... and max_angle, azimuth every 45 deg in the spindle's frame (the design's
+    candidates, docs/design.md)."""
+    m = refsim.load_machine(machine)
+    i_tilt, i_rot = refposes.rotary_roles(m)
+    a = np.zeros((3, 2))
+    a[:, i_tilt], a[:, i_rot] = np.radians(tilt), np.radians(rot)
+    H = _spindle_frame_dirs(refsim.Model(m, {}, {}), np.eye(3), a)  # row k: H^T e_k, i.e. H's row k
+    out = []
+    for th in list(np.arange(0.0, max_angle - 1e-9, step)) + [max_angle]:
+        for phi in np.radians(np.arange(0.0, 360.0, 45.0)) if th > 0 else [0.0]:
+            t = np.radians(th)
+            out.append(-(H @ np.array([np.sin(t) * np.cos(phi), np.sin(t) * np.sin(phi), np.cos(t)])))
+    return np.array(out)
+
+
+def candidate_information(G: np.ndarray, touches: int, directions=None,
+                          touch_directions=None) -> tuple[np.ndarray, float]:
     """The information of one run of each candidate and the number of runs: a pose of G touched
-    once along each of `directions`, or (None) one touch along one of SEARCH_DIRECTIONS."""
+    once along each of `directions`, or (None) one touch along one of SEARCH_DIRECTIONS, or one
+    touch along one of touch_directions[k] (per pose) when given."""
+    if touch_directions is not None:
+        rows = np.concatenate([np.asarray(dd, float) @ G[k] for k, dd in enumerate(touch_directions)])
+        return np.einsum("ki,kj->kij", rows, rows) / SIGMA_MM**2, float(touches)
     if directions is None:
         rows = np.einsum("da,kaj->kdj", SEARCH_DIRECTIONS, G).reshape(-1, G.shape[2])
         return np.einsum("ki,kj->kij", rows, rows) / SIGMA_MM**2, float(touches)
@@ -101,11 +127,13 @@ def candidate_information(G: np.ndarray, touches: int, directions=None) -> tuple
     return np.einsum("kai,ab,kbj->kij", G, D, G) / SIGMA_MM**2, touches / len(directions)
 
 
-def minimax_bound(G: np.ndarray, names: list[str], touches: int, directions=None, iterations: int = 300):
+def minimax_bound(G: np.ndarray, names: list[str], touches: int, directions=None, iterations: int = 300,
+                  touch_directions=None):
     """(U reached by a continuous design, certified lower bound on U, the design's runs per
     candidate) in um over every allocation of `touches` touches to the poses of G: each visit
-    touched once along each of `directions`, or (None) each touch along any direction of its own."""
-    info, runs = candidate_information(G, touches, directions)
+    touched once along each of `directions`, or (None) each touch along any direction of its own,
+    or along one of touch_directions[k] at pose k when given."""
+    info, runs = candidate_information(G, touches, directions, touch_directions)
     s2 = scales(names) ** 2
     w = np.full(len(info), runs / len(info))
     lam = np.full(8, 1.0 / 8)
@@ -120,7 +148,7 @@ def minimax_bound(G: np.ndarray, names: list[str], touches: int, directions=None
         C = np.linalg.inv(np.einsum("k,kij->ij", w, info))
         v = np.diag(C)[:8] * s2
         A = C[:, :8] @ np.diag(lam * s2) @ C[:8, :]
-        if directions is None:  # the best direction of each pose, per touch
+        if directions is None and touch_directions is None:  # the best direction of each pose, per touch
             dmax = max(np.linalg.eigvalsh(g @ A @ g.T)[-1] for g in G) / SIGMA_MM**2
         else:
             dmax = np.einsum("kij,ij->k", info, A).max()

@@ -20,6 +20,7 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "reference"))
 import refsim  # noqa: E402
 from refsim import noise  # noqa: E402
+from refsim import poses as refposes  # noqa: E402
 
 import rotacal  # noqa: E402
 from test_linuxcnc import RS274, run_rs274  # noqa: E402  (the interpreter's canonical commands)
@@ -33,11 +34,14 @@ def run(*args):
                           timeout=600)
 
 
-def nominal_centre(machine: str, angles_deg) -> np.ndarray:
-    """The sphere's nominal centre in machine axes at a pose (refsim, as in its probe_touches)."""
+def nominal_centre(machine: str, angles_deg, sphere=(150.0, 0.0, 80.0)) -> np.ndarray:
+    """The sphere's nominal centre in machine axes at a pose (tilt, rotary; deg) (refsim, as in its
+    probe_touches)."""
     nominal = refsim.Model(machine).nominal()
-    a = np.radians(np.atleast_2d(angles_deg))
-    c = nominal.p_table(np.array([[150.0, 0.0, 80.0]]), a, np.zeros(1))
+    i_tilt, i_rot = refposes.rotary_roles(refsim.load_machine(machine))
+    a = np.zeros((1, 2))
+    a[0, i_tilt], a[0, i_rot] = np.radians(np.ravel(angles_deg))  # refsim's axis order
+    c = nominal.p_table(np.atleast_2d(np.asarray(sphere, float)), a, np.zeros(1))
     return nominal.commanded_xyz(c, a)[0]
 
 
@@ -47,14 +51,14 @@ def segment_distance(c, a, b) -> float:
     return float(np.linalg.norm(a + t * ab - c))
 
 
-@pytest.mark.skipif(RS274 is None, reason="rs274 (LinuxCNC stand-alone interpreter) not on PATH: "
-                                          "apt-get install linuxcnc-uspace")
-@pytest.mark.parametrize("machine", ["AC-trt", "BC-trt"])
-def test_the_probing_program_runs_in_rs274_on_the_reference_geometry(tmp_path, machine):
-    ngc, template = tmp_path / "probe.ngc", tmp_path / "plan.csv"
-    r = run("plan", "probe", "--machine", machine, "--session", template, "-o", ngc)
-    assert r.returncode == 0, r.stderr
-    plan = rotacal.load(template)
+RS274_MISSING = "rs274 (LinuxCNC stand-alone interpreter) not on PATH: apt-get install linuxcnc-uspace"
+
+
+def check_in_rs274(tmp_path, machine: str, ngc: Path, plan, sphere=(150.0, 0.0, 80.0)) -> None:
+    """The program through rs274 against refsim's nominal geometry: every probing move on the line
+    through the sphere's nominal centre along the plan's direction, from outside to inside the
+    trigger sphere; no other move and no turn of the rotary axes within it (turns 10 mm clear);
+    the LOG lines numbered as the plan's poses and touches, with the latched position."""
     tilt, rot = machine[0], "C"
     canon = run_rs274(ngc.read_text(), tmp_path)
     assert canon[[n for n, _ in canon].index("LOGOPEN")][1] == '"rotacal_probe.log"'
@@ -74,9 +78,9 @@ def test_the_probing_program_runs_in_rs274_on_the_reference_geometry(tmp_path, m
                 assert np.allclose(p[:3], pos[:3])
                 for f in np.linspace(0.0, 1.0, 181):
                     a = (ang0[0] + f * (ang1[0] - ang0[0]), ang0[1] + f * (ang1[1] - ang0[1]))
-                    assert np.linalg.norm(p[:3] - nominal_centre(machine, a)) > R + 10.0, (a, p)
+                    assert np.linalg.norm(p[:3] - nominal_centre(machine, a, sphere)) > R + 10.0, (a, p)
             else:
-                c = cache.setdefault(ang1, nominal_centre(machine, ang1))
+                c = cache.setdefault(ang1, nominal_centre(machine, ang1, sphere))
                 if name == "STRAIGHT_PROBE":
                     probes.append((pos[:3], p[:3], c, ang1))
                 elif not after_probe:
@@ -84,15 +88,59 @@ def test_the_probing_program_runs_in_rs274_on_the_reference_geometry(tmp_path, m
         after_probe = name == "STRAIGHT_PROBE"
         pos = p
     n = np.asarray(plan.n)
-    assert len(probes) == len(plan) == len(logs) == 120
+    assert len(probes) == len(plan) == len(logs)
     for k, (start, end, c, ang) in enumerate(probes):
         assert np.allclose(ang, np.asarray(plan.angles_deg)[k], atol=1e-4)
         d = (end - start) / np.linalg.norm(end - start)
         assert np.allclose(d, n[k], atol=1e-4)  # along the approach direction...
         assert segment_distance(c, start - 100 * d, end + 100 * d) < 1e-3  # ...through the centre
         assert np.linalg.norm(start - c) > R + 1.0 and np.linalg.norm(end - c) < R - 1.0  # outside -> inside
-        assert [int(v) for v in logs[k][:2]] == [int(plan.pose_names[k // 5]), k % 5 + 1]
+        assert [int(v) for v in logs[k][:2]] == log_numbers(plan)[k]
         assert np.allclose([float(v) for v in logs[k][2:]], end, atol=1e-5)  # #5061..#5063 of the latch
+
+
+def log_numbers(plan) -> list:
+    """[pose number, touch number] of each row of the plan, as the program logs them."""
+    out, last, touch = [], None, 0
+    for pose in plan.poses:
+        touch = 1 if pose != last else touch + 1
+        last = pose
+        out.append([int(pose), touch])
+    return out
+
+
+@pytest.mark.skipif(RS274 is None, reason=RS274_MISSING)
+@pytest.mark.parametrize("machine", ["AC-trt", "BC-trt"])
+def test_the_probing_program_runs_in_rs274_on_the_reference_geometry(tmp_path, machine):
+    ngc, template = tmp_path / "probe.ngc", tmp_path / "plan.csv"
+    r = run("plan", "probe", "--machine", machine, "--session", template, "-o", ngc)
+    assert r.returncode == 0, r.stderr
+    plan = rotacal.load(template)
+    assert len(plan) == 120 and log_numbers(plan)[:6] == [[1, 1], [1, 2], [1, 3], [1, 4], [1, 5], [2, 1]]
+    check_in_rs274(tmp_path, machine, ngc, plan)
+
+
+@pytest.mark.skipif(RS274 is None, reason=RS274_MISSING)
+def test_the_designed_program_runs_in_rs274(tmp_path):
+    """`design probe --json` -> `plan probe --design`: each touch along its own direction, the
+    sphere where the design puts it (B-head-C-table: moved out on the table), through rs274."""
+    machine = "B-head-C-table"
+    r = run("design", "probe", "--machine", machine, "--json")
+    assert r.returncode == 0, r.stderr
+    design = tmp_path / "design.json"
+    design.write_text(r.stdout)
+    d = json.loads(r.stdout)
+    ngc, template = tmp_path / "probe.ngc", tmp_path / "plan.csv"
+    r = run("plan", "probe", "--machine", machine, "--design", design, "--session", template, "-o", ngc)
+    assert r.returncode == 0, r.stderr
+    plan = rotacal.load(template)
+    assert len(plan) == d["touches"] == 120
+    assert np.allclose(plan.sphere, d["sphere"]) and not np.allclose(d["sphere"], [150.0, 0.0, 80.0])
+    dirs = np.concatenate([np.asarray(x) for x in d["best"]["pose_directions"]])
+    assert np.allclose(np.asarray(plan.n), dirs / np.linalg.norm(dirs, axis=1, keepdims=True), atol=1e-9)
+    check_in_rs274(tmp_path, machine, ngc, plan, d["sphere"])
+    r = run("plan", "probe", "--machine", machine, "--design", design, "--poses", "0,0", "-o", ngc)
+    assert r.returncode == 3 and "--design" in r.stderr
 
 
 def test_other_dialects_and_limits_are_refused(tmp_path):

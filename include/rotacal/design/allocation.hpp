@@ -7,13 +7,17 @@
 /// (design/separation.hpp); the covariance of a design is invert_information's.
 ///
 /// The search: the continuous design (weights w_k over the candidates, information
-/// M(w) = sum w_k A_k) minimising a smooth maximum of the scaled variances,
-/// (sum_j (s_j^2 [M^-1]_jj)^p)^(1/p) for p = 1, 4, 16, 64, by the multiplicative algorithm
-/// w_k <- w_k (d_k / sum_i w_i d_i)^(1/2), d_k = tr(M^-1 L M^-1 A_k), L = diag(s_j^2 v_j^(p-1))
-/// (the gradient of the criterion; Silvey, Titterington and Torsney 1978, Pukelsheim 1993
-/// ch. 9), on the parameters the candidates together determine; the weights rounded to runs by
+/// M(w) = sum w_k A_k) minimising the largest scaled variance v_j = s_j^2 [M^-1]_jj, as the
+/// largest over weights lam on the target of sum_j lam_j v_j: for given lam the weighted
+/// A-optimal design by the multiplicative algorithm w_k <- w_k (d_k / sum_i w_i d_i)^(1/2),
+/// d_k = tr(M^-1 L M^-1 A_k), L = diag(lam_j s_j^2) (Silvey, Titterington and Torsney 1978,
+/// Pukelsheim 1993 ch. 9), then lam_j <- lam_j exp(2 (v_j / max v - 1)) towards the largest
+/// variances (40 x 10 steps, the w of the smallest max v kept), on the parameters the
+/// candidates together determine; the weights rounded to runs by
 /// Pukelsheim and Rieder's efficient rounding (1992); then single runs moved from one candidate
-/// to another while the largest expanded uncertainty (invert_information) decreases.
+/// to another while the largest expanded uncertainty (invert_information) decreases (among more
+/// than 400 candidates, to one of the 16 with the largest d_k at lam_j ~ v_j^63, the derivative
+/// of the smooth maximum (sum_j v_j^64)^(1/64)).
 
 #include <Eigen/Core>
 #include <limits>

@@ -6,6 +6,16 @@
 /// a head, the sphere) gives the smallest largest expanded uncertainty (k = 2) of the location
 /// errors at a given number of touches, and the same for `plan probe`'s default poses.
 ///
+/// Touch by touch (`touch_directions`; the CLI's default): each candidate is one touch at a grid pose
+/// along one direction of contact_directions (the contact point within `max_contact_angle_deg`
+/// of the stylus axis, polar every `contact_step_deg`, azimuth every 45 deg), each checked alone
+/// by probe_moves (travel, the way up clear of the sphere); the engine allocates the touches, and
+/// the designed pattern touches each chosen pose along its own directions (pose_directions).
+/// The sphere: `sphere` (the default set-up) and each of `sphere_candidates` (the engineer
+/// places it; the design says where): the design at each, the one with the smallest largest
+/// expanded uncertainty taken when it is `sphere_gain` below the design at `sphere`. The default
+/// poses are always judged at `sphere`.
+///
 /// Information: the probe problem's Jacobian at the fit's start point on the nominal machine's
 /// commanded touches (simulate_probe without errors or noise), over white noise of `noise_um`
 /// per touch: each touch reads the sphere's centre along its approach direction, so the noise
@@ -42,13 +52,28 @@ struct ProbeDesignOptions {
   double noise_um = 0.5;               ///< 1 sigma per latched coordinate (white)
   double reference_radius_mm = 100.0;  ///< an orientation error in rad counts as this lever arm
   ProbeProgramOptions program;         ///< approach, overtravel, clearance: what makes a pose plannable
+  /// Each touch its own direction (`rotacal design probe` and rotacal.design.design_probe set it);
+  /// false: every visit of a pose along `directions`.
+  bool touch_directions = false;
+  double max_contact_angle_deg = 80.0; ///< candidate contact points within this of the stylus axis, deg
+  double contact_step_deg = 30.0;      ///< their polar angle every this, deg (azimuth every 45)
+  std::vector<Eigen::Vector3d> sphere_candidates;  ///< other places of the sphere to try, table frame, mm
+  double sphere_gain = 0.05;           ///< move the sphere when that lowers the largest U by this fraction
+};
+
+/// One place of the sphere the design tried.
+struct ProbeSphereTrial {
+  Eigen::Vector3d sphere = Eigen::Vector3d::Zero();  ///< table frame, mm
+  bool plannable = false;
+  double worst_expanded_um = 0.0;  ///< the design there (when plannable)
+  std::string why_not;
 };
 
 struct ProbeDesignCandidate {
   ProbePattern pattern;            ///< poses (visits, in program order) and directions
   bool feasible = false;
   std::string why_not;             ///< when not feasible
-  int touches = 0;                 ///< poses x directions
+  int touches = 0;                 ///< the pattern's touches (its information scaled to them)
   std::vector<std::string> names;  ///< the fit's parameters
   Eigen::VectorXd sigma;           ///< predicted 1 sigma at the touches, fit units; infinite: held
   double worst_expanded_um = 0.0;  ///< max over the determined location errors of 2 sigma, um
@@ -63,13 +88,17 @@ struct ProbeDesign {
   ProbeDesignCandidate baseline;  ///< default_probe_pattern at the same number of touches
   int touches = 0;
   double ratio = 0.0;             ///< best / baseline largest expanded uncertainty
-  int poses_tried = 0;            ///< candidate poses that are plannable
+  int poses_tried = 0;            ///< candidate poses that are plannable (at the chosen sphere)
+  int touches_tried = 0;          ///< candidate touches (touch by touch; else poses_tried)
   std::vector<std::string> refused;  ///< candidate poses that are not, with the reason (first few)
+  Eigen::Vector3d sphere = Eigen::Vector3d::Zero();  ///< where the designed test puts the sphere, table frame
+  std::vector<ProbeSphereTrial> spheres;  ///< `sphere` then each of sphere_candidates
 };
 
 /// Choose the poses and touches. Throws InvalidArgument naming the option for touches < 3,
 /// above 100000, not a multiple of the directions or too few to determine the location errors,
-/// non-positive steps, noise, diameters or reference radius, or no plannable pose.
+/// non-positive steps, noise, diameters or reference radius, a contact angle outside (0, 90] deg,
+/// a negative sphere_gain, or no plannable pose at `sphere`.
 ProbeDesign design_probe_test(const ProbeDesignOptions& options);
 
 /// The predicted uncertainty of `pattern` at `touches` touches (0: its own). Never throws for

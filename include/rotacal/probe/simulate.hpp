@@ -20,11 +20,26 @@ namespace rotacal {
 struct ProbePattern {
   std::vector<RotaryAngles<double>> poses_deg;  ///< tilt and rotary angle of each pose, deg
   std::vector<Eigen::Vector3d> directions;      ///< approach directions, machine frame (normalised)
+  /// Each pose's own approach directions (machine frame), one list per pose, in touch order
+  /// (`rotacal design probe` chooses each touch's); empty: `directions` at every pose.
+  std::vector<std::vector<Eigen::Vector3d>> pose_directions;
   Eigen::Vector3d sphere = Eigen::Vector3d(150.0, 0.0, 80.0);  ///< nominal centre, table frame, mm
   double sphere_diameter = 25.0;  ///< mm
   double stylus_diameter = 6.0;   ///< mm
   double touch_dt_s = 2.0;        ///< time between the touches of a pose, s
   double pose_dt_s = 16.0;        ///< time between the first touches of successive poses, s
+
+  /// The approach directions of pose k (0-based).
+  const std::vector<Eigen::Vector3d>& directions_at(std::size_t k) const {
+    return pose_directions.empty() ? directions : pose_directions[k];
+  }
+  /// Touches of the whole pattern.
+  std::size_t touch_count() const {
+    if (pose_directions.empty()) return poses_deg.size() * directions.size();
+    std::size_t n = 0;
+    for (const auto& d : pose_directions) n += d.size();
+    return n;
+  }
 };
 
 /// The pattern of the controller cycles as shared/data/probe_ac_table2.csv has it: 12 poses of
@@ -48,6 +63,7 @@ struct ProbeSimulation {
 };
 
 /// Simulate a whole session. Throws InvalidArgument for an empty pattern, a zero direction,
+/// pose_directions not one non-empty list per pose,
 /// negative noise, |ar1_rho| >= 1, a direction along which the probe misses the sphere, or a
 /// truth model whose effects do not fit its machine.
 ProbeSimulation simulate_probe(const MachineModel& truth, const ProbeSimOptions& options = {});

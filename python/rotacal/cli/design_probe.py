@@ -11,31 +11,33 @@ from typing import Any
 import numpy as np
 
 from .. import _core, jsontext
-from ..design import (design_probe, design_probe_separation, parameter_units, poses_text, probe_design_dict,
-                      probe_separation_dict)
+from ..design import (SPHERE_CANDIDATES, design_probe, design_probe_separation, parameter_units, poses_text,
+                      probe_design_dict, probe_separation_dict)
 from ..machines import load_machine
 from ..outputs import write_output
 from ..sessions import PROBE, save
 from .design import _print_separation, _session_after, add_separation_group
-from .options import EPILOG, EXIT_OK, OptionError, number, path, say
+from .options import EPILOG, EXIT_OK, OptionError, number, numbers, path, say
 from .probe import DEFAULT_LOG_FILE, DEFAULT_SPHERE, _plan_template, add_sphere_args
 
 
 def _write_program(a: argparse.Namespace, mtype: Any, poses: np.ndarray, directions: np.ndarray,
-                   inputs: list[str]) -> None:
-    """-o (the LinuxCNC probing program of `plan probe` at these poses) and --session (its template)."""
+                   inputs: list[str], pose_directions: list | None = None) -> None:
+    """-o (the LinuxCNC probing program of `plan probe` at these poses, each along its own
+    directions when given) and --session (its template), with the sphere at a.sphere."""
+    pose_directions = [np.asarray(d, float) for d in pose_directions or []]
     default_dirs = np.asarray(_core.default_probe_poses_deg(mtype)[1], float)
-    if directions.shape != default_dirs.shape or not np.allclose(directions, default_dirs):
+    if not pose_directions and (directions.shape != default_dirs.shape or not np.allclose(directions, default_dirs)):
         raise OptionError("-o/--session: plan probe touches the default directions; these poses are touched along "
                           "the session's own (see --json for them)")
     sphere = np.asarray(a.sphere if a.sphere is not None else DEFAULT_SPHERE, float)
     if a.output:
         text = _core.write_probe_nc_program(mtype, "linuxcnc", poses, sphere, a.sphere_diameter, a.stylus_diameter,
-                                            a.log_file)
+                                            a.log_file, pose_directions=pose_directions)
         write_output(a.output, text, inputs, [a.session] if a.session else [])
         say(f"wrote {a.output}: linuxcnc probing program, {len(poses)} poses")
     if a.session:
-        save(_plan_template(a, mtype, poses), a.session, inputs, [a.output] if a.output else [])
+        save(_plan_template(a, mtype, poses, pose_directions), a.session, inputs, [a.output] if a.output else [])
         say(f"wrote {a.session}: the commanded touches as a session template (rotacal import probe --plan)")
 
 
@@ -68,14 +70,26 @@ def cmd_design_probe(a: argparse.Namespace) -> int:
     noise = 0.5 if a.noise is None else a.noise
     sphere = a.sphere if a.sphere is not None else DEFAULT_SPHERE
     d = design_probe(mtype, sphere=sphere, sphere_diameter=a.sphere_diameter, stylus_diameter=a.stylus_diameter,
-                     touches=a.touches, tilt_step=a.tilt_step, rot_step=a.rot_step, noise_um=noise)
-    _write_program(a, mtype, np.asarray(d.best.poses_deg), np.asarray(d.best.directions), [])
+                     touches=a.touches, tilt_step=a.tilt_step, rot_step=a.rot_step, noise_um=noise,
+                     touch_directions=not a.same_directions, max_contact_angle=a.max_contact_angle,
+                     sphere_candidates=_sphere_candidates(a.sphere_candidates))
+    a.sphere = np.asarray(d.sphere)
+    _write_program(a, mtype, np.asarray(d.best.poses_deg), np.asarray(d.best.directions), [],
+                   list(d.best.pose_directions))
     if a.json:
         print(jsontext.dumps(probe_design_dict(d)))
         return EXIT_OK
-    print(f"{d.poses_tried} candidate poses within the limits; {d.touches} touches, noise {noise:g} um per touch")
+    tried = f" ({d.touches_tried} candidate touches)" if not a.same_directions else ""
+    print(f"{d.poses_tried} candidate poses within the limits{tried}; {d.touches} touches, "
+          f"noise {noise:g} um per touch")
+    for t in d.spheres:
+        where = ", ".join(f"{v:g}" for v in t.sphere)
+        print(f"  sphere at {where} mm: " + (f"designed largest U {t.worst_expanded_um:.3f} um" if t.plannable
+                                          else f"not used: {t.why_not}"))
+    print(f"place the sphere at {', '.join(f'{v:g}' for v in d.sphere)} mm (table frame)")
     for label, c in (("designed", d.best), ("default", d.baseline)):
-        where = f"{len(c.poses_deg)} poses x {len(c.directions)} touches"
+        where = (f"{len(c.poses_deg)} poses x {len(c.directions)} touches" if not len(c.pose_directions)
+                 else f"{len(c.poses_deg)} poses, {c.touches} touches along their own directions")
         if not c.feasible:
             print(f"{label:9s} {where}: {c.why_not}")
             continue
@@ -87,8 +101,25 @@ def cmd_design_probe(a: argparse.Namespace) -> int:
     print("predicted 1-sigma of the designed poses (inf: not determined):")
     for n, s_, (unit, k) in zip(d.best.names, d.best.sigma, parameter_units(d.best.names)):
         print(f"  {n:16s} {s_ * k if math.isfinite(s_) else math.inf:10.4f} {unit}")
-    print(f'run it with: rotacal plan probe --machine {a.machine} --poses "{poses_text(d.best.poses_deg)}"')
+    if len(d.best.pose_directions):
+        print(f"run it with: rotacal design probe ... --json > design.json; rotacal plan probe --machine {a.machine} "
+              "--design design.json (or -o/--session here)")
+    else:
+        print(f'run it with: rotacal plan probe --machine {a.machine} --sphere {",".join(f"{v:g}" for v in d.sphere)} '
+              f'--poses "{poses_text(d.best.poses_deg)}"')
     return EXIT_OK
+
+
+def _sphere_candidates(text: str) -> np.ndarray:
+    """--sphere-candidates auto | none | X,Y,Z;X,Y,Z;... (mm, table frame)."""
+    if text == "auto":
+        return np.asarray(SPHERE_CANDIDATES, float)
+    if text == "none":
+        return np.zeros((0, 3))
+    rows = [numbers("--sphere-candidates", 3, 1e4, "mm")(item) for item in text.split(";") if item.strip()]
+    if not rows:
+        raise OptionError("--sphere-candidates: auto, none or X,Y,Z;X,Y,Z;... (mm)")
+    return np.asarray(rows, float)
 
 
 def add_design_probe(kinds: argparse._SubParsersAction) -> None:
@@ -100,6 +131,14 @@ def add_design_probe(kinds: argparse._SubParsersAction) -> None:
     k.add_argument("--touches", type=number("--touches", 0, 100000, integer=True), default=0,
                    help="total touches to design for, a multiple of the 5 per pose (default 0: those of plan probe's "
                         "default poses, 120)")
+    k.add_argument("--same-directions", action="store_true",
+                   help="touch every pose along the default five directions (default: each touch its own direction)")
+    k.add_argument("--max-contact-angle", type=number("--max-contact-angle", 0.0, 90.0, "deg", lo_open=True),
+                   default=80.0, help="candidate contact points within this angle of the stylus axis, deg (default 80)")
+    k.add_argument("--sphere-candidates", default="auto", metavar="auto|none|X,Y,Z;...",
+                   help="other places of the sphere on the table to try, mm (default auto: "
+                        + "; ".join(",".join(f"{v:g}" for v in s) for s in SPHERE_CANDIDATES)
+                        + "); taken when the design there is 5 %% better")
     k.add_argument("--tilt-step", type=number("--tilt-step", 0.0, 180.0, "deg", lo_open=True), default=15.0,
                    help="candidate tilt angles over the axis limits every this, deg (default 15)")
     k.add_argument("--rot-step", type=number("--rot-step", 1.0, 359.0, "deg"), default=30.0,

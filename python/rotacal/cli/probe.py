@@ -4,6 +4,7 @@ it is). C++ computes (include/rotacal/probe, rotacal.probe); this module only co
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 import numpy as np
 
@@ -172,13 +173,34 @@ def _poses(text: str | None) -> np.ndarray | None:
     return np.asarray(rows, float)
 
 
-def _plan_template(a: argparse.Namespace, mtype, poses) -> _core.ProbeSession:
+def _plan_template(a: argparse.Namespace, mtype, poses, pose_directions=()) -> _core.ProbeSession:
     """The commanded rows of `plan probe` as a session template: the nominal machine's touches
     (no errors, no noise), in the program's order."""
     sphere = np.asarray(a.sphere if a.sphere is not None else DEFAULT_SPHERE, float)
     session, _ = _core.simulate_probe(mtype, np.zeros(8), [], [], np.zeros(3), 0.0, 0.0, 1, poses, None, sphere,
-                                      a.sphere_diameter, a.stylus_diameter)
+                                      a.sphere_diameter, a.stylus_diameter, list(pose_directions))
     return session
+
+
+def _design_file(a: argparse.Namespace) -> tuple[np.ndarray, list]:
+    """--design FILE: the poses, each pose's directions and the sphere of `design probe --json`
+    (its "best"); the sphere into a.sphere unless --sphere is given."""
+    import json
+    if a.poses is not None:
+        raise OptionError("--design: give --poses or --design, not both")
+    try:
+        doc = json.loads(Path(a.design).read_text())
+        best = doc.get("best", doc)
+        poses = np.asarray(best["poses_deg"], float).reshape(-1, 2)
+        dirs = [np.asarray(d, float).reshape(-1, 3) for d in best.get("pose_directions", [])]
+        sphere = best.get("sphere")
+    except (OSError, ValueError, KeyError, TypeError, AttributeError) as e:
+        raise OptionError(f"--design {a.design}: not the JSON of rotacal design probe --json ({e})") from None
+    if dirs and len(dirs) != len(poses):
+        raise OptionError(f"--design {a.design}: {len(dirs)} direction lists for {len(poses)} poses")
+    if a.sphere is None and sphere is not None:
+        a.sphere = np.asarray(sphere, float)
+    return poses, dirs
 
 
 def cmd_plan_probe(a: argparse.Namespace) -> int:
@@ -187,17 +209,17 @@ def cmd_plan_probe(a: argparse.Namespace) -> int:
     if given:
         raise OptionError(f"plan probe: {', '.join(given)} belong to plan ballbar")
     mtype = load_machine(a.machine) if a.machine else _core.MachineType.AC_trt
-    poses = _poses(a.poses)
+    poses, dirs = _design_file(a) if a.design else (_poses(a.poses), [])
     sphere = np.asarray(a.sphere if a.sphere is not None else DEFAULT_SPHERE, float)
     text = _core.write_probe_nc_program(mtype, a.dialect, poses, sphere, a.sphere_diameter, a.stylus_diameter,
                                         a.log_file, approach_mm=a.approach, probe_feed=a.probe_feed,
-                                        positioning_feed=a.positioning_feed)
-    write_output(a.output, text, [], [a.session] if a.session else [])
-    template = _plan_template(a, mtype, poses)
+                                        positioning_feed=a.positioning_feed, pose_directions=dirs)
+    write_output(a.output, text, [a.design] if a.design else [], [a.session] if a.session else [])
+    template = _plan_template(a, mtype, poses, dirs)
     say(f"wrote {a.output}: {a.dialect} probing program, {len(template)} touches at {len(template.pose_names)} poses, "
         f"latched positions logged to {a.log_file} on the controller")
     if a.session:
-        save(template, a.session, [], [a.output])
+        save(template, a.session, [a.design] if a.design else [], [a.output])
         say(f"wrote {a.session}: the commanded touches as a session template (rotacal import probe --plan)")
     return EXIT_OK
 
@@ -207,6 +229,8 @@ def add_plan_probe_args(q: argparse.ArgumentParser) -> None:
     add_sphere_args(g)
     g.add_argument("--poses", metavar="T,R;T,R;...",
                    help="tilt,rotary pairs, deg (default: the pattern of the controller cycles, rotacal simulate probe's)")
+    g.add_argument("--design", type=path("--design"), metavar="DESIGN.json",
+                   help="the poses, each touch's direction and the sphere of `rotacal design probe --json`")
     g.add_argument("--log-file", default=DEFAULT_LOG_FILE,
                    help="the file on the controller that (LOGOPEN,...) writes the latched positions to")
     g.add_argument("--approach", type=number("--approach", 0.01, 100.0, "mm"), default=DEFAULT_APPROACH_MM,
@@ -222,7 +246,7 @@ def add_plan_probe_args(q: argparse.ArgumentParser) -> None:
 
 def refuse_probe_options(a: argparse.Namespace) -> None:
     """`plan ballbar` with an option of `plan probe`: refused, not ignored."""
-    given = [o for o, v in (("--sphere", a.sphere), ("--poses", a.poses)) if v is not None]
+    given = [o for o, v in (("--sphere", a.sphere), ("--poses", a.poses), ("--design", a.design)) if v is not None]
     given += [o for o, v, d in (("--sphere-diameter", a.sphere_diameter, DEFAULT_SPHERE_DIAMETER),
                                 ("--stylus-diameter", a.stylus_diameter, DEFAULT_STYLUS_DIAMETER),
                                 ("--log-file", a.log_file, DEFAULT_LOG_FILE),
