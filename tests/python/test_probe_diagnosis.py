@@ -145,10 +145,11 @@ def test_a_z_drift_in_strongly_correlated_noise_is_found(tmp_path, entry, size):
     assert not missed, missed
 
 
-def bump_session(tmp_path, machine, seed, kind, height_mm=0.004):
+def bump_session(tmp_path, machine, seed, kind, height_mm=0.004, in_time=False):
     """A session of probe_session's set-up with a shift outside the catalogue added to the
-    touches: the table moves along X by a Gaussian bump of C (20 deg wide at C = 90 deg), a
-    localised defect of the rotary table's track, no harmonic of the catalogue's orders."""
+    touches: the table moves by a Gaussian bump, along X as a function of C (20 deg wide at
+    C = 90 deg: a localised defect of the rotary table's track), or along Y as a function of
+    time (15 s wide at 70 % of the session: the set-up knocked and settling back)."""
     rng = np.random.default_rng(seed)
     m = refsim.builtin(machine)
     s = poses.probe_poses(m, sphere=SPHERE)
@@ -156,11 +157,13 @@ def bump_session(tmp_path, machine, seed, kind, height_mm=0.004):
     actual = s["sphere"] + rng.normal(0, 0.02, 3)
     latched = refsim.probe_touches(refsim.Model(m, errors, {}), actual, s["sphere"], 25.0, 6.0, s["n"],
                                    np.radians(s["angles_deg"]), s["time"])
-    c_deg = s["angles_deg"][:, poses.rotary_roles(m)[1]]
-    gap = (c_deg - 90.0 + 180.0) % 360.0 - 180.0
     n = s["n"] / np.linalg.norm(s["n"], axis=1, keepdims=True)
-    shift = height_mm * np.exp(-0.5 * (gap / 20.0) ** 2)
-    latched = latched + (shift * n[:, 0])[:, None] * n  # the touch meets the moved sphere earlier/later
+    if in_time:
+        shift, axis = height_mm * np.exp(-0.5 * ((s["time"] - 0.7 * s["time"][-1]) / 15.0) ** 2), 1
+    else:
+        gap = (s["angles_deg"][:, poses.rotary_roles(m)[1]] - 90.0 + 180.0) % 360.0 - 180.0
+        shift, axis = height_mm * np.exp(-0.5 * (gap / 20.0) ** 2), 0
+    latched = latched + (shift * n[:, axis])[:, None] * n  # the touch meets the moved sphere
     one = ["touches"] * len(latched)
     sig = 0.5e-3
     e = noise.pink(one, sig, rng) if kind == "pink" else noise.ar1(one, float(kind.split("_")[1]), sig, rng)
@@ -169,13 +172,24 @@ def bump_session(tmp_path, machine, seed, kind, height_mm=0.004):
     return rotacal.load(path)
 
 
-@pytest.mark.parametrize("machine,kind", [("AC-trt", "ar1_0.5"), ("BC-trt", "pink")])
-def test_a_shape_outside_the_catalogue_gets_no_confident_name(tmp_path, machine, kind):
-    """A localised bump of the table's track (outside the catalogue) in coloured noise: the
-    diagnosis may name nothing, report unexplained structure or a group of C's harmonics (what
-    the bump projects on), never one catalogue effect of another kind with confidence."""
-    for seed in (1501, 1502, 1503):
-        d = rotacal.diagnose(bump_session(tmp_path, machine, seed, kind)).to_dict()
-        for f in d["findings"][:1]:
-            if f["named"]:
-                assert "_C_h" in f["effect"], (seed, f["effect"], f["weight"])
+TRACK_BUMP_AS_STRAIGHTNESS = pytest.mark.xfail(strict=True, reason=(
+    "left open: with the default layout's one C sweep, an X shift peaking at C = 90 deg is an X "
+    "error peaking at the sweep's largest Y, which straightness_XY expresses; it is named alone "
+    "(weight 1.00, seeds 1502-1504) where 'unexplained structure' or a group is wanted"))
+TIME_BUMP_AS_WARMUP = pytest.mark.xfail(strict=True, reason=(
+    "left open: in 1/f-like noise a Y shift settling back within 15 s is named thermal_warmup_Y "
+    "(weight 0.91-0.97, seeds 1501 and 1503)"))
+
+
+@pytest.mark.parametrize("machine,kind,in_time", [
+    ("AC-trt", "ar1_0.5", True),
+    pytest.param("BC-trt", "pink", True, marks=TIME_BUMP_AS_WARMUP),
+    pytest.param("AC-trt", "ar1_0.5", False, marks=TRACK_BUMP_AS_STRAIGHTNESS)])
+def test_a_shape_outside_the_catalogue_gets_no_confident_name(tmp_path, machine, kind, in_time):
+    """A shape outside the catalogue (bump_session) in coloured noise: the diagnosis may name
+    nothing, report unexplained structure or a group, never one catalogue entry with
+    confidence."""
+    for seed in (1501, 1502, 1503, 1504):
+        d = rotacal.diagnose(bump_session(tmp_path, machine, seed, kind, in_time=in_time)).to_dict()
+        named = [(f["effect"], f["weight"]) for f in d["findings"] if f["named"]]
+        assert not named, (seed, named)
