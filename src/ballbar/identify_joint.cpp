@@ -7,6 +7,7 @@
 
 #include "rotacal/ballbar/identify.hpp"
 #include "rotacal/core/fit_with_noise.hpp"
+#include "rotacal/core/time_constant_fit.hpp"
 #include "length_model.hpp"
 
 namespace rotacal {
@@ -87,27 +88,6 @@ std::vector<std::string> setup_advice(MachineType m, const std::vector<std::stri
                     " separates them");
   }
   return out;
-}
-
-}  // namespace
-
-namespace {
-
-// A time constant (the log of one, unit "1": thermal_warmup, reversal_spike) moves nothing
-// while its amplitude is 0, where every fit starts, so the observability analysis at the
-// start would hold it there. Such a fit runs twice: with the time constants held, then from
-// that solution with them free.
-JointFitOutcome solve_with_time_constants(const ResidualModel& model, std::vector<FitParameter> params,
-                                          const JointFitSettings& settings) {
-  std::vector<std::size_t> gated;
-  for (std::size_t j = 0; j < params.size(); ++j)
-    if (params[j].unit == "1" && !params[j].held) gated.push_back(j);
-  if (gated.empty()) return solve_joint(model, params, settings);
-  for (std::size_t j : gated) params[j].held = true;
-  const JointFitOutcome first = solve_joint(model, params, settings);
-  for (std::size_t j = 0; j < params.size(); ++j) params[j].start = first.values[static_cast<Eigen::Index>(j)];
-  for (std::size_t j : gated) params[j].held = false;
-  return solve_joint(model, params, settings);
 }
 
 }  // namespace

@@ -286,6 +286,7 @@ void refit_findings(const DiagnosisProblem& P, const DiagnosisOptions& options, 
     for (std::size_t i = 0; i < D.findings.size() && keep == D.findings.size(); ++i)
       if (determined_sigmas(D.final_fit, D.findings[i].effect, gls_noise) / scale < options.min_determined_sigma) keep = i;
     if (keep == D.findings.size()) {
+      profile_time_constants(P, gls_noise, scale, D);
       for (Finding& F : D.findings) {
         F.parameters = parameters_of(D.final_fit, F.effect);
         for (ParameterEstimate& q : F.parameters) q.std *= scale;
@@ -322,6 +323,17 @@ void final_gls(const DiagnosisProblem& P, const DiagnosisOptions& options, const
   refit_findings(P, options, gls_noise, D);
 }
 
+// A white diagnosis' held time constants profiled (time_constants.cpp) where no refit did it,
+// under white noise of the final fit's residual variance.
+void white_time_constants(const DiagnosisProblem& P, Diagnosis& D) {
+  const Eigen::VectorXd& r = D.final_fit.residuals;
+  NoiseTreatment t;
+  t.sigma_mm = std::sqrt(r.squaredNorm() / std::max(1.0, static_cast<double>(r.size() - D.final_fit.num_free)));
+  if (!(t.sigma_mm > 0.0)) return;
+  profile_time_constants(P, t, 1.0, D);
+  for (Finding& F : D.findings) F.parameters = parameters_of(D.final_fit, F.effect);
+}
+
 // A white diagnosis' findings against the stream levels the white residuals cannot show: the
 // readings' variation within each stream is what the final fit leaves, RSS / (n - free
 // parameters); what the declared noise holds beyond it is a level per stream (HiddenLevels),
@@ -329,7 +341,11 @@ void final_gls(const DiagnosisProblem& P, const DiagnosisOptions& options, const
 // 0.30 um where 0.50 um was declared. Nothing changes where the residuals show the declared
 // variance.
 void white_hidden_levels(const DiagnosisProblem& P, const DiagnosisOptions& options, Diagnosis& D) {
-  if (D.findings.empty() || !P.declared_noise_um()) return;
+  if (D.findings.empty()) return;
+  if (!P.declared_noise_um()) {
+    white_time_constants(P, D);
+    return;
+  }
   const Eigen::VectorXd& r = D.final_fit.residuals;
   NoiseModelOptions white_streams;
   white_streams.max_order = 0;
@@ -341,6 +357,7 @@ void white_hidden_levels(const DiagnosisProblem& P, const DiagnosisOptions& opti
   t.W = std::make_shared<ArWhitener>(m);
   with_hidden_levels(P, m, t);
   if (t.full) refit_findings(P, options, t, D);
+  else white_time_constants(P, D);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include <ceres/jet.h>
 
 #include "candidate_jets.hpp"
+#include "rotacal/core/time_constant_fit.hpp"
 #include "rotacal/rtest/problem.hpp"
 
 namespace rotacal {
@@ -52,7 +53,7 @@ ModelFit RtestDiagnosisProblem::fit_gls(const EffectModel& effects,
   JointFitSettings settings;
   settings.sigma = session_.noise_um.value_or(1.0) * 1e-3;
   settings.whitener = std::move(noise);
-  JointFitOutcome fit = solve_joint(model, params, settings);
+  JointFitOutcome fit = solve_with_time_constants(model, params, settings);
 
   ModelFit out;
   out.effects = fx;

@@ -45,6 +45,10 @@ NoiseTreatment coloured_treatment(const NoiseModel& m, bool described = true);
 // (a user's "sphere_f1" or an R-test set-up "nest_cw" keeps its own level).
 Eigen::MatrixXd stream_levels(const DiagnosisProblem& P);
 
+// A thermal_warmup candidate's Jacobian at its amplitude 0 has a zero time-constant column:
+// filled with the tangent of its shift at a unit amplitude (time_constants.cpp).
+void with_time_constant_tangent(const DiagnosisProblem& P, const Effect& candidate, Eigen::MatrixXd& J);
+
 // The effect's parameters in a fit (named "id" or "id.name").
 std::vector<ParameterEstimate> parameters_of(const ModelFit& fit, const Effect& effect);
 
@@ -80,6 +84,7 @@ struct SearchCache {
     for (const Effect& c : todo)
       if (!known.count(c.id())) missing.push_back(c);
     std::vector<Eigen::MatrixXd> fresh = P.candidate_jacobians(at, missing);
+    for (std::size_t i = 0; i < missing.size(); ++i) with_time_constant_tangent(P, missing[i], fresh[i]);
     std::vector<SharedMatrix> out;
     for (const Effect& c : todo) {
       const auto it = known.find(c.id());
@@ -149,6 +154,10 @@ Choice choose(const SearchContext& S, const Round& R, const ModelFit& fit, const
 /// its weight among its rivals, its group, and the ambiguity it leaves (appended to D).
 Finding name_finding(const SearchContext& S, const Round& R, const Choice& choice, const ModelFit& before,
                      const EffectModel& before_effects, Diagnosis& D);
+
+/// A thermal_warmup's time constant the final fit held, profiled, with its uncertainty in the
+/// other parameters' sigmas (time_constants.cpp); `scale`: what the caller multiplies them by.
+void profile_time_constants(const DiagnosisProblem& P, const NoiseTreatment& t, double scale, Diagnosis& D);
 
 /// What the final model leaves: structure after, the unexplained-structure test and, where
 /// structure remains as a function of one rotary angle, its per-angle table (into D).

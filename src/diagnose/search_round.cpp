@@ -39,6 +39,7 @@ struct ColouredRound {
   Eigen::MatrixXd Q_raw;  // orthonormal basis of the free columns
   Eigen::VectorXd Qr;     // Q_raw^T r (zero but for the fit's convergence)
   NoiseModelOptions own_noise;  // each candidate's own noise model (see candidate_treatment)
+  NoiseModel wander_start;      // 1/f-like: the current residuals' AR model, REML's start
   NoiseTreatment wander_noise;  // 1/f-like: AR(1) + random walk by REML, once per round
   std::unique_ptr<ModelProducts> products;  // white or AR(1) candidates' Gram matrices
 };
@@ -90,10 +91,20 @@ void score_coloured(const SearchContext& S, const ModelFit& fit, Round& R, Colou
     in_c.Jfree = R.J_levels;
     in_c.num_free += R.levels_rank;
     if (!C.wander_noise.W) {
-      const NoiseModel start = estimate_noise_model(S.layout, fit.residuals, options.noise);
-      C.wander_noise = coloured_treatment(estimate_noise_model_reml(start, fit.residuals, R.J_levels));
+      C.wander_start = estimate_noise_model(S.layout, fit.residuals, options.noise);
+      C.wander_noise = coloured_treatment(estimate_noise_model_reml(C.wander_start, fit.residuals, R.J_levels));
     }
     own = C.wander_noise;
+    // The walk estimated with the candidate's columns in the model too, so that its own
+    // signature is not taken for the walk (a drift or warm-up the current model leaves, whose
+    // walk whitened it away: thermal_drift_Z and thermal_warmup_Z on the probe in AR(1) 0.9
+    // noise, 'nothing' at 10x). Only where the candidate's own AR model of its residual is
+    // below half the current one's sigma (it explains most of what the walk would take).
+    if (own_model.sigma_um < 0.5 * C.wander_start.sigma_um) {
+      Eigen::MatrixXd X(R.J_levels.rows(), R.J_levels.cols() + Jc.cols());
+      X << R.J_levels, Jc;
+      own = coloured_treatment(estimate_noise_model_reml(C.wander_start, fit.residuals, X));
+    }
   }
   in_c.Q_w = orthonormal_basis_full_rank(own.whiten(in_c.Jfree));
   in_c.r_w = own.whiten(fit.residuals);

@@ -1,6 +1,7 @@
 // Joint fit of a touch-probe session through the one driver with its noise model.
 #include <cmath>
 
+#include "rotacal/core/time_constant_fit.hpp"
 #include "rotacal/probe/identify.hpp"
 #include "rotacal/probe/problem.hpp"
 
@@ -25,7 +26,7 @@ ProbeIdentification identify_probe(const ProbeSession& session, const ProbeFitOp
   settings.whitener = options.whitener;
   const std::vector<FitParameter> parameters = problem.parameters();
   NoiseFit nf = fit_with_noise(
-      [&](const JointFitSettings& s) { return solve_joint(problem, parameters, s); }, settings, problem.groups(),
+      [&](const JointFitSettings& s) { return solve_with_time_constants(problem, parameters, s); }, settings, problem.groups(),
       problem.times(), options.noise);
   JointFitOutcome& fit = nf.fit;
 

@@ -99,3 +99,97 @@ def test_a_stylus_radius_offset_is_still_named(tmp_path, kind):
         assert named == "stylus_radius_offset", (seed, d["findings"][:1])
         p = d["findings"][0]["parameters"]["stylus_radius_offset"]
         assert abs(p["value"] - 5e-3) <= 3 * p["std"], (seed, p)
+
+
+def warmup_tau_s(machine) -> float:
+    """A warm-up time constant other than the fits' start (300 s): a quarter of the session."""
+    return 0.25 * float(poses.probe_poses(refsim.builtin(machine), sphere=SPHERE)["time"][-1])
+
+
+@pytest.mark.parametrize("seed", [1301, 1302, 1303])
+def test_a_warmup_beside_a_wobble_is_named_with_its_amplitude_covered(tmp_path, seed):
+    """Two catalogue effects at once in AR(1) 0.5 noise: a warm-up along Y whose time constant
+    (a quarter of the session) is not the fits' 300 s start, and a second-order wobble of C. The
+    fits hold the time constant there no more (core/time_constant_fit.hpp): the warm-up is named
+    first and its amplitude and time constant cover the truth within 3 sigma. Before, tau was
+    held at 300 s, the amplitude came out 3-10 sigma off and a thermal_drift took the rest."""
+    tau = warmup_tau_s("BC-trt")
+    d_mm = 0.012
+    d = rotacal.diagnose(probe_session(tmp_path, "BC-trt", {"thermal_warmup_Y": [d_mm, tau],
+                                                            "tilt_motion_C_h2": [0, 2e-5, 0, 0]}, seed,
+                                       kind="ar1_0.5")).to_dict()
+    warm = [f for f in d["findings"] if f["effect"] == "thermal_warmup_Y"]
+    assert warm, [f["effect"] for f in d["findings"]]
+    p = warm[0]["parameters"]
+    amp, q = p["thermal_warmup_Y.d"], p["thermal_warmup_Y.ln_tau_300s"]
+    assert amp["value"] is not None and abs(amp["value"] - d_mm) <= 3 * amp["std"], amp
+    assert q["value"] is not None and abs(q["value"] - np.log(tau / 300.0)) <= 3 * q["std"], q
+    assert not any(f["effect"].startswith("thermal_drift") for f in d["findings"]), d["findings"]
+
+
+@pytest.mark.parametrize("entry,size", [("thermal_drift_Z", [4e-5]), ("thermal_warmup_Z", [0.015, None])])
+def test_a_z_drift_in_strongly_correlated_noise_is_found(tmp_path, entry, size):
+    """A drift or warm-up along Z moves each touch by its approach direction's Z part, which the
+    five touches of a pose repeat: the noise model of the baseline's residuals took it for slow
+    noise with a period of five touches (AR(6) of 1.8 um on 0.5 um AR(1) 0.9 readings). It is
+    found (named, or the group that holds it) in each of these sessions, with nothing else named
+    first. Before, 'nothing' in most: cross-validation in two blocks of half a session, and the
+    walk of the 1/f-like treatment estimated with the drift still in the residuals."""
+    params = [size[0], warmup_tau_s("AC-trt")] if entry == "thermal_warmup_Z" else size
+    missed = []
+    for seed in (1401, 1402, 1403, 1404):
+        d = rotacal.diagnose(probe_session(tmp_path, "AC-trt", {entry: params}, seed, kind="ar1_0.9")).to_dict()
+        named, group = first(d)
+        if not (named == entry or (named is None and entry in group)):
+            missed.append((seed, named, group))
+    assert not missed, missed
+
+
+def bump_session(tmp_path, machine, seed, kind, height_mm=0.004, in_time=False):
+    """A session of probe_session's set-up with a shift outside the catalogue added to the
+    touches: the table moves by a Gaussian bump, along X as a function of C (20 deg wide at
+    C = 90 deg: a localised defect of the rotary table's track), or along Y as a function of
+    time (15 s wide at 70 % of the session: the set-up knocked and settling back)."""
+    rng = np.random.default_rng(seed)
+    m = refsim.builtin(machine)
+    s = poses.probe_poses(m, sphere=SPHERE)
+    errors = {n: (rng.normal(0, 0.02) if k % 4 < 2 else rng.normal(0, 4e-5)) for k, n in enumerate(m.error_names())}
+    actual = s["sphere"] + rng.normal(0, 0.02, 3)
+    latched = refsim.probe_touches(refsim.Model(m, errors, {}), actual, s["sphere"], 25.0, 6.0, s["n"],
+                                   np.radians(s["angles_deg"]), s["time"])
+    n = s["n"] / np.linalg.norm(s["n"], axis=1, keepdims=True)
+    if in_time:
+        shift, axis = height_mm * np.exp(-0.5 * ((s["time"] - 0.7 * s["time"][-1]) / 15.0) ** 2), 1
+    else:
+        gap = (s["angles_deg"][:, poses.rotary_roles(m)[1]] - 90.0 + 180.0) % 360.0 - 180.0
+        shift, axis = height_mm * np.exp(-0.5 * (gap / 20.0) ** 2), 0
+    latched = latched + (shift * n[:, axis])[:, None] * n  # the touch meets the moved sphere
+    one = ["touches"] * len(latched)
+    sig = 0.5e-3
+    e = noise.pink(one, sig, rng) if kind == "pink" else noise.ar1(one, float(kind.split("_")[1]), sig, rng)
+    path = writers.write_probe(tmp_path / f"bump_{machine}_{seed}.csv", m, s, latched + e[:, None] * n, 25.0, 6.0,
+                               noise_um=0.5)
+    return rotacal.load(path)
+
+
+TRACK_BUMP_AS_STRAIGHTNESS = pytest.mark.xfail(strict=True, reason=(
+    "left open: with the default layout's one C sweep, an X shift peaking at C = 90 deg is an X "
+    "error peaking at the sweep's largest Y, which straightness_XY expresses; it is named alone "
+    "(weight 1.00, seeds 1502-1504) where 'unexplained structure' or a group is wanted"))
+TIME_BUMP_AS_WARMUP = pytest.mark.xfail(strict=True, reason=(
+    "left open: in 1/f-like noise a Y shift settling back within 15 s is named thermal_warmup_Y "
+    "(weight 0.91-0.97, seeds 1501 and 1503)"))
+
+
+@pytest.mark.parametrize("machine,kind,in_time", [
+    ("AC-trt", "ar1_0.5", True),
+    pytest.param("BC-trt", "pink", True, marks=TIME_BUMP_AS_WARMUP),
+    pytest.param("AC-trt", "ar1_0.5", False, marks=TRACK_BUMP_AS_STRAIGHTNESS)])
+def test_a_shape_outside_the_catalogue_gets_no_confident_name(tmp_path, machine, kind, in_time):
+    """A shape outside the catalogue (bump_session) in coloured noise: the diagnosis may name
+    nothing, report unexplained structure or a group, never one catalogue entry with
+    confidence."""
+    for seed in (1501, 1502, 1503, 1504):
+        d = rotacal.diagnose(bump_session(tmp_path, machine, seed, kind, in_time=in_time)).to_dict()
+        named = [(f["effect"], f["weight"]) for f in d["findings"] if f["named"]]
+        assert not named, (seed, named)
