@@ -442,3 +442,6 @@ Scalar ballbar_reading_error(const EffectModel& fx, const Scalar* p, double t) {
 }
 
 }  // namespace rotacal
+
+// Compiled once per scalar the library uses (extern template declarations).
+#include "rotacal/kinematics/effects_instances.hpp"
