@@ -9,10 +9,6 @@ namespace rotacal::diagnosis_detail {
 
 namespace {
 
-// thermal_warmup's table shift d (1 - exp(-t / tau)), tau = 300 s e^q (kinematics/effects.hpp):
-// the time factor at q.
-double warmup_factor(double t, double q) { return 1.0 - std::exp(-t / (300.0 * std::exp(q))); }
-
 struct ProfilePoint {
   double q = 0.0, chi2 = 0.0;
   Eigen::VectorXd x;      // the free parameters' steps, the amplitude last (its value, not a step)
@@ -55,7 +51,7 @@ void with_time_constant_tangent(const DiagnosisProblem& P, const Effect& candida
       static_cast<Eigen::Index>(times.size()) != J.rows() || J.col(1).squaredNorm() > 0.0)
     return;
   for (Eigen::Index i = 0; i < J.rows(); ++i) {
-    const double t = times[static_cast<std::size_t>(i)], g = warmup_factor(t, 0.0);
+    const double t = times[static_cast<std::size_t>(i)], g = thermal_warmup_factor(t, 0.0);
     J(i, 1) = g > 1e-12 ? J(i, 0) / g * (-(t / 300.0) * std::exp(-t / 300.0)) : 0.0;
   }
 }
@@ -95,12 +91,12 @@ void profile_time_constants(const DiagnosisProblem& P, const NoiseTreatment& t, 
     // The column's geometry per reading, c0_i / factor(t_i, q0) (0 where t_i = 0: no shift yet).
     Eigen::VectorXd geometry = Eigen::VectorXd::Zero(c0.size());
     for (Eigen::Index i = 0; i < c0.size(); ++i) {
-      const double g = warmup_factor(times[static_cast<std::size_t>(i)], q0);
+      const double g = thermal_warmup_factor(times[static_cast<std::size_t>(i)], q0);
       if (g > 1e-12) geometry[i] = c0[i] / g;
     }
     const auto column_at = [&](double q) {
       Eigen::VectorXd c(c0.size());
-      for (Eigen::Index i = 0; i < c.size(); ++i) c[i] = geometry[i] * warmup_factor(times[static_cast<std::size_t>(i)], q);
+      for (Eigen::Index i = 0; i < c.size(); ++i) c[i] = geometry[i] * thermal_warmup_factor(times[static_cast<std::size_t>(i)], q);
       return c;
     };
     std::vector<Eigen::Index> others;

@@ -141,6 +141,14 @@ inline int chain_index(MachineType m, char letter) {
 }
 }  // namespace detail
 
+/// thermal_warmup's time factor 1 - exp(-t / tau), tau = 300 s e^q (the table shifts by d times
+/// it): the one definition, used by the motion below and by the diagnosis' profile of tau.
+template <typename Scalar>
+Scalar thermal_warmup_factor(double t, const Scalar& q) {
+  using std::exp;
+  return Scalar(1) - exp(-Scalar(t) / (Scalar(300) * exp(q)));
+}
+
 /// nR of a rotary effect: the argument of its cos and sin in axis_stages, R the commanded
 /// angle of its axis (0 on a machine without that axis).
 inline double harmonic_angle(MachineType m, const Effect& f, const RotaryAngles<double>& cmd) {
@@ -263,7 +271,7 @@ AxisStages<Scalar> axis_stages(MachineType m, const EffectModel& fx, const Scala
         break;
       case EffectKind::thermal_warmup:  // tau = 300 s * exp(q1): q1 = 0 is a sensible start
         if (!st.D[0]) st.D[0] = Vec3<Scalar>::Zero();
-        (*st.D[0])[axis_index(f.axis)] += q[0] * (Scalar(1) - exp(-Scalar(t) / (Scalar(300) * exp(q[1]))));
+        (*st.D[0])[axis_index(f.axis)] += q[0] * thermal_warmup_factor(t, q[1]);
         break;
       default:  // tool-side and instrument effects do not move the table
         break;
