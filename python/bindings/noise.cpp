@@ -2,6 +2,7 @@
 #include "numpy.hpp"
 #include "rotacal/core/noise_model.hpp"
 #include "rotacal/diagnose/ballbar_diagnosis.hpp"
+#include "rotacal/diagnose/rtest_budget.hpp"
 #include "rotacal/diagnose/rtest_diagnosis.hpp"
 #include "rotacal/diagnose/uncertainty_budget.hpp"
 
@@ -141,6 +142,16 @@ void bind_noise(pyb::module_& m) {
       },
       pyb::arg("session"), pyb::arg("diagnosis"), pyb::arg("sizes") = PlausibleSizes{},
       pyb::arg("coverage") = 0.95, "GUM budget of the location errors of diagnose_rtest's result.");
+  m.def(
+      "uncertainty_budget_rtest_identification",
+      [](const RtestSession& session, const RtestJointIdentification& identification, const PlausibleSizes& sizes,
+         double coverage) {
+        pyb::gil_scoped_release release;
+        return uncertainty_budget(session, identification, sizes, coverage);
+      },
+      pyb::arg("session"), pyb::arg("identification"), pyb::arg("sizes") = PlausibleSizes{},
+      pyb::arg("coverage") = 0.95,
+      "GUM budget of the location errors of identify_rtest_joint's result, on its own model (maps included).");
 }
 
 }  // namespace rotacal::py

@@ -7,9 +7,9 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from . import _core, ballbar, multi, probe, rtest
-from .diagnosis import diagnose, uncertainty_budget
+from .diagnosis import diagnose, plausible_sizes, uncertainty_budget
 from .models import ballbar_model_from_dict
-from .sessions import BALLBAR, PROBE, RTEST, by_kind
+from .sessions import BALLBAR, PROBE, RTEST, by_kind, kind
 
 # A ballbar model holds the pivot where its own session's ball sat (nominal + a set-up error of
 # some 10 um): a session whose nominal pivot is farther from it was set up elsewhere, and its
@@ -47,10 +47,16 @@ def identify(session: Any, method: str = "joint", *, fit_length_offset: bool = F
     return run()
 
 
-def identification_budget(session: Any, sizes: Any = None) -> Any:
+def identification_budget(session: Any, sizes: Any = None, identification: Any = None) -> Any:
     """The GUM budget of a joint identification of ``session`` (diagnose/uncertainty_budget.hpp):
     it rests on the diagnosis of what the model leaves out. An R-test session's raw d1,d2,d3
-    readings are converted as identify_rtest converts them. ``sizes``: plausible_sizes() input."""
+    readings are converted as identify_rtest converts them. Given the R-test ``identification``
+    (identify_rtest's joint result), the budget is of its own model, maps included
+    (diagnose/rtest_budget.hpp): the values and type A are the ones it reports.
+    ``sizes``: plausible_sizes() input."""
+    if identification is not None and kind(session) == RTEST:
+        return _core.uncertainty_budget_rtest_identification(rtest.with_displacements(session)[0],
+                                                             identification.raw, plausible_sizes(sizes))
     fitted = by_kind(session, {BALLBAR: lambda: session, RTEST: lambda: rtest.with_displacements(session)[0]},
                      "identify")()
     return uncertainty_budget(fitted, sizes=sizes)

@@ -11,6 +11,7 @@
 #include "rotacal/core/error.hpp"
 #include "rotacal/core/stats.hpp"
 #include "rotacal/kinematics/parameter_blocks.hpp"
+#include "budget_detail.hpp"
 #include "scoring.hpp"
 
 namespace rotacal {
@@ -62,34 +63,47 @@ std::vector<double> plausible_sizes(const Effect& e, const PlausibleSizes& z, do
   return a;
 }
 
-UncertaintyBudget uncertainty_budget(const DiagnosisProblem& P, const Diagnosis& D,
-                                     const PlausibleSizes& sizes, double coverage, int max_harmonic) {
+void budget_detail::check_inputs(const PlausibleSizes& sizes, const std::vector<Effect>& all, double coverage) {
   if (!(coverage > 0.0 && coverage < 1.0))
     throw InvalidArgument("uncertainty_budget: coverage is " + std::to_string(coverage) + ", must be in (0, 1)");
-  const ModelFit& fit = D.final_fit;
-  const auto n = fit.residuals.size();
-  if (n == 0 || fit.jacobian.rows() != n)
-    throw InvalidArgument("uncertainty_budget: the diagnosis has no final fit");
-  std::vector<Effect> candidates;
-  for (const Effect& c : P.candidates(max_harmonic))
-    if (std::find(fit.effects.effects.begin(), fit.effects.effects.end(), c) == fit.effects.effects.end())
-      candidates.push_back(c);
   for (const auto& [key, value] : sizes.overrides) {
     (void)value;
     const Effect e = Effect::parse(key.substr(0, key.find('.')));
-    const auto all = P.candidates(max_harmonic);
     if (std::find(all.begin(), all.end(), e) == all.end())
       throw InvalidArgument("uncertainty_budget: override '" + key + "' names no candidate of this session");
   }
-  const auto& times = P.times();
+}
+
+UncertaintyBudget uncertainty_budget(const DiagnosisProblem& P, const Diagnosis& D,
+                                     const PlausibleSizes& sizes, double coverage, int max_harmonic) {
+  const std::vector<Effect> all = P.candidates(max_harmonic);
+  budget_detail::check_inputs(sizes, all, coverage);
+  const ModelFit& fit = D.final_fit;
+  if (fit.residuals.size() == 0 || fit.jacobian.rows() != fit.residuals.size())
+    throw InvalidArgument("uncertainty_budget: the diagnosis has no final fit");
+  std::vector<Effect> candidates;  // what the final model leaves out
+  for (const Effect& c : all)
+    if (std::find(fit.effects.effects.begin(), fit.effects.effects.end(), c) == fit.effects.effects.end())
+      candidates.push_back(c);
+  const budget_detail::BudgetedFit model{P.machine(), fit, D.noise, D.baseline.noise_um, nullptr, P.times()};
+  return budget_detail::budget_of(model, candidates, P.candidate_jacobians(fit, candidates), sizes, coverage);
+}
+
+UncertaintyBudget budget_detail::budget_of(const BudgetedFit& m, const std::vector<Effect>& candidates,
+                                           const std::vector<Eigen::MatrixXd>& jacobians,
+                                           const PlausibleSizes& sizes, double coverage) {
+  const ModelFit& fit = m.fit;
+  const auto n = fit.residuals.size();
+  ROTACAL_ASSERT(fit.jacobian.rows() == n && jacobians.size() == candidates.size());
+  const auto& times = m.times;
   const double duration = times.empty() ? 0.0
                                         : *std::max_element(times.begin(), times.end()) -
                                               *std::min_element(times.begin(), times.end());
 
-  // Whitening by the noise model the diagnosis reports (white: 1/sigma).
+  // Whitening by the fit's noise model (white: 1/sigma).
   std::unique_ptr<ArWhitener> W;
-  if (!D.noise.white() && D.noise.n == static_cast<std::size_t>(n)) W = std::make_unique<ArWhitener>(D.noise);
-  const double sigma_mm = std::max(D.baseline.noise_um, 1e-9) * 1e-3;
+  if (!m.noise.white() && m.noise.n == static_cast<std::size_t>(n)) W = std::make_unique<ArWhitener>(m.noise);
+  const double sigma_mm = std::max(m.noise_um, 1e-9) * 1e-3;
   const auto whiten = [&](const Eigen::MatrixXd& M) {
     Eigen::MatrixXd out = M;
     if (W) W->apply(out);
@@ -103,13 +117,23 @@ UncertaintyBudget uncertainty_budget(const DiagnosisProblem& P, const Diagnosis&
   for (Eigen::Index j = 0; j < fit.jacobian.cols(); ++j)
     if (fit.jacobian.col(j).squaredNorm() > 0.0) free_index[static_cast<std::size_t>(j)] = nf++;
   const Eigen::MatrixXd J = free_columns(fit.jacobian);
-  // Type A: GLS covariance (J_w^T J_w)^-1 by SVD (free parameters are determined: no null space).
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd_w(whiten(J), Eigen::ComputeThinV);
-  Eigen::VectorXd inv_s = svd_w.singularValues();
-  for (Eigen::Index i = 0; i < inv_s.size(); ++i)
-    inv_s[i] = inv_s[i] > 1e-12 * inv_s[0] ? 1.0 / inv_s[i] : 0.0;
-  const Eigen::MatrixXd cov_a = svd_w.matrixV() * inv_s.cwiseAbs2().asDiagonal() * svd_w.matrixV().transpose();
-  const double n_eff = W ? D.noise.effective_samples : static_cast<double>(n);
+  // Type A: the fit's own covariance where it has one (the identification's, as it reports it),
+  // else the GLS covariance (J_w^T J_w)^-1 by SVD (free parameters are determined: no null space).
+  Eigen::MatrixXd cov_a;
+  if (m.covariance) {
+    ROTACAL_ASSERT(m.covariance->rows() == fit.jacobian.cols());
+    std::vector<Eigen::Index> cols;
+    for (Eigen::Index j = 0; j < fit.jacobian.cols(); ++j)
+      if (free_index[static_cast<std::size_t>(j)] >= 0) cols.push_back(j);
+    cov_a = (*m.covariance)(cols, cols);
+  } else {
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd_w(whiten(J), Eigen::ComputeThinV);
+    Eigen::VectorXd inv_s = svd_w.singularValues();
+    for (Eigen::Index i = 0; i < inv_s.size(); ++i)
+      inv_s[i] = inv_s[i] > 1e-12 * inv_s[0] ? 1.0 / inv_s[i] : 0.0;
+    cov_a = svd_w.matrixV() * inv_s.cwiseAbs2().asDiagonal() * svd_w.matrixV().transpose();
+  }
+  const double n_eff = W ? m.noise.effective_samples : static_cast<double>(n);
   const double dof_a = std::max(1.0, n_eff - static_cast<double>(J.cols()));
   // Unweighted least squares (what the fits do): bias = pinv(J) J_effect delta.
   const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> ls(J);
@@ -123,7 +147,6 @@ UncertaintyBudget uncertainty_budget(const DiagnosisProblem& P, const Diagnosis&
     std::vector<double> a;
   };
   std::vector<Contribution> lines;
-  const std::vector<Eigen::MatrixXd> jacobians = P.candidate_jacobians(fit, candidates);
   for (std::size_t i = 0; i < candidates.size(); ++i) {
     const Effect& c = candidates[i];
     const Eigen::MatrixXd& Jc = jacobians[i];
@@ -166,7 +189,7 @@ UncertaintyBudget uncertainty_budget(const DiagnosisProblem& P, const Diagnosis&
   UncertaintyBudget out;
   out.coverage = coverage;
   ParameterLayout location;  // the location errors' names and units, as every problem lays them out
-  const ParameterBlock errors = add_location_errors(location, P.machine());
+  const ParameterBlock errors = add_location_errors(location, m.machine);
   for (std::size_t i = 0; i < errors.names.size(); ++i) {
     LocationBudget L;
     L.name = errors.names[i];

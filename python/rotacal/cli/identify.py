@@ -202,7 +202,7 @@ def cmd_identify(a: argparse.Namespace) -> int:
         raise _core.InvalidArgument("identify: --length-offset is for ballbar sessions")
     result = identify(s, a.method, fit_length_offset=a.length_offset, noise=a.noise)
     if a.method == "joint" and not a.no_budget:
-        result.budget = identification_budget(s, sizes)
+        result.budget = identification_budget(s, sizes, result)
     d = result.to_dict()
     if a.monte_carlo:
         d["monte_carlo"] = monte_carlo(s, result, a.monte_carlo, seed=a.seed)
