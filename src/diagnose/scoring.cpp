@@ -211,7 +211,8 @@ std::vector<int> cv_folds(const DiagnosisProblem& P, int K, const NoiseModel* no
     const auto it = min_block.find(kv.first);
     if (it != min_block.end() && it->second > 1.0)
       blocks = std::clamp(static_cast<int>(static_cast<double>(idx.size()) / it->second), 2, K);
-    for (std::size_t k = 0; k < idx.size(); ++k) fold[idx[k]] = contiguous_block(k, idx.size(), blocks, shift);
+    for (std::size_t k = 0; k < idx.size(); ++k)
+      fold[idx[k]] = contiguous_block(k, idx.size(), blocks, shift);
   }
   return fold;
 }
@@ -228,9 +229,10 @@ namespace {
 // The score of candidate c from its Gram quantities per plausible size (score_columns), with
 // why a candidate that is not observable is not. nullopt where score_columns cannot decide.
 // V and d: the observable directions and their coefficients.
-std::optional<Score> score_from_grams(const Effect& c, const Eigen::VectorXd& m, const CandidateGrams& g,
-                                      int num_free, double min_chi2, double tol,
-                                      Eigen::MatrixXd* V_out = nullptr, Eigen::VectorXd* d_out = nullptr) {
+std::optional<Score> score_from_grams(const Effect& c, const Eigen::VectorXd& m,
+                                      const CandidateGrams& g, int num_free, double min_chi2,
+                                      double tol, Eigen::MatrixXd* V_out = nullptr,
+                                      Eigen::VectorXd* d_out = nullptr) {
   ColumnScore cs = score_columns(m, g, num_free, 0, min_chi2, tol);
   if (!cs.decided) return std::nullopt;
   Score s;
