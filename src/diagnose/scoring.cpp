@@ -1,8 +1,8 @@
 // Scoring of candidate effects: least-squares helpers, the linearised refit with its delta
 // BIC and F-test, and blocked cross-validation.
 #include <Eigen/Cholesky>
-#include <Eigen/QR>
 #include <Eigen/Eigenvalues>
+#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -117,6 +117,71 @@ Eigen::MatrixXd free_columns(const Eigen::MatrixXd& J) {
   return out;
 }
 
+ColumnScore score_columns(const Eigen::VectorXd& m, const CandidateGrams& g, int num_free,
+                          int nonlinear, double min_chi2, double tol) {
+  ColumnScore s;
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(g.perp);
+  if (es.info() != Eigen::Success) {
+    s.decided = false;
+    return s;
+  }
+  const Eigen::VectorXd& ev = es.eigenvalues();
+  std::vector<Eigen::Index> dirs;
+  for (Eigen::Index i = 0; i < ev.size(); ++i) {
+    if (std::abs(ev[i] - min_chi2) < tol) {
+      s.decided = false;
+      return s;
+    }
+    if (ev[i] >= min_chi2) dirs.push_back(i);
+  }
+  if (dirs.empty()) {
+    const Eigen::VectorXd ev_raw =
+        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(g.raw, Eigen::EigenvaluesOnly).eigenvalues();
+    const double top = ev_raw.size() ? ev_raw.maxCoeff() : 0.0;
+    s.decided = !(std::abs(top - min_chi2) < tol);
+    s.absorbed = top >= min_chi2;
+    return s;
+  }
+  s.visible = true;
+  s.k = static_cast<int>(dirs.size());
+  s.V.resize(m.size(), s.k);
+  Eigen::VectorXd lambda(s.k);
+  for (int i = 0; i < s.k; ++i) {
+    s.V.col(i) = es.eigenvectors().col(dirs[static_cast<std::size_t>(i)]);
+    lambda[i] = ev[dirs[static_cast<std::size_t>(i)]];
+  }
+  // A = perp_columns V has orthogonal columns of squared norms lambda: d = A' r_w / lambda.
+  const Eigen::VectorXd Atr = s.V.transpose() * g.perp_r;
+  s.d = Atr.cwiseQuotient(lambda);
+  s.params = m.cwiseProduct(s.V * s.d);
+  s.rss1 = std::max(g.rr - Atr.dot(s.d), 1e-300);
+  const int k_all = s.k + nonlinear;
+  s.delta_bic = g.n * std::log(s.rss1 / g.rr) + k_all * std::log(g.n);
+  const double dof = g.n - num_free - k_all;
+  const double F = ((g.rr - s.rss1) / s.k) / (s.rss1 / dof);
+  s.f_pvalue = stats::f_sf(std::max(F, 0.0), s.k, dof);
+  return s;
+}
+
+double blocked_cv_rms_um(const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
+                         const std::vector<int>& fold, int K, const FoldFit& fit) {
+  double ss = 0.0;
+  std::size_t n = 0;
+  for (int k = 0; k < K; ++k) {
+    std::vector<Eigen::Index> tr, te;
+    for (std::size_t i = 0; i < fold.size(); ++i)
+      (fold[i] == k ? te : tr).push_back(static_cast<Eigen::Index>(i));
+    if (te.empty() || tr.empty()) continue;
+    const Eigen::VectorXd d = fit(tr);
+    for (Eigen::Index i : te) {
+      const double e = y[i] - (X.cols() ? X.row(i).dot(d) : 0.0);
+      ss += e * e;
+      ++n;
+    }
+  }
+  return n ? std::sqrt(ss / static_cast<double>(n)) * 1e3 : 0.0;
+}
+
 std::vector<int> cv_folds(const DiagnosisProblem& P, int K, const NoiseModel* noise) {
   const auto& g = P.groups();
   const auto& t = P.times();
@@ -147,63 +212,33 @@ std::vector<int> cv_folds(const DiagnosisProblem& P, int K, const NoiseModel* no
     if (it != min_block.end() && it->second > 1.0)
       blocks = std::clamp(static_cast<int>(static_cast<double>(idx.size()) / it->second), 2, K);
     for (std::size_t k = 0; k < idx.size(); ++k)
-      fold[idx[k]] = (static_cast<int>(k * static_cast<std::size_t>(blocks) / idx.size()) + shift) % blocks;
+      fold[idx[k]] = contiguous_block(k, idx.size(), blocks, shift);
   }
   return fold;
 }
 
 double cv_rms_um(const Eigen::MatrixXd& X, const Eigen::VectorXd& r, const std::vector<int>& fold,
                  int K) {
-  double ss = 0.0;
-  std::size_t n = 0;
-  for (int k = 0; k < K; ++k) {
-    std::vector<Eigen::Index> tr, te;
-    for (std::size_t i = 0; i < fold.size(); ++i)
-      (fold[i] == k ? te : tr).push_back(static_cast<Eigen::Index>(i));
-    if (te.empty() || tr.empty()) continue;
-    Eigen::MatrixXd Xt(static_cast<Eigen::Index>(tr.size()), X.cols());
-    Eigen::VectorXd yt(static_cast<Eigen::Index>(tr.size()));
-    for (std::size_t i = 0; i < tr.size(); ++i) {
-      Xt.row(static_cast<Eigen::Index>(i)) = X.row(tr[i]);
-      yt[static_cast<Eigen::Index>(i)] = r[tr[i]];
-    }
-    const Eigen::VectorXd d = solve_ls(Xt, yt);
-    for (Eigen::Index i : te) {
-      const double e = r[i] - (X.cols() ? X.row(i).dot(d) : 0.0);
-      ss += e * e;
-      ++n;
-    }
-  }
-  return n ? std::sqrt(ss / static_cast<double>(n)) * 1e3 : 0.0;
+  return blocked_cv_rms_um(X, r, fold, K, [&](const std::vector<Eigen::Index>& train) {
+    return solve_ls(X(train, Eigen::all), r(train));
+  });
 }
 
 namespace {
 
-// The score of candidate c from its Gram matrices per plausible size (columns scaled by its
-// magnitudes m): raw before the model is projected out, perp after; perp_r = the projected
-// columns' products with the whitened residual, rr = its squared norm, n readings. The
-// eigenvalues of perp are the chi-square changes of unit directions. tol > 0: nullopt where an
-// eigenvalue lies within tol of the threshold (the products path leaves that to the columns).
+// The score of candidate c from its Gram quantities per plausible size (score_columns), with
+// why a candidate that is not observable is not. nullopt where score_columns cannot decide.
 // V and d: the observable directions and their coefficients.
-std::optional<Score> score_from_grams(const Effect& c, const Eigen::VectorXd& m, const Eigen::MatrixXd& raw,
-                                      const Eigen::MatrixXd& perp, const Eigen::VectorXd& perp_r, double rr,
-                                      double n, int num_free, double min_chi2, double tol,
-                                      Eigen::MatrixXd* V_out = nullptr, Eigen::VectorXd* d_out = nullptr) {
+std::optional<Score> score_from_grams(const Effect& c, const Eigen::VectorXd& m,
+                                      const CandidateGrams& g, int num_free, double min_chi2,
+                                      double tol, Eigen::MatrixXd* V_out = nullptr,
+                                      Eigen::VectorXd* d_out = nullptr) {
+  ColumnScore cs = score_columns(m, g, num_free, 0, min_chi2, tol);
+  if (!cs.decided) return std::nullopt;
   Score s;
   s.effect = c;
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(perp);
-  if (es.info() != Eigen::Success) return std::nullopt;
-  const Eigen::VectorXd ev = es.eigenvalues();
-  std::vector<Eigen::Index> dirs;
-  for (Eigen::Index i = 0; i < ev.size(); ++i) {
-    if (std::abs(ev[i] - min_chi2) < tol) return std::nullopt;
-    if (ev[i] >= min_chi2) dirs.push_back(i);  // plausible sizes change chi-square by >= min_chi2
-  }
-  if (dirs.empty()) {
-    const Eigen::VectorXd ev_raw = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(raw, Eigen::EigenvaluesOnly).eigenvalues();
-    const double top = ev_raw.size() ? ev_raw.maxCoeff() : 0.0;
-    if (std::abs(top - min_chi2) < tol) return std::nullopt;
-    s.why_not = top >= min_chi2
+  if (!cs.visible) {
+    s.why_not = cs.absorbed
                     ? "its effect on these readings is indistinguishable from the location "
                       "errors and set-up parameters already in the model"
                     : "at any plausible size it changes these readings by less than 5 sigma "
@@ -211,27 +246,14 @@ std::optional<Score> score_from_grams(const Effect& c, const Eigen::VectorXd& m,
     return s;
   }
   s.observable = true;
-  s.k = static_cast<int>(dirs.size());
-  Eigen::MatrixXd V(m.size(), s.k);
-  Eigen::VectorXd lambda(s.k);
-  for (int i = 0; i < s.k; ++i) {
-    V.col(i) = es.eigenvectors().col(dirs[static_cast<std::size_t>(i)]);
-    lambda[i] = ev[dirs[static_cast<std::size_t>(i)]];
-  }
-  s.directions = m.asDiagonal() * V;
-  // A = perp V has orthogonal columns of squared norms lambda: d = A^T r_w / lambda.
-  const Eigen::VectorXd Atr = V.transpose() * perp_r;
-  const Eigen::VectorXd d = Atr.cwiseQuotient(lambda);
-  s.params = m.cwiseProduct(V * d);
-  // F and BIC on whitened residuals: independent with unit variance under the noise model,
-  // so the textbook tests hold with the full n (GLS).
-  s.rss1 = std::max(rr - Atr.dot(d), 1e-300);
-  const double dof = n - num_free - s.k;
-  s.delta_bic = n * std::log(s.rss1 / rr) + s.k * std::log(n);
-  const double F = ((rr - s.rss1) / s.k) / (s.rss1 / dof);
-  s.f_pvalue = stats::f_sf(std::max(F, 0.0), s.k, dof);
-  if (V_out) *V_out = std::move(V);
-  if (d_out) *d_out = d;
+  s.k = cs.k;
+  s.directions = m.asDiagonal() * cs.V;
+  s.params = std::move(cs.params);
+  s.rss1 = cs.rss1;
+  s.delta_bic = cs.delta_bic;
+  s.f_pvalue = cs.f_pvalue;
+  if (V_out) *V_out = std::move(cs.V);
+  if (d_out) *d_out = std::move(cs.d);
   return s;
 }
 
@@ -250,15 +272,18 @@ Score score(const ScoringInputs& in, const Effect& c, Eigen::MatrixXd Jc_w, doub
   // the model is projected out. Eigenvalues rather than an SVD of the n x k columns: the
   // threshold min_chi2 sits far above their rounding (eps times the largest), and a 1 kHz
   // recording cannot afford the SVD's copies.
-  const Eigen::MatrixXd raw = m.asDiagonal() * (Jc_w.transpose() * Jc_w) * m.asDiagonal();
+  CandidateGrams g;
+  g.raw = m.asDiagonal() * (Jc_w.transpose() * Jc_w) * m.asDiagonal();
   Jc_w -= in.Q_w * (in.Q_w.transpose() * Jc_w);  // in place: the model projected out
   Jc_w *= m.asDiagonal();
   const Eigen::MatrixXd& perp = Jc_w;
+  g.perp = perp.transpose() * perp;
+  g.perp_r = perp.transpose() * in.r_w;
+  g.rr = rss(in.r_w);
+  g.n = static_cast<double>(in.r_w.size());
   Eigen::MatrixXd V;
   Eigen::VectorXd d;
-  std::optional<Score> got = score_from_grams(c, m, raw, perp.transpose() * perp, perp.transpose() * in.r_w,
-                                              rss(in.r_w), static_cast<double>(in.r_w.size()), in.num_free,
-                                              min_chi2, 0.0, &V, &d);
+  std::optional<Score> got = score_from_grams(c, m, g, in.num_free, min_chi2, 0.0, &V, &d);
   if (!got)  // not with finite columns
     throw DegenerateGeometry("score: the Gram matrix of candidate " + c.id() + " has no eigen decomposition");
   Score s = std::move(*got);
@@ -319,11 +344,14 @@ std::optional<Score> score_from_products(const CandidateProducts& g, const Effec
   }
   // Per plausible size: raw = the candidate's whitened Gram matrix, perp = after projecting
   // out the model (as score() forms them from the columns).
-  const Eigen::MatrixXd raw = m.asDiagonal() * g.G_cc * m.asDiagonal();
-  const Eigen::MatrixXd perp = m.asDiagonal() * (g.G_cc - Y.transpose() * Y) * m.asDiagonal();
-  const double tol = 1e-8 * std::max(raw.norm(), min_chi2);
-  return score_from_grams(c, m, raw, perp, m.asDiagonal() * (g.g_cr - Y.transpose() * yr), g.rr,
-                          static_cast<double>(g.n), num_free, min_chi2, tol);
+  CandidateGrams grams;
+  grams.raw = m.asDiagonal() * g.G_cc * m.asDiagonal();
+  grams.perp = m.asDiagonal() * (g.G_cc - Y.transpose() * Y) * m.asDiagonal();
+  grams.perp_r = m.asDiagonal() * (g.g_cr - Y.transpose() * yr);
+  grams.rr = g.rr;
+  grams.n = static_cast<double>(g.n);
+  const double tol = 1e-8 * std::max(grams.raw.norm(), min_chi2);
+  return score_from_grams(c, m, grams, num_free, min_chi2, tol);
 }
 
 double correlation(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {

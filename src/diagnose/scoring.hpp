@@ -1,8 +1,10 @@
 #pragma once
-// Internal to src/diagnose: the linear algebra, scoring and cross-validation the search loop
-// (diagnosis.cpp) uses, shared with the residual-structure and ambiguity files.
+// Internal to src/diagnose and its adapters: the linear algebra, scoring and cross-validation the
+// search loop (diagnosis.cpp) uses, shared with the residual-structure and ambiguity files and
+// the circular-test diagnosis (src/circular/diagnosis/).
 
 #include <Eigen/Core>
+#include <cstddef>
 #include <functional>
 #include <limits>
 #include <optional>
@@ -41,15 +43,78 @@ Eigen::VectorXd residual_without(const Eigen::MatrixXd& Q, const Eigen::VectorXd
                                  const Eigen::MatrixXd& Jc);
 /// Free (non-zero) columns of a fit's Jacobian.
 Eigen::MatrixXd free_columns(const Eigen::MatrixXd& J);
+
+// ---- What a candidate's columns add to a linear model, defined once for this engine and the
+// circular-test diagnosis (src/circular/diagnosis/, an adapter at this layer). Each caller forms
+// the Gram quantities its own way (from columns, from products, from a pool of variants, under
+// its noise model); what they mean is decided here.
+
+/// A candidate's k columns per plausible size (column j scaled by the plausible magnitude m_j of
+/// its parameter) and whitened, so that squared norms are chi-square changes.
+struct CandidateGrams {
+  Eigen::MatrixXd raw;     ///< k x k Gram matrix of the columns
+  Eigen::MatrixXd perp;    ///< k x k Gram matrix once the model's columns are projected out
+  Eigen::VectorXd perp_r;  ///< k, the projected columns' products with the whitened residuals
+  double rr = 0.0;         ///< the whitened residuals' squared norm (rss before the refit)
+  double n = 0.0;          ///< readings
+};
+
+/// The candidate against the model.
+struct ColumnScore {
+  /// False where the eigen decomposition failed, or an eigenvalue lies within `tol` of the
+  /// threshold (a caller working from rounded products then decides from the columns).
+  bool decided = true;
+  /// Some direction changes chi-square by >= min_chi2 at plausible sizes once the model is
+  /// projected out.
+  bool visible = false;
+  /// Not visible, but a direction of the columns alone is: the model absorbs the candidate.
+  bool absorbed = false;
+  int k = 0;                ///< visible directions
+  Eigen::MatrixXd V;        ///< them, per plausible size (orthonormal columns)
+  Eigen::VectorXd d;        ///< the refit's coefficient along each
+  Eigen::VectorXd params;   ///< the refit's parameters, m .* (V d), in the candidate's units
+  double rss1 = 0.0;        ///< whitened residual sum of squares after the refit
+  double delta_bic = 0.0;   ///< n log(rss1 / rss0) + (k + nonlinear) log n
+  double f_pvalue = 1.0;    ///< P(F > f) of the rss drop, F(k, n - num_free - k - nonlinear)
+};
+
+/// Score candidate columns whose plausible magnitudes are m against a model of num_free free
+/// linear parameters. The eigenvalues of g.perp are the chi-square changes of unit directions
+/// per plausible size; those of at least min_chi2 are visible. Along the visible directions
+/// A = perp_columns V (orthogonal columns of squared norms lambda) the refit removes
+/// (V' perp_r)^2 / lambda each. `nonlinear`: the candidate's parameters profiled outside the
+/// linear model (a backlash's delay), counted in the BIC penalty (Schwarz 1978: k log n) and the
+/// F-test's degrees of freedom. The tests hold with the full n since the residuals are whitened
+/// (GLS). tol > 0: undecided where an eigenvalue lies within tol of min_chi2.
+ColumnScore score_columns(const Eigen::VectorXd& m, const CandidateGrams& g, int num_free,
+                          int nonlinear, double min_chi2, double tol = 0.0);
+
+/// The block (0 .. blocks - 1) of reading i of `size` readings in time order cut into `blocks`
+/// contiguous blocks, shifted by `shift` (mod blocks): the fold of a blocked cross-validation.
+inline int contiguous_block(std::size_t i, std::size_t size, int blocks, int shift = 0) {
+  return (static_cast<int>(i * static_cast<std::size_t>(blocks) / size) + shift) % blocks;
+}
+
+/// The model's coefficients from the training rows of a fold (indices into X's rows, ascending).
+using FoldFit = std::function<Eigen::VectorXd(const std::vector<Eigen::Index>& train)>;
+
+/// Blocked cross-validated RMS (um) of predicting y (mm) from the columns X: for each fold
+/// k < K, the coefficients `fit` finds on the rows of the other folds predict the rows of fold k
+/// (folds without test or training rows are skipped; 0 where no row is predicted).
+double blocked_cv_rms_um(const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
+                         const std::vector<int>& fold, int K, const FoldFit& fit);
+
 /// Blocked K-fold assignment: each group's readings in time order, cut into K contiguous blocks,
 /// fewer (at least 2) where the noise model's correlation time makes blocks of a K-th too short.
 std::vector<int> cv_folds(const DiagnosisProblem& P, int K, const NoiseModel* noise = nullptr);
-/// Cross-validated RMS (um) of predicting r from columns X (linearised refit on the rest).
+/// Cross-validated RMS (um) of predicting r from columns X (blocked_cv_rms_um, each fold's
+/// linearised refit by solve_ls on the rest).
 double cv_rms_um(const Eigen::MatrixXd& X, const Eigen::VectorXd& r, const std::vector<int>& fold,
                  int K);
 
 /// One candidate scored against the current model by a linearised refit, in whitened units
-/// (residuals and columns multiplied by the noise model's W: unit variance, independent).
+/// (residuals and columns multiplied by the noise model's W: unit variance, independent); the
+/// numbers are score_columns'.
 struct Score {
   Effect effect;
   bool observable = false;

@@ -150,6 +150,9 @@ TEST_CASE("Circular diagnosis options are checked", "[circular]") {
   o = {};
   o.alpha = 0.0;
   CHECK_THROWS_WITH(diagnose_circular(s, o), Catch::Contains("alpha"));
+  o = {};
+  o.min_visible_chi2 = 0.0;  // a threshold of zero makes every direction visible, noise or not
+  CHECK_THROWS_WITH(diagnose_circular(s, o), Catch::Contains("min_visible_chi2"));
 }
 
 TEST_CASE("Backlash and a reversal spike on lagging axes: height, decay and the servo's delay",

@@ -1,13 +1,10 @@
 // The scoring of the circular-test diagnosis: visibility at plausible sizes, F-test and BIC
-// of an entry against the current model, one by one or from a pool of every variant.
+// of an entry against the current model (the engine's score_columns), one by one or from a pool
+// of every variant.
 #include "diagnosis_detail.hpp"
 
-#include <Eigen/Eigenvalues>
-#include <algorithm>
-#include <cmath>
-
+#include "../../diagnose/scoring.hpp"
 #include "rotacal/core/error.hpp"
-#include "rotacal/core/stats.hpp"
 
 namespace rotacal::circular_detail {
 
@@ -21,50 +18,35 @@ int nonlinear_params(const CircularEffect& e) {
 // Visibility, F and BIC of entry e against a model whose whitened residuals r_w leave rss0,
 // from the entry's Gram quantities (k <= 2 columns, per unit parameter): G = perp' perp and
 // g = perp' r_w, perp its whitened columns with the model projected out, and Graw = Jw' Jw
-// without. Per plausible size (m) the singular values and right vectors of perp are the square
-// roots and eigenvectors of m G m; the refit along the visible directions A = perp m V
-// (orthogonal columns, squared norms the eigenvalues lambda) removes (v' m g)^2 / lambda each.
+// without. Scaled to plausible sizes (magnitude()), they are scored as the diagnosis engine
+// scores its candidates (score_columns), the profiled nonlinear parameters counted.
 Scored score_gram(const CircularEffect& e, const Eigen::MatrixXd& G, const Eigen::VectorXd& g,
                   const Eigen::MatrixXd& Graw, double rss0, double n, int num_free,
                   double min_chi2) {
-  Scored s;
-  s.effect = e;
   const auto units = e.param_units();
   Eigen::VectorXd m(G.cols());
   for (Eigen::Index j = 0; j < G.cols(); ++j) m[j] = magnitude(units[static_cast<std::size_t>(j)]);
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(m.asDiagonal() * G * m.asDiagonal());
-  const double limit = std::sqrt(min_chi2);
-  std::vector<Eigen::Index> dirs;
-  for (Eigen::Index i = 0; i < eig.eigenvalues().size(); ++i)
-    if (std::sqrt(std::max(eig.eigenvalues()[i], 0.0)) >= limit) dirs.push_back(i);
-  if (dirs.empty()) {
-    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> er(m.asDiagonal() * Graw * m.asDiagonal(),
-                                                            Eigen::EigenvaluesOnly);
-    s.absorbed = er.eigenvalues().size() &&
-                 std::sqrt(std::max(er.eigenvalues().maxCoeff(), 0.0)) >= limit;
-    return s;
-  }
-  s.visible = true;
-  s.k = static_cast<int>(dirs.size());
-  const Eigen::VectorXd mg = m.cwiseProduct(g);
-  Eigen::VectorXd d(s.k);
-  Eigen::MatrixXd V(G.cols(), s.k);
-  double explained = 0.0;
-  for (int i = 0; i < s.k; ++i) {
-    const Eigen::Index j = dirs[static_cast<std::size_t>(i)];
-    V.col(i) = eig.eigenvectors().col(j);
-    const double at_r = V.col(i).dot(mg);
-    d[i] = at_r / eig.eigenvalues()[j];
-    explained += at_r * d[i];
-  }
-  const Eigen::VectorXd params = m.cwiseProduct(V * d);  // in the entry's units
-  if (e.kind == CircularEffectKind::reversal_spike) s.physical = params[0] > 0.0;
-  s.rss1 = std::max(rss0 - explained, 1e-300);
-  const int k_bic = s.k + nonlinear_params(e);
-  s.delta_bic = n * std::log(s.rss1 / rss0) + k_bic * std::log(n);
-  const double dof = n - num_free - k_bic;
-  const double F = ((rss0 - s.rss1) / s.k) / (s.rss1 / dof);
-  s.p = stats::f_sf(std::max(F, 0.0), s.k, dof);
+  diagnosis_detail::CandidateGrams grams;
+  grams.raw = m.asDiagonal() * Graw * m.asDiagonal();
+  grams.perp = m.asDiagonal() * G * m.asDiagonal();
+  grams.perp_r = m.cwiseProduct(g);
+  grams.rr = rss0;
+  grams.n = n;
+  const diagnosis_detail::ColumnScore cs =
+      diagnosis_detail::score_columns(m, grams, num_free, nonlinear_params(e), min_chi2);
+  if (!cs.decided)  // not with finite columns
+    throw DegenerateGeometry("circular diagnosis: the Gram matrix of " + e.id() +
+                             " has no eigen decomposition");
+  Scored s;
+  s.effect = e;
+  s.visible = cs.visible;
+  s.absorbed = cs.absorbed;
+  if (!cs.visible) return s;
+  s.k = cs.k;
+  if (e.kind == CircularEffectKind::reversal_spike) s.physical = cs.params[0] > 0.0;
+  s.rss1 = cs.rss1;
+  s.delta_bic = cs.delta_bic;
+  s.p = cs.f_pvalue;
   return s;
 }
 

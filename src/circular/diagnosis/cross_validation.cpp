@@ -1,56 +1,38 @@
 // Cross-validation of the circular-test diagnosis: blocked folds within each run, and the CV RMS
-// of a model refitted without each fold.
+// of a model refitted without each fold (the engine's blocked_cv_rms_um, refitted with each
+// run's own baseline).
 #include "diagnosis_detail.hpp"
 
-#include <cmath>
-#include <map>
+#include "../../diagnose/scoring.hpp"
 
 namespace rotacal::circular_detail {
 
+// Each run's rows (contiguous, in time order: gather appends runs in order) cut into K blocks.
 std::vector<int> run_folds(const Rows& R, int K) {
   std::vector<int> f(R.n);
-  std::map<int, std::pair<std::size_t, std::size_t>> span;  // run -> first row, count
-  for (std::size_t i = 0; i < R.n; ++i) {
-    auto it = span.find(R.run[i]);
-    if (it == span.end())
-      span[R.run[i]] = {i, 1};
-    else
-      ++it->second.second;
-  }
-  for (std::size_t i = 0; i < R.n; ++i) {
-    const auto& sp = span[R.run[i]];
-    f[i] = static_cast<int>((i - sp.first) * static_cast<std::size_t>(K) / sp.second);
+  for (std::size_t k = 0; k < R.runs; ++k) {
+    const auto count = static_cast<std::size_t>(R.run_count[k]);
+    for (std::size_t i = 0; i < count; ++i)
+      f[static_cast<std::size_t>(R.run_first[k]) + i] =
+          diagnosis_detail::contiguous_block(i, count, K);
   }
   return f;
 }
 
-// Blocked cross-validated RMS (um) of predicting y from the columns M = [B | E] (unwhitened,
-// as diagnosis_detail::cv_rms_um, which it equals): refit on all blocks but one of every run
-// by block_solve, predict the left-out rows.
+// Blocked cross-validated RMS (um) of predicting y from the columns M = [B | E] (unwhitened):
+// each fold's refit by block_solve on the training rows, regrouped run by run.
 double cv_rms_um(const Rows& R, const Eigen::MatrixXd& M, const Eigen::VectorXd& y,
                  const std::vector<int>& fold, int K) {
-  double ss = 0.0;
-  std::size_t n = 0;
-  for (int k = 0; k < K; ++k) {
-    std::vector<Eigen::Index> tr, te;
-    std::vector<Eigen::Index> first(R.runs, 0), count(R.runs, 0);
-    for (std::size_t i = 0; i < fold.size(); ++i) {
-      if (fold[i] == k) {
-        te.push_back(static_cast<Eigen::Index>(i));
-      } else {
-        const std::size_t run = static_cast<std::size_t>(R.run[i]);
-        if (count[run] == 0) first[run] = static_cast<Eigen::Index>(tr.size());
-        ++count[run];
-        tr.push_back(static_cast<Eigen::Index>(i));
-      }
-    }
-    if (te.empty() || tr.empty()) continue;
-    const Eigen::VectorXd d =
-        block_solve(first, count, M(tr, Eigen::all), y(tr));
-    ss += (y(te) - M(te, Eigen::all) * d).squaredNorm();
-    n += te.size();
-  }
-  return n ? std::sqrt(ss / static_cast<double>(n)) * 1e3 : 0.0;
+  return diagnosis_detail::blocked_cv_rms_um(
+      M, y, fold, K, [&](const std::vector<Eigen::Index>& train) {
+        std::vector<Eigen::Index> first(R.runs, 0), count(R.runs, 0);
+        for (std::size_t j = 0; j < train.size(); ++j) {
+          const auto run = static_cast<std::size_t>(R.run[static_cast<std::size_t>(train[j])]);
+          if (count[run] == 0) first[run] = static_cast<Eigen::Index>(j);
+          ++count[run];
+        }
+        return block_solve(first, count, M(train, Eigen::all), y(train));
+      });
 }
 
 }  // namespace rotacal::circular_detail

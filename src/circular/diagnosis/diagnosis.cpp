@@ -26,6 +26,9 @@ const CircularDiagnosisOptions& checked(const CircularDiagnosisOptions& o) {
     throw InvalidArgument("diagnose_circular: screw_pitch must be positive (X, Y, Z), mm");
   if (o.max_findings < 0) throw InvalidArgument("diagnose_circular: max_findings must be >= 0");
   if (o.cv_blocks < 2) throw InvalidArgument("diagnose_circular: cv_blocks must be >= 2");
+  if (!(o.min_visible_chi2 > 0.0 && std::isfinite(o.min_visible_chi2)))
+    throw InvalidArgument("diagnose_circular: min_visible_chi2 must be positive and finite, got " +
+                          std::to_string(o.min_visible_chi2));
   return o;
 }
 
