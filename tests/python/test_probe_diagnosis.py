@@ -88,6 +88,18 @@ def test_the_slow_part_of_1f_noise_is_no_stylus_radius_offset(tmp_path):
     assert not named, named
 
 
+@pytest.mark.parametrize("machine,seed", [("AC-trt", 2252), ("AC-trt", 2291), ("BC-trt", 2138), ("BC-trt", 2276)])
+def test_the_slow_part_of_1f_noise_along_the_poses_is_no_finding(tmp_path, machine, seed):
+    """1/f-like trigger noise wanders slowly along the pose order, as a drift, a harmonic of the C
+    sweep or a shape of the tilt sweep does. A candidate following it leaves a residual that looks
+    white or AR(1), and judged under that model it was found: these null sessions named
+    axial_motion_C_h2, linear_scale_Z (alone, weight 0.92) and thermal_drift_Z groups before.
+    The residuals lack much of the declared noise's variance (the fit took its slow part), so
+    every candidate is judged under the 1/f-like treatment; nothing is found."""
+    d = rotacal.diagnose(probe_session(tmp_path, machine, {}, seed, kind="pink")).to_dict()
+    assert not d["findings"], [(f["effect"], f["named"], f["weight"]) for f in d["findings"]]
+
+
 @pytest.mark.parametrize("kind", ["white", "ar1_0.9"])
 def test_a_stylus_radius_offset_is_still_named(tmp_path, kind):
     """...while a real offset of a few um (10x its half-detection size on this layout) is named,
