@@ -201,78 +201,15 @@ Diagnosis search_white(const DiagnosisProblem& P, const DiagnosisOptions& option
   return D;
 }
 
-// tr(C V C) / n of one AR + walk stream (noise_model.hpp): the mean of its variances less the
-// variance of its mean, 1^T V 1 / n^2, in O(n).
-double within_stream_variance(const NoiseStream& s) {
-  const std::size_t n = s.rows.size();
-  if (n < 2) return 0.0;
-  const std::vector<double> g = ar_autocovariance(s, n);
-  const double q2 = std::pow(s.random_walk_step_um * 1e-3, 2), nd = static_cast<double>(n);
-  double total = nd * g[0];  // 1^T V 1
-  for (std::size_t k = 1; k < n; ++k) total += 2.0 * static_cast<double>(n - k) * g[k];
-  for (std::size_t m = 1; m < n; ++m) total += q2 * static_cast<double>(m) * static_cast<double>(2 * (n - 1 - m) + 1);
-  const double mean_var = g[0] + q2 * (nd - 1.0) / 2.0;
-  return mean_var - total / (nd * nd);
-}
-
-// The noise's lowest frequencies, which the fit hides. What stays put over a stream (1/f-like
-// noise whose slowest parts outlast the session) moves every reading of the stream alike, so
-// the fit's stream-wide parameters take it (a touch probe's stylus_radius_offset is exactly the
-// level of its one stream) and no model of the residuals can see it: of refsim's 1/f-like
-// noise at 0.5 um, a probe session's residuals show AR(1) at 0.30-0.38 um, and the stylus
-// offset's sigma by GLS under REML's AR(1) + walk was 0.09-0.19 um where the Monte Carlo's is
-// 0.34 um (9 of 25 null sessions named the offset). The residuals tell how the readings vary
-// about their stream's level, not where the level sits. The declared noise (noise_um: the
-// 1-sigma of one reading) tells how much variance the readings have, and Var x_t averaged over
-// the stream = E (x_t - mean)^2 averaged + Var(mean): so what the declared variance holds
-// beyond the model's variation within stream s, noise_um^2 - tr(C V_s C) / n_s (C: removing
-// the mean; at least 0), is given to a level of the stream, and so is the walk's mean variance
-// q^2 (n_s - 1) / 2: the walk is pinned at the stream's first reading, which made the level
-// look known from the session's start (0.19 um where 0.34 um is right), and where it starts
-// is as unknown as where it goes. V + d_s 1_s 1_s^T, on top of whatever level V_s has
-// (conservative: in AR(1) 0.9 the offset's sigma is 0.34-0.42 um, test_probe_diagnosis, where the
-// bench layout's Monte Carlo spread is 0.20 um). With W the model's whitener and u_s = W 1_s
-// (disjoint supports), V_total^-1 = W^T (I + sum d_s u_s u_s^T)^-1 W, so
-// W_total = (I - sum c_s e_s e_s^T) W, e_s = u_s / |u_s|, c_s = 1 - 1 / sqrt(1 + d_s |u_s|^2).
-// Without a declared noise there is nothing to compare with, and the model is taken as it is.
-class HiddenLevels : public ResidualWhitener {
- public:
-  HiddenLevels(std::shared_ptr<const ArWhitener> W, const NoiseModel& m, double declared_mm) : W_(std::move(W)) {
-    Eigen::MatrixXd ones = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(m.n), static_cast<Eigen::Index>(m.streams.size()));
-    std::vector<double> d;
-    for (const NoiseStream& s : m.streams) {
-      const double walk = std::pow(s.random_walk_step_um * 1e-3, 2) * (static_cast<double>(s.rows.size()) - 1.0) / 2.0;
-      const double lacking = std::max(0.0, declared_mm * declared_mm - within_stream_variance(s)) + walk;
-      if (!(lacking > 0.0)) continue;
-      for (Eigen::Index r : s.rows) ones(r, static_cast<Eigen::Index>(d.size())) = 1.0;
-      d.push_back(lacking);
-    }
-    U_ = ones.leftCols(static_cast<Eigen::Index>(d.size()));
-    W_->apply(U_);
-    c_.resize(static_cast<Eigen::Index>(d.size()));
-    for (Eigen::Index k = 0; k < U_.cols(); ++k) {
-      const double u2 = U_.col(k).squaredNorm();
-      c_[k] = 1.0 - 1.0 / std::sqrt(1.0 + d[static_cast<std::size_t>(k)] * u2);
-      U_.col(k) /= std::sqrt(u2);
-    }
-  }
-  void apply(Eigen::Ref<Eigen::MatrixXd> columns) const override {
-    W_->apply(columns);
-    if (U_.cols()) columns -= U_ * (c_.asDiagonal() * (U_.transpose() * columns));
-  }
-  Eigen::Index size() const override { return W_->size(); }
-  bool any() const { return U_.cols() > 0; }
-
- private:
-  std::shared_ptr<const ArWhitener> W_;
-  Eigen::MatrixXd U_;  // e_s, one column per stream that lacks variance
-  Eigen::VectorXd c_;
-};
-
 // The findings' numbers by GLS under `gls_noise`, the covariance scaled by the whitened
 // chi-square per dof where that exceeds 1. A finding none of whose parameters is then
-// determined (min_determined_sigma, as in the search) is no finding (issue 29 item 6): it and
-// the findings after it (chosen given it) are reported unobservable, and the rest refitted.
+// determined (min_determined_sigma, as in the search) is no finding (issue 29 item 6). The
+// findings were chosen one after the other, each given the ones before it, so the last is
+// dropped (reported unobservable) and the rest refitted until every finding is determined:
+// the longest such prefix. Dropping the first undetermined finding and all after it lost real
+// effects whose later, nearly aliased rival made both undetermined together (a 10x gravity sag
+// of A on the probe in AR(1) 0.9 found as linear_scale_Z, 56 sigma alone, then a second A
+// shape: 'nothing').
 void refit_findings(const DiagnosisProblem& P, const DiagnosisOptions& options, const NoiseTreatment& gls_noise,
                     Diagnosis& D) {
   for (;;) {
@@ -282,10 +219,10 @@ void refit_findings(const DiagnosisProblem& P, const DiagnosisOptions& options, 
     D.final_fit = P.fit_gls(found, gls_noise.full ? gls_noise.full : gls_noise.W);
     const double scale = std::sqrt(std::max(1.0, gls_noise.whiten(D.final_fit.residuals).squaredNorm() /
                                    std::max(1.0, static_cast<double>(D.final_fit.residuals.size() - D.final_fit.num_free))));
-    std::size_t keep = D.findings.size();
-    for (std::size_t i = 0; i < D.findings.size() && keep == D.findings.size(); ++i)
-      if (determined_sigmas(D.final_fit, D.findings[i].effect, gls_noise) / scale < options.min_determined_sigma) keep = i;
-    if (keep == D.findings.size()) {
+    const auto determined = [&](const Finding& F) {
+      return determined_sigmas(D.final_fit, F.effect, gls_noise) / scale >= options.min_determined_sigma;
+    };
+    if (std::all_of(D.findings.begin(), D.findings.end(), determined)) {
       profile_time_constants(P, gls_noise, scale, D);
       for (Finding& F : D.findings) {
         F.parameters = parameters_of(D.final_fit, F.effect);
@@ -293,20 +230,14 @@ void refit_findings(const DiagnosisProblem& P, const DiagnosisOptions& options, 
       }
       return;
     }
-    for (std::size_t i = keep; i < D.findings.size(); ++i)
-      D.unobservable.push_back({D.findings[i].effect.id(),
-                                "the search named it, but by GLS under the noise the final model leaves none of its "
-                                "parameters reaches " + std::to_string(static_cast<int>(options.min_determined_sigma)) +
-                                " sigma"});
-    D.findings.resize(keep);
-  }
-}
-
-// `t` with the hidden levels of `m` (the model W whitens by) against the declared noise, if any.
-void with_hidden_levels(const DiagnosisProblem& P, const NoiseModel& m, NoiseTreatment& t) {
-  if (const std::optional<double> declared = P.declared_noise_um()) {
-    auto levels = std::make_shared<const HiddenLevels>(t.W, m, *declared * 1e-3);
-    if (levels->any()) t.full = std::move(levels);
+    const std::string sigma = std::to_string(static_cast<int>(options.min_determined_sigma)) + " sigma";
+    D.unobservable.push_back({D.findings.back().effect.id(),
+                              determined(D.findings.back())
+                                  ? "the search named it, but by GLS under the noise the final model leaves an earlier "
+                                    "finding's parameters cannot be determined beside it (none reaches " + sigma + ")"
+                                  : "the search named it, but by GLS under the noise the final model leaves none of its "
+                                    "parameters reaches " + sigma});
+    D.findings.pop_back();
   }
 }
 
@@ -373,7 +304,7 @@ Diagnosis diagnose(const DiagnosisProblem& P, const DiagnosisOptions& options) {
   // unmodelled, white noise), every decision is the white-noise one.
   NoiseModel model = estimate_noise_model(P.groups(), P.times(), baseline.residuals, options.noise);
   Diagnosis D;
-  if (!options.model_noise || model.white()) {
+  if (!options.model_noise || (model.white() && !lacks_declared_variance(P, baseline))) {
     D = search_white(P, options, candidates, baseline, cache);
     white_hidden_levels(P, options, D);
   } else {
@@ -382,7 +313,7 @@ Diagnosis diagnose(const DiagnosisProblem& P, const DiagnosisOptions& options) {
     // Reported: the noise model of what the final model leaves. If that is white, the
     // correlation was the unmodelled effects': the white-noise diagnosis is the right one.
     model = estimate_noise_model(P.groups(), P.times(), D.final_fit.residuals, options.noise);
-    if (model.white()) {
+    if (model.white() && !lacks_declared_variance(P, D.final_fit)) {
       D = Diagnosis{};  // released before the white search builds its own
       D = search_white(P, options, candidates, baseline, cache);
       white_hidden_levels(P, options, D);

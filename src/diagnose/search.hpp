@@ -37,6 +37,20 @@ NoiseTreatment white_treatment(const DiagnosisProblem& P, const ModelFit& baseli
 /// structure test's are never reported, and formatting a summary per candidate is wasted).
 NoiseTreatment coloured_treatment(const NoiseModel& m, bool described = true);
 
+/// `t` with the stream levels of `m` (the model t.W whitens by) that its residuals cannot show,
+/// against the declared noise (hidden_levels.cpp): t.full set where any stream lacks variance;
+/// unchanged without a declared noise.
+void with_hidden_levels(const DiagnosisProblem& P, const NoiseModel& m, NoiseTreatment& t);
+
+/// Whether the declared noise holds variance that `fit`'s residuals lack: |r|^2 / noise_um^2
+/// below the kLacksDeclaredVariance quantile of chi-square(n - free parameters), which white
+/// noise of the declared size would leave. Then the fit has taken a part of the noise into its
+/// parameters, i.e. the noise is slow (1/f-like: its slowest parts follow the fitted
+/// directions) in a way no model of these residuals shows (hidden_levels.cpp). False without a
+/// declared noise.
+inline constexpr double kLacksDeclaredVariance = 1e-3;
+bool lacks_declared_variance(const DiagnosisProblem& P, const ModelFit& fit);
+
 // One indicator column per noise stream (group, channel).
 // One level per noise stream, shared by the runs of one test (radial_C, radial_C_cw,
 // radial_C_f2000, test_of_run): they follow each other with the bar in place, so a wander does

@@ -42,6 +42,7 @@ struct ColouredRound {
   NoiseModel wander_start;      // 1/f-like: the current residuals' AR model, REML's start
   NoiseTreatment wander_noise;  // 1/f-like: AR(1) + random walk by REML, once per round
   std::unique_ptr<ModelProducts> products;  // white or AR(1) candidates' Gram matrices
+  bool slow = false;  // the round's noise is 1/f-like for every candidate (lacks_declared_variance)
 };
 
 // Candidate c scored in coloured noise. Returns false where it is not observable (s.why_not
@@ -55,7 +56,7 @@ void score_coloured(const SearchContext& S, const ModelFit& fit, Round& R, Colou
   // signature is not mistaken for correlated noise (which would whiten it away).
   NoiseModel own_model;
   NoiseTreatment own = candidate_treatment(S.layout, C.own_noise, fit, C.Q_raw, C.Qr, Jc, S.white, &own_model);
-  if (own_model.max_order < 2 && (!own.W || own.W->ar1_only())) {
+  if (!C.slow && own_model.max_order < 2 && (!own.W || own.W->ar1_only())) {
     // White or AR(1): scored from inner products; only a candidate that may pass is
     // scored again below with its columns (the margin of 1 is far beyond rounding).
     if (!C.products) C.products = std::make_unique<ModelProducts>(R.in.Jfree, S.layout.rows);
@@ -71,8 +72,13 @@ void score_coloured(const SearchContext& S, const ModelFit& fit, Round& R, Colou
   ScoringInputs in_c;
   in_c.Jfree = R.in.Jfree;
   in_c.num_free = fit.num_free;
-  if (own_model.max_order >= 2) {
-    // Noise that AR(1) does not describe (BIC wants p >= 2) is taken as 1/f-like: it has
+  if (C.slow || own_model.max_order >= 2) {
+    // Noise that AR(1) does not describe (BIC wants p >= 2), or whose declared variance the
+    // current residuals lack (C.slow, the same for every candidate of the round: a candidate
+    // that follows the slow wander leaves a residual that looks white or AR(1) itself, and was
+    // then judged under that, taking the wander for an effect; 7 of 200 1/f-like probe null
+    // sessions named straightness_ZY, axial_motion_C_h2, A harmonics or Z drifts, 0 with it,
+    // bench/diagnosis_confusion.py --instruments probe --null 200 --seed 101), is taken as 1/f-like: it has
     // no finite correlation time, and its lowest frequencies are indistinguishable from
     // an offset per stream that no AR model of a few hundred readings captures, so the
     // level of each stream becomes a nuisance parameter. Its slow wander within a test
@@ -87,12 +93,11 @@ void score_coloured(const SearchContext& S, const ModelFit& fit, Round& R, Colou
       R.J_levels << R.in.Jfree, L;
       R.levels_rank = static_cast<int>(orthonormal_basis(R.J_levels).cols() - C.Q_raw.cols());
     }
-    with_levels = true;
-    in_c.Jfree = R.J_levels;
-    in_c.num_free += R.levels_rank;
     if (!C.wander_noise.W) {
       C.wander_start = estimate_noise_model(S.layout, fit.residuals, options.noise);
-      C.wander_noise = coloured_treatment(estimate_noise_model_reml(C.wander_start, fit.residuals, R.J_levels));
+      const NoiseModel walk = estimate_noise_model_reml(C.wander_start, fit.residuals, R.J_levels);
+      C.wander_noise = coloured_treatment(walk);
+      with_hidden_levels(S.P, walk, C.wander_noise);
     }
     own = C.wander_noise;
     // The walk estimated with the candidate's columns in the model too, so that its own
@@ -103,7 +108,18 @@ void score_coloured(const SearchContext& S, const ModelFit& fit, Round& R, Colou
     if (own_model.sigma_um < 0.5 * C.wander_start.sigma_um) {
       Eigen::MatrixXd X(R.J_levels.rows(), R.J_levels.cols() + Jc.cols());
       X << R.J_levels, Jc;
-      own = coloured_treatment(estimate_noise_model_reml(C.wander_start, fit.residuals, X));
+      const NoiseModel walk = estimate_noise_model_reml(C.wander_start, fit.residuals, X);
+      own = coloured_treatment(walk);
+      with_hidden_levels(S.P, walk, own);
+    }
+    // The levels: with a declared noise, each stream's level has the variance the declared
+    // noise holds beyond what the model shows (with_hidden_levels, as in the final refit), so a
+    // candidate that moves a whole stream (a probe's stylus_radius_offset) is judged against
+    // it; without one, the level is unknown and a nuisance parameter.
+    with_levels = !own.full;
+    if (with_levels) {
+      in_c.Jfree = R.J_levels;
+      in_c.num_free += R.levels_rank;
     }
   }
   in_c.Q_w = orthonormal_basis_full_rank(own.whiten(in_c.Jfree));
@@ -146,6 +162,7 @@ Round score_round(const SearchContext& S, const ModelFit& fit, const EffectModel
     C.Q_raw = orthonormal_basis(R.in.Jfree);
     C.Qr = C.Q_raw.transpose() * fit.residuals;
     if (S.model) C.own_noise.max_order = std::min(C.own_noise.max_order, S.model->max_order + 2);
+    C.slow = lacks_declared_variance(S.P, fit);
   }
   // This round's candidate Jacobians at the current fit, in batches of at most
   // kChunkValues doubles: one batch for a session of a few thousand readings, and a long

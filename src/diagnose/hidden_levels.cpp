@@ -1,0 +1,101 @@
+// The stream levels a model of the residuals cannot show, against the declared noise: the
+// whitener of the final refit (diagnosis.cpp) and of the search's 1/f-like treatment
+// (search_round.cpp).
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include "rotacal/core/stats.hpp"
+#include "search.hpp"
+
+namespace rotacal::diagnosis_detail {
+
+namespace {
+
+// tr(C V C) / n of one AR + walk stream (noise_model.hpp): the mean of its variances less the
+// variance of its mean, 1^T V 1 / n^2, in O(n).
+double within_stream_variance(const NoiseStream& s) {
+  const std::size_t n = s.rows.size();
+  if (n < 2) return 0.0;
+  const std::vector<double> g = ar_autocovariance(s, n);
+  const double q2 = std::pow(s.random_walk_step_um * 1e-3, 2), nd = static_cast<double>(n);
+  double total = nd * g[0];  // 1^T V 1
+  for (std::size_t k = 1; k < n; ++k) total += 2.0 * static_cast<double>(n - k) * g[k];
+  for (std::size_t m = 1; m < n; ++m) total += q2 * static_cast<double>(m) * static_cast<double>(2 * (n - 1 - m) + 1);
+  const double mean_var = g[0] + q2 * (nd - 1.0) / 2.0;
+  return mean_var - total / (nd * nd);
+}
+
+// The noise's lowest frequencies, which the fit hides. What stays put over a stream (1/f-like
+// noise whose slowest parts outlast the session) moves every reading of the stream alike, so
+// the fit's stream-wide parameters take it (a touch probe's stylus_radius_offset is exactly the
+// level of its one stream) and no model of the residuals can see it: of refsim's 1/f-like
+// noise at 0.5 um, a probe session's residuals show AR(1) at 0.30-0.38 um, and the stylus
+// offset's sigma by GLS under REML's AR(1) + walk was 0.09-0.19 um where the Monte Carlo's is
+// 0.34 um (9 of 25 null sessions named the offset). The residuals tell how the readings vary
+// about their stream's level, not where the level sits. The declared noise (noise_um: the
+// 1-sigma of one reading) tells how much variance the readings have, and Var x_t averaged over
+// the stream = E (x_t - mean)^2 averaged + Var(mean): so what the declared variance holds
+// beyond the model's variation within stream s, noise_um^2 - tr(C V_s C) / n_s (C: removing
+// the mean; at least 0), is given to a level of the stream, and so is the walk's mean variance
+// q^2 (n_s - 1) / 2: the walk is pinned at the stream's first reading, which made the level
+// look known from the session's start (0.19 um where 0.34 um is right), and where it starts
+// is as unknown as where it goes. V + d_s 1_s 1_s^T, on top of whatever level V_s has
+// (conservative: in AR(1) 0.9 the offset's sigma is 0.34-0.42 um, test_probe_diagnosis, where the
+// bench layout's Monte Carlo spread is 0.20 um). With W the model's whitener and u_s = W 1_s
+// (disjoint supports), V_total^-1 = W^T (I + sum d_s u_s u_s^T)^-1 W, so
+// W_total = (I - sum c_s e_s e_s^T) W, e_s = u_s / |u_s|, c_s = 1 - 1 / sqrt(1 + d_s |u_s|^2).
+// Without a declared noise there is nothing to compare with, and the model is taken as it is.
+class HiddenLevels : public ResidualWhitener {
+ public:
+  HiddenLevels(std::shared_ptr<const ArWhitener> W, const NoiseModel& m, double declared_mm) : W_(std::move(W)) {
+    Eigen::MatrixXd ones = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(m.n), static_cast<Eigen::Index>(m.streams.size()));
+    std::vector<double> d;
+    for (const NoiseStream& s : m.streams) {
+      const double walk = std::pow(s.random_walk_step_um * 1e-3, 2) * (static_cast<double>(s.rows.size()) - 1.0) / 2.0;
+      const double lacking = std::max(0.0, declared_mm * declared_mm - within_stream_variance(s)) + walk;
+      if (!(lacking > 0.0)) continue;
+      for (Eigen::Index r : s.rows) ones(r, static_cast<Eigen::Index>(d.size())) = 1.0;
+      d.push_back(lacking);
+    }
+    U_ = ones.leftCols(static_cast<Eigen::Index>(d.size()));
+    W_->apply(U_);
+    c_.resize(static_cast<Eigen::Index>(d.size()));
+    for (Eigen::Index k = 0; k < U_.cols(); ++k) {
+      const double u2 = U_.col(k).squaredNorm();
+      c_[k] = 1.0 - 1.0 / std::sqrt(1.0 + d[static_cast<std::size_t>(k)] * u2);
+      U_.col(k) /= std::sqrt(u2);
+    }
+  }
+  void apply(Eigen::Ref<Eigen::MatrixXd> columns) const override {
+    W_->apply(columns);
+    if (U_.cols()) columns -= U_ * (c_.asDiagonal() * (U_.transpose() * columns));
+  }
+  Eigen::Index size() const override { return W_->size(); }
+  bool any() const { return U_.cols() > 0; }
+
+ private:
+  std::shared_ptr<const ArWhitener> W_;
+  Eigen::MatrixXd U_;  // e_s, one column per stream that lacks variance
+  Eigen::VectorXd c_;
+};
+
+}  // namespace
+
+// `t` with the hidden levels of `m` (the model W whitens by) against the declared noise, if any.
+void with_hidden_levels(const DiagnosisProblem& P, const NoiseModel& m, NoiseTreatment& t) {
+  if (const std::optional<double> declared = P.declared_noise_um()) {
+    auto levels = std::make_shared<const HiddenLevels>(t.W, m, *declared * 1e-3);
+    if (levels->any()) t.full = std::move(levels);
+  }
+}
+
+bool lacks_declared_variance(const DiagnosisProblem& P, const ModelFit& fit) {
+  const std::optional<double> declared = P.declared_noise_um();
+  const double dof = static_cast<double>(fit.residuals.size() - fit.num_free);
+  if (!declared || !(*declared > 0.0) || !(dof > 0.0)) return false;
+  const double chi2 = fit.residuals.squaredNorm() / std::pow(*declared * 1e-3, 2);
+  return 1.0 - stats::chi2_sf(chi2, dof) < kLacksDeclaredVariance;
+}
+
+}  // namespace rotacal::diagnosis_detail
