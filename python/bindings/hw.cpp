@@ -7,7 +7,9 @@
 #include "rotacal/hw/recorder.hpp"
 #include "rotacal/hw/virtual_instrument.hpp"
 
-namespace rotacal::py {
+// In a namespace of its own: the extension compiles the binding files as one unity file
+// (python/CMakeLists.txt), and the using-directive must not reach the files after this one.
+namespace rotacal::py::hw_bindings {
 
 using namespace rotacal::hw;
 
@@ -70,7 +72,7 @@ RecordSummary record_plan(const std::string& port, const Plan& plan, const std::
 
 }  // namespace
 
-void bind_hw(pyb::module_& m) {
+void bind(pyb::module_& m) {
   pyb::class_<FaultInjection>(m, "FaultInjection", "Faults a virtual instrument acts out (counted in frames).")
       .def(pyb::init<>())
       .def_readwrite("garbage_every", &FaultInjection::garbage_every)
@@ -205,5 +207,9 @@ void bind_hw(pyb::module_& m) {
   }, "(path, description, transport) of every serial port libserialport finds.");
 }
 
+}  // namespace rotacal::py::hw_bindings
+
+namespace rotacal::py {
+void bind_hw(pyb::module_& m) { hw_bindings::bind(m); }
 }  // namespace rotacal::py
 #endif  // ROTACAL_WITH_HW
