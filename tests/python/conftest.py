@@ -63,9 +63,8 @@ def run_cli(*args, cwd=None, env=None) -> subprocess.CompletedProcess:
         with warnings.catch_warnings(), contextlib.redirect_stdout(streams[0]), \
                 contextlib.redirect_stderr(streams[1]):
             warnings.resetwarnings()  # the interpreter's default filters: a warning shows on stderr
-            for action, category in (("ignore", DeprecationWarning), ("ignore", PendingDeprecationWarning),
-                                     ("ignore", ImportWarning), ("ignore", ResourceWarning)):
-                warnings.simplefilter(action, category)
+            for category in (DeprecationWarning, PendingDeprecationWarning, ImportWarning, ResourceWarning):
+                warnings.simplefilter("ignore", category)
             try:
                 code = cli.main(argv)
             except SystemExit as e:  # argparse: usage errors, --help, --version
