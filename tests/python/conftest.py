@@ -1,5 +1,12 @@
-"""Fixtures shared by the Python tests: the shared sessions beside the repository and their truth files."""
+"""Fixtures shared by the Python tests: the shared sessions beside the repository and their truth files,
+and the command line run in this process."""
+import contextlib
+import io
 import json
+import os
+import subprocess
+import sys
+import warnings
 from pathlib import Path
 
 import pytest
@@ -33,3 +40,44 @@ def split_by_c(path, step):
         p.write_text("\n".join(meta + [header] + part) + "\n")
         out.append(p)
     return out
+
+
+def run_cli(*args, cwd=None, env=None) -> subprocess.CompletedProcess:
+    """`python -m rotacal ARGS` run in this process, as `subprocess.run(..., capture_output=True,
+    text=True, cwd=cwd, env=dict(os.environ, **env))` returned it: `python -m rotacal` only calls
+    cli.main, so its exit code (argparse's SystemExit included), stdout and stderr (encoded as the
+    child's, read back with universal newlines) are the child's. A child interpreter cost about
+    0.3 CPU-s per command (numpy and the extension imported again); tests whose point is the
+    process itself (the entry point, signals, concurrent commands, memory limits) still start one."""
+    from rotacal import cli
+
+    argv = [str(a) for a in args]
+    streams = [io.TextIOWrapper(io.BytesIO(), encoding=std.encoding, errors=std.errors)
+               for std in (sys.__stdout__, sys.__stderr__)]
+    saved_env, saved_cwd = dict(os.environ), os.getcwd()
+    # A pipe's width for help text, as the child saw; the environment the child had.
+    os.environ.update({"COLUMNS": os.environ.get("COLUMNS", "80"), **(env or {})})
+    try:
+        if cwd is not None:
+            os.chdir(cwd)
+        with warnings.catch_warnings(), contextlib.redirect_stdout(streams[0]), \
+                contextlib.redirect_stderr(streams[1]):
+            warnings.resetwarnings()  # the interpreter's default filters: a warning shows on stderr
+            for category in (DeprecationWarning, PendingDeprecationWarning, ImportWarning, ResourceWarning):
+                warnings.simplefilter("ignore", category)
+            try:
+                code = cli.main(argv)
+            except SystemExit as e:  # argparse: usage errors, --help, --version
+                code = e.code if isinstance(e.code, int) else (0 if e.code is None else 1)
+                if e.code is not None and not isinstance(e.code, int):
+                    print(e.code, file=sys.stderr)
+    finally:
+        os.chdir(saved_cwd)
+        os.environ.clear()
+        os.environ.update(saved_env)
+    text = []
+    for stream in streams:
+        stream.flush()
+        data = stream.buffer.getvalue().decode(stream.encoding, "replace")
+        text.append(data.replace("\r\n", "\n").replace("\r", "\n"))
+    return subprocess.CompletedProcess(["rotacal", *argv], code, text[0], text[1])

@@ -2,8 +2,6 @@
 import json
 import math
 import re
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -12,10 +10,7 @@ import rotacal
 import rotacal.circular as circular
 from rotacal import jsontext
 
-
-def rotacal_cli(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "rotacal", *map(str, args)], capture_output=True, text=True,
-                          cwd=cwd, timeout=600)
+from conftest import run_cli as rotacal_cli
 
 
 def test_help():

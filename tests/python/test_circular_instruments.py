@@ -12,6 +12,8 @@ import rotacal
 import rotacal.circular as circular
 from rotacal import _core
 
+from conftest import run_cli
+
 # One plane, one feed, both directions at 100 Hz: 46 s of program, played at 5x real time.
 PLAN = ["--planes", "XY", "--feeds", "2000", "--rate", "100"]
 MACHINE = ["--squareness", "XY=35", "--backlash", "X=4,Y=2.5", "--servo-lag", "X=1.5", "--cyclic", "X=1.2:-0.7"]
@@ -20,6 +22,7 @@ PATIENT = ["--silence", "30"]
 
 
 def rotacal_cli(*args, timeout=600):
+    """A child: `record` and `virtual` run side by side, each with its own signal handling."""
     return subprocess.run([sys.executable, "-m", "rotacal", *map(str, args)], capture_output=True, text=True,
                           timeout=timeout)
 
@@ -55,7 +58,7 @@ def test_virtual_record_analyze_recovers_the_simulated_machine(tmp_path):
         n = int(np.sum(np.asarray(session.tests) == run.label))
         assert abs(n - len(run.time)) <= 1, (run.label, n, len(run.time))
 
-    r = rotacal_cli("circular", "analyze", tmp_path / "rec.csv", "--json")
+    r = run_cli("circular", "analyze", tmp_path / "rec.csv", "--json")
     assert r.returncode == 0, r.stderr
     result = json.loads(r.stdout)
     assert result["ignored_tests"] == ["transition"]

@@ -7,12 +7,15 @@ from pathlib import Path
 
 import pytest
 
+from conftest import run_cli as rotacal
+
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def rotacal(*args, cwd=None):
+def rotacal_process(*args):
+    """`python -m rotacal` as a user starts it: the entry point itself."""
     return subprocess.run([sys.executable, "-m", "rotacal", *map(str, args)], capture_output=True, text=True,
-                          cwd=cwd, timeout=600)
+                          timeout=600)
 
 
 @pytest.mark.parametrize("cmd", ["plan", "simulate", "identify", "diagnose", "predict", "compensate", "report", "demo", "machines",
@@ -23,7 +26,7 @@ def test_help(cmd):
 
 
 def test_demo_finds_the_hidden_effect(tmp_path):
-    r = rotacal("demo", "-o", tmp_path)
+    r = rotacal_process("demo", "-o", tmp_path)
     assert r.returncode == 0, r.stderr
     assert "[6/6]" in r.stderr  # progress on every step
     d = json.loads((tmp_path / "diagnosis.json").read_text())

@@ -2,18 +2,18 @@
 predicted uncertainty against the default's at the same run time, the NC program of the
 designed test, and refusals by option."""
 import json
-import subprocess
-import sys
 
 import pytest
 
 from rotacal import _core
 
+from conftest import SHARED, run_cli
+
 EXIT_INPUT = 3
 
 
 def rotacal_cli(*args):
-    r = subprocess.run([sys.executable, "-m", "rotacal", *map(str, args)], capture_output=True, text=True, timeout=300)
+    r = run_cli(*args)
     assert "Traceback" not in r.stderr, r.stderr
     return r
 
@@ -59,8 +59,6 @@ def test_design_refuses_by_option(args, option):
     r = rotacal_cli("design", "ballbar", "--step", "5", "--pivot-x", "120", "--pivot-z", "60", *args)
     assert r.returncode in (2, EXIT_INPUT) and option in r.stderr, r.stderr
 
-
-from conftest import SHARED  # noqa: E402
 
 TABLE2 = SHARED / "ballbar_ac_table2.csv"
 

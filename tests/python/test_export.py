@@ -5,8 +5,6 @@ table where the identified model does. The errors a controller cannot hold go in
 model for NC compensation."""
 import json
 import re
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -14,11 +12,13 @@ import pytest
 import rotacal
 from rotacal import _core
 
+from conftest import run_cli
+
 EXIT_INPUT, EXIT_IO = 3, 4
 
 
 def rotacal_cli(*args):
-    r = subprocess.run([sys.executable, "-m", "rotacal", *map(str, args)], capture_output=True, text=True, timeout=300)
+    r = run_cli(*args)
     assert "Traceback" not in r.stderr, r.stderr
     return r
 

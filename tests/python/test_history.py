@@ -24,6 +24,8 @@ import rotacal
 from rotacal import history
 from rotacal.history import DAYS_PER_MONTH, open_history
 
+from conftest import run_cli
+
 PG_BIN = Path("/usr/lib/postgresql/15/bin")
 EXIT_INPUT, EXIT_IO = 3, 4
 AC_NAMES = list(rotacal.location_error_names(rotacal.parse_machine_type("AC-trt")))
@@ -405,9 +407,7 @@ print("not killed")
 # ------------------------------------------------------------------------- the command line
 
 def cli(*args, env=None):
-    e = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path), **(env or {}))
-    r = subprocess.run([sys.executable, "-m", "rotacal", *map(str, args)], capture_output=True, text=True,
-                       timeout=300, env=e)
+    r = run_cli(*args, env=env)
     assert "Traceback" not in r.stderr, r.stderr
     return r
 

@@ -16,15 +16,22 @@ import pytest
 
 import rotacal
 
+from conftest import run_cli
+
 EXIT_INPUT, EXIT_IO = 3, 4
 
 
 def rotacal_cli(*args, cwd=None, timeout=300, memory_bytes=None):
-    def limit():  # a runaway reader must fail inside this, not take the machine
+    """In this process, unless under a memory limit (a child's, so that a runaway reader fails
+    inside it and does not take the machine)."""
+    def limit():
         resource.setrlimit(resource.RLIMIT_AS, (memory_bytes, memory_bytes))
 
-    r = subprocess.run([sys.executable, "-m", "rotacal", *map(str, args)], capture_output=True, text=True,
-                       errors="replace", cwd=cwd, timeout=timeout, preexec_fn=limit if memory_bytes else None)
+    if memory_bytes is None:
+        r = run_cli(*args, cwd=cwd)
+    else:
+        r = subprocess.run([sys.executable, "-m", "rotacal", *map(str, args)], capture_output=True, text=True,
+                           errors="replace", cwd=cwd, timeout=timeout, preexec_fn=limit)
     assert "Traceback" not in r.stderr, r.stderr[-3000:]
     return r
 

@@ -11,6 +11,8 @@ import pytest
 import rotacal
 from rotacal import _core
 
+from conftest import run_cli
+
 HEAD = ("# format: rotacal-ballbar/1\n# machine: AC-trt\n# units: mm, deg, s\n"
         "# ballbar_length: 100\n# pivot: 120, 0, 60\ntest,time,X,Y,Z,A,C,length\n")
 ROW = "sphere_xy,0.0,220,0,60,0,0,100.001\n"
@@ -104,7 +106,7 @@ def test_session_from_arrays_is_one_the_reader_accepts():
 def test_cli_exit_codes(tmp_path, args, code, words):
     (tmp_path / "bad.csv").write_text(HEAD + ROW + _field(ROW2, 2, "1e160"))
     argv = [a.format(tmp=tmp_path) for a in args]
-    r = subprocess.run([sys.executable, "-m", "rotacal", *argv], capture_output=True, text=True, timeout=120)
+    r = run_cli(*argv)
     assert r.returncode == code, r.stderr[-500:]
     assert words in r.stderr
     assert "Traceback" not in r.stderr

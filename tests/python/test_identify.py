@@ -79,10 +79,8 @@ def test_monte_carlo_confirms_the_reported_sigma(shared_data):
 
 
 def test_monte_carlo_cli_shows_progress(shared_data):
-    import subprocess
-    import sys
-    r = subprocess.run([sys.executable, "-m", "rotacal", "identify", str(shared_data / "ballbar_ac_table2.csv"),
-                        "--monte-carlo", "10", "--json"], capture_output=True, text=True, timeout=300)
+    from conftest import run_cli
+    r = run_cli("identify", shared_data / "ballbar_ac_table2.csv", "--monte-carlo", "10", "--json")
     assert r.returncode == 0, r.stderr
     assert "Monte Carlo [" in r.stderr and "100.0%" in r.stderr
     import json

@@ -18,6 +18,8 @@ import pytest
 
 from rotacal import _core, cli
 
+from conftest import run_cli
+
 NC_DIALECTS = ("linuxcnc", "heidenhain", "siemens", "fanuc")
 CONTROLLERS = ("linuxcnc", "siemens", "isg", "heidenhain", "fanuc")
 # A rapid move and program ends behind every way a comment could end early.
@@ -27,11 +29,9 @@ RS274 = shutil.which("rs274")
 
 
 def rotacal_cli(*args):
-    """The command line in this process: `python -m rotacal` only calls this main, which ends every
-    failure in a message and an exit code, never a traceback. A child interpreter for each of this
-    file's ~190 commands cost 0.25 CPU-s apiece (numpy and the extension imported again)."""
-    code = cli.main([str(a) for a in args])
-    assert code == cli.EXIT_OK, f"rotacal {' '.join(map(str, args))}: exit code {code}"
+    """The command line in this process (conftest.run_cli); it must succeed."""
+    r = run_cli(*args)
+    assert r.returncode == cli.EXIT_OK, f"rotacal {' '.join(map(str, args))}: exit code {r.returncode}: {r.stderr}"
 
 
 def is_comment(dialect, line):

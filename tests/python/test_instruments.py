@@ -14,6 +14,8 @@ import rotacal
 from rotacal import _core
 from rotacal.instruments import ProgressBar, record_ballbar, virtual_ballbar
 
+from conftest import run_cli
+
 ROOT = Path(__file__).resolve().parents[2]
 FAST = ["--step", "3", "--rate", "50"]  # 442 s of program at 50 Hz
 # Recorders wait this long for data before calling an instrument silent: a host starved of CPU
@@ -22,6 +24,7 @@ PATIENT = ["--silence", "10"]
 
 
 def rotacal_cli(*args, timeout=300):
+    """A child: `record` runs beside the virtual instrument's child (and its SIGINT handling)."""
     return subprocess.run([sys.executable, "-m", "rotacal", *map(str, args)], capture_output=True, text=True,
                           timeout=timeout)
 
@@ -76,7 +79,7 @@ def test_record_ballbar_cli_end_to_end(tmp_path):
     assert summary["lost"] == 0 and summary["crc_errors"] == 0
     assert "program finished" in err
     assert "recording [" in r.stderr  # the progress bar
-    ident = rotacal_cli("identify", tmp_path / "s.csv", "--json")
+    ident = run_cli("identify", tmp_path / "s.csv", "--json")
     assert ident.returncode == 0, ident.stderr
     d = json.loads(ident.stdout)
     assert d["n_samples"] == summary["rows"] > 20000
@@ -169,7 +172,7 @@ def test_record_rtest_cli_end_to_end(tmp_path, mode):
         f = row.split(",")
         assert int(f[-4]) >= 1 and float(f[-1]) >= 0.0, row
         assert abs(float(f[-2]) - float(f[cols.index("time")])) <= 0.4 * 6.0, row
-    ident = rotacal_cli("identify", tmp_path / "r.csv", "--json")
+    ident = run_cli("identify", tmp_path / "r.csv", "--json")
     assert ident.returncode == 0, ident.stderr
     truth = json.loads((tmp_path / "truth.json").read_text())
     assert within_3_sigma(json.loads(ident.stdout)["location_errors"], truth["errors"],
@@ -196,7 +199,7 @@ def test_python_api_records_and_identifies(tmp_path):
 
 
 def test_bad_port_exits_with_io_error_naming_it(tmp_path):
-    r = rotacal_cli("record", "ballbar", "--port", "/dev/rotacal-no-such-port", "-o", tmp_path / "s.csv")
+    r = run_cli("record", "ballbar", "--port", "/dev/rotacal-no-such-port", "-o", tmp_path / "s.csv")
     assert r.returncode == 4
     assert "/dev/rotacal-no-such-port" in r.stderr
 
@@ -271,7 +274,7 @@ def test_recorded_backlash_and_servo_lag_are_found(tmp_path):
     v.close()
     assert r.returncode == 0, r.stderr
     assert json.loads(r.stdout)["lost"] == 0
-    d = rotacal_cli("diagnose", tmp_path / "s.csv", "--json", "--no-budget")
+    d = run_cli("diagnose", tmp_path / "s.csv", "--json", "--no-budget")
     assert d.returncode == 0, d.stderr
     found = {f["effect"]: next(iter(f["parameters"].values())) for f in json.loads(d.stdout)["findings"]}
     # 4 sigma: the rows depend on the host's timing, so the noise draw is not reproducible.

@@ -4,8 +4,6 @@ several sessions (kind "multi"), as an engineer uses them: `identify --save-mode
 judged against a truth come from the independent implementation's sessions (../shared/data)."""
 import json
 import re
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -14,7 +12,7 @@ import rotacal
 from rotacal import _core
 from rotacal.models import file_sha256
 
-from conftest import truth
+from conftest import run_cli, truth
 from test_export import _travel, rot
 
 EXIT_INPUT = 3
@@ -23,8 +21,7 @@ NAMES = list(_core.location_error_names(_core.MachineType.AC_trt))
 
 
 def cli(*args, cwd=None):
-    r = subprocess.run([sys.executable, "-m", "rotacal", *map(str, args)], capture_output=True, text=True,
-                       timeout=300, cwd=cwd)
+    r = run_cli(*args, cwd=cwd)
     assert "Traceback" not in r.stderr, r.stderr
     return r
 

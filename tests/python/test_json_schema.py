@@ -4,8 +4,6 @@ docs/json_schema.md: its `schema` blocks are read here and real `--json` outputs
 dependency)."""
 import json
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -13,6 +11,8 @@ import pytest
 
 import rotacal
 from rotacal import _core
+
+from conftest import run_cli
 
 DOC = Path(__file__).resolve().parents[2] / "docs" / "json_schema.md"
 
@@ -57,8 +57,7 @@ def check(value, schema, where: str, named: dict) -> None:
 
 
 def cli_json(*args) -> dict:
-    r = subprocess.run([sys.executable, "-m", "rotacal", *map(str, args), "--json"],
-                       capture_output=True, text=True, timeout=600)
+    r = run_cli(*args, "--json")
     assert r.returncode == 0, r.stderr
     return json.loads(r.stdout)
 

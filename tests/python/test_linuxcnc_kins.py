@@ -15,8 +15,6 @@ The run itself: linuxcnc_session.py.
 """
 import json
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -24,6 +22,8 @@ import numpy as np
 from linuxcnc_session import requires_linuxcnc
 from linuxcnc_session import run_linuxcnc as run_session
 from rotacal import _core
+
+from conftest import run_cli
 
 pytestmark = requires_linuxcnc
 
@@ -33,8 +33,7 @@ P0 = np.array([250.0, -120.0, 80.0])  # joint position of the pivot (rotacal's o
 
 
 def rotacal_cli(*args):
-    r = subprocess.run([sys.executable, "-m", "rotacal", *map(str, args)], capture_output=True, text=True,
-                       timeout=300)
+    r = run_cli(*args)
     assert r.returncode == 0 and "Traceback" not in r.stderr, r.stderr
     return r
 

@@ -18,7 +18,6 @@ of the sphere (polled).
 """
 import json
 import re
-import subprocess
 import sys
 import time
 from pathlib import Path
@@ -26,6 +25,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from conftest import run_cli
 from linuxcnc_session import requires_linuxcnc, run_linuxcnc
 
 REFSIM = Path(__file__).resolve().parents[1] / "reference"
@@ -46,8 +46,7 @@ RUN_TIMEOUT = 240           # s, the display's bound (the program runs 80 s at a
 
 
 def rotacal_cli(*args):
-    r = subprocess.run([sys.executable, "-m", "rotacal", *map(str, args)], capture_output=True, text=True,
-                       timeout=300)
+    r = run_cli(*args)
     assert r.returncode == 0 and "Traceback" not in r.stderr, r.stderr
     return r.stdout
 
@@ -91,8 +90,7 @@ def test_plan_probe_feeds_and_approach(tmp_path):
         assert abs(np.linalg.norm(start - centres[0 if k < 5 else 90]) - (r + 0.25)) < 2e-4, (k, start)
     assert re.findall(r"^G38\.2 .* F(\S+)$", text, re.M) == ["7.5"] * 10
     assert set(re.findall(r"^G1 .* F(\S+)$", text, re.M)) == {"4000.0"}
-    bad = subprocess.run([sys.executable, "-m", "rotacal", "plan", "ballbar", "--probe-feed", "7", "-o",
-                          tmp_path / "b.ngc"], capture_output=True, text=True, timeout=300)
+    bad = run_cli("plan", "ballbar", "--probe-feed", "7", "-o", tmp_path / "b.ngc")
     assert bad.returncode != 0 and "--probe-feed" in bad.stderr
 
 

@@ -4,7 +4,6 @@ machine with several location errors) -- ballbar + probe, and ballbar + R-test -
 jointly by rotacal.identify([...]) within 3 sigma of the truth, each session with its own
 nuisances; sessions of two machine types are refused by name. The truth comes from refsim."""
 import json
-import subprocess
 import sys
 from pathlib import Path
 
@@ -16,6 +15,7 @@ import refsim  # noqa: E402
 from refsim import noise, poses, writers  # noqa: E402
 
 import rotacal  # noqa: E402
+from conftest import run_cli  # noqa: E402
 from test_json_schema import check, schemas  # noqa: E402
 
 MACHINE = "AC-trt"
@@ -97,10 +97,6 @@ def test_sessions_of_two_machine_types_are_refused(tmp_path):
     b = rotacal.load(probe_file(tmp_path, "BC-trt", truth_errors("BC-trt"), 2))
     with pytest.raises(rotacal.InvalidArgument, match="session 2"):
         rotacal.identify([a, b])
-
-
-def run_cli(*args, cwd):
-    return subprocess.run([sys.executable, "-m", "rotacal", *map(str, args)], capture_output=True, text=True, cwd=cwd)
 
 
 def test_cli_joint_identification_reports_a_planted_disagreement(tmp_path):

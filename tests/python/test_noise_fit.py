@@ -2,8 +2,6 @@
 times too small on AR(0.95) ballbar sessions, the noise-model fit's holds; the Monte Carlo
 check re-simulates the fitted noise model (issue 11 items 1 and 3)."""
 import json
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -11,6 +9,8 @@ import pytest
 import rotacal
 from rotacal import _core
 from rotacal.ballbar import identify, monte_carlo
+
+from conftest import run_cli
 
 
 @pytest.fixture(scope="module")
@@ -73,12 +73,10 @@ def test_cli_noise_option_and_json(clean, tmp_path):
     s = ar_session(clean, 0.95, 7)
     f = tmp_path / "ar.csv"
     rotacal.save(s, f)
-    run = lambda *a: subprocess.run([sys.executable, "-m", "rotacal", "identify", str(f), "--json", "--no-budget", *a],
-                                    capture_output=True, text=True, timeout=600)
+    run = lambda *a: run_cli("identify", f, "--json", "--no-budget", *a)
     auto, white = json.loads(run().stdout), json.loads(run("--noise", "white").stdout)
     assert auto["noise_model"]["gls_refit"] and not white["noise_model"]["gls_refit"]
     ratio = [auto["location_errors"][n]["std"] / white["location_errors"][n]["std"] for n in auto["location_errors"]]
     assert min(ratio) > 2.0, ratio  # correlated noise: the honest sigma is several times larger
-    bad = subprocess.run([sys.executable, "-m", "rotacal", "identify", str(f), "--noise", "pink"],
-                         capture_output=True, text=True, timeout=600)
+    bad = run_cli("identify", f, "--noise", "pink")
     assert bad.returncode == 2 and "--noise" in bad.stderr

@@ -3,7 +3,6 @@
 reference simulator (tests/reference/refsim), and the simulator's touches are checked against
 refsim's touch model on the truth it wrote."""
 import json
-import subprocess
 import sys
 from pathlib import Path
 
@@ -14,12 +13,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "reference"))
 import refsim  # noqa: E402
 
 import rotacal  # noqa: E402
+from conftest import run_cli as run  # noqa: E402
 from test_probe import refsim_session  # noqa: E402
-
-
-def run(*args):
-    return subprocess.run([sys.executable, "-m", "rotacal", *map(str, args)], capture_output=True, text=True,
-                          timeout=600)
 
 
 def outside_3_sigma(location_errors: dict, truth: dict) -> list[str]:

@@ -7,7 +7,6 @@ Also: axis limits of a machine description respected, the printed poses accepted
 probe --poses`, invalid input refused naming the option, and the separation search on probe
 sessions."""
 import json
-import subprocess
 import sys
 from pathlib import Path
 
@@ -21,6 +20,7 @@ from refsim import poses as refposes  # noqa: E402
 import probe_bound  # noqa: E402
 
 import rotacal  # noqa: E402
+from conftest import run_cli  # noqa: E402
 from rotacal.design import design_probe  # noqa: E402
 from rotacal.probe import identify_probe  # noqa: E402
 
@@ -29,7 +29,7 @@ SPHERE = np.array([150.0, 0.0, 80.0])
 
 
 def rotacal_cli(*args):
-    r = subprocess.run([sys.executable, "-m", "rotacal", *map(str, args)], capture_output=True, text=True, timeout=300)
+    r = run_cli(*args)
     assert "Traceback" not in r.stderr, r.stderr
     return r
 

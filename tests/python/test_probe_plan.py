@@ -10,7 +10,6 @@ the sphere. Then: plan -> latched points of a machine with errors by refsim -> a
 LOG format -> import -> identify, every location error within 3 sigma.
 """
 import json
-import subprocess
 import sys
 from pathlib import Path
 
@@ -23,15 +22,11 @@ from refsim import noise  # noqa: E402
 from refsim import poses as refposes  # noqa: E402
 
 import rotacal  # noqa: E402
+from conftest import run_cli as run  # noqa: E402
 from test_linuxcnc import RS274, run_rs274  # noqa: E402  (the interpreter's canonical commands)
 
 R = 0.5 * (25.0 + 6.0)  # trigger radius of the default sphere and stylus
 SLOT = {"A": 3, "B": 4, "C": 5}
-
-
-def run(*args):
-    return subprocess.run([sys.executable, "-m", "rotacal", *map(str, args)], capture_output=True, text=True,
-                          timeout=600)
 
 
 def nominal_centre(machine: str, angles_deg, sphere=(150.0, 0.0, 80.0)) -> np.ndarray:

@@ -2,9 +2,10 @@
 import re
 import shutil
 import subprocess
-import sys
 
 import pytest
+
+from conftest import run_cli
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
@@ -12,8 +13,7 @@ FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-
 
 
 def write_report(session, out):
-    r = subprocess.run([sys.executable, "-m", "rotacal", "report", str(session), "-o", str(out)],
-                       capture_output=True, text=True, timeout=300)
+    r = run_cli("report", session, "-o", out)
     assert r.returncode == 0, r.stderr
     return out
 

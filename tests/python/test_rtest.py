@@ -1,13 +1,12 @@
 """R-test from Python: identification of the independent implementation's file against its truth."""
 import json
 import re
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
 import rotacal
+from conftest import run_cli as rotacal_cli
 from conftest import split_by_c, truth
 
 
@@ -45,21 +44,15 @@ def test_paper_method_lists_its_assumptions(oyama):
 
 
 def test_cli_identify_rtest(shared_data, tmp_path):
-    run = lambda *a: subprocess.run([sys.executable, "-m", "rotacal", *map(str, a)], capture_output=True,
-                                    text=True, timeout=300)
-    r = run("identify", shared_data / "rtest_bc_oyama.csv")
+    r = rotacal_cli("identify", shared_data / "rtest_bc_oyama.csv")
     assert r.returncode == 0, r.stderr
     assert set(json.loads(r.stdout)["location_errors"]) >= {"E_X0B", "E_Z0B", "E_X0C", "E_Y0C"}
-    r = run("identify", shared_data / "rtest_bc_oyama.csv", "--method", "paper", "--save-model", tmp_path / "m.json")
+    r = rotacal_cli("identify", shared_data / "rtest_bc_oyama.csv", "--method", "paper", "--save-model",
+                    tmp_path / "m.json")
     assert r.returncode == 3 and "--method joint" in r.stderr and not (tmp_path / "m.json").exists()
 
 
 # ------------------------------------------------------------------------- simulate, model files, predict
-
-def rotacal_cli(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "rotacal", *map(str, args)], capture_output=True, text=True,
-                          timeout=300, cwd=cwd)
-
 
 EFFECTS = ["--effect", "gravity_sag_B=0.006", "--effect", "coning_B=0.000145",
            "--effect", "axial_motion_C_h2=0.002,-0.001"]
