@@ -70,7 +70,7 @@ TEST_CASE("null data: no finding", "[diagnose]") {
   }
 }
 
-TEST_CASE("every visible catalogue effect, hidden at 5 sigma, is found first", "[diagnose]") {
+TEST_CASE("every visible catalogue effect, hidden at 5 sigma, is found first", "[diagnose][statistical]") {
   std::mt19937 rng(202);
   int tried = 0;
   std::vector<std::string> invisible;

@@ -56,7 +56,7 @@ std::string names(const Diagnosis& D) {
 
 }  // namespace
 
-TEST_CASE("ballbar null sessions in AR(1) and 1/f-like noise: no finding", "[diagnose][realistic]") {
+TEST_CASE("ballbar null sessions in AR(1) and 1/f-like noise: no finding", "[diagnose][realistic][statistical]") {
   std::mt19937 rng(5);
   int false_white = 0, false_modelled = 0, sessions = 0;
   for (Noise kind : {Noise::ar1_09, Noise::ar1_095, Noise::pink}) {

@@ -69,7 +69,7 @@ TEST_CASE("R-test diagnosis: null data gives no finding; a hidden runout is foun
     for (const CandidateScore& c : round) CHECK(c.effect.rfind("ballbar_", 0) != 0);
 }
 
-TEST_CASE("every catalogue effect an R-test can see, hidden at 5 sigma, is found first", "[diagnose]") {
+TEST_CASE("every catalogue effect an R-test can see, hidden at 5 sigma, is found first", "[diagnose][statistical]") {
   // Same rule as the ballbar test: the amplitude gives 5 sigma RMS of what the location errors
   // and probe zeros cannot absorb, if a plausible size of the effect can do that.
   std::mt19937 rng(31);
