@@ -235,7 +235,7 @@ void judge_local_structure(const DiagnosisProblem& P, const std::vector<LocalBlo
     why << "its signature only in pose" << (at.count > 1 ? "s '" : " '") << blocks[at.first].label << "'"
         << (at.count > 1 ? "..'" + blocks[at.first + at.count - 1].label + "'" : std::string())
         << " and nowhere else fits the readings as well (weight " << w << " against " << F.weight
-        << " before): a local defect there is as likely a cause as this entry";
+        << " before): a local defect there, outside the catalogue, explains them at least as well";
     F.lack_of_fit = why.str();
     F.weight = w;
     at.p = std::min(1.0, at.p * windows);
