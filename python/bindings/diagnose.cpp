@@ -79,6 +79,7 @@ void bind_diagnosis_findings(pyb::module_& m) {
       .def_readonly("weight", &Finding::weight)
       .def_readonly("rivals", &Finding::rivals)
       .def_property_readonly("named_alone", &Finding::named_alone)
+      .def_readonly("lack_of_fit", &Finding::lack_of_fit)
       .def_readonly("parameters", &Finding::parameters)
       .def_readonly("gain", &Finding::gain)
       .def_readonly("shifts", &Finding::shifts);

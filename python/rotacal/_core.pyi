@@ -1378,6 +1378,9 @@ class Finding:
     def gain(self) -> Gain:
         ...
     @property
+    def lack_of_fit(self) -> str:
+        ...
+    @property
     def named_alone(self) -> bool:
         ...
     @property

@@ -102,6 +102,9 @@ class DiagnosisResult:
                     # DiagnosisOptions.min_weight together, and "effect" is then only its best.
                     "weight": f.weight,
                     "named": bool(f.named_alone),
+                    # Non-empty: the finding's signature confined to a few poses fits as well (a
+                    # local defect outside the catalogue), which is why it is not named.
+                    "lack_of_fit": f.lack_of_fit,
                     "group": [{"effect": f.effect, "weight": f.weight}] + [
                         {"effect": r.effect, "weight": r.weight, **({"aliased": True} if r.aliased else {})}
                         for r in f.rivals if r.in_group],

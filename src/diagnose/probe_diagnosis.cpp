@@ -3,6 +3,7 @@
 
 #include "rotacal/probe/identify.hpp"
 #include "rotacal/probe/problem.hpp"
+#include "local_structure.hpp"
 
 namespace rotacal {
 
@@ -53,8 +54,39 @@ Eigen::MatrixXd ProbeDiagnosisProblem::candidate_jacobian(const ModelFit& at, co
   return J.rightCols(candidate.num_params());
 }
 
+namespace {
+
+// Each held pose's touches, in the order the poses were measured, with the columns of a free
+// shift of the sphere there: a touch sees a shift s of the sphere as n.s along its approach n.
+std::vector<diagnosis_detail::LocalBlock> pose_blocks(const ProbeSession& session) {
+  std::vector<diagnosis_detail::LocalBlock> blocks;
+  for (const std::string& label : session.poses()) {
+    diagnosis_detail::LocalBlock B;
+    B.label = label;
+    for (std::size_t i = 0; i < session.samples.size(); ++i)
+      if (session.samples[i].pose == label) B.rows.push_back(static_cast<Eigen::Index>(i));
+    const ProbeSample& first = session.samples[static_cast<std::size_t>(B.rows.front())];
+    B.tilt_deg = first.tilt_deg, B.rot_deg = first.rot_deg;
+    B.t_from = first.time, B.t_to = session.samples[static_cast<std::size_t>(B.rows.back())].time;
+    B.columns.resize(static_cast<Eigen::Index>(B.rows.size()), 3);
+    for (std::size_t k = 0; k < B.rows.size(); ++k)
+      B.columns.row(static_cast<Eigen::Index>(k)) =
+          session.samples[static_cast<std::size_t>(B.rows[k])].n.normalized().transpose();
+    blocks.push_back(std::move(B));
+  }
+  return blocks;
+}
+
+}  // namespace
+
+// The engine's diagnosis, then the poses' local structure (local_structure.hpp): a shape outside
+// the catalogue held by a few poses, and the findings it carries, which are not named alone.
 Diagnosis diagnose_probe(ProbeSession session, const DiagnosisOptions& options) {
-  return diagnose(ProbeDiagnosisProblem(std::move(session)), options);
+  const std::vector<diagnosis_detail::LocalBlock> blocks = pose_blocks(session);
+  const ProbeDiagnosisProblem problem(std::move(session));
+  Diagnosis D = diagnose(problem, options);
+  diagnosis_detail::judge_local_structure(problem, blocks, options, D);
+  return D;
 }
 
 }  // namespace rotacal

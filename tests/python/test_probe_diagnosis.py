@@ -195,24 +195,40 @@ def bump_session(tmp_path, machine, seed, kind, height_mm=0.004, in_time=False):
     return rotacal.load(path)
 
 
-TRACK_BUMP_AS_STRAIGHTNESS = pytest.mark.xfail(strict=True, reason=(
-    "left open: with the default layout's one C sweep, an X shift peaking at C = 90 deg is an X "
-    "error peaking at the sweep's largest Y, which straightness_XY expresses; it is named alone "
-    "(weight 1.00, seeds 1502-1504) where 'unexplained structure' or a group is wanted"))
-TIME_BUMP_AS_WARMUP = pytest.mark.xfail(strict=True, reason=(
-    "left open: in 1/f-like noise a Y shift settling back within 15 s is named thermal_warmup_Y "
-    "(weight 0.91-0.97, seeds 1501 and 1503)"))
-
-
-@pytest.mark.parametrize("machine,kind,in_time", [
-    ("AC-trt", "ar1_0.5", True),
-    pytest.param("BC-trt", "pink", True, marks=TIME_BUMP_AS_WARMUP),
-    pytest.param("AC-trt", "ar1_0.5", False, marks=TRACK_BUMP_AS_STRAIGHTNESS)])
-def test_a_shape_outside_the_catalogue_gets_no_confident_name(tmp_path, machine, kind, in_time):
+@pytest.mark.parametrize("machine,kind,in_time,seeds", [
+    ("AC-trt", "ar1_0.5", True, (1501, 1502, 1503, 1504)),
+    ("BC-trt", "pink", True, (1501, 1502, 1503, 1504, 1601, 1602)),
+    ("AC-trt", "ar1_0.5", False, (1501, 1502, 1503, 1504)),
+    ("BC-trt", "ar1_0.5", False, (1601, 1602, 1603, 1604))])
+def test_a_shape_outside_the_catalogue_gets_no_confident_name(tmp_path, machine, kind, in_time, seeds):
     """A shape outside the catalogue (bump_session) in coloured noise: the diagnosis may name
     nothing, report unexplained structure or a group, never one catalogue entry with
-    confidence."""
-    for seed in (1501, 1502, 1503, 1504):
+    confidence. Before the local rival (src/diagnose/local_structure.cpp), the X shift peaking at
+    C = 90 deg was named straightness_XY alone (weight 1.00; AC-trt seeds 1502-1504, BC-trt 1602
+    and 1603) and the Y shift settling back within 15 s thermal_warmup_Y and thermal_drift_Y
+    (weights 0.91-1.00, every BC-trt seed here)."""
+    for seed in seeds:
         d = rotacal.diagnose(bump_session(tmp_path, machine, seed, kind, in_time=in_time)).to_dict()
         named = [(f["effect"], f["weight"]) for f in d["findings"] if f["named"]]
         assert not named, (seed, named)
+
+
+@pytest.mark.parametrize("seed", [1701, 1702, 1703])
+def test_a_local_shift_outside_the_catalogue_is_reported_where_it_is(tmp_path, seed):
+    """bump_session's Y shift settling back within 15 s (at 70 % of the session, in the tilt
+    sweep) in AR(1) 0.5 noise: no catalogue entry follows it. Before, the probe's diagnosis said
+    nothing at all about it (its structure test fits harmonics of C to the touches' residuals, in
+    which the +Y and -Y touches of a pose cancel); it is reported as unexplained structure in the
+    poses it holds, in time."""
+    m = refsim.builtin("AC-trt")
+    s = poses.probe_poses(m, sphere=SPHERE)
+    peak = int(np.argmin(np.abs(s["time"] - 0.7 * s["time"][-1])))  # the touch nearest the bump's peak
+    tilt = s["angles_deg"][peak, poses.rotary_roles(m)[0]]
+    res = rotacal.diagnose(bump_session(tmp_path, "AC-trt", seed, "ar1_0.5", in_time=True))
+    u = res.raw.unexplained
+    assert u.present, u.signature
+    # In the tilt sweep the poses' range is told in A (in time where the window's angles do not
+    # move one axis alone).
+    at = {"A": tilt, "": s["time"][peak]}[u.axis]
+    assert u.range_from <= at <= u.range_to, (u.axis, u.range_from, u.range_to, at, u.signature)
+    assert not [f for f in res.to_dict()["findings"] if f["named"]]

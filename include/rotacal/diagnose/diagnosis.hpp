@@ -215,7 +215,13 @@ struct Finding {
   /// the finding is the group of `rivals` with in_group set, not `effect` alone.
   double weight = 1.0;
   std::vector<Alternative> rivals;  ///< best first
+  /// Non-empty: its signature confined to a few consecutive poses and zero elsewhere (a local
+  /// defect, outside the catalogue) fits the readings about as well, in words (the probe:
+  /// src/diagnose/local_structure.hpp); `weight` then counts that local rival, and the finding
+  /// is never named alone.
+  std::string lack_of_fit;
   bool named_alone() const {
+    if (!lack_of_fit.empty()) return false;
     for (const Alternative& a : rivals)
       if (a.in_group) return false;
     return true;

@@ -21,6 +21,8 @@ def print_diagnosis(d: dict) -> None:
         g = f["gain"]
         if f["named"]:
             print(f"{i}. {f['effect']} (weight {f['weight']:.2f}): {f['cause']}")
+        elif f.get("lack_of_fit"):
+            print(f"{i}. not named, {f['effect']} (weight {f['weight']:.2g}): {f['lack_of_fit']}. If it is {f['effect']}:")
         else:
             group = ", ".join(f"{m['effect']} ({'aliased' if m.get('aliased') else format(m['weight'], '.2f')})"
                               for m in f["group"])

@@ -214,6 +214,9 @@ def diagnosis_section(d: dict) -> str:
                                  for k, v in f["parameters"].items())
             if f["named"]:
                 effect = _e(f["effect"])
+            elif f.get("lack_of_fit"):  # a local defect outside the catalogue fits as well
+                effect = f"not named: {_e(f['effect'])} ({_e(f['lack_of_fit'])})"
+                params = f"if {_e(f['effect'])}:<br>" + params
             else:  # the group the data cannot separate, with the parameters of its best
                 effect = "one of: " + ", ".join(
                     f"{_e(m['effect'])} ({'aliased' if m.get('aliased') else format(m['weight'], '.2f')})"
