@@ -97,7 +97,7 @@ void check_content(const FittedModelContent& c) {
 
 // ----------------------------------------------------------------- reading
 
-struct Reader {
+struct FittedModelReader {
   const std::string& source;
 
   // An estimate of `unit` within `limit`; value null or "observable": false -> unobservable.
@@ -348,7 +348,7 @@ json fitted_model_document(const FittedModelContent& c) {
 }
 
 FittedModelContent fitted_model_from_json(const json& doc, MachineType machine, const std::string& source) {
-  const Reader r{source};
+  const FittedModelReader r{source};
   FittedModelContent c;
   c.kind = r.text(doc, "kind", "");
   if (c.kind != "probe" && c.kind != "multi") bad(source, "kind", shown(doc["kind"]) + " is not probe or multi");
