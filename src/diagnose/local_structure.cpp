@@ -15,6 +15,14 @@ namespace rotacal::diagnosis_detail {
 
 namespace {
 
+// [A B] by blocks: Eigen's comma initializer asserts on a block without columns (or rows).
+Eigen::MatrixXd side_by_side(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) {
+  Eigen::MatrixXd X(A.rows(), A.cols() + B.cols());
+  X.leftCols(A.cols()) = A;
+  X.rightCols(B.cols()) = B;
+  return X;
+}
+
 // The final model's free columns and, for 1/f-like noise, one level per stream (nuisance, as
 // in the structure test of final_test.cpp), with the noise the final model leaves: white with
 // the diagnosis' sigma, or by REML over what that model leaves.
@@ -32,9 +40,7 @@ FinalModel final_model(const DiagnosisProblem& P, const Diagnosis& D) {
   }
   if (D.noise.max_order >= 2) {
     M.levels = stream_levels(P);
-    Eigen::MatrixXd X(M.X.rows(), M.X.cols() + M.levels.cols());
-    X << M.X, M.levels;
-    M.X = std::move(X);
+    M.X = side_by_side(M.X, M.levels);
   }
   M.noise = coloured_treatment(estimate_noise_model_reml(D.noise, D.final_fit.residuals, M.X), false);
   return M;
@@ -75,9 +81,7 @@ double window_p(const Eigen::MatrixXd& Q, const Eigen::VectorXd& r_w, const Eige
 // The window's shifts (mm) fitted to y_mm beside the columns `model`, linearised at the final fit.
 Eigen::VectorXd window_shift_mm(const FinalModel& M, const Eigen::MatrixXd& model, const Eigen::VectorXd& y_mm,
                                 const Eigen::MatrixXd& G) {
-  Eigen::MatrixXd X(G.rows(), model.cols() + G.cols());
-  X << model, G;
-  return solve_ls(M.noise.whiten(X), M.noise.whiten(y_mm)).tail(G.cols());
+  return solve_ls(M.noise.whiten(side_by_side(model, G)), M.noise.whiten(y_mm)).tail(G.cols());
 }
 
 // Where the window is, in words, and as D.unexplained's axis and range.
@@ -152,8 +156,7 @@ LocalRival local_rival(const Diagnosis& D, const FinalModel& M, const std::vecto
   const Share S = share_of(D.final_fit, F.effect);
   const Eigen::Index n = S.signature.size();
   LocalRival out;
-  out.others.resize(n, S.others.cols() + M.levels.cols());
-  out.others << S.others, M.levels;
+  out.others = M.levels.cols() > 0 ? side_by_side(S.others, M.levels) : S.others;
   out.y_mm = D.final_fit.residuals + S.signature;
   const Eigen::MatrixXd Q = orthonormal_basis(M.noise.whiten(out.others));
   const Eigen::VectorXd y = M.noise.whiten(out.y_mm);
