@@ -65,12 +65,15 @@ std::optional<std::pair<StopReason, std::string>> handshake(ByteTransport& port,
 
 bool start_stream(ByteTransport& port, FrameReader& reader, RecordSummary& sum, const RecordOptions& opt,
                   bool zero, StreamGuard& guard) {
-  auto fail = handshake(port, reader, sum, format_command(StreamCommand::identify), "ID ", 1.0);
-  if (!fail && zero) fail = handshake(port, reader, sum, format_command(StreamCommand::zero), "OK ZERO", 1.0);
-  if (!fail) fail = handshake(port, reader, sum, format_command(StreamCommand::rate, opt.rate_hz), "OK RATE", 1.0);
+  // A reply is awaited as long as the user waits for a silent instrument (--silence): a fixed
+  // 1 s stopped a recording whose instrument (or host) was slow to answer under load.
+  const double wait_s = opt.silence_timeout_s;
+  auto fail = handshake(port, reader, sum, format_command(StreamCommand::identify), "ID ", wait_s);
+  if (!fail && zero) fail = handshake(port, reader, sum, format_command(StreamCommand::zero), "OK ZERO", wait_s);
+  if (!fail) fail = handshake(port, reader, sum, format_command(StreamCommand::rate, opt.rate_hz), "OK RATE", wait_s);
   if (!fail) {
     guard.active = true;
-    fail = handshake(port, reader, sum, format_command(StreamCommand::start), "OK START", 1.0);
+    fail = handshake(port, reader, sum, format_command(StreamCommand::start), "OK START", wait_s);
   }
   if (!fail) return true;
   sum.reason = fail->first;

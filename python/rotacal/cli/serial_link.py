@@ -85,7 +85,7 @@ def add_virtual_args(q: argparse.ArgumentParser) -> None:
 
 def add_record_args(q: argparse.ArgumentParser) -> None:
     q.add_argument("--port", required=True, help="serial port, e.g. /dev/ttyUSB0, /dev/serial/by-id/..., /dev/pts/N")
-    q.add_argument("--silence", type=number("--silence", 0.0, 3600.0, "s", lo_open=True), default=3.0, help="stop after this many seconds without data")
+    q.add_argument("--silence", type=number("--silence", 0.0, 3600.0, "s", lo_open=True), default=3.0, help="stop after this many seconds without data or without a reply to a command")
     q.add_argument("--no-progress", action="store_true", help="no progress bar")
     q.add_argument("--json", action="store_true", help="print the recording summary as JSON")
     q.add_argument("-o", "--output", required=True, type=path("--output"))
