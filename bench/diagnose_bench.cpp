@@ -4,6 +4,7 @@
 // Targets: false-finding rate <= 5 %; <= 200 ms per diagnosis.
 //
 // Usage: diagnose_bench [--null N] [--trials N] [--smoke]
+// (--smoke: 5 null sessions and every effect once at 0.5 sigma, to show the bench runs.)
 #include <Eigen/SVD>
 #include <algorithm>
 #include <chrono>
@@ -28,10 +29,13 @@ constexpr double kNoiseUm = 0.5;
 
 int main(int argc, char** argv) {
   int n_null = 200, trials = 5;
+  // RMS over the whole session: 1 sigma over ~1800 readings is already a chi-square change of
+  // ~1800, so the transition from missed to found lies well below 1.
+  std::vector<double> amps = {0.05, 0.1, 0.2, 0.3, 0.5, 1.0};
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--null") && i + 1 < argc) n_null = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--trials") && i + 1 < argc) trials = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--smoke")) n_null = 5, trials = 1;
+    else if (!std::strcmp(argv[i], "--smoke")) n_null = 5, trials = 1, amps = {0.5};  // every effect once
     else {
       std::fprintf(stderr, "usage: diagnose_bench [--null N] [--trials N] [--smoke]\n");
       return 2;
@@ -61,9 +65,6 @@ int main(int argc, char** argv) {
 
   // Detection rate against amplitude: the hidden effect named first (or in an ambiguity
   // group with the first finding).
-  // RMS over the whole session: 1 sigma over ~1800 readings is already a chi-square change of
-  // ~1800, so the transition from missed to found lies well below 1.
-  const std::vector<double> amps = {0.05, 0.1, 0.2, 0.3, 0.5, 1.0};
   std::printf("\ndetection rate (named first) against amplitude in sigma, %d trial(s) each; '-' = needs more "
               "than a plausible size\n%-28s", trials, "effect");
   for (double a : amps) std::printf(" %5.2fs", a);

@@ -21,9 +21,11 @@ step "Configure the Release build, the AddressSanitizer + UBSan build and the fu
 # the other 73 in Release as well cost about 6 CPU-minutes of compiling and 5 minutes of
 # testing (ctest -j1, at load 6-19). Finer, by Catch2 tag: the cases tagged [statistical] (the
 # catalogue sweeps and the null-session rates of three diagnosis tests: 292 of their 407 CPU-s
-# under ASan, 22 in Release) run in the Release build as test_<header>_statistical; the other
-# cases of those executables, which run the same code on fewer sessions, under the sanitizers
-# (ROTACAL_TEST_HALVES, tests/CMakeLists.txt).
+# under ASan, 22 in Release; the separation design's Monte Carlo in test_ballbar_design: 158 of
+# its 166, 11 in Release, one draw of the same fits, 18, in its place; the probe separation's
+# Monte Carlo in test_probe_design: 12 of 27, 1 in Release) run in the Release build
+# as test_<header>_statistical; the other cases of those executables, which run the same code
+# on fewer sessions, under the sanitizers (ROTACAL_TEST_HALVES, tests/CMakeLists.txt).
 # The sanitizer build at -O1 with line tables only: what ASan recommends, and far quicker to
 # compile than -O2 -g. With clang (the fuzzers' compiler too; setup.sh installs it and its
 # sanitizer runtimes): 27 % less compiler CPU per file than GCC, its tests faster, and its UBSan

@@ -217,7 +217,7 @@ TEST_CASE("separation: gravity sag and the second radial harmonic of A, no probe
 }
 
 TEST_CASE("separation: the joint fit of the session and the added poses realises the predicted sigma",
-          "[probe][design][separation]") {
+          "[probe][design][separation][statistical]") {
   MachineModel t = MachineModel::nominal(MachineType::AC_trt);
   t.effects = EffectModel{{Effect::parse("radial_motion_A_h2"), Effect::parse("tilt_motion_A_h2")}, std::nullopt};
   t.effect_params = {0.002, -0.001, 0.0015, 0.0, 1e-5, 0.0, -2e-5, 1e-5};
