@@ -31,13 +31,15 @@ struct LocalBlock {
 ///  - every finding weighed against its local rival, its own fitted signature free in each
 ///    block of one window and zero elsewhere, in its place (the best window at BIC's and at
 ///    AIC's Occam term): its weight becomes that among itself, its catalogue rivals and the
-///    local rival (1 / (1 / w + e^(-delta IC / 2)), the smaller at the two terms). Below
-///    options.min_weight it gets its Finding::lack_of_fit and is not named alone: a finding
-///    that rests on a few poses is as well a defect there that the catalogue does not hold;
+///    local rival (1 / (1 / w + e^(-delta IC / 2)), the smaller at the two terms). A finding
+///    named alone before and below options.min_weight after, or one whose local rival fits at
+///    least as well (delta IC <= 0 at either term), gets its Finding::lack_of_fit and is not
+///    named alone: a finding that rests on a few poses is as well a defect there that the
+///    catalogue does not hold;
 ///  - the blocks' free shifts F-tested against the final residuals (whitened under the noise the
 ///    final model leaves, its columns projected out), Bonferroni over the windows; where the
-///    best window's p-value is below 1e-3, or else where a finding lost its name to its local
-///    rival, that window is reported in D.unexplained (where, with its poses).
+///    best window's p-value is below 1e-3, or else where a finding got its lack_of_fit, that
+///    window is reported in D.unexplained (where, with its poses).
 inline constexpr int kMaxWindow = 4;
 void judge_local_structure(const DiagnosisProblem& P, const std::vector<LocalBlock>& blocks,
                            const DiagnosisOptions& options, Diagnosis& D);

@@ -53,20 +53,28 @@ RivalJudgement weigh_rivals(const Score& chosen, const std::vector<const Score*>
   std::vector<std::size_t> order(who.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin() + 1, order.end(), [&](std::size_t a, std::size_t b) { return w[a] > w[b]; });
-  // The group: the chosen candidate, then rivals by weight until min_weight is held, and every
-  // rival the best of the field cannot be told apart from (the best's weight against it alone
-  // below min_weight, as an ambiguity claim means): a rival just outside the weight that
-  // completes min_weight is no less a candidate than the last one inside it.
-  const double w_best = *std::max_element(w.begin(), w.end());
+  // The group: the chosen candidate, then rivals by weight until min_weight is held; then every
+  // rival that some member cannot be told apart from (that member's weight against it alone
+  // below min_weight) at either end of the Occam term. A rival just outside the weight that
+  // completes min_weight is no less a candidate than the last one inside it, one that outweighs
+  // a member (the chosen one can hold little weight: the search passes over better-fitting
+  // candidates that fail cross-validation) is more of one, and one that fits as well as a
+  // member with more parameters is set apart from it only by a prior on its size, which the
+  // chosen candidate's own weight does not rest on either.
   double held = w[0];
   std::vector<bool> member(who.size(), false);
   member[0] = true;
-  for (std::size_t j = 1; j < order.size(); ++j) {
-    const std::size_t i = order[j];
-    if (held >= min_weight && w_best / (w_best + w[i]) >= min_weight) break;
-    member[i] = true;
-    held += w[i];
+  for (std::size_t j = 1; j < order.size() && held < min_weight; ++j) {
+    member[order[j]] = true;
+    held += w[order[j]];
   }
+  const double margin = (1.0 - min_weight) / min_weight;  // w_m / (w_m + w_i) < min_weight
+  std::vector<std::size_t> members;
+  for (std::size_t i = 0; i < who.size(); ++i)
+    if (member[i]) members.push_back(i);
+  for (std::size_t i = 0; i < who.size(); ++i)
+    for (std::size_t m : members)
+      if (!member[i] && (w_bic[i] > margin * w_bic[m] || w_aic[i] > margin * w_aic[m])) member[i] = true;
   out.group.push_back(&chosen);
   for (std::size_t j = 1; j < order.size(); ++j) {
     const std::size_t i = order[j];

@@ -41,9 +41,14 @@ struct RivalJudgement {
 /// amplitude.
 ///
 /// The group is the smallest set of them, best first, whose weights add up to `min_weight`,
-/// and any further rival whose weight against the best of the field alone is above
-/// 1 - min_weight (the two cannot be told apart, DiagnosisOptions::min_weight); it holds the
-/// chosen candidate alone when that one's weight reaches `min_weight`.
+/// and any further rival that a member of that set cannot be told apart from: the member's
+/// weight against the rival alone below min_weight (DiagnosisOptions::min_weight) at either
+/// end of the Occam term. So no rival that outweighs a member is left out, nor one that fits
+/// as well as a member with more parameters (on one probe sphere a radial motion of C fits
+/// exactly as its angular positioning does; at BIC's term alone the group [tilt, angular
+/// positioning] left the true radial motion out). It holds the chosen candidate alone when
+/// that one's weight reaches `min_weight` (every rival then holds less than 1 - min_weight at
+/// both ends).
 /// `bic[i]`: the delta BIC of field[i] under the noise model the field is weighed with (one for
 /// all of them; +inf: not visible under it, not a rival); `n`: the readings (BIC's ln n).
 /// `tempering` (>= 1) divides the differences before they become weights (evidence_tempering).
