@@ -102,7 +102,7 @@ struct DiagnosisOptions {
   /// its own by at least rival_correlation) is at least min_weight, at BIC's Occam term of
   /// ln n per parameter and at AIC's of 2 alike (src/diagnose/rivals.hpp: the smaller of the
   /// two weights); otherwise the finding is the group of candidates, best first, that holds
-  /// min_weight together, with every rival the best cannot be told apart from ("one of
+  /// min_weight together, with every rival a member cannot be told apart from ("one of
   /// these"), and those are reported as ambiguous. 0.9: the chosen cause is 9 times as
   /// probable as all its rivals together (a margin of 2 ln 9 = 4.4 over a single rival).
   double min_weight = 0.9;
