@@ -6,13 +6,13 @@
 #include <vector>
 
 #include "../io/nc_words.hpp"
+#include "rotacal/core/angles.hpp"
 #include "rotacal/core/error.hpp"
 
 namespace rotacal {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // Two commanded poses closer than this (mm, deg) are the same: no block is written.
 constexpr double kSamePose = 1e-9;
 

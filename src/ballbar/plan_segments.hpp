@@ -6,11 +6,10 @@
 #include <vector>
 
 #include "rotacal/ballbar/plan.hpp"
+#include "rotacal/core/angles.hpp"
 
 namespace rotacal::plan_detail {
 
-inline constexpr double kPi = 3.14159265358979323846;
-inline constexpr double kDeg = kPi / 180.0;
 // Coincidence tolerance for lengths, mm: far below any NC resolution, far above rounding.
 inline constexpr double kLengthTol = 1e-9;
 // Longest program accepted: a single set-up test runs for minutes to a few hours.

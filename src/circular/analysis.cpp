@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <numeric>
 
+#include "rotacal/core/angles.hpp"
 #include "rotacal/core/error.hpp"
 #include "rotacal/fit/circle.hpp"
 
@@ -12,7 +13,6 @@ namespace rotacal {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kRad = 180.0 / kPi;
 // The shortest data arc whose circle is determined: the least-squares centre of an arc of
 // span s moves ~ noise / (1 - cos(s/2)) along its bisector, so a 2-5 deg arc (issue 32) put the

@@ -7,21 +7,20 @@
 #include <set>
 
 #include "../io/nc_words.hpp"
+#include "rotacal/core/angles.hpp"
 #include "rotacal/core/error.hpp"
 
 namespace rotacal {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDeg = kPi / 180.0;
 constexpr std::size_t kMinReadingsPerArc = 36;
 constexpr std::size_t kMaxReadings = 2000000;
 
 using nc_detail::fixed;
 using nc_detail::general;
 
-void require(bool ok, const std::string& what) {
+void require_plan(bool ok, const std::string& what) {
   if (!ok) throw InvalidArgument("plan_circular_test: " + what);
 }
 
@@ -113,39 +112,39 @@ Eigen::Vector3d circular_point(const CircularTestPlan& plan, CircularPlane plane
 }
 
 CircularPlanResult plan_circular_test(const CircularTestPlan& plan) {
-  require(std::isfinite(plan.radius) && plan.radius > 0.0 && plan.radius <= 1e4,
-          "radius must be in (0, 10000] mm, got " + general(plan.radius));
-  require(plan.centre.allFinite() && plan.centre.cwiseAbs().maxCoeff() <= 1e5,
-          "centre must be finite and within +-1e5 mm");
-  require(!plan.planes.empty(), "planes: at least one plane (XY, YZ, ZX) is needed");
-  require(!plan.feeds_mm_per_min.empty(), "feeds_mm_per_min: at least one feed is needed");
-  require(!plan.directions.empty(), "directions: at least one direction (ccw, cw) is needed");
-  require(
+  require_plan(std::isfinite(plan.radius) && plan.radius > 0.0 && plan.radius <= 1e4,
+               "radius must be in (0, 10000] mm, got " + general(plan.radius));
+  require_plan(plan.centre.allFinite() && plan.centre.cwiseAbs().maxCoeff() <= 1e5,
+               "centre must be finite and within +-1e5 mm");
+  require_plan(!plan.planes.empty(), "planes: at least one plane (XY, YZ, ZX) is needed");
+  require_plan(!plan.feeds_mm_per_min.empty(), "feeds_mm_per_min: at least one feed is needed");
+  require_plan(!plan.directions.empty(), "directions: at least one direction (ccw, cw) is needed");
+  require_plan(
       std::set<CircularPlane>(plan.planes.begin(), plan.planes.end()).size() == plan.planes.size(),
       "planes: a plane is repeated");
-  require(std::set<CircularDirection>(plan.directions.begin(), plan.directions.end()).size() ==
+  require_plan(std::set<CircularDirection>(plan.directions.begin(), plan.directions.end()).size() ==
               plan.directions.size(),
           "directions: a direction is repeated");
   for (double f : plan.feeds_mm_per_min)
-    require(std::isfinite(f) && f > 0.0 && f <= 1e5,
-            "feeds_mm_per_min: each feed must be in (0, 100000] mm/min, got " + general(f));
-  require(std::set<double>(plan.feeds_mm_per_min.begin(), plan.feeds_mm_per_min.end()).size() ==
+    require_plan(std::isfinite(f) && f > 0.0 && f <= 1e5,
+                 "feeds_mm_per_min: each feed must be in (0, 100000] mm/min, got " + general(f));
+  require_plan(std::set<double>(plan.feeds_mm_per_min.begin(), plan.feeds_mm_per_min.end()).size() ==
               plan.feeds_mm_per_min.size(),
           "feeds_mm_per_min: a feed is repeated");
-  require(std::isfinite(plan.span_deg) && plan.span_deg > 0.0 && plan.span_deg <= 360.0,
-          "span_deg must be in (0, 360], got " + general(plan.span_deg));
-  require(std::isfinite(plan.start_deg) && std::abs(plan.start_deg) <= 3600.0,
-          "start_deg must be finite and within +-3600, got " + general(plan.start_deg));
-  require(std::isfinite(plan.run_in_deg) && plan.run_in_deg >= 0.0 && plan.run_in_deg <= 360.0,
-          "run_in_deg must be in [0, 360], got " + general(plan.run_in_deg));
-  require(
+  require_plan(std::isfinite(plan.span_deg) && plan.span_deg > 0.0 && plan.span_deg <= 360.0,
+               "span_deg must be in (0, 360], got " + general(plan.span_deg));
+  require_plan(std::isfinite(plan.start_deg) && std::abs(plan.start_deg) <= 3600.0,
+               "start_deg must be finite and within +-3600, got " + general(plan.start_deg));
+  require_plan(std::isfinite(plan.run_in_deg) && plan.run_in_deg >= 0.0 && plan.run_in_deg <= 360.0,
+               "run_in_deg must be in [0, 360], got " + general(plan.run_in_deg));
+  require_plan(
       std::isfinite(plan.overshoot_deg) && plan.overshoot_deg >= 0.0 && plan.overshoot_deg <= 360.0,
       "overshoot_deg must be in [0, 360], got " + general(plan.overshoot_deg));
-  require(
+  require_plan(
       std::isfinite(plan.sample_rate_hz) && plan.sample_rate_hz > 0.0 && plan.sample_rate_hz <= 1e5,
       "sample_rate_hz must be in (0, 100000], got " + general(plan.sample_rate_hz));
-  require(std::isfinite(plan.remount_s) && plan.remount_s >= 0.0 && plan.remount_s <= 86400.0,
-          "remount_s must be in [0, 86400], got " + general(plan.remount_s));
+  require_plan(std::isfinite(plan.remount_s) && plan.remount_s >= 0.0 && plan.remount_s <= 86400.0,
+               "remount_s must be in [0, 86400], got " + general(plan.remount_s));
 
   CircularPlanResult out;
   out.plan = plan;

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "rotacal/core/angles.hpp"
 #include "rotacal/core/error.hpp"
 #include "rotacal/core/noise_model.hpp"
 
@@ -11,13 +12,11 @@ namespace rotacal {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
-void check(bool ok, const std::string& what) {
+void check_sim(bool ok, const std::string& what) {
   if (!ok) throw InvalidArgument("circular simulation: " + what);
 }
 
-double sign(double v) { return v > 0.0 ? 1.0 : (v < 0.0 ? -1.0 : 0.0); }
+double sign_of(double v) { return v > 0.0 ? 1.0 : (v < 0.0 ? -1.0 : 0.0); }
 
 // Actual machine-axis positions (mm) of the run's reading at time t, before the geometric
 // errors: servo lag, backlash and reversal spikes of the two moving axes.
@@ -38,7 +37,7 @@ Eigen::Vector3d moving_axes(const CircularTestPlan& plan, const CircularRun& run
     a[i] += plan.radius * gain * std::cos(psi);
     // Direction of travel of the axis; 0 at the turning point itself (|sin psi| < 1e-9: a
     // reading exactly at the reversal), where the lost motion is half taken up.
-    const double s = std::abs(std::sin(psi)) < 1e-9 ? 0.0 : sign(-std::sin(psi) * w);
+    const double s = std::abs(std::sin(psi)) < 1e-9 ? 0.0 : sign_of(-std::sin(psi) * w);
     a[i] -= 0.5 * e.backlash[i] * s;
     if (e.spike[i] != 0.0) {
       // Angle travelled since the axis last reversed (psi a multiple of pi).
@@ -73,25 +72,25 @@ Eigen::Vector3d geometric(const LinearAxisErrors& e, const Eigen::Vector3d& a,
 
 void check_circular_simulation(const CircularSimulationOptions& o) {
   const LinearAxisErrors& e = o.errors;
-  check(e.squareness.allFinite() && e.scale.allFinite() && e.straightness.allFinite() &&
+  check_sim(e.squareness.allFinite() && e.scale.allFinite() && e.straightness.allFinite() &&
             e.backlash.allFinite() && e.spike.allFinite() && e.spike_tau.allFinite() &&
             e.servo_tau.allFinite() && e.cyclic_cos.allFinite() && e.cyclic_sin.allFinite() &&
             e.screw_pitch.allFinite(),
         "errors: every value must be finite");
-  check(e.straightness.diagonal().isZero(0.0),
-        "errors.straightness: the diagonal (an axis' error along itself) must be 0");
-  check((e.screw_pitch.array() > 0.0).all(), "errors.screw_pitch must be positive");
-  check((e.spike_tau.array() > 0.0).all(), "errors.spike_tau must be positive");
-  check((e.servo_tau.array() >= 0.0).all() && (e.servo_tau.array() < 10.0).all(),
-        "errors.servo_tau must be in [0, 10) s");
-  check(o.centring_error.allFinite() && o.centring_error.cwiseAbs().maxCoeff() <= 10.0,
-        "centring_error must be within +-10 mm");
-  check(std::isfinite(o.length_error) && std::abs(o.length_error) <= 10.0,
-        "length_error must be within +-10 mm");
-  check(std::isfinite(o.noise_um) && o.noise_um >= 0.0 && o.noise_um <= 1000.0,
-        "noise_um must be in [0, 1000]");
-  check(std::isfinite(o.noise_rho) && o.noise_rho >= 0.0 && o.noise_rho < 1.0,
-        "noise_rho must be in [0, 1)");
+  check_sim(e.straightness.diagonal().isZero(0.0),
+            "errors.straightness: the diagonal (an axis' error along itself) must be 0");
+  check_sim((e.screw_pitch.array() > 0.0).all(), "errors.screw_pitch must be positive");
+  check_sim((e.spike_tau.array() > 0.0).all(), "errors.spike_tau must be positive");
+  check_sim((e.servo_tau.array() >= 0.0).all() && (e.servo_tau.array() < 10.0).all(),
+            "errors.servo_tau must be in [0, 10) s");
+  check_sim(o.centring_error.allFinite() && o.centring_error.cwiseAbs().maxCoeff() <= 10.0,
+            "centring_error must be within +-10 mm");
+  check_sim(std::isfinite(o.length_error) && std::abs(o.length_error) <= 10.0,
+            "length_error must be within +-10 mm");
+  check_sim(std::isfinite(o.noise_um) && o.noise_um >= 0.0 && o.noise_um <= 1000.0,
+            "noise_um must be in [0, 1000]");
+  check_sim(std::isfinite(o.noise_rho) && o.noise_rho >= 0.0 && o.noise_rho < 1.0,
+            "noise_rho must be in [0, 1)");
 
 }
 

@@ -21,7 +21,7 @@ struct KindInfo {
   const char* cause;
 };
 
-constexpr KindInfo kKinds[] = {
+constexpr KindInfo kKindInfo[] = {
     {EffectKind::ballbar_length_offset, "ballbar_length_offset", false, false, false, false, 1,
      "dL", "mm", "the calibrated ballbar length L0 is wrong"},
     {EffectKind::ballbar_thermal_drift, "ballbar_thermal_drift", false, false, false, false, 1,
@@ -82,7 +82,7 @@ constexpr KindInfo kKinds[] = {
 constexpr std::size_t kKindSlots = 64;
 constexpr std::array<const KindInfo*, kKindSlots> kByKind = [] {
   std::array<const KindInfo*, kKindSlots> t{};
-  for (const KindInfo& i : kKinds) t[static_cast<std::size_t>(i.kind)] = &i;
+  for (const KindInfo& i : kKindInfo) t[static_cast<std::size_t>(i.kind)] = &i;
   return t;
 }();
 
@@ -118,7 +118,7 @@ std::string Effect::id() const {
 }
 
 Effect Effect::parse(const std::string& id) {
-  for (const KindInfo& k : kKinds) {
+  for (const KindInfo& k : kKindInfo) {
     const std::string stem = k.stem;
     if (id.compare(0, stem.size(), stem) != 0) continue;
     std::string rest = id.substr(stem.size());
@@ -200,7 +200,7 @@ bool Effect::applies_to(MachineType m) const {
 std::vector<Effect> effect_catalogue(MachineType m, int max_harmonic) {
   std::vector<Effect> out;
   const char T = tilt_axis_letter(m), C = rot_axis_letter(m);
-  for (const KindInfo& k : kKinds) {
+  for (const KindInfo& k : kKindInfo) {
     if (k.kind == EffectKind::stylus_radius_offset || k.kind == EffectKind::probe_lobing) continue;
     if (k.kind == EffectKind::straightness) {
       for (char a : {'X', 'Y', 'Z'})

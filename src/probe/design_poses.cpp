@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rotacal/core/angles.hpp"
 #include "rotacal/core/error.hpp"
 #include "rotacal/design/format.hpp"
 
@@ -34,7 +35,6 @@ std::vector<RotaryAngles<double>> pose_grid(MachineType m, double tilt_step, dou
 
 std::vector<Eigen::Vector3d> contact_directions(MachineType m, const RotaryAngles<double>& pose_deg,
                                                 double max_angle_deg, double step_deg) {
-  constexpr double kDeg = M_PI / 180.0;
   const RotaryAngles<double> a{pose_deg.tilt * kDeg, pose_deg.rot * kDeg};
   const Eigen::Matrix3d R = m.has_head() ? head_pose<double>(m, LocationErrors<double>(), a).R
                                          : Eigen::Matrix3d::Identity().eval();

@@ -49,7 +49,7 @@ double session_pose_time(const ProbeSession& s) {
   return dt.empty() || !(dt[dt.size() / 2] > 0.0) ? ProbePattern{}.pose_dt_s : dt[dt.size() / 2];
 }
 
-void check(const ProbeSession& session, const std::vector<Effect>& pair, const ProbeSeparationOptions& o) {
+void check_separation_inputs(const ProbeSession& session, const std::vector<Effect>& pair, const ProbeSeparationOptions& o) {
   if (pair.size() != 2 || pair[0] == pair[1])
     throw InvalidArgument("design probe: --separate needs two different effects (EFFECT,EFFECT)");
   for (const Effect& f : pair) {
@@ -79,7 +79,7 @@ void check(const ProbeSession& session, const std::vector<Effect>& pair, const P
 
 ProbeSeparationDesign design_probe_separation(const ProbeSession& session, const std::vector<Effect>& pair,
                                               const ProbeSeparationOptions& o) {
-  check(session, pair, o);
+  check_separation_inputs(session, pair, o);
   const MachineType m = session.machine;
   ProbeSeparationDesign D;
   D.effects = {pair[0].id(), pair[1].id()};

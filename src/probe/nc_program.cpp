@@ -9,15 +9,14 @@
 #include <sstream>
 
 #include "../io/nc_words.hpp"
+#include "rotacal/core/angles.hpp"
 #include "rotacal/core/error.hpp"
 
 namespace rotacal {
 
 namespace {
 
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
-
-void require(bool ok, const std::string& what) {
+void require_program(bool ok, const std::string& what) {
   if (!ok) throw InvalidArgument("plan probe: " + what);
 }
 
@@ -56,14 +55,14 @@ double distance_to_segment(const Eigen::Vector3d& c, const Eigen::Vector3d& a, c
 std::vector<ProbeMove> probe_moves(MachineType m, const ProbePattern& P, const ProbeProgramOptions& o,
                                    double* retract_z) {
   const double r = 0.5 * (P.sphere_diameter + P.stylus_diameter);
-  require(P.sphere_diameter > 0.0 && P.stylus_diameter > 0.0, "sphere and stylus diameters must be > 0");
-  require(!P.poses_deg.empty() && (!P.directions.empty() || !P.pose_directions.empty()),
-          "the pattern has no poses or no directions");
-  require(P.pose_directions.empty() || P.pose_directions.size() == P.poses_deg.size(),
-          "the per-pose directions must hold one list per pose");
-  require(o.approach_mm > 0.0 && o.clearance_mm > 0.0, "approach and clearance must be > 0 mm");
-  require(o.overtravel_mm > 0.0 && o.overtravel_mm < r, "overtravel must be in (0, " + nc_detail::general(r) + ") mm");
-  require(o.probe_feed_mm_per_min > 0.0 && o.feed_mm_per_min > 0.0, "feeds must be > 0");
+  require_program(P.sphere_diameter > 0.0 && P.stylus_diameter > 0.0, "sphere and stylus diameters must be > 0");
+  require_program(!P.poses_deg.empty() && (!P.directions.empty() || !P.pose_directions.empty()),
+                  "the pattern has no poses or no directions");
+  require_program(P.pose_directions.empty() || P.pose_directions.size() == P.poses_deg.size(),
+                  "the per-pose directions must hold one list per pose");
+  require_program(o.approach_mm > 0.0 && o.clearance_mm > 0.0, "approach and clearance must be > 0 mm");
+  require_program(o.overtravel_mm > 0.0 && o.overtravel_mm < r, "overtravel must be in (0, " + nc_detail::general(r) + ") mm");
+  require_program(o.probe_feed_mm_per_min > 0.0 && o.feed_mm_per_min > 0.0, "feeds must be > 0");
   std::vector<ProbeMove> out;
   std::vector<Eigen::Vector3d> centres;
   double top = -1e300;
@@ -74,9 +73,9 @@ std::vector<ProbeMove> probe_moves(MachineType m, const ProbePattern& P, const P
     const Eigen::Vector3d c = inverse(m, LocationErrors<double>(), a, P.sphere).xyz;  // as simulate_probe
     top = std::max(top, c.z() + r);
     const std::vector<Eigen::Vector3d>& dirs = P.directions_at(k);
-    require(!dirs.empty(), "pose " + std::to_string(pose) + " has no approach direction");
+    require_program(!dirs.empty(), "pose " + std::to_string(pose) + " has no approach direction");
     for (std::size_t j = 0; j < dirs.size(); ++j) {
-      require(dirs[j].norm() > 0.0, "a zero approach direction");
+      require_program(dirs[j].norm() > 0.0, "a zero approach direction");
       ProbeMove mv;
       mv.pose = pose;
       mv.touch = static_cast<int>(j) + 1;

@@ -5,15 +5,15 @@
 #include <cmath>
 #include <cstdio>
 
+#include "rotacal/core/angles.hpp"
 #include "rotacal/core/noise_model.hpp"
 #include "rotacal/probe/touch_model.hpp"
 
 namespace rotacal {
 
 namespace {
-constexpr double kDeg = M_PI / 180.0;
 
-std::string fmt(double v) {
+std::string fmt4(double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.4f", v);
   return buf;
@@ -35,8 +35,8 @@ double trigger_lambda(MachineType m, const MachineModel& truth, const EffectMode
     const double f0 = f(lambda), h = 1e-6;
     const double slope = (f(lambda + h) - f0) / h;
     if (!(std::abs(slope) > 1e-3))
-      throw InvalidArgument("simulate_probe: the approach along (" + fmt(t.n.x()) + ", " + fmt(t.n.y()) + ", " +
-                            fmt(t.n.z()) + ") grazes or misses the sphere");
+      throw InvalidArgument("simulate_probe: the approach along (" + fmt4(t.n.x()) + ", " + fmt4(t.n.y()) + ", " +
+                            fmt4(t.n.z()) + ") grazes or misses the sphere");
     const double step = f0 / slope;
     lambda -= step;
     if (std::abs(step) < 1e-13) break;
@@ -83,8 +83,8 @@ ProbeSimulation simulate_probe(const MachineModel& truth, const ProbeSimOptions&
   s.stylus_diameter = P.stylus_diameter;
   if (o.noise_um > 0.0) s.noise_um = o.noise_um;
   s.metadata = {{"format", "rotacal-probe/1"}, {"machine", to_string(m)}, {"units", "mm, deg, s"},
-                {"sphere", fmt(P.sphere.x()) + ", " + fmt(P.sphere.y()) + ", " + fmt(P.sphere.z())},
-                {"sphere_diameter", fmt(P.sphere_diameter)}, {"stylus_diameter", fmt(P.stylus_diameter)}};
+                {"sphere", fmt4(P.sphere.x()) + ", " + fmt4(P.sphere.y()) + ", " + fmt4(P.sphere.z())},
+                {"sphere_diameter", fmt4(P.sphere_diameter)}, {"stylus_diameter", fmt4(P.stylus_diameter)}};
   const double radius = s.trigger_radius();
   // The touches: nominal start x0 (the tip at the nominal centre), direction and time.
   std::vector<ProbeTouch> touches;

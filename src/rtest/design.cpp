@@ -313,7 +313,7 @@ std::optional<RtestArrays> added_poses(const RtestPattern& pat, const RtestSepar
 }
 
 // The chosen nest in words.
-std::string describe(const RtestSeparatingCandidate& c) {
+std::string describe_candidate(const RtestSeparatingCandidate& c) {
   const RtestPattern& pat = c.added;
   std::ostringstream d;
   d << "a nest at " << point_text(pat.nests[0]) << ", B " << fixed_text(pat.b_deg.front(), 0) << ".."
@@ -422,7 +422,7 @@ RtestSeparationDesign design_rtest_separation(const RtestSession& session,
     chosen.repeats = c.repeats;
     chosen.correlation = c.correlation;
     chosen.determined = c.determined;
-    chosen.description = describe(chosen);
+    chosen.description = describe_candidate(chosen);
     added_names = added_zero.names;
   }
   SeparationWording wording;

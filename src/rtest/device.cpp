@@ -4,12 +4,12 @@
 #include <cmath>
 #include <random>
 
+#include "rotacal/core/angles.hpp"
 #include "rotacal/core/error.hpp"
 
 namespace rotacal {
 
 namespace {
-constexpr double kDeg = M_PI / 180.0;
 
 void check_dirs(const Eigen::Matrix3d& dirs, const char* what) {
   Eigen::JacobiSVD<Eigen::Matrix3d> svd(dirs);

@@ -8,13 +8,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include "rotacal/core/angles.hpp"
 #include "rotacal/core/error.hpp"
 #include "rotacal/io/output_file.hpp"
 
 namespace rotacal {
 
 namespace {
-constexpr double kDeg = M_PI / 180.0;
 std::string num(double v) {
   if (!std::isfinite(v)) return "";
   char b[40];

@@ -6,12 +6,12 @@
 #include <cmath>
 #include <map>
 
+#include "rotacal/core/angles.hpp"
 #include "rotacal/core/error.hpp"
 
 namespace rotacal {
 
 namespace {
-constexpr double kDeg = M_PI / 180.0;
 using Mat36 = Eigen::Matrix<double, 3, 6>;
 
 // Sensitivity of the small-angle reading (Eq. 8 with the sign of Sec. 5.1) to w_BY / w_CB.
@@ -34,8 +34,8 @@ int index_of(const std::vector<double>& v, double x) {
 
 // Linear least squares with covariance; components along null directions are set to zero
 // (minimum-norm) and get std 0. Returns rank.
-int solve_ls(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::VectorXd& x,
-             Eigen::VectorXd& std, double& ss) {
+int solve_paper_ls(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::VectorXd& x,
+                   Eigen::VectorXd& std, double& ss) {
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeThinU | Eigen::ComputeThinV);
   const Eigen::VectorXd s = svd.singularValues();
   const double tol = 1e-8 * s[0];
@@ -178,7 +178,7 @@ RtestPaperIdentification identify_paper(const RtestSession& session) {
     }
     Eigen::VectorXd x, sd;
     double ss = 0.0;
-    const int rank = solve_ls(A, b, x, sd, ss);
+    const int rank = solve_paper_ls(A, b, x, sd, ss);
     ss_b += ss;
     out.w_BY[i] = x;
     out.w_BY_std[i] = sd;
@@ -217,7 +217,7 @@ RtestPaperIdentification identify_paper(const RtestSession& session) {
       }
       Eigen::VectorXd x, sd;
       double ss = 0.0;
-      solve_ls(A, b, x, sd, ss);
+      solve_paper_ls(A, b, x, sd, ss);
       ss_c += ss;
       out.w_CB[i][j] << x[0], x[1], x[2], x[3], x[4], 0.0;
       out.w_CB_std[i][j] << sd[0], sd[1], sd[2], sd[3], sd[4], 0.0;

@@ -6,14 +6,14 @@
 #include <cstdio>
 #include <random>
 
+#include "rotacal/core/angles.hpp"
 #include "rotacal/core/error.hpp"
 
 namespace rotacal {
 
 namespace {
-constexpr double kDeg = M_PI / 180.0;
 
-std::string fmt(double v, int prec) {
+std::string format_fixed(double v, int prec) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.*f", prec, v);
   return buf;
@@ -37,9 +37,9 @@ std::string travel_violation(MachineType m, const Eigen::Vector3d& q, const std:
       const Eigen::Vector3d xyz = rtest_commanded_xyz(m, q, {b * kDeg, c * kDeg});
       for (int k = 0; k < 3; ++k)
         if (xyz[k] < (*travel)(k, 0) - 1e-9 || xyz[k] > (*travel)(k, 1) + 1e-9)
-          return std::string(1, names[k]) + " = " + fmt(xyz[k], 3) + " mm at " + tilt_axis_letter(m) + " " +
-                 fmt(b, 3) + ", " + rot_axis_letter(m) + " " + fmt(c, 3) + " deg is outside the travel [" +
-                 fmt((*travel)(k, 0), 1) + ", " + fmt((*travel)(k, 1), 1) + "]";
+          return std::string(1, names[k]) + " = " + format_fixed(xyz[k], 3) + " mm at " + tilt_axis_letter(m) + " " +
+                 format_fixed(b, 3) + ", " + rot_axis_letter(m) + " " + format_fixed(c, 3) + " deg is outside the travel [" +
+                 format_fixed((*travel)(k, 0), 1) + ", " + format_fixed((*travel)(k, 1), 1) + "]";
     }
   return "";
 }
@@ -83,7 +83,7 @@ void check_rtest_pattern(MachineType m, const RtestPattern& pattern, const std::
     if (!ax.limits_deg) continue;
     for (double v : a.deg)
       if (v < (*ax.limits_deg)[0] - 1e-9 || v > (*ax.limits_deg)[1] + 1e-9)
-        throw InvalidArgument(context + ": " + std::string(1, ax.name) + " " + fmt(v, 3) +
+        throw InvalidArgument(context + ": " + std::string(1, ax.name) + " " + format_fixed(v, 3) +
                               " deg is beyond its limits " + limits_text(*ax.limits_deg) + " on " +
                               to_string(m) + " (default_rtest_pattern fits the machine)");
   }
@@ -118,16 +118,16 @@ RtestSimulation simulate_rtest(const MachineModel& truth, const RtestSimOptions&
     const Eigen::Vector3d& q = o.pattern.nests[n];
     const std::string label = std::to_string(n + 1);
     s.nests[label] = q;
-    s.metadata.push_back({"nest." + label, fmt(q.x(), 4) + ", " + fmt(q.y(), 4) + ", " + fmt(q.z(), 4)});
+    s.metadata.push_back({"nest." + label, format_fixed(q.x(), 4) + ", " + format_fixed(q.y(), 4) + ", " + format_fixed(q.z(), 4)});
   }
   if (o.probe_dirs)
     for (int k = 0; k < 3; ++k) {
       const Eigen::Vector3d u = o.probe_dirs->row(k).transpose();
       s.probe_dirs[k + 1] = u;
       s.metadata.push_back({"probe." + std::to_string(k + 1) + ".dir",
-                            fmt(u.x(), 6) + ", " + fmt(u.y(), 6) + ", " + fmt(u.z(), 6)});
+                            format_fixed(u.x(), 6) + ", " + format_fixed(u.y(), 6) + ", " + format_fixed(u.z(), 6)});
     }
-  if (o.noise_um > 0.0) s.metadata.push_back({"noise_um", fmt(o.noise_um, 4)});
+  if (o.noise_um > 0.0) s.metadata.push_back({"noise_um", format_fixed(o.noise_um, 4)});
 
   // effects.md: the linear-axis polynomials are about the session's mean commanded xyz.
   EffectModel fx = truth.effects;

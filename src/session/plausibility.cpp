@@ -5,14 +5,13 @@
 #include <cmath>
 #include <cstdio>
 
+#include "rotacal/core/angles.hpp"
 #include "rotacal/core/error.hpp"
 
 namespace rotacal {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDeg = kPi / 180.0;
 constexpr double kInch = 25.4;
 
 std::string fmt(double v, int digits = 4) {
@@ -21,7 +20,7 @@ std::string fmt(double v, int digits = 4) {
   return b;
 }
 
-double median(std::vector<double> v) {
+double median_of(std::vector<double> v) {
   if (v.empty()) return 0.0;
   const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
   std::nth_element(v.begin(), mid, v.end());
@@ -89,18 +88,18 @@ PlausibilityReport check_plausible(const BallbarSession& s, const std::string& s
     measured.push_back(b.length);
     commanded.push_back(nominal_deg);
   }
-  rep.median_deviation_mm = median(dev_deg);
+  rep.median_deviation_mm = median_of(dev_deg);
   const auto worst = std::max_element(dev_deg.begin(), dev_deg.end());
   rep.max_deviation_mm = *worst;
   rep.worst_sample = static_cast<std::size_t>(worst - dev_deg.begin());
   // Name the likely cause, most specific first. L0 itself must agree with the data too: the
   // fit would otherwise absorb a wrong L0 into the length offset it cannot separate.
-  const double med_len = median(measured), med_cmd = median(commanded);
+  const double med_len = median_of(measured), med_cmd = median_of(commanded);
   const double limit = o.max_length_deviation_mm;
   if (rep.max_deviation_mm <= limit && std::abs(med_len - L0) <= limit) return rep;
-  if (max_abs_angle <= 2.0 * kPi + 1e-9 && median(dev_rad) <= limit && rep.median_deviation_mm > limit)
+  if (max_abs_angle <= 2.0 * kPi + 1e-9 && median_of(dev_rad) <= limit && rep.median_deviation_mm > limit)
     refuse(source, "angles look like radians: every angle is within +-2 pi, and read as radians they fit "
-                   "the commanded positions (median deviation " + fmt(median(dev_rad) * 1e3, 3) +
+                   "the commanded positions (median deviation " + fmt(median_of(dev_rad) * 1e3, 3) +
                        " um) while read as degrees they do not (" + fmt(rep.median_deviation_mm, 4) +
                        " mm); the format wants degrees");
   if (std::abs(med_len * kInch - med_cmd) <= limit)
@@ -155,17 +154,17 @@ PlausibilityReport check_plausible(const RtestSession& s, const std::string& sou
                          "a probe out of range? (PlausibilityOptions::max_displacement_mm widens it)");
     }
   }
-  rep.median_deviation_mm = median(dev_deg);
+  rep.median_deviation_mm = median_of(dev_deg);
   const auto worst = std::max_element(dev_deg.begin(), dev_deg.end());
   rep.max_deviation_mm = *worst;
   rep.worst_sample = static_cast<std::size_t>(worst - dev_deg.begin());
   const double limit = o.max_position_deviation_mm;
   if (rep.max_deviation_mm <= limit) return rep;
-  if (max_abs_angle <= 2.0 * kPi + 1e-9 && median(dev_rad) <= limit)
+  if (max_abs_angle <= 2.0 * kPi + 1e-9 && median_of(dev_rad) <= limit)
     refuse(source, "angles look like radians: every angle is within +-2 pi, and read as radians the commanded "
-                   "positions follow the nests (median " + fmt(median(dev_rad) * 1e3, 3) +
+                   "positions follow the nests (median " + fmt(median_of(dev_rad) * 1e3, 3) +
                        " um) while read as degrees they do not; the format wants degrees");
-  if (median(dev_inch) <= limit)
+  if (median_of(dev_inch) <= limit)
     refuse(source, "positions look like inches: times 25.4 the commanded positions follow the nests; the "
                    "format wants mm");
   const RtestSample& w = s.samples[rep.worst_sample];

@@ -17,11 +17,11 @@
 #include <vector>
 
 #include "rotacal/circular/diagnosis.hpp"
+#include "rotacal/core/angles.hpp"
 #include "rotacal/core/noise_model.hpp"
 
 namespace rotacal::circular_detail {
 
-inline constexpr double kPi = 3.14159265358979323846;
 
 std::string axis_name(int i);
 
