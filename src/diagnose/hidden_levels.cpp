@@ -98,6 +98,32 @@ void with_hidden_levels(const DiagnosisProblem& P, const NoiseModel& m, NoiseTre
   }
 }
 
+// A stream's variation about its own level under an AR + walk model grows without bound in the
+// stream's length (the walk's part, q^2 [(n - 1) / 2 - 1^T min(i, j) 1 / n^2], is linear in n),
+// where a stationary noise of the declared 1-sigma varies about its level by at most
+// noise_um^2. REML's walk of 1/f-like ballbar readings allowed 0.31-0.32 um^2 within a test of
+// 360 readings against 0.25 um^2 declared (0.74 um^2 about the test's first reading): a
+// wander that took a thermal drift, 98 % a level and a slope per test, for noise ('nothing'
+// at 10x its half-detection amplitude where an oracle under the true covariance sees it,
+// bench/diagnosis_confusion.py --noise pink --seed 211). Each stream's step is lowered until
+// its within-stream variance is the declared variance (q = 0 where the AR part alone reaches
+// it); unchanged without a declared noise.
+void with_walk_bounded_by_declared(const DiagnosisProblem& P, NoiseModel& m) {
+  const std::optional<double> declared = P.declared_noise_um();
+  if (!declared || !(*declared > 0.0)) return;
+  const double declared2 = std::pow(*declared * 1e-3, 2);
+  for (NoiseStream& s : m.streams) {
+    if (!(s.random_walk_step_um > 0.0) || s.rows.size() < 2) continue;
+    const double within = within_stream_variance(s);
+    if (within <= declared2) continue;
+    const double q = s.random_walk_step_um;
+    s.random_walk_step_um = 0.0;
+    const double ar_part = within_stream_variance(s);
+    const double per_q2 = (within - ar_part) / std::pow(q * 1e-3, 2);  // linear in q^2
+    s.random_walk_step_um = ar_part < declared2 && per_q2 > 0.0 ? std::sqrt((declared2 - ar_part) / per_q2) * 1e3 : 0.0;
+  }
+}
+
 bool lacks_declared_variance(const DiagnosisProblem& P, const ModelFit& fit) {
   const std::optional<double> declared = P.declared_noise_um();
   const double dof = static_cast<double>(fit.residuals.size() - fit.num_free);
