@@ -44,7 +44,7 @@ void with_hidden_levels(const DiagnosisProblem& P, const NoiseModel& m, NoiseTre
 
 /// Each stream's random-walk step of `m` lowered so that its variation within the stream is at
 /// most the declared variance (hidden_levels.cpp); unchanged without a declared noise.
-void with_walk_bounded_by_declared(const DiagnosisProblem& P, NoiseModel& m);
+void with_walk_bounded_by_declared(const DiagnosisProblem& P, const Eigen::VectorXd& residuals, NoiseModel& m);
 
 /// Whether the declared noise holds variance that `fit`'s residuals lack: |r|^2 / noise_um^2
 /// below the kLacksDeclaredVariance quantile of chi-square(n - free parameters), which white
