@@ -129,7 +129,10 @@ void with_hidden_levels(const DiagnosisProblem& P, const NoiseModel& m, NoiseTre
 // at 10x its half-detection amplitude where an oracle under the true covariance sees it,
 // bench/diagnosis_confusion.py --noise pink --seed 211). Each stream's step is lowered until
 // its within-stream variance is the declared variance (q = 0 where the AR part alone reaches
-// it); unchanged without a declared noise.
+// it); unchanged without a declared noise, and on a stream whose readings vary beyond what the
+// declared noise allows (exceeds_declared): the bound forced a 5 um bump over 40 deg of a ballbar
+// test onto three wrong catalogue shapes, where REML's walk leaves it to the unexplained-structure
+// test and its per-angle table (test_diagnose_realistic).
 void with_walk_bounded_by_declared(const DiagnosisProblem& P, const Eigen::VectorXd& r, NoiseModel& m) {
   const std::optional<double> declared = P.declared_noise_um();
   if (!declared || !(*declared > 0.0)) return;

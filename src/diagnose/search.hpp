@@ -43,7 +43,8 @@ NoiseTreatment coloured_treatment(const NoiseModel& m, bool described = true);
 void with_hidden_levels(const DiagnosisProblem& P, const NoiseModel& m, NoiseTreatment& t);
 
 /// Each stream's random-walk step of `m` lowered so that its variation within the stream is at
-/// most the declared variance (hidden_levels.cpp); unchanged without a declared noise.
+/// most the declared variance (hidden_levels.cpp); unchanged without a declared noise, and on a
+/// stream whose `residuals` vary beyond what the declared noise allows.
 void with_walk_bounded_by_declared(const DiagnosisProblem& P, const Eigen::VectorXd& residuals, NoiseModel& m);
 
 /// Whether the declared noise holds variance that `fit`'s residuals lack: |r|^2 / noise_um^2
