@@ -42,6 +42,11 @@ NoiseTreatment coloured_treatment(const NoiseModel& m, bool described = true);
 /// unchanged without a declared noise.
 void with_hidden_levels(const DiagnosisProblem& P, const NoiseModel& m, NoiseTreatment& t);
 
+/// Each stream's random-walk step of `m` lowered so that its variation within the stream is at
+/// most the declared variance (hidden_levels.cpp); unchanged without a declared noise, and on a
+/// stream whose `residuals` vary beyond what the declared noise allows.
+void with_walk_bounded_by_declared(const DiagnosisProblem& P, const Eigen::VectorXd& residuals, NoiseModel& m);
+
 /// Whether the declared noise holds variance that `fit`'s residuals lack: |r|^2 / noise_um^2
 /// below the kLacksDeclaredVariance quantile of chi-square(n - free parameters), which white
 /// noise of the declared size would leave. Then the fit has taken a part of the noise into its

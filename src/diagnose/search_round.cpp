@@ -95,7 +95,8 @@ void score_coloured(const SearchContext& S, const ModelFit& fit, Round& R, Colou
     }
     if (!C.wander_noise.W) {
       C.wander_start = estimate_noise_model(S.layout, fit.residuals, options.noise);
-      const NoiseModel walk = estimate_noise_model_reml(C.wander_start, fit.residuals, R.J_levels);
+      NoiseModel walk = estimate_noise_model_reml(C.wander_start, fit.residuals, R.J_levels);
+      with_walk_bounded_by_declared(S.P, fit.residuals, walk);
       C.wander_noise = coloured_treatment(walk);
       with_hidden_levels(S.P, walk, C.wander_noise);
     }
@@ -108,7 +109,8 @@ void score_coloured(const SearchContext& S, const ModelFit& fit, Round& R, Colou
     if (own_model.sigma_um < 0.5 * C.wander_start.sigma_um) {
       Eigen::MatrixXd X(R.J_levels.rows(), R.J_levels.cols() + Jc.cols());
       X << R.J_levels, Jc;
-      const NoiseModel walk = estimate_noise_model_reml(C.wander_start, fit.residuals, X);
+      NoiseModel walk = estimate_noise_model_reml(C.wander_start, fit.residuals, X);
+      with_walk_bounded_by_declared(S.P, fit.residuals, walk);
       own = coloured_treatment(walk);
       with_hidden_levels(S.P, walk, own);
     }
