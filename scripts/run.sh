@@ -5,7 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 PY=${PYTHON:-python3}
-bash scripts/setup.sh
+bash scripts/setup.sh --main
 echo "run: building and installing the rotacal Python package (pip install .)" >&2
 "$PY" -m pip install -q --disable-pip-version-check --no-build-isolation .
 "$PY" -m rotacal demo -o "${1:-out/demo}"

@@ -1,12 +1,26 @@
 #!/usr/bin/env bash
 # Installs what rotacal needs on a fresh Debian machine (run as root): the C++ toolchain and
-# libraries from Debian packages, the Python build and test tools from PyPI. Idempotent: it
-# skips apt-get when every package is already there.
+# libraries from Debian packages, the Python build tools from PyPI. Idempotent: it skips
+# apt-get when every package is already there.
+#   bash scripts/setup.sh          everything the test suite needs (scripts/test.sh)
+#   bash scripts/setup.sh --main   only what the main job needs (scripts/run.sh): the library,
+#                                  the extension and the demo's report, without the tests' tools
+#                                  (clang's sanitizers, a headless LinuxCNC, Chromium,
+#                                  PostgreSQL, stress-ng, Catch2, SciPy, pytest)
 set -euo pipefail
 
-APT_PACKAGES=(build-essential cmake ninja-build pkg-config libeigen3-dev libceres-dev catch2
-              libserialport-dev clang libclang-rt-14-dev linuxcnc-uspace chromium
-              nlohmann-json3-dev stress-ng postgresql)
+MAIN_APT=(build-essential cmake ninja-build pkg-config libeigen3-dev libceres-dev
+          libserialport-dev nlohmann-json3-dev)
+TEST_APT=(catch2 clang libclang-rt-14-dev linuxcnc-uspace chromium stress-ng postgresql)
+MAIN_PIP=("numpy>=1.22" "matplotlib>=3.5" "pybind11>=2.11" "scikit-build-core>=0.10")
+TEST_PIP=("scipy>=1.9" "pytest>=7" "pybind11-stubgen==2.5.5" "psycopg[binary]>=3.1")
+
+case "${1:-}" in
+  --main) APT_PACKAGES=("${MAIN_APT[@]}"); PIP_PACKAGES=("${MAIN_PIP[@]}") ;;
+  "") APT_PACKAGES=("${MAIN_APT[@]}" "${TEST_APT[@]}"); PIP_PACKAGES=("${MAIN_PIP[@]}" "${TEST_PIP[@]}") ;;
+  *) echo "setup: unknown option '$1' (use --main or nothing)" >&2; exit 2 ;;
+esac
+
 missing=()
 for p in "${APT_PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -19,6 +33,4 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 PY=${PYTHON:-python3}
-"$PY" -m pip install -q --disable-pip-version-check \
-  "numpy>=1.22" "matplotlib>=3.5" "scipy>=1.9" "pytest>=7" \
-  "pybind11>=2.11" "scikit-build-core>=0.10" "pybind11-stubgen==2.5.5" "psycopg[binary]>=3.1"
+"$PY" -m pip install -q --disable-pip-version-check "${PIP_PACKAGES[@]}"
