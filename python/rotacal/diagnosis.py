@@ -104,3 +104,13 @@ def uncertainty_budget(session: Any, diagnosis: DiagnosisResult | None = None, *
                              RTEST: lambda: _core.uncertainty_budget_rtest(session, diagnosis.raw, o, coverage),
                              PROBE: lambda: _core.uncertainty_budget_probe(session, diagnosis.raw, o, coverage)},
                    "uncertainty_budget")()
+
+
+def group_text(finding: dict) -> str:
+    """A group finding's members as a reader should see them: by BIC weight, largest first
+    (the engine lists the search's pick first, which can hold the least weight), the pick marked
+    as the member whose parameters are shown and which the extended model holds."""
+    members = sorted(finding["group"], key=lambda m: -1.0 if m.get("aliased") else -m["weight"])
+    return ", ".join(
+        f"{m['effect']} ({'aliased' if m.get('aliased') else format(m['weight'], '.2f')}"
+        f"{'; in the extended model' if m['effect'] == finding['effect'] else ''})" for m in members)

@@ -33,6 +33,13 @@ def test_demo_finds_the_hidden_effect(tmp_path):
     assert d["findings"][0]["effect"] == "gravity_sag_A"
     s = d["findings"][0]["parameters"]["gravity_sag_A"]
     assert abs(s["value"] - 0.004) <= 3 * s["std"]
+    if not d["findings"][0]["named"]:
+        # A group reads largest BIC weight first (the engine lists the search's pick first, which
+        # can hold the least), with the member the extended model holds marked as such.
+        line = next(x for x in r.stdout.splitlines() if x.startswith("diagnosis found one of:"))
+        weights = [float(w) for w in re.findall(r"\(([0-9.]+)[;)]", line)]
+        assert weights == sorted(weights, reverse=True) and len(weights) == len(d["findings"][0]["group"])
+        assert "gravity_sag_A (" in line and "; in the extended model)" in line.split("gravity_sag_A (")[1].split(",")[0]
     report = (tmp_path / "report.html").read_text()
     assert str((tmp_path / "report.html").resolve()) in r.stdout
     for section in ("setup", "location-errors", "polar", "residuals", "diagnosis", "compensation"):

@@ -13,6 +13,7 @@ def cmd_demo(a: argparse.Namespace) -> int:
     """Simulate a machine with errors and one hidden effect, measure, identify, diagnose,
     compensate, and write a report."""
     from ..demo import run_demo
+    from ..diagnosis import group_text
     r = run_demo(a.output, seed=a.seed, sag_mm=a.sag, say=say)
     print(f"hidden effect: gravity_sag_A, s = {a.sag * 1e3:.1f} um")
     f = r["finding"]
@@ -22,8 +23,8 @@ def cmd_demo(a: argparse.Namespace) -> int:
         if f["named"]:
             print(f"diagnosis found: {f['effect']} ({f['cause']}, weight {f['weight']:.2f}), {size}")
         else:
-            group = ", ".join(f"{g['effect']} ({g['weight']:.2f})" for g in f["group"])
-            print(f"diagnosis found one of: {group}, which this session cannot separate; if {f['effect']}: {size}")
+            print(f"diagnosis found one of: {group_text(f)}, which this session cannot separate "
+                  f"(BIC weights); if {f['effect']}: {size}")
     else:
         print("diagnosis found nothing significant")
     print(f"compensation reduced every location error by at least {-r['worst_change_percent']:.1f} %")

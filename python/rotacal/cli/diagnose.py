@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from .. import _core, jsontext, units
-from ..diagnosis import MAX_HARMONIC
+from ..diagnosis import MAX_HARMONIC, group_text
 from .options import EPILOG, EXIT_OK, budget_sizes, number, path, say
 from .setups import add_db_arg, add_plausibility_arg, load_session
 
@@ -24,9 +24,7 @@ def print_diagnosis(d: dict) -> None:
         elif f.get("lack_of_fit"):
             print(f"{i}. not named, {f['effect']} (weight {f['weight']:.2g}): {f['lack_of_fit']}. If it is {f['effect']}:")
         else:
-            group = ", ".join(f"{m['effect']} ({'aliased' if m.get('aliased') else format(m['weight'], '.2f')})"
-                              for m in f["group"])
-            print(f"{i}. one of: {group}; this session cannot separate them (BIC weights). "
+            print(f"{i}. one of: {group_text(f)}; this session cannot separate them (BIC weights). "
                   f"If it is {f['effect']}:")
         for name, p in f["parameters"].items():
             print(f"     {name} = {units.estimate_text(p['value'], p['std'], p['unit'])}")

@@ -9,6 +9,7 @@ from typing import Any, Iterable
 import numpy as np
 
 from .. import units
+from ..diagnosis import group_text
 from ..version import __version__
 from .page import CSS, escape as _e, img, plot_text, png, plt
 
@@ -218,9 +219,7 @@ def diagnosis_section(d: dict) -> str:
                 effect = f"not named: {_e(f['effect'])} ({_e(f['lack_of_fit'])})"
                 params = f"if {_e(f['effect'])}:<br>" + params
             else:  # the group the data cannot separate, with the parameters of its best
-                effect = "one of: " + ", ".join(
-                    f"{_e(m['effect'])} ({'aliased' if m.get('aliased') else format(m['weight'], '.2f')})"
-                    for m in f["group"])
+                effect = "one of: " + _e(group_text(f))
                 params = f"if {_e(f['effect'])}:<br>" + params
             g = f["gain"]
             out.append(f"<tr><td class=l>{i}</td><td class=l>{effect}</td><td>{f['weight']:.2f}</td>"
