@@ -1,5 +1,6 @@
-// Bindings for include/rotacal/ballbar/{plan,nc_program}.hpp: thin wrappers, numpy out.
+// Bindings for include/rotacal/ballbar/{plan,nc_program,chain_runs}.hpp: thin wrappers, numpy out.
 #include "numpy.hpp"
+#include "rotacal/ballbar/chain_runs.hpp"
 #include "rotacal/ballbar/nc_program.hpp"
 #include "rotacal/ballbar/plan.hpp"
 
@@ -212,6 +213,46 @@ void bind_nc_program(pyb::module_& m) {
       pyb::arg("plan"), pyb::arg("dialect"), pyb::arg("options") = NcProgramOptions{});
 }
 
+// Runs of the measure -> compensate -> measure-again experiment (ballbar/chain_runs.hpp).
+void bind_chain_runs(pyb::module_& m) {
+  m.def(
+      "record_run",
+      [](const BallbarSession& nominal, const BallbarSession& program, const BallbarMachineModel& machine,
+         std::optional<std::uint64_t> seed, const std::string& method, double noise_um, double noise_rho) {
+        return record_run(nominal, program, machine, seed, {method, noise_um, noise_rho});
+      },
+      pyb::arg("nominal"), pyb::arg("program"), pyb::arg("machine"), pyb::arg("seed") = pyb::none(),
+      pyb::arg("method") = "paper", pyb::arg("noise_um") = 0.5, pyb::arg("noise_rho") = 0.0,
+      "The session a run records: `program` played on `machine`, AR(1) noise (seed; none if None), "
+      "recorded against the `nominal` program's X,Y,Z and pivot.");
+  m.def(
+      "identify_runs",
+      [](const BallbarSetup& setup, const std::vector<BallbarMachineModel>& machines,
+         const std::optional<Array>& compensate_for, const std::vector<std::uint64_t>& seeds,
+         const std::string& method, double noise_um, double noise_rho) {
+        const LocationErrorRows c = compensate_for ? rows_of<8>(*compensate_for, "compensate_for") : LocationErrorRows();
+        pyb::gil_scoped_release release;
+        return identify_runs(setup, machines, c, seeds, {method, noise_um, noise_rho});
+      },
+      pyb::arg("setup"), pyb::arg("machines"), pyb::arg("compensate_for") = pyb::none(),
+      pyb::arg("seeds") = std::vector<std::uint64_t>{}, pyb::arg("method") = "paper",
+      pyb::arg("noise_um") = 0.5, pyb::arg("noise_rho") = 0.0,
+      R"doc(Location errors identified from one run on each machine (Flynn et al. 2016, Sec. 4).
+
+Parameters
+----------
+setup : BallbarSetup of the planned test
+machines : [BallbarMachineModel], one run each
+compensate_for : (N, 8) location errors the test of run i is compensated for (None: nominal)
+seeds : one AR(1) noise seed per run ([]: noise-free)
+method : identification, "paper" or "joint"
+noise_um, noise_rho : reading noise, um, and its AR(1) correlation
+
+Returns
+-------
+(N, 8) identified location errors, mm and rad, in location_error_names order)doc");
+}
+
 }  // namespace
 
 void bind_ballbar_plan(pyb::module_& m) {
@@ -219,6 +260,7 @@ void bind_ballbar_plan(pyb::module_& m) {
   bind_ballbar_setup(m);
   bind_ballbar_toolpath(m);
   bind_nc_program(m);
+  bind_chain_runs(m);
 }
 
 }  // namespace rotacal::py

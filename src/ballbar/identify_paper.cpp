@@ -90,7 +90,7 @@ Eigen::Matrix<double, 8, 1> location_errors(MachineType m, const AxisEstimate& T
 
 }  // namespace
 
-BallbarIdentification identify_paper(const BallbarSession& s) {
+BallbarIdentification identify_paper(const BallbarSession& s, bool with_residuals) {
   const MachineType m = s.machine;
   if (m != MachineType::AC_trt && m != MachineType::BC_trt)
     throw InvalidArgument("identify_paper: Flynn et al.'s chain is written for the AC-trt and BC-trt "
@@ -172,14 +172,16 @@ BallbarIdentification identify_paper(const BallbarSession& s) {
     out.parameters.push_back(p);
   }
   // Residuals of the identified model on every sample, as for the joint fit.
-  const std::vector<double> L = predict_lengths(out.model, s.samples);
-  double ss = 0.0;
-  for (std::size_t i = 0; i < L.size(); ++i) {
-    out.residuals.push_back(s.samples[i].length - L[i]);
-    ss += out.residuals.back() * out.residuals.back();
+  if (with_residuals) {
+    const std::vector<double> L = predict_lengths(out.model, s.samples);
+    double ss = 0.0;
+    for (std::size_t i = 0; i < L.size(); ++i) {
+      out.residuals.push_back(s.samples[i].length - L[i]);
+      ss += out.residuals.back() * out.residuals.back();
+    }
+    out.residual_rms_um = std::sqrt(ss / static_cast<double>(L.size())) * 1e3;
+    out.sigma_um = out.residual_rms_um;
   }
-  out.residual_rms_um = std::sqrt(ss / static_cast<double>(L.size())) * 1e3;
-  out.sigma_um = out.residual_rms_um;
   out.notes = {
       "Flynn et al. 2016, Sec. 3: sphere fit (radius L0), Hyper circle fits of the radial tests, "
       "SVD plane fits of the axial tests, lines transported to the nominal intersection",

@@ -16,7 +16,9 @@
 namespace rotacal {
 
 /// Throws InvalidArgument naming any of the seven tests the chain needs that the session
-/// lacks, DegenerateGeometry if a fit is degenerate.
-BallbarIdentification identify_paper(const BallbarSession& session);
+/// lacks, DegenerateGeometry if a fit is degenerate. `with_residuals` false leaves the
+/// residuals (and residual_rms_um, sigma_um) out, for callers that use the identified values
+/// only (ballbar/chain_runs.hpp): predicting every sample is about a quarter of the chain's time.
+BallbarIdentification identify_paper(const BallbarSession& session, bool with_residuals = true);
 
 }  // namespace rotacal

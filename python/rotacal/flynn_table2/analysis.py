@@ -210,7 +210,7 @@ def analyse(table: dict | None = None, assumptions: Assumptions | None = None, *
     if not (np.all(np.isfinite(before)) and np.all(np.isfinite(after))):
         raise _core.InvalidArgument("analyse: before and after values must be finite")
 
-    cache: dict = {}  # noise-free runs, shared by the scenarios (Chain)
+    cache: dict = {}  # runs shared by the scenarios (Chain)
     sc = scenario(a, before, after, draws, seed, max_causes, True, cache)
     prediction = _prediction(sc, before, after)
     per_value = _per_value(sc)

@@ -23,7 +23,7 @@ def _chi2_95(df: int) -> float:
 
 def scenario(a: Assumptions, before: np.ndarray, after: np.ndarray, draws: int, seed: int,
               max_causes: int, want_details: bool, cache: dict | None = None) -> dict:
-    """`cache`: the noise-free runs of the analysis' other scenarios (Chain)."""
+    """`cache`: the runs of the analysis' other scenarios (Chain)."""
     ch = Chain(a, cache)
     truth = ch.truth_for(before)
     cands = candidates(a, ch.duration)
@@ -32,16 +32,20 @@ def scenario(a: Assumptions, before: np.ndarray, after: np.ndarray, draws: int, 
 
     # Prediction: noise in both runs and every constant effect at a random size within its
     # plausible half-width (rectangular), the same in both runs.
-    sims = np.empty((draws, 8))
-    for k in range(draws):
+    plausible = np.array([c.plausible for c in const])
+    runs, seeds = [], []
+    for _ in range(draws):
         errs, effs, piv = np.zeros(8), {}, np.zeros(3)
-        for c in const:
-            r = c.runs(rng.uniform(-c.plausible, c.plausible))[0]
+        # The same random stream as one size per cause, then the two runs' noise seeds.
+        for c, size in zip(const, rng.uniform(-plausible, plausible)):
+            r = c.runs(size)[0]
             errs = errs + r[0]
             piv = piv + r[2]
             for eid, p in r[1].items():
                 effs[eid] = [x + y for x, y in zip(effs.get(eid, [0.0] * len(p)), p)]
-        sims[k] = ch.run(truth, (errs, effs, piv), (errs, effs, piv), rng)[1]
+        runs.append((errs, effs, piv))
+        seeds.append((int(rng.integers(0, 2**63)), int(rng.integers(0, 2**63))))
+    sims = ch.draws(truth, runs, seeds)[1]
     mean = sims.mean(axis=0)
     std = sims.std(axis=0, ddof=1)
     # Coverage factor k = 2 (about 95 %); the draws are noise-dominated and near-Gaussian.
@@ -53,18 +57,18 @@ def scenario(a: Assumptions, before: np.ndarray, after: np.ndarray, draws: int, 
     # central difference at its plausible size.
     R = np.empty((8, len(cands)))
     Rb = np.zeros((8, len(cands)))
+    pairs = [r for c in cands for r in (c.runs(c.plausible), c.runs(-c.plausible))]
+    e1, e2 = ch.runs(truth, pairs)
+    if want_details:
+        # A repeated uncompensated run after the same interval: run 1 on run 2's machine,
+        # minus run 1 (zero for a constant effect, the change itself otherwise).
+        b2 = ch.befores(truth, [p[1] for p in pairs])
     for j, c in enumerate(cands):
         h = c.plausible
-        p1, p2 = c.runs(h)
-        n1, n2 = c.runs(-h)
-        ep = ch.run(truth, p1, p2)
-        en = ch.run(truth, n1, n2)
-        R[:, j] = (ep[1] - en[1]) / (2 * h)
+        R[:, j] = (e2[2 * j] - e2[2 * j + 1]) / (2 * h)
         if want_details:
-            # A repeated uncompensated run after the same interval: run 1 on run 2's machine,
-            # minus run 1 (zero for a constant effect, the change itself otherwise).
-            rp = ch.before(truth, p2) - ep[0]
-            rn = ch.before(truth, n2) - en[0]
+            rp = b2[2 * j] - e1[2 * j]
+            rn = b2[2 * j + 1] - e1[2 * j + 1]
             Rb[:, j] = (rp - rn) / (2 * h)
 
     chi2_0 = float(np.sum(w * d * d))
@@ -124,7 +128,7 @@ def separation(sc: dict, group: list[int]) -> dict:
         c = sc["cands"][j]
         s = next(x["size"] for x in sc["rows"] if x["j"] == j) or c.plausible
         p1, p2 = c.runs(s)
-        res[j] = ch.run(sc["truth"], p1, p2, residuals=True)
+        res[j] = ch.residuals(sc["truth"], p1, p2)
     tests = res[group[0]][3]
     labels = sorted(set(tests), key=tests.index)
     best = {"test": None, "rms_difference_um": 0.0}
