@@ -166,6 +166,14 @@ struct Choice {
   const ModelFit* refit = nullptr;  ///< of the extended model, held by the cache
   double cv_before = 0.0, cv_after = 0.0;
 };
+/// Whether candidate s of round R (scored at `fit`; `refit`: the extended model's fit) still
+/// passes the F-test (alpha / m_tests) and BIC with each noise stream taken as AR(1) at the
+/// upper z-sigma bound of its lag-1 correlation estimated on refit's residuals, z =
+/// P.correlation_bound_z() (correlation_bound.cpp). True where z is 0 and for a candidate judged
+/// under the 1/f-like treatment.
+bool holds_at_correlation_bound(const SearchContext& S, const Round& R, const Score& s, const ModelFit& fit,
+                                const ModelFit& refit, double m_tests);
+
 Choice choose(const SearchContext& S, const Round& R, const ModelFit& fit, const EffectModel& effects,
               const std::vector<int>& fold, std::vector<bool>& done, Diagnosis& D);
 

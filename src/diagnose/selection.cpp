@@ -121,6 +121,7 @@ Choice choose(const SearchContext& S, const Round& R, const ModelFit& fit, const
     out.cv_before = cv_rms_um(R.in.Jfree, fit.residuals, f, options.cv_blocks);
     out.cv_after = cv_rms_um(s->X, fit.residuals, f, options.cv_blocks);
     if (!(out.cv_after < out.cv_before)) continue;
+    if (!holds_at_correlation_bound(S, R, *s, fit, refit, m_tests)) continue;
     // A cause with no number is no finding: at least one combination of its parameters must
     // be determined, min_determined_sigma from zero in the refit (a polynomial's correlated
     // coefficients can be so jointly while none is alone), not merely estimable.

@@ -85,6 +85,11 @@ class DiagnosisProblem {
   /// The mean commanded xyz (mm) of the session: a_ref of the linear-axis polynomials
   /// (straightness_DA, angular_error_*). Default: zero (then those polynomials are about 0).
   virtual Eigen::Vector3d mean_commanded_xyz() const { return Eigen::Vector3d::Zero(); }
+  /// z of the upper confidence bound of each noise stream's lag-1 correlation at which a
+  /// finding must hold too (src/diagnose/correlation_bound.cpp); 0: not judged there.
+  /// An instrument whose noise is one short stream sets it: the estimate's spread there makes a
+  /// slow shape a finding whenever the session's correlation comes out low.
+  virtual double correlation_bound_z() const { return 0.0; }
   virtual Eigen::MatrixXd reference_jacobian(const ModelFit& /*at*/, const Effect& /*c*/,
                                              std::vector<std::string>* /*row_groups*/) const {
     return {};
