@@ -156,9 +156,22 @@ void score_coloured(const SearchContext& S, const ModelFit& fit, Round& R, Colou
 // own (BC-trt ballbar, bench/diagnosis_confusion.py --noise pink --seed 211), where an oracle
 // under the true covariance gives -12 to -28. Every candidate so (the pre-screen alone) took
 // the effect sessions' CPU time 2.3x; a REML per candidate of the round was 8 s a diagnosis.
+// Only where every stream has kOwnWalkMinStream readings: a walk estimated from what a
+// candidate leaves of a short stream is lowered by the candidate that follows the noise's slow
+// part, by more than the thresholds allow for (a probe session's 120 touches in 1/f-like
+// noise: 1 of 200 null sessions gave a group, 0 without; bench/diagnosis_confusion.py
+// --instruments probe --entries zzz_none --null 200 --seed 101). A ballbar test has 181-360
+// readings, an R-test set-up 84 per channel.
 constexpr double kOwnWalkPrescreen = 0.01;
 constexpr std::size_t kOwnWalkCandidates = 3;
 constexpr double kOwnWalkMargin = 30.0;
+constexpr std::size_t kOwnWalkMinStream = 150;
+
+bool streams_hold_own_walk(const NoiseStreamLayout& layout) {
+  for (const std::vector<Eigen::Index>& rows : layout.rows)
+    if (rows.size() < kOwnWalkMinStream) return false;
+  return !layout.rows.empty();
+}
 
 struct OwnWalkCandidate {
   double delta_bic = 0.0;
@@ -254,6 +267,7 @@ Round score_round(const SearchContext& S, const ModelFit& fit, const EffectModel
     return *chunk_jc[chunk_of[c]];
   };
   std::vector<OwnWalkCandidate> own_walk;  // rescored under their own walk after the round
+  const bool rescore_own_walk = noise.W && streams_hold_own_walk(S.layout);
   int round_total = 0, round_done = 0;  // candidates to score in this round (progress)
   for (std::size_t c = 0; c < candidates.size(); ++c) round_total += !done[c] && S.unresolved[c].empty();
   const std::string stage = std::string(noise.W ? "search with the noise model" : "search (white noise)") +
@@ -292,7 +306,7 @@ Round score_round(const SearchContext& S, const ModelFit& fit, const EffectModel
       s.X.resize(R.in.Jfree.rows(), R.in.Jfree.cols() + s.k);
       s.X << R.in.Jfree, Jc * s.directions;
     }
-    if (round_walk && s.f_pvalue < kOwnWalkPrescreen)
+    if (rescore_own_walk && round_walk && s.f_pvalue < kOwnWalkPrescreen)
       keep_best(own_walk, {s.delta_bic, R.scores.size(), c, Jc});
     R.scores.push_back(std::move(s));
     R.treatment_of.push_back(judged_with);
