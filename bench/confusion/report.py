@@ -71,7 +71,7 @@ def summary_tables(hidden: list, null: list, noises: list, amps: list) -> list:
         cov = [h for r in rs for h in r.get("coverage", [])]
         out.append(f"| {nz} | {w}/{len(rs)} ({_pct(w, len(rs))}) | {f}/{len(ns)} ({_pct(f, len(ns))}) | "
                    f"{sum(cov)}/{len(cov)} ({_pct(sum(cov), len(cov))}) |")
-    out += ["", "### Diagnosis time (rotacal.diagnose in this process: wall clock, and CPU time)", "",
+    out += ["", "### Diagnosis time (rotacal.diagnose: wall clock, and the CPU time of its thread)", "",
             "| instrument | sessions | median ms | 90th pct ms | median CPU ms | 90th pct CPU ms |",
             "|---|---|---|---|---|---|"]
     for inst in sorted({r["instrument"] for r in hidden + null}):
