@@ -61,16 +61,20 @@ def summary_tables(hidden: list, null: list, noises: list, amps: list) -> list:
             out.append(f"| {nz} | {a:g}x | {len(rs)} | " + " | ".join(_pct(c[k], len(rs)) for k in KINDS[:3]) +
                        f" | {_pct(w, len(rs))} | {_pct(sum(r['oracle'] for r in rs), len(rs))} |")
     out += ["", "### Per noise kind", "",
-            "| noise | wrong first cause / hidden sessions | false findings / null sessions | 2-sigma coverage (right findings) |",
-            "|---|---|---|---|"]
+            "| noise | wrong first cause / hidden sessions | false findings / null sessions | 2-sigma coverage (right findings) "
+            "| the same by GLS under the true covariance: rotacal / GLS |",
+            "|---|---|---|---|---|"]
     for nz in noises:
         rs = [r for r in hidden if r["noise"] == nz]
         ns = [r for r in null if r["noise"] == nz]
         w = sum(r["outcome"] in ("wrong", "bad_group") for r in rs)
         f = sum(r["outcome"] == "false" for r in ns)
         cov = [h for r in rs for h in r.get("coverage", [])]
+        both = [(h, g) for r in rs if "true_gls_coverage" in r for h, g in zip(r["coverage"], r["true_gls_coverage"])]
+        mine, gls = sum(h for h, _ in both), sum(g for _, g in both)
         out.append(f"| {nz} | {w}/{len(rs)} ({_pct(w, len(rs))}) | {f}/{len(ns)} ({_pct(f, len(ns))}) | "
-                   f"{sum(cov)}/{len(cov)} ({_pct(sum(cov), len(cov))}) |")
+                   f"{sum(cov)}/{len(cov)} ({_pct(sum(cov), len(cov))}) | "
+                   f"{mine} / {gls} of {len(both)} ({_pct(mine, len(both))} / {_pct(gls, len(both))}) |")
     out += ["", "### Diagnosis time (rotacal.diagnose: wall clock, and the CPU time of its thread)", "",
             "| instrument | sessions | median ms | 90th pct ms | median CPU ms | 90th pct CPU ms |",
             "|---|---|---|---|---|---|"]

@@ -153,3 +153,26 @@ class Oracle:
         f = (drop / self.k) / max(chi1 / d2, 1e-300)
         p = f_sf(f, self.k, d2)
         return p < ALPHA / self.n_candidates and -drop + self.k * math.log(self.n) < MIN_DELTA_BIC
+
+
+class TrueGls:
+    """The effect's parameters by GLS with the true noise covariance on J0 + Je (all its
+    parameters, refsim's units): the best a diagnosis that knew the noise could report, on the
+    same readings. None where the baseline absorbs a direction of Je (`visible` < Je's columns,
+    as the half-detection amplitude counts them: the parameters are not all determined) and for
+    thermal_warmup (d only, tau known)."""
+
+    def __init__(self, whitener: Whitener, j0: np.ndarray, je: np.ndarray, visible: int):
+        self.w = whitener
+        x = np.hstack([whitener.apply(j0), whitener.apply(je)])
+        k = je.shape[1]
+        self.ok = visible == k
+        self.cov = np.linalg.pinv(x.T @ x)
+        self.x, self.k = x, k
+
+    def z(self, r: np.ndarray, truth: np.ndarray) -> list | None:
+        """(estimate - truth) / sigma per parameter; r: reading minus the truth's baseline reading."""
+        if not self.ok:
+            return None
+        b = (self.cov @ (self.x.T @ self.w.apply(r)))[-self.k:]
+        return [float(v) for v in (b - truth) / np.sqrt(np.diag(self.cov)[-self.k:])]
