@@ -8,6 +8,7 @@ least 30x faster than the default-tolerance row. Also times the C++ Monte Carlo 
 draws).
 
 Usage: python bench/ballbar_speed.py [SESSION.csv] [--repeat N] [--draws N]
+       python bench/ballbar_speed.py --smoke   # every timing once, 10 draws: that it runs (CI)
 """
 from __future__ import annotations
 
@@ -108,8 +109,11 @@ def main() -> None:
     ap.add_argument("session", nargs="?", default=str(ROOT.parent / "shared" / "data" / "ballbar_ac_table2.csv"))
     ap.add_argument("--repeat", type=int, default=7)
     ap.add_argument("--draws", type=int, default=1000)
+    ap.add_argument("--smoke", action="store_true", help="every timing once, 10 Monte Carlo draws (no figures)")
     a = ap.parse_args()
-    if a.repeat < 5:
+    if a.smoke:
+        a.repeat, a.draws = 1, 10
+    elif a.repeat < 5:
         ap.error("--repeat must be at least 5 (the figures are medians of >= 5 runs)")
     s = rotacal.load(a.session)
     rotacal.identify(s)  # warm-up: first call pays for imports and allocations

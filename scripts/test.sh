@@ -96,7 +96,7 @@ step "Benchmarks, once each as a smoke check (figures: run them without --smoke)
 ./build/release/bench/rtest_bench
 ./build/release/bench/probe_accuracy --smoke
 ./build/release/bench/hw_stream --smoke
-"$PY" bench/ballbar_speed.py --repeat 5 --draws 100
+"$PY" bench/ballbar_speed.py --smoke
 "$PY" bench/diagnosis_confusion.py --smoke
 "$PY" bench/history_bench.py --smoke
 "$PY" bench/design_bench.py --smoke

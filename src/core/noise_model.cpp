@@ -234,14 +234,15 @@ NoiseModel estimate_noise_model(const NoiseStreamLayout& layout, const Eigen::Ve
     xs[s] = residuals_mm(streams[s]);
     xs[s].array() -= xs[s].mean();
   }
-  // BIC over orders 0..P of Burg's prediction error variances v_p for n readings.
-  const auto choose = [](const std::vector<double>& v, std::size_t n) {
-    int best = 0;
+  // BIC over orders min_order..P of Burg's prediction error variances v_p for n readings.
+  const auto choose = [&options](const std::vector<double>& v, std::size_t n) {
+    const std::size_t lowest = std::min(static_cast<std::size_t>(std::max(options.min_order, 0)), v.size() - 1);
+    int best = static_cast<int>(lowest);
     double best_bic = 0.0;
     const double ln_n = std::log(static_cast<double>(std::max<std::size_t>(n, 2)));
-    for (std::size_t p = 0; p < v.size(); ++p) {
+    for (std::size_t p = lowest; p < v.size(); ++p) {
       const double bic = static_cast<double>(n) * std::log(std::max(v[p], 1e-300)) + static_cast<double>(p) * ln_n;
-      if (p == 0 || bic < best_bic) best = static_cast<int>(p), best_bic = bic;
+      if (p == lowest || bic < best_bic) best = static_cast<int>(p), best_bic = bic;
     }
     return best;
   };
@@ -307,28 +308,63 @@ NoiseModel estimate_noise_model(const NoiseStreamLayout& layout, const Eigen::Ve
   return M;
 }
 
-NoiseModel with_mean_bias_corrected(const NoiseModel& model) {
-  NoiseModel M = model;
+namespace {
+
+// Stream S as AR(1) with coefficient phi, its marginal sigma kept.
+void set_ar1(NoiseStream& S, double phi) {
+  const double n = static_cast<double>(S.rows.size());
+  S.reflection.assign(1, phi);
+  S.ar.assign(1, phi);
+  S.innovation_sigma_um = S.marginal_sigma_um * std::sqrt(1.0 - phi * phi);
+  // AR(1): tau = s_e^2 / (s_x^2 (1 - phi)^2) = (1 + phi) / (1 - phi).
+  S.correlation_samples = std::min((1.0 + phi) / (1.0 - phi), n);
+  S.correlation_time_s = S.correlation_samples * S.sample_interval_s;
+  S.effective_samples = std::min(n, n / S.correlation_samples);
+}
+
+// The model's pooled figures again from its streams.
+void resum(NoiseModel& M) {
   double ss_innov = 0.0;
   M.correlation_samples = 1.0, M.correlation_time_s = 0.0, M.effective_samples = 0.0;
+  M.max_order = 0;
+  for (const NoiseStream& S : M.streams) {
+    ss_innov += std::pow(S.innovation_sigma_um, 2) * static_cast<double>(S.rows.size());
+    M.correlation_samples = std::max(M.correlation_samples, S.correlation_samples);
+    M.correlation_time_s = std::max(M.correlation_time_s, S.correlation_time_s);
+    M.effective_samples += S.effective_samples;
+    M.max_order = std::max(M.max_order, S.order());
+  }
+  if (M.n) M.innovation_sigma_um = std::sqrt(ss_innov / static_cast<double>(M.n));
+}
+
+}  // namespace
+
+NoiseModel with_mean_bias_corrected(const NoiseModel& model) {
+  NoiseModel M = model;
   for (NoiseStream& S : M.streams) {
     const double n = static_cast<double>(S.rows.size());
     if (S.order() == 1 && S.random_walk_step_um == 0.0 && n > 0) {
       const double k = S.reflection[0];
-      const double kc = std::min(0.995, k + (1.0 + 3.0 * k) / n);
-      S.reflection[0] = S.ar[0] = kc;
-      S.innovation_sigma_um = S.marginal_sigma_um * std::sqrt(1.0 - kc * kc);
-      // AR(1): tau = s_e^2 / (s_x^2 (1 - phi)^2) = (1 + phi) / (1 - phi).
-      S.correlation_samples = std::min((1.0 + kc) / (1.0 - kc), n);
-      S.correlation_time_s = S.correlation_samples * S.sample_interval_s;
-      S.effective_samples = std::min(n, n / S.correlation_samples);
+      set_ar1(S, std::min(0.995, k + (1.0 + 3.0 * k) / n));
     }
-    ss_innov += std::pow(S.innovation_sigma_um, 2) * n;
-    M.correlation_samples = std::max(M.correlation_samples, S.correlation_samples);
-    M.correlation_time_s = std::max(M.correlation_time_s, S.correlation_time_s);
-    M.effective_samples += S.effective_samples;
   }
-  if (M.n) M.innovation_sigma_um = std::sqrt(ss_innov / static_cast<double>(M.n));
+  resum(M);
+  return M;
+}
+
+NoiseModel with_lag1(const NoiseModel& model, const std::vector<double>& phi) {
+  if (phi.size() != model.streams.size())
+    throw InvalidArgument("with_lag1: " + std::to_string(phi.size()) + " coefficients for " +
+                          std::to_string(model.streams.size()) + " streams");
+  NoiseModel M = model;
+  for (std::size_t s = 0; s < phi.size(); ++s) {
+    if (!(std::abs(phi[s]) < 1.0))
+      throw InvalidArgument("with_lag1: phi[" + std::to_string(s) + "] must be in (-1, 1)");
+    if (M.streams[s].random_walk_step_um != 0.0)
+      throw InvalidArgument("with_lag1: stream " + std::to_string(s) + " has a random walk");
+    set_ar1(M.streams[s], phi[s]);
+  }
+  resum(M);
   return M;
 }
 

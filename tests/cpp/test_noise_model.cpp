@@ -66,6 +66,22 @@ TEST_CASE("white noise comes out white", "[noise_model]") {
   // Pooled sigma over 8000 readings: relative standard error 1/sqrt(2 n) = 0.8 %.
   CHECK(std::abs(M.sigma_um - 0.5) < 4 * 0.5 / std::sqrt(2.0 * 8000));
   CHECK(M.effective_samples > 0.9 * 8000);
+  // min_order 1 keeps Burg's lag-1 coefficient where BIC calls a stream white (the probe's
+  // correlation bound needs it); with_lag1 sets it, the marginal sigma kept.
+  NoiseModelOptions lag1;
+  lag1.max_order = lag1.min_order = 1;
+  const NoiseModel M1 = estimate_noise_model(L.groups, L.times, r, lag1);
+  std::vector<double> phi;
+  for (std::size_t s = 0; s < M1.streams.size(); ++s) {
+    REQUIRE(M1.streams[s].order() == 1);
+    if (M.streams[s].order() == 1) CHECK(M1.streams[s].ar == M.streams[s].ar);
+    phi.push_back(0.5 + 0.01 * static_cast<double>(s));
+  }
+  const NoiseModel B = with_lag1(M1, phi);
+  CHECK(B.streams[7].ar[0] == phi[7]);
+  CHECK(B.streams[7].marginal_sigma_um == M1.streams[7].marginal_sigma_um);
+  CHECK(B.streams[7].correlation_samples == Approx((1 + phi[7]) / (1 - phi[7])));
+  CHECK_THROWS_WITH(with_lag1(M1, {0.5}), Catch::Contains("1 coefficients for 20 streams"));
 }
 
 TEST_CASE("AR(1) coefficient, marginal sigma and correlation time recovered", "[noise_model]") {

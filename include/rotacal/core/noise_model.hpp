@@ -28,6 +28,9 @@ namespace rotacal {
 struct NoiseModelOptions {
   int max_order = 8;        ///< largest AR order tried (limited further to n/4 per stream)
   int min_stream_size = 8;  ///< shorter streams are taken as white (too short for an AR fit)
+  /// Smallest order BIC may choose (at most the stream's own limit, n/4): a bound on the lag-1
+  /// coefficient needs its estimate even where BIC would call the stream white.
+  int min_order = 0;
   /// AR coefficients shared by all streams (Burg's sums taken over every stream: the same
   /// sensor at the same rate in every test), each stream keeping its own variance, rows and
   /// sample interval. Per-stream Burg estimates of a few hundred readings are biased towards
@@ -127,6 +130,12 @@ NoiseModel estimate_noise_model(const NoiseStreamLayout& layout, const Eigen::Ve
 /// correlation time and the effective samples follow; other streams (white, AR(p >= 2), with a
 /// random walk: REML's, which accounts for the mean itself) are returned as they are.
 NoiseModel with_mean_bias_corrected(const NoiseModel& model);
+
+/// `model` with stream s taken as AR(1) with lag-1 coefficient phi[s] (|phi| < 1; its marginal
+/// sigma kept, its innovation sigma, correlation time and effective samples following), e.g. a
+/// coefficient at the bound of its confidence interval. Throws InvalidArgument if phi does not
+/// hold one value per stream or a stream has a random walk.
+NoiseModel with_lag1(const NoiseModel& model, const std::vector<double>& phi);
 
 /// Autocovariance gamma_0..gamma_{n-1} (mm^2) of a stream's AR part, from its marginal
 /// variance and reflection coefficients (gamma_m = k_m v_{m-1} + sum_j phi_{m-1,j} gamma_{m-j}
