@@ -39,6 +39,7 @@ struct ColouredRound {
   Eigen::MatrixXd Q_raw;  // orthonormal basis of the free columns
   Eigen::VectorXd Qr;     // Q_raw^T r (zero but for the fit's convergence)
   NoiseModelOptions own_noise;  // each candidate's own noise model (see candidate_treatment)
+  std::string model_key;        // SearchCache::key of the current model
   NoiseModel wander_start;      // 1/f-like: the current residuals' AR model, REML's start
   NoiseTreatment wander_noise;  // 1/f-like: AR(1) + random walk by REML, once per round
   std::unique_ptr<ModelProducts> products;  // white or AR(1) candidates' Gram matrices
@@ -124,7 +125,7 @@ void score_coloured(const SearchContext& S, const ModelFit& fit, Round& R, Colou
     }
     if (!C.wander_noise.W) {
       C.wander_start = estimate_noise_model(S.layout, fit.residuals, options.noise);
-      NoiseModel walk = estimate_noise_model_reml(C.wander_start, fit.residuals, R.J_levels);
+      NoiseModel walk = S.cache.level_walk(C.model_key, C.wander_start, fit.residuals, R.J_levels);
       with_walk_bounded_by_declared(S.P, fit.residuals, walk);
       C.wander_noise = coloured_treatment(walk);
       with_hidden_levels(S.P, walk, C.wander_noise);
@@ -235,6 +236,7 @@ Round score_round(const SearchContext& S, const ModelFit& fit, const EffectModel
   R.in.r_w = noise.whiten(fit.residuals);
   R.in.num_free = fit.num_free;
   ColouredRound C;
+  C.model_key = SearchCache::key(effects);
   C.own_noise = options.noise;
   if (noise.W) {
     C.Q_raw = orthonormal_basis(R.in.Jfree);
