@@ -43,6 +43,10 @@ struct ColouredRound {
   NoiseModel wander_start;      // 1/f-like: the current residuals' AR model, REML's start
   NoiseTreatment wander_noise;  // 1/f-like: AR(1) + random walk by REML, once per round
   std::unique_ptr<ModelProducts> products;  // white or AR(1) candidates' Gram matrices
+  // The current model under wander_noise, without and with the level columns: the same for
+  // every candidate judged under the round's walk (a basis of n x (p + levels) whitened
+  // columns each, most of a 1/f-like round's scoring when made per candidate).
+  std::optional<ScoringInputs> wander_in[2];
   bool slow = false;  // the round's noise is 1/f-like for every candidate (lacks_declared_variance)
 };
 
@@ -60,15 +64,20 @@ NoiseTreatment walk_with_candidate(const SearchContext& S, const ModelFit& fit, 
   return own;
 }
 
-// Candidate c scored under the noise treatment t, with the stream levels as nuisance
-// parameters if `with_levels`.
-Score score_under(const SearchContext& S, const ModelFit& fit, const Round& R, const Effect& c,
-                  const Eigen::MatrixXd& Jc, const NoiseTreatment& t, bool with_levels) {
+// The current model under the noise treatment t, with the stream levels as nuisance
+// parameters if `with_levels`: what score_under scores a candidate against.
+ScoringInputs inputs_under(const ModelFit& fit, const Round& R, const NoiseTreatment& t, bool with_levels) {
   ScoringInputs in_c;
   in_c.Jfree = with_levels ? R.J_levels : R.in.Jfree;
   in_c.num_free = fit.num_free + (with_levels ? R.levels_rank : 0);
   in_c.Q_w = orthonormal_basis_full_rank(t.whiten(in_c.Jfree));
   in_c.r_w = t.whiten(fit.residuals);
+  return in_c;
+}
+
+// Candidate c scored under the noise treatment t against in_c (inputs_under, of t).
+Score score_under(const SearchContext& S, const Round& R, const ScoringInputs& in_c, const Effect& c,
+                  const Eigen::MatrixXd& Jc, const NoiseTreatment& t) {
   Score s = score(in_c, c, t.whiten(Jc), S.options.min_visible_chi2, S.options.min_delta_bic);
   // Scores are kept relative to the whitened residual of the current model, so the
   // table's RMS-after stays comparable.
@@ -144,7 +153,13 @@ void score_coloured(const SearchContext& S, const ModelFit& fit, Round& R, Colou
     // it; without one, the level is unknown and a nuisance parameter.
     with_levels = !own.full;
   }
-  s = score_under(S, fit, R, c, Jc, own, with_levels);
+  if (round_walk) {
+    std::optional<ScoringInputs>& in = C.wander_in[with_levels ? 1 : 0];
+    if (!in) in = inputs_under(fit, R, own, with_levels);
+    s = score_under(S, R, *in, c, Jc, own);
+  } else {
+    s = score_under(S, R, inputs_under(fit, R, own, with_levels), c, Jc, own);
+  }
   judged_with = own;
 }
 
@@ -198,7 +213,7 @@ void rescore_with_own_walk(const SearchContext& S, const ModelFit& fit, Round& R
     const Effect& c = S.candidates[b.candidate];
     const NoiseTreatment own = walk_with_candidate(S, fit, R, C, b.Jc);
     const bool with_levels = !own.full;
-    Score s = score_under(S, fit, R, c, b.Jc, own, with_levels);
+    Score s = score_under(S, R, inputs_under(fit, R, own, with_levels), c, b.Jc, own);
     if (!s.observable) continue;
     if (s.delta_bic < S.options.min_delta_bic) {
       s.X.resize(R.in.Jfree.rows(), R.in.Jfree.cols() + s.k);
