@@ -108,14 +108,29 @@ class RemlCriterion {
     Eigen::MatrixXd A(n, p + 1);  // [X y], whitened stream by stream
     A << X_, y_;
     // V_s / sigma^2 = a_s (rho^|i-j| + lambda min(i, j)), whitened by its Kalman innovations.
+    // Streams of one length and level share their filter (the gains depend on nothing else;
+    // every level is 1 until the levels' rounds, and a ballbar's tests have few lengths).
     double logdet_v = 0.0;
+    std::vector<ArWalkFilter> filters;
+    filters.reserve(start_.streams.size());
+    std::vector<std::size_t> filter_of(start_.streams.size());
     for (std::size_t s = 0; s < start_.streams.size(); ++s) {
-      const std::vector<Eigen::Index>& rows = start_.streams[s].rows;
-      const ArWalkFilter w(rows.size(), level_[s], rho, level_[s] * lambda);
+      const std::size_t n_s = start_.streams[s].rows.size();
+      std::size_t f = 0;  // an earlier stream of the same length and level
+      while (f < s && !(start_.streams[f].rows.size() == n_s && level_[f] == level_[s])) ++f;
+      if (f < s) {
+        filter_of[s] = filter_of[f];
+      } else {
+        filter_of[s] = filters.size();
+        filters.emplace_back(n_s, level_[s], rho, level_[s] * lambda);
+      }
+      const ArWalkFilter& w = filters[filter_of[s]];
       logdet_v += w.log_det();
-      w.apply(rows, A);
+      w.apply(start_.streams[s].rows, A);
     }
-    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A.leftCols(p));
+    // Factorised in place (A's columns are not needed whitened again): no n x p copy.
+    Eigen::Ref<Eigen::MatrixXd> WX = A.leftCols(p);
+    const Eigen::ColPivHouseholderQR<Eigen::Ref<Eigen::MatrixXd>> qr(WX);
     Value v;
     v.k = qr.rank();
     Eigen::VectorXd c = qr.householderQ().adjoint() * A.col(p);

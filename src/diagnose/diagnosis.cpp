@@ -121,7 +121,8 @@ std::vector<std::string> unresolved_orders(const DiagnosisProblem& P, const std:
 
 // The search: score every candidate against the current model, add the best one that passes
 // the F-test (Bonferroni), BIC and blocked cross-validation and whose parameters the refit can
-// determine, refit, repeat; then judge what is left.
+// determine, refit, repeat. What is left is judged by the caller (judge_kept), once it keeps
+// the result.
 Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
                  const std::vector<Effect>& candidates, const ModelFit& baseline,
                  const NoiseTreatment& noise, const NoiseModel* model, const NoiseTreatment& white,
@@ -170,10 +171,29 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
   }
 
   for (Finding& F : D.findings) F.parameters = parameters_of(*fit, F.effect);
-  const ModelFit& final_fit = *fit;  // copied into the result last, after the structure test's peak
+  D.final_fit = *fit;
+  return D;
+}
+
+// What the final model of the search that gave D leaves, judged under that search's noise
+// (judge_remainder), for the one search whose result is kept: a search that is then discarded
+// (the white one redone with a better sigma, the coloured one whose final residuals are white)
+// decided nothing by it. Judged on the fit the cache holds, D.final_fit (a copy of it) released
+// meanwhile and copied again after: the structure test's peak has no second n x p Jacobian.
+void judge_kept(const DiagnosisProblem& P, const DiagnosisOptions& options, const ModelFit& baseline,
+                const NoiseTreatment& noise, const NoiseModel* model, const NoiseTreatment& white,
+                SearchCache& cache, Diagnosis& D) {
+  EffectModel effects;
+  effects.linear_reference = P.mean_commanded_xyz();
+  for (const Finding& F : D.findings) effects.effects.push_back(F.effect);
+  const ModelFit& final_fit = effects.effects.empty() ? baseline : cache.fit(P, effects);
+  const NoiseStreamLayout layout(P.groups(), P.times());
+  const std::vector<Effect> no_candidates;  // the remainder's test scores no candidate
+  const std::vector<std::string> no_reasons;
+  const SearchContext S{P, options, no_candidates, no_reasons, noise, model, white, layout, cache};
+  D.final_fit = ModelFit{};
   judge_remainder(S, final_fit, D);
   D.final_fit = final_fit;
-  return D;
 }
 
 // White treatment, redone once with the extended model's residual when successive
@@ -183,6 +203,7 @@ Diagnosis search_white(const DiagnosisProblem& P, const DiagnosisOptions& option
                        const std::vector<Effect>& candidates, const ModelFit& baseline, SearchCache& cache) {
   const NoiseTreatment white = white_treatment(P, baseline);
   Diagnosis D = search(P, options, candidates, baseline, white, nullptr, white, cache);
+  NoiseTreatment kept = white;
   if (!P.declared_noise_um()) {
     const double n = static_cast<double>(D.final_fit.residuals.size());
     const double s_final =
@@ -196,8 +217,10 @@ Diagnosis search_white(const DiagnosisProblem& P, const DiagnosisOptions& option
           << D.baseline.noise_um << " um: the sampling is too sparse for them)";
       better.source = why.str();
       D = search(P, options, candidates, baseline, better, nullptr, better, cache);
+      kept = better;
     }
   }
+  judge_kept(P, options, baseline, kept, nullptr, kept, cache, D);
   return D;
 }
 
@@ -316,8 +339,9 @@ Diagnosis diagnose(const DiagnosisProblem& P, const DiagnosisOptions& options) {
     D = search_white(P, options, candidates, baseline, cache);
     white_hidden_levels(P, options, D);
   } else {
-    D = search(P, options, candidates, baseline, coloured_treatment(model), &model, white_treatment(P, baseline),
-               cache);
+    const NoiseModel searched = model;
+    const NoiseTreatment coloured = coloured_treatment(searched), white = white_treatment(P, baseline);
+    D = search(P, options, candidates, baseline, coloured, &searched, white, cache);
     // Reported: the noise model of what the final model leaves. If that is white, the
     // correlation was the unmodelled effects': the white-noise diagnosis is the right one.
     model = estimate_noise_model(P.groups(), P.times(), D.final_fit.residuals, options.noise);
@@ -326,6 +350,7 @@ Diagnosis diagnose(const DiagnosisProblem& P, const DiagnosisOptions& options) {
       D = search_white(P, options, candidates, baseline, cache);
       white_hidden_levels(P, options, D);
     } else {
+      judge_kept(P, options, baseline, coloured, &searched, white, cache, D);
       // The baseline's adequacy against the noise as the final model leaves it (the baseline
       // model of the noise has the unmodelled effects in it).
       const NoiseTreatment final_noise = coloured_treatment(model);

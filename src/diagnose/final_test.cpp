@@ -43,7 +43,10 @@ void judge_remainder(const SearchContext& S, const ModelFit& final_fit, Diagnosi
       X << Jfree, L;
       num_free += static_cast<int>(orthonormal_basis(X).cols() - orthonormal_basis(Jfree).cols());
       Jfree = X;
-      wander = coloured_treatment(estimate_noise_model_reml(final_model, final_fit.residuals, Jfree));
+      EffectModel final_effects;  // the model final_fit is the fit of: the findings'
+      for (const Finding& F : D.findings) final_effects.effects.push_back(F.effect);
+      wander = coloured_treatment(
+          S.cache.level_walk(SearchCache::key(final_effects), final_model, final_fit.residuals, Jfree));
     }
     NoiseModelOptions pooled = S.options.noise;
     pooled.pooled = true;

@@ -83,6 +83,11 @@ struct SearchCache {
   std::map<std::string, ModelFit> fits;
   std::map<std::string, std::map<std::string, SharedMatrix>> jacobians;
   std::size_t cached_values = 0;
+  // Per model: the AR(1) + random walk of its residuals by REML, stream levels beside its free
+  // columns, from the residuals' AR model. The 1/f-like round at a model (search_round.cpp) and
+  // the remainder's test of that model as final (final_test.cpp) estimate the same, and REML is
+  // most of a 1/f-like diagnosis' time.
+  std::map<std::string, NoiseModel> level_walks;
 
   static std::string key(const EffectModel& m) {
     std::string k;
@@ -93,6 +98,15 @@ struct SearchCache {
     const std::string k = key(m);
     auto it = fits.find(k);
     if (it == fits.end()) it = fits.emplace(k, P.fit(m)).first;
+    return it->second;
+  }
+  // The level walk (above) of model key `k`, whose fit left `residuals`; `J_levels`: its free
+  // columns and the stream levels; `start`: the AR model of `residuals`.
+  const NoiseModel& level_walk(const std::string& k, const NoiseModel& start, const Eigen::VectorXd& residuals,
+                               const Eigen::MatrixXd& J_levels) {
+    auto it = level_walks.find(k);
+    if (it == level_walks.end())
+      it = level_walks.emplace(k, estimate_noise_model_reml(start, residuals, J_levels)).first;
     return it->second;
   }
   // The Jacobians of `todo` at `at` (the fit of model `m`).

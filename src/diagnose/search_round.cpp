@@ -39,9 +39,14 @@ struct ColouredRound {
   Eigen::MatrixXd Q_raw;  // orthonormal basis of the free columns
   Eigen::VectorXd Qr;     // Q_raw^T r (zero but for the fit's convergence)
   NoiseModelOptions own_noise;  // each candidate's own noise model (see candidate_treatment)
+  std::string model_key;        // SearchCache::key of the current model
   NoiseModel wander_start;      // 1/f-like: the current residuals' AR model, REML's start
   NoiseTreatment wander_noise;  // 1/f-like: AR(1) + random walk by REML, once per round
   std::unique_ptr<ModelProducts> products;  // white or AR(1) candidates' Gram matrices
+  // The current model under wander_noise, without and with the level columns: the same for
+  // every candidate judged under the round's walk (a basis of n x (p + levels) whitened
+  // columns each, most of a 1/f-like round's scoring when made per candidate).
+  std::optional<ScoringInputs> wander_in[2];
   bool slow = false;  // the round's noise is 1/f-like for every candidate (lacks_declared_variance)
 };
 
@@ -59,15 +64,20 @@ NoiseTreatment walk_with_candidate(const SearchContext& S, const ModelFit& fit, 
   return own;
 }
 
-// Candidate c scored under the noise treatment t, with the stream levels as nuisance
-// parameters if `with_levels`.
-Score score_under(const SearchContext& S, const ModelFit& fit, const Round& R, const Effect& c,
-                  const Eigen::MatrixXd& Jc, const NoiseTreatment& t, bool with_levels) {
+// The current model under the noise treatment t, with the stream levels as nuisance
+// parameters if `with_levels`: what score_under scores a candidate against.
+ScoringInputs inputs_under(const ModelFit& fit, const Round& R, const NoiseTreatment& t, bool with_levels) {
   ScoringInputs in_c;
   in_c.Jfree = with_levels ? R.J_levels : R.in.Jfree;
   in_c.num_free = fit.num_free + (with_levels ? R.levels_rank : 0);
   in_c.Q_w = orthonormal_basis_full_rank(t.whiten(in_c.Jfree));
   in_c.r_w = t.whiten(fit.residuals);
+  return in_c;
+}
+
+// Candidate c scored under the noise treatment t against in_c (inputs_under, of t).
+Score score_under(const SearchContext& S, const Round& R, const ScoringInputs& in_c, const Effect& c,
+                  const Eigen::MatrixXd& Jc, const NoiseTreatment& t) {
   Score s = score(in_c, c, t.whiten(Jc), S.options.min_visible_chi2, S.options.min_delta_bic);
   // Scores are kept relative to the whitened residual of the current model, so the
   // table's RMS-after stays comparable.
@@ -124,7 +134,7 @@ void score_coloured(const SearchContext& S, const ModelFit& fit, Round& R, Colou
     }
     if (!C.wander_noise.W) {
       C.wander_start = estimate_noise_model(S.layout, fit.residuals, options.noise);
-      NoiseModel walk = estimate_noise_model_reml(C.wander_start, fit.residuals, R.J_levels);
+      NoiseModel walk = S.cache.level_walk(C.model_key, C.wander_start, fit.residuals, R.J_levels);
       with_walk_bounded_by_declared(S.P, fit.residuals, walk);
       C.wander_noise = coloured_treatment(walk);
       with_hidden_levels(S.P, walk, C.wander_noise);
@@ -143,7 +153,13 @@ void score_coloured(const SearchContext& S, const ModelFit& fit, Round& R, Colou
     // it; without one, the level is unknown and a nuisance parameter.
     with_levels = !own.full;
   }
-  s = score_under(S, fit, R, c, Jc, own, with_levels);
+  if (round_walk) {
+    std::optional<ScoringInputs>& in = C.wander_in[with_levels ? 1 : 0];
+    if (!in) in = inputs_under(fit, R, own, with_levels);
+    s = score_under(S, R, *in, c, Jc, own);
+  } else {
+    s = score_under(S, R, inputs_under(fit, R, own, with_levels), c, Jc, own);
+  }
   judged_with = own;
 }
 
@@ -197,7 +213,7 @@ void rescore_with_own_walk(const SearchContext& S, const ModelFit& fit, Round& R
     const Effect& c = S.candidates[b.candidate];
     const NoiseTreatment own = walk_with_candidate(S, fit, R, C, b.Jc);
     const bool with_levels = !own.full;
-    Score s = score_under(S, fit, R, c, b.Jc, own, with_levels);
+    Score s = score_under(S, R, inputs_under(fit, R, own, with_levels), c, b.Jc, own);
     if (!s.observable) continue;
     if (s.delta_bic < S.options.min_delta_bic) {
       s.X.resize(R.in.Jfree.rows(), R.in.Jfree.cols() + s.k);
@@ -235,6 +251,7 @@ Round score_round(const SearchContext& S, const ModelFit& fit, const EffectModel
   R.in.r_w = noise.whiten(fit.residuals);
   R.in.num_free = fit.num_free;
   ColouredRound C;
+  C.model_key = SearchCache::key(effects);
   C.own_noise = options.noise;
   if (noise.W) {
     C.Q_raw = orthonormal_basis(R.in.Jfree);
