@@ -5,13 +5,13 @@
 #   bash scripts/setup.sh          everything the test suite needs (scripts/test.sh)
 #   bash scripts/setup.sh --main   only what the main job needs (scripts/run.sh): the library,
 #                                  the extension and the demo's report, without the tests' tools
-#                                  (clang's sanitizers, a headless LinuxCNC, Chromium,
+#                                  (clang's sanitizers and linker, a headless LinuxCNC, Chromium,
 #                                  PostgreSQL, stress-ng, Catch2, SciPy, pytest)
 set -euo pipefail
 
 MAIN_APT=(build-essential cmake ninja-build pkg-config libeigen3-dev libceres-dev
           libserialport-dev nlohmann-json3-dev)
-TEST_APT=(catch2 clang libclang-rt-14-dev linuxcnc-uspace chromium stress-ng postgresql)
+TEST_APT=(catch2 clang libclang-rt-14-dev lld-14 linuxcnc-uspace chromium stress-ng postgresql)
 MAIN_PIP=("numpy>=1.22" "matplotlib>=3.5" "pybind11>=2.11" "scikit-build-core>=0.10")
 TEST_PIP=("scipy>=1.9" "pytest>=7" "pybind11-stubgen==2.5.5" "psycopg[binary]>=3.1")
 
