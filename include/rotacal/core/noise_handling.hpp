@@ -56,8 +56,9 @@ double noise_model_bias_factor(const NoiseModel& model, const std::vector<std::s
 /// R-test whose poses run B outer), which a model of the residuals alone misses (Burg on
 /// them sees a walk as a mild AR). (rho, ln lambda) by Nelder-Mead; a_s by the fixed-point
 /// step a_s <- a_s (|e_s|^2 / n_s) / (S / n) on the whitened GLS residuals e, then once more.
-/// Each evaluation whitens by ArWalkFilter (O(n) per column) and takes a QR of the whitened
-/// Jacobian (O(n k^2)).
+/// Each evaluation whitens an orthonormal basis of the Jacobian's span (made once) by
+/// ArWalkFilter (O(n) per column) and takes the Cholesky factor of its Gram matrix beside the
+/// residuals (O(n k^2) as a matrix product), or a column-pivoted QR where that is near singular.
 /// Throws InvalidArgument if the sizes differ.
 NoiseModel estimate_noise_model_reml(const NoiseModel& start, const Eigen::VectorXd& residuals_mm,
                                      const Eigen::MatrixXd& jacobian_free);
