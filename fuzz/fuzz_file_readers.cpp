@@ -1,4 +1,4 @@
-// libFuzzer target: the session readers (rotacal-ballbar/1, rotacal-rtest/1) and the model-file
+// libFuzzer target: the session readers (rotacal-ballbar/1, rotacal-rtest/1, rotacal-probe/1) and the model-file
 // reader must refuse any bytes with a rotacal::Error, never crash, read out of bounds or throw
 // anything else; what they accept, their writers write back and they read again identically.
 #include <cstdlib>
@@ -8,6 +8,7 @@
 #include "rotacal/core/error.hpp"
 #include "rotacal/io/ballbar_file.hpp"
 #include "rotacal/io/model_file.hpp"
+#include "rotacal/io/probe_file.hpp"
 
 using namespace rotacal;
 
@@ -32,6 +33,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string text(reinterpret_cast<const char*>(data), size);
   session_round_trip(text, parse_ballbar, format_ballbar);
   session_round_trip(text, parse_rtest, format_rtest);
+  session_round_trip(text, parse_probe, format_probe);
   try {
     const ModelFile m = parse_model(text, "fuzz.json");
     // The writer never writes what the reader refuses.

@@ -1,6 +1,7 @@
 #include <catch2/catch.hpp>
 
 #include <cstdio>
+#include <random>
 #include <sstream>
 
 #include "rotacal/io/probe_file.hpp"
@@ -72,6 +73,25 @@ TEST_CASE("a probe session writes and reads back bit-identical", "[io][probe]") 
   CHECK_THAT(format_probe(s), Catch::Contains("pose,time,X,Y,Z,B,C,nx,ny,nz"));
   s.samples[0].n = Eigen::Vector3d(0, 0, 2);
   CHECK_THROWS_AS(format_probe(s), InvalidArgument);
+}
+
+// A direction written to six decimals (norm off 1 by up to 1e-4, which the reader accepts and
+// normalises) must come back from write and read unchanged: renormalising an already unit
+// vector moved its last bit (found by fuzz_file_readers, seed regression-probe-direction-*).
+TEST_CASE("a probe file's directions read, write and read back identical", "[io][probe]") {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> g;
+  std::string text = kHead + kColumns;
+  for (int i = 0; i < 300; ++i) {
+    const Eigen::Vector3d d = Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized();
+    char row[160];
+    std::snprintf(row, sizeof row, "p%d,%d.0,150,0,95,0,0,%.6f,%.6f,%.6f\n", i, i, d.x(), d.y(), d.z());
+    text += row;
+  }
+  std::istringstream in(text);
+  const std::string once = format_probe(parse_probe(in, "six_decimals.csv"));
+  std::istringstream again(once);
+  CHECK(format_probe(parse_probe(again, "again.csv")) == once);
 }
 
 TEST_CASE("bad probe files are refused naming line and column", "[io][probe]") {
