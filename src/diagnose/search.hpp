@@ -171,8 +171,8 @@ struct Round {
   std::vector<Score> scores;                 ///< the observable candidates
   std::vector<NoiseTreatment> treatment_of;  ///< per score: the noise it was judged with
   std::vector<bool> levels_of;               ///< per score: judged with the stream levels
-  /// Per score rescored under the marginal bound (search_round.cpp): the same walk under the
-  /// within-stream bound, what its finding's rivals are weighed under (name_finding). The
+  /// Per score rescored under the marginal bound (search_round.cpp): the round's walk under the
+  /// within-stream bound, what its finding's rivals are weighed under too (name_finding). The
   /// marginal bound takes the walk's share of the middle frequencies too, where rivals such as
   /// linear_scale_X and _Y differ: under it a 3x linear_scale_Y was named [linear_scale_X,
   /// angular_error_BX, angular_error_AY], the truth 22 behind (h-pink10).
