@@ -290,7 +290,7 @@ void rescore_with_own_walk(const SearchContext& S, const ModelFit& fit, Round& R
     const NoiseTreatment own = marginal ? shared : walk_with_candidate(S, fit, R, C, b.Jc);
     // Under the marginal bound the levels are never free: a stream whose walk the bound lowered
     // holds the declared variance to the rounding, and whether that left a hidden level of
-    // ~1e-20 (the level as the walk's start gives it) or none (the level a free parameter)
+    // rounding size (the level as the walk's start gives it) or none (a free level parameter)
     // decided between a 10x ballbar_length_offset at -61.4 and unobservable (BC-trt, seed 223).
     const bool with_levels = !marginal && !own.full;
     Score s = score_under(S, R, inputs_under(fit, R, own, with_levels), c, b.Jc, own);
