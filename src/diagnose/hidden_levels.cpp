@@ -70,7 +70,8 @@ bool exceeds_declared(const NoiseStream& s, const Eigen::VectorXd& r, double dec
 // Without a declared noise there is nothing to compare with, and the model is taken as it is.
 class HiddenLevels : public ResidualWhitener {
  public:
-  HiddenLevels(std::shared_ptr<const ArWhitener> W, const NoiseModel& m, double declared_mm) : W_(std::move(W)) {
+  HiddenLevels(std::shared_ptr<const ArWhitener> W, const NoiseModel& m, double declared_mm, VarianceBound bound)
+      : W_(std::move(W)) {
     Eigen::MatrixXd ones = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(m.n), static_cast<Eigen::Index>(m.streams.size()));
     std::vector<double> d;
     for (const NoiseStream& s : m.streams) {
@@ -83,7 +84,11 @@ class HiddenLevels : public ResidualWhitener {
       // of 283 ballbar and R-test cells, 15 with the bound (bench/diagnosis_confusion.py
       // --noise pink --seed 211); null sessions 0 / 100 before, 0 / 200 with it (seeds 211, 223).
       const double declared2 = declared_mm * declared_mm;
-      const double lacking = std::min(declared2, std::max(0.0, declared2 - within_stream_variance(s)) + walk);
+      // kMarginal: what the declared variance holds beyond the mean of the model's variances of
+      // the readings, g0 + q^2 (n - 1) / 2 (a stationary stream's readings each have it).
+      const double lacking = bound == VarianceBound::kMarginal
+                                 ? declared2 - (ar_autocovariance(s, 1).front() + walk)
+                                 : std::min(declared2, std::max(0.0, declared2 - within_stream_variance(s)) + walk);
       if (!(lacking > 0.0)) continue;
       for (Eigen::Index r : s.rows) ones(r, static_cast<Eigen::Index>(d.size())) = 1.0;
       d.push_back(lacking);
@@ -113,9 +118,9 @@ class HiddenLevels : public ResidualWhitener {
 }  // namespace
 
 // `t` with the hidden levels of `m` (the model W whitens by) against the declared noise, if any.
-void with_hidden_levels(const DiagnosisProblem& P, const NoiseModel& m, NoiseTreatment& t) {
+void with_hidden_levels(const DiagnosisProblem& P, const NoiseModel& m, NoiseTreatment& t, VarianceBound bound) {
   if (const std::optional<double> declared = P.declared_noise_um()) {
-    auto levels = std::make_shared<const HiddenLevels>(t.W, m, *declared * 1e-3);
+    auto levels = std::make_shared<const HiddenLevels>(t.W, m, *declared * 1e-3, bound);
     if (levels->any()) t.full = std::move(levels);
   }
 }
@@ -133,12 +138,22 @@ void with_hidden_levels(const DiagnosisProblem& P, const NoiseModel& m, NoiseTre
 // declared noise allows (exceeds_declared): the bound forced a 5 um bump over 40 deg of a ballbar
 // test onto three wrong catalogue shapes, where REML's walk leaves it to the unexplained-structure
 // test and its per-angle table (test_diagnose_realistic).
-void with_walk_bounded_by_declared(const DiagnosisProblem& P, const Eigen::VectorXd& r, NoiseModel& m) {
+void with_walk_bounded_by_declared(const DiagnosisProblem& P, const Eigen::VectorXd& r, NoiseModel& m,
+                                   VarianceBound bound) {
   const std::optional<double> declared = P.declared_noise_um();
   if (!declared || !(*declared > 0.0)) return;
   const double declared2 = std::pow(*declared * 1e-3, 2);
   for (NoiseStream& s : m.streams) {
     if (!(s.random_walk_step_um > 0.0) || s.rows.size() < 2) continue;
+    if (bound == VarianceBound::kMarginal) {
+      // The mean of the readings' variances, g0 + q^2 (n - 1) / 2, at most the declared one.
+      const double g0 = ar_autocovariance(s, 1).front();
+      const double half_n = (static_cast<double>(s.rows.size()) - 1.0) / 2.0;
+      if (g0 + std::pow(s.random_walk_step_um * 1e-3, 2) * half_n <= declared2 || exceeds_declared(s, r, declared2))
+        continue;
+      s.random_walk_step_um = g0 < declared2 ? std::sqrt((declared2 - g0) / half_n) * 1e3 : 0.0;
+      continue;
+    }
     const double within = within_stream_variance(s);
     if (within <= declared2 || exceeds_declared(s, r, declared2)) continue;
     const double q = s.random_walk_step_um;

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 namespace rotacal::diagnosis_detail {
 
@@ -86,6 +87,23 @@ RivalJudgement weigh_rivals(const Score& chosen, const std::vector<const Score*>
     a.in_group = member[i];
     out.rivals.push_back(a);
     if (member[i]) out.group.push_back(who[i]);
+  }
+  return out;
+}
+
+RivalJudgement worse_of(const RivalJudgement& a, const RivalJudgement& b) {
+  const bool a_worse = a.weight <= b.weight;
+  RivalJudgement out = a_worse ? a : b;
+  const RivalJudgement& other = a_worse ? b : a;
+  for (const Score* g : other.group) {
+    const auto same = [&](const Score* h) { return h->effect == g->effect; };
+    if (std::any_of(out.group.begin(), out.group.end(), same)) continue;
+    out.group.push_back(g);
+    const std::string id = g->effect.id();
+    const auto listed = [&](const Alternative& x) { return x.effect == id; };
+    auto it = std::find_if(out.rivals.begin(), out.rivals.end(), listed);
+    if (it == out.rivals.end()) it = out.rivals.insert(out.rivals.end(), *std::find_if(other.rivals.begin(), other.rivals.end(), listed));
+    it->in_group = true;
   }
   return out;
 }

@@ -56,6 +56,13 @@ RivalJudgement weigh_rivals(const Score& chosen, const std::vector<const Score*>
                             const std::vector<double>& bic, double n, double tempering,
                             double rival_correlation, double min_weight);
 
+/// The chosen candidate's standing under two noise models the data cannot choose between (the
+/// same candidate chosen in both): the smaller weight, with the rivals of that judgement, and
+/// the union of the two groups (the other's members marked in_group). A name is only as sure
+/// as the looser model lets it be, and a rival that only the tighter one cannot tell apart
+/// (their signatures correlate at its middle frequencies) is no less a rival.
+RivalJudgement worse_of(const RivalJudgement& a, const RivalJudgement& b);
+
 /// How much the evidence between two candidates can be overstated by the noise model itself.
 /// The slow signatures that tell effects apart (harmonics over a test, drifts) are judged
 /// against the noise's power at low frequency, S(0) ~ s_e^2 / (1 - sum phi)^2, and that rests

@@ -37,15 +37,21 @@ NoiseTreatment white_treatment(const DiagnosisProblem& P, const ModelFit& baseli
 /// structure test's are never reported, and formatting a summary per candidate is wasted).
 NoiseTreatment coloured_treatment(const NoiseModel& m, bool described = true);
 
+/// What the declared variance bounds (hidden_levels.cpp): the model's variation within each
+/// stream (kWithin), or the mean of its readings' variances, walk and level included (kMarginal).
+enum class VarianceBound { kWithin, kMarginal };
+
 /// `t` with the stream levels of `m` (the model t.W whitens by) that its residuals cannot show,
 /// against the declared noise (hidden_levels.cpp): t.full set where any stream lacks variance;
 /// unchanged without a declared noise.
-void with_hidden_levels(const DiagnosisProblem& P, const NoiseModel& m, NoiseTreatment& t);
+void with_hidden_levels(const DiagnosisProblem& P, const NoiseModel& m, NoiseTreatment& t,
+                        VarianceBound bound = VarianceBound::kWithin);
 
 /// Each stream's random-walk step of `m` lowered so that its variation within the stream is at
 /// most the declared variance (hidden_levels.cpp); unchanged without a declared noise, and on a
 /// stream whose `residuals` vary beyond what the declared noise allows.
-void with_walk_bounded_by_declared(const DiagnosisProblem& P, const Eigen::VectorXd& residuals, NoiseModel& m);
+void with_walk_bounded_by_declared(const DiagnosisProblem& P, const Eigen::VectorXd& residuals, NoiseModel& m,
+                                   VarianceBound bound = VarianceBound::kWithin);
 
 /// Whether the declared noise holds variance that `fit`'s residuals lack: |r|^2 / noise_um^2
 /// below the kLacksDeclaredVariance quantile of chi-square(n - free parameters), which white
@@ -165,6 +171,14 @@ struct Round {
   std::vector<Score> scores;                 ///< the observable candidates
   std::vector<NoiseTreatment> treatment_of;  ///< per score: the noise it was judged with
   std::vector<bool> levels_of;               ///< per score: judged with the stream levels
+  /// Per score rescored under the marginal bound (search_round.cpp): the round's walk under the
+  /// within-stream bound, what its finding's rivals are weighed under too (name_finding). The
+  /// marginal bound takes the walk's share of the middle frequencies too, where rivals such as
+  /// linear_scale_X and _Y differ: under it a 3x linear_scale_Y was named [linear_scale_X,
+  /// angular_error_BX, angular_error_AY], the truth 22 behind (h-pink10).
+  std::map<std::size_t, NoiseTreatment> named_under;
+  std::vector<double> round_bic;             ///< per score: its delta BIC as first scored, before
+                                             ///< any rescoring under its own walk
 };
 
 /// Score every candidate not `done` against `fit` (the fit of `effects`). Candidates that are

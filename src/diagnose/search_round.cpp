@@ -64,6 +64,31 @@ NoiseTreatment walk_with_candidate(const SearchContext& S, const ModelFit& fit, 
   return own;
 }
 
+// The share of candidate signature Jc, beyond the model's span (orthonormal Q_raw), that is a level
+// and a slope per noise stream (slope over the reading's index in the stream): what the 1/f-like
+// treatment's levels and walk take most of. Ballbar thermal drifts and warm-ups 0.20-0.51, the
+// length offset 0.78; harmonics, straightness and squareness 0.02-0.23 (BC-trt, AC-trt, seed 223).
+double slow_share(const NoiseStreamLayout& layout, const Eigen::MatrixXd& Q_raw, const Eigen::MatrixXd& Jc) {
+  const Eigen::MatrixXd Jp = project_out(Q_raw, Jc);
+  const double all = Jp.squaredNorm();
+  if (!(all > 0.0)) return 0.0;
+  double slow = 0.0;
+  for (const std::vector<Eigen::Index>& rows : layout.rows) {
+    const double n = static_cast<double>(rows.size());
+    if (rows.size() < 2) continue;
+    Eigen::RowVectorXd level = Eigen::RowVectorXd::Zero(Jp.cols()), slope = level;
+    double t2 = 0.0;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const double t = static_cast<double>(i) - (n - 1.0) / 2.0;
+      level += Jp.row(rows[i]);
+      slope += t * Jp.row(rows[i]);
+      t2 += t * t;
+    }
+    slow += level.squaredNorm() / n + slope.squaredNorm() / t2;
+  }
+  return slow / all;
+}
+
 // The current model under the noise treatment t, with the stream levels as nuisance
 // parameters if `with_levels`: what score_under scores a candidate against.
 ScoringInputs inputs_under(const ModelFit& fit, const Round& R, const NoiseTreatment& t, bool with_levels) {
@@ -182,6 +207,18 @@ constexpr double kOwnWalkPrescreen = 0.01;
 constexpr std::size_t kOwnWalkCandidates = 3;
 constexpr double kOwnWalkMargin = 30.0;
 constexpr std::size_t kOwnWalkMinStream = 150;
+// A kept candidate whose signature is at least this share a level and a slope per stream is
+// rescored with the walk bounded by the declared variance of the readings themselves
+// (VarianceBound::kMarginal) instead of their variation within the stream. REML's walk of
+// 1/f-like ballbar readings, bounded within the stream, still had readings of 0.45-0.8 um^2
+// (g0 + q^2 (n - 1) / 2) where 0.25 um^2 was declared, and with the hidden levels a test's mean
+// varied by 0.4-0.7 um^2 where refsim's 1/f-like noise gives 0.085-0.10: a 10x thermal drift
+// was taken for noise (delta BIC -3.7, -54 under the bound). Under the bound in every round (all
+// candidates) harmonics were named alone against rivals that had been in their group, some
+// wrongly (3 wrong in the first 30 sessions of seed 223): the bound takes the walk's share of
+// the middle frequencies. So only here, for the kept few, all under one noise model
+// (marginal_round_walk), with their rivals weighed under the round's kWithin walk too (name_finding).
+constexpr double kSlowShare = 0.3;
 
 bool streams_hold_own_walk(const NoiseStreamLayout& layout) {
   for (const std::vector<Eigen::Index>& rows : layout.rows)
@@ -204,15 +241,58 @@ void keep_best(std::vector<OwnWalkCandidate>& best, OwnWalkCandidate c) {
   if (best.size() > kOwnWalkCandidates) best.pop_back();
 }
 
-// The kept candidates rescored under the walk estimated with their own columns (see above).
+// The one noise model of a round's kept few under the marginal bound: AR(1) + walk by REML with
+// all of their columns in the model beside the stream levels, bounded by the declared variance
+// of the readings where what that model leaves does not vary beyond it. The same for each of
+// them, so that none wins by its noise model: a walk by REML with each one's own columns could
+// come out lowest for the most flexible one (a warm-up's time constant takes some of the noise's
+// wander with it), which was then judged under the tightest model (h-pink10 at 3cd9f30, seed 300
+// of test_ballbar_drift_in_one_over_f_noise_is_not_taken_for_the_noise: thermal_warmup_X -260.9,
+// the drift -9.1, the warm-up named first with no parameter at 3 sigma). The round's walk (REML
+// without them) instead keeps their signature in its AR(1) part, which the bound does not
+// touch: a 10x thermal_drift_Z went from -9.8 to +3.2 under it, -62.4 under this one.
+NoiseTreatment marginal_round_walk(const SearchContext& S, const ModelFit& fit, const Round& R, const ColouredRound& C,
+                                   const std::vector<OwnWalkCandidate>& best) {
+  Eigen::Index k = R.J_levels.cols();
+  for (const OwnWalkCandidate& b : best) k += b.Jc.cols();
+  Eigen::MatrixXd X(R.J_levels.rows(), k);
+  X.leftCols(R.J_levels.cols()) = R.J_levels;
+  k = R.J_levels.cols();
+  for (const OwnWalkCandidate& b : best) {
+    X.middleCols(k, b.Jc.cols()) = b.Jc;
+    k += b.Jc.cols();
+  }
+  NoiseModel walk = estimate_noise_model_reml(C.wander_start, fit.residuals, X);
+  const Eigen::MatrixXd Q = orthonormal_basis(X);
+  with_walk_bounded_by_declared(S.P, fit.residuals - Q * (Q.transpose() * fit.residuals), walk,
+                                VarianceBound::kMarginal);
+  NoiseTreatment t = coloured_treatment(walk);
+  with_hidden_levels(S.P, walk, t, VarianceBound::kMarginal);
+  return t;
+}
+
+// The kept candidates rescored under the walk estimated with their own columns (see above), or,
+// where one of them is slow (kSlowShare), all under the marginal bound of marginal_round_walk.
 void rescore_with_own_walk(const SearchContext& S, const ModelFit& fit, Round& R, const ColouredRound& C,
                            const std::vector<OwnWalkCandidate>& best) {
   for (const Score& s : R.scores)
     if (s.delta_bic < S.options.min_delta_bic - kOwnWalkMargin) return;
+  // One bound for all of them: a candidate rescored under the marginal bound beside a rival
+  // rescored under the looser within-stream one won by the bound alone (h-pink9: a 10x
+  // thermal_warmup_X named linear_squareness_ZX's group first, the drift rescored kWithin).
+  VarianceBound bound = VarianceBound::kWithin;
+  for (const OwnWalkCandidate& b : best)
+    if (slow_share(S.layout, C.Q_raw, b.Jc) >= kSlowShare) bound = VarianceBound::kMarginal;
+  const bool marginal = bound == VarianceBound::kMarginal;
+  const NoiseTreatment shared = marginal ? marginal_round_walk(S, fit, R, C, best) : NoiseTreatment{};
   for (const OwnWalkCandidate& b : best) {
     const Effect& c = S.candidates[b.candidate];
-    const NoiseTreatment own = walk_with_candidate(S, fit, R, C, b.Jc);
-    const bool with_levels = !own.full;
+    const NoiseTreatment own = marginal ? shared : walk_with_candidate(S, fit, R, C, b.Jc);
+    // Under the marginal bound the levels are never free: a stream whose walk the bound lowered
+    // holds the declared variance to the rounding, and whether that left a hidden level of
+    // rounding size (the level as the walk's start gives it) or none (a free level parameter)
+    // decided between a 10x ballbar_length_offset at -61.4 and unobservable (BC-trt, seed 223).
+    const bool with_levels = !marginal && !own.full;
     Score s = score_under(S, R, inputs_under(fit, R, own, with_levels), c, b.Jc, own);
     if (!s.observable) continue;
     if (s.delta_bic < S.options.min_delta_bic) {
@@ -222,6 +302,7 @@ void rescore_with_own_walk(const SearchContext& S, const ModelFit& fit, Round& R
     R.scores[b.score] = std::move(s);
     R.treatment_of[b.score] = own;
     R.levels_of[b.score] = with_levels;
+    if (marginal) R.named_under[b.score] = C.wander_noise;
   }
 }
 
@@ -325,6 +406,7 @@ Round score_round(const SearchContext& S, const ModelFit& fit, const EffectModel
     }
     if (rescore_own_walk && round_walk && s.f_pvalue < kOwnWalkPrescreen)
       keep_best(own_walk, {s.delta_bic, R.scores.size(), c, Jc});
+    R.round_bic.push_back(s.delta_bic);
     R.scores.push_back(std::move(s));
     R.treatment_of.push_back(judged_with);
     R.levels_of.push_back(with_levels);
