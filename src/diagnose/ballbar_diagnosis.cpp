@@ -4,6 +4,7 @@
 
 #include <ceres/jet.h>
 
+#include "ballbar_sensitivities.hpp"
 #include "candidate_jets.hpp"
 #include "rotacal/ballbar/problem.hpp"
 
@@ -98,20 +99,34 @@ auto jets_on(MachineType m, const std::vector<BallbarSample>& samples, const std
   };
 }
 
+// The same by the chain rule at the fit of `S`, on machines it supports.
+auto chain_rule_on(const diagnosis_detail::BallbarSensitivities& S) {
+  return [&S](auto /*width*/, const Effect& effect, const std::vector<int>& seed) { return S.columns(effect, seed); };
+}
+
 }  // namespace
 
 Eigen::MatrixXd BallbarDiagnosisProblem::jacobian_on(const std::vector<BallbarSample>& samples,
                                                      const std::vector<RotaryMotion>& motion,
                                                      const ModelFit& at, const Effect& candidate) const {
-  return diagnosis_detail::jacobian_of_candidate(session_.machine, candidate, jets_on(session_.machine, samples, motion, at),
-                                                      [&](Eigen::Index r) { return samples[static_cast<std::size_t>(r)].angles_rad(); });
+  const auto angles = [&](Eigen::Index r) { return samples[static_cast<std::size_t>(r)].angles_rad(); };
+  const MachineType m = session_.machine;
+  if (!diagnosis_detail::BallbarSensitivities::supports(m))
+    return diagnosis_detail::jacobian_of_candidate(m, candidate, jets_on(m, samples, motion, at), angles);
+  const diagnosis_detail::BallbarSensitivities S(m, samples, motion, at);
+  return diagnosis_detail::jacobian_of_candidate(m, candidate, chain_rule_on(S), angles);
 }
 
 std::vector<Eigen::MatrixXd> BallbarDiagnosisProblem::candidate_jacobians(
     const ModelFit& at, const std::vector<Effect>& candidates) const {
-  return diagnosis_detail::jacobians_of_candidates(session_.machine, candidates,
-                                                       jets_on(session_.machine, session_.samples, arrays_.motion, at),
-                                                       [&](Eigen::Index r) { return arrays_.angles[static_cast<std::size_t>(r)]; });
+  const auto angles = [&](Eigen::Index r) { return arrays_.angles[static_cast<std::size_t>(r)]; };
+  const MachineType m = session_.machine;
+  if (!diagnosis_detail::BallbarSensitivities::supports(m))
+    return diagnosis_detail::jacobians_of_candidates(m, candidates, jets_on(m, session_.samples, arrays_.motion, at),
+                                                     angles);
+  // The fit's part of every row once for all candidates (ballbar_sensitivities.hpp).
+  const diagnosis_detail::BallbarSensitivities S(m, session_.samples, arrays_.motion, at);
+  return diagnosis_detail::jacobians_of_candidates(m, candidates, chain_rule_on(S), angles);
 }
 
 Eigen::MatrixXd BallbarDiagnosisProblem::candidate_jacobian(const ModelFit& at,
