@@ -4,25 +4,16 @@
 #include <ceres/jet.h>
 
 #include <cmath>
+#include <cstdio>
 
+#include "../kinematics/stage_instances.hpp"
 #include "rotacal/ballbar/problem.hpp"
 
+namespace rotacal {
+ROTACAL_STAGE_SCALARS(extern)
+}  // namespace rotacal
+
 namespace rotacal::diagnosis_detail {
-
-namespace {
-
-// The small rotation w of a rotation matrix that is the identity at the effect's zero:
-// d R = [d w]x, so d w = (dR(2,1), dR(0,2), dR(1,0)) (the Jets' derivative parts).
-template <typename Jet>
-Eigen::Matrix<double, 3, Jet::DIMENSION> small_rotation(const Mat3<Jet>& R) {
-  Eigen::Matrix<double, 3, Jet::DIMENSION> w;
-  w.row(0) = R(2, 1).v.transpose();
-  w.row(1) = R(0, 2).v.transpose();
-  w.row(2) = R(1, 0).v.transpose();
-  return w;
-}
-
-}  // namespace
 
 BallbarSensitivities::BallbarSensitivities(MachineType m, const std::vector<BallbarSample>& samples,
                                            const std::vector<RotaryMotion>& motion, const ModelFit& at)
@@ -64,6 +55,7 @@ BallbarSensitivities::BallbarSensitivities(MachineType m, const std::vector<Ball
     auto s = s_.col(static_cast<Eigen::Index>(r));
     s.setZero();
     s.segment<3>(kTool) = u;
+    s[kReading] = 1.0;
     Eigen::Vector3d g = -u;
     s.segment<3>(kD) = g;
     for (int k = 0; k < nt; ++k) {
@@ -78,7 +70,7 @@ BallbarSensitivities::BallbarSensitivities(MachineType m, const std::vector<Ball
   }
 }
 
-Eigen::MatrixXd BallbarSensitivities::columns(const Effect& effect, const std::vector<int>& seed) const {
+BallbarPlaces BallbarSensitivities::places(const Effect& effect, const std::vector<int>& seed) const {
   // One Jet width for every candidate (1 to 4 parameters): its own stages are cheap, and one
   // instantiation of the stages keeps the compile time down.
   using Jet = ceres::Jet<double, 4>;
@@ -89,29 +81,60 @@ Eigen::MatrixXd BallbarSensitivities::columns(const Effect& effect, const std::v
   for (std::size_t k = 0; k < seed.size(); ++k) q[seed[k]] = Jet(0.0, static_cast<int>(k));
   const int nt = static_cast<int>(m_.description().table_axes.size());
   const Eigen::Index n = s_.cols();
-  Eigen::Matrix<double, kPlaces, 4> d;
-  Eigen::MatrixXd out(n, static_cast<Eigen::Index>(seed.size()));
+  // Every place's derivatives first (4 per place and row), then only the places it enters.
+  Eigen::Matrix<double, 4 * kPlaces, Eigen::Dynamic> all(4 * kPlaces, n);
+  const auto set = [&](Eigen::Index r, int place, const Jet& x) { all.col(r).segment<4>(4 * place) = x.v; };
   for (Eigen::Index r = 0; r < n; ++r) {
     const std::size_t i = static_cast<std::size_t>(r);
     const BallbarSample& smp = samples_[i];
     const detail::AxisStages<Jet> st = detail::axis_stages<Jet>(m_, fx, q, angles_[i], smp.time, motion_[i]);
-    d.setZero();
+    all.col(r).setZero();
     for (int k = 0; k < nt; ++k) {
-      d.row(kAngle + k) = st.angle[k].v.transpose();
+      set(r, kAngle + k, st.angle[k]);
       if (st.E[k]) {
-        for (int a = 0; a < 3; ++a) d.row(kEt + 3 * k + a) = st.E[k]->t[a].v.transpose();
-        d.middleRows<3>(kEw + 3 * k) = small_rotation(st.E[k]->R);
+        for (int a = 0; a < 3; ++a) set(r, kEt + 3 * k + a, st.E[k]->t[a]);
+        // A left rotation that is the identity at 0: dR = [dw]x, dw = (dR(2,1), dR(0,2), dR(1,0)).
+        set(r, kEw + 3 * k, st.E[k]->R(2, 1)), set(r, kEw + 3 * k + 1, st.E[k]->R(0, 2)),
+            set(r, kEw + 3 * k + 2, st.E[k]->R(1, 0));
       }
-      if (st.K[k]) d.middleRows<3>(kKw + 3 * k) = small_rotation(st.K[k]->R);
+      if (st.K[k])
+        set(r, kKw + 3 * k, st.K[k]->R(2, 1)), set(r, kKw + 3 * k + 1, st.K[k]->R(0, 2)),
+            set(r, kKw + 3 * k + 2, st.K[k]->R(1, 0));
     }
     if (st.D[0])
-      for (int a = 0; a < 3; ++a) d.row(kD + a) = (*st.D[0])[a].v.transpose();
+      for (int a = 0; a < 3; ++a) set(r, kD + a, (*st.D[0])[a]);
     const Vec3<Jet> tool = linear_axes_position<Jet>(fx, q, smp.xyz) + tool_offset<Jet>(fx, q);
-    for (int a = 0; a < 3; ++a) d.row(kTool + a) = tool[a].v.transpose();
-    const Eigen::Matrix<double, 1, 4> row =
-        s_.col(r).transpose() * d + ballbar_reading_error<Jet>(fx, q, smp.time).v.transpose();
-    out.row(r) = row.head(out.cols());
+    for (int a = 0; a < 3; ++a) set(r, kTool + a, tool[a]);
+    set(r, kReading, ballbar_reading_error<Jet>(fx, q, smp.time));
   }
+  BallbarPlaces out;
+  out.seeds = static_cast<int>(seed.size());
+  for (int p = 0; p < kPlaces; ++p)
+    if (all.middleRows(4 * p, out.seeds).cwiseAbs().maxCoeff() > 0.0) out.places.push_back(p);
+  out.d.resize(static_cast<Eigen::Index>(out.places.size()) * out.seeds, n);
+  for (std::size_t i = 0; i < out.places.size(); ++i)
+    out.d.middleRows(static_cast<Eigen::Index>(i) * out.seeds, out.seeds) = all.middleRows(4 * out.places[i], out.seeds);
+  return out;
+}
+
+std::string BallbarSensitivities::key(const Effect& effect, const std::vector<int>& seed) const {
+  std::string k = effect.id();
+  for (int s : seed) k += " " + std::to_string(s);
+  if (const auto& a = reference_.linear_reference) {
+    char buf[80];
+    std::snprintf(buf, sizeof buf, " @%.17g,%.17g,%.17g", (*a)[0], (*a)[1], (*a)[2]);
+    k += buf;
+  }
+  return k;
+}
+
+Eigen::MatrixXd BallbarSensitivities::columns(const BallbarPlaces& p) const {
+  const Eigen::Index n = s_.cols();
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n, p.seeds);
+  for (std::size_t i = 0; i < p.places.size(); ++i)
+    for (int k = 0; k < p.seeds; ++k)
+      out.col(k).array() += s_.row(p.places[i]).transpose().array() *
+                            p.d.row(static_cast<Eigen::Index>(i) * p.seeds + k).transpose().array();
   return out;
 }
 

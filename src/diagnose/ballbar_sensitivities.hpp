@@ -4,16 +4,21 @@
 //
 // Why: Jets of each candidate through the whole length model (the current model's stages and
 // both axis rotations again for every candidate and row) were the largest part of a ballbar
-// diagnosis. A candidate enters the reading only through the places listed in Sensitivity:
-// an axis' angle, the pose of its error motion E or coning K (a left rotation and a
-// translation), the table's translation D, the tool-side ball and the reading itself
-// (effects.hpp composes them so). So
-//   dL/dq = sum over places of (dL / d place, at the fit: once per row for all candidates)
-//         x (d place / dq, from the candidate's own stages alone: Jets of one effect).
+// diagnosis. A candidate enters the reading only at a few places: an axis' angle, the pose of
+// an axis' error motion E or coning K (a left rotation and a translation), the table's
+// translation D, the tool-side ball and the reading itself (effects.hpp composes them so). So
+//   dL/dq = sum over places of (dL / d place: the fit's, once per row for every candidate)
+//         x (d place / dq: the candidate's own stages alone, by Jets of one effect).
+// The second factor does not depend on the fit, so a session keeps it per candidate
+// (BallbarPlacesCache) and a later round pays only the sum.
 // The same derivatives as the Jets up to rounding; test_diagnose_ballbar.cpp checks them against
 // candidate_jacobian_by_jets for every candidate of the catalogue.
 
 #include <Eigen/Core>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
 #include <vector>
 
 #include "rotacal/ballbar/motion.hpp"
@@ -22,6 +27,13 @@
 
 namespace rotacal::diagnosis_detail {
 
+/// d place / d (each seeded parameter) of one candidate on every row, for the places it enters.
+struct BallbarPlaces {
+  std::vector<int> places;  ///< indices of BallbarSensitivities' places, ascending
+  int seeds = 0;
+  Eigen::MatrixXd d;        ///< row i * seeds + k: d places[i] / d seed k; one column per row
+};
+
 class BallbarSensitivities {
  public:
   /// Machines whose ball pivot goes through every rotary axis (no head axes).
@@ -29,14 +41,18 @@ class BallbarSensitivities {
   /// dL / d(each place) on every row of `samples` (with `motion`, one per sample) at fit `at`.
   BallbarSensitivities(MachineType m, const std::vector<BallbarSample>& samples,
                        const std::vector<RotaryMotion>& motion, const ModelFit& at);
-  /// d L / d (the seeded parameters of `effect`), one column per seed (candidate_jets.hpp's
-  /// `jets` contract), the effect's parameters at 0.
-  Eigen::MatrixXd columns(const Effect& effect, const std::vector<int>& seed) const;
+  /// Where `effect` (its seeded parameters, at 0) enters each row; what it depends on besides
+  /// the rows is in key().
+  BallbarPlaces places(const Effect& effect, const std::vector<int>& seed) const;
+  std::string key(const Effect& effect, const std::vector<int>& seed) const;
+  /// d L / d (the seeded parameters), one column per seed (candidate_jets.hpp's `jets`).
+  Eigen::MatrixXd columns(const BallbarPlaces& p) const;
 
  private:
   // Rows of s_: the angle of chain axes 0 and 1; E's translation and left rotation (3 each) of
-  // axes 0 and 1; K's left rotation of axes 0 and 1; the table translation D; the tool-side ball.
-  enum Place { kAngle = 0, kEt = 2, kEw = 8, kKw = 14, kD = 20, kTool = 23, kPlaces = 26 };
+  // axes 0 and 1; K's left rotation of axes 0 and 1; the table translation D; the tool-side
+  // ball; the reading.
+  enum Place { kAngle = 0, kEt = 2, kEw = 8, kKw = 14, kD = 20, kTool = 23, kReading = 26, kPlaces = 27 };
 
   MachineType m_;
   const std::vector<BallbarSample>& samples_;
@@ -44,6 +60,26 @@ class BallbarSensitivities {
   std::vector<RotaryAngles<double>> angles_;
   EffectModel reference_;  // no effects: the fit's linear_reference for the candidate's own stages
   Eigen::Matrix<double, kPlaces, Eigen::Dynamic> s_;
+};
+
+/// BallbarPlaces of one session's rows by BallbarSensitivities::key, shared by every fit.
+class BallbarPlacesCache {
+ public:
+  template <typename Make>
+  std::shared_ptr<const BallbarPlaces> get(const std::string& key, Make&& make) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      auto it = known_.find(key);
+      if (it != known_.end()) return it->second;
+    }
+    auto made = std::make_shared<const BallbarPlaces>(make());
+    std::lock_guard<std::mutex> lock(mutex_);
+    return known_.emplace(key, std::move(made)).first->second;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::map<std::string, std::shared_ptr<const BallbarPlaces>> known_;
 };
 
 }  // namespace rotacal::diagnosis_detail
