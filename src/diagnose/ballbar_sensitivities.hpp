@@ -1,18 +1,12 @@
 #pragma once
 // Internal to src/diagnose: the ballbar candidates' Jacobians by the chain rule at the current
-// fit, for a machine without head axes.
+// fit (src/ballbar/length_chain.hpp), for a machine without head axes.
 //
-// Why: Jets of each candidate through the whole length model (the current model's stages and
-// both axis rotations again for every candidate and row) were the largest part of a ballbar
-// diagnosis. A candidate enters the reading only at a few places: an axis' angle, the pose of
-// an axis' error motion E or coning K (a left rotation and a translation), the table's
-// translation D, the tool-side ball and the reading itself (effects.hpp composes them so). So
-//   dL/dq = sum over places of (dL / d place: the fit's, once per row for every candidate)
-//         x (d place / dq: the candidate's own stages alone, by Jets of one effect).
+// dL/dq = sum over places of (dL / d place: the fit's, once per row for every candidate)
+//       x (d place / dq: the candidate's own stages alone, by Jets of one effect, at q = 0).
 // The second factor does not depend on the fit, so a session keeps it per candidate
-// (BallbarPlacesCache) and a later round pays only the sum.
-// The same derivatives as the Jets up to rounding; test_diagnose_ballbar.cpp checks them against
-// candidate_jacobian_by_jets for every candidate of the catalogue.
+// (BallbarPlacesCache) and a later round pays only the sum. test_diagnose_ballbar.cpp checks
+// the Jacobians against candidate_jacobian_by_jets for every candidate of the catalogue.
 
 #include <Eigen/Core>
 #include <map>
@@ -21,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "../ballbar/length_chain.hpp"
 #include "rotacal/ballbar/motion.hpp"
 #include "rotacal/diagnose/diagnosis.hpp"
 #include "rotacal/session/session.hpp"
@@ -29,7 +24,7 @@ namespace rotacal::diagnosis_detail {
 
 /// d place / d (each seeded parameter) of one candidate on every row, for the places it enters.
 struct BallbarPlaces {
-  std::vector<int> places;  ///< indices of BallbarSensitivities' places, ascending
+  std::vector<int> places;  ///< length_chain::Place indices, ascending
   int seeds = 0;
   Eigen::MatrixXd d;        ///< row i * seeds + k: d places[i] / d seed k; one column per row
 };
@@ -37,7 +32,7 @@ struct BallbarPlaces {
 class BallbarSensitivities {
  public:
   /// Machines whose ball pivot goes through every rotary axis (no head axes).
-  static bool supports(MachineType m) { return !m.description().has_head(); }
+  static bool supports(MachineType m) { return length_chain::supports(m); }
   /// dL / d(each place) on every row of `samples` (with `motion`, one per sample) at fit `at`.
   BallbarSensitivities(MachineType m, const std::vector<BallbarSample>& samples,
                        const std::vector<RotaryMotion>& motion, const ModelFit& at);
@@ -49,17 +44,12 @@ class BallbarSensitivities {
   Eigen::MatrixXd columns(const BallbarPlaces& p) const;
 
  private:
-  // Rows of s_: the angle of chain axes 0 and 1; E's translation and left rotation (3 each) of
-  // axes 0 and 1; K's left rotation of axes 0 and 1; the table translation D; the tool-side
-  // ball; the reading.
-  enum Place { kAngle = 0, kEt = 2, kEw = 8, kKw = 14, kD = 20, kTool = 23, kReading = 26, kPlaces = 27 };
-
   MachineType m_;
   const std::vector<BallbarSample>& samples_;
   const std::vector<RotaryMotion>& motion_;
   std::vector<RotaryAngles<double>> angles_;
   EffectModel reference_;  // no effects: the fit's linear_reference for the candidate's own stages
-  Eigen::Matrix<double, kPlaces, Eigen::Dynamic> s_;
+  Eigen::Matrix<double, length_chain::kPlaces, Eigen::Dynamic> s_;  // dL / d place, a column per row
 };
 
 /// BallbarPlaces of one session's rows by BallbarSensitivities::key, shared by every fit.
