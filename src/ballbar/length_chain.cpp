@@ -74,10 +74,17 @@ void place_derivatives(MachineType m, const EffectModel& fx, const Jet4* q, cons
   const detail::AxisStages<Jet4> st = detail::axis_stages<Jet4>(m, fx, q, smp.angles, smp.time, smp.motion);
   d.setZero();
   // w of a left rotation: dR R^T = [dw]x, w = (M(2,1), M(0,2), M(1,0)) of M = dR R^T.
+  // A candidate at 0 has R = I, so M = dR (exactly what the product gives): no product then.
   const auto rotation = [&](int place, const Mat3<Jet4>& R) {
     Eigen::Matrix3d value;
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) value(i, j) = R(i, j).a;
+    if (value == Eigen::Matrix3d::Identity()) {
+      d.row(place) = R(2, 1).v.transpose();
+      d.row(place + 1) = R(0, 2).v.transpose();
+      d.row(place + 2) = R(1, 0).v.transpose();
+      return;
+    }
     for (int c = 0; c < 4; ++c) {
       Eigen::Matrix3d dR;
       for (int i = 0; i < 3; ++i)

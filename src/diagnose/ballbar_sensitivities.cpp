@@ -11,7 +11,7 @@ namespace rotacal::diagnosis_detail {
 
 BallbarSensitivities::BallbarSensitivities(MachineType m, const std::vector<BallbarSample>& samples,
                                            const std::vector<RotaryMotion>& motion, const ModelFit& at)
-    : m_(m), samples_(samples), motion_(motion), s_(length_chain::kPlaces, static_cast<Eigen::Index>(samples.size())) {
+    : m_(m), samples_(samples), motion_(motion), s_(static_cast<Eigen::Index>(samples.size()), length_chain::kPlaces) {
   ROTACAL_ASSERT(supports(m) && motion.size() == samples.size());
   reference_.linear_reference = at.effects.linear_reference;
   const BallbarLayout L = ballbar_layout(m, at.effects);
@@ -26,7 +26,7 @@ BallbarSensitivities::BallbarSensitivities(MachineType m, const std::vector<Ball
     const BallbarSample& smp = samples[r];
     angles_.push_back(smp.angles_rad());
     length_chain::sensitivities(m, e, pivot, at.effects, p, {smp.xyz, angles_.back(), smp.time, motion[r]}, s, nullptr);
-    s_.col(static_cast<Eigen::Index>(r)) = s;
+    s_.row(static_cast<Eigen::Index>(r)) = s.transpose();
   }
 }
 
@@ -38,29 +38,28 @@ BallbarPlaces BallbarSensitivities::places(const Effect& effect, const std::vect
   fx.effects = {effect};
   Jet4 q[4] = {Jet4(0.0), Jet4(0.0), Jet4(0.0), Jet4(0.0)};
   for (std::size_t k = 0; k < seed.size(); ++k) q[seed[k]] = Jet4(0.0, static_cast<int>(k));
-  const Eigen::Index n = s_.cols();
-  // Every place's derivatives first (column r: place p, seed k at p + kPlaces k), then only
-  // the places it enters.
+  const Eigen::Index n = s_.rows();
+  // Every place's derivatives first (column r: place p, seed k at p + kPlaces k), noting the
+  // places it enters; then those places' rows alone.
   Eigen::Matrix<double, 4 * kPlaces, Eigen::Dynamic> all(4 * kPlaces, n);
   Eigen::Matrix<double, kPlaces, 4> d;
+  Eigen::Array<bool, kPlaces, 1> enters = Eigen::Array<bool, kPlaces, 1>::Constant(false);
+  const int seeds = static_cast<int>(seed.size());
   for (Eigen::Index r = 0; r < n; ++r) {
     const std::size_t i = static_cast<std::size_t>(r);
     const BallbarSample& smp = samples_[i];
     length_chain::place_derivatives(m_, fx, q, {smp.xyz, angles_[i], smp.time, motion_[i]}, d);
     all.col(r) = Eigen::Map<const Eigen::Matrix<double, 4 * kPlaces, 1>>(d.data());
+    enters = enters || (d.leftCols(seeds).array() != 0.0).rowwise().any();
   }
   BallbarPlaces out;
-  out.seeds = static_cast<int>(seed.size());
+  out.seeds = seeds;
   for (int p = 0; p < kPlaces; ++p)
-    for (int k = 0; k < out.seeds; ++k)
-      if (all.row(p + kPlaces * k).cwiseAbs().maxCoeff() > 0.0) {
-        out.places.push_back(p);
-        break;
-      }
-  out.d.resize(static_cast<Eigen::Index>(out.places.size()) * out.seeds, n);
+    if (enters[p]) out.places.push_back(p);
+  out.d.resize(n, static_cast<Eigen::Index>(out.places.size()) * seeds);
   for (std::size_t i = 0; i < out.places.size(); ++i)
-    for (int k = 0; k < out.seeds; ++k)
-      out.d.row(static_cast<Eigen::Index>(i) * out.seeds + k) = all.row(out.places[i] + kPlaces * k);
+    for (int k = 0; k < seeds; ++k)
+      out.d.col(static_cast<Eigen::Index>(i) * seeds + k) = all.row(out.places[i] + kPlaces * k).transpose();
   return out;
 }
 
@@ -76,12 +75,10 @@ std::string BallbarSensitivities::key(const Effect& effect, const std::vector<in
 }
 
 Eigen::MatrixXd BallbarSensitivities::columns(const BallbarPlaces& p) const {
-  const Eigen::Index n = s_.cols();
-  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n, p.seeds);
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(s_.rows(), p.seeds);
   for (std::size_t i = 0; i < p.places.size(); ++i)
     for (int k = 0; k < p.seeds; ++k)
-      out.col(k).array() += s_.row(p.places[i]).transpose().array() *
-                            p.d.row(static_cast<Eigen::Index>(i) * p.seeds + k).transpose().array();
+      out.col(k).array() += s_.col(p.places[i]).array() * p.d.col(static_cast<Eigen::Index>(i) * p.seeds + k).array();
   return out;
 }
 

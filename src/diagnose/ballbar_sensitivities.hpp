@@ -26,7 +26,7 @@ namespace rotacal::diagnosis_detail {
 struct BallbarPlaces {
   std::vector<int> places;  ///< length_chain::Place indices, ascending
   int seeds = 0;
-  Eigen::MatrixXd d;        ///< row i * seeds + k: d places[i] / d seed k; one column per row
+  Eigen::MatrixXd d;        ///< column i * seeds + k: d places[i] / d seed k; a row per reading
 };
 
 class BallbarSensitivities {
@@ -49,7 +49,7 @@ class BallbarSensitivities {
   const std::vector<RotaryMotion>& motion_;
   std::vector<RotaryAngles<double>> angles_;
   EffectModel reference_;  // no effects: the fit's linear_reference for the candidate's own stages
-  Eigen::Matrix<double, length_chain::kPlaces, Eigen::Dynamic> s_;  // dL / d place, a column per row
+  Eigen::Matrix<double, Eigen::Dynamic, length_chain::kPlaces> s_;  // dL / d place: a column per place
 };
 
 /// BallbarPlaces of one session's rows by BallbarSensitivities::key, shared by every fit.
