@@ -68,14 +68,16 @@ void sensitivities(MachineType m, const LocationErrors<double>& e, const Eigen::
   if (base) base->segment<3>(8) = g.transpose();
 }
 
-void place_derivatives(MachineType m, const EffectModel& fx, const Jet4* q, const Sample& smp,
-                       Eigen::Matrix<double, kPlaces, 4>& d) {
+template <int N>
+void place_derivatives(MachineType m, const EffectModel& fx, const ceres::Jet<double, N>* q, const Sample& smp,
+                       Eigen::Matrix<double, kPlaces, N>& d) {
+  using Jet = ceres::Jet<double, N>;
   const int nt = static_cast<int>(m.description().table_axes.size());
-  const detail::AxisStages<Jet4> st = detail::axis_stages<Jet4>(m, fx, q, smp.angles, smp.time, smp.motion);
+  const detail::AxisStages<Jet> st = detail::axis_stages<Jet>(m, fx, q, smp.angles, smp.time, smp.motion);
   d.setZero();
   // w of a left rotation: dR R^T = [dw]x, w = (M(2,1), M(0,2), M(1,0)) of M = dR R^T.
   // A candidate at 0 has R = I, so M = dR (exactly what the product gives): no product then.
-  const auto rotation = [&](int place, const Mat3<Jet4>& R) {
+  const auto rotation = [&](int place, const Mat3<Jet>& R) {
     Eigen::Matrix3d value;
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) value(i, j) = R(i, j).a;
@@ -85,7 +87,7 @@ void place_derivatives(MachineType m, const EffectModel& fx, const Jet4* q, cons
       d.row(place + 2) = R(1, 0).v.transpose();
       return;
     }
-    for (int c = 0; c < 4; ++c) {
+    for (int c = 0; c < N; ++c) {
       Eigen::Matrix3d dR;
       for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) dR(i, j) = R(i, j).v[c];
@@ -103,10 +105,15 @@ void place_derivatives(MachineType m, const EffectModel& fx, const Jet4* q, cons
   }
   if (st.D[0])
     for (int a = 0; a < 3; ++a) d.row(kD + a) = (*st.D[0])[a].v.transpose();
-  const Vec3<Jet4> tool = linear_axes_position<Jet4>(fx, q, smp.xyz) + tool_offset<Jet4>(fx, q);
+  const Vec3<Jet> tool = linear_axes_position<Jet>(fx, q, smp.xyz) + tool_offset<Jet>(fx, q);
   for (int a = 0; a < 3; ++a) d.row(kTool + a) = tool[a].v.transpose();
-  d.row(kReading) = ballbar_reading_error<Jet4>(fx, q, smp.time).v.transpose();
+  d.row(kReading) = ballbar_reading_error<Jet>(fx, q, smp.time).v.transpose();
 }
+
+template void place_derivatives<1>(MachineType, const EffectModel&, const ceres::Jet<double, 1>*, const Sample&,
+                                   Eigen::Matrix<double, kPlaces, 1>&);
+template void place_derivatives<4>(MachineType, const EffectModel&, const Jet4*, const Sample&,
+                                   Eigen::Matrix<double, kPlaces, 4>&);
 
 }  // namespace rotacal::length_chain
 

@@ -46,9 +46,11 @@ void sensitivities(MachineType m, const LocationErrors<double>& e, const Eigen::
                    const EffectModel& fx, const double* q, const Sample& s, Places& out,
                    Eigen::Matrix<double, 1, 11>* base);
 
-/// d(each place) / d(the Jets' four seeds) of effects fx at parameters q (Jets) for one sample.
-/// A rotation's place is its left derivative: dR = [dw]x R.
-void place_derivatives(MachineType m, const EffectModel& fx, const Jet4* q, const Sample& s,
-                       Eigen::Matrix<double, kPlaces, 4>& d);
+/// d(each place) / d(the Jets' N seeds) of effects fx at parameters q (Jets) for one sample.
+/// A rotation's place is its left derivative: dR = [dw]x R. N = 1 or 4 (length_chain.cpp):
+/// a Jet's derivative parts are computed element by element, so both widths give the same bits.
+template <int N>
+void place_derivatives(MachineType m, const EffectModel& fx, const ceres::Jet<double, N>* q, const Sample& s,
+                       Eigen::Matrix<double, kPlaces, N>& d);
 
 }  // namespace rotacal::length_chain

@@ -31,25 +31,31 @@ BallbarSensitivities::BallbarSensitivities(MachineType m, const std::vector<Ball
 }
 
 BallbarPlaces BallbarSensitivities::places(const Effect& effect, const std::vector<int>& seed) const {
-  using length_chain::Jet4;
+  ROTACAL_ASSERT(!seed.empty() && seed.size() <= 4 && effect.num_params() <= 4);
+  // Most candidates (the harmonic channels among them) seed one parameter: Jets of width 1.
+  return seed.size() == 1 ? places_with<1>(effect, seed) : places_with<4>(effect, seed);
+}
+
+template <int N>
+BallbarPlaces BallbarSensitivities::places_with(const Effect& effect, const std::vector<int>& seed) const {
+  using Jet = ceres::Jet<double, N>;
   using length_chain::kPlaces;
-  ROTACAL_ASSERT(seed.size() <= 4 && effect.num_params() <= 4);
   EffectModel fx = reference_;
   fx.effects = {effect};
-  Jet4 q[4] = {Jet4(0.0), Jet4(0.0), Jet4(0.0), Jet4(0.0)};
-  for (std::size_t k = 0; k < seed.size(); ++k) q[seed[k]] = Jet4(0.0, static_cast<int>(k));
+  Jet q[4] = {Jet(0.0), Jet(0.0), Jet(0.0), Jet(0.0)};
+  for (std::size_t k = 0; k < seed.size(); ++k) q[seed[k]] = Jet(0.0, static_cast<int>(k));
   const Eigen::Index n = s_.rows();
   // Every place's derivatives first (column r: place p, seed k at p + kPlaces k), noting the
   // places it enters; then those places' rows alone.
-  Eigen::Matrix<double, 4 * kPlaces, Eigen::Dynamic> all(4 * kPlaces, n);
-  Eigen::Matrix<double, kPlaces, 4> d;
+  Eigen::Matrix<double, N * kPlaces, Eigen::Dynamic> all(N * kPlaces, n);
+  Eigen::Matrix<double, kPlaces, N> d;
   Eigen::Array<bool, kPlaces, 1> enters = Eigen::Array<bool, kPlaces, 1>::Constant(false);
   const int seeds = static_cast<int>(seed.size());
   for (Eigen::Index r = 0; r < n; ++r) {
     const std::size_t i = static_cast<std::size_t>(r);
     const BallbarSample& smp = samples_[i];
-    length_chain::place_derivatives(m_, fx, q, {smp.xyz, angles_[i], smp.time, motion_[i]}, d);
-    all.col(r) = Eigen::Map<const Eigen::Matrix<double, 4 * kPlaces, 1>>(d.data());
+    length_chain::place_derivatives<N>(m_, fx, q, {smp.xyz, angles_[i], smp.time, motion_[i]}, d);
+    all.col(r) = Eigen::Map<const Eigen::Matrix<double, N * kPlaces, 1>>(d.data());
     enters = enters || (d.leftCols(seeds).array() != 0.0).rowwise().any();
   }
   BallbarPlaces out;

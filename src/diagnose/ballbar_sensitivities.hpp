@@ -44,6 +44,9 @@ class BallbarSensitivities {
   Eigen::MatrixXd columns(const BallbarPlaces& p) const;
 
  private:
+  template <int N>
+  BallbarPlaces places_with(const Effect& effect, const std::vector<int>& seed) const;
+
   MachineType m_;
   const std::vector<BallbarSample>& samples_;
   const std::vector<RotaryMotion>& motion_;

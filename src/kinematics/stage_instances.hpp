@@ -15,7 +15,8 @@
                                                   const S&);                                              \
   EXTERN template Vec3<S> tool_offset<S>(const EffectModel&, const S*);
 
-/// The scalars: the fit's doubles and the candidates' Jets of width 4.
-#define ROTACAL_STAGE_SCALARS(EXTERN)            \
-  ROTACAL_STAGE_INSTANCES(EXTERN, double)        \
+/// The scalars: the fit's doubles and the Jets of widths 1 (one-seed candidates) and 4.
+#define ROTACAL_STAGE_SCALARS(EXTERN)                 \
+  ROTACAL_STAGE_INSTANCES(EXTERN, double)             \
+  ROTACAL_STAGE_INSTANCES(EXTERN, detail::JetOf<1>)   \
   ROTACAL_STAGE_INSTANCES(EXTERN, detail::JetOf<4>)
