@@ -1,6 +1,8 @@
 // The ballbar residual model's kernels (length_model.hpp), compiled once for the library.
 #include "length_model.hpp"
 
+#include "length_chain.hpp"
+
 #include <algorithm>
 
 // Inline every call in the row kernel: GCC otherwise keeps the rotation and its derivative
@@ -42,6 +44,7 @@ BallbarLengthModel::BallbarLengthModel(const BallbarArrays& d, const EffectModel
                                        std::vector<int> pivot_of_row, int pivots)
     : d_(d), fx_(fx), L_(ballbar_layout(d.machine, fx, pivots)), pivot_of_(std::move(pivot_of_row)),
       analytic_(pivot_of_.empty() && analytic_supported(fx)),
+      chain_(!analytic_ && pivot_of_.empty() && length_chain::supports(d.machine)),
       nt_(static_cast<int>(d.machine.description().table_axes.size())) {
   if (!pivot_of_.empty() && static_cast<Eigen::Index>(pivot_of_.size()) != d.size())
     throw InvalidArgument("ballbar fit: " + std::to_string(pivot_of_.size()) + " pivot indices for " +
@@ -57,6 +60,10 @@ void BallbarLengthModel::evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::Ve
                                   Eigen::MatrixXd* J) const {
   if (analytic_) {
     evaluate_rows(chain_at(x), d_.size(), [](Eigen::Index k) { return k; }, r, J);
+    return;
+  }
+  if (J && chain_) {
+    evaluate_chain(x, r, *J);
     return;
   }
   evaluate_with_jets([this](Eigen::Index i, const auto* p, auto* out) { sample(i, p, out); },

@@ -18,7 +18,8 @@ namespace rotacal {
 // the Jacobian row, checked against the Jets (r and J) in tests/cpp/test_ballbar_identify.cpp.
 // Jets of one sample with 12 parameters were about half of a fit's time (perf,
 // ballbar_ac_table2.csv). Any other effect takes the templated model (predicted_length) on
-// doubles or Jets.
+// doubles for the residuals, and on a machine without head axes with one pivot the chain rule
+// through the effects' stages for the Jacobian (length_chain.hpp), else Jets.
 //
 // The member functions are defined once, in length_model.cpp: every file that fits a ballbar
 // (identification, Monte Carlo, separation design, several-session fit) used to compile the
@@ -57,12 +58,14 @@ class BallbarLengthModel : public ResidualModel {
   Lanes analytic_lanes(const Chain<Lanes>& ch, const Eigen::Index (&idx)[Lanes::kSize], JacobianLanes* J) const;
   template <typename T>
   void sample(Eigen::Index i, const T* p, T* out) const;
+  void evaluate_chain(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r, Eigen::MatrixXd& J) const;
 
   const BallbarArrays& d_;
   const EffectModel& fx_;
   BallbarLayout L_;
   std::vector<int> pivot_of_;  // pivot of each row (empty: one pivot)
   bool analytic_;
+  bool chain_;  // otherwise the Jacobian by the chain rule (length_chain.hpp) where it applies
   int nt_;  // table axes: chain axes 0 .. nt_ - 1 carry the pivot, the others the tool
   Eigen::Matrix<double, 4, Eigen::Dynamic> cs_;  // commanded_sincos
 };

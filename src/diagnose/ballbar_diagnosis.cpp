@@ -4,6 +4,7 @@
 
 #include <ceres/jet.h>
 
+#include "ballbar_sensitivities.hpp"
 #include "candidate_jets.hpp"
 #include "rotacal/ballbar/problem.hpp"
 
@@ -13,7 +14,8 @@ BallbarDiagnosisProblem::BallbarDiagnosisProblem(BallbarSession session, Ballbar
     : session_(std::move(session)),
       arrays_(ballbar_arrays(session_)),
       reference_(std::move(reference)),
-      reference_motion_(rotary_motion(reference_.samples)) {
+      reference_motion_(rotary_motion(reference_.samples)),
+      places_(std::make_shared<diagnosis_detail::BallbarPlacesCache>()) {
   times_.assign(arrays_.time.data(), arrays_.time.data() + arrays_.time.size());
   if (!reference_.samples.empty() && reference_.machine != session_.machine)
     throw InvalidArgument("reference test is for " + to_string(reference_.machine) +
@@ -90,11 +92,21 @@ Eigen::MatrixXd length_jets(MachineType m, const std::vector<BallbarSample>& sam
   return out;
 }
 
-// jets(width, effect, seed) for candidate_jets.hpp.
+// jets(width, effect, seed) for candidate_jets.hpp, by Jets of width 4 whatever the seed (the
+// head machines' and the tests' path since the chain rule: one instantiation builds faster).
 auto jets_on(MachineType m, const std::vector<BallbarSample>& samples, const std::vector<RotaryMotion>& motion,
              const ModelFit& at) {
-  return [&, m](auto width, const Effect& effect, const std::vector<int>& seed) {
-    return length_jets<decltype(width)::value>(m, samples, motion, at, effect, seed);
+  return [&, m](auto /*width*/, const Effect& effect, const std::vector<int>& seed) {
+    return length_jets<4>(m, samples, motion, at, effect, seed);
+  };
+}
+
+// The same by the chain rule at the fit of `S`, on machines it supports; the candidates' own
+// places kept in `cache` when given (the session's rows).
+auto chain_rule_on(const diagnosis_detail::BallbarSensitivities& S, diagnosis_detail::BallbarPlacesCache* cache) {
+  return [&S, cache](auto /*width*/, const Effect& effect, const std::vector<int>& seed) {
+    if (!cache) return S.columns(S.places(effect, seed));
+    return S.columns(*cache->get(S.key(effect, seed), [&] { return S.places(effect, seed); }));
   };
 }
 
@@ -103,15 +115,25 @@ auto jets_on(MachineType m, const std::vector<BallbarSample>& samples, const std
 Eigen::MatrixXd BallbarDiagnosisProblem::jacobian_on(const std::vector<BallbarSample>& samples,
                                                      const std::vector<RotaryMotion>& motion,
                                                      const ModelFit& at, const Effect& candidate) const {
-  return diagnosis_detail::jacobian_of_candidate(session_.machine, candidate, jets_on(session_.machine, samples, motion, at),
-                                                      [&](Eigen::Index r) { return samples[static_cast<std::size_t>(r)].angles_rad(); });
+  const auto angles = [&](Eigen::Index r) { return samples[static_cast<std::size_t>(r)].angles_rad(); };
+  const MachineType m = session_.machine;
+  if (!diagnosis_detail::BallbarSensitivities::supports(m))
+    return diagnosis_detail::jacobian_of_candidate(m, candidate, jets_on(m, samples, motion, at), angles);
+  const diagnosis_detail::BallbarSensitivities S(m, samples, motion, at);
+  return diagnosis_detail::jacobian_of_candidate(m, candidate, chain_rule_on(S, &samples == &session_.samples ? places_.get() : nullptr),
+                                                 angles);
 }
 
 std::vector<Eigen::MatrixXd> BallbarDiagnosisProblem::candidate_jacobians(
     const ModelFit& at, const std::vector<Effect>& candidates) const {
-  return diagnosis_detail::jacobians_of_candidates(session_.machine, candidates,
-                                                       jets_on(session_.machine, session_.samples, arrays_.motion, at),
-                                                       [&](Eigen::Index r) { return arrays_.angles[static_cast<std::size_t>(r)]; });
+  const auto angles = [&](Eigen::Index r) { return arrays_.angles[static_cast<std::size_t>(r)]; };
+  const MachineType m = session_.machine;
+  if (!diagnosis_detail::BallbarSensitivities::supports(m))
+    return diagnosis_detail::jacobians_of_candidates(m, candidates, jets_on(m, session_.samples, arrays_.motion, at),
+                                                     angles);
+  // The fit's part of every row once for all candidates (ballbar_sensitivities.hpp).
+  const diagnosis_detail::BallbarSensitivities S(m, session_.samples, arrays_.motion, at);
+  return diagnosis_detail::jacobians_of_candidates(m, candidates, chain_rule_on(S, places_.get()), angles);
 }
 
 Eigen::MatrixXd BallbarDiagnosisProblem::candidate_jacobian(const ModelFit& at,

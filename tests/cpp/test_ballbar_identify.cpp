@@ -231,6 +231,45 @@ TEST_CASE("the analytic Jacobian of the length model equals the Jets on every ma
   }
 }
 
+TEST_CASE("the chain-rule Jacobian of the length model with effects equals the Jets", "[identify][jacobian]") {
+  // Every kind of stage (angle, E, K, D, tool side, reading), several effects on one axis' E,
+  // more than four effect parameters (two passes of Jets), nonzero effect parameters, motion.
+  std::mt19937 rng(98);
+  std::normal_distribution<double> N(0.0, 1.0);
+  for (MachineType m : {MachineType::AC_trt, MachineType::BC_trt}) {
+    INFO(to_string(m));
+    BallbarSetup setup;
+    setup.machine = m;
+    setup.step_deg = 9.0;
+    setup.directions = {SweepDirection::ccw, SweepDirection::cw};
+    const BallbarArrays a = ballbar_arrays(commanded_session(plan_ballbar_test(setup)));
+    const char t = tilt_axis_letter(m);
+    const std::string T(1, t);
+    EffectModel fx;
+    for (const std::string& id : std::vector<std::string>{"coning_" + T, "gravity_sag_" + T, "tilt_motion_C_h1", "radial_motion_C_h2",
+                                  "angular_positioning_" + T + "_h2", "servo_lag_C", "thermal_warmup_X",
+                                  "angular_error_BX", "ballbar_thermal_drift", "tool_offset_X"})
+      fx.effects.push_back(Effect::parse(id));
+    fx.linear_reference = Eigen::Vector3d(10.0, -5.0, 40.0);
+    const BallbarLengthModel model(a, fx);
+    REQUIRE_FALSE(model.analytic());
+    const int p = model.num_parameters();
+    Eigen::VectorXd x(p);
+    for (int k = 0; k < 8; ++k) x[k] = location_error_is_angle(k) ? 1e-3 * N(rng) : 0.5 * N(rng);
+    x.segment<3>(8) = Eigen::Vector3d(120.0, 0.0, 60.0) + Eigen::Vector3d(N(rng), N(rng), N(rng));
+    for (int k = 11; k < p; ++k) x[k] = 1e-3 * N(rng);
+    Eigen::VectorXd r1(a.size()), r2(a.size());
+    Eigen::MatrixXd J1(a.size(), p), J2(a.size(), p);
+    model.evaluate(x, r1, &J1);
+    model.evaluate_jets(x, r2, &J2);
+    CHECK((r1 - r2).cwiseAbs().maxCoeff() < 1e-12);
+    for (int c = 0; c < p; ++c) {
+      INFO("column " << c);
+      CHECK((J1.col(c) - J2.col(c)).cwiseAbs().maxCoeff() <= 1e-12 * (1e-300 + J2.col(c).cwiseAbs().maxCoeff()));
+    }
+  }
+}
+
 TEST_CASE("arrays built without the motion refuse an effect of the motion", "[identify]") {
   BallbarSetup setup;
   setup.step_deg = 10.0;

@@ -3,6 +3,7 @@
 #include <Eigen/SVD>
 #include <random>
 
+#include "rotacal/ballbar/plan.hpp"
 #include "rotacal/ballbar/simulate.hpp"
 #include "rotacal/core/least_squares.hpp"
 #include "rotacal/diagnose/ballbar_diagnosis.hpp"
@@ -244,6 +245,36 @@ TEST_CASE("candidate Jacobians: the harmonic shortcut equals Jets of every param
   fx.effects = {Effect::parse("tilt_motion_C_h1"), Effect::parse("radial_motion_A_h2")};
   const int harmonic = synthetic::check_candidate_jacobians(P, fx);
   CHECK(harmonic >= 20);  // angular, radial, axial and tilt motions of both axes, orders 1-4
+}
+
+TEST_CASE("candidate Jacobians by the chain rule equal Jets on BC with motion effects and every stage in the fit", "[diagnose]") {
+  // The chain rule (src/diagnose/ballbar_sensitivities.hpp) passes through every stage the
+  // fit holds: coning (K), gravity sag (D), an error motion (E) on each axis, a reading drift
+  // and a tool-side term; both directions at two feeds make the motion effects candidates.
+  BallbarSetup setup;
+  setup.machine = MachineType::BC_trt;
+  setup.step_deg = 4.0;
+  setup.directions = {SweepDirection::ccw, SweepDirection::cw};
+  setup.feed_factors = {1.0, 2.0};
+  const BallbarSession cmd = commanded_session(plan_ballbar_test(setup));
+  std::mt19937 rng(5);
+  BallbarMachineModel truth = synthetic::random_ballbar_machine(cmd, rng);
+  truth.machine = MachineType::BC_trt;
+  EffectModel fx;
+  fx.effects = {Effect::parse("coning_B"), Effect::parse("gravity_sag_B"), Effect::parse("axial_motion_C_h1"),
+                Effect::parse("tilt_motion_B_h2"), Effect::parse("ballbar_thermal_drift"),
+                Effect::parse("linear_scale_X")};
+  truth.effects = fx;
+  truth.effect_params = {3e-5, 0.004, 0.002, -0.001, 2e-6, -1e-6, 3e-6, 1e-6, 1e-7, 2e-5};
+  BallbarDiagnosisProblem P(simulate_ballbar(cmd, truth, {kNoiseUm, 4, true}));
+  // First at the baseline fit: the second check then takes the candidates' places, which the
+  // problem keeps, at another fit.
+  synthetic::check_candidate_jacobians(P, EffectModel{});
+  const int harmonic = synthetic::check_candidate_jacobians(P, fx);
+  CHECK(harmonic >= 20);
+  bool motion = false;
+  for (const Effect& c : P.candidates(4)) motion = motion || c.depends_on_motion();
+  CHECK(motion);
 }
 
 TEST_CASE("orthonormal_basis_full_rank spans what the rank-revealing QR spans", "[diagnose]") {

@@ -12,6 +12,10 @@
 
 namespace rotacal {
 
+namespace diagnosis_detail {
+class BallbarPlacesCache;
+}
+
 class BallbarDiagnosisProblem : public DiagnosisProblem {
  public:
   /// `reference` is a complete standard test for the same machine (commanded rows; lengths
@@ -52,6 +56,9 @@ class BallbarDiagnosisProblem : public DiagnosisProblem {
   std::vector<RotaryMotion> reference_motion_;
   std::vector<double> times_;  // arrays_.time as the interface's vector (labels and angles are
                                // arrays_'s own: every row of the session, in order)
+  // Where each candidate enters the session's rows, which no fit changes (src/diagnose/
+  // ballbar_sensitivities.hpp): computed once per session, shared by copies of the problem.
+  std::shared_ptr<diagnosis_detail::BallbarPlacesCache> places_;
 };
 
 /// Diagnose a ballbar session (see diagnosis.hpp). The session is taken by value: pass
