@@ -28,8 +28,11 @@ int check_candidate_jacobians(const Problem& P, const EffectModel& fx) {
     REQUIRE(batch[i].cols() == jets.cols());
     const double scale = jets.cwiseAbs().maxCoeff();
     REQUIRE(scale > 0.0);
-    CHECK((batch[i] - jets).cwiseAbs().maxCoeff() <= 1e-12 * scale);
-    CHECK((P.candidate_jacobian(at, candidates[i]) - jets).cwiseAbs().maxCoeff() <= 1e-12 * scale);
+    // 1e-10 of the column's size: the chain rule sums in another order than the Jets. Under
+    // clang -O1 (the sanitizer build) servo_lag_B on BC-trt differed by 1.4e-12 of its size, where
+    // GCC -O3 stays under 1e-12; a wrong factor (1e-4 of one stage's sensitivity) is far above.
+    CHECK((batch[i] - jets).cwiseAbs().maxCoeff() <= 1e-10 * scale);
+    CHECK((P.candidate_jacobian(at, candidates[i]) - jets).cwiseAbs().maxCoeff() <= 1e-10 * scale);
     harmonic += candidates[i].is_harmonic();
   }
   return harmonic;
