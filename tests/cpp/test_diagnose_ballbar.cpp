@@ -240,7 +240,7 @@ TEST_CASE("candidate Jacobians: the harmonic shortcut equals Jets of every param
   truth.effects.effects = {Effect::parse("tilt_motion_C_h1"), Effect::parse("radial_motion_A_h2"),
                            Effect::parse("gravity_sag_A")};
   truth.effect_params = {4e-6, -3e-6, 2e-6, 1e-6, 0.002, -0.001, 0.0015, 0.0005, 0.004};
-  // Every other sample of table 2's session: the identity holds row by row, and 90 A angles over
+  // Every other sample of table 2's session: the identity holds row by row, and about 90 A angles over
   // a half turn still resolve the catalogue's orders; the sanitizers take half the time.
   BallbarSession every_other = commanded();
   every_other.samples.clear();
