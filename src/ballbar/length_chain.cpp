@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "../kinematics/stage_instances.hpp"
 
@@ -16,30 +17,49 @@ ROTACAL_STAGE_SCALARS(extern)
 
 namespace rotacal::length_chain {
 
+namespace {
+
+// The chain rule's forward pass: the pivot carried through the table's stages in
+// walk_table_stages' own order (the one definition of it), keeping what the backward pass needs.
+struct ForwardPass {
+  Eigen::Vector3d p;                             // the point after the stages so far
+  Eigen::Vector3d pE[2], pK[2];                  // the points E's and K's left rotations act on
+  Eigen::Vector3d arm[2];                        // the point less the axis line's point, after the turn
+  std::optional<Eigen::Matrix3d> RE[2], RK[2];   // E's and K's rotations (none: an identity stage)
+  LineRotationDerivatives<double> D[2];          // each axis rotation with its derivatives
+
+  explicit ForwardPass(const Eigen::Vector3d& pivot) : p(pivot) {
+    for (int k = 0; k < 2; ++k) pE[k] = pK[k] = arm[k] = Eigen::Vector3d::Zero();
+  }
+  void rigid(const Pose<double>& P, int k, RigidStage stage) {
+    const Eigen::Vector3d Rp = P.R * p;
+    if (stage == RigidStage::error_motion) RE[k] = P.R;
+    else RK[k] = P.R;
+    (stage == RigidStage::error_motion ? pE[k] : pK[k]) = Rp;
+    p = Rp + P.t;
+  }
+  void about_line(const AxisLine<double>& line, double angle, int k) {
+    if (!RE[k]) pE[k] = p;
+    const double inv_norm = 1.0 / line.direction.norm();
+    D[k] = rotate_point_about_unit_line_derivatives<double>(line.point, line.direction * inv_norm, inv_norm,
+                                                            std::cos(angle), std::sin(angle), p);
+    p = D[k].f;
+    arm[k] = p - line.point;
+    pK[k] = p;  // K's rotation, if any, replaces it
+  }
+  void translate(const Eigen::Vector3d& d) { p += d; }
+};
+
+}  // namespace
+
 void sensitivities(MachineType m, const LocationErrors<double>& e, const Eigen::Vector3d& pivot,
                    const EffectModel& fx, const double* q, const Sample& smp, Places& s,
                    Eigen::Matrix<double, 1, 11>* base) {
   using Row = Eigen::RowVector3d;
   const int nt = static_cast<int>(m.description().table_axes.size());
-  const detail::AxisStages<double> st = detail::axis_stages<double>(m, fx, q, smp.angles, smp.time, smp.motion);
-  // Forward, as walk_table_stages composes (innermost axis first): the points a left rotation
-  // of E or K acts on, and each axis rotation with its derivatives.
-  Eigen::Vector3d pE[2], pK[2], arm[2];
-  LineRotationDerivatives<double> D[2];
-  Eigen::Vector3d p = pivot;
-  for (int k = nt - 1; k >= 0; --k) {
-    pE[k] = st.E[k] ? Eigen::Vector3d(st.E[k]->R * p) : p;
-    p = st.E[k] ? Eigen::Vector3d(pE[k] + st.E[k]->t) : p;
-    const AxisLine<double> line = axis_line(m, k, e);
-    const double inv_norm = 1.0 / line.direction.norm();
-    D[k] = rotate_point_about_unit_line_derivatives<double>(line.point, line.direction * inv_norm, inv_norm,
-                                                            std::cos(st.angle[k]), std::sin(st.angle[k]), p);
-    p = D[k].f;
-    arm[k] = p - line.point;
-    pK[k] = st.K[k] ? Eigen::Vector3d(st.K[k]->R * p) : p;
-    p = st.K[k] ? Eigen::Vector3d(pK[k] + st.K[k]->t) : p;
-  }
-  if (st.D[0]) p += *st.D[0];
+  ForwardPass fw(pivot);
+  walk_table_stages<double>(m, e, fx, q, smp.angles, smp.time, smp.motion, fw);
+  const Eigen::Vector3d& p = fw.p;
   const Eigen::Vector3d tool = tool_position<double>(m, e, fx, q, smp.xyz, smp.angles, smp.time, 0.0, smp.motion);
   const Eigen::Vector3d u = (tool - p).normalized();
   // Backward from the reading: g = dL / d(the point after the stage at hand).
@@ -49,21 +69,21 @@ void sensitivities(MachineType m, const LocationErrors<double>& e, const Eigen::
   Eigen::Vector3d g = -u;
   s.segment<3>(kD) = g;
   for (int k = 0; k < nt; ++k) {
-    s.segment<3>(kKw + 3 * k) = pK[k].cross(g);  // d(w x p) = p x g . dw
-    if (st.K[k]) g = st.K[k]->R.transpose() * g;
+    s.segment<3>(kKw + 3 * k) = fw.pK[k].cross(g);  // d(w x p) = p x g . dw
+    if (fw.RK[k]) g = fw.RK[k]->transpose() * g;
     const Row w = g.transpose();
-    s[kAngle + k] = g.dot(D[k].u.cross(arm[k]));  // d f / d angle = u x (f - point)
-    const Row wq = D[k].times_q(w);
+    s[kAngle + k] = g.dot(fw.D[k].u.cross(fw.arm[k]));  // d f / d angle = u x (f - point)
+    const Row wq = fw.D[k].times_q(w);
     if (base) {
       const RotaryAxis& a = m.description().axis(k);
-      const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - D[k].u * D[k].u.transpose();
-      base->segment<2>(4 * k) = D[k].times_point(w, wq) * a.position_basis;
-      base->segment<2>(4 * k + 2) = D[k].times_unit_direction(w) * (P * D[k].inv_norm * a.direction_basis);
+      const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - fw.D[k].u * fw.D[k].u.transpose();
+      base->segment<2>(4 * k) = fw.D[k].times_point(w, wq) * a.position_basis;
+      base->segment<2>(4 * k + 2) = fw.D[k].times_unit_direction(w) * (P * fw.D[k].inv_norm * a.direction_basis);
     }
     g = wq.transpose();
     s.segment<3>(kEt + 3 * k) = g;
-    s.segment<3>(kEw + 3 * k) = pE[k].cross(g);
-    if (st.E[k]) g = st.E[k]->R.transpose() * g;
+    s.segment<3>(kEw + 3 * k) = fw.pE[k].cross(g);
+    if (fw.RE[k]) g = fw.RE[k]->transpose() * g;
   }
   if (base) base->segment<3>(8) = g.transpose();
 }

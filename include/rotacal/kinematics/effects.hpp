@@ -282,12 +282,16 @@ AxisStages<Scalar> axis_stages(MachineType m, const EffectModel& fx, const Scala
 
 }  // namespace detail
 
+/// Which rigid stage of chain axis k an accumulator is handed (walk_table_stages).
+enum class RigidStage { error_motion, coning };
+
 /// Walks the stages of the table's motion from the innermost (the workpiece-side axis' error
 /// motion) to the outermost (machine-frame translations), handing each to `acc`:
-/// `acc.rigid(Pose)` for error motions and coning, `acc.about_line(AxisLine, angle)` for the
-/// table axis rotations, `acc.translate(Vec3)` for drift and sag. Identity stages are
-/// skipped. This is the one place that fixes the order of composition (see the file comment);
-/// table_pose and table_point below are its two accumulators, and tool_position walks the
+/// `acc.rigid(Pose, k, RigidStage)` for error motions and coning of chain axis k,
+/// `acc.about_line(AxisLine, angle, k)` for its rotation, `acc.translate(Vec3)` for drift and
+/// sag. Identity stages are skipped. This is the one place that fixes the order of composition
+/// (see the file comment); table_pose and table_point below are its two accumulators, the
+/// ballbar's chain rule (src/ballbar/length_chain.cpp) a third, and tool_position walks the
 /// head side the same way.
 template <typename Scalar, typename Accumulator>
 void walk_table_stages(MachineType m, const LocationErrors<Scalar>& e, const EffectModel& fx,
@@ -295,9 +299,9 @@ void walk_table_stages(MachineType m, const LocationErrors<Scalar>& e, const Eff
                        const RotaryMotion& motion, Accumulator& acc) {
   const detail::AxisStages<Scalar> st = detail::axis_stages<Scalar>(m, fx, p, cmd, t, motion);
   for (int k = static_cast<int>(m.description().table_axes.size()) - 1; k >= 0; --k) {
-    if (st.E[k]) acc.rigid(*st.E[k]);
-    acc.about_line(axis_line(m, k, e), st.angle[k]);
-    if (st.K[k]) acc.rigid(*st.K[k]);
+    if (st.E[k]) acc.rigid(*st.E[k], k, RigidStage::error_motion);
+    acc.about_line(axis_line(m, k, e), st.angle[k], k);
+    if (st.K[k]) acc.rigid(*st.K[k], k, RigidStage::coning);
   }
   if (st.D[0]) acc.translate(*st.D[0]);
 }
@@ -306,8 +310,8 @@ namespace detail {
 template <typename Scalar>
 struct PoseAccumulator {  // T <- stage * T
   Pose<Scalar> T;
-  void rigid(const Pose<Scalar>& P) { T = P * T; }
-  void about_line(const AxisLine<Scalar>& L, const Scalar& a) {
+  void rigid(const Pose<Scalar>& P, int, RigidStage) { T = P * T; }
+  void about_line(const AxisLine<Scalar>& L, const Scalar& a, int) {
     T = rotation_about_line(L.point, L.direction, a) * T;
   }
   void translate(const Vec3<Scalar>& d) { T.t += d; }
@@ -315,8 +319,8 @@ struct PoseAccumulator {  // T <- stage * T
 template <typename Scalar>
 struct PointAccumulator {  // q <- stage(q)
   Vec3<Scalar> q;
-  void rigid(const Pose<Scalar>& P) { q = P * q; }
-  void about_line(const AxisLine<Scalar>& L, const Scalar& a) {
+  void rigid(const Pose<Scalar>& P, int, RigidStage) { q = P * q; }
+  void about_line(const AxisLine<Scalar>& L, const Scalar& a, int) {
     q = rotate_point_about_line(L.point, L.direction, a, q);
   }
   void translate(const Vec3<Scalar>& d) { q += d; }
