@@ -122,7 +122,10 @@ struct SearchCache {
     std::vector<Effect> missing;
     for (const Effect& c : todo)
       if (!known.count(c.id())) missing.push_back(c);
-    std::vector<Eigen::MatrixXd> fresh = P.candidate_jacobians(at, missing);
+    // Nothing to compute where every one is known (a finding's field, asked after its round):
+    // the ballbar's chain rule would still evaluate the fit's part of every row first.
+    std::vector<Eigen::MatrixXd> fresh;
+    if (!missing.empty()) fresh = P.candidate_jacobians(at, missing);
     for (std::size_t i = 0; i < missing.size(); ++i) with_time_constant_tangent(P, missing[i], fresh[i]);
     std::vector<SharedMatrix> out;
     for (const Effect& c : todo) {
