@@ -38,7 +38,8 @@ NoiseTreatment white_treatment(const DiagnosisProblem& P, const ModelFit& baseli
 NoiseTreatment coloured_treatment(const NoiseModel& m, bool described = true);
 
 /// What the declared variance bounds (hidden_levels.cpp): the model's variation within each
-/// stream (kWithin), or the mean of its readings' variances, walk and level included (kMarginal).
+/// stream (kWithin), or the mean of its readings' variances, walk and level included (kMarginal;
+/// the walk's step squared three quarters of the way from the within-stream bound's to it).
 enum class VarianceBound { kWithin, kMarginal };
 
 /// `t` with the stream levels of `m` (the model t.W whitens by) that its residuals cannot show,

@@ -344,3 +344,32 @@ def test_ballbar_length_offset_in_one_over_f_noise_is_not_taken_for_the_levels(t
         assert v != "wrong", (seed, r["findings"][:1])
         found += v in ("right", "ambiguous")
     assert found >= 3, found
+
+
+@pytest.mark.parametrize("effect,params", [
+    ("linear_squareness_ZX", [1.2e-5]),  # some 3.5x its half-detection amplitude in white noise
+    ("tilt_motion_B_h4", [4.5e-6, 0.0, -2.2e-6, 0.0]),  # some 3.6x
+])
+def test_ballbar_middle_speed_shape_in_one_over_f_noise_is_found(tmp_path, effect, params):
+    """A squareness and a fourth-order tilt of B on the BC-trt ballbar in 1/f-like noise, another
+    pivot than the bench's: shapes only partly slow (a level and a slope per test make 0.15-0.3
+    of their signature), which the round judged under the walk bounded within each test, where
+    the noise's power at those orders is too high: found (in the group) in 3 of these 10
+    sessions each on main at 4e0a475. Such a kept candidate now sends the round's kept few to
+    the rescoring under one walk bounded by the readings' declared variance, its step three
+    quarters of the way from the within-stream bound (search_round.cpp, hidden_levels.cpp):
+    found in 6 of 10 each. No session names a wrong cause, and null sessions of the same set-up
+    stay clean."""
+    found = 0
+    for seed in range(900, 910):
+        r = rotacal.diagnose(ballbar_pink_session(tmp_path, {effect: params}, seed, machine="BC-trt",
+                                                  pivot=(100.0, -15.0, 70.0))).to_dict()
+        v = verdict(r, effect)
+        assert v != "wrong", (seed, r["findings"][:1])
+        assert_determined(r)
+        found += v in ("right", "ambiguous")
+    for seed in range(1000, 1004):
+        null = rotacal.diagnose(ballbar_pink_session(tmp_path, {}, seed, machine="BC-trt",
+                                                     pivot=(100.0, -15.0, 70.0))).to_dict()
+        assert not null["findings"], (seed, null["findings"][:1])
+    assert found >= 5, found
