@@ -25,9 +25,28 @@ std::vector<double> weights_at(const std::vector<double>& bic, const std::vector
 
 }  // namespace
 
+std::vector<bool> explained_away(const ScoringInputs& in, const Score& chosen, const std::vector<const Score*>& field,
+                                 double min_delta_bic, double rival_correlation) {
+  std::vector<bool> out(field.size(), false);
+  if (!chosen.observable || chosen.A.cols() == 0) return out;
+  const Eigen::MatrixXd Qc = orthonormal_basis(chosen.A);
+  const Eigen::VectorXd e = in.r_w - Qc * (Qc.transpose() * in.r_w);  // what the chosen one leaves
+  const double n = static_cast<double>(in.r_w.size()), rss_c = e.squaredNorm();
+  for (std::size_t i = 0; i < field.size(); ++i) {
+    const Score& s = *field[i];
+    if (&s == &chosen || !s.observable || s.A.cols() == 0 || !(s.delta_bic < min_delta_bic) ||
+        std::abs(correlation(s.signature, chosen.signature)) >= rival_correlation)  // a rival anyway
+      continue;
+    const Eigen::MatrixXd Qs = orthonormal_basis(s.A - Qc * (Qc.transpose() * s.A));
+    const double drop = std::min((Qs.transpose() * e).squaredNorm(), rss_c * (1.0 - 1e-12));
+    out[i] = n * std::log((rss_c - drop) / rss_c) + s.k * std::log(n) >= min_delta_bic;
+  }
+  return out;
+}
+
 RivalJudgement weigh_rivals(const Score& chosen, const std::vector<const Score*>& field,
                             const std::vector<double>& bic, double n, double tempering, double rival_correlation,
-                            double min_weight) {
+                            double min_weight, const std::vector<bool>& explained_away) {
   std::vector<const Score*> who{&chosen};
   std::vector<double> corr{1.0};
   double chosen_bic = chosen.delta_bic;
@@ -39,7 +58,7 @@ RivalJudgement weigh_rivals(const Score& chosen, const std::vector<const Score*>
     const Score* s = field[i];
     if (s == &chosen || !std::isfinite(bic[i])) continue;
     const double c = std::abs(correlation(s->signature, chosen.signature));
-    if (c < rival_correlation) continue;
+    if (c < rival_correlation && !(i < explained_away.size() && explained_away[i])) continue;
     who.push_back(s), corr.push_back(c), ic_bic.push_back(bic[i]), k.push_back(s->k);
   }
   // Weights relative to the best of the field (a rival may fit better than the chosen one: the

@@ -93,7 +93,8 @@ Field weigh_field(const SearchContext& S, const Round& R, const Score& chosen, c
   }
   const double tempering = S.noise.W && S.model ? evidence_tempering(*S.model) : 1.0;
   F.judged = weigh_rivals(*chosen_judged, field, field_bic, n, tempering, S.options.rival_correlation,
-                          S.options.min_weight);
+                          S.options.min_weight, explained_away(in, *chosen_judged, field, S.options.min_delta_bic,
+                                                              S.options.rival_correlation));
   return F;
 }
 
