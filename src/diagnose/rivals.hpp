@@ -19,6 +19,20 @@ struct RivalJudgement {
   std::vector<const Score*> group;     ///< the chosen first, then the other members
 };
 
+/// Which of `field` pass the BIC threshold alone but not beside `chosen` (the same inputs): the two
+/// compete for one signal even where their fitted signatures correlate little. A 3x tilt_motion_C_h4
+/// on the AC-trt ballbar in 1/f-like noise scored -21.6 against radial_motion_C_h4's -23.2, their
+/// signatures correlated by 0.44 (under rival_correlation), and beside the radial motion the tilt
+/// scored +0.4: the radial motion was named alone at weight 1.00 (bench/diagnosis_confusion.py
+/// --noise pink --seed 251). An effect of its own beside the chosen one keeps its evidence (a
+/// thermal drift beside a straightness, -11.8 alone, -12.4 beside it) and stays out.
+/// Each is judged on `in` (the model before the finding, under the noise model the field is
+/// weighed with) by the chosen one's and its own whitened columns (Score::A): its delta BIC beside
+/// the chosen one against min_delta_bic. Only candidates whose signature correlates with the chosen
+/// one's by less than rival_correlation are judged (the others are rivals anyway).
+std::vector<bool> explained_away(const ScoringInputs& in, const Score& chosen, const std::vector<const Score*>& field,
+                                 double min_delta_bic, double rival_correlation);
+
 /// Weigh `chosen` against the other scores of `field` (every observable candidate of the round,
 /// whether it passed the round's tests or not: a rival that fits as well but failed the F-test
 /// or the BIC threshold is no less a rival). A rival is a candidate of the field whose fitted
@@ -52,22 +66,8 @@ struct RivalJudgement {
 /// `bic[i]`: the delta BIC of field[i] under the noise model the field is weighed with (one for
 /// all of them; +inf: not visible under it, not a rival); `n`: the readings (BIC's ln n).
 /// `tempering` (>= 1) divides the differences before they become weights (evidence_tempering).
-/// Which of `field` pass the BIC threshold alone but not beside `chosen` (the same inputs): the two
-/// compete for one signal even where their fitted signatures correlate little. A 3x tilt_motion_C_h4
-/// on the AC-trt ballbar in 1/f-like noise scored -21.6 against radial_motion_C_h4's -23.2, their
-/// signatures correlated by 0.44 (under rival_correlation), and beside the radial motion the tilt
-/// scored +0.4: the radial motion was named alone at weight 1.00 (bench/diagnosis_confusion.py
-/// --noise pink --seed 251). An effect of its own beside the chosen one keeps its evidence (a
-/// thermal drift beside a straightness, -11.8 alone, -12.4 beside it) and stays out.
-/// Each is judged on `in` (the model before the finding, under the noise model the field is
-/// weighed with) by the chosen one's and its own whitened columns (Score::A): its delta BIC beside
-/// the chosen one against min_delta_bic. Only candidates whose signature correlates with the chosen
-/// one's by less than rival_correlation are judged (the others are rivals anyway).
-std::vector<bool> explained_away(const ScoringInputs& in, const Score& chosen, const std::vector<const Score*>& field,
-                                 double min_delta_bic, double rival_correlation);
-
 /// `explained_away[i]`: field[i] passed the detection threshold alone but not beside the chosen
-/// candidate (explained_away above); such a candidate is a rival whatever its
+/// candidate (explained_away); such a candidate is a rival whatever its
 /// signature's correlation: the data support one of the two, not both.
 RivalJudgement weigh_rivals(const Score& chosen, const std::vector<const Score*>& field,
                             const std::vector<double>& bic, double n, double tempering,

@@ -220,7 +220,7 @@ constexpr std::size_t kOwnWalkMinStream = 150;
 // (marginal_round_walk), with their rivals weighed under the round's kWithin walk too (name_finding).
 // A share of 0.15 (0.3 until 12-07): the 1/f-like ballbar misses at 3x were harmonics of order
 // 2-4, straightness, squareness and gravity sag with slow shares of 0.02-0.15 whose truth ranked
-// first at delta BIC +6 to -8.7 under the within-stream bound (seeds 223-239: 5.4-12.4 points
+// first at delta BIC +6 to -8.7 under the within-stream bound (seeds 223-239: 5.4-13.2 points
 // below the oracle); with 0.15 and kMarginal's walk three quarters of the way to the marginal
 // bound (hidden_levels.cpp), -0.8 to 3.1 points, 2 / 300 null sessions with a group.
 constexpr double kSlowShare = 0.15;

@@ -154,9 +154,9 @@ void VirtualInstrument::send_frame(Bytes frame) {
     // ends as soon as the host has), so that the frames before the unplug arrive however busy
     // the host is: 2 s left 281 of 500 frames unread by a recorder at nice 19 at load 11.
     // FIONREAD counts what the line discipline holds, not what the kernel's flip buffer has yet
-    // to hand it (a worker thread does, late on a busy machine: a sanitizer build at nice 19
-    // beside a CI run's pytest lost 62 of 500 frames that way, unread() 0 while they were still
-    // there): the host has read everything once unread() stays 0 for 200 ms.
+    // to hand it (a worker thread does, late on a busy machine): the likeliest reason why the
+    // sanitizer build at nice 19, beside a CI run's benchmarks and fuzzers, read 438 of 500 frames
+    // (not reproduced on demand). The host has read everything once unread() stays 0 for 200 ms.
     int drained = 0;
     for (int i = 0; i < 2000 && drained < 20 && !stop_; ++i) {
       drained = pty_.unread() == 0 ? drained + 1 : 0;
