@@ -176,7 +176,10 @@ def main(argv=None) -> int:
     for st in CACHE.setups.values():
         _ = st.template  # read the template files before forking
     records = run(tasks, a.jobs)
-    key = lambda r: (r["machine"], r["instrument"], r["entry"] or "", r["noise"], r["amp"], r["draw"])  # noqa: E731
+
+    def key(r):
+        return (r["machine"], r["instrument"], r["entry"] or "", r["noise"], r["amp"], r["draw"])
+
     records.sort(key=key)
     motion = sorted({e for m in cfg["machines"] for e in motion_only_entries(m)})
     doc = {"config": cfg, "motion_only": motion, "entries": entries, "records": records,

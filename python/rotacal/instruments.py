@@ -7,12 +7,9 @@ an unplugged device, silence) leaves a valid file with everything read so far.
 """
 from __future__ import annotations
 
-import os
 import signal
-import sys
 import threading
-import time
-from typing import Any, Callable, Mapping, Sequence, TextIO
+from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 

@@ -6,7 +6,6 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-from . import _core
 from .models import ballbar_model_dict, covariance_dict, estimate_dict, fit_model_dict
 
 

@@ -5,7 +5,6 @@ import json
 
 import pytest
 
-from rotacal import _core
 
 from conftest import SHARED, run_cli
 

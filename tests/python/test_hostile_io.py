@@ -2,7 +2,6 @@
 refusal naming file/line/column (or the path), never a crash, a traceback, unbounded memory
 or a destroyed file. The command line maps them to exit 3 (content) and 4 (file system)."""
 import os
-import resource
 import subprocess
 import sys
 

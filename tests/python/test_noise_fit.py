@@ -73,7 +73,9 @@ def test_cli_noise_option_and_json(clean, tmp_path):
     s = ar_session(clean, 0.95, 7)
     f = tmp_path / "ar.csv"
     rotacal.save(s, f)
-    run = lambda *a: run_cli("identify", f, "--json", "--no-budget", *a)
+    def run(*a):
+        return run_cli("identify", f, "--json", "--no-budget", *a)
+
     auto, white = json.loads(run().stdout), json.loads(run("--noise", "white").stdout)
     assert auto["noise_model"]["gls_refit"] and not white["noise_model"]["gls_refit"]
     ratio = [auto["location_errors"][n]["std"] / white["location_errors"][n]["std"] for n in auto["location_errors"]]

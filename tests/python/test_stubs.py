@@ -1,6 +1,5 @@
 """The committed _core.pyi is what pybind11-stubgen (pinned) makes of the built extension."""
 
-import pytest
 
 import rotacal._stubgen as stubgen
 
