@@ -16,9 +16,9 @@
 #include <cstring>
 
 #include "rotacal/ballbar/identify.hpp"
-#include "rotacal/diagnose/ballbar_diagnosis.hpp"
 #include "rotacal/ballbar/simulate.hpp"
 #include "rotacal/ballbar/timeline.hpp"
+#include "rotacal/diagnose/ballbar_diagnosis.hpp"
 
 using namespace rotacal;
 
@@ -41,9 +41,12 @@ int main(int argc, char** argv) {
   long target = 600000;
   bool diagnose = false;
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--samples") && i + 1 < argc) target = std::atol(argv[++i]);
-    else if (!std::strcmp(argv[i], "--smoke")) target = 20000;
-    else if (!std::strcmp(argv[i], "--diagnose")) diagnose = true;
+    if (!std::strcmp(argv[i], "--samples") && i + 1 < argc)
+      target = std::atol(argv[++i]);
+    else if (!std::strcmp(argv[i], "--smoke"))
+      target = 20000;
+    else if (!std::strcmp(argv[i], "--diagnose"))
+      diagnose = true;
     else {
       std::fprintf(stderr, "usage: ballbar_long [--samples N] [--smoke] [--diagnose]\n");
       return 2;
@@ -55,11 +58,13 @@ int main(int argc, char** argv) {
   const int probe = 20000;
   for (int k = 0; k < probe; ++k)
     in_tests += timeline.at(timeline.duration() * k / probe).test != "transition";
-  const long total = static_cast<long>(1.01 * static_cast<double>(target) * probe / std::max(in_tests, 1L)) + 1;
+  const long total =
+      static_cast<long>(1.01 * static_cast<double>(target) * probe / std::max(in_tests, 1L)) + 1;
   BallbarSession commanded = timeline.header();
   commanded.samples.reserve(static_cast<std::size_t>(target) + 1000);
   for (long k = 0; k < total && static_cast<long>(commanded.samples.size()) < target; ++k) {
-    BallbarSample s = timeline.at(timeline.duration() * static_cast<double>(k) / static_cast<double>(total));
+    BallbarSample s =
+        timeline.at(timeline.duration() * static_cast<double>(k) / static_cast<double>(total));
     if (s.test != "transition") commanded.samples.push_back(std::move(s));
   }
   BallbarMachineModel truth;
@@ -76,12 +81,14 @@ int main(int argc, char** argv) {
   const double c0 = cpu_seconds();
   if (diagnose) {
     const Diagnosis D = diagnose_ballbar(std::move(session));  // as a caller done with it would
-    std::printf("ballbar_long: %zu samples; diagnose_ballbar: %.2f s wall, %.2f s CPU, %zu finding(s)%s%s\n",
-                n_samples, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
-                cpu_seconds() - c0, D.findings.size(), D.findings.empty() ? "" : ", first ",
-                D.findings.empty() ? "" : D.findings[0].effect.id().c_str());
-    std::printf("  peak RSS: %.0f MB after building the session, %.0f MB after the diagnosis\n", rss_before,
-                peak_rss_mb());
+    std::printf(
+        "ballbar_long: %zu samples; diagnose_ballbar: %.2f s wall, %.2f s CPU, %zu "
+        "finding(s)%s%s\n",
+        n_samples, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+        cpu_seconds() - c0, D.findings.size(), D.findings.empty() ? "" : ", first ",
+        D.findings.empty() ? "" : D.findings[0].effect.id().c_str());
+    std::printf("  peak RSS: %.0f MB after building the session, %.0f MB after the diagnosis\n",
+                rss_before, peak_rss_mb());
     return 0;
   }
   const BallbarIdentification id = identify_joint(session);
@@ -89,12 +96,17 @@ int main(int argc, char** argv) {
   const double cpu = cpu_seconds() - c0;
   double worst = 0.0;
   for (int j = 0; j < 8; ++j)
-    worst = std::max(worst, std::abs(id.parameters[static_cast<std::size_t>(j)].value - truth.errors.v[j]) /
-                                id.parameters[static_cast<std::size_t>(j)].std);
-  std::printf("ballbar_long: %zu samples over %.0f s of program (%.0f Hz)\n", session.samples.size(),
-              timeline.duration(), static_cast<double>(total) / timeline.duration());
-  std::printf("  identify_joint: %.2f s wall, %.2f s CPU (%d Jacobian and %d residual evaluations), converged %s\n",
-              s, cpu, id.summary.jacobian_evaluations, id.summary.residual_evaluations, id.converged ? "yes" : "no");
+    worst = std::max(
+        worst, std::abs(id.parameters[static_cast<std::size_t>(j)].value - truth.errors.v[j]) /
+                   id.parameters[static_cast<std::size_t>(j)].std);
+  std::printf("ballbar_long: %zu samples over %.0f s of program (%.0f Hz)\n",
+              session.samples.size(), timeline.duration(),
+              static_cast<double>(total) / timeline.duration());
+  std::printf(
+      "  identify_joint: %.2f s wall, %.2f s CPU (%d Jacobian and %d residual evaluations), "
+      "converged %s\n",
+      s, cpu, id.summary.jacobian_evaluations, id.summary.residual_evaluations,
+      id.converged ? "yes" : "no");
   std::printf("  residual RMS %.3f um (noise 0.500); largest |estimate - truth| %.2f sigma\n",
               id.residual_rms_um, worst);
   std::printf("  peak RSS: %.0f MB after building the session, %.0f MB after the fit\n", rss_before,

@@ -10,6 +10,7 @@ draws).
 Usage: python bench/ballbar_speed.py [SESSION.csv] [--repeat N] [--draws N]
        python bench/ballbar_speed.py --smoke   # every timing once, 10 draws: that it runs (CI)
 """
+
 from __future__ import annotations
 
 import argparse
@@ -35,7 +36,7 @@ def rotate_about_line(point, direction, theta, q):
 
 def residuals(x, xyz, tilt, rot, length):
     e, pivot = x[:8], x[8:]
-    a_point, a_dir = np.array([0.0, e[0], e[1]]), np.array([1.0, e[3], -e[2]])      # formats.md, AC-trt
+    a_point, a_dir = np.array([0.0, e[0], e[1]]), np.array([1.0, e[3], -e[2]])  # formats.md, AC-trt
     c_point, c_dir = np.array([e[4], e[5], 0.0]), np.array([e[7], -e[6], 1.0])
     q = np.broadcast_to(pivot, xyz.shape)
     ball = rotate_about_line(a_point, a_dir, tilt, rotate_about_line(c_point, c_dir, rot, q))
@@ -47,7 +48,9 @@ def scipy_fit(s, tight=False):
     ang = np.radians(s.angles_deg)
     x0 = np.r_[np.zeros(8), s.pivot]
     tol = dict(xtol=1e-12, ftol=1e-12, gtol=1e-12) if tight else {}
-    return least_squares(residuals, x0, args=(s.xyz, ang[:, 0], ang[:, 1], s.length), x_scale="jac", **tol)
+    return least_squares(
+        residuals, x0, args=(s.xyz, ang[:, 0], ang[:, 1], s.length), x_scale="jac", **tol
+    )
 
 
 def residuals_per_sample(x, rows):
@@ -73,8 +76,15 @@ def residuals_per_sample(x, rows):
 def scipy_fit_per_sample(s):
     ang = np.radians(s.angles_deg)
     rows = [(*s.xyz[i], ang[i, 0], ang[i, 1], s.length[i]) for i in range(len(s))]
-    return least_squares(residuals_per_sample, np.r_[np.zeros(8), s.pivot], args=(rows,), x_scale="jac",
-                         xtol=1e-12, ftol=1e-12, gtol=1e-12)
+    return least_squares(
+        residuals_per_sample,
+        np.r_[np.zeros(8), s.pivot],
+        args=(rows,),
+        x_scale="jac",
+        xtol=1e-12,
+        ftol=1e-12,
+        gtol=1e-12,
+    )
 
 
 def medians_interleaved(fns, repeat, own_thread=(), block=1):
@@ -106,10 +116,14 @@ def medians_interleaved(fns, repeat, own_thread=(), block=1):
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("session", nargs="?", default=str(ROOT.parent / "shared" / "data" / "ballbar_ac_table2.csv"))
+    ap.add_argument(
+        "session", nargs="?", default=str(ROOT.parent / "shared" / "data" / "ballbar_ac_table2.csv")
+    )
     ap.add_argument("--repeat", type=int, default=7)
     ap.add_argument("--draws", type=int, default=1000)
-    ap.add_argument("--smoke", action="store_true", help="every timing once, 10 Monte Carlo draws (no figures)")
+    ap.add_argument(
+        "--smoke", action="store_true", help="every timing once, 10 Monte Carlo draws (no figures)"
+    )
     a = ap.parse_args()
     if a.smoke:
         a.repeat, a.draws = 1, 10
@@ -118,41 +132,65 @@ def main() -> None:
     s = rotacal.load(a.session)
     rotacal.identify(s)  # warm-up: first call pays for imports and allocations
     (t_rc, c_rc, r), (t_sp, c_sp, sp), (t_tight, c_tight, tight) = medians_interleaved(
-        [lambda: rotacal.identify(s), lambda: scipy_fit(s), lambda: scipy_fit(s, tight=True)], a.repeat,
-        own_thread=(0,))
+        [lambda: rotacal.identify(s), lambda: scipy_fit(s), lambda: scipy_fit(s, tight=True)],
+        a.repeat,
+        own_thread=(0,),
+    )
     (t_rc_w, c_rc_w, _), (t_sp_w, c_sp_w, _) = medians_interleaved(
-        [lambda: rotacal.identify(s), lambda: scipy_fit(s)], a.repeat, own_thread=(0,), block=5)
+        [lambda: rotacal.identify(s), lambda: scipy_fit(s)], a.repeat, own_thread=(0,), block=5
+    )
     ((t_loop, c_loop, loop),) = medians_interleaved([lambda: scipy_fit_per_sample(s)], 1)
-    ((t_mc, c_mc, mc),) = medians_interleaved([lambda: rotacal._core.monte_carlo_joint(s, r.raw, a.draws)], 1,
-                                              own_thread=(0,))
+    ((t_mc, c_mc, mc),) = medians_interleaved(
+        [lambda: rotacal._core.monte_carlo_joint(s, r.raw, a.draws)], 1, own_thread=(0,)
+    )
     d = r.to_dict()
     names = list(d["location_errors"])
 
     def worst(x):
-        return max(abs(x[k] - d["location_errors"][n]["value"]) / d["location_errors"][n]["std"]
-                   for k, n in enumerate(names))
+        return max(
+            abs(x[k] - d["location_errors"][n]["value"]) / d["location_errors"][n]["std"]
+            for k, n in enumerate(names)
+        )
 
     summary = r.raw.summary
-    print(f"ballbar_speed: {Path(a.session).name}, {len(s)} samples, median of {a.repeat} runs each (wall; CPU)")
-    print(f"  rotacal joint fit (+ covariance and observability), {summary.jacobian_evaluations} Jacobian "
-          f"+ {summary.residual_evaluations} residual evaluations: {t_rc * 1e3:8.2f} ms; {c_rc * 1e3:.2f} ms")
-    print(f"  SciPy least_squares, default tolerances (2-point Jacobian, x_scale='jac'):     "
-          f"{t_sp * 1e3:8.2f} ms; {c_sp * 1e3:.2f} ms ({sp.nfev} evaluations)")
-    print(f"  SciPy least_squares, xtol=ftol=gtol=1e-12 (second row):                       "
-          f"{t_tight * 1e3:8.2f} ms; {c_tight * 1e3:.2f} ms ({tight.nfev} evaluations)")
-    print(f"  SciPy least_squares, the model sample by sample in plain Python (one run):    "
-          f"{t_loop * 1e3:8.2f} ms ({loop.nfev} evaluations)")
-    print(f"  speed-up over SciPy with default tolerances, one call each in turn: {t_sp / t_rc:.1f}x wall, "
-          f"{c_sp / c_rc:.1f}x CPU (target >= 30x); over 1e-12: {t_tight / t_rc:.1f}x; over the per-sample "
-          f"model: {t_loop / t_rc:.0f}x")
-    print(f"  the same, 5 calls in a row per turn (warm caches, as in a loop over sessions): rotacal "
-          f"{t_rc_w * 1e3:.2f} ms, SciPy {t_sp_w * 1e3:.2f} ms: {t_sp_w / t_rc_w:.1f}x wall, "
-          f"{c_sp_w / c_rc_w:.1f}x CPU (target >= 30x)")
-    print(f"  largest difference between the solutions: default {worst(sp.x):.4f} sigma, "
-          f"1e-12 {worst(tight.x):.5f} sigma")
+    print(
+        f"ballbar_speed: {Path(a.session).name}, {len(s)} samples, median of {a.repeat} runs each (wall; CPU)"
+    )
+    print(
+        f"  rotacal joint fit (+ covariance and observability), {summary.jacobian_evaluations} Jacobian "
+        f"+ {summary.residual_evaluations} residual evaluations: {t_rc * 1e3:8.2f} ms; {c_rc * 1e3:.2f} ms"
+    )
+    print(
+        f"  SciPy least_squares, default tolerances (2-point Jacobian, x_scale='jac'):     "
+        f"{t_sp * 1e3:8.2f} ms; {c_sp * 1e3:.2f} ms ({sp.nfev} evaluations)"
+    )
+    print(
+        f"  SciPy least_squares, xtol=ftol=gtol=1e-12 (second row):                       "
+        f"{t_tight * 1e3:8.2f} ms; {c_tight * 1e3:.2f} ms ({tight.nfev} evaluations)"
+    )
+    print(
+        f"  SciPy least_squares, the model sample by sample in plain Python (one run):    "
+        f"{t_loop * 1e3:8.2f} ms ({loop.nfev} evaluations)"
+    )
+    print(
+        f"  speed-up over SciPy with default tolerances, one call each in turn: {t_sp / t_rc:.1f}x wall, "
+        f"{c_sp / c_rc:.1f}x CPU (target >= 30x); over 1e-12: {t_tight / t_rc:.1f}x; over the per-sample "
+        f"model: {t_loop / t_rc:.0f}x"
+    )
+    print(
+        f"  the same, 5 calls in a row per turn (warm caches, as in a loop over sessions): rotacal "
+        f"{t_rc_w * 1e3:.2f} ms, SciPy {t_sp_w * 1e3:.2f} ms: {t_sp_w / t_rc_w:.1f}x wall, "
+        f"{c_sp_w / c_rc_w:.1f}x CPU (target >= 30x)"
+    )
+    print(
+        f"  largest difference between the solutions: default {worst(sp.x):.4f} sigma, "
+        f"1e-12 {worst(tight.x):.5f} sigma"
+    )
     ratios = [p.ratio for p in mc.parameters]
-    print(f"  Monte Carlo check in C++, {a.draws} draws: {t_mc:.2f} s wall, {c_mc:.2f} s CPU "
-          f"(target <= 3 s); sigma_MC / sigma_reported {min(ratios):.2f}-{max(ratios):.2f}")
+    print(
+        f"  Monte Carlo check in C++, {a.draws} draws: {t_mc:.2f} s wall, {c_mc:.2f} s CPU "
+        f"(target <= 3 s); sigma_MC / sigma_reported {min(ratios):.2f}-{max(ratios):.2f}"
+    )
 
 
 if __name__ == "__main__":

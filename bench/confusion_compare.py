@@ -13,6 +13,7 @@ floats that a change which reorders arithmetic moves in the last digits.
 Exit status 1 where any session differs (or the plans do), 0 where every one is the same: a
 speed-up that claims to change no outcome is checked so.
 """
+
 import argparse
 import json
 import statistics
@@ -26,17 +27,31 @@ DECIDED = ("outcome", "findings", "z", "coverage")
 
 def decision(r: dict) -> tuple:
     """What a session told the engineer, without the floats (--decisions)."""
-    return (r["outcome"], [(f["effect"], f["named"], sorted(f["group"])) for f in r["findings"]],
-            r.get("coverage"))
+    return (
+        r["outcome"],
+        [(f["effect"], f["named"], sorted(f["group"])) for f in r["findings"]],
+        r.get("coverage"),
+    )
 
 
 def shown(r: dict) -> list:
     """Each finding's name, with the size of its group where it is not named alone."""
-    return [x["effect"] + ("" if x["named"] else f" (group of {len(x['group'])})") for x in r["findings"]]
+    return [
+        x["effect"] + ("" if x["named"] else f" (group of {len(x['group'])})")
+        for x in r["findings"]
+    ]
 
 
 def key(r: dict) -> tuple:
-    return (r["machine"], r["instrument"], r["entry"] or "", r["noise"], r["amp"], r["draw"], r["seed"])
+    return (
+        r["machine"],
+        r["instrument"],
+        r["entry"] or "",
+        r["noise"],
+        r["amp"],
+        r["draw"],
+        r["seed"],
+    )
 
 
 def kind(r: dict) -> str:
@@ -53,18 +68,25 @@ def medians(records: list) -> dict:
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     p.add_argument("before")
     p.add_argument("after")
     p.add_argument("--show", type=int, default=10, help="differing sessions printed (default 10)")
-    p.add_argument("--decisions", action="store_true",
-                   help="compare outcome, names, groups and coverage only, not weights and z")
+    p.add_argument(
+        "--decisions",
+        action="store_true",
+        help="compare outcome, names, groups and coverage only, not weights and z",
+    )
     a = p.parse_args(argv)
     docs = [json.loads(Path(f).read_text()) for f in (a.before, a.after)]
     recs = [{key(r): r for r in d["records"]} for d in docs]
     only = [set(recs[0]) - set(recs[1]), set(recs[1]) - set(recs[0])]
     if only[0] or only[1]:
-        print(f"plans differ: {len(only[0])} sessions only in {a.before}, {len(only[1])} only in {a.after}")
+        print(
+            f"plans differ: {len(only[0])} sessions only in {a.before}, {len(only[1])} only in {a.after}"
+        )
     diffs = []
     for k in sorted(set(recs[0]) & set(recs[1]), key=str):
         b, f = recs[0][k], recs[1][k]
@@ -77,9 +99,13 @@ def main(argv=None) -> int:
     common = len(set(recs[0]) & set(recs[1]))
     print(f"{common} sessions in both, {len(diffs)} differ in what they decided")
     for k, changed, b, f in diffs[: a.show]:
-        print(f"  {k}: {', '.join(changed)}: {b['outcome']} {shown(b)} -> {f['outcome']} {shown(f)}")
+        print(
+            f"  {k}: {', '.join(changed)}: {b['outcome']} {shown(b)} -> {f['outcome']} {shown(f)}"
+        )
     m = [medians(d["records"]) for d in docs]
-    print(f"\nmedian CPU ms per diagnosis (thread time)\n  {'':29s} {'before':>8s} {'after':>8s} {'n':>5s}")
+    print(
+        f"\nmedian CPU ms per diagnosis (thread time)\n  {'':29s} {'before':>8s} {'after':>8s} {'n':>5s}"
+    )
     for k in sorted(set(m[0]) | set(m[1])):
         b, f = m[0].get(k, (float("nan"), 0)), m[1].get(k, (float("nan"), 0))
         print(f"  {k:29s} {b[0]:8.0f} {f[0]:8.0f} {max(b[1], f[1]):5d}")

@@ -21,6 +21,7 @@ default poses at the default sphere and the same 120 touches on the built-in mac
     PYTHONPATH=... python bench/design_bench.py            # the default grid, 100 draws
     PYTHONPATH=... python bench/design_bench.py --smoke    # a 2 x 2 grid, 3 draws: that it runs (CI)
 """
+
 from __future__ import annotations
 
 import argparse
@@ -46,8 +47,10 @@ def main() -> None:
     elapsed = time.perf_counter() - t0
     print(f"design: {len(d.candidates)} set-ups in {elapsed:.2f} s (target <= 10 s)")
     for label, c in (("designed", d.best), ("default", d.baseline)):
-        print(f"{label:9s} L0 {c.setup.ballbar_length:g} mm, pivot {tuple(float(v) for v in c.setup.pivot)}: "
-              f"largest U (k=2) {c.worst_expanded_um:.4f} um ({c.worst_error}) at {d.time_budget_s:.0f} s")
+        print(
+            f"{label:9s} L0 {c.setup.ballbar_length:g} mm, pivot {tuple(float(v) for v in c.setup.pivot)}: "
+            f"largest U (k=2) {c.worst_expanded_um:.4f} um ({c.worst_error}) at {d.time_budget_s:.0f} s"
+        )
     print(f"ratio designed / default at the same run time: {d.ratio:.3f} (target <= 0.7)")
 
     # Monte Carlo at the plan's own sampling: the recorder rate that records the plan's samples.
@@ -57,12 +60,19 @@ def main() -> None:
     t = np.asarray(cmd.time)
     tests = np.asarray(cmd.tests, dtype=object)
     t_tests = sum(t[tests == lab].max() - t[tests == lab].min() for lab in dict.fromkeys(tests))
-    check = design_ballbar(setup, lengths=[setup.ballbar_length], pivot_x=[setup.pivot[0]],
-                           pivot_z=[setup.pivot[2]], rate_hz=len(cmd) / t_tests, noise_um=0.5)
+    check = design_ballbar(
+        setup,
+        lengths=[setup.ballbar_length],
+        pivot_x=[setup.pivot[0]],
+        pivot_z=[setup.pivot[2]],
+        rate_hz=len(cmd) / t_tests,
+        noise_um=0.5,
+    )
     predicted = np.asarray(check.best.sigma)[:8]
     names = list(_core.location_error_names(setup.machine))
-    truth = _core.BallbarMachineModel(setup.machine, np.array([TABLE2_ERRORS[n] for n in names]),
-                                      np.asarray(setup.pivot), [], [])
+    truth = _core.BallbarMachineModel(
+        setup.machine, np.array([TABLE2_ERRORS[n] for n in names]), np.asarray(setup.pivot), [], []
+    )
     est = []
     for k in range(draws):
         s = _core.simulate_ballbar(cmd, truth, 0.5, 100 + k, True)
@@ -70,7 +80,9 @@ def main() -> None:
         est.append([p.value for p in ident.parameters[:8]])
     realised = np.std(np.asarray(est), axis=0, ddof=1)
     ratio = realised / predicted
-    print(f"Monte Carlo sigma / predicted over {draws} draws: {ratio.min():.2f}-{ratio.max():.2f} (target 0.7-1.4)")
+    print(
+        f"Monte Carlo sigma / predicted over {draws} draws: {ratio.min():.2f}-{ratio.max():.2f} (target 0.7-1.4)"
+    )
     separation(draws)
     rtest_design(draws)
     probe_design()
@@ -91,8 +103,14 @@ def separation(draws: int) -> None:
     errors = np.array([TABLE2_ERRORS[n] for n in names])
 
     def truth_of(cmd):  # the Table 2 machine with hidden C error motions (um, urad)
-        return _core.BallbarMachineModel(cmd.machine, errors, np.asarray(cmd.pivot), SEPARATE,
-                                         [1e-3, -0.6e-3, 0.0, 0.0, 3e-6, -2e-6])
+        return _core.BallbarMachineModel(
+            cmd.machine,
+            errors,
+            np.asarray(cmd.pivot),
+            SEPARATE,
+            [1e-3, -0.6e-3, 0.0, 0.0, 3e-6, -2e-6],
+        )
+
     base = _core.BallbarSetup()
     base.step_deg = 2.0
     cmd = _core.plan_ballbar_test(base, None).commanded_session()
@@ -104,11 +122,15 @@ def separation(draws: int) -> None:
     d = _core.design_ballbar_separation(session, SEPARATE, o)
     elapsed = time.perf_counter() - t0
     c = d.chosen
-    print(f"separate {SEPARATE[0]} / {SEPARATE[1]} after a Table 2 session (AR(1) rho {rho}): "
-          f"{d.candidates_tried} added tests in {elapsed:.2f} s (target <= 10 s)")
+    print(
+        f"separate {SEPARATE[0]} / {SEPARATE[1]} after a Table 2 session (AR(1) rho {rho}): "
+        f"{d.candidates_tried} added tests in {elapsed:.2f} s (target <= 10 s)"
+    )
     print(f"  {d.verdict}")
-    print(f"  correlation {d.correlation_before:.2f} -> {c.correlation:.2f} (target < 0.5) with one added test of "
-          f"{c.duration_s * c.slow_down:.0f} s (target <= 600 s)")
+    print(
+        f"  correlation {d.correlation_before:.2f} -> {c.correlation:.2f} (target < 0.5) with one added test of "
+        f"{c.duration_s * c.slow_down:.0f} s (target <= 600 s)"
+    )
     # Monte Carlo: the session and the added test (run slower: more readings) simulated again
     # and fitted jointly; the spread of every determined estimate against its prediction.
     added = c.setup
@@ -116,23 +138,28 @@ def separation(draws: int) -> None:
     add_cmd = _core.plan_ballbar_test(added, None).commanded_session()
     est = []
     for k in range(draws):
-        v, _, _ = _core.identify_joint_sessions([recorded(cmd, truth_of, rho, 1000 + k),
-                                                 recorded(add_cmd, truth_of, rho, 5000 + k)], SEPARATE)
+        v, _, _ = _core.identify_joint_sessions(
+            [recorded(cmd, truth_of, rho, 1000 + k), recorded(add_cmd, truth_of, rho, 5000 + k)],
+            SEPARATE,
+        )
         # fit order: 8 location, pivots, effects; design order: 8 location, pivot, effects, moved pivot
         ne = len(v) - 11 - (3 if c.new_pivot else 0)
-        est.append(np.concatenate([v[:11], v[len(v) - ne:], v[11:14] if c.new_pivot else []]))
+        est.append(np.concatenate([v[:11], v[len(v) - ne :], v[11:14] if c.new_pivot else []]))
     realised = np.std(np.asarray(est), axis=0, ddof=1)
     predicted = np.asarray(d.sigma_after)
     ok = np.isfinite(predicted)
     ratio = realised[ok] / predicted[ok]
-    print(f"  Monte Carlo sigma / predicted of the {ok.sum()} determined parameters over {draws} draws: "
-          f"{ratio.min():.2f}-{ratio.max():.2f} (target 0.7-1.4)")
+    print(
+        f"  Monte Carlo sigma / predicted of the {ok.sum()} determined parameters over {draws} draws: "
+        f"{ratio.min():.2f}-{ratio.max():.2f} (target 0.7-1.4)"
+    )
     t0 = time.perf_counter()
     g = _core.design_ballbar_separation(session, ["gravity_sag_A", "radial_motion_A_h2"], o)
-    print(f"gravity_sag_A / radial_motion_A_h2 in {time.perf_counter() - t0:.2f} s: "
-          f"{'inseparable' if g.motion.same_motion else 'separable'} (target: inseparable)")
+    print(
+        f"gravity_sag_A / radial_motion_A_h2 in {time.perf_counter() - t0:.2f} s: "
+        f"{'inseparable' if g.motion.same_motion else 'separable'} (target: inseparable)"
+    )
     print(f"  {g.verdict}")
-
 
 
 def rtest_design(draws: int) -> None:
@@ -144,44 +171,65 @@ def rtest_design(draws: int) -> None:
     print(f"R-test design: {len(d.candidates)} patterns in {elapsed:.2f} s (target <= 10 s)")
     for label, c in (("designed", d.best), ("default", d.baseline)):
         p = c.pattern
-        print(f"  {label:9s} nests {[tuple(float(v) for v in n) for n in p.nests]}, B {len(p.b_deg)} x C {len(p.c_deg)}, "
-              f"{c.duration_s:.0f} s: largest U (k=2) {c.worst_expanded_um:.4f} um ({c.worst_error})")
+        print(
+            f"  {label:9s} nests {[tuple(float(v) for v in n) for n in p.nests]}, B {len(p.b_deg)} x C {len(p.c_deg)}, "
+            f"{c.duration_s:.0f} s: largest U (k=2) {c.worst_expanded_um:.4f} um ({c.worst_error})"
+        )
     print(f"  ratio designed / default at {d.time_budget_s:.0f} s: {d.ratio:.3f}")
     # Monte Carlo of the designed pattern at its own run time (no repeats), AR(1) noise.
-    c = _core.evaluate_rtest_design(d.best.pattern, o, 0.0) if hasattr(_core, "evaluate_rtest_design") else None
+    c = (
+        _core.evaluate_rtest_design(d.best.pattern, o, 0.0)
+        if hasattr(_core, "evaluate_rtest_design")
+        else None
+    )
     if c is None:
         return
     p = c.pattern
     est = []
     for k in range(draws):
         s, _ = rtest_session(p, k)
-        e = _core.noise_ar1(np.repeat(s.setups, 3).tolist(), np.repeat(s.time, 3).tolist(), o.noise_rho,
-                            o.noise_um * 1e-3, 900 + k).reshape(-1, 3)
+        e = _core.noise_ar1(
+            np.repeat(s.setups, 3).tolist(),
+            np.repeat(s.time, 3).tolist(),
+            o.noise_rho,
+            o.noise_um * 1e-3,
+            900 + k,
+        ).reshape(-1, 3)
         s = s.with_displacements(np.asarray(s.d) + e)
         ident = _core.identify_rtest_joint(s, noise="auto")  # GLS under the fitted AR model
         est.append([p_.value for p_ in ident.parameters[:8]])
     ratio = np.std(np.asarray(est), axis=0, ddof=1) / np.asarray(c.sigma)[:8]
-    print(f"  Monte Carlo sigma / predicted of the designed pattern over {draws} draws: "
-          f"{ratio.min():.2f}-{ratio.max():.2f} (target 0.7-1.4)")
+    print(
+        f"  Monte Carlo sigma / predicted of the designed pattern over {draws} draws: "
+        f"{ratio.min():.2f}-{ratio.max():.2f} (target 0.7-1.4)"
+    )
     # After an R-test session of the default pattern (noise 0.3 um): the nest that separates
     # axial from tilt motion of C, and gravity sag from the second radial harmonic of B.
     s, _ = rtest_session(o.base, 0)
-    s = s.with_displacements(np.asarray(s.d) + np.random.default_rng(5).normal(0.0, 0.3e-3, np.asarray(s.d).shape))
-    for pair in (["axial_motion_C_h2", "tilt_motion_C_h2"], ["gravity_sag_B", "radial_motion_B_h2"]):
+    s = s.with_displacements(
+        np.asarray(s.d) + np.random.default_rng(5).normal(0.0, 0.3e-3, np.asarray(s.d).shape)
+    )
+    for pair in (
+        ["axial_motion_C_h2", "tilt_motion_C_h2"],
+        ["gravity_sag_B", "radial_motion_B_h2"],
+    ):
         t0 = time.perf_counter()
         sep = _core.design_rtest_separation(s, pair)
         took = f"{sep.candidates_tried} added nests in {time.perf_counter() - t0:.2f} s"
         if sep.motion.same_motion:
             print(f"R-test separate {pair[0]} / {pair[1]}: inseparable (same table motion), {took}")
         else:
-            print(f"R-test separate {pair[0]} / {pair[1]}: {took}; correlation {sep.correlation_before:.2f} -> "
-                  f"{sep.chosen.correlation:.2f} with {sep.chosen.duration_s * sep.chosen.repeats:.0f} s")
+            print(
+                f"R-test separate {pair[0]} / {pair[1]}: {took}; correlation {sep.correlation_before:.2f} -> "
+                f"{sep.chosen.correlation:.2f} with {sep.chosen.duration_s * sep.chosen.repeats:.0f} s"
+            )
         print(f"  {sep.verdict[:200]}")
 
 
 def probe_design() -> None:
     from rotacal.design import design_probe
     from rotacal.machines import load_machine
+
     for name in ("AC-trt", "BC-trt", "B45C-trt", "B-head-C-table", "AC-head"):
         t0, c0 = time.perf_counter(), time.process_time()
         d = design_probe(load_machine(name))
@@ -189,20 +237,42 @@ def probe_design() -> None:
         b = d.baseline
         default = f"{b.worst_expanded_um:.3f} um ({b.worst_error})" if b.feasible else b.why_not
         sphere = ", ".join(f"{v:g}" for v in d.sphere)
-        print(f"probe design {name}: {d.poses_tried} poses, {d.touches_tried} touches tried, {len(d.spheres)} sphere "
-              f"places in {cpu:.2f} s CPU ({took:.2f} s wall); sphere at {sphere}; {d.touches} touches, designed "
-              f"{d.best.worst_expanded_um:.3f} um ({d.best.worst_error}) / default {default}: ratio {d.ratio:.3f}")
+        print(
+            f"probe design {name}: {d.poses_tried} poses, {d.touches_tried} touches tried, {len(d.spheres)} sphere "
+            f"places in {cpu:.2f} s CPU ({took:.2f} s wall); sphere at {sphere}; {d.touches} touches, designed "
+            f"{d.best.worst_expanded_um:.3f} um ({d.best.worst_error}) / default {default}: ratio {d.ratio:.3f}"
+        )
 
 
 def rtest_session(p, k: int):
     from rotacal import rtest
-    errors = {"E_X0B": 0.02, "E_Z0B": -0.015, "E_A0B": 3e-5, "E_C0B": -2e-5, "E_X0C": 0.01, "E_Y0C": 0.025,
-              "E_A0C": 1.5e-5, "E_B0C": -4e-5}
-    return rtest.simulate_rtest(errors, {}, machine="BC-trt", b_deg=list(p.b_deg), c_deg=list(p.c_deg),
-                                # the noise is added as AR(1) by the caller; 1e-6 um white here only
-                                # so that the session declares a noise level (the fit needs one)
-                                nests=[list(map(float, n)) for n in p.nests], noise_um=1e-6, probe_zero_um=20.0,
-                                probe_dirs=None, write_d=True, dwell_s=p.dwell_s, seed=100 + k)
+
+    errors = {
+        "E_X0B": 0.02,
+        "E_Z0B": -0.015,
+        "E_A0B": 3e-5,
+        "E_C0B": -2e-5,
+        "E_X0C": 0.01,
+        "E_Y0C": 0.025,
+        "E_A0C": 1.5e-5,
+        "E_B0C": -4e-5,
+    }
+    return rtest.simulate_rtest(
+        errors,
+        {},
+        machine="BC-trt",
+        b_deg=list(p.b_deg),
+        c_deg=list(p.c_deg),
+        # the noise is added as AR(1) by the caller; 1e-6 um white here only
+        # so that the session declares a noise level (the fit needs one)
+        nests=[list(map(float, n)) for n in p.nests],
+        noise_um=1e-6,
+        probe_zero_um=20.0,
+        probe_dirs=None,
+        write_d=True,
+        dwell_s=p.dwell_s,
+        seed=100 + k,
+    )
 
 
 if __name__ == "__main__":

@@ -5,7 +5,8 @@
 // Targets (issue 11): false findings <= 5 %; white null 0; named first >= 90 % at three times
 // the white-noise half-detection amplitude; time with the noise model <= 1.3x white.
 //
-// Usage: diagnose_realistic_bench [--null N] [--trials N] [--rho R (0 white, -1 1/f-like)] [--smoke]
+// Usage: diagnose_realistic_bench [--null N] [--trials N] [--rho R (0 white, -1 1/f-like)]
+// [--smoke]
 //        [--list]  (names each false finding: which effects the noise imitates)
 // (--smoke: one null session per noise kind, every 4th catalogue effect hidden once per rho, to
 // show the bench runs.)
@@ -17,13 +18,13 @@
 #include <random>
 #include <string>
 
-#include "rotacal/ballbar/simulate.hpp"
+#include "../tests/support/detection_amplitude.hpp"
+#include "../tests/support/synthetic_sessions.hpp"
 #include "rotacal/ballbar/plan.hpp"
+#include "rotacal/ballbar/simulate.hpp"
 #include "rotacal/core/least_squares.hpp"
 #include "rotacal/core/noise_model.hpp"
 #include "rotacal/diagnose/ballbar_diagnosis.hpp"
-#include "../tests/support/detection_amplitude.hpp"
-#include "../tests/support/synthetic_sessions.hpp"
 
 using namespace rotacal;
 
@@ -84,7 +85,8 @@ double oracle_detection(const BallbarSession& cmd, const BallbarMachineModel& tr
   const Eigen::VectorXd left = s - J * J.completeOrthogonalDecomposition().solve(s);
   const double lambda = left.squaredNorm();
   const int k = static_cast<int>(truth.effect_params.size());
-  const double need = -DiagnosisOptions{}.min_delta_bic + k * std::log(static_cast<double>(sig.size()));
+  const double need =
+      -DiagnosisOptions{}.min_delta_bic + k * std::log(static_cast<double>(sig.size()));
   std::normal_distribution<double> N(0.0, 1.0);
   int hit = 0;
   const int draws = 4000;
@@ -107,19 +109,27 @@ int main(int argc, char** argv) {
   bool list = false;
   std::vector<double> rhos = {0.0, 0.5, 0.9, 0.95, -1.0};  // 0: white, -1: 1/f-like
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--null") && i + 1 < argc) n_null = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--trials") && i + 1 < argc) trials = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--smoke")) n_null = 1, trials = 1, effect_stride = 4;
-    else if (!std::strcmp(argv[i], "--list")) list = true;
-    else if (!std::strcmp(argv[i], "--rho") && i + 1 < argc) rhos = {std::atof(argv[++i])};
+    if (!std::strcmp(argv[i], "--null") && i + 1 < argc)
+      n_null = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--trials") && i + 1 < argc)
+      trials = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--smoke"))
+      n_null = 1, trials = 1, effect_stride = 4;
+    else if (!std::strcmp(argv[i], "--list"))
+      list = true;
+    else if (!std::strcmp(argv[i], "--rho") && i + 1 < argc)
+      rhos = {std::atof(argv[++i])};
     else {
-      std::fprintf(stderr, "usage: diagnose_realistic_bench [--null N] [--trials N] [--rho R] [--smoke] [--list]\n");
+      std::fprintf(
+          stderr,
+          "usage: diagnose_realistic_bench [--null N] [--trials N] [--rho R] [--smoke] [--list]\n");
       return 2;
     }
   }
   const BallbarSession cmd = commanded_session(plan_ballbar_test(BallbarSetup{}));
-  std::printf("diagnose_realistic_bench: AC-trt single set-up, %zu samples, marginal noise %.1f um\n",
-              cmd.samples.size(), kNoiseUm);
+  std::printf(
+      "diagnose_realistic_bench: AC-trt single set-up, %zu samples, marginal noise %.1f um\n",
+      cmd.samples.size(), kNoiseUm);
   std::printf("%-22s %14s %14s %12s %12s %9s\n", "null sessions", "findings(AR)", "findings(wht)",
               "unexplained", "median ms", "ms white");
   DiagnosisOptions white;
@@ -131,7 +141,9 @@ int main(int argc, char** argv) {
     int fm = 0, fw = 0, un = 0;
     std::vector<double> ms, ms_white;
     for (int k = 0; k < n_null; ++k) {
-      const BallbarSession s = synthetic::noisy_ballbar(cmd, synthetic::random_ballbar_machine(cmd, rng), rho, kNoiseUm, static_cast<std::uint64_t>(k + 1));
+      const BallbarSession s =
+          synthetic::noisy_ballbar(cmd, synthetic::random_ballbar_machine(cmd, rng), rho, kNoiseUm,
+                                   static_cast<std::uint64_t>(k + 1));
       auto t0 = std::chrono::steady_clock::now();
       const Diagnosis D = diagnose_ballbar(s);
       ms.push_back(ms_since(t0));
@@ -140,8 +152,9 @@ int main(int argc, char** argv) {
       ms_white.push_back(ms_since(t0));
       fm += !D.findings.empty();
       if (list && !D.findings.empty())
-        std::printf("  session %d: %s (F-test p %.2g, delta BIC %.1f)\n", k + 1, D.findings[0].effect.id().c_str(),
-                    D.findings[0].gain.f_pvalue, D.findings[0].gain.delta_bic);
+        std::printf("  session %d: %s (F-test p %.2g, delta BIC %.1f)\n", k + 1,
+                    D.findings[0].effect.id().c_str(), D.findings[0].gain.f_pvalue,
+                    D.findings[0].gain.delta_bic);
       fw += !W.findings.empty();
       un += D.unexplained.present;
     }
@@ -149,24 +162,29 @@ int main(int argc, char** argv) {
     all_ms_white.insert(all_ms_white.end(), ms_white.begin(), ms_white.end());
     std::sort(ms.begin(), ms.end());
     std::sort(ms_white.begin(), ms_white.end());
-    const std::string name = rho == 0.0 ? "white" : rho < 0 ? "1/f-like" : "AR(1) rho " + std::to_string(rho).substr(0, 4);
-    std::printf("%-22s %8d/%-5d %8d/%-5d %6d/%-5d %12.0f %9.0f\n", name.c_str(), fm, n_null, fw, n_null, un,
-                n_null, ms[ms.size() / 2], ms_white[ms_white.size() / 2]);
+    const std::string name = rho == 0.0 ? "white"
+                             : rho < 0  ? "1/f-like"
+                                        : "AR(1) rho " + std::to_string(rho).substr(0, 4);
+    std::printf("%-22s %8d/%-5d %8d/%-5d %6d/%-5d %12.0f %9.0f\n", name.c_str(), fm, n_null, fw,
+                n_null, un, n_null, ms[ms.size() / 2], ms_white[ms_white.size() / 2]);
   }
 
   if (!all_ms.empty()) {
     std::sort(all_ms.begin(), all_ms.end());
     std::sort(all_ms_white.begin(), all_ms_white.end());
     const double a = all_ms[all_ms.size() / 2], w = all_ms_white[all_ms_white.size() / 2];
-    std::printf("median over all %zu null sessions: %.0f ms with the noise model, %.0f ms treated as white "
-                "(ratio %.2f; per noise kind above)\n", all_ms.size(), a, w, a / w);
+    std::printf(
+        "median over all %zu null sessions: %.0f ms with the noise model, %.0f ms treated as white "
+        "(ratio %.2f; per noise kind above)\n",
+        all_ms.size(), a, w, a / w);
   }
 
   // Hidden effects in AR(1) noise at 0.45 sigma RMS of unabsorbable signal: three times the
   // ~0.15 sigma at which diagnose_bench's white-noise detection passes 50 %.
   for (double rho : {0.5, 0.9}) {
-    std::printf("\nhidden effects at 0.45 sigma RMS in AR(1) rho %.2f, %d trial(s) each: named first%s\n", rho, trials,
-                effect_stride > 1 ? " (--smoke: every 4th catalogue effect)" : "");
+    std::printf(
+        "\nhidden effects at 0.45 sigma RMS in AR(1) rho %.2f, %d trial(s) each: named first%s\n",
+        rho, trials, effect_stride > 1 ? " (--smoke: every 4th catalogue effect)" : "");
     int hits = 0, done = 0;
     double oracle = 0.0;
     std::string missed;
@@ -179,11 +197,13 @@ int main(int argc, char** argv) {
       int h = 0, d = 0;
       for (int t = 0; t < trials; ++t) {
         BallbarMachineModel truth = synthetic::random_ballbar_machine(cmd, rng);
-        const std::vector<double> p = synthetic::unabsorbable_amplitude(cmd, truth, e, 0.45, kNoiseUm);
+        const std::vector<double> p =
+            synthetic::unabsorbable_amplitude(cmd, truth, e, 0.45, kNoiseUm);
         if (p.empty()) break;
         truth.effects.effects = {e};
         truth.effect_params = p;
-        const Diagnosis D = diagnose_ballbar(synthetic::noisy_ballbar(cmd, truth, rho, kNoiseUm, ++session_seed));
+        const Diagnosis D =
+            diagnose_ballbar(synthetic::noisy_ballbar(cmd, truth, rho, kNoiseUm, ++session_seed));
         ++d;
         h += named_first(D, e);
         oracle += oracle_detection(cmd, truth, rho, oracle_rng);
@@ -192,10 +212,13 @@ int main(int argc, char** argv) {
       hits += h, done += d;
       if (h < d) missed += " " + e.id() + " " + std::to_string(h) + "/" + std::to_string(d);
     }
-    std::printf("  %d of %d sessions (%.0f %%); missed:%s\n", hits, done, done ? 100.0 * hits / done : 0.0,
-                missed.empty() ? " none" : missed.c_str());
-    std::printf("  oracle bound (true noise model, exact signature, the same BIC rule, no rivals): %.1f of %d "
-                "expected (%.0f %%)\n", oracle, done, done ? 100.0 * oracle / done : 0.0);
+    std::printf("  %d of %d sessions (%.0f %%); missed:%s\n", hits, done,
+                done ? 100.0 * hits / done : 0.0, missed.empty() ? " none" : missed.c_str());
+    std::printf(
+        "  oracle bound (true noise model, exact signature, the same BIC rule, no rivals): %.1f of "
+        "%d "
+        "expected (%.0f %%)\n",
+        oracle, done, done ? 100.0 * oracle / done : 0.0);
   }
   return 0;
 }

@@ -50,6 +50,7 @@ true-covariance GLS 224 of 246).
   ... --machines AC-trt,BC-trt --noise white,ar1_0.9 --amplitudes 3,10 --draws 3 --null 30 --json out.json
   ... --tables-from out.json        (re-make the tables of a run)
 """
+
 from __future__ import annotations
 
 import argparse
@@ -69,31 +70,57 @@ from confusion.outcome import CellCache, run_session  # noqa: E402
 from confusion.setup import motion_only_entries, tempdir  # noqa: E402
 from confusion.stats import NOISE_KINDS  # noqa: E402
 
-SMOKE = {"machines": ["BC-trt"], "instruments": ["ballbar", "rtest", "probe"],
-         "entries": ["gravity_sag", "tilt_motion_C_h1", "thermal_warmup_Z"],
-         "noise": ["white", "ar1_0.9"], "amplitudes": [3.0], "draws": 2, "null": 4}
+SMOKE = {
+    "machines": ["BC-trt"],
+    "instruments": ["ballbar", "rtest", "probe"],
+    "entries": ["gravity_sag", "tilt_motion_C_h1", "thermal_warmup_Z"],
+    "noise": ["white", "ar1_0.9"],
+    "amplitudes": [3.0],
+    "draws": 2,
+    "null": 4,
+}
 CACHE: CellCache | None = None
 
 
 def parse_args(argv) -> argparse.Namespace:
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(
+        description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     p.add_argument("--smoke", action="store_true", help="a few cells, a few draws (< 60 s)")
     p.add_argument("--draws", type=int, default=10, help="draws per cell (default 10)")
-    p.add_argument("--null", type=int, default=100, help="null sessions per noise kind (default 100)")
-    p.add_argument("--noise", default="white,ar1_0.5,ar1_0.9,pink", help=f"of {','.join(NOISE_KINDS)}")
+    p.add_argument(
+        "--null", type=int, default=100, help="null sessions per noise kind (default 100)"
+    )
+    p.add_argument(
+        "--noise", default="white,ar1_0.5,ar1_0.9,pink", help=f"of {','.join(NOISE_KINDS)}"
+    )
     p.add_argument("--machines", default="AC-trt,BC-trt,B-head-C-table")
-    p.add_argument("--instruments", default="ballbar,rtest", help="of ballbar,rtest,probe (default ballbar,rtest)")
-    p.add_argument("--amplitudes", default="1,3,10", help="multiples of the half-detection amplitude")
-    p.add_argument("--entries", default="", help="comma-separated substrings of catalogue ids (default: all)")
+    p.add_argument(
+        "--instruments",
+        default="ballbar,rtest",
+        help="of ballbar,rtest,probe (default ballbar,rtest)",
+    )
+    p.add_argument(
+        "--amplitudes", default="1,3,10", help="multiples of the half-detection amplitude"
+    )
+    p.add_argument(
+        "--entries", default="", help="comma-separated substrings of catalogue ids (default: all)"
+    )
     p.add_argument("--seed", type=int, default=29)
     p.add_argument("--json", help="write every session's outcome (and the amplitudes) to this file")
     p.add_argument("--jobs", type=int, default=1, choices=(1, 2))
     p.add_argument("--no-cells", action="store_true", help="leave out the per-cell table")
     p.add_argument("--tables-from", help="print the tables of a --json file and stop")
     a = p.parse_args(argv)
-    cfg = {"machines": a.machines.split(","), "instruments": a.instruments.split(","),
-           "entries": [s for s in a.entries.split(",") if s], "noise": a.noise.split(","),
-           "amplitudes": [float(x) for x in a.amplitudes.split(",")], "draws": a.draws, "null": a.null}
+    cfg = {
+        "machines": a.machines.split(","),
+        "instruments": a.instruments.split(","),
+        "entries": [s for s in a.entries.split(",") if s],
+        "noise": a.noise.split(","),
+        "amplitudes": [float(x) for x in a.amplitudes.split(",")],
+        "draws": a.draws,
+        "null": a.null,
+    }
     if a.smoke:
         cfg.update(SMOKE)
     for nz in cfg["noise"]:
@@ -117,23 +144,49 @@ def plan(cache: CellCache, cfg: dict) -> tuple[list, list]:
             if cfg["entries"] and not any(s in eid for s in cfg["entries"]):
                 continue
             ent = cache.entry(st, eid)
-            entries.append({"machine": m, "instrument": inst, **{k: v for k, v in ent.items() if k not in ("je", "je_visible")}})
+            entries.append(
+                {
+                    "machine": m,
+                    "instrument": inst,
+                    **{k: v for k, v in ent.items() if k not in ("je", "je_visible")},
+                }
+            )
             if ent["a_half"] is None:
                 continue
             for nz in cfg["noise"]:
                 for amp in cfg["amplitudes"]:
-                    tasks += [{"machine": m, "instrument": inst, "entry": eid, "noise": nz, "amp": amp,
-                               "draw": d, "seed": cfg["seed"]} for d in range(cfg["draws"])]
+                    tasks += [
+                        {
+                            "machine": m,
+                            "instrument": inst,
+                            "entry": eid,
+                            "noise": nz,
+                            "amp": amp,
+                            "draw": d,
+                            "seed": cfg["seed"],
+                        }
+                        for d in range(cfg["draws"])
+                    ]
     for nz in cfg["noise"]:
         for d in range(cfg["null"]):
             m, inst = combos[d % len(combos)]
-            tasks.append({"machine": m, "instrument": inst, "entry": None, "noise": nz, "amp": 0.0,
-                          "draw": d, "seed": cfg["seed"]})
+            tasks.append(
+                {
+                    "machine": m,
+                    "instrument": inst,
+                    "entry": None,
+                    "noise": nz,
+                    "amp": 0.0,
+                    "draw": d,
+                    "seed": cfg["seed"],
+                }
+            )
     return entries, tasks
 
 
 def _work(task: dict) -> dict:
     import rotacal
+
     return run_session(CACHE, task, rotacal.diagnose)
 
 
@@ -153,8 +206,11 @@ def run(tasks: list, jobs: int) -> list:
             el = now - t0
             eta = el / len(out) * (len(tasks) - len(out))
             wrong = sum(r["outcome"] in ("wrong", "bad_group") for r in out)
-            print(f"[confusion] {len(out)}/{len(tasks)} sessions, {el:.0f} s, eta {eta:.0f} s, wrong {wrong}",
-                  file=sys.stderr, flush=True)
+            print(
+                f"[confusion] {len(out)}/{len(tasks)} sessions, {el:.0f} s, eta {eta:.0f} s, wrong {wrong}",
+                file=sys.stderr,
+                flush=True,
+            )
     if pool is not None:
         pool.close()
         pool.join()
@@ -171,8 +227,11 @@ def main(argv=None) -> int:
     t0 = time.time()
     CACHE = CellCache(tempdir())
     entries, tasks = plan(CACHE, cfg)
-    print(f"[confusion] {len(tasks)} sessions planned ({len(entries)} entries) in {time.time() - t0:.1f} s",
-          file=sys.stderr, flush=True)
+    print(
+        f"[confusion] {len(tasks)} sessions planned ({len(entries)} entries) in {time.time() - t0:.1f} s",
+        file=sys.stderr,
+        flush=True,
+    )
     for st in CACHE.setups.values():
         _ = st.template  # read the template files before forking
     records = run(tasks, a.jobs)
@@ -182,8 +241,15 @@ def main(argv=None) -> int:
 
     records.sort(key=key)
     motion = sorted({e for m in cfg["machines"] for e in motion_only_entries(m)})
-    doc = {"config": cfg, "motion_only": motion, "entries": entries, "records": records,
-           "wall_s": time.time() - t0, "jobs": a.jobs, "cpu_count": os.cpu_count()}
+    doc = {
+        "config": cfg,
+        "motion_only": motion,
+        "entries": entries,
+        "records": records,
+        "wall_s": time.time() - t0,
+        "jobs": a.jobs,
+        "cpu_count": os.cpu_count(),
+    }
     if a.json:
         Path(a.json).write_text(json.dumps(doc, indent=1))
     print(report.tables(doc, per_cell=not a.no_cells))

@@ -10,6 +10,7 @@ show <= 200 ms on SQLite.
 The identifications are one real joint fit of the shared Table 2 session (model with covariance,
 noise model: the size of a stored entry) with its values shifted a little each time.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -39,8 +40,12 @@ def identification() -> tuple[dict, dict]:
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--smoke", action="store_true", help="300 adds, machines of 100 entries")
-    ap.add_argument("--db", help="an empty store to fill (default: a SQLite file in a temporary folder)")
-    ap.add_argument("--runs", type=int, default=7, help="show is timed this many times; the median is printed")
+    ap.add_argument(
+        "--db", help="an empty store to fill (default: a SQLite file in a temporary folder)"
+    )
+    ap.add_argument(
+        "--runs", type=int, default=7, help="show is timed this many times; the median is printed"
+    )
     a = ap.parse_args()
     n_add, per_machine = (300, 100) if a.smoke else (10_000, 1_000)
     model, details = identification()
@@ -60,8 +65,13 @@ def main() -> int:
         start = time.perf_counter()
         for i, m in enumerate(models):
             when = (t0 + datetime.timedelta(days=i % per_machine)).strftime("%Y-%m-%dT%H:%M:%SZ")
-            h.add_identification(f"SN-{i // per_machine:04d}", m, measured_at=when, details={"identification": details},
-                                 note="bench")
+            h.add_identification(
+                f"SN-{i // per_machine:04d}",
+                m,
+                measured_at=when,
+                details={"identification": details},
+                note="bench",
+            )
         add_s = time.perf_counter() - start
         times = []
         for _ in range(a.runs):
@@ -73,18 +83,34 @@ def main() -> int:
         h2.show("SN-0000")
     open_show = time.perf_counter() - s0
     assert summary["identifications"] == per_machine
-    size = sum(p.stat().st_size for p in Path(db).parent.glob(Path(db).name + "*")) if "://" not in db else None
-    print(f"store: {'PostgreSQL' if '://' in db else 'SQLite'}, {n_add} identifications of "
-          f"{n_add // per_machine} machines")
-    print(f"history add: {n_add} in {add_s:.2f} s = {add_s / n_add * 1e3:.2f} ms each "
-          f"({n_add / add_s:.0f}/s), one transaction each")
+    size = (
+        sum(p.stat().st_size for p in Path(db).parent.glob(Path(db).name + "*"))
+        if "://" not in db
+        else None
+    )
+    print(
+        f"store: {'PostgreSQL' if '://' in db else 'SQLite'}, {n_add} identifications of "
+        f"{n_add // per_machine} machines"
+    )
+    print(
+        f"history add: {n_add} in {add_s:.2f} s = {add_s / n_add * 1e3:.2f} ms each "
+        f"({n_add / add_s:.0f}/s), one transaction each"
+    )
     if size is not None:
-        print(f"store size: {size / 1e6:.1f} MB ({size / n_add / 1e3:.1f} kB per identification, model with "
-              "covariance and the identify --json details)")
+        print(
+            f"store size: {size / 1e6:.1f} MB ({size / n_add / 1e3:.1f} kB per identification, model with "
+            "covariance and the identify --json details)"
+        )
     med = statistics.median(times)
-    print(f"history show of a machine with {per_machine} entries: median {med * 1e3:.1f} ms of {a.runs} "
-          f"(min {min(times) * 1e3:.1f}, max {max(times) * 1e3:.1f}); open + show {open_show * 1e3:.1f} ms"
-          + ("" if a.smoke or "://" in db else f"; target <= 200 ms: {'met' if med <= 0.2 else 'NOT met'}"))
+    print(
+        f"history show of a machine with {per_machine} entries: median {med * 1e3:.1f} ms of {a.runs} "
+        f"(min {min(times) * 1e3:.1f}, max {max(times) * 1e3:.1f}); open + show {open_show * 1e3:.1f} ms"
+        + (
+            ""
+            if a.smoke or "://" in db
+            else f"; target <= 200 ms: {'met' if med <= 0.2 else 'NOT met'}"
+        )
+    )
     tmp.cleanup()
     return 0
 

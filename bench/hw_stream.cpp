@@ -29,7 +29,8 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 void decoder_throughput() {
   Bytes stream;
   for (std::uint32_t k = 0; stream.size() < (64u << 20); ++k) {
-    const Bytes f = encode_ballbar_sample({static_cast<std::uint16_t>(k), k * 1000u, static_cast<std::int32_t>(k), 0});
+    const Bytes f = encode_ballbar_sample(
+        {static_cast<std::uint16_t>(k), k * 1000u, static_cast<std::int32_t>(k), 0});
     stream.insert(stream.end(), f.begin(), f.end());
     if (k % 1000 == 0) stream.insert(stream.end(), {0x13, 0xAA, 0x00});  // a little line noise
   }
@@ -43,18 +44,22 @@ void decoder_throughput() {
   }
   const double dt = seconds_since(t0);
   std::printf("frame decoder: %.0f MB/s (%zu samples from %.0f MiB in %.3f s)\n",
-              static_cast<double>(stream.size()) / dt / 1e6, samples, static_cast<double>(stream.size()) / (1 << 20), dt);
+              static_cast<double>(stream.size()) / dt / 1e6, samples,
+              static_cast<double>(stream.size()) / (1 << 20), dt);
 
   std::string replies;
   while (replies.size() < (16u << 20)) replies += "M0,+01.2345,-00.1234,+FFFFFFF\r+012.3456\r";
   const auto t1 = std::chrono::steady_clock::now();
-  const LineScan ls = split_lines(reinterpret_cast<const std::uint8_t*>(replies.data()), replies.size());
+  const LineScan ls =
+      split_lines(reinterpret_cast<const std::uint8_t*>(replies.data()), replies.size());
   std::size_t ok = 0;
-  for (const std::string& line : ls.lines) ok += line[0] == 'M' ? parse_keyence_reply(line).has_value()
-                                                                  : parse_sylvac_reply(line).has_value();
+  for (const std::string& line : ls.lines)
+    ok += line[0] == 'M' ? parse_keyence_reply(line).has_value()
+                         : parse_sylvac_reply(line).has_value();
   const double dt1 = seconds_since(t1);
   std::printf("probe reply parser: %.0f MB/s (%zu replies, all parsed: %s)\n",
-              static_cast<double>(replies.size()) / dt1 / 1e6, ls.lines.size(), ok == ls.lines.size() ? "yes" : "NO");
+              static_cast<double>(replies.size()) / dt1 / 1e6, ls.lines.size(),
+              ok == ls.lines.size() ? "yes" : "NO");
 }
 
 }  // namespace
@@ -62,9 +67,12 @@ void decoder_throughput() {
 int main(int argc, char** argv) {
   double seconds = 600.0, speed = 1.0;
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--smoke")) seconds = 20.0, speed = 10.0;
-    else if (!std::strcmp(argv[i], "--seconds") && i + 1 < argc) seconds = std::atof(argv[++i]);
-    else if (!std::strcmp(argv[i], "--speed") && i + 1 < argc) speed = std::atof(argv[++i]);
+    if (!std::strcmp(argv[i], "--smoke"))
+      seconds = 20.0, speed = 10.0;
+    else if (!std::strcmp(argv[i], "--seconds") && i + 1 < argc)
+      seconds = std::atof(argv[++i]);
+    else if (!std::strcmp(argv[i], "--speed") && i + 1 < argc)
+      speed = std::atof(argv[++i]);
   }
   decoder_throughput();
 
@@ -96,7 +104,8 @@ int main(int argc, char** argv) {
   opt.rate_hz = 1000.0;
   opt.speed = speed;
   RecordSummary sb, sr;
-  std::printf("streaming %.0f s of 1 kHz ballbar and 1 kHz 3-channel probe data at speed x%g ...\n", seconds, speed);
+  std::printf("streaming %.0f s of 1 kHz ballbar and 1 kHz 3-channel probe data at speed x%g ...\n",
+              seconds, speed);
   std::fflush(stdout);
   const auto t0 = std::chrono::steady_clock::now();
   std::thread tb([&] {
@@ -105,8 +114,8 @@ int main(int argc, char** argv) {
   });
   std::thread tr([&] {
     auto port = open_port(rtest.port(), {});
-    sr = record_rtest(*port, ProbeMode::stream, rtest.program(), ro.sim.pattern.dwell_s, ro.probe_dirs,
-                      dir + "/rotacal-bench-rtest.csv", opt);
+    sr = record_rtest(*port, ProbeMode::stream, rtest.program(), ro.sim.pattern.dwell_s,
+                      ro.probe_dirs, dir + "/rotacal-bench-rtest.csv", opt);
   });
   tb.join();
   tr.join();
@@ -117,11 +126,14 @@ int main(int argc, char** argv) {
   std::printf("ballbar: %llu samples sent, %zu written, %zu lost, %zu checksum errors (%s)\n",
               static_cast<unsigned long long>(vb.frames_sent), sb.rows, sb.lost, sb.crc_errors,
               to_string(sb.reason).c_str());
-  std::printf("probes:  %llu samples sent, %zu decoded, %zu lost, %zu checksum errors, %zu poses written (%s)\n",
-              static_cast<unsigned long long>(vr.frames_sent), sr.frames, sr.lost, sr.crc_errors, sr.rows,
-              to_string(sr.reason).c_str());
+  std::printf(
+      "probes:  %llu samples sent, %zu decoded, %zu lost, %zu checksum errors, %zu poses written "
+      "(%s)\n",
+      static_cast<unsigned long long>(vr.frames_sent), sr.frames, sr.lost, sr.crc_errors, sr.rows,
+      to_string(sr.reason).c_str());
   std::printf("wall time %.1f s for %.0f s of data (speed x%g)\n", wall, seconds, speed);
-  const bool ok = sb.lost == 0 && sr.lost == 0 && sb.rows == vb.frames_sent && sr.frames == vr.frames_sent;
+  const bool ok =
+      sb.lost == 0 && sr.lost == 0 && sb.rows == vb.frames_sent && sr.frames == vr.frames_sent;
   std::printf("lost samples: %zu (target 0): %s\n", sb.lost + sr.lost, ok ? "met" : "NOT MET");
   return ok ? 0 : 1;
 }

@@ -26,7 +26,8 @@ double cpu_seconds() {  // this thread's CPU time (s): other processes share the
 
 // 1 sigma of each location error at the truth: sigma^2 (J^T J)^-1 over the free parameters
 // (location errors and sphere), J the probe problem's Jacobian.
-Eigen::VectorXd cramer_rao(const ProbeSession& s, const MachineModel& t, const Eigen::Vector3d& sphere, double sigma_mm) {
+Eigen::VectorXd cramer_rao(const ProbeSession& s, const MachineModel& t,
+                           const Eigen::Vector3d& sphere, double sigma_mm) {
   const ProbeProblem problem(s);
   const ProbeParameterLayout& L = problem.layout();
   Eigen::VectorXd x = Eigen::VectorXd::Zero(L.size());
@@ -70,21 +71,25 @@ int main(int argc, char** argv) {
     se_known += (identify_probe_cycles(s, {true}).model.errors.v - t.errors.v).cwiseAbs2();
     se_free += (identify_probe_cycles(s, {false}).model.errors.v - t.errors.v).cwiseAbs2();
   }
-  const auto rmse = [&](const Eigen::VectorXd& se) { return Eigen::VectorXd((se / draws).cwiseSqrt()); };
+  const auto rmse = [&](const Eigen::VectorXd& se) {
+    return Eigen::VectorXd((se / draws).cwiseSqrt());
+  };
   const Eigen::VectorXd rj = rmse(se_joint), rk = rmse(se_known), rf = rmse(se_free);
-  std::printf("probe_accuracy: AC-trt, Flynn Table 2 errors, 24 poses x 5 touches, 0.5 um white, %d draws%s\n",
-              draws, smoke ? " (--smoke)" : "");
-  std::printf("joint fit: %.3f ms CPU per fit (mean; target <= 1 ms), %d not converged\n", 1e3 * cpu / draws,
-              unconverged);
-  std::printf("%-7s %5s %10s %10s %9s %12s %12s %10s %10s\n", "error", "unit", "CRB", "joint", "joint/CRB",
-              "cycles(R)", "cycles(free)", "joint/cyc", "cyc(R)/CRB");
+  std::printf(
+      "probe_accuracy: AC-trt, Flynn Table 2 errors, 24 poses x 5 touches, 0.5 um white, %d "
+      "draws%s\n",
+      draws, smoke ? " (--smoke)" : "");
+  std::printf("joint fit: %.3f ms CPU per fit (mean; target <= 1 ms), %d not converged\n",
+              1e3 * cpu / draws, unconverged);
+  std::printf("%-7s %5s %10s %10s %9s %12s %12s %10s %10s\n", "error", "unit", "CRB", "joint",
+              "joint/CRB", "cycles(R)", "cycles(free)", "joint/cyc", "cyc(R)/CRB");
   const auto& names = location_error_names(t.machine);
   for (int k = 0; k < 8; ++k) {
     const bool angle = location_error_is_angle(k);
     const double u = angle ? 1e6 : 1e3;  // urad, um
-    std::printf("%-7s %5s %10.4f %10.4f %9.3f %12.4f %12.4f %10.4f %10.3f\n", names[static_cast<std::size_t>(k)].c_str(),
-                angle ? "urad" : "um", u * crb[k], u * rj[k], rj[k] / crb[k], u * rk[k], u * rf[k], rj[k] / rk[k],
-                rk[k] / crb[k]);
+    std::printf("%-7s %5s %10.4f %10.4f %9.3f %12.4f %12.4f %10.4f %10.3f\n",
+                names[static_cast<std::size_t>(k)].c_str(), angle ? "urad" : "um", u * crb[k],
+                u * rj[k], rj[k] / crb[k], u * rk[k], u * rf[k], rj[k] / rk[k], rk[k] / crb[k]);
   }
   return 0;
 }

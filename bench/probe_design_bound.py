@@ -11,6 +11,7 @@ to 120 touches (whole pose visits, or single touches when each has its own direc
     python bench/probe_design_bound.py            # ~15 min on the loaded 2-core machine
     python bench/probe_design_bound.py --quick    # the default sphere on the 15 / 30 deg grid, 1 min
 """
+
 from __future__ import annotations
 
 import argparse
@@ -35,27 +36,47 @@ def main() -> None:
     u0, worst0 = pb.largest_u_um(pb.pattern_information(Gd, refposes.probe_directions()), names)
     print(f"{m}: default poses at sphere {SPHERE}, 120 touches: largest U {u0:.4f} um ({worst0})")
     grids = [(15.0, 30.0, 90.0)] + ([] if a.quick else [(5.0, 15.0, 110.0)])
-    spheres = [SPHERE] + ([] if a.quick else [(250.0, 0.0, 80.0), (300.0, 0.0, 40.0), (150.0, 0.0, 200.0),
-                                              (0.0, 150.0, 80.0)])
-    print("| poses | sphere | directions | reached U (um) | bound U (um) | bound / default | 120 touches / default |")
+    spheres = [SPHERE] + (
+        []
+        if a.quick
+        else [(250.0, 0.0, 80.0), (300.0, 0.0, 40.0), (150.0, 0.0, 200.0), (0.0, 150.0, 80.0)]
+    )
+    print(
+        "| poses | sphere | directions | reached U (um) | bound U (um) | bound / default | 120 touches / default |"
+    )
     print("|---|---|---|---|---|---|---|")
     for tilt_step, rot_step, limit in grids:
         for sphere in spheres if tilt_step == 15.0 else [SPHERE]:
             G, _ = pb.sensitivities(m, pb.grid(m, tilt_step, rot_step, limit), sphere)
             where = f"tilt +-{limit:g} every {tilt_step:g}, rotary every {rot_step:g} ({len(G)})"
-            contact = [pb.contact_directions(m, t, r) for t, r in pb.grid(m, tilt_step, rot_step, limit)]
-            for label, dirs in (("default 5, every pose", refposes.probe_directions()), ("any, touch by touch", None),
-                                ("contact within 80 deg of the stylus, touch by touch", "contact")):
+            contact = [
+                pb.contact_directions(m, t, r) for t, r in pb.grid(m, tilt_step, rot_step, limit)
+            ]
+            for label, dirs in (
+                ("default 5, every pose", refposes.probe_directions()),
+                ("any, touch by touch", None),
+                ("contact within 80 deg of the stylus, touch by touch", "contact"),
+            ):
                 if isinstance(dirs, str) and len(G) > 200:
                     continue  # the design's grid only (27,000 candidate touches on the fine one)
-                if isinstance(dirs, str):  # the design's candidate directions (rounded: rotacal design probe)
-                    up, low, w = pb.minimax_bound(G, names, 120, iterations=60, touch_directions=contact)
+                if isinstance(
+                    dirs, str
+                ):  # the design's candidate directions (rounded: rotacal design probe)
+                    up, low, w = pb.minimax_bound(
+                        G, names, 120, iterations=60, touch_directions=contact
+                    )
                     whole = ""
                 else:
                     up, low, w = pb.minimax_bound(G, names, 120, dirs)
-                    whole = f"{pb.rounded_u_um(G, names, 120, w, dirs) / u0:.3f}" if len(G) < 200 else ""
-                print(f"| {where} | {sphere} | {label} | {up:.4f} | {low:.4f} | {low / u0:.3f} | {whole} |",
-                      flush=True)
+                    whole = (
+                        f"{pb.rounded_u_um(G, names, 120, w, dirs) / u0:.3f}"
+                        if len(G) < 200
+                        else ""
+                    )
+                print(
+                    f"| {where} | {sphere} | {label} | {up:.4f} | {low:.4f} | {low / u0:.3f} | {whole} |",
+                    flush=True,
+                )
 
 
 if __name__ == "__main__":

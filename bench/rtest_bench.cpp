@@ -31,10 +31,11 @@ double median(std::vector<double> v) {
 }  // namespace
 
 int main() {
-  MachineModel t = MachineModel::nominal(MachineType::BC_trt);  // ../shared/data/rtest_bc_oyama.truth.json + a 2-lobe face runout of C
+  MachineModel t = MachineModel::nominal(
+      MachineType::BC_trt);  // ../shared/data/rtest_bc_oyama.truth.json + a 2-lobe face runout of C
   t.errors.v << 0.01459190348066346, 0.014212100597282357, 3.1102339878434216e-05,
-      -2.385536385835234e-05, -0.016912021691263143, 0.017858631217842532,
-      1.1379169104710182e-05, -4.973692463737003e-05;
+      -2.385536385835234e-05, -0.016912021691263143, 0.017858631217842532, 1.1379169104710182e-05,
+      -4.973692463737003e-05;
   t.effects.effects = {Effect::parse("gravity_sag_B"), Effect::parse("coning_B"),
                        Effect::parse("axial_motion_C_h2")};
   t.effect_params = {0.006, 0.000145, 0.002, -0.001};
@@ -81,16 +82,20 @@ int main() {
     });
   }
   const double mj = median(cpu_joint), mp = median(cpu_paper);
-  std::printf("rtest joint fit, 2 x 84 poses: %.1f ms wall (first call, mean of %d), %.2f ms CPU median "
-              "(range %.2f-%.2f; target <= 10 ms)\n",
-              ms / runs, runs, mj, *std::min_element(cpu_joint.begin(), cpu_joint.end()),
-              *std::max_element(cpu_joint.begin(), cpu_joint.end()));
+  std::printf(
+      "rtest joint fit, 2 x 84 poses: %.1f ms wall (first call, mean of %d), %.2f ms CPU median "
+      "(range %.2f-%.2f; target <= 10 ms)\n",
+      ms / runs, runs, mj, *std::min_element(cpu_joint.begin(), cpu_joint.end()),
+      *std::max_element(cpu_joint.begin(), cpu_joint.end()));
   std::printf("paper method, same sessions: %.3f ms CPU median (range %.3f-%.3f)\n", mp,
-              *std::min_element(cpu_paper.begin(), cpu_paper.end()), *std::max_element(cpu_paper.begin(), cpu_paper.end()));
+              *std::min_element(cpu_paper.begin(), cpu_paper.end()),
+              *std::max_element(cpu_paper.begin(), cpu_paper.end()));
   std::printf("joint / paper CPU time: %.1fx (medians; target <= 10x)\n", mj / mp);
-  std::printf("fit residual sigma: %.3f um (noise 0.300 um); last fit: %d Jacobians, %d residual evaluations, "
-              "noise model %s\n",
-              sigma / runs, last.jacobian_evaluations, last.residual_evaluations, last_noise.c_str());
+  std::printf(
+      "fit residual sigma: %.3f um (noise 0.300 um); last fit: %d Jacobians, %d residual "
+      "evaluations, "
+      "noise model %s\n",
+      sigma / runs, last.jacobian_evaluations, last.residual_evaluations, last_noise.c_str());
   std::printf("held-out prediction RMS: joint %.3f um, paper %.3f um\n", rms_joint / runs,
               rms_paper / runs);
   return 0;

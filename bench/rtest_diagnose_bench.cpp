@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
+#include "../tests/support/synthetic_sessions.hpp"
 #include "rotacal/diagnose/rtest_diagnosis.hpp"
 #include "rotacal/io/ballbar_file.hpp"
 #include "rotacal/rtest/simulate.hpp"
-#include "../tests/support/synthetic_sessions.hpp"
 
 using namespace rotacal;
 
@@ -52,8 +52,10 @@ double median(std::vector<double> v) {
 int main(int argc, char** argv) {
   int n_null = 40, trials = 3;
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--null") && i + 1 < argc) n_null = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--trials") && i + 1 < argc) trials = std::atoi(argv[++i]);
+    if (!std::strcmp(argv[i], "--null") && i + 1 < argc)
+      n_null = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--trials") && i + 1 < argc)
+      trials = std::atoi(argv[++i]);
     else {
       std::fprintf(stderr, "usage: rtest_diagnose_bench [--null N] [--trials N]\n");
       return 2;
@@ -73,8 +75,9 @@ int main(int argc, char** argv) {
     false_findings += !D.findings.empty();
   }
   std::printf("rtest_diagnose_bench: B/C table, 2 nests x 84 poses, 0.3 um white noise\n");
-  std::printf("null data: %d of %d sessions with a finding; median %.0f ms, max %.0f ms\n", false_findings,
-              n_null, median(ms_null), ms_null.empty() ? 0.0 : *std::max_element(ms_null.begin(), ms_null.end()));
+  std::printf("null data: %d of %d sessions with a finding; median %.0f ms, max %.0f ms\n",
+              false_findings, n_null, median(ms_null),
+              ms_null.empty() ? 0.0 : *std::max_element(ms_null.begin(), ms_null.end()));
   std::printf("%-24s %8s %10s\n", "hidden effect", "named 1st", "median ms");
   int named = 0, runs = 0;
   for (const Hidden& h : kHidden) {
@@ -93,7 +96,8 @@ int main(int argc, char** argv) {
       ms.push_back(ms_since(t0));
       bool hit = !D.findings.empty() && D.findings[0].effect.id() == h.id;
       for (const Ambiguity& g : D.ambiguous)
-        hit = hit || (!D.findings.empty() && !g.effects.empty() && g.effects[0] == D.findings[0].effect.id() &&
+        hit = hit || (!D.findings.empty() && !g.effects.empty() &&
+                      g.effects[0] == D.findings[0].effect.id() &&
                       std::find(g.effects.begin(), g.effects.end(), h.id) != g.effects.end());
       hits += hit;
     }
@@ -113,8 +117,11 @@ int main(int argc, char** argv) {
   std::vector<double> all = ms_null;
   all.insert(all.end(), ms_hidden.begin(), ms_hidden.end());
   std::printf("hidden effects named first: %d of %d\n", named, runs);
-  std::printf("rtest_bc_oyama.csv (noise estimated, 2 effects): median of 3 %.0f ms\n", median(ms_file));
-  std::printf("time per diagnosis, median over all %zu sessions (null and hidden): %.0f ms (target <= 150 ms)\n",
-              all.size(), median(all));
+  std::printf("rtest_bc_oyama.csv (noise estimated, 2 effects): median of 3 %.0f ms\n",
+              median(ms_file));
+  std::printf(
+      "time per diagnosis, median over all %zu sessions (null and hidden): %.0f ms (target <= 150 "
+      "ms)\n",
+      all.size(), median(all));
   return 0;
 }

@@ -6,6 +6,7 @@ Writes the program in each dialect (LinuxCNC machine axes, Heidenhain TCPM, Siem
 Fanuc G43.4) and the commanded session template, and prints what the operator needs to know:
 the pivot position, the tests and how long the program runs.
 """
+
 import sys
 from pathlib import Path
 
@@ -17,7 +18,7 @@ from rotacal import _core
 out = Path(sys.argv[1] if len(sys.argv) > 1 else "plan_out")
 out.mkdir(parents=True, exist_ok=True)
 
-setup = _core.BallbarSetup()           # defaults: AC-trt, L0 = 100 mm, pivot (120, 0, 60)
+setup = _core.BallbarSetup()  # defaults: AC-trt, L0 = 100 mm, pivot (120, 0, 60)
 setup.ballbar_length = 100.0
 setup.pivot = np.array([120.0, 0.0, 60.0])
 setup.step_deg = 1.0
@@ -31,9 +32,16 @@ for test in dict.fromkeys(labels):
         n = int(np.sum(labels == test))
         print(f"  {test:10s} {n:4d} points")
 
-for dialect, suffix in (("linuxcnc", "ngc"), ("heidenhain", "h"), ("siemens", "mpf"), ("fanuc", "nc")):
+for dialect, suffix in (
+    ("linuxcnc", "ngc"),
+    ("heidenhain", "h"),
+    ("siemens", "mpf"),
+    ("fanuc", "nc"),
+):
     path = out / f"ballbar_test.{suffix}"
-    rotacal.write_output(path, _core.write_nc_program(plan, dialect))  # never a half-written program
+    rotacal.write_output(
+        path, _core.write_nc_program(plan, dialect)
+    )  # never a half-written program
     print(f"wrote {path} ({dialect})")
 template = out / "commanded.csv"
 rotacal.save(plan.commanded_session(), template)

@@ -8,6 +8,7 @@ port would be; the recorder neither knows nor cares. Run:
 With a real instrument, skip the virtual part and pass its port (e.g. /dev/ttyUSB0) to
 record_ballbar, or use `rotacal record ballbar --port ...`.
 """
+
 import sys
 
 import numpy as np
@@ -24,7 +25,9 @@ setup.step_deg = 2.0
 plan = _core.plan_ballbar_test(setup, None)
 names = list(_core.location_error_names(setup.machine))
 errors = np.array([0.03, -0.02, 4e-5, -6e-5, 0.025, 0.04, 3e-5, -5e-5])  # mm, rad
-truth = _core.BallbarMachineModel(setup.machine, errors, np.asarray(setup.pivot) + [0.01, -0.01, 0.02])
+truth = _core.BallbarMachineModel(
+    setup.machine, errors, np.asarray(setup.pivot) + [0.01, -0.01, 0.02]
+)
 
 # 100 samples/s, 50x faster than real time so the example takes seconds, not minutes.
 device = virtual_ballbar(plan, truth, noise_um=0.5, rate_hz=100, speed=50)

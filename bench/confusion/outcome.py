@@ -1,5 +1,6 @@
 """One benchmark session: draw, diagnose with rotacal, classify the first finding, the oracle,
 the coverage of the parameters of a right finding."""
+
 from __future__ import annotations
 
 import math
@@ -49,8 +50,11 @@ def classify(findings: list, truth: str | None) -> str:
 def z_scores(finding: dict, eid: str, true_params: np.ndarray) -> list:
     """(estimate - truth) / std per determined parameter (rotacal's units)."""
     truth = to_rotacal_params(eid, true_params)
-    return [float((est["value"] - t) / est["std"]) for est, t in zip(finding["parameters"].values(), truth)
-            if est.get("value") is not None and est.get("std")]
+    return [
+        float((est["value"] - t) / est["std"])
+        for est, t in zip(finding["parameters"].values(), truth)
+        if est.get("value") is not None and est.get("std")
+    ]
 
 
 class CellCache:
@@ -63,7 +67,9 @@ class CellCache:
     def setup(self, machine: str, instrument: str) -> Setup:
         key = (machine, instrument)
         if key not in self.setups:
-            self.setups[key] = (ProbeSetup if instrument == "probe" else Setup)(machine, instrument, self.workdir)
+            self.setups[key] = (ProbeSetup if instrument == "probe" else Setup)(
+                machine, instrument, self.workdir
+            )
         return self.setups[key]
 
     def entry(self, st: Setup, eid: str) -> dict:
@@ -77,14 +83,18 @@ class CellCache:
         key = (st.name, st.instrument, eid, noise)
         if key not in self.oracles:
             w = stats.Whitener(st.streams, noise, st.sigma)
-            self.oracles[key] = stats.Oracle(w, st.j0, self.entry(st, eid)["je_visible"], st.n_candidates)
+            self.oracles[key] = stats.Oracle(
+                w, st.j0, self.entry(st, eid)["je_visible"], st.n_candidates
+            )
         return self.oracles[key]
 
     def true_gls(self, st: Setup, eid: str, noise: str) -> stats.TrueGls:
         key = (st.name, st.instrument, eid, noise)
         if key not in self.gls:
             ent = self.entry(st, eid)
-            self.gls[key] = stats.TrueGls(stats.Whitener(st.streams, noise, st.sigma), st.j0, ent["je"], ent["k"])
+            self.gls[key] = stats.TrueGls(
+                stats.Whitener(st.streams, noise, st.sigma), st.j0, ent["je"], ent["k"]
+            )
         return self.gls[key]
 
     def reading(self, st: Setup, eid: str, params: np.ndarray) -> np.ndarray:
@@ -97,8 +107,17 @@ class CellCache:
 def run_session(cache: CellCache, task: dict, diagnose) -> dict:
     """task: machine, instrument, entry (None: null), noise, amp, draw, seed. Returns the record."""
     st = cache.setup(task["machine"], task["instrument"])
-    rng = np.random.default_rng(stable_int(task["seed"], task["machine"], task["instrument"], task["entry"],
-                                           task["noise"], task["amp"], task["draw"]))
+    rng = np.random.default_rng(
+        stable_int(
+            task["seed"],
+            task["machine"],
+            task["instrument"],
+            task["entry"],
+            task["noise"],
+            task["amp"],
+            task["draw"],
+        )
+    )
     rec = dict(task)
     eid = task["entry"]
     if eid is None:
@@ -120,9 +139,16 @@ def run_session(cache: CellCache, task: dict, diagnose) -> dict:
     # threads, which spin on after the bench's own numpy work (h-dtime, 12-06).
     rec["cpu_ms"] = 1e3 * (time.thread_time() - c0)
     rec["outcome"] = classify(findings, eid)
-    rec["findings"] = [{"effect": f["effect"], "weight": f["weight"], "named": f["named"],
-                        "group": [g["effect"] for g in f["group"]],
-                        "aliased": [g["effect"] for g in f["group"] if g.get("aliased")]} for f in findings]
+    rec["findings"] = [
+        {
+            "effect": f["effect"],
+            "weight": f["weight"],
+            "named": f["named"],
+            "group": [g["effect"] for g in f["group"]],
+            "aliased": [g["effect"] for g in f["group"] if g.get("aliased")],
+        }
+        for f in findings
+    ]
     if rec["outcome"] == "right":
         rec["z"] = z_scores(findings[0], eid, params)
         rec["coverage"] = [abs(z) <= 2.0 for z in rec["z"]]

@@ -8,6 +8,7 @@ noise is the trigger's scatter along n, one stream per session in time order (wh
 1/f-like from refsim.noise, marginal 1-sigma 0.5 um). The baseline is rotacal's probe problem
 with no effect: the 8 location errors and the sphere's table position (plus tool_offset_Z on a
 machine with a head, which rotacal's probe baseline holds and its candidates leave out)."""
+
 from __future__ import annotations
 
 import itertools
@@ -32,16 +33,27 @@ class ProbeSetup(Setup):
     def _make_poses(self, rng: np.random.Generator) -> None:
         s = poses.probe_poses(self.machine)
         n = np.round(s["n"], 6)
-        s.update(time=np.round(s["time"], 3), angles_deg=np.round(s["angles_deg"], 6),
-                 n=n / np.linalg.norm(n, axis=1, keepdims=True))
+        s.update(
+            time=np.round(s["time"], 3),
+            angles_deg=np.round(s["angles_deg"], 6),
+            n=n / np.linalg.norm(n, axis=1, keepdims=True),
+        )
         self.s, self.labels = s, ["touches"] * len(s["pose"])
         self.sphere_actual = s["sphere"] + SPHERE_SHIFT
         self.n = len(self.labels)
         self.streams = [np.arange(self.n)]
         self.head = any(a.side == "head" for a in self.machine.axes)
         radius = 0.5 * (SPHERE_DIAMETER + STYLUS_DIAMETER)
-        nominal = refsim.probe_touches(refsim.Model(self.machine), s["sphere"], s["sphere"], SPHERE_DIAMETER,
-                                       STYLUS_DIAMETER, s["n"], np.radians(s["angles_deg"]), s["time"])
+        nominal = refsim.probe_touches(
+            refsim.Model(self.machine),
+            s["sphere"],
+            s["sphere"],
+            SPHERE_DIAMETER,
+            STYLUS_DIAMETER,
+            s["n"],
+            np.radians(s["angles_deg"]),
+            s["time"],
+        )
         self.x0 = nominal + radius * s["n"]
         self._workdir = self.path.parent
 
@@ -54,8 +66,16 @@ class ProbeSetup(Setup):
         s = self.s
         model = refsim.Model(self.machine, self.errors if errors is None else errors, effects)
         centre = self.sphere_actual if sphere_shift is None else self.sphere_actual + sphere_shift
-        latched = refsim.probe_touches(model, centre, s["sphere"], SPHERE_DIAMETER, STYLUS_DIAMETER, s["n"],
-                                       self.angles, s["time"])
+        latched = refsim.probe_touches(
+            model,
+            centre,
+            s["sphere"],
+            SPHERE_DIAMETER,
+            STYLUS_DIAMETER,
+            s["n"],
+            self.angles,
+            s["time"],
+        )
         return np.einsum("ij,ij->i", latched - self.x0, s["n"])
 
     def _nuisance_columns(self) -> list:
@@ -64,9 +84,14 @@ class ProbeSetup(Setup):
         for k in range(3):
             d = np.zeros(3)
             d[k] = 1e-3
-            cols.append((self.reading({}, sphere_shift=d) - self.reading({}, sphere_shift=-d)) / 2e-3)
+            cols.append(
+                (self.reading({}, sphere_shift=d) - self.reading({}, sphere_shift=-d)) / 2e-3
+            )
         if self.head:
-            cols.append((self.reading({"tool_offset_Z": [1e-3]}) - self.reading({"tool_offset_Z": [-1e-3]})) / 2e-3)
+            cols.append(
+                (self.reading({"tool_offset_Z": [1e-3]}) - self.reading({"tool_offset_Z": [-1e-3]}))
+                / 2e-3
+            )
         return cols
 
     def noise(self, kind: str, rng: np.random.Generator) -> np.ndarray:
@@ -83,10 +108,18 @@ class ProbeSetup(Setup):
     def session(self, flat: np.ndarray):
         """The rotacal session of these readings, through the file refsim's writer makes."""
         import rotacal
+
         latched = self.x0 + np.asarray(flat, float)[:, None] * self.s["n"]
         path = self._workdir / f"{self.name}_probe_{os.getpid()}_{next(_COUNTER)}.csv"
-        writers.write_probe(path, self.machine, self.s, latched, SPHERE_DIAMETER, STYLUS_DIAMETER,
-                            noise_um=self.sigma * 1e3)
+        writers.write_probe(
+            path,
+            self.machine,
+            self.s,
+            latched,
+            SPHERE_DIAMETER,
+            STYLUS_DIAMETER,
+            noise_um=self.sigma * 1e3,
+        )
         try:
             return rotacal.load(path)
         finally:

@@ -2,6 +2,7 @@
 the true baseline (location errors, ballbar pivot set-up error, R-test probe zeros), readings,
 noise, finite-difference Jacobians of the baseline and of each entry, the half-detection
 amplitude, and the rotacal session that carries a draw's readings."""
+
 from __future__ import annotations
 
 import math
@@ -18,17 +19,35 @@ from refsim import poses, writers
 
 from . import stats
 
-SIGMA_MM = {"ballbar": 5e-4, "rtest": 3e-4, "probe": 5e-4}  # white-equivalent marginal 1-sigma of the readings
+SIGMA_MM = {
+    "ballbar": 5e-4,
+    "rtest": 3e-4,
+    "probe": 5e-4,
+}  # white-equivalent marginal 1-sigma of the readings
 PIVOT_SHIFT = np.array([0.012, -0.008, 0.015])  # ballbar pivot set-up error, mm
 MOTION_PREFIXES = ("backlash_", "servo_lag_", "reversal_spike_")
 # A step for the central differences and the largest plausible size (1 mm, 1 mrad, 1 um/s,
 # 1e-3 for ratios) of each kind's parameters, in refsim's units.
-_UNIT = {"ballbar_length_offset": "mm", "ballbar_thermal_drift": "mm/s", "tool_offset": "mm",
-         "rotary_zero_offset": "rad", "angular_positioning": "rad", "axial_motion": "mm",
-         "radial_motion": "mm", "tilt_motion": "rad", "gravity_sag": "mm", "coning": "ratio",
-         "linear_squareness": "rad", "linear_scale": "ratio", "thermal_drift": "mm/s",
-         "thermal_warmup": "mm", "straightness": "mm", "angular_error": "rad",
-         "stylus_radius_offset": "mm", "probe_lobing": "mm"}
+_UNIT = {
+    "ballbar_length_offset": "mm",
+    "ballbar_thermal_drift": "mm/s",
+    "tool_offset": "mm",
+    "rotary_zero_offset": "rad",
+    "angular_positioning": "rad",
+    "axial_motion": "mm",
+    "radial_motion": "mm",
+    "tilt_motion": "rad",
+    "gravity_sag": "mm",
+    "coning": "ratio",
+    "linear_squareness": "rad",
+    "linear_scale": "ratio",
+    "thermal_drift": "mm/s",
+    "thermal_warmup": "mm",
+    "straightness": "mm",
+    "angular_error": "rad",
+    "stylus_radius_offset": "mm",
+    "probe_lobing": "mm",
+}
 _STEP = {"mm": 1e-3, "rad": 1e-5, "mm/s": 1e-5, "ratio": 1e-5}
 PLAUSIBLE = {"mm": 1.0, "rad": 1e-3, "mm/s": 1e-3, "ratio": 1e-3}
 
@@ -54,8 +73,9 @@ class Setup:
         self.machine = refsim.builtin(machine)
         self.sigma = SIGMA_MM[instrument]
         rng = np.random.default_rng(stable_int("baseline", machine))
-        self.errors = np.array([rng.uniform(-0.03, 0.03) if i % 4 < 2 else rng.uniform(-8e-5, 8e-5)
-                                for i in range(8)])
+        self.errors = np.array(
+            [rng.uniform(-0.03, 0.03) if i % 4 < 2 else rng.uniform(-8e-5, 8e-5) for i in range(8)]
+        )
         self.path, self._template = Path(workdir) / f"{machine}_{instrument}.csv", None
         self._make_poses(rng)
         self.angles = np.radians(self.s["angles_deg"])
@@ -72,17 +92,33 @@ class Setup:
             self.s = _round_poses(poses.ballbar_single_setup(self.machine, pivot=pivot))
             self.labels = list(self.s["test"])
             self.pivot_actual = self.s["pivot"] + PIVOT_SHIFT
-            writers.write_ballbar(self.path, self.machine, self.s, np.full(len(self.labels), self.s["ballbar_length"]),
-                                  noise_um=self.sigma * 1e3)
-            self.streams = [np.flatnonzero(np.array(self.labels) == g) for g in dict.fromkeys(self.labels)]
+            writers.write_ballbar(
+                self.path,
+                self.machine,
+                self.s,
+                np.full(len(self.labels), self.s["ballbar_length"]),
+                noise_um=self.sigma * 1e3,
+            )
+            self.streams = [
+                np.flatnonzero(np.array(self.labels) == g) for g in dict.fromkeys(self.labels)
+            ]
             self.n = len(self.labels)
             return
-        nests = ((100.0, 0.0, 60.0), (0.0, -120.0, 140.0)) if self.machine.table_axes else \
-            ((100.0, 0.0, 0.0), (0.0, -80.0, 40.0))
+        nests = (
+            ((100.0, 0.0, 60.0), (0.0, -120.0, 140.0))
+            if self.machine.table_axes
+            else ((100.0, 0.0, 0.0), (0.0, -80.0, 40.0))
+        )
         self.s = _round_poses(poses.rtest_grid(self.machine, nests=nests))
         self.labels = list(self.s["setup"])
         self.zeros = {k: rng.uniform(-0.005, 0.005, 3) for k in self.s["nests"]}
-        writers.write_rtest(self.path, self.machine, self.s, np.zeros((len(self.labels), 3)), noise_um=self.sigma * 1e3)
+        writers.write_rtest(
+            self.path,
+            self.machine,
+            self.s,
+            np.zeros((len(self.labels), 3)),
+            noise_um=self.sigma * 1e3,
+        )
         n = len(self.labels)
         per = [np.flatnonzero(np.array(self.labels) == g) for g in dict.fromkeys(self.labels)]
         self.streams = [c * n + idx for c in range(3) for idx in per]
@@ -100,18 +136,22 @@ class Setup:
         if self.instrument == "ballbar":
             pivot = self.pivot_actual if pivot_shift is None else self.pivot_actual + pivot_shift
             return refsim.ballbar_lengths(model, pivot, s["xyz"], self.angles, s["time"])
-        d = refsim.rtest_displacements(model, s["nests"], self.labels, s["xyz"], self.angles, s["time"])
+        d = refsim.rtest_displacements(
+            model, s["nests"], self.labels, s["xyz"], self.angles, s["time"]
+        )
         d = d + np.array([self.zeros[k] for k in self.labels])
         return d.T.reshape(-1)
 
     def noise(self, kind: str, rng: np.random.Generator) -> np.ndarray:
         """refsim.noise of `kind`, one stream per ballbar test / per R-test set-up and component."""
+
         def one():
             if kind == "white":
                 return rnoise.white(len(self.labels), self.sigma, rng)
             if kind == "pink":
                 return rnoise.pink(self.labels, self.sigma, rng)
             return rnoise.ar1(self.labels, float(kind.split("_")[1]), self.sigma, rng)
+
         if self.instrument == "ballbar":
             return one()
         return np.concatenate([one() for _ in range(3)])
@@ -121,6 +161,7 @@ class Setup:
         """rotacal's reading of the file refsim wrote (poses, pivot / nests, declared noise)."""
         if self._template is None:
             import rotacal
+
             self._template = rotacal.load(self.path)
         return self._template
 
@@ -139,7 +180,9 @@ class Setup:
             h = 1e-3 if k % 4 < 2 else 1e-6
             e = np.zeros(8)
             e[k] = h
-            cols.append((self.reading({}, self.errors + e) - self.reading({}, self.errors - e)) / (2 * h))
+            cols.append(
+                (self.reading({}, self.errors + e) - self.reading({}, self.errors - e)) / (2 * h)
+            )
         return np.column_stack(cols + self._nuisance_columns())
 
     def _nuisance_columns(self) -> list:
@@ -149,14 +192,16 @@ class Setup:
             for k in range(3):
                 d = np.zeros(3)
                 d[k] = 1e-3
-                cols.append((self.reading({}, pivot_shift=d) - self.reading({}, pivot_shift=-d)) / 2e-3)
+                cols.append(
+                    (self.reading({}, pivot_shift=d) - self.reading({}, pivot_shift=-d)) / 2e-3
+                )
             return cols
         n = len(self.labels)
         for key in self.s["nests"]:
             rows = np.array(self.labels) == key
             for c in range(3):
                 col = np.zeros(self.n)
-                col[c * n:(c + 1) * n][rows] = 1.0
+                col[c * n : (c + 1) * n][rows] = 1.0
                 cols.append(col)
         return cols
 
@@ -166,7 +211,11 @@ class Setup:
 
     def full_params(self, eid: str, p: np.ndarray) -> np.ndarray:
         """refsim parameters of eid from the benchmark's free ones (thermal_warmup: d, tau fixed)."""
-        return np.array([p[0], self.warmup_tau()]) if rfx.parse(eid).kind == "thermal_warmup" else np.asarray(p)
+        return (
+            np.array([p[0], self.warmup_tau()])
+            if rfx.parse(eid).kind == "thermal_warmup"
+            else np.asarray(p)
+        )
 
     def effect_jacobian(self, eid: str) -> np.ndarray:
         """Central differences of refsim in the entry's parameters at 0 (thermal_warmup: d only)."""
@@ -193,8 +242,13 @@ def half_detection(setup: Setup, eid: str, je: np.ndarray) -> dict:
     # order: the location errors' size times the parameter, and the differences' error).
     k = int(np.sum(sv > 1e-3 * max(scale, 1e-300)))
     unit = _UNIT[rfx.parse(eid).kind]
-    out = {"entry": eid, "k": k, "unit": unit, "visible_fraction": float(sv[0] / scale) if scale > 0 else 0.0,
-           "je_visible": je @ vt[:k].T}
+    out = {
+        "entry": eid,
+        "k": k,
+        "unit": unit,
+        "visible_fraction": float(sv[0] / scale) if scale > 0 else 0.0,
+        "je_visible": je @ vt[:k].T,
+    }
     if k == 0 or sv[0] * PLAUSIBLE[unit] < 1e-3 * setup.sigma:
         return {**out, "a_half": None, "why": "absorbed by the baseline or invisible"}
     need = stats.needed_drop(k, setup.n, setup.q0.shape[1], setup.n_candidates)
@@ -209,8 +263,13 @@ def half_detection(setup: Setup, eid: str, je: np.ndarray) -> dict:
 def motion_only_entries(machine: str) -> list:
     """rotacal's catalogue entries that need a direction of travel (refsim does not model them)."""
     import rotacal
+
     mt = rotacal.parse_machine_type(machine)
-    return sorted(e.id for e in rotacal.effect_catalogue(mt, 4) if e.applies_to(mt) and e.id.startswith(MOTION_PREFIXES))
+    return sorted(
+        e.id
+        for e in rotacal.effect_catalogue(mt, 4)
+        if e.applies_to(mt) and e.id.startswith(MOTION_PREFIXES)
+    )
 
 
 def tempdir() -> Path:

@@ -1,6 +1,7 @@
 """Statistics of the benchmark (numpy + math only): F distribution, the decision thresholds of
 rotacal's DiagnosisOptions, the half-detection noncentrality, noise covariances and whitening,
 and the GLS oracle."""
+
 from __future__ import annotations
 
 import math
@@ -8,7 +9,7 @@ from functools import lru_cache
 
 import numpy as np
 
-ALPHA = 0.01          # DiagnosisOptions.alpha (family-wise, Bonferroni over the candidates)
+ALPHA = 0.01  # DiagnosisOptions.alpha (family-wise, Bonferroni over the candidates)
 MIN_DELTA_BIC = -10.0  # DiagnosisOptions.min_delta_bic
 
 # noise kind -> [(variance fraction, AR(1) rho)] as refsim.noise makes them (pink: 4 AR(1)s of equal
@@ -52,7 +53,9 @@ def betainc(a: float, b: float, x: float) -> float:
         return 0.0
     if x >= 1.0:
         return 1.0
-    lbt = math.lgamma(a + b) - math.lgamma(a) - math.lgamma(b) + a * math.log(x) + b * math.log1p(-x)
+    lbt = (
+        math.lgamma(a + b) - math.lgamma(a) - math.lgamma(b) + a * math.log(x) + b * math.log1p(-x)
+    )
     if x < (a + 1.0) / (a + b + 2.0):
         return math.exp(lbt) * _betacf(a, b, x) / a
     return 1.0 - math.exp(lbt) * _betacf(b, a, 1.0 - x) / b
@@ -103,7 +106,9 @@ def half_detection_lambda(k: int, need: float, draws: int = 40000) -> float:
 def _stream_whitener(length: int, kind: str) -> np.ndarray:
     """inv(chol(Sigma)) of one stream of `length` rows, Sigma in units of the marginal variance."""
     lag = np.abs(np.subtract.outer(np.arange(length), np.arange(length)))
-    cov = sum(f * (rho ** lag if rho > 0 else (lag == 0).astype(float)) for f, rho in NOISE_KINDS[kind])
+    cov = sum(
+        f * (rho**lag if rho > 0 else (lag == 0).astype(float)) for f, rho in NOISE_KINDS[kind]
+    )
     chol = np.linalg.cholesky(cov)
     return np.linalg.inv(chol)
 
@@ -174,5 +179,5 @@ class TrueGls:
         """(estimate - truth) / sigma per parameter; r: reading minus the truth's baseline reading."""
         if not self.ok:
             return None
-        b = (self.cov @ (self.x.T @ self.w.apply(r)))[-self.k:]
-        return [float(v) for v in (b - truth) / np.sqrt(np.diag(self.cov)[-self.k:])]
+        b = (self.cov @ (self.x.T @ self.w.apply(r)))[-self.k :]
+        return [float(v) for v in (b - truth) / np.sqrt(np.diag(self.cov)[-self.k :])]

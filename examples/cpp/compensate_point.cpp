@@ -3,13 +3,12 @@
 // (X Y Z: the point wanted in the table frame, mm). Prints the nominal and the compensated
 // machine axes, and checks that the compensated command reaches the point on the identified
 // machine.
-#include <rotacal/io/model_file.hpp>
-#include <rotacal/kinematics/machine.hpp>
-
 #include <cmath>
 #include <cstdlib>
 #include <iomanip>
 #include <iostream>
+#include <rotacal/io/model_file.hpp>
+#include <rotacal/kinematics/machine.hpp>
 #include <string>
 
 namespace {
@@ -30,22 +29,26 @@ int main(int argc, char** argv) {
   try {
     const rotacal::ModelFile model = rotacal::read_model(argv[1]);
     const double deg = M_PI / 180.0;
-    const rotacal::RotaryAngles<double> angles{number(argv[2], "TILT_DEG") * deg, number(argv[3], "C_DEG") * deg};
+    const rotacal::RotaryAngles<double> angles{number(argv[2], "TILT_DEG") * deg,
+                                               number(argv[3], "C_DEG") * deg};
     const Eigen::Vector3d p_table(number(argv[4], "X"), number(argv[5], "Y"), number(argv[6], "Z"));
 
     // Nominal command (no errors) and the command on the identified machine (Flynn et al.
     // Sec. 5: compensation = inverse kinematics with the identified location errors).
     const rotacal::LocationErrors<double> nominal;
     const rotacal::MachineAxes cmd0 = rotacal::inverse(model.machine, nominal, angles, p_table);
-    const rotacal::MachineAxes cmd = rotacal::inverse(model.machine, model.location_errors, angles, p_table);
+    const rotacal::MachineAxes cmd =
+        rotacal::inverse(model.machine, model.location_errors, angles, p_table);
 
     std::cout << std::fixed << std::setprecision(6);
-    std::cout << rotacal::to_string(model.machine) << " " << model.kind << " model, " << argv[1] << "\n";
+    std::cout << rotacal::to_string(model.machine) << " " << model.kind << " model, " << argv[1]
+              << "\n";
     const auto& names = rotacal::location_error_names(model.machine);
     for (int k = 0; k < 8; ++k)
       std::cout << "  " << names[k] << " = "
-                << (model.observable[static_cast<std::size_t>(k)] ? std::to_string(model.location_errors.v[k])
-                                                                   : std::string("not determined (0)"))
+                << (model.observable[static_cast<std::size_t>(k)]
+                        ? std::to_string(model.location_errors.v[k])
+                        : std::string("not determined (0)"))
                 << (rotacal::location_error_is_angle(k) ? " rad\n" : " mm\n");
     std::cout << "nominal     X Y Z = " << cmd0.xyz.transpose() << "\n";
     std::cout << "compensated X Y Z = " << cmd.xyz.transpose() << "\n";
@@ -53,9 +56,11 @@ int main(int argc, char** argv) {
 
     // On the identified machine the table point sits at forward(errors, angles, p_table) in
     // the machine frame: the compensated command must put the tool exactly there.
-    const Eigen::Vector3d wanted = rotacal::forward(model.machine, model.location_errors, cmd.angles, p_table);
+    const Eigen::Vector3d wanted =
+        rotacal::forward(model.machine, model.location_errors, cmd.angles, p_table);
     const double miss_um = (cmd.xyz - wanted).norm() * 1e3;
-    std::cout << "residual of the compensated command: " << std::setprecision(9) << miss_um << " um\n";
+    std::cout << "residual of the compensated command: " << std::setprecision(9) << miss_um
+              << " um\n";
     return miss_um < 1e-6 ? 0 : 1;
   } catch (const rotacal::IoError& e) {
     std::cerr << e.what() << "\n";

@@ -1,9 +1,8 @@
 // Identify the location errors of a ballbar session from C++.
 // Build: see examples/cpp/CMakeLists.txt; run: quickstart SESSION.csv
+#include <iostream>
 #include <rotacal/ballbar/identify.hpp>
 #include <rotacal/io/ballbar_file.hpp>
-
-#include <iostream>
 
 int main(int argc, char** argv) {
   if (argc != 2) {

@@ -37,29 +37,33 @@ void bind_ballbar_results(pyb::module_& m) {
 
   pyb::class_<BallbarMachineModel>(m, "BallbarMachineModel",
                                    "Location errors, actual pivot and effects of a machine.")
-      .def(pyb::init([](MachineType machine, const pyb::array_t<double, pyb::array::c_style |
-                                                                               pyb::array::forcecast>& errors,
-                        const pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>& pivot,
-                        const std::vector<std::string>& effects,
-                        const std::vector<double>& effect_params) {
-             BallbarMachineModel b;
-             b.machine = machine;
-             b.errors = LocationErrors<double>(vec_of<8>(errors, "errors"));
-             b.pivot = vec_of<3>(pivot, "pivot");
-             b.effects = effects_of(effects);
-             b.effect_params = effect_params;
-             if (static_cast<int>(b.effect_params.size()) != b.effects.num_params())
-               throw InvalidArgument("effect_params: expected " +
-                                     std::to_string(b.effects.num_params()) + " values");
-             return b;
-           }),
+      .def(pyb::init(
+               [](MachineType machine,
+                  const pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>& errors,
+                  const pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>& pivot,
+                  const std::vector<std::string>& effects,
+                  const std::vector<double>& effect_params) {
+                 BallbarMachineModel b;
+                 b.machine = machine;
+                 b.errors = LocationErrors<double>(vec_of<8>(errors, "errors"));
+                 b.pivot = vec_of<3>(pivot, "pivot");
+                 b.effects = effects_of(effects);
+                 b.effect_params = effect_params;
+                 if (static_cast<int>(b.effect_params.size()) != b.effects.num_params())
+                   throw InvalidArgument("effect_params: expected " +
+                                         std::to_string(b.effects.num_params()) + " values");
+                 return b;
+               }),
            pyb::arg("machine"), pyb::arg("errors"), pyb::arg("pivot"),
            pyb::arg("effects") = std::vector<std::string>{},
            pyb::arg("effect_params") = std::vector<double>{})
       .def_readonly("machine", &BallbarMachineModel::machine)
-      .def_property_readonly("errors", [](const BallbarMachineModel& b) { return Eigen::VectorXd(b.errors.v); })
-      .def_property_readonly("pivot", [](const BallbarMachineModel& b) { return Eigen::Vector3d(b.pivot); })
-      .def_property_readonly("effects", [](const BallbarMachineModel& b) { return ids_of(b.effects); })
+      .def_property_readonly(
+          "errors", [](const BallbarMachineModel& b) { return Eigen::VectorXd(b.errors.v); })
+      .def_property_readonly("pivot",
+                             [](const BallbarMachineModel& b) { return Eigen::Vector3d(b.pivot); })
+      .def_property_readonly("effects",
+                             [](const BallbarMachineModel& b) { return ids_of(b.effects); })
       .def_readonly("effect_params", &BallbarMachineModel::effect_params);
 
   pyb::class_<BallbarIdentification>(m, "BallbarIdentification")
@@ -67,10 +71,12 @@ void bind_ballbar_results(pyb::module_& m) {
       .def_readonly("model", &BallbarIdentification::model)
       .def_readonly("parameters", &BallbarIdentification::parameters)
       .def_readonly("covariance", &BallbarIdentification::covariance)
-      .def_property_readonly("residuals", [](const BallbarIdentification& r) {
-        return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(
-            r.residuals.data(), static_cast<Eigen::Index>(r.residuals.size())));
-      })
+      .def_property_readonly(
+          "residuals",
+          [](const BallbarIdentification& r) {
+            return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(
+                r.residuals.data(), static_cast<Eigen::Index>(r.residuals.size())));
+          })
       .def_readonly("residual_rms_um", &BallbarIdentification::residual_rms_um)
       .def_readonly("sigma_um", &BallbarIdentification::sigma_um)
       .def_readonly("n_samples", &BallbarIdentification::n_samples)
@@ -100,9 +106,11 @@ void bind_ballbar_identification(pyb::module_& m) {
         return identify_joint(session, o);
       },
       pyb::arg("session"), pyb::arg("fit_length_offset") = false,
-      pyb::arg("effects") = std::vector<std::string>{}, pyb::arg("tests") = std::vector<std::string>{},
-      pyb::arg("noise") = "auto",
-      "Joint fit (noise 'auto': AR noise model of the residuals, GLS refit when correlated; 'white') of the 8 location errors and the actual pivot to every sample (core/joint_fit.hpp).");
+      pyb::arg("effects") = std::vector<std::string>{},
+      pyb::arg("tests") = std::vector<std::string>{}, pyb::arg("noise") = "auto",
+      "Joint fit (noise 'auto': AR noise model of the residuals, GLS refit when correlated; "
+      "'white') of the 8 location errors and the actual pivot to every sample "
+      "(core/joint_fit.hpp).");
 
   pyb::class_<MonteCarloParameter>(m, "MonteCarloParameter")
       .def_readonly("name", &MonteCarloParameter::name)
@@ -177,15 +185,17 @@ void bind_ballbar_simulation(pyb::module_& m) {
       "predict_session_lengths",
       [](const BallbarMachineModel& model, const BallbarSession& s) {
         const std::vector<double> L = predict_lengths(model, s.samples);
-        return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(L.data(), static_cast<Eigen::Index>(L.size())));
+        return Eigen::VectorXd(
+            Eigen::Map<const Eigen::VectorXd>(L.data(), static_cast<Eigen::Index>(L.size())));
       },
       pyb::arg("model"), pyb::arg("session"),
       "Predicted centre-to-centre lengths (mm) of every sample of the session on the model.");
 
-  m.def("compensate_commands", &compensate_commands, pyb::arg("nominal"), pyb::arg("identified"),
-        pyb::arg("machine"), pyb::arg("tool_length_error") = 0.0,
-        "Compensated commands; tool_length_error (mm): the error of pivot_length + tool_length of a "
-        "head machine (minus the identified tool_offset_Z).");
+  m.def(
+      "compensate_commands", &compensate_commands, pyb::arg("nominal"), pyb::arg("identified"),
+      pyb::arg("machine"), pyb::arg("tool_length_error") = 0.0,
+      "Compensated commands; tool_length_error (mm): the error of pivot_length + tool_length of a "
+      "head machine (minus the identified tool_offset_Z).");
 
   pyb::class_<CompensationRow>(m, "CompensationRow")
       .def_readonly("name", &CompensationRow::name)

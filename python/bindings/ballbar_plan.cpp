@@ -56,37 +56,38 @@ void bind_ballbar_setup(pyb::module_& m) {
   const BallbarSetup d;
   pyb::class_<BallbarSetup>(m, "BallbarSetup",
                             "Layout of the single set-up ballbar test (mm, deg, mm/min, deg/min).")
-      .def(pyb::init([](MachineType machine, double ballbar_length, const Eigen::Vector3d& pivot,
-                        std::optional<std::array<double, 2>> tilt_range_deg, std::array<double, 2> rot_range_deg,
-                        double step_deg, double feed_mm_per_min, double feed_deg_per_min,
-                        std::vector<BallbarTest> tests, RadialSide radial_c_side,
-                        std::optional<double> axial_c_tilt_deg, std::vector<SweepDirection> directions,
-                        std::vector<double> feed_factors) {
-             BallbarSetup s;
-             s.machine = machine;
-             s.ballbar_length = ballbar_length;
-             s.pivot = pivot;
-             s.tilt_range_deg = tilt_range_deg.value_or(default_tilt_range_deg(machine));
-             s.rot_range_deg = rot_range_deg;
-             s.step_deg = step_deg;
-             s.feed_mm_per_min = feed_mm_per_min;
-             s.feed_deg_per_min = feed_deg_per_min;
-             s.tests = std::move(tests);
-             s.radial_c_side = radial_c_side;
-             s.axial_c_tilt_deg = axial_c_tilt_deg;
-             s.directions = std::move(directions);
-             s.feed_factors = std::move(feed_factors);
-             return s;
-           }),
-           pyb::arg("machine") = d.machine, pyb::arg("ballbar_length") = d.ballbar_length,
-           pyb::arg("pivot") = d.pivot, pyb::arg("tilt_range_deg") = pyb::none(),
-           pyb::arg("rot_range_deg") = d.rot_range_deg, pyb::arg("step_deg") = d.step_deg,
-           pyb::arg("feed_mm_per_min") = d.feed_mm_per_min,
-           pyb::arg("feed_deg_per_min") = d.feed_deg_per_min, pyb::arg("tests") = d.tests,
-           pyb::arg("radial_c_side") = d.radial_c_side, pyb::arg("axial_c_tilt_deg") = pyb::none(),
-           pyb::arg("directions") = d.directions, pyb::arg("feed_factors") = d.feed_factors,
-           "tilt_range_deg None: default_tilt_range_deg(machine); axial_c_tilt_deg None: "
-           "default_axial_c_tilt_deg(machine).")
+      .def(
+          pyb::init([](MachineType machine, double ballbar_length, const Eigen::Vector3d& pivot,
+                       std::optional<std::array<double, 2>> tilt_range_deg,
+                       std::array<double, 2> rot_range_deg, double step_deg, double feed_mm_per_min,
+                       double feed_deg_per_min, std::vector<BallbarTest> tests,
+                       RadialSide radial_c_side, std::optional<double> axial_c_tilt_deg,
+                       std::vector<SweepDirection> directions, std::vector<double> feed_factors) {
+            BallbarSetup s;
+            s.machine = machine;
+            s.ballbar_length = ballbar_length;
+            s.pivot = pivot;
+            s.tilt_range_deg = tilt_range_deg.value_or(default_tilt_range_deg(machine));
+            s.rot_range_deg = rot_range_deg;
+            s.step_deg = step_deg;
+            s.feed_mm_per_min = feed_mm_per_min;
+            s.feed_deg_per_min = feed_deg_per_min;
+            s.tests = std::move(tests);
+            s.radial_c_side = radial_c_side;
+            s.axial_c_tilt_deg = axial_c_tilt_deg;
+            s.directions = std::move(directions);
+            s.feed_factors = std::move(feed_factors);
+            return s;
+          }),
+          pyb::arg("machine") = d.machine, pyb::arg("ballbar_length") = d.ballbar_length,
+          pyb::arg("pivot") = d.pivot, pyb::arg("tilt_range_deg") = pyb::none(),
+          pyb::arg("rot_range_deg") = d.rot_range_deg, pyb::arg("step_deg") = d.step_deg,
+          pyb::arg("feed_mm_per_min") = d.feed_mm_per_min,
+          pyb::arg("feed_deg_per_min") = d.feed_deg_per_min, pyb::arg("tests") = d.tests,
+          pyb::arg("radial_c_side") = d.radial_c_side, pyb::arg("axial_c_tilt_deg") = pyb::none(),
+          pyb::arg("directions") = d.directions, pyb::arg("feed_factors") = d.feed_factors,
+          "tilt_range_deg None: default_tilt_range_deg(machine); axial_c_tilt_deg None: "
+          "default_axial_c_tilt_deg(machine).")
       .def_readwrite("machine", &BallbarSetup::machine)
       .def_readwrite("ballbar_length", &BallbarSetup::ballbar_length, "L0, mm")
       .def_readwrite("pivot", &BallbarSetup::pivot, "nominal pivot ball centre, table frame, mm")
@@ -98,7 +99,8 @@ void bind_ballbar_setup(pyb::module_& m) {
       .def_readwrite("feed_deg_per_min", &BallbarSetup::feed_deg_per_min)
       .def_readwrite("tests", &BallbarSetup::tests)
       .def_readwrite("radial_c_side", &BallbarSetup::radial_c_side)
-      .def_readwrite("directions", &BallbarSetup::directions, "directions of every rotary test, in order")
+      .def_readwrite("directions", &BallbarSetup::directions,
+                     "directions of every rotary test, in order")
       .def_readwrite("feed_factors", &BallbarSetup::feed_factors,
                      "feeds of every rotary test as factors of the set-up's feeds; the first is 1")
       .def_readwrite("axial_c_tilt_deg", &BallbarSetup::axial_c_tilt_deg,
@@ -217,8 +219,9 @@ void bind_nc_program(pyb::module_& m) {
 void bind_chain_runs(pyb::module_& m) {
   m.def(
       "record_run",
-      [](const BallbarSession& nominal, const BallbarSession& program, const BallbarMachineModel& machine,
-         std::optional<std::uint64_t> seed, const std::string& method, double noise_um, double noise_rho) {
+      [](const BallbarSession& nominal, const BallbarSession& program,
+         const BallbarMachineModel& machine, std::optional<std::uint64_t> seed,
+         const std::string& method, double noise_um, double noise_rho) {
         return record_run(nominal, program, machine, seed, {method, noise_um, noise_rho});
       },
       pyb::arg("nominal"), pyb::arg("program"), pyb::arg("machine"), pyb::arg("seed") = pyb::none(),
@@ -230,7 +233,8 @@ void bind_chain_runs(pyb::module_& m) {
       [](const BallbarSetup& setup, const std::vector<BallbarMachineModel>& machines,
          const std::optional<Array>& compensate_for, const std::vector<std::uint64_t>& seeds,
          const std::string& method, double noise_um, double noise_rho) {
-        const LocationErrorRows c = compensate_for ? rows_of<8>(*compensate_for, "compensate_for") : LocationErrorRows();
+        const LocationErrorRows c =
+            compensate_for ? rows_of<8>(*compensate_for, "compensate_for") : LocationErrorRows();
         pyb::gil_scoped_release release;
         return identify_runs(setup, machines, c, seeds, {method, noise_um, noise_rho});
       },

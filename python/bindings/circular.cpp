@@ -2,9 +2,9 @@
 // numpy out.
 #include "numpy.hpp"
 #include "rotacal/circular/analysis.hpp"
-#include "rotacal/circular/simulate.hpp"
-#include "rotacal/circular/plan.hpp"
 #include "rotacal/circular/diagnosis.hpp"
+#include "rotacal/circular/plan.hpp"
+#include "rotacal/circular/simulate.hpp"
 
 namespace rotacal::py {
 

@@ -1,55 +1,64 @@
 // Bindings for include/rotacal/io/controller_export.hpp (controller exports of a model file)
 // and io/controller_comment.hpp (free text as comments of the files a controller executes).
+#include "rotacal/io/controller_export.hpp"
+
 #include <pybind11/stl.h>
 
 #include "numpy.hpp"
 #include "rotacal/io/controller_comment.hpp"
-#include "rotacal/io/controller_export.hpp"
 
 namespace rotacal::py {
 
 void bind_controller_export(pyb::module_& m) {
   pyb::class_<ControllerValue>(m, "ControllerValue", "One controller parameter as written.")
       .def_readonly("name", &ControllerValue::name)
-      .def_readonly("current", &ControllerValue::current, "active while the test ran (0 when not given)")
+      .def_readonly("current", &ControllerValue::current,
+                    "active while the test ran (0 when not given)")
       .def_readonly("corrected", &ControllerValue::corrected)
       .def_readonly("std", &ControllerValue::std, "1 sigma of corrected, controller units")
       .def_readonly("unit", &ControllerValue::unit)
       .def_readonly("source", &ControllerValue::from, "the location errors it carries");
-  pyb::class_<ErrorDisposition>(m, "ErrorDisposition", "Whether a location error reaches the controller.")
+  pyb::class_<ErrorDisposition>(m, "ErrorDisposition",
+                                "Whether a location error reaches the controller.")
       .def_readonly("name", &ErrorDisposition::name)
       .def_readonly("value", &ErrorDisposition::value)
       .def_readonly("std", &ErrorDisposition::std)
       .def_readonly("observable", &ErrorDisposition::observable)
       .def_readonly("held", &ErrorDisposition::held)
       .def_readonly("where", &ErrorDisposition::where);
-  pyb::class_<ControllerExport>(m, "ControllerExport", "A model's location errors in a controller's parameters.")
-      .def_property_readonly("controller", [](const ControllerExport& e) { return to_string(e.controller); })
+  pyb::class_<ControllerExport>(m, "ControllerExport",
+                                "A model's location errors in a controller's parameters.")
+      .def_property_readonly("controller",
+                             [](const ControllerExport& e) { return to_string(e.controller); })
       .def_readonly("kinematics", &ControllerExport::kinematics)
       .def_readonly("current_given", &ControllerExport::current_given)
       .def_readonly("values", &ControllerExport::values)
       .def_readonly("errors", &ControllerExport::errors)
-      .def_property_readonly("not_held", [](const ControllerExport& e) { return Eigen::VectorXd(e.not_held.v); },
-                             "(8,) errors the controller cannot hold (mm, rad): NC compensation")
+      .def_property_readonly(
+          "not_held", [](const ControllerExport& e) { return Eigen::VectorXd(e.not_held.v); },
+          "(8,) errors the controller cannot hold (mm, rad): NC compensation")
       .def_readonly("text", &ControllerExport::text, "the file to load on the controller")
       .def_readonly("file_kind", &ControllerExport::file_kind);
   m.def(
       "export_controller",
-      [](const std::string& model_path, const std::string& controller, std::optional<std::string> current_text,
-         const std::string& current_source, int toolholder, const std::string& generated_at) {
+      [](const std::string& model_path, const std::string& controller,
+         std::optional<std::string> current_text, const std::string& current_source, int toolholder,
+         const std::string& generated_at) {
         const Controller c = parse_controller(controller);
         const ModelFile model = read_model(model_path);
         ExportOptions o;
         o.toolholder = toolholder;
         o.generated_at = generated_at;
         if (current_text) {
-          o.current = parse_current_parameters(c, model.machine, *current_text, current_source, toolholder);
+          o.current =
+              parse_current_parameters(c, model.machine, *current_text, current_source, toolholder);
           o.current_given = true;
         }
         return export_kinematics(c, export_input(model, model_path), o);
       },
       pyb::arg("model_path"), pyb::arg("controller"), pyb::arg("current_text") = std::nullopt,
-      pyb::arg("current_source") = "<current>", pyb::arg("toolholder") = 1, pyb::arg("generated_at") = "",
+      pyb::arg("current_source") = "<current>", pyb::arg("toolholder") = 1,
+      pyb::arg("generated_at") = "",
       "Export a model file's location errors into a controller's kinematic parameters "
       "(io/controller_export.hpp); current_text: the controller's current values (its HAL/MPF file "
       "or the documented JSON), None for zero offsets.");

@@ -129,8 +129,8 @@ void bind_ballbar_separation(pyb::module_& m) {
       .def_readonly("slow_down", &SeparatingCandidate::slow_down)
       .def_readonly("correlation", &SeparatingCandidate::correlation)
       .def_readonly("determined", &SeparatingCandidate::determined);
-  auto ballbar_separation = pyb::class_<SeparationDesign>(m, "SeparationDesign",
-                                 "The added test that separates two effects, or why none can.");
+  auto ballbar_separation = pyb::class_<SeparationDesign>(
+      m, "SeparationDesign", "The added test that separates two effects, or why none can.");
   separation_members(ballbar_separation);
   ballbar_separation.def_readonly("chosen", &SeparationDesign::chosen);
   m.def(
@@ -240,8 +240,8 @@ void bind_rtest_separation(pyb::module_& m) {
       .def_readonly("repeats", &RtestSeparatingCandidate::repeats)
       .def_readonly("correlation", &RtestSeparatingCandidate::correlation)
       .def_readonly("determined", &RtestSeparatingCandidate::determined);
-  auto rtestballbar_separation = pyb::class_<RtestSeparationDesign>(m, "RtestSeparationDesign",
-                                 "The added nest that separates two effects, or why none can.");
+  auto rtestballbar_separation = pyb::class_<RtestSeparationDesign>(
+      m, "RtestSeparationDesign", "The added nest that separates two effects, or why none can.");
   separation_members(rtestballbar_separation);
   rtestballbar_separation.def_readonly("chosen", &RtestSeparationDesign::chosen);
   m.def(
@@ -259,7 +259,8 @@ void bind_rtest_separation(pyb::module_& m) {
 
 // Poses (P, 2: tilt, rotary deg) of a probe pattern.
 Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor> poses_of(const ProbePattern& p) {
-  Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor> a(static_cast<Eigen::Index>(p.poses_deg.size()), 2);
+  Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor> a(
+      static_cast<Eigen::Index>(p.poses_deg.size()), 2);
   for (std::size_t i = 0; i < p.poses_deg.size(); ++i)
     a.row(static_cast<Eigen::Index>(i)) << p.poses_deg[i].tilt, p.poses_deg[i].rot;
   return a;
@@ -267,7 +268,8 @@ Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor> poses_of(const ProbePa
 
 // The touch-probe design: poses and touches, and the added poses that separate two effects.
 void bind_probe_design(pyb::module_& m) {
-  pyb::class_<ProbeDesignOptions>(m, "ProbeDesignOptions", "Options of design_probe_test (defaults).")
+  pyb::class_<ProbeDesignOptions>(m, "ProbeDesignOptions",
+                                  "Options of design_probe_test (defaults).")
       .def(pyb::init<>())
       .def_readwrite("machine", &ProbeDesignOptions::machine)
       .def_readwrite("sphere", &ProbeDesignOptions::sphere, "nominal centre, table frame, mm")
@@ -282,12 +284,16 @@ void bind_probe_design(pyb::module_& m) {
       .def_readwrite("rot_step_deg", &ProbeDesignOptions::rot_step_deg)
       .def_readwrite("noise_um", &ProbeDesignOptions::noise_um)
       .def_readwrite("reference_radius_mm", &ProbeDesignOptions::reference_radius_mm)
-      .def_readwrite("touch_directions", &ProbeDesignOptions::touch_directions, "each touch its own direction")
+      .def_readwrite("touch_directions", &ProbeDesignOptions::touch_directions,
+                     "each touch its own direction")
       .def_readwrite("max_contact_angle_deg", &ProbeDesignOptions::max_contact_angle_deg)
       .def_readwrite("contact_step_deg", &ProbeDesignOptions::contact_step_deg)
       .def_property(
-          "sphere_candidates", [](const ProbeDesignOptions& o) { return rows_from(o.sphere_candidates); },
-          [](ProbeDesignOptions& o, const Array& a) { o.sphere_candidates = vectors_of(a, "sphere_candidates"); },
+          "sphere_candidates",
+          [](const ProbeDesignOptions& o) { return rows_from(o.sphere_candidates); },
+          [](ProbeDesignOptions& o, const Array& a) {
+            o.sphere_candidates = vectors_of(a, "sphere_candidates");
+          },
           "other places of the sphere (S, 3), table frame, mm")
       .def_readwrite("sphere_gain", &ProbeDesignOptions::sphere_gain);
   pyb::class_<ProbeSphereTrial>(m, "ProbeSphereTrial", "One place of the sphere the design tried.")
@@ -296,9 +302,12 @@ void bind_probe_design(pyb::module_& m) {
       .def_readonly("worst_expanded_um", &ProbeSphereTrial::worst_expanded_um)
       .def_readonly("why_not", &ProbeSphereTrial::why_not);
   pyb::class_<ProbeDesignCandidate>(m, "ProbeDesignCandidate", "Poses and touches, evaluated.")
-      .def_property_readonly("poses_deg", [](const ProbeDesignCandidate& c) { return poses_of(c.pattern); },
-                             "pose visits (P, 2): tilt, rotary, deg, in program order")
-      .def_property_readonly("directions", [](const ProbeDesignCandidate& c) { return rows_from(c.pattern.directions); })
+      .def_property_readonly(
+          "poses_deg", [](const ProbeDesignCandidate& c) { return poses_of(c.pattern); },
+          "pose visits (P, 2): tilt, rotary, deg, in program order")
+      .def_property_readonly(
+          "directions",
+          [](const ProbeDesignCandidate& c) { return rows_from(c.pattern.directions); })
       .def_property_readonly(
           "pose_directions",
           [](const ProbeDesignCandidate& c) {
@@ -307,7 +316,8 @@ void bind_probe_design(pyb::module_& m) {
             return out;
           },
           "each pose's own directions (K_i, 3); empty: `directions` at every pose")
-      .def_property_readonly("sphere", [](const ProbeDesignCandidate& c) { return Eigen::Vector3d(c.pattern.sphere); })
+      .def_property_readonly(
+          "sphere", [](const ProbeDesignCandidate& c) { return Eigen::Vector3d(c.pattern.sphere); })
       .def_readonly("feasible", &ProbeDesignCandidate::feasible)
       .def_readonly("why_not", &ProbeDesignCandidate::why_not)
       .def_readonly("touches", &ProbeDesignCandidate::touches)
@@ -316,7 +326,8 @@ void bind_probe_design(pyb::module_& m) {
       .def_readonly("worst_expanded_um", &ProbeDesignCandidate::worst_expanded_um)
       .def_readonly("worst_error", &ProbeDesignCandidate::worst_error)
       .def_readonly("undetermined", &ProbeDesignCandidate::undetermined);
-  pyb::class_<ProbeDesign>(m, "ProbeDesign", "The designed poses and the default ones at the same touches.")
+  pyb::class_<ProbeDesign>(m, "ProbeDesign",
+                           "The designed poses and the default ones at the same touches.")
       .def_readonly("best", &ProbeDesign::best)
       .def_readonly("baseline", &ProbeDesign::baseline)
       .def_readonly("touches", &ProbeDesign::touches)
@@ -332,37 +343,46 @@ void bind_probe_design(pyb::module_& m) {
         pyb::gil_scoped_release release;
         return design_probe_test(o);
       },
-      pyb::arg("options"), "The poses and touches with the smallest predicted uncertainty (probe/design.hpp).");
-  pyb::class_<ProbeSeparationOptions>(m, "ProbeSeparationOptions", "Options of design_probe_separation (defaults).")
+      pyb::arg("options"),
+      "The poses and touches with the smallest predicted uncertainty (probe/design.hpp).");
+  pyb::class_<ProbeSeparationOptions>(m, "ProbeSeparationOptions",
+                                      "Options of design_probe_separation (defaults).")
       .def(pyb::init<>())
       .def_readwrite("tilt_step_deg", &ProbeSeparationOptions::tilt_step_deg)
       .def_readwrite("rot_step_deg", &ProbeSeparationOptions::rot_step_deg)
       .def_readwrite("pose_time_s", &ProbeSeparationOptions::pose_time_s, "0: the session's")
       .def_readwrite("max_added_time_s", &ProbeSeparationOptions::max_added_time_s)
       .def_readwrite("max_correlation", &ProbeSeparationOptions::max_correlation)
-      .def_readwrite("noise_um", &ProbeSeparationOptions::noise_um, "0: the session's residual noise")
+      .def_readwrite("noise_um", &ProbeSeparationOptions::noise_um,
+                     "0: the session's residual noise")
       .def_readwrite("reference_radius_mm", &ProbeSeparationOptions::reference_radius_mm);
-  pyb::class_<ProbeSeparatingCandidate>(m, "ProbeSeparatingCandidate", "Added poses, evaluated with the session.")
-      .def_property_readonly("poses_deg", [](const ProbeSeparatingCandidate& c) { return poses_of(c.added); })
-      .def_property_readonly("directions", [](const ProbeSeparatingCandidate& c) { return rows_from(c.added.directions); })
+  pyb::class_<ProbeSeparatingCandidate>(m, "ProbeSeparatingCandidate",
+                                        "Added poses, evaluated with the session.")
+      .def_property_readonly("poses_deg",
+                             [](const ProbeSeparatingCandidate& c) { return poses_of(c.added); })
+      .def_property_readonly(
+          "directions",
+          [](const ProbeSeparatingCandidate& c) { return rows_from(c.added.directions); })
       .def_readonly("description", &ProbeSeparatingCandidate::description)
       .def_readonly("duration_s", &ProbeSeparatingCandidate::duration_s)
       .def_readonly("repeats", &ProbeSeparatingCandidate::repeats)
       .def_readonly("correlation", &ProbeSeparatingCandidate::correlation)
       .def_readonly("determined", &ProbeSeparatingCandidate::determined);
-  auto probeballbar_separation = pyb::class_<ProbeSeparationDesign>(m, "ProbeSeparationDesign",
-                                 "The added poses that separate two effects, or why none can.");
+  auto probeballbar_separation = pyb::class_<ProbeSeparationDesign>(
+      m, "ProbeSeparationDesign", "The added poses that separate two effects, or why none can.");
   separation_members(probeballbar_separation);
   probeballbar_separation.def_readonly("chosen", &ProbeSeparationDesign::chosen);
   m.def(
       "design_probe_separation",
-      [](const ProbeSession& session, const std::vector<std::string>& pair, const ProbeSeparationOptions& o) {
+      [](const ProbeSession& session, const std::vector<std::string>& pair,
+         const ProbeSeparationOptions& o) {
         const EffectModel fx = effects_of(pair);
         pyb::gil_scoped_release release;
         return design_probe_separation(session, fx.effects, o);
       },
       pyb::arg("session"), pyb::arg("pair"), pyb::arg("options") = ProbeSeparationOptions{},
-      "The smallest added set of poses that separates two effects after a touch-probe session (probe/design.hpp).");
+      "The smallest added set of poses that separates two effects after a touch-probe session "
+      "(probe/design.hpp).");
 }
 
 }  // namespace

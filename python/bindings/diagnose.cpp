@@ -42,9 +42,10 @@ void bind_diagnosis_findings(pyb::module_& m) {
       .def_readonly("n", &GroupResidual::n)
       .def_readonly("rms_um", &GroupResidual::rms_um)
       .def_readonly("mean_um", &GroupResidual::mean_um)
-      .def_property_readonly("angle_axis", [](const GroupResidual& g) {
-        return g.angle_axis ? std::string(1, g.angle_axis) : std::string();
-      })
+      .def_property_readonly("angle_axis",
+                             [](const GroupResidual& g) {
+                               return g.angle_axis ? std::string(1, g.angle_axis) : std::string();
+                             })
       .def_readonly("harmonic_um", &GroupResidual::harmonic_um)
       .def_readonly("harmonics_left_out", &GroupResidual::harmonics_left_out)
       .def_readonly("harmonic_note", &GroupResidual::harmonic_note)
@@ -100,7 +101,9 @@ void bind_diagnosis_findings(pyb::module_& m) {
       .def_readonly("p_value", &Unexplained::p_value)
       .def_readonly("signature", &Unexplained::signature)
       .def_readonly("group", &Unexplained::group)
-      .def_property_readonly("axis", [](const Unexplained& u) { return u.axis ? std::string(1, u.axis) : std::string(); })
+      .def_property_readonly(
+          "axis",
+          [](const Unexplained& u) { return u.axis ? std::string(1, u.axis) : std::string(); })
       .def_readonly("range_from", &Unexplained::range_from)
       .def_readonly("range_to", &Unexplained::range_to);
 }

@@ -40,7 +40,8 @@ refine : polish by orthogonal distances (Ceres)
 Raises rotacal.DegenerateGeometry for < 3, collinear points or a too short arc.)doc";
   m.def(
       "hyper_circle_fit",
-      [](const pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>& points, double sigma, bool refine) {
+      [](const pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>& points,
+         double sigma, bool refine) {
         CircleFitOptions o;
         o.sigma = sigma;
         o.refine = refine;
@@ -49,7 +50,8 @@ Raises rotacal.DegenerateGeometry for < 3, collinear points or a too short arc.)
       pyb::arg("points"), pyb::arg("sigma") = 0.0, pyb::arg("refine") = false, circle_doc);
   m.def(
       "kasa_circle_fit",
-      [](const pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>& points, double sigma, bool refine) {
+      [](const pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>& points,
+         double sigma, bool refine) {
         CircleFitOptions o;
         o.sigma = sigma;
         o.refine = refine;
@@ -59,25 +61,26 @@ Raises rotacal.DegenerateGeometry for < 3, collinear points or a too short arc.)
   m.def(
       "sphere_fit",
       [](const pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>& points,
-         std::optional<double> radius, double sigma) {
-        return sphere_fit(rows_of<3>(points, "points"), {radius, sigma});
-      },
+         std::optional<double> radius,
+         double sigma) { return sphere_fit(rows_of<3>(points, "points"), {radius, sigma}); },
       pyb::arg("points"), pyb::arg("radius") = std::nullopt, pyb::arg("sigma") = 0.0,
       "Least-squares sphere to (N, 3) points; radius fixes it (e.g. the ballbar length).");
   m.def(
       "svd_plane_fit",
       [](const pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>& points,
-         const pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>& normal_hint, double sigma) {
-        return svd_plane_fit(rows_of<3>(points, "points"), vec_of<3>(normal_hint, "normal_hint"), sigma);
+         const pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>& normal_hint,
+         double sigma) {
+        return svd_plane_fit(rows_of<3>(points, "points"), vec_of<3>(normal_hint, "normal_hint"),
+                             sigma);
       },
-      pyb::arg("points"), pyb::arg("normal_hint") = pyb::array_t<double>(3, std::array<double, 3>{0, 0, 1}.data()),
+      pyb::arg("points"),
+      pyb::arg("normal_hint") = pyb::array_t<double>(3, std::array<double, 3>{0, 0, 1}.data()),
       pyb::arg("sigma") = 0.0, "Total-least-squares plane (Flynn et al. Eq. 3).");
   m.def(
       "box_least_squares",
-      [](const Eigen::MatrixXd& R, const Eigen::VectorXd& d, const Eigen::VectorXd& w, const Eigen::VectorXd& bounds,
-         int max_sweeps, double tolerance) {
-        return box_least_squares(R, d, w, bounds, {max_sweeps, tolerance});
-      },
+      [](const Eigen::MatrixXd& R, const Eigen::VectorXd& d, const Eigen::VectorXd& w,
+         const Eigen::VectorXd& bounds, int max_sweeps,
+         double tolerance) { return box_least_squares(R, d, w, bounds, {max_sweeps, tolerance}); },
       pyb::arg("R"), pyb::arg("d"), pyb::arg("w"), pyb::arg("bounds"), pyb::arg("max_sweeps") = 200,
       pyb::arg("tolerance") = 1e-9,
       R"doc(min sum w (d - R s)^2 with |s_j| <= bounds_j, by cyclic coordinate descent.

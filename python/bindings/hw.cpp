@@ -73,7 +73,8 @@ RecordSummary record_plan(const std::string& port, const Plan& plan, const std::
 }  // namespace
 
 void bind(pyb::module_& m) {
-  pyb::class_<FaultInjection>(m, "FaultInjection", "Faults a virtual instrument acts out (counted in frames).")
+  pyb::class_<FaultInjection>(m, "FaultInjection",
+                              "Faults a virtual instrument acts out (counted in frames).")
       .def(pyb::init<>())
       .def_readwrite("garbage_every", &FaultInjection::garbage_every)
       .def_readwrite("corrupt_every", &FaultInjection::corrupt_every)
@@ -82,23 +83,24 @@ void bind(pyb::module_& m) {
       .def_readwrite("close_after", &FaultInjection::close_after)
       .def_readwrite("silence_after", &FaultInjection::silence_after);
 
-  pyb::class_<VirtualBallbar> ballbar(m, "VirtualBallbar",
-                                      "A ballbar on a simulated machine, served on a pseudo-terminal.");
-  ballbar.def(pyb::init([](const BallbarPlan& plan, const BallbarMachineModel& truth, double noise_um,
-                        std::uint64_t seed, double rate_hz, double speed, int baud, const FaultInjection& faults) {
-             VirtualBallbarOptions o;
-             o.truth = truth;
-             o.noise_um = noise_um;
-             o.seed = seed;
-             o.rate_hz = rate_hz;
-             o.speed = speed;
-             o.baud = baud;
-             o.faults = faults;
-             return std::make_unique<VirtualBallbar>(ProgramTimeline(plan), o);
-           }),
-           pyb::arg("plan"), pyb::arg("truth"), pyb::arg("noise_um") = 0.5, pyb::arg("seed") = 1,
-           pyb::arg("rate_hz") = 1000.0, pyb::arg("speed") = 1.0, pyb::arg("baud") = 115200,
-           pyb::arg("faults") = FaultInjection{});
+  pyb::class_<VirtualBallbar> ballbar(
+      m, "VirtualBallbar", "A ballbar on a simulated machine, served on a pseudo-terminal.");
+  ballbar.def(pyb::init([](const BallbarPlan& plan, const BallbarMachineModel& truth,
+                           double noise_um, std::uint64_t seed, double rate_hz, double speed,
+                           int baud, const FaultInjection& faults) {
+                VirtualBallbarOptions o;
+                o.truth = truth;
+                o.noise_um = noise_um;
+                o.seed = seed;
+                o.rate_hz = rate_hz;
+                o.speed = speed;
+                o.baud = baud;
+                o.faults = faults;
+                return std::make_unique<VirtualBallbar>(ProgramTimeline(plan), o);
+              }),
+              pyb::arg("plan"), pyb::arg("truth"), pyb::arg("noise_um") = 0.5, pyb::arg("seed") = 1,
+              pyb::arg("rate_hz") = 1000.0, pyb::arg("speed") = 1.0, pyb::arg("baud") = 115200,
+              pyb::arg("faults") = FaultInjection{});
   instrument_methods(ballbar);
 
   pyb::class_<VirtualCircularBallbar> circular(
@@ -116,14 +118,17 @@ void bind(pyb::module_& m) {
                pyb::arg("faults") = FaultInjection{});
   instrument_methods(circular);
 
-  pyb::class_<VirtualRtest> rtest(m, "VirtualRtest",
-                                  "An R-test on a simulated B/C table, served on a pseudo-terminal.");
+  pyb::class_<VirtualRtest> rtest(
+      m, "VirtualRtest", "An R-test on a simulated B/C table, served on a pseudo-terminal.");
   instrument_methods(rtest);
-  rtest.def(pyb::init([](MachineType machine, const Array& errors, const std::vector<std::string>& effects,
+  rtest
+      .def(pyb::init([](MachineType machine, const Array& errors,
+                        const std::vector<std::string>& effects,
                         const std::vector<double>& effect_params, const std::vector<double>& b_deg,
-                        const std::vector<double>& c_deg, const Array& nests, double dwell_s, double noise_um,
-                        double probe_zero_um, const Array& probe_dirs, unsigned seed, const std::string& mode,
-                        double rate_hz, double speed, int baud, const FaultInjection& faults) {
+                        const std::vector<double>& c_deg, const Array& nests, double dwell_s,
+                        double noise_um, double probe_zero_um, const Array& probe_dirs,
+                        unsigned seed, const std::string& mode, double rate_hz, double speed,
+                        int baud, const FaultInjection& faults) {
              VirtualRtestOptions o;
              o.truth.machine = machine;
              o.truth.errors = LocationErrors<double>(vec_of<8>(errors, "errors"));
@@ -146,12 +151,14 @@ void bind(pyb::module_& m) {
            }),
            pyb::arg("machine"), pyb::arg("errors"), pyb::arg("effects"), pyb::arg("effect_params"),
            pyb::arg("b_deg"), pyb::arg("c_deg"), pyb::arg("nests"), pyb::arg("dwell_s"),
-           pyb::arg("noise_um"), pyb::arg("probe_zero_um"), pyb::arg("probe_dirs"), pyb::arg("seed"),
-           pyb::arg("mode") = "keyence", pyb::arg("rate_hz") = 100.0, pyb::arg("speed") = 1.0,
-           pyb::arg("baud") = 115200, pyb::arg("faults") = FaultInjection{})
+           pyb::arg("noise_um"), pyb::arg("probe_zero_um"), pyb::arg("probe_dirs"),
+           pyb::arg("seed"), pyb::arg("mode") = "keyence", pyb::arg("rate_hz") = 100.0,
+           pyb::arg("speed") = 1.0, pyb::arg("baud") = 115200,
+           pyb::arg("faults") = FaultInjection{})
       .def_property_readonly("program", &VirtualRtest::program,
                              "Commanded rows (set-up, time, B, C, X, Y, Z) and nests.")
-      .def_property_readonly("probe_zeros", [](const VirtualRtest& v) { return rows_from(v.probe_zeros()); });
+      .def_property_readonly("probe_zeros",
+                             [](const VirtualRtest& v) { return rows_from(v.probe_zeros()); });
 
   pyb::class_<RecordSummary>(m, "RecordSummary")
       .def_readonly("rows", &RecordSummary::rows)
@@ -167,27 +174,25 @@ void bind(pyb::module_& m) {
       .def_readonly("detail", &RecordSummary::detail)
       .def("describe", &RecordSummary::describe);
 
-  m.def(
-      "record_ballbar", &record_plan<ProgramTimeline, BallbarPlan>,
-      pyb::arg("port"), pyb::arg("plan"), pyb::arg("path"), pyb::arg("baud") = 115200,
-      pyb::arg("rate_hz") = 1000.0, pyb::arg("zero") = false, pyb::arg("silence_timeout_s") = 3.0,
-      pyb::arg("progress") = std::nullopt,
-      "Record a ballbar test from a serial port into a rotacal-ballbar/1 file (hw/recorder.hpp). "
-      "progress(rows, lost, corrupt, t_s, duration_s) -> bool is called a few times a second; "
-      "returning False stops the recording.");
-  m.def(
-      "record_circular_ballbar", &record_plan<CircularTimeline, CircularPlanResult>,
-      pyb::arg("port"), pyb::arg("plan"), pyb::arg("path"), pyb::arg("baud") = 115200,
-      pyb::arg("rate_hz") = 250.0, pyb::arg("zero") = false, pyb::arg("silence_timeout_s") = 3.0,
-      pyb::arg("progress") = std::nullopt,
-      "Record an ISO 230-4 circular test from a serial port into a rotacal-ballbar/1 file: rows "
-      "on a data arc labelled with the run (circular_XY_ccw, ...), the rest 'transition' "
-      "(hw/recorder.hpp); progress as for record_ballbar.");
+  m.def("record_ballbar", &record_plan<ProgramTimeline, BallbarPlan>, pyb::arg("port"),
+        pyb::arg("plan"), pyb::arg("path"), pyb::arg("baud") = 115200, pyb::arg("rate_hz") = 1000.0,
+        pyb::arg("zero") = false, pyb::arg("silence_timeout_s") = 3.0,
+        pyb::arg("progress") = std::nullopt,
+        "Record a ballbar test from a serial port into a rotacal-ballbar/1 file (hw/recorder.hpp). "
+        "progress(rows, lost, corrupt, t_s, duration_s) -> bool is called a few times a second; "
+        "returning False stops the recording.");
+  m.def("record_circular_ballbar", &record_plan<CircularTimeline, CircularPlanResult>,
+        pyb::arg("port"), pyb::arg("plan"), pyb::arg("path"), pyb::arg("baud") = 115200,
+        pyb::arg("rate_hz") = 250.0, pyb::arg("zero") = false, pyb::arg("silence_timeout_s") = 3.0,
+        pyb::arg("progress") = std::nullopt,
+        "Record an ISO 230-4 circular test from a serial port into a rotacal-ballbar/1 file: rows "
+        "on a data arc labelled with the run (circular_XY_ccw, ...), the rest 'transition' "
+        "(hw/recorder.hpp); progress as for record_ballbar.");
   m.def(
       "record_rtest",
-      [](const std::string& port, const std::string& mode, const RtestSession& program, double dwell_s,
-         const Array& probe_dirs, const std::string& path, int baud, double rate_hz, double speed,
-         double silence_timeout_s, const std::optional<pyb::function>& progress) {
+      [](const std::string& port, const std::string& mode, const RtestSession& program,
+         double dwell_s, const Array& probe_dirs, const std::string& path, int baud, double rate_hz,
+         double speed, double silence_timeout_s, const std::optional<pyb::function>& progress) {
         const Eigen::Matrix3d dirs = matrix3_of(probe_dirs, "probe_dirs");
         const ProbeMode pm = parse_probe_mode(mode);
         const RecordOptions o = record_options(rate_hz, speed, silence_timeout_s, false, progress);
@@ -195,16 +200,21 @@ void bind(pyb::module_& m) {
         auto transport = open_port(port, settings_of(baud));
         return record_rtest(*transport, pm, program, dwell_s, dirs, path, o);
       },
-      pyb::arg("port"), pyb::arg("mode"), pyb::arg("program"), pyb::arg("dwell_s"), pyb::arg("probe_dirs"),
-      pyb::arg("path"), pyb::arg("baud") = 115200, pyb::arg("rate_hz") = 100.0, pyb::arg("speed") = 1.0,
-      pyb::arg("silence_timeout_s") = 3.0, pyb::arg("progress") = std::nullopt,
+      pyb::arg("port"), pyb::arg("mode"), pyb::arg("program"), pyb::arg("dwell_s"),
+      pyb::arg("probe_dirs"), pyb::arg("path"), pyb::arg("baud") = 115200,
+      pyb::arg("rate_hz") = 100.0, pyb::arg("speed") = 1.0, pyb::arg("silence_timeout_s") = 3.0,
+      pyb::arg("progress") = std::nullopt,
       "Record an R-test (sylvac, keyence or stream mode) into a rotacal-rtest/1 file with raw "
       "d1,d2,d3 (hw/recorder.hpp); progress as for record_ballbar.");
-  m.def("list_serial_ports", [] {
-    std::vector<std::tuple<std::string, std::string, std::string>> out;
-    for (const PortInfo& p : list_serial_ports()) out.emplace_back(p.path, p.description, p.transport);
-    return out;
-  }, "(path, description, transport) of every serial port libserialport finds.");
+  m.def(
+      "list_serial_ports",
+      [] {
+        std::vector<std::tuple<std::string, std::string, std::string>> out;
+        for (const PortInfo& p : list_serial_ports())
+          out.emplace_back(p.path, p.description, p.transport);
+        return out;
+      },
+      "(path, description, transport) of every serial port libserialport finds.");
 }
 
 }  // namespace rotacal::py::hw_bindings

@@ -1,25 +1,31 @@
 // Bindings for include/rotacal/io: session classes with numpy columns, readers and writers.
 #include "json_value.hpp"
 #include "numpy.hpp"
+#include "rotacal/ballbar/model_document.hpp"
 #include "rotacal/core/json_text.hpp"
 #include "rotacal/io/ballbar_file.hpp"
-#include "rotacal/ballbar/model_document.hpp"
 #include "rotacal/io/model_file.hpp"
 #include "rotacal/io/output_file.hpp"
-#include "rotacal/session/plausibility.hpp"
 #include "rotacal/io/session_arrays.hpp"
 #include "rotacal/rtest/model_document.hpp"
+#include "rotacal/session/plausibility.hpp"
 
 namespace rotacal::py {
 
 pyb::object from_json(const nlohmann::ordered_json& j) {
   switch (j.type()) {
-    case nlohmann::ordered_json::value_t::null: return pyb::none();
-    case nlohmann::ordered_json::value_t::boolean: return pyb::bool_(j.get<bool>());
-    case nlohmann::ordered_json::value_t::number_integer: return pyb::int_(j.get<long long>());
-    case nlohmann::ordered_json::value_t::number_unsigned: return pyb::int_(j.get<unsigned long long>());
-    case nlohmann::ordered_json::value_t::number_float: return pyb::float_(j.get<double>());
-    case nlohmann::ordered_json::value_t::string: return pyb::str(j.get<std::string>());
+    case nlohmann::ordered_json::value_t::null:
+      return pyb::none();
+    case nlohmann::ordered_json::value_t::boolean:
+      return pyb::bool_(j.get<bool>());
+    case nlohmann::ordered_json::value_t::number_integer:
+      return pyb::int_(j.get<long long>());
+    case nlohmann::ordered_json::value_t::number_unsigned:
+      return pyb::int_(j.get<unsigned long long>());
+    case nlohmann::ordered_json::value_t::number_float:
+      return pyb::float_(j.get<double>());
+    case nlohmann::ordered_json::value_t::string:
+      return pyb::str(j.get<std::string>());
     case nlohmann::ordered_json::value_t::array: {
       pyb::list out;
       for (const auto& x : j) out.append(from_json(x));
@@ -27,10 +33,12 @@ pyb::object from_json(const nlohmann::ordered_json& j) {
     }
     case nlohmann::ordered_json::value_t::object: {
       pyb::dict out;
-      for (auto it = j.begin(); it != j.end(); ++it) out[pyb::str(it.key())] = from_json(it.value());
+      for (auto it = j.begin(); it != j.end(); ++it)
+        out[pyb::str(it.key())] = from_json(it.value());
       return std::move(out);
     }
-    default: throw InvalidArgument("model document: a JSON value of an unsupported type");
+    default:
+      throw InvalidArgument("model document: a JSON value of an unsupported type");
   }
 }
 
@@ -66,7 +74,8 @@ nlohmann::ordered_json to_json(const pyb::handle& o, const std::string& where, i
   if (pyb::isinstance<pyb::list>(o) || pyb::isinstance<pyb::tuple>(o)) {
     nlohmann::ordered_json out = nlohmann::ordered_json::array();
     std::size_t i = 0;
-    for (const auto& x : o) out.push_back(to_json(x, where + "[" + std::to_string(i++) + "]", depth + 1));
+    for (const auto& x : o)
+      out.push_back(to_json(x, where + "[" + std::to_string(i++) + "]", depth + 1));
     return out;
   }
   if (pyb::hasattr(o, "tolist")) return to_json(o.attr("tolist")(), where, depth + 1);  // numpy
@@ -84,10 +93,13 @@ void bind_sessions(pyb::module_& m) {
            "angles_deg (N,2) tilt and C, length (N,) measured lengths.")
       .def_readonly("machine", &BallbarSession::machine)
       .def_readonly("ballbar_length", &BallbarSession::ballbar_length)
-      .def_property_readonly("pivot", [](const BallbarSession& s) { return Eigen::Vector3d(s.pivot); })
+      .def_property_readonly("pivot",
+                             [](const BallbarSession& s) { return Eigen::Vector3d(s.pivot); })
       .def_readonly("noise_um", &BallbarSession::noise_um)
-      .def_property_readonly("metadata", [](const BallbarSession& s) { return metadata_dict(s.metadata); })
-      .def_readonly("warnings", &BallbarSession::warnings, "what the reader found suspicious but kept")
+      .def_property_readonly("metadata",
+                             [](const BallbarSession& s) { return metadata_dict(s.metadata); })
+      .def_readonly("warnings", &BallbarSession::warnings,
+                    "what the reader found suspicious but kept")
       .def_property_readonly("tests", &ballbar_tests, "test label of every sample")
       .def_property_readonly("test_names", &BallbarSession::tests, "distinct test labels, in order")
       .def_property_readonly("time", &ballbar_times)
@@ -97,7 +109,8 @@ void bind_sessions(pyb::module_& m) {
       .def_property_readonly("annotations",
                              [](const BallbarSession& s) {
                                std::vector<std::pair<std::size_t, std::string>> out;
-                               for (const Annotation& a : s.annotations) out.emplace_back(a.before_sample, a.text);
+                               for (const Annotation& a : s.annotations)
+                                 out.emplace_back(a.before_sample, a.text);
                                return out;
                              })
       .def("with_lengths", &with_lengths, pyb::arg("length"),
@@ -113,8 +126,10 @@ void bind_sessions(pyb::module_& m) {
       .def_readonly("nests", &RtestSession::nests)
       .def_readonly("probe_dirs", &RtestSession::probe_dirs)
       .def_readonly("noise_um", &RtestSession::noise_um)
-      .def_property_readonly("metadata", [](const RtestSession& s) { return metadata_dict(s.metadata); })
-      .def_readonly("warnings", &RtestSession::warnings, "what the reader found suspicious but kept")
+      .def_property_readonly("metadata",
+                             [](const RtestSession& s) { return metadata_dict(s.metadata); })
+      .def_readonly("warnings", &RtestSession::warnings,
+                    "what the reader found suspicious but kept")
       .def_property_readonly("setups", &rtest_setups, "set-up (nest) label of every pose")
       .def_property_readonly("time", &rtest_times)
       .def_property_readonly("angles_deg", &rtest_angles_deg)
@@ -141,18 +156,24 @@ void bind_sessions(pyb::module_& m) {
 void bind_model_documents(pyb::module_& m) {
   m.def(
       "read_model_document",
-      [](const std::string& path) { return from_json(read_model_document(path)); }, pyb::arg("path"),
+      [](const std::string& path) { return from_json(read_model_document(path)); },
+      pyb::arg("path"),
       "Read a rotacal-model file (strict JSON, version, kind, machine checked); the document as a "
       "dict. ParseError (syntax), InvalidArgument (content), IoError.");
   m.def(
       "parse_model_document",
-      [](const std::string& text, const std::string& source) { return from_json(parse_model(text, source).document); },  // full check
+      [](const std::string& text, const std::string& source) {
+        return from_json(parse_model(text, source).document);
+      },  // full check
       pyb::arg("text"), pyb::arg("source") = "<model>");
   m.def(
       "format_model_document",
-      [](const pyb::dict& doc, const std::string& source) { return format_model(to_json(doc, source), source); },
+      [](const pyb::dict& doc, const std::string& source) {
+        return format_model(to_json(doc, source), source);
+      },
       pyb::arg("document"), pyb::arg("source") = "model",
-      "Strict JSON text of a model document (non-finite numbers as null with a reason), validated.");
+      "Strict JSON text of a model document (non-finite numbers as null with a reason), "
+      "validated.");
   m.def(
       "write_model_document",
       [](const pyb::dict& doc, const std::string& path, const std::vector<std::string>& inputs,
@@ -175,7 +196,8 @@ void bind_model_documents(pyb::module_& m) {
       pyb::arg("model"));
   m.def(
       "rtest_joint_model_document",
-      [](const RtestJointIdentification& identification, const std::map<std::string, Eigen::Vector3d>& nests) {
+      [](const RtestJointIdentification& identification,
+         const std::map<std::string, Eigen::Vector3d>& nests) {
         return from_json(rtest_joint_model_document(identification, nests));
       },
       pyb::arg("identification"), pyb::arg("nests"),
@@ -186,7 +208,8 @@ void bind_model_documents(pyb::module_& m) {
 // The checks before fitting and before writing.
 void bind_checks(pyb::module_& m) {
   // Plausibility before fitting (rotacal/session/plausibility.hpp).
-  pyb::class_<PlausibilityOptions>(m, "PlausibilityOptions", "Limits of the plausibility checks (mm, deg).")
+  pyb::class_<PlausibilityOptions>(m, "PlausibilityOptions",
+                                   "Limits of the plausibility checks (mm, deg).")
       .def(pyb::init<>())
       .def_readwrite("max_length_deviation_mm", &PlausibilityOptions::max_length_deviation_mm)
       .def_readwrite("max_position_deviation_mm", &PlausibilityOptions::max_position_deviation_mm)
@@ -200,14 +223,17 @@ void bind_checks(pyb::module_& m) {
       .def_readonly("tilt_span_deg", &PlausibilityReport::tilt_span_deg)
       .def_readonly("rot_span_deg", &PlausibilityReport::rot_span_deg);
   m.def("check_plausible",
-        pyb::overload_cast<const BallbarSession&, const std::string&, const PlausibilityOptions&>(&check_plausible),
+        pyb::overload_cast<const BallbarSession&, const std::string&, const PlausibilityOptions&>(
+            &check_plausible),
         pyb::arg("session"), pyb::arg("source"), pyb::arg("options") = PlausibilityOptions{},
-        "Refuse (InvalidArgument, likely cause named) a session the nominal kinematics cannot explain.");
+        "Refuse (InvalidArgument, likely cause named) a session the nominal kinematics cannot "
+        "explain.");
   m.def("check_plausible",
-        pyb::overload_cast<const RtestSession&, const std::string&, const PlausibilityOptions&>(&check_plausible),
+        pyb::overload_cast<const RtestSession&, const std::string&, const PlausibilityOptions&>(
+            &check_plausible),
         pyb::arg("session"), pyb::arg("source"), pyb::arg("options") = PlausibilityOptions{});
-  m.def("check_model_machine", &check_model_machine, pyb::arg("model_machine"), pyb::arg("session_machine"),
-        pyb::arg("model_source"));
+  m.def("check_model_machine", &check_model_machine, pyb::arg("model_machine"),
+        pyb::arg("session_machine"), pyb::arg("model_source"));
 
   // The output rule (rotacal/io/output_file.hpp). The GIL is released: a FIFO blocks until read.
   m.def(
@@ -233,9 +259,11 @@ void bind_checks(pyb::module_& m) {
       pyb::arg("path"), pyb::arg("inputs") = std::vector<std::string>{},
       pyb::arg("other_outputs") = std::vector<std::string>{},
       "Check an output path without writing: 'replace' or 'write-through'; raises IoError.");
-  m.def("check_json_bounds", &check_json_bounds, pyb::arg("text"), pyb::arg("source"),
-        "Refuse JSON text nested deeper than 64 levels or with more objects and arrays than its size "
-        "allows (core/json_text.hpp): ParseError naming source, line and column. The syntax is not checked.");
+  m.def(
+      "check_json_bounds", &check_json_bounds, pyb::arg("text"), pyb::arg("source"),
+      "Refuse JSON text nested deeper than 64 levels or with more objects and arrays than its size "
+      "allows (core/json_text.hpp): ParseError naming source, line and column. The syntax is not "
+      "checked.");
 }
 
 }  // namespace

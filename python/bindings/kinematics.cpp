@@ -6,8 +6,8 @@
 namespace rotacal::py {
 
 namespace {
-LocationErrors<double> errors_of(const pyb::array_t<double, pyb::array::c_style |
-                                                                pyb::array::forcecast>& e) {
+LocationErrors<double> errors_of(
+    const pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>& e) {
   return LocationErrors<double>(vec_of<8>(e, "errors"));
 }
 }  // namespace
@@ -18,32 +18,39 @@ void bind_kinematics(pyb::module_& m) {
                            "rotacal-machine/1 description (from_description).")
       .def_readonly_static("AC_trt", &MachineType::AC_trt)
       .def_readonly_static("BC_trt", &MachineType::BC_trt)
-      .def_static("from_description",
-                  [](const std::string& json_text, const std::string& source) {
-                    return MachineType::from_description(parse_machine_description(json_text, source));
-                  },
-                  pyb::arg("json_text"), pyb::arg("source") = "machine description",
-                  "The machine of a rotacal-machine/1 JSON text; errors name `source` and the field.")
+      .def_static(
+          "from_description",
+          [](const std::string& json_text, const std::string& source) {
+            return MachineType::from_description(parse_machine_description(json_text, source));
+          },
+          pyb::arg("json_text"), pyb::arg("source") = "machine description",
+          "The machine of a rotacal-machine/1 JSON text; errors name `source` and the field.")
       .def_property_readonly("name", [](MachineType t) { return to_string(t); })
-      .def_property_readonly("configuration", [](MachineType t) { return t.description().configuration(); })
-      .def_property_readonly("axis_names",
-                             [](MachineType t) {
-                               return std::string{t.description().axis(0).name, t.description().axis(1).name};
-                             },
-                             "Rotary axis letters in chain order (table axes, then head axes): the "
-                             "session's rotary columns.")
-      .def_property_readonly("tilt_axis", [](MachineType t) { return std::string(1, tilt_axis_letter(t)); })
-      .def_property_readonly("rot_axis", [](MachineType t) { return std::string(1, rot_axis_letter(t)); })
+      .def_property_readonly("configuration",
+                             [](MachineType t) { return t.description().configuration(); })
+      .def_property_readonly(
+          "axis_names",
+          [](MachineType t) {
+            return std::string{t.description().axis(0).name, t.description().axis(1).name};
+          },
+          "Rotary axis letters in chain order (table axes, then head axes): the "
+          "session's rotary columns.")
+      .def_property_readonly("tilt_axis",
+                             [](MachineType t) { return std::string(1, tilt_axis_letter(t)); })
+      .def_property_readonly("rot_axis",
+                             [](MachineType t) { return std::string(1, rot_axis_letter(t)); })
       .def_property_readonly("has_head", &MachineType::has_head)
       .def_property_readonly("is_builtin", &MachineType::is_builtin)
-      .def_property_readonly("description_json",
-                             [](MachineType t) { return machine_description_json(t.description()); })
+      .def_property_readonly(
+          "description_json",
+          [](MachineType t) { return machine_description_json(t.description()); })
       .def("__eq__", [](MachineType a, MachineType b) { return a == b; })
       .def("__ne__", [](MachineType a, MachineType b) { return a != b; })
       .def("__hash__", [](MachineType t) { return t.id(); })
       .def(pyb::pickle([](MachineType t) { return machine_description_json(t.description()); },
                        [](const std::string& json_text) {
-                         return MachineType::from_description(parse_machine_description(json_text, "pickle"));
+                         return MachineType::from_description(
+                             parse_machine_description(json_text, "pickle"));
                        }))
       .def("__repr__", [](MachineType t) {
         if (t == MachineType::AC_trt) return std::string("MachineType.AC_trt");
@@ -73,8 +80,8 @@ void bind_kinematics(pyb::module_& m) {
 
   m.def(
       "forward",
-      [](MachineType machine, const pyb::array_t<double, pyb::array::c_style |
-                                                             pyb::array::forcecast>& errors,
+      [](MachineType machine,
+         const pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>& errors,
          const pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>& angles,
          const pyb::array_t<double, pyb::array::c_style | pyb::array::forcecast>& q_table) {
         const auto e = errors_of(errors);
@@ -84,8 +91,8 @@ void bind_kinematics(pyb::module_& m) {
           throw InvalidArgument("forward: angles and q_table must have the same number of rows");
         Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> p(q.rows(), 3);
         for (Eigen::Index i = 0; i < q.rows(); ++i)
-          p.row(i) = forward<double>(machine, e, {a(i, 0), a(i, 1)}, q.row(i).transpose())
-                         .transpose();
+          p.row(i) =
+              forward<double>(machine, e, {a(i, 0), a(i, 1)}, q.row(i).transpose()).transpose();
         return p;
       },
       pyb::arg("machine"), pyb::arg("errors"), pyb::arg("angles"), pyb::arg("q_table"),

@@ -5,10 +5,10 @@
 
 #include "json_value.hpp"
 #include "numpy.hpp"
-#include "rotacal/session/probe_session.hpp"
-#include "rotacal/session/session.hpp"
 #include "rotacal/multi/identify.hpp"
 #include "rotacal/multi/model_document.hpp"
+#include "rotacal/session/probe_session.hpp"
+#include "rotacal/session/session.hpp"
 
 namespace rotacal::py {
 
@@ -52,10 +52,15 @@ void bind_multi(pyb::module_& m) {
          const std::vector<std::string>& effects) {
         std::vector<MultiSessionInput> in;
         for (const auto& [name, s] : sessions) {
-          if (pyb::isinstance<BallbarSession>(s)) in.push_back(MultiSessionInput::of(name, s.cast<BallbarSession>()));
-          else if (pyb::isinstance<RtestSession>(s)) in.push_back(MultiSessionInput::of(name, s.cast<RtestSession>()));
-          else if (pyb::isinstance<ProbeSession>(s)) in.push_back(MultiSessionInput::of(name, s.cast<ProbeSession>()));
-          else throw InvalidArgument("identify: session " + name + " is not a ballbar, R-test or touch-probe session");
+          if (pyb::isinstance<BallbarSession>(s))
+            in.push_back(MultiSessionInput::of(name, s.cast<BallbarSession>()));
+          else if (pyb::isinstance<RtestSession>(s))
+            in.push_back(MultiSessionInput::of(name, s.cast<RtestSession>()));
+          else if (pyb::isinstance<ProbeSession>(s))
+            in.push_back(MultiSessionInput::of(name, s.cast<ProbeSession>()));
+          else
+            throw InvalidArgument("identify: session " + name +
+                                  " is not a ballbar, R-test or touch-probe session");
         }
         MultiFitOptions o;
         o.noise = noise_handling_from_string(noise);
@@ -63,14 +68,17 @@ void bind_multi(pyb::module_& m) {
         pyb::gil_scoped_release release;
         return identify_multi(in, o);
       },
-      pyb::arg("sessions"), pyb::arg("noise") = "auto", pyb::arg("effects") = std::vector<std::string>{},
+      pyb::arg("sessions"), pyb::arg("noise") = "auto",
+      pyb::arg("effects") = std::vector<std::string>{},
       "One identification from several (name, session) pairs of one machine (multi/identify.hpp): "
       "one set of location errors (and of the catalogue effects `effects`), each session's own "
       "nuisances and noise model, and the "
       "disagreements between the sessions fitted alone; noise 'auto' or 'white'.");
   m.def(
       "multi_model_document",
-      [](const MultiIdentification& identification) { return from_json(multi_model_document(identification)); },
+      [](const MultiIdentification& identification) {
+        return from_json(multi_model_document(identification));
+      },
       pyb::arg("identification"),
       "The rotacal-model/1 document (kind multi) of one identification from several sessions "
       "(rotacal/multi/model_document.hpp).");

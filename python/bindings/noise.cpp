@@ -65,8 +65,8 @@ void bind_noise(pyb::module_& m) {
       "AR(p) model (Burg, BIC order) of the residuals per stream (group, channel).");
   m.def("noise_ar1", &noise_gen::ar1, pyb::arg("groups"), pyb::arg("times"), pyb::arg("rho"),
         pyb::arg("sigma_mm"), pyb::arg("seed"));
-  m.def("noise_pink", &noise_gen::pink, pyb::arg("groups"), pyb::arg("times"),
-        pyb::arg("sigma_mm"), pyb::arg("seed"));
+  m.def("noise_pink", &noise_gen::pink, pyb::arg("groups"), pyb::arg("times"), pyb::arg("sigma_mm"),
+        pyb::arg("seed"));
   m.def("noise_thermal_wander", &noise_gen::thermal_wander, pyb::arg("times"),
         pyb::arg("amplitude_mm"), pyb::arg("period_s"), pyb::arg("seed"));
   m.def("noise_probe_zero_wander", &noise_gen::probe_zero_wander, pyb::arg("groups"),
@@ -132,7 +132,8 @@ void bind_noise(pyb::module_& m) {
         return uncertainty_budget(BallbarDiagnosisProblem(session), diagnosis, sizes, coverage);
       },
       pyb::arg("session"), pyb::arg("diagnosis"), pyb::arg("sizes") = PlausibleSizes{},
-      pyb::arg("coverage") = 0.95, "GUM budget of the location errors of diagnose_ballbar's result.");
+      pyb::arg("coverage") = 0.95,
+      "GUM budget of the location errors of diagnose_ballbar's result.");
   m.def(
       "uncertainty_budget_rtest",
       [](const RtestSession& session, const Diagnosis& diagnosis, const PlausibleSizes& sizes,
@@ -144,14 +145,15 @@ void bind_noise(pyb::module_& m) {
       pyb::arg("coverage") = 0.95, "GUM budget of the location errors of diagnose_rtest's result.");
   m.def(
       "uncertainty_budget_rtest_identification",
-      [](const RtestSession& session, const RtestJointIdentification& identification, const PlausibleSizes& sizes,
-         double coverage) {
+      [](const RtestSession& session, const RtestJointIdentification& identification,
+         const PlausibleSizes& sizes, double coverage) {
         pyb::gil_scoped_release release;
         return uncertainty_budget(session, identification, sizes, coverage);
       },
       pyb::arg("session"), pyb::arg("identification"), pyb::arg("sizes") = PlausibleSizes{},
       pyb::arg("coverage") = 0.95,
-      "GUM budget of the location errors of identify_rtest_joint's result, on its own model (maps included).");
+      "GUM budget of the location errors of identify_rtest_joint's result, on its own model (maps "
+      "included).");
 }
 
 }  // namespace rotacal::py

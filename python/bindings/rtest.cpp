@@ -1,6 +1,7 @@
 // Bindings for include/rotacal/rtest: device calibration, simulation, identification, error
 // map and prediction. Thin: numpy in and out, the C++ module does the work.
 #include <pybind11/stl.h>
+
 #include <optional>
 
 #include "numpy.hpp"
@@ -57,21 +58,23 @@ void bind_rtest_basis(pyb::module_& m) {
                     "rotations in the rotary map (false for a head axis: for_machine)")
       .def("for_machine", &RtestBasis::for_machine, pyb::arg("machine"),
            "This basis with the rotations of head axes' maps left out (the sphere is one point).")
-      .def("coefficient_names",
-           [](const RtestBasis& b, std::optional<MachineType> machine) {
-             return machine ? b.coefficient_names(*machine) : b.coefficient_names();
-           },
-           pyb::arg("machine") = pyb::none(),
-           "Names of the map coefficients, tilt-axis map first, in parameter order, with the "
-           "machine's map names (rtest_map_names; BC-trt's 'BY', 'CB' when no machine is given).");
-  m.def("rtest_map_names",
-        [](MachineType machine) {
-          const auto n = rtest_map_names(machine);
-          return std::vector<std::string>(n.begin(), n.end());
-        },
-        pyb::arg("machine"),
-        "Names of a machine's two R-test error maps, [tilt axis' map, rotary axis' map], e.g. "
-        "['BY', 'CB'] on BC-trt, ['BZ', 'CY'] on B-head-C-table.");
+      .def(
+          "coefficient_names",
+          [](const RtestBasis& b, std::optional<MachineType> machine) {
+            return machine ? b.coefficient_names(*machine) : b.coefficient_names();
+          },
+          pyb::arg("machine") = pyb::none(),
+          "Names of the map coefficients, tilt-axis map first, in parameter order, with the "
+          "machine's map names (rtest_map_names; BC-trt's 'BY', 'CB' when no machine is given).");
+  m.def(
+      "rtest_map_names",
+      [](MachineType machine) {
+        const auto n = rtest_map_names(machine);
+        return std::vector<std::string>(n.begin(), n.end());
+      },
+      pyb::arg("machine"),
+      "Names of a machine's two R-test error maps, [tilt axis' map, rotary axis' map], e.g. "
+      "['BY', 'CB'] on BC-trt, ['BZ', 'CY'] on B-head-C-table.");
 }
 
 // The joint model: readings, table and tool errors and the maps, with 1-sigma.
@@ -127,13 +130,15 @@ void bind_rtest_joint_model(pyb::module_& m) {
           [](const RtestJointModel& mo, const Array& xyz, const Array& angles) {
             const auto p = rows_of<3>(xyz, "xyz");
             const auto a = rows_of<2>(angles, "angles");
-            if (p.rows() != a.rows()) throw InvalidArgument("tool_errors: xyz and angles need the same rows");
+            if (p.rows() != a.rows())
+              throw InvalidArgument("tool_errors: xyz and angles need the same rows");
             return evaluate_rows<3>(a.rows(), [&](Eigen::Index i, Eigen::Vector3d& sd) {
               return mo.tool_error(p.row(i).transpose(), a(i, 0), a(i, 1), &sd);
             });
           },
           pyb::arg("xyz"), pyb::arg("angles"),
-          "Error of the sphere (N, 3), actual - nominal, machine frame, mm, for commanded xyz (N, 3) "
+          "Error of the sphere (N, 3), actual - nominal, machine frame, mm, for commanded xyz (N, "
+          "3) "
           "at angles (N, 2) = (tilt, rotary) in rad, and its 1-sigma; zero without head axes.")
       .def(
           "w_by",
@@ -221,7 +226,8 @@ void bind_rtest_identification(pyb::module_& m) {
       pyb::arg("session"), pyb::arg("result"), pyb::arg("draws") = 100, pyb::arg("seed") = 1,
       pyb::arg("basis") = RtestBasis{}, pyb::arg("progress") = pyb::none(),
       "Monte Carlo check of an R-test joint fit's 1-sigma with the noise model fitted to the "
-      "session (AR per nest and channel) when the fit used it, else white (rtest/monte_carlo.hpp).");
+      "session (AR per nest and channel) when the fit used it, else white "
+      "(rtest/monte_carlo.hpp).");
   m.def(
       "identify_rtest_paper",
       [](const RtestSession& session) {
@@ -281,19 +287,20 @@ void bind_rtest_simulation(pyb::module_& m) {
         "The paper's pattern fitted to a machine: tilt angles inside its limits (-90..90 every 30 "
         "deg where they allow), the rotary axis every 30 deg, the two paper nests halved until "
         "every commanded X, Y, Z is inside the travel (rtest/simulate.hpp).");
-  m.def("check_rtest_pattern",
-        [](MachineType machine, const std::vector<double>& b_deg, const std::vector<double>& c_deg,
-           const Array& nests) {
-          RtestPattern p;
-          p.b_deg = b_deg;
-          p.c_deg = c_deg;
-          p.nests = vectors_of(nests, "nests");
-          check_rtest_pattern(machine, p, "R-test pattern");
-        },
-        pyb::arg("machine"), pyb::arg("b_deg"), pyb::arg("c_deg"), pyb::arg("nests"),
-        "Raise InvalidArgument naming the axis and its limits (or the travel) when a tilt (b_deg) "
-        "or rotary (c_deg) angle, deg, or a commanded X, Y, Z of a nest (K, 3) is outside the "
-        "machine's limits.");
+  m.def(
+      "check_rtest_pattern",
+      [](MachineType machine, const std::vector<double>& b_deg, const std::vector<double>& c_deg,
+         const Array& nests) {
+        RtestPattern p;
+        p.b_deg = b_deg;
+        p.c_deg = c_deg;
+        p.nests = vectors_of(nests, "nests");
+        check_rtest_pattern(machine, p, "R-test pattern");
+      },
+      pyb::arg("machine"), pyb::arg("b_deg"), pyb::arg("c_deg"), pyb::arg("nests"),
+      "Raise InvalidArgument naming the axis and its limits (or the travel) when a tilt (b_deg) "
+      "or rotary (c_deg) angle, deg, or a commanded X, Y, Z of a nest (K, 3) is outside the "
+      "machine's limits.");
   pyb::class_<RtestSimOptions>(m, "RtestSimOptions", "Options of simulate_rtest (defaults).")
       .def(pyb::init<>())
       .def_readwrite("pattern", &RtestSimOptions::pattern)
@@ -365,13 +372,17 @@ Returns
         if (time.size() != a.rows()) throw InvalidArgument("time: one value per row of angles");
         std::vector<RotaryAngles<double>> poses;
         for (Eigen::Index i = 0; i < a.rows(); ++i) poses.push_back({a(i, 0), a(i, 1)});
-        if (linear_reference) t.effects.linear_reference = vec_of<3>(*linear_reference, "linear_reference");
-        return rows_from(rtest_readings(t, qv, poses, std::vector<double>(time.data(), time.data() + time.size())));
+        if (linear_reference)
+          t.effects.linear_reference = vec_of<3>(*linear_reference, "linear_reference");
+        return rows_from(rtest_readings(
+            t, qv, poses, std::vector<double>(time.data(), time.data() + time.size())));
       },
       pyb::arg("machine"), pyb::arg("errors"), pyb::arg("effects"), pyb::arg("effect_params"),
-      pyb::arg("q"), pyb::arg("angles"), pyb::arg("time"), pyb::arg("linear_reference") = std::nullopt,
+      pyb::arg("q"), pyb::arg("angles"), pyb::arg("time"),
+      pyb::arg("linear_reference") = std::nullopt,
       "Noise-free readings (N, 3) of the nest at q (mm) at angles (N, 2) in rad and time (N,) s, "
-      "no probe zero: the simulator's truth. linear_reference (3,) mm: the session's mean commanded "
+      "no probe zero: the simulator's truth. linear_reference (3,) mm: the session's mean "
+      "commanded "
       "xyz, about which the linear-axis polynomials are taken (None: the mean of these poses).");
 }
 

@@ -3,6 +3,7 @@
 A typed wrapper over the private extension ``rotacal._core``: sessions are numpy-backed
 objects, analyses return result objects whose ``to_dict()`` is the JSON the CLI prints.
 """
+
 from ._core import (  # noqa: F401
     BallbarMachineModel,
     BallbarSession,
@@ -28,7 +29,19 @@ from ._core import (  # noqa: F401
     svd_plane_fit,
     verify_compensation,
 )
-from ._core import BallbarPlan, BallbarSetup, BallbarTest, NcDialect, NcProgramOptions, RadialSide, parse_ballbar_test, parse_nc_dialect, parse_radial_side, plan_ballbar_test, write_nc_program  # noqa: F401,E501
+from ._core import (
+    BallbarPlan,
+    BallbarSetup,
+    BallbarTest,
+    NcDialect,
+    NcProgramOptions,
+    RadialSide,
+    parse_ballbar_test,
+    parse_nc_dialect,
+    parse_radial_side,
+    plan_ballbar_test,
+    write_nc_program,
+)  # noqa: F401,E501
 from .analysis import identify  # noqa: F401
 from .ballbar import predict  # noqa: F401
 from .machines import TABLE2_ERRORS, random_location_errors  # noqa: F401
@@ -40,4 +53,3 @@ from .probe import identify_probe, simulate_probe  # noqa: F401
 from .rtest import identify_rtest, monte_carlo_rtest  # noqa: F401
 from .sessions import check_plausible, load, save  # noqa: F401
 from .version import __version__  # noqa: F401
-

@@ -1,4 +1,5 @@
 """Writes python/rotacal/_core.pyi from the built extension with the pinned pybind11-stubgen (``python -m rotacal._stubgen [--check]``)."""
+
 from __future__ import annotations
 
 import subprocess
@@ -9,19 +10,29 @@ from pathlib import Path
 # The generator's output changes between versions: the stubs are generated with this one only
 # (scripts/setup.sh installs it) so that regenerating never shows a difference the bindings did not make.
 STUBGEN_VERSION = "2.5.5"
-ENUMS = ("RadialSide", "BallbarTest", "NcDialect", "SegmentKind", "CircularPlane", "CircularDirection")
+ENUMS = (
+    "RadialSide",
+    "BallbarTest",
+    "NcDialect",
+    "SegmentKind",
+    "CircularPlane",
+    "CircularDirection",
+)
 STUB = Path(__file__).with_name("_core.pyi")
 
 
 def generate() -> str:
     """The stub text of the importable rotacal._core."""
     from importlib.metadata import PackageNotFoundError, version
+
     try:
         found = version("pybind11-stubgen")
     except PackageNotFoundError:
         raise SystemExit(f"pybind11-stubgen=={STUBGEN_VERSION} is not installed") from None
     if found != STUBGEN_VERSION:
-        raise SystemExit(f"pybind11-stubgen {found} found, the stubs are made with {STUBGEN_VERSION}")
+        raise SystemExit(
+            f"pybind11-stubgen {found} found, the stubs are made with {STUBGEN_VERSION}"
+        )
     with tempfile.TemporaryDirectory() as out:
         cmd = [sys.executable, "-m", "pybind11_stubgen", "rotacal._core", "-o", out]
         cmd += [f"--enum-class-locations={e}:rotacal._core" for e in ENUMS]
@@ -37,7 +48,10 @@ def main(argv: list[str]) -> int:
     text = generate()
     if "--check" in argv:
         if STUB.read_text() != text:
-            print(f"{STUB} differs from the extension: run python -m rotacal._stubgen", file=sys.stderr)
+            print(
+                f"{STUB} differs from the extension: run python -m rotacal._stubgen",
+                file=sys.stderr,
+            )
             return 1
         return 0
     STUB.write_text(text)

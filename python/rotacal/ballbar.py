@@ -1,4 +1,5 @@
 """Single set-up ballbar test: identification, simulation, prediction, compensation."""
+
 from __future__ import annotations
 
 from typing import Any, Sequence
@@ -11,9 +12,15 @@ from .results import Identification
 from .sessions import BALLBAR, require
 
 
-def identify(session: _core.BallbarSession, method: str = "joint", *,
-             fit_length_offset: bool = False, effects: Sequence[str] = (),
-             tests: Sequence[str] = (), noise: str = "auto") -> Identification:
+def identify(
+    session: _core.BallbarSession,
+    method: str = "joint",
+    *,
+    fit_length_offset: bool = False,
+    effects: Sequence[str] = (),
+    tests: Sequence[str] = (),
+    noise: str = "auto",
+) -> Identification:
     """Identify the 8 location errors (and the actual pivot) of a ballbar session
     (rotacal.identify takes either kind of session).
 
@@ -34,15 +41,23 @@ def identify(session: _core.BallbarSession, method: str = "joint", *,
         raw = _core.identify_joint(session, fit_length_offset, list(effects), list(tests), noise)
     elif method == "paper":
         if fit_length_offset or effects:
-            raise _core.InvalidArgument("identify: the paper method fits no length offset or effects")
+            raise _core.InvalidArgument(
+                "identify: the paper method fits no length offset or effects"
+            )
         raw = _core.identify_paper(session)
     else:
         raise _core.InvalidArgument(f"identify: method must be 'joint' or 'paper', got {method!r}")
     return Identification(raw)
 
 
-def monte_carlo(session: _core.BallbarSession, result: Identification, draws: int = 100, *,
-                seed: int = 1, progress: bool = True) -> dict:
+def monte_carlo(
+    session: _core.BallbarSession,
+    result: Identification,
+    draws: int = 100,
+    *,
+    seed: int = 1,
+    progress: bool = True,
+) -> dict:
     """Check the reported uncertainties by Monte Carlo (GUM Supplement 1 style): simulate
     ``draws`` sessions of the same poses on the identified machine with the fitted noise (the
     AR noise model fitted to the session when the joint fit used it, else white noise),
@@ -53,6 +68,7 @@ def monte_carlo(session: _core.BallbarSession, result: Identification, draws: in
     reported uncertainty is right, well above 1 that it is optimistic.
     """
     from .progress import ProgressBar
+
     if draws < 2:
         raise _core.InvalidArgument(f"monte_carlo: draws must be at least 2, got {draws}")
     raw = result.raw
@@ -64,11 +80,17 @@ def monte_carlo(session: _core.BallbarSession, result: Identification, draws: in
     if method == "joint":
         # The C++ loop (ballbar/monte_carlo.hpp): draws from the noise model fitted to the
         # session (AR per test) when the fit used it, refitted the same way; white otherwise.
-        mc = _core.monte_carlo_joint(session, raw, draws, seed,
-                                     progress=(lambda done, total: bar.update(done)) if bar else None)
+        mc = _core.monte_carlo_joint(
+            session,
+            raw,
+            draws,
+            seed,
+            progress=(lambda done, total: bar.update(done)) if bar else None,
+        )
         if bar:
             bar.close()
         from .results import monte_carlo_dict
+
         return monte_carlo_dict(mc, draws, mc.noise_um)
     values = []  # the paper method: simulate and identify again, in Python
     for k in range(draws):
@@ -85,34 +107,57 @@ def monte_carlo(session: _core.BallbarSession, result: Identification, draws: in
         if not p.observable:
             continue
         std_mc = float(np.std(v[:, j], ddof=1))
-        out[p.name] = {"std_reported": float(p.std), "std_mc": std_mc,
-                       "ratio": std_mc / p.std if p.std > 0 else float("inf"),
-                       "bias": float(np.mean(v[:, j]) - p.value), "unit": p.unit}
-    return {"draws": draws, "noise_um": float(raw.sigma_um), "noise": "white noise", "method": method,
-            "parameters": out}
+        out[p.name] = {
+            "std_reported": float(p.std),
+            "std_mc": std_mc,
+            "ratio": std_mc / p.std if p.std > 0 else float("inf"),
+            "bias": float(np.mean(v[:, j]) - p.value),
+            "unit": p.unit,
+        }
+    return {
+        "draws": draws,
+        "noise_um": float(raw.sigma_um),
+        "noise": "white noise",
+        "method": method,
+        "parameters": out,
+    }
 
 
-def predict(model: _core.BallbarMachineModel, session: _core.BallbarSession) -> _core.BallbarSession:
+def predict(
+    model: _core.BallbarMachineModel, session: _core.BallbarSession
+) -> _core.BallbarSession:
     """The session with every length replaced by the model's prediction."""
     return session.with_lengths(_core.predict_session_lengths(model, session))
 
 
 def compensation_table(report: Any) -> list[dict]:
     """The rows of a CompensationReport (verify_compensation) as dicts, Flynn et al. Table 2 layout."""
-    return [{"name": r.name, "unit": r.unit, "before": r.before, "after": r.after,
-             "std_after": r.std_after, "change_percent": r.change_percent} for r in report.rows]
+    return [
+        {
+            "name": r.name,
+            "unit": r.unit,
+            "before": r.before,
+            "after": r.after,
+            "std_after": r.std_after,
+            "change_percent": r.change_percent,
+        }
+        for r in report.rows
+    ]
 
 
-def nc_program(setup: Any, dialect: str = "linuxcnc", model: Any = None,
-               source: str = "<model>") -> tuple[Any, str]:
+def nc_program(
+    setup: Any, dialect: str = "linuxcnc", model: Any = None, source: str = "<model>"
+) -> tuple[Any, str]:
     """(plan, NC program text) of the test of ``setup`` in ``dialect``; with a fitted
     BallbarMachineModel the program is compensated for its location errors (its machine must
     be the set-up's, ``source`` names the model in the error)."""
     identified = None
     if model is not None:
         if model.machine != setup.machine:
-            raise _core.InvalidArgument(f"{source}: model is for {_core.machine_name(model.machine)}, the test "
-                                        f"for {_core.machine_name(setup.machine)}")
+            raise _core.InvalidArgument(
+                f"{source}: model is for {_core.machine_name(model.machine)}, the test "
+                f"for {_core.machine_name(setup.machine)}"
+            )
         identified = model.errors
     plan = _core.plan_ballbar_test(setup, identified)
     return plan, _core.write_nc_program(plan, _core.parse_nc_dialect(dialect))
@@ -124,4 +169,6 @@ def verify_compensation(setup: Any, truth: Any) -> list[dict]:
     the rows of compensation_table."""
     commanded = _core.plan_ballbar_test(setup, None).commanded_session()
     machine = ballbar_machine_model(setup, truth)
-    return compensation_table(_core.verify_compensation(commanded, machine, truth["noise_um"], truth["seed"]))
+    return compensation_table(
+        _core.verify_compensation(commanded, machine, truth["noise_um"], truth["seed"])
+    )

@@ -11,6 +11,7 @@ replaced, and so may be named twice. A history store that the command writes may
 of its inputs or outputs either. A new command needs its row here: the tests check that every
 subcommand of the parser has one.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -28,6 +29,7 @@ Getter = Callable[[argparse.Namespace], Sequence[str]]
 @dataclass(frozen=True)
 class Slot:
     """One option (or positional) of a command that names files."""
+
     option: str  # as the user writes it: "--model", "-o", "FILE"
     paths: Getter
 
@@ -41,6 +43,7 @@ def arg(option: str, dest: str | None = None) -> Slot:
         if v is None:
             return []
         return [p for p in (v if isinstance(v, list) else [v]) if p]
+
     return Slot(option, get)
 
 
@@ -68,6 +71,7 @@ OUTPUT = arg("-o", "output")
 class Files:
     """What a command reads (inputs), writes by the output rule (outputs), and whether it
     reads or writes the history store (--db, default $ROTACAL_HISTORY or the user's store)."""
+
     inputs: tuple[Slot, ...] = ()
     outputs: tuple[Slot, ...] = ()
     reads_store: Callable[[argparse.Namespace], bool] = lambda a: False
@@ -85,12 +89,19 @@ COMMANDS: dict[tuple[str, ...], Files] = {
     ("machines", "list"): Files(),
     ("machines", "show"): Files((arg("NAME|FILE", "machine"),)),
     ("simulate", "ballbar"): Files((MACHINE,), (OUTPUT, arg("--truth"))),
-    ("simulate", "rtest"): Files((MACHINE,), (OUTPUT, Slot("--truth", lambda a: [rtest_truth_path(a)]))),
+    ("simulate", "rtest"): Files(
+        (MACHINE,), (OUTPUT, Slot("--truth", lambda a: [rtest_truth_path(a)]))
+    ),
     ("simulate", "probe"): Files((MACHINE,), (OUTPUT, arg("--truth"))),
-    ("identify",): Files((arg("FILE", "file"), arg("--budget-sizes"), arg("--controller")),
-                         (arg("--save-model"),), writes_store=lambda a: bool(a.store)),
-    ("history", "add"): Files((arg("MODEL", "model"), arg("--correction"), arg("--diagnosis"), arg("--controller")),
-                              writes_store=_always),
+    ("identify",): Files(
+        (arg("FILE", "file"), arg("--budget-sizes"), arg("--controller")),
+        (arg("--save-model"),),
+        writes_store=lambda a: bool(a.store),
+    ),
+    ("history", "add"): Files(
+        (arg("MODEL", "model"), arg("--correction"), arg("--diagnosis"), arg("--controller")),
+        writes_store=_always,
+    ),
     ("history", "show"): Files(outputs=(arg("--plot"),), reads_store=_always),
     ("history", "list"): Files(reads_store=_always),
     ("diagnose",): Files((arg("FILE", "file"), arg("--budget-sizes")), (arg("--report"),)),
@@ -98,10 +109,19 @@ COMMANDS: dict[tuple[str, ...], Files] = {
     ("design", "ballbar"): Files((MACHINE, arg("--after")), (OUTPUT,)),
     ("design", "rtest"): Files((arg("--after"),)),
     ("design", "probe"): Files((MACHINE, arg("--after")), (OUTPUT, arg("--session"))),
-    ("export",): Files((arg("--model"), arg("--current"), arg("--centres")),
-                       (OUTPUT, arg("--residual-model"), arg("--centres-output"), Slot("--comp-file", _comp_files))),
+    ("export",): Files(
+        (arg("--model"), arg("--current"), arg("--centres")),
+        (
+            OUTPUT,
+            arg("--residual-model"),
+            arg("--centres-output"),
+            Slot("--comp-file", _comp_files),
+        ),
+    ),
     # Without --model nothing is written (-o has a default): --verify alone prints.
-    ("compensate",): Files((MACHINE, arg("--model")), (Slot("-o", lambda a: [a.output] if a.model else []),)),
+    ("compensate",): Files(
+        (MACHINE, arg("--model")), (Slot("-o", lambda a: [a.output] if a.model else []),)
+    ),
     ("virtual", "ballbar"): Files((MACHINE,), (arg("--truth"),)),
     ("virtual", "rtest"): Files((MACHINE,), (arg("--truth"),)),
     ("record", "ballbar"): Files((MACHINE, arg("--port")), (OUTPUT,)),
@@ -125,6 +145,7 @@ def command_key(a: argparse.Namespace) -> tuple[str, ...]:
 def _store(a: argparse.Namespace) -> list[tuple[str, str]]:
     """The history store as a file, or nothing for a postgresql:// URL."""
     from .history import default_location
+
     loc = getattr(a, "db", None) or default_location()
     return [] if "://" in loc else [("--db", loc)]
 
@@ -143,7 +164,9 @@ def _refuse_same(path: str, option: str, others: Sequence[tuple[str, str]], what
     me = _identity(path)
     for other_option, other in others:
         if _identity(other) == me:
-            raise _core.IoError(f"{option} {path}: is also the command's {other_option} ({other}): {what}")
+            raise _core.IoError(
+                f"{option} {path}: is also the command's {other_option} ({other}): {what}"
+            )
 
 
 def check_command_files(a: argparse.Namespace) -> None:
@@ -151,7 +174,9 @@ def check_command_files(a: argparse.Namespace) -> None:
     command's inputs, another of its outputs or the history store it uses. IoError (exit 4)."""
     key = command_key(a)
     if key not in COMMANDS:
-        raise _core.Error(f"rotacal {' '.join(key)}: no row in command_files.COMMANDS (a new command?)")
+        raise _core.Error(
+            f"rotacal {' '.join(key)}: no row in command_files.COMMANDS (a new command?)"
+        )
     files = COMMANDS[key]
     inputs = [(s.option, p) for s in files.inputs for p in s.paths(a)]
     outputs = [(s.option, p) for s in files.outputs for p in s.paths(a)]
@@ -166,6 +191,8 @@ def check_command_files(a: argparse.Namespace) -> None:
         if kind == "write-through":
             continue  # a device or FIFO is never replaced: /dev/null may be named twice
         _refuse_same(p, option, inputs + written_store, "refusing to overwrite it")
-        _refuse_same(p, option, outputs[:k] + outputs[k + 1:], "two outputs of one command in one file")
+        _refuse_same(
+            p, option, outputs[:k] + outputs[k + 1 :], "two outputs of one command in one file"
+        )
     for option, p in written_store:
         _refuse_same(p, option, inputs, "refusing to write the history store over it")

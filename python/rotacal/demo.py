@@ -1,4 +1,5 @@
 """The whole job on a simulated machine: plan, simulate, identify, diagnose, compensate and report (``rotacal demo``)."""
+
 from __future__ import annotations
 
 import time
@@ -18,16 +19,20 @@ STEPS = 6
 
 def compensation_section(rows: list[dict]) -> str:
     """The report section of the Table 2 experiment (rows of ballbar.compensation_table)."""
-    out = ["<section id='compensation'><h2>Compensation (Flynn et al. Table 2 experiment, simulated)</h2>"
-           "<p>A separate experiment on the simulated machine, as in the paper: its own measurement, "
-           "identification of the location errors, compensation and measurement again. Its "
-           "'Uncompensated' column is that run's identification, not this session's: the values to load "
-           "are those of the location-error section above.</p>"
-           "<table><tr><th class=l>Error</th><th>Uncompensated</th><th>Compensated</th><th>Change</th></tr>"]
+    out = [
+        "<section id='compensation'><h2>Compensation (Flynn et al. Table 2 experiment, simulated)</h2>"
+        "<p>A separate experiment on the simulated machine, as in the paper: its own measurement, "
+        "identification of the location errors, compensation and measurement again. Its "
+        "'Uncompensated' column is that run's identification, not this session's: the values to load "
+        "are those of the location-error section above.</p>"
+        "<table><tr><th class=l>Error</th><th>Uncompensated</th><th>Compensated</th><th>Change</th></tr>"
+    ]
     for r in rows:
         k, unit = (1e3, "&micro;m") if r["unit"] == "mm" else (1e6, "&micro;rad")
-        out.append(f"<tr><td class=l>{r['name']}</td><td>{r['before'] * k:+.2f} {unit}</td>"
-                   f"<td>{r['after'] * k:+.2f} {unit}</td><td>{r['change_percent']:+.1f} %</td></tr>")
+        out.append(
+            f"<tr><td class=l>{r['name']}</td><td>{r['before'] * k:+.2f} {unit}</td>"
+            f"<td>{r['after'] * k:+.2f} {unit}</td><td>{r['change_percent']:+.1f} %</td></tr>"
+        )
     out.append("</table></section>")
     return "\n".join(out)
 
@@ -36,8 +41,12 @@ def _write_json(path: Path, data: object) -> None:
     write_output(path, jsontext.dumps(data) + "\n")
 
 
-def run_demo(output: str | Path, seed: int = 2016, sag_mm: float = 0.004,
-             say: Callable[[str], None] = lambda _: None) -> dict:
+def run_demo(
+    output: str | Path,
+    seed: int = 2016,
+    sag_mm: float = 0.004,
+    say: Callable[[str], None] = lambda _: None,
+) -> dict:
     """Simulate the machine of Flynn et al. Table 2 with a pivot set-up error and a hidden
     gravity sag, measure, identify, diagnose, compensate and write every file and the report
     into ``output`` (created, with its parents: the one output folder a command makes). ``say`` receives one progress line per step.
@@ -60,8 +69,13 @@ def run_demo(output: str | Path, seed: int = 2016, sag_mm: float = 0.004,
         plan, text = nc_program(setup, dialect)
         write_output(out / name, text)
 
-    step(2, "simulating the machine of Flynn et al. Table 2 with a pivot set-up error and a hidden effect")
-    truth = ballbar_truth(setup.machine, "table2", {"gravity_sag_A": [sag_mm]}, noise_um=0.5, seed=seed)
+    step(
+        2,
+        "simulating the machine of Flynn et al. Table 2 with a pivot set-up error and a hidden effect",
+    )
+    truth = ballbar_truth(
+        setup.machine, "table2", {"gravity_sag_A": [sag_mm]}, noise_um=0.5, seed=seed
+    )
     truth["pivot_error"] = [0.012, -0.008, 0.015]  # fixed, as in the paper's set-up
     session, machine = simulate_ballbar_test(setup, truth)
     save(session, out / "session.csv")
@@ -89,7 +103,18 @@ def run_demo(output: str | Path, seed: int = 2016, sag_mm: float = 0.004,
     _write_json(out / "compensation.json", rows)
 
     step(6, "writing the report")
-    report = ballbar_report(out / "report.html", session, ident, diag, title="rotacal demo: single set-up ballbar test",
-                            source=str(out / "session.csv"), extra_sections=[compensation_section(rows)])
-    return {"sag_mm": sag_mm, "finding": dd["findings"][0] if dd["findings"] else None,
-            "worst_change_percent": max(r["change_percent"] for r in rows), "report": report}
+    report = ballbar_report(
+        out / "report.html",
+        session,
+        ident,
+        diag,
+        title="rotacal demo: single set-up ballbar test",
+        source=str(out / "session.csv"),
+        extra_sections=[compensation_section(rows)],
+    )
+    return {
+        "sag_mm": sag_mm,
+        "finding": dd["findings"][0] if dd["findings"] else None,
+        "worst_change_percent": max(r["change_percent"] for r in rows),
+        "report": report,
+    }

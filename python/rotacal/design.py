@@ -3,6 +3,7 @@ bar length whose single set-up test gives the smallest largest expanded uncertai
 location errors at a run time, within the machine's travel, from the Fisher information of the
 joint model (C++: ``rotacal/ballbar/design.hpp``; docs/design.md); the R-test's nests and grid,
 the touch probe's poses."""
+
 from __future__ import annotations
 
 import json
@@ -13,10 +14,19 @@ import numpy as np
 from . import _core
 
 
-def design_ballbar(base: Any, *, lengths: Sequence[float] = (100.0, 150.0),
-                   pivot_x: Sequence[float] | None = None, pivot_z: Sequence[float] | None = None,
-                   travel: Sequence[float] | None = None, time_s: float = 0.0, rate_hz: float = 100.0,
-                   noise_um: float = 0.5, rho: float = 0.0, effects: Sequence[str] = ()) -> Any:
+def design_ballbar(
+    base: Any,
+    *,
+    lengths: Sequence[float] = (100.0, 150.0),
+    pivot_x: Sequence[float] | None = None,
+    pivot_z: Sequence[float] | None = None,
+    travel: Sequence[float] | None = None,
+    time_s: float = 0.0,
+    rate_hz: float = 100.0,
+    noise_um: float = 0.5,
+    rho: float = 0.0,
+    effects: Sequence[str] = (),
+) -> Any:
     """A ``_core.BallbarDesign``: ``.best`` and ``.baseline`` (the ``base`` set-up) with their
     predicted 1-sigma at the same run time (``time_s``, 0: the base set-up's), ``.ratio`` of
     their worst expanded uncertainties, and every candidate tried. ``travel``: xmin, xmax,
@@ -48,7 +58,9 @@ def parameter_units(names: Sequence[str]) -> list[tuple[str, float]]:
         if i < 8:
             out.append(("urad", 1e6) if i in (2, 3, 6, 7) else ("um", 1e3))
             continue
-        if n.startswith(("pivot_", "zero_", "sphere.", "tool_offset_")):  # pivot_x (pivot_x#2 of a second set-up),
+        if n.startswith(
+            ("pivot_", "zero_", "sphere.", "tool_offset_")
+        ):  # pivot_x (pivot_x#2 of a second set-up),
             # R-test probe zeros, the touch probe's sphere and a head's tool length
             out.append(("um", 1e3))
             continue
@@ -61,8 +73,12 @@ def parameter_units(names: Sequence[str]) -> list[tuple[str, float]]:
 
 def candidate_dict(c: Any) -> dict:
     """One evaluated set-up as JSON."""
-    out = {"ballbar_length": c.setup.ballbar_length, "pivot": list(map(float, c.setup.pivot)),
-           "feasible": c.feasible, "duration_s": c.duration_s}
+    out = {
+        "ballbar_length": c.setup.ballbar_length,
+        "pivot": list(map(float, c.setup.pivot)),
+        "feasible": c.feasible,
+        "duration_s": c.duration_s,
+    }
     if not c.feasible:
         return out | {"why_not": c.why_not}
     out["predicted_std"] = {n: float(s) for n, s in zip(c.names, c.sigma)}
@@ -70,23 +86,39 @@ def candidate_dict(c: Any) -> dict:
     out["worst_error"] = c.worst_error
     effects = [n for n in c.names[11:]]
     if effects:
-        out["effect_correlation"] = {n: {"max_with_location_errors": a, "max_with_other_effects": b}
-                                     for n, a, b in zip(effects, c.effect_vs_location, c.effect_vs_effects)}
+        out["effect_correlation"] = {
+            n: {"max_with_location_errors": a, "max_with_other_effects": b}
+            for n, a, b in zip(effects, c.effect_vs_location, c.effect_vs_effects)
+        }
     return out
 
 
 def design_dict(d: Any) -> dict:
     """The JSON of ``rotacal design ballbar --json``."""
-    return {"time_budget_s": d.time_budget_s, "ratio_to_default": d.ratio,
-            "best": candidate_dict(d.best), "default": candidate_dict(d.baseline),
-            "candidates": [candidate_dict(c) for c in d.candidates]}
+    return {
+        "time_budget_s": d.time_budget_s,
+        "ratio_to_default": d.ratio,
+        "best": candidate_dict(d.best),
+        "default": candidate_dict(d.baseline),
+        "candidates": [candidate_dict(c) for c in d.candidates],
+    }
 
 
-def design_separation(session: Any, pair: Sequence[str], *, base: Any | None = None,
-                      lengths: Sequence[float] = (100.0, 150.0), pivot_r: Sequence[float] | None = None,
-                      pivot_angle: Sequence[float] | None = None, pivot_z: Sequence[float] | None = None,
-                      travel: Sequence[float] | None = None, tilt_limits: Sequence[float] | None = None,
-                      max_time_s: float = 600.0, max_correlation: float = 0.5, noise_um: float = 0.0) -> Any:
+def design_separation(
+    session: Any,
+    pair: Sequence[str],
+    *,
+    base: Any | None = None,
+    lengths: Sequence[float] = (100.0, 150.0),
+    pivot_r: Sequence[float] | None = None,
+    pivot_angle: Sequence[float] | None = None,
+    pivot_z: Sequence[float] | None = None,
+    travel: Sequence[float] | None = None,
+    tilt_limits: Sequence[float] | None = None,
+    max_time_s: float = 600.0,
+    max_correlation: float = 0.5,
+    noise_um: float = 0.0,
+) -> Any:
     """A ``_core.SeparationDesign``: the smallest ballbar test to add to ``session`` (a
     ``BallbarSession``) so that the two effects of ``pair`` (catalogue ids) come out of the
     joint fit with a canonical correlation below ``max_correlation``, the predicted 1-sigma of
@@ -97,7 +129,11 @@ def design_separation(session: Any, pair: Sequence[str], *, base: Any | None = N
     if base is not None:
         o.added = base
     o.bar_lengths_mm = [float(v) for v in lengths]
-    for value, field in ((pivot_r, "pivot_radius_mm"), (pivot_angle, "pivot_angle_deg"), (pivot_z, "pivot_z_mm")):
+    for value, field in (
+        (pivot_r, "pivot_radius_mm"),
+        (pivot_angle, "pivot_angle_deg"),
+        (pivot_z, "pivot_z_mm"),
+    ):
         if value is not None:
             setattr(o, field, [float(v) for v in value])
     if travel is None:
@@ -112,7 +148,9 @@ def design_separation(session: Any, pair: Sequence[str], *, base: Any | None = N
 
 def _check_pair(pair: Sequence[str]) -> None:
     if len(pair) != 2:
-        raise _core.InvalidArgument(f"--separate: {','.join(pair)}: give two effects, EFFECT,EFFECT")
+        raise _core.InvalidArgument(
+            f"--separate: {','.join(pair)}: give two effects, EFFECT,EFFECT"
+        )
 
 
 def _search_limits(o: Any, max_time_s: float, max_correlation: float, noise_um: float) -> None:
@@ -131,7 +169,9 @@ def machine_travel(machine: Any) -> list[float] | None:
 def _travel(travel: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
     t = np.asarray(travel, dtype=float).reshape(3, 2)
     if np.any(t[:, 0] >= t[:, 1]):
-        raise _core.InvalidArgument("--travel: each axis needs min < max (xmin,xmax,ymin,ymax,zmin,zmax)")
+        raise _core.InvalidArgument(
+            "--travel: each axis needs min < max (xmin,xmax,ymin,ymax,zmin,zmax)"
+        )
     return t[:, 0], t[:, 1]
 
 
@@ -149,25 +189,44 @@ def separation_dict(d: Any) -> dict:
     out = _separation_common(d)
     if d.candidates_tried:
         c = d.chosen
-        out["added_test"] = {"description": c.description, "tests": [_core.test_label(t, c.setup.machine) for t in c.setup.tests],
-                             "ballbar_length": c.setup.ballbar_length, "pivot": list(map(float, c.setup.pivot)),
-                             "new_pivot": c.new_pivot, "tilt_range_deg": list(c.setup.tilt_range_deg),
-                             "radial_c_side": c.setup.radial_c_side.name,
-                             "run_time_s": c.duration_s * c.slow_down, "slow_down": c.slow_down,
-                             "correlation_after": c.correlation}
+        out["added_test"] = {
+            "description": c.description,
+            "tests": [_core.test_label(t, c.setup.machine) for t in c.setup.tests],
+            "ballbar_length": c.setup.ballbar_length,
+            "pivot": list(map(float, c.setup.pivot)),
+            "new_pivot": c.new_pivot,
+            "tilt_range_deg": list(c.setup.tilt_range_deg),
+            "radial_c_side": c.setup.radial_c_side.name,
+            "run_time_s": c.duration_s * c.slow_down,
+            "slow_down": c.slow_down,
+            "correlation_after": c.correlation,
+        }
     return out
 
 
-def design_rtest(*, radii: Sequence[float] | None = None, heights: Sequence[float] | None = None,
-                 b_steps: Sequence[float] | None = None, c_steps: Sequence[float] | None = None,
-                 b_limits: Sequence[float] | None = None, travel: Sequence[float] | None = None,
-                 time_s: float = 0.0, noise_um: float = 0.3, rho: float = 0.0, dwell_s: float | None = None) -> Any:
+def design_rtest(
+    *,
+    radii: Sequence[float] | None = None,
+    heights: Sequence[float] | None = None,
+    b_steps: Sequence[float] | None = None,
+    c_steps: Sequence[float] | None = None,
+    b_limits: Sequence[float] | None = None,
+    travel: Sequence[float] | None = None,
+    time_s: float = 0.0,
+    noise_um: float = 0.3,
+    rho: float = 0.0,
+    dwell_s: float | None = None,
+) -> Any:
     """A ``_core.RtestDesign``: the two R-test nests and the B/C grid with the smallest
     predicted largest expanded uncertainty of the location errors at the run time ``time_s``
     (0: the default pattern's), against the default pattern (C++: ``rotacal/rtest/design.hpp``)."""
     o = _core.RtestDesignOptions()
-    for value, field in ((radii, "nest_radius_mm"), (heights, "nest_height_mm"), (b_steps, "b_step_deg"),
-                         (c_steps, "c_step_deg")):
+    for value, field in (
+        (radii, "nest_radius_mm"),
+        (heights, "nest_height_mm"),
+        (b_steps, "b_step_deg"),
+        (c_steps, "c_step_deg"),
+    ):
         if value is not None:
             setattr(o, field, [float(v) for v in value])
     if b_limits is not None:
@@ -187,33 +246,62 @@ def design_rtest(*, radii: Sequence[float] | None = None, heights: Sequence[floa
 def rtest_candidate_dict(c: Any) -> dict:
     """One evaluated R-test pattern as JSON."""
     p = c.pattern
-    out = {"nests": [list(map(float, n)) for n in p.nests], "b_deg": list(p.b_deg), "c_deg": list(p.c_deg),
-           "dwell_s": p.dwell_s, "feasible": c.feasible, "duration_s": c.duration_s}
+    out = {
+        "nests": [list(map(float, n)) for n in p.nests],
+        "b_deg": list(p.b_deg),
+        "c_deg": list(p.c_deg),
+        "dwell_s": p.dwell_s,
+        "feasible": c.feasible,
+        "duration_s": c.duration_s,
+    }
     if not c.feasible:
         return out | {"why_not": c.why_not}
-    return out | {"predicted_std": {n: float(s) for n, s in zip(c.names, c.sigma)},
-                  "worst_expanded_um": c.worst_expanded_um, "worst_error": c.worst_error}
+    return out | {
+        "predicted_std": {n: float(s) for n, s in zip(c.names, c.sigma)},
+        "worst_expanded_um": c.worst_expanded_um,
+        "worst_error": c.worst_error,
+    }
 
 
 def rtest_design_dict(d: Any) -> dict:
     """The JSON of ``rotacal design rtest --json``."""
-    return {"time_budget_s": d.time_budget_s, "ratio_to_default": d.ratio, "best": rtest_candidate_dict(d.best),
-            "default": rtest_candidate_dict(d.baseline), "candidates": [rtest_candidate_dict(c) for c in d.candidates]}
+    return {
+        "time_budget_s": d.time_budget_s,
+        "ratio_to_default": d.ratio,
+        "best": rtest_candidate_dict(d.best),
+        "default": rtest_candidate_dict(d.baseline),
+        "candidates": [rtest_candidate_dict(c) for c in d.candidates],
+    }
 
 
-def design_rtest_separation(session: Any, pair: Sequence[str], *, radii: Sequence[float] | None = None,
-                            angles: Sequence[float] | None = None, heights: Sequence[float] | None = None,
-                            b_steps: Sequence[float] | None = None, c_steps: Sequence[float] | None = None,
-                            b_limits: Sequence[float] | None = None, travel: Sequence[float] | None = None,
-                            dwell_s: float = 0.0, max_time_s: float = 600.0, max_correlation: float = 0.5,
-                            noise_um: float = 0.0) -> Any:
+def design_rtest_separation(
+    session: Any,
+    pair: Sequence[str],
+    *,
+    radii: Sequence[float] | None = None,
+    angles: Sequence[float] | None = None,
+    heights: Sequence[float] | None = None,
+    b_steps: Sequence[float] | None = None,
+    c_steps: Sequence[float] | None = None,
+    b_limits: Sequence[float] | None = None,
+    travel: Sequence[float] | None = None,
+    dwell_s: float = 0.0,
+    max_time_s: float = 600.0,
+    max_correlation: float = 0.5,
+    noise_um: float = 0.0,
+) -> Any:
     """A ``_core.RtestSeparationDesign``: the smallest R-test nest (position and grid) to add to
     ``session`` (an ``RtestSession``) so that the two effects of ``pair`` come out of the joint
     fit with a canonical correlation below ``max_correlation``, or why no test can."""
     _check_pair(pair)
     o = _core.RtestSeparationOptions()
-    for value, field in ((radii, "nest_radius_mm"), (angles, "nest_angle_deg"), (heights, "nest_height_mm"),
-                         (b_steps, "b_step_deg"), (c_steps, "c_step_deg")):
+    for value, field in (
+        (radii, "nest_radius_mm"),
+        (angles, "nest_angle_deg"),
+        (heights, "nest_height_mm"),
+        (b_steps, "b_step_deg"),
+        (c_steps, "c_step_deg"),
+    ):
         if value is not None:
             setattr(o, field, [float(v) for v in value])
     if b_limits is not None:
@@ -228,12 +316,24 @@ def design_rtest_separation(session: Any, pair: Sequence[str], *, radii: Sequenc
 def _separation_common(d: Any) -> dict:
     def sig(v: Any) -> dict:
         return {n: (float(s) if np.isfinite(s) else None) for n, s in zip(d.names, v)}
-    out = {"effects": list(d.effects), "separable": not d.motion.same_motion,
-           "already_separated": d.already_separated, "found": d.found, "verdict": d.verdict,
-           "table_motion": {"same_motion": d.motion.same_motion, "cosine": d.motion.cosine, "why": d.motion.why},
-           "correlation_before": d.correlation_before, "predicted_std_before": sig(d.sigma_before),
-           "noise_um": d.noise_um, "effective_samples_per_reading": d.effective_per_reading,
-           "candidates_tried": d.candidates_tried}
+
+    out = {
+        "effects": list(d.effects),
+        "separable": not d.motion.same_motion,
+        "already_separated": d.already_separated,
+        "found": d.found,
+        "verdict": d.verdict,
+        "table_motion": {
+            "same_motion": d.motion.same_motion,
+            "cosine": d.motion.cosine,
+            "why": d.motion.why,
+        },
+        "correlation_before": d.correlation_before,
+        "predicted_std_before": sig(d.sigma_before),
+        "noise_um": d.noise_um,
+        "effective_samples_per_reading": d.effective_per_reading,
+        "candidates_tried": d.candidates_tried,
+    }
     if d.candidates_tried:
         out["predicted_std_after"] = sig(d.sigma_after)
     return out
@@ -245,10 +345,16 @@ def rtest_separation_dict(d: Any) -> dict:
     if d.candidates_tried:
         c = d.chosen
         p = c.added
-        out["added_nest"] = {"description": c.description, "nest": list(map(float, p.nests[0])),
-                             "b_deg": list(p.b_deg), "c_deg": list(p.c_deg), "dwell_s": p.dwell_s,
-                             "repeats": c.repeats, "run_time_s": c.duration_s * c.repeats,
-                             "correlation_after": c.correlation}
+        out["added_nest"] = {
+            "description": c.description,
+            "nest": list(map(float, p.nests[0])),
+            "b_deg": list(p.b_deg),
+            "c_deg": list(p.c_deg),
+            "dwell_s": p.dwell_s,
+            "repeats": c.repeats,
+            "run_time_s": c.duration_s * c.repeats,
+            "correlation_after": c.correlation,
+        }
     return out
 
 
@@ -262,10 +368,21 @@ def rtest_separation_dict(d: Any) -> dict:
 SPHERE_CANDIDATES = ((250.0, 0.0, 80.0), (300.0, 0.0, 40.0))
 
 
-def design_probe(machine: Any, *, sphere: Sequence[float] = (150.0, 0.0, 80.0), sphere_diameter: float = 25.0,
-                 stylus_diameter: float = 6.0, touches: int = 0, tilt_step: float = 15.0, rot_step: float = 30.0,
-                 noise_um: float = 0.5, touch_directions: bool = True, max_contact_angle: float = 80.0,
-                 sphere_candidates: Any = SPHERE_CANDIDATES, sphere_gain: float = 0.05) -> Any:
+def design_probe(
+    machine: Any,
+    *,
+    sphere: Sequence[float] = (150.0, 0.0, 80.0),
+    sphere_diameter: float = 25.0,
+    stylus_diameter: float = 6.0,
+    touches: int = 0,
+    tilt_step: float = 15.0,
+    rot_step: float = 30.0,
+    noise_um: float = 0.5,
+    touch_directions: bool = True,
+    max_contact_angle: float = 80.0,
+    sphere_candidates: Any = SPHERE_CANDIDATES,
+    sphere_gain: float = 0.05,
+) -> Any:
     """A ``_core.ProbeDesign``: the rotary poses (in program order; ``.best.poses_deg``) and each
     touch's approach direction (``.best.pose_directions``; with ``touch_directions=False`` every
     visit along the default directions) that give the smallest largest expanded uncertainty
@@ -297,31 +414,64 @@ def poses_text(poses_deg: Any) -> str:
 
 def probe_candidate_dict(c: Any) -> dict:
     """One evaluated set of probe poses as JSON."""
-    out = {"poses_deg": np.asarray(c.poses_deg).tolist(), "directions": np.asarray(c.directions).tolist(),
-           "pose_directions": [np.asarray(d).tolist() for d in c.pose_directions],
-           "sphere": np.asarray(c.sphere).tolist(), "feasible": c.feasible, "touches": c.touches,
-           "undetermined": list(c.undetermined)}
+    out = {
+        "poses_deg": np.asarray(c.poses_deg).tolist(),
+        "directions": np.asarray(c.directions).tolist(),
+        "pose_directions": [np.asarray(d).tolist() for d in c.pose_directions],
+        "sphere": np.asarray(c.sphere).tolist(),
+        "feasible": c.feasible,
+        "touches": c.touches,
+        "undetermined": list(c.undetermined),
+    }
     if not c.feasible:
         return out | {"why_not": c.why_not}
-    return out | {"predicted_std": {n: (float(s) if np.isfinite(s) else None) for n, s in zip(c.names, c.sigma)},
-                  "worst_expanded_um": c.worst_expanded_um, "worst_error": c.worst_error,
-                  "poses_option": poses_text(c.poses_deg)}
+    return out | {
+        "predicted_std": {
+            n: (float(s) if np.isfinite(s) else None) for n, s in zip(c.names, c.sigma)
+        },
+        "worst_expanded_um": c.worst_expanded_um,
+        "worst_error": c.worst_error,
+        "poses_option": poses_text(c.poses_deg),
+    }
 
 
 def probe_design_dict(d: Any) -> dict:
     """The JSON of ``rotacal design probe --json``."""
-    return {"touches": d.touches, "ratio_to_default": d.ratio, "poses_tried": d.poses_tried,
-            "touches_tried": d.touches_tried, "sphere": np.asarray(d.sphere).tolist(),
-            "spheres_tried": [{"sphere": np.asarray(t.sphere).tolist(), "plannable": t.plannable,
-                               **({"worst_expanded_um": t.worst_expanded_um} if t.plannable
-                                  else {"why_not": t.why_not})} for t in d.spheres],
-            "best": probe_candidate_dict(d.best), "default": probe_candidate_dict(d.baseline),
-            "refused_poses": list(d.refused)}
+    return {
+        "touches": d.touches,
+        "ratio_to_default": d.ratio,
+        "poses_tried": d.poses_tried,
+        "touches_tried": d.touches_tried,
+        "sphere": np.asarray(d.sphere).tolist(),
+        "spheres_tried": [
+            {
+                "sphere": np.asarray(t.sphere).tolist(),
+                "plannable": t.plannable,
+                **(
+                    {"worst_expanded_um": t.worst_expanded_um}
+                    if t.plannable
+                    else {"why_not": t.why_not}
+                ),
+            }
+            for t in d.spheres
+        ],
+        "best": probe_candidate_dict(d.best),
+        "default": probe_candidate_dict(d.baseline),
+        "refused_poses": list(d.refused),
+    }
 
 
-def design_probe_separation(session: Any, pair: Sequence[str], *, tilt_step: float = 15.0, rot_step: float = 30.0,
-                            pose_time_s: float = 0.0, max_time_s: float = 600.0, max_correlation: float = 0.5,
-                            noise_um: float = 0.0) -> Any:
+def design_probe_separation(
+    session: Any,
+    pair: Sequence[str],
+    *,
+    tilt_step: float = 15.0,
+    rot_step: float = 30.0,
+    pose_time_s: float = 0.0,
+    max_time_s: float = 600.0,
+    max_correlation: float = 0.5,
+    noise_um: float = 0.0,
+) -> Any:
     """A ``_core.ProbeSeparationDesign``: the smallest set of poses (a sweep of one axis, or one
     pose, repeated) to add to ``session`` (a ``ProbeSession``) so that the two effects of
     ``pair`` come out of the joint fit with a canonical correlation below ``max_correlation``,
@@ -340,7 +490,12 @@ def probe_separation_dict(d: Any) -> dict:
     out = _separation_common(d)
     if d.candidates_tried:
         c = d.chosen
-        out["added_poses"] = {"description": c.description, "poses_deg": np.asarray(c.poses_deg).tolist(),
-                              "poses_option": poses_text(c.poses_deg), "repeats": c.repeats,
-                              "run_time_s": c.duration_s * c.repeats, "correlation_after": c.correlation}
+        out["added_poses"] = {
+            "description": c.description,
+            "poses_deg": np.asarray(c.poses_deg).tolist(),
+            "poses_option": poses_text(c.poses_deg),
+            "repeats": c.repeats,
+            "run_time_s": c.duration_s * c.repeats,
+            "correlation_after": c.correlation,
+        }
     return out

@@ -1,4 +1,5 @@
 """Diagnosis: what the fitted model gets wrong, its cause, the extended model and the gain."""
+
 from __future__ import annotations
 
 from typing import Any
@@ -18,7 +19,9 @@ def diagnosis_options(**options: Any) -> _core.DiagnosisOptions:
     o = _core.DiagnosisOptions()
     mh = options.get("max_harmonic")
     if mh is not None and not (isinstance(mh, int) and 1 <= mh <= MAX_HARMONIC):
-        raise _core.InvalidArgument(f"diagnose: max_harmonic must be an integer in 1..{MAX_HARMONIC}, got {mh!r}")
+        raise _core.InvalidArgument(
+            f"diagnose: max_harmonic must be an integer in 1..{MAX_HARMONIC}, got {mh!r}"
+        )
     for name, value in options.items():
         if not hasattr(o, name) or name.startswith("_"):
             raise _core.InvalidArgument(f"diagnose: unknown option {name!r}")
@@ -41,9 +44,15 @@ def diagnose(session: Any, *, reference: Any = None, **options: Any) -> Diagnosi
         the candidates to these catalogue ids)
     """
     o = diagnosis_options(**options)
-    run = by_kind(session, {BALLBAR: lambda: _core.diagnose_ballbar(session, o, reference),
-                            RTEST: lambda: _core.diagnose_rtest(session, o),
-                            PROBE: lambda: _core.diagnose_probe(session, o)}, "diagnose")
+    run = by_kind(
+        session,
+        {
+            BALLBAR: lambda: _core.diagnose_ballbar(session, o, reference),
+            RTEST: lambda: _core.diagnose_rtest(session, o),
+            PROBE: lambda: _core.diagnose_probe(session, o),
+        },
+        "diagnose",
+    )
     return DiagnosisResult(run())
 
 
@@ -57,6 +66,7 @@ def plausible_sizes(sizes: Any = None) -> _core.PlausibleSizes:
     import json
     import math
     from pathlib import Path
+
     o = _core.PlausibleSizes()
     if sizes is None:
         return o
@@ -68,7 +78,9 @@ def plausible_sizes(sizes: Any = None) -> _core.PlausibleSizes:
         except OSError as e:
             raise _core.IoError(f"{where}: cannot read: {e.strerror}") from None
         except json.JSONDecodeError as e:
-            raise _core.InvalidArgument(f"{where}: line {e.lineno}, column {e.colno}: {e.msg}") from None
+            raise _core.InvalidArgument(
+                f"{where}: line {e.lineno}, column {e.colno}: {e.msg}"
+            ) from None
     if not isinstance(sizes, dict):
         raise _core.InvalidArgument(f"{where}: expected a JSON object of plausible sizes")
     for key, value in sizes.items():
@@ -83,8 +95,15 @@ def plausible_sizes(sizes: Any = None) -> _core.PlausibleSizes:
         if key == "overrides" and not isinstance(value, dict):
             raise _core.InvalidArgument(f"{where}: overrides must be an object of sizes")
         for name, v in items:
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v < 0:
-                raise _core.InvalidArgument(f"{where}: {name}: a size must be a finite number >= 0, got {v!r}")
+            if (
+                isinstance(v, bool)
+                or not isinstance(v, (int, float))
+                or not math.isfinite(v)
+                or v < 0
+            ):
+                raise _core.InvalidArgument(
+                    f"{where}: {name}: a size must be a finite number >= 0, got {v!r}"
+                )
         if key == "overrides":
             o.overrides = {str(k): float(v) for k, v in value.items()}
         else:
@@ -92,18 +111,28 @@ def plausible_sizes(sizes: Any = None) -> _core.PlausibleSizes:
     return o
 
 
-def uncertainty_budget(session: Any, diagnosis: DiagnosisResult | None = None, *, sizes: Any = None,
-                       coverage: float = 0.95) -> Any:
+def uncertainty_budget(
+    session: Any,
+    diagnosis: DiagnosisResult | None = None,
+    *,
+    sizes: Any = None,
+    coverage: float = 0.95,
+) -> Any:
     """GUM / ISO/TR 230-9 budget of the location errors (diagnose/uncertainty_budget.hpp):
     type A from the noise model, type B per catalogue effect the diagnosed model leaves out.
     Runs ``diagnose(session)`` if no diagnosis is given. ``sizes``: plausible_sizes() input."""
     if diagnosis is None:
         diagnosis = diagnose(session)
     o = plausible_sizes(sizes)
-    return by_kind(session, {BALLBAR: lambda: _core.uncertainty_budget_ballbar(session, diagnosis.raw, o, coverage),
-                             RTEST: lambda: _core.uncertainty_budget_rtest(session, diagnosis.raw, o, coverage),
-                             PROBE: lambda: _core.uncertainty_budget_probe(session, diagnosis.raw, o, coverage)},
-                   "uncertainty_budget")()
+    return by_kind(
+        session,
+        {
+            BALLBAR: lambda: _core.uncertainty_budget_ballbar(session, diagnosis.raw, o, coverage),
+            RTEST: lambda: _core.uncertainty_budget_rtest(session, diagnosis.raw, o, coverage),
+            PROBE: lambda: _core.uncertainty_budget_probe(session, diagnosis.raw, o, coverage),
+        },
+        "uncertainty_budget",
+    )()
 
 
 def group_text(finding: dict) -> str:
@@ -113,4 +142,6 @@ def group_text(finding: dict) -> str:
     members = sorted(finding["group"], key=lambda m: -1.0 if m.get("aliased") else -m["weight"])
     return ", ".join(
         f"{m['effect']} ({'aliased' if m.get('aliased') else format(m['weight'], '.2f')}"
-        f"{'; in the extended model' if m['effect'] == finding['effect'] else ''})" for m in members)
+        f"{'; in the extended model' if m['effect'] == finding['effect'] else ''})"
+        for m in members
+    )

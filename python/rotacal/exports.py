@@ -3,6 +3,7 @@
 ($TC_CARR, type P), ISG's universal kinematic, and the field mappings of HEIDENHAIN and FANUC.
 The work is done in C++ (``rotacal/io/controller_export.hpp``); the mapping field by field,
 with its sources: docs/controller_exports.md."""
+
 from __future__ import annotations
 
 import os
@@ -29,16 +30,23 @@ def read_current(path: str | Path) -> str:
     except OSError as e:
         raise _core.IoError(f"{p}: cannot read: {e.strerror}") from None
     if len(data) > MAX_CURRENT_BYTES:
-        raise _core.InvalidArgument(f"{p}: more than {MAX_CURRENT_BYTES} bytes: not a controller parameter file")
+        raise _core.InvalidArgument(
+            f"{p}: more than {MAX_CURRENT_BYTES} bytes: not a controller parameter file"
+        )
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as e:
-        line = data[:e.start].count(b"\n") + 1
+        line = data[: e.start].count(b"\n") + 1
         raise _core.ParseError(f"{p}:{line}: byte 0x{data[e.start]:02x} is not UTF-8") from None
 
 
-def export_controller(model: str | Path, controller: str, current: str | Path | None = None,
-                      toolholder: int = 1, generated_at: str = "") -> Any:
+def export_controller(
+    model: str | Path,
+    controller: str,
+    current: str | Path | None = None,
+    toolholder: int = 1,
+    generated_at: str = "",
+) -> Any:
     """A ``rotacal._core.ControllerExport`` of a model file: ``.text`` is the file for the
     controller, ``.values`` the parameters (current, corrected, 1-sigma), ``.errors`` which of
     the location errors it holds. ``current``: the controller's values active during the test
@@ -49,19 +57,42 @@ def export_controller(model: str | Path, controller: str, current: str | Path | 
         text, where = read_current(current), os.fspath(current)
     else:  # the values the model says were active (identify --controller), if any
         from .models import load_model
+
         text = load_model(model).get("source", {}).get("controller_parameters")
         where = f"{os.fspath(model)}: source.controller_parameters"
-    return _core.export_controller(os.fspath(model), controller, text, where, int(toolholder), generated_at)
+    return _core.export_controller(
+        os.fspath(model), controller, text, where, int(toolholder), generated_at
+    )
 
 
 def export_dict(ex: Any) -> dict:
     """The JSON of ``rotacal export --json``."""
-    return {"controller": ex.controller, "kinematics": ex.kinematics, "current_given": ex.current_given,
-            "parameters": [{"name": v.name, "current": v.current, "corrected": v.corrected, "std": v.std,
-                            "unit": v.unit, "from": v.source} for v in ex.values],
-            "location_errors": [{"name": e.name, "value": e.value if e.observable else None,
-                                 "std": e.std if e.observable else None, "held": e.held, "where": e.where}
-                                for e in ex.errors]}
+    return {
+        "controller": ex.controller,
+        "kinematics": ex.kinematics,
+        "current_given": ex.current_given,
+        "parameters": [
+            {
+                "name": v.name,
+                "current": v.current,
+                "corrected": v.corrected,
+                "std": v.std,
+                "unit": v.unit,
+                "from": v.source,
+            }
+            for v in ex.values
+        ],
+        "location_errors": [
+            {
+                "name": e.name,
+                "value": e.value if e.observable else None,
+                "std": e.std if e.observable else None,
+                "held": e.held,
+                "where": e.where,
+            }
+            for e in ex.errors
+        ],
+    }
 
 
 def residual_model(model: dict, ex: Any) -> dict:
@@ -76,7 +107,9 @@ def residual_model(model: dict, ex: Any) -> dict:
             errors[e.name] = {"value": 0.0, "std": 0.0, "unit": errors[e.name].get("unit", "")}
     out["location_errors"] = errors
     out.pop("covariance", None)
-    out["source"] = dict(model.get("source", {})) | {"residual_after": f"{ex.controller} export ({ex.kinematics})"}
+    out["source"] = dict(model.get("source", {})) | {
+        "residual_after": f"{ex.controller} export ({ex.kinematics})"
+    }
     return out
 
 
@@ -90,6 +123,7 @@ def _positioning_error(model: dict, axis: str, nominal_deg: np.ndarray) -> np.nd
     the C++ model (rtest/error_model.hpp; the basis of docs/model_file.md): beta_BY(B) for B,
     gamma_CB(C) at B = 0 for C."""
     from .models import rtest_model_from_dict
+
     fitted, _, _ = rtest_model_from_dict(model)
     rad = np.radians(nominal_deg)
     if axis == "B":
@@ -99,43 +133,65 @@ def _positioning_error(model: dict, axis: str, nominal_deg: np.ndarray) -> np.nd
     return np.asarray(values)[:, 5]
 
 
-def linuxcnc_comp_table(model: dict, axis: str, lo_deg: float, hi_deg: float, step_deg: float) -> tuple[str, str]:
+def linuxcnc_comp_table(
+    model: dict, axis: str, lo_deg: float, hi_deg: float, step_deg: float
+) -> tuple[str, str]:
     """A LinuxCNC ``[JOINT_n]COMP_FILE`` (``COMP_FILE_TYPE = 0``) of an R-test error map: lines
     ``nominal actual actual`` in degrees, the actual angle being nominal + the map's positioning
     error (B: beta_BY(B); C: gamma_CB(C) at B = 0), the same both ways (an R-test does not see
     reversal). The file can carry no header (LinuxCNC stops at the first line that is not three
     numbers): the second value returned says what it is, for the caller to print."""
     if model.get("kind") != "rtest-joint" or model.get("machine") != "BC-trt":
-        raise _core.InvalidArgument("--comp-file: needs an R-test error map of a BC-trt machine "
-                                    f"(model kind {model.get('kind')!r}, machine {model.get('machine')!r})")
+        raise _core.InvalidArgument(
+            "--comp-file: needs an R-test error map of a BC-trt machine "
+            f"(model kind {model.get('kind')!r}, machine {model.get('machine')!r})"
+        )
     coefficients = model.get("map_coefficients", {})
     prefix = {"B": "beta_BY", "C": "gamma_CB"}.get(axis)
     if prefix is None:
         raise _core.InvalidArgument(f"--comp-file {axis}: the axis must be B or C")
     if not any(k.startswith(prefix + ".") for k in coefficients):
-        raise _core.InvalidArgument(f"--comp-file {axis}: the model's map has no {prefix} terms "
-                                    "(C positioning needs the basis with gamma_cb)")
+        raise _core.InvalidArgument(
+            f"--comp-file {axis}: the model's map has no {prefix} terms "
+            "(C positioning needs the basis with gamma_cb)"
+        )
     if not (step_deg > 0 and hi_deg > lo_deg):
-        raise _core.InvalidArgument(f"--comp-range {lo_deg:g},{hi_deg:g} with step {step_deg:g}: need lo < hi, step > 0")
+        raise _core.InvalidArgument(
+            f"--comp-range {lo_deg:g},{hi_deg:g} with step {step_deg:g}: need lo < hi, step > 0"
+        )
     n = int(np.floor((hi_deg - lo_deg) / step_deg + 1e-9)) + 1
     if n > MAX_COMP_LINES:
-        raise _core.InvalidArgument(f"--comp-range: {n} lines, LinuxCNC reads at most {MAX_COMP_LINES}; use a larger step")
+        raise _core.InvalidArgument(
+            f"--comp-range: {n} lines, LinuxCNC reads at most {MAX_COMP_LINES}; use a larger step"
+        )
     nominal = lo_deg + np.arange(n) * step_deg
     actual = nominal + np.degrees(_positioning_error(model, axis, nominal))
     lines = [f"{a:.6f} {b:.6f} {b:.6f}" for a, b in zip(nominal, actual)]
     # The C map at B = 0: its terms in b^M (M > 0) vanish there; said so when the model has any.
-    dropped_any = axis == "C" and any(k.startswith(prefix + ".") and not k.endswith(".b0")
-                                      and isinstance(v, dict) and v.get("value") is not None
-                                      for k, v in coefficients.items())
-    what = (f"{axis} positioning error from the R-test map ({prefix}), {lo_deg:g}..{hi_deg:g} deg every {step_deg:g}: "
-            f"[JOINT_n]COMP_FILE_TYPE = 0 (nominal, actual moving +, actual moving -, deg)"
-            + ("; terms that depend on B were left out (the table is for B = 0)" if dropped_any else ""))
+    dropped_any = axis == "C" and any(
+        k.startswith(prefix + ".")
+        and not k.endswith(".b0")
+        and isinstance(v, dict)
+        and v.get("value") is not None
+        for k, v in coefficients.items()
+    )
+    what = (
+        f"{axis} positioning error from the R-test map ({prefix}), {lo_deg:g}..{hi_deg:g} deg every {step_deg:g}: "
+        f"[JOINT_n]COMP_FILE_TYPE = 0 (nominal, actual moving +, actual moving -, deg)"
+        + ("; terms that depend on B were left out (the table is for B = 0)" if dropped_any else "")
+    )
     return "\n".join(lines) + "\n", what
 
 
-def isg_sphere_centres(session: Any, model: dict, setup: str | None, kinematic: tuple[int, int],
-                       origin: Sequence[float] = (0.0, 0.0, 0.0), precision_mm: float = 0.06,
-                       session_sha256: str | None = None) -> tuple[str, str]:
+def isg_sphere_centres(
+    session: Any,
+    model: dict,
+    setup: str | None,
+    kinematic: tuple[int, int],
+    origin: Sequence[float] = (0.0, 0.0, 0.0),
+    precision_mm: float = 0.06,
+    session_sha256: str | None = None,
+) -> tuple[str, str]:
     """The measured sphere centres of an R-test set-up as the ISG kinematic optimisation takes
     them from third-party measuring equipment (TF5245, "sphere centre points already
     calculated"): an NC program that calls ``SysCalibFitInit.ecy`` (kinematic type, variant,
@@ -151,56 +207,93 @@ def isg_sphere_centres(session: Any, model: dict, setup: str | None, kinematic: 
     The probe zeros hold only for the session the model was fitted to: a session of other bytes
     (``session_sha256`` against the model's ``source``) or other nests is refused."""
     if model.get("kind") != "rtest-joint":
-        raise _core.InvalidArgument("--centres: needs the rtest-joint model of the same session (its probe zeros)")
+        raise _core.InvalidArgument(
+            "--centres: needs the rtest-joint model of the same session (its probe zeros)"
+        )
     fitted = (model.get("source") or {}).get("session_sha256")
     if session_sha256 is not None and fitted is not None and fitted != session_sha256:
-        raise _core.InvalidArgument("--centres: the model was fitted to another session "
-                                    f"({(model.get('source') or {}).get('session', '?')}, SHA-256 {fitted[:12]}...): "
-                                    "its probe zeros do not hold for this one")
+        raise _core.InvalidArgument(
+            "--centres: the model was fitted to another session "
+            f"({(model.get('source') or {}).get('session', '?')}, SHA-256 {fitted[:12]}...): "
+            "its probe zeros do not hold for this one"
+        )
     s, _ = _rtest_displacements(session)
     setups = list(dict.fromkeys(s.setups))
     label = setup if setup is not None else setups[0]
     if label not in setups:
-        raise _core.InvalidArgument(f"--centres-setup {label!r}: the session's set-ups are {', '.join(setups)}")
+        raise _core.InvalidArgument(
+            f"--centres-setup {label!r}: the session's set-ups are {', '.join(setups)}"
+        )
     zeros = model.get("probe_zeros", {})
     if label not in zeros:
-        raise _core.InvalidArgument(f"--centres: the model has no probe zero for set-up {label!r} "
-                                    "(fit the same session: rotacal identify RTEST --save-model)")
+        raise _core.InvalidArgument(
+            f"--centres: the model has no probe zero for set-up {label!r} "
+            "(fit the same session: rotacal identify RTEST --save-model)"
+        )
     nest = (model.get("nests") or {}).get(label)
     here = np.asarray(session.nests[label], dtype=float)
     if nest is None or not np.allclose(np.asarray(nest, dtype=float), here, rtol=0.0, atol=1e-3):
         raise _core.InvalidArgument(
             f"--centres: set-up {label!r} has its nest at {', '.join(f'{v:.3f}' for v in here)} mm, the model's "
-            + ("has none" if nest is None else "at " + ", ".join(f"{float(v):.3f}" for v in nest) + " mm")
-            + ": the probe zeros are of another session")
+            + (
+                "has none"
+                if nest is None
+                else "at " + ", ".join(f"{float(v):.3f}" for v in nest) + " mm"
+            )
+            + ": the probe zeros are of another session"
+        )
     zero = np.array([zeros[label][a]["value"] or 0.0 for a in "xyz"])
     rows = [i for i, x in enumerate(s.setups) if x == label]
-    xyz, ang, d = np.asarray(s.xyz)[rows], np.radians(np.asarray(s.angles_deg)[rows]), np.asarray(s.d)[rows]
+    xyz, ang, d = (
+        np.asarray(s.xyz)[rows],
+        np.radians(np.asarray(s.angles_deg)[rows]),
+        np.asarray(s.d)[rows],
+    )
     o = np.asarray(origin, dtype=float)
     # The set-up label is the session's text: comments only through the ISG comment writer.
-    lines = [line for text in (
-        "rotacal export: measured sphere centres for the ISG kinematic optimisation (TF5245)",
-        f"set-up {label}, {len(rows)} poses; centre = commanded sphere - Ry(B) Rz(C) (reading - probe zero)",
-        f"origin (rotary axes' intersection, machine coordinates): {o[0]:.6f}, {o[1]:.6f}, {o[2]:.6f} mm")
-        for line in _core.comment_lines("isg", text)]
-    lines += ["#VAR", f"V.L.KIN_TYP = {int(kinematic[0])}", f"V.L.KIN_VARIANT = {int(kinematic[1])}",
-              f"V.L.NUMBER_OF_POSES = {len(rows)}", "#ENDVAR",
-              'L CYCLE [NAME = "SysCalibFitInit.ecy" @P1 = V.L.KIN_TYP @P2 = V.L.KIN_VARIANT '
-              '@P3 = V.L.NUMBER_OF_POSES]']
+    lines = [
+        line
+        for text in (
+            "rotacal export: measured sphere centres for the ISG kinematic optimisation (TF5245)",
+            f"set-up {label}, {len(rows)} poses; centre = commanded sphere - Ry(B) Rz(C) (reading - probe zero)",
+            f"origin (rotary axes' intersection, machine coordinates): {o[0]:.6f}, {o[1]:.6f}, {o[2]:.6f} mm",
+        )
+        for line in _core.comment_lines("isg", text)
+    ]
+    lines += [
+        "#VAR",
+        f"V.L.KIN_TYP = {int(kinematic[0])}",
+        f"V.L.KIN_VARIANT = {int(kinematic[1])}",
+        f"V.L.NUMBER_OF_POSES = {len(rows)}",
+        "#ENDVAR",
+        'L CYCLE [NAME = "SysCalibFitInit.ecy" @P1 = V.L.KIN_TYP @P2 = V.L.KIN_VARIANT '
+        "@P3 = V.L.NUMBER_OF_POSES]",
+    ]
     # The reading turned into the machine frame by the nominal table pose (the one forward
     # kinematics, no errors: Ry(B) Rz(C)).
     turned = _core.forward(session.machine, np.zeros(8), ang, d - zero)
     for p, (b, c), t in zip(xyz, ang, turned):
         centre = o + p - t
-        lines.append(f'L CYCLE [NAME = "SysCalibFitAddRecord.ecy" @P1 = {centre[0]:.6f} @P2 = {centre[1]:.6f} '
-                     f'@P3 = {centre[2]:.6f} @P4 = 0 @P5 = {np.degrees(b):.6f} @P6 = {np.degrees(c):.6f}]')
-    lines += ["#VAR", "V.P.MAX_PRECISION = " + f"{precision_mm:g}", "V.P.LIST_FORMAT = 1", "#ENDVAR",
-              'L CYCLE [NAME = "SysCalibFit.ecy" @P1 = V.P.LIST_FORMAT @P2 = V.P.MAX_PRECISION]', "M30"]
-    return "\n".join(lines) + "\n", f"{len(rows)} measured sphere centres of set-up {label} for SysCalibFitAddRecord.ecy"
+        lines.append(
+            f'L CYCLE [NAME = "SysCalibFitAddRecord.ecy" @P1 = {centre[0]:.6f} @P2 = {centre[1]:.6f} '
+            f"@P3 = {centre[2]:.6f} @P4 = 0 @P5 = {np.degrees(b):.6f} @P6 = {np.degrees(c):.6f}]"
+        )
+    lines += [
+        "#VAR",
+        "V.P.MAX_PRECISION = " + f"{precision_mm:g}",
+        "V.P.LIST_FORMAT = 1",
+        "#ENDVAR",
+        'L CYCLE [NAME = "SysCalibFit.ecy" @P1 = V.P.LIST_FORMAT @P2 = V.P.MAX_PRECISION]',
+        "M30",
+    ]
+    return "\n".join(
+        lines
+    ) + "\n", f"{len(rows)} measured sphere centres of set-up {label} for SysCalibFitAddRecord.ecy"
 
 
 def _rtest_displacements(session: Any) -> tuple[Any, list]:
     from .rtest import with_displacements
+
     if session.machine != _core.MachineType.BC_trt:
         raise _core.InvalidArgument("--centres: an R-test session of a BC-trt machine")
     return with_displacements(session)

@@ -5,6 +5,7 @@ A recording appends and flushes every row, marks lost or corrupt data with ``#``
 file, and ends with a ``# summary:`` line; whatever stops it (the end of the program, Ctrl-C,
 an unplugged device, silence) leaves a valid file with everything read so far.
 """
+
 from __future__ import annotations
 
 import signal
@@ -41,7 +42,9 @@ class RecordingProgress:
             self.bar.close()
 
 
-def _record(run: Callable[[Any], _core.RecordSummary], progress: Progress | bool) -> _core.RecordSummary:
+def _record(
+    run: Callable[[Any], _core.RecordSummary], progress: Progress | bool
+) -> _core.RecordSummary:
     """Run a recorder with Ctrl-C turned into a clean stop: while it records, SIGINT only sets a
     flag that the progress callback returns, so the recorder closes the file and reports."""
     user = RecordingProgress() if progress is True else (progress or None)
@@ -51,7 +54,9 @@ def _record(run: Callable[[Any], _core.RecordSummary], progress: Progress | bool
         return not stop["requested"] and (user is None or bool(user(*p)))
 
     in_main = threading.current_thread() is threading.main_thread()
-    previous = signal.signal(signal.SIGINT, lambda *_: stop.update(requested=True)) if in_main else None
+    previous = (
+        signal.signal(signal.SIGINT, lambda *_: stop.update(requested=True)) if in_main else None
+    )
     try:
         return run(callback)
     finally:
@@ -61,69 +66,152 @@ def _record(run: Callable[[Any], _core.RecordSummary], progress: Progress | bool
             user.close()
 
 
-def virtual_ballbar(plan: Any, truth: Any, *, noise_um: float = 0.5, seed: int = 1, rate_hz: float = 1000.0,
-                    speed: float = 1.0, baud: int = 115200,
-                    faults: _core.FaultInjection | None = None) -> _core.VirtualBallbar:
+def virtual_ballbar(
+    plan: Any,
+    truth: Any,
+    *,
+    noise_um: float = 0.5,
+    seed: int = 1,
+    rate_hz: float = 1000.0,
+    speed: float = 1.0,
+    baud: int = 115200,
+    faults: _core.FaultInjection | None = None,
+) -> _core.VirtualBallbar:
     """Start a virtual ballbar that measures the machine ``truth`` (a BallbarMachineModel) while
     it runs ``plan`` (a BallbarPlan). ``speed`` > 1 runs faster than real time. Returns the
     running instrument: open ``.port`` like a serial port; ``.stop()`` ends it."""
-    dev = _core.VirtualBallbar(plan, truth, noise_um, seed, rate_hz, speed, baud,
-                               faults or _core.FaultInjection())
+    dev = _core.VirtualBallbar(
+        plan, truth, noise_um, seed, rate_hz, speed, baud, faults or _core.FaultInjection()
+    )
     dev.start()
     return dev
 
 
-def record_ballbar(port: str, plan: Any, path: str, *, baud: int = 115200, rate_hz: float = 1000.0,
-                   zero: bool = False, silence_timeout_s: float = 3.0,
-                   progress: Progress | bool = True) -> _core.RecordSummary:
+def record_ballbar(
+    port: str,
+    plan: Any,
+    path: str,
+    *,
+    baud: int = 115200,
+    rate_hz: float = 1000.0,
+    zero: bool = False,
+    silence_timeout_s: float = 3.0,
+    progress: Progress | bool = True,
+) -> _core.RecordSummary:
     """Record a ballbar test from ``port`` into ``path`` (rotacal-ballbar/1); each sample gets the
     commanded pose of ``plan`` at its time. ``progress``: True draws a bar on stderr, False
     nothing, or a callable(rows, lost, corrupt, t_s, duration_s) -> bool (False stops)."""
-    return _record(lambda cb: _core.record_ballbar(port, plan, str(path), baud, rate_hz, zero,
-                                                   silence_timeout_s, cb), progress)
+    return _record(
+        lambda cb: _core.record_ballbar(
+            port, plan, str(path), baud, rate_hz, zero, silence_timeout_s, cb
+        ),
+        progress,
+    )
 
 
-def rtest_program(machine: str = "BC-trt", b_deg: Sequence[float] = rtest.B_GRID,
-                  c_deg: Sequence[float] = rtest.C_GRID,
-                  nests: Sequence[Sequence[float]] = rtest.DEFAULT_NESTS,
-                  dwell_s: float = rtest.DEFAULT_DWELL_S) -> _core.RtestSession:
+def rtest_program(
+    machine: str = "BC-trt",
+    b_deg: Sequence[float] = rtest.B_GRID,
+    c_deg: Sequence[float] = rtest.C_GRID,
+    nests: Sequence[Sequence[float]] = rtest.DEFAULT_NESTS,
+    dwell_s: float = rtest.DEFAULT_DWELL_S,
+) -> _core.RtestSession:
     """The commanded R-test program (set-up, time, B, C, X, Y, Z per pose, nests): the pattern
     on the nominal machine, which is what the NC program commands."""
-    session, _ = rtest.simulate_rtest("zero", {}, machine=machine, b_deg=b_deg, c_deg=c_deg, nests=nests,
-                                      noise_um=0.0, probe_zero_um=0.0, dwell_s=dwell_s, seed=1)
+    session, _ = rtest.simulate_rtest(
+        "zero",
+        {},
+        machine=machine,
+        b_deg=b_deg,
+        c_deg=c_deg,
+        nests=nests,
+        noise_um=0.0,
+        probe_zero_um=0.0,
+        dwell_s=dwell_s,
+        seed=1,
+    )
     return session
 
 
-def virtual_rtest(errors: Any = "random", effects: Mapping[str, Any] | None = None, *, machine: str = "BC-trt",
-                  b_deg: Sequence[float] = rtest.B_GRID, c_deg: Sequence[float] = rtest.C_GRID,
-                  nests: Sequence[Sequence[float]] = rtest.DEFAULT_NESTS, dwell_s: float = rtest.DEFAULT_DWELL_S,
-                  noise_um: float = rtest.DEFAULT_NOISE_UM, probe_zero_um: float = rtest.DEFAULT_PROBE_ZERO_UM,
-                  probe_dirs: np.ndarray | None = None, seed: int = 1, mode: str = "keyence",
-                  rate_hz: float = 100.0, speed: float = 1.0, baud: int = 115200,
-                  faults: _core.FaultInjection | None = None) -> tuple[_core.VirtualRtest, dict]:
+def virtual_rtest(
+    errors: Any = "random",
+    effects: Mapping[str, Any] | None = None,
+    *,
+    machine: str = "BC-trt",
+    b_deg: Sequence[float] = rtest.B_GRID,
+    c_deg: Sequence[float] = rtest.C_GRID,
+    nests: Sequence[Sequence[float]] = rtest.DEFAULT_NESTS,
+    dwell_s: float = rtest.DEFAULT_DWELL_S,
+    noise_um: float = rtest.DEFAULT_NOISE_UM,
+    probe_zero_um: float = rtest.DEFAULT_PROBE_ZERO_UM,
+    probe_dirs: np.ndarray | None = None,
+    seed: int = 1,
+    mode: str = "keyence",
+    rate_hz: float = 100.0,
+    speed: float = 1.0,
+    baud: int = 115200,
+    faults: _core.FaultInjection | None = None,
+) -> tuple[_core.VirtualRtest, dict]:
     """Start a virtual R-test (sylvac, keyence or stream mode) on a machine with location errors
     and catalogue effects, running the Sec. 3.3 pattern. Returns (instrument, truth) where the
     truth has the shape of rtest.simulate_rtest's."""
     mtype, e, ids, params, effects_out = rtest.machine_truth(errors, effects, machine, seed)
     dirs = DEFAULT_PROBE_DIRS if probe_dirs is None else np.asarray(probe_dirs, dtype=float)
     nest_arr = np.asarray(nests, dtype=float).reshape(-1, 3)
-    dev = _core.VirtualRtest(mtype, e, ids, params, list(map(float, b_deg)), list(map(float, c_deg)), nest_arr,
-                             float(dwell_s), float(noise_um), float(probe_zero_um), dirs, int(seed) % 2**32,
-                             mode, rate_hz, speed, baud, faults or _core.FaultInjection())
+    dev = _core.VirtualRtest(
+        mtype,
+        e,
+        ids,
+        params,
+        list(map(float, b_deg)),
+        list(map(float, c_deg)),
+        nest_arr,
+        float(dwell_s),
+        float(noise_um),
+        float(probe_zero_um),
+        dirs,
+        int(seed) % 2**32,
+        mode,
+        rate_hz,
+        speed,
+        baud,
+        faults or _core.FaultInjection(),
+    )
     dev.start()
-    truth = {"errors": dict(zip(_core.location_error_names(mtype), e.tolist())), "effects": effects_out,
-             "nests": nest_arr.tolist(), "noise_um": float(noise_um), "probe_zeros": dev.probe_zeros.tolist(),
-             "probe_zero_um": float(probe_zero_um), **machine_members(mtype),
-             "pattern": {"b_deg": list(map(float, b_deg)), "c_deg": list(map(float, c_deg)),
-                         "dwell_s": float(dwell_s)},
-             "probe_dirs": dirs.tolist(), "mode": mode, "seed": int(seed)}
+    truth = {
+        "errors": dict(zip(_core.location_error_names(mtype), e.tolist())),
+        "effects": effects_out,
+        "nests": nest_arr.tolist(),
+        "noise_um": float(noise_um),
+        "probe_zeros": dev.probe_zeros.tolist(),
+        "probe_zero_um": float(probe_zero_um),
+        **machine_members(mtype),
+        "pattern": {
+            "b_deg": list(map(float, b_deg)),
+            "c_deg": list(map(float, c_deg)),
+            "dwell_s": float(dwell_s),
+        },
+        "probe_dirs": dirs.tolist(),
+        "mode": mode,
+        "seed": int(seed),
+    }
     return dev, truth
 
 
-def record_rtest(port: str, program: _core.RtestSession, path: str, *, mode: str = "keyence",
-                 dwell_s: float = rtest.DEFAULT_DWELL_S, probe_dirs: np.ndarray | None = None,
-                 baud: int = 115200, rate_hz: float = 100.0, speed: float = 1.0,
-                 silence_timeout_s: float = 3.0, progress: Progress | bool = True) -> _core.RecordSummary:
+def record_rtest(
+    port: str,
+    program: _core.RtestSession,
+    path: str,
+    *,
+    mode: str = "keyence",
+    dwell_s: float = rtest.DEFAULT_DWELL_S,
+    probe_dirs: np.ndarray | None = None,
+    baud: int = 115200,
+    rate_hz: float = 100.0,
+    speed: float = 1.0,
+    silence_timeout_s: float = 3.0,
+    progress: Progress | bool = True,
+) -> _core.RecordSummary:
     """Record an R-test from ``port`` into ``path`` (rotacal-rtest/1 with raw d1,d2,d3 and the
     probe directions, so readers convert them to dx,dy,dz). One row per pose: the mean of the
     readings taken inside its read window (the middle 80 % of its dwell, when the program holds
@@ -132,5 +220,19 @@ def record_rtest(port: str, program: _core.RtestSession, path: str, *, mode: str
     not surely inside its window is counted (``summary.outside_window``), marked and not used; a
     pose without a reading inside its window is counted lost and marked."""
     dirs = DEFAULT_PROBE_DIRS if probe_dirs is None else np.asarray(probe_dirs, dtype=float)
-    return _record(lambda cb: _core.record_rtest(port, mode, program, dwell_s, dirs, str(path), baud, rate_hz,
-                                                 speed, silence_timeout_s, cb), progress)
+    return _record(
+        lambda cb: _core.record_rtest(
+            port,
+            mode,
+            program,
+            dwell_s,
+            dirs,
+            str(path),
+            baud,
+            rate_hz,
+            speed,
+            silence_timeout_s,
+            cb,
+        ),
+        progress,
+    )

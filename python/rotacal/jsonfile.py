@@ -3,6 +3,7 @@ strict (no NaN, Infinity or numbers beyond double), bounded in size, and bounded
 and in objects and arrays per byte by the rule of the C++ readers (core/json_text.hpp), so
 that no file exhausts the stack or the memory. Every error names the file (and the option
 it came from), with the line and column where there is one."""
+
 from __future__ import annotations
 
 import json
@@ -43,8 +44,9 @@ def loads(data: Union[bytes, str], where: str) -> Any:
         raise _core.ParseError(f"{where}: not valid JSON: {e}") from None
 
 
-def read_json(path: Union[str, "os.PathLike[str]"], what: str = "",
-              max_bytes: int = MAX_JSON_BYTES) -> tuple[Any, bytes]:
+def read_json(
+    path: Union[str, "os.PathLike[str]"], what: str = "", max_bytes: int = MAX_JSON_BYTES
+) -> tuple[Any, bytes]:
     """(document, bytes) of the JSON file ``path``; ``what`` (e.g. the option) prefixes its name
     in errors. IoError if it cannot be read, InvalidArgument if larger than ``max_bytes``,
     ParseError if it is not strict JSON within the bounds."""

@@ -1,4 +1,5 @@
 """Strict JSON text: never NaN or Infinity; a number that is not finite is written null and its reason listed under "null_reasons"."""
+
 from __future__ import annotations
 
 import json
@@ -45,4 +46,3 @@ def dumps(data: Any, indent: int | None = 1) -> str:
     if reasons and isinstance(clean, dict):
         clean[NULL_REASONS] = reasons
     return json.dumps(clean, indent=indent, allow_nan=False)
-

@@ -14,6 +14,7 @@ when the model is used. Reading and writing go through the C++ implementation
 languages read and write the same files: strict JSON (a non-finite number is written null,
 its reason under ``"null_reasons"``), versioned (a newer major version is refused by name).
 """
+
 from __future__ import annotations
 
 import json
@@ -52,8 +53,12 @@ def machine_of(d: dict, source: str) -> Any:
     if "machine_description" in d:
         desc = d["machine_description"]
         if not isinstance(desc, dict):
-            raise _core.InvalidArgument(f"{source}: machine_description: must be a rotacal-machine/1 object")
-        return _core.MachineType.from_description(json.dumps(desc), f"{source}: machine_description")
+            raise _core.InvalidArgument(
+                f"{source}: machine_description: must be a rotacal-machine/1 object"
+            )
+        return _core.MachineType.from_description(
+            json.dumps(desc), f"{source}: machine_description"
+        )
     try:
         return _core.parse_machine_type(str(d.get("machine", "")))
     except _core.InvalidArgument as e:
@@ -71,8 +76,9 @@ def convention_estimate_dict(p: Any) -> dict:
     return estimate_dict(p)
 
 
-def ballbar_model_dict(machine: Any, parameters: list, effects: list[str], *,
-                       convention_values: bool = False) -> dict:
+def ballbar_model_dict(
+    machine: Any, parameters: list, effects: list[str], *, convention_values: bool = False
+) -> dict:
     """Model dict from the parameter list of a ballbar fit (8 errors, pivot x y z, effects).
     ``convention_values``: keep the values of unobservable parameters (model files, see
     convention_estimate_dict); otherwise they are null."""
@@ -105,14 +111,20 @@ def covariance_dict(parameters: list, covariance: Any) -> dict | None:
     if cov.shape != (len(names), len(names)):
         return None
     ok = [bool(p.observable) for p in parameters]
-    rows = [[float(cov[i, j]) if ok[i] and ok[j] and math.isfinite(cov[i, j]) else None
-             for j in range(len(names))] for i in range(len(names))]
+    rows = [
+        [
+            float(cov[i, j]) if ok[i] and ok[j] and math.isfinite(cov[i, j]) else None
+            for j in range(len(names))
+        ]
+        for i in range(len(names))
+    ]
     return {"parameters": names, "matrix": rows}
 
 
 def file_sha256(path: str | Path) -> str:
     """The SHA-256 of a file's bytes, read in blocks (a session can be large)."""
     import hashlib
+
     h = hashlib.sha256()
     with open(path, "rb") as f:
         for block in iter(lambda: f.read(1 << 20), b""):
@@ -128,13 +140,25 @@ def source_dict(session_path: str | Path | list | tuple) -> dict:
     import datetime
     import hashlib
     from .version import __version__
-    when = {"identified_at": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
-            "rotacal": __version__}
+
+    when = {
+        "identified_at": datetime.datetime.now(datetime.timezone.utc).strftime(
+            "%Y-%m-%dT%H:%M:%SZ"
+        ),
+        "rotacal": __version__,
+    }
     if not isinstance(session_path, (list, tuple)):
-        return {"session": os.fspath(session_path), "session_sha256": file_sha256(session_path)} | when
+        return {
+            "session": os.fspath(session_path),
+            "session_sha256": file_sha256(session_path),
+        } | when
     each = [{"session": os.fspath(p), "session_sha256": file_sha256(p)} for p in session_path]
     joint = hashlib.sha256("".join(s["session_sha256"] for s in each).encode()).hexdigest()
-    return {"session": ", ".join(s["session"] for s in each), "session_sha256": joint} | when | {"sessions": each}
+    return (
+        {"session": ", ".join(s["session"] for s in each), "session_sha256": joint}
+        | when
+        | {"sessions": each}
+    )
 
 
 def _value(d: dict, where: str) -> float:
@@ -156,12 +180,18 @@ def ballbar_model_from_dict(d: dict, source: str = "<model>") -> _core.BallbarMa
     return _core.ballbar_model_from_document(d, source)
 
 
-def save_model(model: dict, path: str | Path, inputs: tuple = (), other_outputs: tuple = ()) -> None:
+def save_model(
+    model: dict, path: str | Path, inputs: tuple = (), other_outputs: tuple = ()
+) -> None:
     """Write a model dict through the C++ writer: validated as the reader would, strict JSON
     (a non-finite number is written null, its reason under "null_reasons"), by the output rule
     of rotacal.outputs (regular files replaced atomically, devices written through)."""
-    _core.write_model_document(model, os.fspath(path), [os.fspath(p) for p in inputs],
-                               [os.fspath(p) for p in other_outputs])
+    _core.write_model_document(
+        model,
+        os.fspath(path),
+        [os.fspath(p) for p in inputs],
+        [os.fspath(p) for p in other_outputs],
+    )
 
 
 def load_model(path: str | Path) -> dict:
@@ -182,19 +212,33 @@ def fit_model_dict(machine: Any, parameters: list, effects: list[str]) -> dict:
         if p.name.startswith("zero."):
             _, setup, axis = p.name.split(".")
             zeros.setdefault(setup, {})[axis] = estimate_dict(p)
-    out = {"format": FORMAT, "kind": "rtest-diagnosis", **machine_members(machine),
-           "location_errors": {n: estimate_dict(by_name[n]) for n in names},
-           "probe_zeros": zeros, "effects": []}
+    out = {
+        "format": FORMAT,
+        "kind": "rtest-diagnosis",
+        **machine_members(machine),
+        "location_errors": {n: estimate_dict(by_name[n]) for n in names},
+        "probe_zeros": zeros,
+        "effects": [],
+    }
     for eid in effects:
         eff = _core.Effect(eid)
-        out["effects"].append({"id": eid, "cause": eff.cause, "params": {
-            pn: estimate_dict(by_name[eid if eff.num_params == 1 else f"{eid}.{pn}"]) for pn in eff.param_names}})
+        out["effects"].append(
+            {
+                "id": eid,
+                "cause": eff.cause,
+                "params": {
+                    pn: estimate_dict(by_name[eid if eff.num_params == 1 else f"{eid}.{pn}"])
+                    for pn in eff.param_names
+                },
+            }
+        )
     return out
 
 
 # ------------------------------------------------------------------------- R-test joint model
 
 RTEST_KIND = "rtest-joint"
+
 
 def rtest_model_dict(ident: Any, nests: dict) -> dict:
     """Model dict (``kind: rtest-joint``) of a joint R-test identification on any machine:
@@ -204,7 +248,9 @@ def rtest_model_dict(ident: Any, nests: dict) -> dict:
     Parameters of an unobservable combination keep the value the fit gave them under its
     convention (``observable: false``, no std), so that the file predicts as the fit did.
     Written by the C++ implementation (rotacal/rtest/model_document.hpp)."""
-    return _core.rtest_joint_model_document(ident, {str(k): np.asarray(v, dtype=float) for k, v in nests.items()})
+    return _core.rtest_joint_model_document(
+        ident, {str(k): np.asarray(v, dtype=float) for k, v in nests.items()}
+    )
 
 
 def _int_field(d: dict, key: str, where: str) -> int:
@@ -222,26 +268,36 @@ def rtest_model_from_dict(d: dict, source: str = "<model>") -> tuple[Any, dict, 
     if d.get("format") != FORMAT:
         raise _core.InvalidArgument(f"{source}: not a {FORMAT} file (format: {d.get('format')!r})")
     if d.get("kind") != RTEST_KIND:
-        raise _core.InvalidArgument(f"{source}: kind {d.get('kind')!r} is not an R-test joint model "
-                                    f"('{RTEST_KIND}')")
+        raise _core.InvalidArgument(
+            f"{source}: kind {d.get('kind')!r} is not an R-test joint model ('{RTEST_KIND}')"
+        )
     machine = machine_of(d, source)
     b = d.get("basis")
     if not isinstance(b, dict):
         raise _core.InvalidArgument(f"{source}: missing 'basis'")
     if not isinstance(b.get("gamma_cb"), bool):
         raise _core.InvalidArgument(f"{source}: basis.gamma_cb: must be true or false")
-    basis = _core.RtestBasis(_int_field(b, "b_degree", f"{source}: basis"),
-                             _int_field(b, "c_harmonics", f"{source}: basis"),
-                             _int_field(b, "c_b_degree", f"{source}: basis"), b["gamma_cb"])
+    basis = _core.RtestBasis(
+        _int_field(b, "b_degree", f"{source}: basis"),
+        _int_field(b, "c_harmonics", f"{source}: basis"),
+        _int_field(b, "c_b_degree", f"{source}: basis"),
+        b["gamma_cb"],
+    )
     head = ["tool_offset_Z"] if machine.has_head else []
     if not head and "tool_offset_Z" in d:
-        raise _core.InvalidArgument(f"{source}: tool_offset_Z: only a machine with head axes has it; "
-                                    f"{_core.machine_name(machine)} has none")
-    names = list(_core.location_error_names(machine)) + head + list(basis.coefficient_names(machine))
+        raise _core.InvalidArgument(
+            f"{source}: tool_offset_Z: only a machine with head axes has it; "
+            f"{_core.machine_name(machine)} has none"
+        )
+    names = (
+        list(_core.location_error_names(machine)) + head + list(basis.coefficient_names(machine))
+    )
     values: dict[str, dict] = {}
     for n in head:
         if not isinstance(d.get(n), dict):
-            raise _core.InvalidArgument(f"{source}: {n}: a machine with head axes needs its estimate")
+            raise _core.InvalidArgument(
+                f"{source}: {n}: a machine with head axes needs its estimate"
+            )
         values[n] = d[n]
     for key in ("location_errors", "map_coefficients"):
         part = d.get(key, {})
@@ -254,36 +310,54 @@ def rtest_model_from_dict(d: dict, source: str = "<model>") -> tuple[Any, dict, 
     if missing or unknown:
         raise _core.InvalidArgument(
             f"{source}: the parameters do not match basis {b['b_degree']}/{b['c_harmonics']}/"
-            f"{b['c_b_degree']}" + (f"; missing: {', '.join(missing[:5])}" if missing else "")
-            + (f"; unknown: {', '.join(unknown[:5])}" if unknown else ""))
+            f"{b['c_b_degree']}"
+            + (f"; missing: {', '.join(missing[:5])}" if missing else "")
+            + (f"; unknown: {', '.join(unknown[:5])}" if unknown else "")
+        )
     params = np.array([_value(values[n], f"{source}: {n}") for n in names])
-    observable = [values[n].get("value") is not None and values[n].get("observable", True) is not False
-                  for n in names]
+    observable = [
+        values[n].get("value") is not None and values[n].get("observable", True) is not False
+        for n in names
+    ]
     cov = d.get("covariance", {})
     if not isinstance(cov, dict) or cov.get("parameters") != names:
-        raise _core.InvalidArgument(f"{source}: covariance.parameters must list the {len(names)} "
-                                    "parameters in model order (location errors, tool_offset_Z on a "
-                                    "machine with head axes, map coefficients)")
+        raise _core.InvalidArgument(
+            f"{source}: covariance.parameters must list the {len(names)} "
+            "parameters in model order (location errors, tool_offset_Z on a "
+            "machine with head axes, map coefficients)"
+        )
     try:
         matrix = np.array(cov.get("matrix"), dtype=float)
     except (TypeError, ValueError):
-        raise _core.InvalidArgument(f"{source}: covariance.matrix: not a matrix of numbers") from None
+        raise _core.InvalidArgument(
+            f"{source}: covariance.matrix: not a matrix of numbers"
+        ) from None
     if matrix.shape != (len(names), len(names)):
-        raise _core.InvalidArgument(f"{source}: covariance.matrix: shape {matrix.shape}, expected "
-                                    f"({len(names)}, {len(names)})")
+        raise _core.InvalidArgument(
+            f"{source}: covariance.matrix: shape {matrix.shape}, expected "
+            f"({len(names)}, {len(names)})"
+        )
     # Then the C++ reader's full check (units, bounds, basis.maps), so both languages refuse the
     # same files; the checks above name the commoner mistakes more precisely.
     _core.parse_model_document(jsontext.dumps(d), source)
     model = _core.RtestJointModel(machine, basis, params, matrix, observable)
-    nests = {str(k): np.array(_floats_of(v, 3, f"{source}: nests.{k}")) for k, v in d.get("nests", {}).items()}
+    nests = {
+        str(k): np.array(_floats_of(v, 3, f"{source}: nests.{k}"))
+        for k, v in d.get("nests", {}).items()
+    }
     zeros = {}
     for setup, z in d.get("probe_zeros", {}).items():
-        zeros[str(setup)] = np.array([_value(z.get(a, {}), f"{source}: probe_zeros.{setup}.{a}") for a in "xyz"])
+        zeros[str(setup)] = np.array(
+            [_value(z.get(a, {}), f"{source}: probe_zeros.{setup}.{a}") for a in "xyz"]
+        )
     return model, nests, zeros
 
 
 def _floats_of(v: Any, n: int, where: str) -> list[float]:
-    if (not isinstance(v, list) or len(v) != n
-            or not all(isinstance(x, (int, float)) and math.isfinite(x) for x in v)):
+    if (
+        not isinstance(v, list)
+        or len(v) != n
+        or not all(isinstance(x, (int, float)) and math.isfinite(x) for x in v)
+    ):
         raise _core.InvalidArgument(f"{where}: must be {n} finite numbers, got {v!r}")
     return [float(x) for x in v]

@@ -3,6 +3,7 @@ one set of location errors (and of catalogue effects where asked), each session'
 and noise model, and the parameters on
 which the sessions fitted alone disagree. C++ computes (include/rotacal/multi); this module only
 composes."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -44,28 +45,43 @@ class MultiIdentification:
             **machine_members(r.machine),
             "location_errors": {p.name: estimate_dict(p) for p in r.location_errors},
             "effects": {p.name: estimate_dict(p) for p in r.effects},
-            "sessions": [{
-                "name": s.name,
-                "instrument": s.instrument,
-                "nuisances": {p.name: estimate_dict(p) for p in s.nuisances},
-                "alone": {p.name: estimate_dict(p) for p in s.alone},
-                "residual_rms_um": float(s.residual_rms_um),
-                "n_residuals": int(s.n_residuals),
-                "noise_model": noise_model_dict(s.noise, s.noise_refit, s.noise_correction),
-            } for s in r.sessions],
-            "disagreements": [{
-                "parameter": d.parameter, "unit": d.unit, "sessions": [d.session_a, d.session_b],
-                "values": [float(d.value_a), float(d.value_b)], "difference": float(d.difference),
-                "sigma": float(d.sigma), "z": float(d.z),
-            } for d in r.disagreements],
+            "sessions": [
+                {
+                    "name": s.name,
+                    "instrument": s.instrument,
+                    "nuisances": {p.name: estimate_dict(p) for p in s.nuisances},
+                    "alone": {p.name: estimate_dict(p) for p in s.alone},
+                    "residual_rms_um": float(s.residual_rms_um),
+                    "n_residuals": int(s.n_residuals),
+                    "noise_model": noise_model_dict(s.noise, s.noise_refit, s.noise_correction),
+                }
+                for s in r.sessions
+            ],
+            "disagreements": [
+                {
+                    "parameter": d.parameter,
+                    "unit": d.unit,
+                    "sessions": [d.session_a, d.session_b],
+                    "values": [float(d.value_a), float(d.value_b)],
+                    "difference": float(d.difference),
+                    "sigma": float(d.sigma),
+                    "z": float(d.z),
+                }
+                for d in r.disagreements
+            ],
             "converged": bool(r.converged),
             "unobservable": list(r.unobservable),
             "notes": list(r.notes),
         }
 
 
-def identify_sessions(sessions: Sequence[Any], names: Sequence[str] | None = None, *,
-                      noise: str = "auto", effects: Sequence[str] = ()) -> MultiIdentification:
+def identify_sessions(
+    sessions: Sequence[Any],
+    names: Sequence[str] | None = None,
+    *,
+    noise: str = "auto",
+    effects: Sequence[str] = (),
+) -> MultiIdentification:
     """Identify several sessions of one machine jointly (rotacal.identify with a list).
     ``names`` name the sessions in the result (default "session 1", ...); ``effects``: catalogue
     ids of the machine fitted along, one set shared by every session (about the machine zero);

@@ -9,6 +9,7 @@
 - Refused with :class:`rotacal.IoError` naming the path: a directory, a block device, a
   missing parent directory, one of the command's ``inputs`` or ``other_outputs``.
 """
+
 from __future__ import annotations
 
 import os
@@ -29,14 +30,19 @@ def _paths(ps: Iterable[PathLike]) -> list[str]:
     return [_path(p) for p in ps if p is not None]
 
 
-def check_output(path: PathLike, inputs: Iterable[PathLike] = (),
-                 other_outputs: Iterable[PathLike] = ()) -> str:
+def check_output(
+    path: PathLike, inputs: Iterable[PathLike] = (), other_outputs: Iterable[PathLike] = ()
+) -> str:
     """Refuse a bad output path before any work; returns ``"replace"`` or ``"write-through"``."""
     return _core.check_output(_path(path), _paths(inputs), _paths(other_outputs))
 
 
-def write_output(path: PathLike, data: Union[bytes, str, Callable[[], Union[bytes, str]]],
-                 inputs: Iterable[PathLike] = (), other_outputs: Iterable[PathLike] = ()) -> None:
+def write_output(
+    path: PathLike,
+    data: Union[bytes, str, Callable[[], Union[bytes, str]]],
+    inputs: Iterable[PathLike] = (),
+    other_outputs: Iterable[PathLike] = (),
+) -> None:
     """Write ``data`` (bytes, or str encoded as UTF-8) to ``path`` by the output rule.
 
     ``data`` may be a callable producing the content: the path is checked first, and if the

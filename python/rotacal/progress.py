@@ -1,4 +1,5 @@
 """A progress bar for long work (recording, Monte Carlo, diagnosis of long sessions)."""
+
 from __future__ import annotations
 
 import os
@@ -14,8 +15,14 @@ class ProgressBar:
     tenth of the way, so logs stay short. ``ROTACAL_PROGRESS=0`` silences it.
     """
 
-    def __init__(self, label: str, total: float, unit: str = "", stream: TextIO | None = None,
-                 delay_s: float = 0.0):
+    def __init__(
+        self,
+        label: str,
+        total: float,
+        unit: str = "",
+        stream: TextIO | None = None,
+        delay_s: float = 0.0,
+    ):
         """``delay_s``: draw nothing until the work has taken this long (short work stays quiet)."""
         self.label, self.total, self.unit = label, float(total), unit
         self.delay_s = delay_s
@@ -36,8 +43,10 @@ class ProgressBar:
         frac = min(max(done / self.total, 0.0), 1.0) if self.total > 0 else 0.0
         since = time.monotonic() - self._t_eta
         eta = f", {since * (1 - frac) / frac:4.0f} s left" if 0.02 < frac < 1 else ""
-        text = (f"{self.label} [{'#' * int(30 * frac):<30s}] {100 * frac:5.1f}% "
-                f"{done:.1f}/{self.total:.1f}{self.unit}{eta}" + (f"  {note}" if note else ""))
+        text = (
+            f"{self.label} [{'#' * int(30 * frac):<30s}] {100 * frac:5.1f}% "
+            f"{done:.1f}/{self.total:.1f}{self.unit}{eta}" + (f"  {note}" if note else "")
+        )
         if self.tty:
             self.stream.write("\r" + text + "\033[K")
             self.stream.flush()

@@ -4,6 +4,7 @@ head-head; "B" and "C" name the tilt and the rotary axis), model files and predi
 numpy-backed RtestSession objects. Angles are in degrees here (as in the files); the C++ core
 takes radians.
 """
+
 from __future__ import annotations
 
 import json
@@ -15,7 +16,13 @@ import numpy as np
 
 from . import _core
 from .machines import Errors, machine_truth  # noqa: F401  (rotacal.rtest.machine_truth)
-from .models import estimate_dict, machine_members, machine_of, rtest_model_dict, rtest_model_from_dict
+from .models import (
+    estimate_dict,
+    machine_members,
+    machine_of,
+    rtest_model_dict,
+    rtest_model_from_dict,
+)
 from .results import budget_dict, noise_model_dict
 
 # The C++ simulator's defaults (rtest/simulate.hpp: RtestSimOptions, RtestPattern): the
@@ -43,8 +50,12 @@ class RtestIdentification:
     notes: list = field(default_factory=list)
     budget: Any = None  # _core.UncertaintyBudget, attached by the CLI / uncertainty_budget
 
-    def error_map(self, fmt: str = "json", b_deg: Sequence[float] | None = None,
-                  c_deg: Sequence[float] | None = None) -> str:
+    def error_map(
+        self,
+        fmt: str = "json",
+        b_deg: Sequence[float] | None = None,
+        c_deg: Sequence[float] | None = None,
+    ) -> str:
         """The error map as JSON or CSV text: on the grid (deg; tilt and rotary axis, default
         the machine's default pattern) for the joint model, at the measured grid for the paper's
         method."""
@@ -61,15 +72,21 @@ class RtestIdentification:
         if self.raw.method != "joint":
             raise _core.InvalidArgument(
                 "identify --save-model: the paper method's map exists only at the measured angles and "
-                "predicts no other pose; use --method joint for a model file")
+                "predicts no other pose; use --method joint for a model file"
+            )
         return rtest_model_dict(self.raw, self.nests)
 
     def to_dict(self) -> dict:
         r = self.raw
-        out = {"method": r.method, "machine": _core.machine_name(self.machine),
-               "residual_rms_um": float(r.residual_rms_um), "n_samples": int(r.n_samples),
-               "unobservable": list(r.unobservable), "notes": list(self.notes) + list(r.notes),
-               "error_map": json.loads(self.error_map("json"))}
+        out = {
+            "method": r.method,
+            "machine": _core.machine_name(self.machine),
+            "residual_rms_um": float(r.residual_rms_um),
+            "n_samples": int(r.n_samples),
+            "unobservable": list(r.unobservable),
+            "notes": list(self.notes) + list(r.notes),
+            "error_map": json.loads(self.error_map("json")),
+        }
         if r.method == "joint":
             names = list(_core.location_error_names(self.machine))
             by_name = {p.name: p for p in r.parameters}
@@ -94,8 +111,9 @@ def has_displacements(session: _core.RtestSession) -> bool:
     return True
 
 
-def with_displacements(session: _core.RtestSession,
-                       dirs: np.ndarray | None = None) -> tuple[_core.RtestSession, list[str]]:
+def with_displacements(
+    session: _core.RtestSession, dirs: np.ndarray | None = None
+) -> tuple[_core.RtestSession, list[str]]:
     """The session with dx,dy,dz filled from raw d1,d2,d3 where missing, and a note saying so.
 
     ``dirs`` (3, 3), rows = probe directions, e.g. from ``calibrate_probes``; by default the
@@ -103,13 +121,19 @@ def with_displacements(session: _core.RtestSession,
     """
     if dirs is None and has_displacements(session):
         return session, []
-    out = _core.displacements_from_raw(session, None if dirs is None else np.asarray(dirs, dtype=float))
+    out = _core.displacements_from_raw(
+        session, None if dirs is None else np.asarray(dirs, dtype=float)
+    )
     src = "the calibrated directions given" if dirs is not None else "the file's probe.N.dir"
     return out, [f"dx,dy,dz computed from raw d1,d2,d3 with {src} (d = Dirs^-1 raw)"]
 
 
-def identify_rtest(session: _core.RtestSession, method: str = "joint",
-                   basis: Any | None = None, noise: str = "auto") -> RtestIdentification:
+def identify_rtest(
+    session: _core.RtestSession,
+    method: str = "joint",
+    basis: Any | None = None,
+    noise: str = "auto",
+) -> RtestIdentification:
     """Identify an R-test session: method "joint" (Ceres fit with smooth maps, default) or
     "paper" (Oyama & Ibaraki's Eqs. 10-22). A session with raw d1,d2,d3 only is converted
     with its probe.N.dir first (said in the notes). ``basis``: a rotacal._core.RtestBasis for
@@ -118,38 +142,59 @@ def identify_rtest(session: _core.RtestSession, method: str = "joint",
     s, notes = with_displacements(session)
     nests = {k: np.asarray(v) for k, v in session.nests.items()}
     if method == "joint":
-        raw = _core.identify_rtest_joint(s, basis if basis is not None else _core.RtestBasis(), noise)
+        raw = _core.identify_rtest_joint(
+            s, basis if basis is not None else _core.RtestBasis(), noise
+        )
         return RtestIdentification(raw, session.machine, nests, notes)
     if basis is not None:
         raise _core.InvalidArgument("identify_rtest: the paper method takes no basis")
     if method == "paper":
         return RtestIdentification(_core.identify_rtest_paper(s), session.machine, nests, notes)
-    raise _core.InvalidArgument(f"identify_rtest: method must be 'joint' or 'paper', got {method!r}")
+    raise _core.InvalidArgument(
+        f"identify_rtest: method must be 'joint' or 'paper', got {method!r}"
+    )
 
 
-def monte_carlo_rtest(session: _core.RtestSession, result: RtestIdentification, draws: int = 100, *,
-                      seed: int = 1, basis: Any | None = None, progress: bool = True) -> dict:
+def monte_carlo_rtest(
+    session: _core.RtestSession,
+    result: RtestIdentification,
+    draws: int = 100,
+    *,
+    seed: int = 1,
+    basis: Any | None = None,
+    progress: bool = True,
+) -> dict:
     """Check an R-test joint fit's 1-sigma by Monte Carlo: the identified model's readings plus
     noise drawn from the noise model fitted to the session (AR per nest and channel: probe
     zeros that wander between poses are re-simulated) when the fit used it, else white; each
     draw refitted the same way. Same dict as rotacal.ballbar.monte_carlo."""
     from .progress import ProgressBar
+
     if result.raw.method != "joint":
         raise _core.InvalidArgument("monte_carlo: only an R-test joint fit is supported")
     s, _ = with_displacements(session)
     bar = ProgressBar("Monte Carlo", draws, " draws") if progress else None
-    mc = _core.monte_carlo_rtest(s, result.raw, draws, seed, basis if basis is not None else _core.RtestBasis(),
-                                 progress=(lambda done, total: bar.update(done)) if bar else None)
+    mc = _core.monte_carlo_rtest(
+        s,
+        result.raw,
+        draws,
+        seed,
+        basis if basis is not None else _core.RtestBasis(),
+        progress=(lambda done, total: bar.update(done)) if bar else None,
+    )
     if bar:
         bar.close()
     from .results import monte_carlo_dict
+
     return monte_carlo_dict(mc, draws, result.raw.sigma_um, keep=lambda name: name.startswith("E_"))
 
 
 # ------------------------------------------------------------------------- prediction
 
-def predict_rtest(model: Mapping, session: _core.RtestSession, probe_zeros: str = "none",
-                  source: str = "<model>") -> _core.RtestSession:
+
+def predict_rtest(
+    model: Mapping, session: _core.RtestSession, probe_zeros: str = "none", source: str = "<model>"
+) -> _core.RtestSession:
     """The session with dx,dy,dz predicted by an ``rtest-joint`` model dict (``load_model``),
     plus 1-sigma columns dx_std, dy_std, dz_std (mm).
 
@@ -162,7 +207,9 @@ def predict_rtest(model: Mapping, session: _core.RtestSession, probe_zeros: str 
     if probe_zeros == "none":
         return _core.predict_rtest_session(m, session)
     if probe_zeros != "fitted":
-        raise _core.InvalidArgument(f"predict: probe_zeros must be 'none' or 'fitted', got {probe_zeros!r}")
+        raise _core.InvalidArgument(
+            f"predict: probe_zeros must be 'none' or 'fitted', got {probe_zeros!r}"
+        )
     for setup in dict.fromkeys(session.setups):
         if setup not in zeros or setup not in nests:
             raise _core.InvalidArgument(f"{source}: no fitted probe zero for set-up '{setup}'")
@@ -170,11 +217,16 @@ def predict_rtest(model: Mapping, session: _core.RtestSession, probe_zeros: str 
         if np.max(np.abs(here - nests[setup])) > 1e-6:
             raise _core.InvalidArgument(
                 f"{source}: set-up '{setup}' was fitted with its nest at {nests[setup].tolist()}, the "
-                f"session has it at {here.tolist()}: fitted probe zeros belong to the fitted set-up")
-    return _core.predict_rtest_session(m, session, {k: zeros[k] for k in dict.fromkeys(session.setups)})
+                f"session has it at {here.tolist()}: fitted probe zeros belong to the fitted set-up"
+            )
+    return _core.predict_rtest_session(
+        m, session, {k: zeros[k] for k in dict.fromkeys(session.setups)}
+    )
 
 
-def prediction_rms_um(model: Mapping, session: _core.RtestSession, source: str = "<model>") -> float:
+def prediction_rms_um(
+    model: Mapping, session: _core.RtestSession, source: str = "<model>"
+) -> float:
     """RMS (um) of measured - predicted readings after one constant offset per set-up (its
     probe zero), over all components; raw-only sessions are converted with probe.N.dir."""
     m, _, _ = rtest_model_from_dict(dict(model), source)
@@ -184,16 +236,26 @@ def prediction_rms_um(model: Mapping, session: _core.RtestSession, source: str =
 
 # ------------------------------------------------------------------------- simulation
 
-def angle_grid(start: float, stop: float, step: float, what: str, full_turn: bool = False) -> list[float]:
+
+def angle_grid(
+    start: float, stop: float, step: float, what: str, full_turn: bool = False
+) -> list[float]:
     """start, start + step, ... up to stop (inclusive, deg). With ``full_turn`` an end at
     start + 360 is left out: it is the start position again."""
-    if not (np.isfinite(start) and np.isfinite(stop) and np.isfinite(step)) or step <= 0 or stop < start:
-        raise _core.InvalidArgument(f"{what}: need start <= stop and step > 0, got {start:g},{stop:g} "
-                                    f"step {step:g}")
+    if (
+        not (np.isfinite(start) and np.isfinite(stop) and np.isfinite(step))
+        or step <= 0
+        or stop < start
+    ):
+        raise _core.InvalidArgument(
+            f"{what}: need start <= stop and step > 0, got {start:g},{stop:g} step {step:g}"
+        )
     n = int(np.floor((stop - start) / step + 1e-9))
     if n + 1 > MAX_GRID_POINTS:
-        raise _core.InvalidArgument(f"{what}: {start:g} to {stop:g} in steps of {step:g} deg is {n + 1} positions, "
-                                    f"more than {MAX_GRID_POINTS}")
+        raise _core.InvalidArgument(
+            f"{what}: {start:g} to {stop:g} in steps of {step:g} deg is {n + 1} positions, "
+            f"more than {MAX_GRID_POINTS}"
+        )
     grid = [start + k * step for k in range(n + 1)]
     if full_turn and abs(grid[-1] - (start + 360.0)) < 1e-9 and len(grid) > 1:
         grid.pop()
@@ -205,16 +267,28 @@ def default_pattern(machine: str | Any) -> dict:
     (rotary axis), ``nests``, fitted to its rotary limits and travel (the paper's on BC-trt)."""
     mtype = machine if isinstance(machine, _core.MachineType) else _core.parse_machine_type(machine)
     p = _core.default_rtest_pattern(mtype)
-    return {"b_deg": [float(b) for b in p.b_deg], "c_deg": [float(c) for c in p.c_deg],
-            "nests": [tuple(float(x) for x in row) for row in p.nests]}
+    return {
+        "b_deg": [float(b) for b in p.b_deg],
+        "c_deg": [float(c) for c in p.c_deg],
+        "nests": [tuple(float(x) for x in row) for row in p.nests],
+    }
 
 
-def simulate_rtest(errors: Errors = "random", effects: Mapping[str, Any] | None = None, *,
-                   machine: str = "BC-trt", b_deg: Sequence[float] | None = None,
-                   c_deg: Sequence[float] | None = None, nests: Sequence[Sequence[float]] | None = None,
-                   noise_um: float = DEFAULT_NOISE_UM, probe_zero_um: float = DEFAULT_PROBE_ZERO_UM,
-                   probe_dirs: np.ndarray | None = None, write_d: bool = True,
-                   dwell_s: float = DEFAULT_DWELL_S, seed: int = 1) -> tuple[_core.RtestSession, dict]:
+def simulate_rtest(
+    errors: Errors = "random",
+    effects: Mapping[str, Any] | None = None,
+    *,
+    machine: str = "BC-trt",
+    b_deg: Sequence[float] | None = None,
+    c_deg: Sequence[float] | None = None,
+    nests: Sequence[Sequence[float]] | None = None,
+    noise_um: float = DEFAULT_NOISE_UM,
+    probe_zero_um: float = DEFAULT_PROBE_ZERO_UM,
+    probe_dirs: np.ndarray | None = None,
+    write_d: bool = True,
+    dwell_s: float = DEFAULT_DWELL_S,
+    seed: int = 1,
+) -> tuple[_core.RtestSession, dict]:
     """Simulate an R-test session (Oyama Sec. 3.3 pattern: B outer, C inner, one nest after the
     other) on a machine with location errors and catalogue effects (shared/spec/effects.md).
 
@@ -247,35 +321,64 @@ def simulate_rtest(errors: Errors = "random", effects: Mapping[str, Any] | None 
     nest_arr = np.asarray(nests, dtype=float).reshape(-1, 3)
     n_poses = len(b_deg) * len(c_deg) * len(nest_arr)
     if n_poses > MAX_POSES:
-        raise _core.InvalidArgument(f"simulate_rtest: {len(b_deg)} B x {len(c_deg)} C x {len(nest_arr)} nests is "
-                                    f"{n_poses} poses, more than {MAX_POSES}")
+        raise _core.InvalidArgument(
+            f"simulate_rtest: {len(b_deg)} B x {len(c_deg)} C x {len(nest_arr)} nests is "
+            f"{n_poses} poses, more than {MAX_POSES}"
+        )
     if not (np.isfinite(dwell_s) and dwell_s > 0):
-        raise _core.InvalidArgument(f"simulate_rtest: dwell_s must be > 0 s (time must increase), got {dwell_s:g}")
-    if not (np.isfinite(noise_um) and noise_um >= 0 and np.isfinite(probe_zero_um) and probe_zero_um >= 0):
-        raise _core.InvalidArgument("simulate_rtest: noise_um and probe_zero_um must be finite and >= 0")
+        raise _core.InvalidArgument(
+            f"simulate_rtest: dwell_s must be > 0 s (time must increase), got {dwell_s:g}"
+        )
+    if not (
+        np.isfinite(noise_um)
+        and noise_um >= 0
+        and np.isfinite(probe_zero_um)
+        and probe_zero_um >= 0
+    ):
+        raise _core.InvalidArgument(
+            "simulate_rtest: noise_um and probe_zero_um must be finite and >= 0"
+        )
     if not 0 <= int(seed) < 2**32:
         raise _core.InvalidArgument(f"simulate_rtest: seed must be in [0, 2^32 - 1], got {seed}")
     dirs = None if probe_dirs is None else np.asarray(probe_dirs, dtype=float)
-    session, zeros = _core.simulate_rtest(mtype, e, ids, params, list(map(float, b_deg)),
-                                          list(map(float, c_deg)), nest_arr, float(dwell_s),
-                                          float(noise_um), float(probe_zero_um), dirs, bool(write_d),
-                                          int(seed))
-    truth = {"errors": dict(zip(_core.location_error_names(mtype), e.tolist())),
-             "effects": effects_out,
-             "nests": nest_arr.tolist(),
-             "noise_um": float(noise_um),
-             "probe_zeros": np.asarray(zeros).tolist(),
-             "probe_zero_um": float(probe_zero_um),
-             **machine_members(mtype),
-             "pattern": {"b_deg": list(map(float, b_deg)), "c_deg": list(map(float, c_deg)),
-                         "dwell_s": float(dwell_s)},
-             "seed": int(seed)}
+    session, zeros = _core.simulate_rtest(
+        mtype,
+        e,
+        ids,
+        params,
+        list(map(float, b_deg)),
+        list(map(float, c_deg)),
+        nest_arr,
+        float(dwell_s),
+        float(noise_um),
+        float(probe_zero_um),
+        dirs,
+        bool(write_d),
+        int(seed),
+    )
+    truth = {
+        "errors": dict(zip(_core.location_error_names(mtype), e.tolist())),
+        "effects": effects_out,
+        "nests": nest_arr.tolist(),
+        "noise_um": float(noise_um),
+        "probe_zeros": np.asarray(zeros).tolist(),
+        "probe_zero_um": float(probe_zero_um),
+        **machine_members(mtype),
+        "pattern": {
+            "b_deg": list(map(float, b_deg)),
+            "c_deg": list(map(float, c_deg)),
+            "dwell_s": float(dwell_s),
+        },
+        "seed": int(seed),
+    }
     if dirs is not None:
         truth["probe_dirs"] = dirs.tolist()
     return session, truth
 
 
-def truth_readings(truth: Mapping, session: _core.RtestSession, probe_zeros: bool = True) -> np.ndarray:
+def truth_readings(
+    truth: Mapping, session: _core.RtestSession, probe_zeros: bool = True
+) -> np.ndarray:
     """Noise-free dx,dy,dz (N, 3) of every row of a session on the machine of a truth dict
     (``simulate_rtest``), with the truth's probe zero of each set-up (set-up "k" is nest k)
     unless ``probe_zeros`` is False."""
@@ -302,10 +405,14 @@ def save_truth(truth: Mapping, path: str | Path, other_outputs: Sequence[str | P
     """Write a truth dict as strict JSON by the output rule (rotacal.outputs)."""
     from . import jsontext
     from .outputs import write_output
-    write_output(path, jsontext.dumps(dict(truth)) + "\n", other_outputs=[str(o) for o in other_outputs])
+
+    write_output(
+        path, jsontext.dumps(dict(truth)) + "\n", other_outputs=[str(o) for o in other_outputs]
+    )
 
 
 # ------------------------------------------------------------------------- device calibration
+
 
 def calibrate_probes(moves: np.ndarray, readings: np.ndarray) -> Any:
     """Identify the probe directions of an R-test nest (Oyama Sec. 3.2) from known linear moves.
@@ -319,10 +426,14 @@ def calibrate_probes(moves: np.ndarray, readings: np.ndarray) -> Any:
     (mm), ``direction_std_rad`` and ``gain_std`` (1 sigma), ``residuals``, ``sigma_um``.
     Raises InvalidArgument (too few moves) or DegenerateGeometry (moves not spanning 3-D).
     """
-    return _core.calibrate_probe_directions(np.asarray(moves, dtype=float), np.asarray(readings, dtype=float))
+    return _core.calibrate_probe_directions(
+        np.asarray(moves, dtype=float), np.asarray(readings, dtype=float)
+    )
 
 
-def calibrate_sphere_offset(dirs: np.ndarray, spindle_deg: Sequence[float], readings: np.ndarray) -> Any:
+def calibrate_sphere_offset(
+    dirs: np.ndarray, spindle_deg: Sequence[float], readings: np.ndarray
+) -> Any:
     """The sphere's offset from the spindle axis from spindle indexing (Oyama Sec. 3.2).
 
     The spindle is turned to the angles ``spindle_deg`` (N,) with the machine at rest; the
@@ -334,12 +445,16 @@ def calibrate_sphere_offset(dirs: np.ndarray, spindle_deg: Sequence[float], read
     ``centre`` and ``residual_rms_um``. Use ``compensate_sphere_offset`` on a session measured
     with that spindle orientation.
     """
-    return _core.calibrate_sphere_offset(np.asarray(dirs, dtype=float),
-                                         np.radians(np.asarray(spindle_deg, dtype=float)),
-                                         np.asarray(readings, dtype=float))
+    return _core.calibrate_sphere_offset(
+        np.asarray(dirs, dtype=float),
+        np.radians(np.asarray(spindle_deg, dtype=float)),
+        np.asarray(readings, dtype=float),
+    )
 
 
-def compensate_sphere_offset(session: _core.RtestSession, offset: Sequence[float]) -> _core.RtestSession:
+def compensate_sphere_offset(
+    session: _core.RtestSession, offset: Sequence[float]
+) -> _core.RtestSession:
     """The session with a sphere offset (x, y, mm, spindle frame: it turns with a head) taken out
     of every dx,dy,dz, on any machine."""
     s, _ = with_displacements(session)

@@ -1,4 +1,5 @@
 """Session files, and the one place that tells a ballbar, an R-test and a touch-probe session apart."""
+
 from __future__ import annotations
 
 import codecs
@@ -26,11 +27,13 @@ T = TypeVar("T")
 
 
 def kind(session: Any) -> str:
-    """"ballbar", "rtest" or "probe"; InvalidArgument for anything that is not a session."""
+    """ "ballbar", "rtest" or "probe"; InvalidArgument for anything that is not a session."""
     k = _KINDS.get(type(session))
     if k is None:
-        raise _core.InvalidArgument(f"not a session: {type(session).__name__} (BallbarSession, RtestSession or "
-                                    "ProbeSession)")
+        raise _core.InvalidArgument(
+            f"not a session: {type(session).__name__} (BallbarSession, RtestSession or "
+            "ProbeSession)"
+        )
     return k
 
 
@@ -61,7 +64,9 @@ def checked_path(path: Any, what: str = "path") -> str:
     if s == "":
         raise _core.InvalidArgument(f"{what}: empty file name")
     if "\x00" in s:
-        raise _core.InvalidArgument(f"{what}: {s.split(chr(0))[0]!r}...: a file name cannot contain a NUL byte")
+        raise _core.InvalidArgument(
+            f"{what}: {s.split(chr(0))[0]!r}...: a file name cannot contain a NUL byte"
+        )
     return s
 
 
@@ -79,7 +84,9 @@ def first_non_utf8(path: str, limit: int = _SCAN_LIMIT) -> tuple[int, int, int] 
             try:
                 decoder.decode(chunk)
             except UnicodeDecodeError as e:
-                data = e.object  # the bytes held back from the last chunk (never a newline) + this chunk
+                data = (
+                    e.object
+                )  # the bytes held back from the last chunk (never a newline) + this chunk
                 base = offset - (len(data) - len(chunk))
                 nl = data.rfind(b"\n", 0, e.start)
                 if nl >= 0:
@@ -116,11 +123,15 @@ def _not_utf8(path: str) -> _core.Error:
     except OSError as e:
         return _core.IoError(f"{path}: {e.strerror}")
     if head[:2] in (b"\xff\xfe", b"\xfe\xff"):
-        return _core.ParseError(f"{path}:1:1: the file is UTF-16 text; rotacal reads UTF-8 (save it as UTF-8)")
+        return _core.ParseError(
+            f"{path}:1:1: the file is UTF-16 text; rotacal reads UTF-8 (save it as UTF-8)"
+        )
     if where is None:
         return _core.ParseError(f"{path}: not UTF-8 text")
     line, col, byte = where
-    return _core.ParseError(f"{path}:{line}:{col}: byte 0x{byte:02X} is not UTF-8 (session files are UTF-8 text)")
+    return _core.ParseError(
+        f"{path}:{line}:{col}: byte 0x{byte:02X} is not UTF-8 (session files are UTF-8 text)"
+    )
 
 
 def load(path: str | Path, format: str | None = None) -> Session:
@@ -138,8 +149,10 @@ def load(path: str | Path, format: str | None = None) -> Session:
     if format is not None:
         wanted = {v: k for k, v in FORMATS.items()}.get(format, format)
         if wanted not in _READERS:
-            raise _core.InvalidArgument(f"load: format must be one of {', '.join(FORMATS)} (or "
-                                        f"{', '.join(FORMATS.values())}), got {format!r}")
+            raise _core.InvalidArgument(
+                f"load: format must be one of {', '.join(FORMATS)} (or "
+                f"{', '.join(FORMATS.values())}), got {format!r}"
+            )
     try:
         session = _READERS[wanted](p) if wanted else _core.read_instrument_session(p)
         getattr(session, _LABELS[kind(session)])  # every label must be text Python can hold
@@ -152,7 +165,9 @@ def load(path: str | Path, format: str | None = None) -> Session:
     return session
 
 
-def check_plausible(session: Session, source: str = "<session>", max_deviation_mm: float | None = None) -> Any:
+def check_plausible(
+    session: Session, source: str = "<session>", max_deviation_mm: float | None = None
+) -> Any:
     """Check a session against the nominal kinematics before any fit (C++ session/plausibility):
     refuses, with the likely cause named ("angles look like radians", "lengths look like
     inches", "all rotary angles equal", a wrong L0, ...), a session no machine with realistic
@@ -161,7 +176,9 @@ def check_plausible(session: Session, source: str = "<session>", max_deviation_m
     opts = _core.PlausibilityOptions()
     if max_deviation_mm is not None:
         if not (0.0 < max_deviation_mm <= 1000.0):
-            raise _core.InvalidArgument(f"--max-deviation {max_deviation_mm}: must be in (0, 1000] mm")
+            raise _core.InvalidArgument(
+                f"--max-deviation {max_deviation_mm}: must be in (0, 1000] mm"
+            )
         opts.max_length_deviation_mm = max_deviation_mm
         opts.max_position_deviation_mm = max_deviation_mm
     return _core.check_plausible(session, source, opts)
@@ -179,16 +196,25 @@ def session_text(session: Session, what: str = "save") -> str:
             _core.read_instrument_session(probe)
         except _core.ParseError as e:
             reason = str(e).replace(probe, "the session")
-            raise _core.InvalidArgument(f"{what}: this session would make a file that load refuses: {reason}") from None
+            raise _core.InvalidArgument(
+                f"{what}: this session would make a file that load refuses: {reason}"
+            ) from None
     return text
 
 
-
-def save(session: Session, path: str | Path, inputs: Iterable[str | Path] = (),
-         other_outputs: Iterable[str | Path] = ()) -> None:
+def save(
+    session: Session,
+    path: str | Path,
+    inputs: Iterable[str | Path] = (),
+    other_outputs: Iterable[str | Path] = (),
+) -> None:
     """Write a session by the output rule (rotacal.outputs: a regular file replaced atomically,
     a device written through); ``inputs`` and ``other_outputs`` of the command are refused as
     targets. A session that would make a file ``load`` refuses is not written."""
     p = checked_path(path, "save")
-    write_output(p, lambda: session_text(session), [str(i) for i in inputs if i is not None],
-                 [str(o) for o in other_outputs if o is not None])
+    write_output(
+        p,
+        lambda: session_text(session),
+        [str(i) for i in inputs if i is not None],
+        [str(o) for o in other_outputs if o is not None],
+    )

@@ -1,11 +1,19 @@
 """How a parameter of each native unit is shown to a person: um and urad beside the tables,
 not mm and rad. The library computes in mm, rad and s; effects bring other units (a servo lag
 in s, a log time constant in 1, a drift in mm/s)."""
+
 from __future__ import annotations
 
 # native unit -> (factor, shown unit)
-SHOWN = {"rad": (1e6, "urad"), "mm": (1e3, "um"), "s": (1e3, "ms"), "mm/s": (1e3, "um/s"),
-         "rad/rad": (1e6, "urad/rad"), "mm/mm": (1e6, "um/m"), "1": (1.0, "")}
+SHOWN = {
+    "rad": (1e6, "urad"),
+    "mm": (1e3, "um"),
+    "s": (1e3, "ms"),
+    "mm/s": (1e3, "um/s"),
+    "rad/rad": (1e6, "urad/rad"),
+    "mm/mm": (1e6, "um/m"),
+    "1": (1.0, ""),
+}
 
 
 def shown(unit: str) -> tuple[float, str]:

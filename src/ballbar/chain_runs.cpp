@@ -34,9 +34,10 @@ BallbarSession record(const BallbarSession& nominal, const RowMatrix3& nominal_x
   // The exact readings (no noise drawn here, none declared): the noise is AR(1) per test.
   const BallbarSession s = simulate_ballbar(program, machine, {0.0, 1, false});
   Eigen::VectorXd length = ballbar_lengths(s);
-  if (seed) length += noise_gen::ar1(columns.tests, columns.times, o.noise_rho, o.noise_um * 1e-3, *seed);
-  return make_ballbar_session(s.machine, s.ballbar_length, nominal.pivot, columns.tests, columns.time,
-                              nominal_xyz, columns.angles_deg, length, o.noise_um);
+  if (seed)
+    length += noise_gen::ar1(columns.tests, columns.times, o.noise_rho, o.noise_um * 1e-3, *seed);
+  return make_ballbar_session(s.machine, s.ballbar_length, nominal.pivot, columns.tests,
+                              columns.time, nominal_xyz, columns.angles_deg, length, o.noise_um);
 }
 
 Eigen::Matrix<double, 8, 1> identified_errors(const BallbarSession& s, const ChainRunOptions& o) {
@@ -63,8 +64,8 @@ void check(const ChainRunOptions& o) {
 BallbarSession record_run(const BallbarSession& nominal, const BallbarSession& program,
                           const BallbarMachineModel& machine, std::optional<std::uint64_t> seed,
                           const ChainRunOptions& options) {
-  return record(nominal, ballbar_xyz(nominal), program, columns_of(program), machine, seed ? &*seed : nullptr,
-                options);
+  return record(nominal, ballbar_xyz(nominal), program, columns_of(program), machine,
+                seed ? &*seed : nullptr, options);
 }
 
 LocationErrorRows identify_runs(const BallbarSetup& setup,
@@ -75,8 +76,9 @@ LocationErrorRows identify_runs(const BallbarSetup& setup,
   check(options);
   const auto n = static_cast<Eigen::Index>(machines.size());
   if (compensate_for.rows() != 0 && compensate_for.rows() != n)
-    throw InvalidArgument("identify_runs: compensate_for has " + std::to_string(compensate_for.rows()) +
-                          " rows for " + std::to_string(n) + " machines (0 or one per machine)");
+    throw InvalidArgument("identify_runs: compensate_for has " +
+                          std::to_string(compensate_for.rows()) + " rows for " + std::to_string(n) +
+                          " machines (0 or one per machine)");
   if (!seeds.empty() && static_cast<Eigen::Index>(seeds.size()) != n)
     throw InvalidArgument("identify_runs: " + std::to_string(seeds.size()) + " seeds for " +
                           std::to_string(n) + " machines (none or one per machine)");
@@ -95,7 +97,8 @@ LocationErrorRows identify_runs(const BallbarSetup& setup,
       s = record(nominal, nominal_xyz, nominal, nominal_columns, machines[k], seed, options);
     } else {
       if (i == 0 || compensate_for.row(i) != compensate_for.row(i - 1)) {
-        const LocationErrors<double> e(Eigen::Matrix<double, 8, 1>(compensate_for.row(i).transpose()));
+        const LocationErrors<double> e(
+            Eigen::Matrix<double, 8, 1>(compensate_for.row(i).transpose()));
         program = commanded_session(plan_ballbar_test(setup, e));
         program_columns = columns_of(program);
       }

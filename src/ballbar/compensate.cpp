@@ -41,8 +41,9 @@ CompensationReport verify_compensation(const BallbarSession& commanded,
   r.before = identify_joint(first, fit);
 
   // The machine runs the compensated program; the ballbar software still holds the nominal one.
-  const BallbarSession program = compensate_commands(commanded, r.before.model.errors, truth.machine,
-                                                     identified_tool_length_error(r.before.model));
+  const BallbarSession program =
+      compensate_commands(commanded, r.before.model.errors, truth.machine,
+                          identified_tool_length_error(r.before.model));
   BallbarSimulationOptions second_options = options;
   second_options.seed = options.seed + 1;
   BallbarSession second = simulate_ballbar(program, truth, second_options);
@@ -59,7 +60,8 @@ CompensationReport verify_compensation(const BallbarSession& commanded,
     row.before = b.value;
     row.after = a.value;
     row.std_after = a.std;
-    row.change_percent = b.value != 0.0 ? 100.0 * (std::abs(a.value) - std::abs(b.value)) / std::abs(b.value) : 0.0;
+    row.change_percent =
+        b.value != 0.0 ? 100.0 * (std::abs(a.value) - std::abs(b.value)) / std::abs(b.value) : 0.0;
     r.rows.push_back(row);
   }
   return r;

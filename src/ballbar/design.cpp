@@ -9,9 +9,9 @@
 #include <limits>
 #include <sstream>
 
-#include "rotacal/design/format.hpp"
 #include "rotacal/ballbar/problem.hpp"
 #include "rotacal/core/error.hpp"
+#include "rotacal/design/format.hpp"
 
 namespace rotacal {
 
@@ -107,7 +107,9 @@ DesignCandidate evaluate_design(const BallbarSetup& setup, const BallbarDesignOp
   c.sigma = cov.diagonal().cwiseSqrt();
   for (Eigen::Index i = L.errors.offset; i < L.errors.end(); ++i) {
     const double u = 2.0 * c.sigma[i] *
-                     (location_error_is_angle(static_cast<int>(i - L.errors.offset)) ? o.reference_radius_mm * 1e3 : 1e3);
+                     (location_error_is_angle(static_cast<int>(i - L.errors.offset))
+                          ? o.reference_radius_mm * 1e3
+                          : 1e3);
     if (u > c.worst_expanded_um)
       c.worst_expanded_um = u, c.worst_error = c.names[static_cast<std::size_t>(i)];
   }
@@ -143,9 +145,10 @@ BallbarDesign design_ballbar_test(const BallbarDesignOptions& o) {
   // effect does: those are refused here rather than predicted wrongly.
   for (const Effect& f : o.effects_of_concern.effects)
     if (f.depends_on_motion())
-      throw InvalidArgument("design: " + f.id() +
-                            " depends on the speed, which the design changes to fill the time; it is "
-                            "not designed for yet (use --separate after a session with both directions)");
+      throw InvalidArgument(
+          "design: " + f.id() +
+          " depends on the speed, which the design changes to fill the time; it is "
+          "not designed for yet (use --separate after a session with both directions)");
   if (!(o.noise_rho >= 0.0 && o.noise_rho <= 0.999))
     throw InvalidArgument("design: --rho must be in [0, 0.999]");
   if (!(o.time_budget_s >= 0.0) || !std::isfinite(o.time_budget_s))
@@ -167,7 +170,8 @@ BallbarDesign design_ballbar_test(const BallbarDesignOptions& o) {
         if (c.feasible && (!out.best.feasible || c.worst_expanded_um < out.best.worst_expanded_um))
           out.best = c;
         if (!c.feasible && reasons.size() < 400)
-          reasons += "; L0 " + fixed_text(L) + ", pivot (" + fixed_text(x) + ", 0, " + fixed_text(z) + "): " + c.why_not;
+          reasons += "; L0 " + fixed_text(L) + ", pivot (" + fixed_text(x) + ", 0, " +
+                     fixed_text(z) + "): " + c.why_not;
         out.candidates.push_back(std::move(c));
       }
   if (!out.best.feasible)

@@ -5,10 +5,10 @@
 #include <memory>
 #include <type_traits>
 
+#include "length_model.hpp"
 #include "rotacal/ballbar/identify.hpp"
 #include "rotacal/core/fit_with_noise.hpp"
 #include "rotacal/core/time_constant_fit.hpp"
-#include "length_model.hpp"
 
 namespace rotacal {
 
@@ -26,7 +26,8 @@ BallbarArrays ballbar_arrays(const BallbarSession& session, const std::vector<st
   a.noise_um = session.noise_um;
   a.session_size = session.samples.size();
   for (std::size_t i = 0; i < session.samples.size(); ++i)
-    if (tests.empty() || std::find(tests.begin(), tests.end(), session.samples[i].test) != tests.end())
+    if (tests.empty() ||
+        std::find(tests.begin(), tests.end(), session.samples[i].test) != tests.end())
       a.index.push_back(i);
   const Eigen::Index n = static_cast<Eigen::Index>(a.index.size());
   a.xyz.resize(3, n);
@@ -35,7 +36,8 @@ BallbarArrays ballbar_arrays(const BallbarSession& session, const std::vector<st
   a.length.resize(n);
   a.test.resize(a.index.size());
   // Motion from every row of the session: a test left out still moved the axes.
-  const std::vector<RotaryMotion> motion = with_motion ? rotary_motion(session.samples) : std::vector<RotaryMotion>{};
+  const std::vector<RotaryMotion> motion =
+      with_motion ? rotary_motion(session.samples) : std::vector<RotaryMotion>{};
   if (with_motion) a.motion.resize(a.index.size());
   for (Eigen::Index k = 0; k < n; ++k) {
     const BallbarSample& s = session.samples[a.index[static_cast<std::size_t>(k)]];
@@ -44,15 +46,18 @@ BallbarArrays ballbar_arrays(const BallbarSession& session, const std::vector<st
     a.time[k] = s.time;
     a.length[k] = s.length;
     a.test[static_cast<std::size_t>(k)] = s.test;
-    if (with_motion) a.motion[static_cast<std::size_t>(k)] = motion[a.index[static_cast<std::size_t>(k)]];
+    if (with_motion)
+      a.motion[static_cast<std::size_t>(k)] = motion[a.index[static_cast<std::size_t>(k)]];
   }
   return a;
 }
 
-BallbarIdentification identify_joint(const BallbarSession& session, const JointFitOptions& options) {
+BallbarIdentification identify_joint(const BallbarSession& session,
+                                     const JointFitOptions& options) {
   // The motion of the axes (rotary_motion) only for effects of the motion.
-  const bool with_motion = std::any_of(options.effects.effects.begin(), options.effects.effects.end(),
-                                       [](const Effect& f) { return f.depends_on_motion(); });
+  const bool with_motion =
+      std::any_of(options.effects.effects.begin(), options.effects.effects.end(),
+                  [](const Effect& f) { return f.depends_on_motion(); });
   // The linear-axis polynomials are about the mean of the whole session, not of the tests fitted.
   JointFitOptions o = options;
   o.effects = centred_on(options.effects, session.samples);
@@ -71,21 +76,24 @@ std::vector<std::string> setup_advice(MachineType m, const std::vector<std::stri
     return false;
   };
   if (mentions("tool_offset_Z"))
-    out.push_back("pivot_length + tool_length is seen together with the head axis' position along the "
-                  "spindle: a second tool length (a second ball position along the spindle) in the "
-                  "head tests separates them");
+    out.push_back(
+        "pivot_length + tool_length is seen together with the head axis' position along the "
+        "spindle: a second tool length (a second ball position along the spindle) in the "
+        "head tests separates them");
   const auto& names = location_error_names(m);
   for (int k = 0; k < 2; ++k) {
     const RotaryAxis& a = m.description().axis(k);
     const bool pos = mentions(names[4 * k]) || mentions(names[4 * k + 1]);
     const bool tilt = mentions(names[4 * k + 2]) || mentions(names[4 * k + 3]);
     if (pos && tilt)
-      out.push_back(std::string("the position and the tilt of ") + a.name +
-                    " are seen as one combination at the ball's height: a test of " + a.name +
-                    (a.on_head ? " with the ball at a second height (another tool length, or the tilt axis turned: "
-                                 "axial_c_tilt_deg)"
-                               : " with the pivot at a second height") +
-                    " separates them");
+      out.push_back(
+          std::string("the position and the tilt of ") + a.name +
+          " are seen as one combination at the ball's height: a test of " + a.name +
+          (a.on_head
+               ? " with the ball at a second height (another tool length, or the tilt axis turned: "
+                 "axial_c_tilt_deg)"
+               : " with the pivot at a second height") +
+          " separates them");
   }
   return out;
 }
@@ -106,7 +114,9 @@ BallbarIdentification identify_joint(const BallbarArrays& data, const JointFitOp
   const bool streams = static_cast<std::size_t>(data.size()) == data.test.size();
   const std::vector<double> t(data.time.data(), data.time.data() + data.time.size());
   NoiseFit nf = fit_with_noise(
-      [&](const JointFitSettings& s) { return solve_with_time_constants(model, setup.parameters, s); },
+      [&](const JointFitSettings& s) {
+        return solve_with_time_constants(model, setup.parameters, s);
+      },
       setup.settings, streams ? data.test : std::vector<std::string>{}, t, no);
   JointFitOutcome& fit = nf.fit;
   const bool refit = nf.refit;
@@ -121,22 +131,30 @@ BallbarIdentification identify_joint(const BallbarArrays& data, const JointFitOp
   out.residuals.assign(data.session_size, 0.0);
   for (std::size_t k = 0; k < data.index.size(); ++k)
     out.residuals[data.index[k]] = fit.residuals[static_cast<Eigen::Index>(k)];
-  out.residual_rms_um = std::sqrt(fit.residuals.squaredNorm() / static_cast<double>(data.size())) * 1e3;
+  out.residual_rms_um =
+      std::sqrt(fit.residuals.squaredNorm() / static_cast<double>(data.size())) * 1e3;
   out.sigma_um = std::sqrt(fit.residual_variance) * 1e3;
   if (options.whitener || refit)  // the noise level the covariance rests on: the whitened fit's
-    out.sigma_um = std::sqrt(fit.residuals.squaredNorm() /
-                             std::max(1.0, static_cast<double>(data.size() - fit.summary.num_free))) * 1e3;
+    out.sigma_um =
+        std::sqrt(fit.residuals.squaredNorm() /
+                  std::max(1.0, static_cast<double>(data.size() - fit.summary.num_free))) *
+        1e3;
   out.covariance = std::move(fit.covariance);
   out.jacobian = std::move(fit.jacobian);
   for (bool f : fit.free) out.fixed.push_back(!f);
   out.parameters = std::move(fit.estimates);
   out.unobservable = std::move(fit.unobservable);
-  for (std::string& advice : setup_advice(data.machine, out.unobservable)) out.notes.push_back(std::move(advice));
+  for (std::string& advice : setup_advice(data.machine, out.unobservable))
+    out.notes.push_back(std::move(advice));
   out.summary = fit.summary;
   out.noise = std::move(nf.noise);
   out.noise_refit = refit;
   out.noise_correction = scale;
-  if (refit) out.notes.push_back("correlated noise (" + out.noise.summary() + "): covariance by GLS under this AR model, scaled by " + std::to_string(scale) + " for the correlation the fit absorbs from its residuals");
+  if (refit)
+    out.notes.push_back("correlated noise (" + out.noise.summary() +
+                        "): covariance by GLS under this AR model, scaled by " +
+                        std::to_string(scale) +
+                        " for the correlation the fit absorbs from its residuals");
   if (!out.converged) out.notes.push_back("the fit did not converge: " + fit.summary.message);
   return out;
 }

@@ -44,8 +44,9 @@ Points3 pivot_estimates(const BallbarSession& s, const std::vector<std::size_t>&
 }
 
 // Axis index of the rotary axis: 0 for A (X), 1 for B (Y), 2 for C (Z).
-AxisEstimate axis_from_tests(const BallbarSession& s, const std::string& radial, const std::string& axial,
-                             int k, const Eigen::Vector3d& pivot, CircleFit* circle, PlaneFit* plane) {
+AxisEstimate axis_from_tests(const BallbarSession& s, const std::string& radial,
+                             const std::string& axial, int k, const Eigen::Vector3d& pivot,
+                             CircleFit* circle, PlaneFit* plane) {
   const int i1 = (k + 1) % 3, i2 = (k + 2) % 3;  // the plane of rotation, cyclic order
   Points3 nominal;
   // 3.2: radial test -> centre of rotation in the plane perpendicular to the axis.
@@ -71,7 +72,8 @@ AxisEstimate axis_from_tests(const BallbarSession& s, const std::string& radial,
 
 // The eight location errors from the two estimated lines (formats.md definitions), with the
 // lines transported to the nominal intersection (the machine origin).
-Eigen::Matrix<double, 8, 1> location_errors(MachineType m, const AxisEstimate& T, const AxisEstimate& C) {
+Eigen::Matrix<double, 8, 1> location_errors(MachineType m, const AxisEstimate& T,
+                                            const AxisEstimate& C) {
   Eigen::Matrix<double, 8, 1> e;
   if (m == MachineType::AC_trt) {
     const Eigen::Vector3d d = T.direction / T.direction.x();  // (1, E_C0A, -E_B0A)
@@ -93,9 +95,12 @@ Eigen::Matrix<double, 8, 1> location_errors(MachineType m, const AxisEstimate& T
 BallbarIdentification identify_paper(const BallbarSession& s, bool with_residuals) {
   const MachineType m = s.machine;
   if (m != MachineType::AC_trt && m != MachineType::BC_trt)
-    throw InvalidArgument("identify_paper: Flynn et al.'s chain is written for the AC-trt and BC-trt "
-                          "tables; the " + to_string(m) + " machine is identified by the joint fit "
-                          "(identify_joint, --method joint)");
+    throw InvalidArgument(
+        "identify_paper: Flynn et al.'s chain is written for the AC-trt and BC-trt "
+        "tables; the " +
+        to_string(m) +
+        " machine is identified by the joint fit "
+        "(identify_joint, --method joint)");
   const char T = tilt_axis_letter(m);
   const int k_tilt = m == MachineType::AC_trt ? 0 : 1;
 
@@ -110,7 +115,8 @@ BallbarIdentification identify_paper(const BallbarSession& s, bool with_residual
   Points3 q(static_cast<Eigen::Index>(sphere_idx.size()), 3);
   for (std::size_t k = 0; k < sphere_idx.size(); ++k) {
     const BallbarSample& b = s.samples[sphere_idx[k]];
-    q.row(static_cast<Eigen::Index>(k)) = (s.pivot + (b.xyz - s.pivot).normalized() * b.length).transpose();
+    q.row(static_cast<Eigen::Index>(k)) =
+        (s.pivot + (b.xyz - s.pivot).normalized() * b.length).transpose();
   }
   SphereFitOptions so;
   so.radius = s.ballbar_length;
@@ -120,7 +126,8 @@ BallbarIdentification identify_paper(const BallbarSession& s, bool with_residual
   CircleFit circle_t, circle_c;
   PlaneFit plane_t, plane_c;
   const std::string tl(1, T);
-  const AxisEstimate at = axis_from_tests(s, "radial_" + tl, "axial_" + tl, k_tilt, pivot, &circle_t, &plane_t);
+  const AxisEstimate at =
+      axis_from_tests(s, "radial_" + tl, "axial_" + tl, k_tilt, pivot, &circle_t, &plane_t);
   const AxisEstimate ac = axis_from_tests(s, "radial_C", "axial_C", 2, pivot, &circle_c, &plane_c);
   const Eigen::Matrix<double, 8, 1> e = location_errors(m, at, ac);
 
@@ -165,7 +172,8 @@ BallbarIdentification identify_paper(const BallbarSession& s, bool with_residual
   out.n_samples = s.samples.size();
   for (int j = 0; j < 11; ++j) {
     ParameterEstimate p;
-    p.name = j < 8 ? location_error_names(m)[static_cast<std::size_t>(j)] : std::string("pivot_") + "xyz"[j - 8];
+    p.name = j < 8 ? location_error_names(m)[static_cast<std::size_t>(j)]
+                   : std::string("pivot_") + "xyz"[j - 8];
     p.unit = j < 8 && location_error_is_angle(j) ? "rad" : "mm";
     p.value = j < 8 ? e[j] : pivot[j - 8];
     p.std = std::sqrt(std::max(0.0, cov(j, j)));

@@ -1,15 +1,13 @@
 // The ballbar reading's chain rule (length_chain.hpp).
 #include "length_chain.hpp"
 
-#include <vector>
-
-#include "length_model.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <vector>
 
 #include "../kinematics/stage_instances.hpp"
+#include "length_model.hpp"
 
 namespace rotacal {
 ROTACAL_STAGE_SCALARS(extern)
@@ -22,27 +20,29 @@ namespace {
 // The chain rule's forward pass: the pivot carried through the table's stages in
 // walk_table_stages' own order (the one definition of it), keeping what the backward pass needs.
 struct ForwardPass {
-  Eigen::Vector3d p;                             // the point after the stages so far
-  Eigen::Vector3d pE[2], pK[2];                  // the points E's and K's left rotations act on
-  Eigen::Vector3d arm[2];                        // the point less the axis line's point, after the turn
-  std::optional<Eigen::Matrix3d> RE[2], RK[2];   // E's and K's rotations (none: an identity stage)
-  LineRotationDerivatives<double> D[2];          // each axis rotation with its derivatives
+  Eigen::Vector3d p;             // the point after the stages so far
+  Eigen::Vector3d pE[2], pK[2];  // the points E's and K's left rotations act on
+  Eigen::Vector3d arm[2];        // the point less the axis line's point, after the turn
+  std::optional<Eigen::Matrix3d> RE[2], RK[2];  // E's and K's rotations (none: an identity stage)
+  LineRotationDerivatives<double> D[2];         // each axis rotation with its derivatives
 
   explicit ForwardPass(const Eigen::Vector3d& pivot) : p(pivot) {
     for (int k = 0; k < 2; ++k) pE[k] = pK[k] = arm[k] = Eigen::Vector3d::Zero();
   }
   void rigid(const Pose<double>& P, int k, RigidStage stage) {
     const Eigen::Vector3d Rp = P.R * p;
-    if (stage == RigidStage::error_motion) RE[k] = P.R;
-    else RK[k] = P.R;
+    if (stage == RigidStage::error_motion)
+      RE[k] = P.R;
+    else
+      RK[k] = P.R;
     (stage == RigidStage::error_motion ? pE[k] : pK[k]) = Rp;
     p = Rp + P.t;
   }
   void about_line(const AxisLine<double>& line, double angle, int k) {
     if (!RE[k]) pE[k] = p;
     const double inv_norm = 1.0 / line.direction.norm();
-    D[k] = rotate_point_about_unit_line_derivatives<double>(line.point, line.direction * inv_norm, inv_norm,
-                                                            std::cos(angle), std::sin(angle), p);
+    D[k] = rotate_point_about_unit_line_derivatives<double>(
+        line.point, line.direction * inv_norm, inv_norm, std::cos(angle), std::sin(angle), p);
     p = D[k].f;
     arm[k] = p - line.point;
     pK[k] = p;  // K's rotation, if any, replaces it
@@ -60,7 +60,8 @@ void sensitivities(MachineType m, const LocationErrors<double>& e, const Eigen::
   ForwardPass fw(pivot);
   walk_table_stages<double>(m, e, fx, q, smp.angles, smp.time, smp.motion, fw);
   const Eigen::Vector3d& p = fw.p;
-  const Eigen::Vector3d tool = tool_position<double>(m, e, fx, q, smp.xyz, smp.angles, smp.time, 0.0, smp.motion);
+  const Eigen::Vector3d tool =
+      tool_position<double>(m, e, fx, q, smp.xyz, smp.angles, smp.time, 0.0, smp.motion);
   const Eigen::Vector3d u = (tool - p).normalized();
   // Backward from the reading: g = dL / d(the point after the stage at hand).
   s.setZero();
@@ -78,7 +79,8 @@ void sensitivities(MachineType m, const LocationErrors<double>& e, const Eigen::
       const RotaryAxis& a = m.description().axis(k);
       const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - fw.D[k].u * fw.D[k].u.transpose();
       base->segment<2>(4 * k) = fw.D[k].times_point(w, wq) * a.position_basis;
-      base->segment<2>(4 * k + 2) = fw.D[k].times_unit_direction(w) * (P * fw.D[k].inv_norm * a.direction_basis);
+      base->segment<2>(4 * k + 2) =
+          fw.D[k].times_unit_direction(w) * (P * fw.D[k].inv_norm * a.direction_basis);
     }
     g = wq.transpose();
     s.segment<3>(kEt + 3 * k) = g;
@@ -89,11 +91,12 @@ void sensitivities(MachineType m, const LocationErrors<double>& e, const Eigen::
 }
 
 template <int N>
-void place_derivatives(MachineType m, const EffectModel& fx, const ceres::Jet<double, N>* q, const Sample& smp,
-                       Eigen::Matrix<double, kPlaces, N>& d) {
+void place_derivatives(MachineType m, const EffectModel& fx, const ceres::Jet<double, N>* q,
+                       const Sample& smp, Eigen::Matrix<double, kPlaces, N>& d) {
   using Jet = ceres::Jet<double, N>;
   const int nt = static_cast<int>(m.description().table_axes.size());
-  const detail::AxisStages<Jet> st = detail::axis_stages<Jet>(m, fx, q, smp.angles, smp.time, smp.motion);
+  const detail::AxisStages<Jet> st =
+      detail::axis_stages<Jet>(m, fx, q, smp.angles, smp.time, smp.motion);
   d.setZero();
   // w of a left rotation: dR R^T = [dw]x, w = (M(2,1), M(0,2), M(1,0)) of M = dR R^T.
   // A candidate at 0 has R = I, so M = dR (exactly what the product gives): no product then.
@@ -130,8 +133,8 @@ void place_derivatives(MachineType m, const EffectModel& fx, const ceres::Jet<do
   d.row(kReading) = ballbar_reading_error<Jet>(fx, q, smp.time).v.transpose();
 }
 
-template void place_derivatives<1>(MachineType, const EffectModel&, const ceres::Jet<double, 1>*, const Sample&,
-                                   Eigen::Matrix<double, kPlaces, 1>&);
+template void place_derivatives<1>(MachineType, const EffectModel&, const ceres::Jet<double, 1>*,
+                                   const Sample&, Eigen::Matrix<double, kPlaces, 1>&);
 template void place_derivatives<4>(MachineType, const EffectModel&, const Jet4*, const Sample&,
                                    Eigen::Matrix<double, kPlaces, 4>&);
 
@@ -158,7 +161,8 @@ void BallbarLengthModel::evaluate_chain(const Eigen::VectorXd& x, Eigen::Ref<Eig
   for (Eigen::Index i = 0; i < d_.size(); ++i) {
     const std::size_t k = static_cast<std::size_t>(i);
     const Eigen::Vector3d xyz = d_.xyz.col(i);
-    const length_chain::Sample smp{xyz, d_.angles[k], d_.time[i], d_.motion.empty() ? still : d_.motion[k]};
+    const length_chain::Sample smp{xyz, d_.angles[k], d_.time[i],
+                                   d_.motion.empty() ? still : d_.motion[k]};
     r[i] = ballbar_residual<double>(L_, d_, fx_, x.data(), i);
     length_chain::sensitivities(m, e, pivot, fx_, q, smp, s, &base);
     J.block<1, 8>(i, L_.errors.offset) = base.head<8>();

@@ -25,7 +25,16 @@ namespace rotacal::length_chain {
 /// The places: the angle of chain axes 0 and 1; E's translation and left rotation (3 each) of
 /// axes 0 and 1; K's left rotation of axes 0 and 1; the table translation D; the tool-side
 /// ball; the reading.
-enum Place { kAngle = 0, kEt = 2, kEw = 8, kKw = 14, kD = 20, kTool = 23, kReading = 26, kPlaces = 27 };
+enum Place {
+  kAngle = 0,
+  kEt = 2,
+  kEw = 8,
+  kKw = 14,
+  kD = 20,
+  kTool = 23,
+  kReading = 26,
+  kPlaces = 27
+};
 using Places = Eigen::Matrix<double, kPlaces, 1>;
 using Jet4 = ceres::Jet<double, 4>;
 
@@ -50,7 +59,7 @@ void sensitivities(MachineType m, const LocationErrors<double>& e, const Eigen::
 /// A rotation's place is its left derivative: dR = [dw]x R. N = 1 or 4 (length_chain.cpp):
 /// a Jet's derivative parts are computed element by element, so both widths give the same bits.
 template <int N>
-void place_derivatives(MachineType m, const EffectModel& fx, const ceres::Jet<double, N>* q, const Sample& s,
-                       Eigen::Matrix<double, kPlaces, N>& d);
+void place_derivatives(MachineType m, const EffectModel& fx, const ceres::Jet<double, N>* q,
+                       const Sample& s, Eigen::Matrix<double, kPlaces, N>& d);
 
 }  // namespace rotacal::length_chain

@@ -1,9 +1,9 @@
 // The ballbar residual model's kernels (length_model.hpp), compiled once for the library.
 #include "length_model.hpp"
 
-#include "length_chain.hpp"
-
 #include <algorithm>
+
+#include "length_chain.hpp"
 
 // Inline every call in the row kernel: GCC otherwise keeps the rotation and its derivative
 // products as calls that pass Lanes vectors through memory. Not under AddressSanitizer: the
@@ -42,17 +42,21 @@ struct BallbarLengthModel::Chain {
 
 BallbarLengthModel::BallbarLengthModel(const BallbarArrays& d, const EffectModel& fx,
                                        std::vector<int> pivot_of_row, int pivots)
-    : d_(d), fx_(fx), L_(ballbar_layout(d.machine, fx, pivots)), pivot_of_(std::move(pivot_of_row)),
+    : d_(d),
+      fx_(fx),
+      L_(ballbar_layout(d.machine, fx, pivots)),
+      pivot_of_(std::move(pivot_of_row)),
       analytic_(pivot_of_.empty() && analytic_supported(fx)),
       chain_(!analytic_ && pivot_of_.empty() && length_chain::supports(d.machine)),
       nt_(static_cast<int>(d.machine.description().table_axes.size())) {
   if (!pivot_of_.empty() && static_cast<Eigen::Index>(pivot_of_.size()) != d.size())
-    throw InvalidArgument("ballbar fit: " + std::to_string(pivot_of_.size()) + " pivot indices for " +
-                          std::to_string(d.size()) + " rows");
+    throw InvalidArgument("ballbar fit: " + std::to_string(pivot_of_.size()) +
+                          " pivot indices for " + std::to_string(d.size()) + " rows");
   if (analytic_) commanded_sincos();
   for (const Effect& f : fx.effects)
     if (f.depends_on_motion() && d.motion.size() != static_cast<std::size_t>(d.size()))
-      throw InvalidArgument("ballbar fit: effect " + f.id() + " needs the motion of the axes, which these "
+      throw InvalidArgument("ballbar fit: effect " + f.id() +
+                            " needs the motion of the axes, which these "
                             "arrays were built without (ballbar_arrays with_motion)");
 }
 
@@ -70,8 +74,8 @@ void BallbarLengthModel::evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::Ve
                      d_.size(), 1, x, r, J);
 }
 
-bool BallbarLengthModel::evaluate_subset(const Eigen::VectorXd& x, Eigen::Index stride, Eigen::VectorXd& r,
-                                         Eigen::MatrixXd* J) const {
+bool BallbarLengthModel::evaluate_subset(const Eigen::VectorXd& x, Eigen::Index stride,
+                                         Eigen::VectorXd& r, Eigen::MatrixXd* J) const {
   // Sessions back to back: every k-th row may miss a short session, and its pivot with it.
   if (!pivot_of_.empty()) return false;
   const Eigen::Index m = (d_.size() + stride - 1) / stride;
@@ -82,8 +86,8 @@ bool BallbarLengthModel::evaluate_subset(const Eigen::VectorXd& x, Eigen::Index 
     return true;
   }
   evaluate_with_jets(
-      [this, stride](Eigen::Index i, const auto* p, auto* out) { sample(i * stride, p, out); }, m, 1,
-      x, r, J);
+      [this, stride](Eigen::Index i, const auto* p, auto* out) { sample(i * stride, p, out); }, m,
+      1, x, r, J);
   return true;
 }
 
@@ -97,9 +101,12 @@ void BallbarLengthModel::evaluate_jets(const Eigen::VectorXd& x, Eigen::Ref<Eige
 bool BallbarLengthModel::analytic_supported(const EffectModel& fx) {
   int tool = 0, length = 0;
   for (const Effect& f : fx.effects) {
-    if (f.kind == EffectKind::tool_offset_Z) ++tool;
-    else if (f.kind == EffectKind::ballbar_length_offset) ++length;
-    else return false;
+    if (f.kind == EffectKind::tool_offset_Z)
+      ++tool;
+    else if (f.kind == EffectKind::ballbar_length_offset)
+      ++length;
+    else
+      return false;
   }
   return tool <= 1 && length <= 1;
 }
@@ -143,8 +150,9 @@ BallbarLengthModel::Chain<Lanes> BallbarLengthModel::in_lanes(const Chain<double
 // sample at a time on doubles, 1,804 Jacobian rows took 139 us, the largest part of a fit of
 // ballbar_ac_table2.csv). A short last block repeats its last sample in the unused lanes.
 template <typename SampleOf>
-void BallbarLengthModel::evaluate_rows(const Chain<double>& chain, Eigen::Index m, SampleOf sample_of,
-                                       Eigen::Ref<Eigen::VectorXd> r, Eigen::MatrixXd* J) const {
+void BallbarLengthModel::evaluate_rows(const Chain<double>& chain, Eigen::Index m,
+                                       SampleOf sample_of, Eigen::Ref<Eigen::VectorXd> r,
+                                       Eigen::MatrixXd* J) const {
   const Chain<Lanes> ch = in_lanes(chain);
   const int cols = num_parameters();
   JacobianLanes row;
@@ -152,7 +160,8 @@ void BallbarLengthModel::evaluate_rows(const Chain<double>& chain, Eigen::Index 
   for (Eigen::Index k0 = 0; k0 < m; k0 += Lanes::kSize) {
     const int count = static_cast<int>(std::min<Eigen::Index>(Lanes::kSize, m - k0));
     for (int l = 0; l < Lanes::kSize; ++l) idx[l] = sample_of(k0 + std::min(l, count - 1));
-    const Lanes rl = J ? analytic_lanes<true>(ch, idx, &row) : analytic_lanes<false>(ch, idx, nullptr);
+    const Lanes rl =
+        J ? analytic_lanes<true>(ch, idx, &row) : analytic_lanes<false>(ch, idx, nullptr);
     for (int l = 0; l < count; ++l) r[k0 + l] = rl[l];
     if (J)
       for (int c = 0; c < cols; ++c)
@@ -167,8 +176,10 @@ BallbarLengthModel::Chain<double> BallbarLengthModel::chain_at(const Eigen::Vect
   double tool_z = 0.0;
   for (std::size_t k = 0; k < fx_.effects.size(); ++k) {
     const int col = static_cast<int>(L_.effects.offset) + fx_.offset(k);
-    if (fx_.effects[k].kind == EffectKind::tool_offset_Z) tool_z += x[col], ch.tool_z_col = col;
-    else ch.length_offset = x[col], ch.length_col = col;
+    if (fx_.effects[k].kind == EffectKind::tool_offset_Z)
+      tool_z += x[col], ch.tool_z_col = col;
+    else
+      ch.length_offset = x[col], ch.length_col = col;
   }
   for (int k = 0; k < 2; ++k) {
     const AxisLine<double> L = axis_line(m, k, e);
@@ -189,8 +200,8 @@ BallbarLengthModel::Chain<double> BallbarLengthModel::chain_at(const Eigen::Vect
 // rule (see the class comment).
 template <bool WithJacobian>
 ROTACAL_FLATTEN Lanes BallbarLengthModel::analytic_lanes(const Chain<Lanes>& ch,
-                                                       const Eigen::Index (&idx)[Lanes::kSize],
-                                                       JacobianLanes* J) const {
+                                                         const Eigen::Index (&idx)[Lanes::kSize],
+                                                         JacobianLanes* J) const {
   using Row = Eigen::Matrix<Lanes, 1, 3>;
   Lanes cs[4], measured;
   Vec3<Lanes> xyz;
@@ -204,8 +215,8 @@ ROTACAL_FLATTEN Lanes BallbarLengthModel::analytic_lanes(const Chain<Lanes>& ch,
   LineRotationDerivatives<Lanes> D[2];
   const auto rotate = [&](int k, const Vec3<Lanes>& q) -> Vec3<Lanes> {
     if constexpr (WithJacobian)
-      return (D[k] = rotate_point_about_unit_line_derivatives<Lanes>(ch.point[k], ch.u[k], ch.inv_norm[k],
-                                                                     cs[2 * k], cs[2 * k + 1], q))
+      return (D[k] = rotate_point_about_unit_line_derivatives<Lanes>(
+                  ch.point[k], ch.u[k], ch.inv_norm[k], cs[2 * k], cs[2 * k + 1], q))
           .f;
     else
       return rotate_point_about_unit_line<Lanes>(ch.point[k], ch.u[k], cs[2 * k], cs[2 * k + 1], q);
@@ -253,7 +264,8 @@ ROTACAL_FLATTEN Lanes BallbarLengthModel::analytic_lanes(const Chain<Lanes>& ch,
 // L_model - L_measured of sample i, on double or Jets: the problem's one residual.
 template <typename T>
 void BallbarLengthModel::sample(Eigen::Index i, const T* p, T* out) const {
-  out[0] = ballbar_residual<T>(L_, d_, fx_, p, i, pivot_of_.empty() ? 0 : pivot_of_[static_cast<std::size_t>(i)]);
+  out[0] = ballbar_residual<T>(L_, d_, fx_, p, i,
+                               pivot_of_.empty() ? 0 : pivot_of_[static_cast<std::size_t>(i)]);
 }
 
 }  // namespace rotacal

@@ -28,18 +28,21 @@ class BallbarLengthModel : public ResidualModel {
  public:
   /// Throws InvalidArgument for a pivot per row that does not match the arrays, or an effect
   /// that needs the axes' motion when the arrays were built without it.
-  BallbarLengthModel(const BallbarArrays& d, const EffectModel& fx, std::vector<int> pivot_of_row = {},
-                     int pivots = 1);
+  BallbarLengthModel(const BallbarArrays& d, const EffectModel& fx,
+                     std::vector<int> pivot_of_row = {}, int pivots = 1);
   Eigen::Index num_residuals() const override { return d_.size(); }
   int num_parameters() const override { return static_cast<int>(L_.all.size()); }
   const BallbarLayout& layout() const { return L_; }
-  void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r, Eigen::MatrixXd* J) const override;
+  void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r,
+                Eigen::MatrixXd* J) const override;
   bool evaluate_subset(const Eigen::VectorXd& x, Eigen::Index stride, Eigen::VectorXd& r,
                        Eigen::MatrixXd* J) const override;
-  /// Whether the residuals and Jacobian come from the analytic path (tests compare it with the Jets).
+  /// Whether the residuals and Jacobian come from the analytic path (tests compare it with the
+  /// Jets).
   bool analytic() const { return analytic_; }
   /// The Jets' residuals and Jacobian, for that comparison.
-  void evaluate_jets(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r, Eigen::MatrixXd* J) const;
+  void evaluate_jets(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r,
+                     Eigen::MatrixXd* J) const;
 
  private:
   template <typename S>
@@ -51,14 +54,16 @@ class BallbarLengthModel : public ResidualModel {
   void commanded_sincos();
   static Chain<Lanes> in_lanes(const Chain<double>& c);
   template <typename SampleOf>
-  void evaluate_rows(const Chain<double>& chain, Eigen::Index m, SampleOf sample_of, Eigen::Ref<Eigen::VectorXd> r,
-                     Eigen::MatrixXd* J) const;
+  void evaluate_rows(const Chain<double>& chain, Eigen::Index m, SampleOf sample_of,
+                     Eigen::Ref<Eigen::VectorXd> r, Eigen::MatrixXd* J) const;
   Chain<double> chain_at(const Eigen::VectorXd& x) const;
   template <bool WithJacobian>
-  Lanes analytic_lanes(const Chain<Lanes>& ch, const Eigen::Index (&idx)[Lanes::kSize], JacobianLanes* J) const;
+  Lanes analytic_lanes(const Chain<Lanes>& ch, const Eigen::Index (&idx)[Lanes::kSize],
+                       JacobianLanes* J) const;
   template <typename T>
   void sample(Eigen::Index i, const T* p, T* out) const;
-  void evaluate_chain(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r, Eigen::MatrixXd& J) const;
+  void evaluate_chain(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r,
+                      Eigen::MatrixXd& J) const;
 
   const BallbarArrays& d_;
   const EffectModel& fx_;
@@ -66,7 +71,7 @@ class BallbarLengthModel : public ResidualModel {
   std::vector<int> pivot_of_;  // pivot of each row (empty: one pivot)
   bool analytic_;
   bool chain_;  // otherwise the Jacobian by the chain rule (length_chain.hpp) where it applies
-  int nt_;  // table axes: chain axes 0 .. nt_ - 1 carry the pivot, the others the tool
+  int nt_;      // table axes: chain axes 0 .. nt_ - 1 carry the pivot, the others the tool
   Eigen::Matrix<double, 4, Eigen::Dynamic> cs_;  // commanded_sincos
 };
 

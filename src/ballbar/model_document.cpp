@@ -14,10 +14,12 @@ json ballbar_model_document(const BallbarMachineModel& model) {
   json le = json::object();
   const auto& names = location_error_names(model.machine);
   for (int k = 0; k < 8; ++k)
-    le[names[k]] = {{"value", model.errors.v[k]}, {"unit", location_error_is_angle(k) ? "rad" : "mm"}};
+    le[names[k]] = {{"value", model.errors.v[k]},
+                    {"unit", location_error_is_angle(k) ? "rad" : "mm"}};
   doc["location_errors"] = le;
   doc["pivot"] = json::object();
-  for (int a = 0; a < 3; ++a) doc["pivot"][std::string(1, "xyz"[a])] = {{"value", model.pivot[a]}, {"unit", "mm"}};
+  for (int a = 0; a < 3; ++a)
+    doc["pivot"][std::string(1, "xyz"[a])] = {{"value", model.pivot[a]}, {"unit", "mm"}};
   json fx = json::array();
   std::size_t offset = 0;
   for (const Effect& e : model.effects.effects) {
@@ -26,7 +28,8 @@ json ballbar_model_document(const BallbarMachineModel& model) {
     const auto pu = e.param_units();
     for (std::size_t k = 0; k < pn.size(); ++k) {
       if (offset >= model.effect_params.size())
-        throw InvalidArgument("ballbar_model_document: effect_params has fewer values than the effects need");
+        throw InvalidArgument(
+            "ballbar_model_document: effect_params has fewer values than the effects need");
       params[pn[k]] = {{"value", model.effect_params[offset++]}, {"unit", pu[k]}};
     }
     fx.push_back({{"id", e.id()}, {"cause", e.cause()}, {"params", params}});
@@ -37,7 +40,8 @@ json ballbar_model_document(const BallbarMachineModel& model) {
 
 BallbarMachineModel ballbar_machine_model(const ModelFile& model) {
   if (model.kind != "ballbar" || !model.pivot)
-    throw InvalidArgument("ballbar_machine_model: a " + model.kind + " model is not a ballbar model");
+    throw InvalidArgument("ballbar_machine_model: a " + model.kind +
+                          " model is not a ballbar model");
   BallbarMachineModel m;
   m.machine = model.machine;
   m.errors = model.location_errors;

@@ -5,20 +5,22 @@
 #include <memory>
 
 #include "length_model.hpp"
+#include "rotacal/ballbar/simulate.hpp"
 #include "rotacal/core/monte_carlo.hpp"
 #include "rotacal/core/noise_handling.hpp"
-#include "rotacal/ballbar/simulate.hpp"
 
 namespace rotacal {
 
 BallbarMonteCarlo monte_carlo(const BallbarSession& session, const BallbarIdentification& result,
                               const BallbarMonteCarloOptions& o) {
   if (result.method != "joint")
-    throw InvalidArgument("monte_carlo: result: method '" + result.method + "' (only a joint fit is supported)");
+    throw InvalidArgument("monte_carlo: result: method '" + result.method +
+                          "' (only a joint fit is supported)");
   if (result.model.machine != session.machine)
     throw InvalidArgument("monte_carlo: result is for a " + to_string(result.model.machine) +
                           " but the session is for a " + to_string(session.machine));
-  if (o.draws < 2) throw InvalidArgument("monte_carlo: draws must be at least 2, got " + std::to_string(o.draws));
+  if (o.draws < 2)
+    throw InvalidArgument("monte_carlo: draws must be at least 2, got " + std::to_string(o.draws));
   if (!(o.noise_um >= 0.0) || !std::isfinite(o.noise_um))
     throw InvalidArgument("monte_carlo: noise_um must be finite and >= 0");
   JointFitOptions fit_options = o.fit;
@@ -33,7 +35,8 @@ BallbarMonteCarlo monte_carlo(const BallbarSession& session, const BallbarIdenti
   if (static_cast<std::size_t>(data.size()) != result.n_samples ||
       result.residuals.size() != session.samples.size())
     throw InvalidArgument("monte_carlo: result was fitted to " + std::to_string(result.n_samples) +
-                          " samples, the session (with fit.tests) has " + std::to_string(data.size()));
+                          " samples, the session (with fit.tests) has " +
+                          std::to_string(data.size()));
   const BallbarFitSetup setup = ballbar_fit_setup(data, fit_options);
   const int p = static_cast<int>(setup.parameters.size());
   if (static_cast<int>(result.parameters.size()) != p || result.jacobian.cols() != p)
@@ -43,7 +46,8 @@ BallbarMonteCarlo monte_carlo(const BallbarSession& session, const BallbarIdenti
   // The reference linearisation: the identified solution, its Jacobian and free set.
   JointFitOutcome reference;
   reference.values.resize(p);
-  for (int j = 0; j < p; ++j) reference.values[j] = result.parameters[static_cast<std::size_t>(j)].value;
+  for (int j = 0; j < p; ++j)
+    reference.values[j] = result.parameters[static_cast<std::size_t>(j)].value;
   reference.jacobian = result.jacobian;
   for (bool f : result.fixed) reference.free.push_back(!f);
   const JointRefitter refitter(reference, setup.parameters, setup.settings);
@@ -51,14 +55,16 @@ BallbarMonteCarlo monte_carlo(const BallbarSession& session, const BallbarIdenti
   const double noise_um = o.noise_um > 0.0 ? o.noise_um : result.sigma_um;
   const std::vector<double> truth_all = predict_lengths(result.model, session.samples);
   Eigen::VectorXd truth(data.size());
-  for (Eigen::Index k = 0; k < data.size(); ++k) truth[k] = truth_all[data.index[static_cast<std::size_t>(k)]];
+  for (Eigen::Index k = 0; k < data.size(); ++k)
+    truth[k] = truth_all[data.index[static_cast<std::size_t>(k)]];
   const BallbarLengthModel model(data, setup.effects);
 
   BallbarMonteCarlo out;
   out.draws = o.draws;
   out.noise_um = noise_um;
-  out.noise = o.noise ? "the caller's noise" : coloured ? "the fitted noise model: " + result.noise.summary()
-                                                       : "white noise";
+  out.noise = o.noise    ? "the caller's noise"
+              : coloured ? "the fitted noise model: " + result.noise.summary()
+                         : "white noise";
   out.values.resize(o.draws, p);
   Eigen::VectorXd noise(data.size());
   for (int k = 0; k < o.draws; ++k) {
@@ -69,9 +75,11 @@ BallbarMonteCarlo monte_carlo(const BallbarSession& session, const BallbarIdenti
       noise = monte_carlo_noise(true, result.noise, noise_um, data.size(), o.seed, k);
     } else {  // as simulate_ballbar(session, model, {noise_um, seed + k}) draws it: one value
               // per session sample, in order, of which the fitted samples are taken
-      const Eigen::VectorXd all = monte_carlo_noise(
-          false, result.noise, noise_um, static_cast<Eigen::Index>(session.samples.size()), o.seed, k);
-      for (Eigen::Index i = 0; i < data.size(); ++i) noise[i] = all[static_cast<Eigen::Index>(data.index[static_cast<std::size_t>(i)])];
+      const Eigen::VectorXd all =
+          monte_carlo_noise(false, result.noise, noise_um,
+                            static_cast<Eigen::Index>(session.samples.size()), o.seed, k);
+      for (Eigen::Index i = 0; i < data.size(); ++i)
+        noise[i] = all[static_cast<Eigen::Index>(data.index[static_cast<std::size_t>(i)])];
     }
     data.length = truth + noise;
     const JointRefitter::Result r = refitter.refit(model);

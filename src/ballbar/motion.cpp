@@ -23,14 +23,16 @@ double member(const RotaryAngles<double>& a, int k) { return k == 0 ? a.tilt : a
 //  - a gap between them (rows not on record, e.g. a transition left out): the axis is taken to
 //    have rested at a's angle and to have left it on b's line.
 // Kept within the two rows' times.
-double turning_time(const std::vector<BallbarSample>& s, const std::vector<RotaryAngles<double>>& angle,
+double turning_time(const std::vector<BallbarSample>& s,
+                    const std::vector<RotaryAngles<double>>& angle,
                     const std::vector<RotaryMotion>& m, std::size_t b, int k) {
   const std::size_t a = b - 1;
   const double ra = member(m[a].rate, k), rb = member(m[b].rate, k);
   const double ta = s[a].time, tb = s[b].time;
   double spacing = 0.0;  // the rows' own spacing on either side
   if (a > 0 && s[a - 1].test == s[a].test) spacing = std::max(spacing, ta - s[a - 1].time);
-  if (b + 1 < s.size() && s[b + 1].test == s[b].test) spacing = std::max(spacing, s[b + 1].time - tb);
+  if (b + 1 < s.size() && s[b + 1].test == s[b].test)
+    spacing = std::max(spacing, s[b + 1].time - tb);
   const bool adjacent = spacing > 0.0 && tb - ta <= 1.5 * spacing;
   const double Aa = member(angle[a], k), Ab = member(angle[b], k);
   const double t = adjacent ? (Ab - Aa + ra * ta - rb * tb) / (ra - rb) : tb - (Ab - Aa) / rb;
@@ -53,7 +55,8 @@ std::vector<RotaryMotion> rotary_motion(const std::vector<BallbarSample>& sample
       const std::size_t lo = i > a ? i - 1 : i, hi = i + 1 < b ? i + 1 : i;
       const double dt = samples[hi].time - samples[lo].time;
       for (int k = 0; k < 2; ++k)
-        member(out[i].rate, k) = hi > lo && dt > 0.0 ? (member(angle[hi], k) - member(angle[lo], k)) / dt : 0.0;
+        member(out[i].rate, k) =
+            hi > lo && dt > 0.0 ? (member(angle[hi], k) - member(angle[lo], k)) / dt : 0.0;
     }
     a = b;
   }
@@ -69,8 +72,9 @@ std::vector<RotaryMotion> rotary_motion(const std::vector<BallbarSample>& sample
         last = s;
       }
       member(out[i].direction, k) = last;
-      member(out[i].since_reversal, k) =
-          std::isnan(reversal_time) ? std::numeric_limits<double>::infinity() : samples[i].time - reversal_time;
+      member(out[i].since_reversal, k) = std::isnan(reversal_time)
+                                             ? std::numeric_limits<double>::infinity()
+                                             : samples[i].time - reversal_time;
     }
   }
   return out;

@@ -34,7 +34,10 @@ bool same_pose(const Commanded& a, const PlannedSample& b) {
 class Writer {
  public:
   Writer(const BallbarPlan& plan, NcDialect d, const NcProgramOptions& o)
-      : plan_(plan), d_(d), o_(o), tilt_(1, tilt_axis_letter(plan.setup.machine)),
+      : plan_(plan),
+        d_(d),
+        o_(o),
+        tilt_(1, tilt_axis_letter(plan.setup.machine)),
         rot_(1, rot_axis_letter(plan.setup.machine)),
         zero_shift_(-tool_vector<double>(plan.setup.machine, 0.0)) {}
 
@@ -87,7 +90,8 @@ class Writer {
   }
 
   std::string feed_word(double dt_s) const {
-    if (d_ == NcDialect::heidenhain) return "F" + fixed(plan_.setup.feed_mm_per_min * feed_factor_, 0);
+    if (d_ == NcDialect::heidenhain)
+      return "F" + fixed(plan_.setup.feed_mm_per_min * feed_factor_, 0);
     return "F" + fixed(60.0 / dt_s, 4);  // G93: reciprocal of the block time in minutes
   }
 
@@ -95,9 +99,10 @@ class Writer {
   // successive samples share a time is refused rather than written with an infinite feed.
   static void require_positive_time(double dt, double t) {
     if (!(dt > 0.0) || !std::isfinite(dt))
-      throw InvalidArgument("write_nc_program: the move ending at t = " + std::to_string(t) +
-                            " s takes no time (samples coincide in time: a plan with coordinates too "
-                            "large or steps too small for the feeds)");
+      throw InvalidArgument(
+          "write_nc_program: the move ending at t = " + std::to_string(t) +
+          " s takes no time (samples coincide in time: a plan with coordinates too "
+          "large or steps too small for the feeds)");
   }
 
   const PlannedSample* first_sample() const {
@@ -148,7 +153,8 @@ class Writer {
     const char* centre_names = "IJK";
     // At rotary zero machine and table frames coincide (rotations by 0 for any errors), so the
     // planned arc, shifted by the tool vector on a head machine, is the machine-axis arc.
-    ROTACAL_ASSERT((cur.xyz - (a.start + zero_shift_)).norm() < kSamePose && cur.tilt == 0.0 && cur.rot == 0.0);
+    ROTACAL_ASSERT((cur.xyz - (a.start + zero_shift_)).norm() < kSamePose && cur.tilt == 0.0 &&
+                   cur.rot == 0.0);
     const Eigen::Vector3d e = a.end + zero_shift_, centre = a.center + zero_shift_;
     const double dt = t_end - cur.time;
     require_positive_time(dt, t_end);
@@ -205,7 +211,8 @@ class Writer {
       std::string runs;
       for (SweepDirection d : s.directions) runs += (runs.empty() ? "" : ", ") + to_string(d);
       std::string feeds;
-      for (double k : s.feed_factors) feeds += (feeds.empty() ? "" : ", ") + general(s.feed_mm_per_min * k);
+      for (double k : s.feed_factors)
+        feeds += (feeds.empty() ? "" : ", ") + general(s.feed_mm_per_min * k);
       comment("each rotary test runs " + runs + " at " + feeds + " mm/min (labels _cw, _f<feed>)");
     }
     comment(tilt_ + " range: " + general(s.tilt_range_deg[0]) + " .. " +
@@ -240,8 +247,9 @@ class Writer {
     else
       comment("coordinates: machine axes of the tool-cup ball centre - rotacal inverse kinematics");
     if (md.has_head() && !is_tcp_dialect())
-      comment("the head's pivot_length + tool_length is in the coordinates: no tool length "
-              "compensation (G49) in this program");
+      comment(
+          "the head's pivot_length + tool_length is in the coordinates: no tool length "
+          "compensation (G49) in this program");
     else if (o_.tool > 0)
       comment("tool " + std::to_string(o_.tool) + ": ballbar tool cup, length to its ball centre");
     comment("every feed block turns a rotary axis by at most " + general(s.step_deg) +
@@ -252,7 +260,8 @@ class Writer {
 
   void prologue() {
     nc_detail::write_preamble(
-        d_, o_, {"write_nc_program", "TCP program", "ROTACAL BALLBAR", plan_.setup.machine.has_head()},
+        d_, o_,
+        {"write_nc_program", "TCP program", "ROTACAL BALLBAR", plan_.setup.machine.has_head()},
         [this](const std::string& s) { line(s); }, [this] { header(); });
   }
 
@@ -337,9 +346,10 @@ std::string write_nc_program(const BallbarPlan& plan, NcDialect dialect,
   for (const PlanSegment& seg : plan.segments)
     for (const PlannedSample& s : seg.samples)
       if (!s.xyz.allFinite() || s.xyz.cwiseAbs().maxCoeff() > 1.0e5 || !std::isfinite(s.tilt_deg) ||
-          !std::isfinite(s.rot_deg) || std::abs(s.rot_deg) > 1.0e6 || std::abs(s.tilt_deg) > 360.0 ||
-          !std::isfinite(s.time))
-        throw InvalidArgument("write_nc_program: a sample of " + seg.label + " at t = " + std::to_string(s.time) +
+          !std::isfinite(s.rot_deg) || std::abs(s.rot_deg) > 1.0e6 ||
+          std::abs(s.tilt_deg) > 360.0 || !std::isfinite(s.time))
+        throw InvalidArgument("write_nc_program: a sample of " + seg.label +
+                              " at t = " + std::to_string(s.time) +
                               " s has coordinates no machine can be sent to");
   return Writer(plan, dialect, options).run();
 }

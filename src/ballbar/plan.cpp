@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "rotacal/core/error.hpp"
 #include "plan_segments.hpp"
+#include "rotacal/core/error.hpp"
 
 namespace rotacal {
 
@@ -39,7 +39,8 @@ std::string test_label(BallbarTest test, MachineType machine) {
 }
 
 bool is_rotary_test(BallbarTest test) {
-  return test != BallbarTest::sphere_xy && test != BallbarTest::sphere_yz && test != BallbarTest::sphere_zx;
+  return test != BallbarTest::sphere_xy && test != BallbarTest::sphere_yz &&
+         test != BallbarTest::sphere_zx;
 }
 
 std::string run_label(BallbarTest test, SweepDirection direction, double feed_factor,
@@ -73,11 +74,10 @@ SweepDirection parse_sweep_direction(const std::string& text) {
 }
 
 BallbarTest parse_ballbar_test(const std::string& label, MachineType machine) {
-  static const BallbarTest all[] = {BallbarTest::sphere_xy,       BallbarTest::sphere_yz,
-                                    BallbarTest::sphere_zx,       BallbarTest::radial_tilt,
-                                    BallbarTest::axial_tilt,      BallbarTest::radial_c,
-                                    BallbarTest::axial_c,         BallbarTest::tangential_tilt,
-                                    BallbarTest::tangential_c};
+  static const BallbarTest all[] = {
+      BallbarTest::sphere_xy,   BallbarTest::sphere_yz,       BallbarTest::sphere_zx,
+      BallbarTest::radial_tilt, BallbarTest::axial_tilt,      BallbarTest::radial_c,
+      BallbarTest::axial_c,     BallbarTest::tangential_tilt, BallbarTest::tangential_c};
   std::string known;
   for (BallbarTest t : all) {
     if (test_label(t, machine) == label) return t;
@@ -140,7 +140,8 @@ BallbarPlan plan_ballbar_test(const BallbarSetup& setup,
   plan.compensation = identified;
 
   for (BallbarTest t : setup.tests) {
-    const std::vector<double> feeds = is_rotary_test(t) ? setup.feed_factors : std::vector<double>{1.0};
+    const std::vector<double> feeds =
+        is_rotary_test(t) ? setup.feed_factors : std::vector<double>{1.0};
     const std::vector<SweepDirection> dirs =
         is_rotary_test(t) ? setup.directions : std::vector<SweepDirection>{SweepDirection::ccw};
     for (double f : feeds) {
@@ -181,7 +182,8 @@ BallbarPlan plan_ballbar_test(const BallbarSetup& setup,
         s.time = 0.0;
       } else {
         // The move to a sample runs at the feeds of the segment the sample belongs to.
-        const double linear = (s.xyz - prev->xyz).norm() / (setup.feed_mm_per_min * seg.feed_factor);
+        const double linear =
+            (s.xyz - prev->xyz).norm() / (setup.feed_mm_per_min * seg.feed_factor);
         const double rotary =
             std::max(std::abs(s.tilt_deg - prev->tilt_deg), std::abs(s.rot_deg - prev->rot_deg)) /
             (setup.feed_deg_per_min * seg.feed_factor);

@@ -64,15 +64,19 @@ constexpr double kMaxPivot = 1.0e4;           // mm from the table origin
 constexpr double kMaxFeed = 1.0e6;            // mm/min and deg/min
 
 void validate(const BallbarSetup& s) {
-  require(std::isfinite(s.ballbar_length) && s.ballbar_length >= 1.0 && s.ballbar_length <= kMaxBallbarLength,
-          "ballbar_length (--length) must be within [1, 2000] mm, got " + format_number_or_nan(s.ballbar_length));
+  require(std::isfinite(s.ballbar_length) && s.ballbar_length >= 1.0 &&
+              s.ballbar_length <= kMaxBallbarLength,
+          "ballbar_length (--length) must be within [1, 2000] mm, got " +
+              format_number_or_nan(s.ballbar_length));
   require(finite3(s.pivot) && s.pivot.cwiseAbs().maxCoeff() <= kMaxPivot,
           "pivot (--pivot) must be finite and within 10000 mm of the table origin");
   require(std::isfinite(s.step_deg) && s.step_deg > 0.0 && s.step_deg <= 90.0,
           "step_deg (--step) must be in (0, 90] deg");
-  require(std::isfinite(s.feed_mm_per_min) && s.feed_mm_per_min > 0.0 && s.feed_mm_per_min <= kMaxFeed,
-          "feed_mm_per_min (--feed) must be in (0, 1e6] mm/min");
-  require(std::isfinite(s.feed_deg_per_min) && s.feed_deg_per_min > 0.0 && s.feed_deg_per_min <= kMaxFeed,
+  require(
+      std::isfinite(s.feed_mm_per_min) && s.feed_mm_per_min > 0.0 && s.feed_mm_per_min <= kMaxFeed,
+      "feed_mm_per_min (--feed) must be in (0, 1e6] mm/min");
+  require(std::isfinite(s.feed_deg_per_min) && s.feed_deg_per_min > 0.0 &&
+              s.feed_deg_per_min <= kMaxFeed,
           "feed_deg_per_min (--rotary-feed) must be in (0, 1e6] deg/min");
   check_range(s.tilt_range_deg, "tilt_range_deg (--a-range/--b-range)", s.step_deg);
   require(s.tilt_range_deg[0] >= -180.0 && s.tilt_range_deg[1] <= 180.0,
@@ -88,12 +92,14 @@ void validate(const BallbarSetup& s) {
     if (lim)
       require(lo >= (*lim)[0] - kAngleTol && hi <= (*lim)[1] + kAngleTol,
               what + " reaches " + std::string(1, d.axis(k).name) + " beyond its limits [" +
-                  format_number_or_nan((*lim)[0]) + ", " + format_number_or_nan((*lim)[1]) + "] deg");
+                  format_number_or_nan((*lim)[0]) + ", " + format_number_or_nan((*lim)[1]) +
+                  "] deg");
   };
-  within(s.machine.tilt_index(), std::min(0.0, s.tilt_range_deg[0]), std::max(0.0, s.tilt_range_deg[1]),
+  within(s.machine.tilt_index(), std::min(0.0, s.tilt_range_deg[0]),
+         std::max(0.0, s.tilt_range_deg[1]),
          "tilt_range_deg (--a-range/--b-range) with the tests at tilt 0");
-  within(s.machine.rot_index(), std::min(0.0, s.rot_range_deg[0]), std::max(0.0, s.rot_range_deg[1]),
-         "rot_range_deg (--c-range) with the tests at 0");
+  within(s.machine.rot_index(), std::min(0.0, s.rot_range_deg[0]),
+         std::max(0.0, s.rot_range_deg[1]), "rot_range_deg (--c-range) with the tests at 0");
   require(!s.tests.empty(), "tests is empty");
   for (std::size_t i = 0; i < s.tests.size(); ++i)
     for (std::size_t j = 0; j < i; ++j)
@@ -101,7 +107,9 @@ void validate(const BallbarSetup& s) {
               "test " + test_label(s.tests[i], s.machine) + " is listed twice");
   for (BallbarTest t : s.tests)
     if (t == BallbarTest::tangential_tilt || t == BallbarTest::tangential_c)
-      require(!d.axis(t == BallbarTest::tangential_tilt ? s.machine.tilt_index() : s.machine.rot_index()).on_head,
+      require(!d.axis(t == BallbarTest::tangential_tilt ? s.machine.tilt_index()
+                                                        : s.machine.rot_index())
+                   .on_head,
               "test " + test_label(t, s.machine) +
                   " is planned for table axes only: a head axis turns the bar's direction with it");
   require(!s.directions.empty(), "directions (--directions) is empty");
@@ -110,7 +118,8 @@ void validate(const BallbarSetup& s) {
       require(s.directions[i] != s.directions[j],
               "direction " + to_string(s.directions[i]) + " is listed twice (--directions)");
   require(!s.feed_factors.empty() && s.feed_factors[0] == 1.0,
-          "feed_factors (--feed-factors) must start with 1: the first run of a test is at the set-up's feeds");
+          "feed_factors (--feed-factors) must start with 1: the first run of a test is at the "
+          "set-up's feeds");
   for (std::size_t i = 0; i < s.feed_factors.size(); ++i) {
     const double k = s.feed_factors[i];
     require(std::isfinite(k) && k > 0.0 && k <= 100.0 && k * s.feed_mm_per_min <= kMaxFeed &&
@@ -159,7 +168,9 @@ Eigen::Vector3d fixed_tool_point(const BallbarSetup& s, BallbarTest t) {
   switch (t) {
     case BallbarTest::radial_tilt:
     case BallbarTest::radial_c:
-      return p + sign * L * (axis.on_head ? head_radial_direction(axis) : radial_direction(p, axis, label));
+      return p +
+             sign * L *
+                 (axis.on_head ? head_radial_direction(axis) : radial_direction(p, axis, label));
     case BallbarTest::axial_tilt:
     case BallbarTest::axial_c:
       return p + L * axis.direction;
@@ -181,7 +192,8 @@ PlannedSample make_sample(const Eigen::Vector3d& p_table, double tilt_deg, doubl
   return s;
 }
 
-PlanSegment make_test(const BallbarSetup& s, BallbarTest t, SweepDirection direction, double feed_factor) {
+PlanSegment make_test(const BallbarSetup& s, BallbarTest t, SweepDirection direction,
+                      double feed_factor) {
   PlanSegment seg;
   seg.label = run_label(t, direction, feed_factor, s);
   seg.kind = SegmentKind::test;
@@ -218,7 +230,9 @@ PlanSegment make_test(const BallbarSetup& s, BallbarTest t, SweepDirection direc
     case BallbarTest::axial_c:
     case BallbarTest::tangential_c: {
       const Eigen::Vector3d q = fixed_tool_point(s, t);
-      const double tilt = t == BallbarTest::axial_c ? s.axial_c_tilt_deg.value_or(default_axial_c_tilt_deg(s.machine)) : 0.0;
+      const double tilt = t == BallbarTest::axial_c
+                              ? s.axial_c_tilt_deg.value_or(default_axial_c_tilt_deg(s.machine))
+                              : 0.0;
       for (double a : sweep(s.rot_range_deg[0], s.rot_range_deg[1], s.step_deg))
         seg.samples.push_back(make_sample(q, tilt, a));
       break;

@@ -19,7 +19,8 @@ void require(bool ok, const std::string& what);
 std::string format_number_or_nan(double v);
 
 void validate(const BallbarSetup& s);
-PlanSegment make_test(const BallbarSetup& s, BallbarTest t, SweepDirection direction, double feed_factor);
+PlanSegment make_test(const BallbarSetup& s, BallbarTest t, SweepDirection direction,
+                      double feed_factor);
 // The moves from the last sample of one test to the first sample of the next, in order; every
 // one keeps the tool at L0 from the pivot. The last move stops short of `to`, which is the
 // next test's first sample.

@@ -6,14 +6,16 @@
 namespace rotacal {
 
 BallbarLayout ballbar_layout(MachineType m, const EffectModel& fx, int pivots) {
-  if (pivots < 1) throw InvalidArgument("ballbar_layout: pivots is " + std::to_string(pivots) + ", must be >= 1");
+  if (pivots < 1)
+    throw InvalidArgument("ballbar_layout: pivots is " + std::to_string(pivots) + ", must be >= 1");
   BallbarLayout L;
   L.errors = add_location_errors(L.all, m);
   std::vector<std::string> names;
   const char* axis = "xyz";
   for (int s = 0; s < pivots; ++s)
     for (int k = 0; k < 3; ++k)
-      names.push_back(std::string("pivot_") + axis[k] + (pivots > 1 ? "#" + std::to_string(s + 1) : ""));
+      names.push_back(std::string("pivot_") + axis[k] +
+                      (pivots > 1 ? "#" + std::to_string(s + 1) : ""));
   L.pivots = L.all.add("pivot", std::move(names), {"mm"}, 3);
   L.effects = add_effects(L.all, fx);
   return L;
@@ -23,7 +25,8 @@ BallbarFitSetup ballbar_fit_setup(const BallbarArrays& data, const JointFitOptio
   BallbarFitSetup out;
   EffectModel& fx = out.effects;
   fx = options.effects;
-  if (!fx.linear_reference && data.size() > 0) fx.linear_reference = Eigen::Vector3d(data.xyz.rowwise().mean());
+  if (!fx.linear_reference && data.size() > 0)
+    fx.linear_reference = Eigen::Vector3d(data.xyz.rowwise().mean());
   if (options.fit_length_offset)
     fx.effects.insert(fx.effects.begin(), Effect::parse("ballbar_length_offset"));
   // On a machine with head axes the ball's distance from the controlled point,
@@ -40,14 +43,16 @@ BallbarFitSetup ballbar_fit_setup(const BallbarArrays& data, const JointFitOptio
   const BallbarLayout& L = out.layout;
   if (static_cast<Eigen::Index>(data.size()) < L.all.size())
     throw InvalidArgument("identify_joint: " + std::to_string(data.size()) +
-                          " samples cannot determine " + std::to_string(L.all.size()) + " unknowns");
+                          " samples cannot determine " + std::to_string(L.all.size()) +
+                          " unknowns");
   // Names, units and start values of the unknowns, in Jacobian column order: zero errors and
   // the nominal pivot.
   const std::vector<std::string> names = L.all.names(), units = L.all.units();
   std::vector<FitParameter>& params = out.parameters;
   for (Eigen::Index j = 0; j < L.all.size(); ++j) {
     const std::size_t k = static_cast<std::size_t>(j);
-    params.push_back({names[k], units[k], L.pivots.contains(j) ? data.pivot[j - L.pivots.offset] : 0.0});
+    params.push_back(
+        {names[k], units[k], L.pivots.contains(j) ? data.pivot[j - L.pivots.offset] : 0.0});
   }
   // Catalogue effects yield to the baseline where they share directions with it
   // (core/yield_convention.hpp); the head's tool length is part of the baseline.
@@ -64,7 +69,8 @@ BallbarFitSetup ballbar_fit_setup(const BallbarArrays& data, const JointFitOptio
   return out;
 }
 
-BallbarMachineModel ballbar_model_at(const BallbarFitSetup& setup, MachineType m, const Eigen::VectorXd& x) {
+BallbarMachineModel ballbar_model_at(const BallbarFitSetup& setup, MachineType m,
+                                     const Eigen::VectorXd& x) {
   const BallbarLayout& L = setup.layout;
   BallbarMachineModel out;
   out.machine = m;

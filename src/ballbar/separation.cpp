@@ -1,15 +1,16 @@
 // The ballbar's candidates for the design engine (design/separation.hpp): the added tests
 // that may separate two effects after a session, and the joint fit of several sessions.
+#include "rotacal/design/separation.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 
 #include "length_model.hpp"
-#include "rotacal/design/format.hpp"
 #include "rotacal/ballbar/design.hpp"
 #include "rotacal/ballbar/problem.hpp"
 #include "rotacal/core/error.hpp"
-#include "rotacal/design/separation.hpp"
+#include "rotacal/design/format.hpp"
 
 namespace rotacal {
 
@@ -56,7 +57,8 @@ std::vector<std::pair<BallbarSetup, bool>> separating_setups(const BallbarSessio
   if (motion_pair)
     for (double L : o.bar_lengths_mm)
       for (BallbarTest t : {BallbarTest::tangential_c, BallbarTest::tangential_tilt})
-        for (const std::vector<double>& feeds : {std::vector<double>{1.0}, std::vector<double>{1.0, 2.0}}) {
+        for (const std::vector<double>& feeds :
+             {std::vector<double>{1.0}, std::vector<double>{1.0, 2.0}}) {
           BallbarSetup s = base;
           s.ballbar_length = L;
           s.pivot = session.pivot;
@@ -96,7 +98,9 @@ std::string describe(const SeparatingCandidate& c, MachineType m) {
                          c.setup.tests.back() == BallbarTest::axial_tilt ||
                          c.setup.tests.back() == BallbarTest::tangential_tilt;
   d << label;
-  if (tilt_test) d << " over " << fixed_text(c.setup.tilt_range_deg[0], 0) << ".." << fixed_text(c.setup.tilt_range_deg[1], 0) << " deg";
+  if (tilt_test)
+    d << " over " << fixed_text(c.setup.tilt_range_deg[0], 0) << ".."
+      << fixed_text(c.setup.tilt_range_deg[1], 0) << " deg";
   if (c.setup.tests.back() == BallbarTest::radial_c)
     d << " (tool circle " << to_string(c.setup.radial_c_side) << ")";
   if (c.setup.directions.size() > 1) d << " ccw and cw";
@@ -115,7 +119,6 @@ std::string describe(const SeparatingCandidate& c, MachineType m) {
   if (c.slow_down > 1.0) d << ", at 1/" << fixed_text(c.slow_down, 0) << " of the feeds";
   return d.str();
 }
-
 
 // Sessions back to back as one set of arrays, and the pivot of each row (session s has pivot
 // pivot_of[s]): the ballbar problem's model over several set-ups.
@@ -144,7 +147,8 @@ Sessions back_to_back(const std::vector<BallbarArrays>& d, const std::vector<int
     a.angles.insert(a.angles.end(), b.angles.begin(), b.angles.end());
     a.motion.insert(a.motion.end(), b.motion.begin(), b.motion.end());
     a.test.insert(a.test.end(), b.test.begin(), b.test.end());
-    out.pivot_of_row.insert(out.pivot_of_row.end(), static_cast<std::size_t>(b.size()), pivot_of[s]);
+    out.pivot_of_row.insert(out.pivot_of_row.end(), static_cast<std::size_t>(b.size()),
+                            pivot_of[s]);
     row += b.size();
   }
   out.pivots = *std::max_element(pivot_of.begin(), pivot_of.end()) + 1;
@@ -201,17 +205,19 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session,
   fo.effects = fx;
   fo.noise = NoiseHandling::white;
   const BallbarIdentification id = identify_joint(session, fo);
-  const double w = session_weight(o.noise_um, id.noise, id.sigma_um,
-                                  "design: --after: the session's residuals are zero (commanded data?); give --noise", D);
+  const double w = session_weight(
+      o.noise_um, id.noise, id.sigma_um,
+      "design: --after: the session's residuals are zero (commanded data?); give --noise", D);
   const BallbarLayout L = ballbar_layout(m, fx);
   ParameterLayout joint = L.all;
-  const ParameterBlock moved_pivot = joint.add("pivot#2", {"pivot_x#2", "pivot_y#2", "pivot_z#2"}, {"mm"});
+  const ParameterBlock moved_pivot =
+      joint.add("pivot#2", {"pivot_x#2", "pivot_y#2", "pivot_z#2"}, {"mm"});
   D.names = L.all.names();
   // The Jacobian at the start point, where the fit judges what it can see (at its solution,
   // location errors of 0.1 mm lend second-order sensitivity that the fit does not use).
-  const SeparationProblem S = separation_problem(nominal_jacobian(session, fx), w, joint, effect_block(L.effects, fx, 0),
-                                                 effect_block(L.effects, fx, 1), o.max_correlation,
-                                                 o.max_added_time_s, D);
+  const SeparationProblem S =
+      separation_problem(nominal_jacobian(session, fx), w, joint, effect_block(L.effects, fx, 0),
+                         effect_block(L.effects, fx, 1), o.max_correlation, o.max_added_time_s, D);
   const bool search = separation_needed(S, D);
   D.chosen.correlation = D.correlation_before;
   if (!search) return D;
@@ -254,8 +260,8 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session,
     chosen.description = describe(chosen, m);
     if (chosen.new_pivot) added_names = moved_pivot.names;
   }
-  finish_separation(S, c, D.chosen.description, D.chosen.duration_s * D.chosen.slow_down, added_names,
-                    SeparationWording{}, D);
+  finish_separation(S, c, D.chosen.description, D.chosen.duration_s * D.chosen.slow_down,
+                    added_names, SeparationWording{}, D);
   return D;
 }
 
@@ -290,7 +296,8 @@ JointFitOutcome identify_joint_sessions(const std::vector<BallbarSession>& sessi
   for (Eigen::Index j = 0; j < L.all.size(); ++j) {
     const std::size_t k = static_cast<std::size_t>(j);
     const Eigen::Index c = j - L.pivots.offset;
-    params.push_back({names[k], units[k], L.pivots.contains(j) ? pivots[static_cast<std::size_t>(c / 3)][c % 3] : 0.0});
+    params.push_back({names[k], units[k],
+                      L.pivots.contains(j) ? pivots[static_cast<std::size_t>(c / 3)][c % 3] : 0.0});
   }
   JointFitSettings settings;
   settings.sigma = sessions.front().noise_um.value_or(1.0) * 1e-3;

@@ -31,9 +31,11 @@ BallbarSession simulate_ballbar(const BallbarSession& commanded, const BallbarMa
     throw InvalidArgument("noise_um must be finite and >= 0");
   for (const Effect& f : truth.effects.effects)
     if (!f.applies_to(truth.machine))
-      throw InvalidArgument("effect " + f.id() + " does not exist on a " + to_string(truth.machine));
+      throw InvalidArgument("effect " + f.id() + " does not exist on a " +
+                            to_string(truth.machine));
   BallbarSession out = commanded;
-  const std::vector<double> L = predict_lengths(truth, commanded.samples);  // about the session's mean
+  const std::vector<double> L =
+      predict_lengths(truth, commanded.samples);  // about the session's mean
   std::mt19937_64 rng(options.seed);
   std::normal_distribution<double> noise(0.0, options.noise_um * 1e-3);
   for (std::size_t i = 0; i < L.size(); ++i)

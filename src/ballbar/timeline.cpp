@@ -37,7 +37,8 @@ ProgramTimeline::ProgramTimeline(const BallbarPlan& plan) {
   for (std::size_t i = 1; i < n; ++i) {
     const double dt = points_[i].time - points_[i - 1].time;
     const RotaryAngles<double> a = points_[i - 1].angles_rad(), b = points_[i].angles_rad();
-    RotaryAngles<double> rate{dt > 0.0 ? (b.tilt - a.tilt) / dt : 0.0, dt > 0.0 ? (b.rot - a.rot) / dt : 0.0};
+    RotaryAngles<double> rate{dt > 0.0 ? (b.tilt - a.tilt) / dt : 0.0,
+                              dt > 0.0 ? (b.rot - a.rot) / dt : 0.0};
     for (double* r : {&rate.tilt, &rate.rot}) {
       const bool tilt = r == &rate.tilt;
       double& d = tilt ? last.tilt : last.rot;
@@ -88,8 +89,9 @@ BallbarSample ProgramTimeline::at(double t) const {
   s.length = header_.ballbar_length;
   // Between two points of one test, or from the end of one run into the next run that
   // continues from it with no transition between (a cw run after its ccw one): that test.
-  const bool same_test = b.test != "transition" && (segment_[i - 1] == segment_[i] ||
-                                                    (segment_[i - 1] + 1 == segment_[i] && a.test != "transition"));
+  const bool same_test =
+      b.test != "transition" && (segment_[i - 1] == segment_[i] ||
+                                 (segment_[i - 1] + 1 == segment_[i] && a.test != "transition"));
   s.test = w == 0.0 ? a.test : same_test ? b.test : "transition";
   return s;
 }

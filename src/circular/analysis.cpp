@@ -178,10 +178,11 @@ CircularAnalysis analyze_circular(const BallbarSession& session) {
   std::vector<Points2> points;
   for (const CircularRunData& r : runs) {
     if (!(r.span_deg() >= kMinCircularSpanDeg))
-      throw InvalidArgument("test " + r.label + ": its data arc spans " + std::to_string(r.span_deg()).substr(0, 6) +
-                            " deg; an arc shorter than " + std::to_string(static_cast<int>(kMinCircularSpanDeg)) +
-                            " deg cannot determine the circle's centre (ISO 230-4: a full circle, or a partial "
-                            "arc of a few tens of degrees at least)");
+      throw InvalidArgument(
+          "test " + r.label + ": its data arc spans " + std::to_string(r.span_deg()).substr(0, 6) +
+          " deg; an arc shorter than " + std::to_string(static_cast<int>(kMinCircularSpanDeg)) +
+          " deg cannot determine the circle's centre (ISO 230-4: a full circle, or a partial "
+          "arc of a few tens of degrees at least)");
     points.push_back(run_points(r, L0));
     const RadialFit f = lsq_circle(points.back(), "test " + r.label);
     const std::vector<double> rad = radial(points.back(), f);

@@ -123,14 +123,15 @@ CircularPlanResult plan_circular_test(const CircularTestPlan& plan) {
       std::set<CircularPlane>(plan.planes.begin(), plan.planes.end()).size() == plan.planes.size(),
       "planes: a plane is repeated");
   require_plan(std::set<CircularDirection>(plan.directions.begin(), plan.directions.end()).size() ==
-              plan.directions.size(),
-          "directions: a direction is repeated");
+                   plan.directions.size(),
+               "directions: a direction is repeated");
   for (double f : plan.feeds_mm_per_min)
     require_plan(std::isfinite(f) && f > 0.0 && f <= 1e5,
                  "feeds_mm_per_min: each feed must be in (0, 100000] mm/min, got " + general(f));
-  require_plan(std::set<double>(plan.feeds_mm_per_min.begin(), plan.feeds_mm_per_min.end()).size() ==
-              plan.feeds_mm_per_min.size(),
-          "feeds_mm_per_min: a feed is repeated");
+  require_plan(
+      std::set<double>(plan.feeds_mm_per_min.begin(), plan.feeds_mm_per_min.end()).size() ==
+          plan.feeds_mm_per_min.size(),
+      "feeds_mm_per_min: a feed is repeated");
   require_plan(std::isfinite(plan.span_deg) && plan.span_deg > 0.0 && plan.span_deg <= 360.0,
                "span_deg must be in (0, 360], got " + general(plan.span_deg));
   require_plan(std::isfinite(plan.start_deg) && std::abs(plan.start_deg) <= 3600.0,

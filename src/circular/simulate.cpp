@@ -73,10 +73,10 @@ Eigen::Vector3d geometric(const LinearAxisErrors& e, const Eigen::Vector3d& a,
 void check_circular_simulation(const CircularSimulationOptions& o) {
   const LinearAxisErrors& e = o.errors;
   check_sim(e.squareness.allFinite() && e.scale.allFinite() && e.straightness.allFinite() &&
-            e.backlash.allFinite() && e.spike.allFinite() && e.spike_tau.allFinite() &&
-            e.servo_tau.allFinite() && e.cyclic_cos.allFinite() && e.cyclic_sin.allFinite() &&
-            e.screw_pitch.allFinite(),
-        "errors: every value must be finite");
+                e.backlash.allFinite() && e.spike.allFinite() && e.spike_tau.allFinite() &&
+                e.servo_tau.allFinite() && e.cyclic_cos.allFinite() && e.cyclic_sin.allFinite() &&
+                e.screw_pitch.allFinite(),
+            "errors: every value must be finite");
   check_sim(e.straightness.diagonal().isZero(0.0),
             "errors.straightness: the diagonal (an axis' error along itself) must be 0");
   check_sim((e.screw_pitch.array() > 0.0).all(), "errors.screw_pitch must be positive");
@@ -91,7 +91,6 @@ void check_circular_simulation(const CircularSimulationOptions& o) {
             "noise_um must be in [0, 1000]");
   check_sim(std::isfinite(o.noise_rho) && o.noise_rho >= 0.0 && o.noise_rho < 1.0,
             "noise_rho must be in [0, 1)");
-
 }
 
 // Reading (mm, noise-free) of the bar on the plan's machine: ball at actual axes `a`.
@@ -138,7 +137,8 @@ BallbarSession simulate_circular(const CircularPlanResult& plan,
     for (std::size_t i = 0; i < session.samples.size(); ++i)
       session.samples[i].length += n[static_cast<Eigen::Index>(i)];
   }
-  if (o.noise_um > 0.0) session.noise_um = o.noise_um;  // noiseless: none declared (a 1-sigma of 0 is refused)
+  if (o.noise_um > 0.0)
+    session.noise_um = o.noise_um;  // noiseless: none declared (a 1-sigma of 0 is refused)
   return session;
 }
 

@@ -55,8 +55,8 @@ BallbarSample CircularTimeline::at(double t) const {
   BallbarSample s;
   s.test = p.on_data ? r.label : "transition";
   s.time = t;
-  s.xyz = circular_point(plan_.plan, r.plane, p.angle_deg) -
-          tool_vector<double>(header_.machine, 0.0);
+  s.xyz =
+      circular_point(plan_.plan, r.plane, p.angle_deg) - tool_vector<double>(header_.machine, 0.0);
   s.length = header_.ballbar_length;
   return s;
 }

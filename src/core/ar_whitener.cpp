@@ -1,13 +1,12 @@
 // The exact AR prewhitener of a noise model (noise_model.hpp), its inverse covariance and
 // Gram matrix, the AR(1) + random-walk filter, and the AR autocovariance of a stream.
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/Cholesky>
-
+#include "levinson.hpp"
 #include "rotacal/core/error.hpp"
 #include "rotacal/core/noise_model.hpp"
-#include "levinson.hpp"
 
 namespace rotacal {
 
@@ -43,11 +42,13 @@ Eigen::MatrixXd stream_covariance(const NoiseStream& s) {
   Eigen::MatrixXd C(n, n);
   for (Eigen::Index i = 0; i < n; ++i)
     for (Eigen::Index j = 0; j < n; ++j)
-      C(i, j) = g[static_cast<std::size_t>(std::abs(i - j))] + q2 * static_cast<double>(std::min(i, j));
+      C(i, j) =
+          g[static_cast<std::size_t>(std::abs(i - j))] + q2 * static_cast<double>(std::min(i, j));
   return C;
 }
 
-ArWalkFilter::ArWalkFilter(std::size_t n, double marginal_var, double rho, double step_var) : rho_(rho) {
+ArWalkFilter::ArWalkFilter(std::size_t n, double marginal_var, double rho, double step_var)
+    : rho_(rho) {
   if (!(marginal_var > 0.0) || !(step_var >= 0.0) || !(std::abs(rho) < 1.0))
     throw InvalidArgument("ArWalkFilter: needs marginal_var > 0, step_var >= 0 and |rho| < 1");
   gain_a_.resize(n), gain_w_.resize(n), inv_sd_.resize(n);
@@ -67,7 +68,8 @@ ArWalkFilter::ArWalkFilter(std::size_t n, double marginal_var, double rho, doubl
   }
 }
 
-void ArWalkFilter::apply(const std::vector<Eigen::Index>& rows, Eigen::Ref<Eigen::MatrixXd> columns) const {
+void ArWalkFilter::apply(const std::vector<Eigen::Index>& rows,
+                         Eigen::Ref<Eigen::MatrixXd> columns) const {
   const std::size_t n = inv_sd_.size();
   if (rows.size() != n) throw InvalidArgument("ArWalkFilter::apply: rows and filter sizes differ");
   // Four columns at a time, interleaved: each column's arithmetic and its order are those
@@ -118,8 +120,9 @@ ArWhitener::ArWhitener(const NoiseModel& model, double residual_unit_mm) : n_(mo
     }
     if (s.random_walk_step_um > 0.0 && !s.rows.empty() && s.order() <= 1) {
       const double u2 = residual_unit_mm * residual_unit_mm;
-      w.walk.emplace_back(s.rows.size(), std::max(std::pow(s.marginal_sigma_um * 1e-3, 2) / u2, 1e-300),
-                          s.order() == 1 ? s.reflection[0] : 0.0, std::pow(s.random_walk_step_um * 1e-3, 2) / u2);
+      w.walk.emplace_back(
+          s.rows.size(), std::max(std::pow(s.marginal_sigma_um * 1e-3, 2) / u2, 1e-300),
+          s.order() == 1 ? s.reflection[0] : 0.0, std::pow(s.random_walk_step_um * 1e-3, 2) / u2);
     } else if (s.random_walk_step_um > 0.0 && !s.rows.empty()) {
       const Eigen::MatrixXd C = stream_covariance(s) / (residual_unit_mm * residual_unit_mm);
       const Eigen::LLT<Eigen::MatrixXd> llt(C);
@@ -147,9 +150,11 @@ void ArWhitener::apply(Eigen::Ref<Eigen::MatrixXd> columns) const {
     if (s.chol.size() > 0) {
       // Dense: L^-1 x for every column at once (L L^T = the stream's covariance).
       block.resize(static_cast<Eigen::Index>(n), columns.cols());
-      for (std::size_t t = 0; t < n; ++t) block.row(static_cast<Eigen::Index>(t)) = columns.row(s.rows[t]);
+      for (std::size_t t = 0; t < n; ++t)
+        block.row(static_cast<Eigen::Index>(t)) = columns.row(s.rows[t]);
       s.chol.triangularView<Eigen::Lower>().solveInPlace(block);
-      for (std::size_t t = 0; t < n; ++t) columns.row(s.rows[t]) = block.row(static_cast<Eigen::Index>(t));
+      for (std::size_t t = 0; t < n; ++t)
+        columns.row(s.rows[t]) = block.row(static_cast<Eigen::Index>(t));
       continue;
     }
     if (p <= 1 && n > 0) {
@@ -192,7 +197,8 @@ bool ArWhitener::ar1_only() const {
 
 void ArWhitener::apply_inverse_covariance(Eigen::Ref<Eigen::MatrixXd> columns) const {
   if (!ar1_only())
-    throw InvalidArgument("ArWhitener::apply_inverse_covariance: needs AR order <= 1 without a random walk");
+    throw InvalidArgument(
+        "ArWhitener::apply_inverse_covariance: needs AR order <= 1 without a random walk");
   // V^-1 = W^T W of the start-up row e_0 = a x_0 and the rows e_t = b (x_t - phi x_{t-1})
   // (apply()) is tridiagonal per stream: diagonal a^2 + b^2 phi^2, b^2 (1 + phi^2), ..., b^2 and
   // -b^2 phi beside it. One pass per column (the candidates' products at rho 0.5 spent most of
@@ -207,7 +213,8 @@ void ArWhitener::apply_inverse_covariance(Eigen::Ref<Eigen::MatrixXd> columns) c
       continue;
     }
     const double b = s.inv_sd[1], phi = s.phi[1][0];
-    const double b2 = b * b, off = -b2 * phi, first = a * a + b2 * phi * phi, mid = b2 * (1.0 + phi * phi);
+    const double b2 = b * b, off = -b2 * phi, first = a * a + b2 * phi * phi,
+                 mid = b2 * (1.0 + phi * phi);
     for (Eigen::Index c = 0; c < columns.cols(); ++c) {
       double prev = 0.0;  // x_{t-1}, before its row was overwritten
       double x = columns(s.rows[0], c);
@@ -222,7 +229,8 @@ void ArWhitener::apply_inverse_covariance(Eigen::Ref<Eigen::MatrixXd> columns) c
   }
 }
 
-StreamLagProducts::StreamLagProducts(const Eigen::MatrixXd& J, std::vector<std::vector<Eigen::Index>> stream_rows)
+StreamLagProducts::StreamLagProducts(const Eigen::MatrixXd& J,
+                                     std::vector<std::vector<Eigen::Index>> stream_rows)
     : rows(std::move(stream_rows)) {
   const Eigen::Index p = J.cols();
   std::vector<char> covered(static_cast<std::size_t>(J.rows()), 0);
@@ -237,8 +245,10 @@ StreamLagProducts::StreamLagProducts(const Eigen::MatrixXd& J, std::vector<std::
     S.push_back(block.transpose() * block);
     U.push_back(m > 1 ? Eigen::MatrixXd(block.bottomRows(m - 1).transpose() * block.topRows(m - 1))
                       : Eigen::MatrixXd::Zero(p, p));
-    first.push_back(m ? Eigen::MatrixXd(block.row(0).transpose() * block.row(0)) : Eigen::MatrixXd::Zero(p, p));
-    last.push_back(m ? Eigen::MatrixXd(block.row(m - 1).transpose() * block.row(m - 1)) : Eigen::MatrixXd::Zero(p, p));
+    first.push_back(m ? Eigen::MatrixXd(block.row(0).transpose() * block.row(0))
+                      : Eigen::MatrixXd::Zero(p, p));
+    last.push_back(m ? Eigen::MatrixXd(block.row(m - 1).transpose() * block.row(m - 1))
+                     : Eigen::MatrixXd::Zero(p, p));
   }
   rest = Eigen::MatrixXd::Zero(p, p);
   for (Eigen::Index i = 0; i < J.rows(); ++i)
@@ -246,15 +256,18 @@ StreamLagProducts::StreamLagProducts(const Eigen::MatrixXd& J, std::vector<std::
 }
 
 Eigen::MatrixXd ArWhitener::gram(const StreamLagProducts& lags) const {
-  if (!ar1_only()) throw InvalidArgument("ArWhitener::gram: needs AR order <= 1 without a random walk");
+  if (!ar1_only())
+    throw InvalidArgument("ArWhitener::gram: needs AR order <= 1 without a random walk");
   if (lags.rows.size() != streams_.size())
-    throw InvalidArgument("ArWhitener::gram: the lag products have " + std::to_string(lags.rows.size()) +
-                          " streams, the noise model " + std::to_string(streams_.size()));
+    throw InvalidArgument("ArWhitener::gram: the lag products have " +
+                          std::to_string(lags.rows.size()) + " streams, the noise model " +
+                          std::to_string(streams_.size()));
   Eigen::MatrixXd G = lags.rest;
   for (std::size_t k = 0; k < streams_.size(); ++k) {
     const Stream& s = streams_[k];
     if (s.rows != lags.rows[k])
-      throw InvalidArgument("ArWhitener::gram: stream " + std::to_string(k) + " has other rows than the lag products");
+      throw InvalidArgument("ArWhitener::gram: stream " + std::to_string(k) +
+                            " has other rows than the lag products");
     if (s.rows.empty()) continue;
     const double a2 = s.inv_sd[0] * s.inv_sd[0];
     if (s.phi.size() < 2) {

@@ -8,12 +8,14 @@
 
 namespace rotacal {
 
-BlockDiagonalWhitener::BlockDiagonalWhitener(std::vector<Block> blocks) : blocks_(std::move(blocks)) {
+BlockDiagonalWhitener::BlockDiagonalWhitener(std::vector<Block> blocks)
+    : blocks_(std::move(blocks)) {
   for (std::size_t k = 0; k < blocks_.size(); ++k) {
     const Block& b = blocks_[k];
     if (b.whitener && b.whitener->size() != b.rows)
-      throw InvalidArgument("block whitener: block " + std::to_string(k) + " has " + std::to_string(b.rows) +
-                            " rows but its whitener was built for " + std::to_string(b.whitener->size()));
+      throw InvalidArgument("block whitener: block " + std::to_string(k) + " has " +
+                            std::to_string(b.rows) + " rows but its whitener was built for " +
+                            std::to_string(b.whitener->size()));
     if (!std::isfinite(b.factor) || b.factor <= 0.0)
       throw InvalidArgument("block whitener: block " + std::to_string(k) + " has factor " +
                             std::to_string(b.factor) + " (must be finite and positive)");

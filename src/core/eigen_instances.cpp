@@ -4,8 +4,8 @@
 template class Eigen::JacobiSVD<Eigen::MatrixXd>;
 template class Eigen::ColPivHouseholderQR<Eigen::MatrixXd>;
 template class Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>;
-template Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>&
-Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>::compute<Eigen::MatrixXd>(const Eigen::EigenBase<Eigen::MatrixXd>&, int);
+template Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>& Eigen::SelfAdjointEigenSolver<
+    Eigen::MatrixXd>::compute<Eigen::MatrixXd>(const Eigen::EigenBase<Eigen::MatrixXd>&, int);
 #ifdef ROTACAL_EIGEN_KERNELS
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wignored-attributes"

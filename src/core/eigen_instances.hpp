@@ -18,9 +18,8 @@
 extern template class Eigen::JacobiSVD<Eigen::MatrixXd>;
 extern template class Eigen::ColPivHouseholderQR<Eigen::MatrixXd>;
 extern template class Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>;
-extern template Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>&
-Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>::compute<Eigen::MatrixXd>(const Eigen::EigenBase<Eigen::MatrixXd>&,
-                                                                         int);
+extern template Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>& Eigen::SelfAdjointEigenSolver<
+    Eigen::MatrixXd>::compute<Eigen::MatrixXd>(const Eigen::EigenBase<Eigen::MatrixXd>&, int);
 
 // The dense product and triangular-solve kernels of double matrices (GEMM's block-panel kernel
 // and packing, GEMV, triangular products and solves), compiled once in eigen_instances.cpp
@@ -32,57 +31,59 @@ Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>::compute<Eigen::MatrixXd>(const E
 // unit these builds enable); with AVX the kernels take other arguments and both sides leave the
 // list out. A mode is Eigen's bits: 1 Lower, 2 Upper, 4 UnitDiag; an order 0 ColMajor, 1 RowMajor.
 #if defined(EIGEN_VECTORIZE_SSE2) && !defined(EIGEN_VECTORIZE_AVX)
-#define ROTACAL_EIGEN_KERNELS(EXTERN)                                                             \
-  EXTERN template struct Eigen::internal::gebp_kernel<                                            \
-      double, double, Eigen::Index, Eigen::internal::blas_data_mapper<double, Eigen::Index, 0, 0, 1>, \
-      4, 4, false, false>;                                                                        \
-  ROTACAL_EIGEN_PACK_LHS(EXTERN, (const_blas_data_mapper<double, Eigen::Index, 0>), 0, false)     \
-  ROTACAL_EIGEN_PACK_LHS(EXTERN, (const_blas_data_mapper<double, Eigen::Index, 1>), 1, false)     \
-  ROTACAL_EIGEN_PACK_LHS(EXTERN, (blas_data_mapper<double, Eigen::Index, 0, 0, 1>), 0, true)      \
-  ROTACAL_EIGEN_PACK_RHS(EXTERN, (const_blas_data_mapper<double, Eigen::Index, 0>), 0, false)     \
-  ROTACAL_EIGEN_PACK_RHS(EXTERN, (const_blas_data_mapper<double, Eigen::Index, 1>), 1, false)     \
-  ROTACAL_EIGEN_PACK_RHS(EXTERN, (const_blas_data_mapper<double, Eigen::Index, 1>), 1, true)      \
-  ROTACAL_EIGEN_PACK_RHS(EXTERN, (blas_data_mapper<double, Eigen::Index, 0, 0, 1>), 0, true)      \
-  ROTACAL_EIGEN_GEMV(EXTERN, 1, 0, 0)                                                             \
-  ROTACAL_EIGEN_GEMV(EXTERN, 0, 1, 0)                                                             \
-  ROTACAL_EIGEN_GEMV(EXTERN, 0, 0, 0)                                                             \
-  ROTACAL_EIGEN_GEMV(EXTERN, 1, 1, 1)                                                             \
-  EXTERN template struct Eigen::internal::triangular_matrix_vector_product<Eigen::Index, 6, double, \
-                                                                           false, double, false, 1, 0>; \
-  ROTACAL_EIGEN_TRMM(EXTERN, 6, 1)                                                                \
-  ROTACAL_EIGEN_TRMM(EXTERN, 5, 0)                                                                \
-  ROTACAL_EIGEN_TRMM(EXTERN, 2, 1)                                                                \
-  ROTACAL_EIGEN_TRMM(EXTERN, 1, 0)                                                                \
-  ROTACAL_EIGEN_TRSM(EXTERN, 1, 5, 0)                                                             \
-  ROTACAL_EIGEN_TRSM(EXTERN, 2, 2, 1)                                                             \
-  ROTACAL_EIGEN_TRSM(EXTERN, 1, 6, 1)                                                             \
-  ROTACAL_EIGEN_TRSM(EXTERN, 1, 2, 0)                                                             \
+#define ROTACAL_EIGEN_KERNELS(EXTERN)                                                         \
+  EXTERN template struct Eigen::internal::gebp_kernel<                                        \
+      double, double, Eigen::Index,                                                           \
+      Eigen::internal::blas_data_mapper<double, Eigen::Index, 0, 0, 1>, 4, 4, false, false>;  \
+  ROTACAL_EIGEN_PACK_LHS(EXTERN, (const_blas_data_mapper<double, Eigen::Index, 0>), 0, false) \
+  ROTACAL_EIGEN_PACK_LHS(EXTERN, (const_blas_data_mapper<double, Eigen::Index, 1>), 1, false) \
+  ROTACAL_EIGEN_PACK_LHS(EXTERN, (blas_data_mapper<double, Eigen::Index, 0, 0, 1>), 0, true)  \
+  ROTACAL_EIGEN_PACK_RHS(EXTERN, (const_blas_data_mapper<double, Eigen::Index, 0>), 0, false) \
+  ROTACAL_EIGEN_PACK_RHS(EXTERN, (const_blas_data_mapper<double, Eigen::Index, 1>), 1, false) \
+  ROTACAL_EIGEN_PACK_RHS(EXTERN, (const_blas_data_mapper<double, Eigen::Index, 1>), 1, true)  \
+  ROTACAL_EIGEN_PACK_RHS(EXTERN, (blas_data_mapper<double, Eigen::Index, 0, 0, 1>), 0, true)  \
+  ROTACAL_EIGEN_GEMV(EXTERN, 1, 0, 0)                                                         \
+  ROTACAL_EIGEN_GEMV(EXTERN, 0, 1, 0)                                                         \
+  ROTACAL_EIGEN_GEMV(EXTERN, 0, 0, 0)                                                         \
+  ROTACAL_EIGEN_GEMV(EXTERN, 1, 1, 1)                                                         \
+  EXTERN template struct Eigen::internal::triangular_matrix_vector_product<                   \
+      Eigen::Index, 6, double, false, double, false, 1, 0>;                                   \
+  ROTACAL_EIGEN_TRMM(EXTERN, 6, 1)                                                            \
+  ROTACAL_EIGEN_TRMM(EXTERN, 5, 0)                                                            \
+  ROTACAL_EIGEN_TRMM(EXTERN, 2, 1)                                                            \
+  ROTACAL_EIGEN_TRMM(EXTERN, 1, 0)                                                            \
+  ROTACAL_EIGEN_TRSM(EXTERN, 1, 5, 0)                                                         \
+  ROTACAL_EIGEN_TRSM(EXTERN, 2, 2, 1)                                                         \
+  ROTACAL_EIGEN_TRSM(EXTERN, 1, 6, 1)                                                         \
+  ROTACAL_EIGEN_TRSM(EXTERN, 1, 2, 0)                                                         \
   ROTACAL_EIGEN_TRSM(EXTERN, 1, 1, 0)
 
 #define ROTACAL_EIGEN_UNPAREN(...) __VA_ARGS__
 // Packing of GEMM's left operand from a mapper of the given storage order (panel mode last).
-#define ROTACAL_EIGEN_PACK_LHS(EXTERN, MAPPER, ORDER, PANEL)                                      \
-  EXTERN template struct Eigen::internal::gemm_pack_lhs<                                          \
-      double, Eigen::Index, Eigen::internal::ROTACAL_EIGEN_UNPAREN MAPPER, 4, 2,                  \
+#define ROTACAL_EIGEN_PACK_LHS(EXTERN, MAPPER, ORDER, PANEL)                     \
+  EXTERN template struct Eigen::internal::gemm_pack_lhs<                         \
+      double, Eigen::Index, Eigen::internal::ROTACAL_EIGEN_UNPAREN MAPPER, 4, 2, \
       Eigen::internal::Packet2d, ORDER, false, PANEL>;
 // Packing of GEMM's right operand.
-#define ROTACAL_EIGEN_PACK_RHS(EXTERN, MAPPER, ORDER, PANEL)                                      \
-  EXTERN template struct Eigen::internal::gemm_pack_rhs<                                          \
-      double, Eigen::Index, Eigen::internal::ROTACAL_EIGEN_UNPAREN MAPPER, 4, ORDER, false, PANEL>;
+#define ROTACAL_EIGEN_PACK_RHS(EXTERN, MAPPER, ORDER, PANEL)                                \
+  EXTERN template struct Eigen::internal::gemm_pack_rhs<                                    \
+      double, Eigen::Index, Eigen::internal::ROTACAL_EIGEN_UNPAREN MAPPER, 4, ORDER, false, \
+      PANEL>;
 // Matrix times vector: the matrix's storage order, the vector mapper's, the kernel's version.
 #define ROTACAL_EIGEN_GEMV(EXTERN, LHS_ORDER, RHS_ORDER, VERSION)                                 \
   EXTERN template struct Eigen::internal::general_matrix_vector_product<                          \
-      Eigen::Index, double, Eigen::internal::const_blas_data_mapper<double, Eigen::Index, LHS_ORDER>, \
-      LHS_ORDER, false, double, Eigen::internal::const_blas_data_mapper<double, Eigen::Index, RHS_ORDER>, \
-      false, VERSION>;
+      Eigen::Index, double,                                                                       \
+      Eigen::internal::const_blas_data_mapper<double, Eigen::Index, LHS_ORDER>, LHS_ORDER, false, \
+      double, Eigen::internal::const_blas_data_mapper<double, Eigen::Index, RHS_ORDER>, false,    \
+      VERSION>;
 // Triangular (mode) times general matrix, the triangle on the left, of the given storage order.
-#define ROTACAL_EIGEN_TRMM(EXTERN, MODE, LHS_ORDER)                                               \
-  EXTERN template struct Eigen::internal::product_triangular_matrix_matrix<                       \
+#define ROTACAL_EIGEN_TRMM(EXTERN, MODE, LHS_ORDER)                         \
+  EXTERN template struct Eigen::internal::product_triangular_matrix_matrix< \
       double, Eigen::Index, MODE, true, LHS_ORDER, false, 0, false, 0, 1, 0>;
 // Triangular solve with many right-hand sides: side, mode, the triangle's storage order.
-#define ROTACAL_EIGEN_TRSM(EXTERN, SIDE, MODE, TRI_ORDER)                                         \
-  EXTERN template struct Eigen::internal::triangular_solve_matrix<                                \
-      double, Eigen::Index, SIDE, MODE, false, TRI_ORDER, 0, 1>;
+#define ROTACAL_EIGEN_TRSM(EXTERN, SIDE, MODE, TRI_ORDER)                                     \
+  EXTERN template struct Eigen::internal::triangular_solve_matrix<double, Eigen::Index, SIDE, \
+                                                                  MODE, false, TRI_ORDER, 0, 1>;
 
 // Eigen names the packet type in these arguments too; GCC notes that its alignment attribute does
 // not take part in the type.

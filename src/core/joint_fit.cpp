@@ -18,11 +18,11 @@
 // ballbar samples 0.21-0.25 s and 221-227 MB peak for the process.
 #include "rotacal/core/joint_fit.hpp"
 
-#include "rotacal/core/yield_convention.hpp"
-
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
+
+#include "rotacal/core/yield_convention.hpp"
 
 namespace rotacal {
 
@@ -37,14 +37,15 @@ Eigen::MatrixXd gram(const Eigen::MatrixXd& J) { return gram_matrix(J); }
 // every column free the normal matrix is gram(Jw) scale^2, taken from `G` when the caller has
 // computed it already.
 struct NormalEquations {
-  Eigen::VectorXd D;         // column norms of the weighted Jacobian (free columns)
-  Eigen::MatrixXd A;         // (J D^-1)^T (J D^-1)
-  Eigen::MatrixXd Ainv;      // A^-1: covariance in normalised coordinates (chi2 units)
-  Eigen::VectorXd sigma_y;   // sqrt(diag(A^-1)): 1 sigma in normalised coordinates
+  Eigen::VectorXd D;        // column norms of the weighted Jacobian (free columns)
+  Eigen::MatrixXd A;        // (J D^-1)^T (J D^-1)
+  Eigen::MatrixXd Ainv;     // A^-1: covariance in normalised coordinates (chi2 units)
+  Eigen::VectorXd sigma_y;  // sqrt(diag(A^-1)): 1 sigma in normalised coordinates
   Eigen::LDLT<Eigen::MatrixXd> ldlt;
 };
 
-NormalEquations normal_equations(const Eigen::MatrixXd& Jw, double scale, const std::vector<Eigen::Index>& idx,
+NormalEquations normal_equations(const Eigen::MatrixXd& Jw, double scale,
+                                 const std::vector<Eigen::Index>& idx,
                                  const Eigen::MatrixXd* G = nullptr) {
   const Eigen::Index q = static_cast<Eigen::Index>(idx.size());
   NormalEquations ne;
@@ -55,7 +56,8 @@ NormalEquations normal_equations(const Eigen::MatrixXd& Jw, double scale, const 
     for (Eigen::Index a = 0; a < q; ++a)
       for (Eigen::Index b = a; b < q; ++b)
         ne.A(a, b) = ne.A(b, a) =
-            Jw.col(idx[static_cast<std::size_t>(a)]).dot(Jw.col(idx[static_cast<std::size_t>(b)])) * (scale * scale);
+            Jw.col(idx[static_cast<std::size_t>(a)]).dot(Jw.col(idx[static_cast<std::size_t>(b)])) *
+            (scale * scale);
   }
   ne.D = ne.A.diagonal().cwiseSqrt();
   for (Eigen::Index a = 0; a < q; ++a)
@@ -82,8 +84,9 @@ namespace {
 // Reports the solution under the yield convention (core/yield_convention.hpp) where a null
 // direction moves a parameter with FitParameter::yields: values and covariance are mapped,
 // the null directions it resolves are no longer listed, `observable` is updated.
-void apply_yield_convention(const std::vector<FitParameter>& params, const std::vector<int>& analysed,
-                            const Eigen::VectorXd& scales, JointFitOutcome& out, std::vector<bool>& observable) {
+void apply_yield_convention(const std::vector<FitParameter>& params,
+                            const std::vector<int>& analysed, const Eigen::VectorXd& scales,
+                            JointFitOutcome& out, std::vector<bool>& observable) {
   std::vector<bool> yields;
   for (int j : analysed) yields.push_back(params[static_cast<std::size_t>(j)].yields);
   std::vector<bool> obs_a = out.observability.observable;
@@ -102,7 +105,8 @@ void apply_yield_convention(const std::vector<FitParameter>& params, const std::
   for (std::size_t k = 0; k < analysed.size(); ++k) {
     const Eigen::Index j = analysed[k];
     observable[static_cast<std::size_t>(j)] =
-        obs_a[k] && std::sqrt(std::max(0.0, out.covariance(j, j))) > 1e-6 * scales[static_cast<Eigen::Index>(k)];
+        obs_a[k] && std::sqrt(std::max(0.0, out.covariance(j, j))) >
+                        1e-6 * scales[static_cast<Eigen::Index>(k)];
   }
   // A null direction the convention resolves no longer moves the reported solution: it is a
   // direction of the old, held convention, and is dropped from the words.
@@ -110,7 +114,8 @@ void apply_yield_convention(const std::vector<FitParameter>& params, const std::
   for (std::size_t k = 0; k < out.observability.null_space.size(); ++k) {
     const Eigen::VectorXd& v = out.observability.null_space[k];
     const Eigen::VectorXd moved = Ma * v;  // zero where the convention fixes this direction
-    if (moved.cwiseQuotient(scales).norm() > 0.5 * v.cwiseQuotient(scales).norm()) kept.push_back(out.unobservable[k]);
+    if (moved.cwiseQuotient(scales).norm() > 0.5 * v.cwiseQuotient(scales).norm())
+      kept.push_back(out.unobservable[k]);
   }
   out.unobservable = std::move(kept);
 }
@@ -127,14 +132,15 @@ struct JointProblem {
   const JointFitSettings& s;
   int p = 0;
   Eigen::Index n = 0;
-  double inv_sigma = 1.0;      // 1 / sigma once, applied as a product to residual vectors
+  double inv_sigma = 1.0;  // 1 / sigma once, applied as a product to residual vectors
   // The full Jacobian Jw is stored as J_weighted / jw_scale: whitened in place under a
   // whitener, left as J under white noise (1/sigma goes into its products instead, which saves
   // scaling the n x p array and scaling it back for the caller).
   double jw_scale = 1.0;
-  std::vector<int> analysed;   // the parameters not held
+  std::vector<int> analysed;  // the parameters not held
 
-  JointProblem(const ResidualModel& m, const std::vector<FitParameter>& ps, const JointFitSettings& settings)
+  JointProblem(const ResidualModel& m, const std::vector<FitParameter>& ps,
+               const JointFitSettings& settings)
       : model(m), params(ps), s(settings) {
     p = static_cast<int>(params.size());
     if (model.num_parameters() != p)
@@ -142,8 +148,9 @@ struct JointProblem {
                             " parameters but " + std::to_string(p) + " were described");
     n = model.num_residuals();
     if (s.whitener && s.whitener->size() != n)
-      throw InvalidArgument("solve_joint: whitener was built for " + std::to_string(s.whitener->size()) +
-                            " residuals, the fit has " + std::to_string(n));
+      throw InvalidArgument("solve_joint: whitener was built for " +
+                            std::to_string(s.whitener->size()) + " residuals, the fit has " +
+                            std::to_string(n));
     if (!(s.sigma > 0.0) || !std::isfinite(s.sigma))
       throw InvalidArgument("solve_joint: sigma must be finite and > 0");
     inv_sigma = 1.0 / s.sigma;
@@ -152,8 +159,10 @@ struct JointProblem {
       if (!params[static_cast<std::size_t>(j)].held) analysed.push_back(j);
   }
   void weigh(Eigen::VectorXd& r) const {
-    if (s.whitener) s.whitener->apply(r);
-    else r *= inv_sigma;
+    if (s.whitener)
+      s.whitener->apply(r);
+    else
+      r *= inv_sigma;
   }
   void weigh_jacobian(Eigen::MatrixXd& J) const {
     if (s.whitener) s.whitener->apply(J);
@@ -176,7 +185,8 @@ struct JointProblem {
     *obs = analyse_observability_normal(Ga, scales(), s.observability_min_chi2);
     std::vector<bool> free(static_cast<std::size_t>(p), false);
     for (int j : analysed) free[static_cast<std::size_t>(j)] = true;
-    for (int k : obs->to_fix) free[static_cast<std::size_t>(analysed[static_cast<std::size_t>(k)])] = false;
+    for (int k : obs->to_fix)
+      free[static_cast<std::size_t>(analysed[static_cast<std::size_t>(k)])] = false;
     return free;
   }
 };
@@ -199,7 +209,8 @@ std::vector<bool> subsample_start(const JointProblem& pr, Eigen::VectorXd& x, Fi
   if (pr.s.whitener || stride < 2) return free_subset;
   Eigen::VectorXd rs, rs_t;
   Eigen::MatrixXd Js;
-  if (!(pr.model.evaluate_subset(x, stride, rs, &Js) && rs.allFinite() && Js.allFinite())) return free_subset;
+  if (!(pr.model.evaluate_subset(x, stride, rs, &Js) && rs.allFinite() && Js.allFinite()))
+    return free_subset;
   rs *= pr.inv_sigma;
   Js *= pr.inv_sigma;
   Observability obs;
@@ -213,14 +224,17 @@ std::vector<bool> subsample_start(const JointProblem& pr, Eigen::VectorXd& x, Fi
   // range), and where the full analysis and solve start would then matter.
   const Eigen::VectorXd sc = pr.scales();
   for (std::size_t a = 0; a < idx.size(); ++a) {
-    const auto k = std::find(pr.analysed.begin(), pr.analysed.end(), static_cast<int>(idx[a])) - pr.analysed.begin();
-    const double sigma_param = ne.sigma_y[static_cast<Eigen::Index>(a)] / ne.D[static_cast<Eigen::Index>(a)];
+    const auto k = std::find(pr.analysed.begin(), pr.analysed.end(), static_cast<int>(idx[a])) -
+                   pr.analysed.begin();
+    const double sigma_param =
+        ne.sigma_y[static_cast<Eigen::Index>(a)] / ne.D[static_cast<Eigen::Index>(a)];
     if (!(sigma_param < 0.01 * sc[k])) return {};
   }
   double cost = rs.squaredNorm();
   for (int it = 0; it < 20 && !idx.empty(); ++it) {
     Eigen::VectorXd g(static_cast<Eigen::Index>(idx.size()));
-    for (Eigen::Index a = 0; a < g.size(); ++a) g[a] = Js.col(idx[static_cast<std::size_t>(a)]).dot(rs) / ne.D[a];
+    for (Eigen::Index a = 0; a < g.size(); ++a)
+      g[a] = Js.col(idx[static_cast<std::size_t>(a)]).dot(rs) / ne.D[a];
     const Eigen::VectorXd dx = ne.D.cwiseInverse().cwiseProduct(-ne.ldlt.solve(g));
     Eigen::VectorXd xt = x;
     for (Eigen::Index a = 0; a < dx.size(); ++a) xt[idx[static_cast<std::size_t>(a)]] += dx[a];
@@ -247,7 +261,8 @@ struct FullEvaluation {
     ++sum.jacobian_evaluations;
     for (Eigen::Index i = 0; i < pr.n; ++i)
       if (!std::isfinite(r[i]))
-        throw InvalidArgument("solve_joint: residual " + std::to_string(i) + " is not finite at the start point");
+        throw InvalidArgument("solve_joint: residual " + std::to_string(i) +
+                              " is not finite at the start point");
     rw = r;
     pr.weigh(rw);
     pr.weigh_jacobian(Jw);
@@ -271,7 +286,8 @@ std::vector<bool> analyse_full(const JointProblem& pr, const std::vector<bool>& 
   }
   std::vector<std::string> names, units;
   for (int j : pr.analysed)
-    names.push_back(pr.params[static_cast<std::size_t>(j)].name), units.push_back(pr.params[static_cast<std::size_t>(j)].unit);
+    names.push_back(pr.params[static_cast<std::size_t>(j)].name),
+        units.push_back(pr.params[static_cast<std::size_t>(j)].unit);
   for (std::size_t k = 0; k < out.observability.null_space.size(); ++k)
     out.unobservable.push_back(out.observability.describe(static_cast<int>(k), names, units));
   std::vector<bool> observable(static_cast<std::size_t>(pr.p), false);
@@ -287,8 +303,9 @@ std::vector<bool> analyse_full(const JointProblem& pr, const std::vector<bool>& 
 // times sqrt(chi2) sigma at most; it is accepted below 0.01 sigma, else refreshed. Moves x
 // and ev to the solution; returns the last normal equations (Jacobian within 0.01 sigma of
 // the solution) and sets `cost`.
-NormalEquations gauss_newton(const JointProblem& pr, const std::vector<Eigen::Index>& idx, Eigen::VectorXd& x,
-                             FullEvaluation& ev, FitSummary& sum, double& cost) {
+NormalEquations gauss_newton(const JointProblem& pr, const std::vector<Eigen::Index>& idx,
+                             Eigen::VectorXd& x, FullEvaluation& ev, FitSummary& sum,
+                             double& cost) {
   const JointFitSettings& s = pr.s;
   const Eigen::Index q = static_cast<Eigen::Index>(idx.size());
   NormalEquations ne = normal_equations(ev.Jw, pr.jw_scale, idx, &ev.G);
@@ -348,7 +365,8 @@ NormalEquations gauss_newton(const JointProblem& pr, const std::vector<Eigen::In
     pr.weigh(rw_t);
     const double cost_t = rw_t.squaredNorm();
     // A step below 1e-3 sigma changes chi2 by < 1e-6: its sign is round-off, so it is taken.
-    if (std::isfinite(cost_t) && (cost_t <= cost * (1.0 + 1e-12) || (step < 1e-3 && cost_t <= cost + 1e-6))) {
+    if (std::isfinite(cost_t) &&
+        (cost_t <= cost * (1.0 + 1e-12) || (step < 1e-3 && cost_t <= cost + 1e-6))) {
       x.swap(x_t);
       ev.r.swap(r_t);
       ev.rw.swap(rw_t);
@@ -377,9 +395,9 @@ NormalEquations gauss_newton(const JointProblem& pr, const std::vector<Eigen::In
 }
 
 // Covariance and outputs at the solution x, from the last normal equations `ne`.
-void finish_outcome(const JointProblem& pr, const std::vector<Eigen::Index>& idx, const NormalEquations& ne,
-                    double cost, Eigen::VectorXd& x, FullEvaluation& ev, std::vector<bool>& observable,
-                    JointFitOutcome& out) {
+void finish_outcome(const JointProblem& pr, const std::vector<Eigen::Index>& idx,
+                    const NormalEquations& ne, double cost, Eigen::VectorXd& x, FullEvaluation& ev,
+                    std::vector<bool>& observable, JointFitOutcome& out) {
   const JointFitSettings& s = pr.s;
   const Eigen::Index q = static_cast<Eigen::Index>(idx.size()), n = pr.n, p = pr.p;
   FitSummary& sum = out.summary;
@@ -449,16 +467,21 @@ JointFitOutcome solve_joint(const ResidualModel& model, const std::vector<FitPar
 
 JointRefitter::JointRefitter(const JointFitOutcome& reference, std::vector<FitParameter> parameters,
                              JointFitSettings settings)
-    : start_(reference.values), parameters_(std::move(parameters)), settings_(std::move(settings)),
+    : start_(reference.values),
+      parameters_(std::move(parameters)),
+      settings_(std::move(settings)),
       convention_(reference.convention) {
   ROTACAL_ASSERT(static_cast<Eigen::Index>(parameters_.size()) == start_.size());
   for (std::size_t j = 0; j < reference.free.size(); ++j)
     if (reference.free[j]) idx_.push_back(static_cast<Eigen::Index>(j));
   const Eigen::Index q = static_cast<Eigen::Index>(idx_.size());
   Jw_free_.resize(reference.jacobian.rows(), q);
-  for (Eigen::Index a = 0; a < q; ++a) Jw_free_.col(a) = reference.jacobian.col(idx_[static_cast<std::size_t>(a)]);
-  if (settings_.whitener) settings_.whitener->apply(Jw_free_);
-  else Jw_free_ /= settings_.sigma;
+  for (Eigen::Index a = 0; a < q; ++a)
+    Jw_free_.col(a) = reference.jacobian.col(idx_[static_cast<std::size_t>(a)]);
+  if (settings_.whitener)
+    settings_.whitener->apply(Jw_free_);
+  else
+    Jw_free_ /= settings_.sigma;
   ldlt_.compute(gram(Jw_free_));
   sigma_ = ldlt_.solve(Eigen::MatrixXd::Identity(q, q)).diagonal().cwiseMax(0.0).cwiseSqrt();
 }
@@ -472,14 +495,17 @@ JointRefitter::Result JointRefitter::refit(const ResidualModel& model) const {
   for (int it = 0; it < 20; ++it) {
     model.evaluate(res.values, r, nullptr);
     ++res.residual_evaluations;
-    if (settings_.whitener) settings_.whitener->apply(r);
-    else r /= settings_.sigma;
+    if (settings_.whitener)
+      settings_.whitener->apply(r);
+    else
+      r /= settings_.sigma;
     const Eigen::VectorXd dx = -ldlt_.solve(Jw_free_.transpose() * r);
     double step = 0.0;
     for (Eigen::Index a = 0; a < dx.size(); ++a)
       if (sigma_[a] > 0.0) step = std::max(step, std::abs(dx[a]) / sigma_[a]);
     if (!std::isfinite(step)) break;
-    for (Eigen::Index a = 0; a < dx.size(); ++a) res.values[idx_[static_cast<std::size_t>(a)]] += dx[a];
+    for (Eigen::Index a = 0; a < dx.size(); ++a)
+      res.values[idx_[static_cast<std::size_t>(a)]] += dx[a];
     if (step < settings_.step_tolerance_sigma) {
       res.converged = true;
       if (convention_.size()) res.values = convention_ * res.values;  // as the reference reports

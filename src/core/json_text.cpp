@@ -66,12 +66,14 @@ void check_json_bounds(const std::string& text, const std::string& source) {
       in_string = true;
     } else if (c == '{' || c == '[') {
       if (++depth > kMaxJsonDepth)
-        refuse(text, source, i, "nested deeper than " + std::to_string(kMaxJsonDepth) +
-                                    " levels of objects and arrays: not a rotacal file");
+        refuse(text, source, i,
+               "nested deeper than " + std::to_string(kMaxJsonDepth) +
+                   " levels of objects and arrays: not a rotacal file");
       if (++containers > max_containers)
-        refuse(text, source, i, "more than " + std::to_string(max_containers) + " objects and arrays in " +
-                                    std::to_string(text.size()) + " bytes (at most one per " +
-                                    std::to_string(kJsonBytesPerContainer) + " bytes): not a rotacal file");
+        refuse(text, source, i,
+               "more than " + std::to_string(max_containers) + " objects and arrays in " +
+                   std::to_string(text.size()) + " bytes (at most one per " +
+                   std::to_string(kJsonBytesPerContainer) + " bytes): not a rotacal file");
     } else if (c == '}' || c == ']') {
       --depth;  // unbalanced brackets are the parser's syntax error
     }

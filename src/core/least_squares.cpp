@@ -37,12 +37,14 @@ Observability analyse_observability(const Eigen::MatrixXd& J, const Eigen::Vecto
   // A non-finite Jacobian (readings far beyond any machine) would reach the eigensolver as
   // NaN; the readers refuse such values, and this stops any other path to it.
   if (!J.allFinite())
-    throw InvalidArgument("analyse_observability: the Jacobian is not finite (a reading or parameter is out of range)");
+    throw InvalidArgument(
+        "analyse_observability: the Jacobian is not finite (a reading or parameter is out of "
+        "range)");
   return analyse_observability_normal(gram_matrix(J), scales, min_chi2_change);
 }
 
-Observability analyse_observability_normal(const Eigen::MatrixXd& JtJ, const Eigen::VectorXd& scales,
-                                           double min_chi2_change) {
+Observability analyse_observability_normal(const Eigen::MatrixXd& JtJ,
+                                           const Eigen::VectorXd& scales, double min_chi2_change) {
   const Eigen::Index p = JtJ.cols();
   if (scales.size() != p || JtJ.rows() != p)
     throw InvalidArgument("analyse_observability: scales has " + std::to_string(scales.size()) +
@@ -51,7 +53,9 @@ Observability analyse_observability_normal(const Eigen::MatrixXd& JtJ, const Eig
   o.observable.assign(static_cast<std::size_t>(p), true);
   if (p == 0) return o;
   if (!JtJ.allFinite())
-    throw InvalidArgument("analyse_observability: the normal matrix is not finite (a reading or parameter is out of range)");
+    throw InvalidArgument(
+        "analyse_observability: the normal matrix is not finite (a reading or parameter is out of "
+        "range)");
   // Eigenvalues of the scaled normal matrix are the squared singular values of J*diag(scales);
   // their absolute error (~1e-16 of the largest) is far below the threshold of ~1 (chi2 units).
   const Eigen::MatrixXd N = scales.asDiagonal() * JtJ * scales.asDiagonal();
@@ -93,7 +97,8 @@ Observability analyse_observability_normal(const Eigen::MatrixXd& JtJ, const Eig
       if (!taken[static_cast<std::size_t>(j)] && (best < 0 || R.row(j).norm() > R.row(best).norm()))
         best = static_cast<int>(j);
     for (Eigen::Index j = p - 1; j > best; --j)
-      if (!taken[static_cast<std::size_t>(j)] && R.row(j).norm() >= (1.0 - 1e-3) * R.row(best).norm()) {
+      if (!taken[static_cast<std::size_t>(j)] &&
+          R.row(j).norm() >= (1.0 - 1e-3) * R.row(best).norm()) {
         best = static_cast<int>(j);
         break;
       }
@@ -108,7 +113,8 @@ Observability analyse_observability_normal(const Eigen::MatrixXd& JtJ, const Eig
   // parameter k alone among them (reduced echelon form of the null space), so that repeated
   // fits describe them alike.
   Eigen::MatrixXd F(k_null, k_null);
-  for (Eigen::Index k = 0; k < k_null; ++k) F.row(k) = Vn.row(o.to_fix[static_cast<std::size_t>(k)]);
+  for (Eigen::Index k = 0; k < k_null; ++k)
+    F.row(k) = Vn.row(o.to_fix[static_cast<std::size_t>(k)]);
   const Eigen::MatrixXd E = Vn * F.inverse();
   for (Eigen::Index k = 0; k < k_null; ++k) {
     const Eigen::VectorXd vs = E.col(k).normalized();
@@ -123,7 +129,7 @@ double plausible_magnitude(const std::string& unit) {
   if (unit == "mm/s") return 1e-3;
   if (unit == "rad/rad" || unit == "mm/mm") return 1e-3;
   if (unit == "s") return 1e-3;  // a servo lag: 1 ms is a gain mismatch of a few percent
-  if (unit == "1") return 1.0;  // dimensionless, e.g. the log of a time constant: a factor e
+  if (unit == "1") return 1.0;   // dimensionless, e.g. the log of a time constant: a factor e
   throw InvalidArgument("plausible_magnitude: unknown unit '" + unit + "'");
 }
 
@@ -134,13 +140,15 @@ std::string Observability::describe(int k, const std::vector<std::string>& names
   int lead = 0;
   double lead_share = -1.0;
   for (Eigen::Index j = 0; j < v.size(); ++j) {
-    const double share = std::abs(v[j]) / plausible_magnitude(units.at(static_cast<std::size_t>(j)));
+    const double share =
+        std::abs(v[j]) / plausible_magnitude(units.at(static_cast<std::size_t>(j)));
     if (share > lead_share) lead = static_cast<int>(j), lead_share = share;
   }
   const double unit_step = plausible_magnitude(units.at(static_cast<std::size_t>(lead)));
   std::ostringstream out;
   out.precision(3);
-  out << names.at(static_cast<std::size_t>(lead)) << " +" << unit_step << " " << units[static_cast<std::size_t>(lead)];
+  out << names.at(static_cast<std::size_t>(lead)) << " +" << unit_step << " "
+      << units[static_cast<std::size_t>(lead)];
   for (Eigen::Index j = 0; j < v.size(); ++j) {
     if (j == lead) continue;
     const double step = v[j] / v[lead] * unit_step;
@@ -171,7 +179,8 @@ Eigen::MatrixXd covariance_from_jacobian(const Eigen::MatrixXd& J, const std::ve
   for (Eigen::Index k = 0; k < sv.size(); ++k)
     if (sv[k] > 1e-12 * sv[0]) inv2[k] = 1.0 / (sv[k] * sv[k]);
   const Eigen::MatrixXd Cn = svd.matrixV() * inv2.asDiagonal() * svd.matrixV().transpose();
-  const Eigen::MatrixXd Cf = s.cwiseInverse().asDiagonal() * Cn * s.cwiseInverse().asDiagonal() * sigma2;
+  const Eigen::MatrixXd Cf =
+      s.cwiseInverse().asDiagonal() * Cn * s.cwiseInverse().asDiagonal() * sigma2;
   for (std::size_t a = 0; a < idx.size(); ++a)
     for (std::size_t b = 0; b < idx.size(); ++b)
       cov(idx[a], idx[b]) = Cf(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));

@@ -69,7 +69,8 @@ Eigen::VectorXd thermal_wander(const std::vector<double>& times, double amplitud
 Eigen::VectorXd probe_zero_wander(const std::vector<std::string>& groups,
                                   const std::vector<double>& times, double step_mm,
                                   std::uint64_t seed) {
-  if (!(step_mm >= 0.0)) throw InvalidArgument("noise_gen::probe_zero_wander: step_mm must be >= 0");
+  if (!(step_mm >= 0.0))
+    throw InvalidArgument("noise_gen::probe_zero_wander: step_mm must be >= 0");
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> N(0.0, step_mm);
   Eigen::VectorXd out = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(groups.size()));

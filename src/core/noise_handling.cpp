@@ -1,13 +1,12 @@
 // Bootstrap bias factor of a noise model estimated from fit residuals (core/noise_handling.hpp).
 #include "rotacal/core/noise_handling.hpp"
 
+#include <Eigen/Cholesky>
+#include <Eigen/QR>
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <random>
-
-#include <Eigen/Cholesky>
-#include <Eigen/QR>
 
 #include "rotacal/core/error.hpp"
 
@@ -26,7 +25,8 @@ Eigen::VectorXd draw_noise(const NoiseModel& model, std::mt19937_64& rng) {
     const std::size_t p = s.ar.size();
     const double se = s.innovation_sigma_um * 1e-3;
     // Stationary start: run the recursion for many correlation times before the first row.
-    const std::size_t burn = p == 0 ? 0 : 200 + static_cast<std::size_t>(20.0 * s.correlation_samples);
+    const std::size_t burn =
+        p == 0 ? 0 : 200 + static_cast<std::size_t>(20.0 * s.correlation_samples);
     std::vector<double> hist(p, 0.0);  // hist[k]: x_{t-1-k}
     const std::size_t total = burn + s.rows.size();
     for (std::size_t t = 0; t < total; ++t) {
@@ -57,19 +57,23 @@ double long_run_variance(const NoiseModel& model) {
     double sum_phi = 0.0;
     for (double p : s.ar) sum_phi += p;
     const double se = s.innovation_sigma_um * 1e-3;
-    v += static_cast<double>(s.rows.size()) * se * se / std::max(1e-12, (1.0 - sum_phi) * (1.0 - sum_phi));
+    v += static_cast<double>(s.rows.size()) * se * se /
+         std::max(1e-12, (1.0 - sum_phi) * (1.0 - sum_phi));
   }
   return v;
 }
 
 double noise_model_bias_factor(const NoiseModel& model, const std::vector<std::string>& groups,
-                               const std::vector<double>& times, const Eigen::MatrixXd& jacobian_free,
+                               const std::vector<double>& times,
+                               const Eigen::MatrixXd& jacobian_free,
                                const NoiseModelOptions& options, int draws, std::uint64_t seed) {
   const Eigen::Index n = static_cast<Eigen::Index>(groups.size());
-  if (times.size() != groups.size() || jacobian_free.rows() != n || static_cast<Eigen::Index>(model.n) != n)
-    throw InvalidArgument("noise_model_bias_factor: groups, times, jacobian_free rows and model.n must agree (" +
-                          std::to_string(groups.size()) + ", " + std::to_string(times.size()) + ", " +
-                          std::to_string(jacobian_free.rows()) + ", " + std::to_string(model.n) + ")");
+  if (times.size() != groups.size() || jacobian_free.rows() != n ||
+      static_cast<Eigen::Index>(model.n) != n)
+    throw InvalidArgument(
+        "noise_model_bias_factor: groups, times, jacobian_free rows and model.n must agree (" +
+        std::to_string(groups.size()) + ", " + std::to_string(times.size()) + ", " +
+        std::to_string(jacobian_free.rows()) + ", " + std::to_string(model.n) + ")");
   if (draws < 1) throw InvalidArgument("noise_model_bias_factor: draws must be >= 1");
   const double target = long_run_variance(model);
   if (model.white() || !(target > 0.0)) return 1.0;
@@ -109,10 +113,10 @@ class RemlCriterion {
       : start_(start), y_(y), X_(span_basis(X)), level_(start.streams.size(), 1.0) {}
 
   struct Value {
-    double m2l = 0.0;   // -2 l, profiled over sigma^2, up to a constant
-    double S = 0.0;     // whitened GLS residual sum of squares (sigma^2 = 1)
-    Eigen::Index k = 0; // rank of X
-    Eigen::VectorXd e;  // whitened GLS residuals (with `residuals`)
+    double m2l = 0.0;    // -2 l, profiled over sigma^2, up to a constant
+    double S = 0.0;      // whitened GLS residual sum of squares (sigma^2 = 1)
+    Eigen::Index k = 0;  // rank of X
+    Eigen::VectorXd e;   // whitened GLS residuals (with `residuals`)
   };
 
   Value operator()(double rho, double lambda, bool residuals = false) const {
@@ -132,7 +136,8 @@ class RemlCriterion {
     Eigen::VectorXd c = qr.householderQ().adjoint() * A.col(p);
     v.S = c.tail(n - v.k).squaredNorm();
     double logdet_xvx = 0.0;
-    for (Eigen::Index i = 0; i < v.k; ++i) logdet_xvx += 2.0 * std::log(std::abs(qr.matrixQR()(i, i)));
+    for (Eigen::Index i = 0; i < v.k; ++i)
+      logdet_xvx += 2.0 * std::log(std::abs(qr.matrixQR()(i, i)));
     const double dof = static_cast<double>(n - v.k);
     v.m2l = dof * std::log(std::max(v.S, 1e-300) / dof) + logdet_v + logdet_xvx;
     if (residuals) {
@@ -234,8 +239,10 @@ std::array<double, 2> nelder_mead_2d(F f, std::array<double, 2> x0, std::array<d
       const std::array<double, 2> e = mix(c, x[w], -2.0);
       const double fe = f(e);
       ++used;
-      if (fe < fr) x[w] = e, fx[w] = fe;
-      else x[w] = r, fx[w] = fr;
+      if (fe < fr)
+        x[w] = e, fx[w] = fe;
+      else
+        x[w] = r, fx[w] = fr;
     } else if (fr < fx[m]) {
       x[w] = r, fx[w] = fr;
     } else {
@@ -263,11 +270,13 @@ NoiseModel estimate_noise_model_reml(const NoiseModel& start, const Eigen::Vecto
                                      const Eigen::MatrixXd& X) {
   const Eigen::Index n = y.size();
   if (static_cast<Eigen::Index>(start.n) != n || X.rows() != n)
-    throw InvalidArgument("estimate_noise_model_reml: start.n, residuals and jacobian_free rows must agree (" +
-                          std::to_string(start.n) + ", " + std::to_string(n) + ", " + std::to_string(X.rows()) + ")");
+    throw InvalidArgument(
+        "estimate_noise_model_reml: start.n, residuals and jacobian_free rows must agree (" +
+        std::to_string(start.n) + ", " + std::to_string(n) + ", " + std::to_string(X.rows()) + ")");
   std::size_t covered = 0;
   for (const NoiseStream& s : start.streams) covered += s.rows.size();
-  if (covered != start.n) throw InvalidArgument("estimate_noise_model_reml: start's streams do not cover its readings");
+  if (covered != start.n)
+    throw InvalidArgument("estimate_noise_model_reml: start's streams do not cover its readings");
   RemlCriterion crit(start, y, X);
   // rho = 0.995 tanh(u) (|rho| < 0.995: beyond it the AR part is a walk itself),
   // lambda = exp(v) with v in [-18, 4] (e^-18: no walk; e^4: walk steps 7x the AR sigma).
@@ -282,12 +291,14 @@ NoiseModel estimate_noise_model_reml(const NoiseModel& start, const Eigen::Vecto
   std::size_t big = 0;
   for (const NoiseStream& s : start.streams)
     if (s.rows.size() > big && s.order() >= 1) big = s.rows.size(), phi1 = s.ar[0];
-  std::array<double, 2> x = {std::atanh(std::max(-0.9, std::min(0.95, phi1)) / 0.995), std::log(1e-3)};
+  std::array<double, 2> x = {std::atanh(std::max(-0.9, std::min(0.95, phi1)) / 0.995),
+                             std::log(1e-3)};
   // Where the levels' steps and a second Nelder-Mead follow, the first optimum is only their
   // start, so it stops at 1e-2 in -2 l: a tenth of a standard deviation of (rho, ln lambda) on
   // the likelihood-ratio scale (one at 1), far below the levels' own uncertainty; the second
   // Nelder-Mead then takes -2 l to 1e-4 as before. First-stage evaluations 49 -> 34 a REML
-  // (all 87 -> 72), no decision changed (bench/diagnosis_confusion.py, 208 AC-trt ballbar sessions).
+  // (all 87 -> 72), no decision changed (bench/diagnosis_confusion.py, 208 AC-trt ballbar
+  // sessions).
   const bool levels = start.streams.size() > 1;
   x = nelder_mead_2d(f, x, {0.5, 3.0}, 120, levels ? 1e-2 : 1e-4);
   // The streams' levels (dx, dy, dz probes may differ): two fixed-point steps at the first
@@ -317,7 +328,8 @@ NoiseModel estimate_noise_model_reml(const NoiseModel& start, const Eigen::Vecto
   const double sigma2 = v.S / static_cast<double>(n - v.k);  // REML: unbiased for sigma^2
   std::size_t longest = 0;
   for (const NoiseStream& s : start.streams) longest = std::max(longest, s.rows.size());
-  if (lambda * static_cast<double>(longest) < 1e-3) lambda = 0.0;  // a walk under 0.1 % of the variance
+  if (lambda * static_cast<double>(longest) < 1e-3)
+    lambda = 0.0;  // a walk under 0.1 % of the variance
 
   NoiseModel M;
   M.n = start.n;

@@ -3,6 +3,7 @@
 // generators noise_generators.cpp.)
 #include "rotacal/core/noise_model.hpp"
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -10,10 +11,8 @@
 #include <random>
 #include <sstream>
 
-#include <Eigen/Cholesky>
-
-#include "rotacal/core/error.hpp"
 #include "levinson.hpp"
+#include "rotacal/core/error.hpp"
 
 namespace rotacal {
 
@@ -42,7 +41,8 @@ namespace {
 // One order m of Burg's recursion on a segment's forward and backward prediction errors f, b:
 // adds its sums of f_t b_{t-1} and f_t^2 + b_{t-1}^2 over t = m..n-1. Written on Eigen
 // segments so that they vectorise: the diagnosis models the residual of every candidate.
-void burg_sums(const Eigen::VectorXd& f, const Eigen::VectorXd& b, Eigen::Index m, double* num, double* den) {
+void burg_sums(const Eigen::VectorXd& f, const Eigen::VectorXd& b, Eigen::Index m, double* num,
+               double* den) {
   const Eigen::Index len = f.size() - m;
   if (len <= 0) return;
   const auto fs = f.segment(m, len);
@@ -55,7 +55,8 @@ void burg_sums(const Eigen::VectorXd& f, const Eigen::VectorXd& b, Eigen::Index 
 void burg_update(Eigen::VectorXd& f, Eigen::VectorXd& b, Eigen::Index m, double km) {
   const Eigen::Index len = f.size() - m;
   if (len <= 0) return;
-  const Eigen::VectorXd bs = b.segment(m - 1, len);  // a copy: b_t is overwritten before b_{t+1} reads it
+  const Eigen::VectorXd bs =
+      b.segment(m - 1, len);  // a copy: b_t is overwritten before b_{t+1} reads it
   b.segment(m, len) = bs - km * f.segment(m, len);
   f.segment(m, len) -= km * bs;
 }
@@ -63,8 +64,8 @@ void burg_update(Eigen::VectorXd& f, Eigen::VectorXd& b, Eigen::Index m, double 
 // Burg's recursion up to order P over one or more segments (one model for all: the sums run
 // over every segment): reflection coefficients k_1..k_P and the prediction error variances
 // v_0..v_P (v_0 = mean square of the readings).
-void burg_pooled(std::vector<Eigen::VectorXd> f, int P, std::vector<double>* k, std::vector<double>* v,
-                 std::size_t* n_total = nullptr) {
+void burg_pooled(std::vector<Eigen::VectorXd> f, int P, std::vector<double>* k,
+                 std::vector<double>* v, std::size_t* n_total = nullptr) {
   double ss = 0.0;
   std::size_t n = 0;
   for (const Eigen::VectorXd& x : f) {
@@ -85,7 +86,6 @@ void burg_pooled(std::vector<Eigen::VectorXd> f, int P, std::vector<double>* k, 
   }
 }
 
-
 double median(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
@@ -99,7 +99,8 @@ void check_sizes(const char* where, const std::vector<std::string>& groups,
                           " entries but times has " + std::to_string(times.size()));
   for (std::size_t i = 0; i < times.size(); ++i)
     if (!std::isfinite(times[i]))
-      throw InvalidArgument(std::string(where) + ": times[" + std::to_string(i) + "] is not finite");
+      throw InvalidArgument(std::string(where) + ": times[" + std::to_string(i) +
+                            "] is not finite");
 }
 
 }  // namespace
@@ -131,7 +132,8 @@ std::vector<std::vector<Eigen::Index>> noise_streams(const std::vector<std::stri
     std::vector<Eigen::Index>& idx = by_group[g];
     // Rows come in time order in a session file: the (stable) sort is needed only when not.
     const auto earlier = [&](Eigen::Index a, Eigen::Index b) { return time_of(a) < time_of(b); };
-    if (!std::is_sorted(idx.begin(), idx.end(), earlier)) std::stable_sort(idx.begin(), idx.end(), earlier);
+    if (!std::is_sorted(idx.begin(), idx.end(), earlier))
+      std::stable_sort(idx.begin(), idx.end(), earlier);
     // Channel = position among the readings that share a time stamp (R-test dx, dy, dz).
     // Distinct time stamps (a ballbar test): one channel, the rows themselves.
     std::vector<std::vector<Eigen::Index>> ch;
@@ -168,7 +170,8 @@ NoiseStreamLayout::NoiseStreamLayout(const std::vector<std::string>& groups,
   for (const std::vector<Eigen::Index>& s : rows) {
     dt.clear();
     for (std::size_t t = 1; t < s.size(); ++t) {
-      const double d = times[static_cast<std::size_t>(s[t])] - times[static_cast<std::size_t>(s[t - 1])];
+      const double d =
+          times[static_cast<std::size_t>(s[t])] - times[static_cast<std::size_t>(s[t - 1])];
       if (d > 0.0) dt.push_back(d);
     }
     sample_interval_s.push_back(median(dt));
@@ -199,7 +202,8 @@ NoiseModel estimate_noise_model(const std::vector<std::string>& groups,
   return estimate_noise_model(NoiseStreamLayout(groups, times), residuals_mm, options);
 }
 
-NoiseModel estimate_noise_model(const NoiseStreamLayout& layout, const Eigen::VectorXd& residuals_mm,
+NoiseModel estimate_noise_model(const NoiseStreamLayout& layout,
+                                const Eigen::VectorXd& residuals_mm,
                                 const NoiseModelOptions& options) {
   if (options.max_order < 0)
     throw InvalidArgument("estimate_noise_model: options.max_order is " +
@@ -236,12 +240,14 @@ NoiseModel estimate_noise_model(const NoiseStreamLayout& layout, const Eigen::Ve
   }
   // BIC over orders min_order..P of Burg's prediction error variances v_p for n readings.
   const auto choose = [&options](const std::vector<double>& v, std::size_t n) {
-    const std::size_t lowest = std::min(static_cast<std::size_t>(std::max(options.min_order, 0)), v.size() - 1);
+    const std::size_t lowest =
+        std::min(static_cast<std::size_t>(std::max(options.min_order, 0)), v.size() - 1);
     int best = static_cast<int>(lowest);
     double best_bic = 0.0;
     const double ln_n = std::log(static_cast<double>(std::max<std::size_t>(n, 2)));
     for (std::size_t p = lowest; p < v.size(); ++p) {
-      const double bic = static_cast<double>(n) * std::log(std::max(v[p], 1e-300)) + static_cast<double>(p) * ln_n;
+      const double bic =
+          static_cast<double>(n) * std::log(std::max(v[p], 1e-300)) + static_cast<double>(p) * ln_n;
       if (p == lowest || bic < best_bic) best = static_cast<int>(p), best_bic = bic;
     }
     return best;
@@ -292,7 +298,8 @@ NoiseModel estimate_noise_model(const NoiseStreamLayout& layout, const Eigen::Ve
     S.correlation_samples = v0 > 0.0 ? vp / (v0 * gap * gap) : 1.0;
     S.correlation_samples = std::min(S.correlation_samples, static_cast<double>(n));
     S.correlation_time_s = S.correlation_samples * S.sample_interval_s;
-    S.effective_samples = std::min(static_cast<double>(n), static_cast<double>(n) / S.correlation_samples);
+    S.effective_samples =
+        std::min(static_cast<double>(n), static_cast<double>(n) / S.correlation_samples);
     ss_marg += v0 * static_cast<double>(n);
     ss_innov += vp * static_cast<double>(n);
     M.correlation_samples = std::max(M.correlation_samples, S.correlation_samples);
@@ -371,7 +378,8 @@ NoiseModel with_lag1(const NoiseModel& model, const std::vector<double>& phi) {
 std::string NoiseModel::summary() const {
   std::ostringstream out;
   out.precision(3);
-  if (white()) out << "white";
+  if (white())
+    out << "white";
   else {
     out << "AR(" << max_order << ")";
     // The coefficient of the largest stream, as the typical one.
@@ -379,7 +387,8 @@ std::string NoiseModel::summary() const {
     for (const NoiseStream& s : streams)
       if (!big || s.rows.size() > big->rows.size()) big = &s;
     if (big && big->order() >= 1) out << ", phi_1 " << big->ar[0];
-    if (random_walk_step_um > 0.0) out << " + random walk " << random_walk_step_um << " um per reading";
+    if (random_walk_step_um > 0.0)
+      out << " + random walk " << random_walk_step_um << " um per reading";
   }
   out << ", sigma " << sigma_um << " um (innovation " << innovation_sigma_um
       << " um), correlation time " << correlation_time_s << " s (" << correlation_samples

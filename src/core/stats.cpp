@@ -109,7 +109,8 @@ double f_sf(double f, double d1, double d2) {
 double t_coverage(double p, double nu) {
   if (!(p > 0.0 && p < 1.0))
     throw InvalidArgument("t_coverage: p is " + std::to_string(p) + ", must be in (0, 1)");
-  if (!(nu > 0.0)) throw InvalidArgument("t_coverage: nu is " + std::to_string(nu) + ", must be > 0");
+  if (!(nu > 0.0))
+    throw InvalidArgument("t_coverage: nu is " + std::to_string(nu) + ", must be > 0");
   // P(|T| > t) = I_{nu/(nu+t^2)}(nu/2, 1/2); for nu beyond 1e7 the normal limit,
   // P(|Z| > z) = erfc(z / sqrt 2). Bisection: both tails fall monotonically in t.
   const auto tail = [nu](double t) {

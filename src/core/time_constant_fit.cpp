@@ -3,7 +3,8 @@
 
 namespace rotacal {
 
-JointFitOutcome solve_with_time_constants(const ResidualModel& model, std::vector<FitParameter> params,
+JointFitOutcome solve_with_time_constants(const ResidualModel& model,
+                                          std::vector<FitParameter> params,
                                           const JointFitSettings& settings) {
   std::vector<std::size_t> gated;
   for (std::size_t j = 0; j < params.size(); ++j)
@@ -11,7 +12,8 @@ JointFitOutcome solve_with_time_constants(const ResidualModel& model, std::vecto
   if (gated.empty()) return solve_joint(model, params, settings);
   for (std::size_t j : gated) params[j].held = true;
   const JointFitOutcome first = solve_joint(model, params, settings);
-  for (std::size_t j = 0; j < params.size(); ++j) params[j].start = first.values[static_cast<Eigen::Index>(j)];
+  for (std::size_t j = 0; j < params.size(); ++j)
+    params[j].start = first.values[static_cast<Eigen::Index>(j)];
   for (std::size_t j : gated) params[j].held = false;
   return solve_joint(model, params, settings);
 }

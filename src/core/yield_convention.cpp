@@ -22,7 +22,8 @@ Eigen::MatrixXd yield_convention(const Observability& o, const std::vector<bool>
   if (y.empty()) return {};
   // Orthonormal basis Q of the null space in scaled units (z = x / scale).
   Eigen::MatrixXd Ns(m, k);
-  for (Eigen::Index c = 0; c < k; ++c) Ns.col(c) = o.null_space[static_cast<std::size_t>(c)].cwiseQuotient(scales);
+  for (Eigen::Index c = 0; c < k; ++c)
+    Ns.col(c) = o.null_space[static_cast<std::size_t>(c)].cwiseQuotient(scales);
   const Eigen::MatrixXd Q = Ns.householderQr().householderQ() * Eigen::MatrixXd::Identity(m, k);
   // Its yielding part, and the directions in which that part is not negligible.
   Eigen::MatrixXd A(static_cast<Eigen::Index>(y.size()), k);
@@ -43,8 +44,10 @@ Eigen::MatrixXd yield_convention(const Observability& o, const std::vector<bool>
   if (resolved.empty()) return {};
   const Eigen::Index g = static_cast<Eigen::Index>(resolved.size());
   Eigen::MatrixXd Vg(k, g), Vr(k, static_cast<Eigen::Index>(left.size()));
-  for (Eigen::Index i = 0; i < g; ++i) Vg.col(i) = svd.matrixV().col(resolved[static_cast<std::size_t>(i)]);
-  for (Eigen::Index i = 0; i < Vr.cols(); ++i) Vr.col(i) = svd.matrixV().col(left[static_cast<std::size_t>(i)]);
+  for (Eigen::Index i = 0; i < g; ++i)
+    Vg.col(i) = svd.matrixV().col(resolved[static_cast<std::size_t>(i)]);
+  for (Eigen::Index i = 0; i < Vr.cols(); ++i)
+    Vr.col(i) = svd.matrixV().col(left[static_cast<std::size_t>(i)]);
   const Eigen::MatrixXd Qg = Q * Vg;  // resolved directions
   const Eigen::MatrixXd Qr = Q * Vr;  // left as they are
   const Eigen::MatrixXd Ag = A * Vg;
@@ -58,7 +61,8 @@ Eigen::MatrixXd yield_convention(const Observability& o, const std::vector<bool>
   if (observable) {
     observable->assign(static_cast<std::size_t>(m), true);
     for (Eigen::Index j = 0; j < m; ++j)
-      if (Qr.cols() > 0 && Qr.row(j).norm() > 0.05) (*observable)[static_cast<std::size_t>(j)] = false;
+      if (Qr.cols() > 0 && Qr.row(j).norm() > 0.05)
+        (*observable)[static_cast<std::size_t>(j)] = false;
   }
   return M;
 }

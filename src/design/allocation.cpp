@@ -16,9 +16,9 @@ namespace {
 // The criterion on the determined parameters F only (the search's screening): the largest
 // scale_j^2 [M^-1]_jj over the target positions in F, or infinity when M is singular.
 struct Reduced {
-  std::vector<Eigen::MatrixXd> A;       // candidates restricted to F
-  std::vector<Eigen::Index> target;     // positions in F of the determinable target parameters
-  std::vector<double> scale2;           // their scale^2
+  std::vector<Eigen::MatrixXd> A;    // candidates restricted to F
+  std::vector<Eigen::Index> target;  // positions in F of the determinable target parameters
+  std::vector<double> scale2;        // their scale^2
 
   // M^-1 of a positive definite M, by Cholesky of its diagonally scaled form; false if singular.
   static bool inverse(const Eigen::MatrixXd& M, Eigen::MatrixXd& out) {
@@ -29,7 +29,8 @@ struct Reduced {
     if (llt.info() != Eigen::Success) return false;
     const Eigen::VectorXd diag = llt.matrixL().toDenseMatrix().diagonal();
     if (!(diag.minCoeff() > 1e-7 * diag.maxCoeff())) return false;
-    out = s.asDiagonal() * llt.solve(Eigen::MatrixXd::Identity(M.rows(), M.cols())) * s.asDiagonal();
+    out =
+        s.asDiagonal() * llt.solve(Eigen::MatrixXd::Identity(M.rows(), M.cols())) * s.asDiagonal();
     return true;
   }
   // The derivative d_k of the smooth maximum (sum_j v_j^64)^(1/64) along each candidate at M:
@@ -38,20 +39,23 @@ struct Reduced {
     Eigen::MatrixXd inv;
     if (!inverse(M, inv)) return {};
     double vmax = 0.0;
-    for (std::size_t t = 0; t < target.size(); ++t) vmax = std::max(vmax, scale2[t] * inv(target[t], target[t]));
+    for (std::size_t t = 0; t < target.size(); ++t)
+      vmax = std::max(vmax, scale2[t] * inv(target[t], target[t]));
     Eigen::VectorXd L = Eigen::VectorXd::Zero(M.rows());
     for (std::size_t t = 0; t < target.size(); ++t)
       L[target[t]] = scale2[t] * std::pow(scale2[t] * inv(target[t], target[t]) / vmax, 63.0);
     const Eigen::MatrixXd B = inv * L.asDiagonal() * inv;
     Eigen::VectorXd d(static_cast<Eigen::Index>(A.size()));
-    for (std::size_t k = 0; k < A.size(); ++k) d[static_cast<Eigen::Index>(k)] = B.cwiseProduct(A[k]).sum();
+    for (std::size_t k = 0; k < A.size(); ++k)
+      d[static_cast<Eigen::Index>(k)] = B.cwiseProduct(A[k]).sum();
     return d;
   }
   double worst(const Eigen::MatrixXd& M) const {
     Eigen::MatrixXd inv;
     if (!inverse(M, inv)) return std::numeric_limits<double>::infinity();
     double w = 0.0;
-    for (std::size_t t = 0; t < target.size(); ++t) w = std::max(w, scale2[t] * inv(target[t], target[t]));
+    for (std::size_t t = 0; t < target.size(); ++t)
+      w = std::max(w, scale2[t] * inv(target[t], target[t]));
     return w;
   }
 };
@@ -81,7 +85,8 @@ Eigen::VectorXd continuous_design(const Reduced& R) {
   }
   Eigen::MatrixXd F(q, first[C]);
   for (std::size_t k = 0; k < C; ++k) F.middleCols(first[k], first[k + 1] - first[k]) = factors[k];
-  Eigen::VectorXd w = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(C), 1.0 / static_cast<double>(C));
+  Eigen::VectorXd w =
+      Eigen::VectorXd::Constant(static_cast<Eigen::Index>(C), 1.0 / static_cast<double>(C));
   Eigen::VectorXd lam = Eigen::VectorXd::Constant(T, 1.0 / static_cast<double>(T)), best_w = w;
   double best = std::numeric_limits<double>::infinity();
   Eigen::VectorXd root(first[C]), d(static_cast<Eigen::Index>(C)), v(T);
@@ -90,14 +95,16 @@ Eigen::VectorXd continuous_design(const Reduced& R) {
   const auto scale2 = [&](Eigen::Index t) { return R.scale2[static_cast<std::size_t>(t)]; };
   const auto information = [&]() {
     for (std::size_t k = 0; k < C; ++k)
-      root.segment(first[k], first[k + 1] - first[k]).setConstant(std::sqrt(w[static_cast<Eigen::Index>(k)]));
+      root.segment(first[k], first[k + 1] - first[k])
+          .setConstant(std::sqrt(w[static_cast<Eigen::Index>(k)]));
     const Eigen::MatrixXd Fw = F * root.asDiagonal();
     return Reduced::inverse(Fw * Fw.transpose(), inv);
   };
   for (int outer = 0; outer < 40; ++outer) {
     for (int it = 0; it < 10; ++it) {
       if (!information()) return best < std::numeric_limits<double>::infinity() ? best_w : w;
-      for (Eigen::Index t = 0; t < T; ++t) W.row(t) = inv.row(target(t)) * std::sqrt(lam[t] * scale2(t));
+      for (Eigen::Index t = 0; t < T; ++t)
+        W.row(t) = inv.row(target(t)) * std::sqrt(lam[t] * scale2(t));
       const Eigen::RowVectorXd col = (W * F).colwise().squaredNorm();
       for (std::size_t k = 0; k < C; ++k)
         d[static_cast<Eigen::Index>(k)] = col.segment(first[k], first[k + 1] - first[k]).sum();
@@ -130,7 +137,8 @@ std::vector<int> efficient_rounding(const Eigen::VectorXd& w, int n) {
   std::vector<int> counts(C, 0);
   const double l = static_cast<double>(support.size());
   for (std::size_t k : support)
-    counts[k] = std::max(1, static_cast<int>(std::ceil((n - l / 2.0) * w[static_cast<Eigen::Index>(k)] / total)));
+    counts[k] = std::max(
+        1, static_cast<int>(std::ceil((n - l / 2.0) * w[static_cast<Eigen::Index>(k)] / total)));
   const auto weight = [&](std::size_t k) { return w[static_cast<Eigen::Index>(k)] / total; };
   int sum = std::accumulate(counts.begin(), counts.end(), 0);
   while (sum < n) {
@@ -142,7 +150,8 @@ std::vector<int> efficient_rounding(const Eigen::VectorXd& w, int n) {
   while (sum > n) {
     std::size_t best = support.front();
     for (std::size_t k : support)
-      if (counts[k] > 1 && (counts[best] <= 1 || (counts[k] - 1) / weight(k) > (counts[best] - 1) / weight(best)))
+      if (counts[k] > 1 &&
+          (counts[best] <= 1 || (counts[k] - 1) / weight(k) > (counts[best] - 1) / weight(best)))
         best = k;
     --counts[best], --sum;
   }
@@ -151,7 +160,8 @@ std::vector<int> efficient_rounding(const Eigen::VectorXd& w, int n) {
 
 }  // namespace
 
-DesignUncertainty design_uncertainty(const Inverted& inv, const ParameterBlock& target, const Eigen::VectorXd& scale,
+DesignUncertainty design_uncertainty(const Inverted& inv, const ParameterBlock& target,
+                                     const Eigen::VectorXd& scale,
                                      const std::vector<bool>& required) {
   DesignUncertainty out;
   out.feasible = true;
@@ -175,12 +185,14 @@ Allocation allocate_runs(const AllocationProblem& P) {
   if (P.runs < 1) throw InvalidArgument("allocate_runs: runs must be >= 1");
   const Eigen::Index p = P.candidates.front().rows();
   for (const Eigen::MatrixXd& A : P.candidates)
-    if (A.rows() != p || A.cols() != p) throw InvalidArgument("allocate_runs: candidates of different sizes");
+    if (A.rows() != p || A.cols() != p)
+      throw InvalidArgument("allocate_runs: candidates of different sizes");
   if (P.scale.size() != P.target.size || P.plausible.size() < p || P.target.end() > p)
     throw InvalidArgument("allocate_runs: scale, plausible or target do not fit the candidates");
   // What all candidates together determine: the criterion's parameters.
   Eigen::MatrixXd all = Eigen::MatrixXd::Zero(p, p);
-  for (const Eigen::MatrixXd& A : P.candidates) all += A * (static_cast<double>(P.runs) / static_cast<double>(C));
+  for (const Eigen::MatrixXd& A : P.candidates)
+    all += A * (static_cast<double>(P.runs) / static_cast<double>(C));
   const Inverted every = invert_information(all, P.plausible.head(p), P.white);
   Allocation out;
   std::vector<Eigen::Index> F;
@@ -192,7 +204,8 @@ Allocation allocate_runs(const AllocationProblem& P) {
   for (const Eigen::MatrixXd& A : P.candidates) R.A.push_back(A(F, F));
   for (Eigen::Index a = 0; a < static_cast<Eigen::Index>(F.size()); ++a)
     if (P.target.contains(F[static_cast<std::size_t>(a)]))
-      R.target.push_back(a), R.scale2.push_back(std::pow(P.scale[F[static_cast<std::size_t>(a)] - P.target.offset], 2));
+      R.target.push_back(a), R.scale2.push_back(std::pow(
+                                 P.scale[F[static_cast<std::size_t>(a)] - P.target.offset], 2));
 
   out.counts = efficient_rounding(continuous_design(R), P.runs);
   const auto information = [&](const std::vector<int>& n) {

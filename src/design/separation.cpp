@@ -10,9 +10,9 @@
 #include <limits>
 #include <sstream>
 
-#include "rotacal/design/format.hpp"
 #include "rotacal/core/error.hpp"
 #include "rotacal/core/least_squares.hpp"
+#include "rotacal/design/format.hpp"
 
 namespace rotacal {
 
@@ -75,7 +75,8 @@ Inverted invert_information(const Eigen::MatrixXd& I, const Eigen::VectorXd& pla
 // and of block b: the largest correlation of any combination of one block with any of the
 // other (held parameters are fixed, as in the fit); 1 when no parameter of a block is
 // determined.
-double canonical_correlation(const Inverted& inv, const ParameterBlock& a, const ParameterBlock& b) {
+double canonical_correlation(const Inverted& inv, const ParameterBlock& a,
+                             const ParameterBlock& b) {
   std::vector<Eigen::Index> ia, ib;
   for (Eigen::Index j = a.offset; j < a.end(); ++j)
     if (inv.determined[static_cast<std::size_t>(j)]) ia.push_back(j);
@@ -113,14 +114,16 @@ double session_weight(double noise_um_option, const NoiseModel& noise, double fi
   return D.effective_per_reading / (sigma_um * sigma_um * 1e-6);
 }
 
-SeparationProblem separation_problem(const Eigen::MatrixXd& Js, double w, const ParameterLayout& joint,
-                                     const ParameterBlock& first, const ParameterBlock& second,
-                                     double max_correlation, double max_added_time_s, const SeparationResult& D) {
+SeparationProblem separation_problem(const Eigen::MatrixXd& Js, double w,
+                                     const ParameterLayout& joint, const ParameterBlock& first,
+                                     const ParameterBlock& second, double max_correlation,
+                                     double max_added_time_s, const SeparationResult& D) {
   SeparationProblem S;
   S.session_information = Js.transpose() * Js * w;
   const std::vector<std::string> units = joint.units();
   S.plausible.resize(joint.size());
-  for (Eigen::Index j = 0; j < joint.size(); ++j) S.plausible[j] = plausible_magnitude(units[static_cast<std::size_t>(j)]);
+  for (Eigen::Index j = 0; j < joint.size(); ++j)
+    S.plausible[j] = plausible_magnitude(units[static_cast<std::size_t>(j)]);
   S.white = 1.0 / D.effective_per_reading;
   S.first = first;
   S.second = second;
@@ -136,7 +139,8 @@ bool separation_needed(const SeparationProblem& S, SeparationResult& D) {
   D.correlation_before = canonical_correlation(before, S.first, S.second);
   D.sigma_after = D.sigma_before;
   if (D.motion.same_motion) {
-    D.verdict = "no test can separate " + D.effects[0] + " and " + D.effects[1] + ": " + D.motion.why;
+    D.verdict =
+        "no test can separate " + D.effects[0] + " and " + D.effects[1] + ": " + D.motion.why;
     return false;
   }
   if (D.correlation_before < S.max_correlation) {
@@ -144,14 +148,16 @@ bool separation_needed(const SeparationProblem& S, SeparationResult& D) {
     std::ostringstream v;
     v.precision(2);
     v << std::fixed << "the session alone separates " << D.effects[0] << " and " << D.effects[1]
-      << " (correlation " << D.correlation_before << " < " << S.max_correlation << "): no added test is needed";
+      << " (correlation " << D.correlation_before << " < " << S.max_correlation
+      << "): no added test is needed";
     D.verdict = v.str();
     return false;
   }
   return true;
 }
 
-SeparationChoice search_separation(const SeparationProblem& S, const std::vector<AddedInformation>& added) {
+SeparationChoice search_separation(const SeparationProblem& S,
+                                   const std::vector<AddedInformation>& added) {
   const Eigen::Index p0 = S.session_information.rows();
   SeparationChoice best;
   double best_run = 0.0;
@@ -161,7 +167,8 @@ SeparationChoice search_separation(const SeparationProblem& S, const std::vector
     const Eigen::Index p = a.information.rows();
     Eigen::MatrixXd I0 = Eigen::MatrixXd::Zero(p, p);
     I0.topLeftCorner(p0, p0) = S.session_information;
-    for (double rep = 1.0; a.duration_s * rep <= S.max_added_time_s * (1 + 1e-12) && (rep == 1.0 || a.repeatable);
+    for (double rep = 1.0;
+         a.duration_s * rep <= S.max_added_time_s * (1 + 1e-12) && (rep == 1.0 || a.repeatable);
          rep *= 2.0) {
       const Eigen::MatrixXd I = I0 + rep * a.information;
       const Inverted inv = invert_information(I, S.plausible.head(p), S.white);
@@ -171,7 +178,8 @@ SeparationChoice search_separation(const SeparationProblem& S, const std::vector
         determined = determined && inv.determined[static_cast<std::size_t>(j)];
       const double run = a.duration_s * rep;
       const auto take = [&] {
-        best.index = k, best.repeats = rep, best.correlation = correlation, best.determined = determined;
+        best.index = k, best.repeats = rep, best.correlation = correlation,
+        best.determined = determined;
         best_run = run;
         best_info = I;
       };
@@ -183,19 +191,23 @@ SeparationChoice search_separation(const SeparationProblem& S, const std::vector
         }
         break;
       }
-      if (!best.found && (best.index == SeparationChoice::none || correlation < best.correlation)) take();
+      if (!best.found && (best.index == SeparationChoice::none || correlation < best.correlation))
+        take();
     }
   }
   if (best.index != SeparationChoice::none)
-    best.sigma_after = invert_information(best_info, S.plausible.head(best_info.rows()), S.white).sigma;
+    best.sigma_after =
+        invert_information(best_info, S.plausible.head(best_info.rows()), S.white).sigma;
   return best;
 }
 
-void finish_separation(const SeparationProblem& S, const SeparationChoice& c, const std::string& description,
-                       double run_s, const std::vector<std::string>& added_names, const SeparationWording& w,
+void finish_separation(const SeparationProblem& S, const SeparationChoice& c,
+                       const std::string& description, double run_s,
+                       const std::vector<std::string>& added_names, const SeparationWording& w,
                        SeparationResult& D) {
   D.found = c.found;
-  const double correlation = c.index == SeparationChoice::none ? D.correlation_before : c.correlation;
+  const double correlation =
+      c.index == SeparationChoice::none ? D.correlation_before : c.correlation;
   if (c.index != SeparationChoice::none) {
     D.sigma_after = c.sigma_after;
     D.names.insert(D.names.end(), added_names.begin(), added_names.end());
@@ -204,18 +216,21 @@ void finish_separation(const SeparationProblem& S, const SeparationChoice& c, co
   v.precision(2);
   v << std::fixed;
   if (D.found)
-    v << "add " << description << ": " << fixed_text(run_s, 0) << " s; fitted with the session, the correlation of "
-      << D.effects[0] << " and " << D.effects[1] << " goes from " << D.correlation_before << " to " << correlation;
+    v << "add " << description << ": " << fixed_text(run_s, 0)
+      << " s; fitted with the session, the correlation of " << D.effects[0] << " and "
+      << D.effects[1] << " goes from " << D.correlation_before << " to " << correlation;
   else
-    v << "none of " << D.candidates_tried << " " << w.added << " within " << fixed_text(S.max_added_time_s, 0)
-      << " s brings the correlation of " << D.effects[0] << " and " << D.effects[1] << " below " << S.max_correlation
-      << (D.candidates_tried ? "; the closest is " + description + " (correlation " + fixed_text(correlation, 2) + ")" +
-                                   w.closest_note
+    v << "none of " << D.candidates_tried << " " << w.added << " within "
+      << fixed_text(S.max_added_time_s, 0) << " s brings the correlation of " << D.effects[0]
+      << " and " << D.effects[1] << " below " << S.max_correlation
+      << (D.candidates_tried ? "; the closest is " + description + " (correlation " +
+                                   fixed_text(correlation, 2) + ")" + w.closest_note
                              : std::string("; every candidate breaks a limit"));
   if (D.candidates_tried) {
     std::string held;
     for (Eigen::Index j = S.first.offset; j < S.second.end(); ++j)
-      if (!std::isfinite(D.sigma_after[j])) held += (held.empty() ? "" : ", ") + D.names[static_cast<std::size_t>(j)];
+      if (!std::isfinite(D.sigma_after[j]))
+        held += (held.empty() ? "" : ", ") + D.names[static_cast<std::size_t>(j)];
     if (!held.empty())
       v << "; " << held << " remain undetermined (no reading" << w.seen_by
         << " sees them: the joint fit holds them at 0, and the correlation is that of the rest)";

@@ -10,9 +10,9 @@
 #include <sstream>
 #include <vector>
 
-#include "rotacal/design/format.hpp"
 #include "rotacal/core/error.hpp"
 #include "rotacal/core/parameter_layout.hpp"
+#include "rotacal/design/format.hpp"
 #include "rotacal/kinematics/parameter_blocks.hpp"
 
 namespace rotacal {
@@ -115,15 +115,16 @@ TableMotionOverlap table_motion_overlap(MachineType m, const Effect& a, const Ef
   const MotionLayout L = motion_layout(m, fx);
   const Eigen::MatrixXd G = table_motion_columns(L, m, fx, poses, times, r_ref);
   const Eigen::Index na = a.num_params(), nb = b.num_params();
-  const Eigen::MatrixXd E1 = G.middleCols(L.effects.offset, na), E2 = G.middleCols(L.effects.offset + na, nb);
+  const Eigen::MatrixXd E1 = G.middleCols(L.effects.offset, na),
+                        E2 = G.middleCols(L.effects.offset + na, nb);
   // The location errors and the table point: the columns before the effects.
   const Eigen::MatrixXd G0 = G.leftCols(L.effects.offset);
   const double n1 = E1.norm(), n2 = E2.norm(), scale = std::max(G0.norm(), 1.0);
   TableMotionOverlap out;
   out.moves_table_first = n1 > 1e-12 * scale;
   out.moves_table_second = n2 > 1e-12 * scale;
-  const std::string range =
-      "tilt " + deg_range(tilt) + ", C over a full turn, time 0.." + fixed_text(duration_s, 0) + " s";
+  const std::string range = "tilt " + deg_range(tilt) + ", C over a full turn, time 0.." +
+                            fixed_text(duration_s, 0) + " s";
   if (!out.moves_table_first || !out.moves_table_second) {
     out.why =
         (out.moves_table_first ? b : a).id() +

@@ -1,10 +1,9 @@
 // Wording of ambiguities: which test of the standard set-up separates two candidates that
 // explain this session's residuals equally well.
+#include <Eigen/SVD>
 #include <map>
 #include <set>
 #include <sstream>
-
-#include <Eigen/SVD>
 
 #include "scoring.hpp"
 
@@ -13,9 +12,11 @@ namespace rotacal::diagnosis_detail {
 std::string separating_test(const DiagnosisProblem& P, const ModelFit& fit, const Score& a,
                             const Score& b, double sigma_mm) {
   if (P.reference_groups().empty())
-    return "none of this session's tests separates them; `rotacal design ballbar|rtest --separate " +
+    return "none of this session's tests separates them; `rotacal design ballbar|rtest "
+           "--separate " +
            a.effect.id() + "," + b.effect.id() +
-           " --after SESSION` (the instrument of this session) proposes the test that does, or says why none "
+           " --after SESSION` (the instrument of this session) proposes the test that does, or "
+           "says why none "
            "can";
   // Fit each candidate's full parameter vector to this session's residual, then compare what
   // they predict on the standard test.

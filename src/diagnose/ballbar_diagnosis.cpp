@@ -59,8 +59,10 @@ ModelFit BallbarDiagnosisProblem::fit_gls(const EffectModel& effects,
                                                   static_cast<Eigen::Index>(id.residuals.size()));
   f.jacobian = std::move(id.jacobian);
   for (std::size_t j = 0; j < id.fixed.size(); ++j) {
-    if (id.fixed[j]) f.jacobian.col(static_cast<Eigen::Index>(j)).setZero();
-    else ++f.num_free;
+    if (id.fixed[j])
+      f.jacobian.col(static_cast<Eigen::Index>(j)).setZero();
+    else
+      ++f.num_free;
   }
   return f;
 }
@@ -81,21 +83,25 @@ Eigen::MatrixXd length_jets(MachineType m, const std::vector<BallbarSample>& sam
   std::vector<Jet> p(static_cast<std::size_t>(L.all.size()), Jet(0.0));
   for (std::size_t i = 0; i < at.parameters.size(); ++i) p[i] = Jet(at.parameters[i].value);
   const std::size_t first = at.parameters.size();  // the candidate's parameters: the layout's last
-  for (std::size_t k = 0; k < seed.size(); ++k) p[first + static_cast<std::size_t>(seed[k])] = Jet(0.0, static_cast<int>(k));
-  Eigen::MatrixXd out(static_cast<Eigen::Index>(samples.size()), static_cast<Eigen::Index>(seed.size()));
+  for (std::size_t k = 0; k < seed.size(); ++k)
+    p[first + static_cast<std::size_t>(seed[k])] = Jet(0.0, static_cast<int>(k));
+  Eigen::MatrixXd out(static_cast<Eigen::Index>(samples.size()),
+                      static_cast<Eigen::Index>(seed.size()));
   for (std::size_t r = 0; r < samples.size(); ++r) {
     const BallbarSample& s = samples[r];
-    const Jet L_r = ballbar_residual<Jet>(L, m, fx, p.data(), 0, s.xyz, s.angles_rad(), s.time, motion[r], 0.0);
+    const Jet L_r =
+        ballbar_residual<Jet>(L, m, fx, p.data(), 0, s.xyz, s.angles_rad(), s.time, motion[r], 0.0);
     for (std::size_t k = 0; k < seed.size(); ++k)
-      out(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(k)) = L_r.v[static_cast<Eigen::Index>(k)];
+      out(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(k)) =
+          L_r.v[static_cast<Eigen::Index>(k)];
   }
   return out;
 }
 
 // jets(width, effect, seed) for candidate_jets.hpp, by Jets of width 4 whatever the seed (the
 // head machines' and the tests' path since the chain rule: one instantiation builds faster).
-auto jets_on(MachineType m, const std::vector<BallbarSample>& samples, const std::vector<RotaryMotion>& motion,
-             const ModelFit& at) {
+auto jets_on(MachineType m, const std::vector<BallbarSample>& samples,
+             const std::vector<RotaryMotion>& motion, const ModelFit& at) {
   return [&, m](auto /*width*/, const Effect& effect, const std::vector<int>& seed) {
     return length_jets<4>(m, samples, motion, at, effect, seed);
   };
@@ -103,7 +109,8 @@ auto jets_on(MachineType m, const std::vector<BallbarSample>& samples, const std
 
 // The same by the chain rule at the fit of `S`, on machines it supports; the candidates' own
 // places kept in `cache` when given (the session's rows).
-auto chain_rule_on(const diagnosis_detail::BallbarSensitivities& S, diagnosis_detail::BallbarPlacesCache* cache) {
+auto chain_rule_on(const diagnosis_detail::BallbarSensitivities& S,
+                   diagnosis_detail::BallbarPlacesCache* cache) {
   return [&S, cache](auto /*width*/, const Effect& effect, const std::vector<int>& seed) {
     if (!cache) return S.columns(S.places(effect, seed));
     return S.columns(*cache->get(S.key(effect, seed), [&] { return S.places(effect, seed); }));
@@ -114,14 +121,19 @@ auto chain_rule_on(const diagnosis_detail::BallbarSensitivities& S, diagnosis_de
 
 Eigen::MatrixXd BallbarDiagnosisProblem::jacobian_on(const std::vector<BallbarSample>& samples,
                                                      const std::vector<RotaryMotion>& motion,
-                                                     const ModelFit& at, const Effect& candidate) const {
-  const auto angles = [&](Eigen::Index r) { return samples[static_cast<std::size_t>(r)].angles_rad(); };
+                                                     const ModelFit& at,
+                                                     const Effect& candidate) const {
+  const auto angles = [&](Eigen::Index r) {
+    return samples[static_cast<std::size_t>(r)].angles_rad();
+  };
   const MachineType m = session_.machine;
   if (!diagnosis_detail::BallbarSensitivities::supports(m))
-    return diagnosis_detail::jacobian_of_candidate(m, candidate, jets_on(m, samples, motion, at), angles);
+    return diagnosis_detail::jacobian_of_candidate(m, candidate, jets_on(m, samples, motion, at),
+                                                   angles);
   const diagnosis_detail::BallbarSensitivities S(m, samples, motion, at);
-  return diagnosis_detail::jacobian_of_candidate(m, candidate, chain_rule_on(S, &samples == &session_.samples ? places_.get() : nullptr),
-                                                 angles);
+  return diagnosis_detail::jacobian_of_candidate(
+      m, candidate, chain_rule_on(S, &samples == &session_.samples ? places_.get() : nullptr),
+      angles);
 }
 
 std::vector<Eigen::MatrixXd> BallbarDiagnosisProblem::candidate_jacobians(
@@ -129,11 +141,12 @@ std::vector<Eigen::MatrixXd> BallbarDiagnosisProblem::candidate_jacobians(
   const auto angles = [&](Eigen::Index r) { return arrays_.angles[static_cast<std::size_t>(r)]; };
   const MachineType m = session_.machine;
   if (!diagnosis_detail::BallbarSensitivities::supports(m))
-    return diagnosis_detail::jacobians_of_candidates(m, candidates, jets_on(m, session_.samples, arrays_.motion, at),
-                                                     angles);
+    return diagnosis_detail::jacobians_of_candidates(
+        m, candidates, jets_on(m, session_.samples, arrays_.motion, at), angles);
   // The fit's part of every row once for all candidates (ballbar_sensitivities.hpp).
   const diagnosis_detail::BallbarSensitivities S(m, session_.samples, arrays_.motion, at);
-  return diagnosis_detail::jacobians_of_candidates(m, candidates, chain_rule_on(S, places_.get()), angles);
+  return diagnosis_detail::jacobians_of_candidates(m, candidates, chain_rule_on(S, places_.get()),
+                                                   angles);
 }
 
 Eigen::MatrixXd BallbarDiagnosisProblem::candidate_jacobian(const ModelFit& at,
@@ -143,8 +156,9 @@ Eigen::MatrixXd BallbarDiagnosisProblem::candidate_jacobian(const ModelFit& at,
 
 Eigen::MatrixXd BallbarDiagnosisProblem::candidate_jacobian_by_jets(const ModelFit& at,
                                                                     const Effect& candidate) const {
-  return diagnosis_detail::jets_of_width(candidate, diagnosis_detail::all_parameters(candidate),
-                                         jets_on(session_.machine, session_.samples, arrays_.motion, at));
+  return diagnosis_detail::jets_of_width(
+      candidate, diagnosis_detail::all_parameters(candidate),
+      jets_on(session_.machine, session_.samples, arrays_.motion, at));
 }
 
 std::vector<std::string> BallbarDiagnosisProblem::reference_groups() const {

@@ -10,13 +10,18 @@
 namespace rotacal::diagnosis_detail {
 
 BallbarSensitivities::BallbarSensitivities(MachineType m, const std::vector<BallbarSample>& samples,
-                                           const std::vector<RotaryMotion>& motion, const ModelFit& at)
-    : m_(m), samples_(samples), motion_(motion), s_(static_cast<Eigen::Index>(samples.size()), length_chain::kPlaces) {
+                                           const std::vector<RotaryMotion>& motion,
+                                           const ModelFit& at)
+    : m_(m),
+      samples_(samples),
+      motion_(motion),
+      s_(static_cast<Eigen::Index>(samples.size()), length_chain::kPlaces) {
   ROTACAL_ASSERT(supports(m) && motion.size() == samples.size());
   reference_.linear_reference = at.effects.linear_reference;
   const BallbarLayout L = ballbar_layout(m, at.effects);
   Eigen::VectorXd x(static_cast<Eigen::Index>(at.parameters.size()));
-  for (std::size_t i = 0; i < at.parameters.size(); ++i) x[static_cast<Eigen::Index>(i)] = at.parameters[i].value;
+  for (std::size_t i = 0; i < at.parameters.size(); ++i)
+    x[static_cast<Eigen::Index>(i)] = at.parameters[i].value;
   const LocationErrors<double> e(L.errors.of<8>(x));
   const Eigen::Vector3d pivot = L.pivots.of<3>(x);
   const double* p = L.effects.ptr(x.data());
@@ -25,19 +30,22 @@ BallbarSensitivities::BallbarSensitivities(MachineType m, const std::vector<Ball
   for (std::size_t r = 0; r < samples.size(); ++r) {
     const BallbarSample& smp = samples[r];
     angles_.push_back(smp.angles_rad());
-    length_chain::sensitivities(m, e, pivot, at.effects, p, {smp.xyz, angles_.back(), smp.time, motion[r]}, s, nullptr);
+    length_chain::sensitivities(m, e, pivot, at.effects, p,
+                                {smp.xyz, angles_.back(), smp.time, motion[r]}, s, nullptr);
     s_.row(static_cast<Eigen::Index>(r)) = s.transpose();
   }
 }
 
-BallbarPlaces BallbarSensitivities::places(const Effect& effect, const std::vector<int>& seed) const {
+BallbarPlaces BallbarSensitivities::places(const Effect& effect,
+                                           const std::vector<int>& seed) const {
   ROTACAL_ASSERT(!seed.empty() && seed.size() <= 4 && effect.num_params() <= 4);
   // Most candidates (the harmonic channels among them) seed one parameter: Jets of width 1.
   return seed.size() == 1 ? places_with<1>(effect, seed) : places_with<4>(effect, seed);
 }
 
 template <int N>
-BallbarPlaces BallbarSensitivities::places_with(const Effect& effect, const std::vector<int>& seed) const {
+BallbarPlaces BallbarSensitivities::places_with(const Effect& effect,
+                                                const std::vector<int>& seed) const {
   using Jet = ceres::Jet<double, N>;
   using length_chain::kPlaces;
   EffectModel fx = reference_;
@@ -65,7 +73,8 @@ BallbarPlaces BallbarSensitivities::places_with(const Effect& effect, const std:
   out.d.resize(n, static_cast<Eigen::Index>(out.places.size()) * seeds);
   for (std::size_t i = 0; i < out.places.size(); ++i)
     for (int k = 0; k < seeds; ++k)
-      out.d.col(static_cast<Eigen::Index>(i) * seeds + k) = all.row(out.places[i] + kPlaces * k).transpose();
+      out.d.col(static_cast<Eigen::Index>(i) * seeds + k) =
+          all.row(out.places[i] + kPlaces * k).transpose();
   return out;
 }
 
@@ -84,7 +93,8 @@ Eigen::MatrixXd BallbarSensitivities::columns(const BallbarPlaces& p) const {
   Eigen::MatrixXd out = Eigen::MatrixXd::Zero(s_.rows(), p.seeds);
   for (std::size_t i = 0; i < p.places.size(); ++i)
     for (int k = 0; k < p.seeds; ++k)
-      out.col(k).array() += s_.col(p.places[i]).array() * p.d.col(static_cast<Eigen::Index>(i) * p.seeds + k).array();
+      out.col(k).array() +=
+          s_.col(p.places[i]).array() * p.d.col(static_cast<Eigen::Index>(i) * p.seeds + k).array();
   return out;
 }
 

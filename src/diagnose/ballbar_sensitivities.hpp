@@ -26,7 +26,7 @@ namespace rotacal::diagnosis_detail {
 struct BallbarPlaces {
   std::vector<int> places;  ///< length_chain::Place indices, ascending
   int seeds = 0;
-  Eigen::MatrixXd d;        ///< column i * seeds + k: d places[i] / d seed k; a row per reading
+  Eigen::MatrixXd d;  ///< column i * seeds + k: d places[i] / d seed k; a row per reading
 };
 
 class BallbarSensitivities {
@@ -52,7 +52,8 @@ class BallbarSensitivities {
   const std::vector<RotaryMotion>& motion_;
   std::vector<RotaryAngles<double>> angles_;
   EffectModel reference_;  // no effects: the fit's linear_reference for the candidate's own stages
-  Eigen::Matrix<double, Eigen::Dynamic, length_chain::kPlaces> s_;  // dL / d place: a column per place
+  Eigen::Matrix<double, Eigen::Dynamic, length_chain::kPlaces>
+      s_;  // dL / d place: a column per place
 };
 
 /// BallbarPlaces of one session's rows by BallbarSensitivities::key, shared by every fit.

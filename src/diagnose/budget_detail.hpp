@@ -13,8 +13,8 @@ namespace rotacal::budget_detail {
 /// The model a budget is of.
 struct BudgetedFit {
   MachineType machine;
-  const ModelFit& fit;     ///< parameters (the location errors by name), residuals, free columns
-  const NoiseModel& noise; ///< of fit.residuals (white: sigma noise_um)
+  const ModelFit& fit;      ///< parameters (the location errors by name), residuals, free columns
+  const NoiseModel& noise;  ///< of fit.residuals (white: sigma noise_um)
   double noise_um;
   /// Type A covariance in fit.parameters order, as the fit reports it; nullptr: (J_w^T J_w)^-1.
   const Eigen::MatrixXd* covariance;
@@ -27,7 +27,7 @@ void check_inputs(const PlausibleSizes& sizes, const std::vector<Effect>& all, d
 /// The budget of m's location errors against the left-out `candidates`, whose columns
 /// (d reading / d effect parameter, mm per unit, rows as m.fit's) are `jacobians`.
 UncertaintyBudget budget_of(const BudgetedFit& m, const std::vector<Effect>& candidates,
-                            const std::vector<Eigen::MatrixXd>& jacobians, const PlausibleSizes& sizes,
-                            double coverage);
+                            const std::vector<Eigen::MatrixXd>& jacobians,
+                            const PlausibleSizes& sizes, double coverage);
 
 }  // namespace rotacal::budget_detail

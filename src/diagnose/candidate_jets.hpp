@@ -26,11 +26,16 @@ namespace rotacal::diagnosis_detail {
 template <typename Jets>
 Eigen::MatrixXd jets_of_width(const Effect& effect, const std::vector<int>& seed, Jets&& jets) {
   switch (seed.size()) {
-    case 1: return jets(std::integral_constant<int, 1>{}, effect, seed);
-    case 2: return jets(std::integral_constant<int, 2>{}, effect, seed);
-    case 3: return jets(std::integral_constant<int, 3>{}, effect, seed);
-    case 4: return jets(std::integral_constant<int, 4>{}, effect, seed);
-    default: break;
+    case 1:
+      return jets(std::integral_constant<int, 1>{}, effect, seed);
+    case 2:
+      return jets(std::integral_constant<int, 2>{}, effect, seed);
+    case 3:
+      return jets(std::integral_constant<int, 3>{}, effect, seed);
+    case 4:
+      return jets(std::integral_constant<int, 4>{}, effect, seed);
+    default:
+      break;
   }
   throw InvalidArgument("candidate " + effect.id() + " has " + std::to_string(seed.size()) +
                         " parameters; the diagnosis handles 1 to 4");
@@ -72,8 +77,9 @@ Eigen::MatrixXd expand_harmonic(MachineType m, const Effect& candidate, const Ei
 /// Jacobians of every candidate at one fit, the channels of each harmonic kind and axis
 /// evaluated once.
 template <typename Jets, typename AnglesOfRow>
-std::vector<Eigen::MatrixXd> jacobians_of_candidates(MachineType m, const std::vector<Effect>& candidates,
-                                                         Jets&& jets, AnglesOfRow&& angles_of_row) {
+std::vector<Eigen::MatrixXd> jacobians_of_candidates(MachineType m,
+                                                     const std::vector<Effect>& candidates,
+                                                     Jets&& jets, AnglesOfRow&& angles_of_row) {
   std::vector<std::pair<Effect, Eigen::MatrixXd>> channels;
   std::vector<Eigen::MatrixXd> out;
   out.reserve(candidates.size());
@@ -84,7 +90,8 @@ std::vector<Eigen::MatrixXd> jacobians_of_candidates(MachineType m, const std::v
     }
     Effect key = c;
     key.harmonic = 0;
-    auto it = std::find_if(channels.begin(), channels.end(), [&](const auto& e) { return e.first == key; });
+    auto it = std::find_if(channels.begin(), channels.end(),
+                           [&](const auto& e) { return e.first == key; });
     if (it == channels.end()) {
       channels.emplace_back(key, harmonic_channels(c, jets));
       it = channels.end() - 1;
@@ -96,7 +103,8 @@ std::vector<Eigen::MatrixXd> jacobians_of_candidates(MachineType m, const std::v
 
 /// One candidate's Jacobian (its own channels when harmonic).
 template <typename Jets, typename AnglesOfRow>
-Eigen::MatrixXd jacobian_of_candidate(MachineType m, const Effect& c, Jets&& jets, AnglesOfRow&& angles_of_row) {
+Eigen::MatrixXd jacobian_of_candidate(MachineType m, const Effect& c, Jets&& jets,
+                                      AnglesOfRow&& angles_of_row) {
   if (!c.is_harmonic()) return jets_of_width(c, all_parameters(c), jets);
   return expand_harmonic(m, c, harmonic_channels(c, jets), angles_of_row);
 }

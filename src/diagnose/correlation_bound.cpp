@@ -24,12 +24,13 @@ double residual_ss(const Eigen::MatrixXd& X, const Eigen::VectorXd& y) {
 
 }  // namespace
 
-bool holds_at_correlation_bound(const SearchContext& S, const Round& R, const Score& s, const ModelFit& fit,
-                                const ModelFit& refit, double m_tests) {
+bool holds_at_correlation_bound(const SearchContext& S, const Round& R, const Score& s,
+                                const ModelFit& fit, const ModelFit& refit, double m_tests) {
   const double z = S.P.correlation_bound_z();
   const std::size_t ci = static_cast<std::size_t>(&s - R.scores.data());
   // The 1/f-like treatment (levels, random walk) bounds its noise by the declared variance.
-  if (!(z > 0.0) || R.levels_of[ci] || R.treatment_of[ci].full || s.X.cols() <= R.in.Jfree.cols()) return true;
+  if (!(z > 0.0) || R.levels_of[ci] || R.treatment_of[ci].full || s.X.cols() <= R.in.Jfree.cols())
+    return true;
   const double n = static_cast<double>(refit.residuals.size());
   // Each stream's lag-1 coefficient (Burg's, at order 1 even where BIC would call the stream
   // white), corrected for the stream's mean, then raised to the upper bound of its confidence
@@ -37,7 +38,8 @@ bool holds_at_correlation_bound(const SearchContext& S, const Round& R, const Sc
   // share of them). Streams too short for an AR fit stay white.
   NoiseModelOptions lag1;
   lag1.max_order = lag1.min_order = 1;
-  const NoiseModel estimated = with_mean_bias_corrected(estimate_noise_model(S.layout, refit.residuals, lag1));
+  const NoiseModel estimated =
+      with_mean_bias_corrected(estimate_noise_model(S.layout, refit.residuals, lag1));
   std::vector<double> rho(estimated.streams.size(), 0.0);
   for (std::size_t st = 0; st < rho.size(); ++st) {
     const NoiseStream& stream = estimated.streams[st];
@@ -57,7 +59,8 @@ bool holds_at_correlation_bound(const SearchContext& S, const Round& R, const Sc
   const double delta_bic = n * std::log(rss1 / rss0) + s.k * std::log(n);
   const double dof = n - fit.num_free - s.k;
   const double F = ((rss0 - rss1) / s.k) / (rss1 / dof);
-  return delta_bic < S.options.min_delta_bic && stats::f_sf(std::max(F, 0.0), s.k, dof) < S.options.alpha / m_tests;
+  return delta_bic < S.options.min_delta_bic &&
+         stats::f_sf(std::max(F, 0.0), s.k, dof) < S.options.alpha / m_tests;
 }
 
 }  // namespace rotacal::diagnosis_detail

@@ -101,7 +101,8 @@ std::vector<Effect> candidate_list(const DiagnosisProblem& P, const DiagnosisOpt
 // the values of lower orders (C every 30 deg: order 7 is order 5): scored, it would name an
 // order the data cannot tell. Judged on every reading's angle of that axis, since the effect's
 // parameters are shared by all of them. Returns the reason per candidate (empty: resolved).
-std::vector<std::string> unresolved_orders(const DiagnosisProblem& P, const std::vector<Effect>& candidates,
+std::vector<std::string> unresolved_orders(const DiagnosisProblem& P,
+                                           const std::vector<Effect>& candidates,
                                            double min_new_content) {
   std::vector<std::string> unresolved(candidates.size());
   std::map<char, int> top;
@@ -180,9 +181,9 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
 // (the white one redone with a better sigma, the coloured one whose final residuals are white)
 // decided nothing by it. Judged on the fit the cache holds, D.final_fit (a copy of it) released
 // meanwhile and copied again after: the structure test's peak has no second n x p Jacobian.
-void judge_kept(const DiagnosisProblem& P, const DiagnosisOptions& options, const ModelFit& baseline,
-                const NoiseTreatment& noise, const NoiseModel* model, const NoiseTreatment& white,
-                SearchCache& cache, Diagnosis& D) {
+void judge_kept(const DiagnosisProblem& P, const DiagnosisOptions& options,
+                const ModelFit& baseline, const NoiseTreatment& noise, const NoiseModel* model,
+                const NoiseTreatment& white, SearchCache& cache, Diagnosis& D) {
   EffectModel effects;
   effects.linear_reference = P.mean_commanded_xyz();
   for (const Finding& F : D.findings) effects.effects.push_back(F.effect);
@@ -200,14 +201,16 @@ void judge_kept(const DiagnosisProblem& P, const DiagnosisOptions& options, cons
 // differences overestimated the noise (sparse sampling against the systematic errors, as an
 // R-test's 30 degree steps): if the extended model leaves less, that is the better estimate.
 Diagnosis search_white(const DiagnosisProblem& P, const DiagnosisOptions& options,
-                       const std::vector<Effect>& candidates, const ModelFit& baseline, SearchCache& cache) {
+                       const std::vector<Effect>& candidates, const ModelFit& baseline,
+                       SearchCache& cache) {
   const NoiseTreatment white = white_treatment(P, baseline);
   Diagnosis D = search(P, options, candidates, baseline, white, nullptr, white, cache);
   NoiseTreatment kept = white;
   if (!P.declared_noise_um()) {
     const double n = static_cast<double>(D.final_fit.residuals.size());
     const double s_final =
-        std::sqrt(D.final_fit.residuals.squaredNorm() / std::max(1.0, n - D.final_fit.num_free)) * 1e3;
+        std::sqrt(D.final_fit.residuals.squaredNorm() / std::max(1.0, n - D.final_fit.num_free)) *
+        1e3;
     if (s_final < 0.8 * D.baseline.noise_um) {
       NoiseTreatment better;
       better.sigma_mm = s_final * 1e-3;
@@ -233,17 +236,20 @@ Diagnosis search_white(const DiagnosisProblem& P, const DiagnosisOptions& option
 // effects whose later, nearly aliased rival made both undetermined together (a 10x gravity sag
 // of A on the probe in AR(1) 0.9 found as linear_scale_Z, 56 sigma alone, then a second A
 // shape: 'nothing').
-void refit_findings(const DiagnosisProblem& P, const DiagnosisOptions& options, const NoiseTreatment& gls_noise,
-                    Diagnosis& D) {
+void refit_findings(const DiagnosisProblem& P, const DiagnosisOptions& options,
+                    const NoiseTreatment& gls_noise, Diagnosis& D) {
   for (;;) {
     EffectModel found;
     found.linear_reference = P.mean_commanded_xyz();
     for (const Finding& F : D.findings) found.effects.push_back(F.effect);
     D.final_fit = P.fit_gls(found, gls_noise.full ? gls_noise.full : gls_noise.W);
-    const double scale = std::sqrt(std::max(1.0, gls_noise.whiten(D.final_fit.residuals).squaredNorm() /
-                                   std::max(1.0, static_cast<double>(D.final_fit.residuals.size() - D.final_fit.num_free))));
+    const double scale =
+        std::sqrt(std::max(1.0, gls_noise.whiten(D.final_fit.residuals).squaredNorm() /
+                                    std::max(1.0, static_cast<double>(D.final_fit.residuals.size() -
+                                                                      D.final_fit.num_free))));
     const auto determined = [&](const Finding& F) {
-      return determined_sigmas(D.final_fit, F.effect, gls_noise) / scale >= options.min_determined_sigma;
+      return determined_sigmas(D.final_fit, F.effect, gls_noise) / scale >=
+             options.min_determined_sigma;
     };
     if (std::all_of(D.findings.begin(), D.findings.end(), determined)) {
       profile_time_constants(P, gls_noise, scale, D);
@@ -253,13 +259,17 @@ void refit_findings(const DiagnosisProblem& P, const DiagnosisOptions& options, 
       }
       return;
     }
-    const std::string sigma = std::to_string(static_cast<int>(options.min_determined_sigma)) + " sigma";
-    D.unobservable.push_back({D.findings.back().effect.id(),
-                              determined(D.findings.back())
-                                  ? "the search named it, but by GLS under the noise the final model leaves an earlier "
-                                    "finding's parameters cannot be determined beside it (none reaches " + sigma + ")"
-                                  : "the search named it, but by GLS under the noise the final model leaves none of its "
-                                    "parameters reaches " + sigma});
+    const std::string sigma =
+        std::to_string(static_cast<int>(options.min_determined_sigma)) + " sigma";
+    D.unobservable.push_back(
+        {D.findings.back().effect.id(),
+         determined(D.findings.back())
+             ? "the search named it, but by GLS under the noise the final model leaves an earlier "
+               "finding's parameters cannot be determined beside it (none reaches " +
+                   sigma + ")"
+             : "the search named it, but by GLS under the noise the final model leaves none of its "
+               "parameters reaches " +
+                   sigma});
     D.findings.pop_back();
   }
 }
@@ -275,9 +285,11 @@ void refit_findings(const DiagnosisProblem& P, const DiagnosisOptions& options, 
 // rho the sigmas were 0.75 of the true-covariance GLS ones (1.00 without it); by REML on the
 // ballbar (where it applies most, REML seldom keeping a walk there) a median 1.085 of the sigmas
 // under the true noise model (1.005 without it; bench/diagnosis_confusion.py cells, AR(1) 0.9).
-void final_gls(const DiagnosisProblem& P, const DiagnosisOptions& options, const NoiseModel& model, Diagnosis& D) {
+void final_gls(const DiagnosisProblem& P, const DiagnosisOptions& options, const NoiseModel& model,
+               Diagnosis& D) {
   if (D.findings.empty()) return;
-  const NoiseModel reml = estimate_noise_model_reml(model, D.final_fit.residuals, free_columns(D.final_fit.jacobian));
+  const NoiseModel reml =
+      estimate_noise_model_reml(model, D.final_fit.residuals, free_columns(D.final_fit.jacobian));
   NoiseTreatment gls_noise;
   gls_noise.sigma_mm = reml.sigma_um * 1e-3;
   gls_noise.W = std::make_shared<ArWhitener>(reml);
@@ -290,7 +302,8 @@ void final_gls(const DiagnosisProblem& P, const DiagnosisOptions& options, const
 void white_time_constants(const DiagnosisProblem& P, Diagnosis& D) {
   const Eigen::VectorXd& r = D.final_fit.residuals;
   NoiseTreatment t;
-  t.sigma_mm = std::sqrt(r.squaredNorm() / std::max(1.0, static_cast<double>(r.size() - D.final_fit.num_free)));
+  t.sigma_mm = std::sqrt(r.squaredNorm() /
+                         std::max(1.0, static_cast<double>(r.size() - D.final_fit.num_free)));
   if (!(t.sigma_mm > 0.0)) return;
   profile_time_constants(P, t, 1.0, D);
   for (Finding& F : D.findings) F.parameters = parameters_of(D.final_fit, F.effect);
@@ -312,14 +325,19 @@ void white_hidden_levels(const DiagnosisProblem& P, const DiagnosisOptions& opti
   NoiseModelOptions white_streams;
   white_streams.max_order = 0;
   NoiseModel m = estimate_noise_model(P.groups(), P.times(), r, white_streams);
-  const double s_um = std::sqrt(r.squaredNorm() / std::max(1.0, static_cast<double>(r.size() - D.final_fit.num_free))) * 1e3;
+  const double s_um =
+      std::sqrt(r.squaredNorm() /
+                std::max(1.0, static_cast<double>(r.size() - D.final_fit.num_free))) *
+      1e3;
   for (NoiseStream& st : m.streams) st.marginal_sigma_um = st.innovation_sigma_um = s_um;
   NoiseTreatment t;
   t.sigma_mm = s_um * 1e-3;
   t.W = std::make_shared<ArWhitener>(m);
   with_hidden_levels(P, m, t);
-  if (t.full) refit_findings(P, options, t, D);
-  else white_time_constants(P, D);
+  if (t.full)
+    refit_findings(P, options, t, D);
+  else
+    white_time_constants(P, D);
 }
 
 }  // namespace
@@ -340,7 +358,8 @@ Diagnosis diagnose(const DiagnosisProblem& P, const DiagnosisOptions& options) {
     white_hidden_levels(P, options, D);
   } else {
     const NoiseModel searched = model;
-    const NoiseTreatment coloured = coloured_treatment(searched), white = white_treatment(P, baseline);
+    const NoiseTreatment coloured = coloured_treatment(searched),
+                         white = white_treatment(P, baseline);
     D = search(P, options, candidates, baseline, coloured, &searched, white, cache);
     // Reported: the noise model of what the final model leaves. If that is white, the
     // correlation was the unmodelled effects': the white-noise diagnosis is the right one.

@@ -29,7 +29,8 @@ void judge_remainder(const SearchContext& S, const ModelFit& final_fit, Diagnosi
     // model would take its structure for correlated noise and whiten it away, and with the
     // tested structure fitted first it would lose the noise's low frequencies with it and find
     // structure in every null session.
-    const NoiseModel final_model = estimate_noise_model(S.layout, final_fit.residuals, S.options.noise);
+    const NoiseModel final_model =
+        estimate_noise_model(S.layout, final_fit.residuals, S.options.noise);
     Eigen::MatrixXd Jfree = free_columns(final_fit.jacobian);
     int num_free = final_fit.num_free;
     // 1/f-like: stream levels are nuisance and the noise is AR(1) + a random walk by REML, as
@@ -45,13 +46,14 @@ void judge_remainder(const SearchContext& S, const ModelFit& final_fit, Diagnosi
       Jfree = X;
       EffectModel final_effects;  // the model final_fit is the fit of: the findings'
       for (const Finding& F : D.findings) final_effects.effects.push_back(F.effect);
-      wander = coloured_treatment(
-          S.cache.level_walk(SearchCache::key(final_effects), final_model, final_fit.residuals, Jfree));
+      wander = coloured_treatment(S.cache.level_walk(SearchCache::key(final_effects), final_model,
+                                                     final_fit.residuals, Jfree));
     }
     NoiseModelOptions pooled = S.options.noise;
     pooled.pooled = true;
     pooled.pool_only_if_all_coloured = false;
-    const NoiseModel pooled_all = estimate_noise_model(S.layout, final_fit.residuals, pooled);  // its streams
+    const NoiseModel pooled_all =
+        estimate_noise_model(S.layout, final_fit.residuals, pooled);  // its streams
     // The other groups' pooled model, one per group tested: the same residual without one
     // group, its order searched up to the pooled order of all groups + 2 (as for the candidates).
     NoiseModelOptions others_options = pooled;
@@ -61,13 +63,15 @@ void judge_remainder(const SearchContext& S, const ModelFit& final_fit, Diagnosi
       NoiseTreatment t_noise = S.white;
       const NoiseStreamLayout others_layout = S.layout.except_group(group);
       if (!others_layout.rows.empty()) {
-        const NoiseModel others = estimate_noise_model(others_layout, final_fit.residuals, others_options);
+        const NoiseModel others =
+            estimate_noise_model(others_layout, final_fit.residuals, others_options);
         if (!others.white()) {
           NoiseModel all = pooled_all;
           const NoiseStream& o = others.streams.front();
           for (NoiseStream& st : all.streams) {
             st.reflection = o.reflection, st.ar = o.ar;
-            st.marginal_sigma_um = o.marginal_sigma_um, st.innovation_sigma_um = o.innovation_sigma_um;
+            st.marginal_sigma_um = o.marginal_sigma_um,
+            st.innovation_sigma_um = o.innovation_sigma_um;
           }
           t_noise = coloured_treatment(all, false);
         }
@@ -94,10 +98,12 @@ void judge_remainder(const SearchContext& S, const ModelFit& final_fit, Diagnosi
       D.unexplained.signature += where.str();
       // A function of one rotary angle: offer the per-angle table as the extension.
       if (L.axis) {
-        const NoiseModel left = estimate_noise_model(S.layout, final_fit.residuals, S.options.noise);
-        AngleTable T = angle_table(S.P, final_fit.residuals, D.unexplained.group, left, S.noise.sigma_mm * 1e3,
-                                   S.options.cv_blocks);
-        if (T.gain.cv_rms_after_um < T.gain.cv_rms_before_um) D.angle_tables.push_back(std::move(T));
+        const NoiseModel left =
+            estimate_noise_model(S.layout, final_fit.residuals, S.options.noise);
+        AngleTable T = angle_table(S.P, final_fit.residuals, D.unexplained.group, left,
+                                   S.noise.sigma_mm * 1e3, S.options.cv_blocks);
+        if (T.gain.cv_rms_after_um < T.gain.cv_rms_before_um)
+          D.angle_tables.push_back(std::move(T));
       }
     }
   }

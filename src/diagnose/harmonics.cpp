@@ -33,8 +33,10 @@ HarmonicResolution resolve_harmonics(const std::vector<double>& angles_rad, char
   std::vector<double> at;
   std::vector<double> count;
   for (double x : a) {
-    if (!at.empty() && x - at.back() <= same) count.back() += 1.0;
-    else at.push_back(x), count.push_back(1.0);
+    if (!at.empty() && x - at.back() <= same)
+      count.back() += 1.0;
+    else
+      at.push_back(x), count.push_back(1.0);
   }
   if (at.size() > 1 && at.front() + turn - at.back() <= same) {  // wraps past 360 deg
     count.front() += count.back();
@@ -103,8 +105,10 @@ std::string HarmonicResolution::why_not(int order) const {
   out.precision(3);
   out << axis << " is sampled at " << distinct_angles << " distinct angle"
       << (distinct_angles == 1 ? "" : "s");
-  if (even_step_deg > 0.0) out << ", " << even_step_deg << " deg apart over a full turn";
-  else out << " spanning " << span_deg << " deg";
+  if (even_step_deg > 0.0)
+    out << ", " << even_step_deg << " deg apart over a full turn";
+  else
+    out << " spanning " << span_deg << " deg";
   if (order <= resolved || order > max_order) {
     out << ": order " << order << " is resolved";
     return out.str();

@@ -25,7 +25,8 @@ double within_stream_variance(const NoiseStream& s) {
   const double q2 = std::pow(s.random_walk_step_um * 1e-3, 2), nd = static_cast<double>(n);
   double total = nd * g[0];  // 1^T V 1
   for (std::size_t k = 1; k < n; ++k) total += 2.0 * static_cast<double>(n - k) * g[k];
-  for (std::size_t m = 1; m < n; ++m) total += q2 * static_cast<double>(m) * static_cast<double>(2 * (n - 1 - m) + 1);
+  for (std::size_t m = 1; m < n; ++m)
+    total += q2 * static_cast<double>(m) * static_cast<double>(2 * (n - 1 - m) + 1);
   const double mean_var = g[0] + q2 * (nd - 1.0) / 2.0;
   return mean_var - total / (nd * nd);
 }
@@ -70,12 +71,15 @@ bool exceeds_declared(const NoiseStream& s, const Eigen::VectorXd& r, double dec
 // Without a declared noise there is nothing to compare with, and the model is taken as it is.
 class HiddenLevels : public ResidualWhitener {
  public:
-  HiddenLevels(std::shared_ptr<const ArWhitener> W, const NoiseModel& m, double declared_mm, VarianceBound bound)
+  HiddenLevels(std::shared_ptr<const ArWhitener> W, const NoiseModel& m, double declared_mm,
+               VarianceBound bound)
       : W_(std::move(W)) {
-    Eigen::MatrixXd ones = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(m.n), static_cast<Eigen::Index>(m.streams.size()));
+    Eigen::MatrixXd ones = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(m.n),
+                                                 static_cast<Eigen::Index>(m.streams.size()));
     std::vector<double> d;
     for (const NoiseStream& s : m.streams) {
-      const double walk = std::pow(s.random_walk_step_um * 1e-3, 2) * (static_cast<double>(s.rows.size()) - 1.0) / 2.0;
+      const double walk = std::pow(s.random_walk_step_um * 1e-3, 2) *
+                          (static_cast<double>(s.rows.size()) - 1.0) / 2.0;
       // At most the declared variance: the noise's level over a stream varies no more than one
       // reading does (the mean of a stationary stream has at most its marginal variance). The
       // walk's mean variance is unbounded in n_s: REML's walk of 1/f-like readings (its slow
@@ -86,9 +90,10 @@ class HiddenLevels : public ResidualWhitener {
       const double declared2 = declared_mm * declared_mm;
       // kMarginal: what the declared variance holds beyond the mean of the model's variances of
       // the readings, g0 + q^2 (n - 1) / 2 (a stationary stream's readings each have it).
-      const double lacking = bound == VarianceBound::kMarginal
-                                 ? declared2 - (ar_autocovariance(s, 1).front() + walk)
-                                 : std::min(declared2, std::max(0.0, declared2 - within_stream_variance(s)) + walk);
+      const double lacking =
+          bound == VarianceBound::kMarginal
+              ? declared2 - (ar_autocovariance(s, 1).front() + walk)
+              : std::min(declared2, std::max(0.0, declared2 - within_stream_variance(s)) + walk);
       if (!(lacking > 0.0)) continue;
       for (Eigen::Index r : s.rows) ones(r, static_cast<Eigen::Index>(d.size())) = 1.0;
       d.push_back(lacking);
@@ -118,7 +123,8 @@ class HiddenLevels : public ResidualWhitener {
 }  // namespace
 
 // `t` with the hidden levels of `m` (the model W whitens by) against the declared noise, if any.
-void with_hidden_levels(const DiagnosisProblem& P, const NoiseModel& m, NoiseTreatment& t, VarianceBound bound) {
+void with_hidden_levels(const DiagnosisProblem& P, const NoiseModel& m, NoiseTreatment& t,
+                        VarianceBound bound) {
   if (const std::optional<double> declared = P.declared_noise_um()) {
     auto levels = std::make_shared<const HiddenLevels>(t.W, m, *declared * 1e-3, bound);
     if (levels->any()) t.full = std::move(levels);
@@ -135,15 +141,18 @@ double walk_step_within(const NoiseStream& s, double declared2) {
   NoiseStream ar_only = s;
   ar_only.random_walk_step_um = 0.0;
   const double ar_part = within_stream_variance(ar_only);
-  const double per_q2 = (within - ar_part) / std::pow(s.random_walk_step_um * 1e-3, 2);  // linear in q^2
-  return ar_part < declared2 && per_q2 > 0.0 ? std::sqrt((declared2 - ar_part) / per_q2) * 1e3 : 0.0;
+  const double per_q2 =
+      (within - ar_part) / std::pow(s.random_walk_step_um * 1e-3, 2);  // linear in q^2
+  return ar_part < declared2 && per_q2 > 0.0 ? std::sqrt((declared2 - ar_part) / per_q2) * 1e3
+                                             : 0.0;
 }
 
 // The same with the mean of the readings' variances, g0 + q^2 (n - 1) / 2, at most declared2.
 double walk_step_marginal(const NoiseStream& s, double declared2) {
   const double g0 = ar_autocovariance(s, 1).front();
   const double half_n = (static_cast<double>(s.rows.size()) - 1.0) / 2.0;
-  if (g0 + std::pow(s.random_walk_step_um * 1e-3, 2) * half_n <= declared2) return s.random_walk_step_um;
+  if (g0 + std::pow(s.random_walk_step_um * 1e-3, 2) * half_n <= declared2)
+    return s.random_walk_step_um;
   return g0 < declared2 ? std::sqrt((declared2 - g0) / half_n) * 1e3 : 0.0;
 }
 
@@ -172,20 +181,22 @@ constexpr double kMarginalShare = 0.75;
 // declared noise allows (exceeds_declared): the bound forced a 5 um bump over 40 deg of a ballbar
 // test onto three wrong catalogue shapes, where REML's walk leaves it to the unexplained-structure
 // test and its per-angle table (test_diagnose_realistic).
-void with_walk_bounded_by_declared(const DiagnosisProblem& P, const Eigen::VectorXd& r, NoiseModel& m,
-                                   VarianceBound bound) {
+void with_walk_bounded_by_declared(const DiagnosisProblem& P, const Eigen::VectorXd& r,
+                                   NoiseModel& m, VarianceBound bound) {
   const std::optional<double> declared = P.declared_noise_um();
   if (!declared || !(*declared > 0.0)) return;
   const double declared2 = std::pow(*declared * 1e-3, 2);
   for (NoiseStream& s : m.streams) {
-    if (!(s.random_walk_step_um > 0.0) || s.rows.size() < 2 || exceeds_declared(s, r, declared2)) continue;
+    if (!(s.random_walk_step_um > 0.0) || s.rows.size() < 2 || exceeds_declared(s, r, declared2))
+      continue;
     const double within = walk_step_within(s, declared2);
     if (bound == VarianceBound::kWithin) {
       s.random_walk_step_um = within;
       continue;
     }
     const double marginal = walk_step_marginal(s, declared2);
-    s.random_walk_step_um = std::sqrt(kMarginalShare * marginal * marginal + (1.0 - kMarginalShare) * within * within);
+    s.random_walk_step_um =
+        std::sqrt(kMarginalShare * marginal * marginal + (1.0 - kMarginalShare) * within * within);
   }
 }
 

@@ -42,12 +42,13 @@ FinalModel final_model(const DiagnosisProblem& P, const Diagnosis& D) {
     M.levels = stream_levels(P);
     M.X = side_by_side(M.X, M.levels);
   }
-  M.noise = coloured_treatment(estimate_noise_model_reml(D.noise, D.final_fit.residuals, M.X), false);
+  M.noise =
+      coloured_treatment(estimate_noise_model_reml(D.noise, D.final_fit.residuals, M.X), false);
   return M;
 }
 
-Eigen::MatrixXd window_columns(const std::vector<LocalBlock>& blocks, std::size_t first, std::size_t count,
-                               Eigen::Index n) {
+Eigen::MatrixXd window_columns(const std::vector<LocalBlock>& blocks, std::size_t first,
+                               std::size_t count, Eigen::Index n) {
   Eigen::Index k = 0;
   for (std::size_t b = first; b < first + count; ++b) k += blocks[b].columns.cols();
   Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, k);
@@ -68,7 +69,8 @@ struct Window {
 
 // The F-test of a window's free shifts on the whitened residual r_w beside the model's
 // whitened basis Q (free parameters: num_free).
-double window_p(const Eigen::MatrixXd& Q, const Eigen::VectorXd& r_w, const Eigen::MatrixXd& G_w, double num_free) {
+double window_p(const Eigen::MatrixXd& Q, const Eigen::VectorXd& r_w, const Eigen::MatrixXd& G_w,
+                double num_free) {
   const Eigen::MatrixXd B = orthonormal_basis(project_out(Q, G_w));
   const auto q = static_cast<double>(B.cols());
   const double dof = static_cast<double>(r_w.size()) - num_free - q;
@@ -79,14 +81,14 @@ double window_p(const Eigen::MatrixXd& Q, const Eigen::VectorXd& r_w, const Eige
 }
 
 // The window's shifts (mm) fitted to y_mm beside the columns `model`, linearised at the final fit.
-Eigen::VectorXd window_shift_mm(const FinalModel& M, const Eigen::MatrixXd& model, const Eigen::VectorXd& y_mm,
-                                const Eigen::MatrixXd& G) {
+Eigen::VectorXd window_shift_mm(const FinalModel& M, const Eigen::MatrixXd& model,
+                                const Eigen::VectorXd& y_mm, const Eigen::MatrixXd& G) {
   return solve_ls(M.noise.whiten(side_by_side(model, G)), M.noise.whiten(y_mm)).tail(G.cols());
 }
 
 // Where the window is, in words, and as D.unexplained's axis and range.
-std::string describe(const DiagnosisProblem& P, const std::vector<LocalBlock>& blocks, const Window& w,
-                     const Eigen::VectorXd& shift_mm, Unexplained& U) {
+std::string describe(const DiagnosisProblem& P, const std::vector<LocalBlock>& blocks,
+                     const Window& w, const Eigen::VectorXd& shift_mm, Unexplained& U) {
   const LocalBlock& a = blocks[w.first];
   const LocalBlock& b = blocks[w.first + w.count - 1];
   double lo_r = 1e300, hi_r = -1e300, lo_t = 1e300, hi_t = -1e300;
@@ -103,7 +105,8 @@ std::string describe(const DiagnosisProblem& P, const std::vector<LocalBlock>& b
   out << " deg, C " << lo_r;
   if (hi_r > lo_r) out << ".." << hi_r;
   out << " deg, t " << a.t_from << ".." << b.t_to << " s): a free shift of "
-      << (w.count > 1 ? "these poses" : "this pose") << " explains what the catalogue does not (p = ";
+      << (w.count > 1 ? "these poses" : "this pose")
+      << " explains what the catalogue does not (p = ";
   out.precision(2);
   out << w.p << " over every window of up to " << kMaxWindow << " poses; largest shift component "
       << shift_mm.cwiseAbs().maxCoeff() * 1e3 << " um)";
@@ -132,12 +135,15 @@ Share share_of(const ModelFit& fit, const Effect& effect) {
     const ParameterEstimate& p = fit.parameters[static_cast<std::size_t>(j)];
     const bool mine = p.name == id || p.name.rfind(id + ".", 0) == 0;
     (mine ? own : others).push_back(j);
-    if (mine && p.name.find(".ln_tau") == std::string::npos) S.signature += fit.jacobian.col(j) * p.value;
+    if (mine && p.name.find(".ln_tau") == std::string::npos)
+      S.signature += fit.jacobian.col(j) * p.value;
   }
   S.own.resize(fit.jacobian.rows(), static_cast<Eigen::Index>(own.size()));
   S.others.resize(fit.jacobian.rows(), static_cast<Eigen::Index>(others.size()));
-  for (std::size_t k = 0; k < own.size(); ++k) S.own.col(static_cast<Eigen::Index>(k)) = fit.jacobian.col(own[k]);
-  for (std::size_t k = 0; k < others.size(); ++k) S.others.col(static_cast<Eigen::Index>(k)) = fit.jacobian.col(others[k]);
+  for (std::size_t k = 0; k < own.size(); ++k)
+    S.own.col(static_cast<Eigen::Index>(k)) = fit.jacobian.col(own[k]);
+  for (std::size_t k = 0; k < others.size(); ++k)
+    S.others.col(static_cast<Eigen::Index>(k)) = fit.jacobian.col(others[k]);
   return S;
 }
 
@@ -151,8 +157,8 @@ struct LocalRival {
   Eigen::MatrixXd others;  // the model's columns without the finding's (+ levels)
   Eigen::VectorXd y_mm;    // the final residuals with the finding's signature put back
 };
-LocalRival local_rival(const Diagnosis& D, const FinalModel& M, const std::vector<LocalBlock>& blocks,
-                       const Finding& F) {
+LocalRival local_rival(const Diagnosis& D, const FinalModel& M,
+                       const std::vector<LocalBlock>& blocks, const Finding& F) {
   const Share S = share_of(D.final_fit, F.effect);
   const Eigen::Index n = S.signature.size();
   LocalRival out;
@@ -166,11 +172,13 @@ LocalRival local_rival(const Diagnosis& D, const FinalModel& M, const std::vecto
   const double dof = static_cast<double>(n - Q.cols() - B_own.cols());
   const double scale = dof > 0 ? std::max(1.0, rss_f / dof) : 1.0;
   const auto k = static_cast<double>(B_own.cols());
-  for (std::size_t count = 1; count <= static_cast<std::size_t>(kMaxWindow) && count <= blocks.size(); ++count)
+  for (std::size_t count = 1;
+       count <= static_cast<std::size_t>(kMaxWindow) && count <= blocks.size(); ++count)
     for (std::size_t first = 0; first + count <= blocks.size(); ++first) {
       Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(count));
       for (std::size_t b = 0; b < count; ++b)
-        for (Eigen::Index i : blocks[first + b].rows) G(i, static_cast<Eigen::Index>(b)) = S.signature[i];
+        for (Eigen::Index i : blocks[first + b].rows)
+          G(i, static_cast<Eigen::Index>(b)) = S.signature[i];
       const Eigen::MatrixXd B = orthonormal_basis(project_out(Q, M.noise.whiten(G)));
       const double rss_w = y_perp.squaredNorm() - (B.transpose() * y_perp).squaredNorm();
       const auto q = static_cast<double>(B.cols());
@@ -178,9 +186,11 @@ LocalRival local_rival(const Diagnosis& D, const FinalModel& M, const std::vecto
       const double d_aic = (rss_w - rss_f) / scale + (q - k) * 2.0;
       // The window's own evidence: its columns' F-test beside the other parameters.
       const double dof_w = static_cast<double>(n - Q.cols()) - q;
-      const double p = q > 0 && dof_w > 0 ? stats::f_sf(std::max(0.0, ((y_perp.squaredNorm() - rss_w) / q) /
-                                                                         (rss_w / dof_w)), q, dof_w)
-                                           : 1.0;
+      const double p =
+          q > 0 && dof_w > 0
+              ? stats::f_sf(std::max(0.0, ((y_perp.squaredNorm() - rss_w) / q) / (rss_w / dof_w)),
+                            q, dof_w)
+              : 1.0;
       if (d_bic < out.delta_bic) out.delta_bic = d_bic, out.window_bic = {first, count, p};
       if (d_aic < out.delta_aic) out.delta_aic = d_aic, out.window_aic = {first, count, p};
     }
@@ -216,10 +226,12 @@ void judge_local_structure(const DiagnosisProblem& P, const std::vector<LocalBlo
   const Eigen::VectorXd r_w = M.noise.whiten(r);
   Window best;
   int windows = 0;
-  for (std::size_t count = 1; count <= static_cast<std::size_t>(kMaxWindow) && count <= blocks.size(); ++count)
+  for (std::size_t count = 1;
+       count <= static_cast<std::size_t>(kMaxWindow) && count <= blocks.size(); ++count)
     for (std::size_t first = 0; first + count <= blocks.size(); ++first, ++windows) {
-      const double p = window_p(Q, r_w, M.noise.whiten(window_columns(blocks, first, count, r.size())),
-                                static_cast<double>(Q.cols()));
+      const double p =
+          window_p(Q, r_w, M.noise.whiten(window_columns(blocks, first, count, r.size())),
+                   static_cast<double>(Q.cols()));
       if (p < best.p) best = {first, count, p};
     }
   best.p = std::min(1.0, best.p * windows);
@@ -245,7 +257,8 @@ void judge_local_structure(const DiagnosisProblem& P, const std::vector<LocalBlo
     Window at = L.delta_aic < L.delta_bic ? L.window_aic : L.window_bic;
     std::ostringstream why;
     why.precision(2);
-    why << "its signature only in pose" << (at.count > 1 ? "s '" : " '") << blocks[at.first].label << "'"
+    why << "its signature only in pose" << (at.count > 1 ? "s '" : " '") << blocks[at.first].label
+        << "'"
         << (at.count > 1 ? "..'" + blocks[at.first + at.count - 1].label + "'" : std::string())
         << " and nowhere else fits the readings as well (weight " << w << " against " << before
         << " before): a local defect there, outside the catalogue, explains them at least as well";
@@ -254,13 +267,17 @@ void judge_local_structure(const DiagnosisProblem& P, const std::vector<LocalBlo
     demoted.emplace_back(at, std::move(L));
   }
   if (best.p < 1e-3) {
-    report(P, blocks, best, window_shift_mm(M, M.X, r, window_columns(blocks, best.first, best.count, r.size())), D);
+    report(P, blocks, best,
+           window_shift_mm(M, M.X, r, window_columns(blocks, best.first, best.count, r.size())), D);
   } else if (!demoted.empty()) {
     // What a finding without a confident name took from the readings is still structure the
     // catalogue does not explain: reported where its local rival holds it, with the shifts
     // fitted in the finding's place.
     const auto& [at, L] = demoted.front();
-    report(P, blocks, at, window_shift_mm(M, L.others, L.y_mm, window_columns(blocks, at.first, at.count, r.size())), D);
+    report(
+        P, blocks, at,
+        window_shift_mm(M, L.others, L.y_mm, window_columns(blocks, at.first, at.count, r.size())),
+        D);
   }
 }
 

@@ -1,9 +1,9 @@
 // The touch probe as an instrument of the diagnosis engine (diagnose/probe_diagnosis.hpp).
 #include "rotacal/diagnose/probe_diagnosis.hpp"
 
+#include "local_structure.hpp"
 #include "rotacal/probe/identify.hpp"
 #include "rotacal/probe/problem.hpp"
-#include "local_structure.hpp"
 
 namespace rotacal {
 
@@ -19,7 +19,8 @@ std::vector<Effect> ProbeDiagnosisProblem::candidates(int max_harmonic) const {
   std::vector<Effect> out;
   const bool head = session_.machine.has_head();
   for (const Effect& e : probe_effect_catalogue(session_.machine, max_harmonic))
-    if (e.kind != EffectKind::ballbar_length_offset && e.kind != EffectKind::ballbar_thermal_drift &&
+    if (e.kind != EffectKind::ballbar_length_offset &&
+        e.kind != EffectKind::ballbar_thermal_drift &&
         !(head && e.kind == EffectKind::tool_offset_Z) && !e.depends_on_motion())
       out.push_back(e);
   return out;
@@ -28,10 +29,12 @@ std::vector<Effect> ProbeDiagnosisProblem::candidates(int max_harmonic) const {
 // A finding must hold with the stream's lag-1 correlation at the upper 2-sigma bound of its
 // estimate: false findings in AR(1) 0.5 null sessions 20 -> 5 of 1600 (seeds 141-151,
 // bench/diagnosis_confusion.py; the 5 pass at the true rho too), detection in AR(1) 0.5, white,
-// AR(1) 0.9 and 1/f-like noise at 3x / 10x unchanged. The ballbar's and R-test's streams are longer or many: their nulls were clean.
+// AR(1) 0.9 and 1/f-like noise at 3x / 10x unchanged. The ballbar's and R-test's streams are longer
+// or many: their nulls were clean.
 double ProbeDiagnosisProblem::correlation_bound_z() const { return 2.0; }
 
-ModelFit ProbeDiagnosisProblem::fit_gls(const EffectModel& effects, std::shared_ptr<const ResidualWhitener> noise) const {
+ModelFit ProbeDiagnosisProblem::fit_gls(const EffectModel& effects,
+                                        std::shared_ptr<const ResidualWhitener> noise) const {
   ProbeFitOptions o;
   o.effects = effects;
   o.whitener = std::move(noise);
@@ -39,21 +42,26 @@ ModelFit ProbeDiagnosisProblem::fit_gls(const EffectModel& effects, std::shared_
   ModelFit f;
   f.effects = id.model.effects;
   f.parameters = std::move(id.parameters);
-  f.residuals = Eigen::Map<const Eigen::VectorXd>(id.residuals.data(), static_cast<Eigen::Index>(id.residuals.size()));
+  f.residuals = Eigen::Map<const Eigen::VectorXd>(id.residuals.data(),
+                                                  static_cast<Eigen::Index>(id.residuals.size()));
   f.jacobian = std::move(id.jacobian);
   for (std::size_t j = 0; j < id.fixed.size(); ++j) {
-    if (id.fixed[j]) f.jacobian.col(static_cast<Eigen::Index>(j)).setZero();
-    else ++f.num_free;
+    if (id.fixed[j])
+      f.jacobian.col(static_cast<Eigen::Index>(j)).setZero();
+    else
+      ++f.num_free;
   }
   return f;
 }
 
-Eigen::MatrixXd ProbeDiagnosisProblem::candidate_jacobian(const ModelFit& at, const Effect& candidate) const {
+Eigen::MatrixXd ProbeDiagnosisProblem::candidate_jacobian(const ModelFit& at,
+                                                          const Effect& candidate) const {
   EffectModel fx = at.effects;
   fx.effects.push_back(candidate);
   const ProbeProblem problem(session_, fx);
   Eigen::VectorXd x = Eigen::VectorXd::Zero(problem.num_parameters());
-  for (std::size_t j = 0; j < at.parameters.size(); ++j) x[static_cast<Eigen::Index>(j)] = at.parameters[j].value;
+  for (std::size_t j = 0; j < at.parameters.size(); ++j)
+    x[static_cast<Eigen::Index>(j)] = at.parameters[j].value;
   Eigen::VectorXd r(problem.num_residuals());
   Eigen::MatrixXd J(problem.num_residuals(), problem.num_parameters());
   problem.evaluate(x, r, &J);

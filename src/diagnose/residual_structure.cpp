@@ -27,8 +27,8 @@ std::string describe_structure(const std::vector<GroupResidual>& groups) {
   out << "largest residual in '" << worst->group << "' (" << worst->rms_um << " um RMS";
   if (!worst->harmonic_um.empty()) {
     const auto it = std::max_element(worst->harmonic_um.begin(), worst->harmonic_um.end());
-    out << "; strongest order " << (it - worst->harmonic_um.begin()) + 1 << " in " << worst->angle_axis
-        << ", " << *it << " um";
+    out << "; strongest order " << (it - worst->harmonic_um.begin()) + 1 << " in "
+        << worst->angle_axis << ", " << *it << " um";
   }
   out << "; trend " << worst->trend_um_per_s << " um/s)";
   return out.str();
@@ -48,9 +48,11 @@ double estimate_noise_um(const DiagnosisProblem& P, const Eigen::VectorXd& r) {
   std::size_t n = 0;
   for (auto& kv : by_group) {
     auto& idx = kv.second;
-    std::stable_sort(idx.begin(), idx.end(), [&](std::size_t a, std::size_t b) { return t[a] < t[b]; });
+    std::stable_sort(idx.begin(), idx.end(),
+                     [&](std::size_t a, std::size_t b) { return t[a] < t[b]; });
     for (std::size_t k = 1; k < idx.size(); ++k) {
-      const double d = r[static_cast<Eigen::Index>(idx[k])] - r[static_cast<Eigen::Index>(idx[k - 1])];
+      const double d =
+          r[static_cast<Eigen::Index>(idx[k])] - r[static_cast<Eigen::Index>(idx[k - 1])];
       ss += d * d;
       ++n;
     }
@@ -90,7 +92,8 @@ std::vector<GroupResidual> residual_structure(const DiagnosisProblem& P, const E
     G.mean_um = y.mean() * 1e3;
     // Trend against time.
     Eigen::MatrixXd T(y.size(), 2);
-    for (Eigen::Index k = 0; k < y.size(); ++k) T(k, 0) = 1.0, T(k, 1) = t[idx[static_cast<std::size_t>(k)]];
+    for (Eigen::Index k = 0; k < y.size(); ++k)
+      T(k, 0) = 1.0, T(k, 1) = t[idx[static_cast<std::size_t>(k)]];
     if (y.size() >= 3) G.trend_um_per_s = solve_ls(T, y)[1] * 1e3;
     // Harmonics in the swept angle: only over a (nearly) full turn. On a partial arc the
     // cos/sin of different orders are nearly collinear and the "spectrum" means nothing.
@@ -132,8 +135,10 @@ std::vector<GroupResidual> residual_structure(const DiagnosisProblem& P, const E
       std::ostringstream note;
       note.precision(3);
       note << "no harmonics: ";
-      if (y.size() < 20) note << "only " << y.size() << " readings";
-      else note << G.angle_axis << " sweeps " << span * 180.0 / M_PI << " deg, not a full turn";
+      if (y.size() < 20)
+        note << "only " << y.size() << " readings";
+      else
+        note << G.angle_axis << " sweeps " << span * 180.0 / M_PI << " deg, not a full turn";
       G.harmonic_note = note.str();
     }
     out.push_back(G);
@@ -153,7 +158,8 @@ std::vector<std::size_t> rows_of(const DiagnosisProblem& P, const std::string& g
     if (P.groups()[i] == group) idx.push_back(i);
   return idx;
 }
-std::vector<double> swept(const DiagnosisProblem& P, const std::vector<std::size_t>& idx, char* axis) {
+std::vector<double> swept(const DiagnosisProblem& P, const std::vector<std::size_t>& idx,
+                          char* axis) {
   double lo_t = 1e300, hi_t = -1e300, lo_r = 1e300, hi_r = -1e300;
   for (std::size_t i : idx) {
     const RotaryAngles<double>& a = P.angles()[i];
@@ -178,26 +184,35 @@ Location locate(const DiagnosisProblem& P, const Eigen::VectorXd& r, const std::
   const std::vector<std::size_t> idx = rows_of(P, group);
   const std::vector<double> x = swept(P, idx, &L.axis);
   if (x.empty()) return L;
-  const double lo = *std::min_element(x.begin(), x.end()), hi = *std::max_element(x.begin(), x.end());
+  const double lo = *std::min_element(x.begin(), x.end()),
+               hi = *std::max_element(x.begin(), x.end());
   constexpr int kBins = 12;
   std::vector<double> sum(kBins, 0.0), cnt(kBins, 0.0);
   for (std::size_t k = 0; k < idx.size(); ++k) {
-    const int b = hi > lo ? std::min(kBins - 1, static_cast<int>((x[k] - lo) / (hi - lo) * kBins)) : 0;
+    const int b =
+        hi > lo ? std::min(kBins - 1, static_cast<int>((x[k] - lo) / (hi - lo) * kBins)) : 0;
     sum[static_cast<std::size_t>(b)] += r[static_cast<Eigen::Index>(idx[k])];
     cnt[static_cast<std::size_t>(b)] += 1.0;
   }
   std::vector<double> mean(kBins, 0.0);
   int peak = 0;
   for (int b = 0; b < kBins; ++b) {
-    mean[static_cast<std::size_t>(b)] = cnt[static_cast<std::size_t>(b)] > 0 ? sum[static_cast<std::size_t>(b)] / cnt[static_cast<std::size_t>(b)] : 0.0;
-    if (std::abs(mean[static_cast<std::size_t>(b)]) > std::abs(mean[static_cast<std::size_t>(peak)])) peak = b;
+    mean[static_cast<std::size_t>(b)] =
+        cnt[static_cast<std::size_t>(b)] > 0
+            ? sum[static_cast<std::size_t>(b)] / cnt[static_cast<std::size_t>(b)]
+            : 0.0;
+    if (std::abs(mean[static_cast<std::size_t>(b)]) >
+        std::abs(mean[static_cast<std::size_t>(peak)]))
+      peak = b;
   }
   const double half = 0.5 * std::abs(mean[static_cast<std::size_t>(peak)]);
   int first = peak, last = peak;
   while (first > 0 && std::abs(mean[static_cast<std::size_t>(first - 1)]) >= half &&
-         mean[static_cast<std::size_t>(first - 1)] * mean[static_cast<std::size_t>(peak)] > 0) --first;
+         mean[static_cast<std::size_t>(first - 1)] * mean[static_cast<std::size_t>(peak)] > 0)
+    --first;
   while (last + 1 < kBins && std::abs(mean[static_cast<std::size_t>(last + 1)]) >= half &&
-         mean[static_cast<std::size_t>(last + 1)] * mean[static_cast<std::size_t>(peak)] > 0) ++last;
+         mean[static_cast<std::size_t>(last + 1)] * mean[static_cast<std::size_t>(peak)] > 0)
+    ++last;
   const double scale = L.axis ? 180.0 / M_PI : 1.0, w = (hi - lo) / kBins;
   L.from = (lo + first * w) * scale;
   L.to = (lo + (last + 1) * w) * scale;
@@ -207,7 +222,8 @@ Location locate(const DiagnosisProblem& P, const Eigen::VectorXd& r, const std::
 
 StructureTest structure_test(
     const DiagnosisProblem& P, const Eigen::VectorXd& r_mm, const Eigen::MatrixXd& Jfree,
-    int num_free, const std::function<Whiten(const std::string&, const Eigen::MatrixXd&)>& whitener_for) {
+    int num_free,
+    const std::function<Whiten(const std::string&, const Eigen::MatrixXd&)>& whitener_for) {
   std::vector<std::string> order;
   for (const std::string& s : P.groups())
     if (std::find(order.begin(), order.end(), s) == order.end()) order.push_back(s);
@@ -219,7 +235,8 @@ StructureTest structure_test(
     if (idx.size() < 20) continue;
     char axis = 0;
     const std::vector<double> x = swept(P, idx, &axis);
-    const double lo = *std::min_element(x.begin(), x.end()), hi = *std::max_element(x.begin(), x.end());
+    const double lo = *std::min_element(x.begin(), x.end()),
+                 hi = *std::max_element(x.begin(), x.end());
     if (!(hi > lo)) continue;
     std::vector<std::function<double(double)>> f;
     int orders = 0;
@@ -231,7 +248,8 @@ StructureTest structure_test(
       }
     } else {
       for (int d = 1; d <= 4; ++d)
-        f.push_back([d, lo, hi](double v) { return std::pow(2.0 * (v - lo) / (hi - lo) - 1.0, d); });
+        f.push_back(
+            [d, lo, hi](double v) { return std::pow(2.0 * (v - lo) / (hi - lo) - 1.0, d); });
     }
     if (f.empty()) continue;
     Eigen::MatrixXd G = Eigen::MatrixXd::Zero(r_mm.size(), static_cast<Eigen::Index>(f.size()));
@@ -266,8 +284,9 @@ StructureTest structure_test(
 
 namespace rotacal {
 
-AngleTable angle_table(const DiagnosisProblem& P, const Eigen::VectorXd& r, const std::string& group,
-                       const NoiseModel& noise, double noise_um, int cv_blocks) {
+AngleTable angle_table(const DiagnosisProblem& P, const Eigen::VectorXd& r,
+                       const std::string& group, const NoiseModel& noise, double noise_um,
+                       int cv_blocks) {
   std::vector<std::size_t> idx;
   for (std::size_t i = 0; i < P.groups().size(); ++i)
     if (P.groups()[i] == group) idx.push_back(i);
@@ -285,7 +304,8 @@ AngleTable angle_table(const DiagnosisProblem& P, const Eigen::VectorXd& r, cons
       throw InvalidArgument("angle_table: group '" + group + "' sweeps no rotary angle");
     const bool rot = hi_r - lo_r >= hi_t - lo_t;
     T.axis = rot ? 'C' : tilt_axis_letter(P.machine());
-    for (std::size_t i : idx) x.push_back((rot ? P.angles()[i].rot : P.angles()[i].tilt) * 180.0 / M_PI);
+    for (std::size_t i : idx)
+      x.push_back((rot ? P.angles()[i].rot : P.angles()[i].tilt) * 180.0 / M_PI);
   }
   // Bins: the distinct commanded angles (within 0.05 deg) if there are at most 72, else 36
   // equal bins over the span.
@@ -297,20 +317,24 @@ AngleTable angle_table(const DiagnosisProblem& P, const Eigen::VectorXd& r, cons
   std::vector<int> bin(x.size());
   if (centres.size() <= 72) {
     for (std::size_t k = 0; k < x.size(); ++k)
-      bin[k] = static_cast<int>(std::min_element(centres.begin(), centres.end(), [&](double a, double b) {
-                                  return std::abs(a - x[k]) < std::abs(b - x[k]);
-                                }) - centres.begin());
+      bin[k] = static_cast<int>(std::min_element(centres.begin(), centres.end(),
+                                                 [&](double a, double b) {
+                                                   return std::abs(a - x[k]) < std::abs(b - x[k]);
+                                                 }) -
+                                centres.begin());
   } else {
     const double lo = sorted.front(), hi = sorted.back(), w = (hi - lo) / 36.0;
     centres.clear();
     for (int b = 0; b < 36; ++b) centres.push_back(lo + (b + 0.5) * w);
-    for (std::size_t k = 0; k < x.size(); ++k) bin[k] = std::min(35, static_cast<int>((x[k] - lo) / w));
+    for (std::size_t k = 0; k < x.size(); ++k)
+      bin[k] = std::min(35, static_cast<int>((x[k] - lo) / w));
   }
   const std::size_t B = centres.size();
   std::vector<double> sum(B, 0.0);
   std::vector<int> cnt(B, 0);
   for (std::size_t k = 0; k < idx.size(); ++k)
-    sum[static_cast<std::size_t>(bin[k])] += r[static_cast<Eigen::Index>(idx[k])], ++cnt[static_cast<std::size_t>(bin[k])];
+    sum[static_cast<std::size_t>(bin[k])] += r[static_cast<Eigen::Index>(idx[k])],
+        ++cnt[static_cast<std::size_t>(bin[k])];
   // Noise per reading and its correlation within the group (largest over its streams).
   double tau = 1.0;
   for (const NoiseStream& st : noise.streams)
@@ -331,8 +355,10 @@ AngleTable angle_table(const DiagnosisProblem& P, const Eigen::VectorXd& r, cons
     after[static_cast<Eigen::Index>(idx[k])] -= sum[b] / cnt[b];
   }
   const double n = static_cast<double>(r.size());
-  const double n_eff = noise.white() ? n : std::max(noise.effective_samples, static_cast<double>(used) + 2.0);
-  const double rss0 = std::max(r.squaredNorm(), 1e-300), rss1 = std::max(after.squaredNorm(), 1e-300);
+  const double n_eff =
+      noise.white() ? n : std::max(noise.effective_samples, static_cast<double>(used) + 2.0);
+  const double rss0 = std::max(r.squaredNorm(), 1e-300),
+               rss1 = std::max(after.squaredNorm(), 1e-300);
   T.gain.rms_before_um = std::sqrt(rss0 / n) * 1e3;
   T.gain.rms_after_um = std::sqrt(rss1 / n) * 1e3;
   // The likelihood scale of correlated residuals is their effective number of samples.
@@ -344,16 +370,22 @@ AngleTable angle_table(const DiagnosisProblem& P, const Eigen::VectorXd& r, cons
   // the bin means of the other blocks.
   std::vector<std::size_t> order(idx.size());
   for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return P.times()[idx[a]] < P.times()[idx[b]]; });
-  const int K = std::clamp(static_cast<int>(static_cast<double>(idx.size()) / tau), 2, std::max(2, cv_blocks));
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return P.times()[idx[a]] < P.times()[idx[b]];
+  });
+  const int K = std::clamp(static_cast<int>(static_cast<double>(idx.size()) / tau), 2,
+                           std::max(2, cv_blocks));
   std::vector<int> fold(idx.size());
-  for (std::size_t k = 0; k < order.size(); ++k) fold[order[k]] = static_cast<int>(k * static_cast<std::size_t>(K) / order.size());
+  for (std::size_t k = 0; k < order.size(); ++k)
+    fold[order[k]] = static_cast<int>(k * static_cast<std::size_t>(K) / order.size());
   double ss_before = 0.0, ss_after = 0.0;
   for (int f = 0; f < K; ++f) {
     std::vector<double> s(B, 0.0);
     std::vector<int> c(B, 0);
     for (std::size_t k = 0; k < idx.size(); ++k)
-      if (fold[k] != f) s[static_cast<std::size_t>(bin[k])] += r[static_cast<Eigen::Index>(idx[k])], ++c[static_cast<std::size_t>(bin[k])];
+      if (fold[k] != f)
+        s[static_cast<std::size_t>(bin[k])] += r[static_cast<Eigen::Index>(idx[k])],
+            ++c[static_cast<std::size_t>(bin[k])];
     for (std::size_t k = 0; k < idx.size(); ++k) {
       if (fold[k] != f) continue;
       const double y = r[static_cast<Eigen::Index>(idx[k])];

@@ -11,22 +11,24 @@ namespace {
 
 // Normalised weights exp(-(IC_i - min IC) / (2 tempering)), IC_i = bic_i - k_i (ln n - c): the
 // Occam term per parameter c instead of BIC's ln n.
-std::vector<double> weights_at(const std::vector<double>& bic, const std::vector<int>& k, double n, double c,
-                               double tempering) {
+std::vector<double> weights_at(const std::vector<double>& bic, const std::vector<int>& k, double n,
+                               double c, double tempering) {
   std::vector<double> ic(bic.size());
   for (std::size_t i = 0; i < bic.size(); ++i) ic[i] = bic[i] - k[i] * (std::log(n) - c);
   const double best = *std::min_element(ic.begin(), ic.end());
   std::vector<double> w(ic.size());
   double total = 0.0;
-  for (std::size_t i = 0; i < ic.size(); ++i) total += (w[i] = std::exp(-0.5 * (ic[i] - best) / tempering));
+  for (std::size_t i = 0; i < ic.size(); ++i)
+    total += (w[i] = std::exp(-0.5 * (ic[i] - best) / tempering));
   for (double& x : w) x /= total;
   return w;
 }
 
 }  // namespace
 
-std::vector<bool> explained_away(const ScoringInputs& in, const Score& chosen, const std::vector<const Score*>& field,
-                                 double min_delta_bic, double rival_correlation) {
+std::vector<bool> explained_away(const ScoringInputs& in, const Score& chosen,
+                                 const std::vector<const Score*>& field, double min_delta_bic,
+                                 double rival_correlation) {
   std::vector<bool> out(field.size(), false);
   if (!chosen.observable || chosen.A.cols() == 0) return out;
   const Eigen::MatrixXd Qc = orthonormal_basis(chosen.A);
@@ -35,7 +37,8 @@ std::vector<bool> explained_away(const ScoringInputs& in, const Score& chosen, c
   for (std::size_t i = 0; i < field.size(); ++i) {
     const Score& s = *field[i];
     if (&s == &chosen || !s.observable || s.A.cols() == 0 || !(s.delta_bic < min_delta_bic) ||
-        std::abs(correlation(s.signature, chosen.signature)) >= rival_correlation)  // a rival anyway
+        std::abs(correlation(s.signature, chosen.signature)) >=
+            rival_correlation)  // a rival anyway
       continue;
     const Eigen::MatrixXd Qs = orthonormal_basis(s.A - Qc * (Qc.transpose() * s.A));
     const double drop = std::min((Qs.transpose() * e).squaredNorm(), rss_c * (1.0 - 1e-12));
@@ -45,8 +48,9 @@ std::vector<bool> explained_away(const ScoringInputs& in, const Score& chosen, c
 }
 
 RivalJudgement weigh_rivals(const Score& chosen, const std::vector<const Score*>& field,
-                            const std::vector<double>& bic, double n, double tempering, double rival_correlation,
-                            double min_weight, const std::vector<bool>& explained_away) {
+                            const std::vector<double>& bic, double n, double tempering,
+                            double rival_correlation, double min_weight,
+                            const std::vector<bool>& explained_away) {
   std::vector<const Score*> who{&chosen};
   std::vector<double> corr{1.0};
   double chosen_bic = chosen.delta_bic;
@@ -72,7 +76,8 @@ RivalJudgement weigh_rivals(const Score& chosen, const std::vector<const Score*>
   out.weight = w[0];
   std::vector<std::size_t> order(who.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin() + 1, order.end(), [&](std::size_t a, std::size_t b) { return w[a] > w[b]; });
+  std::stable_sort(order.begin() + 1, order.end(),
+                   [&](std::size_t a, std::size_t b) { return w[a] > w[b]; });
   // The group: the chosen candidate, then rivals by weight until min_weight is held; then every
   // rival that some member cannot be told apart from (that member's weight against it alone
   // below min_weight) at either end of the Occam term. A rival just outside the weight that
@@ -94,7 +99,8 @@ RivalJudgement weigh_rivals(const Score& chosen, const std::vector<const Score*>
     if (member[i]) members.push_back(i);
   for (std::size_t i = 0; i < who.size(); ++i)
     for (std::size_t m : members)
-      if (!member[i] && (w_bic[i] > margin * w_bic[m] || w_aic[i] > margin * w_aic[m])) member[i] = true;
+      if (!member[i] && (w_bic[i] > margin * w_bic[m] || w_aic[i] > margin * w_aic[m]))
+        member[i] = true;
   out.group.push_back(&chosen);
   for (std::size_t j = 1; j < order.size(); ++j) {
     const std::size_t i = order[j];
@@ -121,7 +127,9 @@ RivalJudgement worse_of(const RivalJudgement& a, const RivalJudgement& b) {
     const std::string id = g->effect.id();
     const auto listed = [&](const Alternative& x) { return x.effect == id; };
     auto it = std::find_if(out.rivals.begin(), out.rivals.end(), listed);
-    if (it == out.rivals.end()) it = out.rivals.insert(out.rivals.end(), *std::find_if(other.rivals.begin(), other.rivals.end(), listed));
+    if (it == out.rivals.end())
+      it = out.rivals.insert(out.rivals.end(),
+                             *std::find_if(other.rivals.begin(), other.rivals.end(), listed));
     it->in_group = true;
   }
   return out;

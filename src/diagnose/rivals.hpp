@@ -14,24 +14,26 @@ namespace rotacal::diagnosis_detail {
 
 /// The chosen candidate's standing among its rivals.
 struct RivalJudgement {
-  double weight = 1.0;                 ///< the chosen candidate's posterior weight
-  std::vector<Alternative> rivals;     ///< best first; in_group marks the group members
-  std::vector<const Score*> group;     ///< the chosen first, then the other members
+  double weight = 1.0;              ///< the chosen candidate's posterior weight
+  std::vector<Alternative> rivals;  ///< best first; in_group marks the group members
+  std::vector<const Score*> group;  ///< the chosen first, then the other members
 };
 
 /// Which of `field` pass the BIC threshold alone but not beside `chosen` (the same inputs): the two
-/// compete for one signal even where their fitted signatures correlate little. A 3x tilt_motion_C_h4
-/// on the AC-trt ballbar in 1/f-like noise scored -21.6 against radial_motion_C_h4's -23.2, their
-/// signatures correlated by 0.44 (under rival_correlation), and beside the radial motion the tilt
-/// scored +0.4: the radial motion was named alone at weight 1.00 (bench/diagnosis_confusion.py
+/// compete for one signal even where their fitted signatures correlate little. A 3x
+/// tilt_motion_C_h4 on the AC-trt ballbar in 1/f-like noise scored -21.6 against
+/// radial_motion_C_h4's -23.2, their signatures correlated by 0.44 (under rival_correlation), and
+/// beside the radial motion the tilt scored +0.4: the radial motion was named alone at weight 1.00
+/// (bench/diagnosis_confusion.py
 /// --noise pink --seed 251). An effect of its own beside the chosen one keeps its evidence (a
 /// thermal drift beside a straightness, -11.8 alone, -12.4 beside it) and stays out.
 /// Each is judged on `in` (the model before the finding, under the noise model the field is
 /// weighed with) by the chosen one's and its own whitened columns (Score::A): its delta BIC beside
 /// the chosen one against min_delta_bic. Only candidates whose signature correlates with the chosen
 /// one's by less than rival_correlation are judged (the others are rivals anyway).
-std::vector<bool> explained_away(const ScoringInputs& in, const Score& chosen, const std::vector<const Score*>& field,
-                                 double min_delta_bic, double rival_correlation);
+std::vector<bool> explained_away(const ScoringInputs& in, const Score& chosen,
+                                 const std::vector<const Score*>& field, double min_delta_bic,
+                                 double rival_correlation);
 
 /// Weigh `chosen` against the other scores of `field` (every observable candidate of the round,
 /// whether it passed the round's tests or not: a rival that fits as well but failed the F-test

@@ -14,7 +14,8 @@ namespace rotacal {
 
 namespace {
 
-const ParameterEstimate& estimate_named(const RtestJointIdentification& id, const std::string& name) {
+const ParameterEstimate& estimate_named(const RtestJointIdentification& id,
+                                        const std::string& name) {
   for (const ParameterEstimate& p : id.parameters)
     if (p.name == name) return p;
   throw InvalidArgument("uncertainty_budget: the identification has no parameter " + name +
@@ -34,8 +35,10 @@ ModelFit diagnosis_point(const RtestArrays& d, const RtestJointIdentification& i
 
 }  // namespace
 
-UncertaintyBudget uncertainty_budget(const RtestSession& session, const RtestJointIdentification& id,
-                                     const PlausibleSizes& sizes, double coverage, int max_harmonic) {
+UncertaintyBudget uncertainty_budget(const RtestSession& session,
+                                     const RtestJointIdentification& id,
+                                     const PlausibleSizes& sizes, double coverage,
+                                     int max_harmonic) {
   const RtestDiagnosisProblem problem(session);
   const std::vector<Effect> candidates = problem.candidates(max_harmonic);
   budget_detail::check_inputs(sizes, candidates, coverage);
@@ -46,17 +49,20 @@ UncertaintyBudget uncertainty_budget(const RtestSession& session, const RtestJoi
   const RtestProblem model(data, &id.model.basis, EffectModel{});
   const std::vector<std::string> names = model.layout().all.names();
   const auto p = static_cast<Eigen::Index>(names.size());
-  if (id.parameters.size() != names.size() || id.covariance.rows() != p || id.residuals.size() != session.samples.size())
+  if (id.parameters.size() != names.size() || id.covariance.rows() != p ||
+      id.residuals.size() != session.samples.size())
     throw InvalidArgument("uncertainty_budget: the identification is not of this session (" +
-                          std::to_string(id.parameters.size()) + " parameters, " + std::to_string(id.residuals.size()) +
+                          std::to_string(id.parameters.size()) + " parameters, " +
+                          std::to_string(id.residuals.size()) +
                           " samples; the session's model has " + std::to_string(p) + " and " +
                           std::to_string(session.samples.size()) + ")");
   Eigen::VectorXd x(p);
   for (Eigen::Index j = 0; j < p; ++j) {
     const ParameterEstimate& e = id.parameters[static_cast<std::size_t>(j)];
     if (e.name != names[static_cast<std::size_t>(j)])
-      throw InvalidArgument("uncertainty_budget: the identification's parameter " + std::to_string(j) + " is " +
-                            e.name + ", the session's model has " + names[static_cast<std::size_t>(j)]);
+      throw InvalidArgument("uncertainty_budget: the identification's parameter " +
+                            std::to_string(j) + " is " + e.name + ", the session's model has " +
+                            names[static_cast<std::size_t>(j)]);
     x[j] = e.value;
   }
   ModelFit fit;
@@ -66,8 +72,11 @@ UncertaintyBudget uncertainty_budget(const RtestSession& session, const RtestJoi
   model.evaluate(x, r, &fit.jacobian);
   fit.residuals = -r;  // measured - model
   for (std::size_t i = 0; i < id.residuals.size(); ++i)
-    if ((fit.residuals.segment<3>(3 * static_cast<Eigen::Index>(i)) - id.residuals[i]).cwiseAbs().maxCoeff() > 1e-9)
-      throw InvalidArgument("uncertainty_budget: the identification's residual of sample " + std::to_string(i + 1) +
+    if ((fit.residuals.segment<3>(3 * static_cast<Eigen::Index>(i)) - id.residuals[i])
+            .cwiseAbs()
+            .maxCoeff() > 1e-9)
+      throw InvalidArgument("uncertainty_budget: the identification's residual of sample " +
+                            std::to_string(i + 1) +
                             " is not the session's: it is another session's identification");
   // Held parameters (fixed, or directions the session cannot see) take no part.
   for (Eigen::Index j = 0; j < p; ++j)
@@ -76,10 +85,12 @@ UncertaintyBudget uncertainty_budget(const RtestSession& session, const RtestJoi
   fit.num_free = static_cast<int>((fit.jacobian.colwise().squaredNorm().array() > 0.0).count());
 
   const NoiseModel white;  // without the GLS refit the identification's covariance is the white one
-  const budget_detail::BudgetedFit budgeted{session.machine, fit, id.noise_refit ? id.noise : white,
-                                            id.sigma_um, &id.covariance, problem.times()};
-  return budget_detail::budget_of(budgeted, candidates,
-                                  problem.candidate_jacobians(diagnosis_point(data, id), candidates), sizes, coverage);
+  const budget_detail::BudgetedFit budgeted{
+      session.machine, fit, id.noise_refit ? id.noise : white, id.sigma_um, &id.covariance,
+      problem.times()};
+  return budget_detail::budget_of(
+      budgeted, candidates, problem.candidate_jacobians(diagnosis_point(data, id), candidates),
+      sizes, coverage);
 }
 
 }  // namespace rotacal

@@ -2,11 +2,11 @@
 // one R-test reading (rtest/model.hpp), and the candidates' Jacobians by Jets of it.
 #include "rotacal/diagnose/rtest_diagnosis.hpp"
 
+#include <ceres/jet.h>
+
 #include <algorithm>
 #include <cmath>
 #include <type_traits>
-
-#include <ceres/jet.h>
 
 #include "candidate_jets.hpp"
 #include "rotacal/core/time_constant_fit.hpp"
@@ -30,7 +30,8 @@ std::vector<Effect> RtestDiagnosisProblem::candidates(int max_harmonic) const {
   const bool head = session_.machine.has_head();
   for (const Effect& e : effect_catalogue(session_.machine, max_harmonic))
     // The probes read static poses: the effects of the motion itself are zero there.
-    if (e.kind != EffectKind::ballbar_length_offset && e.kind != EffectKind::ballbar_thermal_drift &&
+    if (e.kind != EffectKind::ballbar_length_offset &&
+        e.kind != EffectKind::ballbar_thermal_drift &&
         !(head && e.kind == EffectKind::tool_offset_Z) && !e.depends_on_motion())
       out.push_back(e);
   return out;
@@ -82,12 +83,14 @@ Eigen::MatrixXd reading_jets(const RtestArrays& d, const ModelFit& at, const Eff
   std::vector<Jet> p(static_cast<std::size_t>(L.all.size()), Jet(0.0));
   for (std::size_t i = 0; i < at.parameters.size(); ++i) p[i] = Jet(at.parameters[i].value);
   const std::size_t first = at.parameters.size();  // the candidate's parameters: the layout's last
-  for (std::size_t k = 0; k < seed.size(); ++k) p[first + static_cast<std::size_t>(seed[k])] = Jet(0.0, static_cast<int>(k));
+  for (std::size_t k = 0; k < seed.size(); ++k)
+    p[first + static_cast<std::size_t>(seed[k])] = Jet(0.0, static_cast<int>(k));
   Eigen::MatrixXd out(3 * d.size(), static_cast<Eigen::Index>(seed.size()));
   for (Eigen::Index r = 0; r < d.size(); ++r) {
     const Vec3<Jet> res = rtest_residual<Jet>(L, d, fx, p.data(), r);
     for (int a = 0; a < 3; ++a)
-      for (std::size_t k = 0; k < seed.size(); ++k) out(3 * r + a, static_cast<Eigen::Index>(k)) = res[a].v[static_cast<Eigen::Index>(k)];
+      for (std::size_t k = 0; k < seed.size(); ++k)
+        out(3 * r + a, static_cast<Eigen::Index>(k)) = res[a].v[static_cast<Eigen::Index>(k)];
   }
   return out;
 }
@@ -101,19 +104,22 @@ auto RtestDiagnosisProblem::jets_at(const ModelFit& at) const {
   };
 }
 
-Eigen::MatrixXd RtestDiagnosisProblem::candidate_jacobian(const ModelFit& at, const Effect& candidate) const {
+Eigen::MatrixXd RtestDiagnosisProblem::candidate_jacobian(const ModelFit& at,
+                                                          const Effect& candidate) const {
   return candidate_jacobians(at, {candidate}).front();
 }
 
-std::vector<Eigen::MatrixXd> RtestDiagnosisProblem::candidate_jacobians(const ModelFit& at,
-                                                                        const std::vector<Effect>& candidates) const {
+std::vector<Eigen::MatrixXd> RtestDiagnosisProblem::candidate_jacobians(
+    const ModelFit& at, const std::vector<Effect>& candidates) const {
   return diagnosis_detail::jacobians_of_candidates(
       session_.machine, candidates, jets_at(at),
       [&](Eigen::Index row) { return arrays_->angles[static_cast<std::size_t>(row / 3)]; });
 }
 
-Eigen::MatrixXd RtestDiagnosisProblem::candidate_jacobian_by_jets(const ModelFit& at, const Effect& candidate) const {
-  return diagnosis_detail::jets_of_width(candidate, diagnosis_detail::all_parameters(candidate), jets_at(at));
+Eigen::MatrixXd RtestDiagnosisProblem::candidate_jacobian_by_jets(const ModelFit& at,
+                                                                  const Effect& candidate) const {
+  return diagnosis_detail::jets_of_width(candidate, diagnosis_detail::all_parameters(candidate),
+                                         jets_at(at));
 }
 
 Diagnosis diagnose_rtest(const RtestSession& session, const DiagnosisOptions& options) {

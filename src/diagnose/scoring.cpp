@@ -1,5 +1,7 @@
 // Scoring of candidate effects: least-squares helpers, the linearised refit with its delta
 // BIC and F-test, and blocked cross-validation.
+#include "scoring.hpp"
+
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
@@ -10,7 +12,6 @@
 #include "rotacal/core/error.hpp"
 #include "rotacal/core/least_squares.hpp"
 #include "rotacal/core/stats.hpp"
-#include "scoring.hpp"
 
 namespace rotacal::diagnosis_detail {
 
@@ -28,7 +29,8 @@ Eigen::VectorXd magnitudes(const Effect& c) {
   const auto units = c.param_units();
   Eigen::VectorXd m(static_cast<Eigen::Index>(units.size()));
   for (std::size_t k = 0; k < units.size(); ++k)
-    m[static_cast<Eigen::Index>(k)] = c.kind == EffectKind::probe_lobing ? 10e-3 : plausible_magnitude(units[k]);
+    m[static_cast<Eigen::Index>(k)] =
+        c.kind == EffectKind::probe_lobing ? 10e-3 : plausible_magnitude(units[k]);
   return m;
 }
 
@@ -89,8 +91,8 @@ Eigen::MatrixXd project_out(const Eigen::MatrixXd& Q, const Eigen::MatrixXd& C) 
   return C - Q * (Q.transpose() * C);
 }
 
-Eigen::VectorXd residual_without(const Eigen::MatrixXd& Q, const Eigen::VectorXd& r, const Eigen::VectorXd& Qr,
-                                 const Eigen::MatrixXd& Jc) {
+Eigen::VectorXd residual_without(const Eigen::MatrixXd& Q, const Eigen::VectorXd& r,
+                                 const Eigen::VectorXd& Qr, const Eigen::MatrixXd& Jc) {
   const Eigen::MatrixXd A = Q.transpose() * Jc;
   const Eigen::MatrixXd Gc = gram_matrix(Jc);
   const Eigen::MatrixXd G = Gc - A.transpose() * A;
@@ -103,7 +105,8 @@ Eigen::VectorXd residual_without(const Eigen::MatrixXd& Q, const Eigen::VectorXd
   const Eigen::VectorXd di = d.cwiseInverse();
   const Eigen::LLT<Eigen::MatrixXd> llt(di.asDiagonal() * G * di.asDiagonal());
   if (llt.info() != Eigen::Success || !(llt.matrixLLT().diagonal().minCoeff() > 1e-3)) return {};
-  const Eigen::VectorXd b = di.asDiagonal() * llt.solve(di.asDiagonal() * (Jc.transpose() * r - A.transpose() * Qr));
+  const Eigen::VectorXd b =
+      di.asDiagonal() * llt.solve(di.asDiagonal() * (Jc.transpose() * r - A.transpose() * Qr));
   return r - Jc * b + Q * (A * b);
 }
 
@@ -113,7 +116,8 @@ Eigen::MatrixXd free_columns(const Eigen::MatrixXd& J) {
   for (Eigen::Index j = 0; j < J.cols(); ++j)
     if (J.col(j).squaredNorm() > 0.0) keep.push_back(j);
   Eigen::MatrixXd out(J.rows(), static_cast<Eigen::Index>(keep.size()));
-  for (std::size_t k = 0; k < keep.size(); ++k) out.col(static_cast<Eigen::Index>(k)) = J.col(keep[k]);
+  for (std::size_t k = 0; k < keep.size(); ++k)
+    out.col(static_cast<Eigen::Index>(k)) = J.col(keep[k]);
   return out;
 }
 
@@ -206,7 +210,8 @@ std::vector<int> cv_folds(const DiagnosisProblem& P, int K, const NoiseModel* no
   for (auto& kv : by_group) {
     const int shift = group_index++;
     auto& idx = kv.second;
-    std::stable_sort(idx.begin(), idx.end(), [&](std::size_t a, std::size_t b) { return t[a] < t[b]; });
+    std::stable_sort(idx.begin(), idx.end(),
+                     [&](std::size_t a, std::size_t b) { return t[a] < t[b]; });
     int blocks = K;
     const auto it = min_block.find(kv.first);
     if (it != min_block.end() && it->second > 1.0)
@@ -285,7 +290,8 @@ Score score(const ScoringInputs& in, const Effect& c, Eigen::MatrixXd Jc_w, doub
   Eigen::VectorXd d;
   std::optional<Score> got = score_from_grams(c, m, g, in.num_free, min_chi2, 0.0, &V, &d);
   if (!got)  // not with finite columns
-    throw DegenerateGeometry("score: the Gram matrix of candidate " + c.id() + " has no eigen decomposition");
+    throw DegenerateGeometry("score: the Gram matrix of candidate " + c.id() +
+                             " has no eigen decomposition");
   Score s = std::move(*got);
   if (s.observable && s.delta_bic < columns_below_delta_bic) {
     s.A = perp * V;
@@ -294,12 +300,13 @@ Score score(const ScoringInputs& in, const Effect& c, Eigen::MatrixXd Jc_w, doub
   return s;
 }
 
-ModelProducts::ModelProducts(const Eigen::MatrixXd& Jf, std::vector<std::vector<Eigen::Index>> streams)
+ModelProducts::ModelProducts(const Eigen::MatrixXd& Jf,
+                             std::vector<std::vector<Eigen::Index>> streams)
     : lags(Jf, std::move(streams)), gram(Jf.transpose() * Jf) {}
 
-CandidateProducts candidate_products(const ArWhitener* W, double sigma_mm, const ModelProducts& model,
-                                     const Eigen::MatrixXd& Jf, const Eigen::MatrixXd& Jc,
-                                     const Eigen::VectorXd& r) {
+CandidateProducts candidate_products(const ArWhitener* W, double sigma_mm,
+                                     const ModelProducts& model, const Eigen::MatrixXd& Jf,
+                                     const Eigen::MatrixXd& Jc, const Eigen::VectorXd& r) {
   const Eigen::Index k = Jc.cols();
   Eigen::MatrixXd MX(Jc.rows(), k + 1);  // V^-1 [Jc r]
   MX << Jc, r;
@@ -336,7 +343,8 @@ std::optional<Score> score_from_products(const CandidateProducts& g, const Effec
     if (!(d.minCoeff() > 0.0) || !d.allFinite()) return std::nullopt;
     const Eigen::VectorXd di = d.cwiseInverse();
     const Eigen::LLT<Eigen::MatrixXd> llt(di.asDiagonal() * g.G_ff * di.asDiagonal());
-    if (llt.info() != Eigen::Success || !(llt.matrixLLT().diagonal().minCoeff() > 1e-3)) return std::nullopt;
+    if (llt.info() != Eigen::Success || !(llt.matrixLLT().diagonal().minCoeff() > 1e-3))
+      return std::nullopt;
     Y = di.asDiagonal() * Y;
     llt.matrixL().solveInPlace(Y);
     yr = di.asDiagonal() * yr;

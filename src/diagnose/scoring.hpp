@@ -39,8 +39,8 @@ Eigen::MatrixXd project_out(const Eigen::MatrixXd& Q, const Eigen::MatrixXd& C);
 /// orthonormalising Jp, which each candidate's noise model needs. Empty where a column of Jc
 /// keeps under 1e-5 of its norm outside span(Q), or Jp is near rank-deficient: there the
 /// subtraction loses the digits that decide, and the caller orthonormalises Jp instead.
-Eigen::VectorXd residual_without(const Eigen::MatrixXd& Q, const Eigen::VectorXd& r, const Eigen::VectorXd& Qr,
-                                 const Eigen::MatrixXd& Jc);
+Eigen::VectorXd residual_without(const Eigen::MatrixXd& Q, const Eigen::VectorXd& r,
+                                 const Eigen::VectorXd& Qr, const Eigen::MatrixXd& Jc);
 /// Free (non-zero) columns of a fit's Jacobian.
 Eigen::MatrixXd free_columns(const Eigen::MatrixXd& J);
 
@@ -69,13 +69,13 @@ struct ColumnScore {
   bool visible = false;
   /// Not visible, but a direction of the columns alone is: the model absorbs the candidate.
   bool absorbed = false;
-  int k = 0;                ///< visible directions
-  Eigen::MatrixXd V;        ///< them, per plausible size (orthonormal columns)
-  Eigen::VectorXd d;        ///< the refit's coefficient along each
-  Eigen::VectorXd params;   ///< the refit's parameters, m .* (V d), in the candidate's units
-  double rss1 = 0.0;        ///< whitened residual sum of squares after the refit
-  double delta_bic = 0.0;   ///< n log(rss1 / rss0) + (k + nonlinear) log n
-  double f_pvalue = 1.0;    ///< P(F > f) of the rss drop, F(k, n - num_free - k - nonlinear)
+  int k = 0;               ///< visible directions
+  Eigen::MatrixXd V;       ///< them, per plausible size (orthonormal columns)
+  Eigen::VectorXd d;       ///< the refit's coefficient along each
+  Eigen::VectorXd params;  ///< the refit's parameters, m .* (V d), in the candidate's units
+  double rss1 = 0.0;       ///< whitened residual sum of squares after the refit
+  double delta_bic = 0.0;  ///< n log(rss1 / rss0) + (k + nonlinear) log n
+  double f_pvalue = 1.0;   ///< P(F > f) of the rss drop, F(k, n - num_free - k - nonlinear)
 };
 
 /// Score candidate columns whose plausible magnitudes are m against a model of num_free free
@@ -119,14 +119,14 @@ struct Score {
   Effect effect;
   bool observable = false;
   std::string why_not;
-  int k = 0;                  ///< observable directions
-  Eigen::MatrixXd A;          ///< whitened candidate columns along them, model projected out
-  Eigen::MatrixXd directions; ///< the candidate's parameters (its units) per observable direction
-  Eigen::MatrixXd X;          ///< [J, Jc * directions] in mm, for cross-validation (set by the
-                              ///< search, only for a candidate that can pass)
-  Eigen::VectorXd signature;  ///< fitted change of the whitened residuals
-  Eigen::VectorXd params;     ///< the candidate's fitted parameters (its units)
-  double rss1 = 0.0;          ///< whitened residual sum of squares after the refit
+  int k = 0;                   ///< observable directions
+  Eigen::MatrixXd A;           ///< whitened candidate columns along them, model projected out
+  Eigen::MatrixXd directions;  ///< the candidate's parameters (its units) per observable direction
+  Eigen::MatrixXd X;           ///< [J, Jc * directions] in mm, for cross-validation (set by the
+                               ///< search, only for a candidate that can pass)
+  Eigen::VectorXd signature;   ///< fitted change of the whitened residuals
+  Eigen::VectorXd params;      ///< the candidate's fitted parameters (its units)
+  double rss1 = 0.0;           ///< whitened residual sum of squares after the refit
   double delta_bic = 0.0;
   double f_pvalue = 1.0;
 };
@@ -155,7 +155,7 @@ Score score(const ScoringInputs& in, const Effect& c, Eigen::MatrixXd Jc_w, doub
 struct CandidateProducts {
   Eigen::MatrixXd G_ff, g_fc, G_cc;
   Eigen::VectorXd g_fr, g_cr;
-  double rr = 0.0;  ///< <r, r>
+  double rr = 0.0;     ///< <r, r>
   Eigen::Index n = 0;  ///< readings
 };
 /// The current model's free columns Jf as any white or AR(1) noise model of the given streams
@@ -168,9 +168,9 @@ struct ModelProducts {
 };
 /// The products for candidate columns Jc and residuals r (mm) under whitener W (AR order <= 1,
 /// no random walk), or white noise of sigma_mm where W is null. O(n p k).
-CandidateProducts candidate_products(const ArWhitener* W, double sigma_mm, const ModelProducts& model,
-                                     const Eigen::MatrixXd& Jf, const Eigen::MatrixXd& Jc,
-                                     const Eigen::VectorXd& r);
+CandidateProducts candidate_products(const ArWhitener* W, double sigma_mm,
+                                     const ModelProducts& model, const Eigen::MatrixXd& Jf,
+                                     const Eigen::MatrixXd& Jc, const Eigen::VectorXd& r);
 /// score() from inner products alone: O(p^3) per candidate where score() needs a basis of the
 /// whitened model columns, O(n p^2), for each candidate's own noise model (most of the
 /// coloured search's cost at rho 0.5). Returns what the round's table needs (observability,
@@ -216,6 +216,7 @@ using Whiten = std::function<Eigen::MatrixXd(const Eigen::MatrixXd&)>;
 /// of the model whose free columns are Jfree.
 StructureTest structure_test(
     const DiagnosisProblem& P, const Eigen::VectorXd& r_mm, const Eigen::MatrixXd& Jfree,
-    int num_free, const std::function<Whiten(const std::string&, const Eigen::MatrixXd&)>& whitener_for);
+    int num_free,
+    const std::function<Whiten(const std::string&, const Eigen::MatrixXd&)>& whitener_for);
 
 }  // namespace rotacal::diagnosis_detail

@@ -26,8 +26,10 @@ struct NoiseTreatment {
   Eigen::MatrixXd whiten(const Eigen::MatrixXd& M) const {
     if (!W) return M / sigma_mm;
     Eigen::MatrixXd out = M;
-    if (full) full->apply(out);
-    else W->apply(out);
+    if (full)
+      full->apply(out);
+    else
+      W->apply(out);
     return out;
   }
 };
@@ -51,8 +53,8 @@ void with_hidden_levels(const DiagnosisProblem& P, const NoiseModel& m, NoiseTre
 /// Each stream's random-walk step of `m` lowered so that its variation within the stream is at
 /// most the declared variance (hidden_levels.cpp); unchanged without a declared noise, and on a
 /// stream whose `residuals` vary beyond what the declared noise allows.
-void with_walk_bounded_by_declared(const DiagnosisProblem& P, const Eigen::VectorXd& residuals, NoiseModel& m,
-                                   VarianceBound bound = VarianceBound::kWithin);
+void with_walk_bounded_by_declared(const DiagnosisProblem& P, const Eigen::VectorXd& residuals,
+                                   NoiseModel& m, VarianceBound bound = VarianceBound::kWithin);
 
 /// Whether the declared noise holds variance that `fit`'s residuals lack: |r|^2 / noise_um^2
 /// below the kLacksDeclaredVariance quantile of chi-square(n - free parameters), which white
@@ -73,7 +75,8 @@ Eigen::MatrixXd stream_levels(const DiagnosisProblem& P);
 
 // A thermal_warmup candidate's Jacobian at its amplitude 0 has a zero time-constant column:
 // filled with the tangent of its shift at a unit amplitude (time_constants.cpp).
-void with_time_constant_tangent(const DiagnosisProblem& P, const Effect& candidate, Eigen::MatrixXd& J);
+void with_time_constant_tangent(const DiagnosisProblem& P, const Effect& candidate,
+                                Eigen::MatrixXd& J);
 
 // The effect's parameters in a fit (named "id" or "id.name").
 std::vector<ParameterEstimate> parameters_of(const ModelFit& fit, const Effect& effect);
@@ -109,8 +112,8 @@ struct SearchCache {
   }
   // The level walk (above) of model key `k`, whose fit left `residuals`; `J_levels`: its free
   // columns and the stream levels; `start`: the AR model of `residuals`.
-  const NoiseModel& level_walk(const std::string& k, const NoiseModel& start, const Eigen::VectorXd& residuals,
-                               const Eigen::MatrixXd& J_levels) {
+  const NoiseModel& level_walk(const std::string& k, const NoiseModel& start,
+                               const Eigen::VectorXd& residuals, const Eigen::MatrixXd& J_levels) {
     auto it = level_walks.find(k);
     if (it == level_walks.end())
       it = level_walks.emplace(k, estimate_noise_model_reml(start, residuals, J_levels)).first;
@@ -118,7 +121,8 @@ struct SearchCache {
   }
   // The Jacobians of `todo` at `at` (the fit of model `m`).
   std::vector<SharedMatrix> candidate_jacobians(const DiagnosisProblem& P, const EffectModel& m,
-                                                const ModelFit& at, const std::vector<Effect>& todo) {
+                                                const ModelFit& at,
+                                                const std::vector<Effect>& todo) {
     std::map<std::string, SharedMatrix>& known = jacobians[key(m)];
     std::vector<Effect> missing;
     for (const Effect& c : todo)
@@ -127,7 +131,8 @@ struct SearchCache {
     // the ballbar's chain rule would still evaluate the fit's part of every row first.
     std::vector<Eigen::MatrixXd> fresh;
     if (!missing.empty()) fresh = P.candidate_jacobians(at, missing);
-    for (std::size_t i = 0; i < missing.size(); ++i) with_time_constant_tangent(P, missing[i], fresh[i]);
+    for (std::size_t i = 0; i < missing.size(); ++i)
+      with_time_constant_tangent(P, missing[i], fresh[i]);
     std::vector<SharedMatrix> out;
     for (const Effect& c : todo) {
       const auto it = known.find(c.id());
@@ -135,8 +140,8 @@ struct SearchCache {
         out.push_back(it->second);
         continue;
       }
-      const std::size_t i = static_cast<std::size_t>(
-          std::find(missing.begin(), missing.end(), c) - missing.begin());
+      const std::size_t i =
+          static_cast<std::size_t>(std::find(missing.begin(), missing.end(), c) - missing.begin());
       const std::size_t values = static_cast<std::size_t>(fresh[i].size());
       out.push_back(std::make_shared<const Eigen::MatrixXd>(std::move(fresh[i])));
       if (cached_values + values <= kMaxCachedValues) {
@@ -158,7 +163,7 @@ struct SearchContext {
   const NoiseTreatment& noise;                 ///< the search's noise treatment
   const NoiseModel* model;                     ///< the search's noise model (null: white)
   const NoiseTreatment& white;
-  const NoiseStreamLayout& layout;             ///< every noise model of this search
+  const NoiseStreamLayout& layout;  ///< every noise model of this search
   SearchCache& cache;
 };
 
@@ -168,11 +173,11 @@ double determined_sigmas(const ModelFit& refit, const Effect& effect, const Nois
 
 /// One round: every candidate not yet done scored against the current model.
 struct Round {
-  ScoringInputs in;        ///< the current model under the search's noise treatment
-  Eigen::MatrixXd J_levels;  ///< coloured: the free columns and one level column per stream
-                             ///< (only when a 1/f-like candidate needed them; else empty)
-  int levels_rank = 0;       ///< what the level columns add to the model's rank
-  std::vector<Score> scores;                 ///< the observable candidates
+  ScoringInputs in;           ///< the current model under the search's noise treatment
+  Eigen::MatrixXd J_levels;   ///< coloured: the free columns and one level column per stream
+                              ///< (only when a 1/f-like candidate needed them; else empty)
+  int levels_rank = 0;        ///< what the level columns add to the model's rank
+  std::vector<Score> scores;  ///< the observable candidates
   std::vector<NoiseTreatment> treatment_of;  ///< per score: the noise it was judged with
   std::vector<bool> levels_of;               ///< per score: judged with the stream levels
   /// Per score rescored under the marginal bound (search_round.cpp): the round's walk under the
@@ -181,8 +186,8 @@ struct Round {
   /// linear_scale_X and _Y differ: under it a 3x linear_scale_Y was named [linear_scale_X,
   /// angular_error_BX, angular_error_AY], the truth 22 behind (h-pink10).
   std::map<std::size_t, NoiseTreatment> named_under;
-  std::vector<double> round_bic;             ///< per score: its delta BIC as first scored, before
-                                             ///< any rescoring under its own walk
+  std::vector<double> round_bic;  ///< per score: its delta BIC as first scored, before
+                                  ///< any rescoring under its own walk
 };
 
 /// Score every candidate not `done` against `fit` (the fit of `effects`). Candidates that are
@@ -203,20 +208,22 @@ struct Choice {
 /// upper z-sigma bound of its lag-1 correlation estimated on refit's residuals, z =
 /// P.correlation_bound_z() (correlation_bound.cpp). True where z is 0 and for a candidate judged
 /// under the 1/f-like treatment.
-bool holds_at_correlation_bound(const SearchContext& S, const Round& R, const Score& s, const ModelFit& fit,
-                                const ModelFit& refit, double m_tests);
+bool holds_at_correlation_bound(const SearchContext& S, const Round& R, const Score& s,
+                                const ModelFit& fit, const ModelFit& refit, double m_tests);
 
-Choice choose(const SearchContext& S, const Round& R, const ModelFit& fit, const EffectModel& effects,
-              const std::vector<int>& fold, std::vector<bool>& done, Diagnosis& D);
+Choice choose(const SearchContext& S, const Round& R, const ModelFit& fit,
+              const EffectModel& effects, const std::vector<int>& fold, std::vector<bool>& done,
+              Diagnosis& D);
 
 /// The finding of `choice` against the round R scored at `before` (the fit of `before_effects`):
 /// its weight among its rivals, its group, and the ambiguity it leaves (appended to D).
-Finding name_finding(const SearchContext& S, const Round& R, const Choice& choice, const ModelFit& before,
-                     const EffectModel& before_effects, Diagnosis& D);
+Finding name_finding(const SearchContext& S, const Round& R, const Choice& choice,
+                     const ModelFit& before, const EffectModel& before_effects, Diagnosis& D);
 
 /// A thermal_warmup's time constant the final fit held, profiled, with its uncertainty in the
 /// other parameters' sigmas (time_constants.cpp); `scale`: what the caller multiplies them by.
-void profile_time_constants(const DiagnosisProblem& P, const NoiseTreatment& t, double scale, Diagnosis& D);
+void profile_time_constants(const DiagnosisProblem& P, const NoiseTreatment& t, double scale,
+                            Diagnosis& D);
 
 /// What the final model leaves: structure after, the unexplained-structure test and, where
 /// structure remains as a function of one rotary angle, its per-angle table (into D).

@@ -18,9 +18,11 @@ namespace {
 // noise model's order + 2: the candidate's residual differs from the current model's in the k
 // directions it adds, which do not raise the order of the noise's correlation; Burg's recursion
 // through all 8 orders for every candidate was most of this function's time).
-NoiseTreatment candidate_treatment(const NoiseStreamLayout& layout, const NoiseModelOptions& noise_options,
-                                   const ModelFit& fit, const Eigen::MatrixXd& Q_raw, const Eigen::VectorXd& Qr,
-                                   const Eigen::MatrixXd& Jc, const NoiseTreatment& white, NoiseModel* model) {
+NoiseTreatment candidate_treatment(const NoiseStreamLayout& layout,
+                                   const NoiseModelOptions& noise_options, const ModelFit& fit,
+                                   const Eigen::MatrixXd& Q_raw, const Eigen::VectorXd& Qr,
+                                   const Eigen::MatrixXd& Jc, const NoiseTreatment& white,
+                                   NoiseModel* model) {
   Eigen::VectorXd r = residual_without(Q_raw, fit.residuals, Qr, Jc);
   if (r.size() == 0) {
     // What the candidate adds to the model's span, orthonormalised (CholeskyQR2; the
@@ -36,8 +38,8 @@ NoiseTreatment candidate_treatment(const NoiseStreamLayout& layout, const NoiseM
 // columns (built when a 1/f-like candidate first needs them), the white or AR(1) candidates'
 // Gram matrices, the 1/f-like noise model (once per round).
 struct ColouredRound {
-  Eigen::MatrixXd Q_raw;  // orthonormal basis of the free columns
-  Eigen::VectorXd Qr;     // Q_raw^T r (zero but for the fit's convergence)
+  Eigen::MatrixXd Q_raw;        // orthonormal basis of the free columns
+  Eigen::VectorXd Qr;           // Q_raw^T r (zero but for the fit's convergence)
   NoiseModelOptions own_noise;  // each candidate's own noise model (see candidate_treatment)
   std::string model_key;        // SearchCache::key of the current model
   NoiseModel wander_start;      // 1/f-like: the current residuals' AR model, REML's start
@@ -68,7 +70,8 @@ NoiseTreatment walk_with_candidate(const SearchContext& S, const ModelFit& fit, 
 // and a slope per noise stream (slope over the reading's index in the stream): what the 1/f-like
 // treatment's levels and walk take most of. Ballbar thermal drifts and warm-ups 0.20-0.51, the
 // length offset 0.78; harmonics, straightness and squareness 0.02-0.23 (BC-trt, AC-trt, seed 223).
-double slow_share(const NoiseStreamLayout& layout, const Eigen::MatrixXd& Q_raw, const Eigen::MatrixXd& Jc) {
+double slow_share(const NoiseStreamLayout& layout, const Eigen::MatrixXd& Q_raw,
+                  const Eigen::MatrixXd& Jc) {
   const Eigen::MatrixXd Jp = project_out(Q_raw, Jc);
   const double all = Jp.squaredNorm();
   if (!(all > 0.0)) return 0.0;
@@ -91,7 +94,8 @@ double slow_share(const NoiseStreamLayout& layout, const Eigen::MatrixXd& Q_raw,
 
 // The current model under the noise treatment t, with the stream levels as nuisance
 // parameters if `with_levels`: what score_under scores a candidate against.
-ScoringInputs inputs_under(const ModelFit& fit, const Round& R, const NoiseTreatment& t, bool with_levels) {
+ScoringInputs inputs_under(const ModelFit& fit, const Round& R, const NoiseTreatment& t,
+                           bool with_levels) {
   ScoringInputs in_c;
   in_c.Jfree = with_levels ? R.J_levels : R.in.Jfree;
   in_c.num_free = fit.num_free + (with_levels ? R.levels_rank : 0);
@@ -101,8 +105,8 @@ ScoringInputs inputs_under(const ModelFit& fit, const Round& R, const NoiseTreat
 }
 
 // Candidate c scored under the noise treatment t against in_c (inputs_under, of t).
-Score score_under(const SearchContext& S, const Round& R, const ScoringInputs& in_c, const Effect& c,
-                  const Eigen::MatrixXd& Jc, const NoiseTreatment& t) {
+Score score_under(const SearchContext& S, const Round& R, const ScoringInputs& in_c,
+                  const Effect& c, const Eigen::MatrixXd& Jc, const NoiseTreatment& t) {
   Score s = score(in_c, c, t.whiten(Jc), S.options.min_visible_chi2, S.options.min_delta_bic);
   // Scores are kept relative to the whitened residual of the current model, so the
   // table's RMS-after stays comparable.
@@ -113,21 +117,23 @@ Score score_under(const SearchContext& S, const Round& R, const ScoringInputs& i
 // Candidate c scored in coloured noise. Returns false where it is not observable (s.why_not
 // says why); else `s`, the noise it was judged with and whether with the stream levels, and
 // in `round_walk` whether under the round's 1/f-like treatment (estimated without c's columns).
-void score_coloured(const SearchContext& S, const ModelFit& fit, Round& R, ColouredRound& C, const Effect& c,
-                    const Eigen::MatrixXd& Jc, Score& s, NoiseTreatment& judged_with, bool& with_levels,
-                    bool& round_walk) {
+void score_coloured(const SearchContext& S, const ModelFit& fit, Round& R, ColouredRound& C,
+                    const Effect& c, const Eigen::MatrixXd& Jc, Score& s,
+                    NoiseTreatment& judged_with, bool& with_levels, bool& round_walk) {
   const DiagnosisOptions& options = S.options;
   // As the classical F-test takes sigma from the larger model, the noise is modelled on
   // what the model extended by this candidate leaves: correlated noise that no candidate
   // follows stays correlated (so it is not taken for an effect), and an effect's own
   // signature is not mistaken for correlated noise (which would whiten it away).
   NoiseModel own_model;
-  NoiseTreatment own = candidate_treatment(S.layout, C.own_noise, fit, C.Q_raw, C.Qr, Jc, S.white, &own_model);
+  NoiseTreatment own =
+      candidate_treatment(S.layout, C.own_noise, fit, C.Q_raw, C.Qr, Jc, S.white, &own_model);
   if (!C.slow && own_model.max_order < 2 && (!own.W || own.W->ar1_only())) {
     // White or AR(1): scored from inner products; only a candidate that may pass is
     // scored again below with its columns (the margin of 1 is far beyond rounding).
     if (!C.products) C.products = std::make_unique<ModelProducts>(R.in.Jfree, S.layout.rows);
-    const CandidateProducts g = candidate_products(own.W.get(), own.sigma_mm, *C.products, R.in.Jfree, Jc, fit.residuals);
+    const CandidateProducts g =
+        candidate_products(own.W.get(), own.sigma_mm, *C.products, R.in.Jfree, Jc, fit.residuals);
     std::optional<Score> quick = score_from_products(g, c, fit.num_free, options.min_visible_chi2);
     if (quick && !(quick->observable && quick->delta_bic < options.min_delta_bic + 1.0)) {
       s = std::move(*quick);
@@ -142,15 +148,14 @@ void score_coloured(const SearchContext& S, const ModelFit& fit, Round& R, Colou
     // that follows the slow wander leaves a residual that looks white or AR(1) itself, and was
     // then judged under that, taking the wander for an effect; 7 of 200 1/f-like probe null
     // sessions named straightness_ZY, axial_motion_C_h2, A harmonics or Z drifts, 0 with it,
-    // bench/diagnosis_confusion.py --instruments probe --null 200 --seed 101), is taken as 1/f-like: it has
-    // no finite correlation time, and its lowest frequencies are indistinguishable from
-    // an offset per stream that no AR model of a few hundred readings captures, so the
-    // level of each stream becomes a nuisance parameter. Its slow wander within a test
-    // is modelled as a random walk: AR(1) + walk by REML over what the current model and
-    // the levels leave (core/noise_handling.hpp), once per round. Burg's AR(p) of a
-    // stream of a few hundred readings misses that wander and took it for drifts (23
-    // false findings in 200 1/f-like null sessions; with the walk: bench/
-    // diagnose_realistic_bench --rho -1).
+    // bench/diagnosis_confusion.py --instruments probe --null 200 --seed 101), is taken as
+    // 1/f-like: it has no finite correlation time, and its lowest frequencies are indistinguishable
+    // from an offset per stream that no AR model of a few hundred readings captures, so the level
+    // of each stream becomes a nuisance parameter. Its slow wander within a test is modelled as a
+    // random walk: AR(1) + walk by REML over what the current model and the levels leave
+    // (core/noise_handling.hpp), once per round. Burg's AR(p) of a stream of a few hundred readings
+    // misses that wander and took it for drifts (23 false findings in 200 1/f-like null sessions;
+    // with the walk: bench/ diagnose_realistic_bench --rho -1).
     if (!R.J_levels.size()) {
       const Eigen::MatrixXd L = stream_levels(S.P);
       R.J_levels.resize(R.in.Jfree.rows(), R.in.Jfree.cols() + L.cols());
@@ -217,12 +222,13 @@ constexpr std::size_t kOwnWalkMinStream = 150;
 // candidates) harmonics were named alone against rivals that had been in their group, some
 // wrongly (3 wrong in the first 30 sessions of seed 223): the bound takes the walk's share of
 // the middle frequencies. So only here, for the kept few, all under one noise model
-// (marginal_round_walk), with their rivals weighed under the round's kWithin walk too (name_finding).
-// A share of 0.15 (0.3 until 12-07): the 1/f-like ballbar misses at 3x were harmonics of order
-// 2-4, straightness, squareness and gravity sag with slow shares of 0.02-0.15 whose truth ranked
-// first at delta BIC +6 to -8.7 under the within-stream bound (seeds 223-239: 5.4-13.2 points
-// below the oracle); with 0.15 and kMarginal's walk three quarters of the way to the marginal
-// bound (hidden_levels.cpp), -0.8 to 3.1 points, 2 / 300 null sessions with a group.
+// (marginal_round_walk), with their rivals weighed under the round's kWithin walk too
+// (name_finding). A share of 0.15 (0.3 until 12-07): the 1/f-like ballbar misses at 3x were
+// harmonics of order 2-4, straightness, squareness and gravity sag with slow shares of 0.02-0.15
+// whose truth ranked first at delta BIC +6 to -8.7 under the within-stream bound (seeds
+// 223-239: 5.4-13.2 points below the oracle); with 0.15 and kMarginal's walk three quarters of the
+// way to the marginal bound (hidden_levels.cpp), -0.8 to 3.1 points, 2 / 300 null sessions with a
+// group.
 constexpr double kSlowShare = 0.15;
 
 bool streams_hold_own_walk(const NoiseStreamLayout& layout) {
@@ -240,8 +246,9 @@ struct OwnWalkCandidate {
 // Keep `c` among the kOwnWalkCandidates best (lowest delta BIC) of `best`, in order.
 void keep_best(std::vector<OwnWalkCandidate>& best, OwnWalkCandidate c) {
   if (best.size() == kOwnWalkCandidates && !(c.delta_bic < best.back().delta_bic)) return;
-  const auto at = std::upper_bound(best.begin(), best.end(), c.delta_bic,
-                                   [](double d, const OwnWalkCandidate& b) { return d < b.delta_bic; });
+  const auto at =
+      std::upper_bound(best.begin(), best.end(), c.delta_bic,
+                       [](double d, const OwnWalkCandidate& b) { return d < b.delta_bic; });
   best.insert(at, std::move(c));
   if (best.size() > kOwnWalkCandidates) best.pop_back();
 }
@@ -256,7 +263,8 @@ void keep_best(std::vector<OwnWalkCandidate>& best, OwnWalkCandidate c) {
 // the drift -9.1, the warm-up named first with no parameter at 3 sigma). The round's walk (REML
 // without them) instead keeps their signature in its AR(1) part, which the bound does not
 // touch: a 10x thermal_drift_Z went from -9.8 to +3.2 under it, -62.4 under this one.
-NoiseTreatment marginal_round_walk(const SearchContext& S, const ModelFit& fit, const Round& R, const ColouredRound& C,
+NoiseTreatment marginal_round_walk(const SearchContext& S, const ModelFit& fit, const Round& R,
+                                   const ColouredRound& C,
                                    const std::vector<OwnWalkCandidate>& best) {
   Eigen::Index k = R.J_levels.cols();
   for (const OwnWalkCandidate& b : best) k += b.Jc.cols();
@@ -278,8 +286,8 @@ NoiseTreatment marginal_round_walk(const SearchContext& S, const ModelFit& fit, 
 
 // The kept candidates rescored under the walk estimated with their own columns (see above), or,
 // where one of them is slow (kSlowShare), all under the marginal bound of marginal_round_walk.
-void rescore_with_own_walk(const SearchContext& S, const ModelFit& fit, Round& R, const ColouredRound& C,
-                           const std::vector<OwnWalkCandidate>& best) {
+void rescore_with_own_walk(const SearchContext& S, const ModelFit& fit, Round& R,
+                           const ColouredRound& C, const std::vector<OwnWalkCandidate>& best) {
   for (const Score& s : R.scores)
     if (s.delta_bic < S.options.min_delta_bic - kOwnWalkMargin) return;
   // One bound for all of them: a candidate rescored under the marginal bound beside a rival
@@ -289,7 +297,8 @@ void rescore_with_own_walk(const SearchContext& S, const ModelFit& fit, Round& R
   for (const OwnWalkCandidate& b : best)
     if (slow_share(S.layout, C.Q_raw, b.Jc) >= kSlowShare) bound = VarianceBound::kMarginal;
   const bool marginal = bound == VarianceBound::kMarginal;
-  const NoiseTreatment shared = marginal ? marginal_round_walk(S, fit, R, C, best) : NoiseTreatment{};
+  const NoiseTreatment shared =
+      marginal ? marginal_round_walk(S, fit, R, C, best) : NoiseTreatment{};
   for (const OwnWalkCandidate& b : best) {
     const Effect& c = S.candidates[b.candidate];
     const NoiseTreatment own = marginal ? shared : walk_with_candidate(S, fit, R, C, b.Jc);
@@ -319,8 +328,9 @@ std::vector<CandidateScore> round_table(const Round& R, const ModelFit& fit) {
     const double frac = std::sqrt(s.rss1 / std::max(R.in.r_w.squaredNorm(), 1e-300));
     table.push_back({s.effect.id(), s.k, s.delta_bic, s.f_pvalue, rms_um(fit.residuals) * frac});
   }
-  std::sort(table.begin(), table.end(),
-            [](const CandidateScore& a, const CandidateScore& b) { return a.delta_bic < b.delta_bic; });
+  std::sort(table.begin(), table.end(), [](const CandidateScore& a, const CandidateScore& b) {
+    return a.delta_bic < b.delta_bic;
+  });
   return table;
 }
 
@@ -372,9 +382,11 @@ Round score_round(const SearchContext& S, const ModelFit& fit, const EffectModel
   std::vector<OwnWalkCandidate> own_walk;  // rescored under their own walk after the round
   const bool rescore_own_walk = noise.W && streams_hold_own_walk(S.layout);
   int round_total = 0, round_done = 0;  // candidates to score in this round (progress)
-  for (std::size_t c = 0; c < candidates.size(); ++c) round_total += !done[c] && S.unresolved[c].empty();
-  const std::string stage = std::string(noise.W ? "search with the noise model" : "search (white noise)") +
-                            ", round " + std::to_string(D.rounds.size() + 1);
+  for (std::size_t c = 0; c < candidates.size(); ++c)
+    round_total += !done[c] && S.unresolved[c].empty();
+  const std::string stage =
+      std::string(noise.W ? "search with the noise model" : "search (white noise)") + ", round " +
+      std::to_string(D.rounds.size() + 1);
   for (std::size_t c = 0; c < candidates.size(); ++c) {
     if (done[c]) continue;
     if (!S.unresolved[c].empty()) {
@@ -393,7 +405,8 @@ Round score_round(const SearchContext& S, const ModelFit& fit, const EffectModel
     NoiseTreatment judged_with = noise;
     bool with_levels = false, round_walk = false;
     if (!noise.W)
-      s = score(R.in, candidates[c], noise.whiten(Jc), options.min_visible_chi2, options.min_delta_bic);
+      s = score(R.in, candidates[c], noise.whiten(Jc), options.min_visible_chi2,
+                options.min_delta_bic);
     else
       score_coloured(S, fit, R, C, candidates[c], Jc, s, judged_with, with_levels, round_walk);
     if (!s.observable) {

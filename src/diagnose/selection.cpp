@@ -20,20 +20,27 @@ double determined_sigmas(const ModelFit& refit, const Effect& effect, const Nois
   for (Eigen::Index j = 0; j < refit.jacobian.cols(); ++j) {
     if (refit.jacobian.col(j).squaredNorm() == 0.0) continue;
     const ParameterEstimate& p = refit.parameters[static_cast<std::size_t>(j)];
-    if ((p.name == id || p.name.rfind(id + ".", 0) == 0) && p.observable) mine.push_back(static_cast<Eigen::Index>(free.size()));
+    if ((p.name == id || p.name.rfind(id + ".", 0) == 0) && p.observable)
+      mine.push_back(static_cast<Eigen::Index>(free.size()));
     free.push_back(j);
   }
   if (mine.empty()) return 0.0;
   Eigen::MatrixXd Jf(refit.jacobian.rows(), static_cast<Eigen::Index>(free.size()));
-  for (std::size_t a = 0; a < free.size(); ++a) Jf.col(static_cast<Eigen::Index>(a)) = refit.jacobian.col(free[a]);
+  for (std::size_t a = 0; a < free.size(); ++a)
+    Jf.col(static_cast<Eigen::Index>(a)) = refit.jacobian.col(free[a]);
   const Eigen::MatrixXd Jw = t.whiten(Jf);
-  const Eigen::MatrixXd C = (Jw.transpose() * Jw).ldlt().solve(Eigen::MatrixXd::Identity(Jf.cols(), Jf.cols()));
+  const Eigen::MatrixXd C =
+      (Jw.transpose() * Jw).ldlt().solve(Eigen::MatrixXd::Identity(Jf.cols(), Jf.cols()));
   const Eigen::Index k = static_cast<Eigen::Index>(mine.size());
   Eigen::MatrixXd Cee(k, k);
   Eigen::VectorXd v(k);
   for (Eigen::Index a = 0; a < k; ++a) {
-    v[a] = refit.parameters[static_cast<std::size_t>(free[static_cast<std::size_t>(mine[static_cast<std::size_t>(a)])])].value;
-    for (Eigen::Index b = 0; b < k; ++b) Cee(a, b) = C(mine[static_cast<std::size_t>(a)], mine[static_cast<std::size_t>(b)]);
+    v[a] = refit
+               .parameters[static_cast<std::size_t>(
+                   free[static_cast<std::size_t>(mine[static_cast<std::size_t>(a)])])]
+               .value;
+    for (Eigen::Index b = 0; b < k; ++b)
+      Cee(a, b) = C(mine[static_cast<std::size_t>(a)], mine[static_cast<std::size_t>(b)]);
   }
   const double chi2 = v.dot(Cee.ldlt().solve(v));
   return std::isfinite(chi2) && chi2 > 0.0 ? std::sqrt(chi2) : 0.0;
@@ -42,7 +49,8 @@ double determined_sigmas(const ModelFit& refit, const Effect& effect, const Nois
 namespace {
 
 // Why the first of `aliases` is not resolved (the sampling's words).
-std::string unresolved_reason(const std::vector<Effect>& candidates, const std::vector<std::string>& unresolved,
+std::string unresolved_reason(const std::vector<Effect>& candidates,
+                              const std::vector<std::string>& unresolved,
                               const std::vector<Alternative>& aliases) {
   for (std::size_t c = 0; c < candidates.size(); ++c)
     if (!aliases.empty() && candidates[c].id() == aliases.front().effect) return unresolved[c];
@@ -60,8 +68,9 @@ struct Field {
   std::vector<Score> scores;
   RivalJudgement judged;  // its pointers are into `scores`
 };
-Field weigh_field(const SearchContext& S, const Round& R, const Score& chosen, const ModelFit& before,
-                  const EffectModel& before_effects, const NoiseTreatment& common, const ScoringInputs& in) {
+Field weigh_field(const SearchContext& S, const Round& R, const Score& chosen,
+                  const ModelFit& before, const EffectModel& before_effects,
+                  const NoiseTreatment& common, const ScoringInputs& in) {
   const double n = static_cast<double>(before.residuals.size());
   std::vector<Effect> near;
   constexpr double kFieldMargin = 40.0;  // a weight of e^-20 at most, before tempering
@@ -75,10 +84,12 @@ Field weigh_field(const SearchContext& S, const Round& R, const Score& chosen, c
     const Score& s = R.scores[i];
     const double d_bic = std::min(s.delta_bic, R.round_bic[i]) - chosen_bic;
     const double d_aic = d_bic - (s.k - chosen.k) * (std::log(n) - 2.0);
-    if (&s == &chosen || std::min(d_bic, d_aic) < kFieldMargin || s.delta_bic < S.options.min_delta_bic)
+    if (&s == &chosen || std::min(d_bic, d_aic) < kFieldMargin ||
+        s.delta_bic < S.options.min_delta_bic)
       near.push_back(s.effect);
   }
-  const std::vector<SharedMatrix> near_jc = S.cache.candidate_jacobians(S.P, before_effects, before, near);
+  const std::vector<SharedMatrix> near_jc =
+      S.cache.candidate_jacobians(S.P, before_effects, before, near);
   Field F;
   F.scores.reserve(near.size());
   for (std::size_t i = 0; i < near.size(); ++i)
@@ -92,16 +103,18 @@ Field weigh_field(const SearchContext& S, const Round& R, const Score& chosen, c
     if (s.effect == chosen.effect && s.observable) chosen_judged = &s;
   }
   const double tempering = S.noise.W && S.model ? evidence_tempering(*S.model) : 1.0;
-  F.judged = weigh_rivals(*chosen_judged, field, field_bic, n, tempering, S.options.rival_correlation,
-                          S.options.min_weight, explained_away(in, *chosen_judged, field, S.options.min_delta_bic,
-                                                              S.options.rival_correlation));
+  F.judged = weigh_rivals(*chosen_judged, field, field_bic, n, tempering,
+                          S.options.rival_correlation, S.options.min_weight,
+                          explained_away(in, *chosen_judged, field, S.options.min_delta_bic,
+                                         S.options.rival_correlation));
   return F;
 }
 
 // weigh_field under treatment t (coloured: with the stream levels as nuisance parameters if
 // `with_levels`; white: the round's own inputs).
-Field weigh_field_under(const SearchContext& S, const Round& R, const Score& chosen, const ModelFit& before,
-                        const EffectModel& before_effects, const NoiseTreatment& t, bool with_levels) {
+Field weigh_field_under(const SearchContext& S, const Round& R, const Score& chosen,
+                        const ModelFit& before, const EffectModel& before_effects,
+                        const NoiseTreatment& t, bool with_levels) {
   if (!S.noise.W) return weigh_field(S, R, chosen, before, before_effects, t, R.in);
   ScoringInputs in;
   in.Jfree = with_levels ? R.J_levels : R.in.Jfree;
@@ -113,14 +126,17 @@ Field weigh_field_under(const SearchContext& S, const Round& R, const Score& cho
 
 }  // namespace
 
-Choice choose(const SearchContext& S, const Round& R, const ModelFit& fit, const EffectModel& effects,
-              const std::vector<int>& fold, std::vector<bool>& done, Diagnosis& D) {
+Choice choose(const SearchContext& S, const Round& R, const ModelFit& fit,
+              const EffectModel& effects, const std::vector<int>& fold, std::vector<bool>& done,
+              Diagnosis& D) {
   const DiagnosisOptions& options = S.options;
   const double m_tests = std::max<double>(1.0, static_cast<double>(R.scores.size()));
   std::vector<const Score*> passing;
   for (const Score& s : R.scores)
-    if (s.f_pvalue < options.alpha / m_tests && s.delta_bic < options.min_delta_bic) passing.push_back(&s);
-  std::sort(passing.begin(), passing.end(), [](const Score* a, const Score* b) { return a->delta_bic < b->delta_bic; });
+    if (s.f_pvalue < options.alpha / m_tests && s.delta_bic < options.min_delta_bic)
+      passing.push_back(&s);
+  std::sort(passing.begin(), passing.end(),
+            [](const Score* a, const Score* b) { return a->delta_bic < b->delta_bic; });
 
   // The first passing candidate that also predicts left-out blocks better and whose
   // parameters the nonlinear refit can determine.
@@ -136,7 +152,8 @@ Choice choose(const SearchContext& S, const Round& R, const ModelFit& fit, const
     // half the poses, extrapolates badly).
     std::vector<int> own_fold;
     if (S.model) {
-      const NoiseModel own = estimate_noise_model(S.P.groups(), S.P.times(), refit.residuals, options.noise);
+      const NoiseModel own =
+          estimate_noise_model(S.P.groups(), S.P.times(), refit.residuals, options.noise);
       own_fold = cv_folds(S.P, options.cv_blocks, own.white() ? nullptr : &own);
     }
     const std::vector<int>& f = S.model ? own_fold : fold;
@@ -148,16 +165,18 @@ Choice choose(const SearchContext& S, const Round& R, const ModelFit& fit, const
     // be determined, min_determined_sigma from zero in the refit (a polynomial's correlated
     // coefficients can be so jointly while none is alone), not merely estimable.
     const bool any_determined =
-        determined_sigmas(refit, s->effect, R.treatment_of[static_cast<std::size_t>(s - R.scores.data())]) >=
+        determined_sigmas(refit, s->effect,
+                          R.treatment_of[static_cast<std::size_t>(s - R.scores.data())]) >=
         options.min_determined_sigma;
     for (std::size_t c = 0; c < S.candidates.size(); ++c)
       if (S.candidates[c] == s->effect) done[c] = true;
     if (!any_determined) {
       D.unobservable.push_back(
-          {s->effect.id(), "it reduces the residual, but once it is in the model none of its "
-                           "parameters can be determined from these readings (none reaches " +
-                               std::to_string(static_cast<int>(options.min_determined_sigma)) +
-                               " sigma: they trade off against the location errors and the other effects)"});
+          {s->effect.id(),
+           "it reduces the residual, but once it is in the model none of its "
+           "parameters can be determined from these readings (none reaches " +
+               std::to_string(static_cast<int>(options.min_determined_sigma)) +
+               " sigma: they trade off against the location errors and the other effects)"});
       continue;
     }
     out.chosen = s;
@@ -167,8 +186,8 @@ Choice choose(const SearchContext& S, const Round& R, const ModelFit& fit, const
   return out;
 }
 
-Finding name_finding(const SearchContext& S, const Round& R, const Choice& choice, const ModelFit& before,
-                     const EffectModel& before_effects, Diagnosis& D) {
+Finding name_finding(const SearchContext& S, const Round& R, const Choice& choice,
+                     const ModelFit& before, const EffectModel& before_effects, Diagnosis& D) {
   const Score& chosen = *choice.chosen;
   const ModelFit& fit = *choice.refit;
   const double n = static_cast<double>(before.residuals.size());
@@ -192,15 +211,18 @@ Finding name_finding(const SearchContext& S, const Round& R, const Choice& choic
   const auto loose = R.named_under.find(ci);
   std::optional<Field> loose_field;
   if (loose != R.named_under.end())
-    loose_field.emplace(weigh_field_under(S, R, chosen, before, before_effects, loose->second, !loose->second.full));
-  const RivalJudgement judged_rivals = loose_field ? worse_of(field.judged, loose_field->judged) : field.judged;
+    loose_field.emplace(weigh_field_under(S, R, chosen, before, before_effects, loose->second,
+                                          !loose->second.full));
+  const RivalJudgement judged_rivals =
+      loose_field ? worse_of(field.judged, loose_field->judged) : field.judged;
   // A harmonic of an order the sampling cannot resolve takes, at the sampled angles, the
   // values of lower orders: a finding of a harmonic of that axis may be it, of its own kind or
   // another (on the R-test's 7 tilt angles an axial h4 came out as a tilt h3).
   std::vector<Alternative> aliases;
   for (std::size_t c = 0; c < S.candidates.size(); ++c) {
     const Effect& e = S.candidates[c];
-    if (chosen.effect.harmonic > 0 && e.harmonic > 0 && e.axis == chosen.effect.axis && !S.unresolved[c].empty()) {
+    if (chosen.effect.harmonic > 0 && e.harmonic > 0 && e.axis == chosen.effect.axis &&
+        !S.unresolved[c].empty()) {
       Alternative a;
       a.effect = e.id();
       a.in_group = true;
@@ -222,7 +244,8 @@ Finding name_finding(const SearchContext& S, const Round& R, const Choice& choic
         judged_rivals.group.size() > 1
             ? separating_test(S.P, before, chosen, *judged_rivals.group[1], S.noise.sigma_mm)
             : "a finer step of axis " + std::string(1, chosen.effect.axis) +
-                  " resolves the higher orders (" + unresolved_reason(S.candidates, S.unresolved, aliases) + ")";
+                  " resolves the higher orders (" +
+                  unresolved_reason(S.candidates, S.unresolved, aliases) + ")";
     D.ambiguous.push_back(amb);
   }
 
@@ -237,7 +260,8 @@ Finding name_finding(const SearchContext& S, const Round& R, const Choice& choic
   const NoiseTreatment& judged = R.treatment_of[ci];
   const double rss_before = judged.whiten(before.residuals).squaredNorm();
   const double rss_after = std::max(judged.whiten(fit.residuals).squaredNorm(), 1e-300);
-  F.gain.delta_bic = n * std::log(rss_after / rss_before) + (fit.num_free - before.num_free) * std::log(n);
+  F.gain.delta_bic =
+      n * std::log(rss_after / rss_before) + (fit.num_free - before.num_free) * std::log(n);
   F.gain.cv_rms_before_um = choice.cv_before;
   F.gain.cv_rms_after_um = choice.cv_after;
   F.gain.f_pvalue = chosen.f_pvalue;

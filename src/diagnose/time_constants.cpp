@@ -17,8 +17,8 @@ struct ProfilePoint {
 
 // The model with the amplitude's column at q, linearised about the final fit in every other
 // free parameter: min |W (r0 - d0 c0 + J_o dx + d c_q)|^2 over (dx, d).
-ProfilePoint solve_at(const Eigen::MatrixXd& Jo_w, const Eigen::VectorXd& base_w, const Eigen::VectorXd& col,
-                      const NoiseTreatment& t, double q) {
+ProfilePoint solve_at(const Eigen::MatrixXd& Jo_w, const Eigen::VectorXd& base_w,
+                      const Eigen::VectorXd& col, const NoiseTreatment& t, double q) {
   Eigen::MatrixXd A(Jo_w.rows(), Jo_w.cols() + 1);
   A.leftCols(Jo_w.cols()) = Jo_w;
   A.col(Jo_w.cols()) = t.whiten(col);
@@ -27,7 +27,8 @@ ProfilePoint solve_at(const Eigen::MatrixXd& Jo_w, const Eigen::VectorXd& base_w
   p.q = q;
   p.x = qr.solve(-base_w);
   p.chi2 = (base_w + A * p.x).squaredNorm();
-  const Eigen::MatrixXd cov = (A.transpose() * A).ldlt().solve(Eigen::MatrixXd::Identity(A.cols(), A.cols()));
+  const Eigen::MatrixXd cov =
+      (A.transpose() * A).ldlt().solve(Eigen::MatrixXd::Identity(A.cols(), A.cols()));
   p.sigma = cov.diagonal().cwiseMax(0.0).cwiseSqrt();
   return p;
 }
@@ -45,7 +46,8 @@ ProfilePoint solve_at(const Eigen::MatrixXd& Jo_w, const Eigen::VectorXd& base_w
 // amplitude's column), so the candidate spans the warm-ups near tau = 300 s and is scored with
 // both parameters (and their BIC penalty). The fits free tau themselves
 // (core/time_constant_fit.hpp).
-void with_time_constant_tangent(const DiagnosisProblem& P, const Effect& candidate, Eigen::MatrixXd& J) {
+void with_time_constant_tangent(const DiagnosisProblem& P, const Effect& candidate,
+                                Eigen::MatrixXd& J) {
   const std::vector<double>& times = P.times();
   if (candidate.kind != EffectKind::thermal_warmup || J.cols() != 2 ||
       static_cast<Eigen::Index>(times.size()) != J.rows() || J.col(1).squaredNorm() > 0.0)
@@ -71,7 +73,8 @@ void with_time_constant_tangent(const DiagnosisProblem& P, const Effect& candida
 // amplitude only where it stays finite over it. Nothing changes where the fit freed tau
 // (the ballbar's two-stage fit) or the times are not one per residual. Updates D.final_fit
 // (values, sigmas before the caller's `scale`, residuals); the caller reads the findings' from it.
-void profile_time_constants(const DiagnosisProblem& P, const NoiseTreatment& t, double scale, Diagnosis& D) {
+void profile_time_constants(const DiagnosisProblem& P, const NoiseTreatment& t, double scale,
+                            Diagnosis& D) {
   ModelFit& F = D.final_fit;
   const std::vector<double>& times = P.times();
   if (static_cast<Eigen::Index>(times.size()) != F.residuals.size()) return;
@@ -84,7 +87,9 @@ void profile_time_constants(const DiagnosisProblem& P, const NoiseTreatment& t, 
       if (F.parameters[j].name == id + ".ln_tau_300s") jq = static_cast<Eigen::Index>(j);
     }
     if (jd < 0 || jq < 0 || !F.parameters[static_cast<std::size_t>(jd)].observable) continue;
-    if (F.jacobian.col(jq).squaredNorm() > 0.0 && F.parameters[static_cast<std::size_t>(jq)].observable) continue;
+    if (F.jacobian.col(jq).squaredNorm() > 0.0 &&
+        F.parameters[static_cast<std::size_t>(jq)].observable)
+      continue;
     const double q0 = F.parameters[static_cast<std::size_t>(jq)].value;
     const double d0 = F.parameters[static_cast<std::size_t>(jd)].value;
     const Eigen::VectorXd c0 = F.jacobian.col(jd);
@@ -96,14 +101,16 @@ void profile_time_constants(const DiagnosisProblem& P, const NoiseTreatment& t, 
     }
     const auto column_at = [&](double q) {
       Eigen::VectorXd c(c0.size());
-      for (Eigen::Index i = 0; i < c.size(); ++i) c[i] = geometry[i] * thermal_warmup_factor(times[static_cast<std::size_t>(i)], q);
+      for (Eigen::Index i = 0; i < c.size(); ++i)
+        c[i] = geometry[i] * thermal_warmup_factor(times[static_cast<std::size_t>(i)], q);
       return c;
     };
     std::vector<Eigen::Index> others;
     for (Eigen::Index j = 0; j < F.jacobian.cols(); ++j)
       if (j != jd && j != jq && F.jacobian.col(j).squaredNorm() > 0.0) others.push_back(j);
     Eigen::MatrixXd Jo(F.jacobian.rows(), static_cast<Eigen::Index>(others.size()));
-    for (std::size_t k = 0; k < others.size(); ++k) Jo.col(static_cast<Eigen::Index>(k)) = F.jacobian.col(others[k]);
+    for (std::size_t k = 0; k < others.size(); ++k)
+      Jo.col(static_cast<Eigen::Index>(k)) = F.jacobian.col(others[k]);
     const Eigen::MatrixXd Jo_w = t.whiten(Jo);
     const Eigen::VectorXd base_w = t.whiten(Eigen::MatrixXd(F.residuals - d0 * c0));
     const Eigen::Index last = Jo_w.cols();
@@ -115,7 +122,8 @@ void profile_time_constants(const DiagnosisProblem& P, const NoiseTreatment& t, 
     if (!(at0.sigma[last] > 0.0) || !(reported_d > 0.0)) continue;
     const double k = scale * reported_d / at0.sigma[last];
     std::vector<ProfilePoint> grid;
-    for (int s = -40; s <= 30; ++s) grid.push_back(solve_at(Jo_w, base_w, column_at(0.1 * s), t, 0.1 * s));
+    for (int s = -40; s <= 30; ++s)
+      grid.push_back(solve_at(Jo_w, base_w, column_at(0.1 * s), t, 0.1 * s));
     std::size_t best = 0;
     for (std::size_t s = 1; s < grid.size(); ++s)
       if (grid[s].chi2 < grid[best].chi2) best = s;

@@ -8,10 +8,10 @@
 #include <limits>
 #include <memory>
 
+#include "budget_detail.hpp"
 #include "rotacal/core/error.hpp"
 #include "rotacal/core/stats.hpp"
 #include "rotacal/kinematics/parameter_blocks.hpp"
-#include "budget_detail.hpp"
 #include "scoring.hpp"
 
 namespace rotacal {
@@ -22,33 +22,76 @@ std::vector<double> plausible_sizes(const Effect& e, const PlausibleSizes& z, do
   const double T = std::max(duration_s, 1.0);
   std::vector<double> a(static_cast<std::size_t>(e.num_params()), 0.0);
   switch (e.kind) {
-    case EffectKind::ballbar_length_offset: a = {z.bar_length_mm}; break;
-    case EffectKind::ballbar_thermal_drift: a = {z.drift_mm / T}; break;
-    case EffectKind::tool_offset_Z: a = {z.tool_length_mm}; break;
-    case EffectKind::rotary_zero_offset: a = {z.rotary_zero_rad}; break;
-    case EffectKind::angular_positioning: a = {z.angular_positioning_rad, z.angular_positioning_rad}; break;
-    case EffectKind::radial_motion: a.assign(4, z.error_motion_mm); break;
-    case EffectKind::axial_motion: a.assign(2, z.error_motion_mm); break;
-    case EffectKind::tilt_motion: a.assign(4, z.tilt_motion_rad); break;
-    case EffectKind::gravity_sag: a = {z.gravity_sag_mm}; break;
-    case EffectKind::coning: a = {z.coning}; break;
-    case EffectKind::linear_squareness: a = {z.squareness_rad}; break;
-    case EffectKind::linear_scale: a = {z.scale}; break;
-    case EffectKind::thermal_drift: a = {z.drift_mm / T}; break;
-    case EffectKind::thermal_warmup: a = {z.warmup_mm, 0.0}; break;  // tau moves nothing at d = 0
+    case EffectKind::ballbar_length_offset:
+      a = {z.bar_length_mm};
+      break;
+    case EffectKind::ballbar_thermal_drift:
+      a = {z.drift_mm / T};
+      break;
+    case EffectKind::tool_offset_Z:
+      a = {z.tool_length_mm};
+      break;
+    case EffectKind::rotary_zero_offset:
+      a = {z.rotary_zero_rad};
+      break;
+    case EffectKind::angular_positioning:
+      a = {z.angular_positioning_rad, z.angular_positioning_rad};
+      break;
+    case EffectKind::radial_motion:
+      a.assign(4, z.error_motion_mm);
+      break;
+    case EffectKind::axial_motion:
+      a.assign(2, z.error_motion_mm);
+      break;
+    case EffectKind::tilt_motion:
+      a.assign(4, z.tilt_motion_rad);
+      break;
+    case EffectKind::gravity_sag:
+      a = {z.gravity_sag_mm};
+      break;
+    case EffectKind::coning:
+      a = {z.coning};
+      break;
+    case EffectKind::linear_squareness:
+      a = {z.squareness_rad};
+      break;
+    case EffectKind::linear_scale:
+      a = {z.scale};
+      break;
+    case EffectKind::thermal_drift:
+      a = {z.drift_mm / T};
+      break;
+    case EffectKind::thermal_warmup:
+      a = {z.warmup_mm, 0.0};
+      break;  // tau moves nothing at d = 0
     case EffectKind::straightness: {
       // c_k u^k reaches the deviation at the end of the length: u = length / 2 / 100 mm.
       const double u = z.straightness_length_mm / 200.0;
-      a = {z.straightness_mm / (u * u), z.straightness_mm / (u * u * u), z.straightness_mm / (u * u * u * u)};
+      a = {z.straightness_mm / (u * u), z.straightness_mm / (u * u * u),
+           z.straightness_mm / (u * u * u * u)};
       break;
     }
-    case EffectKind::tool_offset: a = {z.tool_offset_mm}; break;
-    case EffectKind::linear_pitch: a = {z.angular_error_rad, z.angular_error_rad}; break;
-    case EffectKind::rotary_backlash: a = {z.backlash_rad}; break;
-    case EffectKind::servo_lag: a = {z.servo_lag_s}; break;
-    case EffectKind::reversal_spike: a = {z.reversal_spike_rad, 0.0}; break;  // tau moves nothing at h = 0
-    case EffectKind::stylus_radius_offset: a = {z.stylus_radius_mm}; break;
-    case EffectKind::probe_lobing: a = {z.probe_lobing_mm, z.probe_lobing_mm}; break;
+    case EffectKind::tool_offset:
+      a = {z.tool_offset_mm};
+      break;
+    case EffectKind::linear_pitch:
+      a = {z.angular_error_rad, z.angular_error_rad};
+      break;
+    case EffectKind::rotary_backlash:
+      a = {z.backlash_rad};
+      break;
+    case EffectKind::servo_lag:
+      a = {z.servo_lag_s};
+      break;
+    case EffectKind::reversal_spike:
+      a = {z.reversal_spike_rad, 0.0};
+      break;  // tau moves nothing at h = 0
+    case EffectKind::stylus_radius_offset:
+      a = {z.stylus_radius_mm};
+      break;
+    case EffectKind::probe_lobing:
+      a = {z.probe_lobing_mm, z.probe_lobing_mm};
+      break;
   }
   const auto names = e.param_names();
   const auto it = z.overrides.find(e.id());
@@ -63,19 +106,23 @@ std::vector<double> plausible_sizes(const Effect& e, const PlausibleSizes& z, do
   return a;
 }
 
-void budget_detail::check_inputs(const PlausibleSizes& sizes, const std::vector<Effect>& all, double coverage) {
+void budget_detail::check_inputs(const PlausibleSizes& sizes, const std::vector<Effect>& all,
+                                 double coverage) {
   if (!(coverage > 0.0 && coverage < 1.0))
-    throw InvalidArgument("uncertainty_budget: coverage is " + std::to_string(coverage) + ", must be in (0, 1)");
+    throw InvalidArgument("uncertainty_budget: coverage is " + std::to_string(coverage) +
+                          ", must be in (0, 1)");
   for (const auto& [key, value] : sizes.overrides) {
     (void)value;
     const Effect e = Effect::parse(key.substr(0, key.find('.')));
     if (std::find(all.begin(), all.end(), e) == all.end())
-      throw InvalidArgument("uncertainty_budget: override '" + key + "' names no candidate of this session");
+      throw InvalidArgument("uncertainty_budget: override '" + key +
+                            "' names no candidate of this session");
   }
 }
 
 UncertaintyBudget uncertainty_budget(const DiagnosisProblem& P, const Diagnosis& D,
-                                     const PlausibleSizes& sizes, double coverage, int max_harmonic) {
+                                     const PlausibleSizes& sizes, double coverage,
+                                     int max_harmonic) {
   const std::vector<Effect> all = P.candidates(max_harmonic);
   budget_detail::check_inputs(sizes, all, coverage);
   const ModelFit& fit = D.final_fit;
@@ -83,13 +130,17 @@ UncertaintyBudget uncertainty_budget(const DiagnosisProblem& P, const Diagnosis&
     throw InvalidArgument("uncertainty_budget: the diagnosis has no final fit");
   std::vector<Effect> candidates;  // what the final model leaves out
   for (const Effect& c : all)
-    if (std::find(fit.effects.effects.begin(), fit.effects.effects.end(), c) == fit.effects.effects.end())
+    if (std::find(fit.effects.effects.begin(), fit.effects.effects.end(), c) ==
+        fit.effects.effects.end())
       candidates.push_back(c);
-  const budget_detail::BudgetedFit model{P.machine(), fit, D.noise, D.baseline.noise_um, nullptr, P.times()};
-  return budget_detail::budget_of(model, candidates, P.candidate_jacobians(fit, candidates), sizes, coverage);
+  const budget_detail::BudgetedFit model{P.machine(),         fit,     D.noise,
+                                         D.baseline.noise_um, nullptr, P.times()};
+  return budget_detail::budget_of(model, candidates, P.candidate_jacobians(fit, candidates), sizes,
+                                  coverage);
 }
 
-UncertaintyBudget budget_detail::budget_of(const BudgetedFit& m, const std::vector<Effect>& candidates,
+UncertaintyBudget budget_detail::budget_of(const BudgetedFit& m,
+                                           const std::vector<Effect>& candidates,
                                            const std::vector<Eigen::MatrixXd>& jacobians,
                                            const PlausibleSizes& sizes, double coverage) {
   const ModelFit& fit = m.fit;
@@ -102,12 +153,15 @@ UncertaintyBudget budget_detail::budget_of(const BudgetedFit& m, const std::vect
 
   // Whitening by the fit's noise model (white: 1/sigma).
   std::unique_ptr<ArWhitener> W;
-  if (!m.noise.white() && m.noise.n == static_cast<std::size_t>(n)) W = std::make_unique<ArWhitener>(m.noise);
+  if (!m.noise.white() && m.noise.n == static_cast<std::size_t>(n))
+    W = std::make_unique<ArWhitener>(m.noise);
   const double sigma_mm = std::max(m.noise_um, 1e-9) * 1e-3;
   const auto whiten = [&](const Eigen::MatrixXd& M) {
     Eigen::MatrixXd out = M;
-    if (W) W->apply(out);
-    else out /= sigma_mm;
+    if (W)
+      W->apply(out);
+    else
+      out /= sigma_mm;
     return out;
   };
 
@@ -141,7 +195,8 @@ UncertaintyBudget budget_detail::budget_of(const BudgetedFit& m, const std::vect
 
   struct Contribution {
     std::string effect, basis;
-    Eigen::VectorXd bias;  // per free parameter, at the half-widths (RSS over the effect's parameters)
+    Eigen::VectorXd
+        bias;  // per free parameter, at the half-widths (RSS over the effect's parameters)
     Eigen::VectorXd u;
     double dof;
     std::vector<double> a;
@@ -161,11 +216,14 @@ UncertaintyBudget budget_detail::budget_of(const BudgetedFit& m, const std::vect
       const Eigen::VectorXd s = svd.singularValues();
       if (s.size() && s[s.size() - 1] > 1e-9 * std::max(1.0, s[0])) {
         const Eigen::VectorXd est = svd.solve(r_w);
-        const Eigen::MatrixXd cov = svd.matrixV() * s.cwiseInverse().cwiseAbs2().asDiagonal() * svd.matrixV().transpose();
+        const Eigen::MatrixXd cov =
+            svd.matrixV() * s.cwiseInverse().cwiseAbs2().asDiagonal() * svd.matrixV().transpose();
         bool tighter = false;
         std::vector<double> bound(a.size());
         for (std::size_t k = 0; k < a.size(); ++k) {
-          bound[k] = std::abs(est[static_cast<Eigen::Index>(k)]) + 2.0 * std::sqrt(cov(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k)));
+          bound[k] =
+              std::abs(est[static_cast<Eigen::Index>(k)]) +
+              2.0 * std::sqrt(cov(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k)));
           tighter = tighter || bound[k] < a[k];
         }
         if (tighter) {
@@ -196,7 +254,9 @@ UncertaintyBudget budget_detail::budget_of(const BudgetedFit& m, const std::vect
     L.unit = errors.units[i];
     const auto p = std::find_if(fit.parameters.begin(), fit.parameters.end(),
                                 [&](const ParameterEstimate& q) { return q.name == L.name; });
-    const auto col = p == fit.parameters.end() ? -1 : free_index[static_cast<std::size_t>(p - fit.parameters.begin())];
+    const auto col = p == fit.parameters.end()
+                         ? -1
+                         : free_index[static_cast<std::size_t>(p - fit.parameters.begin())];
     if (col < 0 || !p->observable) {
       L.observable = false;
       out.errors.push_back(L);
@@ -218,7 +278,8 @@ UncertaintyBudget budget_detail::budget_of(const BudgetedFit& m, const std::vect
       if (std::isfinite(b.dof)) ws += std::pow(b.u, 4) / b.dof;
       L.type_b.push_back(b);
     }
-    std::sort(L.type_b.begin(), L.type_b.end(), [](const BudgetLine& a, const BudgetLine& b) { return a.u > b.u; });
+    std::sort(L.type_b.begin(), L.type_b.end(),
+              [](const BudgetLine& a, const BudgetLine& b) { return a.u > b.u; });
     L.u_c = std::sqrt(uc2);
     L.nu_eff = ws > 0.0 ? std::pow(L.u_c, 4) / ws : std::numeric_limits<double>::infinity();
     L.k = stats::t_coverage(coverage, L.nu_eff);

@@ -9,12 +9,14 @@
 
 namespace rotacal {
 
-Eigen::VectorXd box_least_squares(const Eigen::MatrixXd& R, const Eigen::VectorXd& d, const Eigen::VectorXd& w,
-                                  const Eigen::VectorXd& bounds, const BoxLeastSquaresOptions& options) {
+Eigen::VectorXd box_least_squares(const Eigen::MatrixXd& R, const Eigen::VectorXd& d,
+                                  const Eigen::VectorXd& w, const Eigen::VectorXd& bounds,
+                                  const BoxLeastSquaresOptions& options) {
   const Eigen::Index n = R.rows(), k = R.cols();
   if (d.size() != n || w.size() != n || bounds.size() != k)
-    throw InvalidArgument("box_least_squares: R is " + std::to_string(n) + " x " + std::to_string(k) + ", d has " +
-                          std::to_string(d.size()) + " values, w " + std::to_string(w.size()) + ", bounds " +
+    throw InvalidArgument("box_least_squares: R is " + std::to_string(n) + " x " +
+                          std::to_string(k) + ", d has " + std::to_string(d.size()) +
+                          " values, w " + std::to_string(w.size()) + ", bounds " +
                           std::to_string(bounds.size()));
   if (!R.allFinite() || !d.allFinite() || !w.allFinite() || !bounds.allFinite())
     throw InvalidArgument("box_least_squares: R, d, w and bounds must be finite");
@@ -26,15 +28,18 @@ Eigen::VectorXd box_least_squares(const Eigen::MatrixXd& R, const Eigen::VectorX
   Eigen::VectorXd s = Eigen::VectorXd::Zero(k), old(k);
   // e = d - R s, kept up to date as one coordinate changes at a time.
   Eigen::VectorXd e = d;
-  const Eigen::VectorXd den = (R.array().square().colwise() * w.array()).colwise().sum().transpose();
+  const Eigen::VectorXd den =
+      (R.array().square().colwise() * w.array()).colwise().sum().transpose();
   for (int sweep = 0; sweep < options.max_sweeps; ++sweep) {
     old = s;
     for (Eigen::Index j = 0; j < k; ++j) {
       // The minimum along s_j with the others held: sum w r (e + r s_j) / sum w r^2.
-      const double sj = den[j] > 0.0
-                            ? std::clamp((w.array() * R.col(j).array() * (e + R.col(j) * s[j]).array()).sum() / den[j],
-                                         -bounds[j], bounds[j])
-                            : 0.0;
+      const double sj =
+          den[j] > 0.0
+              ? std::clamp(
+                    (w.array() * R.col(j).array() * (e + R.col(j) * s[j]).array()).sum() / den[j],
+                    -bounds[j], bounds[j])
+              : 0.0;
       e -= R.col(j) * (sj - s[j]);
       s[j] = sj;
     }

@@ -25,8 +25,8 @@ Eigen::Index non_finite_row(const Eigen::Ref<const Points2>& p) {
 
 void check_points(const Eigen::Ref<const Points2>& p, const std::string& who) {
   if (!p.allFinite())
-    throw InvalidArgument(who + ": point " + std::to_string(non_finite_row(p)) + " of " + std::to_string(p.rows()) +
-                          " contains NaN or infinity");
+    throw InvalidArgument(who + ": point " + std::to_string(non_finite_row(p)) + " of " +
+                          std::to_string(p.rows()) + " contains NaN or infinity");
   if (p.rows() < 3)
     throw DegenerateGeometry(who + ": " + std::to_string(p.rows()) +
                              " points cannot determine a circle (need 3 or more)");
@@ -35,8 +35,9 @@ void check_points(const Eigen::Ref<const Points2>& p, const std::string& who) {
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(c);
   const auto s = svd.singularValues();
   if (!(s[1] > 1e-9 * s[0]))
-    throw DegenerateGeometry(who + ": the " + std::to_string(p.rows()) +
-                             " points are collinear (did the axis move?); no circle passes through them");
+    throw DegenerateGeometry(
+        who + ": the " + std::to_string(p.rows()) +
+        " points are collinear (did the axis move?); no circle passes through them");
 }
 
 // r = |p - c| - R for one point (Ceres examples/circle_fit.cc shape, without its
@@ -61,7 +62,8 @@ CircleFit finish(const Eigen::Ref<const Points2>& p, Eigen::Vector2d centre, dou
   if (o.refine) {
     ceres::Problem problem;
     for (Eigen::Index i = 0; i < p.rows(); ++i)
-      problem.AddResidualBlock(CircleDistance::Create(p.row(i).transpose()), nullptr, centre.data(), &radius);
+      problem.AddResidualBlock(CircleDistance::Create(p.row(i).transpose()), nullptr, centre.data(),
+                               &radius);
     ceres::Solver::Options so;
     so.linear_solver_type = ceres::DENSE_QR;
     so.function_tolerance = 1e-14;
@@ -95,9 +97,11 @@ CircleFit finish(const Eigen::Ref<const Points2>& p, Eigen::Vector2d centre, dou
   const double scatter = p.rows() > 3 ? std::sqrt(ss / static_cast<double>(p.rows() - 3)) : 0.0;
   if (sagitta < o.min_sagitta_ratio * scatter)
     throw DegenerateGeometry(who + ": the arc is too short to fit: its sagitta " +
-                             std::to_string(sagitta) + " is below " + std::to_string(o.min_sagitta_ratio) +
-                             " x the scatter " + std::to_string(scatter));
-  const double s2 = o.sigma > 0 ? o.sigma * o.sigma : (p.rows() > 3 ? ss / static_cast<double>(p.rows() - 3) : 0.0);
+                             std::to_string(sagitta) + " is below " +
+                             std::to_string(o.min_sagitta_ratio) + " x the scatter " +
+                             std::to_string(scatter));
+  const double s2 = o.sigma > 0 ? o.sigma * o.sigma
+                                : (p.rows() > 3 ? ss / static_cast<double>(p.rows() - 3) : 0.0);
   f.covariance = (J.transpose() * J).inverse() * s2;
   return f;
 }
@@ -134,7 +138,9 @@ CircleFit hyper_circle_fit(const Eigen::Ref<const Points2>& p, const CircleFitOp
   const double cx = (Mxz * (Myy - x) - Myz * Mxy) / det / 2.0;
   const double cy = (Myz * (Mxx - x) - Mxz * Mxy) / det / 2.0;
   const double r = std::sqrt(cx * cx + cy * cy + Mz - 2 * x);
-  if (!std::isfinite(r)) throw DegenerateGeometry(who + ": no circle fits these " + std::to_string(p.rows()) + " points");
+  if (!std::isfinite(r))
+    throw DegenerateGeometry(who + ": no circle fits these " + std::to_string(p.rows()) +
+                             " points");
   return finish(p, Eigen::Vector2d(cx + mean.x(), cy + mean.y()), r, o, who);
 }
 
@@ -152,7 +158,9 @@ CircleFit kasa_circle_fit(const Eigen::Ref<const Points2>& p, const CircleFitOpt
   const Eigen::Vector3d s = A.colPivHouseholderQr().solve(b);  // x^2+y^2 + D x + E y + F = 0
   const Eigen::Vector2d c(-s[0] / 2, -s[1] / 2);
   const double r = std::sqrt(c.squaredNorm() - s[2]);
-  if (!std::isfinite(r)) throw DegenerateGeometry(who + ": no circle fits these " + std::to_string(p.rows()) + " points");
+  if (!std::isfinite(r))
+    throw DegenerateGeometry(who + ": no circle fits these " + std::to_string(p.rows()) +
+                             " points");
   return finish(p, c + mean.transpose(), r, o, who);
 }
 

@@ -34,17 +34,19 @@ SphereFit sphere_fit(const Eigen::Ref<const Points3>& p, const SphereFitOptions&
     throw InvalidArgument("sphere_fit: radius must be finite and > 0");
   const int need = o.radius ? 3 : 4;
   if (p.rows() < need)
-    throw DegenerateGeometry("sphere_fit: " + std::to_string(p.rows()) + " points cannot determine a sphere (need " +
-                             std::to_string(need) + " or more)");
+    throw DegenerateGeometry("sphere_fit: " + std::to_string(p.rows()) +
+                             " points cannot determine a sphere (need " + std::to_string(need) +
+                             " or more)");
   const Eigen::RowVector3d mean = p.colwise().mean();
   const Eigen::MatrixXd c = p.rowwise() - mean;
   Eigen::JacobiSVD<Eigen::MatrixXd> shape(c);
   const Eigen::Vector3d s = shape.singularValues();
   if (!(s[1] > 1e-9 * s[0])) throw DegenerateGeometry("sphere_fit: the points are collinear");
   if (!(s[2] > 1e-6 * s[0]))
-    throw DegenerateGeometry(o.radius ? "sphere_fit: the points are coplanar; with a fixed radius the centre "
-                                        "has two mirror solutions, one each side of their plane"
-                                      : "sphere_fit: the points are coplanar; a free radius is undetermined");
+    throw DegenerateGeometry(
+        o.radius ? "sphere_fit: the points are coplanar; with a fixed radius the centre "
+                   "has two mirror solutions, one each side of their plane"
+                 : "sphere_fit: the points are coplanar; a free radius is undetermined");
 
   // Algebraic start: |p|^2 + D.p + G = 0 (centre -D/2), on centred coordinates.
   Eigen::MatrixXd A(p.rows(), 4);
@@ -62,7 +64,8 @@ SphereFit sphere_fit(const Eigen::Ref<const Points3>& p, const SphereFitOptions&
   // Geometric refinement.
   ceres::Problem problem;
   for (Eigen::Index i = 0; i < p.rows(); ++i)
-    problem.AddResidualBlock(SphereDistance::Create(p.row(i).transpose()), nullptr, centre.data(), &radius);
+    problem.AddResidualBlock(SphereDistance::Create(p.row(i).transpose()), nullptr, centre.data(),
+                             &radius);
   if (o.radius) problem.SetParameterBlockConstant(&radius);
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_QR;

@@ -1,4 +1,5 @@
-// The ASCII probe dialects (sylvac-, keyence-style) and the probe stream frame (probe_protocol.hpp).
+// The ASCII probe dialects (sylvac-, keyence-style) and the probe stream frame
+// (probe_protocol.hpp).
 #include "rotacal/hw/probe_protocol.hpp"
 
 #include <cctype>
@@ -40,8 +41,10 @@ std::string format_signed(double mm, const char* fmt) {
 std::vector<std::string> split(const std::string& s, char sep) {
   std::vector<std::string> out(1);
   for (char c : s) {
-    if (c == sep) out.emplace_back();
-    else out.back() += c;
+    if (c == sep)
+      out.emplace_back();
+    else
+      out.back() += c;
   }
   return out;
 }
@@ -61,9 +64,12 @@ std::optional<GaugeValue> parse_keyence_value(const std::string& s) {
 
 std::string format_keyence_value(const GaugeValue& v) {
   switch (v.kind) {
-    case GaugeValue::Kind::over_range: return "+FFFFFFF";
-    case GaugeValue::Kind::under_range: return "-FFFFFFF";
-    default: return format_signed(v.mm, "%+08.4f");
+    case GaugeValue::Kind::over_range:
+      return "+FFFFFFF";
+    case GaugeValue::Kind::under_range:
+      return "-FFFFFFF";
+    default:
+      return format_signed(v.mm, "%+08.4f");
   }
 }
 
@@ -71,9 +77,12 @@ std::string format_keyence_value(const GaugeValue& v) {
 
 std::string to_string(ProbeMode m) {
   switch (m) {
-    case ProbeMode::sylvac: return "sylvac";
-    case ProbeMode::keyence: return "keyence";
-    case ProbeMode::stream: return "stream";
+    case ProbeMode::sylvac:
+      return "sylvac";
+    case ProbeMode::keyence:
+      return "keyence";
+    case ProbeMode::stream:
+      return "stream";
   }
   return "?";
 }
@@ -93,8 +102,10 @@ LineScan split_lines(const std::uint8_t* data, std::size_t n, std::size_t max_li
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint8_t c = data[i];
     if (c == '\r' || c == '\n') {
-      if (overlong) scan.garbage_bytes += current.size();
-      else if (!current.empty()) scan.lines.push_back(current);
+      if (overlong)
+        scan.garbage_bytes += current.size();
+      else if (!current.empty())
+        scan.lines.push_back(current);
       current.clear();
       overlong = false;
       start = i + 1;
@@ -130,13 +141,18 @@ std::optional<int> parse_request(const std::string& line, char prefix, int lo, i
 }
 }  // namespace
 
-std::string sylvac_request(int channel) { return request_line("sylvac_request", '?', channel, 1, 3); }
+std::string sylvac_request(int channel) {
+  return request_line("sylvac_request", '?', channel, 1, 3);
+}
 
-std::optional<int> parse_sylvac_request(const std::string& line) { return parse_request(line, '?', 1, 3); }
+std::optional<int> parse_sylvac_request(const std::string& line) {
+  return parse_request(line, '?', 1, 3);
+}
 
 std::optional<GaugeValue> parse_sylvac_reply(const std::string& line) {
   if (line == "Err01") return GaugeValue{GaugeValue::Kind::over_range, 0.0, 1};
-  if (line.size() == 5 && line.rfind("Err", 0) == 0 && std::isdigit(line[3]) && std::isdigit(line[4]))
+  if (line.size() == 5 && line.rfind("Err", 0) == 0 && std::isdigit(line[3]) &&
+      std::isdigit(line[4]))
     return GaugeValue{GaugeValue::Kind::error, 0.0, std::atoi(line.c_str() + 3)};
   if (line == "?") return GaugeValue{GaugeValue::Kind::error, 0.0, -1};
   const auto v = parse_signed_decimal(line);
@@ -146,9 +162,11 @@ std::optional<GaugeValue> parse_sylvac_reply(const std::string& line) {
 
 std::string format_sylvac_reply(const GaugeValue& v) {
   switch (v.kind) {
-    case GaugeValue::Kind::value: return format_signed(v.mm, "%+09.4f") + "\r";
+    case GaugeValue::Kind::value:
+      return format_signed(v.mm, "%+09.4f") + "\r";
     case GaugeValue::Kind::over_range:
-    case GaugeValue::Kind::under_range: return "Err01\r";
+    case GaugeValue::Kind::under_range:
+      return "Err01\r";
     case GaugeValue::Kind::error: {
       if (v.code < 0) return "?\r";
       char buf[16];
@@ -159,16 +177,21 @@ std::string format_sylvac_reply(const GaugeValue& v) {
   return "?\r";
 }
 
-std::string keyence_request(int channel) { return request_line("keyence_request", 'M', channel, 0, 3); }
+std::string keyence_request(int channel) {
+  return request_line("keyence_request", 'M', channel, 0, 3);
+}
 
-std::optional<int> parse_keyence_request(const std::string& line) { return parse_request(line, 'M', 0, 3); }
+std::optional<int> parse_keyence_request(const std::string& line) {
+  return parse_request(line, 'M', 0, 3);
+}
 
 std::optional<KeyenceReply> parse_keyence_reply(const std::string& line) {
   const auto f = split(line, ',');
   if (f.size() == 3 && f[0] == "ER") {  // "ER,M1,02"
     if (f[1].size() != 2 || f[1][0] != 'M') return std::nullopt;
     const auto ch = channel_digit(f[1], 1, 0, 3);
-    if (!ch || f[2].size() != 2 || !std::isdigit(f[2][0]) || !std::isdigit(f[2][1])) return std::nullopt;
+    if (!ch || f[2].size() != 2 || !std::isdigit(f[2][0]) || !std::isdigit(f[2][1]))
+      return std::nullopt;
     return KeyenceReply{*ch, {GaugeValue{GaugeValue::Kind::error, 0.0, std::atoi(f[2].c_str())}}};
   }
   if (f.empty() || f[0].size() != 2 || f[0][0] != 'M') return std::nullopt;

@@ -21,15 +21,24 @@ namespace {
 
 int baud_of(speed_t s) {
   switch (s) {
-    case B9600: return 9600;
-    case B19200: return 19200;
-    case B38400: return 38400;
-    case B57600: return 57600;
-    case B115200: return 115200;
-    case B230400: return 230400;
-    case B460800: return 460800;
-    case B921600: return 921600;
-    default: return 0;
+    case B9600:
+      return 9600;
+    case B19200:
+      return 19200;
+    case B38400:
+      return 38400;
+    case B57600:
+      return 57600;
+    case B115200:
+      return 115200;
+    case B230400:
+      return 230400;
+    case B460800:
+      return 460800;
+    case B921600:
+      return 921600;
+    default:
+      return 0;
   }
 }
 }  // namespace
@@ -52,9 +61,7 @@ PseudoTerminal::PseudoTerminal() {
   ::fcntl(master_, F_SETFL, flags | O_NONBLOCK);
 }
 
-PseudoTerminal::~PseudoTerminal() {
-  hang_up();
-}
+PseudoTerminal::~PseudoTerminal() { hang_up(); }
 
 int PseudoTerminal::host_baud() const {
   if (slave_keepalive_ < 0) return 0;

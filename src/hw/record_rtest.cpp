@@ -7,9 +7,9 @@
 #include <optional>
 #include <thread>
 
+#include "recording.hpp"
 #include "rotacal/hw/pose_window.hpp"
 #include "rotacal/io/ballbar_file.hpp"
-#include "recording.hpp"
 
 namespace rotacal::hw {
 
@@ -70,11 +70,12 @@ class PoseAverager {
   void write_pose() {
     const RtestSample& p = program_.samples[next_];
     const PoseWindow w = window();
-    const std::string pose = "pose " + std::to_string(next_ + 1) + " (set-up " + p.setup + ", B/A=" +
-                             fixed(p.tilt_deg, 3) + ", C=" + fixed(p.rot_deg, 3) + ")";
+    const std::string pose = "pose " + std::to_string(next_ + 1) + " (set-up " + p.setup +
+                             ", B/A=" + fixed(p.tilt_deg, 3) + ", C=" + fixed(p.rot_deg, 3) + ")";
     const std::string span = "[" + fixed(w.begin, 3) + ", " + fixed(w.end, 3) + "] s";
     const std::string late = std::to_string(outside_) + " reading" + (outside_ == 1 ? "" : "s") +
-                             " not surely inside it (margin down to " + fixed(worst_outside_, 3) + " s)";
+                             " not surely inside it (margin down to " + fixed(worst_outside_, 3) +
+                             " s)";
     summary_.outside_window += outside_;
     if (n_ == 0) {
       ++summary_.lost;
@@ -85,22 +86,24 @@ class PoseAverager {
         const double overlap = std::min(w.end, b) - std::max(w.begin, a);
         if (overlap > longest) longest = overlap, when = {a, b};
       }
-      const std::string idle = (longest > 0.0 ? "; the host could not read for " + fixed(longest, 3) + " s of it (" +
-                                                    fixed(when.first, 3) + " to " + fixed(when.second, 3) + " s)"
-                                              : std::string()) +
-                               "; a reading took the host " + fixed(reading_takes_, 3) + " s";
+      const std::string idle =
+          (longest > 0.0 ? "; the host could not read for " + fixed(longest, 3) + " s of it (" +
+                               fixed(when.first, 3) + " to " + fixed(when.second, 3) + " s)"
+                         : std::string()) +
+          "; a reading took the host " + fixed(reading_takes_, 3) + " s";
       out_.annotate("missing: " + pose + ": no reading inside its window " + span + idle +
                     (outside_ > 0 ? "; " + late : ""));
     } else {
-      if (outside_ > 0) out_.annotate("outside: " + pose + ", window " + span + ": " + late + ", not used");
+      if (outside_ > 0)
+        out_.annotate("outside: " + pose + ", window " + span + ": " + late + ", not used");
       RtestSample row = p;
       const double n = static_cast<double>(n_);
       const Eigen::Vector3d mean = sum_ / n;
       row.raw = mean;
       Eigen::Vector3d var = Eigen::Vector3d::Zero();
       if (n_ > 1) var = ((sum_sq_ - n * mean.cwiseProduct(mean)) / (n - 1.0)).cwiseMax(0.0);
-      row.extra = {std::to_string(n_), fixed(1e3 * std::sqrt(var.maxCoeff()), 3), fixed(t_sum_ / n, 4),
-                   fixed(margin_, 4)};
+      row.extra = {std::to_string(n_), fixed(1e3 * std::sqrt(var.maxCoeff()), 3),
+                   fixed(t_sum_ / n, 4), fixed(margin_, 4)};
       out_.append(row);
     }
     ++next_;
@@ -112,9 +115,10 @@ class PoseAverager {
     margin_ = worst_outside_ = std::numeric_limits<double>::infinity();
     if (!done()) {  // keep what may still overlap the next window (a stall may span several)
       const double begin = window().begin;
-      unavailable_.erase(std::remove_if(unavailable_.begin(), unavailable_.end(),
-                                        [&](const std::pair<double, double>& u) { return u.second <= begin; }),
-                         unavailable_.end());
+      unavailable_.erase(
+          std::remove_if(unavailable_.begin(), unavailable_.end(),
+                         [&](const std::pair<double, double>& u) { return u.second <= begin; }),
+          unavailable_.end());
     }
   }
   const RtestSession& program_;
@@ -155,7 +159,8 @@ class RoundTrips {
   double typical() const {
     if (count_ == 0) return 0.0;
     std::array<double, 15> v = last_;
-    std::nth_element(v.begin(), v.begin() + static_cast<long>(count_ / 2), v.begin() + static_cast<long>(count_));
+    std::nth_element(v.begin(), v.begin() + static_cast<long>(count_ / 2),
+                     v.begin() + static_cast<long>(count_));
     return v[count_ / 2];
   }
 
@@ -173,13 +178,15 @@ struct LineReader {
   std::size_t taken = 0;  // lines returned so far
   /// The next reply line. Each read_timeout_ms without one counts as a timeout; nullopt after
   /// give_up_s (the device is silent).
-  std::optional<std::string> take(ByteTransport& port, RecordSummary& sum, int read_timeout_ms, double give_up_s) {
+  std::optional<std::string> take(ByteTransport& port, RecordSummary& sum, int read_timeout_ms,
+                                  double give_up_s) {
     const double t_end = wall_seconds() + give_up_s;
     std::uint8_t buf[256];
     while (next >= lines.size()) {
       const double left = t_end - wall_seconds();
       if (left <= 0) return std::nullopt;
-      const std::size_t n = port.read(buf, sizeof buf, std::clamp(static_cast<int>(1e3 * left), 1, read_timeout_ms));
+      const std::size_t n =
+          port.read(buf, sizeof buf, std::clamp(static_cast<int>(1e3 * left), 1, read_timeout_ms));
       if (n == 0) {
         ++sum.timeouts;
         continue;
@@ -205,15 +212,18 @@ struct Poll {
 // One polled reading of all three channels. A polled device answers every request once, so
 // the host waits for that answer (however late) rather than asking again: a second request
 // would pair every later reply with the wrong request, and the wrong time.
-Poll poll_once(ByteTransport& port, ProbeMode mode, LineReader& lines, RecordSummary& sum, const RecordOptions& opt) {
+Poll poll_once(ByteTransport& port, ProbeMode mode, LineReader& lines, RecordSummary& sum,
+               const RecordOptions& opt) {
   auto ask = [&](const std::string& request) {
     port.write(request, 200);
     return lines.take(port, sum, opt.read_timeout_ms, opt.silence_timeout_s);
   };
   auto value_of = [&](const GaugeValue& v) -> std::optional<double> {
     if (v.ok()) return v.mm;
-    if (v.kind == GaugeValue::Kind::error) ++sum.malformed;
-    else ++sum.over_range;
+    if (v.kind == GaugeValue::Kind::error)
+      ++sum.malformed;
+    else
+      ++sum.over_range;
     return std::nullopt;
   };
   Poll failed;
@@ -249,18 +259,17 @@ Poll poll_once(ByteTransport& port, ProbeMode mode, LineReader& lines, RecordSum
 
 }  // namespace
 
-RecordSummary record_rtest(ByteTransport& port, ProbeMode mode, const RtestSession& program, double dwell_s,
-                           const Eigen::Matrix3d& probe_dirs, const std::string& path,
-                           const RecordOptions& opt) {
+RecordSummary record_rtest(ByteTransport& port, ProbeMode mode, const RtestSession& program,
+                           double dwell_s, const Eigen::Matrix3d& probe_dirs,
+                           const std::string& path, const RecordOptions& opt) {
   if (program.samples.empty()) throw InvalidArgument("record_rtest: the program has no poses");
   if (!(dwell_s > 0.0)) throw InvalidArgument("record_rtest: dwell_s must be positive");
   RtestSession header = program;
   header.samples.clear();
   header.noise_um.reset();  // what the program was simulated with is not what was measured
   header.extra_columns = {"n", "std_um", "t_s", "margin_s"};
-  header.metadata = {{"recorded_from", port.path()},
-                     {"recorded_at", utc_now()},
-                     {"probe_mode", to_string(mode)}};
+  header.metadata = {
+      {"recorded_from", port.path()}, {"recorded_at", utc_now()}, {"probe_mode", to_string(mode)}};
   header.probe_dirs.clear();
   for (int k = 0; k < 3; ++k) header.probe_dirs[k + 1] = probe_dirs.row(k).transpose();
   RtestWriter out(path, header, /*raw=*/true, OutputOptions{{port.path()}, {}});
@@ -285,7 +294,9 @@ RecordSummary record_rtest(ByteTransport& port, ProbeMode mode, const RtestSessi
     std::optional<ProgramClock> clock;
     const double first_sent = wall_seconds();
     RoundTrips round_trips;
-    auto pause = [](double s) { std::this_thread::sleep_for(std::chrono::duration<double>(std::clamp(s, 0.001, 0.05))); };
+    auto pause = [](double s) {
+      std::this_thread::sleep_for(std::chrono::duration<double>(std::clamp(s, 0.001, 0.05)));
+    };
     double last_ran = first_sent;  // when the loop last ran, wall s
     for (;;) {
       if (clock) {
@@ -307,7 +318,8 @@ RecordSummary record_rtest(ByteTransport& port, ProbeMode mode, const RtestSessi
         const PoseWindow w = poses.window();
         const double takes = round_trips.typical() * opt.speed;
         poses.reading_takes(takes);
-        const double guard = poses.has_reading() ? std::max(3.0 * takes, 0.05 * (w.end - w.begin)) : takes;
+        const double guard =
+            poses.has_reading() ? std::max(3.0 * takes, 0.05 * (w.end - w.begin)) : takes;
         if (early < w.begin) {
           pause((w.begin - early) / opt.speed);
           continue;
@@ -329,7 +341,8 @@ RecordSummary record_rtest(ByteTransport& port, ProbeMode mode, const RtestSessi
       if (!clock && lines.taken > taken) clock = ProgramClock{first_sent, received, opt.speed};
       round_trips.add(received - sent);
       if (clock) poses.host_unavailable(clock->latest(sent), clock->earliest(received));
-      if (poll.reading && clock) poses.add(clock->earliest(sent), clock->latest(received), *poll.reading, true);
+      if (poll.reading && clock)
+        poses.add(clock->earliest(sent), clock->latest(received), *poll.reading, true);
       last_ran = wall_seconds();
       pause(0.002);  // between readings inside a window
     }

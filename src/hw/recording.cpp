@@ -29,9 +29,11 @@ namespace {
 
 // Sends a command and waits for the text reply that starts with `expect`; other frames are
 // ignored. Returns the error to stop with, if any.
-std::optional<std::pair<StopReason, std::string>> handshake(ByteTransport& port, FrameReader& reader,
-                                                            RecordSummary& sum, const std::string& command,
-                                                            const std::string& expect, double timeout_s) {
+std::optional<std::pair<StopReason, std::string>> handshake(ByteTransport& port,
+                                                            FrameReader& reader, RecordSummary& sum,
+                                                            const std::string& command,
+                                                            const std::string& expect,
+                                                            double timeout_s) {
   port.write(command, 500);
   const double t_end = wall_seconds() + timeout_s;
   std::uint8_t buf[512];
@@ -49,7 +51,8 @@ std::optional<std::pair<StopReason, std::string>> handshake(ByteTransport& port,
         return std::nullopt;
       }
       if (text->rfind("ERR", 0) == 0)
-        return std::make_pair(StopReason::no_valid_data, "the instrument refused '" + cmd + "': " + *text);
+        return std::make_pair(StopReason::no_valid_data,
+                              "the instrument refused '" + cmd + "': " + *text);
     }
   }
   ++sum.timeouts;
@@ -58,19 +61,23 @@ std::optional<std::pair<StopReason, std::string>> handshake(ByteTransport& port,
                           "no reply to '" + cmd + "' within " + fixed(timeout_s, 1) + " s, only " +
                               std::to_string(sum.garbage_bytes) +
                               " undecodable bytes: wrong baud rate or not this protocol?");
-  return std::make_pair(StopReason::silence, "no reply to '" + cmd + "' within " + fixed(timeout_s, 1) + " s");
+  return std::make_pair(StopReason::silence,
+                        "no reply to '" + cmd + "' within " + fixed(timeout_s, 1) + " s");
 }
 
 }  // namespace
 
-bool start_stream(ByteTransport& port, FrameReader& reader, RecordSummary& sum, const RecordOptions& opt,
-                  bool zero, StreamGuard& guard) {
+bool start_stream(ByteTransport& port, FrameReader& reader, RecordSummary& sum,
+                  const RecordOptions& opt, bool zero, StreamGuard& guard) {
   // A reply is awaited as long as the user waits for a silent instrument (--silence): a fixed
   // 1 s stopped a recording whose instrument (or host) was slow to answer under load.
   const double wait_s = opt.silence_timeout_s;
   auto fail = handshake(port, reader, sum, format_command(StreamCommand::identify), "ID ", wait_s);
-  if (!fail && zero) fail = handshake(port, reader, sum, format_command(StreamCommand::zero), "OK ZERO", wait_s);
-  if (!fail) fail = handshake(port, reader, sum, format_command(StreamCommand::rate, opt.rate_hz), "OK RATE", wait_s);
+  if (!fail && zero)
+    fail = handshake(port, reader, sum, format_command(StreamCommand::zero), "OK ZERO", wait_s);
+  if (!fail)
+    fail = handshake(port, reader, sum, format_command(StreamCommand::rate, opt.rate_hz), "OK RATE",
+                     wait_s);
   if (!fail) {
     guard.active = true;
     fail = handshake(port, reader, sum, format_command(StreamCommand::start), "OK START", wait_s);

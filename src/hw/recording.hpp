@@ -8,11 +8,11 @@
 #include <utility>
 #include <vector>
 
-#include "rotacal/hw/recorder.hpp"
-#include "rotacal/hw/frame.hpp"
-#include "rotacal/hw/stream_protocol.hpp"
 #include "rotacal/hw/ballbar_protocol.hpp"
+#include "rotacal/hw/frame.hpp"
 #include "rotacal/hw/probe_protocol.hpp"
+#include "rotacal/hw/recorder.hpp"
+#include "rotacal/hw/stream_protocol.hpp"
 
 namespace rotacal::hw::recording {
 
@@ -39,20 +39,23 @@ struct StreamPosition {
   double last_t = 0.0;
 
   template <typename Writer>
-  std::optional<double> advance(std::uint16_t seq, std::uint32_t t_us, Writer& out, RecordSummary& sum) {
+  std::optional<double> advance(std::uint16_t seq, std::uint32_t t_us, Writer& out,
+                                RecordSummary& sum) {
     const double t = clock.seconds(t_us);
     if (last_seq) {
       const int gap = sequence_gap(*last_seq, seq);
       if (gap > 0) {
         sum.lost += static_cast<std::size_t>(gap);
-        out.annotate("gap: " + std::to_string(gap) + " samples lost between seq " + std::to_string(*last_seq) +
-                     " and " + std::to_string(seq) + " (t=" + fixed(last_t, 4) + ".." + fixed(t, 4) + " s)");
+        out.annotate("gap: " + std::to_string(gap) + " samples lost between seq " +
+                     std::to_string(*last_seq) + " and " + std::to_string(seq) +
+                     " (t=" + fixed(last_t, 4) + ".." + fixed(t, 4) + " s)");
       }
     }
     last_seq = seq;
     if (t < last_t) {
       ++sum.malformed;
-      out.annotate("malformed: sample time " + fixed(t, 6) + " s goes backwards (seq " + std::to_string(seq) + ")");
+      out.annotate("malformed: sample time " + fixed(t, 6) + " s goes backwards (seq " +
+                   std::to_string(seq) + ")");
       return std::nullopt;
     }
     last_t = t;
@@ -72,10 +75,12 @@ struct FrameReader {
     sum.garbage_bytes += scan.garbage_bytes;
     sum.crc_errors += scan.crc_errors;
     new_crc = scan.crc_errors;
-    garbage_since_data = scan.frames.empty() ? garbage_since_data + scan.garbage_bytes : scan.garbage_bytes;
+    garbage_since_data =
+        scan.frames.empty() ? garbage_since_data + scan.garbage_bytes : scan.garbage_bytes;
     std::vector<Frame> out = std::move(backlog);
     backlog.clear();
-    out.insert(out.end(), std::make_move_iterator(scan.frames.begin()), std::make_move_iterator(scan.frames.end()));
+    out.insert(out.end(), std::make_move_iterator(scan.frames.begin()),
+               std::make_move_iterator(scan.frames.end()));
     return out;
   }
 };
@@ -95,20 +100,21 @@ struct StreamGuard {
 
 // ID?, [ZERO,] RATE, START. False (reason and detail in `sum`) if the instrument does not
 // answer as it should; `guard` sends STOP later once START has gone out.
-bool start_stream(ByteTransport& port, FrameReader& reader, RecordSummary& sum, const RecordOptions& opt,
-                  bool zero, StreamGuard& guard);
+bool start_stream(ByteTransport& port, FrameReader& reader, RecordSummary& sum,
+                  const RecordOptions& opt, bool zero, StreamGuard& guard);
 
 // After each read of a stream: mark checksum failures in the file, and give up (true, reason
 // no_valid_data) when too many bytes have passed without a valid frame.
 template <typename Writer>
-bool check_link(Writer& out, RecordSummary& sum, std::size_t new_crc, std::size_t garbage_since_data,
-                double t, const RecordOptions& opt) {
+bool check_link(Writer& out, RecordSummary& sum, std::size_t new_crc,
+                std::size_t garbage_since_data, double t, const RecordOptions& opt) {
   if (new_crc > 0)
-    out.annotate("corrupt: " + std::to_string(new_crc) + " frames failed their checksum near t=" + fixed(t, 4) +
-                 " s");
+    out.annotate("corrupt: " + std::to_string(new_crc) +
+                 " frames failed their checksum near t=" + fixed(t, 4) + " s");
   if (garbage_since_data <= opt.max_garbage_without_data) return false;
   sum.reason = StopReason::no_valid_data;
-  sum.detail = std::to_string(garbage_since_data) + " bytes without a valid frame: wrong baud rate or not this protocol?";
+  sum.detail = std::to_string(garbage_since_data) +
+               " bytes without a valid frame: wrong baud rate or not this protocol?";
   return true;
 }
 
@@ -138,8 +144,8 @@ inline bool over_range(const ProbeFrame& s) { return s.status != 0; }
 // malformed frames, time going backwards and over-range readings are counted and marked in
 // the file. Returns true at END (the instrument ran its program to the end).
 template <typename Writer, typename Decode, typename Use>
-bool read_stream(ByteTransport& port, const RecordOptions& opt, bool zero, Writer& out, RecordSummary& sum,
-                 Decode decode, Use use, double duration) {
+bool read_stream(ByteTransport& port, const RecordOptions& opt, bool zero, Writer& out,
+                 RecordSummary& sum, Decode decode, Use use, double duration) {
   FrameReader reader;
   StreamGuard guard{port};
   try {
@@ -173,7 +179,8 @@ bool read_stream(ByteTransport& port, const RecordOptions& opt, bool zero, Write
         if (!s) {
           ++sum.malformed;
           out.annotate("malformed: frame of type " + std::to_string(f.type) + " and " +
-                       std::to_string(f.payload.size()) + " bytes near t=" + fixed(stream.last_t, 4) + " s");
+                       std::to_string(f.payload.size()) +
+                       " bytes near t=" + fixed(stream.last_t, 4) + " s");
           continue;
         }
         ++sum.frames;
@@ -181,7 +188,8 @@ bool read_stream(ByteTransport& port, const RecordOptions& opt, bool zero, Write
         if (!t) continue;
         if (over_range(*s)) {
           ++sum.over_range;
-          out.annotate("over range: seq " + std::to_string(s->seq) + " at t=" + fixed(*t, 4) + " s");
+          out.annotate("over range: seq " + std::to_string(s->seq) + " at t=" + fixed(*t, 4) +
+                       " s");
           continue;
         }
         use(*t, *s);

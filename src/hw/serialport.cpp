@@ -14,16 +14,20 @@ namespace {
 // message for SP_ERR_FAIL.
 std::string sp_message(sp_return r) {
   switch (r) {
-    case SP_ERR_ARG: return "invalid argument (libserialport SP_ERR_ARG)";
-    case SP_ERR_MEM: return "out of memory (libserialport SP_ERR_MEM)";
-    case SP_ERR_SUPP: return "not supported by this port (libserialport SP_ERR_SUPP)";
+    case SP_ERR_ARG:
+      return "invalid argument (libserialport SP_ERR_ARG)";
+    case SP_ERR_MEM:
+      return "out of memory (libserialport SP_ERR_MEM)";
+    case SP_ERR_SUPP:
+      return "not supported by this port (libserialport SP_ERR_SUPP)";
     case SP_ERR_FAIL: {
       char* msg = sp_last_error_message();
       std::string text = msg ? msg : "unknown failure";
       sp_free_error_message(msg);
       return text + " (libserialport SP_ERR_FAIL)";
     }
-    default: return "libserialport error " + std::to_string(static_cast<int>(r));
+    default:
+      return "libserialport error " + std::to_string(static_cast<int>(r));
   }
 }
 
@@ -58,13 +62,16 @@ class SerialPortTransport final : public ByteTransport {
     check_open();
     const auto t0 = std::chrono::steady_clock::now();
     const int r = sp_blocking_read(port_, buf, max, static_cast<unsigned>(timeout_ms));
-    if (r < 0) throw SerialError("serial port " + path_ + ": read: " + sp_message(static_cast<sp_return>(r)));
+    if (r < 0)
+      throw SerialError("serial port " + path_ +
+                        ": read: " + sp_message(static_cast<sp_return>(r)));
     if (r > 0) {
       quick_empty_reads_ = 0;
       return static_cast<std::size_t>(r);
     }
-    const auto waited = std::chrono::duration_cast<std::chrono::milliseconds>(
-        std::chrono::steady_clock::now() - t0).count();
+    const auto waited =
+        std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - t0)
+            .count();
     if (timeout_ms > 0 && waited < timeout_ms / 2) {
       if (++quick_empty_reads_ >= 3)
         throw DeviceDisconnected("serial port " + path_ + ": end of file (device unplugged?)");
@@ -77,8 +84,11 @@ class SerialPortTransport final : public ByteTransport {
   void write(const std::uint8_t* data, std::size_t n, int timeout_ms) override {
     check_open();
     const int r = sp_blocking_write(port_, data, n, static_cast<unsigned>(timeout_ms));
-    if (r < 0) throw SerialError("serial port " + path_ + ": write: " + sp_message(static_cast<sp_return>(r)));
-    if (static_cast<std::size_t>(r) != n) throw SerialError("serial port " + path_ + ": write timed out");
+    if (r < 0)
+      throw SerialError("serial port " + path_ +
+                        ": write: " + sp_message(static_cast<sp_return>(r)));
+    if (static_cast<std::size_t>(r) != n)
+      throw SerialError("serial port " + path_ + ": write timed out");
   }
 
   void flush_input() override {
@@ -121,7 +131,9 @@ std::vector<PortInfo> list_serial_ports() {
     const char* desc = sp_get_port_description(*p);
     const sp_transport t = sp_get_port_transport(*p);
     out.push_back({sp_get_port_name(*p), desc ? desc : "",
-                   t == SP_TRANSPORT_USB ? "usb" : t == SP_TRANSPORT_BLUETOOTH ? "bluetooth" : "native"});
+                   t == SP_TRANSPORT_USB         ? "usb"
+                   : t == SP_TRANSPORT_BLUETOOTH ? "bluetooth"
+                                                 : "native"});
   }
   sp_free_port_list(ports);
   return out;

@@ -30,13 +30,18 @@ std::optional<std::string> decode_text(const Frame& f) {
 
 std::string format_command(StreamCommand c, double rate_hz) {
   switch (c) {
-    case StreamCommand::start: return "START\n";
-    case StreamCommand::stop: return "STOP\n";
-    case StreamCommand::zero: return "ZERO\n";
-    case StreamCommand::identify: return "ID?\n";
+    case StreamCommand::start:
+      return "START\n";
+    case StreamCommand::stop:
+      return "STOP\n";
+    case StreamCommand::zero:
+      return "ZERO\n";
+    case StreamCommand::identify:
+      return "ID?\n";
     case StreamCommand::rate: {
       if (!(rate_hz > 0.0) || rate_hz > 1000.0 || rate_hz != std::floor(rate_hz))
-        throw InvalidArgument("stream rate: " + std::to_string(rate_hz) + " Hz is not a whole number in 1..1000");
+        throw InvalidArgument("stream rate: " + std::to_string(rate_hz) +
+                              " Hz is not a whole number in 1..1000");
       return "RATE " + std::to_string(static_cast<int>(rate_hz)) + "\n";
     }
   }

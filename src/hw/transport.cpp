@@ -15,7 +15,8 @@
 namespace rotacal::hw {
 
 void validate(const SerialSettings& s) {
-  if (s.baud <= 0) throw InvalidArgument("serial baud rate " + std::to_string(s.baud) + " must be positive");
+  if (s.baud <= 0)
+    throw InvalidArgument("serial baud rate " + std::to_string(s.baud) + " must be positive");
   if (s.data_bits < 5 || s.data_bits > 8)
     throw InvalidArgument("serial data bits " + std::to_string(s.data_bits) + " must be 5..8");
   if (s.stop_bits != 1 && s.stop_bits != 2)
@@ -37,14 +38,22 @@ namespace {
 
 speed_t termios_speed(int baud, const std::string& path) {
   switch (baud) {
-    case 9600: return B9600;
-    case 19200: return B19200;
-    case 38400: return B38400;
-    case 57600: return B57600;
-    case 115200: return B115200;
-    case 230400: return B230400;
-    case 460800: return B460800;
-    case 921600: return B921600;
+    case 9600:
+      return B9600;
+    case 19200:
+      return B19200;
+    case 38400:
+      return B38400;
+    case 57600:
+      return B57600;
+    case 115200:
+      return B115200;
+    case 230400:
+      return B230400;
+    case 460800:
+      return B460800;
+    case 921600:
+      return B921600;
     default:
       throw InvalidArgument("serial port " + path + ": baud rate " + std::to_string(baud) +
                             " is not one of 9600 .. 921600");
@@ -56,7 +65,8 @@ class TermiosTransport final : public ByteTransport {
   TermiosTransport(const std::string& path, const SerialSettings& s) : path_(path) {
     validate(s);
     fd_ = ::open(path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
-    if (fd_ < 0) throw SerialError("serial port " + path + ": cannot open: " + std::strerror(errno));
+    if (fd_ < 0)
+      throw SerialError("serial port " + path + ": cannot open: " + std::strerror(errno));
     termios t{};
     if (::tcgetattr(fd_, &t) != 0) fail("tcgetattr");
     ::cfmakeraw(&t);
@@ -110,7 +120,8 @@ class TermiosTransport final : public ByteTransport {
         throw DeviceDisconnected("serial port " + path_ + ": the device closed the line");
       if (w < 0 && errno != EAGAIN && errno != EINTR) fail("write");
       const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
-          deadline - std::chrono::steady_clock::now()).count();
+                            deadline - std::chrono::steady_clock::now())
+                            .count();
       if (left <= 0) throw SerialError("serial port " + path_ + ": write timed out");
       pollfd p{fd_, POLLOUT, 0};
       ::poll(&p, 1, static_cast<int>(left));
@@ -141,7 +152,8 @@ class TermiosTransport final : public ByteTransport {
 
 }  // namespace
 
-std::unique_ptr<ByteTransport> open_termios(const std::string& path, const SerialSettings& settings) {
+std::unique_ptr<ByteTransport> open_termios(const std::string& path,
+                                            const SerialSettings& settings) {
   return std::make_unique<TermiosTransport>(resolve_port_path(path), settings);
 }
 

@@ -1,4 +1,5 @@
-// Virtual instruments: the shared pty/stream/command base, the ballbar and the R-test (virtual_instrument.hpp).
+// Virtual instruments: the shared pty/stream/command base, the ballbar and the R-test
+// (virtual_instrument.hpp).
 #include "rotacal/hw/virtual_instrument.hpp"
 
 #include <poll.h>
@@ -25,12 +26,15 @@ double wall_seconds() {
 
 // --------------------------------------------------------------------------- common part
 
-VirtualInstrument::VirtualInstrument(int baud, double speed, double rate_hz, const FaultInjection& faults)
+VirtualInstrument::VirtualInstrument(int baud, double speed, double rate_hz,
+                                     const FaultInjection& faults)
     : baud_(baud), speed_(speed), faults_(faults), rate_hz_(rate_hz) {
   if (!(speed > 0.0) || !std::isfinite(speed))
-    throw InvalidArgument("virtual instrument: speed " + std::to_string(speed) + " must be positive");
+    throw InvalidArgument("virtual instrument: speed " + std::to_string(speed) +
+                          " must be positive");
   if (!(rate_hz >= 1.0 && rate_hz <= 1000.0))
-    throw InvalidArgument("virtual instrument: rate_hz " + std::to_string(rate_hz) + " must be 1..1000");
+    throw InvalidArgument("virtual instrument: rate_hz " + std::to_string(rate_hz) +
+                          " must be 1..1000");
 }
 
 VirtualInstrument::~VirtualInstrument() { halt(); }
@@ -49,7 +53,8 @@ void VirtualInstrument::start() {
 void VirtualInstrument::stop() {
   stop_ = true;
   if (thread_.joinable()) thread_.join();
-  if (!thread_error_.empty()) throw SerialError("virtual instrument on " + port() + ": " + thread_error_);
+  if (!thread_error_.empty())
+    throw SerialError("virtual instrument on " + port() + ": " + thread_error_);
 }
 
 VirtualStats VirtualInstrument::stats() const {
@@ -122,7 +127,8 @@ void VirtualInstrument::write_all(const Bytes& bytes) {
   // A host at the wrong baud rate samples the bits at the wrong instants: it reads garbage.
   const int host = pty_.host_baud();
   if (host != 0 && host != baud_)
-    for (std::size_t i = 0; i < out.size(); ++i) out[i] = static_cast<std::uint8_t>(out[i] * 37u + 11u);
+    for (std::size_t i = 0; i < out.size(); ++i)
+      out[i] = static_cast<std::uint8_t>(out[i] * 37u + 11u);
   std::size_t done = 0;
   int stalls = 0;
   while (done < out.size() && !stop_) {
@@ -199,7 +205,9 @@ void VirtualInstrument::answer(const std::string& line) {
   const auto cmd = parse_command(line);
   if (!cmd) return send_reply(encode_text("ERR unknown command '" + line + "'"));
   switch (cmd->command) {
-    case StreamCommand::identify: send_reply(encode_text("ID " + identity())); break;
+    case StreamCommand::identify:
+      send_reply(encode_text("ID " + identity()));
+      break;
     case StreamCommand::rate:
       if (streaming_) {
         send_reply(encode_text("ERR RATE while streaming"));
@@ -255,10 +263,12 @@ VirtualBallbar::VirtualBallbar(ProgramTimeline program, const VirtualBallbarOpti
       noise_(std::make_shared<Noise>()) {
   if (!(options.noise_um >= 0.0)) throw InvalidArgument("virtual ballbar: noise_um must be >= 0");
   if (options.truth.machine != program_.header().machine)
-    throw InvalidArgument("virtual ballbar: the machine model and the program are for different machines");
+    throw InvalidArgument(
+        "virtual ballbar: the machine model and the program are for different machines");
   if (static_cast<int>(options.truth.effect_params.size()) != options.truth.effects.num_params())
     throw InvalidArgument("virtual ballbar: the machine model has " +
-                          std::to_string(options.truth.effect_params.size()) + " effect parameters, its effects need " +
+                          std::to_string(options.truth.effect_params.size()) +
+                          " effect parameters, its effects need " +
                           std::to_string(options.truth.effects.num_params()));
   noise_->rng.seed(options.seed);
   // effects.md: the linear-axis polynomials are about the session's mean commanded xyz; the
@@ -301,8 +311,7 @@ Bytes ballbar_sample(double t, std::uint16_t seq, double displacement) {
 
 Bytes VirtualBallbar::sample_frame(double t, std::uint16_t seq) {
   const double L0 = program_.header().ballbar_length;
-  const double length =
-      exact_length(t) + 1e-3 * options_.noise_um * noise_->gauss(noise_->rng);
+  const double length = exact_length(t) + 1e-3 * options_.noise_um * noise_->gauss(noise_->rng);
   return ballbar_sample(t, seq, length - L0 - zero_mm_);
 }
 
@@ -396,22 +405,26 @@ Eigen::Vector3d VirtualRtest::readings_at(double t, bool* at_rest) {
     // following-error bump that a recorder must not mistake for a measurement.
     *at_rest = false;
     const auto a = static_cast<std::size_t>(t > w.end ? k : k - 1);
-    const double from = pose_window(rows[a].time, dwell).end, to = pose_window(rows[a + 1].time, dwell).begin;
+    const double from = pose_window(rows[a].time, dwell).end,
+                 to = pose_window(rows[a + 1].time, dwell).begin;
     const double u = (t - from) / (to - from);
-    r = exact_[a] + u * (exact_[a + 1] - exact_[a]) + Eigen::Vector3d::Constant(0.005 * std::sin(M_PI * u));
+    r = exact_[a] + u * (exact_[a + 1] - exact_[a]) +
+        Eigen::Vector3d::Constant(0.005 * std::sin(M_PI * u));
   }
   for (int i = 0; i < 3; ++i) r[i] += 1e-3 * options_.sim.noise_um * noise_->gauss(noise_->rng);
   return r;
 }
 
 double VirtualRtest::stream_end() const {
-  return program_.samples.back().time + 0.5 * options_.sim.pattern.dwell_s;  // the last dwell is over
+  return program_.samples.back().time +
+         0.5 * options_.sim.pattern.dwell_s;  // the last dwell is over
 }
 
 void VirtualRtest::serve_once() {
   VirtualInstrument::serve_once();
   // Polled: the pattern has run once its last dwell is over, asked or not.
-  if (options_.mode != ProbeMode::stream && clock_running() && now() > stream_end()) mark_finished();
+  if (options_.mode != ProbeMode::stream && clock_running() && now() > stream_end())
+    mark_finished();
 }
 
 void VirtualRtest::answer(const std::string& line) {

@@ -53,7 +53,8 @@ BallbarSession parse_ballbar(std::istream& in, const std::string& name) {
   const std::string* L = R.meta("ballbar_length");
   if (!L) R.fail(0, 0, "missing metadata 'ballbar_length' (calibrated length L0, mm)");
   s.ballbar_length = R.meta_number("ballbar_length", *L, kMinLengthMm, kMaxLengthMm, "mm");
-  if (!(s.ballbar_length > 0.0)) R.fail(R.meta_line("ballbar_length"), 0, "ballbar_length must be > 0");
+  if (!(s.ballbar_length > 0.0))
+    R.fail(R.meta_line("ballbar_length"), 0, "ballbar_length must be > 0");
   const std::string* P = R.meta("pivot");
   if (!P) R.fail(0, 0, "missing metadata 'pivot' (nominal centre-pivot position 'x, y, z', mm)");
   s.pivot = R.meta_vector("pivot", *P, kMaxAbsPositionMm, "mm");
@@ -68,7 +69,8 @@ BallbarSession parse_ballbar(std::istream& in, const std::string& name) {
   const std::set<int> known = {c_test, c_time, c_x, c_y, c_z, c_t, c_c, c_len};
   std::vector<int> extra_idx;
   for (int i = 0; i < static_cast<int>(R.header.size()); ++i)
-    if (!known.count(i)) extra_idx.push_back(i), s.extra_columns.push_back(R.header[static_cast<std::size_t>(i)]);
+    if (!known.count(i))
+      extra_idx.push_back(i), s.extra_columns.push_back(R.header[static_cast<std::size_t>(i)]);
   double last = -1e300;
   DuplicateRows dups;
   s.samples.reserve(raw.rows.size());
@@ -117,13 +119,17 @@ void write_ballbar(const BallbarSession& s, const std::string& path) {
   write_output(path, format_ballbar(s));
 }
 
-BallbarWriter::BallbarWriter(const std::string& path, const BallbarSession& header, const OutputOptions& options)
-    : file_(std::make_unique<OutputStream>(path, options)), path_(path), machine_(header.machine),
+BallbarWriter::BallbarWriter(const std::string& path, const BallbarSession& header,
+                             const OutputOptions& options)
+    : file_(std::make_unique<OutputStream>(path, options)),
+      path_(path),
+      machine_(header.machine),
       columns_(header.extra_columns.size()) {
   file_->write(ballbar_head(header));
 }
 void BallbarWriter::append(const BallbarSample& s) {
-  if (s.time < last_time_) throw InvalidArgument(path_ + ": sample time " + format_number(s.time) + " goes backwards");
+  if (s.time < last_time_)
+    throw InvalidArgument(path_ + ": sample time " + format_number(s.time) + " goes backwards");
   put(file_, path_, ballbar_row(s, machine_, columns_));
   last_time_ = s.time;
   ++rows_;

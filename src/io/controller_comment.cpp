@@ -10,11 +10,13 @@ namespace rotacal {
 
 namespace {
 
-constexpr std::array<CommentDialect, 6> kDialects = {CommentDialect::linuxcnc,   CommentDialect::fanuc,
-                                                     CommentDialect::heidenhain, CommentDialect::siemens,
-                                                     CommentDialect::isg,        CommentDialect::hash};
+constexpr std::array<CommentDialect, 6> kDialects = {
+    CommentDialect::linuxcnc, CommentDialect::fanuc, CommentDialect::heidenhain,
+    CommentDialect::siemens,  CommentDialect::isg,   CommentDialect::hash};
 
-bool parenthesised(CommentDialect d) { return d == CommentDialect::linuxcnc || d == CommentDialect::fanuc; }
+bool parenthesised(CommentDialect d) {
+  return d == CommentDialect::linuxcnc || d == CommentDialect::fanuc;
+}
 
 // One printable ASCII character as the dialect may carry it inside a comment.
 char inert(CommentDialect d, char c) {
@@ -56,8 +58,8 @@ bool active_in_linuxcnc(const std::string& chunk) {
   std::string lower;
   for (std::size_t k = i; k < chunk.size(); ++k)
     lower += static_cast<char>(std::tolower(static_cast<unsigned char>(chunk[k])));
-  static const char* const kActive[] = {"msg", "debug", "print", "log", "py", "abort",
-                                        "probeopen", "probeclose", "axis", "system"};
+  static const char* const kActive[] = {"msg",   "debug",     "print",      "log",  "py",
+                                        "abort", "probeopen", "probeclose", "axis", "system"};
   for (const char* word : kActive)
     if (lower.rfind(word, 0) == 0) return true;
   std::size_t w = 0;
@@ -75,12 +77,18 @@ std::string delimited(CommentDialect d, const std::string& chunk) {
 
 std::string to_string(CommentDialect dialect) {
   switch (dialect) {
-    case CommentDialect::linuxcnc: return "linuxcnc";
-    case CommentDialect::fanuc: return "fanuc";
-    case CommentDialect::heidenhain: return "heidenhain";
-    case CommentDialect::siemens: return "siemens";
-    case CommentDialect::isg: return "isg";
-    case CommentDialect::hash: return "hash";
+    case CommentDialect::linuxcnc:
+      return "linuxcnc";
+    case CommentDialect::fanuc:
+      return "fanuc";
+    case CommentDialect::heidenhain:
+      return "heidenhain";
+    case CommentDialect::siemens:
+      return "siemens";
+    case CommentDialect::isg:
+      return "isg";
+    case CommentDialect::hash:
+      return "hash";
   }
   ROTACAL_ASSERT(false);
   return {};
@@ -95,7 +103,9 @@ CommentDialect parse_comment_dialect(const std::string& text) {
   throw InvalidArgument("unknown comment dialect '" + text + "' (known: " + known + ")");
 }
 
-std::size_t comment_line_width(CommentDialect dialect) { return dialect == CommentDialect::hash ? 1000 : 240; }
+std::size_t comment_line_width(CommentDialect dialect) {
+  return dialect == CommentDialect::hash ? 1000 : 240;
+}
 
 std::vector<std::string> comment_lines(CommentDialect d, std::string_view text) {
   const std::string safe = escaped(d, text);

@@ -28,7 +28,8 @@ json number_or_null(double x) { return std::isfinite(x) ? json(x) : json(nullptr
 
 // {"value", "std", "unit"}; an unobservable parameter has neither value nor std.
 json estimate_json(const ParameterEstimate& p) {
-  if (!p.observable) return {{"value", nullptr}, {"std", nullptr}, {"unit", p.unit}, {"observable", false}};
+  if (!p.observable)
+    return {{"value", nullptr}, {"std", nullptr}, {"unit", p.unit}, {"observable", false}};
   return {{"value", number_or_null(p.value)}, {"std", number_or_null(p.std)}, {"unit", p.unit}};
 }
 
@@ -42,17 +43,30 @@ json estimates_json(const std::vector<ParameterEstimate>& ps) {
 json noise_json(const NoiseModel& nm, bool refit, double correction) {
   json streams = json::array();
   for (const NoiseStream& s : nm.streams)
-    streams.push_back({{"group", s.group}, {"channel", s.channel}, {"order", s.order()},
-                       {"ar", s.ar}, {"sigma_um", s.marginal_sigma_um},
+    streams.push_back({{"group", s.group},
+                       {"channel", s.channel},
+                       {"order", s.order()},
+                       {"ar", s.ar},
+                       {"sigma_um", s.marginal_sigma_um},
                        {"innovation_sigma_um", s.innovation_sigma_um},
-                       {"correlation_samples", s.correlation_samples}, {"sample_interval_s", s.sample_interval_s},
-                       {"correlation_time_s", s.correlation_time_s}, {"effective_samples", s.effective_samples},
+                       {"correlation_samples", s.correlation_samples},
+                       {"sample_interval_s", s.sample_interval_s},
+                       {"correlation_time_s", s.correlation_time_s},
+                       {"effective_samples", s.effective_samples},
                        {"random_walk_step_um", s.random_walk_step_um}});
-  return {{"white", nm.white()}, {"summary", nm.summary()}, {"n", nm.n}, {"sigma_um", nm.sigma_um},
-          {"innovation_sigma_um", nm.innovation_sigma_um}, {"max_order", nm.max_order},
-          {"random_walk_step_um", nm.random_walk_step_um}, {"correlation_samples", nm.correlation_samples},
-          {"correlation_time_s", nm.correlation_time_s}, {"effective_samples", nm.effective_samples},
-          {"streams", streams}, {"gls_refit", refit}, {"covariance_factor", correction}};
+  return {{"white", nm.white()},
+          {"summary", nm.summary()},
+          {"n", nm.n},
+          {"sigma_um", nm.sigma_um},
+          {"innovation_sigma_um", nm.innovation_sigma_um},
+          {"max_order", nm.max_order},
+          {"random_walk_step_um", nm.random_walk_step_um},
+          {"correlation_samples", nm.correlation_samples},
+          {"correlation_time_s", nm.correlation_time_s},
+          {"effective_samples", nm.effective_samples},
+          {"streams", streams},
+          {"gls_refit", refit},
+          {"covariance_factor", correction}};
 }
 
 json effects_json(const FittedModelContent& c) {
@@ -61,7 +75,8 @@ json effects_json(const FittedModelContent& c) {
   for (const Effect& e : c.effects.effects) {
     json params = json::object();
     const auto pn = e.param_names();
-    for (std::size_t k = 0; k < pn.size(); ++k) params[pn[k]] = estimate_json(c.effect_parameters[at++]);
+    for (std::size_t k = 0; k < pn.size(); ++k)
+      params[pn[k]] = estimate_json(c.effect_parameters[at++]);
     fx.push_back({{"id", e.id()}, {"cause", e.cause()}, {"params", params}});
   }
   return fx;
@@ -70,7 +85,8 @@ json effects_json(const FittedModelContent& c) {
 json sessions_json(const FittedModelContent& c) {
   json out = json::array();
   for (const FittedSessionContent& s : c.sessions) {
-    json one = {{"name", s.name}, {"instrument", s.instrument}, {"nuisances", estimates_json(s.nuisances)}};
+    json one = {
+        {"name", s.name}, {"instrument", s.instrument}, {"nuisances", estimates_json(s.nuisances)}};
     if (c.kind == "multi") one["alone"] = estimates_json(s.alone);
     one["noise_model"] = noise_json(s.noise, s.noise_refit, s.noise_correction);
     one["residual_rms_um"] = s.residual_rms_um;
@@ -82,17 +98,21 @@ json sessions_json(const FittedModelContent& c) {
 
 void check_content(const FittedModelContent& c) {
   const std::string w = "fitted_model_document: ";
-  if (c.kind != "probe" && c.kind != "multi") throw InvalidArgument(w + "kind '" + c.kind + "' is not probe or multi");
+  if (c.kind != "probe" && c.kind != "multi")
+    throw InvalidArgument(w + "kind '" + c.kind + "' is not probe or multi");
   if (c.location_errors.size() != 8)
     throw InvalidArgument(w + std::to_string(c.location_errors.size()) + " location errors, not 8");
   if (c.effect_parameters.size() != static_cast<std::size_t>(c.effects.num_params()))
-    throw InvalidArgument(w + "effect_parameters has " + std::to_string(c.effect_parameters.size()) +
-                          " values, the effects " + std::to_string(c.effects.num_params()));
+    throw InvalidArgument(w + "effect_parameters has " +
+                          std::to_string(c.effect_parameters.size()) + " values, the effects " +
+                          std::to_string(c.effects.num_params()));
   const auto n = static_cast<Eigen::Index>(c.covariance_parameters.size());
   if (c.covariance.rows() != n || c.covariance.cols() != n)
-    throw InvalidArgument(w + "the covariance is not " + std::to_string(n) + " x " + std::to_string(n));
+    throw InvalidArgument(w + "the covariance is not " + std::to_string(n) + " x " +
+                          std::to_string(n));
   if (c.kind == "probe" && c.sessions.size() != 1)
-    throw InvalidArgument(w + "a probe model holds one session, not " + std::to_string(c.sessions.size()));
+    throw InvalidArgument(w + "a probe model holds one session, not " +
+                          std::to_string(c.sessions.size()));
 }
 
 // ----------------------------------------------------------------- reading
@@ -115,15 +135,19 @@ struct FittedModelReader {
 
   // A session's own parameter (a sphere or pivot position, a probe zero, a tool offset): mm
   // within the pivot limit or rad within the angle limit, as the file says.
-  ParameterEstimate own_estimate(const json& e, const std::string& name, const std::string& where) const {
+  ParameterEstimate own_estimate(const json& e, const std::string& name,
+                                 const std::string& where) const {
     if (!e.is_object() || !e.contains("unit") || !e["unit"].is_string())
-      bad(source, where, "must be an estimate {\"value\", \"std\", \"unit\"} with its unit, got " + shown(e));
+      bad(source, where,
+          "must be an estimate {\"value\", \"std\", \"unit\"} with its unit, got " + shown(e));
     const std::string unit = e["unit"].get<std::string>();
-    if (unit != "mm" && unit != "rad") bad(source, where + ".unit", shown(e["unit"]) + ": must be mm or rad");
+    if (unit != "mm" && unit != "rad")
+      bad(source, where + ".unit", shown(e["unit"]) + ": must be mm or rad");
     return estimate(e, name, where, unit, unit == "mm" ? kMaxModelPivot : kMaxModelAngleError);
   }
 
-  std::vector<ParameterEstimate> location_errors(const json& le, MachineType m, const std::string& where) const {
+  std::vector<ParameterEstimate> location_errors(const json& le, MachineType m,
+                                                 const std::string& where) const {
     std::vector<ParameterEstimate> out;
     const auto& names = location_error_names(m);
     for (int k = 0; k < 8; ++k) {
@@ -134,14 +158,17 @@ struct FittedModelReader {
     }
     for (auto it = le.begin(); it != le.end(); ++it)
       if (std::find(names.begin(), names.end(), it.key()) == names.end())
-        bad(source, where + "." + it.key(), "is not a location error of a " + to_string(m) + " machine");
+        bad(source, where + "." + it.key(),
+            "is not a location error of a " + to_string(m) + " machine");
     return out;
   }
 
-  double number(const json& obj, const std::string& key, const std::string& where, double lo) const {
+  double number(const json& obj, const std::string& key, const std::string& where,
+                double lo) const {
     const json& v = member(obj, key, source, where);
     if (!v.is_number() || !(v.get<double>() >= lo) || !std::isfinite(v.get<double>()))
-      bad(source, where + "." + key, "must be a finite number >= " + json(lo).dump() + ", got " + shown(v));
+      bad(source, where + "." + key,
+          "must be a finite number >= " + json(lo).dump() + ", got " + shown(v));
     return v.get<double>();
   }
 
@@ -157,18 +184,21 @@ struct FittedModelReader {
     return v.get<std::string>();
   }
 
-  std::vector<std::string> texts(const json& obj, const std::string& key, const std::string& where) const {
+  std::vector<std::string> texts(const json& obj, const std::string& key,
+                                 const std::string& where) const {
     const json& v = member(obj, key, source, where);
     if (!v.is_array()) bad(source, where + "." + key, "must be a list of strings, got " + shown(v));
     std::vector<std::string> out;
     for (const json& x : v) {
-      if (!x.is_string()) bad(source, where + "." + key, "must be a list of strings, got " + shown(x));
+      if (!x.is_string())
+        bad(source, where + "." + key, "must be a list of strings, got " + shown(x));
       out.push_back(x.get<std::string>());
     }
     return out;
   }
 
-  NoiseModel noise(const json& nm, const std::string& where, bool& refit, double& correction) const {
+  NoiseModel noise(const json& nm, const std::string& where, bool& refit,
+                   double& correction) const {
     if (!nm.is_object()) bad(source, where, "must be a noise model object, got " + shown(nm));
     NoiseModel out;
     out.n = static_cast<std::size_t>(number(nm, "n", where, 0.0));
@@ -182,7 +212,8 @@ struct FittedModelReader {
     refit = boolean(nm, "gls_refit", where);
     correction = number(nm, "covariance_factor", where, 0.0);
     const json& streams = member(nm, "streams", source, where);
-    if (!streams.is_array()) bad(source, where + ".streams", "must be a list, got " + shown(streams));
+    if (!streams.is_array())
+      bad(source, where + ".streams", "must be a list, got " + shown(streams));
     for (std::size_t i = 0; i < streams.size(); ++i) {
       const std::string at = where + ".streams[" + std::to_string(i) + "]";
       const json& s = streams[i];
@@ -198,8 +229,9 @@ struct FittedModelReader {
         st.ar.push_back(x.get<double>());
       }
       if (number(s, "order", at, 0.0) != static_cast<double>(st.ar.size()))
-        bad(source, at + ".order", shown(s["order"]) + " is not the number of AR coefficients (" +
-                                       std::to_string(st.ar.size()) + ")");
+        bad(source, at + ".order",
+            shown(s["order"]) + " is not the number of AR coefficients (" +
+                std::to_string(st.ar.size()) + ")");
       st.marginal_sigma_um = number(s, "sigma_um", at, 0.0);
       st.innovation_sigma_um = number(s, "innovation_sigma_um", at, 0.0);
       st.correlation_samples = number(s, "correlation_samples", at, 0.0);
@@ -211,20 +243,24 @@ struct FittedModelReader {
     }
     const bool white = boolean(nm, "white", where);
     if (white != out.white())
-      bad(source, where + ".white", shown(nm["white"]) + " contradicts max_order and random_walk_step_um");
+      bad(source, where + ".white",
+          shown(nm["white"]) + " contradicts max_order and random_walk_step_um");
     return out;
   }
 
-  FittedSessionContent session(const json& s, const std::string& where, MachineType m, const std::string& kind,
+  FittedSessionContent session(const json& s, const std::string& where, MachineType m,
+                               const std::string& kind,
                                const std::vector<ParameterEstimate>& shared) const {
     if (!s.is_object()) bad(source, where, "must be an object, got " + shown(s));
     FittedSessionContent out;
     out.name = text(s, "name", where);
     out.instrument = text(s, "instrument", where);
     if (out.instrument != "ballbar" && out.instrument != "rtest" && out.instrument != "probe")
-      bad(source, where + ".instrument", shown(s["instrument"]) + " is not ballbar, rtest or probe");
+      bad(source, where + ".instrument",
+          shown(s["instrument"]) + " is not ballbar, rtest or probe");
     if (kind == "probe" && out.instrument != "probe")
-      bad(source, where + ".instrument", "a probe model's session is a touch-probe session, not " + out.instrument);
+      bad(source, where + ".instrument",
+          "a probe model's session is a touch-probe session, not " + out.instrument);
     const json& own = object_member(s, "nuisances", source, where);
     for (auto it = own.begin(); it != own.end(); ++it)
       out.nuisances.push_back(own_estimate(it.value(), it.key(), where + ".nuisances." + it.key()));
@@ -232,8 +268,8 @@ struct FittedModelReader {
       const json& alone = object_member(s, "alone", source, where);
       out.alone = location_errors_and(alone, m, shared, where + ".alone");
     }
-    out.noise = noise(member(s, "noise_model", source, where), where + ".noise_model", out.noise_refit,
-                      out.noise_correction);
+    out.noise = noise(member(s, "noise_model", source, where), where + ".noise_model",
+                      out.noise_refit, out.noise_correction);
     out.residual_rms_um = number(s, "residual_rms_um", where, 0.0);
     out.n_residuals = static_cast<std::size_t>(number(s, "n_residuals", where, 0.0));
     return out;
@@ -245,11 +281,13 @@ struct FittedModelReader {
                                                      const std::string& where) const {
     json le = json::object();
     for (auto it = obj.begin(); it != obj.end(); ++it)
-      if (std::none_of(shared.begin(), shared.end(), [&](const ParameterEstimate& p) { return p.name == it.key(); }))
+      if (std::none_of(shared.begin(), shared.end(),
+                       [&](const ParameterEstimate& p) { return p.name == it.key(); }))
         le[it.key()] = it.value();
     std::vector<ParameterEstimate> out = location_errors(le, m, where);
     for (const ParameterEstimate& p : shared)
-      out.push_back(estimate(member(obj, p.name, source, where), p.name, where + "." + p.name, p.unit, 1.0e6));
+      out.push_back(estimate(member(obj, p.name, source, where), p.name, where + "." + p.name,
+                             p.unit, 1.0e6));
     return out;
   }
 
@@ -276,26 +314,34 @@ struct FittedModelReader {
   void covariance(const json& doc, FittedModelContent& c) const {
     const json& cov = object_member(doc, "covariance", source);
     c.covariance_parameters = texts(cov, "parameters", "covariance");
-    std::set<std::string> expected, given(c.covariance_parameters.begin(), c.covariance_parameters.end());
+    std::set<std::string> expected,
+        given(c.covariance_parameters.begin(), c.covariance_parameters.end());
     for (const ParameterEstimate& p : c.location_errors) expected.insert(p.name);
     for (const ParameterEstimate& p : c.effect_parameters) expected.insert(p.name);
     for (const FittedSessionContent& s : c.sessions)
-      for (const ParameterEstimate& p : s.nuisances) expected.insert(c.kind == "multi" ? s.name + ":" + p.name : p.name);
+      for (const ParameterEstimate& p : s.nuisances)
+        expected.insert(c.kind == "multi" ? s.name + ":" + p.name : p.name);
     if (given.size() != c.covariance_parameters.size() || given != expected)
       bad(source, "covariance.parameters",
-          "must list each of the " + std::to_string(expected.size()) + " fitted parameters once (location errors, "
-          "effect parameters, the sessions' own parameters" + (c.kind == "multi" ? " as <session>:<name>" : "") + ")");
+          "must list each of the " + std::to_string(expected.size()) +
+              " fitted parameters once (location errors, "
+              "effect parameters, the sessions' own parameters" +
+              (c.kind == "multi" ? " as <session>:<name>" : "") + ")");
     const std::size_t n = c.covariance_parameters.size();
     const json& m = member(cov, "matrix", source, "covariance");
-    if (!m.is_array() || m.size() != n) bad(source, "covariance.matrix", "must be " + std::to_string(n) + " rows");
+    if (!m.is_array() || m.size() != n)
+      bad(source, "covariance.matrix", "must be " + std::to_string(n) + " rows");
     c.covariance.resize(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
     for (std::size_t i = 0; i < n; ++i) {
       const std::string at = "covariance.matrix[" + std::to_string(i) + "]";
-      if (!m[i].is_array() || m[i].size() != n) bad(source, at, "must be " + std::to_string(n) + " numbers");
+      if (!m[i].is_array() || m[i].size() != n)
+        bad(source, at, "must be " + std::to_string(n) + " numbers");
       for (std::size_t j = 0; j < n; ++j) {
         const json& x = m[i][j];
-        if (!x.is_number() && !x.is_null()) bad(source, at, "must hold numbers (or null), got " + shown(x));
-        c.covariance(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = x.is_null() ? kNaN : x.get<double>();
+        if (!x.is_number() && !x.is_null())
+          bad(source, at, "must hold numbers (or null), got " + shown(x));
+        c.covariance(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) =
+            x.is_null() ? kNaN : x.get<double>();
       }
     }
   }
@@ -327,9 +373,11 @@ json fitted_model_document(const FittedModelContent& c) {
     names.push_back(c.covariance_parameters[i]);
     json row = json::array();
     for (std::size_t j = 0; j < c.covariance_parameters.size(); ++j)
-      row.push_back(unknown.count(c.covariance_parameters[i]) || unknown.count(c.covariance_parameters[j])
+      row.push_back(unknown.count(c.covariance_parameters[i]) ||
+                            unknown.count(c.covariance_parameters[j])
                         ? json(nullptr)
-                        : number_or_null(c.covariance(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j))));
+                        : number_or_null(c.covariance(static_cast<Eigen::Index>(i),
+                                                      static_cast<Eigen::Index>(j))));
     matrix.push_back(row);
   }
   doc["covariance"] = {{"parameters", names}, {"matrix", matrix}};
@@ -337,23 +385,32 @@ json fitted_model_document(const FittedModelContent& c) {
   if (c.kind == "multi") {
     json ds = json::array();
     for (const FittedDisagreement& d : c.disagreements)
-      ds.push_back({{"parameter", d.parameter}, {"unit", d.unit}, {"sessions", {d.session_a, d.session_b}},
-                    {"values", {d.value_a, d.value_b}}, {"difference", d.difference}, {"sigma", d.sigma},
+      ds.push_back({{"parameter", d.parameter},
+                    {"unit", d.unit},
+                    {"sessions", {d.session_a, d.session_b}},
+                    {"values", {d.value_a, d.value_b}},
+                    {"difference", d.difference},
+                    {"sigma", d.sigma},
                     {"z", d.z}});
     doc["disagreements"] = ds;
   }
-  doc["fit"] = {{"converged", c.converged}, {"chi2_per_dof", number_or_null(c.chi2_per_dof)},
-                {"unobservable", c.unobservable}, {"notes", c.notes}};
+  doc["fit"] = {{"converged", c.converged},
+                {"chi2_per_dof", number_or_null(c.chi2_per_dof)},
+                {"unobservable", c.unobservable},
+                {"notes", c.notes}};
   return doc;
 }
 
-FittedModelContent fitted_model_from_json(const json& doc, MachineType machine, const std::string& source) {
+FittedModelContent fitted_model_from_json(const json& doc, MachineType machine,
+                                          const std::string& source) {
   const FittedModelReader r{source};
   FittedModelContent c;
   c.kind = r.text(doc, "kind", "");
-  if (c.kind != "probe" && c.kind != "multi") bad(source, "kind", shown(doc["kind"]) + " is not probe or multi");
+  if (c.kind != "probe" && c.kind != "multi")
+    bad(source, "kind", shown(doc["kind"]) + " is not probe or multi");
   c.machine = machine;
-  c.location_errors = r.location_errors(object_member(doc, "location_errors", source), machine, "location_errors");
+  c.location_errors =
+      r.location_errors(object_member(doc, "location_errors", source), machine, "location_errors");
   const json& fx = member(doc, "effects", source, "");
   if (!fx.is_array()) bad(source, "effects", "must be a list, got " + shown(fx));
   for (std::size_t i = 0; i < fx.size(); ++i) {  // ids and units were checked by model_from_json
@@ -363,24 +420,31 @@ FittedModelContent fitted_model_from_json(const json& doc, MachineType machine, 
     const auto pn = e.param_names(), pu = e.param_units();
     for (std::size_t k = 0; k < pn.size(); ++k)
       c.effect_parameters.push_back(r.estimate(member(params, pn[k], source, where + ".params"),
-                                               effect_parameter_name(e, k), where + ".params." + pn[k], pu[k], 1.0e6));
+                                               effect_parameter_name(e, k),
+                                               where + ".params." + pn[k], pu[k], 1.0e6));
     c.effects.effects.push_back(e);
   }
   const std::string model = r.text(doc, "model", "");
   if (model != (c.effects.effects.empty() ? "baseline" : "extended"))
-    bad(source, "model", shown(doc["model"]) + (c.effects.effects.empty()
-                                                    ? ": no effects were fitted along, so the values are the baseline's"
-                                                    : ": effects were fitted along, so the values are the extended model's"));
+    bad(source, "model",
+        shown(doc["model"]) +
+            (c.effects.effects.empty()
+                 ? ": no effects were fitted along, so the values are the baseline's"
+                 : ": effects were fitted along, so the values are the extended model's"));
   const json& sessions = member(doc, "sessions", source, "");
-  if (!sessions.is_array() || sessions.empty()) bad(source, "sessions", "must be a non-empty list, got " + shown(sessions));
-  if (c.kind == "probe" && sessions.size() != 1) bad(source, "sessions", "a probe model holds exactly one session");
-  if (c.kind == "multi" && sessions.size() < 2) bad(source, "sessions", "a multi model holds two sessions or more");
+  if (!sessions.is_array() || sessions.empty())
+    bad(source, "sessions", "must be a non-empty list, got " + shown(sessions));
+  if (c.kind == "probe" && sessions.size() != 1)
+    bad(source, "sessions", "a probe model holds exactly one session");
+  if (c.kind == "multi" && sessions.size() < 2)
+    bad(source, "sessions", "a multi model holds two sessions or more");
   std::set<std::string> names;
   for (std::size_t i = 0; i < sessions.size(); ++i) {
-    c.sessions.push_back(r.session(sessions[i], "sessions[" + std::to_string(i) + "]", machine, c.kind,
-                                   c.effect_parameters));
+    c.sessions.push_back(r.session(sessions[i], "sessions[" + std::to_string(i) + "]", machine,
+                                   c.kind, c.effect_parameters));
     if (!names.insert(c.sessions.back().name).second)
-      bad(source, "sessions[" + std::to_string(i) + "].name", shown(c.sessions.back().name) + " is named twice");
+      bad(source, "sessions[" + std::to_string(i) + "].name",
+          shown(c.sessions.back().name) + " is named twice");
   }
   if (c.kind == "multi") {
     const json& ds = member(doc, "disagreements", source, "");

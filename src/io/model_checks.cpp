@@ -7,7 +7,8 @@
 
 namespace rotacal::model_checks {
 
-[[noreturn]] void bad(const std::string& source, const std::string& where, const std::string& what) {
+[[noreturn]] void bad(const std::string& source, const std::string& where,
+                      const std::string& what) {
   throw InvalidArgument(source + ": " + (where.empty() ? "" : where + ": ") + what);
 }
 
@@ -27,13 +28,15 @@ const json& member(const json& obj, const std::string& key, const std::string& s
 const json& object_member(const json& obj, const std::string& key, const std::string& source,
                           const std::string& where) {
   const json& v = member(obj, key, source, where);
-  if (!v.is_object()) bad(source, where.empty() ? key : where + "." + key, "must be an object, got " + shown(v));
+  if (!v.is_object())
+    bad(source, where.empty() ? key : where + "." + key, "must be an object, got " + shown(v));
   return v;
 }
 
 std::optional<double> estimate(const json& e, const std::string& where, const std::string& unit,
                                double limit, const std::string& source) {
-  if (!e.is_object()) bad(source, where, "must be an object {\"value\", \"std\", \"unit\"}, got " + shown(e));
+  if (!e.is_object())
+    bad(source, where, "must be an object {\"value\", \"std\", \"unit\"}, got " + shown(e));
   const json& v = member(e, "value", source, where);
   if (e.contains("unit")) {
     const json& u = e["unit"];
@@ -50,7 +53,8 @@ std::optional<double> estimate(const json& e, const std::string& where, const st
   const double x = v.get<double>();
   if (!std::isfinite(x) || std::fabs(x) > limit)
     bad(source, where + ".value",
-        shown(v) + " " + unit + " is beyond " + json(limit).dump() + " " + unit + ", which no machine tool has");
+        shown(v) + " " + unit + " is beyond " + json(limit).dump() + " " + unit +
+            ", which no machine tool has");
   return x;
 }
 

@@ -2,10 +2,9 @@
 // The member checks every kind of rotacal-model/1 file shares (model_file.cpp,
 // fitted_model.cpp): messages "source: member: what is wrong", an estimate's value, unit and
 // std, an object member.
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
-
-#include <nlohmann/json.hpp>
 
 namespace rotacal::model_checks {
 
@@ -16,13 +15,14 @@ using json = nlohmann::ordered_json;
 /// At most ~80 characters of a value, for a message.
 std::string shown(const json& v);
 /// obj[key], or InvalidArgument "source: where.key: missing".
-const json& member(const json& obj, const std::string& key, const std::string& source, const std::string& where);
+const json& member(const json& obj, const std::string& key, const std::string& source,
+                   const std::string& where);
 /// member() that must be an object.
 const json& object_member(const json& obj, const std::string& key, const std::string& source,
                           const std::string& where = "");
 /// One {"value", "std", "unit"} entry checked (unit as given, |value| <= limit, std >= 0 or
 /// null); its value, nullopt when null (unobservable).
-std::optional<double> estimate(const json& e, const std::string& where, const std::string& unit, double limit,
-                               const std::string& source);
+std::optional<double> estimate(const json& e, const std::string& where, const std::string& unit,
+                               double limit, const std::string& source);
 
 }  // namespace rotacal::model_checks

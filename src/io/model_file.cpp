@@ -10,10 +10,10 @@
 #include <cstring>
 #include <set>
 
+#include "model_checks.hpp"
 #include "rotacal/core/error.hpp"
 #include "rotacal/core/json_text.hpp"
 #include "rotacal/io/fitted_model.hpp"
-#include "model_checks.hpp"
 
 namespace rotacal {
 
@@ -26,12 +26,14 @@ using model_checks::member;
 using model_checks::object_member;
 using model_checks::shown;
 
-const std::set<std::string> kKinds = {"ballbar", "rtest-joint", "rtest-diagnosis", "probe", "multi"};
+const std::set<std::string> kKinds = {"ballbar", "rtest-joint", "rtest-diagnosis", "probe",
+                                      "multi"};
 
 // Reads `rotacal-model/M` or `rotacal-model/M.N`; refuses another major version by name.
 int format_minor(const json& doc, const std::string& source) {
   const auto it = doc.find("format");
-  if (it == doc.end() || !it->is_string()) bad(source, "format", "missing: not a rotacal-model file");
+  if (it == doc.end() || !it->is_string())
+    bad(source, "format", "missing: not a rotacal-model file");
   const std::string f = it->get<std::string>();
   const std::string prefix = "rotacal-model/";
   if (f.rfind(prefix, 0) != 0) bad(source, "format", shown(*it) + " is not a rotacal-model file");
@@ -52,7 +54,8 @@ int format_minor(const json& doc, const std::string& source) {
   if (major < 1) bad(source, "format", "cannot read the version of " + shown(*it));
   if (major > kModelFormatMajor)
     bad(source, "format",
-        f + " was written by a newer rotacal; this one reads " + kModelFormat + ": upgrade rotacal");
+        f + " was written by a newer rotacal; this one reads " + kModelFormat +
+            ": upgrade rotacal");
   if (major < kModelFormatMajor) bad(source, "format", f + " is older than any rotacal wrote");
   return minor;
 }
@@ -72,16 +75,20 @@ void check_rtest_joint(const json& doc, MachineType machine, const std::string& 
   if (b.contains("maps")) {
     const auto maps = rtest_map_names(machine);
     if (b["maps"] != json(std::vector<std::string>(maps.begin(), maps.end())))
-      bad(source, "basis.maps", shown(b["maps"]) + " are not the " + to_string(machine) + " machine's maps [\"" +
-                                     maps[0] + "\", \"" + maps[1] + "\"]");
+      bad(source, "basis.maps",
+          shown(b["maps"]) + " are not the " + to_string(machine) + " machine's maps [\"" +
+              maps[0] + "\", \"" + maps[1] + "\"]");
   }
-  std::vector<std::string> names(location_error_names(machine).begin(), location_error_names(machine).end());
+  std::vector<std::string> names(location_error_names(machine).begin(),
+                                 location_error_names(machine).end());
   // A machine with head axes also fits tool_offset_Z (minus the error of pivot + tool length).
   if (machine.has_head()) {
-    estimate(member(doc, "tool_offset_Z", source, ""), "tool_offset_Z", "mm", kMaxModelPositionError, source);
+    estimate(member(doc, "tool_offset_Z", source, ""), "tool_offset_Z", "mm",
+             kMaxModelPositionError, source);
     names.push_back("tool_offset_Z");
   } else if (doc.contains("tool_offset_Z")) {
-    bad(source, "tool_offset_Z", "only a machine with head axes has it; " + to_string(machine) + " has none");
+    bad(source, "tool_offset_Z",
+        "only a machine with head axes has it; " + to_string(machine) + " has none");
   }
   const json& mc = object_member(doc, "map_coefficients", source);
   for (auto it = mc.begin(); it != mc.end(); ++it) {
@@ -95,28 +102,33 @@ void check_rtest_joint(const json& doc, MachineType machine, const std::string& 
   const json& cov = object_member(doc, "covariance", source);
   const json& params = member(cov, "parameters", source, "covariance");
   if (params != json(names))
-    bad(source, "covariance.parameters", "must list the " + std::to_string(names.size()) +
-                                             " parameters (location errors, tool_offset_Z on a machine with head "
-                                             "axes, then map_coefficients in order)");
+    bad(source, "covariance.parameters",
+        "must list the " + std::to_string(names.size()) +
+            " parameters (location errors, tool_offset_Z on a machine with head "
+            "axes, then map_coefficients in order)");
   const json& m = member(cov, "matrix", source, "covariance");
   if (!m.is_array() || m.size() != names.size())
     bad(source, "covariance.matrix", "must be " + std::to_string(names.size()) + " rows");
   for (std::size_t i = 0; i < m.size(); ++i) {
     if (!m[i].is_array() || m[i].size() != names.size())
-      bad(source, "covariance.matrix[" + std::to_string(i) + "]", "must be " + std::to_string(names.size()) + " numbers");
+      bad(source, "covariance.matrix[" + std::to_string(i) + "]",
+          "must be " + std::to_string(names.size()) + " numbers");
     for (const json& x : m[i])
       if (!x.is_number() && !x.is_null())
-        bad(source, "covariance.matrix[" + std::to_string(i) + "]", "must hold numbers (or null), got " + shown(x));
+        bad(source, "covariance.matrix[" + std::to_string(i) + "]",
+            "must hold numbers (or null), got " + shown(x));
   }
   if (doc.contains("nests")) {
     const json& nests = object_member(doc, "nests", source);
     for (auto it = nests.begin(); it != nests.end(); ++it) {
       const json& v = it.value();
-      if (!v.is_array() || v.size() != 3 || !v[0].is_number() || !v[1].is_number() || !v[2].is_number())
+      if (!v.is_array() || v.size() != 3 || !v[0].is_number() || !v[1].is_number() ||
+          !v[2].is_number())
         bad(source, "nests." + it.key(), "must be 3 numbers (mm), got " + shown(v));
       for (const json& x : v)
         if (std::fabs(x.get<double>()) > kMaxModelPivot)
-          bad(source, "nests." + it.key(), shown(v) + " is beyond " + json(kMaxModelPivot).dump() + " mm");
+          bad(source, "nests." + it.key(),
+              shown(v) + " is beyond " + json(kMaxModelPivot).dump() + " mm");
     }
   }
 }
@@ -125,10 +137,11 @@ void probe_zeros(const json& doc, const std::string& source) {
   if (!doc.contains("probe_zeros")) return;
   const json& z = object_member(doc, "probe_zeros", source);
   for (auto it = z.begin(); it != z.end(); ++it) {
-    if (!it.value().is_object()) bad(source, "probe_zeros." + it.key(), "must be an object {x, y, z}");
+    if (!it.value().is_object())
+      bad(source, "probe_zeros." + it.key(), "must be an object {x, y, z}");
     for (const char* a : {"x", "y", "z"})
-      estimate(member(it.value(), a, source, "probe_zeros." + it.key()), "probe_zeros." + it.key() + "." + a, "mm",
-               kMaxModelPositionError, source);
+      estimate(member(it.value(), a, source, "probe_zeros." + it.key()),
+               "probe_zeros." + it.key() + "." + a, "mm", kMaxModelPositionError, source);
   }
 }
 
@@ -146,11 +159,13 @@ void nullify(json& v, const std::string& pointer, json& reasons) {
       std::string key = it.key();
       // RFC 6901 escapes: ~ -> ~0, / -> ~1.
       std::string esc;
-      for (char c : key) esc += c == '~' ? std::string("~0") : c == '/' ? std::string("~1") : std::string(1, c);
+      for (char c : key)
+        esc += c == '~' ? std::string("~0") : c == '/' ? std::string("~1") : std::string(1, c);
       nullify(it.value(), pointer + "/" + esc, reasons);
     }
   } else if (v.is_array()) {
-    for (std::size_t i = 0; i < v.size(); ++i) nullify(v[i], pointer + "/" + std::to_string(i), reasons);
+    for (std::size_t i = 0; i < v.size(); ++i)
+      nullify(v[i], pointer + "/" + std::to_string(i), reasons);
   }
 }
 
@@ -160,16 +175,20 @@ void check_envelope(const json& doc, const std::string& source, ModelFile& m) {
   m.format_minor = format_minor(doc, source);
   const json& kind = member(doc, "kind", source, "");
   if (!kind.is_string() || !kKinds.count(kind.get<std::string>()))
-    bad(source, "kind", shown(kind) + " is not one of ballbar, rtest-joint, rtest-diagnosis, probe, multi");
+    bad(source, "kind",
+        shown(kind) + " is not one of ballbar, rtest-joint, rtest-diagnosis, probe, multi");
   m.kind = kind.get<std::string>();
   const json& machine = member(doc, "machine", source, "");
-  if (!machine.is_string()) bad(source, "machine", "must be a string such as \"AC-trt\", got " + shown(machine));
+  if (!machine.is_string())
+    bad(source, "machine", "must be a string such as \"AC-trt\", got " + shown(machine));
   // As in sessions: a machine_description defines the machine, `machine` is then its name.
   if (doc.contains("machine_description")) {
     const json& d = doc["machine_description"];
-    if (!d.is_object()) bad(source, "machine_description", "must be a rotacal-machine/1 object, got " + shown(d));
+    if (!d.is_object())
+      bad(source, "machine_description", "must be a rotacal-machine/1 object, got " + shown(d));
     try {
-      m.machine = MachineType::from_description(parse_machine_description(d.dump(), source + ": machine_description"));
+      m.machine = MachineType::from_description(
+          parse_machine_description(d.dump(), source + ": machine_description"));
     } catch (const InvalidArgument& e) {
       bad(source, "machine_description", e.what());
     }
@@ -191,10 +210,11 @@ void put_machine(json& doc, MachineType m) {
 }
 
 std::string read_text(const std::string& path) {
-  if (path.find('\0') != std::string::npos) throw IoError(std::string(path.c_str()) + "...: path contains a NUL byte");
+  if (path.find('\0') != std::string::npos)
+    throw IoError(std::string(path.c_str()) + "...: path contains a NUL byte");
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) throw IoError(path + ": cannot open for reading: " + std::strerror(errno));
-  struct stat st {};
+  struct stat st{};
   if (::fstat(fd, &st) != 0 || S_ISDIR(st.st_mode)) {
     ::close(fd);
     throw IoError(path + ": is a directory, not a model file");
@@ -245,21 +265,24 @@ ModelFile model_from_json(const json& doc, const std::string& source) {
   if (!lacking.empty()) bad(source, "", "location_errors lacks " + lacking);
   for (int k = 0; k < 8; ++k) {
     const bool angle = location_error_is_angle(k);
-    const std::optional<double> v =
-        estimate(member(le, names[k], source, "location_errors"), "location_errors." + names[k],
-                 angle ? "rad" : "mm", angle ? kMaxModelAngleError : kMaxModelPositionError, source);
+    const std::optional<double> v = estimate(
+        member(le, names[k], source, "location_errors"), "location_errors." + names[k],
+        angle ? "rad" : "mm", angle ? kMaxModelAngleError : kMaxModelPositionError, source);
     m.location_errors.v[k] = v.value_or(0.0);
     m.observable[static_cast<std::size_t>(k)] = v.has_value();
   }
   for (auto it = le.begin(); it != le.end(); ++it)
     if (std::find(names.begin(), names.end(), it.key()) == names.end())
-      bad(source, "location_errors." + it.key(), "is not a location error of a " + to_string(m.machine) + " machine");
+      bad(source, "location_errors." + it.key(),
+          "is not a location error of a " + to_string(m.machine) + " machine");
   if (m.kind == "ballbar") {
     const json& pv = object_member(doc, "pivot", source);
     Eigen::Vector3d p;
     for (int a = 0; a < 3; ++a) {
       const std::string axis(1, "xyz"[a]);
-      p[a] = estimate(member(pv, axis, source, "pivot"), "pivot." + axis, "mm", kMaxModelPivot, source).value_or(0.0);
+      p[a] =
+          estimate(member(pv, axis, source, "pivot"), "pivot." + axis, "mm", kMaxModelPivot, source)
+              .value_or(0.0);
     }
     m.pivot = p;
   }
@@ -278,7 +301,8 @@ ModelFile model_from_json(const json& doc, const std::string& source) {
         bad(source, where + ".id", ex.what());
       }
       if (!e.applies_to(m.machine))
-        bad(source, where + ".id", id.get<std::string>() + " does not exist on a " + to_string(m.machine) + " machine");
+        bad(source, where + ".id",
+            id.get<std::string>() + " does not exist on a " + to_string(m.machine) + " machine");
       const json& params = object_member(fx[i], "params", source, where);
       const auto pn = e.param_names();
       const auto pu = e.param_units();
@@ -304,7 +328,9 @@ ModelFile parse_model(const std::string& text, const std::string& source) {
   return model_from_json(parse_json(text, source), source);
 }
 
-ModelFile read_model(const std::string& path) { return model_from_json(parse_json(read_text(path), path), path); }
+ModelFile read_model(const std::string& path) {
+  return model_from_json(parse_json(read_text(path), path), path);
+}
 
 json strict_json(json document) {
   json reasons = json::object();
@@ -353,7 +379,8 @@ const char* const kRtestBasisDefinition =
 
 // {"value", "std", "unit"}; an unobservable parameter keeps its convention value, no std.
 json convention_estimate(const ParameterEstimate& p) {
-  if (!p.observable) return {{"value", p.value}, {"std", nullptr}, {"unit", p.unit}, {"observable", false}};
+  if (!p.observable)
+    return {{"value", p.value}, {"std", nullptr}, {"unit", p.unit}, {"observable", false}};
   return {{"value", p.value}, {"std", p.std}, {"unit", p.unit}};
 }
 
@@ -362,18 +389,26 @@ json convention_estimate(const ParameterEstimate& p) {
 json rtest_joint_model_document(const RtestJointModelContent& c) {
   const std::size_t n_le = 8, n_head = c.machine.has_head() ? 1 : 0, n = c.parameters.size();
   if (n < n_le + n_head)
-    throw InvalidArgument("rtest_joint_model_document: " + std::to_string(n) + " parameters, fewer than the " +
-                          std::to_string(n_le + n_head) + " of the machine");
-  if (c.covariance.rows() != static_cast<Eigen::Index>(n) || c.covariance.cols() != static_cast<Eigen::Index>(n))
-    throw InvalidArgument("rtest_joint_model_document: the covariance is not " + std::to_string(n) + " x " +
-                          std::to_string(n));
+    throw InvalidArgument("rtest_joint_model_document: " + std::to_string(n) +
+                          " parameters, fewer than the " + std::to_string(n_le + n_head) +
+                          " of the machine");
+  if (c.covariance.rows() != static_cast<Eigen::Index>(n) ||
+      c.covariance.cols() != static_cast<Eigen::Index>(n))
+    throw InvalidArgument("rtest_joint_model_document: the covariance is not " + std::to_string(n) +
+                          " x " + std::to_string(n));
   json doc = model_document_header("rtest-joint", c.machine);
   json maps = json::array();
   for (const std::string& m : rtest_map_names(c.machine)) maps.push_back(m);
-  doc["basis"] = {{"b_degree", c.b_degree}, {"c_harmonics", c.c_harmonics}, {"c_b_degree", c.c_b_degree},
-                  {"gamma_cb", c.gamma_cb}, {"maps", maps}, {"definition", kRtestBasisDefinition}};
-  json le = json::object(), coefficients = json::object(), names = json::array(), matrix = json::array();
-  for (std::size_t i = 0; i < n_le; ++i) le[c.parameters[i].name] = convention_estimate(c.parameters[i]);
+  doc["basis"] = {{"b_degree", c.b_degree},
+                  {"c_harmonics", c.c_harmonics},
+                  {"c_b_degree", c.c_b_degree},
+                  {"gamma_cb", c.gamma_cb},
+                  {"maps", maps},
+                  {"definition", kRtestBasisDefinition}};
+  json le = json::object(), coefficients = json::object(), names = json::array(),
+       matrix = json::array();
+  for (std::size_t i = 0; i < n_le; ++i)
+    le[c.parameters[i].name] = convention_estimate(c.parameters[i]);
   doc["location_errors"] = le;
   if (n_head) doc[c.parameters[n_le].name] = convention_estimate(c.parameters[n_le]);
   for (std::size_t i = n_le + n_head; i < n; ++i)
@@ -391,10 +426,16 @@ json rtest_joint_model_document(const RtestJointModelContent& c) {
   for (const auto& [label, q] : c.nests) nests[label] = {q.x(), q.y(), q.z()};
   doc["nests"] = nests;
   for (const auto& [setup, z] : c.probe_zeros)
-    zeros[setup] = {{"x", convention_estimate(z[0])}, {"y", convention_estimate(z[1])}, {"z", convention_estimate(z[2])}};
+    zeros[setup] = {{"x", convention_estimate(z[0])},
+                    {"y", convention_estimate(z[1])},
+                    {"z", convention_estimate(z[2])}};
   doc["probe_zeros"] = zeros;
-  doc["fit"] = {{"residual_rms_um", c.residual_rms_um}, {"sigma_um", c.sigma_um}, {"n_samples", c.n_samples},
-                {"converged", c.converged}, {"unobservable", c.unobservable}, {"notes", c.notes}};
+  doc["fit"] = {{"residual_rms_um", c.residual_rms_um},
+                {"sigma_um", c.sigma_um},
+                {"n_samples", c.n_samples},
+                {"converged", c.converged},
+                {"unobservable", c.unobservable},
+                {"notes", c.notes}};
   return doc;
 }
 

@@ -1,16 +1,16 @@
 #pragma once
-// Internal to src/ballbar, src/circular and src/probe (kept in src/io, below all three): number formatting of NC words, each
-// dialect's comment writer, and the program preamble per dialect, shared by the NC writer of the
-// rotary-axis test (nc_program.cpp), of the circular tests (src/circular/plan.cpp) and of the
-// touch probe (src/probe/nc_program.cpp).
+// Internal to src/ballbar, src/circular and src/probe (kept in src/io, below all three): number
+// formatting of NC words, each dialect's comment writer, and the program preamble per dialect,
+// shared by the NC writer of the rotary-axis test (nc_program.cpp), of the circular tests
+// (src/circular/plan.cpp) and of the touch probe (src/probe/nc_program.cpp).
 
 #include <cstdio>
 #include <functional>
 #include <string>
 
-#include "rotacal/io/nc_dialect.hpp"
 #include "rotacal/core/error.hpp"
 #include "rotacal/io/controller_comment.hpp"
+#include "rotacal/io/nc_dialect.hpp"
 
 namespace rotacal::nc_detail {
 
@@ -37,10 +37,14 @@ inline std::string general(double v) {
 /// fixed or free text, goes through it.
 inline CommentDialect comment_dialect(NcDialect d) {
   switch (d) {
-    case NcDialect::linuxcnc: return CommentDialect::linuxcnc;
-    case NcDialect::heidenhain: return CommentDialect::heidenhain;
-    case NcDialect::siemens: return CommentDialect::siemens;
-    case NcDialect::fanuc: return CommentDialect::fanuc;
+    case NcDialect::linuxcnc:
+      return CommentDialect::linuxcnc;
+    case NcDialect::heidenhain:
+      return CommentDialect::heidenhain;
+    case NcDialect::siemens:
+      return CommentDialect::siemens;
+    case NcDialect::fanuc:
+      return CommentDialect::fanuc;
   }
   ROTACAL_ASSERT(false);
   return CommentDialect::linuxcnc;
@@ -84,10 +88,12 @@ inline void write_preamble(NcDialect d, const NcProgramOptions& o, const Preambl
     case NcDialect::heidenhain:
       // It is written outside any comment (BEGIN PGM / END PGM): only a plain name.
       if (o.program_name.empty() || o.program_name.size() > 64 ||
-          o.program_name.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_-") !=
+          o.program_name.find_first_not_of(
+              "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_-") !=
               std::string::npos)
-        throw InvalidArgument(p.writer + ": program_name must be one word of letters, digits, '_' and '-', got '" +
-                              o.program_name + "'");
+        throw InvalidArgument(
+            p.writer + ": program_name must be one word of letters, digits, '_' and '-', got '" +
+            o.program_name + "'");
       line("BEGIN PGM " + o.program_name + " MM");
       header();
       line("FUNCTION RESET TCPM");

@@ -6,13 +6,13 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <climits>
 #include <cstdlib>
 #include <cstring>
 #include <random>
 #include <vector>
-#include <algorithm>
 
 #include "rotacal/core/error.hpp"
 
@@ -45,7 +45,7 @@ std::string base_of(const std::string& p) {
 std::string follow_links(const std::string& user_path, const std::string& path0) {
   std::string p = path0;
   for (int hops = 0; hops < 40; ++hops) {
-    struct stat st {};
+    struct stat st{};
     if (::lstat(p.c_str(), &st) != 0 || !S_ISLNK(st.st_mode)) return p;
     std::string buf(PATH_MAX, '\0');
     const ssize_t n = ::readlink(p.c_str(), buf.data(), buf.size());
@@ -85,7 +85,7 @@ struct Resolved {
   std::string canonical;  // realpath of the directory + "/" + final name, links followed
   std::string dir;        // realpath of the directory
   bool exists = false;
-  struct stat st {};
+  struct stat st{};
 };
 
 Resolved resolve(const std::string& user_path, bool require_parent) {
@@ -95,8 +95,7 @@ Resolved resolve(const std::string& user_path, bool require_parent) {
   Resolved r;
   const std::string target = follow_links(user_path, user_path);
   const std::string base = base_of(target);
-  if (base.empty() || base == "." || base == "..")
-    fail(user_path, "is a directory, not a file");
+  if (base.empty() || base == "." || base == "..") fail(user_path, "is a directory, not a file");
   char dir_buf[PATH_MAX];
   if (::realpath(dir_of(target).c_str(), dir_buf) == nullptr) {
     if (!require_parent) {
@@ -131,8 +130,9 @@ OutputKind classify(const std::string& path, const OutputOptions& options, Resol
     if (S_ISCHR(m) || S_ISFIFO(m)) {
       kind = OutputKind::WriteThrough;
     } else if (!S_ISREG(m)) {
-      fail(path, S_ISBLK(m) ? "is a block device: refusing to write to it" : "is not a regular file, "
-                                                                              "character device or FIFO");
+      fail(path, S_ISBLK(m) ? "is a block device: refusing to write to it"
+                            : "is not a regular file, "
+                              "character device or FIFO");
     }
     if (::access(out.canonical.c_str(), W_OK) != 0) fail_errno(path, "cannot write", errno);
   }
@@ -201,7 +201,8 @@ int create_temporary(const std::string& path, const Resolved& r, std::string& tm
       if (r.exists) (void)::fchmod(fd, r.st.st_mode & 07777);  // not narrowed by the umask
       return fd;
     }
-    if (errno != EEXIST && errno != EINTR) fail_errno(path, "cannot create a temporary file in " + r.dir, errno);
+    if (errno != EEXIST && errno != EINTR)
+      fail_errno(path, "cannot create a temporary file in " + r.dir, errno);
   }
   fail(path, "cannot find a free temporary file name in " + r.dir);
 }
@@ -303,7 +304,8 @@ void OutputStream::commit() {
   const int sync_err = errno;
   if (::close(fd) != 0 || !synced) {
     // The rows are measurements: keep them under the temporary name rather than delete them.
-    fail_errno(path_, "write failed (the rows so far are in " + temporary_ + ")", synced ? errno : sync_err);
+    fail_errno(path_, "write failed (the rows so far are in " + temporary_ + ")",
+               synced ? errno : sync_err);
   }
   if (::rename(temporary_.c_str(), target_.c_str()) != 0)
     fail_errno(path_, "cannot replace (the rows are in " + temporary_ + ")", errno);

@@ -42,13 +42,13 @@ std::string rtest_head(const RtestSession& s, RtestColumns cols) {
 std::string rtest_row(const RtestSample& r, MachineType m, RtestColumns cols, std::size_t extra) {
   check_label(r.setup, "setup label");
   if (r.extra.size() != extra) throw InvalidArgument("R-test sample: wrong number of extra values");
-  std::string out = r.setup + "," + format_number(r.time) + "," + rotary_values(m, r.tilt_deg, r.rot_deg) +
-                    "," + format_number(r.xyz.x()) + "," +
+  std::string out = r.setup + "," + format_number(r.time) + "," +
+                    rotary_values(m, r.tilt_deg, r.rot_deg) + "," + format_number(r.xyz.x()) + "," +
                     format_number(r.xyz.y()) + "," + format_number(r.xyz.z());
   auto add = [&](const std::optional<Eigen::Vector3d>& v, const char* names) {
     if (!v)
-      throw InvalidArgument(std::string("R-test sample at time ") + format_number(r.time) + " has no " +
-                            names + " values");
+      throw InvalidArgument(std::string("R-test sample at time ") + format_number(r.time) +
+                            " has no " + names + " values");
     out += "," + format_number(v->x()) + "," + format_number(v->y()) + "," + format_number(v->z());
   };
   if (cols.d) add(r.d, "dx,dy,dz");
@@ -79,7 +79,8 @@ RtestSession parse_rtest(std::istream& in, const std::string& name) {
         R.fail(R.meta_line(kv.first), 0, "probe number must be 1, 2 or 3 in '" + kv.first + "'");
       const Eigen::Vector3d d = R.meta_vector(kv.first, kv.second, 2.0, "");
       if (std::abs(d.norm() - 1.0) > 1e-6)
-        R.fail(R.meta_line(kv.first), 0, kv.first + " must be a unit vector (norm " + format_number(d.norm()) + ")");
+        R.fail(R.meta_line(kv.first), 0,
+               kv.first + " must be a unit vector (norm " + format_number(d.norm()) + ")");
       s.probe_dirs[std::stoi(n)] = d;
     }
   }
@@ -94,7 +95,8 @@ RtestSession parse_rtest(std::istream& in, const std::string& name) {
             c_dz = column_index(R, "dz", false);
   const int c_d1 = column_index(R, "d1", false), c_d2 = column_index(R, "d2", false),
             c_d3 = column_index(R, "d3", false);
-  const int n_d = (c_dx >= 0) + (c_dy >= 0) + (c_dz >= 0), n_raw = (c_d1 >= 0) + (c_d2 >= 0) + (c_d3 >= 0);
+  const int n_d = (c_dx >= 0) + (c_dy >= 0) + (c_dz >= 0),
+            n_raw = (c_d1 >= 0) + (c_d2 >= 0) + (c_d3 >= 0);
   if (n_d != 0 && n_d != 3) R.fail(R.header_line, 0, "dx, dy, dz must come together");
   if (n_raw != 0 && n_raw != 3) R.fail(R.header_line, 0, "d1, d2, d3 must come together");
   if (n_d == 0 && n_raw == 0)
@@ -103,10 +105,12 @@ RtestSession parse_rtest(std::istream& in, const std::string& name) {
     for (int k = 1; k <= 3; ++k)
       if (!s.probe_dirs.count(k))
         R.fail(0, 0, "raw columns d1,d2,d3 need metadata 'probe." + std::to_string(k) + ".dir'");
-  const std::set<int> known = {c_setup, c_time, c_t, c_c, c_x, c_y, c_z, c_dx, c_dy, c_dz, c_d1, c_d2, c_d3};
+  const std::set<int> known = {c_setup, c_time, c_t,  c_c,  c_x,  c_y, c_z,
+                               c_dx,    c_dy,   c_dz, c_d1, c_d2, c_d3};
   std::vector<int> extra_idx;
   for (int i = 0; i < static_cast<int>(R.header.size()); ++i)
-    if (!known.count(i)) extra_idx.push_back(i), s.extra_columns.push_back(R.header[static_cast<std::size_t>(i)]);
+    if (!known.count(i))
+      extra_idx.push_back(i), s.extra_columns.push_back(R.header[static_cast<std::size_t>(i)]);
   double last = -1e300;
   DuplicateRows dups;
   for (const auto& row : raw.rows) {
@@ -115,7 +119,8 @@ RtestSession parse_rtest(std::istream& in, const std::string& name) {
     RtestSample r;
     r.setup = R.label(F(c_setup), "setup label");
     if (!s.nests.count(r.setup))
-      R.fail(R.line_no, F(c_setup).column, "setup '" + excerpt(r.setup) + "' has no 'nest." + excerpt(r.setup) + "' metadata");
+      R.fail(R.line_no, F(c_setup).column,
+             "setup '" + excerpt(r.setup) + "' has no 'nest." + excerpt(r.setup) + "' metadata");
     const auto pos = [&](int c, const char* what) {
       return R.bounded(F(c), what, -kMaxAbsPositionMm, kMaxAbsPositionMm, "mm");
     };
@@ -147,25 +152,33 @@ std::string format_rtest(const RtestSession& s) {
   RtestColumns cols;
   cols.d = !s.samples.empty() && s.samples.front().d.has_value();
   cols.raw = !s.samples.empty() && s.samples.front().raw.has_value();
-  if (!cols.d && !cols.raw) throw InvalidArgument("R-test session has neither dx,dy,dz nor d1,d2,d3 values");
+  if (!cols.d && !cols.raw)
+    throw InvalidArgument("R-test session has neither dx,dy,dz nor d1,d2,d3 values");
   check_samples(s.samples);
   for (const RtestSample& r : s.samples) {
     for (const auto* v : {&r.d, &r.raw})
       if (*v)
         for (int k = 0; k < 3; ++k)
-          check_writable((**v)[k], -kMaxAbsDisplacementMm, kMaxAbsDisplacementMm, "displacement", 0);
-    if (!s.nests.count(r.setup)) throw InvalidArgument("setup '" + r.setup + "' has no nest in the session");
+          check_writable((**v)[k], -kMaxAbsDisplacementMm, kMaxAbsDisplacementMm, "displacement",
+                         0);
+    if (!s.nests.count(r.setup))
+      throw InvalidArgument("setup '" + r.setup + "' has no nest in the session");
     if (r.d.has_value() != cols.d || r.raw.has_value() != cols.raw)
-      throw InvalidArgument("every R-test sample must carry the same columns (dx,dy,dz and/or d1,d2,d3)");
+      throw InvalidArgument(
+          "every R-test sample must carry the same columns (dx,dy,dz and/or d1,d2,d3)");
   }
-  return rtest_head(s, cols) + with_annotations(s.samples, s.annotations, [&](const RtestSample& r) {
+  return rtest_head(s, cols) +
+         with_annotations(s.samples, s.annotations, [&](const RtestSample& r) {
            return rtest_row(r, s.machine, cols, s.extra_columns.size());
          });
 }
 
-void write_rtest(const RtestSession& s, const std::string& path) { write_output(path, format_rtest(s)); }
+void write_rtest(const RtestSession& s, const std::string& path) {
+  write_output(path, format_rtest(s));
+}
 
-RtestWriter::RtestWriter(const std::string& path, const RtestSession& header, bool raw, const OutputOptions& options)
+RtestWriter::RtestWriter(const std::string& path, const RtestSession& header, bool raw,
+                         const OutputOptions& options)
     : path_(path), machine_(header.machine), raw_(raw), extra_(header.extra_columns.size()) {
   if (raw)
     for (int k = 1; k <= 3; ++k)
@@ -175,7 +188,8 @@ RtestWriter::RtestWriter(const std::string& path, const RtestSession& header, bo
   file_->write(rtest_head(header, RtestColumns{!raw, raw}));
 }
 void RtestWriter::append(const RtestSample& s) {
-  if (s.time < last_time_) throw InvalidArgument(path_ + ": sample time " + format_number(s.time) + " goes backwards");
+  if (s.time < last_time_)
+    throw InvalidArgument(path_ + ": sample time " + format_number(s.time) + " goes backwards");
   put(file_, path_, rtest_row(s, machine_, RtestColumns{!raw_, raw_}, extra_));
   last_time_ = s.time;
   ++rows_;

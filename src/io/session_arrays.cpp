@@ -1,9 +1,9 @@
 // Sessions to and from numpy-shaped columns, validated as the file reader validates them.
 #include "rotacal/io/session_arrays.hpp"
 
-#include "rotacal/io/ballbar_file.hpp"
-
 #include <cmath>
+
+#include "rotacal/io/ballbar_file.hpp"
 
 namespace rotacal {
 
@@ -29,8 +29,9 @@ template <typename M>
 void check_range(const M& m, const char* name, double lo, double hi, const char* unit) {
   for (Eigen::Index i = 0; i < m.size(); ++i)
     if (!(m.data()[i] >= lo && m.data()[i] <= hi))
-      throw InvalidArgument(std::string(name) + ": " + format_number(m.data()[i]) + " (entry " + std::to_string(i) +
-                            ") is outside [" + format_number(lo) + ", " + format_number(hi) + "] " + unit);
+      throw InvalidArgument(std::string(name) + ": " + format_number(m.data()[i]) + " (entry " +
+                            std::to_string(i) + ") is outside [" + format_number(lo) + ", " +
+                            format_number(hi) + "] " + unit);
 }
 }  // namespace
 
@@ -47,7 +48,8 @@ Eigen::VectorXd ballbar_lengths(const BallbarSession& s) {
 }
 RowMatrix3 ballbar_xyz(const BallbarSession& s) {
   RowMatrix3 m(static_cast<Eigen::Index>(s.samples.size()), 3);
-  for (std::size_t i = 0; i < s.samples.size(); ++i) m.row(static_cast<Eigen::Index>(i)) = s.samples[i].xyz;
+  for (std::size_t i = 0; i < s.samples.size(); ++i)
+    m.row(static_cast<Eigen::Index>(i)) = s.samples[i].xyz;
   return m;
 }
 RowMatrix2 ballbar_angles_deg(const BallbarSession& s) {
@@ -93,7 +95,8 @@ BallbarSession make_ballbar_session(MachineType machine, double ballbar_length,
     if (tests[static_cast<std::size_t>(i)].empty())
       throw InvalidArgument("tests: empty label at row " + std::to_string(i));
     if (tests[static_cast<std::size_t>(i)].size() > kMaxLabelBytes)
-      throw InvalidArgument("tests: label at row " + std::to_string(i) + " is longer than 256 bytes");
+      throw InvalidArgument("tests: label at row " + std::to_string(i) +
+                            " is longer than 256 bytes");
     BallbarSample b;
     b.test = tests[static_cast<std::size_t>(i)];
     b.time = time[i];
@@ -110,7 +113,8 @@ BallbarSession with_lengths(const BallbarSession& s, const Eigen::VectorXd& leng
   check_rows(length.size(), static_cast<Eigen::Index>(s.samples.size()), "length");
   check_finite(length, "length");
   BallbarSession out = s;
-  for (std::size_t i = 0; i < out.samples.size(); ++i) out.samples[i].length = length[static_cast<Eigen::Index>(i)];
+  for (std::size_t i = 0; i < out.samples.size(); ++i)
+    out.samples[i].length = length[static_cast<Eigen::Index>(i)];
   return out;
 }
 
@@ -130,15 +134,17 @@ RowMatrix2 rtest_angles_deg(const RtestSession& s) {
 }
 RowMatrix3 rtest_xyz(const RtestSession& s) {
   RowMatrix3 m(static_cast<Eigen::Index>(s.samples.size()), 3);
-  for (std::size_t i = 0; i < s.samples.size(); ++i) m.row(static_cast<Eigen::Index>(i)) = s.samples[i].xyz;
+  for (std::size_t i = 0; i < s.samples.size(); ++i)
+    m.row(static_cast<Eigen::Index>(i)) = s.samples[i].xyz;
   return m;
 }
 RowMatrix3 rtest_displacements(const RtestSession& s) {
   RowMatrix3 m(static_cast<Eigen::Index>(s.samples.size()), 3);
   for (std::size_t i = 0; i < s.samples.size(); ++i) {
     if (!s.samples[i].d)
-      throw InvalidArgument("R-test session has no dx,dy,dz (raw probe readings only: convert them "
-                            "with a probe calibration first)");
+      throw InvalidArgument(
+          "R-test session has no dx,dy,dz (raw probe readings only: convert them "
+          "with a probe calibration first)");
     m.row(static_cast<Eigen::Index>(i)) = *s.samples[i].d;
   }
   return m;
@@ -147,7 +153,8 @@ RtestSession with_displacements(const RtestSession& s, const RowMatrix3& d) {
   check_rows(d.rows(), static_cast<Eigen::Index>(s.samples.size()), "d");
   check_finite(d, "d");
   RtestSession out = s;
-  for (std::size_t i = 0; i < out.samples.size(); ++i) out.samples[i].d = d.row(static_cast<Eigen::Index>(i)).transpose();
+  for (std::size_t i = 0; i < out.samples.size(); ++i)
+    out.samples[i].d = d.row(static_cast<Eigen::Index>(i)).transpose();
   return out;
 }
 

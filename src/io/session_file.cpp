@@ -33,20 +33,23 @@ AnySession read_session(const std::string& path) {
   return read_sniffed_session(in, path, sniff_format_line(in, path));
 }
 
-AnySession io_detail::read_sniffed_session(std::ifstream& in, const std::string& path, const FormatLine& sniffed) {
+AnySession io_detail::read_sniffed_session(std::ifstream& in, const std::string& path,
+                                           const FormatLine& sniffed) {
   const std::string &head = sniffed.head, &line = sniffed.line;
   const std::string t = trim(line);
   if (t.find(kRtestFormat) != std::string::npos) return parse_rtest(in, path);
   // Anything but a plain-text first line (binary data, no line end in 4 kB, not UTF-8) gets
   // the ballbar reader's precise message (line, column, byte).
-  const bool plain = head.find('\n') != std::string::npos &&
-                     std::all_of(line.begin(), line.end(), [](char c) {
-                       const unsigned char u = static_cast<unsigned char>(c);
-                       return (u >= 0x20 && u < 0x7F) || u == '\t' || u == '\r';
-                     });
-  if (t.find(kBallbarFormat) != std::string::npos || t.empty() || !plain) return parse_ballbar(in, path);
-  throw ParseError(path, 1, 1, std::string("first line must be '# format: ") + kBallbarFormat + "' or '# format: " +
-                                   kRtestFormat + "', got '" + excerpt(t) + "'");
+  const bool plain =
+      head.find('\n') != std::string::npos && std::all_of(line.begin(), line.end(), [](char c) {
+        const unsigned char u = static_cast<unsigned char>(c);
+        return (u >= 0x20 && u < 0x7F) || u == '\t' || u == '\r';
+      });
+  if (t.find(kBallbarFormat) != std::string::npos || t.empty() || !plain)
+    return parse_ballbar(in, path);
+  throw ParseError(path, 1, 1,
+                   std::string("first line must be '# format: ") + kBallbarFormat +
+                       "' or '# format: " + kRtestFormat + "', got '" + excerpt(t) + "'");
 }
 
 }  // namespace rotacal

@@ -10,7 +10,8 @@
 namespace rotacal {
 
 std::string format_number(double v) {
-  if (!std::isfinite(v)) throw InvalidArgument("cannot write a non-finite number to a session file");
+  if (!std::isfinite(v))
+    throw InvalidArgument("cannot write a non-finite number to a session file");
   char buf[64];
   const auto r = std::to_chars(buf, buf + sizeof(buf), v);
   ROTACAL_ASSERT(r.ec == std::errc());
@@ -31,7 +32,8 @@ std::string rotary_header(MachineType m) {
 }
 std::string rotary_values(MachineType m, double tilt_deg, double rot_deg) {
   const bool rot_first = m.rot_index() == 0;
-  return format_number(rot_first ? rot_deg : tilt_deg) + "," + format_number(rot_first ? tilt_deg : rot_deg);
+  return format_number(rot_first ? rot_deg : tilt_deg) + "," +
+         format_number(rot_first ? tilt_deg : rot_deg);
 }
 
 std::string vec_text(const Eigen::Vector3d& v) {
@@ -40,15 +42,18 @@ std::string vec_text(const Eigen::Vector3d& v) {
 
 void check_label(const std::string& label, const char* what) {
   if (label.empty() || label.find_first_of(",\n\r#") != std::string::npos || trim(label) != label)
-    throw InvalidArgument(std::string(what) + " '" + label +
-                          "' cannot be written (empty, or contains a comma, '#', newline or edge spaces)");
+    throw InvalidArgument(
+        std::string(what) + " '" + label +
+        "' cannot be written (empty, or contains a comma, '#', newline or edge spaces)");
 }
 
 void check_writable(double v, double lo, double hi, const char* what, std::size_t row) {
   if (!(v >= lo && v <= hi))
-    throw InvalidArgument(std::string(what) + " " + (std::isfinite(v) ? format_number(v) : std::string("non-finite")) +
-                          " of sample " + std::to_string(row) + " is outside [" + format_number(lo) + ", " +
-                          format_number(hi) + "]: a file with it could not be read back");
+    throw InvalidArgument(std::string(what) + " " +
+                          (std::isfinite(v) ? format_number(v) : std::string("non-finite")) +
+                          " of sample " + std::to_string(row) + " is outside [" +
+                          format_number(lo) + ", " + format_number(hi) +
+                          "]: a file with it could not be read back");
 }
 
 void put(const std::unique_ptr<OutputStream>& f, const std::string& path, const std::string& text) {

@@ -48,7 +48,8 @@ void check_samples(const std::vector<Sample>& samples) {
     const Sample& r = samples[i];
     check_writable(r.time, last, kMaxAbsTimeS, "time", i);
     last = r.time;
-    for (int k = 0; k < 3; ++k) check_writable(r.xyz[k], -kMaxAbsPositionMm, kMaxAbsPositionMm, "X/Y/Z", i);
+    for (int k = 0; k < 3; ++k)
+      check_writable(r.xyz[k], -kMaxAbsPositionMm, kMaxAbsPositionMm, "X/Y/Z", i);
     check_writable(r.tilt_deg, -kMaxAbsAngleDeg, kMaxAbsAngleDeg, "tilt angle", i);
     check_writable(r.rot_deg, -kMaxAbsAngleDeg, kMaxAbsAngleDeg, "rotary angle", i);
   }

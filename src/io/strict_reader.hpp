@@ -3,8 +3,8 @@
 // rtest_session_file.cpp): bounded UTF-8 lines, metadata and header, fields with their columns,
 // numbers within the limits of ballbar_file.hpp, errors naming file, line and column. The
 // writing helpers the formats share are in session_text.hpp.
-#include <cmath>
 #include <charconv>
+#include <cmath>
 #include <fstream>
 #include <istream>
 #include <optional>
@@ -55,24 +55,28 @@ struct Reader {
     if (f.text.empty()) fail(line_no, f.column, what + " is empty");
     if (r.ec != std::errc() || r.ptr != e)
       fail(line_no, f.column, what + ": '" + excerpt(f.text) + "' is not a number");
-    if (!std::isfinite(v)) fail(line_no, f.column, what + " is " + excerpt(f.text) + " (must be finite)");
+    if (!std::isfinite(v))
+      fail(line_no, f.column, what + " is " + excerpt(f.text) + " (must be finite)");
     return v;
   }
 
   // A number within [lo, hi]: beyond, it cannot come from a machine tool.
-  double bounded(const Field& f, const std::string& what, double lo, double hi, const char* unit) const {
+  double bounded(const Field& f, const std::string& what, double lo, double hi,
+                 const char* unit) const {
     const double v = number(f, what);
     if (v < lo || v > hi)
-      fail(line_no, f.column, what + " " + excerpt(f.text) + " is outside [" + format_number(lo) + ", " +
-                                  format_number(hi) + "] " + unit + " (wrong units, or not a measurement)");
+      fail(line_no, f.column,
+           what + " " + excerpt(f.text) + " is outside [" + format_number(lo) + ", " +
+               format_number(hi) + "] " + unit + " (wrong units, or not a measurement)");
     return v;
   }
 
   std::string label(const Field& f, const std::string& what) const {
     if (f.text.empty()) fail(line_no, f.column, what + " is empty");
     if (f.text.size() > kMaxLabelBytes)
-      fail(line_no, f.column, what + " is longer than " + std::to_string(kMaxLabelBytes) + " bytes ('" +
-                                  excerpt(f.text) + "')");
+      fail(line_no, f.column,
+           what + " is longer than " + std::to_string(kMaxLabelBytes) + " bytes ('" +
+               excerpt(f.text) + "')");
     return f.text;
   }
 
@@ -96,13 +100,15 @@ struct Reader {
     return copy.bounded(f, "metadata '" + key + "'", lo, hi, unit);
   }
 
-  Eigen::Vector3d meta_vector(const std::string& key, const std::string& value, double limit = 1e300,
-                              const char* unit = "") const {
+  Eigen::Vector3d meta_vector(const std::string& key, const std::string& value,
+                              double limit = 1e300, const char* unit = "") const {
     const std::vector<Field> parts = split_fields(value);
     if (parts.size() != 3)
-      fail(meta_line(key), 0, "metadata '" + key + "' must be three numbers 'x, y, z', got '" + excerpt(value) + "'");
+      fail(meta_line(key), 0,
+           "metadata '" + key + "' must be three numbers 'x, y, z', got '" + excerpt(value) + "'");
     Eigen::Vector3d v;
-    for (int k = 0; k < 3; ++k) v[k] = meta_number(key, parts[static_cast<std::size_t>(k)].text, -limit, limit, unit);
+    for (int k = 0; k < 3; ++k)
+      v[k] = meta_number(key, parts[static_cast<std::size_t>(k)].text, -limit, limit, unit);
     return v;
   }
 
@@ -146,7 +152,8 @@ struct DuplicateRows {
 
   void add(const std::pair<int, std::string>& row, int line, double time) {
     if (!(time == current_time)) {
-      if (first_line.bucket_count() > 1024) first_line = {};  // one large group: do not clear it again and again
+      if (first_line.bucket_count() > 1024)
+        first_line = {};  // one large group: do not clear it again and again
       first_line.clear();
       current_time = time;
     }
@@ -156,8 +163,9 @@ struct DuplicateRows {
   void report(std::vector<std::string>& warnings) const {
     if (count == 0) return;
     warnings.push_back(std::to_string(count) + " row" + (count > 1 ? "s repeat" : " repeats") +
-                       " an earlier row exactly (first: line " + std::to_string(example_line) + " repeats line " +
-                       std::to_string(example_of) + "); each counts as a separate measurement in a fit: "
+                       " an earlier row exactly (first: line " + std::to_string(example_line) +
+                       " repeats line " + std::to_string(example_of) +
+                       "); each counts as a separate measurement in a fit: "
                        "remove them if they were written twice");
   }
 };
@@ -175,6 +183,7 @@ struct FormatLine {
 };
 FormatLine sniff_format_line(std::ifstream& in, const std::string& path);
 // read_session on a file already opened and sniffed (session_file.cpp).
-AnySession read_sniffed_session(std::ifstream& in, const std::string& path, const FormatLine& sniffed);
+AnySession read_sniffed_session(std::ifstream& in, const std::string& path,
+                                const FormatLine& sniffed);
 
 }  // namespace rotacal::io_detail

@@ -10,13 +10,13 @@ namespace {
 
 struct KindInfo {
   EffectKind kind;
-  const char* stem;     // id up to the axis
-  bool rotary_axis;     // takes A/B/C
-  bool tilt_only;       // only A or B
-  bool linear_axis;     // takes X/Y/Z
-  bool harmonic;        // has _hn
+  const char* stem;  // id up to the axis
+  bool rotary_axis;  // takes A/B/C
+  bool tilt_only;    // only A or B
+  bool linear_axis;  // takes X/Y/Z
+  bool harmonic;     // has _hn
   int params;
-  const char* names;    // comma separated
+  const char* names;  // comma separated
   const char* units;
   const char* cause;
 };
@@ -24,14 +24,15 @@ struct KindInfo {
 constexpr KindInfo kKindInfo[] = {
     {EffectKind::ballbar_length_offset, "ballbar_length_offset", false, false, false, false, 1,
      "dL", "mm", "the calibrated ballbar length L0 is wrong"},
-    {EffectKind::ballbar_thermal_drift, "ballbar_thermal_drift", false, false, false, false, 1,
-     "k", "mm/s", "the bar or the set-up grows with temperature during the test"},
+    {EffectKind::ballbar_thermal_drift, "ballbar_thermal_drift", false, false, false, false, 1, "k",
+     "mm/s", "the bar or the set-up grows with temperature during the test"},
     {EffectKind::tool_offset_Z, "tool_offset_Z", false, false, false, false, 1, "d", "mm",
      "the tool-cup centre is not at the programmed tool length"},
     {EffectKind::rotary_zero_offset, "rotary_zero_offset", true, false, false, false, 1, "eps",
      "rad", "the zero of the rotary axis is off"},
     {EffectKind::angular_positioning, "angular_positioning", true, false, false, true, 2, "a,b",
-     "rad,rad", "angular positioning error of the rotary axis (encoder eccentricity, worm or gear error)"},
+     "rad,rad",
+     "angular positioning error of the rotary axis (encoder eccentricity, worm or gear error)"},
     {EffectKind::radial_motion, "radial_motion", true, false, false, true, 4, "a,b,c,d",
      "mm,mm,mm,mm", "radial error motion of the rotary axis (out-of-round bearing track)"},
     {EffectKind::axial_motion, "axial_motion", true, false, false, true, 2, "a,b", "mm,mm",
@@ -52,8 +53,8 @@ constexpr KindInfo kKindInfo[] = {
     // minutes; the nonlinear refit moves it once d is non-zero.
     {EffectKind::thermal_warmup, "thermal_warmup", false, false, true, false, 2, "d,ln_tau_300s",
      "mm,1", "the structure warms up towards a steady state"},
-    {EffectKind::straightness, "straightness", false, false, true, false, 3, "c2,c3,c4",
-     "mm,mm,mm", "the linear axis is not straight (ISO 230-1 straightness error)"},
+    {EffectKind::straightness, "straightness", false, false, true, false, 3, "c2,c3,c4", "mm,mm,mm",
+     "the linear axis is not straight (ISO 230-1 straightness error)"},
     {EffectKind::tool_offset, "tool_offset", false, false, true, false, 1, "d", "mm",
      "the tool-side ball is off the spindle axis"},
     {EffectKind::rotary_backlash, "backlash", true, false, false, false, 1, "b", "rad",
@@ -64,10 +65,11 @@ constexpr KindInfo kKindInfo[] = {
      "angle trails in proportion to the angular speed"},
     // tau_s = 0.05 s * exp(q): a few tens of ms, as friction at a reversal releases.
     {EffectKind::reversal_spike, "reversal_spike", true, false, false, false, 2, "h,ln_tau_50ms",
-     "rad,1", "the rotary axis sticks when it reverses (static friction) and catches up over a "
+     "rad,1",
+     "the rotary axis sticks when it reverses (static friction) and catches up over a "
      "short time"},
-    {EffectKind::stylus_radius_offset, "stylus_radius_offset", false, false, false, false, 1, "d", "mm",
-     "the stylus' effective radius differs from its calibration (touch probe)"},
+    {EffectKind::stylus_radius_offset, "stylus_radius_offset", false, false, false, false, 1, "d",
+     "mm", "the stylus' effective radius differs from its calibration (touch probe)"},
     {EffectKind::probe_lobing, "probe_lobing", false, false, false, false, 2, "lc,ls", "mm,mm",
      "the touch probe's pretravel depends on the direction of approach (three-lobed, as "
      "kinematic-seat probes are)"},
@@ -129,7 +131,8 @@ Effect Effect::parse(const std::string& id) {
       continue;
     }
     if (k.kind == EffectKind::straightness) {  // straightness_DA, D != A
-      if (rest.size() == 3 && rest[0] == '_' && std::string("XYZ").find(rest[1]) != std::string::npos &&
+      if (rest.size() == 3 && rest[0] == '_' &&
+          std::string("XYZ").find(rest[1]) != std::string::npos &&
           std::string("XYZ").find(rest[2]) != std::string::npos && rest[1] != rest[2]) {
         f.axis = rest[2];
         f.direction = rest[1];
@@ -159,8 +162,9 @@ Effect Effect::parse(const std::string& id) {
     }
     if (rest.size() < 2 || rest[0] != '_') break;
     const char a = rest[1];
-    const bool ok_axis = k.rotary_axis ? (a == 'A' || a == 'B' || a == 'C') && !(k.tilt_only && a == 'C')
-                                       : (a == 'X' || a == 'Y' || a == 'Z');
+    const bool ok_axis = k.rotary_axis
+                             ? (a == 'A' || a == 'B' || a == 'C') && !(k.tilt_only && a == 'C')
+                             : (a == 'X' || a == 'Y' || a == 'Z');
     if (!ok_axis) break;
     f.axis = a;
     rest = rest.substr(2);
@@ -175,7 +179,8 @@ Effect Effect::parse(const std::string& id) {
     if (f.harmonic < 1 || (k.kind == EffectKind::radial_motion && f.harmonic < 2)) break;
     return f;
   }
-  throw InvalidArgument("'" + id + "' is not an effect id of the catalogue (shared/spec/effects.md)");
+  throw InvalidArgument("'" + id +
+                        "' is not an effect id of the catalogue (shared/spec/effects.md)");
 }
 
 int Effect::num_params() const { return info(kind).params; }
@@ -194,7 +199,8 @@ bool Effect::applies_to(MachineType m) const {
   const KindInfo& k = info(kind);
   if (!k.rotary_axis) return true;
   // Tilt-only effects (sag, coning) belong to the tilt axis, on the table or in the head.
-  return k.tilt_only ? axis == tilt_axis_letter(m) : (axis == tilt_axis_letter(m) || axis == rot_axis_letter(m));
+  return k.tilt_only ? axis == tilt_axis_letter(m)
+                     : (axis == tilt_axis_letter(m) || axis == rot_axis_letter(m));
 }
 
 std::vector<Effect> effect_catalogue(MachineType m, int max_harmonic) {

@@ -155,7 +155,8 @@ RotaryAngles<double> nominal_angles(MachineType m, const Eigen::Vector3d& k, boo
   } else if (d.head_axes.size() == 2) {
     a = d.axis(0).direction, b = d.axis(1).direction, p = ez, q = k;
   } else {  // chain 0 is the table axis, chain 1 the head axis
-    a = d.axis(1).direction, b = d.axis(0).direction, p = k, q = ez, alpha_sign = -1.0, ia = 1, ib = 0;
+    a = d.axis(1).direction, b = d.axis(0).direction, p = k, q = ez, alpha_sign = -1.0, ia = 1,
+    ib = 0;
   }
   const double c = a.dot(b), s2 = 1.0 - c * c;
   const double x = (q.dot(a) - c * p.dot(b)) / s2, y = (p.dot(b) - c * q.dot(a)) / s2;

@@ -1,9 +1,8 @@
 #include "rotacal/kinematics/machine_description.hpp"
 
 #include <cmath>
-#include <set>
-
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "rotacal/core/error.hpp"
 #include "rotacal/core/json_text.hpp"
@@ -24,7 +23,8 @@ RotaryAxis make_rotary_axis(char name, const Eigen::Vector3d& direction,
                             const std::string& where) {
   if (!direction.allFinite() || !point.allFinite())
     throw InvalidArgument(where + ": direction and point must be finite numbers");
-  const double len = direction.stableNorm();  // norm() overflows for [1e200, 1e200, 0]: then 0 after dividing
+  const double len =
+      direction.stableNorm();  // norm() overflows for [1e200, 1e200, 0]: then 0 after dividing
   if (!(len > 1e-9)) throw InvalidArgument(where + ".direction is zero: an axis needs a direction");
   RotaryAxis a;
   a.name = name;
@@ -39,8 +39,9 @@ RotaryAxis make_rotary_axis(char name, const Eigen::Vector3d& direction,
     if (std::abs(std::abs(a.direction[k]) - 1.0) < 1e-12) along = k;
   const int letter_index = name == 'A' ? 0 : name == 'B' ? 1 : name == 'C' ? 2 : -1;
   if (along >= 0 && letter_index < 0)
-    throw InvalidArgument(where + ".name '" + letter + "' is not A, B or C, but the axis lies along " +
-                          std::string(1, "XYZ"[along]) + " (formats.md: A along X, B along Y, C along Z)");
+    throw InvalidArgument(
+        where + ".name '" + letter + "' is not A, B or C, but the axis lies along " +
+        std::string(1, "XYZ"[along]) + " (formats.md: A along X, B along Y, C along Z)");
   if (along >= 0) a.direction = unit(along) * (a.direction[along] > 0 ? 1.0 : -1.0);
   if (along >= 0 && along == letter_index) {
     // formats.md table: A: dp = (0, E_Y0A, E_Z0A), dn = (0, E_C0A, -E_B0A);
@@ -56,8 +57,9 @@ RotaryAxis make_rotary_axis(char name, const Eigen::Vector3d& direction,
     a.direction_basis.col(0) = unit(p1).cross(unit(along));
     a.direction_basis.col(1) = unit(p2).cross(unit(along));
     const char L[3] = {'X', 'Y', 'Z'}, R[3] = {'A', 'B', 'C'};
-    a.error_names = {std::string("E_") + L[p1] + "0" + letter, std::string("E_") + L[p2] + "0" + letter,
-                     std::string("E_") + R[p1] + "0" + letter, std::string("E_") + R[p2] + "0" + letter};
+    a.error_names = {
+        std::string("E_") + L[p1] + "0" + letter, std::string("E_") + L[p2] + "0" + letter,
+        std::string("E_") + R[p1] + "0" + letter, std::string("E_") + R[p2] + "0" + letter};
     if (a.direction[along] < 0) a.direction_basis = -a.direction_basis;
     a.radial1 = unit(i1);
     a.radial2 = unit(i2);
@@ -78,11 +80,14 @@ RotaryAxis make_rotary_axis(char name, const Eigen::Vector3d& direction,
 
 const RotaryAxis& MachineDescription::axis(int k) const {
   const int nt = static_cast<int>(table_axes.size());
-  return k < nt ? table_axes[static_cast<std::size_t>(k)] : head_axes[static_cast<std::size_t>(k - nt)];
+  return k < nt ? table_axes[static_cast<std::size_t>(k)]
+                : head_axes[static_cast<std::size_t>(k - nt)];
 }
 
 std::string MachineDescription::configuration() const {
-  return table_axes.size() == 2 ? "table-table" : head_axes.size() == 2 ? "head-head" : "head-table";
+  return table_axes.size() == 2  ? "table-table"
+         : head_axes.size() == 2 ? "head-head"
+                                 : "head-table";
 }
 
 int MachineDescription::rot_index() const {
@@ -98,7 +103,8 @@ int MachineDescription::rot_index() const {
 std::array<std::string, 8> MachineDescription::location_error_names() const {
   std::array<std::string, 8> out;
   for (int k = 0; k < 2; ++k)
-    for (int i = 0; i < 4; ++i) out[static_cast<std::size_t>(4 * k + i)] = axis(k).error_names[static_cast<std::size_t>(i)];
+    for (int i = 0; i < 4; ++i)
+      out[static_cast<std::size_t>(4 * k + i)] = axis(k).error_names[static_cast<std::size_t>(i)];
   return out;
 }
 
@@ -127,42 +133,50 @@ double finite_number(const json& v, const std::string& where) {
 }
 
 Eigen::Vector3d vector3(const json& v, const std::string& where) {
-  if (!v.is_array() || v.size() != 3) throw InvalidArgument(where + " must be an array of 3 numbers");
+  if (!v.is_array() || v.size() != 3)
+    throw InvalidArgument(where + " must be an array of 3 numbers");
   return {finite_number(v[0], where + "[0]"), finite_number(v[1], where + "[1]"),
           finite_number(v[2], where + "[2]")};
 }
 
 std::array<double, 2> pair(const json& v, const std::string& where) {
   if (!v.is_array() || v.size() != 2) throw InvalidArgument(where + " must be an array [min, max]");
-  const std::array<double, 2> p = {finite_number(v[0], where + "[0]"), finite_number(v[1], where + "[1]")};
+  const std::array<double, 2> p = {finite_number(v[0], where + "[0]"),
+                                   finite_number(v[1], where + "[1]")};
   if (!(p[0] < p[1])) throw InvalidArgument(where + " must have min < max");
   return p;
 }
 
-std::vector<RotaryAxis> axes(const json& doc, const char* key, bool on_head, const std::string& src) {
+std::vector<RotaryAxis> axes(const json& doc, const char* key, bool on_head,
+                             const std::string& src) {
   std::vector<RotaryAxis> out;
   if (!doc.contains(key)) return out;
   const json& list = doc[key];
   const std::string w = src + ": " + key;
   if (!list.is_array()) throw InvalidArgument(w + " must be an array of axes");
-  if (list.size() > 2) throw InvalidArgument(w + " has " + std::to_string(list.size()) + " axes (at most 2 per side)");
+  if (list.size() > 2)
+    throw InvalidArgument(w + " has " + std::to_string(list.size()) + " axes (at most 2 per side)");
   for (std::size_t i = 0; i < list.size(); ++i) {
     const json& a = list[i];
     const std::string wi = w + "[" + std::to_string(i) + "]";
     if (!a.is_object()) throw InvalidArgument(wi + " must be an object");
     for (auto it = a.begin(); it != a.end(); ++it)
-      if (it.key() != "name" && it.key() != "direction" && it.key() != "point" && it.key() != "limits_deg")
-        throw InvalidArgument(wi + "." + it.key() + " is not a field of an axis (name, direction, point, limits_deg)");
+      if (it.key() != "name" && it.key() != "direction" && it.key() != "point" &&
+          it.key() != "limits_deg")
+        throw InvalidArgument(wi + "." + it.key() +
+                              " is not a field of an axis (name, direction, point, limits_deg)");
     if (!a.contains("name") || !a["name"].is_string())
       throw InvalidArgument(wi + ".name is missing (the controller's letter of the axis)");
     const std::string name = a["name"].get<std::string>();
     if (name != "A" && name != "B" && name != "C")
-      throw InvalidArgument(wi + ".name '" + name.substr(0, 16) +
-                            "' must be A, B or C (the rotary axis words of ISO 6983; a nutating axis "
-                            "keeps its controller letter and gets the U/V error names)");
+      throw InvalidArgument(
+          wi + ".name '" + name.substr(0, 16) +
+          "' must be A, B or C (the rotary axis words of ISO 6983; a nutating axis "
+          "keeps its controller letter and gets the U/V error names)");
     if (!a.contains("direction")) throw InvalidArgument(wi + ".direction is missing");
     const Eigen::Vector3d dir = vector3(a["direction"], wi + ".direction");
-    const Eigen::Vector3d pt = a.contains("point") ? vector3(a["point"], wi + ".point") : Eigen::Vector3d::Zero();
+    const Eigen::Vector3d pt =
+        a.contains("point") ? vector3(a["point"], wi + ".point") : Eigen::Vector3d::Zero();
     std::optional<std::array<double, 2>> lim;
     if (a.contains("limits_deg")) lim = pair(a["limits_deg"], wi + ".limits_deg");
     out.push_back(make_rotary_axis(name[0], dir, pt, on_head, lim, wi));
@@ -172,23 +186,25 @@ std::vector<RotaryAxis> axes(const json& doc, const char* key, bool on_head, con
 
 }  // namespace
 
-MachineDescription parse_machine_description(const std::string& json_text, const std::string& source) {
+MachineDescription parse_machine_description(const std::string& json_text,
+                                             const std::string& source) {
   json doc;
   try {
     doc = parse_json(json_text, source);  // strict, bounded in depth and size (core/json_text.hpp)
-  } catch (const ParseError& e) {  // syntax, depth, and numbers beyond double (1e999)
+  } catch (const ParseError& e) {         // syntax, depth, and numbers beyond double (1e999)
     throw InvalidArgument(e.what());
   }
   if (!doc.is_object()) throw InvalidArgument(source + ": a machine description is a JSON object");
   if (!doc.contains("format") || doc["format"] != "rotacal-machine/1")
     throw InvalidArgument(source + ": format must be \"rotacal-machine/1\"");
-  static const std::set<std::string> known = {"format", "name", "table_axes", "head_axes",
-                                              "pivot_length", "tool_length", "travel_mm"};
+  static const std::set<std::string> known = {
+      "format", "name", "table_axes", "head_axes", "pivot_length", "tool_length", "travel_mm"};
   for (auto it = doc.begin(); it != doc.end(); ++it)
     if (!known.count(it.key()))
       throw InvalidArgument(source + ": " + it.key() + " is not a field of rotacal-machine/1");
   MachineDescription d;
-  d.name = doc.contains("name") && doc["name"].is_string() ? doc["name"].get<std::string>() : "custom";
+  d.name =
+      doc.contains("name") && doc["name"].is_string() ? doc["name"].get<std::string>() : "custom";
   d.table_axes = axes(doc, "table_axes", false, source);
   d.head_axes = axes(doc, "head_axes", true, source);
   const std::size_t n = d.table_axes.size() + d.head_axes.size();
@@ -199,8 +215,9 @@ MachineDescription parse_machine_description(const std::string& json_text, const
     throw InvalidArgument(source + ": two axes are named '" + std::string(1, d.axis(0).name) +
                           "' (axis names must differ)");
   if (std::abs(std::abs(d.axis(0).direction.dot(d.axis(1).direction)) - 1.0) < 1e-9)
-    throw InvalidArgument(source + ": the directions of " + std::string(1, d.axis(0).name) + " and " +
-                          std::string(1, d.axis(1).name) + " are parallel; they cannot orient a tool");
+    throw InvalidArgument(source + ": the directions of " + std::string(1, d.axis(0).name) +
+                          " and " + std::string(1, d.axis(1).name) +
+                          " are parallel; they cannot orient a tool");
   for (const char* k : {"pivot_length", "tool_length"})
     if (doc.contains(k)) {
       const double v = finite_number(doc[k], source + ": " + k);
@@ -210,10 +227,12 @@ MachineDescription parse_machine_description(const std::string& json_text, const
   if (doc.contains("travel_mm")) {
     const json& t = doc["travel_mm"];
     if (!t.is_array() || t.size() != 3)
-      throw InvalidArgument(source + ": travel_mm must be [[xmin, xmax], [ymin, ymax], [zmin, zmax]]");
+      throw InvalidArgument(source +
+                            ": travel_mm must be [[xmin, xmax], [ymin, ymax], [zmin, zmax]]");
     Eigen::Matrix<double, 3, 2> m;
     for (int k = 0; k < 3; ++k) {
-      const auto p = pair(t[static_cast<std::size_t>(k)], source + ": travel_mm[" + std::to_string(k) + "]");
+      const auto p =
+          pair(t[static_cast<std::size_t>(k)], source + ": travel_mm[" + std::to_string(k) + "]");
       m(k, 0) = p[0];
       m(k, 1) = p[1];
     }
@@ -229,15 +248,17 @@ std::string machine_description_json(const MachineDescription& d) {
   auto axes_json = [&](const std::vector<RotaryAxis>& list) {
     json out = json::array();
     for (const RotaryAxis& a : list) {
-      json j = {{"name", std::string(1, a.name)}, {"direction", vec(a.direction)}, {"point", vec(a.point)}};
+      json j = {{"name", std::string(1, a.name)},
+                {"direction", vec(a.direction)},
+                {"point", vec(a.point)}};
       if (a.limits_deg) j["limits_deg"] = {(*a.limits_deg)[0], (*a.limits_deg)[1]};
       out.push_back(j);
     }
     return out;
   };
-  json doc = {{"format", "rotacal-machine/1"}, {"name", d.name},
+  json doc = {{"format", "rotacal-machine/1"},         {"name", d.name},
               {"table_axes", axes_json(d.table_axes)}, {"head_axes", axes_json(d.head_axes)},
-              {"pivot_length", d.pivot_length}, {"tool_length", d.tool_length}};
+              {"pivot_length", d.pivot_length},        {"tool_length", d.tool_length}};
   if (d.travel_mm) {
     const auto& t = *d.travel_mm;
     doc["travel_mm"] = {{t(0, 0), t(0, 1)}, {t(1, 0), t(1, 1)}, {t(2, 0), t(2, 1)}};
@@ -282,16 +303,20 @@ const std::vector<MachineDescription>& builtins() {
     v.push_back(builtin("AC-trt", {T('A', X, O, endless), T('C', Z, O, endless)}, {}, 0, 0, trt));
     v.push_back(builtin("BC-trt", {T('B', Y, O, endless), T('C', Z, O, endless)}, {}, 0, 0, trt));
     // B swivel head over a C rotary table; the B line passes through the controlled point.
-    v.push_back(builtin("B-head-C-table", {T('C', Z, O, endless)}, {H('B', Y, O, swivel)}, 150, 100, head));
+    v.push_back(
+        builtin("B-head-C-table", {T('C', Z, O, endless)}, {H('B', Y, O, swivel)}, 150, 100, head));
     // Fork heads: C carries the swivel (A or B); both lines through the controlled point.
-    v.push_back(builtin("AC-head", {}, {H('C', Z, O, endless), H('A', X, O, swivel)}, 150, 100, head));
-    v.push_back(builtin("BC-head", {}, {H('C', Z, O, endless), H('B', Y, O, swivel)}, 150, 100, head));
+    v.push_back(
+        builtin("AC-head", {}, {H('C', Z, O, endless), H('A', X, O, swivel)}, 150, 100, head));
+    v.push_back(
+        builtin("BC-head", {}, {H('C', Z, O, endless), H('B', Y, O, swivel)}, 150, 100, head));
     // Nutating table: a B axis at 45 degrees in the YZ plane carrying a C table; turning B by
     // 180 degrees stands the C table vertical.
-    v.push_back(builtin("B45C-trt",
-                        {T('B', Eigen::Vector3d(0, -1, 1).normalized(), O, std::array<double, 2>{0.0, 180.0}),
-                         T('C', Z, O, endless)},
-                        {}, 0, 0, trt));
+    v.push_back(builtin(
+        "B45C-trt",
+        {T('B', Eigen::Vector3d(0, -1, 1).normalized(), O, std::array<double, 2>{0.0, 180.0}),
+         T('C', Z, O, endless)},
+        {}, 0, 0, trt));
     return v;
   }();
   return all;

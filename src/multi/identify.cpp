@@ -7,9 +7,9 @@
 
 #include "rotacal/core/block_whitener.hpp"
 #include "rotacal/core/parameter_layout.hpp"
+#include "rotacal/kinematics/parameter_blocks.hpp"
 #include "rotacal/session/probe_session.hpp"
 #include "rotacal/session/session.hpp"
-#include "rotacal/kinematics/parameter_blocks.hpp"
 #include "session_parts.hpp"
 
 namespace rotacal {
@@ -59,7 +59,8 @@ namespace {
 // columns on its own.
 class StackedModel : public ResidualModel {
  public:
-  StackedModel(const std::vector<SessionPart>& parts, MachineType m, const EffectModel& fx) : parts_(parts) {
+  StackedModel(const std::vector<SessionPart>& parts, MachineType m, const EffectModel& fx)
+      : parts_(parts) {
     const auto& arr = location_error_names(m);
     std::vector<std::string> names(arr.begin(), arr.end()), units(names.size());
     for (const Effect& f : fx.effects)
@@ -70,12 +71,15 @@ class StackedModel : public ResidualModel {
     for (std::size_t j = 0; j < parts.front().parameters.size(); ++j)
       if (parts.front().shared[j] >= 0 && parts.front().shared[j] < 8)
         units[static_cast<std::size_t>(parts.front().shared[j])] = parts.front().parameters[j].unit;
-    errors_ = layout_.add("location_errors", {names.begin(), names.begin() + 8}, {units.begin(), units.begin() + 8});
-    effects_ = layout_.add("effects", {names.begin() + 8, names.end()}, {units.begin() + 8, units.end()});
+    errors_ = layout_.add("location_errors", {names.begin(), names.begin() + 8},
+                          {units.begin(), units.begin() + 8});
+    effects_ =
+        layout_.add("effects", {names.begin() + 8, names.end()}, {units.begin() + 8, units.end()});
     for (const SessionPart& p : parts) {
       if (std::count_if(p.shared.begin(), p.shared.end(), [](Eigen::Index i) { return i >= 0; }) !=
           static_cast<std::ptrdiff_t>(names.size()))
-        throw InvalidArgument("identify: session " + p.name + " does not hold the " + std::to_string(names.size()) +
+        throw InvalidArgument("identify: session " + p.name + " does not hold the " +
+                              std::to_string(names.size()) +
                               " shared parameters (location errors and effects)");
       std::vector<std::string> own, own_units;
       for (std::size_t j = 0; j < p.parameters.size(); ++j)
@@ -100,7 +104,8 @@ class StackedModel : public ResidualModel {
   Eigen::Index num_shared() const { return errors_.size + effects_.size; }
   Eigen::Index num_residuals() const override { return rows_; }
   int num_parameters() const override { return static_cast<int>(layout_.size()); }
-  void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r, Eigen::MatrixXd* J) const override {
+  void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r,
+                Eigen::MatrixXd* J) const override {
     Eigen::Index row = 0;
     if (J) J->setZero();
     for (std::size_t k = 0; k < parts_.size(); ++k) {
@@ -141,13 +146,14 @@ void check_sessions(const std::vector<MultiSessionInput>& sessions) {
                           std::to_string(sessions.size()));
   std::set<std::string> names;
   for (const MultiSessionInput& s : sessions)
-    if (!names.insert(s.name).second) throw InvalidArgument("identify: session name " + s.name + " given twice");
+    if (!names.insert(s.name).second)
+      throw InvalidArgument("identify: session name " + s.name + " given twice");
   const MachineType m = sessions.front().machine();
   for (const MultiSessionInput& s : sessions)
     if (s.machine() != m)
-      throw InvalidArgument("identify: sessions of different machine types: " + sessions.front().name + " is " +
-                            to_string(m) + ", " + s.name + " is " + to_string(s.machine()) +
-                            "; a joint identification is of one machine");
+      throw InvalidArgument("identify: sessions of different machine types: " +
+                            sessions.front().name + " is " + to_string(m) + ", " + s.name + " is " +
+                            to_string(s.machine()) + "; a joint identification is of one machine");
 }
 
 // The session alone: white fit -> its noise model -> [GLS], as its instrument's own fit.
@@ -161,8 +167,9 @@ NoiseFit fit_alone(const SessionPart& p, const MultiFitOptions& o) {
   JointFitSettings s = p.settings;
   s.max_iterations = o.max_iterations;
   s.observability_min_chi2 = o.observability_min_chi2;
-  return fit_with_noise([&](const JointFitSettings& st) { return solve_joint(*p.model, p.parameters, st); }, s,
-                        p.groups, p.times, no);
+  return fit_with_noise(
+      [&](const JointFitSettings& st) { return solve_joint(*p.model, p.parameters, st); }, s,
+      p.groups, p.times, no);
 }
 
 // The session's block of the joint whitener: its GLS model (scaled by the bias factor) when its
@@ -180,7 +187,8 @@ BlockDiagonalWhitener::Block whitener_block(const SessionPart& p, const NoiseFit
   return b;
 }
 
-std::vector<MultiDisagreement> disagreements(const std::vector<MultiSessionResult>& s, double z_max) {
+std::vector<MultiDisagreement> disagreements(const std::vector<MultiSessionResult>& s,
+                                             double z_max) {
   std::vector<MultiDisagreement> out;
   for (std::size_t a = 0; a < s.size(); ++a)
     for (std::size_t b = a + 1; b < s.size(); ++b)
@@ -212,7 +220,8 @@ EffectModel shared_effects(const MultiFitOptions& o) {
 
 }  // namespace
 
-MultiIdentification identify_multi(const std::vector<MultiSessionInput>& sessions, const MultiFitOptions& o) {
+MultiIdentification identify_multi(const std::vector<MultiSessionInput>& sessions,
+                                   const MultiFitOptions& o) {
   check_sessions(sessions);
   const EffectModel fx = shared_effects(o);
   std::vector<SessionPart> parts;
@@ -266,8 +275,10 @@ MultiIdentification identify_multi(const std::vector<MultiSessionInput>& session
   Eigen::Index row = 0;
   for (std::size_t k = 0; k < parts.size(); ++k) {
     const ParameterBlock& b = model.block(k);
-    out.sessions[k].nuisances.assign(fit.estimates.begin() + b.offset, fit.estimates.begin() + b.end());
-    for (ParameterEstimate& e : out.sessions[k].nuisances) e.name = e.name.substr(parts[k].name.size() + 1);
+    out.sessions[k].nuisances.assign(fit.estimates.begin() + b.offset,
+                                     fit.estimates.begin() + b.end());
+    for (ParameterEstimate& e : out.sessions[k].nuisances)
+      e.name = e.name.substr(parts[k].name.size() + 1);
     const Eigen::Index n = static_cast<Eigen::Index>(out.sessions[k].n_residuals);
     const double ms = fit.residuals.segment(row, n).squaredNorm() / static_cast<double>(n);
     out.sessions[k].residual_rms_um = std::sqrt(ms) * 1e3;
@@ -275,8 +286,9 @@ MultiIdentification identify_multi(const std::vector<MultiSessionInput>& session
   }
   out.disagreements = disagreements(out.sessions, o.disagreement_z);
   for (const MultiDisagreement& d : out.disagreements)
-    out.notes.push_back("sessions " + d.session_a + " and " + d.session_b + " disagree on " + d.parameter +
-                        " (z = " + std::to_string(d.z) + "): the joint value averages them");
+    out.notes.push_back("sessions " + d.session_a + " and " + d.session_b + " disagree on " +
+                        d.parameter + " (z = " + std::to_string(d.z) +
+                        "): the joint value averages them");
   out.parameter_names = names;
   out.covariance = std::move(fit.covariance);
   out.unobservable = std::move(fit.unobservable);

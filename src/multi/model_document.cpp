@@ -7,11 +7,14 @@ namespace rotacal {
 
 FittedModelContent multi_model_content(const MultiIdentification& ident) {
   const std::size_t n = ident.parameter_names.size();
-  if (ident.covariance.rows() != static_cast<Eigen::Index>(n) || ident.covariance.cols() != static_cast<Eigen::Index>(n))
-    throw InvalidArgument("multi_model_content: the covariance is not " + std::to_string(n) + " x " + std::to_string(n));
+  if (ident.covariance.rows() != static_cast<Eigen::Index>(n) ||
+      ident.covariance.cols() != static_cast<Eigen::Index>(n))
+    throw InvalidArgument("multi_model_content: the covariance is not " + std::to_string(n) +
+                          " x " + std::to_string(n));
   if (ident.effects.size() != static_cast<std::size_t>(ident.effect_model.num_params()))
     throw InvalidArgument("multi_model_content: " + std::to_string(ident.effects.size()) +
-                          " effect parameters, the effect model has " + std::to_string(ident.effect_model.num_params()));
+                          " effect parameters, the effect model has " +
+                          std::to_string(ident.effect_model.num_params()));
   FittedModelContent c;
   c.kind = "multi";
   c.machine = ident.machine;
@@ -34,8 +37,8 @@ FittedModelContent multi_model_content(const MultiIdentification& ident) {
     c.sessions.push_back(std::move(s));
   }
   for (const MultiDisagreement& d : ident.disagreements)
-    c.disagreements.push_back({d.parameter, d.unit, d.session_a, d.session_b, d.value_a, d.value_b, d.difference,
-                               d.sigma, d.z});
+    c.disagreements.push_back({d.parameter, d.unit, d.session_a, d.session_b, d.value_a, d.value_b,
+                               d.difference, d.sigma, d.z});
   c.converged = ident.converged;
   c.chi2_per_dof = ident.summary.chi2_per_dof;
   c.unobservable = ident.unobservable;

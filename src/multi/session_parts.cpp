@@ -6,11 +6,11 @@
 
 #include "../ballbar/length_model.hpp"
 #include "rotacal/ballbar/problem.hpp"
-#include "rotacal/session/probe_session.hpp"
-#include "rotacal/session/session.hpp"
 #include "rotacal/kinematics/parameter_blocks.hpp"
 #include "rotacal/probe/problem.hpp"
 #include "rotacal/rtest/problem.hpp"
+#include "rotacal/session/probe_session.hpp"
+#include "rotacal/session/session.hpp"
 
 namespace rotacal::multi_detail {
 namespace {
@@ -58,7 +58,8 @@ SessionPart rtest_part(const MultiSessionInput& in, const EffectModel& fx) {
   }
   for (Eigen::Index k = 0; k < L.zeros.items(); ++k)
     for (int a = 0; a < 3; ++a)
-      p.parameters[static_cast<std::size_t>(L.zeros.item_offset(k) + a)].start = sum(a, k) / count[k];
+      p.parameters[static_cast<std::size_t>(L.zeros.item_offset(k) + a)].start =
+          sum(a, k) / count[k];
   p.errors_offset = L.errors.offset;
   p.errors_size = L.errors.size;
   p.settings.sigma = in.rtest->noise_um.value_or(1.0) * 1e-3;
@@ -92,15 +93,20 @@ SessionPart probe_part(const MultiSessionInput& in, const EffectModel& fx) {
 
 SessionPart session_part(const MultiSessionInput& in, const EffectModel& fx) {
   SessionPart p;
-  if (in.instrument == "ballbar" && in.ballbar) p = ballbar_part(in, fx);
-  else if (in.instrument == "rtest" && in.rtest) p = rtest_part(in, fx);
-  else if (in.instrument == "probe" && in.probe) p = probe_part(in, fx);
-  else throw InvalidArgument("identify: session " + in.name + " has no " + in.instrument + " data");
+  if (in.instrument == "ballbar" && in.ballbar)
+    p = ballbar_part(in, fx);
+  else if (in.instrument == "rtest" && in.rtest)
+    p = rtest_part(in, fx);
+  else if (in.instrument == "probe" && in.probe)
+    p = probe_part(in, fx);
+  else
+    throw InvalidArgument("identify: session " + in.name + " has no " + in.instrument + " data");
   p.name = in.name;
   p.instrument = in.instrument;
   if (p.model->num_residuals() <= static_cast<Eigen::Index>(p.parameters.size()))
-    throw InvalidArgument("identify: session " + in.name + ": " + std::to_string(p.model->num_residuals()) +
-                          " residuals cannot determine its " + std::to_string(p.parameters.size()) + " unknowns");
+    throw InvalidArgument(
+        "identify: session " + in.name + ": " + std::to_string(p.model->num_residuals()) +
+        " residuals cannot determine its " + std::to_string(p.parameters.size()) + " unknowns");
   std::vector<std::string> shared_names;
   for (Eigen::Index j = 0; j < p.errors_size; ++j)
     shared_names.push_back(p.parameters[static_cast<std::size_t>(p.errors_offset + j)].name);
@@ -109,7 +115,8 @@ SessionPart session_part(const MultiSessionInput& in, const EffectModel& fx) {
       shared_names.push_back(effect_parameter_name(f, k));
   for (const FitParameter& f : p.parameters) {
     const auto at = std::find(shared_names.begin(), shared_names.end(), f.name);
-    p.shared.push_back(at == shared_names.end() ? -1 : static_cast<Eigen::Index>(at - shared_names.begin()));
+    p.shared.push_back(
+        at == shared_names.end() ? -1 : static_cast<Eigen::Index>(at - shared_names.begin()));
   }
   return p;
 }

@@ -15,18 +15,18 @@ namespace rotacal::multi_detail {
 
 struct SessionPart {
   std::string name, instrument;
-  std::shared_ptr<const void> data;       // arrays the model refers to (kept alive)
-  std::unique_ptr<ResidualModel> model;   // the instrument's residual model
-  std::vector<FitParameter> parameters;   // its unknowns, its own vector order
-  Eigen::Index errors_offset = 0;         // its location-error block
+  std::shared_ptr<const void> data;      // arrays the model refers to (kept alive)
+  std::unique_ptr<ResidualModel> model;  // the instrument's residual model
+  std::vector<FitParameter> parameters;  // its unknowns, its own vector order
+  Eigen::Index errors_offset = 0;        // its location-error block
   Eigen::Index errors_size = 0;
   // Per parameter: its index among the shared ones (the location errors, then the shared
   // effects' parameters, by name), or -1 for the session's own.
   std::vector<Eigen::Index> shared;
-  JointFitSettings settings;              // sigma of the declared noise
-  std::vector<std::string> groups;        // noise stream of every residual
-  std::vector<double> times;              // time (s) of every residual
-  bool allow_reml = false;                // the R-test's wandering zeros (rtest/identify_joint.cpp)
+  JointFitSettings settings;        // sigma of the declared noise
+  std::vector<std::string> groups;  // noise stream of every residual
+  std::vector<double> times;        // time (s) of every residual
+  bool allow_reml = false;          // the R-test's wandering zeros (rtest/identify_joint.cpp)
 };
 
 /// The part of one session with the shared catalogue effects `fx` fitted along (their

@@ -34,13 +34,14 @@ ProbePattern base_pattern(const ProbeDesignOptions& o) {
 struct Candidates {
   ProbeParameterLayout layout;
   Eigen::Vector3d sphere;
-  std::vector<RotaryAngles<double>> poses;          // the plannable poses
-  std::vector<std::size_t> pose_of;                 // per candidate
-  std::vector<std::vector<Eigen::Vector3d>> dirs;   // per candidate: its touches' directions
+  std::vector<RotaryAngles<double>> poses;         // the plannable poses
+  std::vector<std::size_t> pose_of;                // per candidate
+  std::vector<std::vector<Eigen::Vector3d>> dirs;  // per candidate: its touches' directions
   std::vector<Eigen::MatrixXd> info;
   std::vector<std::string> refused;
-  Eigen::VectorXd plausible, scale;  // per parameter; per location error (um of 2 sigma per mm or rad)
-  std::vector<bool> determinable;    // per location error
+  Eigen::VectorXd plausible,
+      scale;  // per parameter; per location error (um of 2 sigma per mm or rad)
+  std::vector<bool> determinable;  // per location error
 };
 
 // Fisher information of the touches of P, J^T J / sigma^2, and J.
@@ -50,13 +51,14 @@ Eigen::MatrixXd touch_jacobian(const ProbeDesignOptions& o, const ProbePattern& 
 
 // Touch by touch: each grid pose's contact directions that probe_moves accepts one by one.
 void touch_candidates(const ProbeDesignOptions& o, const ProbePattern& base, Candidates& c) {
-  for (const RotaryAngles<double>& pose : probe_design::pose_grid(o.machine, o.tilt_step_deg, o.rot_step_deg)) {
+  for (const RotaryAngles<double>& pose :
+       probe_design::pose_grid(o.machine, o.tilt_step_deg, o.rot_step_deg)) {
     ProbePattern one = base;
     one.poses_deg = {pose};
     std::string why;
     bool any = false;
-    for (const Eigen::Vector3d& n : probe_design::contact_directions(o.machine, pose, o.max_contact_angle_deg,
-                                                                      o.contact_step_deg)) {
+    for (const Eigen::Vector3d& n : probe_design::contact_directions(
+             o.machine, pose, o.max_contact_angle_deg, o.contact_step_deg)) {
       one.directions = {n};
       try {
         probe_moves(o.machine, one, o.program);
@@ -69,7 +71,8 @@ void touch_candidates(const ProbeDesignOptions& o, const ProbePattern& base, Can
       c.dirs.push_back({n});
     }
     if (!any)
-      c.refused.push_back("tilt " + fixed_text(pose.tilt, 1) + ", rotary " + fixed_text(pose.rot, 1) + " deg: " + why);
+      c.refused.push_back("tilt " + fixed_text(pose.tilt, 1) + ", rotary " +
+                          fixed_text(pose.rot, 1) + " deg: " + why);
   }
 }
 
@@ -83,7 +86,8 @@ Candidates candidates(const ProbeDesignOptions& o, const Eigen::Vector3d& sphere
     touch_candidates(o, P, c);
   } else {
     c.poses = plannable_poses(o.machine, P, o.tilt_step_deg, o.rot_step_deg, o.program, &c.refused);
-    for (std::size_t k = 0; k < c.poses.size(); ++k) c.pose_of.push_back(k), c.dirs.push_back(P.directions);
+    for (std::size_t k = 0; k < c.poses.size(); ++k)
+      c.pose_of.push_back(k), c.dirs.push_back(P.directions);
   }
   if (c.poses.empty())
     throw InvalidArgument("design probe: no candidate pose can be planned" +
@@ -111,18 +115,22 @@ Candidates candidates(const ProbeDesignOptions& o, const Eigen::Vector3d& sphere
   }
   const std::vector<std::string> units = c.layout.all.units();
   c.plausible.resize(p);
-  for (Eigen::Index j = 0; j < p; ++j) c.plausible[j] = plausible_magnitude(units[static_cast<std::size_t>(j)]);
+  for (Eigen::Index j = 0; j < p; ++j)
+    c.plausible[j] = plausible_magnitude(units[static_cast<std::size_t>(j)]);
   c.scale.resize(c.layout.errors.size);
   for (Eigen::Index j = 0; j < c.layout.errors.size; ++j)
-    c.scale[j] = 2.0 * 1e3 * (location_error_is_angle(static_cast<int>(j)) ? o.reference_radius_mm : 1.0);
+    c.scale[j] =
+        2.0 * 1e3 * (location_error_is_angle(static_cast<int>(j)) ? o.reference_radius_mm : 1.0);
   const Inverted every = invert_information(all, c.plausible, 1.0);
   for (Eigen::Index j = 0; j < c.layout.errors.size; ++j)
-    c.determinable.push_back(every.determined[static_cast<std::size_t>(c.layout.errors.offset + j)]);
+    c.determinable.push_back(
+        every.determined[static_cast<std::size_t>(c.layout.errors.offset + j)]);
   return c;
 }
 
 // A pattern's predicted uncertainty from its information I (at its touches).
-ProbeDesignCandidate judge(const ProbePattern& P, const Eigen::MatrixXd& I, const Candidates& c, int touches) {
+ProbeDesignCandidate judge(const ProbePattern& P, const Eigen::MatrixXd& I, const Candidates& c,
+                           int touches) {
   ProbeDesignCandidate out;
   out.pattern = P;
   out.touches = touches;
@@ -133,7 +141,8 @@ ProbeDesignCandidate judge(const ProbePattern& P, const Eigen::MatrixXd& I, cons
   std::string missing;
   for (Eigen::Index j = 0; j < c.layout.errors.size; ++j) {
     const std::string& name = out.names[static_cast<std::size_t>(c.layout.errors.offset + j)];
-    if (!c.determinable[static_cast<std::size_t>(j)]) out.undetermined.push_back(name);
+    if (!c.determinable[static_cast<std::size_t>(j)])
+      out.undetermined.push_back(name);
     else if (!inv.determined[static_cast<std::size_t>(c.layout.errors.offset + j)])
       missing += (missing.empty() ? "" : ", ") + name;
   }
@@ -148,7 +157,8 @@ ProbeDesignCandidate judge(const ProbePattern& P, const Eigen::MatrixXd& I, cons
 }
 
 // The pattern evaluated at `touches` (0: its own), after checking that it can be planned.
-ProbeDesignCandidate evaluate(const ProbePattern& P, const ProbeDesignOptions& o, const Candidates& c, int touches) {
+ProbeDesignCandidate evaluate(const ProbePattern& P, const ProbeDesignOptions& o,
+                              const Candidates& c, int touches) {
   ProbeDesignCandidate out;
   out.pattern = P;
   try {
@@ -171,13 +181,15 @@ void check(const ProbeDesignOptions& o) {
     throw InvalidArgument("design probe: --tilt-step must be in (0, 180] deg");
   if (!(o.rot_step_deg > 0.0 && o.rot_step_deg < 360.0))
     throw InvalidArgument("design probe: --rot-step must be in (0, 360) deg");
-  if (!(o.noise_um > 0.0) || !std::isfinite(o.noise_um)) throw InvalidArgument("design probe: --noise must be > 0 um");
+  if (!(o.noise_um > 0.0) || !std::isfinite(o.noise_um))
+    throw InvalidArgument("design probe: --noise must be > 0 um");
   if (!(o.reference_radius_mm > 0.0) || !std::isfinite(o.reference_radius_mm))
     throw InvalidArgument("design probe: the reference radius must be > 0 mm");
   if (!(o.sphere_diameter > 0.0) || !(o.stylus_diameter > 0.0))
     throw InvalidArgument("design probe: --sphere-diameter and --stylus-diameter must be > 0 mm");
   for (const Eigen::Vector3d& n : o.directions)
-    if (!(n.norm() > 0.0) || !n.allFinite()) throw InvalidArgument("design probe: a zero approach direction");
+    if (!(n.norm() > 0.0) || !n.allFinite())
+      throw InvalidArgument("design probe: a zero approach direction");
   if (!(o.max_contact_angle_deg > 0.0 && o.max_contact_angle_deg <= 90.0))
     throw InvalidArgument("design probe: --max-contact-angle must be in (0, 90] deg");
   if (!(o.contact_step_deg > 0.0 && o.contact_step_deg <= 90.0))
@@ -185,14 +197,15 @@ void check(const ProbeDesignOptions& o) {
   if (!(o.sphere_gain >= 0.0 && o.sphere_gain < 1.0))
     throw InvalidArgument("design probe: the sphere gain must be in [0, 1)");
   for (const Eigen::Vector3d& s : o.sphere_candidates)
-    if (!s.allFinite()) throw InvalidArgument("design probe: --sphere-candidates: a place that is not a number");
+    if (!s.allFinite())
+      throw InvalidArgument("design probe: --sphere-candidates: a place that is not a number");
 }
 
 // The designed pattern of `counts` runs of the candidates, in program order: by tilt, the rotary
 // angle back and forth (fewer turns). Touch by touch, a pose is visited once along the
 // directions of its chosen touches; else each run is a visit along the pattern's directions.
-ProbePattern designed_pattern(const ProbePattern& base, const Candidates& c, const std::vector<int>& counts,
-                              bool touch_by_touch) {
+ProbePattern designed_pattern(const ProbePattern& base, const Candidates& c,
+                              const std::vector<int>& counts, bool touch_by_touch) {
   std::vector<std::vector<Eigen::Vector3d>> dirs(c.poses.size());
   std::vector<int> visits(c.poses.size(), 0);
   for (std::size_t i = 0; i < counts.size(); ++i)
@@ -222,7 +235,8 @@ ProbePattern designed_pattern(const ProbePattern& base, const Candidates& c, con
 
 // The design at the sphere of candidates c: the engine's allocation of `touches`, checked as a
 // whole program.
-ProbeDesignCandidate design_at(const ProbeDesignOptions& o, const Candidates& c, int touches, int per_run) {
+ProbeDesignCandidate design_at(const ProbeDesignOptions& o, const Candidates& c, int touches,
+                               int per_run) {
   AllocationProblem ap;
   ap.candidates = c.info;
   ap.runs = touches / per_run;
@@ -234,7 +248,8 @@ ProbeDesignCandidate design_at(const ProbeDesignOptions& o, const Candidates& c,
   try {
     probe_moves(o.machine, best, o.program);
   } catch (const InvalidArgument& e) {
-    throw InvalidArgument(std::string("design probe: the designed poses cannot be planned together: ") + e.what());
+    throw InvalidArgument(
+        std::string("design probe: the designed poses cannot be planned together: ") + e.what());
   }
   Eigen::MatrixXd I = Eigen::MatrixXd::Zero(c.layout.size(), c.layout.size());
   for (std::size_t k = 0; k < c.info.size(); ++k) I += a.counts[k] * c.info[k];
@@ -243,7 +258,8 @@ ProbeDesignCandidate design_at(const ProbeDesignOptions& o, const Candidates& c,
 
 }  // namespace
 
-ProbeDesignCandidate evaluate_probe_pattern(const ProbePattern& pattern, const ProbeDesignOptions& o, int touches) {
+ProbeDesignCandidate evaluate_probe_pattern(const ProbePattern& pattern,
+                                            const ProbeDesignOptions& o, int touches) {
   check(o);
   return evaluate(pattern, o, candidates(o, o.sphere), touches);
 }
@@ -256,13 +272,13 @@ ProbeDesign design_probe_test(const ProbeDesignOptions& o) {
   const int K = o.touch_directions ? 1 : static_cast<int>(base.directions.size());
   out.touches = o.touches > 0 ? o.touches : static_cast<int>(base.touch_count());
   if (out.touches < K || out.touches % K != 0)
-    throw InvalidArgument("design probe: --touches " + std::to_string(out.touches) + " is not a multiple of the " +
-                          std::to_string(K) + " touches of a pose");
+    throw InvalidArgument("design probe: --touches " + std::to_string(out.touches) +
+                          " is not a multiple of the " + std::to_string(K) + " touches of a pose");
   out.baseline = evaluate(base, o, c0, out.touches);
   const auto infeasible = [&](const ProbeDesignCandidate& d) {
     return InvalidArgument("design probe: --touches " + std::to_string(out.touches) + " (" +
-                           std::to_string(out.touches / K) + (K == 1 ? " touches" : " poses") + "): " + d.why_not +
-                           "; give more touches");
+                           std::to_string(out.touches / K) + (K == 1 ? " touches" : " poses") +
+                           "): " + d.why_not + "; give more touches");
   };
   out.best = design_at(o, c0, out.touches, K);
   if (!out.best.feasible) throw infeasible(out.best);
@@ -290,8 +306,10 @@ ProbeDesign design_probe_test(const ProbeDesignOptions& o) {
   out.poses_tried = static_cast<int>(chosen->poses.size());
   out.touches_tried = static_cast<int>(chosen->info.size());
   const std::size_t shown = std::min<std::size_t>(chosen->refused.size(), 5);
-  out.refused.assign(chosen->refused.begin(), chosen->refused.begin() + static_cast<std::ptrdiff_t>(shown));
-  if (out.baseline.feasible) out.ratio = out.best.worst_expanded_um / out.baseline.worst_expanded_um;
+  out.refused.assign(chosen->refused.begin(),
+                     chosen->refused.begin() + static_cast<std::ptrdiff_t>(shown));
+  if (out.baseline.feasible)
+    out.ratio = out.best.worst_expanded_um / out.baseline.worst_expanded_um;
   return out;
 }
 

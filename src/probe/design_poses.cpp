@@ -25,7 +25,8 @@ std::vector<RotaryAngles<double>> pose_grid(MachineType m, double tilt_step, dou
   std::array<double, 2> r = {0.0, 360.0};
   const auto& rl = m.description().axis(m.rot_index()).limits_deg;
   if (rl) r = *rl;
-  for (int k = 0; r[0] + k * rot_step < r[1] - 1e-9 || (rl && r[0] + k * rot_step <= r[1] + 1e-9); ++k)
+  for (int k = 0; r[0] + k * rot_step < r[1] - 1e-9 || (rl && r[0] + k * rot_step <= r[1] + 1e-9);
+       ++k)
     rots.push_back(r[0] + k * rot_step);
   std::vector<RotaryAngles<double>> out;
   for (double tilt : tilts)
@@ -45,14 +46,16 @@ std::vector<Eigen::Vector3d> contact_directions(MachineType m, const RotaryAngle
   for (double th : polar)
     for (int k = 0; k < (th > 0.0 ? 8 : 1); ++k) {
       const double phi = 45.0 * k * kDeg, t = th * kDeg;
-      const Eigen::Vector3d contact(std::sin(t) * std::cos(phi), std::sin(t) * std::sin(phi), std::cos(t));
+      const Eigen::Vector3d contact(std::sin(t) * std::cos(phi), std::sin(t) * std::sin(phi),
+                                    std::cos(t));
       out.push_back(-(R * contact));  // the stylus moves against the contact normal
     }
   return out;
 }
 
-std::vector<RotaryAngles<double>> plannable_poses(MachineType m, const ProbePattern& P, double tilt_step,
-                                                  double rot_step, const ProbeProgramOptions& program,
+std::vector<RotaryAngles<double>> plannable_poses(MachineType m, const ProbePattern& P,
+                                                  double tilt_step, double rot_step,
+                                                  const ProbeProgramOptions& program,
                                                   std::vector<std::string>* refused) {
   std::vector<RotaryAngles<double>> out;
   for (const RotaryAngles<double>& pose : pose_grid(m, tilt_step, rot_step)) {
@@ -63,8 +66,8 @@ std::vector<RotaryAngles<double>> plannable_poses(MachineType m, const ProbePatt
       out.push_back(pose);
     } catch (const InvalidArgument& e) {
       if (refused)
-        refused->push_back("tilt " + fixed_text(pose.tilt, 1) + ", rotary " + fixed_text(pose.rot, 1) +
-                           " deg: " + e.what());
+        refused->push_back("tilt " + fixed_text(pose.tilt, 1) + ", rotary " +
+                           fixed_text(pose.rot, 1) + " deg: " + e.what());
     }
   }
   return out;

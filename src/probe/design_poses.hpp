@@ -31,8 +31,9 @@ std::vector<Eigen::Vector3d> contact_directions(MachineType m, const RotaryAngle
 /// Poses of the grid (tilt over tilt_range every tilt_step, the rotary axis over a full turn or
 /// its limits every rot_step) that probe_moves accepts one by one with P's sphere and
 /// directions; the others' reasons in `refused` (when given).
-std::vector<RotaryAngles<double>> plannable_poses(MachineType m, const ProbePattern& P, double tilt_step,
-                                                  double rot_step, const ProbeProgramOptions& program,
+std::vector<RotaryAngles<double>> plannable_poses(MachineType m, const ProbePattern& P,
+                                                  double tilt_step, double rot_step,
+                                                  const ProbeProgramOptions& program,
                                                   std::vector<std::string>* refused);
 
 /// The commanded touches of P on the nominal machine (no errors, no noise), times from t0.

@@ -21,21 +21,24 @@ struct PoseSet {
 
 // A C sweep at each tilt, a tilt sweep at each rotary angle, and each pose alone.
 std::vector<PoseSet> pose_sets(MachineType m, const std::vector<RotaryAngles<double>>& grid) {
-  const char tilt = m.description().axis(m.tilt_index()).name, rot = m.description().axis(m.rot_index()).name;
+  const char tilt = m.description().axis(m.tilt_index()).name,
+             rot = m.description().axis(m.rot_index()).name;
   std::map<double, std::vector<RotaryAngles<double>>> by_tilt, by_rot;
-  for (const RotaryAngles<double>& a : grid) by_tilt[a.tilt].push_back(a), by_rot[a.rot].push_back(a);
+  for (const RotaryAngles<double>& a : grid)
+    by_tilt[a.tilt].push_back(a), by_rot[a.rot].push_back(a);
   std::vector<PoseSet> out;
   for (const auto& [t, poses] : by_tilt)
     if (poses.size() > 1)
-      out.push_back({poses, std::string(1, rot) + " sweep at " + tilt + " " + fixed_text(t, 0) + " deg (" +
-                                std::to_string(poses.size()) + " poses)"});
+      out.push_back({poses, std::string(1, rot) + " sweep at " + tilt + " " + fixed_text(t, 0) +
+                                " deg (" + std::to_string(poses.size()) + " poses)"});
   for (const auto& [r, poses] : by_rot)
     if (poses.size() > 1)
-      out.push_back({poses, std::string(1, tilt) + " sweep at " + rot + " " + fixed_text(r, 0) + " deg (" +
-                                std::to_string(poses.size()) + " poses)"});
+      out.push_back({poses, std::string(1, tilt) + " sweep at " + rot + " " + fixed_text(r, 0) +
+                                " deg (" + std::to_string(poses.size()) + " poses)"});
   for (const RotaryAngles<double>& a : grid)
-    out.push_back({{a}, std::string("the pose ") + tilt + " " + fixed_text(a.tilt, 0) + ", " + rot + " " +
-                            fixed_text(a.rot, 0) + " deg"});
+    out.push_back({{a},
+                   std::string("the pose ") + tilt + " " + fixed_text(a.tilt, 0) + ", " + rot +
+                       " " + fixed_text(a.rot, 0) + " deg"});
   return out;
 }
 
@@ -49,7 +52,8 @@ double session_pose_time(const ProbeSession& s) {
   return dt.empty() || !(dt[dt.size() / 2] > 0.0) ? ProbePattern{}.pose_dt_s : dt[dt.size() / 2];
 }
 
-void check_separation_inputs(const ProbeSession& session, const std::vector<Effect>& pair, const ProbeSeparationOptions& o) {
+void check_separation_inputs(const ProbeSession& session, const std::vector<Effect>& pair,
+                             const ProbeSeparationOptions& o) {
   if (pair.size() != 2 || pair[0] == pair[1])
     throw InvalidArgument("design probe: --separate needs two different effects (EFFECT,EFFECT)");
   for (const Effect& f : pair) {
@@ -60,7 +64,8 @@ void check_separation_inputs(const ProbeSession& session, const std::vector<Effe
       throw InvalidArgument("design probe: --separate: " + f.id() +
                             " depends on the motion; the touch probe reads the machine at rest");
   }
-  if (session.samples.empty()) throw InvalidArgument("design probe: --after: the session has no touches");
+  if (session.samples.empty())
+    throw InvalidArgument("design probe: --after: the session has no touches");
   if (!(o.tilt_step_deg > 0.0 && o.tilt_step_deg <= 180.0))
     throw InvalidArgument("design probe: --tilt-step must be in (0, 180] deg");
   if (!(o.rot_step_deg > 0.0 && o.rot_step_deg < 360.0))
@@ -69,15 +74,18 @@ void check_separation_inputs(const ProbeSession& session, const std::vector<Effe
     throw InvalidArgument("design probe: --max-time must be > 0 s");
   if (!(o.max_correlation > 0.0 && o.max_correlation < 1.0))
     throw InvalidArgument("design probe: --max-correlation must be in (0, 1)");
-  if (!(o.noise_um >= 0.0) || !std::isfinite(o.noise_um)) throw InvalidArgument("design probe: --noise must be >= 0 um");
+  if (!(o.noise_um >= 0.0) || !std::isfinite(o.noise_um))
+    throw InvalidArgument("design probe: --noise must be >= 0 um");
   if (!(o.pose_time_s >= 0.0) || !std::isfinite(o.pose_time_s))
     throw InvalidArgument("design probe: --pose-time must be >= 0 s");
-  if (!(o.reference_radius_mm > 0.0)) throw InvalidArgument("design probe: the reference radius must be > 0 mm");
+  if (!(o.reference_radius_mm > 0.0))
+    throw InvalidArgument("design probe: the reference radius must be > 0 mm");
 }
 
 }  // namespace
 
-ProbeSeparationDesign design_probe_separation(const ProbeSession& session, const std::vector<Effect>& pair,
+ProbeSeparationDesign design_probe_separation(const ProbeSession& session,
+                                              const std::vector<Effect>& pair,
                                               const ProbeSeparationOptions& o) {
   check_separation_inputs(session, pair, o);
   const MachineType m = session.machine;
@@ -85,10 +93,11 @@ ProbeSeparationDesign design_probe_separation(const ProbeSession& session, const
   D.effects = {pair[0].id(), pair[1].id()};
   EffectModel fx;
   fx.effects = pair;
-  fx = centred_on(fx, session.samples);  // one linear-axis reference for the session and the added touches
+  fx = centred_on(
+      fx, session.samples);  // one linear-axis reference for the session and the added touches
   const double t_end = session.samples.back().time;
-  D.motion = table_motion_overlap(m, pair[0], pair[1], probe_design::tilt_range(m), t_end + o.max_added_time_s,
-                                  o.reference_radius_mm);
+  D.motion = table_motion_overlap(m, pair[0], pair[1], probe_design::tilt_range(m),
+                                  t_end + o.max_added_time_s, o.reference_radius_mm);
 
   // The session's information: the probe problem with the pair at the fit's start point, over
   // the white fit's sigma (residuals over n - p: with 120 touches and 19 parameters the noise
@@ -98,14 +107,16 @@ ProbeSeparationDesign design_probe_separation(const ProbeSession& session, const
   fo.effects = fx;
   fo.noise.noise = NoiseHandling::white;
   const ProbeIdentification id = identify_probe(session, fo);
-  const double w = session_weight(o.noise_um > 0.0 ? o.noise_um : id.sigma_um, id.noise, id.sigma_um,
-                                  "design probe: --after: the session's residuals are zero (commanded touches?); "
-                                  "give --noise", D);
+  const double w = session_weight(
+      o.noise_um > 0.0 ? o.noise_um : id.sigma_um, id.noise, id.sigma_um,
+      "design probe: --after: the session's residuals are zero (commanded touches?); "
+      "give --noise",
+      D);
   const ProbeParameterLayout L = ProbeParameterLayout::make(m, fx);
   D.names = L.all.names();
-  const SeparationProblem S =
-      separation_problem(probe_design::start_jacobian(session, fx), w, L.all, effect_block(L.effects, fx, 0),
-                         effect_block(L.effects, fx, 1), o.max_correlation, o.max_added_time_s, D);
+  const SeparationProblem S = separation_problem(
+      probe_design::start_jacobian(session, fx), w, L.all, effect_block(L.effects, fx, 0),
+      effect_block(L.effects, fx, 1), o.max_correlation, o.max_added_time_s, D);
   const bool search = separation_needed(S, D);
   D.chosen.correlation = D.correlation_before;
   if (!search) return D;
@@ -116,11 +127,13 @@ ProbeSeparationDesign design_probe_separation(const ProbeSession& session, const
   base.sphere_diameter = session.sphere_diameter;
   base.stylus_diameter = session.stylus_diameter;
   base.directions.clear();
-  for (std::size_t i : session.indices_of(session.poses().front())) base.directions.push_back(session.samples[i].n);
+  for (std::size_t i : session.indices_of(session.poses().front()))
+    base.directions.push_back(session.samples[i].n);
   base.pose_dt_s = o.pose_time_s > 0.0 ? o.pose_time_s : session_pose_time(session);
   base.touch_dt_s = base.pose_dt_s / static_cast<double>(base.directions.size() + 1);
-  const std::vector<PoseSet> sets =
-      pose_sets(m, probe_design::plannable_poses(m, base, o.tilt_step_deg, o.rot_step_deg, o.program, nullptr));
+  const std::vector<PoseSet> sets = pose_sets(
+      m,
+      probe_design::plannable_poses(m, base, o.tilt_step_deg, o.rot_step_deg, o.program, nullptr));
   std::vector<AddedInformation> added;
   std::vector<std::size_t> set_of;
   for (std::size_t k = 0; k < sets.size(); ++k) {
@@ -133,7 +146,8 @@ ProbeSeparationDesign design_probe_separation(const ProbeSession& session, const
     } catch (const InvalidArgument&) {
       continue;
     }
-    const Eigen::MatrixXd J = probe_design::start_jacobian(probe_design::nominal_touches(m, P, t_end + base.pose_dt_s), fx);
+    const Eigen::MatrixXd J = probe_design::start_jacobian(
+        probe_design::nominal_touches(m, P, t_end + base.pose_dt_s), fx);
     added.push_back({duration, J.transpose() * J * w, true});
     set_of.push_back(k);
   }
@@ -147,14 +161,16 @@ ProbeSeparationDesign design_probe_separation(const ProbeSession& session, const
     chosen.repeats = c.repeats;
     chosen.correlation = c.correlation;
     chosen.determined = c.determined;
-    chosen.description = sets[set_of[c.index]].description + ", " + fixed_text(base.pose_dt_s, 0) + " s per pose" +
-                         (c.repeats > 1.0 ? ", run " + fixed_text(c.repeats, 0) + " times" : std::string());
+    chosen.description =
+        sets[set_of[c.index]].description + ", " + fixed_text(base.pose_dt_s, 0) + " s per pose" +
+        (c.repeats > 1.0 ? ", run " + fixed_text(c.repeats, 0) + " times" : std::string());
   }
   SeparationWording wording;
   wording.added = "added pose sets";
   wording.seen_by = " of these poses";
   wording.closest_note = ": another instrument or a second sphere position may";
-  finish_separation(S, c, D.chosen.description, D.chosen.duration_s * D.chosen.repeats, {}, wording, D);
+  finish_separation(S, c, D.chosen.description, D.chosen.duration_s * D.chosen.repeats, {}, wording,
+                    D);
   return D;
 }
 

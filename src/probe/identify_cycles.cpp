@@ -27,7 +27,8 @@ std::vector<PoseCentre> pose_centres(const ProbeSession& s, const ProbeCyclesOpt
   for (const std::string& pose : s.poses()) {
     const std::vector<std::size_t> idx = s.indices_of(pose);
     Points3 P(static_cast<Eigen::Index>(idx.size()), 3);
-    for (std::size_t k = 0; k < idx.size(); ++k) P.row(static_cast<Eigen::Index>(k)) = s.samples[idx[k]].xyz;
+    for (std::size_t k = 0; k < idx.size(); ++k)
+      P.row(static_cast<Eigen::Index>(k)) = s.samples[idx[k]].xyz;
     SphereFitOptions so;
     if (o.radius_known) so.radius = s.trigger_radius();
     try {
@@ -42,9 +43,9 @@ std::vector<PoseCentre> pose_centres(const ProbeSession& s, const ProbeCyclesOpt
 }
 
 struct AxisFit {
-  Eigen::Vector3d direction;  // unit, towards the nominal direction
-  Eigen::Vector3d point;      // circle centre, on the axis line
-  double dispersion_sq = 0.0; // sum of squared distances of the centres from the circle
+  Eigen::Vector3d direction;   // unit, towards the nominal direction
+  Eigen::Vector3d point;       // circle centre, on the axis line
+  double dispersion_sq = 0.0;  // sum of squared distances of the centres from the circle
   int n = 0;
 };
 
@@ -58,8 +59,9 @@ AxisFit fit_axis(MachineType m, int k, const std::vector<PoseCentre>& centres) {
     if (std::abs(chain_angle(m, c.angles_deg, other)) < 1e-9) pts.push_back(c.centre);
   const std::string what = std::string("identify_probe_cycles: axis ") + a.name;
   if (pts.size() < 3)
-    throw DegenerateGeometry(what + ": " + std::to_string(pts.size()) + " poses turn it alone (with " +
-                             m.description().axis(other).name + " at 0); the cycles need at least 3");
+    throw DegenerateGeometry(what + ": " + std::to_string(pts.size()) +
+                             " poses turn it alone (with " + m.description().axis(other).name +
+                             " at 0); the cycles need at least 3");
   Points3 P(static_cast<Eigen::Index>(pts.size()), 3);
   for (std::size_t i = 0; i < pts.size(); ++i) P.row(static_cast<Eigen::Index>(i)) = pts[i];
   const PlaneFit plane = svd_plane_fit(P, a.direction, 0.0, what);
@@ -107,9 +109,10 @@ ProbeIdentification identify_probe_cycles(const ProbeSession& s, const ProbeCycl
   const MachineType m = s.machine;
   const MachineDescription& d = m.description();
   if (d.has_head() || d.table_axes.size() != 2)
-    throw InvalidArgument("identify_probe_cycles: " + to_string(m) +
-                          ": the cycles' method measures two table axes; use identify_probe (the joint fit) on "
-                          "a machine with head axes");
+    throw InvalidArgument(
+        "identify_probe_cycles: " + to_string(m) +
+        ": the cycles' method measures two table axes; use identify_probe (the joint fit) on "
+        "a machine with head axes");
   const std::vector<PoseCentre> centres = pose_centres(s, o);
   ProbeIdentification out;
   out.method = "cycles";
@@ -126,7 +129,8 @@ ProbeIdentification identify_probe_cycles(const ProbeSession& s, const ProbeCycl
   const auto& names = location_error_names(m);
   for (int k = 0; k < 8; ++k)
     out.parameters.push_back({names[static_cast<std::size_t>(k)], out.model.errors.v[k],
-                              std::numeric_limits<double>::quiet_NaN(), location_error_is_angle(k) ? "rad" : "mm", true});
+                              std::numeric_limits<double>::quiet_NaN(),
+                              location_error_is_angle(k) ? "rad" : "mm", true});
   // The sphere on the table: each pose's centre taken back by the identified table motion.
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   for (const PoseCentre& c : centres) {
@@ -146,10 +150,11 @@ ProbeIdentification identify_probe_cycles(const ProbeSession& s, const ProbeCycl
   out.residual_rms_um = std::sqrt(ss / std::max<std::size_t>(1, out.residuals.size())) * 1e3;
   out.n_samples = s.samples.size();
   out.converged = true;
-  out.notes.push_back(std::string("cycles' method: sphere per pose (radius ") +
-                      (o.radius_known ? "known" : "free") +
-                      "), plane and circle of the centres per table axis; no uncertainty (std NaN), the "
-                      "dispersion of the centres about the circles instead");
+  out.notes.push_back(
+      std::string("cycles' method: sphere per pose (radius ") +
+      (o.radius_known ? "known" : "free") +
+      "), plane and circle of the centres per table axis; no uncertainty (std NaN), the "
+      "dispersion of the centres about the circles instead");
   return out;
 }
 

@@ -18,7 +18,8 @@ ProbeIdentification identify_probe(const ProbeSession& session, const ProbeFitOp
   const ProbeParameterLayout& L = problem.layout();
   if (problem.num_residuals() <= problem.num_parameters())
     throw InvalidArgument("identify_probe: session: " + std::to_string(problem.num_residuals()) +
-                          " touches cannot determine " + std::to_string(problem.num_parameters()) + " unknowns");
+                          " touches cannot determine " + std::to_string(problem.num_parameters()) +
+                          " unknowns");
   JointFitSettings settings;
   settings.max_iterations = options.max_iterations;
   settings.observability_min_chi2 = options.observability_min_chi2;
@@ -26,8 +27,8 @@ ProbeIdentification identify_probe(const ProbeSession& session, const ProbeFitOp
   settings.whitener = options.whitener;
   const std::vector<FitParameter> parameters = problem.parameters();
   NoiseFit nf = fit_with_noise(
-      [&](const JointFitSettings& s) { return solve_with_time_constants(problem, parameters, s); }, settings, problem.groups(),
-      problem.times(), options.noise);
+      [&](const JointFitSettings& s) { return solve_with_time_constants(problem, parameters, s); },
+      settings, problem.groups(), problem.times(), options.noise);
   JointFitOutcome& fit = nf.fit;
 
   ProbeIdentification out;
@@ -46,7 +47,8 @@ ProbeIdentification identify_probe(const ProbeSession& session, const ProbeFitOp
   out.residual_rms_um = std::sqrt(fit.residuals.squaredNorm() / n) * 1e3;
   out.sigma_um = std::sqrt(fit.residual_variance) * 1e3;
   if (settings.whitener || nf.refit)  // the noise level the covariance rests on
-    out.sigma_um = std::sqrt(fit.residuals.squaredNorm() / std::max(1.0, n - fit.summary.num_free)) * 1e3;
+    out.sigma_um =
+        std::sqrt(fit.residuals.squaredNorm() / std::max(1.0, n - fit.summary.num_free)) * 1e3;
   out.covariance = std::move(fit.covariance);
   out.jacobian = std::move(fit.jacobian);
   for (bool f : fit.free) out.fixed.push_back(!f);
@@ -56,12 +58,14 @@ ProbeIdentification identify_probe(const ProbeSession& session, const ProbeFitOp
   out.noise = std::move(nf.noise);
   out.noise_refit = nf.refit;
   out.noise_correction = nf.scale;
-  out.notes.push_back("calibrated trigger radius (sphere_diameter + stylus_diameter) / 2 = " +
-                      std::to_string(session.trigger_radius()) +
-                      " mm taken as given; a wrong stylus radius is the diagnosis' stylus_radius_offset");
+  out.notes.push_back(
+      "calibrated trigger radius (sphere_diameter + stylus_diameter) / 2 = " +
+      std::to_string(session.trigger_radius()) +
+      " mm taken as given; a wrong stylus radius is the diagnosis' stylus_radius_offset");
   if (nf.refit)
     out.notes.push_back("correlated noise (" + out.noise.summary() +
-                        "): covariance by GLS under this AR model, scaled by " + std::to_string(nf.scale) +
+                        "): covariance by GLS under this AR model, scaled by " +
+                        std::to_string(nf.scale) +
                         " for the correlation the fit absorbs from its residuals");
   if (!out.converged) out.notes.push_back("the fit did not converge: " + fit.summary.message);
   return out;

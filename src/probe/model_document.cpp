@@ -8,19 +8,25 @@
 
 namespace rotacal {
 
-FittedModelContent probe_model_content(const ProbeIdentification& ident, const std::string& session_name) {
+FittedModelContent probe_model_content(const ProbeIdentification& ident,
+                                       const std::string& session_name) {
   if (ident.method != "joint")
-    throw InvalidArgument("probe_model_content: the " + ident.method +
-                          " method gives no uncertainty or covariance; a model file holds the joint fit");
+    throw InvalidArgument(
+        "probe_model_content: the " + ident.method +
+        " method gives no uncertainty or covariance; a model file holds the joint fit");
   const std::size_t n = ident.parameters.size();
-  if (ident.covariance.rows() != static_cast<Eigen::Index>(n) || ident.covariance.cols() != static_cast<Eigen::Index>(n))
-    throw InvalidArgument("probe_model_content: the covariance is not " + std::to_string(n) + " x " + std::to_string(n));
+  if (ident.covariance.rows() != static_cast<Eigen::Index>(n) ||
+      ident.covariance.cols() != static_cast<Eigen::Index>(n))
+    throw InvalidArgument("probe_model_content: the covariance is not " + std::to_string(n) +
+                          " x " + std::to_string(n));
   FittedModelContent c;
   c.kind = "probe";
   c.machine = ident.model.machine;
   c.effects = ident.model.effects;
-  for (const std::string& name : location_error_names(c.machine)) c.location_errors.push_back(ident.parameter(name));
-  std::set<std::string> shared(location_error_names(c.machine).begin(), location_error_names(c.machine).end());
+  for (const std::string& name : location_error_names(c.machine))
+    c.location_errors.push_back(ident.parameter(name));
+  std::set<std::string> shared(location_error_names(c.machine).begin(),
+                               location_error_names(c.machine).end());
   for (const Effect& f : c.effects.effects)
     for (std::size_t k = 0; k < f.param_names().size(); ++k) {
       c.effect_parameters.push_back(ident.parameter(effect_parameter_name(f, k)));
@@ -47,7 +53,8 @@ FittedModelContent probe_model_content(const ProbeIdentification& ident, const s
   return c;
 }
 
-nlohmann::ordered_json probe_model_document(const ProbeIdentification& ident, const std::string& session_name) {
+nlohmann::ordered_json probe_model_document(const ProbeIdentification& ident,
+                                            const std::string& session_name) {
   return fitted_model_document(probe_model_content(ident, session_name));
 }
 

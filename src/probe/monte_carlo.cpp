@@ -24,20 +24,25 @@ ProbeMonteCarlo monte_carlo_probe(const ProbeSession& session, const ProbeIdenti
                                   const ProbeMonteCarloOptions& o) {
   if (result.method != "joint" || result.model.machine != session.machine ||
       result.n_samples != session.samples.size())
-    throw InvalidArgument("monte_carlo_probe: result is not a joint fit of this session (method " + result.method +
-                          ", " + std::to_string(result.n_samples) + " touches)");
-  if (o.draws < 2) throw InvalidArgument("monte_carlo_probe: draws must be at least 2, got " + std::to_string(o.draws));
+    throw InvalidArgument("monte_carlo_probe: result is not a joint fit of this session (method " +
+                          result.method + ", " + std::to_string(result.n_samples) + " touches)");
+  if (o.draws < 2)
+    throw InvalidArgument("monte_carlo_probe: draws must be at least 2, got " +
+                          std::to_string(o.draws));
   // The identified machine, and how each touch's residual changes as the touch moves along its
   // direction (a forward difference; the residual is linear in the shift over micrometres).
   const EffectModel& fx = result.model.effects;  // centred on this session by the fit
   Eigen::VectorXd x(static_cast<Eigen::Index>(result.parameters.size()));
-  for (std::size_t j = 0; j < result.parameters.size(); ++j) x[static_cast<Eigen::Index>(j)] = result.parameters[j].value;
+  for (std::size_t j = 0; j < result.parameters.size(); ++j)
+    x[static_cast<Eigen::Index>(j)] = result.parameters[j].value;
   const Eigen::Index n = static_cast<Eigen::Index>(session.samples.size());
   const Eigen::VectorXd r0 = ProbeProblem(session, fx).residuals(x);
   const double h = 1e-4;  // mm
-  const Eigen::VectorXd slope = (ProbeProblem(moved(session, Eigen::VectorXd::Constant(n, h)), fx).residuals(x) - r0) / h;
+  const Eigen::VectorXd slope =
+      (ProbeProblem(moved(session, Eigen::VectorXd::Constant(n, h)), fx).residuals(x) - r0) / h;
   if (!(slope.array().abs() > 0.1).all())
-    throw InvalidArgument("monte_carlo_probe: a touch's residual does not change along its approach direction");
+    throw InvalidArgument(
+        "monte_carlo_probe: a touch's residual does not change along its approach direction");
 
   ProbeMonteCarlo out;
   out.draws = o.draws;
@@ -49,11 +54,13 @@ ProbeMonteCarlo monte_carlo_probe(const ProbeSession& session, const ProbeIdenti
   fit.noise.noise = o.noise;
   out.values.resize(o.draws, static_cast<Eigen::Index>(result.parameters.size()));
   for (int k = 0; k < o.draws; ++k) {
-    const Eigen::VectorXd e = monte_carlo_noise(coloured, result.noise, result.sigma_um, n, o.seed, k);
+    const Eigen::VectorXd e =
+        monte_carlo_noise(coloured, result.noise, result.sigma_um, n, o.seed, k);
     // Each touch where the identified machine leaves the drawn noise as its residual.
     const ProbeSession draw = moved(session, ((e - r0).array() / slope.array()).matrix());
     const ProbeIdentification r = identify_probe(draw, fit);
-    for (std::size_t j = 0; j < r.parameters.size(); ++j) out.values(k, static_cast<Eigen::Index>(j)) = r.parameters[j].value;
+    for (std::size_t j = 0; j < r.parameters.size(); ++j)
+      out.values(k, static_cast<Eigen::Index>(j)) = r.parameters[j].value;
     if (o.progress) o.progress(k + 1, o.draws);
   }
   out.parameters = monte_carlo_summary(result.parameters, out.values);

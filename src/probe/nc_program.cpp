@@ -26,9 +26,10 @@ void check_limits(MachineType m, const RotaryAngles<double>& a_deg, int pose) {
     const RotaryAxis& ax = m.description().axis(k);
     const double v = k == m.rot_index() ? a_deg.rot : a_deg.tilt;
     if (ax.limits_deg && (v < (*ax.limits_deg)[0] - 1e-9 || v > (*ax.limits_deg)[1] + 1e-9))
-      throw InvalidArgument("plan probe: pose " + std::to_string(pose) + ": " + std::string(1, ax.name) + " " +
-                            nc_detail::general(v) + " deg is outside the axis limits " +
-                            nc_detail::general((*ax.limits_deg)[0]) + ".." + nc_detail::general((*ax.limits_deg)[1]));
+      throw InvalidArgument(
+          "plan probe: pose " + std::to_string(pose) + ": " + std::string(1, ax.name) + " " +
+          nc_detail::general(v) + " deg is outside the axis limits " +
+          nc_detail::general((*ax.limits_deg)[0]) + ".." + nc_detail::general((*ax.limits_deg)[1]));
   }
 }
 
@@ -37,13 +38,14 @@ void check_travel(MachineType m, const Eigen::Vector3d& p, const std::string& wh
   if (!t) return;
   for (int k = 0; k < 3; ++k)
     if (p[k] < (*t)(k, 0) - 1e-9 || p[k] > (*t)(k, 1) + 1e-9)
-      throw InvalidArgument("plan probe: " + what + ": " + std::string(1, "XYZ"[k]) + " " + nc_detail::general(p[k]) +
-                            " mm is outside the travel " + nc_detail::general((*t)(k, 0)) + ".." +
-                            nc_detail::general((*t)(k, 1)));
+      throw InvalidArgument("plan probe: " + what + ": " + std::string(1, "XYZ"[k]) + " " +
+                            nc_detail::general(p[k]) + " mm is outside the travel " +
+                            nc_detail::general((*t)(k, 0)) + ".." + nc_detail::general((*t)(k, 1)));
 }
 
 // Distance from c to the segment [a, b].
-double distance_to_segment(const Eigen::Vector3d& c, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+double distance_to_segment(const Eigen::Vector3d& c, const Eigen::Vector3d& a,
+                           const Eigen::Vector3d& b) {
   const Eigen::Vector3d ab = b - a;
   const double L2 = ab.squaredNorm();
   const double t = L2 > 0.0 ? std::clamp((c - a).dot(ab) / L2, 0.0, 1.0) : 0.0;
@@ -52,16 +54,19 @@ double distance_to_segment(const Eigen::Vector3d& c, const Eigen::Vector3d& a, c
 
 }  // namespace
 
-std::vector<ProbeMove> probe_moves(MachineType m, const ProbePattern& P, const ProbeProgramOptions& o,
-                                   double* retract_z) {
+std::vector<ProbeMove> probe_moves(MachineType m, const ProbePattern& P,
+                                   const ProbeProgramOptions& o, double* retract_z) {
   const double r = 0.5 * (P.sphere_diameter + P.stylus_diameter);
-  require_program(P.sphere_diameter > 0.0 && P.stylus_diameter > 0.0, "sphere and stylus diameters must be > 0");
+  require_program(P.sphere_diameter > 0.0 && P.stylus_diameter > 0.0,
+                  "sphere and stylus diameters must be > 0");
   require_program(!P.poses_deg.empty() && (!P.directions.empty() || !P.pose_directions.empty()),
                   "the pattern has no poses or no directions");
   require_program(P.pose_directions.empty() || P.pose_directions.size() == P.poses_deg.size(),
                   "the per-pose directions must hold one list per pose");
-  require_program(o.approach_mm > 0.0 && o.clearance_mm > 0.0, "approach and clearance must be > 0 mm");
-  require_program(o.overtravel_mm > 0.0 && o.overtravel_mm < r, "overtravel must be in (0, " + nc_detail::general(r) + ") mm");
+  require_program(o.approach_mm > 0.0 && o.clearance_mm > 0.0,
+                  "approach and clearance must be > 0 mm");
+  require_program(o.overtravel_mm > 0.0 && o.overtravel_mm < r,
+                  "overtravel must be in (0, " + nc_detail::general(r) + ") mm");
   require_program(o.probe_feed_mm_per_min > 0.0 && o.feed_mm_per_min > 0.0, "feeds must be > 0");
   std::vector<ProbeMove> out;
   std::vector<Eigen::Vector3d> centres;
@@ -70,7 +75,8 @@ std::vector<ProbeMove> probe_moves(MachineType m, const ProbePattern& P, const P
     const int pose = static_cast<int>(k) + 1;
     check_limits(m, P.poses_deg[k], pose);
     const RotaryAngles<double> a{P.poses_deg[k].tilt * kDeg, P.poses_deg[k].rot * kDeg};
-    const Eigen::Vector3d c = inverse(m, LocationErrors<double>(), a, P.sphere).xyz;  // as simulate_probe
+    const Eigen::Vector3d c =
+        inverse(m, LocationErrors<double>(), a, P.sphere).xyz;  // as simulate_probe
     top = std::max(top, c.z() + r);
     const std::vector<Eigen::Vector3d>& dirs = P.directions_at(k);
     require_program(!dirs.empty(), "pose " + std::to_string(pose) + " has no approach direction");
@@ -92,31 +98,38 @@ std::vector<ProbeMove> probe_moves(MachineType m, const ProbePattern& P, const P
   for (std::size_t k = 1; k < P.poses_deg.size(); ++k) {
     const RotaryAngles<double>& a0 = P.poses_deg[k - 1];
     const RotaryAngles<double>& a1 = P.poses_deg[k];
-    const int steps = 1 + static_cast<int>(2.0 * std::max(std::abs(a1.tilt - a0.tilt), std::abs(a1.rot - a0.rot)));
+    const int steps = 1 + static_cast<int>(2.0 * std::max(std::abs(a1.tilt - a0.tilt),
+                                                          std::abs(a1.rot - a0.rot)));
     for (int i = 1; i < steps; ++i) {
       const double f = static_cast<double>(i) / steps;
-      const RotaryAngles<double> a{(a0.tilt + f * (a1.tilt - a0.tilt)) * kDeg, (a0.rot + f * (a1.rot - a0.rot)) * kDeg};
+      const RotaryAngles<double> a{(a0.tilt + f * (a1.tilt - a0.tilt)) * kDeg,
+                                   (a0.rot + f * (a1.rot - a0.rot)) * kDeg};
       top = std::max(top, inverse(m, LocationErrors<double>(), a, P.sphere).xyz.z() + r);
     }
   }
   const double z = top + o.clearance_mm;
   for (std::size_t i = 0; i < out.size(); ++i) {
     const ProbeMove& mv = out[i];
-    const std::string where = "pose " + std::to_string(mv.pose) + ", touch " + std::to_string(mv.touch);
+    const std::string where =
+        "pose " + std::to_string(mv.pose) + ", touch " + std::to_string(mv.touch);
     const Eigen::Vector3d above(mv.start.x(), mv.start.y(), z);
     if (distance_to_segment(centres[i], mv.start, above) <= r)
-      throw InvalidArgument("plan probe: " + where + ": the way up from the start of the touch passes through "
-                            "the sphere (approach along this direction from farther out, or from above)");
+      throw InvalidArgument(
+          "plan probe: " + where +
+          ": the way up from the start of the touch passes through "
+          "the sphere (approach along this direction from farther out, or from above)");
     for (const Eigen::Vector3d& p : {mv.start, mv.target, above}) check_travel(m, p, where);
   }
   if (retract_z) *retract_z = z;
   return out;
 }
 
-std::string write_probe_nc_program(MachineType m, const ProbePattern& P, NcDialect d, const ProbeProgramOptions& o) {
+std::string write_probe_nc_program(MachineType m, const ProbePattern& P, NcDialect d,
+                                   const ProbeProgramOptions& o) {
   if (d != NcDialect::linuxcnc)
-    throw InvalidArgument("plan probe: no checkable probing words are implemented for the " + to_string(d) +
-                          " dialect (its probing cycles cannot be checked without its controller); use linuxcnc");
+    throw InvalidArgument(
+        "plan probe: no checkable probing words are implemented for the " + to_string(d) +
+        " dialect (its probing cycles cannot be checked without its controller); use linuxcnc");
   double z = 0.0;
   const std::vector<ProbeMove> moves = probe_moves(m, P, o, &z);
   std::vector<std::string> lines;
@@ -129,21 +142,27 @@ std::string write_probe_nc_program(MachineType m, const ProbePattern& P, NcDiale
   NcProgramOptions nc;
   nc.decimals = o.decimals;
   nc.tool = o.tool;
-  nc_detail::Preamble pre{"write_probe_nc_program", "probing program", "ROTACAL PROBE", m.has_head()};
+  nc_detail::Preamble pre{"write_probe_nc_program", "probing program", "ROTACAL PROBE",
+                          m.has_head()};
   nc_detail::write_preamble(d, nc, pre, line, [&] {
     comment("rotacal touch-probe program, machine " + to_string(m) + " (machine axes)");
-    comment("sphere " + nc_detail::general(P.sphere.x()) + ", " + nc_detail::general(P.sphere.y()) + ", " +
-            nc_detail::general(P.sphere.z()) + " mm (table frame), D " + nc_detail::general(P.sphere_diameter) +
-            " mm, stylus d " + nc_detail::general(P.stylus_diameter) + " mm");
-    comment((P.pose_directions.empty()
-                 ? std::to_string(P.poses_deg.size()) + " poses x " + std::to_string(P.directions.size()) + " touches"
-                 : std::to_string(P.poses_deg.size()) + " poses, " + std::to_string(P.touch_count()) +
-                       " touches along each pose's own directions") +
+    comment("sphere " + nc_detail::general(P.sphere.x()) + ", " + nc_detail::general(P.sphere.y()) +
+            ", " + nc_detail::general(P.sphere.z()) + " mm (table frame), D " +
+            nc_detail::general(P.sphere_diameter) + " mm, stylus d " +
+            nc_detail::general(P.stylus_diameter) + " mm");
+    comment((P.pose_directions.empty() ? std::to_string(P.poses_deg.size()) + " poses x " +
+                                             std::to_string(P.directions.size()) + " touches"
+                                       : std::to_string(P.poses_deg.size()) + " poses, " +
+                                             std::to_string(P.touch_count()) +
+                                             " touches along each pose's own directions") +
             "; the log holds one line per touch: pose touch X Y Z (latched)");
-    comment("start with the stylus clear of the sphere: Z goes to the retract plane, then the rotary axes turn");
+    comment(
+        "start with the stylus clear of the sphere: Z goes to the retract plane, then the rotary "
+        "axes turn");
   });
   if (o.log_file.empty() || o.log_file.find_first_of("()\r\n") != std::string::npos)
-    throw InvalidArgument("plan probe: the log file name must be non-empty without '(', ')' or line ends");
+    throw InvalidArgument(
+        "plan probe: the log file name must be non-empty without '(', ')' or line ends");
   line("(LOGOPEN," + o.log_file + ")");
   line("G0 Z" + num(z));
   const std::string probe_feed = "F" + nc_detail::fixed(o.probe_feed_mm_per_min, 1);
@@ -152,15 +171,19 @@ std::string write_probe_nc_program(MachineType m, const ProbePattern& P, NcDiale
   for (const ProbeMove& mv : moves) {
     if (mv.pose != pose) {
       pose = mv.pose;
-      comment("pose " + std::to_string(pose) + ": " + tilt + " " + nc_detail::general(mv.angles_deg.tilt) + ", " +
-              rot + " " + nc_detail::general(mv.angles_deg.rot) + " deg (turned on the retract plane)");
+      comment("pose " + std::to_string(pose) + ": " + tilt + " " +
+              nc_detail::general(mv.angles_deg.tilt) + ", " + rot + " " +
+              nc_detail::general(mv.angles_deg.rot) + " deg (turned on the retract plane)");
       line("G0 " + tilt + num(mv.angles_deg.tilt) + " " + rot + num(mv.angles_deg.rot));
     }
     line("G0 X" + num(mv.start.x()) + " Y" + num(mv.start.y()));
     line("G1 Z" + num(mv.start.z()) + " " + feed);
-    line("G38.2 X" + num(mv.target.x()) + " Y" + num(mv.target.y()) + " Z" + num(mv.target.z()) + " " + probe_feed);
-    line("(LOG," + std::to_string(mv.pose) + " " + std::to_string(mv.touch) + " #5061 #5062 #5063)");
-    line("G1 X" + num(mv.start.x()) + " Y" + num(mv.start.y()) + " Z" + num(mv.start.z()) + " " + feed);
+    line("G38.2 X" + num(mv.target.x()) + " Y" + num(mv.target.y()) + " Z" + num(mv.target.z()) +
+         " " + probe_feed);
+    line("(LOG," + std::to_string(mv.pose) + " " + std::to_string(mv.touch) +
+         " #5061 #5062 #5063)");
+    line("G1 X" + num(mv.start.x()) + " Y" + num(mv.start.y()) + " Z" + num(mv.start.z()) + " " +
+         feed);
     line("G0 Z" + num(z));
   }
   line("(LOGCLOSE)");
@@ -188,22 +211,27 @@ ProbeSession read_linuxcnc_probe_log(const std::string& path, const ProbeSession
     double p = 0, t = 0;
     Eigen::Vector3d xyz;
     std::string extra;
-    if (!(fields >> p >> t >> xyz.x() >> xyz.y() >> xyz.z()) || (fields >> extra) || !xyz.allFinite())
-      throw ParseError(path, line_no, 1, "expected 'pose touch X Y Z' (five numbers), got '" + text + "'");
+    if (!(fields >> p >> t >> xyz.x() >> xyz.y() >> xyz.z()) || (fields >> extra) ||
+        !xyz.allFinite())
+      throw ParseError(path, line_no, 1,
+                       "expected 'pose touch X Y Z' (five numbers), got '" + text + "'");
     if (row >= plan.samples.size())
-      throw ParseError(path, line_no, 1, "more touches than the plan's " + std::to_string(plan.samples.size()));
+      throw ParseError(path, line_no, 1,
+                       "more touches than the plan's " + std::to_string(plan.samples.size()));
     const ProbeSample& s = plan.samples[row];
     if (s.pose != last_pose) ++pose, touch = 0, last_pose = s.pose;
     ++touch;
     if (p != pose || t != touch)
-      throw ParseError(path, line_no, 1, "touch " + nc_detail::general(p) + " " + nc_detail::general(t) +
-                                             " where the plan has pose " + std::to_string(pose) + ", touch " +
-                                             std::to_string(touch) + " (a touch missing or out of order)");
+      throw ParseError(path, line_no, 1,
+                       "touch " + nc_detail::general(p) + " " + nc_detail::general(t) +
+                           " where the plan has pose " + std::to_string(pose) + ", touch " +
+                           std::to_string(touch) + " (a touch missing or out of order)");
     out.samples[row++].xyz = xyz;
   }
   if (row != plan.samples.size())
-    throw ParseError(path, line_no, 1, std::to_string(row) + " touches logged, the plan has " +
-                                           std::to_string(plan.samples.size()));
+    throw ParseError(path, line_no, 1,
+                     std::to_string(row) + " touches logged, the plan has " +
+                         std::to_string(plan.samples.size()));
   out.noise_um.reset();
   out.metadata.erase(std::remove_if(out.metadata.begin(), out.metadata.end(),
                                     [](const auto& kv) { return kv.first == "noise_um"; }),

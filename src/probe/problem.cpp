@@ -13,9 +13,10 @@ std::vector<Effect> probe_effect_catalogue(MachineType m, int max_harmonic) {
 ProbeParameterLayout ProbeParameterLayout::make(MachineType m, const EffectModel& fx) {
   ProbeParameterLayout L;
   L.errors = add_location_errors(L.all, m);
-  L.tool_length = L.all.add("tool_length", m.has_head() ? std::vector<std::string>{"tool_offset_Z"}
-                                                        : std::vector<std::string>{},
-                            {"mm"});
+  L.tool_length = L.all.add(
+      "tool_length",
+      m.has_head() ? std::vector<std::string>{"tool_offset_Z"} : std::vector<std::string>{},
+      {"mm"});
   L.sphere = L.all.add("sphere", {"sphere.x", "sphere.y", "sphere.z"}, {"mm"});
   L.effects = add_effects(L.all, fx);
   return L;
@@ -37,13 +38,17 @@ std::vector<ProbeTouch> probe_touches(const ProbeSession& session) {
 }
 
 ProbeProblem::ProbeProblem(const ProbeSession& session, const EffectModel& effects)
-    : machine_(session.machine), fx_(centred_on(effects, session.samples)),
-      layout_(ProbeParameterLayout::make(session.machine, fx_)), sphere_nominal_(session.sphere),
-      radius_(session.trigger_radius()), touches_(probe_touches(session)) {
+    : machine_(session.machine),
+      fx_(centred_on(effects, session.samples)),
+      layout_(ProbeParameterLayout::make(session.machine, fx_)),
+      sphere_nominal_(session.sphere),
+      radius_(session.trigger_radius()),
+      touches_(probe_touches(session)) {
   if (touches_.empty()) throw InvalidArgument("probe problem: the session has no touches");
   for (const Effect& f : fx_.effects)
     if (!f.applies_to(machine_))
-      throw InvalidArgument("probe problem: effect " + f.id() + " does not exist on " + to_string(machine_));
+      throw InvalidArgument("probe problem: effect " + f.id() + " does not exist on " +
+                            to_string(machine_));
   for (const ProbeSample& s : session.samples) {
     groups_.push_back("touches");
     times_.push_back(s.time);
@@ -63,7 +68,8 @@ std::vector<FitParameter> ProbeProblem::parameters() const {
   return out;
 }
 
-void ProbeProblem::evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r, Eigen::MatrixXd* J) const {
+void ProbeProblem::evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r,
+                            Eigen::MatrixXd* J) const {
   const ProbeParameterLayout& L = layout_;
   const auto one = [&](Eigen::Index i, const auto* p, auto* out) {
     using T = std::remove_const_t<std::remove_pointer_t<decltype(p)>>;

@@ -21,22 +21,25 @@ std::string fmt4(double v) {
 
 // Where the stylus triggers moving from x0 along n: Newton on touch_residual(lambda) = 0 from
 // lambda = -R (the stylus reaching the nominal sphere), the derivative by a forward difference.
-double trigger_lambda(MachineType m, const MachineModel& truth, const EffectModel& fx, const Eigen::Vector3d& q,
-                      ProbeTouch t, const Eigen::Vector3d& x0, double radius) {
+double trigger_lambda(MachineType m, const MachineModel& truth, const EffectModel& fx,
+                      const Eigen::Vector3d& q, ProbeTouch t, const Eigen::Vector3d& x0,
+                      double radius) {
   double lambda = -radius;
   const auto f = [&](double l) {
     t.xyz = x0 + l * t.n;
     // The trigger itself: the latched position without the lobing shift, applied after.
-    const Eigen::Vector3d d = table_point<double>(m, truth.errors, fx, truth.effect_data(), t.angles, t.time, q);
-    const Eigen::Vector3d tip = tool_position<double>(m, truth.errors, fx, truth.effect_data(), t.xyz, t.angles, t.time);
+    const Eigen::Vector3d d =
+        table_point<double>(m, truth.errors, fx, truth.effect_data(), t.angles, t.time, q);
+    const Eigen::Vector3d tip =
+        tool_position<double>(m, truth.errors, fx, truth.effect_data(), t.xyz, t.angles, t.time);
     return (tip - d).norm() - (radius + stylus_radius_error<double>(fx, truth.effect_data()));
   };
   for (int it = 0; it < 30; ++it) {
     const double f0 = f(lambda), h = 1e-6;
     const double slope = (f(lambda + h) - f0) / h;
     if (!(std::abs(slope) > 1e-3))
-      throw InvalidArgument("simulate_probe: the approach along (" + fmt4(t.n.x()) + ", " + fmt4(t.n.y()) + ", " +
-                            fmt4(t.n.z()) + ") grazes or misses the sphere");
+      throw InvalidArgument("simulate_probe: the approach along (" + fmt4(t.n.x()) + ", " +
+                            fmt4(t.n.y()) + ", " + fmt4(t.n.z()) + ") grazes or misses the sphere");
     const double step = f0 / slope;
     lambda -= step;
     if (std::abs(step) < 1e-13) break;
@@ -48,7 +51,8 @@ double trigger_lambda(MachineType m, const MachineModel& truth, const EffectMode
 ProbePattern default_probe_pattern(MachineType m) {
   ProbePattern p;
   double t0 = -90.0, t1 = 90.0;
-  if (const auto& l = m.description().axis(m.tilt_index()).limits_deg) t0 = std::max(t0, (*l)[0]), t1 = std::min(t1, (*l)[1]);
+  if (const auto& l = m.description().axis(m.tilt_index()).limits_deg)
+    t0 = std::max(t0, (*l)[0]), t1 = std::min(t1, (*l)[1]);
   for (int i = 0; i < 12; ++i) p.poses_deg.push_back({0.0, 30.0 * i});
   int tilts = 0;
   for (int i = 0; i < 13 && tilts < 12; ++i) {
@@ -64,15 +68,21 @@ ProbeSimulation simulate_probe(const MachineModel& truth, const ProbeSimOptions&
   truth.validate("simulate_probe: truth");
   const ProbePattern& P = o.pattern;
   if (P.poses_deg.empty() || (P.directions.empty() && P.pose_directions.empty()))
-    throw InvalidArgument("simulate_probe: options.pattern: poses_deg and directions must not be empty");
+    throw InvalidArgument(
+        "simulate_probe: options.pattern: poses_deg and directions must not be empty");
   if (!P.pose_directions.empty() && P.pose_directions.size() != P.poses_deg.size())
-    throw InvalidArgument("simulate_probe: options.pattern: pose_directions must hold one list per pose");
+    throw InvalidArgument(
+        "simulate_probe: options.pattern: pose_directions must hold one list per pose");
   for (const auto& d : P.pose_directions)
-    if (d.empty()) throw InvalidArgument("simulate_probe: options.pattern: a pose without approach directions");
-  if (!(o.noise_um >= 0.0) || !std::isfinite(o.noise_um)) throw InvalidArgument("simulate_probe: options.noise_um must be >= 0");
-  if (!(std::abs(o.ar1_rho) < 1.0)) throw InvalidArgument("simulate_probe: options.ar1_rho must be in (-1, 1)");
+    if (d.empty())
+      throw InvalidArgument("simulate_probe: options.pattern: a pose without approach directions");
+  if (!(o.noise_um >= 0.0) || !std::isfinite(o.noise_um))
+    throw InvalidArgument("simulate_probe: options.noise_um must be >= 0");
+  if (!(std::abs(o.ar1_rho) < 1.0))
+    throw InvalidArgument("simulate_probe: options.ar1_rho must be in (-1, 1)");
   if (!(P.sphere_diameter > 0.0) || !(P.stylus_diameter >= 0.0))
-    throw InvalidArgument("simulate_probe: options.pattern: sphere_diameter must be > 0 and stylus_diameter >= 0");
+    throw InvalidArgument(
+        "simulate_probe: options.pattern: sphere_diameter must be > 0 and stylus_diameter >= 0");
   const MachineType m = truth.machine;
   ProbeSimulation out;
   out.sphere_actual = P.sphere + o.sphere_offset;
@@ -82,9 +92,13 @@ ProbeSimulation simulate_probe(const MachineModel& truth, const ProbeSimOptions&
   s.sphere_diameter = P.sphere_diameter;
   s.stylus_diameter = P.stylus_diameter;
   if (o.noise_um > 0.0) s.noise_um = o.noise_um;
-  s.metadata = {{"format", "rotacal-probe/1"}, {"machine", to_string(m)}, {"units", "mm, deg, s"},
-                {"sphere", fmt4(P.sphere.x()) + ", " + fmt4(P.sphere.y()) + ", " + fmt4(P.sphere.z())},
-                {"sphere_diameter", fmt4(P.sphere_diameter)}, {"stylus_diameter", fmt4(P.stylus_diameter)}};
+  s.metadata = {
+      {"format", "rotacal-probe/1"},
+      {"machine", to_string(m)},
+      {"units", "mm, deg, s"},
+      {"sphere", fmt4(P.sphere.x()) + ", " + fmt4(P.sphere.y()) + ", " + fmt4(P.sphere.z())},
+      {"sphere_diameter", fmt4(P.sphere_diameter)},
+      {"stylus_diameter", fmt4(P.stylus_diameter)}};
   const double radius = s.trigger_radius();
   // The touches: nominal start x0 (the tip at the nominal centre), direction and time.
   std::vector<ProbeTouch> touches;
@@ -96,7 +110,8 @@ ProbeSimulation simulate_probe(const MachineModel& truth, const ProbeSimOptions&
     const Eigen::Vector3d start = inverse(m, LocationErrors<double>(), a, P.sphere).xyz;
     const std::vector<Eigen::Vector3d>& dirs = P.directions_at(k);
     for (std::size_t j = 0; j < dirs.size(); ++j) {
-      if (!(dirs[j].norm() > 0.0)) throw InvalidArgument("simulate_probe: options.pattern: a zero direction");
+      if (!(dirs[j].norm() > 0.0))
+        throw InvalidArgument("simulate_probe: options.pattern: a zero direction");
       ProbeTouch t;
       t.n = dirs[j].normalized();
       t.angles = a;

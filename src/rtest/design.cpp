@@ -9,10 +9,10 @@
 #include <optional>
 #include <sstream>
 
-#include "rotacal/design/format.hpp"
 #include "rotacal/core/error.hpp"
 #include "rotacal/core/joint_fit.hpp"
 #include "rotacal/core/least_squares.hpp"
+#include "rotacal/design/format.hpp"
 #include "rotacal/design/separation.hpp"
 #include "rotacal/rtest/model.hpp"
 #include "rotacal/rtest/problem.hpp"
@@ -96,7 +96,8 @@ RtestDesignCandidate evaluate_rtest_design(const RtestPattern& pattern, const Rt
   c.duration_s = static_cast<double>(poses * pattern.nests.size()) * pattern.dwell_s;
   if (budget <= 0.0) budget = c.duration_s;
   if (c.duration_s > budget * (1 + 1e-12)) {
-    c.why_not = fixed_text(c.duration_s, 0) + " s is over the time budget of " + fixed_text(budget, 0) + " s";
+    c.why_not = fixed_text(c.duration_s, 0) + " s is over the time budget of " +
+                fixed_text(budget, 0) + " s";
     return c;
   }
   const double deg = M_PI / 180.0;
@@ -131,7 +132,7 @@ RtestDesignCandidate evaluate_rtest_design(const RtestPattern& pattern, const Rt
     c.why_not = e.what();
     return c;
   }
-  s.machine = m;  // the same readings: the fit is of the BC-trt error model
+  s.machine = m;            // the same readings: the fit is of the BC-trt error model
   s.noise_um = o.noise_um;  // the fit's chi-square scale (observability), as a recorder declares it
   RtestJointOptions fit;
   fit.basis = o.basis;
@@ -162,7 +163,9 @@ RtestDesignCandidate evaluate_rtest_design(const RtestPattern& pattern, const Rt
       return c;
     }
     const double u = 2.0 * c.sigma[i] *
-                     (location_error_is_angle(static_cast<int>(i - L.errors.offset)) ? o.reference_radius_mm * 1e3 : 1e3);
+                     (location_error_is_angle(static_cast<int>(i - L.errors.offset))
+                          ? o.reference_radius_mm * 1e3
+                          : 1e3);
     if (u > c.worst_expanded_um)
       c.worst_expanded_um = u, c.worst_error = c.names[static_cast<std::size_t>(i)];
   }
@@ -264,7 +267,6 @@ Eigen::MatrixXd nominal_rtest_jacobian(const RtestArrays& poses, const EffectMod
   return J;
 }
 
-
 // The added nests: one at each radius, angle and height, with each grid of B and C steps.
 std::vector<RtestPattern> separating_nests(const RtestSeparationOptions& o, double dwell) {
   const double deg = M_PI / 180.0;
@@ -290,7 +292,8 @@ std::vector<RtestPattern> separating_nests(const RtestSeparationOptions& o, doub
 
 // The added nest's poses after the session (B outer, C inner, one dwell each), or nothing when
 // a pose leaves the travel.
-std::optional<RtestArrays> added_poses(const RtestPattern& pat, const RtestSeparationOptions& o, double t_end) {
+std::optional<RtestArrays> added_poses(const RtestPattern& pat, const RtestSeparationOptions& o,
+                                       double t_end) {
   const double deg = M_PI / 180.0;
   RtestArrays a = pose_arrays(pat.b_deg.size() * pat.c_deg.size());
   a.setups = {"added"};
@@ -316,8 +319,8 @@ std::optional<RtestArrays> added_poses(const RtestPattern& pat, const RtestSepar
 std::string describe_candidate(const RtestSeparatingCandidate& c) {
   const RtestPattern& pat = c.added;
   std::ostringstream d;
-  d << "a nest at " << point_text(pat.nests[0]) << ", B " << fixed_text(pat.b_deg.front(), 0) << ".."
-    << fixed_text(pat.b_deg.back(), 0) << " deg every "
+  d << "a nest at " << point_text(pat.nests[0]) << ", B " << fixed_text(pat.b_deg.front(), 0)
+    << ".." << fixed_text(pat.b_deg.back(), 0) << " deg every "
     << fixed_text(pat.b_deg.size() > 1 ? pat.b_deg[1] - pat.b_deg[0] : 0.0, 0) << ", C every "
     << fixed_text(pat.c_deg.size() > 1 ? pat.c_deg[1] - pat.c_deg[0] : 360.0, 0) << " deg, "
     << fixed_text(pat.dwell_s, 1) << " s per pose";
@@ -372,8 +375,9 @@ RtestSeparationDesign design_rtest_separation(const RtestSession& session,
   RtestJointOptions fo;
   fo.noise = NoiseHandling::white;
   const RtestJointIdentification id = identify_joint(session, fo);
-  const double w = session_weight(o.noise_um, id.noise, id.sigma_um,
-                                  "design rtest: --after: the session's residuals are zero; give --noise", D);
+  const double w =
+      session_weight(o.noise_um, id.noise, id.sigma_um,
+                     "design rtest: --after: the session's residuals are zero; give --noise", D);
   // Joint layout: the R-test problem's (location errors, a probe zero per session nest, the
   // pair), then the added nest's probe zero.
   const RtestLayout L = rtest_layout(m, poses.setups, nullptr, fx, RtestZeroNames::numbered);
@@ -381,9 +385,9 @@ RtestSeparationDesign design_rtest_separation(const RtestSession& session,
   ParameterLayout joint = L.all;
   const ParameterBlock added_zero = joint.add("zero#added", La.zeros.names, {"mm"}, 3);
   D.names = L.all.names();
-  const SeparationProblem S = separation_problem(nominal_rtest_jacobian(poses, fx), w, joint,
-                                                 effect_block(L.effects, fx, 0), effect_block(L.effects, fx, 1),
-                                                 o.max_correlation, o.max_added_time_s, D);
+  const SeparationProblem S = separation_problem(
+      nominal_rtest_jacobian(poses, fx), w, joint, effect_block(L.effects, fx, 0),
+      effect_block(L.effects, fx, 1), o.max_correlation, o.max_added_time_s, D);
   const bool search = separation_needed(S, D);
   D.chosen.correlation = D.correlation_before;
   if (!search) return D;
@@ -407,8 +411,9 @@ RtestSeparationDesign design_rtest_separation(const RtestSession& session,
     if (duration > o.max_added_time_s) continue;
     std::optional<RtestArrays> nest = added_poses(pat, o, t_end);
     if (!nest) continue;
-    const Eigen::MatrixXd Jm = in_layout(nominal_rtest_jacobian(*nest, fx), {La.errors, La.zeros, La.effects},
-                                         {L.errors, added_zero, L.effects}, joint.size());
+    const Eigen::MatrixXd Jm =
+        in_layout(nominal_rtest_jacobian(*nest, fx), {La.errors, La.zeros, La.effects},
+                  {L.errors, added_zero, L.effects}, joint.size());
     added.push_back({duration, Jm.transpose() * Jm * w, true});
     pattern_of.push_back(k);
   }
@@ -429,7 +434,8 @@ RtestSeparationDesign design_rtest_separation(const RtestSession& session,
   wording.added = "added nests";
   wording.seen_by = "";
   wording.closest_note = "";
-  finish_separation(S, c, D.chosen.description, D.chosen.duration_s * D.chosen.repeats, added_names, wording, D);
+  finish_separation(S, c, D.chosen.description, D.chosen.duration_s * D.chosen.repeats, added_names,
+                    wording, D);
   return D;
 }
 
@@ -441,8 +447,10 @@ JointFitOutcome identify_rtest_effects(const RtestSession& session, const Effect
       throw InvalidArgument("effect " + f.id() + " does not exist on a BC-trt");
   RtestArrays poses = rtest_arrays(session, "identify_rtest_effects");
   poses.machine = MachineType::BC_trt;
-  const RtestProblem model(poses, nullptr, centred_on(effects, session.samples), RtestZeroNames::numbered);
-  const std::vector<std::string> names = model.layout().all.names(), units = model.layout().all.units();
+  const RtestProblem model(poses, nullptr, centred_on(effects, session.samples),
+                           RtestZeroNames::numbered);
+  const std::vector<std::string> names = model.layout().all.names(),
+                                 units = model.layout().all.units();
   std::vector<FitParameter> params;
   for (std::size_t j = 0; j < names.size(); ++j) params.push_back({names[j], units[j], 0.0});
   JointFitSettings settings;

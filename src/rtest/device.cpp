@@ -28,8 +28,9 @@ Eigen::Vector3d sphere_displacement(const Eigen::Matrix3d& dirs, const Eigen::Ve
 ProbeCalibration calibrate_probe_directions(const std::vector<ProbeCalibrationSample>& samples) {
   const int n = static_cast<int>(samples.size());
   if (n < 5)
-    throw InvalidArgument("calibrate_probe_directions: samples: " + std::to_string(n) +
-                          " moves cannot determine 4 unknowns per probe with a residual (need >= 5)");
+    throw InvalidArgument(
+        "calibrate_probe_directions: samples: " + std::to_string(n) +
+        " moves cannot determine 4 unknowns per probe with a residual (need >= 5)");
   Eigen::MatrixXd A(n, 4);
   for (int k = 0; k < n; ++k) A.row(k) << samples[k].move.transpose(), 1.0;
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeThinU | Eigen::ComputeThinV);
@@ -153,8 +154,7 @@ std::vector<SpindleIndexSample> simulate_spindle_indexing(const Eigen::Matrix3d&
   std::vector<SpindleIndexSample> out;
   for (double a : angles) {
     const Eigen::Vector3d o(offset.x(), offset.y(), 0.0);
-    const Eigen::Vector3d p =
-        centre + rotation_about_axis<double>(Eigen::Vector3d::UnitZ(), a) * o;
+    const Eigen::Vector3d p = centre + rotation_about_axis<double>(Eigen::Vector3d::UnitZ(), a) * o;
     SpindleIndexSample s;
     s.angle = a;
     s.readings = dirs * p + zeros;
@@ -187,8 +187,9 @@ RtestSession displacements_from_raw(const RtestSession& session, const Eigen::Ma
     RtestSample& s = out.samples[i];
     if (s.d) continue;
     if (!s.raw)
-      throw InvalidArgument("displacements_from_raw: pose " + std::to_string(i) + " (setup " + s.setup +
-                            ", time " + std::to_string(s.time) + " s) has neither dx,dy,dz nor d1,d2,d3");
+      throw InvalidArgument("displacements_from_raw: pose " + std::to_string(i) + " (setup " +
+                            s.setup + ", time " + std::to_string(s.time) +
+                            " s) has neither dx,dy,dz nor d1,d2,d3");
     s.d = dirs.fullPivLu().solve(*s.raw);
   }
   return out;
@@ -202,9 +203,10 @@ RtestSession displacements_from_raw(const RtestSession& session) {
   for (int k = 1; k <= 3; ++k) {
     const auto it = session.probe_dirs.find(k);
     if (it == session.probe_dirs.end())
-      throw InvalidArgument("displacements_from_raw: the session has raw readings d1,d2,d3 but no probe." +
-                            std::to_string(k) + ".dir (the file needs a '# probe." + std::to_string(k) +
-                            ".dir: x, y, z' metadata line, or convert with calibrated directions)");
+      throw InvalidArgument(
+          "displacements_from_raw: the session has raw readings d1,d2,d3 but no probe." +
+          std::to_string(k) + ".dir (the file needs a '# probe." + std::to_string(k) +
+          ".dir: x, y, z' metadata line, or convert with calibrated directions)");
     dirs.row(k - 1) = it->second.transpose();
   }
   return displacements_from_raw(session, dirs);

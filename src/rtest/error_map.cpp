@@ -4,9 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <sstream>
-
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "rotacal/core/angles.hpp"
 #include "rotacal/core/error.hpp"
@@ -118,19 +117,19 @@ std::string error_map_json(const RtestErrorMap& map) {
   }
   if (any_null)
     head["null_means"] =
-        "a null std: the component is assumed, not identified, by this method (e.g. gamma_CB of the "
+        "a null std: the component is assumed, not identified, by this method (e.g. gamma_CB of "
+        "the "
         "paper method, Oyama & Ibaraki Sec. 4.2); a null value: not determined by the data";
   // One entry per line keeps an 84-pose map readable; the rest is nlohmann's indented dump.
   std::string text = head.dump(2);
   text.pop_back();  // the closing brace
   text += ",\n  \"entries\": [\n";
-  for (std::size_t i = 0; i < rows.size(); ++i) text += "    " + rows[i] + (i + 1 < rows.size() ? ",\n" : "\n");
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    text += "    " + rows[i] + (i + 1 < rows.size() ? ",\n" : "\n");
   return text + "  ]\n}\n";
 }
 
-void write_text_file(const std::string& path, const std::string& text) {
-  write_output(path, text);
-}
+void write_text_file(const std::string& path, const std::string& text) { write_output(path, text); }
 
 double prediction_rms_um(const RtestSession& session, const RtestPredictor& predict) {
   if (session.samples.empty()) throw InvalidArgument("prediction_rms_um: session has no samples");

@@ -1,4 +1,5 @@
-// Oyama's error model: Euler angles of a pose, and the exact and first-order maps from location errors.
+// Oyama's error model: Euler angles of a pose, and the exact and first-order maps from location
+// errors.
 #include "rotacal/rtest/error_model.hpp"
 
 #include <cmath>

@@ -49,16 +49,21 @@ void for_each_c_term(const RtestBasis& bs, double B, double C, const std::string
             const double c = std::cos(C), s = bs.c_reversed ? -std::sin(C) : std::sin(C);
             t[k] = cs == 0 ? c : s;
             t[k + 1] = cs == 0 ? -s : c;
-            f([&] { return std::string(k == 0 ? "dxy" : "alphabeta") + "_" + map + ".back1." + (cs == 0 ? "u" : "v") + ".b0"; },
-              t);
+            f(
+                [&] {
+                  return std::string(k == 0 ? "dxy" : "alphabeta") + "_" + map + ".back1." +
+                         (cs == 0 ? "u" : "v") + ".b0";
+                },
+                t);
             continue;
           }
           t[k] = bm * (cs == 0 ? std::cos(n * C) : std::sin(n * C));
-          f([&] {
-            return std::string(kCompNames[k]) + "_" + map + "." + (cs == 0 ? "cos" : "sin") + std::to_string(n) +
-                   ".b" + std::to_string(m);
-          },
-            t);
+          f(
+              [&] {
+                return std::string(kCompNames[k]) + "_" + map + "." + (cs == 0 ? "cos" : "sin") +
+                       std::to_string(n) + ".b" + std::to_string(m);
+              },
+              t);
         }
     }
   }
@@ -66,7 +71,8 @@ void for_each_c_term(const RtestBasis& bs, double B, double C, const std::string
 }  // namespace
 std::vector<AxisErrors<double>> RtestBasis::c_terms(double B, double C) const {
   std::vector<AxisErrors<double>> out;
-  for_each_c_term(*this, B, C, "CB", [&](const auto&, const AxisErrors<double>& t) { out.push_back(t); });
+  for_each_c_term(*this, B, C, "CB",
+                  [&](const auto&, const AxisErrors<double>& t) { out.push_back(t); });
   return out;
 }
 std::vector<double> RtestBasis::b_terms(int k, double B) const {
@@ -88,12 +94,15 @@ std::vector<std::string> basis_names(const RtestBasis& bs, const std::array<std:
   return out;
 }
 }  // namespace
-std::vector<std::string> RtestBasis::coefficient_names() const { return basis_names(*this, {"BY", "CB"}); }
+std::vector<std::string> RtestBasis::coefficient_names() const {
+  return basis_names(*this, {"BY", "CB"});
+}
 std::vector<std::string> RtestBasis::coefficient_names(MachineType m) const {
   return basis_names(for_machine(m), rtest_map_names(m));
 }
 
-void RtestBasis::map_rows(double B, double C, Eigen::Ref<Eigen::MatrixXd> Lb, Eigen::Ref<Eigen::MatrixXd> Lc) const {
+void RtestBasis::map_rows(double B, double C, Eigen::Ref<Eigen::MatrixXd> Lb,
+                          Eigen::Ref<Eigen::MatrixXd> Lc) const {
   Lb.setZero();
   Lc.setZero();
   Eigen::Index o = 0;
@@ -125,8 +134,8 @@ double tool_offset_z_at(const RtestLayout& L, const Eigen::VectorXd& p) {
 }
 
 // Linear map from params to w_BY (6 x P) and w_CB (6 x P) at (B, C).
-void map_rows(const RtestJointModel& m, const RtestLayout& L, double B, double C, Eigen::MatrixXd& Lb,
-              Eigen::MatrixXd& Lc) {
+void map_rows(const RtestJointModel& m, const RtestLayout& L, double B, double C,
+              Eigen::MatrixXd& Lb, Eigen::MatrixXd& Lc) {
   Lb = Eigen::MatrixXd::Zero(6, m.params.size());
   Lc = Eigen::MatrixXd::Zero(6, m.params.size());
   m.basis.for_machine(m.machine).map_rows(B, C, L.map_tilt.columns(Lb), L.map_rot.columns(Lc));
@@ -152,7 +161,8 @@ Eigen::Vector3d propagate_fn(const RtestJointModel& m, const RtestLayout& L, F f
   Eigen::MatrixXd J(3, P);
   Eigen::VectorXd t = m.params;
   for (int j = 0; j < P; ++j) {
-    const bool angle = L.errors.contains(j) && location_error_is_angle(static_cast<int>(j - L.errors.offset));
+    const bool angle =
+        L.errors.contains(j) && location_error_is_angle(static_cast<int>(j - L.errors.offset));
     const double h = angle ? 1e-7 : 1e-5;
     t = m.params;
     t[j] += h;
@@ -171,17 +181,23 @@ Eigen::Vector3d propagate_fn(const RtestJointModel& m, const RtestLayout& L, F f
   return s;
 }
 
-Pose<double> table_pose_at(const RtestJointModel& m, const RtestLayout& L, const Eigen::VectorXd& params,
-                           double B, double C) {
+Pose<double> table_pose_at(const RtestJointModel& m, const RtestLayout& L,
+                           const Eigen::VectorXd& params, double B, double C) {
   const double* p = params.data();
   return rtest_joint_table_pose<double>(m.machine, m.basis, L.errors.ptr(p), p + L.map_tilt.offset,
                                         p + L.map_rot.offset, B, C);
 }
 }  // namespace
 
-std::vector<std::string> RtestJointModel::parameter_names() const { return model_layout(*this).all.names(); }
-LocationErrors<double> RtestJointModel::errors() const { return errors_at(model_layout(*this), params); }
-double RtestJointModel::tool_offset_z() const { return tool_offset_z_at(model_layout(*this), params); }
+std::vector<std::string> RtestJointModel::parameter_names() const {
+  return model_layout(*this).all.names();
+}
+LocationErrors<double> RtestJointModel::errors() const {
+  return errors_at(model_layout(*this), params);
+}
+double RtestJointModel::tool_offset_z() const {
+  return tool_offset_z_at(model_layout(*this), params);
+}
 
 AxisErrors<double> RtestJointModel::w_BY(double B, AxisErrors<double>* std) const {
   Eigen::MatrixXd Lb, Lc;
@@ -253,7 +269,8 @@ bool m_tilt_carries_rot(MachineType m) {
 
 // Which set-up change would show what this session cannot (the unobservable combinations in
 // words, core/least_squares.hpp), in the spirit of the ballbar's advice.
-std::vector<std::string> rtest_setup_advice(MachineType m, const std::vector<std::string>& unobservable) {
+std::vector<std::string> rtest_setup_advice(MachineType m,
+                                            const std::vector<std::string>& unobservable) {
   std::vector<std::string> out;
   if (unobservable.empty()) return out;
   auto mentions = [&](const std::string& name) {
@@ -266,9 +283,10 @@ std::vector<std::string> rtest_setup_advice(MachineType m, const std::vector<std
   const MachineDescription& d = m.description();
   bool head_advised = false;
   if (mentions("tool_offset_Z")) {
-    out.push_back("pivot_length + tool_length (tool_offset_Z) is seen together with a head axis' position "
-                  "along the spindle: a second tool length (the sphere at a second distance from the "
-                  "head) separates them");
+    out.push_back(
+        "pivot_length + tool_length (tool_offset_Z) is seen together with a head axis' position "
+        "along the spindle: a second tool length (the sphere at a second distance from the "
+        "head) separates them");
     head_advised = true;
   }
   for (int k = 0; k < 2; ++k) {
@@ -279,14 +297,17 @@ std::vector<std::string> rtest_setup_advice(MachineType m, const std::vector<std
     if (!seen) continue;
     if (a.on_head) {
       if (!head_advised)
-        out.push_back(std::string("errors of the head axis ") + a.name + " (location errors, map " + map +
-                      ") are seen as one movement of the sphere at one tool length: a second tool length "
-                      "(the rotations' effect scales with it, a translation's does not) separates them");
+        out.push_back(
+            std::string("errors of the head axis ") + a.name + " (location errors, map " + map +
+            ") are seen as one movement of the sphere at one tool length: a second tool length "
+            "(the rotations' effect scales with it, a translation's does not) separates them");
       head_advised = true;
     } else {
-      out.push_back(std::string("errors of the table axis ") + a.name + " (location errors, map " + map +
-                    ") are seen together at these nests: a nest at a second height and a second distance "
-                    "from the " + a.name + " line separates them");
+      out.push_back(
+          std::string("errors of the table axis ") + a.name + " (location errors, map " + map +
+          ") are seen together at these nests: a nest at a second height and a second distance "
+          "from the " +
+          a.name + " line separates them");
     }
   }
   return out;
@@ -319,7 +340,8 @@ RtestJointIdentification identify_joint(const RtestSession& session,
     for (std::size_t i : idx) mean += *session.samples[i].d;
     mean /= static_cast<double>(idx.size());
     for (int a = 0; a < 3; ++a)
-      params[static_cast<std::size_t>(L.zeros.item_offset(static_cast<Eigen::Index>(k)) + a)].start = mean[a];
+      params[static_cast<std::size_t>(L.zeros.item_offset(static_cast<Eigen::Index>(k)) + a)]
+          .start = mean[a];
   }
 
   JointFitSettings settings;
@@ -349,8 +371,9 @@ RtestJointIdentification identify_joint(const RtestSession& session,
   no.min_correlation_samples = options.min_correlation_samples;
   no.noise_bias_correction = options.noise_bias_correction;
   no.allow_reml = true;
-  NoiseFit nf = fit_with_noise([&](const JointFitSettings& s) { return solve_joint(model, params, s); },
-                               settings, groups, times, no);
+  NoiseFit nf =
+      fit_with_noise([&](const JointFitSettings& s) { return solve_joint(model, params, s); },
+                     settings, groups, times, no);
   JointFitOutcome& fit = nf.fit;
   const bool refit = nf.refit, reml = nf.reml;
   const double scale = nf.scale;
@@ -364,50 +387,63 @@ RtestJointIdentification identify_joint(const RtestSession& session,
     out.residuals[i] = fit.residuals.segment<3>(3 * static_cast<Eigen::Index>(i));
   const double n_res = 3.0 * static_cast<double>(session.samples.size());
   out.residual_rms_um = std::sqrt(fit.residuals.squaredNorm() / n_res) * 1e3;
-  out.sigma_um = std::sqrt(fit.residuals.squaredNorm() / std::max(n_res - fit.summary.num_free, 1.0)) * 1e3;
+  out.sigma_um =
+      std::sqrt(fit.residuals.squaredNorm() / std::max(n_res - fit.summary.num_free, 1.0)) * 1e3;
   out.covariance = fit.covariance;
   for (std::size_t k = 0; k < setups.size(); ++k)
-    out.probe_zeros[setups[k]] = fit.values.segment<3>(L.zeros.item_offset(static_cast<Eigen::Index>(k)));
+    out.probe_zeros[setups[k]] =
+        fit.values.segment<3>(L.zeros.item_offset(static_cast<Eigen::Index>(k)));
   out.parameters = fit.estimates;
   out.unobservable = fit.unobservable;
-  for (std::string& advice : rtest_setup_advice(machine, out.unobservable)) out.notes.push_back(std::move(advice));
+  for (std::string& advice : rtest_setup_advice(machine, out.unobservable))
+    out.notes.push_back(std::move(advice));
   out.summary = fit.summary;
   out.noise = std::move(nf.noise);
   out.noise_refit = refit;
   out.noise_correction = scale;
   if (refit && reml)
+    out.notes.push_back(
+        "correlated noise (" + out.noise.summary() +
+        ", REML over the fit's residual space): covariance by GLS under this model");
+  else if (refit)
     out.notes.push_back("correlated noise (" + out.noise.summary() +
-                        ", REML over the fit's residual space): covariance by GLS under this model");
-  else if (refit) out.notes.push_back("correlated noise (" + out.noise.summary() + "): covariance by GLS under this AR model, scaled by " + std::to_string(scale) + " for the correlation the fit absorbs from its residuals");
+                        "): covariance by GLS under this AR model, scaled by " +
+                        std::to_string(scale) +
+                        " for the correlation the fit absorbs from its residuals");
 
   out.model.machine = machine;
   out.model.basis = basis;
   out.model.params = fit.values.head(n_model);
   out.model.covariance = out.covariance.topLeftCorner(n_model, n_model);
   out.model.observable.clear();
-  for (Eigen::Index j = 0; j < n_model; ++j) out.model.observable.push_back(fit.estimates[static_cast<std::size_t>(j)].observable);
+  for (Eigen::Index j = 0; j < n_model; ++j)
+    out.model.observable.push_back(fit.estimates[static_cast<std::size_t>(j)].observable);
 
   out.notes.push_back("probe zero per set-up fitted: no reading is assumed to be zero");
   const std::array<std::string, 2> maps = rtest_map_names(machine);
   const std::string tl(1, tilt_axis_letter(machine)), rl(1, rot_axis_letter(machine));
   out.notes.push_back(
       tl + " map (" + maps[0] + "): " +
-      (basis.b_rotations ? "even powers of " + tl + " for translations, odd for rotations (separates it from the " +
-                               tl + " axis' location errors)"
-                         : "even powers of " + tl + " for translations only (a head axis: the sphere is one point)") +
-      "; " + rl + " map (" + maps[1] + "): harmonics 1.." + std::to_string(basis.c_harmonics) + " of " + rl +
-      (basis.c_rotations ? "" : ", translations only (a head axis)") + ", polynomial of degree " +
-      std::to_string(basis.c_b_degree) + " in " + tl);
+      (basis.b_rotations ? "even powers of " + tl +
+                               " for translations, odd for rotations (separates it from the " + tl +
+                               " axis' location errors)"
+                         : "even powers of " + tl +
+                               " for translations only (a head axis: the sphere is one point)") +
+      "; " + rl + " map (" + maps[1] + "): harmonics 1.." + std::to_string(basis.c_harmonics) +
+      " of " + rl + (basis.c_rotations ? "" : ", translations only (a head axis)") +
+      ", polynomial of degree " + std::to_string(basis.c_b_degree) + " in " + tl);
   if (!basis.gamma_cb && basis.c_rotations)
     out.notes.push_back("gamma_" + maps[1] + " not fitted (assumed zero, as Oyama Sec. 4.2)");
   // A constant offset of the tilt axis turns the rotary axis it carries: a tilt of that axis.
   const bool tilt_carries_rot = m_tilt_carries_rot(machine);
-  out.notes.push_back("rotary zero offsets E_" + tl + "0" + tl + ", E_" + rl + "0" + rl +
-                      " are not in the model: an R-test with the probe zero unknown cannot see a constant " +
-                      rl + " offset" +
-                      (tilt_carries_rot ? "; E_" + tl + "0" + tl + " acts as a tilt of the " + rl + " axis" : ""));
+  out.notes.push_back(
+      "rotary zero offsets E_" + tl + "0" + tl + ", E_" + rl + "0" + rl +
+      " are not in the model: an R-test with the probe zero unknown cannot see a constant " + rl +
+      " offset" +
+      (tilt_carries_rot ? "; E_" + tl + "0" + tl + " acts as a tilt of the " + rl + " axis" : ""));
   if (machine.has_head())
-    out.notes.push_back("tool_offset_Z: minus the error of pivot_length + tool_length, along the spindle");
+    out.notes.push_back(
+        "tool_offset_Z: minus the error of pivot_length + tool_length, along the spindle");
   if (!out.converged) out.notes.push_back("the fit did not converge: " + fit.summary.message);
   return out;
 }

@@ -94,10 +94,12 @@ Eigen::Vector3d RtestPaperIdentification::predict_reading(const Eigen::Vector3d&
 
 RtestPaperIdentification identify_paper(const RtestSession& session) {
   if (session.machine != MachineType::BC_trt)
-    throw InvalidArgument("identify_paper: session.machine: Oyama's two-step method is written for a "
-                          "BC-trt table, this session is a " + to_string(session.machine) +
-                          "; use the joint fit (identify_joint, `rotacal identify --method joint`), which "
-                          "works on any machine");
+    throw InvalidArgument(
+        "identify_paper: session.machine: Oyama's two-step method is written for a "
+        "BC-trt table, this session is a " +
+        to_string(session.machine) +
+        "; use the joint fit (identify_joint, `rotacal identify --method joint`), which "
+        "works on any machine");
   const std::vector<std::string> setups = session.setups();
   if (setups.size() < 2)
     throw InvalidArgument("identify_paper: session: the C-axis step needs >= 2 nests, got " +
@@ -130,8 +132,8 @@ RtestPaperIdentification identify_paper(const RtestSession& session) {
     q[k] = it->second;
   }
   for (const RtestSample& s : session.samples) {
-    const std::size_t k = static_cast<std::size_t>(
-        std::find(setups.begin(), setups.end(), s.setup) - setups.begin());
+    const std::size_t k =
+        static_cast<std::size_t>(std::find(setups.begin(), setups.end(), s.setup) - setups.begin());
     const int i = index_of(out.b_deg, s.tilt_deg);
     const int j = index_of(out.c_deg, std::fmod(std::fmod(s.rot_deg, 360.0) + 360.0, 360.0));
     d[k][i][j] = *s.d;
@@ -141,10 +143,10 @@ RtestPaperIdentification identify_paper(const RtestSession& session) {
     for (std::size_t i = 0; i < nB; ++i)
       for (std::size_t j = 0; j < nC; ++j)
         if (seen[k][i][j] != 1)
-          throw InvalidArgument("identify_paper: session: set-up " + setups[k] + " has " +
-                                std::to_string(seen[k][i][j]) + " samples at B = " +
-                                std::to_string(out.b_deg[i]) + ", C = " +
-                                std::to_string(out.c_deg[j]) + " (need exactly one per grid pose)");
+          throw InvalidArgument(
+              "identify_paper: session: set-up " + setups[k] + " has " +
+              std::to_string(seen[k][i][j]) + " samples at B = " + std::to_string(out.b_deg[i]) +
+              ", C = " + std::to_string(out.c_deg[j]) + " (need exactly one per grid pose)");
   for (std::size_t k = 0; k < nS; ++k) {
     const Eigen::Vector3d ref = d[k][i0][j0];
     for (auto& row : d[k])
@@ -183,8 +185,8 @@ RtestPaperIdentification identify_paper(const RtestSession& session) {
     out.w_BY[i] = x;
     out.w_BY_std[i] = sd;
     if (rank < 6)
-      out.unobservable.push_back("B = " + std::to_string(out.b_deg[i]) + " deg: " +
-                                 std::to_string(6 - rank) +
+      out.unobservable.push_back("B = " + std::to_string(out.b_deg[i]) +
+                                 " deg: " + std::to_string(6 - rank) +
                                  " combination(s) of w_BY are invisible relative to the reference "
                                  "pose and set to zero");
   };
@@ -211,7 +213,7 @@ RtestPaperIdentification identify_paper(const RtestSession& session) {
         const Eigen::Vector3d rB = Rz * (d[k][i][j] - pred);
         const Eigen::Vector3d P = Rz * q[k];
         A.middleRows<3>(3 * k) << -1, 0, 0, 0, -P.z(),  //
-            0, -1, 0, P.z(), 0,                          //
+            0, -1, 0, P.z(), 0,                         //
             0, 0, -1, -P.y(), P.x();
         b.segment<3>(3 * k) = rB;
       }
@@ -232,7 +234,8 @@ RtestPaperIdentification identify_paper(const RtestSession& session) {
       "appear in w_BY (Sec. 5.3)",
       "gamma_CB(B_i, C_j) = 0 assumed (Sec. 4.2)",
       "small-angle (first-order) model of Eqs. 8-9 in both steps",
-      "maps are given only at the measured (B_i, C_j); predictions in between interpolate linearly"};
+      "maps are given only at the measured (B_i, C_j); predictions in between interpolate "
+      "linearly"};
   return out;
 }
 

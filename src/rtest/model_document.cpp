@@ -5,14 +5,15 @@
 
 namespace rotacal {
 
-RtestJointModelContent rtest_joint_model_content(const RtestJointIdentification& ident,
-                                                 const std::map<std::string, Eigen::Vector3d>& nests) {
+RtestJointModelContent rtest_joint_model_content(
+    const RtestJointIdentification& ident, const std::map<std::string, Eigen::Vector3d>& nests) {
   std::map<std::string, const ParameterEstimate*> by_name;
   for (const ParameterEstimate& p : ident.parameters) by_name[p.name] = &p;
   const auto find = [&](const std::string& name) -> const ParameterEstimate& {
     const auto it = by_name.find(name);
     if (it == by_name.end())
-      throw InvalidArgument("rtest_joint_model_content: the identification has no parameter '" + name + "'");
+      throw InvalidArgument("rtest_joint_model_content: the identification has no parameter '" +
+                            name + "'");
     return *it->second;
   };
   const RtestJointModel& m = ident.model;
@@ -38,8 +39,8 @@ RtestJointModelContent rtest_joint_model_content(const RtestJointIdentification&
   return c;
 }
 
-nlohmann::ordered_json rtest_joint_model_document(const RtestJointIdentification& ident,
-                                                  const std::map<std::string, Eigen::Vector3d>& nests) {
+nlohmann::ordered_json rtest_joint_model_document(
+    const RtestJointIdentification& ident, const std::map<std::string, Eigen::Vector3d>& nests) {
   return rtest_joint_model_document(rtest_joint_model_content(ident, nests));
 }
 

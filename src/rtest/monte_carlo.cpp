@@ -11,7 +11,8 @@ namespace rotacal {
 
 RtestMonteCarlo monte_carlo(const RtestSession& session, const RtestJointIdentification& result,
                             const RtestMonteCarloOptions& o) {
-  if (o.draws < 2) throw InvalidArgument("monte_carlo: draws must be at least 2, got " + std::to_string(o.draws));
+  if (o.draws < 2)
+    throw InvalidArgument("monte_carlo: draws must be at least 2, got " + std::to_string(o.draws));
   const std::size_t n = session.samples.size();
   if (result.residuals.size() != n || result.n_samples != n)
     throw InvalidArgument("monte_carlo: result was fitted to " + std::to_string(result.n_samples) +
@@ -24,7 +25,8 @@ RtestMonteCarlo monte_carlo(const RtestSession& session, const RtestJointIdentif
   std::vector<Eigen::Vector3d> model(n);
   for (std::size_t i = 0; i < n; ++i) {
     if (!session.samples[i].d)
-      throw InvalidArgument("monte_carlo: session: sample " + std::to_string(i) + " has no dx,dy,dz");
+      throw InvalidArgument("monte_carlo: session: sample " + std::to_string(i) +
+                            " has no dx,dy,dz");
     model[i] = *session.samples[i].d - result.residuals[i];
   }
   const int p = static_cast<int>(result.parameters.size());
@@ -47,9 +49,9 @@ RtestMonteCarlo monte_carlo(const RtestSession& session, const RtestJointIdentif
     if (o.progress) o.progress(k + 1, o.draws);
   }
   // The probe zeros are nuisance parameters: not compared.
-  out.parameters = monte_carlo_summary(result.parameters, out.values, [](const ParameterEstimate& e) {
-    return e.name.rfind("zero.", 0) == 0;
-  });
+  out.parameters =
+      monte_carlo_summary(result.parameters, out.values,
+                          [](const ParameterEstimate& e) { return e.name.rfind("zero.", 0) == 0; });
   return out;
 }
 

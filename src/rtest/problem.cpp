@@ -1,21 +1,23 @@
 // The R-test problem's layout, arrays and residual model (rtest/problem.hpp).
 #include "rotacal/rtest/problem.hpp"
 
+#include <ceres/jet.h>
+
 #include <algorithm>
 #include <type_traits>
 
-#include <ceres/jet.h>
-
 namespace rotacal {
 
-RtestLayout rtest_layout(MachineType m, const std::vector<std::string>& setups, const RtestBasis* basis,
-                         const EffectModel& fx, RtestZeroNames zero_names) {
+RtestLayout rtest_layout(MachineType m, const std::vector<std::string>& setups,
+                         const RtestBasis* basis, const EffectModel& fx,
+                         RtestZeroNames zero_names) {
   RtestLayout L;
   L.errors = add_location_errors(L.all, m);
   // On a machine with head axes the sphere's distance from the controlled point, pivot_length
   // + tool_length, is a parameter of the head (formats.md): its error as tool_offset_Z.
-  L.tool = m.has_head() ? L.all.add("tool_offset_Z", {"tool_offset_Z"}, {"mm"})
-                        : L.all.add("tool_offset_Z", std::vector<std::string>{}, std::vector<std::string>{});
+  L.tool = m.has_head()
+               ? L.all.add("tool_offset_Z", {"tool_offset_Z"}, {"mm"})
+               : L.all.add("tool_offset_Z", std::vector<std::string>{}, std::vector<std::string>{});
   std::vector<std::string> b_names, b_units, c_names, c_units;
   if (basis) {
     // The basis as the machine has it (no rotations in a head axis' map): names and counts alike.
@@ -33,7 +35,8 @@ RtestLayout rtest_layout(MachineType m, const std::vector<std::string>& setups, 
   std::vector<std::string> z;
   for (const std::string& s : setups)
     for (const char* a : {"x", "y", "z"})
-      z.push_back(zero_names == RtestZeroNames::dotted ? "zero." + s + "." + a : std::string("zero_") + a + "#" + s);
+      z.push_back(zero_names == RtestZeroNames::dotted ? "zero." + s + "." + a
+                                                       : std::string("zero_") + a + "#" + s);
   L.zeros = L.all.add("zeros", std::move(z), {"mm"}, 3);
   L.effects = add_effects(L.all, fx);
   return L;
@@ -51,8 +54,10 @@ RtestArrays rtest_arrays(const RtestSession& session, const std::string& who, bo
       throw InvalidArgument(who + ": sample " + std::to_string(i) + " of set-up '" + s.setup +
                             "' has no dx,dy,dz (convert raw probe readings first)");
     const auto nest = session.nests.find(s.setup);
-    if (nest == session.nests.end()) throw InvalidArgument(who + ": session.nests: no nest." + s.setup);
-    a.setup_of.push_back(static_cast<int>(std::find(a.setups.begin(), a.setups.end(), s.setup) - a.setups.begin()));
+    if (nest == session.nests.end())
+      throw InvalidArgument(who + ": session.nests: no nest." + s.setup);
+    a.setup_of.push_back(
+        static_cast<int>(std::find(a.setups.begin(), a.setups.end(), s.setup) - a.setups.begin()));
     a.xyz.col(i) = s.xyz;
     a.nest.col(i) = nest->second;
     if (s.d) a.d.col(i) = *s.d;
@@ -62,11 +67,16 @@ RtestArrays rtest_arrays(const RtestSession& session, const std::string& who, bo
   return a;
 }
 
-RtestProblem::RtestProblem(const RtestArrays& d, const RtestBasis* basis, EffectModel fx, RtestZeroNames zero_names)
-    : d_(d), fx_(std::move(fx)), L_(rtest_layout(d.machine, d.setups, basis, fx_, zero_names)), maps_(basis != nullptr) {
+RtestProblem::RtestProblem(const RtestArrays& d, const RtestBasis* basis, EffectModel fx,
+                           RtestZeroNames zero_names)
+    : d_(d),
+      fx_(std::move(fx)),
+      L_(rtest_layout(d.machine, d.setups, basis, fx_, zero_names)),
+      maps_(basis != nullptr) {
   if (maps_ && !fx_.effects.empty())
-    throw InvalidArgument("R-test problem: the smooth maps and catalogue effects are two models of the table "
-                          "pose; give one");
+    throw InvalidArgument(
+        "R-test problem: the smooth maps and catalogue effects are two models of the table "
+        "pose; give one");
   if (!maps_) return;
   const RtestBasis b = basis->for_machine(d_.machine);  // as the layout counts its coefficients
   const Eigen::Index n = d_.size(), nb = L_.map_tilt.size, nc = L_.map_rot.size;
@@ -78,7 +88,8 @@ RtestProblem::RtestProblem(const RtestArrays& d, const RtestBasis* basis, Effect
   }
 }
 
-void RtestProblem::evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r, Eigen::MatrixXd* J) const {
+void RtestProblem::evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r,
+                            Eigen::MatrixXd* J) const {
   if (maps_) return evaluate_maps(x, r, J);
   const auto f = [this](Eigen::Index i, const auto* p, auto* out) {
     using T = std::remove_const_t<std::remove_pointer_t<decltype(p)>>;
@@ -108,7 +119,8 @@ void RtestProblem::evaluate_maps(const Eigen::VectorXd& x, Eigen::Ref<Eigen::Vec
     const Eigen::Vector3d zero = x.segment<3>(z0);
     const Eigen::Vector3d xyz = d_.xyz.col(i), q = d_.nest.col(i);
     if (!J) {
-      r.segment<3>(row) = rtest_joint_reading<double>(m, e, wb, wc, tz, d_.angles[k], xyz, q) + zero - d_.d.col(i);
+      r.segment<3>(row) =
+          rtest_joint_reading<double>(m, e, wb, wc, tz, d_.angles[k], xyz, q) + zero - d_.d.col(i);
       continue;
     }
     AxisErrors<Jet> wbj, wcj;

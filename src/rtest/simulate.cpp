@@ -27,7 +27,8 @@ std::string limits_text(const std::array<double, 2>& l) {
 
 // First offending commanded X, Y, Z of the nest q over the pattern's poses, as text; empty
 // when every pose is inside the travel (or the machine gives none).
-std::string travel_violation(MachineType m, const Eigen::Vector3d& q, const std::vector<double>& tilt_deg,
+std::string travel_violation(MachineType m, const Eigen::Vector3d& q,
+                             const std::vector<double>& tilt_deg,
                              const std::vector<double>& rot_deg) {
   const auto& travel = m.description().travel_mm;
   if (!travel) return "";
@@ -37,8 +38,9 @@ std::string travel_violation(MachineType m, const Eigen::Vector3d& q, const std:
       const Eigen::Vector3d xyz = rtest_commanded_xyz(m, q, {b * kDeg, c * kDeg});
       for (int k = 0; k < 3; ++k)
         if (xyz[k] < (*travel)(k, 0) - 1e-9 || xyz[k] > (*travel)(k, 1) + 1e-9)
-          return std::string(1, names[k]) + " = " + format_fixed(xyz[k], 3) + " mm at " + tilt_axis_letter(m) + " " +
-                 format_fixed(b, 3) + ", " + rot_axis_letter(m) + " " + format_fixed(c, 3) + " deg is outside the travel [" +
+          return std::string(1, names[k]) + " = " + format_fixed(xyz[k], 3) + " mm at " +
+                 tilt_axis_letter(m) + " " + format_fixed(b, 3) + ", " + rot_axis_letter(m) + " " +
+                 format_fixed(c, 3) + " deg is outside the travel [" +
                  format_fixed((*travel)(k, 0), 1) + ", " + format_fixed((*travel)(k, 1), 1) + "]";
     }
   return "";
@@ -58,16 +60,19 @@ RtestPattern default_rtest_pattern(MachineType m) {
   if (const auto& l = d.axis(m.rot_index()).limits_deg) {
     const double span = (*l)[1] - (*l)[0];
     p.c_deg.clear();
-    for (int i = 0; i < 12; ++i) p.c_deg.push_back(span >= 360.0 ? (*l)[0] + 30.0 * i : (*l)[0] + span * i / 11.0);
+    for (int i = 0; i < 12; ++i)
+      p.c_deg.push_back(span >= 360.0 ? (*l)[0] + 30.0 * i : (*l)[0] + span * i / 11.0);
   }
   for (std::size_t n = 0; n < p.nests.size(); ++n) {
     Eigen::Vector3d& q = p.nests[n];
     int halvings = 0;
     std::string why;
-    while (!(why = travel_violation(m, q, p.b_deg, p.c_deg)).empty() && halvings < 4) q *= 0.5, ++halvings;
+    while (!(why = travel_violation(m, q, p.b_deg, p.c_deg)).empty() && halvings < 4)
+      q *= 0.5, ++halvings;
     if (!why.empty())
-      throw InvalidArgument("default_rtest_pattern: " + to_string(m) + ": nest " + std::to_string(n + 1) +
-                            " does not fit the travel even at 1/16 of its default position: " + why);
+      throw InvalidArgument(
+          "default_rtest_pattern: " + to_string(m) + ": nest " + std::to_string(n + 1) +
+          " does not fit the travel even at 1/16 of its default position: " + why);
   }
   return p;
 }
@@ -90,14 +95,16 @@ void check_rtest_pattern(MachineType m, const RtestPattern& pattern, const std::
   for (std::size_t n = 0; n < pattern.nests.size(); ++n) {
     const std::string why = travel_violation(m, pattern.nests[n], pattern.b_deg, pattern.c_deg);
     if (!why.empty())
-      throw InvalidArgument(context + ": nest " + std::to_string(n + 1) + ": " + why + " on " + to_string(m));
+      throw InvalidArgument(context + ": nest " + std::to_string(n + 1) + ": " + why + " on " +
+                            to_string(m));
   }
 }
 
 RtestSimulation simulate_rtest(const MachineModel& truth, const RtestSimOptions& o) {
   truth.validate("simulate_rtest: truth");
   if (o.pattern.b_deg.empty() || o.pattern.c_deg.empty() || o.pattern.nests.empty())
-    throw InvalidArgument("simulate_rtest: options.pattern: b_deg, c_deg and nests must not be empty");
+    throw InvalidArgument(
+        "simulate_rtest: options.pattern: b_deg, c_deg and nests must not be empty");
   check_rtest_pattern(truth.machine, o.pattern, "simulate_rtest: options.pattern");
   if (o.noise_um < 0 || o.probe_zero_um < 0)
     throw InvalidArgument("simulate_rtest: options.noise_um and probe_zero_um must be >= 0");
@@ -111,21 +118,25 @@ RtestSimulation simulate_rtest(const MachineModel& truth, const RtestSimOptions&
   RtestSimulation out;
   RtestSession& s = out.session;
   s.machine = truth.machine;
-  if (o.noise_um > 0.0) s.noise_um = o.noise_um;  // noiseless: none declared (a 1-sigma of 0 is refused)
-  s.metadata = {{"format", "rotacal-rtest/1"}, {"machine", to_string(truth.machine)},
+  if (o.noise_um > 0.0)
+    s.noise_um = o.noise_um;  // noiseless: none declared (a 1-sigma of 0 is refused)
+  s.metadata = {{"format", "rotacal-rtest/1"},
+                {"machine", to_string(truth.machine)},
                 {"units", "mm, deg, s"}};
   for (std::size_t n = 0; n < o.pattern.nests.size(); ++n) {
     const Eigen::Vector3d& q = o.pattern.nests[n];
     const std::string label = std::to_string(n + 1);
     s.nests[label] = q;
-    s.metadata.push_back({"nest." + label, format_fixed(q.x(), 4) + ", " + format_fixed(q.y(), 4) + ", " + format_fixed(q.z(), 4)});
+    s.metadata.push_back({"nest." + label, format_fixed(q.x(), 4) + ", " + format_fixed(q.y(), 4) +
+                                               ", " + format_fixed(q.z(), 4)});
   }
   if (o.probe_dirs)
     for (int k = 0; k < 3; ++k) {
       const Eigen::Vector3d u = o.probe_dirs->row(k).transpose();
       s.probe_dirs[k + 1] = u;
-      s.metadata.push_back({"probe." + std::to_string(k + 1) + ".dir",
-                            format_fixed(u.x(), 6) + ", " + format_fixed(u.y(), 6) + ", " + format_fixed(u.z(), 6)});
+      s.metadata.push_back(
+          {"probe." + std::to_string(k + 1) + ".dir",
+           format_fixed(u.x(), 6) + ", " + format_fixed(u.y(), 6) + ", " + format_fixed(u.z(), 6)});
     }
   if (o.noise_um > 0.0) s.metadata.push_back({"noise_um", format_fixed(o.noise_um, 4)});
 
@@ -135,9 +146,11 @@ RtestSimulation simulate_rtest(const MachineModel& truth, const RtestSimOptions&
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     for (const Eigen::Vector3d& q : o.pattern.nests)
       for (double b : o.pattern.b_deg)
-        for (double c : o.pattern.c_deg) sum += rtest_commanded_xyz(truth.machine, q, {b * kDeg, c * kDeg});
-    fx.linear_reference = sum / static_cast<double>(o.pattern.nests.size() * o.pattern.b_deg.size() *
-                                                    o.pattern.c_deg.size());
+        for (double c : o.pattern.c_deg)
+          sum += rtest_commanded_xyz(truth.machine, q, {b * kDeg, c * kDeg});
+    fx.linear_reference =
+        sum / static_cast<double>(o.pattern.nests.size() * o.pattern.b_deg.size() *
+                                  o.pattern.c_deg.size());
   }
   double t = 0.0;
   for (std::size_t n = 0; n < o.pattern.nests.size(); ++n) {
@@ -153,9 +166,9 @@ RtestSimulation simulate_rtest(const MachineModel& truth, const RtestSimOptions&
         r.rot_deg = c;
         const RotaryAngles<double> a{b * kDeg, c * kDeg};
         r.xyz = rtest_commanded_xyz(truth.machine, q, a);
-        const Eigen::Vector3d d =
-            rtest_reading<double>(truth.machine, truth.errors, fx, truth.effect_data(),
-                                  r.xyz, a, t, q) + z;
+        const Eigen::Vector3d d = rtest_reading<double>(truth.machine, truth.errors, fx,
+                                                        truth.effect_data(), r.xyz, a, t, q) +
+                                  z;
         const Eigen::Vector3d e(noise(rng), noise(rng), noise(rng));
         if (o.probe_dirs) {
           r.raw = (*o.probe_dirs) * d + e;

@@ -51,10 +51,12 @@ RotaryAngles<double> angles_as(double tilt, double rot, bool file_is_radians) {
   throw InvalidArgument(source + ": implausible session: " + what);
 }
 
-void check_spans(const std::string& source, double tilt_span, double rot_span, const PlausibilityOptions& o) {
+void check_spans(const std::string& source, double tilt_span, double rot_span,
+                 const PlausibilityOptions& o) {
   if (tilt_span < o.min_rotary_span_deg && rot_span < o.min_rotary_span_deg)
-    refuse(source, "all rotary angles equal: the axes never move (tilt spans " + fmt(tilt_span) + " deg, C " +
-                       fmt(rot_span) + " deg); the rotary axes' errors cannot be seen");
+    refuse(source, "all rotary angles equal: the axes never move (tilt spans " + fmt(tilt_span) +
+                       " deg, C " + fmt(rot_span) +
+                       " deg); the rotary axes' errors cannot be seen");
 }
 
 }  // namespace
@@ -65,7 +67,8 @@ PlausibilityReport check_plausible(const BallbarSession& s, const std::string& s
   PlausibilityReport rep;
   const double L0 = s.ballbar_length;
   if (L0 < o.min_ballbar_length_mm)
-    refuse(source, "ballbar_length " + fmt(L0) + " mm: no ballbar is that short; lengths look like inches (" +
+    refuse(source, "ballbar_length " + fmt(L0) +
+                       " mm: no ballbar is that short; lengths look like inches (" +
                        fmt(L0 * kInch) + " mm?)");
   double max_abs_angle = 0.0;
   spans(s.samples, rep.tilt_span_deg, rep.rot_span_deg, max_abs_angle);
@@ -80,7 +83,8 @@ PlausibilityReport check_plausible(const BallbarSession& s, const std::string& s
     // The nominal bar: tool ball of the command against the nominal pivot (any machine).
     auto bar = [&](bool radians) {
       const RotaryAngles<double> a = angles_as(b.tilt_deg, b.rot_deg, radians);
-      return (tool_ball(s.machine, nominal, a, b.xyz) - forward(s.machine, nominal, a, s.pivot)).norm();
+      return (tool_ball(s.machine, nominal, a, b.xyz) - forward(s.machine, nominal, a, s.pivot))
+          .norm();
     };
     const double nominal_deg = bar(false), nominal_rad = bar(true);
     dev_deg.push_back(std::abs(b.length - nominal_deg));
@@ -97,30 +101,39 @@ PlausibilityReport check_plausible(const BallbarSession& s, const std::string& s
   const double med_len = median_of(measured), med_cmd = median_of(commanded);
   const double limit = o.max_length_deviation_mm;
   if (rep.max_deviation_mm <= limit && std::abs(med_len - L0) <= limit) return rep;
-  if (max_abs_angle <= 2.0 * kPi + 1e-9 && median_of(dev_rad) <= limit && rep.median_deviation_mm > limit)
-    refuse(source, "angles look like radians: every angle is within +-2 pi, and read as radians they fit "
-                   "the commanded positions (median deviation " + fmt(median_of(dev_rad) * 1e3, 3) +
-                       " um) while read as degrees they do not (" + fmt(rep.median_deviation_mm, 4) +
-                       " mm); the format wants degrees");
+  if (max_abs_angle <= 2.0 * kPi + 1e-9 && median_of(dev_rad) <= limit &&
+      rep.median_deviation_mm > limit)
+    refuse(source,
+           "angles look like radians: every angle is within +-2 pi, and read as radians they fit "
+           "the commanded positions (median deviation " +
+               fmt(median_of(dev_rad) * 1e3, 3) + " um) while read as degrees they do not (" +
+               fmt(rep.median_deviation_mm, 4) + " mm); the format wants degrees");
   if (std::abs(med_len * kInch - med_cmd) <= limit)
     refuse(source, "lengths look like inches: the measured lengths are ~" + fmt(med_len) +
-                       " while the commanded positions are ~" + fmt(med_cmd) + " mm from the pivot (" +
-                       fmt(med_len) + " in = " + fmt(med_len * kInch) + " mm); the format wants mm");
+                       " while the commanded positions are ~" + fmt(med_cmd) +
+                       " mm from the pivot (" + fmt(med_len) + " in = " + fmt(med_len * kInch) +
+                       " mm); the format wants mm");
   if (std::abs(med_len - L0) > limit && std::abs(med_len - med_cmd) <= limit)
-    refuse(source, "ballbar_length " + fmt(L0) + " but the data say ~" + fmt(med_len) +
-                       " mm (measured lengths and commanded positions agree on it): fix '# ballbar_length:'");
+    refuse(
+        source,
+        "ballbar_length " + fmt(L0) + " but the data say ~" + fmt(med_len) +
+            " mm (measured lengths and commanded positions agree on it): fix '# ballbar_length:'");
   if (std::abs(med_cmd - L0) <= limit && std::abs(med_len - L0) > limit)
-    refuse(source, "ballbar_length " + fmt(L0) + " and the commanded positions agree, but the measured lengths "
-                       "are ~" + fmt(med_len) + " mm: a length column in other units or of another ballbar?");
+    refuse(source, "ballbar_length " + fmt(L0) +
+                       " and the commanded positions agree, but the measured lengths "
+                       "are ~" +
+                       fmt(med_len) + " mm: a length column in other units or of another ballbar?");
   if (std::abs(med_cmd - L0) > limit && std::abs(med_len - L0) <= limit)
-    refuse(source, "the commanded positions are ~" + fmt(med_cmd) + " mm from the nominal pivot, not L0 = " +
-                       fmt(L0) + " mm: wrong '# pivot:', wrong machine, or the positions are not the "
+    refuse(source, "the commanded positions are ~" + fmt(med_cmd) +
+                       " mm from the nominal pivot, not L0 = " + fmt(L0) +
+                       " mm: wrong '# pivot:', wrong machine, or the positions are not the "
                        "commanded machine axes");
   const BallbarSample& w = s.samples[rep.worst_sample];
-  refuse(source, "sample " + std::to_string(rep.worst_sample) + " (test " + w.test + ", time " + fmt(w.time, 8) +
-                     " s): measured length " + fmt(w.length, 8) + " mm, nominal kinematics give " +
-                     fmt(commanded[rep.worst_sample], 8) + " mm; " + fmt(rep.max_deviation_mm) +
-                     " mm apart, more than the " + fmt(limit) +
+  refuse(source, "sample " + std::to_string(rep.worst_sample) + " (test " + w.test + ", time " +
+                     fmt(w.time, 8) + " s): measured length " + fmt(w.length, 8) +
+                     " mm, nominal kinematics give " + fmt(commanded[rep.worst_sample], 8) +
+                     " mm; " + fmt(rep.max_deviation_mm) + " mm apart, more than the " +
+                     fmt(limit) +
                      " mm a machine's errors and set-up explain (rotacal's --max-deviation or "
                      "PlausibilityOptions::max_length_deviation_mm widens it)");
 }
@@ -140,18 +153,20 @@ PlausibilityReport check_plausible(const RtestSession& s, const std::string& sou
     const Eigen::Vector3d& q = it->second;
     // Commanded linear axes against where the nominal machine commands the nest (any machine).
     auto off = [&](const Eigen::Vector3d& xyz, bool radians) {
-      return (xyz - inverse(s.machine, nominal, angles_as(r.tilt_deg, r.rot_deg, radians), q).xyz).norm();
+      return (xyz - inverse(s.machine, nominal, angles_as(r.tilt_deg, r.rot_deg, radians), q).xyz)
+          .norm();
     };
     dev_deg.push_back(off(r.xyz, false));
     dev_rad.push_back(off(r.xyz, true));
     dev_inch.push_back(off(r.xyz * kInch, false));
     if (r.d && r.d->cwiseAbs().maxCoeff() > o.max_displacement_mm) {
       const std::size_t i = dev_deg.size() - 1;
-      refuse(source, "pose " + std::to_string(i) + " (setup " + r.setup + ", time " + fmt(r.time, 8) +
-                         " s): displacement (" + fmt(r.d->x()) + ", " + fmt(r.d->y()) + ", " + fmt(r.d->z()) +
-                         ") mm exceeds " + fmt(o.max_displacement_mm) +
-                         " mm, far more than a machine's errors: displacements in um instead of mm, or "
-                         "a probe out of range? (PlausibilityOptions::max_displacement_mm widens it)");
+      refuse(source,
+             "pose " + std::to_string(i) + " (setup " + r.setup + ", time " + fmt(r.time, 8) +
+                 " s): displacement (" + fmt(r.d->x()) + ", " + fmt(r.d->y()) + ", " +
+                 fmt(r.d->z()) + ") mm exceeds " + fmt(o.max_displacement_mm) +
+                 " mm, far more than a machine's errors: displacements in um instead of mm, or "
+                 "a probe out of range? (PlausibilityOptions::max_displacement_mm widens it)");
     }
   }
   rep.median_deviation_mm = median_of(dev_deg);
@@ -161,24 +176,34 @@ PlausibilityReport check_plausible(const RtestSession& s, const std::string& sou
   const double limit = o.max_position_deviation_mm;
   if (rep.max_deviation_mm <= limit) return rep;
   if (max_abs_angle <= 2.0 * kPi + 1e-9 && median_of(dev_rad) <= limit)
-    refuse(source, "angles look like radians: every angle is within +-2 pi, and read as radians the commanded "
-                   "positions follow the nests (median " + fmt(median_of(dev_rad) * 1e3, 3) +
-                       " um) while read as degrees they do not; the format wants degrees");
+    refuse(
+        source,
+        "angles look like radians: every angle is within +-2 pi, and read as radians the commanded "
+        "positions follow the nests (median " +
+            fmt(median_of(dev_rad) * 1e3, 3) +
+            " um) while read as degrees they do not; the format wants degrees");
   if (median_of(dev_inch) <= limit)
-    refuse(source, "positions look like inches: times 25.4 the commanded positions follow the nests; the "
-                   "format wants mm");
+    refuse(source,
+           "positions look like inches: times 25.4 the commanded positions follow the nests; the "
+           "format wants mm");
   const RtestSample& w = s.samples[rep.worst_sample];
-  refuse(source, "pose " + std::to_string(rep.worst_sample) + " (setup " + w.setup + ", time " + fmt(w.time, 8) +
-                     " s): the commanded position is " + fmt(rep.max_deviation_mm) +
-                     " mm from where the nominal axes carry nest." + w.setup + ", more than the " + fmt(limit) +
-                     " mm a machine's errors explain: wrong nest metadata, wrong machine, or positions that "
-                     "are not the commanded axes (rotacal's --max-deviation or PlausibilityOptions::max_position_deviation_mm widens it)");
+  refuse(
+      source,
+      "pose " + std::to_string(rep.worst_sample) + " (setup " + w.setup + ", time " +
+          fmt(w.time, 8) + " s): the commanded position is " + fmt(rep.max_deviation_mm) +
+          " mm from where the nominal axes carry nest." + w.setup + ", more than the " +
+          fmt(limit) +
+          " mm a machine's errors explain: wrong nest metadata, wrong machine, or positions that "
+          "are not the commanded axes (rotacal's --max-deviation or "
+          "PlausibilityOptions::max_position_deviation_mm widens it)");
 }
 
-void check_model_machine(MachineType model_machine, MachineType session_machine, const std::string& model_source) {
+void check_model_machine(MachineType model_machine, MachineType session_machine,
+                         const std::string& model_source) {
   if (model_machine != session_machine)
-    throw InvalidArgument("session machine " + to_string(session_machine) + ", model " + to_string(model_machine) +
-                          " (" + model_source + "): a model applies only to its own machine");
+    throw InvalidArgument("session machine " + to_string(session_machine) + ", model " +
+                          to_string(model_machine) + " (" + model_source +
+                          "): a model applies only to its own machine");
 }
 
 }  // namespace rotacal

@@ -1,10 +1,9 @@
 // Uses the installed package: where does a table point go on an AC-trt table with an E_X0C?
+#include <cmath>
+#include <iostream>
 #include <rotacal/ballbar/model_document.hpp>
 #include <rotacal/io/model_file.hpp>
 #include <rotacal/kinematics/machine.hpp>
-
-#include <cmath>
-#include <iostream>
 
 int main() {
   rotacal::LocationErrors<double> e;
@@ -17,7 +16,8 @@ int main() {
   // The model file through the installed package (its nlohmann_json dependency found for us).
   rotacal::BallbarMachineModel m;
   m.errors = e;
-  const rotacal::ModelFile f = rotacal::parse_model(rotacal::format_model(rotacal::ballbar_model_document(m)), "m");
+  const rotacal::ModelFile f =
+      rotacal::parse_model(rotacal::format_model(rotacal::ballbar_model_document(m)), "m");
   std::cout << "model file round trip: E_X0C = " << f.location_errors.v[4] << " mm\n";
   return f.location_errors.v == e.v ? 0 : 1;
 }

@@ -3,16 +3,15 @@
 // the joint fit; hidden location errors within 3 sigma, unobservable combinations named with
 // the set-up change that would show them.
 #include <catch2/catch.hpp>
-
 #include <random>
 #include <sstream>
 
+#include "../support/synthetic_sessions.hpp"
 #include "rotacal/ballbar/compensate.hpp"
 #include "rotacal/ballbar/identify.hpp"
 #include "rotacal/ballbar/nc_program.hpp"
 #include "rotacal/ballbar/plan.hpp"
 #include "rotacal/diagnose/ballbar_diagnosis.hpp"
-#include "../support/synthetic_sessions.hpp"
 
 using namespace rotacal;
 
@@ -43,7 +42,8 @@ std::vector<MachineType> machines() {
 
 }  // namespace
 
-TEST_CASE("hidden location errors are identified within 3 sigma on every machine", "[any_machine]") {
+TEST_CASE("hidden location errors are identified within 3 sigma on every machine",
+          "[any_machine]") {
   std::mt19937 rng(2026);
   std::normal_distribution<double> N(0.0, 1.0);
   std::uint64_t seed = 100;
@@ -53,7 +53,8 @@ TEST_CASE("hidden location errors are identified within 3 sigma on every machine
     const BallbarSession cmd = commanded_session(plan_ballbar_test(setup));
     BallbarMachineModel truth;
     truth.machine = m;
-    for (int i = 0; i < 8; ++i) truth.errors.v[i] = location_error_is_angle(i) ? 5e-5 * N(rng) : 0.03 * N(rng);
+    for (int i = 0; i < 8; ++i)
+      truth.errors.v[i] = location_error_is_angle(i) ? 5e-5 * N(rng) : 0.03 * N(rng);
     truth.pivot = cmd.pivot + 0.02 * Eigen::Vector3d(N(rng), N(rng), N(rng));
     if (m.has_head()) {  // a tool 15 um short: a head parameter the fit models
       truth.effects.effects.push_back(Effect::parse("tool_offset_Z"));
@@ -78,7 +79,8 @@ TEST_CASE("hidden location errors are identified within 3 sigma on every machine
       REQUIRE(!id.unobservable.empty());
       CHECK_THAT(id.unobservable.front(), Catch::Contains("tool_offset_Z"));
       bool advised = false;
-      for (const std::string& n : id.notes) advised |= n.find("second tool length") != std::string::npos;
+      for (const std::string& n : id.notes)
+        advised |= n.find("second tool length") != std::string::npos;
       CHECK(advised);
     } else {
       CHECK(id.unobservable.empty());
@@ -95,7 +97,8 @@ TEST_CASE("the plan keeps every rotary angle inside the machine's limits", "[any
   CHECK_NOTHROW(plan_ballbar_test(setup));
 }
 
-TEST_CASE("machine-axis programs put the ball where the plan wants it on every machine", "[any_machine]") {
+TEST_CASE("machine-axis programs put the ball where the plan wants it on every machine",
+          "[any_machine]") {
   for (const MachineType m : machines()) {
     INFO(to_string(m));
     const BallbarPlan plan = plan_ballbar_test(default_setup(m, 5.0));
@@ -111,13 +114,16 @@ TEST_CASE("machine-axis programs put the ball where the plan wants it on every m
   }
 }
 
-TEST_CASE("a description written out for AC-trt identifies the shared sessions as the built-in does", "[any_machine]") {
+TEST_CASE(
+    "a description written out for AC-trt identifies the shared sessions as the built-in does",
+    "[any_machine]") {
   for (const char* file : {"data/ballbar_ac_table2.csv", "data/ballbar_ac_random.csv"}) {
     INFO(file);
     const BallbarSession builtin = read_ballbar(synthetic::shared_file(file));
     // The same machine as a rotacal-machine/1 description of another name, through a file:
     // the session then carries '# machine_description:'.
-    MachineDescription d = parse_machine_description(machine_description_json(builtin.machine.description()), "copy");
+    MachineDescription d =
+        parse_machine_description(machine_description_json(builtin.machine.description()), "copy");
     d.name = "AC table described";
     BallbarSession described = builtin;
     described.machine = MachineType::from_description(d);
@@ -167,7 +173,8 @@ TEST_CASE("compensation removes what the ballbar sees on head machines", "[any_m
     truth.effect_params = {0.02};
     const CompensationReport r = verify_compensation(cmd, truth, {0.5, 7, true});
     for (const CompensationRow& row : r.rows) {
-      INFO(row.name << " before " << row.before << " after " << row.after << " +- " << row.std_after);
+      INFO(row.name << " before " << row.before << " after " << row.after << " +- "
+                    << row.std_after);
       const bool seen = r.after.parameter(row.name).observable;
       if (seen) CHECK(std::abs(row.after) <= 4.0 * row.std_after);
     }
@@ -176,7 +183,8 @@ TEST_CASE("compensation removes what the ballbar sees on head machines", "[any_m
   }
 }
 
-TEST_CASE("files of the new built-ins carry their description and read back as the built-in", "[any_machine]") {
+TEST_CASE("files of the new built-ins carry their description and read back as the built-in",
+          "[any_machine]") {
   for (const std::string& name : builtin_machine_names()) {
     INFO(name);
     const BallbarSetup setup = default_setup(parse_machine_type(name), 10.0);

@@ -232,8 +232,9 @@ Eigen::Index joint_index(int j, int p, int ne) {
 
 }  // namespace
 
-TEST_CASE("one draw of the session and the added test, fitted jointly: the design's parameters "
-          "and their uncertainty") {
+TEST_CASE(
+    "one draw of the session and the added test, fitted jointly: the design's parameters "
+    "and their uncertainty") {
   const SeparationStudy st = separation_study();
   const SeparationDesign& d = st.d;
   check_separation_design(d);
@@ -252,12 +253,13 @@ TEST_CASE("one draw of the session and the added test, fitted jointly: the desig
   REQUIRE(f.covariance.rows() == p);
   REQUIRE(f.covariance.cols() == p);
   Eigen::VectorXd truth(11 + ne);
-  truth << st.truth.errors.v, st.cmd.pivot, Eigen::Map<const Eigen::VectorXd>(
-                                                 st.truth.effect_params.data(), ne);
+  truth << st.truth.errors.v, st.cmd.pivot,
+      Eigen::Map<const Eigen::VectorXd>(st.truth.effect_params.data(), ne);
   for (int j = 0; j < p; ++j) {
     const Eigen::Index k = joint_index(j, p, ne);
-    INFO(d.names[static_cast<std::size_t>(j)] << " (fit: " << f.estimates[k].name << "): "
-         << f.values[k] << " jointly, predicted sigma " << d.sigma_after[j]);
+    INFO(d.names[static_cast<std::size_t>(j)]
+         << " (fit: " << f.estimates[k].name << "): " << f.values[k] << " jointly, predicted sigma "
+         << d.sigma_after[j]);
     CHECK(f.estimates[k].name == d.names[static_cast<std::size_t>(j)]);
     CHECK(std::isfinite(f.values[k]));
     // The parameters the design holds, the fit holds; the others it determines.

@@ -1,23 +1,24 @@
 // Tests of the ballbar joint fit and paper chain: random machines, observability, compensation.
 #include <catch2/catch.hpp>
-
 #include <random>
 
+#include "../../src/ballbar/length_model.hpp"  // the fit's model, to compare its two Jacobians
 #include "rotacal/ballbar/compensate.hpp"
 #include "rotacal/ballbar/identify.hpp"
 #include "rotacal/ballbar/identify_paper.hpp"
-#include "rotacal/ballbar/simulate.hpp"
 #include "rotacal/ballbar/plan.hpp"
-#include "../../src/ballbar/length_model.hpp"  // the fit's model, to compare its two Jacobians
+#include "rotacal/ballbar/simulate.hpp"
 
 using namespace rotacal;
 
 namespace {
-BallbarMachineModel random_machine(MachineType m, const Eigen::Vector3d& nominal_pivot, std::mt19937& rng) {
+BallbarMachineModel random_machine(MachineType m, const Eigen::Vector3d& nominal_pivot,
+                                   std::mt19937& rng) {
   std::normal_distribution<double> N(0.0, 1.0);
   BallbarMachineModel t;
   t.machine = m;
-  for (int i = 0; i < 8; ++i) t.errors.v[i] = location_error_is_angle(i) ? 5e-5 * N(rng) : 0.03 * N(rng);
+  for (int i = 0; i < 8; ++i)
+    t.errors.v[i] = location_error_is_angle(i) ? 5e-5 * N(rng) : 0.03 * N(rng);
   t.pivot = nominal_pivot + 0.02 * Eigen::Vector3d(N(rng), N(rng), N(rng));
   return t;
 }
@@ -50,7 +51,8 @@ TEST_CASE("joint fit recovers random machines within 3 sigma, AC and BC", "[ball
       const BallbarMachineModel t = random_machine(m, cmd.pivot, rng);
       JointFitOptions automatic;  // the noise model estimated; white noise must come out white
       automatic.noise = NoiseHandling::automatic;
-      const BallbarIdentification id = identify_joint(simulate_ballbar(cmd, t, {0.5, seed, true}), automatic);
+      const BallbarIdentification id =
+          identify_joint(simulate_ballbar(cmd, t, {0.5, seed, true}), automatic);
       INFO("noise model " << id.noise.summary());
       CHECK(id.converged);
       CHECK_FALSE(id.noise_refit);  // white noise: fitted once, as before
@@ -61,7 +63,8 @@ TEST_CASE("joint fit recovers random machines within 3 sigma, AC and BC", "[ball
   }
 }
 
-TEST_CASE("paper chain recovers random machines within 3 sigma plus its approximation", "[ballbar]") {
+TEST_CASE("paper chain recovers random machines within 3 sigma plus its approximation",
+          "[ballbar]") {
   // Allowance for the chain's small-error approximations (Eq. 2, nominal radial coordinates
   // in the axial tests, first-order pivot): measured at 0.24 um and 1.2 urad on the Table 2
   // machine of ../shared/data; 0.5 um and 2 urad here.
@@ -79,9 +82,11 @@ TEST_CASE("paper chain recovers random machines within 3 sigma plus its approxim
 TEST_CASE("a test the session lacks: joint names what it cannot see, paper refuses", "[ballbar]") {
   std::mt19937 rng(13);
   const BallbarSession cmd = commanded(MachineType::AC_trt);
-  const BallbarSession s = simulate_ballbar(cmd, random_machine(MachineType::AC_trt, cmd.pivot, rng), {0.5, 4, true});
+  const BallbarSession s =
+      simulate_ballbar(cmd, random_machine(MachineType::AC_trt, cmd.pivot, rng), {0.5, 4, true});
   JointFitOptions o;
-  o.tests = {"sphere_xy", "sphere_yz", "sphere_zx", "radial_A", "axial_A", "radial_C"};  // no axial_C
+  o.tests = {"sphere_xy", "sphere_yz", "sphere_zx",
+             "radial_A",  "axial_A",   "radial_C"};  // no axial_C
   const BallbarIdentification id = identify_joint(s, o);
   CHECK_FALSE(id.parameter("E_A0C").observable);
   CHECK_FALSE(id.parameter("E_B0C").observable);
@@ -120,7 +125,8 @@ TEST_CASE("compensation of the Table 2 machine removes at least 85 % of every er
   t.pivot = cmd.pivot + Eigen::Vector3d(0.012, -0.008, 0.015);
   const CompensationReport r = verify_compensation(cmd, t, {0.1, 7, true});
   for (const CompensationRow& row : r.rows) {
-    INFO(row.name << ": " << row.before << " -> " << row.after << " (" << row.change_percent << " %)");
+    INFO(row.name << ": " << row.before << " -> " << row.after << " (" << row.change_percent
+                  << " %)");
     CHECK(row.change_percent <= -85.0);
     CHECK(std::abs(row.after) <= 4.0 * row.std_after * std::sqrt(2.0));  // what is left is noise
   }
@@ -134,13 +140,15 @@ TEST_CASE("compensation of the Table 2 machine removes at least 85 % of every er
 }
 
 namespace {
-// AR(1) prewhitening of residuals in mm: e_i = phi e_{i-1} + s w_i (marginal sigma s / sqrt(1 - phi^2)).
+// AR(1) prewhitening of residuals in mm: e_i = phi e_{i-1} + s w_i (marginal sigma s / sqrt(1 -
+// phi^2)).
 class Ar1 : public ResidualWhitener {
  public:
   Ar1(Eigen::Index n, double phi, double s) : n_(n), phi_(phi), s_(s) {}
   void apply(Eigen::Ref<Eigen::MatrixXd> c) const override {
     for (Eigen::Index j = 0; j < c.cols(); ++j) {
-      for (Eigen::Index i = c.rows() - 1; i >= 1; --i) c(i, j) = (c(i, j) - phi_ * c(i - 1, j)) / s_;
+      for (Eigen::Index i = c.rows() - 1; i >= 1; --i)
+        c(i, j) = (c(i, j) - phi_ * c(i - 1, j)) / s_;
       c(0, j) *= std::sqrt(1.0 - phi_ * phi_) / s_;
     }
   }
@@ -152,7 +160,8 @@ class Ar1 : public ResidualWhitener {
 };
 }  // namespace
 
-TEST_CASE("joint fit with a noise model (GLS): whitened chi2, honest sigma, recovery", "[ballbar]") {
+TEST_CASE("joint fit with a noise model (GLS): whitened chi2, honest sigma, recovery",
+          "[ballbar]") {
   std::mt19937 rng(31);
   const BallbarSession cmd = commanded(MachineType::AC_trt);
   const BallbarMachineModel t = random_machine(MachineType::AC_trt, cmd.pivot, rng);
@@ -184,7 +193,8 @@ TEST_CASE("joint fit with a noise model (GLS): whitened chi2, honest sigma, reco
   CHECK_THROWS_WITH(identify_joint(s, wrong), Catch::Contains("whitener"));
 }
 
-TEST_CASE("the analytic Jacobian of the length model equals the Jets on every machine", "[identify][jacobian]") {
+TEST_CASE("the analytic Jacobian of the length model equals the Jets on every machine",
+          "[identify][jacobian]") {
   std::mt19937 rng(99);
   std::normal_distribution<double> N(0.0, 1.0);
   for (const std::string& name : builtin_machine_names()) {
@@ -225,13 +235,15 @@ TEST_CASE("the analytic Jacobian of the length model equals the Jets on every ma
       for (Eigen::Index k = 0; k < rs.size(); ++k) {
         CHECK(std::abs(rs[k] - r2[k * stride]) < 1e-12);
         CHECK(std::abs(rs_only[k] - r2[k * stride]) < 1e-12);
-        CHECK((Js.row(k) - J2.row(k * stride)).cwiseAbs().maxCoeff() < 1e-9 * (1.0 + J2.cwiseAbs().maxCoeff()));
+        CHECK((Js.row(k) - J2.row(k * stride)).cwiseAbs().maxCoeff() <
+              1e-9 * (1.0 + J2.cwiseAbs().maxCoeff()));
       }
     }
   }
 }
 
-TEST_CASE("the chain-rule Jacobian of the length model with effects equals the Jets", "[identify][jacobian]") {
+TEST_CASE("the chain-rule Jacobian of the length model with effects equals the Jets",
+          "[identify][jacobian]") {
   // Every kind of stage (angle, E, K, D, tool side, reading), several effects on one axis' E,
   // more than four effect parameters (two passes of Jets), nonzero effect parameters, motion.
   std::mt19937 rng(98);
@@ -246,9 +258,10 @@ TEST_CASE("the chain-rule Jacobian of the length model with effects equals the J
     const char t = tilt_axis_letter(m);
     const std::string T(1, t);
     EffectModel fx;
-    for (const std::string& id : std::vector<std::string>{"coning_" + T, "gravity_sag_" + T, "tilt_motion_C_h1", "radial_motion_C_h2",
-                                  "angular_positioning_" + T + "_h2", "servo_lag_C", "thermal_warmup_X",
-                                  "angular_error_BX", "ballbar_thermal_drift", "tool_offset_X"})
+    for (const std::string& id : std::vector<std::string>{
+             "coning_" + T, "gravity_sag_" + T, "tilt_motion_C_h1", "radial_motion_C_h2",
+             "angular_positioning_" + T + "_h2", "servo_lag_C", "thermal_warmup_X",
+             "angular_error_BX", "ballbar_thermal_drift", "tool_offset_X"})
       fx.effects.push_back(Effect::parse(id));
     fx.linear_reference = Eigen::Vector3d(10.0, -5.0, 40.0);
     const BallbarLengthModel model(a, fx);
@@ -265,7 +278,8 @@ TEST_CASE("the chain-rule Jacobian of the length model with effects equals the J
     CHECK((r1 - r2).cwiseAbs().maxCoeff() < 1e-12);
     for (int c = 0; c < p; ++c) {
       INFO("column " << c);
-      CHECK((J1.col(c) - J2.col(c)).cwiseAbs().maxCoeff() <= 1e-12 * (1e-300 + J2.col(c).cwiseAbs().maxCoeff()));
+      CHECK((J1.col(c) - J2.col(c)).cwiseAbs().maxCoeff() <=
+            1e-12 * (1e-300 + J2.col(c).cwiseAbs().maxCoeff()));
     }
   }
 }
@@ -278,7 +292,8 @@ TEST_CASE("arrays built without the motion refuse an effect of the motion", "[id
   fx.effects = {Effect::parse("backlash_C")};
   const BallbarArrays without = ballbar_arrays(s, {}, false);
   CHECK(without.motion.empty());
-  CHECK_THROWS_WITH(BallbarLengthModel(without, fx), Catch::Contains("backlash_C") && Catch::Contains("motion"));
+  CHECK_THROWS_WITH(BallbarLengthModel(without, fx),
+                    Catch::Contains("backlash_C") && Catch::Contains("motion"));
   const BallbarArrays with = ballbar_arrays(s);
   CHECK(with.motion.size() == static_cast<std::size_t>(with.size()));
   CHECK_NOTHROW(BallbarLengthModel(with, fx));

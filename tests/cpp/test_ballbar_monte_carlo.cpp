@@ -1,14 +1,13 @@
 // Tests of the ballbar Monte Carlo: same draws as simulate_ballbar + identify_joint, spread
 // against the reported sigma, a coloured-noise generator plugged in, refusals.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <random>
 
 #include "rotacal/ballbar/identify_paper.hpp"
 #include "rotacal/ballbar/monte_carlo.hpp"
-#include "rotacal/ballbar/simulate.hpp"
 #include "rotacal/ballbar/plan.hpp"
+#include "rotacal/ballbar/simulate.hpp"
 
 using namespace rotacal;
 
@@ -37,7 +36,8 @@ struct Fixture {
 };
 }  // namespace
 
-TEST_CASE("Monte Carlo draws are those of simulate_ballbar and refits match fresh fits", "[monte_carlo]") {
+TEST_CASE("Monte Carlo draws are those of simulate_ballbar and refits match fresh fits",
+          "[monte_carlo]") {
   const Fixture f;
   REQUIRE(f.id.converged);
   BallbarMonteCarloOptions o;
@@ -47,7 +47,8 @@ TEST_CASE("Monte Carlo draws are those of simulate_ballbar and refits match fres
   CHECK(mc.fresh_fits == 0);
   CHECK(mc.noise_um == Approx(f.id.sigma_um));
   for (int k = 0; k < o.draws; ++k) {
-    const BallbarSession sim = simulate_ballbar(f.session, f.id.model, {f.id.sigma_um, o.seed + k, true});
+    const BallbarSession sim =
+        simulate_ballbar(f.session, f.id.model, {f.id.sigma_um, o.seed + k, true});
     const BallbarIdentification fresh = identify_joint(sim, f.fit);
     for (std::size_t j = 0; j < fresh.parameters.size(); ++j) {
       INFO("draw " << k << " " << fresh.parameters[j].name);
@@ -75,7 +76,8 @@ TEST_CASE("Monte Carlo spread matches the reported sigma on white noise", "[mont
   }
 }
 
-TEST_CASE("a coloured noise generator shows the white fit's sigma to be optimistic", "[monte_carlo]") {
+TEST_CASE("a coloured noise generator shows the white fit's sigma to be optimistic",
+          "[monte_carlo]") {
   const Fixture f;
   BallbarMonteCarloOptions o;
   o.draws = 200;

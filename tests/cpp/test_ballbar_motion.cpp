@@ -1,7 +1,6 @@
 // The rotary axes' motion read from a session's time and angle columns (ballbar/motion.hpp),
 // and what the motion effects of the catalogue do with it (kinematics/effects.hpp).
 #include <catch2/catch.hpp>
-
 #include <cmath>
 
 #include "rotacal/ballbar/motion.hpp"
@@ -31,8 +30,8 @@ Eigen::Vector3d moved(const std::string& id, std::vector<double> p, RotaryAngles
 }
 
 Eigen::Vector3d at_angle(RotaryAngles<double> a) {
-  return table_point<double>(MachineType::AC_trt, LocationErrors<double>(), EffectModel{}, nullptr, a, 0.0,
-                             Eigen::Vector3d(120, 0, 60));
+  return table_point<double>(MachineType::AC_trt, LocationErrors<double>(), EffectModel{}, nullptr,
+                             a, 0.0, Eigen::Vector3d(120, 0, 60));
 }
 
 }  // namespace
@@ -52,8 +51,8 @@ TEST_CASE("rates, directions and reversals from the time and angle columns", "[b
     CHECK(std::isinf(m[i].since_reversal.rot));
     CHECK(m[i].direction.tilt == 0.0);
   }
-  CHECK(m[5].rate.rot == 0.0);        // a single row is at rest ...
-  CHECK(m[5].direction.rot == 1.0);   // ... on the side it last moved to
+  CHECK(m[5].rate.rot == 0.0);       // a single row is at rest ...
+  CHECK(m[5].direction.rot == 1.0);  // ... on the side it last moved to
   // Reversed where the line through the row before the first row down (at rest at C 4 deg,
   // 1.0 s) meets the line through that row (C 4 deg at 2.0 s, -20 deg/s): at 2.0 s.
   for (int i = 6; i < 11; ++i) {
@@ -70,13 +69,16 @@ TEST_CASE("rates, directions and reversals from the time and angle columns", "[b
   // Rows across a vertex (a program's cw run from where its ccw run ended, sampled between
   // points): the reversal is placed at the vertex, not at the first row after it.
   std::vector<BallbarSample> v;
-  for (int i = 0; i < 5; ++i) v.push_back(row("ccw", 0.1 * i, 0.0, 10.0 * i));  // up to 40 deg at 0.4 s
-  for (int i = 0; i < 5; ++i) v.push_back(row("cw", 0.43 + 0.1 * i, 0.0, 40.0 - 100.0 * (0.03 + 0.1 * i)));
+  for (int i = 0; i < 5; ++i)
+    v.push_back(row("ccw", 0.1 * i, 0.0, 10.0 * i));  // up to 40 deg at 0.4 s
+  for (int i = 0; i < 5; ++i)
+    v.push_back(row("cw", 0.43 + 0.1 * i, 0.0, 40.0 - 100.0 * (0.03 + 0.1 * i)));
   const std::vector<RotaryMotion> mv = rotary_motion(v);
   CHECK(mv[5].since_reversal.rot == Approx(0.43 - 0.4).margin(1e-9));  // vertex at 0.4 s
 }
 
-TEST_CASE("motion effects: backlash, servo lag and reversal spikes shift the actual angle", "[effects][motion]") {
+TEST_CASE("motion effects: backlash, servo lag and reversal spikes shift the actual angle",
+          "[effects][motion]") {
   const RotaryAngles<double> a{0.3, 1.1};
   RotaryMotion mv;
   mv.rate.rot = 0.2;
@@ -93,22 +95,26 @@ TEST_CASE("motion effects: backlash, servo lag and reversal spikes shift the act
   CHECK((moved("servo_lag_C", {2e-3}, a, mv) - at_angle({0.3, 1.1 - 2e-3 * 0.2})).norm() < 1e-12);
   // Reversal spike h, tau_s = 0.05 s e^q: h e^(-dt / tau_s) behind, in the new direction.
   const double h = 3e-5, q = std::log(0.4);  // tau_s = 20 ms
-  CHECK((moved("reversal_spike_C", {h, q}, a, mv) - at_angle({0.3, 1.1 - h * std::exp(-0.03 / 0.02)})).norm() <
-        1e-12);
+  CHECK(
+      (moved("reversal_spike_C", {h, q}, a, mv) - at_angle({0.3, 1.1 - h * std::exp(-0.03 / 0.02)}))
+          .norm() < 1e-12);
   // The tilt axis reads the tilt's motion, not C's (RotaryMotion members by axis role).
   CHECK((moved("backlash_A", {b}, a, mv) - at_angle(a)).norm() < 1e-15);
   RotaryMotion tilting;
   tilting.direction.tilt = -1.0;
   tilting.rate.tilt = -0.5;
   CHECK((moved("backlash_A", {b}, a, tilting) - at_angle({0.3 + b / 2, 1.1})).norm() < 1e-12);
-  CHECK((moved("servo_lag_A", {2e-3}, a, tilting) - at_angle({0.3 + 2e-3 * 0.5, 1.1})).norm() < 1e-12);
+  CHECK((moved("servo_lag_A", {2e-3}, a, tilting) - at_angle({0.3 + 2e-3 * 0.5, 1.1})).norm() <
+        1e-12);
   CHECK((moved("servo_lag_C", {2e-3}, a, tilting) - at_angle(a)).norm() < 1e-15);
   // At rest with no history (a static pose, an R-test): all zero.
   for (const char* id : {"backlash_C", "servo_lag_C", "reversal_spike_A"})
-    CHECK((moved(id, std::vector<double>(static_cast<std::size_t>(Effect::parse(id).num_params()), 1e-4), a,
-                 RotaryMotion{}) -
-           at_angle(a))
-              .norm() < 1e-15);
+    CHECK(
+        (moved(id,
+               std::vector<double>(static_cast<std::size_t>(Effect::parse(id).num_params()), 1e-4),
+               a, RotaryMotion{}) -
+         at_angle(a))
+            .norm() < 1e-15);
   CHECK(Effect::parse("servo_lag_A").depends_on_motion());
   CHECK_FALSE(Effect::parse("rotary_zero_offset_C").depends_on_motion());
 }

@@ -266,7 +266,8 @@ TEST_CASE("a hand-made plan with coordinates no machine has, or moves without ti
   BallbarPlan plan = plan_ballbar_test(BallbarSetup{});
   BallbarPlan far = plan;
   far.segments[0].samples[1].xyz.x() = 1e300;
-  CHECK_THROWS_WITH(write_nc_program(far, NcDialect::linuxcnc), Catch::Contains("no machine can be sent to"));
+  CHECK_THROWS_WITH(write_nc_program(far, NcDialect::linuxcnc),
+                    Catch::Contains("no machine can be sent to"));
   BallbarPlan still = plan;
   still.segments[0].samples[1].time = still.segments[0].samples[0].time;
   CHECK_THROWS_WITH(write_nc_program(still, NcDialect::linuxcnc), Catch::Contains("takes no time"));
@@ -286,7 +287,8 @@ bool is_comment(NcDialect d, const std::string& l) {
 std::vector<std::string> blocks(NcDialect d, const std::string& text) {
   std::vector<std::string> out;
   for (std::string l : lines_of(text)) {
-    if (d == NcDialect::heidenhain && !l.empty() && std::isdigit(static_cast<unsigned char>(l[0])))  // block number
+    if (d == NcDialect::heidenhain && !l.empty() &&
+        std::isdigit(static_cast<unsigned char>(l[0])))  // block number
       l = l.substr(l.find(' ') + 1);
     if (!is_comment(d, l)) out.push_back(l);
   }
@@ -303,9 +305,10 @@ MachineType renamed(MachineType m, const std::string& name) {
 
 TEST_CASE("a machine's name cannot add a block to the program, in any dialect", "[ballbar][nc]") {
   // The name is free text from a description file; it is written in the header comments.
-  const std::string hostile[] = {"x\nG0 Z-500\n", "x\r\nG0 Z-500\r\n", "x) G0 Z-500 (", "x; G0 Z-500",
-                                 "%\nG0 Z-500\n%", "MSG, G0 Z-500", "\n$TC_CARR4[1]=500\nM30",
-                                 std::string(400, 'n') + "\nG0 Z-500"};
+  const std::string hostile[] = {"x\nG0 Z-500\n",           "x\r\nG0 Z-500\r\n",
+                                 "x) G0 Z-500 (",           "x; G0 Z-500",
+                                 "%\nG0 Z-500\n%",          "MSG, G0 Z-500",
+                                 "\n$TC_CARR4[1]=500\nM30", std::string(400, 'n') + "\nG0 Z-500"};
   for (MachineType base : {MachineType::AC_trt, MachineType::BC_trt}) {
     BallbarSetup s;
     s.tests = {BallbarTest::sphere_xy, BallbarTest::radial_c};
@@ -315,7 +318,8 @@ TEST_CASE("a machine's name cannot add a block to the program, in any dialect", 
     for (const std::string& name : hostile) {
       s.machine = renamed(base, name);
       const BallbarPlan plan = plan_ballbar_test(s);
-      for (NcDialect d : {NcDialect::linuxcnc, NcDialect::heidenhain, NcDialect::siemens, NcDialect::fanuc}) {
+      for (NcDialect d :
+           {NcDialect::linuxcnc, NcDialect::heidenhain, NcDialect::siemens, NcDialect::fanuc}) {
         INFO(to_string(d) << ", machine named '" << name << "'");
         const std::string text = write_nc_program(plan, d);
         // The same blocks as for a plain name, every other line a whole comment.

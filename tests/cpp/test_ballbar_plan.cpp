@@ -399,7 +399,8 @@ TEST_CASE("tabulate and commanded_session flatten the plan in order", "[ballbar]
   CHECK(parse_ballbar(in, "plan").samples.size() == session.samples.size());
 }
 
-TEST_CASE("tangential tests: the bar along the pivot's circle, at L0 throughout", "[ballbar][plan]") {
+TEST_CASE("tangential tests: the bar along the pivot's circle, at L0 throughout",
+          "[ballbar][plan]") {
   for (MachineType m : {MachineType::AC_trt, MachineType::BC_trt}) {
     BallbarSetup s;
     s.machine = m;
@@ -414,7 +415,8 @@ TEST_CASE("tangential tests: the bar along the pivot's circle, at L0 throughout"
     const Eigen::Vector3d bar_c = tc.samples.front().p_table - s.pivot;
     CHECK((bar_c - 100.0 * Eigen::Vector3d::UnitZ().cross(rc)).norm() < 1e-9);
     // Tilt axis X (A) or Y (B) through the origin: radius in the plane normal to it.
-    const Eigen::Vector3d a = m == MachineType::AC_trt ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+    const Eigen::Vector3d a =
+        m == MachineType::AC_trt ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
     const Eigen::Vector3d rt = (s.pivot - a * a.dot(s.pivot)).normalized();
     CHECK(((tt.samples.front().p_table - s.pivot) - 100.0 * a.cross(rt)).norm() < 1e-9);
     for (const auto& seg : plan.segments)
@@ -428,7 +430,8 @@ TEST_CASE("tangential tests: the bar along the pivot's circle, at L0 throughout"
   h.machine = parse_machine_type("B-head-C-table");
   h.tilt_range_deg = default_tilt_range_deg(h.machine);
   h.tests = {BallbarTest::tangential_tilt};
-  CHECK_THROWS_WITH(plan_ballbar_test(h), Catch::Contains("tangential_B") && Catch::Contains("table axes"));
+  CHECK_THROWS_WITH(plan_ballbar_test(h),
+                    Catch::Contains("tangential_B") && Catch::Contains("table axes"));
 }
 
 TEST_CASE("both directions and two feeds: runs, labels, reversals and times", "[ballbar][plan]") {
@@ -440,9 +443,9 @@ TEST_CASE("both directions and two feeds: runs, labels, reversals and times", "[
   std::vector<std::string> runs;
   for (const auto& seg : plan.segments)
     if (seg.kind == SegmentKind::test) runs.push_back(seg.label);
-  CHECK(runs == std::vector<std::string>{"radial_C", "radial_C_cw", "radial_C_f2000", "radial_C_cw_f2000",
-                                         "tangential_A", "tangential_A_cw", "tangential_A_f2000",
-                                         "tangential_A_cw_f2000"});
+  CHECK(runs == std::vector<std::string>{"radial_C", "radial_C_cw", "radial_C_f2000",
+                                         "radial_C_cw_f2000", "tangential_A", "tangential_A_cw",
+                                         "tangential_A_f2000", "tangential_A_cw_f2000"});
   // The cw run sweeps the same poses back from where the ccw run ended, without its
   // repeated first pose; no transition between them.
   const PlanSegment& ccw = segment_of(plan, "radial_C");
@@ -464,7 +467,8 @@ TEST_CASE("both directions and two feeds: runs, labels, reversals and times", "[
   BallbarSetup sp = s;
   sp.tests = {BallbarTest::sphere_xy, BallbarTest::radial_c};
   std::size_t spheres = 0;
-  for (const auto& seg : plan_ballbar_test(sp).segments) spheres += seg.label.rfind("sphere", 0) == 0;
+  for (const auto& seg : plan_ballbar_test(sp).segments)
+    spheres += seg.label.rfind("sphere", 0) == 0;
   CHECK(spheres == 1);
 
   BallbarSetup bad = s;

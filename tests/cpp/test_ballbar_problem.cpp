@@ -1,13 +1,12 @@
 // ballbar/problem.hpp: the ballbar layout, its one residual (doubles and Jets) and the fit
 // set-up built from the layout.
-#include <catch2/catch.hpp>
-
 #include <ceres/jet.h>
 
+#include <catch2/catch.hpp>
 #include <vector>
 
-#include "rotacal/ballbar/problem.hpp"
 #include "rotacal/ballbar/plan.hpp"
+#include "rotacal/ballbar/problem.hpp"
 
 using namespace rotacal;
 
@@ -26,28 +25,33 @@ TEST_CASE("the ballbar layout: location errors, pivots, effects, with the fit's 
   fx.effects = {Effect::parse("ballbar_length_offset"), Effect::parse("tilt_motion_C_h1")};
   const BallbarLayout one = ballbar_layout(MachineType::AC_trt, fx);
   CHECK(one.errors.offset == 0);
-  CHECK(one.errors.names == std::vector<std::string>(location_error_names(MachineType::AC_trt).begin(),
-                                                     location_error_names(MachineType::AC_trt).end()));
+  CHECK(one.errors.names ==
+        std::vector<std::string>(location_error_names(MachineType::AC_trt).begin(),
+                                 location_error_names(MachineType::AC_trt).end()));
   CHECK(one.pivots.offset == 8);
   CHECK(one.pivots.names == std::vector<std::string>{"pivot_x", "pivot_y", "pivot_z"});
   CHECK(one.effects.offset == 11);
   CHECK(one.effects.size == 1 + 4);
-  CHECK(one.effects.names.front() == "ballbar_length_offset");         // one parameter: the id
-  CHECK(one.effects.names[1].rfind("tilt_motion_C_h1.", 0) == 0);      // several: id.parameter
+  CHECK(one.effects.names.front() == "ballbar_length_offset");     // one parameter: the id
+  CHECK(one.effects.names[1].rfind("tilt_motion_C_h1.", 0) == 0);  // several: id.parameter
   const BallbarLayout two = ballbar_layout(MachineType::AC_trt, fx, 2);
   CHECK(two.pivots.size == 6);
-  CHECK(two.pivots.item(1).names == std::vector<std::string>{"pivot_x#2", "pivot_y#2", "pivot_z#2"});
+  CHECK(two.pivots.item(1).names ==
+        std::vector<std::string>{"pivot_x#2", "pivot_y#2", "pivot_z#2"});
   CHECK(two.effects.offset == 14);
   CHECK_THROWS_AS(ballbar_layout(MachineType::AC_trt, fx, 0), InvalidArgument);
 }
 
-TEST_CASE("the residual is zero on the commanded session at the nominal pivot, and the pivot block moves it") {
+TEST_CASE(
+    "the residual is zero on the commanded session at the nominal pivot, and the pivot block moves "
+    "it") {
   const BallbarArrays a = commanded("AC-trt");
   const EffectModel fx;
   const BallbarLayout L = ballbar_layout(a.machine, fx);
   Eigen::VectorXd x = Eigen::VectorXd::Zero(L.all.size());
   L.pivots.of<3>(x) = a.pivot;
-  for (Eigen::Index i = 0; i < a.size(); ++i) CHECK(std::abs(ballbar_residual<double>(L, a, fx, x.data(), i)) < 1e-10);
+  for (Eigen::Index i = 0; i < a.size(); ++i)
+    CHECK(std::abs(ballbar_residual<double>(L, a, fx, x.data(), i)) < 1e-10);
   // d r / d pivot by Jets against central differences of the doubles.
   using Jet = ceres::Jet<double, 3>;
   std::vector<Jet> xj(static_cast<std::size_t>(L.all.size()));
@@ -58,7 +62,9 @@ TEST_CASE("the residual is zero on the commanded session at the nominal pivot, a
     for (int k = 0; k < 3; ++k) {
       Eigen::VectorXd xp = x, xm = x;
       xp[L.pivots.offset + k] += 1e-4, xm[L.pivots.offset + k] -= 1e-4;
-      const double fd = (ballbar_residual<double>(L, a, fx, xp.data(), i) - ballbar_residual<double>(L, a, fx, xm.data(), i)) / 2e-4;
+      const double fd = (ballbar_residual<double>(L, a, fx, xp.data(), i) -
+                         ballbar_residual<double>(L, a, fx, xm.data(), i)) /
+                        2e-4;
       CHECK(r.v[k] == Approx(fd).margin(1e-8));
     }
   }
@@ -72,13 +78,16 @@ TEST_CASE("the residual is zero on the commanded session at the nominal pivot, a
   CHECK(largest <= 0.05 + 1e-12);
 }
 
-TEST_CASE("the fit set-up: start at the nominal pivot; on a head the tool length is baseline and does not yield") {
+TEST_CASE(
+    "the fit set-up: start at the nominal pivot; on a head the tool length is baseline and does "
+    "not yield") {
   const BallbarArrays a = commanded("AC-trt");
   JointFitOptions o;
   o.effects.effects = {Effect::parse("tilt_motion_C_h1")};
   const BallbarFitSetup s = ballbar_fit_setup(a, o);
   REQUIRE(static_cast<Eigen::Index>(s.parameters.size()) == s.layout.all.size());
-  for (int k = 0; k < 3; ++k) CHECK(s.parameters[static_cast<std::size_t>(8 + k)].start == a.pivot[k]);
+  for (int k = 0; k < 3; ++k)
+    CHECK(s.parameters[static_cast<std::size_t>(8 + k)].start == a.pivot[k]);
   CHECK(s.parameters[2].unit == "rad");
   for (Eigen::Index j = s.layout.effects.offset; j < s.layout.effects.end(); ++j)
     CHECK(s.parameters[static_cast<std::size_t>(j)].yields);
@@ -89,7 +98,8 @@ TEST_CASE("the fit set-up: start at the nominal pivot; on a head the tool length
   CHECK_FALSE(sh.parameters[static_cast<std::size_t>(sh.layout.effects.offset)].yields);
   CHECK(sh.parameters.back().yields);
   // The model at a solution reads each block where the layout puts it.
-  Eigen::VectorXd x = Eigen::VectorXd::LinSpaced(sh.layout.all.size(), 1.0, static_cast<double>(sh.layout.all.size()));
+  Eigen::VectorXd x = Eigen::VectorXd::LinSpaced(sh.layout.all.size(), 1.0,
+                                                 static_cast<double>(sh.layout.all.size()));
   const BallbarMachineModel m = ballbar_model_at(sh, h.machine, x);
   CHECK(m.errors.v[7] == 8.0);
   CHECK(m.pivot == Eigen::Vector3d(9.0, 10.0, 11.0));

@@ -1,5 +1,4 @@
 #include <catch2/catch.hpp>
-
 #include <cmath>
 
 #include "rotacal/ballbar/motion.hpp"
@@ -38,7 +37,8 @@ TEST_CASE("the move from a ccw run into its cw run belongs to the cw run", "[bal
   const ProgramTimeline tl(plan);
   REQUIRE(plan.segments[0].label == "tangential_C");
   REQUIRE(plan.segments[1].label == "tangential_C_cw");
-  const double t_end = plan.segments[0].samples.back().time, t_next = plan.segments[1].samples.front().time;
+  const double t_end = plan.segments[0].samples.back().time,
+               t_next = plan.segments[1].samples.front().time;
   const BallbarSample between = tl.at(0.5 * (t_end + t_next));
   CHECK(between.test == "tangential_C_cw");
   CHECK(between.rot_deg == Approx(358.5));
@@ -48,7 +48,8 @@ TEST_CASE("the move from a ccw run into its cw run belongs to the cw run", "[bal
   CHECK(tl.at(t_last + 1e-3).test == "transition");
 }
 
-TEST_CASE("the program's motion agrees with the motion read back from its recorded rows", "[ballbar][motion]") {
+TEST_CASE("the program's motion agrees with the motion read back from its recorded rows",
+          "[ballbar][motion]") {
   // What the virtual ballbar plays (motion_at) and what the fit reads from the file
   // (rotary_motion of the rows) must be the same motion, or a recorded backlash would be
   // fitted against a different signature than the one played.

@@ -3,9 +3,9 @@
 #include <cmath>
 #include <map>
 
+#include "rotacal/circular/diagnosis.hpp"
 #include "rotacal/circular/simulate.hpp"
 #include "rotacal/core/error.hpp"
-#include "rotacal/circular/diagnosis.hpp"
 
 using namespace rotacal;
 

@@ -1,14 +1,14 @@
 // The NC program preamble shared by the rotary-axis and the circular-test writers
 // (src/io/nc_words.hpp): what it writes per dialect, that it is what both programs open
 // with, and the errors it raises in each writer's name.
-#include <catch2/catch.hpp>
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <sstream>
 
 #include "../../src/io/nc_words.hpp"
-#include "rotacal/circular/plan.hpp"
 #include "rotacal/ballbar/nc_program.hpp"
 #include "rotacal/ballbar/plan.hpp"
+#include "rotacal/circular/plan.hpp"
 
 using namespace rotacal;
 
@@ -88,8 +88,8 @@ TEST_CASE("preamble: both NC writers open with it") {
     const auto rot = without_header(
         preamble(d, o, {"write_nc_program", "TCP program", "ROTACAL BALLBAR", false}));
     CHECK(opening_blocks(write_nc_program(rotary, d), d, rot.size()) == rot);
-    auto circ = without_header(preamble(
-        d, o, {"write_circular_nc_program", "program", "ROTACAL CIRCULAR", false}));
+    auto circ = without_header(
+        preamble(d, o, {"write_circular_nc_program", "program", "ROTACAL CIRCULAR", false}));
     if (d == NcDialect::fanuc) circ.push_back("G43 H1");  // the circular program's own block
     CHECK(opening_blocks(write_circular_nc_program(circular, d), d, circ.size()) == circ);
   }
@@ -113,9 +113,10 @@ TEST_CASE("preamble: bad options are refused in the writer's name") {
                     "write_nc_program: the fanuc TCP program needs a tool number (tool = 0 given)");
   o = {};
   o.program_name = "TWO WORDS";
-  CHECK_THROWS_WITH(write_circular_nc_program(circular, NcDialect::heidenhain, o),
-                    "write_circular_nc_program: program_name must be one word of letters, digits, '_' and '-', "
-                    "got 'TWO WORDS'");
+  CHECK_THROWS_WITH(
+      write_circular_nc_program(circular, NcDialect::heidenhain, o),
+      "write_circular_nc_program: program_name must be one word of letters, digits, '_' and '-', "
+      "got 'TWO WORDS'");
   // It is written outside any comment (BEGIN PGM, END PGM): a line end or ';' is refused.
   for (const char* name : {"P\nL Z-500 FMAX", "P\rM30", "P;X", "P~", "P(1)"}) {
     o.program_name = name;

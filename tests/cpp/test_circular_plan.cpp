@@ -193,7 +193,8 @@ TEST_CASE("Circular NC program: G2/G3 arcs in G17/G18/G19 that stay on the circl
              Catch::Contains("decimals"));
 }
 
-TEST_CASE("Circular NC program: a machine's name cannot add a block, in any dialect", "[circular]") {
+TEST_CASE("Circular NC program: a machine's name cannot add a block, in any dialect",
+          "[circular]") {
   // The name is free text from a description file; it is written in the header comments.
   auto lines_of = [](const std::string& text) {
     std::vector<std::string> out;
@@ -201,14 +202,17 @@ TEST_CASE("Circular NC program: a machine's name cannot add a block, in any dial
     for (std::string l; std::getline(in, l);) out.push_back(l);
     return out;
   };
-  auto blocks = [&](NcDialect d, const std::string& text) {  // the lines that are not whole comments
+  auto blocks = [&](NcDialect d,
+                    const std::string& text) {  // the lines that are not whole comments
     std::vector<std::string> out;
     for (std::string l : lines_of(text)) {
-      if (d == NcDialect::heidenhain && !l.empty() && std::isdigit(static_cast<unsigned char>(l[0])))  // block number
+      if (d == NcDialect::heidenhain && !l.empty() &&
+          std::isdigit(static_cast<unsigned char>(l[0])))  // block number
         l = l.substr(l.find(' ') + 1);
-      const bool comment = d == NcDialect::linuxcnc || d == NcDialect::fanuc
-                               ? l.size() >= 2 && l.front() == '(' && l.find_first_of("()", 1) == l.size() - 1
-                               : l.rfind(";", 0) == 0;
+      const bool comment =
+          d == NcDialect::linuxcnc || d == NcDialect::fanuc
+              ? l.size() >= 2 && l.front() == '(' && l.find_first_of("()", 1) == l.size() - 1
+              : l.rfind(";", 0) == 0;
       if (!comment) out.push_back(l);
     }
     return out;
@@ -223,11 +227,13 @@ TEST_CASE("Circular NC program: a machine's name cannot add a block, in any dial
     return plan_circular_test(p);
   };
   const CircularPlanResult plain = named("plain");
-  for (const std::string& name : {std::string("x\nG0 Z-500\n"), std::string("x\rM30\r"), std::string("x) G0 Z-500 ("),
-                                  std::string("x; G0 Z-500"), std::string("%\nG0 Z-500\n%"), std::string("MSG, x"),
-                                  std::string(300, 'n') + "\nG0 Z-500"}) {
+  for (const std::string& name :
+       {std::string("x\nG0 Z-500\n"), std::string("x\rM30\r"), std::string("x) G0 Z-500 ("),
+        std::string("x; G0 Z-500"), std::string("%\nG0 Z-500\n%"), std::string("MSG, x"),
+        std::string(300, 'n') + "\nG0 Z-500"}) {
     const CircularPlanResult r = named(name);
-    for (NcDialect d : {NcDialect::linuxcnc, NcDialect::heidenhain, NcDialect::siemens, NcDialect::fanuc}) {
+    for (NcDialect d :
+         {NcDialect::linuxcnc, NcDialect::heidenhain, NcDialect::siemens, NcDialect::fanuc}) {
       INFO(to_string(d) << ", machine named '" << name << "'");
       const std::string text = write_circular_nc_program(r, d);
       CHECK(blocks(d, text) == blocks(d, write_circular_nc_program(plain, d)));

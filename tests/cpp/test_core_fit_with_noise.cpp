@@ -1,7 +1,6 @@
 // core/fit_with_noise.hpp: the white fit, the noise model of its residuals and the GLS refit,
 // on a straight line y = a + b t whose noise is white or AR(1) (drawn here, seeded).
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <random>
 
@@ -16,7 +15,8 @@ class Line : public ResidualModel {
   Line(Eigen::VectorXd t, Eigen::VectorXd y) : t_(std::move(t)), y_(std::move(y)) {}
   Eigen::Index num_residuals() const override { return t_.size(); }
   int num_parameters() const override { return 2; }
-  void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r, Eigen::MatrixXd* J) const override {
+  void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r,
+                Eigen::MatrixXd* J) const override {
     r = (x[0] + x[1] * t_.array() - y_.array()).matrix();
     if (J) J->col(0).setOnes(), J->col(1) = t_;
   }
@@ -50,14 +50,15 @@ Case line_case(double rho, unsigned seed) {
   return c;
 }
 
-NoiseFit fit(const Case& c, NoiseHandling handling, JointFitSettings settings = {}, bool groups = true) {
+NoiseFit fit(const Case& c, NoiseHandling handling, JointFitSettings settings = {},
+             bool groups = true) {
   const Line model(c.t, c.y);
   const std::vector<FitParameter> params = {{"a", "mm", 0.0}, {"b", "mm", 0.0}};
   settings.sigma = 1e-3;
   NoiseFitOptions o;
   o.noise = handling;
-  return fit_with_noise([&](const JointFitSettings& s) { return solve_joint(model, params, s); }, settings,
-                        groups ? c.groups : std::vector<std::string>{}, c.times, o);
+  return fit_with_noise([&](const JointFitSettings& s) { return solve_joint(model, params, s); },
+                        settings, groups ? c.groups : std::vector<std::string>{}, c.times, o);
 }
 }  // namespace
 
@@ -103,6 +104,7 @@ TEST_CASE("streams that do not name every residual are refused") {
   const std::vector<FitParameter> params = {{"a", "mm", 0.0}, {"b", "mm", 0.0}};
   const auto solve = [&](const JointFitSettings& s) { return solve_joint(model, params, s); };
   const std::vector<std::string> short_groups(c.groups.begin() + 1, c.groups.end());
-  CHECK_THROWS_AS(fit_with_noise(solve, JointFitSettings{}, short_groups, c.times, NoiseFitOptions{}),
-                  InvalidArgument);
+  CHECK_THROWS_AS(
+      fit_with_noise(solve, JointFitSettings{}, short_groups, c.times, NoiseFitOptions{}),
+      InvalidArgument);
 }

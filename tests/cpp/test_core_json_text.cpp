@@ -1,7 +1,6 @@
 // core/json_text.hpp: strict JSON, bounded in nesting and in objects and arrays per byte.
-#include <catch2/catch.hpp>
-
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <string>
 
 #include "rotacal/core/error.hpp"
@@ -12,7 +11,8 @@ using namespace rotacal;
 
 namespace {
 std::string nested(int depth, const std::string& inner = "0") {
-  return std::string(static_cast<std::size_t>(depth), '[') + inner + std::string(static_cast<std::size_t>(depth), ']');
+  return std::string(static_cast<std::size_t>(depth), '[') + inner +
+         std::string(static_cast<std::size_t>(depth), ']');
 }
 }  // namespace
 
@@ -32,7 +32,8 @@ TEST_CASE("nesting up to the limit is read, one level more is refused at its lin
 TEST_CASE("50,000 nested brackets are refused before the parser, without recursion") {
   // Issue 32: in an ignored member of a model file they overflowed the stack of the bindings.
   const std::string doc = "{\"format\": \"rotacal-model/1\", \"x\": " + nested(50000) + "}";
-  CHECK_THROWS_WITH(parse_json(doc, "m.json"), Catch::Contains("m.json:1:") && Catch::Contains("nested deeper"));
+  CHECK_THROWS_WITH(parse_json(doc, "m.json"),
+                    Catch::Contains("m.json:1:") && Catch::Contains("nested deeper"));
   CHECK_THROWS_AS(parse_model(doc, "m.json"), ParseError);
 }
 
@@ -55,7 +56,8 @@ TEST_CASE("a flood of empty objects is refused by objects per byte, a model's ow
 }
 
 TEST_CASE("brackets inside strings are text, not nesting") {
-  const std::string s = "{\"name\": \"" + std::string(1000, '[') + "\\\"" + std::string(1000, '{') + "\"}";
+  const std::string s =
+      "{\"name\": \"" + std::string(1000, '[') + "\\\"" + std::string(1000, '{') + "\"}";
   CHECK(parse_json(s, "s.json")["name"].get<std::string>().size() == 2001);
 }
 
@@ -78,6 +80,7 @@ TEST_CASE("a byte that is not UTF-8 is named in printable text") {
   } catch (const ParseError& e) {
     const std::string what = e.what();
     CHECK_THAT(what, Catch::Contains("u.json:1:") && Catch::Contains("\\xFF"));
-    CHECK(std::all_of(what.begin(), what.end(), [](char c) { return static_cast<unsigned char>(c) < 0x80; }));
+    CHECK(std::all_of(what.begin(), what.end(),
+                      [](char c) { return static_cast<unsigned char>(c) < 0x80; }));
   }
 }

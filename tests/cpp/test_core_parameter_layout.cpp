@@ -1,9 +1,8 @@
 // core/parameter_layout.hpp: named blocks, their offsets, views over Eigen vectors, Jacobian
 // columns and raw double / Jet arrays, items of zeros per nest, and the errors it throws.
-#include <catch2/catch.hpp>
-
 #include <ceres/jet.h>
 
+#include <catch2/catch.hpp>
 #include <string>
 #include <vector>
 
@@ -19,7 +18,8 @@ ParameterLayout example() {
   L.add("location_errors", {"X_OC", "Y_OC", "A_OC", "B_OC", "Y_OA", "Z_OA", "B_OA", "C_OA"},
         {"mm", "mm", "rad", "rad", "mm", "mm", "rad", "rad"});
   L.add("pivot", {"pivot_x", "pivot_y", "pivot_z"}, {"mm"});
-  L.add("zeros", {"zero.1.x", "zero.1.y", "zero.1.z", "zero.2.x", "zero.2.y", "zero.2.z"}, {"mm"}, 3);
+  L.add("zeros", {"zero.1.x", "zero.1.y", "zero.1.z", "zero.2.x", "zero.2.y", "zero.2.z"}, {"mm"},
+        3);
   L.add("effects", 3, "1");
   L.add("radius", 0, "mm");
   return L;
@@ -93,7 +93,8 @@ TEST_CASE("a part of a block is a block at the part's offset, with its names") {
   CHECK(second.name == "second");
   CHECK(second.names == std::vector<std::string>{"effects[1]", "effects[2]"});
   CHECK(L.block("effects").part(3, 0, "none").empty());
-  CHECK_THROWS_WITH(L.block("effects").part(2, 2, "x"), Catch::Contains("effects: parameters 2..4 of 3"));
+  CHECK_THROWS_WITH(L.block("effects").part(2, 2, "x"),
+                    Catch::Contains("effects: parameters 2..4 of 3"));
   CHECK_THROWS_AS(L.block("effects").part(-1, 1, "x"), InvalidArgument);
 }
 
@@ -106,7 +107,8 @@ TEST_CASE("raw pointers serve doubles and Jets alike, and an empty block gives n
   CHECK(L.block("radius").ptr(cp) == nullptr);
   using Jet = ceres::Jet<double, 4>;
   std::vector<Jet> pj(20);
-  for (std::size_t k = 0; k < pj.size(); ++k) pj[k] = Jet(static_cast<double>(k), static_cast<int>(k % 4));
+  for (std::size_t k = 0; k < pj.size(); ++k)
+    pj[k] = Jet(static_cast<double>(k), static_cast<int>(k % 4));
   const Jet* const cj = pj.data();
   const Jet* z = L.block("zeros").item(1).ptr(cj);
   CHECK(z[2].a == 16.0);
@@ -130,7 +132,8 @@ TEST_CASE("a block's Jacobian columns") {
 TEST_CASE("bad layouts and unknown names are refused, naming the block") {
   ParameterLayout L = example();
   CHECK_THROWS_WITH(L.add("pivot", 3, "mm"), Catch::Contains("pivot added twice"));
-  CHECK_THROWS_WITH(L.add("sphere", {"a", "b"}, {"mm", "mm", "mm"}), Catch::Contains("sphere has 2 names but 3 units"));
+  CHECK_THROWS_WITH(L.add("sphere", {"a", "b"}, {"mm", "mm", "mm"}),
+                    Catch::Contains("sphere has 2 names but 3 units"));
   CHECK_THROWS_WITH(L.add("nests", {"a", "b", "c", "d"}, {"mm"}, 3), Catch::Contains("nests of 4"));
   CHECK_THROWS_WITH(L.block("sphere"), Catch::Contains("no block named sphere"));
   CHECK_THROWS_WITH(L.block_of(20), Catch::Contains("index 20 outside the 20"));

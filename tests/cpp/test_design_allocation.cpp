@@ -1,7 +1,6 @@
 // design/allocation.hpp: the allocation of runs among candidates, on information matrices whose
 // best allocation is known in closed form.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <limits>
 
@@ -42,7 +41,8 @@ TEST_CASE("runs go where they equalise the variances", "[design][allocation]") {
   CHECK(a.inverted.sigma[0] == Approx(0.5));
 }
 
-TEST_CASE("a parameter no candidate determines is left out of the criterion", "[design][allocation]") {
+TEST_CASE("a parameter no candidate determines is left out of the criterion",
+          "[design][allocation]") {
   const Allocation a = allocate_runs(two_parameters({diag(4, 0), diag(1, 0)}, 3));
   REQUIRE(a.determinable.size() == 2);
   CHECK(a.determinable[0]);
@@ -53,9 +53,10 @@ TEST_CASE("a parameter no candidate determines is left out of the criterion", "[
   CHECK(a.uncertainty.worst_index == 0);
 }
 
-TEST_CASE("correlated candidates: the allocation is the best of every allocation", "[design][allocation]") {
-  // Candidates reading a + b, a - b, a + b four times as well, and 2a + b/2; every allocation of 4 and
-  // of 7 runs enumerated, its largest 2 sigma from the closed-form 2 x 2 inverse.
+TEST_CASE("correlated candidates: the allocation is the best of every allocation",
+          "[design][allocation]") {
+  // Candidates reading a + b, a - b, a + b four times as well, and 2a + b/2; every allocation of 4
+  // and of 7 runs enumerated, its largest 2 sigma from the closed-form 2 x 2 inverse.
   Eigen::MatrixXd plus(2, 2), minus(2, 2), cross;
   plus << 1, 1, 1, 1;
   minus << 1, -1, -1, 1;
@@ -66,7 +67,8 @@ TEST_CASE("correlated candidates: the allocation is the best of every allocation
     for (int i = 0; i <= runs; ++i)
       for (int j = 0; i + j <= runs; ++j)
         for (int k = 0; i + j + k <= runs; ++k) {
-          const Eigen::MatrixXd M = i * cands[0] + j * cands[1] + k * cands[2] + (runs - i - j - k) * cands[3];
+          const Eigen::MatrixXd M =
+              i * cands[0] + j * cands[1] + k * cands[2] + (runs - i - j - k) * cands[3];
           const double det = M(0, 0) * M(1, 1) - M(0, 1) * M(1, 0);
           if (!(det > 1e-9)) continue;
           best = std::min(best, 2.0 * std::sqrt(std::max(M(1, 1), M(0, 0)) / det));
@@ -81,5 +83,6 @@ TEST_CASE("correlated candidates: the allocation is the best of every allocation
 TEST_CASE("invalid problems are refused", "[design][allocation]") {
   CHECK_THROWS_AS(allocate_runs(two_parameters({}, 3)), InvalidArgument);
   CHECK_THROWS_AS(allocate_runs(two_parameters({diag(1, 1)}, 0)), InvalidArgument);
-  CHECK_THROWS_AS(allocate_runs(two_parameters({diag(1, 1), Eigen::MatrixXd::Identity(3, 3)}, 2)), InvalidArgument);
+  CHECK_THROWS_AS(allocate_runs(two_parameters({diag(1, 1), Eigen::MatrixXd::Identity(3, 3)}, 2)),
+                  InvalidArgument);
 }

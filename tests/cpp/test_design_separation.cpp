@@ -2,7 +2,6 @@
 // correlation, columns between layouts) and the one separation search, on information
 // matrices whose correlations are known in closed form.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <limits>
 
@@ -19,7 +18,8 @@ ParameterLayout pair_layout() {
   return L;
 }
 
-// Information k [[1, c], [c, 1]]: the estimates' correlation is -c (covariance ~ [[1, -c], [-c, 1]]).
+// Information k [[1, c], [c, 1]]: the estimates' correlation is -c (covariance ~ [[1, -c], [-c,
+// 1]]).
 Eigen::MatrixXd correlated(double k, double c) {
   Eigen::MatrixXd I(2, 2);
   I << 1.0, c, c, 1.0;
@@ -27,7 +27,9 @@ Eigen::MatrixXd correlated(double k, double c) {
 }
 }  // namespace
 
-TEST_CASE("inverse of an information matrix: 1 / sqrt(information) when diagonal; a parameter nothing sees is held") {
+TEST_CASE(
+    "inverse of an information matrix: 1 / sqrt(information) when diagonal; a parameter nothing "
+    "sees is held") {
   Eigen::MatrixXd I = Eigen::MatrixXd::Zero(3, 3);
   I(0, 0) = 400.0, I(1, 1) = 25.0;  // the third: no information
   const Inverted inv = invert_information(I, Eigen::VectorXd::Ones(3), 1.0);
@@ -48,7 +50,8 @@ TEST_CASE("canonical correlation of two one-parameter blocks is their correlatio
 TEST_CASE("columns move between layouts by block") {
   ParameterLayout from, to;
   const ParameterBlock fa = from.add("a", 2, "mm"), fb = from.add("b", 1, "mm");
-  const ParameterBlock tb = to.add("b", 1, "mm"), tx = to.add("x", 3, "mm"), ta = to.add("a", 2, "mm");
+  const ParameterBlock tb = to.add("b", 1, "mm"), tx = to.add("x", 3, "mm"),
+                       ta = to.add("a", 2, "mm");
   Eigen::MatrixXd J(2, 3);
   J << 1, 2, 3, 4, 5, 6;
   const Eigen::MatrixXd out = in_layout(J, {fa, fb}, {ta, tb}, to.size());
@@ -58,7 +61,9 @@ TEST_CASE("columns move between layouts by block") {
   CHECK(tx.columns(out).isZero());
 }
 
-TEST_CASE("the search takes the shortest run below the target, and the lowest correlation when none reaches it") {
+TEST_CASE(
+    "the search takes the shortest run below the target, and the lowest correlation when none "
+    "reaches it") {
   // Session: correlation 0.9. A candidate adding d (k = 100) on both diagonals run r times
   // leaves 90 / (100 + r d): below 0.5 when r d > 80.
   const ParameterLayout L = pair_layout();
@@ -73,7 +78,7 @@ TEST_CASE("the search takes the shortest run below the target, and the lowest co
   D.effects = {"a", "b"};
   REQUIRE(separation_needed(S, D));
   CHECK(D.correlation_before == Approx(0.9));
-  const Eigen::MatrixXd slow = 30.0 * Eigen::MatrixXd::Identity(2, 2);  // needs r = 4 (run 40 s)
+  const Eigen::MatrixXd slow = 30.0 * Eigen::MatrixXd::Identity(2, 2);   // needs r = 4 (run 40 s)
   const Eigen::MatrixXd fast = 100.0 * Eigen::MatrixXd::Identity(2, 2);  // r = 1 (run 30 s)
   const std::vector<AddedInformation> added = {{10.0, slow, true}, {30.0, fast, true}};
   SeparationChoice c = search_separation(S, added);
@@ -95,7 +100,8 @@ TEST_CASE("the search takes the shortest run below the target, and the lowest co
   D.candidates_tried = 2;
   finish_separation(S, c, "the first", 20.0, {}, SeparationWording{}, D);
   CHECK_FALSE(D.found);
-  CHECK_THAT(D.verdict, Catch::StartsWith("none of 2 added tests within 35 s") && Catch::Contains("the closest is the first (correlation 0.56)"));
+  CHECK_THAT(D.verdict, Catch::StartsWith("none of 2 added tests within 35 s") &&
+                            Catch::Contains("the closest is the first (correlation 0.56)"));
 }
 
 TEST_CASE("no search when the session separates the pair already") {
@@ -109,5 +115,6 @@ TEST_CASE("no search when the session separates the pair already") {
   D.effects = {"a", "b"};
   CHECK_FALSE(separation_needed(S, D));
   CHECK(D.already_separated);
-  CHECK_THAT(D.verdict, Catch::StartsWith("the session alone separates a and b (correlation 0.20 < 0.50)"));
+  CHECK_THAT(D.verdict,
+             Catch::StartsWith("the session alone separates a and b (correlation 0.20 < 0.50)"));
 }

@@ -1,16 +1,15 @@
-#include <catch2/catch.hpp>
-
 #include <Eigen/SVD>
+#include <catch2/catch.hpp>
 #include <random>
 
+#include "../../src/diagnose/scoring.hpp"
+#include "../support/candidate_jacobians.hpp"
+#include "../support/synthetic_sessions.hpp"
 #include "rotacal/ballbar/plan.hpp"
 #include "rotacal/ballbar/simulate.hpp"
 #include "rotacal/core/least_squares.hpp"
 #include "rotacal/diagnose/ballbar_diagnosis.hpp"
 #include "rotacal/io/ballbar_file.hpp"
-#include "../../src/diagnose/scoring.hpp"
-#include "../support/candidate_jacobians.hpp"
-#include "../support/synthetic_sessions.hpp"
 
 using namespace rotacal;
 
@@ -18,20 +17,25 @@ namespace {
 constexpr double kNoiseUm = 0.5;
 
 const BallbarSession& commanded() { return synthetic::table2_commanded(); }
-BallbarMachineModel random_machine(std::mt19937& rng) { return synthetic::random_ballbar_machine(commanded(), rng); }
+BallbarMachineModel random_machine(std::mt19937& rng) {
+  return synthetic::random_ballbar_machine(commanded(), rng);
+}
 
 // Parameters of `effect` whose reading change, after the baseline (location errors + pivot)
 // has absorbed what it can, is `k_sigma` noise sigmas RMS over the session; empty if that
 // needs more than a plausible size of the effect (1 mm, 1 mrad, ...): the effect is then
 // invisible to this test set and is not hidden.
-std::vector<double> hidden_amplitude(const BallbarMachineModel& truth, const Effect& effect, double k_sigma) {
+std::vector<double> hidden_amplitude(const BallbarMachineModel& truth, const Effect& effect,
+                                     double k_sigma) {
   BallbarSession noiseless = simulate_ballbar(commanded(), truth, {0.0, 1, true});
   noiseless.noise_um = kNoiseUm;
   BallbarDiagnosisProblem P(noiseless);
   const ModelFit at = P.fit(EffectModel{});
   Eigen::VectorXd m(effect.num_params());
-  for (int k = 0; k < m.size(); ++k) m[k] = plausible_magnitude(effect.param_units()[static_cast<std::size_t>(k)]);
-  const Eigen::MatrixXd Jc = P.candidate_jacobian(at, effect) * m.asDiagonal();  // per plausible size
+  for (int k = 0; k < m.size(); ++k)
+    m[k] = plausible_magnitude(effect.param_units()[static_cast<std::size_t>(k)]);
+  const Eigen::MatrixXd Jc =
+      P.candidate_jacobian(at, effect) * m.asDiagonal();  // per plausible size
   const Eigen::MatrixXd& J = at.jacobian;
   const Eigen::MatrixXd perp = Jc - J * J.completeOrthogonalDecomposition().solve(Jc);
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(perp, Eigen::ComputeThinV);
@@ -71,7 +75,8 @@ TEST_CASE("null data: no finding", "[diagnose]") {
   }
 }
 
-TEST_CASE("every visible catalogue effect, hidden at 5 sigma, is found first", "[diagnose][statistical]") {
+TEST_CASE("every visible catalogue effect, hidden at 5 sigma, is found first",
+          "[diagnose][statistical]") {
   std::mt19937 rng(202);
   int tried = 0;
   std::vector<std::string> invisible;
@@ -86,7 +91,8 @@ TEST_CASE("every visible catalogue effect, hidden at 5 sigma, is found first", "
     truth.effect_params = p;
     const Diagnosis D = diagnose_hidden(truth, 11);
     ++tried;
-    INFO(effect.id() << ": first finding " << (D.findings.empty() ? "none" : D.findings[0].effect.id()));
+    INFO(effect.id() << ": first finding "
+                     << (D.findings.empty() ? "none" : D.findings[0].effect.id()));
     REQUIRE(named_first(D, effect.id()));
     const Finding& F = D.findings[0];
     CHECK(F.gain.rms_after_um < F.gain.rms_before_um);
@@ -136,8 +142,11 @@ TEST_CASE("the progress callback counts every round's candidates to its end", "[
   };
   std::vector<Call> calls;
   DiagnosisOptions o;
-  o.progress = [&](const std::string& stage, int done, int total) { calls.push_back({stage, done, total}); };
-  const Diagnosis D = diagnose_ballbar(simulate_ballbar(commanded(), truth, {kNoiseUm, 7, true}), o);
+  o.progress = [&](const std::string& stage, int done, int total) {
+    calls.push_back({stage, done, total});
+  };
+  const Diagnosis D =
+      diagnose_ballbar(simulate_ballbar(commanded(), truth, {kNoiseUm, 7, true}), o);
   REQUIRE(D.findings.size() == 1);
   // Per stage: 0, 1, ..., total, in order, and a round after the finding with fewer candidates.
   std::vector<std::string> stages;
@@ -232,7 +241,8 @@ TEST_CASE("ballbar residual harmonics: full C turns keep every order, half A tur
   }
 }
 
-TEST_CASE("candidate Jacobians: the harmonic shortcut equals Jets of every parameter", "[diagnose]") {
+TEST_CASE("candidate Jacobians: the harmonic shortcut equals Jets of every parameter",
+          "[diagnose]") {
   // At a fit that already holds harmonic effects of the same kinds (their channels then
   // compose with the candidate's), on a machine where both axes have errors.
   std::mt19937 rng(7);
@@ -240,11 +250,12 @@ TEST_CASE("candidate Jacobians: the harmonic shortcut equals Jets of every param
   truth.effects.effects = {Effect::parse("tilt_motion_C_h1"), Effect::parse("radial_motion_A_h2"),
                            Effect::parse("gravity_sag_A")};
   truth.effect_params = {4e-6, -3e-6, 2e-6, 1e-6, 0.002, -0.001, 0.0015, 0.0005, 0.004};
-  // Every other sample of table 2's session: the identity holds row by row, and about 90 A angles over
-  // a half turn still resolve the catalogue's orders; the sanitizers take half the time.
+  // Every other sample of table 2's session: the identity holds row by row, and about 90 A angles
+  // over a half turn still resolve the catalogue's orders; the sanitizers take half the time.
   BallbarSession every_other = commanded();
   every_other.samples.clear();
-  for (std::size_t i = 0; i < commanded().samples.size(); i += 2) every_other.samples.push_back(commanded().samples[i]);
+  for (std::size_t i = 0; i < commanded().samples.size(); i += 2)
+    every_other.samples.push_back(commanded().samples[i]);
   BallbarDiagnosisProblem P(simulate_ballbar(every_other, truth, {kNoiseUm, 3, true}));
   EffectModel fx;
   fx.effects = {Effect::parse("tilt_motion_C_h1"), Effect::parse("radial_motion_A_h2")};
@@ -252,14 +263,18 @@ TEST_CASE("candidate Jacobians: the harmonic shortcut equals Jets of every param
   CHECK(harmonic >= 20);  // angular, radial, axial and tilt motions of both axes, orders 1-4
 }
 
-TEST_CASE("candidate Jacobians by the chain rule equal Jets on BC with motion effects and every stage in the fit", "[diagnose]") {
+TEST_CASE(
+    "candidate Jacobians by the chain rule equal Jets on BC with motion effects and every stage in "
+    "the fit",
+    "[diagnose]") {
   // The chain rule (src/diagnose/ballbar_sensitivities.hpp) passes through every stage the
   // fit holds: coning (K), gravity sag (D), an error motion (E) on each axis, a reading drift
   // and a tool-side term; both directions at two feeds make the motion effects candidates.
   BallbarSetup setup;
   setup.machine = MachineType::BC_trt;
   // 8 degree steps: the identity holds row by row, so half the rows check every candidate as
-  // well (624 assertions either way) at less than half the cost under the sanitizers (about 21 -> 9 s, 12-06).
+  // well (624 assertions either way) at less than half the cost under the sanitizers (about 21 -> 9
+  // s, 12-06).
   setup.step_deg = 8.0;
   setup.directions = {SweepDirection::ccw, SweepDirection::cw};
   setup.feed_factors = {1.0, 2.0};
@@ -268,8 +283,11 @@ TEST_CASE("candidate Jacobians by the chain rule equal Jets on BC with motion ef
   BallbarMachineModel truth = synthetic::random_ballbar_machine(cmd, rng);
   truth.machine = MachineType::BC_trt;
   EffectModel fx;
-  fx.effects = {Effect::parse("coning_B"), Effect::parse("gravity_sag_B"), Effect::parse("axial_motion_C_h1"),
-                Effect::parse("tilt_motion_B_h2"), Effect::parse("ballbar_thermal_drift"),
+  fx.effects = {Effect::parse("coning_B"),
+                Effect::parse("gravity_sag_B"),
+                Effect::parse("axial_motion_C_h1"),
+                Effect::parse("tilt_motion_B_h2"),
+                Effect::parse("ballbar_thermal_drift"),
                 Effect::parse("linear_scale_X")};
   truth.effects = fx;
   truth.effect_params = {3e-5, 0.004, 0.002, -0.001, 2e-6, -1e-6, 3e-6, 1e-6, 1e-7, 2e-5};
@@ -292,7 +310,9 @@ TEST_CASE("orthonormal_basis_full_rank spans what the rank-revealing QR spans", 
   Eigen::MatrixXd J(600, 11);
   for (Eigen::Index i = 0; i < J.size(); ++i) J.data()[i] = N(rng);
   J.col(3) *= 1e4;  // columns of very different sizes, as mm and rad columns are
-  const auto projector = [](const Eigen::MatrixXd& Q) { return Eigen::MatrixXd(Q * Q.transpose()); };
+  const auto projector = [](const Eigen::MatrixXd& Q) {
+    return Eigen::MatrixXd(Q * Q.transpose());
+  };
   const Eigen::MatrixXd Q = orthonormal_basis_full_rank(J);
   REQUIRE(Q.cols() == 11);
   CHECK((Q.transpose() * Q - Eigen::MatrixXd::Identity(11, 11)).cwiseAbs().maxCoeff() < 1e-12);
@@ -300,10 +320,13 @@ TEST_CASE("orthonormal_basis_full_rank spans what the rank-revealing QR spans", 
   // A column that repeats another: the rank-revealing QR decides the rank.
   J.col(10) = 2.0 * J.col(4);
   CHECK(orthonormal_basis_full_rank(J).cols() == 10);
-  CHECK((projector(orthonormal_basis_full_rank(J)) - projector(orthonormal_basis(J))).cwiseAbs().maxCoeff() < 1e-10);
+  CHECK((projector(orthonormal_basis_full_rank(J)) - projector(orthonormal_basis(J)))
+            .cwiseAbs()
+            .maxCoeff() < 1e-10);
 }
 
-TEST_CASE("residual_without equals the projection on orthonormalised columns, or declines", "[diagnose]") {
+TEST_CASE("residual_without equals the projection on orthonormalised columns, or declines",
+          "[diagnose]") {
   using namespace diagnosis_detail;
   std::mt19937 rng(5);
   std::normal_distribution<double> N(0.0, 1.0);
@@ -328,7 +351,8 @@ TEST_CASE("residual_without equals the projection on orthonormalised columns, or
   const Eigen::VectorXd y_out = residual_without(Q, y, Q.transpose() * y, Jc);
   const Eigen::MatrixXd QJ = orthonormal_basis((Eigen::MatrixXd(800, 14) << J, Jc).finished());
   const Eigen::VectorXd y_ref = y - Q * (Q.transpose() * y);
-  CHECK((y_out - Q * (Q.transpose() * y_out) - (y_ref - QJ * (QJ.transpose() * y_ref))).norm() < 1e-9 * y.norm());
+  CHECK((y_out - Q * (Q.transpose() * y_out) - (y_ref - QJ * (QJ.transpose() * y_ref))).norm() <
+        1e-9 * y.norm());
   // A column inside span(Q) up to 1e-8 of its norm: the products would decide on rounding.
   Jc.col(1) = J.col(4) + 1e-8 * Jc.col(1);
   CHECK(residual_without(Q, r, Q.transpose() * r, Jc).size() == 0);
@@ -350,8 +374,8 @@ TEST_CASE("scoring from inner products agrees with scoring from whitened columns
   const Eigen::MatrixXd Jf = free_columns(fit.jacobian);
   // The noise model of what the true model leaves (the search would model each candidate's):
   // AR(1), as simulated.
-  const NoiseModel model =
-      with_mean_bias_corrected(estimate_noise_model(P.groups(), P.times(), P.fit(truth.effects).residuals));
+  const NoiseModel model = with_mean_bias_corrected(
+      estimate_noise_model(P.groups(), P.times(), P.fit(truth.effects).residuals));
   REQUIRE(model.max_order == 1);
   const ArWhitener W(model);
   const ModelProducts products(Jf, noise_streams(P.groups(), P.times()));
@@ -374,7 +398,8 @@ TEST_CASE("scoring from inner products agrees with scoring from whitened columns
       const Eigen::MatrixXd Jc = P.candidate_jacobian(fit, e);
       const Score full = score(in, e, whiten(Jc), min_chi2);
       const std::optional<Score> quick =
-          score_from_products(candidate_products(w, sigma_mm, products, Jf, Jc, fit.residuals), e, fit.num_free, min_chi2);
+          score_from_products(candidate_products(w, sigma_mm, products, Jf, Jc, fit.residuals), e,
+                              fit.num_free, min_chi2);
       if (!quick) continue;  // left to the columns (near a threshold or near rank-deficient)
       ++compared;
       INFO(e.id() << (w ? " (AR(1))" : " (white)"));
@@ -393,7 +418,8 @@ TEST_CASE("scoring from inner products agrees with scoring from whitened columns
       CHECK(quick->delta_bic == Approx(full.delta_bic).margin(1e-4));
       CHECK(quick->f_pvalue == Approx(full.f_pvalue).margin(1e-9).epsilon(1e-6));
       for (int j = 0; j < full.params.size(); ++j)
-        CHECK(quick->params[j] == Approx(full.params[j]).margin(1e-9 * full.params.cwiseAbs().maxCoeff()));
+        CHECK(quick->params[j] ==
+              Approx(full.params[j]).margin(1e-9 * full.params.cwiseAbs().maxCoeff()));
     }
   }
   // Most candidates are decided from the products, both kinds among them.

@@ -25,7 +25,8 @@ ProbeSession session_with(const EffectModel& fx, const std::vector<double>& p, s
 }  // namespace
 
 TEST_CASE("a wrong stylus radius is named stylus_radius_offset", "[diagnose][probe]") {
-  const ProbeSession s = session_with(EffectModel{{Effect::parse("stylus_radius_offset")}, std::nullopt}, {3e-3}, 21);
+  const ProbeSession s =
+      session_with(EffectModel{{Effect::parse("stylus_radius_offset")}, std::nullopt}, {3e-3}, 21);
   DiagnosisOptions o;
   o.max_harmonic = 2;
   const Diagnosis d = diagnose_probe(s, o);
@@ -47,7 +48,8 @@ TEST_CASE("the probe candidates' Jacobian agrees with central differences", "[di
     const Eigen::MatrixXd J = problem.candidate_jacobian(at, c);
     const ProbeProblem full(s, EffectModel{{c}, std::nullopt});
     Eigen::VectorXd x = Eigen::VectorXd::Zero(full.num_parameters());
-    for (std::size_t j = 0; j < at.parameters.size(); ++j) x[static_cast<Eigen::Index>(j)] = at.parameters[j].value;
+    for (std::size_t j = 0; j < at.parameters.size(); ++j)
+      x[static_cast<Eigen::Index>(j)] = at.parameters[j].value;
     for (int k = 0; k < c.num_params(); ++k) {
       const Eigen::Index col = static_cast<Eigen::Index>(at.parameters.size()) + k;
       Eigen::VectorXd xp = x, xm = x;

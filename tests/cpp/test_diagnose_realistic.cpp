@@ -4,19 +4,18 @@
 // with the noise treated as white (options.model_noise = false, the behaviour before the noise
 // model) where that is what went wrong, so the test shows what the noise model changes.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <random>
 
-#include "rotacal/ballbar/simulate.hpp"
+#include "../support/synthetic_sessions.hpp"
 #include "rotacal/ballbar/plan.hpp"
+#include "rotacal/ballbar/simulate.hpp"
 #include "rotacal/ballbar/timeline.hpp"
 #include "rotacal/core/noise_model.hpp"
 #include "rotacal/diagnose/ballbar_diagnosis.hpp"
 #include "rotacal/diagnose/rtest_diagnosis.hpp"
 #include "rotacal/io/ballbar_file.hpp"
 #include "rotacal/rtest/simulate.hpp"
-#include "../support/synthetic_sessions.hpp"
 
 using namespace rotacal;
 
@@ -25,23 +24,30 @@ namespace {
 enum class Noise { ar1_09, ar1_095, pink, ar1_05 };
 
 const BallbarSession& commanded() { return synthetic::table2_commanded(); }
-BallbarMachineModel random_machine(std::mt19937& rng) { return synthetic::random_ballbar_machine(commanded(), rng); }
+BallbarMachineModel random_machine(std::mt19937& rng) {
+  return synthetic::random_ballbar_machine(commanded(), rng);
+}
 MachineModel random_table(std::mt19937& rng) { return synthetic::random_bc_table(rng); }
 
 // Coloured noise of 0.5 um marginal sigma, which the file declares.
 BallbarSession noisy_ballbar(const BallbarMachineModel& truth, Noise kind, std::uint64_t seed) {
-  const double rho = kind == Noise::pink ? -1.0 : kind == Noise::ar1_09 ? 0.9 : kind == Noise::ar1_05 ? 0.5 : 0.95;
+  const double rho = kind == Noise::pink     ? -1.0
+                     : kind == Noise::ar1_09 ? 0.9
+                     : kind == Noise::ar1_05 ? 0.5
+                                             : 0.95;
   return synthetic::noisy_ballbar(commanded(), truth, rho, 0.5, seed);
 }
 
 // R-test session with AR(1) noise per probe channel and probe zeros wandering between poses.
-RtestSession noisy_rtest(const MachineModel& truth, double rho, double wander_um, std::uint64_t seed) {
+RtestSession noisy_rtest(const MachineModel& truth, double rho, double wander_um,
+                         std::uint64_t seed) {
   RtestSimOptions o;
   o.noise_um = 0.0;
   RtestSession s = simulate_rtest(truth, o).session;
   RtestDiagnosisProblem layout(s);
-  const Eigen::VectorXd e = noise_gen::ar1(layout.groups(), layout.times(), rho, 0.3e-3, seed) +
-                            noise_gen::probe_zero_wander(layout.groups(), layout.times(), wander_um * 1e-3, seed + 1);
+  const Eigen::VectorXd e =
+      noise_gen::ar1(layout.groups(), layout.times(), rho, 0.3e-3, seed) +
+      noise_gen::probe_zero_wander(layout.groups(), layout.times(), wander_um * 1e-3, seed + 1);
   for (std::size_t r = 0; r < s.samples.size(); ++r)
     for (int a = 0; a < 3; ++a) (*s.samples[r].d)[a] += e[3 * static_cast<Eigen::Index>(r) + a];
   s.noise_um = 0.3;
@@ -56,12 +62,14 @@ std::string names(const Diagnosis& D) {
 
 }  // namespace
 
-TEST_CASE("ballbar null sessions in AR(1) and 1/f-like noise: no finding", "[diagnose][realistic][statistical]") {
+TEST_CASE("ballbar null sessions in AR(1) and 1/f-like noise: no finding",
+          "[diagnose][realistic][statistical]") {
   std::mt19937 rng(5);
   int false_white = 0, false_modelled = 0, sessions = 0;
   for (Noise kind : {Noise::ar1_09, Noise::ar1_095, Noise::pink}) {
     for (std::uint64_t seed : {1u, 2u}) {
-      const BallbarSession s = noisy_ballbar(random_machine(rng), kind, 100 * static_cast<int>(kind) + seed);
+      const BallbarSession s =
+          noisy_ballbar(random_machine(rng), kind, 100 * static_cast<int>(kind) + seed);
       const Diagnosis D = diagnose_ballbar(s);
       INFO("noise kind " << static_cast<int>(kind) << " seed " << seed << ": " << D.noise.summary()
                          << "; findings " << names(D));
@@ -95,7 +103,8 @@ TEST_CASE("1/f-like wander within a test is noise, not a drift", "[diagnose][rea
   for (int k = 0; k < 36; ++k) {
     const BallbarMachineModel m = synthetic::random_ballbar_machine(cmd, rng);
     if (k != 20 && k != 27 && k != 35) continue;
-    const Diagnosis D = diagnose_ballbar(synthetic::noisy_ballbar(cmd, m, -1.0, 0.5, static_cast<std::uint64_t>(k + 1)));
+    const Diagnosis D = diagnose_ballbar(
+        synthetic::noisy_ballbar(cmd, m, -1.0, 0.5, static_cast<std::uint64_t>(k + 1)));
     INFO("session " << k + 1 << ": " << D.noise.summary() << "; findings " << names(D));
     CHECK(D.findings.empty());
   }
@@ -114,7 +123,8 @@ TEST_CASE("ballbar AR(1) noise model reported with its correlation time", "[diag
   CHECK(D.noise.correlation_time_s > 0.0);
 }
 
-TEST_CASE("a gravity sag hidden in AR(1) noise is named, not three invented causes", "[diagnose][realistic]") {
+TEST_CASE("a gravity sag hidden in AR(1) noise is named, not three invented causes",
+          "[diagnose][realistic]") {
   std::mt19937 rng(13);
   BallbarMachineModel truth = random_machine(rng);
   truth.effects.effects = {Effect::parse("gravity_sag_A")};
@@ -156,7 +166,8 @@ TEST_CASE("two effects at once in AR(1) noise are both found", "[diagnose][reali
   CHECK(D.findings.size() <= 3);
 }
 
-TEST_CASE("a local defect outside the catalogue is reported as unexplained, where it is", "[diagnose][realistic]") {
+TEST_CASE("a local defect outside the catalogue is reported as unexplained, where it is",
+          "[diagnose][realistic]") {
   // A 5 um bump of the radial C test between C = 90 and 130 deg (a damaged bearing track
   // segment, a chip under the ball): no catalogue shape follows it.
   std::mt19937 rng(23);
@@ -183,8 +194,10 @@ TEST_CASE("a local defect outside the catalogue is reported as unexplained, wher
   int n_in = 0, n_out = 0;
   for (std::size_t k = 0; k < T.angle_deg.size(); ++k) {
     const double a = std::fmod(T.angle_deg[k] + 720.0, 360.0);
-    if (a > 100.0 && a < 120.0) in += T.value_um[k], ++n_in;
-    else if (a < 80.0 || a > 140.0) out += T.value_um[k], ++n_out;
+    if (a > 100.0 && a < 120.0)
+      in += T.value_um[k], ++n_in;
+    else if (a < 80.0 || a > 140.0)
+      out += T.value_um[k], ++n_out;
   }
   REQUIRE(n_in > 0);
   REQUIRE(n_out > 0);
@@ -192,7 +205,8 @@ TEST_CASE("a local defect outside the catalogue is reported as unexplained, wher
   CHECK(in / n_in - out / n_out > 2.0);
 }
 
-TEST_CASE("the same local defect in 1/f-like noise is still reported, where it is", "[diagnose][realistic]") {
+TEST_CASE("the same local defect in 1/f-like noise is still reported, where it is",
+          "[diagnose][realistic]") {
   // Under 1/f-like noise the unexplained-structure test whitens with the AR(1) + random walk
   // model (31 of 200 null sessions were flagged with Burg's AR(p), none with the walk:
   // diagnose_realistic_bench --rho -1); a defect of 5 um must not be taken for wander.
@@ -248,7 +262,8 @@ TEST_CASE("a straightness error of X in Y is named as straightness, not as a rot
   BallbarMachineModel truth = random_machine(rng);
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   double lo = 1e300, hi = -1e300;
-  for (const BallbarSample& x : commanded().samples) mean += x.xyz, lo = std::min(lo, x.xyz.x()), hi = std::max(hi, x.xyz.x());
+  for (const BallbarSample& x : commanded().samples)
+    mean += x.xyz, lo = std::min(lo, x.xyz.x()), hi = std::max(hi, x.xyz.x());
   mean /= static_cast<double>(commanded().samples.size());
   const double u_max = std::max(hi - mean.x(), mean.x() - lo) / 100.0;
   truth.effects.effects = {Effect::parse("straightness_YX")};
@@ -299,8 +314,9 @@ const Finding* finding(const Diagnosis& D, const std::string& id) {
 
 }  // namespace
 
-TEST_CASE("backlash and servo lag of C, with a gravity sag, in AR(1) noise: each named with its size",
-          "[diagnose][realistic][motion]") {
+TEST_CASE(
+    "backlash and servo lag of C, with a gravity sag, in AR(1) noise: each named with its size",
+    "[diagnose][realistic][motion]") {
   // Tangential C both ways at two feeds: backlash flips with the direction, lag scales with
   // the speed, the zero offset does neither. 40 urad of lost motion is 3 um at the tool,
   // 0.3 ms of lag about 5 um at the lower feed.
@@ -308,7 +324,8 @@ TEST_CASE("backlash and servo lag of C, with a gravity sag, in AR(1) noise: each
   const BallbarPlan plan = plan_ballbar_test(motion_setup({1.0, 2.0}));
   const BallbarSession cmd = commanded_session(plan);
   BallbarMachineModel truth = synthetic::random_ballbar_machine(cmd, rng);
-  truth.effects.effects = {Effect::parse("backlash_C"), Effect::parse("servo_lag_C"), Effect::parse("gravity_sag_A")};
+  truth.effects.effects = {Effect::parse("backlash_C"), Effect::parse("servo_lag_C"),
+                           Effect::parse("gravity_sag_A")};
   truth.effect_params = {40e-6, 0.3e-3, 0.005};
   const Diagnosis D = diagnose_ballbar(synthetic::noisy_ballbar(cmd, truth, 0.9, 0.5, 61));
   INFO("findings " << names(D) << "; " << D.noise.summary());
@@ -322,7 +339,8 @@ TEST_CASE("backlash and servo lag of C, with a gravity sag, in AR(1) noise: each
   CHECK(D.findings.size() <= 4);
 }
 
-TEST_CASE("backlash against servo lag at one feed: reported as indistinguishable", "[diagnose][realistic][motion]") {
+TEST_CASE("backlash against servo lag at one feed: reported as indistinguishable",
+          "[diagnose][realistic][motion]") {
   std::mt19937 rng(31);
   const BallbarSession cmd = commanded_session(plan_ballbar_test(motion_setup({1.0})));
   BallbarMachineModel truth = synthetic::random_ballbar_machine(cmd, rng);
@@ -332,8 +350,9 @@ TEST_CASE("backlash against servo lag at one feed: reported as indistinguishable
   INFO("findings " << names(D));
   bool pair = false;
   for (const Ambiguity& a : D.ambiguous)
-    pair = pair || (std::find(a.effects.begin(), a.effects.end(), "backlash_C") != a.effects.end() &&
-                    std::find(a.effects.begin(), a.effects.end(), "servo_lag_C") != a.effects.end());
+    pair =
+        pair || (std::find(a.effects.begin(), a.effects.end(), "backlash_C") != a.effects.end() &&
+                 std::find(a.effects.begin(), a.effects.end(), "servo_lag_C") != a.effects.end());
   CHECK(pair);
   // In one direction only, the motion effects are not tried at all.
   BallbarSetup one_way = motion_setup({1.0});
@@ -343,8 +362,9 @@ TEST_CASE("backlash against servo lag at one feed: reported as indistinguishable
   for (const Effect& e : P.candidates(3)) CHECK_FALSE(e.depends_on_motion());
 }
 
-TEST_CASE("a reversal spike of C in a 50 Hz recording is named, with a radial error motion beside it",
-          "[diagnose][realistic][motion]") {
+TEST_CASE(
+    "a reversal spike of C in a 50 Hz recording is named, with a radial error motion beside it",
+    "[diagnose][realistic][motion]") {
   // The spike lasts about 0.1 s after each reversal: only a recording at the transducer's
   // rate sees it, not the plan's points. The axial test tells the radial motion from a tilt.
   BallbarSetup s;
@@ -361,7 +381,8 @@ TEST_CASE("a reversal spike of C in a 50 Hz recording is named, with a radial er
   INFO("findings " << names(D) << "; " << D.noise.summary());
   const Finding* f = finding(D, "reversal_spike_C");
   REQUIRE(f != nullptr);
-  INFO("h = " << f->parameters[0].value << " +- " << f->parameters[0].std << ", ln tau/50ms = " << f->parameters[1].value << " +- " << f->parameters[1].std);
+  INFO("h = " << f->parameters[0].value << " +- " << f->parameters[0].std
+              << ", ln tau/50ms = " << f->parameters[1].value << " +- " << f->parameters[1].std);
   CHECK(std::abs(f->parameters[0].value - 60e-6) < 3.0 * f->parameters[0].std);
   CHECK(finding(D, "radial_motion_C_h2") != nullptr);
 }

@@ -1,16 +1,14 @@
-#include <catch2/catch.hpp>
-
 #include <Eigen/SVD>
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <random>
 
+#include "../support/candidate_jacobians.hpp"
+#include "../support/synthetic_sessions.hpp"
 #include "rotacal/core/least_squares.hpp"
-
 #include "rotacal/diagnose/rtest_diagnosis.hpp"
 #include "rotacal/io/ballbar_file.hpp"
 #include "rotacal/rtest/simulate.hpp"
-#include "../support/candidate_jacobians.hpp"
-#include "../support/synthetic_sessions.hpp"
 
 using namespace rotacal;
 
@@ -18,7 +16,8 @@ namespace {
 MachineModel random_table(std::mt19937& rng) { return synthetic::random_bc_table(rng); }
 }  // namespace
 
-TEST_CASE("R-test diagnosis finds the effects hidden in the independent implementation's file", "[diagnose]") {
+TEST_CASE("R-test diagnosis finds the effects hidden in the independent implementation's file",
+          "[diagnose]") {
   // rtest_bc_oyama.truth.json: gravity_sag_B = 0.006 mm, coning_B = 1.45e-4 rad/rad, noise 0.3 um.
   RtestSession s = read_rtest(std::string(ROTACAL_SHARED_DIR) + "/data/rtest_bc_oyama.csv");
   const Diagnosis D = diagnose_rtest(s);  // the file declares no noise: it is estimated
@@ -69,7 +68,8 @@ TEST_CASE("R-test diagnosis: null data gives no finding; a hidden runout is foun
     for (const CandidateScore& c : round) CHECK(c.effect.rfind("ballbar_", 0) != 0);
 }
 
-TEST_CASE("every catalogue effect an R-test can see, hidden at 5 sigma, is found first", "[diagnose][statistical]") {
+TEST_CASE("every catalogue effect an R-test can see, hidden at 5 sigma, is found first",
+          "[diagnose][statistical]") {
   // Same rule as the ballbar test: the amplitude gives 5 sigma RMS of what the location errors
   // and probe zeros cannot absorb, if a plausible size of the effect can do that.
   std::mt19937 rng(31);
@@ -91,9 +91,11 @@ TEST_CASE("every catalogue effect an R-test can see, hidden at 5 sigma, is found
     RtestDiagnosisProblem P(clean);
     const ModelFit at = P.fit(EffectModel{});
     Eigen::VectorXd m(effect.num_params());
-    for (int j = 0; j < m.size(); ++j) m[j] = plausible_magnitude(effect.param_units()[static_cast<std::size_t>(j)]);
+    for (int j = 0; j < m.size(); ++j)
+      m[j] = plausible_magnitude(effect.param_units()[static_cast<std::size_t>(j)]);
     const Eigen::MatrixXd Jc = P.candidate_jacobian(at, effect) * m.asDiagonal();
-    const Eigen::MatrixXd perp = Jc - at.jacobian * at.jacobian.completeOrthogonalDecomposition().solve(Jc);
+    const Eigen::MatrixXd perp =
+        Jc - at.jacobian * at.jacobian.completeOrthogonalDecomposition().solve(Jc);
     Eigen::JacobiSVD<Eigen::MatrixXd> svd(perp, Eigen::ComputeThinV);
     const double per_size = svd.singularValues()[0] / std::sqrt(static_cast<double>(perp.rows()));
     const double sizes = 5.0 * noise_um * 1e-3 / per_size;
@@ -114,19 +116,23 @@ TEST_CASE("every catalogue effect an R-test can see, hidden at 5 sigma, is found
     std::string also;
     for (const Ambiguity& a : D.ambiguous)
       for (const std::string& id : a.effects) also += id + " ";
-    INFO(effect.id() << ": first finding " << (D.findings.empty() ? "none" : D.findings[0].effect.id())
+    INFO(effect.id() << ": first finding "
+                     << (D.findings.empty() ? "none" : D.findings[0].effect.id())
                      << "; ambiguous with: " << also);
     // A cause whose refit determines none of its parameters is never named (issue 11): then
     // it must be reported as such, and nothing else named in its place.
-    const bool undetermined = std::any_of(D.unobservable.begin(), D.unobservable.end(), [&](const UnobservableEffect& u) {
-      return u.effect == effect.id() && u.reason.find("none of its parameters can be determined") != std::string::npos;
-    });
+    const bool undetermined =
+        std::any_of(D.unobservable.begin(), D.unobservable.end(), [&](const UnobservableEffect& u) {
+          return u.effect == effect.id() &&
+                 u.reason.find("none of its parameters can be determined") != std::string::npos;
+        });
     if (undetermined && D.findings.empty()) continue;
     REQUIRE_FALSE(D.findings.empty());
     bool named = D.findings[0].effect == effect;
     for (const Ambiguity& a : D.ambiguous)
-      named = named || (a.effects[0] == D.findings[0].effect.id() &&
-                        std::find(a.effects.begin(), a.effects.end(), effect.id()) != a.effects.end());
+      named =
+          named || (a.effects[0] == D.findings[0].effect.id() &&
+                    std::find(a.effects.begin(), a.effects.end(), effect.id()) != a.effects.end());
     CHECK(named);
     if (D.findings[0].effect == effect)
       for (Eigen::Index k = 0; k < p.size(); ++k) {
@@ -135,7 +141,8 @@ TEST_CASE("every catalogue effect an R-test can see, hidden at 5 sigma, is found
       }
     CHECK(D.findings[0].gain.cv_rms_after_um < D.findings[0].gain.cv_rms_before_um);
   }
-  WARN(tried << " R-test catalogue effects hidden and found; invisible at plausible sizes: " << invisible);
+  WARN(tried << " R-test catalogue effects hidden and found; invisible at plausible sizes: "
+             << invisible);
   CHECK(tried >= 20);
 }
 
@@ -248,11 +255,13 @@ TEST_CASE("harmonic resolution: Nyquist on even turns, rank and conditioning oth
   CHECK_THROWS_AS(resolve_harmonics(uneven, 'C', 8, 0.0), InvalidArgument);
 }
 
-TEST_CASE("R-test candidate Jacobians: the harmonic shortcut equals Jets of every parameter", "[diagnose]") {
+TEST_CASE("R-test candidate Jacobians: the harmonic shortcut equals Jets of every parameter",
+          "[diagnose]") {
   // At a fit holding effects of the same harmonic kinds, three rows per pose.
   RtestDiagnosisProblem P(read_rtest(std::string(ROTACAL_SHARED_DIR) + "/data/rtest_bc_oyama.csv"));
   EffectModel fx;
-  fx.effects = {Effect::parse("radial_motion_C_h2"), Effect::parse("tilt_motion_B_h1"), Effect::parse("coning_B")};
+  fx.effects = {Effect::parse("radial_motion_C_h2"), Effect::parse("tilt_motion_B_h1"),
+                Effect::parse("coning_B")};
   const int harmonic = synthetic::check_candidate_jacobians(P, fx);
   CHECK(harmonic >= 20);
 }

@@ -1,14 +1,13 @@
 // The one scorer and cross-validation of src/diagnose/scoring.hpp, which the engine and the
 // circular-test diagnosis share: score_columns against an independent dense least-squares fit,
 // its visibility decisions, and the blocked CV RMS against means worked out by hand.
-#include <catch2/catch.hpp>
-
 #include <Eigen/QR>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <random>
 
-#include "rotacal/core/stats.hpp"
 #include "../../src/diagnose/scoring.hpp"
+#include "rotacal/core/stats.hpp"
 
 using namespace rotacal;
 using namespace rotacal::diagnosis_detail;
@@ -30,8 +29,8 @@ Eigen::VectorXd ls_residual(const Eigen::MatrixXd& X, const Eigen::VectorXd& y) 
 
 // The Gram quantities of candidate columns Jc (whitened) against model columns Jf, residuals r0
 // of the model, per plausible size m: formed from an explicit projection.
-CandidateGrams grams_of(const Eigen::MatrixXd& Jf, const Eigen::MatrixXd& Jc, const Eigen::VectorXd& r0,
-                        const Eigen::VectorXd& m) {
+CandidateGrams grams_of(const Eigen::MatrixXd& Jf, const Eigen::MatrixXd& Jc,
+                        const Eigen::VectorXd& r0, const Eigen::VectorXd& m) {
   const Eigen::HouseholderQR<Eigen::MatrixXd> qr(Jf);
   const Eigen::MatrixXd Q = qr.householderQ() * Eigen::MatrixXd::Identity(Jf.rows(), Jf.cols());
   const Eigen::MatrixXd P = (Jc - Q * (Q.transpose() * Jc)) * m.asDiagonal();
@@ -46,7 +45,8 @@ CandidateGrams grams_of(const Eigen::MatrixXd& Jf, const Eigen::MatrixXd& Jc, co
 
 }  // namespace
 
-TEST_CASE("score_columns refits as the joint least squares, nonlinear parameters counted", "[scoring]") {
+TEST_CASE("score_columns refits as the joint least squares, nonlinear parameters counted",
+          "[scoring]") {
   std::mt19937 rng(3);
   const Eigen::Index n = 400;
   const Eigen::MatrixXd Jf = gaussian(n, 3, rng);
@@ -78,7 +78,8 @@ TEST_CASE("score_columns refits as the joint least squares, nonlinear parameters
   CHECK(s.f_pvalue < 0.2);
 }
 
-TEST_CASE("score_columns: directions below the threshold, absorbed and undecided candidates", "[scoring]") {
+TEST_CASE("score_columns: directions below the threshold, absorbed and undecided candidates",
+          "[scoring]") {
   std::mt19937 rng(5);
   const Eigen::Index n = 300;
   const Eigen::MatrixXd Jf = gaussian(n, 3, rng);
@@ -99,7 +100,8 @@ TEST_CASE("score_columns: directions below the threshold, absorbed and undecided
   CHECK(absorbed.absorbed);
 
   // Too small to see at all.
-  const ColumnScore small = score_columns(m, grams_of(Jf, 0.01 * gaussian(n, 2, rng), r0, m), 3, 0, 25.0);
+  const ColumnScore small =
+      score_columns(m, grams_of(Jf, 0.01 * gaussian(n, 2, rng), r0, m), 3, 0, 25.0);
   CHECK_FALSE(small.visible);
   CHECK_FALSE(small.absorbed);
 
@@ -121,7 +123,8 @@ TEST_CASE("Blocked folds and the cross-validated RMS of a mean", "[scoring]") {
   CHECK(contiguous_block(0, 10, 3, 2) == 2);
 
   // y ~ a constant, two blocks: each block is predicted by the other's mean (mm -> um).
-  const Eigen::VectorXd y = (Eigen::VectorXd(6) << 1.0, 2.0, 3.0, 10.0, 11.0, 15.0).finished() * 1e-3;
+  const Eigen::VectorXd y =
+      (Eigen::VectorXd(6) << 1.0, 2.0, 3.0, 10.0, 11.0, 15.0).finished() * 1e-3;
   const Eigen::MatrixXd X = Eigen::MatrixXd::Ones(6, 1);
   const std::vector<int> fold = {0, 0, 0, 1, 1, 1};
   const double mean0 = 2.0, mean1 = 12.0;
@@ -135,5 +138,6 @@ TEST_CASE("Blocked folds and the cross-validated RMS of a mean", "[scoring]") {
           return Eigen::VectorXd::Zero(1).eval();
         }) == Approx(y.norm() / std::sqrt(6.0) * 1e3).epsilon(1e-12));
   // No columns: the prediction is zero.
-  CHECK(cv_rms_um(Eigen::MatrixXd(6, 0), y, fold, 2) == Approx(y.norm() / std::sqrt(6.0) * 1e3).epsilon(1e-12));
+  CHECK(cv_rms_um(Eigen::MatrixXd(6, 0), y, fold, 2) ==
+        Approx(y.norm() / std::sqrt(6.0) * 1e3).epsilon(1e-12));
 }

@@ -1,6 +1,6 @@
-#include <catch2/catch.hpp>
 #include <ceres/jet.h>
 
+#include <catch2/catch.hpp>
 #include <random>
 
 #include "rotacal/kinematics/effects.hpp"
@@ -47,10 +47,13 @@ TEST_CASE("angle effects shift the actual angle", "[effects]") {
   const Eigen::Vector3d q(100, 20, 50);
   const auto m = MachineType::AC_trt;
   const double C = 0.7, A = -0.4, eps = 1e-3;
-  CHECK((moved(m, "rotary_zero_offset_C", {eps}, {A, C}, q) - Rx(A) * Rz(C + eps) * q).norm() < 1e-12);
-  CHECK((moved(m, "rotary_zero_offset_A", {eps}, {A, C}, q) - Rx(A + eps) * Rz(C) * q).norm() < 1e-12);
+  CHECK((moved(m, "rotary_zero_offset_C", {eps}, {A, C}, q) - Rx(A) * Rz(C + eps) * q).norm() <
+        1e-12);
+  CHECK((moved(m, "rotary_zero_offset_A", {eps}, {A, C}, q) - Rx(A + eps) * Rz(C) * q).norm() <
+        1e-12);
   const double a = 2e-4, b = -1e-4, dC = a * std::cos(2 * C) + b * std::sin(2 * C);
-  CHECK((moved(m, "angular_positioning_C_h2", {a, b}, {A, C}, q) - Rx(A) * Rz(C + dC) * q).norm() < 1e-12);
+  CHECK((moved(m, "angular_positioning_C_h2", {a, b}, {A, C}, q) - Rx(A) * Rz(C + dC) * q).norm() <
+        1e-12);
 }
 
 TEST_CASE("error motions act in the axis' turning frame before its rotation", "[effects]") {
@@ -58,31 +61,40 @@ TEST_CASE("error motions act in the axis' turning frame before its rotation", "[
   const Eigen::Vector3d q(100, 0, 60);
   const double B = 0.5, C = 1.1, n = 3;
   const double a = 1e-3, b = 2e-3, c = -1e-3, d = 5e-4;
-  const double u = a * std::cos(n * C) + b * std::sin(n * C), v = c * std::cos(n * C) + d * std::sin(n * C);
+  const double u = a * std::cos(n * C) + b * std::sin(n * C),
+               v = c * std::cos(n * C) + d * std::sin(n * C);
   // C turns about Z: the perpendicular pair is (X, Y) of C's turning frame.
   CHECK((moved(m, "radial_motion_C_h3", {a, b, c, d}, {B, C}, q) -
-         Ry(B) * Rz(C) * (q + Eigen::Vector3d(u, v, 0))).norm() < 1e-12);
+         Ry(B) * Rz(C) * (q + Eigen::Vector3d(u, v, 0)))
+            .norm() < 1e-12);
   CHECK((moved(m, "axial_motion_C_h3", {a, b}, {B, C}, q) -
-         Ry(B) * Rz(C) * (q + Eigen::Vector3d(0, 0, u))).norm() < 1e-12);
-  CHECK((moved(m, "tilt_motion_C_h3", {a, b, c, d}, {B, C}, q) -
-         Ry(B) * Rz(C) * Rx(u) * Ry(v) * q).norm() < 1e-12);
+         Ry(B) * Rz(C) * (q + Eigen::Vector3d(0, 0, u)))
+            .norm() < 1e-12);
+  CHECK((moved(m, "tilt_motion_C_h3", {a, b, c, d}, {B, C}, q) - Ry(B) * Rz(C) * Rx(u) * Ry(v) * q)
+            .norm() < 1e-12);
   // B turns about Y: its perpendicular pair is (Z, X), and E_B acts after C has turned.
-  const double uB = a * std::cos(2 * B) + b * std::sin(2 * B), vB = c * std::cos(2 * B) + d * std::sin(2 * B);
+  const double uB = a * std::cos(2 * B) + b * std::sin(2 * B),
+               vB = c * std::cos(2 * B) + d * std::sin(2 * B);
   CHECK((moved(m, "radial_motion_B_h2", {a, b, c, d}, {B, C}, q) -
-         Ry(B) * (Rz(C) * q + Eigen::Vector3d(vB, 0, uB))).norm() < 1e-12);
+         Ry(B) * (Rz(C) * q + Eigen::Vector3d(vB, 0, uB)))
+            .norm() < 1e-12);
 }
 
 TEST_CASE("tilt-axis effects: gravity sag, coning, drift", "[effects]") {
   const Eigen::Vector3d q(100, -20, 60);
   const double B = -1.2, C = 0.3;
   CHECK((moved(MachineType::BC_trt, "gravity_sag_B", {0.006}, {B, C}, q) -
-         (Ry(B) * Rz(C) * q - Eigen::Vector3d(0, 0, 0.006 * (1 - std::cos(B))))).norm() < 1e-12);
+         (Ry(B) * Rz(C) * q - Eigen::Vector3d(0, 0, 0.006 * (1 - std::cos(B)))))
+            .norm() < 1e-12);
   CHECK((moved(MachineType::BC_trt, "coning_B", {1.45e-4}, {B, C}, q) -
-         Rx(1.45e-4 * B) * Ry(B) * Rz(C) * q).norm() < 1e-12);
-  CHECK((moved(MachineType::AC_trt, "coning_A", {1e-4}, {B, C}, q) -
-         Ry(1e-4 * B) * Rx(B) * Rz(C) * q).norm() < 1e-12);
+         Rx(1.45e-4 * B) * Ry(B) * Rz(C) * q)
+            .norm() < 1e-12);
+  CHECK(
+      (moved(MachineType::AC_trt, "coning_A", {1e-4}, {B, C}, q) - Ry(1e-4 * B) * Rx(B) * Rz(C) * q)
+          .norm() < 1e-12);
   CHECK((moved(MachineType::AC_trt, "thermal_drift_Y", {1e-5}, {B, C}, q, 100.0) -
-         (Rx(B) * Rz(C) * q + Eigen::Vector3d(0, 1e-3, 0))).norm() < 1e-12);
+         (Rx(B) * Rz(C) * q + Eigen::Vector3d(0, 1e-3, 0)))
+            .norm() < 1e-12);
 }
 
 TEST_CASE("tool-side and instrument effects", "[effects]") {
@@ -105,7 +117,8 @@ TEST_CASE("effect parameters are differentiable with ceres::Jet", "[effects][jet
                   Effect::parse("tilt_motion_C_h1"), Effect::parse("radial_motion_B_h2"),
                   Effect::parse("angular_positioning_C_h1")}};
   REQUIRE(fx.num_params() == 12);
-  std::vector<double> p = {0.006, 1e-4, 1e-5, -2e-5, 3e-5, 1e-5, 1e-3, -2e-3, 5e-4, 1e-3, 1e-5, -1e-5};
+  std::vector<double> p = {0.006, 1e-4,  1e-5, -2e-5, 3e-5, 1e-5,
+                           1e-3,  -2e-3, 5e-4, 1e-3,  1e-5, -1e-5};
   std::vector<J> pj(12);
   for (int i = 0; i < 12; ++i) pj[i] = J(p[i], i);
   const Eigen::Vector3d q(100, 30, 60);
@@ -119,8 +132,10 @@ TEST_CASE("effect parameters are differentiable with ceres::Jet", "[effects][jet
     pp[i] += h;
     pmn[i] -= h;
     const Eigen::Vector3d fd = (table_pose<double>(m, e, fx, pp.data(), a, 0.0) * q -
-                                table_pose<double>(m, e, fx, pmn.data(), a, 0.0) * q) / (2 * h);
-    for (int k = 0; k < 3; ++k) CHECK_THAT(pm[k].v[i], WithinAbs(fd[k], 1e-5 * (1 + std::abs(fd[k]))));
+                                table_pose<double>(m, e, fx, pmn.data(), a, 0.0) * q) /
+                               (2 * h);
+    for (int k = 0; k < 3; ++k)
+      CHECK_THAT(pm[k].v[i], WithinAbs(fd[k], 1e-5 * (1 + std::abs(fd[k]))));
   }
 }
 
@@ -129,7 +144,8 @@ TEST_CASE("table_point agrees with table_pose for every stage", "[effects]") {
   EffectModel fx{{Effect::parse("thermal_drift_X"), Effect::parse("coning_A"),
                   Effect::parse("tilt_motion_A_h2"), Effect::parse("radial_motion_C_h2"),
                   Effect::parse("rotary_zero_offset_C")}};
-  const std::vector<double> p = {1e-5, 1e-4, 1e-5, 2e-5, -1e-5, 3e-5, 1e-3, 2e-3, -1e-3, 4e-4, 2e-4};
+  const std::vector<double> p = {1e-5, 1e-4, 1e-5,  2e-5, -1e-5, 3e-5,
+                                 1e-3, 2e-3, -1e-3, 4e-4, 2e-4};
   REQUIRE(static_cast<int>(p.size()) == fx.num_params());
   LocationErrors<double> e;
   e.v << 0.01, -0.02, 1e-5, 2e-5, 0.03, 0.01, -1e-5, 3e-5;
@@ -142,5 +158,6 @@ TEST_CASE("table_point agrees with table_pose for every stage", "[effects]") {
   // With no effects both reduce to the baseline kinematics of machine.hpp.
   const EffectModel none;
   CHECK((table_point<double>(m, e, none, nullptr, {0.4, 1.0}, 0.0, q) -
-         forward<double>(m, e, {0.4, 1.0}, q)).norm() < 1e-12);
+         forward<double>(m, e, {0.4, 1.0}, q))
+            .norm() < 1e-12);
 }

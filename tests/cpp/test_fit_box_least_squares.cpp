@@ -1,6 +1,5 @@
-#include <catch2/catch.hpp>
-
 #include <Eigen/Cholesky>
+#include <catch2/catch.hpp>
 #include <limits>
 #include <random>
 
@@ -45,7 +44,8 @@ TEST_CASE("box least squares meets the KKT conditions where a bound is active", 
     const Eigen::MatrixXd A = p.R.transpose() * p.w.asDiagonal() * p.R;
     const Eigen::VectorXd free_solution = A.ldlt().solve(p.R.transpose() * p.w.asDiagonal() * p.d);
     // Bounds at half the unconstrained solution's size: at least one is active.
-    const Eigen::VectorXd bounds = 0.5 * free_solution.cwiseAbs() + Eigen::VectorXd::Constant(3, 1e-3);
+    const Eigen::VectorXd bounds =
+        0.5 * free_solution.cwiseAbs() + Eigen::VectorXd::Constant(3, 1e-3);
     const Eigen::VectorXd s = box_least_squares(p.R, p.d, p.w, bounds);
     // Gradient of 1/2 sum w (d - R s)^2: g = -R^T W (d - R s). At the minimum, g_j = 0 where
     // s_j is inside its bound, and g_j pushes outward (g_j s_j <= 0) where s_j is at its bound.
@@ -70,7 +70,8 @@ TEST_CASE("box least squares: an unweighted column stays at zero, bad input thro
   p.R.col(2).setZero();
   const Eigen::VectorXd s = box_least_squares(p.R, p.d, p.w, Eigen::VectorXd::Constant(3, 10.0));
   CHECK(s[2] == 0.0);
-  CHECK_THROWS_AS(box_least_squares(p.R, p.d.head(7), p.w, Eigen::VectorXd::Ones(3)), InvalidArgument);
+  CHECK_THROWS_AS(box_least_squares(p.R, p.d.head(7), p.w, Eigen::VectorXd::Ones(3)),
+                  InvalidArgument);
   CHECK_THROWS_AS(box_least_squares(p.R, p.d, p.w, Eigen::VectorXd::Ones(2)), InvalidArgument);
   CHECK_THROWS_AS(box_least_squares(p.R, p.d, -p.w, Eigen::VectorXd::Ones(3)), InvalidArgument);
   CHECK_THROWS_AS(box_least_squares(p.R, p.d, p.w, -Eigen::VectorXd::Ones(3)), InvalidArgument);

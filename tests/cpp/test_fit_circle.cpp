@@ -1,5 +1,4 @@
 #include <catch2/catch.hpp>
-
 #include <random>
 
 #include "rotacal/core/error.hpp"
@@ -8,7 +7,8 @@
 using namespace rotacal;
 
 namespace {
-Points2 arc(double cx, double cy, double r, double from, double to, int n, double sigma, std::mt19937& rng) {
+Points2 arc(double cx, double cy, double r, double from, double to, int n, double sigma,
+            std::mt19937& rng) {
   std::normal_distribution<double> N(0.0, sigma);
   Points2 p(n, 2);
   for (int i = 0; i < n; ++i) {
@@ -36,7 +36,8 @@ TEST_CASE("reported 1-sigma uncertainties agree with Monte Carlo", "[fit]") {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero(), sq = Eigen::Vector3d::Zero();
   Eigen::Vector3d reported = Eigen::Vector3d::Zero();
   for (int k = 0; k < draws; ++k) {
-    const CircleFit f = hyper_circle_fit(arc(0.0, 60.0, 120.0, -M_PI / 2, M_PI / 2, 181, sigma, rng));
+    const CircleFit f =
+        hyper_circle_fit(arc(0.0, 60.0, 120.0, -M_PI / 2, M_PI / 2, 181, sigma, rng));
     const Eigen::Vector3d v(f.centre.x(), f.centre.y() - 60.0, f.radius - 120.0);
     sum += v;
     sq += v.cwiseProduct(v);
@@ -65,7 +66,8 @@ TEST_CASE("on a short noisy arc Hyper is essentially unbiased and Kasa is not", 
   }
   bias_h /= draws, bias_k /= draws;
   const double sem = std::sqrt(var_h / draws - bias_h * bias_h) / std::sqrt(draws);
-  INFO("mean radius error: Hyper " << bias_h << " mm, Kasa " << bias_k << " mm, standard error " << sem);
+  INFO("mean radius error: Hyper " << bias_h << " mm, Kasa " << bias_k << " mm, standard error "
+                                   << sem);
   CHECK(bias_k < -5 * sem);
   CHECK(std::abs(bias_h) < 3 * sem);
   CHECK(std::abs(bias_k) > 3 * std::abs(bias_h));
@@ -81,7 +83,8 @@ TEST_CASE("degenerate input is refused with a clear error", "[fit]") {
   CHECK_THROWS_WITH(hyper_circle_fit(line), Catch::Contains("collinear"));
   CHECK_THROWS_WITH(kasa_circle_fit(line), Catch::Contains("collinear"));
   // 0.5 degree of a 100 mm circle with 0.05 mm noise: sagitta 1 um, far below the scatter.
-  CHECK_THROWS_WITH(hyper_circle_fit(arc(0, 0, 100, 0, M_PI / 360, 20, 0.05, rng)), Catch::Contains("too short"));
+  CHECK_THROWS_WITH(hyper_circle_fit(arc(0, 0, 100, 0, M_PI / 360, 20, 0.05, rng)),
+                    Catch::Contains("too short"));
   Points2 nan = arc(0, 0, 10, 0, 3, 10, 0.0, rng);
   nan(3, 1) = std::numeric_limits<double>::quiet_NaN();
   CHECK_THROWS_AS(hyper_circle_fit(nan), InvalidArgument);
@@ -89,8 +92,10 @@ TEST_CASE("degenerate input is refused with a clear error", "[fit]") {
   // The caller's context names the data in every message.
   CircleFitOptions o;
   o.context = "s.csv: test radial_C";
-  CHECK_THROWS_WITH(hyper_circle_fit(line, o), Catch::StartsWith("s.csv: test radial_C: hyper_circle_fit: the 5 points"));
-  CHECK_THROWS_WITH(kasa_circle_fit(two, o), Catch::StartsWith("s.csv: test radial_C: kasa_circle_fit: 2 points"));
+  CHECK_THROWS_WITH(hyper_circle_fit(line, o),
+                    Catch::StartsWith("s.csv: test radial_C: hyper_circle_fit: the 5 points"));
+  CHECK_THROWS_WITH(kasa_circle_fit(two, o),
+                    Catch::StartsWith("s.csv: test radial_C: kasa_circle_fit: 2 points"));
 }
 
 TEST_CASE("geometric refinement lowers the orthogonal residual", "[fit]") {

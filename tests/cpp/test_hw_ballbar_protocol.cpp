@@ -6,8 +6,9 @@
 using namespace rotacal::hw;
 
 TEST_CASE("ballbar sample frames round-trip, negative displacements included", "[hw]") {
-  for (const BallbarFrame f : {BallbarFrame{0, 0, 0, 0}, BallbarFrame{65535, 4294967295u, -123456789, 1},
-                               BallbarFrame{17, 1000, 987654, 0}}) {
+  for (const BallbarFrame f :
+       {BallbarFrame{0, 0, 0, 0}, BallbarFrame{65535, 4294967295u, -123456789, 1},
+        BallbarFrame{17, 1000, 987654, 0}}) {
     const Bytes bytes = encode_ballbar_sample(f);
     CHECK(bytes.size() == 17);  // 11-byte payload + framing, as docs/protocols.md says
     const FrameScan s = scan_frames(bytes.data(), bytes.size());

@@ -1,6 +1,5 @@
 // Binary framing: CRC check value, round trips, resynchronisation after garbage and corruption.
 #include <catch2/catch.hpp>
-
 #include <cstring>
 
 #include "rotacal/core/error.hpp"

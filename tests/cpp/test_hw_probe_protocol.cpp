@@ -41,7 +41,8 @@ TEST_CASE("sylvac-style replies", "[hw]") {
   CHECK(parse_sylvac_reply("Err02")->kind == GaugeValue::Kind::error);
   CHECK(parse_sylvac_reply("Err02")->code == 2);
   CHECK(parse_sylvac_reply("?")->kind == GaugeValue::Kind::error);
-  for (const char* bad : {"", "12.3", "+", "+1.2.3", "+12a", "Err1", "+nan", "+0444444412", "+1.1234567"})
+  for (const char* bad :
+       {"", "12.3", "+", "+1.2.3", "+12a", "Err1", "+nan", "+0444444412", "+1.1234567"})
     CHECK_FALSE(parse_sylvac_reply(bad));  // the 10-digit value: found by fuzz_probe_lines
   // format then parse gives the value back to the reply's 0.1 um resolution
   const std::string line = format_sylvac_reply({GaugeValue::Kind::value, -1.23456, 0});
@@ -67,8 +68,10 @@ TEST_CASE("keyence-style replies", "[hw]") {
   CHECK(er->values[0].code == 2);
   for (const char* bad : {"M0,+1.0", "M1,+1,+2", "M5,+1", "ER,M1,2", "ER,X1,02", "M1,1.0", "M1"})
     CHECK_FALSE(parse_keyence_reply(bad));
-  const KeyenceReply r{0, {{GaugeValue::Kind::value, 0.5, 0}, {GaugeValue::Kind::under_range, 0, 0},
-                           {GaugeValue::Kind::value, -0.00004, 0}}};
+  const KeyenceReply r{0,
+                       {{GaugeValue::Kind::value, 0.5, 0},
+                        {GaugeValue::Kind::under_range, 0, 0},
+                        {GaugeValue::Kind::value, -0.00004, 0}}};
   CHECK(format_keyence_reply(r) == "M0,+00.5000,-FFFFFFF,-00.0000\r");
 }
 

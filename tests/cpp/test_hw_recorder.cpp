@@ -1,14 +1,13 @@
 // End to end: virtual instrument -> pty -> recorder -> session file -> identification.
-#include <catch2/catch.hpp>
+#include <unistd.h>
 
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <thread>
-
-#include <unistd.h>
 
 #include "rotacal/ballbar/identify.hpp"
 #include "rotacal/hw/recorder.hpp"
@@ -25,7 +24,8 @@ namespace {
 // Unique per process: other test runs on the same machine write their own recordings.
 std::string temp_file(const std::string& name) {
   static const std::filesystem::path dir = [] {
-    auto d = std::filesystem::temp_directory_path() / ("rotacal-test-hw-" + std::to_string(::getpid()));
+    auto d =
+        std::filesystem::temp_directory_path() / ("rotacal-test-hw-" + std::to_string(::getpid()));
     std::filesystem::create_directories(d);
     return d;
   }();
@@ -54,8 +54,9 @@ struct BallbarRun {
 
 // `silence_s`: long enough that a host starved of CPU for seconds (both cores busy, nice 19)
 // does not take its own stall for a silent instrument.
-BallbarRun run_ballbar(const std::string& name, const FaultInjection& faults, double rate_hz = 100.0,
-                       SerialSettings host = {}, std::function<bool(const RecordProgress&)> progress = {},
+BallbarRun run_ballbar(const std::string& name, const FaultInjection& faults,
+                       double rate_hz = 100.0, SerialSettings host = {},
+                       std::function<bool(const RecordProgress&)> progress = {},
                        double silence_s = 10.0) {
   const BallbarPlan plan = small_plan();
   VirtualBallbarOptions o;
@@ -165,7 +166,9 @@ TEST_CASE("ballbar: a host at the wrong baud rate gets no valid data and says so
 TEST_CASE("ballbar: a recording with no row leaves the previous file as it was", "[hw]") {
   // Issue 32: an instrument that never answers replaced a 1,804-row session with an empty file.
   const std::string path = temp_file("previous.csv");
-  { std::ofstream(path) << "the previous session\n"; }
+  {
+    std::ofstream(path) << "the previous session\n";
+  }
   SerialSettings host;
   host.baud = 9600;
   const BallbarRun run = run_ballbar("previous.csv", {}, 100.0, host, {}, 1.0);
@@ -173,12 +176,14 @@ TEST_CASE("ballbar: a recording with no row leaves the previous file as it was",
   std::ifstream in(path);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   CHECK(text == "the previous session\n");
-  for (const auto& e : std::filesystem::directory_iterator(std::filesystem::path(path).parent_path()))
+  for (const auto& e :
+       std::filesystem::directory_iterator(std::filesystem::path(path).parent_path()))
     CHECK(e.path().extension() != ".part");
 }
 
 TEST_CASE("ballbar: the progress callback stops the recording (Ctrl-C)", "[hw]") {
-  const BallbarRun run = run_ballbar("stop.csv", {}, 100.0, {}, [](const RecordProgress& p) { return p.rows < 200; });
+  const BallbarRun run =
+      run_ballbar("stop.csv", {}, 100.0, {}, [](const RecordProgress& p) { return p.rows < 200; });
   CHECK(run.summary.reason == StopReason::stopped);
   CHECK(run.summary.rows >= 200);
   CHECK(read_ballbar(run.path).samples.size() == run.summary.rows);
@@ -216,10 +221,13 @@ class LateHost final : public ByteTransport {
       : port_(std::move(port)), after_(after), stall_s_(stall_s) {}
   std::size_t read(std::uint8_t* buf, std::size_t max, int timeout_ms) override {
     const std::size_t n = port_->read(buf, max, timeout_ms);
-    if (n > 0 && ++reads_ == after_) std::this_thread::sleep_for(std::chrono::duration<double>(stall_s_));
+    if (n > 0 && ++reads_ == after_)
+      std::this_thread::sleep_for(std::chrono::duration<double>(stall_s_));
     return n;
   }
-  void write(const std::uint8_t* data, std::size_t n, int timeout_ms) override { port_->write(data, n, timeout_ms); }
+  void write(const std::uint8_t* data, std::size_t n, int timeout_ms) override {
+    port_->write(data, n, timeout_ms);
+  }
   void flush_input() override { port_->flush_input(); }
   void close() override { port_->close(); }
   const std::string& path() const override { return port_->path(); }
@@ -235,7 +243,8 @@ class LateHost final : public ByteTransport {
 // (80 % of its dwell) is most of a second of real time, so that a host starved of CPU (a
 // loaded machine, nice 19, a sanitizer) still reads every pose inside its window.
 // `host_stall_s` > 0: the host stalls that long once, early in the program (LateHost).
-RtestRun run_rtest(ProbeMode mode, double speed, const RtestPattern& pattern = {}, double host_stall_s = 0.0) {
+RtestRun run_rtest(ProbeMode mode, double speed, const RtestPattern& pattern = {},
+                   double host_stall_s = 0.0) {
   VirtualRtestOptions o;
   o.truth = rtest_truth();
   o.sim.pattern = pattern;
@@ -253,9 +262,11 @@ RtestRun run_rtest(ProbeMode mode, double speed, const RtestPattern& pattern = {
   ro.rate_hz = o.rate_hz;
   ro.speed = o.speed;
   ro.silence_timeout_s = 10.0;  // a starved host's stall is not a silent instrument
-  const std::string path = temp_file("rtest-" + to_string(mode) + (host_stall_s > 0 ? "-late" : "") + ".csv");
+  const std::string path =
+      temp_file("rtest-" + to_string(mode) + (host_stall_s > 0 ? "-late" : "") + ".csv");
   RtestRun run;
-  run.summary = record_rtest(*port, mode, device.program(), o.sim.pattern.dwell_s, o.probe_dirs, path, ro);
+  run.summary =
+      record_rtest(*port, mode, device.program(), o.sim.pattern.dwell_s, o.probe_dirs, path, ro);
   device.stop();
   run.path = path;
   run.recorded = displacements_from_raw(read_rtest(path));
@@ -293,14 +304,16 @@ double worst_deviation(const RtestRun& run) {
   const std::vector<std::string> setups = run.program.setups();
   double worst = 0.0;
   for (const RtestSample& r : run.recorded.samples) {
-    const auto p = std::find_if(run.program.samples.begin(), run.program.samples.end(), [&](const RtestSample& q) {
-      return q.setup == r.setup && q.tilt_deg == r.tilt_deg && q.rot_deg == r.rot_deg;
-    });
+    const auto p = std::find_if(
+        run.program.samples.begin(), run.program.samples.end(), [&](const RtestSample& q) {
+          return q.setup == r.setup && q.tilt_deg == r.tilt_deg && q.rot_deg == r.rot_deg;
+        });
     REQUIRE(p != run.program.samples.end());
-    const std::size_t nest =
-        static_cast<std::size_t>(std::find(setups.begin(), setups.end(), p->setup) - setups.begin());
+    const std::size_t nest = static_cast<std::size_t>(
+        std::find(setups.begin(), setups.end(), p->setup) - setups.begin());
     const Eigen::Vector3d exact =
-        rtest_reading(truth, run.program.nests.at(p->setup), p->angles_rad(), p->time) + run.zeros[nest];
+        rtest_reading(truth, run.program.nests.at(p->setup), p->angles_rad(), p->time) +
+        run.zeros[nest];
     worst = std::max(worst, (*r.d - exact).cwiseAbs().maxCoeff());
   }
   return worst;
@@ -312,7 +325,8 @@ void check_read_times(const RtestRun& run, double dwell_s) {
   const auto& cols = run.recorded.extra_columns;
   REQUIRE(cols == std::vector<std::string>{"n", "std_um", "t_s", "margin_s"});
   for (const RtestSample& r : run.recorded.samples) {
-    INFO("pose at t=" << r.time << ": n=" << r.extra[0] << " t_s=" << r.extra[2] << " margin_s=" << r.extra[3]);
+    INFO("pose at t=" << r.time << ": n=" << r.extra[0] << " t_s=" << r.extra[2]
+                      << " margin_s=" << r.extra[3]);
     const PoseWindow w = pose_window(r.time, dwell_s);
     CHECK(std::stoi(r.extra[0]) >= 1);
     CHECK(w.contains(std::stod(r.extra[2]), std::stod(r.extra[2])));
@@ -335,7 +349,6 @@ RtestPattern polled_pattern() {
   return p;
 }
 
-
 // The `# missing:` lines of a recording that show the host was late for that pose: it could
 // not read (did not run, or waited for a reply) for a quarter of the window or more, or one
 // reading took it that long. A pose lost for any other reason (a recorder reading at the
@@ -349,8 +362,8 @@ std::size_t losses_to_a_late_host(const std::string& path, double window_s) {
       const auto at = line.find(said);
       return at == std::string::npos ? 0.0 : std::stod(line.substr(at + said.size()));
     };
-    n += std::max(seconds_after("the host could not read for "), seconds_after("a reading took the host ")) >=
-         0.25 * window_s;
+    n += std::max(seconds_after("the host could not read for "),
+                  seconds_after("a reading took the host ")) >= 0.25 * window_s;
   }
   return n;
 }
@@ -367,7 +380,8 @@ TEST_CASE("R-test polled modes: every pose is read inside its window, to the noi
     CHECK(run.summary.reason == StopReason::end_of_program);
     CHECK(run.recorded.samples.size() + run.summary.lost == run.program.samples.size());
     CHECK(count_lines(run.path, "# missing: pose") == run.summary.lost);
-    CHECK(losses_to_a_late_host(run.path, kRtestRestFraction * pattern.dwell_s) == run.summary.lost);
+    CHECK(losses_to_a_late_host(run.path, kRtestRestFraction * pattern.dwell_s) ==
+          run.summary.lost);
     CHECK(run.recorded.samples.size() >= run.program.samples.size() / 2);
     // Rows in program order, each at its commanded pose.
     std::size_t k = 0;
@@ -379,11 +393,13 @@ TEST_CASE("R-test polled modes: every pose is read inside its window, to the noi
     }
     check_read_times(run, pattern.dwell_s);
     // The mean of n readings of 0.3 um noise, plus the replies' 0.1 um resolution.
-    CHECK(worst_deviation(run) < 1.5e-3);  // 1.5 um: under 5 sigma of one reading, far under a pose mix-up
+    CHECK(worst_deviation(run) <
+          1.5e-3);  // 1.5 um: under 5 sigma of one reading, far under a pose mix-up
   }
 }
 
-TEST_CASE("R-test polled: a host that stalls past a window loses that pose, counted and marked", "[hw]") {
+TEST_CASE("R-test polled: a host that stalls past a window loses that pose, counted and marked",
+          "[hw]") {
   RtestPattern pattern = polled_pattern();
   pattern.nests.resize(1);  // 12 poses
   // The host stalls 2.5 s (15 s of program) at its 10th read: the reading it was taking is not

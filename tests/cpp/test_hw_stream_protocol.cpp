@@ -24,7 +24,8 @@ TEST_CASE("sequence gaps across the 16-bit wrap", "[hw]") {
 }
 
 TEST_CASE("host commands: format and parse agree; bad lines are refused", "[hw]") {
-  for (StreamCommand c : {StreamCommand::start, StreamCommand::stop, StreamCommand::zero, StreamCommand::identify}) {
+  for (StreamCommand c :
+       {StreamCommand::start, StreamCommand::stop, StreamCommand::zero, StreamCommand::identify}) {
     const auto p = parse_command(format_command(c));
     REQUIRE(p);
     CHECK(p->command == c);

@@ -1,8 +1,7 @@
 // Transports: pseudo-terminal open, read timeouts, hang-up as a disconnect.
-#include <catch2/catch.hpp>
-
 #include <unistd.h>
 
+#include <catch2/catch.hpp>
 #include <cstdio>
 #include <filesystem>
 
@@ -24,11 +23,13 @@ TEST_CASE("a pty carries bytes both ways through the termios backend", "[hw]") {
     if (n <= 0) ::usleep(1000);
   }
   CHECK(std::string(buf, static_cast<std::size_t>(std::max<ssize_t>(n, 0))) == "ID?\n");
-  const std::uint8_t reply[] = {0xAA, 0x55, 0x00, 0x0D, 0x0A};  // binary passes unchanged (raw mode)
+  const std::uint8_t reply[] = {0xAA, 0x55, 0x00, 0x0D,
+                                0x0A};  // binary passes unchanged (raw mode)
   REQUIRE(::write(pty.master(), reply, sizeof reply) == 5);
   std::uint8_t got[8] = {};
   std::size_t total = 0;
-  for (int i = 0; i < 10 && total < 5; ++i) total += port->read(got + total, sizeof got - total, 50);
+  for (int i = 0; i < 10 && total < 5; ++i)
+    total += port->read(got + total, sizeof got - total, 50);
   CHECK(total == 5);
   CHECK(std::equal(reply, reply + 5, got));
   CHECK(port->read(got, sizeof got, 20) == 0);  // silence is a timeout, not an error
@@ -45,7 +46,8 @@ TEST_CASE("an unplugged device is reported as disconnected", "[hw]") {
 
 TEST_CASE("symlinks such as /dev/serial/by-id are resolved before opening", "[hw]") {
   PseudoTerminal pty;
-  const std::string link = (std::filesystem::temp_directory_path() / "rotacal-test-port-link").string();
+  const std::string link =
+      (std::filesystem::temp_directory_path() / "rotacal-test-port-link").string();
   std::filesystem::remove(link);
   std::filesystem::create_symlink(pty.slave_path(), link);
   CHECK(resolve_port_path(link) == pty.slave_path());

@@ -1,5 +1,4 @@
 #include <catch2/catch.hpp>
-
 #include <cstdio>
 #include <fstream>
 #include <random>
@@ -29,7 +28,8 @@ const std::string kBallbarHead =
     "# format: rotacal-ballbar/1\n# machine: AC-trt\n# units: mm, deg, s\n"
     "# ballbar_length: 100.0000\n# pivot: 120.0000, 0.0000, 60.0000\n";
 const std::string kBallbarColumns = "test,time,X,Y,Z,A,C,length\n";
-const std::string kGoodRow = "sphere_xy,0.000,220.000000,0.000000,60.000000,0.000000,0.000000,99.9904419\n";
+const std::string kGoodRow =
+    "sphere_xy,0.000,220.000000,0.000000,60.000000,0.000000,0.000000,99.9904419\n";
 
 BallbarSession random_ballbar(std::mt19937& rng) {
   std::uniform_real_distribution<double> U(-500, 500);
@@ -122,7 +122,8 @@ TEST_CASE("write_ballbar writes a file that reads back; bad paths raise IoError"
   CHECK(r.samples.back().length == s.samples.back().length);
   std::remove(path.c_str());
   CHECK_THROWS_AS(write_ballbar(s, "/nonexistent-dir/x.csv"), IoError);
-  CHECK_THROWS_WITH(read_ballbar("/nonexistent-dir/x.csv"), Catch::Contains("/nonexistent-dir/x.csv"));
+  CHECK_THROWS_WITH(read_ballbar("/nonexistent-dir/x.csv"),
+                    Catch::Contains("/nonexistent-dir/x.csv"));
 }
 
 TEST_CASE("malformed ballbar files are refused with the line that is wrong", "[io]") {
@@ -135,42 +136,64 @@ TEST_CASE("malformed ballbar files are refused with the line that is wrong", "[i
   const std::vector<Case> cases = {
       {"empty file", "", 0, "empty file"},
       {"blank file", "\n\n", 0, "empty file"},
-      {"wrong format line", "# format: rotacal-ballbar/2\n" + kBallbarHead.substr(28) + kBallbarColumns + kGoodRow, 1,
+      {"wrong format line",
+       "# format: rotacal-ballbar/2\n" + kBallbarHead.substr(28) + kBallbarColumns + kGoodRow, 1,
        "rotacal-ballbar/2"},
-      {"no format line", kBallbarHead.substr(28) + kBallbarColumns + kGoodRow, 1, "first line must be"},
-      {"unknown machine", "# format: rotacal-ballbar/1\n# machine: XYZ-trt\n# ballbar_length: 100\n# pivot: 1,2,3\n" +
-                              kBallbarColumns + kGoodRow, 2, "XYZ-trt"},
+      {"no format line", kBallbarHead.substr(28) + kBallbarColumns + kGoodRow, 1,
+       "first line must be"},
+      {"unknown machine",
+       "# format: rotacal-ballbar/1\n# machine: XYZ-trt\n# ballbar_length: 100\n# pivot: 1,2,3\n" +
+           kBallbarColumns + kGoodRow,
+       2, "XYZ-trt"},
       {"missing column", kBallbarHead + "test,time,X,Y,Z,A,C\n" + kGoodRow, 6, "length"},
-      {"text in a number", kBallbarHead + kBallbarColumns + kGoodRow +
-                               "sphere_xy,0.1,219.9,abc,60,0,0,99.99\n", 8, "'abc' is not a number"},
-      {"NaN", kBallbarHead + kBallbarColumns + kGoodRow + "sphere_xy,0.1,219.9,1.7,60,0,0,nan\n", 8, "finite"},
-      {"infinity", kBallbarHead + kBallbarColumns + kGoodRow + "sphere_xy,0.1,inf,1.7,60,0,0,99\n", 8, "finite"},
-      {"decreasing time", kBallbarHead + kBallbarColumns + "s,1.0,1,2,3,0,0,99\ns,0.5,1,2,3,0,0,99\n", 8,
+      {"text in a number",
+       kBallbarHead + kBallbarColumns + kGoodRow + "sphere_xy,0.1,219.9,abc,60,0,0,99.99\n", 8,
+       "'abc' is not a number"},
+      {"NaN", kBallbarHead + kBallbarColumns + kGoodRow + "sphere_xy,0.1,219.9,1.7,60,0,0,nan\n", 8,
+       "finite"},
+      {"infinity", kBallbarHead + kBallbarColumns + kGoodRow + "sphere_xy,0.1,inf,1.7,60,0,0,99\n",
+       8, "finite"},
+      {"decreasing time",
+       kBallbarHead + kBallbarColumns + "s,1.0,1,2,3,0,0,99\ns,0.5,1,2,3,0,0,99\n", 8,
        "time must not decrease"},
-      {"too few fields", kBallbarHead + kBallbarColumns + "s,1.0,1,2,3,0,0\n", 7, "expected 8 fields"},
+      {"too few fields", kBallbarHead + kBallbarColumns + "s,1.0,1,2,3,0,0\n", 7,
+       "expected 8 fields"},
       {"no data rows", kBallbarHead + kBallbarColumns, 6, "no data rows"},
       {"B column on an AC machine", kBallbarHead + "test,time,X,Y,Z,B,C,length\n" + kGoodRow, 6,
        "does not belong to a AC-trt"},
-      {"duplicate column", kBallbarHead + "test,time,X,X,Z,A,C,length\n" + kGoodRow, 6, "appears twice"},
-      {"missing ballbar_length", "# format: rotacal-ballbar/1\n# machine: AC-trt\n# pivot: 1,2,3\n" + kBallbarColumns +
-                                     kGoodRow, 0, "ballbar_length"},
-      {"pivot not three numbers", "# format: rotacal-ballbar/1\n# machine: AC-trt\n# ballbar_length: 100\n"
-                                  "# pivot: 1,2\n" + kBallbarColumns + kGoodRow, 4, "three numbers"},
-      {"wrong units", "# format: rotacal-ballbar/1\n# machine: AC-trt\n# units: in, deg, s\n# ballbar_length: 100\n"
-                      "# pivot: 1,2,3\n" + kBallbarColumns + kGoodRow, 3, "units"},
-      {"negative noise", kBallbarHead + "# noise_um: -1\n" + kBallbarColumns + kGoodRow, 6, "noise_um"},
+      {"duplicate column", kBallbarHead + "test,time,X,X,Z,A,C,length\n" + kGoodRow, 6,
+       "appears twice"},
+      {"missing ballbar_length",
+       "# format: rotacal-ballbar/1\n# machine: AC-trt\n# pivot: 1,2,3\n" + kBallbarColumns +
+           kGoodRow,
+       0, "ballbar_length"},
+      {"pivot not three numbers",
+       "# format: rotacal-ballbar/1\n# machine: AC-trt\n# ballbar_length: 100\n"
+       "# pivot: 1,2\n" +
+           kBallbarColumns + kGoodRow,
+       4, "three numbers"},
+      {"wrong units",
+       "# format: rotacal-ballbar/1\n# machine: AC-trt\n# units: in, deg, s\n# ballbar_length: "
+       "100\n"
+       "# pivot: 1,2,3\n" +
+           kBallbarColumns + kGoodRow,
+       3, "units"},
+      {"negative noise", kBallbarHead + "# noise_um: -1\n" + kBallbarColumns + kGoodRow, 6,
+       "noise_um"},
   };
   for (const Case& c : cases) {
     INFO(c.what);
-    const ParseError e = refusal(c.text, [](std::istream& in, const std::string& n) { return parse_ballbar(in, n); });
+    const ParseError e = refusal(
+        c.text, [](std::istream& in, const std::string& n) { return parse_ballbar(in, n); });
     CHECK(e.line() == c.line);
     CHECK(e.file() == "bad.csv");
     CHECK_THAT(e.what(), Catch::Contains(c.says));
     if (c.line > 0) CHECK_THAT(e.what(), Catch::Contains("bad.csv:" + std::to_string(c.line)));
   }
   // The column of a bad number is reported too (1-based character position).
-  const ParseError e = refusal(kBallbarHead + kBallbarColumns + "s,0.1,219.9,abc,60,0,0,99\n",
-                               [](std::istream& in, const std::string& n) { return parse_ballbar(in, n); });
+  const ParseError e =
+      refusal(kBallbarHead + kBallbarColumns + "s,0.1,219.9,abc,60,0,0,99\n",
+              [](std::istream& in, const std::string& n) { return parse_ballbar(in, n); });
   CHECK(e.column() == 13);
 }
 

@@ -1,7 +1,6 @@
 // Tests of rotacal/io/controller_comment.hpp: whatever the text, each dialect's comment lines
 // are whole comments that its controller cannot read as a block or a command.
 #include <catch2/catch.hpp>
-
 #include <cctype>
 #include <string>
 #include <vector>
@@ -13,8 +12,9 @@ using namespace rotacal;
 
 namespace {
 
-const CommentDialect kAll[] = {CommentDialect::linuxcnc, CommentDialect::fanuc, CommentDialect::heidenhain,
-                               CommentDialect::siemens,  CommentDialect::isg,   CommentDialect::hash};
+const CommentDialect kAll[] = {CommentDialect::linuxcnc,   CommentDialect::fanuc,
+                               CommentDialect::heidenhain, CommentDialect::siemens,
+                               CommentDialect::isg,        CommentDialect::hash};
 
 // Every dialect's dangerous characters, each where it would do harm: a line end before a
 // block, comment terminators, block ends, tape ends, active comments, continuations, bytes
@@ -50,7 +50,8 @@ std::vector<std::string> hostile_texts() {
       "",
   };
   std::string words;
-  for (int i = 0; i < 400; ++i) words += "msg, word ";  // every cut line starts like an active comment
+  for (int i = 0; i < 400; ++i)
+    words += "msg, word ";  // every cut line starts like an active comment
   t.push_back(words);
   return t;
 }
@@ -60,7 +61,8 @@ bool active_in_linuxcnc(std::string body) {
   if (i == std::string::npos) return false;
   for (char& c : body) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   body = body.substr(i);
-  for (const char* w : {"msg", "debug", "print", "log", "py", "abort", "probeopen", "probeclose", "axis"})
+  for (const char* w :
+       {"msg", "debug", "print", "log", "py", "abort", "probeopen", "probeclose", "axis"})
     if (body.rfind(w, 0) == 0) return true;
   const std::size_t comma = body.find(',');
   return comma != std::string::npos && comma > 0 &&
@@ -69,9 +71,11 @@ bool active_in_linuxcnc(std::string body) {
 
 // The properties every comment line of `d` must have; returns what is wrong, empty if none.
 std::string fault(CommentDialect d, const std::string& l) {
-  if (l.size() > comment_line_width(d)) return "longer than " + std::to_string(comment_line_width(d));
+  if (l.size() > comment_line_width(d))
+    return "longer than " + std::to_string(comment_line_width(d));
   for (char c : l)
-    if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) > 0x7e) return "a byte outside printable ASCII";
+    if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) > 0x7e)
+      return "a byte outside printable ASCII";
   if (l.find('\\') != std::string::npos) return "a backslash";
   switch (d) {
     case CommentDialect::linuxcnc:
@@ -80,7 +84,8 @@ std::string fault(CommentDialect d, const std::string& l) {
       const std::string body = l.substr(1, l.size() - 2);
       if (body.find_first_of("()") != std::string::npos) return "a parenthesis inside";
       if (d == CommentDialect::linuxcnc && active_in_linuxcnc(body)) return "an active comment";
-      if (d == CommentDialect::fanuc && body.find_first_of(";%") != std::string::npos) return "';' or '%'";
+      if (d == CommentDialect::fanuc && body.find_first_of(";%") != std::string::npos)
+        return "';' or '%'";
       if (d == CommentDialect::fanuc)
         for (char c : body)
           if (std::islower(static_cast<unsigned char>(c))) return "lower case";
@@ -125,15 +130,18 @@ TEST_CASE("the checks above catch a comment written verbatim") {
 
 TEST_CASE("the text stays readable: what each dialect replaces, and nothing else") {
   using V = std::vector<std::string>;
-  CHECK(comment_lines(CommentDialect::linuxcnc, "machine: x\nG0 Z-500\n") == V{"(machine: x^JG0 Z-500^J)"});
+  CHECK(comment_lines(CommentDialect::linuxcnc, "machine: x\nG0 Z-500\n") ==
+        V{"(machine: x^JG0 Z-500^J)"});
   CHECK(comment_lines(CommentDialect::linuxcnc, "a (b) c") == V{"(a [b] c)"});
   CHECK(comment_lines(CommentDialect::linuxcnc, " MSG, hi") == V{"(-  MSG, hi)"});
   CHECK(comment_lines(CommentDialect::linuxcnc, "pivot: 1, 2") == V{"(pivot: 1, 2)"});
   CHECK(comment_lines(CommentDialect::fanuc, "a(b); 5%") == V{"(A[B], 5_)"});
   CHECK(comment_lines(CommentDialect::heidenhain, "c:\\x ~") == V{"; c:/x -"});
-  CHECK(comment_lines(CommentDialect::siemens, "$TC_CARR1[1]=0\r\nM30") == V{"; $TC_CARR1[1]=0^M^JM30"});
+  CHECK(comment_lines(CommentDialect::siemens, "$TC_CARR1[1]=0\r\nM30") ==
+        V{"; $TC_CARR1[1]=0^M^JM30"});
   CHECK(comment_lines(CommentDialect::isg, "caf\xc3\xa9") == V{"; caf??"});
-  CHECK(comment_lines(CommentDialect::hash, "s.csv\nloadusr -w touch X") == V{"# s.csv^Jloadusr -w touch X"});
+  CHECK(comment_lines(CommentDialect::hash, "s.csv\nloadusr -w touch X") ==
+        V{"# s.csv^Jloadusr -w touch X"});
   CHECK(comment_lines(CommentDialect::hash, "") == V{"#"});
   CHECK(comment_lines(CommentDialect::siemens, "") == V{";"});
   CHECK(comment_lines(CommentDialect::linuxcnc, "") == V{"()"});
@@ -148,7 +156,8 @@ TEST_CASE("a long text is cut into whole lines at blanks, and nothing is lost") 
     std::string joined;
     for (const std::string& l : lines) {
       CHECK(l.size() <= comment_line_width(d));
-      const std::string body = d == CommentDialect::linuxcnc ? l.substr(1, l.size() - 2) : l.substr(2);
+      const std::string body =
+          d == CommentDialect::linuxcnc ? l.substr(1, l.size() - 2) : l.substr(2);
       joined += (joined.empty() ? "" : " ") + body;
       CHECK(body.back() != ' ');
     }

@@ -3,7 +3,6 @@
 // sessions ("multi") read back exactly what was written, a malformed member is refused naming
 // it, and the controller export reads the identified errors and their covariance from them.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <string>
 
@@ -64,14 +63,17 @@ void check_round_trip(const FittedModelContent& c) {
   check_same(r.location_errors, c.location_errors);
   check_same(r.effect_parameters, c.effect_parameters);
   REQUIRE(r.effects.effects.size() == c.effects.effects.size());
-  for (std::size_t i = 0; i < c.effects.effects.size(); ++i) CHECK(r.effects.effects[i].id() == c.effects.effects[i].id());
+  for (std::size_t i = 0; i < c.effects.effects.size(); ++i)
+    CHECK(r.effects.effects[i].id() == c.effects.effects[i].id());
   CHECK(r.covariance_parameters == c.covariance_parameters);
   REQUIRE(r.covariance.rows() == c.covariance.rows());
   for (Eigen::Index i = 0; i < c.covariance.rows(); ++i)
     for (Eigen::Index j = 0; j < c.covariance.cols(); ++j) {
-      INFO(c.covariance_parameters[static_cast<std::size_t>(i)] << ", " << c.covariance_parameters[static_cast<std::size_t>(j)]);
+      INFO(c.covariance_parameters[static_cast<std::size_t>(i)]
+           << ", " << c.covariance_parameters[static_cast<std::size_t>(j)]);
       // An undetermined parameter's row is written null.
-      const bool known = r.covariance(i, i) == r.covariance(i, i) && r.covariance(j, j) == r.covariance(j, j);
+      const bool known =
+          r.covariance(i, i) == r.covariance(i, i) && r.covariance(j, j) == r.covariance(j, j);
       if (known) CHECK(same(r.covariance(i, j), c.covariance(i, j)));
     }
   REQUIRE(r.sessions.size() == c.sessions.size());
@@ -112,9 +114,11 @@ const MultiIdentification& multi_fit() {
   static const MultiIdentification id = [] {
     MultiFitOptions o;
     o.effects.effects.push_back(Effect::parse("gravity_sag_A"));
-    return identify_multi({MultiSessionInput::of("ballbar_ac_table2.csv", read_ballbar(kData + "ballbar_ac_table2.csv")),
-                           MultiSessionInput::of("probe_ac_table2.csv", read_probe(kData + "probe_ac_table2.csv"))},
-                          o);
+    return identify_multi(
+        {MultiSessionInput::of("ballbar_ac_table2.csv",
+                               read_ballbar(kData + "ballbar_ac_table2.csv")),
+         MultiSessionInput::of("probe_ac_table2.csv", read_probe(kData + "probe_ac_table2.csv"))},
+        o);
   }();
   return id;
 }
@@ -148,7 +152,8 @@ TEST_CASE("a probe identification's model file reads back what was written", "[m
   CHECK(doc["model"] == "baseline");
 }
 
-TEST_CASE("a joint identification of several sessions reads back what was written", "[model][multi]") {
+TEST_CASE("a joint identification of several sessions reads back what was written",
+          "[model][multi]") {
   const MultiIdentification& id = multi_fit();
   const FittedModelContent c = multi_model_content(id);
   REQUIRE(c.sessions.size() == 2);
@@ -164,8 +169,10 @@ TEST_CASE("a joint identification of several sessions reads back what was writte
 }
 
 TEST_CASE("the cycles' method has no model file", "[model][probe]") {
-  const ProbeIdentification cycles = identify_probe_cycles(read_probe(kData + "probe_ac_table2.csv"));
-  CHECK_THROWS_WITH(probe_model_content(cycles, "p.csv"), Catch::Contains("no uncertainty or covariance"));
+  const ProbeIdentification cycles =
+      identify_probe_cycles(read_probe(kData + "probe_ac_table2.csv"));
+  CHECK_THROWS_WITH(probe_model_content(cycles, "p.csv"),
+                    Catch::Contains("no uncertainty or covariance"));
 }
 
 TEST_CASE("a malformed probe or multi model is refused naming the member", "[model]") {
@@ -177,32 +184,42 @@ TEST_CASE("a malformed probe or multi model is refused naming the member", "[mod
              Catch::Contains("sessions[0].noise_model.gls_refit: must be true or false"));
   CHECK_THAT(refusal(probe, "/sessions/0/noise_model/streams/0/ar", json::array({"x"})),
              Catch::Contains("sessions[0].noise_model.streams[0].ar"));
-  CHECK_THAT(refusal(probe, "/sessions/0/instrument", "ballbar"), Catch::Contains("sessions[0].instrument"));
+  CHECK_THAT(refusal(probe, "/sessions/0/instrument", "ballbar"),
+             Catch::Contains("sessions[0].instrument"));
   CHECK_THAT(refusal(probe, "/sessions/0/nuisances/sphere.x/unit", "um"),
              Catch::Contains("sessions[0].nuisances.sphere.x"));
-  CHECK_THAT(refusal(probe, "/location_errors/E_Y0A/std", -1.0), Catch::Contains("location_errors.E_Y0A.std"));
-  CHECK_THAT(refusal(probe, "/covariance/parameters/0", "E_Q0A"), Catch::Contains("covariance.parameters"));
-  CHECK_THAT(refusal(probe, "/covariance/matrix/1/1", "0.1"), Catch::Contains("covariance.matrix[1]"));
-  CHECK_THAT(refusal(probe, "/fit/notes", 3), Catch::Contains("fit.notes: must be a list of strings"));
-  CHECK_THAT(refusal(multi, "/sessions/1/name", multi["sessions"][0]["name"]), Catch::Contains("named twice"));
+  CHECK_THAT(refusal(probe, "/location_errors/E_Y0A/std", -1.0),
+             Catch::Contains("location_errors.E_Y0A.std"));
+  CHECK_THAT(refusal(probe, "/covariance/parameters/0", "E_Q0A"),
+             Catch::Contains("covariance.parameters"));
+  CHECK_THAT(refusal(probe, "/covariance/matrix/1/1", "0.1"),
+             Catch::Contains("covariance.matrix[1]"));
+  CHECK_THAT(refusal(probe, "/fit/notes", 3),
+             Catch::Contains("fit.notes: must be a list of strings"));
+  CHECK_THAT(refusal(multi, "/sessions/1/name", multi["sessions"][0]["name"]),
+             Catch::Contains("named twice"));
   CHECK_THAT(refusal(multi, "/sessions/0/alone/E_Q0A", json{{"value", 0.0}}),
              Catch::Contains("sessions[0].alone.E_Q0A: is not a location error"));
-  CHECK_THAT(refusal(multi, "/disagreements/0", json{{"parameter", 1}}), Catch::Contains("disagreements[0].parameter"));
+  CHECK_THAT(refusal(multi, "/disagreements/0", json{{"parameter", 1}}),
+             Catch::Contains("disagreements[0].parameter"));
   json lone = multi;
   lone["sessions"].erase(1);
-  CHECK_THROWS_WITH(parse_model(lone.dump(), "one.json"), Catch::Contains("one.json: sessions: a multi model holds two"));
+  CHECK_THROWS_WITH(parse_model(lone.dump(), "one.json"),
+                    Catch::Contains("one.json: sessions: a multi model holds two"));
 }
 
 TEST_CASE("the controller export takes the errors and their covariance from a probe or multi model",
           "[model][export]") {
-  for (const json& doc : {probe_model_document(probe_fit(), "p.csv"), multi_model_document(multi_fit())}) {
+  for (const json& doc :
+       {probe_model_document(probe_fit(), "p.csv"), multi_model_document(multi_fit())}) {
     const ModelFile m = parse_model(format_model(doc, "m.json"), "m.json");
     const ExportInput in = export_input(m, "m.json");
     CHECK(in.full_covariance);
     const FittedModelContent c = fitted_model_content(m, "m.json");
     for (int i = 0; i < 8; ++i) {
       CHECK(in.errors.v[i] == c.location_errors[static_cast<std::size_t>(i)].value);
-      CHECK(std::sqrt(in.covariance(i, i)) == Approx(c.location_errors[static_cast<std::size_t>(i)].std).epsilon(1e-12));
+      CHECK(std::sqrt(in.covariance(i, i)) ==
+            Approx(c.location_errors[static_cast<std::size_t>(i)].std).epsilon(1e-12));
     }
     const ControllerExport ex = export_kinematics(Controller::siemens, in);
     CHECK(ex.errors.size() == 8);

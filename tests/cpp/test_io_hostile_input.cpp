@@ -1,9 +1,9 @@
 // Session readers against hostile and careless input: bounded memory and messages, UTF-8,
 // BOM, directories, magnitudes no machine has, duplicated rows (issue 17 items 2, 3, 6, 11).
-#include <catch2/catch.hpp>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <catch2/catch.hpp>
 #include <fstream>
 #include <sstream>
 
@@ -18,12 +18,15 @@ const std::string kBallbarHead =
     "# format: rotacal-ballbar/1\n# machine: AC-trt\n# units: mm, deg, s\n"
     "# ballbar_length: 100.0000\n# pivot: 120.0000, 0.0000, 60.0000\n"
     "test,time,X,Y,Z,A,C,length\n";
-const std::string kRow = "sphere_xy,0.000,220.000000,0.000000,60.000000,0.000000,0.000000,99.9904419\n";
-const std::string kRow2 = "sphere_xy,0.100,219.000000,1.000000,60.000000,0.000000,1.000000,99.9904419\n";
+const std::string kRow =
+    "sphere_xy,0.000,220.000000,0.000000,60.000000,0.000000,0.000000,99.9904419\n";
+const std::string kRow2 =
+    "sphere_xy,0.100,219.000000,1.000000,60.000000,0.000000,1.000000,99.9904419\n";
 const std::string kRtestHead =
     "# format: rotacal-rtest/1\n# machine: BC-trt\n# units: mm, deg, s\n"
     "# nest.1: 100.0000, 0.0000, 60.0000\nsetup,time,B,C,X,Y,Z,dx,dy,dz\n";
-const std::string kRtestRow = "1,0.0,-90.0000,0.0000,-60.000000,0.000000,100.000000,0.0058340,-0.0301318,-0.0129457\n";
+const std::string kRtestRow =
+    "1,0.0,-90.0000,0.0000,-60.000000,0.000000,100.000000,0.0058340,-0.0301318,-0.0129457\n";
 
 ParseError refusal(const std::string& text, bool rtest = false) {
   std::istringstream in(text);
@@ -57,7 +60,8 @@ TEST_CASE("/dev/zero and a file without line ends are refused after one bounded 
     (void)read_session("/dev/zero");
     FAIL("/dev/zero accepted");
   } catch (const ParseError& e) {
-    CHECK_THAT(e.what(), Catch::Contains("/dev/zero") && Catch::Contains("longer than 65536 bytes"));
+    CHECK_THAT(e.what(),
+               Catch::Contains("/dev/zero") && Catch::Contains("longer than 65536 bytes"));
     CHECK(std::string(e.what()).size() < 250);
   }
   // 20 MB on one line (a CR-only file of 200 MB behaves the same: stopped at 64 kB).
@@ -85,11 +89,13 @@ TEST_CASE("CRLF line ends are read; bytes that are not UTF-8 name line and colum
   CHECK(bad.line() == 7);
   CHECK(bad.column() == 19);
   CHECK_THAT(bad.what(), Catch::Contains("0xFF is not UTF-8"));
-  CHECK(refusal(kBallbarHead + "sph\xc3\x28re,0,220,0,60,0,0,100\n").column() == 4);  // broken 2-byte
-  CHECK(refusal(kBallbarHead + "\xed\xa0\x80,0,220,0,60,0,0,100\n").column() == 1);   // a surrogate
-  CHECK(refusal(kBallbarHead + "s\x01,0,220,0,60,0,0,100\n").column() == 2);          // control char
+  CHECK(refusal(kBallbarHead + "sph\xc3\x28re,0,220,0,60,0,0,100\n").column() ==
+        4);  // broken 2-byte
+  CHECK(refusal(kBallbarHead + "\xed\xa0\x80,0,220,0,60,0,0,100\n").column() == 1);  // a surrogate
+  CHECK(refusal(kBallbarHead + "s\x01,0,220,0,60,0,0,100\n").column() == 2);         // control char
   // A UTF-16 file: a NUL on its first line.
-  CHECK_THAT(refusal(std::string("\xff\xfe#\0 \0f\0", 8)).what(), Catch::Contains("line 1") || Catch::Contains(":1:"));
+  CHECK_THAT(refusal(std::string("\xff\xfe#\0 \0f\0", 8)).what(),
+             Catch::Contains("line 1") || Catch::Contains(":1:"));
   // Valid non-ASCII labels are fine.
   std::istringstream ok(kBallbarHead + with_field(kRow, 0, "r\xc3\xa9sum\xc3\xa9_\xe2\x88\x86"));
   CHECK(parse_ballbar(ok, "ok.csv").samples[0].test == "r\xc3\xa9sum\xc3\xa9_\xe2\x88\x86");
@@ -118,8 +124,9 @@ TEST_CASE("magnitudes no machine has are refused where they are read, naming the
     int column_of_field;
   };
   // length 1e308, X 1e160, A 1e308, time 1e300, length 4e-320 (denormal), C 1e300
-  for (const auto& [field, value, col] : {Case{7, "1e308", 0}, Case{2, "1e160", 0}, Case{5, "1e308", 0},
-                                          Case{1, "1e300", 0}, Case{7, "4e-320", 0}, Case{6, "1e300", 0}}) {
+  for (const auto& [field, value, col] :
+       {Case{7, "1e308", 0}, Case{2, "1e160", 0}, Case{5, "1e308", 0}, Case{1, "1e300", 0},
+        Case{7, "4e-320", 0}, Case{6, "1e300", 0}}) {
     (void)col;
     const ParseError e = refusal(kBallbarHead + kRow + with_field(kRow2, field, value));
     CHECK(e.line() == 8);
@@ -128,13 +135,19 @@ TEST_CASE("magnitudes no machine has are refused where they are read, naming the
   }
   const ParseError len = refusal(kBallbarHead + with_field(kRow, 7, "1e308"));
   CHECK_THAT(len.what(), Catch::Contains("length 1e308 is outside [0.001, 10000] mm"));
-  CHECK_THAT(refusal(std::string(kBallbarHead).replace(kBallbarHead.find("100.0000"), 8, "1e6") + kRow).what(),
-             Catch::Contains("ballbar_length"));
-  CHECK_THAT(refusal(std::string(kBallbarHead).replace(kBallbarHead.find("120.0000"), 8, "1e300") + kRow).what(),
-             Catch::Contains("pivot"));
+  CHECK_THAT(
+      refusal(std::string(kBallbarHead).replace(kBallbarHead.find("100.0000"), 8, "1e6") + kRow)
+          .what(),
+      Catch::Contains("ballbar_length"));
+  CHECK_THAT(
+      refusal(std::string(kBallbarHead).replace(kBallbarHead.find("120.0000"), 8, "1e300") + kRow)
+          .what(),
+      Catch::Contains("pivot"));
   // R-test: dx 1e308, B 1e308.
-  CHECK_THAT(refusal(kRtestHead + with_field(kRtestRow, 7, "1e308"), true).what(), Catch::Contains("dx 1e308"));
-  CHECK_THAT(refusal(kRtestHead + with_field(kRtestRow, 2, "1e308"), true).what(), Catch::Contains("B 1e308"));
+  CHECK_THAT(refusal(kRtestHead + with_field(kRtestRow, 7, "1e308"), true).what(),
+             Catch::Contains("dx 1e308"));
+  CHECK_THAT(refusal(kRtestHead + with_field(kRtestRow, 2, "1e308"), true).what(),
+             Catch::Contains("B 1e308"));
 }
 
 TEST_CASE("labels and values are bounded and echoed at most ~80 characters") {
@@ -145,7 +158,8 @@ TEST_CASE("labels and values are bounded and echoed at most ~80 characters") {
   const ParseError n = refusal(kBallbarHead + with_field(kRow, 2, std::string(5000, '9') + "x"));
   CHECK_THAT(n.what(), Catch::Contains("is not a number"));
   CHECK(std::string(n.what()).size() < 250);
-  const ParseError m = refusal("# format: rotacal-ballbar/1\n# machine: " + std::string(10000, 'M') + "\n");
+  const ParseError m =
+      refusal("# format: rotacal-ballbar/1\n# machine: " + std::string(10000, 'M') + "\n");
   CHECK(std::string(m.what()).size() < 250);
 }
 
@@ -154,7 +168,8 @@ TEST_CASE("rows repeated exactly are kept and reported as a warning") {
   const BallbarSession s = parse_ballbar(in, "dup.csv");
   CHECK(s.samples.size() == 4);
   REQUIRE(s.warnings.size() == 1);
-  CHECK_THAT(s.warnings[0], Catch::StartsWith("2 rows repeat an earlier row") && Catch::Contains("line 9 repeats line 8"));
+  CHECK_THAT(s.warnings[0], Catch::StartsWith("2 rows repeat an earlier row") &&
+                                Catch::Contains("line 9 repeats line 8"));
   std::istringstream clean(kBallbarHead + kRow + kRow2);
   CHECK(parse_ballbar(clean, "ok.csv").warnings.empty());
   std::istringstream rt(kRtestHead + kRtestRow + kRtestRow);

@@ -1,15 +1,15 @@
 // Tests of rotacal-model/1 files (io/model_file.hpp): round trip, strict JSON, versions,
 // units and limits, and the files the Python writer made before the C++ one existed.
-#include <catch2/catch.hpp>
 #include <unistd.h>
 
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <fstream>
 #include <limits>
 #include <sstream>
 
-#include "rotacal/core/error.hpp"
 #include "rotacal/ballbar/model_document.hpp"
+#include "rotacal/core/error.hpp"
 #include "rotacal/io/model_file.hpp"
 
 using namespace rotacal;
@@ -21,7 +21,8 @@ BallbarMachineModel sample_model() {
   BallbarMachineModel m;
   m.machine = MachineType::AC_trt;
   // Flynn et al. Table 2 magnitudes (mm, rad), not round numbers, so a digit lost shows.
-  m.errors.v << 0.0712345678901, -0.0231, 1.234e-4, -5.6789e-5, 0.0133910001, 0.0125, 2.2e-5, -3.3e-5;
+  m.errors.v << 0.0712345678901, -0.0231, 1.234e-4, -5.6789e-5, 0.0133910001, 0.0125, 2.2e-5,
+      -3.3e-5;
   m.pivot = Eigen::Vector3d(120.000123, -0.5, 60.25);
   m.effects.effects = {Effect::parse("gravity_sag_A")};
   m.effect_params = {0.004};
@@ -67,7 +68,8 @@ TEST_CASE("a non-finite number is written as null with its reason, never NaN or 
 
 TEST_CASE("an unobservable location error (null) is nominal and flagged") {
   json doc = ballbar_model_document(sample_model());
-  doc["location_errors"]["E_C0A"] = {{"value", nullptr}, {"std", nullptr}, {"unit", "rad"}, {"observable", false}};
+  doc["location_errors"]["E_C0A"] = {
+      {"value", nullptr}, {"std", nullptr}, {"unit", "rad"}, {"observable", false}};
   const ModelFile f = model_from_json(doc, "m.json");
   CHECK(f.location_errors.v[3] == 0.0);
   CHECK_FALSE(f.observable[3]);
@@ -77,9 +79,9 @@ TEST_CASE("an unobservable location error (null) is nominal and flagged") {
 TEST_CASE("versions: a newer major version is refused by name, a minor one is read") {
   json doc = ballbar_model_document(sample_model());
   doc["format"] = "rotacal-model/2";
-  CHECK_THROWS_WITH(model_from_json(doc, "new.json"),
-                    Catch::Contains("new.json") && Catch::Contains("rotacal-model/2") &&
-                        Catch::Contains("newer rotacal"));
+  CHECK_THROWS_WITH(model_from_json(doc, "new.json"), Catch::Contains("new.json") &&
+                                                          Catch::Contains("rotacal-model/2") &&
+                                                          Catch::Contains("newer rotacal"));
   doc["format"] = "rotacal-model/1.4";
   doc["added_in_1_4"] = {1, 2, 3};
   const ModelFile f = model_from_json(doc, "minor.json");
@@ -96,13 +98,18 @@ TEST_CASE("content errors name the file and the member") {
   auto refused = [&](auto change, const std::string& words) {
     json d = good;
     change(d);
-    CHECK_THROWS_WITH(model_from_json(d, "bad.json"), Catch::Contains("bad.json") && Catch::Contains(words));
+    CHECK_THROWS_WITH(model_from_json(d, "bad.json"),
+                      Catch::Contains("bad.json") && Catch::Contains(words));
   };
-  refused([](json& d) { d["location_errors"]["E_Y0C"]["unit"] = "um"; }, "location_errors.E_Y0C.unit");
-  refused([](json& d) { d["location_errors"]["E_B0A"]["value"] = 1e300; }, "which no machine tool has");
-  refused([](json& d) { d["location_errors"]["E_B0A"]["value"] = "x"; }, "must be a number or null");
+  refused([](json& d) { d["location_errors"]["E_Y0C"]["unit"] = "um"; },
+          "location_errors.E_Y0C.unit");
+  refused([](json& d) { d["location_errors"]["E_B0A"]["value"] = 1e300; },
+          "which no machine tool has");
+  refused([](json& d) { d["location_errors"]["E_B0A"]["value"] = "x"; },
+          "must be a number or null");
   refused([](json& d) { d["location_errors"].erase("E_Y0A"); }, "location_errors lacks E_Y0A");
-  refused([](json& d) { d["location_errors"]["E_X0B"] = {{"value", 0.0}, {"unit", "mm"}}; }, "not a location error");
+  refused([](json& d) { d["location_errors"]["E_X0B"] = {{"value", 0.0}, {"unit", "mm"}}; },
+          "not a location error");
   refused([](json& d) { d["machine"] = "XY-trt"; }, "machine");
   refused([](json& d) { d["kind"] = "laser"; }, "kind");
   refused([](json& d) { d["pivot"].erase("z"); }, "pivot.z");
@@ -178,26 +185,32 @@ RtestJointModelContent sample_rtest_content(MachineType machine) {
   c.c_b_degree = 0;
   c.gamma_cb = false;
   const auto maps = rtest_map_names(machine);
-  std::vector<std::string> names(location_error_names(machine).begin(), location_error_names(machine).end());
+  std::vector<std::string> names(location_error_names(machine).begin(),
+                                 location_error_names(machine).end());
   if (machine.has_head()) names.push_back("tool_offset_Z");
-  for (const std::string& n : {"dz_" + maps[0] + ".b2", "alpha_" + maps[0] + ".b1", "dx_" + maps[1] + ".cos1.b0"})
+  for (const std::string& n :
+       {"dz_" + maps[0] + ".b2", "alpha_" + maps[0] + ".b1", "dx_" + maps[1] + ".cos1.b0"})
     names.push_back(n);
   for (std::size_t i = 0; i < names.size(); ++i) {
     const bool angle = i < 8 ? location_error_is_angle(static_cast<int>(i))
                              : names[i] != "tool_offset_Z" && names[i].rfind("d", 0) != 0;
-    c.parameters.push_back({names[i], (i % 2 ? -1.0 : 1.0) * (angle ? 3.1e-5 : 0.0123) * (1.0 + 0.137 * i),
+    c.parameters.push_back({names[i],
+                            (i % 2 ? -1.0 : 1.0) * (angle ? 3.1e-5 : 0.0123) * (1.0 + 0.137 * i),
                             angle ? 1.7e-6 : 4.3e-4, angle ? "rad" : "mm", true});
   }
   c.parameters[3].observable = false;  // kept at its convention value, written without a std
   const auto n = static_cast<Eigen::Index>(names.size());
   c.covariance = Eigen::MatrixXd::Zero(n, n);
-  for (Eigen::Index i = 0; i < n; ++i) c.covariance(i, i) = std::pow(c.parameters[static_cast<std::size_t>(i)].std, 2);
+  for (Eigen::Index i = 0; i < n; ++i)
+    c.covariance(i, i) = std::pow(c.parameters[static_cast<std::size_t>(i)].std, 2);
   c.covariance(0, 1) = c.covariance(1, 0) = -1.234567e-8;
-  c.nests = {{"1", Eigen::Vector3d(100.125, 0.0, 50.0)}, {"2", Eigen::Vector3d(-0.3, 99.875, 120.0)}};
+  c.nests = {{"1", Eigen::Vector3d(100.125, 0.0, 50.0)},
+             {"2", Eigen::Vector3d(-0.3, 99.875, 120.0)}};
   for (const char* setup : {"1", "2"}) {
     std::array<ParameterEstimate, 3> z;
     for (int a = 0; a < 3; ++a)
-      z[static_cast<std::size_t>(a)] = {std::string("zero.") + setup + "." + "xyz"[a], 0.00213 * (a + 1), 1.1e-4, "mm", true};
+      z[static_cast<std::size_t>(a)] = {std::string("zero.") + setup + "." + "xyz"[a],
+                                        0.00213 * (a + 1), 1.1e-4, "mm", true};
     c.probe_zeros[setup] = z;
   }
   c.residual_rms_um = 0.8123;
@@ -212,7 +225,8 @@ RtestJointModelContent sample_rtest_content(MachineType machine) {
 }  // namespace
 
 TEST_CASE("an R-test joint model is written in C++ and reads back member by member") {
-  for (MachineType machine : {MachineType::BC_trt, MachineType::AC_trt, parse_machine_type("B-head-C-table")}) {
+  for (MachineType machine :
+       {MachineType::BC_trt, MachineType::AC_trt, parse_machine_type("B-head-C-table")}) {
     CAPTURE(to_string(machine));
     const RtestJointModelContent c = sample_rtest_content(machine);
     const std::string path = tmp_path("rtest.json");
@@ -228,14 +242,17 @@ TEST_CASE("an R-test joint model is written in C++ and reads back member by memb
     CHECK(d["basis"]["gamma_cb"] == false);
     const auto maps = rtest_map_names(machine);
     CHECK(d["basis"]["maps"] == json({maps[0], maps[1]}));
-    CHECK(d["basis"]["definition"].get<std::string>().find("Oyama & Ibaraki Eq. 1") != std::string::npos);
+    CHECK(d["basis"]["definition"].get<std::string>().find("Oyama & Ibaraki Eq. 1") !=
+          std::string::npos);
     // Every parameter where the format puts it, its value bit for bit.
     const std::size_t n_head = machine.has_head() ? 1 : 0;
     std::vector<std::string> names;
     for (std::size_t i = 0; i < c.parameters.size(); ++i) {
       const ParameterEstimate& p = c.parameters[i];
       names.push_back(p.name);
-      const json& e = i < 8 ? d["location_errors"][p.name] : i < 8 + n_head ? d[p.name] : d["map_coefficients"][p.name];
+      const json& e = i < 8            ? d["location_errors"][p.name]
+                      : i < 8 + n_head ? d[p.name]
+                                       : d["map_coefficients"][p.name];
       CAPTURE(p.name);
       CHECK(e["value"].get<double>() == p.value);
       CHECK(e["unit"] == p.unit);
@@ -270,5 +287,6 @@ TEST_CASE("the R-test joint writer refuses content that does not fit the machine
   c.covariance = Eigen::MatrixXd::Zero(2, 2);
   CHECK_THROWS_WITH(rtest_joint_model_document(c), Catch::Contains("covariance is not 11 x 11"));
   c.parameters.resize(5);
-  CHECK_THROWS_WITH(rtest_joint_model_document(c), Catch::Contains("5 parameters, fewer than the 8"));
+  CHECK_THROWS_WITH(rtest_joint_model_document(c),
+                    Catch::Contains("5 parameters, fewer than the 8"));
 }

@@ -1,14 +1,13 @@
 // Tests of the output rule (rotacal/io/output_file.hpp): files replaced atomically, devices
 // and FIFOs written through, symlinks followed, directories/inputs/other outputs refused.
-#include <catch2/catch.hpp>
 #include <dirent.h>
 #include <fcntl.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
 #include <unistd.h>
 
-#include <sys/resource.h>
-
+#include <catch2/catch.hpp>
 #include <csignal>
 #include <cstdlib>
 #include <fstream>
@@ -51,7 +50,9 @@ std::string slurp(const std::string& p) {
   return s.str();
 }
 
-void put(const std::string& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
+void put(const std::string& p, const std::string& text) {
+  std::ofstream(p, std::ios::binary) << text;
+}
 
 }  // namespace
 
@@ -78,7 +79,7 @@ TEST_CASE("the old file keeps its permission bits") {
   put(d / "p", "old");
   REQUIRE(::chmod((d / "p").c_str(), 0640) == 0);
   write_output(d / "p", std::string("new"));
-  struct stat st {};
+  struct stat st{};
   REQUIRE(::stat((d / "p").c_str(), &st) == 0);
   CHECK((st.st_mode & 0777) == 0640);
 }
@@ -104,7 +105,7 @@ TEST_CASE("a character device is written through, not replaced") {
   }
   CHECK(check_output(dev) == OutputKind::WriteThrough);
   write_output(dev, std::string("discarded\n"));
-  struct stat st {};
+  struct stat st{};
   REQUIRE(::lstat(dev.c_str(), &st) == 0);
   CHECK(S_ISCHR(st.st_mode));
   CHECK(st.st_rdev == ::makedev(1, 3));
@@ -120,7 +121,7 @@ TEST_CASE("a FIFO is written through to its reader") {
   write_output(fifo, std::string("through the pipe\n"));
   reader.join();
   CHECK(got == "through the pipe\n");
-  struct stat st {};
+  struct stat st{};
   REQUIRE(::lstat(fifo.c_str(), &st) == 0);
   CHECK(S_ISFIFO(st.st_mode));
   CHECK(d.entries() == std::vector<std::string>{"pipe"});
@@ -131,7 +132,7 @@ TEST_CASE("a symlink is followed: the target changes, the link stays a link") {
   put(d / "target.txt", "old");
   REQUIRE(::symlink("target.txt", (d / "link").c_str()) == 0);
   write_output(d / "link", std::string("new"));
-  struct stat st {};
+  struct stat st{};
   REQUIRE(::lstat((d / "link").c_str(), &st) == 0);
   CHECK(S_ISLNK(st.st_mode));
   CHECK(slurp(d / "target.txt") == "new");
@@ -165,7 +166,8 @@ TEST_CASE("directories, missing parents, inputs and other outputs are refused by
 
   OutputOptions two;
   two.other_outputs = {d / "sub/../x.json"};  // neither exists yet
-  CHECK_THROWS_WITH(write_output(d / "x.json", std::string("x"), two), Catch::Contains("another output"));
+  CHECK_THROWS_WITH(write_output(d / "x.json", std::string("x"), two),
+                    Catch::Contains("another output"));
   two.other_outputs = {d / "y.json"};
   write_output(d / "x.json", std::string("x"), two);
   CHECK(d.entries() == std::vector<std::string>{"hard.csv", "session.csv", "sub", "x.json"});
@@ -174,9 +176,10 @@ TEST_CASE("directories, missing parents, inputs and other outputs are refused by
 TEST_CASE("an exception while producing the content leaves the old file and no leftovers") {
   TempDir d;
   put(d / "prog.ngc", "G0 X0\nM30\n");
-  CHECK_THROWS_AS(write_output(d / "prog.ngc",
-                               []() -> std::string { throw InvalidArgument("--length: out of range"); }),
-                  InvalidArgument);
+  CHECK_THROWS_AS(
+      write_output(d / "prog.ngc",
+                   []() -> std::string { throw InvalidArgument("--length: out of range"); }),
+      InvalidArgument);
   CHECK(slurp(d / "prog.ngc") == "G0 X0\nM30\n");
   write_output(d / "prog.ngc", [] { return std::string("G0 X1\nM30\n"); });
   CHECK(slurp(d / "prog.ngc") == "G0 X1\nM30\n");
@@ -201,7 +204,7 @@ TEST_CASE("a write cut off mid-file (file size limit) keeps the old file and lea
   TempDir d;
   put(d / "prog.ngc", "G0 X0\nM30\n");
   // RLIMIT_FSIZE makes the write fail with EFBIG part-way, as a full disk would.
-  struct rlimit old {};
+  struct rlimit old{};
   REQUIRE(::getrlimit(RLIMIT_FSIZE, &old) == 0);
   auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
   struct rlimit small = old;
@@ -272,7 +275,7 @@ TEST_CASE("a stream refuses its inputs and writes devices through") {
   CHECK(null.writing_path() == "/dev/null");
   null.write("discarded\n");
   null.commit();
-  struct stat st {};
+  struct stat st{};
   REQUIRE(::stat("/dev/null", &st) == 0);
   CHECK(S_ISCHR(st.st_mode));
   CHECK(d.entries() == std::vector<std::string>{"port"});

@@ -1,5 +1,4 @@
 #include <catch2/catch.hpp>
-
 #include <cstdio>
 #include <random>
 #include <sstream>
@@ -11,11 +10,14 @@ using namespace rotacal;
 namespace {
 const std::string kShared = ROTACAL_SHARED_DIR;
 const std::string kHead =
-    "# format: rotacal-probe/1\n# machine: AC-trt\n# units: mm, deg, s\n# sphere: 150.0000, 0.0000, 80.0000\n"
+    "# format: rotacal-probe/1\n# machine: AC-trt\n# units: mm, deg, s\n# sphere: 150.0000, "
+    "0.0000, 80.0000\n"
     "# sphere_diameter: 25.0000\n# stylus_diameter: 6.0000\n";
 const std::string kColumns = "pose,time,X,Y,Z,A,C,nx,ny,nz\n";
-const std::string kRow = "1,0.0,149.999348,0.000453,95.464574,0.0000,0.0000,0.000000,0.000000,-1.000000\n";
-const std::string kRow2 = "1,2.0,163.408519,0.000291,87.741750,0.0000,0.0000,-0.866025,-0.000000,-0.500000\n";
+const std::string kRow =
+    "1,0.0,149.999348,0.000453,95.464574,0.0000,0.0000,0.000000,0.000000,-1.000000\n";
+const std::string kRow2 =
+    "1,2.0,163.408519,0.000291,87.741750,0.0000,0.0000,-0.866025,-0.000000,-0.500000\n";
 
 // The line (and column) a text is refused at, with the message checked.
 std::pair<int, int> refused_at(const std::string& text, const std::string& says) {
@@ -45,9 +47,12 @@ TEST_CASE("the independent implementation's probe file loads", "[io][probe]") {
   CHECK(s.samples[1].xyz.x() == 163.408519);
   CHECK(s.samples[1].n.norm() == Approx(1.0).epsilon(1e-15));  // normalised on reading
   CHECK(s.samples[5].rot_deg == 30.0);
-  CHECK(std::holds_alternative<ProbeSession>(read_instrument_session(kShared + "/data/probe_ac_table2.csv")));
-  CHECK(std::holds_alternative<BallbarSession>(read_instrument_session(kShared + "/data/ballbar_ac_table2.csv")));
-  CHECK(std::holds_alternative<RtestSession>(read_instrument_session(kShared + "/data/rtest_bc_oyama.csv")));
+  CHECK(std::holds_alternative<ProbeSession>(
+      read_instrument_session(kShared + "/data/probe_ac_table2.csv")));
+  CHECK(std::holds_alternative<BallbarSession>(
+      read_instrument_session(kShared + "/data/ballbar_ac_table2.csv")));
+  CHECK(std::holds_alternative<RtestSession>(
+      read_instrument_session(kShared + "/data/rtest_bc_oyama.csv")));
 }
 
 TEST_CASE("a probe session writes and reads back bit-identical", "[io][probe]") {
@@ -85,7 +90,8 @@ TEST_CASE("a probe file's directions read, write and read back identical", "[io]
   for (int i = 0; i < 300; ++i) {
     const Eigen::Vector3d d = Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized();
     char row[160];
-    std::snprintf(row, sizeof row, "p%d,%d.0,150,0,95,0,0,%.6f,%.6f,%.6f\n", i, i, d.x(), d.y(), d.z());
+    std::snprintf(row, sizeof row, "p%d,%d.0,150,0,95,0,0,%.6f,%.6f,%.6f\n", i, i, d.x(), d.y(),
+                  d.z());
     text += row;
   }
   std::istringstream in(text);
@@ -95,13 +101,19 @@ TEST_CASE("a probe file's directions read, write and read back identical", "[io]
 }
 
 TEST_CASE("bad probe files are refused naming line and column", "[io][probe]") {
-  CHECK(refused_at(kHead + kColumns + kRow + "1,2.0,163.4,0.0,87.7,0.0,0.0,-0.9,0.0,-0.5\n", "norm").first == 9);
-  CHECK(refused_at(kHead + kColumns + kRow + "1,2.0,163.4,0.0,87.7,0.0,0.0,-0.9,0.0,-0.5\n", "norm").second == 30);
-  CHECK(refused_at(kHead + kColumns + kRow + kRow2 + "1,1.0,1,2,3,0,0,0,0,-1\n", "time").first == 10);
-  CHECK(refused_at(kHead + kColumns + kRow + "1,2.0,1,2,3,15,0,0,0,-1\n", "held at one rotary position").first == 9);
+  CHECK(refused_at(kHead + kColumns + kRow + "1,2.0,163.4,0.0,87.7,0.0,0.0,-0.9,0.0,-0.5\n", "norm")
+            .first == 9);
+  CHECK(refused_at(kHead + kColumns + kRow + "1,2.0,163.4,0.0,87.7,0.0,0.0,-0.9,0.0,-0.5\n", "norm")
+            .second == 30);
+  CHECK(refused_at(kHead + kColumns + kRow + kRow2 + "1,1.0,1,2,3,0,0,0,0,-1\n", "time").first ==
+        10);
+  CHECK(refused_at(kHead + kColumns + kRow + "1,2.0,1,2,3,15,0,0,0,-1\n",
+                   "held at one rotary position")
+            .first == 9);
   CHECK(refused_at(kHead + kColumns + "1,0.0,nan,0,0,0,0,0,0,-1\n", "X").first == 8);
   CHECK(refused_at(kHead + kColumns + "1,0.0,abc,0,0,0,0,0,0,-1\n", "not a number").second == 7);
-  CHECK(refused_at(kHead + "pose,time,X,Y,Z,A,C,nx,ny\n" + kRow, "missing required column 'nz'").first == 7);
+  CHECK(refused_at(kHead + "pose,time,X,Y,Z,A,C,nx,ny\n" + kRow, "missing required column 'nz'")
+            .first == 7);
   CHECK(refused_at(kHead + "pose,time,X,Y,Z,B,C,nx,ny,nz\n" + kRow, "does not belong").first == 7);
   std::string no_sphere = kHead;
   no_sphere.replace(no_sphere.find("# sphere: "), 36, "");
@@ -112,7 +124,8 @@ TEST_CASE("bad probe files are refused naming line and column", "[io][probe]") {
   std::string neg_stylus = kHead;
   neg_stylus.replace(neg_stylus.find("6.0000"), 6, "-6");
   CHECK(refused_at(neg_stylus + kColumns + kRow, "stylus_diameter").first == 6);
-  refused_at("# format: rotacal-ballbar/1\n" + kHead.substr(kHead.find('\n') + 1) + kColumns + kRow, "rotacal-probe/1");
+  refused_at("# format: rotacal-ballbar/1\n" + kHead.substr(kHead.find('\n') + 1) + kColumns + kRow,
+             "rotacal-probe/1");
   CHECK(refused_at(kHead + kColumns + "1,0.0,1,2\n", "expected 10 fields").first == 8);
   CHECK_THROWS_AS(read_probe("/nonexistent/probe.csv"), IoError);
 }

@@ -1,5 +1,4 @@
 #include <catch2/catch.hpp>
-
 #include <cstdio>
 #include <sstream>
 
@@ -13,7 +12,8 @@ const std::string kHead =
     "# format: rotacal-rtest/1\n# machine: BC-trt\n# units: mm, deg, s\n"
     "# nest.1: 100.0000, 0.0000, 60.0000\n# nest.2: 0.0000, -120.0000, 140.0000\n";
 const std::string kColumns = "setup,time,B,C,X,Y,Z,dx,dy,dz\n";
-const std::string kRow = "1,0.0,-90.0000,0.0000,-60.000000,0.000000,100.000000,0.0058340,-0.0301318,-0.0129457\n";
+const std::string kRow =
+    "1,0.0,-90.0000,0.0000,-60.000000,0.000000,100.000000,0.0058340,-0.0301318,-0.0129457\n";
 
 int refused_line(const std::string& text, const std::string& says) {
   std::istringstream in(text);
@@ -40,12 +40,14 @@ TEST_CASE("the independent implementation's R-test file loads", "[io]") {
   CHECK(s.samples[0].d->x() == 0.0036884);
   CHECK_FALSE(s.samples[0].raw.has_value());
   CHECK(std::holds_alternative<RtestSession>(read_session(kShared + "/data/rtest_bc_oyama.csv")));
-  CHECK(std::holds_alternative<BallbarSession>(read_session(kShared + "/data/ballbar_ac_table2.csv")));
+  CHECK(std::holds_alternative<BallbarSession>(
+      read_session(kShared + "/data/ballbar_ac_table2.csv")));
 }
 
 TEST_CASE("R-test write-then-read is exact, with raw probe readings too", "[io]") {
   RtestSession s = read_rtest(kShared + "/data/rtest_bc_oyama.csv");
-  s.probe_dirs = {{1, Eigen::Vector3d(1, 0, 0)}, {2, Eigen::Vector3d(0, 1, 0)}, {3, Eigen::Vector3d(0, 0, 1)}};
+  s.probe_dirs = {
+      {1, Eigen::Vector3d(1, 0, 0)}, {2, Eigen::Vector3d(0, 1, 0)}, {3, Eigen::Vector3d(0, 0, 1)}};
   for (auto& r : s.samples) r.raw = Eigen::Vector3d(r.d->x() + 1e-7, r.d->y() / 3.0, -r.d->z());
   s.noise_um = 0.3;
   std::istringstream in(format_rtest(s));
@@ -64,12 +66,16 @@ TEST_CASE("R-test write-then-read is exact, with raw probe readings too", "[io]"
 TEST_CASE("malformed R-test files are refused with the line that is wrong", "[io]") {
   CHECK(refused_line(kHead + "setup,time,B,C,X,Y,Z\n" + kRow, "dx,dy,dz or d1,d2,d3") == 6);
   CHECK(refused_line(kHead + kColumns + "3,0.0,0,0,1,2,3,0,0,0\n", "nest.3") == 7);
-  CHECK(refused_line(kHead + kColumns + kRow + "1,1.0,0,0,1,2,3,0,x,0\n", "'x' is not a number") == 8);
+  CHECK(refused_line(kHead + kColumns + kRow + "1,1.0,0,0,1,2,3,0,x,0\n", "'x' is not a number") ==
+        8);
   CHECK(refused_line(kHead + "setup,time,B,C,X,Y,Z,d1,d2,d3\n" + kRow, "probe.1.dir") == 0);
-  CHECK(refused_line(kHead + "setup,time,A,C,X,Y,Z,dx,dy,dz\n" + kRow, "does not belong to a BC-trt") == 6);
-  CHECK(refused_line("# format: rotacal-rtest/1\n# machine: BC-trt\n# probe.1.dir: 1, 1, 0\n" + kColumns + kRow,
+  CHECK(refused_line(kHead + "setup,time,A,C,X,Y,Z,dx,dy,dz\n" + kRow,
+                     "does not belong to a BC-trt") == 6);
+  CHECK(refused_line("# format: rotacal-rtest/1\n# machine: BC-trt\n# probe.1.dir: 1, 1, 0\n" +
+                         kColumns + kRow,
                      "unit vector") == 3);
-  CHECK(refused_line(kHead + kColumns + kRow + "1,-1.0,0,0,1,2,3,0,0,0\n", "time must not decrease") == 8);
+  CHECK(refused_line(kHead + kColumns + kRow + "1,-1.0,0,0,1,2,3,0,0,0\n",
+                     "time must not decrease") == 8);
 }
 
 TEST_CASE("R-test appending writer", "[io]") {

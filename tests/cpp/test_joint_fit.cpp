@@ -1,7 +1,6 @@
 // Tests of the joint-fit driver: batched Jets against finite differences, observability,
 // GLS with a whitener against Monte Carlo on AR(1) noise, refits against fresh fits.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <random>
 #include <type_traits>
@@ -18,7 +17,8 @@ struct SineModel : ResidualModel {
   Eigen::VectorXd t, y;
   Eigen::Index num_residuals() const override { return t.size(); }
   int num_parameters() const override { return 5; }
-  void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r, Eigen::MatrixXd* J) const override {
+  void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r,
+                Eigen::MatrixXd* J) const override {
     const auto f = [this](Eigen::Index i, const auto* p, auto* out) {
       using T = std::remove_const_t<std::remove_pointer_t<decltype(p)>>;
       using std::sin;
@@ -30,8 +30,11 @@ struct SineModel : ResidualModel {
 
 // Starts near the truth (the driver is a local solver); scales: plausible sizes of each.
 std::vector<FitParameter> sine_parameters() {
-  return {{"A", "mm", 1.1, 0.1}, {"w", "rad", 0.518, 0.01}, {"phase", "rad", 0.3, 0.1},
-          {"c", "mm", 0.0, 0.1}, {"d", "mm/s", 0.0, 0.01}};
+  return {{"A", "mm", 1.1, 0.1},
+          {"w", "rad", 0.518, 0.01},
+          {"phase", "rad", 0.3, 0.1},
+          {"c", "mm", 0.0, 0.1},
+          {"d", "mm/s", 0.0, 0.01}};
 }
 
 // AR(1) prewhitening for e_i = phi e_{i-1} + s w_i (stationary, w white with unit variance):
@@ -41,7 +44,8 @@ class Ar1Whitener : public ResidualWhitener {
   Ar1Whitener(Eigen::Index n, double phi, double s) : n_(n), phi_(phi), s_(s) {}
   void apply(Eigen::Ref<Eigen::MatrixXd> c) const override {
     for (Eigen::Index j = 0; j < c.cols(); ++j) {
-      for (Eigen::Index i = c.rows() - 1; i >= 1; --i) c(i, j) = (c(i, j) - phi_ * c(i - 1, j)) / s_;
+      for (Eigen::Index i = c.rows() - 1; i >= 1; --i)
+        c(i, j) = (c(i, j) - phi_ * c(i - 1, j)) / s_;
       c(0, j) *= std::sqrt(1.0 - phi_ * phi_) / s_;
     }
   }
@@ -62,7 +66,8 @@ Eigen::VectorXd ar1_noise(Eigen::Index n, double phi, double s, std::mt19937_64&
 
 }  // namespace
 
-TEST_CASE("batched Jets give the Jacobian of the one ballbar model, over several passes", "[joint_fit]") {
+TEST_CASE("batched Jets give the Jacobian of the one ballbar model, over several passes",
+          "[joint_fit]") {
   // 11 + 20 effect parameters: passes of 16, 12 and the model's own composition.
   EffectModel fx;
   for (const char* id : {"radial_motion_C_h2", "tilt_motion_A_h1", "gravity_sag_A", "coning_A",
@@ -124,7 +129,8 @@ TEST_CASE("solve_joint recovers a nonlinear model and reports its covariance", "
   const double truth[5] = {A, w, ph, c, d};
   for (int j = 0; j < 5; ++j) {
     INFO(out.estimates[static_cast<std::size_t>(j)].name);
-    CHECK(std::abs(out.values[j] - truth[j]) <= 4.0 * out.estimates[static_cast<std::size_t>(j)].std);
+    CHECK(std::abs(out.values[j] - truth[j]) <=
+          4.0 * out.estimates[static_cast<std::size_t>(j)].std);
   }
   CHECK(out.summary.chi2_per_dof == Approx(1.0).margin(4.0 * std::sqrt(2.0 / n)));
   // The gradient vanishes at the solution: J^T r = 0 relative to |J||r|.
@@ -139,7 +145,8 @@ TEST_CASE("solve_joint holds one parameter per invisible combination and says so
     Eigen::VectorXd t, y;
     Eigen::Index num_residuals() const override { return t.size(); }
     int num_parameters() const override { return 3; }
-    void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r, Eigen::MatrixXd* J) const override {
+    void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r,
+                  Eigen::MatrixXd* J) const override {
       const auto f = [this](Eigen::Index i, const auto* p, auto* out) {
         using T = std::remove_const_t<std::remove_pointer_t<decltype(p)>>;
         out[0] = p[0] * T(t[i]) + p[1] + p[2] - T(y[i]);
@@ -164,7 +171,8 @@ TEST_CASE("solve_joint holds one parameter per invisible combination and says so
   CHECK(out.values[1] + out.values[2] == Approx(0.2).margin(1e-9));
 }
 
-TEST_CASE("with an AR(1) whitener the covariance matches the Monte Carlo spread; white does not", "[joint_fit]") {
+TEST_CASE("with an AR(1) whitener the covariance matches the Monte Carlo spread; white does not",
+          "[joint_fit]") {
   // Strongly correlated noise (phi = 0.8): the white fit's reported sigma is ~3x too small
   // ((1 + phi) / (1 - phi) inflation of the variance of slowly varying parameters); the GLS
   // fit's (Jw^T Jw)^-1 is right. 300 draws: the spread's own relative error is ~4 %.
@@ -173,7 +181,8 @@ TEST_CASE("with an AR(1) whitener the covariance matches the Monte Carlo spread;
   SineModel m;
   m.t = Eigen::VectorXd::LinSpaced(n, 0.0, 30.0);
   Eigen::VectorXd clean(n);
-  for (int i = 0; i < n; ++i) clean[i] = 1.2 * std::sin(0.52 * m.t[i] + 0.25) + 0.1 - 0.003 * m.t[i];
+  for (int i = 0; i < n; ++i)
+    clean[i] = 1.2 * std::sin(0.52 * m.t[i] + 0.25) + 0.1 - 0.003 * m.t[i];
   JointFitSettings white, gls;
   white.sigma = s;
   gls.whitener = std::make_shared<Ar1Whitener>(n, phi, s);
@@ -190,8 +199,9 @@ TEST_CASE("with an AR(1) whitener the covariance matches the Monte Carlo spread;
     CHECK(b.summary.whitened);
     v_white.row(k) = a.values.transpose();
     v_gls.row(k) = b.values.transpose();
-    for (int j = 0; j < 5; ++j) std_white[j] += a.estimates[static_cast<std::size_t>(j)].std / draws,
-                                std_gls[j] += b.estimates[static_cast<std::size_t>(j)].std / draws;
+    for (int j = 0; j < 5; ++j)
+      std_white[j] += a.estimates[static_cast<std::size_t>(j)].std / draws,
+          std_gls[j] += b.estimates[static_cast<std::size_t>(j)].std / draws;
     chi2_gls += b.summary.chi2_per_dof / draws;
   }
   const auto spread = [&](const Eigen::MatrixXd& v, int j) {
@@ -234,7 +244,8 @@ TEST_CASE("a refit from the reference linearisation lands where a fresh fit does
     CHECK(r.converged);
     CHECK_FALSE(r.fell_back);
     for (int j = 0; j < 5; ++j)
-      CHECK(std::abs(r.values[j] - fresh.values[j]) <= 1e-3 * fresh.estimates[static_cast<std::size_t>(j)].std);
+      CHECK(std::abs(r.values[j] - fresh.values[j]) <=
+            1e-3 * fresh.estimates[static_cast<std::size_t>(j)].std);
   }
 }
 
@@ -271,7 +282,8 @@ TEST_CASE("a long session starts on a subsample and lands on the same solution",
   const int n = 20000;
   m.t = Eigen::VectorXd::LinSpaced(n, 0.0, 40.0);
   m.y.resize(n);
-  for (int i = 0; i < n; ++i) m.y[i] = 1.2 * std::sin(0.52 * m.t[i] + 0.25) + 0.1 - 0.003 * m.t[i] + 1e-3 * N(rng);
+  for (int i = 0; i < n; ++i)
+    m.y[i] = 1.2 * std::sin(0.52 * m.t[i] + 0.25) + 0.1 - 0.003 * m.t[i] + 1e-3 * N(rng);
   SineModel plain;
   plain.t = m.t, plain.y = m.y;
   JointFitSettings set;
@@ -281,7 +293,9 @@ TEST_CASE("a long session starts on a subsample and lands on the same solution",
   CHECK(a.summary.converged);
   CHECK(a.summary.jacobian_evaluations < b.summary.jacobian_evaluations);
   for (int j = 0; j < 5; ++j) {
-    CHECK(std::abs(a.values[j] - b.values[j]) <= 1e-2 * b.estimates[static_cast<std::size_t>(j)].std);
-    CHECK(a.estimates[static_cast<std::size_t>(j)].std == Approx(b.estimates[static_cast<std::size_t>(j)].std).epsilon(1e-3));
+    CHECK(std::abs(a.values[j] - b.values[j]) <=
+          1e-2 * b.estimates[static_cast<std::size_t>(j)].std);
+    CHECK(a.estimates[static_cast<std::size_t>(j)].std ==
+          Approx(b.estimates[static_cast<std::size_t>(j)].std).epsilon(1e-3));
   }
 }

@@ -1,11 +1,11 @@
 // Joint fits (ballbar and R-test) on correlated noise: the noise model estimated from the
 // residuals, the GLS refit, and 1-sigma figures that hold (issue 11 item 1).
-#include <catch2/catch.hpp>
-
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <random>
 
+#include "../support/synthetic_sessions.hpp"
 #include "rotacal/ballbar/identify.hpp"
 #include "rotacal/ballbar/simulate.hpp"
 #include "rotacal/core/noise_model.hpp"
@@ -13,14 +13,15 @@
 #include "rotacal/rtest/identify_joint.hpp"
 #include "rotacal/rtest/monte_carlo.hpp"
 #include "rotacal/rtest/simulate.hpp"
-#include "../support/synthetic_sessions.hpp"
 
 using namespace rotacal;
 
 namespace {
 
 const BallbarSession& commanded() { return synthetic::table2_commanded(); }
-BallbarMachineModel random_machine(std::mt19937& rng) { return synthetic::random_ballbar_machine(commanded(), rng); }
+BallbarMachineModel random_machine(std::mt19937& rng) {
+  return synthetic::random_ballbar_machine(commanded(), rng);
+}
 // AR(1) noise per test (0.5 um marginal), as the issue's sessions.
 BallbarSession ar_ballbar(const BallbarMachineModel& truth, double rho, std::uint64_t seed) {
   return synthetic::noisy_ballbar(commanded(), truth, rho, 0.5, seed);
@@ -28,7 +29,8 @@ BallbarSession ar_ballbar(const BallbarMachineModel& truth, double rho, std::uin
 
 // RMS over sessions and location errors of (estimate - truth) / reported sigma.
 template <typename Id, typename Truth>
-void accumulate_z(const Id& id, const Truth& truth_errors, MachineType machine, double* sum, int* n) {
+void accumulate_z(const Id& id, const Truth& truth_errors, MachineType machine, double* sum,
+                  int* n) {
   const auto& names = location_error_names(machine);
   for (int j = 0; j < 8; ++j) {
     const ParameterEstimate& p = id.parameter(names[static_cast<std::size_t>(j)]);
@@ -101,7 +103,8 @@ TEST_CASE("R-test joint fit with AR(0.95) noise and probe zeros wandering betwee
   for (int k = 0; k < 4; ++k) {
     MachineModel truth = MachineModel::nominal(MachineType::BC_trt);
     truth.machine = MachineType::BC_trt;
-    for (int i = 0; i < 8; ++i) truth.errors.v[i] = location_error_is_angle(i) ? 3e-5 * N(rng) : 0.02 * N(rng);
+    for (int i = 0; i < 8; ++i)
+      truth.errors.v[i] = location_error_is_angle(i) ? 3e-5 * N(rng) : 0.02 * N(rng);
     RtestSimOptions o;
     o.noise_um = 0.0;
     o.seed = 20 + k;
@@ -144,7 +147,8 @@ TEST_CASE("R-test Monte Carlo re-simulates the fitted noise model (wandering pro
   std::vector<double> t;
   for (const RtestSample& x : s.samples)
     for (int a = 0; a < 3; ++a) g.push_back("nest " + x.setup), t.push_back(x.time);
-  const Eigen::VectorXd e = noise_gen::ar1(g, t, 0.9, 0.3e-3, 3) + noise_gen::probe_zero_wander(g, t, 0.1e-3, 4);
+  const Eigen::VectorXd e =
+      noise_gen::ar1(g, t, 0.9, 0.3e-3, 3) + noise_gen::probe_zero_wander(g, t, 0.1e-3, 4);
   for (std::size_t r = 0; r < s.samples.size(); ++r)
     for (int a = 0; a < 3; ++a) (*s.samples[r].d)[a] += e[3 * static_cast<Eigen::Index>(r) + a];
   s.noise_um = 0.3;
@@ -175,12 +179,15 @@ TEST_CASE("R-test Monte Carlo re-simulates the fitted noise model (wandering pro
 namespace {
 // Spread over sessions of each location error / RMS of its reported sigma (the bench's figure).
 struct Ratios {
-  std::vector<std::vector<double>> v = std::vector<std::vector<double>>(8), s = std::vector<std::vector<double>>(8);
+  std::vector<std::vector<double>> v = std::vector<std::vector<double>>(8),
+                                   s = std::vector<std::vector<double>>(8);
   void add(const RtestJointIdentification& id) {
     for (int j = 0; j < 8; ++j) {
-      const ParameterEstimate& p = id.parameter(location_error_names(MachineType::BC_trt)[static_cast<std::size_t>(j)]);
+      const ParameterEstimate& p =
+          id.parameter(location_error_names(MachineType::BC_trt)[static_cast<std::size_t>(j)]);
       REQUIRE(p.observable);
-      v[static_cast<std::size_t>(j)].push_back(p.value), s[static_cast<std::size_t>(j)].push_back(p.std);
+      v[static_cast<std::size_t>(j)].push_back(p.value),
+          s[static_cast<std::size_t>(j)].push_back(p.std);
     }
   }
   std::vector<double> ratios() const {
@@ -203,8 +210,9 @@ double rms_log(const std::vector<double>& r) {
 }
 }  // namespace
 
-TEST_CASE("R-test sigmas hold for every location error under AR(0.9) noise with wandering probe zeros",
-          "[rtest][noise]") {
+TEST_CASE(
+    "R-test sigmas hold for every location error under AR(0.9) noise with wandering probe zeros",
+    "[rtest][noise]") {
   // Monte Carlo over 50 sessions of one machine (0.3 um AR(0.9) per probe channel, probe zeros
   // stepping 0.1 um per pose, as bench/noise_mc_bench): the spread of each location error over
   // the reported sigma. The old covariance (Burg AR(p) of the residuals, scaled by one bias
@@ -214,7 +222,8 @@ TEST_CASE("R-test sigmas hold for every location error under AR(0.9) noise with 
   std::normal_distribution<double> N(0.0, 1.0);
   MachineModel truth = MachineModel::nominal(MachineType::BC_trt);
   truth.machine = MachineType::BC_trt;
-  for (int i = 0; i < 8; ++i) truth.errors.v[i] = location_error_is_angle(i) ? 3e-5 * N(rng) : 0.02 * N(rng);
+  for (int i = 0; i < 8; ++i)
+    truth.errors.v[i] = location_error_is_angle(i) ? 3e-5 * N(rng) : 0.02 * N(rng);
   RtestSimOptions o;
   o.noise_um = 0.0;
   const RtestSession clean = simulate_rtest(truth, o).session;
@@ -228,8 +237,9 @@ TEST_CASE("R-test sigmas hold for every location error under AR(0.9) noise with 
   Ratios r_now, r_old;
   for (int k = 0; k < 50; ++k) {
     RtestSession s = clean;
-    const Eigen::VectorXd e = noise_gen::ar1(g, t, 0.9, 0.3e-3, 7000 + static_cast<std::uint64_t>(k)) +
-                              noise_gen::probe_zero_wander(g, t, 0.1e-3, 8000 + static_cast<std::uint64_t>(k));
+    const Eigen::VectorXd e =
+        noise_gen::ar1(g, t, 0.9, 0.3e-3, 7000 + static_cast<std::uint64_t>(k)) +
+        noise_gen::probe_zero_wander(g, t, 0.1e-3, 8000 + static_cast<std::uint64_t>(k));
     for (std::size_t r = 0; r < s.samples.size(); ++r)
       for (int a = 0; a < 3; ++a) (*s.samples[r].d)[a] += e[3 * static_cast<Eigen::Index>(r) + a];
     s.noise_um = 0.3;

@@ -1,5 +1,4 @@
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <random>
 
@@ -60,7 +59,8 @@ TEST_CASE("Lanes through Eigen: norms, cross and dot products lane by lane", "[l
   }
 }
 
-TEST_CASE("the rotation and its derivative products in Lanes equal four double evaluations", "[lanes][rotation]") {
+TEST_CASE("the rotation and its derivative products in Lanes equal four double evaluations",
+          "[lanes][rotation]") {
   std::mt19937 rng(11);
   std::normal_distribution<double> N(0.0, 1.0);
   for (int trial = 0; trial < 25; ++trial) {
@@ -77,14 +77,17 @@ TEST_CASE("the rotation and its derivative products in Lanes equal four double e
       c[l] = std::cos(th), s[l] = std::sin(th);
     }
     const LineRotationDerivatives<Lanes> D = rotate_point_about_unit_line_derivatives<Lanes>(
-        point.cast<Lanes>(), u.cast<Lanes>(), Lanes(inv_norm), lanes_of(c), lanes_of(s), lanes_of(q));
+        point.cast<Lanes>(), u.cast<Lanes>(), Lanes(inv_norm), lanes_of(c), lanes_of(s),
+        lanes_of(q));
     const Eigen::Matrix<Lanes, 1, 3> W = lanes_of(w3).transpose();
-    const Eigen::Matrix<Lanes, 1, 3> wq = D.times_q(W), wu = D.times_unit_direction(W), wd = D.times_direction(W);
+    const Eigen::Matrix<Lanes, 1, 3> wq = D.times_q(W), wu = D.times_unit_direction(W),
+                                     wd = D.times_direction(W);
     for (int l = 0; l < 4; ++l) {
       const LineRotationDerivatives<double> Dl =
           rotate_point_about_unit_line_derivatives<double>(point, u, inv_norm, c[l], s[l], q[l]);
       const Eigen::RowVector3d w = w3[l].transpose();
-      const Eigen::RowVector3d eq = Dl.times_q(w), eu = Dl.times_unit_direction(w), ed = Dl.times_direction(w);
+      const Eigen::RowVector3d eq = Dl.times_q(w), eu = Dl.times_unit_direction(w),
+                               ed = Dl.times_direction(w);
       for (int a = 0; a < 3; ++a) {
         CHECK(std::abs(D.f[a][l] - Dl.f[a]) < 1e-12 * (1.0 + std::abs(Dl.f[a])));
         CHECK(std::abs(wq[a][l] - eq[a]) < 1e-12);

@@ -1,6 +1,6 @@
-#include <catch2/catch.hpp>
 #include <ceres/jet.h>
 
+#include <catch2/catch.hpp>
 #include <random>
 
 #include "rotacal/kinematics/machine.hpp"
@@ -113,7 +113,8 @@ TEST_CASE("forward kinematics is differentiable in the errors with ceres::Jet", 
       ep.v[i] += h;
       em.v[i] -= h;
       const Eigen::Vector3d fd = (forward(m, ep, a, q) - forward(m, em, a, q)) / (2 * h);
-      for (int k = 0; k < 3; ++k) CHECK_THAT(pj[k].v[i], WithinAbs(fd[k], 1e-5 * (1 + std::abs(fd[k]))));
+      for (int k = 0; k < 3; ++k)
+        CHECK_THAT(pj[k].v[i], WithinAbs(fd[k], 1e-5 * (1 + std::abs(fd[k]))));
     }
   }
 }

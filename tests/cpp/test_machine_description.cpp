@@ -1,6 +1,6 @@
-#include <catch2/catch.hpp>
 #include <ceres/jet.h>
 
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <random>
 
@@ -40,7 +40,8 @@ const char* kAcJson = R"({"format": "rotacal-machine/1", "name": "my AC table",
 
 }  // namespace
 
-TEST_CASE("built-in machines: configuration, tilt and rotary axes, error names", "[machine_description]") {
+TEST_CASE("built-in machines: configuration, tilt and rotary axes, error names",
+          "[machine_description]") {
   const MachineType bh = parse_machine_type("B-head-C-table");
   CHECK(bh.description().configuration() == "head-table");
   CHECK(tilt_axis_letter(bh) == 'B');
@@ -62,8 +63,8 @@ TEST_CASE("built-in machines: configuration, tilt and rotary axes, error names",
 }
 
 TEST_CASE("a nutating axis: u, v as formats.md defines them", "[machine_description]") {
-  const RotaryAxis a = make_rotary_axis('B', Eigen::Vector3d(0, -1, 1), Eigen::Vector3d::Zero(), false,
-                                        std::nullopt, "test");
+  const RotaryAxis a = make_rotary_axis('B', Eigen::Vector3d(0, -1, 1), Eigen::Vector3d::Zero(),
+                                        false, std::nullopt, "test");
   // e = +X (|X . n| = 0 <= 0.5): u = unit(X x n), v = n x u.
   const Eigen::Vector3d n = Eigen::Vector3d(0, -1, 1).normalized();
   const Eigen::Vector3d u = Eigen::Vector3d::UnitX().cross(n).normalized();
@@ -72,14 +73,16 @@ TEST_CASE("a nutating axis: u, v as formats.md defines them", "[machine_descript
   CHECK((a.direction_basis - a.position_basis).norm() == 0.0);
   CHECK(a.principal == -1);
   // A letter that does not match its direction takes the U/V names too.
-  const RotaryAxis b = make_rotary_axis('A', Eigen::Vector3d::UnitY(), Eigen::Vector3d::Zero(), true,
-                                        std::nullopt, "test");
+  const RotaryAxis b = make_rotary_axis('A', Eigen::Vector3d::UnitY(), Eigen::Vector3d::Zero(),
+                                        true, std::nullopt, "test");
   CHECK(b.error_names[0] == "E_U0A");
 }
 
 TEST_CASE("an axis along -X keeps the meaning of its error names", "[machine_description]") {
-  const RotaryAxis plus = make_rotary_axis('A', Eigen::Vector3d::UnitX(), Eigen::Vector3d::Zero(), false, std::nullopt, "t");
-  const RotaryAxis minus = make_rotary_axis('A', -Eigen::Vector3d::UnitX(), Eigen::Vector3d::Zero(), false, std::nullopt, "t");
+  const RotaryAxis plus = make_rotary_axis('A', Eigen::Vector3d::UnitX(), Eigen::Vector3d::Zero(),
+                                           false, std::nullopt, "t");
+  const RotaryAxis minus = make_rotary_axis('A', -Eigen::Vector3d::UnitX(), Eigen::Vector3d::Zero(),
+                                            false, std::nullopt, "t");
   const Eigen::Vector2d o(2e-4, -3e-4);  // E_B0A, E_C0A
   const Eigen::Vector3d dp = plus.direction + plus.direction_basis * o;
   const Eigen::Vector3d dm = minus.direction + minus.direction_basis * o;
@@ -90,20 +93,25 @@ TEST_CASE("an axis along -X keeps the meaning of its error names", "[machine_des
 
 TEST_CASE("a huge direction is normalised, not overflowed to zero", "[machine_description]") {
   // Issue 32: [1e200, 1e200, 0] had norm() = inf, so direction / norm was the zero vector.
-  const RotaryAxis a = make_rotary_axis('A', Eigen::Vector3d(1e200, 0, 0), Eigen::Vector3d::Zero(), false, std::nullopt, "t");
+  const RotaryAxis a = make_rotary_axis('A', Eigen::Vector3d(1e200, 0, 0), Eigen::Vector3d::Zero(),
+                                        false, std::nullopt, "t");
   CHECK(a.direction == Eigen::Vector3d::UnitX());
   CHECK(a.principal == 0);
-  const RotaryAxis u = make_rotary_axis('B', Eigen::Vector3d(1e200, 1e200, 0), Eigen::Vector3d::Zero(), false, std::nullopt, "t");
+  const RotaryAxis u = make_rotary_axis('B', Eigen::Vector3d(1e200, 1e200, 0),
+                                        Eigen::Vector3d::Zero(), false, std::nullopt, "t");
   CHECK(std::abs(u.direction.norm() - 1.0) < 1e-15);
   CHECK(std::abs(u.direction.x() - std::sqrt(0.5)) < 1e-15);
-  CHECK_THROWS_AS(make_rotary_axis('A', Eigen::Vector3d(1e-300, 0, 0), Eigen::Vector3d::Zero(), false, std::nullopt, "t"),
+  CHECK_THROWS_AS(make_rotary_axis('A', Eigen::Vector3d(1e-300, 0, 0), Eigen::Vector3d::Zero(),
+                                   false, std::nullopt, "t"),
                   InvalidArgument);
 }
 
-TEST_CASE("a description written out for AC-trt and BC-trt moves exactly like the built-in", "[machine_description]") {
+TEST_CASE("a description written out for AC-trt and BC-trt moves exactly like the built-in",
+          "[machine_description]") {
   std::mt19937 rng(7);
   for (MachineType b : {MachineType::AC_trt, MachineType::BC_trt}) {
-    MachineDescription d = parse_machine_description(machine_description_json(b.description()), "round trip");
+    MachineDescription d =
+        parse_machine_description(machine_description_json(b.description()), "round trip");
     CHECK(MachineType::from_description(d) == b);  // same name and kinematics: the built-in
     d.name = "custom copy";
     const MachineType c = MachineType::from_description(d);
@@ -129,8 +137,7 @@ TEST_CASE("inverse(forward) returns the pose on every built-in machine", "[machi
       const RotaryAngles<double> a = random_pose(m, rng);
       const Eigen::Vector3d xyz(U(rng), U(rng), U(rng) + 200.0);
       const Eigen::Vector3d p_table = ball_in_table(m, e, a, xyz);
-      const Eigen::Vector3d k_table =
-          table_pose(m, e, a).R.transpose() * tool_direction(m, e, a);
+      const Eigen::Vector3d k_table = table_pose(m, e, a).R.transpose() * tool_direction(m, e, a);
       const MachineAxes back = inverse_with_tool_axis(m, e, p_table, k_table, a.tilt > 0, a.rot);
       CHECK(std::abs(wrap(back.angles.tilt - a.tilt)) < 1e-9);
       CHECK(std::abs(wrap(back.angles.rot - a.rot)) < 1e-9);
@@ -141,7 +148,8 @@ TEST_CASE("inverse(forward) returns the pose on every built-in machine", "[machi
   }
 }
 
-TEST_CASE("head kinematics pass Ceres Jets and agree with finite differences", "[machine_description]") {
+TEST_CASE("head kinematics pass Ceres Jets and agree with finite differences",
+          "[machine_description]") {
   using J = ceres::Jet<double, 9>;
   std::mt19937 rng(3);
   for (const char* name : {"B-head-C-table", "AC-head", "B45C-trt"}) {
@@ -153,16 +161,21 @@ TEST_CASE("head kinematics pass Ceres Jets and agree with finite differences", "
     for (int k = 0; k < 8; ++k) ej.v[k] = J(e.v[k], k);
     const J dl(0.01, 8);
     const RotaryAngles<J> aj{J(a.tilt), J(a.rot)};
-    const Vec3<J> d = tool_ball<J>(m, ej, aj, xyz.cast<J>(), dl) - forward<J>(m, ej, aj, q.cast<J>());
+    const Vec3<J> d =
+        tool_ball<J>(m, ej, aj, xyz.cast<J>(), dl) - forward<J>(m, ej, aj, q.cast<J>());
     for (int k = 0; k < 9; ++k) {
       const double h = k < 8 && location_error_is_angle(k) ? 1e-7 : 1e-5;
       LocationErrors<double> ep = e, em = e;
       double lp = 0.01, lm = 0.01;
-      if (k < 8) ep.v[k] += h, em.v[k] -= h;
-      else lp += h, lm -= h;
+      if (k < 8)
+        ep.v[k] += h, em.v[k] -= h;
+      else
+        lp += h, lm -= h;
       const Eigen::Vector3d fd = ((tool_ball(m, ep, a, xyz, lp) - forward(m, ep, a, q)) -
-                                  (tool_ball(m, em, a, xyz, lm) - forward(m, em, a, q))) / (2 * h);
-      for (int r = 0; r < 3; ++r) CHECK(std::abs(d[r].v[k] - fd[r]) < 1e-5 * (1.0 + std::abs(fd[r])));
+                                  (tool_ball(m, em, a, xyz, lm) - forward(m, em, a, q))) /
+                                 (2 * h);
+      for (int r = 0; r < 3; ++r)
+        CHECK(std::abs(d[r].v[k] - fd[r]) < 1e-5 * (1.0 + std::abs(fd[r])));
     }
   }
 }
@@ -171,31 +184,49 @@ TEST_CASE("bad machine descriptions are refused with the field named", "[machine
   auto refuses = [](const std::string& text, const std::string& what) {
     INFO(text);
     CHECK_THROWS_AS(parse_machine_description(text, "m.json"), InvalidArgument);
-    CHECK_THROWS_WITH(parse_machine_description(text, "m.json"), Catch::Contains("m.json") && Catch::Contains(what));
+    CHECK_THROWS_WITH(parse_machine_description(text, "m.json"),
+                      Catch::Contains("m.json") && Catch::Contains(what));
   };
   const std::string head = R"({"format": "rotacal-machine/1", )";
-  refuses(head + R"("table_axes": [{"name": "A", "direction": [0, 0, 0]}, {"name": "C", "direction": [0, 0, 1]}]})",
-          "table_axes[0].direction is zero");
-  refuses(head + R"("table_axes": [{"name": "C", "direction": [1, 0, 0]}, {"name": "C", "direction": [0, 0, 1]}]})",
-          "named 'C'");
-  refuses(head + R"("table_axes": [{"name": "A", "direction": [1, 0, 0]}, {"name": "B", "direction": [0, 1, 0]},
-          {"name": "C", "direction": [0, 0, 1]}]})", "at most 2 per side");
-  refuses(head + R"("table_axes": [{"name": "A", "direction": [1, 0, 0]}], "head_axes": [{"name": "W", "direction": [0, 0, 1]}]})",
-          "head_axes[0].name 'W'");
-  refuses(head + R"("table_axes": [{"name": "A", "direction": [1, 0, 1e999]}, {"name": "C", "direction": [0, 0, 1]}]})",
-          "number overflow parsing '1e999'");
-  refuses(head + R"("table_axes": [{"name": "A", "direction": [1, 0, NaN]}, {"name": "C", "direction": [0, 0, 1]}]})",
-          "not valid JSON");
+  refuses(
+      head +
+          R"("table_axes": [{"name": "A", "direction": [0, 0, 0]}, {"name": "C", "direction": [0, 0, 1]}]})",
+      "table_axes[0].direction is zero");
+  refuses(
+      head +
+          R"("table_axes": [{"name": "C", "direction": [1, 0, 0]}, {"name": "C", "direction": [0, 0, 1]}]})",
+      "named 'C'");
+  refuses(
+      head +
+          R"("table_axes": [{"name": "A", "direction": [1, 0, 0]}, {"name": "B", "direction": [0, 1, 0]},
+          {"name": "C", "direction": [0, 0, 1]}]})",
+      "at most 2 per side");
+  refuses(
+      head +
+          R"("table_axes": [{"name": "A", "direction": [1, 0, 0]}], "head_axes": [{"name": "W", "direction": [0, 0, 1]}]})",
+      "head_axes[0].name 'W'");
+  refuses(
+      head +
+          R"("table_axes": [{"name": "A", "direction": [1, 0, 1e999]}, {"name": "C", "direction": [0, 0, 1]}]})",
+      "number overflow parsing '1e999'");
+  refuses(
+      head +
+          R"("table_axes": [{"name": "A", "direction": [1, 0, NaN]}, {"name": "C", "direction": [0, 0, 1]}]})",
+      "not valid JSON");
   refuses(head + R"("table_axes": [{"name": "A", "direction": [1, 0, 0]}]})", "hold 1 rotary axes");
-  refuses(head + R"("table_axes": [{"name": "A", "direction": [1, 0, 0], "limits_deg": [30, -120]}, {"name": "C", "direction": [0, 0, 1]}]})",
-          "limits_deg must have min < max");
-  refuses(head + R"("table_axes": [{"name": "A", "direction": [0, 0, 1]}, {"name": "C", "direction": [0, 0, -1]}]})",
-          "parallel");
+  refuses(
+      head +
+          R"("table_axes": [{"name": "A", "direction": [1, 0, 0], "limits_deg": [30, -120]}, {"name": "C", "direction": [0, 0, 1]}]})",
+      "limits_deg must have min < max");
+  refuses(
+      head +
+          R"("table_axes": [{"name": "A", "direction": [0, 0, 1]}, {"name": "C", "direction": [0, 0, -1]}]})",
+      "parallel");
   refuses(head + R"("tabel_axes": []})", "tabel_axes is not a field");
   refuses(R"({"format": "rotacal-machine/2"})", "format");
   // Built in memory (no JSON to stop it), a NaN is refused where the axis is made.
-  CHECK_THROWS_WITH(make_rotary_axis('A', Eigen::Vector3d(1, 0, std::nan("")), Eigen::Vector3d::Zero(), false,
-                                     std::nullopt, "axes[0]"),
+  CHECK_THROWS_WITH(make_rotary_axis('A', Eigen::Vector3d(1, 0, std::nan("")),
+                                     Eigen::Vector3d::Zero(), false, std::nullopt, "axes[0]"),
                     Catch::Contains("axes[0]") && Catch::Contains("finite"));
   // A valid one parses, with its limits.
   const MachineDescription d = parse_machine_description(kAcJson, "ac.json");

@@ -1,7 +1,6 @@
 // Tests of MachineModel: validation naming the field, parameter names, and that both
 // instruments' models are one.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 
 #include "rotacal/ballbar/simulate.hpp"
@@ -15,7 +14,8 @@ TEST_CASE("MachineModel validation names what is wrong", "[machine_model]") {
   m.machine = MachineType::AC_trt;
   m.effects.effects = {Effect::parse("gravity_sag_A"), Effect::parse("radial_motion_C_h2")};
   m.effect_params = {0.004, 0.001, 0.0, 0.0};
-  CHECK_THROWS_WITH(m.validate("truth"), Catch::Contains("truth.effect_params") && Catch::Contains("5"));
+  CHECK_THROWS_WITH(m.validate("truth"),
+                    Catch::Contains("truth.effect_params") && Catch::Contains("5"));
   m.effect_params.push_back(0.0);
   CHECK_NOTHROW(m.validate("truth"));
   m.effect_params[2] = std::nan("");
@@ -25,11 +25,13 @@ TEST_CASE("MachineModel validation names what is wrong", "[machine_model]") {
   CHECK_THROWS_WITH(m.validate("truth"), Catch::Contains("E_Y0C"));
   m.errors.v[5] = 0.0;
   m.machine = MachineType::BC_trt;  // gravity sag of an A table on a B machine
-  CHECK_THROWS_WITH(m.validate("truth"), Catch::Contains("gravity_sag_A") && Catch::Contains("BC-trt"));
+  CHECK_THROWS_WITH(m.validate("truth"),
+                    Catch::Contains("gravity_sag_A") && Catch::Contains("BC-trt"));
   CHECK_THROWS_AS(m.validate("truth"), InvalidArgument);
 }
 
-TEST_CASE("MachineModel parameter names: location errors, then effect parameters", "[machine_model]") {
+TEST_CASE("MachineModel parameter names: location errors, then effect parameters",
+          "[machine_model]") {
   MachineModel m;
   m.machine = MachineType::BC_trt;
   m.effects.effects = {Effect::parse("coning_B"), Effect::parse("axial_motion_C_h1")};

@@ -6,9 +6,9 @@
 #include <catch2/catch.hpp>
 
 #include "rotacal/ballbar/plan.hpp"
+#include "rotacal/ballbar/simulate.hpp"
 #include "rotacal/core/block_whitener.hpp"
 #include "rotacal/core/noise_model.hpp"
-#include "rotacal/ballbar/simulate.hpp"
 #include "rotacal/multi/identify.hpp"
 #include "rotacal/probe/simulate.hpp"
 
@@ -46,8 +46,9 @@ ProbeSession probe_session(const MachineModel& t, std::uint64_t seed) {
 TEST_CASE("ballbar + probe of one machine: joint values within 3 sigma, sigma no larger than alone",
           "[multi]") {
   const MachineModel t = machine_truth();
-  const MultiIdentification id = identify_multi(
-      {MultiSessionInput::of("bb", ballbar_session(t, 11)), MultiSessionInput::of("probe", probe_session(t, 12))});
+  const MultiIdentification id =
+      identify_multi({MultiSessionInput::of("bb", ballbar_session(t, 11)),
+                      MultiSessionInput::of("probe", probe_session(t, 12))});
   CHECK(id.converged);
   REQUIRE(id.sessions.size() == 2);
   CHECK(id.disagreements.empty());
@@ -55,7 +56,8 @@ TEST_CASE("ballbar + probe of one machine: joint values within 3 sigma, sigma no
   int observed = 0;
   for (std::size_t j = 0; j < names.size(); ++j) {
     const ParameterEstimate& p = id.location_error(names[j]);
-    INFO(p.name << " = " << p.value << " +- " << p.std << ", truth " << t.errors.v[static_cast<Eigen::Index>(j)]);
+    INFO(p.name << " = " << p.value << " +- " << p.std << ", truth "
+                << t.errors.v[static_cast<Eigen::Index>(j)]);
     if (!p.observable) continue;
     ++observed;
     CHECK(std::abs(p.value - t.errors.v[static_cast<Eigen::Index>(j)]) <= 3.0 * p.std);
@@ -78,12 +80,14 @@ TEST_CASE("a session whose machine differs by 30 um is reported as disagreeing",
   MachineModel moved = t;
   const auto& names = location_error_names(MachineType::AC_trt);
   moved.errors.v[4] += 0.030;  // one location error of the probe's machine, 30 um off
-  const MultiIdentification id = identify_multi(
-      {MultiSessionInput::of("bb", ballbar_session(t, 21)), MultiSessionInput::of("probe", probe_session(moved, 22))});
+  const MultiIdentification id =
+      identify_multi({MultiSessionInput::of("bb", ballbar_session(t, 21)),
+                      MultiSessionInput::of("probe", probe_session(moved, 22))});
   REQUIRE(!id.disagreements.empty());
   bool found = false;
   for (const MultiDisagreement& d : id.disagreements) {
-    INFO(d.parameter << " " << d.session_a << " vs " << d.session_b << ": " << d.difference << " +- " << d.sigma);
+    INFO(d.parameter << " " << d.session_a << " vs " << d.session_b << ": " << d.difference
+                     << " +- " << d.sigma);
     CHECK(std::abs(d.z) > 3.0);
     CHECK(std::abs(d.z - d.difference / d.sigma) < 1e-9);
     if (d.parameter == names[4]) {
@@ -108,7 +112,8 @@ TEST_CASE("sessions of different machine types are refused by name", "[multi]") 
     CHECK(what.find("bb") != std::string::npos);
     CHECK(what.find("probe-bc") != std::string::npos);
   }
-  CHECK_THROWS_AS(identify_multi({MultiSessionInput::of("bb", ballbar_session(t, 1))}), InvalidArgument);
+  CHECK_THROWS_AS(identify_multi({MultiSessionInput::of("bb", ballbar_session(t, 1))}),
+                  InvalidArgument);
 }
 
 TEST_CASE("a catalogue effect shared by both sessions is fitted once, within 3 sigma", "[multi]") {
@@ -117,8 +122,10 @@ TEST_CASE("a catalogue effect shared by both sessions is fitted once, within 3 s
   t.effect_params = {0.004};
   MultiFitOptions o;
   o.effects = EffectModel{{Effect::parse("gravity_sag_A")}, std::nullopt};
-  const MultiIdentification id = identify_multi(
-      {MultiSessionInput::of("bb", ballbar_session(t, 31)), MultiSessionInput::of("probe", probe_session(t, 32))}, o);
+  const MultiIdentification id =
+      identify_multi({MultiSessionInput::of("bb", ballbar_session(t, 31)),
+                      MultiSessionInput::of("probe", probe_session(t, 32))},
+                     o);
   CHECK(id.converged);
   REQUIRE(id.effects.size() == 1);
   INFO("gravity_sag_A = " << id.effects[0].value << " +- " << id.effects[0].std);
@@ -129,10 +136,12 @@ TEST_CASE("a catalogue effect shared by both sessions is fitted once, within 3 s
   for (std::size_t j = 0; j < names.size(); ++j) {
     const ParameterEstimate& p = id.location_errors[j];
     INFO(p.name << " = " << p.value << " +- " << p.std);
-    if (p.observable) CHECK(std::abs(p.value - t.errors.v[static_cast<Eigen::Index>(j)]) <= 3.0 * p.std);
+    if (p.observable)
+      CHECK(std::abs(p.value - t.errors.v[static_cast<Eigen::Index>(j)]) <= 3.0 * p.std);
   }
   for (const MultiSessionResult& s : id.sessions) {
-    REQUIRE(s.alone.size() == 9);  // the location errors, then the shared effect, each session alone
+    REQUIRE(s.alone.size() ==
+            9);  // the location errors, then the shared effect, each session alone
     CHECK(s.alone[8].name == "gravity_sag_A");
     for (const ParameterEstimate& n : s.nuisances) CHECK(n.name != "gravity_sag_A");
   }
@@ -153,7 +162,8 @@ TEST_CASE("the block-diagonal whitener whitens each session's rows by its own mo
   W.apply(c);
   CHECK(c.topRows(2).isApprox(Eigen::MatrixXd::Constant(2, 2, 2.0)));
   CHECK(c.bottomRows(3).isApprox(0.5 * lower));
-  CHECK_THROWS_AS(BlockDiagonalWhitener({{4, ar, 1.0}}), InvalidArgument);   // 3-row whitener on 4 rows
+  CHECK_THROWS_AS(BlockDiagonalWhitener({{4, ar, 1.0}}),
+                  InvalidArgument);  // 3-row whitener on 4 rows
   CHECK_THROWS_AS(BlockDiagonalWhitener({{2, nullptr, 0.0}}), InvalidArgument);
 }
 
@@ -161,14 +171,17 @@ TEST_CASE("white noise handling weights each session by its own residual sigma",
   const MachineModel t = machine_truth();
   MultiFitOptions o;
   o.noise = NoiseHandling::white;
-  const MultiIdentification id = identify_multi(
-      {MultiSessionInput::of("bb", ballbar_session(t, 41)), MultiSessionInput::of("probe", probe_session(t, 42))}, o);
+  const MultiIdentification id =
+      identify_multi({MultiSessionInput::of("bb", ballbar_session(t, 41)),
+                      MultiSessionInput::of("probe", probe_session(t, 42))},
+                     o);
   CHECK(id.converged);
   for (const MultiSessionResult& s : id.sessions) CHECK_FALSE(s.noise_refit);
   // Whitened to unit variance per session: the joint chi2/dof is near 1.
   CHECK(id.summary.chi2_per_dof == Approx(1.0).margin(0.1));
   for (std::size_t j = 0; j < 8; ++j) {
     const ParameterEstimate& p = id.location_errors[j];
-    if (p.observable) CHECK(std::abs(p.value - t.errors.v[static_cast<Eigen::Index>(j)]) <= 3.0 * p.std);
+    if (p.observable)
+      CHECK(std::abs(p.value - t.errors.v[static_cast<Eigen::Index>(j)]) <= 3.0 * p.std);
   }
 }

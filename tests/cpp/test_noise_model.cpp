@@ -1,11 +1,10 @@
 // Tests of the residual noise model: AR order and coefficients recovered within their
 // sampling error, white noise found white, the whitener is the inverse Cholesky factor of the
 // model's covariance, and whitened AR data are white.
-#include <catch2/catch.hpp>
-
 #include <Eigen/Cholesky>
-#include <Eigen/QR>
 #include <Eigen/LU>
+#include <Eigen/QR>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <random>
 
@@ -110,7 +109,8 @@ TEST_CASE("AR(1) coefficient, marginal sigma and correlation time recovered", "[
   }
 }
 
-TEST_CASE("the mean-removal bias of a short stream's AR(1) coefficient is corrected", "[noise_model]") {
+TEST_CASE("the mean-removal bias of a short stream's AR(1) coefficient is corrected",
+          "[noise_model]") {
   // 400 streams of 250 readings (a ballbar test) at rho 0.95: Burg with the mean removed is
   // about (1 + 3 rho) / n = 0.015 low on average; corrected, the mean is within its standard
   // error sqrt((1 - rho^2) / n) / sqrt(400) = 0.001 (4 of them allowed) of rho.
@@ -129,7 +129,8 @@ TEST_CASE("the mean-removal bias of a short stream's AR(1) coefficient is correc
     corrected += C.streams[0].ar[0];
     CHECK(C.streams[0].reflection[0] == C.streams[0].ar[0]);
     const double k = C.streams[0].ar[0];
-    CHECK(C.streams[0].correlation_samples == Approx(std::min((1 + k) / (1 - k), static_cast<double>(n))));
+    CHECK(C.streams[0].correlation_samples ==
+          Approx(std::min((1 + k) / (1 - k), static_cast<double>(n))));
     CHECK(C.streams[0].innovation_sigma_um < M.streams[0].innovation_sigma_um);
   }
   REQUIRE(ar1 > draws * 9 / 10);
@@ -148,7 +149,8 @@ TEST_CASE("the mean-removal bias of a short stream's AR(1) coefficient is correc
 
 TEST_CASE("the whitener is the inverse Cholesky factor of the AR(1) covariance", "[noise_model]") {
   const Layout L = layout(1, 3000, 100.0);
-  const NoiseModel M = estimate_noise_model(L.groups, L.times, noise_gen::ar1(L.groups, L.times, 0.8, 1e-3, 3));
+  const NoiseModel M =
+      estimate_noise_model(L.groups, L.times, noise_gen::ar1(L.groups, L.times, 0.8, 1e-3, 3));
   REQUIRE(M.streams[0].order() == 1);
   const double phi = M.streams[0].ar[0], sx = M.streams[0].marginal_sigma_um * 1e-3;
   // Check on the first 6 readings: the covariance of a stationary AR(1) is sx^2 phi^|i-j|,
@@ -166,7 +168,8 @@ TEST_CASE("the whitener is the inverse Cholesky factor of the AR(1) covariance",
   CHECK(W.triangularView<Eigen::StrictlyUpper>().toDenseMatrix().cwiseAbs().maxCoeff() == 0.0);
 }
 
-TEST_CASE("AR(1) inverse covariance and lag-product Gram matrix equal the whitened products", "[noise_model]") {
+TEST_CASE("AR(1) inverse covariance and lag-product Gram matrix equal the whitened products",
+          "[noise_model]") {
   // Two AR(1) streams with interleaved rows, a white one, an AR(1) one of a single reading,
   // and a row in no stream (the whitener leaves it as it is). V^-1 is written from the
   // definition (the inverse of each stream's sigma^2 phi^|i-j| covariance), independently of
@@ -194,10 +197,12 @@ TEST_CASE("AR(1) inverse covariance and lag-product Gram matrix equal the whiten
     const double phi = s.ar.empty() ? 0.0 : s.ar[0], sx = s.marginal_sigma_um * 1e-3;
     Eigen::MatrixXd C(m, m);
     for (Eigen::Index i = 0; i < m; ++i)
-      for (Eigen::Index j = 0; j < m; ++j) C(i, j) = sx * sx * std::pow(phi, std::abs(static_cast<double>(i - j)));
+      for (Eigen::Index j = 0; j < m; ++j)
+        C(i, j) = sx * sx * std::pow(phi, std::abs(static_cast<double>(i - j)));
     const Eigen::MatrixXd Ci = C.inverse();
     for (Eigen::Index i = 0; i < m; ++i)
-      for (Eigen::Index j = 0; j < m; ++j) Vinv(s.rows[static_cast<std::size_t>(i)], s.rows[static_cast<std::size_t>(j)]) = Ci(i, j);
+      for (Eigen::Index j = 0; j < m; ++j)
+        Vinv(s.rows[static_cast<std::size_t>(i)], s.rows[static_cast<std::size_t>(j)]) = Ci(i, j);
   }
   std::mt19937 rng(5);
   std::normal_distribution<double> N(0.0, 1.0);
@@ -222,7 +227,8 @@ TEST_CASE("AR(1) inverse covariance and lag-product Gram matrix equal the whiten
   CHECK_THROWS_AS(ArWhitener(ar2).apply_inverse_covariance(VJ), InvalidArgument);
 }
 
-TEST_CASE("AR(2) autocovariance from the reflection coefficients agrees with the whitener", "[noise_model]") {
+TEST_CASE("AR(2) autocovariance from the reflection coefficients agrees with the whitener",
+          "[noise_model]") {
   // The autocovariance (Levinson read backwards, then the AR recursion) and the whitener (the
   // forward recursion of prediction errors) are computed independently: W C W^T = I ties them.
   NoiseModel M;
@@ -244,7 +250,8 @@ TEST_CASE("AR(2) autocovariance from the reflection coefficients agrees with the
   CHECK((W * C * W.transpose() - Eigen::MatrixXd::Identity(40, 40)).cwiseAbs().maxCoeff() < 1e-9);
 }
 
-TEST_CASE("a stream with a random walk is whitened by its covariance's Cholesky factor", "[noise_model]") {
+TEST_CASE("a stream with a random walk is whitened by its covariance's Cholesky factor",
+          "[noise_model]") {
   NoiseModel M;
   M.n = 30;
   NoiseStream st;
@@ -275,9 +282,11 @@ TEST_CASE("a stream with a random walk is whitened by its covariance's Cholesky 
   CHECK(Wf.triangularView<Eigen::StrictlyUpper>().toDenseMatrix().cwiseAbs().maxCoeff() == 0.0);
   Eigen::MatrixXd Sf(30, 30);
   for (int i = 0; i < 30; ++i)
-    for (int j = 0; j < 30; ++j) Sf(i, j) = 0.09e-6 * std::pow(0.6, std::abs(i - j)) + 0.01e-6 * std::min(i, j);
+    for (int j = 0; j < 30; ++j)
+      Sf(i, j) = 0.09e-6 * std::pow(0.6, std::abs(i - j)) + 0.01e-6 * std::min(i, j);
   const Eigen::LLT<Eigen::MatrixXd> llt(Sf);
-  CHECK(f.log_det() == Approx(2.0 * Eigen::MatrixXd(llt.matrixL()).diagonal().array().log().sum()).epsilon(1e-10));
+  CHECK(f.log_det() ==
+        Approx(2.0 * Eigen::MatrixXd(llt.matrixL()).diagonal().array().log().sum()).epsilon(1e-10));
   // AR(2) + walk: the dense Cholesky path.
   st.reflection = {0.6, -0.3};
   st.ar = {0.6 * 1.3, -0.3};
@@ -289,7 +298,8 @@ TEST_CASE("a stream with a random walk is whitened by its covariance's Cholesky 
   S2 = P * S2 * P.transpose();
   Eigen::MatrixXd W2 = Eigen::MatrixXd::Identity(30, 30);
   ArWhitener(M).apply(W2);
-  CHECK((W2 * S2 * W2.transpose() - Eigen::MatrixXd::Identity(30, 30)).cwiseAbs().maxCoeff() < 1e-8);
+  CHECK((W2 * S2 * W2.transpose() - Eigen::MatrixXd::Identity(30, 30)).cwiseAbs().maxCoeff() <
+        1e-8);
 }
 
 namespace {
@@ -324,10 +334,13 @@ Eigen::VectorXd project_out(const Eigen::MatrixXd& X, const Eigen::VectorXd& e) 
 // Var(x_{t+h} - x_t) of a stream model: 2 (gamma_0 - gamma_h) + q^2 h (um^2).
 double variogram(const NoiseStream& s, std::size_t h) {
   const std::vector<double> g = ar_autocovariance(s, h + 1);
-  return (2.0 * (g[0] - g[h]) + std::pow(s.random_walk_step_um * 1e-3, 2) * static_cast<double>(h)) * 1e6;
+  return (2.0 * (g[0] - g[h]) +
+          std::pow(s.random_walk_step_um * 1e-3, 2) * static_cast<double>(h)) *
+         1e6;
 }
 
-TEST_CASE("REML recovers AR(1) + random walk from what a fit leaves; white stays white", "[noise_model]") {
+TEST_CASE("REML recovers AR(1) + random walk from what a fit leaves; white stays white",
+          "[noise_model]") {
   // 84 readings per stream cannot tell a walk from an AR(1) near 1 session by session (the
   // likelihood has a ridge along rho-lambda), but the covariance they imply can be checked:
   // the variogram Var(x_{t+h} - x_t), which the parameters' sigmas rest on, at short and long
@@ -335,7 +348,8 @@ TEST_CASE("REML recovers AR(1) + random walk from what a fit leaves; white stays
   const RemlCase c = reml_case();
   const int K = 12;
   const std::size_t lags[3] = {1, 10, 40};
-  double reml_v[3] = {0, 0, 0}, burg_v[3] = {0, 0, 0}, white_v40 = 0.0, q_white = 0.0, rho_white = 0.0;
+  double reml_v[3] = {0, 0, 0}, burg_v[3] = {0, 0, 0}, white_v40 = 0.0, q_white = 0.0,
+         rho_white = 0.0;
   for (int k = 0; k < K; ++k) {
     const Eigen::VectorXd e = noise_gen::ar1(c.groups, c.times, 0.9, 0.3e-3, 100 + k) +
                               noise_gen::probe_zero_wander(c.groups, c.times, 0.1e-3, 200 + k);
@@ -354,17 +368,20 @@ TEST_CASE("REML recovers AR(1) + random walk from what a fit leaves; white stays
     Eigen::VectorXd w(c.X.rows());
     for (Eigen::Index i = 0; i < w.size(); ++i) w[i] = N(rng);
     const Eigen::VectorXd rw = project_out(c.X, w);
-    const NoiseModel Mw = estimate_noise_model_reml(estimate_noise_model(c.groups, c.times, rw), rw, c.X);
+    const NoiseModel Mw =
+        estimate_noise_model_reml(estimate_noise_model(c.groups, c.times, rw), rw, c.X);
     q_white += Mw.random_walk_step_um / K, rho_white += Mw.streams[0].ar[0] / K;
     white_v40 += variogram(Mw.streams[0], 40) / K;
   }
   double truth[3];
   for (int l = 0; l < 3; ++l)
-    truth[l] = 2 * 0.09 * (1 - std::pow(0.9, static_cast<double>(lags[l]))) + 0.01 * static_cast<double>(lags[l]);
-  INFO("variogram at lags 1, 10, 40 (um^2): truth " << truth[0] << ", " << truth[1] << ", " << truth[2]
-       << "; REML " << reml_v[0] << ", " << reml_v[1] << ", " << reml_v[2] << "; Burg on the residuals "
-       << burg_v[0] << ", " << burg_v[1] << ", " << burg_v[2] << "; white: rho " << rho_white << ", walk "
-       << q_white << " um, lag 40 " << white_v40);
+    truth[l] = 2 * 0.09 * (1 - std::pow(0.9, static_cast<double>(lags[l]))) +
+               0.01 * static_cast<double>(lags[l]);
+  INFO("variogram at lags 1, 10, 40 (um^2): truth "
+       << truth[0] << ", " << truth[1] << ", " << truth[2] << "; REML " << reml_v[0] << ", "
+       << reml_v[1] << ", " << reml_v[2] << "; Burg on the residuals " << burg_v[0] << ", "
+       << burg_v[1] << ", " << burg_v[2] << "; white: rho " << rho_white << ", walk " << q_white
+       << " um, lag 40 " << white_v40);
   // Means over 12 sessions x 6 streams: within 25 % (the session-to-session spread is ~40 %).
   for (int l = 0; l < 3; ++l) CHECK(reml_v[l] == Approx(truth[l]).epsilon(0.25));
   // What the old estimate missed: the residuals' Burg model sees the long lags far too small.
@@ -372,7 +389,8 @@ TEST_CASE("REML recovers AR(1) + random walk from what a fit leaves; white stays
   CHECK(std::abs(rho_white) < 0.05);
   CHECK(q_white < 0.02);
   CHECK(white_v40 == Approx(2 * 0.09).epsilon(0.1));
-  CHECK_THROWS_WITH(estimate_noise_model_reml(NoiseModel{}, Eigen::VectorXd::Zero(3), Eigen::MatrixXd::Zero(3, 1)),
+  CHECK_THROWS_WITH(estimate_noise_model_reml(NoiseModel{}, Eigen::VectorXd::Zero(3),
+                                              Eigen::MatrixXd::Zero(3, 1)),
                     Catch::Contains("must agree"));
 }
 
@@ -390,7 +408,8 @@ TEST_CASE("whitened AR and 1/f-like data are white with unit variance", "[noise_
     for (int s = 0; s < 2; ++s) {
       const Eigen::VectorXd x = w.col(0).segment(s * n, n);
       // Sampling error of a white autocorrelation: 1/sqrt(n); of a variance: sqrt(2/n).
-      for (int lag = 1; lag <= 5; ++lag) CHECK(std::abs(autocorrelation(x, lag)) < 4 / std::sqrt(n));
+      for (int lag = 1; lag <= 5; ++lag)
+        CHECK(std::abs(autocorrelation(x, lag)) < 4 / std::sqrt(n));
       CHECK(std::abs(x.squaredNorm() / n - 1.0) < 4 * std::sqrt(2.0 / n));
     }
     // The raw data are far from white at lag 1.
@@ -412,7 +431,8 @@ TEST_CASE("readings that share a time stamp are separate channels", "[noise_mode
   CHECK(streams[1][0] == 1);
   CHECK(streams[1][1] == 4);
   // A probe zero wandering between poses is a random walk: strongly correlated per channel.
-  const Eigen::VectorXd r = noise_gen::probe_zero_wander(g, t, 0.1e-3, 9) + noise_gen::ar1(g, t, 0.0, 0.3e-3, 10);
+  const Eigen::VectorXd r =
+      noise_gen::probe_zero_wander(g, t, 0.1e-3, 9) + noise_gen::ar1(g, t, 0.0, 0.3e-3, 10);
   const NoiseModel M = estimate_noise_model(g, t, r);
   CHECK(M.streams.size() == 3);
   CHECK_FALSE(M.white());
@@ -446,7 +466,8 @@ TEST_CASE("bad input to the noise model names what was wrong", "[noise_model]") 
   CHECK_THROWS_WITH(estimate_noise_model(L.groups, L.times, r), Catch::Contains("residuals[3]"));
   NoiseModelOptions o;
   o.max_order = -1;
-  CHECK_THROWS_AS(estimate_noise_model(L.groups, L.times, Eigen::VectorXd::Zero(10), o), InvalidArgument);
+  CHECK_THROWS_AS(estimate_noise_model(L.groups, L.times, Eigen::VectorXd::Zero(10), o),
+                  InvalidArgument);
   const NoiseModel M = estimate_noise_model(L.groups, L.times, Eigen::VectorXd::Ones(10));
   Eigen::MatrixXd wrong(4, 1);
   CHECK_THROWS_WITH(ArWhitener(M).apply(wrong), Catch::Contains("4 rows given"));
@@ -471,7 +492,8 @@ TEST_CASE("Burg's reflection coefficients agree with the textbook recursion", "[
   std::vector<double> b = f;
   for (std::size_t m = 1; m <= k.size(); ++m) {
     double num = 0.0, den = 0.0;
-    for (std::size_t t = m; t < f.size(); ++t) num += f[t] * b[t - 1], den += f[t] * f[t] + b[t - 1] * b[t - 1];
+    for (std::size_t t = m; t < f.size(); ++t)
+      num += f[t] * b[t - 1], den += f[t] * f[t] + b[t - 1] * b[t - 1];
     const double km = 2.0 * num / den;
     CHECK(k[m - 1] == Approx(km).epsilon(1e-12));
     for (std::size_t t = f.size() - 1; t >= m; --t) {
@@ -481,7 +503,8 @@ TEST_CASE("Burg's reflection coefficients agree with the textbook recursion", "[
   }
 }
 
-TEST_CASE("a noise model on a stream layout built once equals the one from groups and times", "[noise_model]") {
+TEST_CASE("a noise model on a stream layout built once equals the one from groups and times",
+          "[noise_model]") {
   // The diagnosis builds the layout once and models many residual vectors on it; the structure
   // test models the other groups' residuals on layout.except_group(g).
   Layout L = layout(3, 120, 200.0);
@@ -503,15 +526,20 @@ TEST_CASE("a noise model on a stream layout built once equals the one from group
     std::vector<double> t;
     std::vector<double> rv;
     for (std::size_t i = 0; i < L.groups.size(); ++i)
-      if (L.groups[i] != "test1") g.push_back(L.groups[i]), t.push_back(L.times[i]), rv.push_back(r[static_cast<Eigen::Index>(i)]);
-    const NoiseModel c = estimate_noise_model(g, t, Eigen::Map<const Eigen::VectorXd>(rv.data(), static_cast<Eigen::Index>(rv.size())), o);
+      if (L.groups[i] != "test1")
+        g.push_back(L.groups[i]), t.push_back(L.times[i]),
+            rv.push_back(r[static_cast<Eigen::Index>(i)]);
+    const NoiseModel c = estimate_noise_model(
+        g, t, Eigen::Map<const Eigen::VectorXd>(rv.data(), static_cast<Eigen::Index>(rv.size())),
+        o);
     const NoiseModel d = estimate_noise_model(layout_all.except_group("test1"), r, o);
     REQUIRE(c.streams.size() == 2);
     REQUIRE(d.streams.size() == 2);
     for (std::size_t s = 0; s < 2; ++s) {
       CHECK(c.streams[s].group == d.streams[s].group);
       CHECK(c.streams[s].reflection == d.streams[s].reflection);
-      CHECK(c.streams[s].marginal_sigma_um == Approx(d.streams[s].marginal_sigma_um).epsilon(1e-12));
+      CHECK(c.streams[s].marginal_sigma_um ==
+            Approx(d.streams[s].marginal_sigma_um).epsilon(1e-12));
     }
   }
   CHECK_THROWS_WITH(estimate_noise_model(layout_all, Eigen::VectorXd::Zero(5)),

@@ -4,7 +4,6 @@
 // options are refused by name; the separation search says which pairs no probe test can
 // separate and finds poses for one it can.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <random>
 
@@ -23,7 +22,8 @@ ProbeDesignOptions options_for(const char* machine) {
 
 // The variance of each location error's estimate over simulated sessions of `pattern` (random
 // location errors and sphere set-up error, white noise o.noise_um), divided by the predicted.
-std::vector<double> realised_over_predicted(const ProbeDesignCandidate& c, const ProbeDesignOptions& o, int draws) {
+std::vector<double> realised_over_predicted(const ProbeDesignCandidate& c,
+                                            const ProbeDesignOptions& o, int draws) {
   std::mt19937_64 rng(7);
   std::normal_distribution<double> g(0.0, 1.0);
   std::vector<double> sum(8, 0.0);
@@ -36,10 +36,12 @@ std::vector<double> realised_over_predicted(const ProbeDesignCandidate& c, const
     so.seed = 100 + static_cast<std::uint64_t>(d);
     so.sphere_offset = Eigen::Vector3d(g(rng), g(rng), g(rng)) * 0.05;
     const ProbeIdentification id = identify_probe(simulate_probe(t, so).session);
-    for (int k = 0; k < 8; ++k) sum[static_cast<std::size_t>(k)] += std::pow(id.model.errors.v[k] - t.errors.v[k], 2);
+    for (int k = 0; k < 8; ++k)
+      sum[static_cast<std::size_t>(k)] += std::pow(id.model.errors.v[k] - t.errors.v[k], 2);
   }
   std::vector<double> out;
-  for (int k = 0; k < 8; ++k) out.push_back(std::sqrt(sum[static_cast<std::size_t>(k)] / draws) / c.sigma[k]);
+  for (int k = 0; k < 8; ++k)
+    out.push_back(std::sqrt(sum[static_cast<std::size_t>(k)] / draws) / c.sigma[k]);
   return out;
 }
 }  // namespace
@@ -48,9 +50,9 @@ TEST_CASE("the design beats the default poses at the same number of touches", "[
   for (const char* name : {"AC-trt", "BC-trt"}) {
     const ProbeDesignOptions o = options_for(name);
     const ProbeDesign d = design_probe_test(o);
-    INFO(name << ": designed " << d.best.worst_expanded_um << " um (" << d.best.worst_error << "), default "
-              << d.baseline.worst_expanded_um << " um (" << d.baseline.worst_error << "), " << d.best.pattern.poses_deg.size()
-              << " visits");
+    INFO(name << ": designed " << d.best.worst_expanded_um << " um (" << d.best.worst_error
+              << "), default " << d.baseline.worst_expanded_um << " um (" << d.baseline.worst_error
+              << "), " << d.best.pattern.poses_deg.size() << " visits");
     REQUIRE(d.best.feasible);
     REQUIRE(d.baseline.feasible);
     CHECK(d.touches == 120);
@@ -59,14 +61,16 @@ TEST_CASE("the design beats the default poses at the same number of touches", "[
   }
 }
 
-TEST_CASE("touch by touch, with the sphere's place: each pose its own directions, plannable", "[probe][design]") {
+TEST_CASE("touch by touch, with the sphere's place: each pose its own directions, plannable",
+          "[probe][design]") {
   ProbeDesignOptions o = options_for("B-head-C-table");
   o.touch_directions = true;
   o.sphere_candidates = {Eigen::Vector3d(300.0, 0.0, 40.0)};
   const ProbeDesign d = design_probe_test(o);
   REQUIRE(d.best.feasible);
   REQUIRE(d.baseline.feasible);
-  INFO("designed " << d.best.worst_expanded_um << " um, default " << d.baseline.worst_expanded_um << " um");
+  INFO("designed " << d.best.worst_expanded_um << " um, default " << d.baseline.worst_expanded_um
+                   << " um");
   CHECK(d.ratio <= 0.7);  // 0.93 with the default directions at the default sphere (docs/design.md)
   CHECK(d.sphere.isApprox(Eigen::Vector3d(300.0, 0.0, 40.0)));
   CHECK(d.best.pattern.sphere.isApprox(d.sphere));
@@ -85,7 +89,8 @@ TEST_CASE("touch by touch, with the sphere's place: each pose its own directions
   CHECK_THROWS_AS(simulate_probe(MachineModel::nominal(o.machine), so), InvalidArgument);
 }
 
-TEST_CASE("the designed poses are within the axis limits, plannable, and their sigma is realised", "[probe][design]") {
+TEST_CASE("the designed poses are within the axis limits, plannable, and their sigma is realised",
+          "[probe][design]") {
   for (const char* name : {"AC-trt", "BC-trt"}) {
     ProbeDesignOptions o = options_for(name);
     o.touches = 60;
@@ -100,7 +105,8 @@ TEST_CASE("the designed poses are within the axis limits, plannable, and their s
     }
     const std::vector<double> r = realised_over_predicted(d.best, o, 60);
     for (int k = 0; k < 8; ++k) {
-      INFO(name << " " << d.best.names[static_cast<std::size_t>(k)] << ": realised / predicted " << r[static_cast<std::size_t>(k)]);
+      INFO(name << " " << d.best.names[static_cast<std::size_t>(k)] << ": realised / predicted "
+                << r[static_cast<std::size_t>(k)]);
       CHECK(r[static_cast<std::size_t>(k)] >= 0.7);
       CHECK(r[static_cast<std::size_t>(k)] <= 1.4);
     }
@@ -181,13 +187,14 @@ ProbeSession session_with(const std::vector<std::string>& ids) {
 }
 }  // namespace
 
-TEST_CASE("separation: added poses that tell radial from tilt motion of A", "[probe][design][separation]") {
+TEST_CASE("separation: added poses that tell radial from tilt motion of A",
+          "[probe][design][separation]") {
   // The default poses tilt A at C 0 only, where the sphere lies at one distance along the A
   // axis: the second harmonics of the radial and the tilt motion of A read alike there. At C
   // 180 the lever arm of the tilt changes sign.
   const ProbeSession s = session_with({"radial_motion_A_h2", "tilt_motion_A_h2"});
-  const ProbeSeparationDesign D =
-      design_probe_separation(s, {Effect::parse("radial_motion_A_h2"), Effect::parse("tilt_motion_A_h2")});
+  const ProbeSeparationDesign D = design_probe_separation(
+      s, {Effect::parse("radial_motion_A_h2"), Effect::parse("tilt_motion_A_h2")});
   INFO(D.verdict);
   CHECK_FALSE(D.motion.same_motion);
   CHECK(D.correlation_before > 0.9);
@@ -200,10 +207,11 @@ TEST_CASE("separation: added poses that tell radial from tilt motion of A", "[pr
   CHECK(D.sigma_after.size() == D.sigma_before.size());
 }
 
-TEST_CASE("separation: gravity sag and the second radial harmonic of A, no probe test", "[probe][design][separation]") {
+TEST_CASE("separation: gravity sag and the second radial harmonic of A, no probe test",
+          "[probe][design][separation]") {
   const ProbeSession s = session_with({"gravity_sag_A"});
-  const ProbeSeparationDesign D =
-      design_probe_separation(s, {Effect::parse("gravity_sag_A"), Effect::parse("radial_motion_A_h2")});
+  const ProbeSeparationDesign D = design_probe_separation(
+      s, {Effect::parse("gravity_sag_A"), Effect::parse("radial_motion_A_h2")});
   CHECK(D.motion.same_motion);
   CHECK_FALSE(D.found);
   CHECK(D.candidates_tried == 0);
@@ -216,14 +224,17 @@ TEST_CASE("separation: gravity sag and the second radial harmonic of A, no probe
   }
 }
 
-TEST_CASE("separation: the joint fit of the session and the added poses realises the predicted sigma",
-          "[probe][design][separation][statistical]") {
+TEST_CASE(
+    "separation: the joint fit of the session and the added poses realises the predicted sigma",
+    "[probe][design][separation][statistical]") {
   MachineModel t = MachineModel::nominal(MachineType::AC_trt);
-  t.effects = EffectModel{{Effect::parse("radial_motion_A_h2"), Effect::parse("tilt_motion_A_h2")}, std::nullopt};
+  t.effects = EffectModel{{Effect::parse("radial_motion_A_h2"), Effect::parse("tilt_motion_A_h2")},
+                          std::nullopt};
   t.effect_params = {0.002, -0.001, 0.0015, 0.0, 1e-5, 0.0, -2e-5, 1e-5};
   ProbeSimOptions so;
   so.pattern = default_probe_pattern(t.machine);
-  const ProbeSeparationDesign D = design_probe_separation(simulate_probe(t, so).session, t.effects.effects);
+  const ProbeSeparationDesign D =
+      design_probe_separation(simulate_probe(t, so).session, t.effects.effects);
   REQUIRE(D.found);
   // The session's poses, then the added ones as often as the design runs them.
   for (int r = 0; r < static_cast<int>(D.chosen.repeats); ++r)
@@ -240,12 +251,14 @@ TEST_CASE("separation: the joint fit of the session and the added poses realises
     for (int k = 0; k < 8; ++k) m.errors.v[k] = g(rng) * (location_error_is_angle(k) ? 5e-5 : 0.02);
     so.seed = 300 + static_cast<std::uint64_t>(d);
     const ProbeIdentification id = identify_probe(simulate_probe(m, so).session, fo);
-    for (std::size_t k = 0; k < 8; ++k) sum[k] += std::pow(id.model.effect_params[k] - t.effect_params[k], 2);
+    for (std::size_t k = 0; k < 8; ++k)
+      sum[k] += std::pow(id.model.effect_params[k] - t.effect_params[k], 2);
   }
   const std::size_t first = D.names.size() - 8;  // the pair's parameters close the layout
   for (std::size_t k = 0; k < 8; ++k) {
     const double predicted = D.sigma_after[static_cast<Eigen::Index>(first + k)];
-    INFO(D.names[first + k] << ": realised " << std::sqrt(sum[k] / draws) << ", predicted " << predicted);
+    INFO(D.names[first + k] << ": realised " << std::sqrt(sum[k] / draws) << ", predicted "
+                            << predicted);
     REQUIRE(std::isfinite(predicted));
     CHECK(std::sqrt(sum[k] / draws) / predicted >= 0.7);
     CHECK(std::sqrt(sum[k] / draws) / predicted <= 1.4);

@@ -1,9 +1,8 @@
 // Identification of touch-probe sessions (probe/identify.hpp, probe/problem.hpp): the joint fit
 // finds the independent implementation's errors within 3 sigma, finds simulated errors in
-// coloured noise with an effect fitted along, its sigma agrees with the scatter of repeated draws, and the cycles' method is exact on
-// noiseless data.
+// coloured noise with an effect fitted along, its sigma agrees with the scatter of repeated draws,
+// and the cycles' method is exact on noiseless data.
 #include <catch2/catch.hpp>
-
 #include <fstream>
 #include <sstream>
 
@@ -31,7 +30,8 @@ MachineModel plausible_machine(MachineType m) {
 }
 }  // namespace
 
-TEST_CASE("the joint fit finds the independent session's errors within 3 sigma", "[probe][identify]") {
+TEST_CASE("the joint fit finds the independent session's errors within 3 sigma",
+          "[probe][identify]") {
   const ProbeSession s = read_probe(kShared + "/data/probe_ac_table2.csv");
   std::ifstream in(kShared + "/data/probe_ac_table2.truth.json");
   const std::string truth((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -47,7 +47,8 @@ TEST_CASE("the joint fit finds the independent session's errors within 3 sigma",
   }
   const char* axes[3] = {"sphere.x", "sphere.y", "sphere.z"};
   for (int k = 0; k < 3; ++k)
-    CHECK(std::abs(id.parameter(axes[k]).value - truth_value(truth, "sphere_actual", k)) <= 3 * id.parameter(axes[k]).std);
+    CHECK(std::abs(id.parameter(axes[k]).value - truth_value(truth, "sphere_actual", k)) <=
+          3 * id.parameter(axes[k]).std);
 }
 
 TEST_CASE("coloured noise and a stylus offset: every error within 3 sigma on every table machine",
@@ -85,7 +86,8 @@ TEST_CASE("coloured noise and a stylus offset: every error within 3 sigma on eve
   }
 }
 
-TEST_CASE("the joint fit's sigma matches the scatter over draws (white noise)", "[probe][identify]") {
+TEST_CASE("the joint fit's sigma matches the scatter over draws (white noise)",
+          "[probe][identify]") {
   const MachineModel t = plausible_machine(MachineType::AC_trt);
   ProbeSimOptions o;
   o.pattern = default_probe_pattern(t.machine);
@@ -108,7 +110,8 @@ TEST_CASE("the joint fit's sigma matches the scatter over draws (white noise)", 
   }
 }
 
-TEST_CASE("the cycles' method is exact on noiseless data and refuses head machines", "[probe][cycles]") {
+TEST_CASE("the cycles' method is exact on noiseless data and refuses head machines",
+          "[probe][cycles]") {
   for (const char* name : {"AC-trt", "BC-trt"}) {
     const MachineModel t = plausible_machine(parse_machine_type(name));
     ProbeSimOptions o;
@@ -128,7 +131,8 @@ TEST_CASE("the cycles' method is exact on noiseless data and refuses head machin
   }
   ProbeSimOptions o;
   o.pattern = default_probe_pattern(parse_machine_type("B-head-C-table"));
-  const ProbeSession head = simulate_probe(MachineModel::nominal(parse_machine_type("B-head-C-table")), o).session;
+  const ProbeSession head =
+      simulate_probe(MachineModel::nominal(parse_machine_type("B-head-C-table")), o).session;
   CHECK_THROWS_AS(identify_probe_cycles(head), InvalidArgument);
   // Too few poses about one axis alone: named.
   ProbeSimOptions few;

@@ -3,7 +3,6 @@
 // values (the touches are moved onto the identified machine) by the reported 1-sigma, and a fit
 // that is not the joint fit of the session is refused.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <string>
 
@@ -13,7 +12,8 @@
 
 using namespace rotacal;
 
-TEST_CASE("the probe Monte Carlo scatters about the identified values by the reported sigma", "[probe][mc]") {
+TEST_CASE("the probe Monte Carlo scatters about the identified values by the reported sigma",
+          "[probe][mc]") {
   const ProbeSession s = read_probe(std::string(ROTACAL_SHARED_DIR) + "/data/probe_ac_table2.csv");
   const ProbeIdentification id = identify_probe(s);
   ProbeMonteCarloOptions o;
@@ -22,7 +22,8 @@ TEST_CASE("the probe Monte Carlo scatters about the identified values by the rep
   const ProbeMonteCarlo mc = monte_carlo_probe(s, id, o);
   CHECK(mc.noise == "white noise");
   CHECK(mc.noise_um == id.sigma_um);
-  REQUIRE(mc.parameters.size() == id.parameters.size());  // 8 location errors and the sphere, all observable
+  REQUIRE(mc.parameters.size() ==
+          id.parameters.size());  // 8 location errors and the sphere, all observable
   for (const MonteCarloParameter& p : mc.parameters) {
     INFO(p.name << ": ratio " << p.ratio << ", bias " << p.bias << ", std_mc " << p.std_mc);
     // 400 draws: the sample sigma is within ~3.5 % (1 sigma) of the truth.
@@ -38,7 +39,8 @@ TEST_CASE("the probe Monte Carlo refuses what is not the joint fit of the sessio
   CHECK_THROWS_AS(monte_carlo_probe(s, identify_probe_cycles(s)), InvalidArgument);
   ProbeMonteCarloOptions one;
   one.draws = 1;
-  CHECK_THROWS_WITH(monte_carlo_probe(s, identify_probe(s), one), Catch::Contains("draws must be at least 2"));
+  CHECK_THROWS_WITH(monte_carlo_probe(s, identify_probe(s), one),
+                    Catch::Contains("draws must be at least 2"));
   ProbeSession fewer = s;
   fewer.samples.pop_back();
   CHECK_THROWS_AS(monte_carlo_probe(fewer, identify_probe(s)), InvalidArgument);

@@ -3,7 +3,6 @@
 // back into the plan's rows. Its moves are checked against LinuxCNC's own interpreter and the
 // reference simulator in tests/python/test_probe_plan.py.
 #include <catch2/catch.hpp>
-
 #include <filesystem>
 #include <fstream>
 
@@ -29,8 +28,9 @@ TEST_CASE("one G38.2 and one LOG per touch, between LOGOPEN and LOGCLOSE", "[pro
   CHECK(text.find("(LOGCLOSE)\nM2\n") != std::string::npos);
   CHECK(text.find("(LOG,24 5 #5061 #5062 #5063)") != std::string::npos);
   for (NcDialect d : {NcDialect::heidenhain, NcDialect::siemens, NcDialect::fanuc})
-    CHECK_THROWS_WITH(write_probe_nc_program(MachineType::AC_trt, P, d),
-                      Catch::Contains("no checkable probing words") && Catch::Contains(to_string(d)));
+    CHECK_THROWS_WITH(
+        write_probe_nc_program(MachineType::AC_trt, P, d),
+        Catch::Contains("no checkable probing words") && Catch::Contains(to_string(d)));
 }
 
 TEST_CASE("moves start outside the trigger sphere and end inside it, along n", "[probe][plan]") {
@@ -51,19 +51,24 @@ TEST_CASE("limits, travel and a way up through the sphere are refused", "[probe]
   ProbePattern beyond = default_probe_pattern(head);
   CHECK_NOTHROW(probe_moves(head, beyond, {}));
   beyond.poses_deg.push_back({-150.0, 0.0});
-  CHECK_THROWS_WITH(probe_moves(head, beyond, {}), Catch::Contains("B -150 deg is outside the axis limits"));
+  CHECK_THROWS_WITH(probe_moves(head, beyond, {}),
+                    Catch::Contains("B -150 deg is outside the axis limits"));
   ProbePattern high = P;
   high.sphere.z() = 380.0;  // the retract plane above Z's travel (-300..400 mm)
-  CHECK_THROWS_WITH(probe_moves(MachineType::AC_trt, high, {}), Catch::Contains("Z") && Catch::Contains("travel"));
+  CHECK_THROWS_WITH(probe_moves(MachineType::AC_trt, high, {}),
+                    Catch::Contains("Z") && Catch::Contains("travel"));
   ProbePattern below = P;
-  below.directions.push_back(Eigen::Vector3d(0.0, 0.0, 1.0));  // from underneath: the way up hits it
-  CHECK_THROWS_WITH(probe_moves(MachineType::AC_trt, below, {}), Catch::Contains("passes through the sphere"));
+  below.directions.push_back(
+      Eigen::Vector3d(0.0, 0.0, 1.0));  // from underneath: the way up hits it
+  CHECK_THROWS_WITH(probe_moves(MachineType::AC_trt, below, {}),
+                    Catch::Contains("passes through the sphere"));
   ProbeProgramOptions o;
   o.overtravel_mm = 20.0;
   CHECK_THROWS_AS(probe_moves(MachineType::AC_trt, P, o), InvalidArgument);
 }
 
-TEST_CASE("the log is read back into the plan's rows, and a bad log is refused by line", "[probe][plan]") {
+TEST_CASE("the log is read back into the plan's rows, and a bad log is refused by line",
+          "[probe][plan]") {
   ProbePattern P = default_probe_pattern(MachineType::AC_trt);
   P.poses_deg.resize(2);
   ProbeSimOptions so;
@@ -71,7 +76,8 @@ TEST_CASE("the log is read back into the plan's rows, and a bad log is refused b
   so.noise_um = 0.0;
   MachineModel nominal = MachineModel::nominal(MachineType::AC_trt);
   const ProbeSession plan = simulate_probe(nominal, so).session;
-  const std::string path = (std::filesystem::temp_directory_path() / "rotacal_test_probe.log").string();
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "rotacal_test_probe.log").string();
   {
     std::ofstream f(path);
     for (std::size_t i = 0; i < plan.samples.size(); ++i)
@@ -85,7 +91,8 @@ TEST_CASE("the log is read back into the plan's rows, and a bad log is refused b
     std::ofstream f(path);
     f << "1 1 1 2 3\n1 3 1 2 3\n";
   }
-  CHECK_THROWS_WITH(read_linuxcnc_probe_log(path, plan), Catch::Contains(":2:") && Catch::Contains("out of order"));
+  CHECK_THROWS_WITH(read_linuxcnc_probe_log(path, plan),
+                    Catch::Contains(":2:") && Catch::Contains("out of order"));
   {
     std::ofstream f(path);
     f << "1 1 1 2\n";

@@ -49,7 +49,8 @@ TEST_CASE("the probe problem's Jacobian agrees with central differences", "[prob
   o.pattern = default_probe_pattern(t.machine);
   const ProbeSession s = simulate_probe(t, o).session;
   const EffectModel fx{{Effect::parse("stylus_radius_offset"), Effect::parse("probe_lobing"),
-                        Effect::parse("tilt_motion_C_h2")}, std::nullopt};
+                        Effect::parse("tilt_motion_C_h2")},
+                       std::nullopt};
   const ProbeProblem problem(s, fx);
   const ProbeParameterLayout& L = problem.layout();
   CHECK(L.size() == 8 + 3 + 1 + 2 + 4);
@@ -70,4 +71,3 @@ TEST_CASE("the probe problem's Jacobian agrees with central differences", "[prob
     CHECK((J.col(k) - fd).cwiseAbs().maxCoeff() <= 1e-6 * (1.0 + fd.cwiseAbs().maxCoeff()));
   }
 }
-

@@ -2,7 +2,6 @@
 // session: with the truth file's errors and sphere it reproduces the latched positions of
 // ../shared/data/probe_ac_table2.csv to within their noise, and the nominal machine does not.
 #include <catch2/catch.hpp>
-
 #include <fstream>
 #include <sstream>
 
@@ -48,7 +47,8 @@ ProbePattern pattern_of(const ProbeSession& s) {
 
 double rms_um(const ProbeSession& a, const ProbeSession& b) {
   double ss = 0.0;
-  for (std::size_t i = 0; i < a.samples.size(); ++i) ss += (a.samples[i].xyz - b.samples[i].xyz).squaredNorm();
+  for (std::size_t i = 0; i < a.samples.size(); ++i)
+    ss += (a.samples[i].xyz - b.samples[i].xyz).squaredNorm();
   return std::sqrt(ss / (3.0 * static_cast<double>(a.samples.size()))) * 1e3;
 }
 }  // namespace
@@ -59,7 +59,8 @@ TEST_CASE("the simulator reproduces the independent probe session", "[probe][con
   const std::string truth((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   MachineModel m = MachineModel::nominal(MachineType::AC_trt);
   const auto& names = location_error_names(m.machine);
-  for (int k = 0; k < 8; ++k) m.errors.v[k] = truth_numbers(truth, names[static_cast<std::size_t>(k)], 1)[0];
+  for (int k = 0; k < 8; ++k)
+    m.errors.v[k] = truth_numbers(truth, names[static_cast<std::size_t>(k)], 1)[0];
   const std::vector<double> sphere = truth_numbers(truth, "sphere_actual", 3);
   ProbeSimOptions o;
   o.pattern = pattern_of(file);
@@ -70,7 +71,8 @@ TEST_CASE("the simulator reproduces the independent probe session", "[probe][con
   const double noise = truth_numbers(truth, "noise_um", 1)[0];
   CHECK(rms_um(sim, file) == Approx(noise).margin(0.15 * noise));
   // Teeth: without the location errors the positions are far off.
-  CHECK(rms_um(simulate_probe(MachineModel::nominal(MachineType::AC_trt), o).session, file) > 5 * noise);
+  CHECK(rms_um(simulate_probe(MachineModel::nominal(MachineType::AC_trt), o).session, file) >
+        5 * noise);
 }
 
 TEST_CASE("simulated touches lie on the truth's sphere, noise as asked", "[probe]") {
@@ -78,7 +80,8 @@ TEST_CASE("simulated touches lie on the truth's sphere, noise as asked", "[probe
     MachineModel m = MachineModel::nominal(parse_machine_type(name));
     m.errors.v << 0.03, -0.02, 2e-5, -3e-5, 0.01, 0.04, -1e-5, 2e-5;
     m.effects = EffectModel{{Effect::parse("stylus_radius_offset"), Effect::parse("probe_lobing"),
-                             Effect::parse("angular_positioning_C_h1")}, std::nullopt};
+                             Effect::parse("angular_positioning_C_h1")},
+                            std::nullopt};
     m.effect_params = {2e-3, 0.8e-3, -0.4e-3, 2e-5, 1e-5};
     ProbeSimOptions o;
     o.pattern = default_probe_pattern(m.machine);
@@ -94,8 +97,9 @@ TEST_CASE("simulated touches lie on the truth's sphere, noise as asked", "[probe
       ProbeTouch t;
       t.xyz = x.xyz, t.n = x.n, t.angles = x.angles_rad(), t.time = x.time;
       t.n_spindle = spindle_frame_direction(m.machine, t.angles, t.n);
-      worst = std::max(worst, std::abs(touch_residual<double>(m.machine, m.errors, fx, m.effect_params.data(),
-                                                              sim.sphere_actual, t, s.trigger_radius())));
+      worst = std::max(
+          worst, std::abs(touch_residual<double>(m.machine, m.errors, fx, m.effect_params.data(),
+                                                 sim.sphere_actual, t, s.trigger_radius())));
     }
     INFO(name);
     CHECK(worst < 1e-9);  // the lobing shift is exact in the latched position (touch_model.hpp)
@@ -103,17 +107,22 @@ TEST_CASE("simulated touches lie on the truth's sphere, noise as asked", "[probe
     o.noise_um = 1.0;
     o.ar1_rho = 0.9;
     o.pattern.poses_deg.resize(12);
-    for (int k = 0; k < 30; ++k) o.pattern.poses_deg.push_back(o.pattern.poses_deg[static_cast<std::size_t>(k)]);
+    for (int k = 0; k < 30; ++k)
+      o.pattern.poses_deg.push_back(o.pattern.poses_deg[static_cast<std::size_t>(k)]);
     const ProbeSession noisy = simulate_probe(m, o).session;
     o.noise_um = 0.0;
     const ProbeSession clean = simulate_probe(m, o).session;
     const Eigen::Index n = static_cast<Eigen::Index>(noisy.samples.size());
     Eigen::MatrixXd e(n, 3);  // one stream per coordinate, touches in time order
     for (Eigen::Index i = 0; i < n; ++i)
-      e.row(i) = (noisy.samples[static_cast<std::size_t>(i)].xyz - clean.samples[static_cast<std::size_t>(i)].xyz).transpose();
-    const double lag1 = (e.topRows(n - 1).array() * e.bottomRows(n - 1).array()).sum() / e.squaredNorm();
+      e.row(i) = (noisy.samples[static_cast<std::size_t>(i)].xyz -
+                  clean.samples[static_cast<std::size_t>(i)].xyz)
+                     .transpose();
+    const double lag1 =
+        (e.topRows(n - 1).array() * e.bottomRows(n - 1).array()).sum() / e.squaredNorm();
     CHECK(lag1 > 0.75);
-    CHECK(std::sqrt(e.squaredNorm() / static_cast<double>(e.size())) * 1e3 == Approx(1.0).margin(0.4));
+    CHECK(std::sqrt(e.squaredNorm() / static_cast<double>(e.size())) * 1e3 ==
+          Approx(1.0).margin(0.4));
   }
 }
 

@@ -1,6 +1,6 @@
-#include <catch2/catch.hpp>
 #include <ceres/jet.h>
 
+#include <catch2/catch.hpp>
 #include <random>
 
 #include "rotacal/kinematics/rotation.hpp"
@@ -31,8 +31,8 @@ TEST_CASE("rotation_about_line: points on the line stay, distances are kept", "[
   CHECK((T.R.transpose() * T.R - Eigen::Matrix3d::Identity()).norm() < 1e-14);
   CHECK_THAT(T.R.determinant(), WithinAbs(1.0, 1e-14));
   // Right-handed: +90 deg about +Z takes +X to +Y.
-  const Pose<double> Rz = rotation_about_line<double>(Eigen::Vector3d::Zero(),
-                                                       Eigen::Vector3d::UnitZ(), M_PI / 2);
+  const Pose<double> Rz =
+      rotation_about_line<double>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), M_PI / 2);
   CHECK((Rz * Eigen::Vector3d::UnitX() - Eigen::Vector3d::UnitY()).norm() < 1e-15);
 }
 
@@ -65,8 +65,7 @@ TEST_CASE("rotation_about_line is differentiable with ceres::Jet", "[rotation][j
   const Vec3<J> aj = a.cast<J>(), dj = d.cast<J>(), qj = q.cast<J>();
   const Vec3<J> p = rotation_about_line<J>(aj, dj, J(th, 0)) * qj;
   const Eigen::Vector3d u = d.normalized();
-  const Eigen::Vector3d expected =
-      u.cross(rotation_about_line<double>(a, d, th) * q - a);
+  const Eigen::Vector3d expected = u.cross(rotation_about_line<double>(a, d, th) * q - a);
   for (int i = 0; i < 3; ++i) CHECK_THAT(p[i].v[0], WithinAbs(expected[i], 1e-10));
 }
 
@@ -78,12 +77,14 @@ TEST_CASE("rotate_point_about_line is the Pose form applied to a point", "[rotat
   }
 }
 
-TEST_CASE("rotate_point_about_line_derivatives agree with Jets of rotate_point_about_line", "[rotation][jet]") {
+TEST_CASE("rotate_point_about_line_derivatives agree with Jets of rotate_point_about_line",
+          "[rotation][jet]") {
   using J = ceres::Jet<double, 9>;
   std::mt19937 rng(5);
   std::normal_distribution<double> N(0.0, 1.0);
   for (int trial = 0; trial < 50; ++trial) {
-    const Eigen::Vector3d a(N(rng), N(rng), N(rng)), d(N(rng), N(rng), N(rng)), q(100 * N(rng), 100 * N(rng), 100 * N(rng));
+    const Eigen::Vector3d a(N(rng), N(rng), N(rng)), d(N(rng), N(rng), N(rng)),
+        q(100 * N(rng), 100 * N(rng), 100 * N(rng));
     const double theta = 3.0 * N(rng);
     Vec3<J> aj, dj, qj;
     for (int k = 0; k < 3; ++k) aj[k] = J(a[k], k), dj[k] = J(d[k], 3 + k), qj[k] = J(q[k], 6 + k);

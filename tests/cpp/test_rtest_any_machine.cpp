@@ -4,7 +4,6 @@
 // errors (and a tool-length error on a head), and the joint fit finds them within 3 sigma,
 // naming what one session cannot see with the set-up change that would show it.
 #include <catch2/catch.hpp>
-
 #include <random>
 
 #include "rotacal/core/noise_model.hpp"
@@ -48,8 +47,8 @@ void add_coloured_noise(RtestSession& s, std::uint64_t seed) {
   std::vector<double> t;
   for (const RtestSample& x : s.samples)
     for (int a = 0; a < 3; ++a) g.push_back("nest " + x.setup), t.push_back(x.time);
-  const Eigen::VectorXd e =
-      noise_gen::ar1(g, t, 0.9, 0.3e-3, seed) + noise_gen::probe_zero_wander(g, t, 0.1e-3, seed + 1);
+  const Eigen::VectorXd e = noise_gen::ar1(g, t, 0.9, 0.3e-3, seed) +
+                            noise_gen::probe_zero_wander(g, t, 0.1e-3, seed + 1);
   for (std::size_t r = 0; r < s.samples.size(); ++r)
     for (int a = 0; a < 3; ++a) (*s.samples[r].d)[a] += e[3 * static_cast<Eigen::Index>(r) + a];
   s.noise_um = 0.3;
@@ -83,7 +82,8 @@ TEST_CASE("the default pattern fits every machine's limits", "[rtest][any_machin
 TEST_CASE("map names follow each axis and its carrier", "[rtest][any_machine]") {
   CHECK(rtest_map_names(MachineType::BC_trt) == std::array<std::string, 2>{"BY", "CB"});
   CHECK(rtest_map_names(MachineType::AC_trt) == std::array<std::string, 2>{"AY", "CA"});
-  CHECK(rtest_map_names(parse_machine_type("B-head-C-table")) == std::array<std::string, 2>{"BZ", "CY"});
+  CHECK(rtest_map_names(parse_machine_type("B-head-C-table")) ==
+        std::array<std::string, 2>{"BZ", "CY"});
   CHECK(rtest_map_names(parse_machine_type("AC-head")) == std::array<std::string, 2>{"AC", "CZ"});
   // The BC-trt names stay those of the model files written before any machine.
   CHECK(RtestBasis{}.coefficient_names() == RtestBasis{}.coefficient_names(MachineType::BC_trt));
@@ -97,7 +97,8 @@ TEST_CASE("hidden location errors are identified within 3 sigma from an R-test o
   for (const MachineType m : machines()) {
     INFO(to_string(m));
     MachineModel truth = MachineModel::nominal(m);
-    for (int i = 0; i < 8; ++i) truth.errors.v[i] = location_error_is_angle(i) ? 5e-5 * N(rng) : 0.03 * N(rng);
+    for (int i = 0; i < 8; ++i)
+      truth.errors.v[i] = location_error_is_angle(i) ? 5e-5 * N(rng) : 0.03 * N(rng);
     if (m.has_head()) {  // a tool 15 um short: a head parameter the fit models
       truth.effects.effects.push_back(Effect::parse("tool_offset_Z"));
       truth.effect_params.push_back(0.015);
@@ -139,10 +140,12 @@ TEST_CASE("hidden location errors are identified within 3 sigma from an R-test o
       CHECK(seen >= 6);
       REQUIRE(!id.unobservable.empty());
       bool tool = false;
-      for (const std::string& u : id.unobservable) tool |= u.find("tool_offset_Z") != std::string::npos;
+      for (const std::string& u : id.unobservable)
+        tool |= u.find("tool_offset_Z") != std::string::npos;
       CHECK(tool);
       bool advised = false;
-      for (const std::string& n : id.notes) advised |= n.find("second tool length") != std::string::npos;
+      for (const std::string& n : id.notes)
+        advised |= n.find("second tool length") != std::string::npos;
       CHECK(advised);
     } else {
       // Two nests at two heights: a table machine shows every location error.
@@ -162,9 +165,9 @@ TEST_CASE("hidden location errors are identified within 3 sigma from an R-test o
       Eigen::Vector3d mean = Eigen::Vector3d::Zero();
       for (std::size_t i : s.indices_of(setup)) {
         const RtestSample& x = s.samples[i];
-        diff.push_back(*pred.samples[i].d - rtest_reading<double>(m, truth.errors, truth.effects,
-                                                                  truth.effect_data(), x.xyz, x.angles_rad(),
-                                                                  x.time, s.nests.at(x.setup)));
+        diff.push_back(*pred.samples[i].d -
+                       rtest_reading<double>(m, truth.errors, truth.effects, truth.effect_data(),
+                                             x.xyz, x.angles_rad(), x.time, s.nests.at(x.setup)));
         mean += diff.back();
       }
       mean /= static_cast<double>(diff.size());
@@ -207,12 +210,14 @@ TEST_CASE("R-test diagnosis on any machine: null data gives no finding, a bearin
           "[rtest][any_machine][diagnose]") {
   std::mt19937 rng(77);
   std::normal_distribution<double> N(0.0, 1.0);
-  for (const MachineType m : {parse_machine_type("B-head-C-table"), parse_machine_type("AC-head"),
-                              parse_machine_type("B45C-trt"),
-                              MachineType::from_description(parse_machine_description(kCustom, "custom"))}) {
+  for (const MachineType m :
+       {parse_machine_type("B-head-C-table"), parse_machine_type("AC-head"),
+        parse_machine_type("B45C-trt"),
+        MachineType::from_description(parse_machine_description(kCustom, "custom"))}) {
     INFO(to_string(m));
     MachineModel truth = MachineModel::nominal(m);
-    for (int i = 0; i < 8; ++i) truth.errors.v[i] = location_error_is_angle(i) ? 5e-5 * N(rng) : 0.03 * N(rng);
+    for (int i = 0; i < 8; ++i)
+      truth.errors.v[i] = location_error_is_angle(i) ? 5e-5 * N(rng) : 0.03 * N(rng);
     if (m.has_head()) {  // in the baseline on a head: not a finding
       truth.effects.effects.push_back(Effect::parse("tool_offset_Z"));
       truth.effect_params.push_back(0.015);
@@ -244,7 +249,8 @@ TEST_CASE("R-test diagnosis on any machine: null data gives no finding, a bearin
   }
 }
 
-TEST_CASE("R-test Monte Carlo on a head machine re-simulates the fitted noise", "[rtest][any_machine][mc]") {
+TEST_CASE("R-test Monte Carlo on a head machine re-simulates the fitted noise",
+          "[rtest][any_machine][mc]") {
   const MachineType m = parse_machine_type("B-head-C-table");
   MachineModel truth = MachineModel::nominal(m);
   truth.errors.v << 0.01, -0.02, 3e-5, 1e-5, 0.015, -0.01, -2e-5, 1e-5;
@@ -283,7 +289,8 @@ TEST_CASE("the joint reading passes Jets: derivatives match central differences 
   for (const MachineType m : machines()) {
     INFO(to_string(m));
     Eigen::Matrix<double, 21, 1> x;  // e (8), w_BY (6), w_CB (6), tool_offset_Z
-    for (int k = 0; k < 21; ++k) x[k] = (k < 8 ? (location_error_is_angle(k) ? 1e-4 : 0.05) : k < 20 ? 1e-3 : 0.02) * N(rng);
+    for (int k = 0; k < 21; ++k)
+      x[k] = (k < 8 ? (location_error_is_angle(k) ? 1e-4 : 0.05) : k < 20 ? 1e-3 : 0.02) * N(rng);
     const RotaryAngles<double> a{0.7, -2.1};
     const Eigen::Vector3d q(80, -30, 50);
     const Eigen::Vector3d xyz = rtest_commanded_xyz(m, q, a);
@@ -308,26 +315,30 @@ TEST_CASE("the joint reading passes Jets: derivatives match central differences 
         CHECK(dj[r].v[k] == Approx(fd[r]).margin(1e-6 * std::max(1.0, std::abs(fd[r]))));
       }
     }
-    // Without head axes tool_offset_Z changes nothing; with them it moves the sphere along the spindle.
+    // Without head axes tool_offset_Z changes nothing; with them it moves the sphere along the
+    // spindle.
     double dtz = 0.0;
     for (int r = 0; r < 3; ++r) dtz += dj[r].v[20] * dj[r].v[20];
     CHECK((m.has_head() ? std::abs(std::sqrt(dtz) - 1.0) < 1e-9 : dtz == 0.0));
   }
 }
 
-TEST_CASE("one nest cannot show a table axis' tilt: named with the second-nest advice", "[rtest][any_machine]") {
+TEST_CASE("one nest cannot show a table axis' tilt: named with the second-nest advice",
+          "[rtest][any_machine]") {
   for (const MachineType m : {MachineType::BC_trt, parse_machine_type("B-head-C-table")}) {
     INFO(to_string(m));
     RtestSimOptions o;
     o.pattern = default_rtest_pattern(m);
     o.pattern.nests = {Eigen::Vector3d(100, 0, 60)};
-    const RtestJointIdentification id = identify_joint(simulate_rtest(MachineModel::nominal(m), o).session);
+    const RtestJointIdentification id =
+        identify_joint(simulate_rtest(MachineModel::nominal(m), o).session);
     bool c_tilt = false;
     for (const std::string& u : id.unobservable) c_tilt |= u.find("E_A0C") != std::string::npos;
     CHECK(c_tilt);
     CHECK(!id.parameter("E_A0C").observable);
     bool advised = false;
-    for (const std::string& n : id.notes) advised |= n.find("a nest at a second height") != std::string::npos;
+    for (const std::string& n : id.notes)
+      advised |= n.find("a nest at a second height") != std::string::npos;
     CHECK(advised);
   }
 }

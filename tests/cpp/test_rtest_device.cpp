@@ -126,7 +126,8 @@ TEST_CASE("sphere offset compensation on a head machine follows the spindle", "[
     o.pattern = default_rtest_pattern(m);
     o.noise_um = 0.0;
     const RtestSession a = simulate_rtest(centred, o).session;
-    const RtestSession b = compensate_sphere_offset(simulate_rtest(off, o).session, Eigen::Vector2d(0.01, 0.0));
+    const RtestSession b =
+        compensate_sphere_offset(simulate_rtest(off, o).session, Eigen::Vector2d(0.01, 0.0));
     double worst = 0.0;
     for (std::size_t i = 0; i < a.samples.size(); ++i)
       worst = std::max(worst, (*a.samples[i].d - *b.samples[i].d).norm());

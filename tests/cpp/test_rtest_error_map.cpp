@@ -1,12 +1,12 @@
 // Tests of rtest/error_map.hpp: map writers and held-out prediction.
 #include <catch2/catch.hpp>
-#include <nlohmann/json.hpp>
 #include <iostream>
+#include <nlohmann/json.hpp>
 
+#include "../support/synthetic_sessions.hpp"
 #include "rotacal/core/error.hpp"
 #include "rotacal/rtest/error_map.hpp"
 #include "rotacal/rtest/simulate.hpp"
-#include "../support/synthetic_sessions.hpp"
 
 using namespace rotacal;
 
@@ -31,15 +31,13 @@ TEST_CASE("fit on C = 0, 30, ...; predict held-out C = 15, 45, ... to the noise 
   const RtestSimulation held = simulate_rtest(truth(), held_o);
 
   const RtestJointIdentification joint = identify_joint(fit.session);
-  const double rms_joint = prediction_rms_um(held.session, [&](const Eigen::Vector3d& q, double B,
-                                                               double C) {
-    return joint.model.reading(q, B, C);
-  });
+  const double rms_joint = prediction_rms_um(
+      held.session,
+      [&](const Eigen::Vector3d& q, double B, double C) { return joint.model.reading(q, B, C); });
   const RtestPaperIdentification paper = identify_paper(fit.session);
-  const double rms_paper = prediction_rms_um(held.session, [&](const Eigen::Vector3d& q, double B,
-                                                               double C) {
-    return paper.predict_reading(q, B, C);
-  });
+  const double rms_paper = prediction_rms_um(
+      held.session,
+      [&](const Eigen::Vector3d& q, double B, double C) { return paper.predict_reading(q, B, C); });
   std::cout << "held-out prediction RMS: joint " << rms_joint << " um, paper " << rms_paper
             << " um (noise 0.3 um)\n";
   // The held-out readings carry 0.3 um noise; the joint model adds its own prediction error
@@ -58,7 +56,8 @@ TEST_CASE("fit on C = 0, 30, ...; predict held-out C = 15, 45, ... to the noise 
   }
   // Table error of a table point with its 1 sigma (finite: every parameter is observable).
   Eigen::Vector3d te_sd;
-  const Eigen::Vector3d te = joint.model.table_error(Eigen::Vector3d(50, 50, 0), M_PI / 2, 0.0, &te_sd);
+  const Eigen::Vector3d te =
+      joint.model.table_error(Eigen::Vector3d(50, 50, 0), M_PI / 2, 0.0, &te_sd);
   CHECK(te.allFinite());
   CHECK((te_sd.array() > 0.0).all());
 }

@@ -1,6 +1,7 @@
 // Tests of rtest/error_model.hpp: Oyama Eqs. 4-9 and the mapping to ISO 230-7 location errors.
-#include <catch2/catch.hpp>
 #include <ceres/jet.h>
+
+#include <catch2/catch.hpp>
 #include <random>
 
 #include "rotacal/rtest/error_model.hpp"
@@ -17,9 +18,8 @@ AxisErrors<double> random_w(std::mt19937& rng, double t_mm, double r_rad) {
 }
 LocationErrors<double> truth_errors() {  // ../shared/data/rtest_bc_oyama.truth.json
   Eigen::Matrix<double, 8, 1> v;
-  v << 0.01459190348066346, 0.014212100597282357, 3.1102339878434216e-05,
-      -2.385536385835234e-05, -0.016912021691263143, 0.017858631217842532,
-      1.1379169104710182e-05, -4.973692463737003e-05;
+  v << 0.01459190348066346, 0.014212100597282357, 3.1102339878434216e-05, -2.385536385835234e-05,
+      -0.016912021691263143, 0.017858631217842532, 1.1379169104710182e-05, -4.973692463737003e-05;
   return LocationErrors<double>(v);
 }
 }  // namespace
@@ -60,8 +60,8 @@ TEST_CASE("exact Eq. 4 and small-angle Eqs. 8-9 agree to second order") {
 TEST_CASE("sign of the small-angle form: a table shifted +z makes the sphere read -z") {
   AxisErrors<double> w = AxisErrors<double>::Zero();
   w[2] = 0.01;  // dz_BY: table up by 10 um at B = 0
-  const Eigen::Vector3d d =
-      oyama_displacement<double>(w, AxisErrors<double>::Zero(), 0.0, 0.0, Eigen::Vector3d(50, 0, 0));
+  const Eigen::Vector3d d = oyama_displacement<double>(w, AxisErrors<double>::Zero(), 0.0, 0.0,
+                                                       Eigen::Vector3d(50, 0, 0));
   CHECK((d - Eigen::Vector3d(0, 0, -0.01)).norm() < 1e-15);
   CHECK(oyama_small_angle_twist<double>(w, AxisErrors<double>::Zero(), 0.0, 0.0)[2] == 0.01);
 }
@@ -76,8 +76,8 @@ TEST_CASE("constant Oyama errors reproduce the location-error kinematics up to a
       const Pose<double> T_oy = oyama_table_pose<double>(m.w_BY, m.w_CB, B, C) * m.F;
       CHECK((T_loc.matrix() - T_oy.matrix()).norm() < 1e-12);
       // And the joint-fit model with w = 0 is machine.hpp's table_pose.
-      const Pose<double> T_j = rtest_table_pose<double>(e, AxisErrors<double>::Zero(),
-                                                        AxisErrors<double>::Zero(), B, C);
+      const Pose<double> T_j =
+          rtest_table_pose<double>(e, AxisErrors<double>::Zero(), AxisErrors<double>::Zero(), B, C);
       CHECK((T_loc.matrix() - T_j.matrix()).norm() < 1e-14);
     }
   // R-test readings: d_loc = F^-1 (q + d_oy) - q, i.e. d_oy plus a constant per nest, up to
@@ -88,7 +88,8 @@ TEST_CASE("constant Oyama errors reproduce the location-error kinematics up to a
   for (int i = -3; i <= 3; ++i) {
     const double B = i * 30.0 * kDeg, C = i * 50.0 * kDeg;
     const Eigen::Vector3d p = oyama_table_pose<double>(z, z, B, C) * q;
-    const Eigen::Vector3d d_loc = table_pose<double>(MachineType::BC_trt, e, {B, C}).inverse() * p - q;
+    const Eigen::Vector3d d_loc =
+        table_pose<double>(MachineType::BC_trt, e, {B, C}).inverse() * p - q;
     const Eigen::Vector3d d_oy = oyama_displacement<double>(m.w_BY, m.w_CB, B, C, q);
     CHECK((d_loc - (m.F.inverse() * (q + d_oy) - q)).norm() < 1e-12);
     CHECK((d_loc - (d_oy + shift)).norm() < 5e-6);
@@ -122,9 +123,10 @@ TEST_CASE("the Oyama model is templated: Jets flow and match finite differences"
     wp[k] += h;
     wm[k] -= h;
     const AxisErrors<double> vz = AxisErrors<double>::Zero();
-    const Eigen::Vector3d fd = (oyama_displacement<double>(wp, vz, 0.5, 1.2, Eigen::Vector3d(100.0, -20.0, 60.0)) -
-                                oyama_displacement<double>(wm, vz, 0.5, 1.2, Eigen::Vector3d(100.0, -20.0, 60.0))) /
-                               (2 * h);
+    const Eigen::Vector3d fd =
+        (oyama_displacement<double>(wp, vz, 0.5, 1.2, Eigen::Vector3d(100.0, -20.0, 60.0)) -
+         oyama_displacement<double>(wm, vz, 0.5, 1.2, Eigen::Vector3d(100.0, -20.0, 60.0))) /
+        (2 * h);
     for (int r = 0; r < 3; ++r) CHECK(d[r].v[k] == Approx(fd[r]).margin(1e-6));
   }
 }

@@ -5,11 +5,11 @@
 #include <cmath>
 #include <iostream>
 
+#include "../support/synthetic_sessions.hpp"
 #include "rotacal/core/error.hpp"
 #include "rotacal/io/ballbar_file.hpp"
 #include "rotacal/rtest/identify_joint.hpp"
 #include "rotacal/rtest/simulate.hpp"
-#include "../support/synthetic_sessions.hpp"
 
 using namespace rotacal;
 
@@ -167,16 +167,19 @@ TEST_CASE("R-test joint fit with a noise model: same solution, covariance in uni
   const RtestJointIdentification white = identify_joint(sim.session, as_white);
   RtestJointOptions gls;
   const double s = 0.6e-3;  // deliberately twice the true noise: chi2/dof must show it
-  gls.whitener = std::make_shared<KnownWhiteNoise>(3 * static_cast<Eigen::Index>(sim.session.samples.size()), s);
+  gls.whitener = std::make_shared<KnownWhiteNoise>(
+      3 * static_cast<Eigen::Index>(sim.session.samples.size()), s);
   const RtestJointIdentification w = identify_joint(sim.session, gls);
   REQUIRE(w.converged);
   CHECK(w.summary.whitened);
   CHECK(w.summary.chi2_per_dof == Approx(0.25).margin(0.05));
   for (std::size_t j = 0; j < w.parameters.size(); ++j) {
     if (!w.parameters[j].observable) continue;
-    CHECK(std::abs(w.parameters[j].value - white.parameters[j].value) <= 1e-3 * white.parameters[j].std);
+    CHECK(std::abs(w.parameters[j].value - white.parameters[j].value) <=
+          1e-3 * white.parameters[j].std);
     // (J^T J)^-1 s^2, not rescaled by the residual variance (white.sigma_um):
-    CHECK(w.parameters[j].std == Approx(white.parameters[j].std * s * 1e3 / white.sigma_um).epsilon(1e-3));
+    CHECK(w.parameters[j].std ==
+          Approx(white.parameters[j].std * s * 1e3 / white.sigma_um).epsilon(1e-3));
   }
 }
 
@@ -185,9 +188,9 @@ namespace {
 // lost, as a recorder starved of CPU loses them; `drop` indexes the session's rows.
 RtestSession rtest_b60_c60_without(const std::vector<std::size_t>& drop) {
   MachineModel t = MachineModel::nominal(MachineType::BC_trt);
-  t.errors = LocationErrors<double>(
-      (Eigen::Matrix<double, 8, 1>() << 0.0612, -0.0767, 2.09e-5, -2.84e-5, -0.0136, -0.0065, -1.01e-4, -1.16e-5)
-          .finished());
+  t.errors = LocationErrors<double>((Eigen::Matrix<double, 8, 1>() << 0.0612, -0.0767, 2.09e-5,
+                                     -2.84e-5, -0.0136, -0.0065, -1.01e-4, -1.16e-5)
+                                        .finished());
   RtestSimOptions o;
   o.pattern.b_deg = {-90, -30, 30, 90};
   o.pattern.c_deg = {0, 60, 120, 180, 240, 300};
@@ -203,7 +206,8 @@ RtestSession rtest_b60_c60_without(const std::vector<std::size_t>& drop) {
 }
 }  // namespace
 
-TEST_CASE("R-test joint fit with poses lost: a parameter is unobservable or has a positive 1-sigma") {
+TEST_CASE(
+    "R-test joint fit with poses lost: a parameter is unobservable or has a positive 1-sigma") {
   // With four B angles the B polynomial to b^6 leaves several null directions of (nearly) equal
   // eigenvalue, whose basis the eigensolver picks at will. Observability was judged per basis
   // vector and one parameter held per vector, the largest share of each: a parameter could be
@@ -222,7 +226,8 @@ TEST_CASE("R-test joint fit with poses lost: a parameter is unobservable or has 
     INFO(s.samples.size() << " of 48 poses kept");
     CHECK(!id.unobservable.empty());
     for (const ParameterEstimate& p : id.parameters) {
-      INFO(p.name << " = " << p.value << " +- " << p.std << (p.observable ? "" : " (unobservable)"));
+      INFO(p.name << " = " << p.value << " +- " << p.std
+                  << (p.observable ? "" : " (unobservable)"));
       if (p.observable) CHECK((std::isfinite(p.std) && p.std > 0.0));
     }
     // Every location error the fit cannot determine is named in a null direction.

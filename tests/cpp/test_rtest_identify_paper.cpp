@@ -10,7 +10,7 @@ using namespace rotacal;
 
 namespace {
 constexpr double kDeg = M_PI / 180.0;
-const double s_sag = 0.006, k_con = 1.45e-4;  // gravity sag (mm), coning (rad/rad)
+const double s_sag = 0.006, k_con = 1.45e-4;       // gravity sag (mm), coning (rad/rad)
 const double ax = 0.002, tx = 20e-6, ty = -15e-6;  // C: axial sin 2C (mm), tilt sin 2C (rad)
 
 MachineModel truth_b_and_c() {

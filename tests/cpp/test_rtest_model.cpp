@@ -1,9 +1,8 @@
 // Tests of the one R-test reading (rtest/model.hpp) against the other routes to the same
 // number: machine.hpp's table pose, the joint model with zero maps, Oyama's HTM form.
-#include <catch2/catch.hpp>
-
 #include <ceres/jet.h>
 
+#include <catch2/catch.hpp>
 #include <random>
 
 #include "rotacal/rtest/error_model.hpp"
@@ -17,7 +16,8 @@ MachineModel random_bc(std::mt19937_64& rng) {
   std::normal_distribution<double> N(0.0, 1.0);
   MachineModel m;
   m.machine = MachineType::BC_trt;
-  for (int i = 0; i < 8; ++i) m.errors.v[i] = location_error_is_angle(i) ? 5e-5 * N(rng) : 0.02 * N(rng);
+  for (int i = 0; i < 8; ++i)
+    m.errors.v[i] = location_error_is_angle(i) ? 5e-5 * N(rng) : 0.02 * N(rng);
   return m;
 }
 }  // namespace
@@ -37,7 +37,8 @@ TEST_CASE("the reading equals T^-1 xyz - q with machine.hpp's table pose", "[rte
     const MachineModel m = random_bc(rng);
     for (double B : {-1.2, 0.3, 1.5})
       for (double C : {0.0, 2.0, 5.0}) {
-        const Eigen::Vector3d xyz = forward<double>(MachineType::BC_trt, LocationErrors<double>(), {B, C}, q);
+        const Eigen::Vector3d xyz =
+            forward<double>(MachineType::BC_trt, LocationErrors<double>(), {B, C}, q);
         const Pose<double> T = table_pose<double>(MachineType::BC_trt, m.errors, {B, C});
         const Eigen::Vector3d expect = T.inverse() * xyz - q;
         CHECK((rtest_reading(m, q, {B, C}, 0.0) - expect).norm() < 1e-12);
@@ -82,10 +83,13 @@ TEST_CASE("Jets pass through the reading with effects", "[rtest_model]") {
   for (int j = 0; j < 9; ++j) {
     MachineModel p = m, n = m;
     const double h = 1e-7;
-    if (j < 8) p.errors.v[j] += h, n.errors.v[j] -= h;
-    else p.effect_params[0] += h, n.effect_params[0] -= h;
+    if (j < 8)
+      p.errors.v[j] += h, n.errors.v[j] -= h;
+    else
+      p.effect_params[0] += h, n.effect_params[0] -= h;
     const auto read = [&](const MachineModel& mm) {
-      return rtest_reading<double>(mm.machine, mm.errors, mm.effects, mm.effect_data(), xyz, a, 5.0, q);
+      return rtest_reading<double>(mm.machine, mm.errors, mm.effects, mm.effect_data(), xyz, a, 5.0,
+                                   q);
     };
     const Eigen::Vector3d fd = (read(p) - read(n)) / (2 * h);
     for (int r = 0; r < 3; ++r) CHECK(d[r].v[j] == Approx(fd[r]).margin(1e-6));

@@ -24,9 +24,11 @@ RtestJointIdentification sample_identification() {
   r.model.covariance = Eigen::MatrixXd::Identity(n, n) * 1e-8;
   r.model.observable.assign(names.size(), true);
   for (std::size_t i = 0; i < names.size(); ++i)
-    r.parameters.push_back({names[i], r.model.params[static_cast<Eigen::Index>(i)], 1e-4, i < 8 && i % 2 ? "rad" : "mm", i != 5});
+    r.parameters.push_back({names[i], r.model.params[static_cast<Eigen::Index>(i)], 1e-4,
+                            i < 8 && i % 2 ? "rad" : "mm", i != 5});
   r.probe_zeros["1"] = Eigen::Vector3d(0.001, 0.002, 0.003);
-  for (const char* a : {"x", "y", "z"}) r.parameters.push_back({std::string("zero.1.") + a, 0.002, 1e-4, "mm", true});
+  for (const char* a : {"x", "y", "z"})
+    r.parameters.push_back({std::string("zero.1.") + a, 0.002, 1e-4, "mm", true});
   r.residual_rms_um = 1.25;
   r.n_samples = 96;
   r.converged = true;

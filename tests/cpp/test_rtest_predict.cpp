@@ -4,11 +4,11 @@
 #include <iostream>
 #include <sstream>
 
+#include "../support/synthetic_sessions.hpp"
 #include "rotacal/core/error.hpp"
 #include "rotacal/io/ballbar_file.hpp"
 #include "rotacal/rtest/predict.hpp"
 #include "rotacal/rtest/simulate.hpp"
-#include "../support/synthetic_sessions.hpp"
 
 using namespace rotacal;
 
@@ -47,8 +47,9 @@ TEST_CASE("make_rtest_joint_model checks the parts against the basis") {
     CHECK(bh.c_rotations);   // C is on the table
     const Eigen::Index nh = 9 + bh.num_b_coefficients() + bh.num_c_coefficients();
     CHECK(nh == n + 1 - 9);  // 9 odd-power rotation coefficients of the B map are not there
-    const RtestJointModel mh = make_rtest_joint_model(head, b, Eigen::VectorXd::Zero(nh), Eigen::MatrixXd::Zero(nh, nh),
-                                                      std::vector<bool>(static_cast<std::size_t>(nh), true));
+    const RtestJointModel mh =
+        make_rtest_joint_model(head, b, Eigen::VectorXd::Zero(nh), Eigen::MatrixXd::Zero(nh, nh),
+                               std::vector<bool>(static_cast<std::size_t>(nh), true));
     CHECK(mh.parameter_names().size() == static_cast<std::size_t>(nh));
     CHECK(mh.parameter_names()[8] == "tool_offset_Z");
     CHECK(mh.parameter_names()[9] == "dx_BZ.b2");

@@ -2,7 +2,6 @@
 // the arrays, and the residual model's two table poses with their Jacobians against central
 // differences.
 #include <catch2/catch.hpp>
-
 #include <vector>
 
 #include "rotacal/rtest/problem.hpp"
@@ -37,7 +36,8 @@ double jacobian_error(const ResidualModel& model, const Eigen::VectorXd& x) {
 }
 }  // namespace
 
-TEST_CASE("the R-test layout: tool length only on a head, maps only with a basis, zeros per set-up") {
+TEST_CASE(
+    "the R-test layout: tool length only on a head, maps only with a basis, zeros per set-up") {
   EffectModel fx;
   fx.effects = {Effect::parse("gravity_sag_B")};
   const RtestLayout t = rtest_layout(MachineType::BC_trt, {"1", "2"}, nullptr, fx);
@@ -50,7 +50,8 @@ TEST_CASE("the R-test layout: tool length only on a head, maps only with a basis
   CHECK(t.zeros.item(1).names == std::vector<std::string>{"zero.2.x", "zero.2.y", "zero.2.z"});
   CHECK(t.effects.offset == 14);
   CHECK(t.effects.names == std::vector<std::string>{"gravity_sag_B"});
-  const RtestLayout n = rtest_layout(MachineType::BC_trt, {"1"}, nullptr, fx, RtestZeroNames::numbered);
+  const RtestLayout n =
+      rtest_layout(MachineType::BC_trt, {"1"}, nullptr, fx, RtestZeroNames::numbered);
   CHECK(n.zeros.names.front() == "zero_x#1");
   const RtestBasis basis;
   const RtestLayout h = rtest_layout(parse_machine_type("BC-head"), {"1"}, &basis, EffectModel{});
@@ -66,7 +67,8 @@ TEST_CASE("the R-test layout: tool length only on a head, maps only with a basis
     CHECK(h.map_tilt.units[k] == (h.map_tilt.names[k][0] == 'd' ? "mm" : "rad"));
 }
 
-TEST_CASE("the machine model's residuals: zero at the truth, Jacobian equal to central differences") {
+TEST_CASE(
+    "the machine model's residuals: zero at the truth, Jacobian equal to central differences") {
   MachineModel truth = MachineModel::nominal(MachineType::BC_trt);
   truth.errors.v << 0.01, -0.02, 1e-4, -2e-4, 0.015, 0.005, 5e-5, -1e-4;
   const RtestSession s = small_session(truth);
@@ -106,7 +108,8 @@ TEST_CASE("the joint model's residuals: Jacobian through the basis equal to cent
   const RtestLayout& L = model.layout();
   CHECK(L.map_tilt.size == b.num_b_coefficients());
   Eigen::VectorXd x = Eigen::VectorXd::Zero(L.all.size());
-  for (Eigen::Index j = 0; j < x.size(); ++j) x[j] = 1e-4 * std::sin(1.0 + 3.0 * static_cast<double>(j));
+  for (Eigen::Index j = 0; j < x.size(); ++j)
+    x[j] = 1e-4 * std::sin(1.0 + 3.0 * static_cast<double>(j));
   CHECK(jacobian_error(model, x) < 1e-6);
 }
 
@@ -119,7 +122,8 @@ TEST_CASE("maps and effects together are refused, and a sample without d is name
   CHECK_THROWS_WITH(RtestProblem(a, &b, fx), Catch::Contains("give one"));
   RtestSession no_d = s;
   no_d.samples[3].d.reset();
-  CHECK_THROWS_WITH(rtest_arrays(no_d, "who"), Catch::Contains("who: sample 3") && Catch::Contains("dx,dy,dz"));
+  CHECK_THROWS_WITH(rtest_arrays(no_d, "who"),
+                    Catch::Contains("who: sample 3") && Catch::Contains("dx,dy,dz"));
   CHECK_NOTHROW(rtest_arrays(no_d, "who", false));
   RtestSession no_nest = s;
   no_nest.nests.erase(no_nest.nests.begin());

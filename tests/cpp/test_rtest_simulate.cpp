@@ -2,10 +2,10 @@
 // ../shared/data/rtest_bc_oyama.csv.
 #include <catch2/catch.hpp>
 
+#include "../support/synthetic_sessions.hpp"
 #include "rotacal/core/error.hpp"
 #include "rotacal/io/ballbar_file.hpp"
 #include "rotacal/rtest/simulate.hpp"
-#include "../support/synthetic_sessions.hpp"
 
 using namespace rotacal;
 

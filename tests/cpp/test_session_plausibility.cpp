@@ -1,7 +1,6 @@
 // Tests of session/plausibility.hpp: the shared sessions pass; sessions with the careless mistakes
 // of issue 17 item 5 are refused with the cause named.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 
 #include "rotacal/core/error.hpp"

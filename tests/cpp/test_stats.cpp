@@ -1,10 +1,9 @@
 #include <catch2/catch.hpp>
+#include <cmath>
+#include <limits>
 
 #include "rotacal/core/error.hpp"
 #include "rotacal/core/stats.hpp"
-
-#include <cmath>
-#include <limits>
 
 using namespace rotacal;
 using Catch::Matchers::WithinRel;
@@ -42,7 +41,8 @@ TEST_CASE("Student-t coverage factor matches SciPy", "[stats]") {
   CHECK_THAT(stats::t_coverage(0.95, 1), WithinRel(12.706204736174694, 1e-8));
   CHECK_THAT(stats::t_coverage(0.95, 10), WithinRel(2.2281388519862744, 1e-8));
   CHECK_THAT(stats::t_coverage(0.95, 50.5), WithinRel(2.0080664982950434, 1e-8));
-  CHECK_THAT(stats::t_coverage(0.95, std::numeric_limits<double>::infinity()), WithinRel(1.959963984540054, 1e-8));
+  CHECK_THAT(stats::t_coverage(0.95, std::numeric_limits<double>::infinity()),
+             WithinRel(1.959963984540054, 1e-8));
   CHECK_THROWS_WITH(stats::t_coverage(1.5, 3), Catch::Contains("p is 1.5"));
   CHECK_THROWS_AS(stats::t_coverage(0.95, 0), InvalidArgument);
 }

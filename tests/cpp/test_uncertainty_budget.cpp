@@ -1,9 +1,8 @@
 // Tests of the uncertainty budget: the type B line of a left-out effect equals the shift that
 // effect really puts on a location error (nonlinear refit of a simulated session), the GUM
 // arithmetic (combined, Welch-Satterthwaite, coverage), overrides, and bad input.
-#include <catch2/catch.hpp>
-
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <random>
 
@@ -18,7 +17,8 @@ using namespace rotacal;
 
 namespace {
 const BallbarSession& commanded() {
-  static const BallbarSession s = read_ballbar(std::string(ROTACAL_SHARED_DIR) + "/data/ballbar_ac_table2.csv");
+  static const BallbarSession s =
+      read_ballbar(std::string(ROTACAL_SHARED_DIR) + "/data/ballbar_ac_table2.csv");
   return s;
 }
 BallbarMachineModel machine() {
@@ -26,7 +26,8 @@ BallbarMachineModel machine() {
   m.machine = MachineType::AC_trt;
   std::mt19937 rng(3);
   std::normal_distribution<double> N(0.0, 1.0);
-  for (int i = 0; i < 8; ++i) m.errors.v[i] = location_error_is_angle(i) ? 5e-5 * N(rng) : 0.03 * N(rng);
+  for (int i = 0; i < 8; ++i)
+    m.errors.v[i] = location_error_is_angle(i) ? 5e-5 * N(rng) : 0.03 * N(rng);
   m.pivot = commanded().pivot;
   return m;
 }
@@ -47,8 +48,9 @@ TEST_CASE("a left-out X/Y squareness of 20 urad: the budget line is the shift it
   const UncertaintyBudget B = uncertainty_budget(P, D);
   const LocationBudget& c0a = line_of(B, "E_C0A");
   REQUIRE(c0a.observable);
-  const auto it = std::find_if(c0a.type_b.begin(), c0a.type_b.end(),
-                               [](const BudgetLine& b) { return b.effect == "linear_squareness_XY"; });
+  const auto it = std::find_if(c0a.type_b.begin(), c0a.type_b.end(), [](const BudgetLine& b) {
+    return b.effect == "linear_squareness_XY";
+  });
   REQUIRE(it != c0a.type_b.end());
   // Independent: hide 20 urad of squareness in a noise-free session, refit the baseline
   // (nonlinear), and see how far E_C0A moves.
@@ -58,16 +60,19 @@ TEST_CASE("a left-out X/Y squareness of 20 urad: the budget line is the shift it
   BallbarSession s = simulate_ballbar(commanded(), with, {0.0, 1, false});
   s.noise_um = 0.5;
   const ModelFit refit = BallbarDiagnosisProblem(s).fit(EffectModel{});
-  const double shift = std::abs(refit.parameters[static_cast<std::size_t>(
-                                    std::find(location_error_names(MachineType::AC_trt).begin(),
-                                              location_error_names(MachineType::AC_trt).end(), "E_C0A") -
-                                    location_error_names(MachineType::AC_trt).begin())].value -
-                                truth.errors.v[static_cast<Eigen::Index>(
-                                    std::find(location_error_names(MachineType::AC_trt).begin(),
-                                              location_error_names(MachineType::AC_trt).end(), "E_C0A") -
-                                    location_error_names(MachineType::AC_trt).begin())]);
-  INFO("shift of E_C0A " << shift * 1e6 << " urad; budget line " << it->bias_at_size * 1e6 << " urad at "
-                         << it->basis);
+  const double shift =
+      std::abs(refit
+                   .parameters[static_cast<std::size_t>(
+                       std::find(location_error_names(MachineType::AC_trt).begin(),
+                                 location_error_names(MachineType::AC_trt).end(), "E_C0A") -
+                       location_error_names(MachineType::AC_trt).begin())]
+                   .value -
+               truth.errors.v[static_cast<Eigen::Index>(
+                   std::find(location_error_names(MachineType::AC_trt).begin(),
+                             location_error_names(MachineType::AC_trt).end(), "E_C0A") -
+                   location_error_names(MachineType::AC_trt).begin())]);
+  INFO("shift of E_C0A " << shift * 1e6 << " urad; budget line " << it->bias_at_size * 1e6
+                         << " urad at " << it->basis);
   // The issue's statement: about 20 urad.
   CHECK(shift > 10e-6);
   CHECK(shift < 30e-6);
@@ -83,16 +88,18 @@ TEST_CASE("a left-out X/Y squareness of 20 urad: the budget line is the shift it
   defaults.use_session_bounds = false;
   const UncertaintyBudget B_default = uncertainty_budget(P, D, defaults);
   const LocationBudget& c0a_default = line_of(B_default, "E_C0A");
-  const auto d = std::find_if(c0a_default.type_b.begin(), c0a_default.type_b.end(),
-                              [](const BudgetLine& b) { return b.effect == "linear_squareness_XY"; });
+  const auto d =
+      std::find_if(c0a_default.type_b.begin(), c0a_default.type_b.end(),
+                   [](const BudgetLine& b) { return b.effect == "linear_squareness_XY"; });
   REQUIRE(d != c0a_default.type_b.end());
   CHECK(d->basis == "default plausible size");
   CHECK(d->bias_at_size == Approx(shift).epsilon(0.03));
-  CHECK(std::find(c0a_default.dominant.begin(), c0a_default.dominant.end(), "linear_squareness_XY") !=
-        c0a_default.dominant.end());
+  CHECK(std::find(c0a_default.dominant.begin(), c0a_default.dominant.end(),
+                  "linear_squareness_XY") != c0a_default.dominant.end());
 }
 
-TEST_CASE("budget arithmetic: combined, Welch-Satterthwaite, coverage factor, overrides", "[budget]") {
+TEST_CASE("budget arithmetic: combined, Welch-Satterthwaite, coverage factor, overrides",
+          "[budget]") {
   const BallbarSession s = simulate_ballbar(commanded(), machine(), {0.5, 12, true});
   BallbarDiagnosisProblem P(s);
   const Diagnosis D = diagnose(P);
@@ -123,7 +130,8 @@ TEST_CASE("budget arithmetic: combined, Welch-Satterthwaite, coverage factor, ov
     if (!B.errors[i].observable) continue;
     for (const BudgetLine& a : B.errors[i].type_b)
       for (const BudgetLine& b : B2.errors[i].type_b)
-        if (a.effect == "linear_squareness_XY" && b.effect == a.effect && a.basis == "default plausible size")
+        if (a.effect == "linear_squareness_XY" && b.effect == a.effect &&
+            a.basis == "default plausible size")
           CHECK(b.u == Approx(2 * a.u).epsilon(1e-9));
   }
   PlausibleSizes bad;

@@ -7,6 +7,7 @@ machine out of E-stop, switches it on and homes all joints (where they stand: HO
 0). Every wait is bounded; `run` bounds the whole display by SIGALRM and writes any failure to
 its result file as {"error": ...}, exiting 1.
 """
+
 import json
 import os
 import signal
@@ -66,7 +67,7 @@ class Machine:
         c.teleop_enable(0)  # homing is done in joint mode
         c.wait_complete(WAIT)
         c.home(-1)
-        self.wait_for("all joints homed", lambda: all(s.homed[:s.joints]))
+        self.wait_for("all joints homed", lambda: all(s.homed[: s.joints]))
 
 
 def write_json(path, data):
@@ -76,8 +77,10 @@ def write_json(path, data):
 
 def run(main, result):
     """main() -> dict, written to `result`; a failure is written there as {"error": ...}."""
+
     def on_alarm(signum, frame):
         raise TimeoutError(f"display ran longer than {RUN_TIMEOUT} s")
+
     signal.signal(signal.SIGALRM, on_alarm)
     signal.alarm(int(RUN_TIMEOUT))
     try:

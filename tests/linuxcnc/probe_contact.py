@@ -28,6 +28,7 @@ The record (JSON, rewritten after every touch and on exit):
   poll_s:  {mean, max, over_10ms}: this loop's period, the latency a userspace trigger would
            have (why the contact is decided in realtime instead)
 """
+
 import json
 import math
 import os
@@ -50,6 +51,7 @@ class Sphere:
     def __init__(self, cfg):
         sys.path.insert(0, cfg["refsim"])
         import refsim  # noqa: E402 - the path comes from truth.json
+
         self.model = refsim.Model(cfg["machine"], cfg["errors"])
         self.names = self.model.machine.axis_names
         self.q = np.asarray(cfg["sphere_actual"], float)[None, :]
@@ -79,11 +81,17 @@ def main():
 
     def stop(signum, frame):
         running[0] = False
+
     signal.signal(signal.SIGTERM, stop)
     signal.signal(signal.SIGINT, stop)
 
-    record = {"touches": [], "strays": 0, "clearance_mm": {}, "poll_s": {"mean": 0.0, "max": 0.0, "over_10ms": 0},
-              "extent": {k: [math.inf, -math.inf] for k in "xyzac"}}
+    record = {
+        "touches": [],
+        "strays": 0,
+        "clearance_mm": {},
+        "poll_s": {"mean": 0.0, "max": 0.0, "over_10ms": 0},
+        "extent": {k: [math.inf, -math.inf] for k in "xyzac"},
+    }
     polls, t_last, t_first = 0, None, None
 
     def save():
@@ -116,8 +124,16 @@ def main():
             last_ac = ac
         n = c["touches"]
         while counted < n:
-            record["touches"].append({"index": counted, "radius": c["trigger-radius"], "centre": centre.tolist(),
-                                      "a": ac[0], "c": ac[1], "armed": armed_for == counted})
+            record["touches"].append(
+                {
+                    "index": counted,
+                    "radius": c["trigger-radius"],
+                    "centre": centre.tolist(),
+                    "a": ac[0],
+                    "c": ac[1],
+                    "armed": armed_for == counted,
+                }
+            )
             counted += 1
             retracting = True
             save()

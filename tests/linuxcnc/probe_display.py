@@ -7,6 +7,7 @@ result.json: the program's run time and the counts of the realtime probe chain o
 LinuxCNC error (a G38.2 that ends without contact, a probe already tripped at its start, a
 limit) fails the run: {"error": ...}, exit 1.
 """
+
 import os
 import subprocess
 import time
@@ -17,7 +18,9 @@ from lcnc_display import RUN_TIMEOUT, Machine, run
 
 
 def getp(name):
-    return int(subprocess.run(["halcmd", "getp", name], capture_output=True, text=True, check=True).stdout)
+    return int(
+        subprocess.run(["halcmd", "getp", name], capture_output=True, text=True, check=True).stdout
+    )
 
 
 def main():
@@ -29,9 +32,14 @@ def main():
     t0 = time.monotonic()
     m.c.auto(linuxcnc.AUTO_RUN, 0)
     m.wait_for("the program to start", lambda: s.interp_state != linuxcnc.INTERP_IDLE)
-    m.wait_for("the program to end", lambda: s.interp_state == linuxcnc.INTERP_IDLE, timeout=RUN_TIMEOUT)
-    return {"program_s": time.monotonic() - t0, "touches": getp("probe_touches.count"),
-            "strays": getp("probe_strays.count")}
+    m.wait_for(
+        "the program to end", lambda: s.interp_state == linuxcnc.INTERP_IDLE, timeout=RUN_TIMEOUT
+    )
+    return {
+        "program_s": time.monotonic() - t0,
+        "touches": getp("probe_touches.count"),
+        "strays": getp("probe_strays.count"),
+    }
 
 
 if __name__ == "__main__":

@@ -7,6 +7,7 @@ is in teleop/coordinated mode once all joints are homed) it moves to every pose 
 reads the joint positions (the feedback after the simulated drives) and writes them, and the
 world position LinuxCNC reports, to joints.json (a failure: {"error": ...}, exit 1).
 """
+
 import json
 import time
 
@@ -31,9 +32,13 @@ def main():
         m.wait_for("in position", lambda: s.inpos and s.interp_state == linuxcnc.INTERP_IDLE)
         time.sleep(0.01)  # a few more servo periods: the feedback is settled
         m.poll()
-        out["moves"].append({"joints": list(s.joint_actual_position[:s.joints]),
-                             "joints_cmd": [j["output"] for j in s.joint[:s.joints]],
-                             "world": list(s.actual_position[:6])})
+        out["moves"].append(
+            {
+                "joints": list(s.joint_actual_position[: s.joints]),
+                "joints_cmd": [j["output"] for j in s.joint[: s.joints]],
+                "world": list(s.actual_position[:6]),
+            }
+        )
     return out
 
 

@@ -1,5 +1,6 @@
 """Fixtures shared by the Python tests: the shared sessions beside the repository and their truth files,
 and the command line run in this process."""
+
 import contextlib
 import io
 import json
@@ -52,18 +53,28 @@ def run_cli(*args, cwd=None, env=None) -> subprocess.CompletedProcess:
     from rotacal import cli
 
     argv = [str(a) for a in args]
-    streams = [io.TextIOWrapper(io.BytesIO(), encoding=std.encoding, errors=std.errors)
-               for std in (sys.__stdout__, sys.__stderr__)]
+    streams = [
+        io.TextIOWrapper(io.BytesIO(), encoding=std.encoding, errors=std.errors)
+        for std in (sys.__stdout__, sys.__stderr__)
+    ]
     saved_env, saved_cwd = dict(os.environ), os.getcwd()
     # A pipe's width for help text, as the child saw; the environment the child had.
     os.environ.update({"COLUMNS": os.environ.get("COLUMNS", "80"), **(env or {})})
     try:
         if cwd is not None:
             os.chdir(cwd)
-        with warnings.catch_warnings(), contextlib.redirect_stdout(streams[0]), \
-                contextlib.redirect_stderr(streams[1]):
+        with (
+            warnings.catch_warnings(),
+            contextlib.redirect_stdout(streams[0]),
+            contextlib.redirect_stderr(streams[1]),
+        ):
             warnings.resetwarnings()  # the interpreter's default filters: a warning shows on stderr
-            for category in (DeprecationWarning, PendingDeprecationWarning, ImportWarning, ResourceWarning):
+            for category in (
+                DeprecationWarning,
+                PendingDeprecationWarning,
+                ImportWarning,
+                ResourceWarning,
+            ):
                 warnings.simplefilter("ignore", category)
             try:
                 code = cli.main(argv)

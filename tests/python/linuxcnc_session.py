@@ -8,6 +8,7 @@ old one down), so a run refuses to start while another is running. Whatever the 
 is ended by pid (its process group, then the processes that carry the run's marker in their
 environment), never by name.
 """
+
 import json
 import os
 import shutil
@@ -30,15 +31,20 @@ LCNC_PROCESSES = {"linuxcncsvr", "milltask", "rtapi_app", "io"}
 def _linuxcnc_module():
     if not os.access(LCNC_PYTHON, os.X_OK):
         return False
-    r = subprocess.run([LCNC_PYTHON, "-c", "import linuxcnc, hal"], capture_output=True, timeout=60,
-                       env={"PATH": "/usr/bin:/bin"})
+    r = subprocess.run(
+        [LCNC_PYTHON, "-c", "import linuxcnc, hal"],
+        capture_output=True,
+        timeout=60,
+        env={"PATH": "/usr/bin:/bin"},
+    )
     return r.returncode == 0
 
 
 requires_linuxcnc = pytest.mark.skipif(
     LINUXCNC is None or not _linuxcnc_module(),
     reason="LinuxCNC not installed (linuxcnc on PATH and the linuxcnc and hal modules of /usr/bin/python3): "
-    "apt-get install linuxcnc-uspace")
+    "apt-get install linuxcnc-uspace",
+)
 
 
 def _processes():
@@ -49,13 +55,17 @@ def _processes():
                 stat = (p / "stat").read_text()
             except OSError:
                 continue
-            comm = stat[stat.index("(") + 1:stat.rindex(")")]
-            yield int(p.name), comm, stat[stat.rindex(")") + 2:].split()[0]
+            comm = stat[stat.index("(") + 1 : stat.rindex(")")]
+            yield int(p.name), comm, stat[stat.rindex(")") + 2 :].split()[0]
 
 
 def _running_linuxcnc():
     """LinuxCNC processes on this machine (zombies left for their parent to reap excepted)."""
-    return [f"{comm} ({pid})" for pid, comm, state in _processes() if comm in LCNC_PROCESSES and state != "Z"]
+    return [
+        f"{comm} ({pid})"
+        for pid, comm, state in _processes()
+        if comm in LCNC_PROCESSES and state != "Z"
+    ]
 
 
 def _ours(marker):
@@ -123,20 +133,35 @@ def run_linuxcnc(run_dir: Path, ini: str, files: dict, result: str, run_timeout:
         (run_dir / name).write_text(text)
     other = _running_linuxcnc()
     if other:
-        pytest.fail(f"another LinuxCNC is running ({', '.join(other)}); starting one would shut it down")
+        pytest.fail(
+            f"another LinuxCNC is running ({', '.join(other)}); starting one would shut it down"
+        )
     fifo_dir = Path(tempfile.mkdtemp(prefix="rotacal-rtapi-"))  # /tmp: reachable by RTAPI_UID
     os.chown(fifo_dir, RTAPI_UID, -1)
-    env = {k: v for k, v in os.environ.items()
-           if k not in ("PYTHONPATH", "PYTHONHOME", "VIRTUAL_ENV", "DISPLAY", "WAYLAND_DISPLAY")}
-    env.update(RTAPI_UID=str(RTAPI_UID), RTAPI_FIFO_PATH=str(fifo_dir / "rtapi_fifo"),
-               HOME=str(run_dir),  # without a tty, linuxcnc leaves its logs in $HOME on an error
-               ROTACAL_LCNC_RUN_TIMEOUT=str(run_timeout), ROTACAL_LCNC_RUN=str(run_dir))
+    env = {
+        k: v
+        for k, v in os.environ.items()
+        if k not in ("PYTHONPATH", "PYTHONHOME", "VIRTUAL_ENV", "DISPLAY", "WAYLAND_DISPLAY")
+    }
+    env.update(
+        RTAPI_UID=str(RTAPI_UID),
+        RTAPI_FIFO_PATH=str(fifo_dir / "rtapi_fifo"),
+        HOME=str(run_dir),  # without a tty, linuxcnc leaves its logs in $HOME on an error
+        ROTACAL_LCNC_RUN_TIMEOUT=str(run_timeout),
+        ROTACAL_LCNC_RUN=str(run_dir),
+    )
     marker = f"ROTACAL_LCNC_RUN={run_dir}".encode()
     log = []
     t0 = time.monotonic()
-    proc = subprocess.Popen([LINUXCNC, str(run_dir / ini)], cwd=run_dir, env=env,
-                            stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                            start_new_session=True)
+    proc = subprocess.Popen(
+        [LINUXCNC, str(run_dir / ini)],
+        cwd=run_dir,
+        env=env,
+        stdin=subprocess.DEVNULL,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        start_new_session=True,
+    )
     try:
         try:
             out, _ = proc.communicate(timeout=run_timeout + 15)
@@ -152,8 +177,11 @@ def run_linuxcnc(run_dir: Path, ini: str, files: dict, result: str, run_timeout:
     print(f"linuxcnc ran {t_end - t0:.1f} s, shut down in {elapsed - (t_end - t0):.1f} s more")
 
     def diagnostics():
-        logs = "".join(f"\n--- {f.name}\n{f.read_text(errors='replace')[-3000:]}"
-                       for f in (run_dir / "linuxcnc_print.txt", run_dir / "linuxcnc_debug.txt") if f.exists())
+        logs = "".join(
+            f"\n--- {f.name}\n{f.read_text(errors='replace')[-3000:]}"
+            for f in (run_dir / "linuxcnc_print.txt", run_dir / "linuxcnc_debug.txt")
+            if f.exists()
+        )
         return f"{'; '.join(log)}\nlinuxcnc exit {proc.returncode}, output:\n{out.decode(errors='replace')}{logs}"
 
     path = run_dir / result

@@ -18,6 +18,7 @@ phi(M') >= phi(M)^2 / (T max_k d_k), d_k = tr(I_k M^-1 L M^-1) the derivative al
 `any_direction`, each pose may be touched along any direction, touch by touch: d_k is then the
 largest eigenvalue of G_k M^-1 L M^-1 G_k^T, the derivative along the best direction of that pose.
 """
+
 from __future__ import annotations
 
 import sys
@@ -33,8 +34,24 @@ from refsim.instruments import _spindle_frame_dirs  # noqa: E402  (the nominal h
 SIGMA_MM = 0.5e-3
 # Touch directions the inner search may use when every touch has its own (n and -n inform
 # alike): the axes, the face and the body diagonals. The bound holds for every direction.
-SEARCH_DIRECTIONS = np.array([(1, 0, 0), (0, 1, 0), (0, 0, 1), (1, 1, 0), (1, -1, 0), (1, 0, 1), (1, 0, -1),
-                              (0, 1, 1), (0, 1, -1), (1, 1, 1), (1, 1, -1), (1, -1, 1), (-1, 1, 1)], float)
+SEARCH_DIRECTIONS = np.array(
+    [
+        (1, 0, 0),
+        (0, 1, 0),
+        (0, 0, 1),
+        (1, 1, 0),
+        (1, -1, 0),
+        (1, 0, 1),
+        (1, 0, -1),
+        (0, 1, 1),
+        (0, 1, -1),
+        (1, 1, 1),
+        (1, 1, -1),
+        (1, -1, 1),
+        (-1, 1, 1),
+    ],
+    float,
+)
 SEARCH_DIRECTIONS /= np.linalg.norm(SEARCH_DIRECTIONS, axis=1, keepdims=True)
 
 
@@ -56,7 +73,9 @@ def sensitivities(machine: str, poses_deg, sphere) -> tuple[np.ndarray, list[str
 
     def reading(errors: dict, effects: dict, actual) -> np.ndarray:
         model = refsim.Model(m, errors, effects)
-        return -np.einsum("ij,ij->i", refsim.probe_touches(model, actual, sphere, 25.0, 6.0, n, angles, time), n)
+        return -np.einsum(
+            "ij,ij->i", refsim.probe_touches(model, actual, sphere, 25.0, 6.0, n, angles, time), n
+        )
 
     names = list(m.error_names())
     cols = []
@@ -65,8 +84,13 @@ def sensitivities(machine: str, poses_deg, sphere) -> tuple[np.ndarray, list[str
         cols.append((reading({name: h}, {}, sphere) - reading({name: -h}, {}, sphere)) / (2 * h))
     if head:
         names.append("tool_offset_Z")
-        cols.append((reading({}, {"tool_offset_Z": [1e-4]}, sphere) - reading({}, {"tool_offset_Z": [-1e-4]}, sphere))
-                    / 2e-4)
+        cols.append(
+            (
+                reading({}, {"tool_offset_Z": [1e-4]}, sphere)
+                - reading({}, {"tool_offset_Z": [-1e-4]}, sphere)
+            )
+            / 2e-4
+        )
     for k in range(2 if head else 3):
         e = np.zeros(3)
         e[k] = 1e-4
@@ -93,8 +117,9 @@ def pattern_information(G: np.ndarray, directions) -> np.ndarray:
     return np.einsum("kai,ab,kbj->ij", G, D, G) / SIGMA_MM**2
 
 
-def contact_directions(machine: str, tilt: float, rot: float, max_angle: float = 80.0,
-                       step: float = 30.0) -> np.ndarray:
+def contact_directions(
+    machine: str, tilt: float, rot: float, max_angle: float = 80.0, step: float = 30.0
+) -> np.ndarray:
     """Approach directions (machine frame) whose contact point lies within `max_angle` deg of the
     stylus axis (the spindle's +z turned by refsim's nominal head) at a pose (deg): polar angles
     0, step, ... and max_angle, azimuth every 45 deg in the spindle's frame (the design's
@@ -108,17 +133,22 @@ def contact_directions(machine: str, tilt: float, rot: float, max_angle: float =
     for th in list(np.arange(0.0, max_angle - 1e-9, step)) + [max_angle]:
         for phi in np.radians(np.arange(0.0, 360.0, 45.0)) if th > 0 else [0.0]:
             t = np.radians(th)
-            out.append(-(H @ np.array([np.sin(t) * np.cos(phi), np.sin(t) * np.sin(phi), np.cos(t)])))
+            out.append(
+                -(H @ np.array([np.sin(t) * np.cos(phi), np.sin(t) * np.sin(phi), np.cos(t)]))
+            )
     return np.array(out)
 
 
-def candidate_information(G: np.ndarray, touches: int, directions=None,
-                          touch_directions=None) -> tuple[np.ndarray, float]:
+def candidate_information(
+    G: np.ndarray, touches: int, directions=None, touch_directions=None
+) -> tuple[np.ndarray, float]:
     """The information of one run of each candidate and the number of runs: a pose of G touched
     once along each of `directions`, or (None) one touch along one of SEARCH_DIRECTIONS, or one
     touch along one of touch_directions[k] (per pose) when given."""
     if touch_directions is not None:
-        rows = np.concatenate([np.asarray(dd, float) @ G[k] for k, dd in enumerate(touch_directions)])
+        rows = np.concatenate(
+            [np.asarray(dd, float) @ G[k] for k, dd in enumerate(touch_directions)]
+        )
         return np.einsum("ki,kj->kij", rows, rows) / SIGMA_MM**2, float(touches)
     if directions is None:
         rows = np.einsum("da,kaj->kdj", SEARCH_DIRECTIONS, G).reshape(-1, G.shape[2])
@@ -127,8 +157,14 @@ def candidate_information(G: np.ndarray, touches: int, directions=None,
     return np.einsum("kai,ab,kbj->kij", G, D, G) / SIGMA_MM**2, touches / len(directions)
 
 
-def minimax_bound(G: np.ndarray, names: list[str], touches: int, directions=None, iterations: int = 300,
-                  touch_directions=None):
+def minimax_bound(
+    G: np.ndarray,
+    names: list[str],
+    touches: int,
+    directions=None,
+    iterations: int = 300,
+    touch_directions=None,
+):
     """(U reached by a continuous design, certified lower bound on U, the design's runs per
     candidate) in um over every allocation of `touches` touches to the poses of G: each visit
     touched once along each of `directions`, or (None) each touch along any direction of its own,
@@ -148,7 +184,9 @@ def minimax_bound(G: np.ndarray, names: list[str], touches: int, directions=None
         C = np.linalg.inv(np.einsum("k,kij->ij", w, info))
         v = np.diag(C)[:8] * s2
         A = C[:, :8] @ np.diag(lam * s2) @ C[:8, :]
-        if directions is None and touch_directions is None:  # the best direction of each pose, per touch
+        if (
+            directions is None and touch_directions is None
+        ):  # the best direction of each pose, per touch
             dmax = max(np.linalg.eigvalsh(g @ A @ g.T)[-1] for g in G) / SIGMA_MM**2
         else:
             dmax = np.einsum("kij,ij->k", info, A).max()
@@ -160,7 +198,9 @@ def minimax_bound(G: np.ndarray, names: list[str], touches: int, directions=None
     return float(np.sqrt(upper)), float(np.sqrt(lower)), best
 
 
-def rounded_u_um(G: np.ndarray, names: list[str], touches: int, weights: np.ndarray, directions=None) -> float:
+def rounded_u_um(
+    G: np.ndarray, names: list[str], touches: int, weights: np.ndarray, directions=None
+) -> float:
     """The largest U (um) of the continuous design `weights` rounded to whole runs (Pukelsheim and
     Rieder's efficient rounding on its support), then single runs moved between its candidates
     while that decreases."""
@@ -175,7 +215,11 @@ def rounded_u_um(G: np.ndarray, names: list[str], touches: int, weights: np.ndar
 
     def u(counts):
         M = np.einsum("k,kij->ij", counts, info[support])
-        return np.sqrt((np.diag(np.linalg.inv(M))[:8] * s2).max()) if np.linalg.cond(M) < 1e14 else np.inf
+        return (
+            np.sqrt((np.diag(np.linalg.inv(M))[:8] * s2).max())
+            if np.linalg.cond(M) < 1e14
+            else np.inf
+        )
 
     def better_move() -> bool:  # the first single run moved that lowers the value, made
         nonlocal value
@@ -198,7 +242,9 @@ def rounded_u_um(G: np.ndarray, names: list[str], touches: int, weights: np.ndar
     return float(value)
 
 
-def grid(machine: str, tilt_step: float = 15.0, rot_step: float = 30.0, tilt_limit: float = 90.0) -> list:
+def grid(
+    machine: str, tilt_step: float = 15.0, rot_step: float = 30.0, tilt_limit: float = 90.0
+) -> list:
     """Candidate poses (tilt, rotary), deg: rotacal design probe's grid over a full turn."""
     m = refsim.load_machine(machine)
     lim = m.axes[refposes.rotary_roles(m)[0]].limits_deg or (-90.0, 90.0)

@@ -1,6 +1,7 @@
 """The runs of the measure -> compensate -> measure-again chain in batches (ballbar/chain_runs.hpp):
 what a run records, that a batch equals its runs one at a time, and that compensating for the
 identified errors of the shared Table 2 machine removes most of them."""
+
 import json
 
 import numpy as np
@@ -26,17 +27,23 @@ def table2_machine(shared_data):
     t = json.loads((shared_data / "ballbar_ac_table2.truth.json").read_text())
     names = list(_core.location_error_names(AC))
     errors = np.array([t["errors"][n] for n in names])
-    return errors, _core.BallbarMachineModel(AC, errors, np.array(t["pivot_actual"]), ["gravity_sag_A"], [0.003])
+    return errors, _core.BallbarMachineModel(
+        AC, errors, np.array(t["pivot_actual"]), ["gravity_sag_A"], [0.003]
+    )
 
 
-def test_a_record_holds_the_nominal_commands_and_the_programs_angles_with_ar1_noise(setup, nominal, table2_machine):
+def test_a_record_holds_the_nominal_commands_and_the_programs_angles_with_ar1_noise(
+    setup, nominal, table2_machine
+):
     errors, m = table2_machine
     program = _core.plan_ballbar_test(setup, errors).commanded_session()
     clean = _core.record_run(nominal, program, m, None, "paper", 0.5, 0.6)
     noisy = _core.record_run(nominal, program, m, 17, "paper", 0.5, 0.6)
     assert np.array_equal(noisy.xyz, nominal.xyz) and not np.allclose(program.xyz, nominal.xyz)
     assert np.array_equal(noisy.pivot, nominal.pivot)
-    assert np.array_equal(noisy.angles_deg, program.angles_deg) and np.array_equal(noisy.time, program.time)
+    assert np.array_equal(noisy.angles_deg, program.angles_deg) and np.array_equal(
+        noisy.time, program.time
+    )
     assert list(noisy.tests) == list(program.tests)
     assert noisy.noise_um == 0.5 and clean.noise_um == 0.5
     # The clean reading is the simulator's; the noise is the core's AR(1) generator with this seed.

@@ -1,4 +1,5 @@
 """The command line and the examples, run as a user runs them."""
+
 import json
 import re
 import subprocess
@@ -14,12 +15,30 @@ ROOT = Path(__file__).resolve().parents[2]
 
 def rotacal_process(*args):
     """`python -m rotacal` as a user starts it: the entry point itself."""
-    return subprocess.run([sys.executable, "-m", "rotacal", *map(str, args)], capture_output=True, text=True,
-                          timeout=600)
+    return subprocess.run(
+        [sys.executable, "-m", "rotacal", *map(str, args)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
 
 
-@pytest.mark.parametrize("cmd", ["plan", "simulate", "identify", "diagnose", "predict", "compensate", "report", "demo", "machines",
-                                 "virtual", "record"])
+@pytest.mark.parametrize(
+    "cmd",
+    [
+        "plan",
+        "simulate",
+        "identify",
+        "diagnose",
+        "predict",
+        "compensate",
+        "report",
+        "demo",
+        "machines",
+        "virtual",
+        "record",
+    ],
+)
 def test_help(cmd):
     r = rotacal(cmd, "--help")
     assert r.returncode == 0 and "exit codes" in r.stdout
@@ -38,8 +57,13 @@ def test_demo_finds_the_hidden_effect(tmp_path):
         # can hold the least), with the member the extended model holds marked as such.
         line = next(x for x in r.stdout.splitlines() if x.startswith("diagnosis found one of:"))
         weights = [float(w) for w in re.findall(r"\(([0-9.]+)[;)]", line)]
-        assert weights == sorted(weights, reverse=True) and len(weights) == len(d["findings"][0]["group"])
-        assert "gravity_sag_A (" in line and "; in the extended model)" in line.split("gravity_sag_A (")[1].split(",")[0]
+        assert weights == sorted(weights, reverse=True) and len(weights) == len(
+            d["findings"][0]["group"]
+        )
+        assert (
+            "gravity_sag_A (" in line
+            and "; in the extended model)" in line.split("gravity_sag_A (")[1].split(",")[0]
+        )
     report = (tmp_path / "report.html").read_text()
     assert str((tmp_path / "report.html").resolve()) in r.stdout
     for section in ("setup", "location-errors", "polar", "residuals", "diagnosis", "compensation"):
@@ -49,19 +73,47 @@ def test_demo_finds_the_hidden_effect(tmp_path):
 
 
 def test_identify_json_and_model_round_trip(shared_data, tmp_path):
-    r = rotacal("identify", shared_data / "ballbar_ac_table2.csv", "--json", "--save-model", tmp_path / "m.json")
+    r = rotacal(
+        "identify",
+        shared_data / "ballbar_ac_table2.csv",
+        "--json",
+        "--save-model",
+        tmp_path / "m.json",
+    )
     assert r.returncode == 0, r.stderr
     d = json.loads(r.stdout)
     assert d["method"] == "joint" and set(d["location_errors"]) == {
-        "E_Y0A", "E_Z0A", "E_B0A", "E_C0A", "E_X0C", "E_Y0C", "E_A0C", "E_B0C"}
+        "E_Y0A",
+        "E_Z0A",
+        "E_B0A",
+        "E_C0A",
+        "E_X0C",
+        "E_Y0C",
+        "E_A0C",
+        "E_B0C",
+    }
     # A model fitted on one file predicts another session of the same machine; here the
     # same file, so the residual equals the fit's.
-    r = rotacal("predict", shared_data / "ballbar_ac_table2.csv", "--model", tmp_path / "m.json", "-o", tmp_path / "p.csv")
+    r = rotacal(
+        "predict",
+        shared_data / "ballbar_ac_table2.csv",
+        "--model",
+        tmp_path / "m.json",
+        "-o",
+        tmp_path / "p.csv",
+    )
     assert r.returncode == 0, r.stderr
     rms = float(re.search(r"RMS ([0-9.]+) um", r.stderr).group(1))
     assert rms == pytest.approx(d["residual_rms_um"], abs=1e-3)
     # ... and a machine with other errors badly.
-    r = rotacal("predict", shared_data / "ballbar_ac_random.csv", "--model", tmp_path / "m.json", "-o", tmp_path / "q.csv")
+    r = rotacal(
+        "predict",
+        shared_data / "ballbar_ac_random.csv",
+        "--model",
+        tmp_path / "m.json",
+        "-o",
+        tmp_path / "q.csv",
+    )
     assert float(re.search(r"RMS ([0-9.]+) um", r.stderr).group(1)) > 10
 
 
@@ -70,12 +122,29 @@ def test_diagnose_null_file(shared_data):
     assert r.returncode == 0, r.stderr
     d = json.loads(r.stdout)
     assert d["findings"] == [] and not d["unexplained"]["present"]
-    assert {"baseline", "findings", "ambiguous", "unobservable", "unexplained", "final_model"} <= set(d)
+    assert {
+        "baseline",
+        "findings",
+        "ambiguous",
+        "unobservable",
+        "unexplained",
+        "final_model",
+    } <= set(d)
 
 
 def test_simulate_then_identify(tmp_path):
-    r = rotacal("simulate", "ballbar", "--errors", "table2", "--seed", "3", "-o", tmp_path / "s.csv",
-                "--truth", tmp_path / "t.json")
+    r = rotacal(
+        "simulate",
+        "ballbar",
+        "--errors",
+        "table2",
+        "--seed",
+        "3",
+        "-o",
+        tmp_path / "s.csv",
+        "--truth",
+        tmp_path / "t.json",
+    )
     assert r.returncode == 0, r.stderr
     truth = json.loads((tmp_path / "t.json").read_text())
     d = json.loads(rotacal("identify", tmp_path / "s.csv", "--json").stdout)
@@ -84,18 +153,41 @@ def test_simulate_then_identify(tmp_path):
 
 
 def test_plan_writes_programs(tmp_path):
-    for dialect, marker in [("linuxcnc", "G21"), ("heidenhain", "TCPM"), ("siemens", "TRAORI"), ("fanuc", "G43.4")]:
+    for dialect, marker in [
+        ("linuxcnc", "G21"),
+        ("heidenhain", "TCPM"),
+        ("siemens", "TRAORI"),
+        ("fanuc", "G43.4"),
+    ]:
         out = tmp_path / f"p.{dialect}"
-        r = rotacal("plan", "ballbar", "--machine", "AC-trt", "--length", "100", "--pivot", "120,0,60",
-                    "--a-range", "-90,90", "--step", "1", "--dialect", dialect, "-o", out)
+        r = rotacal(
+            "plan",
+            "ballbar",
+            "--machine",
+            "AC-trt",
+            "--length",
+            "100",
+            "--pivot",
+            "120,0,60",
+            "--a-range",
+            "-90,90",
+            "--step",
+            "1",
+            "--dialect",
+            dialect,
+            "-o",
+            out,
+        )
         assert r.returncode == 0, r.stderr
         assert marker in out.read_text()
 
 
 def test_errors_have_exit_codes(tmp_path):
     bad = tmp_path / "bad.csv"
-    bad.write_text("# format: rotacal-ballbar/1\n# machine: AC-trt\n# ballbar_length: 100\n# pivot: 1,2,3\n"
-                   "test,time,X,Y,Z,A,C,length\nt,0,1,2,x,0,0,100\n")
+    bad.write_text(
+        "# format: rotacal-ballbar/1\n# machine: AC-trt\n# ballbar_length: 100\n# pivot: 1,2,3\n"
+        "test,time,X,Y,Z,A,C,length\nt,0,1,2,x,0,0,100\n"
+    )
     r = rotacal("identify", bad)
     assert r.returncode == 3 and "bad.csv:6" in r.stderr
     r = rotacal("identify", tmp_path / "missing.csv")
@@ -105,23 +197,34 @@ def test_errors_have_exit_codes(tmp_path):
     assert rotacal("identify").returncode == 2
 
 
-@pytest.mark.parametrize("script,args", [("simulate_and_diagnose.py", []),
-                                         ("identify_session.py", ["ballbar_ac_table2.csv"])])
+@pytest.mark.parametrize(
+    "script,args",
+    [("simulate_and_diagnose.py", []), ("identify_session.py", ["ballbar_ac_table2.csv"])],
+)
 def test_examples_run(shared_data, script, args):
-    r = subprocess.run([sys.executable, str(ROOT / "examples" / script), *[str(shared_data / a) for a in args]],
-                       capture_output=True, text=True, timeout=300)
+    r = subprocess.run(
+        [sys.executable, str(ROOT / "examples" / script), *[str(shared_data / a) for a in args]],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert r.returncode == 0, r.stderr
     assert r.stdout.strip()
 
 
 def test_plan_example_writes_every_dialect(tmp_path):
-    r = subprocess.run([sys.executable, str(ROOT / "examples" / "plan_ballbar_test.py"), str(tmp_path)],
-                       capture_output=True, text=True, timeout=300)
+    r = subprocess.run(
+        [sys.executable, str(ROOT / "examples" / "plan_ballbar_test.py"), str(tmp_path)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert r.returncode == 0, r.stderr
     for name in ("ballbar_test.ngc", "ballbar_test.h", "ballbar_test.mpf", "ballbar_test.nc"):
         assert (tmp_path / name).stat().st_size > 10_000, name
     assert "FUNCTION TCPM" in (tmp_path / "ballbar_test.h").read_text()
     from rotacal import load
+
     session = load(tmp_path / "commanded.csv")
     assert len(session) > 1000 and "radial_C" in r.stdout
 
@@ -131,19 +234,25 @@ def test_readme_python_example_runs(shared_data, tmp_path):
     blocks = re.findall(r"```python\n(.*?)```", text, re.S)
     assert blocks, "README has no python example"
     for code in blocks:
-        r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, cwd=ROOT)
+        r = subprocess.run(
+            [sys.executable, "-c", code], capture_output=True, text=True, timeout=300, cwd=ROOT
+        )
         assert r.returncode == 0, r.stderr
 
 
 def test_diagnose_rtest_file_names_gravity_and_coning(shared_data, tmp_path):
-    r = rotacal("diagnose", shared_data / "rtest_bc_oyama.csv", "--json", "--report", tmp_path / "r.html")
+    r = rotacal(
+        "diagnose", shared_data / "rtest_bc_oyama.csv", "--json", "--report", tmp_path / "r.html"
+    )
     assert r.returncode == 0, r.stderr
     d = json.loads(r.stdout)
     found = {f["effect"]: f["parameters"] for f in d["findings"]}
     assert set(found) == {"gravity_sag_B", "coning_B"}
     s = found["gravity_sag_B"]["gravity_sag_B"]
     assert abs(s["value"] - 0.006) <= 3 * s["std"]
-    assert d["final_model"]["kind"] == "rtest-diagnosis" and set(d["final_model"]["probe_zeros"]) == {"1", "2"}
+    assert d["final_model"]["kind"] == "rtest-diagnosis" and set(
+        d["final_model"]["probe_zeros"]
+    ) == {"1", "2"}
     assert 'id="diagnosis"' in (tmp_path / "r.html").read_text()
 
 
@@ -153,6 +262,7 @@ def test_rtest_noise_model_json_has_the_walk(shared_data, tmp_path):
     from test_json_schema import check, schemas
     from test_report import walk_session
     from rotacal.results import noise_handling_words
+
     r = rotacal("identify", walk_session(shared_data, tmp_path / "walk.csv"), "--no-budget")
     assert r.returncode == 0, r.stderr
     nm = json.loads(r.stdout)["noise_model"]
@@ -166,32 +276,82 @@ def test_rtest_noise_model_json_has_the_walk(shared_data, tmp_path):
     # The shared session itself (white readings): no walk, readings independent.
     r = rotacal("identify", shared_data / "rtest_bc_oyama.csv", "--no-budget")
     nm = json.loads(r.stdout)["noise_model"]
-    assert nm["random_walk_step_um"] == 0.0 and noise_handling_words(nm) == "readings taken as independent"
+    assert (
+        nm["random_walk_step_um"] == 0.0
+        and noise_handling_words(nm) == "readings taken as independent"
+    )
 
 
 def test_rotary_tests_both_ways_at_two_feeds_find_backlash_and_servo_lag(tmp_path):
     # Tangential C ccw and cw at two feeds: lost motion flips with the direction, lag scales
     # with the speed (docs/effects.md); the standard tests beside them, a sag of A as well.
     tests = "sphere_xy,sphere_yz,sphere_zx,radial_A,axial_C,radial_C,axial_A,tangential_C"
-    r = rotacal("simulate", "ballbar", "--errors", "table2", "--tests", tests, "--directions", "ccw,cw",
-                "--feed-factors", "1,2", "--step", "2", "--effect", "backlash_C=4e-5", "--effect", "servo_lag_C=3e-4",
-                "--effect", "gravity_sag_A=0.004", "--seed", "5", "-o", tmp_path / "s.csv", "--truth", tmp_path / "t.json")
+    r = rotacal(
+        "simulate",
+        "ballbar",
+        "--errors",
+        "table2",
+        "--tests",
+        tests,
+        "--directions",
+        "ccw,cw",
+        "--feed-factors",
+        "1,2",
+        "--step",
+        "2",
+        "--effect",
+        "backlash_C=4e-5",
+        "--effect",
+        "servo_lag_C=3e-4",
+        "--effect",
+        "gravity_sag_A=0.004",
+        "--seed",
+        "5",
+        "-o",
+        tmp_path / "s.csv",
+        "--truth",
+        tmp_path / "t.json",
+    )
     assert r.returncode == 0, r.stderr
-    labels = {line.split(",")[0] for line in (tmp_path / "s.csv").read_text().splitlines() if not line.startswith("#")}
-    assert {"tangential_C", "tangential_C_cw", "tangential_C_f2000", "tangential_C_cw_f2000", "radial_A_cw"} <= labels
+    labels = {
+        line.split(",")[0]
+        for line in (tmp_path / "s.csv").read_text().splitlines()
+        if not line.startswith("#")
+    }
+    assert {
+        "tangential_C",
+        "tangential_C_cw",
+        "tangential_C_f2000",
+        "tangential_C_cw_f2000",
+        "radial_A_cw",
+    } <= labels
     d = json.loads(rotacal("diagnose", tmp_path / "s.csv", "--json", "--no-budget").stdout)
     found = {f["effect"]: next(iter(f["parameters"].values())) for f in d["findings"]}
     for effect, value in (("backlash_C", 4e-5), ("servo_lag_C", 3e-4), ("gravity_sag_A", 0.004)):
         assert effect in found, list(found)
         assert abs(found[effect]["value"] - value) <= 3 * found[effect]["std"], effect
     # The program says what it runs.
-    r = rotacal("plan", "ballbar", "--tests", "tangential_C", "--directions", "ccw,cw", "--feed-factors", "1,2",
-                "-o", tmp_path / "p.ngc")
+    r = rotacal(
+        "plan",
+        "ballbar",
+        "--tests",
+        "tangential_C",
+        "--directions",
+        "ccw,cw",
+        "--feed-factors",
+        "1,2",
+        "-o",
+        tmp_path / "p.ngc",
+    )
     assert r.returncode == 0, r.stderr
     text = (tmp_path / "p.ngc").read_text()
     assert "TEST tangential_C_cw_f2000" in text and "runs ccw, cw at 1000, 2000 mm/min" in text
     # Refused by name.
-    for option, value in (("--feed-factors", "2,1"), ("--directions", "up"), ("--feed-factors", "1,x")):
+    for option, value in (
+        ("--feed-factors", "2,1"),
+        ("--directions", "up"),
+        ("--feed-factors", "1,x"),
+    ):
         r = rotacal("plan", "ballbar", option, value, "-o", tmp_path / "bad.ngc")
         assert r.returncode == 3 and (option in r.stderr or value in r.stderr), r.stderr
 
@@ -201,9 +361,30 @@ def test_design_tries_both_ways_and_two_feeds_for_backlash_against_servo_lag(tmp
     # correlation of (1 + k) / sqrt(2 (1 + k^2)) (docs/effects.md), so the design names the
     # closest test and says that none reaches 0.5.
     tests = "sphere_xy,sphere_yz,sphere_zx,radial_A,axial_C,radial_C,axial_A,tangential_C"
-    assert rotacal("simulate", "ballbar", "--errors", "table2", "--tests", tests, "--directions", "ccw,cw",
-                   "--step", "2", "--effect", "backlash_C=4e-5", "--seed", "5", "-o", tmp_path / "one.csv").returncode == 0
-    r = rotacal("design", "ballbar", "--separate", "backlash_C,servo_lag_C", "--after", tmp_path / "one.csv")
+    assert (
+        rotacal(
+            "simulate",
+            "ballbar",
+            "--errors",
+            "table2",
+            "--tests",
+            tests,
+            "--directions",
+            "ccw,cw",
+            "--step",
+            "2",
+            "--effect",
+            "backlash_C=4e-5",
+            "--seed",
+            "5",
+            "-o",
+            tmp_path / "one.csv",
+        ).returncode
+        == 0
+    )
+    r = rotacal(
+        "design", "ballbar", "--separate", "backlash_C,servo_lag_C", "--after", tmp_path / "one.csv"
+    )
     assert r.returncode == 0, r.stderr
     assert "none of" in r.stdout and "ccw and cw at 1000, 2000 mm/min" in r.stdout, r.stdout
     corr = float(re.search(r"correlation (\d\.\d+)\)", r.stdout).group(1))

@@ -2,6 +2,7 @@
 outputs or the history store it uses: refused before any work with exit 4, the file left
 as it was. The rule is one table (rotacal.command_files.COMMANDS); every subcommand of the
 parser must have its row, and every file option of a row is tried here against every other."""
+
 import argparse
 import json
 import re
@@ -20,46 +21,200 @@ SLOT = re.compile(r"\{([^{}]+)\}")
 
 # One (or two) command lines per row of the table, each file option as {its option}.
 TEMPLATES = {
-    ("plan", "ballbar"): [["plan", "ballbar", "--machine", "{--machine}", "--compensate", "{--compensate}",
-                           "--session", "{--session}", "-o", "{-o}"]],
-    ("plan", "probe"): [["plan", "probe", "--machine", "{--machine}", "--session", "{--session}", "-o", "{-o}"]],
+    ("plan", "ballbar"): [
+        [
+            "plan",
+            "ballbar",
+            "--machine",
+            "{--machine}",
+            "--compensate",
+            "{--compensate}",
+            "--session",
+            "{--session}",
+            "-o",
+            "{-o}",
+        ]
+    ],
+    ("plan", "probe"): [
+        ["plan", "probe", "--machine", "{--machine}", "--session", "{--session}", "-o", "{-o}"]
+    ],
     ("import", "probe"): [["import", "probe", "{LOG}", "--plan", "{--plan}", "-o", "{-o}"]],
-    ("simulate", "ballbar"): [["simulate", "ballbar", "--machine", "{--machine}", "--truth", "{--truth}",
-                               "-o", "{-o}"]],
-    ("simulate", "rtest"): [["simulate", "rtest", "--machine", "{--machine}", "--truth", "{--truth}", "-o", "{-o}"]],
-    ("simulate", "probe"): [["simulate", "probe", "--machine", "{--machine}", "--truth", "{--truth}", "-o", "{-o}"]],
-    ("identify",): [["identify", "{FILE}", "--budget-sizes", "{--budget-sizes}", "--controller", "{--controller}",
-                     "--save-model", "{--save-model}", "--store", "--machine-id", "M1", "--db", "{--db}"]],
-    ("history", "add"): [["history", "add", "{MODEL}", "--diagnosis", "{--diagnosis}", "--controller", "{--controller}",
-                          "--machine-id", "M1", "--db", "{--db}"],
-                         ["history", "add", "--correction", "{--correction}", "--machine-id", "M1", "--db", "{--db}"]],
+    ("simulate", "ballbar"): [
+        ["simulate", "ballbar", "--machine", "{--machine}", "--truth", "{--truth}", "-o", "{-o}"]
+    ],
+    ("simulate", "rtest"): [
+        ["simulate", "rtest", "--machine", "{--machine}", "--truth", "{--truth}", "-o", "{-o}"]
+    ],
+    ("simulate", "probe"): [
+        ["simulate", "probe", "--machine", "{--machine}", "--truth", "{--truth}", "-o", "{-o}"]
+    ],
+    ("identify",): [
+        [
+            "identify",
+            "{FILE}",
+            "--budget-sizes",
+            "{--budget-sizes}",
+            "--controller",
+            "{--controller}",
+            "--save-model",
+            "{--save-model}",
+            "--store",
+            "--machine-id",
+            "M1",
+            "--db",
+            "{--db}",
+        ]
+    ],
+    ("history", "add"): [
+        [
+            "history",
+            "add",
+            "{MODEL}",
+            "--diagnosis",
+            "{--diagnosis}",
+            "--controller",
+            "{--controller}",
+            "--machine-id",
+            "M1",
+            "--db",
+            "{--db}",
+        ],
+        [
+            "history",
+            "add",
+            "--correction",
+            "{--correction}",
+            "--machine-id",
+            "M1",
+            "--db",
+            "{--db}",
+        ],
+    ],
     ("history", "show"): [["history", "show", "M1", "--plot", "{--plot}", "--db", "{--db}"]],
-    ("diagnose",): [["diagnose", "{FILE}", "--budget-sizes", "{--budget-sizes}", "--report", "{--report}"]],
+    ("diagnose",): [
+        ["diagnose", "{FILE}", "--budget-sizes", "{--budget-sizes}", "--report", "{--report}"]
+    ],
     ("predict",): [["predict", "{SESSION}", "--model", "{--model}", "-o", "{-o}"]],
-    ("design", "ballbar"): [["design", "ballbar", "--machine", "{--machine}", "-o", "{-o}"],
-                            ["design", "ballbar", "--separate", "gravity_sag_A,gravity_sag_C", "--after", "{--after}",
-                             "-o", "{-o}"]],
-    ("design", "probe"): [["design", "probe", "--machine", "{--machine}", "-o", "{-o}", "--session", "{--session}"],
-                          ["design", "probe", "--separate", "gravity_sag_A,radial_motion_A_h2", "--after", "{--after}",
-                           "-o", "{-o}", "--session", "{--session}"]],
-    ("export",): [["export", "--model", "{--model}", "--controller", "isg", "--current", "{--current}",
-                   "--centres", "{--centres}", "--centres-output", "{--centres-output}",
-                   "--residual-model", "{--residual-model}", "-o", "{-o}"],
-                  ["export", "--model", "{--model}", "--controller", "linuxcnc", "--comp-file", "B={--comp-file}"]],
-    ("compensate",): [["compensate", "--machine", "{--machine}", "--model", "{--model}", "-o", "{-o}"]],
-    ("virtual", "ballbar"): [["virtual", "ballbar", "--machine", "{--machine}", "--truth", "{--truth}"]],
-    ("virtual", "rtest"): [["virtual", "rtest", "--machine", "{--machine}", "--truth", "{--truth}"]],
-    ("record", "ballbar"): [["record", "ballbar", "--machine", "{--machine}", "--port", "{--port}", "-o", "{-o}",
-                             "--silence", "0.1", "--no-progress"]],
-    ("record", "rtest"): [["record", "rtest", "--machine", "{--machine}", "--port", "{--port}", "-o", "{-o}",
-                           "--silence", "0.1", "--no-progress"]],
+    ("design", "ballbar"): [
+        ["design", "ballbar", "--machine", "{--machine}", "-o", "{-o}"],
+        [
+            "design",
+            "ballbar",
+            "--separate",
+            "gravity_sag_A,gravity_sag_C",
+            "--after",
+            "{--after}",
+            "-o",
+            "{-o}",
+        ],
+    ],
+    ("design", "probe"): [
+        ["design", "probe", "--machine", "{--machine}", "-o", "{-o}", "--session", "{--session}"],
+        [
+            "design",
+            "probe",
+            "--separate",
+            "gravity_sag_A,radial_motion_A_h2",
+            "--after",
+            "{--after}",
+            "-o",
+            "{-o}",
+            "--session",
+            "{--session}",
+        ],
+    ],
+    ("export",): [
+        [
+            "export",
+            "--model",
+            "{--model}",
+            "--controller",
+            "isg",
+            "--current",
+            "{--current}",
+            "--centres",
+            "{--centres}",
+            "--centres-output",
+            "{--centres-output}",
+            "--residual-model",
+            "{--residual-model}",
+            "-o",
+            "{-o}",
+        ],
+        [
+            "export",
+            "--model",
+            "{--model}",
+            "--controller",
+            "linuxcnc",
+            "--comp-file",
+            "B={--comp-file}",
+        ],
+    ],
+    ("compensate",): [
+        ["compensate", "--machine", "{--machine}", "--model", "{--model}", "-o", "{-o}"]
+    ],
+    ("virtual", "ballbar"): [
+        ["virtual", "ballbar", "--machine", "{--machine}", "--truth", "{--truth}"]
+    ],
+    ("virtual", "rtest"): [
+        ["virtual", "rtest", "--machine", "{--machine}", "--truth", "{--truth}"]
+    ],
+    ("record", "ballbar"): [
+        [
+            "record",
+            "ballbar",
+            "--machine",
+            "{--machine}",
+            "--port",
+            "{--port}",
+            "-o",
+            "{-o}",
+            "--silence",
+            "0.1",
+            "--no-progress",
+        ]
+    ],
+    ("record", "rtest"): [
+        [
+            "record",
+            "rtest",
+            "--machine",
+            "{--machine}",
+            "--port",
+            "{--port}",
+            "-o",
+            "{-o}",
+            "--silence",
+            "0.1",
+            "--no-progress",
+        ]
+    ],
     ("report",): [["report", "{FILE}", "--history", "M1", "--db", "{--db}", "-o", "{-o}"]],
-    ("circular", "plan"): [["circular", "plan", "--machine", "{--machine}", "--session", "{--session}", "-o", "{-o}"]],
-    ("circular", "simulate"): [["circular", "simulate", "--machine", "{--machine}", "--truth", "{--truth}",
-                                "-o", "{-o}"]],
-    ("circular", "virtual"): [["circular", "virtual", "--machine", "{--machine}", "--truth", "{--truth}"]],
-    ("circular", "record"): [["circular", "record", "--machine", "{--machine}", "--port", "{--port}", "-o", "{-o}",
-                              "--silence", "0.1", "--no-progress"]],
+    ("circular", "plan"): [
+        ["circular", "plan", "--machine", "{--machine}", "--session", "{--session}", "-o", "{-o}"]
+    ],
+    ("circular", "simulate"): [
+        ["circular", "simulate", "--machine", "{--machine}", "--truth", "{--truth}", "-o", "{-o}"]
+    ],
+    ("circular", "virtual"): [
+        ["circular", "virtual", "--machine", "{--machine}", "--truth", "{--truth}"]
+    ],
+    ("circular", "record"): [
+        [
+            "circular",
+            "record",
+            "--machine",
+            "{--machine}",
+            "--port",
+            "{--port}",
+            "-o",
+            "{-o}",
+            "--silence",
+            "0.1",
+            "--no-progress",
+        ]
+    ],
     ("circular", "analyze"): [["circular", "analyze", "{FILE}", "--plot", "{--plot}"]],
 }
 
@@ -91,7 +246,9 @@ def test_every_file_option_of_a_writing_command_is_tried(key):
         return  # reads only: nothing to overwrite
     ins, outs = _roles(key)
     tried = {m for t in TEMPLATES[key] for m in SLOT.findall(" ".join(t))}
-    assert ins | outs <= tried, f"{key}: options of the table not tried here: {sorted((ins | outs) - tried)}"
+    assert ins | outs <= tried, (
+        f"{key}: options of the table not tried here: {sorted((ins | outs) - tried)}"
+    )
 
 
 @pytest.fixture(scope="module")
@@ -116,16 +273,37 @@ def sources(shared_data, tmp_path_factory):
     diag.write_text(json.dumps({"findings": []}))
     port = d / "port"
     port.write_text("not a device\n")
-    probe_plan = d / "probe_plan.csv"  # a touch-probe session as `import probe --plan` template, and its log
+    probe_plan = (
+        d / "probe_plan.csv"
+    )  # a touch-probe session as `import probe --plan` template, and its log
     probe_plan.write_bytes((shared_data / "probe_ac_table2.csv").read_bytes())
     probe = rotacal.load(probe_plan)
     probe_log = d / "probe.log"
-    probe_log.write_text("".join(f"{k // 5 + 1} {k % 5 + 1} {x:f} {y:f} {z:f}\n"
-                                 for k, (x, y, z) in enumerate(np.asarray(probe.xyz))))
-    return {"FILE": session, "SESSION": session, "--after": session, "--centres": rsession, "--model": model,
-            "--compensate": model, "MODEL": model, "--machine": machine, "--db": store, "--controller": hal,
-            "--current": hal, "--budget-sizes": empty, "--correction": empty, "--diagnosis": diag, "--port": port,
-            "LOG": probe_log, "--plan": probe_plan}
+    probe_log.write_text(
+        "".join(
+            f"{k // 5 + 1} {k % 5 + 1} {x:f} {y:f} {z:f}\n"
+            for k, (x, y, z) in enumerate(np.asarray(probe.xyz))
+        )
+    )
+    return {
+        "FILE": session,
+        "SESSION": session,
+        "--after": session,
+        "--centres": rsession,
+        "--model": model,
+        "--compensate": model,
+        "MODEL": model,
+        "--machine": machine,
+        "--db": store,
+        "--controller": hal,
+        "--current": hal,
+        "--budget-sizes": empty,
+        "--correction": empty,
+        "--diagnosis": diag,
+        "--port": port,
+        "LOG": probe_log,
+        "--plan": probe_plan,
+    }
 
 
 def _argv(template, paths):
@@ -149,13 +327,18 @@ def _cases():
 
 
 @pytest.mark.parametrize("key,k,target,other", _cases())
-def test_an_output_is_never_another_file_of_its_command(sources, tmp_path, capsys, monkeypatch, key, k, target,
-                                                         other):
-    monkeypatch.setattr(serial_link, "serve", lambda *a: 0)  # a virtual instrument not refused must not wait for a host
+def test_an_output_is_never_another_file_of_its_command(
+    sources, tmp_path, capsys, monkeypatch, key, k, target, other
+):
+    monkeypatch.setattr(
+        serial_link, "serve", lambda *a: 0
+    )  # a virtual instrument not refused must not wait for a host
     template = TEMPLATES[key][k]
     ins, outs = _roles(key)
-    paths = {s: sources[s] if s in ins or s == "--db" else tmp_path / f"out{n}{s.strip('-')}"
-             for n, s in enumerate(SLOT.findall(" ".join(template)))}
+    paths = {
+        s: sources[s] if s in ins or s == "--db" else tmp_path / f"out{n}{s.strip('-')}"
+        for n, s in enumerate(SLOT.findall(" ".join(template)))
+    }
     for s in paths:  # a private copy of every input, so a failure cannot spoil the next case
         if s in ins or s == "--db":
             copy = tmp_path / f"in.{s.strip('-')}.{sources[s].name}"
@@ -175,18 +358,27 @@ def test_an_output_is_never_another_file_of_its_command(sources, tmp_path, capsy
 
 
 def _output_cases():
-    return [(key, k, o) for key, templates in TEMPLATES.items() for k, t in enumerate(templates)
-            for o in SLOT.findall(" ".join(t)) if o in _roles(key)[1]]
+    return [
+        (key, k, o)
+        for key, templates in TEMPLATES.items()
+        for k, t in enumerate(templates)
+        for o in SLOT.findall(" ".join(t))
+        if o in _roles(key)[1]
+    ]
 
 
 @pytest.mark.parametrize("where", ["a directory", "a missing folder"])
 @pytest.mark.parametrize("key,k,target", _output_cases())
-def test_an_output_in_no_place_to_write_is_refused_first(sources, tmp_path, capsys, monkeypatch, key, k, target, where):
+def test_an_output_in_no_place_to_write_is_refused_first(
+    sources, tmp_path, capsys, monkeypatch, key, k, target, where
+):
     monkeypatch.setattr(serial_link, "serve", lambda *a: 0)
     template = TEMPLATES[key][k]
     ins, _ = _roles(key)
-    paths = {s: sources[s] if s in ins or s == "--db" else tmp_path / f"out{n}{s.strip('-')}"
-             for n, s in enumerate(SLOT.findall(" ".join(template)))}
+    paths = {
+        s: sources[s] if s in ins or s == "--db" else tmp_path / f"out{n}{s.strip('-')}"
+        for n, s in enumerate(SLOT.findall(" ".join(template)))
+    }
     if where == "a directory":
         paths[target] = tmp_path / "a_folder"
         paths[target].mkdir()
@@ -195,7 +387,9 @@ def test_an_output_in_no_place_to_write_is_refused_first(sources, tmp_path, caps
     code = cli.main(_argv(template, paths))
     err = capsys.readouterr().err
     assert code == EXIT_IO and target in err, err
-    assert [p.name for p in tmp_path.iterdir()] in (["a_folder"], []), "an output was written before the refusal"
+    assert [p.name for p in tmp_path.iterdir()] in (["a_folder"], []), (
+        "an output was written before the refusal"
+    )
 
 
 def test_simulate_rtest_default_truth_is_checked(sources, tmp_path, capsys):
@@ -211,14 +405,26 @@ def test_simulate_rtest_default_truth_is_checked(sources, tmp_path, capsys):
 def test_postgresql_store_is_no_file(sources, tmp_path, capsys):
     # A URL names no file: it is neither refused as one nor compared with the outputs.
     files = command_files.COMMANDS[("report",)]
-    a = cli.build_parser().parse_args(["report", str(sources["FILE"]), "--history", "M1", "--db",
-                                       "postgresql://u@localhost/x", "-o", str(tmp_path / "r.html")])
+    a = cli.build_parser().parse_args(
+        [
+            "report",
+            str(sources["FILE"]),
+            "--history",
+            "M1",
+            "--db",
+            "postgresql://u@localhost/x",
+            "-o",
+            str(tmp_path / "r.html"),
+        ]
+    )
     assert files.reads_store(a)
     command_files.check_command_files(a)  # does not raise
 
 
 def test_devices_may_be_named_twice(sources, tmp_path):
-    a = cli.build_parser().parse_args(["simulate", "ballbar", "--truth", "/dev/null", "-o", "/dev/null"])
+    a = cli.build_parser().parse_args(
+        ["simulate", "ballbar", "--truth", "/dev/null", "-o", "/dev/null"]
+    )
     command_files.check_command_files(a)  # written through, never replaced: not refused
 
 

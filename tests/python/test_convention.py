@@ -1,6 +1,7 @@
 """Convention check against the independent implementation: with the truth's location errors,
 pivot and effects, the library's exact forward model reproduces the recorded readings to
 within the stated noise (residual RMS within 15 % of noise_um)."""
+
 import numpy as np
 import pytest
 
@@ -18,8 +19,9 @@ def test_ballbar_truth_reproduces_lengths(shared_data, name):
     names = rotacal.location_error_names(s.machine)
     errors = np.array([t["errors"][n] for n in names])
     ids = list(t["effects"].keys())
-    model = rotacal.BallbarMachineModel(s.machine, errors, np.array(t["pivot_actual"]), ids,
-                                        [float(t["effects"][i]) for i in ids])
+    model = rotacal.BallbarMachineModel(
+        s.machine, errors, np.array(t["pivot_actual"]), ids, [float(t["effects"][i]) for i in ids]
+    )
     predicted = rotacal.predict(model, s).length
     rms_um = np.sqrt(np.mean((s.length - predicted) ** 2)) * 1e3
     assert abs(rms_um - t["noise_um"]) <= 0.15 * t["noise_um"], rms_um

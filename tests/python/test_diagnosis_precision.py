@@ -3,6 +3,7 @@ the independent reference simulator (tests/reference/refsim), with set-ups and s
 than the issue's, in coloured noise where it applies. A session is judged as a calibration
 engineer reads it: a cause named alone must be the hidden one; "one of these" must hold it;
 nothing is an allowed answer where the data cannot decide."""
+
 import sys
 from pathlib import Path
 
@@ -19,38 +20,68 @@ import rotacal  # noqa: E402
 def location_errors(machine, rng) -> dict:
     """Location errors of a few tens of um and urad, as a machine after assembly has them."""
     m = refsim.builtin(machine)
-    return {n: (rng.normal(0, 20e-3) if n[-3] in "XYZUV" and "D" not in n[2:4] else rng.normal(0, 40e-6))
-            for n in m.error_names()}
+    return {
+        n: (
+            rng.normal(0, 20e-3) if n[-3] in "XYZUV" and "D" not in n[2:4] else rng.normal(0, 40e-6)
+        )
+        for n in m.error_names()
+    }
 
 
-def rtest_session(tmp_path, effects, seed, nests=((100.0, 0.0, 60.0), (0.0, -120.0, 140.0)),
-                  noise_um=0.3, rho=0.0, machine="BC-trt"):
+def rtest_session(
+    tmp_path,
+    effects,
+    seed,
+    nests=((100.0, 0.0, 60.0), (0.0, -120.0, 140.0)),
+    noise_um=0.3,
+    rho=0.0,
+    machine="BC-trt",
+):
     rng = np.random.default_rng(seed)
     m = refsim.builtin(machine)
     s = poses.rtest_grid(m, nests=nests)
     model = refsim.Model(m, location_errors(machine, rng), effects)
-    d = refsim.rtest_displacements(model, s["nests"], s["setup"], s["xyz"], np.radians(s["angles_deg"]), s["time"])
+    d = refsim.rtest_displacements(
+        model, s["nests"], s["setup"], s["xyz"], np.radians(s["angles_deg"]), s["time"]
+    )
     zeros = {k: rng.normal(0, 5e-3, 3) for k in s["nests"]}  # each set-up's unknown probe zero
     d = d + np.array([zeros[k] for k in s["setup"]])
     for a in range(3):
-        d[:, a] += (noise.ar1(s["setup"], rho, noise_um * 1e-3, rng) if rho else
-                    noise.white(len(d), noise_um * 1e-3, rng))
+        d[:, a] += (
+            noise.ar1(s["setup"], rho, noise_um * 1e-3, rng)
+            if rho
+            else noise.white(len(d), noise_um * 1e-3, rng)
+        )
     path = writers.write_rtest(tmp_path / f"rtest_{seed}.csv", m, s, d, noise_um=noise_um)
     return rotacal.load(path)
 
 
-def ballbar_session(tmp_path, effects, seed, pivot=(120.0, 0.0, 60.0), noise_um=0.5, rho=0.0,
-                    machine="AC-trt", declare_noise=True):
+def ballbar_session(
+    tmp_path,
+    effects,
+    seed,
+    pivot=(120.0, 0.0, 60.0),
+    noise_um=0.5,
+    rho=0.0,
+    machine="AC-trt",
+    declare_noise=True,
+):
     rng = np.random.default_rng(seed)
     m = refsim.builtin(machine)
     s = poses.ballbar_single_setup(m, pivot=pivot)
     model = refsim.Model(m, location_errors(machine, rng), effects)
     actual_pivot = np.asarray(pivot) + rng.normal(0, 10e-3, 3)  # the set-up error
-    length = refsim.ballbar_lengths(model, actual_pivot, s["xyz"], np.radians(s["angles_deg"]), s["time"])
-    length = length + (noise.ar1(s["test"], rho, noise_um * 1e-3, rng) if rho else
-                       noise.white(len(length), noise_um * 1e-3, rng))
-    path = writers.write_ballbar(tmp_path / f"ballbar_{seed}.csv", m, s, length,
-                                 noise_um=noise_um if declare_noise else None)
+    length = refsim.ballbar_lengths(
+        model, actual_pivot, s["xyz"], np.radians(s["angles_deg"]), s["time"]
+    )
+    length = length + (
+        noise.ar1(s["test"], rho, noise_um * 1e-3, rng)
+        if rho
+        else noise.white(len(length), noise_um * 1e-3, rng)
+    )
+    path = writers.write_ballbar(
+        tmp_path / f"ballbar_{seed}.csv", m, s, length, noise_um=noise_um if declare_noise else None
+    )
     return rotacal.load(path)
 
 
@@ -72,8 +103,11 @@ def assert_determined(d: dict) -> None:
 
 
 @pytest.mark.parametrize("amplitude", [1.2e-5, 2.5e-5])
-@pytest.mark.parametrize("nests", [((100.0, 0.0, 60.0), (0.0, -120.0, 140.0)),
-                                   ((130.0, 40.0, 40.0), (-30.0, -100.0, 170.0))], ids=["default", "other"])
+@pytest.mark.parametrize(
+    "nests",
+    [((100.0, 0.0, 60.0), (0.0, -120.0, 140.0)), ((130.0, 40.0, 40.0), (-30.0, -100.0, 170.0))],
+    ids=["default", "other"],
+)
 def test_rtest_wobble_of_c_is_named_as_wobble_not_face_runout(tmp_path, nests, amplitude):
     """The C table's first-order wobble moves two nests at different heights differently, a face
     runout moves both alike: with two nests the diagnosis names the wobble (it named axial_motion_C_h1
@@ -114,8 +148,14 @@ def test_ballbar_sag_in_strongly_correlated_noise_is_never_named_wrong(tmp_path,
     the sag is at the edge of what such noise lets an oracle see (docs/noise_model.md), so
     "nothing" is an answer; a wrong name (radial_motion_A_h3, tilt_motion_A_h3 at 14 sigma)
     is not."""
-    s = ballbar_session(tmp_path, {"gravity_sag_A": [5e-3]}, seed=seed, pivot=(100.0, 20.0, 70.0), rho=0.9,
-                        declare_noise=False)
+    s = ballbar_session(
+        tmp_path,
+        {"gravity_sag_A": [5e-3]},
+        seed=seed,
+        pivot=(100.0, 20.0, 70.0),
+        rho=0.9,
+        declare_noise=False,
+    )
     r = rotacal.diagnose(s).to_dict()
     assert verdict(r, "gravity_sag_A") != "wrong", r["findings"][:1]
     assert_determined(r)
@@ -152,7 +192,9 @@ def test_ballbar_finding_uncertainty_holds_in_strongly_correlated_noise(tmp_path
     truth = [4e-3, -3e-3, 2e-3, 3e-3]
     z = []
     for seed in range(100, 116):
-        s = ballbar_session(tmp_path, {"radial_motion_C_h2": truth}, seed=seed, rho=0.9, declare_noise=False)
+        s = ballbar_session(
+            tmp_path, {"radial_motion_C_h2": truth}, seed=seed, rho=0.9, declare_noise=False
+        )
         d = rotacal.diagnose(s).to_dict()
         assert verdict(d, "radial_motion_C_h2") != "wrong", d["findings"][:1]
         if d["findings"] and d["findings"][0]["effect"] == "radial_motion_C_h2":
@@ -161,15 +203,19 @@ def test_ballbar_finding_uncertainty_holds_in_strongly_correlated_noise(tmp_path
                     z.append((p["value"] - t) / p["std"])
     z = np.asarray(z)
     assert len(z) >= 16
-    assert 0.6 < np.sqrt(np.mean(z ** 2)) < 1.6, z
+    assert 0.6 < np.sqrt(np.mean(z**2)) < 1.6, z
     assert np.mean(np.abs(z) <= 2.0) >= 0.75, z
 
 
-@pytest.mark.parametrize("machine,effect,params", [
-    ("AC-trt", "tilt_motion_A_h2", [0.0, 5e-6, 0.0, 0.0]),
-    ("BC-trt", "radial_motion_B_h2", [0.0, 3e-4, 0.0, 6e-4]),
-    ("AC-trt", "straightness_ZX", [3e-5, -7e-5, 1.6e-4]),
-], ids=["tilt_h2-vs-coning", "radial_h2-vs-sag", "straightness-vs-axial_h2"])
+@pytest.mark.parametrize(
+    "machine,effect,params",
+    [
+        ("AC-trt", "tilt_motion_A_h2", [0.0, 5e-6, 0.0, 0.0]),
+        ("BC-trt", "radial_motion_B_h2", [0.0, 3e-4, 0.0, 6e-4]),
+        ("AC-trt", "straightness_ZX", [3e-5, -7e-5, 1.6e-4]),
+    ],
+    ids=["tilt_h2-vs-coning", "radial_h2-vs-sag", "straightness-vs-axial_h2"],
+)
 def test_ballbar_weak_effect_is_never_named_as_a_simpler_rival(tmp_path, machine, effect, params):
     """Near the detection limit (AR(1) rho 0.5, another pivot than the bench's), a simpler
     candidate that fits the readings as well, or nearly, was named alone at a weight of 0.95-1.0:
@@ -181,12 +227,21 @@ def test_ballbar_weak_effect_is_never_named_as_a_simpler_rival(tmp_path, machine
     BIC's: the answer is "one of these" (holding the truth) or nothing, never a wrong name
     (main at 502354a: 6 wrong of these 36 sessions)."""
     for seed in range(200, 212):
-        s = ballbar_session(tmp_path, {effect: params}, seed=seed, machine=machine, rho=0.5, pivot=(100.0, 20.0, 70.0))
+        s = ballbar_session(
+            tmp_path,
+            {effect: params},
+            seed=seed,
+            machine=machine,
+            rho=0.5,
+            pivot=(100.0, 20.0, 70.0),
+        )
         r = rotacal.diagnose(s).to_dict()
         assert verdict(r, effect) != "wrong", (seed, r["findings"][:1])
 
 
-def ballbar_pink_session(tmp_path, effects, seed, machine="AC-trt", pivot=(120.0, 0.0, 60.0), noise_um=0.5):
+def ballbar_pink_session(
+    tmp_path, effects, seed, machine="AC-trt", pivot=(120.0, 0.0, 60.0), noise_um=0.5
+):
     """A ballbar session in refsim's 1/f-like noise (equal-variance AR(1)s of 1 to 1000 samples),
     one stream per test, its 1-sigma declared in the file."""
     rng = np.random.default_rng(seed)
@@ -194,9 +249,13 @@ def ballbar_pink_session(tmp_path, effects, seed, machine="AC-trt", pivot=(120.0
     s = poses.ballbar_single_setup(m, pivot=pivot)
     model = refsim.Model(m, location_errors(machine, rng), effects)
     actual_pivot = np.asarray(pivot) + rng.normal(0, 10e-3, 3)
-    length = refsim.ballbar_lengths(model, actual_pivot, s["xyz"], np.radians(s["angles_deg"]), s["time"])
+    length = refsim.ballbar_lengths(
+        model, actual_pivot, s["xyz"], np.radians(s["angles_deg"]), s["time"]
+    )
     length = length + noise.pink(s["test"], noise_um * 1e-3, rng)
-    path = writers.write_ballbar(tmp_path / f"ballbar_pink_{seed}.csv", m, s, length, noise_um=noise_um)
+    path = writers.write_ballbar(
+        tmp_path / f"ballbar_pink_{seed}.csv", m, s, length, noise_um=noise_um
+    )
     return rotacal.load(path)
 
 
@@ -206,7 +265,9 @@ def found_in_pink_sessions(tmp_path, effect, params, seeds, null_seeds, **setup)
     has a determined parameter, and the null sessions of `null_seeds` stay clean."""
     found = 0
     for seed in seeds:
-        r = rotacal.diagnose(ballbar_pink_session(tmp_path, {effect: params}, seed, **setup)).to_dict()
+        r = rotacal.diagnose(
+            ballbar_pink_session(tmp_path, {effect: params}, seed, **setup)
+        ).to_dict()
         v = verdict(r, effect)
         assert v != "wrong", (seed, r["findings"][:1])
         assert_determined(r)
@@ -227,7 +288,9 @@ def test_ballbar_drift_in_one_over_f_noise_is_not_taken_for_the_noise(tmp_path):
     stay clean."""
     found = 0
     for seed in range(300, 312):
-        r = rotacal.diagnose(ballbar_pink_session(tmp_path, {"thermal_drift_X": [1.9e-5]}, seed)).to_dict()
+        r = rotacal.diagnose(
+            ballbar_pink_session(tmp_path, {"thermal_drift_X": [1.9e-5]}, seed)
+        ).to_dict()
         v = verdict(r, "thermal_drift_X")
         assert v != "wrong", (seed, r["findings"][:1])
         assert_determined(r)
@@ -249,14 +312,24 @@ def test_ballbar_slow_shape_in_one_over_f_noise_is_found(tmp_path):
     names a wrong cause."""
     found = 0
     for seed in range(400, 410):
-        r = rotacal.diagnose(ballbar_pink_session(tmp_path, {"tilt_motion_C_h4": [0.0, 0.0, 4.5e-6, 0.0]}, seed,
-                                                  machine="BC-trt", pivot=(100.0, 20.0, 70.0))).to_dict()
+        r = rotacal.diagnose(
+            ballbar_pink_session(
+                tmp_path,
+                {"tilt_motion_C_h4": [0.0, 0.0, 4.5e-6, 0.0]},
+                seed,
+                machine="BC-trt",
+                pivot=(100.0, 20.0, 70.0),
+            )
+        ).to_dict()
         v = verdict(r, "tilt_motion_C_h4")
         assert v != "wrong", (seed, r["findings"][:1])
         assert_determined(r)
         found += v in ("right", "ambiguous")
-        null = rotacal.diagnose(ballbar_pink_session(tmp_path, {}, seed + 100, machine="BC-trt",
-                                                     pivot=(100.0, 20.0, 70.0))).to_dict()
+        null = rotacal.diagnose(
+            ballbar_pink_session(
+                tmp_path, {}, seed + 100, machine="BC-trt", pivot=(100.0, 20.0, 70.0)
+            )
+        ).to_dict()
         assert not null["findings"], (seed + 100, null["findings"][:1])
     assert found >= 8, found
 
@@ -286,14 +359,16 @@ def ballbar_gls_sigma(machine, effect, k, rho, noise_um, pivot=(120.0, 0.0, 60.0
     for i in range(k):
         h = np.zeros(k)
         h[i] = 1e-6
-        cols.append((lengths(np.zeros(len(names)), p=h) - lengths(np.zeros(len(names)), p=-h)) / 2e-6)
+        cols.append(
+            (lengths(np.zeros(len(names)), p=h) - lengths(np.zeros(len(names)), p=-h)) / 2e-6
+        )
     X = np.column_stack(cols)
     tests = np.asarray(s["test"])
     whitened = np.empty_like(X)
     for t in dict.fromkeys(s["test"]):
         idx = np.flatnonzero(tests == t)
         lag = np.abs(np.subtract.outer(np.arange(len(idx)), np.arange(len(idx))))
-        chol = np.linalg.cholesky((noise_um * 1e-3) ** 2 * rho ** lag)
+        chol = np.linalg.cholesky((noise_um * 1e-3) ** 2 * rho**lag)
         whitened[idx] = np.linalg.solve(chol, X[idx])
     return np.sqrt(np.diag(np.linalg.inv(whitened.T @ whitened))[-k:])
 
@@ -331,8 +406,15 @@ def test_ballbar_weak_shape_in_one_over_f_noise_is_not_taken_for_the_walk(tmp_pa
     covariance gives -12 to -28. The round's best few candidates are now judged under the walk
     estimated with their own columns: found (in the group) in 8 of these 10 sessions, 5 on main
     at 0da6be6. Null sessions of the same set-up stay clean and no session names a wrong cause."""
-    found = found_in_pink_sessions(tmp_path, "axial_motion_C_h3", [5.0e-4, 0.0], range(600, 610), range(700, 704),
-                                   machine="BC-trt", pivot=(110.0, -10.0, 65.0))
+    found = found_in_pink_sessions(
+        tmp_path,
+        "axial_motion_C_h3",
+        [5.0e-4, 0.0],
+        range(600, 610),
+        range(700, 704),
+        machine="BC-trt",
+        pivot=(110.0, -10.0, 65.0),
+    )
     assert found >= 7, found
 
 
@@ -345,18 +427,24 @@ def test_ballbar_length_offset_in_one_over_f_noise_is_not_taken_for_the_levels(t
     (search_round.cpp, h-pink10): found in 3. No session names a wrong cause."""
     found = 0
     for seed in range(800, 806):
-        r = rotacal.diagnose(ballbar_pink_session(tmp_path, {"ballbar_length_offset": [9.0e-4]}, seed,
-                                                  pivot=(110.0, 15.0, 70.0))).to_dict()
+        r = rotacal.diagnose(
+            ballbar_pink_session(
+                tmp_path, {"ballbar_length_offset": [9.0e-4]}, seed, pivot=(110.0, 15.0, 70.0)
+            )
+        ).to_dict()
         v = verdict(r, "ballbar_length_offset")
         assert v != "wrong", (seed, r["findings"][:1])
         found += v in ("right", "ambiguous")
     assert found >= 3, found
 
 
-@pytest.mark.parametrize("effect,params", [
-    ("linear_squareness_ZX", [1.2e-5]),  # some 3.5x its half-detection amplitude in white noise
-    ("tilt_motion_B_h4", [4.5e-6, 0.0, -2.2e-6, 0.0]),  # some 3.6x
-])
+@pytest.mark.parametrize(
+    "effect,params",
+    [
+        ("linear_squareness_ZX", [1.2e-5]),  # some 3.5x its half-detection amplitude in white noise
+        ("tilt_motion_B_h4", [4.5e-6, 0.0, -2.2e-6, 0.0]),  # some 3.6x
+    ],
+)
 def test_ballbar_middle_speed_shape_in_one_over_f_noise_is_found(tmp_path, effect, params):
     """A squareness and a fourth-order tilt of B on the BC-trt ballbar in 1/f-like noise, another
     pivot than the bench's: shapes only partly a level and a slope per test, which the round
@@ -367,6 +455,13 @@ def test_ballbar_middle_speed_shape_in_one_over_f_noise_is_found(tmp_path, effec
     quarters of the way from the within-stream bound (search_round.cpp, hidden_levels.cpp):
     found in 6 of 10 each. No session names a wrong cause, and null sessions of the same set-up
     stay clean."""
-    found = found_in_pink_sessions(tmp_path, effect, params, range(900, 910), range(1000, 1004),
-                                   machine="BC-trt", pivot=(100.0, -15.0, 70.0))
+    found = found_in_pink_sessions(
+        tmp_path,
+        effect,
+        params,
+        range(900, 910),
+        range(1000, 1004),
+        machine="BC-trt",
+        pivot=(100.0, -15.0, 70.0),
+    )
     assert found >= 5, found

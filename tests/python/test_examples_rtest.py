@@ -1,4 +1,5 @@
 """examples/rtest_error_map.py, run as a user runs it (as test_cli.py runs the other examples)."""
+
 import json
 import subprocess
 import sys
@@ -10,8 +11,12 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def run_example(*args):
-    return subprocess.run([sys.executable, str(ROOT / "examples" / "rtest_error_map.py"), *map(str, args)],
-                          capture_output=True, text=True, timeout=300)
+    return subprocess.run(
+        [sys.executable, str(ROOT / "examples" / "rtest_error_map.py"), *map(str, args)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
 
 
 def test_rtest_error_map_example_on_the_shared_file(shared_data, tmp_path):

@@ -1,4 +1,5 @@
 """Python geometric fits (circle, sphere, plane) against an independent SciPy fit, and their typed errors."""
+
 import numpy as np
 import pytest
 from scipy.optimize import least_squares

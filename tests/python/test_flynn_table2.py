@@ -1,5 +1,6 @@
 """Flynn et al. (2016) Table 2 as a real-data case: the shipped table against the paper's text,
 the analysis on a synthetic before/after pair with a known hidden cause, and on Table 2."""
+
 import json
 import re
 from decimal import Decimal
@@ -11,7 +12,9 @@ import pytest
 import rotacal
 from rotacal import flynn_table2 as ft
 
-PAPER = Path(__file__).resolve().parents[3] / "shared" / "papers" / "flynn2016-single-setup-ballbar.txt"
+PAPER = (
+    Path(__file__).resolve().parents[3] / "shared" / "papers" / "flynn2016-single-setup-ballbar.txt"
+)
 NAMES = list(rotacal.location_error_names(rotacal.MachineType.AC_trt))
 
 
@@ -22,7 +25,7 @@ def paper_table2() -> dict:
     lines = PAPER.read_text().splitlines()
     start = next(i for i, ln in enumerate(lines) if ln.startswith("Table 2:"))
     rows = {}
-    for ln in lines[start + 1:]:
+    for ln in lines[start + 1 :]:
         if ln.startswith("ACKNOWLEDGEMENTS"):
             break
         cells = ln.split("\t")
@@ -43,7 +46,12 @@ def test_table_matches_the_paper_text_character_for_character():
     assert [r["name"] for r in shipped["rows"]] == NAMES
     for r in shipped["rows"]:
         u, c, pct, unit = paper[r["name"]]
-        assert (r["uncompensated"], r["compensated"], r["change_percent"], r["unit"]) == (u, c, pct, unit), r["name"]
+        assert (r["uncompensated"], r["compensated"], r["change_percent"], r["unit"]) == (
+            u,
+            c,
+            pct,
+            unit,
+        ), r["name"]
     assert shipped["source"]["table"].startswith("Table 2")
 
 
@@ -58,7 +66,7 @@ def _percent_agrees(row: dict, printed: dict) -> bool:
     b, a = row["before"], row["after"]
     pct = float(row["printed"]["change_percent"].strip("()"))
     db, da = _last_digit(printed["uncompensated"]), _last_digit(printed["compensated"])
-    tol = 100 * (da / abs(b) + (abs(a) + da) * db / b ** 2) + 0.0005
+    tol = 100 * (da / abs(b) + (abs(a) + da) * db / b**2) + 0.0005
     return abs(100 * (abs(a) - abs(b)) / abs(b) - pct) <= tol
 
 
@@ -81,7 +89,7 @@ def test_loaded_values_reproduce_the_papers_percent_column():
 
 def test_bad_table_files_raise_typed_errors(tmp_path):
     p = tmp_path / "t.json"
-    p.write_text("{\"rows\": [")
+    p.write_text('{"rows": [')
     with pytest.raises(rotacal.ParseError, match="t.json"):
         ft.load_table2(p)
     d = json.loads(ft.TABLE2_PATH.read_text())
@@ -109,18 +117,43 @@ def _synthetic_pair(shift_y_mm: float, seed: int) -> dict:
     params = [15e-6, 0.003, 0.0008, -0.0005]
 
     def measure(program, errs, piv, s):
-        sim = rotacal.simulate_ballbar(program, rotacal.BallbarMachineModel(m, errs, piv, effects, params), 0.5, s)
-        return rotacal.BallbarSession(m, sim.ballbar_length, cmd.pivot, sim.tests, sim.time, cmd.xyz,
-                                      sim.angles_deg, sim.length, 0.5)
+        sim = rotacal.simulate_ballbar(
+            program, rotacal.BallbarMachineModel(m, errs, piv, effects, params), 0.5, s
+        )
+        return rotacal.BallbarSession(
+            m,
+            sim.ballbar_length,
+            cmd.pivot,
+            sim.tests,
+            sim.time,
+            cmd.xyz,
+            sim.angles_deg,
+            sim.length,
+            0.5,
+        )
 
-    e1 = np.array([p.value for p in rotacal.identify(measure(cmd, errors, pivot, seed), "paper").parameters[:8]])
+    e1 = np.array(
+        [
+            p.value
+            for p in rotacal.identify(measure(cmd, errors, pivot, seed), "paper").parameters[:8]
+        ]
+    )
     program = rotacal.plan_ballbar_test(setup, e1).commanded_session()
     shift = np.zeros(8)
     shift[[0, 5]] = shift_y_mm  # E_Y0A and E_Y0C: the whole table moved along Y
     s2 = measure(program, errors + shift, pivot + np.array([0.0, shift_y_mm, 0.0]), seed + 1)
     e2 = np.array([p.value for p in rotacal.identify(s2, "paper").parameters[:8]])
-    return {"rows": [{"name": n, "unit": "mm" if i % 4 < 2 else "rad", "before": float(e1[i]), "after": float(e2[i])}
-                     for i, n in enumerate(NAMES)]}
+    return {
+        "rows": [
+            {
+                "name": n,
+                "unit": "mm" if i % 4 < 2 else "rad",
+                "before": float(e1[i]),
+                "after": float(e2[i]),
+            }
+            for i, n in enumerate(NAMES)
+        ]
+    }
 
 
 def test_a_hidden_table_shift_between_the_runs_is_named_first_with_its_size():
@@ -144,7 +177,9 @@ def test_a_hidden_table_shift_between_the_runs_is_named_first_with_its_size():
 
 
 def test_table2_analysis_runs_and_is_strict_json():
-    r = ft.analyse(draws=30, seed=1, sweep=[("bar 150 mm", {"ballbar_length": 150.0})], sweep_draws=20)
+    r = ft.analyse(
+        draws=30, seed=1, sweep=[("bar 150 mm", {"ballbar_length": 150.0})], sweep_draws=20
+    )
     text = json.dumps(r, allow_nan=False)
     back = json.loads(text)
     assert set(back["prediction"]) == set(NAMES)
@@ -152,8 +187,10 @@ def test_table2_analysis_runs_and_is_strict_json():
     p = back["prediction"]["E_Y0A"]
     assert p["measured_after"] == pytest.approx(10.0) and p["outside"] and p["predicted_std"] < 1.0
     assert len(back["sweep"]) == 1 and back["sweep"][0]["scenario"] == "bar 150 mm"
-    assert back["extended_model"]["sum_abs_unexplained"]["um"]["extended"] \
+    assert (
+        back["extended_model"]["sum_abs_unexplained"]["um"]["extended"]
         <= back["extended_model"]["sum_abs_unexplained"]["um"]["baseline"]
+    )
     out = ft.render(r)
     for n in NAMES:
         assert n in out

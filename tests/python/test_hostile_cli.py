@@ -2,6 +2,7 @@
 reproducer of the issue, and each must end in a clean refusal with the documented exit code
 (3 invalid content or arguments, 4 file system or device) or a correct result; never a
 traceback, never a file destroyed."""
+
 import json
 import os
 import random
@@ -24,14 +25,22 @@ EXIT_INPUT, EXIT_IO = 3, 4
 def rotacal_cli(*args, cwd=None, timeout=300, memory_bytes=None):
     """In this process, unless under a memory limit (a child's, so that a runaway reader fails
     inside it and does not take the machine)."""
+
     def limit():
         resource.setrlimit(resource.RLIMIT_AS, (memory_bytes, memory_bytes))
 
     if memory_bytes is None:
         r = run_cli(*args, cwd=cwd)
     else:
-        r = subprocess.run([sys.executable, "-m", "rotacal", *map(str, args)], capture_output=True, text=True,
-                           errors="replace", cwd=cwd, timeout=timeout, preexec_fn=limit)
+        r = subprocess.run(
+            [sys.executable, "-m", "rotacal", *map(str, args)],
+            capture_output=True,
+            text=True,
+            errors="replace",
+            cwd=cwd,
+            timeout=timeout,
+            preexec_fn=limit,
+        )
     assert "Traceback" not in r.stderr, r.stderr[-3000:]
     return r
 
@@ -39,10 +48,12 @@ def rotacal_cli(*args, cwd=None, timeout=300, memory_bytes=None):
 def strict_json(text):
     def refuse(name):
         raise ValueError(f"not strict JSON: {name}")
+
     return json.loads(text, parse_constant=refuse)
 
 
 # ------------------------------------------------------------------------- the files
+
 
 def _rows(path):
     """(comment lines + column line, data rows) of a session file."""
@@ -54,7 +65,7 @@ def _rows(path):
 def _with_field(rows, k, col, value):
     f = rows[k].split(",")
     f[col] = value
-    return rows[:k] + [",".join(f)] + rows[k + 1:]
+    return rows[:k] + [",".join(f)] + rows[k + 1 :]
 
 
 @pytest.fixture(scope="module")
@@ -74,7 +85,7 @@ def files(shared_data, tmp_path_factory):
     lines_bad[k] = bytes(bad)
     (d / "nonutf8.csv").write_bytes(b"\n".join(lines_bad))
     lines_label = list(lines)
-    lines_label[k] = b"\xfe\xfelabel" + lines[k][lines[k].index(b","):]
+    lines_label[k] = b"\xfe\xfelabel" + lines[k][lines[k].index(b",") :]
     (d / "label.csv").write_bytes(b"\n".join(lines_label))
     (d / "utf16.csv").write_bytes(raw.decode().encode("utf-16"))
     rng = random.Random(17)
@@ -83,17 +94,32 @@ def files(shared_data, tmp_path_factory):
 
     script = "<script>alert(1)</script>"
     first_label = rows[0].split(",")[0]
-    (d / "html.csv").write_text("\n".join(head + [script + r[len(first_label):] if r.startswith(first_label + ",")
-                                                  else r for r in rows]) + "\n")
+    (d / "html.csv").write_text(
+        "\n".join(
+            head
+            + [
+                script + r[len(first_label) :] if r.startswith(first_label + ",") else r
+                for r in rows
+            ]
+        )
+        + "\n"
+    )
     # One row, again and again: nothing is determined (NaN and infinity inside the fit).
-    same = [",".join([rows[100].split(",")[0], f"{0.1 * i:.1f}", *rows[100].split(",")[2:]]) for i in range(200)]
+    same = [
+        ",".join([rows[100].split(",")[0], f"{0.1 * i:.1f}", *rows[100].split(",")[2:]])
+        for i in range(200)
+    ]
     (d / "same.csv").write_text("\n".join(head + same) + "\n")
     (d / "big_length.csv").write_text("\n".join(head + _with_field(rows, 5, 7, "1e308")) + "\n")
     (d / "big_x.csv").write_text("\n".join(head + _with_field(rows, 5, 2, "1e160")) + "\n")
     rhead, rrows = _rows(out["rtest"])
     cols = rhead[-1].split(",")
-    (d / "big_dx.csv").write_text("\n".join(rhead + _with_field(rrows, 5, cols.index("dx"), "1e308")) + "\n")
-    (d / "big_b.csv").write_text("\n".join(rhead + _with_field(rrows, 5, cols.index("B"), "1e308")) + "\n")
+    (d / "big_dx.csv").write_text(
+        "\n".join(rhead + _with_field(rrows, 5, cols.index("dx"), "1e308")) + "\n"
+    )
+    (d / "big_b.csv").write_text(
+        "\n".join(rhead + _with_field(rrows, 5, cols.index("B"), "1e308")) + "\n"
+    )
     out.update({p.stem: p for p in d.glob("*.csv")})
     out["dir"] = d
     return out
@@ -105,31 +131,34 @@ SIM = ("simulate", "ballbar")
 SIM_R = ("simulate", "rtest")
 
 
-@pytest.mark.parametrize("args,option", [
-    (SIM_R + ("--c-step", "1e-7"), "--c-step"),
-    (SIM_R + ("--b-step", "1e-7"), "--b-step"),
-    (SIM_R + ("--dwell", "-1"), "--dwell"),
-    (SIM_R + ("--dwell", "nan"), "--dwell"),
-    (SIM_R + ("--noise", "1e5"), "--noise"),
-    (SIM_R + ("--seed", "-1"), "--seed"),
-    (SIM + ("--seed", "-1"), "--seed"),
-    (SIM + ("--seed", "12345678901234567890"), "--seed"),
-    (SIM + ("--seed", "1.5"), "--seed"),
-    (SIM + ("--pivot-error", "-1"), "--pivot-error"),
-    (SIM + ("--noise", "1e5"), "--noise"),
-    (SIM + ("--noise", "inf"), "--noise"),
-    (SIM + ("--length", "5", "--noise", "999"), "--noise"),
-    (SIM + ("--effect", "gravity_sag_A=nan"), "gravity_sag_A"),
-    (SIM + ("--errors", "E_Y0A=1e300"), "E_Y0A"),
-    (("plan", "ballbar", "--length", "1e9"), "--length"),
-    (("plan", "ballbar", "--length", "1e300"), "--length"),
-    (("plan", "ballbar", "--length", "0"), "--length"),
-    (("plan", "ballbar", "--pivot", "1e300,0,60"), "--pivot"),
-    (("plan", "ballbar", "--step", "0"), "--step"),
-    (("plan", "ballbar", "--step", "-1"), "--step"),
-    (("plan", "ballbar", "--feed", "0"), "--feed"),
-    (("plan", "ballbar", "--a-range", "-1e9,90"), "--a-range"),
-])
+@pytest.mark.parametrize(
+    "args,option",
+    [
+        (SIM_R + ("--c-step", "1e-7"), "--c-step"),
+        (SIM_R + ("--b-step", "1e-7"), "--b-step"),
+        (SIM_R + ("--dwell", "-1"), "--dwell"),
+        (SIM_R + ("--dwell", "nan"), "--dwell"),
+        (SIM_R + ("--noise", "1e5"), "--noise"),
+        (SIM_R + ("--seed", "-1"), "--seed"),
+        (SIM + ("--seed", "-1"), "--seed"),
+        (SIM + ("--seed", "12345678901234567890"), "--seed"),
+        (SIM + ("--seed", "1.5"), "--seed"),
+        (SIM + ("--pivot-error", "-1"), "--pivot-error"),
+        (SIM + ("--noise", "1e5"), "--noise"),
+        (SIM + ("--noise", "inf"), "--noise"),
+        (SIM + ("--length", "5", "--noise", "999"), "--noise"),
+        (SIM + ("--effect", "gravity_sag_A=nan"), "gravity_sag_A"),
+        (SIM + ("--errors", "E_Y0A=1e300"), "E_Y0A"),
+        (("plan", "ballbar", "--length", "1e9"), "--length"),
+        (("plan", "ballbar", "--length", "1e300"), "--length"),
+        (("plan", "ballbar", "--length", "0"), "--length"),
+        (("plan", "ballbar", "--pivot", "1e300,0,60"), "--pivot"),
+        (("plan", "ballbar", "--step", "0"), "--step"),
+        (("plan", "ballbar", "--step", "-1"), "--step"),
+        (("plan", "ballbar", "--feed", "0"), "--feed"),
+        (("plan", "ballbar", "--a-range", "-1e9,90"), "--a-range"),
+    ],
+)
 def test_numeric_options_are_bounded(tmp_path, args, option):
     out = tmp_path / "out.any"
     r = rotacal_cli(*args, "-o", out, timeout=60)
@@ -143,8 +172,15 @@ def test_max_harmonic_is_bounded(files, value):
     assert r.returncode == EXIT_INPUT and "--max-harmonic" in r.stderr, r.stderr
 
 
-@pytest.mark.parametrize("command", [("report", "{good}"), ("predict", "{good}", "--model", "{good}"),
-                                     ("simulate", "ballbar"), ("plan", "ballbar")])
+@pytest.mark.parametrize(
+    "command",
+    [
+        ("report", "{good}"),
+        ("predict", "{good}", "--model", "{good}"),
+        ("simulate", "ballbar"),
+        ("plan", "ballbar"),
+    ],
+)
 def test_empty_output_name(files, command):
     r = rotacal_cli(*[c.format(**files) for c in command], "-o", "", timeout=60)
     assert r.returncode == EXIT_INPUT and "--output" in r.stderr and "empty" in r.stderr, r.stderr
@@ -157,22 +193,35 @@ def test_monte_carlo_draws_bounded(files):
 
 # ------------------------------------------------------------------------- input decoding
 
+
 @pytest.mark.parametrize("command", ["identify", "diagnose", "report"])
 def test_non_utf8_byte_names_file_line_column(files, tmp_path, command):
     extra = ["-o", tmp_path / "r.html"] if command == "report" else []
     r = rotacal_cli(command, files["nonutf8"], *extra, timeout=60)
     line, col = files["nonutf8_line"]
     assert r.returncode == EXIT_INPUT, r.stderr
-    assert f"nonutf8.csv:{line}:{col}:" in r.stderr and "0xff" in r.stderr.lower() and "UTF-8" in r.stderr
+    assert (
+        f"nonutf8.csv:{line}:{col}:" in r.stderr
+        and "0xff" in r.stderr.lower()
+        and "UTF-8" in r.stderr
+    )
     assert not (tmp_path / "r.html").exists()
 
 
-@pytest.mark.parametrize("command", [("identify",), ("diagnose", "--json"), ("report", "-o", "{out}")])
+@pytest.mark.parametrize(
+    "command", [("identify",), ("diagnose", "--json"), ("report", "-o", "{out}")]
+)
 def test_non_utf8_label_refused_by_every_command(files, tmp_path, command):
     # A label that is not UTF-8 used to pass identify and crash report, diagnose --json.
-    r = rotacal_cli(command[0], files["label"], *[c.format(out=tmp_path / "r.html") for c in command[1:]],
-                    timeout=60)
-    assert r.returncode == EXIT_INPUT and "label.csv:" in r.stderr and "0xfe" in r.stderr.lower(), r.stderr
+    r = rotacal_cli(
+        command[0],
+        files["label"],
+        *[c.format(out=tmp_path / "r.html") for c in command[1:]],
+        timeout=60,
+    )
+    assert r.returncode == EXIT_INPUT and "label.csv:" in r.stderr and "0xfe" in r.stderr.lower(), (
+        r.stderr
+    )
 
 
 def test_utf16_said_so(files):
@@ -254,12 +303,15 @@ def test_json_is_strict_on_identical_rows(files, tmp_path):
     # p-values undetermined (NaN, infinity): strict JSON has null there and says why.
     import rotacal
     from rotacal import jsontext
+
     s = rotacal.load(files["same"])
     d = strict_json(jsontext.dumps(rotacal.diagnose(s).to_dict()))
     assert d["baseline"]["p_value"] is None
     assert "not determined" in d["null_reasons"]["/baseline/p_value"]
     result = rotacal.identify(s)
-    assert strict_json(jsontext.dumps(result.to_dict()))["location_errors"]["E_Y0A"]["value"] is None
+    assert (
+        strict_json(jsontext.dumps(result.to_dict()))["location_errors"]["E_Y0A"]["value"] is None
+    )
     model = tmp_path / "m.json"
     rotacal.save_model(result.model_dict(), model)
     strict_json(model.read_text())
@@ -267,15 +319,21 @@ def test_json_is_strict_on_identical_rows(files, tmp_path):
 
 def test_jsontext_writes_null_with_reasons():
     from rotacal import jsontext
-    d = strict_json(jsontext.dumps({"a": float("inf"), "b/c": [1.0, float("nan")], "d": -float("inf")}))
+
+    d = strict_json(
+        jsontext.dumps({"a": float("inf"), "b/c": [1.0, float("nan")], "d": -float("inf")})
+    )
     assert d["a"] is None and d["b/c"] == [1.0, None]
-    assert d["null_reasons"] == {"/a": "+Infinity: not determined by the data",
-                                 "/b~1c/1": "NaN: not determined by the data",
-                                 "/d": "-Infinity: not determined by the data"}
+    assert d["null_reasons"] == {
+        "/a": "+Infinity: not determined by the data",
+        "/b~1c/1": "NaN: not determined by the data",
+        "/d": "-Infinity: not determined by the data",
+    }
 
 
 def test_first_non_utf8_counts_lines_across_chunks(tmp_path):
     from rotacal.sessions import first_non_utf8
+
     text = ("a" * 99 + "\n") * 700  # 70 kB: past the first 64 kB chunk
     body = text.encode() + "é\n".encode() + b"xy\xc3" + b"(\n"  # a broken two-byte sequence
     (tmp_path / "f").write_bytes(body)
@@ -300,6 +358,7 @@ def test_predict_refuses_a_model_with_infinity(files, tmp_path):
 
 
 # ------------------------------------------------------------------------- outputs
+
 
 def test_predict_refuses_to_overwrite_its_input(files, tmp_path):
     session = tmp_path / "s.csv"
@@ -349,9 +408,11 @@ def test_record_checks_its_output_before_opening_the_port(tmp_path, kind):
 
 
 def test_devices_written_through_not_replaced(files):
-    for args in (("simulate", "ballbar", "-o", "/dev/null"),
-                 ("plan", "ballbar", "-o", "/dev/null"),
-                 ("report", files["good"], "--no-diagnosis", "-o", "/dev/null")):
+    for args in (
+        ("simulate", "ballbar", "-o", "/dev/null"),
+        ("plan", "ballbar", "-o", "/dev/null"),
+        ("report", files["good"], "--no-diagnosis", "-o", "/dev/null"),
+    ):
         r = rotacal_cli(*args)
         assert r.returncode == 0, (args, r.stderr)
         assert stat.S_ISCHR(os.stat("/dev/null").st_mode)
@@ -369,9 +430,11 @@ def test_own_null_device_is_not_replaced(files, tmp_path):
 
 
 def test_failure_leaves_nothing_behind(files, tmp_path):
-    for args in (("report", files["nonutf8"], "-o", tmp_path / "r.html"),
-                 ("simulate", "ballbar", "--effect", "no_such_effect=1", "-o", tmp_path / "s.csv"),
-                 ("predict", files["good"], "--model", files["good"], "-o", tmp_path / "p.csv")):
+    for args in (
+        ("report", files["nonutf8"], "-o", tmp_path / "r.html"),
+        ("simulate", "ballbar", "--effect", "no_such_effect=1", "-o", tmp_path / "s.csv"),
+        ("predict", files["good"], "--model", files["good"], "-o", tmp_path / "p.csv"),
+    ):
         r = rotacal_cli(*args)
         assert r.returncode == EXIT_INPUT, (args, r.stderr)
     assert list(tmp_path.iterdir()) == []
@@ -383,17 +446,36 @@ def test_megabyte_label_report_is_bounded(files, tmp_path):
     first = rows[0].split(",")[0]
     label = "L" * 1_000_000
     src = tmp_path / "label.csv"
-    src.write_text("\n".join(head + [label + r[len(first):] if r.startswith(first + ",") else r for r in rows]) + "\n")
-    r = rotacal_cli("report", src, "--no-diagnosis", "-o", tmp_path / "r.html", timeout=300, memory_bytes=4 << 30)
+    src.write_text(
+        "\n".join(
+            head + [label + r[len(first) :] if r.startswith(first + ",") else r for r in rows]
+        )
+        + "\n"
+    )
+    r = rotacal_cli(
+        "report",
+        src,
+        "--no-diagnosis",
+        "-o",
+        tmp_path / "r.html",
+        timeout=300,
+        memory_bytes=4 << 30,
+    )
     assert r.returncode in (0, EXIT_INPUT), r.stderr[-500:]
 
 
 @pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full")
 def test_full_disk_is_a_file_system_error(files):
-    for args in (("simulate", "ballbar", "-o", "/dev/full"), ("identify", files["good"], "--save-model", "/dev/full"),
-                 ("plan", "ballbar", "-o", "/dev/full")):
+    for args in (
+        ("simulate", "ballbar", "-o", "/dev/full"),
+        ("identify", files["good"], "--save-model", "/dev/full"),
+        ("plan", "ballbar", "-o", "/dev/full"),
+    ):
         r = rotacal_cli(*args)
-        assert r.returncode == EXIT_IO and "/dev/full" in r.stderr and "space" in r.stderr, (args, r.stderr)
+        assert r.returncode == EXIT_IO and "/dev/full" in r.stderr and "space" in r.stderr, (
+            args,
+            r.stderr,
+        )
 
 
 def test_fifo_written_through(tmp_path):
@@ -416,7 +498,12 @@ def test_users_tmp_file_and_symlink_kept(files, tmp_path):
     assert rotacal_cli("plan", "ballbar", "-o", out, "--session", link).returncode == 0
     assert (tmp_path / "p.ngc.tmp").read_text() == "mine"
     assert link.is_symlink() and rotacal.load(link) is not None and target.read_text() != "old"
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["link.csv", "p.ngc", "p.ngc.tmp", "real.csv"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "link.csv",
+        "p.ngc",
+        "p.ngc.tmp",
+        "real.csv",
+    ]
 
 
 def test_long_file_name(files, tmp_path):
@@ -428,11 +515,19 @@ def test_long_file_name(files, tmp_path):
 
 # ------------------------------------------------------------------------- sessions from Python
 
+
 def _columns(length):
     n = len(length)
-    return dict(machine=rotacal.MachineType.AC_trt, ballbar_length=100.0, pivot=np.array([120.0, 0.0, 60.0]),
-                tests=["radial_A"] * n, time=np.arange(n, dtype=float), xyz=np.tile([120.0, 0.0, 160.0], (n, 1)),
-                angles_deg=np.zeros((n, 2)), length=np.asarray(length, dtype=float))
+    return dict(
+        machine=rotacal.MachineType.AC_trt,
+        ballbar_length=100.0,
+        pivot=np.array([120.0, 0.0, 60.0]),
+        tests=["radial_A"] * n,
+        time=np.arange(n, dtype=float),
+        xyz=np.tile([120.0, 0.0, 160.0], (n, 1)),
+        angles_deg=np.zeros((n, 2)),
+        length=np.asarray(length, dtype=float),
+    )
 
 
 @pytest.mark.parametrize("length", [[100.0, 0.0, 100.0], [100.0, -100.0, 100.0]])
@@ -445,8 +540,12 @@ def test_save_never_writes_a_file_load_refuses(tmp_path, monkeypatch):
     # Whatever a session holds, save checks its text with the reader first: a text the reader
     # refuses (here a formatter made to drop the format line) writes nothing.
     from rotacal import sessions
+
     s = rotacal.BallbarSession(**_columns([100.0, 100.01, 99.99]))
-    broken = {k: (lambda session, f=f: f(session).split("\n", 1)[1]) for k, f in sessions._FORMATTERS.items()}
+    broken = {
+        k: (lambda session, f=f: f(session).split("\n", 1)[1])
+        for k, f in sessions._FORMATTERS.items()
+    }
     monkeypatch.setattr(sessions, "_FORMATTERS", broken)
     with pytest.raises(rotacal.InvalidArgument, match="would make a file that load refuses"):
         rotacal.save(s, tmp_path / "bad.csv")
@@ -463,12 +562,24 @@ def test_save_writes_what_load_reads(tmp_path):
 
 # ------------------------------------------------------------------------- huge finite numbers
 
-@pytest.mark.parametrize("name,command", [("big_length", "identify"), ("big_length", "diagnose"),
-                                          ("big_x", "identify"), ("big_dx", "identify"), ("big_b", "identify")])
+
+@pytest.mark.parametrize(
+    "name,command",
+    [
+        ("big_length", "identify"),
+        ("big_length", "diagnose"),
+        ("big_x", "identify"),
+        ("big_dx", "identify"),
+        ("big_b", "identify"),
+    ],
+)
 def test_huge_finite_numbers_are_refused(files, name, command):
     # Used to end in a segmentation fault (exit 139) inside the fit.
     r = rotacal_cli(command, files[name], timeout=120)
-    assert r.returncode == EXIT_INPUT and f"{name}.csv:" in r.stderr, (r.returncode, r.stderr[-500:])
+    assert r.returncode == EXIT_INPUT and f"{name}.csv:" in r.stderr, (
+        r.returncode,
+        r.stderr[-500:],
+    )
 
 
 def test_repeated_rows_are_reported(files, tmp_path):
@@ -483,6 +594,7 @@ def test_repeated_rows_are_reported(files, tmp_path):
 
 
 # ------------------------------------------------------------------------- plausibility before fitting
+
 
 def _transformed(src, dst, angle=None, linear=None, meta=None):
     """A copy of the ballbar session ``src`` with the angle columns (A, C) and/or the linear
@@ -502,20 +614,29 @@ def _transformed(src, dst, angle=None, linear=None, meta=None):
     return dst
 
 
-@pytest.mark.parametrize("case, cause", [
-    ("radians", "radians"),
-    ("inches", "inches"),
-    ("long_l0", "ballbar_length 150"),
-])
+@pytest.mark.parametrize(
+    "case, cause",
+    [
+        ("radians", "radians"),
+        ("inches", "inches"),
+        ("long_l0", "ballbar_length 150"),
+    ],
+)
 @pytest.mark.parametrize("command", ["identify", "diagnose"])
-def test_implausible_sessions_are_refused_with_the_cause(shared_data, tmp_path, case, cause, command):
+def test_implausible_sessions_are_refused_with_the_cause(
+    shared_data, tmp_path, case, cause, command
+):
     src = shared_data / "ballbar_ac_table2.csv"
     dst = tmp_path / f"{case}.csv"
     if case == "radians":
         _transformed(src, dst, angle=np.radians)
     elif case == "inches":
-        _transformed(src, dst, linear=lambda v: v / 25.4,
-                     meta={"ballbar_length": f"{100 / 25.4:.6f}", "pivot": "4.724409, 0.000000, 2.362205"})
+        _transformed(
+            src,
+            dst,
+            linear=lambda v: v / 25.4,
+            meta={"ballbar_length": f"{100 / 25.4:.6f}", "pivot": "4.724409, 0.000000, 2.362205"},
+        )
     else:
         _transformed(src, dst, meta={"ballbar_length": "150.0000"})
     r = rotacal_cli(command, dst)
@@ -526,7 +647,11 @@ def test_implausible_sessions_are_refused_with_the_cause(shared_data, tmp_path, 
 def test_max_deviation_widens_the_check_for_an_unusual_session(shared_data, tmp_path):
     # A session 3 mm off its nominal lengths everywhere (a bar 3 mm longer than declared) is
     # refused at the default limit and accepted when the user widens it.
-    dst = _transformed(shared_data / "ballbar_ac_table2.csv", tmp_path / "off.csv", meta={"ballbar_length": "97.0000"})
+    dst = _transformed(
+        shared_data / "ballbar_ac_table2.csv",
+        tmp_path / "off.csv",
+        meta={"ballbar_length": "97.0000"},
+    )
     assert rotacal_cli("identify", dst).returncode == EXIT_INPUT
     r = rotacal_cli("identify", dst, "--max-deviation", "5", "--length-offset")
     assert r.returncode == 0, r.stderr
@@ -547,9 +672,27 @@ def test_deviation_message_names_the_cli_option(shared_data, tmp_path):
 
 def test_predict_with_a_model_of_another_machine_is_refused(shared_data, tmp_path):
     model, bc = tmp_path / "ac.json", tmp_path / "bc.csv"
-    assert rotacal_cli("identify", shared_data / "ballbar_ac_table2.csv", "--save-model", model).returncode == 0
-    assert rotacal_cli("simulate", "ballbar", "--machine", "BC-trt", "-o", bc, "--truth", tmp_path / "t.json",
-                       "--step", "5").returncode == 0
+    assert (
+        rotacal_cli(
+            "identify", shared_data / "ballbar_ac_table2.csv", "--save-model", model
+        ).returncode
+        == 0
+    )
+    assert (
+        rotacal_cli(
+            "simulate",
+            "ballbar",
+            "--machine",
+            "BC-trt",
+            "-o",
+            bc,
+            "--truth",
+            tmp_path / "t.json",
+            "--step",
+            "5",
+        ).returncode
+        == 0
+    )
     r = rotacal_cli("predict", bc, "--model", model, "-o", tmp_path / "p.csv")
     assert r.returncode == EXIT_INPUT, r.stdout + r.stderr
     assert "AC-trt" in r.stderr and "BC-trt" in r.stderr, r.stderr

@@ -1,4 +1,5 @@
 """Joint and paper identification of the shared ballbar sessions from Python, against their truth files."""
+
 import json
 
 import numpy as np
@@ -26,7 +27,9 @@ def test_joint_fit_recovers_truth_within_3_sigma(shared_data, name):
 
 def test_missing_tests_are_reported_unobservable(shared_data):
     s = rotacal.load(shared_data / "ballbar_ac_table2.csv")
-    d = rotacal.identify(s, tests=["sphere_xy", "sphere_yz", "sphere_zx", "radial_A", "radial_C"]).to_dict()
+    d = rotacal.identify(
+        s, tests=["sphere_xy", "sphere_yz", "sphere_zx", "radial_A", "radial_C"]
+    ).to_dict()
     # Without the axial tests, the axes' tilts trade off against their offsets.
     assert d["location_errors"]["E_B0C"]["value"] is None
     assert d["location_errors"]["E_B0C"]["observable"] is False
@@ -47,8 +50,12 @@ def test_model_file_round_trip_and_predict(shared_data, tmp_path):
     # The model predicts the held-in data to the fit's residual, and other data it never saw
     # (ballbar_ac_random has other errors) far worse.
     pred = rotacal.predict(model, s).length
-    assert np.sqrt(np.mean((pred - s.length) ** 2)) * 1e3 == pytest.approx(r.to_dict()["residual_rms_um"], rel=1e-6)
-    (tmp_path / "bad.json").write_text('{"format": "rotacal-model/1", "kind": "ballbar", "machine": "AC-trt"}')
+    assert np.sqrt(np.mean((pred - s.length) ** 2)) * 1e3 == pytest.approx(
+        r.to_dict()["residual_rms_um"], rel=1e-6
+    )
+    (tmp_path / "bad.json").write_text(
+        '{"format": "rotacal-model/1", "kind": "ballbar", "machine": "AC-trt"}'
+    )
     with pytest.raises(rotacal.InvalidArgument, match="location_errors lacks"):
         rotacal.ballbar_model_from_dict(rotacal.load_model(tmp_path / "bad.json"), "bad.json")
 
@@ -70,6 +77,7 @@ def test_monte_carlo_confirms_the_reported_sigma(shared_data):
     # 40 repeats: the Monte Carlo sigma of each parameter is within ~3 x 11 % of the truth, so
     # a ratio outside 0.55..1.5 means the reported (linearised) 1-sigma is wrong.
     from rotacal.ballbar import monte_carlo
+
     s = rotacal.load(shared_data / "ballbar_ac_table2.csv")
     mc = monte_carlo(s, rotacal.identify(s), draws=40, seed=3, progress=False)
     assert mc["draws"] == 40 and len(mc["parameters"]) == 11
@@ -80,8 +88,10 @@ def test_monte_carlo_confirms_the_reported_sigma(shared_data):
 
 def test_monte_carlo_cli_shows_progress(shared_data):
     from conftest import run_cli
+
     r = run_cli("identify", shared_data / "ballbar_ac_table2.csv", "--monte-carlo", "10", "--json")
     assert r.returncode == 0, r.stderr
     assert "Monte Carlo [" in r.stderr and "100.0%" in r.stderr
     import json
+
     assert json.loads(r.stdout)["monte_carlo"]["draws"] == 10

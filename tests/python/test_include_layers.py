@@ -7,11 +7,24 @@ A file may include its own layer and the layers below it, never one above, and n
 includes another instrument. Adapters live with their instrument but belong to the engine they
 adapt: a file named *diagnosis* in an instrument folder, or under its diagnosis/ folder, is at
 the diagnose layer."""
+
 import re
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
-ORDER = ["core", "kinematics", "fit", "session", "io", "design", "instrument", "circular", "diagnose", "multi", "hw"]
+ORDER = [
+    "core",
+    "kinematics",
+    "fit",
+    "session",
+    "io",
+    "design",
+    "instrument",
+    "circular",
+    "diagnose",
+    "multi",
+    "hw",
+]
 INSTRUMENTS = {"ballbar", "rtest", "probe"}
 INCLUDE = re.compile(r'^\s*#\s*include\s+"(?:rotacal/)?([^"]+)"', re.M)
 
@@ -49,14 +62,19 @@ def _edges():
     for src in _sources():
         for target in INCLUDE.findall(src.read_text()):
             dst = _resolve(src, target)
-            if dst is None or not (dst.is_relative_to(ROOT / "include") or dst.is_relative_to(ROOT / "src")):
+            if dst is None or not (
+                dst.is_relative_to(ROOT / "include") or dst.is_relative_to(ROOT / "src")
+            ):
                 continue
             yield src, dst
 
 
 def test_every_folder_has_a_layer():
-    folders = {_folder_of(p) for p in _sources() if len(p.relative_to(ROOT).parts) > 3
-               or p.relative_to(ROOT).parts[0] == "src"}
+    folders = {
+        _folder_of(p)
+        for p in _sources()
+        if len(p.relative_to(ROOT).parts) > 3 or p.relative_to(ROOT).parts[0] == "src"
+    }
     unknown = {f for f in folders if f not in ORDER and f not in INSTRUMENTS}
     assert not unknown, f"folders without a place in the layer order: {sorted(unknown)}"
 
@@ -72,6 +90,11 @@ def test_no_include_runs_against_the_layer_order():
 
 
 def test_no_instrument_includes_another():
-    bad = [f"{s.relative_to(ROOT)} -> {d.relative_to(ROOT)}" for s, d in _edges()
-           if _folder_of(s) in INSTRUMENTS and _folder_of(d) in INSTRUMENTS and _folder_of(s) != _folder_of(d)]
+    bad = [
+        f"{s.relative_to(ROOT)} -> {d.relative_to(ROOT)}"
+        for s, d in _edges()
+        if _folder_of(s) in INSTRUMENTS
+        and _folder_of(d) in INSTRUMENTS
+        and _folder_of(s) != _folder_of(d)
+    ]
     assert not bad, "\n".join(bad)

@@ -9,6 +9,7 @@ comment; LinuxCNC's own interpreter (rs274) must run the program with the same c
 commands. Lines are split as str.splitlines() does (also at U+2028, form feed, NEL, ...): a
 reader that breaks lines there must not find a command either.
 """
+
 import hashlib
 import json
 import re
@@ -23,15 +24,25 @@ from conftest import run_cli
 NC_DIALECTS = ("linuxcnc", "heidenhain", "siemens", "fanuc")
 CONTROLLERS = ("linuxcnc", "siemens", "isg", "heidenhain", "fanuc")
 # A rapid move and program ends behind every way a comment could end early.
-HOSTILE_NAMES = ("x\nG0 Z-500\n", "x\r\nG0 Z-500\rM30", "x) G0 Z-500 (y", "x; G0 Z-500", "%\nG0 Z-500\n%",
-                 "MSG, x\u2028G0 Z-500\x85M30", "x ~\n* G0 Z-500 \\", "x" * 300 + "\nG0 Z-500")
+HOSTILE_NAMES = (
+    "x\nG0 Z-500\n",
+    "x\r\nG0 Z-500\rM30",
+    "x) G0 Z-500 (y",
+    "x; G0 Z-500",
+    "%\nG0 Z-500\n%",
+    "MSG, x\u2028G0 Z-500\x85M30",
+    "x ~\n* G0 Z-500 \\",
+    "x" * 300 + "\nG0 Z-500",
+)
 RS274 = shutil.which("rs274")
 
 
 def rotacal_cli(*args):
     """The command line in this process (conftest.run_cli); it must succeed."""
     r = run_cli(*args)
-    assert r.returncode == cli.EXIT_OK, f"rotacal {' '.join(map(str, args))}: exit code {r.returncode}: {r.stderr}"
+    assert r.returncode == cli.EXIT_OK, (
+        f"rotacal {' '.join(map(str, args))}: exit code {r.returncode}: {r.stderr}"
+    )
 
 
 def is_comment(dialect, line):
@@ -39,7 +50,12 @@ def is_comment(dialect, line):
     if dialect == "heidenhain":
         line = line.split(" ", 1)[1] if re.match(r"^\d+ ", line) else line
     if dialect in ("linuxcnc", "fanuc"):
-        return len(line) >= 2 and line[0] == "(" and line[-1] == ")" and not re.search(r"[()]", line[1:-1])
+        return (
+            len(line) >= 2
+            and line[0] == "("
+            and line[-1] == ")"
+            and not re.search(r"[()]", line[1:-1])
+        )
     return line.startswith(";")
 
 
@@ -64,7 +80,9 @@ def custom_model(tmp_path_factory):
     """The model of a description machine (a plain name), to rename for compensate."""
     d = tmp_path_factory.mktemp("inject")
     s, m = d / "s.csv", d / "m.json"
-    rotacal_cli("simulate", "ballbar", "--machine", machine_file(d / "custom.json", "custom"), "-o", s)
+    rotacal_cli(
+        "simulate", "ballbar", "--machine", machine_file(d / "custom.json", "custom"), "-o", s
+    )
     rotacal_cli("identify", s, "--save-model", m)
     return json.loads(m.read_text())
 
@@ -75,33 +93,44 @@ def nc_program(command, tmp_path, name, dialect, model):
     machine = machine_file(tmp_path / f"{tag}.json", name)
     out = tmp_path / f"{tag}.{dialect}"
     if command == "compensate":  # the model of that machine
-        m = dict(model, machine=name, machine_description=dict(model["machine_description"], name=name))
+        m = dict(
+            model, machine=name, machine_description=dict(model["machine_description"], name=name)
+        )
         mp = tmp_path / f"{tag}_model.json"
         mp.write_text(json.dumps(m))
-        rotacal_cli("compensate", "--model", mp, "--machine", machine, "--dialect", dialect, "-o", out)
+        rotacal_cli(
+            "compensate", "--model", mp, "--machine", machine, "--dialect", dialect, "-o", out
+        )
     else:
         rotacal_cli(*command.split(), "--machine", machine, "--dialect", dialect, "-o", out)
     return out.read_text(encoding="utf-8")
 
 
-@pytest.mark.parametrize("command", ["plan ballbar", "design ballbar", "circular plan", "compensate"])
+@pytest.mark.parametrize(
+    "command", ["plan ballbar", "design ballbar", "circular plan", "compensate"]
+)
 @pytest.mark.parametrize("dialect", NC_DIALECTS)
 def test_a_machine_name_adds_no_block(command, dialect, tmp_path, custom_model):
     expected = blocks(dialect, nc_program(command, tmp_path, "plain", dialect, custom_model))
     for name in HOSTILE_NAMES:
         text = nc_program(command, tmp_path, name, dialect, custom_model)
         assert blocks(dialect, text) == expected, f"{command} {dialect}, machine named {name!r}"
-        assert re.fullmatch(r"[\x20-\x7e\n]*", text), f"{command} {dialect}: a byte outside printable ASCII"
+        assert re.fullmatch(r"[\x20-\x7e\n]*", text), (
+            f"{command} {dialect}: a byte outside printable ASCII"
+        )
 
 
 def canonical(text, tmp_path):
     """rs274's canonical commands of a program but its comments (a long name takes two)."""
     from test_linuxcnc import run_rs274  # fails on any interpreter error (an unclosed comment, ...)
+
     return [(name, args) for name, args in run_rs274(text, tmp_path) if name != "COMMENT"]
 
 
-@pytest.mark.skipif(RS274 is None, reason="rs274 (LinuxCNC's G-code interpreter) not on PATH: "
-                                          "apt-get install linuxcnc-uspace")
+@pytest.mark.skipif(
+    RS274 is None,
+    reason="rs274 (LinuxCNC's G-code interpreter) not on PATH: apt-get install linuxcnc-uspace",
+)
 @pytest.mark.parametrize("command", ["plan ballbar", "circular plan", "compensate"])
 def test_linuxcnc_runs_the_same_commands_whatever_the_name(command, tmp_path, custom_model):
     expected = canonical(nc_program(command, tmp_path, "plain", "linuxcnc", custom_model), tmp_path)
@@ -118,7 +147,9 @@ EXPORT_LINES = {
     "heidenhain": r"(?!)",  # mapping sheets: comments only
     "fanuc": r"(?!)",
 }
-HOSTILE_PATH = "s\nloadusr -w touch X\nsetp xyzac-trt-kins.z-offset 500\n$TC_CARR4[1]=500\nM17\n\u2028M30\\"
+HOSTILE_PATH = (
+    "s\nloadusr -w touch X\nsetp xyzac-trt-kins.z-offset 500\n$TC_CARR4[1]=500\nM17\n\u2028M30\\"
+)
 
 
 @pytest.fixture(scope="module")
@@ -136,7 +167,9 @@ def hostile_model(tmp_path_factory):
 
 
 @pytest.mark.parametrize("controller", CONTROLLERS)
-def test_an_export_holds_only_its_values_whatever_the_session_path(controller, hostile_model, tmp_path):
+def test_an_export_holds_only_its_values_whatever_the_session_path(
+    controller, hostile_model, tmp_path
+):
     hostile, plain = hostile_model
     comment = ";" if controller == "siemens" else "#"
 
@@ -149,7 +182,9 @@ def test_an_export_holds_only_its_values_whatever_the_session_path(controller, h
     text, got = export(hostile)
     assert got == export(plain)[1]
     for line in got:
-        assert re.fullmatch(EXPORT_LINES[controller], line), f"{controller}: {line!r} is not a value line"
+        assert re.fullmatch(EXPORT_LINES[controller], line), (
+            f"{controller}: {line!r} is not a value line"
+        )
     assert re.fullmatch(r"[\x20-\x7e\n]*", text), "a byte outside printable ASCII"
     assert all(len(line) <= 1000 for line in text.splitlines())  # halcmd reads 1023 a line
 
@@ -161,25 +196,47 @@ def test_isg_centres_program_holds_only_its_blocks_whatever_the_setup_label(tmp_
     rotacal_cli("simulate", "rtest", "--seed", "4", "-o", s)
     rotacal_cli("identify", s, "--save-model", m)
     label = "2 (x) ; % $ * \\ ~\u2028M30\u2029G0 Z-500\x85M30"
-    rows = [(label + line[1:]) if line.startswith("2,") else line.replace("# nest.2:", f"# nest.{label}:")
-            for line in s.read_text().split("\n")]
+    rows = [
+        (label + line[1:])
+        if line.startswith("2,")
+        else line.replace("# nest.2:", f"# nest.{label}:")
+        for line in s.read_text().split("\n")
+    ]
     hs, hm = tmp_path / "h.csv", tmp_path / "h.json"
     hs.write_text("\n".join(rows), encoding="utf-8")
     doc = json.loads(m.read_text())
     doc["probe_zeros"][label] = doc["probe_zeros"].pop("2")
     doc["nests"][label] = doc["nests"].pop("2")
-    doc["source"]["session_sha256"] = hashlib.sha256(hs.read_bytes()).hexdigest()  # fitted to hs, as it were
+    doc["source"]["session_sha256"] = hashlib.sha256(
+        hs.read_bytes()
+    ).hexdigest()  # fitted to hs, as it were
     hm.write_text(json.dumps(doc))
 
     def program(model, session, setup):
         out = tmp_path / "centres.nc"
-        rotacal_cli("export", "--model", model, "--controller", "isg", "--centres", session, "--centres-output", out,
-                    "--centres-setup", setup)
+        rotacal_cli(
+            "export",
+            "--model",
+            model,
+            "--controller",
+            "isg",
+            "--centres",
+            session,
+            "--centres-output",
+            out,
+            "--centres-setup",
+            setup,
+        )
         return out.read_text(encoding="utf-8")
 
     text = program(hm, hs, label)
     assert re.fullmatch(r"[\x20-\x7e\n]*", text), "a byte outside printable ASCII"
     got = [line for line in text.splitlines() if not line.startswith(";")]
     assert got == [line for line in program(m, s, "2").splitlines() if not line.startswith(";")]
-    assert all(re.fullmatch(r"#VAR|#ENDVAR|V\.[LP]\.[A-Z_]+ = [-0-9.]+|L CYCLE \[NAME = \"SysCalib\w+\.ecy\"[^\]]*\]|M30",
-                            line) for line in got)
+    assert all(
+        re.fullmatch(
+            r"#VAR|#ENDVAR|V\.[LP]\.[A-Z_]+ = [-0-9.]+|L CYCLE \[NAME = \"SysCalib\w+\.ecy\"[^\]]*\]|M30",
+            line,
+        )
+        for line in got
+    )

@@ -2,6 +2,7 @@
 docs/json_schema.md: its `schema` blocks are read here and real `--json` outputs of
 `rotacal identify` / `rotacal diagnose` are checked against them (a small checker; no new
 dependency)."""
+
 import json
 import re
 from pathlib import Path
@@ -35,11 +36,17 @@ def check(value, schema, where: str, named: dict) -> None:
             for k, v in value.items():
                 check(v, named[m.group(1)], f"{where}.{k}", named)
             return
-        ok = {"number": lambda v: isinstance(v, (int, float)) and not isinstance(v, bool) and np.isfinite(v),
-              "integer": lambda v: isinstance(v, int) and not isinstance(v, bool),
-              "string": lambda v: isinstance(v, str),
-              "boolean": lambda v: isinstance(v, bool)}
-        assert any(ok[k](value) for k in kinds if k != "null"), f"{where}: {value!r} is not {schema}"
+        ok = {
+            "number": lambda v: (
+                isinstance(v, (int, float)) and not isinstance(v, bool) and np.isfinite(v)
+            ),
+            "integer": lambda v: isinstance(v, int) and not isinstance(v, bool),
+            "string": lambda v: isinstance(v, str),
+            "boolean": lambda v: isinstance(v, bool),
+        }
+        assert any(ok[k](value) for k in kinds if k != "null"), (
+            f"{where}: {value!r} is not {schema}"
+        )
     elif isinstance(schema, list):
         assert isinstance(value, list), f"{where}: expected an array"
         for i, v in enumerate(value):

@@ -1,4 +1,5 @@
 """Kinematics from Python: nominal forward transforms, shapes, machine names."""
+
 import numpy as np
 import pytest
 

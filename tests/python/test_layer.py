@@ -1,6 +1,7 @@
 """The Python layer's seams: one dispatch on the session kind, options laid over the C++
 defaults, no import cycle in the package, a library that never imports the command line, and
 a CLI that draws only when asked."""
+
 import ast
 import re
 import subprocess
@@ -58,7 +59,7 @@ def _import_graph() -> dict[str, set[str]]:
             if not isinstance(node, ast.ImportFrom):
                 continue
             if node.level:
-                base = here[:len(here) - node.level + 1]
+                base = here[: len(here) - node.level + 1]
             elif node.module and node.module.split(".")[0] == "rotacal":
                 base = []
             else:
@@ -106,7 +107,10 @@ def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
 
 def test_the_package_has_no_import_cycle():
     graph = _import_graph()
-    assert "rotacal.diagnosis" in graph["rotacal.analysis"] and "rotacal.sessions" in graph["rotacal.diagnosis"]
+    assert (
+        "rotacal.diagnosis" in graph["rotacal.analysis"]
+        and "rotacal.sessions" in graph["rotacal.diagnosis"]
+    )
     readers = {m for m, targets in graph.items() if "rotacal" in targets}
     assert not readers, f"modules importing the package facade: {sorted(readers)}"
     assert _cycles(graph) == []
@@ -115,7 +119,9 @@ def test_the_package_has_no_import_cycle():
 def test_the_library_never_imports_the_command_line():
     cli = {m for m in _module_files() if m == "rotacal.cli" or m.startswith("rotacal.cli.")}
     entry = {"rotacal.__main__"}  # `python -m rotacal`: the command line's own entry point
-    importers = {m for m, targets in _import_graph().items() if targets & cli and m not in cli | entry}
+    importers = {
+        m for m, targets in _import_graph().items() if targets & cli and m not in cli | entry
+    }
     assert not importers, f"library modules importing rotacal.cli: {sorted(importers)}"
 
 
@@ -128,7 +134,9 @@ def test_by_kind(shared_data):
     b = rotacal.load(shared_data / "ballbar_ac_table2.csv")
     r = rotacal.load(shared_data / "rtest_bc_oyama.csv")
     assert sessions.kind(b) == "ballbar" and sessions.kind(r) == "rtest"
-    with pytest.raises(rotacal.InvalidArgument, match="needs a rotacal-ballbar/1 session, this is rotacal-rtest/1"):
+    with pytest.raises(
+        rotacal.InvalidArgument, match="needs a rotacal-ballbar/1 session, this is rotacal-rtest/1"
+    ):
         sessions.by_kind(r, {"ballbar": 1}, "report")
     with pytest.raises(rotacal.InvalidArgument, match="not a session: str"):
         rotacal.diagnose("ballbar_ac_table2.csv")
@@ -150,11 +158,15 @@ def test_diagnosis_options_lie_over_the_cpp_defaults():
 def test_cli_setup_defaults_are_the_cpp_ones():
     from rotacal.cli import build_parser
     from rotacal.cli.setups import ballbar_setup as _setup
+
     a = build_parser().parse_args(["plan", "ballbar", "-o", "x.ngc"])
     s, cpp = _setup(a), _core.BallbarSetup()
     assert s.ballbar_length == cpp.ballbar_length and np.allclose(s.pivot, cpp.pivot)
     assert s.step_deg == cpp.step_deg and list(s.tilt_range_deg) == list(cpp.tilt_range_deg)
-    assert list(s.rot_range_deg) == [0.0, 359.0]  # the CLI's own C range (one step short of the turn)
+    assert list(s.rot_range_deg) == [
+        0.0,
+        359.0,
+    ]  # the CLI's own C range (one step short of the turn)
 
 
 def test_truth_draws_random_errors_then_the_pivot_error():
@@ -164,7 +176,10 @@ def test_truth_draws_random_errors_then_the_pivot_error():
     errors = machines.random_location_errors(rotacal.MachineType.AC_trt, rng)
     assert np.allclose(list(a["errors"].values()), errors)
     assert np.allclose(a["pivot_error"], rng.normal(0.0, machines.PIVOT_ERROR_MM, 3))
-    assert b["pivot_error"] == np.random.default_rng(5).normal(0.0, machines.PIVOT_ERROR_MM, 3).tolist()
+    assert (
+        b["pivot_error"]
+        == np.random.default_rng(5).normal(0.0, machines.PIVOT_ERROR_MM, 3).tolist()
+    )
     t2 = machines.ballbar_truth(rotacal.MachineType.AC_trt, "table2")
     assert t2["errors"] == machines.TABLE2_ERRORS
     with pytest.raises(rotacal.InvalidArgument, match="table2 is the paper's AC-trt"):
@@ -174,8 +189,20 @@ def test_truth_draws_random_errors_then_the_pivot_error():
 
 
 def test_identify_does_not_load_matplotlib(shared_data):
-    r = subprocess.run([sys.executable, "-X", "importtime", "-m", "rotacal", "identify",
-                        str(shared_data / "ballbar_ac_table2.csv")], capture_output=True, text=True, timeout=120)
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-X",
+            "importtime",
+            "-m",
+            "rotacal",
+            "identify",
+            str(shared_data / "ballbar_ac_table2.csv"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert r.returncode == 0 and "rotacal.cli" in r.stderr
     assert "matplotlib" not in r.stderr
 

@@ -9,6 +9,7 @@ planned toolpath (every sample, 1e-4 mm / 1e-4 deg) and with the ballbar geometr
 independently (|tool - pivot| = L0 at every block end and all along the arcs), and the block
 times with the plan's time stamps.
 """
+
 import json
 import math
 import re
@@ -25,7 +26,8 @@ RS274 = shutil.which("rs274")
 pytestmark = pytest.mark.skipif(
     RS274 is None,
     reason="rs274 (LinuxCNC stand-alone G-code interpreter) not on PATH: "
-    "apt-get install linuxcnc-uspace")
+    "apt-get install linuxcnc-uspace",
+)
 
 TOL = 1e-4  # mm and deg: the program carries 4 decimals, rs274 prints 4
 CANON = re.compile(r"^\s*\d+\s+N\.+\s+([A-Z_0-9]+)\((.*)\)\s*$")
@@ -64,10 +66,14 @@ class Chain:
 
     def __init__(self, machine):
         d = json.loads(machine.description_json)
-        self.table = [(np.array(a.get("point", [0, 0, 0]), float), np.array(a["direction"], float), a["name"])
-                      for a in d["table_axes"]]
-        self.head = [(np.array(a.get("point", [0, 0, 0]), float), np.array(a["direction"], float), a["name"])
-                     for a in d["head_axes"]]
+        self.table = [
+            (np.array(a.get("point", [0, 0, 0]), float), np.array(a["direction"], float), a["name"])
+            for a in d["table_axes"]
+        ]
+        self.head = [
+            (np.array(a.get("point", [0, 0, 0]), float), np.array(a["direction"], float), a["name"])
+            for a in d["head_axes"]
+        ]
         self.t = np.array([0.0, 0.0, -(d["pivot_length"] + d["tool_length"])])
 
     @staticmethod
@@ -88,8 +94,13 @@ def run_rs274(text, tmp_path):
     ngc.write_text(text)
     tbl = tmp_path / "tool.tbl"
     tbl.write_text("T1 P1 Z0 D0 ;ballbar tool cup\n")
-    out = subprocess.run([RS274, "-t", str(tbl), "-g", str(ngc)], capture_output=True, text=True,
-                         stdin=subprocess.DEVNULL, timeout=300)
+    out = subprocess.run(
+        [RS274, "-t", str(tbl), "-g", str(ngc)],
+        capture_output=True,
+        text=True,
+        stdin=subprocess.DEVNULL,
+        timeout=300,
+    )
     canon = []
     for line in (out.stdout + out.stderr).splitlines():
         m = CANON.match(line)
@@ -183,7 +194,10 @@ def check_program(plan, text, tmp_path, actual_errors=None):
     def ballbar_length(p6):
         if actual_errors is None:
             if machine in (rotacal.MachineType.AC_trt, rotacal.MachineType.BC_trt):
-                tilt, c = math.radians(p6[tilt_slot]), math.radians(p6[5])  # Flynn's two tables, by hand
+                tilt, c = (
+                    math.radians(p6[tilt_slot]),
+                    math.radians(p6[5]),
+                )  # Flynn's two tables, by hand
                 return np.linalg.norm(p6[:3] - (rx(tilt) if ac else ry(tilt)) @ rz(c) @ pivot)
             return chain.ballbar_length(p6, pivot)
         assert not machine.has_head, "actual_errors: table machines only (rotacal.forward)"
@@ -236,8 +250,10 @@ def check_program(plan, text, tmp_path, actual_errors=None):
             worst["time"] = max(worst["time"], abs(dt_rs - dt_plan))
         j, t_prev = j_end + 1, T[j_end]
     assert j == len(P), f"{len(P) - j} planned samples never reached"
-    print(f"rs274: {n_lines} lines, {n_arcs} arcs; worst pose {worst['pose']:.2g}, "
-          f"|L - L0| {worst['length']:.2g} mm, block time {worst['time']:.2g} s")
+    print(
+        f"rs274: {n_lines} lines, {n_arcs} arcs; worst pose {worst['pose']:.2g}, "
+        f"|L - L0| {worst['length']:.2g} mm, block time {worst['time']:.2g} s"
+    )
     return n_lines, n_arcs
 
 
@@ -260,20 +276,29 @@ def test_compensated_program_runs_the_plan(shared_data, tmp_path):
     # ... the nominal program does not, and the compensated one is not the nominal plan.
     nominal = rotacal.plan_ballbar_test()
     with pytest.raises(AssertionError):
-        check_program(nominal, rotacal.write_nc_program(nominal, "linuxcnc"), tmp_path,
-                      actual_errors=errors)
+        check_program(
+            nominal, rotacal.write_nc_program(nominal, "linuxcnc"), tmp_path, actual_errors=errors
+        )
     with pytest.raises(AssertionError):
         check_program(nominal, text, tmp_path)
 
 
-@pytest.mark.parametrize("machine,pivot,side,step", [
-    (rotacal.MachineType.BC_trt, (0.0, 120.0, 60.0), rotacal.RadialSide.outside, 1.0),
-    (rotacal.MachineType.AC_trt, (95.0, 40.0, 75.0), rotacal.RadialSide.inside, 2.5),
-    (rotacal.MachineType.BC_trt, (-80.0, 60.0, 90.0), rotacal.RadialSide.inside, 3.0),
-])
+@pytest.mark.parametrize(
+    "machine,pivot,side,step",
+    [
+        (rotacal.MachineType.BC_trt, (0.0, 120.0, 60.0), rotacal.RadialSide.outside, 1.0),
+        (rotacal.MachineType.AC_trt, (95.0, 40.0, 75.0), rotacal.RadialSide.inside, 2.5),
+        (rotacal.MachineType.BC_trt, (-80.0, 60.0, 90.0), rotacal.RadialSide.inside, 3.0),
+    ],
+)
 def test_other_layouts_run_the_plan(machine, pivot, side, step, tmp_path):
-    setup = rotacal.BallbarSetup(machine=machine, pivot=np.array(pivot), radial_c_side=side,
-                                 step_deg=step, ballbar_length=110.0)
+    setup = rotacal.BallbarSetup(
+        machine=machine,
+        pivot=np.array(pivot),
+        radial_c_side=side,
+        step_deg=step,
+        ballbar_length=110.0,
+    )
     plan = rotacal.plan_ballbar_test(setup)
     n_lines, n_arcs = check_program(plan, rotacal.write_nc_program(plan, "linuxcnc"), tmp_path)
     assert n_lines > 0

@@ -13,6 +13,7 @@ table point (P0 + forward(position errors, A, C, q)); with the current pins they
 
 The run itself: linuxcnc_session.py.
 """
+
 import json
 import re
 from pathlib import Path
@@ -40,14 +41,20 @@ def rotacal_cli(*args):
 
 def run_linuxcnc(run_dir: Path, pins: Path, poses: np.ndarray) -> dict:
     """One headless LinuxCNC session with the pins of `pins`; the joints at every pose."""
-    return run_session(run_dir, "xyzac-trt-sim.ini", {"pins.hal": pins.read_text(),
-                                                      "poses.json": json.dumps(poses.tolist())},
-                       "joints.json", RUN_TIMEOUT)
+    return run_session(
+        run_dir,
+        "xyzac-trt-sim.ini",
+        {"pins.hal": pins.read_text(), "poses.json": json.dumps(poses.tolist())},
+        "joints.json",
+        RUN_TIMEOUT,
+    )
 
 
 def _pins(path: Path) -> dict:
-    return {m.group(1): float(m.group(2))
-            for m in re.finditer(r"^setp xyzac-trt-kins\.(\S+) (\S+)$", path.read_text(), re.M)}
+    return {
+        m.group(1): float(m.group(2))
+        for m in re.finditer(r"^setp xyzac-trt-kins\.(\S+) (\S+)$", path.read_text(), re.M)
+    }
 
 
 def test_xyzac_trt_kins_with_exported_pins_reproduces_the_model(shared_data, tmp_path):
@@ -55,11 +62,23 @@ def test_xyzac_trt_kins_with_exported_pins_reproduces_the_model(shared_data, tmp
     rotacal_cli("identify", shared_data / "ballbar_ac_table2.csv", "--save-model", model)
     # The machine's kinematics while the ballbar test ran: the pivot at joint position P0.
     current = tmp_path / "machine.hal"
-    current.write_text(f"setp xyzac-trt-kins.x-rot-point {P0[0]}\nsetp xyzac-trt-kins.y-rot-point {P0[1]}\n"
-                       f"setp xyzac-trt-kins.z-rot-point 0\nsetp xyzac-trt-kins.z-offset {P0[2]}\n"
-                       "setp xyzac-trt-kins.y-offset 0\n")
+    current.write_text(
+        f"setp xyzac-trt-kins.x-rot-point {P0[0]}\nsetp xyzac-trt-kins.y-rot-point {P0[1]}\n"
+        f"setp xyzac-trt-kins.z-rot-point 0\nsetp xyzac-trt-kins.z-offset {P0[2]}\n"
+        "setp xyzac-trt-kins.y-offset 0\n"
+    )
     corrected = tmp_path / "corrected.hal"
-    rotacal_cli("export", "--model", model, "--controller", "linuxcnc", "--current", current, "-o", corrected)
+    rotacal_cli(
+        "export",
+        "--model",
+        model,
+        "--controller",
+        "linuxcnc",
+        "--current",
+        current,
+        "-o",
+        corrected,
+    )
     pins = _pins(corrected)
     assert set(pins) == {"x-rot-point", "y-rot-point", "z-rot-point", "y-offset", "z-offset"}
 
@@ -93,9 +112,11 @@ def test_xyzac_trt_kins_with_exported_pins_reproduces_the_model(shared_data, tmp
         assert np.abs(fb - cmd).max() < 1e-9  # the simulated drives follow exactly
         assert np.abs(fb[:, 3:] - poses[:, 3:]).max() < 1e-9  # rotary joints = A, C
         runs[name] = fb[:, :3]
-        print(f"{name}: LinuxCNC session {r['elapsed']:.1f} s, "
-              f"|joints - model| max {np.abs(fb[:, :3] - expected).max():.2e} mm, "
-              f"|joints - nominal| max {np.abs(fb[:, :3] - nominal).max():.2e} mm")
+        print(
+            f"{name}: LinuxCNC session {r['elapsed']:.1f} s, "
+            f"|joints - model| max {np.abs(fb[:, :3] - expected).max():.2e} mm, "
+            f"|joints - nominal| max {np.abs(fb[:, :3] - nominal).max():.2e} mm"
+        )
 
     # The current pins are the nominal machine (the test can fail) ...
     assert np.abs(runs["current"] - nominal).max() < TOL

@@ -3,6 +3,7 @@ interpreter, rs274: it runs to M2 without an error, every block ends on the plan
 axes (the machine's own rotary letters in their a, b, c slots), the ballbar keeps L0 at every
 block end and along every arc by the kinematics written out from the description in
 test_linuxcnc.Chain, and each block takes the planned time (test_linuxcnc.check_program)."""
+
 import re
 
 import numpy as np
@@ -14,7 +15,8 @@ from test_linuxcnc import RS274, Chain, check_program
 
 pytestmark = pytest.mark.skipif(
     RS274 is None,
-    reason="rs274 (LinuxCNC stand-alone G-code interpreter) not on PATH: apt-get install linuxcnc-uspace")
+    reason="rs274 (LinuxCNC stand-alone G-code interpreter) not on PATH: apt-get install linuxcnc-uspace",
+)
 
 BUILTINS = list(_core.builtin_machine_names())
 
@@ -39,8 +41,13 @@ def test_every_builtin_program_runs_the_plan(name, tmp_path):
 @pytest.mark.parametrize("name", ["B-head-C-table", "AC-head"])
 def test_head_programs_at_another_layout(name, tmp_path):
     """A head machine with another pivot, bar, step and the radial test inside."""
-    plan = plan_of(name, pivot=np.array([80.0, -40.0, 90.0]), ballbar_length=150.0, step_deg=2.5,
-                   radial_c_side=rotacal.RadialSide.inside)
+    plan = plan_of(
+        name,
+        pivot=np.array([80.0, -40.0, 90.0]),
+        ballbar_length=150.0,
+        step_deg=2.5,
+        radial_c_side=rotacal.RadialSide.inside,
+    )
     assert check_program(plan, rotacal.write_nc_program(plan, "linuxcnc"), tmp_path)[0] > 0
 
 
@@ -53,6 +60,7 @@ def test_the_chain_check_catches_a_head_program_off_the_ball(tmp_path):
     chain = Chain(plan.setup.machine)
     chain.t = chain.t + np.array([0.0, 0.0, -1e-3])  # 1 um longer tool
     import test_linuxcnc
+
     original = test_linuxcnc.Chain
     try:
         test_linuxcnc.Chain = lambda machine: chain

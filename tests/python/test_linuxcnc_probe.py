@@ -16,6 +16,7 @@ pretravel, measured); no contact outside the G38.2 moves (counted in realtime; L
 the program at one itself, as a program with a G1 into the sphere shows) and the traverses clear
 of the sphere (polled).
 """
+
 import json
 import re
 import sys
@@ -33,16 +34,18 @@ sys.path.insert(0, str(REFSIM))
 import refsim  # noqa: E402
 from refsim import noise  # noqa: E402
 
-SERVO_PERIOD_S = 1e-3       # tests/linuxcnc/common.inc, [EMCMOT]SERVO_PERIOD
-PROBE_FEED = 30.0           # mm/min: one servo period's travel is 0.5 um
-POSITIONING_FEED = 6000.0   # mm/min, the G1 moves to and from each G38.2
-APPROACH_MM = 0.3           # each G38.2 starts this far outside the nominal trigger sphere
+SERVO_PERIOD_S = 1e-3  # tests/linuxcnc/common.inc, [EMCMOT]SERVO_PERIOD
+PROBE_FEED = 30.0  # mm/min: one servo period's travel is 0.5 um
+POSITIONING_FEED = 6000.0  # mm/min, the G1 moves to and from each G38.2
+APPROACH_MM = 0.3  # each G38.2 starts this far outside the nominal trigger sphere
 SPHERE = (150.0, 0.0, 80.0)
 SPHERE_D, STYLUS_D = 25.0, 6.0
-SPHERE_ERROR_MM = 0.02      # 1 sigma per axis: the sphere set where the cycle's first touches found it
+SPHERE_ERROR_MM = 0.02  # 1 sigma per axis: the sphere set where the cycle's first touches found it
 POSES = [(0, 0), (0, 120), (0, 240), (-90, 0), (45, 0), (90, 0)]  # A, C deg
-NOISE_UM, RHO = 0.5, 0.5    # trigger radius, touch to touch
-RUN_TIMEOUT = 240           # s, the display's bound (the program ran 80 s at F10 at a load average of 12, 44 s at F30)
+NOISE_UM, RHO = 0.5, 0.5  # trigger radius, touch to touch
+RUN_TIMEOUT = (
+    240  # s, the display's bound (the program ran 80 s at F10 at a load average of 12, 44 s at F30)
+)
 
 
 def rotacal_cli(*args):
@@ -79,15 +82,33 @@ def test_plan_probe_feeds_and_approach(tmp_path):
     # trigger sphere on the nominal machine and runs at --probe-feed, the G1 moves at
     # --positioning-feed; plan ballbar refuses them.
     ngc = tmp_path / "p.ngc"
-    rotacal_cli("plan", "probe", "--poses", "0,0;0,90", "--approach", 0.25, "--probe-feed", 7.5,
-                "--positioning-feed", 4000, "-o", ngc)
+    rotacal_cli(
+        "plan",
+        "probe",
+        "--poses",
+        "0,0;0,90",
+        "--approach",
+        0.25,
+        "--probe-feed",
+        7.5,
+        "--positioning-feed",
+        4000,
+        "-o",
+        ngc,
+    )
     text = ngc.read_text()
     r = 0.5 * (25.0 + 6.0)  # the defaults: sphere 150, 0, 80; D 25; d 6
-    centres = {0: np.array([150.0, 0.0, 80.0]), 90: np.array([0.0, 150.0, 80.0])}  # C turns the table (+Z)
+    centres = {
+        0: np.array([150.0, 0.0, 80.0]),
+        90: np.array([0.0, 150.0, 80.0]),
+    }  # C turns the table (+Z)
     moves = probing_moves(text)
     assert len(moves) == 10
     for k, (start, target) in enumerate(moves):
-        assert abs(np.linalg.norm(start - centres[0 if k < 5 else 90]) - (r + 0.25)) < 2e-4, (k, start)
+        assert abs(np.linalg.norm(start - centres[0 if k < 5 else 90]) - (r + 0.25)) < 2e-4, (
+            k,
+            start,
+        )
     assert re.findall(r"^G38\.2 .* F(\S+)$", text, re.M) == ["7.5"] * 10
     assert set(re.findall(r"^G1 .* F(\S+)$", text, re.M)) == {"4000.0"}
     bad = run_cli("plan", "ballbar", "--probe-feed", "7", "-o", tmp_path / "b.ngc")
@@ -100,7 +121,9 @@ def simulated_machine(shared_data):
     errors = json.loads((shared_data / "probe_ac_table2.truth.json").read_text())["errors"]
     rng = np.random.default_rng(31)
     sphere_actual = np.array(SPHERE) + rng.normal(0.0, SPHERE_ERROR_MM, 3)
-    eps = noise.ar1(["touch"] * 5 * len(POSES), RHO, NOISE_UM * 1e-3, rng)  # five directions per pose
+    eps = noise.ar1(
+        ["touch"] * 5 * len(POSES), RHO, NOISE_UM * 1e-3, rng
+    )  # five directions per pose
     return errors, sphere_actual, eps
 
 
@@ -110,21 +133,54 @@ def plan(tmp_path, poses, log):
     # period's travel) is part of its effective radius (docs/probe.md, "A real client").
     stylus_calibrated = STYLUS_D - PROBE_FEED / 60.0 * SERVO_PERIOD_S
     ngc, template = tmp_path / "probe.ngc", tmp_path / "template.csv"
-    rotacal_cli("plan", "probe", "--machine", "AC-trt", "--sphere", ",".join(map(str, SPHERE)),
-                "--sphere-diameter", SPHERE_D, "--stylus-diameter", f"{stylus_calibrated:.7f}",
-                "--poses", ";".join(f"{a},{c}" for a, c in poses), "--approach", APPROACH_MM,
-                "--probe-feed", PROBE_FEED, "--positioning-feed", POSITIONING_FEED, "--log-file", log,
-                "-o", ngc, "--session", template)
+    rotacal_cli(
+        "plan",
+        "probe",
+        "--machine",
+        "AC-trt",
+        "--sphere",
+        ",".join(map(str, SPHERE)),
+        "--sphere-diameter",
+        SPHERE_D,
+        "--stylus-diameter",
+        f"{stylus_calibrated:.7f}",
+        "--poses",
+        ";".join(f"{a},{c}" for a, c in poses),
+        "--approach",
+        APPROACH_MM,
+        "--probe-feed",
+        PROBE_FEED,
+        "--positioning-feed",
+        POSITIONING_FEED,
+        "--log-file",
+        log,
+        "-o",
+        ngc,
+        "--session",
+        template,
+    )
     return ngc.read_text(), template
 
 
 def run_probe(run_dir, program, errors, sphere_actual, eps):
     """LinuxCNC runs `program` on the simulated machine: (display's result, probe's record)."""
-    truth = {"refsim": str(REFSIM), "machine": "AC-trt", "errors": errors, "sphere_actual": sphere_actual.tolist(),
-             "sphere_diameter": SPHERE_D, "stylus_diameter": STYLUS_D, "trigger_noise_mm": eps.tolist(),
-             "record": str(run_dir / "contact.json")}
-    result = run_linuxcnc(run_dir, "probe-sim.ini", {"probe.ngc": program, "truth.json": json.dumps(truth)},
-                          "result.json", RUN_TIMEOUT)
+    truth = {
+        "refsim": str(REFSIM),
+        "machine": "AC-trt",
+        "errors": errors,
+        "sphere_actual": sphere_actual.tolist(),
+        "sphere_diameter": SPHERE_D,
+        "stylus_diameter": STYLUS_D,
+        "trigger_noise_mm": eps.tolist(),
+        "record": str(run_dir / "contact.json"),
+    }
+    result = run_linuxcnc(
+        run_dir,
+        "probe-sim.ini",
+        {"probe.ngc": program, "truth.json": json.dumps(truth)},
+        "result.json",
+        RUN_TIMEOUT,
+    )
     print(f"LinuxCNC: program {result['program_s']:.1f} s, session {result['elapsed']:.1f} s")
     return result, json.loads((run_dir / "contact.json").read_text())
 
@@ -141,7 +197,7 @@ def test_a_contact_outside_probing_is_counted(shared_data, tmp_path):
     retract = first + 2  # G38.2, (LOG,...), then the G1 back to the start
     assert lines[retract].startswith("G1 X")
     crash = re.sub(r" F\S+$", f" F{POSITIONING_FEED:.1f}", lines[first].replace("G38.2 ", "G1 ", 1))
-    lines[retract + 1:retract + 1] = [crash, lines[retract]]
+    lines[retract + 1 : retract + 1] = [crash, lines[retract]]
     # LinuxCNC stops the program itself, and the realtime count has it.
     with pytest.raises(AssertionError, match="Probe tripped during non-probe move"):
         run_probe(run_dir, "\n".join(lines) + "\n", errors, sphere_actual, eps)
@@ -150,7 +206,9 @@ def test_a_contact_outside_probing_is_counted(shared_data, tmp_path):
 
 
 @requires_linuxcnc
-def test_linuxcnc_runs_the_probing_program_and_the_log_identifies_the_machine(shared_data, tmp_path):
+def test_linuxcnc_runs_the_probing_program_and_the_log_identifies_the_machine(
+    shared_data, tmp_path
+):
     t_start = time.monotonic()
     errors, sphere_actual, eps = simulated_machine(shared_data)
     n = len(eps)
@@ -162,22 +220,38 @@ def test_linuxcnc_runs_the_probing_program_and_the_log_identifies_the_machine(sh
     result, contact = run_probe(run_dir, program, errors, sphere_actual, eps)
 
     # Every touch a G38.2 contact, none elsewhere; the traverses clear of the sphere.
-    assert result["touches"] == n and len(contact["touches"]) == n, (result, len(contact["touches"]))
-    assert result["strays"] == 0 and contact["strays"] == 0, "the stylus touched the sphere outside a G38.2 move"
-    assert all(t["armed"] for t in contact["touches"]), "a touch began before its trigger radius was set"
+    assert result["touches"] == n and len(contact["touches"]) == n, (
+        result,
+        len(contact["touches"]),
+    )
+    assert result["strays"] == 0 and contact["strays"] == 0, (
+        "the stylus touched the sphere outside a G38.2 move"
+    )
+    assert all(t["armed"] for t in contact["touches"]), (
+        "a touch began before its trigger radius was set"
+    )
     clearance = contact["clearance_mm"]
     assert min(clearance.values()) > 0.0, clearance
-    print("smallest polled clearance outside the touches (mm): "
-          + ", ".join(f"{k} {v:.3f}" for k, v in sorted(clearance.items())))
+    print(
+        "smallest polled clearance outside the touches (mm): "
+        + ", ".join(f"{k} {v:.3f}" for k, v in sorted(clearance.items()))
+    )
     # Within the machine's travel (its built-in description) and the poses' A, C all along.
-    travel = json.loads(rotacal_cli("machines", "show", "AC-trt", "--json"))["description"]["travel_mm"]
+    travel = json.loads(rotacal_cli("machines", "show", "AC-trt", "--json"))["description"][
+        "travel_mm"
+    ]
     extent = contact["extent"]
     for k, (lo, hi) in zip("xyz", travel):
         assert lo <= extent[k][0] <= extent[k][1] <= hi, (k, extent[k], (lo, hi))
     for k, i in (("a", 0), ("c", 1)):
         angles = [p[i] for p in POSES] + [0.0]  # the machine starts homed at 0
-        assert min(angles) - 1e-9 <= extent[k][0] <= extent[k][1] <= max(angles) + 1e-9, (k, extent[k])
-    print("polled extent: " + ", ".join(f"{k} {lo:.3f}..{hi:.3f}" for k, (lo, hi) in extent.items()))
+        assert min(angles) - 1e-9 <= extent[k][0] <= extent[k][1] <= max(angles) + 1e-9, (
+            k,
+            extent[k],
+        )
+    print(
+        "polled extent: " + ", ".join(f"{k} {lo:.3f}..{hi:.3f}" for k, (lo, hi) in extent.items())
+    )
 
     # Each latched position on its commanded line, past the contact by at most one period's travel.
     model = refsim.Model("AC-trt", errors)
@@ -185,25 +259,39 @@ def test_linuxcnc_runs_the_probing_program_and_the_log_identifies_the_machine(sh
     rows = [line.split() for line in log.read_text().splitlines() if line.strip()]
     assert len(rows) == n
     pretravel = []
-    for k, ((start, target), row, rec) in enumerate(zip(probing_moves(program), rows, contact["touches"])):
+    for k, ((start, target), row, rec) in enumerate(
+        zip(probing_moves(program), rows, contact["touches"])
+    ):
         a, c = POSES[k // 5]
         centre = sphere_centre(model, a, c, sphere_actual)
-        assert np.abs(centre - rec["centre"]).max() < 1e-9 and abs(rec["radius"] - (r + eps[k])) < 1e-12
+        assert (
+            np.abs(centre - rec["centre"]).max() < 1e-9
+            and abs(rec["radius"] - (r + eps[k])) < 1e-12
+        )
         u = (target - start) / np.linalg.norm(target - start)
         w = start - centre
-        lam_contact = -w @ u - np.sqrt((w @ u) ** 2 - w @ w + (r + eps[k]) ** 2)  # entry into the trigger sphere
+        lam_contact = -w @ u - np.sqrt(
+            (w @ u) ** 2 - w @ w + (r + eps[k]) ** 2
+        )  # entry into the trigger sphere
         latched = np.array([float(v) for v in row[2:]])
         lam = (latched - start) @ u
-        assert np.linalg.norm(start + lam * u - latched) < 2e-6, (k, row)  # on the line (log: 6 decimals)
+        assert np.linalg.norm(start + lam * u - latched) < 2e-6, (
+            k,
+            row,
+        )  # on the line (log: 6 decimals)
         pretravel.append(lam - lam_contact)
     pretravel = np.array(pretravel)
-    print(f"pretravel over {n} touches: mean {pretravel.mean() * 1e3:.4f} um, max {pretravel.max() * 1e3:.4f} um, "
-          f"min {pretravel.min() * 1e3:.4f} um (one servo period at F{PROBE_FEED:g}: {period_travel * 1e3:.4f} um)")
+    print(
+        f"pretravel over {n} touches: mean {pretravel.mean() * 1e3:.4f} um, max {pretravel.max() * 1e3:.4f} um, "
+        f"min {pretravel.min() * 1e3:.4f} um (one servo period at F{PROBE_FEED:g}: {period_travel * 1e3:.4f} um)"
+    )
     assert pretravel.min() > -2e-6 and pretravel.max() < period_travel + 2e-6
     poll = contact["poll_s"]
-    print(f"userspace loop: mean {poll['mean'] * 1e3:.2f} ms, max {poll['max'] * 1e3:.1f} ms, "
-          f"{poll['over_10ms']} periods over 10 ms: a trigger decided there would latch up to "
-          f"{poll['max'] * PROBE_FEED / 60.0 * 1e3:.1f} um late")
+    print(
+        f"userspace loop: mean {poll['mean'] * 1e3:.2f} ms, max {poll['max'] * 1e3:.1f} ms, "
+        f"{poll['over_10ms']} periods over 10 ms: a trigger decided there would latch up to "
+        f"{poll['max'] * PROBE_FEED / 60.0 * 1e3:.1f} um late"
+    )
 
     # The log read back and identified: every location error within 3 sigma of the machine's.
     session = tmp_path / "probe.csv"

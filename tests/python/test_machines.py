@@ -2,6 +2,7 @@
 (NC programs in every dialect), simulate ballbar, identify (known errors recovered), report;
 `rotacal machines`; machines.load_machine; descriptions that break formats.md refused with the
 file and the field named."""
+
 import json
 import re
 import subprocess
@@ -25,7 +26,9 @@ CUSTOM = {
     "format": "rotacal-machine/1",
     "name": "shop-7 A-head C-table",
     "table_axes": [{"name": "C", "direction": [0, 0, -1], "point": [0, 0, 0]}],
-    "head_axes": [{"name": "A", "direction": [1, 0, 0], "point": [0, 0, -40], "limits_deg": [-100, 100]}],
+    "head_axes": [
+        {"name": "A", "direction": [1, 0, 0], "point": [0, 0, -40], "limits_deg": [-100, 100]}
+    ],
     "pivot_length": 120.0,
     "tool_length": 80.0,
     "travel_mm": [[-500, 500], [-400, 400], [-100, 600]],
@@ -55,6 +58,7 @@ def custom_file(tmp_path):
 
 # ------------------------------------------------------------------------- machines command
 
+
 def test_machines_lists_every_builtin(capsys):
     code, out, _ = run(capsys, "machines")
     assert code == 0
@@ -66,9 +70,13 @@ def test_machines_lists_every_builtin(capsys):
     rows = json.loads(out)
     assert [r["name"] for r in rows] == BUILTINS
     by = {r["name"]: r for r in rows}
-    assert by["AC-trt"]["location_error_names"] == list(_core.location_error_names(_core.MachineType.AC_trt))
+    assert by["AC-trt"]["location_error_names"] == list(
+        _core.location_error_names(_core.MachineType.AC_trt)
+    )
     assert [(a["name"], a["side"], a["role"]) for a in by["B-head-C-table"]["axes"]] == [
-        ("C", "table", "rotary"), ("B", "head", "tilt")]
+        ("C", "table", "rotary"),
+        ("B", "head", "tilt"),
+    ]
     assert [(a["name"], a["side"]) for a in by["AC-head"]["axes"]] == [("C", "head"), ("A", "head")]
 
 
@@ -83,7 +91,10 @@ def test_machines_show_draws_and_prints_the_description(capsys, name):
         assert re.search(rf"^\s+\[{letter}\]\s+(table|head) axis", out, re.M)
     # Drawn from the tool down to the workpiece: head axes above X, Y, Z, table axes below the bed.
     rows = out.splitlines()
-    at = {k: next(i for i, r in enumerate(rows) if r.strip().startswith(k)) for k in ("(o)", "XYZ", "===", "[W]")}
+    at = {
+        k: next(i for i, r in enumerate(rows) if r.strip().startswith(k))
+        for k in ("(o)", "XYZ", "===", "[W]")
+    }
     for letter in m.axis_names:
         i = next(i for i, r in enumerate(rows) if r.strip().startswith(f"[{letter}]"))
         head = f"[{letter}]  head" in rows[i]
@@ -99,8 +110,10 @@ def test_nutating_axis_u_v_as_drawn_move_the_table_as_the_kinematics_does():
     a table point turned 90 deg about a line shifted by d moves by (I - R) d = d - n x d."""
     m = _core.parse_machine_type("B45C-trt")
     text = machine_drawing(m)
-    u, v = (np.array([float(x) for x in g.split(",")])
-            for g in re.search(r"u = \(([^)]*)\), v = \(([^)]*)\)", text).groups())
+    u, v = (
+        np.array([float(x) for x in g.split(",")])
+        for g in re.search(r"u = \(([^)]*)\), v = \(([^)]*)\)", text).groups()
+    )
     n = np.array(json.loads(m.description_json)["table_axes"][0]["direction"])
     q, ang = np.array([[50.0, -30.0, 20.0]]), np.array([[np.pi / 2, 0.0]])
     base = rotacal.forward(m, np.zeros(8), ang, q)[0]
@@ -113,13 +126,23 @@ def test_nutating_axis_u_v_as_drawn_move_the_table_as_the_kinematics_does():
 
 # ------------------------------------------------------------------------- the chain, every machine
 
+
 @pytest.mark.parametrize("name", BUILTINS)
 def test_single_setup_chain_on_every_builtin(capsys, tmp_path, name):
     m = _core.parse_machine_type(name)
     # plan: every dialect; the linuxcnc program moves the machine's own rotary letters only.
     for dialect in DIALECTS:
-        code, _, err = run(capsys, "plan", "ballbar", "--machine", name, "--dialect", dialect,
-                           "-o", tmp_path / f"p.{dialect}")
+        code, _, err = run(
+            capsys,
+            "plan",
+            "ballbar",
+            "--machine",
+            name,
+            "--dialect",
+            dialect,
+            "-o",
+            tmp_path / f"p.{dialect}",
+        )
         assert code == 0, err
     text = (tmp_path / "p.linuxcnc").read_text()
     moves = [l for l in text.splitlines() if l.startswith(("G1 ", "G0 "))]
@@ -128,8 +151,21 @@ def test_single_setup_chain_on_every_builtin(capsys, tmp_path, name):
     # simulate with known errors, identify them back (5 sigma), report.
     truth, arg = errors_arg(m)
     session = tmp_path / "s.csv"
-    code, _, err = run(capsys, "simulate", "ballbar", "--machine", name, "--errors", arg, "--seed", 3,
-                       "-o", session, "--truth", tmp_path / "t.json")
+    code, _, err = run(
+        capsys,
+        "simulate",
+        "ballbar",
+        "--machine",
+        name,
+        "--errors",
+        arg,
+        "--seed",
+        3,
+        "-o",
+        session,
+        "--truth",
+        tmp_path / "t.json",
+    )
     assert code == 0, err
     header = session.read_text().splitlines()[:9]
     assert f"# machine: {name}" in header
@@ -144,7 +180,9 @@ def test_single_setup_chain_on_every_builtin(capsys, tmp_path, name):
     code, out, err = run(capsys, "identify", session, "--json", "--no-budget")
     assert code == 0, err
     d = json.loads(out)
-    assert d["machine"] == name and list(d["location_errors"]) == list(_core.location_error_names(m))
+    assert d["machine"] == name and list(d["location_errors"]) == list(
+        _core.location_error_names(m)
+    )
     hidden = set()
     for n, p in d["location_errors"].items():
         if p["value"] is None:
@@ -171,7 +209,9 @@ def test_single_setup_chain_on_every_builtin(capsys, tmp_path, name):
         assert f"{label}: measured and model" in html
     assert ("tool_offset_Z" in html) == m.has_head
     # The paper's chain is Flynn's two tables; other machines are told to use the joint fit.
-    code, _, err = run(capsys, "report", session, "--method", "paper", "-o", tmp_path / "p.html", "--no-diagnosis")
+    code, _, err = run(
+        capsys, "report", session, "--method", "paper", "-o", tmp_path / "p.html", "--no-diagnosis"
+    )
     if name in ("AC-trt", "BC-trt"):
         assert code == 0, err
     else:
@@ -181,15 +221,35 @@ def test_single_setup_chain_on_every_builtin(capsys, tmp_path, name):
 
 def test_custom_description_round_trip(capsys, tmp_path, custom_file):
     """A machine from a file: the session carries it, identify and report read it back."""
-    code, _, err = run(capsys, "plan", "ballbar", "--machine", custom_file, "-o", tmp_path / "c.ngc",
-                       "--session", tmp_path / "c.template.csv")
+    code, _, err = run(
+        capsys,
+        "plan",
+        "ballbar",
+        "--machine",
+        custom_file,
+        "-o",
+        tmp_path / "c.ngc",
+        "--session",
+        tmp_path / "c.template.csv",
+    )
     assert code == 0, err
     assert "(machine: shop-7 A-head C-table)" in (tmp_path / "c.ngc").read_text()
     m = load_machine(custom_file)
     truth, arg = errors_arg(m)
     session = tmp_path / "c.csv"
-    code, _, err = run(capsys, "simulate", "ballbar", "--machine", custom_file, "--errors", arg, "--seed", 5,
-                       "-o", session)
+    code, _, err = run(
+        capsys,
+        "simulate",
+        "ballbar",
+        "--machine",
+        custom_file,
+        "--errors",
+        arg,
+        "--seed",
+        5,
+        "-o",
+        session,
+    )
     assert code == 0, err
     lines = session.read_text().splitlines()
     desc = next(l for l in lines if l.startswith("# machine_description: "))
@@ -211,10 +271,17 @@ def test_custom_description_round_trip(capsys, tmp_path, custom_file):
 
 def test_model_file_of_a_described_machine(capsys, tmp_path, custom_file):
     session = tmp_path / "c.csv"
-    assert run(capsys, "simulate", "ballbar", "--machine", custom_file, "--seed", 5, "-o", session)[0] == 0
-    code, out, err = run(capsys, "identify", session, "--json", "--no-budget", "--save-model", tmp_path / "m.json")
+    assert (
+        run(capsys, "simulate", "ballbar", "--machine", custom_file, "--seed", 5, "-o", session)[0]
+        == 0
+    )
+    code, out, err = run(
+        capsys, "identify", session, "--json", "--no-budget", "--save-model", tmp_path / "m.json"
+    )
     assert code == 0, err
-    code, _, err = run(capsys, "predict", session, "--model", tmp_path / "m.json", "-o", tmp_path / "pred.csv")
+    code, _, err = run(
+        capsys, "predict", session, "--model", tmp_path / "m.json", "-o", tmp_path / "pred.csv"
+    )
     assert code == 0, err
     rms = float(re.search(r"RMS ([0-9.]+) um", err).group(1))
     assert rms == pytest.approx(json.loads(out)["residual_rms_um"], abs=1e-3)
@@ -222,8 +289,12 @@ def test_model_file_of_a_described_machine(capsys, tmp_path, custom_file):
 
 def test_python_module_entry_point_with_a_description_file(tmp_path, custom_file):
     """`python -m rotacal` as a user runs it: a file machine shown and simulated."""
-    r = subprocess.run([sys.executable, "-m", "rotacal", "machines", "show", str(custom_file), "--json"],
-                       capture_output=True, text=True, timeout=300)
+    r = subprocess.run(
+        [sys.executable, "-m", "rotacal", "machines", "show", str(custom_file), "--json"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert r.returncode == 0, r.stderr
     assert json.loads(r.stdout)["configuration"] == "head-table"
 
@@ -235,12 +306,22 @@ def test_tilt_range_defaults_to_the_machines(capsys, tmp_path):
     assert code == 0, err
     lo, hi = _core.default_tilt_range_deg(m)
     assert f"(B range: {lo:g} .. {hi:g} deg" in (tmp_path / "a.ngc").read_text()
-    code, _, err = run(capsys, "plan", "ballbar", "--machine", "B45C-trt", "--b-range", "-90,90",
-                       "-o", tmp_path / "b.ngc")
+    code, _, err = run(
+        capsys,
+        "plan",
+        "ballbar",
+        "--machine",
+        "B45C-trt",
+        "--b-range",
+        "-90,90",
+        "-o",
+        tmp_path / "b.ngc",
+    )
     assert code == cli.EXIT_INPUT and "limits" in err
 
 
 # ------------------------------------------------------------------------- Python API
+
 
 def test_load_machine_by_name_file_and_handle(custom_file):
     assert load_machine("BC-trt") == _core.MachineType.BC_trt
@@ -248,7 +329,12 @@ def test_load_machine_by_name_file_and_handle(custom_file):
     a, b = load_machine(custom_file), load_machine(str(custom_file))
     assert a == b and a.name == CUSTOM["name"] and not a.is_builtin
     assert a.axis_names == "CA" and a.has_head and a.configuration == "head-table"
-    assert machine_dict(custom_file)["axes"][1]["location_errors"] == ["E_Y0A", "E_Z0A", "E_B0A", "E_C0A"]
+    assert machine_dict(custom_file)["axes"][1]["location_errors"] == [
+        "E_Y0A",
+        "E_Z0A",
+        "E_B0A",
+        "E_C0A",
+    ]
     with pytest.raises(_core.InvalidArgument, match="unknown machine 'XY-trt'.*AC-trt"):
         load_machine("XY-trt")
     with pytest.raises(_core.IoError, match="missing.json"):
@@ -260,11 +346,23 @@ def test_load_machine_by_name_file_and_handle(custom_file):
 # ------------------------------------------------------------------------- bad descriptions
 
 BAD = [
-    ("zero direction", lambda d: d["table_axes"][0].update(direction=[0, 0, 0]), "table_axes[0].direction"),
+    (
+        "zero direction",
+        lambda d: d["table_axes"][0].update(direction=[0, 0, 0]),
+        "table_axes[0].direction",
+    ),
     ("same letter twice", lambda d: d["head_axes"][0].update(name="C"), "'C'"),
     ("letter not A/B/C", lambda d: d["head_axes"][0].update(name="W"), "head_axes[0].name"),
-    ("limits reversed", lambda d: d["head_axes"][0].update(limits_deg=[100, -100]), "head_axes[0].limits_deg"),
-    ("three axes", lambda d: d["head_axes"].append({"name": "B", "direction": [0, 1, 0]}), "3 rotary axes"),
+    (
+        "limits reversed",
+        lambda d: d["head_axes"][0].update(limits_deg=[100, -100]),
+        "head_axes[0].limits_deg",
+    ),
+    (
+        "three axes",
+        lambda d: d["head_axes"].append({"name": "B", "direction": [0, 1, 0]}),
+        "3 rotary axes",
+    ),
     ("unknown field", lambda d: d.update(colour="red"), "colour"),
     ("wrong format", lambda d: d.update(format="rotacal-machine/2"), "format"),
     ("tool length text", lambda d: d.update(tool_length="80"), "tool_length"),
@@ -272,21 +370,31 @@ BAD = [
 
 
 @pytest.mark.parametrize("what,change,field", BAD, ids=[b[0] for b in BAD])
-@pytest.mark.parametrize("command", [["plan", "ballbar"], ["simulate", "ballbar"], ["design", "ballbar"],
-                                     ["machines", "show"]])
-def test_bad_description_refused_with_file_and_field(capsys, tmp_path, what, change, field, command):
+@pytest.mark.parametrize(
+    "command",
+    [["plan", "ballbar"], ["simulate", "ballbar"], ["design", "ballbar"], ["machines", "show"]],
+)
+def test_bad_description_refused_with_file_and_field(
+    capsys, tmp_path, what, change, field, command
+):
     d = json.loads(json.dumps(CUSTOM))
     change(d)
     bad = tmp_path / "bad.json"
     bad.write_text(json.dumps(d))
-    args = [*command, bad] if command[0] == "machines" else [*command, "--machine", bad, "-o", tmp_path / "o"]
+    args = (
+        [*command, bad]
+        if command[0] == "machines"
+        else [*command, "--machine", bad, "-o", tmp_path / "o"]
+    )
     code, _, err = run(capsys, *args)
     assert code == cli.EXIT_INPUT, err
     assert str(bad) in err and field in err, err
     assert not (tmp_path / "o").exists()
 
 
-@pytest.mark.parametrize("text,why", [("{", "not valid JSON"), ("[]", "JSON object"), ("\xff", "UTF-8")])
+@pytest.mark.parametrize(
+    "text,why", [("{", "not valid JSON"), ("[]", "JSON object"), ("\xff", "UTF-8")]
+)
 def test_not_a_description_refused(capsys, tmp_path, text, why):
     bad = tmp_path / "m.json"
     bad.write_bytes(text.encode("latin-1"))
@@ -295,7 +403,9 @@ def test_not_a_description_refused(capsys, tmp_path, text, why):
 
 
 def test_unreadable_or_unknown_machine(capsys, tmp_path):
-    code, _, err = run(capsys, "simulate", "ballbar", "--machine", tmp_path / "none.json", "-o", tmp_path / "o.csv")
+    code, _, err = run(
+        capsys, "simulate", "ballbar", "--machine", tmp_path / "none.json", "-o", tmp_path / "o.csv"
+    )
     assert code == cli.EXIT_IO and "none.json" in err
     code, _, err = run(capsys, "plan", "ballbar", "--machine", tmp_path, "-o", tmp_path / "o.ngc")
     assert code == cli.EXIT_IO and "directory" in err
@@ -312,11 +422,15 @@ def test_axial_c_tilt_on_a_head_head_machine(capsys, tmp_path):
     for tilt in (None, 0):
         extra = [] if tilt is None else ["--axial-c-tilt", tilt]
         s = tmp_path / f"s{tilt}.csv"
-        code, _, err = run(capsys, "simulate", "ballbar", "--machine", "AC-head", "--seed", 1, *extra, "-o", s)
+        code, _, err = run(
+            capsys, "simulate", "ballbar", "--machine", "AC-head", "--seed", 1, *extra, "-o", s
+        )
         assert code == 0, err
         code, out, err = run(capsys, "identify", s, "--json", "--no-budget")
         assert code == 0, err
-        seen[tilt] = {n for n, p in json.loads(out)["location_errors"].items() if p["value"] is not None}
+        seen[tilt] = {
+            n for n, p in json.loads(out)["location_errors"].items() if p["value"] is not None
+        }
     assert seen[None] == set(_core.location_error_names(load_machine("AC-head"))) - {"E_Z0A"}
     assert seen[0] == {"E_Y0A", "E_B0A", "E_C0A"}
 
@@ -336,8 +450,11 @@ def test_doc_example_description_is_the_tested_one(tmp_path):
 
 
 def test_doc_table_of_builtins_matches_the_descriptions():
-    rows = re.findall(r"^\| (\S+) \| (table-table|head-table|head-head) \| ([A-C]), ([A-C]) \| ([E_A-Z0-9 ]+) \|$",
-                      DOC.read_text(encoding="utf-8"), re.M)
+    rows = re.findall(
+        r"^\| (\S+) \| (table-table|head-table|head-head) \| ([A-C]), ([A-C]) \| ([E_A-Z0-9 ]+) \|$",
+        DOC.read_text(encoding="utf-8"),
+        re.M,
+    )
     assert [r[0] for r in rows] == BUILTINS
     for name, conf, a0, a1, names in rows:
         m = _core.parse_machine_type(name)
@@ -346,7 +463,9 @@ def test_doc_table_of_builtins_matches_the_descriptions():
 
 
 @pytest.mark.parametrize("name", ["B-head-C-table", "AC-head", "B45C-trt", "AC-trt", "custom"])
-def test_rtest_model_file_predicts_held_out_poses_on_any_machine(capsys, tmp_path, custom_file, name):
+def test_rtest_model_file_predicts_held_out_poses_on_any_machine(
+    capsys, tmp_path, custom_file, name
+):
     """Fit on C = 0, 30, ...; save the rtest-joint model; predict C = 15, 45, ... from the file.
     The prediction (the file's probe zeros added) matches the simulated machine's noise-free
     readings to well under the noise: the maps, tool_offset_Z of a head and the convention
@@ -354,14 +473,36 @@ def test_rtest_model_file_predicts_held_out_poses_on_any_machine(capsys, tmp_pat
     spindle) all travel through the file."""
     machine = str(custom_file) if name == "custom" else name
     session = tmp_path / "r.csv"
-    code, _, err = run(capsys, "simulate", "rtest", "--machine", machine, "--c-step", 15, "--seed", 3,
-                       "--effect", "gravity_sag_" + load_machine(machine).tilt_axis + "=0.004", "-o", session)
+    code, _, err = run(
+        capsys,
+        "simulate",
+        "rtest",
+        "--machine",
+        machine,
+        "--c-step",
+        15,
+        "--seed",
+        3,
+        "--effect",
+        "gravity_sag_" + load_machine(machine).tilt_axis + "=0.004",
+        "-o",
+        session,
+    )
     assert code == 0, err
     fit, held = split_by_c(session, 30)
     code, _, err = run(capsys, "identify", fit, "--no-budget", "--save-model", tmp_path / "m.json")
     assert code == 0, err
-    code, _, err = run(capsys, "predict", held, "--model", tmp_path / "m.json", "--probe-zeros", "fitted",
-                       "-o", tmp_path / "p.csv")
+    code, _, err = run(
+        capsys,
+        "predict",
+        held,
+        "--model",
+        tmp_path / "m.json",
+        "--probe-zeros",
+        "fitted",
+        "-o",
+        tmp_path / "p.csv",
+    )
     assert code == 0, err
     saved = rotacal.load_model(tmp_path / "m.json")
     m = load_machine(machine)
@@ -369,14 +510,18 @@ def test_rtest_model_file_predicts_held_out_poses_on_any_machine(capsys, tmp_pat
     assert saved["basis"]["maps"] == list(_core.rtest_map_names(m))
     truth = json.loads((tmp_path / "r.truth.json").read_text())
     s_held = rotacal.load(held)
-    err_mm = np.asarray(rotacal.load(tmp_path / "p.csv").d) - rotacal.rtest.truth_readings(truth, s_held)
+    err_mm = np.asarray(rotacal.load(tmp_path / "p.csv").d) - rotacal.rtest.truth_readings(
+        truth, s_held
+    )
     noise_mm = truth["noise_um"] * 1e-3
     # The model's own error ~ noise * sqrt(p / n) (about 0.35 noise here); 2x margin.
-    assert np.sqrt(np.mean(err_mm ** 2)) < 0.7 * noise_mm
+    assert np.sqrt(np.mean(err_mm**2)) < 0.7 * noise_mm
     # The file predicts exactly as the fit in memory does.
     ident = rotacal.identify_rtest(rotacal.load(fit))
     in_memory = rotacal.rtest.predict_rtest(ident.model_dict(), s_held, probe_zeros="fitted")
-    assert np.allclose(np.asarray(in_memory.d), np.asarray(rotacal.load(tmp_path / "p.csv").d), atol=1e-12)
+    assert np.allclose(
+        np.asarray(in_memory.d), np.asarray(rotacal.load(tmp_path / "p.csv").d), atol=1e-12
+    )
 
 
 def test_rtest_model_file_layout_is_checked_per_machine(capsys, tmp_path):
@@ -384,10 +529,14 @@ def test_rtest_model_file_layout_is_checked_per_machine(capsys, tmp_path):
     not the machine's are refused, naming the member."""
     session = tmp_path / "r.csv"
     assert run(capsys, "simulate", "rtest", "--machine", "B-head-C-table", "-o", session)[0] == 0
-    assert run(capsys, "identify", session, "--no-budget", "--save-model", tmp_path / "m.json")[0] == 0
+    assert (
+        run(capsys, "identify", session, "--no-budget", "--save-model", tmp_path / "m.json")[0] == 0
+    )
     good = json.loads((tmp_path / "m.json").read_text())
-    for change, member in ((lambda d: d.pop("tool_offset_Z"), "tool_offset_Z"),
-                           (lambda d: d["basis"].update(maps=["BY", "CB"]), "basis.maps")):
+    for change, member in (
+        (lambda d: d.pop("tool_offset_Z"), "tool_offset_Z"),
+        (lambda d: d["basis"].update(maps=["BY", "CB"]), "basis.maps"),
+    ):
         d = json.loads(json.dumps(good))
         change(d)
         bad = tmp_path / "bad.json"
@@ -407,12 +556,25 @@ def test_rtest_pattern_options_start_from_the_machines_default(capsys, tmp_path)
     (its nutating B), so --b-step 45 gives 0, 45, ..., 180, not the paper's -90..90 (refused
     there); --c-step 15 keeps the full turn."""
     s = tmp_path / "r.csv"
-    code, out, err = run(capsys, "simulate", "rtest", "--machine", "B45C-trt", "--b-step", 45, "--c-step", 15,
-                         "-o", s)
+    code, out, err = run(
+        capsys,
+        "simulate",
+        "rtest",
+        "--machine",
+        "B45C-trt",
+        "--b-step",
+        45,
+        "--c-step",
+        15,
+        "-o",
+        s,
+    )
     assert code == 0, err
     angles = np.asarray(rotacal.load(s).angles_deg)
     assert sorted(set(angles[:, 0])) == [0.0, 45.0, 90.0, 135.0, 180.0]
     assert sorted(set(angles[:, 1])) == [15.0 * k for k in range(24)]
     # A range outside the limits is still refused, naming the axis.
-    code, _, err = run(capsys, "simulate", "rtest", "--machine", "B45C-trt", "--b-range", "-90,90", "-o", s)
+    code, _, err = run(
+        capsys, "simulate", "rtest", "--machine", "B45C-trt", "--b-range", "-90,90", "-o", s
+    )
     assert code != 0 and "B" in err, err

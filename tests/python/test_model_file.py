@@ -1,6 +1,7 @@
 """rotacal-model/1 files between the languages: what Python's standard json module writes the
 C++ reader reads (as every file written before the C++ writer existed), and what the C++
 writer writes Python's json module reads back, value for value; strict JSON, versions."""
+
 import json
 import math
 
@@ -14,6 +15,7 @@ from rotacal import _core
 def _strict_loads(text):
     def refuse(token):
         raise AssertionError(f"non-standard JSON token {token}")
+
     return json.loads(text, parse_constant=refuse)
 
 
@@ -38,7 +40,9 @@ def test_python_written_ballbar_model_is_read_by_cpp(ballbar_fit, tmp_path):
     np.testing.assert_array_equal(model.pivot, [d["pivot"][a]["value"] for a in "xyz"])
     # The model the C++ reader built predicts the fitted session to the fit's own residual.
     pred = rotacal.predict(model, s).length
-    assert np.sqrt(np.mean((pred - s.length) ** 2)) * 1e3 == pytest.approx(r.to_dict()["residual_rms_um"], rel=1e-6)
+    assert np.sqrt(np.mean((pred - s.length) ** 2)) * 1e3 == pytest.approx(
+        r.to_dict()["residual_rms_um"], rel=1e-6
+    )
 
 
 def test_cpp_written_ballbar_model_is_read_by_python_json(ballbar_fit, tmp_path):
@@ -67,12 +71,16 @@ def test_rtest_joint_model_both_ways(rtest_fit, tmp_path):
     assert full["covariance"]["parameters"] == d["covariance"]["parameters"]
     rotacal.save_model(d, tmp_path / "cpp.json")
     back = _strict_loads((tmp_path / "cpp.json").read_text())
-    np.testing.assert_array_equal(np.array(back["covariance"]["matrix"], dtype=float),
-                                  np.array(d["covariance"]["matrix"], dtype=float))
+    np.testing.assert_array_equal(
+        np.array(back["covariance"]["matrix"], dtype=float),
+        np.array(d["covariance"]["matrix"], dtype=float),
+    )
     assert back["map_coefficients"] == d["map_coefficients"]
     # The model read back from the C++-written file is the Python-written one's.
-    assert rotacal.load_model(tmp_path / "cpp.json")["location_errors"] == \
-        rotacal.load_model(tmp_path / "py.json")["location_errors"]
+    assert (
+        rotacal.load_model(tmp_path / "cpp.json")["location_errors"]
+        == rotacal.load_model(tmp_path / "py.json")["location_errors"]
+    )
 
 
 def test_non_finite_numbers_become_null_with_a_reason(ballbar_fit, tmp_path):
@@ -91,12 +99,15 @@ def test_non_finite_numbers_become_null_with_a_reason(ballbar_fit, tmp_path):
         rotacal.load_model(tmp_path / "nan.json")
 
 
-@pytest.mark.parametrize("change,match", [
-    (lambda d: d.update(format="rotacal-model/2"), "newer rotacal"),
-    (lambda d: d["location_errors"]["E_Y0C"].update(unit="um"), r"E_Y0C\.unit"),
-    (lambda d: d["location_errors"]["E_Y0C"].update(value=1e300), "no machine tool"),
-    (lambda d: d.update(machine="BC-trt"), "location_errors lacks"),
-])
+@pytest.mark.parametrize(
+    "change,match",
+    [
+        (lambda d: d.update(format="rotacal-model/2"), "newer rotacal"),
+        (lambda d: d["location_errors"]["E_Y0C"].update(unit="um"), r"E_Y0C\.unit"),
+        (lambda d: d["location_errors"]["E_Y0C"].update(value=1e300), "no machine tool"),
+        (lambda d: d.update(machine="BC-trt"), "location_errors lacks"),
+    ],
+)
 def test_bad_models_refused(ballbar_fit, tmp_path, change, match):
     d = json.loads(json.dumps(ballbar_fit[1].model_dict()))
     change(d)

@@ -3,6 +3,7 @@ sessions made by the independent reference simulator (tests/reference/refsim, AR
 machine with several location errors) -- ballbar + probe, and ballbar + R-test -- are identified
 jointly by rotacal.identify([...]) within 3 sigma of the truth, each session with its own
 nuisances; sessions of two machine types are refused by name. The truth comes from refsim."""
+
 import json
 import sys
 from pathlib import Path
@@ -31,8 +32,13 @@ def ballbar_file(tmp_path, machine: str, errors: dict, seed: int) -> Path:
     m = refsim.builtin(machine)
     s = poses.ballbar_single_setup(m)
     model = refsim.Model(m, errors)
-    length = refsim.ballbar_lengths(model, s["pivot"] + np.array([0.012, -0.008, 0.015]), s["xyz"],
-                                    np.radians(s["angles_deg"]), s["time"])
+    length = refsim.ballbar_lengths(
+        model,
+        s["pivot"] + np.array([0.012, -0.008, 0.015]),
+        s["xyz"],
+        np.radians(s["angles_deg"]),
+        s["time"],
+    )
     length = length + noise.ar1(s["test"], 0.5, 5e-4, np.random.default_rng(seed))
     return writers.write_ballbar(tmp_path / f"bb_{machine}_{seed}.csv", m, s, length, noise_um=0.5)
 
@@ -41,19 +47,35 @@ def probe_file(tmp_path, machine: str, errors: dict, seed: int) -> Path:
     m = refsim.builtin(machine)
     ses = poses.probe_poses(m)
     sphere_actual = ses["sphere"] + np.array([0.031, -0.024, 0.017])
-    latched = refsim.probe_touches(refsim.Model(m, errors), sphere_actual, ses["sphere"], 25.0, 6.0, ses["n"],
-                                   np.radians(ses["angles_deg"]), ses["time"])
+    latched = refsim.probe_touches(
+        refsim.Model(m, errors),
+        sphere_actual,
+        ses["sphere"],
+        25.0,
+        6.0,
+        ses["n"],
+        np.radians(ses["angles_deg"]),
+        ses["time"],
+    )
     rng = np.random.default_rng(seed)
     one = ["touches"] * len(latched)
     latched = latched + np.column_stack([noise.ar1(one, 0.6, 5e-4, rng) for _ in range(3)])
-    return writers.write_probe(tmp_path / f"probe_{machine}_{seed}.csv", m, ses, latched, 25.0, 6.0, noise_um=0.5)
+    return writers.write_probe(
+        tmp_path / f"probe_{machine}_{seed}.csv", m, ses, latched, 25.0, 6.0, noise_um=0.5
+    )
 
 
 def rtest_file(tmp_path, machine: str, errors: dict, seed: int) -> Path:
     m = refsim.builtin(machine)
     s = poses.rtest_grid(m)
-    d = refsim.rtest_displacements(refsim.Model(m, errors), s["nests"], s["setup"], s["xyz"],
-                                   np.radians(s["angles_deg"]), s["time"])
+    d = refsim.rtest_displacements(
+        refsim.Model(m, errors),
+        s["nests"],
+        s["setup"],
+        s["xyz"],
+        np.radians(s["angles_deg"]),
+        s["time"],
+    )
     rng = np.random.default_rng(seed)
     d = d + np.stack([noise.ar1(s["setup"], 0.5, 5e-4, rng) for _ in range(3)], axis=1)
     d = d + np.array([0.2, -0.1, 0.05])  # the probe zeros: the sessions' own nuisances
@@ -73,8 +95,10 @@ def off_by_more_than_3_sigma(result: dict, errors: dict) -> list:
 def test_joint_identification_within_3_sigma(tmp_path, second):
     errors = truth_errors(MACHINE)
     make = probe_file if second == "probe" else rtest_file
-    sessions = [rotacal.load(ballbar_file(tmp_path, MACHINE, errors, 5)),
-                rotacal.load(make(tmp_path, MACHINE, errors, 6))]
+    sessions = [
+        rotacal.load(ballbar_file(tmp_path, MACHINE, errors, 5)),
+        rotacal.load(make(tmp_path, MACHINE, errors, 6)),
+    ]
     r = rotacal.identify(sessions)
     d = r.to_dict()
     assert d["converged"]
@@ -101,7 +125,9 @@ def test_sessions_of_two_machine_types_are_refused(tmp_path):
 
 def test_cli_joint_identification_reports_a_planted_disagreement(tmp_path):
     errors = truth_errors(MACHINE)
-    moved = dict(errors, E_X0C=errors["E_X0C"] + 0.030)  # the probe's machine, 30 um off in one error
+    moved = dict(
+        errors, E_X0C=errors["E_X0C"] + 0.030
+    )  # the probe's machine, 30 um off in one error
     bb, pr = ballbar_file(tmp_path, MACHINE, errors, 7), probe_file(tmp_path, MACHINE, moved, 8)
     r = run_cli("identify", bb, pr, "--json", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
@@ -127,12 +153,21 @@ def test_shared_effect_within_3_sigma(tmp_path):
     sag = {"gravity_sag_A": 0.004}
     m = refsim.builtin(MACHINE)
     s = poses.ballbar_single_setup(m)
-    length = refsim.ballbar_lengths(refsim.Model(m, errors, sag), s["pivot"], s["xyz"], np.radians(s["angles_deg"]),
-                                    s["time"]) + noise.ar1(s["test"], 0.5, 5e-4, np.random.default_rng(11))
+    length = refsim.ballbar_lengths(
+        refsim.Model(m, errors, sag), s["pivot"], s["xyz"], np.radians(s["angles_deg"]), s["time"]
+    ) + noise.ar1(s["test"], 0.5, 5e-4, np.random.default_rng(11))
     bb = writers.write_ballbar(tmp_path / "bb_sag.csv", m, s, length, noise_um=0.5)
     ses = poses.probe_poses(m)
-    latched = refsim.probe_touches(refsim.Model(m, errors, sag), ses["sphere"], ses["sphere"], 25.0, 6.0, ses["n"],
-                                   np.radians(ses["angles_deg"]), ses["time"])
+    latched = refsim.probe_touches(
+        refsim.Model(m, errors, sag),
+        ses["sphere"],
+        ses["sphere"],
+        25.0,
+        6.0,
+        ses["n"],
+        np.radians(ses["angles_deg"]),
+        ses["time"],
+    )
     latched = latched + np.random.default_rng(12).normal(0.0, 5e-4, latched.shape)
     pr = writers.write_probe(tmp_path / "probe_sag.csv", m, ses, latched, 25.0, 6.0, noise_um=0.5)
     d = rotacal.identify([rotacal.load(bb), rotacal.load(pr)], effects=["gravity_sag_A"]).to_dict()

@@ -1,6 +1,7 @@
 """Joint fits on correlated noise from Python and the CLI: the white fit's 1-sigma is several
 times too small on AR(0.95) ballbar sessions, the noise-model fit's holds; the Monte Carlo
 check re-simulates the fitted noise model (issue 11 items 1 and 3)."""
+
 import json
 
 import numpy as np
@@ -25,8 +26,17 @@ def ar_session(clean, rho, seed):
     s, _ = clean
     e = _core.noise_ar1(list(s.tests), list(s.time), rho, 0.5e-3, seed)
     # declared 0.5 um, the marginal sigma, as a user who measured the noise at rest would
-    return rotacal.BallbarSession(s.machine, s.ballbar_length, s.pivot, s.tests, s.time, s.xyz,
-                                  s.angles_deg, np.asarray(s.length) + e, noise_um=0.5)
+    return rotacal.BallbarSession(
+        s.machine,
+        s.ballbar_length,
+        s.pivot,
+        s.tests,
+        s.time,
+        s.xyz,
+        s.angles_deg,
+        np.asarray(s.length) + e,
+        noise_um=0.5,
+    )
 
 
 def test_ar095_white_sigmas_too_small_noise_model_right(clean):
@@ -47,7 +57,7 @@ def test_ar095_white_sigmas_too_small_noise_model_right(clean):
                 assert 15 < nm["correlation_samples"] < 100  # AR(0.95): tau = 39 readings
                 assert nm["covariance_factor"] >= 1.0
     rms = {k: float(np.sqrt(np.mean(np.square(v)))) for k, v in z.items()}
-    assert rms["white"] > 3.0, rms   # the issue measured 6.5
+    assert rms["white"] > 3.0, rms  # the issue measured 6.5
     assert 0.6 < rms["auto"] < 1.5, rms  # 40 z-scores: RMS 1 +- 0.11 for independent ones
 
 
@@ -73,12 +83,16 @@ def test_cli_noise_option_and_json(clean, tmp_path):
     s = ar_session(clean, 0.95, 7)
     f = tmp_path / "ar.csv"
     rotacal.save(s, f)
+
     def run(*a):
         return run_cli("identify", f, "--json", "--no-budget", *a)
 
     auto, white = json.loads(run().stdout), json.loads(run("--noise", "white").stdout)
     assert auto["noise_model"]["gls_refit"] and not white["noise_model"]["gls_refit"]
-    ratio = [auto["location_errors"][n]["std"] / white["location_errors"][n]["std"] for n in auto["location_errors"]]
+    ratio = [
+        auto["location_errors"][n]["std"] / white["location_errors"][n]["std"]
+        for n in auto["location_errors"]
+    ]
     assert min(ratio) > 2.0, ratio  # correlated noise: the honest sigma is several times larger
     bad = run_cli("identify", f, "--noise", "pink")
     assert bad.returncode == 2 and "--noise" in bad.stderr

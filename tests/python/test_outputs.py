@@ -1,5 +1,6 @@
 """The output rule from Python (rotacal.outputs.write_output): files replaced atomically,
 devices and FIFOs written through, symlinks followed, bad targets refused with IoError."""
+
 import os
 import stat
 import threading
@@ -71,10 +72,13 @@ def test_symlink_followed(tmp_path):
     assert (tmp_path / "target").read_text() == "new"
 
 
-@pytest.mark.parametrize("make,path,words", [
-    (lambda d: (d / "sub").mkdir(), "sub", "is a directory"),
-    (lambda d: None, "missing/out.csv", "does not exist"),
-])
+@pytest.mark.parametrize(
+    "make,path,words",
+    [
+        (lambda d: (d / "sub").mkdir(), "sub", "is a directory"),
+        (lambda d: None, "missing/out.csv", "does not exist"),
+    ],
+)
 def test_bad_targets_refused(tmp_path, make, path, words):
     make(tmp_path)
     with pytest.raises(_core.IoError, match=words):
@@ -98,7 +102,9 @@ def test_input_and_other_output_refused(tmp_path):
         write_output(tmp_path / "." / "S.csv", "predicted", inputs=[s])
     assert s.read_text() == "measurements"
     with pytest.raises(_core.IoError, match="another output"):
-        write_output(tmp_path / "X", "session", other_outputs=[tmp_path / "X"], inputs=[])  # same name
+        write_output(
+            tmp_path / "X", "session", other_outputs=[tmp_path / "X"], inputs=[]
+        )  # same name
     # `simulate -o X --truth X`: the second output is refused before anything is written
     with pytest.raises(_core.IoError, match="another output"):
         check_output(tmp_path / "X", other_outputs=[str(tmp_path / "sub" / ".." / "X")])

@@ -1,5 +1,6 @@
 """Ballbar test planning from Python: arrays, the reference session's commands, L0 along the
 whole toolpath, compensation, NC program text, typed errors."""
+
 import numpy as np
 import pytest
 
@@ -57,8 +58,13 @@ def test_default_plan_arrays_and_reference_commands(shared_data):
 @pytest.mark.parametrize("machine", [rotacal.MachineType.AC_trt, rotacal.MachineType.BC_trt])
 def test_ballbar_stays_at_l0_everywhere(machine):
     pivot = np.array([95.0, 40.0, 75.0])
-    setup = rotacal.BallbarSetup(machine=machine, ballbar_length=125.0, pivot=pivot, step_deg=3.0,
-                                 radial_c_side=rotacal.RadialSide.inside)
+    setup = rotacal.BallbarSetup(
+        machine=machine,
+        ballbar_length=125.0,
+        pivot=pivot,
+        step_deg=3.0,
+        radial_c_side=rotacal.RadialSide.inside,
+    )
     plan = rotacal.plan_ballbar_test(setup)
     # Table frame: every sample, tests and transitions.
     np.testing.assert_allclose(np.linalg.norm(plan.p_table - pivot, axis=1), 125.0, atol=1e-9)
@@ -66,8 +72,9 @@ def test_ballbar_stays_at_l0_everywhere(machine):
     tilt = rx if machine == rotacal.MachineType.AC_trt else ry
     ang = np.radians(plan.angles_deg)
     pivot_m = np.array([tilt(a) @ rz(c) @ pivot for a, c in ang])
-    np.testing.assert_allclose(np.linalg.norm(plan.machine_axes[:, :3] - pivot_m, axis=1), 125.0,
-                               atol=1e-9)
+    np.testing.assert_allclose(
+        np.linalg.norm(plan.machine_axes[:, :3] - pivot_m, axis=1), 125.0, atol=1e-9
+    )
     letter = "A" if machine == rotacal.MachineType.AC_trt else "B"
     assert f"radial_{letter}" in plan.labels and f"axial_{letter}" in plan.labels
 
@@ -91,23 +98,29 @@ def test_compensated_plan_hits_targets_on_the_actual_machine(shared_data):
 
 
 def test_setup_options_round_trip_and_validation():
-    s = rotacal.BallbarSetup(tilt_range_deg=(-60, 60), step_deg=2.0,
-                             tests=[rotacal.BallbarTest.radial_tilt, rotacal.BallbarTest.axial_c])
+    s = rotacal.BallbarSetup(
+        tilt_range_deg=(-60, 60),
+        step_deg=2.0,
+        tests=[rotacal.BallbarTest.radial_tilt, rotacal.BallbarTest.axial_c],
+    )
     assert s.tilt_range_deg == [-60.0, 60.0]
     plan = rotacal.plan_ballbar_test(s)
     labels = np.array(plan.labels)
     assert (labels == "radial_A").sum() == 61
     assert (labels == "axial_C").sum() == 180
-    np.testing.assert_array_equal(plan.angles_deg[labels == "radial_A"][:, 0],
-                                  np.arange(-60, 61, 2))
+    np.testing.assert_array_equal(
+        plan.angles_deg[labels == "radial_A"][:, 0], np.arange(-60, 61, 2)
+    )
     s.ballbar_length = -1
     with pytest.raises(rotacal.InvalidArgument, match="ballbar_length"):
         rotacal.plan_ballbar_test(s)
     s = rotacal.BallbarSetup(pivot=np.array([0.0, 0.0, 50.0]))
     with pytest.raises(rotacal.InvalidArgument, match="radial_C"):
         rotacal.plan_ballbar_test(s)
-    assert rotacal.parse_ballbar_test("axial_B", rotacal.MachineType.BC_trt) == \
-        rotacal.BallbarTest.axial_tilt
+    assert (
+        rotacal.parse_ballbar_test("axial_B", rotacal.MachineType.BC_trt)
+        == rotacal.BallbarTest.axial_tilt
+    )
     with pytest.raises(rotacal.InvalidArgument, match="axial_B"):
         rotacal.parse_ballbar_test("axial_B", rotacal.MachineType.AC_trt)
 
@@ -124,7 +137,7 @@ def test_commanded_session_feeds_the_simulator(shared_data):
     ref = rotacal.load(shared_data / "ballbar_ac_table2.csv")
     diff_um = (sim.length - ref.length) * 1e3
     # Only the file's noise separates them (0.5 um, 1-sigma).
-    assert np.sqrt(np.mean(diff_um ** 2)) < 1.2 * t["noise_um"]
+    assert np.sqrt(np.mean(diff_um**2)) < 1.2 * t["noise_um"]
 
 
 def test_nc_program_text():

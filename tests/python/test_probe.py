@@ -3,6 +3,7 @@ rotacal.identify fits it (joint, and the cycles' method as the peer), and sessio
 independent reference simulator (tests/reference/refsim: other seeds, AR(1) noise, an effect)
 are identified within 3 sigma. The truth of every check comes from /work/shared/data or refsim,
 never from rotacal's own simulator."""
+
 import json
 import sys
 from pathlib import Path
@@ -67,20 +68,39 @@ def test_the_cycles_method_runs_as_the_peer():
         rotacal.identify(s, "paper")
 
 
-def refsim_session(tmp_path, machine: str, errors: dict, effects: dict, rho: float, seed: int,
-                   sigma_um: float = 0.5):
+def refsim_session(
+    tmp_path,
+    machine: str,
+    errors: dict,
+    effects: dict,
+    rho: float,
+    seed: int,
+    sigma_um: float = 0.5,
+):
     """A session by the reference simulator: its poses, its touch model, AR(1) noise per latched
     coordinate from touch to touch, written by its writer."""
     m = refsim.builtin(machine)
     ses = poses.probe_poses(m)
     sphere_actual = ses["sphere"] + np.array([0.031, -0.024, 0.017])
     model = refsim.Model(machine, errors, effects)
-    latched = refsim.probe_touches(model, sphere_actual, ses["sphere"], 25.0, 6.0, ses["n"],
-                                   np.radians(ses["angles_deg"]), ses["time"])
+    latched = refsim.probe_touches(
+        model,
+        sphere_actual,
+        ses["sphere"],
+        25.0,
+        6.0,
+        ses["n"],
+        np.radians(ses["angles_deg"]),
+        ses["time"],
+    )
     rng = np.random.default_rng(seed)
     one = ["touches"] * len(latched)
-    latched = latched + np.column_stack([noise.ar1(one, rho, sigma_um * 1e-3, rng) for _ in range(3)])
-    path = writers.write_probe(tmp_path / f"{machine}_{seed}.csv", m, ses, latched, 25.0, 6.0, noise_um=sigma_um)
+    latched = latched + np.column_stack(
+        [noise.ar1(one, rho, sigma_um * 1e-3, rng) for _ in range(3)]
+    )
+    path = writers.write_probe(
+        tmp_path / f"{machine}_{seed}.csv", m, ses, latched, 25.0, 6.0, noise_um=sigma_um
+    )
     return path, sphere_actual
 
 
@@ -88,12 +108,17 @@ def refsim_session(tmp_path, machine: str, errors: dict, effects: dict, rho: flo
 def test_reference_sessions_in_ar1_noise_with_an_effect(tmp_path, machine, seed):
     names = refsim.builtin(machine).error_names()
     rng = np.random.default_rng(seed)
-    errors = {n: (rng.normal(0, 0.03) if k % 4 < 2 else rng.normal(0, 4e-5)) for k, n in enumerate(names)}
-    path, sphere_actual = refsim_session(tmp_path, machine, errors, {"stylus_radius_offset": 1.5e-3},
-                                         rho=0.8, seed=seed)
+    errors = {
+        n: (rng.normal(0, 0.03) if k % 4 < 2 else rng.normal(0, 4e-5)) for k, n in enumerate(names)
+    }
+    path, sphere_actual = refsim_session(
+        tmp_path, machine, errors, {"stylus_radius_offset": 1.5e-3}, rho=0.8, seed=seed
+    )
     s = rotacal.load(path, format="probe")
     r = rotacal.identify(s, effects=["stylus_radius_offset"])
-    assert r.raw.noise.n == len(s)  # the noise model of the residuals (AR per coordinate seen along n)
+    assert r.raw.noise.n == len(
+        s
+    )  # the noise model of the residuals (AR per coordinate seen along n)
     assert not within_3_sigma(r, errors), within_3_sigma(r, errors)
     assert not within_3_sigma(r, {"stylus_radius_offset": 1.5e-3})
     # Teeth: the offset is determined (well away from zero), and the baseline alone leaves it in
@@ -106,7 +131,9 @@ def test_reference_sessions_in_ar1_noise_with_an_effect(tmp_path, machine, seed)
 
 def test_rotacal_simulation_round_trips_through_a_file(tmp_path):
     names = rotacal.location_error_names(rotacal.MachineType.AC_trt)
-    s, sphere = rotacal.simulate_probe("AC-trt", np.full(8, 1e-5), {"probe_lobing": [1e-3, 0.0]}, seed=3)
+    s, sphere = rotacal.simulate_probe(
+        "AC-trt", np.full(8, 1e-5), {"probe_lobing": [1e-3, 0.0]}, seed=3
+    )
     assert len(s) == 120 and np.asarray(sphere).shape == (3,)
     path = tmp_path / "sim.csv"
     rotacal.save(s, path)
@@ -143,8 +170,15 @@ def test_a_wrong_stylus_radius_in_a_reference_session_is_named(tmp_path):
     calibration is named stylus_radius_offset with its size; the same session without it names
     nothing."""
     names = refsim.builtin("AC-trt").error_names()
-    errors = dict(zip(names, [0.0726, -0.0202, 1.1284e-05, -0.000113006, 0.0283, 0.1041, 5.1954e-06, -4.1544e-05]))
-    path, _ = refsim_session(tmp_path, "AC-trt", errors, {"stylus_radius_offset": 3e-3}, rho=0.0, seed=31)
+    errors = dict(
+        zip(
+            names,
+            [0.0726, -0.0202, 1.1284e-05, -0.000113006, 0.0283, 0.1041, 5.1954e-06, -4.1544e-05],
+        )
+    )
+    path, _ = refsim_session(
+        tmp_path, "AC-trt", errors, {"stylus_radius_offset": 3e-3}, rho=0.0, seed=31
+    )
     d = rotacal.diagnose(rotacal.load(path), max_harmonic=2)
     assert d.raw.findings and d.raw.findings[0].effect == "stylus_radius_offset"
     p = d.raw.findings[0].parameters[0]

@@ -2,6 +2,7 @@
 `diagnose` of a rotacal-probe/1 session. The truth of the fits comes from the independent
 reference simulator (tests/reference/refsim), and the simulator's touches are checked against
 refsim's touch model on the truth it wrote."""
+
 import json
 import sys
 from pathlib import Path
@@ -29,14 +30,32 @@ def outside_3_sigma(location_errors: dict, truth: dict) -> list[str]:
 def reference_errors(machine: str, seed: int) -> dict:
     rng = np.random.default_rng(seed)
     names = refsim.builtin(machine).error_names()
-    return {n: (rng.normal(0, 0.03) if k % 4 < 2 else rng.normal(0, 4e-5)) for k, n in enumerate(names)}
+    return {
+        n: (rng.normal(0, 0.03) if k % 4 < 2 else rng.normal(0, 4e-5)) for k, n in enumerate(names)
+    }
 
 
 @pytest.mark.parametrize("machine", ["AC-trt", "BC-trt"])
 def test_simulate_probe_touches_where_the_reference_simulator_does(tmp_path, machine):
     out, truth_path = tmp_path / "s.csv", tmp_path / "s.truth.json"
-    r = run("simulate", "probe", "--machine", machine, "--effect", "stylus_radius_offset=0.002",
-            "--sphere", "-40,30,90", "--noise", "0", "--seed", "5", "-o", out, "--truth", truth_path)
+    r = run(
+        "simulate",
+        "probe",
+        "--machine",
+        machine,
+        "--effect",
+        "stylus_radius_offset=0.002",
+        "--sphere",
+        "-40,30,90",
+        "--noise",
+        "0",
+        "--seed",
+        "5",
+        "-o",
+        out,
+        "--truth",
+        truth_path,
+    )
     assert r.returncode == 0, r.stderr
     assert "wrote" in r.stderr and "120 touches at 24 poses" in r.stderr
     s = rotacal.load(out)
@@ -44,16 +63,45 @@ def test_simulate_probe_touches_where_the_reference_simulator_does(tmp_path, mac
     t = json.loads(truth_path.read_text())
     assert set(t["errors"]) == set(refsim.builtin(machine).error_names())
     assert t["sphere_nominal"] == [-40.0, 30.0, 90.0]
-    assert np.linalg.norm(np.subtract(t["sphere_actual"], t["sphere_nominal"])) > 1e-3  # a set-up error
+    assert (
+        np.linalg.norm(np.subtract(t["sphere_actual"], t["sphere_nominal"])) > 1e-3
+    )  # a set-up error
     # The same touches from refsim's own model of the truth (noise 0): within 1 nm.
     model = refsim.Model(machine, t["errors"], t["effects"])
-    angles = np.radians(np.column_stack([np.asarray(s.angles_deg)[:, 0], np.asarray(s.angles_deg)[:, 1]]))
-    ref = refsim.probe_touches(model, np.asarray(t["sphere_actual"]), np.asarray(t["sphere_nominal"]), 25.0, 6.0,
-                               np.asarray(s.n), angles, np.asarray(s.time))
+    angles = np.radians(
+        np.column_stack([np.asarray(s.angles_deg)[:, 0], np.asarray(s.angles_deg)[:, 1]])
+    )
+    ref = refsim.probe_touches(
+        model,
+        np.asarray(t["sphere_actual"]),
+        np.asarray(t["sphere_nominal"]),
+        25.0,
+        6.0,
+        np.asarray(s.n),
+        angles,
+        np.asarray(s.time),
+    )
     assert np.abs(np.asarray(s.xyz) - ref).max() < 1e-6
     again = tmp_path / "again.csv"
-    assert run("simulate", "probe", "--machine", machine, "--effect", "stylus_radius_offset=0.002", "--sphere",
-               "-40,30,90", "--noise", "0", "--seed", "5", "-o", again).returncode == 0
+    assert (
+        run(
+            "simulate",
+            "probe",
+            "--machine",
+            machine,
+            "--effect",
+            "stylus_radius_offset=0.002",
+            "--sphere",
+            "-40,30,90",
+            "--noise",
+            "0",
+            "--seed",
+            "5",
+            "-o",
+            again,
+        ).returncode
+        == 0
+    )
     assert again.read_text() == out.read_text()
 
 
@@ -75,7 +123,9 @@ def test_identify_a_reference_session_within_3_sigma(tmp_path, machine, seed):
     assert r.returncode == 0, r.stderr
     d = json.loads(r.stdout)
     assert d["method"] == "joint" and d["machine"] == machine and d["n_samples"] == 120
-    assert not outside_3_sigma(d["location_errors"], errors), outside_3_sigma(d["location_errors"], errors)
+    assert not outside_3_sigma(d["location_errors"], errors), outside_3_sigma(
+        d["location_errors"], errors
+    )
     for k, c in enumerate("xyz"):
         p = d["other_parameters"]["sphere." + c]
         assert abs(p["value"] - sphere_actual[k]) <= 3 * p["std"]
@@ -101,7 +151,11 @@ def test_identify_prints_a_table_with_the_budget_and_refuses_what_a_probe_fit_la
     model = tmp_path / "m.json"
     r = run("identify", path, "--method", "cycles", "--save-model", model)
     assert r.returncode == 3 and "gives none" in r.stderr and not model.exists()
-    for bad in (["--method", "paper"], ["--length-offset"], ["--method", "cycles", "--monte-carlo", "10"]):
+    for bad in (
+        ["--method", "paper"],
+        ["--length-offset"],
+        ["--method", "cycles", "--monte-carlo", "10"],
+    ):
         r = run("identify", path, *bad)
         assert r.returncode == 3 and r.stdout == "", bad
     # The cycles' method is the touch probe's: a ballbar session refuses it.
@@ -110,8 +164,14 @@ def test_identify_prints_a_table_with_the_budget_and_refuses_what_a_probe_fit_la
 
 
 def test_diagnose_finds_the_stylus_offset_of_a_reference_session(tmp_path):
-    path, _ = refsim_session(tmp_path, "AC-trt", reference_errors("AC-trt", 7), {"stylus_radius_offset": 2e-3},
-                             rho=0.0, seed=7)
+    path, _ = refsim_session(
+        tmp_path,
+        "AC-trt",
+        reference_errors("AC-trt", 7),
+        {"stylus_radius_offset": 2e-3},
+        rho=0.0,
+        seed=7,
+    )
     r = run("diagnose", path, "--json", "--no-progress")
     assert r.returncode == 0, r.stderr
     d = json.loads(r.stdout)

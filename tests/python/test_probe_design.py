@@ -6,6 +6,7 @@ position, and its largest expanded uncertainty (k = 2, orientation errors x 100 
 Also: axis limits of a machine description respected, the printed poses accepted by `plan
 probe --poses`, invalid input refused naming the option, and the separation search on probe
 sessions."""
+
 import functools
 import json
 import sys
@@ -35,14 +36,21 @@ def rotacal_cli(*args):
     return r
 
 
-def refsim_touch_information(machine, poses_deg, pose_directions, sphere) -> tuple[np.ndarray, list[str]]:
+def refsim_touch_information(
+    machine, poses_deg, pose_directions, sphere
+) -> tuple[np.ndarray, list[str]]:
     """J^T J / sigma^2 of touches at `poses_deg` (tilt, rotary), pose k along the directions
     pose_directions[k], the sphere at `sphere`: each touch's row n^T G_k, G_k the derivative of the
     latched position at pose k by central differences of refsim.probe_touches (probe_bound.py)."""
-    G, names = probe_bound.sensitivities(machine, np.asarray(poses_deg, float), np.asarray(sphere, float))
-    info = sum(np.einsum("a,ai->i", n, G[k])[:, None] * np.einsum("a,ai->i", n, G[k])[None, :]
-               for k, dirs in enumerate(pose_directions) for n in np.asarray(dirs, float)
-               / np.linalg.norm(np.asarray(dirs, float), axis=1, keepdims=True))
+    G, names = probe_bound.sensitivities(
+        machine, np.asarray(poses_deg, float), np.asarray(sphere, float)
+    )
+    info = sum(
+        np.einsum("a,ai->i", n, G[k])[:, None] * np.einsum("a,ai->i", n, G[k])[None, :]
+        for k, dirs in enumerate(pose_directions)
+        for n in np.asarray(dirs, float)
+        / np.linalg.norm(np.asarray(dirs, float), axis=1, keepdims=True)
+    )
     return info / probe_bound.SIGMA_MM**2, names
 
 
@@ -69,7 +77,9 @@ def refsim_largest_u_um(machine, poses_deg: np.ndarray) -> float:
     the 8 location errors, tool_offset_Z on a head, and the sphere's actual centre (its z held on
     a head, as the fit holds it) (probe_bound.py)."""
     G, names = probe_bound.sensitivities(machine, poses_deg, SPHERE)
-    return probe_bound.largest_u_um(probe_bound.pattern_information(G, refposes.probe_directions()), names)[0]
+    return probe_bound.largest_u_um(
+        probe_bound.pattern_information(G, refposes.probe_directions()), names
+    )[0]
 
 
 # The ratio designed / default each machine reached before each touch had its own direction and
@@ -86,7 +96,10 @@ def test_designed_test_reaches_the_target_by_refsim(machine):
     the default sphere with the default directions can reach it), no machine worse than before;
     rotacal's predicted sigma of every location error equals refsim's (1 %)."""
     d, (s_best, names) = default_design(machine)
-    assert d.touches == d.best.touches == 120 and len(np.concatenate(list(d.best.pose_directions))) == 120
+    assert (
+        d.touches == d.best.touches == 120
+        and len(np.concatenate(list(d.best.pose_directions))) == 120
+    )
     s_default, _ = refsim_sigma(machine, d.baseline)
     scale = probe_bound.scales(names)
     ratio = (s_best[:8] * scale).max() / (s_default[:8] * scale).max()
@@ -109,7 +122,9 @@ def test_head_machine_design_is_near_the_bound_of_its_candidates():
     poses = probe_bound.grid(machine)
     G, _ = probe_bound.sensitivities(machine, poses, np.asarray(d.sphere))
     dirs = [probe_bound.contact_directions(machine, t, r) for t, r in poses]
-    reached, bound, _ = probe_bound.minimax_bound(G, names, 120, iterations=60, touch_directions=dirs)
+    reached, bound, _ = probe_bound.minimax_bound(
+        G, names, 120, iterations=60, touch_directions=dirs
+    )
     assert bound <= u_design <= 1.05 * bound, (u_design, bound, reached)
 
 
@@ -127,8 +142,18 @@ def test_designed_test_monte_carlo_realises_the_predicted_sigma(tmp_path):
     design, template = tmp_path / "design.json", tmp_path / "plan.csv"
     design.write_text(r.stdout)
     d = json.loads(r.stdout)
-    r = rotacal_cli("plan", "probe", "--machine", machine, "--design", design, "--session", template,
-                    "-o", tmp_path / "probe.ngc")
+    r = rotacal_cli(
+        "plan",
+        "probe",
+        "--machine",
+        machine,
+        "--design",
+        design,
+        "--session",
+        template,
+        "-o",
+        tmp_path / "probe.ngc",
+    )
     assert r.returncode == 0, r.stderr
     plan = rotacal.load(template)
     sphere = np.asarray(d["sphere"])
@@ -147,13 +172,27 @@ def test_designed_test_monte_carlo_realises_the_predicted_sigma(tmp_path):
     log = tmp_path / "rotacal_probe.log"
     misses = []
     for _ in range(100):
-        truth = np.array([rng.normal(0, 0.03) if k % 4 < 2 else rng.normal(0, 4e-5) for k in range(8)])
+        truth = np.array(
+            [rng.normal(0, 0.03) if k % 4 < 2 else rng.normal(0, 4e-5) for k in range(8)]
+        )
         model = refsim.Model(machine, dict(zip(names, truth)), {})
         actual = sphere + np.r_[rng.normal(0, 0.02, 2), 0.0]
-        latched = refsim.probe_touches(model, actual, sphere, 25.0, 6.0, np.asarray(plan.n), np.radians(angles),
-                                       np.asarray(plan.time))
+        latched = refsim.probe_touches(
+            model,
+            actual,
+            sphere,
+            25.0,
+            6.0,
+            np.asarray(plan.n),
+            np.radians(angles),
+            np.asarray(plan.time),
+        )
         latched = latched + rng.normal(0, 0.5e-3, latched.shape)
-        log.write_text("".join(f"{p} {t} {x:.7f} {y:.7f} {z:.7f}\n" for (p, t), (x, y, z) in zip(pose, latched)))
+        log.write_text(
+            "".join(
+                f"{p} {t} {x:.7f} {y:.7f} {z:.7f}\n" for (p, t), (x, y, z) in zip(pose, latched)
+            )
+        )
         fit = identify_probe(rotacal._core.read_linuxcnc_probe_log(str(log), plan), noise="white")
         value = {q.name: q.value for q in fit.raw.parameters}
         numbers.append([value[n] for n in names] - truth)
@@ -172,7 +211,9 @@ def test_head_machine_design_is_at_the_bound_and_the_target_out_of_reach():
     directions, touch by touch, cannot reach 0.7 of the default poses either: what the design's
     own directions and the sphere's place add (test_designed_test_reaches_the_target_by_refsim)."""
     machine = "B-head-C-table"
-    d = design_probe(rotacal.machines.load_machine(machine), touch_directions=False, sphere_candidates=())
+    d = design_probe(
+        rotacal.machines.load_machine(machine), touch_directions=False, sphere_candidates=()
+    )
     assert d.poses_tried == 156 and d.touches == 120
     u_default = refsim_largest_u_um(machine, probe_bound.default_poses(machine))
     u_design = refsim_largest_u_um(machine, np.asarray(d.best.poses_deg))
@@ -202,24 +243,54 @@ def test_axis_limits_of_a_description_are_respected(tmp_path):
 
 
 def test_printed_poses_are_what_plan_probe_takes(tmp_path):
-    r = rotacal_cli("design", "probe", "--machine", "BC-trt", "--touches", 40, "--same-directions",
-                    "--sphere-candidates", "none", "-o", tmp_path / "d.ngc", "--session", tmp_path / "d.csv")
+    r = rotacal_cli(
+        "design",
+        "probe",
+        "--machine",
+        "BC-trt",
+        "--touches",
+        40,
+        "--same-directions",
+        "--sphere-candidates",
+        "none",
+        "-o",
+        tmp_path / "d.ngc",
+        "--session",
+        tmp_path / "d.csv",
+    )
     assert r.returncode == 0, r.stderr
     line = [x for x in r.stdout.splitlines() if x.startswith("run it with:")][0]
     poses = line.split('--poses "')[1].rstrip('"')
     assert len(poses.split(";")) == 8  # 40 touches, 5 per pose
-    p = rotacal_cli("plan", "probe", "--machine", "BC-trt", "--poses", poses, "-o", tmp_path / "p.ngc",
-                    "--session", tmp_path / "p.csv")
+    p = rotacal_cli(
+        "plan",
+        "probe",
+        "--machine",
+        "BC-trt",
+        "--poses",
+        poses,
+        "-o",
+        tmp_path / "p.ngc",
+        "--session",
+        tmp_path / "p.csv",
+    )
     assert p.returncode == 0, p.stderr
     assert (tmp_path / "d.ngc").read_text() == (tmp_path / "p.ngc").read_text()
     assert (tmp_path / "d.csv").read_text() == (tmp_path / "p.csv").read_text()
 
 
-@pytest.mark.parametrize("args,option", [(["--touches", "2"], "--touches"), (["--touches", "-5"], "--touches"),
-                                         (["--touches", "4"], "--touches"),
-                                         (["--touches", "123", "--same-directions"], "--touches"),
-                                         (["--tilt-step", "0"], "--tilt-step"),
-                                         (["--noise", "0"], "--noise"), (["--after", "x.csv"], "--after")])
+@pytest.mark.parametrize(
+    "args,option",
+    [
+        (["--touches", "2"], "--touches"),
+        (["--touches", "-5"], "--touches"),
+        (["--touches", "4"], "--touches"),
+        (["--touches", "123", "--same-directions"], "--touches"),
+        (["--tilt-step", "0"], "--tilt-step"),
+        (["--noise", "0"], "--noise"),
+        (["--after", "x.csv"], "--after"),
+    ],
+)
 def test_invalid_options_are_refused_by_name(args, option):
     r = rotacal_cli("design", "probe", *args)
     assert r.returncode == EXIT_INPUT, r.stderr
@@ -235,20 +306,41 @@ def test_invalid_python_arguments_raise_typed_errors():
 
 def test_separation_on_a_probe_session(tmp_path):
     s = tmp_path / "s.csv"
-    r = rotacal_cli("simulate", "probe", "--errors", "zero", "--effect", "radial_motion_A_h2=0.002,0,0,0",
-                    "-o", s)
+    r = rotacal_cli(
+        "simulate",
+        "probe",
+        "--errors",
+        "zero",
+        "--effect",
+        "radial_motion_A_h2=0.002,0,0,0",
+        "-o",
+        s,
+    )
     assert r.returncode == 0, r.stderr
-    r = rotacal_cli("design", "probe", "--separate", "radial_motion_A_h2,tilt_motion_A_h2", "--after", s, "--json",
-                    "-o", tmp_path / "added.ngc")
+    r = rotacal_cli(
+        "design",
+        "probe",
+        "--separate",
+        "radial_motion_A_h2,tilt_motion_A_h2",
+        "--after",
+        s,
+        "--json",
+        "-o",
+        tmp_path / "added.ngc",
+    )
     assert r.returncode == 0, r.stderr
     out = json.loads(r.stdout)
     assert out["separable"] and out["found"]
     assert out["correlation_before"] > 0.9 and out["added_poses"]["correlation_after"] < 0.5
     assert (tmp_path / "added.ngc").exists()
-    r = rotacal_cli("design", "probe", "--separate", "gravity_sag_A,radial_motion_A_h2", "--after", s)
+    r = rotacal_cli(
+        "design", "probe", "--separate", "gravity_sag_A,radial_motion_A_h2", "--after", s
+    )
     assert r.returncode == 0, r.stderr
     assert "no test can separate" in r.stdout
     ballbar = tmp_path / "b.csv"
     assert rotacal_cli("simulate", "ballbar", "-o", ballbar).returncode == 0
-    r = rotacal_cli("design", "probe", "--separate", "gravity_sag_A,radial_motion_A_h3", "--after", ballbar)
+    r = rotacal_cli(
+        "design", "probe", "--separate", "gravity_sag_A,radial_motion_A_h3", "--after", ballbar
+    )
     assert r.returncode == EXIT_INPUT and "touch-probe session" in r.stderr

@@ -3,6 +3,7 @@ independent reference simulator (tests/reference/refsim) with set-ups and seeds 
 bench/diagnosis_confusion.py's (sphere at (130, 20, 70), other location errors, other seeds),
 noise along each touch's approach direction as the benchmark makes it, coloured where the case
 is about coloured noise."""
+
 import sys
 from pathlib import Path
 
@@ -24,17 +25,40 @@ def probe_session(tmp_path, machine, effects, seed, kind="white", sigma_um=0.5, 
     rng = np.random.default_rng(seed)
     m = refsim.builtin(machine)
     s = poses.probe_poses(m, sphere=sphere)
-    errors = {n: (rng.normal(0, 0.02) if k % 4 < 2 else rng.normal(0, 4e-5)) for k, n in enumerate(m.error_names())}
+    errors = {
+        n: (rng.normal(0, 0.02) if k % 4 < 2 else rng.normal(0, 4e-5))
+        for k, n in enumerate(m.error_names())
+    }
     actual = s["sphere"] + rng.normal(0, 0.02, 3)
-    latched = refsim.probe_touches(refsim.Model(m, errors, effects), actual, s["sphere"], 25.0, 6.0, s["n"],
-                                   np.radians(s["angles_deg"]), s["time"])
+    latched = refsim.probe_touches(
+        refsim.Model(m, errors, effects),
+        actual,
+        s["sphere"],
+        25.0,
+        6.0,
+        s["n"],
+        np.radians(s["angles_deg"]),
+        s["time"],
+    )
     one = ["touches"] * len(latched)
     sig = sigma_um * 1e-3
-    e = (noise.white(len(one), sig, rng) if kind == "white" else noise.pink(one, sig, rng) if kind == "pink"
-         else noise.ar1(one, float(kind.split("_")[1]), sig, rng))
+    e = (
+        noise.white(len(one), sig, rng)
+        if kind == "white"
+        else noise.pink(one, sig, rng)
+        if kind == "pink"
+        else noise.ar1(one, float(kind.split("_")[1]), sig, rng)
+    )
     n = s["n"] / np.linalg.norm(s["n"], axis=1, keepdims=True)
-    path = writers.write_probe(tmp_path / f"probe_{machine}_{seed}.csv", m, s, latched + e[:, None] * n, 25.0, 6.0,
-                               noise_um=sigma_um)
+    path = writers.write_probe(
+        tmp_path / f"probe_{machine}_{seed}.csv",
+        m,
+        s,
+        latched + e[:, None] * n,
+        25.0,
+        6.0,
+        noise_um=sigma_um,
+    )
     return rotacal.load(path)
 
 
@@ -52,8 +76,11 @@ def test_every_finding_in_correlated_noise_has_a_determined_parameter(tmp_path, 
     GLS under the noise it leaves (REML); a finding none of whose parameters is then 3 sigma from
     zero is no finding. Before, these sessions (null, and a sag of A) named stylus_radius_offset
     at 0.1 and 1.5 sigma, straightness_ZX, thermal_drift_Z at 0.01 sigma, axial_motion_C_h2."""
-    for kind, machine, effects in (("pink", "BC-trt", {}), ("ar1_0.9", "AC-trt", {}),
-                                   ("pink", "AC-trt", {"gravity_sag_A": 4e-3})):
+    for kind, machine, effects in (
+        ("pink", "BC-trt", {}),
+        ("ar1_0.9", "AC-trt", {}),
+        ("pink", "AC-trt", {"gravity_sag_A": 4e-3}),
+    ):
         d = rotacal.diagnose(probe_session(tmp_path, machine, effects, seed, kind=kind)).to_dict()
         for f in d["findings"]:
             ps = [p for p in f["parameters"].values() if p["value"] is not None and p["std"]]
@@ -64,9 +91,15 @@ def test_lobing_the_default_touches_cannot_see_is_reported_unobservable(tmp_path
     """Three-lobed trigger lobing, sampled by four horizontal touches 90 deg apart and one from
     above, moves the touches as a shift of the sphere does: it is reported unobservable and the
     session's finding (a wobble of C) is named, not the lobing."""
-    d = rotacal.diagnose(probe_session(tmp_path, "AC-trt", {"probe_lobing": [2e-3, -1e-3],
-                                                            "tilt_motion_C_h2": [0, 0, 3e-5, 0]}, 901,
-                                       kind="ar1_0.5")).to_dict()
+    d = rotacal.diagnose(
+        probe_session(
+            tmp_path,
+            "AC-trt",
+            {"probe_lobing": [2e-3, -1e-3], "tilt_motion_C_h2": [0, 0, 3e-5, 0]},
+            901,
+            kind="ar1_0.5",
+        )
+    ).to_dict()
     assert "probe_lobing" in {u["effect"] for u in d["unobservable"]}
     assert all(f["effect"] != "probe_lobing" for f in d["findings"])
     named, group = first(d)
@@ -82,13 +115,18 @@ def test_the_slow_part_of_1f_noise_is_no_stylus_radius_offset(tmp_path):
     for machine in ("AC-trt", "BC-trt"):
         for seed in range(1101, 1121):
             d = rotacal.diagnose(probe_session(tmp_path, machine, {}, seed, kind="pink")).to_dict()
-            if any(f["effect"] == "stylus_radius_offset" or "stylus_radius_offset" in [g["effect"] for g in f["group"]]
-                   for f in d["findings"]):
+            if any(
+                f["effect"] == "stylus_radius_offset"
+                or "stylus_radius_offset" in [g["effect"] for g in f["group"]]
+                for f in d["findings"]
+            ):
                 named.append((machine, seed))
     assert not named, named
 
 
-@pytest.mark.parametrize("machine,seed", [("AC-trt", 2252), ("AC-trt", 2291), ("BC-trt", 2138), ("BC-trt", 2276)])
+@pytest.mark.parametrize(
+    "machine,seed", [("AC-trt", 2252), ("AC-trt", 2291), ("BC-trt", 2138), ("BC-trt", 2276)]
+)
 def test_the_slow_part_of_1f_noise_along_the_poses_is_no_finding(tmp_path, machine, seed):
     """1/f-like trigger noise wanders slowly along the pose order, as a drift, a harmonic of the C
     sweep or a shape of the tilt sweep does. A candidate following it leaves a residual that looks
@@ -105,8 +143,9 @@ def test_a_stylus_radius_offset_is_still_named(tmp_path, kind):
     """...while a real offset of a few um (10x its half-detection size on this layout) is named,
     its sigma covering the truth (within 3 sigma; AR(1) 0.9 seed 1201 was 3.4 sigma off before)."""
     for seed in range(1201, 1206):
-        d = rotacal.diagnose(probe_session(tmp_path, "AC-trt", {"stylus_radius_offset": [5e-3]}, seed,
-                                           kind=kind)).to_dict()
+        d = rotacal.diagnose(
+            probe_session(tmp_path, "AC-trt", {"stylus_radius_offset": [5e-3]}, seed, kind=kind)
+        ).to_dict()
         named, group = first(d)
         assert named == "stylus_radius_offset", (seed, d["findings"][:1])
         p = d["findings"][0]["parameters"]["stylus_radius_offset"]
@@ -127,9 +166,15 @@ def test_a_warmup_beside_a_wobble_is_named_with_its_amplitude_covered(tmp_path, 
     held at 300 s, the amplitude came out 3-10 sigma off and a thermal_drift took the rest."""
     tau = warmup_tau_s("BC-trt")
     d_mm = 0.012
-    d = rotacal.diagnose(probe_session(tmp_path, "BC-trt", {"thermal_warmup_Y": [d_mm, tau],
-                                                            "tilt_motion_C_h2": [0, 2e-5, 0, 0]}, seed,
-                                       kind="ar1_0.5")).to_dict()
+    d = rotacal.diagnose(
+        probe_session(
+            tmp_path,
+            "BC-trt",
+            {"thermal_warmup_Y": [d_mm, tau], "tilt_motion_C_h2": [0, 2e-5, 0, 0]},
+            seed,
+            kind="ar1_0.5",
+        )
+    ).to_dict()
     warm = [f for f in d["findings"] if f["effect"] == "thermal_warmup_Y"]
     assert warm, [f["effect"] for f in d["findings"]]
     p = warm[0]["parameters"]
@@ -139,7 +184,9 @@ def test_a_warmup_beside_a_wobble_is_named_with_its_amplitude_covered(tmp_path, 
     assert not any(f["effect"].startswith("thermal_drift") for f in d["findings"]), d["findings"]
 
 
-@pytest.mark.parametrize("entry,size", [("thermal_drift_Z", [4e-5]), ("thermal_warmup_Z", [0.015, None])])
+@pytest.mark.parametrize(
+    "entry,size", [("thermal_drift_Z", [4e-5]), ("thermal_warmup_Z", [0.015, None])]
+)
 def test_a_z_drift_in_strongly_correlated_noise_is_found(tmp_path, entry, size):
     """A drift or warm-up along Z moves each touch by its approach direction's Z part, which the
     five touches of a pose repeat: the noise model of the baseline's residuals took it for slow
@@ -150,7 +197,9 @@ def test_a_z_drift_in_strongly_correlated_noise_is_found(tmp_path, entry, size):
     params = [size[0], warmup_tau_s("AC-trt")] if entry == "thermal_warmup_Z" else size
     missed = []
     for seed in (1401, 1402, 1403, 1404):
-        d = rotacal.diagnose(probe_session(tmp_path, "AC-trt", {entry: params}, seed, kind="ar1_0.9")).to_dict()
+        d = rotacal.diagnose(
+            probe_session(tmp_path, "AC-trt", {entry: params}, seed, kind="ar1_0.9")
+        ).to_dict()
         named, group = first(d)
         if not (named == entry or (named is None and entry in group)):
             missed.append((seed, named, group))
@@ -173,8 +222,9 @@ def test_a_z_drift_in_moderately_correlated_noise_is_still_found(tmp_path):
     the same noise is found, named or in the group that holds it, in each of these sessions."""
     missed = []
     for seed in (1451, 1452, 1453, 1454):
-        d = rotacal.diagnose(probe_session(tmp_path, "AC-trt", {"thermal_drift_Z": [1e-5]}, seed,
-                                           kind="ar1_0.5")).to_dict()
+        d = rotacal.diagnose(
+            probe_session(tmp_path, "AC-trt", {"thermal_drift_Z": [1e-5]}, seed, kind="ar1_0.5")
+        ).to_dict()
         named, group = first(d)
         if not (named == "thermal_drift_Z" or (named is None and "thermal_drift_Z" in group)):
             missed.append((seed, named, group))
@@ -187,9 +237,13 @@ def test_a_sag_found_beside_an_aliased_shape_is_not_lost_in_the_final_refit(tmp_
     A or linear_scale_Z), then a nearly aliased second shape; by GLS neither is determined beside
     the other. The final refit dropped the first and all after it ('nothing' in these sessions);
     it drops the last until the rest are determined, and the sag is in the first finding's group."""
-    d = rotacal.diagnose(probe_session(tmp_path, "AC-trt", {"gravity_sag_A": 0.01}, seed, kind="ar1_0.9")).to_dict()
+    d = rotacal.diagnose(
+        probe_session(tmp_path, "AC-trt", {"gravity_sag_A": 0.01}, seed, kind="ar1_0.9")
+    ).to_dict()
     named, group = first(d)
-    assert named == "gravity_sag_A" or (named is None and "gravity_sag_A" in group), d["findings"][:1]
+    assert named == "gravity_sag_A" or (named is None and "gravity_sag_A" in group), d["findings"][
+        :1
+    ]
 
 
 def bump_session(tmp_path, machine, seed, kind, height_mm=0.004, in_time=False):
@@ -200,10 +254,21 @@ def bump_session(tmp_path, machine, seed, kind, height_mm=0.004, in_time=False):
     rng = np.random.default_rng(seed)
     m = refsim.builtin(machine)
     s = poses.probe_poses(m, sphere=SPHERE)
-    errors = {n: (rng.normal(0, 0.02) if k % 4 < 2 else rng.normal(0, 4e-5)) for k, n in enumerate(m.error_names())}
+    errors = {
+        n: (rng.normal(0, 0.02) if k % 4 < 2 else rng.normal(0, 4e-5))
+        for k, n in enumerate(m.error_names())
+    }
     actual = s["sphere"] + rng.normal(0, 0.02, 3)
-    latched = refsim.probe_touches(refsim.Model(m, errors, {}), actual, s["sphere"], 25.0, 6.0, s["n"],
-                                   np.radians(s["angles_deg"]), s["time"])
+    latched = refsim.probe_touches(
+        refsim.Model(m, errors, {}),
+        actual,
+        s["sphere"],
+        25.0,
+        6.0,
+        s["n"],
+        np.radians(s["angles_deg"]),
+        s["time"],
+    )
     n = s["n"] / np.linalg.norm(s["n"], axis=1, keepdims=True)
     if in_time:
         shift, axis = height_mm * np.exp(-0.5 * ((s["time"] - 0.7 * s["time"][-1]) / 15.0) ** 2), 1
@@ -213,18 +278,35 @@ def bump_session(tmp_path, machine, seed, kind, height_mm=0.004, in_time=False):
     latched = latched + (shift * n[:, axis])[:, None] * n  # the touch meets the moved sphere
     one = ["touches"] * len(latched)
     sig = 0.5e-3
-    e = noise.pink(one, sig, rng) if kind == "pink" else noise.ar1(one, float(kind.split("_")[1]), sig, rng)
-    path = writers.write_probe(tmp_path / f"bump_{machine}_{seed}.csv", m, s, latched + e[:, None] * n, 25.0, 6.0,
-                               noise_um=0.5)
+    e = (
+        noise.pink(one, sig, rng)
+        if kind == "pink"
+        else noise.ar1(one, float(kind.split("_")[1]), sig, rng)
+    )
+    path = writers.write_probe(
+        tmp_path / f"bump_{machine}_{seed}.csv",
+        m,
+        s,
+        latched + e[:, None] * n,
+        25.0,
+        6.0,
+        noise_um=0.5,
+    )
     return rotacal.load(path)
 
 
-@pytest.mark.parametrize("machine,kind,in_time,seeds", [
-    ("AC-trt", "ar1_0.5", True, (1501, 1502, 1503, 1504)),
-    ("BC-trt", "pink", True, (1501, 1502, 1503, 1504, 1601, 1602)),
-    ("AC-trt", "ar1_0.5", False, (1501, 1502, 1503, 1504)),
-    ("BC-trt", "ar1_0.5", False, (1601, 1602, 1603, 1604))])
-def test_a_shape_outside_the_catalogue_gets_no_confident_name(tmp_path, machine, kind, in_time, seeds):
+@pytest.mark.parametrize(
+    "machine,kind,in_time,seeds",
+    [
+        ("AC-trt", "ar1_0.5", True, (1501, 1502, 1503, 1504)),
+        ("BC-trt", "pink", True, (1501, 1502, 1503, 1504, 1601, 1602)),
+        ("AC-trt", "ar1_0.5", False, (1501, 1502, 1503, 1504)),
+        ("BC-trt", "ar1_0.5", False, (1601, 1602, 1603, 1604)),
+    ],
+)
+def test_a_shape_outside_the_catalogue_gets_no_confident_name(
+    tmp_path, machine, kind, in_time, seeds
+):
     """A shape outside the catalogue (bump_session) in coloured noise: the diagnosis may name
     nothing, report unexplained structure or a group, never one catalogue entry with
     confidence. Before the local rival (src/diagnose/local_structure.cpp), the X shift peaking at
@@ -246,7 +328,9 @@ def test_a_local_shift_outside_the_catalogue_is_reported_where_it_is(tmp_path, s
     poses it holds, in time."""
     m = refsim.builtin("AC-trt")
     s = poses.probe_poses(m, sphere=SPHERE)
-    peak = int(np.argmin(np.abs(s["time"] - 0.7 * s["time"][-1])))  # the touch nearest the bump's peak
+    peak = int(
+        np.argmin(np.abs(s["time"] - 0.7 * s["time"][-1]))
+    )  # the touch nearest the bump's peak
     tilt = s["angles_deg"][peak, poses.rotary_roles(m)[0]]
     res = rotacal.diagnose(bump_session(tmp_path, "AC-trt", seed, "ar1_0.5", in_time=True))
     u = res.raw.unexplained
@@ -258,13 +342,46 @@ def test_a_local_shift_outside_the_catalogue_is_reported_where_it_is(tmp_path, s
     assert not [f for f in res.to_dict()["findings"] if f["named"]]
 
 
-@pytest.mark.parametrize("machine,sphere,entry,params,kind,seed", [
-    ("AC-trt", (0.0, 130.0, 70.0), "radial_motion_C_h2", [4e-3, 0.0, 0.0, 0.0], "ar1_0.9", 3102),
-    ("AC-trt", (0.0, 130.0, 70.0), "radial_motion_C_h2", [4e-3, 0.0, 0.0, 0.0], "ar1_0.9", 3107),
-    ("AC-trt", (0.0, 130.0, 70.0), "radial_motion_C_h2", [4e-3, 0.0, 0.0, 0.0], "ar1_0.9", 3120),
-    ("BC-trt", (120.0, 0.0, 60.0), "tilt_motion_B_h2", [0.0, 5.8e-5, 0.0, -3.1e-5], "ar1_0.5", 3308)])
-def test_a_group_holds_every_rival_a_member_cannot_be_told_apart_from(tmp_path, machine, sphere, entry, params,
-                                                                      kind, seed):
+@pytest.mark.parametrize(
+    "machine,sphere,entry,params,kind,seed",
+    [
+        (
+            "AC-trt",
+            (0.0, 130.0, 70.0),
+            "radial_motion_C_h2",
+            [4e-3, 0.0, 0.0, 0.0],
+            "ar1_0.9",
+            3102,
+        ),
+        (
+            "AC-trt",
+            (0.0, 130.0, 70.0),
+            "radial_motion_C_h2",
+            [4e-3, 0.0, 0.0, 0.0],
+            "ar1_0.9",
+            3107,
+        ),
+        (
+            "AC-trt",
+            (0.0, 130.0, 70.0),
+            "radial_motion_C_h2",
+            [4e-3, 0.0, 0.0, 0.0],
+            "ar1_0.9",
+            3120,
+        ),
+        (
+            "BC-trt",
+            (120.0, 0.0, 60.0),
+            "tilt_motion_B_h2",
+            [0.0, 5.8e-5, 0.0, -3.1e-5],
+            "ar1_0.5",
+            3308,
+        ),
+    ],
+)
+def test_a_group_holds_every_rival_a_member_cannot_be_told_apart_from(
+    tmp_path, machine, sphere, entry, params, kind, seed
+):
     """A sphere on one radius of the table sees a radial motion of C along the tangent only, as an
     angular positioning error of C (and nearly as a tilt of C at the sphere's height): the radial
     motion fits as well with two more parameters. A sphere on the B axis' plane sees a tilt of B
@@ -274,7 +391,9 @@ def test_a_group_holds_every_rival_a_member_cannot_be_told_apart_from(tmp_path, 
     (BIC's Occam term alone put it at 0.01-0.05 weight, the weakest member at about as much), and
     [axial_motion_B_h2, straightness_YZ] the tilt of B at the very weight of the named axial
     motion."""
-    d = rotacal.diagnose(probe_session(tmp_path, machine, {entry: params}, seed, kind=kind, sphere=sphere)).to_dict()
+    d = rotacal.diagnose(
+        probe_session(tmp_path, machine, {entry: params}, seed, kind=kind, sphere=sphere)
+    ).to_dict()
     named, group = first(d)
     assert named == entry or (named is None and entry in group), d["findings"][:1]
 
@@ -287,9 +406,14 @@ def test_a_catalogue_effect_left_in_a_group_is_no_local_defect(tmp_path, seed):
     reported. Before, every finding its catalogue rivals had left without a name was said to be
     explained as well by a local defect, and the wobble's own signal in those poses was reported
     as unexplained local structure (p down to 3e-9)."""
-    d = rotacal.diagnose(probe_session(tmp_path, "BC-trt", {"tilt_motion_C_h2": [0.0, 2e-5, 0.0, 0.0]}, seed,
-                                       kind="ar1_0.5")).to_dict()
+    d = rotacal.diagnose(
+        probe_session(
+            tmp_path, "BC-trt", {"tilt_motion_C_h2": [0.0, 2e-5, 0.0, 0.0]}, seed, kind="ar1_0.5"
+        )
+    ).to_dict()
     named, group = first(d)
-    assert named == "tilt_motion_C_h2" or (named is None and "tilt_motion_C_h2" in group), d["findings"][:1]
+    assert named == "tilt_motion_C_h2" or (named is None and "tilt_motion_C_h2" in group), d[
+        "findings"
+    ][:1]
     assert not d["findings"][0].get("lack_of_fit"), d["findings"][0]["lack_of_fit"]
     assert "local structure" not in d["unexplained"].get("signature", ""), d["unexplained"]

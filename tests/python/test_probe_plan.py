@@ -9,6 +9,7 @@ direction, and no other move, nor any turn of the rotary axes, comes within the 
 the sphere. Then: plan -> latched points of a machine with errors by refsim -> a log in LinuxCNC's
 LOG format -> import -> identify, every location error within 3 sigma.
 """
+
 import json
 import sys
 from pathlib import Path
@@ -46,7 +47,9 @@ def segment_distance(c, a, b) -> float:
     return float(np.linalg.norm(a + t * ab - c))
 
 
-RS274_MISSING = "rs274 (LinuxCNC stand-alone interpreter) not on PATH: apt-get install linuxcnc-uspace"
+RS274_MISSING = (
+    "rs274 (LinuxCNC stand-alone interpreter) not on PATH: apt-get install linuxcnc-uspace"
+)
 
 
 def check_in_rs274(tmp_path, machine: str, ngc: Path, plan, sphere=(150.0, 0.0, 80.0)) -> None:
@@ -73,7 +76,10 @@ def check_in_rs274(tmp_path, machine: str, ngc: Path, plan, sphere=(150.0, 0.0, 
                 assert np.allclose(p[:3], pos[:3])
                 for f in np.linspace(0.0, 1.0, 181):
                     a = (ang0[0] + f * (ang1[0] - ang0[0]), ang0[1] + f * (ang1[1] - ang0[1]))
-                    assert np.linalg.norm(p[:3] - nominal_centre(machine, a, sphere)) > R + 10.0, (a, p)
+                    assert np.linalg.norm(p[:3] - nominal_centre(machine, a, sphere)) > R + 10.0, (
+                        a,
+                        p,
+                    )
             else:
                 c = cache.setdefault(ang1, nominal_centre(machine, ang1, sphere))
                 if name == "STRAIGHT_PROBE":
@@ -89,9 +95,13 @@ def check_in_rs274(tmp_path, machine: str, ngc: Path, plan, sphere=(150.0, 0.0, 
         d = (end - start) / np.linalg.norm(end - start)
         assert np.allclose(d, n[k], atol=1e-4)  # along the approach direction...
         assert segment_distance(c, start - 100 * d, end + 100 * d) < 1e-3  # ...through the centre
-        assert np.linalg.norm(start - c) > R + 1.0 and np.linalg.norm(end - c) < R - 1.0  # outside -> inside
+        assert (
+            np.linalg.norm(start - c) > R + 1.0 and np.linalg.norm(end - c) < R - 1.0
+        )  # outside -> inside
         assert [int(v) for v in logs[k][:2]] == log_numbers(plan)[k]
-        assert np.allclose([float(v) for v in logs[k][2:]], end, atol=1e-5)  # #5061..#5063 of the latch
+        assert np.allclose(
+            [float(v) for v in logs[k][2:]], end, atol=1e-5
+        )  # #5061..#5063 of the latch
 
 
 def log_numbers(plan) -> list:
@@ -111,7 +121,14 @@ def test_the_probing_program_runs_in_rs274_on_the_reference_geometry(tmp_path, m
     r = run("plan", "probe", "--machine", machine, "--session", template, "-o", ngc)
     assert r.returncode == 0, r.stderr
     plan = rotacal.load(template)
-    assert len(plan) == 120 and log_numbers(plan)[:6] == [[1, 1], [1, 2], [1, 3], [1, 4], [1, 5], [2, 1]]
+    assert len(plan) == 120 and log_numbers(plan)[:6] == [
+        [1, 1],
+        [1, 2],
+        [1, 3],
+        [1, 4],
+        [1, 5],
+        [2, 1],
+    ]
     check_in_rs274(tmp_path, machine, ngc, plan)
 
 
@@ -126,13 +143,19 @@ def test_the_designed_program_runs_in_rs274(tmp_path):
     design.write_text(r.stdout)
     d = json.loads(r.stdout)
     ngc, template = tmp_path / "probe.ngc", tmp_path / "plan.csv"
-    r = run("plan", "probe", "--machine", machine, "--design", design, "--session", template, "-o", ngc)
+    r = run(
+        "plan", "probe", "--machine", machine, "--design", design, "--session", template, "-o", ngc
+    )
     assert r.returncode == 0, r.stderr
     plan = rotacal.load(template)
     assert len(plan) == d["touches"] == 120
-    assert np.allclose(plan.sphere, d["sphere"]) and not np.allclose(d["sphere"], [150.0, 0.0, 80.0])
+    assert np.allclose(plan.sphere, d["sphere"]) and not np.allclose(
+        d["sphere"], [150.0, 0.0, 80.0]
+    )
     dirs = np.concatenate([np.asarray(x) for x in d["best"]["pose_directions"]])
-    assert np.allclose(np.asarray(plan.n), dirs / np.linalg.norm(dirs, axis=1, keepdims=True), atol=1e-9)
+    assert np.allclose(
+        np.asarray(plan.n), dirs / np.linalg.norm(dirs, axis=1, keepdims=True), atol=1e-9
+    )
     check_in_rs274(tmp_path, machine, ngc, plan, d["sphere"])
     r = run("plan", "probe", "--machine", machine, "--design", design, "--poses", "0,0", "-o", ngc)
     assert r.returncode == 3 and "--design" in r.stderr
@@ -142,7 +165,9 @@ def test_other_dialects_and_limits_are_refused(tmp_path):
     out = tmp_path / "p.ngc"
     for dialect in ("heidenhain", "siemens", "fanuc"):
         r = run("plan", "probe", "--dialect", dialect, "-o", out)
-        assert r.returncode == 3 and "no checkable probing words" in r.stderr and dialect in r.stderr
+        assert (
+            r.returncode == 3 and "no checkable probing words" in r.stderr and dialect in r.stderr
+        )
     r = run("plan", "probe", "--machine", "B-head-C-table", "--poses", "0,0;-150,0", "-o", out)
     assert r.returncode == 3 and "outside the axis limits" in r.stderr
     r = run("plan", "probe", "--sphere", "150,0,380", "-o", out)
@@ -156,7 +181,10 @@ def test_other_dialects_and_limits_are_refused(tmp_path):
 
 def write_linuxcnc_log(path: Path, plan, latched: np.ndarray) -> None:
     """What (LOG,pose touch #5061 #5062 #5063) writes: the parameters as %f."""
-    lines = [f"{plan.pose_names[k // 5]} {k % 5 + 1} {x:f} {y:f} {z:f}" for k, (x, y, z) in enumerate(latched)]
+    lines = [
+        f"{plan.pose_names[k // 5]} {k % 5 + 1} {x:f} {y:f} {z:f}"
+        for k, (x, y, z) in enumerate(latched)
+    ]
     path.write_text("\n".join(lines) + "\n")
 
 
@@ -164,29 +192,49 @@ def write_linuxcnc_log(path: Path, plan, latched: np.ndarray) -> None:
 def test_plan_log_import_identify_within_3_sigma(tmp_path, machine, seed):
     poses = "0,0;0,45;0,90;0,135;0,180;0,225;0,270;0,315;-60,0;-30,0;30,0;60,0;-45,90;45,90;-45,270;45,270"
     ngc, template = tmp_path / "probe.ngc", tmp_path / "plan.csv"
-    r = run("plan", "probe", "--machine", machine, "--poses", poses, "--session", template, "-o", ngc)
+    r = run(
+        "plan", "probe", "--machine", machine, "--poses", poses, "--session", template, "-o", ngc
+    )
     assert r.returncode == 0, r.stderr
     plan = rotacal.load(template)
     assert len(plan) == 16 * 5
     rng = np.random.default_rng(seed)
     names = refsim.builtin(machine).error_names()
-    errors = {nm: (rng.normal(0, 0.03) if k % 4 < 2 else rng.normal(0, 4e-5)) for k, nm in enumerate(names)}
+    errors = {
+        nm: (rng.normal(0, 0.03) if k % 4 < 2 else rng.normal(0, 4e-5))
+        for k, nm in enumerate(names)
+    }
     sphere_actual = np.array([150.0, 0.0, 80.0]) + np.array([0.021, -0.013, 0.008])
     model = refsim.Model(machine, errors, {})
-    latched = refsim.probe_touches(model, sphere_actual, np.array([150.0, 0.0, 80.0]), 25.0, 6.0, np.asarray(plan.n),
-                                   np.radians(np.asarray(plan.angles_deg)), np.asarray(plan.time))
-    latched = latched + np.column_stack([noise.ar1(["t"] * len(plan), 0.3, 0.5e-3, rng) for _ in range(3)])
+    latched = refsim.probe_touches(
+        model,
+        sphere_actual,
+        np.array([150.0, 0.0, 80.0]),
+        25.0,
+        6.0,
+        np.asarray(plan.n),
+        np.radians(np.asarray(plan.angles_deg)),
+        np.asarray(plan.time),
+    )
+    latched = latched + np.column_stack(
+        [noise.ar1(["t"] * len(plan), 0.3, 0.5e-3, rng) for _ in range(3)]
+    )
     log, session = tmp_path / "rotacal_probe.log", tmp_path / "session.csv"
     write_linuxcnc_log(log, plan, latched)
     r = run("import", "probe", log, "--plan", template, "-o", session)
     assert r.returncode == 0, r.stderr
     s = rotacal.load(session)
-    assert np.allclose(np.asarray(s.xyz), latched, atol=1e-6) and np.array_equal(np.asarray(s.n), np.asarray(plan.n))
+    assert np.allclose(np.asarray(s.xyz), latched, atol=1e-6) and np.array_equal(
+        np.asarray(s.n), np.asarray(plan.n)
+    )
     r = run("identify", session, "--json", "--no-budget")
     assert r.returncode == 0, r.stderr
     d = json.loads(r.stdout)
-    bad = [f"{k}: {d['location_errors'][k]} truth {v}" for k, v in errors.items()
-           if abs(d["location_errors"][k]["value"] - v) > 3 * d["location_errors"][k]["std"]]
+    bad = [
+        f"{k}: {d['location_errors'][k]} truth {v}"
+        for k, v in errors.items()
+        if abs(d["location_errors"][k]["value"] - v) > 3 * d["location_errors"][k]["std"]
+    ]
     assert not bad, bad
     # A log with a touch missing is refused naming the line; the session is not written.
     lines = log.read_text().splitlines()

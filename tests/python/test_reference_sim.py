@@ -12,6 +12,7 @@ tests/reference/refsim implements shared/spec/formats.md and effects.md from the
 A failure here is a disagreement between rotacal and the reference: decide from the spec
 which side is wrong.
 """
+
 import json
 import sys
 from functools import lru_cache
@@ -33,10 +34,17 @@ TOL_MM = 1e-9
 SECOND_ORDER_TOL_MM = 1e-7  # where the spec names no order of two small rotations
 
 # docs/machines.md "Describing a new machine": C table turning clockwise, A head off the point.
-SHOP7 = {"format": "rotacal-machine/1", "name": "shop-7 A-head C-table",
-         "table_axes": [{"name": "C", "direction": [0, 0, -1], "point": [0, 0, 0]}],
-         "head_axes": [{"name": "A", "direction": [1, 0, 0], "point": [0, 0, -40], "limits_deg": [-100, 100]}],
-         "pivot_length": 120.0, "tool_length": 80.0, "travel_mm": [[-500, 500], [-400, 400], [-100, 600]]}
+SHOP7 = {
+    "format": "rotacal-machine/1",
+    "name": "shop-7 A-head C-table",
+    "table_axes": [{"name": "C", "direction": [0, 0, -1], "point": [0, 0, 0]}],
+    "head_axes": [
+        {"name": "A", "direction": [1, 0, 0], "point": [0, 0, -40], "limits_deg": [-100, 100]}
+    ],
+    "pivot_length": 120.0,
+    "tool_length": 80.0,
+    "travel_mm": [[-500, 500], [-400, 400], [-100, 600]],
+}
 MACHINES = list(refsim.BUILTIN_NAMES) + ["shop7"]
 
 
@@ -66,6 +74,7 @@ def rms_um(r) -> float:
 
 # ---------------------------------------------------------------- shared data, reference alone
 
+
 def _columns(name):
     s = writers.read_session(SHARED / name)
     return s["meta"], s["columns"]
@@ -86,7 +95,9 @@ def test_reference_reproduces_shared_ballbar(name):
 def _rtest_residual_rms(model, c, nests):
     setups = [str(int(s)) for s in c["setup"]]
     ang = np.radians(np.c_[c["B"], c["C"]])
-    d = refsim.rtest_displacements(model, nests, setups, np.c_[c["X"], c["Y"], c["Z"]], ang, c["time"])
+    d = refsim.rtest_displacements(
+        model, nests, setups, np.c_[c["X"], c["Y"], c["Z"]], ang, c["time"]
+    )
     r = np.c_[c["dx"], c["dy"], c["dz"]] - d
     for s in set(setups):  # formats.md: each set-up's probe zero is unknown
         sel = np.array(setups) == s
@@ -103,7 +114,10 @@ def test_reference_reproduces_shared_rtest():
     assert _rtest_residual_rms(refsim.Model(meta["machine"]), c, nests) > 5 * t["noise_um"]
     # Teeth for the effects too: without coning_B the truth's errors leave far more than noise.
     no_coning = {k: v for k, v in t["effects"].items() if k != "coning_B"}
-    assert _rtest_residual_rms(refsim.Model(meta["machine"], t["errors"], no_coning), c, nests) > 5 * t["noise_um"]
+    assert (
+        _rtest_residual_rms(refsim.Model(meta["machine"], t["errors"], no_coning), c, nests)
+        > 5 * t["noise_um"]
+    )
 
 
 def test_reference_reproduces_shared_probe():
@@ -112,8 +126,15 @@ def test_reference_reproduces_shared_probe():
     ang = np.radians(np.c_[c["A"], c["C"]])
     n = np.c_[c["nx"], c["ny"], c["nz"]]
     latched = lambda m: refsim.probe_touches(  # noqa: E731
-        m, t["sphere_actual"], writers.vector(meta["sphere"]), float(meta["sphere_diameter"]),
-        float(meta["stylus_diameter"]), n, ang, c["time"])
+        m,
+        t["sphere_actual"],
+        writers.vector(meta["sphere"]),
+        float(meta["sphere_diameter"]),
+        float(meta["stylus_diameter"]),
+        n,
+        ang,
+        c["time"],
+    )
     xyz = np.c_[c["X"], c["Y"], c["Z"]]
     got = rms_um(xyz - latched(refsim.Model(meta["machine"], t["errors"], t["effects"])))
     assert abs(got - t["noise_um"]) <= 0.15 * t["noise_um"], got
@@ -121,6 +142,7 @@ def test_reference_reproduces_shared_probe():
 
 
 # ---------------------------------------------------------------- the same poses in both
+
 
 @lru_cache(maxsize=None)
 def ballbar_poses(name):
@@ -132,14 +154,20 @@ def ballbar_poses(name):
 @lru_cache(maxsize=None)
 def rtest_poses(name):
     m = ref_machine(name)
-    nests = ((100.0, 0.0, 60.0), (0.0, -120.0, 140.0)) if m.table_axes else ((100.0, 0.0, 0.0), (0.0, -80.0, 40.0))
+    nests = (
+        ((100.0, 0.0, 60.0), (0.0, -120.0, 140.0))
+        if m.table_axes
+        else ((100.0, 0.0, 0.0), (0.0, -80.0, 40.0))
+    )
     return poses.rtest_grid(m, nests=nests)
 
 
 def base_errors(name, scale):
     """Location errors of a plausible size (mm, rad), in the machine's name order."""
     rng = np.random.default_rng(29)
-    v = np.array([rng.uniform(-0.03, 0.03) if i % 4 < 2 else rng.uniform(-8e-5, 8e-5) for i in range(8)])
+    v = np.array(
+        [rng.uniform(-0.03, 0.03) if i % 4 < 2 else rng.uniform(-8e-5, 8e-5) for i in range(8)]
+    )
     return v * scale
 
 
@@ -149,14 +177,26 @@ _SIGNS = np.array([1.0, -0.7, 0.4, 0.9])
 
 def effect_params(e: rfx.EffectId) -> np.ndarray:
     """Reference parameters (order of effects.md) of a visible, plausible size, all distinct."""
-    base = {"ballbar_length_offset": [2e-3], "ballbar_thermal_drift": [1e-5], "tool_offset": [3e-3],
-            "rotary_zero_offset": [3e-5], "angular_positioning": [2e-5] * 2, "axial_motion": [2e-3] * 2,
-            "radial_motion": [2e-3] * 4, "tilt_motion": [2e-5] * 4, "gravity_sag": [5e-3],
-            "coning": [1.5e-4], "linear_squareness": [2e-5], "linear_scale": [1e-5],
-            "thermal_drift": [1e-5], "straightness": [2e-3] * 3, "angular_error": [2e-5] * 2}
+    base = {
+        "ballbar_length_offset": [2e-3],
+        "ballbar_thermal_drift": [1e-5],
+        "tool_offset": [3e-3],
+        "rotary_zero_offset": [3e-5],
+        "angular_positioning": [2e-5] * 2,
+        "axial_motion": [2e-3] * 2,
+        "radial_motion": [2e-3] * 4,
+        "tilt_motion": [2e-5] * 4,
+        "gravity_sag": [5e-3],
+        "coning": [1.5e-4],
+        "linear_squareness": [2e-5],
+        "linear_scale": [1e-5],
+        "thermal_drift": [1e-5],
+        "straightness": [2e-3] * 3,
+        "angular_error": [2e-5] * 2,
+    }
     if e.kind == "thermal_warmup":
         return np.array([3e-3, 200.0])
-    return np.array(base[e.kind]) * _SIGNS[:e.num_params]
+    return np.array(base[e.kind]) * _SIGNS[: e.num_params]
 
 
 def to_rotacal_params(e: rfx.EffectId, p: np.ndarray) -> list:
@@ -169,22 +209,42 @@ def to_rotacal_params(e: rfx.EffectId, p: np.ndarray) -> list:
 def rc_ballbar_lengths(name, errors, pivot, ids, params):
     s = ballbar_poses(name)
     m = rc_machine(name)
-    session = _core.BallbarSession(m, s["ballbar_length"], s["pivot"], s["test"], s["time"], s["xyz"],
-                                   rc_order(name, s["angles_deg"]), np.full(len(s["time"]), s["ballbar_length"]))
-    model = rotacal.BallbarMachineModel(m, np.asarray(errors, float), np.asarray(pivot, float), ids, params)
+    session = _core.BallbarSession(
+        m,
+        s["ballbar_length"],
+        s["pivot"],
+        s["test"],
+        s["time"],
+        s["xyz"],
+        rc_order(name, s["angles_deg"]),
+        np.full(len(s["time"]), s["ballbar_length"]),
+    )
+    model = rotacal.BallbarMachineModel(
+        m, np.asarray(errors, float), np.asarray(pivot, float), ids, params
+    )
     return np.asarray(rotacal.predict(model, session).length)
 
 
 def rc_rtest(name, errors, nests, ids, params):
     s = rtest_poses(name)
     setups = np.array(s["setup"])
-    a_ref = np.asarray(s["xyz"], float).mean(axis=0)  # the session's mean, as a session fit takes it
+    a_ref = np.asarray(s["xyz"], float).mean(
+        axis=0
+    )  # the session's mean, as a session fit takes it
     out = np.zeros((len(setups), 3))
     ang = np.radians(rc_order(name, s["angles_deg"]))
     for k, q in nests.items():
         sel = setups == k
-        out[sel] = _core.rtest_readings(rc_machine(name), np.asarray(errors, float), ids, params,
-                                        np.asarray(q, float), ang[sel], s["time"][sel], a_ref)
+        out[sel] = _core.rtest_readings(
+            rc_machine(name),
+            np.asarray(errors, float),
+            ids,
+            params,
+            np.asarray(q, float),
+            ang[sel],
+            s["time"][sel],
+            a_ref,
+        )
     return out
 
 
@@ -193,14 +253,20 @@ def ref_reading(name, instrument, errors, effects, linear_ref=None):
     m = refsim.Model(ref_machine(name), errors, effects, linear_ref=linear_ref)
     if instrument == "ballbar":
         s = ballbar_poses(name)
-        return refsim.ballbar_lengths(m, s["pivot"] + PIVOT_SHIFT, s["xyz"], np.radians(s["angles_deg"]), s["time"])
+        return refsim.ballbar_lengths(
+            m, s["pivot"] + PIVOT_SHIFT, s["xyz"], np.radians(s["angles_deg"]), s["time"]
+        )
     s = rtest_poses(name)  # rotacal's rtest_readings commands the linear axes to the nest itself
-    return refsim.rtest_displacements(m, s["nests"], s["setup"], s["xyz"], np.radians(s["angles_deg"]), s["time"])
+    return refsim.rtest_displacements(
+        m, s["nests"], s["setup"], s["xyz"], np.radians(s["angles_deg"]), s["time"]
+    )
 
 
 def rc_reading(name, instrument, errors, ids, params):
     if instrument == "ballbar":
-        return rc_ballbar_lengths(name, errors, ballbar_poses(name)["pivot"] + PIVOT_SHIFT, ids, params)
+        return rc_ballbar_lengths(
+            name, errors, ballbar_poses(name)["pivot"] + PIVOT_SHIFT, ids, params
+        )
     return rc_rtest(name, errors, rtest_poses(name)["nests"], ids, params)
 
 
@@ -229,8 +295,14 @@ def signatures(name, instrument, eid, p, with_errors, linear_ref=None):
     """(reference, rotacal) signature of entry eid with reference parameters p."""
     e = rfx.parse(eid)
     errors = base_errors(name, 1.0 if with_errors else 0.0)
-    ref = ref_reading(name, instrument, errors, {eid: p}, linear_ref) - base_readings(name, instrument, with_errors)[0]
-    rc = rc_reading(name, instrument, errors, [eid], to_rotacal_params(e, p)) - base_readings(name, instrument, with_errors)[1]
+    ref = (
+        ref_reading(name, instrument, errors, {eid: p}, linear_ref)
+        - base_readings(name, instrument, with_errors)[0]
+    )
+    rc = (
+        rc_reading(name, instrument, errors, [eid], to_rotacal_params(e, p))
+        - base_readings(name, instrument, with_errors)[1]
+    )
     return ref, rc
 
 
@@ -238,7 +310,9 @@ def signatures(name, instrument, eid, p, with_errors, linear_ref=None):
 INVISIBLE = {("B-head-C-table", "ballbar", "gravity_sag_B"), ("shop7", "ballbar", "gravity_sag_A")}
 
 
-@pytest.mark.parametrize("with_errors", [False, True], ids=["no_location_errors", "location_errors"])
+@pytest.mark.parametrize(
+    "with_errors", [False, True], ids=["no_location_errors", "location_errors"]
+)
 @pytest.mark.parametrize("name,instrument,eid", _cases())
 def test_effect_signature_matches_rotacal(name, instrument, eid, with_errors):
     """Signature of each entry, reference vs rotacal, to 1e-9 mm. Two spec points are checked on
@@ -252,10 +326,14 @@ def test_effect_signature_matches_rotacal(name, instrument, eid, with_errors):
     p = effect_params(e)
     variants = [p * [1, 1, 0, 0], p * [0, 0, 1, 1]] if e.kind == "tilt_motion" else [p]
     seen = 0.0
-    for q in variants:  # (a head's tilt about its own spindle axis moves no ball: one variant may be 0)
+    for (
+        q
+    ) in variants:  # (a head's tilt about its own spindle axis moves no ball: one variant may be 0)
         ref, rc = signatures(name, instrument, eid, q, with_errors)
         seen = max(seen, float(np.max(np.abs(ref))))
-        assert np.max(np.abs(ref - rc)) <= TOL_MM, _report(ref - rc, f"{eid} {q.tolist()} on {name}, {instrument}")
+        assert np.max(np.abs(ref - rc)) <= TOL_MM, _report(
+            ref - rc, f"{eid} {q.tolist()} on {name}, {instrument}"
+        )
     if (name, instrument, eid) not in INVISIBLE:
         assert seen > 1e-5, "the test pose set does not see this entry"
 
@@ -274,10 +352,14 @@ def test_linear_polynomials_are_centred_on_the_session_mean(name, instrument):
             continue
         p = effect_params(e)
         ref, rc = signatures(name, instrument, eid, p, False)
-        assert np.max(np.abs(ref - rc)) <= TOL_MM, _report(ref - rc, f"{eid} about the session mean on {name}")
+        assert np.max(np.abs(ref - rc)) <= TOL_MM, _report(
+            ref - rc, f"{eid} about the session mean on {name}"
+        )
         zero, _ = signatures(name, instrument, eid, p, False, linear_ref=np.zeros(3))
         apart = max(apart, float(np.max(np.abs(zero - rc))))
-    assert apart > 1e-4, f"about the machine zero the reference differs by only {apart:.2e} mm: no test"
+    assert apart > 1e-4, (
+        f"about the machine zero the reference differs by only {apart:.2e} mm: no test"
+    )
 
 
 @pytest.mark.parametrize("instrument", ["ballbar", "rtest"])
@@ -302,7 +384,11 @@ def test_catalogues_list_the_same_static_entries():
     (motion-only entries, which need a direction of travel, are left out)."""
     motion = ("backlash_", "servo_lag_", "reversal_spike_")
     for name in MACHINES:
-        rc = {e.id for e in rotacal.effect_catalogue(rc_machine(name), 4) if e.applies_to(rc_machine(name))}
+        rc = {
+            e.id
+            for e in rotacal.effect_catalogue(rc_machine(name), 4)
+            if e.applies_to(rc_machine(name))
+        }
         rc = {i for i in rc if not i.startswith(motion)}
         ref = set(rfx.catalogue(ref_machine(name), 4, "ballbar"))
         assert rc == ref, (name, sorted(rc - ref), sorted(ref - rc))
@@ -315,7 +401,9 @@ def test_location_error_signatures_match_rotacal(name, instrument):
     bad = []
     zero = np.zeros(8)
     ref0, rc0 = ref_reading(name, instrument, zero, {}), rc_reading(name, instrument, zero, [], [])
-    assert np.max(np.abs(ref0 - rc0)) <= TOL_MM, _report(ref0 - rc0, "nominal machine, set-up error only")
+    assert np.max(np.abs(ref0 - rc0)) <= TOL_MM, _report(
+        ref0 - rc0, "nominal machine, set-up error only"
+    )
     for k, err in enumerate(ref_machine(name).error_names()):
         e = np.zeros(8)
         e[k] = 0.02 if k % 4 < 2 else 1e-4
@@ -328,16 +416,24 @@ def test_location_error_signatures_match_rotacal(name, instrument):
 
 # ---------------------------------------------------------------- files written by the reference
 
+
 def _simulated_ballbar(tmp_path, name="AC-trt"):
     m = ref_machine(name)
     s = ballbar_poses(name)
     rng = np.random.default_rng(7)
     model = refsim.Model(m, base_errors(name, 1.0), {"gravity_sag_" + m.tilt_axes()[0].name: 0.004})
-    length = refsim.ballbar_lengths(model, s["pivot"] + PIVOT_SHIFT, s["xyz"], np.radians(s["angles_deg"]), s["time"])
+    length = refsim.ballbar_lengths(
+        model, s["pivot"] + PIVOT_SHIFT, s["xyz"], np.radians(s["angles_deg"]), s["time"]
+    )
     length = length + noise.ar1(s["test"], 0.5, 5e-4, rng)
     path = writers.write_ballbar(tmp_path / f"bb_{name}.csv", m, s, length, noise_um=0.5)
-    writers.write_truth(tmp_path / f"bb_{name}.truth.json", model.errors, {"gravity_sag_" + m.tilt_axes()[0].name: 0.004},
-                        0.5, pivot_actual=s["pivot"] + PIVOT_SHIFT)
+    writers.write_truth(
+        tmp_path / f"bb_{name}.truth.json",
+        model.errors,
+        {"gravity_sag_" + m.tilt_axes()[0].name: 0.004},
+        0.5,
+        pivot_actual=s["pivot"] + PIVOT_SHIFT,
+    )
     return path, s
 
 
@@ -348,10 +444,13 @@ def test_ballbar_file_round_trips_through_rotacal(tmp_path, name):
     got = rotacal.load(path)
     assert got.machine.axis_names == "".join(ref_machine(name).axis_names)
     assert list(got.tests) == s["test"]
-    np.testing.assert_allclose(np.asarray(got.xyz), np.c_[cols["X"], cols["Y"], cols["Z"]], atol=1e-12)
+    np.testing.assert_allclose(
+        np.asarray(got.xyz), np.c_[cols["X"], cols["Y"], cols["Z"]], atol=1e-12
+    )
     axes = ref_machine(name).axis_names
-    np.testing.assert_allclose(np.asarray(got.angles_deg), rc_order(name, np.c_[cols[axes[0]], cols[axes[1]]]),
-                               atol=1e-12)
+    np.testing.assert_allclose(
+        np.asarray(got.angles_deg), rc_order(name, np.c_[cols[axes[0]], cols[axes[1]]]), atol=1e-12
+    )
     np.testing.assert_allclose(np.asarray(got.length), cols["length"], atol=1e-12)
     np.testing.assert_allclose(np.asarray(got.time), cols["time"], atol=1e-12)
     np.testing.assert_allclose(np.asarray(got.pivot), s["pivot"], atol=1e-12)
@@ -368,15 +467,21 @@ def test_rtest_file_round_trips_through_rotacal(tmp_path):
     s = rtest_poses("BC-trt")
     rng = np.random.default_rng(3)
     model = refsim.Model(m, base_errors("BC-trt", 1.0), {"coning_B": 1e-4})
-    d = refsim.rtest_displacements(model, s["nests"], s["setup"], s["xyz"], np.radians(s["angles_deg"]), s["time"])
+    d = refsim.rtest_displacements(
+        model, s["nests"], s["setup"], s["xyz"], np.radians(s["angles_deg"]), s["time"]
+    )
     zero_walk = np.stack([noise.random_walk(s["setup"], 1e-4, rng) for _ in range(3)], axis=1)
     d = d + zero_walk + np.stack([noise.pink(s["setup"], 3e-4, rng) for _ in range(3)], axis=1)
     path = writers.write_rtest(tmp_path / "r.csv", m, s, d, noise_um=0.3)
     cols = writers.read_session(path)["columns"]
     got = rotacal.load(path)
     assert list(got.setups) == s["setup"]
-    np.testing.assert_allclose(np.asarray(got.d), np.c_[cols["dx"], cols["dy"], cols["dz"]], atol=1e-12)
-    np.testing.assert_allclose(np.asarray(got.xyz), np.c_[cols["X"], cols["Y"], cols["Z"]], atol=1e-12)
+    np.testing.assert_allclose(
+        np.asarray(got.d), np.c_[cols["dx"], cols["dy"], cols["dz"]], atol=1e-12
+    )
+    np.testing.assert_allclose(
+        np.asarray(got.xyz), np.c_[cols["X"], cols["Y"], cols["Z"]], atol=1e-12
+    )
     np.testing.assert_allclose(np.asarray(got.angles_deg), np.c_[cols["B"], cols["C"]], atol=1e-12)
     for k, v in s["nests"].items():
         np.testing.assert_allclose(np.asarray(got.nests[k]), v, atol=1e-12)

@@ -1,4 +1,5 @@
 """R-test from Python: identification of the independent implementation's file against its truth."""
+
 import json
 import re
 
@@ -47,27 +48,43 @@ def test_cli_identify_rtest(shared_data, tmp_path):
     r = rotacal_cli("identify", shared_data / "rtest_bc_oyama.csv")
     assert r.returncode == 0, r.stderr
     assert set(json.loads(r.stdout)["location_errors"]) >= {"E_X0B", "E_Z0B", "E_X0C", "E_Y0C"}
-    r = rotacal_cli("identify", shared_data / "rtest_bc_oyama.csv", "--method", "paper", "--save-model",
-                    tmp_path / "m.json")
+    r = rotacal_cli(
+        "identify",
+        shared_data / "rtest_bc_oyama.csv",
+        "--method",
+        "paper",
+        "--save-model",
+        tmp_path / "m.json",
+    )
     assert r.returncode == 3 and "--method joint" in r.stderr and not (tmp_path / "m.json").exists()
 
 
 # ------------------------------------------------------------------------- simulate, model files, predict
 
-EFFECTS = ["--effect", "gravity_sag_B=0.006", "--effect", "coning_B=0.000145",
-           "--effect", "axial_motion_C_h2=0.002,-0.001"]
+EFFECTS = [
+    "--effect",
+    "gravity_sag_B=0.006",
+    "--effect",
+    "coning_B=0.000145",
+    "--effect",
+    "axial_motion_C_h2=0.002,-0.001",
+]
 
 
 @pytest.fixture(scope="module")
 def held_out(tmp_path_factory):
     """Simulate C = 0, 15, ..., 345; fit on C = 0, 30, ...; predict C = 15, 45, ... through files."""
     tmp = tmp_path_factory.mktemp("heldout")
-    r = rotacal_cli("simulate", "rtest", "--c-step", "15", *EFFECTS, "--seed", "11", "-o", tmp / "s.csv")
+    r = rotacal_cli(
+        "simulate", "rtest", "--c-step", "15", *EFFECTS, "--seed", "11", "-o", tmp / "s.csv"
+    )
     assert r.returncode == 0, r.stderr
     fit, held = split_by_c(tmp / "s.csv", 30)
     r = rotacal_cli("identify", fit, "--save-model", tmp / "m.json")
     assert r.returncode == 0, r.stderr
-    r = rotacal_cli("predict", held, "--model", tmp / "m.json", "--probe-zeros", "fitted", "-o", tmp / "p.csv")
+    r = rotacal_cli(
+        "predict", held, "--model", tmp / "m.json", "--probe-zeros", "fitted", "-o", tmp / "p.csv"
+    )
     assert r.returncode == 0, r.stderr
     return tmp, fit, held, json.loads((tmp / "s.truth.json").read_text()), r.stderr
 
@@ -81,16 +98,21 @@ def test_held_out_poses_are_predicted_to_the_noise(held_out):
     d_true = rotacal.rtest.truth_readings(truth, s_held)
     err = np.asarray(pred.d) - d_true
     noise = truth["noise_um"] * 1e-3
-    rms = np.sqrt(np.mean(err ** 2))
+    rms = np.sqrt(np.mean(err**2))
     # The model's own error: noise * sqrt(p / n) ~ 0.3 * sqrt(70 / 504) um; the bound is 2x noise.
     assert rms < 2 * noise, rms
     assert rms < 0.5 * noise, rms  # what the estimate above says it should be
     # The 1-sigma columns account for it (probe-zero uncertainty noise / sqrt(84) added).
-    std = np.array([[float(v) for v in row.split(",")[-3:]] for row in
-                    (tmp / "p.csv").read_text().splitlines() if row[:1].isdigit()])
+    std = np.array(
+        [
+            [float(v) for v in row.split(",")[-3:]]
+            for row in (tmp / "p.csv").read_text().splitlines()
+            if row[:1].isdigit()
+        ]
+    )
     assert std.shape == err.shape and np.all(std > 0)
     z = err / np.hypot(std, noise / np.sqrt(84))
-    assert 0.3 < np.sqrt(np.mean(z ** 2)) < 2.0
+    assert 0.3 < np.sqrt(np.mean(z**2)) < 2.0
     # The CLI's measured - predicted RMS (one offset per set-up removed) is the noise.
     rms_cli = float(re.search(r"RMS ([0-9.]+) um", stderr).group(1))
     assert abs(rms_cli - truth["noise_um"]) < 0.15 * truth["noise_um"]
@@ -102,7 +124,10 @@ def test_model_file_round_trip_predicts_as_in_memory(held_out):
     s_held = rotacal.load(held)
     in_memory = rotacal.rtest.predict_rtest(ident.model_dict(), s_held, probe_zeros="fitted")
     saved = rotacal.load_model(tmp / "m.json")
-    assert saved["kind"] == "rtest-joint" and saved["nests"] == {"1": [100.0, 0.0, 60.0], "2": [0.0, -120.0, 140.0]}
+    assert saved["kind"] == "rtest-joint" and saved["nests"] == {
+        "1": [100.0, 0.0, 60.0],
+        "2": [0.0, -120.0, 140.0],
+    }
     from_file = rotacal.rtest.predict_rtest(saved, s_held, probe_zeros="fitted")
     assert np.array_equal(np.asarray(in_memory.d), np.asarray(from_file.d))
     assert rotacal._core.format_rtest(in_memory) == rotacal._core.format_rtest(from_file)
@@ -133,33 +158,89 @@ def test_model_file_errors_name_file_and_key(held_out, tmp_path, shared_data):
     broken(lambda d: d["map_coefficients"].pop("dz_BY.b2"), "missing: dz_BY.b2")
     broken(lambda d: d["basis"].update(c_harmonics=3), "do not match basis")
     broken(lambda d: d["covariance"]["matrix"].pop(), r"covariance.matrix: shape")
-    broken(lambda d: d["location_errors"]["E_X0B"].update(value="x"), "E_X0B: 'value' must be a finite number")
+    broken(
+        lambda d: d["location_errors"]["E_X0B"].update(value="x"),
+        "E_X0B: 'value' must be a finite number",
+    )
     # Fitted probe zeros belong to the fitted set-up: a moved nest is refused.
-    (tmp_path / "moved.csv").write_text(held.read_text().replace("# nest.2: 0, -120, 140", "# nest.2: 0, -120, 150"))
-    r = rotacal_cli("predict", tmp_path / "moved.csv", "--model", tmp / "m.json", "--probe-zeros", "fitted",
-                    "-o", tmp_path / "x.csv")
+    (tmp_path / "moved.csv").write_text(
+        held.read_text().replace("# nest.2: 0, -120, 140", "# nest.2: 0, -120, 150")
+    )
+    r = rotacal_cli(
+        "predict",
+        tmp_path / "moved.csv",
+        "--model",
+        tmp / "m.json",
+        "--probe-zeros",
+        "fitted",
+        "-o",
+        tmp_path / "x.csv",
+    )
     assert r.returncode == 3 and "nest.2" in r.stderr  # the plausibility check sees it first
-    r = rotacal_cli("predict", tmp_path / "moved.csv", "--model", tmp / "m.json", "--probe-zeros", "fitted",
-                    "--max-deviation", "20", "-o", tmp_path / "x.csv")
+    r = rotacal_cli(
+        "predict",
+        tmp_path / "moved.csv",
+        "--model",
+        tmp / "m.json",
+        "--probe-zeros",
+        "fitted",
+        "--max-deviation",
+        "20",
+        "-o",
+        tmp_path / "x.csv",
+    )
     assert r.returncode == 3 and "set-up '2'" in r.stderr
     # An R-test session with a ballbar model, and the other way round.
     (tmp_path / "ballbar.json").write_text(json.dumps(dict(good, kind="ballbar")))
     r = rotacal_cli("predict", held, "--model", tmp_path / "ballbar.json", "-o", tmp_path / "x.csv")
     assert r.returncode == 3 and "not an R-test joint model" in r.stderr
-    r = rotacal_cli("predict", shared_data / "ballbar_ac_table2.csv", "--model", tmp / "m.json", "-o", tmp_path / "x.csv")
+    r = rotacal_cli(
+        "predict",
+        shared_data / "ballbar_ac_table2.csv",
+        "--model",
+        tmp / "m.json",
+        "-o",
+        tmp_path / "x.csv",
+    )
     assert r.returncode == 3 and "not a ballbar model" in r.stderr
 
 
 def test_simulate_rtest_pattern_truth_and_identification(tmp_path):
     out = tmp_path / "sim.csv"
-    r = rotacal_cli("simulate", "rtest", "--b-range", "-90,90", "--b-step", "45", "--c-range", "0,360",
-                    "--c-step", "45", "--nest", "100,0,60", "--nest", "0,-120,140", "--nest", "-80,60,100",
-                    "--errors", "E_X0B=0.02,E_B0C=-4e-5", *EFFECTS[:4], "--noise", "0.5", "--seed", "4", "-o", out)
+    r = rotacal_cli(
+        "simulate",
+        "rtest",
+        "--b-range",
+        "-90,90",
+        "--b-step",
+        "45",
+        "--c-range",
+        "0,360",
+        "--c-step",
+        "45",
+        "--nest",
+        "100,0,60",
+        "--nest",
+        "0,-120,140",
+        "--nest",
+        "-80,60,100",
+        "--errors",
+        "E_X0B=0.02,E_B0C=-4e-5",
+        *EFFECTS[:4],
+        "--noise",
+        "0.5",
+        "--seed",
+        "4",
+        "-o",
+        out,
+    )
     assert r.returncode == 0, r.stderr
     s = rotacal.load(out)
     assert len(s) == 5 * 8 * 3 and sorted(s.nests) == ["1", "2", "3"] and s.noise_um == 0.5
     a = np.asarray(s.angles_deg)
-    assert sorted(set(a[:, 0])) == [-90, -45, 0, 45, 90] and sorted(set(a[:, 1])) == list(range(0, 360, 45))
+    assert sorted(set(a[:, 0])) == [-90, -45, 0, 45, 90] and sorted(set(a[:, 1])) == list(
+        range(0, 360, 45)
+    )
     # Beside it, the truth in the shape of ../shared/data/rtest_bc_oyama.truth.json.
     truth = json.loads(out.with_suffix(".truth.json").read_text())
     assert {"errors", "effects", "nests", "noise_um"} <= set(truth)
@@ -168,19 +249,25 @@ def test_simulate_rtest_pattern_truth_and_identification(tmp_path):
     assert len(truth["probe_zeros"]) == 3
     # The readings are the truth plus noise of the stated size.
     res = np.asarray(s.d) - rotacal.rtest.truth_readings(truth, s)
-    assert abs(np.sqrt(np.mean(res ** 2)) - 0.5e-3) < 0.15 * 0.5e-3
+    assert abs(np.sqrt(np.mean(res**2)) - 0.5e-3) < 0.15 * 0.5e-3
     d = rotacal.identify(s).to_dict()
     for n, p in d["location_errors"].items():
         assert abs(p["value"] - truth["errors"][n]) < 4 * p["std"], n
     # Random errors are seeded; the ballbar simulator still answers as before.
     r1 = rotacal_cli("simulate", "rtest", "--seed", "9", "-o", tmp_path / "a.csv")
-    r2 = rotacal_cli("simulate", "rtest", "--seed", "9", "-o", tmp_path / "b.csv", "--truth", tmp_path / "t.json")
+    r2 = rotacal_cli(
+        "simulate", "rtest", "--seed", "9", "-o", tmp_path / "b.csv", "--truth", tmp_path / "t.json"
+    )
     assert r1.returncode == r2.returncode == 0
     assert (tmp_path / "a.csv").read_text() == (tmp_path / "b.csv").read_text()
     assert json.loads((tmp_path / "t.json").read_text())["errors"]["E_X0B"] != 0.0
-    for bad, what in ((["--b-step", "0"], "--b-range/--b-step"), (["--effect", "coning_B=1,2"], "coning_B"),
-                      (["--errors", "E_Y0A=1"], "E_Y0A"), (["--probe-dir", "1,0,0"], "--probe-dir"),
-                      (["--nest", "1,2"], "--nest")):
+    for bad, what in (
+        (["--b-step", "0"], "--b-range/--b-step"),
+        (["--effect", "coning_B=1,2"], "coning_B"),
+        (["--errors", "E_Y0A=1"], "E_Y0A"),
+        (["--probe-dir", "1,0,0"], "--probe-dir"),
+        (["--nest", "1,2"], "--nest"),
+    ):
         r = rotacal_cli("simulate", "rtest", *bad, "-o", tmp_path / "x.csv")
         assert r.returncode == 3 and what in r.stderr, (bad, r.stderr)
 
@@ -214,8 +301,9 @@ def test_probe_calibration_recovers_directions_and_sphere_offset():
 
     spindle = np.arange(0, 360, 45.0)
     offset = np.array([0.004, -0.0025])
-    r = rotacal._core.simulate_spindle_indexing(DIRS, zeros, offset, np.array([0.01, 0.02, -0.03]),
-                                                np.radians(spindle), noise_um, 6)
+    r = rotacal._core.simulate_spindle_indexing(
+        DIRS, zeros, offset, np.array([0.01, 0.02, -0.03]), np.radians(spindle), noise_um, 6
+    )
     so = rotacal.rtest.calibrate_sphere_offset(dirs, spindle, r)
     assert np.all(np.abs(np.asarray(so.offset) - offset) < 4 * np.asarray(so.offset_std))
     assert np.all(np.asarray(so.offset_std) < 1e-3)
@@ -224,7 +312,9 @@ def test_probe_calibration_recovers_directions_and_sphere_offset():
 def test_raw_probe_session_is_converted(tmp_path):
     out = tmp_path / "raw.csv"
     dirs = [f"--probe-dir={','.join(map(str, d))}" for d in DIRS]
-    r = rotacal_cli("simulate", "rtest", *dirs, "--raw-only", *EFFECTS[:4], "--seed", "8", "-o", out)
+    r = rotacal_cli(
+        "simulate", "rtest", *dirs, "--raw-only", *EFFECTS[:4], "--seed", "8", "-o", out
+    )
     assert r.returncode == 0, r.stderr
     text = out.read_text()
     assert "probe.3.dir:" in text and "setup,time,B,C,X,Y,Z,d1,d2,d3\n" in text
@@ -237,8 +327,8 @@ def test_raw_probe_session_is_converted(tmp_path):
     # d = Dirs^-1 raw: its noise is the reading noise through Dirs^-1 (per component, RMS).
     err = np.asarray(converted.d) - rotacal.rtest.truth_readings(truth, s)
     inv = np.linalg.inv(DIRS)
-    expected = truth["noise_um"] * 1e-3 * np.sqrt(np.mean(np.sum(inv ** 2, axis=1)))
-    assert abs(np.sqrt(np.mean(err ** 2)) - expected) < 0.15 * expected
+    expected = truth["noise_um"] * 1e-3 * np.sqrt(np.mean(np.sum(inv**2, axis=1)))
+    assert abs(np.sqrt(np.mean(err**2)) - expected) < 0.15 * expected
     # identify and report take the raw file as it is (the conversion is stated in the notes).
     d = rotacal.identify(s).to_dict()
     assert any("d1,d2,d3" in n for n in d["notes"])
@@ -249,13 +339,15 @@ def test_raw_probe_session_is_converted(tmp_path):
     assert 'id="error-map"' in (tmp_path / "raw.html").read_text()
     # With calibrated directions instead of the file's.
     moves = rotacal._core.default_calibration_moves(0.5)
-    cal = rotacal.rtest.calibrate_probes(moves, rotacal._core.simulate_probe_calibration(
-        DIRS, np.zeros(3), moves, truth["noise_um"], 2))
+    cal = rotacal.rtest.calibrate_probes(
+        moves,
+        rotacal._core.simulate_probe_calibration(DIRS, np.zeros(3), moves, truth["noise_um"], 2),
+    )
     calibrated, notes = rotacal.rtest.with_displacements(s, cal.dirs)
     assert "calibrated" in notes[0]
     # Direction errors of ~1 mrad on readings of ~50 um add < 0.1 um: still the noise level.
     err = np.asarray(calibrated.d) - rotacal.rtest.truth_readings(truth, s)
-    assert np.sqrt(np.mean(err ** 2)) < 1.5 * expected
+    assert np.sqrt(np.mean(err**2)) < 1.5 * expected
 
 
 def test_diagnosis_json_says_which_harmonics_the_sampling_cannot_resolve(shared_data):
@@ -269,9 +361,11 @@ def test_diagnosis_json_says_which_harmonics_the_sampling_cannot_resolve(shared_
 
 # ------------------------------------------------------------------------- any machine (issue 13)
 
+
 @pytest.mark.parametrize("machine", ["AC-trt", "B45C-trt", "B-head-C-table", "AC-head", "BC-head"])
 def test_simulate_and_identify_on_any_machine(machine):
     from rotacal import rtest
+
     mtype = rotacal._core.parse_machine_type(machine)
     effects = {"tool_offset_Z": 0.015} if mtype.has_head else None
     s, t = rtest.simulate_rtest("random", effects, machine=machine, noise_um=0.3, seed=7)
@@ -303,6 +397,7 @@ def test_simulate_and_identify_on_any_machine(machine):
 
 def test_default_pattern_follows_the_limits():
     from rotacal import rtest
+
     p = rtest.default_pattern("B45C-trt")  # B turns 0..180
     assert p["b_deg"][0] == pytest.approx(0.0) and p["b_deg"][-1] == pytest.approx(180.0)
     assert rtest.default_pattern("BC-trt")["b_deg"] == rtest.B_GRID
@@ -329,6 +424,16 @@ def test_cli_simulate_and_identify_head_machine(tmp_path):
     r = rotacal_cli("identify", out, "--method", "paper")
     assert r.returncode != 0 and "joint fit" in r.stderr
     # A grid the machine cannot turn to is refused, naming the axis and its limits.
-    r = rotacal_cli("simulate", "rtest", "--machine", "B45C-trt", "--b-range", "-90,90", "--b-step", "45",
-                    "-o", tmp_path / "nut.csv")
+    r = rotacal_cli(
+        "simulate",
+        "rtest",
+        "--machine",
+        "B45C-trt",
+        "--b-range",
+        "-90,90",
+        "--b-step",
+        "45",
+        "-o",
+        tmp_path / "nut.csv",
+    )
     assert r.returncode != 0 and "beyond its limits [0, 180]" in r.stderr

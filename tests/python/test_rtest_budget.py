@@ -7,6 +7,7 @@ per quantity. Sessions from the independent reference simulator (tests/reference
   errors (a nonlinear refit of refsim sessions with and without it), maps included (the
   baseline's line for E_C0B is 7.3 urad where the maps leave 0.19 urad);
 - an identification of another session is refused by name."""
+
 import sys
 from pathlib import Path
 
@@ -29,8 +30,14 @@ def session_file(tmp_path, name: str, effects: dict, ar_sigma_mm: float, seed: i
     m = refsim.builtin(MACHINE)
     s = poses.rtest_grid(m, tilt_step=15.0, rot_step=30.0)
     errors = dict(zip(m.error_names(), ERRORS))
-    d = refsim.rtest_displacements(refsim.Model(m, errors, effects), s["nests"], s["setup"], s["xyz"],
-                                   np.radians(s["angles_deg"]), s["time"])
+    d = refsim.rtest_displacements(
+        refsim.Model(m, errors, effects),
+        s["nests"],
+        s["setup"],
+        s["xyz"],
+        np.radians(s["angles_deg"]),
+        s["time"],
+    )
     if ar_sigma_mm > 0:  # 6 s per pose: probe drift between poses, one AR(1) stream per channel
         rng = np.random.default_rng(seed)
         d = d + np.stack([noise.ar1(s["setup"], 0.6, ar_sigma_mm, rng) for _ in range(3)], axis=1)
@@ -43,7 +50,9 @@ def by_name(budget) -> dict:
 
 
 def test_the_budget_is_of_the_identifications_model(tmp_path):
-    s = rotacal.load(session_file(tmp_path, "ar", {"angular_positioning_C_h3": [8e-6, -5e-6]}, 5e-4))
+    s = rotacal.load(
+        session_file(tmp_path, "ar", {"angular_positioning_C_h3": [8e-6, -5e-6]}, 5e-4)
+    )
     result = identify(s, "joint", noise="auto")
     reported = result.to_dict()["location_errors"]
     budget = by_name(identification_budget(s, None, result))

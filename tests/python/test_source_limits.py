@@ -4,6 +4,7 @@ no function over 150 (tests and the generated stub _core.pyi excepted).
 C++ functions are found by their braces, with comments and literals blanked: a brace opened at
 namespace or class scope whose statement holds a parameter list is a function body (lambdas
 inside count to their function); Python functions by ast."""
+
 import ast
 import re
 from pathlib import Path
@@ -15,6 +16,7 @@ MAX_FUNCTION_LINES = 150
 # listed function is split without being taken off this list, as when a new one grows too long.
 # Empty since solve_joint (src/core/joint_fit.cpp) was split along its stages.
 KNOWN_LONG: set = set()
+
 
 def _cpp_sources():
     for base in ("include", "src", "python/bindings"):
@@ -57,8 +59,10 @@ SCOPE = re.compile(r"\b(namespace|class|struct|union)\b")
 def cpp_functions(text: str):
     """(name, first line, number of lines) of each function body opened at namespace or class
     scope: its statement holds a parameter list, no `=` before it, and is not a class head."""
-    s = "\n".join("" if line.lstrip().startswith("#") else line
-                  for line in _blank_comments_and_literals(text).split("\n"))
+    s = "\n".join(
+        "" if line.lstrip().startswith("#") else line
+        for line in _blank_comments_and_literals(text).split("\n")
+    )
     line_at = [0] * len(s)
     line = 1
     for i, ch in enumerate(s):
@@ -88,15 +92,21 @@ def cpp_functions(text: str):
 
 def test_the_function_finder_sees_long_functions_and_only_functions():
     body = "\n".join(f"  x += {k};  // {{" for k in range(200))
-    text = (f"namespace rotacal {{\n\ntemplate <typename T>\nint f(int x,\n      int y) {{\n{body}\n  return x;\n}}\n\n"
-            "struct A : B {\n  int g() const {\n    const char* c = \"}\";\n    return 1;\n  }\n};\n"
-            "const std::vector<int> table = {1, 2};\n}  // namespace rotacal\n")
+    text = (
+        f"namespace rotacal {{\n\ntemplate <typename T>\nint f(int x,\n      int y) {{\n{body}\n  return x;\n}}\n\n"
+        'struct A : B {\n  int g() const {\n    const char* c = "}";\n    return 1;\n  }\n};\n'
+        "const std::vector<int> table = {1, 2};\n}  // namespace rotacal\n"
+    )
     assert list(cpp_functions(text)) == [("f", 3, 205), ("g", 210, 4)]
 
 
 def test_no_source_file_is_over_500_lines():
-    long = [f"{p.relative_to(ROOT)}: {n}" for p in [*_cpp_sources(), *_py_sources()]
-            for n in [len(p.read_text().splitlines())] if n > MAX_FILE_LINES]
+    long = [
+        f"{p.relative_to(ROOT)}: {n}"
+        for p in [*_cpp_sources(), *_py_sources()]
+        for n in [len(p.read_text().splitlines())]
+        if n > MAX_FILE_LINES
+    ]
     assert not long, long
 
 

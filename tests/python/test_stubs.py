@@ -1,13 +1,14 @@
 """The committed _core.pyi is what pybind11-stubgen (pinned) makes of the built extension."""
 
-
 import rotacal._stubgen as stubgen
 
 
 def test_stubs_match_the_extension():
     text = stubgen.generate()
     committed = stubgen.STUB.read_text()
-    assert committed == text, "python/rotacal/_core.pyi is stale: run python -m rotacal._stubgen and commit it"
+    assert committed == text, (
+        "python/rotacal/_core.pyi is stale: run python -m rotacal._stubgen and commit it"
+    )
 
 
 def test_stub_check_fails_on_a_changed_binding(tmp_path, monkeypatch):

@@ -1,9 +1,8 @@
 #pragma once
 // Test support: the candidate Jacobians of a diagnosis problem (the harmonic shortcut of
 // src/diagnose/candidate_jets.hpp) against Jets of every parameter of each candidate.
-#include <catch2/catch.hpp>
-
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <vector>
 
 #include "rotacal/diagnose/diagnosis.hpp"
@@ -17,7 +16,8 @@ int check_candidate_jacobians(const Problem& P, const EffectModel& fx) {
   const ModelFit at = P.fit(fx);
   std::vector<Effect> candidates;
   for (const Effect& c : P.candidates(4))
-    if (std::find(fx.effects.begin(), fx.effects.end(), c) == fx.effects.end()) candidates.push_back(c);
+    if (std::find(fx.effects.begin(), fx.effects.end(), c) == fx.effects.end())
+      candidates.push_back(c);
   const std::vector<Eigen::MatrixXd> batch = P.candidate_jacobians(at, candidates);
   REQUIRE(batch.size() == candidates.size());
   int harmonic = 0;

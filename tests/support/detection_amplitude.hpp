@@ -4,10 +4,9 @@
 /// sigma RMS of signal that the baseline model (location errors) cannot absorb, along the
 /// effect's least-absorbable direction. Used by the diagnosis benchmarks.
 
+#include <Eigen/SVD>
 #include <cmath>
 #include <vector>
-
-#include <Eigen/SVD>
 
 #include "rotacal/ballbar/simulate.hpp"
 #include "rotacal/core/least_squares.hpp"
@@ -17,16 +16,19 @@ namespace rotacal::synthetic {
 
 /// Parameters of `e` giving k * noise_um RMS of unabsorbable signal on `cmd` simulated on
 /// `truth`, or empty when that needs more than a plausible size of some parameter.
-inline std::vector<double> unabsorbable_amplitude(const BallbarSession& cmd, const BallbarMachineModel& truth,
-                                                  const Effect& e, double k, double noise_um) {
+inline std::vector<double> unabsorbable_amplitude(const BallbarSession& cmd,
+                                                  const BallbarMachineModel& truth, const Effect& e,
+                                                  double k, double noise_um) {
   BallbarSession s = simulate_ballbar(cmd, truth, {0.0, 1, false});
   s.noise_um = noise_um;
   BallbarDiagnosisProblem P(s);
   const ModelFit at = P.fit(EffectModel{});
   Eigen::VectorXd m(e.num_params());
-  for (int j = 0; j < m.size(); ++j) m[j] = plausible_magnitude(e.param_units()[static_cast<std::size_t>(j)]);
+  for (int j = 0; j < m.size(); ++j)
+    m[j] = plausible_magnitude(e.param_units()[static_cast<std::size_t>(j)]);
   const Eigen::MatrixXd Jc = P.candidate_jacobian(at, e) * m.asDiagonal();
-  const Eigen::MatrixXd perp = Jc - at.jacobian * at.jacobian.completeOrthogonalDecomposition().solve(Jc);
+  const Eigen::MatrixXd perp =
+      Jc - at.jacobian * at.jacobian.completeOrthogonalDecomposition().solve(Jc);
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(perp, Eigen::ComputeThinV);
   const double per_size = svd.singularValues()[0] / std::sqrt(static_cast<double>(perp.rows()));
   const double sizes = k * noise_um * 1e-3 / per_size;

@@ -6,18 +6,17 @@
 /// with coloured noise added to the readings as a recorder would see it.
 /// Needs ROTACAL_SHARED_DIR (set by tests/CMakeLists.txt and bench/CMakeLists.txt).
 
+#include <Eigen/Core>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <string>
 #include <vector>
 
-#include <Eigen/Core>
-#include <nlohmann/json.hpp>
-
 #include "rotacal/ballbar/simulate.hpp"
-#include "rotacal/kinematics/machine_model.hpp"
 #include "rotacal/core/noise_model.hpp"
 #include "rotacal/io/ballbar_file.hpp"
+#include "rotacal/kinematics/machine_model.hpp"
 
 namespace rotacal::synthetic {
 
@@ -37,7 +36,8 @@ inline BallbarMachineModel random_ballbar_machine(const BallbarSession& cmd, std
   std::normal_distribution<double> N(0.0, 1.0);
   BallbarMachineModel m;
   m.machine = cmd.machine;
-  for (int i = 0; i < 8; ++i) m.errors.v[i] = location_error_is_angle(i) ? 5e-5 * N(rng) : 0.03 * N(rng);
+  for (int i = 0; i < 8; ++i)
+    m.errors.v[i] = location_error_is_angle(i) ? 5e-5 * N(rng) : 0.03 * N(rng);
   m.pivot = cmd.pivot + Eigen::Vector3d(N(rng), N(rng), N(rng)) * 0.02;
   return m;
 }
@@ -46,7 +46,8 @@ inline BallbarMachineModel random_ballbar_machine(const BallbarSession& cmd, std
 inline MachineModel random_bc_table(std::mt19937& rng) {
   std::normal_distribution<double> N(0.0, 1.0);
   MachineModel t = MachineModel::nominal(MachineType::BC_trt);
-  for (int i = 0; i < 8; ++i) t.errors.v[i] = location_error_is_angle(i) ? 3e-5 * N(rng) : 0.02 * N(rng);
+  for (int i = 0; i < 8; ++i)
+    t.errors.v[i] = location_error_is_angle(i) ? 3e-5 * N(rng) : 0.02 * N(rng);
   return t;
 }
 
@@ -57,7 +58,8 @@ inline MachineModel oyama_truth() {
   const nlohmann::ordered_json j = nlohmann::ordered_json::parse(in);  // effects in file order
   MachineModel t = MachineModel::nominal(MachineType::BC_trt);
   const auto& names = location_error_names(t.machine);
-  for (std::size_t i = 0; i < names.size(); ++i) t.errors.v[static_cast<Eigen::Index>(i)] = j.at("errors").at(names[i]);
+  for (std::size_t i = 0; i < names.size(); ++i)
+    t.errors.v[static_cast<Eigen::Index>(i)] = j.at("errors").at(names[i]);
   for (const auto& [id, value] : j.at("effects").items()) {
     t.effects.effects.push_back(Effect::parse(id));
     t.effect_params.push_back(value.get<double>());
@@ -72,17 +74,19 @@ inline Eigen::VectorXd coloured_length_noise(const BallbarSession& s, double rho
   std::vector<std::string> g;
   std::vector<double> t;
   for (const BallbarSample& x : s.samples) g.push_back(x.test), t.push_back(x.time);
-  return rho < 0 ? noise_gen::pink(g, t, sigma_mm, seed) : noise_gen::ar1(g, t, rho, sigma_mm, seed);
+  return rho < 0 ? noise_gen::pink(g, t, sigma_mm, seed)
+                 : noise_gen::ar1(g, t, rho, sigma_mm, seed);
 }
 
 /// A noise-free simulation of `cmd` on `truth` plus coloured noise (coloured_length_noise) of
 /// marginal sigma noise_um, which the file declares, as a user who measured the noise at rest
 /// would.
-inline BallbarSession noisy_ballbar(const BallbarSession& cmd, const BallbarMachineModel& truth, double rho,
-                                    double noise_um, std::uint64_t seed) {
+inline BallbarSession noisy_ballbar(const BallbarSession& cmd, const BallbarMachineModel& truth,
+                                    double rho, double noise_um, std::uint64_t seed) {
   BallbarSession s = simulate_ballbar(cmd, truth, {0.0, 1, false});
   const Eigen::VectorXd e = coloured_length_noise(s, rho, noise_um * 1e-3, seed);
-  for (std::size_t i = 0; i < s.samples.size(); ++i) s.samples[i].length += e[static_cast<Eigen::Index>(i)];
+  for (std::size_t i = 0; i < s.samples.size(); ++i)
+    s.samples[i].length += e[static_cast<Eigen::Index>(i)];
   s.noise_um = noise_um;
   return s;
 }

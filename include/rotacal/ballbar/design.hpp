@@ -76,7 +76,8 @@ struct BallbarDesign {
 
 /// The first sample of `plan` whose machine axes leave the travel [lo, hi] (mm), in words;
 /// empty if none does.
-std::string travel_violation(const BallbarPlan& plan, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
+std::string travel_violation(const BallbarPlan& plan, const Eigen::Vector3d& lo,
+                             const Eigen::Vector3d& hi);
 
 /// Evaluate one set-up at a time budget (0: its own run time). Never throws for a set-up that
 /// breaks a limit: the candidate says why it is not feasible.

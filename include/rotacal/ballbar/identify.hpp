@@ -18,17 +18,17 @@
 namespace rotacal {
 
 struct BallbarIdentification {
-  std::string method;                 ///< "joint" or "paper"
-  BallbarMachineModel model;          ///< identified machine (unobservable parts left nominal)
+  std::string method;         ///< "joint" or "paper"
+  BallbarMachineModel model;  ///< identified machine (unobservable parts left nominal)
   std::vector<ParameterEstimate> parameters;  ///< 8 location errors, pivot x y z, then extras
-  Eigen::MatrixXd covariance;         ///< in `parameters` order, 1-sigma^2
-  std::vector<double> residuals;      ///< measured - model, mm, per sample (session order)
+  Eigen::MatrixXd covariance;                 ///< in `parameters` order, 1-sigma^2
+  std::vector<double> residuals;              ///< measured - model, mm, per sample (session order)
   /// d(model length)/d(parameter) at the solution, mm per parameter unit; one row per fitted
   /// sample (in session order of the samples used), columns in `parameters` order.
   Eigen::MatrixXd jacobian;
-  std::vector<bool> fixed;            ///< per parameter: held at its start value
+  std::vector<bool> fixed;  ///< per parameter: held at its start value
   double residual_rms_um = 0.0;
-  double sigma_um = 0.0;              ///< noise level used for the covariance
+  double sigma_um = 0.0;  ///< noise level used for the covariance
   std::size_t n_samples = 0;
   bool converged = false;
   int iterations = 0;
@@ -85,18 +85,18 @@ struct BallbarArrays {
   std::vector<std::size_t> index;                   ///< session index of each row
   Eigen::Matrix3Xd xyz;                             ///< commanded tool-side ball, mm
   std::vector<RotaryAngles<double>> angles;         ///< rad
-  std::vector<RotaryMotion> motion;                 ///< rotary_motion of the whole session (empty: not built)
-  Eigen::VectorXd time;                             ///< s
-  Eigen::VectorXd length;                           ///< measured length, mm
-  std::vector<std::string> test;                    ///< test label of each row (noise streams)
+  std::vector<RotaryMotion> motion;  ///< rotary_motion of the whole session (empty: not built)
+  Eigen::VectorXd time;              ///< s
+  Eigen::VectorXd length;            ///< measured length, mm
+  std::vector<std::string> test;     ///< test label of each row (noise streams)
 
   Eigen::Index size() const { return time.size(); }
 };
 
 /// The rows of `session` whose test is in `tests` (all if empty), as arrays. `with_motion`
 /// false leaves `motion` empty, for a fit none of whose effects depends on the motion.
-BallbarArrays ballbar_arrays(const BallbarSession& session, const std::vector<std::string>& tests = {},
-                             bool with_motion = true);
+BallbarArrays ballbar_arrays(const BallbarSession& session,
+                             const std::vector<std::string>& tests = {}, bool with_motion = true);
 
 /// Joint least-squares fit of location errors + actual pivot (+ dL, + effects) to every
 /// sample: residual_i = (L_model,i - L_i) / sigma, Jacobians by Jets of the one model
@@ -109,6 +109,7 @@ BallbarIdentification identify_joint(const BallbarSession& session,
 
 /// The same fit on prepared arrays (options.tests was applied when they were built and is
 /// ignored here).
-BallbarIdentification identify_joint(const BallbarArrays& data, const JointFitOptions& options = {});
+BallbarIdentification identify_joint(const BallbarArrays& data,
+                                     const JointFitOptions& options = {});
 
 }  // namespace rotacal

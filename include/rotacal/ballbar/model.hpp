@@ -7,9 +7,9 @@
 #include <vector>
 
 #include "rotacal/ballbar/motion.hpp"
+#include "rotacal/kinematics/effects.hpp"
 #include "rotacal/kinematics/machine_model.hpp"
 #include "rotacal/session/session.hpp"
-#include "rotacal/kinematics/effects.hpp"
 
 namespace rotacal {
 
@@ -29,7 +29,8 @@ Scalar predicted_length(MachineType m, const LocationErrors<Scalar>& e, const Ve
                         const EffectModel& fx, const Scalar* fx_params, const Eigen::Vector3d& xyz,
                         const RotaryAngles<double>& angles, double t, const RotaryMotion& motion,
                         const Scalar& tool_length_error = Scalar(0)) {
-  const Vec3<Scalar> tool = tool_position(m, e, fx, fx_params, xyz, angles, t, tool_length_error, motion);
+  const Vec3<Scalar> tool =
+      tool_position(m, e, fx, fx_params, xyz, angles, t, tool_length_error, motion);
   const Vec3<Scalar> ball = table_point(m, e, fx, fx_params, angles, t, pivot, motion);
   return (tool - ball).norm() + ballbar_reading_error(fx, fx_params, t);
 }

@@ -16,8 +16,8 @@ namespace rotacal {
 
 struct BallbarMonteCarloOptions {
   int draws = 100;
-  std::uint64_t seed = 1;     ///< draw k uses seed + k (as simulate_ballbar with that seed)
-  double noise_um = 0.0;      ///< 1 sigma of the simulated noise; 0: the fit's sigma_um
+  std::uint64_t seed = 1;  ///< draw k uses seed + k (as simulate_ballbar with that seed)
+  double noise_um = 0.0;   ///< 1 sigma of the simulated noise; 0: the fit's sigma_um
   /// Fit options of the identification being checked (tests, whitener, ...); its effects are
   /// taken from the identified model.
   JointFitOptions fit;

@@ -7,8 +7,8 @@
 
 #include <vector>
 
-#include "rotacal/session/session.hpp"
 #include "rotacal/kinematics/machine.hpp"
+#include "rotacal/session/session.hpp"
 
 namespace rotacal {
 

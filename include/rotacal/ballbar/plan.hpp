@@ -19,8 +19,8 @@
 #include <string>
 #include <vector>
 
-#include "rotacal/session/session.hpp"
 #include "rotacal/kinematics/machine.hpp"
+#include "rotacal/session/session.hpp"
 
 namespace rotacal {
 
@@ -94,7 +94,7 @@ struct BallbarSetup {
   /// first must be 1. A run at factor k != 1 appends "_f<feed_mm_per_min * k>" to its label
   /// (radial_C_cw_f2000). Two feeds tell servo lag (proportional to the speed) from backlash.
   std::vector<double> feed_factors = {1.0};
-  RadialSide radial_c_side = RadialSide::outside;            ///< Flynn's '±' of radial C
+  RadialSide radial_c_side = RadialSide::outside;  ///< Flynn's '±' of radial C
   /// Tilt angle (deg) held during axial_c. Unset: 0, except on a head-head machine, where the
   /// ball sits on the rotary (C) head axis at tilt 0 and its position and tilt errors are seen
   /// only as one combination per ball height; 45 deg takes the ball off the axis, where the
@@ -146,10 +146,10 @@ struct TransitionArc {
 struct PlanSegment {
   std::string label;  ///< run label (run_label) or "transition"
   SegmentKind kind = SegmentKind::test;
-  std::optional<BallbarTest> test;  ///< set for kind == test
+  std::optional<BallbarTest> test;                 ///< set for kind == test
   SweepDirection direction = SweepDirection::ccw;  ///< of a rotary test
   double feed_factor = 1.0;                        ///< of the feeds during this segment
-  TransitionArc arc;                ///< meaningful for kind == arc_transition
+  TransitionArc arc;                               ///< meaningful for kind == arc_transition
   std::vector<PlannedSample> samples;
 };
 

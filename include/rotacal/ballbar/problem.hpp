@@ -35,18 +35,20 @@ BallbarLayout ballbar_layout(MachineType m, const EffectModel& fx, int pivots = 
 /// block, parameters p in `L`'s order (doubles or Jets).
 template <typename T>
 T ballbar_residual(const BallbarLayout& L, MachineType m, const EffectModel& fx, const T* p,
-                   Eigen::Index pivot, const Eigen::Vector3d& xyz, const RotaryAngles<double>& angles,
-                   double t, const RotaryMotion& motion, double measured) {
+                   Eigen::Index pivot, const Eigen::Vector3d& xyz,
+                   const RotaryAngles<double>& angles, double t, const RotaryMotion& motion,
+                   double measured) {
   const T* c = p + L.pivots.item_offset(pivot);
-  return predicted_length<T>(m, LocationErrors<T>::from_ptr(L.errors.ptr(p)), Vec3<T>(c[0], c[1], c[2]), fx,
-                             L.effects.ptr(p), xyz, angles, t, motion) -
+  return predicted_length<T>(m, LocationErrors<T>::from_ptr(L.errors.ptr(p)),
+                             Vec3<T>(c[0], c[1], c[2]), fx, L.effects.ptr(p), xyz, angles, t,
+                             motion) -
          T(measured);
 }
 
 /// The same for row i of `d` (its motion, when built with it).
 template <typename T>
-T ballbar_residual(const BallbarLayout& L, const BallbarArrays& d, const EffectModel& fx, const T* p,
-                   Eigen::Index i, Eigen::Index pivot = 0) {
+T ballbar_residual(const BallbarLayout& L, const BallbarArrays& d, const EffectModel& fx,
+                   const T* p, Eigen::Index i, Eigen::Index pivot = 0) {
   const std::size_t k = static_cast<std::size_t>(i);
   return ballbar_residual<T>(L, d.machine, fx, p, pivot, d.xyz.col(i), d.angles[k], d.time[i],
                              d.motion.empty() ? RotaryMotion{} : d.motion[k], d.length[i]);
@@ -65,6 +67,7 @@ struct BallbarFitSetup {
 BallbarFitSetup ballbar_fit_setup(const BallbarArrays& data, const JointFitOptions& options);
 
 /// The machine model at a solution `x` of a fit with `setup` (pivot: the first).
-BallbarMachineModel ballbar_model_at(const BallbarFitSetup& setup, MachineType m, const Eigen::VectorXd& x);
+BallbarMachineModel ballbar_model_at(const BallbarFitSetup& setup, MachineType m,
+                                     const Eigen::VectorXd& x);
 
 }  // namespace rotacal

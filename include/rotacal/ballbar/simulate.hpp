@@ -10,9 +10,9 @@
 namespace rotacal {
 
 struct BallbarSimulationOptions {
-  double noise_um = 0.5;       ///< 1-sigma Gaussian noise of one reading, um
-  std::uint64_t seed = 1;      ///< random seed (same seed, same file)
-  bool declare_noise = true;   ///< write `# noise_um:` into the session
+  double noise_um = 0.5;      ///< 1-sigma Gaussian noise of one reading, um
+  std::uint64_t seed = 1;     ///< random seed (same seed, same file)
+  bool declare_noise = true;  ///< write `# noise_um:` into the session
 };
 
 /// Fill in `length` of every sample of `commanded` (test labels, time, X,Y,Z, rotary angles;

@@ -24,8 +24,8 @@
 #include <vector>
 
 #include "rotacal/io/nc_dialect.hpp"
-#include "rotacal/session/session.hpp"
 #include "rotacal/kinematics/machine.hpp"
+#include "rotacal/session/session.hpp"
 
 namespace rotacal {
 

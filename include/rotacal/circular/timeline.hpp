@@ -24,10 +24,10 @@ class CircularTimeline {
  public:
   /// Where the program is at a time.
   struct Position {
-    std::size_t run = 0;  ///< the run being driven, or the next one (transitions)
-    bool on_run = false;  ///< on the run's circle at its feed (run-in, data arc or overshoot)
-    bool on_data = false;  ///< on its data arc
-    bool moving = false;   ///< the axes move (a run, or a move along the circle between runs)
+    std::size_t run = 0;     ///< the run being driven, or the next one (transitions)
+    bool on_run = false;     ///< on the run's circle at its feed (run-in, data arc or overshoot)
+    bool on_data = false;    ///< on its data arc
+    bool moving = false;     ///< the axes move (a run, or a move along the circle between runs)
     double angle_deg = 0.0;  ///< commanded path angle in the run's plane
   };
 

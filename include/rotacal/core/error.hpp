@@ -61,9 +61,9 @@ class IoError : public Error {
 }  // namespace rotacal
 
 /// Internal invariant check: a failure is a bug in rotacal, not bad input.
-#define ROTACAL_ASSERT(cond)                                                            \
-  do {                                                                                  \
-    if (!(cond))                                                                        \
-      throw ::rotacal::Error(std::string("internal error: ") + #cond + " at " + __FILE__ + \
-                             ":" + std::to_string(__LINE__));                           \
+#define ROTACAL_ASSERT(cond)                                                                     \
+  do {                                                                                           \
+    if (!(cond))                                                                                 \
+      throw ::rotacal::Error(std::string("internal error: ") + #cond + " at " + __FILE__ + ":" + \
+                             std::to_string(__LINE__));                                          \
   } while (0)

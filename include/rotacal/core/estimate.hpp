@@ -21,17 +21,17 @@ struct ParameterEstimate {
 /// How a least-squares solve went (core/joint_fit.hpp).
 struct FitSummary {
   bool converged = false;
-  int iterations = 0;            ///< accepted steps
+  int iterations = 0;  ///< accepted steps
   int jacobian_evaluations = 0;
   int residual_evaluations = 0;
   std::size_t num_residuals = 0;
-  int num_free = 0;              ///< parameters estimated (not held)
+  int num_free = 0;  ///< parameters estimated (not held)
   /// Sum of squared weighted residuals: in units of the declared sigma without a whitener,
   /// of the whitened residuals (units of their own sigma) with one.
   double chi2 = 0.0;
-  double chi2_per_dof = 0.0;     ///< chi2 / (num_residuals - num_free)
-  bool whitened = false;         ///< a ResidualWhitener was applied (GLS)
-  std::string message;           ///< why the solver stopped, in words
+  double chi2_per_dof = 0.0;  ///< chi2 / (num_residuals - num_free)
+  bool whitened = false;      ///< a ResidualWhitener was applied (GLS)
+  std::string message;        ///< why the solver stopped, in words
 };
 
 }  // namespace rotacal

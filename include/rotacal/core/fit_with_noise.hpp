@@ -34,11 +34,11 @@ struct NoiseFitOptions {
 };
 
 struct NoiseFit {
-  JointFitOutcome fit;   ///< the white fit, or the GLS refit when `refit`
-  NoiseModel noise;      ///< noise model of the white fit's residuals (empty: not estimated)
-  bool refit = false;    ///< the fit was redone by GLS under `noise`
-  bool reml = false;     ///< `noise` is REML's AR(1) + random walk
-  double scale = 1.0;    ///< bias factor applied to the GLS covariance
+  JointFitOutcome fit;  ///< the white fit, or the GLS refit when `refit`
+  NoiseModel noise;     ///< noise model of the white fit's residuals (empty: not estimated)
+  bool refit = false;   ///< the fit was redone by GLS under `noise`
+  bool reml = false;    ///< `noise` is REML's AR(1) + random walk
+  double scale = 1.0;   ///< bias factor applied to the GLS covariance
 };
 
 /// `solve(settings)` runs the instrument's fit. With settings.whitener set (the caller's own

@@ -82,19 +82,19 @@ struct JointFitSettings {
 };
 
 struct JointFitOutcome {
-  Eigen::VectorXd values;                      ///< solution, in parameter order
-  std::vector<ParameterEstimate> estimates;    ///< one per parameter, in order
-  Eigen::MatrixXd covariance;                  ///< 1 sigma^2, zero rows/cols for fixed ones
-  Eigen::VectorXd residuals;                   ///< measured - model at the solution
-  Eigen::MatrixXd jacobian;                    ///< d model / d parameter at the solution
-                                               ///< (unweighted, measurement units)
-  std::vector<bool> free;                      ///< per parameter: estimated (not held or fixed)
-  Observability observability;                 ///< at the start point
+  Eigen::VectorXd values;                    ///< solution, in parameter order
+  std::vector<ParameterEstimate> estimates;  ///< one per parameter, in order
+  Eigen::MatrixXd covariance;                ///< 1 sigma^2, zero rows/cols for fixed ones
+  Eigen::VectorXd residuals;                 ///< measured - model at the solution
+  Eigen::MatrixXd jacobian;                  ///< d model / d parameter at the solution
+                                             ///< (unweighted, measurement units)
+  std::vector<bool> free;                    ///< per parameter: estimated (not held or fixed)
+  Observability observability;               ///< at the start point
   /// x_reported = convention * x_solved (p x p; empty: none): the yield convention of the
   /// parameters with FitParameter::yields. A refit of the same model applies it too.
   Eigen::MatrixXd convention;
-  std::vector<std::string> unobservable;       ///< null directions in words
-  double residual_variance = 0.0;              ///< s^2 used for the covariance (1 when whitened)
+  std::vector<std::string> unobservable;  ///< null directions in words
+  double residual_variance = 0.0;         ///< s^2 used for the covariance (1 when whitened)
   FitSummary summary;
 };
 
@@ -132,8 +132,8 @@ class JointRefitter {
   std::vector<Eigen::Index> idx_;  // free parameters
   Eigen::MatrixXd Jw_free_;        // weighted Jacobian of the free parameters
   Eigen::LDLT<Eigen::MatrixXd> ldlt_;
-  Eigen::VectorXd sigma_;          // 1 sigma of each free parameter (chi2 units)
-  Eigen::MatrixXd convention_;     // the reference's yield convention (empty: none)
+  Eigen::VectorXd sigma_;       // 1 sigma of each free parameter (chi2 units)
+  Eigen::MatrixXd convention_;  // the reference's yield convention (empty: none)
 };
 
 // ------------------------------------------------------------------ Jets over batches
@@ -185,10 +185,14 @@ void evaluate_with_jets(const F& f, Eigen::Index n_items, int rows, const Eigen:
   for (int c0 = 0; c0 < std::max(p, 1); c0 += 16) {
     double* rr = c0 == 0 ? r.data() : nullptr;
     const int left = p - c0;
-    if (left <= 4) detail::jet_pass<4>(f, n_items, rows, x, c0, rr, *J);
-    else if (left <= 8) detail::jet_pass<8>(f, n_items, rows, x, c0, rr, *J);
-    else if (left <= 12) detail::jet_pass<12>(f, n_items, rows, x, c0, rr, *J);
-    else detail::jet_pass<16>(f, n_items, rows, x, c0, rr, *J);
+    if (left <= 4)
+      detail::jet_pass<4>(f, n_items, rows, x, c0, rr, *J);
+    else if (left <= 8)
+      detail::jet_pass<8>(f, n_items, rows, x, c0, rr, *J);
+    else if (left <= 12)
+      detail::jet_pass<12>(f, n_items, rows, x, c0, rr, *J);
+    else
+      detail::jet_pass<16>(f, n_items, rows, x, c0, rr, *J);
   }
 }
 

@@ -16,9 +16,8 @@
 /// memory and names the line and column.
 
 #include <cstddef>
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 namespace rotacal {
 

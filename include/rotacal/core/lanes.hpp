@@ -24,10 +24,22 @@ struct Lanes {
   double operator[](int lane) const { return v[lane]; }
   double& operator[](int lane) { return v[lane]; }
 
-  Lanes& operator+=(const Lanes& o) { v += o.v; return *this; }
-  Lanes& operator-=(const Lanes& o) { v -= o.v; return *this; }
-  Lanes& operator*=(const Lanes& o) { v *= o.v; return *this; }
-  Lanes& operator/=(const Lanes& o) { v /= o.v; return *this; }
+  Lanes& operator+=(const Lanes& o) {
+    v += o.v;
+    return *this;
+  }
+  Lanes& operator-=(const Lanes& o) {
+    v -= o.v;
+    return *this;
+  }
+  Lanes& operator*=(const Lanes& o) {
+    v *= o.v;
+    return *this;
+  }
+  Lanes& operator/=(const Lanes& o) {
+    v /= o.v;
+    return *this;
+  }
 };
 
 inline Lanes operator+(const Lanes& a, const Lanes& b) { return Lanes(Eigen::Array4d(a.v + b.v)); }

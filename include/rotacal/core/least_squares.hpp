@@ -27,7 +27,7 @@ struct Observability {
   /// Directions in parameter space (original units); direction k moves to_fix[k] and no other
   /// held parameter.
   std::vector<Eigen::VectorXd> null_space;
-  Eigen::VectorXd singular_values;          ///< of J*diag(scales), descending
+  Eigen::VectorXd singular_values;  ///< of J*diag(scales), descending
   /// Parameters to hold fixed so that the rest is determined: one per null direction, all
   /// distinct, chosen by largest remaining (scaled) share in the null space (pivoted QR).
   std::vector<int> to_fix;
@@ -40,7 +40,8 @@ Observability analyse_observability(const Eigen::MatrixXd& J, const Eigen::Vecto
 /// The same from the normal matrix J^T J (p x p), so that a fit over 10^6 residuals need not
 /// copy its Jacobian: the singular values of J*diag(scales) are the square roots of the
 /// eigenvalues of diag(scales) J^T J diag(scales).
-Observability analyse_observability_normal(const Eigen::MatrixXd& JtJ, const Eigen::VectorXd& scales,
+Observability analyse_observability_normal(const Eigen::MatrixXd& JtJ,
+                                           const Eigen::VectorXd& scales,
                                            double min_chi2_change = 1.0);
 
 /// Plausible magnitude of a parameter by its unit, for analyse_observability: 1 mm, 1 mrad,

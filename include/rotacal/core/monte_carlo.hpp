@@ -4,12 +4,11 @@
 /// model's AR streams, or white Gaussian noise) and the comparison of the draws' spread with
 /// the reported 1-sigma (GUM Supplement 1 style).
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "rotacal/core/estimate.hpp"
 #include "rotacal/core/noise_model.hpp"
@@ -20,9 +19,9 @@ struct MonteCarloParameter {
   std::string name;
   std::string unit;
   double std_reported = 0.0;
-  double std_mc = 0.0;   ///< sample standard deviation over the draws
-  double ratio = 0.0;    ///< std_mc / std_reported (near 1: the reported sigma is right)
-  double bias = 0.0;     ///< mean over the draws - identified value
+  double std_mc = 0.0;  ///< sample standard deviation over the draws
+  double ratio = 0.0;   ///< std_mc / std_reported (near 1: the reported sigma is right)
+  double bias = 0.0;    ///< mean over the draws - identified value
 };
 
 /// The noise (mm) of draw k, seeded with std::mt19937_64(seed + k): AR draws per stream from

@@ -38,7 +38,8 @@ namespace rotacal {
 /// the re-estimated ones (summed over streams by size), at least 1. Throws InvalidArgument
 /// if the sizes differ.
 double noise_model_bias_factor(const NoiseModel& model, const std::vector<std::string>& groups,
-                               const std::vector<double>& times, const Eigen::MatrixXd& jacobian_free,
+                               const std::vector<double>& times,
+                               const Eigen::MatrixXd& jacobian_free,
                                const NoiseModelOptions& options, int draws = 32,
                                std::uint64_t seed = 1);
 
@@ -83,7 +84,8 @@ inline Eigen::MatrixXd free_jacobian(const JointFitOutcome& fit) {
   for (std::size_t j = 0; j < fit.free.size(); ++j)
     if (fit.free[j]) cols.push_back(static_cast<Eigen::Index>(j));
   Eigen::MatrixXd J(fit.jacobian.rows(), static_cast<Eigen::Index>(cols.size()));
-  for (std::size_t k = 0; k < cols.size(); ++k) J.col(static_cast<Eigen::Index>(k)) = fit.jacobian.col(cols[k]);
+  for (std::size_t k = 0; k < cols.size(); ++k)
+    J.col(static_cast<Eigen::Index>(k)) = fit.jacobian.col(cols[k]);
   return J;
 }
 

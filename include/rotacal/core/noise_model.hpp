@@ -118,7 +118,8 @@ struct NoiseStreamLayout {
 
 /// estimate_noise_model on a layout built once. Throws InvalidArgument if `residuals_mm` does not
 /// hold layout.n values, one is not finite, or max_order < 0.
-NoiseModel estimate_noise_model(const NoiseStreamLayout& layout, const Eigen::VectorXd& residuals_mm,
+NoiseModel estimate_noise_model(const NoiseStreamLayout& layout,
+                                const Eigen::VectorXd& residuals_mm,
                                 const NoiseModelOptions& options = {});
 
 /// `model` with the lag-1 coefficient of every AR(1) stream corrected for the bias that removing
@@ -208,8 +209,8 @@ class ArWhitener : public ResidualWhitener {
     std::vector<Eigen::Index> rows;
     std::vector<std::vector<double>> phi;  ///< phi[m]: coefficients of order m = 0..p
     std::vector<double> inv_sd;            ///< 1 / sqrt(v_m) in column units
-    Eigen::MatrixXd chol;                  ///< random walk, AR order >= 2: lower Cholesky factor, column units
-    std::vector<ArWalkFilter> walk;        ///< random walk, AR order 0 or 1 (one filter or none)
+    Eigen::MatrixXd chol;  ///< random walk, AR order >= 2: lower Cholesky factor, column units
+    std::vector<ArWalkFilter> walk;  ///< random walk, AR order 0 or 1 (one filter or none)
   };
   std::vector<Stream> streams_;
   std::size_t n_ = 0;
@@ -240,9 +241,8 @@ Eigen::VectorXd probe_zero_wander(const std::vector<std::string>& groups,
 }  // namespace noise_gen
 
 /// The streams of readings (group, channel) in time order, as the noise model splits them.
-std::vector<std::vector<Eigen::Index>> noise_streams(const std::vector<std::string>& groups,
-                                                     const std::vector<double>& times,
-                                                     std::vector<std::string>* stream_group = nullptr,
-                                                     std::vector<int>* stream_channel = nullptr);
+std::vector<std::vector<Eigen::Index>> noise_streams(
+    const std::vector<std::string>& groups, const std::vector<double>& times,
+    std::vector<std::string>* stream_group = nullptr, std::vector<int>* stream_channel = nullptr);
 
 }  // namespace rotacal

@@ -25,12 +25,12 @@ namespace rotacal {
 
 /// One block of a parameter vector: where it lies, and what its parameters are called.
 struct ParameterBlock {
-  std::string name;                    ///< block name ("location_errors", "pivot", ...)
-  Eigen::Index offset = 0;             ///< first index in the parameter vector
-  Eigen::Index size = 0;               ///< number of parameters (0: the block is absent)
-  Eigen::Index item_size = 1;          ///< parameters per item (3 for zeros per nest)
-  std::vector<std::string> names;      ///< parameter names, `size` of them
-  std::vector<std::string> units;      ///< their units ("mm", "rad", "1", ...), `size` of them
+  std::string name;                ///< block name ("location_errors", "pivot", ...)
+  Eigen::Index offset = 0;         ///< first index in the parameter vector
+  Eigen::Index size = 0;           ///< number of parameters (0: the block is absent)
+  Eigen::Index item_size = 1;      ///< parameters per item (3 for zeros per nest)
+  std::vector<std::string> names;  ///< parameter names, `size` of them
+  std::vector<std::string> units;  ///< their units ("mm", "rad", "1", ...), `size` of them
 
   bool empty() const { return size == 0; }
   /// One past the block's last index.
@@ -94,10 +94,12 @@ struct ParameterBlock {
     b.size = item_size;
     b.item_size = item_size;
     const auto first = static_cast<std::size_t>(k * item_size);
-    b.names.assign(names.begin() + static_cast<std::ptrdiff_t>(first),
-                   names.begin() + static_cast<std::ptrdiff_t>(first + static_cast<std::size_t>(item_size)));
-    b.units.assign(units.begin() + static_cast<std::ptrdiff_t>(first),
-                   units.begin() + static_cast<std::ptrdiff_t>(first + static_cast<std::size_t>(item_size)));
+    b.names.assign(
+        names.begin() + static_cast<std::ptrdiff_t>(first),
+        names.begin() + static_cast<std::ptrdiff_t>(first + static_cast<std::size_t>(item_size)));
+    b.units.assign(
+        units.begin() + static_cast<std::ptrdiff_t>(first),
+        units.begin() + static_cast<std::ptrdiff_t>(first + static_cast<std::size_t>(item_size)));
     return b;
   }
   /// Parameters [first, first + count) of this block (first counted from the block's start) as
@@ -105,8 +107,8 @@ struct ParameterBlock {
   /// Throws InvalidArgument when they are not inside the block.
   ParameterBlock part(Eigen::Index first, Eigen::Index count, const std::string& part_name) const {
     if (first < 0 || count < 0 || first + count > size)
-      throw InvalidArgument("parameter block " + name + ": parameters " + std::to_string(first) + ".." +
-                            std::to_string(first + count) + " of " + std::to_string(size));
+      throw InvalidArgument("parameter block " + name + ": parameters " + std::to_string(first) +
+                            ".." + std::to_string(first + count) + " of " + std::to_string(size));
     ParameterBlock b;
     b.name = part_name;
     b.offset = offset + first;
@@ -137,7 +139,7 @@ class ParameterLayout {
   /// grows at its end). Throws InvalidArgument for a repeated block
   /// name, a units list of another length, or an item size that does not divide the size.
   ParameterBlock add(const std::string& name, std::vector<std::string> names,
-                            std::vector<std::string> units, Eigen::Index item_size = 1) {
+                     std::vector<std::string> units, Eigen::Index item_size = 1) {
     for (const ParameterBlock& b : blocks_)
       if (b.name == name) throw InvalidArgument("parameter layout: block " + name + " added twice");
     const Eigen::Index n = static_cast<Eigen::Index>(names.size());
@@ -164,7 +166,8 @@ class ParameterLayout {
     if (size < 0) throw InvalidArgument("parameter layout: block " + name + " of negative size");
     std::vector<std::string> names;
     for (Eigen::Index k = 0; k < size; ++k) names.push_back(name + "[" + std::to_string(k) + "]");
-    return add(name, std::move(names), std::vector<std::string>(static_cast<std::size_t>(size), unit));
+    return add(name, std::move(names),
+               std::vector<std::string>(static_cast<std::size_t>(size), unit));
   }
 
   /// Total number of parameters.

@@ -1,8 +1,9 @@
 #pragma once
 /// \file
 /// Tail probabilities for the model-adequacy and model-comparison tests of the diagnosis:
-/// chi-square and Fisher F; the Student-t coverage factor of an uncertainty budget. (Eigen and Ceres have none; these are the textbook continued
-/// fraction and series of the regularised incomplete gamma and beta functions.)
+/// chi-square and Fisher F; the Student-t coverage factor of an uncertainty budget. (Eigen and
+/// Ceres have none; these are the textbook continued fraction and series of the regularised
+/// incomplete gamma and beta functions.)
 
 namespace rotacal::stats {
 

@@ -14,7 +14,8 @@ namespace rotacal {
 /// the amplitude biased where the session's differs). Such a fit runs twice: with the time
 /// constants held, then from that solution with them free. Without time constants, one
 /// solve_joint.
-JointFitOutcome solve_with_time_constants(const ResidualModel& model, std::vector<FitParameter> params,
+JointFitOutcome solve_with_time_constants(const ResidualModel& model,
+                                          std::vector<FitParameter> params,
                                           const JointFitSettings& settings);
 
 }  // namespace rotacal

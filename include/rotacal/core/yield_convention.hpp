@@ -25,9 +25,10 @@ namespace rotacal {
 /// (in scaled units, over an orthonormal basis of the null space split by the SVD of the
 /// yielding part) are at least 0.3 of it. A null
 /// direction within the yielding parameters alone (a component of an effect the instrument
-/// cannot see) is not a trade-off and stays unobservable. `observable` (in: Observability::observable) is updated: a parameter is
-/// observable when it takes no part (share <= 0.05) in the null directions left unresolved.
-/// Returns an empty matrix when no null direction moves a yielding parameter.
+/// cannot see) is not a trade-off and stays unobservable. `observable` (in:
+/// Observability::observable) is updated: a parameter is observable when it takes no part (share <=
+/// 0.05) in the null directions left unresolved. Returns an empty matrix when no null direction
+/// moves a yielding parameter.
 Eigen::MatrixXd yield_convention(const Observability& o, const std::vector<bool>& yields,
                                  const Eigen::VectorXd& scales, std::vector<bool>* observable);
 

@@ -30,32 +30,36 @@ namespace rotacal {
 
 /// Candidates, the budget and the target of an allocation.
 struct AllocationProblem {
-  std::vector<Eigen::MatrixXd> candidates;  ///< information of one run of each candidate, p x p (fit units)
-  int runs = 0;                             ///< total runs to allocate
-  ParameterBlock target;                    ///< the parameters whose largest expanded uncertainty counts
-  Eigen::VectorXd scale;    ///< per target parameter: expanded uncertainty per unit of sigma (e.g. 2 x 1e3 um/mm)
+  std::vector<Eigen::MatrixXd>
+      candidates;         ///< information of one run of each candidate, p x p (fit units)
+  int runs = 0;           ///< total runs to allocate
+  ParameterBlock target;  ///< the parameters whose largest expanded uncertainty counts
+  Eigen::VectorXd
+      scale;  ///< per target parameter: expanded uncertainty per unit of sigma (e.g. 2 x 1e3 um/mm)
   Eigen::VectorXd plausible;  ///< per parameter of the layout, as invert_information takes them
   double white = 1.0;         ///< as invert_information takes it
 };
 
 /// The largest expanded uncertainty of a design.
 struct DesignUncertainty {
-  double worst = std::numeric_limits<double>::infinity();  ///< max over the target of scale_j sigma_j
-  Eigen::Index worst_index = -1;                           ///< its layout index
-  bool feasible = false;  ///< every parameter of `required` is determined
+  double worst =
+      std::numeric_limits<double>::infinity();  ///< max over the target of scale_j sigma_j
+  Eigen::Index worst_index = -1;                ///< its layout index
+  bool feasible = false;                        ///< every parameter of `required` is determined
 };
 
 /// scale_j sigma_j over the target's determined parameters, and whether every target parameter
 /// marked in `required` (target order) is determined.
-DesignUncertainty design_uncertainty(const Inverted& inv, const ParameterBlock& target, const Eigen::VectorXd& scale,
+DesignUncertainty design_uncertainty(const Inverted& inv, const ParameterBlock& target,
+                                     const Eigen::VectorXd& scale,
                                      const std::vector<bool>& required);
 
 /// The engine's answer.
 struct Allocation {
-  std::vector<int> counts;          ///< runs of each candidate, summing to problem.runs
-  Inverted inverted;                ///< of sum counts_k A_k
-  DesignUncertainty uncertainty;    ///< of it
-  std::vector<bool> determinable;   ///< per target parameter: determined by all candidates together
+  std::vector<int> counts;         ///< runs of each candidate, summing to problem.runs
+  Inverted inverted;               ///< of sum counts_k A_k
+  DesignUncertainty uncertainty;   ///< of it
+  std::vector<bool> determinable;  ///< per target parameter: determined by all candidates together
 };
 
 /// Allocate the runs. A target parameter that no combination of candidates determines is left

@@ -33,7 +33,8 @@ struct Inverted {
   std::vector<bool> determined;
   Eigen::VectorXd sigma;  ///< infinite for held parameters
 };
-Inverted invert_information(const Eigen::MatrixXd& I, const Eigen::VectorXd& plausible, double white);
+Inverted invert_information(const Eigen::MatrixXd& I, const Eigen::VectorXd& plausible,
+                            double white);
 
 /// Largest canonical correlation between the determined parameters of block a and those of
 /// block b (1 when either block has none).
@@ -51,7 +52,8 @@ struct SeparationResult {
   /// Parameters of the joint fit: the session's, then the added measurement's own (absent
   /// from sigma_before).
   std::vector<std::string> names;
-  Eigen::VectorXd sigma_before;     ///< session alone, 1 sigma, fit units; infinite: held (undetermined)
+  Eigen::VectorXd
+      sigma_before;  ///< session alone, 1 sigma, fit units; infinite: held (undetermined)
   Eigen::VectorXd sigma_after;      ///< session + the chosen candidate
   double correlation_before = 1.0;  ///< largest canonical correlation of the pair (1: undetermined)
   bool already_separated = false;   ///< the session alone is below max_correlation: nothing to add
@@ -84,9 +86,10 @@ double session_weight(double noise_um_option, const NoiseModel& noise, double fi
 /// The problem of a session whose nominal Jacobian Js (session layout: the first columns of
 /// `joint`) is weighted by w: plausible magnitudes by the units of `joint` (1 mm, 1 mrad, ...,
 /// as the fit's observability test uses them), and D's effective samples per reading.
-SeparationProblem separation_problem(const Eigen::MatrixXd& Js, double w, const ParameterLayout& joint,
-                                     const ParameterBlock& first, const ParameterBlock& second,
-                                     double max_correlation, double max_added_time_s, const SeparationResult& D);
+SeparationProblem separation_problem(const Eigen::MatrixXd& Js, double w,
+                                     const ParameterLayout& joint, const ParameterBlock& first,
+                                     const ParameterBlock& second, double max_correlation,
+                                     double max_added_time_s, const SeparationResult& D);
 
 /// One added measurement, in the joint layout (p >= p0 parameters; the session's first).
 struct AddedInformation {
@@ -99,8 +102,8 @@ struct AddedInformation {
 struct SeparationChoice {
   static constexpr std::size_t none = std::numeric_limits<std::size_t>::max();
   std::size_t index = none;
-  bool found = false;      ///< below max_correlation
-  double repeats = 1.0;    ///< runs (or slow-down factor)
+  bool found = false;    ///< below max_correlation
+  double repeats = 1.0;  ///< runs (or slow-down factor)
   double correlation = 1.0;
   bool determined = false;  ///< every parameter of both effects is determined
   Eigen::VectorXd sigma_after;
@@ -112,20 +115,22 @@ struct SeparationChoice {
 bool separation_needed(const SeparationProblem& S, SeparationResult& D);
 
 /// The search over `added` (in order; ties keep the first).
-SeparationChoice search_separation(const SeparationProblem& S, const std::vector<AddedInformation>& added);
+SeparationChoice search_separation(const SeparationProblem& S,
+                                   const std::vector<AddedInformation>& added);
 
 /// How the verdict names the instrument's candidates.
 struct SeparationWording {
-  std::string added = "added tests";             ///< "none of N <added> within ..."
-  std::string seen_by = " of these tests";       ///< "no reading<seen_by> sees them"
+  std::string added = "added tests";        ///< "none of N <added> within ..."
+  std::string seen_by = " of these tests";  ///< "no reading<seen_by> sees them"
   std::string closest_note = ": a longer test or another instrument may";
 };
 
 /// Fills found, sigma_after, the added measurement's parameter names and the verdict from the
 /// search's choice and the chosen candidate's description (`run_s`: its run time, repeats
 /// included; `added_names`: the chosen candidate's own parameters, appended to D.names).
-void finish_separation(const SeparationProblem& S, const SeparationChoice& c, const std::string& description,
-                       double run_s, const std::vector<std::string>& added_names, const SeparationWording& w,
+void finish_separation(const SeparationProblem& S, const SeparationChoice& c,
+                       const std::string& description, double run_s,
+                       const std::vector<std::string>& added_names, const SeparationWording& w,
                        SeparationResult& D);
 
 }  // namespace rotacal

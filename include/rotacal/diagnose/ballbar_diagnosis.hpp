@@ -29,13 +29,16 @@ class BallbarDiagnosisProblem : public DiagnosisProblem {
   const std::vector<double>& times() const override { return times_; }
   const std::vector<RotaryAngles<double>>& angles() const override { return arrays_.angles; }
   std::optional<double> declared_noise_um() const override { return session_.noise_um; }
-  Eigen::Vector3d mean_commanded_xyz() const override { return rotacal::mean_commanded_xyz(session_.samples); }
+  Eigen::Vector3d mean_commanded_xyz() const override {
+    return rotacal::mean_commanded_xyz(session_.samples);
+  }
   std::vector<Effect> candidates(int max_harmonic) const override;
   ModelFit fit(const EffectModel& effects) const override { return fit_gls(effects, whitener); }
-  ModelFit fit_gls(const EffectModel& effects, std::shared_ptr<const ResidualWhitener> noise) const override;
+  ModelFit fit_gls(const EffectModel& effects,
+                   std::shared_ptr<const ResidualWhitener> noise) const override;
   Eigen::MatrixXd candidate_jacobian(const ModelFit& at, const Effect& candidate) const override;
-  std::vector<Eigen::MatrixXd> candidate_jacobians(const ModelFit& at,
-                                                   const std::vector<Effect>& candidates) const override;
+  std::vector<Eigen::MatrixXd> candidate_jacobians(
+      const ModelFit& at, const std::vector<Effect>& candidates) const override;
   /// The candidate's Jacobian by Jets of all its parameters, without the harmonic shortcut
   /// (tests compare the two).
   Eigen::MatrixXd candidate_jacobian_by_jets(const ModelFit& at, const Effect& candidate) const;

@@ -26,9 +26,9 @@
 ///     data as well as the chosen one are reported ambiguous; significant structure that is
 ///     left is reported unexplained with its signature.
 
-#include <optional>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -66,13 +66,14 @@ class DiagnosisProblem {
   virtual ModelFit fit(const EffectModel& effects) const = 0;
   /// The same fit by GLS under `noise` (one residual per scalar reading, in reading order):
   /// the final model's numbers when the noise is correlated.
-  virtual ModelFit fit_gls(const EffectModel& effects, std::shared_ptr<const ResidualWhitener> noise) const = 0;
+  virtual ModelFit fit_gls(const EffectModel& effects,
+                           std::shared_ptr<const ResidualWhitener> noise) const = 0;
   /// d model / d (parameters of `candidate`) at `at`, one row per reading.
   virtual Eigen::MatrixXd candidate_jacobian(const ModelFit& at, const Effect& candidate) const = 0;
   /// candidate_jacobian of each of `candidates`, in order; an instrument may share work
   /// between them (the ballbar: one evaluation per harmonic kind and axis).
-  virtual std::vector<Eigen::MatrixXd> candidate_jacobians(const ModelFit& at,
-                                                           const std::vector<Effect>& candidates) const {
+  virtual std::vector<Eigen::MatrixXd> candidate_jacobians(
+      const ModelFit& at, const std::vector<Effect>& candidates) const {
     std::vector<Eigen::MatrixXd> out;
     out.reserve(candidates.size());
     for (const Effect& c : candidates) out.push_back(candidate_jacobian(at, c));
@@ -180,14 +181,14 @@ struct GroupResidual {
   std::size_t n = 0;
   double rms_um = 0.0;
   double mean_um = 0.0;
-  char angle_axis = 0;                 ///< the rotary axis that varies in the group (0: none)
-  std::vector<double> harmonic_um;     ///< amplitude of orders 1..K in that angle, um: only
-                                       ///< when it sweeps a full turn, and only the orders its
-                                       ///< sampling resolves (K <= 8; empty otherwise)
-  std::vector<int> harmonics_left_out; ///< orders K+1..8 not fitted: the sampling cannot
-                                       ///< resolve them (no amplitude is given for them)
-  std::string harmonic_note;           ///< why harmonics were left out, in words (empty if none)
-  double trend_um_per_s = 0.0;         ///< least-squares slope against time
+  char angle_axis = 0;                  ///< the rotary axis that varies in the group (0: none)
+  std::vector<double> harmonic_um;      ///< amplitude of orders 1..K in that angle, um: only
+                                        ///< when it sweeps a full turn, and only the orders its
+                                        ///< sampling resolves (K <= 8; empty otherwise)
+  std::vector<int> harmonics_left_out;  ///< orders K+1..8 not fitted: the sampling cannot
+                                        ///< resolve them (no amplitude is given for them)
+  std::string harmonic_note;            ///< why harmonics were left out, in words (empty if none)
+  double trend_um_per_s = 0.0;          ///< least-squares slope against time
 };
 
 struct Gain {
@@ -213,7 +214,7 @@ struct Alternative {
 };
 
 struct Finding {
-  Effect effect;             ///< the best of its group (the one the model is extended with)
+  Effect effect;  ///< the best of its group (the one the model is extended with)
   std::string cause;
   /// Posterior weight of `effect` among itself and its rivals (DiagnosisOptions::min_weight:
   /// the smaller of its BIC and AIC weights); below DiagnosisOptions::min_weight
@@ -265,8 +266,8 @@ struct Unexplained {
   /// Where (coloured noise: the group whose structure test fails; white: the group with the
   /// largest residual), and the range of its swept angle where the residual is largest.
   std::string group;
-  char axis = 0;                 ///< swept rotary axis of that group (0: none; range in time)
-  double range_from = 0.0;       ///< deg (or s when axis == 0)
+  char axis = 0;            ///< swept rotary axis of that group (0: none; range in time)
+  double range_from = 0.0;  ///< deg (or s when axis == 0)
   double range_to = 0.0;
 };
 
@@ -310,7 +311,7 @@ struct Diagnosis {
     double noise_um = 0.0;
     std::string noise_source;  ///< "declared" or "estimated from successive differences"
     double chi2_per_dof = 0.0;
-    double p_value = 1.0;      ///< P(chi2 >= observed) if the baseline were adequate
+    double p_value = 1.0;  ///< P(chi2 >= observed) if the baseline were adequate
     std::size_t n = 0;
     int dof = 0;
   } baseline;

@@ -24,7 +24,9 @@ class ProbeDiagnosisProblem : public DiagnosisProblem {
   const std::vector<double>& times() const override { return times_; }
   const std::vector<RotaryAngles<double>>& angles() const override { return angles_; }
   std::optional<double> declared_noise_um() const override { return session_.noise_um; }
-  Eigen::Vector3d mean_commanded_xyz() const override { return rotacal::mean_commanded_xyz(session_.samples); }
+  Eigen::Vector3d mean_commanded_xyz() const override {
+    return rotacal::mean_commanded_xyz(session_.samples);
+  }
   /// probe_effect_catalogue without the ballbar's own entries, the effects of motion (the
   /// touches are at rest) and, on a head, tool_offset_Z (in the baseline).
   std::vector<Effect> candidates(int max_harmonic) const override;
@@ -32,7 +34,8 @@ class ProbeDiagnosisProblem : public DiagnosisProblem {
   /// 0.43 +- 0.09 for a true 0.5, and the low sessions took the noise's slow part for an effect.
   double correlation_bound_z() const override;
   ModelFit fit(const EffectModel& effects) const override { return fit_gls(effects, whitener); }
-  ModelFit fit_gls(const EffectModel& effects, std::shared_ptr<const ResidualWhitener> noise) const override;
+  ModelFit fit_gls(const EffectModel& effects,
+                   std::shared_ptr<const ResidualWhitener> noise) const override;
   /// Jets of the probe problem with the candidate appended at 0, the fit's values elsewhere.
   Eigen::MatrixXd candidate_jacobian(const ModelFit& at, const Effect& candidate) const override;
 

@@ -20,7 +20,8 @@ namespace rotacal {
 /// present: convert raw readings first, as the identification did). Throws InvalidArgument if
 /// coverage is not in (0, 1), a size is negative, an override names no candidate of this
 /// session, or the identification is not of this session.
-UncertaintyBudget uncertainty_budget(const RtestSession& session, const RtestJointIdentification& identification,
+UncertaintyBudget uncertainty_budget(const RtestSession& session,
+                                     const RtestJointIdentification& identification,
                                      const PlausibleSizes& sizes = {}, double coverage = 0.95,
                                      int max_harmonic = 4);
 

@@ -1,7 +1,8 @@
 #pragma once
 /// \file
 /// The diagnosis of an R-test session: the DiagnosisProblem for the exact R-test reading,
-///   d = T(B, C, t)^-1 * p_tool(xyz, t) - q_nest + zero_setup      (Oyama Eq. 4, in the table frame)
+///   d = T(B, C, t)^-1 * p_tool(xyz, t) - q_nest + zero_setup      (Oyama Eq. 4, in the table
+///   frame)
 /// with baseline = the 8 location errors (+ tool_offset_Z, minus the error of pivot_length +
 /// tool_length, on a machine with head axes) + an unknown probe zero per set-up, and the
 /// catalogue's effects (kinematics/effects.hpp) that exist on the machine as the candidate
@@ -30,15 +31,18 @@ class RtestDiagnosisProblem : public DiagnosisProblem {
   const std::vector<double>& times() const override { return times_; }
   const std::vector<RotaryAngles<double>>& angles() const override { return angles_; }
   std::optional<double> declared_noise_um() const override { return session_.noise_um; }
-  Eigen::Vector3d mean_commanded_xyz() const override { return rotacal::mean_commanded_xyz(session_.samples); }
+  Eigen::Vector3d mean_commanded_xyz() const override {
+    return rotacal::mean_commanded_xyz(session_.samples);
+  }
   /// The catalogue less the ballbar's own entries (and tool_offset_Z on a head machine, where
   /// it is in the baseline).
   std::vector<Effect> candidates(int max_harmonic) const override;
   ModelFit fit(const EffectModel& effects) const override { return fit_gls(effects, whitener); }
-  ModelFit fit_gls(const EffectModel& effects, std::shared_ptr<const ResidualWhitener> noise) const override;
+  ModelFit fit_gls(const EffectModel& effects,
+                   std::shared_ptr<const ResidualWhitener> noise) const override;
   Eigen::MatrixXd candidate_jacobian(const ModelFit& at, const Effect& candidate) const override;
-  std::vector<Eigen::MatrixXd> candidate_jacobians(const ModelFit& at,
-                                                   const std::vector<Effect>& candidates) const override;
+  std::vector<Eigen::MatrixXd> candidate_jacobians(
+      const ModelFit& at, const std::vector<Effect>& candidates) const override;
   /// The candidate's Jacobian by Jets of all its parameters, without the harmonic shortcut
   /// (tests compare the two).
   Eigen::MatrixXd candidate_jacobian_by_jets(const ModelFit& at, const Effect& candidate) const;

@@ -38,16 +38,16 @@ struct PlausibleSizes {
   double scale = 10e-6;                   ///< linear_scale_* (10 um/m)
   double angular_error_rad = 20e-6;       ///< angular_error_* (pitch over 100 mm of travel)
   double rotary_zero_rad = 20e-6;         ///< rotary_zero_offset_*
-  double angular_positioning_rad = 10e-6; ///< angular_positioning_*_hn
-  double error_motion_mm = 1e-3;          ///< radial/axial_motion_*_hn
-  double tilt_motion_rad = 10e-6;         ///< tilt_motion_*_hn
-  double gravity_sag_mm = 2e-3;           ///< gravity_sag_*
-  double coning = 20e-6;                  ///< coning_* (rad/rad)
-  double backlash_rad = 20e-6;            ///< backlash_* (lost motion of a rotary drive)
-  double servo_lag_s = 1e-3;              ///< servo_lag_* (gain mismatch of a few percent)
-  double reversal_spike_rad = 20e-6;      ///< reversal_spike_*: h
-  double stylus_radius_mm = 0.5e-3;       ///< stylus_radius_offset (stylus calibration)
-  double probe_lobing_mm = 0.5e-3;        ///< probe_lobing: lc, ls (after the probe's calibration)
+  double angular_positioning_rad = 10e-6;  ///< angular_positioning_*_hn
+  double error_motion_mm = 1e-3;           ///< radial/axial_motion_*_hn
+  double tilt_motion_rad = 10e-6;          ///< tilt_motion_*_hn
+  double gravity_sag_mm = 2e-3;            ///< gravity_sag_*
+  double coning = 20e-6;                   ///< coning_* (rad/rad)
+  double backlash_rad = 20e-6;             ///< backlash_* (lost motion of a rotary drive)
+  double servo_lag_s = 1e-3;               ///< servo_lag_* (gain mismatch of a few percent)
+  double reversal_spike_rad = 20e-6;       ///< reversal_spike_*: h
+  double stylus_radius_mm = 0.5e-3;        ///< stylus_radius_offset (stylus calibration)
+  double probe_lobing_mm = 0.5e-3;         ///< probe_lobing: lc, ls (after the probe's calibration)
   std::map<std::string, double> overrides;
   /// Use the session's bound where it is tighter than the default (false: defaults only).
   bool use_session_bounds = true;
@@ -56,10 +56,10 @@ struct PlausibleSizes {
 /// One left-out effect's contribution to one location error.
 struct BudgetLine {
   std::string effect;
-  std::string basis;          ///< "session bound" or "default plausible size"
-  double u = 0.0;             ///< standard uncertainty it contributes (location error's unit)
-  double bias_at_size = 0.0;  ///< largest |bias| at the half-width (a), before / sqrt 3
-  double dof = 0.0;           ///< infinity for default sizes
+  std::string basis;               ///< "session bound" or "default plausible size"
+  double u = 0.0;                  ///< standard uncertainty it contributes (location error's unit)
+  double bias_at_size = 0.0;       ///< largest |bias| at the half-width (a), before / sqrt 3
+  double dof = 0.0;                ///< infinity for default sizes
   std::vector<double> half_width;  ///< a of each of the effect's parameters (its units)
 };
 
@@ -68,8 +68,8 @@ struct LocationBudget {
   std::string unit;
   bool observable = true;  ///< false: no budget (the session cannot determine it)
   double value = 0.0;
-  double u_a = 0.0;    ///< type A, from the noise model
-  double dof_a = 0.0;  ///< effective samples - free parameters
+  double u_a = 0.0;                ///< type A, from the noise model
+  double dof_a = 0.0;              ///< effective samples - free parameters
   std::vector<BudgetLine> type_b;  ///< largest first
   double u_c = 0.0;                ///< combined standard uncertainty
   double nu_eff = 0.0;             ///< Welch-Satterthwaite (infinity when type B dominates)

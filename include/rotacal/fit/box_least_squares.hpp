@@ -11,14 +11,15 @@
 namespace rotacal {
 
 struct BoxLeastSquaresOptions {
-  int max_sweeps = 200;      ///< passes over every unknown
-  double tolerance = 1e-9;   ///< stop when no unknown moves by more than this fraction of its bound
+  int max_sweeps = 200;     ///< passes over every unknown
+  double tolerance = 1e-9;  ///< stop when no unknown moves by more than this fraction of its bound
 };
 
 /// The solution s (R.cols() values). A column with no weight on it (sum w r^2 = 0) stays at
 /// zero. Throws InvalidArgument for mismatched sizes, non-finite values, a negative weight or
 /// a negative bound.
-Eigen::VectorXd box_least_squares(const Eigen::MatrixXd& R, const Eigen::VectorXd& d, const Eigen::VectorXd& w,
-                                  const Eigen::VectorXd& bounds, const BoxLeastSquaresOptions& options = {});
+Eigen::VectorXd box_least_squares(const Eigen::MatrixXd& R, const Eigen::VectorXd& d,
+                                  const Eigen::VectorXd& w, const Eigen::VectorXd& bounds,
+                                  const BoxLeastSquaresOptions& options = {});
 
 }  // namespace rotacal

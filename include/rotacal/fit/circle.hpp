@@ -22,8 +22,8 @@ struct CircleFit {
 };
 
 struct CircleFitOptions {
-  double sigma = 0.0;       ///< known 1-sigma noise of the points (same units); 0: estimate
-  bool refine = false;      ///< polish the algebraic solution by orthogonal distances (Ceres)
+  double sigma = 0.0;   ///< known 1-sigma noise of the points (same units); 0: estimate
+  bool refine = false;  ///< polish the algebraic solution by orthogonal distances (Ceres)
   double min_sagitta_ratio = 3.0;  ///< refuse arcs whose sagitta is below this x the scatter
   /// What the points are, put before every error message (e.g. "s.csv: test radial_A"), so a
   /// refusal names the data rather than only the fit.
@@ -34,10 +34,12 @@ struct CircleFitOptions {
 /// vanishes to second order. Throws DegenerateGeometry for fewer than 3 points, collinear
 /// points or an arc too short to fit (sagitta below min_sagitta_ratio x the scatter), and
 /// InvalidArgument for non-finite input.
-CircleFit hyper_circle_fit(const Eigen::Ref<const Points2>& points, const CircleFitOptions& options = {});
+CircleFit hyper_circle_fit(const Eigen::Ref<const Points2>& points,
+                           const CircleFitOptions& options = {});
 
 /// Kasa fit: least squares of x^2 + y^2 + D x + E y + F = 0. Biased towards smaller radii on
 /// short noisy arcs; kept for comparison. Same errors as hyper_circle_fit.
-CircleFit kasa_circle_fit(const Eigen::Ref<const Points2>& points, const CircleFitOptions& options = {});
+CircleFit kasa_circle_fit(const Eigen::Ref<const Points2>& points,
+                          const CircleFitOptions& options = {});
 
 }  // namespace rotacal

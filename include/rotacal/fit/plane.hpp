@@ -13,7 +13,7 @@ namespace rotacal {
 
 struct PlaneFit {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< unit; sign: normal . hint >= 0
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();          ///< unit; sign: normal . hint >= 0
   Eigen::Vector3d singular_values = Eigen::Vector3d::Zero();  ///< descending
   /// 1-sigma^2 covariance of the normal (3x3, rank 2: it lies in the plane), first order:
   /// sigma^2 * sum_k v_k v_k^T / s_k^2 over the two in-plane singular directions.
@@ -26,7 +26,7 @@ struct PlaneFit {
 /// InvalidArgument for non-finite input or a zero hint. `sigma` 0: estimated from residuals.
 /// `context` (e.g. "s.csv: test axial_C") is put before every error message.
 PlaneFit svd_plane_fit(const Eigen::Ref<const Points3>& points,
-                       const Eigen::Vector3d& normal_hint = Eigen::Vector3d::UnitZ(), double sigma = 0.0,
-                       const std::string& context = "");
+                       const Eigen::Vector3d& normal_hint = Eigen::Vector3d::UnitZ(),
+                       double sigma = 0.0, const std::string& context = "");
 
 }  // namespace rotacal

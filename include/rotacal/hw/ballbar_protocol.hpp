@@ -23,8 +23,8 @@ inline constexpr std::uint8_t kStatusOverRange = 0x01;
 /// One transducer sample: displacement from the length at which it was zeroed (in the
 /// calibrator, at L0), on the transducer's own clock.
 struct BallbarFrame {
-  std::uint16_t seq = 0;           ///< increments by one per sample, wraps at 65536
-  std::uint32_t t_us = 0;          ///< µs since START, wraps at 2^32
+  std::uint16_t seq = 0;   ///< increments by one per sample, wraps at 65536
+  std::uint32_t t_us = 0;  ///< µs since START, wraps at 2^32
   std::int32_t displacement_nm = 0;
   std::uint8_t status = 0;
 };

@@ -38,8 +38,8 @@ struct Frame {
 
 /// What scan_frames found in a buffer.
 struct FrameScan {
-  std::vector<Frame> frames;      ///< valid frames, in order
-  std::size_t consumed = 0;       ///< bytes fully processed; keep data[consumed..n) for the next read
+  std::vector<Frame> frames;  ///< valid frames, in order
+  std::size_t consumed = 0;   ///< bytes fully processed; keep data[consumed..n) for the next read
   std::size_t garbage_bytes = 0;  ///< bytes skipped while looking for a frame start
   std::size_t crc_errors = 0;     ///< complete frames whose checksum failed (dropped, resynced)
 };

@@ -58,8 +58,8 @@ std::optional<int> parse_sylvac_request(const std::string& line);
 /// "M0" (channel 0: all three) or "M1".."M3".
 std::string keyence_request(int channel);
 struct KeyenceReply {
-  int channel = 0;                  ///< 0 = all
-  std::vector<GaugeValue> values;   ///< 3 for M0, 1 otherwise; one error value for "ER"
+  int channel = 0;                 ///< 0 = all
+  std::vector<GaugeValue> values;  ///< 3 for M0, 1 otherwise; one error value for "ER"
 };
 std::optional<KeyenceReply> parse_keyence_reply(const std::string& line);
 std::string format_keyence_reply(const KeyenceReply& r);

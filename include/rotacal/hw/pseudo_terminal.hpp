@@ -30,7 +30,8 @@ class PseudoTerminal {
 
  private:
   int master_ = -1;
-  int slave_keepalive_ = -1;  ///< our own slave fd: keeps the master usable while no host is attached
+  int slave_keepalive_ =
+      -1;  ///< our own slave fd: keeps the master usable while no host is attached
   std::string slave_path_;
 };
 

@@ -11,8 +11,8 @@
 #include <functional>
 #include <string>
 
-#include "rotacal/circular/timeline.hpp"
 #include "rotacal/ballbar/timeline.hpp"
+#include "rotacal/circular/timeline.hpp"
 #include "rotacal/hw/pose_window.hpp"
 #include "rotacal/hw/probe_protocol.hpp"
 #include "rotacal/hw/transport.hpp"
@@ -22,10 +22,10 @@ namespace rotacal::hw {
 
 /// Progress of a recording, passed to the callback a few times a second.
 struct RecordProgress {
-  std::size_t rows = 0;          ///< rows written
-  std::size_t lost = 0;          ///< samples known lost (sequence gaps, missing poses)
-  std::size_t corrupt = 0;       ///< frames / replies that failed their check
-  double device_time_s = 0.0;    ///< how far into the program
+  std::size_t rows = 0;        ///< rows written
+  std::size_t lost = 0;        ///< samples known lost (sequence gaps, missing poses)
+  std::size_t corrupt = 0;     ///< frames / replies that failed their check
+  double device_time_s = 0.0;  ///< how far into the program
   double program_duration_s = 0.0;
 };
 
@@ -51,7 +51,7 @@ struct RecordSummary {
   /// (the host was late), marked in the file and not used.
   std::size_t outside_window = 0;
   StopReason reason = StopReason::end_of_program;
-  std::string detail;             ///< the error text for disconnected / no_valid_data
+  std::string detail;  ///< the error text for disconnected / no_valid_data
   /// One line for the console and the file's last `#` line.
   std::string describe() const;
 };
@@ -61,8 +61,8 @@ struct RecordOptions {
   double silence_timeout_s = 3.0;
   /// Garbage bytes with no valid frame in between before giving up (wrong baud / protocol).
   std::size_t max_garbage_without_data = 4096;
-  double rate_hz = 1000.0;      ///< stream modes: requested sample rate
-  bool zero = false;            ///< ballbar: send ZERO before START
+  double rate_hz = 1000.0;  ///< stream modes: requested sample rate
+  bool zero = false;        ///< ballbar: send ZERO before START
   /// Virtual seconds per wall second of the instrument (polled modes pace on the host clock).
   double speed = 1.0;
   std::function<bool(const RecordProgress&)> progress;  ///< return false to stop

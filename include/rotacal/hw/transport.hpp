@@ -67,7 +67,8 @@ bool is_pseudo_terminal(const std::string& resolved_path);
 /// Open a port: ptys through termios, everything else through libserialport.
 std::unique_ptr<ByteTransport> open_port(const std::string& path, const SerialSettings& settings);
 /// The two backends, for callers that must choose.
-std::unique_ptr<ByteTransport> open_termios(const std::string& path, const SerialSettings& settings);
+std::unique_ptr<ByteTransport> open_termios(const std::string& path,
+                                            const SerialSettings& settings);
 std::unique_ptr<ByteTransport> open_libserialport(const std::string& path,
                                                   const SerialSettings& settings);
 

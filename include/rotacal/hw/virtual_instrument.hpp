@@ -15,10 +15,10 @@
 #include <string>
 #include <thread>
 
-#include "rotacal/circular/simulate.hpp"
-#include "rotacal/circular/timeline.hpp"
 #include "rotacal/ballbar/model.hpp"
 #include "rotacal/ballbar/timeline.hpp"
+#include "rotacal/circular/simulate.hpp"
+#include "rotacal/circular/timeline.hpp"
 #include "rotacal/hw/frame.hpp"
 #include "rotacal/hw/pose_window.hpp"
 #include "rotacal/hw/probe_protocol.hpp"
@@ -29,12 +29,13 @@ namespace rotacal::hw {
 
 /// Faults to act out, counted in streamed frames (0 / -1: never).
 struct FaultInjection {
-  int garbage_every = 0;   ///< after every Nth frame, 7 bytes of line noise
-  int corrupt_every = 0;   ///< every Nth frame has one bit flipped (checksum fails)
-  int drop_every = 0;      ///< every Nth frame is not sent (sequence gap)
+  int garbage_every = 0;      ///< after every Nth frame, 7 bytes of line noise
+  int corrupt_every = 0;      ///< every Nth frame has one bit flipped (checksum fails)
+  int drop_every = 0;         ///< every Nth frame is not sent (sequence gap)
   bool split_frames = false;  ///< every frame in two writes, 1 ms apart
-  long close_after = -1;   ///< hang up the line after this many frames, once the host has read them (unplug)
-  long silence_after = -1; ///< stop sending after this many frames, line stays open
+  long close_after =
+      -1;  ///< hang up the line after this many frames, once the host has read them (unplug)
+  long silence_after = -1;  ///< stop sending after this many frames, line stays open
 };
 
 /// What an instrument did, for tests and the `virtual` command's summary.
@@ -107,9 +108,9 @@ class VirtualInstrument {
   FaultInjection faults_;
   std::thread thread_;
   std::atomic<bool> stop_{false};
-  std::atomic<bool> finished_{false};      ///< the program has run to its end
-  std::atomic<bool> thread_done_{false};   ///< the serving thread has stopped
-  std::atomic<double> finished_at_{0.0};   ///< wall s
+  std::atomic<bool> finished_{false};     ///< the program has run to its end
+  std::atomic<bool> thread_done_{false};  ///< the serving thread has stopped
+  std::atomic<double> finished_at_{0.0};  ///< wall s
   bool hung_up_ = false;
   bool silent_ = false;
   bool clock_running_ = false;
@@ -187,7 +188,8 @@ class VirtualCircularBallbar final : public VirtualInstrument {
 };
 
 struct VirtualRtestOptions {
-  MachineModel truth = MachineModel::nominal(MachineType::BC_trt);  ///< the machine the probes measure
+  MachineModel truth =
+      MachineModel::nominal(MachineType::BC_trt);  ///< the machine the probes measure
   RtestSimOptions sim;  ///< pattern (poses, dwell), noise, probe zeros sigma, seed
   Eigen::Matrix3d probe_dirs = Eigen::Matrix3d::Identity();  ///< rows: probe directions
   ProbeMode mode = ProbeMode::keyence;

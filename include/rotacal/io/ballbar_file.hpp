@@ -18,15 +18,15 @@ namespace rotacal {
 /// Limits of what a session file may hold. Beyond them a value cannot come from a machine
 /// tool (a typo, wrong units, binary data): the reader refuses it naming file, line and column,
 /// before any numeric kernel sees it.
-inline constexpr std::size_t kMaxLineBytes = 65536;    ///< one line, bytes
-inline constexpr std::size_t kMaxLabelBytes = 256;     ///< a test or set-up label, a column name
-inline constexpr double kMaxAbsPositionMm = 1.0e5;     ///< X, Y, Z, pivot, nests (100 m)
-inline constexpr double kMaxAbsAngleDeg = 1.0e6;       ///< rotary angles (2778 turns)
-inline constexpr double kMinLengthMm = 1.0e-3;         ///< ballbar lengths and L0
+inline constexpr std::size_t kMaxLineBytes = 65536;  ///< one line, bytes
+inline constexpr std::size_t kMaxLabelBytes = 256;   ///< a test or set-up label, a column name
+inline constexpr double kMaxAbsPositionMm = 1.0e5;   ///< X, Y, Z, pivot, nests (100 m)
+inline constexpr double kMaxAbsAngleDeg = 1.0e6;     ///< rotary angles (2778 turns)
+inline constexpr double kMinLengthMm = 1.0e-3;       ///< ballbar lengths and L0
 inline constexpr double kMaxLengthMm = 1.0e4;
-inline constexpr double kMaxAbsTimeS = 1.0e9;          ///< time column (31 years)
-inline constexpr double kMaxAbsDisplacementMm = 1.0e2; ///< R-test dx, dy, dz and d1, d2, d3
-inline constexpr double kMaxNoiseUm = 1.0e5;           ///< noise_um metadata
+inline constexpr double kMaxAbsTimeS = 1.0e9;           ///< time column (31 years)
+inline constexpr double kMaxAbsDisplacementMm = 1.0e2;  ///< R-test dx, dy, dz and d1, d2, d3
+inline constexpr double kMaxNoiseUm = 1.0e5;            ///< noise_um metadata
 
 /// Read a ballbar session; throws ParseError (file, line, column, what) or IoError.
 BallbarSession read_ballbar(const std::string& path);
@@ -55,7 +55,8 @@ AnySession read_session(const std::string& path);
 class BallbarWriter {
  public:
   /// `header` supplies machine, metadata and extra columns; its samples are not written.
-  BallbarWriter(const std::string& path, const BallbarSession& header, const OutputOptions& options = {});
+  BallbarWriter(const std::string& path, const BallbarSession& header,
+                const OutputOptions& options = {});
   BallbarWriter(const BallbarWriter&) = delete;
   BallbarWriter& operator=(const BallbarWriter&) = delete;
   void append(const BallbarSample& sample);

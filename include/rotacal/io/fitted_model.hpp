@@ -11,12 +11,11 @@
 ///     write_model(fitted_model_document(content), "model.json");
 ///     const FittedModelContent c = fitted_model_content(read_model("model.json"), "model.json");
 
+#include <Eigen/Core>
 #include <cstddef>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <nlohmann/json.hpp>
 
 #include "rotacal/core/estimate.hpp"
 #include "rotacal/core/noise_model.hpp"
@@ -33,7 +32,8 @@ struct FittedSessionContent {
   /// Its own parameters in the fit (probe: sphere.x/y/z, tool_offset_Z on a machine with head
   /// axes; ballbar: pivot_x/y/z; R-test: zero.<set-up>.x/y/z, ...).
   std::vector<ParameterEstimate> nuisances;
-  /// "multi": its location errors, then the shared effects' parameters, fitted alone (empty for "probe").
+  /// "multi": its location errors, then the shared effects' parameters, fitted alone (empty for
+  /// "probe").
   std::vector<ParameterEstimate> alone;
   NoiseModel noise;               ///< of its residuals (streams keep no rows)
   bool noise_refit = false;       ///< the fit whitened it by `noise` (GLS)
@@ -55,7 +55,8 @@ struct FittedModelContent {
   /// with value and std null and read back with value 0, std NaN.
   std::vector<ParameterEstimate> location_errors;
   /// The catalogue effects fitted along (the values are then the extended model's: "model":
-  /// "extended"; none: "baseline"), their parameters named effect_parameter_name, EffectModel order.
+  /// "extended"; none: "baseline"), their parameters named effect_parameter_name, EffectModel
+  /// order.
   EffectModel effects;
   std::vector<ParameterEstimate> effect_parameters;
   /// Names of the covariance's rows: location errors, effect parameters and the sessions'
@@ -80,7 +81,7 @@ FittedModelContent fitted_model_content(const ModelFile& model, const std::strin
 
 /// The check model_from_json runs on a "probe" or "multi" document (after the members every
 /// kind shares): InvalidArgument "source: member: what is wrong".
-FittedModelContent fitted_model_from_json(const nlohmann::ordered_json& document, MachineType machine,
-                                          const std::string& source);
+FittedModelContent fitted_model_from_json(const nlohmann::ordered_json& document,
+                                          MachineType machine, const std::string& source);
 
 }  // namespace rotacal

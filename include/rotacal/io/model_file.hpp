@@ -14,11 +14,10 @@
 #include <array>
 #include <cstddef>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "rotacal/core/estimate.hpp"
 #include "rotacal/io/output_file.hpp"
@@ -44,8 +43,9 @@ inline constexpr double kMaxModelPivot = 1.0e4;
 
 /// A validated model file.
 struct ModelFile {
-  int format_minor = 0;   ///< N of rotacal-model/1.N (0 for "rotacal-model/1")
-  std::string kind;       ///< "ballbar", "rtest-joint", "rtest-diagnosis", "probe" or "multi" (io/fitted_model.hpp)
+  int format_minor = 0;  ///< N of rotacal-model/1.N (0 for "rotacal-model/1")
+  std::string kind;      ///< "ballbar", "rtest-joint", "rtest-diagnosis", "probe" or "multi"
+                         ///< (io/fitted_model.hpp)
   MachineType machine = MachineType::AC_trt;
   /// Location errors in location_error_names(machine) order (mm, rad); an unobservable one
   /// (value null) is nominal, 0, and flagged in `observable`.
@@ -53,8 +53,8 @@ struct ModelFile {
   std::array<bool, 8> observable{};
   std::optional<Eigen::Vector3d> pivot;  ///< table frame, mm (ballbar models)
   EffectModel effects;
-  std::vector<double> effect_params;     ///< effects.num_params() values, nulls as 0
-  nlohmann::ordered_json document;               ///< the whole file as read (strict, no NaN)
+  std::vector<double> effect_params;  ///< effects.num_params() values, nulls as 0
+  nlohmann::ordered_json document;    ///< the whole file as read (strict, no NaN)
 };
 
 /// Validate a parsed document; `source` names the file in messages. Throws InvalidArgument
@@ -73,7 +73,8 @@ nlohmann::ordered_json read_model_document(const std::string& path);
 nlohmann::ordered_json strict_json(nlohmann::ordered_json document);
 /// The file text of a model document: validated (throws InvalidArgument naming "source" like
 /// the reader would, so nothing is written that cannot be read back), strict, 2-space indented.
-std::string format_model(const nlohmann::ordered_json& document, const std::string& source = "model");
+std::string format_model(const nlohmann::ordered_json& document,
+                         const std::string& source = "model");
 /// format_model, then written by the output rule (rotacal/io/output_file.hpp).
 void write_model(const nlohmann::ordered_json& document, const std::string& path,
                  const OutputOptions& options = {});
@@ -94,7 +95,7 @@ struct RtestJointModelContent {
   /// map coefficients. An unobservable one keeps the value the fit gave it under its convention
   /// (written with "observable": false and no std), so that the file predicts as the fit did.
   std::vector<ParameterEstimate> parameters;
-  Eigen::MatrixXd covariance;  ///< of `parameters`, mm and rad
+  Eigen::MatrixXd covariance;                    ///< of `parameters`, mm and rad
   std::map<std::string, Eigen::Vector3d> nests;  ///< nominal ball centre per nest, table frame, mm
   std::map<std::string, std::array<ParameterEstimate, 3>> probe_zeros;  ///< x, y, z per set-up, mm
   double residual_rms_um = 0.0;

@@ -44,7 +44,8 @@ enum class OutputKind {
 OutputKind check_output(const std::string& path, const OutputOptions& options = {});
 
 /// Write `data` to `path` by the rule above. Throws IoError naming the path.
-void write_output(const std::string& path, const std::string& data, const OutputOptions& options = {});
+void write_output(const std::string& path, const std::string& data,
+                  const OutputOptions& options = {});
 
 /// Produce the content with `produce` (which may throw: then nothing is written and the old
 /// file stays), then write it by the rule above.

@@ -31,35 +31,35 @@ namespace rotacal {
 
 /// Kinds of effect in the catalogue. `axis` of an Effect says which axis it belongs to.
 enum class EffectKind {
-  ballbar_length_offset,   ///< measured length += dL (mm)
-  ballbar_thermal_drift,   ///< measured length += k t (mm/s)
-  tool_offset_Z,           ///< tool-side ball += (0, 0, d) (mm)
-  rotary_zero_offset,      ///< actual angle = R + eps (rad); axis A, B or C
-  angular_positioning,     ///< actual angle = R + a cos nR + b sin nR (rad)
-  radial_motion,           ///< E(R) translates perpendicular to R (mm), n >= 2
-  axial_motion,            ///< E(R) translates along R (mm)
-  tilt_motion,             ///< E(R) turns about the two axes perpendicular to R (rad)
-  gravity_sag,             ///< table += (0, 0, -s (1 - cos T)) (mm); axis A or B
-  coning,                  ///< extra rotation k*T about X (B) or Y (A) (rad/rad)
-  linear_squareness,       ///< axis X: x += s y ("XY"), Y: y += s z ("YZ"), Z: z += s x ("ZX")
-  linear_scale,            ///< x += k x (likewise y, z)
-  thermal_drift,           ///< table += d t along X, Y or Z (mm/s)
-  thermal_warmup,          ///< table += d (1 - exp(-t / tau)) along X, Y or Z; tau = 300 s e^q
-  straightness,            ///< E_DA: tool D += c2 u^2 + c3 u^3 + c4 u^4, u = (a - a_ref)/100 mm
-  tool_offset,             ///< tool-side ball += d along X or Y (mm)
-  linear_pitch,            ///< E_BX / E_AY seen through the Z arm: x += e(x) (z - z_ref),
-                           ///< y -= e(y) (z - z_ref), e(a) = e1 u + e2 u^2 (rad)
+  ballbar_length_offset,  ///< measured length += dL (mm)
+  ballbar_thermal_drift,  ///< measured length += k t (mm/s)
+  tool_offset_Z,          ///< tool-side ball += (0, 0, d) (mm)
+  rotary_zero_offset,     ///< actual angle = R + eps (rad); axis A, B or C
+  angular_positioning,    ///< actual angle = R + a cos nR + b sin nR (rad)
+  radial_motion,          ///< E(R) translates perpendicular to R (mm), n >= 2
+  axial_motion,           ///< E(R) translates along R (mm)
+  tilt_motion,            ///< E(R) turns about the two axes perpendicular to R (rad)
+  gravity_sag,            ///< table += (0, 0, -s (1 - cos T)) (mm); axis A or B
+  coning,                 ///< extra rotation k*T about X (B) or Y (A) (rad/rad)
+  linear_squareness,      ///< axis X: x += s y ("XY"), Y: y += s z ("YZ"), Z: z += s x ("ZX")
+  linear_scale,           ///< x += k x (likewise y, z)
+  thermal_drift,          ///< table += d t along X, Y or Z (mm/s)
+  thermal_warmup,         ///< table += d (1 - exp(-t / tau)) along X, Y or Z; tau = 300 s e^q
+  straightness,           ///< E_DA: tool D += c2 u^2 + c3 u^3 + c4 u^4, u = (a - a_ref)/100 mm
+  tool_offset,            ///< tool-side ball += d along X or Y (mm)
+  linear_pitch,           ///< E_BX / E_AY seen through the Z arm: x += e(x) (z - z_ref),
+                          ///< y -= e(y) (z - z_ref), e(a) = e1 u + e2 u^2 (rad)
   // Effects of the motion itself (RotaryMotion): a sweep in one direction at one speed sees
   // each as a constant angle offset, i.e. as the zero offset; both directions and two feeds
   // of a tangential test tell them apart (docs/effects.md).
-  rotary_backlash,         ///< actual angle -= b/2 * direction (lost motion b, rad)
-  servo_lag,               ///< actual angle -= tau * rate (lag behind the linear axes, s)
-  reversal_spike,          ///< actual angle -= direction * h exp(-dt / tau_s) after a reversal;
-                           ///< tau_s = 0.05 s e^q (h rad, q 1)
+  rotary_backlash,  ///< actual angle -= b/2 * direction (lost motion b, rad)
+  servo_lag,        ///< actual angle -= tau * rate (lag behind the linear axes, s)
+  reversal_spike,   ///< actual angle -= direction * h exp(-dt / tau_s) after a reversal;
+                    ///< tau_s = 0.05 s e^q (h rad, q 1)
   // The touch probe's own effects (probe/touch_model.hpp evaluates them): effect_catalogue
   // leaves them out, probe_effect_catalogue (probe/touch_model.hpp) adds them.
-  stylus_radius_offset,    ///< trigger distance from the sphere centre += d (mm)
-  probe_lobing,            ///< latched position += (lc cos 3phi + ls sin 3phi) sqrt(1 - nz^2) n (mm)
+  stylus_radius_offset,  ///< trigger distance from the sphere centre += d (mm)
+  probe_lobing,          ///< latched position += (lc cos 3phi + ls sin 3phi) sqrt(1 - nz^2) n (mm)
 };
 
 /// One catalogue entry, e.g. {angular_positioning, 'C', 1} = "angular_positioning_C_h1".
@@ -166,7 +166,9 @@ Mat3<Scalar> small_rotation_xyz(const Scalar& ax, const Scalar& ay, const Scalar
 }
 
 // Index of X, Y, Z for a linear axis letter (A, B, C map to their principal axes).
-inline int axis_index(char axis) { return axis == 'A' || axis == 'X' ? 0 : (axis == 'B' || axis == 'Y') ? 1 : 2; }
+inline int axis_index(char axis) {
+  return axis == 'A' || axis == 'X' ? 0 : (axis == 'B' || axis == 'Y') ? 1 : 2;
+}
 
 // Axis about which coning turns the tilt axis: Y for an A axis, X for a B axis (formats and
 // effects.md), the first radial direction u of any other axis.
@@ -189,7 +191,8 @@ struct AxisStages {
 
 template <typename Scalar>
 AxisStages<Scalar> axis_stages(MachineType m, const EffectModel& fx, const Scalar* p,
-                               const RotaryAngles<double>& cmd, double t, const RotaryMotion& motion) {
+                               const RotaryAngles<double>& cmd, double t,
+                               const RotaryMotion& motion) {
   using std::cos;
   using std::exp;
   const MachineDescription& d = m.description();
@@ -198,7 +201,8 @@ AxisStages<Scalar> axis_stages(MachineType m, const EffectModel& fx, const Scala
   for (std::size_t i = 0, off = 0; i < fx.effects.size(); off += fx.effects[i].num_params(), ++i) {
     const Effect& f = fx.effects[i];
     const Scalar* q = p + off;
-    const bool rotary = f.kind == EffectKind::rotary_zero_offset || f.kind == EffectKind::angular_positioning ||
+    const bool rotary = f.kind == EffectKind::rotary_zero_offset ||
+                        f.kind == EffectKind::angular_positioning ||
                         f.kind == EffectKind::radial_motion || f.kind == EffectKind::axial_motion ||
                         f.kind == EffectKind::tilt_motion || f.kind == EffectKind::gravity_sag ||
                         f.kind == EffectKind::coning || f.depends_on_motion();
@@ -257,7 +261,9 @@ AxisStages<Scalar> axis_stages(MachineType m, const EffectModel& fx, const Scala
           break;
         case EffectKind::coning:
           if (!st.K[k]) st.K[k].emplace();
-          st.K[k]->R = rotation_about_axis<Scalar>(coning_axis(ax).cast<Scalar>(), q[0] * Scalar(R)) * st.K[k]->R;
+          st.K[k]->R =
+              rotation_about_axis<Scalar>(coning_axis(ax).cast<Scalar>(), q[0] * Scalar(R)) *
+              st.K[k]->R;
           break;
         default:
           break;
@@ -355,8 +361,8 @@ Vec3<Scalar> table_point(MachineType m, const LocationErrors<Scalar>& e, const E
 /// `ball_dz`: the height of the ball above the controlled point (a head's tool vector turned by
 /// its axes; 0 without head axes): the angular errors act through the ball's height.
 template <typename Scalar>
-Vec3<Scalar> linear_axes_position(const EffectModel& fx, const Scalar* p, const Eigen::Vector3d& xyz,
-                                  const Scalar& ball_dz = Scalar(0)) {
+Vec3<Scalar> linear_axes_position(const EffectModel& fx, const Scalar* p,
+                                  const Eigen::Vector3d& xyz, const Scalar& ball_dz = Scalar(0)) {
   Vec3<Scalar> out = xyz.cast<Scalar>();
   const Eigen::Vector3d a_ref = fx.linear_reference.value_or(Eigen::Vector3d::Zero());
   for (std::size_t i = 0, off = 0; i < fx.effects.size(); off += fx.effects[i].num_params(), ++i) {
@@ -372,15 +378,16 @@ Vec3<Scalar> linear_axes_position(const EffectModel& fx, const Scalar* p, const 
         break;
       case EffectKind::straightness: {  // E_DA, u = (a - a_ref) / 100 mm
         const double u = (xyz[k] - a_ref[k]) / 100.0;
-        out[detail::axis_index(f.direction)] += q[0] * Scalar(u * u) + q[1] * Scalar(u * u * u) +
-                                                q[2] * Scalar(u * u * u * u);
+        out[detail::axis_index(f.direction)] +=
+            q[0] * Scalar(u * u) + q[1] * Scalar(u * u * u) + q[2] * Scalar(u * u * u * u);
         break;
       }
       case EffectKind::linear_pitch: {  // a rotation of the carriage, times the Z arm
         const double u = (xyz[k] - a_ref[k]) / 100.0;
         const Scalar arm = Scalar(xyz[2] - a_ref[2]) + ball_dz;
         const Scalar e = q[0] * Scalar(u) + q[1] * Scalar(u * u);
-        // E_BX (about Y) moves a point above the guide by +e*arm in X; E_AY (about X) by -e*arm in Y.
+        // E_BX (about Y) moves a point above the guide by +e*arm in X; E_AY (about X) by -e*arm in
+        // Y.
         out[k] += (f.direction == 'B' ? arm : Scalar(-arm)) * e;
         break;
       }
@@ -406,9 +413,10 @@ Vec3<Scalar> tool_offset(const EffectModel& fx, const Scalar* p) {
 }
 
 /// Actual position of the ball (machine frame, mm) for a commanded xyz (mm) at commanded
-/// rotary angles (rad), time t (s) and motion of the axes (at rest if not given), on a machine with location errors e and effects fx
-/// (parameters p). Without head axes: the controlled point with the linear-axis effects and
-/// the tool offset. With head axes, the head side is walked like the table side:
+/// rotary angles (rad), time t (s) and motion of the axes (at rest if not given), on a machine with
+/// location errors e and effects fx (parameters p). Without head axes: the controlled point with
+/// the linear-axis effects and the tool offset. With head axes, the head side is walked like the
+/// table side:
 ///   ball = xyz' + D_h + K_H1 Rot(H1) E_H1 * K_H2 Rot(H2) E_H2 * (tool_vector + tool offset),
 /// a coning K after its own axis' rotation, in the frame of the axis that carries it (on a
 /// head-head machine the C head turns the A axis' coning with it).
@@ -437,7 +445,8 @@ Vec3<Scalar> tool_position(MachineType m, const LocationErrors<Scalar>& e, const
 /// The ball on a machine without head axes (the table machines' tool side); kept for the
 /// callers that have no rotary angles at hand.
 template <typename Scalar>
-Vec3<Scalar> tool_position(const EffectModel& fx, const Scalar* p, const Eigen::Vector3d& xyz, double /*t*/) {
+Vec3<Scalar> tool_position(const EffectModel& fx, const Scalar* p, const Eigen::Vector3d& xyz,
+                           double /*t*/) {
   return linear_axes_position<Scalar>(fx, p, xyz) + tool_offset<Scalar>(fx, p);
 }
 

@@ -14,17 +14,16 @@
 
 /// `EXTERN template` declarations (EXTERN = extern) or definitions (EXTERN empty) of the
 /// effects' entry points for scalar S.
-#define ROTACAL_EFFECTS_INSTANCES(EXTERN, S)                                                        \
+#define ROTACAL_EFFECTS_INSTANCES(EXTERN, S)                                                       \
   EXTERN template Pose<S> table_pose<S>(MachineType, const LocationErrors<S>&, const EffectModel&, \
-                                        const S*, const RotaryAngles<double>&, double,            \
+                                        const S*, const RotaryAngles<double>&, double,             \
                                         const RotaryMotion&);                                      \
-  EXTERN template Vec3<S> table_point<S>(MachineType, const LocationErrors<S>&, const EffectModel&, \
-                                         const S*, const RotaryAngles<double>&, double,           \
-                                         const Vec3<S>&, const RotaryMotion&);                     \
-  EXTERN template Vec3<S> tool_position<S>(MachineType, const LocationErrors<S>&,                 \
-                                           const EffectModel&, const S*, const Eigen::Vector3d&,  \
-                                           const RotaryAngles<double>&, double, const S&,         \
-                                           const RotaryMotion&);
+  EXTERN template Vec3<S> table_point<S>(                                                          \
+      MachineType, const LocationErrors<S>&, const EffectModel&, const S*,                         \
+      const RotaryAngles<double>&, double, const Vec3<S>&, const RotaryMotion&);                   \
+  EXTERN template Vec3<S> tool_position<S>(                                                        \
+      MachineType, const LocationErrors<S>&, const EffectModel&, const S*, const Eigen::Vector3d&, \
+      const RotaryAngles<double>&, double, const S&, const RotaryMotion&);
 
 /// Applies F(EXTERN, S) to each scalar of the list above (a Jet's comma would split the
 /// macro argument, hence the alias).

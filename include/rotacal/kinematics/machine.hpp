@@ -90,13 +90,15 @@ struct LocationErrors {
 /// Location error names in LocationErrors order for the given machine (formats.md).
 const std::array<std::string, 8>& location_error_names(MachineType m);
 
-/// Names of the two R-test error maps of a machine (rtest/identify_joint.hpp), {tilt axis' map, rotary axis' map}: the axis letter and
-/// the letter of what carries it (Oyama's "BY": B on the Y slide, "CB": C on B). The axis
-/// nearest the bed rides the Y slide ("Y"), the head axis nearest the linear axes the Z slide
+/// Names of the two R-test error maps of a machine (rtest/identify_joint.hpp), {tilt axis' map,
+/// rotary axis' map}: the axis letter and the letter of what carries it (Oyama's "BY": B on the Y
+/// slide, "CB": C on B). The axis nearest the bed rides the Y slide ("Y"), the head axis nearest
+/// the linear axes the Z slide
 /// ("Z"), any other the axis before it on its side. BC-trt: {"BY", "CB"}; AC-trt: {"AY", "CA"};
 /// B-head-C-table: {"BZ", "CY"}; AC-head: {"AC", "CZ"}.
 std::array<std::string, 2> rtest_map_names(MachineType m);
-/// Index of a location error name for the machine; throws InvalidArgument if it is not one of its 8.
+/// Index of a location error name for the machine; throws InvalidArgument if it is not one of
+/// its 8.
 int location_error_index(MachineType m, const std::string& name);
 /// True for the four orientation errors (rad), false for the four positions (mm).
 inline bool location_error_is_angle(int index) { return index == 2 || index == 3 || index >= 6; }
@@ -111,10 +113,13 @@ struct AxisLine {
 namespace detail {
 // v += B * (a, b) for a 3x2 basis of unit vectors, skipping zero entries (Jets are not free).
 template <typename Scalar>
-void add_basis(Vec3<Scalar>& v, const Eigen::Matrix<double, 3, 2>& B, const Scalar& a, const Scalar& b) {
+void add_basis(Vec3<Scalar>& v, const Eigen::Matrix<double, 3, 2>& B, const Scalar& a,
+               const Scalar& b) {
   for (int i = 0; i < 3; ++i) {
-    if (B(i, 0) != 0.0) v[i] += B(i, 0) == 1.0 ? a : B(i, 0) == -1.0 ? Scalar(-a) : Scalar(B(i, 0) * a);
-    if (B(i, 1) != 0.0) v[i] += B(i, 1) == 1.0 ? b : B(i, 1) == -1.0 ? Scalar(-b) : Scalar(B(i, 1) * b);
+    if (B(i, 0) != 0.0)
+      v[i] += B(i, 0) == 1.0 ? a : B(i, 0) == -1.0 ? Scalar(-a) : Scalar(B(i, 0) * a);
+    if (B(i, 1) != 0.0)
+      v[i] += B(i, 1) == 1.0 ? b : B(i, 1) == -1.0 ? Scalar(-b) : Scalar(B(i, 1) * b);
   }
 }
 }  // namespace detail
@@ -206,7 +211,8 @@ Pose<Scalar> head_pose(MachineType m, const LocationErrors<Scalar>& e,
                        const RotaryAngles<Scalar>& angles) {
   Pose<Scalar> H;
   const MachineDescription& d = m.description();
-  const int nt = static_cast<int>(d.table_axes.size()), n = nt + static_cast<int>(d.head_axes.size());
+  const int nt = static_cast<int>(d.table_axes.size()),
+            n = nt + static_cast<int>(d.head_axes.size());
   for (int k = nt; k < n; ++k) {
     const AxisLine<Scalar> L = axis_line(m, k, e);
     H = H * rotation_about_line(L.point, L.direction, chain_angle(m, angles, k));
@@ -221,7 +227,8 @@ template <typename Scalar>
 Vec3<Scalar> tool_vector(MachineType m, const Scalar& tool_length_error) {
   const MachineDescription& d = m.description();
   if (!d.has_head()) return Vec3<Scalar>::Zero();
-  return Vec3<Scalar>(Scalar(0), Scalar(0), -(Scalar(d.pivot_length + d.tool_length) + tool_length_error));
+  return Vec3<Scalar>(Scalar(0), Scalar(0),
+                      -(Scalar(d.pivot_length + d.tool_length) + tool_length_error));
 }
 
 /// Forward kinematics: machine-frame position of a point fixed on the table.

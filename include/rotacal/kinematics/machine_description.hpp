@@ -10,29 +10,28 @@
 /// Nothing here moves anything: kinematics/machine.hpp turns a description and the
 /// location errors into the table pose and the tool position.
 
+#include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <array>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include <Eigen/Core>
-#include <Eigen/Geometry>
-
 namespace rotacal {
 
 /// One rotary axis of the chain.
 struct RotaryAxis {
-  char name = 'C';                                            ///< controller letter: A, B or C
-  Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();       ///< nominal, unit
-  Eigen::Vector3d point = Eigen::Vector3d::Zero();            ///< nominal point on the line, mm
-  std::optional<std::array<double, 2>> limits_deg;            ///< rotary limits, none: endless
-  bool on_head = false;                                       ///< head side of the chain
+  char name = 'C';                                       ///< controller letter: A, B or C
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();  ///< nominal, unit
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();       ///< nominal point on the line, mm
+  std::optional<std::array<double, 2>> limits_deg;       ///< rotary limits, none: endless
+  bool on_head = false;                                  ///< head side of the chain
 
   /// Location errors of the axis: the actual line passes through point + P * (e0, e1) along
   /// direction + N * (e2, e3) (formats.md). Columns of P and N are unit vectors.
   Eigen::Matrix<double, 3, 2> position_basis = Eigen::Matrix<double, 3, 2>::Zero();
   Eigen::Matrix<double, 3, 2> direction_basis = Eigen::Matrix<double, 3, 2>::Zero();
-  std::array<std::string, 4> error_names;                     ///< e0..e3 names
+  std::array<std::string, 4> error_names;  ///< e0..e3 names
   /// Index 0..2 of X, Y, Z when the axis is the letter's principal axis (A along X, B along
   /// Y, C along Z, either sign); -1 for a nutating axis or a letter that does not match.
   int principal = -1;
@@ -85,7 +84,8 @@ struct MachineDescription {
 /// of FILE:LINE") in every message; the message names the field that is wrong (zero
 /// direction, duplicate names, more than two axes, a letter outside A/B/C for a principal
 /// direction, NaN, limits the wrong way round...).
-MachineDescription parse_machine_description(const std::string& json_text, const std::string& source);
+MachineDescription parse_machine_description(const std::string& json_text,
+                                             const std::string& source);
 /// The description as `rotacal-machine/1` JSON on one line (for `# machine_description:`).
 std::string machine_description_json(const MachineDescription& d);
 

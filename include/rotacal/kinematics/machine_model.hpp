@@ -19,11 +19,11 @@ namespace rotacal {
 
 struct MachineModel {
   MachineType machine = MachineType::AC_trt;
-  LocationErrors<double> errors;       ///< mm / rad, location_error_names(machine) order
+  LocationErrors<double> errors;  ///< mm / rad, location_error_names(machine) order
   /// On a machine with head axes, tool_offset_Z among the effects is minus the error of
   /// pivot_length + tool_length (only their sum is visible to a ball-ended instrument).
   EffectModel effects;
-  std::vector<double> effect_params;   ///< effects.num_params() values, EffectModel layout
+  std::vector<double> effect_params;  ///< effects.num_params() values, EffectModel layout
 
   /// A machine of this kinematics without location errors or effects.
   static MachineModel nominal(MachineType m) {
@@ -33,7 +33,9 @@ struct MachineModel {
   }
 
   /// Pointer to the effect parameters (nullptr when there are none), for the templated model.
-  const double* effect_data() const { return effect_params.empty() ? nullptr : effect_params.data(); }
+  const double* effect_data() const {
+    return effect_params.empty() ? nullptr : effect_params.data();
+  }
   /// ISO 230-7 names of the location errors, then "id.name" of every effect parameter.
   std::vector<std::string> parameter_names() const;
   /// Throws InvalidArgument, naming `context` (e.g. "simulate_rtest: truth"), if the effect

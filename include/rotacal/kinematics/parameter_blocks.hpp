@@ -48,7 +48,8 @@ inline ParameterBlock add_effects(ParameterLayout& layout, const EffectModel& fx
 
 /// The parameters of effect i of fx within its block `effects` (add_effects), named by the
 /// effect's id.
-inline ParameterBlock effect_block(const ParameterBlock& effects, const EffectModel& fx, std::size_t i) {
+inline ParameterBlock effect_block(const ParameterBlock& effects, const EffectModel& fx,
+                                   std::size_t i) {
   return effects.part(fx.offset(i), fx.effects[i].num_params(), fx.effects[i].id());
 }
 

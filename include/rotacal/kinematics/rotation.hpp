@@ -71,26 +71,29 @@ Pose<Scalar> rotation_about_line(const Vec3<Scalar>& point, const Vec3<Scalar>& 
 /// the form below takes theta.
 /// The form with a unit direction u is the one body; the others normalise and call it.
 template <typename Scalar>
-Vec3<Scalar> rotate_point_about_unit_line(const Vec3<Scalar>& point, const Vec3<Scalar>& u, const Scalar& c,
-                                          const Scalar& s, const Vec3<Scalar>& q) {
+Vec3<Scalar> rotate_point_about_unit_line(const Vec3<Scalar>& point, const Vec3<Scalar>& u,
+                                          const Scalar& c, const Scalar& s, const Vec3<Scalar>& q) {
   const Vec3<Scalar> v = q - point;
   return point + v * c + u.cross(v) * s + u * (u.dot(v) * (Scalar(1) - c));
 }
 template <typename Scalar>
 Vec3<Scalar> rotate_point_about_line(const Vec3<Scalar>& point, const Vec3<Scalar>& direction,
                                      const Scalar& c, const Scalar& s, const Vec3<Scalar>& q) {
-  return rotate_point_about_unit_line<Scalar>(point, Vec3<Scalar>(direction / direction.norm()), c, s, q);
+  return rotate_point_about_unit_line<Scalar>(point, Vec3<Scalar>(direction / direction.norm()), c,
+                                              s, q);
 }
 template <typename Scalar>
 Vec3<Scalar> rotate_point_about_line(const Vec3<Scalar>& point, const Vec3<Scalar>& direction,
                                      const Scalar& theta, const Vec3<Scalar>& q) {
   using std::cos;
   using std::sin;
-  return rotate_point_about_line<Scalar>(point, direction, Scalar(cos(theta)), Scalar(sin(theta)), q);
+  return rotate_point_about_line<Scalar>(point, direction, Scalar(cos(theta)), Scalar(sin(theta)),
+                                         q);
 }
 
 /// rotate_point_about_line with its first derivatives (double, or Lanes of four samples: the
-/// fits' fast path, checked against Jets of rotate_point_about_line in tests/cpp/test_rotation.cpp):
+/// fits' fast path, checked against Jets of rotate_point_about_line in
+/// tests/cpp/test_rotation.cpp):
 ///   f = a + R(u, theta) (q - a),  u = d / |d|,  v = q - a
 ///   df/dq = R,  df/da = I - R,
 ///   df/dd = [-sin(theta) [v]x + (1 - cos(theta)) ((u . v) I + u v^T)] (I - u u^T) / |d|.
@@ -120,9 +123,15 @@ struct LineRotationDerivatives {
     const Vec3<Scalar> wt = w.transpose();
     return (-s * wt.cross(v) + (Scalar(1) - c) * (u.dot(v) * wt + wt.dot(u) * v)).transpose();
   }
-  Mat3<Scalar> d_q() const { return rows([this](const Row& w) { return times_q(w); }); }
-  Mat3<Scalar> d_point() const { return rows([this](const Row& w) { return times_point(w); }); }
-  Mat3<Scalar> d_direction() const { return rows([this](const Row& w) { return times_direction(w); }); }
+  Mat3<Scalar> d_q() const {
+    return rows([this](const Row& w) { return times_q(w); });
+  }
+  Mat3<Scalar> d_point() const {
+    return rows([this](const Row& w) { return times_point(w); });
+  }
+  Mat3<Scalar> d_direction() const {
+    return rows([this](const Row& w) { return times_direction(w); });
+  }
 
  private:
   template <typename F>
@@ -138,10 +147,9 @@ struct LineRotationDerivatives {
 /// and the commanded angles' sines once per session. Scalar double, or Lanes (core/lanes.hpp)
 /// for four samples at once.
 template <typename Scalar>
-LineRotationDerivatives<Scalar> rotate_point_about_unit_line_derivatives(const Vec3<Scalar>& point,
-                                                                         const Vec3<Scalar>& u,
-                                                                         const Scalar& inv_norm, const Scalar& c,
-                                                                         const Scalar& s, const Vec3<Scalar>& q) {
+LineRotationDerivatives<Scalar> rotate_point_about_unit_line_derivatives(
+    const Vec3<Scalar>& point, const Vec3<Scalar>& u, const Scalar& inv_norm, const Scalar& c,
+    const Scalar& s, const Vec3<Scalar>& q) {
   LineRotationDerivatives<Scalar> D;
   D.inv_norm = inv_norm;
   D.u = u;
@@ -151,12 +159,12 @@ LineRotationDerivatives<Scalar> rotate_point_about_unit_line_derivatives(const V
   D.f = rotate_point_about_unit_line<Scalar>(point, u, c, s, q);  // the one definition
   return D;
 }
-inline LineRotationDerivatives<double> rotate_point_about_line_derivatives(const Eigen::Vector3d& point,
-                                                                           const Eigen::Vector3d& direction,
-                                                                           double theta, const Eigen::Vector3d& q) {
+inline LineRotationDerivatives<double> rotate_point_about_line_derivatives(
+    const Eigen::Vector3d& point, const Eigen::Vector3d& direction, double theta,
+    const Eigen::Vector3d& q) {
   const double inv_norm = 1.0 / direction.norm();
-  return rotate_point_about_unit_line_derivatives<double>(point, direction * inv_norm, inv_norm, std::cos(theta),
-                                                          std::sin(theta), q);
+  return rotate_point_about_unit_line_derivatives<double>(point, direction * inv_norm, inv_norm,
+                                                          std::cos(theta), std::sin(theta), q);
 }
 
 /// Flynn et al. 2016, Eq. 1 written out component by component: rotates q = (x, y, z) about

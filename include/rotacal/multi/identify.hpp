@@ -77,11 +77,11 @@ struct MultiDisagreement {
 struct MultiSessionResult {
   std::string name, instrument;
   std::vector<ParameterEstimate> nuisances;  ///< its own parameters in the joint fit
-  std::vector<ParameterEstimate> alone;      ///< its location errors (then shared effects) fitted alone
-  NoiseModel noise;                          ///< noise model of its residuals alone
-  bool noise_refit = false;                  ///< whitened by `noise` (GLS) in the joint fit
-  double noise_correction = 1.0;             ///< bias factor on its share of the covariance
-  double residual_rms_um = 0.0;              ///< of the joint fit, this session's rows
+  std::vector<ParameterEstimate> alone;  ///< its location errors (then shared effects) fitted alone
+  NoiseModel noise;                      ///< noise model of its residuals alone
+  bool noise_refit = false;              ///< whitened by `noise` (GLS) in the joint fit
+  double noise_correction = 1.0;         ///< bias factor on its share of the covariance
+  double residual_rms_um = 0.0;          ///< of the joint fit, this session's rows
   std::size_t n_residuals = 0;
 };
 
@@ -89,11 +89,11 @@ struct MultiIdentification {
   MachineType machine = MachineType::AC_trt;
   std::vector<ParameterEstimate> location_errors;  ///< the one shared set, joint fit
   std::vector<ParameterEstimate> effects;          ///< the shared catalogue effects' parameters
-  EffectModel effect_model;                        ///< the shared catalogue effects (options.effects)
-  std::vector<MultiSessionResult> sessions;        ///< in input order
+  EffectModel effect_model;                  ///< the shared catalogue effects (options.effects)
+  std::vector<MultiSessionResult> sessions;  ///< in input order
   std::vector<MultiDisagreement> disagreements;
-  std::vector<std::string> parameter_names;        ///< joint vector order
-  Eigen::MatrixXd covariance;                      ///< joint, 1 sigma^2
+  std::vector<std::string> parameter_names;  ///< joint vector order
+  Eigen::MatrixXd covariance;                ///< joint, 1 sigma^2
   std::vector<std::string> unobservable;
   bool converged = false;
   FitSummary summary;

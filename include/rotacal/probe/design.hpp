@@ -6,8 +6,8 @@
 /// a head, the sphere) gives the smallest largest expanded uncertainty (k = 2) of the location
 /// errors at a given number of touches, and the same for `plan probe`'s default poses.
 ///
-/// Touch by touch (`touch_directions`; the CLI's default): each candidate is one touch at a grid pose
-/// along one direction of contact_directions (the contact point within `max_contact_angle_deg`
+/// Touch by touch (`touch_directions`; the CLI's default): each candidate is one touch at a grid
+/// pose along one direction of contact_directions (the contact point within `max_contact_angle_deg`
 /// of the stylus axis, polar every `contact_step_deg`, azimuth every 45 deg), each checked alone
 /// by probe_moves (travel, the way up clear of the sphere); the engine allocates the touches, and
 /// the designed pattern touches each chosen pose along its own directions (pose_directions).
@@ -34,9 +34,9 @@
 #include <vector>
 
 #include "rotacal/design/separation.hpp"
-#include "rotacal/session/probe_session.hpp"
 #include "rotacal/probe/nc_program.hpp"
 #include "rotacal/probe/simulate.hpp"
+#include "rotacal/session/probe_session.hpp"
 
 namespace rotacal {
 
@@ -45,20 +45,24 @@ struct ProbeDesignOptions {
   Eigen::Vector3d sphere = Eigen::Vector3d(150.0, 0.0, 80.0);  ///< nominal centre, table frame, mm
   double sphere_diameter = 25.0;                               ///< mm
   double stylus_diameter = 6.0;                                ///< mm
-  int touches = 0;                     ///< total touches; 0: the default poses' (default_probe_pattern)
-  std::vector<Eigen::Vector3d> directions;  ///< approach directions, machine frame; empty: the default pattern's
-  double tilt_step_deg = 15.0;         ///< candidate tilts: the tilt axis' limits (-90..90 without) every step
-  double rot_step_deg = 30.0;          ///< candidate rotary angles: a full turn (or its limits) every step
-  double noise_um = 0.5;               ///< 1 sigma per latched coordinate (white)
+  int touches = 0;  ///< total touches; 0: the default poses' (default_probe_pattern)
+  std::vector<Eigen::Vector3d>
+      directions;  ///< approach directions, machine frame; empty: the default pattern's
+  double tilt_step_deg =
+      15.0;  ///< candidate tilts: the tilt axis' limits (-90..90 without) every step
+  double rot_step_deg = 30.0;  ///< candidate rotary angles: a full turn (or its limits) every step
+  double noise_um = 0.5;       ///< 1 sigma per latched coordinate (white)
   double reference_radius_mm = 100.0;  ///< an orientation error in rad counts as this lever arm
-  ProbeProgramOptions program;         ///< approach, overtravel, clearance: what makes a pose plannable
+  ProbeProgramOptions program;  ///< approach, overtravel, clearance: what makes a pose plannable
   /// Each touch its own direction (`rotacal design probe` and rotacal.design.design_probe set it);
   /// false: every visit of a pose along `directions`.
   bool touch_directions = false;
-  double max_contact_angle_deg = 80.0; ///< candidate contact points within this of the stylus axis, deg
-  double contact_step_deg = 30.0;      ///< their polar angle every this, deg (azimuth every 45)
-  std::vector<Eigen::Vector3d> sphere_candidates;  ///< other places of the sphere to try, table frame, mm
-  double sphere_gain = 0.05;           ///< move the sphere when that lowers the largest U by this fraction
+  double max_contact_angle_deg =
+      80.0;                        ///< candidate contact points within this of the stylus axis, deg
+  double contact_step_deg = 30.0;  ///< their polar angle every this, deg (azimuth every 45)
+  std::vector<Eigen::Vector3d>
+      sphere_candidates;      ///< other places of the sphere to try, table frame, mm
+  double sphere_gain = 0.05;  ///< move the sphere when that lowers the largest U by this fraction
 };
 
 /// One place of the sphere the design tried.
@@ -70,7 +74,7 @@ struct ProbeSphereTrial {
 };
 
 struct ProbeDesignCandidate {
-  ProbePattern pattern;            ///< poses (visits, in program order) and directions
+  ProbePattern pattern;  ///< poses (visits, in program order) and directions
   bool feasible = false;
   std::string why_not;             ///< when not feasible
   int touches = 0;                 ///< the pattern's touches (its information scaled to them)
@@ -87,11 +91,12 @@ struct ProbeDesign {
   ProbeDesignCandidate best;
   ProbeDesignCandidate baseline;  ///< default_probe_pattern at the same number of touches
   int touches = 0;
-  double ratio = 0.0;             ///< best / baseline largest expanded uncertainty
-  int poses_tried = 0;            ///< candidate poses that are plannable (at the chosen sphere)
-  int touches_tried = 0;          ///< candidate touches (touch by touch; else poses_tried)
+  double ratio = 0.0;                ///< best / baseline largest expanded uncertainty
+  int poses_tried = 0;               ///< candidate poses that are plannable (at the chosen sphere)
+  int touches_tried = 0;             ///< candidate touches (touch by touch; else poses_tried)
   std::vector<std::string> refused;  ///< candidate poses that are not, with the reason (first few)
-  Eigen::Vector3d sphere = Eigen::Vector3d::Zero();  ///< where the designed test puts the sphere, table frame
+  Eigen::Vector3d sphere =
+      Eigen::Vector3d::Zero();            ///< where the designed test puts the sphere, table frame
   std::vector<ProbeSphereTrial> spheres;  ///< `sphere` then each of sphere_candidates
 };
 
@@ -104,24 +109,24 @@ ProbeDesign design_probe_test(const ProbeDesignOptions& options);
 /// The predicted uncertainty of `pattern` at `touches` touches (0: its own). Never throws for
 /// a pattern that breaks a limit or leaves a location error undetermined that the design's
 /// candidates determine: the candidate says why it is not feasible.
-ProbeDesignCandidate evaluate_probe_pattern(const ProbePattern& pattern, const ProbeDesignOptions& options,
-                                            int touches);
+ProbeDesignCandidate evaluate_probe_pattern(const ProbePattern& pattern,
+                                            const ProbeDesignOptions& options, int touches);
 
 // ------------------------------------------------------------------ separating two effects
 
 struct ProbeSeparationOptions {
   double tilt_step_deg = 15.0;  ///< grid of the added poses (within the axis limits)
   double rot_step_deg = 30.0;
-  double pose_time_s = 0.0;     ///< per pose; 0: the session's (median time between poses)
+  double pose_time_s = 0.0;  ///< per pose; 0: the session's (median time between poses)
   double max_added_time_s = 600.0;
   double max_correlation = 0.5;
-  double noise_um = 0.0;        ///< 0: the session's residual noise (the probe fit's noise model)
+  double noise_um = 0.0;  ///< 0: the session's residual noise (the probe fit's noise model)
   double reference_radius_mm = 100.0;
   ProbeProgramOptions program;
 };
 
 struct ProbeSeparatingCandidate {
-  ProbePattern added;       ///< the added poses, the session's sphere and first pose's directions
+  ProbePattern added;  ///< the added poses, the session's sphere and first pose's directions
   std::string description;
   double duration_s = 0.0;  ///< poses x pose time
   double repeats = 1.0;     ///< run this many times
@@ -141,7 +146,8 @@ struct ProbeSeparationDesign : SeparationResult {
 /// the table alike: table_motion_overlap). Throws InvalidArgument naming the option for a pair
 /// that is not two different effects of the machine, an effect that depends on the motion (the
 /// probe reads at rest), a session without touches, or non-positive limits.
-ProbeSeparationDesign design_probe_separation(const ProbeSession& session, const std::vector<Effect>& pair,
+ProbeSeparationDesign design_probe_separation(const ProbeSession& session,
+                                              const std::vector<Effect>& pair,
                                               const ProbeSeparationOptions& options = {});
 
 }  // namespace rotacal

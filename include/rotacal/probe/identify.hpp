@@ -48,21 +48,21 @@ struct ProbeIdentification {
   /// Location errors, [tool_offset_Z], sphere.x/y/z, effect parameters (joint); location errors
   /// only (cycles, with std NaN: the cycles give no uncertainty).
   std::vector<ParameterEstimate> parameters;
-  Eigen::MatrixXd covariance;      ///< in `parameters` order, 1-sigma^2 (joint; empty for cycles)
+  Eigen::MatrixXd covariance;  ///< in `parameters` order, 1-sigma^2 (joint; empty for cycles)
   /// measured - model per touch at the solution, mm, session order: the trigger distance
   /// (D + d)/2 (+ delta) minus the touch's distance from the fitted sphere centre.
   std::vector<double> residuals;
-  Eigen::MatrixXd jacobian;        ///< d residual / d parameter at the solution (joint)
-  std::vector<bool> fixed;         ///< per parameter: held at its start value (joint)
+  Eigen::MatrixXd jacobian;  ///< d residual / d parameter at the solution (joint)
+  std::vector<bool> fixed;   ///< per parameter: held at its start value (joint)
   double residual_rms_um = 0.0;
-  double sigma_um = 0.0;           ///< noise level the covariance rests on
+  double sigma_um = 0.0;  ///< noise level the covariance rests on
   std::size_t n_samples = 0;
   bool converged = false;
   int iterations = 0;
   std::vector<std::string> unobservable;  ///< combinations the session cannot see, in words
   std::vector<std::string> notes;
   FitSummary summary;
-  NoiseModel noise;                 ///< of the residuals (joint)
+  NoiseModel noise;  ///< of the residuals (joint)
   double noise_correction = 1.0;
   bool noise_refit = false;
   /// Cycles: the sphere centre fitted at each pose (machine frame, mm), the poses' labels and
@@ -78,7 +78,8 @@ struct ProbeIdentification {
 
 /// Joint fit of every touch. Throws InvalidArgument for a session with fewer touches than
 /// unknowns or an effect that does not exist on its machine.
-ProbeIdentification identify_probe(const ProbeSession& session, const ProbeFitOptions& options = {});
+ProbeIdentification identify_probe(const ProbeSession& session,
+                                   const ProbeFitOptions& options = {});
 
 struct ProbeCyclesOptions {
   /// Fit each pose's sphere with the calibrated radius (D + d)/2 (true) or with a free radius
@@ -90,6 +91,7 @@ struct ProbeCyclesOptions {
 /// the sphere then turns with them). Throws InvalidArgument for a machine with head axes and
 /// DegenerateGeometry, naming the pose or axis, when a pose has too few touches for its sphere
 /// or an axis fewer than 3 poses turned about it alone.
-ProbeIdentification identify_probe_cycles(const ProbeSession& session, const ProbeCyclesOptions& options = {});
+ProbeIdentification identify_probe_cycles(const ProbeSession& session,
+                                          const ProbeCyclesOptions& options = {});
 
 }  // namespace rotacal

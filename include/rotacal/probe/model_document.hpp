@@ -9,9 +9,8 @@
 /// The layout of the file is io/fitted_model.hpp's; this header only takes an identification
 /// apart into it.
 
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "rotacal/io/fitted_model.hpp"
 #include "rotacal/probe/identify.hpp"
@@ -22,7 +21,8 @@ namespace rotacal {
 /// The location errors and effect parameters are the fit's, every other parameter (sphere.x/y/z,
 /// tool_offset_Z on a machine with head axes) the session's own. InvalidArgument for a fit of the
 /// cycles' method (no uncertainty, no covariance) or one that lacks a parameter of its model.
-FittedModelContent probe_model_content(const ProbeIdentification& identification, const std::string& session_name);
+FittedModelContent probe_model_content(const ProbeIdentification& identification,
+                                       const std::string& session_name);
 
 /// fitted_model_document(probe_model_content(identification, session_name)).
 nlohmann::ordered_json probe_model_document(const ProbeIdentification& identification,

@@ -7,12 +7,11 @@
 /// of the draws with the reported sigma. The noise is the fit's: AR draws from the noise model
 /// when the fit was refitted under it (GLS), else white of the fit's sigma (core/monte_carlo.hpp).
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "rotacal/core/monte_carlo.hpp"
 #include "rotacal/probe/identify.hpp"
@@ -31,8 +30,8 @@ struct ProbeMonteCarloOptions {
 
 struct ProbeMonteCarlo {
   int draws = 0;
-  double noise_um = 0.0;  ///< 1 sigma of the simulated noise per touch
-  std::string noise;      ///< what was simulated, in words
+  double noise_um = 0.0;                        ///< 1 sigma of the simulated noise per touch
+  std::string noise;                            ///< what was simulated, in words
   std::vector<MonteCarloParameter> parameters;  ///< observable parameters only
   Eigen::MatrixXd values;                       ///< draws x all parameters (identification order)
 };

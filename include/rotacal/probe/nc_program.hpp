@@ -10,9 +10,9 @@
 /// c - (r - overtravel) n. It retracts to the start along the same line, then straight up to
 /// the retract plane. Between poses the rotary axes turn with the tool on the retract plane,
 /// above the sphere at every pose and all along the turns between them (the program starts by
-/// going up to it before the first turn). A move that would pass through the sphere (closer than r to
-/// its nominal centre), a rotary angle outside the machine's limits or a linear position
-/// outside its travel (when the description gives it) is refused.
+/// going up to it before the first turn). A move that would pass through the sphere (closer than r
+/// to its nominal centre), a rotary angle outside the machine's limits or a linear position outside
+/// its travel (when the description gives it) is refused.
 ///
 /// Dialects: linuxcnc only, machine axes: `G38.2` per touch, and the latched position #5061
 /// #5062 #5063 written to a log file with `(LOGOPEN,file)`, `(LOG,...)`, `(LOGCLOSE)`; every
@@ -22,26 +22,26 @@
 #include <vector>
 
 #include "rotacal/io/nc_dialect.hpp"
-#include "rotacal/session/probe_session.hpp"
 #include "rotacal/probe/simulate.hpp"
+#include "rotacal/session/probe_session.hpp"
 
 namespace rotacal {
 
 struct ProbeProgramOptions {
-  int decimals = 4;                  ///< digits after the point, 0..9
-  int tool = 1;                      ///< G43 H<tool> on a table machine; 0 leaves it to the operator
-  double approach_mm = 5.0;          ///< start of a probing move: this far outside the trigger sphere
-  double overtravel_mm = 2.0;        ///< its G38.2 target: this far inside it
-  double clearance_mm = 20.0;        ///< retract plane: this far above the highest trigger sphere top
+  int decimals = 4;            ///< digits after the point, 0..9
+  int tool = 1;                ///< G43 H<tool> on a table machine; 0 leaves it to the operator
+  double approach_mm = 5.0;    ///< start of a probing move: this far outside the trigger sphere
+  double overtravel_mm = 2.0;  ///< its G38.2 target: this far inside it
+  double clearance_mm = 20.0;  ///< retract plane: this far above the highest trigger sphere top
   double probe_feed_mm_per_min = 50.0;
-  double feed_mm_per_min = 1000.0;   ///< positioning feed between touches (G1)
+  double feed_mm_per_min = 1000.0;             ///< positioning feed between touches (G1)
   std::string log_file = "rotacal_probe.log";  ///< the controller's file of the latched positions
 };
 
 /// One probing move, machine axes (mm, deg).
 struct ProbeMove {
-  int pose = 1;                      ///< 1-based pose number
-  int touch = 1;                     ///< 1-based touch number within the pose
+  int pose = 1;   ///< 1-based pose number
+  int touch = 1;  ///< 1-based touch number within the pose
   RotaryAngles<double> angles_deg;
   Eigen::Vector3d n = Eigen::Vector3d::UnitZ();  ///< approach direction, machine frame, unit
   Eigen::Vector3d start = Eigen::Vector3d::Zero();
@@ -52,8 +52,8 @@ struct ProbeMove {
 /// Throws InvalidArgument for an empty pattern, a zero direction, options out of range (non
 /// positive approach, overtravel or feeds, overtravel >= the trigger radius), a rotary angle
 /// outside the machine's limits, a move outside its travel, or a move through the sphere.
-std::vector<ProbeMove> probe_moves(MachineType m, const ProbePattern& P, const ProbeProgramOptions& o,
-                                   double* retract_z = nullptr);
+std::vector<ProbeMove> probe_moves(MachineType m, const ProbePattern& P,
+                                   const ProbeProgramOptions& o, double* retract_z = nullptr);
 
 /// The NC program of the probing moves (lines end with '\n'). InvalidArgument as probe_moves,
 /// and for a dialect other than linuxcnc, naming it.

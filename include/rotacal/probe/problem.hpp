@@ -18,9 +18,9 @@
 #include <vector>
 
 #include "rotacal/core/joint_fit.hpp"
-#include "rotacal/session/probe_session.hpp"
 #include "rotacal/kinematics/parameter_blocks.hpp"
 #include "rotacal/probe/touch_model.hpp"
+#include "rotacal/session/probe_session.hpp"
 
 namespace rotacal {
 
@@ -58,7 +58,8 @@ class ProbeProblem : public ResidualModel {
 
   Eigen::Index num_residuals() const override { return static_cast<Eigen::Index>(touches_.size()); }
   int num_parameters() const override { return static_cast<int>(layout_.size()); }
-  void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r, Eigen::MatrixXd* J) const override;
+  void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r,
+                Eigen::MatrixXd* J) const override;
 
   /// Noise streams of the residuals: one group (the session), touches in time order.
   const std::vector<std::string>& groups() const { return groups_; }

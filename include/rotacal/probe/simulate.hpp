@@ -24,10 +24,10 @@ struct ProbePattern {
   /// (`rotacal design probe` chooses each touch's); empty: `directions` at every pose.
   std::vector<std::vector<Eigen::Vector3d>> pose_directions;
   Eigen::Vector3d sphere = Eigen::Vector3d(150.0, 0.0, 80.0);  ///< nominal centre, table frame, mm
-  double sphere_diameter = 25.0;  ///< mm
-  double stylus_diameter = 6.0;   ///< mm
-  double touch_dt_s = 2.0;        ///< time between the touches of a pose, s
-  double pose_dt_s = 16.0;        ///< time between the first touches of successive poses, s
+  double sphere_diameter = 25.0;                               ///< mm
+  double stylus_diameter = 6.0;                                ///< mm
+  double touch_dt_s = 2.0;  ///< time between the touches of a pose, s
+  double pose_dt_s = 16.0;  ///< time between the first touches of successive poses, s
 
   /// The approach directions of pose k (0-based).
   const std::vector<Eigen::Vector3d>& directions_at(std::size_t k) const {

@@ -67,7 +67,8 @@ Scalar lobing_shift(const EffectModel& fx, const Scalar* p, const Eigen::Vector3
     const double phi = std::atan2(n_spindle.y(), n_spindle.x());
     const double radial = std::sqrt(std::max(0.0, 1.0 - n_spindle.z() * n_spindle.z()));
     const Scalar* q = p + fx.offset(i);
-    out += (q[0] * Scalar(std::cos(3.0 * phi)) + q[1] * Scalar(std::sin(3.0 * phi))) * Scalar(radial);
+    out +=
+        (q[0] * Scalar(std::cos(3.0 * phi)) + q[1] * Scalar(std::sin(3.0 * phi))) * Scalar(radial);
   }
   return out;
 }
@@ -76,10 +77,11 @@ Scalar lobing_shift(const EffectModel& fx, const Scalar* p, const Eigen::Vector3
 /// p_tool(xyz) - a n - p_table(q_sphere). `tool_length_error` as in kinematics tool_position.
 template <typename Scalar>
 Vec3<Scalar> touch_offset(MachineType m, const LocationErrors<Scalar>& e, const EffectModel& fx,
-                          const Scalar* fx_params, const Vec3<Scalar>& q_sphere, const ProbeTouch& t,
-                          const Scalar& tool_length_error = Scalar(0)) {
+                          const Scalar* fx_params, const Vec3<Scalar>& q_sphere,
+                          const ProbeTouch& t, const Scalar& tool_length_error = Scalar(0)) {
   const Vec3<Scalar> centre = table_point<Scalar>(m, e, fx, fx_params, t.angles, t.time, q_sphere);
-  const Vec3<Scalar> tip = tool_position<Scalar>(m, e, fx, fx_params, t.xyz, t.angles, t.time, tool_length_error);
+  const Vec3<Scalar> tip =
+      tool_position<Scalar>(m, e, fx, fx_params, t.xyz, t.angles, t.time, tool_length_error);
   return tip - t.n.cast<Scalar>() * lobing_shift<Scalar>(fx, fx_params, t.n_spindle) - centre;
 }
 
@@ -90,7 +92,8 @@ Scalar touch_residual(MachineType m, const LocationErrors<Scalar>& e, const Effe
                       double trigger_radius, const Scalar& tool_length_error = Scalar(0)) {
   using std::sqrt;
   const Vec3<Scalar> d = touch_offset<Scalar>(m, e, fx, fx_params, q_sphere, t, tool_length_error);
-  return sqrt(d.squaredNorm()) - (Scalar(trigger_radius) + stylus_radius_error<Scalar>(fx, fx_params));
+  return sqrt(d.squaredNorm()) -
+         (Scalar(trigger_radius) + stylus_radius_error<Scalar>(fx, fx_params));
 }
 
 }  // namespace rotacal

@@ -24,8 +24,8 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "rotacal/session/session.hpp"
 #include "rotacal/kinematics/rotation.hpp"
+#include "rotacal/session/session.hpp"
 
 namespace rotacal {
 
@@ -49,8 +49,8 @@ struct ProbeCalibrationSample {
 /// Result of calibrate_probe_directions.
 struct ProbeCalibration {
   Eigen::Matrix3d dirs = Eigen::Matrix3d::Identity();  ///< unit directions (rows)
-  Eigen::Vector3d gains = Eigen::Vector3d::Ones();      ///< |gain * dir| per probe (1 = ideal)
-  Eigen::Vector3d zeros = Eigen::Vector3d::Zero();      ///< probe zero offsets, mm
+  Eigen::Vector3d gains = Eigen::Vector3d::Ones();     ///< |gain * dir| per probe (1 = ideal)
+  Eigen::Vector3d zeros = Eigen::Vector3d::Zero();     ///< probe zero offsets, mm
   Eigen::Vector3d direction_std_rad = Eigen::Vector3d::Zero();  ///< 1-sigma angular uncertainty
   Eigen::Vector3d gain_std = Eigen::Vector3d::Zero();           ///< 1-sigma of the gains
   std::vector<Eigen::Vector3d> residuals;  ///< measured - model reading per sample, mm
@@ -80,9 +80,11 @@ struct SpindleIndexSample {
 
 /// Result of calibrate_sphere_offset.
 struct SphereOffsetCalibration {
-  Eigen::Vector2d offset = Eigen::Vector2d::Zero();      ///< sphere centre - spindle axis at angle 0 (x, y), mm
+  Eigen::Vector2d offset =
+      Eigen::Vector2d::Zero();  ///< sphere centre - spindle axis at angle 0 (x, y), mm
   Eigen::Vector2d offset_std = Eigen::Vector2d::Zero();  ///< 1 sigma, mm
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();      ///< spindle-axis point in probe coordinates (incl. zeros), mm
+  Eigen::Vector3d centre =
+      Eigen::Vector3d::Zero();  ///< spindle-axis point in probe coordinates (incl. zeros), mm
   double residual_rms_um = 0.0;
 };
 

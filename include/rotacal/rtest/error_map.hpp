@@ -29,7 +29,7 @@ struct RtestErrorMap {
   MachineType machine = MachineType::BC_trt;
   std::array<std::string, 2> maps = {"BY", "CB"};  ///< names of the tilt and rotary maps
   std::array<char, 2> letters = {'B', 'C'};        ///< tilt and rotary axis letters
-  std::vector<RtestErrorMapEntry> entries;  ///< B outer, C inner
+  std::vector<RtestErrorMapEntry> entries;         ///< B outer, C inner
   std::vector<std::string> notes;
 };
 
@@ -48,8 +48,7 @@ std::string error_map_json(const RtestErrorMap& map);
 void write_text_file(const std::string& path, const std::string& text);
 
 /// Predicted reading of the nest at q (table frame) at (B, C) in rad.
-using RtestPredictor =
-    std::function<Eigen::Vector3d(const Eigen::Vector3d& q, double B, double C)>;
+using RtestPredictor = std::function<Eigen::Vector3d(const Eigen::Vector3d& q, double B, double C)>;
 
 /// RMS (um, over all components) of measured - predicted readings of a session after removing
 /// one constant offset per set-up (the probe zero is unknown in any new session).

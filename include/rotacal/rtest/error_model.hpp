@@ -27,7 +27,8 @@ namespace rotacal {
 template <typename Scalar>
 using AxisErrors = Eigen::Matrix<Scalar, 6, 1>;
 
-/// D_x(dx) D_y(dy) D_z(dz) D_a(alpha) D_b(beta) D_c(gamma) (the error factor of Eqs. 6-7) as a Pose.
+/// D_x(dx) D_y(dy) D_z(dz) D_a(alpha) D_b(beta) D_c(gamma) (the error factor of Eqs. 6-7) as a
+/// Pose.
 template <typename Scalar>
 Pose<Scalar> oyama_error_pose(const AxisErrors<Scalar>& w) {
   using std::cos;
@@ -36,7 +37,8 @@ Pose<Scalar> oyama_error_pose(const AxisErrors<Scalar>& w) {
   P.t = w.template head<3>();
   // D_a(alpha) D_b(beta) D_c(gamma) of Eq. 1 multiplied out: on the joint fit's Jets the three
   // Rodrigues rotations and their two products took about half of the R-test Jacobian's time.
-  const Scalar ca = cos(w[3]), sa = sin(w[3]), cb = cos(w[4]), sb = sin(w[4]), cc = cos(w[5]), sc = sin(w[5]);
+  const Scalar ca = cos(w[3]), sa = sin(w[3]), cb = cos(w[4]), sb = sin(w[4]), cc = cos(w[5]),
+               sc = sin(w[5]);
   P.R << cb * cc, -cb * sc, sb,                                  //
       ca * sc + sa * sb * cc, ca * cc - sa * sb * sc, -sa * cb,  //
       sa * sc - ca * sb * cc, sa * cc + ca * sb * sc, ca * cb;
@@ -70,14 +72,15 @@ Vec3<Scalar> oyama_displacement(const AxisErrors<Scalar>& w_BY, const AxisErrors
   const AxisErrors<Scalar> zero = AxisErrors<Scalar>::Zero();
   const Vec3<Scalar> p_machine = oyama_table_pose<Scalar>(zero, zero, B, C) * p_star;
   return rtest_displacement<Scalar>(oyama_table_pose(w_BY, w_CB, B, C), p_machine,
-                                    Eigen::Vector3d::Zero()) - p_star;
+                                    Eigen::Vector3d::Zero()) -
+         p_star;
 }
 
 /// Eq. 9: small-angle table error twist (dX, dY, dZ, dA, dB, dC) in the table frame.
 template <typename Scalar>
 Eigen::Matrix<Scalar, 6, 1> oyama_small_angle_twist(const AxisErrors<Scalar>& w_BY,
-                                                    const AxisErrors<Scalar>& w_CB,
-                                                    const Scalar& B, const Scalar& C) {
+                                                    const AxisErrors<Scalar>& w_CB, const Scalar& B,
+                                                    const Scalar& C) {
   using std::cos;
   using std::sin;
   const Scalar cB = cos(B), sB = sin(B), cC = cos(C), sC = sin(C);

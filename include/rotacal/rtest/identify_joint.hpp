@@ -7,7 +7,8 @@
 /// reading. The model (rtest_joint_reading below; on BC-trt error_model.hpp's rtest_table_pose):
 ///   T = prod over table axes k of E(w_k) Rot(line k, angle k)       (identity without table axes)
 ///   H = prod over head axes k of E(w_k) Rot(line k, angle k)        (identity without head axes)
-///   d = T^-1 (xyz + H t) - q_nest + zero_setup,  t = (0, 0, -(pivot + tool length) + tool_offset_Z)
+///   d = T^-1 (xyz + H t) - q_nest + zero_setup,  t = (0, 0, -(pivot + tool length) +
+///   tool_offset_Z)
 /// w_k is the tilt axis' map w_BY(B) on the tilt axis and the rotary axis' map w_CB(B, C) on the
 /// rotary axis, whichever side of the chain they are on (B = tilt, C = rotary angle; on BC-trt
 /// T(B, C) = E(w_BY(B)) Rot(B line, B) E(w_CB(B, C)) Rot(C line, C), Oyama Eqs. 5-7).
@@ -33,20 +34,18 @@
 
 #include <array>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
-
-#include <memory>
 
 #include "rotacal/core/estimate.hpp"
 #include "rotacal/core/noise_handling.hpp"
 #include "rotacal/core/whitener.hpp"
-#include "rotacal/session/session.hpp"
 #include "rotacal/rtest/error_model.hpp"
 #include "rotacal/rtest/model.hpp"
+#include "rotacal/session/session.hpp"
 
 namespace rotacal {
-
 
 /// Number of the model's non-map parameters: the 8 location errors, and on a machine with head
 /// axes tool_offset_Z (minus the error of pivot_length + tool_length, along the spindle).
@@ -88,7 +87,8 @@ struct RtestBasis {
   /// Basis values at (B, C) as matrices: w_BY = Lb * (tilt-map coefficients), w_CB = Lc *
   /// (rotary-map coefficients); Lb 6 x num_b_coefficients, Lc 6 x num_c_coefficients. The one
   /// evaluation of the basis, for the fit (rtest/problem.hpp) and the error maps.
-  void map_rows(double B, double C, Eigen::Ref<Eigen::MatrixXd> Lb, Eigen::Ref<Eigen::MatrixXd> Lc) const;
+  void map_rows(double B, double C, Eigen::Ref<Eigen::MatrixXd> Lb,
+                Eigen::Ref<Eigen::MatrixXd> Lc) const;
 };
 
 /// Everything needed to predict: location errors, map coefficients and their covariance.
@@ -164,7 +164,8 @@ Pose<Scalar> rtest_joint_table_pose(MachineType m, const RtestBasis& basis, cons
     for (Eigen::Index o = 0; o < Lc.cols(); ++o)
       if (Lc(k, o) != 0.0) wc[k] += cc[o] * Scalar(Lc(k, o));
   }
-  return rtest_joint_side_pose<Scalar>(m, LocationErrors<Scalar>::from_ptr(e), wb, wc, {B, C}, false);
+  return rtest_joint_side_pose<Scalar>(m, LocationErrors<Scalar>::from_ptr(e), wb, wc, {B, C},
+                                       false);
 }
 
 /// The joint model's R-test reading (rtest/model.hpp) for the sphere commanded to xyz (mm)
@@ -192,7 +193,8 @@ template <typename Scalar>
 Vec3<Scalar> rtest_joint_reading(const LocationErrors<Scalar>& e, const AxisErrors<Scalar>& w_BY,
                                  const AxisErrors<Scalar>& w_CB, double B, double C,
                                  const Eigen::Vector3d& xyz, const Eigen::Vector3d& q_nest) {
-  return rtest_joint_reading<Scalar>(MachineType::BC_trt, e, w_BY, w_CB, Scalar(0), {B, C}, xyz, q_nest);
+  return rtest_joint_reading<Scalar>(MachineType::BC_trt, e, w_BY, w_CB, Scalar(0), {B, C}, xyz,
+                                     q_nest);
 }
 
 struct RtestJointOptions {
@@ -223,19 +225,19 @@ struct RtestJointOptions {
 struct RtestJointIdentification {
   std::string method = "joint";
   RtestJointModel model;
-  std::vector<ParameterEstimate> parameters;  ///< location errors, map coefficients, zeros
-  Eigen::MatrixXd covariance;                 ///< in `parameters` order
+  std::vector<ParameterEstimate> parameters;           ///< location errors, map coefficients, zeros
+  Eigen::MatrixXd covariance;                          ///< in `parameters` order
   std::map<std::string, Eigen::Vector3d> probe_zeros;  ///< per set-up, mm
-  std::vector<Eigen::Vector3d> residuals;     ///< measured - model per sample, mm
-  double residual_rms_um = 0.0;               ///< over all components
-  double sigma_um = 0.0;                      ///< dof-corrected residual sigma used for covariance
+  std::vector<Eigen::Vector3d> residuals;              ///< measured - model per sample, mm
+  double residual_rms_um = 0.0;                        ///< over all components
+  double sigma_um = 0.0;  ///< dof-corrected residual sigma used for covariance
   std::size_t n_samples = 0;
   bool converged = false;
   int iterations = 0;
   std::vector<std::string> unobservable;  ///< combinations the nests cannot see, in words
   std::vector<std::string> notes;
   FitSummary summary;  ///< solver figures; whitened chi2/dof with a whitener
-  NoiseModel noise;          ///< noise model of the residuals (streams: nest x channel)
+  NoiseModel noise;    ///< noise model of the residuals (streams: nest x channel)
   /// Factor applied to the GLS covariance for the noise model's bias (estimated from
   /// residuals that the fit has already taken the slow noise from): core/noise_handling.hpp.
   double noise_correction = 1.0;

@@ -12,21 +12,21 @@
 #include <string>
 #include <vector>
 
-#include "rotacal/session/session.hpp"
 #include "rotacal/rtest/error_model.hpp"
+#include "rotacal/session/session.hpp"
 
 namespace rotacal {
 
 struct RtestPaperIdentification {
   std::string method = "paper";
-  std::vector<double> b_deg;                        ///< B_i, deg (ascending)
-  std::vector<double> c_deg;                        ///< C_j, deg (ascending)
-  std::vector<AxisErrors<double>> w_BY;             ///< per B_i (mm, rad)
-  std::vector<AxisErrors<double>> w_BY_std;         ///< 1 sigma per B_i (0 where assumed)
+  std::vector<double> b_deg;                          ///< B_i, deg (ascending)
+  std::vector<double> c_deg;                          ///< C_j, deg (ascending)
+  std::vector<AxisErrors<double>> w_BY;               ///< per B_i (mm, rad)
+  std::vector<AxisErrors<double>> w_BY_std;           ///< 1 sigma per B_i (0 where assumed)
   std::vector<std::vector<AxisErrors<double>>> w_CB;  ///< [i][j], gamma_CB = 0 (assumed)
   std::vector<std::vector<AxisErrors<double>>> w_CB_std;
-  double b_step_rms_um = 0.0;   ///< residual RMS of step 1 (includes what C errors cause)
-  double residual_rms_um = 0.0; ///< residual RMS after both steps (2 nests: 1 dof per pose)
+  double b_step_rms_um = 0.0;    ///< residual RMS of step 1 (includes what C errors cause)
+  double residual_rms_um = 0.0;  ///< residual RMS after both steps (2 nests: 1 dof per pose)
   std::size_t n_samples = 0;
   std::vector<std::string> unobservable;  ///< what the method cannot see, in words
   std::vector<std::string> notes;         ///< the paper's assumptions

@@ -37,10 +37,11 @@ template <typename Scalar>
 Vec3<Scalar> rtest_reading(MachineType m, const LocationErrors<Scalar>& e, const EffectModel& fx,
                            const Scalar* fxp, const Eigen::Vector3d& xyz,
                            const RotaryAngles<double>& angles, double t,
-                           const Eigen::Vector3d& q_nest, const Scalar& tool_length_error = Scalar(0)) {
-  return rtest_displacement<Scalar>(table_pose<Scalar>(m, e, fx, fxp, angles, t),
-                                    tool_position<Scalar>(m, e, fx, fxp, xyz, angles, t, tool_length_error),
-                                    q_nest);
+                           const Eigen::Vector3d& q_nest,
+                           const Scalar& tool_length_error = Scalar(0)) {
+  return rtest_displacement<Scalar>(
+      table_pose<Scalar>(m, e, fx, fxp, angles, t),
+      tool_position<Scalar>(m, e, fx, fxp, xyz, angles, t, tool_length_error), q_nest);
 }
 
 /// Noise-free reading d (table frame, mm, no probe zero) of the nest at q_nest (table frame)
@@ -48,12 +49,14 @@ Vec3<Scalar> rtest_reading(MachineType m, const LocationErrors<Scalar>& e, const
 inline Eigen::Vector3d rtest_reading(const MachineModel& model, const Eigen::Vector3d& q_nest,
                                      const RotaryAngles<double>& angles, double t) {
   return rtest_reading<double>(model.machine, model.errors, model.effects, model.effect_data(),
-                               rtest_commanded_xyz(model.machine, q_nest, angles), angles, t, q_nest);
+                               rtest_commanded_xyz(model.machine, q_nest, angles), angles, t,
+                               q_nest);
 }
 
 /// Noise-free readings of the nest at q_nest at each pose (rad) and time (s). The linear-axis
 /// polynomials are about the model's a_ref, unset: the mean commanded xyz of these poses.
-inline std::vector<Eigen::Vector3d> rtest_readings(const MachineModel& model, const Eigen::Vector3d& q_nest,
+inline std::vector<Eigen::Vector3d> rtest_readings(const MachineModel& model,
+                                                   const Eigen::Vector3d& q_nest,
                                                    const std::vector<RotaryAngles<double>>& angles,
                                                    const std::vector<double>& times) {
   MachineModel m = model;
@@ -63,7 +66,8 @@ inline std::vector<Eigen::Vector3d> rtest_readings(const MachineModel& model, co
     m.effects.linear_reference = sum / static_cast<double>(std::max<std::size_t>(angles.size(), 1));
   }
   std::vector<Eigen::Vector3d> out;
-  for (std::size_t i = 0; i < angles.size(); ++i) out.push_back(rtest_reading(m, q_nest, angles[i], times[i]));
+  for (std::size_t i = 0; i < angles.size(); ++i)
+    out.push_back(rtest_reading(m, q_nest, angles[i], times[i]));
   return out;
 }
 

@@ -18,7 +18,8 @@ namespace rotacal {
 struct RtestMonteCarloOptions {
   int draws = 100;
   std::uint64_t seed = 1;  ///< draw k uses std::mt19937_64(seed + k)
-  RtestJointOptions fit;   ///< the identification's options (basis); noise handling is taken from the result
+  RtestJointOptions
+      fit;  ///< the identification's options (basis); noise handling is taken from the result
   /// Called after every draw with (draws done, draws); may be empty.
   std::function<void(int, int)> progress;
 };

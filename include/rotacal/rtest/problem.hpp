@@ -21,10 +21,10 @@
 #include <vector>
 
 #include "rotacal/core/joint_fit.hpp"
-#include "rotacal/session/session.hpp"
 #include "rotacal/kinematics/parameter_blocks.hpp"
 #include "rotacal/rtest/identify_joint.hpp"
 #include "rotacal/rtest/model.hpp"
+#include "rotacal/session/session.hpp"
 
 namespace rotacal {
 
@@ -40,8 +40,9 @@ enum class RtestZeroNames { dotted, numbered };
 
 /// The layout of a problem on machine m with a probe zero for each of `setups`, the maps of
 /// `basis` (nullptr: none) and the parameters of fx.
-RtestLayout rtest_layout(MachineType m, const std::vector<std::string>& setups, const RtestBasis* basis,
-                         const EffectModel& fx, RtestZeroNames zero_names = RtestZeroNames::dotted);
+RtestLayout rtest_layout(MachineType m, const std::vector<std::string>& setups,
+                         const RtestBasis* basis, const EffectModel& fx,
+                         RtestZeroNames zero_names = RtestZeroNames::dotted);
 
 /// The poses of an R-test fit as arrays (structure of arrays), three residual rows each.
 struct RtestArrays {
@@ -64,13 +65,13 @@ RtestArrays rtest_arrays(const RtestSession& session, const std::string& who, bo
 /// (location errors, tool_offset_Z, effects; no maps), parameters p in `L`'s order (doubles
 /// or Jets).
 template <typename T>
-Vec3<T> rtest_residual(const RtestLayout& L, const RtestArrays& d, const EffectModel& fx, const T* p,
-                       Eigen::Index i) {
+Vec3<T> rtest_residual(const RtestLayout& L, const RtestArrays& d, const EffectModel& fx,
+                       const T* p, Eigen::Index i) {
   const std::size_t k = static_cast<std::size_t>(i);
   const T* zero = p + L.zeros.item_offset(d.setup_of[k]);
-  const Vec3<T> r = rtest_reading<T>(d.machine, LocationErrors<T>::from_ptr(L.errors.ptr(p)), fx, L.effects.ptr(p),
-                                     d.xyz.col(i), d.angles[k], d.time[k], d.nest.col(i),
-                                     L.tool.empty() ? T(0) : T(-p[L.tool.offset]));
+  const Vec3<T> r = rtest_reading<T>(d.machine, LocationErrors<T>::from_ptr(L.errors.ptr(p)), fx,
+                                     L.effects.ptr(p), d.xyz.col(i), d.angles[k], d.time[k],
+                                     d.nest.col(i), L.tool.empty() ? T(0) : T(-p[L.tool.offset]));
   Vec3<T> out;
   for (int a = 0; a < 3; ++a) out[a] = r[a] + zero[a] - T(d.d(a, i));
   return out;
@@ -92,10 +93,12 @@ class RtestProblem : public ResidualModel {
   int num_parameters() const override { return static_cast<int>(L_.all.size()); }
   Eigen::Index num_items() const override { return d_.size(); }
   int rows_per_item() const override { return 3; }
-  void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r, Eigen::MatrixXd* J) const override;
+  void evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r,
+                Eigen::MatrixXd* J) const override;
 
  private:
-  void evaluate_maps(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r, Eigen::MatrixXd* J) const;
+  void evaluate_maps(const Eigen::VectorXd& x, Eigen::Ref<Eigen::VectorXd> r,
+                     Eigen::MatrixXd* J) const;
   const RtestArrays& d_;
   EffectModel fx_;  // by value: callers pass a model centred on the session (a temporary)
   RtestLayout L_;

@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "rotacal/kinematics/machine_model.hpp"
-#include "rotacal/session/session.hpp"
 #include "rotacal/rtest/model.hpp"
+#include "rotacal/session/session.hpp"
 
 namespace rotacal {
 
@@ -23,11 +23,13 @@ namespace rotacal {
 /// On any machine b_deg are the tilt axis' angles and c_deg the rotary axis' (RotaryAngles);
 /// default_rtest_pattern fits them and the nests to a machine's limits.
 struct RtestPattern {
-  std::vector<double> b_deg = {-90, -60, -30, 0, 30, 60, 90};                      ///< tilt, deg
-  std::vector<double> c_deg = {0, 30, 60, 90, 120, 150, 180, 210, 240, 270, 300, 330};  ///< rotary, deg
+  std::vector<double> b_deg = {-90, -60, -30, 0, 30, 60, 90};  ///< tilt, deg
+  std::vector<double> c_deg = {0,   30,  60,  90,  120, 150,
+                               180, 210, 240, 270, 300, 330};  ///< rotary, deg
   std::vector<Eigen::Vector3d> nests = {Eigen::Vector3d(100, 0, 60),
                                         Eigen::Vector3d(0, -120, 140)};  ///< table frame, mm
-  double dwell_s = 6.0;  ///< time between poses, s; the program holds each pose at rest for the middle 80 % (hw/pose_window.hpp)
+  double dwell_s = 6.0;  ///< time between poses, s; the program holds each pose at rest for the
+                         ///< middle 80 % (hw/pose_window.hpp)
 };
 
 /// The paper's pattern fitted to machine m: seven tilt angles over the widest span of at most

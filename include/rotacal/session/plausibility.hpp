@@ -25,17 +25,18 @@ namespace rotacal {
 
 /// Limits of the plausibility checks (mm, deg).
 struct PlausibilityOptions {
-  double max_length_deviation_mm = 2.0;   ///< ballbar: |measured - nominal length|
-  double max_position_deviation_mm = 2.0; ///< R-test: |commanded centre - nominal nest position|
-  double max_displacement_mm = 1.0;       ///< R-test: |dx|, |dy|, |dz|
-  double min_ballbar_length_mm = 20.0;    ///< L0
-  double min_rotary_span_deg = 1.0;       ///< span of the tilt or C angles
+  double max_length_deviation_mm = 2.0;    ///< ballbar: |measured - nominal length|
+  double max_position_deviation_mm = 2.0;  ///< R-test: |commanded centre - nominal nest position|
+  double max_displacement_mm = 1.0;        ///< R-test: |dx|, |dy|, |dz|
+  double min_ballbar_length_mm = 20.0;     ///< L0
+  double min_rotary_span_deg = 1.0;        ///< span of the tilt or C angles
 };
 
 /// What the checks measured (for a report), when the session passed.
 struct PlausibilityReport {
-  double median_deviation_mm = 0.0;  ///< median |measured - nominal| (ballbar) or |xyz - nominal| (R-test)
-  double max_deviation_mm = 0.0;     ///< the largest, with the sample it came from
+  double median_deviation_mm =
+      0.0;  ///< median |measured - nominal| (ballbar) or |xyz - nominal| (R-test)
+  double max_deviation_mm = 0.0;  ///< the largest, with the sample it came from
   std::size_t worst_sample = 0;
   double tilt_span_deg = 0.0;
   double rot_span_deg = 0.0;

@@ -23,10 +23,13 @@ struct ProbeSample {
   Eigen::Vector3d xyz = Eigen::Vector3d::Zero();  ///< latched X, Y, Z, machine frame, mm
   double tilt_deg = 0.0;                          ///< tilt axis (A or B), deg
   double rot_deg = 0.0;                           ///< rotary axis (C), deg
-  Eigen::Vector3d n = Eigen::Vector3d::UnitZ();   ///< unit direction of the probe's motion, machine frame
-  std::vector<std::string> extra;                 ///< values of extra columns, as text
+  Eigen::Vector3d n =
+      Eigen::Vector3d::UnitZ();    ///< unit direction of the probe's motion, machine frame
+  std::vector<std::string> extra;  ///< values of extra columns, as text
 
-  RotaryAngles<double> angles_rad() const { return {tilt_deg * M_PI / 180.0, rot_deg * M_PI / 180.0}; }
+  RotaryAngles<double> angles_rad() const {
+    return {tilt_deg * M_PI / 180.0, rot_deg * M_PI / 180.0};
+  }
 };
 
 /// A `rotacal-probe/1` session.
@@ -34,9 +37,9 @@ struct ProbeSession {
   MachineType machine = MachineType::AC_trt;
   Eigen::Vector3d sphere = Eigen::Vector3d::Zero();  ///< nominal sphere centre, table frame, mm
   double sphere_diameter = 0.0;                      ///< calibrated, mm
-  double stylus_diameter = 0.0;                      ///< effective (calibrated, mean pretravel included), mm
-  std::optional<double> noise_um;                    ///< 1 sigma of each latched coordinate, um
-  Metadata metadata;                                 ///< every `# key: value` line, in order
+  double stylus_diameter = 0.0;    ///< effective (calibrated, mean pretravel included), mm
+  std::optional<double> noise_um;  ///< 1 sigma of each latched coordinate, um
+  Metadata metadata;               ///< every `# key: value` line, in order
   std::vector<std::string> extra_columns;
   std::vector<Annotation> annotations;
   std::vector<ProbeSample> samples;

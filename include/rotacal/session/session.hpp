@@ -27,13 +27,13 @@ struct Annotation {
 
 /// One row of a ballbar session.
 struct BallbarSample {
-  std::string test;                                    ///< test label, e.g. "radial_A"
-  double time = 0.0;                                   ///< s, non-decreasing
-  Eigen::Vector3d xyz = Eigen::Vector3d::Zero();       ///< tool cup, commanded, machine frame, mm
-  double tilt_deg = 0.0;                               ///< A or B, deg
-  double rot_deg = 0.0;                                ///< C, deg
-  double length = 0.0;                                 ///< measured centre-to-centre length, mm
-  std::vector<std::string> extra;                      ///< values of extra columns, as text
+  std::string test;                               ///< test label, e.g. "radial_A"
+  double time = 0.0;                              ///< s, non-decreasing
+  Eigen::Vector3d xyz = Eigen::Vector3d::Zero();  ///< tool cup, commanded, machine frame, mm
+  double tilt_deg = 0.0;                          ///< A or B, deg
+  double rot_deg = 0.0;                           ///< C, deg
+  double length = 0.0;                            ///< measured centre-to-centre length, mm
+  std::vector<std::string> extra;                 ///< values of extra columns, as text
 
   RotaryAngles<double> angles_rad() const;
 };
@@ -41,11 +41,11 @@ struct BallbarSample {
 /// A `rotacal-ballbar/1` session.
 struct BallbarSession {
   MachineType machine = MachineType::AC_trt;
-  double ballbar_length = 0.0;                          ///< calibrated L0, mm
-  Eigen::Vector3d pivot = Eigen::Vector3d::Zero();      ///< nominal centre-pivot ball, table frame, mm
-  std::optional<double> noise_um;                       ///< 1-sigma noise of one reading, um
-  Metadata metadata;                                    ///< every `# key: value` line, in order
-  std::vector<std::string> extra_columns;               ///< columns beyond the required ones
+  double ballbar_length = 0.0;                      ///< calibrated L0, mm
+  Eigen::Vector3d pivot = Eigen::Vector3d::Zero();  ///< nominal centre-pivot ball, table frame, mm
+  std::optional<double> noise_um;                   ///< 1-sigma noise of one reading, um
+  Metadata metadata;                                ///< every `# key: value` line, in order
+  std::vector<std::string> extra_columns;           ///< columns beyond the required ones
   std::vector<Annotation> annotations;
   std::vector<BallbarSample> samples;
   /// What the reader found suspicious but kept (e.g. rows repeated exactly); not written back.
@@ -59,13 +59,13 @@ struct BallbarSession {
 
 /// One row of an R-test session.
 struct RtestSample {
-  std::string setup;                                   ///< nest label: "N" of `nest.N`
-  double time = 0.0;                                   ///< s, non-decreasing
-  double tilt_deg = 0.0;                               ///< B (or A), deg
-  double rot_deg = 0.0;                                ///< C, deg
-  Eigen::Vector3d xyz = Eigen::Vector3d::Zero();       ///< commanded sphere centre, machine frame, mm
-  std::optional<Eigen::Vector3d> d;                    ///< dx,dy,dz: sphere displacement, table frame, mm
-  std::optional<Eigen::Vector3d> raw;                  ///< d1,d2,d3: probe readings, mm
+  std::string setup;                              ///< nest label: "N" of `nest.N`
+  double time = 0.0;                              ///< s, non-decreasing
+  double tilt_deg = 0.0;                          ///< B (or A), deg
+  double rot_deg = 0.0;                           ///< C, deg
+  Eigen::Vector3d xyz = Eigen::Vector3d::Zero();  ///< commanded sphere centre, machine frame, mm
+  std::optional<Eigen::Vector3d> d;    ///< dx,dy,dz: sphere displacement, table frame, mm
+  std::optional<Eigen::Vector3d> raw;  ///< d1,d2,d3: probe readings, mm
   std::vector<std::string> extra;
 
   RotaryAngles<double> angles_rad() const;
@@ -74,8 +74,9 @@ struct RtestSample {
 /// A `rotacal-rtest/1` session.
 struct RtestSession {
   MachineType machine = MachineType::BC_trt;
-  std::map<std::string, Eigen::Vector3d> nests;         ///< "N" -> nominal ball centre of nest.N, table frame, mm
-  std::map<int, Eigen::Vector3d> probe_dirs;            ///< N -> probe.N.dir (unit, table frame)
+  std::map<std::string, Eigen::Vector3d>
+      nests;  ///< "N" -> nominal ball centre of nest.N, table frame, mm
+  std::map<int, Eigen::Vector3d> probe_dirs;  ///< N -> probe.N.dir (unit, table frame)
   std::optional<double> noise_um;
   Metadata metadata;
   std::vector<std::string> extra_columns;

@@ -10,5 +10,6 @@ package of one module per command group over the library; the library never impo
   circular: the commands;
 - parser: the parser built from those modules, and main.
 """
+
 from .options import EXIT_ERROR, EXIT_INPUT, EXIT_IO, EXIT_OK, EXIT_USAGE  # noqa: F401
 from .parser import build_parser, main  # noqa: F401

@@ -1,5 +1,6 @@
 """``rotacal demo`` (the whole job on a simulated machine) and ``rotacal table2`` (Flynn et
 al.'s measured Table 2 against the simulated measure -> compensate -> measure-again chain)."""
+
 from __future__ import annotations
 
 import argparse
@@ -14,6 +15,7 @@ def cmd_demo(a: argparse.Namespace) -> int:
     compensate, and write a report."""
     from ..demo import run_demo
     from ..diagnosis import group_text
+
     r = run_demo(a.output, seed=a.seed, sag_mm=a.sag, say=say)
     print(f"hidden effect: gravity_sag_A, s = {a.sag * 1e3:.1f} um")
     f = r["finding"]
@@ -21,13 +23,19 @@ def cmd_demo(a: argparse.Namespace) -> int:
         name, p = next(iter(f["parameters"].items()))
         size = f"{name} = {units.estimate_text(p['value'], p['std'], p['unit'])}"
         if f["named"]:
-            print(f"diagnosis found: {f['effect']} ({f['cause']}, weight {f['weight']:.2f}), {size}")
+            print(
+                f"diagnosis found: {f['effect']} ({f['cause']}, weight {f['weight']:.2f}), {size}"
+            )
         else:
-            print(f"diagnosis found one of: {group_text(f)}, which this session cannot separate "
-                  f"(BIC weights); if {f['effect']}: {size}")
+            print(
+                f"diagnosis found one of: {group_text(f)}, which this session cannot separate "
+                f"(BIC weights); if {f['effect']}: {size}"
+            )
     else:
         print("diagnosis found nothing significant")
-    print(f"compensation reduced every location error by at least {-r['worst_change_percent']:.1f} %")
+    print(
+        f"compensation reduced every location error by at least {-r['worst_change_percent']:.1f} %"
+    )
     print(f"report: {Path(r['report']).resolve()}")
     return EXIT_OK
 
@@ -36,41 +44,80 @@ def cmd_table2(a: argparse.Namespace) -> int:
     """Measured before/after identifications (default: Flynn et al.'s Table 2) against the
     simulated measure -> compensate -> measure-again chain: what falls outside, and why."""
     from .. import flynn_table2 as t2
+
     table = t2.load_table2(a.table) if a.table else t2.load_table2()
-    assumptions = t2.Assumptions(noise_um=a.noise, noise_rho=a.rho, hours_between_runs=a.hours, method=a.method)
-    result = t2.analyse(table, assumptions, draws=a.draws, seed=a.seed, sweep=[] if a.no_sweep else None)
+    assumptions = t2.Assumptions(
+        noise_um=a.noise, noise_rho=a.rho, hours_between_runs=a.hours, method=a.method
+    )
+    result = t2.analyse(
+        table, assumptions, draws=a.draws, seed=a.seed, sweep=[] if a.no_sweep else None
+    )
     print(jsontext.dumps(result) if a.json else t2.render(result))
     return EXIT_OK
 
 
 def add_table2(sub: argparse._SubParsersAction) -> None:
-    q = sub.add_parser("table2", help="measured before/after compensation (Flynn et al. Table 2) against "
-                                      "the simulated chain: what falls outside, and which causes explain it",
-                       epilog=EPILOG)
-    q.add_argument("--table", type=path("--table"), metavar="FILE.json",
-                   help="before/after values in the layout of rotacal/data/flynn2016_table2.json "
-                        "(default: the paper's Table 2)")
-    q.add_argument("--method", default="paper", choices=["paper", "joint"],
-                   help="identification of both runs (the paper used its own chain)")
-    q.add_argument("--noise", type=number("--noise", 0.0, 100.0, "um", lo_open=True), default=0.5,
-                   help="assumed 1-sigma ballbar noise, um")
-    q.add_argument("--rho", type=number("--rho", 0.0, 0.999), default=0.0,
-                   help="assumed AR(1) correlation of successive samples")
-    q.add_argument("--hours", type=number("--hours", 0.0, 10_000.0, "h"), default=1.0,
-                   help="assumed time between the two runs, h")
+    q = sub.add_parser(
+        "table2",
+        help="measured before/after compensation (Flynn et al. Table 2) against "
+        "the simulated chain: what falls outside, and which causes explain it",
+        epilog=EPILOG,
+    )
+    q.add_argument(
+        "--table",
+        type=path("--table"),
+        metavar="FILE.json",
+        help="before/after values in the layout of rotacal/data/flynn2016_table2.json "
+        "(default: the paper's Table 2)",
+    )
+    q.add_argument(
+        "--method",
+        default="paper",
+        choices=["paper", "joint"],
+        help="identification of both runs (the paper used its own chain)",
+    )
+    q.add_argument(
+        "--noise",
+        type=number("--noise", 0.0, 100.0, "um", lo_open=True),
+        default=0.5,
+        help="assumed 1-sigma ballbar noise, um",
+    )
+    q.add_argument(
+        "--rho",
+        type=number("--rho", 0.0, 0.999),
+        default=0.0,
+        help="assumed AR(1) correlation of successive samples",
+    )
+    q.add_argument(
+        "--hours",
+        type=number("--hours", 0.0, 10_000.0, "h"),
+        default=1.0,
+        help="assumed time between the two runs, h",
+    )
     q.add_argument("--draws", type=number("--draws", 10, 100_000, integer=True), default=200)
     q.add_argument("--seed", type=SEED, default=1)
-    q.add_argument("--no-sweep", action="store_true", help="skip the sweep over the unstated assumptions")
+    q.add_argument(
+        "--no-sweep", action="store_true", help="skip the sweep over the unstated assumptions"
+    )
     q.add_argument("--json", action="store_true")
     q.set_defaults(func=cmd_table2)
 
 
 def add_demo(sub: argparse._SubParsersAction) -> None:
-    q = sub.add_parser("demo", help="the whole job on a simulated machine: plan, simulate, identify, "
-                                    "diagnose, compensate, report", epilog=EPILOG)
+    q = sub.add_parser(
+        "demo",
+        help="the whole job on a simulated machine: plan, simulate, identify, "
+        "diagnose, compensate, report",
+        epilog=EPILOG,
+    )
     q.add_argument("-o", "--output", default="out/demo", type=path("--output"))
     q.add_argument("--seed", type=SEED, default=2016)
-    q.add_argument("--sag", type=number("--sag", -1.0, 1.0, "mm"), default=0.004, help="hidden gravity sag of the A table, mm")
+    q.add_argument(
+        "--sag",
+        type=number("--sag", -1.0, 1.0, "mm"),
+        default=0.004,
+        help="hidden gravity sag of the A table, mm",
+    )
     q.set_defaults(func=cmd_demo)
 
 

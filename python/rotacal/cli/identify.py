@@ -1,12 +1,23 @@
 """``rotacal identify`` (location errors of a session, their uncertainty budget, the model file
 and the history entry) and ``rotacal predict`` (a session predicted by a model file)."""
+
 from __future__ import annotations
 
 import argparse
 
 from .. import _core, jsontext, units
 from ..sessions import BALLBAR, PROBE, RTEST, by_kind, kind, save
-from .options import (EPILOG, EXIT_OK, SEED, OptionError, budget_sizes, controller_text, number, path, say)
+from .options import (
+    EPILOG,
+    EXIT_OK,
+    SEED,
+    OptionError,
+    budget_sizes,
+    controller_text,
+    number,
+    path,
+    say,
+)
 from .setups import add_db_arg, add_plausibility_arg, load_session
 
 
@@ -23,27 +34,37 @@ def _fmt_value(v, unit: str) -> str:
 
 def print_noise_model(nm: dict) -> None:
     from ..results import noise_handling_words
+
     how = f"; {noise_handling_words(nm)}" if "gls_refit" in nm else ""
     print(f"noise model: {nm['summary']}{how}")
 
 
 def print_budget(b: dict) -> None:
     from ..results import budget_why
+
     print(f"uncertainty budget (GUM; coverage {b['coverage'] * 100:.0f} %; um / urad):")
-    print(f"  {'':6s} {'value':>10s} {'type A':>8s} {'u_c':>8s} {'U':>8s} {'k':>5s} {'nu_eff':>7s}  dominant left-out effect")
+    print(
+        f"  {'':6s} {'value':>10s} {'type A':>8s} {'u_c':>8s} {'U':>8s} {'k':>5s} {'nu_eff':>7s}  dominant left-out effect"
+    )
     for name, e in b["location_errors"].items():
         if not e["observable"]:
             print(f"  {name:6s} unobservable")
             continue
         f = 1e6 if e["unit"] == "rad" else 1e3
         nu = "inf" if e["nu_eff"] is None else f"{e['nu_eff']:.0f}"
-        dom = e["dominant"][0] if e["dominant"] else (e["type_b"][0]["effect"] if e["type_b"] else "-")
+        dom = (
+            e["dominant"][0]
+            if e["dominant"]
+            else (e["type_b"][0]["effect"] if e["type_b"] else "-")
+        )
         line = e["type_b"][0] if e["type_b"] else None
         dom_u = ""
         if line is not None and dom == line["effect"]:
             dom_u = f" ({line['u'] * f:.3f}, {line['basis']})"
-        print(f"  {name:6s} {e['value'] * f:+10.3f} {e['u_a'] * f:8.3f} {e['u_c'] * f:8.3f} "
-              f"{e['expanded'] * f:8.3f} {e['k']:5.2f} {nu:>7s}  {dom}{dom_u}")
+        print(
+            f"  {name:6s} {e['value'] * f:+10.3f} {e['u_a'] * f:8.3f} {e['u_c'] * f:8.3f} "
+            f"{e['expanded'] * f:8.3f} {e['k']:5.2f} {nu:>7s}  {dom}{dom_u}"
+        )
     why = budget_why(b)
     if why:
         print("  " + why)
@@ -51,31 +72,52 @@ def print_budget(b: dict) -> None:
 
 def _print_monte_carlo(mc: dict) -> None:
     noise = mc.get("noise") or f"white noise, {mc['noise_um']:.3f} um"
-    print(f"Monte Carlo check of the 1-sigma, {mc['draws']} draws with {noise} "
-          "(ratio = Monte Carlo sigma / reported sigma):")
+    print(
+        f"Monte Carlo check of the 1-sigma, {mc['draws']} draws with {noise} "
+        "(ratio = Monte Carlo sigma / reported sigma):"
+    )
     for name, m in mc["parameters"].items():
         scale, unit = (1e6, "urad") if m["unit"] == "rad" else (1e3, "um")
-        print(f"  {name:16s} reported {m['std_reported'] * scale:8.3f}  Monte Carlo {m['std_mc'] * scale:8.3f} "
-              f"{unit:4s}  ratio {m['ratio']:.2f}")
+        print(
+            f"  {name:16s} reported {m['std_reported'] * scale:8.3f}  Monte Carlo {m['std_mc'] * scale:8.3f} "
+            f"{unit:4s}  ratio {m['ratio']:.2f}"
+        )
 
 
 def print_identification(d: dict) -> None:
-    print(f"{d['method']} identification, {d['machine']}, {d['n_samples']} samples, "
-          f"residual RMS {d['residual_rms_um']:.3f} um")
+    print(
+        f"{d['method']} identification, {d['machine']}, {d['n_samples']} samples, "
+        f"residual RMS {d['residual_rms_um']:.3f} um"
+    )
     budget = d.get("uncertainty_budget")
     for name, p in d["location_errors"].items():
         if p["value"] is None:
             print(f"  {name:6s}  unobservable")
             continue
-        print(f"  {name:6s} {_fmt_value(p['value'], p['unit'])} +- {p['std'] * _shown(p['unit'])[0]:.3f}")
+        print(
+            f"  {name:6s} {_fmt_value(p['value'], p['unit'])} +- {p['std'] * _shown(p['unit'])[0]:.3f}"
+        )
     for axis, p in d.get("pivot", {}).items():
-        print(f"  pivot {axis}  " + ("unobservable" if p["value"] is None else f"{p['value']:.4f} mm +- {p['std'] * 1e3:.3f} um"))
+        print(
+            f"  pivot {axis}  "
+            + (
+                "unobservable"
+                if p["value"] is None
+                else f"{p['value']:.4f} mm +- {p['std'] * 1e3:.3f} um"
+            )
+        )
     for eff in d.get("effects", []):
         for pname, p in eff["params"].items():
             what = f"{eff['id']} ({eff['cause']})"
-            print(f"  {what}: " + ("unobservable" if p["value"] is None
-                                   else f"{pname} = {_fmt_value(p['value'], p['unit']).strip()} +- "
-                                        f"{p['std'] * _shown(p['unit'])[0]:.3f}"))
+            print(
+                f"  {what}: "
+                + (
+                    "unobservable"
+                    if p["value"] is None
+                    else f"{pname} = {_fmt_value(p['value'], p['unit']).strip()} +- "
+                    f"{p['std'] * _shown(p['unit'])[0]:.3f}"
+                )
+            )
     for u in d["unobservable"]:
         print(f"  not determined by these tests: {u}")
     for n in d.get("notes", []):
@@ -93,12 +135,22 @@ def _refuse_history_options(a: argparse.Namespace) -> None:
     can be opened, a valid date; the others go with --store (--controller also --save-model)."""
     if a.store or a.machine_id is not None:
         from ..history import refuse_before_storing
+
         if not a.store:
-            raise OptionError("--machine-id: add --store to store the identification in the history")
+            raise OptionError(
+                "--machine-id: add --store to store the identification in the history"
+            )
         refuse_before_storing(a.db, a.machine_id, a.date)
-    elif a.note is not None or a.date is not None or a.db is not None or (a.controller and not a.save_model):
-        raise OptionError("--note, --date and --db go with --store --machine-id; --controller with --store or "
-                          "--save-model")
+    elif (
+        a.note is not None
+        or a.date is not None
+        or a.db is not None
+        or (a.controller and not a.save_model)
+    ):
+        raise OptionError(
+            "--note, --date and --db go with --store --machine-id; --controller with --store or "
+            "--save-model"
+        )
 
 
 def print_joint_identification(d: dict) -> None:
@@ -110,25 +162,43 @@ def print_joint_identification(d: dict) -> None:
             print(f"  {name:6s}  unobservable")
             continue
         f = _shown(p["unit"])[0]
-        alone = "  ".join(f"{s['name']}: " + ("unobservable" if a["value"] is None else
-                                               f"{a['value'] * f:+.3f} +- {a['std'] * f:.3f}")
-                          for s in d["sessions"] for a in (s["alone"][name],))
-        print(f"  {name:6s} {_fmt_value(p['value'], p['unit'])} +- {p['std'] * f:.3f}   (alone: {alone})")
+        alone = "  ".join(
+            f"{s['name']}: "
+            + (
+                "unobservable"
+                if a["value"] is None
+                else f"{a['value'] * f:+.3f} +- {a['std'] * f:.3f}"
+            )
+            for s in d["sessions"]
+            for a in (s["alone"][name],)
+        )
+        print(
+            f"  {name:6s} {_fmt_value(p['value'], p['unit'])} +- {p['std'] * f:.3f}   (alone: {alone})"
+        )
     for name, p in d["effects"].items():
-        shown = "unobservable" if p["value"] is None else \
-            f"{_fmt_value(p['value'], p['unit']).strip()} +- {p['std'] * _shown(p['unit'])[0]:.3f}"
+        shown = (
+            "unobservable"
+            if p["value"] is None
+            else f"{_fmt_value(p['value'], p['unit']).strip()} +- {p['std'] * _shown(p['unit'])[0]:.3f}"
+        )
         print(f"  {name} (shared): {shown}")
     for s in d["sessions"]:
-        own = ", ".join(f"{n} = " + ("unobservable" if p["value"] is None else f"{p['value']:.4f} {p['unit']}")
-                        for n, p in s["nuisances"].items())
-        print(f"  session {s['name']} ({s['instrument']}, {s['n_residuals']} residuals, RMS "
-              f"{s['residual_rms_um']:.3f} um): {own}")
+        own = ", ".join(
+            f"{n} = " + ("unobservable" if p["value"] is None else f"{p['value']:.4f} {p['unit']}")
+            for n, p in s["nuisances"].items()
+        )
+        print(
+            f"  session {s['name']} ({s['instrument']}, {s['n_residuals']} residuals, RMS "
+            f"{s['residual_rms_um']:.3f} um): {own}"
+        )
         print("    ", end="")
         print_noise_model(s["noise_model"])
     for g in d["disagreements"]:
         f, shown = _shown(g["unit"])
-        print(f"  DISAGREE {g['parameter']}: {g['sessions'][0]} - {g['sessions'][1]} = {g['difference'] * f:+.3f} "
-              f"+- {g['sigma'] * f:.3f} {shown.strip()} (z = {g['z']:+.1f})")
+        print(
+            f"  DISAGREE {g['parameter']}: {g['sessions'][0]} - {g['sessions'][1]} = {g['difference'] * f:+.3f} "
+            f"+- {g['sigma'] * f:.3f} {shown.strip()} (z = {g['z']:+.1f})"
+        )
     for u in d["unobservable"]:
         print(f"  not determined by these sessions: {u}")
     for n in d["notes"]:
@@ -140,29 +210,52 @@ def _keep(a: argparse.Namespace, result, d: dict, files) -> None:
     by the C++ writer, strict: a non-finite number is written null with its reason) and the
     history entry. ``files``: the session, or the list of sessions of a joint identification."""
     from ..analysis import identification_document
+
     inputs = tuple(files) if isinstance(files, list) else (files,)
     if a.save_model:
         from ..models import save_model
-        save_model(identification_document(result, files, controller_text(a.controller)), a.save_model,
-                   inputs=inputs)
+
+        save_model(
+            identification_document(result, files, controller_text(a.controller)),
+            a.save_model,
+            inputs=inputs,
+        )
         say(f"wrote {a.save_model}")
     if a.store:
         from ..history import open_history, redact
+
         controller = controller_text(a.controller)
         with open_history(a.db) as h:
-            entry = h.add_identification(a.machine_id, identification_document(result, files), note=a.note,
-                                         measured_at=a.date, details={"identification": d},
-                                         controller=controller, where=", ".join(inputs))
+            entry = h.add_identification(
+                a.machine_id,
+                identification_document(result, files),
+                note=a.note,
+                measured_at=a.date,
+                details={"identification": d},
+                controller=controller,
+                where=", ".join(inputs),
+            )
             say(f"stored as entry {entry} of machine {a.machine_id!r} in {redact(h.location)}")
 
 
 def _cmd_identify_joint(a: argparse.Namespace) -> int:
     """Several sessions of one machine: one joint identification (rotacal.multi)."""
     from ..multi import identify_sessions
-    given = [o for o, on in ((f"--method {a.method}", a.method != "joint"), ("--length-offset", a.length_offset),
-                             ("--monte-carlo", a.monte_carlo), ("--budget-sizes", a.budget_sizes)) if on]
+
+    given = [
+        o
+        for o, on in (
+            (f"--method {a.method}", a.method != "joint"),
+            ("--length-offset", a.length_offset),
+            ("--monte-carlo", a.monte_carlo),
+            ("--budget-sizes", a.budget_sizes),
+        )
+        if on
+    ]
     if given:
-        raise OptionError(f"{', '.join(given)}: not available for a joint identification of several sessions")
+        raise OptionError(
+            f"{', '.join(given)}: not available for a joint identification of several sessions"
+        )
     _refuse_history_options(a)
     sessions = [load_session(f, a) for f in a.file]
     result = identify_sessions(sessions, list(a.file), noise=a.noise)
@@ -177,6 +270,7 @@ def _cmd_identify_joint(a: argparse.Namespace) -> int:
 
 def cmd_identify(a: argparse.Namespace) -> int:
     from ..analysis import identification_budget, identify, monte_carlo
+
     if len(a.file) > 1:
         return _cmd_identify_joint(a)
     a.file = a.file[0]
@@ -185,6 +279,7 @@ def cmd_identify(a: argparse.Namespace) -> int:
     s = load_session(a.file, a)
     if kind(s) == PROBE:  # the touch probe's options and fit: cli/probe.py
         from .probe import identify_probe_session, print_probe_identification
+
         result, d = identify_probe_session(a, s, sizes)
         _keep(a, result, d, a.file)
         if a.json:
@@ -217,6 +312,7 @@ def cmd_identify(a: argparse.Namespace) -> int:
 def cmd_predict(a: argparse.Namespace) -> int:
     from ..analysis import predict_session
     from ..models import load_model
+
     model_dict = load_model(a.model)
     s = load_session(a.session, a)
     out, line = predict_session(model_dict, s, a.probe_zeros, source=a.model)
@@ -228,38 +324,81 @@ def cmd_predict(a: argparse.Namespace) -> int:
 
 
 def add_identify(sub: argparse._SubParsersAction) -> None:
-    q = sub.add_parser("identify", help="identify location errors from a session, or jointly from several "
-                                        "sessions of one machine", epilog=EPILOG)
-    q.add_argument("file", type=path("FILE"), nargs="+",
-                   help="a session; several (ballbar, R-test, touch probe) of one machine are identified jointly")
-    q.add_argument("--method", default="joint", choices=["joint", "paper", "cycles", "cycles-free-radius"],
-                   help="joint (default); paper (ballbar, R-test); cycles, cycles-free-radius (touch probe: the "
-                        "controller cycles' method, radius known or fitted per pose)")
+    q = sub.add_parser(
+        "identify",
+        help="identify location errors from a session, or jointly from several "
+        "sessions of one machine",
+        epilog=EPILOG,
+    )
+    q.add_argument(
+        "file",
+        type=path("FILE"),
+        nargs="+",
+        help="a session; several (ballbar, R-test, touch probe) of one machine are identified jointly",
+    )
+    q.add_argument(
+        "--method",
+        default="joint",
+        choices=["joint", "paper", "cycles", "cycles-free-radius"],
+        help="joint (default); paper (ballbar, R-test); cycles, cycles-free-radius (touch probe: the "
+        "controller cycles' method, radius known or fitted per pose)",
+    )
     q.add_argument("--length-offset", action="store_true", help="also fit an offset of L0 (joint)")
     q.add_argument("--json", action="store_true", help="print the result as JSON")
-    q.add_argument("--save-model", metavar="MODEL.json", type=path("--save-model"),
-                   help="write the fitted model (ballbar; R-test joint: location errors, maps, covariance; touch probe "
-                        "joint fit; several sessions' joint identification)")
-    q.add_argument("--monte-carlo", type=number("--monte-carlo", 0, 10_000, integer=True), default=0, metavar="N",
-                   help="check the 1-sigma by N simulated repeats of the session with its fitted noise model (progress bar)")
+    q.add_argument(
+        "--save-model",
+        metavar="MODEL.json",
+        type=path("--save-model"),
+        help="write the fitted model (ballbar; R-test joint: location errors, maps, covariance; touch probe "
+        "joint fit; several sessions' joint identification)",
+    )
+    q.add_argument(
+        "--monte-carlo",
+        type=number("--monte-carlo", 0, 10_000, integer=True),
+        default=0,
+        metavar="N",
+        help="check the 1-sigma by N simulated repeats of the session with its fitted noise model (progress bar)",
+    )
     q.add_argument("--seed", type=SEED, default=1, help="seed of the Monte Carlo draws")
     add_plausibility_arg(q)
-    q.add_argument("--noise", default="auto", choices=["auto", "white"],
-                   help="auto (default): AR noise model of the residuals, GLS refit when correlated; "
-                        "white: readings taken as independent")
-    q.add_argument("--budget-sizes", metavar="SIZES.json", type=path("--budget-sizes"),
-                   help="plausible sizes of left-out effects for the uncertainty budget (JSON object; "
-                        "docs/json_schema.md)")
-    q.add_argument("--no-budget", action="store_true",
-                   help="skip the uncertainty budget (it runs a diagnosis of the left-out effects)")
+    q.add_argument(
+        "--noise",
+        default="auto",
+        choices=["auto", "white"],
+        help="auto (default): AR noise model of the residuals, GLS refit when correlated; "
+        "white: readings taken as independent",
+    )
+    q.add_argument(
+        "--budget-sizes",
+        metavar="SIZES.json",
+        type=path("--budget-sizes"),
+        help="plausible sizes of left-out effects for the uncertainty budget (JSON object; "
+        "docs/json_schema.md)",
+    )
+    q.add_argument(
+        "--no-budget",
+        action="store_true",
+        help="skip the uncertainty budget (it runs a diagnosis of the left-out effects)",
+    )
     g = q.add_argument_group("calibration history (docs/history.md)")
-    g.add_argument("--store", action="store_true", help="store the identification in the history (needs --machine-id)")
-    g.add_argument("--machine-id", help="the physical machine, e.g. its serial number (the session's "
-                                        "'# machine:' stays its kinematic type)")
+    g.add_argument(
+        "--store",
+        action="store_true",
+        help="store the identification in the history (needs --machine-id)",
+    )
+    g.add_argument(
+        "--machine-id",
+        help="the physical machine, e.g. its serial number (the session's "
+        "'# machine:' stays its kinematic type)",
+    )
     g.add_argument("--note", help="operator note stored with it")
     g.add_argument("--date", help="when it was measured, ISO 8601 (default: now)")
-    g.add_argument("--controller", metavar="CURRENT", type=path("--controller"),
-                   help="the controller parameters active during the test (HAL, MPF or JSON file), stored with it")
+    g.add_argument(
+        "--controller",
+        metavar="CURRENT",
+        type=path("--controller"),
+        help="the controller parameters active during the test (HAL, MPF or JSON file), stored with it",
+    )
     add_db_arg(g)
     q.set_defaults(func=cmd_identify)
 
@@ -268,11 +407,20 @@ def add_predict(sub: argparse._SubParsersAction) -> None:
     q = sub.add_parser("predict", help="predict a session with a fitted model", epilog=EPILOG)
     q.add_argument("session", type=path("SESSION"))
     q.add_argument("--model", required=True, type=path("--model"))
-    q.add_argument("--probe-zeros", choices=["none", "fitted"], default="none",
-                   help="R-test: add the probe zeros fitted for the same set-ups (same nests), or none "
-                        "(default: a new set-up's zeros are unknown)")
-    q.add_argument("-o", "--output", required=True, type=path("--output"),
-                   help="the session with predicted lengths (ballbar) or dx,dy,dz and dx_std,dy_std,dz_std (R-test)")
+    q.add_argument(
+        "--probe-zeros",
+        choices=["none", "fitted"],
+        default="none",
+        help="R-test: add the probe zeros fitted for the same set-ups (same nests), or none "
+        "(default: a new set-up's zeros are unknown)",
+    )
+    q.add_argument(
+        "-o",
+        "--output",
+        required=True,
+        type=path("--output"),
+        help="the session with predicted lengths (ballbar) or dx,dy,dz and dx_std,dy_std,dz_std (R-test)",
+    )
     add_plausibility_arg(q)
     q.set_defaults(func=cmd_predict)
 

@@ -10,6 +10,7 @@ subparsers of the command's kinds (``simulate ballbar|rtest``) or None. A module
 ``KINDS``, {command: add(kinds)}, to add its instrument's kind to another module's command
 (``simulate probe``): listing the module in MODULES registers it.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -20,25 +21,73 @@ from typing import Sequence
 
 from .. import _core
 from ..command_files import check_command_files
-from . import (circular, controller, demo, design, design_probe, diagnose, history, identify, instruments, machines,
-               plan, probe, simulate)
+from . import (
+    circular,
+    controller,
+    demo,
+    design,
+    design_probe,
+    diagnose,
+    history,
+    identify,
+    instruments,
+    machines,
+    plan,
+    probe,
+    simulate,
+)
 from .options import EPILOG, EXIT_ERROR, EXIT_INPUT, EXIT_IO, EXIT_OK, OptionError, say
 
-MODULES = (plan, machines, simulate, identify, history, diagnose, design, controller, instruments, demo, circular,
-           probe, design_probe)
+MODULES = (
+    plan,
+    machines,
+    simulate,
+    identify,
+    history,
+    diagnose,
+    design,
+    controller,
+    instruments,
+    demo,
+    circular,
+    probe,
+    design_probe,
+)
 
 # The order `rotacal --help` lists the commands in.
-ORDER = ("plan", "machines", "simulate", "identify", "history", "diagnose", "predict", "design", "export",
-         "compensate", "virtual", "record", "import", "report", "table2", "demo", "circular")
+ORDER = (
+    "plan",
+    "machines",
+    "simulate",
+    "identify",
+    "history",
+    "diagnose",
+    "predict",
+    "design",
+    "export",
+    "compensate",
+    "virtual",
+    "record",
+    "import",
+    "report",
+    "table2",
+    "demo",
+    "circular",
+)
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="rotacal", description="Calibration of the rotary axes of 5-axis machine tools.",
-                                epilog=EPILOG)
+    p = argparse.ArgumentParser(
+        prog="rotacal",
+        description="Calibration of the rotary axes of 5-axis machine tools.",
+        epilog=EPILOG,
+    )
     sub = p.add_subparsers(dest="command", required=True)
     adders = {name: add for m in MODULES for name, add in m.COMMANDS.items()}
     if set(adders) != set(ORDER):
-        raise _core.Error(f"rotacal: commands {sorted(set(adders) ^ set(ORDER))} are not both in ORDER and a module")
+        raise _core.Error(
+            f"rotacal: commands {sorted(set(adders) ^ set(ORDER))} are not both in ORDER and a module"
+        )
     for name in ORDER:
         kinds = adders[name](sub)
         extra = [m.KINDS[name] for m in MODULES if name in getattr(m, "KINDS", {})]
@@ -51,8 +100,23 @@ def build_parser() -> argparse.ArgumentParser:
 
 # Options whose values may start with '-' ("--a-range -90,90"): argparse would take the value
 # for an option, so such pairs are joined as "--a-range=-90,90" before parsing.
-_SIGNED_VALUE_OPTIONS = {"--a-range", "--sphere", "--b-range", "--tilt-range", "--c-range", "--axial-c-tilt", "--pivot", "--errors", "--nest", "--probe-dir",
-                         "--comp-range", "--travel", "--poses", "--pivot-z", "--centres-origin"}
+_SIGNED_VALUE_OPTIONS = {
+    "--a-range",
+    "--sphere",
+    "--b-range",
+    "--tilt-range",
+    "--c-range",
+    "--axial-c-tilt",
+    "--pivot",
+    "--errors",
+    "--nest",
+    "--probe-dir",
+    "--comp-range",
+    "--travel",
+    "--poses",
+    "--pivot-z",
+    "--centres-origin",
+}
 
 
 def _join_signed_values(argv: Sequence[str]) -> list[str]:
@@ -70,7 +134,9 @@ def _join_signed_values(argv: Sequence[str]) -> list[str]:
 def _message(e: BaseException, limit: int = 2000) -> str:
     """An error message fit for a terminal: bounded (a file's line may be megabytes long)."""
     text = str(e)
-    return text if len(text) <= limit else text[:limit] + f"... ({len(text) - limit} more characters)"
+    return (
+        text if len(text) <= limit else text[:limit] + f"... ({len(text) - limit} more characters)"
+    )
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -88,7 +154,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_INPUT
     except BrokenPipeError:  # `rotacal history show M | head`: the reader has what it wanted
         try:
-            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error at exit
+            os.dup2(
+                os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno()
+            )  # no second error at exit
         except OSError:
             pass
         return EXIT_OK

@@ -1,4 +1,5 @@
 """``rotacal plan``: the NC program of a test (and its commanded rows as a session template)."""
+
 from __future__ import annotations
 
 import argparse
@@ -13,13 +14,19 @@ from .setups import add_setup_args, ballbar_model, ballbar_setup
 def cmd_plan(a: argparse.Namespace) -> int:
     if a.kind == "probe":  # the touch probe's program: cli/probe.py
         from .probe import cmd_plan_probe
+
         return cmd_plan_probe(a)
     from ..ballbar import nc_program
+
     refuse_probe_options(a)
     plan, text = nc_program(ballbar_setup(a), a.dialect, ballbar_model(a.compensate), a.compensate)
-    write_output(a.output, text, [a.compensate] if a.compensate else [], [a.session] if a.session else [])
-    say(f"wrote {a.output}: {a.dialect} program, {plan.num_samples} points, {plan.duration:.0f} s"
-        + (" (compensated)" if a.compensate else ""))
+    write_output(
+        a.output, text, [a.compensate] if a.compensate else [], [a.session] if a.session else []
+    )
+    say(
+        f"wrote {a.output}: {a.dialect} program, {plan.num_samples} points, {plan.duration:.0f} s"
+        + (" (compensated)" if a.compensate else "")
+    )
     if a.session:
         save(plan.commanded_session(), a.session, [a.compensate], [a.output])
         say(f"wrote {a.session}: the commanded rows as a session template")
@@ -31,10 +38,21 @@ def add_plan(sub: argparse._SubParsersAction) -> None:
     q.add_argument("kind", choices=["ballbar", "probe"])
     add_setup_args(q)
     add_plan_probe_args(q)
-    q.add_argument("--dialect", default="linuxcnc", help="linuxcnc (machine axes), heidenhain, siemens, fanuc")
-    q.add_argument("--compensate", metavar="MODEL.json", type=path("--compensate"), help="emit the program compensated for a fitted model")
-    q.add_argument("--session", metavar="CSV", type=path("--session"),
-                   help="also write the commanded rows as a session template")
+    q.add_argument(
+        "--dialect", default="linuxcnc", help="linuxcnc (machine axes), heidenhain, siemens, fanuc"
+    )
+    q.add_argument(
+        "--compensate",
+        metavar="MODEL.json",
+        type=path("--compensate"),
+        help="emit the program compensated for a fitted model",
+    )
+    q.add_argument(
+        "--session",
+        metavar="CSV",
+        type=path("--session"),
+        help="also write the commanded rows as a session template",
+    )
     q.add_argument("-o", "--output", required=True, type=path("--output"))
     q.set_defaults(func=cmd_plan)
 

@@ -14,6 +14,7 @@ Modules: table (Table 2 as printed), causes (the assumptions and the causes trie
 (the simulated experiment), scenario (prediction, responses, fits), analysis (analyse),
 render (conclusions and text).
 """
+
 from .analysis import DEFAULT_SWEEP, analyse  # noqa: F401
 from .causes import PLAUSIBLE_CHANGE, PLAUSIBLE_CONSTANT, Assumptions, Candidate, candidates  # noqa: F401
 from .render import render  # noqa: F401

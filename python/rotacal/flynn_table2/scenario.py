@@ -1,6 +1,7 @@
 """One scenario of the analysis: the Monte Carlo prediction of the after-values, each cause's
 response, the one-at-a-time fits and the extended model (greedy, sizes bounded by their
 plausible half-widths); and which raw test separates causes the 8 values cannot."""
+
 from __future__ import annotations
 
 import math
@@ -21,8 +22,16 @@ def _chi2_95(df: int) -> float:
     return df * (1.0 - h + 1.6449 * math.sqrt(h)) ** 3
 
 
-def scenario(a: Assumptions, before: np.ndarray, after: np.ndarray, draws: int, seed: int,
-              max_causes: int, want_details: bool, cache: dict | None = None) -> dict:
+def scenario(
+    a: Assumptions,
+    before: np.ndarray,
+    after: np.ndarray,
+    draws: int,
+    seed: int,
+    max_causes: int,
+    want_details: bool,
+    cache: dict | None = None,
+) -> dict:
     """`cache`: the runs of the analysis' other scenarios (Chain)."""
     ch = Chain(a, cache)
     truth = ch.truth_for(before)
@@ -51,7 +60,7 @@ def scenario(a: Assumptions, before: np.ndarray, after: np.ndarray, draws: int, 
     # Coverage factor k = 2 (about 95 %); the draws are noise-dominated and near-Gaussian.
     lo, hi = mean - 2.0 * std, mean + 2.0 * std
     d = after - mean
-    w = 1.0 / std ** 2
+    w = 1.0 / std**2
 
     # Response of the after-values (and of a repeated uncompensated run) to each cause, by a
     # central difference at its plausible size.
@@ -78,14 +87,31 @@ def scenario(a: Assumptions, before: np.ndarray, after: np.ndarray, draws: int, 
         den = float(np.sum(w * r * r))
         reach = np.abs(r) * c.plausible * _SCALE
         if den <= 0 or np.max(reach) < 1e-9:
-            rows.append({"c": c, "j": j, "size": 0.0, "size_std": None, "chi2": chi2_0, "chi2_plausible": chi2_0,
-                         "reach": reach})
+            rows.append(
+                {
+                    "c": c,
+                    "j": j,
+                    "size": 0.0,
+                    "size_std": None,
+                    "chi2": chi2_0,
+                    "chi2_plausible": chi2_0,
+                    "reach": reach,
+                }
+            )
             continue
         s = float(np.sum(w * r * d) / den)
         sp = float(np.clip(s, -c.plausible, c.plausible))
-        rows.append({"c": c, "j": j, "size": s, "size_std": 1.0 / math.sqrt(den),
-                     "chi2": float(np.sum(w * (d - s * r) ** 2)),
-                     "chi2_plausible": float(np.sum(w * (d - sp * r) ** 2)), "reach": reach})
+        rows.append(
+            {
+                "c": c,
+                "j": j,
+                "size": s,
+                "size_std": 1.0 / math.sqrt(den),
+                "chi2": float(np.sum(w * (d - s * r) ** 2)),
+                "chi2_plausible": float(np.sum(w * (d - sp * r) ** 2)),
+                "reach": reach,
+            }
+        )
     # Rank by what the cause explains at a plausible size, then by what it needs.
     rows.sort(key=lambda x: (x["chi2_plausible"], x["chi2"]))
 
@@ -101,7 +127,9 @@ def scenario(a: Assumptions, before: np.ndarray, after: np.ndarray, draws: int, 
             if j in chosen or x["size_std"] is None:
                 continue
             idx = chosen + [j]
-            sv = _core.box_least_squares(R[:, idx], d, w, np.array([cands[i].plausible for i in idx]))
+            sv = _core.box_least_squares(
+                R[:, idx], d, w, np.array([cands[i].plausible for i in idx])
+            )
             c2 = float(np.sum(w * (d - R[:, idx] @ sv) ** 2))
             if best is None or c2 < best[0]:
                 best = (c2, j, sv)
@@ -113,9 +141,26 @@ def scenario(a: Assumptions, before: np.ndarray, after: np.ndarray, draws: int, 
         chosen.append(j)
     ext = R[:, chosen] @ s_sel if chosen else np.zeros(8)
 
-    out = {"truth": truth, "mean": mean, "std": std, "lo": lo, "hi": hi, "d": d, "w": w, "chi2_0": chi2_0,
-           "rows": rows, "chosen": chosen, "s_sel": s_sel, "ext": ext, "chi2_ext": chi2, "R": R, "Rb": Rb,
-           "cands": cands, "duration": ch.duration, "chain": ch}
+    out = {
+        "truth": truth,
+        "mean": mean,
+        "std": std,
+        "lo": lo,
+        "hi": hi,
+        "d": d,
+        "w": w,
+        "chi2_0": chi2_0,
+        "rows": rows,
+        "chosen": chosen,
+        "s_sel": s_sel,
+        "ext": ext,
+        "chi2_ext": chi2,
+        "R": R,
+        "Rb": Rb,
+        "cands": cands,
+        "duration": ch.duration,
+        "chain": ch,
+    }
     return out
 
 
@@ -135,8 +180,11 @@ def separation(sc: dict, group: list[int]) -> dict:
     per = {}
     for lab in labels:
         m = np.array([t == lab for t in tests])
-        diffs = [float(np.sqrt(np.mean((res[i][2][m] - res[k][2][m]) ** 2)))
-                 for ii, i in enumerate(group) for k in group[ii + 1:]]
+        diffs = [
+            float(np.sqrt(np.mean((res[i][2][m] - res[k][2][m]) ** 2)))
+            for ii, i in enumerate(group)
+            for k in group[ii + 1 :]
+        ]
         per[lab] = min(diffs) if diffs else 0.0
         if per[lab] > best["rms_difference_um"]:
             best = {"test": lab, "rms_difference_um": per[lab], "samples": int(m.sum())}

@@ -1,5 +1,6 @@
 """Table 2 of Flynn et al. (2016), as printed: the shipped file read strictly, each number as
 the paper prints it."""
+
 from __future__ import annotations
 
 import math
@@ -22,7 +23,9 @@ def _printed_float(text: str, where: str) -> float:
     try:
         v = float(t)
     except ValueError:
-        raise _core.InvalidArgument(f"{where}: '{text}' is not a number as printed in Table 2") from None
+        raise _core.InvalidArgument(
+            f"{where}: '{text}' is not a number as printed in Table 2"
+        ) from None
     if not math.isfinite(v):
         raise _core.InvalidArgument(f"{where}: '{text}' is not finite")
     return v
@@ -40,15 +43,20 @@ def load_table2(path: str | Path | None = None, reading: str = "printed") -> dic
     table, rotacal.InvalidArgument for a value that is not a number.
     """
     from ..jsonfile import read_json
+
     p = Path(path) if path is not None else TABLE2_PATH
     d, _ = read_json(p)  # strict and bounded: deep nesting is a ParseError, not a RecursionError
     if not isinstance(d, dict):
         raise _core.ParseError(f"{p}: Table 2 is a JSON object with 'rows'")
     if reading not in ("printed", "percent_consistent"):
-        raise _core.InvalidArgument(f"load_table2: reading must be 'printed' or 'percent_consistent', got {reading!r}")
+        raise _core.InvalidArgument(
+            f"load_table2: reading must be 'printed' or 'percent_consistent', got {reading!r}"
+        )
     rows = d.get("rows")
     if not isinstance(rows, list) or [r.get("name") for r in rows] != list(NAMES):
-        raise _core.ParseError(f"{p}: 'rows' must hold the 8 location errors in the order {', '.join(NAMES)}")
+        raise _core.ParseError(
+            f"{p}: 'rows' must hold the 8 location errors in the order {', '.join(NAMES)}"
+        )
     out = []
     for i, r in enumerate(rows):
         where = f"{p}: rows[{i}] ({r['name']})"
@@ -56,9 +64,23 @@ def load_table2(path: str | Path | None = None, reading: str = "printed") -> dic
         if r.get("unit") != unit:
             raise _core.ParseError(f"{where}: unit must be '{unit}', got {r.get('unit')!r}")
         alt = r.get("percent_consistent", {}) if reading == "percent_consistent" else {}
-        out.append({"name": r["name"], "unit": unit,
-                    "before": _printed_float(str(alt.get("uncompensated", r["uncompensated"])), where + " uncompensated"),
-                    "after": _printed_float(str(alt.get("compensated", r["compensated"])), where + " compensated"),
-                    "printed": {k: r[k] for k in ("uncompensated", "compensated", "change_percent")}})
-    return {"source": d.get("source", {}), "machine": d.get("machine", "AC-trt"), "reading": reading,
-            "notes": d.get("notes", []), "rows": out}
+        out.append(
+            {
+                "name": r["name"],
+                "unit": unit,
+                "before": _printed_float(
+                    str(alt.get("uncompensated", r["uncompensated"])), where + " uncompensated"
+                ),
+                "after": _printed_float(
+                    str(alt.get("compensated", r["compensated"])), where + " compensated"
+                ),
+                "printed": {k: r[k] for k in ("uncompensated", "compensated", "change_percent")},
+            }
+        )
+    return {
+        "source": d.get("source", {}),
+        "machine": d.get("machine", "AC-trt"),
+        "reading": reading,
+        "notes": d.get("notes", []),
+        "rows": out,
+    }

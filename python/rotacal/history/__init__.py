@@ -15,11 +15,39 @@ mid-write leaves the store as it was before that write.
 Modules: entries (what is stored, checked), store (schema, reads and writes), opening (SQLite
 file or PostgreSQL URL), drift (the history of each location error), figures (plots, HTML).
 """
-from .drift import (DAYS_PER_MONTH, DRIFT_SPAN_WHY, K_EXPANDED, MIN_DRIFT_SPAN_DAYS, drift_fit,  # noqa: F401
-                    expand_tolerances, summarize)
-from .entries import (CORRECTION, IDENTIFICATION, MAX_ERROR, MAX_MACHINE_ID, MAX_NOTE, Entry, Estimate,  # noqa: F401
-                      check_machine_id, correction_amounts, now_utc, parse_date, sha256_of_json, unit_of)
+
+from .drift import (
+    DAYS_PER_MONTH,
+    DRIFT_SPAN_WHY,
+    K_EXPANDED,
+    MIN_DRIFT_SPAN_DAYS,
+    drift_fit,  # noqa: F401
+    expand_tolerances,
+    summarize,
+)
+from .entries import (
+    CORRECTION,
+    IDENTIFICATION,
+    MAX_ERROR,
+    MAX_MACHINE_ID,
+    MAX_NOTE,
+    Entry,
+    Estimate,  # noqa: F401
+    check_machine_id,
+    correction_amounts,
+    now_utc,
+    parse_date,
+    sha256_of_json,
+    unit_of,
+)
 from .figures import history_section, write_plot  # noqa: F401
 from .opening import ENV_STORE, default_location, open_history, refuse_before_storing  # noqa: F401
-from .store import (BUSY_TIMEOUT_S, MIGRATIONS, POSTGRESQL, SCHEMA_VERSION, SQLITE, CalibrationHistory,  # noqa: F401
-                    redact)
+from .store import (
+    BUSY_TIMEOUT_S,
+    MIGRATIONS,
+    POSTGRESQL,
+    SCHEMA_VERSION,
+    SQLITE,
+    CalibrationHistory,  # noqa: F401
+    redact,
+)

@@ -1,6 +1,7 @@
 """The history of a machine's location errors: the machine's own value over time (measured +
 compensation loaded), the changes between consecutive calibrations flagged against their
 expanded uncertainty or a tolerance, and the drift per month."""
+
 from __future__ import annotations
 
 import datetime
@@ -23,12 +24,21 @@ K_EXPANDED = 2.0
 
 def _epoch_months(at: str) -> float:
     """Months since 1970 of a stored date-time (fixed layout: sliced, not parsed, for speed)."""
-    d = datetime.datetime(int(at[0:4]), int(at[5:7]), int(at[8:10]), int(at[11:13]), int(at[14:16]),
-                          int(at[17:19]), tzinfo=datetime.timezone.utc)
+    d = datetime.datetime(
+        int(at[0:4]),
+        int(at[5:7]),
+        int(at[8:10]),
+        int(at[11:13]),
+        int(at[14:16]),
+        int(at[17:19]),
+        tzinfo=datetime.timezone.utc,
+    )
     return d.timestamp() / 86400.0 / DAYS_PER_MONTH
 
 
-def drift_fit(t_months: Sequence[float], y: Sequence[float], std: Sequence[float | None]) -> dict | None:
+def drift_fit(
+    t_months: Sequence[float], y: Sequence[float], std: Sequence[float | None]
+) -> dict | None:
     """Least-squares straight line through (t, y) weighted by 1/std^2: slope per month, its
     1-sigma from the stated stds, and chi2/dof (about 1 when the stds explain the scatter).
     Unweighted (and said so) when a point has no positive std. None for fewer than two
@@ -52,18 +62,27 @@ def drift_fit(t_months: Sequence[float], y: Sequence[float], std: Sequence[float
         slope_std = math.sqrt(chi2 / dof / stt)
     else:
         slope_std = None
-    return {"value": slope, "std": slope_std, "n": n, "span_months": max(t_months) - min(t_months),
-            "chi2_per_dof": chi2 / dof if weighted and dof > 0 else None,
-            "weighting": "1/std^2" if weighted else "equal (a calibration has no 1-sigma)"}
+    return {
+        "value": slope,
+        "std": slope_std,
+        "n": n,
+        "span_months": max(t_months) - min(t_months),
+        "chi2_per_dof": chi2 / dof if weighted and dof > 0 else None,
+        "weighting": "1/std^2" if weighted else "equal (a calibration has no 1-sigma)",
+    }
 
 
-def expand_tolerances(tolerances: Mapping[str, float], names: Sequence[str], machine_type: str) -> dict[str, float]:
+def expand_tolerances(
+    tolerances: Mapping[str, float], names: Sequence[str], machine_type: str
+) -> dict[str, float]:
     """Tolerance by location error from keys that are error names or ``position`` (every
     error in mm) or ``orientation`` (every error in rad); a name overrides its group."""
     for k, v in tolerances.items():
         if k not in names and k not in ("position", "orientation"):
-            raise _core.InvalidArgument(f"--tolerance: {k}: not a location error of a {machine_type} "
-                                        f"({' '.join(names)}), nor position or orientation")
+            raise _core.InvalidArgument(
+                f"--tolerance: {k}: not a location error of a {machine_type} "
+                f"({' '.join(names)}), nor position or orientation"
+            )
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v <= 0:
             raise _core.InvalidArgument(f"--tolerance {k}: must be a number > 0, got {v!r}")
     out = {}
@@ -74,7 +93,9 @@ def expand_tolerances(tolerances: Mapping[str, float], names: Sequence[str], mac
     return out
 
 
-def summarize(machine_type: str, entries: Sequence[Entry], tolerances: Mapping[str, float] | None = None) -> dict:
+def summarize(
+    machine_type: str, entries: Sequence[Entry], tolerances: Mapping[str, float] | None = None
+) -> dict:
     """Each location error over time: the values measured with their 1-sigma, the compensation
     the controller held at the time (the sum of the corrections recorded before), the machine's
     own value (measured + compensation), the change between consecutive calibrations with the
@@ -105,54 +126,117 @@ def summarize(machine_type: str, entries: Sequence[Entry], tolerances: Mapping[s
             if est is None or est.value is None:
                 unobservable.append(e.id)
                 continue
-            p = {"entry": e.id, "at": e.measured_at, "measured": est.value, "std": est.std,
-                 "compensation": held, "value": est.value + held}
+            p = {
+                "entry": e.id,
+                "at": e.measured_at,
+                "measured": est.value,
+                "std": est.std,
+                "compensation": held,
+                "value": est.value + held,
+            }
             if points:
                 q = points[-1]
                 change = p["value"] - q["value"]
-                u = (math.sqrt(q["std"] ** 2 + p["std"] ** 2) * K_EXPANDED
-                     if q["std"] is not None and p["std"] is not None else None)
-                step = {"from": q["entry"], "to": e.id, "from_at": q["at"], "to_at": e.measured_at,
-                        "measured_change": p["measured"] - q["measured"], "corrections": since_last,
-                        "change": change, "expanded_uncertainty": u,
-                        "exceeds_uncertainty": u is not None and abs(change) > u,
-                        "tolerance": tol.get(name), "exceeds_tolerance": name in tol and abs(change) > tol[name]}
+                u = (
+                    math.sqrt(q["std"] ** 2 + p["std"] ** 2) * K_EXPANDED
+                    if q["std"] is not None and p["std"] is not None
+                    else None
+                )
+                step = {
+                    "from": q["entry"],
+                    "to": e.id,
+                    "from_at": q["at"],
+                    "to_at": e.measured_at,
+                    "measured_change": p["measured"] - q["measured"],
+                    "corrections": since_last,
+                    "change": change,
+                    "expanded_uncertainty": u,
+                    "exceeds_uncertainty": u is not None and abs(change) > u,
+                    "tolerance": tol.get(name),
+                    "exceeds_tolerance": name in tol and abs(change) > tol[name],
+                }
                 steps.append(step)
                 if step["exceeds_uncertainty"] or step["exceeds_tolerance"]:
-                    why = [w for w, hit in (("exceeds k=2 uncertainty", step["exceeds_uncertainty"]),
-                                            ("exceeds tolerance", step["exceeds_tolerance"])) if hit]
-                    flags.append({"name": name, "unit": unit, **{k: step[k] for k in
-                                  ("from", "to", "from_at", "to_at", "change", "expanded_uncertainty", "tolerance")},
-                                  "why": why})
+                    why = [
+                        w
+                        for w, hit in (
+                            ("exceeds k=2 uncertainty", step["exceeds_uncertainty"]),
+                            ("exceeds tolerance", step["exceeds_tolerance"]),
+                        )
+                        if hit
+                    ]
+                    flags.append(
+                        {
+                            "name": name,
+                            "unit": unit,
+                            **{
+                                k: step[k]
+                                for k in (
+                                    "from",
+                                    "to",
+                                    "from_at",
+                                    "to_at",
+                                    "change",
+                                    "expanded_uncertainty",
+                                    "tolerance",
+                                )
+                            },
+                            "why": why,
+                        }
+                    )
             since_last = 0.0
             points.append(p)
         drift = None
         if len(points) >= 2:
             t0 = months[points[0]["entry"]]
-            drift = drift_fit([months[p["entry"]] - t0 for p in points], [p["value"] for p in points],
-                              [p["std"] for p in points])
+            drift = drift_fit(
+                [months[p["entry"]] - t0 for p in points],
+                [p["value"] for p in points],
+                [p["std"] for p in points],
+            )
         if drift is not None and drift["span_months"] * DAYS_PER_MONTH < MIN_DRIFT_SPAN_DAYS:
             drift = None  # the difference of two close calibrations is not a rate per month
-        errors[name] = {"unit": unit, "points": points, "steps": steps, "unobservable_in": unobservable,
-                        "drift_per_month": drift}
+        errors[name] = {
+            "unit": unit,
+            "points": points,
+            "steps": steps,
+            "unobservable_in": unobservable,
+            "drift_per_month": drift,
+        }
     return {
         "machine_type": machine_type,
         "identifications": len(calibrations),
-        "corrections": [{"entry": c.id, "at": c.measured_at, "controller": c.test, "note": c.note,
-                         "amounts": {n: est.value for n, est in c.estimates.items()}} for c in corrections],
-        "calibrations": [{"entry": c.id, "at": c.measured_at, "test": c.test, "session": c.session,
-                          "session_sha256": c.source_sha256, "note": c.note} for c in calibrations],
+        "corrections": [
+            {
+                "entry": c.id,
+                "at": c.measured_at,
+                "controller": c.test,
+                "note": c.note,
+                "amounts": {n: est.value for n, est in c.estimates.items()},
+            }
+            for c in corrections
+        ],
+        "calibrations": [
+            {
+                "entry": c.id,
+                "at": c.measured_at,
+                "test": c.test,
+                "session": c.session,
+                "session_sha256": c.source_sha256,
+                "note": c.note,
+            }
+            for c in calibrations
+        ],
         "location_errors": errors,
         "flags": flags,
         "definitions": {
             "value": "measured + compensation: the machine's own error, as if no correction had been loaded",
             "compensation": "sum of the corrections recorded before the calibration (a correction loads the "
-                            "identified values of the errors the controller holds)",
+            "identified values of the errors the controller holds)",
             "change": "value minus the previous calibration's value: drift, corrections taken out",
             "expanded_uncertainty": f"{K_EXPANDED:g} * sqrt(std1^2 + std2^2)",
             "drift_per_month": f"slope of value over time, least squares weighted by 1/std^2, per "
-                               f"{DAYS_PER_MONTH:.4f} days; null when the calibrations span less than "
-                               f"{MIN_DRIFT_SPAN_DAYS:g} days ({DRIFT_SPAN_WHY})",
+            f"{DAYS_PER_MONTH:.4f} days; null when the calibrations span less than "
+            f"{MIN_DRIFT_SPAN_DAYS:g} days ({DRIFT_SPAN_WHY})",
         },
     }
-

@@ -1,5 +1,6 @@
 """The entries of a calibration history: what an identification or a correction stores,
 checked (machine id, date, note, estimates, correction amounts)."""
+
 from __future__ import annotations
 
 import datetime
@@ -33,8 +34,9 @@ def parse_date(text: str, what: str = "date") -> str:
     try:
         d = datetime.datetime.fromisoformat(t[:-1] + "+00:00" if t.endswith("Z") else t)
     except ValueError:
-        raise _core.InvalidArgument(f"{what}: {t[:40]!r} is not an ISO 8601 date (e.g. 2026-03-01 "
-                                    "or 2026-03-01T14:30:00Z)") from None
+        raise _core.InvalidArgument(
+            f"{what}: {t[:40]!r} is not an ISO 8601 date (e.g. 2026-03-01 or 2026-03-01T14:30:00Z)"
+        ) from None
     if d.tzinfo is None:
         d = d.replace(tzinfo=datetime.timezone.utc)
     d = d.astimezone(datetime.timezone.utc)
@@ -46,9 +48,13 @@ def parse_date(text: str, what: str = "date") -> str:
 def check_machine_id(machine_id: Any) -> str:
     """The id of a physical machine: 1..100 printable characters, not only blanks."""
     if not isinstance(machine_id, str) or not machine_id.strip():
-        raise _core.InvalidArgument("--machine-id: give the id of the physical machine (e.g. its serial number)")
+        raise _core.InvalidArgument(
+            "--machine-id: give the id of the physical machine (e.g. its serial number)"
+        )
     if len(machine_id) > MAX_MACHINE_ID or not machine_id.isprintable():
-        raise _core.InvalidArgument(f"--machine-id: {machine_id[:40]!r}: at most {MAX_MACHINE_ID} printable characters")
+        raise _core.InvalidArgument(
+            f"--machine-id: {machine_id[:40]!r}: at most {MAX_MACHINE_ID} printable characters"
+        )
     return machine_id
 
 
@@ -67,7 +73,9 @@ def unit_of(name: str) -> str:
 
 
 def sha256_of_json(doc: Any) -> str:
-    return hashlib.sha256(json.dumps(doc, sort_keys=True, separators=(",", ":")).encode()).hexdigest()
+    return hashlib.sha256(
+        json.dumps(doc, sort_keys=True, separators=(",", ":")).encode()
+    ).hexdigest()
 
 
 @dataclass
@@ -80,6 +88,7 @@ class Estimate:
 @dataclass
 class Entry:
     """One identification or correction of a machine, as show reads it."""
+
     id: int
     kind: str
     test: str  # ballbar / rtest-joint / ... ; for a correction the controller
@@ -90,7 +99,9 @@ class Entry:
     estimates: dict[str, Estimate] = field(default_factory=dict)
 
 
-def estimates_of(model: Mapping[str, Any], where: str) -> list[tuple[str, str, float | None, float | None, str]]:
+def estimates_of(
+    model: Mapping[str, Any], where: str
+) -> list[tuple[str, str, float | None, float | None, str]]:
     """(part, name, value, std, unit) of a model's location errors and map coefficients,
     checked: a value finite or null, a std finite and >= 0 or null."""
     rows = []
@@ -103,13 +114,24 @@ def estimates_of(model: Mapping[str, Any], where: str) -> list[tuple[str, str, f
                 raise _core.InvalidArgument(f"{where}: {part}.{name}: must be an estimate object")
             v, s = est.get("value"), est.get("std")
             for key, x in (("value", v), ("std", s)):
-                if x is not None and (isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x)):
-                    raise _core.InvalidArgument(f"{where}: {part}.{name}.{key}: must be a finite number or null, got {x!r}")
+                if x is not None and (
+                    isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x)
+                ):
+                    raise _core.InvalidArgument(
+                        f"{where}: {part}.{name}.{key}: must be a finite number or null, got {x!r}"
+                    )
             if s is not None and s < 0:
                 raise _core.InvalidArgument(f"{where}: {part}.{name}.std: must be >= 0, got {s!r}")
             unit = est.get("unit", unit_of(name) if part == "location_errors" else "")
-            rows.append((part, str(name), None if v is None else float(v),
-                         None if v is None or s is None else float(s), str(unit)))
+            rows.append(
+                (
+                    part,
+                    str(name),
+                    None if v is None else float(v),
+                    None if v is None or s is None else float(s),
+                    str(unit),
+                )
+            )
     return rows
 
 
@@ -119,22 +141,33 @@ def correction_amounts(export: Mapping[str, Any], where: str = "<export>") -> di
     measures the machine less that value (docs/history.md)."""
     errors = export.get("location_errors") if isinstance(export, Mapping) else None
     if not isinstance(errors, list) or not isinstance(export.get("controller"), str):
-        raise _core.InvalidArgument(f"{where}: not the JSON of 'rotacal export --json' (controller, location_errors)")
+        raise _core.InvalidArgument(
+            f"{where}: not the JSON of 'rotacal export --json' (controller, location_errors)"
+        )
     out: dict[str, float] = {}
     for i, e in enumerate(errors):
-        if not isinstance(e, Mapping) or not isinstance(e.get("name"), str) or not isinstance(e.get("held"), bool):
+        if (
+            not isinstance(e, Mapping)
+            or not isinstance(e.get("name"), str)
+            or not isinstance(e.get("held"), bool)
+        ):
             raise _core.InvalidArgument(f"{where}: location_errors[{i}]: needs name and held")
         v = e.get("value")
         if not e["held"] or v is None:
             continue  # not loaded, or unobservable (the export leaves it at its current value)
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-            raise _core.InvalidArgument(f"{where}: location_errors[{i}].value: must be a finite number, got {v!r}")
+            raise _core.InvalidArgument(
+                f"{where}: location_errors[{i}].value: must be a finite number, got {v!r}"
+            )
         limit = MAX_ERROR.get(unit_of(e["name"]))
         if limit is not None and abs(v) > limit:
-            raise _core.InvalidArgument(f"{where}: location_errors[{i}].value: {v:g} {unit_of(e['name'])} is beyond "
-                                        f"+-{limit:g}: no machine tool has such a location error")
+            raise _core.InvalidArgument(
+                f"{where}: location_errors[{i}].value: {v:g} {unit_of(e['name'])} is beyond "
+                f"+-{limit:g}: no machine tool has such a location error"
+            )
         out[e["name"]] = float(v)
     if not out:
-        raise _core.InvalidArgument(f"{where}: the export holds none of the location errors: no correction to record")
+        raise _core.InvalidArgument(
+            f"{where}: the export holds none of the location errors: no correction to record"
+        )
     return out
-

@@ -1,5 +1,6 @@
 """Opening a calibration history store: a SQLite file (created, switched to WAL and full sync)
 or a PostgreSQL database by its ``postgresql://`` URL (psycopg 3); the default location."""
+
 from __future__ import annotations
 
 import os
@@ -24,8 +25,9 @@ def default_location() -> str:
     return str(Path.home() / ".local" / "share" / "rotacal" / "history.sqlite")
 
 
-
-def refuse_before_storing(location: str | None, machine_id: Any, measured_at: str | None = None) -> None:
+def refuse_before_storing(
+    location: str | None, machine_id: Any, measured_at: str | None = None
+) -> None:
     """Refuse, before any work is done for it, what storing an identification would refuse: a
     machine id or date that is not one, a store that cannot be opened."""
     check_machine_id(machine_id)
@@ -34,14 +36,18 @@ def refuse_before_storing(location: str | None, machine_id: Any, measured_at: st
     open_history(location).close()
 
 
-def open_history(location: str | None = None, create_folder: bool | None = None) -> CalibrationHistory:
+def open_history(
+    location: str | None = None, create_folder: bool | None = None
+) -> CalibrationHistory:
     """Open (creating and migrating as needed) the store at ``location``: a SQLite file path
     or a ``postgresql://`` URL; default :func:`default_location`. The folder of the default
     SQLite file is created; for a path given, its folder must exist."""
     given = location is not None
     loc = default_location() if location is None else location
     if not isinstance(loc, (str, os.PathLike)):
-        raise _core.InvalidArgument(f"--db: expected a file path or a postgresql:// URL, got {type(loc).__name__}")
+        raise _core.InvalidArgument(
+            f"--db: expected a file path or a postgresql:// URL, got {type(loc).__name__}"
+        )
     loc = os.fspath(loc)
     if "://" in loc:
         return _open_postgresql(loc)
@@ -55,10 +61,14 @@ def open_history(location: str | None = None, create_folder: bool | None = None)
             raise _core.IoError(f"{loc}: the folder {folder} does not exist")
     if Path(loc).is_dir():
         raise _core.IoError(f"{loc}: is a directory, not a history store")
-    if Path(loc).exists() and not Path(loc).is_file():  # SQLite would create loc-journal beside /dev/null
+    if (
+        Path(loc).exists() and not Path(loc).is_file()
+    ):  # SQLite would create loc-journal beside /dev/null
         raise _core.IoError(f"{loc}: is a device or FIFO, not a history store (a SQLite file)")
     try:
-        conn = sqlite3.connect(loc, timeout=BUSY_TIMEOUT_S, isolation_level=None, check_same_thread=False)
+        conn = sqlite3.connect(
+            loc, timeout=BUSY_TIMEOUT_S, isolation_level=None, check_same_thread=False
+        )
     except sqlite3.Error as e:
         raise _core.IoError(f"{loc}: cannot open: {e}") from None
     try:
@@ -81,8 +91,12 @@ def open_history(location: str | None = None, create_folder: bool | None = None)
         if isinstance(e, sqlite3.OperationalError) and ("locked" in str(e) or "readonly" in str(e)):
             raise _core.IoError(f"{loc}: {e}{_why_not_writable(loc)}") from None
         if _is_sqlite_file(loc):  # a valid store that cannot be opened: the file system's doing
-            raise _core.IoError(f"{loc}: cannot open the history store: {e}{_why_not_writable(loc)}") from None
-        raise _core.InvalidArgument(f"{loc}: not a rotacal history store (not an SQLite database: {e})") from None
+            raise _core.IoError(
+                f"{loc}: cannot open the history store: {e}{_why_not_writable(loc)}"
+            ) from None
+        raise _core.InvalidArgument(
+            f"{loc}: not a rotacal history store (not an SQLite database: {e})"
+        ) from None
     try:
         return CalibrationHistory(conn, SQLITE, loc)
     except BaseException:
@@ -115,13 +129,14 @@ def _why_not_writable(loc: str) -> str:
     return ""
 
 
-
 def _open_postgresql(url: str) -> CalibrationHistory:
     shown = redact(url)
     scheme = url.split("://", 1)[0]
     if scheme not in ("postgresql", "postgres"):
-        raise _core.InvalidArgument(f"--db: {shown}: a history store is a SQLite file path or a postgresql:// URL, "
-                                    f"not {scheme}://")
+        raise _core.InvalidArgument(
+            f"--db: {shown}: a history store is a SQLite file path or a postgresql:// URL, "
+            f"not {scheme}://"
+        )
     try:
         parts = urlsplit(url)
         parts.port  # raises on a port that is not a number
@@ -130,8 +145,10 @@ def _open_postgresql(url: str) -> CalibrationHistory:
     try:
         import psycopg
     except ImportError:
-        raise _core.Error("a PostgreSQL history store needs psycopg 3: pip install 'rotacal[postgresql]' "
-                          "(or 'psycopg[binary]')") from None
+        raise _core.Error(
+            "a PostgreSQL history store needs psycopg 3: pip install 'rotacal[postgresql]' "
+            "(or 'psycopg[binary]')"
+        ) from None
     try:
         psycopg.conninfo.conninfo_to_dict(url)
     except psycopg.Error as e:
@@ -145,4 +162,3 @@ def _open_postgresql(url: str) -> CalibrationHistory:
     except BaseException:
         conn.close()
         raise
-

@@ -1,5 +1,6 @@
 """The page of a report: self-contained HTML (figures as PNG data URIs, no network needed to
 open it), every text from a file escaped, written by the output rule."""
+
 from __future__ import annotations
 
 import base64
@@ -38,7 +39,7 @@ def plot_text(text: Any, limit: int = 60) -> str:
     """A label from a file as matplotlib text: cut to ``limit`` characters, and '$' escaped so
     that it is never read as mathtext (an unbalanced '$' would stop the report)."""
     t = str(text)
-    t = t if len(t) <= limit else t[:limit - 1] + "\u2026"
+    t = t if len(t) <= limit else t[: limit - 1] + "\u2026"
     return t.replace("$", r"\$")
 
 
@@ -50,29 +51,37 @@ def png(fig) -> str:
 
 
 def img(src: str, caption: str, section: str) -> str:
-    return (f'<figure data-section="{escape(section)}"><img src="{src}" alt="{escape(caption)}">'
-            f"<figcaption>{escape(caption)}</figcaption></figure>")
+    return (
+        f'<figure data-section="{escape(section)}"><img src="{src}" alt="{escape(caption)}">'
+        f"<figcaption>{escape(caption)}</figcaption></figure>"
+    )
 
 
 def head(title: str, heading: str, source: str) -> list[str]:
     """The start of a page: title, style, heading, and the line naming rotacal's version, the
     time and the source."""
-    return [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{escape(title)}</title>"
-            f"<style>{CSS}</style></head><body>", f"<h1>{escape(heading)}</h1>",
-            f"<p class=muted>rotacal {escape(__version__)} &middot; "
-            f"{_dt.datetime.now().strftime('%Y-%m-%d %H:%M')} &middot; {escape(source)}</p>"]
+    return [
+        f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{escape(title)}</title>"
+        f"<style>{CSS}</style></head><body>",
+        f"<h1>{escape(heading)}</h1>",
+        f"<p class=muted>rotacal {escape(__version__)} &middot; "
+        f"{_dt.datetime.now().strftime('%Y-%m-%d %H:%M')} &middot; {escape(source)}</p>",
+    ]
 
 
 # Records on load how many figures decoded, so a browser test can check they render.
-_IMAGE_CHECK = ("<script>window.addEventListener('load',function(){var im=document.images,ok=0;"
-                "for(var i=0;i<im.length;i++){if(im[i].complete&&im[i].naturalWidth>0)ok++;}"
-                "document.body.setAttribute('data-images',im.length);"
-                "document.body.setAttribute('data-images-rendered',ok);});</script>")
+_IMAGE_CHECK = (
+    "<script>window.addEventListener('load',function(){var im=document.images,ok=0;"
+    "for(var i=0;i<im.length;i++){if(im[i].complete&&im[i].naturalWidth>0)ok++;}"
+    "document.body.setAttribute('data-images',im.length);"
+    "document.body.setAttribute('data-images-rendered',ok);});</script>"
+)
 
 
 def write_page(path: Path, parts: list[str], inputs: Iterable[str] = ()) -> Path:
     """Close the page (with the image check) and write it by the output rule."""
     from ..outputs import write_output
+
     parts = parts + [_IMAGE_CHECK, "</body></html>"]
     write_output(path, "\n".join(parts), [str(i) for i in inputs])
     return path

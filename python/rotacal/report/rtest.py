@@ -1,6 +1,7 @@
 """The report of an R-test session: set-up, location errors, the error maps of the tilt and
 the rotary axis against their angles with 1-sigma bands (Oyama & Ibaraki Sec. 5.2),
 residuals and the diagnosis."""
+
 from __future__ import annotations
 
 import base64
@@ -11,8 +12,14 @@ import numpy as np
 
 from .. import _core
 from .page import escape as _e, head, img, png, plt, write_page
-from .sections import (diagnosis_section, location_error_table, machine_words, noise_budget_section,
-                       residual_plot, with_budget)
+from .sections import (
+    diagnosis_section,
+    location_error_table,
+    machine_words,
+    noise_budget_section,
+    residual_plot,
+    with_budget,
+)
 
 
 _COMPONENTS = ["dx", "dy", "dz", "alpha", "beta", "gamma"]
@@ -61,16 +68,28 @@ def rtest_b_map_plot(model: Any, b_range_deg: tuple[float, float]) -> str:
         if k < fitted:
             _band(ax, b, v[:, k] * scale, s[:, k] * scale, "#246", None)
         else:
-            ax.text(0.5, 0.5, "not fitted: a head axis' rotations\nonly move the one sphere", ha="center",
-                    va="center", transform=ax.transAxes, fontsize=8, color="#777")
+            ax.text(
+                0.5,
+                0.5,
+                "not fitted: a head axis' rotations\nonly move the one sphere",
+                ha="center",
+                va="center",
+                transform=ax.transAxes,
+                fontsize=8,
+                color="#777",
+            )
         ax.axhline(0, color="#999", lw=0.6)
-        ax.set_title(f"{_COMPONENTS[k]}_{tilt_map} ({unit})"
-                     + ("" if k >= fitted or np.all(np.isfinite(s[:, k])) else ", not determined (dashed)"),
-                     fontsize=9)
+        ax.set_title(
+            f"{_COMPONENTS[k]}_{tilt_map} ({unit})"
+            + ("" if k >= fitted or np.all(np.isfinite(s[:, k])) else ", not determined (dashed)"),
+            fontsize=9,
+        )
         ax.tick_params(labelsize=7)
         if k >= 3:
             ax.set_xlabel(f"{tilt} (deg)", fontsize=8)
-    fig.suptitle(f"{tilt}-axis errors beyond its location errors, joint fit (band: 1\u03c3)", fontsize=10)
+    fig.suptitle(
+        f"{tilt}-axis errors beyond its location errors, joint fit (band: 1\u03c3)", fontsize=10
+    )
     fig.tight_layout()
     return png(fig)
 
@@ -89,7 +108,14 @@ def rtest_c_map_plot(model: Any, b_values_deg: Iterable[float]) -> str:
         v, s = (np.asarray(a) for a in model.w_cb(ang))
         for k in range(fitted):
             scale, _ = _component_scale(k)
-            _band(axes.flat[k], c, v[:, k] * scale, s[:, k] * scale, colors[bi], f"{tilt} = {b:g}\u00b0")
+            _band(
+                axes.flat[k],
+                c,
+                v[:, k] * scale,
+                s[:, k] * scale,
+                colors[bi],
+                f"{tilt} = {b:g}\u00b0",
+            )
     for k, ax in enumerate(axes.flat):
         scale, unit = _component_scale(k)
         ax.set_title(f"{_COMPONENTS[k]}_{rot_map} ({unit})", fontsize=9)
@@ -97,13 +123,26 @@ def rtest_c_map_plot(model: Any, b_values_deg: Iterable[float]) -> str:
         if k >= 3:
             ax.set_xlabel(f"{rot} (deg)", fontsize=8)
         if k >= fitted:
-            why = ("assumed 0\n(Oyama Sec. 4.2)" if k == 5 and fitted == 5
-                   else "a head axis' rotations\nonly move the one sphere")
-            ax.text(0.5, 0.5, "not fitted: " + why, ha="center", va="center",
-                    transform=ax.transAxes, fontsize=8, color="#777")
+            why = (
+                "assumed 0\n(Oyama Sec. 4.2)"
+                if k == 5 and fitted == 5
+                else "a head axis' rotations\nonly move the one sphere"
+            )
+            ax.text(
+                0.5,
+                0.5,
+                "not fitted: " + why,
+                ha="center",
+                va="center",
+                transform=ax.transAxes,
+                fontsize=8,
+                color="#777",
+            )
         ax.axhline(0, color="#999", lw=0.6)
     axes.flat[0].legend(fontsize=6, ncol=2)
-    fig.suptitle(f"{rot}-axis errors beyond its location errors, joint fit (bands: 1\u03c3)", fontsize=10)
+    fig.suptitle(
+        f"{rot}-axis errors beyond its location errors, joint fit (bands: 1\u03c3)", fontsize=10
+    )
     fig.tight_layout()
     return png(fig)
 
@@ -114,9 +153,16 @@ def rtest_residual_plot(setups: np.ndarray, residuals: np.ndarray) -> str:
     return residual_plot(labels, [(f"d{a}", residuals[:, k]) for k, a in enumerate("xyz")])
 
 
-def rtest_report(path: str | Path, session: Any, identification: Any, diagnosis: Any | None = None,
-                 title: str | None = None, source: str = "", inputs: Iterable[str] = (),
-                 extra_sections: Iterable[str] = ()) -> Path:
+def rtest_report(
+    path: str | Path,
+    session: Any,
+    identification: Any,
+    diagnosis: Any | None = None,
+    title: str | None = None,
+    source: str = "",
+    inputs: Iterable[str] = (),
+    extra_sections: Iterable[str] = (),
+) -> Path:
     """Write the HTML report of an R-test session: set-up, location errors (ISO 230-7 table),
     the error map against B and C with uncertainty bands, residuals and the diagnosis."""
 
@@ -124,7 +170,9 @@ def rtest_report(path: str | Path, session: Any, identification: Any, diagnosis:
     with_budget(identification, session, diagnosis)
     ident = identification.to_dict()
     if ident["method"] != "joint":
-        raise _core.InvalidArgument("rtest_report: needs the joint identification (its model draws the map)")
+        raise _core.InvalidArgument(
+            "rtest_report: needs the joint identification (its model draws the map)"
+        )
     model = identification.raw.model
     setups = np.asarray(session.setups, dtype=object)
     angles = np.asarray(session.angles_deg)
@@ -133,54 +181,98 @@ def rtest_report(path: str | Path, session: Any, identification: Any, diagnosis:
     heading = title or "R-test: location errors and error map of the rotary axes"
     parts = head(heading, heading, source)
 
-    rows = [f"<tr><th class=l>Machine</th><td class=l>{_e(machine_words(session.machine))}</td></tr>"]
+    rows = [
+        f"<tr><th class=l>Machine</th><td class=l>{_e(machine_words(session.machine))}</td></tr>"
+    ]
     for label, q in sorted(session.nests.items()):
-        rows.append(f"<tr><th class=l>Nest {_e(label)} (table frame)</th>"
-                    f"<td class=l>{', '.join(f'{v:.4f}' for v in q)} mm</td></tr>")
+        rows.append(
+            f"<tr><th class=l>Nest {_e(label)} (table frame)</th>"
+            f"<td class=l>{', '.join(f'{v:.4f}' for v in q)} mm</td></tr>"
+        )
     for n, d in sorted(session.probe_dirs.items()):
-        rows.append(f"<tr><th class=l>Probe {_e(str(n))} direction</th><td class=l>{', '.join(f'{v:.6f}' for v in d)}</td></tr>")
+        rows.append(
+            f"<tr><th class=l>Probe {_e(str(n))} direction</th><td class=l>{', '.join(f'{v:.6f}' for v in d)}</td></tr>"
+        )
     tilt, rot = session.machine.tilt_axis, session.machine.rot_axis
-    rows.append(f"<tr><th class=l>Poses</th><td class=l>{len(setups)} ({len(b_meas)} {tilt} &times; {len(c_meas)} "
-                f"{rot} positions, {len(set(setups.tolist()))} set-ups)</td></tr>")
-    rows.append(f"<tr><th class=l>{tilt} (deg)</th><td class=l>{', '.join(f'{b:g}' for b in b_meas)}</td></tr>")
-    rows.append(f"<tr><th class=l>{rot} (deg)</th><td class=l>{', '.join(f'{c:g}' for c in c_meas)}</td></tr>")
+    rows.append(
+        f"<tr><th class=l>Poses</th><td class=l>{len(setups)} ({len(b_meas)} {tilt} &times; {len(c_meas)} "
+        f"{rot} positions, {len(set(setups.tolist()))} set-ups)</td></tr>"
+    )
+    rows.append(
+        f"<tr><th class=l>{tilt} (deg)</th><td class=l>{', '.join(f'{b:g}' for b in b_meas)}</td></tr>"
+    )
+    rows.append(
+        f"<tr><th class=l>{rot} (deg)</th><td class=l>{', '.join(f'{c:g}' for c in c_meas)}</td></tr>"
+    )
     if session.noise_um is not None:
-        rows.append(f"<tr><th class=l>Stated noise</th><td class=l>{session.noise_um:.3f} &micro;m</td></tr>")
-    parts.append('<section id="setup"><h2>Machine and set-up</h2><table>' + "".join(rows) + "</table></section>")
+        rows.append(
+            f"<tr><th class=l>Stated noise</th><td class=l>{session.noise_um:.3f} &micro;m</td></tr>"
+        )
+    parts.append(
+        '<section id="setup"><h2>Machine and set-up</h2><table>'
+        + "".join(rows)
+        + "</table></section>"
+    )
 
     parts.append('<section id="location-errors"><h2>Location errors (ISO 230-7), joint fit</h2>')
     parts.append(location_error_table(ident["location_errors"]))
-    zeros = ", ".join(f"set-up {_e(k)}: ({', '.join(f'{v * 1e3:+.2f}' for v in z)}) &micro;m"
-                      for k, z in ident["probe_zeros"].items())
-    parts.append(f"<p>Residual RMS {ident['residual_rms_um']:.3f} &micro;m over {ident['n_samples']} poses "
-                 f"(3 readings each). Fitted probe zeros: {zeros}.</p>")
+    zeros = ", ".join(
+        f"set-up {_e(k)}: ({', '.join(f'{v * 1e3:+.2f}' for v in z)}) &micro;m"
+        for k, z in ident["probe_zeros"].items()
+    )
+    parts.append(
+        f"<p>Residual RMS {ident['residual_rms_um']:.3f} &micro;m over {ident['n_samples']} poses "
+        f"(3 readings each). Fitted probe zeros: {zeros}.</p>"
+    )
     if ident["unobservable"]:
-        parts.append("<p class=warn>Not determined by this session's nests:</p><ul>" +
-                     "".join(f"<li>{_e(u)}</li>" for u in ident["unobservable"]) + "</ul>")
-    parts.append("<ul class=muted>" + "".join(f"<li>{_e(n)}</li>" for n in ident["notes"]) + "</ul>")
+        parts.append(
+            "<p class=warn>Not determined by this session's nests:</p><ul>"
+            + "".join(f"<li>{_e(u)}</li>" for u in ident["unobservable"])
+            + "</ul>"
+        )
+    parts.append(
+        "<ul class=muted>" + "".join(f"<li>{_e(n)}</li>" for n in ident["notes"]) + "</ul>"
+    )
     parts.append("</section>")
 
     map_csv = identification.error_map("csv", b_meas, c_meas)
     tilt, rot, tilt_map, rot_map = _map_words(model)
     parts.append(noise_budget_section(ident))
-    parts.append('<section id="error-map"><h2>Error map (Oyama &amp; Ibaraki Sec. 5.2)</h2>'
-                 f"<p>Position-dependent errors of the {tilt} axis (w_{tilt_map}, in front of the {tilt} "
-                 f"rotation) and of the {rot} axis (w_{rot_map}, in front of the {rot} rotation), beyond "
-                 "the rigid axis lines whose location errors are in the table above. Curves: the joint "
-                 "fit's smooth maps; bands: "
-                 "&plusmn;1&sigma; from the parameter covariance. "
-                 f"<a download='error_map.csv' href='data:text/csv;base64,"
-                 f"{base64.b64encode(map_csv.encode()).decode('ascii')}'>The map at the measured angles "
-                 "(CSV)</a>.</p>")
-    parts.append(img(rtest_b_map_plot(model, (b_meas[0], b_meas[-1])), f"{tilt}-axis errors against {tilt}",
-                      "error-map"))
-    parts.append(img(rtest_c_map_plot(model, b_meas), f"{rot}-axis errors against {rot} at each measured {tilt}",
-                      "error-map"))
+    parts.append(
+        '<section id="error-map"><h2>Error map (Oyama &amp; Ibaraki Sec. 5.2)</h2>'
+        f"<p>Position-dependent errors of the {tilt} axis (w_{tilt_map}, in front of the {tilt} "
+        f"rotation) and of the {rot} axis (w_{rot_map}, in front of the {rot} rotation), beyond "
+        "the rigid axis lines whose location errors are in the table above. Curves: the joint "
+        "fit's smooth maps; bands: "
+        "&plusmn;1&sigma; from the parameter covariance. "
+        f"<a download='error_map.csv' href='data:text/csv;base64,"
+        f"{base64.b64encode(map_csv.encode()).decode('ascii')}'>The map at the measured angles "
+        "(CSV)</a>.</p>"
+    )
+    parts.append(
+        img(
+            rtest_b_map_plot(model, (b_meas[0], b_meas[-1])),
+            f"{tilt}-axis errors against {tilt}",
+            "error-map",
+        )
+    )
+    parts.append(
+        img(
+            rtest_c_map_plot(model, b_meas),
+            f"{rot}-axis errors against {rot} at each measured {tilt}",
+            "error-map",
+        )
+    )
     parts.append("</section>")
 
     parts.append('<section id="residuals"><h2>Residuals</h2>')
-    parts.append(img(rtest_residual_plot(setups, np.asarray(identification.raw.residuals)),
-                      "residual per pose and reading (measured - joint model)", "residuals"))
+    parts.append(
+        img(
+            rtest_residual_plot(setups, np.asarray(identification.raw.residuals)),
+            "residual per pose and reading (measured - joint model)",
+            "residuals",
+        )
+    )
     parts.append("</section>")
 
     if diagnosis is not None:

@@ -1,9 +1,8 @@
 // The scoring of the circular-test diagnosis: visibility at plausible sizes, F-test and BIC
 // of an entry against the current model (the engine's score_columns), one by one or from a pool
 // of every variant.
-#include "diagnosis_detail.hpp"
-
 #include "../../diagnose/scoring.hpp"
+#include "diagnosis_detail.hpp"
 #include "rotacal/core/error.hpp"
 
 namespace rotacal::circular_detail {
@@ -107,10 +106,9 @@ Scored ScoringPool::score(std::size_t i, const CircularEffect& e, const Eigen::V
                           double min_chi2) const {
   const Eigen::VectorXd qr = q_.transpose() * r_w;
   const Eigen::MatrixXd G = gb_[i] - c_[i].transpose() * c_[i];
-  const Eigen::VectorXd g =
-      scale_ * (variants_[i]->transpose() * r_w) - c_[i].transpose() * qr;
-  return score_gram(e, G, g, graw_[i], r_w.squaredNorm(), static_cast<double>(r_w.size()),
-                    rank_, min_chi2);
+  const Eigen::VectorXd g = scale_ * (variants_[i]->transpose() * r_w) - c_[i].transpose() * qr;
+  return score_gram(e, G, g, graw_[i], r_w.squaredNorm(), static_cast<double>(r_w.size()), rank_,
+                    min_chi2);
 }
 
 }  // namespace rotacal::circular_detail

@@ -1,7 +1,6 @@
 // The catalogue of the circular-test diagnosis (diagnosis.hpp): its entries, their parameters
 // with units, and the cause each one names.
 #include "diagnosis_detail.hpp"
-
 #include "rotacal/core/error.hpp"
 
 namespace rotacal::circular_detail {

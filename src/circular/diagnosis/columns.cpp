@@ -1,9 +1,9 @@
 // The columns of the circular-test diagnosis: the readings of every run as rows, the runs'
 // baselines (centre offset and radius), and each entry's first-order change of the reading per
 // unit parameter.
-#include "diagnosis_detail.hpp"
-
 #include <cmath>
+
+#include "diagnosis_detail.hpp"
 
 namespace rotacal::circular_detail {
 

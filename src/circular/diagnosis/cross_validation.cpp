@@ -1,9 +1,8 @@
 // Cross-validation of the circular-test diagnosis: blocked folds within each run, and the CV RMS
 // of a model refitted without each fold (the engine's blocked_cv_rms_um, refitted with each
 // run's own baseline).
-#include "diagnosis_detail.hpp"
-
 #include "../../diagnose/scoring.hpp"
+#include "diagnosis_detail.hpp"
 
 namespace rotacal::circular_detail {
 

@@ -120,8 +120,7 @@ std::vector<Scored> CircularSearch::score_round(const ScoringPool* pool, const M
       Scored sc = score_variant(first_variant + g, e);
       sc.tau = cs[g].tau;
       sc.delay = cs[g].delay;
-      if (!have || (sc.visible && (!best.visible || sc.rss1 < best.rss1)))
-        best = sc, have = true;
+      if (!have || (sc.visible && (!best.visible || sc.rss1 < best.rss1))) best = sc, have = true;
     }
     if (!best.visible) {
       (best.absorbed ? absorbed : invisible).insert(e.id());
@@ -183,8 +182,7 @@ void CircularSearch::eliminate() {
     // Every drop-one refit from one QR of the whitened model (CompressedFit).
     const CompressedFit drop(R, W(Mk), W(Eigen::MatrixXd(R.y)).col(0));
     for (std::size_t k = 0; k < chosen.size(); ++k) {
-      const Eigen::Index width =
-          (k + 1 < chosen.size() ? offs[k + 1] : Mk.cols()) - offs[k];
+      const Eigen::Index width = (k + 1 < chosen.size() ? offs[k + 1] : Mk.cols()) - offs[k];
       const double rss_without = drop.rss_without(offs[k], width);
       const int kk = static_cast<int>(width) + nonlinear_params(chosen[k].effect);
       const double dof = n - static_cast<double>(Mk.cols()) - 1.0;
@@ -194,10 +192,9 @@ void CircularSearch::eliminate() {
           n * std::log(std::max(fit.rss_w, 1e-300) / rss_without) + kk * std::log(n);
       const bool outward =
           chosen[k].effect.kind != CircularEffectKind::reversal_spike || fit.beta[offs[k]] > 0.0;
-      const double score =
-          (p * m < o_.alpha && dbic < o_.min_delta_bic && outward)
-              ? -1.0
-              : p + (dbic >= o_.min_delta_bic ? 1.0 : 0.0) + (outward ? 0.0 : 2.0);
+      const double score = (p * m < o_.alpha && dbic < o_.min_delta_bic && outward)
+                               ? -1.0
+                               : p + (dbic >= o_.min_delta_bic ? 1.0 : 0.0) + (outward ? 0.0 : 2.0);
       if (score > worst_score) worst_score = score, worst = k;
     }
     if (worst_score < 0.0) break;

@@ -22,7 +22,6 @@
 
 namespace rotacal::circular_detail {
 
-
 std::string axis_name(int i);
 
 // Plausible sizes per unit, for visibility (see CircularDiagnosisOptions::min_visible_chi2).
@@ -67,9 +66,9 @@ std::string not_moved(const Rows& R, const CircularEffect& e);
 // The model's columns for a list of chosen entries (spikes at their tau).
 struct Chosen {
   CircularEffect effect;
-  double tau = 0.0;                       // spike
-  double delay = 0.0;                     // backlash, spike
-  double delay_sd = 0.0;                  // its 1 sigma (after the scan)
+  double tau = 0.0;                                    // spike
+  double delay = 0.0;                                  // backlash, spike
+  double delay_sd = 0.0;                               // its 1 sigma (after the scan)
   std::pair<double, double> delay_range = {0.0, 0.0};  // its delta-chi-square-1 range
 };
 

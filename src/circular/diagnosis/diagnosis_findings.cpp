@@ -2,11 +2,10 @@
 // finding's parameters with 1-sigma (linear ones from the whitened Jacobian, nonlinear ones
 // from their profile, whose spread is carried into the linear ones), its gain, and why each
 // entry left out stays unobservable.
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <limits>
-
-#include <Eigen/Cholesky>
 
 #include "diagnosis_detail.hpp"
 #include "rotacal/core/stats.hpp"
@@ -148,8 +147,8 @@ void CircularSearch::explain_unobservable() {
   for (const CircularEffect& e : cands) {
     if (!absorbed.count(e.id())) continue;
     const Eigen::MatrixXd Jc = W(cols[e.id()].front().J);
-    Scored vs_base = score_one(e, Jc, Qb, Eigen::VectorXd::Zero(Jc.rows()), Qb.rank(),
-                               o_.min_visible_chi2);
+    Scored vs_base =
+        score_one(e, Jc, Qb, Eigen::VectorXd::Zero(Jc.rows()), Qb.rank(), o_.min_visible_chi2);
     std::string why;
     if (!vs_base.visible) {
       why = "the centre offset and radius of each run absorb its signature in these runs";

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <memory>
 
-#include "diagnosis_detail.hpp"
 #include "../../diagnose/scoring.hpp"
+#include "diagnosis_detail.hpp"
 
 namespace rotacal::circular_detail {
 

@@ -1,13 +1,12 @@
 // The fits of the circular-test diagnosis: whitening by the noise model, least squares over the
 // runs' baselines block by block (GLS), and the noise of the residuals.
-#include "diagnosis_detail.hpp"
-
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 
-#include "rotacal/core/error.hpp"
 #include "../../diagnose/scoring.hpp"
+#include "diagnosis_detail.hpp"
+#include "rotacal/core/error.hpp"
 
 namespace rotacal::circular_detail {
 

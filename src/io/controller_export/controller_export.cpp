@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-
 #include <nlohmann/json.hpp>
 
 #include "rotacal/core/error.hpp"
@@ -29,9 +28,10 @@ const std::map<std::string, Controller>& controller_names() {
 // (docs/controller_exports.md); other chains have other parameter sets, not written yet.
 void require_table_machine(MachineType m) {
   if (m != MachineType::AC_trt && m != MachineType::BC_trt)
-    throw InvalidArgument("export: the controller exports are written for the AC-trt and BC-trt tables; a " +
-                          to_string(m) + " (" + m.description().configuration() +
-                          ") machine's identified errors are in its model file (--save-model)");
+    throw InvalidArgument(
+        "export: the controller exports are written for the AC-trt and BC-trt tables; a " +
+        to_string(m) + " (" + m.description().configuration() +
+        ") machine's identified errors are in its model file (--save-model)");
 }
 
 }  // namespace
@@ -71,7 +71,8 @@ ExportInput export_input(const ModelFile& model, const std::string& model_path) 
     for (int i = 0; i < 8; ++i) {
       at[static_cast<std::size_t>(i)] = -1;
       for (std::size_t j = 0; j < params.size(); ++j)
-        if (params[j] == names[static_cast<std::size_t>(i)]) at[static_cast<std::size_t>(i)] = static_cast<int>(j);
+        if (params[j] == names[static_cast<std::size_t>(i)])
+          at[static_cast<std::size_t>(i)] = static_cast<int>(j);
       all = all && at[static_cast<std::size_t>(i)] >= 0;
     }
     if (all) {
@@ -79,7 +80,8 @@ ExportInput export_input(const ModelFile& model, const std::string& model_path) 
       Eigen::Matrix<double, 8, 8> c;
       for (int i = 0; i < 8; ++i)
         for (int j = 0; j < 8; ++j) {
-          const auto& x = cov.at("matrix").at(static_cast<std::size_t>(at[static_cast<std::size_t>(i)]))
+          const auto& x = cov.at("matrix")
+                              .at(static_cast<std::size_t>(at[static_cast<std::size_t>(i)]))
                               .at(static_cast<std::size_t>(at[static_cast<std::size_t>(j)]));
           finite = finite && x.is_number();
           c(i, j) = x.is_number() ? x.get<double>() : 0.0;
@@ -92,10 +94,13 @@ ExportInput export_input(const ModelFile& model, const std::string& model_path) 
   }
   if (doc.contains("source") && doc["source"].is_object()) {
     const auto& s = doc["source"];
-    auto str = [&](const char* k) { return s.contains(k) && s[k].is_string() ? s[k].get<std::string>() : std::string(); };
+    auto str = [&](const char* k) {
+      return s.contains(k) && s[k].is_string() ? s[k].get<std::string>() : std::string();
+    };
     in.source = str("session");
     if (!str("identified_at").empty()) in.source += " on " + str("identified_at");
-    if (!str("session_sha256").empty()) in.source += " (sha256 " + str("session_sha256").substr(0, 16) + "...)";
+    if (!str("session_sha256").empty())
+      in.source += " (sha256 " + str("session_sha256").substr(0, 16) + "...)";
   }
   return in;
 }
@@ -107,20 +112,27 @@ ControllerExport export_kinematics(Controller c, const ExportInput& in, const Ex
   const std::vector<std::string> known = current_parameter_names(c, in.machine, o.toolholder);
   for (const auto& [name, value] : o.current) {
     if (std::find(known.begin(), known.end(), name) == known.end())
-      throw InvalidArgument("current value '" + name + "' is not a parameter of the " + to_string(c) + " export");
+      throw InvalidArgument("current value '" + name + "' is not a parameter of the " +
+                            to_string(c) + " export");
     if (!std::isfinite(value)) throw InvalidArgument("current value '" + name + "' is not finite");
   }
   switch (c) {
-    case Controller::linuxcnc: return export_linuxcnc(in, o);
-    case Controller::siemens: return export_siemens(in, o);
-    case Controller::isg: return export_isg(in, o);
-    case Controller::heidenhain: return export_heidenhain(in, o);
-    case Controller::fanuc: return export_fanuc(in, o);
+    case Controller::linuxcnc:
+      return export_linuxcnc(in, o);
+    case Controller::siemens:
+      return export_siemens(in, o);
+    case Controller::isg:
+      return export_isg(in, o);
+    case Controller::heidenhain:
+      return export_heidenhain(in, o);
+    case Controller::fanuc:
+      return export_fanuc(in, o);
   }
   throw InvalidArgument("export: unknown controller");
 }
 
-std::vector<std::string> current_parameter_names(Controller c, MachineType machine, int toolholder) {
+std::vector<std::string> current_parameter_names(Controller c, MachineType machine,
+                                                 int toolholder) {
   require_table_machine(machine);
   ExportInput in;
   in.machine = machine;
@@ -130,15 +142,27 @@ std::vector<std::string> current_parameter_names(Controller c, MachineType machi
   o.generated_at = "-";
   ControllerExport ex;
   switch (c) {
-    case Controller::linuxcnc: ex = export_linuxcnc(in, o); break;
-    case Controller::siemens: ex = export_siemens(in, o); break;
-    case Controller::isg: ex = export_isg(in, o); break;
-    case Controller::heidenhain: ex = export_heidenhain(in, o); break;
-    case Controller::fanuc: ex = export_fanuc(in, o); break;
+    case Controller::linuxcnc:
+      ex = export_linuxcnc(in, o);
+      break;
+    case Controller::siemens:
+      ex = export_siemens(in, o);
+      break;
+    case Controller::isg:
+      ex = export_isg(in, o);
+      break;
+    case Controller::heidenhain:
+      ex = export_heidenhain(in, o);
+      break;
+    case Controller::fanuc:
+      ex = export_fanuc(in, o);
+      break;
   }
   std::vector<std::string> names;
   for (const ControllerValue& v : ex.values) {
-    const std::size_t cut = c == Controller::fanuc ? 9 : c == Controller::siemens ? v.name.find(' ') : std::string::npos;
+    const std::size_t cut = c == Controller::fanuc     ? 9
+                            : c == Controller::siemens ? v.name.find(' ')
+                                                       : std::string::npos;
     names.push_back(v.name.substr(0, cut));
   }
   return names;

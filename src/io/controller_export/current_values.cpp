@@ -3,9 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <sstream>
-
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "rotacal/core/error.hpp"
 #include "rotacal/core/json_text.hpp"
@@ -21,29 +20,38 @@ const char* const kMaxCurrentText = "1e6";
 bool plausible_current(double v) { return std::isfinite(v) && std::abs(v) <= kMaxCurrent; }
 }  // namespace
 
-std::map<std::string, double> parse_current_parameters(Controller c, MachineType machine, const std::string& text,
+std::map<std::string, double> parse_current_parameters(Controller c, MachineType machine,
+                                                       const std::string& text,
                                                        const std::string& source, int toolholder) {
   const std::vector<std::string> known = current_parameter_names(c, machine, toolholder);
-  auto is_known = [&](const std::string& n) { return std::find(known.begin(), known.end(), n) != known.end(); };
+  auto is_known = [&](const std::string& n) {
+    return std::find(known.begin(), known.end(), n) != known.end();
+  };
   std::map<std::string, double> out;
   const std::size_t first = text.find_first_not_of(" \t\r\n");
   if (first != std::string::npos && text[first] == '{') {  // the documented JSON
-    const nlohmann::ordered_json j = parse_json(text, source);  // bounded, strict; ParseError names the line
+    const nlohmann::ordered_json j =
+        parse_json(text, source);  // bounded, strict; ParseError names the line
     if (!j.is_object() || !j.contains("parameters") || !j["parameters"].is_object())
-      throw InvalidArgument(source + ": expected {\"controller\": ..., \"parameters\": {name: value}}");
+      throw InvalidArgument(source +
+                            ": expected {\"controller\": ..., \"parameters\": {name: value}}");
     if (j.contains("controller") && j["controller"] != to_string(c))
-      throw InvalidArgument(source + ": values of controller " + j["controller"].dump() + ", export for " + to_string(c));
+      throw InvalidArgument(source + ": values of controller " + j["controller"].dump() +
+                            ", export for " + to_string(c));
     for (const auto& [name, value] : j["parameters"].items()) {
-      if (!is_known(name)) throw InvalidArgument(source + ": parameters." + name + ": not a parameter of this export");
+      if (!is_known(name))
+        throw InvalidArgument(source + ": parameters." + name + ": not a parameter of this export");
       if (!value.is_number() || !plausible_current(value.get<double>()))
-        throw InvalidArgument(source + ": parameters." + name + ": must be a finite number of at most " +
-                              kMaxCurrentText + " (mm or deg)");
+        throw InvalidArgument(source + ": parameters." + name +
+                              ": must be a finite number of at most " + kMaxCurrentText +
+                              " (mm or deg)");
       out[name] = value.get<double>();
     }
     return out;
   }
   if (c != Controller::linuxcnc && c != Controller::siemens)
-    throw InvalidArgument(source + ": current values of " + to_string(c) + " are read from the JSON form only");
+    throw InvalidArgument(source + ": current values of " + to_string(c) +
+                          " are read from the JSON form only");
   std::istringstream in(text);
   std::string line;
   int n = 0;
@@ -57,8 +65,8 @@ std::map<std::string, double> parse_current_parameters(Controller c, MachineType
       std::string cmd;
       if (!(ls >> cmd) || cmd != "setp" || !(ls >> name) || name.rfind(kins, 0) != 0) continue;
       if (!(ls >> value)) throw InvalidArgument(where + ": setp " + name + " without a value");
-      if (name == kins + "tool-offset" || name == kins + "conventional-directions" || name == kins + "x-offset" ||
-          name == kins + "y-offset") {
+      if (name == kins + "tool-offset" || name == kins + "conventional-directions" ||
+          name == kins + "x-offset" || name == kins + "y-offset") {
         if (!is_known(name)) continue;  // read by the module but not changed by the export
       }
     } else {
@@ -73,18 +81,22 @@ std::map<std::string, double> parse_current_parameters(Controller c, MachineType
       };
       name = trim(stmt.substr(0, eq));
       value = trim(stmt.substr(eq + 1));
-      if (name.find("[" + std::to_string(toolholder) + "]") == std::string::npos) continue;  // another data set
+      if (name.find("[" + std::to_string(toolholder) + "]") == std::string::npos)
+        continue;                     // another data set
       if (!is_known(name)) continue;  // names, type, limits, fine offsets: kept as they are
     }
-    if (!is_known(name)) throw InvalidArgument(where + ": " + name + " is not a parameter of this export");
+    if (!is_known(name))
+      throw InvalidArgument(where + ": " + name + " is not a parameter of this export");
     char* end = nullptr;
     const double v = std::strtod(value.c_str(), &end);
     if (end == value.c_str() || *end != '\0' || !plausible_current(v))
-      throw InvalidArgument(where + ": " + name + ": '" + value + "' is not a finite number of at most " +
-                            kMaxCurrentText + " (mm or deg)");
+      throw InvalidArgument(where + ": " + name + ": '" + value +
+                            "' is not a finite number of at most " + kMaxCurrentText +
+                            " (mm or deg)");
     out[name] = v;
   }
-  if (out.empty()) throw InvalidArgument(source + ": no current values of " + to_string(c) + " found");
+  if (out.empty())
+    throw InvalidArgument(source + ": no current values of " + to_string(c) + " found");
   return out;
 }
 

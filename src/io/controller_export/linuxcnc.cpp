@@ -24,18 +24,23 @@ ControllerExport export_linuxcnc(const ExportInput& in, const ExportOptions& o) 
   const std::string off = ac ? "y-offset" : "x-offset";
   const std::string no_orient = "no orientation terms in " + kins + " (trtfuncs.c)";
   dispositions(ex, in,
-               {ac ? "y-offset (A line y = y-rot-point + y-offset)" : "x-offset (B line x = x-rot-point + x-offset)",
-                "z-offset (" + std::string(1, L.tilt) + " line z = z-rot-point + z-offset)", no_orient, no_orient,
-                "x-rot-point (and " + off + ", which is relative to it)",
-                ac ? "y-rot-point (and y-offset, which is relative to it)" : "y-rot-point", no_orient, no_orient},
+               {ac ? "y-offset (A line y = y-rot-point + y-offset)"
+                   : "x-offset (B line x = x-rot-point + x-offset)",
+                "z-offset (" + std::string(1, L.tilt) + " line z = z-rot-point + z-offset)",
+                no_orient, no_orient, "x-rot-point (and " + off + ", which is relative to it)",
+                ac ? "y-rot-point (and y-offset, which is relative to it)" : "y-rot-point",
+                no_orient, no_orient},
                {true, true, false, false, true, true, false, false});
   Writer w(CommentDialect::hash);
   header(w, ex, in, o,
-         "LinuxCNC " + kins + " HAL pins (src/emc/kinematics/trtfuncs.c), linear units mm ([TRAJ]LINEAR_UNITS), "
-         "angles as the module's default directions (right-handed table rotation)");
-  w.line(std::string(ac ? "x-offset" : "y-offset") + " is never read by " + kins + "; tool-offset stays wired to "
+         "LinuxCNC " + kins +
+             " HAL pins (src/emc/kinematics/trtfuncs.c), linear units mm ([TRAJ]LINEAR_UNITS), "
+             "angles as the module's default directions (right-handed table rotation)");
+  w.line(std::string(ac ? "x-offset" : "y-offset") + " is never read by " + kins +
+         "; tool-offset stays wired to "
          "motion.tooloffset.z.");
-  for (const ControllerValue& v : ex.values) w.out << "setp " << v.name << " " << fixed(v.corrected, 6) << "\n";
+  for (const ControllerValue& v : ex.values)
+    w.out << "setp " << v.name << " " << fixed(v.corrected, 6) << "\n";
   ex.text = w.out.str();
   return ex;
 }

@@ -54,7 +54,8 @@ std::string from_text(const Row& c, MachineType m) {
   for (int i = 0; i < 8; ++i) {
     if (c[i] == 0.0) continue;
     const std::string sign = c[i] > 0 ? (s.empty() ? "" : " + ") : (s.empty() ? "-" : " - ");
-    s += sign + (std::abs(c[i]) == 1.0 ? "" : fixed(std::abs(c[i]), 3) + " ") + names[static_cast<std::size_t>(i)];
+    s += sign + (std::abs(c[i]) == 1.0 ? "" : fixed(std::abs(c[i]), 3) + " ") +
+         names[static_cast<std::size_t>(i)];
   }
   return s;
 }
@@ -88,15 +89,17 @@ ControllerValue value_of(const Param& p, double current, const ExportInput& in) 
   return v;
 }
 
-AxisVector corrected_axis(const Eigen::Vector3d& current_raw, const Eigen::Vector3d& nominal, const Map3& dn,
-                          const ExportInput& in, const std::string& what, double default_sense) {
+AxisVector corrected_axis(const Eigen::Vector3d& current_raw, const Eigen::Vector3d& nominal,
+                          const Map3& dn, const ExportInput& in, const std::string& what,
+                          double default_sense) {
   AxisVector a;
   a.current = current_raw.norm() > 0 ? current_raw : Eigen::Vector3d(default_sense * nominal);
   const Eigen::Vector3d u = a.current.normalized();
   const double cosine = u.dot(nominal);
   if (std::abs(cosine) < std::cos(1.0 * M_PI / 180.0))
-    throw InvalidArgument(what + ": the current axis vector (" + fixed(a.current.x(), 6) + ", " + fixed(a.current.y(), 6) +
-                          ", " + fixed(a.current.z(), 6) + ") is more than 1 deg from the machine's nominal axis; "
+    throw InvalidArgument(what + ": the current axis vector (" + fixed(a.current.x(), 6) + ", " +
+                          fixed(a.current.y(), 6) + ", " + fixed(a.current.z(), 6) +
+                          ") is more than 1 deg from the machine's nominal axis; "
                           "the export corrects a kinematics of this machine");
   const double s = cosine > 0 ? 1.0 : -1.0;
   Map3 c = s * dn;
@@ -107,8 +110,8 @@ AxisVector corrected_axis(const Eigen::Vector3d& current_raw, const Eigen::Vecto
   return a;
 }
 
-ControllerValue vector_component(const std::string& name, const AxisVector& a, int k, const ExportInput& in,
-                                 const Map3& dn) {
+ControllerValue vector_component(const std::string& name, const AxisVector& a, int k,
+                                 const ExportInput& in, const Map3& dn) {
   ControllerValue v;
   v.name = name;
   v.unit = "1";
@@ -120,8 +123,8 @@ ControllerValue vector_component(const std::string& name, const AxisVector& a, i
   return v;
 }
 
-ControllerExport new_export(Controller c, const std::string& kinematics, const std::string& file_kind,
-                            const ExportOptions& o) {
+ControllerExport new_export(Controller c, const std::string& kinematics,
+                            const std::string& file_kind, const ExportOptions& o) {
   ControllerExport ex;
   ex.controller = c;
   ex.kinematics = kinematics;
@@ -136,33 +139,37 @@ void header(Writer& w, const ControllerExport& ex, const ExportInput& in, const 
   w.line("model: " + (in.model_path.empty() ? std::string("(not named)") : in.model_path) +
          (in.source.empty() ? "" : "; identified from " + in.source));
   w.line("written: " + (o.generated_at.empty() ? utc_now() : o.generated_at));
-  w.line(ex.current_given ? "current values: as given (the values active while the test ran)"
-                          : "current values: NOT GIVEN - zero offsets assumed, so each value below is the "
-                            "correction itself; add it to the controller's value");
-  if (!in.full_covariance) w.line("1-sigma: from each error's own std (the model holds no covariance)");
+  w.line(ex.current_given
+             ? "current values: as given (the values active while the test ran)"
+             : "current values: NOT GIVEN - zero offsets assumed, so each value below is the "
+               "correction itself; add it to the controller's value");
+  if (!in.full_covariance)
+    w.line("1-sigma: from each error's own std (the model holds no covariance)");
   w.line();
   w.line("parameter | current | corrected | 1-sigma | unit | from");
   for (const ControllerValue& v : ex.values) {
     const int d = v.unit == "1" ? 9 : v.unit == "0.1 um" ? 1 : 6;
-    w.line(v.name + " | " + fixed(v.current, d) + " | " + fixed(v.corrected, d) + " | " + fixed(v.std, d + 1) + " | " +
-           v.unit + " | " + (v.from.empty() ? "-" : v.from));
+    w.line(v.name + " | " + fixed(v.current, d) + " | " + fixed(v.corrected, d) + " | " +
+           fixed(v.std, d + 1) + " | " + v.unit + " | " + (v.from.empty() ? "-" : v.from));
   }
   w.line();
   for (std::size_t i = 0; i < ex.errors.size(); ++i) {
     const ErrorDisposition& e = ex.errors[i];
     const bool angle = location_error_is_angle(static_cast<int>(i));
     const std::string val = e.observable ? fixed(e.value * (angle ? 1e6 : 1e3), 2) + " +- " +
-                                               fixed(e.std * (angle ? 1e6 : 1e3), 2) + (angle ? " urad" : " um")
+                                               fixed(e.std * (angle ? 1e6 : 1e3), 2) +
+                                               (angle ? " urad" : " um")
                                          : "not determined by the data";
     w.line(e.name + " = " + val + ": " + (e.held ? "held in " : "NOT HELD: ") + e.where);
   }
   if (ex.not_held.v.cwiseAbs().maxCoeff() > 0)
-    w.line("Errors not held remain: apply them as NC compensation (rotacal compensate --model ...).");
+    w.line(
+        "Errors not held remain: apply them as NC compensation (rotacal compensate --model ...).");
   w.line();
 }
 
-void dispositions(ControllerExport& ex, const ExportInput& in, const std::array<std::string, 8>& where,
-                  const std::array<bool, 8>& held) {
+void dispositions(ControllerExport& ex, const ExportInput& in,
+                  const std::array<std::string, 8>& where, const std::array<bool, 8>& held) {
   const auto& names = location_error_names(in.machine);
   for (int i = 0; i < 8; ++i) {
     const auto k = static_cast<std::size_t>(i);
@@ -172,7 +179,8 @@ void dispositions(ControllerExport& ex, const ExportInput& in, const std::array<
     d.std = std::sqrt(std::max(0.0, in.covariance(i, i)));
     d.observable = in.observable[k];
     d.held = held[k] && d.observable;
-    d.where = !d.observable ? "not determined by the data: the parameters keep their current value" : where[k];
+    d.where = !d.observable ? "not determined by the data: the parameters keep their current value"
+                            : where[k];
     if (!held[k] && d.observable) ex.not_held.v[i] = in.errors.v[i];
     ex.errors.push_back(d);
   }

@@ -2,11 +2,10 @@
 // The part of the controller exports that every controller shares (controller_export/*.cpp):
 // the axis lines as linear maps of the location errors, one parameter's corrected value and
 // its sigma, corrected axis vectors, the header of the file, and where each error goes.
+#include <Eigen/Core>
 #include <array>
 #include <sstream>
 #include <string>
-
-#include <Eigen/Core>
 
 #include "rotacal/io/controller_comment.hpp"
 #include "rotacal/io/controller_export.hpp"
@@ -20,7 +19,8 @@ using Map3 = Eigen::Matrix<double, 3, 8>;  // a 3-vector as a linear function of
 // axis (A or B) and C, their point offsets dp and direction offsets dn. The lines are linear in
 // the errors, so each column is the one definition (kinematics/machine.hpp) at a unit error.
 struct LineMaps {
-  Map3 tilt_point = Map3::Zero(), tilt_dir = Map3::Zero(), c_point = Map3::Zero(), c_dir = Map3::Zero();
+  Map3 tilt_point = Map3::Zero(), tilt_dir = Map3::Zero(), c_point = Map3::Zero(),
+       c_dir = Map3::Zero();
   Eigen::Vector3d tilt_axis, c_axis;
   char tilt = 'A';
 };
@@ -50,11 +50,12 @@ struct AxisVector {
   Map3 coef;  // first-order d corrected / d errors
 };
 
-AxisVector corrected_axis(const Eigen::Vector3d& current_raw, const Eigen::Vector3d& nominal, const Map3& dn,
-                          const ExportInput& in, const std::string& what, double default_sense = 1.0);
+AxisVector corrected_axis(const Eigen::Vector3d& current_raw, const Eigen::Vector3d& nominal,
+                          const Map3& dn, const ExportInput& in, const std::string& what,
+                          double default_sense = 1.0);
 
-ControllerValue vector_component(const std::string& name, const AxisVector& a, int k, const ExportInput& in,
-                                 const Map3& dn);
+ControllerValue vector_component(const std::string& name, const AxisVector& a, int k,
+                                 const ExportInput& in, const Map3& dn);
 
 // The file: comment lines through the dialect's comment writer (a model path, a session or
 // a date may hold any text), then the values.
@@ -67,14 +68,14 @@ struct Writer {
   }
 };
 
-ControllerExport new_export(Controller c, const std::string& kinematics, const std::string& file_kind,
-                            const ExportOptions& o);
+ControllerExport new_export(Controller c, const std::string& kinematics,
+                            const std::string& file_kind, const ExportOptions& o);
 
 void header(Writer& w, const ControllerExport& ex, const ExportInput& in, const ExportOptions& o,
             const std::string& title);
 
-void dispositions(ControllerExport& ex, const ExportInput& in, const std::array<std::string, 8>& where,
-                  const std::array<bool, 8>& held);
+void dispositions(ControllerExport& ex, const ExportInput& in,
+                  const std::array<std::string, 8>& where, const std::array<bool, 8>& held);
 
 // One export per controller (linuxcnc.cpp, sinumerik.cpp, isg.cpp, heidenhain.cpp, fanuc.cpp).
 ControllerExport export_linuxcnc(const ExportInput& in, const ExportOptions& o);

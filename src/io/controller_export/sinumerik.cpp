@@ -26,24 +26,32 @@ ControllerExport export_siemens(const ExportInput& in, const ExportOptions& o) {
   vector_params(15, L.c_point - L.tilt_point, "l3");
   vector_params(18, -L.c_point, "l4");
   auto current_vec = [&](int first) {
-    return Eigen::Vector3d(current_of(o, name(first)), current_of(o, name(first + 1)), current_of(o, name(first + 2)));
+    return Eigen::Vector3d(current_of(o, name(first)), current_of(o, name(first + 1)),
+                           current_of(o, name(first + 2)));
   };
-  const AxisVector v1 = corrected_axis(current_vec(7), L.tilt_axis, L.tilt_dir, in, name(7) + ".." + name(9) + " (v1)");
-  const AxisVector v2 = corrected_axis(current_vec(10), L.c_axis, L.c_dir, in, name(10) + ".." + name(12) + " (v2)");
+  const AxisVector v1 = corrected_axis(current_vec(7), L.tilt_axis, L.tilt_dir, in,
+                                       name(7) + ".." + name(9) + " (v1)");
+  const AxisVector v2 =
+      corrected_axis(current_vec(10), L.c_axis, L.c_dir, in, name(10) + ".." + name(12) + " (v2)");
   for (int c = 0; c < 3; ++c)
-    ex.values.push_back(vector_component(name(7 + c) + " (v1 " + xyz[c] + ")", v1, c, in, L.tilt_dir));
+    ex.values.push_back(
+        vector_component(name(7 + c) + " (v1 " + xyz[c] + ")", v1, c, in, L.tilt_dir));
   for (int c = 0; c < 3; ++c)
-    ex.values.push_back(vector_component(name(10 + c) + " (v2 " + xyz[c] + ")", v2, c, in, L.c_dir));
+    ex.values.push_back(
+        vector_component(name(10 + c) + " (v2 " + xyz[c] + ")", v2, c, in, L.c_dir));
   const std::string t(1, L.tilt);
-  dispositions(ex, in,
-               {"l2, l3 (" + t + " line through l2)", "l2, l3 (" + t + " line through l2)", "v1 (" + t + " direction)",
-                "v1 (" + t + " direction)", "l3, l4 (C line through l2 + l3)", "l3, l4 (C line through l2 + l3)",
-                "v2 (C direction)", "v2 (C direction)"},
-               {true, true, true, true, true, true, true, true});
+  dispositions(
+      ex, in,
+      {"l2, l3 (" + t + " line through l2)", "l2, l3 (" + t + " line through l2)",
+       "v1 (" + t + " direction)", "v1 (" + t + " direction)", "l3, l4 (C line through l2 + l3)",
+       "l3, l4 (C line through l2 + l3)", "v2 (C direction)", "v2 (C direction)"},
+      {true, true, true, true, true, true, true, true});
   Writer w(CommentDialect::siemens);
   header(w, ex, in, o,
-         "SINUMERIK orientable toolholder " + ex.kinematics + " (W1 function manual: type P, chain l2 v1 l3 v2 l4), "
-         "basic values in mm, axis vectors as unit vectors; fine offsets ($TC_CARR41..65) are not changed");
+         "SINUMERIK orientable toolholder " + ex.kinematics +
+             " (W1 function manual: type P, chain l2 v1 l3 v2 l4), "
+             "basic values in mm, axis vectors as unit vectors; fine offsets ($TC_CARR41..65) are "
+             "not changed");
   w.out << name(23) << "=\"P\"\n";
   for (const ControllerValue& v : ex.values) {
     const std::string bare = v.name.substr(0, v.name.find(' '));

@@ -9,6 +9,7 @@ Parameter order is the order the spec writes them:
   straightness_DA (c_2, c_3, c_4) | angular_error_BX / _AY (e1, e2)   [docs/effects.md]
   stylus_radius_offset (d) | probe_lobing (l_c, l_s)
 """
+
 from __future__ import annotations
 
 import re
@@ -22,11 +23,22 @@ _AXIS_INDEX = {"X": 0, "Y": 1, "Z": 2}
 # effects.md does not fix it; a nutating axis uses formats.md's u, v (docs/effects.md).
 ISO_RADIAL = {"A": (1, 2), "B": (2, 0), "C": (0, 1)}
 
-_ROTARY = {"rotary_zero_offset": 1, "angular_positioning": 2, "axial_motion": 2,
-           "radial_motion": 4, "tilt_motion": 4, "gravity_sag": 1, "coning": 1}
+_ROTARY = {
+    "rotary_zero_offset": 1,
+    "angular_positioning": 2,
+    "axial_motion": 2,
+    "radial_motion": 4,
+    "tilt_motion": 4,
+    "gravity_sag": 1,
+    "coning": 1,
+}
 _HARMONIC_KINDS = {"angular_positioning", "axial_motion", "radial_motion", "tilt_motion"}
-_SIMPLE = {"ballbar_length_offset": 1, "ballbar_thermal_drift": 1, "stylus_radius_offset": 1,
-           "probe_lobing": 2}
+_SIMPLE = {
+    "ballbar_length_offset": 1,
+    "ballbar_thermal_drift": 1,
+    "stylus_radius_offset": 1,
+    "probe_lobing": 2,
+}
 BALLBAR_ONLY = {"ballbar_length_offset", "ballbar_thermal_drift"}
 PROBE_ONLY = {"stylus_radius_offset", "probe_lobing"}
 
@@ -34,9 +46,10 @@ PROBE_ONLY = {"stylus_radius_offset", "probe_lobing"}
 @dataclass(frozen=True)
 class EffectId:
     """A parsed catalogue id."""
+
     id: str
     kind: str
-    axis: str = ""      # rotary letter, or linear axis / pair letters
+    axis: str = ""  # rotary letter, or linear axis / pair letters
     harmonic: int = 0
     num_params: int = 1
 
@@ -45,7 +58,9 @@ def parse(effect_id: str) -> EffectId:
     """Parse an id of effects.md; ValueError for anything else."""
     if effect_id in _SIMPLE:
         return EffectId(effect_id, effect_id, num_params=_SIMPLE[effect_id])
-    m = re.fullmatch(r"(angular_positioning|axial_motion|radial_motion|tilt_motion)_([A-Z])_h(\d+)", effect_id)
+    m = re.fullmatch(
+        r"(angular_positioning|axial_motion|radial_motion|tilt_motion)_([A-Z])_h(\d+)", effect_id
+    )
     if m:
         n = int(m.group(3))
         if n < 1 or (m.group(1) == "radial_motion" and n < 2):
@@ -56,7 +71,9 @@ def parse(effect_id: str) -> EffectId:
         return EffectId(effect_id, m.group(1), m.group(2), 0, 1)
     m = re.fullmatch(r"(tool_offset|linear_scale|thermal_drift|thermal_warmup)_([XYZ])", effect_id)
     if m:
-        return EffectId(effect_id, m.group(1), m.group(2), 0, 2 if m.group(1) == "thermal_warmup" else 1)
+        return EffectId(
+            effect_id, m.group(1), m.group(2), 0, 2 if m.group(1) == "thermal_warmup" else 1
+        )
     m = re.fullmatch(r"linear_squareness_(XY|YZ|ZX)", effect_id)
     if m:
         return EffectId(effect_id, "linear_squareness", m.group(1))
@@ -88,7 +105,11 @@ def catalogue(machine, max_harmonic: int = 4, instrument: str = "ballbar") -> li
     for ax in machine.axis_names:
         ids.append(f"rotary_zero_offset_{ax}")
         for n in range(1, max_harmonic + 1):
-            ids += [f"angular_positioning_{ax}_h{n}", f"axial_motion_{ax}_h{n}", f"tilt_motion_{ax}_h{n}"]
+            ids += [
+                f"angular_positioning_{ax}_h{n}",
+                f"axial_motion_{ax}_h{n}",
+                f"tilt_motion_{ax}_h{n}",
+            ]
             if n >= 2:
                 ids.append(f"radial_motion_{ax}_h{n}")
     ids += [f"gravity_sag_{a.name}" for a in machine.tilt_axes()]
@@ -139,26 +160,28 @@ def linear_reference(xyz: np.ndarray) -> np.ndarray:
     return np.mean(np.asarray(xyz, dtype=float), axis=0)
 
 
-def linear_axis_delta(effects: dict, xyz: np.ndarray, ball_z: np.ndarray, ref: np.ndarray) -> np.ndarray:
+def linear_axis_delta(
+    effects: dict, xyz: np.ndarray, ball_z: np.ndarray, ref: np.ndarray
+) -> np.ndarray:
     """Tool-side ball displacement (N, 3) of the linear-axis entries, functions of the commanded
     X, Y, Z (effects.md rows linear_squareness, linear_scale, straightness; docs angular_error)."""
     d = np.zeros_like(xyz)
     for e, p in effects.items():
         if e.kind == "linear_squareness":
             i, j = _AXIS_INDEX[e.axis[0]], _AXIS_INDEX[e.axis[1]]
-            d[:, i] += p[0] * xyz[:, j]                       # XY: x += s y, YZ: y += s z, ZX: z += s x
+            d[:, i] += p[0] * xyz[:, j]  # XY: x += s y, YZ: y += s z, ZX: z += s x
         elif e.kind == "linear_scale":
             i = _AXIS_INDEX[e.axis]
             d[:, i] += p[0] * xyz[:, i]
         elif e.kind == "straightness":
             i, j = _AXIS_INDEX[e.axis[0]], _AXIS_INDEX[e.axis[1]]
             u = (xyz[:, j] - ref[j]) / 100.0
-            d[:, i] += sum(c * u ** k for k, c in zip((2, 3, 4), p))
+            d[:, i] += sum(c * u**k for k, c in zip((2, 3, 4), p))
         elif e.kind == "angular_error":
             j = _AXIS_INDEX[e.axis[1]]
             u = (xyz[:, j] - ref[j]) / 100.0
-            tilt = p[0] * u + p[1] * u ** 2
-            sign = 1.0 if e.axis == "BX" else -1.0           # BX: x += e (z - z_ref); AY: y -= e (z - z_ref)
+            tilt = p[0] * u + p[1] * u**2
+            sign = 1.0 if e.axis == "BX" else -1.0  # BX: x += e (z - z_ref); AY: y -= e (z - z_ref)
             d[:, j] += sign * tilt * (ball_z - ref[2])
     return d
 

@@ -1,4 +1,5 @@
 """Instrument readings (formats.md "Instruments on any machine", "Touch-probe session")."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -51,8 +52,17 @@ def _spindle_frame_dirs(model: Model, n: np.ndarray, angles_rad) -> np.ndarray:
     return (np.transpose(h[:, :3, :3], (0, 2, 1)) @ n[..., None])[..., 0]
 
 
-def probe_touches(model: Model, sphere_actual, sphere_nominal, sphere_diameter: float,
-                  stylus_diameter: float, n_dirs, angles_rad, time, iterations: int = 30) -> np.ndarray:
+def probe_touches(
+    model: Model,
+    sphere_actual,
+    sphere_nominal,
+    sphere_diameter: float,
+    stylus_diameter: float,
+    n_dirs,
+    angles_rad,
+    time,
+    iterations: int = 30,
+) -> np.ndarray:
     """Latched X, Y, Z (N, 3) of touches along n through the nominal centre (formats.md,
     rotacal-probe/1): the stylus tip moves on the line c_nom + lam n of the nominal machine and
     triggers where |p_tool - p_table(q_sphere)| = (D + d)/2 (+ stylus_radius_offset); the
@@ -62,8 +72,10 @@ def probe_touches(model: Model, sphere_actual, sphere_nominal, sphere_diameter: 
     time = np.asarray(time, float)
     angles_rad = np.atleast_2d(np.asarray(angles_rad, float))
     nominal = model.nominal()
-    c_nom = nominal.p_table(np.broadcast_to(np.asarray(sphere_nominal, float), n.shape), angles_rad, time)
-    x0 = nominal.commanded_xyz(c_nom, angles_rad)       # controlled point with the tip at c_nom
+    c_nom = nominal.p_table(
+        np.broadcast_to(np.asarray(sphere_nominal, float), n.shape), angles_rad, time
+    )
+    x0 = nominal.commanded_xyz(c_nom, angles_rad)  # controlled point with the tip at c_nom
     radius = 0.5 * (sphere_diameter + stylus_diameter)
     for e, p in model.effects.items():
         if e.kind == "stylus_radius_offset":
@@ -71,10 +83,16 @@ def probe_touches(model: Model, sphere_actual, sphere_nominal, sphere_diameter: 
     m = model if model.linear_ref is not None else _with_session_reference(model, x0 - radius * n)
     centre = m.p_table(np.broadcast_to(np.asarray(sphere_actual, float), n.shape), angles_rad, time)
     lam = np.full(len(n), -radius)
-    for _ in range(iterations):                          # Newton on |p_tool(lam) - centre| = radius
-        f0 = np.linalg.norm(m.p_tool(x0 + lam[:, None] * n, angles_rad, time) - centre, axis=1) - radius
+    for _ in range(iterations):  # Newton on |p_tool(lam) - centre| = radius
+        f0 = (
+            np.linalg.norm(m.p_tool(x0 + lam[:, None] * n, angles_rad, time) - centre, axis=1)
+            - radius
+        )
         h = 1e-6
-        f1 = np.linalg.norm(m.p_tool(x0 + (lam + h)[:, None] * n, angles_rad, time) - centre, axis=1) - radius
+        f1 = (
+            np.linalg.norm(m.p_tool(x0 + (lam + h)[:, None] * n, angles_rad, time) - centre, axis=1)
+            - radius
+        )
         step = f0 / ((f1 - f0) / h)
         lam = lam - step
         if np.max(np.abs(step)) < 1e-13:
@@ -84,6 +102,8 @@ def probe_touches(model: Model, sphere_actual, sphere_nominal, sphere_diameter: 
         if e.kind == "probe_lobing":
             ns = _spindle_frame_dirs(model, n, angles_rad)
             phi = np.arctan2(ns[:, 1], ns[:, 0])
-            amount = (p[0] * np.cos(3 * phi) + p[1] * np.sin(3 * phi)) * np.sqrt(np.clip(1 - ns[:, 2] ** 2, 0, None))
+            amount = (p[0] * np.cos(3 * phi) + p[1] * np.sin(3 * phi)) * np.sqrt(
+                np.clip(1 - ns[:, 2] ** 2, 0, None)
+            )
             latched = latched + amount[:, None] * n
     return latched

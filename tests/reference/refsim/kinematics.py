@@ -7,6 +7,7 @@ with, per axis R (effects.md, "R's turning frame": the error motion acts before 
 coning after it, about the machine axis through the frame's origin):
   S(R) = Cone(k R) . Rot(R-line, R_actual) . E(R)
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -34,7 +35,9 @@ def rotation_vector(w: np.ndarray) -> np.ndarray:
     return rodrigues(w / safe[..., None], ang)
 
 
-def homogeneous(rot: np.ndarray | None = None, shift: np.ndarray | None = None, n: int = 1) -> np.ndarray:
+def homogeneous(
+    rot: np.ndarray | None = None, shift: np.ndarray | None = None, n: int = 1
+) -> np.ndarray:
     """(N, 4, 4) from rotations (N, 3, 3) and translations (N, 3) applied after them."""
     m = np.tile(np.eye(4), (n, 1, 1))
     if rot is not None:
@@ -115,7 +118,9 @@ class Model:
     def table_transform(self, angles: np.ndarray, time: np.ndarray) -> np.ndarray:
         """(N, 4, 4): p_table(q) = T . q (formats.md "Table side") with table effects."""
         m = self._chain(angles, "table")
-        shift = fx.table_translation(self.effects, self.machine, np.atleast_2d(angles), np.asarray(time, float))
+        shift = fx.table_translation(
+            self.effects, self.machine, np.atleast_2d(angles), np.asarray(time, float)
+        )
         return homogeneous(None, shift, len(m)) @ m
 
     def p_table(self, q: np.ndarray, angles: np.ndarray, time: np.ndarray) -> np.ndarray:

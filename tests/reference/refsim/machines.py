@@ -2,6 +2,7 @@
 
 Written from /work/shared/spec/formats.md and docs/machines.md only (independent of rotacal).
 """
+
 from __future__ import annotations
 
 import json
@@ -12,16 +13,22 @@ import numpy as np
 ISO_LETTER_AXIS = {"A": 0, "B": 1, "C": 2}  # letter -> index of the machine axis it turns about
 # formats.md, "Location errors": (names of dp components, names of dn components) per ISO axis,
 # as (component index, name, sign) triples.
-_ISO_DP = {"A": [(1, "E_Y0A", 1), (2, "E_Z0A", 1)],
-           "B": [(0, "E_X0B", 1), (2, "E_Z0B", 1)],
-           "C": [(0, "E_X0C", 1), (1, "E_Y0C", 1)]}
-_ISO_DN = {"A": [(1, "E_C0A", 1), (2, "E_B0A", -1)],
-           "B": [(0, "E_C0B", -1), (2, "E_A0B", 1)],
-           "C": [(0, "E_B0C", 1), (1, "E_A0C", -1)]}
+_ISO_DP = {
+    "A": [(1, "E_Y0A", 1), (2, "E_Z0A", 1)],
+    "B": [(0, "E_X0B", 1), (2, "E_Z0B", 1)],
+    "C": [(0, "E_X0C", 1), (1, "E_Y0C", 1)],
+}
+_ISO_DN = {
+    "A": [(1, "E_C0A", 1), (2, "E_B0A", -1)],
+    "B": [(0, "E_C0B", -1), (2, "E_A0B", 1)],
+    "C": [(0, "E_B0C", 1), (1, "E_A0C", -1)],
+}
 # Order of the names of an ISO axis in an errors vector (docs/machines.md, built-ins table).
-_ISO_ORDER = {"A": ["E_Y0A", "E_Z0A", "E_B0A", "E_C0A"],
-              "B": ["E_X0B", "E_Z0B", "E_A0B", "E_C0B"],
-              "C": ["E_X0C", "E_Y0C", "E_A0C", "E_B0C"]}
+_ISO_ORDER = {
+    "A": ["E_Y0A", "E_Z0A", "E_B0A", "E_C0A"],
+    "B": ["E_X0B", "E_Z0B", "E_A0B", "E_C0B"],
+    "C": ["E_X0C", "E_Y0C", "E_A0C", "E_B0C"],
+}
 
 
 def unit(v) -> np.ndarray:
@@ -32,6 +39,7 @@ def unit(v) -> np.ndarray:
 @dataclass
 class Axis:
     """One rotary axis: letter, nominal unit direction n, nominal point p0 (formats.md)."""
+
     name: str
     direction: np.ndarray
     point: np.ndarray = field(default_factory=lambda: np.zeros(3))
@@ -87,6 +95,7 @@ class Axis:
 @dataclass
 class Machine:
     """A rotacal-machine/1 machine: table axes from the bed outwards, head axes from X,Y,Z outwards."""
+
     name: str
     table_axes: list
     head_axes: list
@@ -141,22 +150,39 @@ def _axis_from_dict(d: dict, side: str, where: str) -> Axis:
     lim = d.get("limits_deg")
     if lim is not None and not lim[0] < lim[1]:
         raise ValueError(f"{where}.limits_deg must have min < max")
-    return Axis(str(d["name"]), unit(n), np.asarray(d.get("point", [0, 0, 0]), dtype=float),
-                tuple(lim) if lim is not None else None, side)
+    return Axis(
+        str(d["name"]),
+        unit(n),
+        np.asarray(d.get("point", [0, 0, 0]), dtype=float),
+        tuple(lim) if lim is not None else None,
+        side,
+    )
 
 
 def machine_from_dict(d: dict) -> Machine:
     """Parse a rotacal-machine/1 dict (formats.md, "Machine description file")."""
     if d.get("format") != "rotacal-machine/1":
         raise ValueError("format must be rotacal-machine/1")
-    table = [_axis_from_dict(a, "table", f"table_axes[{i}]") for i, a in enumerate(d.get("table_axes", []))]
-    head = [_axis_from_dict(a, "head", f"head_axes[{i}]") for i, a in enumerate(d.get("head_axes", []))]
+    table = [
+        _axis_from_dict(a, "table", f"table_axes[{i}]")
+        for i, a in enumerate(d.get("table_axes", []))
+    ]
+    head = [
+        _axis_from_dict(a, "head", f"head_axes[{i}]") for i, a in enumerate(d.get("head_axes", []))
+    ]
     if len(table) + len(head) != 2:
         raise ValueError("a machine has two rotary axes in all")
     if len({a.name for a in table + head}) != 2:
         raise ValueError("repeated axis letter")
-    return Machine(str(d.get("name", "custom")), table, head, float(d.get("pivot_length", 0.0)),
-                   float(d.get("tool_length", 0.0)), d.get("travel_mm"), dict(d))
+    return Machine(
+        str(d.get("name", "custom")),
+        table,
+        head,
+        float(d.get("pivot_length", 0.0)),
+        float(d.get("tool_length", 0.0)),
+        d.get("travel_mm"),
+        dict(d),
+    )
 
 
 def machine_from_json(text: str) -> Machine:
@@ -164,7 +190,7 @@ def machine_from_json(text: str) -> Machine:
 
 
 _X, _Y, _Z = [1, 0, 0], [0, 1, 0], [0, 0, 1]
-_S = 0.5 ** 0.5
+_S = 0.5**0.5
 # docs/machines.md, "The built-ins".
 _BUILTIN = {
     "AC-trt": ([("A", _X, None), ("C", _Z, None)], [], 0.0, 0.0),

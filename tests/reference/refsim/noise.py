@@ -2,6 +2,7 @@
 
 Streams: one per group label (ballbar test, R-test set-up); rows keep their order within a stream.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -28,7 +29,9 @@ def ar1(groups, rho: float, sigma: float, rng: np.random.Generator) -> np.ndarra
     return out
 
 
-def pink(groups, sigma: float, rng: np.random.Generator, taus=(1.0, 10.0, 100.0, 1000.0)) -> np.ndarray:
+def pink(
+    groups, sigma: float, rng: np.random.Generator, taus=(1.0, 10.0, 100.0, 1000.0)
+) -> np.ndarray:
     """1/f-like: the sum of equal-variance AR(1)s with correlation times `taus` samples
     (rho = exp(-1/tau)), flat per decade over three decades; total marginal 1-sigma `sigma`."""
     part = sigma / np.sqrt(len(taus))

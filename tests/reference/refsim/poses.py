@@ -7,6 +7,7 @@
 Each returns a dict of arrays: time (N,), xyz (N, 3), angles_deg (N, 2) in chain order, plus
 labels (ballbar tests, R-test set-ups, probe poses); probe also n (N, 3).
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -31,7 +32,9 @@ def default_tilt_range(machine) -> tuple[float, float]:
 
 def _xyz_for(model: Model, q_table: np.ndarray, angles_rad: np.ndarray) -> np.ndarray:
     """Commanded X, Y, Z that put the ball at table point q at the given angles, nominally."""
-    p = model.p_table(np.broadcast_to(q_table, (len(angles_rad), 3)), angles_rad, np.zeros(len(angles_rad)))
+    p = model.p_table(
+        np.broadcast_to(q_table, (len(angles_rad), 3)), angles_rad, np.zeros(len(angles_rad))
+    )
     return model.commanded_xyz(p, angles_rad)
 
 
@@ -46,8 +49,14 @@ def _radial_direction(axis, pivot: np.ndarray) -> np.ndarray:
     return unit(c) if np.linalg.norm(c) > 1e-9 else np.array([1.0, 0.0, 0.0])
 
 
-def ballbar_single_setup(machine, pivot=(120.0, 0.0, 60.0), length: float = 100.0, step_deg: float = 1.0,
-                         dt: float = 1.0 / 6.0, axial_c_tilt_deg: float | None = None) -> dict:
+def ballbar_single_setup(
+    machine,
+    pivot=(120.0, 0.0, 60.0),
+    length: float = 100.0,
+    step_deg: float = 1.0,
+    dt: float = 1.0 / 6.0,
+    axial_c_tilt_deg: float | None = None,
+) -> dict:
     """The seven tests of the single set-up method, one after the other in time."""
     machine = load_machine(machine)
     nominal = Model(machine)
@@ -75,7 +84,10 @@ def ballbar_single_setup(machine, pivot=(120.0, 0.0, 60.0), length: float = 100.
     arc("sphere_yz", 1, 2, 180.0)
     arc("sphere_zx", 0, 2, 180.0)
     t0, t1 = default_tilt_range(machine)
-    sweeps = {i_tilt: np.arange(t0, t1 + 1e-9, step_deg), i_rot: np.arange(0.0, 360.0 - 1e-9, step_deg)}
+    sweeps = {
+        i_tilt: np.arange(t0, t1 + 1e-9, step_deg),
+        i_rot: np.arange(0.0, 360.0 - 1e-9, step_deg),
+    }
     for idx in (i_tilt, i_rot):
         axis = machine.axes[idx]
         for kind in ("radial", "axial"):
@@ -86,18 +98,33 @@ def ballbar_single_setup(machine, pivot=(120.0, 0.0, 60.0), length: float = 100.
             d = _radial_direction(axis, pivot) if kind == "radial" else axis.direction
             add(f"{kind}_{axis.name}", pivot + length * d, a)
     xyz = np.vstack(xyz)
-    return {"test": labels, "time": dt * np.arange(len(xyz)), "xyz": xyz, "angles_deg": np.vstack(ang),
-            "pivot": pivot, "ballbar_length": length}
+    return {
+        "test": labels,
+        "time": dt * np.arange(len(xyz)),
+        "xyz": xyz,
+        "angles_deg": np.vstack(ang),
+        "pivot": pivot,
+        "ballbar_length": length,
+    }
 
 
-def rtest_grid(machine, nests=((100.0, 0.0, 60.0), (0.0, -120.0, 140.0)), tilt_step: float = 30.0,
-               rot_step: float = 30.0, dwell_s: float = 6.0) -> dict:
+def rtest_grid(
+    machine,
+    nests=((100.0, 0.0, 60.0), (0.0, -120.0, 140.0)),
+    tilt_step: float = 30.0,
+    rot_step: float = 30.0,
+    dwell_s: float = 6.0,
+) -> dict:
     """Tilt outer, rotary inner; one set-up per nest, one after the other (Oyama's pattern)."""
     machine = load_machine(machine)
     nominal = Model(machine)
     i_tilt, i_rot = rotary_roles(machine)
     t0, t1 = default_tilt_range(machine)
-    grid = [(b, c) for b in np.arange(t0, t1 + 1e-9, tilt_step) for c in np.arange(0.0, 360.0 - 1e-9, rot_step)]
+    grid = [
+        (b, c)
+        for b in np.arange(t0, t1 + 1e-9, tilt_step)
+        for c in np.arange(0.0, 360.0 - 1e-9, rot_step)
+    ]
     setups, xyz, ang = [], [], []
     for k, nest in enumerate(nests, start=1):
         a = np.zeros((len(grid), 2))
@@ -107,8 +134,13 @@ def rtest_grid(machine, nests=((100.0, 0.0, 60.0), (0.0, -120.0, 140.0)), tilt_s
         xyz.append(_xyz_for(nominal, np.asarray(nest, float), np.radians(a)))
         ang.append(a)
     xyz = np.vstack(xyz)
-    return {"setup": setups, "time": dwell_s * np.arange(len(xyz)), "xyz": xyz, "angles_deg": np.vstack(ang),
-            "nests": {str(k): np.asarray(n, float) for k, n in enumerate(nests, start=1)}}
+    return {
+        "setup": setups,
+        "time": dwell_s * np.arange(len(xyz)),
+        "xyz": xyz,
+        "angles_deg": np.vstack(ang),
+        "nests": {str(k): np.asarray(n, float) for k, n in enumerate(nests, start=1)},
+    }
 
 
 def probe_directions() -> np.ndarray:
@@ -117,8 +149,14 @@ def probe_directions() -> np.ndarray:
     return np.array([[0, 0, -1], [-c, 0, -s], [0, -c, -s], [c, 0, -s], [0, c, -s]], float)
 
 
-def probe_poses(machine, sphere=(150.0, 0.0, 80.0), rot_step: float = 30.0, tilt_step: float = 15.0,
-                touch_dt: float = 2.0, pose_dt: float = 16.0) -> dict:
+def probe_poses(
+    machine,
+    sphere=(150.0, 0.0, 80.0),
+    rot_step: float = 30.0,
+    tilt_step: float = 15.0,
+    touch_dt: float = 2.0,
+    pose_dt: float = 16.0,
+) -> dict:
     """12 poses of C at tilt 0, then 12 tilts at C 0 (24 poses x 5 touches)."""
     machine = load_machine(machine)
     i_tilt, i_rot = rotary_roles(machine)
@@ -136,5 +174,10 @@ def probe_poses(machine, sphere=(150.0, 0.0, 80.0), rot_step: float = 30.0, tilt
             time.append((k - 1) * pose_dt + j * touch_dt)
             ang.append(a)
             n.append(d)
-    return {"pose": pose, "time": np.array(time), "angles_deg": np.array(ang), "n": np.array(n),
-            "sphere": np.asarray(sphere, float)}
+    return {
+        "pose": pose,
+        "time": np.array(time),
+        "angles_deg": np.array(ang),
+        "n": np.array(n),
+        "sphere": np.asarray(sphere, float),
+    }

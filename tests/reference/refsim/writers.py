@@ -1,6 +1,7 @@
 """Writers (and a minimal reader) of the three session formats of formats.md, and truth JSON
 like /work/shared/data/*.truth.json (keys errors, pivot_actual / sphere_actual / nests, effects,
 noise_um; probe_zeros for an R-test)."""
+
 from __future__ import annotations
 
 import json
@@ -12,7 +13,9 @@ import numpy as np
 def _header(fmt: str, machine, extra: list[str], noise_um: float | None) -> list[str]:
     lines = [f"# format: {fmt}", f"# machine: {machine.name}", "# units: mm, deg, s"]
     if machine.description is not None:  # formats.md: a machine that is not built in
-        lines.append("# machine_description: " + json.dumps(machine.description, separators=(",", ":")))
+        lines.append(
+            "# machine_description: " + json.dumps(machine.description, separators=(",", ":"))
+        )
     lines += extra
     if noise_um is not None:
         lines.append(f"# noise_um: {noise_um:.6g}")
@@ -31,11 +34,18 @@ def _write(path, lines: list[str]) -> Path:
 
 def write_ballbar(path, machine, session: dict, length, noise_um: float | None = None) -> Path:
     """rotacal-ballbar/1: test,time,X,Y,Z,<rotary columns>,length."""
-    extra = [f"# ballbar_length: {session['ballbar_length']:.4f}", f"# pivot: {_v(session['pivot'])}"]
+    extra = [
+        f"# ballbar_length: {session['ballbar_length']:.4f}",
+        f"# pivot: {_v(session['pivot'])}",
+    ]
     lines = _header("rotacal-ballbar/1", machine, extra, noise_um)
     lines.append(",".join(["test", "time", "X", "Y", "Z", *machine.axis_names, "length"]))
-    for lab, t, p, a, ln in zip(session["test"], session["time"], session["xyz"], session["angles_deg"], length):
-        lines.append(f"{lab},{t:.3f},{p[0]:.6f},{p[1]:.6f},{p[2]:.6f},{a[0]:.6f},{a[1]:.6f},{ln:.7f}")
+    for lab, t, p, a, ln in zip(
+        session["test"], session["time"], session["xyz"], session["angles_deg"], length
+    ):
+        lines.append(
+            f"{lab},{t:.3f},{p[0]:.6f},{p[1]:.6f},{p[2]:.6f},{a[0]:.6f},{a[1]:.6f},{ln:.7f}"
+        )
     return _write(path, lines)
 
 
@@ -44,32 +54,56 @@ def write_rtest(path, machine, session: dict, d, noise_um: float | None = None) 
     extra = [f"# nest.{k}: {_v(v)}" for k, v in session["nests"].items()]
     lines = _header("rotacal-rtest/1", machine, extra, noise_um)
     lines.append(",".join(["setup", "time", *machine.axis_names, "X", "Y", "Z", "dx", "dy", "dz"]))
-    for s, t, a, p, r in zip(session["setup"], session["time"], session["angles_deg"], session["xyz"], d):
-        lines.append(f"{s},{t:.3f},{a[0]:.6f},{a[1]:.6f},{p[0]:.6f},{p[1]:.6f},{p[2]:.6f},"
-                     f"{r[0]:.7f},{r[1]:.7f},{r[2]:.7f}")
+    for s, t, a, p, r in zip(
+        session["setup"], session["time"], session["angles_deg"], session["xyz"], d
+    ):
+        lines.append(
+            f"{s},{t:.3f},{a[0]:.6f},{a[1]:.6f},{p[0]:.6f},{p[1]:.6f},{p[2]:.6f},"
+            f"{r[0]:.7f},{r[1]:.7f},{r[2]:.7f}"
+        )
     return _write(path, lines)
 
 
-def write_probe(path, machine, session: dict, latched, sphere_diameter: float, stylus_diameter: float,
-                noise_um: float | None = None) -> Path:
+def write_probe(
+    path,
+    machine,
+    session: dict,
+    latched,
+    sphere_diameter: float,
+    stylus_diameter: float,
+    noise_um: float | None = None,
+) -> Path:
     """rotacal-probe/1: pose,time,X,Y,Z,<rotary columns>,nx,ny,nz (X, Y, Z latched)."""
-    extra = [f"# sphere: {_v(session['sphere'])}", f"# sphere_diameter: {sphere_diameter:.4f}",
-             f"# stylus_diameter: {stylus_diameter:.4f}"]
+    extra = [
+        f"# sphere: {_v(session['sphere'])}",
+        f"# sphere_diameter: {sphere_diameter:.4f}",
+        f"# stylus_diameter: {stylus_diameter:.4f}",
+    ]
     lines = _header("rotacal-probe/1", machine, extra, noise_um)
     lines.append(",".join(["pose", "time", "X", "Y", "Z", *machine.axis_names, "nx", "ny", "nz"]))
-    for k, t, p, a, n in zip(session["pose"], session["time"], latched, session["angles_deg"], session["n"]):
-        lines.append(f"{k},{t:.3f},{p[0]:.6f},{p[1]:.6f},{p[2]:.6f},{a[0]:.6f},{a[1]:.6f},"
-                     f"{n[0]:.6f},{n[1]:.6f},{n[2]:.6f}")
+    for k, t, p, a, n in zip(
+        session["pose"], session["time"], latched, session["angles_deg"], session["n"]
+    ):
+        lines.append(
+            f"{k},{t:.3f},{p[0]:.6f},{p[1]:.6f},{p[2]:.6f},{a[0]:.6f},{a[1]:.6f},"
+            f"{n[0]:.6f},{n[1]:.6f},{n[2]:.6f}"
+        )
     return _write(path, lines)
 
 
-def write_truth(path, errors: dict, effects: dict | None = None, noise_um: float = 0.0, **extra) -> Path:
+def write_truth(
+    path, errors: dict, effects: dict | None = None, noise_um: float = 0.0, **extra
+) -> Path:
     """Truth JSON: errors, effects, noise_um, and pivot_actual / sphere_actual / nests / probe_zeros."""
-    doc = {"errors": {k: float(v) for k, v in errors.items()},
-           **{k: np.asarray(v, float).tolist() for k, v in extra.items()},
-           "effects": {k: (np.asarray(v, float).tolist() if np.ndim(v) else float(v))
-                       for k, v in (effects or {}).items()},
-           "noise_um": float(noise_um)}
+    doc = {
+        "errors": {k: float(v) for k, v in errors.items()},
+        **{k: np.asarray(v, float).tolist() for k, v in extra.items()},
+        "effects": {
+            k: (np.asarray(v, float).tolist() if np.ndim(v) else float(v))
+            for k, v in (effects or {}).items()
+        },
+        "noise_um": float(noise_um),
+    }
     path = Path(path)
     path.write_text(json.dumps(doc, indent=1) + "\n", encoding="utf-8")
     return path
