@@ -227,7 +227,7 @@ def rtest_design(draws: int) -> None:
 
 
 def probe_design() -> None:
-    from rotacal.design import design_probe
+    from rotacal.probe_design import design_probe
     from rotacal.machines import load_machine
 
     for name in ("AC-trt", "BC-trt", "B45C-trt", "B-head-C-table", "AC-head"):

@@ -139,6 +139,34 @@ UncertaintyBudget uncertainty_budget(const DiagnosisProblem& P, const Diagnosis&
                                   coverage);
 }
 
+namespace {
+
+// The session's own bound on a left-out effect where it sees it: the linearised estimate on the
+// final (whitened) residuals with the model projected out, |value| + 2 sigma. Replaces the
+// half-widths `a` where that is tighter; false where the session does not determine the effect
+// or the bound is no tighter.
+bool tighten_by_session(const Eigen::MatrixXd& perp_w, const Eigen::VectorXd& r_w,
+                        std::vector<double>& a) {
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(perp_w, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  const Eigen::VectorXd s = svd.singularValues();
+  if (!s.size() || s[s.size() - 1] <= 1e-9 * std::max(1.0, s[0])) return false;
+  const Eigen::VectorXd est = svd.solve(r_w);
+  const Eigen::MatrixXd cov =
+      svd.matrixV() * s.cwiseInverse().cwiseAbs2().asDiagonal() * svd.matrixV().transpose();
+  bool tighter = false;
+  std::vector<double> bound(a.size());
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    bound[k] = std::abs(est[i]) + 2.0 * std::sqrt(cov(i, i));
+    tighter = tighter || bound[k] < a[k];
+  }
+  if (!tighter) return false;
+  for (std::size_t k = 0; k < a.size(); ++k) a[k] = std::min(a[k], bound[k]);
+  return true;
+}
+
+}  // namespace
+
 UncertaintyBudget budget_detail::budget_of(const BudgetedFit& m,
                                            const std::vector<Effect>& candidates,
                                            const std::vector<Eigen::MatrixXd>& jacobians,
@@ -207,31 +235,8 @@ UncertaintyBudget budget_detail::budget_of(const BudgetedFit& m,
     const Eigen::MatrixXd& Jc = jacobians[i];
     const Eigen::MatrixXd B = ls.solve(Jc);  // d(free params) / d(effect params)
     std::vector<double> a = plausible_sizes(c, sizes, duration);
-    // The session's own bound where it sees the effect: linearised estimate on the final
-    // residuals with the model projected out, |value| + 2 sigma.
-    bool bounded = false;
-    if (sizes.use_session_bounds) {
-      const Eigen::MatrixXd perp_w = whiten(Jc - J * B);
-      Eigen::JacobiSVD<Eigen::MatrixXd> svd(perp_w, Eigen::ComputeThinU | Eigen::ComputeThinV);
-      const Eigen::VectorXd s = svd.singularValues();
-      if (s.size() && s[s.size() - 1] > 1e-9 * std::max(1.0, s[0])) {
-        const Eigen::VectorXd est = svd.solve(r_w);
-        const Eigen::MatrixXd cov =
-            svd.matrixV() * s.cwiseInverse().cwiseAbs2().asDiagonal() * svd.matrixV().transpose();
-        bool tighter = false;
-        std::vector<double> bound(a.size());
-        for (std::size_t k = 0; k < a.size(); ++k) {
-          bound[k] =
-              std::abs(est[static_cast<Eigen::Index>(k)]) +
-              2.0 * std::sqrt(cov(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k)));
-          tighter = tighter || bound[k] < a[k];
-        }
-        if (tighter) {
-          for (std::size_t k = 0; k < a.size(); ++k) a[k] = std::min(a[k], bound[k]);
-          bounded = true;
-        }
-      }
-    }
+    // The session's own bound where it sees the effect, where it is tighter.
+    const bool bounded = sizes.use_session_bounds && tighten_by_session(whiten(Jc - J * B), r_w, a);
     Contribution L;
     L.effect = c.id();
     L.basis = bounded ? "session bound" : "default plausible size";

@@ -23,7 +23,7 @@ import probe_bound  # noqa: E402
 
 import rotacal  # noqa: E402
 from conftest import run_cli  # noqa: E402
-from rotacal.design import design_probe  # noqa: E402
+from rotacal.probe_design import design_probe  # noqa: E402
 from rotacal.probe import identify_probe  # noqa: E402
 
 EXIT_INPUT = 3

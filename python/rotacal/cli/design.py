@@ -284,6 +284,12 @@ def add_design(sub: argparse._SubParsersAction) -> argparse._SubParsersAction:
         epilog=EPILOG + "; docs/design.md",
     )
     dk = q.add_subparsers(dest="kind", required=True)
+    _add_design_ballbar(dk)
+    _add_design_rtest(dk)
+    return dk
+
+
+def _add_design_ballbar(dk: argparse._SubParsersAction) -> None:
     k = dk.add_parser(
         "ballbar",
         help="the pivot and bar length with the smallest predicted uncertainty",
@@ -363,6 +369,9 @@ def add_design(sub: argparse._SubParsersAction) -> argparse._SubParsersAction:
     )
     k.add_argument("--json", action="store_true")
     k.set_defaults(func=cmd_design_ballbar)
+
+
+def _add_design_rtest(dk: argparse._SubParsersAction) -> None:
     k = dk.add_parser(
         "rtest",
         help="the R-test nests and B/C grid with the smallest predicted uncertainty",
@@ -429,7 +438,6 @@ def add_design(sub: argparse._SubParsersAction) -> argparse._SubParsersAction:
     )
     k.add_argument("--json", action="store_true")
     k.set_defaults(func=cmd_design_rtest)
-    return dk
 
 
 COMMANDS = {"design": add_design}

@@ -12,15 +12,15 @@ from typing import Any
 import numpy as np
 
 from .. import _core, jsontext
-from ..design import (
+from ..probe_design import (
     SPHERE_CANDIDATES,
     design_probe,
     design_probe_separation,
-    parameter_units,
     poses_text,
     probe_design_dict,
     probe_separation_dict,
 )
+from ..design import parameter_units
 from ..machines import load_machine
 from ..outputs import write_output
 from ..sessions import PROBE, save

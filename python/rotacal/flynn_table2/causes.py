@@ -147,6 +147,12 @@ def no_change(_size: float = 0.0) -> tuple:
 def candidates(a: Assumptions, duration: float) -> list[Candidate]:
     """Every cause the analysis tries: each sized parameter of each catalogue effect that
     exists for AC-trt, constant in both runs; and the changes between the runs."""
+    return constant_candidates(duration) + between_run_candidates(a, duration)
+
+
+def constant_candidates(duration: float) -> list[Candidate]:
+    """Each sized parameter of each catalogue effect that exists for AC-trt, and the pivot's
+    set-up error, the same in both runs."""
     out: list[Candidate] = []
     for eff in _core.effect_catalogue(_core.MachineType.AC_trt, 2):
         eid = eff.id
@@ -200,6 +206,13 @@ def candidates(a: Assumptions, duration: float) -> list[Candidate]:
             )
         )
 
+    return out
+
+
+def between_run_candidates(a: Assumptions, duration: float) -> list[Candidate]:
+    """The changes between the two runs: location errors (thermal state), the table shifted,
+    the pivot moved, the tool and bar lengths, the drifts, squareness and scale."""
+    out: list[Candidate] = []
     f = 1.0 - math.exp(-a.hours_between_runs / a.thermal_time_constant_h)
 
     def change(cid, cause, family, unit, disp, plaus, run2):
