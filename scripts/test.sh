@@ -24,6 +24,9 @@ step() { printf '\n==== [%s, foreground %s CPU-s] %s\n' "$(elapsed)" "$(foregrou
 step "set-up"
 bash scripts/setup.sh
 
+step "Formatting and lint: clang-format and ruff at the pinned versions (scripts/format.sh)"
+bash scripts/format.sh --check
+
 step "Configure the Release build, the AddressSanitizer + UBSan build and the fuzz build"
 # Every C++ test runs once: under the sanitizers (the same assertions, plus ASan and UBSan),
 # except the two Monte Carlo studies (hundreds of refits of code the other tests run too), which
