@@ -131,17 +131,21 @@ cmake --build build/consumer
 step "C++ example (examples/cpp) against the installed package"
 cmake -S examples/cpp -B build/example -G Ninja -DCMAKE_PREFIX_PATH="$ROOT/build/install"
 cmake --build build/example
-./build/example/quickstart ../shared/data/ballbar_ac_table2.csv
+./build/example/quickstart examples/data/ballbar_ac_table2.csv
 
 step "Python package (pip install .) and pytest"
 # The extension only, linked against the library installed above: compiling the library again
 # inside pip took about 4.5 of CI's 45 minutes. A plain `pip install .` builds everything.
 "$PY" -m pip install -q --disable-pip-version-check --no-build-isolation \
   -C cmake.define.ROTACAL_PYTHON_FROM_INSTALLED=ON -C cmake.define.CMAKE_PREFIX_PATH="$ROOT/build/install" .
-(cd tests/python && "$PY" -m pytest -q -p no:cacheprovider --durations=15 .)
+# The installed package is this tree's: the README's main job (run by test_readme.py) need not
+# build it again (scripts/source_id.sh).
+bash scripts/source_id.sh --record
+# test_readme.py builds the README's C++ quick start against the installed CMake package.
+(cd tests/python && ROTACAL_PREFIX="$ROOT/build/install" "$PY" -m pytest -q -p no:cacheprovider --durations=15 .)
 
 step "C++ example: a model file written by the Python CLI, read by C++ to compensate a point"
-"$PY" -m rotacal identify ../shared/data/ballbar_ac_table2.csv --save-model build/example/model.json > /dev/null
+"$PY" -m rotacal identify examples/data/ballbar_ac_table2.csv --save-model build/example/model.json > /dev/null
 ./build/example/compensate_point build/example/model.json 30 45 10 20 30
 
 step "Benchmarks, once each as a smoke check (figures: run them without --smoke)"

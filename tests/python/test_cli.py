@@ -229,17 +229,6 @@ def test_plan_example_writes_every_dialect(tmp_path):
     assert len(session) > 1000 and "radial_C" in r.stdout
 
 
-def test_readme_python_example_runs(shared_data, tmp_path):
-    text = (ROOT / "README.md").read_text()
-    blocks = re.findall(r"```python\n(.*?)```", text, re.S)
-    assert blocks, "README has no python example"
-    for code in blocks:
-        r = subprocess.run(
-            [sys.executable, "-c", code], capture_output=True, text=True, timeout=300, cwd=ROOT
-        )
-        assert r.returncode == 0, r.stderr
-
-
 def test_diagnose_rtest_file_names_gravity_and_coning(shared_data, tmp_path):
     r = rotacal(
         "diagnose", shared_data / "rtest_bc_oyama.csv", "--json", "--report", tmp_path / "r.html"
