@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # The main job on the embedded default: plan a single set-up ballbar test, simulate a machine
 # with location errors, a pivot set-up error and one hidden effect, identify, diagnose,
 # verify compensation, and write an HTML report. Usage: bash scripts/run.sh [OUTPUT_DIR]

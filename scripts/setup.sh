@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Installs what rotacal needs on a fresh Debian machine (run as root): the C++ toolchain and
 # libraries from Debian packages, the Python build tools from PyPI. Idempotent: it skips
 # apt-get when every package is already there.

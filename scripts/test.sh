@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # The whole test suite: C++ tests (ctest), the installed CMake package used from a separate
 # project, the Python package built by pip and its tests (pytest), the benchmarks once each
 # as a smoke check, the decoders under libFuzzer for a bounded time, and the C++ tests again

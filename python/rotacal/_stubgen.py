@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Writes python/rotacal/_core.pyi from the built extension with the pinned pybind11-stubgen (``python -m rotacal._stubgen [--check]``)."""
 
 from __future__ import annotations

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The joint-fit driver: observability, a dense Gauss-Newton solve with step control,
 // covariance and estimates for every fit in rotacal.
 //

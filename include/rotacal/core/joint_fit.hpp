@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The one joint-fit driver: parameters with names, units and plausible scales -> observability

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Circle fits to 2-D points: the "Hyper" algebraic fit of Al-Sharadqah & Chernov (2009),

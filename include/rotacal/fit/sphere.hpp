@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Least-squares sphere: algebraic start, geometric (orthogonal distance) refinement with

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The calibration history store: the schema and its migrations, and the reads and writes of
 identifications and corrections, on SQLite or PostgreSQL through one code path (the SQL is the
 common subset; a small dialect sets the placeholders and two column types)."""
