@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The joint ballbar fit on every built-in machine (issue 13): over Monte Carlo noise draws,
 // each location error's RMSE divided by its Cramer-Rao bound (from the Jacobian of the free
 // parameters at the truth), pooled and per error, and the fit time against AC-trt's in the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Accuracy of the ballbar identification: over Monte Carlo noise draws on the simulated
 // Table 2 machine, each parameter's RMSE divided by its Cramer-Rao bound (sqrt of the
 // diagonal of (J^T J / sigma^2)^-1 at the truth). Target: joint fit <= 1.05 for all eight.

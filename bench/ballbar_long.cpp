@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Long-session bench: a 10-minute single set-up ballbar test recorded at 1 kHz (600,000
 // samples), built in memory from the program timeline on the Table 2 machine, identified by the
 // joint fit. Prints the identification time and the process' peak memory; the figures

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Speed of the joint ballbar fit against a plain SciPy least_squares implementation of the
 same model (vectorised numpy), in one process on a shared session, SciPy run as its users run
 it: default tolerances, default 2-point finite-difference Jacobian, x_scale="jac". The 1e-12

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """Two --json files of bench/diagnosis_confusion.py (the same plan: machines, noise, amplitudes,
 draws, null, seed), compared session by session: whether a change of the diagnosis changed any
 decision (outcome, findings with their groups and BIC weights to full float, z and coverage of

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Figures of the ballbar test design (docs/design.md) on the Table 2 machine (AC-trt, the
 default set-up of Flynn et al. Table 1): the designed single set-up's largest expanded
 uncertainty of the location errors against the default plan's at the same run time (target

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Diagnosis of single set-up ballbar sessions: false-finding rate on null data, detection
 // rate against the amplitude of a hidden effect (in noise sigmas RMS of what the location
 // errors cannot absorb), and time per diagnosis on one core.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Diagnosis of single set-up ballbar sessions in coloured noise: false findings on null
 // sessions with AR(1) noise (rho 0.5, 0.9, 0.95) and 1/f-like noise, white null as control,
 // hidden catalogue effects in AR(1) noise named first, and the time the noise model costs

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Confusion-matrix benchmark of rotacal's diagnosis on data from the independent reference
 simulator tests/reference/refsim (issue 29, item 2). rotacal never simulates here: refsim makes
 the readings, refsim.writers the file rotacal reads, refsim.noise the noise; rotacal only

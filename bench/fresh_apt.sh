@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # How long scripts/setup.sh's apt step takes on a fresh Debian 12 machine: debootstraps one
 # (--variant=buildd: gcc, g++ and make present, as on a new machine here) and times apt-get
 # update + install of the main job's packages (setup.sh --main) and, in a second copy, of the

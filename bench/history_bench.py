@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Figures of the calibration history (docs/history.md): `history add` of 10,000
 identifications (each its own transaction, as the command stores it) and `history show` of a
 machine with 1,000 entries, in process; prints the times and the store's size. The target:

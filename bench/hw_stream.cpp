@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Hardware-layer benchmark.
 //  1. Decoder throughput (MB/s): scan_frames + sample decoding over a recorded-like stream with
 //     a little line noise, and the ASCII probe-reply parsers.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Joint ballbar + touch-probe identification of one AC-trt machine (issue 31, item 5, "Figures
 // to reach"): over N draws of both sessions (the ballbar's default single set-up plan, 0.5 um
 // white noise; the probe's default 24 poses x 5 touches, 0.5 um AR(1) noise with rho 0.5 from

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Monte Carlo of the joint fits' 1-sigma on coloured noise (issue 11 item 1): empirical sigma
 // over noise draws / reported sigma, per location error, ballbar and R-test, with the noise
 // model (GLS) and with the noise treated as white; then the issue's RMS z measurement.

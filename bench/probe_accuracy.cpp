@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Touch-probe accuracy bench (issue 31, "Figures to reach"): AC-trt with Flynn et al.'s Table 2
 // errors (as ../shared/data/probe_ac_table2.truth.json), 24 poses x 5 touches
 // (default_probe_pattern), 0.5 um white noise per latched coordinate. Over N draws: the joint

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The lower bound of the touch probe's largest expanded uncertainty (k = 2) of the location
 errors at 120 touches on B-head-C-table (docs/design.md, "Touch probe": why the design cannot
 reach 0.7 of the default poses there), from the reference simulator alone

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // R-test benchmark: joint-fit time for 2 nests x 84 poses against the paper's method on the
 // same sessions in the same process (median CPU times and their ratio; issue 30's target: the
 // joint fit at most 10x the paper method), and held-out prediction RMS of both (fit on

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // R-test diagnosis: time per diagnosis (median over sessions with and without hidden effects;
 // issue 14 target <= 150 ms), false findings on null sessions and hidden effects named first.
 // Sessions: random B/C tables (location errors 20 um, 30 urad), the default R-test pattern

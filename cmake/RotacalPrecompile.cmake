@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # Precompiled headers: the standard library, Eigen and Ceres' Jet, parsed once per target
 # instead of once per translation unit (README, "Build time"). Only external headers, which
 # change with the toolchain and not with rotacal's sources, and never nlohmann/json: the 8 files

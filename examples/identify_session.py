@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Identify the location errors of a ballbar session and diagnose what the model misses.
 
 Usage: python examples/identify_session.py SESSION.csv

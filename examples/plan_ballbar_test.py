@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Plan a single set-up ballbar test (Flynn et al. 2016) and write its NC programs.
 
     python examples/plan_ballbar_test.py [OUT_DIR]

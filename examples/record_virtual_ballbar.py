@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Record a ballbar test from a virtual instrument and identify the machine it measured.
 
 The virtual ballbar sits on a pseudo-terminal, exactly where a real transducer's USB-serial

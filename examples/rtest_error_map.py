@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """R-test error map of a B/C table (Oyama & Ibaraki): identify the location errors and the
 position-dependent errors, print the map and save it with the fitted model.
 

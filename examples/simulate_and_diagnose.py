@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Plan the single set-up ballbar test, simulate a machine with a hidden effect, find it.
 
 Usage: python examples/simulate_and_diagnose.py

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // libFuzzer target: the session readers (rotacal-ballbar/1, rotacal-rtest/1, rotacal-probe/1) and
 // the model-file reader must refuse any bytes with a rotacal::Error, never crash, read out of
 // bounds or throw anything else; what they accept, their writers write back and they read again

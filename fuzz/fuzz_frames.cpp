@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // libFuzzer target: the binary frame decoder and the sample decoders behind it must accept any
 // bytes without crashing, reading out of bounds or looping, and must account for every byte.
 #include <cstdlib>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // libFuzzer target: the ASCII probe dialects (line splitter, sylvac-style and keyence-style
 // replies, device-side request parsers) must accept any bytes without crashing, and a reply
 // they accept must survive format -> parse unchanged in kind.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # Stage the rotacal Python package for a plain CMake build (cmake -P, run by rotacal_py_stage):
 # every .py and .pyi under SRC, subpackages included, py.typed and data/*.json, copied to DST
 # with their folders; staged sources that no longer exist in SRC are removed (a module turned

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Installs what rotacal needs on a fresh Debian machine (run as root): the C++ toolchain and
 # libraries from Debian packages, the Python build tools from PyPI. Idempotent: it skips
 # apt-get when every package is already there.
@@ -12,7 +13,7 @@ set -euo pipefail
 MAIN_APT=(build-essential cmake ninja-build pkg-config libeigen3-dev libceres-dev
           libserialport-dev nlohmann-json3-dev)
 TEST_APT=(catch2 clang libclang-rt-14-dev lld-14 linuxcnc-uspace chromium stress-ng postgresql)
-MAIN_PIP=("numpy>=1.22" "matplotlib>=3.5" "pybind11>=2.11" "scikit-build-core>=0.10")
+MAIN_PIP=("numpy>=1.22" "matplotlib>=3.5" "pybind11>=2.11" "scikit-build-core>=0.11")
 TEST_PIP=("scipy>=1.9" "pytest>=7" "pybind11-stubgen==2.5.5" "psycopg[binary]>=3.1"
           "clang-format==23.1.5" "ruff==0.17.6")
 

@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Compiler launcher that appends "user_s sys_s output" of each compile or link to $ROTACAL_TIME_LOG
 # (default build_times.txt in the working directory): the per-translation-unit CPU the README's
 # build-time figures come from. Configure with

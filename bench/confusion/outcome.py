@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """One benchmark session: draw, diagnose with rotacal, classify the first finding, the oracle,
 the coverage of the parameters of a right finding."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The touch probe on a sphere as an instrument of the confusion benchmark, all from refsim:
 refsim.poses.probe_poses (plan probe's default layout, 24 poses x 5 touches), refsim.probe_touches
 (formats.md, rotacal-probe/1), refsim.writers.write_probe for the file rotacal reads.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Tables of the confusion benchmark, from the per-session records alone (so that a run's
 --json file re-makes them)."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """One machine x instrument of the benchmark, all from refsim (never rotacal's simulator): poses,
 the true baseline (location errors, ballbar pivot set-up error, R-test probe zeros), readings,
 noise, finite-difference Jacobians of the baseline and of each entry, the half-detection

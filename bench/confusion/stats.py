@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Statistics of the benchmark (numpy + math only): F distribution, the decision thresholds of
 rotacal's DiagnosisOptions, the half-detection noncentrality, noise covariances and whitening,
 and the GLS oracle."""

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Load a rotacal-model/1 file (e.g. from `rotacal identify --save-model`) and compensate a point.
 // Build: see examples/cpp/CMakeLists.txt; run: compensate_point MODEL.json TILT_DEG C_DEG X Y Z
 // (X Y Z: the point wanted in the table frame, mm). Prints the nominal and the compensated

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Identify the location errors of a ballbar session from C++.
 // Build: see examples/cpp/CMakeLists.txt; run: quickstart SESSION.csv
 #include <iostream>

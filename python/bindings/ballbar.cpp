@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Bindings for include/rotacal/ballbar (model, simulation, joint fit, compensation).
 #include "numpy.hpp"
 #include "rotacal/ballbar/compensate.hpp"

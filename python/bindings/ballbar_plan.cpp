@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Bindings for include/rotacal/ballbar/{plan,nc_program,chain_runs}.hpp: thin wrappers, numpy out.
 #include "numpy.hpp"
 #include "rotacal/ballbar/chain_runs.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Bindings for include/rotacal/circular/{plan,simulate,analysis,diagnosis}.hpp: thin wrappers,
 // numpy out.
 #include "numpy.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Bindings for include/rotacal/io/controller_export.hpp (controller exports of a model file)
 // and io/controller_comment.hpp (free text as comments of the files a controller executes).
 #include "rotacal/io/controller_export.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Bindings for the test designs: ballbar/design.hpp, rtest/design.hpp, probe/design.hpp.
 #include "rotacal/ballbar/design.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Bindings for include/rotacal/diagnose.
 #include <pybind11/functional.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Bindings for include/rotacal/fit.
 #include "numpy.hpp"
 #include "rotacal/fit/box_least_squares.hpp"

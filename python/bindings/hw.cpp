@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Bindings for include/rotacal/hw: virtual instruments, recorders, serial ports. Thin: the
 // recorders run in C++ with the GIL released; the progress callback takes it back.
 #ifdef ROTACAL_WITH_HW  // the module is built without the serial layer when libserialport is off

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Bindings for include/rotacal/io: session classes with numpy columns, readers and writers.
 #include "json_value.hpp"
 #include "numpy.hpp"

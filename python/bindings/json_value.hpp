@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// JSON values (nlohmann) as Python objects (dicts of str keys, lists, numbers, None), for the

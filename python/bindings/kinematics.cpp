@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Bindings for include/rotacal/kinematics: thin wrappers, numpy in, numpy out.
 #include "numpy.hpp"
 #include "rotacal/kinematics/effects.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // rotacal._core: the private extension behind the typed Python package. Each bind_* lives in
 // its own file next to this one, one per C++ module.
 #include <pybind11/pybind11.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Bindings for one identification from several sessions of one machine (multi/identify.hpp).
 // Thin: the sessions in, the result's fields out.
 #include <pybind11/eigen.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Bindings for include/rotacal/core/noise_model.hpp and diagnose/uncertainty_budget.hpp.
 #include "numpy.hpp"
 #include "rotacal/core/noise_model.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Bindings for the touch probe (include/rotacal/probe, io/probe_file.hpp): session, reader and
 // writer, simulation, the joint fit and the cycles' method, the probing program and its log.
 // Thin: numpy in and out.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Bindings for include/rotacal/rtest: device calibration, simulation, identification, error
 // map and prediction. Thin: numpy in and out, the C++ module does the work.
 #include <pybind11/stl.h>

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """rotacal: calibration of the rotary axes of 5-axis machine tools.
 
 A typed wrapper over the private extension ``rotacal._core``: sessions are numpy-backed

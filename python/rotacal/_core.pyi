@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """
 rotacal native core (use the rotacal package, not this module)
 """

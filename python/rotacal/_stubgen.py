@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Writes python/rotacal/_core.pyi from the built extension with the pinned pybind11-stubgen (``python -m rotacal._stubgen [--check]``)."""
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ ENUMS = (
     "CircularDirection",
 )
 STUB = Path(__file__).with_name("_core.pyi")
+SPDX = "# SPDX-License-Identifier: BSD-3-Clause\n"
 
 
 def generate() -> str:
@@ -41,7 +43,9 @@ def generate() -> str:
         r = subprocess.run(cmd, capture_output=True, text=True)
         if r.returncode != 0:
             raise SystemExit(f"pybind11-stubgen failed:\n{r.stderr}")
-        return (Path(out) / "rotacal" / "_core.pyi").read_text()
+        # The licence line every source file of rotacal starts with, which the generator
+        # does not write.
+        return SPDX + (Path(out) / "rotacal" / "_core.pyi").read_text()
 
 
 def main(argv: list[str]) -> int:

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """What each command does with each kind of session: identify, predict and report a ballbar, an R-test or a touch-probe session."""
 
 from __future__ import annotations

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Single set-up ballbar test: identification, simulation, prediction, compensation."""
 
 from __future__ import annotations

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """ISO 230-4 circular tests of the linear axes with the ballbar: plan, NC program, simulation,
 G / G(b) / H and the diagnosis of their classic causes (include/rotacal/ballbar/circular_*.hpp,
 include/rotacal/diagnose/circular_diagnosis.hpp). The ``rotacal circular`` command is

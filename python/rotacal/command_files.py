@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The files every command reads and writes, in one table, and the output rule checked on
 all of them in one place, before any work (README, exit codes: "an output that is one of
 the command's inputs or outputs" is a file-system error, exit 4).

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The whole job on a simulated machine: plan, simulate, identify, diagnose, compensate and report (``rotacal demo``)."""
 
 from __future__ import annotations

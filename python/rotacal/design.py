@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Test design before the machine runs it (``rotacal design ballbar|rtest|probe``): the pivot and
 bar length whose single set-up test gives the smallest largest expanded uncertainty of the
 location errors at a run time, within the machine's travel, from the Fisher information of the

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Diagnosis: what the fitted model gets wrong, its cause, the extended model and the gain."""
 
 from __future__ import annotations

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Identified location errors written into a controller's own kinematic parameters
 (``rotacal export``): LinuxCNC's trt kinematics (HAL pins), SINUMERIK toolholder data
 ($TC_CARR, type P), ISG's universal kinematic, and the field mappings of HEIDENHAIN and FANUC.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Instruments over serial: virtual instruments on pseudo-terminals and recorders that write
 session files as they read (docs/protocols.md has the byte-level protocols).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """JSON files the package reads itself (budget sizes, exports, diagnoses, Flynn's table):
 strict (no NaN, Infinity or numbers beyond double), bounded in size, and bounded in nesting
 and in objects and arrays per byte by the rule of the C++ readers (core/json_text.hpp), so

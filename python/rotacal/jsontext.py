@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Strict JSON text: never NaN or Infinity; a number that is not finite is written null and its reason listed under "null_reasons"."""
 
 from __future__ import annotations

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Machines: loading one by built-in name or from a rotacal-machine/1 file, drawing it as text;
 simulated machines: the paper's Table 2 machine, random location errors, effects, and the truth
 a simulation runs on."""

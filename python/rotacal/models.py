@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Fitted machine models as JSON files (``rotacal-model/1``).
 
 A model file holds what an identification or a diagnosis learnt about a machine, so that it

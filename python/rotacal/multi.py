@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """One identification from several sessions of one machine (ballbar, R-test, touch probe):
 one set of location errors (and of catalogue effects where asked), each session's own nuisances
 and noise model, and the parameters on

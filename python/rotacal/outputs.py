@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Every file rotacal writes goes through :func:`write_output` (the C++ rule of
 ``rotacal/io/output_file.hpp``, the same for both languages).
 

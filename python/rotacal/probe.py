@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The touch probe on a sphere (rotacal-probe/1): identify a session by the joint fit or by the
 controller cycles' method, and simulate one. C++ computes (include/rotacal/probe); this module
 only composes."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Touch-probe test design (``rotacal design probe``): the poses of a sphere test with the
 smallest largest expanded uncertainty, and the poses added to separate two effects after a
 session (C++: ``rotacal/probe/design.hpp``; docs/design.md)."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """A progress bar for long work (recording, Monte Carlo, diagnosis of long sessions)."""
 
 from __future__ import annotations

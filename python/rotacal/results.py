@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Typed results of identification and diagnosis, with ``to_dict()`` giving the JSON that
 ``rotacal identify --json`` and ``rotacal diagnose --json`` print."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """R-test (Oyama & Ibaraki): simulation, probe calibration, identification of the location
 errors and error maps of the two rotary axes of any machine (table-table, head-table,
 head-head; "B" and "C" name the tilt and the rotary axis), model files and prediction, on

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Session files, and the one place that tells a ballbar, an R-test and a touch-probe session apart."""
 
 from __future__ import annotations

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """How a parameter of each native unit is shown to a person: um and urad beside the tables,
 not mm and rad. The library computes in mm, rad and s; effects bring other units (a servo lag
 in s, a log time constant in 1, a drift in mm/s)."""

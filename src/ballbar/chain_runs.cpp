@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Runs of the measure -> compensate -> measure-again experiment, one or a batch at a time.
 #include "rotacal/ballbar/chain_runs.hpp"
 

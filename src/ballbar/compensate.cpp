@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Compensated commands for identified location errors, and the measure-compensate-remeasure check.
 #include "rotacal/ballbar/compensate.hpp"
 

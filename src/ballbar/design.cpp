@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Test design: the single set-up ballbar test with the smallest predicted uncertainty.
 #include "rotacal/ballbar/design.hpp"
 

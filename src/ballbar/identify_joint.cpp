@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Joint ballbar fit: the exact length model (model.hpp) over structure-of-arrays samples,
 // solved by the one joint-fit driver (core/joint_fit.hpp).
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Flynn et al.'s geometric identification chain: sphere, circle and plane fits, then transport.
 #include "rotacal/ballbar/identify_paper.hpp"
 

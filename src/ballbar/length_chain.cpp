@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The ballbar reading's chain rule (length_chain.hpp).
 #include "length_chain.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The ballbar reading's derivatives by the chain rule through the stages of effects.hpp, for a
 // machine without head axes and one pivot: the fit's Jacobian with effects (length_model.hpp)
 // and the diagnosis' candidate Jacobians (src/diagnose/ballbar_sensitivities.hpp).

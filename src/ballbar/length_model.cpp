@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The ballbar residual model's kernels (length_model.hpp), compiled once for the library.
 #include "length_model.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The ballbar problem's residual model over arrays (ballbar/problem.hpp: its layout and its one
 // residual), shared by identify_joint, monte_carlo, the design and the several-session fit.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // A ballbar machine model in and out of a rotacal-model/1 document (ballbar/model_document.hpp).
 #include "rotacal/ballbar/model_document.hpp"
 

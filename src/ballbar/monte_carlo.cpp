@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Monte Carlo check of the ballbar joint fit's 1-sigma, reusing one prepared problem.
 #include "rotacal/ballbar/monte_carlo.hpp"
 

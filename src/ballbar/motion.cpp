@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Motion of the rotary axes from a session's time and angle columns (motion.hpp).
 #include "rotacal/ballbar/motion.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The single set-up ballbar test's program (plan.hpp): labels and names, and the plan in
 // program order with machine axes and times; its segments are plan_segments.cpp.
 #include "rotacal/ballbar/plan.hpp"

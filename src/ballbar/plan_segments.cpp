@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The segments of the single set-up ballbar test (plan_segments.hpp).
 #include "plan_segments.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // The segments of the single set-up ballbar test (plan.hpp): the set-up's validation, each
 // test's samples, and the moves between tests that keep the ballbar in place. plan.cpp puts

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The ballbar problem's layout and fit set-up (ballbar/problem.hpp).
 #include "rotacal/ballbar/problem.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The ballbar's candidates for the design engine (design/separation.hpp): the added tests
 // that may separate two effects after a session, and the joint fit of several sessions.
 #include "rotacal/design/separation.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Ballbar simulator: predicted lengths on a machine model plus Gaussian noise.
 #include "rotacal/ballbar/simulate.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "rotacal/circular/simulate.hpp"
 
 #include <cmath>

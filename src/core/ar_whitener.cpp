@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The exact AR prewhitener of a noise model (noise_model.hpp), its inverse covariance and
 // Gram matrix, the AR(1) + random-walk filter, and the AR autocovariance of a stream.
 #include <Eigen/Cholesky>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Block-diagonal whitening of stacked residuals (core/block_whitener.hpp).
 #include "rotacal/core/block_whitener.hpp"
 

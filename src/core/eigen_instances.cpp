@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The one instantiation of the Eigen decompositions declared extern in eigen_instances.hpp.
 #include "eigen_instances.hpp"
 

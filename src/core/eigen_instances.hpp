@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Eigen decompositions compiled once for the library (eigen_instances.cpp) instead of in every
 // file that uses them. Included into every library file through the precompiled header
 // (cmake/RotacalPrecompile.cmake), so no source includes it by name.

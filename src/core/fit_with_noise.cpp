@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The feasible-GLS sequence of the joint fits (core/fit_with_noise.hpp).
 #include "rotacal/core/fit_with_noise.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The joint-fit driver: observability, a dense Gauss-Newton solve with step control,
 // covariance and estimates for every fit in rotacal.
 //
@@ -300,7 +301,7 @@ std::vector<bool> analyse_full(const JointProblem& pr, const std::vector<bool>& 
 // shrinking by 10x per iteration, and refreshed when a step does not reduce the cost or
 // contracts slowly. At convergence a stale Jacobian moves the solution by about
 // (J_ref - J)^T r: relative change of J (~ the contraction ratio rho of the chord steps)
-// times sqrt(chi2) sigma at most; it is accepted below 0.01 sigma, else refreshed. Moves x
+// times sqrt(chi2) sigma at most; accepted below stale_jacobian_sigma, else refreshed. Moves x
 // and ev to the solution; returns the last normal equations (Jacobian within 0.01 sigma of
 // the solution) and sets `cost`.
 NormalEquations gauss_newton(const JointProblem& pr, const std::vector<Eigen::Index>& idx,
@@ -349,7 +350,8 @@ NormalEquations gauss_newton(const JointProblem& pr, const std::vector<Eigen::In
     }
     if (step < s.step_tolerance_sigma && lambda == 0.0) {
       const double rho_now = last_step > 1e-3 ? std::max(rho, step / last_step) : rho;
-      if (at_J || (rho_now > 0.0 && rho_now * std::sqrt(std::max(cost, 1.0)) < 1e-2)) {
+      if (at_J ||
+          (rho_now > 0.0 && rho_now * std::sqrt(std::max(cost, 1.0)) < s.stale_jacobian_sigma)) {
         sum.converged = true;
         sum.message = "step below " + std::to_string(s.step_tolerance_sigma) + " sigma";
         break;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // JointRefitter: refits of a joint fit's model on other readings (a Monte Carlo draw, a
 // bootstrap resample), chord steps on the reference fit's Jacobian, falling back to a fresh
 // solve_joint where that Jacobian no longer contracts the step.

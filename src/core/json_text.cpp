@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Strict, bounded JSON text (core/json_text.hpp).
 #include "rotacal/core/json_text.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Observability and covariance of least-squares fits (no solver here: core/joint_fit.cpp).
 #include "rotacal/core/least_squares.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Levinson's recursion, shared by the AR estimate (noise_model.cpp) and the AR prewhitener and
 // covariances (ar_whitener.cpp).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The parts of the Monte Carlo checks that both instruments share: noise draws and the summary.
 #include "rotacal/core/monte_carlo.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Seeded coloured-noise generators (noise_model.hpp, noise_gen): AR(1), pink, thermal wander
 // and probe-zero wander, at the instrument's sample times.
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Bootstrap bias factor of a noise model estimated from fit residuals (core/noise_handling.hpp).
 #include "rotacal/core/noise_handling.hpp"
 

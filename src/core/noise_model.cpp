@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Residual noise model: per-stream AR(p) by Burg with BIC order selection. (The exact AR
 // prewhitener and the stream covariances are ar_whitener.cpp, the seeded coloured-noise
 // generators noise_generators.cpp.)

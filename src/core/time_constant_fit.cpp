@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The two-stage joint fit of a model with time constants (core/time_constant_fit.hpp).
 #include "rotacal/core/time_constant_fit.hpp"
 

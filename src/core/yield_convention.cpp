@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The yield convention for effects that share directions with the baseline (yield_convention.hpp).
 #include "rotacal/core/yield_convention.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The design engine's allocation of runs among candidate measurements (design/allocation.hpp).
 #include "rotacal/design/allocation.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The design engine (design/separation.hpp): the information algebra of a joint fit and the
 // one search for the added measurement that separates two effects.
 #include "rotacal/design/separation.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Table motion of two effects (design/table_motion.hpp): the derivative of the table pose as a
 // twist, with the location errors and the table point projected out.
 #include "rotacal/design/table_motion.hpp"

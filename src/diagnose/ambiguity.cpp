@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Wording of ambiguities: which test of the standard set-up separates two candidates that
 // explain this session's residuals equally well.
 #include <Eigen/SVD>

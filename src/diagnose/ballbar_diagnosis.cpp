@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The ballbar diagnosis problem: baseline + effects by the joint fit on arrays built once,
 // and the candidates' Jacobians by Jets of the one length model.
 #include "rotacal/diagnose/ballbar_diagnosis.hpp"

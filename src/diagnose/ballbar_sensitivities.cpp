@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The ballbar candidates' Jacobians by the chain rule (ballbar_sensitivities.hpp).
 #include "ballbar_sensitivities.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Internal to src/diagnose: the ballbar candidates' Jacobians by the chain rule at the current
 // fit (src/ballbar/length_chain.hpp), for a machine without head axes.

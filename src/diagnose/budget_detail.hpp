@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Internal to src/diagnose: the uncertainty budget of any fitted model, shared by the budget of
 // a diagnosis' final model (uncertainty_budget.cpp) and that of an identification whose model is

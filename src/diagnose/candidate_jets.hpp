@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Internal to src/diagnose: candidate Jacobians by Jets of the instrument's one model, shared
 // by the ballbar and R-test problems.

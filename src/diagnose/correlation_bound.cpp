@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // A finding judged again with each noise stream's lag-1 correlation at the upper bound of its
 // confidence interval (search.hpp: holds_at_correlation_bound). The search judges a candidate
 // under the AR model of what the extended model leaves; where the noise is one short stream

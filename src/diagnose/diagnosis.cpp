@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The diagnosis search loop and its entry point: baseline fit, candidates scored round by round
 // (search_round.cpp), the best significant one added and the model refitted (selection.cpp),
 // then what is left (final_test.cpp); in correlated noise, the final model's numbers by GLS.

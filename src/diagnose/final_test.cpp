@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // What the final model of a search leaves: its residual structure, the test for structure the
 // noise does not explain (white: chi-square; coloured: per group against the other groups'
 // noise model) and, where it is a function of one rotary angle, the per-angle table offered as

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Which harmonic orders of a rotary angle a set of readings resolves (Nyquist and aliasing on
 // the sampled angles), and why an order is left out, in words.
 #include <Eigen/SVD>

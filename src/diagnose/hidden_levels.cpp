@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The stream levels a model of the residuals cannot show, against the declared noise: the
 // whitener of the final refit (diagnosis.cpp) and of the search's 1/f-like treatment
 // (search_round.cpp).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Structure the final model leaves in a few consecutive poses, and the findings whose evidence
 // lies in it (local_structure.hpp).
 #include "local_structure.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Internal to src/diagnose: structure the final model leaves in a few consecutive poses, and the
 // findings whose evidence lies in it (local_structure.cpp). An instrument that holds a pose for

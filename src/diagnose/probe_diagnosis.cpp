@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The touch probe as an instrument of the diagnosis engine (diagnose/probe_diagnosis.hpp).
 #include "rotacal/diagnose/probe_diagnosis.hpp"
 

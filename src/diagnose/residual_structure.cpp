@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Residual structure per group (RMS, mean, harmonics in the swept angle, trend) and the
 // successive-difference noise estimate.
 #include <algorithm>

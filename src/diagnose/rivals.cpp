@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Posterior weights of a finding against its rivals (rivals.hpp).
 #include "rivals.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Internal to src/diagnose: how sure a finding is of its name. The chosen candidate of a search
 // round is weighed against its rivals (the candidates of the round that explain the same

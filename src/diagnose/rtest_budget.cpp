@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The uncertainty budget of an R-test joint identification: the budget of its own model (location
 // errors, tool_offset_Z on a head machine, the smooth error maps, probe zeros), not of the
 // diagnosis' baseline, so that the values and type A it shows are the ones identify reports.

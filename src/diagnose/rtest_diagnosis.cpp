@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The R-test diagnosis problem: baseline + effects fitted through the joint-fit driver on the
 // one R-test reading (rtest/model.hpp), and the candidates' Jacobians by Jets of it.
 #include "rotacal/diagnose/rtest_diagnosis.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Scoring of candidate effects: least-squares helpers, the linearised refit with its delta
 // BIC and F-test, and blocked cross-validation.
 #include "scoring.hpp"

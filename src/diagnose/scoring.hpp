@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Internal to src/diagnose and its adapters: the linear algebra, scoring and cross-validation the
 // search loop (diagnosis.cpp) uses, shared with the residual-structure and ambiguity files and

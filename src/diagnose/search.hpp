@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Internal to src/diagnose: the pieces of the diagnosis search (diagnosis.cpp, the loop and its
 // entry point): how the noise enters every decision, what the searches of one diagnosis share,

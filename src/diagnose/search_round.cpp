@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // One round of the diagnosis search: every candidate not yet done scored against the current
 // model by a linearised refit (scoring.hpp), in white noise with the search's sigma, in coloured
 // noise under each candidate's own noise model.

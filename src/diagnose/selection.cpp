@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The choice of a round's finding and how sure its name is: the best candidate that passes the
 // tests and whose refit determines a parameter, its posterior weight among its rivals
 // (rivals.hpp), the group the data cannot separate and the ambiguity it leaves.

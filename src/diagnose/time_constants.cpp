@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // A finding's time constant that the fit held (diagnosis.cpp, after the final refit): profiled
 // over a grid, its uncertainty carried into the other parameters' sigmas (search.hpp).
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // GUM / ISO/TR 230-9 uncertainty budget of the identified location errors: type A from the
 // noise model, type B from the catalogue effects the final model leaves out.
 #include "rotacal/diagnose/uncertainty_budget.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Bounded linear least squares by cyclic coordinate descent (fit/box_least_squares.hpp).
 #include "rotacal/fit/box_least_squares.hpp"
 

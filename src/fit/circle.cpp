@@ -1,12 +1,12 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "rotacal/fit/circle.hpp"
-
-#include <ceres/ceres.h>
 
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <vector>
 
+#include "orthogonal_distance.hpp"
 #include "rotacal/core/error.hpp"
 
 namespace rotacal {
@@ -40,37 +40,12 @@ void check_points(const Eigen::Ref<const Points2>& p, const std::string& who) {
         " points are collinear (did the axis move?); no circle passes through them");
 }
 
-// r = |p - c| - R for one point (Ceres examples/circle_fit.cc shape, without its
-// reparameterisation: the radius here is at least one sagitta away from zero).
-struct CircleDistance {
-  explicit CircleDistance(const Eigen::Vector2d& p) : p_(p) {}
-  template <typename T>
-  bool operator()(const T* centre, const T* radius, T* residual) const {
-    const T dx = T(p_.x()) - centre[0], dy = T(p_.y()) - centre[1];
-    residual[0] = ceres::sqrt(dx * dx + dy * dy) - radius[0];
-    return true;
-  }
-  static ceres::CostFunction* Create(const Eigen::Vector2d& p) {
-    return new ceres::AutoDiffCostFunction<CircleDistance, 1, 2, 1>(new CircleDistance(p));
-  }
-  Eigen::Vector2d p_;
-};
-
 // Orthogonal residuals, covariance from their Jacobian, and the short-arc check.
 CircleFit finish(const Eigen::Ref<const Points2>& p, Eigen::Vector2d centre, double radius,
                  const CircleFitOptions& o, const std::string& who) {
-  if (o.refine) {
-    ceres::Problem problem;
-    for (Eigen::Index i = 0; i < p.rows(); ++i)
-      problem.AddResidualBlock(CircleDistance::Create(p.row(i).transpose()), nullptr, centre.data(),
-                               &radius);
-    ceres::Solver::Options so;
-    so.linear_solver_type = ceres::DENSE_QR;
-    so.function_tolerance = 1e-14;
-    so.parameter_tolerance = 1e-14;
-    ceres::Solver::Summary summary;
-    ceres::Solve(so, &problem, &summary);
-  }
+  // The geometric refinement (orthogonal_distance.hpp; Ceres examples/circle_fit.cc without its
+  // reparameterisation: the radius here is at least one sagitta away from zero).
+  if (o.refine) refine_orthogonal_distance<2>(p, centre, radius, false);
   CircleFit f;
   f.centre = centre;
   f.radius = radius;

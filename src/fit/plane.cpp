@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "rotacal/fit/plane.hpp"
 
 #include <Eigen/Dense>

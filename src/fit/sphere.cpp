@@ -1,32 +1,13 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "rotacal/fit/sphere.hpp"
-
-#include <ceres/ceres.h>
 
 #include <Eigen/Dense>
 #include <cmath>
 
+#include "orthogonal_distance.hpp"
 #include "rotacal/core/error.hpp"
 
 namespace rotacal {
-
-namespace {
-
-// r = |p - c| - R for one point.
-struct SphereDistance {
-  explicit SphereDistance(const Eigen::Vector3d& p) : p_(p) {}
-  template <typename T>
-  bool operator()(const T* centre, const T* radius, T* residual) const {
-    const T dx = T(p_.x()) - centre[0], dy = T(p_.y()) - centre[1], dz = T(p_.z()) - centre[2];
-    residual[0] = ceres::sqrt(dx * dx + dy * dy + dz * dz) - radius[0];
-    return true;
-  }
-  static ceres::CostFunction* Create(const Eigen::Vector3d& p) {
-    return new ceres::AutoDiffCostFunction<SphereDistance, 1, 3, 1>(new SphereDistance(p));
-  }
-  Eigen::Vector3d p_;
-};
-
-}  // namespace
 
 SphereFit sphere_fit(const Eigen::Ref<const Points3>& p, const SphereFitOptions& o) {
   if (!p.allFinite()) throw InvalidArgument("sphere_fit: points contain NaN or infinity");
@@ -61,25 +42,14 @@ SphereFit sphere_fit(const Eigen::Ref<const Points3>& p, const SphereFitOptions&
   centre += mean.transpose();
   if (o.radius) radius = *o.radius;
 
-  // Geometric refinement.
-  ceres::Problem problem;
-  for (Eigen::Index i = 0; i < p.rows(); ++i)
-    problem.AddResidualBlock(SphereDistance::Create(p.row(i).transpose()), nullptr, centre.data(),
-                             &radius);
-  if (o.radius) problem.SetParameterBlockConstant(&radius);
-  ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_QR;
-  so.function_tolerance = 1e-15;
-  so.parameter_tolerance = 1e-15;
-  so.gradient_tolerance = 1e-15;
-  ceres::Solver::Summary summary;
-  ceres::Solve(so, &problem, &summary);
+  // Geometric refinement (orthogonal_distance.hpp).
+  const bool converged = refine_orthogonal_distance<3>(p, centre, radius, o.radius.has_value());
 
   SphereFit f;
   f.centre = centre;
   f.radius = radius;
   f.n = static_cast<int>(p.rows());
-  f.converged = summary.termination_type == ceres::CONVERGENCE;
+  f.converged = converged;
   const int k = o.radius ? 3 : 4;
   Eigen::MatrixXd J(p.rows(), k);
   double ss = 0.0;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Ballbar sample frames: encode and decode (ballbar_protocol.hpp).
 #include "rotacal/hw/ballbar_protocol.hpp"
 

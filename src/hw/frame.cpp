@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Binary framing: CRC-16, frame encode and the resynchronising scanner (frame.hpp).
 #include "rotacal/hw/frame.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The ASCII probe dialects (sylvac-, keyence-style) and the probe stream frame
 // (probe_protocol.hpp).
 #include "rotacal/hw/probe_protocol.hpp"

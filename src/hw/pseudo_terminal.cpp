@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Pseudo-terminals for the virtual instruments (pseudo_terminal.hpp).
 #include "rotacal/hw/pseudo_terminal.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The R-test recorder: the probe stream through the shared stream reader (recording.hpp), or
 // the polled probe loop, averaging each pose's readings inside its read window.
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Recorders: the summary of a recording, and the ballbar recorder (recorder.hpp); the stream reader
 // it shares with the R-test recorder is recording.hpp, the R-test recorder record_rtest.cpp.
 #include "rotacal/hw/recorder.hpp"

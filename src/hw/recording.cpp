@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // What the recorders share (recording.hpp): clocks, the handshake and the start of a stream.
 #include "recording.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // The one stream reader of both recorders (recorder.cpp: ballbar, record_rtest.cpp: the probe
 // stream) and what a recording shares: host clock, device clock, frames across reads, the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // libserialport backend of ByteTransport (real serial ports, USB adapters).
 #include <libserialport.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // What both instrument streams share: command lines, text reply frames (stream_protocol.hpp).
 #include "rotacal/hw/stream_protocol.hpp"
 

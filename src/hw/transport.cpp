@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // ByteTransport: termios for pseudo-terminals, port listing and opening (transport.hpp).
 #include "rotacal/hw/transport.hpp"
 

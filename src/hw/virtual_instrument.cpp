@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Virtual instruments: the shared pty/stream/command base, the ballbar and the R-test
 // (virtual_instrument.hpp).
 #include "rotacal/hw/virtual_instrument.hpp"

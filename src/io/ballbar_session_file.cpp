@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // rotacal-ballbar/1 session files: the strict reader, the exact writer, the appending writer.
 #include <set>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Free text as comment lines that no controller reads as a command.
 #include "rotacal/io/controller_comment.hpp"
 

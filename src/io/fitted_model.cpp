@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The "probe" and "multi" kinds of rotacal-model/1 files, written and read back strictly
 // (io/fitted_model.hpp; the layout in docs/model_file.md).
 #include "rotacal/io/fitted_model.hpp"

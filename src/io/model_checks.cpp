@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The member checks shared by the kinds of rotacal-model/1 files (model_checks.hpp).
 #include "model_checks.hpp"
 

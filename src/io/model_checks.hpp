@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // The member checks every kind of rotacal-model/1 file shares (model_file.cpp,
 // fitted_model.cpp): messages "source: member: what is wrong", an estimate's value, unit and

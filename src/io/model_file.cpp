@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // rotacal-model/1 files: strict JSON (nlohmann), validated member by member, versioned.
 #include "rotacal/io/model_file.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The NC dialects by name (io/nc_dialect.hpp).
 #include "rotacal/io/nc_dialect.hpp"
 

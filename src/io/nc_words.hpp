@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Internal to src/ballbar, src/circular and src/probe (kept in src/io, below all three): number
 // formatting of NC words, each dialect's comment writer, and the program preamble per dialect,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The output rule: regular files replaced atomically, devices and FIFOs written through,
 // everything else (directories, the command's inputs, its other outputs) refused.
 #include "rotacal/io/output_file.hpp"

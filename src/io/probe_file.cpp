@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // rotacal-probe/1 session files: strict reader, exact writer (formats.md, "Touch-probe session").
 #include "rotacal/io/probe_file.hpp"
 

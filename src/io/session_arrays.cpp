@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Sessions to and from numpy-shaped columns, validated as the file reader validates them.
 #include "rotacal/io/session_arrays.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Either kind of session file, chosen by its `# format:` line. The formats themselves are
 // ballbar_session_file.cpp and rtest_session_file.cpp over the strict reader (strict_reader.hpp);
 // probe_file.cpp reads rotacal-probe/1 and uses the same sniffing.

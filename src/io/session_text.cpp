@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The writing shared by the session-file formats (session_text.hpp).
 #include "session_text.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // The writing shared by the session-file formats: machine and rotary columns of a header, a
 // sample's rotary values, labels and values checked so that no file is written that the

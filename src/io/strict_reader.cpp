@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The strict reading shared by the session-file formats (strict_reader.hpp).
 #include "strict_reader.hpp"
 

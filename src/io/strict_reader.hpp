@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // The strict reading shared by the session-file formats (ballbar_session_file.cpp,
 // rtest_session_file.cpp): bounded UTF-8 lines, metadata and header, fields with their columns,

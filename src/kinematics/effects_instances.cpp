@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The effects' entry points for the library's scalars, compiled once here
 // (include/rotacal/kinematics/effects_instances.hpp), and the stages the diagnosis' chain rule
 // calls (stage_instances.hpp).

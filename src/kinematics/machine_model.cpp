@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // MachineModel: parameter names and validation shared by the ballbar and the R-test.
 #include "rotacal/kinematics/machine_model.hpp"
 

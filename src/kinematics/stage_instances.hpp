@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The effects' stages that the ballbar diagnosis' chain rule
 // (src/diagnose/ballbar_sensitivities.cpp) calls directly, compiled once in effects_instances.cpp,
 // where table_point and tool_position instantiate them anyway: declared extern there, the chain

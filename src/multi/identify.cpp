@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // One identification from several sessions of one machine (multi/identify.hpp).
 #include "rotacal/multi/identify.hpp"
 

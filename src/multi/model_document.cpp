@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // A joint identification of several sessions as a model document (multi/model_document.hpp).
 #include "rotacal/multi/model_document.hpp"
 

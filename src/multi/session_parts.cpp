@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Each instrument's problem as one session of the stacked fit (src/multi/session_parts.hpp).
 // Only this layer includes the three instrument problems; they do not include each other.
 #include "session_parts.hpp"

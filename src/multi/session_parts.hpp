@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // One session of a multi-session fit as the stacked model needs it (multi/identify.hpp): the
 // instrument's own residual model, its unknowns with their start values, where its location
 // errors lie in its own vector, and its noise streams. Private to src/multi.

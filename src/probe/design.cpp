@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Test design of the touch probe (probe/design.hpp): the candidate poses and their
 // information, handed to the design engine (design/allocation.hpp).
 #include "rotacal/probe/design.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The touch probe's candidates for the design engine (design_poses.hpp).
 #include "design_poses.hpp"
 

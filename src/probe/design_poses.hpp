@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // The touch probe's candidates for the design engine, shared by the design of a test and the
 // separation search (probe/design.hpp): the pose grid within the axis limits that the probing

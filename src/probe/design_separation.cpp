@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The touch probe's candidates for the separation search of the design engine
 // (design/separation.hpp): added poses that may separate two effects after a probe session.
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The controller cycles' method on touch-probe data (HEIDENHAIN KinematicsOpt cycle 451,
 // ISG SysMeasRotAx), as the peer of the joint fit: sphere per pose, then per table axis a
 // plane (Flynn et al. 2016, Eq. 3) and a circle (hyper fit, Al-Sharadqah & Chernov 2009)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Joint fit of a touch-probe session through the one driver with its noise model.
 #include <cmath>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // A joint touch-probe identification as a model document (probe/model_document.hpp).
 #include "rotacal/probe/model_document.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Monte Carlo check of a touch-probe joint fit (probe/monte_carlo.hpp).
 #include "rotacal/probe/monte_carlo.hpp"
 

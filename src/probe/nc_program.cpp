@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The probing program of a touch-probe session and the reader of its LinuxCNC log
 // (probe/nc_program.hpp). NC words and comments: src/io/nc_words.hpp, as the ballbar's
 // and the circular tests' programs write them.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The touch-probe problem: layout, touches and the residual model (probe/problem.hpp).
 #include "rotacal/probe/problem.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Touch-probe simulator: the touch geometry of formats.md through probe/touch_model.hpp.
 #include "rotacal/probe/simulate.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Test design: the R-test nests and pose grid with the smallest predicted uncertainty.
 #include "rotacal/rtest/design.hpp"
 

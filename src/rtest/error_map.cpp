@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // R-test error maps (Oyama & Ibaraki): tabulated from the paper method, written as CSV and JSON.
 #include "rotacal/rtest/error_map.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Oyama's error model: Euler angles of a pose, and the exact and first-order maps from location
 // errors.
 #include "rotacal/rtest/error_model.hpp"

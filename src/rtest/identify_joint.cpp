@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // R-test joint fit: smooth basis of the error maps, the joint model's readings with their
 // uncertainty, and the fit through the one joint-fit driver (core/joint_fit.hpp).
 #include "rotacal/rtest/identify_joint.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Oyama & Ibaraki's two-step R-test identification (Eqs. 10-22).
 #include "rotacal/rtest/identify_paper.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // A joint R-test identification as a model document (rtest/model_document.hpp).
 #include "rotacal/rtest/model_document.hpp"
 

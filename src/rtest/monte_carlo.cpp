@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Monte Carlo check of the R-test joint fit's 1-sigma with the session's fitted noise model.
 #include "rotacal/rtest/monte_carlo.hpp"
 

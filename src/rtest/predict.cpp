@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Prediction of R-test readings from a model, with their 1 sigma.
 #include "rotacal/rtest/predict.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The R-test problem's layout, arrays and residual model (rtest/problem.hpp).
 #include "rotacal/rtest/problem.hpp"
 

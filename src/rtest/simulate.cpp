@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // R-test simulator: the one reading of rtest/model.hpp on a machine model, probe zeros and noise.
 #include "rotacal/rtest/simulate.hpp"
 

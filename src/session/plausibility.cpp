@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Plausibility of sessions against the nominal kinematics, with the likely cause of a misfit named.
 #include "rotacal/session/plausibility.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Uses the installed package: where does a table point go on an AC-trt table with an E_X0C?
 #include <cmath>
 #include <iostream>

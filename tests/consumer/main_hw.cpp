@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Uses the installed serial layer: a frame through a pseudo-terminal and back.
 #include <unistd.h>
 

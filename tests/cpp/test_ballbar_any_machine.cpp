@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The single set-up ballbar test on every built-in machine and on a custom description
 // (issue 13): plan, simulate with AR(0.5) noise at the recorder's rate, identify by
 // the joint fit; hidden location errors within 3 sigma, unobservable combinations named with

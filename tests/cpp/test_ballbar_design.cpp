@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tests of the ballbar test design (rotacal/ballbar/design.hpp): the predicted 1-sigma is the
 // one a simulated test realises, limits exclude set-ups by name, and the design beats the
 // default set-up at the same run time.

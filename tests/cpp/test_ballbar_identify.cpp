@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tests of the ballbar joint fit and paper chain: random machines, observability, compensation.
 #include <catch2/catch.hpp>
 #include <random>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tests of the ballbar Monte Carlo: same draws as simulate_ballbar + identify_joint, spread
 // against the reported sigma, a coloured-noise generator plugged in, refusals.
 #include <catch2/catch.hpp>

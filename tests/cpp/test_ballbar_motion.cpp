@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The rotary axes' motion read from a session's time and angle columns (ballbar/motion.hpp),
 // and what the motion effects of the catalogue do with it (kinematics/effects.hpp).
 #include <catch2/catch.hpp>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // ballbar/problem.hpp: the ballbar layout, its one residual (doubles and Jets) and the fit
 // set-up built from the layout.
 #include <ceres/jet.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The NC program preamble shared by the rotary-axis and the circular-test writers
 // (src/io/nc_words.hpp): what it writes per dialect, that it is what both programs open
 // with, and the errors it raises in each writer's name.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The circular program as a function of time (circular/timeline.hpp) and the noise-free
 // reading a virtual ballbar plays from it (circular/simulate.hpp).
 #include <catch2/catch.hpp>

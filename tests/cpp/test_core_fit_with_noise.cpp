@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // core/fit_with_noise.hpp: the white fit, the noise model of its residuals and the GLS refit,
 // on a straight line y = a + b t whose noise is white or AR(1) (drawn here, seeded).
 #include <catch2/catch.hpp>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // core/json_text.hpp: strict JSON, bounded in nesting and in objects and arrays per byte.
 #include <algorithm>
 #include <catch2/catch.hpp>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // core/parameter_layout.hpp: named blocks, their offsets, views over Eigen vectors, Jacobian
 // columns and raw double / Jet arrays, items of zeros per nest, and the errors it throws.
 #include <ceres/jet.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // design/allocation.hpp: the allocation of runs among candidates, on information matrices whose
 // best allocation is known in closed form.
 #include <catch2/catch.hpp>

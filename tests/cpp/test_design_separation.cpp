@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // design/separation.hpp: the information algebra (inverse with held parameters, canonical
 // correlation, columns between layouts) and the one separation search, on information
 // matrices whose correlations are known in closed form.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include <Eigen/SVD>
 #include <catch2/catch.hpp>
 #include <random>

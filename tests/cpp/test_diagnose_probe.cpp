@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The diagnosis on touch-probe data (diagnose/probe_diagnosis.hpp): a stylus whose effective
 // radius is 3 um off its calibration is named stylus_radius_offset, with its size; clean data
 // name nothing; the candidates' Jacobian agrees with central differences of the probe problem.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Diagnosis on data that look like measurements: coloured noise (AR(1) and 1/f-like, per
 // session sample, as recorded), probe zeros that wander between poses, hidden effects in it,
 // and a local defect outside the catalogue shapes, for both instruments. Each case also runs

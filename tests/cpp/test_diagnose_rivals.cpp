@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // How sure a finding is of its name (src/diagnose/rivals.hpp): a candidate whose evidence the
 // chosen one explains away is its rival even where their fitted signatures correlate little,
 // and an effect of its own beside the chosen one is not. Exact readings built from orthonormal

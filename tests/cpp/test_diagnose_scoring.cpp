@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The one scorer and cross-validation of src/diagnose/scoring.hpp, which the engine and the
 // circular-test diagnosis share: score_columns against an independent dense least-squares fit,
 // its visibility decisions, and the blocked CV RMS against means worked out by hand.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include <ceres/jet.h>
 
 #include <catch2/catch.hpp>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include <Eigen/Geometry>
 #include <catch2/catch.hpp>
 #include <limits>

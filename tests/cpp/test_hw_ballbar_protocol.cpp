@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Ballbar sample frames: encode/decode round trip, refusal of other frames.
 #include <catch2/catch.hpp>
 

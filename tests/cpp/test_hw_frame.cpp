@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Binary framing: CRC check value, round trips, resynchronisation after garbage and corruption.
 #include <catch2/catch.hpp>
 #include <cstring>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // ASCII probe dialects and probe stream frames: parse/format agreement, refusals.
 #include <catch2/catch.hpp>
 

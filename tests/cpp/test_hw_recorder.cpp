@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // End to end: virtual instrument -> pty -> recorder -> session file -> identification.
 #include <unistd.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The stream protocol both instruments share: text frames, sequence gaps, host commands.
 #include <catch2/catch.hpp>
 

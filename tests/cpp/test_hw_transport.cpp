@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Transports: pseudo-terminal open, read timeouts, hang-up as a disconnect.
 #include <unistd.h>
 

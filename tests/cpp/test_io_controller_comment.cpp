@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tests of rotacal/io/controller_comment.hpp: whatever the text, each dialect's comment lines
 // are whole comments that its controller cannot read as a block or a command.
 #include <catch2/catch.hpp>

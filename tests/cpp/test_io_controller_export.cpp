@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tests of the controller exports (rotacal/io/controller_export.hpp): each public kinematics is
 // re-implemented here from the controller's documented formulas, fed only with the exported
 // text, and must put the table point where rotacal's identified model does (0.1 um) over the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tests of io/fitted_model.hpp, probe/model_document.hpp and multi/model_document.hpp: the
 // model files of a touch-probe identification ("probe") and of one identification from several
 // sessions ("multi") read back exactly what was written, a malformed member is refused naming

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Session readers against hostile and careless input: bounded memory and messages, UTF-8,
 // BOM, directories, magnitudes no machine has, duplicated rows (issue 17 items 2, 3, 6, 11).
 #include <sys/stat.h>

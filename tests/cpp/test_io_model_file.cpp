@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tests of rotacal-model/1 files (io/model_file.hpp): round trip, strict JSON, versions,
 // units and limits, and the files the Python writer made before the C++ one existed.
 #include <unistd.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tests of the output rule (rotacal/io/output_file.hpp): files replaced atomically, devices
 // and FIFOs written through, symlinks followed, directories/inputs/other outputs refused.
 #include <dirent.h>

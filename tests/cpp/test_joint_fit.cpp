@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tests of the joint-fit driver: batched Jets against finite differences, observability,
 // GLS with a whitener against Monte Carlo on AR(1) noise, refits against fresh fits.
 #include <catch2/catch.hpp>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Joint fits (ballbar and R-test) on correlated noise: the noise model estimated from the
 // residuals, the GLS refit, and 1-sigma figures that hold (issue 11 item 1).
 #include <algorithm>

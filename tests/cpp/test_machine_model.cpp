@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tests of MachineModel: validation naming the field, parameter names, and that both
 // instruments' models are one.
 #include <catch2/catch.hpp>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // One identification from a ballbar and a touch-probe session of one AC-trt machine
 // (multi/identify.hpp): the joint values lie within 3 sigma of the simulated machine, the joint
 // sigma is no larger than either session's alone, a session of another machine is refused by

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tests of the residual noise model: AR order and coefficients recovered within their
 // sampling error, white noise found white, the whitener is the inverse Cholesky factor of the
 // model's covariance, and whitened AR data are white.

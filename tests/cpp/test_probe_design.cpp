@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // probe/design.hpp: the designed poses beat the default poses of `plan probe` at the same number
 // of touches (largest expanded uncertainty ratio <= 0.7, issue 31), respect the axis limits and
 // can be planned; the predicted sigma is what simulated sessions of the design realise; invalid

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Identification of touch-probe sessions (probe/identify.hpp, probe/problem.hpp): the joint fit
 // finds the independent implementation's errors within 3 sigma, finds simulated errors in
 // coloured noise with an effect fitted along, its sigma agrees with the scatter of repeated draws,

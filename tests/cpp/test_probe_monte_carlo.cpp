@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tests of probe/monte_carlo.hpp on the independent implementation's touch-probe session
 // (../shared/data/probe_ac_table2.csv, 0.5 um white noise): the draws scatter about the identified
 // values (the touches are moved onto the identified machine) by the reported 1-sigma, and a fit

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The probing program (probe/nc_program.hpp): one G38.2 and one LOG per touch of the pattern,
 // in LinuxCNC words only; limits, travel and moves through the sphere refused; the log read
 // back into the plan's rows. Its moves are checked against LinuxCNC's own interpreter and the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The probe problem (probe/problem.hpp): its named blocks tile the parameter vector in the
 // stated order, its parameters carry the names and units of the blocks, and its Jacobian (Jets
 // of the one touch model) agrees with central differences.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The touch-probe simulator (probe/simulate.hpp) against the independent implementation's
 // session: with the truth file's errors and sphere it reproduces the latched positions of
 // ../shared/data/probe_ac_table2.csv to within their noise, and the nominal machine does not.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The touch model (probe/touch_model.hpp): an ideal touch has a zero residual, the probe's two
 // effects act as effects.md says, and Jets of the one templated formula agree with central
 // differences of its double evaluation.

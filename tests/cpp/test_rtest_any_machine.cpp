@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The R-test on every built-in machine and on a custom description (issue 13): the default
 // pattern fits the machine's limits, a simulated session with coloured noise (AR(0.9) +
 // probe zeros wandering between poses, core/noise_model.hpp noise_gen) hides random location

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tests of the R-test design (rotacal/rtest/design.hpp): the predicted 1-sigma is what
 // simulated R-tests with coloured noise realise, limits and coarse grids exclude patterns by
 // name, and the design beats the default pattern at the same run time.

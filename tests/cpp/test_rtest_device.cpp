@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tests of rtest/device.hpp: probe model, direction calibration, sphere offset, raw conversion.
 #include <catch2/catch.hpp>
 #include <random>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tests of rtest/error_map.hpp: map writers and held-out prediction.
 #include <catch2/catch.hpp>
 #include <iostream>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tests of rtest/error_model.hpp: Oyama Eqs. 4-9 and the mapping to ISO 230-7 location errors.
 #include <ceres/jet.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tests of rtest/identify_joint.hpp: joint fit, observability per nest arrangement, and the
 // gravity/coning map on ../shared/data/rtest_bc_oyama.csv.
 #include <algorithm>

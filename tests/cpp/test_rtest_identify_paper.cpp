@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tests of rtest/identify_paper.hpp: the paper's two-step method on simulated sessions whose
 // position-dependent errors are known in closed form.
 #include <catch2/catch.hpp>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tests of the one R-test reading (rtest/model.hpp) against the other routes to the same
 // number: machine.hpp's table pose, the joint model with zero maps, Oyama's HTM form.
 #include <ceres/jet.h>

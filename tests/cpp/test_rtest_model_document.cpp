@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tests of rtest/model_document.hpp: a joint R-test identification taken apart into its model
 // file's content (the file's layout itself: test_io_model_file.cpp).
 #include <catch2/catch.hpp>

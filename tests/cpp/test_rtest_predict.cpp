@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tests of rtest/predict.hpp: a model rebuilt from its parts, and held-out poses predicted
 // against the simulator's noise-free truth with honest 1-sigma columns.
 #include <catch2/catch.hpp>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // rtest/problem.hpp: the R-test layout (with and without maps, on table and head machines),
 // the arrays, and the residual model's two table poses with their Jacobians against central
 // differences.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tests of rtest/simulate.hpp, cross-checked against the independent implementation's session
 // ../shared/data/rtest_bc_oyama.csv.
 #include <catch2/catch.hpp>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tests of session/plausibility.hpp: the shared sessions pass; sessions with the careless mistakes
 // of issue 17 item 5 are refused with the cause named.
 #include <catch2/catch.hpp>

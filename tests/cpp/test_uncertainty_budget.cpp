@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tests of the uncertainty budget: the type B line of a left-out effect equals the shift that
 // effect really puts on a location error (nonlinear refit of a simulated session), the GUM
 // arithmetic (combined, Welch-Satterthwaite, coverage), overrides, and bad input.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """What the headless [DISPLAY] programs of tests/linuxcnc share (tcp_display.py, probe_display.py).
 
 LinuxCNC starts a display as `PROGRAM -ini FILE` from the INI's directory, after HAL and the

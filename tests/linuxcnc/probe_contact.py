@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: BSD-3-Clause
 """Userspace HAL component `probe-sim` of probe.hal: where the simulated machine holds the sphere.
 
 Loaded by `loadusr -Wn probe-sim /usr/bin/python3 probe_contact.py truth.json` (Debian's python3:

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: BSD-3-Clause
 """Headless [DISPLAY] program for probe-sim.ini (tests/python/test_linuxcnc_probe.py).
 
 After lcnc_display.Machine.bring_up it runs probe.ngc in AUTO mode to its end (M2) and writes

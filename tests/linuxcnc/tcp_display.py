@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: BSD-3-Clause
 """Headless [DISPLAY] program for xyzac-trt-sim.ini (tests/python/test_linuxcnc_kins.py).
 
 After lcnc_display.Machine.bring_up, in MDI (world coordinates through xyzac-trt-kins: motion

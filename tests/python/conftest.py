@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Fixtures shared by the Python tests: the shared sessions beside the repository and their truth files,
 and the command line run in this process."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Running a headless LinuxCNC of tests/linuxcnc from a test (test_linuxcnc_kins.py,
 test_linuxcnc_probe.py).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """How small the touch probe's largest expanded uncertainty (k = 2) of the location errors can
 get at a number of touches, whatever the design (docs/design.md, "Touch probe"), from the
 reference simulator alone (tests/reference/refsim, no rotacal import).

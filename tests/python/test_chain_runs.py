@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The runs of the measure -> compensate -> measure-again chain in batches (ballbar/chain_runs.hpp):
 what a run records, that a batch equals its runs one at a time, and that compensating for the
 identified errors of the shared Table 2 machine removes most of them."""

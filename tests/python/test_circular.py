@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """ISO 230-4 circular tests from the command line and Python: plan -> simulate -> analyze."""
 
 import json

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """A virtual ballbar playing an ISO 230-4 circular program over a pseudo-terminal, recorded by
 `rotacal circular record` and analysed by `rotacal circular analyze`, as a user runs them; the
 recovered G and causes against the simulated machine."""

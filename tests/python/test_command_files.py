@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Issue 32, class 2: no output of any command may be one of its inputs, another of its
 outputs or the history store it uses: refused before any work with exit 4, the file left
 as it was. The rule is one table (rotacal.command_files.COMMANDS); every subcommand of the

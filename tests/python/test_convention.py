@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Convention check against the independent implementation: with the truth's location errors,
 pivot and effects, the library's exact forward model reproduces the recorded readings to
 within the stated noise (residual RMS within 15 % of noise_um)."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """`rotacal design ballbar` as an engineer runs it: the designed set-up within the travel, its
 predicted uncertainty against the default's at the same run time, the NC program of the
 designed test, and refusals by option."""

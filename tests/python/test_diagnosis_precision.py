@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The diagnosis is never confidently wrong (issue 29): the cases it named wrongly, on data from
 the independent reference simulator (tests/reference/refsim), with set-ups and seeds other
 than the issue's, in coloured noise where it applies. A session is judged as a calibration

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """examples/rtest_error_map.py, run as a user runs it (as test_cli.py runs the other examples)."""
 
 import json

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """`rotacal export` as an engineer runs it: identify, export into the controller's parameters,
 and check with the controller's own kinematics (written here from LinuxCNC's trtfuncs.c and
 the SINUMERIK W1 manual, fed only with the exported file) that the corrected machine puts the

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Python geometric fits (circle, sphere, plane) against an independent SciPy fit, and their typed errors."""
 
 import numpy as np

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Flynn et al. (2016) Table 2 as a real-data case: the shipped table against the paper's text,
 the analysis on a synthetic before/after pair with a known hidden cause, and on Table 2."""
 

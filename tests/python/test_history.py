@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The calibration history (docs/history.md): drift, corrections and flags computed as the
 docs define them, against an independent fit; duplicates, unknown machines, bad locations and
 foreign or newer stores refused; older stores migrated; two writers at once and a writer killed

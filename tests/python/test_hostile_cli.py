@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Hostile and careless input at the command line and the Python API (issue 17): each row is a
 reproducer of the issue, and each must end in a clean refusal with the documented exit code
 (3 invalid content or arguments, 4 file system or device) or a correct result; never a

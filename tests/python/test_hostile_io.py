@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Hostile and careless input at the file layer (issue 17): every case ends in a typed
 refusal naming file/line/column (or the path), never a crash, a traceback, unbounded memory
 or a destroyed file. The command line maps them to exit 3 (content) and 4 (file system)."""

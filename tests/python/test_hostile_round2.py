@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The second hostile round (issue 32, classes 3-7 and what a user sees): hostile JSON in every
 file a command reads as JSON, recordings that measure nothing, broken options, nonsense that
 used to exit 0, and exit codes of the history store. Each run asserts its exit code and a

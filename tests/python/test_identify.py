@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Joint and paper identification of the shared ballbar sessions from Python, against their truth files."""
 
 import json

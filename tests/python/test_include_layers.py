@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The C++ layer order of the README, checked on every #include of include/ and src/.
 
 core < kinematics < fit < session < io < design < instrument problems (ballbar, rtest, probe) <

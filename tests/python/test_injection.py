@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Issue 32, class 1: no free text can put a block or a command into a file a controller executes.
 
 Every text that is not the writer's own reaches those files: a machine description's `name`

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Virtual instruments and recorders from Python and the command line, as a user runs them:
 a virtual instrument on a pseudo-terminal, `rotacal record`, then identification."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Session files from Python: both formats, exact round trips, sessions built from arrays and validated."""
 
 import numpy as np

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The model files of a touch-probe identification (kind "probe") and of one identification from
 several sessions (kind "multi"), as an engineer uses them: `identify --save-model --store`, then
 `export` into all five controllers, `history show` and `report` (issue 31, item 5). The values

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The JSON of the noise model, the uncertainty budget and the per-angle table follows
 docs/json_schema.md: its `schema` blocks are read here and real `--json` outputs of
 `rotacal identify` / `rotacal diagnose` are checked against them (a small checker; no new

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Kinematics from Python: nominal forward transforms, shapes, machine names."""
 
 import numpy as np

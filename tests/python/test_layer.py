@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The Python layer's seams: one dispatch on the session kind, options laid over the C++
 defaults, no import cycle in the package, a library that never imports the command line, and
 a CLI that draws only when asked."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The linuxcnc program through LinuxCNC's own interpreter.
 
 `rs274 -t tool.tbl -g program.ngc` (Debian package linuxcnc-uspace) interprets the program

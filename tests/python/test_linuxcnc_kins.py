@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """`rotacal export --controller linuxcnc` checked by LinuxCNC itself.
 
 test_export.py re-implements xyzac-trt-kins (trtfuncs.c) in numpy; here the real module does

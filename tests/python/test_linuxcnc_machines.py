@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The LinuxCNC (machine-axis) program of every built-in machine through LinuxCNC's own
 interpreter, rs274: it runs to M2 without an error, every block ends on the planned machine
 axes (the machine's own rotary letters in their a, b, c slots), the ballbar keeps L0 at every

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """A real client of the probing program (issue 31, item 6): LinuxCNC runs it on a simulated
 machine whose probe input is the simulated contact of the stylus with the sphere.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Every built-in machine and a machine described in a file, through the command line: plan
 (NC programs in every dialect), simulate ballbar, identify (known errors recovered), report;
 `rotacal machines`; machines.load_machine; descriptions that break formats.md refused with the

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """rotacal-model/1 files between the languages: what Python's standard json module writes the
 C++ reader reads (as every file written before the C++ writer existed), and what the C++
 writer writes Python's json module reads back, value for value; strict JSON, versions."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """One identification from several sessions of one machine (issue 31, item 5) from Python:
 sessions made by the independent reference simulator (tests/reference/refsim, AR(1) noise, one
 machine with several location errors) -- ballbar + probe, and ballbar + R-test -- are identified

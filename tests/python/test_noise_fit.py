@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Joint fits on correlated noise from Python and the CLI: the white fit's 1-sigma is several
 times too small on AR(0.95) ballbar sessions, the noise-model fit's holds; the Monte Carlo
 check re-simulates the fitted noise model (issue 11 items 1 and 3)."""

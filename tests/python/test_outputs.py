@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The output rule from Python (rotacal.outputs.write_output): files replaced atomically,
 devices and FIFOs written through, symlinks followed, bad targets refused with IoError."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Ballbar test planning from Python: arrays, the reference session's commands, L0 along the
 whole toolpath, compensation, NC program text, typed errors."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The touch probe on a sphere (issue 31) from Python: rotacal.load recognises rotacal-probe/1,
 rotacal.identify fits it (joint, and the cycles' method as the peer), and sessions made by the
 independent reference simulator (tests/reference/refsim: other seeds, AR(1) noise, an effect)

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The touch probe on the command line (issue 31): `rotacal simulate probe`, and `identify` and
 `diagnose` of a rotacal-probe/1 session. The truth of the fits comes from the independent
 reference simulator (tests/reference/refsim), and the simulator's touches are checked against

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """`rotacal design probe` (docs/design.md, issue 31): the designed poses against `plan probe`'s
 default poses at the same number of touches, judged independently of rotacal's code: the
 information matrix is taken from finite differences of the reference simulator's touches

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The touch-probe diagnosis is never confidently wrong (issues 29 and 31), on sessions of the
 independent reference simulator (tests/reference/refsim) with set-ups and seeds other than
 bench/diagnosis_confusion.py's (sphere at (130, 20, 70), other location errors, other seeds),

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """`rotacal plan probe` through LinuxCNC's own interpreter, and `rotacal import probe` of its log.
 
 `rs274 -t tool.tbl -g probe.ngc` (linuxcnc-uspace; test_linuxcnc.run_rs274) interprets the program stand-alone and prints

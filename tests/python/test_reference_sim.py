@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """rotacal against an independent reference simulator (issue 29, item 1).
 
 tests/reference/refsim implements shared/spec/formats.md and effects.md from the spec text alone

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The HTML report, opened in headless Chromium as a person would open it."""
 
 import re

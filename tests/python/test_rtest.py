@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """R-test from Python: identification of the independent implementation's file against its truth."""
 
 import json

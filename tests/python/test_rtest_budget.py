@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The uncertainty budget of an R-test joint identification is the budget of the identification's
 own model, the location errors with the smooth error maps (diagnose/rtest_budget.hpp): one value
 per quantity. Sessions from the independent reference simulator (tests/reference/refsim):

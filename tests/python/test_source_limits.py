@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The size limits of the brief, on every hand-written library source: no file over 500 lines,
 no function over 150 (tests and the generated stub _core.pyi excepted).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The committed _core.pyi is what pybind11-stubgen (pinned) makes of the built extension."""
 
 import rotacal._stubgen as stubgen

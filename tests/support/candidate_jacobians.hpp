@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Test support: the candidate Jacobians of a diagnosis problem (the harmonic shortcut of
 // src/diagnose/candidate_jets.hpp) against Jets of every parameter of each candidate.

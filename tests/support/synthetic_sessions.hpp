@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Synthetic machines and sessions that several tests and benchmarks build alike: the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The runs of the measure -> compensate -> measure-again experiment (Flynn et al. 2016,

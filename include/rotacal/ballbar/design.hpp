@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Design of the single set-up ballbar test before the machine runs it: among pivot positions

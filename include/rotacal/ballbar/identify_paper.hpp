@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Flynn et al. (2016)'s identification chain, Sec. 3:

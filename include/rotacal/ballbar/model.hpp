@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The exact ballbar reading: the distance between the tool-side ball and the centre-pivot

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// A ballbar machine model as a `rotacal-model/1` document of kind "ballbar", and back: what a

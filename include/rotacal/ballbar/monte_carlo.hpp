@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Monte Carlo check of the joint fit's reported 1-sigma (GUM Supplement 1 style): simulate

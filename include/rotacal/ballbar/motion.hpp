@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The motion of the rotary axes at each sample of a ballbar session, read from its time and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// NC programs of a planned single set-up ballbar test (Flynn et al. 2016, Sec. 3.4).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Toolpath of the single set-up ballbar test (Flynn et al. 2016, Sec. 3): three sphere arcs at

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The ballbar problem: the one parameter layout and the one residual of every ballbar fit

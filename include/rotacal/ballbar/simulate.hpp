@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// A virtual machine with a ballbar: the exact reading for each commanded sample, plus

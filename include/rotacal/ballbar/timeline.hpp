@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The ballbar test program as a function of time. A transducer samples at its own rate while

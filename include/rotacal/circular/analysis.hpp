@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// ISO 230-4 results of ballbar circular tests (circular/plan.hpp) from a `rotacal-ballbar/1`

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Diagnosis of ISO 230-4 ballbar circular tests of the linear axes: which classic causes

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// ISO 230-4 circular tests of the linear axes with the ballbar: the plan (plane, centre,

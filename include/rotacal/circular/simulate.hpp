@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Simulated ballbar readings of the ISO 230-4 circular tests (circular/plan.hpp) on a machine

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The circular-test program (circular/plan.hpp) as a function of time: the counterpart of

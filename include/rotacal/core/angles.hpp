@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The angle constants of the library's sources, defined once: file-local copies of them clashed

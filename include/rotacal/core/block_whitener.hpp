@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// A block-diagonal ResidualWhitener: the residuals of a stacked fit (core/joint_fit.hpp) lie

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Typed exceptions. Bad input throws one of these with a message that names what was wrong

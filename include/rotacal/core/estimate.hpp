@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// What every fit reports, whatever the instrument: one estimate per parameter (value, 1 sigma,

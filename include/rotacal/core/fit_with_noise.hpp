@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The one feasible-GLS sequence of every instrument's joint fit (the ballbar's and the

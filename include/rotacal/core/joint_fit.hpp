@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The one joint-fit driver: parameters with names, units and plausible scales -> observability
@@ -79,6 +80,10 @@ struct JointFitSettings {
   std::shared_ptr<const ResidualWhitener> whitener;
   /// Stop when no free parameter moves by more than this fraction of its 1 sigma.
   double step_tolerance_sigma = 1e-6;
+  /// Accept a solution reached with a Jacobian from an earlier point while the shift that stale
+  /// Jacobian can leave is below this many sigma; 0: always end on a Jacobian evaluated at the
+  /// solution (small fits that must reach the minimum to round-off, fit/orthogonal_distance).
+  double stale_jacobian_sigma = 1e-2;
 };
 
 struct JointFitOutcome {

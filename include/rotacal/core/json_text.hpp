@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The one strict JSON reader behind every JSON file rotacal reads (model files, machine

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Lanes: a scalar that holds one quantity of four samples at once, so that a kinematic formula

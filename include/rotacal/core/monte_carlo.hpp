@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// What both instruments' Monte Carlo checks share: the noise of one draw (the fitted noise

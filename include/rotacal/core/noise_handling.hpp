@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// How a joint fit (ballbar or R-test) treats correlated residual noise.

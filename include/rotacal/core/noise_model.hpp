@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The residual noise as measured data have it: correlated in time (servo loops and sensor

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Named parameter blocks of a fit: the one place where a parameter vector's layout

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Tail probabilities for the model-adequacy and model-comparison tests of the diagnosis:

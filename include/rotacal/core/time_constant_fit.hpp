@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// A joint fit whose model has time constants (the log of one, unit "1": thermal_warmup,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The seam between a noise model and the joint fits: a linear map W applied to residuals and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The design engine's allocation: how many runs of each candidate measurement (for the touch

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Whether two effects can be told apart by any instrument at all, from the motion of the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The diagnosis of a ballbar session: the DiagnosisProblem for the exact ballbar model,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Diagnosis: show what the fitted model gets wrong, name the physical cause from the

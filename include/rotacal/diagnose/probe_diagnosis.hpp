@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The diagnosis of a touch-probe session: the DiagnosisProblem of the one probe problem

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Uncertainty budget of an R-test joint identification (rtest/identify_joint.hpp): the same

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The diagnosis of an R-test session: the DiagnosisProblem for the exact R-test reading,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Uncertainty budget of every identified location error, in the manner of the GUM (JCGM

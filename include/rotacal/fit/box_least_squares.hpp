@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Linear least squares with each unknown held within its bound: min_s sum_i w_i (d_i - (R s)_i)^2

@@ -1,8 +1,10 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Circle fits to 2-D points: the "Hyper" algebraic fit of Al-Sharadqah & Chernov (2009),
 /// which Flynn et al. (2016, Sec. 3.2) use for the centre of rotation, the plain Kasa fit it
-/// improves on, and a geometric (orthogonal distance) refinement with Ceres.
+/// improves on, and a geometric (orthogonal distance) refinement (Ceres' solver, or rotacal's
+/// joint-fit driver in a build with -DROTACAL_CERES_SOLVER=OFF).
 
 #include <Eigen/Core>
 #include <string>
@@ -22,8 +24,8 @@ struct CircleFit {
 };
 
 struct CircleFitOptions {
-  double sigma = 0.0;   ///< known 1-sigma noise of the points (same units); 0: estimate
-  bool refine = false;  ///< polish the algebraic solution by orthogonal distances (Ceres)
+  double sigma = 0.0;              ///< known 1-sigma noise of the points (same units); 0: estimate
+  bool refine = false;             ///< polish the algebraic solution by orthogonal distances
   double min_sagitta_ratio = 3.0;  ///< refuse arcs whose sagitta is below this x the scatter
   /// What the points are, put before every error message (e.g. "s.csv: test radial_A"), so a
   /// refusal names the data rather than only the fit.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Total-least-squares plane by SVD of the centred points (Flynn et al. 2016, Eq. 3): the

@@ -1,9 +1,11 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
-/// Least-squares sphere: algebraic start, geometric (orthogonal distance) refinement with
-/// Ceres. Flynn et al. (2016, Sec. 3.1) locate the ballbar's centre pivot this way from the
-/// three arcs at rotary zero; with the calibrated bar length as a fixed radius, because a free
-/// radius confounds the pivot height with the radius on the short YZ and ZX arcs.
+/// Least-squares sphere: algebraic start, geometric (orthogonal distance) refinement (Ceres'
+/// solver, or rotacal's joint-fit driver with -DROTACAL_CERES_SOLVER=OFF). Flynn et al. (2016,
+/// Sec. 3.1) locate the ballbar's centre pivot this way from the three arcs at rotary zero; with
+/// the calibrated bar length as a fixed radius, because a free radius confounds the pivot height
+/// with the radius on the short YZ and ZX arcs.
 
 #include <Eigen/Core>
 #include <optional>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The ballbar transducer protocol (docs/protocols.md): the host's commands, the text replies

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Binary framing shared by the ballbar stream and the probe stream (docs/protocols.md):

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// When an R-test pose is read: the timing the recorder and the virtual R-test agree on

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// R-test probe protocols (docs/protocols.md): three displacement probes behind one interface,

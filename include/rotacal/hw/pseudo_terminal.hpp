@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// A pseudo-terminal pair for virtual instruments: the instrument holds the master side, the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Recorders: read an instrument through a ByteTransport and write a session file as they go.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// What the ballbar stream and the R-test probe stream share (docs/protocols.md): the host's

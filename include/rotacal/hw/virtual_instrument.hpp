@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Virtual instruments: a ballbar and an R-test that open a pseudo-terminal and speak the

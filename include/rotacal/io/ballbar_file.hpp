@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// `rotacal-ballbar/1` and `rotacal-rtest/1` files (../shared/spec/formats.md): strict readers

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The `rotacal-model/1` kinds of a touch-probe identification ("probe") and of one

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Fitted machine models as `rotacal-model/1` JSON files (docs/model_file.md): the one reader

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The NC dialects rotacal writes programs in, and the options every NC program shares: the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The one rule by which every rotacal writer (C++ and Python) puts a file on disk.

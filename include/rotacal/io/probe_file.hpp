@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// `rotacal-probe/1` files (../shared/spec/formats.md, "Touch-probe session"): a strict reader

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Sessions as columns and back: what array front ends (numpy) exchange with the library.

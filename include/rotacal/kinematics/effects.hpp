@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The diagnosis catalogue of ../shared/spec/effects.md as exact extensions of the baseline

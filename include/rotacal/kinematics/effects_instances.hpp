@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The catalogue's table and tool motion (effects.hpp: table_pose, table_point, tool_position,

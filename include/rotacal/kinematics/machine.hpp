@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Kinematics of any 5-axis machine with two rotary axes (table-table, head-table, head-head)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// What a 5-axis machine is, as ../shared/spec/formats.md ("Any 5-axis machine") describes

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// A machine as every instrument sees it: its kinematics, its location errors, and the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The parameter blocks every instrument's problem shares (core/parameter_layout.hpp): the 8

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Rigid rotations used by every kinematic formula in rotacal: rotation about an arbitrary line

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// One identification from several sessions of one machine (issue 31, item 5): ballbar,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// One identification from several sessions (multi/identify.hpp) as a `rotacal-model/1`

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Design of the touch-probe test before the machine runs it (`rotacal design probe`): the

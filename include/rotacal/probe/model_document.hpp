@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// A touch-probe identification (the joint fit, probe/identify.hpp) as a `rotacal-model/1`

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The probing program of a touch-probe session (issue 31, item 1: `rotacal plan probe`), and

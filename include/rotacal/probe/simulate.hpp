@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Touch-probe simulator (issue 31, item 2): the touch geometry of ../shared/spec/formats.md

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The one model of a touch (../shared/spec/formats.md, "Touch-probe session"; effects.md,

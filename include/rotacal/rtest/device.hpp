@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The R-test device (Oyama & Ibaraki, Sec. 3.1-3.2): a precision sphere in the spindle and three

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The error map per angle (Oyama Sec. 5.2, Figs. 6-7) from either identification, its JSON/CSV

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Position-dependent geometric errors of a B/C tilting-rotary table (Oyama & Ibaraki, Sec. 2.3):

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Position-dependent geometric errors by the paper's two-step method (Oyama & Ibaraki, Sec. 4):

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The R-test reading, one definition (Oyama & Ibaraki, Eq. 4, in the table frame), used by

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// A joint R-test identification as a `rotacal-model/1` document of kind "rtest-joint": what

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Prediction with a fitted R-test joint model (identify_joint.hpp), e.g. one read back from a

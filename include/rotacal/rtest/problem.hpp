@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// The R-test problem: the one parameter layout and the one residual model of every R-test fit

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// R-test simulator (Oyama & Ibaraki, Sec. 3.3): the sphere follows each sensor nest while the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// Plausibility of a session before any fit: the commanded positions, angles, pivot or nests

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// In-memory touch-probe session: what a `rotacal-probe/1` file holds

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 /// \file
 /// In-memory measurement sessions: what a `rotacal-ballbar/1` or `rotacal-rtest/1` file holds

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The ``rotacal`` command line (``python -m rotacal``, the ``rotacal`` console script): a
 package of one module per command group over the library; the library never imports it.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """``rotacal circular plan|simulate|virtual|record|analyze``: ISO 230-4 circular tests of the
 linear axes with the ballbar (the library: rotacal.circular)."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """``rotacal export`` (the identified location errors as a controller's kinematic parameters,
 LinuxCNC compensation tables, ISG sphere centres) and ``rotacal compensate`` (a compensated NC
 program, and its verification in simulation)."""

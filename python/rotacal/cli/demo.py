@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """``rotacal demo`` (the whole job on a simulated machine) and ``rotacal table2`` (Flynn et
 al.'s measured Table 2 against the simulated measure -> compensate -> measure-again chain)."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """``rotacal design ballbar|rtest``: the test set-up with the smallest predicted uncertainty,
 or the added test that separates two effects a session could not tell apart."""
 

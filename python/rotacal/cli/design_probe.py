@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """``rotacal design probe``: the touch probe's poses with the smallest predicted uncertainty at a
 number of touches, against ``plan probe``'s default poses, or the poses to add to a probe
 session to separate two effects (docs/design.md). C++ computes (include/rotacal/probe/design.hpp,

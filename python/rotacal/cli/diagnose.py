@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """``rotacal diagnose`` (what the model gets wrong and why) and ``rotacal report`` (the HTML
 report of a session, rotary-axis test or ISO 230-4 circular tests)."""
 

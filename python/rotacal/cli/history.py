@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """``rotacal history add|show|list``: the calibration history of physical machines."""
 
 from __future__ import annotations

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """``rotacal identify`` (location errors of a session, their uncertainty budget, the model file
 and the history entry) and ``rotacal predict`` (a session predicted by a model file)."""
 

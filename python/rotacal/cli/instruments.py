@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """``rotacal virtual ballbar|rtest`` (a virtual instrument on a pseudo-terminal, for testing
 recorders without a machine) and ``rotacal record ballbar|rtest`` (a session from an
 instrument on a serial port)."""

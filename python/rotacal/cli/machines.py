@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """``rotacal machines``: list the built-in machines, or show one (built-in or file)."""
 
 from __future__ import annotations

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """What every command of the CLI shares: the exit codes, the epilog that states them, the
 message line on stderr, and one argparse type per kind of option value.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The ``rotacal`` command line: the parser built from the command modules, and ``main``,
 which runs a command and turns every failure into a one-line message and its exit code.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """``rotacal plan``: the NC program of a test (and its commanded rows as a session template)."""
 
 from __future__ import annotations

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The touch probe on a sphere on the command line (issue 31): ``rotacal simulate probe``, and
 what ``rotacal identify`` does with a rotacal-probe/1 session (``rotacal diagnose`` takes it as
 it is). C++ computes (include/rotacal/probe, rotacal.probe); this module only composes."""

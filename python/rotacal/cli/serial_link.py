@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The two ends of a serial line, shared by ``rotacal virtual``, ``rotacal record`` and
 ``rotacal circular virtual|record``: the link's options, the faults a virtual instrument acts
 out, serving a virtual instrument until stopped, and the exit code of a recording."""

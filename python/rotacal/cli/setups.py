@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Argument groups that several commands share, and what they read: the ballbar test set-up
 (plan, simulate, design, compensate, virtual, record), the simulated machine, the R-test
 pattern, the session a command analyses, and the history store."""

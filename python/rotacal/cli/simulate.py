@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """``rotacal simulate ballbar|rtest``: a measurement on a simulated machine with errors."""
 
 from __future__ import annotations

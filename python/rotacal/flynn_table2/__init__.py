@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Flynn et al. (2016) Table 2 as a real-data case: what the simulation of the paper's
 measure -> compensate -> measure-again chain predicts, which measured post-compensation values
 it misses, and which effects (constant in both runs, or changed between the runs) of which

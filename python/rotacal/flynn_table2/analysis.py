@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Analyse measured before/after identifications against the simulated chain: which values
 fall outside the prediction, which kind of cause can produce each, the causes ranked, those
 the 8 values cannot tell apart, the extended model and a sweep of the assumptions."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """What the paper does not give (the assumptions) and the causes the analysis tries: every
 sized catalogue effect constant in both runs, and the changes between the runs, each with its
 plausible size."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The experiment as it was run (Flynn et al. Sec. 4), simulated: measure -> identify ->
 compensate -> measure again -> identify."""
 

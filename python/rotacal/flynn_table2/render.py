@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The analysis in words: its conclusions, and a plain-text rendering of the result."""
 
 from __future__ import annotations

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """One scenario of the analysis: the Monte Carlo prediction of the after-values, each cause's
 response, the one-at-a-time fits and the extended model (greedy, sizes bounded by their
 plausible half-widths); and which raw test separates causes the 8 values cannot."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Table 2 of Flynn et al. (2016), as printed: the shipped file read strictly, each number as
 the paper prints it."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Calibration history: every identification of a physical machine, and every correction
 loaded into its controller, kept in a store, so that the drift of each location error can be
 followed over months (docs/history.md).

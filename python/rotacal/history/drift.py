@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The history of a machine's location errors: the machine's own value over time (measured +
 compensation loaded), the changes between consecutive calibrations flagged against their
 expanded uncertainty or a tolerance, and the drift per month."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The entries of a calibration history: what an identification or a correction stores,
 checked (machine id, date, note, estimates, correction amounts)."""
 

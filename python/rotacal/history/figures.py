@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The history of a machine as figures: a PNG of each location error over time, an HTML
 section for `rotacal report --history`, a page for `history show --plot`."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Opening a calibration history store: a SQLite file (created, switched to WAL and full sync)
 or a PostgreSQL database by its ``postgresql://`` URL (psycopg 3); the default location."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The calibration history's schema: its version and the migrations that reach it."""
 
 SCHEMA_VERSION = 2

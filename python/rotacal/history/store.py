@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The calibration history store: its schema migrated (schema.py), and the reads and writes of
 identifications and corrections, on SQLite or PostgreSQL through one code path (the SQL is the
 common subset; a small dialect sets the placeholders and two column types)."""

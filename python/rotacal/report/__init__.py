@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Self-contained HTML reports (no network needed to open them): set-up, location errors in
 an ISO 230-7 style table, ballbar polar plots of measured against model with the deviation
 magnified, R-test error maps, residual plots, and the diagnosis with before/after plots.

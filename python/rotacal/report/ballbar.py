@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The report of a ballbar session: set-up, location errors (of the model the diagnosis
 extended, where it found an effect), noise model and budget, polar plots of measured against
 model with the deviation magnified, residuals and the diagnosis."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The report of ISO 230-4 circular tests of the linear axes: G per run, G(b) and H per cw/ccw
 pair, the polar plot and the named causes."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The page of a report: self-contained HTML (figures as PNG data URIs, no network needed to
 open it), every text from a file escaped, written by the output rule."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The report of a touch-probe session (set-up, location errors of the model the diagnosis
 extended where it found an effect, the sphere, noise model and budget, residuals per touch and
 the diagnosis) and of one identification from several sessions (the shared location errors

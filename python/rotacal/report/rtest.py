@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The report of an R-test session: set-up, location errors, the error maps of the tilt and
 the rotary axis against their angles with 1-sigma bands (Oyama & Ibaraki Sec. 5.2),
 residuals and the diagnosis."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The parts of a report every instrument's page shares: the words for the location errors
 and the machine, the ISO 230-7 table, the effects fitted along, the noise model and
 uncertainty budget, the diagnosis, and the residual and harmonic plots."""

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The scoring of the circular-test diagnosis: visibility at plausible sizes, F-test and BIC
 // of an entry against the current model (the engine's score_columns), one by one or from a pool
 // of every variant.

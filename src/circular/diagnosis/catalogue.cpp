@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The catalogue of the circular-test diagnosis (diagnosis.hpp): its entries, their parameters
 // with units, and the cause each one names.
 #include "diagnosis_detail.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The columns of the circular-test diagnosis: the readings of every run as rows, the runs'
 // baselines (centre offset and radius), and each entry's first-order change of the reading per
 // unit parameter.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Cross-validation of the circular-test diagnosis: blocked folds within each run, and the CV RMS
 // of a model refitted without each fold (the engine's blocked_cv_rms_um, refitted with each
 // run's own baseline).

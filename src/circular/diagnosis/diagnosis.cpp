@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Diagnosis of ballbar circular tests (diagnosis.hpp): the search. Its catalogue, columns, fits,
 // scoring and cross-validation are the other files of this folder (diagnosis_detail.hpp); here
 // the forward selection with the thresholds of the rotary diagnosis, and the backward

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Internal to src/circular: the parts of the circular-test diagnosis (diagnosis.hpp) and the
 // search that puts them together. catalogue.cpp: the entries, their parameters and causes;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The final model of the circular-test diagnosis: GLS under the noise of its residuals, each
 // finding's parameters with 1-sigma (linear ones from the whitened Jacobian, nonlinear ones
 // from their profile, whose spread is carried into the linear ones), its gain, and why each

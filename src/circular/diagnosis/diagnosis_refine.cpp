@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The nonlinear parameters of the circular-test diagnosis' findings (a spike's time constant,
 // a reversal delay): profiled, every linear parameter refitted at each trial; golden section
 // for ln tau, a scan of the delay's staircase profile.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The fits of the circular-test diagnosis: whitening by the noise model, least squares over the
 // runs' baselines block by block (GLS), and the noise of the residuals.
 #include <Eigen/QR>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Location errors into controllers' kinematic parameters: the controllers by name, the export
 // input of a model file, and the export of each controller (one file each in this folder).
 #include "rotacal/io/controller_export.hpp"

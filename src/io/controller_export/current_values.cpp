@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The controller's current values, from its own text (a LinuxCNC HAL file, a SINUMERIK MPF) or
 // from the small JSON form (docs/controller_exports.md).
 #include <algorithm>

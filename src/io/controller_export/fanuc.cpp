@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The FANUC export (mapping only): the 30i tool centre point parameters 19700-19705. HEIDENHAIN
 // and FANUC do not publish their kinematic formulas: the export is the mapping of each error
 // to the parameters that hold it, as line-position changes in machine axes.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The HEIDENHAIN export (mapping only): the Trans rows of the TNC kinematics table.
 #include "shared.hpp"
 

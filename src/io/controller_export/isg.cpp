@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The ISG/Beckhoff export: the universal kinematic (ID 91).
 #include "shared.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The LinuxCNC export: the HAL pins of xyzac-trt-kins / xyzbc-trt-kins.
 #include "shared.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The part of the controller exports that every controller shares (shared.hpp).
 #include "shared.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // The part of the controller exports that every controller shares (controller_export/*.cpp):
 // the axis lines as linear maps of the location errors, one parameter's corrected value and

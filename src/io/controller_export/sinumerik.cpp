@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The SINUMERIK export: the orientable toolholder $TC_CARR, kinematic type P.
 #include "shared.hpp"
 

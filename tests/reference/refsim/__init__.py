@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """refsim: an independent reference simulator of shared/spec/formats.md and effects.md.
 
 numpy only; written from the spec text, docs/machines.md, docs/effects.md, docs/noise_model.md.

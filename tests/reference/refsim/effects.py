@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The effects catalogue (shared/spec/effects.md, plus docs/effects.md additions): ids, their
 parameter vectors, which machines they apply to, and their small building blocks.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Instrument readings (formats.md "Instruments on any machine", "Touch-probe session")."""
 
 from __future__ import annotations

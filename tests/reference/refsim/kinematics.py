@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Forward kinematics of formats.md "Any 5-axis machine", with the effects of effects.md.
 
 Every rigid motion is a (N, 4, 4) homogeneous matrix, vectorised over poses:

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Machines of formats.md "Any 5-axis machine": rotary axes, built-ins, location-error names.
 
 Written from /work/shared/spec/formats.md and docs/machines.md only (independent of rotacal).

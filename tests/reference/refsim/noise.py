@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Noise generators (docs/noise_model.md kinds), all from a seeded numpy Generator.
 
 Streams: one per group label (ballbar test, R-test set-up); rows keep their order within a stream.

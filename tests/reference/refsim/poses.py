@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Simple, explicit pose sets for the tests (not rotacal's planner).
 
 - ballbar: Flynn et al.'s single set-up (sphere_xy/yz/zx arcs at rotary 0, radial_R / axial_R

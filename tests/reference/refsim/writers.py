@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Writers (and a minimal reader) of the three session formats of formats.md, and truth JSON
 like /work/shared/data/*.truth.json (keys errors, pivot_actual / sphere_actual / nests, effects,
 noise_um; probe_zeros for an R-test)."""
