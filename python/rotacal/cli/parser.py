@@ -22,6 +22,7 @@ from typing import Sequence
 from .. import _core
 from ..command_files import check_command_files
 from . import (
+    batch,
     circular,
     controller,
     demo,
@@ -52,6 +53,7 @@ MODULES = (
     circular,
     probe,
     design_probe,
+    batch,
 )
 
 # The order `rotacal --help` lists the commands in.
@@ -73,6 +75,7 @@ ORDER = (
     "table2",
     "demo",
     "circular",
+    "batch",
 )
 
 
