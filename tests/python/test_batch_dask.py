@@ -26,11 +26,15 @@ import rotacal  # noqa: E402
 from rotacal.batch import BatchError, run, stream  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
+REPO = HERE.parents[1]
 BALLBAR = ("ballbar_ac_random.csv", "ballbar_ac_table2.csv")
-# The workers import rotacal where this process does, and batch_grid from this folder.
+# The workers import rotacal where this process does, batch_grid from this folder, and the
+# confusion grid's modules from bench/ and tests/reference/.
+PATHS = [str(Path(rotacal.__file__).resolve().parents[1]), str(HERE)]
+PATHS += [str(REPO / "bench"), str(REPO / "tests" / "reference")]
 ENV = dict(
     os.environ,
-    PYTHONPATH=os.pathsep.join([str(Path(rotacal.__file__).resolve().parents[1]), str(HERE)]),
+    PYTHONPATH=os.pathsep.join(PATHS),
     OMP_NUM_THREADS="1",
     DASK_DISTRIBUTED__WORKER__DAEMON="False",
 )
@@ -111,6 +115,34 @@ def local(grid):
 
 def test_a_grid_slice_on_dask_gives_the_local_results(cluster, grid, local):
     assert run(batch_grid.noisy_identification, grid, seed=3, executor=cluster.address) == local
+
+
+def test_a_confusion_grid_slice_on_dask_gives_the_local_results(cluster):
+    """bench/diagnosis_confusion.py's sessions (refsim's readings, rotacal's diagnosis): the
+    same decisions, weights and z to the last bit, wherever they ran (the timings aside)."""
+    sys.path[:0] = PATHS[2:]
+    import diagnosis_confusion as bench
+    from confusion import outcome
+    from confusion.setup import tempdir
+
+    cfg = {
+        **bench.SMOKE,
+        "instruments": ["ballbar"],
+        "entries": ["gravity_sag"],
+        "draws": 3,
+        "null": 2,
+        "seed": 29,
+    }
+    _, tasks = bench.plan(outcome.process_cache(tempdir()), cfg)
+    assert len(tasks) == 10
+
+    def untimed(results):
+        assert all(ok for ok, _ in results), results
+        return [{k: v for k, v in r.items() if k not in ("time_ms", "cpu_ms")} for _, r in results]
+
+    local = untimed(run(outcome.work, tasks, jobs=1))
+    assert untimed(run(outcome.work, tasks, executor=cluster.address, chunk=2)) == local
+    assert any(r["findings"] for r in local)  # a real diagnosis, not empty records
 
 
 def test_a_worker_killed_mid_run_leaves_every_item_exactly_once(cluster, grid, local):
