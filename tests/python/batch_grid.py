@@ -23,3 +23,10 @@ def noisy_identification(item: tuple, seed: np.random.SeedSequence) -> dict:
 def grid(files: list, n: int) -> list:
     """n items over the files, two noise levels."""
     return [(str(files[i % len(files)]), (0.5, 2.0)[i % 2]) for i in range(n)]
+
+
+def process_id(item, seed) -> int:
+    """Which process ran the item."""
+    import os
+
+    return os.getpid()

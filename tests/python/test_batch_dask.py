@@ -117,6 +117,12 @@ def test_a_grid_slice_on_dask_gives_the_local_results(cluster, grid, local):
     assert run(batch_grid.noisy_identification, grid, seed=3, executor=cluster.address) == local
 
 
+def test_dask_scheduler_address_in_the_environment_is_the_default(cluster, monkeypatch):
+    monkeypatch.setenv("DASK_SCHEDULER_ADDRESS", cluster.address)
+    pids = {pid for _, pid in run(batch_grid.process_id, list(range(8)), chunk=1)}
+    assert os.getpid() not in pids and pids <= {w.pid for w in cluster.workers}, pids
+
+
 def test_a_confusion_grid_slice_on_dask_gives_the_local_results(cluster):
     """bench/diagnosis_confusion.py's sessions (refsim's readings, rotacal's diagnosis): the
     same decisions, weights and z to the last bit, wherever they ran (the timings aside)."""
