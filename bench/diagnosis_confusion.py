@@ -49,6 +49,7 @@ true-covariance GLS 224 of 246).
   PYTHONPATH=build/dev/python python3 bench/diagnosis_confusion.py --smoke
   ... --machines AC-trt,BC-trt --noise white,ar1_0.9 --amplitudes 3,10 --draws 3 --null 30 --json out.json
   ... --tables-from out.json        (re-make the tables of a run)
+  ... --results run.jsonl           (each session as it finishes; a rerun resumes)
   ... --jobs 2 | --scheduler tcp://host:8786   (local threads, default one per core; a Dask
       cluster whose workers import rotacal, tests/reference and bench: docs/batch.md)
 """
@@ -115,6 +116,12 @@ def parse_args(argv) -> argparse.Namespace:
         "--scheduler",
         metavar="ADDRESS",
         help="a Dask scheduler (default $DASK_SCHEDULER_ADDRESS, else local threads)",
+    )
+    p.add_argument(
+        "--results",
+        metavar="RUN.jsonl",
+        help="stream each session's record to this file as it finishes; a rerun of the same "
+        "plan computes only the sessions not in it yet (the whole grid in several runs)",
     )
     p.add_argument("--no-cells", action="store_true", help="leave out the per-cell table")
     p.add_argument("--tables-from", help="print the tables of a --json file and stop")
@@ -191,21 +198,35 @@ def plan(cache: outcome.CellCache, cfg: dict) -> tuple[list, list]:
     return entries, tasks
 
 
-def run(tasks: list, executor, jobs: int | None) -> list:
+def task_key(t: dict) -> str:
+    """A session's key in a --results file: its cell and draw."""
+    return "/".join(str(t[k]) for k in ("machine", "instrument", "entry", "noise", "amp", "draw"))
+
+
+def run(tasks: list, executor, jobs: int | None, results=None) -> list:
     """Every task, in order of completion (rotacal.batch: local threads, a Dask cluster), with a
-    progress line on stderr. A session that fails stops the bench: it is a bug, not data."""
+    progress line on stderr; with ``results`` (a rotacal.batch.ResultsFile) the sessions it
+    holds are taken from it and the others added to it as they finish. A session that fails
+    stops the bench: it is a bug, not data."""
     from rotacal.batch import stream
 
-    out, t0, last = [], time.time(), 0.0
-    for _, ok, rec in stream(outcome.work, tasks, seed=0, executor=executor, jobs=jobs):
+    keys = [task_key(t) for t in tasks]
+    held = results.records if results is not None else {}
+    done = {i for i, k in enumerate(keys) if k in held}
+    if done:
+        print(f"[confusion] {len(done)} sessions from {results.path}", file=sys.stderr)
+    out, t0, last = [held[keys[i]]["result"] for i in sorted(done)], time.time(), 0.0
+    for i, ok, rec in stream(outcome.work, tasks, seed=0, executor=executor, jobs=jobs, skip=done):
         if not ok:
             raise RuntimeError(f"a session failed: {rec}")
+        if results is not None:
+            results.add(keys[i], True, rec)
         out.append(rec)
         now = time.time()
         if now - last > 5.0 or len(out) == len(tasks):
             last = now
             el = now - t0
-            eta = el / len(out) * (len(tasks) - len(out))
+            eta = el / max(1, len(out) - len(done)) * (len(tasks) - len(out))
             wrong = sum(r["outcome"] in ("wrong", "bad_group") for r in out)
             print(
                 f"[confusion] {len(out)}/{len(tasks)} sessions, {el:.0f} s, eta {eta:.0f} s, wrong {wrong}",
@@ -229,7 +250,13 @@ def main(argv=None) -> int:
         file=sys.stderr,
         flush=True,
     )
-    records = run(tasks, a.scheduler, a.jobs)
+    if a.results:
+        from rotacal.batch import ResultsFile
+
+        with ResultsFile(a.results, {"command": "diagnosis_confusion", "options": cfg}) as held:
+            records = run(tasks, a.scheduler, a.jobs, held)
+    else:
+        records = run(tasks, a.scheduler, a.jobs)
 
     def key(r):
         return (r["machine"], r["instrument"], r["entry"] or "", r["noise"], r["amp"], r["draw"])
