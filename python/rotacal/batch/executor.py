@@ -9,7 +9,8 @@
 - Any ``concurrent.futures.Executor`` (a Dask client's ``get_executor()``, a process pool,
   mpi4py's): used as it is, and left open.
 
-Work goes out in chunks (tens of items a task), and every item draws its random numbers from
+Work goes out to a cluster or a process pool in chunks (tens of items a task; to threads one by
+one, as cheap and streaming each result as it is done), and every item draws its random numbers from
 its own child of ``numpy.random.SeedSequence(root).spawn(n)``, chosen by the item's index in
 the whole batch: results are bit-identical whatever the backend, the chunking and the order.
 """
@@ -101,7 +102,8 @@ def _workers_of(executor: cf.Executor) -> int:
 
 
 def chunk_size(n_items: int, workers: int) -> int:
-    """Items a task: tens where the batch is large, fewer where it would leave workers idle."""
+    """Items a task off this process: tens where the batch is large, fewer where it would leave
+    workers idle."""
     return max(1, min(MAX_CHUNK, n_items // (CHUNKS_PER_WORKER * max(1, workers))))
 
 
@@ -150,7 +152,10 @@ def stream(
     if not todo:
         return
     with opened(executor, jobs) as (ex, workers):
-        size = chunk or chunk_size(len(todo), workers)
+        # Threads share the process: a task costs some 18 us, not worth a chunk, and an item
+        # alone streams its result (and its resume point) as soon as it is done.
+        local = isinstance(ex, cf.ThreadPoolExecutor)
+        size = chunk or (1 if local else chunk_size(len(todo), workers))
         futures = [ex.submit(run_chunk, fn, todo[k : k + size]) for k in range(0, len(todo), size)]
         try:
             for f in cf.as_completed(futures):
