@@ -50,13 +50,15 @@ true-covariance GLS 224 of 246).
   PYTHONPATH=build/dev/python python3 bench/diagnosis_confusion.py --smoke
   ... --machines AC-trt,BC-trt --noise white,ar1_0.9 --amplitudes 3,10 --draws 3 --null 30 --json out.json
   ... --tables-from out.json        (re-make the tables of a run)
+  ... --results run.jsonl           (each session as it finishes; a rerun resumes)
+  ... --jobs 2 | --scheduler tcp://host:8786   (local threads, default one per core; a Dask
+      cluster whose workers import rotacal, tests/reference and bench: docs/batch.md)
 """
 
 from __future__ import annotations
 
 import argparse
 import json
-import multiprocessing
 import os
 import sys
 import time
@@ -67,7 +69,7 @@ sys.path.insert(0, str(HERE.parent / "tests" / "reference"))
 sys.path.insert(0, str(HERE))
 
 from confusion import report  # noqa: E402
-from confusion.outcome import CellCache, run_session  # noqa: E402
+from confusion import outcome  # noqa: E402
 from confusion.setup import motion_only_entries, tempdir  # noqa: E402
 from confusion.stats import NOISE_KINDS  # noqa: E402
 
@@ -80,7 +82,6 @@ SMOKE = {
     "draws": 2,
     "null": 4,
 }
-CACHE: CellCache | None = None
 
 
 def parse_args(argv) -> argparse.Namespace:
@@ -109,7 +110,20 @@ def parse_args(argv) -> argparse.Namespace:
     )
     p.add_argument("--seed", type=int, default=29)
     p.add_argument("--json", help="write every session's outcome (and the amplitudes) to this file")
-    p.add_argument("--jobs", type=int, default=1, choices=(1, 2))
+    p.add_argument(
+        "--jobs", type=int, help="local worker threads (rotacal.batch; default one per core)"
+    )
+    p.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="a Dask scheduler (default $DASK_SCHEDULER_ADDRESS, else local threads)",
+    )
+    p.add_argument(
+        "--results",
+        metavar="RUN.jsonl",
+        help="stream each session's record to this file as it finishes; a rerun of the same "
+        "plan computes only the sessions not in it yet (the whole grid in several runs)",
+    )
     p.add_argument("--no-cells", action="store_true", help="leave out the per-cell table")
     p.add_argument("--tables-from", help="print the tables of a --json file and stop")
     a = p.parse_args(argv)
@@ -135,7 +149,7 @@ def parse_args(argv) -> argparse.Namespace:
     return a
 
 
-def plan(cache: CellCache, cfg: dict) -> tuple[list, list]:
+def plan(cache: outcome.CellCache, cfg: dict) -> tuple[list, list]:
     """(entries with their amplitudes, tasks): the hidden-effect cells' draws, then the nulls."""
     entries, tasks = [], []
     combos = [(m, i) for m in cfg["machines"] for i in cfg["instruments"]]
@@ -185,57 +199,65 @@ def plan(cache: CellCache, cfg: dict) -> tuple[list, list]:
     return entries, tasks
 
 
-def _work(task: dict) -> dict:
-    import rotacal
+def task_key(t: dict) -> str:
+    """A session's key in a --results file: its cell and draw."""
+    return "/".join(str(t[k]) for k in ("machine", "instrument", "entry", "noise", "amp", "draw"))
 
-    return run_session(CACHE, task, rotacal.diagnose)
 
+def run(tasks: list, executor, jobs: int | None, results=None) -> list:
+    """Every task, in order of completion (rotacal.batch: local threads, a Dask cluster), with a
+    progress line on stderr; with ``results`` (a rotacal.batch.ResultsFile) the sessions it
+    holds are taken from it and the others added to it as they finish. A session that fails
+    stops the bench: it is a bug, not data."""
+    from rotacal.batch import stream
 
-def run(tasks: list, jobs: int) -> list:
-    """Every task, in order of completion, with a progress line on stderr."""
-    out, t0, last = [], time.time(), 0.0
-    if jobs > 1:
-        pool = multiprocessing.get_context("fork").Pool(jobs)
-        it = pool.imap_unordered(_work, tasks, chunksize=2)
-    else:
-        pool, it = None, map(_work, tasks)
-    for rec in it:
+    keys = [task_key(t) for t in tasks]
+    held = results.records if results is not None else {}
+    done = {i for i, k in enumerate(keys) if k in held}
+    if done:
+        print(f"[confusion] {len(done)} sessions from {results.path}", file=sys.stderr)
+    out, t0, last = [held[keys[i]]["result"] for i in sorted(done)], time.time(), 0.0
+    for i, ok, rec in stream(outcome.work, tasks, seed=0, executor=executor, jobs=jobs, skip=done):
+        if not ok:
+            raise RuntimeError(f"a session failed: {rec}")
+        if results is not None:
+            results.add(keys[i], True, rec)
         out.append(rec)
         now = time.time()
         if now - last > 5.0 or len(out) == len(tasks):
             last = now
             el = now - t0
-            eta = el / len(out) * (len(tasks) - len(out))
+            eta = el / max(1, len(out) - len(done)) * (len(tasks) - len(out))
             wrong = sum(r["outcome"] in ("wrong", "bad_group") for r in out)
             print(
                 f"[confusion] {len(out)}/{len(tasks)} sessions, {el:.0f} s, eta {eta:.0f} s, wrong {wrong}",
                 file=sys.stderr,
                 flush=True,
             )
-    if pool is not None:
-        pool.close()
-        pool.join()
     return out
 
 
 def main(argv=None) -> int:
-    global CACHE
     a = parse_args(sys.argv[1:] if argv is None else argv)
     if a.tables_from:
         print(report.tables(json.loads(Path(a.tables_from).read_text()), per_cell=not a.no_cells))
         return 0
     cfg = a.cfg
     t0 = time.time()
-    CACHE = CellCache(tempdir())
-    entries, tasks = plan(CACHE, cfg)
+    cache = outcome.process_cache(tempdir())
+    entries, tasks = plan(cache, cfg)
     print(
         f"[confusion] {len(tasks)} sessions planned ({len(entries)} entries) in {time.time() - t0:.1f} s",
         file=sys.stderr,
         flush=True,
     )
-    for st in CACHE.setups.values():
-        _ = st.template  # read the template files before forking
-    records = run(tasks, a.jobs)
+    if a.results:
+        from rotacal.batch import ResultsFile
+
+        with ResultsFile(a.results, {"command": "diagnosis_confusion", "options": cfg}) as held:
+            records = run(tasks, a.scheduler, a.jobs, held)
+    else:
+        records = run(tasks, a.scheduler, a.jobs)
 
     def key(r):
         return (r["machine"], r["instrument"], r["entry"] or "", r["noise"], r["amp"], r["draw"])
@@ -249,6 +271,7 @@ def main(argv=None) -> int:
         "records": records,
         "wall_s": time.time() - t0,
         "jobs": a.jobs,
+        "scheduler": a.scheduler,
         "cpu_count": os.cpu_count(),
     }
     if a.json:

@@ -5,6 +5,7 @@ the coverage of the parameters of a right finding."""
 from __future__ import annotations
 
 import math
+import threading
 import time
 
 import numpy as np
@@ -64,13 +65,19 @@ class CellCache:
     def __init__(self, workdir):
         self.workdir = workdir
         self.setups, self.entries, self.oracles, self.clean, self.gls = {}, {}, {}, {}, {}
+        # A set-up writes refsim's file and reads it back: one thread at a time. The other
+        # caches are pure: two threads filling one entry at once both compute the same values.
+        self._setup_lock = threading.Lock()
 
     def setup(self, machine: str, instrument: str) -> Setup:
         key = (machine, instrument)
-        if key not in self.setups:
-            self.setups[key] = (ProbeSetup if instrument == "probe" else Setup)(
-                machine, instrument, self.workdir
-            )
+        with self._setup_lock:
+            if key not in self.setups:
+                st = (ProbeSetup if instrument == "probe" else Setup)(
+                    machine, instrument, self.workdir
+                )
+                _ = st.template  # read the template file before any thread uses the set-up
+                self.setups[key] = st
         return self.setups[key]
 
     def entry(self, st: Setup, eid: str) -> dict:
@@ -103,6 +110,31 @@ class CellCache:
         if key not in self.clean:
             self.clean[key] = st.reading({eid: params})
         return self.clean[key]
+
+
+_CACHE: CellCache | None = None
+_CACHE_LOCK = threading.Lock()
+
+
+def process_cache(workdir=None) -> CellCache:
+    """This process's cache: the one the bench planned with, or (a Dask or spawned worker) a new
+    one in a folder of its own; its values are the same, being computed from the same seeds."""
+    global _CACHE
+    with _CACHE_LOCK:
+        if _CACHE is None:
+            from .setup import tempdir
+
+            _CACHE = CellCache(workdir or tempdir())
+        return _CACHE
+
+
+def work(task: dict, seed=None) -> dict:
+    """One batch item (rotacal.batch): the session of ``task``. Its random stream is the task's
+    own (stable_int of the cell and draw, as before the batch module), not ``seed``'s, so that a
+    run stays comparable, session by session, with the bench's earlier --json files."""
+    import rotacal
+
+    return run_session(process_cache(), task, rotacal.diagnose)
 
 
 def run_session(cache: CellCache, task: dict, diagnose) -> dict:

@@ -136,6 +136,16 @@ COMMANDS: dict[tuple[str, ...], Files] = {
     ("circular", "virtual"): Files((MACHINE,), (arg("--truth"),)),
     ("circular", "record"): Files((MACHINE, arg("--port")), (OUTPUT,)),
     ("circular", "analyze"): Files((arg("FILE", "file"),), (arg("--plot"),)),
+    ("batch", "identify"): Files(
+        (arg("FILE", "file"), arg("--budget-sizes")),
+        (arg("--results"),),
+        writes_store=lambda a: bool(a.store),
+    ),
+    ("batch", "diagnose"): Files(
+        (arg("FILE", "file"), arg("--budget-sizes")),
+        (arg("--results"),),
+        writes_store=lambda a: bool(a.store),
+    ),
 }
 
 

@@ -217,6 +217,24 @@ TEMPLATES = {
         ]
     ],
     ("circular", "analyze"): [["circular", "analyze", "{FILE}", "--plot", "{--plot}"]],
+    **{
+        ("batch", kind): [
+            [
+                "batch",
+                kind,
+                "{FILE}",
+                "--budget-sizes",
+                "{--budget-sizes}",
+                "--results",
+                "{--results}",
+                "--store",
+                "--db",
+                "{--db}",
+                "--no-progress",
+            ]
+        ]
+        for kind in ("identify", "diagnose")
+    },
 }
 
 

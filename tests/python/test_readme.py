@@ -26,11 +26,15 @@ def blocks() -> list[tuple[str, str]]:
 
 def test_readme_is_for_users():
     text = README.read_text()
-    assert len(text.encode()) <= 30 * 1024, f"README.md is {len(text.encode())} bytes (at most 30 KB)"
+    assert len(text.encode()) <= 30 * 1024, (
+        f"README.md is {len(text.encode())} bytes (at most 30 KB)"
+    )
     long = [i + 1 for i, line in enumerate(text.splitlines()) if len(line) > 400]
     assert not long, f"README.md lines over 400 characters: {long}"
     kinds = {k for k, _ in blocks()}
-    assert kinds <= set(KINDS), f"a README block of a kind this test cannot run: {kinds - set(KINDS)}"
+    assert kinds <= set(KINDS), (
+        f"a README block of a kind this test cannot run: {kinds - set(KINDS)}"
+    )
     assert {"sh", "python", "cpp"} <= kinds
 
 
@@ -108,7 +112,16 @@ def test_readme_cpp_block_builds_and_runs(clone, tmp_path):
     )
     build = tmp_path / "build"
     for cmd in (
-        ["cmake", "-S", str(tmp_path), "-B", str(build), "-G", "Ninja", f"-DCMAKE_PREFIX_PATH={prefix}"],
+        [
+            "cmake",
+            "-S",
+            str(tmp_path),
+            "-B",
+            str(build),
+            "-G",
+            "Ninja",
+            f"-DCMAKE_PREFIX_PATH={prefix}",
+        ],
         ["cmake", "--build", str(build)],
     ):
         r = subprocess.run(cmd, capture_output=True, text=True, timeout=600)

@@ -23,6 +23,7 @@ from typing import Sequence
 from .. import _core
 from ..command_files import check_command_files
 from . import (
+    batch,
     circular,
     controller,
     demo,
@@ -53,6 +54,7 @@ MODULES = (
     circular,
     probe,
     design_probe,
+    batch,
 )
 
 # The order `rotacal --help` lists the commands in.
@@ -74,6 +76,7 @@ ORDER = (
     "table2",
     "demo",
     "circular",
+    "batch",
 )
 
 
