@@ -106,7 +106,7 @@ COMMANDS: dict[tuple[str, ...], Files] = {
     ("history", "show"): Files(outputs=(arg("--plot"),), reads_store=_always),
     ("history", "list"): Files(reads_store=_always),
     ("diagnose",): Files((arg("FILE", "file"), arg("--budget-sizes")), (arg("--report"),)),
-    ("predict",): Files((arg("SESSION", "session"), arg("--model")), (OUTPUT,)),
+    ("predict",): Files((arg("SESSION", "session"), arg("--model"), arg("--joints")), (OUTPUT,)),
     ("design", "ballbar"): Files((MACHINE, arg("--after")), (OUTPUT,)),
     ("design", "rtest"): Files((arg("--after"),)),
     ("design", "probe"): Files((MACHINE, arg("--after")), (OUTPUT, arg("--session"))),

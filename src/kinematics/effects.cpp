@@ -11,70 +11,69 @@ namespace {
 
 struct KindInfo {
   EffectKind kind;
-  const char* stem;  // id up to the axis
-  bool rotary_axis;  // takes A/B/C
-  bool tilt_only;    // only A or B
-  bool linear_axis;  // takes X/Y/Z
-  bool harmonic;     // has _hn
-  int params;
+  const char* stem;   // id up to the axis
+  bool rotary_axis;   // takes A/B/C
+  bool tilt_only;     // only A or B
+  bool linear_axis;   // takes X/Y/Z
+  bool harmonic;      // has _hn (the parameter count: effect_num_params)
   const char* names;  // comma separated
   const char* units;
   const char* cause;
 };
 
 constexpr KindInfo kKindInfo[] = {
-    {EffectKind::ballbar_length_offset, "ballbar_length_offset", false, false, false, false, 1,
-     "dL", "mm", "the calibrated ballbar length L0 is wrong"},
-    {EffectKind::ballbar_thermal_drift, "ballbar_thermal_drift", false, false, false, false, 1, "k",
+    {EffectKind::ballbar_length_offset, "ballbar_length_offset", false, false, false, false, "dL",
+     "mm", "the calibrated ballbar length L0 is wrong"},
+    {EffectKind::ballbar_thermal_drift, "ballbar_thermal_drift", false, false, false, false, "k",
      "mm/s", "the bar or the set-up grows with temperature during the test"},
-    {EffectKind::tool_offset_Z, "tool_offset_Z", false, false, false, false, 1, "d", "mm",
+    {EffectKind::tool_offset_Z, "tool_offset_Z", false, false, false, false, "d", "mm",
      "the tool-cup centre is not at the programmed tool length"},
-    {EffectKind::rotary_zero_offset, "rotary_zero_offset", true, false, false, false, 1, "eps",
-     "rad", "the zero of the rotary axis is off"},
-    {EffectKind::angular_positioning, "angular_positioning", true, false, false, true, 2, "a,b",
+    {EffectKind::rotary_zero_offset, "rotary_zero_offset", true, false, false, false, "eps", "rad",
+     "the zero of the rotary axis is off"},
+    {EffectKind::angular_positioning, "angular_positioning", true, false, false, true, "a,b",
      "rad,rad",
      "angular positioning error of the rotary axis (encoder eccentricity, worm or gear error)"},
-    {EffectKind::radial_motion, "radial_motion", true, false, false, true, 4, "a,b,c,d",
-     "mm,mm,mm,mm", "radial error motion of the rotary axis (out-of-round bearing track)"},
-    {EffectKind::axial_motion, "axial_motion", true, false, false, true, 2, "a,b", "mm,mm",
+    {EffectKind::radial_motion, "radial_motion", true, false, false, true, "a,b,c,d", "mm,mm,mm,mm",
+     "radial error motion of the rotary axis (out-of-round bearing track)"},
+    {EffectKind::axial_motion, "axial_motion", true, false, false, true, "a,b", "mm,mm",
      "axial error motion of the rotary axis (face runout)"},
-    {EffectKind::tilt_motion, "tilt_motion", true, false, false, true, 4, "a,b,c,d",
-     "rad,rad,rad,rad", "tilt error motion of the rotary axis (wobble of the rotating table)"},
-    {EffectKind::gravity_sag, "gravity_sag", true, true, false, false, 1, "s", "mm",
+    {EffectKind::tilt_motion, "tilt_motion", true, false, false, true, "a,b,c,d", "rad,rad,rad,rad",
+     "tilt error motion of the rotary axis (wobble of the rotating table)"},
+    {EffectKind::gravity_sag, "gravity_sag", true, true, false, false, "s", "mm",
      "the tilting table deflects under its own weight"},
-    {EffectKind::coning, "coning", true, true, false, false, 1, "k", "rad/rad",
+    {EffectKind::coning, "coning", true, true, false, false, "k", "rad/rad",
      "the tilting axis' orientation changes in proportion to its angle (coning)"},
-    {EffectKind::linear_squareness, "linear_squareness", false, false, true, false, 1, "s", "rad",
+    {EffectKind::linear_squareness, "linear_squareness", false, false, true, false, "s", "rad",
      "two linear axes are out of square"},
-    {EffectKind::linear_scale, "linear_scale", false, false, true, false, 1, "k", "mm/mm",
+    {EffectKind::linear_scale, "linear_scale", false, false, true, false, "k", "mm/mm",
      "linear positioning scale error"},
-    {EffectKind::thermal_drift, "thermal_drift", false, false, true, false, 1, "d", "mm/s",
+    {EffectKind::thermal_drift, "thermal_drift", false, false, true, false, "d", "mm/s",
      "the machine structure drifts while the test runs"},
     // tau = 300 s * exp(q): q is dimensionless (unit "1"), 0 a sensible start for a test of
     // minutes; the nonlinear refit moves it once d is non-zero.
-    {EffectKind::thermal_warmup, "thermal_warmup", false, false, true, false, 2, "d,ln_tau_300s",
+    {EffectKind::thermal_warmup, "thermal_warmup", false, false, true, false, "d,ln_tau_300s",
      "mm,1", "the structure warms up towards a steady state"},
-    {EffectKind::straightness, "straightness", false, false, true, false, 3, "c2,c3,c4", "mm,mm,mm",
+    {EffectKind::straightness, "straightness", false, false, true, false, "c2,c3,c4", "mm,mm,mm",
      "the linear axis is not straight (ISO 230-1 straightness error)"},
-    {EffectKind::tool_offset, "tool_offset", false, false, true, false, 1, "d", "mm",
+    {EffectKind::tool_offset, "tool_offset", false, false, true, false, "d", "mm",
      "the tool-side ball is off the spindle axis"},
-    {EffectKind::rotary_backlash, "backlash", true, false, false, false, 1, "b", "rad",
+    {EffectKind::rotary_backlash, "backlash", true, false, false, false, "b", "rad",
      "lost motion in the rotary axis' drive (backlash of the worm or gear, or wind-up): the "
      "axis trails by half of it in its direction of travel"},
-    {EffectKind::servo_lag, "servo_lag", true, false, false, false, 1, "tau", "s",
+    {EffectKind::servo_lag, "servo_lag", true, false, false, false, "tau", "s",
      "the rotary axis' position loop lags behind the linear axes' (unequal servo gains): the "
      "angle trails in proportion to the angular speed"},
     // tau_s = 0.05 s * exp(q): a few tens of ms, as friction at a reversal releases.
-    {EffectKind::reversal_spike, "reversal_spike", true, false, false, false, 2, "h,ln_tau_50ms",
+    {EffectKind::reversal_spike, "reversal_spike", true, false, false, false, "h,ln_tau_50ms",
      "rad,1",
      "the rotary axis sticks when it reverses (static friction) and catches up over a "
      "short time"},
-    {EffectKind::stylus_radius_offset, "stylus_radius_offset", false, false, false, false, 1, "d",
+    {EffectKind::stylus_radius_offset, "stylus_radius_offset", false, false, false, false, "d",
      "mm", "the stylus' effective radius differs from its calibration (touch probe)"},
-    {EffectKind::probe_lobing, "probe_lobing", false, false, false, false, 2, "lc,ls", "mm,mm",
+    {EffectKind::probe_lobing, "probe_lobing", false, false, false, false, "lc,ls", "mm,mm",
      "the touch probe's pretravel depends on the direction of approach (three-lobed, as "
      "kinematic-seat probes are)"},
-    {EffectKind::linear_pitch, "angular_error", false, false, true, false, 2, "e1,e2", "rad,rad",
+    {EffectKind::linear_pitch, "angular_error", false, false, true, false, "e1,e2", "rad,rad",
      "the linear axis' carriage pitches as it moves (ISO 230-1 angular error), seen through the "
      "tool's height"},
 };
@@ -184,15 +183,12 @@ Effect Effect::parse(const std::string& id) {
                         "' is not an effect id of the catalogue (shared/spec/effects.md)");
 }
 
-int Effect::num_params() const { return info(kind).params; }
+int Effect::num_params() const { return effect_num_params(kind); }
 std::vector<std::string> Effect::param_names() const { return split(info(kind).names); }
 std::vector<std::string> Effect::param_units() const { return split(info(kind).units); }
 std::string Effect::cause() const { return info(kind).cause; }
 
-bool Effect::depends_on_motion() const {
-  return kind == EffectKind::rotary_backlash || kind == EffectKind::servo_lag ||
-         kind == EffectKind::reversal_spike;
-}
+bool Effect::depends_on_motion() const { return effect_depends_on_motion(kind); }
 
 bool Effect::is_harmonic() const { return info(kind).harmonic; }
 
@@ -239,13 +235,13 @@ std::vector<Effect> effect_catalogue(MachineType m, int max_harmonic) {
 
 int EffectModel::num_params() const {
   int n = 0;
-  for (const Effect& f : effects) n += info(f.kind).params;
+  for (const Effect& f : effects) n += effect_num_params(f.kind);
   return n;
 }
 
 int EffectModel::offset(std::size_t i) const {
   int n = 0;
-  for (std::size_t k = 0; k < i; ++k) n += info(effects[k].kind).params;
+  for (std::size_t k = 0; k < i; ++k) n += effect_num_params(effects[k].kind);
   return n;
 }
 

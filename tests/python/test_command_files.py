@@ -95,7 +95,10 @@ TEMPLATES = {
     ("diagnose",): [
         ["diagnose", "{FILE}", "--budget-sizes", "{--budget-sizes}", "--report", "{--report}"]
     ],
-    ("predict",): [["predict", "{SESSION}", "--model", "{--model}", "-o", "{-o}"]],
+    ("predict",): [
+        ["predict", "{SESSION}", "--model", "{--model}", "-o", "{-o}"],
+        ["predict", "--joints", "{--joints}", "--model", "{--model}", "-o", "{-o}"],
+    ],
     ("design", "ballbar"): [
         ["design", "ballbar", "--machine", "{--machine}", "-o", "{-o}"],
         [
@@ -290,6 +293,8 @@ def sources(shared_data, tmp_path_factory):
     empty.write_text("{}\n")
     diag = d / "diagnosis.json"
     diag.write_text(json.dumps({"findings": []}))
+    joints = d / "joints.csv"
+    joints.write_text("x,y,z,tilt,rot\n10,20,30,40,50\n")
     port = d / "port"
     port.write_text("not a device\n")
     probe_plan = (
@@ -319,6 +324,7 @@ def sources(shared_data, tmp_path_factory):
         "--budget-sizes": empty,
         "--correction": empty,
         "--diagnosis": diag,
+        "--joints": joints,
         "--port": port,
         "LOG": probe_log,
         "--plan": probe_plan,

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: BSD-3-Clause
 """The C++ layer order of the README, checked on every #include of include/ and src/.
 
-core < kinematics < fit < session < io < design < instrument problems (ballbar, rtest, probe) <
+core < kinematics < realtime (the controller's evaluation, on kinematics alone) < fit < session < io < design < instrument problems (ballbar, rtest, probe) <
 circular (the ballbar's tests of the linear axes) < diagnose < multi < hw.
 
 A file may include its own layer and the layers below it, never one above, and no instrument
@@ -16,6 +16,7 @@ ROOT = Path(__file__).resolve().parents[2]
 ORDER = [
     "core",
     "kinematics",
+    "realtime",
     "fit",
     "session",
     "io",

@@ -16,6 +16,7 @@
 #include <string>
 
 #include "rotacal/core/error.hpp"
+#include "rotacal/kinematics/chain_stages.hpp"
 #include "rotacal/kinematics/machine_description.hpp"
 #include "rotacal/kinematics/rotation.hpp"
 
@@ -63,31 +64,6 @@ MachineType parse_machine_type(const std::string& s);
 char tilt_axis_letter(MachineType m);
 char rot_axis_letter(MachineType m);
 
-/// The eight location errors of one machine, four per axis in chain order (table axes from
-/// the bed outwards, then head axes from the linear axes outwards):
-///   index 0, 1: position of the first axis' line; 2, 3: orientation of the first axis;
-///   index 4, 5: position of the second axis' line; 6, 7: orientation of the second axis.
-/// AC-trt: E_Y0A E_Z0A E_B0A E_C0A E_X0C E_Y0C E_A0C E_B0C (Flynn et al., Table 1 order)
-/// BC-trt: E_X0B E_Z0B E_A0B E_C0B E_X0C E_Y0C E_A0C E_B0C
-/// B-head-C-table: E_X0C E_Y0C E_A0C E_B0C E_X0B E_Z0B E_A0B E_C0B; nutating axes E_U0R...
-/// Positions in mm, orientations in rad.
-template <typename Scalar>
-struct LocationErrors {
-  static constexpr int kSize = 8;
-  Eigen::Matrix<Scalar, kSize, 1> v = Eigen::Matrix<Scalar, kSize, 1>::Zero();
-
-  LocationErrors() = default;
-  explicit LocationErrors(const Eigen::Matrix<Scalar, kSize, 1>& values) : v(values) {}
-  /// View of a raw parameter block (e.g. a Ceres parameter pointer).
-  static LocationErrors from_ptr(const Scalar* p) {
-    return LocationErrors(Eigen::Map<const Eigen::Matrix<Scalar, kSize, 1>>(p));
-  }
-  template <typename Other>
-  LocationErrors<Other> cast() const {
-    return LocationErrors<Other>(v.template cast<Other>());
-  }
-};
-
 /// Location error names in LocationErrors order for the given machine (formats.md).
 const std::array<std::string, 8>& location_error_names(MachineType m);
 
@@ -104,36 +80,22 @@ int location_error_index(MachineType m, const std::string& name);
 /// True for the four orientation errors (rad), false for the four positions (mm).
 inline bool location_error_is_angle(int index) { return index == 2 || index == 3 || index >= 6; }
 
-/// An axis line: a point it passes through and a (not necessarily unit) direction.
-template <typename Scalar>
-struct AxisLine {
-  Vec3<Scalar> point;
-  Vec3<Scalar> direction;
+/// A MachineType as a chain of chain_stages.hpp: the formulas there read its axes through it.
+struct MachineChain {
+  const MachineDescription& d;
+  int rot;
+  explicit MachineChain(MachineType m) : d(m.description()), rot(m.rot_index()) {}
+  const RotaryAxis& axis(int k) const { return d.axis(k); }
+  int rot_index() const { return rot; }
+  int num_table_axes() const { return static_cast<int>(d.table_axes.size()); }
+  bool has_head() const { return d.has_head(); }
 };
-
-namespace detail {
-// v += B * (a, b) for a 3x2 basis of unit vectors, skipping zero entries (Jets are not free).
-template <typename Scalar>
-void add_basis(Vec3<Scalar>& v, const Eigen::Matrix<double, 3, 2>& B, const Scalar& a,
-               const Scalar& b) {
-  for (int i = 0; i < 3; ++i) {
-    if (B(i, 0) != 0.0)
-      v[i] += B(i, 0) == 1.0 ? a : B(i, 0) == -1.0 ? Scalar(-a) : Scalar(B(i, 0) * a);
-    if (B(i, 1) != 0.0)
-      v[i] += B(i, 1) == 1.0 ? b : B(i, 1) == -1.0 ? Scalar(-b) : Scalar(B(i, 1) * b);
-  }
-}
-}  // namespace detail
 
 /// Actual line of chain axis k (0, 1) at all rotary axes 0: through p0 + dp along n + dn
 /// (formats.md). Table axes in the machine frame, head axes relative to the controlled point.
 template <typename Scalar>
 AxisLine<Scalar> axis_line(MachineType m, int k, const LocationErrors<Scalar>& e) {
-  const RotaryAxis& a = m.description().axis(k);
-  AxisLine<Scalar> L{a.point.cast<Scalar>(), a.direction.cast<Scalar>()};
-  detail::add_basis(L.point, a.position_basis, e.v[4 * k], e.v[4 * k + 1]);
-  detail::add_basis(L.direction, a.direction_basis, e.v[4 * k + 2], e.v[4 * k + 3]);
-  return L;
+  return chain::axis_line(MachineChain(m), k, e);
 }
 
 /// Actual line of the tilt axis (A or B on the table machines) and of the rotary axis (C).
@@ -146,33 +108,11 @@ AxisLine<Scalar> c_axis_line(MachineType m, const LocationErrors<Scalar>& e) {
   return axis_line(m, m.rot_index(), e);
 }
 
-/// Rotary axis positions (rad): `tilt` of the tilt axis (A or B), `rot` of the rotary axis
-/// (C), whichever side of the chain they are on (MachineDescription::rot_index).
-template <typename Scalar>
-struct RotaryAngles {
-  Scalar tilt = Scalar(0);
-  Scalar rot = Scalar(0);
-};
-
 /// Angle of chain axis k.
 template <typename Scalar>
 const Scalar& chain_angle(MachineType m, const RotaryAngles<Scalar>& a, int k) {
   return k == m.rot_index() ? a.rot : a.tilt;
 }
-
-/// How the rotary axes move at a sample (issue 16: effects that depend on the direction and
-/// speed of motion). `rate`: commanded angular velocity of each axis, rad/s; `direction`: +1 or
-/// -1, the sign of the current motion, or of the last one when the axis is at rest (it stays
-/// on that side of its lost motion), 0 when no motion is on record; `since_reversal`: time
-/// since the axis last reversed its direction, s (infinity when no reversal is on record).
-/// The default, at rest with no history, is what a static pose (R-test) or a caller without
-/// motion information gets: every motion effect is zero there.
-struct RotaryMotion {
-  RotaryAngles<double> rate;
-  RotaryAngles<double> direction;
-  RotaryAngles<double> since_reversal{std::numeric_limits<double>::infinity(),
-                                      std::numeric_limits<double>::infinity()};
-};
 
 /// Rigid motion of the tilt axis alone: exact rotation about its actual line.
 template <typename Scalar>

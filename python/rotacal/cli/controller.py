@@ -21,7 +21,36 @@ def _comp_file(text: str) -> tuple[str, str]:
     return axis, checked_path(file, "--comp-file")
 
 
+def cmd_export_realtime(a: argparse.Namespace) -> int:
+    """export --controller realtime: the whole model as the blob a controller's real-time path
+    loads (include/rotacal/realtime/blob.hpp), binary, so -o is required."""
+    given = [
+        o
+        for o, v in (
+            ("--current", a.current),
+            ("--residual-model", a.residual_model),
+            ("--centres", a.centres),
+            ("--comp-file", a.comp_file),
+            ("--json", a.json),
+        )
+        if v
+    ]
+    if given:
+        raise _core.InvalidArgument(f"{', '.join(given)}: not with --controller realtime")
+    if not a.output:
+        raise _core.InvalidArgument("--controller realtime writes a binary blob: give -o FILE")
+    model = _core.realtime_model_of_file(a.model)
+    write_output(a.output, model.blob(), inputs=[a.model])
+    say(
+        f"wrote {a.output}: the real-time model blob ({model.num_effects} effects, every location "
+        f"error; machine fingerprint {model.fingerprint:016x}); docs/realtime.md"
+    )
+    return EXIT_OK
+
+
 def cmd_export(a: argparse.Namespace) -> int:
+    if a.controller == "realtime":
+        return cmd_export_realtime(a)
     from ..exports import export_controller, export_dict, linuxcnc_comp_table, residual_model
     from ..models import load_model, save_model
 
@@ -128,7 +157,11 @@ def add_export(sub: argparse._SubParsersAction) -> None:
         "--model", required=True, type=path("--model"), help="model file (identify --save-model)"
     )
     q.add_argument(
-        "--controller", required=True, choices=["linuxcnc", "siemens", "isg", "heidenhain", "fanuc"]
+        "--controller",
+        required=True,
+        choices=["linuxcnc", "siemens", "isg", "heidenhain", "fanuc", "realtime"],
+        help="realtime: the whole model (location errors and every effect) as the blob of the "
+        "real-time evaluation (docs/realtime.md)",
     )
     q.add_argument(
         "--current",

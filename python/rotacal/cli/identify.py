@@ -310,10 +310,28 @@ def cmd_identify(a: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def cmd_predict_joints(a: argparse.Namespace) -> int:
+    """predict --joints: the tool relative to the workpiece by the controller's real-time
+    evaluation (realtime/evaluate.hpp), of a model file or of the blob a controller loads."""
+    from .. import realtime
+    from ..outputs import write_output
+
+    model = realtime.load_realtime(a.model)
+    joints = realtime.read_joints(a.joints)
+    tip, direction = realtime.forward(model, joints, a.tool_length, a.y1, a.y2)
+    write_output(a.output, realtime.joints_csv(joints, tip, direction), inputs=[a.joints, a.model])
+    say(f"wrote {a.output}: the tool tip and direction of {len(joints)} joint positions")
+    return EXIT_OK
+
+
 def cmd_predict(a: argparse.Namespace) -> int:
     from ..analysis import predict_session
     from ..models import load_model
 
+    if (a.session is None) == (a.joints is None):
+        raise _core.InvalidArgument("predict: give a SESSION or --joints, one of them")
+    if a.joints is not None:
+        return cmd_predict_joints(a)
     model_dict = load_model(a.model)
     s = load_session(a.session, a)
     out, line = predict_session(model_dict, s, a.probe_zeros, source=a.model)
@@ -406,8 +424,33 @@ def add_identify(sub: argparse._SubParsersAction) -> None:
 
 def add_predict(sub: argparse._SubParsersAction) -> None:
     q = sub.add_parser("predict", help="predict a session with a fitted model", epilog=EPILOG)
-    q.add_argument("session", type=path("SESSION"))
-    q.add_argument("--model", required=True, type=path("--model"))
+    q.add_argument("session", nargs="?", type=path("SESSION"))
+    q.add_argument(
+        "--model",
+        required=True,
+        type=path("--model"),
+        help="model file, or with --joints also the blob of export --controller realtime",
+    )
+    q.add_argument(
+        "--joints",
+        type=path("--joints"),
+        help="instead of a session: a CSV x,y,z,tilt,rot (mm, deg) of joint positions; the output "
+        "holds the tool tip and direction relative to the workpiece, computed by the controller's "
+        "real-time evaluation (docs/realtime.md)",
+    )
+    q.add_argument(
+        "--tool-length",
+        type=number("--tool-length", 0.0, 1e4, "mm"),
+        default=0.0,
+        help="--joints: spindle nose to tool tip (head machines; table machines: the tip below "
+        "X, Y, Z), mm",
+    )
+    q.add_argument(
+        "--y1", type=number("--y1", -10.0, 10.0), default=0.0, help="--joints: thermal lag state"
+    )
+    q.add_argument(
+        "--y2", type=number("--y2", -10.0, 10.0), default=0.0, help="--joints: thermal lag state"
+    )
     q.add_argument(
         "--probe-zeros",
         choices=["none", "fitted"],
@@ -420,7 +463,8 @@ def add_predict(sub: argparse._SubParsersAction) -> None:
         "--output",
         required=True,
         type=path("--output"),
-        help="the session with predicted lengths (ballbar) or dx,dy,dz and dx_std,dy_std,dz_std (R-test)",
+        help="the session with predicted lengths (ballbar) or dx,dy,dz and dx_std,dy_std,dz_std "
+        "(R-test); with --joints the CSV of the tool's tip and direction",
     )
     add_plausibility_arg(q)
     q.set_defaults(func=cmd_predict)
