@@ -141,6 +141,7 @@ cmake -S tests/consumer -B build/consumer -G Ninja -DCMAKE_PREFIX_PATH="$ROOT/bu
 cmake --build build/consumer
 ./build/consumer/rotacal_consumer
 ./build/consumer/rotacal_consumer_hw
+./build/consumer/rotacal_consumer_realtime  # the real-time headers alone: Eigen, no exceptions, no library
 
 step "C++ example (examples/cpp) against the installed package"
 cmake -S examples/cpp -B build/example -G Ninja -DCMAKE_PREFIX_PATH="$ROOT/build/install"
@@ -176,6 +177,7 @@ step "Benchmarks, once each as a smoke check (figures: run them without --smoke)
 "$PY" bench/design_bench.py --smoke
 ./build/release/bench/noise_mc_bench --smoke
 ./build/release/bench/any_machine_bench --smoke
+./build/release/bench/realtime_bench --smoke
 
 step "libFuzzer targets of the instrument decoders, 20 s each (clang; built in the background)"
 if ! wait "$FUZZ_PID"; then
