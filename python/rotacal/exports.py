@@ -113,6 +113,36 @@ def residual_model(model: dict, ex: Any) -> dict:
     return out
 
 
+def controller_tables(
+    model: str | Path,
+    controller: str,
+    directory: str | Path,
+    spacing_deg: float = 5.0,
+    ranges: dict[str, Sequence[float]] | None = None,
+    generated_at: str = "",
+) -> Any:
+    """The controller's compensation tables of a model's errors that move with a rotary axis
+    (``rotacal export --tables``), computed in C++ (``rotacal/io/compensation_table.hpp``): a
+    ``rotacal._core.CompensationTables`` whose ``tables`` each carry ``file_name`` (in
+    ``directory``) and ``text``, and ``ini`` the lines that load them. LinuxCNC only: the
+    other controllers' tables are refused by name (docs/controller_exports.md)."""
+    if controller != "linuxcnc":
+        raise _core.InvalidArgument(
+            f"--tables: compensation tables are written for linuxcnc; {controller}'s are not "
+            "(docs/controller_exports.md, the table of error terms x controller)"
+        )
+    d = os.path.abspath(os.fspath(directory))
+    names = {a: os.path.join(d, f"comp_{a}.txt") for a in "ABC"}
+    return _core.linuxcnc_comp_tables(
+        os.fspath(model),
+        float(spacing_deg),
+        {k: [float(v[0]), float(v[1])] for k, v in (ranges or {}).items()},
+        names,
+        256,
+        generated_at,
+    )
+
+
 # LinuxCNC 2.9 reads a joint's COMP_FILE up to the first line that is not three numbers, and
 # holds at most 256 of them.
 MAX_COMP_LINES = 256

@@ -22,8 +22,14 @@ AngleMapTerms terms_of(const Pose<double>& delta, const RotaryAxis& ax) {
   const Pose<double> at_point{delta.R, delta * ax.point - ax.point};
   AngleMapTerms t;
   t.head<6>() = oyama_errors_of(at_point);
-  const Eigen::AngleAxisd r(delta.R);
-  t[6] = r.angle() * r.axis().dot(ax.direction);
+  // A principal axis: its own Euler component (the R-test map's gamma or beta itself, no
+  // second-order part of the other two); a nutating one: the rotation vector along it.
+  if (ax.principal >= 0) {
+    t[6] = t[3 + ax.principal] * (ax.direction[ax.principal] < 0 ? -1.0 : 1.0);
+  } else {
+    const Eigen::AngleAxisd r(delta.R);
+    t[6] = r.angle() * r.axis().dot(ax.direction);
+  }
   return t;
 }
 

@@ -18,8 +18,9 @@
 /// motion^-1, taken about the axis' nominal point, as
 ///   E_X, E_Y, E_Z (mm, machine X, Y, Z) and E_A, E_B, E_C (rad, Delta's rotation as
 ///   Rx(E_A) Ry(E_B) Rz(E_C), oyama_errors_of),
-/// plus the positioning error (rad): Delta's rotation vector along the axis' own direction,
-/// i.e. actual minus commanded angle. Names: "E_XC" ... "E_CC", "positioning_C".
+/// plus the positioning error (rad), actual minus commanded angle: the Euler component about
+/// the axis' own principal direction (E_CC of a C along +Z, -E_CC along -Z), for a nutating
+/// axis Delta's rotation vector along its direction. Names: "E_XC" ... "E_CC", "positioning_C".
 
 #include <Eigen/Core>
 #include <array>

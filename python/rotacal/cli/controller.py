@@ -20,6 +20,48 @@ def _comp_file(text: str) -> tuple[str, str]:
     return axis, checked_path(file, "--comp-file")
 
 
+def _table_range(text: str) -> tuple[str, list[float]]:
+    axis, sep, rng = text.partition("=")
+    parts = rng.split(",")
+    try:
+        lo, hi = (float(v.strip().removesuffix("deg")) for v in parts) if len(parts) == 2 else ()
+    except ValueError:
+        lo = hi = float("nan")
+    if not sep or axis not in ("A", "B", "C") or not (lo < hi):
+        raise _core.InvalidArgument(
+            f"--table-range {text!r}: expected AXIS=LO,HI in deg, AXIS A, B or C, LO < HI"
+        )
+    return axis, [lo, hi]
+
+
+def _spacing(text: str) -> float:
+    try:
+        v = float(text.strip().removesuffix("deg").strip())
+    except ValueError:
+        v = float("nan")
+    if not (0.001 <= v <= 90.0):
+        raise _core.InvalidArgument(f"--spacing {text!r}: a number of deg, 0.001 to 90 (5deg)")
+    return v
+
+
+def _write_tables(a: argparse.Namespace) -> None:
+    import os
+
+    from ..exports import controller_tables
+
+    directory = a.tables_dir or (os.path.dirname(os.fspath(a.output)) if a.output else ".")
+    ranges = dict(_table_range(t) for t in a.table_range or [])
+    tabs = controller_tables(a.model, a.controller, directory, _spacing(a.spacing), ranges)
+    for t in tabs.tables:
+        write_output(t.file_name, t.text, inputs=[a.model])
+        say(f"wrote {t.file_name}: {t.summary}")
+    ini = os.path.join(os.path.abspath(directory), "comp_tables.ini")
+    write_output(ini, tabs.ini, inputs=[a.model])
+    say(f"wrote {ini}: the [JOINT_n] lines that load them")
+    for n in tabs.not_held:
+        say(f"not in a table: {n}; left to rotacal compensate")
+
+
 def cmd_export(a: argparse.Namespace) -> int:
     from ..exports import export_controller, export_dict, linuxcnc_comp_table, residual_model
     from ..models import load_model, save_model
@@ -34,6 +76,8 @@ def cmd_export(a: argparse.Namespace) -> int:
             "--centres and --centres-output go together, with --controller isg"
         )
     ex = export_controller(a.model, a.controller, current=a.current, toolholder=a.toolholder)
+    if a.tables:
+        _write_tables(a)
     tables = {
         axis: linuxcnc_comp_table(load_model(a.model), axis, *a.comp_range, a.comp_step)
         for axis in comp
@@ -197,6 +241,27 @@ def add_export(sub: argparse._SubParsersAction) -> None:
         type=number("--comp-step", 0.01, 90.0, "deg"),
         default=1.0,
         help="step of the table, deg (default 1; LinuxCNC reads at most 256 lines)",
+    )
+    q.add_argument(
+        "--tables",
+        action="store_true",
+        help="linuxcnc: also write each table axis' positioning error as a [JOINT_n]COMP_FILE "
+        "(type 1) and the INI lines that load them (comp_tables.ini)",
+    )
+    q.add_argument(
+        "--spacing", default="5deg", help="--tables: between table points (default 5deg)"
+    )
+    q.add_argument(
+        "--table-range",
+        action="append",
+        metavar="AXIS=LO,HI",
+        help="--tables: the angles a table spans, deg (default: the axis' limits, an endless "
+        "axis -360,360); a continuously turning C needs what the program turns through",
+    )
+    q.add_argument(
+        "--tables-dir",
+        type=path("--tables-dir"),
+        help="--tables: the folder of the tables (default: that of -o, else the current one)",
     )
     q.add_argument(
         "--json", action="store_true", help="print the parameters and the errors held as JSON"

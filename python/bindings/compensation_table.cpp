@@ -1,0 +1,84 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Bindings for include/rotacal/io/angle_map.hpp and io/compensation_table.hpp (the errors that
+// move with a rotary axis, and the controller tables written from them).
+#include "rotacal/io/compensation_table.hpp"
+
+#include <pybind11/stl.h>
+
+#include "numpy.hpp"
+#include "rotacal/io/angle_map.hpp"
+
+namespace rotacal::py {
+
+void bind_compensation_table(pyb::module_& m) {
+  pyb::class_<AxisAngleMap>(m, "AxisAngleMap", "One rotary axis' error terms at equal spacing.")
+      .def_property_readonly("axis", [](const AxisAngleMap& a) { return std::string(1, a.axis); })
+      .def_readonly("names", &AxisAngleMap::names, "E_X<axis> .. E_C<axis>, positioning_<axis>")
+      .def_readonly("units", &AxisAngleMap::units)
+      .def_readonly("sources", &AxisAngleMap::sources, "the model's terms that feed it")
+      .def_readonly("notes", &AxisAngleMap::notes, "what the map leaves out")
+      .def_readonly("angle_deg", &AxisAngleMap::angle_deg)
+      .def_property_readonly(
+          "values", [](const AxisAngleMap& a) { return Eigen::MatrixXd(a.values); },
+          "(n, 7) the terms at angle_deg (mm, rad)")
+      .def_property_readonly(
+          "max_interpolation_error",
+          [](const AxisAngleMap& a) { return Eigen::VectorXd(a.max_interpolation_error); },
+          "(7,) worst |model - linear interpolation| between the points")
+      .def_readonly("samples_between", &AxisAngleMap::samples_between);
+  m.def(
+      "angle_maps",
+      [](const std::string& model_path, double lo_deg, double hi_deg, double spacing_deg,
+         int samples_between) {
+        const ModelFile model = read_model(model_path);
+        std::vector<AxisAngleMap> out;
+        for (const AxisErrorFunction& f : axis_error_functions(model, model_path))
+          out.push_back(sample_angle_map(f, lo_deg, hi_deg, spacing_deg, samples_between));
+        return out;
+      },
+      pyb::arg("model_path"), pyb::arg("lo_deg"), pyb::arg("hi_deg"), pyb::arg("spacing_deg"),
+      pyb::arg("samples_between") = 16,
+      "The position-dependent errors of a model file's table axes as functions of each axis' "
+      "angle (io/angle_map.hpp), sampled from lo_deg to hi_deg.");
+  pyb::class_<CompensationTable>(m, "CompensationTable", "One joint's compensation table.")
+      .def_property_readonly("axis",
+                             [](const CompensationTable& t) { return std::string(1, t.axis); })
+      .def_readonly("joint", &CompensationTable::joint)
+      .def_readonly("file_name", &CompensationTable::file_name)
+      .def_readonly("text", &CompensationTable::text)
+      .def_readonly("nominal_deg", &CompensationTable::nominal_deg)
+      .def_readonly("trim_deg", &CompensationTable::trim_deg)
+      .def_readonly("max_interpolation_error_deg", &CompensationTable::max_interpolation_error_deg)
+      .def_readonly("summary", &CompensationTable::summary);
+  pyb::class_<CompensationTables>(m, "CompensationTables", "A controller's tables of a model.")
+      .def_readonly("tables", &CompensationTables::tables)
+      .def_readonly("ini", &CompensationTables::ini, "the INI lines that load them")
+      .def_readonly("not_held", &CompensationTables::not_held);
+  m.def(
+      "linuxcnc_comp_tables",
+      [](const std::string& model_path, double spacing_deg,
+         const std::map<std::string, std::array<double, 2>>& range_deg,
+         const std::map<std::string, std::string>& file_names, std::size_t max_points,
+         const std::string& generated_at) {
+        CompensationTableOptions o;
+        o.spacing_deg = spacing_deg;
+        const auto letter = [](const std::string& k) {
+          if (k.size() != 1) throw InvalidArgument("axis '" + k + "': one letter A, B or C");
+          return k[0];
+        };
+        for (const auto& [k, v] : range_deg) o.range_deg[letter(k)] = v;
+        for (const auto& [k, v] : file_names) o.file_names[letter(k)] = v;
+        o.max_points = max_points;
+        o.model_path = model_path;
+        o.generated_at = generated_at;
+        return linuxcnc_comp_tables(read_model(model_path), o);
+      },
+      pyb::arg("model_path"), pyb::arg("spacing_deg") = 5.0,
+      pyb::arg("range_deg") = std::map<std::string, std::array<double, 2>>{},
+      pyb::arg("file_names") = std::map<std::string, std::string>{}, pyb::arg("max_points") = 256,
+      pyb::arg("generated_at") = "",
+      "LinuxCNC COMP_FILEs (type 1) of each table axis' positioning error and the INI lines "
+      "that load them (io/compensation_table.hpp).");
+}
+
+}  // namespace rotacal::py
