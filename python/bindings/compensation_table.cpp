@@ -47,38 +47,58 @@ void bind_compensation_table(pyb::module_& m) {
       .def_readonly("file_name", &CompensationTable::file_name)
       .def_readonly("text", &CompensationTable::text)
       .def_readonly("nominal_deg", &CompensationTable::nominal_deg)
-      .def_readonly("trim_deg", &CompensationTable::trim_deg)
+      .def_readonly("value_deg", &CompensationTable::value_deg, "the values written, deg")
       .def_readonly("max_interpolation_error_deg", &CompensationTable::max_interpolation_error_deg)
       .def_readonly("summary", &CompensationTable::summary);
   pyb::class_<CompensationTables>(m, "CompensationTables", "A controller's tables of a model.")
       .def_readonly("tables", &CompensationTables::tables)
       .def_readonly("ini", &CompensationTables::ini, "the INI lines that load them")
       .def_readonly("not_held", &CompensationTables::not_held);
+  const auto options = [](const std::string& model_path, double spacing_deg,
+                          const std::map<std::string, std::array<double, 2>>& range_deg,
+                          const std::map<std::string, std::string>& file_names,
+                          const std::map<std::string, std::string>& axis_names,
+                          std::size_t max_points, const std::string& generated_at) {
+    CompensationTableOptions o;
+    o.spacing_deg = spacing_deg;
+    const auto letter = [](const std::string& k) {
+      if (k.size() != 1) throw InvalidArgument("axis '" + k + "': one letter A, B or C");
+      return k[0];
+    };
+    for (const auto& [k, v] : range_deg) o.range_deg[letter(k)] = v;
+    for (const auto& [k, v] : file_names) o.file_names[letter(k)] = v;
+    for (const auto& [k, v] : axis_names) o.axis_names[letter(k)] = v;
+    o.max_points = max_points;
+    o.model_path = model_path;
+    o.generated_at = generated_at;
+    return o;
+  };
+  using Ranges = std::map<std::string, std::array<double, 2>>;
+  using Names = std::map<std::string, std::string>;
   m.def(
       "linuxcnc_comp_tables",
-      [](const std::string& model_path, double spacing_deg,
-         const std::map<std::string, std::array<double, 2>>& range_deg,
-         const std::map<std::string, std::string>& file_names, std::size_t max_points,
-         const std::string& generated_at) {
-        CompensationTableOptions o;
-        o.spacing_deg = spacing_deg;
-        const auto letter = [](const std::string& k) {
-          if (k.size() != 1) throw InvalidArgument("axis '" + k + "': one letter A, B or C");
-          return k[0];
-        };
-        for (const auto& [k, v] : range_deg) o.range_deg[letter(k)] = v;
-        for (const auto& [k, v] : file_names) o.file_names[letter(k)] = v;
-        o.max_points = max_points;
-        o.model_path = model_path;
-        o.generated_at = generated_at;
-        return linuxcnc_comp_tables(read_model(model_path), o);
+      [options](const std::string& model_path, double spacing_deg, const Ranges& range_deg,
+                const Names& file_names, std::size_t max_points, const std::string& generated_at) {
+        return linuxcnc_comp_tables(
+            read_model(model_path),
+            options(model_path, spacing_deg, range_deg, file_names, {}, max_points, generated_at));
       },
-      pyb::arg("model_path"), pyb::arg("spacing_deg") = 5.0,
-      pyb::arg("range_deg") = std::map<std::string, std::array<double, 2>>{},
-      pyb::arg("file_names") = std::map<std::string, std::string>{}, pyb::arg("max_points") = 256,
-      pyb::arg("generated_at") = "",
+      pyb::arg("model_path"), pyb::arg("spacing_deg") = 5.0, pyb::arg("range_deg") = Ranges{},
+      pyb::arg("file_names") = Names{}, pyb::arg("max_points") = 0, pyb::arg("generated_at") = "",
       "LinuxCNC COMP_FILEs (type 1) of each table axis' positioning error and the INI lines "
-      "that load them (io/compensation_table.hpp).");
+      "that load them (io/compensation_table.hpp); max_points 0: LinuxCNC's 256.");
+  m.def(
+      "sinumerik_eec_tables",
+      [options](const std::string& model_path, double spacing_deg, const Ranges& range_deg,
+                const Names& axis_names, std::size_t max_points, const std::string& generated_at) {
+        return sinumerik_eec_tables(
+            read_model(model_path),
+            options(model_path, spacing_deg, range_deg, {}, axis_names, max_points, generated_at));
+      },
+      pyb::arg("model_path"), pyb::arg("spacing_deg") = 5.0, pyb::arg("range_deg") = Ranges{},
+      pyb::arg("axis_names") = Names{}, pyb::arg("max_points") = 0, pyb::arg("generated_at") = "",
+      "SINUMERIK EEC programs ($AA_ENC_COMP) of each table axis' positioning error "
+      "(io/compensation_table.hpp); max_points 0: 200 (808D), else MD38000 as configured.");
 }
 
 }  // namespace rotacal::py

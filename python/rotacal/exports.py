@@ -119,27 +119,35 @@ def controller_tables(
     directory: str | Path,
     spacing_deg: float = 5.0,
     ranges: dict[str, Sequence[float]] | None = None,
+    axis_names: dict[str, str] | None = None,
+    max_points: int = 0,
     generated_at: str = "",
 ) -> Any:
     """The controller's compensation tables of a model's errors that move with a rotary axis
     (``rotacal export --tables``), computed in C++ (``rotacal/io/compensation_table.hpp``): a
     ``rotacal._core.CompensationTables`` whose ``tables`` each carry ``file_name`` (in
-    ``directory``) and ``text``, and ``ini`` the lines that load them. LinuxCNC only: the
-    other controllers' tables are refused by name (docs/controller_exports.md)."""
-    if controller != "linuxcnc":
-        raise _core.InvalidArgument(
-            f"--tables: compensation tables are written for linuxcnc; {controller}'s are not "
-            "(docs/controller_exports.md, the table of error terms x controller)"
-        )
+    ``directory``) and ``text``, and (LinuxCNC) ``ini`` the lines that load them. LinuxCNC
+    COMP_FILEs and SINUMERIK EEC programs; the other controllers are refused by name
+    (docs/controller_exports.md). ``max_points`` 0: the controller's own limit."""
+    rng = {k: [float(v[0]), float(v[1])] for k, v in (ranges or {}).items()}
     d = os.path.abspath(os.fspath(directory))
-    names = {a: os.path.join(d, f"comp_{a}.txt") for a in "ABC"}
-    return _core.linuxcnc_comp_tables(
-        os.fspath(model),
-        float(spacing_deg),
-        {k: [float(v[0]), float(v[1])] for k, v in (ranges or {}).items()},
-        names,
-        256,
-        generated_at,
+    if controller == "linuxcnc":
+        names = {a: os.path.join(d, f"comp_{a}.txt") for a in "ABC"}
+        return _core.linuxcnc_comp_tables(
+            os.fspath(model), float(spacing_deg), rng, names, int(max_points), generated_at
+        )
+    if controller == "siemens":
+        return _core.sinumerik_eec_tables(
+            os.fspath(model),
+            float(spacing_deg),
+            rng,
+            axis_names or {},
+            int(max_points),
+            generated_at,
+        )
+    raise _core.InvalidArgument(
+        f"--tables: compensation tables are written for linuxcnc and siemens; {controller}'s "
+        "are not (docs/controller_exports.md, the table of error terms x controller)"
     )
 
 

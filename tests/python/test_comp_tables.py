@@ -148,6 +148,7 @@ def test_compensated_c_reaches_the_commanded_angle_over_the_table(exported):
     assert np.abs(motor + positioning_deg(motor) - table[0]).max() < 2e-9
     assert not (d / "comp_A.txt").exists()  # A has no positioning error
     assert "E_ZA" in r.stderr and "E_XC" in r.stderr  # the sag and the run-out: not in a table
+    assert "E_CC" not in r.stderr  # C's rotation about Z is its positioning: in the table
 
 
 def test_the_header_says_what_the_table_holds_and_where_it_stops(exported):
@@ -214,9 +215,9 @@ def test_refusals_name_the_limit(exported, tmp_path):
     assert r.returncode == EXIT_INPUT and "at most 256" in r.stderr and "721" in r.stderr
     assert not (tmp_path / "comp_C.txt").exists()
     r = run_cli(
-        "export", "--model", m, "--controller", "siemens", "--tables", "--tables-dir", tmp_path
+        "export", "--model", m, "--controller", "fanuc", "--tables", "--tables-dir", tmp_path
     )
-    assert r.returncode == EXIT_INPUT and "--tables" in r.stderr and "siemens" in r.stderr
+    assert r.returncode == EXIT_INPUT and "--tables" in r.stderr and "fanuc" in r.stderr
     none = tmp_path / "none.json"
     none.write_text(json.dumps(model_doc(effects=False)))
     r = run_cli(
@@ -275,3 +276,82 @@ def test_linuxcnc_loads_the_comp_file_and_adds_its_trims(exported, tmp_path):
     # slope (<= 4e-4 deg/deg) that is < 1e-6 deg (measured: 3.2e-7 deg); the trims are ~5e-3.
     assert np.abs(got - want).max() < 1e-6, (got, want)
     assert np.abs(want).max() > 1e-3  # the trims are far from 0: the check can fail
+
+
+def load_eec(text):
+    """A SINUMERIK EEC program as K3 ("Interpolatory compensation") and the 808D manual ("LEC")
+    describe it: $AA_ENC_COMP[e,N,AXi] values at MIN + N STEP up to MAX, with MODULO 0/1."""
+    values, params = {}, {}
+    for line in text.splitlines():
+        m = re.fullmatch(r"\$AA_ENC_COMP\[0,(\d+),(\w+)\]=(-?\d+\.\d+)", line)
+        if m:
+            values[int(m[1])] = float(m[3])
+            continue
+        m = re.fullmatch(r"\$AA_ENC_COMP_(STEP|MIN|MAX|IS_MODULO)\[0,(\w+)\]=(-?[\d.]+)", line)
+        if m:
+            params[m[1]] = float(m[3])
+    n = round((params["MAX"] - params["MIN"]) / params["STEP"])
+    assert sorted(values) == list(range(n + 1)), "every interpolation point has its value"
+    return params, np.array([values[i] for i in range(n + 1)])
+
+
+def eec_value(params, values, x):
+    """Linear between the points; beyond them the end values hold, or (modulo) the table repeats
+    every MAX - MIN."""
+    lo, step = params["MIN"], params["STEP"]
+    if params["IS_MODULO"] == 1:
+        x = lo + np.mod(x - lo, params["MAX"] - lo)
+    grid = lo + step * np.arange(len(values))
+    return np.interp(x, grid, values)  # np.interp holds the end values
+
+
+def test_sinumerik_eec_moves_c_where_the_model_says(exported, tmp_path):
+    d, _ = exported
+    r = run_cli(
+        "export",
+        "--model",
+        d / "model.json",
+        "--controller",
+        "siemens",
+        "--tables",
+        "--spacing",
+        "5",
+        "--siemens-axis",
+        "C=C1",
+        "--tables-dir",
+        tmp_path,
+    )
+    assert r.returncode == EXIT_OK, r.stderr
+    text = (tmp_path / "eec_C.mpf").read_text()
+    lines = text.splitlines()
+    assert lines[:2] == ["%_N_AX_EEC_INI", "CHANDATA(1)"] and lines[-1] == "M17"
+    params, values = load_eec(text)
+    assert params == {"STEP": 5.0, "MIN": 0.0, "MAX": 360.0, "IS_MODULO": 1.0}
+    assert values[0] == values[-1]  # a modulo table: both ends entered, equal
+    stated = stated_error_deg(text)
+    # The control corrects the actual value by the table's value at the axis position x: the
+    # loop settles where x + value(x) = commanded, and a positive value moves the axis negative.
+    # The axis then stands at x + positioning(x) (effects.md), which must be the commanded angle.
+    x = np.linspace(-720.0, 720.0, 28801)[:-1] + 0.0173
+    commanded = x + eec_value(params, values, x)
+    actual = x + positioning_deg(x)
+    residual = np.abs(actual - commanded)
+    assert residual.max() <= stated * 1.001 + 1e-9, (residual.max(), stated)
+    assert residual.max() >= 0.5 * stated
+    assert np.abs(positioning_deg(x)).max() > 100 * stated
+    # Sign: where the axis runs ahead (positioning > 0) the value is positive.
+    i = np.argmax(positioning_deg(np.arange(0, 360, 5.0)))
+    assert values[i] > 0
+    r = run_cli(
+        "export",
+        "--model",
+        d / "model.json",
+        "--controller",
+        "siemens",
+        "--tables",
+        "--spacing",
+        "1",
+        "--tables-dir",
+        tmp_path,
+    )
+    assert r.returncode == EXIT_INPUT and "MD38000" in r.stderr and "361" in r.stderr

@@ -284,3 +284,26 @@ def test_comp_tables_hold_only_their_triplets_whatever_the_session_path(hostile_
     assert re.fullmatch(r"[\x20-\x7e\n]*", text), "a byte outside printable ASCII"
     for line in ini.splitlines():
         assert re.fullmatch(r"\[JOINT_\d\]|#[\x20-\x7e]*|COMP_FILE = \S+|COMP_FILE_TYPE = 1", line)
+    # The SINUMERIK EEC program of the same model: its blocks, then comments only.
+    d = tmp_path / "s"
+    d.mkdir()
+    rotacal_cli(
+        "export",
+        "--model",
+        with_worm_gear(hostile, HOSTILE_PATH + ".worm.json"),
+        "--controller",
+        "siemens",
+        "--tables",
+        "--tables-dir",
+        d,
+    )
+    mpf = (d / "eec_C.mpf").read_text(encoding="utf-8")
+    assert "loadusr" in mpf and re.fullmatch(r"[\x20-\x7e\n]*", mpf)
+    blocks = [ln for ln in mpf.splitlines() if not ln.startswith(";")]
+    assert len(blocks) == 2 + 73 + 4 + 1
+    for line in blocks:
+        assert re.fullmatch(
+            r"%_N_AX_EEC_INI|CHANDATA\(1\)|M17|\$AA_ENC_COMP\[0,\d+,C1\]=-?\d+\.\d{9}"
+            r"|\$AA_ENC_COMP_(STEP|MIN|MAX|IS_MODULO)\[0,C1\]=-?[\d.]+",
+            line,
+        ), line

@@ -29,8 +29,12 @@ struct CompensationTableOptions {
   /// The angles each table spans, by axis letter (deg). Default: the axis' limits; an endless
   /// axis -360..360 (the table is looked up without modulo: the header says where it stops).
   std::map<char, std::array<double, 2>> range_deg;
-  std::size_t max_points = 256;  ///< LinuxCNC: EMCMOT_COMP_SIZE (src/emc/motion/motion.h)
-  int samples_between = 63;      ///< model evaluations inside each interval for the error
+  /// Most points a table may hold; 0: the controller's own (LinuxCNC 256, EMCMOT_COMP_SIZE in
+  /// src/emc/motion/motion.h; SINUMERIK 200, the 808D's, else MD38000 as configured).
+  std::size_t max_points = 0;
+  /// SINUMERIK: the machine axis identifier of each axis letter (MD10000; default "<letter>1").
+  std::map<char, std::string> axis_names;
+  int samples_between = 63;  ///< model evaluations inside each interval for the error
   /// The file each table is written to, by axis letter, for the INI lines (default
   /// "comp_<axis>.txt").
   std::map<char, std::string> file_names;
@@ -44,8 +48,10 @@ struct CompensationTable {
   int joint = 0;          ///< LinuxCNC joint number ([JOINT_n])
   std::string file_name;  ///< as the INI lines name it
   std::string text;       ///< the file
-  std::vector<double> nominal_deg, trim_deg;
-  double max_interpolation_error_deg = 0.0;  ///< worst |exact trim - interpolated trim|
+  /// The table's positions and the values written (LinuxCNC: the trims; SINUMERIK: the EEC
+  /// values), deg.
+  std::vector<double> nominal_deg, value_deg;
+  double max_interpolation_error_deg = 0.0;  ///< worst |exact value - interpolated value|
   std::string summary;                       ///< one line for people
 };
 
@@ -63,6 +69,18 @@ struct CompensationTables {
 /// max_points lines, a range or spacing is not usable, the machine has an axis on the head,
 /// or the model holds no positioning error of any table axis.
 CompensationTables linuxcnc_comp_tables(const ModelFile& model,
+                                        const CompensationTableOptions& options);
+
+/// SINUMERIK encoder / leadscrew error compensation (EEC, K3 function manual "Interpolatory
+/// compensation"; 808D function manual "LEC") of each table axis' positioning error: one
+/// program per axis, `%_N_AX_EEC_INI`, `$AA_ENC_COMP[0,N,<axis>]` values in deg, linear between
+/// equidistant points from `$AA_ENC_COMP_MIN` every `$AA_ENC_COMP_STEP` to `$AA_ENC_COMP_MAX`,
+/// the end values held beyond them, or repeated with `$AA_ENC_COMP_IS_MODULO = 1`. The control
+/// corrects the actual value by the table's value, so a positive value moves the axis negative:
+/// the value at axis position x is the positioning error there (actual - commanded angle). An
+/// endless axis without a range gets a modulo table 0..360 deg. Refused as
+/// linuxcnc_comp_tables, naming MD38000 for too many points (`ini` stays empty).
+CompensationTables sinumerik_eec_tables(const ModelFile& model,
                                         const CompensationTableOptions& options);
 
 }  // namespace rotacal

@@ -51,13 +51,25 @@ def _write_tables(a: argparse.Namespace) -> None:
 
     directory = a.tables_dir or (os.path.dirname(os.fspath(a.output)) if a.output else ".")
     ranges = dict(_table_range(t) for t in a.table_range or [])
-    tabs = controller_tables(a.model, a.controller, directory, _spacing(a.spacing), ranges)
+    names = {}
+    for text in a.siemens_axis or []:
+        axis, sep, name = text.partition("=")
+        if not sep or axis not in ("A", "B", "C"):
+            raise _core.InvalidArgument(
+                f"--siemens-axis {text!r}: expected AXIS=NAME, AXIS A, B or C"
+            )
+        names[axis] = name
+    tabs = controller_tables(
+        a.model, a.controller, directory, _spacing(a.spacing), ranges, names, a.max_points or 0
+    )
     for t in tabs.tables:
-        write_output(t.file_name, t.text, inputs=[a.model])
-        say(f"wrote {t.file_name}: {t.summary}")
-    ini = os.path.join(os.path.abspath(directory), "comp_tables.ini")
-    write_output(ini, tabs.ini, inputs=[a.model])
-    say(f"wrote {ini}: the [JOINT_n] lines that load them")
+        out = os.path.join(os.path.abspath(directory), os.path.basename(t.file_name))
+        write_output(out, t.text, inputs=[a.model])
+        say(f"wrote {out}: {t.summary}")
+    if tabs.ini:
+        ini = os.path.join(os.path.abspath(directory), "comp_tables.ini")
+        write_output(ini, tabs.ini, inputs=[a.model])
+        say(f"wrote {ini}: the [JOINT_n] lines that load them")
     for n in tabs.not_held:
         say(f"not in a table: {n}; left to rotacal compensate")
 
@@ -245,8 +257,9 @@ def add_export(sub: argparse._SubParsersAction) -> None:
     q.add_argument(
         "--tables",
         action="store_true",
-        help="linuxcnc: also write each table axis' positioning error as a [JOINT_n]COMP_FILE "
-        "(type 1) and the INI lines that load them (comp_tables.ini)",
+        help="also write each table axis' positioning error as the controller's table: linuxcnc "
+        "[JOINT_n]COMP_FILE (type 1) and the INI lines (comp_tables.ini); siemens EEC "
+        "($AA_ENC_COMP) programs eec_<axis>.mpf",
     )
     q.add_argument(
         "--spacing", default="5deg", help="--tables: between table points (default 5deg)"
@@ -257,6 +270,18 @@ def add_export(sub: argparse._SubParsersAction) -> None:
         metavar="AXIS=LO,HI",
         help="--tables: the angles a table spans, deg (default: the axis' limits, an endless "
         "axis -360,360); a continuously turning C needs what the program turns through",
+    )
+    q.add_argument(
+        "--siemens-axis",
+        action="append",
+        metavar="AXIS=NAME",
+        help="--tables, siemens: the machine axis identifier of AXIS (MD10000; default C1, B1, A1)",
+    )
+    q.add_argument(
+        "--max-points",
+        type=number("--max-points", 2, 100000, integer=True),
+        help="--tables: the most points a table may hold (default: linuxcnc 256, siemens 200; "
+        "SINUMERIK: MD38000 as configured)",
     )
     q.add_argument(
         "--tables-dir",

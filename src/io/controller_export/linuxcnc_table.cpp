@@ -10,22 +10,13 @@
 #include "rotacal/io/compensation_table.hpp"
 #include "rotacal/io/controller_export.hpp"
 #include "shared.hpp"
+#include "table_shared.hpp"
 
 namespace rotacal {
 
 namespace linuxcnc_table_detail {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
-
-// The time of the export, UTC ISO 8601 (as the kinematic exports' header writes it).
-std::string table_written_at() {
-  const std::time_t t = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
-}
+using namespace table_detail;
 
 // The trim (deg) that makes the model's axis reach p (deg): the actual angle of a motor command
 // m is m + positioning(m), so t = -positioning(p + t); a contraction for any real error
@@ -34,40 +25,6 @@ double trim_deg(const AxisErrorFunction& f, double p_deg) {
   double t = 0.0;
   for (int i = 0; i < 4; ++i) t = -f.evaluate((p_deg + t) / kRadToDeg)[6] * kRadToDeg;
   return t;
-}
-
-// v with 4 significant digits, rounded up (a stated error is never below the one found).
-std::string rounded_up(double v) {
-  if (!(v > 0.0)) return "0";
-  const double step = std::pow(10.0, std::floor(std::log10(v)) - 3);
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3e", std::ceil(v / step - 1e-9) * step);
-  return buf;
-}
-
-// The model terms that feed the positioning error: the effects of the axis' angle, or the
-// R-test map's rotation about the axis (gamma_CB of a C, beta_BY of a B).
-std::vector<std::string> positioning_sources(const AxisErrorFunction& f, const RotaryAxis& ax) {
-  static const char* rotation[3] = {"alpha_", "beta_", "gamma_"};
-  std::vector<std::string> out;
-  for (const std::string& s : f.sources)
-    if (s.rfind("rotary_zero_offset", 0) == 0 || s.rfind("angular_positioning", 0) == 0 ||
-        (ax.principal >= 0 && s.rfind(rotation[ax.principal], 0) == 0))
-      out.push_back(s);
-  return out;
-}
-
-std::array<double, 2> range_of(const RotaryAxis& ax, const CompensationTableOptions& o) {
-  const auto it = o.range_deg.find(ax.name);
-  if (it != o.range_deg.end()) return it->second;
-  if (ax.limits_deg) return *ax.limits_deg;
-  return {-360.0, 360.0};
-}
-
-std::string joined(const std::vector<std::string>& v, const std::string& none) {
-  std::string s;
-  for (const std::string& x : v) s += (s.empty() ? "" : ", ") + x;
-  return s.empty() ? none : s;
 }
 
 // A file name for the INI lines: printable ASCII without the INI's comment characters, so no
@@ -98,21 +55,22 @@ CompensationTable one_table(const AxisErrorFunction& f, const MachineType& m,
   check_file_name(t.file_name);
   t.nominal_deg =
       equally_spaced_deg(lo, hi, o.spacing_deg, "--table-range " + letter + " / --spacing");
-  if (t.nominal_deg.size() > o.max_points)
+  const std::size_t max_points = o.max_points ? o.max_points : 256;
+  if (t.nominal_deg.size() > max_points)
     throw InvalidArgument(
-        "--tables: LinuxCNC holds at most " + std::to_string(o.max_points) +
+        "--tables: LinuxCNC holds at most " + std::to_string(max_points) +
         " compensation triplets per joint (EMCMOT_COMP_SIZE, src/emc/motion/motion.h); the " +
         letter + " table over " + export_detail::fixed(lo, 3) + ".." + export_detail::fixed(hi, 3) +
         " deg every " + export_detail::fixed(o.spacing_deg, 3) + " deg has " +
         std::to_string(t.nominal_deg.size()) +
         ": use a larger --spacing or a shorter --table-range");
-  for (const double p : t.nominal_deg) t.trim_deg.push_back(trim_deg(f, p));
+  for (const double p : t.nominal_deg) t.value_deg.push_back(trim_deg(f, p));
   t.max_interpolation_error_deg = worst_interpolation_error(
-      t.nominal_deg, t.trim_deg, [&](double p) { return trim_deg(f, p); }, o.samples_between);
+      t.nominal_deg, t.value_deg, [&](double p) { return trim_deg(f, p); }, o.samples_between);
   std::ostringstream out;
   for (std::size_t i = 0; i < t.nominal_deg.size(); ++i)
     out << export_detail::fixed(t.nominal_deg[i], 6) << " "
-        << export_detail::fixed(t.trim_deg[i], 9) << " " << export_detail::fixed(t.trim_deg[i], 9)
+        << export_detail::fixed(t.value_deg[i], 9) << " " << export_detail::fixed(t.value_deg[i], 9)
         << "\n";
   // The header follows the numbers: LinuxCNC reads up to the first line that is not three
   // numbers, so these lines (each starting with #) are never read as data.
@@ -128,7 +86,7 @@ CompensationTable one_table(const AxisErrorFunction& f, const MachineType& m,
   w.line("points: " + std::to_string(t.nominal_deg.size()) + " every " +
          export_detail::fixed(o.spacing_deg, 6) + " deg over " + export_detail::fixed(lo, 6) +
          ".." + export_detail::fixed(hi, 6) + " deg (LinuxCNC holds at most " +
-         std::to_string(o.max_points) + ")");
+         std::to_string(max_points) + ")");
   w.line("worst interpolation error between points: " + rounded_up(err) + " deg (" +
          rounded_up(err / kRadToDeg * 1e6) + " urad; the model evaluated at " +
          std::to_string(o.samples_between) + " angles inside each interval)");
@@ -153,6 +111,7 @@ CompensationTable one_table(const AxisErrorFunction& f, const MachineType& m,
 
 CompensationTables linuxcnc_comp_tables(const ModelFile& model, const CompensationTableOptions& o) {
   using namespace linuxcnc_table_detail;
+  using namespace table_detail;
   const MachineType m = model.machine;
   if (m.has_head())
     throw InvalidArgument("--tables: linuxcnc tables are written for table-table machines; " +
@@ -161,13 +120,8 @@ CompensationTables linuxcnc_comp_tables(const ModelFile& model, const Compensati
   CompensationTables out;
   std::ostringstream ini;
   for (const AxisErrorFunction& f : axis_error_functions(model, o.model_path)) {
-    const AxisAngleMap map = sample_angle_map(f, -180.0, 180.0, 5.0, 1);  // what else it holds
-    for (int j = 0; j < 6; ++j)
-      if (map.max_abs[j] > 0.0)
-        out.not_held.push_back(map.names[static_cast<std::size_t>(j)] + " up to " +
-                               export_detail::fixed(map.max_abs[j] * 1e3 * (j < 3 ? 1.0 : 1e3), 3) +
-                               (j < 3 ? " um" : " urad") + " (a table holds no error motion)");
-    if (map.max_abs[6] == 0.0) continue;
+    list_not_held(f, m.description().axis(f.chain_index), out);
+    if (sample_angle_map(f, -180.0, 180.0, 5.0, 1).max_abs[6] == 0.0) continue;
     CompensationTable t = one_table(f, m, o, in);
     ini << "[JOINT_" << t.joint << "]\n"
         << "# axis " << t.axis << " positioning (rotacal export --tables); BACKLASH is not used "
