@@ -49,7 +49,9 @@ void bind_compensation_table(pyb::module_& m) {
       .def_readonly("nominal_deg", &CompensationTable::nominal_deg)
       .def_readonly("value_deg", &CompensationTable::value_deg, "the values written, deg")
       .def_readonly("max_interpolation_error_deg", &CompensationTable::max_interpolation_error_deg)
-      .def_readonly("summary", &CompensationTable::summary);
+      .def_readonly("summary", &CompensationTable::summary)
+      .def_readonly("holds", &CompensationTable::holds,
+                    "the model's terms the table holds (a residual model zeroes them)");
   pyb::class_<CompensationTables>(m, "CompensationTables", "A controller's tables of a model.")
       .def_readonly("tables", &CompensationTables::tables)
       .def_readonly("ini", &CompensationTables::ini, "the INI lines that load them")

@@ -1091,6 +1091,11 @@ class CompensationTable:
     def file_name(self) -> str:
         ...
     @property
+    def holds(self) -> list[str]:
+        """
+        the model's terms the table holds (a residual model zeroes them)
+        """
+    @property
     def joint(self) -> int:
         ...
     @property

@@ -95,21 +95,38 @@ def export_dict(ex: Any) -> dict:
     }
 
 
-def residual_model(model: dict, ex: Any) -> dict:
+def residual_model(model: dict, ex: Any, tables: Any = None) -> dict:
     """The model with the errors the controller now holds set to zero: what NC compensation
     (``rotacal compensate --model``) must still correct once the export is loaded. Its
     ``source.residual_after`` names the export. The covariance is dropped (it describes the
-    identification, not this difference)."""
+    identification, not this difference). ``tables``: the compensation tables written with it
+    (``controller_tables``); the model terms they hold (effects, R-test map coefficients) are
+    zeroed too, so the NC program does not correct them a second time."""
     out = dict(model)
     errors = {name: dict(est) for name, est in model["location_errors"].items()}
     for e in ex.errors:
         if e.held:
-            errors[e.name] = {"value": 0.0, "std": 0.0, "unit": errors[e.name].get("unit", "")}
+            unit = errors[e.name].get("unit")  # optional in a model file: kept only if given
+            errors[e.name] = {"value": 0.0, "std": 0.0} | ({"unit": unit} if unit else {})
     out["location_errors"] = errors
+    held = {h for t in (tables.tables if tables is not None else []) for h in t.holds}
+    if held and "effects" in model:
+        out["effects"] = [
+            dict(f, params={k: dict(v, value=0.0, std=0.0) for k, v in f["params"].items()})
+            if f.get("id") in held
+            else f
+            for f in model["effects"]
+        ]
+    if held and "map_coefficients" in model:
+        out["map_coefficients"] = {
+            k: (dict(v, value=0.0, std=0.0) if isinstance(v, dict) else 0.0) if k in held else v
+            for k, v in model["map_coefficients"].items()
+        }
     out.pop("covariance", None)
-    out["source"] = dict(model.get("source", {})) | {
-        "residual_after": f"{ex.controller} export ({ex.kinematics})"
-    }
+    what = f"{ex.controller} export ({ex.kinematics})"
+    if held:
+        what += " and its tables (" + ", ".join(sorted(held)) + ")"
+    out["source"] = dict(model.get("source", {})) | {"residual_after": what}
     return out
 
 

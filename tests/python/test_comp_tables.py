@@ -355,3 +355,29 @@ def test_sinumerik_eec_moves_c_where_the_model_says(exported, tmp_path):
         tmp_path,
     )
     assert r.returncode == EXIT_INPUT and "MD38000" in r.stderr and "361" in r.stderr
+
+
+def test_the_residual_model_leaves_to_compensate_only_what_no_table_holds(exported, tmp_path):
+    d, _ = exported
+    res = tmp_path / "residual.json"
+    r = run_cli(
+        "export",
+        "--model",
+        d / "model.json",
+        "--controller",
+        "linuxcnc",
+        "--tables",
+        "--tables-dir",
+        tmp_path,
+        "--residual-model",
+        res,
+        "-o",
+        tmp_path / "kins.hal",
+    )
+    assert r.returncode == EXIT_OK, r.stderr
+    doc = json.loads(res.read_text())
+    values = {f["id"]: [p["value"] for p in f["params"].values()] for f in doc["effects"]}
+    for held in ("rotary_zero_offset_C", "angular_positioning_C_h1", "angular_positioning_C_h3"):
+        assert values[held] == [0.0] * len(values[held]), held  # in the COMP_FILE
+    assert values["radial_motion_C_h2"][0] == 2e-3 and values["gravity_sag_A"] == [0.004]
+    assert "tables" in doc["source"]["residual_after"]

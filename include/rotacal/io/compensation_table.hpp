@@ -52,7 +52,10 @@ struct CompensationTable {
   /// values), deg.
   std::vector<double> nominal_deg, value_deg;
   double max_interpolation_error_deg = 0.0;  ///< worst |exact value - interpolated value|
-  std::string summary;                       ///< one line for people
+  /// The model's terms the table holds (effect ids, R-test map coefficients): a residual model
+  /// for `rotacal compensate` sets them to zero.
+  std::vector<std::string> holds;
+  std::string summary;  ///< one line for people
 };
 
 struct CompensationTables {

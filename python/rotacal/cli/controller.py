@@ -44,7 +44,7 @@ def _spacing(text: str) -> float:
     return v
 
 
-def _write_tables(a: argparse.Namespace) -> None:
+def _write_tables(a: argparse.Namespace) -> object:
     import os
 
     from ..exports import controller_tables
@@ -72,6 +72,7 @@ def _write_tables(a: argparse.Namespace) -> None:
         say(f"wrote {ini}: the [JOINT_n] lines that load them")
     for n in tabs.not_held:
         say(f"not in a table: {n}; left to rotacal compensate")
+    return tabs
 
 
 def cmd_export(a: argparse.Namespace) -> int:
@@ -88,8 +89,7 @@ def cmd_export(a: argparse.Namespace) -> int:
             "--centres and --centres-output go together, with --controller isg"
         )
     ex = export_controller(a.model, a.controller, current=a.current, toolholder=a.toolholder)
-    if a.tables:
-        _write_tables(a)
+    tabs = _write_tables(a) if a.tables else None
     tables = {
         axis: linuxcnc_comp_table(load_model(a.model), axis, *a.comp_range, a.comp_step)
         for axis in comp
@@ -115,7 +115,7 @@ def cmd_export(a: argparse.Namespace) -> int:
         say(f"wrote {comp[axis]}: {what}")
     if a.residual_model:
         save_model(
-            residual_model(load_model(a.model), ex),
+            residual_model(load_model(a.model), ex, tabs),
             a.residual_model,
             inputs=[a.model],
             other_outputs=[a.output] if a.output else [],

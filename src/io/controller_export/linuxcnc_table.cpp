@@ -49,6 +49,7 @@ CompensationTable one_table(const AxisErrorFunction& f, const MachineType& m,
   const std::string letter(1, f.axis);
   CompensationTable t;
   t.axis = f.axis;
+  t.holds = positioning_sources(f, ax);
   t.joint = f.chain_index == m.rot_index() ? 4 : 3;
   const auto fn = o.file_names.find(f.axis);
   t.file_name = fn != o.file_names.end() ? fn->second : "comp_" + letter + ".txt";

@@ -40,6 +40,7 @@ CompensationTable one_table(const AxisErrorFunction& f, const MachineType& m,
                         : asked_hi;
   CompensationTable t;
   t.axis = f.axis;
+  t.holds = positioning_sources(f, ax);
   t.joint = -1;
   t.file_name = "eec_" + letter + ".mpf";
   t.nominal_deg = equally_spaced_deg(lo, hi, o.spacing_deg,
