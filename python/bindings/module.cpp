@@ -20,6 +20,7 @@ void bind_diagnose(pyb::module_& m);
 void bind_ballbar_plan(pyb::module_& m);
 void bind_noise(pyb::module_& m);
 void bind_controller_export(pyb::module_& m);
+void bind_compensation_table(pyb::module_& m);
 void bind_design(pyb::module_& m);
 void bind_circular(pyb::module_& m);
 void bind_probe(pyb::module_& m);
@@ -52,6 +53,7 @@ PYBIND11_MODULE(_core, m) {
   rotacal::py::bind_diagnose(m);
   rotacal::py::bind_ballbar_plan(m);
   rotacal::py::bind_controller_export(m);
+  rotacal::py::bind_compensation_table(m);
   rotacal::py::bind_design(m);
   rotacal::py::bind_circular(m);
   rotacal::py::bind_probe(m);

@@ -96,22 +96,77 @@ def export_dict(ex: Any) -> dict:
     }
 
 
-def residual_model(model: dict, ex: Any) -> dict:
+def residual_model(model: dict, ex: Any, tables: Any = None) -> dict:
     """The model with the errors the controller now holds set to zero: what NC compensation
     (``rotacal compensate --model``) must still correct once the export is loaded. Its
     ``source.residual_after`` names the export. The covariance is dropped (it describes the
-    identification, not this difference)."""
+    identification, not this difference). ``tables``: the compensation tables written with it
+    (``controller_tables``); the model terms they hold (effects, R-test map coefficients) are
+    zeroed too, so the NC program does not correct them a second time."""
     out = dict(model)
     errors = {name: dict(est) for name, est in model["location_errors"].items()}
     for e in ex.errors:
         if e.held:
-            errors[e.name] = {"value": 0.0, "std": 0.0, "unit": errors[e.name].get("unit", "")}
+            unit = errors[e.name].get("unit")  # optional in a model file: kept only if given
+            errors[e.name] = {"value": 0.0, "std": 0.0} | ({"unit": unit} if unit else {})
     out["location_errors"] = errors
+    held = {h for t in (tables.tables if tables is not None else []) for h in t.holds}
+    if held and "effects" in model:
+        out["effects"] = [
+            dict(f, params={k: dict(v, value=0.0, std=0.0) for k, v in f["params"].items()})
+            if f.get("id") in held
+            else f
+            for f in model["effects"]
+        ]
+    if held and "map_coefficients" in model:
+        out["map_coefficients"] = {
+            k: (dict(v, value=0.0, std=0.0) if isinstance(v, dict) else 0.0) if k in held else v
+            for k, v in model["map_coefficients"].items()
+        }
     out.pop("covariance", None)
-    out["source"] = dict(model.get("source", {})) | {
-        "residual_after": f"{ex.controller} export ({ex.kinematics})"
-    }
+    what = f"{ex.controller} export ({ex.kinematics})"
+    if held:
+        what += " and its tables (" + ", ".join(sorted(held)) + ")"
+    out["source"] = dict(model.get("source", {})) | {"residual_after": what}
     return out
+
+
+def controller_tables(
+    model: str | Path,
+    controller: str,
+    directory: str | Path,
+    spacing_deg: float = 5.0,
+    ranges: dict[str, Sequence[float]] | None = None,
+    axis_names: dict[str, str] | None = None,
+    max_points: int = 0,
+    generated_at: str = "",
+) -> Any:
+    """The controller's compensation tables of a model's errors that move with a rotary axis
+    (``rotacal export --tables``), computed in C++ (``rotacal/io/compensation_table.hpp``): a
+    ``rotacal._core.CompensationTables`` whose ``tables`` each carry ``file_name`` (in
+    ``directory``) and ``text``, and (LinuxCNC) ``ini`` the lines that load them. LinuxCNC
+    COMP_FILEs and SINUMERIK EEC programs; the other controllers are refused by name
+    (docs/controller_exports.md). ``max_points`` 0: the controller's own limit."""
+    rng = {k: [float(v[0]), float(v[1])] for k, v in (ranges or {}).items()}
+    d = os.path.abspath(os.fspath(directory))
+    if controller == "linuxcnc":
+        names = {a: os.path.join(d, f"comp_{a}.txt") for a in "ABC"}
+        return _core.linuxcnc_comp_tables(
+            os.fspath(model), float(spacing_deg), rng, names, int(max_points), generated_at
+        )
+    if controller == "siemens":
+        return _core.sinumerik_eec_tables(
+            os.fspath(model),
+            float(spacing_deg),
+            rng,
+            axis_names or {},
+            int(max_points),
+            generated_at,
+        )
+    raise _core.InvalidArgument(
+        f"--tables: compensation tables are written for linuxcnc and siemens; {controller}'s "
+        "are not (docs/controller_exports.md, the table of error terms x controller)"
+    )
 
 
 # LinuxCNC 2.9 reads a joint's COMP_FILE up to the first line that is not three numbers, and

@@ -217,6 +217,32 @@ def test_linuxcnc_comp_file_of_an_rtest_map_holds_the_positioning_error(tmp_path
     err = np.radians(rows[:, 1] - rows[:, 0])
     assert np.abs(err - 2e-4 * np.sin(np.radians(rows[:, 0]))).max() < 3e-6  # rad
     assert np.array_equal(rows[:, 1], rows[:, 2])  # an R-test does not see reversal
+    # --tables (issue 54) from the same map: B's COMP_FILE (type 1) trims are -2e-4 sin B.
+    r = rotacal_cli(
+        "export",
+        "--model",
+        m,
+        "--controller",
+        "linuxcnc",
+        "--tables",
+        "--table-range",
+        "B=-90,90",
+        "--tables-dir",
+        tmp_path,
+    )
+    assert r.returncode == 0, r.stderr
+    rows = np.array(
+        [
+            [float(x) for x in line.split()]
+            for line in (tmp_path / "comp_B.txt").read_text().splitlines()
+            if line[0] != "#"
+        ]
+    )
+    assert rows.shape == (37, 3) and np.array_equal(rows[:, 1], rows[:, 2])
+    trim = np.radians(rows[:, 1])
+    assert np.abs(trim + 2e-4 * np.sin(np.radians(rows[:, 0]))).max() < 3e-6  # rad
+    assert "[JOINT_3]" in (tmp_path / "comp_tables.ini").read_text()
+    assert not (tmp_path / "comp_C.txt").exists()  # the map has no gamma_CB: no C positioning
     # A ballbar model has no map: refused by name; so is a map term the model does not have.
     assert (
         rotacal_cli(

@@ -241,3 +241,70 @@ def test_isg_centres_program_holds_only_its_blocks_whatever_the_setup_label(tmp_
         )
         for line in got
     )
+
+
+def test_comp_tables_hold_only_their_triplets_whatever_the_session_path(hostile_model, tmp_path):
+    """`export --tables` (issue 54): the COMP_FILE holds its triplets, then comment lines only;
+    the INI lines that load it hold only section, key and comment lines."""
+    hostile, plain = hostile_model
+
+    def with_worm_gear(model, name):
+        doc = json.loads(model.read_text())
+        doc["effects"] = [
+            {"id": "angular_positioning_C_h1", "params": {"a": {"value": 1e-4}, "b": {"value": 0}}}
+        ]
+        doc.pop("covariance", None)
+        out = model.parent / name
+        out.write_text(json.dumps(doc))
+        return out
+
+    def tables(model, d):
+        d.mkdir()
+        rotacal_cli(
+            "export",
+            "--model",
+            model,
+            "--controller",
+            "linuxcnc",
+            "--tables",
+            "--tables-dir",
+            d,
+            "-o",
+            d / "kins.hal",
+        )
+        return (d / "comp_C.txt").read_text(encoding="utf-8"), (d / "comp_tables.ini").read_text()
+
+    text, ini = tables(with_worm_gear(hostile, HOSTILE_PATH + ".worm.json"), tmp_path / "h")
+    plain_text, _ = tables(with_worm_gear(plain, "plain.worm.json"), tmp_path / "p")
+    assert "loadusr" in text  # the path is there, as a comment
+    data = [ln for ln in text.splitlines() if not ln.startswith("#")]
+    assert data == [ln for ln in plain_text.splitlines() if not ln.startswith("#")]
+    assert len(data) == 145 and text.splitlines()[:145] == data
+    for line in data:
+        assert re.fullmatch(r"-?\d+\.\d{6} -?\d+\.\d{9} -?\d+\.\d{9}", line), line
+    assert re.fullmatch(r"[\x20-\x7e\n]*", text), "a byte outside printable ASCII"
+    for line in ini.splitlines():
+        assert re.fullmatch(r"\[JOINT_\d\]|#[\x20-\x7e]*|COMP_FILE = \S+|COMP_FILE_TYPE = 1", line)
+    # The SINUMERIK EEC program of the same model: its blocks, then comments only.
+    d = tmp_path / "s"
+    d.mkdir()
+    rotacal_cli(
+        "export",
+        "--model",
+        with_worm_gear(hostile, HOSTILE_PATH + ".worm.json"),
+        "--controller",
+        "siemens",
+        "--tables",
+        "--tables-dir",
+        d,
+    )
+    mpf = (d / "eec_C.mpf").read_text(encoding="utf-8")
+    assert "loadusr" in mpf and re.fullmatch(r"[\x20-\x7e\n]*", mpf)
+    blocks = [ln for ln in mpf.splitlines() if not ln.startswith(";")]
+    assert len(blocks) == 2 + 73 + 4 + 1
+    for line in blocks:
+        assert re.fullmatch(
+            r"%_N_AX_EEC_INI|CHANDATA\(1\)|M17|\$AA_ENC_COMP\[0,\d+,C1\]=-?\d+\.\d{9}"
+            r"|\$AA_ENC_COMP_(STEP|MIN|MAX|IS_MODULO)\[0,C1\]=-?[\d.]+",
+            line,
+        ), line

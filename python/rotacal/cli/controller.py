@@ -32,6 +32,7 @@ def cmd_export_realtime(a: argparse.Namespace) -> int:
             ("--centres", a.centres),
             ("--comp-file", a.comp_file),
             ("--json", a.json),
+            ("--tables", a.tables),
         )
         if v
     ]
@@ -46,6 +47,61 @@ def cmd_export_realtime(a: argparse.Namespace) -> int:
         f"error; machine fingerprint {model.fingerprint:016x}); docs/realtime.md"
     )
     return EXIT_OK
+
+
+def _table_range(text: str) -> tuple[str, list[float]]:
+    axis, sep, rng = text.partition("=")
+    parts = rng.split(",")
+    try:
+        lo, hi = (float(v.strip().removesuffix("deg")) for v in parts) if len(parts) == 2 else ()
+    except ValueError:
+        lo = hi = float("nan")
+    if not sep or axis not in ("A", "B", "C") or not (lo < hi):
+        raise _core.InvalidArgument(
+            f"--table-range {text!r}: expected AXIS=LO,HI in deg, AXIS A, B or C, LO < HI"
+        )
+    return axis, [lo, hi]
+
+
+def _spacing(text: str) -> float:
+    try:
+        v = float(text.strip().removesuffix("deg").strip())
+    except ValueError:
+        v = float("nan")
+    if not (0.001 <= v <= 90.0):
+        raise _core.InvalidArgument(f"--spacing {text!r}: a number of deg, 0.001 to 90 (5deg)")
+    return v
+
+
+def _write_tables(a: argparse.Namespace) -> object:
+    import os
+
+    from ..exports import controller_tables
+
+    directory = a.tables_dir or (os.path.dirname(os.fspath(a.output)) if a.output else ".")
+    ranges = dict(_table_range(t) for t in a.table_range or [])
+    names = {}
+    for text in a.siemens_axis or []:
+        axis, sep, name = text.partition("=")
+        if not sep or axis not in ("A", "B", "C"):
+            raise _core.InvalidArgument(
+                f"--siemens-axis {text!r}: expected AXIS=NAME, AXIS A, B or C"
+            )
+        names[axis] = name
+    tabs = controller_tables(
+        a.model, a.controller, directory, _spacing(a.spacing), ranges, names, a.max_points or 0
+    )
+    for t in tabs.tables:
+        out = os.path.join(os.path.abspath(directory), os.path.basename(t.file_name))
+        write_output(out, t.text, inputs=[a.model])
+        say(f"wrote {out}: {t.summary}")
+    if tabs.ini:
+        ini = os.path.join(os.path.abspath(directory), "comp_tables.ini")
+        write_output(ini, tabs.ini, inputs=[a.model])
+        say(f"wrote {ini}: the [JOINT_n] lines that load them")
+    for n in tabs.not_held:
+        say(f"not in a table: {n}; left to rotacal compensate")
+    return tabs
 
 
 def cmd_export(a: argparse.Namespace) -> int:
@@ -64,6 +120,7 @@ def cmd_export(a: argparse.Namespace) -> int:
             "--centres and --centres-output go together, with --controller isg"
         )
     ex = export_controller(a.model, a.controller, current=a.current, toolholder=a.toolholder)
+    tabs = _write_tables(a) if a.tables else None
     tables = {
         axis: linuxcnc_comp_table(load_model(a.model), axis, *a.comp_range, a.comp_step)
         for axis in comp
@@ -89,7 +146,7 @@ def cmd_export(a: argparse.Namespace) -> int:
         say(f"wrote {comp[axis]}: {what}")
     if a.residual_model:
         save_model(
-            residual_model(load_model(a.model), ex),
+            residual_model(load_model(a.model), ex, tabs),
             a.residual_model,
             inputs=[a.model],
             other_outputs=[a.output] if a.output else [],
@@ -231,6 +288,40 @@ def add_export(sub: argparse._SubParsersAction) -> None:
         type=number("--comp-step", 0.01, 90.0, "deg"),
         default=1.0,
         help="step of the table, deg (default 1; LinuxCNC reads at most 256 lines)",
+    )
+    q.add_argument(
+        "--tables",
+        action="store_true",
+        help="also write each table axis' positioning error as the controller's table: linuxcnc "
+        "[JOINT_n]COMP_FILE (type 1) and the INI lines (comp_tables.ini); siemens EEC "
+        "($AA_ENC_COMP) programs eec_<axis>.mpf",
+    )
+    q.add_argument(
+        "--spacing", default="5deg", help="--tables: between table points (default 5deg)"
+    )
+    q.add_argument(
+        "--table-range",
+        action="append",
+        metavar="AXIS=LO,HI",
+        help="--tables: the angles a table spans, deg (default: the axis' limits, an endless "
+        "axis -360,360); a continuously turning C needs what the program turns through",
+    )
+    q.add_argument(
+        "--siemens-axis",
+        action="append",
+        metavar="AXIS=NAME",
+        help="--tables, siemens: the machine axis identifier of AXIS (MD10000; default C1, B1, A1)",
+    )
+    q.add_argument(
+        "--max-points",
+        type=number("--max-points", 2, 100000, integer=True),
+        help="--tables: the most points a table may hold (default: linuxcnc 256, siemens 200; "
+        "SINUMERIK: MD38000 as configured)",
+    )
+    q.add_argument(
+        "--tables-dir",
+        type=path("--tables-dir"),
+        help="--tables: the folder of the tables (default: that of -o, else the current one)",
     )
     q.add_argument(
         "--json", action="store_true", help="print the parameters and the errors held as JSON"
