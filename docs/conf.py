@@ -48,13 +48,18 @@ autodoc_member_order = "bysource"
 autodoc_typehints = "signature"
 napoleon_numpy_docstring = True
 napoleon_google_docstring = False
+# The docstrings' "type" slots say shape and units in words ("R : (N, K) array", "Returns
+# BallbarPlan: labels, time (N,), ..."): shown as text, not as types whose every word would be
+# looked up as a Python name.
+napoleon_use_param = False
+napoleon_use_rtype = False
 
-# Cross-references must resolve (-n) inside rotacal; types of other packages (numpy, the
-# standard library, Eigen, std) are not documented here and no inventory is fetched (no
-# network in CI), so those are the only ones let through.
+# Cross-references must resolve (-n) inside rotacal: every rotacal.* Python name, C++ rotacal
+# type, page, heading and label. Let through: a Python type in a signature that is not a rotacal
+# name (numpy, typing, the standard library: no inventory is fetched, CI has no network), and
+# std, Eigen, Ceres, nlohmann in C++ declarations.
 nitpick_ignore_regex = [
-    (r"py:(class|obj|data|exc)", r"(numpy|np|pathlib|typing|collections|os|datetime|io|argparse)\..*"),
-    (r"py:(class|obj|data)", r"(Any|Path|Sequence|Mapping|Iterable|Iterator|Callable|ndarray|NDArray|float|int|str|bool|bytes|dict|list|tuple|None|object|optional)"),
+    (r"py:(class|obj|data|exc)", r"(?!rotacal\.).*"),
     (r"cpp:identifier", r"(std|Eigen|ceres|nlohmann)(::.*)?"),
 ]
 
@@ -73,8 +78,29 @@ def _run_doxygen() -> None:
     subprocess.run(["doxygen", "-"], input=doxyfile, text=True, cwd=ROOT, check=True)
 
 
+def _napoleon_except_attributes(app) -> None:
+    """Napoleon reads the numpy-style sections of the functions' docstrings, but would read an
+    attribute's first line as Google's "type: description": rotacal's attribute docstrings are
+    prose ("0: the default set-up's run time", "(8,) errors ... (mm, rad): ..."), so napoleon's
+    handler is kept for everything else."""
+    from sphinx.ext.napoleon import _process_docstring
+
+    listeners = app.events.listeners["autodoc-process-docstring"]
+    ours = [listener for listener in listeners if listener.handler is _process_docstring]
+    if len(ours) != 1:
+        raise RuntimeError("conf.py: napoleon's docstring handler not found once")
+    app.disconnect(ours[0].id)
+
+    def process(app, what, name, obj, options, lines):
+        if what not in ("attribute", "data", "property"):
+            _process_docstring(app, what, name, obj, options, lines)
+
+    app.connect("autodoc-process-docstring", process)
+
+
 def setup(app):
     # docs/json_schema.md's ```schema NAME blocks are JSON (tests/python/test_json_schema.py
     # reads them by that tag).
     app.add_lexer("schema", JsonLexer)
+    _napoleon_except_attributes(app)
     _run_doxygen()
