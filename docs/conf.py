@@ -64,7 +64,9 @@ nitpick_ignore_regex = [
 ]
 
 # Doxygen's XML of the public headers, written once per build; breathe reads it.
-DOXYGEN_XML = Path(os.environ.get("ROTACAL_DOXYGEN_DIR", ROOT / "build" / "docs" / "doxygen")) / "xml"
+DOXYGEN_XML = (
+    Path(os.environ.get("ROTACAL_DOXYGEN_DIR", ROOT / "build" / "docs" / "doxygen")) / "xml"
+)
 breathe_projects = {"rotacal": str(DOXYGEN_XML)}
 breathe_default_project = "rotacal"
 breathe_default_members = ("members", "undoc-members")
