@@ -158,6 +158,7 @@ step "Python package (pip install .) and pytest"
 bash scripts/source_id.sh --record
 # test_readme.py builds the README's C++ quick start against the installed CMake package.
 (cd tests/python && ROTACAL_PREFIX="$ROOT/build/install" "$PY" -m pytest -q -p no:cacheprovider --durations=15 .)
+bash scripts/docs.sh
 
 step "C++ example: a model file written by the Python CLI, read by C++ to compensate a point"
 "$PY" -m rotacal identify examples/data/ballbar_ac_table2.csv --save-model build/example/model.json > /dev/null

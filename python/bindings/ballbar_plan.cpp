@@ -12,7 +12,7 @@ namespace {
 // The tests, directions, segment kinds and dialects, and their labels.
 void bind_ballbar_tests(pyb::module_& m) {
   pyb::enum_<BallbarTest>(m, "BallbarTest",
-                          "Tests of the single set-up method; *_tilt are A or B by machine.")
+                          "Tests of the single set-up method; ``*_tilt`` are A or B by machine.")
       .value("sphere_xy", BallbarTest::sphere_xy)
       .value("sphere_yz", BallbarTest::sphere_yz)
       .value("sphere_zx", BallbarTest::sphere_zx)

@@ -84,7 +84,7 @@ Raises rotacal.DegenerateGeometry for < 3, collinear points or a too short arc.)
          double tolerance) { return box_least_squares(R, d, w, bounds, {max_sweeps, tolerance}); },
       pyb::arg("R"), pyb::arg("d"), pyb::arg("w"), pyb::arg("bounds"), pyb::arg("max_sweeps") = 200,
       pyb::arg("tolerance") = 1e-9,
-      R"doc(min sum w (d - R s)^2 with |s_j| <= bounds_j, by cyclic coordinate descent.
+      R"doc(min sum w (d - R s)^2 with abs(s_j) <= bounds_j, by cyclic coordinate descent.
 
 Parameters
 ----------

@@ -462,7 +462,7 @@ class BallbarSetup:
         ...
 class BallbarTest:
     """
-    Tests of the single set-up method; *_tilt are A or B by machine.
+    Tests of the single set-up method; ``*_tilt`` are A or B by machine.
     
     Members:
     
@@ -3818,7 +3818,7 @@ def ballbar_model_from_document(document: dict, source: str = '<model>') -> ...:
     ...
 def box_least_squares(R: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"], d: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], w: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], bounds: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], max_sweeps: typing.SupportsInt | typing.SupportsIndex = 200, tolerance: typing.SupportsFloat | typing.SupportsIndex = 1e-09) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
     """
-    min sum w (d - R s)^2 with |s_j| <= bounds_j, by cyclic coordinate descent.
+    min sum w (d - R s)^2 with abs(s_j) <= bounds_j, by cyclic coordinate descent.
     
     Parameters
     ----------

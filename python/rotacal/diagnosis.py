@@ -40,7 +40,7 @@ def diagnose(session: Any, *, reference: Any = None, **options: Any) -> Diagnosi
     reference : a complete standard test for the machine (commanded rows) used to name the
         test that separates ambiguous candidates (ballbar only)
     options : fields of DiagnosisOptions over its C++ defaults, e.g. ``max_harmonic`` (highest
-        harmonic order tried for the *_hn catalogue entries), ``max_findings`` (stop after this
+        harmonic order tried for the ``*_hn`` catalogue entries), ``max_findings`` (stop after this
         many effects), ``alpha`` (family-wise false-finding rate per step), ``only`` (restrict
         the candidates to these catalogue ids)
     """

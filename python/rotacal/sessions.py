@@ -172,7 +172,7 @@ def check_plausible(
     """Check a session against the nominal kinematics before any fit (C++ session/plausibility):
     refuses, with the likely cause named ("angles look like radians", "lengths look like
     inches", "all rotary angles equal", a wrong L0, ...), a session no machine with realistic
-    errors can have produced. ``max_deviation_mm`` widens the limit on |measured - nominal| of
+    errors can have produced. ``max_deviation_mm`` widens the limit on ``|measured - nominal|`` of
     a ballbar length or of an R-test centre for an unusual session. Returns the report."""
     opts = _core.PlausibilityOptions()
     if max_deviation_mm is not None:

@@ -354,7 +354,7 @@ def add_plausibility_arg(q: argparse.ArgumentParser) -> None:
         "--max-deviation",
         type=number("--max-deviation", 0.0, 1000.0, "mm", lo_open=True),
         metavar="MM",
-        help="largest |measured - nominal| a reading may have before the session is "
+        help="largest abs(measured - nominal) a reading may have before the session is "
         f"refused as implausible (default {_core.PlausibilityOptions().max_length_deviation_mm:g} mm)",
     )
 
