@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: BSD-3-Clause
 """The files every command reads and writes, in one table, and the output rule checked on
-all of them in one place, before any work (README, exit codes: "an output that is one of
-the command's inputs or outputs" is a file-system error, exit 4).
+all of them in one place, before any work (README, exit codes: an output that is one of
+the inputs is a file-system error, exit 4).
 
 Each output is first checked by the output rule itself (:func:`rotacal.outputs.check_output`:
 a directory, a missing folder, a file that may not be written), then compared with every

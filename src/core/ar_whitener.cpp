@@ -76,7 +76,7 @@ void ArWalkFilter::apply(const std::vector<Eigen::Index>& rows,
   // Four columns at a time, interleaved: each column's arithmetic and its order are those
   // of the one-column loop below (bit-identical), but the four recursions' latencies overlap
   // (the filter is a serial chain per column): 82-136 -> 21-40 us a call on 360 readings x 30
-  // columns, at load 4-8 (README, issue-29 rows).
+  // columns, at load 4-8.
   constexpr Eigen::Index kLanes = 4;
   Eigen::Index c = 0;
   for (; c + kLanes <= columns.cols(); c += kLanes) {

@@ -4,7 +4,7 @@
 /// The catalogue's table and tool motion (effects.hpp: table_pose, table_point, tool_position,
 /// and through them axis_stages and the rotations) compiled once per scalar type the library
 /// uses, in src/kinematics/effects_instances.cpp, instead of in every file that fits, simulates
-/// or diagnoses (README, "Build time"). The scalars: double, the diagnosis' candidate Jets
+/// or diagnoses. The scalars: double, the diagnosis' candidate Jets
 /// (widths 1 to 4, candidate_jets.hpp) and evaluate_with_jets' passes (4, 8, 12, 16,
 /// joint_fit.hpp). Another scalar still works: it is compiled where it is used.
 /// Included at the end of effects.hpp; not meant to be included by name.
