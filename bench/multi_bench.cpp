@@ -4,8 +4,8 @@
 // white noise; the probe's default 24 poses x 5 touches, 0.5 um AR(1) noise with rho 0.5 from
 // touch to touch), per location error: the joint fit's Monte Carlo sigma / its mean reported
 // sigma (target 0.9-1.1), and the sigma jointly and from each instrument alone (the table of
-// BENCHMARKS.md), and each session alone's Monte Carlo / reported sigma. `--smoke`: 10 draws; `--draws
-// N`; default 200.
+// BENCHMARKS.md), and each session alone's Monte Carlo / reported sigma. `--smoke`: 10 draws;
+// `--draws N`; default 200.
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
