@@ -69,7 +69,12 @@ class MultiIdentification:
                 }
                 for d in r.disagreements
             ],
+            "disagreement_test": {
+                "comparisons": int(r.comparisons),
+                "z": float(r.disagreement_z),
+            },
             "converged": bool(r.converged),
+            "sigma_inflated": bool(r.sigma_inflated),
             "unobservable": list(r.unobservable),
             "notes": list(r.notes),
         }
@@ -81,14 +86,19 @@ def identify_sessions(
     *,
     noise: str = "auto",
     effects: Sequence[str] = (),
+    inflate_sigma: bool = False,
 ) -> MultiIdentification:
     """Identify several sessions of one machine jointly (rotacal.identify with a list).
     ``names`` name the sessions in the result (default "session 1", ...); ``effects``: catalogue
     ids of the machine fitted along, one set shared by every session (about the machine zero);
-    an R-test session's raw d1,d2,d3 readings are converted as identify_rtest converts them."""
+    an R-test session's raw d1,d2,d3 readings are converted as identify_rtest converts them.
+    While the sessions disagree the result has no model (``model_dict`` refuses it), unless
+    ``inflate_sigma`` widened the sigmas of the parameters they disagree on by their scatter."""
     sessions = list(sessions)
     names = [f"session {k + 1}" for k in range(len(sessions))] if names is None else list(names)
     if len(names) != len(sessions):
         raise _core.InvalidArgument(f"identify: {len(names)} names for {len(sessions)} sessions")
     ready = [rtest.with_displacements(s)[0] if kind(s) == RTEST else s for s in sessions]
-    return MultiIdentification(_core.identify_multi(list(zip(names, ready)), noise, list(effects)))
+    return MultiIdentification(
+        _core.identify_multi(list(zip(names, ready)), noise, list(effects), inflate_sigma)
+    )
