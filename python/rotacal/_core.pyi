@@ -3846,6 +3846,9 @@ def check_plausible(session: BallbarSession, source: str, options: PlausibilityO
 @typing.overload
 def check_plausible(session: RtestSession, source: str, options: PlausibilityOptions = ...) -> PlausibilityReport:
     ...
+@typing.overload
+def check_plausible(session: ..., source: str, options: PlausibilityOptions = ...) -> PlausibilityReport:
+    ...
 def check_rtest_pattern(machine: MachineType, b_deg: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], c_deg: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], nests: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> None:
     """
     Raise InvalidArgument naming the axis and its limits (or the travel) when a tilt (b_deg) or rotary (c_deg) angle, deg, or a commanded X, Y, Z of a nest (K, 3) is outside the machine's limits.

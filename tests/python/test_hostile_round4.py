@@ -7,12 +7,13 @@ off in E_Y0C) never become one confident model; the disagreement test corrected 
 of comparisons (class 7) keeps consistent sessions unflagged."""
 
 import json
+import math
 
 
 import pytest
 
 from conftest import run_cli
-from test_multi import MACHINE, ballbar_file, rtest_file, truth_errors
+from test_multi import MACHINE, ballbar_file, probe_file, rtest_file, truth_errors
 
 EXIT_OK, EXIT_INPUT, EXIT_IO = 0, 3, 4
 
@@ -98,3 +99,97 @@ def test_consistent_sessions_are_not_flagged(tmp_path):
     assert d["disagreement_test"]["comparisons"] == 45 * 8, d["disagreement_test"]
     assert d["disagreement_test"]["z"] > 4.0, d["disagreement_test"]
     assert d["disagreements"] == [], d["disagreements"][:3]
+
+
+# ---------------------------------------------------------------- class 2: touch-probe plausibility
+
+
+@pytest.fixture(scope="module")
+def probe_lines(tmp_path_factory):
+    """A good rotacal-probe/1 session of the reference simulator (sphere 25 mm, stylus 6 mm), as
+    header lines, column line and rows split at commas; and the BC-trt one likewise."""
+    d = tmp_path_factory.mktemp("probe")
+    out = {}
+    for machine in ("AC-trt", "BC-trt"):
+        text = probe_file(d, machine, truth_errors(machine), 21).read_text()
+        lines = text.splitlines()
+        k = next(i for i, line in enumerate(lines) if line.startswith("pose,"))
+        out[machine] = (lines[:k], lines[k], [line.split(",") for line in lines[k + 1 :]])
+    return out
+
+
+def _probe_variant(probe_lines, tmp_path, machine="AC-trt", header=None, column=None, rows=None):
+    head, columns, body = probe_lines[machine]
+    head = [header(h) for h in head] if header else head
+    columns = column(columns) if column else columns
+    body = rows([list(r) for r in body]) if rows else body
+    p = tmp_path / "variant.csv"
+    p.write_text("\n".join([*head, columns, *(",".join(r) for r in body)]) + "\n")
+    return p
+
+
+def _swap_rotary(rows):
+    return [[*r[:5], r[6], r[5], *r[7:]] for r in rows]
+
+
+def _radians(rows):
+    return [
+        [*r[:5], repr(math.radians(float(r[5]))), repr(math.radians(float(r[6]))), *r[7:]]
+        for r in rows
+    ]
+
+
+def _one_touch_off(rows):
+    rows[len(rows) // 3][4] = repr(float(rows[len(rows) // 3][4]) + 35.0)  # Z 35 mm off
+    return rows
+
+
+PROBE_HOSTILE = {
+    # case: (machine, header edit, column-line edit, rows edit, words the cause must hold)
+    "sphere diameter wrong": (
+        "AC-trt",
+        lambda h: "# sphere_diameter: 31.7500" if h.startswith("# sphere_diameter:") else h,
+        None,
+        None,
+        ["sphere_diameter", "stylus_diameter", "trigger radius"],
+    ),
+    "stylus of 400 mm": (
+        "AC-trt",
+        lambda h: "# stylus_diameter: 400" if h.startswith("# stylus_diameter:") else h,
+        None,
+        None,
+        ["trigger radius"],
+    ),
+    "rotary columns swapped": ("BC-trt", None, None, _swap_rotary, ["columns look swapped"]),
+    "angles in radians": ("BC-trt", None, None, _radians, ["radians"]),
+    "machine of another kind": (
+        "BC-trt",
+        lambda h: "# machine: AC-trt" if h.startswith("# machine:") else h,
+        lambda c: c.replace(",B,", ",A,"),
+        None,
+        ["BC-trt", "fix '# machine:'"],
+    ),
+    "one touch 35 mm off": ("AC-trt", None, None, _one_touch_off, ["outlier touch", "touch "]),
+}
+
+
+@pytest.mark.parametrize("case", sorted(PROBE_HOSTILE))
+def test_implausible_probe_session_is_refused_with_its_cause(probe_lines, tmp_path, case):
+    machine, header, column, rows, words = PROBE_HOSTILE[case]
+    bad = _probe_variant(probe_lines, tmp_path, machine, header, column, rows)
+    model, hal = tmp_path / "m.json", tmp_path / "out.hal"
+    for method in ("joint", "cycles"):
+        extra = ["--save-model", model] if method == "joint" else []
+        r = run_cli("identify", bad, "--method", method, *extra, cwd=tmp_path)
+        assert r.returncode == EXIT_INPUT, (case, method, r.stdout, r.stderr)
+        assert "implausible session" in r.stderr and str(bad) in r.stderr, r.stderr
+        for w in words:
+            assert w in r.stderr, (case, w, r.stderr)
+    assert not model.exists() and not hal.exists()
+
+
+def test_good_probe_sessions_pass_the_check(probe_lines, tmp_path):
+    for machine in ("AC-trt", "BC-trt"):
+        good = _probe_variant(probe_lines, tmp_path, machine)
+        r = run_cli("identify", good, "--no-budget", cwd=tmp_path)
+        assert r.returncode == EXIT_OK, (machine, r.stderr)

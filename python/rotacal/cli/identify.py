@@ -265,6 +265,11 @@ def _cmd_identify_joint(a: argparse.Namespace) -> int:
     sessions = [load_session(f, a) for f in a.file]
     result = identify_sessions(sessions, list(a.file), noise=a.noise, inflate_sigma=a.inflate_sigma)
     d = result.to_dict()
+    if not d["converged"]:
+        raise _core.DegenerateGeometry(
+            "identify: the joint fit of the sessions did not converge: "
+            + "; ".join(n for n in d["notes"] if "converge" in n)
+        )
     keeps = a.save_model or a.store
     if keeps and d["disagreements"] and not d["sigma_inflated"]:
         _print_joint(a, d)  # what disagrees, then the refusal: nothing is written

@@ -238,6 +238,12 @@ def identify_probe_session(
         )
     result = probe.identify_probe(s, a.method, noise=a.noise)
     d = result.to_dict()
+    if not d["converged"]:  # an error, not a note: its values are no identification
+        why = "; ".join(n for n in d.get("notes", []) if "converge" in n) or "did not converge"
+        raise _core.DegenerateGeometry(
+            f"identify: {a.file}: the {a.method} fit did not converge ({why}): check the session "
+            "for an outlier touch or a wrong sphere position; nothing is reported or saved"
+        )
     if a.method == "joint" and not a.no_budget:
         from ..diagnosis import uncertainty_budget
         from ..results import budget_dict
