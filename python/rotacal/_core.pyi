@@ -4165,9 +4165,9 @@ def read_instrument_session(path: str) -> rotacal._core.BallbarSession | rotacal
     """
     Read a ballbar, R-test or touch-probe session (chosen by its format line).
     """
-def read_linuxcnc_probe_log(path: str, plan: ProbeSession) -> ProbeSession:
+def read_linuxcnc_probe_log(path: str, plan: ProbeSession, max_off_line_mm: typing.SupportsFloat | typing.SupportsIndex = 1.0) -> ProbeSession:
     """
-    The session of a LinuxCNC probing log: its latched X Y Z in the plan's rows (probe/nc_program.hpp).
+    The session of a LinuxCNC probing log: its latched X Y Z in the plan's rows (probe/nc_program.hpp); a latch farther than max_off_line_mm from its commanded line is refused.
     """
 def read_model_document(path: str) -> typing.Any:
     """

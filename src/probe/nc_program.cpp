@@ -193,7 +193,8 @@ std::string write_probe_nc_program(MachineType m, const ProbePattern& P, NcDiale
   return out;
 }
 
-ProbeSession read_linuxcnc_probe_log(const std::string& path, const ProbeSession& plan) {
+ProbeSession read_linuxcnc_probe_log(const std::string& path, const ProbeSession& plan,
+                                     double max_off_line_mm) {
   std::ifstream in(path);
   if (!in) throw IoError("cannot read " + path);
   ProbeSession out = plan;
@@ -226,6 +227,17 @@ ProbeSession read_linuxcnc_probe_log(const std::string& path, const ProbeSession
                        "touch " + nc_detail::general(p) + " " + nc_detail::general(t) +
                            " where the plan has pose " + std::to_string(pose) + ", touch " +
                            std::to_string(touch) + " (a touch missing or out of order)");
+    // G38.2 moves along the commanded line: a latch off it is another touch, or a typo.
+    const Eigen::Vector3d d = xyz - s.xyz, n = s.n.normalized();
+    const double off = (d - d.dot(n) * n).norm();
+    if (!(off <= max_off_line_mm))
+      throw ParseError(path, line_no, 1,
+                       "pose " + std::to_string(pose) + ", touch " + std::to_string(touch) +
+                           " latched " + nc_detail::general(off) +
+                           " mm off its commanded line (the plan's X, Y, Z along its nx, ny, nz), "
+                           "more than " +
+                           nc_detail::general(max_off_line_mm) +
+                           " mm: not the touch the program commanded, or a mistyped value");
     out.samples[row++].xyz = xyz;
   }
   if (row != plan.samples.size())

@@ -9,6 +9,7 @@ of comparisons (class 7) keeps consistent sessions unflagged."""
 import json
 import math
 
+import numpy as np
 
 import pytest
 
@@ -193,3 +194,119 @@ def test_good_probe_sessions_pass_the_check(probe_lines, tmp_path):
         good = _probe_variant(probe_lines, tmp_path, machine)
         r = run_cli("identify", good, "--no-budget", cwd=tmp_path)
         assert r.returncode == EXIT_OK, (machine, r.stderr)
+
+
+# ------------------------------------------- classes 4 and 5: plan probe --design, outputs, import
+
+
+@pytest.fixture(scope="module")
+def plan(tmp_path_factory):
+    """`plan probe` of a few poses: its program and session template."""
+    d = tmp_path_factory.mktemp("plan")
+    ngc, template = d / "p.ngc", d / "plan.csv"
+    r = run_cli(
+        "plan",
+        "probe",
+        "--poses",
+        "0,0;0,120;0,240;-40,60;35,200",
+        "--session",
+        template,
+        "-o",
+        ngc,
+    )
+    assert r.returncode == EXIT_OK, r.stderr
+    return d, ngc, template
+
+
+def _design(tmp_path, text):
+    p = tmp_path / "design.json"
+    p.write_text(text)
+    return p
+
+
+DESIGN_HOSTILE = {
+    "nested 60000 deep": "[" * 60_000 + "]" * 60_000,
+    "text for an angle": '{"best": {"poses_deg": [[0, 0], [15, "ninety"]]}}',
+    "angle of 7.5e2 deg": '{"best": {"poses_deg": [[0, 0], [750, 10]]}}',
+    "angle beyond a double": '{"best": {"poses_deg": [[0, 0], [1e400, 10]]}}',
+    "a pose of three numbers": '{"poses_deg": [[0, 0, 1]]}',
+    "20001 poses": json.dumps({"poses_deg": [[0, k % 300] for k in range(20_001)]}),
+    "a sphere of text": '{"best": {"poses_deg": [[0, 0]], "sphere": ["a", 0, 80]}}',
+    "directions of the wrong count": '{"best": {"poses_deg": [[0, 0], [0, 90]], '
+    '"pose_directions": [[[0, 0, -1]]]}}',
+    "not an object": "[1, 2]",
+}
+
+
+@pytest.mark.parametrize("case", sorted(DESIGN_HOSTILE))
+def test_plan_probe_design_is_read_strictly_and_bounded(tmp_path, case):
+    design = _design(tmp_path, DESIGN_HOSTILE[case])
+    ngc = tmp_path / "out.ngc"
+    r = run_cli("plan", "probe", "--design", design, "-o", ngc, cwd=tmp_path)
+    assert r.returncode == EXIT_INPUT, (case, r.stderr)
+    assert "--design" in r.stderr and "internal error" not in r.stderr, r.stderr
+    assert not ngc.exists()
+
+
+def test_plan_probe_design_missing_or_overwritten(tmp_path):
+    ngc = tmp_path / "out.ngc"
+    r = run_cli("plan", "probe", "--design", tmp_path / "absent.json", "-o", ngc, cwd=tmp_path)
+    assert r.returncode == EXIT_IO and "absent.json" in r.stderr, r.stderr
+    design = _design(tmp_path, '{"poses_deg": [[0, 0], [0, 90], [-30, 180]]}')
+    before = design.read_bytes()
+    r = run_cli("plan", "probe", "--design", design, "--session", design, "-o", ngc, cwd=tmp_path)
+    assert r.returncode == EXIT_IO and "--design" in r.stderr, r.stderr  # checked before any work
+    assert design.read_bytes() == before and not ngc.exists()
+
+
+def test_plan_probe_writes_no_output_when_one_cannot_be(tmp_path):
+    ngc = tmp_path / "old.ngc"
+    ngc.write_text("(the old program)\n")
+    r = run_cli(
+        "plan",
+        "probe",
+        "--poses",
+        "0,0;0,90;-30,180",
+        "--session",
+        "/dev/full",
+        "-o",
+        ngc,
+        cwd=tmp_path,
+    )
+    assert r.returncode == EXIT_IO, r.stderr
+    assert ngc.read_text() == "(the old program)\n"  # not a new program beside no template
+
+
+def _log(path, template, moved=None):
+    """A LinuxCNC log of the template's own touches; ``moved``: (row, offset) of one latch."""
+    import rotacal
+
+    plan_session = rotacal.load(template)
+    xyz = np.asarray(plan_session.xyz, float).copy()
+    if moved is not None:
+        xyz[moved[0]] += moved[1]
+    lines, last, touch = [], None, 0
+    numbers = {name: k + 1 for k, name in enumerate(plan_session.pose_names)}
+    for pose, p in zip(plan_session.poses, xyz):
+        touch = 1 if pose != last else touch + 1
+        last = pose
+        lines.append(f"{numbers[pose]} {touch} {p[0]:f} {p[1]:f} {p[2]:f}")
+    path.write_text("\n".join(lines) + "\n")
+    return np.asarray(plan_session.n, float)
+
+
+def test_import_refuses_a_latch_off_its_commanded_line(plan, tmp_path):
+    _, _, template = plan
+    log, out = tmp_path / "probe.log", tmp_path / "s.csv"
+    n = _log(log, template)
+    row = 7
+    side = np.cross(n[row], [0.0, 0.0, 1.0] if abs(n[row][2]) < 0.9 else [1.0, 0.0, 0.0])
+    side = 4.0 * side / np.linalg.norm(side)  # 4 mm across the line
+    _log(log, template, (row, side))
+    r = run_cli("import", "probe", log, "--plan", template, "-o", out, cwd=tmp_path)
+    assert r.returncode == EXIT_INPUT and "off its commanded line" in r.stderr, r.stderr
+    assert f"{log}:{row + 1}:" in r.stderr, r.stderr  # the log's line
+    assert not out.exists()
+    _log(log, template, (row, 0.4 * n[row]))  # along the line: a touch that came early
+    r = run_cli("import", "probe", log, "--plan", template, "-o", out, cwd=tmp_path)
+    assert r.returncode == EXIT_OK, r.stderr
