@@ -6,13 +6,14 @@ composes."""
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass
 from typing import Any, Sequence
 
 from . import _core, rtest
 from .models import estimate_dict, machine_members
 from .results import noise_model_dict
-from .sessions import RTEST, kind
+from .sessions import RTEST, kind, session_text
 
 
 @dataclass
@@ -80,6 +81,22 @@ class MultiIdentification:
         }
 
 
+def _refuse_duplicates(sessions: Sequence[Any], names: Sequence[str]) -> None:
+    """One measurement given twice (a copy, a symlink, the same data under another name) would
+    count twice and shrink every sigma by sqrt(2): refused by the SHA-256 of its content (the
+    session's file text as rotacal writes it, so comments and spacing do not hide a copy)."""
+    seen: dict[str, str] = {}
+    for s, name in zip(sessions, names):
+        digest = hashlib.sha256(session_text(s, "identify").encode("utf-8")).hexdigest()
+        if digest in seen:
+            raise _core.InvalidArgument(
+                f"identify: {name} and {seen[digest]} hold the same session (content SHA-256 "
+                f"{digest[:16]}...): one measurement counted twice would shrink the sigmas by "
+                "sqrt(2); give each session once"
+            )
+        seen[digest] = name
+
+
 def identify_sessions(
     sessions: Sequence[Any],
     names: Sequence[str] | None = None,
@@ -98,6 +115,7 @@ def identify_sessions(
     names = [f"session {k + 1}" for k in range(len(sessions))] if names is None else list(names)
     if len(names) != len(sessions):
         raise _core.InvalidArgument(f"identify: {len(names)} names for {len(sessions)} sessions")
+    _refuse_duplicates(sessions, names)
     ready = [rtest.with_displacements(s)[0] if kind(s) == RTEST else s for s in sessions]
     return MultiIdentification(
         _core.identify_multi(list(zip(names, ready)), noise, list(effects), inflate_sigma)

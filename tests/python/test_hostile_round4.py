@@ -310,3 +310,20 @@ def test_import_refuses_a_latch_off_its_commanded_line(plan, tmp_path):
     _log(log, template, (row, 0.4 * n[row]))  # along the line: a touch that came early
     r = run_cli("import", "probe", log, "--plan", template, "-o", out, cwd=tmp_path)
     assert r.returncode == EXIT_OK, r.stderr
+
+
+# ------------------------------------------------------------- class 7: statistics that overclaim
+
+
+def test_one_session_twice_is_refused_by_content(disagreeing, tmp_path):
+    _, bb, rt = disagreeing
+    copy = tmp_path / "copy_of_rt.csv"
+    # The same readings under another name, saved with CRLF line ends: the same content.
+    copy.write_bytes(rt.read_bytes().replace(b"\n", b"\r\n"))
+    link = tmp_path / "link.csv"
+    link.symlink_to(bb)
+    for twice in ([rt, copy], [bb, link], [bb, rt, copy]):
+        r = run_cli("identify", *twice, cwd=tmp_path)
+        assert r.returncode == EXIT_INPUT, r.stderr
+        assert "same session" in r.stderr and "sqrt(2)" in r.stderr, r.stderr
+        assert str(twice[-1]) in r.stderr and str(twice[-2]) in r.stderr, r.stderr
