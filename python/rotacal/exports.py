@@ -98,15 +98,26 @@ def export_dict(ex: Any) -> dict:
 def residual_model(model: dict, ex: Any) -> dict:
     """The model with the errors the controller now holds set to zero: what NC compensation
     (``rotacal compensate --model``) must still correct once the export is loaded. Its
-    ``source.residual_after`` names the export. The covariance is dropped (it describes the
-    identification, not this difference)."""
+    ``source.residual_after`` names the export. The covariance, which every model kind but the
+    ballbar's must carry, keeps its rows: those of the held errors are zero (their residual is
+    exactly zero, the export holds the identified value)."""
     out = dict(model)
     errors = {name: dict(est) for name, est in model["location_errors"].items()}
-    for e in ex.errors:
-        if e.held:
-            errors[e.name] = {"value": 0.0, "std": 0.0, "unit": errors[e.name].get("unit", "")}
+    held = {e.name for e in ex.errors if e.held}
+    for name in held:
+        errors[name] = {"value": 0.0, "std": 0.0, "unit": errors[name].get("unit", "")}
     out["location_errors"] = errors
-    out.pop("covariance", None)
+    cov = model.get("covariance")
+    if isinstance(cov, dict) and "parameters" in cov and "matrix" in cov:
+        zero = [k for k, n in enumerate(cov["parameters"]) if n in held]
+        matrix = [list(row) for row in cov["matrix"]]
+        for k in zero:
+            for j in range(len(matrix)):
+                matrix[k][j] = 0.0 if matrix[k][j] is not None else None
+                matrix[j][k] = 0.0 if matrix[j][k] is not None else None
+        out["covariance"] = dict(cov) | {"matrix": matrix}
+    else:
+        out.pop("covariance", None)
     out["source"] = dict(model.get("source", {})) | {
         "residual_after": f"{ex.controller} export ({ex.kinematics})"
     }

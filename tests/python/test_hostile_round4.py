@@ -327,3 +327,92 @@ def test_one_session_twice_is_refused_by_content(disagreeing, tmp_path):
         assert r.returncode == EXIT_INPUT, r.stderr
         assert "same session" in r.stderr and "sqrt(2)" in r.stderr, r.stderr
         assert str(twice[-1]) in r.stderr and str(twice[-2]) in r.stderr, r.stderr
+
+
+# ----------------------------------------------------------------- class 8: valid input refused
+
+# A machine of a description file, unlike any built-in and unlike test_machines' (a C table
+# turning the usual way, a B head 30 mm below the controlled point).
+DESCRIBED = {
+    "format": "rotacal-machine/1",
+    "name": "cell-4 B-head C-table",
+    "table_axes": [{"name": "C", "direction": [0, 0, 1], "point": [0, 0, 0]}],
+    "head_axes": [
+        {"name": "B", "direction": [0, 1, 0], "point": [0, 0, -30], "limits_deg": [-95, 95]}
+    ],
+    "pivot_length": 110.0,
+    "tool_length": 90.0,
+    "travel_mm": [[-600, 600], [-450, 450], [-150, 650]],
+}
+
+
+def test_history_of_a_machine_given_by_a_description_file(tmp_path):
+    desc = tmp_path / "cell4.json"
+    desc.write_text(json.dumps(DESCRIBED))
+    db = tmp_path / "h.sqlite"
+    for seed in (3, 4):
+        s = tmp_path / f"s{seed}.csv"
+        r = run_cli("simulate", "ballbar", "--machine", desc, "--seed", seed, "-o", s, cwd=tmp_path)
+        assert r.returncode == EXIT_OK, r.stderr
+        r = run_cli(
+            "identify",
+            s,
+            "--no-budget",
+            "--store",
+            "--machine-id",
+            "CELL-4",
+            "--db",
+            db,
+            "--date",
+            f"2026-0{seed}-01",
+            cwd=tmp_path,
+        )
+        assert r.returncode == EXIT_OK, r.stderr
+    shown = run_cli("history", "show", "CELL-4", "--db", db, "--json", cwd=tmp_path)
+    assert shown.returncode == EXIT_OK, shown.stderr
+    d = json.loads(shown.stdout)
+    assert d["machine_type"] == DESCRIBED["name"]
+    from rotacal import _core
+    from rotacal.machines import load_machine
+
+    names = list(_core.location_error_names(load_machine(str(desc))))
+    assert sorted(d["location_errors"]) == sorted(names), list(d["location_errors"])
+    assert all(len(d["location_errors"][n]["points"]) == 2 for n in names)
+
+
+def _export_residual(model, tmp_path):
+    residual = tmp_path / f"residual_{model.stem}.json"
+    r = run_cli(
+        "export",
+        "--model",
+        model,
+        "--controller",
+        "linuxcnc",
+        "--residual-model",
+        residual,
+        "-o",
+        tmp_path / f"{model.stem}.hal",
+        cwd=tmp_path,
+    )
+    assert r.returncode == EXIT_OK, (model.name, r.stderr)
+    doc = json.loads(residual.read_text())
+    zeroed = [n for n, e in doc["location_errors"].items() if e["value"] == 0.0 and e["std"] == 0.0]
+    assert zeroed, doc["location_errors"]  # the errors the controller now holds
+    import rotacal
+
+    rotacal.load_model(residual)  # a model file rotacal reads back
+    return doc
+
+
+def test_residual_model_of_probe_rtest_and_joint_models(disagreeing, probe_lines, tmp_path):
+    _, bb, rt = disagreeing
+    probe = _probe_variant(probe_lines, tmp_path, "AC-trt")
+    for session in (probe, rt):
+        model = tmp_path / f"model_{session.stem}.json"
+        r = run_cli("identify", session, "--no-budget", "--save-model", model, cwd=tmp_path)
+        assert r.returncode == EXIT_OK, r.stderr
+        _export_residual(model, tmp_path)
+    joint = tmp_path / "joint.json"
+    r = run_cli("identify", bb, rt, "--inflate-sigma", "--save-model", joint, cwd=tmp_path)
+    assert r.returncode == EXIT_OK, r.stderr
+    _export_residual(joint, tmp_path)

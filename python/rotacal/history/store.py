@@ -13,7 +13,8 @@ from typing import Any, Iterator, Mapping, Sequence
 from urllib.parse import urlsplit
 
 from .. import _core, jsontext
-from .drift import summarize
+from ..models import machine_of
+from .drift import error_names, summarize
 from .entries import (
     CORRECTION,
     IDENTIFICATION,
@@ -344,8 +345,8 @@ class CalibrationHistory:
         note = check_note(note)
         if not isinstance(model, Mapping):
             raise _core.InvalidArgument(f"{where}: a model must be a JSON object")
-        machine_type = _core.machine_name(_core.parse_machine_type(str(model.get("machine", ""))))
-        names = set(_core.location_error_names(_core.parse_machine_type(machine_type)))
+        machine = machine_of(dict(model), where)  # a built-in, or the model's own description
+        machine_type, names = _core.machine_name(machine), set(_core.location_error_names(machine))
         estimates = estimates_of(model, where)
         unknown = [e[1] for e in estimates if e[0] == "location_errors" and e[1] not in names]
         if unknown:
@@ -399,7 +400,7 @@ class CalibrationHistory:
         row = self._machine_type(machine_id)
         if row is None:
             raise self._unknown(machine_id, "record a correction of it")
-        names = set(_core.location_error_names(_core.parse_machine_type(row)))
+        names = set(error_names(row, self.entries(machine_id)[1]))
         foreign = [n for n in amounts if n not in names]
         if foreign:
             raise _core.InvalidArgument(
