@@ -416,3 +416,28 @@ def test_residual_model_of_probe_rtest_and_joint_models(disagreeing, probe_lines
     r = run_cli("identify", bb, rt, "--inflate-sigma", "--save-model", joint, cwd=tmp_path)
     assert r.returncode == EXIT_OK, r.stderr
     _export_residual(joint, tmp_path)
+
+
+# ------------------------------------------------------------ class 6: memory and time bounded
+
+
+def test_design_probe_grid_beyond_its_cap_is_refused_before_any_work(tmp_path):
+    out = tmp_path / "d.json"
+    # 0.02 deg x 1 deg: ~3.2 million candidate poses before this round's cap.
+    r = run_cli("design", "probe", "--tilt-step", "0.02", "--rot-step", "1", "--json", cwd=tmp_path)
+    assert r.returncode == EXIT_INPUT, r.stderr
+    assert "--tilt-step" in r.stderr and "coarsen" in r.stderr, r.stderr
+    assert not out.exists()
+
+
+def test_out_of_memory_is_invalid_input_with_its_cause(disagreeing, tmp_path, monkeypatch):
+    import rotacal.multi
+
+    def too_large(*args, **kwargs):
+        raise MemoryError("std::bad_alloc")  # what pybind11 makes of C++'s std::bad_alloc
+
+    monkeypatch.setattr(rotacal.multi._core, "identify_multi", too_large)
+    _, bb, rt = disagreeing
+    r = run_cli("identify", bb, rt, cwd=tmp_path)
+    assert r.returncode == EXIT_INPUT, r.stderr
+    assert "out of memory" in r.stderr and "too large" in r.stderr, r.stderr
