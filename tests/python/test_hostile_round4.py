@@ -441,3 +441,72 @@ def test_out_of_memory_is_invalid_input_with_its_cause(disagreeing, tmp_path, mo
     r = run_cli("identify", bb, rt, cwd=tmp_path)
     assert r.returncode == EXIT_INPUT, r.stderr
     assert "out of memory" in r.stderr and "too large" in r.stderr, r.stderr
+
+
+# ------------------------------------------- class 3: degenerate geometry in the cycles' method
+
+
+def _probe_session(tmp_path, name, sphere=(150.0, 0.0, 80.0), directions=None, seed=41):
+    """A reference-simulator probe session of AC-trt (sphere 25 mm, stylus 6 mm, 0.5 um AR
+    noise): the default poses, the sphere where given, each pose's touches along
+    ``directions`` (5 unit vectors) instead of the default five."""
+    import refsim
+    from refsim import poses, writers
+
+    m = refsim.builtin(MACHINE)
+    ses = poses.probe_poses(m, sphere=sphere)
+    if directions is not None:
+        ses["n"] = np.tile(np.asarray(directions, float), (len(ses["n"]) // 5, 1))
+    actual = ses["sphere"] + np.array([0.011, -0.007, 0.009])
+    latched = refsim.probe_touches(
+        refsim.Model(m, truth_errors(MACHINE)),
+        actual,
+        ses["sphere"],
+        25.0,
+        6.0,
+        ses["n"],
+        np.radians(ses["angles_deg"]),
+        ses["time"],
+    )
+    rng = np.random.default_rng(seed)
+    latched = latched + rng.normal(0.0, 5e-4, latched.shape)
+    return writers.write_probe(tmp_path / name, m, ses, latched, 25.0, 6.0, noise_um=0.5)
+
+
+def _ring(elevation_deg, count=5):
+    """Approach directions towards the centre from points on one circle of the sphere."""
+    e = math.radians(elevation_deg)
+    return [
+        [-math.cos(e) * math.cos(a), -math.cos(e) * math.sin(a), -math.sin(e)]
+        for a in np.radians(np.arange(count) * 360.0 / count)
+    ]
+
+
+def test_sphere_near_the_rotary_axis_leaves_that_axis_unobservable(tmp_path):
+    # ~20 um from the C axis: the C poses' centres circle it too tightly to give its line.
+    s = _probe_session(tmp_path, "near_axis.csv", sphere=(0.02, 0.04, 60.0))
+    r = run_cli("identify", s, "--method", "cycles", "--json", cwd=tmp_path)
+    assert r.returncode == EXIT_OK, r.stderr
+    d = json.loads(r.stdout)
+    c_errors = [n for n in d["location_errors"] if n.endswith("C")]
+    assert c_errors and all(d["location_errors"][n]["value"] is None for n in c_errors), d
+    assert any("axis C" in u for u in d["unobservable"]), d["unobservable"]
+    a_errors = [n for n in d["location_errors"] if n.endswith("A")]
+    assert all(d["location_errors"][n]["value"] is not None for n in a_errors), d
+
+
+@pytest.mark.parametrize(
+    "case,method,directions,words",
+    [
+        ("two spots per pose", "cycles", [[0, 0, -1]] * 3 + [[-1, 0, 0]] * 2, "at one spot"),
+        ("touches on the equator", "cycles", _ring(0.0), "one great circle"),
+        ("a ring at 40 deg, radius free", "cycles-free-radius", _ring(40.0), "one plane"),
+    ],
+)
+def test_pose_touches_degenerate_within_the_noise_are_refused(
+    tmp_path, case, method, directions, words
+):
+    s = _probe_session(tmp_path, "degenerate.csv", directions=directions)
+    r = run_cli("identify", s, "--method", method, cwd=tmp_path)
+    assert r.returncode == EXIT_INPUT, (case, r.stdout, r.stderr)
+    assert "pose '" in r.stderr and words in r.stderr, (case, r.stderr)
