@@ -154,7 +154,13 @@ void check_sessions(const std::vector<MultiSessionInput>& sessions) {
       throw InvalidArgument("identify: session name " + s.name + " given twice");
   const MachineType m = sessions.front().machine();
   for (const MultiSessionInput& s : sessions)
-    if (s.machine() != m)
+    if (s.machine() != m && to_string(s.machine()) == to_string(m))
+      throw InvalidArgument("identify: sessions " + sessions.front().name + " and " + s.name +
+                            " name one machine, " + to_string(m) +
+                            ", with two different descriptions (axes or lengths differ): a "
+                            "joint identification is of one machine; give both its one "
+                            "description");
+    else if (s.machine() != m)
       throw InvalidArgument("identify: sessions of different machine types: " +
                             sessions.front().name + " is " + to_string(m) + ", " + s.name + " is " +
                             to_string(s.machine()) + "; a joint identification is of one machine");

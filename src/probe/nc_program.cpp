@@ -11,6 +11,7 @@
 #include "../io/nc_words.hpp"
 #include "rotacal/core/angles.hpp"
 #include "rotacal/core/error.hpp"
+#include "rotacal/core/json_text.hpp"
 
 namespace rotacal {
 
@@ -160,9 +161,21 @@ std::string write_probe_nc_program(MachineType m, const ProbePattern& P, NcDiale
         "start with the stylus clear of the sphere: Z goes to the retract plane, then the rotary "
         "axes turn");
   });
-  if (o.log_file.empty() || o.log_file.find_first_of("()\r\n") != std::string::npos)
-    throw InvalidArgument(
-        "plan probe: the log file name must be non-empty without '(', ')' or line ends");
+  // (LOGOPEN,name) is one comment-like word of the line: no byte that ends or changes it, and
+  // the line within what LinuxCNC reads (254 characters).
+  const bool control = std::any_of(o.log_file.begin(), o.log_file.end(), [](char c) {
+    const auto u = static_cast<unsigned char>(c);
+    return u < 0x20 || u == 0x7F;
+  });
+  if (o.log_file.empty() || control || o.log_file.find_first_of("()") != std::string::npos)
+    throw InvalidArgument("plan probe: --log-file '" + printable(o.log_file) +
+                          "': the log file name must be non-empty, without '(', ')' or control "
+                          "bytes (line ends, escapes)");
+  if (o.log_file.size() > kMaxLogFileName)
+    throw InvalidArgument("plan probe: --log-file: " + std::to_string(o.log_file.size()) +
+                          " characters; (LOGOPEN,...) must stay within LinuxCNC's 254-character "
+                          "line, so at most " +
+                          std::to_string(kMaxLogFileName));
   line("(LOGOPEN," + o.log_file + ")");
   line("G0 Z" + num(z));
   const std::string probe_feed = "F" + nc_detail::fixed(o.probe_feed_mm_per_min, 1);
@@ -215,7 +228,7 @@ ProbeSession read_linuxcnc_probe_log(const std::string& path, const ProbeSession
     if (!(fields >> p >> t >> xyz.x() >> xyz.y() >> xyz.z()) || (fields >> extra) ||
         !xyz.allFinite())
       throw ParseError(path, line_no, 1,
-                       "expected 'pose touch X Y Z' (five numbers), got '" + text + "'");
+                       "expected 'pose touch X Y Z' (five numbers), got '" + printable(text) + "'");
     if (row >= plan.samples.size())
       throw ParseError(path, line_no, 1,
                        "more touches than the plan's " + std::to_string(plan.samples.size()));

@@ -510,3 +510,43 @@ def test_pose_touches_degenerate_within_the_noise_are_refused(
     r = run_cli("identify", s, "--method", method, cwd=tmp_path)
     assert r.returncode == EXIT_INPUT, (case, r.stdout, r.stderr)
     assert "pose '" in r.stderr and words in r.stderr, (case, r.stderr)
+
+
+# ------------------------------------------------------------- classes 9 and 10: text, smaller
+
+
+@pytest.mark.parametrize(
+    "name,words",
+    [("probe\x07log.txt", "control bytes"), ("x" * 250 + ".log", "254-character")],
+)
+def test_plan_probe_log_file_name_is_bounded(tmp_path, name, words):
+    ngc = tmp_path / "p.ngc"
+    r = run_cli("plan", "probe", "--poses", "0,0;0,90;-30,180", "--log-file", name, "-o", ngc)
+    assert r.returncode == EXIT_INPUT and words in r.stderr, r.stderr
+    assert "\x07" not in r.stderr and not ngc.exists()
+
+
+def test_import_echoes_a_bad_line_without_its_escapes(plan, tmp_path):
+    _, _, template = plan
+    log, out = tmp_path / "probe.log", tmp_path / "s.csv"
+    log.write_text("1 1 150.0 \x1b[2J\x1b[31m0.0 95.5\n")
+    r = run_cli("import", "probe", log, "--plan", template, "-o", out, cwd=tmp_path)
+    assert r.returncode == EXIT_INPUT, r.stderr
+    assert "\x1b" not in r.stderr and "\\x1B[2J" in r.stderr, repr(r.stderr)
+    assert not out.exists()
+
+
+def test_two_descriptions_of_one_name_are_named_as_such(tmp_path):
+    sessions = []
+    for k, pivot in enumerate((110.0, 125.0)):
+        desc = tmp_path / f"d{k}.json"
+        desc.write_text(json.dumps(dict(DESCRIBED, pivot_length=pivot)))
+        s = tmp_path / f"s{k}.csv"
+        r = run_cli(
+            "simulate", "ballbar", "--machine", desc, "--seed", 7 + k, "-o", s, cwd=tmp_path
+        )
+        assert r.returncode == EXIT_OK, r.stderr
+        sessions.append(s)
+    r = run_cli("identify", *sessions, cwd=tmp_path)
+    assert r.returncode == EXIT_INPUT, r.stderr
+    assert "two different descriptions" in r.stderr and DESCRIBED["name"] in r.stderr, r.stderr

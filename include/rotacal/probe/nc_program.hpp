@@ -38,6 +38,9 @@ struct ProbeProgramOptions {
   std::string log_file = "rotacal_probe.log";  ///< the controller's file of the latched positions
 };
 
+/// The longest --log-file name: "(LOGOPEN," + name + ")" within LinuxCNC's 254-character line.
+inline constexpr std::size_t kMaxLogFileName = 254 - 10;
+
 /// One probing move, machine axes (mm, deg).
 struct ProbeMove {
   int pose = 1;   ///< 1-based pose number
