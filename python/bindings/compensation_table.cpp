@@ -6,6 +6,7 @@
 #include <pybind11/stl.h>
 
 #include "numpy.hpp"
+#include "rotacal/compensation/axis_errors.hpp"
 #include "rotacal/io/angle_map.hpp"
 
 namespace rotacal::py {
@@ -81,8 +82,9 @@ void bind_compensation_table(pyb::module_& m) {
       "linuxcnc_comp_tables",
       [options](const std::string& model_path, double spacing_deg, const Ranges& range_deg,
                 const Names& file_names, std::size_t max_points, const std::string& generated_at) {
+        const ModelFile model = read_model(model_path);
         return linuxcnc_comp_tables(
-            read_model(model_path),
+            model, axis_error_functions(model, model_path),
             options(model_path, spacing_deg, range_deg, file_names, {}, max_points, generated_at));
       },
       pyb::arg("model_path"), pyb::arg("spacing_deg") = 5.0, pyb::arg("range_deg") = Ranges{},
@@ -93,8 +95,9 @@ void bind_compensation_table(pyb::module_& m) {
       "sinumerik_eec_tables",
       [options](const std::string& model_path, double spacing_deg, const Ranges& range_deg,
                 const Names& axis_names, std::size_t max_points, const std::string& generated_at) {
+        const ModelFile model = read_model(model_path);
         return sinumerik_eec_tables(
-            read_model(model_path),
+            model, axis_error_functions(model, model_path),
             options(model_path, spacing_deg, range_deg, {}, axis_names, max_points, generated_at));
       },
       pyb::arg("model_path"), pyb::arg("spacing_deg") = 5.0, pyb::arg("range_deg") = Ranges{},

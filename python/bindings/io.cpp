@@ -233,6 +233,10 @@ void bind_checks(pyb::module_& m) {
         pyb::overload_cast<const RtestSession&, const std::string&, const PlausibilityOptions&>(
             &check_plausible),
         pyb::arg("session"), pyb::arg("source"), pyb::arg("options") = PlausibilityOptions{});
+  m.def("check_plausible",
+        pyb::overload_cast<const ProbeSession&, const std::string&, const PlausibilityOptions&>(
+            &check_plausible),
+        pyb::arg("session"), pyb::arg("source"), pyb::arg("options") = PlausibilityOptions{});
   m.def("check_model_machine", &check_model_machine, pyb::arg("model_machine"),
         pyb::arg("session_machine"), pyb::arg("model_source"));
 

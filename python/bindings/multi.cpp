@@ -45,12 +45,15 @@ void bind_multi(pyb::module_& m) {
       .def_readonly("unobservable", &MultiIdentification::unobservable)
       .def_readonly("converged", &MultiIdentification::converged)
       .def_readonly("summary", &MultiIdentification::summary)
-      .def_readonly("notes", &MultiIdentification::notes);
+      .def_readonly("notes", &MultiIdentification::notes)
+      .def_readonly("sigma_inflated", &MultiIdentification::sigma_inflated)
+      .def_readonly("comparisons", &MultiIdentification::comparisons)
+      .def_readonly("disagreement_z", &MultiIdentification::disagreement_z);
 
   m.def(
       "identify_multi",
       [](const std::vector<std::pair<std::string, pyb::object>>& sessions, const std::string& noise,
-         const std::vector<std::string>& effects) {
+         const std::vector<std::string>& effects, bool inflate_sigma) {
         std::vector<MultiSessionInput> in;
         for (const auto& [name, s] : sessions) {
           if (pyb::isinstance<BallbarSession>(s))
@@ -66,15 +69,20 @@ void bind_multi(pyb::module_& m) {
         MultiFitOptions o;
         o.noise = noise_handling_from_string(noise);
         o.effects = effects_of(effects);
+        o.inflate_sigma = inflate_sigma;
         pyb::gil_scoped_release release;
         return identify_multi(in, o);
       },
       pyb::arg("sessions"), pyb::arg("noise") = "auto",
-      pyb::arg("effects") = std::vector<std::string>{},
+      pyb::arg("effects") = std::vector<std::string>{}, pyb::arg("inflate_sigma") = false,
       "One identification from several (name, session) pairs of one machine (multi/identify.hpp): "
       "one set of location errors (and of the catalogue effects `effects`), each session's own "
       "nuisances and noise model, and the "
-      "disagreements between the sessions fitted alone; noise 'auto' or 'white'.");
+      "disagreements between the sessions fitted alone; noise 'auto' or 'white'; inflate_sigma: "
+      "widen the sigmas of disagreeing parameters by their Birge ratio.");
+  m.def("refuse_disagreeing", &refuse_disagreeing, pyb::arg("identification"),
+        "InvalidArgument naming every disagreement unless there is none or the sigmas were "
+        "widened for them (multi/model_document.hpp).");
   m.def(
       "multi_model_document",
       [](const MultiIdentification& identification) {

@@ -264,8 +264,10 @@ void bind_probe_program(pyb::module_& m) {
       "sphere; probe_feed: its feed, positioning_feed: the G1 moves' to and from its start, "
       "mm/min.");
   m.def("read_linuxcnc_probe_log", &read_linuxcnc_probe_log, pyb::arg("path"), pyb::arg("plan"),
+        pyb::arg("max_off_line_mm") = 1.0,
         "The session of a LinuxCNC probing log: its latched X Y Z in the plan's rows "
-        "(probe/nc_program.hpp).");
+        "(probe/nc_program.hpp); a latch farther than max_off_line_mm from its commanded line is "
+        "refused.");
   m.def(
       "default_probe_poses_deg",
       [](MachineType machine) {

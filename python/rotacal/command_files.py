@@ -86,7 +86,7 @@ def _always(a: argparse.Namespace) -> bool:
 # Keyed by the words of the command: (command,) or (command, kind|action).
 COMMANDS: dict[tuple[str, ...], Files] = {
     ("plan", "ballbar"): Files((MACHINE, arg("--compensate")), (OUTPUT, arg("--session"))),
-    ("plan", "probe"): Files((MACHINE,), (OUTPUT, arg("--session"))),
+    ("plan", "probe"): Files((MACHINE, arg("--design")), (OUTPUT, arg("--session"))),
     ("machines", "list"): Files(),
     ("machines", "show"): Files((arg("NAME|FILE", "machine"),)),
     ("simulate", "ballbar"): Files((MACHINE,), (OUTPUT, arg("--truth"))),

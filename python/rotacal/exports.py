@@ -99,34 +99,51 @@ def export_dict(ex: Any) -> dict:
 def residual_model(model: dict, ex: Any, tables: Any = None) -> dict:
     """The model with the errors the controller now holds set to zero: what NC compensation
     (``rotacal compensate --model``) must still correct once the export is loaded. Its
-    ``source.residual_after`` names the export. The covariance is dropped (it describes the
-    identification, not this difference). ``tables``: the compensation tables written with it
-    (``controller_tables``); the model terms they hold (effects, R-test map coefficients) are
-    zeroed too, so the NC program does not correct them a second time."""
+    ``source.residual_after`` names the export. The covariance, which every model kind but the
+    ballbar's must carry, keeps its rows: those of the held terms are zero (their residual is
+    exactly zero, the export holds the identified value). ``tables``: the compensation tables
+    written with it (``controller_tables``); the model terms they hold (effects, R-test map
+    coefficients) are zeroed too, so the NC program does not correct them a second time."""
     out = dict(model)
     errors = {name: dict(est) for name, est in model["location_errors"].items()}
-    for e in ex.errors:
-        if e.held:
-            unit = errors[e.name].get("unit")  # optional in a model file: kept only if given
-            errors[e.name] = {"value": 0.0, "std": 0.0} | ({"unit": unit} if unit else {})
+    held = {e.name for e in ex.errors if e.held}
+    for name in held:
+        unit = errors[name].get("unit")  # optional in a model file: kept only if given
+        errors[name] = {"value": 0.0, "std": 0.0} | ({"unit": unit} if unit else {})
     out["location_errors"] = errors
-    held = {h for t in (tables.tables if tables is not None else []) for h in t.holds}
-    if held and "effects" in model:
+    in_tables = {h for t in (tables.tables if tables is not None else []) for h in t.holds}
+    if in_tables and "effects" in model:
         out["effects"] = [
             dict(f, params={k: dict(v, value=0.0, std=0.0) for k, v in f["params"].items()})
-            if f.get("id") in held
+            if f.get("id") in in_tables
             else f
             for f in model["effects"]
         ]
-    if held and "map_coefficients" in model:
+    if in_tables and "map_coefficients" in model:
         out["map_coefficients"] = {
-            k: (dict(v, value=0.0, std=0.0) if isinstance(v, dict) else 0.0) if k in held else v
+            k: (dict(v, value=0.0, std=0.0) if isinstance(v, dict) else 0.0)
+            if k in in_tables
+            else v
             for k, v in model["map_coefficients"].items()
         }
-    out.pop("covariance", None)
+
+    def zeroed(name: str) -> bool:
+        return name in held or name in in_tables or name.split(".", 1)[0] in in_tables
+
+    cov = model.get("covariance")
+    if isinstance(cov, dict) and "parameters" in cov and "matrix" in cov:
+        zero = [k for k, n in enumerate(cov["parameters"]) if zeroed(n)]
+        matrix = [list(row) for row in cov["matrix"]]
+        for k in zero:
+            for j in range(len(matrix)):
+                matrix[k][j] = 0.0 if matrix[k][j] is not None else None
+                matrix[j][k] = 0.0 if matrix[j][k] is not None else None
+        out["covariance"] = dict(cov) | {"matrix": matrix}
+    else:
+        out.pop("covariance", None)
     what = f"{ex.controller} export ({ex.kinematics})"
-    if held:
-        what += " and its tables (" + ", ".join(sorted(held)) + ")"
+    if in_tables:
+        what += " and its tables (" + ", ".join(sorted(in_tables)) + ")"
     out["source"] = dict(model.get("source", {})) | {"residual_after": what}
     return out
 

@@ -7,13 +7,14 @@ composes."""
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass
 from typing import Any, Sequence
 
 from . import _core, rtest
 from .models import estimate_dict, machine_members
 from .results import noise_model_dict
-from .sessions import RTEST, kind
+from .sessions import RTEST, kind, session_text
 
 
 @dataclass
@@ -70,10 +71,31 @@ class MultiIdentification:
                 }
                 for d in r.disagreements
             ],
+            "disagreement_test": {
+                "comparisons": int(r.comparisons),
+                "z": float(r.disagreement_z),
+            },
             "converged": bool(r.converged),
+            "sigma_inflated": bool(r.sigma_inflated),
             "unobservable": list(r.unobservable),
             "notes": list(r.notes),
         }
+
+
+def _refuse_duplicates(sessions: Sequence[Any], names: Sequence[str]) -> None:
+    """One measurement given twice (a copy, a symlink, the same data under another name) would
+    count twice and shrink every sigma by sqrt(2): refused by the SHA-256 of its content (the
+    session's file text as rotacal writes it, so comments and spacing do not hide a copy)."""
+    seen: dict[str, str] = {}
+    for s, name in zip(sessions, names):
+        digest = hashlib.sha256(session_text(s, "identify").encode("utf-8")).hexdigest()
+        if digest in seen:
+            raise _core.InvalidArgument(
+                f"identify: {name} and {seen[digest]} hold the same session (content SHA-256 "
+                f"{digest[:16]}...): one measurement counted twice would shrink the sigmas by "
+                "sqrt(2); give each session once"
+            )
+        seen[digest] = name
 
 
 def identify_sessions(
@@ -82,14 +104,20 @@ def identify_sessions(
     *,
     noise: str = "auto",
     effects: Sequence[str] = (),
+    inflate_sigma: bool = False,
 ) -> MultiIdentification:
     """Identify several sessions of one machine jointly (rotacal.identify with a list).
     ``names`` name the sessions in the result (default "session 1", ...); ``effects``: catalogue
     ids of the machine fitted along, one set shared by every session (about the machine zero);
-    an R-test session's raw d1,d2,d3 readings are converted as identify_rtest converts them."""
+    an R-test session's raw d1,d2,d3 readings are converted as identify_rtest converts them.
+    While the sessions disagree the result has no model (``model_dict`` refuses it), unless
+    ``inflate_sigma`` widened the sigmas of the parameters they disagree on by their scatter."""
     sessions = list(sessions)
     names = [f"session {k + 1}" for k in range(len(sessions))] if names is None else list(names)
     if len(names) != len(sessions):
         raise _core.InvalidArgument(f"identify: {len(names)} names for {len(sessions)} sessions")
+    _refuse_duplicates(sessions, names)
     ready = [rtest.with_displacements(s)[0] if kind(s) == RTEST else s for s in sessions]
-    return MultiIdentification(_core.identify_multi(list(zip(names, ready)), noise, list(effects)))
+    return MultiIdentification(
+        _core.identify_multi(list(zip(names, ready)), noise, list(effects), inflate_sigma)
+    )

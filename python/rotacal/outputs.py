@@ -59,3 +59,22 @@ def write_output(
     if not isinstance(data, (bytes, bytearray, memoryview)):
         raise TypeError(f"write_output: data must be bytes or str, got {type(data).__name__}")
     _core.write_output(p, bytes(data), ins, others)
+
+
+def write_outputs(
+    outputs: Iterable[tuple[PathLike, Union[bytes, str]]], inputs: Iterable[PathLike] = ()
+) -> None:
+    """Write every output of one command, or none where it can be known: each path is checked
+    against the inputs and the other outputs first, then the devices and FIFOs (which may
+    still fail while written, e.g. /dev/full) are written before any regular file is replaced,
+    so a failure leaves no new file beside an old one."""
+    outs = [(_path(p), data) for p, data in outputs]
+    ins = _paths(inputs)
+    kinds = [
+        check_output(p, ins, [q for j, (q, _) in enumerate(outs) if j != k])
+        for k, (p, _) in enumerate(outs)
+    ]
+    order = sorted(range(len(outs)), key=lambda k: kinds[k] != "write-through")
+    for k in order:
+        p, data = outs[k]
+        write_output(p, data, ins, [q for j, (q, _) in enumerate(outs) if j != k])

@@ -23,24 +23,6 @@ std::pair<int, int> line_column(const std::string& text, std::size_t byte) {
   return {line, col};
 }
 
-// nlohmann's message quotes the bytes it stopped at: not UTF-8 there, and then not a message
-// that Python can decode. Bytes outside printable ASCII are shown as \xNN, at most 160 in all.
-std::string printable(const std::string& what) {
-  static const char hex[] = "0123456789ABCDEF";
-  std::string out;
-  for (const char ch : what) {
-    const auto u = static_cast<unsigned char>(ch);
-    if (u >= 0x20 && u < 0x7F) {
-      out += ch;
-    } else {
-      out += "\\x";
-      out += hex[u >> 4];
-      out += hex[u & 15];
-    }
-  }
-  return out.size() > 160 ? out.substr(0, 157) + "..." : out;
-}
-
 [[noreturn]] void refuse(const std::string& text, const std::string& source, std::size_t byte,
                          const std::string& what) {
   const auto lc = line_column(text, byte);
@@ -95,6 +77,22 @@ nlohmann::ordered_json parse_json(const std::string& text, const std::string& so
     // e.g. out_of_range 406, a number beyond double ("1e99999"): found by fuzz_file_readers.
     throw ParseError(source, 0, 0, std::string("not valid JSON: ") + printable(e.what()));
   }
+}
+
+std::string printable(const std::string& what) {
+  static const char hex[] = "0123456789ABCDEF";
+  std::string out;
+  for (const char ch : what) {
+    const auto u = static_cast<unsigned char>(ch);
+    if (u >= 0x20 && u < 0x7F) {
+      out += ch;
+    } else {
+      out += "\\x";
+      out += hex[u >> 4];
+      out += hex[u & 15];
+    }
+  }
+  return out.size() > 160 ? out.substr(0, 157) + "..." : out;
 }
 
 }  // namespace rotacal

@@ -61,6 +61,22 @@ SphereFit sphere_fit(const Eigen::Ref<const Points3>& p, const SphereFitOptions&
     if (!o.radius) J(i, 3) = -1.0;
   }
   f.rms = std::sqrt(ss / static_cast<double>(p.rows()));
+  if (o.max_condition > 0.0) {
+    // Points on one great circle, in one plane (radius free) or at one spot only to within
+    // their noise pass the shape checks above, yet leave a direction of the solution resting on
+    // the noise: the Jacobian's condition number shows it whatever the scale.
+    const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(J).singularValues();
+    const double cond = sv[0] / sv[sv.size() - 1];
+    if (!(cond <= o.max_condition))
+      throw DegenerateGeometry(
+          "sphere_fit: the points leave the " +
+          std::string(o.radius ? "centre" : "centre and radius") +
+          " undetermined in one direction (condition number " + std::to_string(cond) +
+          ", more than " + std::to_string(o.max_condition) + "): they lie, to within their " +
+          "noise, " +
+          (o.radius ? "on one great circle or at one spot (need 3 off one great circle)"
+                    : "in one plane or at one spot (need 4 off one plane)"));
+  }
   const double s2 = o.sigma > 0 ? o.sigma * o.sigma
                                 : (p.rows() > k ? ss / static_cast<double>(p.rows() - k) : 0.0);
   f.covariance.topLeftCorner(k, k) = (J.transpose() * J).inverse() * s2;

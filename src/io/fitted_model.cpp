@@ -399,6 +399,7 @@ json fitted_model_document(const FittedModelContent& c) {
                 {"chi2_per_dof", number_or_null(c.chi2_per_dof)},
                 {"unobservable", c.unobservable},
                 {"notes", c.notes}};
+  if (c.kind == "multi") doc["fit"]["sigma_inflated"] = c.sigma_inflated;
   return doc;
 }
 
@@ -460,6 +461,7 @@ FittedModelContent fitted_model_from_json(const json& doc, MachineType machine,
   c.chi2_per_dof = chi.is_null() ? kNaN : r.number(fit, "chi2_per_dof", "fit", 0.0);
   c.unobservable = r.texts(fit, "unobservable", "fit");
   c.notes = r.texts(fit, "notes", "fit");
+  if (fit.contains("sigma_inflated")) c.sigma_inflated = r.boolean(fit, "sigma_inflated", "fit");
   return c;
 }
 

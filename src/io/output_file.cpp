@@ -3,7 +3,9 @@
 // everything else (directories, the command's inputs, its other outputs) refused.
 #include "rotacal/io/output_file.hpp"
 
+#include <dirent.h>
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -12,6 +14,7 @@
 #include <climits>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <random>
 #include <vector>
 
@@ -184,16 +187,48 @@ void write_through(const std::string& path, const Resolved& r, const std::string
   if (::close(fd) != 0 && errno != EINTR) fail_errno(path, "write failed", errno);
 }
 
+// A temporary of a run killed before its rename (kill -9, power loss) stays behind: the next
+// write into that directory removes it when its name's process is gone and it is older than
+// kStaleTemporarySeconds (a live write takes seconds; a directory shared with another host
+// may hold a live one whose process this host cannot see), and it is this user's own file.
+void remove_stale_temporaries(const std::string& dir) {
+  DIR* d = ::opendir(dir.c_str());
+  if (d == nullptr) return;
+  const std::time_t now = std::time(nullptr);
+  while (const dirent* e = ::readdir(d)) {
+    const std::string name = e->d_name;
+    const std::size_t dash = name.find('-', 9);
+    if (name.rfind(".rotacal-", 0) != 0 || dash == std::string::npos || name.size() < 6 ||
+        name.compare(name.size() - 5, 5, ".part") != 0)
+      continue;
+    const std::string digits = name.substr(9, dash - 9);
+    if (digits.empty() || digits.size() > 9 ||
+        digits.find_first_not_of("0123456789") != std::string::npos)
+      continue;
+    const pid_t pid = static_cast<pid_t>(std::stol(digits));
+    if (pid == ::getpid() || ::kill(pid, 0) == 0 || errno != ESRCH) continue;
+    const std::string full = (dir == "/" ? "" : dir) + "/" + name;
+    struct stat st{};
+    if (::lstat(full.c_str(), &st) != 0 || !S_ISREG(st.st_mode) || st.st_uid != ::geteuid() ||
+        now - st.st_mtime < kStaleTemporarySeconds)
+      continue;
+    (void)::unlink(full.c_str());
+  }
+  ::closedir(d);
+}
+
 // A temporary name in the target's directory: short (fits beside a 255-byte target name),
-// hidden, unique per process and attempt, created with O_EXCL so no existing file is touched.
+// hidden, unique per process and attempt, created with O_EXCL so no existing file is touched;
+// the process id in the name lets a later run tell a temporary left by a killed one.
 int create_temporary(const std::string& path, const Resolved& r, std::string& tmp) {
+  remove_stale_temporaries(r.dir);
   std::random_device rd;
   std::mt19937_64 gen((static_cast<std::uint64_t>(rd()) << 32) ^ rd() ^
                       static_cast<std::uint64_t>(::getpid()));
   static const char hex[] = "0123456789abcdef";
   for (int attempt = 0; attempt < 100; ++attempt) {
     std::uint64_t x = gen();
-    std::string name = ".rotacal-";
+    std::string name = ".rotacal-" + std::to_string(::getpid()) + "-";
     for (int i = 0; i < 16; ++i, x >>= 4) name += hex[x & 15];
     tmp = (r.dir == "/" ? "" : r.dir) + "/" + name + ".part";
     const mode_t mode = r.exists ? (r.st.st_mode & 07777) : 0666;

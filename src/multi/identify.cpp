@@ -4,10 +4,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
+#include <limits>
 #include <set>
+#include <sstream>
 
 #include "rotacal/core/block_whitener.hpp"
 #include "rotacal/core/parameter_layout.hpp"
+#include "rotacal/core/stats.hpp"
 #include "rotacal/kinematics/parameter_blocks.hpp"
 #include "rotacal/session/probe_session.hpp"
 #include "rotacal/session/session.hpp"
@@ -151,7 +155,13 @@ void check_sessions(const std::vector<MultiSessionInput>& sessions) {
       throw InvalidArgument("identify: session name " + s.name + " given twice");
   const MachineType m = sessions.front().machine();
   for (const MultiSessionInput& s : sessions)
-    if (s.machine() != m)
+    if (s.machine() != m && to_string(s.machine()) == to_string(m))
+      throw InvalidArgument("identify: sessions " + sessions.front().name + " and " + s.name +
+                            " name one machine, " + to_string(m) +
+                            ", with two different descriptions (axes or lengths differ): a "
+                            "joint identification is of one machine; give both its one "
+                            "description");
+    else if (s.machine() != m)
       throw InvalidArgument("identify: sessions of different machine types: " +
                             sessions.front().name + " is " + to_string(m) + ", " + s.name + " is " +
                             to_string(s.machine()) + "; a joint identification is of one machine");
@@ -188,8 +198,8 @@ BlockDiagonalWhitener::Block whitener_block(const SessionPart& p, const NoiseFit
   return b;
 }
 
-std::vector<MultiDisagreement> disagreements(const std::vector<MultiSessionResult>& s,
-                                             double z_max) {
+// Every comparison of two sessions alone on a parameter both determine, as a candidate.
+std::vector<MultiDisagreement> comparisons(const std::vector<MultiSessionResult>& s) {
   std::vector<MultiDisagreement> out;
   for (std::size_t a = 0; a < s.size(); ++a)
     for (std::size_t b = a + 1; b < s.size(); ++b)
@@ -206,9 +216,95 @@ std::vector<MultiDisagreement> disagreements(const std::vector<MultiSessionResul
         d.difference = ea.value - eb.value;
         d.sigma = std::hypot(ea.std, eb.std);
         d.z = d.sigma > 0.0 ? d.difference / d.sigma : 0.0;
-        if (std::abs(d.z) > z_max) out.push_back(d);
+        out.push_back(d);
       }
   return out;
+}
+
+// The |z| beyond which a comparison is a disagreement: Bonferroni's bound over the m
+// comparisons made, so that sessions of one machine show any disagreement with probability at
+// most alpha (whatever the comparisons' correlation), and never below z_min.
+double disagreement_threshold(std::size_t m, const MultiFitOptions& o) {
+  if (m == 0) return o.disagreement_z;
+  const double p = 1.0 - o.disagreement_alpha / static_cast<double>(m);
+  return std::max(o.disagreement_z, stats::t_coverage(p, std::numeric_limits<double>::infinity()));
+}
+
+ParameterEstimate& joint_shared(MultiIdentification& m, std::size_t j) {
+  // The shared parameters in the order of each session's `alone`: location errors, effects.
+  return j < m.location_errors.size() ? m.location_errors[j]
+                                      : m.effects[j - m.location_errors.size()];
+}
+
+// A joint value beyond every session's own on one side (each session's value more than z_max
+// of its sigma above it, or each below) is no average of them: reported as each session's
+// disagreement with the joint fit. A joint value between sessions that disagree is not this.
+void outside_every_session(MultiIdentification& m, double z_max,
+                           std::vector<MultiDisagreement>& out) {
+  for (std::size_t j = 0; j < m.sessions.front().alone.size(); ++j) {
+    const ParameterEstimate& J = joint_shared(m, j);
+    if (!J.observable) continue;
+    std::vector<MultiDisagreement> sides;
+    bool all_above = true, all_below = true;
+    for (const MultiSessionResult& s : m.sessions) {
+      const ParameterEstimate& e = s.alone[j];
+      if (!e.observable) continue;
+      MultiDisagreement d;
+      d.parameter = J.name;
+      d.unit = J.unit;
+      d.session_a = s.name;
+      d.session_b = kJointFitSide;
+      d.value_a = e.value;
+      d.value_b = J.value;
+      d.difference = e.value - J.value;
+      d.sigma = e.std;
+      d.z = d.sigma > 0.0 ? d.difference / d.sigma : 0.0;
+      all_above = all_above && d.z > z_max;
+      all_below = all_below && d.z < -z_max;
+      sides.push_back(d);
+    }
+    if (!sides.empty() && (all_above || all_below))
+      out.insert(out.end(), sides.begin(), sides.end());
+  }
+}
+
+std::string shown(double v) {
+  std::ostringstream s;
+  s << std::setprecision(3) << v;
+  return s.str();
+}
+
+// inflate_sigma: each parameter the sessions disagree on gets its sigma (and its covariance
+// row and column) widened by its Birge ratio, the scatter of the sessions alone about the
+// joint value, sqrt(chi2 / (n - 1)), when that exceeds 1.
+void inflate_disagreeing(MultiIdentification& m) {
+  std::set<std::string> hit;
+  for (const MultiDisagreement& d : m.disagreements) hit.insert(d.parameter);
+  for (std::size_t j = 0; j < m.sessions.front().alone.size(); ++j) {
+    ParameterEstimate& J = joint_shared(m, j);
+    if (!J.observable || hit.count(J.name) == 0) continue;
+    double chi2 = 0.0;
+    int n = 0;
+    for (const MultiSessionResult& s : m.sessions) {
+      const ParameterEstimate& e = s.alone[j];
+      if (!e.observable || !(e.std > 0.0)) continue;
+      chi2 += std::pow((e.value - J.value) / e.std, 2);
+      ++n;
+    }
+    const double r = std::sqrt(chi2 / std::max(1, n - 1));
+    if (!(r > 1.0)) continue;
+    J.std *= r;
+    const auto at = std::find(m.parameter_names.begin(), m.parameter_names.end(), J.name);
+    if (at != m.parameter_names.end()) {
+      const Eigen::Index i = at - m.parameter_names.begin();
+      m.covariance.row(i) *= r;
+      m.covariance.col(i) *= r;
+    }
+    m.notes.push_back("the sigma of " + J.name + " is widened x" + shown(r) +
+                      " (Birge ratio of the sessions alone about the joint value) because the "
+                      "sessions disagree on it, as asked (inflate sigma)");
+  }
+  m.sigma_inflated = true;
 }
 
 // The shared catalogue effects as every session fits them: their linear-axis polynomials about
@@ -285,16 +381,25 @@ MultiIdentification identify_multi(const std::vector<MultiSessionInput>& session
     out.sessions[k].residual_rms_um = std::sqrt(ms) * 1e3;
     row += n;
   }
-  out.disagreements = disagreements(out.sessions, o.disagreement_z);
-  for (const MultiDisagreement& d : out.disagreements)
-    out.notes.push_back("sessions " + d.session_a + " and " + d.session_b + " disagree on " +
-                        d.parameter + " (z = " + std::to_string(d.z) +
-                        "): the joint value averages them");
   out.parameter_names = names;
   out.covariance = std::move(fit.covariance);
   out.unobservable = std::move(fit.unobservable);
   out.converged = fit.summary.converged;
   out.summary = fit.summary;
+  std::vector<MultiDisagreement> all = comparisons(out.sessions);
+  out.comparisons = all.size();
+  out.disagreement_z = disagreement_threshold(all.size(), o);
+  for (const MultiDisagreement& d : all)
+    if (std::abs(d.z) > out.disagreement_z) out.disagreements.push_back(d);
+  outside_every_session(out, out.disagreement_z, out.disagreements);
+  for (const MultiDisagreement& d : out.disagreements)
+    out.notes.push_back(
+        d.session_b == kJointFitSide
+            ? "the joint " + d.parameter + " lies outside every session's own value (session " +
+                  d.session_a + ": z = " + shown(d.z) + "): it is no average of them"
+            : "sessions " + d.session_a + " and " + d.session_b + " disagree on " + d.parameter +
+                  " (z = " + shown(d.z) + "): the joint value describes neither of them");
+  if (!out.disagreements.empty() && o.inflate_sigma) inflate_disagreeing(out);
   if (!out.converged) out.notes.push_back("the joint fit did not converge: " + fit.summary.message);
   return out;
 }

@@ -2,9 +2,31 @@
 // A joint identification of several sessions as a model document (multi/model_document.hpp).
 #include "rotacal/multi/model_document.hpp"
 
+#include <cstdio>
+
 #include "rotacal/core/error.hpp"
 
 namespace rotacal {
+
+void refuse_disagreeing(const MultiIdentification& ident) {
+  if (ident.disagreements.empty() || ident.sigma_inflated) return;
+  std::string what;
+  for (const MultiDisagreement& d : ident.disagreements) {
+    if (what.size() > 600) {
+      what += "; ...";
+      break;
+    }
+    char z[32];
+    std::snprintf(z, sizeof z, "%.1f", d.z);
+    what += (what.empty() ? "" : "; ") + d.parameter + " (" + d.session_a + " vs " + d.session_b +
+            ", z = " + z + ")";
+  }
+  throw InvalidArgument(
+      "the sessions disagree: " + what +
+      ". A joint model of sessions that disagree describes no machine, so it is not saved, "
+      "stored or exported: find the session in error (another machine, a gross error), or "
+      "ask for the sigmas to be widened by the sessions' scatter (identify --inflate-sigma)");
+}
 
 FittedModelContent multi_model_content(const MultiIdentification& ident) {
   const std::size_t n = ident.parameter_names.size();
@@ -16,6 +38,7 @@ FittedModelContent multi_model_content(const MultiIdentification& ident) {
     throw InvalidArgument("multi_model_content: " + std::to_string(ident.effects.size()) +
                           " effect parameters, the effect model has " +
                           std::to_string(ident.effect_model.num_params()));
+  refuse_disagreeing(ident);
   FittedModelContent c;
   c.kind = "multi";
   c.machine = ident.machine;
@@ -44,6 +67,7 @@ FittedModelContent multi_model_content(const MultiIdentification& ident) {
   c.chi2_per_dof = ident.summary.chi2_per_dof;
   c.unobservable = ident.unobservable;
   c.notes = ident.notes;
+  c.sigma_inflated = ident.sigma_inflated;
   return c;
 }
 

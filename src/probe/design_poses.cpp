@@ -20,12 +20,22 @@ std::array<double, 2> tilt_range(MachineType m) {
 
 std::vector<RotaryAngles<double>> pose_grid(MachineType m, double tilt_step, double rot_step) {
   const std::array<double, 2> t = tilt_range(m);
-  std::vector<double> tilts, rots;
-  for (int k = 0; t[0] + k * tilt_step <= t[1] + 1e-9; ++k) tilts.push_back(t[0] + k * tilt_step);
-  if (t[1] - tilts.back() > 1e-9) tilts.push_back(t[1]);
   std::array<double, 2> r = {0.0, 360.0};
   const auto& rl = m.description().axis(m.rot_index()).limits_deg;
   if (rl) r = *rl;
+  // Each candidate pose holds its touches' Jacobian rows in the design: a grid beyond the cap
+  // would exhaust the memory (a 0.01 deg tilt step: ~300,000 poses), so it is refused first.
+  const double count =
+      (std::floor((t[1] - t[0]) / tilt_step) + 2.0) * (std::floor((r[1] - r[0]) / rot_step) + 2.0);
+  if (count > kMaxGridPoses)
+    throw InvalidArgument("design probe: --tilt-step " + fixed_text(tilt_step, 3) +
+                          " and --rot-step " + fixed_text(rot_step, 3) + " deg make ~" +
+                          fixed_text(count, 0) + " candidate poses, more than the " +
+                          std::to_string(kMaxGridPoses) +
+                          " a design holds in bounded memory: coarsen the steps");
+  std::vector<double> tilts, rots;
+  for (int k = 0; t[0] + k * tilt_step <= t[1] + 1e-9; ++k) tilts.push_back(t[0] + k * tilt_step);
+  if (t[1] - tilts.back() > 1e-9) tilts.push_back(t[1]);
   for (int k = 0; r[0] + k * rot_step < r[1] - 1e-9 || (rl && r[0] + k * rot_step <= r[1] + 1e-9);
        ++k)
     rots.push_back(r[0] + k * rot_step);

@@ -17,8 +17,11 @@ namespace rotacal::probe_design {
 /// The tilt axis' limits within -90..90 deg (-90..90 without limits), as default_probe_pattern.
 std::array<double, 2> tilt_range(MachineType m);
 
+/// The most candidate poses a grid may hold (about 10 kB of design state each).
+inline constexpr int kMaxGridPoses = 10000;
 /// The grid: tilt over tilt_range every tilt_step (and its end), the rotary axis over a full
-/// turn (or its limits, both ends) every rot_step.
+/// turn (or its limits, both ends) every rot_step; InvalidArgument naming the steps when it
+/// would hold more than kMaxGridPoses poses.
 std::vector<RotaryAngles<double>> pose_grid(MachineType m, double tilt_step, double rot_step);
 
 /// Candidate approach directions (machine frame, unit) at a pose (deg): the contact point's

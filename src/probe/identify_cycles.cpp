@@ -3,6 +3,8 @@
 // ISG SysMeasRotAx), as the peer of the joint fit: sphere per pose, then per table axis a
 // plane (Flynn et al. 2016, Eq. 3) and a circle (hyper fit, Al-Sharadqah & Chernov 2009)
 // through the centres of the poses that turn that axis alone.
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -19,7 +21,17 @@ struct PoseCentre {
   std::string label;
   RotaryAngles<double> angles_deg;
   Eigen::Vector3d centre;
+  double rms = 0.0;  // of its sphere fit, mm
 };
+
+// A pose's centre resting on the noise in one direction (its Jacobian's condition number
+// beyond this: the std there 100 times the best one's) is refused, naming the pose.
+constexpr double kMaxPoseCondition = 100.0;
+// An axis whose poses' centres circle it less than this many noise sigmas in radius leaves
+// its direction and position to the noise: reported unobservable, as the joint fit does.
+constexpr double kMinCircleToNoise = 200.0;
+// The noise floor of that judgement (mm): noise-free simulated touches still set a scale.
+constexpr double kNoiseFloorMm = 1e-4;
 
 // Sphere fit of each pose's touches (the stylus-tip centres: on a table-table machine the
 // latched X, Y, Z themselves).
@@ -32,10 +44,11 @@ std::vector<PoseCentre> pose_centres(const ProbeSession& s, const ProbeCyclesOpt
       P.row(static_cast<Eigen::Index>(k)) = s.samples[idx[k]].xyz;
     SphereFitOptions so;
     if (o.radius_known) so.radius = s.trigger_radius();
+    so.max_condition = kMaxPoseCondition;
     try {
       const SphereFit f = sphere_fit(P, so);
       const ProbeSample& first = s.samples[idx.front()];
-      out.push_back({pose, {first.tilt_deg, first.rot_deg}, f.centre});
+      out.push_back({pose, {first.tilt_deg, first.rot_deg}, f.centre, f.rms});
     } catch (const DegenerateGeometry& e) {
       throw DegenerateGeometry("identify_probe_cycles: pose '" + pose + "': " + e.what());
     }
@@ -48,6 +61,7 @@ struct AxisFit {
   Eigen::Vector3d point;       // circle centre, on the axis line
   double dispersion_sq = 0.0;  // sum of squared distances of the centres from the circle
   int n = 0;
+  double radius = 0.0;  // of the circle of the centres, mm
 };
 
 // Plane and circle through the centres of the poses that turn chain axis k alone (the other
@@ -87,6 +101,7 @@ AxisFit fit_axis(MachineType m, int k, const std::vector<PoseCentre>& centres) {
     out.dispersion_sq += axial * axial + radial * radial;
   }
   out.n = static_cast<int>(P.rows());
+  out.radius = circle.radius;
   return out;
 }
 
@@ -118,20 +133,37 @@ ProbeIdentification identify_probe_cycles(const ProbeSession& s, const ProbeCycl
   ProbeIdentification out;
   out.method = "cycles";
   out.model.machine = m;
-  double dispersion_sq = 0.0;
+  double dispersion_sq = 0.0, noise_sq = 0.0;
   int n_disp = 0;
+  for (const PoseCentre& c : centres) noise_sq += c.rms * c.rms;
+  const double noise =
+      std::max(kNoiseFloorMm, std::sqrt(noise_sq / static_cast<double>(centres.size())));
+  std::array<bool, 2> seen{true, true};
   for (int k = 0; k < 2; ++k) {
     const AxisFit f = fit_axis(m, k, centres);
-    out.model.errors.v.segment<4>(4 * k) = axis_errors(d.axis(k), f);
     dispersion_sq += f.dispersion_sq;
     n_disp += f.n;
+    if (!(f.radius >= kMinCircleToNoise * noise)) {  // the sphere on or near this axis
+      seen[static_cast<std::size_t>(k)] = false;
+      out.unobservable.push_back(
+          std::string("axis ") + d.axis(k).name +
+          ": the sphere centres of the poses that turn "
+          "it circle it with a radius of " +
+          std::to_string(f.radius) + " mm, under " + std::to_string(kMinCircleToNoise) +
+          " times the touches' noise (" + std::to_string(noise * 1e3) +
+          " um): the sphere sits on or near the axis, so its "
+          "direction and position are not determined (move the sphere off the axis)");
+      continue;
+    }
+    out.model.errors.v.segment<4>(4 * k) = axis_errors(d.axis(k), f);
   }
   out.dispersion_um = std::sqrt(dispersion_sq / std::max(1, n_disp)) * 1e3;
   const auto& names = location_error_names(m);
   for (int k = 0; k < 8; ++k)
     out.parameters.push_back({names[static_cast<std::size_t>(k)], out.model.errors.v[k],
                               std::numeric_limits<double>::quiet_NaN(),
-                              location_error_is_angle(k) ? "rad" : "mm", true});
+                              location_error_is_angle(k) ? "rad" : "mm",
+                              seen[static_cast<std::size_t>(k / 4)]});
   // The sphere on the table: each pose's centre taken back by the identified table motion.
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   for (const PoseCentre& c : centres) {

@@ -12,6 +12,7 @@
 #include "../io/nc_words.hpp"
 #include "rotacal/core/angles.hpp"
 #include "rotacal/core/error.hpp"
+#include "rotacal/core/json_text.hpp"
 
 namespace rotacal {
 
@@ -161,9 +162,21 @@ std::string write_probe_nc_program(MachineType m, const ProbePattern& P, NcDiale
         "start with the stylus clear of the sphere: Z goes to the retract plane, then the rotary "
         "axes turn");
   });
-  if (o.log_file.empty() || o.log_file.find_first_of("()\r\n") != std::string::npos)
-    throw InvalidArgument(
-        "plan probe: the log file name must be non-empty without '(', ')' or line ends");
+  // (LOGOPEN,name) is one comment-like word of the line: no byte that ends or changes it, and
+  // the line within what LinuxCNC reads (254 characters).
+  const bool control = std::any_of(o.log_file.begin(), o.log_file.end(), [](char c) {
+    const auto u = static_cast<unsigned char>(c);
+    return u < 0x20 || u == 0x7F;
+  });
+  if (o.log_file.empty() || control || o.log_file.find_first_of("()") != std::string::npos)
+    throw InvalidArgument("plan probe: --log-file '" + printable(o.log_file) +
+                          "': the log file name must be non-empty, without '(', ')' or control "
+                          "bytes (line ends, escapes)");
+  if (o.log_file.size() > kMaxLogFileName)
+    throw InvalidArgument("plan probe: --log-file: " + std::to_string(o.log_file.size()) +
+                          " characters; (LOGOPEN,...) must stay within LinuxCNC's 254-character "
+                          "line, so at most " +
+                          std::to_string(kMaxLogFileName));
   line("(LOGOPEN," + o.log_file + ")");
   line("G0 Z" + num(z));
   const std::string probe_feed = "F" + nc_detail::fixed(o.probe_feed_mm_per_min, 1);
@@ -194,7 +207,8 @@ std::string write_probe_nc_program(MachineType m, const ProbePattern& P, NcDiale
   return out;
 }
 
-ProbeSession read_linuxcnc_probe_log(const std::string& path, const ProbeSession& plan) {
+ProbeSession read_linuxcnc_probe_log(const std::string& path, const ProbeSession& plan,
+                                     double max_off_line_mm) {
   std::ifstream in(path);
   if (!in) throw IoError("cannot read " + path);
   ProbeSession out = plan;
@@ -215,7 +229,7 @@ ProbeSession read_linuxcnc_probe_log(const std::string& path, const ProbeSession
     if (!(fields >> p >> t >> xyz.x() >> xyz.y() >> xyz.z()) || (fields >> extra) ||
         !xyz.allFinite())
       throw ParseError(path, line_no, 1,
-                       "expected 'pose touch X Y Z' (five numbers), got '" + text + "'");
+                       "expected 'pose touch X Y Z' (five numbers), got '" + printable(text) + "'");
     if (row >= plan.samples.size())
       throw ParseError(path, line_no, 1,
                        "more touches than the plan's " + std::to_string(plan.samples.size()));
@@ -227,6 +241,17 @@ ProbeSession read_linuxcnc_probe_log(const std::string& path, const ProbeSession
                        "touch " + nc_detail::general(p) + " " + nc_detail::general(t) +
                            " where the plan has pose " + std::to_string(pose) + ", touch " +
                            std::to_string(touch) + " (a touch missing or out of order)");
+    // G38.2 moves along the commanded line: a latch off it is another touch, or a typo.
+    const Eigen::Vector3d d = xyz - s.xyz, n = s.n.normalized();
+    const double off = (d - d.dot(n) * n).norm();
+    if (!(off <= max_off_line_mm))
+      throw ParseError(path, line_no, 1,
+                       "pose " + std::to_string(pose) + ", touch " + std::to_string(touch) +
+                           " latched " + nc_detail::general(off) +
+                           " mm off its commanded line (the plan's X, Y, Z along its nx, ny, nz), "
+                           "more than " +
+                           nc_detail::general(max_off_line_mm) +
+                           " mm: not the touch the program commanded, or a mistyped value");
     out.samples[row++].xyz = xyz;
   }
   if (row != plan.samples.size())

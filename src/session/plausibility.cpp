@@ -8,6 +8,8 @@
 
 #include "rotacal/core/angles.hpp"
 #include "rotacal/core/error.hpp"
+#include "rotacal/kinematics/machine_description.hpp"
+#include "rotacal/session/probe_session.hpp"
 
 namespace rotacal {
 
@@ -197,6 +199,107 @@ PlausibilityReport check_plausible(const RtestSession& s, const std::string& sou
           " mm a machine's errors explain: wrong nest metadata, wrong machine, or positions that "
           "are not the commanded axes (rotacal's --max-deviation or "
           "PlausibilityOptions::max_position_deviation_mm widens it)");
+}
+
+namespace {
+
+// |distance of the nominal stylus-tip centre from the nominal sphere centre - trigger radius|
+// of every touch, the angles read as the file says or as a careless file may hold them.
+struct ProbeReading {
+  bool radians = false;  // the file's angles taken as radians
+  bool swapped = false;  // the tilt and rotary columns exchanged
+};
+
+std::vector<double> touch_distances(const ProbeSession& s, MachineType m, ProbeReading how) {
+  const LocationErrors<double> nominal;
+  std::vector<double> out;
+  out.reserve(s.samples.size());
+  for (const ProbeSample& t : s.samples) {
+    const double tilt = how.swapped ? t.rot_deg : t.tilt_deg;
+    const double rot = how.swapped ? t.tilt_deg : t.rot_deg;
+    const RotaryAngles<double> a = angles_as(tilt, rot, how.radians);
+    out.push_back((tool_ball(m, nominal, a, t.xyz) - forward(m, nominal, a, s.sphere)).norm());
+  }
+  return out;
+}
+
+// How many touches lie farther than `limit` from `radius` about the nominal sphere centre.
+std::size_t off_sphere(const std::vector<double>& dist, double radius, double limit) {
+  return static_cast<std::size_t>(std::count_if(
+      dist.begin(), dist.end(), [&](double d) { return !(std::abs(d - radius) <= limit); }));
+}
+
+}  // namespace
+
+PlausibilityReport check_plausible(const ProbeSession& s, const std::string& source,
+                                   const PlausibilityOptions& o) {
+  if (s.samples.empty()) refuse(source, "no touches");
+  PlausibilityReport rep;
+  double max_abs_angle = 0.0;
+  spans(s.samples, rep.tilt_span_deg, rep.rot_span_deg, max_abs_angle);
+  check_spans(source, rep.tilt_span_deg, rep.rot_span_deg, o);
+  const double R = s.trigger_radius();
+  if (!(R > 0.0) || !std::isfinite(R))
+    refuse(source, "trigger radius (sphere_diameter + stylus_diameter) / 2 = " + fmt(R) +
+                       " mm: a touch needs a sphere and a stylus of positive size");
+  // Every touch: the nominal stylus-tip centre at the trigger lies the trigger radius from the
+  // nominal sphere centre, to within the sphere's placement and the machine's errors.
+  const std::vector<double> dist = touch_distances(s, s.machine, {});
+  std::vector<double> dev;
+  for (double d : dist) dev.push_back(std::abs(d - R));
+  rep.median_deviation_mm = median_of(dev);
+  const auto worst = std::max_element(dev.begin(), dev.end());
+  rep.max_deviation_mm = *worst;
+  rep.worst_sample = static_cast<std::size_t>(worst - dev.begin());
+  const double limit = o.max_position_deviation_mm;
+  if (rep.max_deviation_mm <= limit) return rep;
+  // The likely cause, most specific first: a reading of the file under which every touch but
+  // a few outliers (at most 1 in 20) lies on the sphere.
+  const std::size_t allowed = std::max<std::size_t>(1, dist.size() / 20);
+  const bool most_fail = off_sphere(dist, R, limit) > allowed;
+  auto fits = [&](MachineType m, ProbeReading how) {
+    return off_sphere(touch_distances(s, m, how), R, limit) <= allowed;
+  };
+  if (most_fail && max_abs_angle <= 2.0 * kPi + 1e-9 && fits(s.machine, {true, false}))
+    refuse(source,
+           "angles look like radians: every angle is within +-2 pi, and read as radians the "
+           "touches lie on the sphere while read as degrees they do not (median " +
+               fmt(rep.median_deviation_mm) + " mm off); the format wants degrees");
+  if (most_fail && fits(s.machine, {false, true}))
+    refuse(source, std::string("the ") + tilt_axis_letter(s.machine) + " and " +
+                       rot_axis_letter(s.machine) +
+                       " columns look swapped: exchanged, the touches lie on the sphere (median " +
+                       fmt(rep.median_deviation_mm) + " mm off as the file has them)");
+  if (most_fail)
+    for (const std::string& name : builtin_machine_names()) {
+      const MachineType other = parse_machine_type(name);
+      if (other == s.machine || !fits(other, {})) continue;
+      refuse(source, "the touches fit a " + name + " machine, not the " + to_string(s.machine) +
+                         " the file names (median " + fmt(rep.median_deviation_mm) +
+                         " mm off): fix '# machine:'");
+    }
+  const double M = median_of(dist);
+  if (std::abs(M - R) > limit && off_sphere(dist, M, limit) <= allowed)
+    refuse(source, "the touches lie ~" + fmt(M) +
+                       " mm from the nominal sphere centre, but the trigger radius "
+                       "(sphere_diameter " +
+                       fmt(s.sphere_diameter) + " + stylus_diameter " + fmt(s.stylus_diameter) +
+                       ") / 2 is " + fmt(R) +
+                       " mm: a wrong '# sphere_diameter:' or '# stylus_diameter:' (together ~" +
+                       fmt(2.0 * M) + " mm by the data)");
+  const ProbeSample& w = s.samples[rep.worst_sample];
+  refuse(source,
+         "touch " + std::to_string(rep.worst_sample) + " (pose " + w.pose + ", time " +
+             fmt(w.time, 8) + " s) at (" + fmt(w.xyz.x(), 8) + ", " + fmt(w.xyz.y(), 8) + ", " +
+             fmt(w.xyz.z(), 8) + ") is " + fmt(rep.max_deviation_mm) +
+             " mm off the nominal sphere, more than the " + fmt(limit) + " mm its placement and " +
+             "a machine's errors explain" +
+             (most_fail ? ", and so are most touches (median " + fmt(rep.median_deviation_mm) +
+                              " mm): wrong '# sphere:', wrong machine, or positions that are "
+                              "not the latched stylus-tip centre"
+                        : ": an outlier touch (a false trigger or a mistyped value)") +
+             " (rotacal's --max-deviation or PlausibilityOptions::max_position_deviation_mm "
+             "widens it)");
 }
 
 void check_model_machine(MachineType model_machine, MachineType session_machine,

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include "rotacal/compensation/axis_errors.hpp"
 #include "rotacal/core/error.hpp"
 #include "rotacal/io/angle_map.hpp"
 

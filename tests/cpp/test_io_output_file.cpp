@@ -6,11 +6,13 @@
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
 #include <csignal>
 #include <cstdlib>
+#include <ctime>
 #include <fstream>
 #include <sstream>
 #include <thread>
@@ -73,6 +75,31 @@ TEST_CASE("a user's own OUT.tmp is never touched") {
   write_output(d / "out.csv", std::string("x"));
   CHECK(slurp(d / "out.csv.tmp") == "mine");
   CHECK(d.entries() == std::vector<std::string>{"out.csv", "out.csv.tmp"});
+}
+
+TEST_CASE("a temporary left by a killed run is removed by the next write, a live one is not") {
+  TempDir d;
+  const pid_t child = ::fork();  // a process id that is gone once waited for
+  if (child == 0) ::_exit(0);
+  REQUIRE(child > 0);
+  int status = 0;
+  REQUIRE(::waitpid(child, &status, 0) == child);
+  const std::string gone = std::to_string(child), mine = std::to_string(::getpid());
+  auto aged = [&](const std::string& name, long seconds) {
+    put(d / name, "rows");
+    const timespec t[2] = {{std::time(nullptr) - seconds, 0}, {std::time(nullptr) - seconds, 0}};
+    REQUIRE(::utimensat(AT_FDCWD, (d / name).c_str(), t, 0) == 0);
+  };
+  aged(".rotacal-" + gone + "-0123456789abcdef.part", kStaleTemporarySeconds + 60);  // stale
+  aged(".rotacal-" + gone + "-fedcba9876543210.part", 5);     // too young: maybe another host's
+  aged(".rotacal-" + mine + "-00112233aabbccdd.part", 3600);  // a live process's
+  aged(".rotacal-0123456789abcdef.part", 3600);               // no process id: not rotacal's now
+  write_output(d / "out.csv", std::string("x"));
+  std::vector<std::string> kept = {".rotacal-" + gone + "-fedcba9876543210.part",
+                                   ".rotacal-" + mine + "-00112233aabbccdd.part",
+                                   ".rotacal-0123456789abcdef.part", "out.csv"};
+  std::sort(kept.begin(), kept.end());
+  CHECK(d.entries() == kept);
 }
 
 TEST_CASE("the old file keeps its permission bits") {

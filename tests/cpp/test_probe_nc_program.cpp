@@ -6,6 +6,7 @@
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 
 #include "rotacal/probe/nc_program.hpp"
 
@@ -79,18 +80,38 @@ TEST_CASE("the log is read back into the plan's rows, and a bad log is refused b
   const ProbeSession plan = simulate_probe(nominal, so).session;
   const std::string path =
       (std::filesystem::temp_directory_path() / "rotacal_test_probe.log").string();
-  {
+  // A latch lies on its commanded line (the plan's X, Y, Z along n), here 1 um further per row.
+  auto on_line = [&](std::size_t i, double along) {
+    return Eigen::Vector3d(plan.samples[i].xyz + along * plan.samples[i].n.normalized());
+  };
+  auto write = [&](const std::vector<Eigen::Vector3d>& latched) {
     std::ofstream f(path);
-    for (std::size_t i = 0; i < plan.samples.size(); ++i)
-      f << i / 5 + 1 << " " << i % 5 + 1 << " " << 1.0 + i << " 2.000000 3.000000\n";
-  }
+    f << std::setprecision(12);
+    for (std::size_t i = 0; i < latched.size(); ++i)
+      f << i / 5 + 1 << " " << i % 5 + 1 << " " << latched[i].x() << " " << latched[i].y() << " "
+        << latched[i].z() << "\n";
+  };
+  std::vector<Eigen::Vector3d> latched;
+  for (std::size_t i = 0; i < plan.samples.size(); ++i) latched.push_back(on_line(i, 1e-3 * i));
+  write(latched);
   const ProbeSession s = read_linuxcnc_probe_log(path, plan);
   REQUIRE(s.samples.size() == plan.samples.size());
-  CHECK(s.samples[7].xyz.x() == 8.0);
+  CHECK((s.samples[7].xyz - on_line(7, 7e-3)).norm() < 1e-9);
   CHECK(s.samples[7].n == plan.samples[7].n);
+  // 1.5 mm across its line (perpendicular to n): not the touch commanded, refused by line.
+  const Eigen::Vector3d n3 = plan.samples[3].n.normalized();
+  const Eigen::Vector3d across = n3.cross(Eigen::Vector3d::UnitX()).norm() > 0.1
+                                     ? n3.cross(Eigen::Vector3d::UnitX()).normalized()
+                                     : n3.cross(Eigen::Vector3d::UnitY()).normalized();
+  latched[3] += 1.5 * across;
+  write(latched);
+  CHECK_THROWS_WITH(read_linuxcnc_probe_log(path, plan),
+                    Catch::Contains(":4:") && Catch::Contains("off its commanded line"));
+  CHECK_NOTHROW(read_linuxcnc_probe_log(path, plan, 2.0));  // a wider bound takes it
   {
     std::ofstream f(path);
-    f << "1 1 1 2 3\n1 3 1 2 3\n";
+    f << std::setprecision(12) << "1 1 " << latched[0].x() << " " << latched[0].y() << " "
+      << latched[0].z() << "\n1 3 1 2 3\n";
   }
   CHECK_THROWS_WITH(read_linuxcnc_probe_log(path, plan),
                     Catch::Contains(":2:") && Catch::Contains("out of order"));

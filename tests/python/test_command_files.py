@@ -37,7 +37,8 @@ TEMPLATES = {
         ]
     ],
     ("plan", "probe"): [
-        ["plan", "probe", "--machine", "{--machine}", "--session", "{--session}", "-o", "{-o}"]
+        ["plan", "probe", "--machine", "{--machine}", "--session", "{--session}", "-o", "{-o}"],
+        ["plan", "probe", "--design", "{--design}", "--session", "{--session}", "-o", "{-o}"],
     ],
     ("import", "probe"): [["import", "probe", "{LOG}", "--plan", "{--plan}", "-o", "{-o}"]],
     ("simulate", "ballbar"): [
@@ -302,6 +303,8 @@ def sources(shared_data, tmp_path_factory):
     )  # a touch-probe session as `import probe --plan` template, and its log
     probe_plan.write_bytes((shared_data / "probe_ac_table2.csv").read_bytes())
     probe = rotacal.load(probe_plan)
+    design = d / "design.json"  # what `design probe --json` gives `plan probe --design`
+    design.write_text(json.dumps({"poses_deg": [[0, 0], [0, 90], [-30, 180]]}))
     probe_log = d / "probe.log"
     probe_log.write_text(
         "".join(
@@ -328,6 +331,7 @@ def sources(shared_data, tmp_path_factory):
         "--port": port,
         "LOG": probe_log,
         "--plan": probe_plan,
+        "--design": design,
     }
 
 

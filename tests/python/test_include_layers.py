@@ -25,6 +25,7 @@ ORDER = [
     "circular",
     "diagnose",
     "multi",
+    "compensation",
     "hw",
 ]
 INSTRUMENTS = {"ballbar", "rtest", "probe"}

@@ -34,4 +34,9 @@ void check_json_bounds(const std::string& text, const std::string& source);
 /// bounds above. Throws ParseError naming `source`, line and column.
 nlohmann::ordered_json parse_json(const std::string& text, const std::string& source);
 
+/// Text fit for a message: bytes outside printable ASCII (terminal escapes, control bytes,
+/// bytes that are not UTF-8) shown as \xNN, at most 160 characters in all. nlohmann's
+/// messages quote the bytes they stopped at; a reader echoes a bad line with it.
+std::string printable(const std::string& text);
+
 }  // namespace rotacal

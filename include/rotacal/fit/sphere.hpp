@@ -28,11 +28,16 @@ struct SphereFit {
 struct SphereFitOptions {
   std::optional<double> radius;  ///< fix the radius (e.g. the calibrated ballbar length)
   double sigma = 0.0;            ///< known 1-sigma noise; 0: estimate from the residuals
+  /// Refuse (DegenerateGeometry) a solution whose Jacobian's condition number exceeds this:
+  /// points degenerate only to within their noise (one spot, one great circle, one plane).
+  /// 0: no such check.
+  double max_condition = 0.0;
 };
 
-/// Throws DegenerateGeometry for too few points (4 free radius, 3 fixed), collinear points, or
+/// Throws DegenerateGeometry for too few points (4 free radius, 3 fixed), collinear points,
 /// coplanar points (a free radius is then undetermined; a fixed one has two mirror
-/// solutions); InvalidArgument for non-finite input or a radius <= 0.
+/// solutions), or a condition number beyond options.max_condition; InvalidArgument for non-finite
+/// input or a radius <= 0.
 SphereFit sphere_fit(const Eigen::Ref<const Points3>& points, const SphereFitOptions& options = {});
 
 }  // namespace rotacal

@@ -12,6 +12,8 @@
 ///     the stages of one axis as kinematics/effects.hpp walks them (zero offset, angular
 ///     positioning, radial / axial / tilt motion harmonics, coning, gravity sag).
 /// The location errors are left out: the kinematic parameters hold them (controller_export.hpp).
+/// Here the terms' types and their sampling; the functions of a model, which need the R-test
+/// layer: compensation/axis_errors.hpp.
 ///
 /// The terms of axis k are the ISO 230-1 error motions of that axis in the frame it is mounted
 /// in, with the other axis at 0: the small transform Delta(angle) = actual motion * nominal
@@ -48,12 +50,6 @@ struct AxisErrorFunction {
   std::vector<std::string> notes;  ///< what the function leaves out, in words
   std::function<AngleMapTerms(double angle_rad)> evaluate;
 };
-
-/// The function of every table-side rotary axis of the model's machine, in chain order. An
-/// axis on the head is not covered: it is named in the result's notes. Throws InvalidArgument
-/// naming `source` and the member when an R-test model's map is not the basis' own.
-std::vector<AxisErrorFunction> axis_error_functions(const ModelFile& model,
-                                                    const std::string& source);
 
 /// One axis' terms at equally spaced angles.
 struct AxisAngleMap {

@@ -65,13 +65,15 @@ struct CompensationTables {
   std::vector<std::string> not_held;
 };
 
-/// LinuxCNC COMP_FILEs (COMP_FILE_TYPE = 1) of each table axis' positioning error, joints
+/// LinuxCNC COMP_FILEs (COMP_FILE_TYPE = 1) of each table axis' positioning error, from the
+/// model's axis functions (compensation/axis_errors.hpp: axis_error_functions(model, path)), joints
 /// numbered as xyzac-trt-kins / xyzbc-trt-kins (tilt 3, C 4). The trim at nominal angle p
 /// is what makes the model's axis reach p: t = -positioning(p + t) (solved by iteration), in
 /// deg. Throws InvalidArgument naming the limit or option when a table would have more than
 /// max_points lines, a range or spacing is not usable, the machine has an axis on the head,
 /// or the model holds no positioning error of any table axis.
 CompensationTables linuxcnc_comp_tables(const ModelFile& model,
+                                        const std::vector<AxisErrorFunction>& functions,
                                         const CompensationTableOptions& options);
 
 /// SINUMERIK encoder / leadscrew error compensation (EEC, K3 function manual "Interpolatory
@@ -84,6 +86,7 @@ CompensationTables linuxcnc_comp_tables(const ModelFile& model,
 /// endless axis without a range gets a modulo table 0..360 deg. Refused as
 /// linuxcnc_comp_tables, naming MD38000 for too many points (`ini` stays empty).
 CompensationTables sinumerik_eec_tables(const ModelFile& model,
+                                        const std::vector<AxisErrorFunction>& functions,
                                         const CompensationTableOptions& options);
 
 }  // namespace rotacal

@@ -70,6 +70,10 @@ struct FittedModelContent {
   double chi2_per_dof = 0.0;
   std::vector<std::string> unobservable;  ///< combinations the data cannot see, in words
   std::vector<std::string> notes;
+  /// "multi": the sigmas of disagreeing parameters were widened at the user's request
+  /// (written "fit.sigma_inflated"; a file without it: false). Export refuses a multi model
+  /// whose sessions disagree unless it is true.
+  bool sigma_inflated = false;
 };
 
 /// The document of a "probe" or "multi" model. InvalidArgument when the content is not one

@@ -20,13 +20,18 @@
 ///   (a recording's rows are measurements that cannot be taken again), unless the writer
 ///   discards it (a recording that ended with no row: the old file stays, as after any failed
 ///   write). Only a process that is killed leaves its rows behind, in the hidden
-///   `.rotacal-<hex>.part` of the target's folder.
+///   `.rotacal-<pid>-<hex>.part` of the target's folder; the next replacing write into that
+///   folder removes such a file once its process is gone and it is older than
+///   kStaleTemporarySeconds (and it is the user's own regular file).
 
 #include <functional>
 #include <string>
 #include <vector>
 
 namespace rotacal {
+
+/// Age (s) after which a temporary of a process that is gone is removed (see above).
+inline constexpr long kStaleTemporarySeconds = 600;
 
 /// The other paths of the command that writes an output; none of them may be the output.
 struct OutputOptions {

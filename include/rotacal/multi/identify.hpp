@@ -14,8 +14,12 @@
 /// joint fit then whitens each session's rows by that session's model (core/block_whitener.hpp).
 ///
 /// The sessions alone are also compared: a location error seen by two sessions whose
-/// difference exceeds `disagreement_z` sigma of the difference is reported as a disagreement
-/// (which parameter, which sessions, by how much) rather than averaged silently.
+/// difference exceeds a threshold (`disagreement_alpha` over all comparisons, at least
+/// `disagreement_z`) in sigmas of the difference is reported as a disagreement
+/// (which parameter, which sessions, by how much) rather than averaged silently, and so is a
+/// joint value that lies outside every session's own (session_b then "joint fit"). While
+/// sessions disagree the joint values describe no machine: the model document refuses them
+/// (multi/model_document.hpp) unless `inflate_sigma` widened their sigmas by the scatter.
 
 #include <Eigen/Core>
 #include <memory>
@@ -60,9 +64,20 @@ struct MultiFitOptions {
   bool noise_bias_correction = true;
   int max_iterations = 100;
   double observability_min_chi2 = 1.0;
-  /// |difference| / sigma of the difference beyond which two sessions disagree.
+  /// Probability that sessions of one machine are reported to disagree on anything: the
+  /// threshold on |difference| / sigma of the difference is Bonferroni's over every comparison
+  /// made (pairs of sessions x parameters both determine), so more sessions need a larger |z|.
+  double disagreement_alpha = 0.01;
+  /// The threshold never goes below this |z| (a single comparison at alpha 1 % would be 2.58).
   double disagreement_z = 3.0;
+  /// When sessions disagree, widen the sigma of each parameter they disagree on by its Birge
+  /// ratio (the scatter of the sessions alone about the joint value, sqrt(chi2 / (n - 1))),
+  /// the user's choice to keep a joint model anyway; the result says so in its notes.
+  bool inflate_sigma = false;
 };
+
+/// The name a disagreement between one session and the joint value gives its second side.
+inline constexpr const char* kJointFitSide = "joint fit";
 
 /// Two sessions alone disagree on one location error (or shared effect parameter).
 struct MultiDisagreement {
@@ -99,6 +114,9 @@ struct MultiIdentification {
   bool converged = false;
   FitSummary summary;
   std::vector<std::string> notes;
+  bool sigma_inflated = false;  ///< inflate_sigma widened the sigmas of disagreeing parameters
+  std::size_t comparisons = 0;  ///< pairs of sessions x parameters both determine
+  double disagreement_z = 0.0;  ///< the |z| beyond which one of them is a disagreement
   const ParameterEstimate& location_error(const std::string& name) const;
 };
 

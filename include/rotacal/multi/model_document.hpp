@@ -21,8 +21,14 @@ namespace rotacal {
 /// errors and effects, the joint covariance (the sessions' own parameters as
 /// "<session>:<name>"), each session with its own parameters, its location errors alone, its
 /// noise model, and the disagreements. InvalidArgument when the covariance does not match
-/// `parameter_names` or the effects' parameters do not match the effect model.
+/// `parameter_names` or the effects' parameters do not match the effect model, and when the
+/// sessions disagree (refuse_disagreeing).
 FittedModelContent multi_model_content(const MultiIdentification& identification);
+
+/// InvalidArgument naming every disagreement (parameter, sessions, z) unless there is none or
+/// the sigmas were widened for them (MultiFitOptions::inflate_sigma): no model is kept of
+/// sessions that disagree.
+void refuse_disagreeing(const MultiIdentification& identification);
 
 /// fitted_model_document(multi_model_content(identification)).
 nlohmann::ordered_json multi_model_document(const MultiIdentification& identification);

@@ -39,6 +39,9 @@ struct ProbeProgramOptions {
   std::string log_file = "rotacal_probe.log";  ///< the controller's file of the latched positions
 };
 
+/// The longest --log-file name: "(LOGOPEN," + name + ")" within LinuxCNC's 254-character line.
+inline constexpr std::size_t kMaxLogFileName = 254 - 10;
+
 /// One probing move, machine axes (mm, deg).
 struct ProbeMove {
   int pose = 1;   ///< 1-based pose number
@@ -65,7 +68,11 @@ std::string write_probe_nc_program(MachineType m, const ProbePattern& P, NcDiale
 /// latched #5061..#5063) take the place of the X, Y, Z of `plan`'s rows, in order (the plan:
 /// the session template of the same pattern, its rows in probe_moves order). Throws ParseError
 /// naming `path` and the line for a line that is not five numbers, a pose or touch number out
-/// of order, or a row count that differs from the plan's; IoError if the file cannot be read.
-ProbeSession read_linuxcnc_probe_log(const std::string& path, const ProbeSession& plan);
+/// of order, a row count that differs from the plan's, or a latched position farther than
+/// `max_off_line_mm` from its commanded line (the plan's X, Y, Z along its approach direction:
+/// G38.2 moves on that line, so a latch off it by more than a servo's error is not the touch
+/// commanded); IoError if the file cannot be read.
+ProbeSession read_linuxcnc_probe_log(const std::string& path, const ProbeSession& plan,
+                                     double max_off_line_mm = 1.0);
 
 }  // namespace rotacal

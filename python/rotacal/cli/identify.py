@@ -194,6 +194,11 @@ def print_joint_identification(d: dict) -> None:
         )
         print("    ", end="")
         print_noise_model(s["noise_model"])
+    t = d["disagreement_test"]
+    print(
+        f"  sessions alone compared {t['comparisons']} times; a disagreement is |z| > "
+        f"{t['z']:.2f} (1 % chance of any for sessions of one machine)"
+    )
     for g in d["disagreements"]:
         f, shown = _shown(g["unit"])
         print(
@@ -259,14 +264,27 @@ def _cmd_identify_joint(a: argparse.Namespace) -> int:
         )
     _refuse_history_options(a)
     sessions = [load_session(f, a) for f in a.file]
-    result = identify_sessions(sessions, list(a.file), noise=a.noise)
+    result = identify_sessions(sessions, list(a.file), noise=a.noise, inflate_sigma=a.inflate_sigma)
     d = result.to_dict()
+    if not d["converged"]:
+        raise _core.DegenerateGeometry(
+            "identify: the joint fit of the sessions did not converge: "
+            + "; ".join(n for n in d["notes"] if "converge" in n)
+        )
+    keeps = a.save_model or a.store
+    if keeps and d["disagreements"] and not d["sigma_inflated"]:
+        _print_joint(a, d)  # what disagrees, then the refusal: nothing is written
+        _core.refuse_disagreeing(result.raw)
     _keep(a, result, d, list(a.file))
+    _print_joint(a, d)
+    return EXIT_OK
+
+
+def _print_joint(a: argparse.Namespace, d: dict) -> None:
     if a.json:
         print(jsontext.dumps(d))
     else:
         print_joint_identification(d)
-    return EXIT_OK
 
 
 def cmd_identify(a: argparse.Namespace) -> int:
@@ -274,6 +292,8 @@ def cmd_identify(a: argparse.Namespace) -> int:
 
     if len(a.file) > 1:
         return _cmd_identify_joint(a)
+    if a.inflate_sigma:
+        raise OptionError("--inflate-sigma: for a joint identification of several sessions")
     a.file = a.file[0]
     _refuse_history_options(a)
     sizes = budget_sizes(a.budget_sizes)  # refused before any work
@@ -380,6 +400,13 @@ def add_identify(sub: argparse._SubParsersAction) -> None:
     )
     q.add_argument("--seed", type=SEED, default=1, help="seed of the Monte Carlo draws")
     add_plausibility_arg(q)
+    q.add_argument(
+        "--inflate-sigma",
+        action="store_true",
+        help="several sessions that disagree: widen the sigma of each parameter they disagree on "
+        "by its Birge ratio and keep the joint model (without it, no model is saved, stored or "
+        "exported while they disagree: exit 3)",
+    )
     q.add_argument(
         "--noise",
         default="auto",

@@ -19,7 +19,7 @@ EXIT_OK, EXIT_USAGE, EXIT_INPUT, EXIT_IO, EXIT_ERROR = 0, 2, 3, 4, 5
 
 EPILOG = (
     "exit codes: 0 success, 2 usage error, 3 invalid input (malformed file, bad parameter, "
-    "degenerate geometry), 4 I/O error, 5 other rotacal error"
+    "degenerate geometry, a request too large for the memory), 4 I/O error, 5 other rotacal error"
 )
 
 

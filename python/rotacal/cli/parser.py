@@ -3,7 +3,7 @@
 which runs a command and turns every failure into a one-line message and its exit code.
 
 Exit codes: 0 success; 2 usage error; 3 invalid input (a malformed file, a bad parameter, a
-degenerate geometry); 4 I/O error (cannot read or write a file or device); 5 any other
+degenerate geometry, a request too large for the memory); 4 I/O error (cannot read or write a file or device); 5 any other
 rotacal error.
 
 Each command module holds ``COMMANDS``, {command: add(subparsers)}; an add returns the
@@ -164,10 +164,16 @@ def main(argv: Sequence[str] | None = None) -> int:
         except OSError:
             pass
         return EXIT_OK
+    except MemoryError as e:  # a request too large for this machine (std::bad_alloc in C++)
+        say(
+            "rotacal: error: out of memory: the request is too large for this machine's memory "
+            f"(reduce the number of touches, poses or candidates asked for){': ' + _message(e) if str(e) else ''}"
+        )
+        return EXIT_INPUT
     except UnicodeError as e:  # text that is not UTF-8 where the reader did not say so itself
         say(f"rotacal: error: input is not UTF-8 text: {_message(e)}")
         return EXIT_INPUT
-    except (_core.IoError, OSError, MemoryError) as e:
+    except (_core.IoError, OSError) as e:
         say(f"rotacal: error: {_message(e) or type(e).__name__}")
         return EXIT_IO
     except _core.Error as e:

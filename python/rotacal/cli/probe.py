@@ -6,7 +6,6 @@ it is). C++ computes (include/rotacal/probe, rotacal.probe); this module only co
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 import numpy as np
 
@@ -15,6 +14,7 @@ from ..machines import PIVOT_ERROR_MM, location_errors, load_machine
 from ..sessions import save
 from .options import EPILOG, EXIT_OK, SEED, OptionError, number, numbers, path, say
 from .options import effects_option, errors_option
+from .probe_poses import design_file, poses_option
 from .setups import write_truth
 
 # The sphere and stylus of the simulator's default pattern (probe/simulate.hpp, rotacal.simulate_probe).
@@ -239,6 +239,12 @@ def identify_probe_session(
         )
     result = probe.identify_probe(s, a.method, noise=a.noise)
     d = result.to_dict()
+    if not d["converged"]:  # an error, not a note: its values are no identification
+        why = "; ".join(n for n in d.get("notes", []) if "converge" in n) or "did not converge"
+        raise _core.DegenerateGeometry(
+            f"identify: {a.file}: the {a.method} fit did not converge ({why}): check the session "
+            "for an outlier touch or a wrong sphere position; nothing is reported or saved"
+        )
     if a.method == "joint" and not a.no_budget:
         from ..diagnosis import uncertainty_budget
         from ..results import budget_dict
@@ -270,16 +276,6 @@ _BALLBAR_ONLY = (
 )
 
 
-def _poses(text: str | None) -> np.ndarray | None:
-    """--poses "TILT,ROT;TILT,ROT;..." (deg) -> (P, 2), or None for the default poses."""
-    if text is None:
-        return None
-    rows = [numbers("--poses", 2, 720.0, "deg")(item) for item in text.split(";") if item.strip()]
-    if not rows:
-        raise OptionError("--poses: no pose given (TILT,ROT;TILT,ROT;... deg)")
-    return np.asarray(rows, float)
-
-
 def _plan_template(a: argparse.Namespace, mtype, poses, pose_directions=()) -> _core.ProbeSession:
     """The commanded rows of `plan probe` as a session template: the nominal machine's touches
     (no errors, no noise), in the program's order."""
@@ -303,34 +299,9 @@ def _plan_template(a: argparse.Namespace, mtype, poses, pose_directions=()) -> _
     return session
 
 
-def _design_file(a: argparse.Namespace) -> tuple[np.ndarray, list]:
-    """--design FILE: the poses, each pose's directions and the sphere of `design probe --json`
-    (its "best"); the sphere into a.sphere unless --sphere is given."""
-    import json
-
-    if a.poses is not None:
-        raise OptionError("--design: give --poses or --design, not both")
-    try:
-        doc = json.loads(Path(a.design).read_text())
-        best = doc.get("best", doc)
-        poses = np.asarray(best["poses_deg"], float).reshape(-1, 2)
-        dirs = [np.asarray(d, float).reshape(-1, 3) for d in best.get("pose_directions", [])]
-        sphere = best.get("sphere")
-    except (OSError, ValueError, KeyError, TypeError, AttributeError) as e:
-        raise OptionError(
-            f"--design {a.design}: not the JSON of rotacal design probe --json ({e})"
-        ) from None
-    if dirs and len(dirs) != len(poses):
-        raise OptionError(
-            f"--design {a.design}: {len(dirs)} direction lists for {len(poses)} poses"
-        )
-    if a.sphere is None and sphere is not None:
-        a.sphere = np.asarray(sphere, float)
-    return poses, dirs
-
-
 def cmd_plan_probe(a: argparse.Namespace) -> int:
-    from ..outputs import write_output
+    from ..outputs import write_outputs
+    from ..sessions import session_text
 
     given = [
         f"--{d.replace('_', '-')}"
@@ -340,7 +311,7 @@ def cmd_plan_probe(a: argparse.Namespace) -> int:
     if given:
         raise OptionError(f"plan probe: {', '.join(given)} belong to plan ballbar")
     mtype = load_machine(a.machine) if a.machine else _core.MachineType.AC_trt
-    poses, dirs = _design_file(a) if a.design else (_poses(a.poses), [])
+    poses, dirs = design_file(a) if a.design else (poses_option(a.poses), [])
     sphere = np.asarray(a.sphere if a.sphere is not None else DEFAULT_SPHERE, float)
     text = _core.write_probe_nc_program(
         mtype,
@@ -355,14 +326,18 @@ def cmd_plan_probe(a: argparse.Namespace) -> int:
         positioning_feed=a.positioning_feed,
         pose_directions=dirs,
     )
-    write_output(a.output, text, [a.design] if a.design else [], [a.session] if a.session else [])
+    # Every output only once all can be written: the template is made and checked (a file
+    # load reads back) before either is written (rotacal.outputs.write_outputs).
     template = _plan_template(a, mtype, poses, dirs)
+    outputs = [(a.output, text)]
+    if a.session:
+        outputs.append((a.session, session_text(template, "plan probe --session")))
+    write_outputs(outputs, [a.design] if a.design else [])
     say(
         f"wrote {a.output}: {a.dialect} probing program, {len(template)} touches at {len(template.pose_names)} poses, "
         f"latched positions logged to {a.log_file} on the controller"
     )
     if a.session:
-        save(template, a.session, [a.design] if a.design else [], [a.output])
         say(
             f"wrote {a.session}: the commanded touches as a session template (rotacal import probe --plan)"
         )

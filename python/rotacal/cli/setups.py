@@ -11,7 +11,7 @@ from typing import Any, Sequence
 from .. import _core, jsontext, rtest
 from ..machines import BALLBAR_NOISE_UM, PIVOT_ERROR_MM
 from ..outputs import write_output
-from ..sessions import PROBE, check_plausible, kind, load
+from ..sessions import check_plausible, load
 from .options import (
     SEED,
     OptionError,
@@ -378,9 +378,7 @@ def load_session(
                 f"{', ...' if len(set(s.tests)) > 3 else ''}), not a rotary-axis test: `rotacal circular analyze "
                 f"{path}` gives G, G(b), H and their causes, `rotacal report {path} -o OUT.html` the report"
             )
-        if (
-            not is_circular(s) and kind(s) != PROBE
-        ):  # session/plausibility has no touch-probe check yet
+        if not is_circular(s):
             check_plausible(s, path, getattr(a, "max_deviation", None))
     return s
 

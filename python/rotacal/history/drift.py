@@ -94,6 +94,15 @@ def expand_tolerances(
     return out
 
 
+def error_names(machine_type: str, entries: Sequence[Entry]) -> list[str]:
+    """A built-in's location errors by its name; a machine of a description file's as its
+    calibrations name them (its models' machine_description defines them)."""
+    if machine_type in _core.builtin_machine_names():
+        return list(_core.location_error_names(_core.parse_machine_type(machine_type)))
+    found = (n for e in entries if e.kind == IDENTIFICATION for n in e.estimates)
+    return list(dict.fromkeys(n for n in found if n[:2] == "E_"))
+
+
 def summarize(
     machine_type: str, entries: Sequence[Entry], tolerances: Mapping[str, float] | None = None
 ) -> dict:
@@ -103,7 +112,7 @@ def summarize(
     corrections in between taken out, flagged when it exceeds the expanded (k = 2) uncertainty
     of the difference or the tolerance given for that error (same unit as the error), and the
     drift per month (weighted straight line through the machine's own values)."""
-    names = list(_core.location_error_names(_core.parse_machine_type(machine_type)))
+    names = error_names(machine_type, entries)
     tol = expand_tolerances(tolerances or {}, names, machine_type)
     calibrations = [e for e in entries if e.kind == IDENTIFICATION]
     corrections = [e for e in entries if e.kind == CORRECTION]

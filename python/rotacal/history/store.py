@@ -11,10 +11,10 @@ import sqlite3
 from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any, Iterator, Mapping, Sequence
-from urllib.parse import urlsplit
 
 from .. import _core, jsontext
-from .drift import summarize
+from ..models import machine_of
+from .drift import error_names, summarize
 from .entries import (
     CORRECTION,
     IDENTIFICATION,
@@ -29,23 +29,10 @@ from .entries import (
     sha256_of_json,
     unit_of,
 )
+from .messages import one_line, redact
 from .schema import MIGRATIONS, SCHEMA_VERSION
 
 BUSY_TIMEOUT_S = 60.0
-
-
-def redact(location: str) -> str:
-    """A store location fit to print: the password of a URL replaced by ***."""
-    if "://" not in location:
-        return location
-    try:
-        parts = urlsplit(location)
-    except ValueError:
-        return location.split("://", 1)[0] + "://..."
-    if parts.password is None:
-        return location
-    netloc = parts.netloc.replace(f":{parts.password}@", ":***@", 1)
-    return parts._replace(netloc=netloc).geturl()
 
 
 # ------------------------------------------------------------------------- dialects
@@ -314,8 +301,8 @@ class CalibrationHistory:
         note = check_note(note)
         if not isinstance(model, Mapping):
             raise _core.InvalidArgument(f"{where}: a model must be a JSON object")
-        machine_type = _core.machine_name(_core.parse_machine_type(str(model.get("machine", ""))))
-        names = set(_core.location_error_names(_core.parse_machine_type(machine_type)))
+        machine = machine_of(dict(model), where)  # a built-in, or the model's own description
+        machine_type, names = _core.machine_name(machine), set(_core.location_error_names(machine))
         estimates = estimates_of(model, where)
         unknown = [e[1] for e in estimates if e[0] == "location_errors" and e[1] not in names]
         if unknown:
@@ -369,7 +356,7 @@ class CalibrationHistory:
         row = self._machine_type(machine_id)
         if row is None:
             raise self._unknown(machine_id, "record a correction of it")
-        names = set(_core.location_error_names(_core.parse_machine_type(row)))
+        names = set(error_names(row, self.entries(machine_id)[1]))
         foreign = [n for n in amounts if n not in names]
         if foreign:
             raise _core.InvalidArgument(
@@ -494,7 +481,3 @@ class CalibrationHistory:
         machine_type, entries = self.entries(machine_id)
         out = summarize(machine_type, entries, tolerances)
         return {"machine_id": machine_id, "store": redact(self.location)} | out
-
-
-def one_line(e: BaseException) -> str:
-    return " ".join(str(e).split())

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "rotacal/core/error.hpp"
+#include "rotacal/io/fitted_model.hpp"
 #include "shared.hpp"
 
 namespace rotacal {
@@ -52,6 +53,19 @@ std::string to_string(Controller c) {
 }
 
 ExportInput export_input(const ModelFile& model, const std::string& model_path) {
+  if (model.kind == "multi") {  // sessions that disagree make no model to load on a machine
+    const FittedModelContent c = fitted_model_content(model, model_path);
+    if (!c.disagreements.empty() && !c.sigma_inflated) {
+      std::string what;
+      for (const FittedDisagreement& d : c.disagreements)
+        what += (what.empty() ? "" : "; ") + d.parameter + " (" + d.session_a + " vs " +
+                d.session_b + ")";
+      throw InvalidArgument(model_path +
+                            ": the sessions of this joint model disagree: " + what.substr(0, 600) +
+                            "; it is not exported (identify again without the session in "
+                            "error, or with --inflate-sigma)");
+    }
+  }
   ExportInput in;
   in.machine = model.machine;
   in.errors = model.location_errors;

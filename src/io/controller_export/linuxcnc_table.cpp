@@ -110,7 +110,9 @@ CompensationTable one_table(const AxisErrorFunction& f, const MachineType& m,
 
 }  // namespace linuxcnc_table_detail
 
-CompensationTables linuxcnc_comp_tables(const ModelFile& model, const CompensationTableOptions& o) {
+CompensationTables linuxcnc_comp_tables(const ModelFile& model,
+                                        const std::vector<AxisErrorFunction>& functions,
+                                        const CompensationTableOptions& o) {
   using namespace linuxcnc_table_detail;
   using namespace table_detail;
   const MachineType m = model.machine;
@@ -120,7 +122,7 @@ CompensationTables linuxcnc_comp_tables(const ModelFile& model, const Compensati
   const ExportInput in = export_input(model, o.model_path);
   CompensationTables out;
   std::ostringstream ini;
-  for (const AxisErrorFunction& f : axis_error_functions(model, o.model_path)) {
+  for (const AxisErrorFunction& f : functions) {
     list_not_held(f, m.description().axis(f.chain_index), out);
     if (sample_angle_map(f, -180.0, 180.0, 5.0, 1).max_abs[6] == 0.0) continue;
     CompensationTable t = one_table(f, m, o, in);

@@ -104,7 +104,9 @@ CompensationTable one_table(const AxisErrorFunction& f, const MachineType& m,
 
 }  // namespace sinumerik_table_detail
 
-CompensationTables sinumerik_eec_tables(const ModelFile& model, const CompensationTableOptions& o) {
+CompensationTables sinumerik_eec_tables(const ModelFile& model,
+                                        const std::vector<AxisErrorFunction>& functions,
+                                        const CompensationTableOptions& o) {
   using namespace sinumerik_table_detail;
   const MachineType m = model.machine;
   if (m.has_head())
@@ -112,7 +114,7 @@ CompensationTables sinumerik_eec_tables(const ModelFile& model, const Compensati
                           to_string(m) + " has an axis on the head");
   const ExportInput in = export_input(model, o.model_path);
   CompensationTables out;
-  for (const AxisErrorFunction& f : axis_error_functions(model, o.model_path)) {
+  for (const AxisErrorFunction& f : functions) {
     list_not_held(f, m.description().axis(f.chain_index), out);
     if (sample_angle_map(f, -180.0, 180.0, 5.0, 1).max_abs[6] == 0.0) continue;
     out.tables.push_back(one_table(f, m, o, in));
