@@ -20,6 +20,7 @@ void bind_diagnosis_findings(pyb::module_& m) {
       .def_readwrite("min_delta_bic", &DiagnosisOptions::min_delta_bic)
       .def_readwrite("cv_blocks", &DiagnosisOptions::cv_blocks)
       .def_readwrite("only", &DiagnosisOptions::only)
+      .def_readwrite("hold_by_weight", &DiagnosisOptions::hold_by_weight)
       .def_readwrite("model_noise", &DiagnosisOptions::model_noise)
       .def_readwrite("min_weight", &DiagnosisOptions::min_weight)
       .def_readwrite("rival_correlation", &DiagnosisOptions::rival_correlation)
@@ -77,6 +78,7 @@ void bind_diagnosis_findings(pyb::module_& m) {
 
   pyb::class_<Finding>(m, "Finding")
       .def_property_readonly("effect", [](const Finding& f) { return f.effect.id(); })
+      .def_readonly("model_reason", &Finding::model_reason)
       .def_readonly("cause", &Finding::cause)
       .def_readonly("weight", &Finding::weight)
       .def_readonly("rivals", &Finding::rivals)

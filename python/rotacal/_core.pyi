@@ -1209,6 +1209,7 @@ class DiagnosisBaseline:
     def residual_rms_um(self) -> float:
         ...
 class DiagnosisOptions:
+    hold_by_weight: bool
     model_noise: bool
     def __init__(self) -> None:
         ...
@@ -1380,6 +1381,9 @@ class Finding:
         ...
     @property
     def lack_of_fit(self) -> str:
+        ...
+    @property
+    def model_reason(self) -> str:
         ...
     @property
     def named_alone(self) -> bool:

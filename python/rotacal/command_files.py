@@ -64,6 +64,18 @@ def rtest_truth_path(a: argparse.Namespace) -> str:
     return a.truth if a.truth else str(Path(a.output).with_suffix(".truth.json"))
 
 
+def separation_template_path(a: argparse.Namespace) -> str | None:
+    """Where `design ballbar|probe` writes a session template: --session, else with --separate
+    beside -o with the suffix .csv (added.ngc -> added.csv: the added test's program and
+    template go together, issue 50); None without either."""
+    if getattr(a, "session", None):
+        return a.session
+    if getattr(a, "separate", None) and getattr(a, "output", None):
+        return str(Path(a.output).with_suffix(".csv"))
+    return None
+
+
+TEMPLATE = Slot("--session", lambda a: [p for p in [separation_template_path(a)] if p])
 MACHINE = Slot("--machine", _machine_file)
 OUTPUT = arg("-o", "output")
 
@@ -107,9 +119,9 @@ COMMANDS: dict[tuple[str, ...], Files] = {
     ("history", "list"): Files(reads_store=_always),
     ("diagnose",): Files((arg("FILE", "file"), arg("--budget-sizes")), (arg("--report"),)),
     ("predict",): Files((arg("SESSION", "session"), arg("--model"), arg("--joints")), (OUTPUT,)),
-    ("design", "ballbar"): Files((MACHINE, arg("--after")), (OUTPUT,)),
+    ("design", "ballbar"): Files((MACHINE, arg("--after")), (OUTPUT, TEMPLATE)),
     ("design", "rtest"): Files((arg("--after"),)),
-    ("design", "probe"): Files((MACHINE, arg("--after")), (OUTPUT, arg("--session"))),
+    ("design", "probe"): Files((MACHINE, arg("--after")), (OUTPUT, TEMPLATE)),
     ("export",): Files(
         (arg("--model"), arg("--current"), arg("--centres")),
         (

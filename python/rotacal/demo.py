@@ -9,7 +9,7 @@ from typing import Callable
 
 from . import _core, jsontext
 from .ballbar import identify, nc_program, verify_compensation
-from .diagnosis import diagnose
+from .diagnosis import diagnose, held_effects
 from .machines import ballbar_truth, simulate_ballbar_test
 from .models import save_model
 from .outputs import write_output
@@ -94,7 +94,11 @@ def run_demo(
     # (model.json, identification.json); the location errors alone are kept beside it, labelled.
     extended = extended_identification(session, ident, diag)
     result = extended if extended is not None else ident
-    save_model(result.model_dict(), out / "model.json")
+    model = result.model_dict()
+    why = {h["id"]: h["held_because"] for h in held_effects(diag)} if extended else {}
+    for entry in model.get("effects", []):  # which member of its group, and why (issue 50)
+        entry["held_because"] = why[entry["id"]]
+    save_model(model, out / "model.json")
     _write_json(out / "identification.json", result.to_dict())
     if extended is not None:
         _write_json(out / "identification_location_errors_only.json", ident.to_dict())

@@ -137,12 +137,22 @@ def uncertainty_budget(
 
 
 def group_text(finding: dict) -> str:
-    """A group finding's members as a reader should see them: by BIC weight, largest first
-    (the engine lists the search's pick first, which can hold the least weight), the pick marked
-    as the member whose parameters are shown and which the extended model holds."""
+    """A group finding's members as a reader should see them: by BIC weight, largest first,
+    the member the extended model holds (whose parameters are shown) marked."""
     members = sorted(finding["group"], key=lambda m: -1.0 if m.get("aliased") else -m["weight"])
     return ", ".join(
         f"{m['effect']} ({'aliased' if m.get('aliased') else format(m['weight'], '.2f')}"
         f"{'; in the extended model' if m['effect'] == finding['effect'] else ''})"
         for m in members
     )
+
+
+def model_text(finding: dict) -> str:
+    """Why the extended model holds the finding's effect, as one sentence."""
+    return f"the model holds {finding['model']['holds']} because {finding['model']['why']}"
+
+
+def held_effects(diagnosis: Any) -> list[dict]:
+    """The effects the extended model holds, each with why (``held_because``), as a model
+    file's ``effects`` entries carry them (docs/model_file.md)."""
+    return [{"id": f.effect, "held_because": f.model_reason} for f in diagnosis.findings]

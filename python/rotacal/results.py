@@ -101,10 +101,14 @@ class DiagnosisResult:
                     "effect": f.effect,
                     "cause": f.cause,
                     # How sure the name is (issue 29): the BIC weight among the finding's rivals;
-                    # named is False when the finding is the group, best first, that holds
-                    # DiagnosisOptions.min_weight together, and "effect" is then only its best.
+                    # named is False when the finding is the group that holds
+                    # DiagnosisOptions.min_weight together, and "effect" is then the member the
+                    # extended model holds (diagnose/diagnosis.hpp, Finding::effect).
                     "weight": f.weight,
                     "named": bool(f.named_alone),
+                    # Which member of the group the extended model holds, and why (issue 50):
+                    # "effect" is that member; its parameters and gain are the ones shown.
+                    "model": {"holds": f.effect, "why": f.model_reason},
                     # Non-empty: the finding's signature confined to a few poses fits as well (a
                     # local defect outside the catalogue), which is why it is not named.
                     "lack_of_fit": f.lack_of_fit,

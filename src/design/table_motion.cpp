@@ -153,6 +153,11 @@ TableMotionOverlap table_motion_overlap(MachineType m, const Effect& a, const Ef
   const Eigen::JacobiSVD<Eigen::MatrixXd> svd(U1.transpose() * U2);
   out.cosine = std::min(1.0, svd.singularValues()[0]);
   out.same_motion = out.cosine >= 1.0 - 1e-6;
+  // Nested: all principal angles zero (the smallest cosine 1), so the span of the one with fewer
+  // motions lies in the other's.
+  const bool within = svd.singularValues().minCoeff() >= 1.0 - 1e-6;
+  out.first_within_second = within && U1.cols() < U2.cols();
+  out.second_within_first = within && U2.cols() < U1.cols();
   std::ostringstream w;
   w.precision(6);
   if (out.same_motion) {

@@ -12,13 +12,13 @@ namespace rotacal::diagnosis_detail {
 
 std::string separating_test(const DiagnosisProblem& P, const ModelFit& fit, const Score& a,
                             const Score& b, double sigma_mm) {
+  // The design command of this session's own instrument (issue 50 item 5: a probe user was told
+  // to run `rotacal design ballbar|rtest`).
+  const std::string design = "`rotacal design " + P.instrument() + " --separate " + a.effect.id() +
+                             "," + b.effect.id() + " --after SESSION`";
   if (P.reference_groups().empty())
-    return "none of this session's tests separates them; `rotacal design ballbar|rtest "
-           "--separate " +
-           a.effect.id() + "," + b.effect.id() +
-           " --after SESSION` (the instrument of this session) proposes the test that does, or "
-           "says why none "
-           "can";
+    return "none of this session's tests separates them; " + design +
+           " proposes the test that does, or says why none can";
   // Fit each candidate's full parameter vector to this session's residual, then compare what
   // they predict on the standard test.
   std::vector<std::string> rows_a, rows_b;
@@ -46,9 +46,8 @@ std::string separating_test(const DiagnosisProblem& P, const ModelFit& fit, cons
   out.precision(2);
   if (best.empty() || best_rms < sigma_mm)
     out << "no test of the standard single set-up that this session lacks separates them (their "
-           "predictions differ by less than the noise there); `rotacal design ballbar --separate "
-        << a.effect.id() << "," << b.effect.id()
-        << " --after SESSION` proposes the smallest added test that does, or says why none can";
+           "predictions differ by less than the noise there); "
+        << design << " proposes the smallest added test that does, or says why none can";
   else
     out << "a '" << best << "' test separates them: their predictions differ there by "
         << std::fixed << best_rms * 1e3 << " um RMS";

@@ -165,11 +165,15 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
     first_round = false;
     const Choice choice = choose(S, R, *fit, effects, fold, done, D);
     if (!choice.chosen) break;
-    const ModelFit* before = fit;
     const EffectModel before_effects = effects;
-    effects.effects.push_back(choice.chosen->effect);
-    fit = choice.refit;
-    D.findings.push_back(name_finding(S, R, choice, *before, before_effects, D));
+    std::optional<Finding> F = name_finding(S, R, choice, *fit, before_effects, D);
+    if (!F) continue;  // no member of its group determined: the model holds the baseline
+    // The model holds the member the weights say (model_member.hpp), not always the pick.
+    for (std::size_t c = 0; c < candidates.size(); ++c)
+      if (candidates[c] == F->effect) done[c] = true;
+    effects.effects.push_back(F->effect);
+    fit = &cache.fit(P, effects);
+    D.findings.push_back(std::move(*F));
   }
 
   for (Finding& F : D.findings) F.parameters = parameters_of(*fit, F.effect);

@@ -7,7 +7,9 @@
 
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "rotacal/core/noise_handling.hpp"
@@ -171,6 +173,9 @@ struct SearchContext {
 /// How many sigma from zero the best-determined combination of `effect`'s observable free
 /// parameters is in `refit` under noise treatment t (selection.cpp).
 double determined_sigmas(const ModelFit& refit, const Effect& effect, const NoiseTreatment& t);
+/// How many sigma from zero the best-determined single parameter of `effect` is in `refit`
+/// (selection.cpp): issue 29's rule 6 as the model member must meet it (model_member.hpp).
+double parameter_sigmas(const ModelFit& refit, const Effect& effect, const NoiseTreatment& t);
 
 /// One round: every candidate not yet done scored against the current model.
 struct Round {
@@ -203,7 +208,14 @@ struct Choice {
   const Score* chosen = nullptr;
   const ModelFit* refit = nullptr;  ///< of the extended model, held by the cache
   double cv_before = 0.0, cv_after = 0.0;
+  const std::vector<int>* fold = nullptr;  ///< the search's cross-validation blocks
 };
+/// Blocked cross-validated RMS (um) of the residuals of `fit` before and after adding the
+/// columns X = [the model's free columns, a candidate's], on blocks as long as the noise's
+/// correlation as `refit` (the extended model) leaves it, or `fold` in white noise.
+std::pair<double, double> cross_validated(const SearchContext& S, const Round& R,
+                                          const Eigen::MatrixXd& X, const ModelFit& fit,
+                                          const ModelFit& refit, const std::vector<int>& fold);
 /// Whether candidate s of round R (scored at `fit`; `refit`: the extended model's fit) still
 /// passes the F-test (alpha / m_tests) and BIC with each noise stream taken as AR(1) at the
 /// upper z-sigma bound of its lag-1 correlation estimated on refit's residuals, z =
@@ -218,8 +230,11 @@ Choice choose(const SearchContext& S, const Round& R, const ModelFit& fit,
 
 /// The finding of `choice` against the round R scored at `before` (the fit of `before_effects`):
 /// its weight among its rivals, its group, and the ambiguity it leaves (appended to D).
-Finding name_finding(const SearchContext& S, const Round& R, const Choice& choice,
-                     const ModelFit& before, const EffectModel& before_effects, Diagnosis& D);
+/// The finding holds the member of its group that the extended model holds (model_member.hpp);
+/// none (reported unobservable in D, with why) where no member's parameters are determined.
+std::optional<Finding> name_finding(const SearchContext& S, const Round& R, const Choice& choice,
+                                    const ModelFit& before, const EffectModel& before_effects,
+                                    Diagnosis& D);
 
 /// A thermal_warmup's time constant the final fit held, profiled, with its uncertainty in the
 /// other parameters' sigmas (time_constants.cpp); `scale`: what the caller multiplies them by.

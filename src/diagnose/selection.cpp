@@ -6,16 +6,23 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <tuple>
+#include <utility>
 
+#include "model_member.hpp"
 #include "rivals.hpp"
 #include "search.hpp"
 
 namespace rotacal::diagnosis_detail {
 
-// How many sigma from zero the best-determined combination of `effect`'s observable free
-// parameters is in `refit`, under noise treatment t: sqrt(v^T C_ee^-1 v), C the refit's
-// covariance of its free parameters (the whitened Gram matrix's inverse), e the effect's.
-double determined_sigmas(const ModelFit& refit, const Effect& effect, const NoiseTreatment& t) {
+namespace {
+
+// The effect's observable free parameters in `refit` (v) and their covariance (C_ee) under
+// noise treatment t: C the refit's covariance of its free parameters (the whitened Gram
+// matrix's inverse), e the effect's. Empty where it has none.
+std::pair<Eigen::VectorXd, Eigen::MatrixXd> effect_estimate(const ModelFit& refit,
+                                                            const Effect& effect,
+                                                            const NoiseTreatment& t) {
   const std::string id = effect.id();
   std::vector<Eigen::Index> free, mine;
   for (Eigen::Index j = 0; j < refit.jacobian.cols(); ++j) {
@@ -25,7 +32,7 @@ double determined_sigmas(const ModelFit& refit, const Effect& effect, const Nois
       mine.push_back(static_cast<Eigen::Index>(free.size()));
     free.push_back(j);
   }
-  if (mine.empty()) return 0.0;
+  if (mine.empty()) return {};
   Eigen::MatrixXd Jf(refit.jacobian.rows(), static_cast<Eigen::Index>(free.size()));
   for (std::size_t a = 0; a < free.size(); ++a)
     Jf.col(static_cast<Eigen::Index>(a)) = refit.jacobian.col(free[a]);
@@ -43,8 +50,29 @@ double determined_sigmas(const ModelFit& refit, const Effect& effect, const Nois
     for (Eigen::Index b = 0; b < k; ++b)
       Cee(a, b) = C(mine[static_cast<std::size_t>(a)], mine[static_cast<std::size_t>(b)]);
   }
+  return {v, Cee};
+}
+
+}  // namespace
+
+// How many sigma from zero the best-determined combination of `effect`'s observable free
+// parameters is in `refit`, under noise treatment t: sqrt(v^T C_ee^-1 v).
+double determined_sigmas(const ModelFit& refit, const Effect& effect, const NoiseTreatment& t) {
+  const auto [v, Cee] = effect_estimate(refit, effect, t);
+  if (v.size() == 0) return 0.0;
   const double chi2 = v.dot(Cee.ldlt().solve(v));
   return std::isfinite(chi2) && chi2 > 0.0 ? std::sqrt(chi2) : 0.0;
+}
+
+// How many sigma from zero the best-determined single parameter of `effect` is: max |v_i| /
+// sqrt(C_ii) (never more than determined_sigmas).
+double parameter_sigmas(const ModelFit& refit, const Effect& effect, const NoiseTreatment& t) {
+  const auto [v, Cee] = effect_estimate(refit, effect, t);
+  double best = 0.0;
+  for (Eigen::Index i = 0; i < v.size(); ++i)
+    if (Cee(i, i) > 0.0 && std::isfinite(Cee(i, i)))
+      best = std::max(best, std::abs(v[i]) / std::sqrt(Cee(i, i)));
+  return best;
 }
 
 namespace {
@@ -125,7 +153,62 @@ Field weigh_field_under(const SearchContext& S, const Round& R, const Score& cho
   return weigh_field(S, R, chosen, before, before_effects, t, in);
 }
 
+// The rivals of a finding about the member the model holds instead of the search's pick
+// (judged.group.front()): the same weights (posterior over the field), delta BIC and the
+// correlation of the fitted signatures about `held`, the pick among them.
+std::vector<Alternative> rivals_about(const RivalJudgement& judged, const Score& held,
+                                      double held_delta_bic, const Field& field,
+                                      const std::optional<Field>& loose) {
+  const auto signature_of = [&](const std::string& id) -> const Eigen::VectorXd* {
+    for (const Score& s : field.scores)
+      if (s.effect.id() == id) return &s.signature;
+    if (loose)
+      for (const Score& s : loose->scores)
+        if (s.effect.id() == id) return &s.signature;
+    return nullptr;
+  };
+  const auto about_held = [&](Alternative a) {
+    a.delta_bic -= held_delta_bic;
+    if (const Eigen::VectorXd* sig = signature_of(a.effect);
+        sig && sig->size() == held.signature.size())
+      a.correlation = std::abs(correlation(*sig, held.signature));
+    return a;
+  };
+  Alternative pick;
+  pick.effect = judged.group.front()->effect.id();
+  pick.weight = judged.weight;
+  pick.in_group = true;
+  std::vector<Alternative> out{about_held(pick)};
+  const std::string id = held.effect.id();
+  for (const Alternative& a : judged.rivals)
+    if (a.effect != id) out.push_back(about_held(a));
+  std::stable_sort(out.begin(), out.end(),
+                   [](const Alternative& a, const Alternative& b) { return a.weight > b.weight; });
+  return out;
+}
+
 }  // namespace
+
+std::pair<double, double> cross_validated(const SearchContext& S, const Round& R,
+                                          const Eigen::MatrixXd& X, const ModelFit& fit,
+                                          const ModelFit& refit, const std::vector<int>& fold) {
+  const DiagnosisOptions& options = S.options;
+  // Blocks as long as the noise's correlation as the extended model leaves it: the model of
+  // the current residuals takes an unmodelled drift for slow noise (AR(7) at 1.9 um of
+  // 0.5 um AR(1) 0.9 readings with a Z drift on the probe, a correlation of 42 of 120
+  // touches), and two blocks of half a session each fail any effect (the baseline, fitted on
+  // half the poses, extrapolates badly).
+  std::vector<int> own_fold;
+  if (S.model) {
+    const NoiseModel own =
+        estimate_noise_model(S.P.groups(), S.P.times(), refit.residuals, options.noise);
+    own_fold = cv_folds(S.P, options.cv_blocks, own.white() ? nullptr : &own);
+  }
+  const std::vector<int>& f = S.model ? own_fold : fold;
+  const double before = cv_rms_um(R.in.Jfree, fit.residuals, f, options.cv_blocks);
+  const double after = cv_rms_um(X, fit.residuals, f, options.cv_blocks);
+  return {before, after};
+}
 
 Choice choose(const SearchContext& S, const Round& R, const ModelFit& fit,
               const EffectModel& effects, const std::vector<int>& fold, std::vector<bool>& done,
@@ -146,20 +229,7 @@ Choice choose(const SearchContext& S, const Round& R, const ModelFit& fit,
     EffectModel extended = effects;
     extended.effects.push_back(s->effect);
     const ModelFit& refit = S.cache.fit(S.P, extended);
-    // Blocks as long as the noise's correlation as the extended model leaves it: the model of
-    // the current residuals takes an unmodelled drift for slow noise (AR(7) at 1.9 um of
-    // 0.5 um AR(1) 0.9 readings with a Z drift on the probe, a correlation of 42 of 120
-    // touches), and two blocks of half a session each fail any effect (the baseline, fitted on
-    // half the poses, extrapolates badly).
-    std::vector<int> own_fold;
-    if (S.model) {
-      const NoiseModel own =
-          estimate_noise_model(S.P.groups(), S.P.times(), refit.residuals, options.noise);
-      own_fold = cv_folds(S.P, options.cv_blocks, own.white() ? nullptr : &own);
-    }
-    const std::vector<int>& f = S.model ? own_fold : fold;
-    out.cv_before = cv_rms_um(R.in.Jfree, fit.residuals, f, options.cv_blocks);
-    out.cv_after = cv_rms_um(s->X, fit.residuals, f, options.cv_blocks);
+    std::tie(out.cv_before, out.cv_after) = cross_validated(S, R, s->X, fit, refit, fold);
     if (!(out.cv_after < out.cv_before)) continue;
     if (!holds_at_correlation_bound(S, R, *s, fit, refit, m_tests)) continue;
     // A cause with no number is no finding: at least one combination of its parameters must
@@ -182,13 +252,15 @@ Choice choose(const SearchContext& S, const Round& R, const ModelFit& fit,
     }
     out.chosen = s;
     out.refit = &refit;
+    out.fold = &fold;
     return out;
   }
   return out;
 }
 
-Finding name_finding(const SearchContext& S, const Round& R, const Choice& choice,
-                     const ModelFit& before, const EffectModel& before_effects, Diagnosis& D) {
+std::optional<Finding> name_finding(const SearchContext& S, const Round& R, const Choice& choice,
+                                    const ModelFit& before, const EffectModel& before_effects,
+                                    Diagnosis& D) {
   const Score& chosen = *choice.chosen;
   const ModelFit& fit = *choice.refit;
   const double n = static_cast<double>(before.residuals.size());
@@ -250,24 +322,53 @@ Finding name_finding(const SearchContext& S, const Round& R, const Choice& choic
     D.ambiguous.push_back(amb);
   }
 
+  // The member the extended model holds (model_member.hpp); its numbers are the finding's.
+  const HeldMember held = hold_member(S, R, judged_rivals, fit, before_effects);
   Finding F;
-  F.effect = chosen.effect;
-  F.cause = chosen.effect.cause();
-  F.weight = judged_rivals.weight;
-  F.rivals = judged_rivals.rivals;
+  F.model_reason = held.why;
+  if (!held.member) {
+    std::string members;
+    for (const Score* g : judged_rivals.group)
+      members += (members.empty() ? "" : ", ") + g->effect.id();
+    D.unobservable.push_back({held.top->effect.id(), "one of " + members + ": " + held.why});
+    return std::nullopt;
+  }
+  const Score& shown = *held.member;
+  const ModelFit& shown_fit = *held.refit;
+  F.effect = shown.effect;
+  F.cause = shown.effect.cause();
+  F.weight = held.weight;
+  F.rivals = shown.effect == chosen.effect
+                 ? judged_rivals.rivals
+                 : rivals_about(judged_rivals, shown, held.delta_bic, field, loose_field);
   F.rivals.insert(F.rivals.end(), aliases.begin(), aliases.end());
   F.gain.rms_before_um = rms_um(before.residuals);
-  F.gain.rms_after_um = rms_um(fit.residuals);
-  const NoiseTreatment& judged = R.treatment_of[ci];
+  F.gain.rms_after_um = rms_um(shown_fit.residuals);
+  std::size_t si = ci;
+  for (std::size_t i = 0; i < R.scores.size(); ++i)
+    if (R.scores[i].effect == shown.effect) si = i;
+  const NoiseTreatment& judged = R.treatment_of[si];
   const double rss_before = judged.whiten(before.residuals).squaredNorm();
-  const double rss_after = std::max(judged.whiten(fit.residuals).squaredNorm(), 1e-300);
+  const double rss_after = std::max(judged.whiten(shown_fit.residuals).squaredNorm(), 1e-300);
   F.gain.delta_bic =
-      n * std::log(rss_after / rss_before) + (fit.num_free - before.num_free) * std::log(n);
+      n * std::log(rss_after / rss_before) + (shown_fit.num_free - before.num_free) * std::log(n);
   F.gain.cv_rms_before_um = choice.cv_before;
   F.gain.cv_rms_after_um = choice.cv_after;
-  F.gain.f_pvalue = chosen.f_pvalue;
+  F.gain.f_pvalue = R.scores[si].f_pvalue;
+  if (si != ci) {  // the held member's own cross-validation, on the search's blocks
+    const Score& s = R.scores[si];
+    Eigen::MatrixXd X = s.X;
+    if (X.cols() == 0) {
+      const std::vector<SharedMatrix> jc =
+          S.cache.candidate_jacobians(S.P, before_effects, before, {s.effect});
+      X.resize(R.in.Jfree.rows(), R.in.Jfree.cols() + s.k);
+      X << R.in.Jfree, *jc.front() * s.directions;
+    }
+    std::tie(F.gain.cv_rms_before_um, F.gain.cv_rms_after_um) =
+        cross_validated(S, R, X, before, shown_fit, *choice.fold);
+  }
   for (const ParameterEstimate& b : before.parameters) {
-    for (const ParameterEstimate& a : fit.parameters) {
+    for (const ParameterEstimate& a : shown_fit.parameters) {
       if (a.name != b.name || !a.observable || !b.observable) continue;
       if (std::abs(a.value - b.value) > std::max(a.std, 1e-15))
         F.shifts.push_back({a.name, b.value, a.value, a.std, a.unit});

@@ -148,6 +148,14 @@ TEST_CASE("the table motion decides which effects no instrument can separate") {
   CHECK(ac.same_motion);
   CHECK(ac.cosine > 1.0 - 1e-6);
   CHECK(ac.why.find("no test can tell them apart") != std::string::npos);
+  // ... and the sag is the special case (1 parameter of the harmonic's 4): nested, one way only
+  // (the diagnosis' extended model holds the simpler one of the two when they fit alike).
+  CHECK(ac.first_within_second);
+  CHECK_FALSE(ac.second_within_first);
+  const TableMotionOverlap ca = table_motion_overlap(
+      MachineType::AC_trt, Effect::parse("radial_motion_A_h2"), Effect::parse("gravity_sag_A"));
+  CHECK(ca.second_within_first);
+  CHECK_FALSE(ca.first_within_second);
   const TableMotionOverlap bc = table_motion_overlap(
       MachineType::BC_trt, Effect::parse("gravity_sag_B"), Effect::parse("radial_motion_B_h2"));
   CHECK(bc.same_motion);
@@ -156,6 +164,8 @@ TEST_CASE("the table motion decides which effects no instrument can separate") {
       MachineType::AC_trt, Effect::parse("gravity_sag_A"), Effect::parse("radial_motion_A_h3"));
   CHECK_FALSE(h3.same_motion);
   CHECK(h3.cosine < 0.9);
+  CHECK_FALSE(h3.first_within_second);
+  CHECK_FALSE(h3.second_within_first);
   // The axial and tilt motions of C differ by the lever arm of the table point.
   const TableMotionOverlap c2 = table_motion_overlap(
       MachineType::AC_trt, Effect::parse("axial_motion_C_h2"), Effect::parse("tilt_motion_C_h2"));

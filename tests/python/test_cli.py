@@ -66,6 +66,11 @@ def test_demo_finds_the_hidden_effect(tmp_path):
             and "; in the extended model)" in line.split("gravity_sag_A (")[1].split(",")[0]
         )
     report = (tmp_path / "report.html").read_text()
+    # Which member the model holds, and why (issue 50): printed, in the report and the model file.
+    assert "the model holds gravity_sag_A because " in r.stdout, r.stdout
+    assert "The model holds gravity_sag_A because " in report
+    model = json.loads((tmp_path / "model.json").read_text())
+    assert model["effects"][0]["held_because"] == d["findings"][0]["model"]["why"]
     assert str((tmp_path / "report.html").resolve()) in r.stdout
     for section in ("setup", "location-errors", "polar", "residuals", "diagnosis", "compensation"):
         assert f'id="{section}"' in report or f"id='{section}'" in report

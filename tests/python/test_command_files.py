@@ -111,6 +111,8 @@ TEMPLATES = {
             "{--after}",
             "-o",
             "{-o}",
+            "--session",
+            "{--session}",
         ],
     ],
     ("design", "probe"): [
@@ -429,6 +431,20 @@ def test_simulate_rtest_default_truth_is_checked(sources, tmp_path, capsys):
     code = cli.main(["simulate", "rtest", "--machine", str(machine), "-o", str(tmp_path / "m.csv")])
     assert code == EXIT_IO, capsys.readouterr().err
     assert machine.read_bytes() == before and not (tmp_path / "m.csv").exists()
+
+
+def test_separation_default_template_is_checked(sources, tmp_path, capsys):
+    # design --separate -o s.ngc writes the added test's template to s.csv: the --after session
+    # of that name is an input, never overwritten (issue 50).
+    after = tmp_path / "s.csv"
+    after.write_bytes(sources["--after"].read_bytes())
+    before = after.read_bytes()
+    code = cli.main(
+        ["design", "ballbar", "--separate", "gravity_sag_A,gravity_sag_C", "--after", str(after)]
+        + ["-o", str(tmp_path / "s.ngc")]
+    )
+    assert code == EXIT_IO, capsys.readouterr().err
+    assert after.read_bytes() == before and not (tmp_path / "s.ngc").exists()
 
 
 def test_postgresql_store_is_no_file(sources, tmp_path, capsys):

@@ -7,6 +7,8 @@ import json
 
 import pytest
 
+import rotacal
+
 
 from conftest import SHARED, run_cli
 
@@ -139,6 +141,10 @@ def test_separate_after_a_session_proposes_the_added_test(tmp_path):
     # The program is that of the added test, at the slowed feeds.
     text = prog.read_text()
     assert added["tests"][-1] in text
+    # ... and its session template is written beside it, as plan --session writes one (issue 50).
+    template = rotacal.load(tmp_path / "added.csv")
+    assert sorted(set(template.tests)) == sorted(added["tests"])
+    assert len(template) > 0
 
 
 def test_separate_says_when_no_test_can():

@@ -334,6 +334,10 @@ def test_separation_on_a_probe_session(tmp_path):
     assert out["separable"] and out["found"]
     assert out["correlation_before"] > 0.9 and out["added_poses"]["correlation_after"] < 0.5
     assert (tmp_path / "added.ngc").exists()
+    # -o alone writes the added poses' session template beside the program (issue 50), for
+    # `rotacal import probe --plan added.csv`: the added poses' commanded touches.
+    template = rotacal.load(tmp_path / "added.csv")
+    assert len(template.pose_names) == len(out["added_poses"]["poses_deg"])
     r = rotacal_cli(
         "design", "probe", "--separate", "gravity_sag_A,radial_motion_A_h2", "--after", s
     )

@@ -33,7 +33,12 @@ struct TableMotionOverlap {
   bool second_is_location = false;
   double cosine = 0.0;       ///< largest cosine of the principal angles, [0, 1]
   bool same_motion = false;  ///< cosine >= 1 - 1e-6, or an effect is all location
-  std::string why;           ///< in words, for reports
+  /// Nesting: every table motion of the first, beyond the location errors and the table point,
+  /// is one of the second's, and the second has more of them (the first is a special case with
+  /// fewer parameters, as gravity_sag_A of radial_motion_A_h2). Never both.
+  bool first_within_second = false;
+  bool second_within_first = false;
+  std::string why;  ///< in words, for reports
 };
 
 /// Compare the table motions of `a` and `b` on machine `m` over tilt in `tilt_limits_deg`, C

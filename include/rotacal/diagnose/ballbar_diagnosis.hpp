@@ -26,6 +26,8 @@ class BallbarDiagnosisProblem : public DiagnosisProblem {
   std::shared_ptr<const ResidualWhitener> whitener;
 
   MachineType machine() const override { return session_.machine; }
+
+  std::string instrument() const override { return "ballbar"; }
   const std::vector<std::string>& groups() const override { return arrays_.test; }
   const std::vector<double>& times() const override { return times_; }
   const std::vector<RotaryAngles<double>>& angles() const override { return arrays_.angles; }

@@ -55,6 +55,9 @@ class DiagnosisProblem {
  public:
   virtual ~DiagnosisProblem() = default;
   virtual MachineType machine() const = 0;
+  /// The instrument, as `rotacal design` names it ("ballbar", "rtest", "probe"): the design
+  /// command a finding of this session points to.
+  virtual std::string instrument() const = 0;
   /// Group (test label or nest) of each scalar reading.
   virtual const std::vector<std::string>& groups() const = 0;
   /// Time (s) of each reading, and the rotary angles (rad) at it.
@@ -119,6 +122,14 @@ struct DiagnosisOptions {
   /// |value| >= k std, or correlated coefficients jointly); a candidate whose refit determines
   /// none is reported unobservable, not named.
   double min_determined_sigma = 3.0;
+  /// Which member of a group finding the extended model holds (issue 50 item 3;
+  /// src/diagnose/model_member.hpp). False: the search's pick, the best-scoring member that
+  /// passed its tests, with what the weights say beside it in Finding::model_reason. True: the
+  /// member of the highest weight with a single parameter determined to min_determined_sigma, a
+  /// nested member within delta BIC 2 of it, or none (the baseline). Off by default: holding
+  /// another member changes the later rounds and the local-defect rival's judgement, and two
+  /// safety checks of tests/python then fail (docs/json_schema.md, Finding).
+  bool hold_by_weight = false;
   std::vector<std::string> only;  ///< restrict candidates to these ids (empty: all)
   /// A candidate is visible when moving its parameters by plausible sizes (1 mm, 1 mrad, 1 um/s,
   /// 1e-3 for ratios, 10 um for a probe's lobing) beyond what the model absorbs changes
@@ -215,7 +226,10 @@ struct Alternative {
 };
 
 struct Finding {
-  Effect effect;  ///< the best of its group (the one the model is extended with)
+  /// The member of its group the extended model holds (src/diagnose/model_member.hpp): the
+  /// search's pick, or with DiagnosisOptions::hold_by_weight the member the weights say.
+  Effect effect;
+  std::string model_reason;  ///< why the model holds `effect`, in words
   std::string cause;
   /// Posterior weight of `effect` among itself and its rivals (DiagnosisOptions::min_weight:
   /// the smaller of its BIC and AIC weights); below DiagnosisOptions::min_weight

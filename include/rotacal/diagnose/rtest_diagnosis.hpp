@@ -28,6 +28,8 @@ class RtestDiagnosisProblem : public DiagnosisProblem {
   std::shared_ptr<const ResidualWhitener> whitener;
 
   MachineType machine() const override { return session_.machine; }
+
+  std::string instrument() const override { return "rtest"; }
   const std::vector<std::string>& groups() const override { return groups_; }
   const std::vector<double>& times() const override { return times_; }
   const std::vector<RotaryAngles<double>>& angles() const override { return angles_; }

@@ -159,10 +159,21 @@ def cmd_export(a: argparse.Namespace) -> int:
     if a.output:
         write_output(a.output, ex.text, inputs=[p for p in (a.model, a.current) if p])
         say(f"wrote {a.output} ({ex.file_kind} for {ex.kinematics})")
+    # The model's effects: which member of a diagnosis' group each is, and why (issue 50), so
+    # that what is loaded into the controller says what model its values come from.
+    effects = [
+        {"id": e["id"], "held_because": e.get("held_because")}
+        for e in load_model(a.model).get("effects", [])
+    ]
     if a.json:
-        print(jsontext.dumps(export_dict(ex)))
+        print(jsontext.dumps(export_dict(ex) | {"model_effects": effects}))
     elif not a.output:
         print(ex.text, end="")
+    for e in effects:
+        say(
+            f"the values come from a model with {e['id']}"
+            + (f": it holds it because {e['held_because']}" if e["held_because"] else "")
+        )
     say(
         f"held: {', '.join(held) or 'none'}; not held: {', '.join(left) or 'none'}"
         + (

@@ -15,7 +15,7 @@ def cmd_demo(a: argparse.Namespace) -> int:
     """Simulate a machine with errors and one hidden effect, measure, identify, diagnose,
     compensate, and write a report."""
     from ..demo import run_demo
-    from ..diagnosis import group_text
+    from ..diagnosis import group_text, model_text
 
     r = run_demo(a.output, seed=a.seed, sag_mm=a.sag, say=say)
     print(f"hidden effect: gravity_sag_A, s = {a.sag * 1e3:.1f} um")
@@ -32,6 +32,7 @@ def cmd_demo(a: argparse.Namespace) -> int:
                 f"diagnosis found one of: {group_text(f)}, which this session cannot separate "
                 f"(BIC weights); if {f['effect']}: {size}"
             )
+        print(model_text(f))
     else:
         print("diagnosis found nothing significant")
     print(

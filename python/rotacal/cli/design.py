@@ -9,8 +9,9 @@ import math
 from typing import Any, Sequence
 
 from .. import jsontext
+from ..command_files import separation_template_path
 from ..outputs import write_output
-from ..sessions import BALLBAR, PROBE, RTEST, kind
+from ..sessions import BALLBAR, PROBE, RTEST, kind, save
 from .options import EPILOG, EXIT_OK, OptionError, number, number_list, numbers, path, say
 from .setups import add_setup_args, ballbar_setup, load_session
 
@@ -64,12 +65,17 @@ def cmd_design_separation(a: argparse.Namespace) -> int:
         max_correlation=a.max_correlation,
         noise_um=a.noise or 0.0,
     )
-    if a.output and d.found:
+    template = separation_template_path(a)
+    if (a.output or template) and d.found:
         plan, text = nc_program(added_setup(d), a.dialect, None, None)
-        write_output(a.output, text, [a.after])
-        say(f"wrote {a.output}: {a.dialect} program of the added test, {plan.duration:.0f} s")
-    elif a.output:
-        say(f"rotacal: {a.output} not written: no added test separates them")
+        if a.output:
+            write_output(a.output, text, [a.after], [template] if template else [])
+            say(f"wrote {a.output}: {a.dialect} program of the added test, {plan.duration:.0f} s")
+        if template:  # as plan --session: what record/import of the measured test fills in
+            save(plan.commanded_session(), template, [a.after], [a.output] if a.output else [])
+            say(f"wrote {template}: the added test's commanded rows as a session template")
+    elif a.output or template:
+        say("rotacal: -o/--session not written: no added test separates them")
     if a.json:
         print(jsontext.dumps(separation_dict(d)))
         return EXIT_OK
@@ -101,6 +107,8 @@ def cmd_design_ballbar(a: argparse.Namespace) -> int:
         return cmd_design_separation(a)
     if a.after:
         raise OptionError("--after: goes with --separate EFFECT,EFFECT")
+    if a.session:
+        raise OptionError("--session: goes with --separate (the added test's template)")
     a.noise = 0.5 if a.noise is None else a.noise
     d = design_ballbar(
         ballbar_setup(a),
@@ -366,7 +374,14 @@ def _add_design_ballbar(dk: argparse._SubParsersAction) -> None:
         "-o",
         "--output",
         type=path("--output"),
-        help="write the designed test's NC program here (with --separate: the added test's)",
+        help="write the designed test's NC program here (with --separate: the added test's, and "
+        "its session template beside it as .csv unless --session names one)",
+    )
+    k.add_argument(
+        "--session",
+        type=path("--session"),
+        metavar="TEMPLATE.csv",
+        help="with --separate: write the added test's commanded rows as a session template here",
     )
     k.add_argument("--json", action="store_true")
     k.set_defaults(func=cmd_design_ballbar)

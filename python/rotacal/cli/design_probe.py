@@ -76,7 +76,10 @@ def _write_program(
 
 
 def cmd_design_probe_separation(a: argparse.Namespace) -> int:
+    from ..command_files import separation_template_path
+
     session = _session_after(a, PROBE)
+    a.session = separation_template_path(a)  # -o alone: the template beside it (import --plan)
     d = design_probe_separation(
         session,
         [e.strip() for e in a.separate.split(",")],
@@ -286,7 +289,8 @@ def add_design_probe(kinds: argparse._SubParsersAction) -> None:
         "-o",
         "--output",
         type=path("--output"),
-        help="write the LinuxCNC probing program of the designed (with --separate: the added) poses",
+        help="write the LinuxCNC probing program of the designed (with --separate: the added) poses; "
+        "with --separate, their session template beside it as .csv unless --session names one",
     )
     k.add_argument(
         "--session",

@@ -8,7 +8,7 @@ import argparse
 from pathlib import Path
 
 from .. import _core, jsontext, units
-from ..diagnosis import MAX_HARMONIC, group_text
+from ..diagnosis import MAX_HARMONIC, group_text, model_text
 from .options import EPILOG, EXIT_OK, budget_sizes, number, path, say
 from .setups import add_db_arg, add_plausibility_arg, load_session
 
@@ -34,6 +34,7 @@ def print_diagnosis(d: dict) -> None:
                 f"{i}. one of: {group_text(f)}; this session cannot separate them (BIC weights). "
                 f"If it is {f['effect']}:"
             )
+        print(f"     {model_text(f)}")
         for name, p in f["parameters"].items():
             print(f"     {name} = {units.estimate_text(p['value'], p['std'], p['unit'])}")
         print(
@@ -84,7 +85,9 @@ def cmd_diagnose(a: argparse.Namespace) -> int:
     s = load_session(a.file, a)
     bar, progress = _diagnosis_progress(a)
     try:
-        result = diagnose(s, max_harmonic=a.max_harmonic, progress=progress)
+        result = diagnose(
+            s, max_harmonic=a.max_harmonic, hold_by_weight=a.hold_by_weight, progress=progress
+        )
     finally:
         if bar:
             bar.close()
@@ -180,6 +183,12 @@ def add_diagnose(sub: argparse._SubParsersAction) -> None:
         "--max-harmonic",
         type=number("--max-harmonic", 1, MAX_HARMONIC, integer=True),
         help=f"highest harmonic order tried (1..{MAX_HARMONIC}; default {_core.DiagnosisOptions().max_harmonic})",
+    )
+    q.add_argument(
+        "--hold-by-weight",
+        action="store_true",
+        help="the extended model holds each group's member of the highest weight (with a "
+        "determined parameter; a nested one within delta BIC 2), not the search's pick",
     )
     q.add_argument("--json", action="store_true")
     q.add_argument("--report", metavar="OUT.html", type=path("--report"))

@@ -56,6 +56,10 @@ def location_errors_section(ident: dict, baseline: dict | None, diagnosis: Any) 
             "The uncertainty budget below is of this model too.</p>",
             location_error_table(ident["location_errors"], baseline["location_errors"]),
         ]
+        parts += [
+            f"<p>The model holds {_e(f.effect)} because {_e(f.model_reason)}.</p>"
+            for f in diagnosis.findings
+        ]
         for f in diagnosis.findings:
             if not f.named_alone:
                 others = ", ".join(r.effect for r in f.rivals if r.in_group)

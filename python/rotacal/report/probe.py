@@ -116,6 +116,11 @@ def probe_report(
     parts.append(
         location_error_table(ident["location_errors"], baseline and baseline["location_errors"])
     )
+    if found:
+        parts += [
+            f"<p>The model holds {_e(f.effect)} because {_e(f.model_reason)}.</p>"
+            for f in diagnosis.findings
+        ]
     parts.append(
         f"<p>Residual RMS {ident['residual_rms_um']:.3f} &micro;m over {ident['n_samples']} touches.</p>"
     )

@@ -11,7 +11,7 @@ from typing import Any, Iterable
 import numpy as np
 
 from .. import units
-from ..diagnosis import group_text
+from ..diagnosis import group_text, model_text
 from ..version import __version__
 from .page import CSS, escape as _e, img, plot_text, png, plt
 
@@ -288,9 +288,10 @@ def diagnosis_section(d: dict) -> str:
             elif f.get("lack_of_fit"):  # a local defect outside the catalogue fits as well
                 effect = f"not named: {_e(f['effect'])} ({_e(f['lack_of_fit'])})"
                 params = f"if {_e(f['effect'])}:<br>" + params
-            else:  # the group the data cannot separate, with the parameters of its best
+            else:  # the group the data cannot separate, with the parameters of the held one
                 effect = "one of: " + _e(group_text(f))
                 params = f"if {_e(f['effect'])}:<br>" + params
+            effect += f"<br><span class=muted>{_e(model_text(f))}</span>"
             g = f["gain"]
             out.append(
                 f"<tr><td class=l>{i}</td><td class=l>{effect}</td><td>{f['weight']:.2f}</td>"

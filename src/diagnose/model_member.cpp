@@ -1,0 +1,148 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Which member of a finding's group the extended model holds (model_member.hpp).
+#include "model_member.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <vector>
+
+#include "rotacal/design/table_motion.hpp"
+
+namespace rotacal::diagnosis_detail {
+
+namespace {
+
+std::string two(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.2f", v);
+  return b;
+}
+
+struct Member {
+  const Score* s = nullptr;
+  double weight = 0.0;
+  double delta_bic = 0.0;  // BIC - the search pick's
+};
+
+// The group's members with their weights, highest first (the search's pick first among equals).
+std::vector<Member> members_by_weight(const RivalJudgement& judged) {
+  std::vector<Member> out;
+  for (const Score* g : judged.group) {
+    Member m{g, judged.weight, 0.0};
+    if (g != judged.group.front()) {
+      const std::string id = g->effect.id();
+      for (const Alternative& a : judged.rivals)
+        if (a.effect == id) m.weight = a.weight, m.delta_bic = a.delta_bic;
+    }
+    out.push_back(m);
+  }
+  std::stable_sort(out.begin(), out.end(),
+                   [](const Member& a, const Member& b) { return a.weight > b.weight; });
+  return out;
+}
+
+// The noise treatment the round judged `e` under (the search's where it was not scored).
+const NoiseTreatment& treatment_of(const SearchContext& S, const Round& R, const Effect& e) {
+  for (std::size_t i = 0; i < R.scores.size(); ++i)
+    if (R.scores[i].effect == e) return R.treatment_of[i];
+  return S.noise;
+}
+
+}  // namespace
+
+HeldMember hold_member(const SearchContext& S, const Round& R, const RivalJudgement& judged,
+                       const ModelFit& chosen_refit, const EffectModel& before_effects) {
+  const std::vector<Member> members = members_by_weight(judged);
+  const Score* chosen = judged.group.front();
+  const double k_sigma = S.options.min_determined_sigma;
+  const auto refit_of = [&](const Score* s) -> const ModelFit& {
+    if (s == chosen) return chosen_refit;
+    EffectModel extended = before_effects;
+    extended.effects.push_back(s->effect);
+    return S.cache.fit(S.P, extended);
+  };
+  const auto determined = [&](const Score* s) {
+    return parameter_sigmas(refit_of(s), s->effect, treatment_of(S, R, s->effect)) >= k_sigma;
+  };
+  const std::string rule6 = "determined to " + std::to_string(static_cast<int>(k_sigma)) + " sigma";
+
+  HeldMember out;
+  out.top = members.front().s;
+  if (!S.options.hold_by_weight) {  // the search's pick, and what the weights say beside it
+    out.member = chosen;
+    out.refit = &chosen_refit;
+    out.weight = judged.weight;
+    if (judged.group.size() == 1)
+      out.why = "it is named alone (weight " + two(judged.weight) + ")";
+    else
+      out.why =
+          "it is the search's pick, the member that scored best of those that passed its "
+          "tests (weight " +
+          two(judged.weight) + ")" +
+          (out.top == chosen ? std::string(", and the highest weight of its group")
+                             : "; the weights rank " + out.top->effect.id() + " first (" +
+                                   two(members.front().weight) +
+                                   "), with another member the location errors differ");
+    return out;
+  }
+  std::string skipped;
+  const Member* top = nullptr;
+  for (const Member& m : members) {
+    if (determined(m.s)) {
+      top = &m;
+      break;
+    }
+    skipped += (skipped.empty() ? "" : ", ") + m.s->effect.id() + " (" + two(m.weight) + ")";
+  }
+  if (!top) {
+    out.weight = members.front().weight;
+    out.delta_bic = members.front().delta_bic;
+    out.why = "no member of the group has a parameter " + rule6 +
+              " once it is in the model: the result holds the baseline (the location errors "
+              "alone) for this finding";
+    return out;
+  }
+  const bool alone = judged.group.size() == 1;
+  std::string why = alone ? "it is named alone (weight " + two(top->weight) + ")"
+                          : "it holds the highest weight of its group (" + two(top->weight) + ")";
+  if (!skipped.empty())
+    why += " of the members with a parameter " + rule6 + " (" + skipped +
+           " weigh more, but none of their parameters is " + rule6 + " beside the model)";
+
+  // The simplest of equals: a member nested in the top one, as well supported (delta BIC <= 2,
+  // "not worth more than a bare mention" on the Kass-Raftery scale), is what the data show; the
+  // top one's extra parameters fit only the noise. Of several, the best fitting.
+  double t_end = 0.0;
+  for (double t : S.P.times()) t_end = std::max(t_end, t);
+  const Member* nested = nullptr;
+  std::string nest_why;
+  for (const Member& m : members) {
+    if (&m == top || m.s->effect.num_params() >= top->s->effect.num_params()) continue;
+    if (m.delta_bic - top->delta_bic > 2.0) continue;
+    if (nested && m.delta_bic >= nested->delta_bic) continue;
+    const TableMotionOverlap o =
+        table_motion_overlap(S.P.machine(), m.s->effect, top->s->effect, {-90.0, 90.0}, t_end);
+    if (!o.first_within_second || !determined(m.s)) continue;
+    nested = &m;
+    nest_why = m.s->effect.id() + " (" + two(m.weight) + ") is a special case of " +
+               top->s->effect.id() + " with fewer parameters (" +
+               std::to_string(m.s->effect.num_params()) + " against " +
+               std::to_string(top->s->effect.num_params()) +
+               ": every table motion of it is one of the other's, once the location errors and "
+               "the set-up are taken out) and fits as well (delta BIC " +
+               two(m.delta_bic - top->delta_bic) +
+               " <= 2): the simpler one is held, the other's extra parameters fitting only noise";
+  }
+  const Member& held = nested ? *nested : *top;
+  out.member = held.s;
+  out.refit = &refit_of(held.s);
+  out.weight = held.weight;
+  out.delta_bic = held.delta_bic;
+  out.why = nested ? nest_why + " (" + top->s->effect.id() + ": " + why + ")" : why;
+  if (held.s != chosen && top->s != chosen)
+    out.why += "; the search's pick, " + chosen->effect.id() + " (" + two(judged.weight) +
+               "), scored best of those that passed its tests, but the weights rank it lower";
+  return out;
+}
+
+}  // namespace rotacal::diagnosis_detail
