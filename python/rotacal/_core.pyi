@@ -7,7 +7,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Alternative', 'Ambiguity', 'AngleTable', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CircularAnalysis', 'CircularDiagnosis', 'CircularDiagnosisOptions', 'CircularDirection', 'CircularEffect', 'CircularFinding', 'CircularPairResult', 'CircularPlanResult', 'CircularPlane', 'CircularRun', 'CircularRunResult', 'CircularSimulationOptions', 'CircularTestPlan', 'CompensationReport', 'CompensationRow', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LinearAxisErrors', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'MultiDisagreement', 'MultiIdentification', 'MultiSessionResult', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'ProbeDesign', 'ProbeDesignCandidate', 'ProbeDesignOptions', 'ProbeIdentification', 'ProbeMonteCarlo', 'ProbeSeparatingCandidate', 'ProbeSeparationDesign', 'ProbeSeparationOptions', 'ProbeSession', 'ProbeSphereTrial', 'RadialSide', 'RealtimeModel', 'RecordSummary', 'RtestBasis', 'RtestDesign', 'RtestDesignCandidate', 'RtestDesignOptions', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSeparatingCandidate', 'RtestSeparationDesign', 'RtestSeparationOptions', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SeparatingCandidate', 'SeparationDesign', 'SeparationOptions', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'SweepDirection', 'TableMotionOverlap', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualCircularBallbar', 'VirtualRtest', 'analyze_circular', 'ballbar_model_document', 'ballbar_model_from_document', 'box_least_squares', 'builtin_machine_names', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_json_bounds', 'check_model_machine', 'check_output', 'check_plausible', 'check_rtest_pattern', 'circular_catalogue', 'circular_commanded_session', 'circular_label', 'comment_lines', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_axial_c_tilt_deg', 'default_ballbar_tests', 'default_calibration_moves', 'default_probe_poses_deg', 'default_rtest_pattern', 'default_tilt_range_deg', 'design_ballbar_separation', 'design_ballbar_test', 'design_probe_separation', 'design_probe_test', 'design_rtest_separation', 'design_rtest_test', 'diagnose_ballbar', 'diagnose_circular', 'diagnose_probe', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'evaluate_rtest_design', 'export_controller', 'format_ballbar', 'format_model_document', 'format_probe', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_joint_sessions', 'identify_multi', 'identify_paper', 'identify_probe', 'identify_probe_cycles', 'identify_rtest_joint', 'identify_rtest_paper', 'identify_runs', 'is_rotary_test', 'kasa_circle_fit', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_probe', 'monte_carlo_rtest', 'multi_model_document', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_circular_direction', 'parse_circular_plane', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'parse_sweep_direction', 'plan_ballbar_test', 'plan_circular_test', 'predict_rtest_session', 'predict_session_lengths', 'probe_effect_catalogue', 'probe_model_document', 'read_ballbar', 'read_instrument_session', 'read_linuxcnc_probe_log', 'read_model_document', 'read_probe', 'read_rtest', 'read_session', 'realtime_model_of_blob', 'realtime_model_of_file', 'record_ballbar', 'record_circular_ballbar', 'record_rtest', 'record_run', 'rtest_error_map', 'rtest_joint_model_document', 'rtest_map_names', 'rtest_prediction_rms_um', 'rtest_readings', 'run_label', 'simulate_ballbar', 'simulate_circular', 'simulate_probe', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sphere_fit', 'svd_plane_fit', 'table_motion_overlap', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_probe', 'uncertainty_budget_rtest', 'uncertainty_budget_rtest_identification', 'verify_compensation', 'write_ballbar', 'write_circular_nc_program', 'write_model_document', 'write_nc_program', 'write_output', 'write_probe', 'write_probe_nc_program', 'write_rtest']
+__all__: list[str] = ['Alternative', 'Ambiguity', 'AngleTable', 'AxisAngleMap', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CircularAnalysis', 'CircularDiagnosis', 'CircularDiagnosisOptions', 'CircularDirection', 'CircularEffect', 'CircularFinding', 'CircularPairResult', 'CircularPlanResult', 'CircularPlane', 'CircularRun', 'CircularRunResult', 'CircularSimulationOptions', 'CircularTestPlan', 'CompensationReport', 'CompensationRow', 'CompensationTable', 'CompensationTables', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LinearAxisErrors', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'MultiDisagreement', 'MultiIdentification', 'MultiSessionResult', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'ProbeDesign', 'ProbeDesignCandidate', 'ProbeDesignOptions', 'ProbeIdentification', 'ProbeMonteCarlo', 'ProbeSeparatingCandidate', 'ProbeSeparationDesign', 'ProbeSeparationOptions', 'ProbeSession', 'ProbeSphereTrial', 'RadialSide', 'RealtimeModel', 'RecordSummary', 'RtestBasis', 'RtestDesign', 'RtestDesignCandidate', 'RtestDesignOptions', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSeparatingCandidate', 'RtestSeparationDesign', 'RtestSeparationOptions', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SeparatingCandidate', 'SeparationDesign', 'SeparationOptions', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'SweepDirection', 'TableMotionOverlap', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualCircularBallbar', 'VirtualRtest', 'analyze_circular', 'angle_maps', 'ballbar_model_document', 'ballbar_model_from_document', 'box_least_squares', 'builtin_machine_names', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_json_bounds', 'check_model_machine', 'check_output', 'check_plausible', 'check_rtest_pattern', 'circular_catalogue', 'circular_commanded_session', 'circular_label', 'comment_lines', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_axial_c_tilt_deg', 'default_ballbar_tests', 'default_calibration_moves', 'default_probe_poses_deg', 'default_rtest_pattern', 'default_tilt_range_deg', 'design_ballbar_separation', 'design_ballbar_test', 'design_probe_separation', 'design_probe_test', 'design_rtest_separation', 'design_rtest_test', 'diagnose_ballbar', 'diagnose_circular', 'diagnose_probe', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'evaluate_rtest_design', 'export_controller', 'format_ballbar', 'format_model_document', 'format_probe', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_joint_sessions', 'identify_multi', 'identify_paper', 'identify_probe', 'identify_probe_cycles', 'identify_rtest_joint', 'identify_rtest_paper', 'identify_runs', 'is_rotary_test', 'kasa_circle_fit', 'linuxcnc_comp_tables', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_probe', 'monte_carlo_rtest', 'multi_model_document', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_circular_direction', 'parse_circular_plane', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'parse_sweep_direction', 'plan_ballbar_test', 'plan_circular_test', 'predict_rtest_session', 'predict_session_lengths', 'probe_effect_catalogue', 'probe_model_document', 'read_ballbar', 'read_instrument_session', 'read_linuxcnc_probe_log', 'read_model_document', 'read_probe', 'read_rtest', 'read_session', 'realtime_model_of_blob', 'realtime_model_of_file', 'record_ballbar', 'record_circular_ballbar', 'record_rtest', 'record_run', 'refuse_disagreeing', 'rtest_error_map', 'rtest_joint_model_document', 'rtest_map_names', 'rtest_prediction_rms_um', 'rtest_readings', 'run_label', 'simulate_ballbar', 'simulate_circular', 'simulate_probe', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sinumerik_eec_tables', 'sphere_fit', 'svd_plane_fit', 'table_motion_overlap', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_probe', 'uncertainty_budget_rtest', 'uncertainty_budget_rtest_identification', 'verify_compensation', 'write_ballbar', 'write_circular_nc_program', 'write_model_document', 'write_nc_program', 'write_output', 'write_probe', 'write_probe_nc_program', 'write_rtest']
 class Alternative:
     @property
     def aliased(self) -> bool:
@@ -62,6 +62,47 @@ class AngleTable:
     @property
     def value_um(self) -> list[float]:
         ...
+class AxisAngleMap:
+    """
+    One rotary axis' error terms at equal spacing.
+    """
+    @property
+    def angle_deg(self) -> list[float]:
+        ...
+    @property
+    def axis(self) -> str:
+        ...
+    @property
+    def max_interpolation_error(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        (7,) worst |model - linear interpolation| between the points
+        """
+    @property
+    def names(self) -> typing.Annotated[list[str], "FixedSize(7)"]:
+        """
+        E_X<axis> .. E_C<axis>, positioning_<axis>
+        """
+    @property
+    def notes(self) -> list[str]:
+        """
+        what the map leaves out
+        """
+    @property
+    def samples_between(self) -> int:
+        ...
+    @property
+    def sources(self) -> list[str]:
+        """
+        the model's terms that feed it
+        """
+    @property
+    def units(self) -> typing.Annotated[list[str], "FixedSize(7)"]:
+        ...
+    @property
+    def values(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        """
+        (n, 7) the terms at angle_deg (mm, rad)
+        """
 class BallbarDesign:
     """
     The chosen set-up and the default one.
@@ -1040,6 +1081,56 @@ class CompensationRow:
     @property
     def unit(self) -> str:
         ...
+class CompensationTable:
+    """
+    One joint's compensation table.
+    """
+    @property
+    def axis(self) -> str:
+        ...
+    @property
+    def file_name(self) -> str:
+        ...
+    @property
+    def holds(self) -> list[str]:
+        """
+        the model's terms the table holds (a residual model zeroes them)
+        """
+    @property
+    def joint(self) -> int:
+        ...
+    @property
+    def max_interpolation_error_deg(self) -> float:
+        ...
+    @property
+    def nominal_deg(self) -> list[float]:
+        ...
+    @property
+    def summary(self) -> str:
+        ...
+    @property
+    def text(self) -> str:
+        ...
+    @property
+    def value_deg(self) -> list[float]:
+        """
+        the values written, deg
+        """
+class CompensationTables:
+    """
+    A controller's tables of a model.
+    """
+    @property
+    def ini(self) -> str:
+        """
+        the INI lines that load them
+        """
+    @property
+    def not_held(self) -> list[str]:
+        ...
+    @property
+    def tables(self) -> list[CompensationTable]:
+        ...
 class ControllerExport:
     """
     A model's location errors in a controller's parameters.
@@ -1699,10 +1790,16 @@ class MultiDisagreement:
         ...
 class MultiIdentification:
     @property
+    def comparisons(self) -> int:
+        ...
+    @property
     def converged(self) -> bool:
         ...
     @property
     def covariance(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        ...
+    @property
+    def disagreement_z(self) -> float:
         ...
     @property
     def disagreements(self) -> list[MultiDisagreement]:
@@ -1724,6 +1821,9 @@ class MultiIdentification:
         ...
     @property
     def sessions(self) -> list[MultiSessionResult]:
+        ...
+    @property
+    def sigma_inflated(self) -> bool:
         ...
     @property
     def summary(self) -> FitSummary:
@@ -3816,6 +3916,10 @@ def analyze_circular(session: BallbarSession) -> CircularAnalysis:
     """
     ISO 230-4 circular deviation G per run, G(b) and hysteresis H per cw/ccw pair.
     """
+def angle_maps(model_path: str, lo_deg: typing.SupportsFloat | typing.SupportsIndex, hi_deg: typing.SupportsFloat | typing.SupportsIndex, spacing_deg: typing.SupportsFloat | typing.SupportsIndex, samples_between: typing.SupportsInt | typing.SupportsIndex = 16) -> list[AxisAngleMap]:
+    """
+    The position-dependent errors of a model file's table axes as functions of each axis' angle (io/angle_map.hpp), sampled from lo_deg to hi_deg.
+    """
 def ballbar_model_document(model: ...) -> typing.Any:
     ...
 def ballbar_model_from_document(document: dict, source: str = '<model>') -> ...:
@@ -3863,6 +3967,9 @@ def check_plausible(session: BallbarSession, source: str, options: PlausibilityO
     """
 @typing.overload
 def check_plausible(session: RtestSession, source: str, options: PlausibilityOptions = ...) -> PlausibilityReport:
+    ...
+@typing.overload
+def check_plausible(session: ..., source: str, options: PlausibilityOptions = ...) -> PlausibilityReport:
     ...
 def check_rtest_pattern(machine: MachineType, b_deg: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], c_deg: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], nests: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> None:
     """
@@ -4017,9 +4124,9 @@ def identify_joint_sessions(sessions: collections.abc.Sequence[BallbarSession], 
     """
     Joint fit of several ballbar sessions (shared location errors and effects, one pivot each): (values, covariance, converged) in the order 8 location errors, pivots, effect parameters.
     """
-def identify_multi(sessions: collections.abc.Sequence[tuple[str, typing.Any]], noise: str = 'auto', effects: collections.abc.Sequence[str] = []) -> MultiIdentification:
+def identify_multi(sessions: collections.abc.Sequence[tuple[str, typing.Any]], noise: str = 'auto', effects: collections.abc.Sequence[str] = [], inflate_sigma: bool = False) -> MultiIdentification:
     """
-    One identification from several (name, session) pairs of one machine (multi/identify.hpp): one set of location errors (and of the catalogue effects `effects`), each session's own nuisances and noise model, and the disagreements between the sessions fitted alone; noise 'auto' or 'white'.
+    One identification from several (name, session) pairs of one machine (multi/identify.hpp): one set of location errors (and of the catalogue effects `effects`), each session's own nuisances and noise model, and the disagreements between the sessions fitted alone; noise 'auto' or 'white'; inflate_sigma: widen the sigmas of disagreeing parameters by their Birge ratio.
     """
 def identify_paper(session: BallbarSession) -> BallbarIdentification:
     """
@@ -4071,6 +4178,10 @@ def kasa_circle_fit(points: typing.Annotated[numpy.typing.ArrayLike, numpy.float
     refine : polish by orthogonal distances (Ceres)
     
     Raises rotacal.DegenerateGeometry for < 3, collinear points or a too short arc.
+    """
+def linuxcnc_comp_tables(model_path: str, spacing_deg: typing.SupportsFloat | typing.SupportsIndex = 5.0, range_deg: collections.abc.Mapping[str, typing.Annotated[collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], "FixedSize(2)"]] = {}, file_names: collections.abc.Mapping[str, str] = {}, max_points: typing.SupportsInt | typing.SupportsIndex = 0, generated_at: str = '') -> CompensationTables:
+    """
+    LinuxCNC COMP_FILEs (type 1) of each table axis' positioning error and the INI lines that load them (io/compensation_table.hpp); max_points 0: LinuxCNC's 256.
     """
 def list_serial_ports() -> list[tuple[str, str, str]]:
     """
@@ -4180,9 +4291,9 @@ def read_instrument_session(path: str) -> rotacal._core.BallbarSession | rotacal
     """
     Read a ballbar, R-test or touch-probe session (chosen by its format line).
     """
-def read_linuxcnc_probe_log(path: str, plan: ProbeSession) -> ProbeSession:
+def read_linuxcnc_probe_log(path: str, plan: ProbeSession, max_off_line_mm: typing.SupportsFloat | typing.SupportsIndex = 1.0) -> ProbeSession:
     """
-    The session of a LinuxCNC probing log: its latched X Y Z in the plan's rows (probe/nc_program.hpp).
+    The session of a LinuxCNC probing log: its latched X Y Z in the plan's rows (probe/nc_program.hpp); a latch farther than max_off_line_mm from its commanded line is refused.
     """
 def read_model_document(path: str) -> typing.Any:
     """
@@ -4221,6 +4332,10 @@ def record_rtest(port: str, mode: str, program: RtestSession, dwell_s: typing.Su
 def record_run(nominal: BallbarSession, program: BallbarSession, machine: BallbarMachineModel, seed: typing.SupportsInt | typing.SupportsIndex | None = None, method: str = 'paper', noise_um: typing.SupportsFloat | typing.SupportsIndex = 0.5, noise_rho: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> BallbarSession:
     """
     The session a run records: `program` played on `machine`, AR(1) noise (seed; none if None), recorded against the `nominal` program's X,Y,Z and pivot.
+    """
+def refuse_disagreeing(identification: MultiIdentification) -> None:
+    """
+    InvalidArgument naming every disagreement unless there is none or the sigmas were widened for them (multi/model_document.hpp).
     """
 @typing.overload
 def rtest_error_map(identification: RtestJointIdentification, b_deg: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], c_deg: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], format: str = 'json') -> str:
@@ -4291,6 +4406,10 @@ def simulate_rtest(machine: MachineType, errors: typing.Annotated[numpy.typing.A
 def simulate_spindle_indexing(dirs: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], zeros: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], offset: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], centre: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], angles: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], noise_um: typing.SupportsFloat | typing.SupportsIndex, seed: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
     """
     Simulated spindle-indexing readings (N, 3), mm.
+    """
+def sinumerik_eec_tables(model_path: str, spacing_deg: typing.SupportsFloat | typing.SupportsIndex = 5.0, range_deg: collections.abc.Mapping[str, typing.Annotated[collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], "FixedSize(2)"]] = {}, axis_names: collections.abc.Mapping[str, str] = {}, max_points: typing.SupportsInt | typing.SupportsIndex = 0, generated_at: str = '') -> CompensationTables:
+    """
+    SINUMERIK EEC programs ($AA_ENC_COMP) of each table axis' positioning error (io/compensation_table.hpp); max_points 0: 200 (808D), else MD38000 as configured.
     """
 def sphere_fit(points: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], radius: typing.SupportsFloat | typing.SupportsIndex | None = None, sigma: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> SphereFit:
     """
