@@ -113,7 +113,9 @@ int main(int argc, char** argv) {
                 value[j].sd() / rep, rep * f, alone(alone_bb[j]), alone(alone_pr[j]),
                 ratio(value_bb[j], alone_bb[j]), ratio(value_pr[j], alone_pr[j]));
   }
-  std::printf("draws with a reported disagreement (|z| > 3 between the sessions alone): %d of %d\n",
-              disagreeing, draws);
+  std::printf(
+      "draws with a reported disagreement (the sessions alone, at identify's "
+      "multiplicity-corrected threshold): %d of %d\n",
+      disagreeing, draws);
   return 0;
 }
