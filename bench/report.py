@@ -118,6 +118,33 @@ HEADLINES: list[tuple[str, str, str]] = [
         "ballbar_speed",
         r"one call each in turn: ([\d.]+x wall, [\d.]+x CPU)",
     ),
+    ("Touch-probe joint fit, 120 touches", "probe_accuracy", r"joint fit: ([\d.]+ ms CPU) per fit"),
+    ("R-test joint fit, 2 x 84 poses", "rtest_bench", r"poses: .*?, ([\d.]+ ms CPU) median"),
+    (
+        "Diagnosis named the hidden cause alone, white noise, 3x its detection amplitude (AC-trt)",
+        "diagnosis_confusion",
+        r"\| white \| 3x \| \d+ \| (\d+%) \|",
+    ),
+    (
+        "The same in 1/f-like noise (the others: 'one of these', or nothing found)",
+        "diagnosis_confusion",
+        r"\| pink \| 3x \| \d+ \| (\d+%) \|",
+    ),
+    (
+        "Diagnosis named a wrong cause first, 1/f-like noise, sessions",
+        "diagnosis_confusion",
+        r"\| pink \| (\d+/\d+) \(\d+%\) \|",
+    ),
+    (
+        "Real-time kinematics with every model term, AC-trt: forward, median us",
+        "realtime_bench",
+        r"AC-trt\s+\d+\s+([\d.]+)\s",
+    ),
+    (
+        "The same, inverse (5 fixed Newton steps), median us",
+        "realtime_bench",
+        r"AC-trt\s+\d+\s+[\d.]+\s+[\d.]+\s+([\d.]+)\s",
+    ),
 ]
 HEADLINE_START = "<!-- headlines: made by `python3 bench/report.py render` -->"
 HEADLINE_END = "<!-- /headlines -->"
