@@ -212,7 +212,9 @@ def commit(rev: str | None = None) -> str:
         ["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True, text=True
     )
     dirty = subprocess.run(
-        ["git", "-C", str(ROOT), "status", "--porcelain", "--untracked-files=no"],
+        # what this script writes itself does not count as a change of what was measured
+        ["git", "-C", str(ROOT), "status", "--porcelain", "--untracked-files=no", "--", "."]
+        + [":!bench/results", ":!BENCHMARKS.md", ":!README.md"],
         capture_output=True,
         text=True,
     ).stdout.strip()
