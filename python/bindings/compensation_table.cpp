@@ -25,7 +25,8 @@ void bind_compensation_table(pyb::module_& m) {
       .def_property_readonly(
           "max_interpolation_error",
           [](const AxisAngleMap& a) { return Eigen::VectorXd(a.max_interpolation_error); },
-          "(7,) worst |model - linear interpolation| between the points")
+          "(7,) worst absolute difference of the model and the linear interpolation between the "
+          "points")
       .def_readonly("samples_between", &AxisAngleMap::samples_between);
   m.def(
       "angle_maps",

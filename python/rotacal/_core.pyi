@@ -75,7 +75,7 @@ class AxisAngleMap:
     @property
     def max_interpolation_error(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
-        (7,) worst |model - linear interpolation| between the points
+        (7,) worst absolute difference of the model and the linear interpolation between the points
         """
     @property
     def names(self) -> typing.Annotated[list[str], "FixedSize(7)"]:
