@@ -42,6 +42,15 @@ void bind_compensation_table(pyb::module_& m) {
       pyb::arg("samples_between") = 16,
       "The position-dependent errors of a model file's table axes as functions of each axis' "
       "angle (io/angle_map.hpp), sampled from lo_deg to hi_deg.");
+  pyb::class_<FanucPitchOptions>(m, "FanucPitchOptions",
+                                 "FANUC pitch error compensation: the control's units and limits.")
+      .def(pyb::init<>())
+      .def_readwrite("detection_unit_deg", &FanucPitchOptions::detection_unit_deg)
+      .def_readwrite("first_number", &FanucPitchOptions::first_number)
+      .def_readwrite("last_number", &FanucPitchOptions::last_number)
+      .def_readwrite("max_value", &FanucPitchOptions::max_value)
+      .def_readwrite("magnification", &FanucPitchOptions::magnification,
+                     "parameter 3623; 0: the smallest of 1..100 that keeps the values in range");
   pyb::class_<CompensationTable>(m, "CompensationTable", "One joint's compensation table.")
       .def_property_readonly("axis",
                              [](const CompensationTable& t) { return std::string(1, t.axis); })
@@ -105,6 +114,20 @@ void bind_compensation_table(pyb::module_& m) {
       pyb::arg("axis_names") = Names{}, pyb::arg("max_points") = 0, pyb::arg("generated_at") = "",
       "SINUMERIK EEC programs ($AA_ENC_COMP) of each table axis' positioning error "
       "(io/compensation_table.hpp); max_points 0: 200 (808D), else MD38000 as configured.");
+  m.def(
+      "fanuc_pitch_tables",
+      [options](const std::string& model_path, double spacing_deg, const Ranges& range_deg,
+                const FanucPitchOptions& fanuc, const std::string& generated_at) {
+        const ModelFile model = read_model(model_path);
+        CompensationTableOptions o =
+            options(model_path, spacing_deg, range_deg, {}, {}, 0, generated_at);
+        o.fanuc = fanuc;
+        return fanuc_pitch_tables(model, axis_error_functions(model, model_path), o);
+      },
+      pyb::arg("model_path"), pyb::arg("spacing_deg") = 5.0, pyb::arg("range_deg") = Ranges{},
+      pyb::arg("fanuc") = FanucPitchOptions{}, pyb::arg("generated_at") = "",
+      "FANUC pitch error compensation data (parameters 3620-3625 and values by data number) of "
+      "each table axis' positioning error (io/compensation_table.hpp).");
 }
 
 }  // namespace rotacal::py

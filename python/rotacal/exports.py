@@ -157,17 +157,23 @@ def controller_tables(
     axis_names: dict[str, str] | None = None,
     max_points: int = 0,
     generated_at: str = "",
+    file_names: dict[str, str] | None = None,
+    fanuc: dict[str, float] | None = None,
 ) -> Any:
     """The controller's compensation tables of a model's errors that move with a rotary axis
     (``rotacal export --tables``), computed in C++ (``rotacal/io/compensation_table.hpp``): a
     ``rotacal._core.CompensationTables`` whose ``tables`` each carry ``file_name`` (in
     ``directory``) and ``text``, and (LinuxCNC) ``ini`` the lines that load them. LinuxCNC
     COMP_FILEs and SINUMERIK EEC programs; the other controllers are refused by name
-    (docs/controller_exports.md). ``max_points`` 0: the controller's own limit."""
+    (docs/controller_exports.md). ``max_points`` 0: the controller's own limit. ``file_names``:
+    LinuxCNC, the file of an axis' table (default ``directory/comp_<axis>.txt``). ``fanuc``: the
+    fields of ``rotacal._core.FanucPitchOptions`` (detection unit, data numbers, value range,
+    magnification) for FANUC's pitch error compensation data."""
     rng = {k: [float(v[0]), float(v[1])] for k, v in (ranges or {}).items()}
     d = os.path.abspath(os.fspath(directory))
     if controller == "linuxcnc":
         names = {a: os.path.join(d, f"comp_{a}.txt") for a in "ABC"}
+        names |= {a: os.path.abspath(os.fspath(f)) for a, f in (file_names or {}).items()}
         return _core.linuxcnc_comp_tables(
             os.fspath(model), float(spacing_deg), rng, names, int(max_points), generated_at
         )
@@ -180,80 +186,15 @@ def controller_tables(
             int(max_points),
             generated_at,
         )
+    if controller == "fanuc":
+        o = _core.FanucPitchOptions()
+        for k, v in (fanuc or {}).items():
+            setattr(o, k, v)
+        return _core.fanuc_pitch_tables(os.fspath(model), float(spacing_deg), rng, o, generated_at)
     raise _core.InvalidArgument(
-        f"--tables: compensation tables are written for linuxcnc and siemens; {controller}'s "
+        f"--tables: compensation tables are written for linuxcnc, siemens and fanuc; {controller}'s "
         "are not (docs/controller_exports.md, the table of error terms x controller)"
     )
-
-
-# LinuxCNC 2.9 reads a joint's COMP_FILE up to the first line that is not three numbers, and
-# holds at most 256 of them.
-MAX_COMP_LINES = 256
-
-
-def _positioning_error(model: dict, axis: str, nominal_deg: np.ndarray) -> np.ndarray:
-    """The axis' positioning error (rad) at the nominal angles from the R-test map, evaluated by
-    the C++ model (rtest/error_model.hpp; the basis of docs/model_file.md): beta_BY(B) for B,
-    gamma_CB(C) at B = 0 for C."""
-    from .models import rtest_model_from_dict
-
-    fitted, _, _ = rtest_model_from_dict(model)
-    rad = np.radians(nominal_deg)
-    if axis == "B":
-        values, _ = fitted.w_by(rad)
-        return np.asarray(values)[:, 4]
-    values, _ = fitted.w_cb(np.column_stack([np.zeros_like(rad), rad]))
-    return np.asarray(values)[:, 5]
-
-
-def linuxcnc_comp_table(
-    model: dict, axis: str, lo_deg: float, hi_deg: float, step_deg: float
-) -> tuple[str, str]:
-    """A LinuxCNC ``[JOINT_n]COMP_FILE`` (``COMP_FILE_TYPE = 0``) of an R-test error map: lines
-    ``nominal actual actual`` in degrees, the actual angle being nominal + the map's positioning
-    error (B: beta_BY(B); C: gamma_CB(C) at B = 0), the same both ways (an R-test does not see
-    reversal). The file can carry no header (LinuxCNC stops at the first line that is not three
-    numbers): the second value returned says what it is, for the caller to print."""
-    if model.get("kind") != "rtest-joint" or model.get("machine") != "BC-trt":
-        raise _core.InvalidArgument(
-            "--comp-file: needs an R-test error map of a BC-trt machine "
-            f"(model kind {model.get('kind')!r}, machine {model.get('machine')!r})"
-        )
-    coefficients = model.get("map_coefficients", {})
-    prefix = {"B": "beta_BY", "C": "gamma_CB"}.get(axis)
-    if prefix is None:
-        raise _core.InvalidArgument(f"--comp-file {axis}: the axis must be B or C")
-    if not any(k.startswith(prefix + ".") for k in coefficients):
-        raise _core.InvalidArgument(
-            f"--comp-file {axis}: the model's map has no {prefix} terms "
-            "(C positioning needs the basis with gamma_cb)"
-        )
-    if not (step_deg > 0 and hi_deg > lo_deg):
-        raise _core.InvalidArgument(
-            f"--comp-range {lo_deg:g},{hi_deg:g} with step {step_deg:g}: need lo < hi, step > 0"
-        )
-    n = int(np.floor((hi_deg - lo_deg) / step_deg + 1e-9)) + 1
-    if n > MAX_COMP_LINES:
-        raise _core.InvalidArgument(
-            f"--comp-range: {n} lines, LinuxCNC reads at most {MAX_COMP_LINES}; use a larger step"
-        )
-    nominal = lo_deg + np.arange(n) * step_deg
-    actual = nominal + np.degrees(_positioning_error(model, axis, nominal))
-    lines = [f"{a:.6f} {b:.6f} {b:.6f}" for a, b in zip(nominal, actual)]
-    # The C map at B = 0: its terms in b^M (M > 0) vanish there; said so when the model has any.
-    dropped_any = axis == "C" and any(
-        k.startswith(prefix + ".")
-        and not k.endswith(".b0")
-        and isinstance(v, dict)
-        and v.get("value") is not None
-        for k, v in coefficients.items()
-    )
-    what = (
-        f"{axis} positioning error from the R-test map ({prefix}), {lo_deg:g}..{hi_deg:g} deg every {step_deg:g}: "
-        f"[JOINT_n]COMP_FILE_TYPE = 0 (nominal, actual moving +, actual moving -, deg)"
-        + ("; terms that depend on B were left out (the table is for B = 0)" if dropped_any else "")
-    )
-    return "\n".join(lines) + "\n", what
 
 
 def isg_sphere_centres(

@@ -214,10 +214,8 @@ def test_refusals_name_the_limit(exported, tmp_path):
     )
     assert r.returncode == EXIT_INPUT and "at most 256" in r.stderr and "721" in r.stderr
     assert not (tmp_path / "comp_C.txt").exists()
-    r = run_cli(
-        "export", "--model", m, "--controller", "fanuc", "--tables", "--tables-dir", tmp_path
-    )
-    assert r.returncode == EXIT_INPUT and "--tables" in r.stderr and "fanuc" in r.stderr
+    r = run_cli("export", "--model", m, "--controller", "isg", "--tables", "--tables-dir", tmp_path)
+    assert r.returncode == EXIT_INPUT and "--tables" in r.stderr and "isg" in r.stderr
     none = tmp_path / "none.json"
     none.write_text(json.dumps(model_doc(effects=False)))
     r = run_cli(

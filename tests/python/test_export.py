@@ -211,12 +211,17 @@ def test_linuxcnc_comp_file_of_an_rtest_map_holds_the_positioning_error(tmp_path
         "1",
     )
     assert r.returncode == 0, r.stderr
-    # As LinuxCNC 2.9 reads it: three numbers a line, nominal strictly increasing, <= 256 lines.
-    rows = np.array([[float(x) for x in line.split()] for line in comp.read_text().splitlines()])
+    # As LinuxCNC 2.9 reads it: three numbers a line up to the header, nominal strictly
+    # increasing, <= 256 lines; COMP_FILE_TYPE 1 trims (nominal - actual), the same both ways.
+    lines = comp.read_text().splitlines()
+    rows = np.array([[float(x) for x in ln.split()] for ln in lines if not ln.startswith("#")])
     assert rows.shape == (181, 3) and np.all(np.diff(rows[:, 0]) > 0)
-    err = np.radians(rows[:, 1] - rows[:, 0])
-    assert np.abs(err - 2e-4 * np.sin(np.radians(rows[:, 0]))).max() < 3e-6  # rad
+    assert all(ln.startswith("#") for ln in lines[181:])  # the header follows the numbers
+    trim = np.radians(rows[:, 1])
+    assert np.abs(trim + 2e-4 * np.sin(np.radians(rows[:, 0]))).max() < 3e-6  # rad
     assert np.array_equal(rows[:, 1], rows[:, 2])  # an R-test does not see reversal
+    assert "[JOINT_3]" in r.stderr and f"COMP_FILE = {comp}" in r.stderr
+    assert "COMP_FILE_TYPE = 1" in r.stderr and "[JOINT_4]" not in r.stderr
     # --tables (issue 54) from the same map: B's COMP_FILE (type 1) trims are -2e-4 sin B.
     r = rotacal_cli(
         "export",
@@ -243,7 +248,7 @@ def test_linuxcnc_comp_file_of_an_rtest_map_holds_the_positioning_error(tmp_path
     assert np.abs(trim + 2e-4 * np.sin(np.radians(rows[:, 0]))).max() < 3e-6  # rad
     assert "[JOINT_3]" in (tmp_path / "comp_tables.ini").read_text()
     assert not (tmp_path / "comp_C.txt").exists()  # the map has no gamma_CB: no C positioning
-    # A ballbar model has no map: refused by name; so is a map term the model does not have.
+    # An axis without positioning error in the model is refused by name; so is another controller.
     assert (
         rotacal_cli(
             "export",

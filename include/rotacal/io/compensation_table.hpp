@@ -24,6 +24,18 @@
 
 namespace rotacal {
 
+/// FANUC pitch error compensation (parameter manual, parameters 3620-3627): the data numbers,
+/// units and limits of the control. The defaults are a 0i's; other series hold other ranges.
+struct FanucPitchOptions {
+  double detection_unit_deg = 0.001;  ///< the axis' detection unit (IS-B: 0.001 deg)
+  int first_number = 0;               ///< the first data number of the first table written
+  int last_number = 1023;             ///< the highest data number the control holds
+  int max_value = 127;                ///< the largest |value| one data number holds
+  /// Parameter 3623: values are in detection units times it. 0: the smallest of 1..100 that
+  /// keeps every value within max_value.
+  int magnification = 0;
+};
+
 struct CompensationTableOptions {
   double spacing_deg = 5.0;  ///< between table points
   /// The angles each table spans, by axis letter (deg). Default: the axis' limits; an endless
@@ -40,6 +52,7 @@ struct CompensationTableOptions {
   std::map<char, std::string> file_names;
   std::string model_path;    ///< for the header
   std::string generated_at;  ///< UTC time for the header (empty: now)
+  FanucPitchOptions fanuc;
 };
 
 /// One joint's table.
@@ -88,5 +101,21 @@ CompensationTables linuxcnc_comp_tables(const ModelFile& model,
 CompensationTables sinumerik_eec_tables(const ModelFile& model,
                                         const std::vector<AxisErrorFunction>& functions,
                                         const CompensationTableOptions& options);
+
+/// FANUC pitch error compensation data of each table axis' positioning error: per axis a
+/// listing of the parameters 3620-3625 and the values by data number, to enter on the pitch
+/// error compensation screen. The value of data number R+k is the compensation of the section
+/// from (k-1) to k intervals past the reference position (at 0 deg), incremental, in detection
+/// units times the magnification; the control adds their sum to the motor command, so the
+/// absolute compensation at a point is the trim nominal - actual relative to the reference
+/// position's (linuxcnc_comp_tables' sign). An endless axis without a range gets one turn: the
+/// values sum to zero and the reference number holds the last one's value. The trim at the
+/// reference position is not in the table (the compensation is zero there): the header gives
+/// it. Refused as linuxcnc_comp_tables, and naming the limit for a value beyond max_value at
+/// every magnification, data numbers beyond last_number, a spacing that is no multiple of the
+/// detection unit or does not divide a turn, and a model whose turn does not sum to zero.
+CompensationTables fanuc_pitch_tables(const ModelFile& model,
+                                      const std::vector<AxisErrorFunction>& functions,
+                                      const CompensationTableOptions& options);
 
 }  // namespace rotacal

@@ -6,6 +6,7 @@ program, and its verification in simulation)."""
 from __future__ import annotations
 
 import argparse
+from types import SimpleNamespace
 
 from .. import _core, jsontext
 from ..outputs import write_output
@@ -16,9 +17,42 @@ from .setups import add_setup_args, add_truth_args, ballbar_model, ballbar_setup
 
 def _comp_file(text: str) -> tuple[str, str]:
     axis, sep, file = text.partition("=")
-    if not sep or axis not in ("B", "C") or not file:
-        raise _core.InvalidArgument(f"--comp-file {text!r}: expected AXIS=FILE with AXIS B or C")
+    if not sep or axis not in ("A", "B", "C") or not file:
+        raise _core.InvalidArgument(f"--comp-file {text!r}: expected AXIS=FILE with AXIS A, B or C")
     return axis, checked_path(file, "--comp-file")
+
+
+def _write_comp_files(a: argparse.Namespace, comp: dict[str, str]) -> object:
+    """--comp-file AXIS=FILE: the axis' COMP_FILE of --tables (one writer, in C++), over
+    --comp-range every --comp-step, written to FILE; the INI lines are printed."""
+    import os
+
+    from ..exports import controller_tables
+
+    tabs = controller_tables(
+        a.model,
+        "linuxcnc",
+        os.path.dirname(os.path.abspath(next(iter(comp.values())))),
+        a.comp_step,
+        {axis: list(a.comp_range) for axis in comp},
+        file_names=comp,
+    )
+    written = {t.axis: t for t in tabs.tables}
+    missing = [axis for axis in comp if axis not in written]
+    if missing:
+        raise _core.InvalidArgument(
+            f"--comp-file {', '.join(missing)}: the model holds no positioning error of that "
+            f"axis (tables: {', '.join(sorted(written)) or 'none'})"
+        )
+    for axis, file in comp.items():
+        write_output(file, written[axis].text, inputs=[a.model])
+        say(f"wrote {file}: {written[axis].summary}")
+    # The [JOINT_n] blocks of the axes asked for.
+    blocks = [("[" + b if k else b).rstrip("\n") for k, b in enumerate(tabs.ini.split("\n["))]
+    wanted = [f"COMP_FILE = {written[axis].file_name}" for axis in comp]
+    ini = "\n".join(b for b in blocks if any(w in b for w in wanted))
+    say("the INI lines that load them:\n" + ini)
+    return SimpleNamespace(tables=[written[axis] for axis in comp])  # what --residual-model zeroes
 
 
 def cmd_export_realtime(a: argparse.Namespace) -> int:
@@ -88,8 +122,26 @@ def _write_tables(a: argparse.Namespace) -> object:
                 f"--siemens-axis {text!r}: expected AXIS=NAME, AXIS A, B or C"
             )
         names[axis] = name
+    fanuc = {
+        k: v
+        for k, v in (
+            ("detection_unit_deg", a.fanuc_unit),
+            ("first_number", a.fanuc_first_number),
+            ("last_number", a.fanuc_last_number),
+            ("max_value", a.fanuc_max_value),
+            ("magnification", a.fanuc_magnification),
+        )
+        if v is not None
+    }
     tabs = controller_tables(
-        a.model, a.controller, directory, _spacing(a.spacing), ranges, names, a.max_points or 0
+        a.model,
+        a.controller,
+        directory,
+        _spacing(a.spacing),
+        ranges,
+        names,
+        a.max_points or 0,
+        fanuc=fanuc,
     )
     for t in tabs.tables:
         out = os.path.join(os.path.abspath(directory), os.path.basename(t.file_name))
@@ -107,7 +159,7 @@ def _write_tables(a: argparse.Namespace) -> object:
 def cmd_export(a: argparse.Namespace) -> int:
     if a.controller == "realtime":
         return cmd_export_realtime(a)
-    from ..exports import export_controller, export_dict, linuxcnc_comp_table, residual_model
+    from ..exports import export_controller, export_dict, residual_model
     from ..models import load_model, save_model
 
     comp = dict(_comp_file(c) for c in a.comp_file or [])
@@ -120,11 +172,9 @@ def cmd_export(a: argparse.Namespace) -> int:
             "--centres and --centres-output go together, with --controller isg"
         )
     ex = export_controller(a.model, a.controller, current=a.current, toolholder=a.toolholder)
-    tabs = _write_tables(a) if a.tables else None
-    tables = {
-        axis: linuxcnc_comp_table(load_model(a.model), axis, *a.comp_range, a.comp_step)
-        for axis in comp
-    }
+    if comp and a.tables:
+        raise _core.InvalidArgument("--comp-file and --tables: give one of them")
+    tabs = _write_tables(a) if a.tables else (_write_comp_files(a, comp) if comp else None)
     if a.centres:
         from ..exports import isg_sphere_centres
         from ..models import file_sha256
@@ -141,9 +191,6 @@ def cmd_export(a: argparse.Namespace) -> int:
             a.centres_output, text, inputs=[p for p in (a.model, a.current, a.centres) if p]
         )
         say(f"wrote {a.centres_output}: {what}")
-    for axis, (text, what) in tables.items():
-        write_output(comp[axis], text, inputs=[p for p in (a.model, a.current) if p])
-        say(f"wrote {comp[axis]}: {what}")
     if a.residual_model:
         save_model(
             residual_model(load_model(a.model), ex, tabs),
@@ -285,8 +332,8 @@ def add_export(sub: argparse._SubParsersAction) -> None:
         "--comp-file",
         action="append",
         metavar="AXIS=FILE",
-        help="linuxcnc, R-test map of a BC-trt: the axis' positioning error as a [JOINT_n]COMP_FILE "
-        "(type 0) table; AXIS B or C (C needs the map's gamma terms); may be repeated",
+        help="linuxcnc: the axis' positioning error as a [JOINT_n]COMP_FILE (type 1, as --tables "
+        "writes it) over --comp-range every --comp-step, written to FILE; may be repeated",
     )
     q.add_argument(
         "--comp-range",
@@ -305,7 +352,8 @@ def add_export(sub: argparse._SubParsersAction) -> None:
         action="store_true",
         help="also write each table axis' positioning error as the controller's table: linuxcnc "
         "[JOINT_n]COMP_FILE (type 1) and the INI lines (comp_tables.ini); siemens EEC "
-        "($AA_ENC_COMP) programs eec_<axis>.mpf",
+        "($AA_ENC_COMP) programs eec_<axis>.mpf; fanuc pitch error compensation data "
+        "pitch_<axis>.txt (parameters 3620-3625, values by data number)",
     )
     q.add_argument(
         "--spacing", default="5deg", help="--tables: between table points (default 5deg)"
@@ -334,6 +382,15 @@ def add_export(sub: argparse._SubParsersAction) -> None:
         type=path("--tables-dir"),
         help="--tables: the folder of the tables (default: that of -o, else the current one)",
     )
+    fanuc = q.add_argument_group("--tables with --controller fanuc (pitch error compensation)")
+    for option, lo, hi, whole, what in (
+        ("--fanuc-unit", 1e-6, 1.0, False, "the rotary axes' detection unit, deg (default 0.001)"),
+        ("--fanuc-first-number", 0, 1e5, True, "the first data number of the first table (0)"),
+        ("--fanuc-last-number", 0, 1e5, True, "the control's highest data number (1023, a 0i's)"),
+        ("--fanuc-max-value", 1, 1e6, True, "the largest |value| of one data number (127)"),
+        ("--fanuc-magnification", 1, 100, True, "parameter 3623 (default: the smallest that fits)"),
+    ):
+        fanuc.add_argument(option, type=number(option, lo, hi, integer=whole), help=what)
     q.add_argument(
         "--json", action="store_true", help="print the parameters and the errors held as JSON"
     )

@@ -18,15 +18,6 @@ namespace linuxcnc_table_detail {
 
 using namespace table_detail;
 
-// The trim (deg) that makes the model's axis reach p (deg): the actual angle of a motor command
-// m is m + positioning(m), so t = -positioning(p + t); a contraction for any real error
-// (|d positioning / d angle| << 1), four steps leave (n a)^4 a of a harmonic's amplitude a.
-double trim_deg(const AxisErrorFunction& f, double p_deg) {
-  double t = 0.0;
-  for (int i = 0; i < 4; ++i) t = -f.evaluate((p_deg + t) / kRadToDeg)[6] * kRadToDeg;
-  return t;
-}
-
 // A file name for the INI lines: printable ASCII without the INI's comment characters, so no
 // name becomes a second INI line or a comment.
 void check_file_name(const std::string& name) {
@@ -115,27 +106,16 @@ CompensationTables linuxcnc_comp_tables(const ModelFile& model,
                                         const CompensationTableOptions& o) {
   using namespace linuxcnc_table_detail;
   using namespace table_detail;
-  const MachineType m = model.machine;
-  if (m.has_head())
-    throw InvalidArgument("--tables: linuxcnc tables are written for table-table machines; " +
-                          to_string(m) + " has an axis on the head");
   const ExportInput in = export_input(model, o.model_path);
-  CompensationTables out;
+  CompensationTables out = positioning_tables(
+      model, functions, "linuxcnc", "a LinuxCNC COMP_FILE",
+      [&](const AxisErrorFunction& f) { return one_table(f, model.machine, o, in); });
   std::ostringstream ini;
-  for (const AxisErrorFunction& f : functions) {
-    list_not_held(f, m.description().axis(f.chain_index), out);
-    if (sample_angle_map(f, -180.0, 180.0, 5.0, 1).max_abs[6] == 0.0) continue;
-    CompensationTable t = one_table(f, m, o, in);
+  for (const CompensationTable& t : out.tables)
     ini << "[JOINT_" << t.joint << "]\n"
         << "# axis " << t.axis << " positioning (rotacal export --tables); BACKLASH is not used "
         << "while COMP_FILE is set\n"
         << "COMP_FILE = " << t.file_name << "\nCOMP_FILE_TYPE = 1\n";
-    out.tables.push_back(std::move(t));
-  }
-  if (out.tables.empty())
-    throw InvalidArgument("--tables: the model (" + model.kind +
-                          ") holds no positioning error of a table axis; nothing for a "
-                          "LinuxCNC COMP_FILE");
   out.ini = ini.str();
   return out;
 }

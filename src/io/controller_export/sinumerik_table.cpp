@@ -108,21 +108,10 @@ CompensationTables sinumerik_eec_tables(const ModelFile& model,
                                         const std::vector<AxisErrorFunction>& functions,
                                         const CompensationTableOptions& o) {
   using namespace sinumerik_table_detail;
-  const MachineType m = model.machine;
-  if (m.has_head())
-    throw InvalidArgument("--tables: SINUMERIK tables are written for table-table machines; " +
-                          to_string(m) + " has an axis on the head");
   const ExportInput in = export_input(model, o.model_path);
-  CompensationTables out;
-  for (const AxisErrorFunction& f : functions) {
-    list_not_held(f, m.description().axis(f.chain_index), out);
-    if (sample_angle_map(f, -180.0, 180.0, 5.0, 1).max_abs[6] == 0.0) continue;
-    out.tables.push_back(one_table(f, m, o, in));
-  }
-  if (out.tables.empty())
-    throw InvalidArgument("--tables: the model (" + model.kind +
-                          ") holds no positioning error of a table axis; nothing for an EEC table");
-  return out;
+  return positioning_tables(
+      model, functions, "SINUMERIK", "an EEC table",
+      [&](const AxisErrorFunction& f) { return one_table(f, model.machine, o, in); });
 }
 
 }  // namespace rotacal

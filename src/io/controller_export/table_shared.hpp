@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-// What the controllers' compensation tables share (linuxcnc_table.cpp, sinumerik_table.cpp).
+// What the controllers' compensation tables share (linuxcnc_table.cpp, sinumerik_table.cpp,
+// fanuc_table.cpp).
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -9,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "rotacal/core/error.hpp"
 #include "rotacal/io/compensation_table.hpp"
 
 namespace rotacal::table_detail {
@@ -47,6 +49,15 @@ inline std::vector<std::string> positioning_sources(const AxisErrorFunction& f,
   return out;
 }
 
+// The trim (deg) that makes the model's axis reach p (deg): the actual angle of a motor command
+// m is m + positioning(m), so t = -positioning(p + t); a contraction for any real error
+// (|d positioning / d angle| << 1), four steps leave (n a)^4 a of a harmonic's amplitude a.
+inline double trim_deg(const AxisErrorFunction& f, double p_deg) {
+  double t = 0.0;
+  for (int i = 0; i < 4; ++i) t = -f.evaluate((p_deg + t) / kRadToDeg)[6] * kRadToDeg;
+  return t;
+}
+
 inline std::array<double, 2> range_of(const RotaryAxis& ax, const CompensationTableOptions& o) {
   const auto it = o.range_deg.find(ax.name);
   if (it != o.range_deg.end()) return it->second;
@@ -73,6 +84,32 @@ inline void list_not_held(const AxisErrorFunction& f, const RotaryAxis& ax,
       out.not_held.push_back(map.names[static_cast<std::size_t>(j)] + buf +
                              " (a table holds no error motion)");
     }
+}
+
+// The tables `make(f)` of every table axis whose positioning error is not zero, with the error
+// motions no table holds; refused for a machine with a head axis (`controller` names whose
+// tables) or a model without any positioning error (`nothing_for` says for what).
+template <class MakeTable>
+CompensationTables positioning_tables(const ModelFile& model,
+                                      const std::vector<AxisErrorFunction>& functions,
+                                      const std::string& controller, const std::string& nothing_for,
+                                      MakeTable make) {
+  const MachineType& m = model.machine;
+  if (m.has_head())
+    throw InvalidArgument("--tables: " + controller +
+                          " tables are written for table-table machines; " + to_string(m) +
+                          " has an axis on the head");
+  CompensationTables out;
+  for (const AxisErrorFunction& f : functions) {
+    list_not_held(f, m.description().axis(f.chain_index), out);
+    if (sample_angle_map(f, -180.0, 180.0, 5.0, 1).max_abs[6] == 0.0) continue;
+    out.tables.push_back(make(f));
+  }
+  if (out.tables.empty())
+    throw InvalidArgument("--tables: the model (" + model.kind +
+                          ") holds no positioning error of a table axis; nothing for " +
+                          nothing_for);
+  return out;
 }
 
 }  // namespace rotacal::table_detail
