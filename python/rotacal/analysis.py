@@ -174,17 +174,35 @@ def write_report(
     source: str = "",
     inputs: Sequence[str] = (),
     extra_sections: Sequence[str] = (),
+    controller: str | None = None,
 ) -> Path:
     """The HTML report of a session (rotacal.report): identification, plots and diagnosis,
     written by the output rule (``inputs`` of the command are refused as the target);
-    ``extra_sections``: HTML sections appended (e.g. rotacal.history.history_section)."""
+    ``extra_sections``: HTML sections appended (e.g. rotacal.history.history_section);
+    ``controller``: a section of what that controller's export and tables correct of the
+    report's model (the extended one where the diagnosis extended it), and what remains."""
     from . import report  # draws: matplotlib is imported only here
+
+    def with_controller(ident: Any) -> Sequence[str]:
+        if controller is None:
+            return extra_sections
+        from .report.controller import controller_section
+
+        model = identification_document(ident, source or "session")
+        return [*extra_sections, controller_section(model, controller)]
 
     def ballbar_report():
         ident = ballbar.identify(session, method)
         d = diagnose(session) if with_diagnosis else None
+        extended = report.extended_identification(session, ident, d) if controller else None
         return report.ballbar_report(
-            path, session, ident, d, source=source, inputs=inputs, extra_sections=extra_sections
+            path,
+            session,
+            ident,
+            d,
+            source=source,
+            inputs=inputs,
+            extra_sections=with_controller(extended or ident),
         )
 
     def rtest_report():
@@ -199,7 +217,7 @@ def write_report(
         ident = rtest.identify_rtest(s, "joint")
         d = diagnose(s) if with_diagnosis else None
         return report.rtest_report(
-            path, s, ident, d, source=source, inputs=inputs, extra_sections=extra_sections
+            path, s, ident, d, source=source, inputs=inputs, extra_sections=with_controller(ident)
         )
 
     def probe_report():
@@ -209,14 +227,15 @@ def write_report(
                 "in `rotacal identify --method cycles`"
             )
         d = diagnose(session) if with_diagnosis else None
+        ident = probe.identify_probe(session, "joint")
         return report.probe_report(
             path,
             session,
-            probe.identify_probe(session, "joint"),
+            ident,
             d,
             source=source,
             inputs=inputs,
-            extra_sections=extra_sections,
+            extra_sections=with_controller(ident),
         )
 
     return by_kind(

@@ -142,6 +142,8 @@ def cmd_report(a: argparse.Namespace) -> int:
             history = h.show(a.history)
         extra.append(history_section(history))
     if len(a.file) > 1:  # one identification from several sessions of one machine
+        if a.controller:
+            raise _core.InvalidArgument("report --controller: one session (export the joint model)")
         return _joint_report(a, extra, history)
     a.file = a.file[0]
     s = load_session(a.file, a, circular_tests=True)
@@ -171,6 +173,7 @@ def cmd_report(a: argparse.Namespace) -> int:
             source=a.file,
             inputs=[a.file],
             extra_sections=extra,
+            controller=a.controller,
         )
     print(Path(out).resolve())
     return EXIT_OK
@@ -227,6 +230,11 @@ def add_report(sub: argparse._SubParsersAction) -> None:
         help="add the machine's calibration history (rotacal history show) as plots and flags",
     )
     add_db_arg(q)
+    q.add_argument(
+        "--controller",
+        choices=["linuxcnc", "siemens", "isg", "heidenhain", "fanuc"],
+        help="add what this controller's export and tables correct and what remains (one session)",
+    )
     q.add_argument("-o", "--output", required=True, type=path("--output"))
     add_plausibility_arg(q)
     q.set_defaults(func=cmd_report)
