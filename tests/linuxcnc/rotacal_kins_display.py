@@ -13,8 +13,10 @@ It writes everything to rotacal_kins.json (a failure: {"error": ...}, exit 1).
 """
 
 import json
+import os
 import subprocess
 import time
+from pathlib import Path
 
 import linuxcnc
 
@@ -56,6 +58,26 @@ def jog_to(m, target):
             m.wait_for(f"joint {j} at {v}", lambda: m.s.joint[j]["inpos"] and m.s.inpos)
 
 
+def lcnc_cpu_seconds():
+    """CPU seconds LinuxCNC's processes (which leave the test's process tree) have used so far:
+    the cost of a run, reported by the test."""
+    total = 0.0
+    for p in Path("/proc").iterdir():
+        try:
+            stat = (p / "stat").read_text() if p.name.isdigit() else ""
+        except OSError:
+            continue
+        if stat and stat[stat.index("(") + 1 : stat.rindex(")")] in (
+            "rtapi_app",
+            "milltask",
+            "linuxcncsvr",
+            "io",
+        ):
+            fields = stat[stat.rindex(")") + 2 :].split()
+            total += (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    return total
+
+
 def main():
     plan = json.load(open("plan.json"))
     m = Machine()
@@ -81,6 +103,7 @@ def main():
             m.mdi("G0 " + " ".join(f"{a}{v:.6f}" for a, v in zip(LETTERS, pose)))
             res["world_moves"].append(settle(m))
         out["models"].append(res)
+    out["lcnc_cpu_s"] = lcnc_cpu_seconds()
     return out
 
 

@@ -172,7 +172,9 @@ def test_rotacal_kins_in_linuxcnc_is_the_model(tmp_path, installed_module):
         )
     finally:
         shutil.rmtree(blob_dir, ignore_errors=True)
-    print(f"LinuxCNC session {out['elapsed']:.1f} s")
+    print(
+        f"LinuxCNC session {out['elapsed']:.1f} s, {out['lcnc_cpu_s']:.1f} CPU-s in its processes"
+    )
 
     for (ref, nominal_ref, tilt_col, tool), p, got in zip(refs, plan["models"], out["models"]):
         cols = [0, 1, 2, tilt_col, 5]  # the model's joints: X Y Z tilt C
