@@ -19,7 +19,6 @@ tests/python/linuxcnc_session.py), under `flock /tmp/linuxcnc.lock`.
 """
 
 import argparse
-import json
 import os
 import shutil
 import struct
@@ -194,7 +193,6 @@ def main():
     t, r = res["xyzac-trt-kins"], res["rotacal-kins"]
     print(f"ratio rotacal-kins / xyzac-trt-kins, median: {r['median'] / t['median']:.2f}")
     print(f"rotacal-kins adds, median: {r['median'] - t['median']:.2f} {unit} per servo period")
-    print(json.dumps(res))
 
 
 if __name__ == "__main__":
