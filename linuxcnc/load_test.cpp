@@ -94,8 +94,8 @@ Model ac_machine() {
                         {EffectKind::radial_motion, 'C', 2, 0},
                         {EffectKind::gravity_sag, 'A', 0, 0}};
   for (const Term& t : terms) {
-    for (int i = 0; i < effect_num_params(t.kind); ++i)
-      m.params[m.num_params++] = 2e-5 * (i % 2 ? -1 : 1) * (m.num_params % 3 + 1);
+    for (int i = 0; i < effect_num_params(t.kind); ++i, ++m.num_params)
+      m.params[m.num_params] = 2e-5 * (i % 2 ? -1 : 1) * (m.num_params % 3 + 1);
     m.effects[m.num_effects++] = t;
   }
   return m;

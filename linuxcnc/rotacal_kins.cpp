@@ -211,11 +211,11 @@ bool map_joints() {
       return false;
     }
   for (int k = 0; k < g_num_models; ++k)
-    for (int a = 0; a < 2; ++a)
-      if (g_joint_of_letter[letter_index(g_models[k].axes[a].name)] < 0) {
+    for (const rt::Axis& ax : g_models[k].axes)
+      if (g_joint_of_letter[letter_index(ax.name)] < 0) {
         rtapi_print_msg(RTAPI_MSG_ERR,
                         "rotacal-kins: model[%d] %s: axes.name: %c is not in coordinates\n", k,
-                        model[k], g_models[k].axes[a].name);
+                        model[k], ax.name);
         return false;
       }
   return true;
