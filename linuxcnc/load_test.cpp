@@ -21,6 +21,11 @@
 #include "rotacal/realtime/blob.hpp"
 #include "rotacal/realtime/evaluate.hpp"
 
+// emcpos.h's EmcPose (tran x, y, z, then a, b, c, u, v, w), under its name.
+struct EmcPose {
+  double v[9];
+};
+
 namespace {
 std::string g_printed;
 std::vector<std::string> g_pins;
@@ -106,13 +111,9 @@ struct Module {
   char** model;
   char** coordinates;
   int (*main)();
-  int (*forward)(const double*, void*, const void*, void*);
-  int (*inverse)(const void*, double*, const void*, void*);
-};
-
-// EmcPose: tran x, y, z, then a, b, c, u, v, w (emcpos.h).
-struct Pose {
-  double v[9];
+  // kinematics.h's signatures, to the type (UBSan checks calls through function pointers).
+  int (*forward)(const double*, EmcPose*, const unsigned long*, unsigned long*);
+  int (*inverse)(const EmcPose*, double*, const unsigned long*, unsigned long*);
 };
 
 std::string write(const std::string& path, const std::string& bytes) {
@@ -196,7 +197,7 @@ int main(int argc, char** argv) {
   for (int i = 0; i < 50; ++i) {
     const double joints[5] = {-120.0 + 5 * i, 80.0 - 3 * i, 40.0 + i, -94.5 + 4 * i,
                               -300.0 + 13 * i};
-    Pose world{};
+    EmcPose world{};
     mod.forward(joints, &world, nullptr, nullptr);
     Joints q;
     q.xyz = Eigen::Vector3d(joints[0], joints[1], joints[2]);
