@@ -95,7 +95,11 @@ def module_so() -> Path:
             capture_output=True,
             text=True,
         )
-        assert r.returncode == 0, f"building rotacal-kins failed:\n{r.stdout}\n{r.stderr}"
+        assert r.returncode == 0, (
+            f"building rotacal-kins in {build} failed (CMake makes the target where LinuxCNC's "
+            f"headers are: apt-get install linuxcnc-uspace-dev, then configure again):\n"
+            f"{r.stdout}\n{r.stderr}"
+        )
     return so
 
 
