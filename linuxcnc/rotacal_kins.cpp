@@ -178,9 +178,9 @@ bool load_model(int k, const char* path) {
                     r.reason);
     return false;
   }
-  if (g_models[k].table_axes == 0 || g_models[k].axes[0].name == g_models[k].axes[1].name) {
-    rtapi_print_msg(RTAPI_MSG_ERR, "rotacal-kins: model[%d] %s: axes.name: not two rotary axes\n",
-                    k, path);
+  if (g_models[k].axes[0].name == g_models[k].axes[1].name) {
+    rtapi_print_msg(RTAPI_MSG_ERR, "rotacal-kins: model[%d] %s: axes.name: both axes are %c\n", k,
+                    path, g_models[k].axes[0].name);
     return false;
   }
   return true;
