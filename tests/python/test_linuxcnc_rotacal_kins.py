@@ -200,9 +200,9 @@ def test_rotacal_kins_in_linuxcnc_is_the_model(tmp_path, installed_module):
         lw = np.array([m["world"] for m in got["world_moves"]])
         back = np.abs(lw - world)
         print(
-            f"model {tilt_col}: forward {fwd_err * 1e6:.3g} nm (model - nominal "
+            f"{'AC' if tilt_col == 3 else 'BC'}-trt: forward {fwd_err * 1e6:.3g} nm (model - nominal "
             f"{np.abs(tip - nominal).max() * 1e3:.3g} um), inverse {inv_err.max() * 1e6:.3g} nm, "
-            f"world back {back.max():.3g}"
+            f"world read back {back[:, :3].max() * 1e6:.3g} nm, {back[:, 3:].max():.3g} deg"
         )
         assert np.abs(tip - nominal).max() > 0.01  # mm: the model's terms move the tip
         assert fwd_err < TOL
