@@ -84,6 +84,14 @@ BENCHMARKS: dict[str, tuple[str, str, str]] = {
         "measures the scheduler.",
         "{bin}/realtime_bench",
     ),
+    "linuxcnc_kins_bench": (
+        "Real-time kinematics in LinuxCNC's servo thread: rotacal-kins against xyzac-trt-kins",
+        "The motion controller's own time per servo period (HAL's motion-controller.time) in "
+        "the headless LinuxCNC, moving in world coordinates, with LinuxCNC's trt kinematics and "
+        "with rotacal-kins running a model with every catalogue term; the median ratio is the "
+        "figure. Needs root, LinuxCNC and the built module; run under flock /tmp/linuxcnc.lock.",
+        "{py} bench/linuxcnc_kins_bench.py --build {bin}/..",
+    ),
     "diagnosis_confusion": (
         "Diagnosis: named right, ambiguous, nothing, named wrong",
         "Reference-simulator sessions (tests/reference/refsim), one hidden catalogue effect "

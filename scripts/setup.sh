@@ -12,7 +12,7 @@ set -euo pipefail
 
 MAIN_APT=(build-essential cmake ninja-build pkg-config libeigen3-dev libceres-dev
           libserialport-dev nlohmann-json3-dev)
-TEST_APT=(catch2 clang libclang-rt-14-dev lld-14 linuxcnc-uspace chromium stress-ng postgresql doxygen)
+TEST_APT=(catch2 clang libclang-rt-14-dev lld-14 linuxcnc-uspace linuxcnc-uspace-dev chromium stress-ng postgresql doxygen)
 MAIN_PIP=("numpy>=1.22" "matplotlib>=3.5" "pybind11>=2.11" "scikit-build-core>=0.11")
 TEST_PIP=("scipy>=1.9" "pytest>=7" "pybind11-stubgen==2.5.5" "psycopg[binary]>=3.1"
           "clang-format==23.1.5" "ruff==0.17.6" "dask[distributed]>=2023.1"

@@ -187,3 +187,32 @@ TEST_CASE("the blob of a model reads back and is refused for another machine", "
   wrong.effects = {Effect::parse("gravity_sag_B")};
   CHECK_THROWS_AS(realtime_model(ac, t.errors, wrong, {0.01}, "test"), InvalidArgument);
 }
+
+TEST_CASE("forward_world is the inverse's counterpart: joints -> world -> the same joints",
+          "[realtime]") {
+  std::mt19937 rng(17);
+  for (const char* name : {"AC-trt", "BC-trt", "B-head-C-table"}) {
+    const MachineType m = machine_named(name);
+    const TestModel t = every_term(m, rng);
+    const realtime::Model rt = realtime_model(m, t.errors, t.fx, t.p, "test");
+    realtime::State s;
+    s.tool_length = m.has_head() ? m.description().tool_length : 25.0;
+    double worst_xyz = 0, worst_angle = 0, worst_shift = 0;
+    for (int i = 0; i < 300; ++i) {
+      const realtime::Joints q = random_joints(m, rng);
+      if (std::abs(q.angles.tilt) < 0.02) continue;  // the rotary axis is free at tilt 0
+      const realtime::Joints w = realtime::forward_world(rt, q, s);
+      const realtime::Joints back = realtime::inverse(rt, w, s).joints;
+      worst_xyz = std::max(worst_xyz, (back.xyz - q.xyz).norm());
+      worst_angle = std::max({worst_angle, std::abs(back.angles.tilt - q.angles.tilt),
+                              std::abs(back.angles.rot - q.angles.rot)});
+      // The world angles differ from the joints' by the model's angular errors, not by zero.
+      worst_shift = std::max(worst_shift, std::abs(w.angles.rot - q.angles.rot));
+    }
+    INFO(name << ": worst xyz " << worst_xyz * 1e6 << " nm, angle " << worst_angle * 1e9
+              << " nrad; world - joint angle up to " << worst_shift * 1e6 << " urad");
+    CHECK(worst_xyz < 1e-5);
+    CHECK(worst_angle < 1e-8);
+    CHECK(worst_shift > 1e-6);
+  }
+}

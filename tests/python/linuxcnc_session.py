@@ -128,10 +128,10 @@ def run_linuxcnc(run_dir: Path, ini: str, files: dict, result: str, run_timeout:
     `files` (name -> text) added there; returns the JSON its display wrote to `result`, with
     "elapsed" (s, start to shut-down) added. The display is bounded by `run_timeout` s."""
     shutil.copytree(CONFIG, run_dir)
-    for program in run_dir.glob("*.py"):  # the displays and the HAL component are run as programs
-        os.chmod(program, 0o755)
     for name, text in files.items():
         (run_dir / name).write_text(text)
+    for program in run_dir.glob("*.py"):  # the displays and the HAL component are run as programs
+        os.chmod(program, 0o755)
     other = _running_linuxcnc()
     if other:
         pytest.fail(

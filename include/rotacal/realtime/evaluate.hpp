@@ -139,5 +139,49 @@ inline InverseResult inverse(const Model& m, const Joints& world, const State& s
   return out;
 }
 
+/// The nominal rotary angles whose nominal tool direction (relative to the workpiece) is
+/// `direction`: kInverseSteps chord Newton steps from `start` (the Jacobian of the nominal
+/// direction at `start`, damped by 1e-12 rad^2 as in inverse(), so that the rotary axis stays at
+/// `start` at the singular pose). The world angles of a controller's forward kinematics.
+inline RotaryAngles<double> nominal_angles(const Model& m, const Eigen::Vector3d& direction,
+                                           RotaryAngles<double> start, int steps = kInverseSteps) {
+  const Model nom = nominal_of(m);
+  Joints q;
+  q.angles = start;
+  const State s0;
+  const Eigen::Vector3d d0 = forward(nom, q, s0).direction;
+  Eigen::Matrix<double, 3, 2> J;
+  const double h = 1e-6;  // rad, as inverse()
+  for (int a = 0; a < 2; ++a) {
+    Joints qa = q;
+    (a == 0 ? qa.angles.tilt : qa.angles.rot) += h;
+    J.col(a) = (forward(nom, qa, s0).direction - d0) / h;
+  }
+  Eigen::Matrix2d N = J.transpose() * J;
+  N(0, 0) += 1e-12;
+  N(1, 1) += 1e-12;
+  const Eigen::LDLT<Eigen::Matrix2d> solver(N);
+  Eigen::Vector3d r = d0 - direction;
+  for (int i = 0; i < steps; ++i) {
+    const Eigen::Vector2d dx = solver.solve(J.transpose() * r);
+    q.angles.tilt -= dx[0];
+    q.angles.rot -= dx[1];
+    r = forward(nom, q, s0).direction - direction;
+  }
+  return q.angles;
+}
+
+/// Forward kinematics as a controller's world coordinates hold it, the exact counterpart of
+/// inverse(): the tool tip relative to the workpiece (xyz) and the nominal angles of the actual
+/// tool direction, so that inverse(forward_world(q)) is q (to the inverse's bound) and a
+/// controller that switches between joint and world coordinates sees no jump.
+inline Joints forward_world(const Model& m, const Joints& q, const State& s) {
+  const ToolPose p = forward(m, q, s);
+  Joints w;
+  w.xyz = p.tip;
+  w.angles = nominal_angles(m, p.direction, q.angles);
+  return w;
+}
+
 }  // namespace realtime
 }  // namespace rotacal
