@@ -69,12 +69,18 @@ def probe_candidate_dict(c: Any) -> dict:
         "directions": np.asarray(c.directions).tolist(),
         "pose_directions": [np.asarray(d).tolist() for d in c.pose_directions],
         "sphere": np.asarray(c.sphere).tolist(),
-        "feasible": c.feasible,
+        # Feasible: every parameter determined. Those no pose can determine are named instead.
+        "feasible": c.feasible and not len(c.undetermined),
         "touches": c.touches,
         "undetermined": list(c.undetermined),
     }
     if not c.feasible:
         return out | {"why_not": c.why_not}
+    if len(c.undetermined):
+        out["why_not"] = (
+            f"{', '.join(c.undetermined)}: no probe pose of the candidates determines "
+            f"{'it' if len(c.undetermined) == 1 else 'them'} (left out of the largest expanded uncertainty)"
+        )
     return out | {
         "predicted_std": {
             n: (float(s) if np.isfinite(s) else None) for n, s in zip(c.names, c.sigma)

@@ -19,6 +19,14 @@ NoiseFit fit_with_noise(const std::function<JointFitOutcome(const JointFitSettin
     throw InvalidArgument("fit_with_noise: groups and times must hold one value per residual (" +
                           std::to_string(n) + "), got " + std::to_string(groups.size()) + " and " +
                           std::to_string(times.size()));
+  if (o.own_noise && o.noise == NoiseHandling::automatic) {
+    std::shared_ptr<const ResidualWhitener> w = o.own_noise(out.fit, out.noise);
+    if (!w) return out;
+    settings.whitener = out.whitener = std::move(w);
+    out.fit = solve(settings);
+    out.refit = true;
+    return out;
+  }
   out.noise = estimate_noise_model(groups, times, out.fit.residuals, o.noise_options);
   if (o.noise != NoiseHandling::automatic || out.noise.white() ||
       out.noise.correlation_samples < o.min_correlation_samples)
@@ -31,7 +39,7 @@ NoiseFit fit_with_noise(const std::function<JointFitOutcome(const JointFitSettin
     out.noise = estimate_noise_model_reml(out.noise, out.fit.residuals, free_jacobian(out.fit));
   else if (o.noise_bias_correction)
     out.scale = noise_correction(out.noise, groups, times, out.fit, o.noise_options);
-  settings.whitener = std::make_shared<ArWhitener>(out.noise);
+  settings.whitener = out.whitener = std::make_shared<ArWhitener>(out.noise);
   out.fit = solve(settings);
   apply_noise_correction(out.scale, &out.fit);
   out.refit = true;

@@ -175,6 +175,7 @@ NoiseFit fit_alone(const SessionPart& p, const MultiFitOptions& o) {
   no.min_correlation_samples = o.min_correlation_samples;
   no.noise_bias_correction = o.noise_bias_correction;
   no.allow_reml = p.allow_reml;
+  no.own_noise = p.own_noise;
   JointFitSettings s = p.settings;
   s.max_iterations = o.max_iterations;
   s.observability_min_chi2 = o.observability_min_chi2;
@@ -189,7 +190,7 @@ BlockDiagonalWhitener::Block whitener_block(const SessionPart& p, const NoiseFit
   BlockDiagonalWhitener::Block b;
   b.rows = p.model->num_residuals();
   if (nf.refit) {
-    b.whitener = std::make_shared<ArWhitener>(nf.noise);
+    b.whitener = nf.whitener;
     b.factor = 1.0 / nf.scale;
     return b;
   }

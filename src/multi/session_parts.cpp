@@ -9,6 +9,7 @@
 #include "rotacal/ballbar/problem.hpp"
 #include "rotacal/kinematics/parameter_blocks.hpp"
 #include "rotacal/probe/problem.hpp"
+#include "rotacal/probe/touch_noise.hpp"
 #include "rotacal/rtest/problem.hpp"
 #include "rotacal/session/probe_session.hpp"
 #include "rotacal/session/session.hpp"
@@ -85,6 +86,7 @@ SessionPart probe_part(const MultiSessionInput& in, const EffectModel& fx) {
   p.settings.sigma = in.probe->noise_um.value_or(1.0) * 1e-3;
   p.groups = problem->groups();
   p.times = problem->times();
+  p.own_noise = touch_noise_model(in.probe);
   p.model = std::move(problem);
   p.data = in.probe;
   return p;

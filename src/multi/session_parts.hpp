@@ -28,6 +28,7 @@ struct SessionPart {
   std::vector<std::string> groups;  // noise stream of every residual
   std::vector<double> times;        // time (s) of every residual
   bool allow_reml = false;          // the R-test's wandering zeros (rtest/identify_joint.cpp)
+  OwnNoiseModel own_noise;          // the touch probe's (probe/touch_noise.hpp)
 };
 
 /// The part of one session with the shared catalogue effects `fx` fitted along (their

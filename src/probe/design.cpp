@@ -42,7 +42,8 @@ struct Candidates {
   std::vector<std::string> refused;
   Eigen::VectorXd plausible,
       scale;  // per parameter; per location error (um of 2 sigma per mm or rad)
-  std::vector<bool> determinable;  // per location error
+  std::vector<bool> determinable;      // per location error
+  std::vector<bool> determinable_all;  // per parameter: by all candidates together
 };
 
 // Fisher information of the touches of P, J^T J / sigma^2, and J.
@@ -123,6 +124,7 @@ Candidates candidates(const ProbeDesignOptions& o, const Eigen::Vector3d& sphere
     c.scale[j] =
         2.0 * 1e3 * (location_error_is_angle(static_cast<int>(j)) ? o.reference_radius_mm : 1.0);
   const Inverted every = invert_information(all, c.plausible, 1.0);
+  c.determinable_all = every.determined;
   for (Eigen::Index j = 0; j < c.layout.errors.size; ++j)
     c.determinable.push_back(
         every.determined[static_cast<std::size_t>(c.layout.errors.offset + j)]);
@@ -147,7 +149,19 @@ ProbeDesignCandidate judge(const ProbePattern& P, const Eigen::MatrixXd& I, cons
     else if (!inv.determined[static_cast<std::size_t>(c.layout.errors.offset + j)])
       missing += (missing.empty() ? "" : ", ") + name;
   }
-  if (!u.feasible) {
+  // The sphere's centre (and any other parameter beside the location errors) that the candidates
+  // determine but these poses do not is held by the fit, and the errors' sigmas would take it
+  // as known. (What no candidate determines, as the tool length with the sphere's z on a head,
+  // is a choice of origin, which moves no location error.)
+  const auto e0 = static_cast<std::size_t>(c.layout.errors.offset),
+             e1 = e0 + static_cast<std::size_t>(c.layout.errors.size);
+  bool nuisance_missing = false;
+  for (std::size_t j = 0; j < out.names.size(); ++j) {
+    if (j >= e0 && j < e1) continue;
+    if (c.determinable_all[j] && !inv.determined[j])
+      missing += (missing.empty() ? "" : ", ") + out.names[j], nuisance_missing = true;
+  }
+  if (!u.feasible || nuisance_missing) {
     out.why_not = missing + " not determined by these poses";
     return out;
   }

@@ -5,6 +5,7 @@
 #include "rotacal/core/time_constant_fit.hpp"
 #include "rotacal/probe/identify.hpp"
 #include "rotacal/probe/problem.hpp"
+#include "rotacal/probe/touch_noise.hpp"
 
 namespace rotacal {
 
@@ -27,9 +28,12 @@ ProbeIdentification identify_probe(const ProbeSession& session, const ProbeFitOp
   settings.sigma = session.noise_um.value_or(1.0) * 1e-3;  // scales chi-square only
   settings.whitener = options.whitener;
   const std::vector<FitParameter> parameters = problem.parameters();
+  NoiseFitOptions noise = options.noise;
+  if (!noise.own_noise && noise.noise == NoiseHandling::automatic)
+    noise.own_noise = touch_noise_model(std::make_shared<const ProbeSession>(session));
   NoiseFit nf = fit_with_noise(
       [&](const JointFitSettings& s) { return solve_with_time_constants(problem, parameters, s); },
-      settings, problem.groups(), problem.times(), options.noise);
+      settings, problem.groups(), problem.times(), noise);
   JointFitOutcome& fit = nf.fit;
 
   ProbeIdentification out;
@@ -65,9 +69,9 @@ ProbeIdentification identify_probe(const ProbeSession& session, const ProbeFitOp
       " mm taken as given; a wrong stylus radius is the diagnosis' stylus_radius_offset");
   if (nf.refit)
     out.notes.push_back("correlated noise (" + out.noise.summary() +
-                        "): covariance by GLS under this AR model, scaled by " +
-                        std::to_string(nf.scale) +
-                        " for the correlation the fit absorbs from its residuals");
+                        ", each machine coordinate's from one touch to the next, seen along "
+                        "the approach; REML over what the fit leaves): covariance by GLS under "
+                        "this model");
   if (!out.converged) out.notes.push_back("the fit did not converge: " + fit.summary.message);
   return out;
 }

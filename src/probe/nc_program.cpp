@@ -221,6 +221,11 @@ ProbeSession read_linuxcnc_probe_log(const std::string& path, const ProbeSession
   while (std::getline(in, text)) {
     ++line_no;
     if (!text.empty() && text.back() == '\r') text.pop_back();
+    if (line_no == 1 && text.size() >= 2 &&
+        (text.compare(0, 2, "\xFF\xFE") == 0 || text.compare(0, 2, "\xFE\xFF") == 0))
+      throw ParseError(path, 1, 1,
+                       "the log is UTF-16 text; rotacal reads the controller's log as ASCII "
+                       "(save it as UTF-8 or ASCII)");
     if (text.find_first_not_of(" \t") == std::string::npos) continue;
     std::istringstream fields(text);
     double p = 0, t = 0;
@@ -229,7 +234,9 @@ ProbeSession read_linuxcnc_probe_log(const std::string& path, const ProbeSession
     if (!(fields >> p >> t >> xyz.x() >> xyz.y() >> xyz.z()) || (fields >> extra) ||
         !xyz.allFinite())
       throw ParseError(path, line_no, 1,
-                       "expected 'pose touch X Y Z' (five numbers), got '" + printable(text) + "'");
+                       "expected 'pose touch X Y Z' (five finite numbers within a double's range), "
+                       "got '" +
+                           printable(text) + "'");
     if (row >= plan.samples.size())
       throw ParseError(path, line_no, 1,
                        "more touches than the plan's " + std::to_string(plan.samples.size()));

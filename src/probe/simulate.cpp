@@ -109,6 +109,17 @@ ProbeSimulation simulate_probe(const MachineModel& truth, const ProbeSimOptions&
   for (std::size_t k = 0; k < P.poses_deg.size(); ++k) {
     const RotaryAngles<double> a{P.poses_deg[k].tilt * kDeg, P.poses_deg[k].rot * kDeg};
     const Eigen::Vector3d start = inverse(m, LocationErrors<double>(), a, P.sphere).xyz;
+    // A sphere the machine cannot reach (a description's travel) is no session it could take.
+    if (const auto& travel = m.description().travel_mm)
+      for (int ax = 0; ax < 3; ++ax)
+        if (start[ax] < (*travel)(ax, 0) - 1e-9 || start[ax] > (*travel)(ax, 1) + 1e-9)
+          throw InvalidArgument("simulate_probe: the sphere at " + fmt4(P.sphere.x()) + ", " +
+                                fmt4(P.sphere.y()) + ", " + fmt4(P.sphere.z()) +
+                                " mm is outside the machine's travel at pose " +
+                                std::to_string(k + 1) + " (" + fmt4(P.poses_deg[k].tilt) + ", " +
+                                fmt4(P.poses_deg[k].rot) + " deg): " + std::string(1, "XYZ"[ax]) +
+                                " " + fmt4(start[ax]) + " mm, travel " + fmt4((*travel)(ax, 0)) +
+                                ".." + fmt4((*travel)(ax, 1)));
     const std::vector<Eigen::Vector3d>& dirs = P.directions_at(k);
     for (std::size_t j = 0; j < dirs.size(); ++j) {
       if (!(dirs[j].norm() > 0.0))

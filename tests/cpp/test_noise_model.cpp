@@ -395,6 +395,40 @@ TEST_CASE("REML recovers AR(1) + random walk from what a fit leaves; white stays
                     Catch::Contains("must agree"));
 }
 
+TEST_CASE("REML and the bias factor of a long stream hold memory linear in it (issue 57)",
+          "[noise_model]") {
+  // 150,000 readings in one stream (a probe session of that many touches is one stream): an
+  // n x n matrix of them is 180 GB, which this test would not survive; what is linear is a few
+  // MB. The correlation time REML reports is 1^T C 1 / tr C of the stream's covariance, checked
+  // on a short stream against the dense matrix (stream_covariance), summed here.
+  const int n = 150000;
+  const Layout L = layout(1, n, 10.0);
+  Eigen::MatrixXd X(n, 2);
+  for (int i = 0; i < n; ++i) X(i, 0) = 1.0, X(i, 1) = static_cast<double>(i) / n;
+  const Eigen::VectorXd e = noise_gen::ar1(L.groups, L.times, 0.6, 0.5e-3, 17) +
+                            noise_gen::probe_zero_wander(L.groups, L.times, 0.002e-3, 18);
+  const Eigen::VectorXd r = project_out(X, e);
+  const NoiseModel burg = estimate_noise_model(L.groups, L.times, r);
+  const NoiseModel M = estimate_noise_model_reml(burg, r, X);
+  REQUIRE(M.streams.size() == 1);
+  CHECK(M.streams[0].ar[0] == Approx(0.6).margin(0.05));
+  const double f = noise_model_bias_factor(burg, L.groups, L.times, X, NoiseModelOptions{}, 2, 5);
+  CHECK(f >= 1.0);
+  CHECK(std::isfinite(f));
+
+  const int m = 60;
+  const Layout S = layout(1, m, 10.0);
+  Eigen::MatrixXd Xs = Eigen::MatrixXd::Ones(m, 1);
+  const Eigen::VectorXd es = noise_gen::ar1(S.groups, S.times, 0.7, 0.5e-3, 21) +
+                             noise_gen::probe_zero_wander(S.groups, S.times, 0.1e-3, 22);
+  const Eigen::VectorXd rs = project_out(Xs, es);
+  const NoiseModel Ms =
+      estimate_noise_model_reml(estimate_noise_model(S.groups, S.times, rs), rs, Xs);
+  const Eigen::MatrixXd C = stream_covariance(Ms.streams[0]);
+  CHECK(Ms.streams[0].correlation_samples ==
+        Approx(std::min<double>(m, std::max(1e-3, C.sum() / C.trace()))).epsilon(1e-9));
+}
+
 TEST_CASE("whitened AR and 1/f-like data are white with unit variance", "[noise_model]") {
   const int n = 3000;
   const Layout L = layout(2, n, 1000.0);

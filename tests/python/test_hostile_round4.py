@@ -550,3 +550,90 @@ def test_two_descriptions_of_one_name_are_named_as_such(tmp_path):
     r = run_cli("identify", *sessions, cwd=tmp_path)
     assert r.returncode == EXIT_INPUT, r.stderr
     assert "two different descriptions" in r.stderr and DESCRIBED["name"] in r.stderr, r.stderr
+
+
+def test_import_names_a_utf16_log_and_an_out_of_range_value(plan, tmp_path):
+    _, _, template = plan
+    out = tmp_path / "s.csv"
+    cases = {
+        "wide.log": ("1 1 150.0 0.0 95.5\n".encode("utf-16-be"), b"\xfe\xff", "UTF-16"),
+        "huge.log": (b"1 1 150.0 0.0 95.5\n1 2 2e308 0.0 95.5\n", b"", "within a double's range"),
+    }
+    for name, (body, bom, words) in cases.items():
+        log = tmp_path / name
+        log.write_bytes(bom + body)
+        r = run_cli("import", "probe", log, "--plan", template, "-o", out, cwd=tmp_path)
+        assert r.returncode == EXIT_INPUT, (name, r.stderr)
+        line = 1 if bom else 2
+        assert f"{name}:{line}:" in r.stderr and words in r.stderr, (name, r.stderr)
+    assert not out.exists()
+
+
+def test_notes_and_messages_escaped_and_commands_quoted(disagreeing, tmp_path):
+    _, bb, rt = disagreeing
+    # Session files whose names carry a terminal escape and a bell: every line that names them
+    # shows the bytes escaped, on stdout (the notes) and on stderr (the refusal).
+    odd_bb, odd_rt = tmp_path / "bb\x1b]0;owned\x07.csv", tmp_path / "rt\x1b[1m.csv"
+    odd_bb.write_bytes(bb.read_bytes())
+    odd_rt.write_bytes(rt.read_bytes())
+    r = run_cli("identify", odd_bb, odd_rt, "--save-model", tmp_path / "m.json", cwd=tmp_path)
+    assert r.returncode == EXIT_INPUT, r.stderr
+    assert "\x1b" not in r.stdout + r.stderr and "\x07" not in r.stdout + r.stderr
+    assert "rt\\x1B[1m.csv" in r.stderr, r.stderr
+    assert any("note:" in line and "\\x1B" in line for line in r.stdout.splitlines()), r.stdout
+    # A suggested command names a file the shell must take as one word.
+    folder = tmp_path / "cell 4; rm -rf x"
+    folder.mkdir()
+    desc = folder / "m.json"
+    desc.write_text(json.dumps(DESCRIBED))
+    d = run_cli("design", "probe", "--machine", desc, "--tilt-step", "30", cwd=tmp_path)
+    assert d.returncode == EXIT_OK, d.stderr
+    run_it = next(line for line in d.stdout.splitlines() if line.startswith("run it with:"))
+    assert f"--machine '{desc}'" in run_it, run_it
+
+
+def test_simulate_probe_refuses_what_the_machine_cannot_reach(tmp_path):
+    desc = tmp_path / "m.json"
+    desc.write_text(json.dumps(DESCRIBED))
+    out = tmp_path / "s.csv"
+    for extra, words in (
+        (["--sphere", "700,0,80"], "outside the machine's travel"),  # X travel is +-600
+        (["--stylus-diameter", "8", "--sphere-diameter=-6"], "--sphere-diameter"),
+    ):
+        r = run_cli("simulate", "probe", "--machine", desc, *extra, "-o", out, cwd=tmp_path)
+        assert r.returncode == EXIT_INPUT and words in r.stderr, (extra, r.stderr)
+    assert not out.exists()
+
+
+def test_design_probe_with_a_parameter_undetermined_is_not_feasible(tmp_path):
+    # An A table that tilts +-1 deg: the poses the design picks leave the sphere's x to the
+    # noise, which the fit would hold (the errors' sigmas taking it as known). That design was
+    # called feasible; now it is refused, naming what it leaves undetermined.
+    narrow = {
+        "format": "rotacal-machine/1",
+        "name": "tilts one degree",
+        "table_axes": [
+            {"name": "A", "direction": [1, 0, 0], "point": [0, 0, 0], "limits_deg": [-1, 1]},
+            {"name": "C", "direction": [0, 0, 1], "point": [0, 0, 0]},
+        ],
+        "head_axes": [],
+        "pivot_length": 0.0,
+        "tool_length": 0.0,
+    }
+    desc = tmp_path / "m.json"
+    desc.write_text(json.dumps(narrow))
+    r = run_cli("design", "probe", "--machine", desc, "--tilt-step", "0.5", "--json", cwd=tmp_path)
+    assert r.returncode == EXIT_INPUT, r.stdout
+    assert "sphere.x not determined by these poses" in r.stderr, r.stderr
+    # A location error no pose can determine: the design is not called feasible either.
+    from types import SimpleNamespace
+
+    from rotacal.probe_design import probe_candidate_dict
+
+    c = SimpleNamespace(
+        poses_deg=[[0.0, 0.0]], directions=[[0, 0, -1]], pose_directions=[], sphere=[0, 0, 0],
+        feasible=True, touches=5, undetermined=["E_Z0B"], names=["E_Z0B"], sigma=[math.inf],
+        worst_expanded_um=1.0, worst_error="E_X0C",
+    )  # fmt: skip
+    d = probe_candidate_dict(c)
+    assert d["feasible"] is False and "E_Z0B: no probe pose" in d["why_not"], d

@@ -14,6 +14,7 @@
 ///   which has no bias left to scale (the R-test, whose probe zeros wander between poses).
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,12 @@
 #include "rotacal/core/noise_handling.hpp"
 
 namespace rotacal {
+
+/// An instrument's own noise model of its white fit's residuals (the touch probe's,
+/// probe/touch_noise.hpp): the GLS whitener (null: white, the white fit stands), and in
+/// `described` the model as reports and files say it.
+using OwnNoiseModel = std::function<std::shared_ptr<const ResidualWhitener>(
+    const JointFitOutcome& white_fit, NoiseModel& described)>;
 
 /// The noise handling options both instruments' JointFitOptions carry.
 struct NoiseFitOptions {
@@ -32,6 +39,8 @@ struct NoiseFitOptions {
   /// REML of AR(1) + a random walk when noise_options.reml_random_walk is set and no stream
   /// is longer than noise_options.reml_max_stream_size (the R-test); else Burg + bias factor.
   bool allow_reml = false;
+  /// Under `automatic`, used instead of the AR streams when set; no bias factor (REML).
+  OwnNoiseModel own_noise;
 };
 
 struct NoiseFit {
@@ -40,6 +49,7 @@ struct NoiseFit {
   bool refit = false;   ///< the fit was redone by GLS under `noise`
   bool reml = false;    ///< `noise` is REML's AR(1) + random walk
   double scale = 1.0;   ///< bias factor applied to the GLS covariance
+  std::shared_ptr<const ResidualWhitener> whitener;  ///< of the GLS refit (when `refit`)
 };
 
 /// `solve(settings)` runs the instrument's fit. With settings.whitener set (the caller's own

@@ -84,7 +84,8 @@ struct ProbeDesignCandidate {
   double worst_expanded_um = 0.0;  ///< max over the determined location errors of 2 sigma, um
   std::string worst_error;
   /// Location errors no probe pose of the candidates determines (e.g. E_Z0B on a head with the
-  /// tool length and the sphere's z): reported, left out of the largest expanded uncertainty.
+  /// tool length and the sphere's z): reported, left out of the largest expanded uncertainty. A
+  /// design with any is not complete (the JSON's "feasible" is false and says why).
   std::vector<std::string> undetermined;
 };
 

@@ -26,7 +26,7 @@ from ..machines import load_machine
 from ..outputs import write_output
 from ..sessions import PROBE, save
 from .design import _print_separation, _session_after, add_separation_group
-from .options import EPILOG, EXIT_OK, OptionError, number, numbers, path, say
+from .options import EPILOG, EXIT_OK, OptionError, number, numbers, path, say, shell_word
 from .probe import DEFAULT_LOG_FILE, DEFAULT_SPHERE, _plan_template, add_sphere_args
 
 
@@ -111,7 +111,7 @@ def cmd_design_probe_separation(a: argparse.Namespace) -> int:
     _print_separation(d, a.after, parameter_units(d.names))
     if d.found:
         print(
-            f"run it with: rotacal plan probe --machine {_core.machine_name(session.machine)} --poses "
+            f"run it with: rotacal plan probe --machine {shell_word(_core.machine_name(session.machine))} --poses "
             f'"{poses_text(d.chosen.poses_deg)}"'
             + (f" ({d.chosen.repeats:g} times)" if d.chosen.repeats > 1 else "")
         )
@@ -190,12 +190,12 @@ def cmd_design_probe(a: argparse.Namespace) -> int:
         print(f"  {n:16s} {s_ * k if math.isfinite(s_) else math.inf:10.4f} {unit}")
     if len(d.best.pose_directions):
         print(
-            f"run it with: rotacal design probe ... --json > design.json; rotacal plan probe --machine {a.machine} "
+            f"run it with: rotacal design probe ... --json > design.json; rotacal plan probe --machine {shell_word(a.machine)} "
             "--design design.json (or -o/--session here)"
         )
     else:
         print(
-            f"run it with: rotacal plan probe --machine {a.machine} --sphere {','.join(f'{v:g}' for v in d.sphere)} "
+            f"run it with: rotacal plan probe --machine {shell_word(a.machine)} --sphere {','.join(f'{v:g}' for v in d.sphere)} "
             f'--poses "{poses_text(d.best.poses_deg)}"'
         )
     return EXIT_OK

@@ -23,9 +23,45 @@ EPILOG = (
 )
 
 
+def terminal_text(text: str, keep: str = " ") -> str:
+    """``text`` with its control characters (escape sequences, line ends, C1) as \\xNN, as the
+    C++ messages show a bad line: a file name or a note read from a file never drives the
+    terminal. Characters in ``keep`` stay as they are."""
+    return "".join(
+        c
+        if c.isprintable() or c in keep
+        else f"\\x{ord(c):02X}"
+        if ord(c) < 256
+        else f"\\u{ord(c):04X}"
+        for c in text
+    )
+
+
+def shell_word(text: str) -> str:
+    """One word of a suggested command, quoted for a POSIX shell (and shown escaped)."""
+    import shlex
+
+    return terminal_text(shlex.quote(str(text)))
+
+
+class EscapedOutput:
+    """A text stream whose writes go through terminal_text, line ends and tabs kept: what a
+    command prints names files and quotes notes, which may hold any byte."""
+
+    def __init__(self, inner: Any) -> None:
+        self._inner = inner
+
+    def write(self, text: str) -> int:
+        return self._inner.write(terminal_text(text, keep=" \n\t"))
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._inner, name)
+
+
 def say(msg: str) -> None:
-    """One line for the user on stderr (stdout carries the results)."""
-    print(msg, file=sys.stderr, flush=True)
+    """One line for the user on stderr (stdout carries the results), its control characters
+    escaped (terminal_text)."""
+    print(terminal_text(msg), file=sys.stderr, flush=True)
 
 
 class OptionError(Exception):

@@ -38,7 +38,16 @@ from . import (
     probe,
     simulate,
 )
-from .options import EPILOG, EXIT_ERROR, EXIT_INPUT, EXIT_IO, EXIT_OK, OptionError, say
+from .options import (
+    EPILOG,
+    EXIT_ERROR,
+    EXIT_INPUT,
+    EXIT_IO,
+    EXIT_OK,
+    EscapedOutput,
+    OptionError,
+    say,
+)
 
 MODULES = (
     plan,
@@ -147,6 +156,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit code. Every failure ends in a one-line message
     and the documented code, never a traceback (ROTACAL_TRACEBACK=1 shows it for debugging)."""
     argv = list(sys.argv[1:] if argv is None else argv)
+    stdout = sys.stdout
+    sys.stdout = EscapedOutput(stdout)  # file names and notes never drive the terminal
+    try:
+        return _run(argv)
+    finally:
+        sys.stdout = stdout
+
+
+def _run(argv: list[str]) -> int:
     try:
         args = build_parser().parse_args(_join_signed_values(argv))
         check_command_files(args)  # every output against every input and output, before any work

@@ -22,6 +22,7 @@ from .options import (
     numbers,
     path,
     say,
+    shell_word,
 )
 
 # The CLI's C range: 0..359 deg, one step short of the full turn (the C++ default is 0..360).
@@ -376,7 +377,7 @@ def load_session(
             raise _core.InvalidArgument(
                 f"{path}: holds ISO 230-4 circular tests of the linear axes ({', '.join(sorted(set(s.tests))[:3])}"
                 f"{', ...' if len(set(s.tests)) > 3 else ''}), not a rotary-axis test: `rotacal circular analyze "
-                f"{path}` gives G, G(b), H and their causes, `rotacal report {path} -o OUT.html` the report"
+                f"{shell_word(path)}` gives G, G(b), H and their causes, `rotacal report {shell_word(path)} -o OUT.html` the report"
             )
         if not is_circular(s):
             check_plausible(s, path, getattr(a, "max_deviation", None))
