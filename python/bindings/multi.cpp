@@ -23,7 +23,9 @@ void bind_multi(pyb::module_& m) {
       .def_readonly("value_b", &MultiDisagreement::value_b)
       .def_readonly("difference", &MultiDisagreement::difference)
       .def_readonly("sigma", &MultiDisagreement::sigma)
-      .def_readonly("z", &MultiDisagreement::z);
+      .def_readonly("z", &MultiDisagreement::z)
+      .def_readonly("dof", &MultiDisagreement::dof, "of sigma (Welch-Satterthwaite)")
+      .def_readonly("threshold", &MultiDisagreement::threshold, "|z| beyond which it disagrees");
   pyb::class_<MultiSessionResult>(m, "MultiSessionResult")
       .def_readonly("name", &MultiSessionResult::name)
       .def_readonly("instrument", &MultiSessionResult::instrument)
@@ -33,7 +35,8 @@ void bind_multi(pyb::module_& m) {
       .def_readonly("noise_refit", &MultiSessionResult::noise_refit)
       .def_readonly("noise_correction", &MultiSessionResult::noise_correction)
       .def_readonly("residual_rms_um", &MultiSessionResult::residual_rms_um)
-      .def_readonly("n_residuals", &MultiSessionResult::n_residuals);
+      .def_readonly("n_residuals", &MultiSessionResult::n_residuals)
+      .def_readonly("dof", &MultiSessionResult::dof, "of its sigmas alone");
   pyb::class_<MultiIdentification>(m, "MultiIdentification")
       .def_readonly("machine", &MultiIdentification::machine)
       .def_readonly("location_errors", &MultiIdentification::location_errors)

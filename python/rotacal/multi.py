@@ -68,6 +68,7 @@ class MultiIdentification:
                     "difference": float(d.difference),
                     "sigma": float(d.sigma),
                     "z": float(d.z),
+                    "threshold": float(d.threshold),
                 }
                 for d in r.disagreements
             ],

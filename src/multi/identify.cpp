@@ -217,6 +217,10 @@ std::vector<MultiDisagreement> comparisons(const std::vector<MultiSessionResult>
         d.difference = ea.value - eb.value;
         d.sigma = std::hypot(ea.std, eb.std);
         d.z = d.sigma > 0.0 ? d.difference / d.sigma : 0.0;
+        // Welch-Satterthwaite: (s_a^2 + s_b^2)^2 / (s_a^4 / nu_a + s_b^4 / nu_b).
+        const double va = ea.std * ea.std, vb = eb.std * eb.std;
+        const double den = va * va / s[a].dof + vb * vb / s[b].dof;
+        d.dof = den > 0.0 ? (va + vb) * (va + vb) / den : std::numeric_limits<double>::infinity();
         out.push_back(d);
       }
   return out;
@@ -225,10 +229,14 @@ std::vector<MultiDisagreement> comparisons(const std::vector<MultiSessionResult>
 // The |z| beyond which a comparison is a disagreement: Bonferroni's bound over the m
 // comparisons made, so that sessions of one machine show any disagreement with probability at
 // most alpha (whatever the comparisons' correlation), and never below z_min.
-double disagreement_threshold(std::size_t m, const MultiFitOptions& o) {
+// With `dof` finite the sigma of the difference is itself estimated: the bound is Student's t
+// at that dof (a sigma from 40 effective touches makes |z| > 3.3 three times likelier than a
+// known one would).
+double disagreement_threshold(std::size_t m, const MultiFitOptions& o,
+                              double dof = std::numeric_limits<double>::infinity()) {
   if (m == 0) return o.disagreement_z;
   const double p = 1.0 - o.disagreement_alpha / static_cast<double>(m);
-  return std::max(o.disagreement_z, stats::t_coverage(p, std::numeric_limits<double>::infinity()));
+  return std::max(o.disagreement_z, stats::t_coverage(p, std::max(dof, 1.0)));
 }
 
 ParameterEstimate& joint_shared(MultiIdentification& m, std::size_t j) {
@@ -356,6 +364,8 @@ MultiIdentification identify_multi(const std::vector<MultiSessionInput>& session
     r.noise = nf.noise;
     r.noise_refit = nf.refit;
     r.noise_correction = nf.scale;
+    r.dof =
+        std::max(1.0, nf.noise.effective_samples - static_cast<double>(nf.fit.summary.num_free));
     r.n_residuals = static_cast<std::size_t>(p.model->num_residuals());
     out.sessions.push_back(std::move(r));
   }
@@ -390,8 +400,10 @@ MultiIdentification identify_multi(const std::vector<MultiSessionInput>& session
   std::vector<MultiDisagreement> all = comparisons(out.sessions);
   out.comparisons = all.size();
   out.disagreement_z = disagreement_threshold(all.size(), o);
-  for (const MultiDisagreement& d : all)
-    if (std::abs(d.z) > out.disagreement_z) out.disagreements.push_back(d);
+  for (MultiDisagreement& d : all) {
+    d.threshold = disagreement_threshold(all.size(), o, d.dof);
+    if (std::abs(d.z) > d.threshold) out.disagreements.push_back(d);
+  }
   outside_every_session(out, out.disagreement_z, out.disagreements);
   for (const MultiDisagreement& d : out.disagreements)
     out.notes.push_back(

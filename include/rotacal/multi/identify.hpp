@@ -22,6 +22,7 @@
 /// (multi/model_document.hpp) unless `inflate_sigma` widened their sigmas by the scatter.
 
 #include <Eigen/Core>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -87,6 +88,10 @@ struct MultiDisagreement {
   double difference = 0.0;  ///< value_a - value_b
   double sigma = 0.0;       ///< 1 sigma of the difference (independent sessions)
   double z = 0.0;           ///< difference / sigma
+  /// Degrees of freedom of `sigma` (Welch-Satterthwaite over the two sessions' own: each
+  /// sigma rests on its noise model's effective samples less its free parameters).
+  double dof = std::numeric_limits<double>::infinity();
+  double threshold = 0.0;  ///< the |z| beyond which it is a disagreement, at `dof`
 };
 
 /// What one session contributes.
@@ -95,9 +100,12 @@ struct MultiSessionResult {
   std::vector<ParameterEstimate> nuisances;  ///< its own parameters in the joint fit
   std::vector<ParameterEstimate> alone;  ///< its location errors (then shared effects) fitted alone
   NoiseModel noise;                      ///< noise model of its residuals alone
-  bool noise_refit = false;              ///< whitened by `noise` (GLS) in the joint fit
-  double noise_correction = 1.0;         ///< bias factor on its share of the covariance
-  double residual_rms_um = 0.0;          ///< of the joint fit, this session's rows
+  /// Degrees of freedom of its sigmas alone: the noise model's effective samples less the
+  /// free parameters of its fit alone.
+  double dof = std::numeric_limits<double>::infinity();
+  bool noise_refit = false;       ///< whitened by `noise` (GLS) in the joint fit
+  double noise_correction = 1.0;  ///< bias factor on its share of the covariance
+  double residual_rms_um = 0.0;   ///< of the joint fit, this session's rows
   std::size_t n_residuals = 0;
 };
 
@@ -116,7 +124,9 @@ struct MultiIdentification {
   std::vector<std::string> notes;
   bool sigma_inflated = false;  ///< inflate_sigma widened the sigmas of disagreeing parameters
   std::size_t comparisons = 0;  ///< pairs of sessions x parameters both determine
-  double disagreement_z = 0.0;  ///< the |z| beyond which one of them is a disagreement
+  /// The |z| beyond which one of them is a disagreement with exactly known sigmas; a
+  /// comparison of sigmas from few effective samples has its own (MultiDisagreement::threshold).
+  double disagreement_z = 0.0;
   const ParameterEstimate& location_error(const std::string& name) const;
 };
 
