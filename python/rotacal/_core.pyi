@@ -1803,6 +1803,11 @@ class MultiDisagreement:
     def difference(self) -> float:
         ...
     @property
+    def dof(self) -> float:
+        """
+        of sigma (Welch-Satterthwaite)
+        """
+    @property
     def parameter(self) -> str:
         ...
     @property
@@ -1814,6 +1819,11 @@ class MultiDisagreement:
     @property
     def sigma(self) -> float:
         ...
+    @property
+    def threshold(self) -> float:
+        """
+        |z| beyond which it disagrees
+        """
     @property
     def unit(self) -> str:
         ...
@@ -1873,6 +1883,11 @@ class MultiSessionResult:
     @property
     def alone(self) -> list[ParameterEstimate]:
         ...
+    @property
+    def dof(self) -> float:
+        """
+        of its sigmas alone
+        """
     @property
     def instrument(self) -> str:
         ...

@@ -3,9 +3,11 @@
 #include "rotacal/probe/monte_carlo.hpp"
 
 #include <cmath>
+#include <random>
 
 #include "rotacal/core/error.hpp"
 #include "rotacal/probe/problem.hpp"
+#include "rotacal/probe/touch_noise.hpp"
 
 namespace rotacal {
 
@@ -49,14 +51,23 @@ ProbeMonteCarlo monte_carlo_probe(const ProbeSession& session, const ProbeIdenti
   out.draws = o.draws;
   out.noise_um = result.sigma_um;
   const bool coloured = result.noise_refit;
+  const bool touch =
+      coloured && result.noise.streams.size() == 1 && result.noise.streams.front().ar.size() == 1;
+  const double touch_rho = touch ? result.noise.streams.front().ar.front() : 0.0;
+  if (coloured && !touch)
+    throw InvalidArgument("monte_carlo_probe: the fit's noise model is not the touch probe's (" +
+                          result.noise.summary() + ")");
   out.noise = coloured ? "the fitted noise model: " + result.noise.summary() : "white noise";
   ProbeFitOptions fit;
   fit.effects = fx;
   fit.noise.noise = o.noise;
   out.values.resize(o.draws, static_cast<Eigen::Index>(result.parameters.size()));
   for (int k = 0; k < o.draws; ++k) {
+    // The noise the fit assumed: the touch model's (probe/touch_noise.hpp) where it is coloured.
+    std::mt19937_64 rng(o.seed + static_cast<std::uint64_t>(k));
     const Eigen::VectorXd e =
-        monte_carlo_noise(coloured, result.noise, result.sigma_um, n, o.seed, k);
+        touch ? draw_touch_noise(session, touch_rho, result.noise.sigma_um * 1e-3, rng)
+              : monte_carlo_noise(false, result.noise, result.sigma_um, n, o.seed, k);
     // Each touch where the identified machine leaves the drawn noise as its residual.
     const ProbeSession draw = moved(session, ((e - r0).array() / slope.array()).matrix());
     const ProbeIdentification r = identify_probe(draw, fit);

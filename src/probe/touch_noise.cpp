@@ -156,6 +156,28 @@ TouchNoise estimate_touch_noise(const ProbeSession& session, const Eigen::Vector
   return out;
 }
 
+Eigen::VectorXd draw_touch_noise(const ProbeSession& session, double rho, double sigma_mm,
+                                 std::mt19937_64& rng) {
+  if (!(std::abs(rho) < 1.0) || !(sigma_mm >= 0.0))
+    throw InvalidArgument("draw_touch_noise: needs |rho| < 1 and sigma >= 0");
+  std::vector<std::size_t> order(session.samples.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return session.samples[a].time < session.samples[b].time;
+  });
+  std::normal_distribution<double> g(0.0, 1.0);
+  const auto white3 = [&] { return Eigen::Vector3d(g(rng), g(rng), g(rng)); };
+  Eigen::Vector3d state = sigma_mm * white3();  // started stationary
+  const double innovation = sigma_mm * std::sqrt(1.0 - rho * rho);
+  Eigen::VectorXd e(static_cast<Eigen::Index>(order.size()));
+  for (std::size_t t = 0; t < order.size(); ++t) {
+    if (t > 0) state = rho * state + innovation * white3();
+    const std::size_t i = order[t];
+    e[static_cast<Eigen::Index>(i)] = session.samples[i].n.normalized().dot(state);
+  }
+  return e;
+}
+
 OwnNoiseModel touch_noise_model(std::shared_ptr<const ProbeSession> session) {
   return [session](const JointFitOutcome& white,
                    NoiseModel& described) -> std::shared_ptr<const ResidualWhitener> {

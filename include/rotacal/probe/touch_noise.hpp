@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <random>
 #include <vector>
 
 #include "rotacal/core/fit_with_noise.hpp"
@@ -53,6 +54,12 @@ struct TouchNoise {
 };
 TouchNoise estimate_touch_noise(const ProbeSession& session, const Eigen::VectorXd& residuals_mm,
                                 const Eigen::MatrixXd& free_jacobian);
+
+/// A draw of that noise for `session` (mm, one per touch in session order): each coordinate's
+/// AR(1) at `rho` and marginal `sigma_mm` in time order, read along each touch's direction; what
+/// a Monte Carlo check of a fit under this model must draw (probe/monte_carlo.cpp).
+Eigen::VectorXd draw_touch_noise(const ProbeSession& session, double rho, double sigma_mm,
+                                 std::mt19937_64& rng);
 
 /// The NoiseFitOptions::own_noise of a probe session (kept alive by the returned function).
 OwnNoiseModel touch_noise_model(std::shared_ptr<const ProbeSession> session);
