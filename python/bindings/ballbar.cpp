@@ -102,7 +102,7 @@ void bind_ballbar_identification(pyb::module_& m) {
         o.fit_length_offset = fit_length_offset;
         o.effects = effects_of(effects);
         o.tests = tests;
-        o.noise = noise_handling_from_string(noise);
+        o.noise.noise = noise_handling_from_string(noise);
         pyb::gil_scoped_release release;
         return identify_joint(session, o);
       },

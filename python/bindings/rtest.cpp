@@ -199,7 +199,7 @@ void bind_rtest_identification(pyb::module_& m) {
       [](const RtestSession& session, const RtestBasis& basis, const std::string& noise) {
         RtestJointOptions o;
         o.basis = basis;
-        o.noise = noise_handling_from_string(noise);
+        o.noise.noise = noise_handling_from_string(noise);
         pyb::gil_scoped_release release;
         return identify_joint(session, o);
       },

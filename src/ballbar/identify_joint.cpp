@@ -107,18 +107,13 @@ BallbarIdentification identify_joint(const BallbarArrays& data, const JointFitOp
 
   // The noise model of what the fit leaves, one AR stream per test in time order; with
   // correlated noise the fit is redone by GLS under it (core/fit_with_noise.hpp).
-  NoiseFitOptions no;
-  no.noise = options.noise;
-  no.noise_options = options.noise_options;
-  no.min_correlation_samples = options.min_correlation_samples;
-  no.noise_bias_correction = options.noise_bias_correction;
   const bool streams = static_cast<std::size_t>(data.size()) == data.test.size();
   const std::vector<double> t(data.time.data(), data.time.data() + data.time.size());
   NoiseFit nf = fit_with_noise(
       [&](const JointFitSettings& s) {
         return solve_with_time_constants(model, setup.parameters, s);
       },
-      setup.settings, streams ? data.test : std::vector<std::string>{}, t, no);
+      setup.settings, streams ? data.test : std::vector<std::string>{}, t, options.noise);
   JointFitOutcome& fit = nf.fit;
   const bool refit = nf.refit;
   const double scale = nf.scale;

@@ -366,15 +366,9 @@ RtestJointIdentification identify_joint(const RtestSession& session,
       groups.push_back("nest " + s.setup);
       times.push_back(s.time);
     }
-  NoiseFitOptions no;
-  no.noise = options.noise;
-  no.noise_options = options.noise_options;
-  no.min_correlation_samples = options.min_correlation_samples;
-  no.noise_bias_correction = options.noise_bias_correction;
-  no.allow_reml = true;
   NoiseFit nf =
       fit_with_noise([&](const JointFitSettings& s) { return solve_joint(model, params, s); },
-                     settings, groups, times, no);
+                     settings, groups, times, options.noise);
   JointFitOutcome& fit = nf.fit;
   const bool refit = nf.refit, reml = nf.reml;
   const double scale = nf.scale;

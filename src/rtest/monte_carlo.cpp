@@ -19,7 +19,7 @@ RtestMonteCarlo monte_carlo(const RtestSession& session, const RtestJointIdentif
     throw InvalidArgument("monte_carlo: result was fitted to " + std::to_string(result.n_samples) +
                           " samples, the session has " + std::to_string(n));
   RtestJointOptions fit = o.fit;
-  fit.noise = NoiseHandling::white;  // each draw is fitted as the identification was
+  fit.noise.noise = NoiseHandling::white;  // each draw is fitted as the identification was
   const bool coloured = result.noise_refit;
   if (coloured) fit.whitener = std::make_shared<ArWhitener>(result.noise);
   // The identified model's readings: measured - residual (probe zeros included).

@@ -13,6 +13,7 @@
 
 #include "rotacal/ballbar/model.hpp"
 #include "rotacal/core/estimate.hpp"  // ParameterEstimate (kept reachable from this header)
+#include "rotacal/core/fit_with_noise.hpp"
 #include "rotacal/core/noise_handling.hpp"
 #include "rotacal/core/whitener.hpp"
 
@@ -60,19 +61,13 @@ struct JointFitOptions {
   /// order) to independent unit-variance ones. The covariance is then (Jw^T Jw)^-1 with no
   /// rescaling, and summary.chi2_per_dof is the whitened one.
   std::shared_ptr<const ResidualWhitener> whitener;
-  /// Without a whitener: `automatic` estimates the noise model of the first (white) fit's
-  /// residuals and, when some stream is correlated (AR order > 0), refits with its ArWhitener
-  /// so that the covariance holds on correlated data; white data are fitted once, as before.
-  /// C++ default `white` (as before) because the diagnosis refits through identify_joint
-  /// with its own whitener decisions; the Python API and the CLI default to `auto`.
-  NoiseHandling noise = NoiseHandling::white;
-  NoiseModelOptions noise_options;
-  /// The GLS refit is done only when some stream's integrated correlation time reaches this
-  /// (samples): below it the white covariance is within ~10 % and BIC's rare spurious AR(1) of
-  /// white noise (|phi| ~ 0.05) must not change the answer.
-  double min_correlation_samples = 1.2;
-  /// Scale the GLS covariance by the bootstrap bias factor (core/noise_handling.hpp).
-  bool noise_bias_correction = true;  ///< AR order search of the noise model
+  /// Without a whitener: noise.noise `automatic` estimates the noise model of the first (white)
+  /// fit's residuals (one AR stream per test) and, when some stream is correlated, refits with
+  /// its ArWhitener so that the covariance holds on correlated data (core/fit_with_noise.hpp);
+  /// white data are fitted once, as before. C++ default `white` because the diagnosis refits
+  /// through identify_joint with its own whitener decisions; the Python API and the CLI
+  /// default to `auto`.
+  NoiseFitOptions noise;
 };
 
 /// The samples a fit uses as contiguous arrays (structure of arrays): built once per session

@@ -40,6 +40,7 @@
 #include <vector>
 
 #include "rotacal/core/estimate.hpp"
+#include "rotacal/core/fit_with_noise.hpp"
 #include "rotacal/core/noise_handling.hpp"
 #include "rotacal/core/whitener.hpp"
 #include "rotacal/rtest/error_model.hpp"
@@ -208,19 +209,17 @@ struct RtestJointOptions {
   /// order) to independent unit-variance ones; the covariance is then (Jw^T Jw)^-1 and
   /// summary.chi2_per_dof the whitened one.
   std::shared_ptr<const ResidualWhitener> whitener;
-  /// Without a whitener: `automatic` estimates the noise model of the first fit's residuals
-  /// (one AR stream per nest and channel dx, dy, dz, in time order; probe zeros that wander
-  /// between poses show as correlation) and refits by GLS when it is not white.
-  /// C++ default `white` (as before) because the diagnosis refits through identify_joint
-  /// with its own whitener decisions; the Python API and the CLI default to `auto`.
-  NoiseHandling noise = NoiseHandling::white;
-  NoiseModelOptions noise_options;
-  /// The GLS refit is done only when some stream's integrated correlation time reaches this
-  /// (samples): below it the white covariance is within ~10 % and BIC's rare spurious AR(1) of
-  /// white noise (|phi| ~ 0.05) must not change the answer.
-  double min_correlation_samples = 1.2;
-  /// Scale the GLS covariance by the bootstrap bias factor (core/noise_handling.hpp).
-  bool noise_bias_correction = true;
+  /// Without a whitener: noise.noise `automatic` estimates the noise model of the first fit's
+  /// residuals (one AR stream per nest and channel dx, dy, dz, in time order; probe zeros that
+  /// wander between poses show as correlation) and refits by GLS when it is not white, with
+  /// REML of AR(1) + a random walk where the streams are short enough (allow_reml).
+  /// C++ default `white` because the diagnosis refits through identify_joint with its own
+  /// whitener decisions; the Python API and the CLI default to `auto`.
+  NoiseFitOptions noise = [] {
+    NoiseFitOptions o;
+    o.allow_reml = true;
+    return o;
+  }();
 };
 
 struct RtestJointIdentification {
