@@ -14,39 +14,18 @@
 #include "rotacal/ballbar/model.hpp"
 #include "rotacal/core/estimate.hpp"  // ParameterEstimate (kept reachable from this header)
 #include "rotacal/core/fit_with_noise.hpp"
+#include "rotacal/core/identification.hpp"
 #include "rotacal/core/noise_handling.hpp"
 #include "rotacal/core/whitener.hpp"
 
 namespace rotacal {
 
-struct BallbarIdentification {
-  std::string method;         ///< "joint" or "paper"
+/// A ballbar identification (core/identification.hpp): `parameters` are the 8 location errors,
+/// the block "pivot" (x y z), then the extras (dL, effects); `residuals` one per sample of the
+/// session (0 for samples not fitted); the Jacobian one row per fitted sample, in session
+/// order. Method "joint" or "paper" (identify_paper.hpp).
+struct BallbarIdentification : Identification {
   BallbarMachineModel model;  ///< identified machine (unobservable parts left nominal)
-  std::vector<ParameterEstimate> parameters;  ///< 8 location errors, pivot x y z, then extras
-  Eigen::MatrixXd covariance;                 ///< in `parameters` order, 1-sigma^2
-  std::vector<double> residuals;              ///< measured - model, mm, per sample (session order)
-  /// d(model length)/d(parameter) at the solution, mm per parameter unit; one row per fitted
-  /// sample (in session order of the samples used), columns in `parameters` order.
-  Eigen::MatrixXd jacobian;
-  std::vector<bool> fixed;  ///< per parameter: held at its start value
-  double residual_rms_um = 0.0;
-  double sigma_um = 0.0;  ///< noise level used for the covariance
-  std::size_t n_samples = 0;
-  bool converged = false;
-  int iterations = 0;
-  std::vector<std::string> unobservable;  ///< combinations the tests cannot see, in words
-  std::vector<std::string> notes;         ///< assumptions and warnings for the report
-  FitSummary summary;                     ///< solver figures; whitened chi2/dof with a whitener
-  /// Noise model of the residuals (one stream per test), estimated after the fit; when it is
-  /// not white (and noise = automatic) the covariance is the GLS one under it.
-  NoiseModel noise;
-  /// Factor applied to the GLS covariance for the noise model's bias (estimated from
-  /// residuals that the fit has already taken the slow noise from): core/noise_handling.hpp.
-  double noise_correction = 1.0;
-  bool noise_refit = false;  ///< the fit was redone with the noise model's whitener (GLS)
-
-  /// The estimate called `name`; throws InvalidArgument if there is none.
-  const ParameterEstimate& parameter(const std::string& name) const;
 };
 
 struct JointFitOptions {

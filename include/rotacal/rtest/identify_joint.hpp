@@ -41,6 +41,7 @@
 
 #include "rotacal/core/estimate.hpp"
 #include "rotacal/core/fit_with_noise.hpp"
+#include "rotacal/core/identification.hpp"
 #include "rotacal/core/noise_handling.hpp"
 #include "rotacal/core/whitener.hpp"
 #include "rotacal/rtest/error_model.hpp"
@@ -222,28 +223,18 @@ struct RtestJointOptions {
   }();
 };
 
-struct RtestJointIdentification {
-  std::string method = "joint";
+/// An R-test identification (core/identification.hpp): `parameters` are the location errors,
+/// [tool_offset_Z on a machine with head axes], the map coefficients, then the block "zeros"
+/// (dx dy dz per set-up); `residuals` dx dy dz per sample (mm, session order), `noise` one
+/// stream per nest and channel. It adds the identified model with its maps.
+struct RtestJointIdentification : Identification {
   RtestJointModel model;
-  std::vector<ParameterEstimate> parameters;           ///< location errors, map coefficients, zeros
-  Eigen::MatrixXd covariance;                          ///< in `parameters` order
-  std::map<std::string, Eigen::Vector3d> probe_zeros;  ///< per set-up, mm
-  std::vector<Eigen::Vector3d> residuals;              ///< measured - model per sample, mm
-  double residual_rms_um = 0.0;                        ///< over all components
-  double sigma_um = 0.0;  ///< dof-corrected residual sigma used for covariance
-  std::size_t n_samples = 0;
-  bool converged = false;
-  int iterations = 0;
-  std::vector<std::string> unobservable;  ///< combinations the nests cannot see, in words
-  std::vector<std::string> notes;
-  FitSummary summary;  ///< solver figures; whitened chi2/dof with a whitener
-  NoiseModel noise;    ///< noise model of the residuals (streams: nest x channel)
-  /// Factor applied to the GLS covariance for the noise model's bias (estimated from
-  /// residuals that the fit has already taken the slow noise from): core/noise_handling.hpp.
-  double noise_correction = 1.0;
-  bool noise_refit = false;  ///< the fit was redone by GLS under `noise`
+  std::map<std::string, Eigen::Vector3d> probe_zeros;  ///< per set-up, mm (the block "zeros")
 
-  const ParameterEstimate& parameter(const std::string& name) const;
+  /// measured - model of sample i (mm): residuals 3i .. 3i + 2.
+  Eigen::Vector3d residual(std::size_t i) const {
+    return Eigen::Vector3d(residuals[3 * i], residuals[3 * i + 1], residuals[3 * i + 2]);
+  }
 };
 
 /// Fit the joint model to every sample, on any machine. Throws InvalidArgument for samples
