@@ -135,11 +135,11 @@ int main(int argc, char** argv) {
   std::vector<double> t;
   for (const BallbarSample& x : clean.samples) g.push_back(x.test), t.push_back(x.time);
   JointFitOptions white;
-  white.noise = NoiseHandling::white;
+  white.noise.noise = NoiseHandling::white;
   JointFitOptions automatic;
-  automatic.noise = NoiseHandling::automatic;
-  automatic.noise_options.pooled = pooled;
-  automatic.noise_bias_correction = bias;
+  automatic.noise.noise = NoiseHandling::automatic;
+  automatic.noise.noise_options.pooled = pooled;
+  automatic.noise.noise_bias_correction = bias;
   for (const Noise& nz : kinds) {
     if (!ballbar) break;
     const auto t0 = clock::now();
@@ -172,12 +172,12 @@ int main(int argc, char** argv) {
     for (const RtestSample& x : rclean.samples)
       for (int c = 0; c < 3; ++c) rg.push_back("nest " + x.setup), rtm.push_back(x.time);
     RtestJointOptions rauto;
-    rauto.noise = NoiseHandling::automatic;
-    rauto.noise_options.pooled = pooled;
-    rauto.noise_bias_correction = bias;
-    rauto.noise_options.reml_random_walk = reml;
+    rauto.noise.noise = NoiseHandling::automatic;
+    rauto.noise.noise_options.pooled = pooled;
+    rauto.noise.noise_bias_correction = bias;
+    rauto.noise.noise_options.reml_random_walk = reml;
     RtestJointOptions rwhite;
-    rwhite.noise = NoiseHandling::white;
+    rwhite.noise.noise = NoiseHandling::white;
     // The generating covariance as a noise model (AR(1) + random walk per stream), for
     // --oracle: the best any estimated noise model can do.
     const auto truth_model = [&](double rho) {
@@ -205,7 +205,7 @@ int main(int argc, char** argv) {
     for (const Noise& nz : kinds) {
       rauto.whitener = nullptr;
       if (oracle && nz.rho >= 0) {
-        rauto.noise = NoiseHandling::white;
+        rauto.noise.noise = NoiseHandling::white;
         rauto.whitener = std::make_shared<ArWhitener>(truth_model(nz.rho));
       }
       const auto t0 = clock::now();

@@ -36,6 +36,42 @@ void bind_ballbar_results(pyb::module_& m) {
       .def_readonly("whitened", &FitSummary::whitened)
       .def_readonly("message", &FitSummary::message);
 
+  pyb::class_<Identification>(
+      m, "Identification",
+      "What an identification reports, whatever the instrument (core/identification.hpp); "
+      "the instrument's parts (pivot, zeros, sphere, effects) are named blocks of `parameters`.")
+      .def_readonly("method", &Identification::method)
+      .def_readonly("parameters", &Identification::parameters)
+      .def_property_readonly("block_names",
+                             [](const Identification& r) {
+                               std::vector<std::string> out;
+                               for (const ParameterBlock& b : r.blocks.blocks())
+                                 out.push_back(b.name);
+                               return out;
+                             })
+      .def("block", &Identification::block, pyb::arg("name"),
+           "The estimates of the named parameter block (e.g. 'pivot', 'sphere', 'zeros').")
+      .def("parameter", &Identification::parameter, pyb::arg("name"),
+           pyb::return_value_policy::copy, "The estimate called `name`.")
+      .def_readonly("covariance", &Identification::covariance)
+      .def_property_readonly(
+          "residuals",
+          [](const Identification& r) {
+            return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(
+                r.residuals.data(), static_cast<Eigen::Index>(r.residuals.size())));
+          })
+      .def_readonly("residual_rms_um", &Identification::residual_rms_um)
+      .def_readonly("sigma_um", &Identification::sigma_um)
+      .def_readonly("n_samples", &Identification::n_samples)
+      .def_readonly("converged", &Identification::converged)
+      .def_readonly("iterations", &Identification::iterations)
+      .def_readonly("unobservable", &Identification::unobservable)
+      .def_readonly("notes", &Identification::notes)
+      .def_readonly("summary", &Identification::summary)
+      .def_readonly("noise", &Identification::noise)
+      .def_readonly("noise_refit", &Identification::noise_refit)
+      .def_readonly("noise_correction", &Identification::noise_correction);
+
   pyb::class_<BallbarMachineModel>(m, "BallbarMachineModel",
                                    "Location errors, actual pivot and effects of a machine.")
       .def(pyb::init(
@@ -67,28 +103,8 @@ void bind_ballbar_results(pyb::module_& m) {
                              [](const BallbarMachineModel& b) { return ids_of(b.effects); })
       .def_readonly("effect_params", &BallbarMachineModel::effect_params);
 
-  pyb::class_<BallbarIdentification>(m, "BallbarIdentification")
-      .def_readonly("method", &BallbarIdentification::method)
-      .def_readonly("model", &BallbarIdentification::model)
-      .def_readonly("parameters", &BallbarIdentification::parameters)
-      .def_readonly("covariance", &BallbarIdentification::covariance)
-      .def_property_readonly(
-          "residuals",
-          [](const BallbarIdentification& r) {
-            return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(
-                r.residuals.data(), static_cast<Eigen::Index>(r.residuals.size())));
-          })
-      .def_readonly("residual_rms_um", &BallbarIdentification::residual_rms_um)
-      .def_readonly("sigma_um", &BallbarIdentification::sigma_um)
-      .def_readonly("n_samples", &BallbarIdentification::n_samples)
-      .def_readonly("converged", &BallbarIdentification::converged)
-      .def_readonly("iterations", &BallbarIdentification::iterations)
-      .def_readonly("unobservable", &BallbarIdentification::unobservable)
-      .def_readonly("notes", &BallbarIdentification::notes)
-      .def_readonly("summary", &BallbarIdentification::summary)
-      .def_readonly("noise", &BallbarIdentification::noise)
-      .def_readonly("noise_refit", &BallbarIdentification::noise_refit)
-      .def_readonly("noise_correction", &BallbarIdentification::noise_correction);
+  pyb::class_<BallbarIdentification, Identification>(m, "BallbarIdentification")
+      .def_readonly("model", &BallbarIdentification::model);
 }
 
 // The joint fit, its Monte Carlo check and the paper's method.
@@ -102,7 +118,7 @@ void bind_ballbar_identification(pyb::module_& m) {
         o.fit_length_offset = fit_length_offset;
         o.effects = effects_of(effects);
         o.tests = tests;
-        o.noise = noise_handling_from_string(noise);
+        o.noise.noise = noise_handling_from_string(noise);
         pyb::gil_scoped_release release;
         return identify_joint(session, o);
       },

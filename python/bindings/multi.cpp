@@ -70,7 +70,7 @@ void bind_multi(pyb::module_& m) {
                                   " is not a ballbar, R-test or touch-probe session");
         }
         MultiFitOptions o;
-        o.noise = noise_handling_from_string(noise);
+        o.noise.noise = noise_handling_from_string(noise);
         o.effects = effects_of(effects);
         o.inflate_sigma = inflate_sigma;
         pyb::gil_scoped_release release;

@@ -107,8 +107,7 @@ void bind_probe_session(pyb::module_& m) {
 
 // The joint fit, the cycles' method, the diagnosis and its uncertainty budget.
 void bind_probe_identification(pyb::module_& m) {
-  pyb::class_<ProbeIdentification>(m, "ProbeIdentification")
-      .def_readonly("method", &ProbeIdentification::method)
+  pyb::class_<ProbeIdentification, Identification>(m, "ProbeIdentification")
       .def_property_readonly("machine",
                              [](const ProbeIdentification& r) { return r.model.machine; })
       .def_property_readonly(
@@ -119,25 +118,6 @@ void bind_probe_identification(pyb::module_& m) {
                              [](const ProbeIdentification& r) { return r.model.effect_params; })
       .def_property_readonly("sphere",
                              [](const ProbeIdentification& r) { return Eigen::Vector3d(r.sphere); })
-      .def_readonly("parameters", &ProbeIdentification::parameters)
-      .def_readonly("covariance", &ProbeIdentification::covariance)
-      .def_property_readonly(
-          "residuals",
-          [](const ProbeIdentification& r) {
-            return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(
-                r.residuals.data(), static_cast<Eigen::Index>(r.residuals.size())));
-          })
-      .def_readonly("residual_rms_um", &ProbeIdentification::residual_rms_um)
-      .def_readonly("sigma_um", &ProbeIdentification::sigma_um)
-      .def_readonly("n_samples", &ProbeIdentification::n_samples)
-      .def_readonly("converged", &ProbeIdentification::converged)
-      .def_readonly("iterations", &ProbeIdentification::iterations)
-      .def_readonly("unobservable", &ProbeIdentification::unobservable)
-      .def_readonly("notes", &ProbeIdentification::notes)
-      .def_readonly("summary", &ProbeIdentification::summary)
-      .def_readonly("noise", &ProbeIdentification::noise)
-      .def_readonly("noise_refit", &ProbeIdentification::noise_refit)
-      .def_readonly("noise_correction", &ProbeIdentification::noise_correction)
       .def_property_readonly("pose_centres",
                              [](const ProbeIdentification& r) { return rows_from(r.pose_centres); })
       .def_readonly("pose_labels", &ProbeIdentification::pose_labels)

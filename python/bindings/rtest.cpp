@@ -165,25 +165,16 @@ void bind_rtest_joint_model(pyb::module_& m) {
 
 // The joint fit, the paper's method, Monte Carlo and the error maps.
 void bind_rtest_identification(pyb::module_& m) {
-  pyb::class_<RtestJointIdentification>(m, "RtestJointIdentification")
-      .def_readonly("method", &RtestJointIdentification::method)
+  pyb::class_<RtestJointIdentification, Identification>(m, "RtestJointIdentification")
       .def_readonly("model", &RtestJointIdentification::model)
-      .def_readonly("parameters", &RtestJointIdentification::parameters)
-      .def_readonly("covariance", &RtestJointIdentification::covariance)
       .def_readonly("probe_zeros", &RtestJointIdentification::probe_zeros)
       .def_property_readonly(
-          "residuals", [](const RtestJointIdentification& r) { return rows_from(r.residuals); })
-      .def_readonly("residual_rms_um", &RtestJointIdentification::residual_rms_um)
-      .def_readonly("sigma_um", &RtestJointIdentification::sigma_um)
-      .def_readonly("n_samples", &RtestJointIdentification::n_samples)
-      .def_readonly("converged", &RtestJointIdentification::converged)
-      .def_readonly("iterations", &RtestJointIdentification::iterations)
-      .def_readonly("unobservable", &RtestJointIdentification::unobservable)
-      .def_readonly("notes", &RtestJointIdentification::notes)
-      .def_readonly("summary", &RtestJointIdentification::summary)
-      .def_readonly("noise", &RtestJointIdentification::noise)
-      .def_readonly("noise_refit", &RtestJointIdentification::noise_refit)
-      .def_readonly("noise_correction", &RtestJointIdentification::noise_correction);
+          "residuals",
+          [](const RtestJointIdentification& r) {
+            return Eigen::MatrixXd(Eigen::Map<const Eigen::Matrix<double, -1, 3, Eigen::RowMajor>>(
+                r.residuals.data(), static_cast<Eigen::Index>(r.residuals.size() / 3), 3));
+          },
+          "measured - model per sample (N, 3) = (dx, dy, dz), mm.");
 
   pyb::class_<RtestPaperIdentification>(m, "RtestPaperIdentification")
       .def_readonly("method", &RtestPaperIdentification::method)
@@ -199,7 +190,7 @@ void bind_rtest_identification(pyb::module_& m) {
       [](const RtestSession& session, const RtestBasis& basis, const std::string& noise) {
         RtestJointOptions o;
         o.basis = basis;
-        o.noise = noise_handling_from_string(noise);
+        o.noise.noise = noise_handling_from_string(noise);
         pyb::gil_scoped_release release;
         return identify_joint(session, o);
       },

@@ -7,7 +7,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Alternative', 'Ambiguity', 'AngleTable', 'AxisAngleMap', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CircularAnalysis', 'CircularDiagnosis', 'CircularDiagnosisOptions', 'CircularDirection', 'CircularEffect', 'CircularFinding', 'CircularPairResult', 'CircularPlanResult', 'CircularPlane', 'CircularRun', 'CircularRunResult', 'CircularSimulationOptions', 'CircularTestPlan', 'CompensationReport', 'CompensationRow', 'CompensationTable', 'CompensationTables', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FanucPitchOptions', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'InvalidArgument', 'IoError', 'LinearAxisErrors', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'MultiDisagreement', 'MultiIdentification', 'MultiSessionResult', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'ProbeDesign', 'ProbeDesignCandidate', 'ProbeDesignOptions', 'ProbeIdentification', 'ProbeMonteCarlo', 'ProbeSeparatingCandidate', 'ProbeSeparationDesign', 'ProbeSeparationOptions', 'ProbeSession', 'ProbeSphereTrial', 'RadialSide', 'RealtimeModel', 'RecordSummary', 'RtestBasis', 'RtestDesign', 'RtestDesignCandidate', 'RtestDesignOptions', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSeparatingCandidate', 'RtestSeparationDesign', 'RtestSeparationOptions', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SeparatingCandidate', 'SeparationDesign', 'SeparationOptions', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'SweepDirection', 'TableMotionOverlap', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualCircularBallbar', 'VirtualRtest', 'analyze_circular', 'angle_maps', 'ballbar_model_document', 'ballbar_model_from_document', 'box_least_squares', 'builtin_machine_names', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_json_bounds', 'check_model_machine', 'check_output', 'check_plausible', 'check_rtest_pattern', 'circular_catalogue', 'circular_commanded_session', 'circular_label', 'comment_lines', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_axial_c_tilt_deg', 'default_ballbar_tests', 'default_calibration_moves', 'default_probe_poses_deg', 'default_rtest_pattern', 'default_tilt_range_deg', 'design_ballbar_separation', 'design_ballbar_test', 'design_probe_separation', 'design_probe_test', 'design_rtest_separation', 'design_rtest_test', 'diagnose_ballbar', 'diagnose_circular', 'diagnose_probe', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'evaluate_rtest_design', 'export_controller', 'fanuc_pitch_tables', 'format_ballbar', 'format_model_document', 'format_probe', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_joint_sessions', 'identify_multi', 'identify_paper', 'identify_probe', 'identify_probe_cycles', 'identify_rtest_joint', 'identify_rtest_paper', 'identify_runs', 'is_rotary_test', 'kasa_circle_fit', 'linuxcnc_comp_tables', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_probe', 'monte_carlo_rtest', 'multi_model_document', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_circular_direction', 'parse_circular_plane', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'parse_sweep_direction', 'plan_ballbar_test', 'plan_circular_test', 'predict_rtest_session', 'predict_session_lengths', 'probe_effect_catalogue', 'probe_model_document', 'read_ballbar', 'read_instrument_session', 'read_linuxcnc_probe_log', 'read_model_document', 'read_probe', 'read_rtest', 'read_session', 'realtime_model_of_blob', 'realtime_model_of_file', 'record_ballbar', 'record_circular_ballbar', 'record_rtest', 'record_run', 'refuse_disagreeing', 'rtest_error_map', 'rtest_joint_model_document', 'rtest_map_names', 'rtest_prediction_rms_um', 'rtest_readings', 'run_label', 'simulate_ballbar', 'simulate_circular', 'simulate_probe', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sinumerik_eec_tables', 'sphere_fit', 'svd_plane_fit', 'table_motion_overlap', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_probe', 'uncertainty_budget_rtest', 'uncertainty_budget_rtest_identification', 'verify_compensation', 'write_ballbar', 'write_circular_nc_program', 'write_model_document', 'write_nc_program', 'write_output', 'write_probe', 'write_probe_nc_program', 'write_rtest']
+__all__: list[str] = ['Alternative', 'Ambiguity', 'AngleTable', 'AxisAngleMap', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CircularAnalysis', 'CircularDiagnosis', 'CircularDiagnosisOptions', 'CircularDirection', 'CircularEffect', 'CircularFinding', 'CircularPairResult', 'CircularPlanResult', 'CircularPlane', 'CircularRun', 'CircularRunResult', 'CircularSimulationOptions', 'CircularTestPlan', 'CompensationReport', 'CompensationRow', 'CompensationTable', 'CompensationTables', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'Identification', 'InvalidArgument', 'IoError', 'LinearAxisErrors', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'MultiDisagreement', 'MultiIdentification', 'MultiSessionResult', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'ProbeDesign', 'ProbeDesignCandidate', 'ProbeDesignOptions', 'ProbeIdentification', 'ProbeMonteCarlo', 'ProbeSeparatingCandidate', 'ProbeSeparationDesign', 'ProbeSeparationOptions', 'ProbeSession', 'ProbeSphereTrial', 'RadialSide', 'RealtimeModel', 'RecordSummary', 'RtestBasis', 'RtestDesign', 'RtestDesignCandidate', 'RtestDesignOptions', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSeparatingCandidate', 'RtestSeparationDesign', 'RtestSeparationOptions', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SeparatingCandidate', 'SeparationDesign', 'SeparationOptions', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'SweepDirection', 'TableMotionOverlap', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualCircularBallbar', 'VirtualRtest', 'analyze_circular', 'angle_maps', 'ballbar_model_document', 'ballbar_model_from_document', 'box_least_squares', 'builtin_machine_names', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_json_bounds', 'check_model_machine', 'check_output', 'check_plausible', 'check_rtest_pattern', 'circular_catalogue', 'circular_commanded_session', 'circular_label', 'comment_lines', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_axial_c_tilt_deg', 'default_ballbar_tests', 'default_calibration_moves', 'default_probe_poses_deg', 'default_rtest_pattern', 'default_tilt_range_deg', 'design_ballbar_separation', 'design_ballbar_test', 'design_probe_separation', 'design_probe_test', 'design_rtest_separation', 'design_rtest_test', 'diagnose_ballbar', 'diagnose_circular', 'diagnose_probe', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'evaluate_rtest_design', 'export_controller', 'format_ballbar', 'format_model_document', 'format_probe', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_joint_sessions', 'identify_multi', 'identify_paper', 'identify_probe', 'identify_probe_cycles', 'identify_rtest_joint', 'identify_rtest_paper', 'identify_runs', 'is_rotary_test', 'kasa_circle_fit', 'linuxcnc_comp_tables', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_probe', 'monte_carlo_rtest', 'multi_model_document', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_circular_direction', 'parse_circular_plane', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'parse_sweep_direction', 'plan_ballbar_test', 'plan_circular_test', 'predict_rtest_session', 'predict_session_lengths', 'probe_effect_catalogue', 'probe_model_document', 'read_ballbar', 'read_instrument_session', 'read_linuxcnc_probe_log', 'read_model_document', 'read_probe', 'read_rtest', 'read_session', 'realtime_model_of_blob', 'realtime_model_of_file', 'record_ballbar', 'record_circular_ballbar', 'record_rtest', 'record_run', 'refuse_disagreeing', 'rtest_error_map', 'rtest_joint_model_document', 'rtest_map_names', 'rtest_prediction_rms_um', 'rtest_readings', 'run_label', 'simulate_ballbar', 'simulate_circular', 'simulate_probe', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sinumerik_eec_tables', 'sphere_fit', 'svd_plane_fit', 'table_motion_overlap', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_probe', 'uncertainty_budget_rtest', 'uncertainty_budget_rtest_identification', 'verify_compensation', 'write_ballbar', 'write_circular_nc_program', 'write_model_document', 'write_nc_program', 'write_output', 'write_probe', 'write_probe_nc_program', 'write_rtest']
 class Alternative:
     @property
     def aliased(self) -> bool:
@@ -208,54 +208,9 @@ class BallbarDesignOptions:
     @travel_min.setter
     def travel_min(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
         ...
-class BallbarIdentification:
-    @property
-    def converged(self) -> bool:
-        ...
-    @property
-    def covariance(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
-        ...
-    @property
-    def iterations(self) -> int:
-        ...
-    @property
-    def method(self) -> str:
-        ...
+class BallbarIdentification(Identification):
     @property
     def model(self) -> BallbarMachineModel:
-        ...
-    @property
-    def n_samples(self) -> int:
-        ...
-    @property
-    def noise(self) -> ...:
-        ...
-    @property
-    def noise_correction(self) -> float:
-        ...
-    @property
-    def noise_refit(self) -> bool:
-        ...
-    @property
-    def notes(self) -> list[str]:
-        ...
-    @property
-    def parameters(self) -> list[ParameterEstimate]:
-        ...
-    @property
-    def residual_rms_um(self) -> float:
-        ...
-    @property
-    def residuals(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
-        ...
-    @property
-    def sigma_um(self) -> float:
-        ...
-    @property
-    def summary(self) -> FitSummary:
-        ...
-    @property
-    def unobservable(self) -> list[str]:
         ...
 class BallbarMachineModel:
     """
@@ -1423,44 +1378,6 @@ class ErrorDisposition:
     @property
     def where(self) -> str:
         ...
-class FanucPitchOptions:
-    """
-    FANUC pitch error compensation: the control's units and limits.
-    """
-    def __init__(self) -> None:
-        ...
-    @property
-    def detection_unit_deg(self) -> float:
-        ...
-    @detection_unit_deg.setter
-    def detection_unit_deg(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
-        ...
-    @property
-    def first_number(self) -> int:
-        ...
-    @first_number.setter
-    def first_number(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
-        ...
-    @property
-    def last_number(self) -> int:
-        ...
-    @last_number.setter
-    def last_number(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
-        ...
-    @property
-    def magnification(self) -> int:
-        """
-        parameter 3623; 0: the smallest of 1..100 that keeps the values in range
-        """
-    @magnification.setter
-    def magnification(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
-        ...
-    @property
-    def max_value(self) -> int:
-        ...
-    @max_value.setter
-    def max_value(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
-        ...
 class FaultInjection:
     """
     Faults a virtual instrument acts out (counted in frames).
@@ -1609,6 +1526,66 @@ class GroupResidual:
         ...
     @property
     def trend_um_per_s(self) -> float:
+        ...
+class Identification:
+    """
+    What an identification reports, whatever the instrument (core/identification.hpp); the instrument's parts (pivot, zeros, sphere, effects) are named blocks of `parameters`.
+    """
+    def block(self, name: str) -> list[ParameterEstimate]:
+        """
+        The estimates of the named parameter block (e.g. 'pivot', 'sphere', 'zeros').
+        """
+    def parameter(self, name: str) -> ParameterEstimate:
+        """
+        The estimate called `name`.
+        """
+    @property
+    def block_names(self) -> list[str]:
+        ...
+    @property
+    def converged(self) -> bool:
+        ...
+    @property
+    def covariance(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        ...
+    @property
+    def iterations(self) -> int:
+        ...
+    @property
+    def method(self) -> str:
+        ...
+    @property
+    def n_samples(self) -> int:
+        ...
+    @property
+    def noise(self) -> ...:
+        ...
+    @property
+    def noise_correction(self) -> float:
+        ...
+    @property
+    def noise_refit(self) -> bool:
+        ...
+    @property
+    def notes(self) -> list[str]:
+        ...
+    @property
+    def parameters(self) -> list[ParameterEstimate]:
+        ...
+    @property
+    def residual_rms_um(self) -> float:
+        ...
+    @property
+    def residuals(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def sigma_um(self) -> float:
+        ...
+    @property
+    def summary(self) -> FitSummary:
+        ...
+    @property
+    def unobservable(self) -> list[str]:
         ...
 class InvalidArgument(Error):
     pass
@@ -1803,11 +1780,6 @@ class MultiDisagreement:
     def difference(self) -> float:
         ...
     @property
-    def dof(self) -> float:
-        """
-        of sigma (Welch-Satterthwaite)
-        """
-    @property
     def parameter(self) -> str:
         ...
     @property
@@ -1819,11 +1791,6 @@ class MultiDisagreement:
     @property
     def sigma(self) -> float:
         ...
-    @property
-    def threshold(self) -> float:
-        """
-        |z| beyond which it disagrees
-        """
     @property
     def unit(self) -> str:
         ...
@@ -1883,11 +1850,6 @@ class MultiSessionResult:
     @property
     def alone(self) -> list[ParameterEstimate]:
         ...
-    @property
-    def dof(self) -> float:
-        """
-        of its sigmas alone
-        """
     @property
     def instrument(self) -> str:
         ...
@@ -2555,13 +2517,7 @@ class ProbeDesignOptions:
     @touches.setter
     def touches(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
-class ProbeIdentification:
-    @property
-    def converged(self) -> bool:
-        ...
-    @property
-    def covariance(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
-        ...
+class ProbeIdentification(Identification):
     @property
     def dispersion_um(self) -> float:
         ...
@@ -2575,31 +2531,7 @@ class ProbeIdentification:
     def errors(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         ...
     @property
-    def iterations(self) -> int:
-        ...
-    @property
     def machine(self) -> MachineType:
-        ...
-    @property
-    def method(self) -> str:
-        ...
-    @property
-    def n_samples(self) -> int:
-        ...
-    @property
-    def noise(self) -> NoiseModel:
-        ...
-    @property
-    def noise_correction(self) -> float:
-        ...
-    @property
-    def noise_refit(self) -> bool:
-        ...
-    @property
-    def notes(self) -> list[str]:
-        ...
-    @property
-    def parameters(self) -> list[ParameterEstimate]:
         ...
     @property
     def pose_centres(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
@@ -2608,22 +2540,7 @@ class ProbeIdentification:
     def pose_labels(self) -> list[str]:
         ...
     @property
-    def residual_rms_um(self) -> float:
-        ...
-    @property
-    def residuals(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
-        ...
-    @property
-    def sigma_um(self) -> float:
-        ...
-    @property
     def sphere(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
-        ...
-    @property
-    def summary(self) -> FitSummary:
-        ...
-    @property
-    def unobservable(self) -> list[str]:
         ...
 class ProbeMonteCarlo:
     @property
@@ -3121,58 +3038,18 @@ class RtestDesignOptions:
     @travel_min.setter
     def travel_min(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
         ...
-class RtestJointIdentification:
-    @property
-    def converged(self) -> bool:
-        ...
-    @property
-    def covariance(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
-        ...
-    @property
-    def iterations(self) -> int:
-        ...
-    @property
-    def method(self) -> str:
-        ...
+class RtestJointIdentification(Identification):
     @property
     def model(self) -> RtestJointModel:
-        ...
-    @property
-    def n_samples(self) -> int:
-        ...
-    @property
-    def noise(self) -> NoiseModel:
-        ...
-    @property
-    def noise_correction(self) -> float:
-        ...
-    @property
-    def noise_refit(self) -> bool:
-        ...
-    @property
-    def notes(self) -> list[str]:
-        ...
-    @property
-    def parameters(self) -> list[ParameterEstimate]:
         ...
     @property
     def probe_zeros(self) -> dict[str, typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]]:
         ...
     @property
-    def residual_rms_um(self) -> float:
-        ...
-    @property
-    def residuals(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 3]"]:
-        ...
-    @property
-    def sigma_um(self) -> float:
-        ...
-    @property
-    def summary(self) -> FitSummary:
-        ...
-    @property
-    def unobservable(self) -> list[str]:
-        ...
+    def residuals(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        """
+        measured - model per sample (N, 3) = (dx, dy, dz), mm.
+        """
 class RtestJointModel:
     """
     Location errors, tool_offset_Z (machines with head axes) and smooth error maps of the tilt and the rotary axis of any machine, with covariance.
@@ -4131,10 +4008,6 @@ def evaluate_rtest_design(pattern: RtestPattern, options: RtestDesignOptions, ti
 def export_controller(model_path: str, controller: str, current_text: str | None = None, current_source: str = '<current>', toolholder: typing.SupportsInt | typing.SupportsIndex = 1, generated_at: str = '') -> ControllerExport:
     """
     Export a model file's location errors into a controller's kinematic parameters (io/controller_export.hpp); current_text: the controller's current values (its HAL/MPF file or the documented JSON), None for zero offsets.
-    """
-def fanuc_pitch_tables(model_path: str, spacing_deg: typing.SupportsFloat | typing.SupportsIndex = 5.0, range_deg: collections.abc.Mapping[str, typing.Annotated[collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], "FixedSize(2)"]] = {}, fanuc: FanucPitchOptions = ..., generated_at: str = '') -> CompensationTables:
-    """
-    FANUC pitch error compensation data (parameters 3620-3625 and values by data number) of each table axis' positioning error (io/compensation_table.hpp).
     """
 def format_ballbar(session: BallbarSession) -> str:
     ...

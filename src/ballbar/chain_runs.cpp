@@ -47,7 +47,7 @@ Eigen::Matrix<double, 8, 1> identified_errors(const BallbarSession& s, const Cha
     r = identify_paper(s, false);
   } else {
     JointFitOptions fit;
-    fit.noise = NoiseHandling::automatic;
+    fit.noise.noise = NoiseHandling::automatic;
     r = identify_joint(s, fit);
   }
   Eigen::Matrix<double, 8, 1> e;

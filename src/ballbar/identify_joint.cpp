@@ -13,12 +13,6 @@
 
 namespace rotacal {
 
-const ParameterEstimate& BallbarIdentification::parameter(const std::string& name) const {
-  for (const ParameterEstimate& p : parameters)
-    if (p.name == name) return p;
-  throw InvalidArgument("no identified parameter named '" + name + "'");
-}
-
 BallbarArrays ballbar_arrays(const BallbarSession& session, const std::vector<std::string>& tests,
                              bool with_motion) {
   BallbarArrays a;
@@ -107,56 +101,28 @@ BallbarIdentification identify_joint(const BallbarArrays& data, const JointFitOp
 
   // The noise model of what the fit leaves, one AR stream per test in time order; with
   // correlated noise the fit is redone by GLS under it (core/fit_with_noise.hpp).
-  NoiseFitOptions no;
-  no.noise = options.noise;
-  no.noise_options = options.noise_options;
-  no.min_correlation_samples = options.min_correlation_samples;
-  no.noise_bias_correction = options.noise_bias_correction;
   const bool streams = static_cast<std::size_t>(data.size()) == data.test.size();
   const std::vector<double> t(data.time.data(), data.time.data() + data.time.size());
   NoiseFit nf = fit_with_noise(
       [&](const JointFitSettings& s) {
         return solve_with_time_constants(model, setup.parameters, s);
       },
-      setup.settings, streams ? data.test : std::vector<std::string>{}, t, no);
-  JointFitOutcome& fit = nf.fit;
-  const bool refit = nf.refit;
-  const double scale = nf.scale;
-
+      setup.settings, streams ? data.test : std::vector<std::string>{}, t, options.noise);
+  const std::string gls_note = noise_refit_note(nf);
+  const Eigen::VectorXd values = nf.fit.values;
   BallbarIdentification out;
-  out.method = "joint";
-  out.model = ballbar_model_at(setup, data.machine, fit.values);
-  out.converged = fit.summary.converged;
-  out.iterations = fit.summary.iterations;
+  static_cast<Identification&>(out) =
+      joint_identification(std::move(nf), setup.layout.all, options.whitener != nullptr);
+  out.model = ballbar_model_at(setup, data.machine, values);
   out.n_samples = static_cast<std::size_t>(data.size());
-  out.residuals.assign(data.session_size, 0.0);
-  for (std::size_t k = 0; k < data.index.size(); ++k)
-    out.residuals[data.index[k]] = fit.residuals[static_cast<Eigen::Index>(k)];
-  out.residual_rms_um =
-      std::sqrt(fit.residuals.squaredNorm() / static_cast<double>(data.size())) * 1e3;
-  out.sigma_um = std::sqrt(fit.residual_variance) * 1e3;
-  if (options.whitener || refit)  // the noise level the covariance rests on: the whitened fit's
-    out.sigma_um =
-        std::sqrt(fit.residuals.squaredNorm() /
-                  std::max(1.0, static_cast<double>(data.size() - fit.summary.num_free))) *
-        1e3;
-  out.covariance = std::move(fit.covariance);
-  out.jacobian = std::move(fit.jacobian);
-  for (bool f : fit.free) out.fixed.push_back(!f);
-  out.parameters = std::move(fit.estimates);
-  out.unobservable = std::move(fit.unobservable);
+  // One residual per sample of the session, 0 for the samples not fitted.
+  std::vector<double> fitted(data.session_size, 0.0);
+  for (std::size_t k = 0; k < data.index.size(); ++k) fitted[data.index[k]] = out.residuals[k];
+  out.residuals = std::move(fitted);
   for (std::string& advice : setup_advice(data.machine, out.unobservable))
     out.notes.push_back(std::move(advice));
-  out.summary = fit.summary;
-  out.noise = std::move(nf.noise);
-  out.noise_refit = refit;
-  out.noise_correction = scale;
-  if (refit)
-    out.notes.push_back("correlated noise (" + out.noise.summary() +
-                        "): covariance by GLS under this AR model, scaled by " +
-                        std::to_string(scale) +
-                        " for the correlation the fit absorbs from its residuals");
-  if (!out.converged) out.notes.push_back("the fit did not converge: " + fit.summary.message);
+  if (!gls_note.empty()) out.notes.push_back(gls_note);
+  if (!out.converged) out.notes.push_back("the fit did not converge: " + out.summary.message);
   return out;
 }
 

@@ -204,7 +204,7 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session,
   // the session's pivot, the pair), then a moved pivot's when a candidate moves it.
   JointFitOptions fo;
   fo.effects = fx;
-  fo.noise = NoiseHandling::white;
+  fo.noise.noise = NoiseHandling::white;
   const BallbarIdentification id = identify_joint(session, fo);
   const double w = session_weight(
       o.noise_um, id.noise, id.sigma_um,

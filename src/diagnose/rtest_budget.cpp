@@ -51,12 +51,12 @@ UncertaintyBudget uncertainty_budget(const RtestSession& session,
   const std::vector<std::string> names = model.layout().all.names();
   const auto p = static_cast<Eigen::Index>(names.size());
   if (id.parameters.size() != names.size() || id.covariance.rows() != p ||
-      id.residuals.size() != session.samples.size())
+      id.n_samples != session.samples.size() || id.residuals.size() != 3 * id.n_samples)
     throw InvalidArgument("uncertainty_budget: the identification is not of this session (" +
                           std::to_string(id.parameters.size()) + " parameters, " +
-                          std::to_string(id.residuals.size()) +
-                          " samples; the session's model has " + std::to_string(p) + " and " +
-                          std::to_string(session.samples.size()) + ")");
+                          std::to_string(id.n_samples) + " samples; the session's model has " +
+                          std::to_string(p) + " and " + std::to_string(session.samples.size()) +
+                          ")");
   Eigen::VectorXd x(p);
   for (Eigen::Index j = 0; j < p; ++j) {
     const ParameterEstimate& e = id.parameters[static_cast<std::size_t>(j)];
@@ -72,8 +72,8 @@ UncertaintyBudget uncertainty_budget(const RtestSession& session,
   fit.jacobian.setZero(model.num_residuals(), p);  // evaluate() fills a Jacobian of this size
   model.evaluate(x, r, &fit.jacobian);
   fit.residuals = -r;  // measured - model
-  for (std::size_t i = 0; i < id.residuals.size(); ++i)
-    if ((fit.residuals.segment<3>(3 * static_cast<Eigen::Index>(i)) - id.residuals[i])
+  for (std::size_t i = 0; i < id.n_samples; ++i)
+    if ((fit.residuals.segment<3>(3 * static_cast<Eigen::Index>(i)) - id.residual(i))
             .cwiseAbs()
             .maxCoeff() > 1e-9)
       throw InvalidArgument("uncertainty_budget: the identification's residual of sample " +

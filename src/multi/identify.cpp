@@ -169,12 +169,8 @@ void check_sessions(const std::vector<MultiSessionInput>& sessions) {
 
 // The session alone: white fit -> its noise model -> [GLS], as its instrument's own fit.
 NoiseFit fit_alone(const SessionPart& p, const MultiFitOptions& o) {
-  NoiseFitOptions no;
-  no.noise = o.noise;
-  no.noise_options = o.noise_options;
-  no.min_correlation_samples = o.min_correlation_samples;
-  no.noise_bias_correction = o.noise_bias_correction;
-  no.allow_reml = p.allow_reml;
+  NoiseFitOptions no = o.noise;
+  no.allow_reml = o.noise.allow_reml && p.allow_reml;
   no.own_noise = p.own_noise;
   JointFitSettings s = p.settings;
   s.max_iterations = o.max_iterations;

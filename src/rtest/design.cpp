@@ -374,7 +374,7 @@ RtestSeparationDesign design_rtest_separation(const RtestSession& session,
   RtestArrays poses = rtest_arrays(session, "design rtest: --after", false);
   poses.machine = m;
   RtestJointOptions fo;
-  fo.noise = NoiseHandling::white;
+  fo.noise.noise = NoiseHandling::white;
   const RtestJointIdentification id = identify_joint(session, fo);
   const double w =
       session_weight(o.noise_um, id.noise, id.sigma_um,

@@ -254,12 +254,6 @@ Eigen::Vector3d RtestJointModel::tool_error(const Eigen::Vector3d& xyz, double B
   return f(params);
 }
 
-const ParameterEstimate& RtestJointIdentification::parameter(const std::string& name) const {
-  for (const ParameterEstimate& p : parameters)
-    if (p.name == name) return p;
-  throw InvalidArgument("no identified parameter named '" + name + "'");
-}
-
 // ---------------------------------------------------------------- fit
 namespace {
 // True when the tilt axis carries the rotary axis on the same side of the chain.
@@ -366,59 +360,29 @@ RtestJointIdentification identify_joint(const RtestSession& session,
       groups.push_back("nest " + s.setup);
       times.push_back(s.time);
     }
-  NoiseFitOptions no;
-  no.noise = options.noise;
-  no.noise_options = options.noise_options;
-  no.min_correlation_samples = options.min_correlation_samples;
-  no.noise_bias_correction = options.noise_bias_correction;
-  no.allow_reml = true;
   NoiseFit nf =
       fit_with_noise([&](const JointFitSettings& s) { return solve_joint(model, params, s); },
-                     settings, groups, times, no);
-  JointFitOutcome& fit = nf.fit;
-  const bool refit = nf.refit, reml = nf.reml;
-  const double scale = nf.scale;
-
+                     settings, groups, times, options.noise);
+  const std::string gls_note = noise_refit_note(nf);
+  const Eigen::VectorXd values = nf.fit.values;
   RtestJointIdentification out;
-  out.converged = fit.summary.converged;
-  out.iterations = fit.summary.iterations;
+  static_cast<Identification&>(out) =
+      joint_identification(std::move(nf), L.all, options.whitener != nullptr, true);
   out.n_samples = session.samples.size();
-  out.residuals.resize(session.samples.size());
-  for (std::size_t i = 0; i < session.samples.size(); ++i)
-    out.residuals[i] = fit.residuals.segment<3>(3 * static_cast<Eigen::Index>(i));
-  const double n_res = 3.0 * static_cast<double>(session.samples.size());
-  out.residual_rms_um = std::sqrt(fit.residuals.squaredNorm() / n_res) * 1e3;
-  out.sigma_um =
-      std::sqrt(fit.residuals.squaredNorm() / std::max(n_res - fit.summary.num_free, 1.0)) * 1e3;
-  out.covariance = fit.covariance;
   for (std::size_t k = 0; k < setups.size(); ++k)
     out.probe_zeros[setups[k]] =
-        fit.values.segment<3>(L.zeros.item_offset(static_cast<Eigen::Index>(k)));
-  out.parameters = fit.estimates;
-  out.unobservable = fit.unobservable;
+        values.segment<3>(L.zeros.item_offset(static_cast<Eigen::Index>(k)));
   for (std::string& advice : rtest_setup_advice(machine, out.unobservable))
     out.notes.push_back(std::move(advice));
-  out.summary = fit.summary;
-  out.noise = std::move(nf.noise);
-  out.noise_refit = refit;
-  out.noise_correction = scale;
-  if (refit && reml)
-    out.notes.push_back(
-        "correlated noise (" + out.noise.summary() +
-        ", REML over the fit's residual space): covariance by GLS under this model");
-  else if (refit)
-    out.notes.push_back("correlated noise (" + out.noise.summary() +
-                        "): covariance by GLS under this AR model, scaled by " +
-                        std::to_string(scale) +
-                        " for the correlation the fit absorbs from its residuals");
+  if (!gls_note.empty()) out.notes.push_back(gls_note);
 
   out.model.machine = machine;
   out.model.basis = basis;
-  out.model.params = fit.values.head(n_model);
+  out.model.params = values.head(n_model);
   out.model.covariance = out.covariance.topLeftCorner(n_model, n_model);
   out.model.observable.clear();
   for (Eigen::Index j = 0; j < n_model; ++j)
-    out.model.observable.push_back(fit.estimates[static_cast<std::size_t>(j)].observable);
+    out.model.observable.push_back(out.parameters[static_cast<std::size_t>(j)].observable);
 
   out.notes.push_back("probe zero per set-up fitted: no reading is assumed to be zero");
   const std::array<std::string, 2> maps = rtest_map_names(machine);
@@ -445,7 +409,7 @@ RtestJointIdentification identify_joint(const RtestSession& session,
   if (machine.has_head())
     out.notes.push_back(
         "tool_offset_Z: minus the error of pivot_length + tool_length, along the spindle");
-  if (!out.converged) out.notes.push_back("the fit did not converge: " + fit.summary.message);
+  if (!out.converged) out.notes.push_back("the fit did not converge: " + out.summary.message);
   return out;
 }
 

@@ -15,11 +15,11 @@ RtestMonteCarlo monte_carlo(const RtestSession& session, const RtestJointIdentif
   if (o.draws < 2)
     throw InvalidArgument("monte_carlo: draws must be at least 2, got " + std::to_string(o.draws));
   const std::size_t n = session.samples.size();
-  if (result.residuals.size() != n || result.n_samples != n)
+  if (result.residuals.size() != 3 * n || result.n_samples != n)
     throw InvalidArgument("monte_carlo: result was fitted to " + std::to_string(result.n_samples) +
                           " samples, the session has " + std::to_string(n));
   RtestJointOptions fit = o.fit;
-  fit.noise = NoiseHandling::white;  // each draw is fitted as the identification was
+  fit.noise.noise = NoiseHandling::white;  // each draw is fitted as the identification was
   const bool coloured = result.noise_refit;
   if (coloured) fit.whitener = std::make_shared<ArWhitener>(result.noise);
   // The identified model's readings: measured - residual (probe zeros included).
@@ -28,7 +28,7 @@ RtestMonteCarlo monte_carlo(const RtestSession& session, const RtestJointIdentif
     if (!session.samples[i].d)
       throw InvalidArgument("monte_carlo: session: sample " + std::to_string(i) +
                             " has no dx,dy,dz");
-    model[i] = *session.samples[i].d - result.residuals[i];
+    model[i] = *session.samples[i].d - result.residual(i);
   }
   const int p = static_cast<int>(result.parameters.size());
   RtestMonteCarlo out;

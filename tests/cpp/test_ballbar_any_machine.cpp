@@ -63,7 +63,7 @@ TEST_CASE("hidden location errors are identified within 3 sigma on every machine
     }
     const BallbarSession s = synthetic::noisy_ballbar(cmd, truth, 0.5, 0.5, ++seed);
     JointFitOptions o;
-    o.noise = NoiseHandling::automatic;  // as the CLI and Python run it
+    o.noise.noise = NoiseHandling::automatic;  // as the CLI and Python run it
     const BallbarIdentification id = identify_joint(s, o);
     REQUIRE(id.converged);
     const auto& names = location_error_names(m);
@@ -135,7 +135,7 @@ TEST_CASE(
     REQUIRE(back.machine == described.machine);
     REQUIRE(back.machine != builtin.machine);
     JointFitOptions o;
-    o.noise = NoiseHandling::automatic;
+    o.noise.noise = NoiseHandling::automatic;
     const BallbarIdentification a = identify_joint(builtin, o), b = identify_joint(back, o);
     REQUIRE(a.parameters.size() == b.parameters.size());
     for (std::size_t k = 0; k < a.parameters.size(); ++k) {

@@ -51,7 +51,7 @@ TEST_CASE("joint fit recovers random machines within 3 sigma, AC and BC", "[ball
     for (std::uint64_t seed : {1u, 2u}) {
       const BallbarMachineModel t = random_machine(m, cmd.pivot, rng);
       JointFitOptions automatic;  // the noise model estimated; white noise must come out white
-      automatic.noise = NoiseHandling::automatic;
+      automatic.noise.noise = NoiseHandling::automatic;
       const BallbarIdentification id =
           identify_joint(simulate_ballbar(cmd, t, {0.5, seed, true}), automatic);
       INFO("noise model " << id.noise.summary());
@@ -177,7 +177,7 @@ TEST_CASE("joint fit with a noise model (GLS): whitened chi2, honest sigma, reco
   gls.whitener = std::make_shared<Ar1>(static_cast<Eigen::Index>(s.samples.size()), phi, innov);
   const BallbarIdentification w = identify_joint(s, gls);
   JointFitOptions as_white;  // the noise treated as white (no noise model, no GLS refit)
-  as_white.noise = NoiseHandling::white;
+  as_white.noise.noise = NoiseHandling::white;
   const BallbarIdentification white = identify_joint(s, as_white);
   CHECK(w.converged);
   CHECK(w.summary.whitened);

@@ -53,8 +53,8 @@ TEST_CASE("ballbar joint fit on AR(0.95) noise: white sigmas ~6x too small, GLS 
     const BallbarMachineModel truth = random_machine(rng);
     const BallbarSession s = ar_ballbar(truth, 0.95, 100 + k);
     JointFitOptions white, automatic;
-    white.noise = NoiseHandling::white;
-    automatic.noise = NoiseHandling::automatic;
+    white.noise.noise = NoiseHandling::white;
+    automatic.noise.noise = NoiseHandling::automatic;
     const BallbarIdentification w = identify_joint(s, white);
     const BallbarIdentification a = identify_joint(s, automatic);
     // The white fit still estimates (and reports) the noise model, but does not use it.
@@ -84,8 +84,8 @@ TEST_CASE("ballbar joint fit on white noise: the noise model is white and the fi
   const BallbarMachineModel truth = random_machine(rng);
   const BallbarSession s = simulate_ballbar(commanded(), truth, {0.5, 7, false});
   JointFitOptions white, automatic;
-  white.noise = NoiseHandling::white;
-  automatic.noise = NoiseHandling::automatic;
+  white.noise.noise = NoiseHandling::white;
+  automatic.noise.noise = NoiseHandling::automatic;
   const BallbarIdentification a = identify_joint(s, automatic), w = identify_joint(s, white);
   CHECK(a.noise.white());
   CHECK_FALSE(a.noise_refit);
@@ -120,8 +120,8 @@ TEST_CASE("R-test joint fit with AR(0.95) noise and probe zeros wandering betwee
       for (int a = 0; a < 3; ++a) (*s.samples[r].d)[a] += e[3 * static_cast<Eigen::Index>(r) + a];
     s.noise_um = 0.3;
     RtestJointOptions white, automatic;
-    white.noise = NoiseHandling::white;
-    automatic.noise = NoiseHandling::automatic;
+    white.noise.noise = NoiseHandling::white;
+    automatic.noise.noise = NoiseHandling::automatic;
     const RtestJointIdentification w = identify_joint(s, white);
     const RtestJointIdentification a = identify_joint(s, automatic);
     REQUIRE(a.noise_refit);
@@ -154,7 +154,7 @@ TEST_CASE("R-test Monte Carlo re-simulates the fitted noise model (wandering pro
     for (int a = 0; a < 3; ++a) (*s.samples[r].d)[a] += e[3 * static_cast<Eigen::Index>(r) + a];
   s.noise_um = 0.3;
   RtestJointOptions automatic;
-  automatic.noise = NoiseHandling::automatic;
+  automatic.noise.noise = NoiseHandling::automatic;
   const RtestJointIdentification id = identify_joint(s, automatic);
   REQUIRE(id.noise_refit);
   RtestMonteCarloOptions mo;
@@ -233,8 +233,8 @@ TEST_CASE(
   for (const RtestSample& x : clean.samples)
     for (int a = 0; a < 3; ++a) g.push_back("nest " + x.setup), t.push_back(x.time);
   RtestJointOptions now, old;
-  now.noise = old.noise = NoiseHandling::automatic;
-  old.noise_options.reml_random_walk = false;
+  now.noise.noise = old.noise.noise = NoiseHandling::automatic;
+  old.noise.noise_options.reml_random_walk = false;
   Ratios r_now, r_old;
   for (int k = 0; k < 50; ++k) {
     RtestSession s = clean;

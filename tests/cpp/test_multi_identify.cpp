@@ -171,7 +171,7 @@ TEST_CASE("the block-diagonal whitener whitens each session's rows by its own mo
 TEST_CASE("white noise handling weights each session by its own residual sigma", "[multi]") {
   const MachineModel t = machine_truth();
   MultiFitOptions o;
-  o.noise = NoiseHandling::white;
+  o.noise.noise = NoiseHandling::white;
   const MultiIdentification id =
       identify_multi({MultiSessionInput::of("bb", ballbar_session(t, 41)),
                       MultiSessionInput::of("probe", probe_session(t, 42))},

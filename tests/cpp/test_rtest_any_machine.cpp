@@ -111,7 +111,7 @@ TEST_CASE("hidden location errors are identified within 3 sigma from an R-test o
     RtestSession s = simulate_rtest(truth, o).session;
     add_coloured_noise(s, seed * 10);
     RtestJointOptions jo;
-    jo.noise = NoiseHandling::automatic;  // as the CLI and Python run it
+    jo.noise.noise = NoiseHandling::automatic;  // as the CLI and Python run it
     const RtestJointIdentification id = identify_joint(s, jo);
     INFO("fit: " << id.summary.message << ", " << id.iterations << " iterations, residual "
                  << id.residual_rms_um << " um, " << id.unobservable.size() << " unobservable");
@@ -263,7 +263,7 @@ TEST_CASE("R-test Monte Carlo on a head machine re-simulates the fitted noise",
   RtestSession s = simulate_rtest(truth, o).session;
   add_coloured_noise(s, 41);
   RtestJointOptions jo;
-  jo.noise = NoiseHandling::automatic;
+  jo.noise.noise = NoiseHandling::automatic;
   const RtestJointIdentification id = identify_joint(s, jo);
   REQUIRE(id.noise_refit);
   RtestMonteCarloOptions mo;

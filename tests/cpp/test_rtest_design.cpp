@@ -50,7 +50,7 @@ TEST_CASE(
       *s.samples[i].d += e.segment<3>(3 * static_cast<Eigen::Index>(i));
     s.noise_um = o.noise_um;
     RtestJointOptions fit;
-    fit.noise =
+    fit.noise.noise =
         NoiseHandling::automatic;  // AR noise model of the residuals, GLS refit, as the CLI fits
     const RtestJointIdentification id = identify_joint(s, fit);
     for (int i = 0; i < 8; ++i) est(k, i) = id.parameters[static_cast<std::size_t>(i)].value;

@@ -164,7 +164,7 @@ TEST_CASE("R-test joint fit with a noise model: same solution, covariance in uni
   o.noise_um = 0.3;
   const RtestSimulation sim = simulate_rtest(oyama_truth(), o);
   RtestJointOptions as_white;  // no noise model (the basis' misfit of the truth's effects is
-  as_white.noise = NoiseHandling::white;  // correlated; here the white fit is the reference)
+  as_white.noise.noise = NoiseHandling::white;  // correlated; here the white fit is the reference)
   const RtestJointIdentification white = identify_joint(sim.session, as_white);
   RtestJointOptions gls;
   const double s = 0.6e-3;  // deliberately twice the true noise: chi2/dof must show it

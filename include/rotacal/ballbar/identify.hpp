@@ -13,39 +13,19 @@
 
 #include "rotacal/ballbar/model.hpp"
 #include "rotacal/core/estimate.hpp"  // ParameterEstimate (kept reachable from this header)
+#include "rotacal/core/fit_with_noise.hpp"
+#include "rotacal/core/identification.hpp"
 #include "rotacal/core/noise_handling.hpp"
 #include "rotacal/core/whitener.hpp"
 
 namespace rotacal {
 
-struct BallbarIdentification {
-  std::string method;         ///< "joint" or "paper"
+/// A ballbar identification (core/identification.hpp): `parameters` are the 8 location errors,
+/// the block "pivot" (x y z), then the extras (dL, effects); `residuals` one per sample of the
+/// session (0 for samples not fitted); the Jacobian one row per fitted sample, in session
+/// order. Method "joint" or "paper" (identify_paper.hpp).
+struct BallbarIdentification : Identification {
   BallbarMachineModel model;  ///< identified machine (unobservable parts left nominal)
-  std::vector<ParameterEstimate> parameters;  ///< 8 location errors, pivot x y z, then extras
-  Eigen::MatrixXd covariance;                 ///< in `parameters` order, 1-sigma^2
-  std::vector<double> residuals;              ///< measured - model, mm, per sample (session order)
-  /// d(model length)/d(parameter) at the solution, mm per parameter unit; one row per fitted
-  /// sample (in session order of the samples used), columns in `parameters` order.
-  Eigen::MatrixXd jacobian;
-  std::vector<bool> fixed;  ///< per parameter: held at its start value
-  double residual_rms_um = 0.0;
-  double sigma_um = 0.0;  ///< noise level used for the covariance
-  std::size_t n_samples = 0;
-  bool converged = false;
-  int iterations = 0;
-  std::vector<std::string> unobservable;  ///< combinations the tests cannot see, in words
-  std::vector<std::string> notes;         ///< assumptions and warnings for the report
-  FitSummary summary;                     ///< solver figures; whitened chi2/dof with a whitener
-  /// Noise model of the residuals (one stream per test), estimated after the fit; when it is
-  /// not white (and noise = automatic) the covariance is the GLS one under it.
-  NoiseModel noise;
-  /// Factor applied to the GLS covariance for the noise model's bias (estimated from
-  /// residuals that the fit has already taken the slow noise from): core/noise_handling.hpp.
-  double noise_correction = 1.0;
-  bool noise_refit = false;  ///< the fit was redone with the noise model's whitener (GLS)
-
-  /// The estimate called `name`; throws InvalidArgument if there is none.
-  const ParameterEstimate& parameter(const std::string& name) const;
 };
 
 struct JointFitOptions {
@@ -60,19 +40,13 @@ struct JointFitOptions {
   /// order) to independent unit-variance ones. The covariance is then (Jw^T Jw)^-1 with no
   /// rescaling, and summary.chi2_per_dof is the whitened one.
   std::shared_ptr<const ResidualWhitener> whitener;
-  /// Without a whitener: `automatic` estimates the noise model of the first (white) fit's
-  /// residuals and, when some stream is correlated (AR order > 0), refits with its ArWhitener
-  /// so that the covariance holds on correlated data; white data are fitted once, as before.
-  /// C++ default `white` (as before) because the diagnosis refits through identify_joint
-  /// with its own whitener decisions; the Python API and the CLI default to `auto`.
-  NoiseHandling noise = NoiseHandling::white;
-  NoiseModelOptions noise_options;
-  /// The GLS refit is done only when some stream's integrated correlation time reaches this
-  /// (samples): below it the white covariance is within ~10 % and BIC's rare spurious AR(1) of
-  /// white noise (|phi| ~ 0.05) must not change the answer.
-  double min_correlation_samples = 1.2;
-  /// Scale the GLS covariance by the bootstrap bias factor (core/noise_handling.hpp).
-  bool noise_bias_correction = true;  ///< AR order search of the noise model
+  /// Without a whitener: noise.noise `automatic` estimates the noise model of the first (white)
+  /// fit's residuals (one AR stream per test) and, when some stream is correlated, refits with
+  /// its ArWhitener so that the covariance holds on correlated data (core/fit_with_noise.hpp);
+  /// white data are fitted once, as before. C++ default `white` because the diagnosis refits
+  /// through identify_joint with its own whitener decisions; the Python API and the CLI
+  /// default to `auto`.
+  NoiseFitOptions noise;
 };
 
 /// The samples a fit uses as contiguous arrays (structure of arrays): built once per session

@@ -29,12 +29,18 @@ namespace rotacal {
 using OwnNoiseModel = std::function<std::shared_ptr<const ResidualWhitener>(
     const JointFitOutcome& white_fit, NoiseModel& described)>;
 
-/// The noise handling options both instruments' JointFitOptions carry.
+/// The noise handling options every instrument's fit options carry (ballbar JointFitOptions,
+/// RtestJointOptions, ProbeFitOptions, MultiFitOptions), as their member `noise`.
 struct NoiseFitOptions {
+  /// `automatic`: noise model of the white fit's residuals, GLS refit when it is correlated;
+  /// `white`: one fit, no noise model.
   NoiseHandling noise = NoiseHandling::white;
   NoiseModelOptions noise_options;
-  /// The GLS refit is done only when some stream's integrated correlation time reaches this.
+  /// The GLS refit is done only when some stream's integrated correlation time reaches this
+  /// (samples): below it the white covariance is within ~10 % and BIC's rare spurious AR(1) of
+  /// white noise (|phi| ~ 0.05) must not change the answer.
   double min_correlation_samples = 1.2;
+  /// Scale the GLS covariance by the bootstrap bias factor (core/noise_handling.hpp).
   bool noise_bias_correction = true;
   /// REML of AR(1) + a random walk when noise_options.reml_random_walk is set and no stream
   /// is longer than noise_options.reml_max_stream_size (the R-test); else Burg + bias factor.

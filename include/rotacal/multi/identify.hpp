@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "rotacal/core/estimate.hpp"
+#include "rotacal/core/fit_with_noise.hpp"
 #include "rotacal/core/noise_handling.hpp"
 #include "rotacal/kinematics/effects.hpp"
 #include "rotacal/kinematics/machine.hpp"
@@ -59,10 +60,13 @@ struct MultiFitOptions {
   EffectModel effects;
   /// `automatic`: a session whose residuals are correlated is whitened by its AR model (GLS),
   /// as in its single-instrument fit; `white`: each session weighted by its residual sigma.
-  NoiseHandling noise = NoiseHandling::automatic;
-  NoiseModelOptions noise_options;
-  double min_correlation_samples = 1.2;
-  bool noise_bias_correction = true;
+  /// allow_reml applies to the sessions whose instrument's own fit allows it (the R-test's).
+  NoiseFitOptions noise = [] {
+    NoiseFitOptions o;
+    o.noise = NoiseHandling::automatic;
+    o.allow_reml = true;
+    return o;
+  }();
   int max_iterations = 100;
   double observability_min_chi2 = 1.0;
   /// Probability that sessions of one machine are reported to disagree on anything: the

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "rotacal/core/fit_with_noise.hpp"
+#include "rotacal/core/identification.hpp"
 #include "rotacal/kinematics/machine_model.hpp"
 #include "rotacal/session/probe_session.hpp"
 
@@ -40,41 +41,22 @@ struct ProbeFitOptions {
   }();
 };
 
-struct ProbeIdentification {
-  std::string method;  ///< "joint" or "cycles"
+/// A touch-probe identification (core/identification.hpp). Joint: `parameters` are the
+/// location errors, [tool_offset_Z on a machine with head axes], the block "sphere" (x y z),
+/// the effect parameters; `residuals` one per touch (mm, session order): the trigger distance
+/// (D + d)/2 (+ delta) minus the touch's distance from the fitted sphere centre. Cycles: the
+/// location errors only, with std NaN (the cycles give no uncertainty) and no covariance.
+struct ProbeIdentification : Identification {
   /// Identified machine: location errors (unobservable ones left at 0), the fitted effects and
-  /// their values; on a machine with head axes tool_offset_Z is reported among `parameters`.
+  /// their values.
   MachineModel model;
-  Eigen::Vector3d sphere = Eigen::Vector3d::Zero();  ///< actual sphere centre, table frame, mm
-  /// Location errors, [tool_offset_Z], sphere.x/y/z, effect parameters (joint); location errors
-  /// only (cycles, with std NaN: the cycles give no uncertainty).
-  std::vector<ParameterEstimate> parameters;
-  Eigen::MatrixXd covariance;  ///< in `parameters` order, 1-sigma^2 (joint; empty for cycles)
-  /// measured - model per touch at the solution, mm, session order: the trigger distance
-  /// (D + d)/2 (+ delta) minus the touch's distance from the fitted sphere centre.
-  std::vector<double> residuals;
-  Eigen::MatrixXd jacobian;  ///< d residual / d parameter at the solution (joint)
-  std::vector<bool> fixed;   ///< per parameter: held at its start value (joint)
-  double residual_rms_um = 0.0;
-  double sigma_um = 0.0;  ///< noise level the covariance rests on
-  std::size_t n_samples = 0;
-  bool converged = false;
-  int iterations = 0;
-  std::vector<std::string> unobservable;  ///< combinations the session cannot see, in words
-  std::vector<std::string> notes;
-  FitSummary summary;
-  NoiseModel noise;  ///< of the residuals (joint)
-  double noise_correction = 1.0;
-  bool noise_refit = false;
+  Eigen::Vector3d sphere = Eigen::Vector3d::Zero();  ///< actual sphere centre (block "sphere")
   /// Cycles: the sphere centre fitted at each pose (machine frame, mm), the poses' labels and
   /// the dispersion of the centres about the fitted circles (RMS, um): what the controller
   /// cycles report instead of an uncertainty.
   std::vector<Eigen::Vector3d> pose_centres;
   std::vector<std::string> pose_labels;
   double dispersion_um = 0.0;
-
-  /// The estimate called `name`; throws InvalidArgument if there is none.
-  const ParameterEstimate& parameter(const std::string& name) const;
 };
 
 /// Joint fit of every touch. Throws InvalidArgument for a session with fewer touches than

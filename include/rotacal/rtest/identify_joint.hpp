@@ -40,6 +40,8 @@
 #include <vector>
 
 #include "rotacal/core/estimate.hpp"
+#include "rotacal/core/fit_with_noise.hpp"
+#include "rotacal/core/identification.hpp"
 #include "rotacal/core/noise_handling.hpp"
 #include "rotacal/core/whitener.hpp"
 #include "rotacal/rtest/error_model.hpp"
@@ -208,43 +210,31 @@ struct RtestJointOptions {
   /// order) to independent unit-variance ones; the covariance is then (Jw^T Jw)^-1 and
   /// summary.chi2_per_dof the whitened one.
   std::shared_ptr<const ResidualWhitener> whitener;
-  /// Without a whitener: `automatic` estimates the noise model of the first fit's residuals
-  /// (one AR stream per nest and channel dx, dy, dz, in time order; probe zeros that wander
-  /// between poses show as correlation) and refits by GLS when it is not white.
-  /// C++ default `white` (as before) because the diagnosis refits through identify_joint
-  /// with its own whitener decisions; the Python API and the CLI default to `auto`.
-  NoiseHandling noise = NoiseHandling::white;
-  NoiseModelOptions noise_options;
-  /// The GLS refit is done only when some stream's integrated correlation time reaches this
-  /// (samples): below it the white covariance is within ~10 % and BIC's rare spurious AR(1) of
-  /// white noise (|phi| ~ 0.05) must not change the answer.
-  double min_correlation_samples = 1.2;
-  /// Scale the GLS covariance by the bootstrap bias factor (core/noise_handling.hpp).
-  bool noise_bias_correction = true;
+  /// Without a whitener: noise.noise `automatic` estimates the noise model of the first fit's
+  /// residuals (one AR stream per nest and channel dx, dy, dz, in time order; probe zeros that
+  /// wander between poses show as correlation) and refits by GLS when it is not white, with
+  /// REML of AR(1) + a random walk where the streams are short enough (allow_reml).
+  /// C++ default `white` because the diagnosis refits through identify_joint with its own
+  /// whitener decisions; the Python API and the CLI default to `auto`.
+  NoiseFitOptions noise = [] {
+    NoiseFitOptions o;
+    o.allow_reml = true;
+    return o;
+  }();
 };
 
-struct RtestJointIdentification {
-  std::string method = "joint";
+/// An R-test identification (core/identification.hpp): `parameters` are the location errors,
+/// [tool_offset_Z on a machine with head axes], the map coefficients, then the block "zeros"
+/// (dx dy dz per set-up); `residuals` dx dy dz per sample (mm, session order), `noise` one
+/// stream per nest and channel. It adds the identified model with its maps.
+struct RtestJointIdentification : Identification {
   RtestJointModel model;
-  std::vector<ParameterEstimate> parameters;           ///< location errors, map coefficients, zeros
-  Eigen::MatrixXd covariance;                          ///< in `parameters` order
-  std::map<std::string, Eigen::Vector3d> probe_zeros;  ///< per set-up, mm
-  std::vector<Eigen::Vector3d> residuals;              ///< measured - model per sample, mm
-  double residual_rms_um = 0.0;                        ///< over all components
-  double sigma_um = 0.0;  ///< dof-corrected residual sigma used for covariance
-  std::size_t n_samples = 0;
-  bool converged = false;
-  int iterations = 0;
-  std::vector<std::string> unobservable;  ///< combinations the nests cannot see, in words
-  std::vector<std::string> notes;
-  FitSummary summary;  ///< solver figures; whitened chi2/dof with a whitener
-  NoiseModel noise;    ///< noise model of the residuals (streams: nest x channel)
-  /// Factor applied to the GLS covariance for the noise model's bias (estimated from
-  /// residuals that the fit has already taken the slow noise from): core/noise_handling.hpp.
-  double noise_correction = 1.0;
-  bool noise_refit = false;  ///< the fit was redone by GLS under `noise`
+  std::map<std::string, Eigen::Vector3d> probe_zeros;  ///< per set-up, mm (the block "zeros")
 
-  const ParameterEstimate& parameter(const std::string& name) const;
+  /// measured - model of sample i (mm): residuals 3i .. 3i + 2.
+  Eigen::Vector3d residual(std::size_t i) const {
+    return Eigen::Vector3d(residuals[3 * i], residuals[3 * i + 1], residuals[3 * i + 2]);
+  }
 };
 
 /// Fit the joint model to every sample, on any machine. Throws InvalidArgument for samples
