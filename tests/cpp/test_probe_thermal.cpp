@@ -1,0 +1,75 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The joint fit of a thermal probe session (probe/thermal.hpp) on the independent
+// implementation's thermal_probe_ac.csv, judged against its .truth.json.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "rotacal/core/json_text.hpp"
+#include "rotacal/probe/thermal.hpp"
+
+using namespace rotacal;
+
+namespace {
+const std::string kShared = ROTACAL_SHARED_DIR;
+
+nlohmann::ordered_json truth_of(const std::string& name) {
+  std::ifstream in(kShared + "/data/" + name);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parse_json(ss.str(), name);
+}
+}  // namespace
+
+TEST_CASE("thermal_probe_ac.csv: tau and every determinable gain within 3 sigma of the truth",
+          "[probe][thermal]") {
+  const ThermalSession t = read_thermal_session(kShared + "/data/thermal_probe_ac.csv");
+  const auto& s = std::get<ProbeSession>(t.session);
+  const ThermalIdentification id = identify_thermal_probe(s, t.thermal);
+  const auto truth = truth_of("thermal_probe_ac.truth.json");
+  const auto& lag = truth["thermal"][0];
+  REQUIRE(id.converged);
+  REQUIRE(id.lags.size() == 1);
+  CHECK(id.axis == 'C');
+  CHECK(id.tested_speed_rpm == 300.0);
+  const double tau = lag["tau_s"].get<double>();
+  INFO("tau " << id.lags[0].tau_s << " +- " << id.lags[0].tau_std_s << " truth " << tau);
+  CHECK(id.lags[0].tau_observable);
+  CHECK(std::abs(id.lags[0].tau_s - tau) <= 3.0 * id.lags[0].tau_std_s);
+  int determined = 0;
+  for (const ThermalGainEstimate& g : id.lags[0].gains) {
+    const double want = lag["gains"][g.name].get<double>();
+    INFO(g.name << " " << g.value << " +- " << g.std << " truth " << want << " " << g.reason);
+    if (!g.observable) {
+      CHECK_FALSE(g.reason.empty());
+      continue;
+    }
+    ++determined;
+    CHECK(g.std > 0.0);
+    CHECK(std::abs(g.value - want) <= 3.0 * g.std);
+  }
+  CHECK(determined >= 8);
+  // The cold location errors too (the set-up's sphere: truth's sphere_actual).
+  for (int k = 0; k < 8; ++k) {
+    const ThermalGainEstimate& c = id.cold[static_cast<std::size_t>(k)];
+    if (!c.observable) continue;
+    const double want = truth["errors"][c.name].get<double>();
+    INFO(c.name << " " << c.value << " +- " << c.std << " truth " << want);
+    CHECK(std::abs(c.value - want) <= 3.0 * c.std);
+  }
+  CHECK(id.residual_rms_um < 0.6);  // noise 0.5 um: the model leaves nothing else
+}
+
+TEST_CASE("a thermal probe session without duty: gains unobservable, for that reason",
+          "[probe][thermal]") {
+  const ThermalSession t = read_thermal_session(kShared + "/data/thermal_probe_ac.csv");
+  ThermalTest cold = t.thermal;
+  cold.duty.clear();
+  const ThermalIdentification id = identify_thermal_probe(std::get<ProbeSession>(t.session), cold);
+  CHECK(id.axis == 0);
+  for (const ThermalGainEstimate& g : id.lags[0].gains) {
+    CHECK_FALSE(g.observable);
+    CHECK_THAT(g.reason, Catch::Contains("no heat input"));
+  }
+}
