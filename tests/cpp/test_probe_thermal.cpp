@@ -8,6 +8,7 @@
 
 #include "rotacal/core/json_text.hpp"
 #include "rotacal/probe/thermal.hpp"
+#include "rotacal/session/thermal_summary.hpp"
 
 using namespace rotacal;
 
@@ -72,4 +73,45 @@ TEST_CASE("a thermal probe session without duty: gains unobservable, for that re
     CHECK_FALSE(g.observable);
     CHECK_THAT(g.reason, Catch::Contains("no heat input"));
   }
+}
+
+TEST_CASE("thermal summary of the shared probe session", "[probe][thermal]") {
+  const ThermalSession t = read_thermal_session(kShared + "/data/thermal_probe_ac.csv");
+  const ThermalIdentification id =
+      identify_thermal_probe(std::get<ProbeSession>(t.session), t.thermal);
+  ThermalSummaryOptions o;
+  o.tolerance_mm = 0.005;
+  o.tolerance_rad = 10e-6;
+  const ThermalSummary s = thermal_summary(id, o);
+  REQUIRE(s.drifts.size() == 11);
+  CHECK(s.tau_s[0] == id.lags[0].tau_s);
+  const double tau = s.tau_s[0];
+  int never = 0, timed = 0;
+  for (std::size_t k = 0; k < s.drifts.size(); ++k) {
+    const ThermalDrift& d = s.drifts[k];
+    const ThermalGainEstimate& g = id.lags[0].gains[k];
+    INFO(d.name << " " << d.steady_change << " +- " << d.steady_std);
+    REQUIRE(d.observable);
+    CHECK(d.steady_change == Approx(3.0 * g.value));  // 300 rev/min = 3 x 100
+    CHECK(d.steady_std == Approx(3.0 * g.std));
+    CHECK(d.significant == (std::abs(g.value) > 3.0 * g.std));
+    // One lag: the bound is (|Delta| + 1.645 sigma)(1 - exp(-t / tau)), crossing the tolerance
+    // at -tau ln(1 - tol / bound) when the bound at steady state exceeds it.
+    const double tol = d.unit == "rad" ? 10e-6 : 0.005;
+    const double bound = std::abs(d.steady_change) + 1.6448536269514722 * d.steady_std;
+    if (bound <= tol) {
+      CHECK_FALSE(d.exceeds_after_s);
+      ++never;
+    } else {
+      REQUIRE(d.exceeds_after_s);
+      CHECK(*d.exceeds_after_s == Approx(-tau * std::log(1.0 - tol / bound)).epsilon(1e-9));
+      ++timed;
+    }
+  }
+  CHECK(never > 0);  // e.g. q_z: 0.47 um at 300 rev/min
+  CHECK(timed > 0);  // E_X0C: -23 um at 300 rev/min
+  const auto j = to_json(s);
+  CHECK(j["drifts"].size() == 11);
+  CHECK(j["lags"][0]["tau_s"].get<double>() == tau);
+  CHECK_THROWS_AS(thermal_summary(id, ThermalSummaryOptions{-1.0, {}}), InvalidArgument);
 }
