@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Joint fit of a thermal touch-probe session (probe/thermal.hpp).
+#include <algorithm>
 #include <cmath>
 
 #include "rotacal/core/parameter_layout.hpp"
-#include "rotacal/core/time_constant_fit.hpp"
 #include "rotacal/kinematics/parameter_blocks.hpp"
 #include "rotacal/probe/problem.hpp"
 #include "rotacal/probe/thermal.hpp"
@@ -103,14 +103,6 @@ class ThermalProbeModel : public ResidualModel {
   HeatInput heat_;
 };
 
-// Why a gain the driver held is not determined.
-std::string gain_reason(bool cold_free, bool heated, const std::string& cold_name) {
-  if (!heated) return "no heat input: the duty never turns the axis between the epochs";
-  if (!cold_free) return "the poses do not determine " + cold_name + " itself";
-  return "the epochs do not separate it from the cold value and the other gains (test too short "
-         "or epochs too sparse for the lag)";
-}
-
 }  // namespace
 
 Eigen::VectorXd thermal_probe_residuals(const ProbeSession& session, const ThermalTest& thermal,
@@ -124,83 +116,42 @@ Eigen::VectorXd thermal_probe_residuals(const ProbeSession& session, const Therm
 ThermalIdentification identify_thermal_probe(const ProbeSession& session,
                                              const ThermalTest& thermal,
                                              const ThermalFitOptions& options) {
-  if (options.lags < 1 || options.lags > 2)
-    throw InvalidArgument("thermal identification: lags must be 1 or 2, got " +
-                          std::to_string(options.lags));
-  const ThermalProbeModel model(session, thermal, options.lags);
+  const ThermalProbeModel model(session, thermal, std::max(1, std::min(2, options.lags)));
   const ThermalLayout& L = model.layout();
-  if (model.num_residuals() <= model.num_parameters())
-    throw InvalidArgument("thermal identification: " + std::to_string(model.num_residuals()) +
-                          " touches cannot determine " + std::to_string(model.num_parameters()) +
-                          " unknowns");
   std::vector<FitParameter> params;
   const std::vector<std::string> names = L.all.names(), units = L.all.units();
   for (Eigen::Index j = 0; j < L.all.size(); ++j)
     params.push_back({names[static_cast<std::size_t>(j)], units[static_cast<std::size_t>(j)], 0.0});
   for (int k = 0; k < 3; ++k)
     params[static_cast<std::size_t>(L.sphere.offset + k)].start = session.sphere[k];
-  const bool heated = model.axis() != 0;
+  ThermalFitIndex index;
+  const auto& enames = location_error_names(session.machine);
+  for (int k = 0; k < 11; ++k) {
+    const bool e = k < 8;
+    index.cold.push_back(static_cast<int>(e ? L.errors.offset + k : L.sphere.offset + k - 8));
+    index.cold_names.push_back(e ? enames[static_cast<std::size_t>(k)]
+                                 : std::string("sphere.") + "xyz"[k - 8]);
+    index.gain_names.push_back(e ? enames[static_cast<std::size_t>(k)] : kPointGains[k - 8]);
+    index.gain_cold.push_back(k);
+  }
   for (std::size_t l = 0; l < L.tau.size(); ++l) {
-    FitParameter& q = params[static_cast<std::size_t>(L.tau[l].offset)];
-    q.start = std::log(options.tau_start_s * (l == 0 ? 1.0 : 4.0) / 300.0);
-    q.held = !heated;  // without heat input tau moves nothing
-    if (!heated)
-      for (Eigen::Index k = 0; k < L.gains[l].size; ++k)
-        params[static_cast<std::size_t>(L.gains[l].offset + k)].held = true;
+    index.tau.push_back(static_cast<int>(L.tau[l].offset));
+    index.gains.push_back(static_cast<int>(L.gains[l].offset));
   }
   JointFitSettings settings;
   settings.max_iterations = options.max_iterations;
   settings.observability_min_chi2 = options.observability_min_chi2;
-  settings.sigma = session.noise_um.value_or(1.0) * 1e-3;
-  std::vector<std::string> groups(session.samples.size(), "touches");
-  NoiseFit nf = fit_with_noise(
-      [&](const JointFitSettings& s) { return solve_with_time_constants(model, params, s); },
-      settings, groups, thermal.time, options.noise);
-  JointFitOutcome& fit = nf.fit;
-
-  ThermalIdentification out;
+  settings.sigma = session.noise_um.value_or(1.0) * 1e-3;  // scales chi-square only
+  const bool heated = model.axis() != 0;
+  const NoiseFit nf = fit_thermal(model, params, index, heated, settings,
+                                  std::vector<std::string>(session.samples.size(), "touches"),
+                                  thermal.time, options);
+  ThermalIdentification out = thermal_identification(nf, index, heated);
   out.machine = session.machine;
   out.axis = model.axis();
   out.tested_speed_rpm = heated ? thermal.tested_speed(out.axis) : 0.0;
   out.n_samples = session.samples.size();
   out.n_epochs = thermal.epoch_spans().size();
-  const auto est = [&](Eigen::Index j, const std::string& name) {
-    const ParameterEstimate& p = fit.estimates[static_cast<std::size_t>(j)];
-    ThermalGainEstimate g{name, p.unit, p.value, p.std, p.observable && fit.free[j], ""};
-    return g;
-  };
-  const auto& enames = location_error_names(session.machine);
-  for (int k = 0; k < 8; ++k)
-    out.cold.push_back(est(L.errors.offset + k, enames[static_cast<std::size_t>(k)]));
-  for (int k = 0; k < 3; ++k)
-    out.cold.push_back(est(L.sphere.offset + k, std::string("sphere.") + "xyz"[k]));
-  for (std::size_t l = 0; l < L.tau.size(); ++l) {
-    ThermalLag lag;
-    const Eigen::Index jq = L.tau[l].offset;
-    const bool tau_free = fit.free[static_cast<std::size_t>(jq)];
-    lag.tau_s = 300.0 * std::exp(fit.values[jq]);
-    lag.tau_std_s = lag.tau_s * fit.estimates[static_cast<std::size_t>(jq)].std;
-    lag.tau_observable = tau_free && fit.estimates[static_cast<std::size_t>(jq)].observable;
-    out.tau_index.push_back(static_cast<int>(jq));
-    out.gain_index.push_back(static_cast<int>(L.gains[l].offset));
-    for (int k = 0; k < 11; ++k) {
-      const std::string name = k < 8 ? enames[static_cast<std::size_t>(k)] : kPointGains[k - 8];
-      ThermalGainEstimate g = est(L.gains[l].offset + k, name);
-      const ThermalGainEstimate& c = out.cold[static_cast<std::size_t>(k)];
-      if (!g.observable) g.reason = gain_reason(c.observable, heated, c.name);
-      lag.gains.push_back(g);
-    }
-    out.lags.push_back(std::move(lag));
-  }
-  out.parameters = fit.estimates;
-  out.covariance = fit.covariance;
-  out.unobservable = fit.unobservable;
-  out.converged = fit.summary.converged;
-  out.residual_rms_um =
-      std::sqrt(fit.residuals.squaredNorm() / static_cast<double>(fit.residuals.size())) * 1e3;
-  if (nf.refit) out.noise = nf.noise.summary();
-  if (!out.converged) out.notes.push_back("the fit did not converge: " + fit.summary.message);
-  if (!heated) out.notes.push_back("no duty: an ordinary session, its thermal gains unobservable");
   return out;
 }
 

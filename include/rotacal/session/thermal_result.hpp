@@ -13,6 +13,7 @@
 
 #include "rotacal/core/estimate.hpp"
 #include "rotacal/core/fit_with_noise.hpp"
+#include "rotacal/core/joint_fit.hpp"
 #include "rotacal/kinematics/machine.hpp"
 
 namespace rotacal {
@@ -58,5 +59,29 @@ struct ThermalIdentification {
   std::string noise;  ///< the noise model's summary (empty: white)
   std::vector<std::string> notes;
 };
+
+/// Where a thermal fit keeps what: parameter indices of the cold values, of each lag's ln tau
+/// and first gain, the gains' names and the cold value each gain moves (-1: none), so that
+/// every instrument's thermal fit runs and reports through the same two functions below.
+struct ThermalFitIndex {
+  std::vector<int> cold;                ///< parameter index of each cold value
+  std::vector<std::string> cold_names;  ///< their names
+  std::vector<int> tau;                 ///< per lag: index of ln(tau / 300 s)
+  std::vector<int> gains;               ///< per lag: index of its first gain
+  std::vector<std::string> gain_names;  ///< per gain of a lag
+  std::vector<int> gain_cold;           ///< per gain: its cold value in `cold`, -1 none
+};
+
+/// The joint fit: tau held, then free (core/time_constant_fit.hpp), with the noise model of
+/// core/fit_with_noise.hpp; without heat input (`heated` false) tau and the gains are held at
+/// their start (0: nothing moves them).
+NoiseFit fit_thermal(const ResidualModel& model, std::vector<FitParameter> params,
+                     const ThermalFitIndex& index, bool heated, const JointFitSettings& settings,
+                     const std::vector<std::string>& groups, const std::vector<double>& times,
+                     const ThermalFitOptions& options);
+
+/// The result of fit_thermal in the instrument's words (axis, speed and counts left to it).
+ThermalIdentification thermal_identification(const NoiseFit& nf, const ThermalFitIndex& index,
+                                             bool heated);
 
 }  // namespace rotacal
