@@ -136,4 +136,42 @@ nlohmann::ordered_json to_json(const ThermalSummary& s) {
   return j;
 }
 
+namespace {
+nlohmann::ordered_json estimate_json(const ThermalGainEstimate& g) {
+  nlohmann::ordered_json e = {{"name", g.name}, {"unit", g.unit}, {"observable", g.observable}};
+  if (g.observable) {
+    e["value"] = g.value;
+    e["std"] = g.std;
+  } else {
+    e["reason"] = g.reason;
+  }
+  return e;
+}
+}  // namespace
+
+nlohmann::ordered_json to_json(const ThermalIdentification& id) {
+  nlohmann::ordered_json j;
+  j["machine"] = to_string(id.machine);
+  j["axis"] = id.axis ? std::string(1, id.axis) : std::string();
+  j["tested_speed_rpm"] = id.tested_speed_rpm;
+  j["converged"] = id.converged;
+  j["n_samples"] = id.n_samples;
+  j["n_epochs"] = id.n_epochs;
+  j["residual_rms_um"] = id.residual_rms_um;
+  j["noise_model"] = id.noise;
+  j["cold"] = nlohmann::ordered_json::array();
+  for (const ThermalGainEstimate& c : id.cold) j["cold"].push_back(estimate_json(c));
+  j["lags"] = nlohmann::ordered_json::array();
+  for (const ThermalLag& l : id.lags) {
+    nlohmann::ordered_json lag = {
+        {"tau_s", l.tau_s}, {"tau_std_s", l.tau_std_s}, {"tau_observable", l.tau_observable}};
+    lag["gains"] = nlohmann::ordered_json::array();
+    for (const ThermalGainEstimate& g : l.gains) lag["gains"].push_back(estimate_json(g));
+    j["lags"].push_back(lag);
+  }
+  j["unobservable"] = id.unobservable;
+  j["notes"] = id.notes;
+  return j;
+}
+
 }  // namespace rotacal

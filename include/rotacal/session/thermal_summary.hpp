@@ -52,5 +52,7 @@ ThermalSummary thermal_summary(const ThermalIdentification& id,
 
 /// The summary as JSON (the CLI's --json and the Python binding).
 nlohmann::ordered_json to_json(const ThermalSummary& s);
+/// The identification as JSON: cold values and each lag's tau and gains, with sigma or reason.
+nlohmann::ordered_json to_json(const ThermalIdentification& id);
 
 }  // namespace rotacal

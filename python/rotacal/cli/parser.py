@@ -37,6 +37,7 @@ from . import (
     plan,
     probe,
     simulate,
+    thermal,
 )
 from .options import EPILOG, EXIT_ERROR, EXIT_INPUT, EXIT_IO, EXIT_OK, OptionError, say
 
@@ -55,6 +56,7 @@ MODULES = (
     probe,
     design_probe,
     batch,
+    thermal,
 )
 
 # The order `rotacal --help` lists the commands in.

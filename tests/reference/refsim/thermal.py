@@ -90,3 +90,17 @@ def drifted(errors: dict, table_point, lags, duty, time, epoch):
             else:
                 errs[name] = errs.get(name, np.zeros(len(time))) + k * y
     return errs, q
+
+
+def add_thermal_columns(path, duty, epoch) -> None:
+    """Turn a probe or R-test file written by writers.py into a thermal session: `# duty.N:`
+    lines after the metadata, and the `epoch` column last (formats.md)."""
+    from pathlib import Path
+
+    lines = Path(path).read_text(encoding="utf-8").splitlines()
+    head = [ln for ln in lines if ln.startswith("#")]
+    body = [ln for ln in lines if not ln.startswith("#")]
+    for n, (t, speeds) in enumerate(duty, start=1):
+        head.append(f"# duty.{n}: {t:g}, " + ", ".join(f"{a}={v:g}" for a, v in speeds.items()))
+    body = [body[0] + ",epoch"] + [f"{r},{int(e)}" for r, e in zip(body[1:], epoch)]
+    Path(path).write_text("\n".join(head + body) + "\n", encoding="utf-8")
