@@ -16,7 +16,7 @@ import refsim  # noqa: E402
 from refsim import thermal, writers  # noqa: E402
 
 from conftest import run_cli as run  # noqa: E402
-from conftest import truth  # noqa: E402
+from conftest import SHARED, truth  # noqa: E402
 
 
 def test_shared_thermal_probe_identified(shared_data):
@@ -43,36 +43,45 @@ def test_shared_thermal_probe_identified(shared_data):
     assert "lag 1: tau = " in text.stdout and "never exceeds 5.000 um" in text.stdout
 
 
-def _null_session(path, seed=1):
+def _refsim_session(path, lags, seed=1, interval_s=1200.0):
     """AC-trt probe, C at 300 rev/min for 4 h then at rest to 6 h, an epoch of 8 poses x 5
-    touches every 20 min; no drift at all, 0.5 um white noise along each approach."""
-    m = refsim.Model("AC-trt", {"E_X0C": 0.02, "E_Y0C": -0.01, "E_Y0A": 0.03, "E_Z0A": -0.01})
+    touches every `interval_s`; the shared file's cold errors and set-up, the drift of `lags`
+    (refsim.thermal: the truth's "thermal" list), 0.5 um white noise along each approach."""
+    t = truth(SHARED / "thermal_probe_ac.csv")
     dirs = refsim.poses.probe_directions()
     poses = [(0.0, c) for c in (0, 90, 180, 270)] + [(a, 0.0) for a in (-60, -30, 30, 60)]
     pose, time, ang, n, epoch = [], [], [], [], []
-    for e in range(19):
+    for e in range(int(6 * 3600 / interval_s) + 1):
         for k, (a, c) in enumerate(poses):
             for j, d in enumerate(dirs):
                 pose.append(len(poses) * e + k + 1)
-                time.append(1200.0 * e + 16.0 * k + 2.0 * j)
+                time.append(interval_s * e + 16.0 * k + 2.0 * j)
                 ang.append((a, c))
                 n.append(d)
                 epoch.append(e + 1)
     s = {"pose": pose, "time": np.array(time), "angles_deg": np.array(ang), "n": np.array(n)}
     s["sphere"] = np.array([150.0, 0.0, 80.0])
-    sphere_actual = s["sphere"] + [0.01, -0.02, 0.005]
+    duty = [(0.0, {"C": 300.0}), (14400.0, {"C": 0.0})]
+    errors, sphere = thermal.drifted(t["errors"], t["sphere_actual"], lags, duty, time, epoch)
     latched = refsim.probe_touches(
-        m, sphere_actual, s["sphere"], 25.0, 6.0, s["n"], np.radians(s["angles_deg"]), s["time"]
+        refsim.Model("AC-trt", errors),
+        sphere,
+        s["sphere"],
+        25.0,
+        6.0,
+        s["n"],
+        np.radians(s["angles_deg"]),
+        s["time"],
     )
     rng = np.random.default_rng(seed)
     latched = latched + s["n"] * (5e-4 * rng.standard_normal(len(time)))[:, None]
-    writers.write_probe(path, m.machine, s, latched, 25.0, 6.0, noise_um=0.5)
-    thermal.add_thermal_columns(path, [(0.0, {"C": 300.0}), (14400.0, {"C": 0.0})], epoch)
+    writers.write_probe(path, refsim.builtin("AC-trt"), s, latched, 25.0, 6.0, noise_um=0.5)
+    thermal.add_thermal_columns(path, duty, epoch)
     return path
 
 
 def test_no_drift_gives_no_significant_drift(tmp_path):
-    r = run("identify", _null_session(tmp_path / "null.csv"), "--tolerance", "5um", "--json")
+    r = run("identify", _refsim_session(tmp_path / "null.csv", []), "--tolerance", "5um", "--json")
     assert r.returncode == 0, r.stderr
     drifts = json.loads(r.stdout)["summary"]["drifts"]
     assert len(drifts) == 11
@@ -84,6 +93,29 @@ def test_no_drift_gives_no_significant_drift(tmp_path):
             assert e["exceeds_after_s"] is None, e
         else:  # no tolerance given for the orientations: no time either
             assert "tolerance" not in e and "exceeds_after_s" not in e
+
+
+def test_two_lags_identified(tmp_path):
+    """tau2 = 4 tau1, K2 = 0.7 K1 (the issue's two-lag case) in a 6 h test, epochs every 10 min:
+    both taus and all 22 gains within 3 sigma; one lag leaves a lack of fit."""
+    k1 = truth(SHARED / "thermal_probe_ac.csv")["thermal"][0]["gains"]
+    lags = [
+        {"axis": "C", "tau_s": 1200.0, "gains": k1},
+        {"axis": "C", "tau_s": 4800.0, "gains": {k: 0.7 * v for k, v in k1.items()}},
+    ]
+    f = _refsim_session(tmp_path / "two.csv", lags, interval_s=600.0)
+    r = run("identify", f, "--lags", "2", "--noise", "white", "--json")
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout)["identification"]
+    assert d["converged"] and len(d["lags"]) == 2
+    for got, want in zip(d["lags"], lags):
+        assert abs(got["tau_s"] - want["tau_s"]) <= 3 * got["tau_std_s"], got["tau_s"]
+        for g in got["gains"]:
+            assert g["observable"], g
+            assert abs(g["value"] - want["gains"][g["name"]]) <= 3 * g["std"], g
+    assert d["residual_rms_um"] < 0.55  # noise 0.5 um
+    one = json.loads(run("identify", f, "--noise", "white", "--json").stdout)["identification"]
+    assert one["residual_rms_um"] > 0.65  # 0.71 um: one lag cannot follow both
 
 
 HEAD = (
