@@ -2,6 +2,7 @@
 // The epoch column and duty lines of a thermal session (formats.md "Thermal test").
 #include "rotacal/io/thermal_file.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -104,6 +105,9 @@ ThermalSession read_thermal_session(const std::string& path) {
   }
   Reader R;
   R.name = path;
+  out.warnings.erase(
+      std::remove(out.warnings.begin(), out.warnings.end(), std::string(kThermalSessionPooled)),
+      out.warnings.end());  // this reader fits the drift
   std::ifstream in = open_for_reading(path);
   const RawFile raw = read_structure(in, R, format);
   ThermalTest& th = out.thermal;

@@ -103,6 +103,8 @@ ThermalSummary thermal_summary(const ThermalIdentification& id,
     if (d.tolerance) d.exceeds_after_s = first_exceedance(curve, *d.tolerance, tau_max);
     s.drifts.push_back(d);
   }
+  s.no_significant_drift = std::none_of(s.drifts.begin(), s.drifts.end(),
+                                        [](const ThermalDrift& d) { return d.significant; });
   return s;
 }
 
@@ -110,6 +112,7 @@ nlohmann::ordered_json to_json(const ThermalSummary& s) {
   nlohmann::ordered_json j;
   j["axis"] = s.axis ? std::string(1, s.axis) : std::string();
   j["tested_speed_rpm"] = s.tested_speed_rpm;
+  j["no_significant_drift"] = s.no_significant_drift;
   j["lags"] = nlohmann::ordered_json::array();
   for (std::size_t l = 0; l < s.tau_s.size(); ++l)
     j["lags"].push_back({{"tau_s", s.tau_s[l]},

@@ -2,6 +2,7 @@
 // The epoch column and `# duty.N:` lines of a thermal session (io/thermal_file.hpp).
 #include <unistd.h>
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
@@ -141,4 +142,16 @@ TEST_CASE("an epoch column without duty is an ordinary session; early duty warns
   CHECK_THAT(b.warnings[0], Catch::Contains("starts at 0 at the first row"));
   std::filesystem::remove(p1);
   std::filesystem::remove(p2);
+}
+
+TEST_CASE("the ordinary readers pool a thermal session's epochs and warn that it drifts",
+          "[io][thermal]") {
+  const ProbeSession p = read_probe(kShared + "/data/thermal_probe_ac.csv");
+  CHECK(p.samples.size() == 1480);
+  CHECK(std::count(p.warnings.begin(), p.warnings.end(), kThermalSessionPooled) == 1);
+  const auto r = std::get<RtestSession>(read_session(kShared + "/data/thermal_rtest_bc.csv"));
+  CHECK(std::count(r.warnings.begin(), r.warnings.end(), kThermalSessionPooled) == 1);
+  CHECK(read_probe(kShared + "/data/probe_ac_table2.csv").warnings.empty());
+  const ThermalSession t = read_thermal_session(kShared + "/data/thermal_probe_ac.csv");
+  CHECK(t.warnings.empty());
 }

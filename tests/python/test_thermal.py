@@ -31,7 +31,7 @@ def test_shared_thermal_probe_identified(shared_data):
         assert g["observable"], g
         assert abs(g["value"] - t["gains"][g["name"]]) <= 3 * g["std"], g
     s = d["summary"]
-    assert s["axis"] == "C" and s["tested_speed_rpm"] == 300
+    assert s["axis"] == "C" and s["tested_speed_rpm"] == 300 and not s["no_significant_drift"]
     by_name = {e["name"]: e for e in s["drifts"]}
     x = by_name["E_X0C"]  # truth -7.7 um per 100 rev/min: -23 um at 300, over 5 um
     assert x["significant"] and x["tolerance"] == pytest.approx(0.005)
@@ -83,7 +83,9 @@ def _refsim_session(path, lags, seed=1, interval_s=1200.0):
 def test_no_drift_gives_no_significant_drift(tmp_path):
     r = run("identify", _refsim_session(tmp_path / "null.csv", []), "--tolerance", "5um", "--json")
     assert r.returncode == 0, r.stderr
-    drifts = json.loads(r.stdout)["summary"]["drifts"]
+    summary = json.loads(r.stdout)["summary"]
+    assert summary["no_significant_drift"]
+    drifts = summary["drifts"]
     assert len(drifts) == 11
     for e in drifts:
         assert e["observable"], e

@@ -44,6 +44,8 @@ struct ThermalSummary {
   std::vector<double> tau_s, tau_std_s;  ///< per lag
   std::vector<bool> tau_observable;
   std::vector<ThermalDrift> drifts;  ///< location errors, then q_x, q_y, q_z
+  /// True when no determined drift is significant: tau then rests on noise alone.
+  bool no_significant_drift = false;
 };
 
 /// The summary of `id` (throws InvalidArgument for a tolerance <= 0 or not finite).

@@ -14,6 +14,16 @@
 
 namespace rotacal {
 
+/// What a reader that pools the epochs (read_probe, read_session) says of a file with duty
+/// lines (formats.md: it reads a thermal session as an ordinary one and warns that it drifts);
+/// read_thermal_session, which fits the drift, leaves it out.
+inline constexpr const char* kThermalSessionPooled =
+    "a thermal session (# duty.N: lines): read as an ordinary session with its epochs pooled, "
+    "though its location errors drift; `rotacal identify` fits the drift (docs/thermal.md)";
+
+/// True for a metadata key of a duty entry ("duty.1", ...).
+inline bool is_duty_key(const std::string& key) { return key.rfind("duty.", 0) == 0; }
+
 /// One `# duty.N:` entry.
 struct DutyEntry {
   double time = 0.0;                           ///< s, the rows' clock

@@ -121,6 +121,8 @@ def print_thermal(d: dict) -> None:
             else "unobservable"
         )
         print(f"lag {k}: tau = {tau}")
+    if s["no_significant_drift"]:
+        print("no significant drift of any location error: tau rests on the noise alone")
     print(f"steady-state change after long turning at {s['tested_speed_rpm']:g} rev/min:")
     for e in s["drifts"]:
         if not e["observable"]:
