@@ -20,7 +20,7 @@ void bind_thermal(pyb::module_& m) {
   m.def(
       "identify_thermal",
       [](const std::string& path, int lags, std::optional<double> tolerance_mm,
-         std::optional<double> tolerance_rad, const std::string& noise) {
+         std::optional<double> tolerance_rad, const std::string& noise, bool peer) {
         nlohmann::ordered_json j;
         {
           pyb::gil_scoped_release release;
@@ -34,12 +34,21 @@ void bind_thermal(pyb::module_& m) {
                   : identify_thermal_rtest(std::get<RtestSession>(t.session), t.thermal, o);
           j["identification"] = to_json(id);
           j["summary"] = to_json(thermal_summary(id, {tolerance_mm, tolerance_rad}));
+          if (peer) {
+            if (!std::holds_alternative<ProbeSession>(t.session))
+              throw InvalidArgument(path + ": the per-epoch peer is for touch-probe sessions");
+            const ThermalIdentification p =
+                thermal_peer_probe(std::get<ProbeSession>(t.session), t.thermal, o);
+            j["peer"] = {{"identification", to_json(p)},
+                         {"summary", to_json(thermal_summary(p, {tolerance_mm, tolerance_rad}))}};
+          }
           j["warnings"] = t.warnings;
         }
         return from_json(j);
       },
       pyb::arg("path"), pyb::arg("lags") = 1, pyb::arg("tolerance_mm") = std::nullopt,
       pyb::arg("tolerance_rad") = std::nullopt, pyb::arg("noise") = "auto",
+      pyb::arg("peer") = false,
       R"(Identify a thermal probe or R-test session (one joint fit over every row).
 
 Parameters
@@ -53,6 +62,9 @@ tolerance_mm, tolerance_rad : float, optional
     The drift the user tolerates, for the time from cold after which it may exceed it.
 noise : str
     "auto": AR noise model of the residuals, GLS refit when correlated; "white".
+peer : bool
+    Also the per-epoch peer (touch probe): each epoch identified alone, then one lag fitted
+    to the series; under ``peer``, as the joint fit's.
 
 Returns
 -------

@@ -4165,7 +4165,7 @@ def identify_runs(setup: BallbarSetup, machines: collections.abc.Sequence[Ballba
     -------
     (N, 8) identified location errors, mm and rad, in location_error_names order
     """
-def identify_thermal(path: str, lags: typing.SupportsInt | typing.SupportsIndex = 1, tolerance_mm: typing.SupportsFloat | typing.SupportsIndex | None = None, tolerance_rad: typing.SupportsFloat | typing.SupportsIndex | None = None, noise: str = 'auto') -> typing.Any:
+def identify_thermal(path: str, lags: typing.SupportsInt | typing.SupportsIndex = 1, tolerance_mm: typing.SupportsFloat | typing.SupportsIndex | None = None, tolerance_rad: typing.SupportsFloat | typing.SupportsIndex | None = None, noise: str = 'auto', peer: bool = False) -> typing.Any:
     """
     Identify a thermal probe or R-test session (one joint fit over every row).
     
@@ -4180,6 +4180,9 @@ def identify_thermal(path: str, lags: typing.SupportsInt | typing.SupportsIndex 
         The drift the user tolerates, for the time from cold after which it may exceed it.
     noise : str
         "auto": AR noise model of the residuals, GLS refit when correlated; "white".
+    peer : bool
+        Also the per-epoch peer (touch probe): each epoch identified alone, then one lag fitted
+        to the series; under ``peer``, as the joint fit's.
     
     Returns
     -------

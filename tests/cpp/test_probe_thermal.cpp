@@ -115,3 +115,27 @@ TEST_CASE("thermal summary of the shared probe session", "[probe][thermal]") {
   CHECK(j["lags"][0]["tau_s"].get<double>() == tau);
   CHECK_THROWS_AS(thermal_summary(id, ThermalSummaryOptions{-1.0, {}}), InvalidArgument);
 }
+
+TEST_CASE("the per-epoch peer on the shared probe session", "[probe][thermal]") {
+  const ThermalSession t = read_thermal_session(kShared + "/data/thermal_probe_ac.csv");
+  const auto& s = std::get<ProbeSession>(t.session);
+  const ThermalIdentification joint = identify_thermal_probe(s, t.thermal);
+  const ThermalIdentification peer = thermal_peer_probe(s, t.thermal);
+  const auto truth = truth_of("thermal_probe_ac.truth.json");
+  const auto& lag = truth["thermal"][0];
+  REQUIRE(peer.converged);
+  REQUIRE(peer.lags.size() == 1);
+  CHECK(peer.n_epochs == 37);
+  INFO("peer tau " << peer.lags[0].tau_s << " +- " << peer.lags[0].tau_std_s << ", joint "
+                   << joint.lags[0].tau_s << " +- " << joint.lags[0].tau_std_s);
+  CHECK(std::abs(peer.lags[0].tau_s - lag["tau_s"].get<double>()) <= 3.0 * peer.lags[0].tau_std_s);
+  // The joint fit uses every touch through one model: its sigma is not larger than the peer's.
+  CHECK(joint.lags[0].tau_std_s <= peer.lags[0].tau_std_s);
+  for (std::size_t k = 0; k < peer.lags[0].gains.size(); ++k) {
+    const ThermalGainEstimate& g = peer.lags[0].gains[k];
+    INFO(g.name << " peer " << g.value << " +- " << g.std << " joint "
+                << joint.lags[0].gains[k].value << " +- " << joint.lags[0].gains[k].std);
+    if (!g.observable) continue;
+    CHECK(std::abs(g.value - lag["gains"][g.name].get<double>()) <= 3.0 * g.std);
+  }
+}

@@ -37,10 +37,12 @@ def test_shared_thermal_probe_identified(shared_data):
     assert x["significant"] and x["tolerance"] == pytest.approx(0.005)
     assert 0 < x["exceeds_after_s"] < t["tau_s"]
     assert by_name["E_A0C"]["tolerance"] == pytest.approx(1e-5)
-    text = run("identify", f, "--tolerance", "5um")
+    text = run("identify", f, "--tolerance", "5um", "--peer")
     assert text.returncode == 0, text.stderr
-    assert "thermal test of axis C at 300 rev/min: 1480 rows in 37 epochs" in text.stdout
-    assert "lag 1: tau = " in text.stdout and "never exceeds 5.000 um" in text.stdout
+    joint, peer = text.stdout.split("the per-epoch peer")
+    assert "thermal test of axis C at 300 rev/min: 1480 rows in 37 epochs" in joint
+    assert "lag 1: tau = " in joint and "never exceeds 5.000 um" in joint
+    assert "lag 1: tau = " in peer and "note: per-epoch peer" in peer
 
 
 def _refsim_session(path, lags, seed=1, interval_s=1200.0):

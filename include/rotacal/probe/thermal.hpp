@@ -27,6 +27,12 @@ ThermalIdentification identify_thermal_probe(const ProbeSession& session,
                                              const ThermalTest& thermal,
                                              const ThermalFitOptions& options = {});
 
+/// The per-epoch peer (session/thermal_series.hpp): each epoch's touches identified alone
+/// (identify_probe, white noise), then one lag fitted to the 11 series (location errors and
+/// the sphere's x, y, z as the table-side point). Same exceptions as identify_thermal_probe.
+ThermalIdentification thermal_peer_probe(const ProbeSession& session, const ThermalTest& thermal,
+                                         const ThermalFitOptions& options = {});
+
 /// Touch residuals (mm) of a thermal model given as the fit's parameter vector (tests, peer).
 Eigen::VectorXd thermal_probe_residuals(const ProbeSession& session, const ThermalTest& thermal,
                                         int lags, const Eigen::VectorXd& x);

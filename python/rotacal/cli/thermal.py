@@ -25,7 +25,7 @@ _TOLERANCE_UNITS = {
     "rad": ("rad", 1.0),
 }
 # Options of `identify` a thermal session uses; the others are refused rather than ignored.
-_THERMAL_DESTS = {"command", "func", "file", "json", "noise", "tolerance", "lags"}
+_THERMAL_DESTS = {"command", "func", "file", "json", "noise", "tolerance", "lags", "peer"}
 
 
 def tolerance(text: str) -> tuple[str, float]:
@@ -59,6 +59,12 @@ def add_identify(sub: argparse._SubParsersAction) -> None:
         default=1,
         help="thermal session: first-order lags of the drift, 1 (default) or 2",
     )
+    q.add_argument(
+        "--peer",
+        action="store_true",
+        help="thermal probe session: also the per-epoch peer (each epoch identified alone, then "
+        "one lag fitted to the series: what a kinematics cycle re-run at intervals gives)",
+    )
     q.set_defaults(func=cmd_identify)
     defaults = {act.dest: act.default for act in q._actions if act.dest not in _THERMAL_DESTS}
     q.set_defaults(_identify_defaults=defaults)
@@ -75,9 +81,9 @@ def _refuse_other_options(a: argparse.Namespace) -> None:
 
 def cmd_identify(a: argparse.Namespace) -> int:
     if len(a.file) != 1 or not _core.is_thermal_session(a.file[0]):
-        if a.tolerance or a.lags != 1:
+        if a.tolerance or a.lags != 1 or a.peer:
             raise OptionError(
-                "--tolerance, --lags: for a thermal session (an epoch column and duty lines)"
+                "--tolerance, --lags, --peer: for a thermal session (an epoch column and duty lines)"
             )
         return identify.cmd_identify(a)
     _refuse_other_options(a)
@@ -86,13 +92,18 @@ def cmd_identify(a: argparse.Namespace) -> int:
         if unit in tol:
             raise OptionError(f"--tolerance: given twice in {'um' if unit == 'mm' else 'urad'}")
         tol[unit] = value
-    d = _core.identify_thermal(a.file[0], a.lags, tol.get("mm"), tol.get("rad"), noise=a.noise)
+    d = _core.identify_thermal(
+        a.file[0], a.lags, tol.get("mm"), tol.get("rad"), noise=a.noise, peer=a.peer
+    )
     for w in d["warnings"]:
         say(f"rotacal: warning: {w}")
     if a.json:
         print(jsontext.dumps(d))
     else:
         print_thermal(d)
+        if "peer" in d:
+            print("\nthe per-epoch peer (each epoch alone, then one lag fitted to the series):")
+            print_thermal(d["peer"])
     return EXIT_OK
 
 
@@ -107,10 +118,12 @@ def _value(x: float, unit: str) -> str:
 def print_thermal(d: dict) -> None:
     ident, s = d["identification"], d["summary"]
     axis = s["axis"] or "-"
+    rms = ident["residual_rms_um"]  # 0 for the peer, whose residuals are per epoch
     print(
         f"thermal test of axis {axis} at {s['tested_speed_rpm']:g} rev/min: "
-        f"{ident['n_samples']} rows in {ident['n_epochs']} epochs, residual RMS "
-        f"{ident['residual_rms_um']:.3f} um{'' if ident['converged'] else ' (NOT converged)'}"
+        f"{ident['n_samples']} rows in {ident['n_epochs']} epochs"
+        f"{f', residual RMS {rms:.3f} um' if rms > 0 else ''}"
+        f"{'' if ident['converged'] else ' (NOT converged)'}"
     )
     if ident["noise_model"]:
         print(f"noise model: {ident['noise_model']}")
