@@ -83,7 +83,11 @@ class ThermalProbeModel : public ResidualModel {
         ThermalGains<T> k;
         k.errors = Eigen::Map<const Eigen::Matrix<T, 8, 1>>(g);
         k.point = Vec3<T>(g[8], g[9], g[10]);
-        const T y = lag_state<T>(heat_, t.time, thermal_tau<T>(L_.tau[l].ptr(p)[0]));
+        // Rows come in order within a pass (evaluate_with_jets): one tracker per lag and
+        // scalar type continues from the previous row.
+        static thread_local LagTracker<T> track[2];
+        const T y =
+            track[l].at(static_cast<long>(i), heat_, t.time, thermal_tau<T>(L_.tau[l].ptr(p)[0]));
         e = drifted_errors<T>(e, k, y);
         sphere = drifted_point<T>(sphere, k, y);
       }

@@ -78,7 +78,9 @@ class ThermalRtestModel : public ResidualModel {
         ThermalGains<T> K;
         K.errors = Eigen::Map<const Eigen::Matrix<T, 8, 1>>(g);
         K.point = Vec3<T>(g[8 + 3 * setup], g[9 + 3 * setup], g[10 + 3 * setup]);
-        const T y = lag_state<T>(heat_, d_.time[k], thermal_tau<T>(L_.tau[l].ptr(p)[0]));
+        static thread_local LagTracker<T> track[2];  // rows in order: continue (thermal_lag)
+        const T y = track[l].at(static_cast<long>(i), heat_, d_.time[k],
+                                thermal_tau<T>(L_.tau[l].ptr(p)[0]));
         e = drifted_errors<T>(e, K, y);
         nest_shift = drifted_point<T>(nest_shift, K, y);
       }

@@ -100,6 +100,12 @@ TEST_CASE("lag state: closed form by hand and the one-pass form agree", "[therma
     CHECK(all[i] == Approx(want[i]).margin(1e-15));
   }
   CHECK(thermal_tau(std::log(8.0)) == Approx(2400.0));
+  // The tracker continues row after row, and starts over when a row is not the next one.
+  LagTracker<double> track;
+  for (int pass = 0; pass < 2; ++pass)
+    for (std::size_t i = 0; i < t.size(); ++i)
+      CHECK(track.at(static_cast<long>(i), h, t[i], 40.0) == Approx(want[i]).margin(1e-15));
+  CHECK(track.at(2, h, t[2], 40.0) == Approx(want[2]).margin(1e-15));
 }
 
 TEST_CASE("thermal sessions refused by file and line", "[io][thermal]") {
