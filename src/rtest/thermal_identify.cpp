@@ -131,6 +131,24 @@ ThermalIdentification identify_thermal_rtest(const RtestSession& session,
     index.tau.push_back(static_cast<int>(L.tau[l].offset));
     index.gains.push_back(static_cast<int>(L.gains[l].offset));
   }
+  // formats.md: a nest dismounted between epochs is a set-up per epoch, whose probe zero takes
+  // the nest's drift: its gains are held and reported so, not fitted to the decay within one
+  // epoch (which would leave them "determined" at +-70 um).
+  std::vector<bool> dismounted(model.arrays().setups.size(), false);
+  if (axis != 0) {
+    std::vector<std::pair<int, int>> span(dismounted.size(), {-1, -1});  // first, last epoch
+    for (std::size_t i = 0; i < session.samples.size(); ++i) {
+      auto& sp = span[static_cast<std::size_t>(model.arrays().setup_of[i])];
+      if (sp.first < 0) sp.first = thermal.epoch[i];
+      sp.second = thermal.epoch[i];
+    }
+    for (std::size_t s = 0; s < dismounted.size(); ++s) {
+      dismounted[s] = span[s].first == span[s].second;
+      for (std::size_t l = 0; l < L.gains.size() && dismounted[s]; ++l)
+        for (int a = 0; a < 3; ++a)
+          params[static_cast<std::size_t>(L.gains[l].offset) + 8 + 3 * s + a].held = true;
+    }
+  }
   JointFitSettings settings;
   settings.max_iterations = options.max_iterations;
   settings.observability_min_chi2 = options.observability_min_chi2;
@@ -144,6 +162,15 @@ ThermalIdentification identify_thermal_rtest(const RtestSession& session,
   o.noise.allow_reml = true;  // the probe zeros may wander (rtest/identify_joint.cpp)
   const NoiseFit nf = fit_thermal(model, params, index, heated, settings, groups, times, o);
   ThermalIdentification out = thermal_identification(nf, index, heated);
+  for (ThermalLag& lag : out.lags)
+    for (std::size_t s = 0; s < dismounted.size(); ++s)
+      for (int a = 0; a < 3 && dismounted[s]; ++a) {
+        ThermalGainEstimate& g = lag.gains[8 + 3 * s + static_cast<std::size_t>(a)];
+        g.observable = false;
+        g.reason = "the nest of set-up " + model.arrays().setups[s] +
+                   " was measured in one epoch only (dismounted between epochs): its probe "
+                   "zero takes the nest's drift";
+      }
   out.machine = session.machine;
   out.axis = axis;
   out.tested_speed_rpm = heated ? thermal.tested_speed(axis) : 0.0;

@@ -51,3 +51,24 @@ TEST_CASE("thermal_rtest_bc.csv: tau and every determinable gain within 3 sigma 
     CHECK(std::abs(c.value - want) <= 3.0 * c.std);
   }
 }
+
+TEST_CASE("a nest dismounted between epochs: its gains unobservable, for that reason",
+          "[rtest][thermal]") {
+  const ThermalSession t = read_thermal_session(kShared + "/data/thermal_rtest_bc.csv");
+  RtestSession s = std::get<RtestSession>(t.session);
+  const Eigen::Vector3d nest = s.nests.at("1");
+  s.nests.clear();
+  for (std::size_t i = 0; i < s.samples.size(); ++i) {  // each epoch a set-up of its own
+    s.samples[i].setup = std::to_string(t.thermal.epoch[i]);
+    s.nests[s.samples[i].setup] = nest;
+  }
+  const ThermalIdentification id = identify_thermal_rtest(s, t.thermal);
+  REQUIRE(id.lags[0].gains.size() == 8 + 3 * 28);
+  for (std::size_t k = 0; k < id.lags[0].gains.size(); ++k) {
+    const ThermalGainEstimate& g = id.lags[0].gains[k];
+    INFO(g.name << " " << g.reason);
+    CHECK(g.observable == (k < 8));
+    if (k >= 8) CHECK_THAT(g.reason, Catch::Contains("dismounted between epochs"));
+  }
+  CHECK(id.lags[0].tau_observable);
+}
