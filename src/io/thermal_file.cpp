@@ -15,13 +15,16 @@ using namespace io_detail;
 
 namespace {
 
-// "duty.N" -> N (0 when the key is not a duty entry).
+// "duty.N" -> N; 0 for a key that is not "duty."-anything (other metadata, kept as it is); -1
+// for "duty." followed by anything but a positive integer without leading zeros (< 1e6).
 int duty_number(const std::string& key) {
-  if (key.rfind("duty.", 0) != 0 || key.size() == 5 || key.size() > 12) return 0;
+  if (!is_duty_key(key)) return 0;
+  const std::string digits = key.substr(5);
+  if (digits.empty() || digits.size() > 6 || digits[0] == '0') return -1;
   int n = 0;
-  for (std::size_t i = 5; i < key.size(); ++i) {
-    if (key[i] < '0' || key[i] > '9') return -1;
-    n = 10 * n + (key[i] - '0');
+  for (char c : digits) {
+    if (c < '0' || c > '9') return -1;
+    n = 10 * n + (c - '0');
   }
   return n;
 }
@@ -60,8 +63,9 @@ std::vector<DutyEntry> read_duty(const Reader& R, MachineType m) {
   int count = 0;
   for (const auto& kv : R.metadata) {
     const int n = duty_number(kv.first);
-    if (n < 0 || (n == 0 && kv.first.rfind("duty", 0) == 0))
-      R.fail(R.meta_line(kv.first), 0, "'" + excerpt(kv.first) + "' is not a duty.N entry");
+    if (n < 0)
+      R.fail(R.meta_line(kv.first), 0,
+             "'" + excerpt(kv.first) + "' is not a duty.N entry (N = 1, 2, ...)");
     if (n > 0) ++count;
   }
   std::vector<DutyEntry> out;

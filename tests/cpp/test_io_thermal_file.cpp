@@ -128,6 +128,8 @@ TEST_CASE("thermal sessions refused by file and line", "[io][thermal]") {
   CHECK(refused_at(kHead + "# duty.1: 0, C=300\n# duty.3: 9, C=0\n" + kColumns + rows,
                    "duty.2 is missing") == 0);
   CHECK(refused_at(kHead + "# duty.1: 0, C:300\n" + kColumns + rows, "AXIS=SPEED") == 7);
+  CHECK(refused_at(kHead + "# duty.1: 0, C=300\n# duty.02: 9, C=0\n" + kColumns + rows,
+                   "is not a duty.N entry") == 8);
   CHECK(refused_at(kHead + "# duty.1: 0, C=fast\n" + kColumns + rows, "not a number") == 7);
   CHECK(refused_at(kHead + kColumns + row(1, 0, 0), "epoch") == 8);
   CHECK(refused_at(kHead + kColumns + "1,0.0,149.9,0.0,95.4,0,0,0,0,-1,1.5\n", "not an integer") ==
@@ -141,7 +143,8 @@ TEST_CASE("an epoch column without duty is an ordinary session; early duty warns
   const ThermalSession a = read_thermal_session(p1);
   CHECK(a.thermal.duty.empty());
   CHECK(a.thermal.axes().empty());
-  const std::string p2 = write_temp(kHead + "# duty.1: 0, C=-300\n" + kColumns + rows);
+  const std::string p2 =
+      write_temp(kHead + "# duty_notes: spindle off\n# duty.1: 0, C=-300\n" + kColumns + rows);
   const ThermalSession b = read_thermal_session(p2);
   CHECK(b.thermal.tested_speed('C') == 300.0);
   REQUIRE(b.warnings.size() == 1);
