@@ -8,6 +8,7 @@
 #include <set>
 
 #include "rotacal/io/output_file.hpp"
+#include "rotacal/session/thermal_test.hpp"
 #include "session_text.hpp"
 #include "strict_reader.hpp"
 
@@ -139,6 +140,11 @@ ProbeSession parse_probe(std::istream& in, const std::string& name) {
   }
   s.annotations = annotations_of(raw);
   dups.report(s.warnings);
+  for (const auto& kv : s.metadata)  // formats.md, thermal test: pooled, but it drifts
+    if (is_duty_key(kv.first)) {
+      s.warnings.push_back(kThermalSessionPooled);
+      break;
+    }
   return s;
 }
 

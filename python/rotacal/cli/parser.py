@@ -37,6 +37,7 @@ from . import (
     plan,
     probe,
     simulate,
+    thermal,
 )
 from .options import (
     EPILOG,
@@ -64,6 +65,7 @@ MODULES = (
     probe,
     design_probe,
     batch,
+    thermal,
 )
 
 # The order `rotacal --help` lists the commands in.

@@ -49,9 +49,11 @@ def homogeneous(
 
 
 def about_line(point: np.ndarray, unit_dir: np.ndarray, theta: np.ndarray) -> np.ndarray:
-    """x -> R (x - p) + p: rotation about the line through p along unit_dir (formats.md)."""
+    """x -> R (x - p) + p: rotation about the line through p along unit_dir (formats.md);
+    p and unit_dir (3,) or per pose (N, 3)."""
     r = rodrigues(unit_dir, theta)
-    return homogeneous(r, point - r @ point, len(theta))
+    p = np.broadcast_to(np.asarray(point, float), (len(theta), 3))
+    return homogeneous(r, p - (r @ p[..., None])[..., 0], len(theta))
 
 
 def error_motion(effects: dict, axis, theta: np.ndarray) -> np.ndarray:

@@ -77,20 +77,24 @@ class Axis:
         return [f"E_U0{r}", f"E_V0{r}", f"E_DU0{r}", f"E_DV0{r}"]
 
     def actual_line(self, errors: dict) -> tuple[np.ndarray, np.ndarray]:
-        """(point p0 + dp, unit(n + dn)) of the actual line (formats.md, "Location errors")."""
-        dp, dn = np.zeros(3), np.zeros(3)
+        """(point p0 + dp, unit(n + dn)) of the actual line (formats.md, "Location errors");
+        (N, 3) each where the errors are (N,) arrays (per-row errors of a thermal test)."""
+        shape = np.broadcast(*[np.asarray(v) for v in errors.values()], np.zeros(())).shape
+        dp, dn = np.zeros(shape + (3,)), np.zeros(shape + (3,))
         s = self.iso_sign
         if s:
             for k, name, sign in _ISO_DP[self.name]:
-                dp[k] += errors.get(name, 0.0) * sign
+                dp[..., k] += errors.get(name, 0.0) * sign
             for k, name, sign in _ISO_DN[self.name]:
-                dn[k] += errors.get(name, 0.0) * sign * s  # dn negated with n
+                dn[..., k] += errors.get(name, 0.0) * sign * s  # dn negated with n
         else:
             u, v = self.uv()
             r = self.name
-            dp = errors.get(f"E_U0{r}", 0.0) * u + errors.get(f"E_V0{r}", 0.0) * v
-            dn = errors.get(f"E_DU0{r}", 0.0) * u + errors.get(f"E_DV0{r}", 0.0) * v
-        return self.point + dp, unit(self.direction + dn)
+            g = lambda n: np.asarray(errors.get(n, 0.0))[..., None]  # noqa: E731
+            dp = g(f"E_U0{r}") * u + g(f"E_V0{r}") * v
+            dn = g(f"E_DU0{r}") * u + g(f"E_DV0{r}") * v
+        d = self.direction + dn
+        return self.point + dp, d / np.linalg.norm(d, axis=-1, keepdims=True)
 
 
 @dataclass
@@ -124,8 +128,11 @@ class Machine:
 
     def errors_dict(self, errors) -> dict:
         """Accept a dict (name -> value) or a vector in error_names() order."""
-        if isinstance(errors, dict):
-            return {k: float(v) for k, v in errors.items()}
+        if isinstance(errors, dict):  # a value may be an (N,) array: per-row errors (thermal.py)
+            return {
+                k: (float(v) if np.ndim(v) == 0 else np.asarray(v, float))
+                for k, v in errors.items()
+            }
         vals = np.zeros(8) if errors is None else np.asarray(errors, dtype=float)
         return dict(zip(self.error_names(), vals.tolist()))
 

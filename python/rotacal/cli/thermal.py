@@ -1,0 +1,162 @@
+# SPDX-License-Identifier: BSD-3-Clause
+"""``rotacal identify`` of a thermal session (issue 53; formats.md "Thermal test of a rotary
+axis"): a probe or R-test file with an ``epoch`` column and ``# duty.N:`` lines is identified by
+one joint fit over every row (probe/thermal.hpp, rtest/thermal.hpp), and its summary printed:
+per location error the steady-state change at the tested speed, whether it is significant, and
+after how long from cold it may exceed ``--tolerance``. Any other file goes to cli/identify.py.
+"""
+
+from __future__ import annotations
+
+import argparse
+import re
+
+from .. import _core, jsontext
+from . import identify
+from .options import EXIT_OK, OptionError, number, say
+
+# --tolerance units -> (native unit, factor to it)
+_TOLERANCE_UNITS = {
+    "nm": ("mm", 1e-6),
+    "um": ("mm", 1e-3),
+    "mm": ("mm", 1.0),
+    "urad": ("rad", 1e-6),
+    "mrad": ("rad", 1e-3),
+    "rad": ("rad", 1.0),
+}
+# Options of `identify` a thermal session uses; the others are refused rather than ignored.
+_THERMAL_DESTS = {"command", "func", "file", "json", "noise", "tolerance", "lags", "peer"}
+
+
+def tolerance(text: str) -> tuple[str, float]:
+    """argparse type: '5um', '10urad' -> ('mm', 0.005), ('rad', 1e-5)."""
+    m = re.fullmatch(r"\s*([0-9.eE+-]+)\s*([a-z]+)\s*", text)
+    if not m or m.group(2) not in _TOLERANCE_UNITS:
+        raise OptionError(
+            f"--tolerance: '{text[:40]}' is not a number with a unit "
+            f"({', '.join(_TOLERANCE_UNITS)}), e.g. 5um or 10urad"
+        )
+    unit, factor = _TOLERANCE_UNITS[m.group(2)]
+    value = number("--tolerance", 0.0, 1e6, lo_open=True)(m.group(1))
+    return unit, value * factor
+
+
+def add_identify(sub: argparse._SubParsersAction) -> None:
+    identify.add_identify(sub)
+    q = sub.choices["identify"]
+    q.add_argument(
+        "--tolerance",
+        action="append",
+        type=tolerance,
+        metavar="VALUE",
+        help="thermal session: the drift tolerated, e.g. 5um (positions, the table-side point) "
+        "or 10urad (orientations); repeat for both. The summary says after how long at the tested "
+        "speed from cold each error's 95 %% upper bound exceeds it",
+    )
+    q.add_argument(
+        "--lags",
+        type=number("--lags", 1, 2, integer=True),
+        default=1,
+        help="thermal session: first-order lags of the drift, 1 (default) or 2",
+    )
+    q.add_argument(
+        "--peer",
+        action="store_true",
+        help="thermal probe session: also the per-epoch peer (each epoch identified alone, then "
+        "one lag fitted to the series: what a kinematics cycle re-run at intervals gives)",
+    )
+    q.set_defaults(func=cmd_identify)
+    defaults = {act.dest: act.default for act in q._actions if act.dest not in _THERMAL_DESTS}
+    q.set_defaults(_identify_defaults=defaults)
+
+
+def _refuse_other_options(a: argparse.Namespace) -> None:
+    for dest, default in a._identify_defaults.items():
+        if dest != "help" and getattr(a, dest, default) != default:
+            raise OptionError(
+                f"--{dest.replace('_', '-')}: not for a thermal session (yet); "
+                "its options are --tolerance, --lags, --noise and --json"
+            )
+
+
+def cmd_identify(a: argparse.Namespace) -> int:
+    if len(a.file) != 1 or not _core.is_thermal_session(a.file[0]):
+        if a.tolerance or a.lags != 1 or a.peer:
+            raise OptionError(
+                "--tolerance, --lags, --peer: for a thermal session (an epoch column and duty lines)"
+            )
+        return identify.cmd_identify(a)
+    _refuse_other_options(a)
+    tol = {}
+    for unit, value in a.tolerance or []:
+        if unit in tol:
+            raise OptionError(f"--tolerance: given twice in {'um' if unit == 'mm' else 'urad'}")
+        tol[unit] = value
+    d = _core.identify_thermal(
+        a.file[0], a.lags, tol.get("mm"), tol.get("rad"), noise=a.noise, peer=a.peer
+    )
+    for w in d["warnings"]:
+        say(f"rotacal: warning: {w}")
+    if a.json:
+        print(jsontext.dumps(d))
+    else:
+        print_thermal(d)
+        if "peer" in d:
+            print("\nthe per-epoch peer (each epoch alone, then one lag fitted to the series):")
+            print_thermal(d["peer"])
+    return EXIT_OK
+
+
+def _minutes(seconds: float) -> str:
+    return f"{seconds / 60:.1f} min" if seconds < 7200 else f"{seconds / 3600:.2f} h"
+
+
+def _value(x: float, unit: str) -> str:
+    return f"{x * 1e3:+.3f} um" if unit == "mm" else f"{x * 1e6:+.3f} urad"
+
+
+def print_thermal(d: dict) -> None:
+    ident, s = d["identification"], d["summary"]
+    axis = s["axis"] or "-"
+    rms = ident["residual_rms_um"]  # 0 for the peer, whose residuals are per epoch
+    print(
+        f"thermal test of axis {axis} at {s['tested_speed_rpm']:g} rev/min: "
+        f"{ident['n_samples']} rows in {ident['n_epochs']} epochs"
+        f"{f', residual RMS {rms:.3f} um' if rms > 0 else ''}"
+        f"{'' if ident['converged'] else ' (NOT converged)'}"
+    )
+    if ident["noise_model"]:
+        print(f"noise model: {ident['noise_model']}")
+    for k, lag in enumerate(s["lags"], start=1):
+        tau = (
+            f"{_minutes(lag['tau_s'])} +- {_minutes(lag['tau_std_s'])}"
+            if lag["observable"]
+            else "unobservable"
+        )
+        print(f"lag {k}: tau = {tau}")
+    if s["no_significant_drift"]:
+        print("no significant drift of any location error: tau rests on the noise alone")
+    print(f"steady-state change after long turning at {s['tested_speed_rpm']:g} rev/min:")
+    for e in s["drifts"]:
+        if not e["observable"]:
+            print(f"  {e['name']:<8} unobservable: {e['reason']}")
+            continue
+        change = (
+            f"{_value(e['steady_change'], e['unit'])} +- {_value(e['steady_std'], e['unit'])[1:]}"
+        )
+        line = f"  {e['name']:<8} {change:<28}"
+        line += "significant" if e["significant"] else "no significant drift"
+        if "tolerance" in e:
+            tol = _value(e["tolerance"], e["unit"])[1:]
+            after = e["exceeds_after_s"]
+            line += (
+                f"; may exceed {tol} after {_minutes(after)}"
+                if after is not None
+                else f"; never exceeds {tol}"
+            )
+        print(line)
+    for n in ident["notes"]:
+        print(f"note: {n}")
+
+
+COMMANDS = {"identify": add_identify}

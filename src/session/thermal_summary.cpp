@@ -1,0 +1,180 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The thermal test's answers from its joint fit (session/thermal_summary.hpp).
+#include "rotacal/session/thermal_summary.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "rotacal/core/error.hpp"
+
+namespace rotacal {
+
+namespace {
+
+constexpr double kUpper95 = 1.6448536269514722;  // one-sided 95 % quantile of N(0, 1)
+
+// d(t) and sigma(t) of gain k: (s/100) sum_l K_l g_l(t), g_l = 1 - exp(-t / tau_l) (g_l = 1
+// at t = infinity).
+struct DriftCurve {
+  const ThermalIdentification& id;
+  std::size_t k;
+  double scale;
+  std::pair<double, double> at(double t) const {
+    const std::size_t n = id.lags.size();
+    std::vector<double> g(n);
+    double d = 0.0, var = 0.0;
+    for (std::size_t l = 0; l < n; ++l) {
+      g[l] = std::isinf(t) ? 1.0 : 1.0 - std::exp(-t / id.lags[l].tau_s);
+      d += id.lags[l].gains[k].value * g[l];
+    }
+    for (std::size_t a = 0; a < n; ++a)
+      for (std::size_t b = 0; b < n; ++b)
+        var += g[a] * g[b] *
+               id.covariance(id.gain_index[a] + static_cast<int>(k),
+                             id.gain_index[b] + static_cast<int>(k));
+    return {scale * d, scale * std::sqrt(std::max(0.0, var))};
+  }
+  double bound(double t) const {
+    const auto v = at(t);
+    return std::abs(v.first) + kUpper95 * v.second;
+  }
+};
+
+// First t where the curve's upper bound exceeds tol: a scan over 0..20 tau_max (the bound is
+// within 2e-9 of its steady state there), then bisection. Unset: never.
+std::optional<double> first_exceedance(const DriftCurve& c, double tol, double tau_max) {
+  const int n = 4000;
+  const double t_end = 20.0 * tau_max;
+  double prev = 0.0;
+  for (int i = 1; i <= n; ++i) {
+    const double t = t_end * i / n;
+    if (c.bound(t) > tol) {
+      double lo = prev, hi = t;
+      for (int it = 0; it < 60; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (c.bound(mid) > tol ? hi : lo) = mid;
+      }
+      return hi;
+    }
+    prev = t;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+ThermalSummary thermal_summary(const ThermalIdentification& id,
+                               const ThermalSummaryOptions& options) {
+  for (const auto& t : {options.tolerance_mm, options.tolerance_rad})
+    if (t && !(std::isfinite(*t) && *t > 0.0))
+      throw InvalidArgument("thermal summary: a tolerance must be > 0, got " + std::to_string(*t));
+  ThermalSummary s;
+  s.axis = id.axis;
+  s.tested_speed_rpm = id.tested_speed_rpm;
+  double tau_max = 0.0;
+  for (const ThermalLag& l : id.lags) {
+    s.tau_s.push_back(l.tau_s);
+    s.tau_std_s.push_back(l.tau_std_s);
+    s.tau_observable.push_back(l.tau_observable);
+    tau_max = std::max(tau_max, l.tau_s);
+  }
+  if (id.lags.empty()) return s;
+  const double scale = id.tested_speed_rpm / 100.0;
+  for (std::size_t k = 0; k < id.lags[0].gains.size(); ++k) {
+    const ThermalGainEstimate& g0 = id.lags[0].gains[k];
+    ThermalDrift d;
+    d.name = g0.name;
+    d.unit = g0.unit;
+    for (const ThermalLag& l : id.lags)
+      if (!l.gains[k].observable) {
+        d.observable = false;
+        d.reason = l.gains[k].reason;
+      }
+    d.tolerance = d.unit == "rad" ? options.tolerance_rad : options.tolerance_mm;
+    if (!d.observable) {
+      s.drifts.push_back(d);
+      continue;
+    }
+    const DriftCurve curve{id, k, scale};
+    const auto steady = curve.at(INFINITY);
+    d.steady_change = steady.first;
+    d.steady_std = steady.second;
+    d.significant = std::abs(steady.first) > 3.0 * steady.second;
+    if (d.tolerance) d.exceeds_after_s = first_exceedance(curve, *d.tolerance, tau_max);
+    s.drifts.push_back(d);
+  }
+  s.no_significant_drift = std::none_of(s.drifts.begin(), s.drifts.end(),
+                                        [](const ThermalDrift& d) { return d.significant; });
+  return s;
+}
+
+nlohmann::ordered_json to_json(const ThermalSummary& s) {
+  nlohmann::ordered_json j;
+  j["axis"] = s.axis ? std::string(1, s.axis) : std::string();
+  j["tested_speed_rpm"] = s.tested_speed_rpm;
+  j["no_significant_drift"] = s.no_significant_drift;
+  j["lags"] = nlohmann::ordered_json::array();
+  for (std::size_t l = 0; l < s.tau_s.size(); ++l)
+    j["lags"].push_back({{"tau_s", s.tau_s[l]},
+                         {"tau_std_s", s.tau_std_s[l]},
+                         {"observable", static_cast<bool>(s.tau_observable[l])}});
+  j["drifts"] = nlohmann::ordered_json::array();
+  for (const ThermalDrift& d : s.drifts) {
+    nlohmann::ordered_json e = {{"name", d.name}, {"unit", d.unit}, {"observable", d.observable}};
+    if (!d.observable) {
+      e["reason"] = d.reason;
+    } else {
+      e["steady_change"] = d.steady_change;
+      e["steady_std"] = d.steady_std;
+      e["significant"] = d.significant;
+    }
+    if (d.tolerance) {
+      e["tolerance"] = *d.tolerance;
+      if (d.observable)
+        e["exceeds_after_s"] =
+            d.exceeds_after_s ? nlohmann::ordered_json(*d.exceeds_after_s) : nullptr;
+    }
+    j["drifts"].push_back(e);
+  }
+  return j;
+}
+
+namespace {
+nlohmann::ordered_json estimate_json(const ThermalGainEstimate& g) {
+  nlohmann::ordered_json e = {{"name", g.name}, {"unit", g.unit}, {"observable", g.observable}};
+  if (g.observable) {
+    e["value"] = g.value;
+    e["std"] = g.std;
+  } else {
+    e["reason"] = g.reason;
+  }
+  return e;
+}
+}  // namespace
+
+nlohmann::ordered_json to_json(const ThermalIdentification& id) {
+  nlohmann::ordered_json j;
+  j["machine"] = to_string(id.machine);
+  j["axis"] = id.axis ? std::string(1, id.axis) : std::string();
+  j["tested_speed_rpm"] = id.tested_speed_rpm;
+  j["converged"] = id.converged;
+  j["n_samples"] = id.n_samples;
+  j["n_epochs"] = id.n_epochs;
+  j["residual_rms_um"] = id.residual_rms_um;
+  j["noise_model"] = id.noise;
+  j["cold"] = nlohmann::ordered_json::array();
+  for (const ThermalGainEstimate& c : id.cold) j["cold"].push_back(estimate_json(c));
+  j["lags"] = nlohmann::ordered_json::array();
+  for (const ThermalLag& l : id.lags) {
+    nlohmann::ordered_json lag = {
+        {"tau_s", l.tau_s}, {"tau_std_s", l.tau_std_s}, {"tau_observable", l.tau_observable}};
+    lag["gains"] = nlohmann::ordered_json::array();
+    for (const ThermalGainEstimate& g : l.gains) lag["gains"].push_back(estimate_json(g));
+    j["lags"].push_back(lag);
+  }
+  j["unobservable"] = id.unobservable;
+  j["notes"] = id.notes;
+  return j;
+}
+
+}  // namespace rotacal
