@@ -1,0 +1,73 @@
+# SPDX-License-Identifier: BSD-3-Clause
+"""Sessions of ONE simulated machine for the diagnosis of several sessions (issue 50 item 1),
+made by the independent reference simulator (tests/reference/refsim, never rotacal's own): a
+ballbar single set-up and a touch-probe pose set on the same location errors and effects, each
+with its own set-up error and AR(1) noise."""
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "reference"))
+import refsim  # noqa: E402
+from refsim import noise, poses, writers  # noqa: E402
+
+import rotacal  # noqa: E402
+
+
+def machine_errors(machine: str, seed: int) -> dict:
+    """Location errors of the machine: tens of um and tens of urad."""
+    rng = np.random.default_rng(seed)
+    names = refsim.builtin(machine).error_names()
+    return {
+        n: (rng.normal(0, 0.02) if k % 4 < 2 else rng.normal(0, 4e-5)) for k, n in enumerate(names)
+    }
+
+
+def ballbar(
+    tmp_path, machine, errors, effects, seed, rho=0.5, noise_um=0.5, pivot=(110.0, 10.0, 70.0)
+):
+    """The single set-up ballbar tests; `effects`: the machine's and this session's own."""
+    rng = np.random.default_rng(seed)
+    m = refsim.builtin(machine)
+    s = poses.ballbar_single_setup(m, pivot=pivot)
+    model = refsim.Model(m, errors, effects)
+    actual = np.asarray(pivot) + rng.normal(0, 10e-3, 3)  # the set-up error
+    length = refsim.ballbar_lengths(model, actual, s["xyz"], np.radians(s["angles_deg"]), s["time"])
+    length = length + noise.ar1(s["test"], rho, noise_um * 1e-3, rng)
+    path = writers.write_ballbar(tmp_path / f"ballbar_{seed}.csv", m, s, length, noise_um=noise_um)
+    return rotacal.load(path), path
+
+
+def probe(
+    tmp_path, machine, errors, effects, seed, rho=0.5, noise_um=0.5, sphere=(140.0, -10.0, 75.0)
+):
+    """refsim's 24 poses x 5 touches about `sphere`; the trigger's noise along the approach."""
+    rng = np.random.default_rng(seed)
+    m = refsim.builtin(machine)
+    s = poses.probe_poses(m, sphere=sphere)
+    actual = s["sphere"] + rng.normal(0, 0.02, 3)
+    latched = refsim.probe_touches(
+        refsim.Model(m, errors, effects),
+        actual,
+        s["sphere"],
+        25.0,
+        6.0,
+        s["n"],
+        np.radians(s["angles_deg"]),
+        s["time"],
+    )
+    one = ["touches"] * len(latched)
+    e = noise.ar1(one, rho, noise_um * 1e-3, rng)
+    n = s["n"] / np.linalg.norm(s["n"], axis=1, keepdims=True)
+    path = writers.write_probe(
+        tmp_path / f"probe_{machine}_{seed}.csv",
+        m,
+        s,
+        latched + e[:, None] * n,
+        25.0,
+        6.0,
+        noise_um=noise_um,
+    )
+    return rotacal.load(path), path
