@@ -83,37 +83,6 @@ void check_sessions(const std::vector<DiagnosisSession>& sessions) {
   }
 }
 
-// A session's fit holds an effect's parameter its readings cannot tell from the others (a zero
-// column: the ballbar's c, d of radial_motion_A_h2 beside its pivot and location errors). In the
-// joint fit another session determines them, and these readings then respond to them: the held
-// columns get the session's own derivative (its candidate Jacobian, at the effect's zero, the
-// model being linear in it far below the noise).
-void with_held_effect_columns(const DiagnosisProblem& P, ModelFit& f) {
-  const Eigen::Index baseline =
-      static_cast<Eigen::Index>(f.parameters.size()) - f.effects.num_params();
-  Eigen::Index at = baseline;
-  for (std::size_t i = 0; i < f.effects.effects.size(); ++i) {
-    const Effect& e = f.effects.effects[i];
-    const Eigen::Index m = e.num_params();
-    bool held = false;
-    for (Eigen::Index j = at; j < at + m; ++j)
-      held = held || f.jacobian.col(j).squaredNorm() == 0.0;
-    if (held) {
-      ModelFit without;  // the fit's values, the effect left out
-      without.effects = f.effects;
-      without.effects.effects.erase(without.effects.effects.begin() +
-                                    static_cast<std::ptrdiff_t>(i));
-      for (Eigen::Index j = 0; j < static_cast<Eigen::Index>(f.parameters.size()); ++j)
-        if (j < at || j >= at + m)
-          without.parameters.push_back(f.parameters[static_cast<std::size_t>(j)]);
-      const Eigen::MatrixXd J = P.candidate_jacobian(without, e);
-      for (Eigen::Index j = 0; j < m; ++j)
-        if (f.jacobian.col(at + j).squaredNorm() == 0.0) f.jacobian.col(at + j) = J.col(j);
-    }
-    at += m;
-  }
-}
-
 }  // namespace
 
 MultiDiagnosisProblem::MultiDiagnosisProblem(std::vector<DiagnosisSession> sessions)
@@ -198,7 +167,8 @@ const ModelFit& MultiDiagnosisProblem::session_fit(std::size_t k, const EffectMo
       throw InvalidArgument("diagnose: session " + sessions_[k].name + ": its fit gives " +
                             std::to_string(f.residuals.size()) + " residuals for " +
                             std::to_string(sessions_[k].problem->groups().size()) + " readings");
-    with_held_effect_columns(*sessions_[k].problem, f);
+    for (std::size_t i = 0; i < f.held.size(); ++i)  // held alone, another session may tell
+      f.jacobian.col(f.held[i]) = f.held_columns.col(static_cast<Eigen::Index>(i));
     it = fits_[k].emplace(key, std::move(f)).first;
   }
   return it->second;
@@ -261,22 +231,37 @@ ModelFit MultiDiagnosisProblem::fit_gls(const EffectModel& effects,
           add(names_of[k][j], fits[k]->parameters[j].unit);
 
   const Eigen::Index n = offsets_.back(), p = static_cast<Eigen::Index>(names.size());
+  // A parameter one session held (its readings cannot tell it from its other parameters: the
+  // C-axis location errors of an A sweep at one C) that another determines: these readings
+  // respond to it in the joint fit, by the derivative the session's fit kept (held_columns).
+  std::vector<bool> free_somewhere(static_cast<std::size_t>(p), false);
+  for (std::size_t k = 0; k < K; ++k)
+    for (std::size_t j = 0; j < names_of[k].size(); ++j)
+      if (std::find(fits[k]->held.begin(), fits[k]->held.end(), static_cast<Eigen::Index>(j)) ==
+          fits[k]->held.end())
+        free_somewhere[static_cast<std::size_t>(index.at(names_of[k][j]))] = true;
   Eigen::MatrixXd J = Eigen::MatrixXd::Zero(n, p);
   Eigen::VectorXd b(n), x0 = Eigen::VectorXd::Zero(p);
   std::vector<bool> has_start(static_cast<std::size_t>(p), false);
   for (std::size_t k = 0; k < K; ++k) {
     const ModelFit& f = *fits[k];
+    Eigen::MatrixXd Jk = f.jacobian;
+    for (std::size_t i = 0; i < f.held.size(); ++i) {
+      const std::string& name = names_of[k][static_cast<std::size_t>(f.held[i])];
+      if (free_somewhere[static_cast<std::size_t>(index.at(name))])
+        Jk.col(f.held[i]) = f.held_columns.col(static_cast<Eigen::Index>(i));
+    }
     Eigen::VectorXd x(static_cast<Eigen::Index>(f.parameters.size()));
     for (std::size_t j = 0; j < f.parameters.size(); ++j) {
       const Eigen::Index c = index.at(names_of[k][j]);
       x[static_cast<Eigen::Index>(j)] = f.parameters[j].value;
-      J.block(offsets_[k], c, rows(k), 1) +=
-          weights_[k] * f.jacobian.col(static_cast<Eigen::Index>(j));
+      J.block(offsets_[k], c, rows(k), 1) += weights_[k] * Jk.col(static_cast<Eigen::Index>(j));
       if (!has_start[static_cast<std::size_t>(c)]) x0[c] = f.parameters[j].value;
       has_start[static_cast<std::size_t>(c)] = true;
     }
-    b.segment(offsets_[k], rows(k)) = weights_[k] * (f.residuals + f.jacobian * x);
+    b.segment(offsets_[k], rows(k)) = weights_[k] * (f.residuals + Jk * x);
   }
+  b -= J * x0;  // the step from x0: min-norm where the joint readings cannot tell parameters apart
   std::vector<Eigen::Index> free;
   for (Eigen::Index c = 0; c < p; ++c)
     if (J.col(c).squaredNorm() > 0.0) free.push_back(c);
@@ -293,7 +278,7 @@ ModelFit MultiDiagnosisProblem::fit_gls(const EffectModel& effects,
   const Eigen::VectorXd theta_free = cod.solve(bw).col(0);
   Eigen::VectorXd theta = x0;
   for (std::size_t i = 0; i < free.size(); ++i)
-    theta[free[i]] = theta_free[static_cast<Eigen::Index>(i)];
+    theta[free[i]] += theta_free[static_cast<Eigen::Index>(i)];
 
   ModelFit out;
   out.effects = effects;
@@ -314,10 +299,15 @@ ModelFit MultiDiagnosisProblem::fit_gls(const EffectModel& effects,
     sigma = declared_ ? *declared_ * 1e-3 : std::sqrt(out.residuals.squaredNorm() / dof);
   }
   std::vector<double> std_of(static_cast<std::size_t>(p), 0.0);
-  for (std::size_t i = 0; i < free.size(); ++i)
-    std_of[static_cast<std::size_t>(free[i])] =
-        sigma *
-        std::sqrt(std::max(0.0, C(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i))));
+  std::vector<bool> determined(static_cast<std::size_t>(p), false);
+  for (std::size_t i = 0; i < free.size(); ++i) {
+    const Eigen::Index c = static_cast<Eigen::Index>(i);
+    std_of[static_cast<std::size_t>(free[i])] = sigma * std::sqrt(std::max(0.0, C(c, c)));
+    double in_null = 0.0;  // its share of the directions the joint readings cannot see
+    for (Eigen::Index v = 0; v < ev.size(); ++v)
+      if (!(ev[v] > tol)) in_null += eig.eigenvectors()(c, v) * eig.eigenvectors()(c, v);
+    determined[static_cast<std::size_t>(free[i])] = in_null < 1e-6;
+  }
   out.jacobian = J;
   for (Eigen::Index c = 0; c < p; ++c) {
     ParameterEstimate e;
@@ -325,7 +315,7 @@ ModelFit MultiDiagnosisProblem::fit_gls(const EffectModel& effects,
     e.unit = units[static_cast<std::size_t>(c)];
     e.value = theta[c];
     e.std = std_of[static_cast<std::size_t>(c)];
-    e.observable = J.col(c).squaredNorm() > 0.0;
+    e.observable = determined[static_cast<std::size_t>(c)];
     out.parameters.push_back(e);
   }
   return out;

@@ -41,13 +41,27 @@ def ballbar(
 
 
 def probe(
-    tmp_path, machine, errors, effects, seed, rho=0.5, noise_um=0.5, sphere=(140.0, -10.0, 75.0)
+    tmp_path,
+    machine,
+    errors,
+    effects,
+    seed,
+    rho=0.5,
+    noise_um=0.5,
+    sphere=(140.0, -10.0, 75.0),
+    poses_of=None,
+    actual=None,
+    name=None,
 ):
-    """refsim's 24 poses x 5 touches about `sphere`; the trigger's noise along the approach."""
+    """refsim's 24 poses x 5 touches about `sphere`, or the poses of `poses_of` (pose, time,
+    angles_deg, n, sphere: a session template read by template_poses); the sphere where it
+    actually is, `actual`, else the nominal one moved by a set-up error; the trigger's noise
+    along the approach."""
     rng = np.random.default_rng(seed)
     m = refsim.builtin(machine)
-    s = poses.probe_poses(m, sphere=sphere)
-    actual = s["sphere"] + rng.normal(0, 0.02, 3)
+    s = poses_of if poses_of is not None else poses.probe_poses(m, sphere=sphere)
+    set_up = s["sphere"] + rng.normal(0, 0.02, 3)
+    actual = set_up if actual is None else np.asarray(actual, float)
     latched = refsim.probe_touches(
         refsim.Model(m, errors, effects),
         actual,
@@ -62,7 +76,7 @@ def probe(
     e = noise.ar1(one, rho, noise_um * 1e-3, rng)
     n = s["n"] / np.linalg.norm(s["n"], axis=1, keepdims=True)
     path = writers.write_probe(
-        tmp_path / f"probe_{machine}_{seed}.csv",
+        tmp_path / (name or f"probe_{machine}_{seed}.csv"),
         m,
         s,
         latched + e[:, None] * n,
@@ -71,3 +85,22 @@ def probe(
         noise_um=noise_um,
     )
     return rotacal.load(path), path
+
+
+def template_poses(path) -> dict:
+    """The commanded poses of a rotacal-probe/1 session template (`design probe --separate ...
+    -o added.ngc` writes added.csv): pose, time, rotary angles, approach n and nominal sphere,
+    read as a user's recorder would, from the file's text."""
+    lines = Path(path).read_text().splitlines()
+    sphere = next(ln for ln in lines if ln.startswith("# sphere:")).split(":", 1)[1]
+    rows = [ln.split(",") for ln in lines if ln and not ln.startswith("#")]
+    head, body = rows[0], np.array(rows[1:], float)
+    col = {c: i for i, c in enumerate(head)}
+    rot = [c for c in head[5:] if c not in ("nx", "ny", "nz")]
+    return {
+        "pose": [int(p) for p in body[:, col["pose"]]],
+        "time": body[:, col["time"]],
+        "angles_deg": body[:, [col[c] for c in rot]],
+        "n": body[:, [col["nx"], col["ny"], col["nz"]]],
+        "sphere": np.array([float(v) for v in sphere.split(",")]),
+    }
