@@ -20,6 +20,7 @@ from multi_diagnosis_data import ballbar, machine_errors, probe, template_poses
 
 import rotacal
 from conftest import run_cli
+from test_json_schema import check, schemas
 
 AC = "AC-trt"
 
@@ -106,6 +107,11 @@ def test_an_instrument_effect_of_one_session_is_named_for_that_session(tmp_path,
     r = run_cli("diagnose", bb_path, pr_path, "--json", "--no-progress")
     assert r.returncode == 0, r.stderr
     j = json.loads(r.stdout)
+    named = schemas()  # docs/json_schema.md
+    for i, f in enumerate(j["findings"]):
+        check(f, named["finding"], f"findings[{i}]", named)
+    for i, x in enumerate(j["sessions"]):
+        check(x, named["multi_diagnosis_session"], f"sessions[{i}]", named)
     stem = {"ballbar": bb_path.stem, "probe": pr_path.stem}[session]
     assert [(f["effect"], f["where"]) for f in j["findings"]] == [(f"{stem}:{entry}", stem)]
     assert [s["instrument"] for s in j["sessions"]] == ["ballbar", "probe"]
