@@ -366,8 +366,10 @@ std::vector<Eigen::MatrixXd> MultiDiagnosisProblem::candidate_jacobians(
 MultiDiagnosis diagnose_sessions(std::vector<DiagnosisSession> sessions,
                                  const DiagnosisOptions& options) {
   const MultiDiagnosisProblem P(std::move(sessions));
+  DiagnosisOptions o = options;
+  o.noise.pool_by_session = true;  // each instrument its own AR coefficients
   MultiDiagnosis out;
-  out.diagnosis = diagnose(P, options);
+  out.diagnosis = diagnose(P, o);
   const Diagnosis& D = out.diagnosis;
   const auto rms_um = [](const Eigen::VectorXd& r) {
     return r.size() ? std::sqrt(r.squaredNorm() / static_cast<double>(r.size())) * 1e3 : 0.0;

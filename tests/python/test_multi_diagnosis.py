@@ -51,6 +51,9 @@ def test_a_machine_effect_each_session_leaves_in_a_group_is_named_by_both(tmp_pa
     assert len(d["findings"]) == 1, [g["effect"] for g in d["findings"]]
     k = f["parameters"]["coning_A"]
     assert abs(k["value"] - 2.5e-5) < 3 * k["std"], k
+    # Each session keeps its noise model: the probe's AR coefficients are not the ballbar's.
+    ar = {x["group"].split(":")[0]: x["ar"] for x in d["noise_model"]["streams"]}
+    assert ar["ballbar"] != ar["probe"], ar
     # Each session's residual RMS drops to about its noise (0.5 um).
     for s in d["sessions"]:
         assert s["residual_rms_after_um"] < s["residual_rms_before_um"], s

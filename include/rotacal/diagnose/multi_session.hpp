@@ -16,7 +16,8 @@
 ///  - each session's readings are weighted by the reference noise over its own (declared, else
 ///    from successive differences of its baseline residuals), so that a white treatment with
 ///    one sigma weighs each instrument by its noise; the engine's noise model then has one
-///    stream per session and group (group names "name:group", times on each session's clock).
+///    stream per session and group (group names "name:group", times on each session's clock)
+///    and each session its own AR coefficients (NoiseModelOptions::pool_by_session).
 ///
 /// The joint fit of a model: each session's own nonlinear fit of the effects it models, then one
 /// linear (GLS) step on their stacked Jacobians to the shared parameters' common value. The
