@@ -104,3 +104,22 @@ def template_poses(path) -> dict:
         "n": body[:, [col["nx"], col["ny"], col["nz"]]],
         "sphere": np.array([float(v) for v in sphere.split(",")]),
     }
+
+
+def rtest(tmp_path, machine, errors, effects, seed, rho=0.5, noise_um=0.5):
+    """refsim's tilt x C grid with two nests; the probe zeros are the session's own."""
+    rng = np.random.default_rng(seed)
+    m = refsim.builtin(machine)
+    s = poses.rtest_grid(m)
+    d = refsim.rtest_displacements(
+        refsim.Model(m, errors, effects),
+        s["nests"],
+        s["setup"],
+        s["xyz"],
+        np.radians(s["angles_deg"]),
+        s["time"],
+    )
+    d = d + np.stack([noise.ar1(s["setup"], rho, noise_um * 1e-3, rng) for _ in range(3)], axis=1)
+    d = d + np.array([0.2, -0.1, 0.05])
+    path = writers.write_rtest(tmp_path / f"rtest_{machine}_{seed}.csv", m, s, d, noise_um=noise_um)
+    return rotacal.load(path), path

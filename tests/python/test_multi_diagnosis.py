@@ -5,7 +5,8 @@ with set-ups, seeds and amplitudes other than the issue's: a ballbar single set-
 touch-probe session of one AC-trt table (multi_diagnosis_data.py).
 
 - A machine effect fits both sessions with one set of parameters: a coning of A that each session
-  alone leaves in a group is named alone by the two together; a gravity sag of A, which each
+  alone leaves in a group is named alone by the two together (and a coning of B by an R-test and
+  a probe of a BC-trt table); a gravity sag of A, which each
   alone ranks among three to six members, the two together rank first with more weight than
   either (its nested rival radial_motion_A_h2 stays in the group: no instrument separates them,
   issue 50 item 3).
@@ -16,7 +17,7 @@ touch-probe session of one AC-trt table (multi_diagnosis_data.py).
 import json
 
 import pytest
-from multi_diagnosis_data import ballbar, machine_errors, probe, template_poses
+from multi_diagnosis_data import ballbar, machine_errors, probe, rtest, template_poses
 
 import rotacal
 from conftest import run_cli
@@ -64,6 +65,24 @@ def test_a_machine_effect_each_session_leaves_in_a_group_is_named_by_both(tmp_pa
     assert "1. coning_A (weight" in r.stdout and "finding 1 holds for the machine" in r.stdout
     assert f"  {bb_path.stem} (ballbar, " in r.stdout and f"  {pr_path.stem} (probe, " in r.stdout
     assert "location errors of the extended joint model:" in r.stdout
+
+
+def test_an_rtest_and_a_probe_of_a_bc_table_name_its_coning_together(tmp_path):
+    """coning_B 30 urad/rad on a BC-trt table: the R-test alone says coning_B or tilt_motion_B_h2,
+    the probe one of six; together, coning_B alone, for the machine."""
+    bc = "BC-trt"
+    errors = machine_errors(bc, 6)
+    fx = {"coning_B": [3e-5]}
+    rt, _ = rtest(tmp_path, bc, errors, fx, 6)
+    pr, _ = probe(tmp_path, bc, errors, fx, 8)
+    for alone in (rotacal.diagnose(rt).to_dict(), rotacal.diagnose(pr).to_dict()):
+        assert not first(alone)["named"] and "coning_B" in group(first(alone)), first(alone)
+    d = rotacal.diagnose([rt, pr]).to_dict()
+    f = first(d)
+    assert f["named"] and f["effect"] == "coning_B" and f["where"] == "machine", d["findings"]
+    k = f["parameters"]["coning_B"]
+    assert abs(k["value"] - 3e-5) < 3 * k["std"], k
+    assert [x["name"] for x in d["sessions"]] == ["rtest", "probe"]
 
 
 @pytest.mark.parametrize("seed", [21, 41])
