@@ -26,6 +26,7 @@ void bind_circular(pyb::module_& m);
 void bind_probe(pyb::module_& m);
 void bind_probe_design_module(pyb::module_& m);
 void bind_multi(pyb::module_& m);
+void bind_multi_diagnosis(pyb::module_& m);
 void bind_realtime(pyb::module_& m);
 void bind_thermal(pyb::module_& m);
 #ifdef ROTACAL_WITH_HW
@@ -60,6 +61,7 @@ PYBIND11_MODULE(_core, m) {
   rotacal::py::bind_probe(m);
   rotacal::py::bind_probe_design_module(m);
   rotacal::py::bind_multi(m);
+  rotacal::py::bind_multi_diagnosis(m);
   rotacal::py::bind_realtime(m);
   rotacal::py::bind_thermal(m);
 #ifdef ROTACAL_WITH_HW

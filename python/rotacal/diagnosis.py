@@ -36,7 +36,9 @@ def diagnose(session: Any, *, reference: Any = None, **options: Any) -> Diagnosi
 
     Parameters
     ----------
-    session : a BallbarSession, an RtestSession (with dx,dy,dz) or a ProbeSession
+    session : a BallbarSession, an RtestSession (with dx,dy,dz) or a ProbeSession; or several
+        sessions of one machine (a list, (name, session) pairs or a dict by name), diagnosed
+        together (multi_diagnosis.py: a MultiDiagnosisResult)
     reference : a complete standard test for the machine (commanded rows) used to name the
         test that separates ambiguous candidates (ballbar only)
     options : fields of DiagnosisOptions over its C++ defaults, e.g. ``max_harmonic`` (highest
@@ -45,6 +47,10 @@ def diagnose(session: Any, *, reference: Any = None, **options: Any) -> Diagnosi
         the candidates to these catalogue ids)
     """
     o = diagnosis_options(**options)
+    if isinstance(session, (list, tuple, dict)):  # several sessions of one machine (issue 50)
+        from .multi_diagnosis import diagnose_sessions
+
+        return diagnose_sessions(session, o)  # type: ignore[return-value]
     run = by_kind(
         session,
         {

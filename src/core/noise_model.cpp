@@ -253,14 +253,22 @@ NoiseModel estimate_noise_model(const NoiseStreamLayout& layout,
     }
     return best;
   };
-  std::vector<double> pooled_k, pooled_v;
-  int pooled_order = 0;
+  // Pooled: the coefficients and order of each pool (every stream, or each session's).
+  const auto pool_of = [&options, &sg](std::size_t s) {
+    return options.pool_by_session ? sg[s].substr(0, sg[s].find(':')) : std::string();
+  };
+  std::map<std::string, std::pair<std::vector<double>, int>> pooled;
   if (options.pooled) {
-    std::size_t shortest = SIZE_MAX, total = 0;
-    for (const auto& x : xs) shortest = std::min(shortest, static_cast<std::size_t>(x.size()));
-    const int P = streams.empty() ? 0 : std::min(options.max_order, static_cast<int>(shortest / 4));
-    burg_pooled(xs, std::max(P, 0), &pooled_k, &pooled_v, &total);
-    pooled_order = choose(pooled_v, total);
+    std::map<std::string, std::vector<Eigen::VectorXd>> members;
+    for (std::size_t s = 0; s < streams.size(); ++s) members[pool_of(s)].push_back(xs[s]);
+    for (auto& [key, x] : members) {
+      std::size_t shortest = SIZE_MAX, total = 0;
+      for (const auto& xi : x) shortest = std::min(shortest, static_cast<std::size_t>(xi.size()));
+      const int P = std::min(options.max_order, static_cast<int>(shortest / 4));
+      std::vector<double> k, v;
+      burg_pooled(std::move(x), std::max(P, 0), &k, &v, &total);
+      pooled[key] = {k, choose(v, total)};
+    }
   }
   double ss_marg = 0.0, ss_innov = 0.0;
   for (std::size_t s = 0; s < streams.size(); ++s) {
@@ -274,7 +282,7 @@ NoiseModel estimate_noise_model(const NoiseStreamLayout& layout,
     int best = 0;
     if (options.pooled) {
       // Shared coefficients, the stream's own variance: v_m = v_0 prod (1 - k_j^2).
-      k = pooled_k, best = pooled_order;
+      k = pooled.at(pool_of(s)).first, best = pooled.at(pool_of(s)).second;
       double v0 = 0.0;
       for (double xi : xs[s]) v0 += xi * xi;
       v.assign(1, n ? v0 / static_cast<double>(n) : 0.0);

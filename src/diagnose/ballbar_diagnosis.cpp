@@ -59,12 +59,12 @@ ModelFit BallbarDiagnosisProblem::fit_gls(const EffectModel& effects,
   f.residuals = Eigen::Map<const Eigen::VectorXd>(id.residuals.data(),
                                                   static_cast<Eigen::Index>(id.residuals.size()));
   f.jacobian = std::move(id.jacobian);
+  std::vector<bool> held(id.fixed.size());
   for (std::size_t j = 0; j < id.fixed.size(); ++j) {
-    if (id.fixed[j])
-      f.jacobian.col(static_cast<Eigen::Index>(j)).setZero();
-    else
-      ++f.num_free;
+    held[j] = id.fixed[j];
+    if (!held[j]) ++f.num_free;
   }
+  f.hold(held);
   return f;
 }
 

@@ -62,8 +62,9 @@ ModelFit RtestDiagnosisProblem::fit_gls(const EffectModel& effects,
   out.residuals = std::move(fit.residuals);  // measured - model
   out.jacobian = std::move(fit.jacobian);
   out.num_free = fit.summary.num_free;
-  for (std::size_t j = 0; j < fit.free.size(); ++j)
-    if (!fit.free[j]) out.jacobian.col(static_cast<Eigen::Index>(j)).setZero();
+  std::vector<bool> held(fit.free.size());
+  for (std::size_t j = 0; j < fit.free.size(); ++j) held[j] = !fit.free[j];
+  out.hold(held);
   out.parameters = std::move(fit.estimates);
   return out;
 }

@@ -109,6 +109,11 @@ const char* squareness_plane(char axis) { return axis == 'X' ? "XY" : axis == 'Y
 }  // namespace
 
 std::string Effect::id() const {
+  if (!session.empty()) {
+    Effect machine = *this;
+    machine.session.clear();
+    return session + ":" + machine.id();
+  }
   const KindInfo& k = info(kind);
   std::string s = k.stem;
   if (kind == EffectKind::linear_squareness) return s + "_" + squareness_plane(axis);
@@ -120,6 +125,13 @@ std::string Effect::id() const {
 }
 
 Effect Effect::parse(const std::string& id) {
+  const std::size_t colon = id.rfind(':');
+  if (colon != std::string::npos) {  // "session:id" (Effect::session)
+    Effect f = parse(id.substr(colon + 1));
+    f.session = id.substr(0, colon);
+    if (f.session.empty()) throw InvalidArgument("effect id '" + id + "': no session before ':'");
+    return f;
+  }
   for (const KindInfo& k : kKindInfo) {
     const std::string stem = k.stem;
     if (id.compare(0, stem.size(), stem) != 0) continue;

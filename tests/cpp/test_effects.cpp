@@ -44,6 +44,19 @@ TEST_CASE("every catalogue id round-trips and bad ids are refused", "[effects]")
   CHECK_THROWS_WITH(Effect::parse("coning_C"), Catch::Contains("coning_C"));
 }
 
+TEST_CASE("a session's effect is named after its session and is not the machine's", "[effects]") {
+  // diagnose/multi_session.hpp: "probe2:stylus_radius_offset" is session probe2's own.
+  const Effect own = Effect::parse("probe2:stylus_radius_offset");
+  CHECK(own.session == "probe2");
+  CHECK(own.kind == EffectKind::stylus_radius_offset);
+  CHECK(own.id() == "probe2:stylus_radius_offset");
+  CHECK(Effect::parse(own.id()) == own);
+  CHECK_FALSE(own == Effect::parse("stylus_radius_offset"));
+  CHECK(Effect::parse("bb:thermal_warmup_Z").num_params() == 2);
+  CHECK_THROWS_AS(Effect::parse(":coning_A"), InvalidArgument);
+  CHECK_THROWS_WITH(Effect::parse("bb:coning_C"), Catch::Contains("coning_C"));
+}
+
 TEST_CASE("angle effects shift the actual angle", "[effects]") {
   const Eigen::Vector3d q(100, 20, 50);
   const auto m = MachineType::AC_trt;

@@ -580,3 +580,34 @@ TEST_CASE("a noise model on a stream layout built once equals the one from group
   CHECK_THROWS_WITH(estimate_noise_model(layout_all, Eigen::VectorXd::Zero(5)),
                     Catch::Contains("residuals has 5 entries but the session has 360 readings"));
 }
+
+TEST_CASE("pooled by session: each session's streams share their own AR coefficients",
+          "[noise_model]") {
+  // A diagnosis of several sessions names its groups "session:group" (multi_session.hpp): a
+  // ballbar's streams at rho 0.8 and a probe's at 0.2 keep their own coefficients.
+  std::vector<std::string> groups;
+  std::vector<double> times;
+  Eigen::VectorXd r(4 * 600);
+  for (int s = 0; s < 4; ++s) {
+    const Layout L = layout(1, 600, 10.0);
+    const double rho = s < 2 ? 0.8 : 0.2;
+    r.segment(600 * s, 600) = noise_gen::ar1(L.groups, L.times, rho, 0.5e-3, 31 + s);
+    for (int i = 0; i < 600; ++i) {
+      groups.push_back((s < 2 ? "bb:test" : "probe:touches") + std::to_string(s));
+      times.push_back(L.times[static_cast<std::size_t>(i)]);
+    }
+  }
+  NoiseModelOptions o;
+  o.pooled = true;
+  const NoiseModel one = estimate_noise_model(groups, times, r, o);
+  o.pool_by_session = true;
+  const NoiseModel each = estimate_noise_model(groups, times, r, o);
+  REQUIRE(each.streams.size() == 4);
+  CHECK(one.streams[0].reflection == one.streams[3].reflection);  // one set for all
+  CHECK(each.streams[0].reflection == each.streams[1].reflection);
+  CHECK(each.streams[2].reflection == each.streams[3].reflection);
+  REQUIRE(each.streams[0].order() >= 1);
+  // 1200 readings a session: an AR(1) coefficient's standard error is about 0.02-0.03.
+  CHECK(std::abs(each.streams[0].ar[0] - 0.8) < 0.1);
+  CHECK((each.streams[3].order() == 0 || std::abs(each.streams[3].ar[0] - 0.2) < 0.1));
+}

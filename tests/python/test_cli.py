@@ -205,7 +205,11 @@ def test_errors_have_exit_codes(tmp_path):
 
 @pytest.mark.parametrize(
     "script,args",
-    [("simulate_and_diagnose.py", []), ("identify_session.py", ["ballbar_ac_table2.csv"])],
+    [
+        ("simulate_and_diagnose.py", []),
+        ("identify_session.py", ["ballbar_ac_table2.csv"]),
+        ("diagnose_with_added_test.py", []),
+    ],
 )
 def test_examples_run(shared_data, script, args):
     r = subprocess.run(

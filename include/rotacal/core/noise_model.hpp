@@ -41,6 +41,10 @@ struct NoiseModelOptions {
   /// correlation is structure in some groups (an effect), not the sensor's, and each stream
   /// keeps its own model.
   bool pool_only_if_all_coloured = false;
+  /// With `pooled`: one set of coefficients per session, the part of a stream's group before
+  /// its first ':' (a diagnosis of several sessions names its groups "session:group",
+  /// diagnose/multi_session.hpp): each instrument keeps its own noise model.
+  bool pool_by_session = false;
   /// The R-test joint fit: when the residuals are correlated, estimate AR(1) + a random walk
   /// per stream by REML over what the fit leaves (estimate_noise_model_reml in
   /// core/noise_handling.hpp: probe zeros that wander between poses), instead of Burg's AR(p)

@@ -48,6 +48,22 @@ struct ModelFit {
   Eigen::MatrixXd jacobian;                   ///< d model / d parameter (mm per unit), free columns
                                               ///< only (fixed ones are zero)
   int num_free = 0;                           ///< parameters actually estimated
+  /// The parameters the fit held (zero columns of `jacobian`) and the model's derivative in
+  /// each there, one column per held parameter: in a diagnosis of several sessions
+  /// (multi_session.hpp) another session may determine them. Empty where none is held.
+  std::vector<Eigen::Index> held;
+  Eigen::MatrixXd held_columns;
+  /// Zero the held columns of `jacobian`, keeping them in held / held_columns.
+  void hold(const std::vector<bool>& is_held) {
+    held.clear();
+    for (std::size_t j = 0; j < is_held.size(); ++j)
+      if (is_held[j]) held.push_back(static_cast<Eigen::Index>(j));
+    held_columns.resize(jacobian.rows(), static_cast<Eigen::Index>(held.size()));
+    for (std::size_t i = 0; i < held.size(); ++i) {
+      held_columns.col(static_cast<Eigen::Index>(i)) = jacobian.col(held[i]);
+      jacobian.col(held[i]).setZero();
+    }
+  }
 };
 
 /// What the engine needs from an instrument.

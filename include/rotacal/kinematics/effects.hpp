@@ -39,10 +39,15 @@ struct Effect {
   /// straightness_DA: the error direction D ('X','Y','Z'; axis holds the moving axis A);
   /// linear_pitch: the ISO 230-1 rotation letter ('B' for E_BX, 'A' for E_AY). Else 0.
   char direction = 0;
+  /// In a diagnosis of several sessions (diagnose/multi_session.hpp): the session an
+  /// instrument, set-up or time effect belongs to, id() then "session:id". Empty: the
+  /// machine's (or a one-session model's). The kinematics do not read it.
+  std::string session;
 
-  /// The effects.md id.
+  /// The effects.md id, "session:" before it when `session` is set.
   std::string id() const;
-  /// Parse an effects.md id; throws InvalidArgument naming the id if it is not in the catalogue.
+  /// Parse an effects.md id, optionally "session:id"; throws InvalidArgument naming the id if
+  /// it is not in the catalogue.
   static Effect parse(const std::string& id);
   int num_params() const;
   /// Parameter names ("dL", "a", "b", ...) and units ("mm", "rad", "mm/s", ...).
@@ -61,7 +66,8 @@ struct Effect {
   /// derivative with respect to the cos parameters at order 0 times cos(nR) and sin(nR).
   bool is_harmonic() const;
   bool operator==(const Effect& o) const {
-    return kind == o.kind && axis == o.axis && harmonic == o.harmonic && direction == o.direction;
+    return kind == o.kind && axis == o.axis && harmonic == o.harmonic && direction == o.direction &&
+           session == o.session;
   }
 };
 

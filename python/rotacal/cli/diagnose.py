@@ -78,9 +78,42 @@ def _diagnosis_progress(a: argparse.Namespace):
     return bar, update
 
 
+def _diagnose_several(a: argparse.Namespace) -> int:
+    """One diagnosis of several sessions of one machine (diagnose/multi_session.hpp)."""
+    from ..diagnosis import diagnose
+    from ..multi_diagnosis import print_several
+
+    if a.report or a.budget_sizes:
+        raise _core.InvalidArgument(
+            "diagnose: --report and --budget-sizes are of one session; several sessions are "
+            "diagnosed to the terminal or --json"
+        )
+    stems = [Path(f).stem for f in a.file]
+    sessions = [load_session(f, a) for f in a.file]
+    named = list(zip(stems, sessions)) if len(set(stems)) == len(stems) else sessions
+    bar, progress = _diagnosis_progress(a)
+    try:
+        result = diagnose(
+            named, max_harmonic=a.max_harmonic, hold_by_weight=a.hold_by_weight, progress=progress
+        )
+    finally:
+        if bar:
+            bar.close()
+    d = result.to_dict()
+    if a.json:
+        print(jsontext.dumps(d))
+    else:
+        print_diagnosis(d)
+        print_several(d)
+    return EXIT_OK
+
+
 def cmd_diagnose(a: argparse.Namespace) -> int:
     from ..diagnosis import diagnose, uncertainty_budget
 
+    if len(a.file) > 1:  # several sessions of one machine (issue 50)
+        return _diagnose_several(a)
+    a.file = a.file[0]
     sizes = budget_sizes(a.budget_sizes)  # refused before any work
     s = load_session(a.file, a)
     bar, progress = _diagnosis_progress(a)
@@ -181,7 +214,13 @@ def cmd_report(a: argparse.Namespace) -> int:
 
 def add_diagnose(sub: argparse._SubParsersAction) -> None:
     q = sub.add_parser("diagnose", help="find what the model gets wrong and why", epilog=EPILOG)
-    q.add_argument("file", type=path("FILE"))
+    q.add_argument(
+        "file",
+        type=path("FILE"),
+        nargs="+",
+        help="a session; several (ballbar, R-test, touch probe) of one machine are diagnosed "
+        "together: machine effects shared, each session's own named NAME:effect (NAME: its file's stem)",
+    )
     q.add_argument(
         "--max-harmonic",
         type=number("--max-harmonic", 1, MAX_HARMONIC, integer=True),
