@@ -178,6 +178,8 @@ side_job() {
   ./build/release/bench/noise_mc_bench --smoke
   ./build/release/bench/any_machine_bench --smoke
   ./build/release/bench/realtime_bench --smoke
+  ./build/release/bench/multi_bench --smoke
+  "$PY" bench/multi_diagnosis_pairs.py --smoke
   echo "finished at $(elapsed)"
 }
 export -f side_job

@@ -169,11 +169,11 @@ std::string write_probe_nc_program(MachineType m, const ProbePattern& P, NcDiale
     return u < 0x20 || u == 0x7F;
   });
   if (o.log_file.empty() || control || o.log_file.find_first_of("()") != std::string::npos)
-    throw InvalidArgument("plan probe: --log-file '" + printable(o.log_file) +
+    throw InvalidArgument("the probe program's --log-file '" + printable(o.log_file) +
                           "': the log file name must be non-empty, without '(', ')' or control "
                           "bytes (line ends, escapes)");
   if (o.log_file.size() > kMaxLogFileName)
-    throw InvalidArgument("plan probe: --log-file: " + std::to_string(o.log_file.size()) +
+    throw InvalidArgument("the probe program's --log-file: " + std::to_string(o.log_file.size()) +
                           " characters; (LOGOPEN,...) must stay within LinuxCNC's 254-character "
                           "line, so at most " +
                           std::to_string(kMaxLogFileName));

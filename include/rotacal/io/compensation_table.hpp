@@ -30,7 +30,7 @@ struct FanucPitchOptions {
   double detection_unit_deg = 0.001;  ///< the axis' detection unit (IS-B: 0.001 deg)
   int first_number = 0;               ///< the first data number of the first table written
   int last_number = 1023;             ///< the highest data number the control holds
-  int max_value = 127;                ///< the largest |value| one data number holds
+  int max_value = 127;                ///< the largest absolute value one data number holds
   /// Parameter 3623: values are in detection units times it. 0: the smallest of 1..100 that
   /// keeps every value within max_value.
   int magnification = 0;

@@ -71,9 +71,9 @@ struct MultiFitOptions {
   double observability_min_chi2 = 1.0;
   /// Probability that sessions of one machine are reported to disagree on anything: the
   /// threshold on |difference| / sigma of the difference is Bonferroni's over every comparison
-  /// made (pairs of sessions x parameters both determine), so more sessions need a larger |z|.
+  /// made (pairs of sessions x parameters both determine), so more sessions need a larger abs(z).
   double disagreement_alpha = 0.01;
-  /// The threshold never goes below this |z| (a single comparison at alpha 1 % would be 2.58).
+  /// The threshold never goes below this abs(z) (a single comparison at alpha 1 % would be 2.58).
   double disagreement_z = 3.0;
   /// When sessions disagree, widen the sigma of each parameter they disagree on by its Birge
   /// ratio (the scatter of the sessions alone about the joint value, sqrt(chi2 / (n - 1))),
@@ -95,7 +95,7 @@ struct MultiDisagreement {
   /// Degrees of freedom of `sigma` (Welch-Satterthwaite over the two sessions' own: each
   /// sigma rests on its noise model's effective samples less its free parameters).
   double dof = std::numeric_limits<double>::infinity();
-  double threshold = 0.0;  ///< the |z| beyond which it is a disagreement, at `dof`
+  double threshold = 0.0;  ///< the abs(z) beyond which it is a disagreement, at `dof`
 };
 
 /// What one session contributes.
@@ -128,7 +128,7 @@ struct MultiIdentification {
   std::vector<std::string> notes;
   bool sigma_inflated = false;  ///< inflate_sigma widened the sigmas of disagreeing parameters
   std::size_t comparisons = 0;  ///< pairs of sessions x parameters both determine
-  /// The |z| beyond which one of them is a disagreement with exactly known sigmas; a
+  /// The abs(z) beyond which one of them is a disagreement with exactly known sigmas; a
   /// comparison of sigmas from few effective samples has its own (MultiDisagreement::threshold).
   double disagreement_z = 0.0;
   const ParameterEstimate& location_error(const std::string& name) const;

@@ -196,16 +196,14 @@ def print_joint_identification(d: dict) -> None:
         print_noise_model(s["noise_model"])
     t = d["disagreement_test"]
     print(
-        f"  sessions alone compared {t['comparisons']} times; a disagreement is |z| > "
-        f"{t['z']:.2f} (1 % chance of any for sessions of one machine; higher where a sigma rests "
-        "on few effective samples)"
+        f"  sessions alone compared {t['comparisons']} times; a disagreement is |z| > {t['z']:.2f}, "
+        "more where a sigma rests on few samples (1 % chance of any for one machine)"
     )
     for g in d["disagreements"]:
         f, shown = _shown(g["unit"])
         print(
             f"  DISAGREE {g['parameter']}: {g['sessions'][0]} - {g['sessions'][1]} = {g['difference'] * f:+.3f} "
-            f"+- {g['sigma'] * f:.3f} {shown.strip()} (z = {g['z']:+.1f}, threshold "
-            f"{g['threshold']:.2f})"
+            f"+- {g['sigma'] * f:.3f} {shown.strip()} (z = {g['z']:+.1f} of {g['threshold']:.2f})"
         )
     for u in d["unobservable"]:
         print(f"  not determined by these sessions: {u}")
