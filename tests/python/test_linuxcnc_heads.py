@@ -255,3 +255,28 @@ def test_real_module_puts_the_tool_where_the_held_model_does(tmp_path, kins):
     off = [module_inverse(kins, nominal, w, B, C) for w, (B, C) in zip(commands[:, :3], ang)]
     assert np.abs(np.array(off) - want).max() > 1e-3
     assert np.abs(fwd - commands[:, :3])[agree].max() < TOL
+
+
+def test_current_values_and_residual_model_of_a_head_export(tmp_path):
+    model, out, res = tmp_path / "m.json", tmp_path / "k.hal", tmp_path / "residual.json"
+    names = write_model(model, "maxkins")
+    current = tmp_path / "machine.hal"  # the machine's HAL: other lines are skipped
+    current.write_text("loadrt maxkins\nsetp maxkins.pivot-length 251.5\nsetp other.pin 3\n")
+    r = run_cli(
+        "export", "--model", model, "--controller", "linuxcnc", "--current", current, "-o", out,
+        "--residual-model", res, "--json",
+    )  # fmt: skip
+    assert r.returncode == 0, r.stderr
+    pins = dict(re.findall(r"^setp (\S+) (\S+)$", out.read_text(), re.M))
+    assert float(pins["maxkins.pivot-length"]) == pytest.approx(251.5 + ERRORS[5], abs=1e-6)
+    d = json.loads(res.read_text())
+    for i, n in enumerate(names):  # the residual model keeps exactly what maxkins cannot hold
+        want = 0.0 if i in HELD["maxkins"] else ERRORS[i]
+        assert d["location_errors"][n]["value"] == pytest.approx(want, abs=1e-15), n
+    # the HOME_OFFSETs from the JSON form of --current
+    cj = tmp_path / "current.json"
+    cj.write_text(json.dumps({"parameters": {"[JOINT_0]HOME_OFFSET": 12.5}}))
+    r = run_cli("export", "--model", model, "--controller", "linuxcnc", "--current", cj)
+    assert r.returncode == 0, r.stderr
+    assert f"# [JOINT_0]HOME_OFFSET = {12.5 - ERRORS[0]:.6f}" in r.stdout
+    assert f"# [JOINT_1]HOME_OFFSET = {-ERRORS[1]:.6f}" in r.stdout

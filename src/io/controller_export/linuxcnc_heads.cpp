@@ -51,6 +51,9 @@ ControllerExport export_linuxcnc_head(const ExportInput& in, const ExportOptions
   header(w, ex, in, o,
          "LinuxCNC 2.9 " + kins + " HAL pin (src/emc/kinematics/" + kins +
              ".c), linear units mm ([TRAJ]LINEAR_UNITS)");
+  if (!o.current_given || o.current.count(ex.values[0].name) == 0)
+    w.line("current " + ex.values[0].name + ": not given, taken as the description's " +
+           "pivot_length + tool_length");
   w.line(std::string("angles: ") +
          (table_c ? "maxkins turns B about -Y and the C table about -Z"
                   : "5axiskins turns C about +Z and B about -Y") +
