@@ -31,6 +31,8 @@ P = 250.0  # mm: the built-ins' pivot_length + tool_length (150 + 100)
 ERRORS = np.array([0.021, -0.034, 40e-6, -25e-6, 0.017, -0.045, 30e-6, -55e-6])
 HELD = {"maxkins": [0, 1, 5], "5axiskins": [5]}
 MACHINE = {"maxkins": "B-head-C-table", "5axiskins": "BC-head"}
+# a model field that tries to add a pin and an INI line to the file
+HOSTILE = "s <m> $(rm -rf)\nsetp maxkins.pivot-length 0\n# [JOINT_0]HOME_OFFSET = 5\r\n"
 
 
 def rot(axis, a):
@@ -90,7 +92,7 @@ def write_model(path, kins, e=ERRORS):
             for i, n in enumerate(names)
         },
         "pivot": {k: {"value": 0.0, "unit": "mm"} for k in "xyz"},
-        "source": {"session": "head <machine> $(rm -rf) session"},
+        "source": {"session": HOSTILE},
     }
     path.write_text(json.dumps(doc))
     return names
@@ -154,6 +156,7 @@ def test_head_export_holds_its_part_and_reports_the_rest(tmp_path, kins):
             assert "compensate" in where[n] and "--controller realtime" in where[n], where[n]
     # the model's source (any text) stays in comments: only comments and the one setp line
     assert all(ln.startswith("#") or ln.startswith("setp ") for ln in text.splitlines() if ln)
+    assert sum(ln.startswith("setp") for ln in text.splitlines()) == 1
 
     q, b, c = poses(kins, n=400)
     world, ang, want = expected(kins, q, b, c)
