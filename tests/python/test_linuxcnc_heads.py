@@ -258,6 +258,11 @@ def test_real_module_puts_the_tool_where_the_held_model_does(tmp_path, kins):
     off = [module_inverse(kins, nominal, w, B, C) for w, (B, C) in zip(commands[:, :3], ang)]
     assert np.abs(np.array(off) - want).max() > 1e-3
     assert np.abs(fwd - commands[:, :3])[agree].max() < TOL
+    if kins == "maxkins":  # elsewhere by (I - Rz(C)) (L sin B, 0, 0): the offset unrotated
+        L, Br, Cr = pins["maxkins.pivot-length"], np.radians(ang[:, 0]), np.radians(ang[:, 1])
+        xb = L * np.sin(Br)
+        gap = np.column_stack([xb * (1 - np.cos(Cr)), -xb * np.sin(Cr), 0 * xb])
+        assert np.abs(fwd - commands[:, :3] - gap).max() < TOL
 
 
 def test_current_values_and_residual_model_of_a_head_export(tmp_path):
