@@ -26,14 +26,45 @@ const std::map<std::string, Controller>& controller_names() {
   return names;
 }
 
-// The exports map the two table machines' errors onto their controllers' table kinematics
-// (docs/controller_exports.md); other chains have other parameter sets, not written yet.
-void require_table_machine(MachineType m) {
-  if (m != MachineType::AC_trt && m != MachineType::BC_trt)
-    throw InvalidArgument(
-        "export: the controller exports are written for the AC-trt and BC-trt tables; a " +
-        to_string(m) + " (" + m.description().configuration() +
-        ") machine's identified errors are in its model file (--save-model)");
+// The exports map the two table machines' errors onto their controllers' table kinematics, and
+// LinuxCNC's the two head machines it ships a module for (docs/controller_exports.md). Any other
+// machine is refused with the kinematics the controller's export lacks for it.
+void require_exportable(Controller c, MachineType m) {
+  if (m == MachineType::AC_trt || m == MachineType::BC_trt) return;
+  if (c == Controller::linuxcnc && !linuxcnc_head_kinematics(m).empty()) return;
+  const std::string kind = m.description().configuration();
+  std::string lacks;
+  switch (c) {
+    case Controller::linuxcnc:
+      lacks =
+          "LinuxCNC 2.9 ships no kinematics module for it (xyzac-trt-kins and xyzbc-trt-kins: "
+          "the AC/BC tables; maxkins: B-head-C-table; 5axiskins: BC-head)";
+      break;
+    case Controller::siemens:
+      lacks =
+          "the SINUMERIK export writes $TC_CARR type P (table-table) only, not the types T "
+          "(head-table) or M (head-head) nor a nutating axis";
+      break;
+    case Controller::isg:
+      lacks =
+          "the ISG export writes the universal kinematic (ID 91) of an AC/BC table only, not "
+          "the kinematic IDs of head or nutating machines";
+      break;
+    case Controller::heidenhain:
+      lacks =
+          "the HEIDENHAIN mapping covers the kinematics table of an AC/BC table only, not the "
+          "head or nutating axes' rows";
+      break;
+    case Controller::fanuc:
+      lacks =
+          "the FANUC mapping covers tool centre point control with two table axes (No. 19680 "
+          "= 12) only, not the head or nutating machine types";
+      break;
+  }
+  throw InvalidArgument("export --controller " + to_string(c) + ": a " + to_string(m) + " (" +
+                        kind + ") machine: " + lacks +
+                        "; its identified errors are in its model file (--save-model), for "
+                        "rotacal compensate --model");
 }
 
 }  // namespace
@@ -121,7 +152,7 @@ ExportInput export_input(const ModelFile& model, const std::string& model_path) 
 }
 
 ControllerExport export_kinematics(Controller c, const ExportInput& in, const ExportOptions& o) {
-  require_table_machine(in.machine);
+  require_exportable(c, in.machine);
   if (o.toolholder < 1 || o.toolholder > 99)
     throw InvalidArgument("--toolholder " + std::to_string(o.toolholder) + ": must be 1..99");
   const std::vector<std::string> known = current_parameter_names(c, in.machine, o.toolholder);
@@ -148,7 +179,7 @@ ControllerExport export_kinematics(Controller c, const ExportInput& in, const Ex
 
 std::vector<std::string> current_parameter_names(Controller c, MachineType machine,
                                                  int toolholder) {
-  require_table_machine(machine);
+  require_exportable(c, machine);
   ExportInput in;
   in.machine = machine;
   in.observable.fill(true);

@@ -10,6 +10,7 @@
 #include "rotacal/core/error.hpp"
 #include "rotacal/core/json_text.hpp"
 #include "rotacal/io/controller_export.hpp"
+#include "shared.hpp"
 
 namespace rotacal {
 
@@ -56,7 +57,10 @@ std::map<std::string, double> parse_current_parameters(Controller c, MachineType
   std::istringstream in(text);
   std::string line;
   int n = 0;
-  const std::string kins = machine == MachineType::AC_trt ? "xyzac-trt-kins." : "xyzbc-trt-kins.";
+  const std::string head = export_detail::linuxcnc_head_kinematics(machine);
+  const std::string kins = !head.empty()                    ? head + "."
+                           : machine == MachineType::AC_trt ? "xyzac-trt-kins."
+                                                            : "xyzbc-trt-kins.";
   while (std::getline(in, line)) {
     ++n;
     const std::string where = source + ":" + std::to_string(n);

@@ -9,6 +9,7 @@ namespace rotacal::export_detail {
 // C line passes through (x-rot-point, y-rot-point), the tilt line through r + d; both turn
 // right-handed (the module's default directions). No orientation terms exist.
 ControllerExport export_linuxcnc(const ExportInput& in, const ExportOptions& o) {
+  if (in.machine.has_head()) return export_linuxcnc_head(in, o);
   const LineMaps L = line_maps(in.machine);
   const bool ac = in.machine == MachineType::AC_trt;
   const std::string kins = ac ? "xyzac-trt-kins" : "xyzbc-trt-kins";

@@ -85,4 +85,9 @@ ControllerExport export_isg(const ExportInput& in, const ExportOptions& o);
 ControllerExport export_heidenhain(const ExportInput& in, const ExportOptions& o);
 ControllerExport export_fanuc(const ExportInput& in, const ExportOptions& o);
 
+// The head machines LinuxCNC ships a kinematics module for (linuxcnc_heads.cpp): "maxkins" for
+// B-head-C-table, "5axiskins" for BC-head, "" for any other machine.
+std::string linuxcnc_head_kinematics(MachineType m);
+ControllerExport export_linuxcnc_head(const ExportInput& in, const ExportOptions& o);
+
 }  // namespace rotacal::export_detail
