@@ -11,6 +11,7 @@
 
 #include "model_checks.hpp"
 #include "rotacal/core/error.hpp"
+#include "rotacal/io/controller_export.hpp"
 #include "rotacal/kinematics/thermal_lag.hpp"
 
 namespace rotacal {

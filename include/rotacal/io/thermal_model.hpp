@@ -4,9 +4,9 @@
 /// The thermal model file (kind "thermal", docs/model_file.md): what the joint fit of a thermal
 /// session (session/thermal_result.hpp) identified, kept to predict the location errors for
 /// another duty (`rotacal predict --duty`) and to export them at a lag state (`rotacal export
-/// --at` / `--state`). The errors at lag states y_l are E0 + sum_l K_l y_l
-/// (kinematics/thermal_lag.hpp, the one lag implementation); their covariance is propagated
-/// from the fit's covariance of the cold errors, each tau and the gains.
+/// --at` / `--state`; thermal_export_input of io/controller_export.hpp). The errors at lag states
+/// y_l are E0 + sum_l K_l y_l (kinematics/thermal_lag.hpp, the one lag implementation); their
+/// covariance is propagated from the fit's covariance of the cold errors, each tau and the gains.
 
 #include <Eigen/Core>
 #include <array>
@@ -14,7 +14,6 @@
 #include <string>
 #include <vector>
 
-#include "rotacal/io/controller_export.hpp"
 #include "rotacal/io/model_file.hpp"
 #include "rotacal/session/thermal_result.hpp"
 #include "rotacal/session/thermal_test.hpp"
@@ -78,10 +77,5 @@ ThermalErrorsAt thermal_errors_at_time(const ThermalModel& m, const HeatInput& h
 /// its first piece to 5 of the longest tau after its last (the drift within 1 % of its end).
 std::vector<double> thermal_prediction_times(const ThermalModel& m, const HeatInput& heat,
                                              double step_s = 600.0);
-
-/// The export input of the errors at a state: values, covariance and observability of `at`,
-/// the source of the file with `state` (words, e.g. "y1 = 0.81: 2 h of the test duty") added.
-ExportInput thermal_export_input(const ThermalModel& m, const ThermalErrorsAt& at,
-                                 const std::string& model_path, const std::string& state);
 
 }  // namespace rotacal
