@@ -6,9 +6,42 @@
 #include <pybind11/stl.h>
 
 #include "numpy.hpp"
+#include "rotacal/io/ballbar_file.hpp"
 #include "rotacal/io/controller_comment.hpp"
+#include "rotacal/io/thermal_model.hpp"
 
 namespace rotacal::py {
+
+namespace {
+
+// The export of a thermal model at a lag state: at a time of the test's duty, or given.
+ControllerExport export_thermal(Controller c, const std::string& model_path,
+                                const std::optional<std::string>& current_text,
+                                const std::string& current_source, int toolholder,
+                                const std::string& generated_at, std::optional<double> at_s,
+                                const std::optional<std::vector<double>>& state) {
+  if (at_s && state) throw InvalidArgument("--at and --state: give one of them");
+  if (at_s && !(*at_s >= 0.0 && *at_s <= 1e8))
+    throw InvalidArgument("--at: a time of the test duty, 0 to 1e8 s from its first row");
+  const ThermalModel m = read_thermal_model(model_path);
+  const ThermalErrorsAt at =
+      at_s ? thermal_errors_at_time(m, m.test_heat, m.test_heat.start.front() + *at_s)
+           : thermal_errors_at_state(m, *state);
+  std::string words;
+  for (std::size_t l = 0; l < at.y.size(); ++l)
+    words += (l ? ", y" : "y") + std::to_string(l + 1) + " = " + format_number(at.y[l]);
+  if (at_s) words += " (" + format_number(*at_s) + " s of the test duty from its first row)";
+  ExportOptions o;
+  o.toolholder = toolholder;
+  o.generated_at = generated_at;
+  if (current_text) {
+    o.current = parse_current_parameters(c, m.machine, *current_text, current_source, toolholder);
+    o.current_given = true;
+  }
+  return export_kinematics(c, thermal_export_input(m, at, model_path, words), o);
+}
+
+}  // namespace
 
 void bind_controller_export(pyb::module_& m) {
   pyb::class_<ControllerValue>(m, "ControllerValue", "One controller parameter as written.")
@@ -44,8 +77,12 @@ void bind_controller_export(pyb::module_& m) {
       "export_controller",
       [](const std::string& model_path, const std::string& controller,
          std::optional<std::string> current_text, const std::string& current_source, int toolholder,
-         const std::string& generated_at) {
+         const std::string& generated_at, std::optional<double> thermal_at_s,
+         std::optional<std::vector<double>> thermal_state) {
         const Controller c = parse_controller(controller);
+        if (thermal_at_s || thermal_state)  // a thermal model at a lag state (io/thermal_model.hpp)
+          return export_thermal(c, model_path, current_text, current_source, toolholder,
+                                generated_at, thermal_at_s, thermal_state);
         const ModelFile model = read_model(model_path);
         ExportOptions o;
         o.toolholder = toolholder;
@@ -59,10 +96,12 @@ void bind_controller_export(pyb::module_& m) {
       },
       pyb::arg("model_path"), pyb::arg("controller"), pyb::arg("current_text") = std::nullopt,
       pyb::arg("current_source") = "<current>", pyb::arg("toolholder") = 1,
-      pyb::arg("generated_at") = "",
+      pyb::arg("generated_at") = "", pyb::arg("thermal_at_s") = std::nullopt,
+      pyb::arg("thermal_state") = std::nullopt,
       "Export a model file's location errors into a controller's kinematic parameters "
       "(io/controller_export.hpp); current_text: the controller's current values (its HAL/MPF file "
-      "or the documented JSON), None for zero offsets.");
+      "or the documented JSON), None for zero offsets. A thermal model at thermal_at_s (s of the "
+      "test's duty from its first row) or at thermal_state (y per lag): its errors there.");
   m.def(
       "comment_lines",
       [](const std::string& dialect, const std::string& text) {

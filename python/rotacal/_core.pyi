@@ -7,7 +7,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Alternative', 'Ambiguity', 'AngleTable', 'AxisAngleMap', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CircularAnalysis', 'CircularDiagnosis', 'CircularDiagnosisOptions', 'CircularDirection', 'CircularEffect', 'CircularFinding', 'CircularPairResult', 'CircularPlanResult', 'CircularPlane', 'CircularRun', 'CircularRunResult', 'CircularSimulationOptions', 'CircularTestPlan', 'CompensationReport', 'CompensationRow', 'CompensationTable', 'CompensationTables', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'Identification', 'InvalidArgument', 'IoError', 'LinearAxisErrors', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'MultiDisagreement', 'MultiIdentification', 'MultiSessionResult', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'ProbeDesign', 'ProbeDesignCandidate', 'ProbeDesignOptions', 'ProbeIdentification', 'ProbeMonteCarlo', 'ProbeSeparatingCandidate', 'ProbeSeparationDesign', 'ProbeSeparationOptions', 'ProbeSession', 'ProbeSphereTrial', 'RadialSide', 'RealtimeModel', 'RecordSummary', 'RtestBasis', 'RtestDesign', 'RtestDesignCandidate', 'RtestDesignOptions', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSeparatingCandidate', 'RtestSeparationDesign', 'RtestSeparationOptions', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SeparatingCandidate', 'SeparationDesign', 'SeparationOptions', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'SweepDirection', 'TableMotionOverlap', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualCircularBallbar', 'VirtualRtest', 'analyze_circular', 'angle_maps', 'ballbar_model_document', 'ballbar_model_from_document', 'box_least_squares', 'builtin_machine_names', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_json_bounds', 'check_model_machine', 'check_output', 'check_plausible', 'check_rtest_pattern', 'circular_catalogue', 'circular_commanded_session', 'circular_label', 'comment_lines', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_axial_c_tilt_deg', 'default_ballbar_tests', 'default_calibration_moves', 'default_probe_poses_deg', 'default_rtest_pattern', 'default_tilt_range_deg', 'design_ballbar_separation', 'design_ballbar_test', 'design_probe_separation', 'design_probe_test', 'design_rtest_separation', 'design_rtest_test', 'diagnose_ballbar', 'diagnose_circular', 'diagnose_probe', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'evaluate_rtest_design', 'export_controller', 'format_ballbar', 'format_model_document', 'format_probe', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_joint_sessions', 'identify_multi', 'identify_paper', 'identify_probe', 'identify_probe_cycles', 'identify_rtest_joint', 'identify_rtest_paper', 'identify_runs', 'is_rotary_test', 'kasa_circle_fit', 'linuxcnc_comp_tables', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_probe', 'monte_carlo_rtest', 'multi_model_document', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_circular_direction', 'parse_circular_plane', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'parse_sweep_direction', 'plan_ballbar_test', 'plan_circular_test', 'predict_rtest_session', 'predict_session_lengths', 'probe_effect_catalogue', 'probe_model_document', 'read_ballbar', 'read_instrument_session', 'read_linuxcnc_probe_log', 'read_model_document', 'read_probe', 'read_rtest', 'read_session', 'realtime_model_of_blob', 'realtime_model_of_file', 'record_ballbar', 'record_circular_ballbar', 'record_rtest', 'record_run', 'refuse_disagreeing', 'rtest_error_map', 'rtest_joint_model_document', 'rtest_map_names', 'rtest_prediction_rms_um', 'rtest_readings', 'run_label', 'simulate_ballbar', 'simulate_circular', 'simulate_probe', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sinumerik_eec_tables', 'sphere_fit', 'svd_plane_fit', 'table_motion_overlap', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_probe', 'uncertainty_budget_rtest', 'uncertainty_budget_rtest_identification', 'verify_compensation', 'write_ballbar', 'write_circular_nc_program', 'write_model_document', 'write_nc_program', 'write_output', 'write_probe', 'write_probe_nc_program', 'write_rtest']
+__all__: list[str] = ['Alternative', 'Ambiguity', 'AngleTable', 'AxisAngleMap', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CircularAnalysis', 'CircularDiagnosis', 'CircularDiagnosisOptions', 'CircularDirection', 'CircularEffect', 'CircularFinding', 'CircularPairResult', 'CircularPlanResult', 'CircularPlane', 'CircularRun', 'CircularRunResult', 'CircularSimulationOptions', 'CircularTestPlan', 'CompensationReport', 'CompensationRow', 'CompensationTable', 'CompensationTables', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FanucPitchOptions', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'Identification', 'InvalidArgument', 'IoError', 'LinearAxisErrors', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'MultiDisagreement', 'MultiIdentification', 'MultiSessionResult', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'ProbeDesign', 'ProbeDesignCandidate', 'ProbeDesignOptions', 'ProbeIdentification', 'ProbeMonteCarlo', 'ProbeSeparatingCandidate', 'ProbeSeparationDesign', 'ProbeSeparationOptions', 'ProbeSession', 'ProbeSphereTrial', 'RadialSide', 'RealtimeModel', 'RecordSummary', 'RtestBasis', 'RtestDesign', 'RtestDesignCandidate', 'RtestDesignOptions', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSeparatingCandidate', 'RtestSeparationDesign', 'RtestSeparationOptions', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SeparatingCandidate', 'SeparationDesign', 'SeparationOptions', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'SweepDirection', 'TableMotionOverlap', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualCircularBallbar', 'VirtualRtest', 'analyze_circular', 'angle_maps', 'ballbar_model_document', 'ballbar_model_from_document', 'box_least_squares', 'builtin_machine_names', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_json_bounds', 'check_model_machine', 'check_output', 'check_plausible', 'check_rtest_pattern', 'circular_catalogue', 'circular_commanded_session', 'circular_label', 'comment_lines', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_axial_c_tilt_deg', 'default_ballbar_tests', 'default_calibration_moves', 'default_probe_poses_deg', 'default_rtest_pattern', 'default_tilt_range_deg', 'design_ballbar_separation', 'design_ballbar_test', 'design_probe_separation', 'design_probe_test', 'design_rtest_separation', 'design_rtest_test', 'diagnose_ballbar', 'diagnose_circular', 'diagnose_probe', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'evaluate_rtest_design', 'export_controller', 'fanuc_pitch_tables', 'format_ballbar', 'format_model_document', 'format_probe', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_joint_sessions', 'identify_multi', 'identify_paper', 'identify_probe', 'identify_probe_cycles', 'identify_rtest_joint', 'identify_rtest_paper', 'identify_runs', 'identify_thermal', 'is_rotary_test', 'is_thermal_session', 'kasa_circle_fit', 'linuxcnc_comp_tables', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_probe', 'monte_carlo_rtest', 'multi_model_document', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_circular_direction', 'parse_circular_plane', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'parse_sweep_direction', 'plan_ballbar_test', 'plan_circular_test', 'predict_rtest_session', 'predict_session_lengths', 'predict_thermal', 'probe_effect_catalogue', 'probe_model_document', 'read_ballbar', 'read_instrument_session', 'read_linuxcnc_probe_log', 'read_model_document', 'read_probe', 'read_rtest', 'read_session', 'realtime_model_of_blob', 'realtime_model_of_file', 'record_ballbar', 'record_circular_ballbar', 'record_rtest', 'record_run', 'refuse_disagreeing', 'rtest_error_map', 'rtest_joint_model_document', 'rtest_map_names', 'rtest_prediction_rms_um', 'rtest_readings', 'run_label', 'simulate_ballbar', 'simulate_circular', 'simulate_probe', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sinumerik_eec_tables', 'sphere_fit', 'svd_plane_fit', 'table_motion_overlap', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_probe', 'uncertainty_budget_rtest', 'uncertainty_budget_rtest_identification', 'verify_compensation', 'write_ballbar', 'write_circular_nc_program', 'write_model_document', 'write_nc_program', 'write_output', 'write_probe', 'write_probe_nc_program', 'write_rtest']
 class Alternative:
     @property
     def aliased(self) -> bool:
@@ -1378,6 +1378,44 @@ class ErrorDisposition:
     @property
     def where(self) -> str:
         ...
+class FanucPitchOptions:
+    """
+    FANUC pitch error compensation: the control's units and limits.
+    """
+    def __init__(self) -> None:
+        ...
+    @property
+    def detection_unit_deg(self) -> float:
+        ...
+    @detection_unit_deg.setter
+    def detection_unit_deg(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def first_number(self) -> int:
+        ...
+    @first_number.setter
+    def first_number(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def last_number(self) -> int:
+        ...
+    @last_number.setter
+    def last_number(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def magnification(self) -> int:
+        """
+        parameter 3623; 0: the smallest of 1..100 that keeps the values in range
+        """
+    @magnification.setter
+    def magnification(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def max_value(self) -> int:
+        ...
+    @max_value.setter
+    def max_value(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
 class FaultInjection:
     """
     Faults a virtual instrument acts out (counted in frames).
@@ -1780,6 +1818,11 @@ class MultiDisagreement:
     def difference(self) -> float:
         ...
     @property
+    def dof(self) -> float:
+        """
+        of sigma (Welch-Satterthwaite)
+        """
+    @property
     def parameter(self) -> str:
         ...
     @property
@@ -1791,6 +1834,11 @@ class MultiDisagreement:
     @property
     def sigma(self) -> float:
         ...
+    @property
+    def threshold(self) -> float:
+        """
+        |z| beyond which it disagrees
+        """
     @property
     def unit(self) -> str:
         ...
@@ -1850,6 +1898,11 @@ class MultiSessionResult:
     @property
     def alone(self) -> list[ParameterEstimate]:
         ...
+    @property
+    def dof(self) -> float:
+        """
+        of its sigmas alone
+        """
     @property
     def instrument(self) -> str:
         ...
@@ -4005,9 +4058,13 @@ def evaluate_rtest_design(pattern: RtestPattern, options: RtestDesignOptions, ti
     """
     One R-test pattern evaluated at a time budget (0: its own run time).
     """
-def export_controller(model_path: str, controller: str, current_text: str | None = None, current_source: str = '<current>', toolholder: typing.SupportsInt | typing.SupportsIndex = 1, generated_at: str = '') -> ControllerExport:
+def export_controller(model_path: str, controller: str, current_text: str | None = None, current_source: str = '<current>', toolholder: typing.SupportsInt | typing.SupportsIndex = 1, generated_at: str = '', thermal_at_s: typing.SupportsFloat | typing.SupportsIndex | None = None, thermal_state: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] | None = None) -> ControllerExport:
     """
-    Export a model file's location errors into a controller's kinematic parameters (io/controller_export.hpp); current_text: the controller's current values (its HAL/MPF file or the documented JSON), None for zero offsets.
+    Export a model file's location errors into a controller's kinematic parameters (io/controller_export.hpp); current_text: the controller's current values (its HAL/MPF file or the documented JSON), None for zero offsets. A thermal model at thermal_at_s (s of the test's duty from its first row) or at thermal_state (y per lag): its errors there.
+    """
+def fanuc_pitch_tables(model_path: str, spacing_deg: typing.SupportsFloat | typing.SupportsIndex = 5.0, range_deg: collections.abc.Mapping[str, typing.Annotated[collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], "FixedSize(2)"]] = {}, fanuc: FanucPitchOptions = ..., generated_at: str = '') -> CompensationTables:
+    """
+    FANUC pitch error compensation data (parameters 3620-3625 and values by data number) of each table axis' positioning error (io/compensation_table.hpp).
     """
 def format_ballbar(session: BallbarSession) -> str:
     ...
@@ -4095,8 +4152,41 @@ def identify_runs(setup: BallbarSetup, machines: collections.abc.Sequence[Ballba
     -------
     (N, 8) identified location errors, mm and rad, in location_error_names order
     """
+def identify_thermal(path: str, lags: typing.SupportsInt | typing.SupportsIndex = 1, tolerance_mm: typing.SupportsFloat | typing.SupportsIndex | None = None, tolerance_rad: typing.SupportsFloat | typing.SupportsIndex | None = None, noise: str = 'auto', peer: bool = False, model: bool = False) -> typing.Any:
+    """
+    Identify a thermal probe or R-test session (one joint fit over every row).
+    
+    Parameters
+    ----------
+    path : str
+        A ``rotacal-probe/1`` or ``rotacal-rtest/1`` file with an ``epoch`` column and
+        ``# duty.N:`` lines.
+    lags : int
+        1, or 2 (a fast and a slow lag).
+    tolerance_mm, tolerance_rad : float, optional
+        The drift the user tolerates, for the time from cold after which it may exceed it.
+    noise : str
+        "auto": AR noise model of the residuals, GLS refit when correlated; "white".
+    peer : bool
+        Also the per-epoch peer (touch probe): each epoch identified alone, then one lag fitted
+        to the series; under ``peer``, as the joint fit's.
+    model : bool
+        Also the thermal model file's document (``model``; io/thermal_model.hpp), without its
+        ``source``.
+    
+    Returns
+    -------
+    dict
+        ``identification`` (cold values, each lag's tau and gains with sigma or the reason they
+        are unobservable), ``summary`` (steady-state change at the tested speed, significance,
+        time to exceed the tolerance, tau), ``warnings``.
+    """
 def is_rotary_test(test: BallbarTest) -> bool:
     ...
+def is_thermal_session(path: str) -> bool:
+    """
+    True when the file has an ``epoch`` column or ``# duty.N:`` lines.
+    """
 def kasa_circle_fit(points: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], sigma: typing.SupportsFloat | typing.SupportsIndex = 0.0, refine: bool = False) -> CircleFit:
     """
     Circle fit to (N, 2) points.
@@ -4206,6 +4296,27 @@ def predict_rtest_session(model: RtestJointModel, session: RtestSession, probe_z
 def predict_session_lengths(model: BallbarMachineModel, session: BallbarSession) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
     """
     Predicted centre-to-centre lengths (mm) of every sample of the session on the model.
+    """
+def predict_thermal(model_path: str, duty_path: str, times: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] | None = None, step_s: typing.SupportsFloat | typing.SupportsIndex = 600.0) -> typing.Any:
+    """
+    The location errors a thermal model file predicts for a duty (io/thermal_model.hpp).
+    
+    Parameters
+    ----------
+    model_path : str
+        A thermal model file (``rotacal identify THERMAL.csv --save-model``).
+    duty_path : str
+        A file of ``# duty.N: TIME, AXIS=SPEED, ...`` lines (from cold at 0 s), or a thermal
+        session (its duty and epochs, the lag state 0 at its first row).
+    times : list of float, optional
+        s on the duty's clock; default every ``step_s`` to 5 taus after the last entry.
+    
+    Returns
+    -------
+    dict
+        ``axis``, ``times_s``, ``states`` (each lag's y per time) and ``errors``: per location
+        error ``name``, ``unit``, ``observable``, ``value`` and ``std`` per time (tau's
+        uncertainty propagated with the cold values' and the gains').
     """
 def probe_effect_catalogue(machine: MachineType, max_harmonic: typing.SupportsInt | typing.SupportsIndex = 4) -> list[Effect]:
     """

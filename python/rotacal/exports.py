@@ -47,13 +47,16 @@ def export_controller(
     current: str | Path | None = None,
     toolholder: int = 1,
     generated_at: str = "",
+    thermal_at_s: float | None = None,
+    thermal_state: list[float] | None = None,
 ) -> Any:
     """A ``rotacal._core.ControllerExport`` of a model file: ``.text`` is the file for the
     controller, ``.values`` the parameters (current, corrected, 1-sigma), ``.errors`` which of
     the location errors it holds. ``current``: the controller's values active during the test
     (its HAL or MPF file, or ``{"controller": ..., "parameters": {...}}`` JSON); without it the
     values the model keeps (``source.controller_parameters``, from ``identify --controller``),
-    else zero offsets, which the output says."""
+    else zero offsets, which the output says. A thermal model (docs/thermal.md) is exported at
+    ``thermal_at_s`` (s of the test's duty) or ``thermal_state`` (y per lag)."""
     if current is not None:
         text, where = read_current(current), os.fspath(current)
     else:  # the values the model says were active (identify --controller), if any
@@ -62,7 +65,14 @@ def export_controller(
         text = load_model(model).get("source", {}).get("controller_parameters")
         where = f"{os.fspath(model)}: source.controller_parameters"
     return _core.export_controller(
-        os.fspath(model), controller, text, where, int(toolholder), generated_at
+        os.fspath(model),
+        controller,
+        text,
+        where,
+        int(toolholder),
+        generated_at,
+        thermal_at_s,
+        thermal_state,
     )
 
 

@@ -15,6 +15,7 @@
 #include "rotacal/core/error.hpp"
 #include "rotacal/core/json_text.hpp"
 #include "rotacal/io/fitted_model.hpp"
+#include "rotacal/io/thermal_model.hpp"
 
 namespace rotacal {
 
@@ -27,8 +28,8 @@ using model_checks::member;
 using model_checks::object_member;
 using model_checks::shown;
 
-const std::set<std::string> kKinds = {"ballbar", "rtest-joint", "rtest-diagnosis", "probe",
-                                      "multi"};
+const std::set<std::string> kKinds = {"ballbar", "rtest-joint", "rtest-diagnosis",
+                                      "probe",   "multi",       "thermal"};
 
 // Reads `rotacal-model/M` or `rotacal-model/M.N`; refuses another major version by name.
 int format_minor(const json& doc, const std::string& source) {
@@ -177,7 +178,8 @@ void check_envelope(const json& doc, const std::string& source, ModelFile& m) {
   const json& kind = member(doc, "kind", source, "");
   if (!kind.is_string() || !kKinds.count(kind.get<std::string>()))
     bad(source, "kind",
-        shown(kind) + " is not one of ballbar, rtest-joint, rtest-diagnosis, probe, multi");
+        shown(kind) +
+            " is not one of ballbar, rtest-joint, rtest-diagnosis, probe, multi, thermal");
   m.kind = kind.get<std::string>();
   const json& machine = member(doc, "machine", source, "");
   if (!machine.is_string())
@@ -249,7 +251,8 @@ json read_model_document(const std::string& path) {
   ModelFile envelope;
   check_envelope(doc, path, envelope);
   // Nothing later reads a probe or multi model's own members member by member: all checked now.
-  if (envelope.kind == "probe" || envelope.kind == "multi") model_from_json(doc, path);
+  if (envelope.kind == "probe" || envelope.kind == "multi" || envelope.kind == "thermal")
+    model_from_json(doc, path);
   return doc;
 }
 
@@ -318,6 +321,7 @@ ModelFile model_from_json(const json& doc, const std::string& source) {
   }
   if (m.kind == "rtest-joint") check_rtest_joint(doc, m.machine, source);
   if (m.kind == "probe" || m.kind == "multi") fitted_model_from_json(doc, m.machine, source);
+  if (m.kind == "thermal") check_thermal_model(doc, m.machine, source);
   probe_zeros(doc, source);
   if (doc.contains("null_reasons") && !doc["null_reasons"].is_object())
     bad(source, "null_reasons", "must be an object (JSON pointer -> reason)");
@@ -330,7 +334,14 @@ ModelFile parse_model(const std::string& text, const std::string& source) {
 }
 
 ModelFile read_model(const std::string& path) {
-  return model_from_json(parse_json(read_text(path), path), path);
+  ModelFile m = model_from_json(parse_json(read_text(path), path), path);
+  // Its location_errors are the cold ones: a use that knows no lag state would take them.
+  if (m.kind == "thermal")
+    bad(path, "kind",
+        "a thermal model: its location errors drift as the axis runs; predict them with "
+        "`rotacal predict --duty` or export them at a state with `rotacal export --at/--state` "
+        "(docs/thermal.md)");
+  return m;
 }
 
 json strict_json(json document) {

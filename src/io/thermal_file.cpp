@@ -149,4 +149,42 @@ ThermalSession read_thermal_session(const std::string& path) {
   return out;
 }
 
+ThermalTest read_duty_file(const std::string& path, MachineType machine) {
+  std::ifstream in = open_for_reading(path);
+  if (sniff_format_line(in, path).line.rfind("# format:", 0) == 0) {  // a thermal session
+    const ThermalSession s = read_thermal_session(path);
+    const MachineType m = std::visit([](const auto& x) { return x.machine; }, s.session);
+    if (!(m == machine))
+      throw InvalidArgument(path + ": a session of machine " + to_string(m) + ", the model's is " +
+                            to_string(machine));
+    if (s.thermal.duty.empty())
+      throw InvalidArgument(path + ": no '# duty.N:' lines: no duty to predict");
+    return s.thermal;
+  }
+  Reader R;
+  R.name = path;
+  std::string line;
+  while (std::getline(in, line)) {
+    ++R.line_no;
+    if (R.line_no > 100000) R.fail(R.line_no, 0, "more than 100000 lines: not a duty file");
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const std::string t = trim(line);
+    if (t.empty()) continue;
+    const std::size_t colon = t.find(':');
+    if (t[0] != '#' || colon == std::string::npos)
+      R.fail(R.line_no, 0,
+             "'" + excerpt(t) + "' is not a '# duty.N: TIME, AXIS=SPEED, ...' line (formats.md)");
+    const std::string key = trim(t.substr(1, colon - 1));
+    for (const auto& kv : R.metadata)
+      if (kv.first == key) R.fail(R.line_no, 0, "'" + excerpt(key) + "' given twice");
+    R.metadata.emplace_back(key, trim(t.substr(colon + 1)));
+    R.meta_lines.push_back(R.line_no);
+  }
+  ThermalTest th;
+  th.duty = read_duty(R, machine);
+  if (th.duty.empty()) throw InvalidArgument(path + ": no '# duty.N:' lines: no duty to predict");
+  th.time = {0.0, th.duty.back().time + 1.0};  // from cold at 0 s; the last entry runs on
+  return th;
+}
+
 }  // namespace rotacal

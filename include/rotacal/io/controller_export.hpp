@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "rotacal/io/model_file.hpp"
+#include "rotacal/io/thermal_model.hpp"
 #include "rotacal/kinematics/machine.hpp"
 
 namespace rotacal {
@@ -112,5 +113,10 @@ std::map<std::string, double> parse_current_parameters(Controller controller, Ma
                                                        const std::string& text,
                                                        const std::string& source,
                                                        int toolholder = 1);
+
+/// The export input of the errors at a state: values, covariance and observability of `at`,
+/// the source of the file with `state` (words, e.g. "y1 = 0.81: 2 h of the test duty") added.
+ExportInput thermal_export_input(const ThermalModel& m, const ThermalErrorsAt& at,
+                                 const std::string& model_path, const std::string& state);
 
 }  // namespace rotacal

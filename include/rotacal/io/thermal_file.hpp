@@ -32,6 +32,14 @@ struct ThermalSession {
 /// lag state starts at 0 at the first row whatever turned before it.
 ThermalSession read_thermal_session(const std::string& path);
 
+/// The duty of a prediction (`rotacal predict --duty`) for `machine`: a file of `# duty.N: TIME,
+/// AXIS=SPEED, ...` lines (formats.md; other `# key: value` lines and blank lines are kept out,
+/// any other line refused by line), its clock starting cold at 0 s with no epochs; or a thermal
+/// session, whose duty and epochs (the axes held) are the test's, its lag state 0 at its first
+/// row. ParseError (file, line) as read_thermal_session; InvalidArgument for a file without duty
+/// lines or a session of another machine.
+ThermalTest read_duty_file(const std::string& path, MachineType machine);
+
 /// True when the file has an `epoch` column or `# duty.N:` lines (a cheap look at its head).
 bool is_thermal_session(const std::string& path);
 

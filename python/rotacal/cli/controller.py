@@ -11,7 +11,7 @@ from types import SimpleNamespace
 from .. import _core, jsontext
 from ..outputs import write_output
 from ..sessions import checked_path, load
-from .options import EPILOG, EXIT_OK, OptionError, number, numbers, path, say
+from .options import EPILOG, EXIT_OK, OptionError, number, number_list, numbers, path, say
 from .setups import add_setup_args, add_truth_args, ballbar_model, ballbar_setup, ballbar_truth
 
 
@@ -67,6 +67,7 @@ def cmd_export_realtime(a: argparse.Namespace) -> int:
             ("--comp-file", a.comp_file),
             ("--json", a.json),
             ("--tables", a.tables),
+            ("--at/--state", a.at is not None or a.state is not None),
         )
         if v
     ]
@@ -171,7 +172,15 @@ def cmd_export(a: argparse.Namespace) -> int:
         raise _core.InvalidArgument(
             "--centres and --centres-output go together, with --controller isg"
         )
-    ex = export_controller(a.model, a.controller, current=a.current, toolholder=a.toolholder)
+    thermal = {"thermal_at_s": a.at, "thermal_state": a.state}  # a thermal model's lag state
+    if (a.at is not None or a.state is not None) and (a.residual_model or a.tables or comp):
+        raise _core.InvalidArgument(
+            "--at/--state: the parameters at that state only (no --residual-model, --tables, "
+            "--comp-file)"
+        )
+    ex = export_controller(
+        a.model, a.controller, current=a.current, toolholder=a.toolholder, **thermal
+    )
     if comp and a.tables:
         raise _core.InvalidArgument("--comp-file and --tables: give one of them")
     tabs = _write_tables(a) if a.tables else (_write_comp_files(a, comp) if comp else None)
@@ -283,6 +292,20 @@ def add_export(sub: argparse._SubParsersAction) -> None:
         type=path("--current"),
         help="the controller's values active during the test: its HAL file (linuxcnc), MPF (siemens) "
         'or JSON {"controller": ..., "parameters": {...}}; default: zero offsets',
+    )
+    from .thermal import duration
+
+    q.add_argument(
+        "--at",
+        type=duration("--at"),
+        help="a thermal model (docs/thermal.md): the errors after this time of the test's duty "
+        "from its first row, e.g. 2h",
+    )
+    q.add_argument(
+        "--state",
+        type=number_list("--state", 0.0, 1000.0, most=2),
+        help="a thermal model: the errors at these lag states y1[,y2] (0: cold; 3: steady "
+        "state at 300 rev/min)",
     )
     q.add_argument(
         "--toolholder",

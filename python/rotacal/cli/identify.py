@@ -497,4 +497,4 @@ def add_predict(sub: argparse._SubParsersAction) -> None:
     q.set_defaults(func=cmd_predict)
 
 
-COMMANDS = {"predict": add_predict}  # identify: cli/thermal.py (which calls add_identify)
+COMMANDS: dict = {}  # identify and predict: cli/thermal.py (which calls add_identify, add_predict)

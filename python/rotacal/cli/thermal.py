@@ -3,7 +3,11 @@
 axis"): a probe or R-test file with an ``epoch`` column and ``# duty.N:`` lines is identified by
 one joint fit over every row (probe/thermal.hpp, rtest/thermal.hpp), and its summary printed:
 per location error the steady-state change at the tested speed, whether it is significant, and
-after how long from cold it may exceed ``--tolerance``. Any other file goes to cli/identify.py.
+after how long from cold it may exceed ``--tolerance``; ``--save-model`` writes the thermal model
+file (io/thermal_model.hpp). Any other file goes to cli/identify.py.
+
+``rotacal predict --model THERMAL_MODEL --duty FILE``: the location errors that model predicts
+over the times of another duty. Any other predict goes to cli/identify.py.
 """
 
 from __future__ import annotations
@@ -13,7 +17,7 @@ import re
 
 from .. import _core, jsontext
 from . import identify
-from .options import EXIT_OK, OptionError, number, say
+from .options import EXIT_OK, OptionError, number, path, say
 
 # --tolerance units -> (native unit, factor to it)
 _TOLERANCE_UNITS = {
@@ -25,7 +29,46 @@ _TOLERANCE_UNITS = {
     "rad": ("rad", 1.0),
 }
 # Options of `identify` a thermal session uses; the others are refused rather than ignored.
-_THERMAL_DESTS = {"command", "func", "file", "json", "noise", "tolerance", "lags", "peer"}
+_THERMAL_DESTS = {
+    "command",
+    "func",
+    "file",
+    "json",
+    "noise",
+    "tolerance",
+    "lags",
+    "peer",
+    "save_model",
+}
+_DURATION_UNITS = {"s": 1.0, "min": 60.0, "h": 3600.0}
+
+
+def duration(option: str):
+    """argparse type: a time such as 2h, 10min, 90s or 600 (s), 0 to 1e8 s."""
+
+    def parse(text: str) -> float:
+        m = re.fullmatch(r"\s*([0-9.eE+-]+)\s*(s|min|h)?\s*", text)
+        if not m:
+            raise OptionError(f"{option}: '{text[:40]}' is not a time such as 2h, 10min or 600s")
+        value = number(option, 0.0, 1e8, "s")(m.group(1)) * _DURATION_UNITS[m.group(2) or "s"]
+        if not value <= 1e8:
+            raise OptionError(f"{option}: {text[:40]} is beyond 1e8 s")
+        return value
+
+    return parse
+
+
+def durations(option: str):
+    """argparse type: comma-separated times (see duration), at most 100000."""
+    one = duration(option)
+
+    def parse(text: str) -> list[float]:
+        parts = text.split(",")
+        if len(parts) > 100_000:
+            raise OptionError(f"{option}: more than 100000 times")
+        return [one(p) for p in parts]
+
+    return parse
 
 
 def tolerance(text: str) -> tuple[str, float]:
@@ -93,8 +136,21 @@ def cmd_identify(a: argparse.Namespace) -> int:
             raise OptionError(f"--tolerance: given twice in {'um' if unit == 'mm' else 'urad'}")
         tol[unit] = value
     d = _core.identify_thermal(
-        a.file[0], a.lags, tol.get("mm"), tol.get("rad"), noise=a.noise, peer=a.peer
+        a.file[0],
+        a.lags,
+        tol.get("mm"),
+        tol.get("rad"),
+        noise=a.noise,
+        peer=a.peer,
+        model=bool(a.save_model),
     )
+    if a.save_model:
+        from ..models import save_model, source_dict
+
+        save_model(
+            d.pop("model") | {"source": source_dict(a.file[0])}, a.save_model, inputs=(a.file[0],)
+        )
+        say(f"wrote {a.save_model}: the thermal model (docs/thermal.md)")
     for w in d["warnings"]:
         say(f"rotacal: warning: {w}")
     if a.json:
@@ -159,4 +215,70 @@ def print_thermal(d: dict) -> None:
         print(f"note: {n}")
 
 
-COMMANDS = {"identify": add_identify}
+def add_predict(sub: argparse._SubParsersAction) -> None:
+    identify.add_predict(sub)
+    q = sub.choices["predict"]
+    q._option_string_actions["--output"].required = False  # the thermal prediction prints
+    g = q.add_argument_group("a thermal model (docs/thermal.md)")
+    g.add_argument(
+        "--duty",
+        type=path("--duty"),
+        help="instead of a session: a file of '# duty.N: TIME, AXIS=SPEED, ...' lines (from cold "
+        "at 0 s), or a thermal session (its duty and epochs); prints the location errors the "
+        "thermal --model predicts over time (CSV, or -o FILE, or --json)",
+    )
+    g.add_argument(
+        "--times",
+        type=durations("--times"),
+        help="--duty: the times, e.g. 0,30min,2h (default: every --step to 5 taus after the "
+        "duty's last entry)",
+    )
+    g.add_argument(
+        "--step",
+        type=duration("--step"),
+        default=600.0,
+        help="--duty: between the default times (default 10min)",
+    )
+    g.add_argument("--json", action="store_true", help="--duty: print the prediction as JSON")
+    q.set_defaults(func=cmd_predict)
+
+
+def cmd_predict(a: argparse.Namespace) -> int:
+    if a.duty is None:
+        if a.times is not None or a.json or a.step != 600.0:
+            raise OptionError("--times, --step, --json: for a thermal prediction (--duty)")
+        if a.output is None:
+            raise OptionError("predict: -o/--output is required")
+        return identify.cmd_predict(a)
+    if a.session is not None or a.joints is not None:
+        raise OptionError("predict --duty: no SESSION or --joints with it")
+    if not a.step > 0:
+        raise OptionError("--step: must be > 0")
+    d = _core.predict_thermal(a.model, a.duty, a.times, a.step)
+    text = jsontext.dumps(d) + "\n" if a.json else prediction_csv(d)
+    if a.output:
+        from ..outputs import write_output
+
+        write_output(a.output, text, inputs=[a.model, a.duty])
+        say(f"wrote {a.output}: the location errors at {len(d['times_s'])} times")
+    else:
+        print(text, end="")
+    return EXIT_OK
+
+
+def prediction_csv(d: dict) -> str:
+    """time_s, each lag's y, then each location error and its 1 sigma (mm, rad)."""
+    lags = len(d["states"][0]) if d["states"] else 0
+    head = ["time_s", *(f"y{k + 1}" for k in range(lags))]
+    for e in d["errors"]:
+        head += [e["name"], f"{e['name']}_std"]
+    rows = [",".join(head)]
+    for i, t in enumerate(d["times_s"]):
+        row = [f"{t:.3f}", *(f"{y:.9f}" for y in d["states"][i])]
+        for e in d["errors"]:
+            row += [f"{e['value'][i]:.9g}", f"{e['std'][i]:.3g}"]
+        rows.append(",".join(row))
+    return "\n".join(rows) + "\n"
+
+
+COMMANDS = {"identify": add_identify, "predict": add_predict}
