@@ -150,6 +150,20 @@ std::vector<Eigen::MatrixXd> BallbarDiagnosisProblem::candidate_jacobians(
                                                    angles);
 }
 
+void BallbarDiagnosisProblem::visit_candidate_jacobians(
+    const ModelFit& at, const std::vector<Effect>& candidates,
+    const std::function<void(std::size_t, const Eigen::MatrixXd&)>& visit) const {
+  const auto angles = [&](Eigen::Index r) { return arrays_.angles[static_cast<std::size_t>(r)]; };
+  const MachineType m = session_.machine;
+  const auto each = [&](std::size_t i, const Eigen::MatrixXd& J) { visit(i, J); };
+  if (!diagnosis_detail::BallbarSensitivities::supports(m))
+    return diagnosis_detail::for_each_candidate(
+        m, candidates, jets_on(m, session_.samples, arrays_.motion, at), angles, each);
+  const diagnosis_detail::BallbarSensitivities S(m, session_.samples, arrays_.motion, at);
+  // Each candidate visited once: the places are not kept (a long session's memory).
+  diagnosis_detail::for_each_candidate(m, candidates, chain_rule_on(S, nullptr), angles, each);
+}
+
 Eigen::MatrixXd BallbarDiagnosisProblem::candidate_jacobian(const ModelFit& at,
                                                             const Effect& candidate) const {
   return jacobian_on(session_.samples, arrays_.motion, at, candidate);
