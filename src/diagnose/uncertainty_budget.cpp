@@ -122,8 +122,8 @@ void budget_detail::check_inputs(const PlausibleSizes& sizes, const std::vector<
 }
 
 UncertaintyBudget uncertainty_budget(const DiagnosisProblem& P, const Diagnosis& D,
-                                     const PlausibleSizes& sizes, double coverage,
-                                     int max_harmonic) {
+                                     const PlausibleSizes& sizes, double coverage, int max_harmonic,
+                                     std::size_t design_rows) {
   const std::vector<Effect> all = P.candidates(max_harmonic);
   budget_detail::check_inputs(sizes, all, coverage);
   const ModelFit& fit = D.final_fit;
@@ -139,7 +139,7 @@ UncertaintyBudget uncertainty_budget(const DiagnosisProblem& P, const Diagnosis&
   return budget_detail::budget_of(
       model, candidates,
       [&](const budget_detail::JacobianVisitor& v) {
-        P.visit_candidate_jacobians(fit, candidates, v);
+        P.visit_candidate_jacobians_reduced(fit, candidates, design_rows, v);
       },
       sizes, coverage);
 }
