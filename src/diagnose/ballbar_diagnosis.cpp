@@ -150,6 +150,80 @@ std::vector<Eigen::MatrixXd> BallbarDiagnosisProblem::candidate_jacobians(
                                                    angles);
 }
 
+void BallbarDiagnosisProblem::visit_candidate_jacobians(
+    const ModelFit& at, const std::vector<Effect>& candidates,
+    const std::function<void(std::size_t, const Eigen::MatrixXd&)>& visit) const {
+  const auto angles = [&](Eigen::Index r) { return arrays_.angles[static_cast<std::size_t>(r)]; };
+  const MachineType m = session_.machine;
+  const auto each = [&](std::size_t i, const Eigen::MatrixXd& J) { visit(i, J); };
+  if (!diagnosis_detail::BallbarSensitivities::supports(m))
+    return diagnosis_detail::for_each_candidate(
+        m, candidates, jets_on(m, session_.samples, arrays_.motion, at), angles, each);
+  const diagnosis_detail::BallbarSensitivities S(m, session_.samples, arrays_.motion, at);
+  // Each candidate visited once: the places are not kept (a long session's memory).
+  diagnosis_detail::for_each_candidate(m, candidates, chain_rule_on(S, nullptr), angles, each);
+}
+
+namespace {
+
+// Rows of a reduced design: every `stride`-th row, the last, and both sides of every break
+// where a left-out effect may jump (a new test; an axis reversing, starting or stopping).
+std::vector<std::size_t> design_rows(const BallbarArrays& a, std::size_t stride) {
+  const std::size_t n = a.motion.size();
+  const auto sign = [](double v) { return (v > 0.0) - (v < 0.0); };
+  const auto jumps = [&](std::size_t i) {
+    const RotaryMotion &p = a.motion[i - 1], &q = a.motion[i];
+    return a.test[i] != a.test[i - 1] || sign(p.rate.tilt) != sign(q.rate.tilt) ||
+           sign(p.rate.rot) != sign(q.rate.rot) || p.direction.tilt != q.direction.tilt ||
+           p.direction.rot != q.direction.rot;
+  };
+  std::vector<std::size_t> out;
+  for (std::size_t i = 0; i < n; ++i)
+    if (i % stride == 0 || i + 1 == n || (i > 0 && jumps(i)) || (i + 1 < n && jumps(i + 1)))
+      out.push_back(i);
+  return out;
+}
+
+}  // namespace
+
+void BallbarDiagnosisProblem::visit_candidate_jacobians_reduced(
+    const ModelFit& at, const std::vector<Effect>& candidates, std::size_t rows,
+    const std::function<void(std::size_t, const Eigen::MatrixXd&)>& visit) const {
+  const std::size_t n = session_.samples.size();
+  if (rows == 0 || n <= 2 * rows) return visit_candidate_jacobians(at, candidates, visit);
+  const std::vector<std::size_t> R = design_rows(arrays_, (n + rows - 1) / rows);
+  std::vector<BallbarSample> samples;
+  std::vector<RotaryMotion> motion;
+  samples.reserve(R.size());
+  motion.reserve(R.size());
+  for (std::size_t r : R) {
+    samples.push_back(session_.samples[r]);
+    motion.push_back(arrays_.motion[r]);
+  }
+  // Linear in the row between two design rows (R holds row 0 and row n - 1).
+  const auto each = [&](std::size_t i, const Eigen::MatrixXd& Jr) {
+    Eigen::MatrixXd J(static_cast<Eigen::Index>(n), Jr.cols());
+    for (std::size_t j = 0; j + 1 < R.size(); ++j) {
+      const auto a = static_cast<Eigen::Index>(j);
+      for (std::size_t r = R[j]; r < R[j + 1]; ++r) {
+        const double w = static_cast<double>(r - R[j]) / static_cast<double>(R[j + 1] - R[j]);
+        J.row(static_cast<Eigen::Index>(r)) = (1.0 - w) * Jr.row(a) + w * Jr.row(a + 1);
+      }
+    }
+    J.row(static_cast<Eigen::Index>(n - 1)) = Jr.row(Jr.rows() - 1);
+    visit(i, J);
+  };
+  const auto angles = [&](Eigen::Index r) {
+    return samples[static_cast<std::size_t>(r)].angles_rad();
+  };
+  const MachineType m = session_.machine;
+  if (!diagnosis_detail::BallbarSensitivities::supports(m))
+    return diagnosis_detail::for_each_candidate(m, candidates, jets_on(m, samples, motion, at),
+                                                angles, each);
+  const diagnosis_detail::BallbarSensitivities S(m, samples, motion, at);
+  diagnosis_detail::for_each_candidate(m, candidates, chain_rule_on(S, nullptr), angles, each);
+}
+
 Eigen::MatrixXd BallbarDiagnosisProblem::candidate_jacobian(const ModelFit& at,
                                                             const Effect& candidate) const {
   return jacobian_on(session_.samples, arrays_.motion, at, candidate);

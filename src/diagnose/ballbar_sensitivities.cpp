@@ -2,6 +2,7 @@
 // The ballbar candidates' Jacobians by the chain rule (ballbar_sensitivities.hpp).
 #include "ballbar_sensitivities.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -54,28 +55,44 @@ BallbarPlaces BallbarSensitivities::places_with(const Effect& effect,
   Jet q[4] = {Jet(0.0), Jet(0.0), Jet(0.0), Jet(0.0)};
   for (std::size_t k = 0; k < seed.size(); ++k) q[seed[k]] = Jet(0.0, static_cast<int>(k));
   const Eigen::Index n = s_.rows();
-  // Every place's derivatives first (column r: place p, seed k at p + kPlaces k), noting the
-  // places it enters; then those places' rows alone.
-  Eigen::Matrix<double, N * kPlaces, Eigen::Dynamic> all(N * kPlaces, n);
-  Eigen::Matrix<double, kPlaces, N> d;
-  Eigen::Array<bool, kPlaces, 1> enters = Eigen::Array<bool, kPlaces, 1>::Constant(false);
   const int seeds = static_cast<int>(seed.size());
-  for (Eigen::Index r = 0; r < n; ++r) {
-    const std::size_t i = static_cast<std::size_t>(r);
-    const BallbarSample& smp = samples_[i];
-    length_chain::place_derivatives<N>(m_, fx, q, {smp.xyz, angles_[i], smp.time, motion_[i]}, d);
-    all.col(r) = Eigen::Map<const Eigen::Matrix<double, N * kPlaces, 1>>(d.data());
-    enters = enters || (d.leftCols(seeds).array() != 0.0).rowwise().any();
+  // Rows in blocks, and a column kept only for a (place, seed) the effect enters: a dense
+  // N * kPlaces x n block would hold 864 bytes a row for N = 4 (a long session's peak memory),
+  // where the effect enters a few places. The values are the same.
+  constexpr Eigen::Index kBlock = 2048;
+  Eigen::Matrix<double, N * kPlaces, Eigen::Dynamic> block(N * kPlaces, kBlock);
+  Eigen::Matrix<double, kPlaces, N> d;
+  std::vector<Eigen::VectorXd> column(static_cast<std::size_t>(kPlaces * seeds));
+  for (Eigen::Index r0 = 0; r0 < n; r0 += kBlock) {
+    const Eigen::Index rows = std::min(kBlock, n - r0);
+    for (Eigen::Index b = 0; b < rows; ++b) {
+      const std::size_t i = static_cast<std::size_t>(r0 + b);
+      const BallbarSample& smp = samples_[i];
+      length_chain::place_derivatives<N>(m_, fx, q, {smp.xyz, angles_[i], smp.time, motion_[i]}, d);
+      block.col(b) = Eigen::Map<const Eigen::Matrix<double, N * kPlaces, 1>>(d.data());
+    }
+    for (int p = 0; p < kPlaces; ++p)
+      for (int k = 0; k < seeds; ++k) {
+        const auto row = block.row(p + kPlaces * k).head(rows);
+        Eigen::VectorXd& c = column[static_cast<std::size_t>(p * seeds + k)];
+        if (c.size() == 0 && (row.array() != 0.0).any()) c = Eigen::VectorXd::Zero(n);
+        if (c.size()) c.segment(r0, rows) = row.transpose();
+      }
   }
   BallbarPlaces out;
   out.seeds = seeds;
   for (int p = 0; p < kPlaces; ++p)
-    if (enters[p]) out.places.push_back(p);
-  out.d.resize(n, static_cast<Eigen::Index>(out.places.size()) * seeds);
-  for (std::size_t i = 0; i < out.places.size(); ++i)
     for (int k = 0; k < seeds; ++k)
-      out.d.col(static_cast<Eigen::Index>(i) * seeds + k) =
-          all.row(out.places[i] + kPlaces * k).transpose();
+      if (column[static_cast<std::size_t>(p * seeds + k)].size()) {
+        out.places.push_back(p);
+        break;
+      }
+  out.d = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(out.places.size()) * seeds);
+  for (std::size_t i = 0; i < out.places.size(); ++i)
+    for (int k = 0; k < seeds; ++k) {
+      const Eigen::VectorXd& c = column[static_cast<std::size_t>(out.places[i] * seeds + k)];
+      if (c.size()) out.d.col(static_cast<Eigen::Index>(i) * seeds + k) = c;
+    }
   return out;
 }
 

@@ -5,6 +5,7 @@
 // not the diagnosis' (the R-test's smooth error maps: rtest_budget.cpp).
 
 #include <Eigen/Core>
+#include <functional>
 #include <vector>
 
 #include "rotacal/diagnose/uncertainty_budget.hpp"
@@ -25,10 +26,15 @@ struct BudgetedFit {
 /// Throws InvalidArgument for a coverage outside (0, 1) or an override naming none of `all`.
 void check_inputs(const PlausibleSizes& sizes, const std::vector<Effect>& all, double coverage);
 
-/// The budget of m's location errors against the left-out `candidates`, whose columns
-/// (d reading / d effect parameter, mm per unit, rows as m.fit's) are `jacobians`.
+/// Hands each candidate's Jacobian (d reading / d effect parameter, mm per unit, rows as
+/// m.fit's) to the visitor with its index: DiagnosisProblem::visit_candidate_jacobians.
+using JacobianVisitor = std::function<void(std::size_t, const Eigen::MatrixXd&)>;
+using CandidateJacobians = std::function<void(const JacobianVisitor&)>;
+
+/// The budget of m's location errors against the left-out `candidates`, whose Jacobians
+/// `jacobians` visits, one at a time (a long session never holds them all).
 UncertaintyBudget budget_of(const BudgetedFit& m, const std::vector<Effect>& candidates,
-                            const std::vector<Eigen::MatrixXd>& jacobians,
-                            const PlausibleSizes& sizes, double coverage);
+                            const CandidateJacobians& jacobians, const PlausibleSizes& sizes,
+                            double coverage);
 
 }  // namespace rotacal::budget_detail

@@ -75,18 +75,16 @@ Eigen::MatrixXd expand_harmonic(MachineType m, const Effect& candidate, const Ei
   return out;
 }
 
-/// Jacobians of every candidate at one fit, the channels of each harmonic kind and axis
-/// evaluated once.
-template <typename Jets, typename AnglesOfRow>
-std::vector<Eigen::MatrixXd> jacobians_of_candidates(MachineType m,
-                                                     const std::vector<Effect>& candidates,
-                                                     Jets&& jets, AnglesOfRow&& angles_of_row) {
+/// Each candidate's Jacobian at one fit handed to `visit(index, jacobian)` in order, the
+/// channels of each harmonic kind and axis evaluated once; only the channels are kept.
+template <typename Jets, typename AnglesOfRow, typename Visit>
+void for_each_candidate(MachineType m, const std::vector<Effect>& candidates, Jets&& jets,
+                        AnglesOfRow&& angles_of_row, Visit&& visit) {
   std::vector<std::pair<Effect, Eigen::MatrixXd>> channels;
-  std::vector<Eigen::MatrixXd> out;
-  out.reserve(candidates.size());
-  for (const Effect& c : candidates) {
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    const Effect& c = candidates[i];
     if (!c.is_harmonic()) {
-      out.push_back(jets_of_width(c, all_parameters(c), jets));
+      visit(i, jets_of_width(c, all_parameters(c), jets));
       continue;
     }
     Effect key = c;
@@ -97,8 +95,19 @@ std::vector<Eigen::MatrixXd> jacobians_of_candidates(MachineType m,
       channels.emplace_back(key, harmonic_channels(c, jets));
       it = channels.end() - 1;
     }
-    out.push_back(expand_harmonic(m, c, it->second, angles_of_row));
+    visit(i, expand_harmonic(m, c, it->second, angles_of_row));
   }
+}
+
+/// Jacobians of every candidate at one fit (for_each_candidate, all kept).
+template <typename Jets, typename AnglesOfRow>
+std::vector<Eigen::MatrixXd> jacobians_of_candidates(MachineType m,
+                                                     const std::vector<Effect>& candidates,
+                                                     Jets&& jets, AnglesOfRow&& angles_of_row) {
+  std::vector<Eigen::MatrixXd> out;
+  out.reserve(candidates.size());
+  for_each_candidate(m, candidates, jets, angles_of_row,
+                     [&](std::size_t, Eigen::MatrixXd&& J) { out.push_back(std::move(J)); });
   return out;
 }
 

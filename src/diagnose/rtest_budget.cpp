@@ -89,8 +89,12 @@ UncertaintyBudget uncertainty_budget(const RtestSession& session,
   const budget_detail::BudgetedFit budgeted{
       session.machine, fit, id.noise_refit ? id.noise : white, id.sigma_um, &id.covariance,
       problem.times()};
+  const ModelFit at = diagnosis_point(data, id);
   return budget_detail::budget_of(
-      budgeted, candidates, problem.candidate_jacobians(diagnosis_point(data, id), candidates),
+      budgeted, candidates,
+      [&](const budget_detail::JacobianVisitor& v) {
+        problem.visit_candidate_jacobians(at, candidates, v);
+      },
       sizes, coverage);
 }
 

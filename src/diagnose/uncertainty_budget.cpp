@@ -122,8 +122,8 @@ void budget_detail::check_inputs(const PlausibleSizes& sizes, const std::vector<
 }
 
 UncertaintyBudget uncertainty_budget(const DiagnosisProblem& P, const Diagnosis& D,
-                                     const PlausibleSizes& sizes, double coverage,
-                                     int max_harmonic) {
+                                     const PlausibleSizes& sizes, double coverage, int max_harmonic,
+                                     std::size_t design_rows) {
   const std::vector<Effect> all = P.candidates(max_harmonic);
   budget_detail::check_inputs(sizes, all, coverage);
   const ModelFit& fit = D.final_fit;
@@ -136,8 +136,12 @@ UncertaintyBudget uncertainty_budget(const DiagnosisProblem& P, const Diagnosis&
       candidates.push_back(c);
   const budget_detail::BudgetedFit model{P.machine(),         fit,     D.noise,
                                          D.baseline.noise_um, nullptr, P.times()};
-  return budget_detail::budget_of(model, candidates, P.candidate_jacobians(fit, candidates), sizes,
-                                  coverage);
+  return budget_detail::budget_of(
+      model, candidates,
+      [&](const budget_detail::JacobianVisitor& v) {
+        P.visit_candidate_jacobians_reduced(fit, candidates, design_rows, v);
+      },
+      sizes, coverage);
 }
 
 namespace {
@@ -170,11 +174,11 @@ bool tighten_by_session(const Eigen::MatrixXd& perp_w, const Eigen::VectorXd& r_
 
 UncertaintyBudget budget_detail::budget_of(const BudgetedFit& m,
                                            const std::vector<Effect>& candidates,
-                                           const std::vector<Eigen::MatrixXd>& jacobians,
+                                           const CandidateJacobians& jacobians,
                                            const PlausibleSizes& sizes, double coverage) {
   const ModelFit& fit = m.fit;
   const auto n = fit.residuals.size();
-  ROTACAL_ASSERT(fit.jacobian.rows() == n && jacobians.size() == candidates.size());
+  ROTACAL_ASSERT(fit.jacobian.rows() == n);
   const auto& times = m.times;
   const double duration = times.empty() ? 0.0
                                         : *std::max_element(times.begin(), times.end()) -
@@ -230,10 +234,12 @@ UncertaintyBudget budget_detail::budget_of(const BudgetedFit& m,
     double dof;
     std::vector<double> a;
   };
-  std::vector<Contribution> lines;
-  for (std::size_t i = 0; i < candidates.size(); ++i) {
+  std::vector<Contribution> lines(candidates.size());
+  std::size_t visited = 0;
+  jacobians([&](std::size_t i, const Eigen::MatrixXd& Jc) {
+    ROTACAL_ASSERT(i < candidates.size() && Jc.rows() == n);
+    ++visited;
     const Effect& c = candidates[i];
-    const Eigen::MatrixXd& Jc = jacobians[i];
     const Eigen::MatrixXd B = ls.solve(Jc);  // d(free params) / d(effect params)
     std::vector<double> a = plausible_sizes(c, sizes, duration);
     // The session's own bound where it sees the effect, where it is tighter.
@@ -247,8 +253,9 @@ UncertaintyBudget budget_detail::budget_of(const BudgetedFit& m,
     L.bias = per.rowwise().norm();
     L.u = L.bias / std::sqrt(3.0);  // rectangular
     L.a = a;
-    lines.push_back(std::move(L));
-  }
+    lines[i] = std::move(L);
+  });
+  ROTACAL_ASSERT(visited == candidates.size());
 
   UncertaintyBudget out;
   out.coverage = coverage;

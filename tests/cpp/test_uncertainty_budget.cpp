@@ -143,3 +143,25 @@ TEST_CASE("budget arithmetic: combined, Welch-Satterthwaite, coverage factor, ov
   CHECK_THROWS_WITH(uncertainty_budget(P, D, negative), Catch::Contains("linear_squareness_XY.s"));
   CHECK_THROWS_WITH(uncertainty_budget(P, D, {}, 1.5), Catch::Contains("coverage is 1.5"));
 }
+
+TEST_CASE("a budget on a reduced design: expanded uncertainties within 1 % of every row's",
+          "[budget]") {
+  // The independent simulator's session (shared data), its left-out effects evaluated on every
+  // third row and both sides of each test's and reversal's break, interpolated in between.
+  const BallbarDiagnosisProblem P(commanded());
+  const Diagnosis D = diagnose(P);
+  const UncertaintyBudget every = uncertainty_budget(P, D, {}, 0.95, 4, 0);
+  const UncertaintyBudget reduced = uncertainty_budget(P, D, {}, 0.95, 4, 900);
+  REQUIRE(every.errors.size() == reduced.errors.size());
+  int compared = 0;
+  for (std::size_t i = 0; i < every.errors.size(); ++i) {
+    const LocationBudget &e = every.errors[i], &r = reduced.errors[i];
+    REQUIRE(e.observable == r.observable);
+    if (!e.observable) continue;
+    ++compared;
+    CHECK(r.u_a == e.u_a);  // type A from every row
+    CHECK(std::abs(r.expanded - e.expanded) <= 0.01 * e.expanded);
+    CHECK(r.type_b.size() == e.type_b.size());
+  }
+  CHECK(compared >= 6);
+}

@@ -42,6 +42,12 @@ class BallbarDiagnosisProblem : public DiagnosisProblem {
   Eigen::MatrixXd candidate_jacobian(const ModelFit& at, const Effect& candidate) const override;
   std::vector<Eigen::MatrixXd> candidate_jacobians(
       const ModelFit& at, const std::vector<Effect>& candidates) const override;
+  void visit_candidate_jacobians(
+      const ModelFit& at, const std::vector<Effect>& candidates,
+      const std::function<void(std::size_t, const Eigen::MatrixXd&)>& visit) const override;
+  void visit_candidate_jacobians_reduced(
+      const ModelFit& at, const std::vector<Effect>& candidates, std::size_t rows,
+      const std::function<void(std::size_t, const Eigen::MatrixXd&)>& visit) const override;
   /// The candidate's Jacobian by Jets of all its parameters, without the harmonic shortcut
   /// (tests compare the two).
   Eigen::MatrixXd candidate_jacobian_by_jets(const ModelFit& at, const Effect& candidate) const;

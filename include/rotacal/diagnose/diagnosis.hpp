@@ -99,6 +99,24 @@ class DiagnosisProblem {
     for (const Effect& c : candidates) out.push_back(candidate_jacobian(at, c));
     return out;
   }
+  /// candidate_jacobians handed to `visit(index, jacobian)` one at a time, so that a caller
+  /// needing each once (the uncertainty budget of a long session) never holds them all.
+  virtual void visit_candidate_jacobians(
+      const ModelFit& at, const std::vector<Effect>& candidates,
+      const std::function<void(std::size_t, const Eigen::MatrixXd&)>& visit) const {
+    const std::vector<Eigen::MatrixXd> all = candidate_jacobians(at, candidates);
+    for (std::size_t i = 0; i < all.size(); ++i) visit(i, all[i]);
+  }
+  /// visit_candidate_jacobians on a reduced design of about `rows` rows (every k-th row and
+  /// both sides of every break where an effect may jump), interpolated linearly to every row
+  /// between them: for smooth effects of a long session (the uncertainty budget's type B).
+  /// The default evaluates every row.
+  virtual void visit_candidate_jacobians_reduced(
+      const ModelFit& at, const std::vector<Effect>& candidates, std::size_t rows,
+      const std::function<void(std::size_t, const Eigen::MatrixXd&)>& visit) const {
+    (void)rows;
+    visit_candidate_jacobians(at, candidates, visit);
+  }
   /// The group names of a complete standard test for this machine and instrument, and the
   /// candidate Jacobian on it (used to name the test that separates two ambiguous
   /// candidates). Empty if the instrument has no standard test.

@@ -85,12 +85,19 @@ struct UncertaintyBudget {
   std::vector<LocationBudget> errors;  ///< the 8 location errors, in order
 };
 
+/// Rows on which a long session's left-out effects are evaluated for the budget's type B
+/// (DiagnosisProblem::visit_candidate_jacobians_reduced); type A uses every row. At 90,000
+/// ballbar samples the expanded uncertainties move by less than 1 % (bench/long_session_budget.py).
+constexpr std::size_t kBudgetDesignRows = 8192;
+
 /// Budget of the location errors of `diagnosis.final_fit`. `problem` must be the one the
-/// diagnosis ran on. Throws InvalidArgument if coverage is not in (0, 1), a size is negative,
-/// or an override names no candidate of this problem.
+/// diagnosis ran on. `design_rows`: kBudgetDesignRows, 0 for every row. Throws
+/// InvalidArgument if coverage is not in (0, 1), a size is negative, or an override names no
+/// candidate of this problem.
 UncertaintyBudget uncertainty_budget(const DiagnosisProblem& problem, const Diagnosis& diagnosis,
                                      const PlausibleSizes& sizes = {}, double coverage = 0.95,
-                                     int max_harmonic = 4);
+                                     int max_harmonic = 4,
+                                     std::size_t design_rows = kBudgetDesignRows);
 
 /// Default half-width of each parameter of `effect` for a session lasting `duration_s`.
 std::vector<double> plausible_sizes(const Effect& effect, const PlausibleSizes& sizes,
