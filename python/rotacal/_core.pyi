@@ -7,7 +7,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Alternative', 'Ambiguity', 'AngleTable', 'AxisAngleMap', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CircularAnalysis', 'CircularDiagnosis', 'CircularDiagnosisOptions', 'CircularDirection', 'CircularEffect', 'CircularFinding', 'CircularPairResult', 'CircularPlanResult', 'CircularPlane', 'CircularRun', 'CircularRunResult', 'CircularSimulationOptions', 'CircularTestPlan', 'CompensationReport', 'CompensationRow', 'CompensationTable', 'CompensationTables', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FanucPitchOptions', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'Identification', 'InvalidArgument', 'IoError', 'LinearAxisErrors', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'MultiDisagreement', 'MultiIdentification', 'MultiSessionResult', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'ProbeDesign', 'ProbeDesignCandidate', 'ProbeDesignOptions', 'ProbeIdentification', 'ProbeMonteCarlo', 'ProbeSeparatingCandidate', 'ProbeSeparationDesign', 'ProbeSeparationOptions', 'ProbeSession', 'ProbeSphereTrial', 'RadialSide', 'RealtimeModel', 'RecordSummary', 'RtestBasis', 'RtestDesign', 'RtestDesignCandidate', 'RtestDesignOptions', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSeparatingCandidate', 'RtestSeparationDesign', 'RtestSeparationOptions', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SeparatingCandidate', 'SeparationDesign', 'SeparationOptions', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'SweepDirection', 'TableMotionOverlap', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualCircularBallbar', 'VirtualRtest', 'analyze_circular', 'angle_maps', 'ballbar_model_document', 'ballbar_model_from_document', 'box_least_squares', 'builtin_machine_names', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_json_bounds', 'check_model_machine', 'check_output', 'check_plausible', 'check_rtest_pattern', 'circular_catalogue', 'circular_commanded_session', 'circular_label', 'comment_lines', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_axial_c_tilt_deg', 'default_ballbar_tests', 'default_calibration_moves', 'default_probe_poses_deg', 'default_rtest_pattern', 'default_tilt_range_deg', 'design_ballbar_separation', 'design_ballbar_test', 'design_probe_separation', 'design_probe_test', 'design_rtest_separation', 'design_rtest_test', 'diagnose_ballbar', 'diagnose_circular', 'diagnose_probe', 'diagnose_rtest', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'evaluate_rtest_design', 'export_controller', 'fanuc_pitch_tables', 'format_ballbar', 'format_model_document', 'format_probe', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_joint_sessions', 'identify_multi', 'identify_paper', 'identify_probe', 'identify_probe_cycles', 'identify_rtest_joint', 'identify_rtest_paper', 'identify_runs', 'identify_thermal', 'is_rotary_test', 'is_thermal_session', 'kasa_circle_fit', 'linuxcnc_comp_tables', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_probe', 'monte_carlo_rtest', 'multi_model_document', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_circular_direction', 'parse_circular_plane', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'parse_sweep_direction', 'plan_ballbar_test', 'plan_circular_test', 'predict_rtest_session', 'predict_session_lengths', 'predict_thermal', 'probe_effect_catalogue', 'probe_model_document', 'read_ballbar', 'read_instrument_session', 'read_linuxcnc_probe_log', 'read_model_document', 'read_probe', 'read_rtest', 'read_session', 'realtime_model_of_blob', 'realtime_model_of_file', 'record_ballbar', 'record_circular_ballbar', 'record_rtest', 'record_run', 'refuse_disagreeing', 'rtest_error_map', 'rtest_joint_model_document', 'rtest_map_names', 'rtest_prediction_rms_um', 'rtest_readings', 'run_label', 'simulate_ballbar', 'simulate_circular', 'simulate_probe', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sinumerik_eec_tables', 'sphere_fit', 'svd_plane_fit', 'table_motion_overlap', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_probe', 'uncertainty_budget_rtest', 'uncertainty_budget_rtest_identification', 'verify_compensation', 'write_ballbar', 'write_circular_nc_program', 'write_model_document', 'write_nc_program', 'write_output', 'write_probe', 'write_probe_nc_program', 'write_rtest']
+__all__: list[str] = ['Alternative', 'Ambiguity', 'AngleTable', 'AxisAngleMap', 'BallbarDesign', 'BallbarDesignOptions', 'BallbarIdentification', 'BallbarMachineModel', 'BallbarMonteCarlo', 'BallbarPlan', 'BallbarSession', 'BallbarSetup', 'BallbarTest', 'BudgetLine', 'CandidateScore', 'CircleFit', 'CircularAnalysis', 'CircularDiagnosis', 'CircularDiagnosisOptions', 'CircularDirection', 'CircularEffect', 'CircularFinding', 'CircularPairResult', 'CircularPlanResult', 'CircularPlane', 'CircularRun', 'CircularRunResult', 'CircularSimulationOptions', 'CircularTestPlan', 'CompensationReport', 'CompensationRow', 'CompensationTable', 'CompensationTables', 'ControllerExport', 'ControllerValue', 'DegenerateGeometry', 'DesignCandidate', 'DeviceDisconnected', 'Diagnosis', 'DiagnosisBaseline', 'DiagnosisOptions', 'Effect', 'Error', 'ErrorDisposition', 'FanucPitchOptions', 'FaultInjection', 'Finding', 'FitSummary', 'Gain', 'GroupResidual', 'Identification', 'InvalidArgument', 'IoError', 'LinearAxisErrors', 'LocationBudget', 'MachineType', 'ModelFit', 'MonteCarloParameter', 'MultiDiagnosis', 'MultiDiagnosisSession', 'MultiDisagreement', 'MultiIdentification', 'MultiSessionResult', 'NcDialect', 'NcProgramOptions', 'NoiseModel', 'NoiseModelOptions', 'NoiseStream', 'ParameterEstimate', 'ParameterShift', 'ParseError', 'PlanSegment', 'PlaneFit', 'PlausibilityOptions', 'PlausibilityReport', 'PlausibleSizes', 'ProbeCalibration', 'ProbeDesign', 'ProbeDesignCandidate', 'ProbeDesignOptions', 'ProbeIdentification', 'ProbeMonteCarlo', 'ProbeSeparatingCandidate', 'ProbeSeparationDesign', 'ProbeSeparationOptions', 'ProbeSession', 'ProbeSphereTrial', 'RadialSide', 'RealtimeModel', 'RecordSummary', 'RtestBasis', 'RtestDesign', 'RtestDesignCandidate', 'RtestDesignOptions', 'RtestJointIdentification', 'RtestJointModel', 'RtestMonteCarlo', 'RtestPaperIdentification', 'RtestPattern', 'RtestSeparatingCandidate', 'RtestSeparationDesign', 'RtestSeparationOptions', 'RtestSession', 'RtestSimOptions', 'SegmentKind', 'SeparatingCandidate', 'SeparationDesign', 'SeparationOptions', 'SerialError', 'SphereFit', 'SphereOffsetCalibration', 'SweepDirection', 'TableMotionOverlap', 'TransitionArc', 'UncertaintyBudget', 'Unexplained', 'UnobservableEffect', 'VirtualBallbar', 'VirtualCircularBallbar', 'VirtualRtest', 'analyze_circular', 'angle_maps', 'ballbar_model_document', 'ballbar_model_from_document', 'box_least_squares', 'builtin_machine_names', 'calibrate_probe_directions', 'calibrate_sphere_offset', 'check_json_bounds', 'check_model_machine', 'check_output', 'check_plausible', 'check_rtest_pattern', 'circular_catalogue', 'circular_commanded_session', 'circular_label', 'comment_lines', 'compensate_commands', 'compensate_sphere_offset', 'controller_parameter_names', 'default_axial_c_tilt_deg', 'default_ballbar_tests', 'default_calibration_moves', 'default_probe_poses_deg', 'default_rtest_pattern', 'default_tilt_range_deg', 'design_ballbar_separation', 'design_ballbar_test', 'design_probe_separation', 'design_probe_test', 'design_rtest_separation', 'design_rtest_test', 'diagnose_ballbar', 'diagnose_circular', 'diagnose_probe', 'diagnose_rtest', 'diagnose_sessions', 'displacements_from_raw', 'effect_catalogue', 'estimate_noise_model', 'evaluate_rtest_design', 'export_controller', 'fanuc_pitch_tables', 'format_ballbar', 'format_model_document', 'format_probe', 'format_rtest', 'forward', 'hyper_circle_fit', 'identify_joint', 'identify_joint_sessions', 'identify_multi', 'identify_paper', 'identify_probe', 'identify_probe_cycles', 'identify_rtest_joint', 'identify_rtest_paper', 'identify_runs', 'identify_thermal', 'is_machine_effect', 'is_rotary_test', 'is_thermal_session', 'kasa_circle_fit', 'linuxcnc_comp_tables', 'list_serial_ports', 'location_error_names', 'machine_name', 'monte_carlo_joint', 'monte_carlo_probe', 'monte_carlo_rtest', 'multi_model_document', 'noise_ar1', 'noise_pink', 'noise_probe_zero_wander', 'noise_thermal_wander', 'parse_ballbar_test', 'parse_circular_direction', 'parse_circular_plane', 'parse_machine_type', 'parse_model_document', 'parse_nc_dialect', 'parse_radial_side', 'parse_sweep_direction', 'plan_ballbar_test', 'plan_circular_test', 'predict_rtest_session', 'predict_session_lengths', 'predict_thermal', 'probe_effect_catalogue', 'probe_model_document', 'read_ballbar', 'read_instrument_session', 'read_linuxcnc_probe_log', 'read_model_document', 'read_probe', 'read_rtest', 'read_session', 'realtime_model_of_blob', 'realtime_model_of_file', 'record_ballbar', 'record_circular_ballbar', 'record_rtest', 'record_run', 'refuse_disagreeing', 'rtest_error_map', 'rtest_joint_model_document', 'rtest_map_names', 'rtest_prediction_rms_um', 'rtest_readings', 'run_label', 'simulate_ballbar', 'simulate_circular', 'simulate_probe', 'simulate_probe_calibration', 'simulate_rtest', 'simulate_spindle_indexing', 'sinumerik_eec_tables', 'sphere_fit', 'svd_plane_fit', 'table_motion_overlap', 'test_label', 'uncertainty_budget_ballbar', 'uncertainty_budget_probe', 'uncertainty_budget_rtest', 'uncertainty_budget_rtest_identification', 'verify_compensation', 'write_ballbar', 'write_circular_nc_program', 'write_model_document', 'write_nc_program', 'write_output', 'write_probe', 'write_probe_nc_program', 'write_rtest']
 class Alternative:
     @property
     def aliased(self) -> bool:
@@ -1812,6 +1812,38 @@ class MonteCarloParameter:
         ...
     @property
     def unit(self) -> str:
+        ...
+class MultiDiagnosis:
+    @property
+    def diagnosis(self) -> Diagnosis:
+        ...
+    @property
+    def sessions(self) -> list[MultiDiagnosisSession]:
+        ...
+    @property
+    def where(self) -> list[str]:
+        ...
+class MultiDiagnosisSession:
+    @property
+    def instrument(self) -> str:
+        ...
+    @property
+    def n(self) -> int:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def noise_um(self) -> float:
+        ...
+    @property
+    def rms_after_um(self) -> float:
+        ...
+    @property
+    def rms_before_um(self) -> float:
+        ...
+    @property
+    def weight(self) -> float:
         ...
 class MultiDisagreement:
     @property
@@ -4042,6 +4074,10 @@ def diagnose_rtest(session: RtestSession, options: DiagnosisOptions = ...) -> Di
     """
     Diagnose an R-test session (baseline: location errors and a probe zero per set-up).
     """
+def diagnose_sessions(sessions: collections.abc.Sequence[tuple[str, typing.Any]], options: DiagnosisOptions = ...) -> MultiDiagnosis:
+    """
+    One diagnosis of several (name, session) pairs of one machine (diagnose/multi_session.hpp): machine effects shared, instrument, set-up and time effects per session (ids 'name:id').
+    """
 def displacements_from_raw(session: RtestSession, dirs: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] | None = None) -> RtestSession:
     """
     Fill dx,dy,dz from raw d1,d2,d3 with the session's probe.N.dir, or with calibrated dirs (3, 3) (rows keep a dx,dy,dz they already have).
@@ -4180,6 +4216,10 @@ def identify_thermal(path: str, lags: typing.SupportsInt | typing.SupportsIndex 
         ``identification`` (cold values, each lag's tau and gains with sigma or the reason they
         are unobservable), ``summary`` (steady-state change at the tested speed, significance,
         time to exceed the tolerance, tau), ``warnings``.
+    """
+def is_machine_effect(effect: Effect) -> bool:
+    """
+    True for an effect of the machine (one parameter set shared by every session).
     """
 def is_rotary_test(test: BallbarTest) -> bool:
     ...
