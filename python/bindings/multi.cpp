@@ -25,7 +25,7 @@ void bind_multi(pyb::module_& m) {
       .def_readonly("sigma", &MultiDisagreement::sigma)
       .def_readonly("z", &MultiDisagreement::z)
       .def_readonly("dof", &MultiDisagreement::dof, "of sigma (Welch-Satterthwaite)")
-      .def_readonly("threshold", &MultiDisagreement::threshold, "|z| beyond which it disagrees");
+      .def_readonly("threshold", &MultiDisagreement::threshold, "abs(z) beyond which it disagrees");
   pyb::class_<MultiSessionResult>(m, "MultiSessionResult")
       .def_readonly("name", &MultiSessionResult::name)
       .def_readonly("instrument", &MultiSessionResult::instrument)

@@ -1869,7 +1869,7 @@ class MultiDisagreement:
     @property
     def threshold(self) -> float:
         """
-        |z| beyond which it disagrees
+        abs(z) beyond which it disagrees
         """
     @property
     def unit(self) -> str:

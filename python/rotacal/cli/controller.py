@@ -410,7 +410,7 @@ def add_export(sub: argparse._SubParsersAction) -> None:
         ("--fanuc-unit", 1e-6, 1.0, False, "the rotary axes' detection unit, deg (default 0.001)"),
         ("--fanuc-first-number", 0, 1e5, True, "the first data number of the first table (0)"),
         ("--fanuc-last-number", 0, 1e5, True, "the control's highest data number (1023, a 0i's)"),
-        ("--fanuc-max-value", 1, 1e6, True, "the largest |value| of one data number (127)"),
+        ("--fanuc-max-value", 1, 1e6, True, "the largest absolute value of one data number (127)"),
         ("--fanuc-magnification", 1, 100, True, "parameter 3623 (default: the smallest that fits)"),
     ):
         fanuc.add_argument(option, type=number(option, lo, hi, integer=whole), help=what)
