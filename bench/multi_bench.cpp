@@ -70,7 +70,7 @@ int main(int argc, char** argv) {
          MultiSessionInput::of("probe", simulate_probe(t, po).session)});
     if (!id.disagreements.empty()) ++disagreeing;
     for (int j = 0; j < 8; ++j) {
-      const ParameterEstimate& p = id.location_errors[static_cast<std::size_t>(j)];
+      const ParameterEstimate p = id.location_errors()[static_cast<std::size_t>(j)];
       if (!p.observable) {
         ++unobservable[static_cast<std::size_t>(j)];
         continue;

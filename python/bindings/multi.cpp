@@ -37,18 +37,14 @@ void bind_multi(pyb::module_& m) {
       .def_readonly("residual_rms_um", &MultiSessionResult::residual_rms_um)
       .def_readonly("n_residuals", &MultiSessionResult::n_residuals)
       .def_readonly("dof", &MultiSessionResult::dof, "of its sigmas alone");
-  pyb::class_<MultiIdentification>(m, "MultiIdentification")
+  pyb::class_<MultiIdentification, Identification>(
+      m, "MultiIdentification",
+      "The joint identification: blocks 'location_errors', 'effects', then one per session.")
       .def_readonly("machine", &MultiIdentification::machine)
-      .def_readonly("location_errors", &MultiIdentification::location_errors)
-      .def_readonly("effects", &MultiIdentification::effects)
+      .def_property_readonly("location_errors", &MultiIdentification::location_errors)
+      .def_property_readonly("effects", &MultiIdentification::effects)
       .def_readonly("sessions", &MultiIdentification::sessions)
       .def_readonly("disagreements", &MultiIdentification::disagreements)
-      .def_readonly("parameter_names", &MultiIdentification::parameter_names)
-      .def_readonly("covariance", &MultiIdentification::covariance)
-      .def_readonly("unobservable", &MultiIdentification::unobservable)
-      .def_readonly("converged", &MultiIdentification::converged)
-      .def_readonly("summary", &MultiIdentification::summary)
-      .def_readonly("notes", &MultiIdentification::notes)
       .def_readonly("sigma_inflated", &MultiIdentification::sigma_inflated)
       .def_readonly("comparisons", &MultiIdentification::comparisons)
       .def_readonly("disagreement_z", &MultiIdentification::disagreement_z);

@@ -1883,15 +1883,12 @@ class MultiDisagreement:
     @property
     def z(self) -> float:
         ...
-class MultiIdentification:
+class MultiIdentification(Identification):
+    """
+    The joint identification: blocks 'location_errors', 'effects', then one per session.
+    """
     @property
     def comparisons(self) -> int:
-        ...
-    @property
-    def converged(self) -> bool:
-        ...
-    @property
-    def covariance(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
         ...
     @property
     def disagreement_z(self) -> float:
@@ -1909,22 +1906,10 @@ class MultiIdentification:
     def machine(self) -> MachineType:
         ...
     @property
-    def notes(self) -> list[str]:
-        ...
-    @property
-    def parameter_names(self) -> list[str]:
-        ...
-    @property
     def sessions(self) -> list[MultiSessionResult]:
         ...
     @property
     def sigma_inflated(self) -> bool:
-        ...
-    @property
-    def summary(self) -> FitSummary:
-        ...
-    @property
-    def unobservable(self) -> list[str]:
         ...
 class MultiSessionResult:
     @property

@@ -50,8 +50,10 @@ MachineType MultiSessionInput::machine() const {
 }
 
 const ParameterEstimate& MultiIdentification::location_error(const std::string& name) const {
-  for (const ParameterEstimate& e : location_errors)
-    if (e.name == name) return e;
+  const ParameterBlock& E = blocks.block("location_errors");
+  for (Eigen::Index j = E.offset; j < E.end(); ++j)
+    if (parameters[static_cast<std::size_t>(j)].name == name)
+      return parameters[static_cast<std::size_t>(j)];
   throw InvalidArgument("no location error named '" + name + "'");
 }
 
@@ -235,10 +237,16 @@ double disagreement_threshold(std::size_t m, const MultiFitOptions& o,
   return std::max(o.disagreement_z, stats::t_coverage(p, std::max(dof, 1.0)));
 }
 
+// Shared parameter j in the order of each session's `alone` (location errors, then effects):
+// its index in the joint vector.
+Eigen::Index joint_index(const MultiIdentification& m, std::size_t j) {
+  const ParameterBlock& E = m.blocks.block("location_errors");
+  const auto k = static_cast<Eigen::Index>(j);
+  return k < E.size ? E.offset + k : m.blocks.block("effects").offset + (k - E.size);
+}
+
 ParameterEstimate& joint_shared(MultiIdentification& m, std::size_t j) {
-  // The shared parameters in the order of each session's `alone`: location errors, effects.
-  return j < m.location_errors.size() ? m.location_errors[j]
-                                      : m.effects[j - m.location_errors.size()];
+  return m.parameters[static_cast<std::size_t>(joint_index(m, j))];
 }
 
 // A joint value beyond every session's own on one side (each session's value more than z_max
@@ -299,12 +307,9 @@ void inflate_disagreeing(MultiIdentification& m) {
     const double r = std::sqrt(chi2 / std::max(1, n - 1));
     if (!(r > 1.0)) continue;
     J.std *= r;
-    const auto at = std::find(m.parameter_names.begin(), m.parameter_names.end(), J.name);
-    if (at != m.parameter_names.end()) {
-      const Eigen::Index i = at - m.parameter_names.begin();
-      m.covariance.row(i) *= r;
-      m.covariance.col(i) *= r;
-    }
+    const Eigen::Index i = joint_index(m, j);
+    m.covariance.row(i) *= r;
+    m.covariance.col(i) *= r;
     m.notes.push_back("the sigma of " + J.name + " is widened x" + shown(r) +
                       " (Birge ratio of the sessions alone about the joint value) because the "
                       "sessions disagree on it, as asked (inflate sigma)");
@@ -370,12 +375,9 @@ MultiIdentification identify_multi(const std::vector<MultiSessionInput>& session
   settings.max_iterations = o.max_iterations;
   settings.observability_min_chi2 = o.observability_min_chi2;
   settings.whitener = std::make_shared<BlockDiagonalWhitener>(std::move(wblocks));
-  JointFitOutcome fit = solve_joint(model, params, settings);
-
-  const ParameterBlock& E = model.errors();
-  out.location_errors.assign(fit.estimates.begin() + E.offset, fit.estimates.begin() + E.end());
-  const ParameterBlock& F = model.effects();
-  out.effects.assign(fit.estimates.begin() + F.offset, fit.estimates.begin() + F.end());
+  NoiseFit joint;
+  joint.fit = solve_joint(model, params, settings);
+  const JointFitOutcome& fit = joint.fit;
   Eigen::Index row = 0;
   for (std::size_t k = 0; k < parts.size(); ++k) {
     const ParameterBlock& b = model.block(k);
@@ -388,11 +390,10 @@ MultiIdentification identify_multi(const std::vector<MultiSessionInput>& session
     out.sessions[k].residual_rms_um = std::sqrt(ms) * 1e3;
     row += n;
   }
-  out.parameter_names = names;
-  out.covariance = std::move(fit.covariance);
-  out.unobservable = std::move(fit.unobservable);
-  out.converged = fit.summary.converged;
-  out.summary = fit.summary;
+  // The common part (estimates, covariance, residuals, solver figures) as every instrument's;
+  // the rows are whitened per session, so sigma_um is the dof-corrected level of the raw rows.
+  static_cast<Identification&>(out) = joint_identification(std::move(joint), model.layout(), true);
+  out.n_samples = out.residuals.size();
   std::vector<MultiDisagreement> all = comparisons(out.sessions);
   out.comparisons = all.size();
   out.disagreement_z = disagreement_threshold(all.size(), o);
@@ -409,7 +410,7 @@ MultiIdentification identify_multi(const std::vector<MultiSessionInput>& session
             : "sessions " + d.session_a + " and " + d.session_b + " disagree on " + d.parameter +
                   " (z = " + shown(d.z) + "): the joint value describes neither of them");
   if (!out.disagreements.empty() && o.inflate_sigma) inflate_disagreeing(out);
-  if (!out.converged) out.notes.push_back("the joint fit did not converge: " + fit.summary.message);
+  if (!out.converged) out.notes.push_back("the joint fit did not converge: " + out.summary.message);
   return out;
 }
 

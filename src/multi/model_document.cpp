@@ -29,23 +29,24 @@ void refuse_disagreeing(const MultiIdentification& ident) {
 }
 
 FittedModelContent multi_model_content(const MultiIdentification& ident) {
-  const std::size_t n = ident.parameter_names.size();
+  const std::size_t n = ident.parameters.size();
   if (ident.covariance.rows() != static_cast<Eigen::Index>(n) ||
       ident.covariance.cols() != static_cast<Eigen::Index>(n))
     throw InvalidArgument("multi_model_content: the covariance is not " + std::to_string(n) +
                           " x " + std::to_string(n));
-  if (ident.effects.size() != static_cast<std::size_t>(ident.effect_model.num_params()))
-    throw InvalidArgument("multi_model_content: " + std::to_string(ident.effects.size()) +
+  const std::vector<ParameterEstimate> effects = ident.effects();
+  if (effects.size() != static_cast<std::size_t>(ident.effect_model.num_params()))
+    throw InvalidArgument("multi_model_content: " + std::to_string(effects.size()) +
                           " effect parameters, the effect model has " +
                           std::to_string(ident.effect_model.num_params()));
   refuse_disagreeing(ident);
   FittedModelContent c;
   c.kind = "multi";
   c.machine = ident.machine;
-  c.location_errors = ident.location_errors;
+  c.location_errors = ident.location_errors();
   c.effects = ident.effect_model;
-  c.effect_parameters = ident.effects;
-  c.covariance_parameters = ident.parameter_names;
+  c.effect_parameters = effects;
+  for (const ParameterEstimate& p : ident.parameters) c.covariance_parameters.push_back(p.name);
   c.covariance = ident.covariance;
   for (const MultiSessionResult& r : ident.sessions) {
     FittedSessionContent s;

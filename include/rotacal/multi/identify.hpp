@@ -29,6 +29,7 @@
 
 #include "rotacal/core/estimate.hpp"
 #include "rotacal/core/fit_with_noise.hpp"
+#include "rotacal/core/identification.hpp"
 #include "rotacal/core/noise_handling.hpp"
 #include "rotacal/kinematics/effects.hpp"
 #include "rotacal/kinematics/machine.hpp"
@@ -113,24 +114,27 @@ struct MultiSessionResult {
   std::size_t n_residuals = 0;
 };
 
-struct MultiIdentification {
+/// The joint identification, an Identification (core/identification.hpp) whose parameter
+/// vector holds the blocks "location_errors" (the one shared set), "effects" (the shared
+/// catalogue effects' parameters, empty unless asked) and then one block per session, named
+/// after it, of its own parameters ("name:parameter"). Its covariance, residuals (the sessions'
+/// rows back to back), unobservable combinations, notes and solver figures are the joint fit's;
+/// `noise` is left white: each session has its own (MultiSessionResult::noise).
+struct MultiIdentification : Identification {
   MachineType machine = MachineType::AC_trt;
-  std::vector<ParameterEstimate> location_errors;  ///< the one shared set, joint fit
-  std::vector<ParameterEstimate> effects;          ///< the shared catalogue effects' parameters
   EffectModel effect_model;                  ///< the shared catalogue effects (options.effects)
   std::vector<MultiSessionResult> sessions;  ///< in input order
   std::vector<MultiDisagreement> disagreements;
-  std::vector<std::string> parameter_names;  ///< joint vector order
-  Eigen::MatrixXd covariance;                ///< joint, 1 sigma^2
-  std::vector<std::string> unobservable;
-  bool converged = false;
-  FitSummary summary;
-  std::vector<std::string> notes;
   bool sigma_inflated = false;  ///< inflate_sigma widened the sigmas of disagreeing parameters
   std::size_t comparisons = 0;  ///< pairs of sessions x parameters both determine
   /// The abs(z) beyond which one of them is a disagreement with exactly known sigmas; a
   /// comparison of sigmas from few effective samples has its own (MultiDisagreement::threshold).
   double disagreement_z = 0.0;
+  /// The one shared set of location errors (block "location_errors").
+  std::vector<ParameterEstimate> location_errors() const { return block("location_errors"); }
+  /// The shared catalogue effects' parameters (block "effects").
+  std::vector<ParameterEstimate> effects() const { return block("effects"); }
+  /// The shared location error called `name`; throws InvalidArgument when there is none.
   const ParameterEstimate& location_error(const std::string& name) const;
 };
 
