@@ -104,6 +104,37 @@ def print_history(h: dict, max_flags: int = 20) -> None:
             + (f"  [{c['note']}]" if c["note"] else "")
         )
     _print_flags(h["flags"], max_flags)
+    if h.get("thermal"):
+        _print_thermal(h["thermal"])
+
+
+def _print_thermal(thermal: dict) -> None:
+    """The thermal tests' lags over time: tau (min) and each gain (um or urad per unit of heat
+    input, u = speed / 100 rev/min), the latest value, its change from the test before and the
+    drift per month."""
+    print(
+        "thermal tests: each lag's tau (min) and gains (um, urad per unit of u = speed / 100 rev/min)"
+    )
+    print(
+        f"  {'parameter':14s} {'n':>3s} {'latest':>10s} {'1-sigma':>8s} {'change':>10s} "
+        f"{'beyond k=2':>10s} {'drift/month':>11s}"
+    )
+    for name, e in thermal.items():
+        if not e["points"]:
+            print(f"  {name:14s} unobservable in every thermal test")
+            continue
+        k = 1 / 60 if e["unit"] == "s" else (1e3 if e["unit"] == "mm" else 1e6)
+
+        def fmt(v, signed=True, k=k):
+            return "-" if v is None else f"{v * k:+.3f}" if signed else f"{v * k:.3f}"
+
+        last, dr = e["points"][-1], e["drift_per_month"] or {}
+        beyond = "-" if "change" not in last else "yes" if last["exceeds_uncertainty"] else "no"
+        print(
+            f"  {name:14s} {len(e['points']):3d} {fmt(last['value']):>10s} "
+            f"{fmt(last['std'], False):>8s} {fmt(last.get('change')):>10s} {beyond:>10s} "
+            f"{fmt(dr.get('value')):>11s}"
+        )
 
 
 def cmd_history_add(a: argparse.Namespace) -> int:

@@ -131,7 +131,7 @@ def print_identification(d: dict) -> None:
         _print_monte_carlo(d["monte_carlo"])
 
 
-def _refuse_history_options(a: argparse.Namespace) -> None:
+def refuse_history_options(a: argparse.Namespace) -> None:
     """The history options, refused before any work: --store needs --machine-id, a store that
     can be opened, a valid date; the others go with --store (--controller also --save-model)."""
     if a.store or a.machine_id is not None:
@@ -262,7 +262,7 @@ def _cmd_identify_joint(a: argparse.Namespace) -> int:
         raise OptionError(
             f"{', '.join(given)}: not available for a joint identification of several sessions"
         )
-    _refuse_history_options(a)
+    refuse_history_options(a)
     sessions = [load_session(f, a) for f in a.file]
     result = identify_sessions(sessions, list(a.file), noise=a.noise, inflate_sigma=a.inflate_sigma)
     d = result.to_dict()
@@ -295,7 +295,7 @@ def cmd_identify(a: argparse.Namespace) -> int:
     if a.inflate_sigma:
         raise OptionError("--inflate-sigma: for a joint identification of several sessions")
     a.file = a.file[0]
-    _refuse_history_options(a)
+    refuse_history_options(a)
     sizes = budget_sizes(a.budget_sizes)  # refused before any work
     s = load_session(a.file, a)
     if kind(s) == PROBE:  # the touch probe's options and fit: cli/probe.py

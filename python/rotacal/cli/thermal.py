@@ -39,6 +39,11 @@ _THERMAL_DESTS = {
     "lags",
     "peer",
     "save_model",
+    "store",
+    "machine_id",
+    "db",
+    "note",
+    "date",
 }
 _DURATION_UNITS = {"s": 1.0, "min": 60.0, "h": 3600.0}
 
@@ -118,7 +123,7 @@ def _refuse_other_options(a: argparse.Namespace) -> None:
         if dest != "help" and getattr(a, dest, default) != default:
             raise OptionError(
                 f"--{dest.replace('_', '-')}: not for a thermal session (yet); "
-                "its options are --tolerance, --lags, --noise and --json"
+                "its options are --tolerance, --lags, --peer, --noise, --json, --save-model and --store"
             )
 
 
@@ -130,6 +135,7 @@ def cmd_identify(a: argparse.Namespace) -> int:
             )
         return identify.cmd_identify(a)
     _refuse_other_options(a)
+    identify.refuse_history_options(a)
     tol = {}
     for unit, value in a.tolerance or []:
         if unit in tol:
@@ -142,15 +148,10 @@ def cmd_identify(a: argparse.Namespace) -> int:
         tol.get("rad"),
         noise=a.noise,
         peer=a.peer,
-        model=bool(a.save_model),
+        model=bool(a.save_model or a.store),
     )
-    if a.save_model:
-        from ..models import save_model, source_dict
-
-        save_model(
-            d.pop("model") | {"source": source_dict(a.file[0])}, a.save_model, inputs=(a.file[0],)
-        )
-        say(f"wrote {a.save_model}: the thermal model (docs/thermal.md)")
+    if a.save_model or a.store:
+        _keep_thermal(a, d.pop("model"), d)
     for w in d["warnings"]:
         say(f"rotacal: warning: {w}")
     if a.json:
@@ -161,6 +162,30 @@ def cmd_identify(a: argparse.Namespace) -> int:
             print("\nthe per-epoch peer (each epoch alone, then one lag fitted to the series):")
             print_thermal(d["peer"])
     return EXIT_OK
+
+
+def _keep_thermal(a: argparse.Namespace, model: dict, d: dict) -> None:
+    """--save-model writes the thermal model file; --store keeps it in the calibration history
+    (its cold errors beside the other calibrations, its taus and gains followed by history show)."""
+    from ..models import save_model, source_dict
+
+    model = model | {"source": source_dict(a.file[0])}
+    if a.save_model:
+        save_model(model, a.save_model, inputs=(a.file[0],))
+        say(f"wrote {a.save_model}: the thermal model (docs/thermal.md)")
+    if a.store:
+        from ..history import open_history, redact
+
+        with open_history(a.db) as h:
+            entry = h.add_identification(
+                a.machine_id,
+                model,
+                note=a.note,
+                measured_at=a.date,
+                details={"identification": d["identification"], "summary": d["summary"]},
+                where=a.file[0],
+            )
+        say(f"stored as entry {entry} of machine {a.machine_id!r} in {redact(h.location)}")
 
 
 def _minutes(seconds: float) -> str:

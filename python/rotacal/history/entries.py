@@ -103,37 +103,60 @@ class Entry:
 def estimates_of(
     model: Mapping[str, Any], where: str
 ) -> list[tuple[str, str, float | None, float | None, str]]:
-    """(part, name, value, std, unit) of a model's location errors and map coefficients,
-    checked: a value finite or null, a std finite and >= 0 or null."""
+    """(part, name, value, std, unit) of a model's location errors and map coefficients, and of a
+    thermal model's lags (part ``thermal``: ``lag1.tau`` in s, ``lag1.E_X0C`` per unit of heat
+    input), checked: a value finite or null, a std finite and >= 0 or null."""
     rows = []
     for part in ("location_errors", "map_coefficients"):
         block = model.get(part, {})
         if not isinstance(block, Mapping):
             raise _core.InvalidArgument(f"{where}: {part}: must be an object")
         for name, est in block.items():
-            if not isinstance(est, Mapping):
-                raise _core.InvalidArgument(f"{where}: {part}.{name}: must be an estimate object")
-            v, s = est.get("value"), est.get("std")
-            for key, x in (("value", v), ("std", s)):
-                if x is not None and (
-                    isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x)
-                ):
-                    raise _core.InvalidArgument(
-                        f"{where}: {part}.{name}.{key}: must be a finite number or null, got {x!r}"
-                    )
-            if s is not None and s < 0:
-                raise _core.InvalidArgument(f"{where}: {part}.{name}.std: must be >= 0, got {s!r}")
-            unit = est.get("unit", unit_of(name) if part == "location_errors" else "")
-            rows.append(
-                (
-                    part,
-                    str(name),
-                    None if v is None else float(v),
-                    None if v is None or s is None else float(s),
-                    str(unit),
+            default = unit_of(name) if part == "location_errors" else ""
+            rows.append(_estimate_row(part, str(name), est, default, f"{where}: {part}.{name}"))
+    if model.get("kind") == "thermal":
+        lags = (
+            model.get("thermal", {}).get("lags")
+            if isinstance(model.get("thermal"), Mapping)
+            else None
+        )
+        if not isinstance(lags, list):
+            raise _core.InvalidArgument(f"{where}: thermal.lags: must be a list")
+        for k, lag in enumerate(lags, start=1):
+            at = f"{where}: thermal.lags[{k - 1}]"
+            if not isinstance(lag, Mapping) or not isinstance(lag.get("gains"), Mapping):
+                raise _core.InvalidArgument(f"{at}: needs tau and gains")
+            rows.append(_estimate_row("thermal", f"lag{k}.tau", lag.get("tau"), "s", f"{at}.tau"))
+            for name, est in lag["gains"].items():
+                rows.append(
+                    _estimate_row("thermal", f"lag{k}.{name}", est, "", f"{at}.gains.{name}")
                 )
-            )
     return rows
+
+
+def _estimate_row(
+    part: str, name: str, est: Any, default_unit: str, where: str
+) -> tuple[str, str, float | None, float | None, str]:
+    if not isinstance(est, Mapping):
+        raise _core.InvalidArgument(f"{where}: must be an estimate object")
+    v, s = est.get("value"), est.get("std")
+    for key, x in (("value", v), ("std", s)):
+        if x is not None and (
+            isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x)
+        ):
+            raise _core.InvalidArgument(
+                f"{where}.{key}: must be a finite number or null, got {x!r}"
+            )
+    if s is not None and s < 0:
+        raise _core.InvalidArgument(f"{where}.std: must be >= 0, got {s!r}")
+    unit = est.get("unit", default_unit)
+    return (
+        part,
+        name,
+        None if v is None else float(v),
+        None if v is None or s is None else float(s),
+        str(unit),
+    )
 
 
 def correction_amounts(export: Mapping[str, Any], where: str = "<export>") -> dict[str, float]:

@@ -439,7 +439,7 @@ class CalibrationHistory:
                 est = self._x(
                     "SELECT e.calibration_id, e.name, e.value, e.std, e.unit FROM estimates e "
                     "JOIN calibrations c ON c.id = e.calibration_id WHERE c.machine_id = ? "
-                    "AND e.part IN ('location_errors', 'correction')",
+                    "AND e.part IN ('location_errors', 'correction', 'thermal')",
                     (machine_id,),
                 ).fetchall()
         if unknown:
