@@ -94,6 +94,8 @@ ThermalIdentification fit_lag_to_series(const std::vector<ThermalSeries>& series
       "per-epoch peer: each epoch identified alone, then one lag fitted to the "
       "series (chi2/dof " +
       std::to_string(nf.fit.summary.chi2_per_dof) + ")");
+  out.epoch_series = series;
+  out.epoch_mid_s = t_mid;
   return out;
 }
 

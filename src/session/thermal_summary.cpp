@@ -174,6 +174,20 @@ nlohmann::ordered_json to_json(const ThermalIdentification& id) {
   }
   j["unobservable"] = id.unobservable;
   j["notes"] = id.notes;
+  if (!id.epoch_series.empty()) {  // the peer: each epoch's values, what its lag was fitted to
+    nlohmann::ordered_json series = nlohmann::ordered_json::array();
+    for (const ThermalSeries& s : id.epoch_series) {
+      nlohmann::ordered_json value = nlohmann::ordered_json::array(),
+                             std = nlohmann::ordered_json::array();
+      for (std::size_t e = 0; e < s.value.size(); ++e) {
+        const bool known = s.std[e] > 0.0 && std::isfinite(s.value[e]);
+        value.push_back(known ? nlohmann::ordered_json(s.value[e]) : nlohmann::ordered_json());
+        std.push_back(known ? nlohmann::ordered_json(s.std[e]) : nlohmann::ordered_json());
+      }
+      series.push_back({{"name", s.name}, {"unit", s.unit}, {"value", value}, {"std", std}});
+    }
+    j["epochs"] = {{"t_mid_s", id.epoch_mid_s}, {"series", series}};
+  }
   return j;
 }
 

@@ -41,6 +41,13 @@ struct ThermalLag {
   std::vector<ThermalGainEstimate> gains;  ///< 8 location errors, then q_x, q_y, q_z
 };
 
+/// One quantity identified epoch by epoch (a location error, or the table-side point's x).
+struct ThermalSeries {
+  std::string name;                ///< the gain's name: a location error's, or "q_x", "q_y", "q_z"
+  std::string unit;                ///< "mm" or "rad"
+  std::vector<double> value, std;  ///< per epoch; std <= 0: that epoch did not determine it
+};
+
 /// The result of the joint thermal fit.
 struct ThermalIdentification {
   MachineType machine = MachineType::AC_trt;
@@ -58,6 +65,10 @@ struct ThermalIdentification {
   std::size_t n_samples = 0, n_epochs = 0;
   std::string noise;  ///< the noise model's summary (empty: white)
   std::vector<std::string> notes;
+  /// The per-epoch peer's series, what its lag was fitted to (session/thermal_series.hpp), at
+  /// the epochs' middle times (s); empty for the joint fit.
+  std::vector<ThermalSeries> epoch_series;
+  std::vector<double> epoch_mid_s;
 };
 
 /// Where a thermal fit keeps what: parameter indices of the cold values, of each lag's ln tau

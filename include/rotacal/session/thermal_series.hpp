@@ -17,13 +17,6 @@
 
 namespace rotacal {
 
-/// One quantity identified epoch by epoch (a location error, or the table-side point's x).
-struct ThermalSeries {
-  std::string name;                ///< the gain's name: a location error's, or "q_x", "q_y", "q_z"
-  std::string unit;                ///< "mm" or "rad"
-  std::vector<double> value, std;  ///< per epoch; std <= 0: that epoch did not determine it
-};
-
 /// Fit one lag (cold value and gain per series, one tau) to the series, epochs at times
 /// `t_mid` (s) of `thermal`'s duty on `axis` (0: no heat input, every gain unobservable).
 ThermalIdentification fit_lag_to_series(const std::vector<ThermalSeries>& series,

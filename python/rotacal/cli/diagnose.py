@@ -174,6 +174,14 @@ def cmd_report(a: argparse.Namespace) -> int:
         with open_history(a.db) as h:  # an unknown machine id is refused before the fit
             history = h.show(a.history)
         extra.append(history_section(history))
+    if len(a.file) == 1 and _core.is_thermal_session(a.file[0]):
+        from ..report.thermal import thermal_report
+
+        if a.controller:
+            raise _core.InvalidArgument("report --controller: export a thermal model --at a time")
+        out = thermal_report(a.output, a.file[0], inputs=a.file, extra_sections=extra)
+        print(Path(out).resolve())
+        return EXIT_OK
     if len(a.file) > 1:  # one identification from several sessions of one machine
         if a.controller:
             raise _core.InvalidArgument("report --controller: one session (export the joint model)")
