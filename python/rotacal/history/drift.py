@@ -213,9 +213,6 @@ def summarize(
             "unobservable_in": unobservable,
             "drift_per_month": drift,
         }
-    from .thermal import thermal_history  # thermal.py builds on this module's drift_fit
-
-    thermal = thermal_history(entries)
     return {
         "machine_type": machine_type,
         "identifications": len(calibrations),
@@ -241,7 +238,6 @@ def summarize(
             for c in calibrations
         ],
         "location_errors": errors,
-        **({"thermal": thermal} if thermal else {}),
         "flags": flags,
         "definitions": {
             "value": "measured + compensation: the machine's own error, as if no correction had been loaded",

@@ -31,6 +31,7 @@ from .entries import (
 )
 from .messages import one_line, redact
 from .schema import MIGRATIONS, SCHEMA_VERSION
+from .thermal import thermal_history
 
 BUSY_TIMEOUT_S = 60.0
 
@@ -477,7 +478,11 @@ class CalibrationHistory:
         return out
 
     def show(self, machine_id: str, tolerances: Mapping[str, float] | None = None) -> dict:
-        """The history of a machine's location errors: :func:`summarize` of its entries."""
+        """The history of a machine's location errors (:func:`summarize` of its entries) and of
+        its thermal tests' lags (:func:`thermal_history`)."""
         machine_type, entries = self.entries(machine_id)
         out = summarize(machine_type, entries, tolerances)
+        thermal = thermal_history(entries)  # the thermal tests' lags, when there are any
+        if thermal:
+            out["thermal"] = thermal
         return {"machine_id": machine_id, "store": redact(self.location)} | out
