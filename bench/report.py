@@ -105,6 +105,14 @@ BENCHMARKS: dict[str, tuple[str, str, str]] = {
         "The designed set-ups' predicted sigma against Monte Carlo draws.",
         "{py} bench/design_bench.py",
     ),
+    "multi_diagnosis_pairs": (
+        "Several sessions of one machine diagnosed together",
+        "Two sessions of one table (ballbar + probe on an AC-trt, R-test + probe on a BC-trt), "
+        "reference simulator, AR(1) 0.5 noise: one hidden machine effect, an instrument effect "
+        "in one session, or nothing; the first finding of each session alone and of the two "
+        "together.",
+        "{py} bench/multi_diagnosis_pairs.py --figures --draws 20",
+    ),
     "history_bench": (
         "Calibration history: store and read",
         "Time to store and read identifications in the SQLite history.",
@@ -142,6 +150,11 @@ HEADLINES: list[tuple[str, str, str]] = [
         "Diagnosis named a wrong cause first, 1/f-like noise, sessions",
         "diagnosis_confusion",
         r"\| pink \| (\d+/\d+) \(\d+%\) \|",
+    ),
+    (
+        "Ballbar + probe of one AC-trt diagnosed together: coning of A named alone (each alone)",
+        "multi_diagnosis_pairs",
+        r"coning_A 2\.5e-05[\s\S]*?named first: first alone (\d+, probe alone \d+, joint \d+ of \d+)",
     ),
     (
         "Real-time kinematics with every model term, AC-trt: forward, median us",
