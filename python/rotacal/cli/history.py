@@ -137,6 +137,34 @@ def _print_thermal(thermal: dict) -> None:
         )
 
 
+def store_identification(
+    a: argparse.Namespace,
+    model: dict,
+    details: dict | None,
+    where: str,
+    controller: str | None = None,
+    label: str = "",
+) -> None:
+    """--store, and history add: the model (a rotacal-model/1 dict) as an entry of --machine-id
+    in the history at --db, with --note and --date; says where it went."""
+    from ..history import open_history, redact
+
+    with open_history(a.db) as h:
+        entry = h.add_identification(
+            a.machine_id,
+            model,
+            note=a.note,
+            measured_at=a.date,
+            details=details,
+            controller=controller,
+            where=where,
+        )
+        say(
+            f"stored {label + ' ' if label else ''}as entry {entry} of machine {a.machine_id!r} "
+            f"in {redact(h.location)}"
+        )
+
+
 def cmd_history_add(a: argparse.Namespace) -> int:
     from ..history import open_history, redact
 
@@ -174,20 +202,7 @@ def cmd_history_add(a: argparse.Namespace) -> int:
                 f"--diagnosis {a.diagnosis}: not the JSON of 'rotacal diagnose --json' (findings)"
             )
         details = {"diagnosis": diag}
-    controller = controller_text(a.controller)
-    with open_history(a.db) as h:
-        entry = h.add_identification(
-            a.machine_id,
-            model,
-            note=a.note,
-            measured_at=a.date,
-            details=details,
-            controller=controller,
-            where=a.model,
-        )
-        say(
-            f"stored {a.model} as entry {entry} of machine {a.machine_id!r} in {redact(h.location)}"
-        )
+    store_identification(a, model, details, a.model, controller_text(a.controller), a.model)
     return EXIT_OK
 
 

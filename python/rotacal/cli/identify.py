@@ -228,20 +228,15 @@ def _keep(a: argparse.Namespace, result, d: dict, files) -> None:
         )
         say(f"wrote {a.save_model}")
     if a.store:
-        from ..history import open_history, redact
+        from .history import store_identification
 
-        controller = controller_text(a.controller)
-        with open_history(a.db) as h:
-            entry = h.add_identification(
-                a.machine_id,
-                identification_document(result, files),
-                note=a.note,
-                measured_at=a.date,
-                details={"identification": d},
-                controller=controller,
-                where=", ".join(inputs),
-            )
-            say(f"stored as entry {entry} of machine {a.machine_id!r} in {redact(h.location)}")
+        store_identification(
+            a,
+            identification_document(result, files),
+            {"identification": d},
+            ", ".join(inputs),
+            controller_text(a.controller),
+        )
 
 
 def _cmd_identify_joint(a: argparse.Namespace) -> int:

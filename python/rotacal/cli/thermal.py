@@ -174,18 +174,10 @@ def _keep_thermal(a: argparse.Namespace, model: dict, d: dict) -> None:
         save_model(model, a.save_model, inputs=(a.file[0],))
         say(f"wrote {a.save_model}: the thermal model (docs/thermal.md)")
     if a.store:
-        from ..history import open_history, redact
+        details = {"identification": d["identification"], "summary": d["summary"]}
+        from .history import store_identification
 
-        with open_history(a.db) as h:
-            entry = h.add_identification(
-                a.machine_id,
-                model,
-                note=a.note,
-                measured_at=a.date,
-                details={"identification": d["identification"], "summary": d["summary"]},
-                where=a.file[0],
-            )
-        say(f"stored as entry {entry} of machine {a.machine_id!r} in {redact(h.location)}")
+        store_identification(a, model, details, a.file[0])
 
 
 def _minutes(seconds: float) -> str:
