@@ -312,6 +312,17 @@ def test_isg_ssfk_puts_c_where_it_is_commanded_both_ways(isg):
         "--spacing", "0.2", "--max-cross-points", "3601", "--tables-dir", d,
     )  # fmt: skip
     assert r.returncode == EXIT_INPUT and "kw_nr_max" in r.stderr and "1801" in r.stderr
+    r = run_cli(
+        "export", "--model", d.parent / "model.json", "--controller", "isg", "--tables",
+        "--max-points", "72", "--tables-dir", d,
+    )  # fmt: skip
+    # The limit as configured (P-COMP-00059): a control set to 72 entries refuses the 73.
+    assert r.returncode == EXIT_INPUT and "at most 72" in r.stderr and "73" in r.stderr
+    r = run_cli(
+        "export", "--model", d.parent / "model.json", "--controller", "isg", "--tables",
+        "--spacing", "0.00125", "--tables-dir", d,
+    )  # fmt: skip
+    assert r.returncode == EXIT_INPUT and "0.0001 deg" in r.stderr, r.stderr
 
 
 def test_isg_crosscomp_moves_each_slave_with_one_master(isg):

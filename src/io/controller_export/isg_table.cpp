@@ -43,8 +43,6 @@ CompensationTable ssfk_table(const AxisErrorFunction& f, const MachineType& m,
   const RotaryAxis& ax = m.description().axis(f.chain_index);
   const std::string letter(1, f.axis);
   const auto [lo, hi, modulo] = span_of(f, ax, o);
-  if (std::abs(o.spacing_deg / kUnitDeg - std::round(o.spacing_deg / kUnitDeg)) > 1e-6)
-    throw InvalidArgument("--spacing: ISG's kw.ssfk.interval is a whole number of 0.0001 deg");
   CompensationTable t;
   t.axis = f.axis;
   t.joint = -1;
@@ -186,6 +184,10 @@ CompensationTables isg_tables(const ModelFile& model,
                               const std::vector<AxisErrorFunction>& functions,
                               const CompensationTableOptions& o) {
   using namespace isg_table_detail;
+  if (std::abs(o.spacing_deg / kUnitDeg - std::round(o.spacing_deg / kUnitDeg)) > 1e-6)
+    throw InvalidArgument(
+        "--spacing: ISG's positions (kw.ssfk.interval, kw.crosscomp sollw) are whole numbers of "
+        "0.0001 deg");
   const ExportInput in = export_input(model, o.model_path);
   // Each slave's master: the axis with the largest translation along it; the others' are listed.
   std::array<std::size_t, 3> master{functions.size(), functions.size(), functions.size()};

@@ -136,14 +136,14 @@ inline double tilt_remains_mm(const AxisErrorFunction& f, const MachineType& m,
   if (f.chain_index != m.rot_index() || m.description().table_axes.size() < 2) return 0.0;
   const RotaryAxis& tilt = m.description().axis(m.tilt_index());
   tilt_range = range_of(tilt, o);
+  std::vector<Eigen::Vector3d> e;
+  for (const double x : grid_deg) e.push_back(f.evaluate(x / kRadToDeg).head<3>());
   double worst = 0.0;
   for (double t = tilt_range[0]; t <= tilt_range[1] + 1e-9; t += 1.0) {
     const Eigen::Matrix3d R =
-        Eigen::AngleAxisd(t / kRadToDeg, tilt.direction.normalized()).toRotationMatrix();
-    for (const double x : grid_deg) {
-      const Eigen::Vector3d e = f.evaluate(x / kRadToDeg).head<3>();
-      worst = std::max(worst, ((R - Eigen::Matrix3d::Identity()) * e).norm());
-    }
+        Eigen::AngleAxisd(t / kRadToDeg, tilt.direction.normalized()).toRotationMatrix() -
+        Eigen::Matrix3d::Identity();
+    for (const Eigen::Vector3d& v : e) worst = std::max(worst, (R * v).norm());
   }
   return worst;
 }
