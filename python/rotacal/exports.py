@@ -216,10 +216,17 @@ def controller_tables(
         for k, v in (fanuc or {}).items():
             setattr(o, k, v)
         return _core.fanuc_pitch_tables(os.fspath(model), float(spacing_deg), rng, o, generated_at)
+    mapping = (
+        ": HEIDENHAIN is mapping only, its .COM/.CMA table layout and the sign of their values "
+        "are only partly public (a rotary axis' positioning would be a .COM column C = F(C), "
+        "its translations columns X, Y, Z = F(C), assigned in a .CMA)"
+        if controller == "heidenhain"
+        else ""
+    )
     raise _core.InvalidArgument(
         f"--tables: compensation tables are written for linuxcnc, siemens, isg and fanuc; "
-        f"{controller}'s "
-        "are not (docs/controller_exports.md, the table of error terms x controller)"
+        f"{controller}'s are not{mapping} (docs/controller_exports.md, the table of error terms "
+        "x controller)"
     )
 
 

@@ -342,3 +342,13 @@ def test_isg_crosscomp_moves_each_slave_with_one_master(isg):
     assert res.max() <= stated_mm(lists["Z"]) * 1.001 + 1e-9
     assert "E_ZC" in lists["Z"] and "E_ZC" in r.stderr  # C's axial motion: not in a table
     assert "held at A = 0 only" in lists["X"]
+
+
+def test_heidenhain_tables_are_mapping_only(siemens, tmp_path):
+    d, _ = siemens
+    r = run_cli(
+        "export", "--model", d / "model.json", "--controller", "heidenhain", "--tables",
+        "--tables-dir", tmp_path,
+    )  # fmt: skip
+    assert r.returncode == EXIT_INPUT and "mapping only" in r.stderr and ".CMA" in r.stderr
+    assert not list(tmp_path.iterdir())

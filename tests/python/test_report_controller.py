@@ -39,6 +39,9 @@ def test_the_section_says_which_terms_the_tables_hold_and_what_remains():
     r = rows(controller_section(model_doc(), "siemens"))
     assert r["positioning_C"][1] == "table eec_C.mpf" and r["E_A0C"][1].startswith("kinematics")
     assert r["E_XC"][1] == "table cec_C.mpf" and r["E_ZA"][1] == "table cec_A.mpf"
+    # ... the C tables at A = 0 only: away from it the run-out turns with A (up to 2 um x 2).
+    away = r["E_XC, E_YC, E_ZC away from A = 0"]
+    assert away[1] == "left to rotacal compensate" and 2.0 < float(away[0].split()[0]) <= 4.0
     # ISG: the positioning in kw.ssfk, each slave's translation in kw.crosscomp.
     r = rows(controller_section(model_doc(), "isg"))
     assert r["positioning_C"][1] == "table ssfk_C.lis" and r["E_XC"][1] == "table crosscomp_X.lis"

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import tempfile
 from typing import Any
 
@@ -45,6 +46,11 @@ def _term_rows(model_path: str, tables: Any) -> list[tuple[str, str, str]]:
             else:
                 where = "left to rotacal compensate"
             rows.append((name, _size(largest, unit), where))
+    # A rotary axis' cross tables hold at tilt 0 only: what remains of them over the tilt range.
+    for n in tables.not_held if tables else []:
+        m = re.match(r"(.+ away from .+?): up to ([\d.]+) um", n)
+        if m:
+            rows.append((m[1], f"{float(m[2]):.2f} &micro;m", "left to rotacal compensate"))
     return rows
 
 
