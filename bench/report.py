@@ -113,6 +113,15 @@ BENCHMARKS: dict[str, tuple[str, str, str]] = {
         "together.",
         "{py} bench/multi_diagnosis_pairs.py --figures --draws 20",
     ),
+    "table_residual_bench": (
+        "Compensation tables: what each controller's tables leave over the travel",
+        "A model with a worm-gear C, C run-out, face runout and wobble and a sagging A, exported "
+        "with --tables for each controller and applied as the controller's documentation "
+        "describes its tables: the residual of each held term against the interpolation error "
+        "the table states (ratio <= 1 but for the slope of the error, about 1e-4), and the "
+        "size of every term no table holds, at tilt 0 over a turn of C.",
+        "{py} bench/table_residual_bench.py",
+    ),
     "history_bench": (
         "Calibration history: store and read",
         "Time to store and read identifications in the SQLite history.",

@@ -11,6 +11,8 @@
 
 namespace rotacal::py {
 
+void bind_table_writers(pyb::module_& m);
+
 void bind_compensation_table(pyb::module_& m) {
   pyb::class_<AxisAngleMap>(m, "AxisAngleMap", "One rotary axis' error terms at equal spacing.")
       .def_property_readonly("axis", [](const AxisAngleMap& a) { return std::string(1, a.axis); })
@@ -62,11 +64,25 @@ void bind_compensation_table(pyb::module_& m) {
       .def_readonly("max_interpolation_error_deg", &CompensationTable::max_interpolation_error_deg)
       .def_readonly("summary", &CompensationTable::summary)
       .def_readonly("holds", &CompensationTable::holds,
-                    "the model's terms the table holds (a residual model zeroes them)");
+                    "the model's terms the table holds (a residual model zeroes them)")
+      .def_property_readonly(
+          "value_mm",
+          [](const CompensationTable& t) {
+            std::map<std::string, std::vector<double>> out;
+            for (const auto& [k, v] : t.value_mm) out[std::string(1, k)] = v;
+            return out;
+          },
+          "a cross table: the correction of each output axis X, Y, Z at nominal_deg, mm")
+      .def_readonly("max_interpolation_error_mm", &CompensationTable::max_interpolation_error_mm);
   pyb::class_<CompensationTables>(m, "CompensationTables", "A controller's tables of a model.")
       .def_readonly("tables", &CompensationTables::tables)
       .def_readonly("ini", &CompensationTables::ini, "the INI lines that load them")
       .def_readonly("not_held", &CompensationTables::not_held);
+  bind_table_writers(m);
+}
+
+// The writers of io/compensation_table.hpp, each with the options it reads.
+void bind_table_writers(pyb::module_& m) {
   const auto options = [](const std::string& model_path, double spacing_deg,
                           const std::map<std::string, std::array<double, 2>>& range_deg,
                           const std::map<std::string, std::string>& file_names,
@@ -75,7 +91,7 @@ void bind_compensation_table(pyb::module_& m) {
     CompensationTableOptions o;
     o.spacing_deg = spacing_deg;
     const auto letter = [](const std::string& k) {
-      if (k.size() != 1) throw InvalidArgument("axis '" + k + "': one letter A, B or C");
+      if (k.size() != 1) throw InvalidArgument("axis '" + k + "': one letter A, B, C, X, Y or Z");
       return k[0];
     };
     for (const auto& [k, v] : range_deg) o.range_deg[letter(k)] = v;
@@ -114,6 +130,45 @@ void bind_compensation_table(pyb::module_& m) {
       pyb::arg("axis_names") = Names{}, pyb::arg("max_points") = 0, pyb::arg("generated_at") = "",
       "SINUMERIK EEC programs ($AA_ENC_COMP) of each table axis' positioning error "
       "(io/compensation_table.hpp); max_points 0: 200 (808D), else MD38000 as configured.");
+  m.def(
+      "sinumerik_tables",
+      [options](const std::string& model_path, double spacing_deg, const Ranges& range_deg,
+                const Names& axis_names, std::size_t max_points, std::size_t max_cross_points,
+                const std::string& generated_at) {
+        const ModelFile model = read_model(model_path);
+        CompensationTableOptions o =
+            options(model_path, spacing_deg, range_deg, {}, axis_names, max_points, generated_at);
+        o.max_cross_points = max_cross_points;
+        return sinumerik_tables(model, axis_error_functions(model, model_path), o);
+      },
+      pyb::arg("model_path"), pyb::arg("spacing_deg") = 5.0, pyb::arg("range_deg") = Ranges{},
+      pyb::arg("axis_names") = Names{}, pyb::arg("max_points") = 0,
+      pyb::arg("max_cross_points") = 0, pyb::arg("generated_at") = "",
+      "SINUMERIK EEC programs of each table axis' positioning error and CEC programs of its "
+      "translations (io/compensation_table.hpp); max_points 0: 200, else MD38000; "
+      "max_cross_points 0: 200, else MD18342.");
+  m.def(
+      "isg_tables",
+      [options](const std::string& model_path, double spacing_deg, const Ranges& range_deg,
+                const std::map<std::string, int>& axis_numbers, std::size_t max_points,
+                std::size_t max_cross_points, const std::string& generated_at) {
+        const ModelFile model = read_model(model_path);
+        CompensationTableOptions o =
+            options(model_path, spacing_deg, range_deg, {}, {}, max_points, generated_at);
+        o.max_cross_points = max_cross_points;
+        for (const auto& [k, v] : axis_numbers) {
+          if (k.size() != 1 || std::string("XYZABC").find(k[0]) == std::string::npos)
+            throw InvalidArgument("--isg-axis '" + k + "': one letter X, Y, Z, A, B or C");
+          o.isg_axis_numbers[k[0]] = v;
+        }
+        return isg_tables(model, axis_error_functions(model, model_path), o);
+      },
+      pyb::arg("model_path"), pyb::arg("spacing_deg") = 5.0, pyb::arg("range_deg") = Ranges{},
+      pyb::arg("axis_numbers") = std::map<std::string, int>{}, pyb::arg("max_points") = 0,
+      pyb::arg("max_cross_points") = 0, pyb::arg("generated_at") = "",
+      "ISG compensation value lists: kw.ssfk of each table axis' positioning error, kw.crosscomp "
+      "of its translations (io/compensation_table.hpp); max_points 0: kw_nr_max 1500; "
+      "max_cross_points 0: 1000.");
   m.def(
       "fanuc_pitch_tables",
       [options](const std::string& model_path, double spacing_deg, const Ranges& range_deg,

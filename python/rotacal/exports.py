@@ -169,13 +169,17 @@ def controller_tables(
     generated_at: str = "",
     file_names: dict[str, str] | None = None,
     fanuc: dict[str, float] | None = None,
+    max_cross_points: int = 0,
+    isg_axis_numbers: dict[str, int] | None = None,
 ) -> Any:
     """The controller's compensation tables of a model's errors that move with a rotary axis
     (``rotacal export --tables``), computed in C++ (``rotacal/io/compensation_table.hpp``): a
     ``rotacal._core.CompensationTables`` whose ``tables`` each carry ``file_name`` (in
     ``directory``) and ``text``, and (LinuxCNC) ``ini`` the lines that load them. LinuxCNC
-    COMP_FILEs and SINUMERIK EEC programs; the other controllers are refused by name
-    (docs/controller_exports.md). ``max_points`` 0: the controller's own limit. ``file_names``:
+    COMP_FILEs, SINUMERIK EEC and CEC programs, ISG kw.ssfk and kw.crosscomp lists, FANUC pitch
+    error data; HEIDENHAIN is refused by name (docs/controller_exports.md). ``max_points`` 0: the
+    controller's own limit; ``max_cross_points`` likewise for a cross table (SINUMERIK MD18342,
+    ISG kw.crosscomp). ``isg_axis_numbers``: ISG logical axis numbers by letter. ``file_names``:
     LinuxCNC, the file of an axis' table (default ``directory/comp_<axis>.txt``). ``fanuc``: the
     fields of ``rotacal._core.FanucPitchOptions`` (detection unit, data numbers, value range,
     magnification) for FANUC's pitch error compensation data."""
@@ -188,12 +192,23 @@ def controller_tables(
             os.fspath(model), float(spacing_deg), rng, names, int(max_points), generated_at
         )
     if controller == "siemens":
-        return _core.sinumerik_eec_tables(
+        return _core.sinumerik_tables(
             os.fspath(model),
             float(spacing_deg),
             rng,
             axis_names or {},
             int(max_points),
+            int(max_cross_points),
+            generated_at,
+        )
+    if controller == "isg":
+        return _core.isg_tables(
+            os.fspath(model),
+            float(spacing_deg),
+            rng,
+            isg_axis_numbers or {},
+            int(max_points),
+            int(max_cross_points),
             generated_at,
         )
     if controller == "fanuc":
@@ -201,9 +216,17 @@ def controller_tables(
         for k, v in (fanuc or {}).items():
             setattr(o, k, v)
         return _core.fanuc_pitch_tables(os.fspath(model), float(spacing_deg), rng, o, generated_at)
+    mapping = (
+        ": HEIDENHAIN is mapping only, its .COM/.CMA table layout and the sign of their values "
+        "are only partly public (a rotary axis' positioning would be a .COM column C = F(C), "
+        "its translations columns X, Y, Z = F(C), assigned in a .CMA)"
+        if controller == "heidenhain"
+        else ""
+    )
     raise _core.InvalidArgument(
-        f"--tables: compensation tables are written for linuxcnc, siemens and fanuc; {controller}'s "
-        "are not (docs/controller_exports.md, the table of error terms x controller)"
+        f"--tables: compensation tables are written for linuxcnc, siemens, isg and fanuc; "
+        f"{controller}'s are not{mapping} (docs/controller_exports.md, the table of error terms "
+        "x controller)"
     )
 
 

@@ -33,8 +33,10 @@ double worst_interpolation_error(const std::vector<double>& grid,
                                  const std::vector<double>& at_grid,
                                  const std::function<double(double)>& f, int samples_between) {
   double worst = 0.0;
+  // From each interval's first point on (a table's values may be rounded there), and the last.
+  if (!grid.empty()) worst = std::abs(f(grid.back()) - at_grid.back());
   for (std::size_t i = 0; i + 1 < grid.size(); ++i)
-    for (int s = 1; s <= samples_between; ++s) {
+    for (int s = 0; s <= samples_between; ++s) {
       const double u = static_cast<double>(s) / (samples_between + 1);
       const double x = grid[i] + u * (grid[i + 1] - grid[i]);
       const double lin = at_grid[i] + u * (at_grid[i + 1] - at_grid[i]);

@@ -34,13 +34,17 @@ def test_the_section_says_which_terms_the_tables_hold_and_what_remains():
     assert r["E_A0C"][1] == "left to rotacal compensate"  # no orientation pins in trt kins
     remains = html.split("Remains after loading:")[1]
     assert "E_XC 2.00" in remains and "positioning_C" not in remains
-    # SINUMERIK holds the tilts in its kinematics and the positioning in an EEC table.
+    # SINUMERIK holds the tilts in its kinematics, the positioning in an EEC table and the
+    # translations (run-out, sag) in CEC tables.
     r = rows(controller_section(model_doc(), "siemens"))
     assert r["positioning_C"][1] == "table eec_C.mpf" and r["E_A0C"][1].startswith("kinematics")
-    # ISG has no table writer yet: the positioning stays for compensate.
-    assert rows(controller_section(model_doc(), "isg"))["positioning_C"][1] == (
-        "left to rotacal compensate"
-    )
+    assert r["E_XC"][1] == "table cec_C.mpf" and r["E_ZA"][1] == "table cec_A.mpf"
+    # ... the C tables at A = 0 only: away from it the run-out turns with A (up to 2 um x 2).
+    away = r["E_XC, E_YC, E_ZC away from A = 0"]
+    assert away[1] == "left to rotacal compensate" and 2.0 < float(away[0].split()[0]) <= 4.0
+    # ISG: the positioning in kw.ssfk, each slave's translation in kw.crosscomp.
+    r = rows(controller_section(model_doc(), "isg"))
+    assert r["positioning_C"][1] == "table ssfk_C.lis" and r["E_XC"][1] == "table crosscomp_X.lis"
 
 
 def test_report_of_a_session_adds_the_section_as_the_export_holds_it(shared_data, tmp_path):

@@ -76,9 +76,9 @@ std::vector<double> equally_spaced_deg(double lo_deg, double hi_deg, double spac
 AxisAngleMap sample_angle_map(const AxisErrorFunction& f, double lo_deg, double hi_deg,
                               double spacing_deg, int samples_between = 16);
 
-/// Worst |f(x) - linear interpolation of f between the grid points| over `samples_between`
-/// equally spaced x inside each interval of `grid` (increasing): the one estimate of every
-/// table's interpolation error.
+/// Worst |f(x) - linear interpolation of `at_grid` between the grid points| over the grid points
+/// (where a table's written values may be rounded) and `samples_between` equally spaced x inside
+/// each interval of `grid` (increasing): the one estimate of every table's interpolation error.
 double worst_interpolation_error(const std::vector<double>& grid,
                                  const std::vector<double>& at_grid,
                                  const std::function<double(double)>& f, int samples_between);

@@ -44,12 +44,18 @@ struct CompensationTableOptions {
   /// Most points a table may hold; 0: the controller's own (LinuxCNC 256, EMCMOT_COMP_SIZE in
   /// src/emc/motion/motion.h; SINUMERIK 200, the 808D's, else MD38000 as configured).
   std::size_t max_points = 0;
+  /// Most points a cross table may hold; 0: the controller's own (SINUMERIK 200, the 828D's,
+  /// else MD18342 $MN_MM_CEC_MAX_POINTS as configured; ISG 1000, kw.crosscomp.table).
+  std::size_t max_cross_points = 0;
   /// SINUMERIK: the machine axis identifier of each axis letter (MD10000; default "<letter>1").
   std::map<char, std::string> axis_names;
   int samples_between = 63;  ///< model evaluations inside each interval for the error
   /// The file each table is written to, by axis letter, for the INI lines (default
   /// "comp_<axis>.txt").
   std::map<char, std::string> file_names;
+  /// ISG: the logical axis number of each axis letter (kopf, kw.crosscomp.master_ax_nr;
+  /// default X 1, Y 2, Z 3, A 4, B 5, C 6).
+  std::map<char, int> isg_axis_numbers;
   std::string model_path;    ///< for the header
   std::string generated_at;  ///< UTC time for the header (empty: now)
   FanucPitchOptions fanuc;
@@ -69,6 +75,11 @@ struct CompensationTable {
   /// for `rotacal compensate` sets them to zero.
   std::vector<std::string> holds;
   std::string summary;  ///< one line for people
+  /// A cross table (SINUMERIK CEC, ISG kw.crosscomp): the value of each output axis X, Y, Z at
+  /// nominal_deg, mm, the correction added to that linear axis' position; empty for a
+  /// positioning table.
+  std::map<char, std::vector<double>> value_mm;
+  double max_interpolation_error_mm = 0.0;  ///< a cross table's worst error, over its outputs
 };
 
 struct CompensationTables {
@@ -101,6 +112,37 @@ CompensationTables linuxcnc_comp_tables(const ModelFile& model,
 CompensationTables sinumerik_eec_tables(const ModelFile& model,
                                         const std::vector<AxisErrorFunction>& functions,
                                         const CompensationTableOptions& options);
+
+/// SINUMERIK tables: the EEC tables of sinumerik_eec_tables and, per table axis with a
+/// translation E_X, E_Y or E_Z, a cross error compensation program (CEC, K3 "Sag compensation",
+/// `%_N_NC_CEC_INI`): one table per output axis, `$AN_CEC[t,N]` values in mm at the input axis'
+/// positions `$AN_CEC_MIN + N $AN_CEC_STEP` up to `$AN_CEC_MAX`, linear between them, the end
+/// values held beyond (or modulo), both directions, no table multiplication. A table's value is
+/// added to its output axis' position: it is the axis' translation E there, which moves the
+/// table point, so the tool follows it. The translations are those of the frame the axis is
+/// mounted in (angle_map.hpp): the tilt axis' hold at any rotary angle, the rotary axis' at tilt
+/// 0 only (the header says so and gives what remains over the tilt range; `not_held` too).
+/// Tables are numbered from 0 over the files. Refused as sinumerik_eec_tables, naming MD18342
+/// for a cross table over max_cross_points.
+CompensationTables sinumerik_tables(const ModelFile& model,
+                                    const std::vector<AxisErrorFunction>& functions,
+                                    const CompensationTableOptions& options);
+
+/// ISG/Beckhoff compensation value lists (TF5200 axis compensation): per table axis with a
+/// positioning error a leadscrew error compensation list `ssfk_<axis>.lis` (kw.ssfk: equidistant
+/// from kw_startpos every interval, 0.0001 deg, the values actual - commanded position, which the
+/// control takes off the setpoint, bilateral with the same values both ways, kw.ssfk.modulo over
+/// one turn for an endless axis without a range, linear between points, end values held), and
+/// per linear axis X, Y, Z that a table axis translates a cross compensation list
+/// `crosscomp_<slave>.lis` (kw.crosscomp: the master's positions, the corrections in 0.1 um
+/// added to the slave's position, no modulo) of the master with the largest translation along it:
+/// a slave's list holds one master, the others' are in `not_held`. The angular error motions are
+/// not held (ISG's Volumetric Compensation would hold them; not written). Refused as
+/// sinumerik_eec_tables, naming kw_nr_max (default 1500, `max_points`) or kw.crosscomp's 1000
+/// values (`max_cross_points`).
+CompensationTables isg_tables(const ModelFile& model,
+                              const std::vector<AxisErrorFunction>& functions,
+                              const CompensationTableOptions& options);
 
 /// FANUC pitch error compensation data of each table axis' positioning error: per axis a
 /// listing of the parameters 3620-3625 and the values by data number, to enter on the pitch

@@ -108,6 +108,15 @@ def _spacing(text: str) -> float:
     return v
 
 
+def _isg_axis(text: str) -> tuple[str, int]:
+    axis, sep, number_text = text.partition("=")
+    if not sep or axis not in ("X", "Y", "Z", "A", "B", "C") or not number_text.isdigit():
+        raise _core.InvalidArgument(
+            f"--isg-axis {text!r}: expected AXIS=N, AXIS X, Y, Z, A, B or C, N its logical number"
+        )
+    return axis, int(number_text)
+
+
 def _write_tables(a: argparse.Namespace) -> object:
     import os
 
@@ -118,9 +127,9 @@ def _write_tables(a: argparse.Namespace) -> object:
     names = {}
     for text in a.siemens_axis or []:
         axis, sep, name = text.partition("=")
-        if not sep or axis not in ("A", "B", "C"):
+        if not sep or axis not in ("A", "B", "C", "X", "Y", "Z"):
             raise _core.InvalidArgument(
-                f"--siemens-axis {text!r}: expected AXIS=NAME, AXIS A, B or C"
+                f"--siemens-axis {text!r}: expected AXIS=NAME, AXIS A, B, C, X, Y or Z"
             )
         names[axis] = name
     fanuc = {
@@ -143,6 +152,8 @@ def _write_tables(a: argparse.Namespace) -> object:
         names,
         a.max_points or 0,
         fanuc=fanuc,
+        max_cross_points=a.max_cross_points or 0,
+        isg_axis_numbers=dict(_isg_axis(t) for t in a.isg_axis or []),
     )
     for t in tabs.tables:
         out = os.path.join(os.path.abspath(directory), os.path.basename(t.file_name))
@@ -271,6 +282,69 @@ def cmd_compensate(a: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _add_table_args(q: argparse.ArgumentParser) -> None:
+    """export --tables and its options."""
+    q.add_argument(
+        "--tables",
+        action="store_true",
+        help="also write each table axis' positioning error as the controller's table: linuxcnc "
+        "[JOINT_n]COMP_FILE (type 1) and the INI lines (comp_tables.ini); siemens EEC "
+        "($AA_ENC_COMP) programs eec_<axis>.mpf and, for the axes' translations, CEC ($AN_CEC) "
+        "programs cec_<axis>.mpf; isg kw.ssfk lists ssfk_<axis>.lis and kw.crosscomp lists "
+        "crosscomp_<X|Y|Z>.lis; fanuc pitch error compensation data "
+        "pitch_<axis>.txt (parameters 3620-3625, values by data number)",
+    )
+    q.add_argument(
+        "--spacing", default="5deg", help="--tables: between table points (default 5deg)"
+    )
+    q.add_argument(
+        "--table-range",
+        action="append",
+        metavar="AXIS=LO,HI",
+        help="--tables: the angles a table spans, deg (default: the axis' limits, an endless "
+        "axis -360,360); a continuously turning C needs what the program turns through",
+    )
+    q.add_argument(
+        "--siemens-axis",
+        action="append",
+        metavar="AXIS=NAME",
+        help="--tables, siemens: the machine axis identifier of AXIS, a rotary or (CEC outputs) "
+        "a linear axis (MD10000; default C1, B1, A1, X1, Y1, Z1)",
+    )
+    q.add_argument(
+        "--max-points",
+        type=number("--max-points", 2, 100000, integer=True),
+        help="--tables: the most points a table may hold (default: linuxcnc 256, siemens 200, "
+        "MD38000 as configured; isg 1500, kw_nr_max)",
+    )
+    q.add_argument(
+        "--isg-axis",
+        action="append",
+        metavar="AXIS=N",
+        help="--tables, isg: the logical axis number of AXIS (default X 1, Y 2, Z 3, A 4, B 5, C 6)",
+    )
+    q.add_argument(
+        "--max-cross-points",
+        type=number("--max-cross-points", 2, 100000, integer=True),
+        help="--tables: the most points a cross table may hold (default: siemens 200, "
+        "MD18342 as configured; isg 1000, kw.crosscomp)",
+    )
+    q.add_argument(
+        "--tables-dir",
+        type=path("--tables-dir"),
+        help="--tables: the folder of the tables (default: that of -o, else the current one)",
+    )
+    fanuc = q.add_argument_group("--tables with --controller fanuc (pitch error compensation)")
+    for option, lo, hi, whole, what in (
+        ("--fanuc-unit", 1e-6, 1.0, False, "the rotary axes' detection unit, deg (default 0.001)"),
+        ("--fanuc-first-number", 0, 1e5, True, "the first data number of the first table (0)"),
+        ("--fanuc-last-number", 0, 1e5, True, "the control's highest data number (1023, a 0i's)"),
+        ("--fanuc-max-value", 1, 1e6, True, "the largest absolute value of one data number (127)"),
+        ("--fanuc-magnification", 1, 100, True, "parameter 3623 (default: the smallest that fits)"),
+    ):
+        fanuc.add_argument(option, type=number(option, lo, hi, integer=whole), help=what)
+
+
 def add_export(sub: argparse._SubParsersAction) -> None:
     q = sub.add_parser(
         "export",
@@ -370,50 +444,7 @@ def add_export(sub: argparse._SubParsersAction) -> None:
         default=1.0,
         help="step of the table, deg (default 1; LinuxCNC reads at most 256 lines)",
     )
-    q.add_argument(
-        "--tables",
-        action="store_true",
-        help="also write each table axis' positioning error as the controller's table: linuxcnc "
-        "[JOINT_n]COMP_FILE (type 1) and the INI lines (comp_tables.ini); siemens EEC "
-        "($AA_ENC_COMP) programs eec_<axis>.mpf; fanuc pitch error compensation data "
-        "pitch_<axis>.txt (parameters 3620-3625, values by data number)",
-    )
-    q.add_argument(
-        "--spacing", default="5deg", help="--tables: between table points (default 5deg)"
-    )
-    q.add_argument(
-        "--table-range",
-        action="append",
-        metavar="AXIS=LO,HI",
-        help="--tables: the angles a table spans, deg (default: the axis' limits, an endless "
-        "axis -360,360); a continuously turning C needs what the program turns through",
-    )
-    q.add_argument(
-        "--siemens-axis",
-        action="append",
-        metavar="AXIS=NAME",
-        help="--tables, siemens: the machine axis identifier of AXIS (MD10000; default C1, B1, A1)",
-    )
-    q.add_argument(
-        "--max-points",
-        type=number("--max-points", 2, 100000, integer=True),
-        help="--tables: the most points a table may hold (default: linuxcnc 256, siemens 200; "
-        "SINUMERIK: MD38000 as configured)",
-    )
-    q.add_argument(
-        "--tables-dir",
-        type=path("--tables-dir"),
-        help="--tables: the folder of the tables (default: that of -o, else the current one)",
-    )
-    fanuc = q.add_argument_group("--tables with --controller fanuc (pitch error compensation)")
-    for option, lo, hi, whole, what in (
-        ("--fanuc-unit", 1e-6, 1.0, False, "the rotary axes' detection unit, deg (default 0.001)"),
-        ("--fanuc-first-number", 0, 1e5, True, "the first data number of the first table (0)"),
-        ("--fanuc-last-number", 0, 1e5, True, "the control's highest data number (1023, a 0i's)"),
-        ("--fanuc-max-value", 1, 1e6, True, "the largest absolute value of one data number (127)"),
-        ("--fanuc-magnification", 1, 100, True, "parameter 3623 (default: the smallest that fits)"),
-    ):
-        fanuc.add_argument(option, type=number(option, lo, hi, integer=whole), help=what)
+    _add_table_args(q)
     q.add_argument(
         "--json", action="store_true", help="print the parameters and the errors held as JSON"
     )

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import tempfile
 from typing import Any
 
@@ -18,7 +19,7 @@ from .. import _core
 from ..exports import controller_tables, export_controller
 from .page import escape as _e
 
-TABLE_CONTROLLERS = ("linuxcnc", "siemens", "fanuc")
+TABLE_CONTROLLERS = ("linuxcnc", "siemens", "isg", "fanuc")
 
 
 def _size(value: float, unit: str) -> str:
@@ -27,7 +28,10 @@ def _size(value: float, unit: str) -> str:
 
 def _term_rows(model_path: str, tables: Any) -> list[tuple[str, str, str]]:
     """(term, its largest size over a turn, where) of each error motion of the table axes."""
-    in_table = {t.axis: os.path.basename(t.file_name) for t in (tables.tables if tables else [])}
+    written = tables.tables if tables else []
+    in_table = {t.axis: os.path.basename(t.file_name) for t in written if not t.value_mm}
+    # Cross tables (SINUMERIK CEC, ISG kw.crosscomp): E_<output><axis> by (axis, output).
+    crossed = {(t.axis, o): os.path.basename(t.file_name) for t in written for o in t.value_mm}
     rows = []
     for m in _core.angle_maps(model_path, -180.0, 180.0, 5.0):
         values = np.abs(np.asarray(m.values))
@@ -35,9 +39,18 @@ def _term_rows(model_path: str, tables: Any) -> list[tuple[str, str, str]]:
             largest = float(values[:, j].max()) if len(values) else 0.0
             if largest == 0.0 or name == f"E_{m.axis}{m.axis}":  # that one is positioning_
                 continue
-            held = name.startswith("positioning_") and m.axis in in_table
-            where = f"table {in_table[m.axis]}" if held else "left to rotacal compensate"
+            if name.startswith("positioning_") and m.axis in in_table:
+                where = f"table {in_table[m.axis]}"
+            elif (m.axis, name[2]) in crossed and name[2] in "XYZ":
+                where = f"table {crossed[(m.axis, name[2])]}"
+            else:
+                where = "left to rotacal compensate"
             rows.append((name, _size(largest, unit), where))
+    # A rotary axis' cross tables hold at tilt 0 only: what remains of them over the tilt range.
+    for n in tables.not_held if tables else []:
+        m = re.match(r"(.+ away from .+?): up to ([\d.]+) um", n)
+        if m:
+            rows.append((m[1], f"{float(m[2]):.2f} &micro;m", "left to rotacal compensate"))
     return rows
 
 

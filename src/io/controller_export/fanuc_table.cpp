@@ -188,12 +188,13 @@ CompensationTable one_table(const AxisErrorFunction& f, const MachineType& m,
 CompensationTables fanuc_pitch_tables(const ModelFile& model,
                                       const std::vector<AxisErrorFunction>& functions,
                                       const CompensationTableOptions& o) {
-  using namespace fanuc_table_detail;
-  const ExportInput in = export_input(model, o.model_path);
   int next_number = o.fanuc.first_number;  // the axes' tables take consecutive data numbers
-  return positioning_tables(
-      model, functions, "FANUC", "FANUC's pitch error compensation",
-      [&](const AxisErrorFunction& f) { return one_table(f, model.machine, o, in, next_number); });
+  return table_detail::positioning_tables(
+      model, functions, o, "FANUC", "FANUC's pitch error compensation",
+      [&](const AxisErrorFunction& f, const MachineType& m, const CompensationTableOptions& opt,
+          const ExportInput& in) {
+        return fanuc_table_detail::one_table(f, m, opt, in, next_number);
+      });
 }
 
 }  // namespace rotacal
