@@ -33,9 +33,11 @@ import rotacal
 from rotacal import realtime
 
 from conftest import run_cli
-from linuxcnc_session import requires_linuxcnc, run_linuxcnc
+import lcnc_thermal
+from linuxcnc_session import requires_linuxcnc, shared
 
 pytestmark = requires_linuxcnc
+LINUXCNC_STARTS = {"rotacal-kins"}  # linuxcnc_session.shared
 
 ROOT = Path(__file__).resolve().parents[2]
 MODULE_DIR = Path("/usr/lib/linuxcnc/modules")
@@ -103,7 +105,7 @@ def module_so() -> Path:
     return so
 
 
-@pytest.fixture()
+@pytest.fixture(scope="module")
 def installed_module():
     dest = MODULE_DIR / "rotacal-kins.so"
     tmp = MODULE_DIR / ".rotacal-kins.so.tmp"
@@ -122,7 +124,11 @@ def travel(rng, n, tilt_col):
     return j
 
 
-def test_rotacal_kins_in_linuxcnc_is_the_model(tmp_path, installed_module):
+@pytest.fixture(scope="module")
+def rotacal_kins(installed_module, tmp_path_factory):
+    """The shared start of rotacal-kins-sim.ini with an AC-trt and a BC-trt model (switchkins
+    types 0 and 1): (start, plan, references)."""
+    tmp_path = tmp_path_factory.mktemp("rotacal-kins")
     rng = np.random.default_rng(55)
     blob_dir = Path(tempfile.mkdtemp(prefix="rotacal-kins-"))  # rtapi_app reads it as RTAPI_UID
     os.chmod(blob_dir, 0o755)
@@ -164,20 +170,30 @@ def test_rotacal_kins_in_linuxcnc_is_the_model(tmp_path, installed_module):
                 }
             )
         ini = (ROOT / "tests/linuxcnc/rotacal-kins-sim.ini").read_text()
-        out = run_linuxcnc(
-            tmp_path / "run",
+        start = shared(
+            "rotacal-kins",
             "rotacal-kins-sim.ini",
-            {
-                "rotacal-kins-sim.ini": ini.replace("@MODELS@", ",".join(blobs)),
-                "plan.json": json.dumps(plan),
-            },
-            "rotacal_kins.json",
-            RUN_TIMEOUT,
+            {"rotacal-kins-sim.ini": ini.replace("@MODELS@", ",".join(blobs))},
         )
+        # rtapi_app reads the blobs when the module loads: the first job waits for that
+        start.job("rotacal_kins_display", tmp_path / "up", {"plan.json": '{"models": []}'},
+                  "rotacal_kins.json", RUN_TIMEOUT)  # fmt: skip
     finally:
         shutil.rmtree(blob_dir, ignore_errors=True)
+    return start, plan, refs
+
+
+def test_rotacal_kins_in_linuxcnc_is_the_model(tmp_path, rotacal_kins):
+    start, plan, refs = rotacal_kins
+    out = start.job(
+        "rotacal_kins_display",
+        tmp_path / "run",
+        {"plan.json": json.dumps(plan)},
+        "rotacal_kins.json",
+        RUN_TIMEOUT,
+    )
     print(
-        f"LinuxCNC session {out['elapsed']:.1f} s, {out['lcnc_cpu_s']:.1f} CPU-s in its processes"
+        f"LinuxCNC job {out['elapsed']:.1f} s, {out['lcnc_cpu_s']:.1f} CPU-s in its processes so far"
     )
 
     for (ref, nominal_ref, tilt_col, tool), p, got in zip(refs, plan["models"], out["models"]):
@@ -209,3 +225,24 @@ def test_rotacal_kins_in_linuxcnc_is_the_model(tmp_path, installed_module):
         assert residual[:, 0].max() < TOL
         assert inv_err.max() < TOL
         assert back[:, :3].max() < TOL and back[:, 3:].max() < 1e-6  # deg
+
+
+def test_thermal_chain_feeds_y1_as_the_lag(fast_thermal_model, tmp_path, rotacal_kins):
+    """Issue 53's HAL chain into rotacal-kins: the lag state itself on its pin y1 (the gains are
+    the blob's), from C's vel-cmd (joint 5 of coordinates=XYZABC)."""
+    start = rotacal_kins[0]
+    r = run_cli(
+        "export", "--model", fast_thermal_model, "--controller", "linuxcnc",
+        "--thermal-chain", "rotacal-kins", "--json",
+    )  # fmt: skip
+    assert r.returncode == 0, r.stderr
+    info = json.loads(r.stdout)
+    assert info["joint"] == 5 and info["pins"] == []
+    text = run_cli(
+        "export", "--model", fast_thermal_model, "--controller", "linuxcnc",
+        "--thermal-chain", "rotacal-kins",
+    ).stdout  # fmt: skip
+    assert "net rotacal-th-y1 rotacal-th-lag1.out => rotacal-kins.y1" in text
+    tau = json.loads(fast_thermal_model.read_text())["thermal"]["lags"][0]["tau"]["value"]
+    log = lcnc_thermal.run(start, tmp_path / "run", text, [])
+    lcnc_thermal.check_lag(log, tau, 1e-3)
