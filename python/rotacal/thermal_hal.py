@@ -61,6 +61,8 @@ def chain(
     t = servo_period_ns * 1e-9
     if joint is None:
         joint = (TRT_JOINT if target == "trt" else ROTACAL_KINS_JOINT)[axis]
+    if not 0 <= joint < 16:  # EMCMOT_MAX_JOINTS
+        raise _core.InvalidArgument(f"--heat-joint {joint}: not a LinuxCNC joint (0 to 15)")
     L = len(lags)
     cold = export_controller(model, "linuxcnc", current=current, thermal_state=[0.0] * L)
     kins = cold.kinematics

@@ -268,8 +268,21 @@ class Start:
         data["elapsed"] = time.monotonic() - t0
         return data
 
+    def cpu_seconds(self) -> float:
+        """CPU seconds the start's processes (rtapi_app, task, io, ...) have used so far."""
+        total = 0.0
+        for pid, _ in _ours(self.marker):
+            try:
+                stat = Path(f"/proc/{pid}/stat").read_text()
+            except OSError:
+                continue
+            fields = stat[stat.rindex(")") + 2 :].split()
+            total += (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+        return total
+
     def close(self):
         """Stop the display (and with it LinuxCNC); the checks a one-shot run makes."""
+        cpu = self.cpu_seconds()
         tmp = self.run_dir / "jobs" / f".{self.jobs}.json"
         tmp.write_text(json.dumps({"stop": True}))
         os.replace(tmp, self.run_dir / "jobs" / f"{self.jobs}.json")
@@ -282,7 +295,10 @@ class Start:
             _end_ours(self.marker, self.log)
             shutil.rmtree(self.fifo_dir, ignore_errors=True)
             self._out.close()
-        print(f"LinuxCNC start {self.key}: {self.jobs} jobs, {time.monotonic() - self.t0:.1f} s")
+        print(
+            f"LinuxCNC start {self.key}: {self.jobs} jobs, {time.monotonic() - self.t0:.1f} s, "
+            f"{cpu:.1f} CPU-s in its processes before the stop"
+        )
         assert self.proc.returncode == 0 and not self.log, self.diagnostics()
         assert not LOCK.exists(), f"LinuxCNC left {LOCK}\n{self.diagnostics()}"
         shutil.rmtree(self.run_dir.parent, ignore_errors=True)
