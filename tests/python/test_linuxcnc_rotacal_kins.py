@@ -6,8 +6,9 @@ The test installs the module built with the library (build/release/linuxcnc/rota
 it builds it there if missing) into LinuxCNC's module directory, writes an AC-trt and a BC-trt
 model (location errors, angular positioning and radial run-out harmonics, sag; the AC one with
 thermal gains on two location errors) as blobs with `rotacal export --controller realtime`,
-and starts one headless LinuxCNC (tests/linuxcnc/rotacal-kins-sim.ini) that loads both and
-switches between them with motion.switchkins-type. Its display sets the tool-offset, y1 and y2
+and the blob of a thermal model (its cold errors and gains, exported by the same command), and
+starts one headless LinuxCNC (tests/linuxcnc/rotacal-kins-sim.ini) that loads the three and
+switches between them with motion.switchkins-type (shared with the thermal HAL chain's check). Its display sets the tool-offset, y1 and y2
 pins, jogs the joints to positions over the travel and moves in world coordinates with G0.
 
 Reference: rotacal's Python evaluation of the model files (rotacal.realtime on the JSON, not on
@@ -52,6 +53,7 @@ ERRORS = [0.03, -0.02, 5e-5, -4e-5, 0.015, 0.025, -3e-5, 6e-5]  # mm, rad
 # y1, E_Y0C -3 um per unit of y2; the display sets y1, y2 to these.
 GAINS = {(4, 0): 0.004, (5, 1): -0.003}
 Y1, Y2 = 0.5, -0.8
+Y_THERMAL = 1.5  # y1 of the thermal model's blob (steady state at 150 rev/min)
 GAIN_OFFSET = 20 + 18 + 2 * 195 + 8 * 8  # header, machine..pivot, two axes, errors: bytes
 
 
@@ -125,9 +127,10 @@ def travel(rng, n, tilt_col):
 
 
 @pytest.fixture(scope="module")
-def rotacal_kins(installed_module, tmp_path_factory):
+def rotacal_kins(installed_module, tmp_path_factory, fast_thermal_model):
     """The shared start of rotacal-kins-sim.ini with an AC-trt and a BC-trt model (switchkins
-    types 0 and 1): (start, plan, references)."""
+    types 0 and 1) and the blob `export --controller realtime` writes of a thermal model (type
+    2, AC-trt): (start, plan, references)."""
     tmp_path = tmp_path_factory.mktemp("rotacal-kins")
     rng = np.random.default_rng(55)
     blob_dir = Path(tempfile.mkdtemp(prefix="rotacal-kins-"))  # rtapi_app reads it as RTAPI_UID
@@ -169,6 +172,32 @@ def rotacal_kins(installed_module, tmp_path_factory):
                     "world": world.tolist(),
                 }
             )
+        # Type 2: the thermal model's blob (its cold errors and gains) at y1 = Y_THERMAL; the
+        # reference is the plain model of its errors at that state (effects.md
+        # thermal_location_R: E0 + K y).
+        blob = blob_dir / "thermal.rtb"
+        r = run_cli(
+            "export", "--model", fast_thermal_model, "--controller", "realtime", "-o", blob
+        )  # fmt: skip
+        assert r.returncode == 0, r.stderr
+        os.chmod(blob, 0o644)
+        blobs.append(str(blob))
+        th = json.loads(fast_thermal_model.read_text())
+        errors = [
+            (th["location_errors"][n]["value"] or 0.0)
+            + (th["thermal"]["lags"][0]["gains"][n]["value"] or 0.0) * Y_THERMAL
+            for n in NAMES["AC-trt"]
+        ]
+        ref = tmp_path / "thermal.ref.json"
+        rotacal.save_model(model_doc("AC-trt", "A", errors, effects=False), ref)
+        refs.append(
+            (realtime.load_realtime(ref), realtime.load_realtime(tmp_path / "AC-trt.nominal.json"), 3, 0.0)
+        )  # fmt: skip
+        joints, world = travel(rng, 4, 3), travel(rng, 4, 3)
+        world[:, 3] = np.where(np.abs(world[:, 3]) < 2, 10, world[:, 3])
+        plan["models"].append(
+            {"tool-offset": 0.0, "y1": Y_THERMAL, "y2": 0.0, "joints": joints.tolist(), "world": world.tolist()}
+        )  # fmt: skip
         ini = (ROOT / "tests/linuxcnc/rotacal-kins-sim.ini").read_text()
         start = shared(
             "rotacal-kins",
@@ -216,7 +245,7 @@ def test_rotacal_kins_in_linuxcnc_is_the_model(tmp_path, rotacal_kins):
         lw = np.array([m["world"] for m in got["world_moves"]])
         back = np.abs(lw - world)
         print(
-            f"{'AC' if tilt_col == 3 else 'BC'}-trt: forward {fwd_err * 1e6:.3g} nm (model - nominal "
+            f"{'AC' if tilt_col == 3 else 'BC'}-trt{' thermal' if p['y1'] == Y_THERMAL else ''}: forward {fwd_err * 1e6:.3g} nm (model - nominal "
             f"{np.abs(tip - nominal).max() * 1e3:.3g} um), inverse {inv_err.max() * 1e6:.3g} nm, "
             f"world read back {back[:, :3].max() * 1e6:.3g} nm, {back[:, 3:].max():.3g} deg"
         )
