@@ -25,11 +25,17 @@ from lcnc_display import WAIT, Machine
 
 def halcmd(*args):
     r = subprocess.run(["halcmd", *args], capture_output=True, text=True, timeout=WAIT)
-    # unloadrt sampler reports a failed rmmod although the component is gone: what counts is
-    # that it is gone
     if r.returncode != 0 and args[0] == "unloadrt":
-        if args[1] not in halcmd("list", "comp").split():
-            return r.stdout
+        # unloadrt sampler can report a failed rmmod while halsampler's detach is under way;
+        # the component goes a moment later, or a second unloadrt takes it: what counts is
+        # that it is gone
+        for _ in range(20):
+            time.sleep(0.25)
+            if args[1] not in halcmd("list", "comp").split():
+                return r.stdout
+            r = subprocess.run(["halcmd", *args], capture_output=True, text=True, timeout=WAIT)
+            if r.returncode == 0:
+                return r.stdout
     if r.returncode != 0:
         raise RuntimeError(f"halcmd {' '.join(args)}: {r.stdout}{r.stderr}")
     return r.stdout
