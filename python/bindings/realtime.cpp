@@ -4,6 +4,7 @@
 // same blob it loads.
 #include "numpy.hpp"
 #include "rotacal/io/realtime_export.hpp"
+#include "rotacal/io/thermal_model.hpp"
 #include "rotacal/realtime/blob.hpp"
 #include "rotacal/realtime/evaluate.hpp"
 
@@ -85,10 +86,13 @@ void bind_realtime(pyb::module_& m) {
           "tip relative to the workpiece (mm) and the nominal rotary angles (rad).");
   m.def(
       "realtime_model_of_file",
-      [](const std::string& path) { return realtime_model(read_model(path), path); },
-      pyb::arg("path"),
+      [](const std::string& path, bool thermal) {
+        return thermal ? realtime_model(read_thermal_model(path), path)
+                       : realtime_model(read_model(path), path);
+      },
+      pyb::arg("path"), pyb::arg("thermal") = false,
       "The real-time model of a model file (io/realtime_export.hpp): every location error and "
-      "effect.");
+      "effect; thermal (a model of kind thermal): its cold errors and each lag's gains.");
   m.def(
       "realtime_model_of_blob",
       [](const pyb::bytes& data, std::optional<MachineType> machine, const std::string& source) {

@@ -4391,9 +4391,9 @@ def realtime_model_of_blob(data: bytes, machine: rotacal._core.MachineType | Non
     """
     Read a blob (realtime/blob.hpp); ParseError naming the field when it is corrupt, truncated, of another version or (given machine) of another machine.
     """
-def realtime_model_of_file(path: str) -> RealtimeModel:
+def realtime_model_of_file(path: str, thermal: bool = False) -> RealtimeModel:
     """
-    The real-time model of a model file (io/realtime_export.hpp): every location error and effect.
+    The real-time model of a model file (io/realtime_export.hpp): every location error and effect; thermal (a model of kind thermal): its cold errors and each lag's gains.
     """
 def record_ballbar(port: str, plan: BallbarPlan, path: str, baud: typing.SupportsInt | typing.SupportsIndex = 115200, rate_hz: typing.SupportsFloat | typing.SupportsIndex = 1000.0, zero: bool = False, silence_timeout_s: typing.SupportsFloat | typing.SupportsIndex = 3.0, progress: collections.abc.Callable | None = None) -> RecordSummary:
     """

@@ -6,6 +6,7 @@ checked (``rotacal predict --joints``). The work is done in C++ (``realtime/eval
 
 from __future__ import annotations
 
+import json
 import os
 from pathlib import Path
 from typing import Any
@@ -17,6 +18,7 @@ from . import _core
 BLOB_MAGIC = b"RCRTBLOB"
 # A blob of the largest model is under 6 kB; anything much larger is not one.
 MAX_BLOB_BYTES = 1 << 16
+MAX_MODEL_BYTES = 1 << 26  # a model file's size bound for the peek at its kind
 
 
 def is_blob(path: str | Path) -> bool:
@@ -25,13 +27,22 @@ def is_blob(path: str | Path) -> bool:
         return f.read(len(BLOB_MAGIC)) == BLOB_MAGIC
 
 
+def is_thermal_model(path: str | Path) -> bool:
+    """True for a model file of kind thermal (its gains go into the blob's thermal_gain)."""
+    try:
+        with open(os.fspath(path), "rb") as f:
+            return json.loads(f.read(MAX_MODEL_BYTES)).get("kind") == "thermal"
+    except (ValueError, OSError, AttributeError):
+        return False  # not JSON or not readable: the C++ reader says what is wrong
+
+
 def load_realtime(path: str | Path, machine: Any = None) -> Any:
     """A ``_core.RealtimeModel`` from a model file (every location error and effect) or from a
     blob; a blob is refused, naming the field, when it is corrupt, truncated, of another version
     or (``machine`` given) of another machine."""
     p = os.fspath(path)
     if not is_blob(p):
-        return _core.realtime_model_of_file(p)
+        return _core.realtime_model_of_file(p, thermal=is_thermal_model(p))
     with open(p, "rb") as f:
         data = f.read(MAX_BLOB_BYTES + 1)
     if len(data) > MAX_BLOB_BYTES:

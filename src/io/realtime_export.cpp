@@ -2,6 +2,7 @@
 #include "rotacal/io/realtime_export.hpp"
 
 #include "rotacal/core/error.hpp"
+#include "rotacal/io/thermal_model.hpp"
 #include "rotacal/realtime/blob.hpp"
 
 namespace rotacal {
@@ -66,6 +67,16 @@ realtime::Model realtime_model(MachineType m, const LocationErrors<double>& e,
 realtime::Model realtime_model(const ModelFile& model, const std::string& context) {
   return realtime_model(model.machine, model.location_errors, model.effects, model.effect_params,
                         context);
+}
+
+realtime::Model realtime_model(const ThermalModel& model, const std::string& context) {
+  if (model.lags.empty() || model.lags.size() > 2)
+    throw InvalidArgument(context + ": " + std::to_string(model.lags.size()) +
+                          " lags; the real-time model holds 1 or 2");
+  realtime::Model out = realtime_model(model.machine, model.cold, EffectModel{}, {}, context);
+  for (std::size_t l = 0; l < model.lags.size(); ++l)
+    out.thermal_gain.col(static_cast<Eigen::Index>(l)) = model.lags[l].gains;
+  return out;
 }
 
 std::uint64_t realtime_fingerprint(MachineType m) {

@@ -60,6 +60,8 @@ class Machine:
     def bring_up(self):
         s, c = self.s, self.c
         self.wait_for("task to come up", lambda: s.task_state != 0)
+        if s.task_state == linuxcnc.STATE_ON and all(s.homed[: s.joints]):
+            return  # a served start (serve_display.py): up since an earlier job
         c.state(linuxcnc.STATE_ESTOP_RESET)
         self.wait_for("E-stop reset", lambda: s.task_state == linuxcnc.STATE_ESTOP_RESET)
         c.state(linuxcnc.STATE_ON)

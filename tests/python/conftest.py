@@ -17,11 +17,54 @@ import pytest
 SHARED = Path(__file__).resolve().parents[3] / "shared" / "data"
 
 
+def _starts(item) -> set:
+    """The LinuxCNC starts (linuxcnc_session.shared keys) a test module declares it uses."""
+    return set(getattr(getattr(item, "module", None), "LINUXCNC_STARTS", ()))
+
+
+def pytest_collection_modifyitems(session, config, items):
+    """The modules that share a LinuxCNC start run one after the other (each module's tests in
+    their order), so that the start serves them all and does not idle through other modules."""
+    first, rank = {}, {}
+    for it in items:
+        m = getattr(it, "module", None)
+        if m not in rank:
+            key = min(_starts(it), default=None)
+            i = len(rank)
+            rank[m] = (first.setdefault(key, i) if key else i, i)
+    items.sort(key=lambda it: rank[getattr(it, "module", None)])
+
+
+def pytest_runtest_teardown(item, nextitem):
+    """A shared start ends when the next test does not use it (its servo thread would run on
+    through the other tests), and with the session."""
+    session = sys.modules.get("linuxcnc_session")
+    if session is None or session._current is None:
+        return
+    if nextitem is None or session._current.key not in _starts(nextitem):
+        session.close_shared()
+
+
 @pytest.fixture(scope="session")
 def shared_data() -> Path:
     if not SHARED.is_dir():
         pytest.fail(f"shared data not found at {SHARED} (expected ../shared beside the repository)")
     return SHARED
+
+
+@pytest.fixture(scope="session")
+def fast_thermal_model(shared_data, tmp_path_factory) -> Path:
+    """The thermal model of ../shared/data/thermal_probe_ac.csv (one lag, gains of every
+    location error) with tau set to 3 s: a lag that settles within a LinuxCNC test."""
+    import rotacal
+
+    path = tmp_path_factory.mktemp("thermal") / "thermal.json"
+    r = run_cli("identify", shared_data / "thermal_probe_ac.csv", "--save-model", path)
+    assert r.returncode == 0, r.stderr
+    doc = json.loads(path.read_text())
+    doc["thermal"]["lags"][0]["tau"]["value"] = 3.0
+    rotacal.save_model(doc, path)
+    return path
 
 
 def truth(path: Path) -> dict:

@@ -18,11 +18,12 @@ import re
 import numpy as np
 import pytest
 
-from linuxcnc_session import requires_linuxcnc
-from linuxcnc_session import run_linuxcnc as run_session
+from linuxcnc_session import hal_commands, requires_linuxcnc, shared
 from rotacal import _core
 
 from conftest import run_cli
+
+LINUXCNC_STARTS = {"maxkins", "5axiskins"}  # linuxcnc_session.shared
 
 EXIT_INPUT = 3
 TOL = 1e-4  # mm: 0.1 um
@@ -228,12 +229,14 @@ def test_real_module_puts_the_tool_where_the_held_model_does(tmp_path, kins):
     q, b, c = poses(kins)
     world, ang, want = expected(kins, q, b, c)
     commands = np.column_stack([np.round(world, 6), ang])
-    r = run_session(
+    # One start per module (linuxcnc_session.shared): motion binds one kinematics module
+    r = shared(kins, f"{kins}-sim.ini", {"pins.hal": ""}).job(
+        "heads_display",
         tmp_path / "run",
-        f"{kins}-sim.ini",
-        {"pins.hal": text, "poses.json": json.dumps(commands.tolist())},
+        {"poses.json": json.dumps(commands.tolist())},
         "joints.json",
         45,
+        hal_commands(text),
     )
     assert r["motion_mode"] == 2, r  # TRAJ_MODE_COORD: moves through the kinematics
     fb = np.array([m["joints"] for m in r["moves"]])

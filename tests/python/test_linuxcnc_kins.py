@@ -3,9 +3,10 @@
 
 test_export.py re-implements xyzac-trt-kins (trtfuncs.c) in numpy; here the real module does
 the inverse kinematics. A headless simulated machine (tests/linuxcnc/xyzac-trt-sim.ini: motion,
-xyzac-trt-kins, pass-through joints as LinuxCNC's sim configs, no GUI) is started twice with
-`linuxcnc`, once with the machine's current pins (the --current file of the export) and once
-with rotacal's exported HAL file loaded as a [HAL]HALFILE. Its display program
+xyzac-trt-kins, pass-through joints as LinuxCNC's sim configs, no GUI) is started once with
+`linuxcnc` (shared with the other checks of xyzac-trt-kins) and runs twice, once with the
+machine's current pins (the --current file of the export) and once with the pins of rotacal's
+exported HAL file, set with halcmd. Its display program
 (tests/linuxcnc/tcp_display.py, run by Debian's /usr/bin/python3, which has the `linuxcnc`
 module) homes the machine, moves in world coordinates (TCP: coordinated mode through the
 kinematics) with MDI G0 to table points q at tilt A and rotation C, and reads back the joint
@@ -20,14 +21,17 @@ import re
 from pathlib import Path
 
 import numpy as np
+import pytest
 
-from linuxcnc_session import requires_linuxcnc
-from linuxcnc_session import run_linuxcnc as run_session
+import lcnc_thermal
+from linuxcnc_session import hal_commands, requires_linuxcnc, shared
 from rotacal import _core
+from rotacal.exports import export_controller
 
 from conftest import run_cli
 
 pytestmark = requires_linuxcnc
+LINUXCNC_STARTS = {"xyzac-trt"}  # linuxcnc_session.shared
 
 RUN_TIMEOUT = 45  # s, the display's own bound (SIGALRM); the test waits 15 s longer
 TOL = 1e-4  # mm: 0.1 um; LinuxCNC reports doubles, the exported pins carry 1 nm
@@ -40,14 +44,21 @@ def rotacal_cli(*args):
     return r
 
 
+def xyzac_trt():
+    """The shared start of xyzac-trt-sim.ini (linuxcnc_session.shared): its pins.hal is empty,
+    each job sets the pins it uses."""
+    return shared("xyzac-trt", "xyzac-trt-sim.ini", {"pins.hal": ""})
+
+
 def run_linuxcnc(run_dir: Path, pins: Path, poses: np.ndarray) -> dict:
-    """One headless LinuxCNC session with the pins of `pins`; the joints at every pose."""
-    return run_session(
+    """The joints at every pose, with the pins of `pins` set in the shared start."""
+    return xyzac_trt().job(
+        "tcp_display",
         run_dir,
-        "xyzac-trt-sim.ini",
-        {"pins.hal": pins.read_text(), "poses.json": json.dumps(poses.tolist())},
+        {"poses.json": json.dumps(poses.tolist())},
         "joints.json",
         RUN_TIMEOUT,
+        hal_commands(pins.read_text()),
     )
 
 
@@ -124,3 +135,67 @@ def test_xyzac_trt_kins_with_exported_pins_reproduces_the_model(shared_data, tmp
     assert np.abs(runs["current"] - expected).max() > 1e-3
     # ... the exported ones put the table point where the identified model does.
     assert np.abs(runs["corrected"] - expected).max() < TOL
+
+
+def test_thermal_chain_feeds_the_trt_pins_as_the_lag(fast_thermal_model, tmp_path):
+    """Issue 53's HAL chain: the lag of a tau 3 s thermal model run by LinuxCNC's abs, scale,
+    lowpass and sum2 while C turns, into xyzac-trt-kins' pins."""
+    current = tmp_path / "machine.hal"
+    current.write_text(
+        "".join(f"setp xyzac-trt-kins.{k} {v}\n" for k, v in zip(
+            ("x-rot-point", "y-rot-point", "z-rot-point", "y-offset", "z-offset"),
+            (P0[0], P0[1], 0.0, 0.0, P0[2]),
+        ))
+    )  # fmt: skip
+    chain = tmp_path / "chain.hal"
+    r = rotacal_cli(
+        "export", "--model", fast_thermal_model, "--controller", "linuxcnc",
+        "--thermal-chain", "trt", "--current", current, "-o", chain, "--json",
+    )  # fmt: skip
+    info, text = json.loads(r.stdout), chain.read_text()
+    doc = json.loads(fast_thermal_model.read_text())
+    tau = doc["thermal"]["lags"][0]["tau"]["value"]
+    assert info["lowpass_gains"] == [pytest.approx(-np.expm1(-1e-3 / tau), rel=1e-15)]
+    # Not held by the trt pins: the tilts and the table-side point, each with its steady state
+    for name in ("E_B0A", "E_C0A", "E_A0C", "E_B0C", "q_x", "q_y", "q_z"):
+        assert re.search(rf"^#   {name}: [-+]\S+ (rad|mm)", text, re.M), name
+    pins = [p["pin"] for p in info["pins"]]
+    assert set(pins) == {f"xyzac-trt-kins.{k}" for k in
+                         ("x-rot-point", "y-rot-point", "z-rot-point", "y-offset", "z-offset")}  # fmt: skip
+
+    log = lcnc_thermal.run(xyzac_trt(), tmp_path / "run", text, pins)
+    y = lcnc_thermal.check_lag(log, tau, 1e-3)
+    # Each pin: what `rotacal export --state y` writes at the reference's state (C++ export),
+    # at every logged period by the export's affinity in y, checked at 12 of them directly.
+    cold = {
+        v.name: v.corrected
+        for v in export_controller(
+            fast_thermal_model, "linuxcnc", current, thermal_state=[0.0]
+        ).values
+    }
+    one = {
+        v.name: v.corrected
+        for v in export_controller(
+            fast_thermal_model, "linuxcnc", current, thermal_state=[1.0]
+        ).values
+    }
+    for k in np.linspace(0, len(log) - 1, 12).astype(int):
+        at = {
+            v.name: v.corrected
+            for v in export_controller(
+                fast_thermal_model, "linuxcnc", current, thermal_state=[float(y[k])]
+            ).values
+        }
+        for i, p in enumerate(pins):
+            assert (
+                abs(log[k, 3 + i] - at[p])
+                < 1e-9 + 0.01 * abs(one[p] - cold[p]) * lcnc_thermal.U_TEST
+            ), (p, k)
+    for i, p in enumerate(pins):
+        steady = abs(one[p] - cold[p]) * lcnc_thermal.U_TEST
+        err = np.abs(log[:, 3 + i] - (cold[p] + (one[p] - cold[p]) * y)).max()
+        print(
+            f"  {p}: steady-state change {steady * 1e3:.3f} um, |pin - model| max {err * 1e6:.3g} nm"
+        )
+        assert err < max(0.01 * steady, 1e-6)
+    assert max(abs(one[p] - cold[p]) for p in pins) * lcnc_thermal.U_TEST > 1e-3  # mm: pins move

@@ -3,8 +3,9 @@
 machine whose probe input is the simulated contact of the stylus with the sphere.
 
 `rotacal plan probe` writes the G38.2 program and its session template; a headless LinuxCNC
-(tests/linuxcnc/probe-sim.ini: trivkins, the program's machine axes are the joints) runs it.
-The probe (tests/linuxcnc/probe.hal) is a realtime HAL chain that compares the joints' X, Y, Z
+runs it: the start of xyzac-trt-sim.ini that test_linuxcnc_kins.py shares, switched to
+xyzac-trt-kins' identity type (as probe-sim.ini's trivkins: the program's machine axes are the
+joints). The probe (tests/linuxcnc/probe.hal, loaded for the run) is a realtime HAL chain that compares the joints' X, Y, Z
 with the sphere every servo period and drives motion.probe-input; a userspace component
 (probe_contact.py) places the sphere where the simulated machine holds it at the current A, C,
 with the independent reference simulator (tests/reference/refsim, no rotacal import): Flynn et
@@ -28,12 +29,14 @@ import numpy as np
 import pytest
 
 from conftest import run_cli
-from linuxcnc_session import requires_linuxcnc, run_linuxcnc
+from linuxcnc_session import CONFIG, hal_commands, requires_linuxcnc, shared
 
 REFSIM = Path(__file__).resolve().parents[1] / "reference"
 sys.path.insert(0, str(REFSIM))
 import refsim  # noqa: E402
 from refsim import noise  # noqa: E402
+
+LINUXCNC_STARTS = {"xyzac-trt"}  # linuxcnc_session.shared
 
 SERVO_PERIOD_S = 1e-3  # tests/linuxcnc/common.inc, [EMCMOT]SERVO_PERIOD
 PROBE_FEED = 30.0  # mm/min: one servo period's travel is 0.5 um
@@ -175,13 +178,35 @@ def run_probe(run_dir, program, errors, sphere_actual, eps):
         "trigger_noise_mm": eps.tolist(),
         "record": str(run_dir / "contact.json"),
     }
-    result = run_linuxcnc(
-        run_dir,
-        "probe-sim.ini",
-        {"probe.ngc": program, "truth.json": json.dumps(truth)},
-        "result.json",
-        RUN_TIMEOUT,
+    # The shared start of xyzac-trt-kins (test_linuxcnc_kins.py), its switchkins type 1 the
+    # identity (probe-sim.ini's trivkins); probe.hal loaded for this run and taken out after it.
+    start = shared("xyzac-trt", "xyzac-trt-sim.ini", {"pins.hal": ""})
+    chain = (
+        (CONFIG / "probe.hal")
+        .read_text()
+        .replace("loadusr -Wn probe-sim /usr/bin/python3 probe_contact.py truth.json", "")
     )
+    cmds = hal_commands(chain)
+    existing = {f"J{j}-pos-fb" for j in range(5)}  # sim.hal's signals
+    cleanup = [["unload", "probe-sim"]]
+    cleanup += [["unloadrt", c[1]] for c in cmds if c[0] == "loadrt"]
+    cleanup += [["delsig", c[1]] for c in cmds if c[0] == "net" and c[1] not in existing]
+    contact = [
+        "loadusr", "-Wn", "probe-sim", "/usr/bin/python3",
+        str(start.run_dir / "probe_contact.py"), str(run_dir / "truth.json"),
+    ]  # fmt: skip
+    served = {
+        "identity_type": 1,
+        "timeout_s": RUN_TIMEOUT,
+        "hal": [contact] + cmds,
+        "cleanup": cleanup,
+    }
+    files = {
+        "probe.ngc": program,
+        "truth.json": json.dumps(truth),
+        "served.json": json.dumps(served),
+    }
+    result = start.job("probe_display", run_dir, files, "result.json", RUN_TIMEOUT + 30)
     print(f"LinuxCNC: program {result['program_s']:.1f} s, session {result['elapsed']:.1f} s")
     return result, json.loads((run_dir / "contact.json").read_text())
 

@@ -6,8 +6,9 @@ The test installs the module built with the library (build/release/linuxcnc/rota
 it builds it there if missing) into LinuxCNC's module directory, writes an AC-trt and a BC-trt
 model (location errors, angular positioning and radial run-out harmonics, sag; the AC one with
 thermal gains on two location errors) as blobs with `rotacal export --controller realtime`,
-and starts one headless LinuxCNC (tests/linuxcnc/rotacal-kins-sim.ini) that loads both and
-switches between them with motion.switchkins-type. Its display sets the tool-offset, y1 and y2
+and the blob of a thermal model (its cold errors and gains, exported by the same command), and
+starts one headless LinuxCNC (tests/linuxcnc/rotacal-kins-sim.ini) that loads the three and
+switches between them with motion.switchkins-type (shared with the thermal HAL chain's check). Its display sets the tool-offset, y1 and y2
 pins, jogs the joints to positions over the travel and moves in world coordinates with G0.
 
 Reference: rotacal's Python evaluation of the model files (rotacal.realtime on the JSON, not on
@@ -33,9 +34,11 @@ import rotacal
 from rotacal import realtime
 
 from conftest import run_cli
-from linuxcnc_session import requires_linuxcnc, run_linuxcnc
+import lcnc_thermal
+from linuxcnc_session import requires_linuxcnc, shared
 
 pytestmark = requires_linuxcnc
+LINUXCNC_STARTS = {"rotacal-kins"}  # linuxcnc_session.shared
 
 ROOT = Path(__file__).resolve().parents[2]
 MODULE_DIR = Path("/usr/lib/linuxcnc/modules")
@@ -50,6 +53,7 @@ ERRORS = [0.03, -0.02, 5e-5, -4e-5, 0.015, 0.025, -3e-5, 6e-5]  # mm, rad
 # y1, E_Y0C -3 um per unit of y2; the display sets y1, y2 to these.
 GAINS = {(4, 0): 0.004, (5, 1): -0.003}
 Y1, Y2 = 0.5, -0.8
+Y_THERMAL = 1.5  # y1 of the thermal model's blob (steady state at 150 rev/min)
 GAIN_OFFSET = 20 + 18 + 2 * 195 + 8 * 8  # header, machine..pivot, two axes, errors: bytes
 
 
@@ -103,7 +107,7 @@ def module_so() -> Path:
     return so
 
 
-@pytest.fixture()
+@pytest.fixture(scope="module")
 def installed_module():
     dest = MODULE_DIR / "rotacal-kins.so"
     tmp = MODULE_DIR / ".rotacal-kins.so.tmp"
@@ -122,7 +126,12 @@ def travel(rng, n, tilt_col):
     return j
 
 
-def test_rotacal_kins_in_linuxcnc_is_the_model(tmp_path, installed_module):
+@pytest.fixture(scope="module")
+def rotacal_kins(installed_module, tmp_path_factory, fast_thermal_model):
+    """The shared start of rotacal-kins-sim.ini with an AC-trt and a BC-trt model (switchkins
+    types 0 and 1) and the blob `export --controller realtime` writes of a thermal model (type
+    2, AC-trt): (start, plan, references)."""
+    tmp_path = tmp_path_factory.mktemp("rotacal-kins")
     rng = np.random.default_rng(55)
     blob_dir = Path(tempfile.mkdtemp(prefix="rotacal-kins-"))  # rtapi_app reads it as RTAPI_UID
     os.chmod(blob_dir, 0o755)
@@ -163,21 +172,57 @@ def test_rotacal_kins_in_linuxcnc_is_the_model(tmp_path, installed_module):
                     "world": world.tolist(),
                 }
             )
+        # Type 2: the thermal model's blob (its cold errors and gains) at y1 = Y_THERMAL; the
+        # reference is the plain model of its errors at that state (effects.md
+        # thermal_location_R: E0 + K y).
+        blob = blob_dir / "thermal.rtb"
+        r = run_cli(
+            "export", "--model", fast_thermal_model, "--controller", "realtime", "-o", blob
+        )  # fmt: skip
+        assert r.returncode == 0, r.stderr
+        os.chmod(blob, 0o644)
+        blobs.append(str(blob))
+        th = json.loads(fast_thermal_model.read_text())
+        errors = [
+            (th["location_errors"][n]["value"] or 0.0)
+            + (th["thermal"]["lags"][0]["gains"][n]["value"] or 0.0) * Y_THERMAL
+            for n in NAMES["AC-trt"]
+        ]
+        ref = tmp_path / "thermal.ref.json"
+        rotacal.save_model(model_doc("AC-trt", "A", errors, effects=False), ref)
+        refs.append(
+            (realtime.load_realtime(ref), realtime.load_realtime(tmp_path / "AC-trt.nominal.json"), 3, 0.0)
+        )  # fmt: skip
+        joints, world = travel(rng, 4, 3), travel(rng, 4, 3)
+        world[:, 3] = np.where(np.abs(world[:, 3]) < 2, 10, world[:, 3])
+        plan["models"].append(
+            {"tool-offset": 0.0, "y1": Y_THERMAL, "y2": 0.0, "joints": joints.tolist(), "world": world.tolist()}
+        )  # fmt: skip
         ini = (ROOT / "tests/linuxcnc/rotacal-kins-sim.ini").read_text()
-        out = run_linuxcnc(
-            tmp_path / "run",
+        start = shared(
+            "rotacal-kins",
             "rotacal-kins-sim.ini",
-            {
-                "rotacal-kins-sim.ini": ini.replace("@MODELS@", ",".join(blobs)),
-                "plan.json": json.dumps(plan),
-            },
-            "rotacal_kins.json",
-            RUN_TIMEOUT,
+            {"rotacal-kins-sim.ini": ini.replace("@MODELS@", ",".join(blobs))},
         )
+        # rtapi_app reads the blobs when the module loads: the first job waits for that
+        start.job("rotacal_kins_display", tmp_path / "up", {"plan.json": '{"models": []}'},
+                  "rotacal_kins.json", RUN_TIMEOUT)  # fmt: skip
     finally:
         shutil.rmtree(blob_dir, ignore_errors=True)
+    return start, plan, refs
+
+
+def test_rotacal_kins_in_linuxcnc_is_the_model(tmp_path, rotacal_kins):
+    start, plan, refs = rotacal_kins
+    out = start.job(
+        "rotacal_kins_display",
+        tmp_path / "run",
+        {"plan.json": json.dumps(plan)},
+        "rotacal_kins.json",
+        RUN_TIMEOUT,
+    )
     print(
-        f"LinuxCNC session {out['elapsed']:.1f} s, {out['lcnc_cpu_s']:.1f} CPU-s in its processes"
+        f"LinuxCNC job {out['elapsed']:.1f} s, {out['lcnc_cpu_s']:.1f} CPU-s in its processes so far"
     )
 
     for (ref, nominal_ref, tilt_col, tool), p, got in zip(refs, plan["models"], out["models"]):
@@ -200,7 +245,7 @@ def test_rotacal_kins_in_linuxcnc_is_the_model(tmp_path, installed_module):
         lw = np.array([m["world"] for m in got["world_moves"]])
         back = np.abs(lw - world)
         print(
-            f"{'AC' if tilt_col == 3 else 'BC'}-trt: forward {fwd_err * 1e6:.3g} nm (model - nominal "
+            f"{'AC' if tilt_col == 3 else 'BC'}-trt{' thermal' if p['y1'] == Y_THERMAL else ''}: forward {fwd_err * 1e6:.3g} nm (model - nominal "
             f"{np.abs(tip - nominal).max() * 1e3:.3g} um), inverse {inv_err.max() * 1e6:.3g} nm, "
             f"world read back {back[:, :3].max() * 1e6:.3g} nm, {back[:, 3:].max():.3g} deg"
         )
@@ -209,3 +254,24 @@ def test_rotacal_kins_in_linuxcnc_is_the_model(tmp_path, installed_module):
         assert residual[:, 0].max() < TOL
         assert inv_err.max() < TOL
         assert back[:, :3].max() < TOL and back[:, 3:].max() < 1e-6  # deg
+
+
+def test_thermal_chain_feeds_y1_as_the_lag(fast_thermal_model, tmp_path, rotacal_kins):
+    """Issue 53's HAL chain into rotacal-kins: the lag state itself on its pin y1 (the gains are
+    the blob's), from C's vel-cmd (joint 5 of coordinates=XYZABC)."""
+    start = rotacal_kins[0]
+    r = run_cli(
+        "export", "--model", fast_thermal_model, "--controller", "linuxcnc",
+        "--thermal-chain", "rotacal-kins", "--json",
+    )  # fmt: skip
+    assert r.returncode == 0, r.stderr
+    info = json.loads(r.stdout)
+    assert info["joint"] == 5 and info["pins"] == []
+    text = run_cli(
+        "export", "--model", fast_thermal_model, "--controller", "linuxcnc",
+        "--thermal-chain", "rotacal-kins",
+    ).stdout  # fmt: skip
+    assert "net rotacal-th-y1 rotacal-th-lag1.out => rotacal-kins.y1" in text
+    tau = json.loads(fast_thermal_model.read_text())["thermal"]["lags"][0]["tau"]["value"]
+    log = lcnc_thermal.run(start, tmp_path / "run", text, [])
+    lcnc_thermal.check_lag(log, tau, 1e-3)

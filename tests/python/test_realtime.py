@@ -3,7 +3,9 @@
 `rotacal export --controller realtime` writes the blob, `rotacal predict --joints` evaluates it
 (or the model file) with the same C++ a controller runs, and the blob is refused by field."""
 
+import json
 import re
+import struct
 from pathlib import Path
 
 import numpy as np
@@ -150,3 +152,46 @@ def test_export_realtime_needs_an_output_and_no_other_controllers_options(model,
         "export", "--model", model, "--controller", "realtime", "--json", "-o", tmp_path / "x"
     )
     assert r.returncode == EXIT_INPUT and "--json: not with --controller realtime" in r.stderr
+
+
+def test_a_thermal_models_blob_carries_its_gains(fast_thermal_model, tmp_path):
+    """export --controller realtime of a thermal model: the cold errors and the lag's gains in
+    the blob's thermal_gain (column y1; y2 zero for one lag), so that rotacal-kins, fed y1 by the
+    HAL chain, evaluates the errors E0 + K y1 (the model at export --state y1)."""
+    blob = tmp_path / "thermal.rtb"
+    r = run_cli("export", "--model", fast_thermal_model, "--controller", "realtime", "-o", blob)
+    assert r.returncode == 0, r.stderr
+    doc = json.loads(fast_thermal_model.read_text())
+    gains = [doc["thermal"]["lags"][0]["gains"][n]["value"] or 0.0 for n in NAMES]
+    cold = [doc["location_errors"][n]["value"] or 0.0 for n in NAMES]
+    assert max(abs(g) for g in gains) > 1e-4  # mm per unit of u: gains to carry
+    # The layout of realtime/blob.hpp's comment: header, machine..pivot, two axes, errors.
+    offset = 20 + 18 + 2 * 195 + 8 * 8
+    data = blob.read_bytes()
+    assert list(struct.unpack_from("<8d", data, offset)) == gains
+    assert struct.unpack_from("<8d", data, offset + 64) == (0.0,) * 8
+    assert list(struct.unpack_from("<8d", data, offset - 64)) == cold
+    # Evaluated at y1: the plain model of the errors at that state.
+    y1 = 2.5
+    at = tmp_path / "at.json"
+    rotacal.save_model(
+        {
+            "format": "rotacal-model/1",
+            "kind": "ballbar",
+            "machine": "AC-trt",
+            "location_errors": {
+                n: {"value": c + g * y1, "std": 1e-6} for n, c, g in zip(NAMES, cold, gains)
+            },
+            "pivot": {k: {"value": 0.0, "std": 0.0, "unit": "mm"} for k in "xyz"},
+        },
+        at,
+    )
+    _, j = _joints(tmp_path)
+    want, _ = realtime.forward(realtime.load_realtime(at), j)
+    got, _ = realtime.forward(realtime.load_realtime(blob), j, y1=y1)
+    cold_tip, _ = realtime.forward(realtime.load_realtime(blob), j)
+    assert np.abs(got - want).max() < 1e-12
+    assert np.abs(got - cold_tip).max() > 1e-3  # mm: the state moves the tip
+    # The model file itself evaluates the same (rotacal predict --joints of a thermal model).
+    direct, _ = realtime.forward(realtime.load_realtime(fast_thermal_model), j, y1=y1)
+    assert np.abs(direct - got).max() == 0.0

@@ -15,9 +15,11 @@
 
 namespace rotacal {
 
+struct ThermalModel;  // io/thermal_model.hpp
+
 /// The real-time model of a machine with location errors e and effects fx (parameters p):
 /// the machine's axes, pivot length, errors, effects and a_ref (zero when unset, as the
-/// evaluators take it). Thermal gains are zero (rotacal models hold none yet). Throws
+/// evaluators take it). Thermal gains are zero (a thermal model: the overload below). Throws
 /// InvalidArgument naming `context` when the model does not fit the fixed capacity
 /// (realtime::kMaxEffects, kMaxParams), an effect does not apply to the machine, or the
 /// parameter count does not match.
@@ -26,6 +28,12 @@ realtime::Model realtime_model(MachineType m, const LocationErrors<double>& e,
                                const std::string& context);
 /// The same from a model file (its location errors, effects and parameters).
 realtime::Model realtime_model(const ModelFile& model, const std::string& context);
+
+/// The real-time model of a thermal model (io/thermal_model.hpp): its cold location errors and,
+/// per lag, its gains as the blob's thermal_gain columns (y1, y2 come from the controller, which
+/// runs the lags: the LinuxCNC HAL chain). A gain the test could not determine is 0 in the
+/// model file and here. No effects: a thermal model holds none.
+realtime::Model realtime_model(const ThermalModel& model, const std::string& context);
 
 /// The fingerprint (realtime::machine_fingerprint) of a machine's nominal kinematics.
 std::uint64_t realtime_fingerprint(MachineType m);

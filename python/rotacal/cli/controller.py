@@ -68,6 +68,7 @@ def cmd_export_realtime(a: argparse.Namespace) -> int:
             ("--json", a.json),
             ("--tables", a.tables),
             ("--at/--state", a.at is not None or a.state is not None),
+            ("--thermal-chain", a.thermal_chain),
         )
         if v
     ]
@@ -75,11 +76,15 @@ def cmd_export_realtime(a: argparse.Namespace) -> int:
         raise _core.InvalidArgument(f"{', '.join(given)}: not with --controller realtime")
     if not a.output:
         raise _core.InvalidArgument("--controller realtime writes a binary blob: give -o FILE")
-    model = _core.realtime_model_of_file(a.model)
+    from ..realtime import is_thermal_model
+
+    thermal = is_thermal_model(a.model)
+    model = _core.realtime_model_of_file(a.model, thermal=thermal)
     write_output(a.output, model.blob(), inputs=[a.model])
     say(
         f"wrote {a.output}: the real-time model blob ({model.num_effects} effects, every location "
-        f"error; machine fingerprint {model.fingerprint:016x}); docs/realtime.md"
+        f"error{', the cold ones and their thermal gains' if thermal else ''}; machine "
+        f"fingerprint {model.fingerprint:016x}); docs/realtime.md"
     )
     return EXIT_OK
 
@@ -171,6 +176,10 @@ def _write_tables(a: argparse.Namespace) -> object:
 def cmd_export(a: argparse.Namespace) -> int:
     if a.controller == "realtime":
         return cmd_export_realtime(a)
+    if a.thermal_chain:
+        from . import export_chain
+
+        return export_chain.cmd(a)
     from ..exports import export_controller, export_dict, residual_model
     from ..models import load_model, save_model
 
@@ -381,6 +390,9 @@ def add_export(sub: argparse._SubParsersAction) -> None:
         help="a thermal model: the errors at these lag states y1[,y2] (0: cold; 3: steady "
         "state at 300 rev/min)",
     )
+    from . import export_chain
+
+    export_chain.add_options(q)
     q.add_argument(
         "--toolholder",
         type=number("--toolholder", 1, 99, integer=True),

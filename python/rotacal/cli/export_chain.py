@@ -1,0 +1,62 @@
+# SPDX-License-Identifier: BSD-3-Clause
+"""``rotacal export --controller linuxcnc --thermal-chain trt|rotacal-kins``: a thermal model
+as a HAL file that runs its lags in the servo thread with LinuxCNC's own components
+(rotacal/thermal_hal.py, docs/thermal.md)."""
+
+from __future__ import annotations
+
+import argparse
+
+from .. import _core, jsontext
+from ..outputs import write_output
+from .options import EXIT_OK, say
+
+
+def add_options(q: argparse.ArgumentParser) -> None:
+    q.add_argument(
+        "--thermal-chain",
+        choices=["trt", "rotacal-kins"],
+        help="linuxcnc, a thermal model: a HAL file whose lowpass components run the lags from "
+        "the heated joint's speed, into the trt module's pins or rotacal-kins' y1, y2",
+    )
+    q.add_argument(
+        "--servo-period",
+        type=int,
+        default=1_000_000,
+        help="--thermal-chain: the servo thread's period, ns ([EMCMOT]SERVO_PERIOD; default 1000000)",
+    )
+    q.add_argument(
+        "--heat-joint",
+        type=int,
+        help="--thermal-chain: the joint of the heated axis (default: the trt modules' joints "
+        "X Y Z tilt C; rotacal-kins coordinates=XYZABC)",
+    )
+
+
+def cmd(a: argparse.Namespace) -> int:
+    from ..thermal_hal import chain
+
+    given = [
+        o
+        for o, v in (
+            ("--at/--state", a.at is not None or a.state is not None),
+            ("--residual-model", a.residual_model),
+            ("--tables", a.tables),
+            ("--comp-file", a.comp_file),
+        )
+        if v
+    ]
+    if a.controller != "linuxcnc" or given:
+        raise _core.InvalidArgument(
+            "--thermal-chain: with --controller linuxcnc only, and not with "
+            + (", ".join(given) or "another controller")
+        )
+    text, info = chain(a.model, a.thermal_chain, a.current, a.servo_period, a.heat_joint)
+    if a.output:
+        write_output(a.output, text, inputs=[p for p in (a.model, a.current) if p])
+        say(f"wrote {a.output}: the thermal chain for {info['kinematics']} ({a.thermal_chain})")
+    if a.json:
+        print(jsontext.dumps(info))
+    elif not a.output:
+        print(text, end="")
+    return EXIT_OK
