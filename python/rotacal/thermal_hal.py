@@ -42,6 +42,34 @@ def _lags(doc: dict, where: str) -> list[dict]:
     return lags
 
 
+def lowpass_gain(period_s: float, tau_s: float) -> float:
+    """The weight of u in one step of the lag over a period of constant u: y <- y + g (u - y),
+    g = 1 - exp(-T/tau) (LinuxCNC's lowpass gain; a PLC's b = g, a = 1 - g)."""
+    return 1.0 - math.exp(-period_s / tau_s)
+
+
+def parameter_gains(
+    model: str | Path, controller: str, current: str | Path | None, cold, lags: int, **options
+) -> list[list[float]]:
+    """Per parameter of the controller's export `cold` (at the cold state), its change per unit
+    of each lag's state: the export at the unit state of lag l less the cold one (each parameter
+    is affine in the location errors, the errors in the states)."""
+    unit = [
+        export_controller(
+            model,
+            controller,
+            current=current,
+            thermal_state=[float(i == k) for i in range(lags)],
+            **options,
+        )
+        for k in range(lags)
+    ]
+    return [
+        [unit[k].values[i].corrected - v.corrected for k in range(lags)]
+        for i, v in enumerate(cold.values)
+    ]
+
+
 def chain(
     model: str | Path,
     target: str = "trt",
@@ -73,7 +101,7 @@ def chain(
         " is u = 1); per lag tau dy/dt = u - y as lowpass gain = 1 - exp(-T/tau),"
         f" T = {servo_period_ns} ns ([EMCMOT]SERVO_PERIOD): change it with the period.",
     ]
-    gain = [1.0 - math.exp(-t / float(lag["tau"]["value"])) for lag in lags]
+    gain = [lowpass_gain(t, float(lag["tau"]["value"])) for lag in lags]
     for k, lag in enumerate(lags):
         lines.append(f"# lag{k + 1}: tau {lag['tau']['value']:.6g} s, lowpass gain {gain[k]:.12g}")
     readers: list[list[str]] = [[] for _ in range(L)]  # the inputs each lag's state feeds
@@ -82,17 +110,10 @@ def chain(
         for k in range(L):
             readers[k].append(f"rotacal-kins.y{k + 1}")
     else:
-        unit = [
-            export_controller(
-                model, "linuxcnc", current=current, thermal_state=[float(i == k) for i in range(L)]
-            )
-            for k in range(L)
-        ]
-        for i, v in enumerate(cold.values):
+        for v, g in zip(cold.values, parameter_gains(model, "linuxcnc", current, cold, L)):
             if not v.name.startswith(kins + "."):
                 continue  # an INI value (HOME_OFFSET): no pin to feed
             pin = v.name[len(kins) + 1 :]
-            g = [unit[k].values[i].corrected - v.corrected for k in range(L)]
             pins.append({"pin": v.name, "cold": v.corrected, "gains": g})
             for k in range(L):
                 name = f"{PREFIX}-k{k + 1}-{pin}"

@@ -176,10 +176,10 @@ def _write_tables(a: argparse.Namespace) -> object:
 def cmd_export(a: argparse.Namespace) -> int:
     if a.controller == "realtime":
         return cmd_export_realtime(a)
-    if a.thermal_chain:
+    if a.thermal_chain or a.thermal_predictor:
         from . import export_chain
 
-        return export_chain.cmd(a)
+        return export_chain.cmd_predictor(a) if a.thermal_predictor else export_chain.cmd(a)
     from ..exports import export_controller, export_dict, residual_model
     from ..models import load_model, save_model
 
@@ -393,6 +393,7 @@ def add_export(sub: argparse._SubParsersAction) -> None:
     from . import export_chain
 
     export_chain.add_options(q)
+    export_chain.add_predictor_options(q)
     q.add_argument(
         "--toolholder",
         type=number("--toolholder", 1, 99, integer=True),

@@ -33,6 +33,52 @@ def add_options(q: argparse.ArgumentParser) -> None:
     )
 
 
+def add_predictor_options(q: argparse.ArgumentParser) -> None:
+    from .thermal import duration
+
+    q.add_argument(
+        "--thermal-predictor",
+        action="store_true",
+        help="a thermal model: the state-space predictor a PLC runs each --cycle to rewrite the "
+        "controller's parameters as the axis warms (JSON, docs/thermal.md)",
+    )
+    q.add_argument(
+        "--cycle",
+        type=duration("--cycle"),
+        default=0.01,
+        help="--thermal-predictor: the PLC's cycle (default 10ms)",
+    )
+
+
+def cmd_predictor(a: argparse.Namespace) -> int:
+    from ..thermal_predictor import predictor
+
+    given = [
+        o
+        for o, v in (
+            ("--at/--state", a.at is not None or a.state is not None),
+            ("--residual-model", a.residual_model),
+            ("--tables", a.tables),
+            ("--comp-file", a.comp_file),
+            ("--thermal-chain", getattr(a, "thermal_chain", None)),
+        )
+        if v
+    ]
+    if given:
+        raise _core.InvalidArgument("--thermal-predictor: not with " + ", ".join(given))
+    doc = predictor(a.model, a.controller, a.cycle, a.current, a.toolholder)
+    text = jsontext.dumps(doc) + "\n"
+    if a.output:
+        write_output(a.output, text, inputs=[p for p in (a.model, a.current) if p])
+        say(
+            f"wrote {a.output}: the thermal predictor for {doc['kinematics']}, "
+            f"{len(doc['rewrites'])} parameters rewritten every {a.cycle:g} s"
+        )
+    else:
+        print(text, end="")
+    return EXIT_OK
+
+
 def cmd(a: argparse.Namespace) -> int:
     from ..thermal_hal import chain
 

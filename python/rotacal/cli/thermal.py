@@ -45,14 +45,14 @@ _THERMAL_DESTS = {
     "note",
     "date",
 }
-_DURATION_UNITS = {"s": 1.0, "min": 60.0, "h": 3600.0}
+_DURATION_UNITS = {"ms": 1e-3, "s": 1.0, "min": 60.0, "h": 3600.0}
 
 
 def duration(option: str):
-    """argparse type: a time such as 2h, 10min, 90s or 600 (s), 0 to 1e8 s."""
+    """argparse type: a time such as 2h, 10min, 90s, 10ms or 600 (s), 0 to 1e8 s."""
 
     def parse(text: str) -> float:
-        m = re.fullmatch(r"\s*([0-9.eE+-]+)\s*(s|min|h)?\s*", text)
+        m = re.fullmatch(r"\s*([0-9.eE+-]+)\s*(ms|s|min|h)?\s*", text)
         if not m:
             raise OptionError(f"{option}: '{text[:40]}' is not a time such as 2h, 10min or 600s")
         value = number(option, 0.0, 1e8, "s")(m.group(1)) * _DURATION_UNITS[m.group(2) or "s"]
