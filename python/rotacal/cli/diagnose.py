@@ -53,6 +53,12 @@ def print_diagnosis(d: dict) -> None:
         )
     if d["unexplained"]["present"]:
         print(f"unexplained structure remains: {d['unexplained']['signature']}")
+        ns = d["unexplained"].get("noise_structure")
+        if ns:
+            print(
+                f"     not noise: {ns['size_um']:.2g} um beyond the instrument's "
+                f"{ns['noise_um']:.2g} um; to resolve it: {ns['suggested_test']}"
+            )
     print(
         f"{len(d['unobservable'])} catalogue entries are invisible to this session's tests "
         "(--json lists them with reasons)"
