@@ -65,6 +65,12 @@ void judge_remainder(const SearchContext& S, const ModelFit& final_fit, Diagnosi
       if (wander.W) return Whiten([wander](const Eigen::MatrixXd& M) { return wander.whiten(M); });
       NoiseTreatment t_noise = S.white;
       const NoiseStreamLayout others_layout = S.layout.except_group(group);
+      // A session of one group (the probe's touches) has no other group to model its noise on:
+      // its own model, whose AR part takes a share of slow structure, rather than white noise,
+      // which took the correlation of every coloured null session for structure (AR(1) 0.5 and
+      // 1/f-like probe sessions: 5 of 12 flagged; bench/structure_null.py).
+      if (others_layout.rows.empty() && !final_model.white())
+        t_noise = coloured_treatment(final_model, false);
       if (!others_layout.rows.empty()) {
         const NoiseModel others =
             estimate_noise_model(others_layout, final_fit.residuals, others_options);
