@@ -8,6 +8,7 @@ other than the issue's; the bigger null count is bench/structure_null.py."""
 
 import pytest
 import structure_data as sd
+from test_json_schema import check, schemas
 
 import rotacal
 
@@ -45,6 +46,8 @@ def test_rtest_bump_in_c_is_reported_as_structure_where_it_is(tmp_path, seed, bu
     # named and the location errors took a little of the bump), the structure beyond it.
     assert 0.22 < ns["noise_um"] < 0.45 and ns["size_um"] > 2 * ns["noise_um"], ns
     assert "structure the noise model took for noise" in u["signature"]
+    named = schemas()
+    check(u, named["unexplained"], "unexplained", named)  # docs/json_schema.md
 
 
 def test_rtest_bump_in_the_cli_text(tmp_path):
