@@ -61,7 +61,9 @@ def test_rtest_bump_in_the_cli_text(tmp_path):
     with contextlib.redirect_stdout(out):
         main(["diagnose", str(path), "--no-progress"])
     text = out.getvalue()
-    assert "unexplained structure remains" in text and "not noise:" in text, text
+    assert (
+        "unexplained structure remains" in text and "at C 210 deg are structure, not noise" in text
+    ), text
     assert "C angles between 180 and 240 deg" in text, text
 
 
