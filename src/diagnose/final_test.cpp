@@ -125,25 +125,16 @@ namespace rotacal::diagnosis_detail {
 namespace {
 
 // A stream's residual level for the channels' F-test.
+// Tested: half the sum of squared successive differences (von Neumann), which a slow wander of
+// the noise barely reaches and a structure that changes from one commanded pose to the next
+// does; reported: the level about the stream's mean.
 struct StreamLevel {
   const NoiseStream* stream = nullptr;
-  double ss = 0.0;   // sum of squares about the stream's mean, mm^2
-  double dof = 0.0;  // its degrees of freedom: the readings less the fit's share of parameters
+  double ss = 0.0;        // sum of squared successive differences / 2, mm^2
+  double level_ss = 0.0;  // sum of squares about the stream's mean, mm^2
+  double dof = 0.0;       // its degrees of freedom: the readings less the fit's share of parameters
   double effective_dof = 0.0;  // dof over the scatter a correlated stream's variance has
 };
-
-// 1 + 2 sum_k rho_k^2: the sample variance of a correlated stream scatters as that of
-// n / this independent readings (Bartlett 1946), under the noise model of the stream.
-double variance_inflation(const NoiseStream& s) {
-  if (s.ar.empty() || !(s.marginal_sigma_um > 0.0)) return 1.0;
-  const std::vector<double> g = ar_autocovariance(s, s.rows.size());
-  double sum = 1.0;
-  for (std::size_t k = 1; k < g.size(); ++k) sum += 2.0 * (g[k] / g[0]) * (g[k] / g[0]);
-  return sum;
-}
-
-// The smallest ratio of a loud channel's noise sigma to the quiet channels' that is reported.
-constexpr double kMinLevelRatio = 1.5;
 
 // The step-down F-test of the channels' levels: the loudest channel against the pooled others,
 // Bonferroni over the channels, at `alpha`; a loud channel found is left out of the reference
@@ -170,16 +161,6 @@ std::vector<std::size_t> loud_channels(const std::vector<StreamLevel>& levels, d
     }
     if (loud.empty()) *p_first = std::min(1.0, best_p * k);
     if (best_p * k >= alpha) break;
-    // A loud channel is also loud enough to matter: 1/f-like noise scatters 84 readings'
-    // variances more than any AR model of them says (sd of ln variance 0.24 against 0.18), and
-    // the F-test alone flagged 4 of 100 coloured null R-test sessions, at ratios 1.36-1.48;
-    // the bump of issue 50 item 4 gives 2.2-2.8.
-    {
-      double ss = 0.0, dof = 0.0;
-      for (std::size_t j = 0; j < levels.size(); ++j)
-        if (j != best && !is_loud[j]) ss += levels[j].ss, dof += levels[j].dof;
-      if (levels[best].ss / levels[best].dof < kMinLevelRatio * kMinLevelRatio * (ss / dof)) break;
-    }
     loud.push_back(best), is_loud[best] = true;
   }
   return loud;
@@ -312,6 +293,7 @@ void judge_noise_structure(const DiagnosisProblem& P, const DiagnosisOptions& op
       shortest = std::min(shortest, s->rows.size()), channels |= s->channel > 0;
     // (a) The levels of the instrument's channels (an R-test's dx, dy, dz at each nest).
     std::vector<StreamLevel> levels;
+    std::vector<std::vector<double>> diffs;
     for (const NoiseStream* s : streams) {
       if (!channels || s->rows.size() < 8) break;
       StreamLevel L;
@@ -319,43 +301,35 @@ void judge_noise_structure(const DiagnosisProblem& P, const DiagnosisOptions& op
       double mean = 0.0;
       for (Eigen::Index i : s->rows) mean += r[i];
       mean /= static_cast<double>(s->rows.size());
-      for (Eigen::Index i : s->rows) L.ss += (r[i] - mean) * (r[i] - mean);
+      for (Eigen::Index i : s->rows) L.level_ss += (r[i] - mean) * (r[i] - mean);
+      diffs.emplace_back();
+      for (std::size_t t = 1; t < s->rows.size(); ++t)
+        diffs.back().push_back(r[s->rows[t]] - r[s->rows[t - 1]]);
+      for (double d : diffs.back()) L.ss += 0.5 * d * d;
       L.dof = std::max(1.0, (static_cast<double>(s->rows.size()) - 1.0) * fit_share);
-      L.effective_dof = variance_inflation(*s);  // divided below
       levels.push_back(L);
     }
-    // One inflation for every channel: under the hypothesis tested the channels share one noise
-    // process. 1 + 2 sum_k rho_k^2 with rho_k the median over the channels of their sample
-    // autocorrelations at lags 1..8 (a quarter of the shortest at most), or the median of the
-    // channels' noise models' where that is larger. Each channel's own model (BIC on 84
-    // readings) took 3 of 100 AR(1) 0.5 and 1/f-like null R-test sessions for structure; the
-    // loud channel's own model is the structure's (AR(8)), which takes the test's power; and
-    // an AR(1) misses the slow correlation of 1/f-like noise, which scatters the variances more.
+    // One inflation for every channel, as under the hypothesis tested the channels share one
+    // noise process: 1 + 2 sum_k rho_k^2 (Bartlett 1946) over lags 1..n/4 of the differences,
+    // rho_k the median over the channels of their sample autocorrelations (white noise: 1.5).
+    // The channels' levels themselves, each with its own AR model, flagged 4 of 100 1/f-like
+    // null R-test sessions (seeds 21000-21049), and with the loud channel's own model (the
+    // structure's AR(8)) the test lost its power.
     if (!levels.empty()) {
-      std::vector<double> infl;
-      for (const StreamLevel& L : levels) infl.push_back(L.effective_dof);
-      std::nth_element(infl.begin(), infl.begin() + infl.size() / 2, infl.end());
-      double inflation = infl[infl.size() / 2];
-      const std::size_t lags = std::min<std::size_t>(8, shortest / 4);
-      double sample = 1.0;
-      for (std::size_t k = 1; k <= lags; ++k) {
+      double inflation = 1.0;
+      for (std::size_t k = 1; k <= shortest / 4; ++k) {
         std::vector<double> rho;
-        for (const StreamLevel& L : levels) {
-          const std::vector<Eigen::Index>& rows = L.stream->rows;
-          double mean = 0.0, c0 = 0.0, ck = 0.0;
-          for (Eigen::Index i : rows) mean += r[i];
-          mean /= static_cast<double>(rows.size());
-          for (std::size_t t = 0; t < rows.size(); ++t) {
-            const double x = r[rows[t]] - mean;
-            c0 += x * x;
-            if (t >= k) ck += x * (r[rows[t - k]] - mean);
+        for (const std::vector<double>& d : diffs) {
+          double c0 = 0.0, ck = 0.0;
+          for (std::size_t t = 0; t < d.size(); ++t) {
+            c0 += d[t] * d[t];
+            if (t >= k) ck += d[t] * d[t - k];
           }
           rho.push_back(c0 > 0.0 ? ck / c0 : 0.0);
         }
         std::nth_element(rho.begin(), rho.begin() + rho.size() / 2, rho.end());
-        sample += 2.0 * rho[rho.size() / 2] * rho[rho.size() / 2];
+        inflation += 2.0 * rho[rho.size() / 2] * rho[rho.size() / 2];
       }
-      inflation = std::max(inflation, sample);
       for (StreamLevel& L : levels) L.effective_dof = L.dof / inflation;
     }
     if (levels.size() >= 3 && levels.size() == streams.size()) {
@@ -366,7 +340,7 @@ void judge_noise_structure(const DiagnosisProblem& P, const DiagnosisOptions& op
         std::vector<bool> is_loud(levels.size(), false);
         for (std::size_t i : loud) is_loud[i] = true;
         for (std::size_t i = 0; i < levels.size(); ++i)
-          if (!is_loud[i]) ss += levels[i].ss, dof += levels[i].dof;
+          if (!is_loud[i]) ss += levels[i].level_ss, dof += levels[i].dof;
         noise_var = ss / dof;
         p_value = std::min(p_value, p);
         what << (what.tellp() > 0 ? "; " : "")
@@ -375,7 +349,7 @@ void judge_noise_structure(const DiagnosisProblem& P, const DiagnosisOptions& op
           const StreamLevel& L = levels[loud[k]];
           flagged.push_back(L.stream);
           what << (k ? ", " : "") << "'" << L.stream->group << "' "
-               << P.channel_name(L.stream->channel) << " " << std::sqrt(L.ss / L.dof) * 1e3
+               << P.channel_name(L.stream->channel) << " " << std::sqrt(L.level_ss / L.dof) * 1e3
                << " um";
         }
         what << " against " << std::sqrt(noise_var) * 1e3 << " um in the other "

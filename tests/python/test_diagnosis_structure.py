@@ -65,6 +65,8 @@ def test_rtest_bump_in_the_cli_text(tmp_path):
         "unexplained structure remains" in text and "at C 210 deg are structure, not noise" in text
     ), text
     assert "C angles between 180 and 240 deg" in text, text
+    # This seed's bump also took the largest AR order on a stream of 84 readings (item 4's (b)).
+    assert "largest AR order allowed, AR(8)" in text, text
 
 
 def null_counts(tmp_path, make, seeds, **kw) -> dict:
