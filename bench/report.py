@@ -100,6 +100,14 @@ BENCHMARKS: dict[str, tuple[str, str, str]] = {
         "{py} bench/diagnosis_confusion.py --machines AC-trt --noise white,pink "
         "--amplitudes 3 --draws 1 --null 10 --seed 61 --jobs 2",
     ),
+    "structure_null": (
+        "Diagnosis: structure is not noise (unexplained structure, null rate)",
+        "Reference-simulator sessions with nothing hidden in coloured noise (R-test, probe, "
+        "ballbar): how often unexplained structure is reported (target <= 2 %) and a cause named "
+        "(named wrong); and an R-test whose C angle is off by a Gaussian bump outside the "
+        "catalogue: reported, and where.",
+        "{py} bench/structure_null.py --draws 200 --bump-draws 20",
+    ),
     "design_bench": (
         "Test design: predicted against Monte Carlo uncertainty",
         "The designed set-ups' predicted sigma against Monte Carlo draws.",

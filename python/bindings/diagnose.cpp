@@ -108,7 +108,13 @@ void bind_diagnosis_findings(pyb::module_& m) {
           "axis",
           [](const Unexplained& u) { return u.axis ? std::string(1, u.axis) : std::string(); })
       .def_readonly("range_from", &Unexplained::range_from)
-      .def_readonly("range_to", &Unexplained::range_to);
+      .def_readonly("range_to", &Unexplained::range_to)
+      .def_readonly("noise_structure", &Unexplained::noise_structure)
+      .def_readonly("noise_structure_p", &Unexplained::noise_structure_p)
+      .def_readonly("size_um", &Unexplained::size_um)
+      .def_readonly("at", &Unexplained::at)
+      .def_readonly("noise_um", &Unexplained::noise_um)
+      .def_readonly("suggested_test", &Unexplained::suggested_test);
 }
 
 // The diagnosis report and the diagnose functions.

@@ -170,6 +170,7 @@ class DiagnosisResult:
                 "chi2_per_dof": d.unexplained.chi2_per_dof,
                 "p_value": d.unexplained.p_value,
                 "signature": d.unexplained.signature,
+                **_where_unexplained(d.unexplained),
             },
             "residual_structure": {
                 "before": [_group(g) for g in d.structure_before],
@@ -194,6 +195,24 @@ class DiagnosisResult:
         if self.budget is not None:
             out["uncertainty_budget"] = budget_dict(self.budget)
         return out
+
+
+def _where_unexplained(u: Any) -> dict:
+    """Where the unexplained structure is (deg, or s when axis is ""), and, where the noise model
+    took structure for noise (issue 50 item 4), why, how large and the test to resolve it."""
+    if not u.present:
+        return {}
+    out = {"group": u.group, "axis": u.axis, "range_from": u.range_from, "range_to": u.range_to}
+    if u.noise_structure:
+        out["noise_structure"] = {
+            "reason": u.noise_structure,
+            "f_test_p": u.noise_structure_p,
+            "at": u.at,
+            "size_um": u.size_um,
+            "noise_um": u.noise_um,
+            "suggested_test": u.suggested_test,
+        }
+    return out
 
 
 def _num(x: float):

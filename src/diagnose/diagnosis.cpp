@@ -387,6 +387,7 @@ Diagnosis diagnose(const DiagnosisProblem& P, const DiagnosisOptions& options) {
     }
   }
   D.noise = std::move(model);
+  judge_noise_structure(P, options, D);  // structure the noise model took in (final_test.cpp)
   D.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return D;
 }

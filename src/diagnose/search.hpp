@@ -245,4 +245,13 @@ void profile_time_constants(const DiagnosisProblem& P, const NoiseTreatment& t, 
 /// structure remains as a function of one rotary angle, its per-angle table (into D).
 void judge_remainder(const SearchContext& S, const ModelFit& final_fit, Diagnosis& D);
 
+/// Structure the noise model took for noise (issue 50 item 4), judged on D's final residuals and
+/// D.noise (final_test.cpp): the noise levels of one instrument's channels differ (a step-down
+/// F-test at 1 %, Bonferroni over the channels, each channel's degrees of freedom divided by the
+/// scatter its correlation gives its variance), or a stream of fewer than 200 readings took the
+/// largest AR order allowed. Where either holds, D.unexplained says so, with where the
+/// structure is largest, how large beyond the quiet channels' noise, and the test to resolve it.
+void judge_noise_structure(const DiagnosisProblem& P, const DiagnosisOptions& options,
+                           Diagnosis& D);
+
 }  // namespace rotacal::diagnosis_detail

@@ -71,7 +71,13 @@ def cli_json(*args) -> dict:
 
 
 def test_document_has_the_schemas():
-    assert {"noise_model", "uncertainty_budget", "budget_entry", "angle_table"} <= set(schemas())
+    assert {
+        "noise_model",
+        "uncertainty_budget",
+        "budget_entry",
+        "angle_table",
+        "unexplained",
+    } <= set(schemas())
 
 
 def test_checker_refuses_what_departs():
@@ -114,6 +120,7 @@ def test_diagnose_json(shared_data):
     d = cli_json("diagnose", shared_data / "ballbar_ac_table2.csv")
     assert "noise_model" in d and "angle_tables" in d and "uncertainty_budget" in d
     check(d["noise_model"], named["noise_model"], "noise_model", named)
+    check(d["unexplained"], named["unexplained"], "unexplained", named)
     for i, t in enumerate(d["angle_tables"]):
         check(t, named["angle_table"], f"angle_tables[{i}]", named)
     # The shared R-test session hides a sag and a coning of B: findings to check.

@@ -129,6 +129,11 @@ class DiagnosisProblem {
   /// An instrument whose noise is one short stream sets it: the estimate's spread there makes a
   /// slow shape a finding whenever the session's correlation comes out low.
   virtual double correlation_bound_z() const { return 0.0; }
+  /// The name of the k-th reading that shares a time stamp in a group (a noise stream's channel,
+  /// core/noise_model.hpp), as a message names it: an R-test's "dx", "dy", "dz".
+  virtual std::string channel_name(int channel) const {
+    return "channel " + std::to_string(channel + 1);
+  }
   virtual Eigen::MatrixXd reference_jacobian(const ModelFit& /*at*/, const Effect& /*c*/,
                                              std::vector<std::string>* /*row_groups*/) const {
     return {};
@@ -318,6 +323,15 @@ struct Unexplained {
   char axis = 0;            ///< swept rotary axis of that group (0: none; range in time)
   double range_from = 0.0;  ///< deg (or s when axis == 0)
   double range_to = 0.0;
+  /// Structure the noise model took for noise (issue 50 item 4; src/diagnose/final_test.cpp),
+  /// in words: the noise levels of one instrument's channels differ (F-test at 1 %), or a
+  /// stream of fewer than 200 readings got the largest AR order allowed. Empty: neither.
+  std::string noise_structure;
+  double noise_structure_p = 1.0;  ///< the channels' F-test (Bonferroni), 1 where not applied
+  double size_um = 0.0;            ///< RMS beyond the noise where that structure is largest, um
+  double at = 0.0;                 ///< where it is largest: deg (or s when axis == 0)
+  double noise_um = 0.0;           ///< the instrument's noise without it (its quiet channels), um
+  std::string suggested_test;      ///< the test that would resolve it, in words
 };
 
 /// Structure outside the catalogue as a function of one rotary angle: a non-parametric table of

@@ -34,6 +34,10 @@ class RtestDiagnosisProblem : public DiagnosisProblem {
   const std::vector<double>& times() const override { return times_; }
   const std::vector<RotaryAngles<double>>& angles() const override { return angles_; }
   std::optional<double> declared_noise_um() const override { return session_.noise_um; }
+  std::string channel_name(int channel) const override {  // the readings dx, dy, dz of a pose
+    return channel >= 0 && channel < 3 ? std::string("d") + "xyz"[channel]
+                                       : DiagnosisProblem::channel_name(channel);
+  }
   Eigen::Vector3d mean_commanded_xyz() const override {
     return rotacal::mean_commanded_xyz(session_.samples);
   }

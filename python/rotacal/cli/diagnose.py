@@ -53,6 +53,20 @@ def print_diagnosis(d: dict) -> None:
         )
     if d["unexplained"]["present"]:
         print(f"unexplained structure remains: {d['unexplained']['signature']}")
+        ns = d["unexplained"].get("noise_structure")
+        if ns:
+            where = (
+                f"{d['unexplained']['axis']} {ns['at']:.4g} deg"
+                if d["unexplained"]["axis"]
+                else f"t {ns['at']:.4g} s"
+            )
+            source = (
+                "its quiet channels" if ns["f_test_p"] < 1.0 else "the noise model's innovations"
+            )
+            print(
+                f"     the instrument's noise is {ns['noise_um']:.2g} um ({source}): "
+                f"the {ns['size_um']:.2g} um at {where} are structure, not noise"
+            )
     print(
         f"{len(d['unobservable'])} catalogue entries are invisible to this session's tests "
         "(--json lists them with reasons)"

@@ -146,9 +146,27 @@ def harmonic(p_cos: float, p_sin: float, n: int, theta: np.ndarray) -> np.ndarra
     return p_cos * np.cos(n * theta) + p_sin * np.sin(n * theta)
 
 
-def actual_angle(effects: dict, letter: str, theta: np.ndarray) -> np.ndarray:
-    """effects.md: actual angle = R + eps (zero offset) + a cos nR + b sin nR (positioning)."""
+def gaussian_bump(amplitude_rad: float, centre_deg: float, sigma_deg: float):
+    """An error OUTSIDE the catalogue (issue 50 item 4): the angle off by a Gaussian bump,
+    amplitude exp(-d^2 / (2 sigma^2)), d the angle's shortest distance to the centre on the
+    circle. Returns theta (rad) -> angle error (rad), for Model(angle_errors={letter: ...})."""
+    if not sigma_deg > 0.0:
+        raise ValueError(f"gaussian_bump: sigma_deg must be > 0, got {sigma_deg}")
+    c, s = np.radians(centre_deg), np.radians(sigma_deg)
+
+    def bump(theta):
+        d = np.angle(np.exp(1j * (np.asarray(theta, dtype=float) - c)))  # wrapped to (-pi, pi]
+        return amplitude_rad * np.exp(-0.5 * (d / s) ** 2)
+
+    return bump
+
+
+def actual_angle(effects: dict, letter: str, theta: np.ndarray, extra=None) -> np.ndarray:
+    """effects.md: actual angle = R + eps (zero offset) + a cos nR + b sin nR (positioning),
+    + `extra(theta)` (rad): an angle error outside the catalogue, e.g. gaussian_bump."""
     out = np.array(theta, dtype=float)
+    if extra is not None:
+        out = out + extra(np.asarray(theta, dtype=float))
     for _, p in of_axis(effects, letter, "rotary_zero_offset"):
         out = out + p[0]
     for e, p in of_axis(effects, letter, "angular_positioning"):

@@ -88,7 +88,8 @@ def coning_axis(axis) -> np.ndarray:
 def axis_stage(model, axis, theta: np.ndarray) -> np.ndarray:
     """S(R) = Cone(k R) . Rot(R-line, actual R) . E(R), theta the commanded angle (rad)."""
     point, direction = axis.actual_line(model.errors)
-    s = about_line(point, direction, fx.actual_angle(model.effects, axis.name, theta))
+    extra = model.angle_errors.get(axis.name)
+    s = about_line(point, direction, fx.actual_angle(model.effects, axis.name, theta, extra))
     s = s @ error_motion(model.effects, axis, theta)
     for _, p in fx.of_axis(model.effects, axis.name, "coning"):
         s = homogeneous(rodrigues(coning_axis(axis), p[0] * theta), None, len(theta)) @ s
@@ -98,8 +99,14 @@ def axis_stage(model, axis, theta: np.ndarray) -> np.ndarray:
 class Model:
     """A machine with location errors and effects: the truth a session is measured on."""
 
-    def __init__(self, machine, errors=None, effects=None, linear_ref=None):
+    def __init__(self, machine, errors=None, effects=None, linear_ref=None, angle_errors=None):
+        """angle_errors: {axis letter: theta (rad) -> angle error (rad)}, errors outside the
+        catalogue added to the actual angle (effects.gaussian_bump)."""
         self.machine = load_machine(machine)
+        self.angle_errors = dict(angle_errors or {})
+        for letter in self.angle_errors:
+            if letter not in self.machine.axis_names:
+                raise ValueError(f"angle_errors: {self.machine.name} has no axis {letter}")
         self.errors = self.machine.errors_dict(errors if errors is not None else {})
         self.effects = fx.normalise(effects)
         for e in self.effects:
@@ -107,7 +114,7 @@ class Model:
                 raise ValueError(f"{e.id} does not apply to {self.machine.name}")
         self.linear_ref = None if linear_ref is None else np.asarray(linear_ref, dtype=float)
 
-    def nominal(self) -> "Model":
+    def nominal(self) -> "Model":  # no errors, no effects, no angle errors
         return Model(self.machine)
 
     def _chain(self, angles: np.ndarray, side: str) -> np.ndarray:
