@@ -181,6 +181,7 @@ side_job() {
   ./build/release/bench/multi_bench --smoke
   "$PY" bench/multi_diagnosis_pairs.py --smoke
   "$PY" bench/table_residual_bench.py --smoke
+  "$PY" bench/structure_null.py --smoke
   echo "finished at $(elapsed)"
 }
 export -f side_job
