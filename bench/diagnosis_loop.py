@@ -64,7 +64,8 @@ def session(kind, tmp, machine, errors, fx, seed, name, template=None):
 
 
 def one_draw(kind, machine, truth, params, seed, tmp: Path) -> str:
-    """ambiguous-nested / ambiguous-none / named / wrong / group / not-ambiguous."""
+    """not-ambiguous / ambiguous-nested / ambiguous-none, else the joint diagnosis' verdict:
+    named / group / nothing / wrong / refused."""
     errors = md.machine_errors(machine, seed)
     fx = {truth: params}
     s, s_path = session(kind, tmp, machine, errors, fx, seed, f"S{seed}.csv")
@@ -86,6 +87,9 @@ def one_draw(kind, machine, truth, params, seed, tmp: Path) -> str:
         return "ambiguous-nested" if nested else "ambiguous-none"
     _, a_path = session(kind, tmp, machine, errors, fx, seed + 1000, f"A{seed}.csv", template)
     r = cli("diagnose", s_path, a_path, "--json", "--no-progress")
+    if r.returncode != 0:  # e.g. a one-pose probe test: identify_probe refuses it alone
+        print(f"  seed {seed}: diagnose refused: {r.stderr.strip()}", file=sys.stderr)
+        return "refused"
     j = json.loads(r.stdout)
     g = j["findings"][0] if j["findings"] else None
     if g is None:
@@ -101,8 +105,9 @@ def main() -> None:
     p.add_argument("--draws", type=int, default=20)
     p.add_argument("--first-seed", type=int, default=300)
     p.add_argument("--smoke", action="store_true", help="the first cell, 1 draw")
+    p.add_argument("--cell", type=int, action="append", help="only these cells (0-based)")
     a = p.parse_args()
-    cells = CELLS[:1] if a.smoke else CELLS
+    cells = CELLS[:1] if a.smoke else [c for i, c in enumerate(CELLS) if not a.cell or i in a.cell]
     for kind, machine, truth, params in cells:
         counts: Counter = Counter()
         t0 = time.perf_counter()
@@ -116,7 +121,8 @@ def main() -> None:
             f"{kind} {machine} {truth} {params}: {n} draws, {amb} ambiguous, "
             f"{counts['ambiguous-nested']} nested, {predicted} predicted separable "
             f"({counts['ambiguous-none']} not), of those named {counts['named']}, "
-            f"group {counts['group']}, nothing {counts['nothing']}, wrong {counts['wrong']} "
+            f"group {counts['group']}, nothing {counts['nothing']}, wrong {counts['wrong']}, "
+            f"refused {counts['refused']} "
             f"({time.perf_counter() - t0:.1f} s)"
         )
 
