@@ -65,7 +65,7 @@ def rtest_truth_path(a: argparse.Namespace) -> str:
 
 
 def separation_template_path(a: argparse.Namespace) -> str | None:
-    """Where `design ballbar|probe` writes a session template: --session, else with --separate
+    """Where `design ballbar|rtest|probe` writes a session template: --session, else with --separate
     beside -o with the suffix .csv (added.ngc -> added.csv: the added test's program and
     template go together, issue 50); None without either."""
     if getattr(a, "session", None):
@@ -120,7 +120,7 @@ COMMANDS: dict[tuple[str, ...], Files] = {
     ("diagnose",): Files((arg("FILE", "file"), arg("--budget-sizes")), (arg("--report"),)),
     ("predict",): Files((arg("SESSION", "session"), arg("--model"), arg("--joints")), (OUTPUT,)),
     ("design", "ballbar"): Files((MACHINE, arg("--after")), (OUTPUT, TEMPLATE)),
-    ("design", "rtest"): Files((arg("--after"),)),
+    ("design", "rtest"): Files((arg("--after"),), (TEMPLATE,)),
     ("design", "probe"): Files((MACHINE, arg("--after")), (OUTPUT, TEMPLATE)),
     ("export",): Files(
         (arg("--model"), arg("--current"), arg("--centres")),

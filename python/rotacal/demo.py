@@ -5,7 +5,9 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
-from typing import Callable
+from typing import Any, Callable
+
+import numpy as np
 
 from . import _core, jsontext
 from .ballbar import identify, nc_program, verify_compensation
@@ -15,7 +17,7 @@ from .models import save_model
 from .outputs import write_output
 from .sessions import save
 
-STEPS = 6
+STEPS = 7
 
 
 def compensation_section(rows: list[dict]) -> str:
@@ -38,6 +40,92 @@ def compensation_section(rows: list[dict]) -> str:
     return "\n".join(out)
 
 
+def loop_section(loop: dict) -> str:
+    """The report section of the loop (issue 50 item 2): the group, the deciding test designed
+    and simulated, the two sessions diagnosed together, the cause, the gain and the location
+    errors of the final model."""
+    from html import escape
+
+    from . import units
+
+    out = ["<section id='loop'><h2>The deciding test (the loop of an ambiguous diagnosis)</h2>"]
+    out.append(f"<p>1. The session alone: one of {escape(', '.join(loop['group']))}.</p>")
+    for t in loop["tried"]:
+        out.append(
+            f"<p>2. Design to separate {escape(' and '.join(t['pair']))}: {escape(t['verdict'])}</p>"
+        )
+    if not loop.get("added_test"):
+        out.append("<p>No added test separates the members: the model rule decides.</p></section>")
+        return "\n".join(out)
+    a = loop["added_test"]
+    out.append(
+        f"<p>3. The added test ({escape(', '.join(a['tests']))}, pivot "
+        f"{', '.join(f'{v:g}' for v in a['pivot'])} mm, {a['run_time_s']:.0f} s) simulated on the "
+        f"same machine: {escape(a['session'])}.</p>"
+    )
+    f = loop["finding"]
+    what = (
+        f"{escape(f['effect'])} alone (weight {f['weight']:.2f})"
+        if f["named"]
+        else "still one of " + escape(", ".join(g["effect"] for g in f["group"]))
+    )
+    out.append(f"<p>4. Both sessions diagnosed together: {what}, for {escape(f['where'])}.</p>")
+    out.append("<table><tr><th class=l>Session</th><th>RMS before</th><th>RMS after</th></tr>")
+    for x in loop["sessions"]:
+        out.append(
+            f"<tr><td class=l>{escape(x['name'])}</td><td>{x['residual_rms_before_um']:.3f} &micro;m</td>"
+            f"<td>{x['residual_rms_after_um']:.3f} &micro;m</td></tr>"
+        )
+    out.append(
+        "</table><p>5. Location errors of the final model (both sessions, the cause in it):</p>"
+    )
+    out.append("<table><tr><th class=l>Error</th><th>Value</th></tr>")
+    for name, p in loop["location_errors"].items():
+        out.append(
+            f"<tr><td class=l>{escape(name)}</td>"
+            f"<td>{escape(units.estimate_text(p['value'], p['std'], p['unit']))}</td></tr>"
+        )
+    out.append("</table></section>")
+    return "\n".join(out)
+
+
+def close_the_loop(
+    setup: Any, session: Any, truth: dict, finding: dict, seed: int, out: Path
+) -> dict:
+    """Design the test that decides between members of `finding`'s group, simulate it on the
+    machine of `truth` (a new pivot: a new set-up error), diagnose both sessions together."""
+    from .deciding_test import design_deciding_test, group_members
+    from .design import added_setup
+
+    design, tried = design_deciding_test(session, finding, setup)
+    loop: dict = {"group": group_members(finding), "tried": tried}
+    if design is None:
+        return loop
+    added = added_setup(design)
+    plan, text = nc_program(added, "linuxcnc")
+    write_output(out / "added_test.ngc", text)
+    rng = np.random.default_rng(seed + 1)
+    truth_added = dict(truth, seed=seed + 1)
+    if design.chosen.new_pivot:  # the bar mounted again: a set-up error of its own
+        truth_added["pivot_error"] = rng.normal(0.0, 0.01, 3).tolist()
+    added_session, _ = simulate_ballbar_test(added, truth_added)
+    save(added_session, out / "added_test.csv")
+    joint = diagnose([("session", session), ("added_test", added_session)]).to_dict()
+    _write_json(out / "loop_diagnosis.json", joint)
+    f = joint["findings"][0] if joint["findings"] else None
+    loop["added_test"] = {
+        "tests": [_core.test_label(t, added.machine) for t in added.tests],
+        "pivot": list(map(float, added.pivot)),
+        "run_time_s": plan.duration,
+        "session": str(out / "added_test.csv"),
+    }
+    loop["finding"] = f
+    loop["sessions"] = joint["sessions"]
+    loop["location_errors"] = joint["final_model"]["location_errors"]
+    loop["final_model"] = joint["final_model"]
+    return loop
+
+
 def _write_json(path: Path, data: object) -> None:
     write_output(path, jsontext.dumps(data) + "\n")
 
@@ -52,8 +140,11 @@ def run_demo(
     gravity sag, measure, identify, diagnose, compensate and write every file and the report
     into ``output`` (created, with its parents: the one output folder a command makes). ``say`` receives one progress line per step.
 
+    Where the diagnosis gives a group, the loop (close_the_loop): the deciding test designed,
+    simulated on the same machine and diagnosed with the session.
+
     Returns {"sag_mm", "finding" (the first finding's dict or None), "worst_change_percent",
-    "report" (path)}.
+    "report" (path), "loop" (close_the_loop's dict, None where the diagnosis named its cause)}.
     """
     from .report import ballbar_report, extended_identification  # draws
 
@@ -103,11 +194,24 @@ def run_demo(
     if extended is not None:
         _write_json(out / "identification_location_errors_only.json", ident.to_dict())
 
-    step(5, "compensating and measuring again (Table 2 experiment)")
+    f = dd["findings"][0] if dd["findings"] else None
+    loop = None
+    if f is not None and not f["named"]:
+        step(
+            5,
+            "the diagnosis gives a group: designing the deciding test, simulating it, "
+            "diagnosing both sessions",
+        )
+        loop = close_the_loop(setup, session, truth, f, seed, out)
+        _write_json(out / "loop.json", {k: v for k, v in loop.items() if k != "final_model"})
+    else:
+        step(5, "the diagnosis names its cause alone (or nothing): no deciding test needed")
+
+    step(6, "compensating and measuring again (Table 2 experiment)")
     rows = verify_compensation(setup, truth)
     _write_json(out / "compensation.json", rows)
 
-    step(6, "writing the report")
+    step(7, "writing the report")
     report = ballbar_report(
         out / "report.html",
         session,
@@ -115,11 +219,12 @@ def run_demo(
         diag,
         title="rotacal demo: single set-up ballbar test",
         source=str(out / "session.csv"),
-        extra_sections=[compensation_section(rows)],
+        extra_sections=([loop_section(loop)] if loop else []) + [compensation_section(rows)],
     )
     return {
         "sag_mm": sag_mm,
         "finding": dd["findings"][0] if dd["findings"] else None,
         "worst_change_percent": max(r["change_percent"] for r in rows),
         "report": report,
+        "loop": loop,
     }

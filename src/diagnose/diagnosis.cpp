@@ -241,8 +241,13 @@ Diagnosis search_white(const DiagnosisProblem& P, const DiagnosisOptions& option
 // effects whose later, nearly aliased rival made both undetermined together (a 10x gravity sag
 // of A on the probe in AR(1) 0.9 found as linear_scale_Z, 56 sigma alone, then a second A
 // shape: 'nothing').
+//
+// Where the model holds what the weights say (hold_by_weight), a finding's held member must have
+// a single parameter determined (model_member.hpp): one that has not, in a group with other
+// scored members, is put in `not_held` and the caller runs the search again without holding it.
 void refit_findings(const DiagnosisProblem& P, const DiagnosisOptions& options,
-                    const NoiseTreatment& gls_noise, Diagnosis& D) {
+                    const NoiseTreatment& gls_noise, Diagnosis& D,
+                    std::set<std::string>& not_held) {
   for (;;) {
     EffectModel found;
     found.linear_reference = P.mean_commanded_xyz();
@@ -253,8 +258,9 @@ void refit_findings(const DiagnosisProblem& P, const DiagnosisOptions& options,
                                     std::max(1.0, static_cast<double>(D.final_fit.residuals.size() -
                                                                       D.final_fit.num_free))));
     const auto determined = [&](const Finding& F) {
-      return determined_sigmas(D.final_fit, F.effect, gls_noise) / scale >=
-             options.min_determined_sigma;
+      const double k = options.hold_by_weight ? parameter_sigmas(D.final_fit, F.effect, gls_noise)
+                                              : determined_sigmas(D.final_fit, F.effect, gls_noise);
+      return k / scale >= options.min_determined_sigma;
     };
     if (std::all_of(D.findings.begin(), D.findings.end(), determined)) {
       profile_time_constants(P, gls_noise, scale, D);
@@ -266,6 +272,11 @@ void refit_findings(const DiagnosisProblem& P, const DiagnosisOptions& options,
     }
     const std::string sigma =
         std::to_string(static_cast<int>(options.min_determined_sigma)) + " sigma";
+    const Finding& last = D.findings.back();
+    if (options.hold_by_weight && !determined(last) &&
+        std::any_of(last.rivals.begin(), last.rivals.end(),
+                    [](const Alternative& a) { return a.in_group && !a.aliased; }))
+      not_held.insert(last.effect.id());
     D.unobservable.push_back(
         {D.findings.back().effect.id(),
          determined(D.findings.back())
@@ -291,7 +302,7 @@ void refit_findings(const DiagnosisProblem& P, const DiagnosisOptions& options,
 // ballbar (where it applies most, REML seldom keeping a walk there) a median 1.085 of the sigmas
 // under the true noise model (1.005 without it; bench/diagnosis_confusion.py cells, AR(1) 0.9).
 void final_gls(const DiagnosisProblem& P, const DiagnosisOptions& options, const NoiseModel& model,
-               Diagnosis& D) {
+               Diagnosis& D, std::set<std::string>& not_held) {
   if (D.findings.empty()) return;
   const NoiseModel reml =
       estimate_noise_model_reml(model, D.final_fit.residuals, free_columns(D.final_fit.jacobian));
@@ -299,7 +310,7 @@ void final_gls(const DiagnosisProblem& P, const DiagnosisOptions& options, const
   gls_noise.sigma_mm = reml.sigma_um * 1e-3;
   gls_noise.W = std::make_shared<ArWhitener>(reml);
   with_hidden_levels(P, reml, gls_noise);
-  refit_findings(P, options, gls_noise, D);
+  refit_findings(P, options, gls_noise, D, not_held);
 }
 
 // A white diagnosis' held time constants profiled (time_constants.cpp) where no refit did it,
@@ -320,7 +331,8 @@ void white_time_constants(const DiagnosisProblem& P, Diagnosis& D) {
 // e.g. 1/f-like noise whose slow part a stylus_radius_offset took, leaving white residuals of
 // 0.30 um where 0.50 um was declared. Nothing changes where the residuals show the declared
 // variance.
-void white_hidden_levels(const DiagnosisProblem& P, const DiagnosisOptions& options, Diagnosis& D) {
+void white_hidden_levels(const DiagnosisProblem& P, const DiagnosisOptions& options, Diagnosis& D,
+                         std::set<std::string>& not_held) {
   if (D.findings.empty()) return;
   if (!P.declared_noise_um()) {
     white_time_constants(P, D);
@@ -340,27 +352,24 @@ void white_hidden_levels(const DiagnosisProblem& P, const DiagnosisOptions& opti
   t.W = std::make_shared<ArWhitener>(m);
   with_hidden_levels(P, m, t);
   if (t.full)
-    refit_findings(P, options, t, D);
+    refit_findings(P, options, t, D, not_held);
   else
     white_time_constants(P, D);
 }
 
-}  // namespace
-
-Diagnosis diagnose(const DiagnosisProblem& P, const DiagnosisOptions& options) {
-  const auto t0 = std::chrono::steady_clock::now();
-  const std::vector<Effect> candidates = candidate_list(P, options);
-  EffectModel none;
-  none.linear_reference = P.mean_commanded_xyz();
-  const ModelFit baseline = P.fit(none);
-  SearchCache cache;
+// One pass of the diagnosis: the search, what it leaves, the final numbers. A held member the
+// final GLS finds undetermined goes into cache.not_held (refit_findings).
+Diagnosis diagnose_pass(const DiagnosisProblem& P, const DiagnosisOptions& options,
+                        const std::vector<Effect>& candidates, const ModelFit& baseline,
+                        SearchCache& cache) {
+  std::set<std::string> not_held;
   // Correlated at all? Judged on the baseline residuals: if even they are white (nothing
   // unmodelled, white noise), every decision is the white-noise one.
   NoiseModel model = estimate_noise_model(P.groups(), P.times(), baseline.residuals, options.noise);
   Diagnosis D;
   if (!options.model_noise || (model.white() && !lacks_declared_variance(P, baseline))) {
     D = search_white(P, options, candidates, baseline, cache);
-    white_hidden_levels(P, options, D);
+    white_hidden_levels(P, options, D, not_held);
   } else {
     const NoiseModel searched = model;
     const NoiseTreatment coloured = coloured_treatment(searched),
@@ -372,7 +381,7 @@ Diagnosis diagnose(const DiagnosisProblem& P, const DiagnosisOptions& options) {
     if (model.white() && !lacks_declared_variance(P, D.final_fit)) {
       D = Diagnosis{};  // released before the white search builds its own
       D = search_white(P, options, candidates, baseline, cache);
-      white_hidden_levels(P, options, D);
+      white_hidden_levels(P, options, D, not_held);
     } else {
       judge_kept(P, options, baseline, coloured, &searched, white, cache, D);
       // The baseline's adequacy against the noise as the final model leaves it (the baseline
@@ -383,10 +392,36 @@ Diagnosis diagnose(const DiagnosisProblem& P, const DiagnosisOptions& options) {
       D.baseline.noise_source = final_noise.source;
       D.baseline.chi2_per_dof = chi2 / D.baseline.dof;
       D.baseline.p_value = stats::chi2_sf(chi2, D.baseline.dof);
-      final_gls(P, options, model, D);  // the final model's numbers by GLS under that noise
+      final_gls(P, options, model, D, not_held);  // the final numbers by GLS under that noise
     }
   }
   D.noise = std::move(model);
+  cache.not_held.insert(not_held.begin(), not_held.end());
+  return D;
+}
+
+}  // namespace
+
+Diagnosis diagnose(const DiagnosisProblem& P, const DiagnosisOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::vector<Effect> candidates = candidate_list(P, options);
+  EffectModel none;
+  none.linear_reference = P.mean_commanded_xyz();
+  const ModelFit baseline = P.fit(none);
+  SearchCache cache;
+  Diagnosis D = diagnose_pass(P, options, candidates, baseline, cache);
+  // A held member the final GLS left undetermined: the search again, holding the next member of
+  // its group by weight (the fits are cached). At most as many passes as findings can be dropped.
+  for (int pass = 0; pass < options.max_findings; ++pass) {
+    const std::size_t known = cache.not_held.size();
+    if (known == 0) break;
+    Diagnosis again = diagnose_pass(P, options, candidates, baseline, cache);
+    if (cache.not_held.size() == known) {  // nothing new passed over: this pass is the result
+      D = std::move(again);
+      break;
+    }
+    D = std::move(again);
+  }
   judge_noise_structure(P, options, D);  // structure the noise model took in (final_test.cpp)
   D.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return D;

@@ -62,6 +62,7 @@ HeldMember hold_member(const SearchContext& S, const Round& R, const RivalJudgem
     return S.cache.fit(S.P, extended);
   };
   const auto determined = [&](const Score* s) {
+    if (S.cache.not_held.count(s->effect.id())) return false;  // not so under the final noise
     return parameter_sigmas(refit_of(s), s->effect, treatment_of(S, R, s->effect)) >= k_sigma;
   };
   const std::string rule6 = "determined to " + std::to_string(static_cast<int>(k_sigma)) + " sigma";
@@ -93,6 +94,7 @@ HeldMember hold_member(const SearchContext& S, const Round& R, const RivalJudgem
       break;
     }
     skipped += (skipped.empty() ? "" : ", ") + m.s->effect.id() + " (" + two(m.weight) + ")";
+    if (S.cache.not_held.count(m.s->effect.id())) skipped += " by GLS under the final noise";
   }
   if (!top) {
     out.weight = members.front().weight;

@@ -8,6 +8,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -101,6 +102,11 @@ struct SearchCache {
   // the remainder's test of that model as final (final_test.cpp) estimate the same, and REML is
   // most of a 1/f-like diagnosis' time.
   std::map<std::string, NoiseModel> level_walks;
+  // Group members a previous pass's final GLS left with no parameter determined where the model
+  // held them (DiagnosisOptions::hold_by_weight; diagnosis.cpp, diagnose): the model member rule
+  // passes over them, as over any undetermined member (model_member.hpp), so that the next member
+  // by weight is held rather than the finding dropped. Kept with the fits the next pass reuses.
+  std::set<std::string> not_held;
 
   static std::string key(const EffectModel& m) {
     std::string k;

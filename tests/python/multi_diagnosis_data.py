@@ -106,11 +106,75 @@ def template_poses(path) -> dict:
     }
 
 
-def rtest(tmp_path, machine, errors, effects, seed, rho=0.5, noise_um=0.5):
-    """refsim's tilt x C grid with two nests; the probe zeros are the session's own."""
+def read_template(path) -> tuple[dict, dict]:
+    """A session template as a user's recorder reads it, from the file's text: its metadata
+    ("# key: value") and its columns by name (floats where they parse, else strings)."""
+    lines = Path(path).read_text().splitlines()
+    meta = dict(ln[2:].split(":", 1) for ln in lines if ln.startswith("# ") and ":" in ln)
+    meta = {k.strip(): v.strip() for k, v in meta.items()}
+    rows = [ln.split(",") for ln in lines if ln and not ln.startswith("#")]
+    cols: dict = {}
+    for i, name in enumerate(rows[0]):
+        values = [r[i] for r in rows[1:]]
+        try:
+            cols[name] = np.array(values, float)
+        except ValueError:
+            cols[name] = values
+    return meta, cols
+
+
+def vector(text: str) -> np.ndarray:
+    return np.array([float(v) for v in text.split(",")])
+
+
+def ballbar_template(path) -> dict:
+    """The commanded rows of a rotacal-ballbar/1 session template (`design ballbar --separate
+    ... -o added.ngc` writes added.csv) as refsim's poses.ballbar_single_setup gives them."""
+    meta, c = read_template(path)
+    return {
+        "test": [str(t) for t in c["test"]],
+        "time": c["time"],
+        "xyz": np.stack([c["X"], c["Y"], c["Z"]], axis=1),
+        "angles_deg": np.stack([c[k] for k in list(c)[5:7]], axis=1),
+        "pivot": vector(meta["pivot"]),
+        "ballbar_length": float(meta["ballbar_length"]),
+    }
+
+
+def rtest_template(path) -> dict:
+    """The commanded rows of a rotacal-rtest/1 session template (`design rtest --separate ...
+    --session added.csv` writes it) as refsim's poses.rtest_grid gives them."""
+    meta, c = read_template(path)
+    return {
+        "setup": [str(int(v)) if not isinstance(v, str) else v for v in c["setup"]],
+        "time": c["time"],
+        "xyz": np.stack([c["X"], c["Y"], c["Z"]], axis=1),
+        "angles_deg": np.stack([c[k] for k in list(c)[2:4]], axis=1),
+        "nests": {k[5:]: vector(v) for k, v in meta.items() if k.startswith("nest.")},
+    }
+
+
+def ballbar_from(tmp_path, machine, errors, effects, seed, template, name, rho=0.5, noise_um=0.5):
+    """The test of a session template measured on the machine: the ballbar's pivot where it is,
+    the nominal one moved by a set-up error."""
     rng = np.random.default_rng(seed)
     m = refsim.builtin(machine)
-    s = poses.rtest_grid(m)
+    actual = template["pivot"] + rng.normal(0, 10e-3, 3)
+    model = refsim.Model(m, errors, effects)
+    length = refsim.ballbar_lengths(
+        model, actual, template["xyz"], np.radians(template["angles_deg"]), template["time"]
+    )
+    length = length + noise.ar1(template["test"], rho, noise_um * 1e-3, rng)
+    path = writers.write_ballbar(tmp_path / name, m, template, length, noise_um=noise_um)
+    return rotacal.load(path), path
+
+
+def rtest(tmp_path, machine, errors, effects, seed, rho=0.5, noise_um=0.5, pattern=None, name=None):
+    """refsim's tilt x C grid with two nests, or the poses of `pattern` (rtest_template); the
+    probe zeros are the session's own."""
+    rng = np.random.default_rng(seed)
+    m = refsim.builtin(machine)
+    s = pattern if pattern is not None else poses.rtest_grid(m)
     d = refsim.rtest_displacements(
         refsim.Model(m, errors, effects),
         s["nests"],
@@ -121,5 +185,7 @@ def rtest(tmp_path, machine, errors, effects, seed, rho=0.5, noise_um=0.5):
     )
     d = d + np.stack([noise.ar1(s["setup"], rho, noise_um * 1e-3, rng) for _ in range(3)], axis=1)
     d = d + np.array([0.2, -0.1, 0.05])
-    path = writers.write_rtest(tmp_path / f"rtest_{machine}_{seed}.csv", m, s, d, noise_um=noise_um)
+    path = writers.write_rtest(
+        tmp_path / (name or f"rtest_{machine}_{seed}.csv"), m, s, d, noise_um=noise_um
+    )
     return rotacal.load(path), path

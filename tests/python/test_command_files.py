@@ -115,6 +115,18 @@ TEMPLATES = {
             "{--session}",
         ],
     ],
+    ("design", "rtest"): [
+        [
+            "design",
+            "rtest",
+            "--separate",
+            "coning_B,tilt_motion_B_h2",
+            "--after",
+            "{--after}",
+            "--session",
+            "{--session}",
+        ],
+    ],
     ("design", "probe"): [
         ["design", "probe", "--machine", "{--machine}", "-o", "{-o}", "--session", "{--session}"],
         [

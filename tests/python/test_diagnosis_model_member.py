@@ -8,8 +8,8 @@ say (DiagnosisOptions.hold_by_weight): the group's member of the highest weight 
 a determined parameter (issue 29's rule 6), a nested special case of it where that fits within
 delta BIC 2, and says why. On main at 77707f3 the model held the search's pick, the best-scoring
 member that passed the search's tests, which the weights could rank last of its group, and said
-nothing of it; by default it still does (the rule, held by default, fails two safety checks of
-test_diagnosis_precision.py and test_probe_diagnosis.py), and now says so."""
+nothing of it; by default it still does (the rule, on by default, fails a safety check of
+test_probe_diagnosis.py: see DiagnosisOptions::hold_by_weight), and now says so."""
 
 import json
 import re
@@ -118,7 +118,8 @@ def test_the_model_member_of_a_drift_has_a_determined_parameter(tmp_path, amplit
 def test_the_report_the_cli_and_export_say_what_the_model_holds(tmp_path):
     """The report, `diagnose` and `export` of the extended model say which member it holds and
     why (the demo's model file carries it: `held_because`); by default the search's pick, with
-    the member the weights rank first named beside it."""
+    the member the weights rank first named beside it, and with hold_by_weight (the CLI's
+    --hold-by-weight) that member, naming the pick it passed over."""
     from rotacal import report
     from rotacal.diagnosis import held_effects, model_text
 
@@ -127,6 +128,11 @@ def test_the_report_the_cli_and_export_say_what_the_model_holds(tmp_path):
     diag = rotacal.diagnose(s)
     f = diag.to_dict()["findings"][0]
     assert "the weights rank radial_motion_A_h3 first" in f["model"]["why"], f["model"]
+    by_weight = rotacal.diagnose(s, hold_by_weight=True).to_dict()
+    assert_holds_what_the_weights_say(by_weight)
+    w = by_weight["findings"][0]
+    assert w["effect"] == "radial_motion_A_h3" != f["effect"], (w["model"], f["model"])
+    assert f"the search's pick, {f['effect']}" in w["model"]["why"], w["model"]
     page = report.ballbar_report(tmp_path / "r.html", s, base, diag).read_text()
     assert f"The model holds {f['effect']} because" in page
     assert model_text(f).startswith(f"the model holds {f['effect']} because ")
@@ -141,6 +147,12 @@ def test_the_report_the_cli_and_export_say_what_the_model_holds(tmp_path):
     out = json.loads(r.stdout)
     assert out["model_effects"] == [{"id": f["effect"], "held_because": f["model"]["why"]}]
     assert f"the values come from a model with {f['effect']}: it holds it because" in r.stderr
+    # The CLI holds the same member as the library, and the other with --hold-by-weight.
+    path = tmp_path / "ballbar_605.csv"  # the session's file, as ballbar_session wrote it
+    for flag, held in (([], f["effect"]), (["--hold-by-weight"], w["effect"])):
+        r = run_cli("diagnose", path, "--json", "--no-progress", "--no-budget", *flag)
+        assert r.returncode == 0, r.stderr
+        assert json.loads(r.stdout)["findings"][0]["model"]["holds"] == held, flag
 
 
 @pytest.mark.parametrize("seed", [600, 603])

@@ -17,7 +17,14 @@ touch-probe session of one AC-trt table (multi_diagnosis_data.py).
 import json
 
 import pytest
-from multi_diagnosis_data import ballbar, machine_errors, probe, rtest, template_poses
+from multi_diagnosis_data import (
+    ballbar,
+    machine_errors,
+    probe,
+    rtest,
+    rtest_template,
+    template_poses,
+)
 
 import rotacal
 from conftest import run_cli
@@ -183,3 +190,37 @@ def test_the_added_test_designed_after_a_session_is_diagnosed_with_it(tmp_path):
     assert "tilt_motion_A_h2" in group(alone) and "tilt_motion_A_h2" not in g, (alone, g)
     for x in d["sessions"]:  # each session left at about its noise
         assert x["residual_rms_after_um"] < 0.7, x
+
+
+def test_the_added_nest_designed_after_an_rtest_session_is_diagnosed_with_it(tmp_path):
+    """Issue 50 item 2 for the R-test: `design rtest --separate X,Y --after S --session added.csv`
+    writes the added nest's commanded rows (rotacal writes no R-test program: `record rtest` runs
+    the printed pattern); measured on the same machine (refsim, AR(1) 0.5, its own probe zeros),
+    `diagnose S added.csv` uses it with S. coning_B 25 urad/rad against tilt_motion_B_h2, the
+    R-test's group of a coning (test above): no added nest separates them to a correlation of
+    0.5, and the design says so and writes nothing; the closest nest (0.977 -> 0.973) is taken
+    with --max-correlation 0.975 to write its template. This seed's session alone names coning_B
+    (0.98); with the added nest it stays named, for the machine, its value within 3 sigma."""
+    bc = "BC-trt"
+    errors = machine_errors(bc, 9)
+    fx = {"coning_B": [2.5e-5]}
+    s, s_path = rtest(tmp_path, bc, errors, fx, 9, name="S.csv")
+    alone = first(rotacal.diagnose(s).to_dict())
+    assert "coning_B" in group(alone), alone
+    pair = ["design", "rtest", "--separate", "coning_B,tilt_motion_B_h2", "--after", s_path]
+    r = run_cli(*pair, "--session", tmp_path / "none.csv")
+    assert r.returncode == 0 and "--session not written" in r.stderr, (r.stdout, r.stderr)
+    assert not (tmp_path / "none.csv").exists()
+    r = run_cli(*pair, "--max-correlation", "0.975", "--session", tmp_path / "added.csv")
+    assert r.returncode == 0 and "wrote " in r.stderr, r.stderr
+    nest = rtest_template(tmp_path / "added.csv")
+    assert len(nest["nests"]) == 1 and len(nest["time"]) > 12, nest["nests"]
+    _, added_path = rtest(tmp_path, bc, errors, fx, 10, pattern=nest, name="added.csv")
+    r = run_cli("diagnose", s_path, added_path, "--json", "--no-progress")
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout)
+    f = first(d)
+    assert f["named"] and f["effect"] == "coning_B" and f["where"] == "machine", d["findings"]
+    k = f["parameters"]["coning_B"]
+    assert abs(k["value"] - 2.5e-5) < 3 * k["std"], k
+    assert [x["name"] for x in d["sessions"]] == ["S", "added"]

@@ -35,11 +35,42 @@ def cmd_demo(a: argparse.Namespace) -> int:
         print(model_text(f))
     else:
         print("diagnosis found nothing significant")
+    if r["loop"]:
+        print_loop(r["loop"])
     print(
         f"compensation reduced every location error by at least {-r['worst_change_percent']:.1f} %"
     )
     print(f"report: {Path(r['report']).resolve()}")
     return EXIT_OK
+
+
+def print_loop(loop: dict) -> None:
+    """The loop of a group (demo.close_the_loop): the deciding test, both sessions together, the
+    gain and the location errors of the final model."""
+    from ..diagnosis import group_text, model_text
+
+    for t in loop["tried"]:
+        print(f"deciding test for {' and '.join(t['pair'])}: {t['verdict']}")
+    if not loop.get("added_test"):
+        print("no added test separates the group's members: the model rule decides between them")
+        return
+    f = loop["finding"]
+    if f is None:
+        print("the session and the added test together: nothing significant")
+        return
+    if f["named"]:
+        print(f"the session and the added test together: {f['effect']} (weight {f['weight']:.2f})")
+    else:
+        print(f"the session and the added test together: one of {group_text(f)}")
+    print(model_text(f))
+    for x in loop["sessions"]:
+        print(
+            f"  {x['name']}: residual RMS {x['residual_rms_before_um']:.3f} -> "
+            f"{x['residual_rms_after_um']:.3f} um"
+        )
+    print("location errors of the final model (both sessions):")
+    for name, p in loop["location_errors"].items():
+        print(f"  {name} = {units.estimate_text(p['value'], p['std'], p['unit'])}")
 
 
 def cmd_table2(a: argparse.Namespace) -> int:

@@ -8,7 +8,7 @@ import argparse
 import math
 from typing import Any, Sequence
 
-from .. import jsontext
+from .. import _core, jsontext
 from ..command_files import separation_template_path
 from ..outputs import write_output
 from ..sessions import BALLBAR, PROBE, RTEST, kind, save
@@ -181,6 +181,17 @@ def cmd_design_rtest_separation(a: argparse.Namespace) -> int:
         max_correlation=a.max_correlation,
         noise_um=a.noise or 0.0,
     )
+    if a.session and d.found:  # as plan --session: the pattern's commanded rows, to be measured
+        from ..instruments import rtest_program
+
+        p = d.chosen.added
+        template = rtest_program(
+            _core.machine_name(session.machine), p.b_deg, p.c_deg, p.nests, p.dwell_s
+        )
+        save(template, a.session, [a.after])
+        say(f"wrote {a.session}: the added nest's commanded rows as a session template")
+    elif a.session:
+        say("rotacal: --session not written: no added nest separates them")
     if a.json:
         print(jsontext.dumps(rtest_separation_dict(d)))
         return EXIT_OK
@@ -203,6 +214,8 @@ def cmd_design_rtest(a: argparse.Namespace) -> int:
         return cmd_design_rtest_separation(a)
     if a.after:
         raise OptionError("--after: goes with --separate EFFECT,EFFECT")
+    if a.session:
+        raise OptionError("--session: goes with --separate (the added nest's template)")
     a.noise = 0.3 if a.noise is None else a.noise
     d = design_rtest(
         radii=a.radii,
@@ -451,6 +464,14 @@ def _add_design_rtest(dk: argparse._SubParsersAction) -> None:
         "--nest-angles",
         type=number_list("--nest-angles", -360.0, 360.0, "deg", 12),
         help="added nest: angles about C from +X, deg (default 0,90,180,270)",
+    )
+    g.add_argument(
+        "--session",
+        type=path("--session"),
+        metavar="CSV",
+        help="write the added nest's commanded rows (set-up, time, B, C, X, Y, Z) as a session "
+        "template here: the pattern record rtest runs, diagnosed with --after's session "
+        "(rotacal diagnose SESSION CSV)",
     )
     k.add_argument("--json", action="store_true")
     k.set_defaults(func=cmd_design_rtest)

@@ -92,64 +92,49 @@ def _diagnosis_progress(a: argparse.Namespace):
     return bar, update
 
 
-def _diagnose_several(a: argparse.Namespace) -> int:
-    """One diagnosis of several sessions of one machine (diagnose/multi_session.hpp)."""
-    from ..diagnosis import diagnose
+def cmd_diagnose(a: argparse.Namespace) -> int:
+    """One session, or several of one machine diagnosed together (diagnose/multi_session.hpp,
+    issue 50): the same diagnosis and the same printout, several adding each session's lines."""
+    from ..diagnosis import diagnose, uncertainty_budget
     from ..multi_diagnosis import print_several
 
-    if a.report or a.budget_sizes:
+    several = len(a.file) > 1
+    if several and (a.report or a.budget_sizes):
         raise _core.InvalidArgument(
             "diagnose: --report and --budget-sizes are of one session; several sessions are "
             "diagnosed to the terminal or --json"
         )
-    stems = [Path(f).stem for f in a.file]
+    sizes = None if several else budget_sizes(a.budget_sizes)  # refused before any work
     sessions = [load_session(f, a) for f in a.file]
-    named = list(zip(stems, sessions)) if len(set(stems)) == len(stems) else sessions
-    bar, progress = _diagnosis_progress(a)
-    try:
-        result = diagnose(
-            named, max_harmonic=a.max_harmonic, hold_by_weight=a.hold_by_weight, progress=progress
-        )
-    finally:
-        if bar:
-            bar.close()
-    d = result.to_dict()
-    if a.json:
-        print(jsontext.dumps(d))
+    stems = [Path(f).stem for f in a.file]
+    if not several:
+        what = sessions[0]
+    elif len(set(stems)) == len(stems):  # each session's own effects named STEM:effect
+        what = list(zip(stems, sessions))
     else:
-        print_diagnosis(d)
-        print_several(d)
-    return EXIT_OK
-
-
-def cmd_diagnose(a: argparse.Namespace) -> int:
-    from ..diagnosis import diagnose, uncertainty_budget
-
-    if len(a.file) > 1:  # several sessions of one machine (issue 50)
-        return _diagnose_several(a)
-    a.file = a.file[0]
-    sizes = budget_sizes(a.budget_sizes)  # refused before any work
-    s = load_session(a.file, a)
+        what = sessions
     bar, progress = _diagnosis_progress(a)
     try:
         result = diagnose(
-            s, max_harmonic=a.max_harmonic, hold_by_weight=a.hold_by_weight, progress=progress
+            what, max_harmonic=a.max_harmonic, hold_by_weight=a.hold_by_weight, progress=progress
         )
     finally:
         if bar:
             bar.close()
-    if not a.no_budget:  # what the left-out effects could still put on each location error
-        result.budget = uncertainty_budget(s, result, sizes=sizes)
+    if not several and not a.no_budget:  # what left-out effects could put on each location error
+        result.budget = uncertainty_budget(what, result, sizes=sizes)
     d = result.to_dict()
     if a.report:
         from ..analysis import write_diagnosis_report
 
-        write_diagnosis_report(a.report, s, result, source=a.file, inputs=[a.file])
+        write_diagnosis_report(a.report, what, result, source=a.file[0], inputs=[a.file[0]])
         say(f"wrote {a.report}")
     if a.json:
         print(jsontext.dumps(d))
     else:
         print_diagnosis(d)
+        if several:
+            print_several(d)
     return EXIT_OK
 
 
@@ -250,9 +235,11 @@ def add_diagnose(sub: argparse._SubParsersAction) -> None:
     )
     q.add_argument(
         "--hold-by-weight",
-        action="store_true",
-        help="the extended model holds each group's member of the highest weight (with a "
-        "determined parameter; a nested one within delta BIC 2), not the search's pick",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="the extended model holds each group's member of the highest weight with a "
+        "determined parameter (a nested one within delta BIC 2), not the search's pick "
+        f"(default: {'on' if _core.DiagnosisOptions().hold_by_weight else 'off'})",
     )
     q.add_argument("--json", action="store_true")
     q.add_argument("--report", metavar="OUT.html", type=path("--report"))
