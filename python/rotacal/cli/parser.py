@@ -38,6 +38,7 @@ from . import (
     probe,
     simulate,
     thermal,
+    thermal_sim,
 )
 from .options import (
     EPILOG,
@@ -66,6 +67,7 @@ MODULES = (
     design_probe,
     batch,
     thermal,
+    thermal_sim,
 )
 
 # The order `rotacal --help` lists the commands in.
