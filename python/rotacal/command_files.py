@@ -124,6 +124,7 @@ COMMANDS: dict[tuple[str, ...], Files] = {
     ("design", "ballbar"): Files((MACHINE, arg("--after")), (OUTPUT, TEMPLATE)),
     ("design", "rtest"): Files((arg("--after"),)),
     ("design", "probe"): Files((MACHINE, arg("--after")), (OUTPUT, TEMPLATE)),
+    ("design", "thermal"): Files((MACHINE,)),
     ("export",): Files(
         (arg("--model"), arg("--current"), arg("--centres")),
         (

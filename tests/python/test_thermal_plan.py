@@ -166,3 +166,21 @@ def test_rs274_runs_the_thermal_programs(tmp_path):
     canon = run_rs274(ngc.read_text(), tmp_path / "a")
     a_ends = [float(a.split(",")[3]) for n, a in canon if n == "STRAIGHT_FEED"]
     assert min(a_ends) == pytest.approx(-60.0) and max(a_ends) == pytest.approx(60.0)
+
+
+def test_design_thermal_chooses_among_intervals_and_poses(tmp_path):
+    """More epochs in the same test time bound the drift better: at every pose set the 10 min
+    interval's largest U(k=2)/|prior| is below the 30 min one's; the best design's poses are a
+    valid plan."""
+    r = run("design", "thermal", "--intervals", "10,30", "--json")
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout)
+    by = {(c["interval_min"], c["poses"]): c for c in d["candidates"]}
+    for poses in ("6 poses", "8 poses", "10 poses"):
+        assert by[(10, poses)]["worst"] < by[(30, poses)]["worst"]
+        assert by[(10, poses)]["epochs"] == 37 and 0 < by[(10, poses)]["worst"] < 1
+    best = d["best"]
+    assert best["worst"] == min(c["worst"] for c in d["candidates"])
+    assert best["state_change"] == pytest.approx(1 - np.exp(-best["epoch_s"] / 1800.0))
+    r, _, _ = _plan(tmp_path, "--poses", best["poses_deg"])
+    assert r.returncode == 0, r.stderr

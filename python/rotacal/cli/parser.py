@@ -38,6 +38,7 @@ from . import (
     probe,
     simulate,
     thermal,
+    thermal_design,
     thermal_sim,
 )
 from .options import (
@@ -68,6 +69,7 @@ MODULES = (
     batch,
     thermal,
     thermal_sim,
+    thermal_design,
 )
 
 # The order `rotacal --help` lists the commands in.
