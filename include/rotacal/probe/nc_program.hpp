@@ -34,7 +34,7 @@ namespace rotacal {
 /// template's clock), `axis` turning at speed_rpm between epochs until heat_s, then at rest
 /// (G4) to heat_s + cool_s. An endless axis turns whole revolutions, half of them back, so its
 /// position stays bounded; the tilting axis (or any axis with limits) swings between the pattern's
-/// lowest and highest angle of it, at a mean |omega| of speed_rpm.
+/// lowest and highest angle of it, at a mean absolute speed of speed_rpm.
 struct ThermalProgramDuty {
   char axis = 'C';
   double speed_rpm = 300.0;      ///< rev/min while heating

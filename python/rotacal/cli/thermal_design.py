@@ -2,7 +2,7 @@
 """``rotacal design thermal`` (issue 53, item 1): the interval and the epoch's poses of a thermal
 probe test, at a prior tau and prior gains, in a given test time. Each candidate is measured
 once on rotacal's own simulator at the prior (simulate_thermal, 0.5 um noise by default) and
-identified (identify_thermal); its figure is the largest U(k=2)/|prior| = 2 sigma/|prior| over
+identified (identify_thermal); its figure is the largest U(k=2)/abs(prior) = 2 sigma/abs(prior) over
 the gains and tau, sigma the fit's own (the bench, bench/thermal_bench.py, measures it at the
 Cramer-Rao bound on the reference simulator). The design also says how much the lag state
 changes within one epoch (the axis held: y decays by 1 - exp(-T_epoch/tau))."""
@@ -28,9 +28,11 @@ from .thermal_sim import (
     thermal_session_text,
 )
 
-# The shared thermal_probe_ac.truth.json's gains (mm, rad per 100 rev/min): the default prior.
+# The shared thermal_probe_ac.truth.json's gains to 2 digits (mm, rad per 100 rev/min): the
+# default prior.
 DEFAULT_PRIOR_GAINS = [
-    "E_X0C=-0.0077", "E_Y0C=0.003", "E_A0C=1e-5", "E_B0C=-6e-6", "q_z=0.004",
+    "E_X0C=-0.0077", "E_Y0C=-0.0037", "E_A0C=-7.0e-6", "E_B0C=-3.8e-6", "E_Y0A=-0.0063",
+    "E_Z0A=0.0010", "E_B0A=8.4e-6", "E_C0A=-1.1e-6", "q_x=0.0031", "q_y=0.00090", "q_z=0.00014",
 ]  # fmt: skip
 
 
@@ -107,7 +109,7 @@ def cmd_design_thermal(a: argparse.Namespace) -> int:
         return EXIT_OK
     print(f"design thermal: {a.axis or machine.rot_axis} at {a.speed:g} rev/min, {a.heat / 3600:g} h + "
           f"{a.cool / 3600:g} h, prior tau {tau / 60:g} min, noise {a.noise:g} um")  # fmt: skip
-    print("  interval  poses     epochs  largest U(k=2)/|prior|   state change in an epoch")
+    print("  interval  poses     epochs  largest U(k=2)/abs(prior)  state change in an epoch")
     for r in rows:
         u = (
             "unobservable: " + ", ".join(r["unobservable"])
