@@ -184,3 +184,23 @@ def test_design_thermal_chooses_among_intervals_and_poses(tmp_path):
     assert best["state_change"] == pytest.approx(1 - np.exp(-best["epoch_s"] / 1800.0))
     r, _, _ = _plan(tmp_path, "--poses", best["poses_deg"])
     assert r.returncode == 0, r.stderr
+
+
+def test_simulated_coloured_noise(tmp_path):
+    """--rho makes the noise AR(1) from row to row, white without it: the difference from the
+    same session without noise, touch after touch."""
+    base = ["simulate", "thermal", "--errors", "zero", "--gain", "E_X0C=0.004", "--heat", "2h"]
+    base += ["--cool", "1h", "--interval", "10min", "--seed", "9"]
+    clean = tmp_path / "clean.csv"
+    assert run(*base, "--noise", "0", "-o", clean).returncode == 0
+    _, c0 = _columns(clean)
+    x0 = np.c_[c0["X"], c0["Y"], c0["Z"]]
+    lag1 = {}
+    for rho in ("0", "0.8"):
+        f = tmp_path / f"rho{rho}.csv"
+        assert run(*base, "--noise", "1", "--rho", rho, "-o", f).returncode == 0
+        _, c = _columns(f)
+        e = (np.c_[c["X"], c["Y"], c["Z"]] - x0)[:, 0] * 1e3  # um, X of each touch
+        assert 0.8 < e.std() < 1.2
+        lag1[rho] = np.corrcoef(e[:-1], e[1:])[0, 1]
+    assert abs(lag1["0"]) < 0.1 and 0.7 < lag1["0.8"] < 0.9, lag1  # measured 0.002, 0.81
