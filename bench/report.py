@@ -111,7 +111,7 @@ BENCHMARKS: dict[str, tuple[str, str, str]] = {
         "test, the shared truth's gains scaled 0.5-2x, 0.5 um white noise: the joint fit's RMSE "
         "against the Cramer-Rao bound and the per-epoch peer, 2-sigma coverage, prediction of the "
         "cool-down from the heat-up, null sessions, two lags named by BIC, identification time.",
-        "{py} bench/thermal_bench.py --draws 100",
+        "{py} bench/thermal_bench.py --draws 500 --draws-slow 100",
     ),
     "history_bench": (
         "Calibration history: store and read",

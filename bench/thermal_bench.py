@@ -21,7 +21,7 @@ one factor, log-uniform in 0.5..2; 0.5 um white noise along each approach.
 - time: identification (fit, noise model, budget; the file load measured apart and taken
   off) of one 6 h session, and the peer's, in this process.
 
-    python3 bench/thermal_bench.py [--draws N] [--smoke]
+    python3 bench/thermal_bench.py [--draws N] [--draws-slow M] [--smoke]
 """
 
 from __future__ import annotations
@@ -327,12 +327,19 @@ def timing(rng, tmp: Path, repeats: int) -> None:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--draws", type=int, default=100)
+    ap.add_argument("--draws", type=int, default=100, help="draws of accuracy and null")
+    ap.add_argument(
+        "--draws-slow",
+        type=int,
+        default=None,
+        help="draws of prediction and two_lags (default --draws)",
+    )
     ap.add_argument("--seed", type=int, default=53)
     ap.add_argument("--parts", default="accuracy,prediction,null,two_lags,time")
     ap.add_argument("--smoke", action="store_true", help="2 draws of each part (CI)")
     a = ap.parse_args()
     draws = 2 if a.smoke else a.draws
+    slow = 2 if a.smoke else (a.draws_slow or a.draws)
     rng = np.random.default_rng(a.seed)
     parts = {"accuracy": accuracy, "prediction": prediction, "null": null, "two_lags": two_lags}
     with tempfile.TemporaryDirectory(prefix="thermal-bench-") as d:
@@ -341,7 +348,7 @@ def main() -> None:
             if p == "time":
                 timing(rng, Path(d), 3 if a.smoke else 15)
             else:
-                parts[p](draws, rng, Path(d))
+                parts[p](slow if p in ("prediction", "two_lags") else draws, rng, Path(d))
             print(f"({p}: {time.process_time() - c0:.1f} CPU-s)\n")
 
 
