@@ -130,6 +130,14 @@ BENCHMARKS: dict[str, tuple[str, str, str]] = {
         "size of every term no table holds, at tilt 0 over a turn of C.",
         "{py} bench/table_residual_bench.py",
     ),
+    "thermal_bench": (
+        "Thermal test of a rotary axis: accuracy, prediction, null sessions, two lags, time",
+        "Reference-simulator sessions (tests/reference/refsim/thermal.py) of a 6 h AC-trt probe "
+        "test, the shared truth's gains scaled 0.5-2x, 0.5 um white noise: the joint fit's RMSE "
+        "against the Cramer-Rao bound and the per-epoch peer, 2-sigma coverage, prediction of the "
+        "cool-down from the heat-up, null sessions, two lags named by BIC, identification time.",
+        "{py} bench/thermal_bench.py --draws 500 --draws-slow 100",
+    ),
     "history_bench": (
         "Calibration history: store and read",
         "Time to store and read identifications in the SQLite history.",

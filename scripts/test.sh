@@ -182,6 +182,7 @@ side_job() {
   "$PY" bench/multi_diagnosis_pairs.py --smoke
   "$PY" bench/table_residual_bench.py --smoke
   "$PY" bench/structure_null.py --smoke
+  "$PY" bench/thermal_bench.py --smoke
   echo "finished at $(elapsed)"
 }
 export -f side_job

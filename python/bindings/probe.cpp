@@ -5,6 +5,7 @@
 #include <pybind11/stl.h>
 
 #include <optional>
+#include <tuple>
 
 #include "json_value.hpp"
 #include "numpy.hpp"
@@ -211,7 +212,8 @@ void bind_probe_program(pyb::module_& m) {
       [](MachineType machine, const std::string& dialect, std::optional<Array> poses_deg,
          const Array& sphere, double sphere_diameter, double stylus_diameter,
          const std::string& log_file, int tool, int decimals, double approach_mm, double probe_feed,
-         double positioning_feed, const std::vector<Array>& pose_directions) {
+         double positioning_feed, const std::vector<Array>& pose_directions,
+         std::optional<std::tuple<std::string, double, double, double, double, double>> thermal) {
         ProbePattern p = default_probe_pattern(machine);
         if (poses_deg) p.poses_deg = angles_of(*poses_deg);
         for (const Array& d : pose_directions)
@@ -226,6 +228,11 @@ void bind_probe_program(pyb::module_& m) {
         o.approach_mm = approach_mm;
         o.probe_feed_mm_per_min = probe_feed;
         o.feed_mm_per_min = positioning_feed;
+        if (thermal) {
+          const auto& [axis, speed, heat, cool, interval, max_speed] = *thermal;
+          if (axis.size() != 1) throw InvalidArgument("thermal: axis '" + axis + "'");
+          o.thermal = ThermalProgramDuty{axis[0], speed, heat, cool, interval, max_speed};
+        }
         return write_probe_nc_program(machine, p, parse_nc_dialect(dialect), o);
       },
       pyb::arg("machine"), pyb::arg("dialect"), pyb::arg("poses_deg") = pyb::none(),
@@ -235,14 +242,15 @@ void bind_probe_program(pyb::module_& m) {
       pyb::arg("decimals") = 4, pyb::arg("approach_mm") = ProbeProgramOptions().approach_mm,
       pyb::arg("probe_feed") = ProbeProgramOptions().probe_feed_mm_per_min,
       pyb::arg("positioning_feed") = ProbeProgramOptions().feed_mm_per_min,
-      pyb::arg("pose_directions") = std::vector<Array>{},
+      pyb::arg("pose_directions") = std::vector<Array>{}, pyb::arg("thermal") = pyb::none(),
       "The probing program of the default pattern's directions (or each pose's `pose_directions`, "
       "(K_i, 3)) "
       "at `poses_deg` (default: its poses) "
       "(probe/nc_program.hpp); linuxcnc only. approach_mm: the G38.2 starts this far outside the "
       "trigger "
       "sphere; probe_feed: its feed, positioning_feed: the G1 moves' to and from its start, "
-      "mm/min.");
+      "mm/min. thermal: (axis, speed rev/min, heat s, cool s, interval s, max speed rev/min), the "
+      "pattern as one epoch per interval and the duty between (ThermalProgramDuty).");
   m.def("read_linuxcnc_probe_log", &read_linuxcnc_probe_log, pyb::arg("path"), pyb::arg("plan"),
         pyb::arg("max_off_line_mm") = 1.0,
         "The session of a LinuxCNC probing log: its latched X Y Z in the plan's rows "

@@ -6,16 +6,140 @@
 
 #include <pybind11/stl.h>
 
+#include <map>
 #include <optional>
+#include <tuple>
 
 #include "json_value.hpp"
+#include "numpy.hpp"
 #include "rotacal/io/thermal_model.hpp"
+#include "rotacal/probe/simulate.hpp"
+#include "rotacal/rtest/simulate.hpp"
 #include "rotacal/rtest/thermal.hpp"
 #include "rotacal/session/thermal_summary.hpp"
 
 namespace rotacal::py {
 
+namespace {
+
+// One lag from Python: (tau_s, gains of the 8 location errors, gains of the table-side point).
+using LagArgs = std::tuple<double, Array, Array>;
+using DutyArgs = std::vector<std::pair<double, std::map<std::string, double>>>;
+
+ThermalSimSpec thermal_spec(const DutyArgs& duty, const std::vector<double>& epoch_start_s,
+                            const std::string& axis, const std::vector<LagArgs>& lags) {
+  ThermalSimSpec spec;
+  for (const auto& [t, speeds] : duty) {
+    DutyEntry d;
+    d.time = t;
+    for (const auto& [a, v] : speeds) {
+      if (a.size() != 1) throw InvalidArgument("simulate_thermal: duty: axis '" + a + "'");
+      d.speed.emplace_back(a[0], v);
+    }
+    spec.duty.push_back(d);
+  }
+  spec.epoch_start_s = epoch_start_s;
+  if (axis.size() != 1) throw InvalidArgument("simulate_thermal: axis '" + axis + "'");
+  spec.axis = axis[0];
+  for (const auto& [tau, k, kq] : lags) {
+    ThermalLagTruth l;
+    l.tau_s = tau;
+    l.gains.errors = vec_of<8>(k, "lags: gains of the location errors");
+    l.gains.point = vec_of<3>(kq, "lags: gains of the table-side point");
+    spec.lags.push_back(l);
+  }
+  return spec;
+}
+
+void bind_thermal_simulation(pyb::module_& m) {
+  m.def(
+      "simulate_thermal",
+      [](const std::string& instrument, MachineType machine, const Array& errors,
+         const std::vector<std::string>& effects, const std::vector<double>& effect_params,
+         const DutyArgs& duty, const std::vector<double>& epoch_start_s, const std::string& axis,
+         const std::vector<LagArgs>& lags, const Array& poses_deg, double noise_um, double ar1_rho,
+         std::uint64_t seed, const Array& table_points, const Array& sphere_offset,
+         double probe_zero_um, double dwell_s) {
+        MachineModel t;
+        t.machine = machine;
+        t.errors = LocationErrors<double>(vec_of<8>(errors, "errors"));
+        t.effects = effects_of(effects);
+        t.effect_params = effect_params;
+        const ThermalSimSpec spec = thermal_spec(duty, epoch_start_s, axis, lags);
+        const auto ang = rows_of<2>(poses_deg, "poses_deg");
+        std::vector<RotaryAngles<double>> poses;
+        for (Eigen::Index i = 0; i < ang.rows(); ++i) poses.push_back({ang(i, 0), ang(i, 1)});
+        const std::vector<Eigen::Vector3d> points = vectors_of(table_points, "table_points");
+        std::vector<int> epoch;
+        pyb::object session;
+        Rows3 actual;
+        if (instrument == "probe") {
+          ProbeSimOptions o;
+          o.pattern = default_probe_pattern(machine);
+          o.pattern.poses_deg = poses;
+          if (points.size() != 1) throw InvalidArgument("simulate_thermal: one sphere centre");
+          o.pattern.sphere = points[0];
+          o.sphere_offset = vec_of<3>(sphere_offset, "sphere_offset");
+          o.noise_um = noise_um, o.ar1_rho = ar1_rho, o.seed = seed, o.thermal = spec;
+          ProbeSimulation sim;
+          {
+            pyb::gil_scoped_release release;
+            sim = simulate_probe(t, o);
+          }
+          epoch = sim.thermal.epoch;
+          actual = rows_from({sim.sphere_actual});
+          session = pyb::cast(sim.session);
+        } else if (instrument == "rtest") {
+          RtestSimOptions o;
+          o.pattern.poses_deg = poses;
+          o.pattern.nests = points;
+          o.pattern.dwell_s = dwell_s;
+          o.noise_um = noise_um, o.ar1_rho = ar1_rho, o.probe_zero_um = probe_zero_um;
+          o.seed = static_cast<unsigned>(seed), o.thermal = spec;
+          RtestSimulation sim;
+          {
+            pyb::gil_scoped_release release;
+            sim = simulate_rtest(t, o);
+          }
+          epoch = sim.thermal.epoch;
+          actual = rows_from(sim.probe_zeros);
+          session = pyb::cast(sim.session);
+        } else {
+          throw InvalidArgument("simulate_thermal: instrument '" + instrument +
+                                "' (probe or rtest)");
+        }
+        return pyb::make_tuple(session, epoch, actual);
+      },
+      pyb::arg("instrument"), pyb::arg("machine"), pyb::arg("errors"), pyb::arg("effects"),
+      pyb::arg("effect_params"), pyb::arg("duty"), pyb::arg("epoch_start_s"), pyb::arg("axis"),
+      pyb::arg("lags"), pyb::arg("poses_deg"), pyb::arg("noise_um"), pyb::arg("ar1_rho"),
+      pyb::arg("seed"), pyb::arg("table_points"), pyb::arg("sphere_offset"),
+      pyb::arg("probe_zero_um"), pyb::arg("dwell_s"),
+      R"(Simulate a thermal probe or R-test session on rotacal's own simulators.
+
+The pattern (``poses_deg``, (N, 2) tilt and rotary angles in deg) is measured once per epoch
+from each of ``epoch_start_s``; between and during them the location errors and the
+table-side points drift as ``thermal_location_R`` of ``axis`` (effects.md) driven by ``duty``
+(``[(time_s, {axis: rev/min})]``), one or two ``lags`` of (tau_s, 8 gains, 3 point gains).
+
+Parameters
+----------
+instrument : str
+    "probe" (``table_points``: the nominal sphere centre, ``sphere_offset`` its set-up error)
+    or "rtest" (``table_points``: the nests, each mounted through the session).
+noise_um, ar1_rho : float
+    1-sigma noise per coordinate or reading; its AR(1) correlation from row to row.
+
+Returns
+-------
+tuple
+    (session, each row's epoch, the probe's actual sphere centre or the R-test's probe zeros).)");
+}
+
+}  // namespace
+
 void bind_thermal(pyb::module_& m) {
+  bind_thermal_simulation(m);
   m.def("is_thermal_session", &is_thermal_session, pyb::arg("path"),
         "True when the file has an ``epoch`` column or ``# duty.N:`` lines.");
   m.def(

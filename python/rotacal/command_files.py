@@ -99,6 +99,7 @@ def _always(a: argparse.Namespace) -> bool:
 COMMANDS: dict[tuple[str, ...], Files] = {
     ("plan", "ballbar"): Files((MACHINE, arg("--compensate")), (OUTPUT, arg("--session"))),
     ("plan", "probe"): Files((MACHINE, arg("--design")), (OUTPUT, arg("--session"))),
+    ("plan", "thermal"): Files((MACHINE,), (OUTPUT, arg("--session"))),
     ("machines", "list"): Files(),
     ("machines", "show"): Files((arg("NAME|FILE", "machine"),)),
     ("simulate", "ballbar"): Files((MACHINE,), (OUTPUT, arg("--truth"))),
@@ -106,6 +107,7 @@ COMMANDS: dict[tuple[str, ...], Files] = {
         (MACHINE,), (OUTPUT, Slot("--truth", lambda a: [rtest_truth_path(a)]))
     ),
     ("simulate", "probe"): Files((MACHINE,), (OUTPUT, arg("--truth"))),
+    ("simulate", "thermal"): Files((MACHINE,), (OUTPUT, arg("--truth"))),
     ("identify",): Files(
         (arg("FILE", "file"), arg("--budget-sizes"), arg("--controller")),
         (arg("--save-model"),),
@@ -122,6 +124,7 @@ COMMANDS: dict[tuple[str, ...], Files] = {
     ("design", "ballbar"): Files((MACHINE, arg("--after")), (OUTPUT, TEMPLATE)),
     ("design", "rtest"): Files((arg("--after"),), (TEMPLATE,)),
     ("design", "probe"): Files((MACHINE, arg("--after")), (OUTPUT, TEMPLATE)),
+    ("design", "thermal"): Files((MACHINE,)),
     ("export",): Files(
         (arg("--model"), arg("--current"), arg("--centres")),
         (

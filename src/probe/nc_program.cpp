@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <sstream>
 
 #include "../io/nc_words.hpp"
@@ -54,7 +55,43 @@ double distance_to_segment(const Eigen::Vector3d& c, const Eigen::Vector3d& a,
   return (a + t * ab - c).norm();
 }
 
+// The axis turning for `seconds` at the duty's speed (ThermalProgramDuty): whole revolutions of
+// an endless axis, half forward and half back; strokes between lo and hi of an axis with
+// limits. G91 for the endless axis' two moves, G90 after.
+void write_duty_turning(MachineType m, const ThermalProgramDuty& t, double seconds, double lo,
+                        double hi, int label, const std::function<void(const std::string&)>& line,
+                        const std::function<std::string(double)>& num) {
+  const double feed = 360.0 * t.speed_rpm;  // deg/min
+  const std::string ax(1, t.axis), f = " F" + nc_detail::fixed(feed, 1);
+  const RotaryAxis& axis =
+      m.description().axis(t.axis == rot_axis_letter(m) ? m.rot_index() : m.tilt_index());
+  if (t.axis != tilt_axis_letter(m) && !axis.limits_deg) {
+    const long half = std::lround(0.5 * t.speed_rpm * seconds / 60.0);  // revolutions each way
+    if (half < 1) return;
+    line("G91");
+    line("G1 " + ax + num(360.0 * static_cast<double>(half)) + f);
+    line("G1 " + ax + num(-360.0 * static_cast<double>(half)) + f);
+    line("G90");
+    return;
+  }
+  const long pairs = std::lround(feed * seconds / 60.0 / (2.0 * (hi - lo)));
+  if (pairs < 1) return;
+  const std::string o = "O" + std::to_string(label);
+  line("G1 " + ax + num(lo) + f);
+  line(o + " repeat [" + std::to_string(pairs) + "]");
+  line("G1 " + ax + num(hi) + f);
+  line("G1 " + ax + num(lo) + f);
+  line(o + " endrepeat");
+}
+
 }  // namespace
+
+std::vector<double> ThermalProgramDuty::epoch_starts() const {
+  std::vector<double> out;
+  for (int e = 0; interval_s > 0.0 && e * interval_s <= heat_s + cool_s + 1e-9; ++e)
+    out.push_back(e * interval_s);
+  return out;
+}
 
 std::vector<ProbeMove> probe_moves(MachineType m, const ProbePattern& P,
                                    const ProbeProgramOptions& o, double* retract_z) {
@@ -181,24 +218,71 @@ std::string write_probe_nc_program(MachineType m, const ProbePattern& P, NcDiale
   line("G0 Z" + num(z));
   const std::string probe_feed = "F" + nc_detail::fixed(o.probe_feed_mm_per_min, 1);
   const std::string feed = "F" + nc_detail::fixed(o.feed_mm_per_min, 1);
-  int pose = 0;
-  for (const ProbeMove& mv : moves) {
-    if (mv.pose != pose) {
-      pose = mv.pose;
-      comment("pose " + std::to_string(pose) + ": " + tilt + " " +
-              nc_detail::general(mv.angles_deg.tilt) + ", " + rot + " " +
-              nc_detail::general(mv.angles_deg.rot) + " deg (turned on the retract plane)");
-      line("G0 " + tilt + num(mv.angles_deg.tilt) + " " + rot + num(mv.angles_deg.rot));
+  // A thermal test: the pattern once per epoch, the duty between (ThermalProgramDuty).
+  std::vector<double> epochs{0.0};
+  double lo = 0.0, hi = 0.0, epoch_s = P.pose_dt_s * static_cast<double>(P.poses_deg.size());
+  if (o.thermal) {
+    const ThermalProgramDuty& t = *o.thermal;
+    require_program(
+        t.axis == tilt_axis_letter(m) || t.axis == rot_axis_letter(m),
+        "thermal duty: machine " + to_string(m) + " has no axis " + std::string(1, t.axis));
+    require_program(t.speed_rpm > 0.0 && t.speed_rpm <= t.max_speed_rpm,
+                    "thermal duty: --speed " + nc_detail::general(t.speed_rpm) +
+                        " rev/min must be > 0 and at most --max-speed " +
+                        nc_detail::general(t.max_speed_rpm) + " rev/min");
+    require_program(t.interval_s > epoch_s && t.heat_s >= 0.0 && t.cool_s >= 0.0,
+                    "thermal duty: --interval " + nc_detail::general(t.interval_s) +
+                        " s must be longer than an epoch (" + nc_detail::general(epoch_s) +
+                        " s: " + std::to_string(P.poses_deg.size()) + " poses)");
+    epochs = t.epoch_starts();
+    lo = 1e300, hi = -1e300;  // the swing of an axis with limits: the pattern's own range
+    for (const RotaryAngles<double>& a : P.poses_deg) {
+      const double v = t.axis == tilt_axis_letter(m) ? a.tilt : a.rot;
+      lo = std::min(lo, v), hi = std::max(hi, v);
     }
-    line("G0 X" + num(mv.start.x()) + " Y" + num(mv.start.y()));
-    line("G1 Z" + num(mv.start.z()) + " " + feed);
-    line("G38.2 X" + num(mv.target.x()) + " Y" + num(mv.target.y()) + " Z" + num(mv.target.z()) +
-         " " + probe_feed);
-    line("(LOG," + std::to_string(mv.pose) + " " + std::to_string(mv.touch) +
-         " #5061 #5062 #5063)");
-    line("G1 X" + num(mv.start.x()) + " Y" + num(mv.start.y()) + " Z" + num(mv.start.z()) + " " +
-         feed);
-    line("G0 Z" + num(z));
+    const RotaryAxis& ax =
+        m.description().axis(t.axis == rot_axis_letter(m) ? m.rot_index() : m.tilt_index());
+    require_program((t.axis != tilt_axis_letter(m) && !ax.limits_deg) || hi > lo,
+                    "thermal duty: axis " + std::string(1, t.axis) +
+                        " tilts or has limits, so it swings back and forth between the epoch "
+                        "poses' "
+                        "angles of it, which must differ");
+  }
+  const int n_poses = static_cast<int>(P.poses_deg.size());
+  for (std::size_t e = 0; e < epochs.size(); ++e) {
+    const int first = static_cast<int>(e) * n_poses;  // pose numbers run on over the epochs
+    if (o.thermal)
+      comment("epoch " + std::to_string(e + 1) + " at " + nc_detail::general(epochs[e]) + " s");
+    int pose = 0;
+    for (const ProbeMove& mv : moves) {
+      if (mv.pose != pose) {
+        pose = mv.pose;
+        comment("pose " + std::to_string(first + pose) + ": " + tilt + " " +
+                nc_detail::general(mv.angles_deg.tilt) + ", " + rot + " " +
+                nc_detail::general(mv.angles_deg.rot) + " deg (turned on the retract plane)");
+        line("G0 " + tilt + num(mv.angles_deg.tilt) + " " + rot + num(mv.angles_deg.rot));
+      }
+      line("G0 X" + num(mv.start.x()) + " Y" + num(mv.start.y()));
+      line("G1 Z" + num(mv.start.z()) + " " + feed);
+      line("G38.2 X" + num(mv.target.x()) + " Y" + num(mv.target.y()) + " Z" + num(mv.target.z()) +
+           " " + probe_feed);
+      line("(LOG," + std::to_string(first + mv.pose) + " " + std::to_string(mv.touch) +
+           " #5061 #5062 #5063)");
+      line("G1 X" + num(mv.start.x()) + " Y" + num(mv.start.y()) + " Z" + num(mv.start.z()) + " " +
+           feed);
+      line("G0 Z" + num(z));
+    }
+    if (!o.thermal || e + 1 == epochs.size()) continue;
+    // The duty until the next epoch: turning while t < heat_s, at rest after.
+    const ThermalProgramDuty& t = *o.thermal;
+    const double from = epochs[e] + epoch_s, to = epochs[e + 1];
+    const double turn = std::max(0.0, std::min(to, t.heat_s) - from);
+    if (turn > 0.0) {
+      comment("duty: " + std::string(1, t.axis) + " at " + nc_detail::general(t.speed_rpm) +
+              " rev/min for " + nc_detail::general(turn) + " s");
+      write_duty_turning(m, t, turn, lo, hi, 100 + static_cast<int>(e), line, num);
+    }
+    if (to - from - turn > 0.0) line("G4 P" + nc_detail::fixed(to - from - turn, 1));
   }
   line("(LOGCLOSE)");
   line("M2");

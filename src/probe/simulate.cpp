@@ -85,6 +85,13 @@ ProbeSimulation simulate_probe(const MachineModel& truth, const ProbeSimOptions&
     throw InvalidArgument(
         "simulate_probe: options.pattern: sphere_diameter must be > 0 and stylus_diameter >= 0");
   const MachineType m = truth.machine;
+  if (o.thermal) {
+    double last = 0.0;  // the pattern's last touch after its first
+    for (std::size_t k = 0; k < P.poses_deg.size(); ++k)
+      last = std::max(last, static_cast<double>(k) * P.pose_dt_s +
+                                static_cast<double>(P.directions_at(k).size() - 1) * P.touch_dt_s);
+    o.thermal->validate(m, last, "simulate_probe: options.thermal");
+  }
   ProbeSimulation out;
   out.sphere_actual = P.sphere + o.sphere_offset;
   ProbeSession& s = out.session;
@@ -106,7 +113,13 @@ ProbeSimulation simulate_probe(const MachineModel& truth, const ProbeSimOptions&
   std::vector<Eigen::Vector3d> x0;
   std::vector<std::size_t> pose_of;
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (std::size_t k = 0; k < P.poses_deg.size(); ++k) {
+  // A thermal test repeats the pattern at each epoch's start (pose numbers run on).
+  const std::vector<double> epoch_start =
+      o.thermal ? o.thermal->epoch_start_s : std::vector<double>{0.0};
+  const std::size_t n_poses = P.poses_deg.size();
+  std::vector<int> epoch_of;
+  for (std::size_t kk = 0; kk < n_poses * epoch_start.size(); ++kk) {
+    const std::size_t k = kk % n_poses, e = kk / n_poses;
     const RotaryAngles<double> a{P.poses_deg[k].tilt * kDeg, P.poses_deg[k].rot * kDeg};
     const Eigen::Vector3d start = inverse(m, LocationErrors<double>(), a, P.sphere).xyz;
     // A sphere the machine cannot reach (a description's travel) is no session it could take.
@@ -128,10 +141,12 @@ ProbeSimulation simulate_probe(const MachineModel& truth, const ProbeSimOptions&
       t.n = dirs[j].normalized();
       t.angles = a;
       t.n_spindle = spindle_frame_direction(m, a, t.n);
-      t.time = static_cast<double>(k) * P.pose_dt_s + static_cast<double>(j) * P.touch_dt_s;
+      t.time = epoch_start[e] + static_cast<double>(k) * P.pose_dt_s +
+               static_cast<double>(j) * P.touch_dt_s;
       touches.push_back(t);
       x0.push_back(start);
-      pose_of.push_back(k);
+      pose_of.push_back(kk);
+      epoch_of.push_back(static_cast<int>(e) + 1);
       mean += start - radius * t.n;
     }
   }
@@ -142,14 +157,28 @@ ProbeSimulation simulate_probe(const MachineModel& truth, const ProbeSimOptions&
   std::vector<double> times;
   for (const ProbeTouch& t : touches) times.insert(times.end(), 3, t.time);
   const Eigen::VectorXd noise = noise_gen::ar1(groups, times, o.ar1_rho, o.noise_um * 1e-3, o.seed);
+  // The drift: each touch on the machine and sphere of its lag states (session/thermal_test).
+  std::vector<std::vector<double>> states;
+  if (o.thermal) {
+    std::vector<double> row_time;
+    for (const ProbeTouch& t : touches) row_time.push_back(t.time);
+    out.thermal = o.thermal->test(row_time, epoch_of);
+    states = o.thermal->lag_states(out.thermal);
+  }
+  MachineModel now = truth;
   for (std::size_t i = 0; i < touches.size(); ++i) {
     const ProbeTouch& t = touches[i];
-    const double lambda = trigger_lambda(m, truth, fx, out.sphere_actual, t, x0[i], radius);
+    Eigen::Vector3d q = out.sphere_actual;
+    if (o.thermal) {
+      now.errors = o.thermal->errors_at(truth.errors, states, i);
+      q = o.thermal->point_at(q, states, i);
+    }
+    const double lambda = trigger_lambda(m, now, fx, q, t, x0[i], radius);
     ProbeSample r;
     r.pose = std::to_string(pose_of[i] + 1);
     r.time = t.time;
-    r.tilt_deg = P.poses_deg[pose_of[i]].tilt;
-    r.rot_deg = P.poses_deg[pose_of[i]].rot;
+    r.tilt_deg = P.poses_deg[pose_of[i] % n_poses].tilt;
+    r.rot_deg = P.poses_deg[pose_of[i] % n_poses].rot;
     r.n = t.n;
     r.xyz = x0[i] + (lambda + lobing_shift<double>(fx, truth.effect_data(), t.n_spindle)) * t.n +
             noise.segment<3>(3 * static_cast<Eigen::Index>(i));

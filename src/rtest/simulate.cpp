@@ -9,6 +9,7 @@
 
 #include "rotacal/core/angles.hpp"
 #include "rotacal/core/error.hpp"
+#include "rotacal/core/noise_model.hpp"
 
 namespace rotacal {
 
@@ -26,28 +27,35 @@ std::string limits_text(const std::array<double, 2>& l) {
   return buf;
 }
 
-// First offending commanded X, Y, Z of the nest q over the pattern's poses, as text; empty
-// when every pose is inside the travel (or the machine gives none).
+// First offending commanded X, Y, Z of the nest q over the poses (deg), as text; empty when
+// every pose is inside the travel (or the machine gives none).
 std::string travel_violation(MachineType m, const Eigen::Vector3d& q,
-                             const std::vector<double>& tilt_deg,
-                             const std::vector<double>& rot_deg) {
+                             const std::vector<RotaryAngles<double>>& poses) {
   const auto& travel = m.description().travel_mm;
   if (!travel) return "";
   const char* names = "XYZ";
-  for (double b : tilt_deg)
-    for (double c : rot_deg) {
-      const Eigen::Vector3d xyz = rtest_commanded_xyz(m, q, {b * kDeg, c * kDeg});
-      for (int k = 0; k < 3; ++k)
-        if (xyz[k] < (*travel)(k, 0) - 1e-9 || xyz[k] > (*travel)(k, 1) + 1e-9)
-          return std::string(1, names[k]) + " = " + format_fixed(xyz[k], 3) + " mm at " +
-                 tilt_axis_letter(m) + " " + format_fixed(b, 3) + ", " + rot_axis_letter(m) + " " +
-                 format_fixed(c, 3) + " deg is outside the travel [" +
-                 format_fixed((*travel)(k, 0), 1) + ", " + format_fixed((*travel)(k, 1), 1) + "]";
-    }
+  for (const RotaryAngles<double>& p : poses) {
+    const double b = p.tilt, c = p.rot;
+    const Eigen::Vector3d xyz = rtest_commanded_xyz(m, q, {b * kDeg, c * kDeg});
+    for (int k = 0; k < 3; ++k)
+      if (xyz[k] < (*travel)(k, 0) - 1e-9 || xyz[k] > (*travel)(k, 1) + 1e-9)
+        return std::string(1, names[k]) + " = " + format_fixed(xyz[k], 3) + " mm at " +
+               tilt_axis_letter(m) + " " + format_fixed(b, 3) + ", " + rot_axis_letter(m) + " " +
+               format_fixed(c, 3) + " deg is outside the travel [" +
+               format_fixed((*travel)(k, 0), 1) + ", " + format_fixed((*travel)(k, 1), 1) + "]";
+  }
   return "";
 }
 
 }  // namespace
+
+std::vector<RotaryAngles<double>> RtestPattern::poses() const {
+  if (!poses_deg.empty()) return poses_deg;
+  std::vector<RotaryAngles<double>> out;
+  for (double b : b_deg)
+    for (double c : c_deg) out.push_back({b, c});
+  return out;
+}
 
 RtestPattern default_rtest_pattern(MachineType m) {
   const MachineDescription& d = m.description();
@@ -68,8 +76,7 @@ RtestPattern default_rtest_pattern(MachineType m) {
     Eigen::Vector3d& q = p.nests[n];
     int halvings = 0;
     std::string why;
-    while (!(why = travel_violation(m, q, p.b_deg, p.c_deg)).empty() && halvings < 4)
-      q *= 0.5, ++halvings;
+    while (!(why = travel_violation(m, q, p.poses())).empty() && halvings < 4) q *= 0.5, ++halvings;
     if (!why.empty())
       throw InvalidArgument(
           "default_rtest_pattern: " + to_string(m) + ": nest " + std::to_string(n + 1) +
@@ -80,21 +87,20 @@ RtestPattern default_rtest_pattern(MachineType m) {
 
 void check_rtest_pattern(MachineType m, const RtestPattern& pattern, const std::string& context) {
   const MachineDescription& d = m.description();
-  const struct {
-    int k;
-    const std::vector<double>& deg;
-  } axes[2] = {{m.tilt_index(), pattern.b_deg}, {m.rot_index(), pattern.c_deg}};
-  for (const auto& a : axes) {
-    const RotaryAxis& ax = d.axis(a.k);
+  const std::vector<RotaryAngles<double>> poses = pattern.poses();
+  for (int k : {m.tilt_index(), m.rot_index()}) {
+    const RotaryAxis& ax = d.axis(k);
     if (!ax.limits_deg) continue;
-    for (double v : a.deg)
+    for (const RotaryAngles<double>& p : poses) {
+      const double v = k == m.tilt_index() ? p.tilt : p.rot;
       if (v < (*ax.limits_deg)[0] - 1e-9 || v > (*ax.limits_deg)[1] + 1e-9)
         throw InvalidArgument(context + ": " + std::string(1, ax.name) + " " + format_fixed(v, 3) +
                               " deg is beyond its limits " + limits_text(*ax.limits_deg) + " on " +
                               to_string(m) + " (default_rtest_pattern fits the machine)");
+    }
   }
   for (std::size_t n = 0; n < pattern.nests.size(); ++n) {
-    const std::string why = travel_violation(m, pattern.nests[n], pattern.b_deg, pattern.c_deg);
+    const std::string why = travel_violation(m, pattern.nests[n], poses);
     if (!why.empty())
       throw InvalidArgument(context + ": nest " + std::to_string(n + 1) + ": " + why + " on " +
                             to_string(m));
@@ -103,9 +109,10 @@ void check_rtest_pattern(MachineType m, const RtestPattern& pattern, const std::
 
 RtestSimulation simulate_rtest(const MachineModel& truth, const RtestSimOptions& o) {
   truth.validate("simulate_rtest: truth");
-  if (o.pattern.b_deg.empty() || o.pattern.c_deg.empty() || o.pattern.nests.empty())
+  const std::vector<RotaryAngles<double>> poses = o.pattern.poses();
+  if (poses.empty() || o.pattern.nests.empty())
     throw InvalidArgument(
-        "simulate_rtest: options.pattern: b_deg, c_deg and nests must not be empty");
+        "simulate_rtest: options.pattern: b_deg, c_deg (or poses_deg) and nests must not be empty");
   check_rtest_pattern(truth.machine, o.pattern, "simulate_rtest: options.pattern");
   if (o.noise_um < 0 || o.probe_zero_um < 0)
     throw InvalidArgument("simulate_rtest: options.noise_um and probe_zero_um must be >= 0");
@@ -113,6 +120,12 @@ RtestSimulation simulate_rtest(const MachineModel& truth, const RtestSimOptions&
     throw InvalidArgument("simulate_rtest: options.probe_dirs: directions are linearly dependent");
   if (!o.probe_dirs && !o.write_d)
     throw InvalidArgument("simulate_rtest: options.write_d = false needs probe_dirs");
+  if (!(std::abs(o.ar1_rho) < 1.0))
+    throw InvalidArgument("simulate_rtest: options.ar1_rho must be in (-1, 1)");
+  const std::size_t per_epoch = poses.size() * o.pattern.nests.size();
+  if (o.thermal)
+    o.thermal->validate(truth.machine, o.pattern.dwell_s * static_cast<double>(per_epoch - 1),
+                        "simulate_rtest: options.thermal");
 
   std::mt19937 rng(o.seed);
   std::normal_distribution<double> noise(0.0, o.noise_um * 1e-3), zero(0.0, o.probe_zero_um * 1e-3);
@@ -146,40 +159,69 @@ RtestSimulation simulate_rtest(const MachineModel& truth, const RtestSimOptions&
   if (!fx.linear_reference) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     for (const Eigen::Vector3d& q : o.pattern.nests)
-      for (double b : o.pattern.b_deg)
-        for (double c : o.pattern.c_deg)
-          sum += rtest_commanded_xyz(truth.machine, q, {b * kDeg, c * kDeg});
-    fx.linear_reference =
-        sum / static_cast<double>(o.pattern.nests.size() * o.pattern.b_deg.size() *
-                                  o.pattern.c_deg.size());
+      for (const RotaryAngles<double>& p : poses)
+        sum += rtest_commanded_xyz(truth.machine, q, {p.tilt * kDeg, p.rot * kDeg});
+    fx.linear_reference = sum / static_cast<double>(per_epoch);
   }
-  double t = 0.0;
-  for (std::size_t n = 0; n < o.pattern.nests.size(); ++n) {
-    const Eigen::Vector3d& q = o.pattern.nests[n];
-    const Eigen::Vector3d z(zero(rng), zero(rng), zero(rng));
-    out.probe_zeros.push_back(z);
-    for (double b : o.pattern.b_deg)
-      for (double c : o.pattern.c_deg) {
-        RtestSample r;
-        r.setup = std::to_string(n + 1);
-        r.time = t;
-        r.tilt_deg = b;
-        r.rot_deg = c;
-        const RotaryAngles<double> a{b * kDeg, c * kDeg};
-        r.xyz = rtest_commanded_xyz(truth.machine, q, a);
-        const Eigen::Vector3d d = rtest_reading<double>(truth.machine, truth.errors, fx,
-                                                        truth.effect_data(), r.xyz, a, t, q) +
-                                  z;
-        const Eigen::Vector3d e(noise(rng), noise(rng), noise(rng));
-        if (o.probe_dirs) {
-          r.raw = (*o.probe_dirs) * d + e;
-          if (o.write_d) r.d = o.probe_dirs->fullPivLu().solve(*r.raw);
-        } else {
-          r.d = d + e;
-        }
-        s.samples.push_back(r);
-        t += o.pattern.dwell_s;
-      }
+  // The rows: each nest's poses in turn, once (or once per thermal epoch, every nest mounted
+  // through the session), dwell_s apart.
+  const std::vector<double> epoch_start =
+      o.thermal ? o.thermal->epoch_start_s : std::vector<double>{0.0};
+  std::vector<double> row_time;
+  std::vector<int> row_epoch;
+  std::vector<std::string> groups;
+  for (std::size_t e = 0; e < epoch_start.size(); ++e)
+    for (std::size_t i = 0; i < per_epoch; ++i) {
+      row_time.push_back(epoch_start[e] + o.pattern.dwell_s * static_cast<double>(i));
+      row_epoch.push_back(static_cast<int>(e) + 1);
+      for (int k = 0; k < 3; ++k)
+        groups.push_back(std::to_string(i / poses.size()) + "." + std::to_string(k));
+    }
+  std::vector<std::vector<double>> states;
+  if (o.thermal) {
+    out.thermal = o.thermal->test(row_time, row_epoch);
+    states = o.thermal->lag_states(out.thermal);
+  }
+  // Coloured noise: AR(1) per set-up and channel in row order (white draws below when rho = 0).
+  std::vector<double> stream_time;
+  for (double t : row_time) stream_time.insert(stream_time.end(), 3, t);
+  const Eigen::VectorXd ar =
+      o.ar1_rho != 0.0 ? noise_gen::ar1(groups, stream_time, o.ar1_rho, o.noise_um * 1e-3, o.seed)
+                       : Eigen::VectorXd();
+  LocationErrors<double> errors = truth.errors;
+  for (std::size_t row = 0; row < row_time.size(); ++row) {
+    const std::size_t n = (row % per_epoch) / poses.size();
+    const RotaryAngles<double>& p = poses[row % poses.size()];
+    Eigen::Vector3d q = o.pattern.nests[n];
+    if (o.thermal) {
+      errors = o.thermal->errors_at(truth.errors, states, row);
+      q = o.thermal->point_at(q, states, row);
+    }
+    if (n == out.probe_zeros.size()) {  // a nest's first row draws its zero (the draws' order)
+      const Eigen::Vector3d z(zero(rng), zero(rng), zero(rng));
+      out.probe_zeros.push_back(z);
+    }
+    const double t = row_time[row];
+    RtestSample r;
+    r.setup = std::to_string(n + 1);
+    r.time = t;
+    r.tilt_deg = p.tilt;
+    r.rot_deg = p.rot;
+    const RotaryAngles<double> a{p.tilt * kDeg, p.rot * kDeg};
+    // Commanded at the nominal nest; read against it, the table-side point where it drifted to.
+    r.xyz = rtest_commanded_xyz(truth.machine, o.pattern.nests[n], a);
+    const Eigen::Vector3d d =
+        rtest_reading<double>(truth.machine, errors, fx, truth.effect_data(), r.xyz, a, t, q) +
+        out.probe_zeros[n];
+    const Eigen::Vector3d e = ar.size() ? Eigen::Vector3d(ar.segment<3>(3 * row))
+                                        : Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+    if (o.probe_dirs) {
+      r.raw = (*o.probe_dirs) * d + e;
+      if (o.write_d) r.d = o.probe_dirs->fullPivLu().solve(*r.raw);
+    } else {
+      r.d = d + e;
+    }
+    s.samples.push_back(r);
   }
   return out;
 }

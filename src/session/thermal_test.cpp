@@ -4,6 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+
+#include "rotacal/core/error.hpp"
 
 namespace rotacal {
 
@@ -62,6 +65,73 @@ double ThermalTest::tested_speed(char axis) const {
   double v = 0.0;
   for (const DutyEntry& d : duty) v = std::max(v, std::abs(d.speed_of(axis)));
   return v;
+}
+
+void ThermalSimSpec::validate(MachineType m, double epoch_length_s,
+                              const std::string& context) const {
+  const auto fail = [&](const std::string& what) { throw InvalidArgument(context + ": " + what); };
+  const std::string axes{tilt_axis_letter(m), rot_axis_letter(m)};
+  const auto known = [&](char a) { return axes.find(a) != std::string::npos; };
+  if (!known(axis))
+    fail(std::string("axis ") + axis + ": machine " + to_string(m) + " has rotary axes " + axes[0] +
+         ", " + axes[1]);
+  if (epoch_start_s.empty()) fail("epoch_start_s: no epoch");
+  for (std::size_t e = 0; e < epoch_start_s.size(); ++e) {
+    if (!std::isfinite(epoch_start_s[e]) || epoch_start_s[e] < 0.0)
+      fail("epoch_start_s: epoch " + std::to_string(e + 1) + " starts before 0 s");
+    if (e > 0 && !(epoch_start_s[e] > epoch_start_s[e - 1] + epoch_length_s)) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf,
+                    "epoch_start_s: epoch %zu starts %g s after the one before, which lasts %g s",
+                    e + 1, epoch_start_s[e] - epoch_start_s[e - 1], epoch_length_s);
+      fail(buf);
+    }
+  }
+  for (std::size_t i = 0; i < duty.size(); ++i) {
+    const std::string n = "duty." + std::to_string(i + 1);
+    if (!(duty[i].time >= 0.0) || (i > 0 && !(duty[i].time > duty[i - 1].time)))
+      fail(n + ": TIME must be >= 0 and strictly increasing");
+    for (const auto& s : duty[i].speed)
+      if (!known(s.first) || !std::isfinite(s.second))
+        fail(n + ": axis " + std::string(1, s.first) + " is not a rotary axis of " + to_string(m) +
+             " or its speed is not a number");
+  }
+  if (lags.size() > 2) fail("at most two lags of one axis");
+  for (const ThermalLagTruth& l : lags)
+    if (!(l.tau_s > 0.0) || !std::isfinite(l.tau_s)) fail("a lag's tau_s must be > 0");
+}
+
+ThermalTest ThermalSimSpec::test(const std::vector<double>& time,
+                                 const std::vector<int>& epoch) const {
+  ThermalTest t;
+  t.duty = duty;
+  t.time = time;
+  t.epoch = epoch;
+  return t;
+}
+
+std::vector<std::vector<double>> ThermalSimSpec::lag_states(const ThermalTest& test) const {
+  const HeatInput heat = test.heat_input(axis);
+  std::vector<std::vector<double>> out;
+  for (const ThermalLagTruth& l : lags)
+    out.push_back(rotacal::lag_states(heat, test.time, l.tau_s));
+  return out;
+}
+
+LocationErrors<double> ThermalSimSpec::errors_at(const LocationErrors<double>& cold,
+                                                 const std::vector<std::vector<double>>& states,
+                                                 std::size_t i) const {
+  LocationErrors<double> e = cold;
+  for (std::size_t l = 0; l < lags.size(); ++l) e = drifted_errors(e, lags[l].gains, states[l][i]);
+  return e;
+}
+
+Eigen::Vector3d ThermalSimSpec::point_at(const Eigen::Vector3d& cold,
+                                         const std::vector<std::vector<double>>& states,
+                                         std::size_t i) const {
+  Eigen::Vector3d q = cold;
+  for (std::size_t l = 0; l < lags.size(); ++l) q = drifted_point(q, lags[l].gains, states[l][i]);
+  return q;
 }
 
 }  // namespace rotacal

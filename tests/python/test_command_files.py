@@ -40,6 +40,12 @@ TEMPLATES = {
         ["plan", "probe", "--machine", "{--machine}", "--session", "{--session}", "-o", "{-o}"],
         ["plan", "probe", "--design", "{--design}", "--session", "{--session}", "-o", "{-o}"],
     ],
+    ("plan", "thermal"): [
+        ["plan", "thermal", "--machine", "{--machine}", "--session", "{--session}", "-o", "{-o}"]
+    ],
+    ("simulate", "thermal"): [
+        ["simulate", "thermal", "--machine", "{--machine}", "--truth", "{--truth}", "-o", "{-o}"]
+    ],
     ("import", "probe"): [["import", "probe", "{LOG}", "--plan", "{--plan}", "-o", "{-o}"]],
     ("simulate", "ballbar"): [
         ["simulate", "ballbar", "--machine", "{--machine}", "--truth", "{--truth}", "-o", "{-o}"]

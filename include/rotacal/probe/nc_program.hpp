@@ -19,6 +19,7 @@
 /// #5062 #5063 written to a log file with `(LOGOPEN,file)`, `(LOG,...)`, `(LOGCLOSE)`; every
 /// other dialect is refused (no probing words of it are implemented that can be checked here).
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,23 @@
 #include "rotacal/session/probe_session.hpp"
 
 namespace rotacal {
+
+/// The duty of a thermal test's program (formats.md "Thermal test of a rotary axis"): the
+/// pattern as one epoch at 0 s and every interval_s (each taking pose_dt_s per pose, the
+/// template's clock), `axis` turning at speed_rpm between epochs until heat_s, then at rest
+/// (G4) to heat_s + cool_s. An endless axis turns whole revolutions, half of them back, so its
+/// position stays bounded; the tilting axis (or any axis with limits) swings between the pattern's
+/// lowest and highest angle of it, at a mean absolute speed of speed_rpm.
+struct ThermalProgramDuty {
+  char axis = 'C';
+  double speed_rpm = 300.0;      ///< rev/min while heating
+  double heat_s = 14400.0;       ///< s
+  double cool_s = 7200.0;        ///< s
+  double interval_s = 600.0;     ///< s, from one epoch's start to the next's
+  double max_speed_rpm = 500.0;  ///< the axis' speed limit: speed_rpm above it is refused
+  /// Epoch start times, s (0, interval_s, ... up to heat_s + cool_s).
+  std::vector<double> epoch_starts() const;
+};
 
 struct ProbeProgramOptions {
   int decimals = 4;            ///< digits after the point, 0..9
@@ -37,6 +55,8 @@ struct ProbeProgramOptions {
   double probe_feed_mm_per_min = 50.0;
   double feed_mm_per_min = 1000.0;             ///< positioning feed between touches (G1)
   std::string log_file = "rotacal_probe.log";  ///< the controller's file of the latched positions
+  /// A thermal test: the pattern once per epoch (pose numbers run on), the duty between.
+  std::optional<ThermalProgramDuty> thermal;
 };
 
 /// The longest --log-file name: "(LOGOPEN," + name + ")" within LinuxCNC's 254-character line.
@@ -60,7 +80,8 @@ std::vector<ProbeMove> probe_moves(MachineType m, const ProbePattern& P,
                                    const ProbeProgramOptions& o, double* retract_z = nullptr);
 
 /// The NC program of the probing moves (lines end with '\n'). InvalidArgument as probe_moves,
-/// and for a dialect other than linuxcnc, naming it.
+/// for a dialect other than linuxcnc, naming it, and for a thermal duty whose speed exceeds
+/// its max_speed_rpm, whose axis the machine lacks, or whose interval does not hold an epoch.
 std::string write_probe_nc_program(MachineType m, const ProbePattern& P, NcDialect dialect,
                                    const ProbeProgramOptions& options = {});
 

@@ -10,10 +10,12 @@
 /// added to each latched coordinate.
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "rotacal/kinematics/machine_model.hpp"
 #include "rotacal/session/probe_session.hpp"
+#include "rotacal/session/thermal_test.hpp"
 
 namespace rotacal {
 
@@ -56,17 +58,22 @@ struct ProbeSimOptions {
   double noise_um = 0.5;  ///< 1 sigma of each latched coordinate, um (0: none)
   double ar1_rho = 0.0;   ///< correlation of each coordinate's noise from one touch to the next
   std::uint64_t seed = 1;
+  /// A thermal test (formats.md): the pattern once per epoch, the machine's location errors and
+  /// the sphere drifting as thermal_location_R between and during them. None: one pass from 0 s.
+  std::optional<ThermalSimSpec> thermal;
 };
 
 struct ProbeSimulation {
   ProbeSession session;
-  Eigen::Vector3d sphere_actual = Eigen::Vector3d::Zero();  ///< table frame, mm
+  Eigen::Vector3d sphere_actual = Eigen::Vector3d::Zero();  ///< table frame, mm (cold)
+  ThermalTest thermal;  ///< with options.thermal: the duty, each touch's epoch and time
 };
 
 /// Simulate a whole session. Throws InvalidArgument for an empty pattern, a zero direction,
 /// pose_directions not one non-empty list per pose,
-/// negative noise, |ar1_rho| >= 1, a direction along which the probe misses the sphere, or a
-/// truth model whose effects do not fit its machine.
+/// negative noise, |ar1_rho| >= 1, a direction along which the probe misses the sphere, a
+/// truth model whose effects do not fit its machine, or a thermal spec ThermalSimSpec::validate
+/// refuses.
 ProbeSimulation simulate_probe(const MachineModel& truth, const ProbeSimOptions& options = {});
 
 }  // namespace rotacal

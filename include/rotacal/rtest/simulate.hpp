@@ -16,6 +16,7 @@
 #include "rotacal/kinematics/machine_model.hpp"
 #include "rotacal/rtest/model.hpp"
 #include "rotacal/session/session.hpp"
+#include "rotacal/session/thermal_test.hpp"
 
 namespace rotacal {
 
@@ -31,6 +32,12 @@ struct RtestPattern {
                                         Eigen::Vector3d(0, -120, 140)};  ///< table frame, mm
   double dwell_s = 6.0;  ///< time between poses, s; the program holds each pose at rest for the
                          ///< middle 80 % (hw/pose_window.hpp)
+  /// Poses (tilt, rot, deg) in visiting order; non-empty: they replace the b_deg x c_deg grid
+  /// in simulate_rtest and check_rtest_pattern (a thermal epoch's few poses; design_rtest
+  /// chooses grids only).
+  std::vector<RotaryAngles<double>> poses_deg;
+  /// The poses visited, deg: poses_deg, or the grid with B outer and C inner.
+  std::vector<RotaryAngles<double>> poses() const;
 };
 
 /// The paper's pattern fitted to machine m: seven tilt angles over the widest span of at most
@@ -56,18 +63,27 @@ struct RtestSimOptions {
   std::optional<Eigen::Matrix3d> probe_dirs;
   bool write_d = true;  ///< with probe_dirs: also fill dx,dy,dz (false: raw only)
   unsigned seed = 1;
+  /// Correlation of each reading's noise from one pose to the next within a set-up (AR(1),
+  /// core/noise_model.hpp noise_gen::ar1); 0: independent draws.
+  double ar1_rho = 0.0;
+  /// A thermal test (formats.md): the pattern once per epoch for each nest, the location errors
+  /// and every nest drifting as thermal_location_R. None: one pass from 0 s.
+  std::optional<ThermalSimSpec> thermal;
 };
 
 struct RtestSimulation {
   RtestSession session;
   std::vector<Eigen::Vector3d> probe_zeros;  ///< per set-up (nest order), table frame, mm
+  ThermalTest thermal;  ///< with options.thermal: the duty, each row's epoch and time
 };
 
 /// Simulate a whole session on any machine; each reading is rtest_reading (model.hpp), with the
 /// tool-length error of a head machine taken from tool_offset_Z among the effects. Throws
 /// InvalidArgument for an empty pattern, a pattern outside the machine's limits
-/// (check_rtest_pattern), negative noise or effect parameters that do not match the effect
-/// model.
+/// (check_rtest_pattern), negative noise, |ar1_rho| >= 1, effect parameters that do not match
+/// the effect model, or a thermal spec ThermalSimSpec::validate refuses. A thermal test keeps
+/// each nest mounted over the whole session (one set-up, one probe zero): each epoch visits
+/// every nest in turn.
 RtestSimulation simulate_rtest(const MachineModel& truth, const RtestSimOptions& options = {});
 
 }  // namespace rotacal

@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "rotacal/kinematics/machine.hpp"
 #include "rotacal/kinematics/thermal_lag.hpp"
 
 namespace rotacal {
@@ -51,6 +52,38 @@ struct ThermalTest {
   HeatInput heat_input(char axis) const;
   /// Largest |speed| the duty gives `axis`, rev/min (the tested speed).
   double tested_speed(char axis) const;
+};
+
+/// One lag of a simulated `thermal_location_R`: its time constant and gains (effects.md).
+struct ThermalLagTruth {
+  double tau_s = 1800.0;  ///< s
+  ThermalGains<double> gains;
+};
+
+/// The drift rotacal's own simulators (probe/simulate.hpp, rtest/simulate.hpp) put on a machine:
+/// their pattern measured once per epoch, from each of `epoch_start_s`, every axis held during
+/// it, the duty turning `axis` between, and one or two lags of it.
+struct ThermalSimSpec {
+  std::vector<DutyEntry> duty;        ///< as a session's `# duty.N:` lines
+  std::vector<double> epoch_start_s;  ///< s, strictly increasing: each epoch's first row
+  char axis = 'C';                    ///< the axis whose motion heats (its lags below)
+  std::vector<ThermalLagTruth> lags;  ///< one or two; empty: no drift (a null session)
+
+  /// Throws InvalidArgument (naming `context` and the field) for no epoch, epochs closer than
+  /// `epoch_length_s` (the pattern's own length) or not increasing, a duty the reader would
+  /// refuse (times negative or not increasing, an axis `m` lacks), an axis `m` lacks, more
+  /// than two lags or a tau not > 0.
+  void validate(MachineType m, double epoch_length_s, const std::string& context) const;
+  /// The rows' test: the duty, each row's epoch (1-based) and time.
+  ThermalTest test(const std::vector<double>& time, const std::vector<int>& epoch) const;
+  /// Each lag's state at each row of `test` (kinematics/thermal_lag.hpp), [lag][row].
+  std::vector<std::vector<double>> lag_states(const ThermalTest& test) const;
+  /// E0 + sum_l K_l y_l and q0 + sum_l Kq_l y_l at row i of `states`.
+  LocationErrors<double> errors_at(const LocationErrors<double>& cold,
+                                   const std::vector<std::vector<double>>& states,
+                                   std::size_t i) const;
+  Eigen::Vector3d point_at(const Eigen::Vector3d& cold,
+                           const std::vector<std::vector<double>>& states, std::size_t i) const;
 };
 
 }  // namespace rotacal

@@ -38,6 +38,8 @@ from . import (
     probe,
     simulate,
     thermal,
+    thermal_design,
+    thermal_sim,
 )
 from .options import (
     EPILOG,
@@ -66,6 +68,8 @@ MODULES = (
     design_probe,
     batch,
     thermal,
+    thermal_sim,
+    thermal_design,
 )
 
 # The order `rotacal --help` lists the commands in.

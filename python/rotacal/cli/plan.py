@@ -7,12 +7,21 @@ import argparse
 
 from ..outputs import write_output
 from ..sessions import save
-from .options import EPILOG, EXIT_OK, path, say
+from .options import EPILOG, EXIT_OK, OptionError, path, say
 from .probe import add_plan_probe_args, refuse_probe_options
 from .setups import add_setup_args, ballbar_model, ballbar_setup
+from .thermal_plan import add_plan_thermal_args
+from .thermal_sim import add_test_args, given_test_options
 
 
 def cmd_plan(a: argparse.Namespace) -> int:
+    if a.kind == "thermal":  # the thermal test's program: cli/thermal_plan.py
+        from .thermal_plan import cmd_plan_thermal
+
+        return cmd_plan_thermal(a)
+    given = given_test_options(a) + (["--max-speed"] if a.max_speed is not None else [])
+    if given:
+        raise OptionError(f"plan {a.kind}: {', '.join(given)} belong to plan thermal")
     if a.kind == "probe":  # the touch probe's program: cli/probe.py
         from .probe import cmd_plan_probe
 
@@ -36,9 +45,11 @@ def cmd_plan(a: argparse.Namespace) -> int:
 
 def add_plan(sub: argparse._SubParsersAction) -> None:
     q = sub.add_parser("plan", help="plan a test and write its NC program", epilog=EPILOG)
-    q.add_argument("kind", choices=["ballbar", "probe"])
+    q.add_argument("kind", choices=["ballbar", "probe", "thermal"])
     add_setup_args(q)
     add_plan_probe_args(q)
+    add_test_args(q, defaults=False)
+    add_plan_thermal_args(q)
     q.add_argument(
         "--dialect", default="linuxcnc", help="linuxcnc (machine axes), heidenhain, siemens, fanuc"
     )
