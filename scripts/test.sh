@@ -183,6 +183,7 @@ side_job() {
   "$PY" bench/table_residual_bench.py --smoke
   "$PY" bench/structure_null.py --smoke
   "$PY" bench/thermal_bench.py --smoke
+  "$PY" bench/diagnosis_loop.py --smoke
   echo "finished at $(elapsed)"
 }
 export -f side_job
