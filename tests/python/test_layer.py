@@ -223,7 +223,7 @@ def test_a_module_adds_its_kind_to_another_modules_command(monkeypatch):
     monkeypatch.setattr(parser, "MODULES", parser.MODULES + (extra,))
     p = parser.build_parser()
     assert p.parse_args(["simulate", "gauge", "-o", "x"]).kind == "gauge"
-    assert "{ballbar,rtest,probe,gauge}" in _subparser(p, "simulate").format_help()
+    assert "{ballbar,rtest,probe,thermal,gauge}" in _subparser(p, "simulate").format_help()
     assert p.parse_args(["simulate", "rtest", "-o", "x.csv"]).kind == "rtest"
 
 

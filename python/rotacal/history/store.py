@@ -479,7 +479,7 @@ class CalibrationHistory:
 
     def show(self, machine_id: str, tolerances: Mapping[str, float] | None = None) -> dict:
         """The history of a machine's location errors (:func:`summarize` of its entries) and of
-        its thermal tests' lags (:func:`thermal_history`)."""
+        its thermal tests' lags (``thermal_history``)."""
         machine_type, entries = self.entries(machine_id)
         out = summarize(machine_type, entries, tolerances)
         thermal = thermal_history(entries)  # the thermal tests' lags, when there are any
