@@ -50,20 +50,22 @@ def add_predictor_options(q: argparse.ArgumentParser) -> None:
     )
 
 
+def _refused_options(a: argparse.Namespace, *more: tuple) -> list:
+    """The export options given that a thermal chain or predictor does not take."""
+    options = (
+        ("--at/--state", a.at is not None or a.state is not None),
+        ("--residual-model", a.residual_model),
+        ("--tables", a.tables),
+        ("--comp-file", a.comp_file),
+        *more,
+    )
+    return [o for o, v in options if v]
+
+
 def cmd_predictor(a: argparse.Namespace) -> int:
     from ..thermal_predictor import predictor
 
-    given = [
-        o
-        for o, v in (
-            ("--at/--state", a.at is not None or a.state is not None),
-            ("--residual-model", a.residual_model),
-            ("--tables", a.tables),
-            ("--comp-file", a.comp_file),
-            ("--thermal-chain", getattr(a, "thermal_chain", None)),
-        )
-        if v
-    ]
+    given = _refused_options(a, ("--thermal-chain", getattr(a, "thermal_chain", None)))
     if given:
         raise _core.InvalidArgument("--thermal-predictor: not with " + ", ".join(given))
     doc = predictor(a.model, a.controller, a.cycle, a.current, a.toolholder)
@@ -82,16 +84,7 @@ def cmd_predictor(a: argparse.Namespace) -> int:
 def cmd(a: argparse.Namespace) -> int:
     from ..thermal_hal import chain
 
-    given = [
-        o
-        for o, v in (
-            ("--at/--state", a.at is not None or a.state is not None),
-            ("--residual-model", a.residual_model),
-            ("--tables", a.tables),
-            ("--comp-file", a.comp_file),
-        )
-        if v
-    ]
+    given = _refused_options(a)
     if a.controller != "linuxcnc" or given:
         raise _core.InvalidArgument(
             "--thermal-chain: with --controller linuxcnc only, and not with "
