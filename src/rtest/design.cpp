@@ -440,23 +440,4 @@ RtestSeparationDesign design_rtest_separation(const RtestSession& session,
   return D;
 }
 
-JointFitOutcome identify_rtest_effects(const RtestSession& session, const EffectModel& effects) {
-  if (session.machine != MachineType::BC_trt)
-    throw InvalidArgument("identify_rtest_effects: the session is not of a BC-trt machine");
-  for (const Effect& f : effects.effects)
-    if (!f.applies_to(session.machine))
-      throw InvalidArgument("effect " + f.id() + " does not exist on a BC-trt");
-  RtestArrays poses = rtest_arrays(session, "identify_rtest_effects");
-  poses.machine = MachineType::BC_trt;
-  const RtestProblem model(poses, nullptr, centred_on(effects, session.samples),
-                           RtestZeroNames::numbered);
-  const std::vector<std::string> names = model.layout().all.names(),
-                                 units = model.layout().all.units();
-  std::vector<FitParameter> params;
-  for (std::size_t j = 0; j < names.size(); ++j) params.push_back({names[j], units[j], 0.0});
-  JointFitSettings settings;
-  settings.sigma = session.noise_um.value_or(1.0) * 1e-3;
-  return solve_joint(model, params, settings);
-}
-
 }  // namespace rotacal
