@@ -320,7 +320,6 @@ TEST_CASE("the added test separates axial and tilt motion of C; its predicted si
   const BallbarSession& cmd = st.cmd;
   const BallbarMachineModel& truth = st.truth;
   const double rho = st.rho;
-  const int ne = 6;
 
   // Monte Carlo: new noise on the session and on the added test (run slower: s times the
   // readings), both fitted jointly; the spread of the estimates against the prediction.
