@@ -137,15 +137,22 @@ def separation(draws: int) -> None:
     added = c.setup
     added.step_deg = added.step_deg / c.slow_down
     add_cmd = _core.plan_ballbar_test(added, None).commanded_session()
+    # The several-session identification, white; the pivot shared unless the design moved it.
     est = []
     for k in range(draws):
-        v, _, _ = _core.identify_joint_sessions(
-            [recorded(cmd, truth_of, rho, 1000 + k), recorded(add_cmd, truth_of, rho, 5000 + k)],
-            SEPARATE,
+        f = _core.identify_multi(
+            [
+                ("session", recorded(cmd, truth_of, rho, 1000 + k)),
+                ("added", recorded(add_cmd, truth_of, rho, 5000 + k)),
+            ],
+            noise="white",
+            effects=SEPARATE,
+            same_setup={} if c.new_pivot else {"added": "session"},
         )
-        # fit order: 8 location, pivots, effects; design order: 8 location, pivot, effects, moved pivot
-        ne = len(v) - 11 - (3 if c.new_pivot else 0)
-        est.append(np.concatenate([v[:11], v[len(v) - ne :], v[11:14] if c.new_pivot else []]))
+        # the design's order: 8 location, the session's pivot, effects, the moved pivot
+        moved = f.sessions[1].nuisances if c.new_pivot else []
+        order = f.location_errors + f.sessions[0].nuisances + f.effects + moved
+        est.append([e.value for e in order])
     realised = np.std(np.asarray(est), axis=0, ddof=1)
     predicted = np.asarray(d.sigma_after)
     ok = np.isfinite(predicted)

@@ -144,20 +144,6 @@ void bind_ballbar_separation(pyb::module_& m) {
       },
       pyb::arg("session"), pyb::arg("pair"), pyb::arg("options") = SeparationOptions{},
       "The smallest added test that separates two effects after a session (ballbar/design.hpp).");
-  m.def(
-      "identify_joint_sessions",
-      [](const std::vector<BallbarSession>& sessions, const std::vector<std::string>& effects) {
-        const EffectModel fx = effects_of(effects);
-        JointFitOutcome f;
-        {
-          pyb::gil_scoped_release release;
-          f = identify_joint_sessions(sessions, fx);
-        }
-        return pyb::make_tuple(f.values, f.covariance, f.summary.converged);
-      },
-      pyb::arg("sessions"), pyb::arg("effects") = std::vector<std::string>{},
-      "Joint fit of several ballbar sessions (shared location errors and effects, one pivot each): "
-      "(values, covariance, converged) in the order 8 location errors, pivots, effect parameters.");
 }
 
 // The R-test pattern design.

@@ -4,6 +4,9 @@
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
+#include <map>
+
 #include "json_value.hpp"
 #include "numpy.hpp"
 #include "rotacal/multi/identify.hpp"
@@ -52,7 +55,8 @@ void bind_multi(pyb::module_& m) {
   m.def(
       "identify_multi",
       [](const std::vector<std::pair<std::string, pyb::object>>& sessions, const std::string& noise,
-         const std::vector<std::string>& effects, bool inflate_sigma) {
+         const std::vector<std::string>& effects, bool inflate_sigma,
+         const std::map<std::string, std::string>& same_setup) {
         std::vector<MultiSessionInput> in;
         for (const auto& [name, s] : sessions) {
           if (pyb::isinstance<BallbarSession>(s))
@@ -64,7 +68,14 @@ void bind_multi(pyb::module_& m) {
           else
             throw InvalidArgument("identify: session " + name +
                                   " is not a ballbar, R-test or touch-probe session");
+          const auto earlier = same_setup.find(name);
+          if (earlier != same_setup.end()) in.back().same_setup_as = earlier->second;
         }
+        for (const auto& [later, earlier] : same_setup)
+          if (std::none_of(in.begin(), in.end(),
+                           [&](const MultiSessionInput& s) { return s.name == later; }))
+            throw InvalidArgument("identify: same_setup names session " + later +
+                                  ", which is not among the sessions");
         MultiFitOptions o;
         o.noise.noise = noise_handling_from_string(noise);
         o.effects = effects_of(effects);
@@ -74,11 +85,14 @@ void bind_multi(pyb::module_& m) {
       },
       pyb::arg("sessions"), pyb::arg("noise") = "auto",
       pyb::arg("effects") = std::vector<std::string>{}, pyb::arg("inflate_sigma") = false,
+      pyb::arg("same_setup") = std::map<std::string, std::string>{},
       "One identification from several (name, session) pairs of one machine (multi/identify.hpp): "
       "one set of location errors (and of the catalogue effects `effects`), each session's own "
       "nuisances and noise model, and the "
       "disagreements between the sessions fitted alone; noise 'auto' or 'white'; inflate_sigma: "
-      "widen the sigmas of disagreeing parameters by their Birge ratio.");
+      "widen the sigmas of disagreeing parameters by their Birge ratio; same_setup: session name "
+      "-> the earlier session whose set-up it continues, sharing its own parameters (pivot, nest "
+      "zeros).");
   m.def("refuse_disagreeing", &refuse_disagreeing, pyb::arg("identification"),
         "InvalidArgument naming every disagreement unless there is none or the sigmas were "
         "widened for them (multi/model_document.hpp).");

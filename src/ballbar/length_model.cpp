@@ -41,18 +41,13 @@ struct BallbarLengthModel::Chain {
   int tool_z_col = -1, length_col = -1;
 };
 
-BallbarLengthModel::BallbarLengthModel(const BallbarArrays& d, const EffectModel& fx,
-                                       std::vector<int> pivot_of_row, int pivots)
+BallbarLengthModel::BallbarLengthModel(const BallbarArrays& d, const EffectModel& fx)
     : d_(d),
       fx_(fx),
-      L_(ballbar_layout(d.machine, fx, pivots)),
-      pivot_of_(std::move(pivot_of_row)),
-      analytic_(pivot_of_.empty() && analytic_supported(fx)),
-      chain_(!analytic_ && pivot_of_.empty() && length_chain::supports(d.machine)),
+      L_(ballbar_layout(d.machine, fx)),
+      analytic_(analytic_supported(fx)),
+      chain_(!analytic_ && length_chain::supports(d.machine)),
       nt_(static_cast<int>(d.machine.description().table_axes.size())) {
-  if (!pivot_of_.empty() && static_cast<Eigen::Index>(pivot_of_.size()) != d.size())
-    throw InvalidArgument("ballbar fit: " + std::to_string(pivot_of_.size()) +
-                          " pivot indices for " + std::to_string(d.size()) + " rows");
   if (analytic_) commanded_sincos();
   for (const Effect& f : fx.effects)
     if (f.depends_on_motion() && d.motion.size() != static_cast<std::size_t>(d.size()))
@@ -77,8 +72,6 @@ void BallbarLengthModel::evaluate(const Eigen::VectorXd& x, Eigen::Ref<Eigen::Ve
 
 bool BallbarLengthModel::evaluate_subset(const Eigen::VectorXd& x, Eigen::Index stride,
                                          Eigen::VectorXd& r, Eigen::MatrixXd* J) const {
-  // Sessions back to back: every k-th row may miss a short session, and its pivot with it.
-  if (!pivot_of_.empty()) return false;
   const Eigen::Index m = (d_.size() + stride - 1) / stride;
   r.resize(m);
   if (J) J->resize(m, num_parameters());
@@ -265,8 +258,7 @@ ROTACAL_FLATTEN Lanes BallbarLengthModel::analytic_lanes(const Chain<Lanes>& ch,
 // L_model - L_measured of sample i, on double or Jets: the problem's one residual.
 template <typename T>
 void BallbarLengthModel::sample(Eigen::Index i, const T* p, T* out) const {
-  out[0] = ballbar_residual<T>(L_, d_, fx_, p, i,
-                               pivot_of_.empty() ? 0 : pivot_of_[static_cast<std::size_t>(i)]);
+  out[0] = ballbar_residual<T>(L_, d_, fx_, p, i);
 }
 
 }  // namespace rotacal

@@ -11,8 +11,8 @@
 
 namespace rotacal {
 
-// r_i = L_model,i - L_i (mm), parameters in the ballbar layout (ballbar/problem.hpp). Several
-// centre pivots (the design's sessions back to back): `pivot_of_row` gives each row's pivot.
+// r_i = L_model,i - L_i (mm), parameters in the ballbar layout (ballbar/problem.hpp), one centre
+// pivot (sessions at several pivots are fitted together by multi/identify.hpp).
 // The base model (location errors, pivot, and the tool length and ballbar length offsets)
 // has an analytic path: the one model's rotations (rotate_point_about_unit_line) composed
 // along the machine's axes for the residual, and the chain rule over their derivatives for
@@ -27,10 +27,9 @@ namespace rotacal {
 // whole residual kernel (the Lanes rows and four Jet widths of the templated model) again.
 class BallbarLengthModel : public ResidualModel {
  public:
-  /// Throws InvalidArgument for a pivot per row that does not match the arrays, or an effect
-  /// that needs the axes' motion when the arrays were built without it.
-  BallbarLengthModel(const BallbarArrays& d, const EffectModel& fx,
-                     std::vector<int> pivot_of_row = {}, int pivots = 1);
+  /// Throws InvalidArgument for an effect that needs the axes' motion when the arrays were
+  /// built without it.
+  BallbarLengthModel(const BallbarArrays& d, const EffectModel& fx);
   Eigen::Index num_residuals() const override { return d_.size(); }
   int num_parameters() const override { return static_cast<int>(L_.all.size()); }
   const BallbarLayout& layout() const { return L_; }
@@ -69,7 +68,6 @@ class BallbarLengthModel : public ResidualModel {
   const BallbarArrays& d_;
   const EffectModel& fx_;
   BallbarLayout L_;
-  std::vector<int> pivot_of_;  // pivot of each row (empty: one pivot)
   bool analytic_;
   bool chain_;  // otherwise the Jacobian by the chain rule (length_chain.hpp) where it applies
   int nt_;      // table axes: chain axes 0 .. nt_ - 1 carry the pivot, the others the tool

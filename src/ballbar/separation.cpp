@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The ballbar's candidates for the design engine (design/separation.hpp): the added tests
-// that may separate two effects after a session, and the joint fit of several sessions.
+// that may separate two effects after a session.
 #include "rotacal/design/separation.hpp"
 
 #include <algorithm>
@@ -121,48 +121,13 @@ std::string describe(const SeparatingCandidate& c, MachineType m) {
   return d.str();
 }
 
-// Sessions back to back as one set of arrays, and the pivot of each row (session s has pivot
-// pivot_of[s]): the ballbar problem's model over several set-ups.
-struct Sessions {
-  BallbarArrays data;
-  std::vector<int> pivot_of_row;
-  int pivots = 1;
-};
-
-Sessions back_to_back(const std::vector<BallbarArrays>& d, const std::vector<int>& pivot_of) {
-  Sessions out;
-  BallbarArrays& a = out.data;
-  a.machine = d.front().machine;
-  a.pivot = d.front().pivot;
-  Eigen::Index n = 0;
-  for (const BallbarArrays& s : d) n += s.size();
-  a.xyz.resize(3, n);
-  a.time.resize(n);
-  a.length.resize(n);
-  Eigen::Index row = 0;
-  for (std::size_t s = 0; s < d.size(); ++s) {
-    const BallbarArrays& b = d[s];
-    a.xyz.middleCols(row, b.size()) = b.xyz;
-    a.time.segment(row, b.size()) = b.time;
-    a.length.segment(row, b.size()) = b.length;
-    a.angles.insert(a.angles.end(), b.angles.begin(), b.angles.end());
-    a.motion.insert(a.motion.end(), b.motion.begin(), b.motion.end());
-    a.test.insert(a.test.end(), b.test.begin(), b.test.end());
-    out.pivot_of_row.insert(out.pivot_of_row.end(), static_cast<std::size_t>(b.size()),
-                            pivot_of[s]);
-    row += b.size();
-  }
-  out.pivots = *std::max_element(pivot_of.begin(), pivot_of.end()) + 1;
-  return out;
-}
-
 // Jacobian (mm per unit) of the ballbar lengths of `s` at zero errors and the nominal pivot:
 // the joint fit's model without solving it (8 location errors, pivot, effects).
 Eigen::MatrixXd nominal_jacobian(const BallbarSession& s, const EffectModel& fx) {
-  const Sessions one = back_to_back({ballbar_arrays(s)}, {0});
-  const BallbarLengthModel model(one.data, fx, one.pivot_of_row);
+  const BallbarArrays data = ballbar_arrays(s);
+  const BallbarLengthModel model(data, fx);
   Eigen::VectorXd x = Eigen::VectorXd::Zero(model.num_parameters());
-  model.layout().pivots.of<3>(x) = one.data.pivot;
+  model.layout().pivots.of<3>(x) = data.pivot;
   Eigen::VectorXd r(model.num_residuals());
   Eigen::MatrixXd J(model.num_residuals(), model.num_parameters());
   model.evaluate(x, r, &J);
@@ -264,45 +229,6 @@ SeparationDesign design_ballbar_separation(const BallbarSession& session,
   finish_separation(S, c, D.chosen.description, D.chosen.duration_s * D.chosen.slow_down,
                     added_names, SeparationWording{}, D);
   return D;
-}
-
-JointFitOutcome identify_joint_sessions(const std::vector<BallbarSession>& sessions,
-                                        const EffectModel& effects) {
-  if (sessions.empty()) throw InvalidArgument("identify_joint_sessions: no session");
-  const MachineType m = sessions.front().machine;
-  for (const BallbarSession& s : sessions)
-    if (s.machine != m)
-      throw InvalidArgument("identify_joint_sessions: the sessions are of different machines");
-  for (const Effect& f : effects.effects)
-    if (!f.applies_to(m))
-      throw InvalidArgument("effect " + f.id() + " does not exist on a " + to_string(m));
-  std::vector<BallbarArrays> data;
-  for (const BallbarSession& s : sessions) data.push_back(ballbar_arrays(s));
-  // Sessions with the same nominal pivot share it (the ball stayed in its cup).
-  std::vector<int> pivot_of;
-  std::vector<Eigen::Vector3d> pivots;
-  for (const BallbarSession& s : sessions) {
-    int k = 0;
-    while (k < static_cast<int>(pivots.size()) &&
-           (pivots[static_cast<std::size_t>(k)] - s.pivot).norm() > 1e-9)
-      ++k;
-    if (k == static_cast<int>(pivots.size())) pivots.push_back(s.pivot);
-    pivot_of.push_back(k);
-  }
-  const Sessions all = back_to_back(data, pivot_of);
-  const BallbarLengthModel model(all.data, effects, all.pivot_of_row, all.pivots);
-  const BallbarLayout& L = model.layout();
-  const std::vector<std::string> names = L.all.names(), units = L.all.units();
-  std::vector<FitParameter> params;
-  for (Eigen::Index j = 0; j < L.all.size(); ++j) {
-    const std::size_t k = static_cast<std::size_t>(j);
-    const Eigen::Index c = j - L.pivots.offset;
-    params.push_back({names[k], units[k],
-                      L.pivots.contains(j) ? pivots[static_cast<std::size_t>(c / 3)][c % 3] : 0.0});
-  }
-  JointFitSettings settings;
-  settings.sigma = sessions.front().noise_um.value_or(1.0) * 1e-3;
-  return solve_joint(model, params, settings);
 }
 
 }  // namespace rotacal

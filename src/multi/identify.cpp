@@ -63,10 +63,12 @@ namespace {
 // "location_errors" and "effects" (the catalogue effects fitted for the machine, empty unless
 // asked), then each session's own parameters as a block named after it. Each session's own
 // model computes its rows and Jacobian; its shared columns land on the shared blocks, its other
-// columns on its own.
+// columns on its own, or on those of the same name of the earlier session same_as[k] (>= 0)
+// whose set-up it continues.
 class StackedModel : public ResidualModel {
  public:
-  StackedModel(const std::vector<SessionPart>& parts, MachineType m, const EffectModel& fx)
+  StackedModel(const std::vector<SessionPart>& parts, const std::vector<int>& same_as,
+               MachineType m, const EffectModel& fx)
       : parts_(parts) {
     const auto& arr = location_error_names(m);
     std::vector<std::string> names(arr.begin(), arr.end()), units(names.size());
@@ -82,25 +84,28 @@ class StackedModel : public ResidualModel {
                           {units.begin(), units.begin() + 8});
     effects_ =
         layout_.add("effects", {names.begin() + 8, names.end()}, {units.begin() + 8, units.end()});
-    for (const SessionPart& p : parts) {
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      const SessionPart& p = parts[k];
       if (std::count_if(p.shared.begin(), p.shared.end(), [](Eigen::Index i) { return i >= 0; }) !=
           static_cast<std::ptrdiff_t>(names.size()))
         throw InvalidArgument("identify: session " + p.name + " does not hold the " +
                               std::to_string(names.size()) +
                               " shared parameters (location errors and effects)");
+      std::vector<Eigen::Index> map(p.parameters.size(), -1);
+      if (same_as[k] >= 0) map = continued(parts, static_cast<std::size_t>(same_as[k]), p);
       std::vector<std::string> own, own_units;
       for (std::size_t j = 0; j < p.parameters.size(); ++j)
-        if (p.shared[j] < 0) {
+        if (p.shared[j] < 0 && map[j] < 0) {
           own.push_back(p.name + ":" + p.parameters[j].name);
           own_units.push_back(p.parameters[j].unit);
         }
-      const ParameterBlock b = layout_.add(p.name, own, own_units);
-      std::vector<Eigen::Index> map;
-      Eigen::Index next = b.offset;
+      Eigen::Index next = layout_.add(p.name, own, own_units).offset;
       for (std::size_t j = 0; j < p.parameters.size(); ++j)
-        map.push_back(p.shared[j] < 0 ? next++ : shared_index(p.shared[j]));
+        if (p.shared[j] >= 0)
+          map[j] = shared_index(p.shared[j]);
+        else if (map[j] < 0)
+          map[j] = next++;
       maps_.push_back(std::move(map));
-      blocks_.push_back(b);
       rows_ += p.model->num_residuals();
     }
   }
@@ -135,17 +140,44 @@ class StackedModel : public ResidualModel {
   const ParameterLayout& layout() const { return layout_; }
   const ParameterBlock& errors() const { return errors_; }
   const ParameterBlock& effects() const { return effects_; }
-  const ParameterBlock& block(std::size_t k) const { return blocks_[k]; }
   const std::vector<Eigen::Index>& map(std::size_t k) const { return maps_[k]; }
 
  private:
+  // Where p's own parameters of the same name as an own parameter of the earlier session q
+  // are in the joint vector (-1: not q's).
+  std::vector<Eigen::Index> continued(const std::vector<SessionPart>& parts, std::size_t q,
+                                      const SessionPart& p) const {
+    std::vector<Eigen::Index> map(p.parameters.size(), -1);
+    for (std::size_t j = 0; j < p.parameters.size(); ++j)
+      for (std::size_t i = 0; i < parts[q].parameters.size() && p.shared[j] < 0; ++i)
+        if (parts[q].shared[i] < 0 && parts[q].parameters[i].name == p.parameters[j].name)
+          map[j] = maps_[q][i];
+    return map;
+  }
+
   const std::vector<SessionPart>& parts_;
   ParameterLayout layout_;
   ParameterBlock errors_, effects_;
-  std::vector<ParameterBlock> blocks_;
   std::vector<std::vector<Eigen::Index>> maps_;
   Eigen::Index rows_ = 0;
 };
+
+// The index of the earlier session each session continues (same_setup_as), -1 for none.
+std::vector<int> continued_setups(const std::vector<MultiSessionInput>& sessions) {
+  std::vector<int> out;
+  for (std::size_t k = 0; k < sessions.size(); ++k) {
+    const MultiSessionInput& s = sessions[k];
+    int q = -1;
+    for (std::size_t i = 0; i < k && !s.same_setup_as.empty(); ++i)
+      if (sessions[i].name == s.same_setup_as) q = static_cast<int>(i);
+    if (!s.same_setup_as.empty() &&
+        (q < 0 || sessions[static_cast<std::size_t>(q)].instrument != s.instrument))
+      throw InvalidArgument("identify: session " + s.name + " continues the set-up of " +
+                            s.same_setup_as + ", which is no earlier " + s.instrument + " session");
+    out.push_back(q);
+  }
+  return out;
+}
 
 void check_sessions(const std::vector<MultiSessionInput>& sessions) {
   if (sessions.size() < 2)
@@ -333,7 +365,7 @@ MultiIdentification identify_multi(const std::vector<MultiSessionInput>& session
   const EffectModel fx = shared_effects(o);
   std::vector<SessionPart> parts;
   for (const MultiSessionInput& s : sessions) parts.push_back(multi_detail::session_part(s, fx));
-  const StackedModel model(parts, sessions.front().machine(), fx);
+  const StackedModel model(parts, continued_setups(sessions), sessions.front().machine(), fx);
 
   MultiIdentification out;
   out.machine = sessions.front().machine();
@@ -380,11 +412,12 @@ MultiIdentification identify_multi(const std::vector<MultiSessionInput>& session
   const JointFitOutcome& fit = joint.fit;
   Eigen::Index row = 0;
   for (std::size_t k = 0; k < parts.size(); ++k) {
-    const ParameterBlock& b = model.block(k);
-    out.sessions[k].nuisances.assign(fit.estimates.begin() + b.offset,
-                                     fit.estimates.begin() + b.end());
-    for (ParameterEstimate& e : out.sessions[k].nuisances)
-      e.name = e.name.substr(parts[k].name.size() + 1);
+    for (std::size_t j = 0; j < parts[k].parameters.size(); ++j)
+      if (parts[k].shared[j] < 0) {
+        out.sessions[k].nuisances.push_back(
+            fit.estimates[static_cast<std::size_t>(model.map(k)[j])]);
+        out.sessions[k].nuisances.back().name = parts[k].parameters[j].name;
+      }
     const Eigen::Index n = static_cast<Eigen::Index>(out.sessions[k].n_residuals);
     const double ms = fit.residuals.segment(row, n).squaredNorm() / static_cast<double>(n);
     out.sessions[k].residual_rms_um = std::sqrt(ms) * 1e3;

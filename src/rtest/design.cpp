@@ -13,6 +13,7 @@
 #include "rotacal/core/error.hpp"
 #include "rotacal/core/joint_fit.hpp"
 #include "rotacal/core/least_squares.hpp"
+#include "rotacal/core/noise_model.hpp"
 #include "rotacal/design/format.hpp"
 #include "rotacal/design/separation.hpp"
 #include "rotacal/rtest/model.hpp"
@@ -24,44 +25,31 @@ namespace {
 
 // The whitener of AR(1) noise with coefficient rho and marginal sigma per stream (one per nest
 // and component dx, dy, dz, in time order, as noise_gen::ar1 and the noise model split them):
-//   w_0 = x_0 / sigma,   w_t = (x_t - rho x_{t-1}) / (sigma sqrt(1 - rho^2))   (Prais-Winsten).
+// the core's (core/noise_model.hpp) with its exact start-up row (Prais-Winsten),
+//   w_0 = x_0 / sigma,   w_t = (x_t - rho x_{t-1}) / (sigma sqrt(1 - rho^2)).
 // With it the joint fit's covariance is (J^T Sigma^-1 J)^-1, the GLS covariance under that
 // noise, with no rescaling by the (zero) residual variance of noise-free readings. rho = 0
 // gives W = I / sigma, i.e. (J^T J)^-1 sigma^2.
-class Ar1Whitener : public ResidualWhitener {
- public:
-  Ar1Whitener(const RtestSession& s, double sigma_mm, double rho)
-      : n_(3 * static_cast<Eigen::Index>(s.samples.size())) {
-    inv_first_ = 1.0 / sigma_mm;
-    inv_next_ = 1.0 / (sigma_mm * std::sqrt(1.0 - rho * rho));
-    rho_ = rho;
-    std::map<std::string, std::vector<std::size_t>> by_nest;
-    for (std::size_t i = 0; i < s.samples.size(); ++i) by_nest[s.samples[i].setup].push_back(i);
-    for (auto& [nest, rows] : by_nest) {
-      std::stable_sort(rows.begin(), rows.end(), [&](std::size_t a, std::size_t b) {
-        return s.samples[a].time < s.samples[b].time;
-      });
-      for (int k = 0; k < 3; ++k) {
-        std::vector<Eigen::Index> stream;
-        for (std::size_t i : rows) stream.push_back(3 * static_cast<Eigen::Index>(i) + k);
-        streams_.push_back(std::move(stream));
-      }
-    }
+std::shared_ptr<const ResidualWhitener> ar1_whitener(const RtestSession& s, double sigma_um,
+                                                     double rho) {
+  std::vector<std::string> groups;
+  std::vector<double> times;
+  for (const RtestSample& x : s.samples)
+    for (int k = 0; k < 3; ++k) groups.push_back(x.setup), times.push_back(x.time);
+  const NoiseStreamLayout layout(groups, times);
+  NoiseModel model;
+  model.n = layout.n;
+  for (std::size_t k = 0; k < layout.rows.size(); ++k) {
+    NoiseStream stream;
+    stream.group = layout.group[k];
+    stream.channel = layout.channel[k];
+    stream.rows = layout.rows[k];
+    if (rho > 0.0) stream.ar = stream.reflection = {rho};
+    stream.marginal_sigma_um = sigma_um;
+    model.streams.push_back(std::move(stream));
   }
-  void apply(Eigen::Ref<Eigen::MatrixXd> columns) const override {
-    for (const auto& st : streams_) {
-      for (std::size_t t = st.size(); t-- > 1;)
-        columns.row(st[t]) = (columns.row(st[t]) - rho_ * columns.row(st[t - 1])) * inv_next_;
-      columns.row(st[0]) *= inv_first_;
-    }
-  }
-  Eigen::Index size() const override { return n_; }
-
- private:
-  Eigen::Index n_;
-  double inv_first_ = 1.0, inv_next_ = 1.0, rho_ = 0.0;
-  std::vector<std::vector<Eigen::Index>> streams_;
-};
+  return std::make_shared<ArWhitener>(model);
+}
 
 // BC-trt with the design's travel and B limits: the user's machine, which may be larger than
 // the built-in description, whose travel would refuse the readings of a pattern the design
@@ -137,7 +125,7 @@ RtestDesignCandidate evaluate_rtest_design(const RtestPattern& pattern, const Rt
   s.noise_um = o.noise_um;  // the fit's chi-square scale (observability), as a recorder declares it
   RtestJointOptions fit;
   fit.basis = o.basis;
-  fit.whitener = std::make_shared<Ar1Whitener>(s, o.noise_um * 1e-3, o.noise_rho);
+  fit.whitener = ar1_whitener(s, o.noise_um, o.noise_rho);
   RtestJointIdentification id;
   try {
     id = identify_joint(s, fit);
@@ -438,25 +426,6 @@ RtestSeparationDesign design_rtest_separation(const RtestSession& session,
   finish_separation(S, c, D.chosen.description, D.chosen.duration_s * D.chosen.repeats, added_names,
                     wording, D);
   return D;
-}
-
-JointFitOutcome identify_rtest_effects(const RtestSession& session, const EffectModel& effects) {
-  if (session.machine != MachineType::BC_trt)
-    throw InvalidArgument("identify_rtest_effects: the session is not of a BC-trt machine");
-  for (const Effect& f : effects.effects)
-    if (!f.applies_to(session.machine))
-      throw InvalidArgument("effect " + f.id() + " does not exist on a BC-trt");
-  RtestArrays poses = rtest_arrays(session, "identify_rtest_effects");
-  poses.machine = MachineType::BC_trt;
-  const RtestProblem model(poses, nullptr, centred_on(effects, session.samples),
-                           RtestZeroNames::numbered);
-  const std::vector<std::string> names = model.layout().all.names(),
-                                 units = model.layout().all.units();
-  std::vector<FitParameter> params;
-  for (std::size_t j = 0; j < names.size(); ++j) params.push_back({names[j], units[j], 0.0});
-  JointFitSettings settings;
-  settings.sigma = session.noise_um.value_or(1.0) * 1e-3;
-  return solve_joint(model, params, settings);
 }
 
 }  // namespace rotacal

@@ -11,6 +11,7 @@
 #include "rotacal/ballbar/simulate.hpp"
 #include "rotacal/core/error.hpp"
 #include "rotacal/core/noise_model.hpp"
+#include "rotacal/multi/identify.hpp"
 
 using namespace rotacal;
 
@@ -233,12 +234,28 @@ void check_separation_design(const SeparationDesign& d) {
   for (int j = 0; j < 8; ++j) CHECK(std::isfinite(d.sigma_after[j]));
 }
 
-// Where identify_joint_sessions puts the design's parameter j: 8 location, pivots (3 per
-// distinct pivot), effects; the design's order: 8 location, session pivot, effects, moved pivot.
-Eigen::Index joint_index(int j, int p, int ne) {
-  if (j < 11) return j;
-  if (j < 11 + ne) return p - ne + (j - 11);
-  return 11 + (j - 11 - ne);
+// The session and the added test fitted jointly by the several-session identification
+// (multi/identify.hpp), white: the location errors and the pair shared, and the pivot too
+// unless the design moved it (the ball stayed in its cup).
+MultiIdentification fitted_jointly(const SeparationStudy& st, const BallbarSession& first,
+                                   const BallbarSession& added) {
+  MultiFitOptions o;
+  o.effects.effects = st.pair;
+  o.noise.noise = NoiseHandling::white;
+  MultiSessionInput more = MultiSessionInput::of("added", added);
+  if (!st.d.chosen.new_pivot) more.same_setup_as = "session";
+  return identify_multi({MultiSessionInput::of("session", first), more}, o);
+}
+
+// Its estimates in the design's order: 8 location errors, the session's pivot, the pair's
+// parameters, the moved pivot (the added session's own; else it reports the session's).
+std::vector<ParameterEstimate> in_design_order(const MultiIdentification& f, bool moved) {
+  std::vector<ParameterEstimate> out = f.location_errors();
+  for (const std::vector<ParameterEstimate>& b :
+       {f.sessions[0].nuisances, f.effects(),
+        moved ? f.sessions[1].nuisances : std::vector<ParameterEstimate>{}})
+    out.insert(out.end(), b.begin(), b.end());
+  return out;
 }
 
 }  // namespace
@@ -254,39 +271,40 @@ TEST_CASE(
   const int ne = 6;
   const int p = static_cast<int>(d.names.size());
   const BallbarSession first = recorded(st.cmd, st.truth, st.rho, 1000);
-  const JointFitOutcome alone = identify_joint_sessions({first}, fx);
-  const JointFitOutcome f =
-      identify_joint_sessions({first, recorded(st.added_cmd, st.truth, st.rho, 5000)}, fx);
-  REQUIRE(alone.summary.converged);
-  REQUIRE(f.summary.converged);
-  REQUIRE(alone.values.size() == 11 + ne);
-  REQUIRE(f.values.size() == p);
-  REQUIRE(f.covariance.rows() == p);
-  REQUIRE(f.covariance.cols() == p);
+  JointFitOptions white;
+  white.effects = fx;
+  const std::vector<ParameterEstimate> alone = identify_joint(first, white).parameters;
+  const MultiIdentification joint =
+      fitted_jointly(st, first, recorded(st.added_cmd, st.truth, st.rho, 5000));
+  const std::vector<ParameterEstimate> f = in_design_order(joint, st.d.chosen.new_pivot);
+  REQUIRE(joint.converged);
+  REQUIRE(alone.size() == 11 + ne);
+  REQUIRE(f.size() == static_cast<std::size_t>(p));
   Eigen::VectorXd truth(11 + ne);
   truth << st.truth.errors.v, st.cmd.pivot,
       Eigen::Map<const Eigen::VectorXd>(st.truth.effect_params.data(), ne);
-  for (int j = 0; j < p; ++j) {
-    const Eigen::Index k = joint_index(j, p, ne);
-    INFO(d.names[static_cast<std::size_t>(j)]
-         << " (fit: " << f.estimates[k].name << "): " << f.values[k] << " jointly, predicted sigma "
-         << d.sigma_after[j]);
-    CHECK(f.estimates[k].name == d.names[static_cast<std::size_t>(j)]);
-    CHECK(std::isfinite(f.values[k]));
-    // The parameters the design holds, the fit holds; the others it determines.
-    CHECK(f.free[static_cast<std::size_t>(k)] == std::isfinite(d.sigma_after[j]));
-    if (j >= 11 + ne || !std::isfinite(d.sigma_after[j])) continue;
+  for (std::size_t j = 0; j < f.size(); ++j) {
+    const double predicted = d.sigma_after[static_cast<Eigen::Index>(j)];
+    INFO(d.names[j] << " (fit: " << f[j].name << "): " << f[j].value << " jointly, predicted sigma "
+                    << predicted);
+    // The moved pivot is the added session's own "pivot_x"; the design calls it "pivot_x#2".
+    CHECK(f[j].name + (j >= 11u + ne ? "#2" : "") == d.names[j]);
+    CHECK(std::isfinite(f[j].value));
+    // The parameters the design holds, the fit holds (a zero sigma); the others it determines.
+    CHECK((f[j].std > 0.0) == std::isfinite(predicted));
+    if (j >= 11u + ne || !std::isfinite(predicted)) continue;
     // One draw from the truth: within 5 predicted sigma, jointly and from the session alone.
-    CHECK(std::abs(f.values[k] - truth[j]) < 5.0 * d.sigma_after[j]);
-    if (std::isfinite(d.sigma_before[j]))
-      CHECK(std::abs(alone.values[j] - truth[j]) < 5.0 * d.sigma_before[j]);
+    const Eigen::Index i = static_cast<Eigen::Index>(j);
+    CHECK(std::abs(f[j].value - truth[i]) < 5.0 * predicted);
+    if (std::isfinite(d.sigma_before[i]))
+      CHECK(std::abs(alone[j].value - truth[i]) < 5.0 * d.sigma_before[i]);
   }
   // The fits' own covariances (white: the noise's colour scales both alike) shrink the pair's
   // sigma by the factor the design predicts (within 0.1 % on this draw).
   for (int j = 11; j < 11 + ne; ++j) {
-    const Eigen::Index k = joint_index(j, p, ne);
+    const std::size_t k = static_cast<std::size_t>(j);
     if (!std::isfinite(d.sigma_before[j]) || !std::isfinite(d.sigma_after[j])) continue;
-    const double realised = std::sqrt(f.covariance(k, k) / alone.covariance(j, j));
+    const double realised = f[k].std / alone[k].std;
     const double predicted = d.sigma_after[j] / d.sigma_before[j];
     INFO(d.names[static_cast<std::size_t>(j)] << ": sigma ratio " << realised << ", predicted "
                                               << predicted);
@@ -302,7 +320,6 @@ TEST_CASE("the added test separates axial and tilt motion of C; its predicted si
   const BallbarSession& cmd = st.cmd;
   const BallbarMachineModel& truth = st.truth;
   const double rho = st.rho;
-  const int ne = 6;
 
   // Monte Carlo: new noise on the session and on the added test (run slower: s times the
   // readings), both fitted jointly; the spread of the estimates against the prediction.
@@ -312,12 +329,12 @@ TEST_CASE("the added test separates axial and tilt motion of C; its predicted si
   const int p = static_cast<int>(d.names.size());
   Eigen::MatrixXd est(draws, p);
   for (int k = 0; k < draws; ++k) {
-    const std::vector<BallbarSession> both = {recorded(cmd, truth, rho, 1000 + k),
-                                              recorded(st.added_cmd, truth, rho, 5000 + k)};
-    const JointFitOutcome f = identify_joint_sessions(both, fx);
-    REQUIRE(f.summary.converged);
-    REQUIRE(f.values.size() == p);
-    for (int j = 0; j < p; ++j) est(k, j) = f.values[joint_index(j, p, ne)];
+    const MultiIdentification f = fitted_jointly(st, recorded(cmd, truth, rho, 1000 + k),
+                                                 recorded(st.added_cmd, truth, rho, 5000 + k));
+    REQUIRE(f.converged);
+    const std::vector<ParameterEstimate> v = in_design_order(f, st.d.chosen.new_pivot);
+    REQUIRE(v.size() == static_cast<std::size_t>(p));
+    for (int j = 0; j < p; ++j) est(k, j) = v[static_cast<std::size_t>(j)].value;
   }
   for (int j = 0; j < p; ++j) {
     if (!std::isfinite(d.sigma_after[j])) continue;  // held by the design: the fit holds it too

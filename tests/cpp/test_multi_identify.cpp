@@ -3,7 +3,8 @@
 // (multi/identify.hpp): the joint values lie within 3 sigma of the simulated machine, the joint
 // sigma is no larger than either session's alone, a session of another machine is refused by
 // name, a session whose machine differs by 30 um in one error is reported as disagreeing, a shared
-// effect is fitted once, and the block-diagonal whitener whitens each session by its own model.
+// effect is fitted once, the block-diagonal whitener whitens each session by its own model, and
+// a session that continues another's set-up shares its pivot.
 #include <catch2/catch.hpp>
 
 #include "rotacal/ballbar/plan.hpp"
@@ -186,4 +187,40 @@ TEST_CASE("white noise handling weights each session by its own residual sigma",
     if (p.observable)
       CHECK(std::abs(p.value - t.errors.v[static_cast<Eigen::Index>(j)]) <= 3.0 * p.std);
   }
+}
+
+TEST_CASE("a session that continues another's set-up shares its pivot, fitted once", "[multi]") {
+  const MachineModel t = machine_truth();
+  MultiFitOptions o;
+  o.noise.noise = NoiseHandling::white;
+  MultiSessionInput added = MultiSessionInput::of("added", ballbar_session(t, 52));
+  const MultiIdentification apart =
+      identify_multi({MultiSessionInput::of("bb", ballbar_session(t, 51)), added}, o);
+  added.same_setup_as = "bb";
+  const MultiIdentification shared =
+      identify_multi({MultiSessionInput::of("bb", ballbar_session(t, 51)), added}, o);
+  CHECK(apart.parameters.size() == 8 + 3 + 3);
+  REQUIRE(shared.parameters.size() == 8 + 3);
+  CHECK(shared.block("bb").size() == 3);
+  CHECK(shared.block("added").empty());
+  // Both sessions report the one pivot as their own.
+  const Eigen::Vector3d truth = commanded_session(plan_ballbar_test(BallbarSetup{})).pivot +
+                                Eigen::Vector3d(0.02, -0.01, 0.015);
+  for (int k = 0; k < 3; ++k) {
+    const ParameterEstimate &a = shared.sessions[0].nuisances[static_cast<std::size_t>(k)],
+                            &b = shared.sessions[1].nuisances[static_cast<std::size_t>(k)];
+    INFO(a.name << " = " << a.value << " +- " << a.std << ", truth " << truth[k]);
+    CHECK(b.name == a.name);
+    CHECK(b.value == a.value);
+    CHECK(std::abs(a.value - truth[k]) <= 3.0 * a.std);
+    // Twice the readings of one pivot: its sigma about 1/sqrt(2) of either session's own.
+    CHECK(a.std < 0.85 * apart.sessions[0].nuisances[static_cast<std::size_t>(k)].std);
+  }
+  added.same_setup_as = "probe";
+  CHECK_THROWS_WITH(identify_multi({MultiSessionInput::of("bb", ballbar_session(t, 51)), added}, o),
+                    Catch::Contains("added") && Catch::Contains("no earlier ballbar session"));
+  MultiSessionInput first = MultiSessionInput::of("bb", ballbar_session(t, 51));
+  first.same_setup_as = "added";  // a later session: not continued
+  CHECK_THROWS_WITH(identify_multi({first, MultiSessionInput::of("added", ballbar_session(t, 52))}),
+                    Catch::Contains("no earlier ballbar session"));
 }

@@ -8,6 +8,7 @@
 
 #include "rotacal/core/error.hpp"
 #include "rotacal/core/noise_model.hpp"
+#include "rotacal/multi/identify.hpp"
 #include "rotacal/rtest/design.hpp"
 
 using namespace rotacal;
@@ -176,31 +177,33 @@ TEST_CASE("R-test: the added nest separates axial from tilt motion of C; Monte C
   CHECK(d.chosen.correlation < 0.5);
   CHECK(d.chosen.duration_s * d.chosen.repeats <= 600.0);
   // Monte Carlo: the session and the added nest (its grid repeated) recorded again, fitted
-  // jointly with the effects; every determined parameter's spread against its prediction.
+  // jointly with the effects by the several-session identification (white; one probe zero per
+  // nest, the session's own); every determined parameter's spread against its prediction.
   RtestPattern added = d.chosen.added;
   std::vector<double> b;
   for (int r = 0; r < static_cast<int>(d.chosen.repeats); ++r)
     b.insert(b.end(), added.b_deg.begin(), added.b_deg.end());
   added.b_deg = b;
-  EffectModel fx;
-  fx.effects = pair;
+  MultiFitOptions fo;
+  fo.effects.effects = pair;
+  fo.noise.noise = NoiseHandling::white;
   const int draws = 80, p = static_cast<int>(d.names.size()),
             ns = static_cast<int>(session.nests.size());
-  const int e0 = 8 + 3 * ns, ne = fx.num_params();
+  const int ne = fo.effects.num_params();
   Eigen::MatrixXd est(draws, p);
   for (int k = 0; k < draws; ++k) {
-    RtestSession both = recorded(truth, base, rho, static_cast<unsigned>(100 + k));
+    const RtestSession first = recorded(truth, base, rho, static_cast<unsigned>(100 + k));
     const RtestSession more = recorded(truth, added, rho, static_cast<unsigned>(5000 + k), ns + 1,
-                                       both.samples.back().time + 1.0);
-    both.nests.insert(more.nests.begin(), more.nests.end());
-    both.samples.insert(both.samples.end(), more.samples.begin(), more.samples.end());
-    const JointFitOutcome f = identify_rtest_effects(both, fx);
-    REQUIRE(f.values.size() == p);
-    // fit: 8 location, zeros (session nests, added), effects; design: 8, session zeros, effects,
-    // added zeros.
-    est.row(k).head(e0) = f.values.head(e0);
-    est.row(k).segment(e0, ne) = f.values.tail(ne);
-    est.row(k).tail(3) = f.values.segment(e0, 3);
+                                       first.samples.back().time + 1.0);
+    const MultiIdentification f = identify_multi(
+        {MultiSessionInput::of("session", first), MultiSessionInput::of("added", more)}, fo);
+    // The design's order: 8 location errors, the session's zeros, the effects, the added zeros.
+    std::vector<ParameterEstimate> v = f.location_errors();
+    for (const std::vector<ParameterEstimate>& b :
+         {f.sessions[0].nuisances, f.effects(), f.sessions[1].nuisances})
+      v.insert(v.end(), b.begin(), b.end());
+    REQUIRE(v.size() == static_cast<std::size_t>(p));
+    for (int j = 0; j < p; ++j) est(k, j) = v[static_cast<std::size_t>(j)].value;
   }
   int checked = 0;
   for (int j = 0; j < p; ++j) {

@@ -148,21 +148,13 @@ struct SeparationDesign : SeparationResult {
 /// session's information is its joint-fit Jacobian (fit with the pair included) over its noise
 /// (sigma and effective samples per reading from its AR noise model); the added test is read
 /// as the session was (one reading per plan step) and slowing it down by s gathers s times the
-/// readings. When the pair moves the table alike (table_motion_overlap) no test is searched:
+/// readings. The session and the test as run are fitted together by identify_multi
+/// (multi/identify.hpp; the test continues the session's set-up unless its pivot moved). When
+/// the pair moves the table alike (table_motion_overlap) no test is searched:
 /// the verdict says why. Throws InvalidArgument naming the option for a pair that is not two
 /// different effects of the machine, empty grids, or non-positive limits.
 SeparationDesign design_ballbar_separation(const BallbarSession& session,
                                            const std::vector<Effect>& pair,
                                            const SeparationOptions& options = {});
-
-/// Joint fit of several ballbar sessions of one machine (e.g. a session and the test added to
-/// it): location errors and the effects shared, one pivot per distinct nominal pivot (sessions
-/// with the same nominal pivot share it: the ball stayed in its cup), lengths by the exact
-/// model (model.hpp) with Jets. Parameters: 8 location errors, then pivot x, y, z of each
-/// distinct pivot in order of first use ("pivot_x#k"), then the effect parameters. White least
-/// squares; the covariance is (J^T J)^-1 s^2. Throws InvalidArgument for no session, mixed machines
-/// or an effect that does not exist on the machine.
-JointFitOutcome identify_joint_sessions(const std::vector<BallbarSession>& sessions,
-                                        const EffectModel& effects);
 
 }  // namespace rotacal

@@ -47,6 +47,12 @@ struct MultiSessionInput {
   std::shared_ptr<const BallbarSession> ballbar;
   std::shared_ptr<const RtestSession> rtest;
   std::shared_ptr<const ProbeSession> probe;
+  /// Empty, or the name of an earlier session of the same instrument whose set-up this one
+  /// continues with nothing moved between them (a test added to a session with the ball left in
+  /// its cup, a nest whose label and fixture stayed): the two share their own parameters of the
+  /// same name (the pivot; the probe zero of a nest of that label; the sphere) instead of
+  /// fitting one each.
+  std::string same_setup_as;
 
   static MultiSessionInput of(std::string name, BallbarSession session);
   static MultiSessionInput of(std::string name, RtestSession session);
@@ -102,7 +108,8 @@ struct MultiDisagreement {
 /// What one session contributes.
 struct MultiSessionResult {
   std::string name, instrument;
-  std::vector<ParameterEstimate> nuisances;  ///< its own parameters in the joint fit
+  /// Its own parameters in the joint fit (those shared by same_setup_as included).
+  std::vector<ParameterEstimate> nuisances;
   std::vector<ParameterEstimate> alone;  ///< its location errors (then shared effects) fitted alone
   NoiseModel noise;                      ///< noise model of its residuals alone
   /// Degrees of freedom of its sigmas alone: the noise model's effective samples less the
@@ -117,7 +124,8 @@ struct MultiSessionResult {
 /// The joint identification, an Identification (core/identification.hpp) whose parameter
 /// vector holds the blocks "location_errors" (the one shared set), "effects" (the shared
 /// catalogue effects' parameters, empty unless asked) and then one block per session, named
-/// after it, of its own parameters ("name:parameter"). Its covariance, residuals (the sessions'
+/// after it, of its own parameters ("name:parameter"; a session with same_setup_as holds only
+/// those its earlier session has not). Its covariance, residuals (the sessions'
 /// rows back to back), unobservable combinations, notes and solver figures are the joint fit's;
 /// `noise` is left white: each session has its own (MultiSessionResult::noise).
 struct MultiIdentification : Identification {
@@ -139,7 +147,8 @@ struct MultiIdentification : Identification {
 };
 
 /// The joint identification. Throws InvalidArgument for fewer than two sessions, sessions of
-/// different machine types (naming them), a session without data, or repeated names.
+/// different machine types (naming them), a session without data, repeated names, or a
+/// same_setup_as that names no earlier session of the same instrument.
 MultiIdentification identify_multi(const std::vector<MultiSessionInput>& sessions,
                                    const MultiFitOptions& options = {});
 

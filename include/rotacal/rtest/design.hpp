@@ -128,19 +128,12 @@ struct RtestSeparationDesign : SeparationResult {
 /// below options.max_correlation, and the predicted 1 sigma afterwards; or, when the pair moves
 /// the table alike (table_motion_overlap), why no test can. The session's noise (sigma and
 /// effective samples per reading) comes from the R-test joint fit's noise model (identify_joint
-/// with its default maps). Throws InvalidArgument naming the option for a pair that is not two
-/// different effects of the machine, empty grids, a session without displacements, or
+/// with its default maps); the session and the nest as run are fitted together by
+/// identify_multi (multi/identify.hpp). Throws InvalidArgument naming the option for a pair that is
+/// not two different effects of the machine, empty grids, a session without displacements, or
 /// non-positive limits.
 RtestSeparationDesign design_rtest_separation(const RtestSession& session,
                                               const std::vector<Effect>& pair,
                                               const RtestSeparationOptions& options = {});
-
-/// Joint fit of an R-test session with catalogue effects instead of the smooth maps (e.g. a
-/// session and the nest added to it, as one session): 8 location errors, a probe zero per nest
-/// ("zero_x#N"), then the effects' parameters, readings d = T^-1 tool - q + zero of
-/// kinematics/effects.hpp with Jets. White least squares; covariance (J^T J)^-1 s^2. Throws
-/// InvalidArgument for a non-BC-trt session, a nest without position, a sample without d, or an
-/// effect that does not exist on the machine.
-JointFitOutcome identify_rtest_effects(const RtestSession& session, const EffectModel& effects);
 
 }  // namespace rotacal
