@@ -287,7 +287,7 @@ const std::vector<MachineDescription>& builtins() {
     const Eigen::Vector3d X = Eigen::Vector3d::UnitX(), Y = Eigen::Vector3d::UnitY(),
                           Z = Eigen::Vector3d::UnitZ(), O = Eigen::Vector3d::Zero();
     using Lim = std::optional<std::array<double, 2>>;
-    const Lim tilt = std::array<double, 2>{-120.0, 120.0}, endless = std::nullopt;
+    const Lim endless = std::nullopt;
     const Lim swivel = std::array<double, 2>{-110.0, 110.0};
     Eigen::Matrix<double, 3, 2> trt, head;
     trt << -400, 400, -300, 300, -300, 400;
