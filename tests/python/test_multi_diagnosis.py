@@ -103,9 +103,15 @@ def test_a_shared_sag_is_ranked_first_with_more_weight_than_either_session_gives
     alone = [group(first(rotacal.diagnose(s, hold_by_weight=True).to_dict())) for s in (bb, pr)]
     for g in alone:
         assert len(g) >= 3 and "gravity_sag_A" in g, g
-    f = first(rotacal.diagnose([bb, pr], hold_by_weight=True).to_dict())
+    d = rotacal.diagnose([bb, pr], hold_by_weight=True).to_dict()
+    f = first(d)
     g = group(f)
     assert f["effect"] == "gravity_sag_A" and f["where"] == "machine", f
+    # Issue 50 item 5: the design command of each instrument, after its own session.
+    (say,) = [a["separating_test"] for a in d["ambiguous"] if "gravity_sag_A" in a["effects"]][:1]
+    assert "none of these sessions' tests" in say and "ballbar|rtest" not in say, say
+    assert "`rotacal design ballbar --separate " in say and "of session ballbar)" in say, say
+    assert "`rotacal design probe --separate " in say and "of session probe)" in say, say
     assert g["gravity_sag_A"] == max(g.values()), g
     assert g["gravity_sag_A"] > max(a["gravity_sag_A"] for a in alone) + 0.2, (g, alone)
     # Each session rules out members of the other's group: fewer members than either alone.
