@@ -83,8 +83,10 @@ def one_draw(kind, machine, truth, params, seed, tmp: Path) -> str:
     for pair in deciding_pairs(f):
         out = ["--session", template] if kind == "rtest" else ["-o", added]
         r = cli("design", kind, "--separate", ",".join(pair), "--after", s_path, "--json", *out)
-        if r.returncode == 0:
-            all_nested = all_nested and not json.loads(r.stdout)["separable"]
+        if r.returncode != 0:  # a failed design is no verdict on the pair: counted apart
+            print(f"  seed {seed}: design failed: {r.stderr.strip()}", file=sys.stderr)
+            return "design-failed"
+        all_nested = all_nested and not json.loads(r.stdout)["separable"]
         if template.exists():
             break
     if not template.exists():
@@ -116,7 +118,9 @@ def nested(kind, a, b, s_path) -> bool:
     key = (kind, frozenset((a, b)))
     if key not in _NESTED:
         r = cli("design", kind, "--separate", f"{a},{b}", "--after", s_path, "--json")
-        _NESTED[key] = r.returncode == 0 and not json.loads(r.stdout)["separable"]
+        if r.returncode != 0:
+            raise SystemExit(f"design {kind} --separate {a},{b} failed: {r.stderr.strip()}")
+        _NESTED[key] = not json.loads(r.stdout)["separable"]
     return _NESTED[key]
 
 
@@ -159,7 +163,9 @@ def main() -> None:
                 counts[one_draw(kind, machine, truth, params, seed, Path(tmp))] += 1
         n = sum(counts.values())
         amb = n - counts["not-ambiguous"]
-        predicted = amb - counts["ambiguous-nested"] - counts["ambiguous-none"]
+        predicted = (
+            amb - counts["ambiguous-nested"] - counts["ambiguous-none"] - counts["design-failed"]
+        )
         print(
             f"{kind} {machine} {truth} {params}: {n} draws, {amb} ambiguous, "
             f"{counts['ambiguous-nested']} nested, {predicted} predicted separable "
@@ -167,7 +173,7 @@ def main() -> None:
             f"left with only members nested with the truth {counts['nested-held']} (the model "
             f"holding the truth) + {counts['nested-other']} (another), "
             f"group {counts['group']}, nothing {counts['nothing']}, wrong {counts['wrong']}, "
-            f"refused {counts['refused']} "
+            f"refused {counts['refused']}, design failed {counts['design-failed']} "
             f"({time.perf_counter() - t0:.1f} s)"
         )
         o = OTHER[(kind, machine, truth)]
