@@ -121,6 +121,16 @@ BENCHMARKS: dict[str, tuple[str, str, str]] = {
         "together.",
         "{py} bench/multi_diagnosis_pairs.py --figures --draws 20",
     ),
+    "diagnosis_loop": (
+        "The loop of an ambiguous diagnosis: the deciding test designed, measured and used",
+        "A session of the reference simulator (AR(1) 0.5 noise of 0.5 um, one hidden effect) "
+        "whose diagnosis gives a group holding the truth: the deciding test designed by "
+        "`rotacal design KIND --separate X,Y --after S`, measured on the same machine and "
+        "diagnosed with S; where no test of the instrument decides, the touch probe's standard "
+        "poses on the same machine too. Counts per cell, nested members (no test can separate "
+        "them, the model rule decides) apart.",
+        "{py} bench/diagnosis_loop.py --draws 20",
+    ),
     "table_residual_bench": (
         "Compensation tables: what each controller's tables leave over the travel",
         "A model with a worm-gear C, C run-out, face runout and wobble and a sagging A, exported "

@@ -22,7 +22,8 @@ void bind_multi_diagnosis(pyb::module_& m) {
   pyb::class_<MultiDiagnosis>(m, "MultiDiagnosis")
       .def_readonly("diagnosis", &MultiDiagnosis::diagnosis)
       .def_readonly("sessions", &MultiDiagnosis::sessions)
-      .def_readonly("where", &MultiDiagnosis::where);
+      .def_readonly("where", &MultiDiagnosis::where)
+      .def_readonly("notes", &MultiDiagnosis::notes);
   m.def("is_machine_effect", &is_machine_effect, pyb::arg("effect"),
         "True for an effect of the machine (one parameter set shared by every session).");
   m.def(

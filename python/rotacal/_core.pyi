@@ -1826,6 +1826,9 @@ class MultiDiagnosis:
     def diagnosis(self) -> Diagnosis:
         ...
     @property
+    def notes(self) -> list[str]:
+        ...
+    @property
     def sessions(self) -> list[MultiDiagnosisSession]:
         ...
     @property

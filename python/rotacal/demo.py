@@ -85,7 +85,46 @@ def loop_section(loop: dict) -> str:
             f"<tr><td class=l>{escape(name)}</td>"
             f"<td>{escape(units.estimate_text(p['value'], p['std'], p['unit']))}</td></tr>"
         )
-    out.append("</table></section>")
+    out.append("</table>")
+    if loop.get("other_instrument"):
+        out.append(_probe_step_html(loop["other_instrument"]))
+    out.append("</section>")
+    return "\n".join(out)
+
+
+def _probe_step_html(o: dict) -> str:
+    """The report's part of probe_step: the probe test, the three sessions together, the cause,
+    each session's RMS and the location errors of the final model."""
+    from html import escape
+
+    from . import units
+
+    f = o["finding"]
+    if f is None:
+        what = "nothing significant"
+    elif f["named"]:
+        what = f"{escape(f['effect'])} alone (weight {f['weight']:.2f}), for {escape(f['where'])}"
+    else:
+        what = "still one of " + escape(", ".join(g["effect"] for g in f["group"]))
+    out = [
+        f"<p>6. No added ballbar test separates what is left; the machine's other instrument: "
+        f"{escape(o['test'])}, simulated on the same machine. The three sessions together: "
+        f"{what}.</p>",
+        "<table><tr><th class=l>Session</th><th>RMS before</th><th>RMS after</th></tr>",
+    ]
+    for x in o["sessions"]:
+        out.append(
+            f"<tr><td class=l>{escape(x['name'])}</td><td>{x['residual_rms_before_um']:.3f} &micro;m</td>"
+            f"<td>{x['residual_rms_after_um']:.3f} &micro;m</td></tr>"
+        )
+    out.append("</table><p>7. Location errors of the final model (the three sessions):</p>")
+    out.append("<table><tr><th class=l>Error</th><th>Value</th></tr>")
+    for name, p in o["location_errors"].items():
+        out.append(
+            f"<tr><td class=l>{escape(name)}</td>"
+            f"<td>{escape(units.estimate_text(p['value'], p['std'], p['unit']))}</td></tr>"
+        )
+    out.append("</table>")
     return "\n".join(out)
 
 
@@ -123,7 +162,59 @@ def close_the_loop(
     loop["sessions"] = joint["sessions"]
     loop["location_errors"] = joint["final_model"]["location_errors"]
     loop["final_model"] = joint["final_model"]
+    if f is not None and not f["named"] and _separable_left(f, tried):
+        sessions = [("session", session), ("added_test", added_session)]
+        loop["other_instrument"] = probe_step(setup, truth, sessions, seed, out)
     return loop
+
+
+def _separable_left(finding: dict, tried: list[dict]) -> bool:
+    """True where the group still holds a pair not known to be nested (no ballbar design said
+    their table motions are the same): another instrument may separate it."""
+    from .deciding_test import group_members
+
+    nested = {frozenset(t["pair"]) for t in tried if t["same_motion"]}
+    members = group_members(finding)
+    return any(
+        frozenset((a, b)) not in nested for i, a in enumerate(members) for b in members[i + 1 :]
+    )
+
+
+def probe_step(setup: Any, truth: dict, sessions: list, seed: int, out: Path) -> dict:
+    """The machine's other instrument where no added ballbar test separates what is left (issue
+    50 item 2): a machine effect is shared by every session of the machine, so the touch probe's
+    standard poses (`rotacal plan probe`: its default cross, a sphere of its own set-up) are
+    simulated on the same machine and diagnosed with the ballbar sessions."""
+    from .probe import simulate_probe
+
+    m = setup.machine
+    poses, _ = _core.default_probe_poses_deg(m)
+    sphere = (150.0, 0.0, 80.0)  # plan probe's default sphere position
+    write_output(out / "probe_test.ngc", _core.write_probe_nc_program(m, "linuxcnc", poses, sphere))
+    names = list(_core.location_error_names(m))
+    rng = np.random.default_rng(seed + 2)
+    probe_session, _ = simulate_probe(
+        m,
+        [truth["errors"][n] for n in names],
+        truth["effects"],
+        sphere_offset=rng.normal(0.0, 0.01, 3),  # the sphere's own set-up error
+        noise_um=truth["noise_um"],
+        seed=seed + 2,
+        sphere=sphere,
+    )
+    save(probe_session, out / "probe_test.csv")
+    joint = diagnose([*sessions, ("probe_test", probe_session)]).to_dict()
+    _write_json(out / "loop_probe_diagnosis.json", joint)
+    f = joint["findings"][0] if joint["findings"] else None
+    return {
+        "test": f"touch probe, {len(poses)} poses (plan probe's default), sphere "
+        + ", ".join(f"{v:g}" for v in sphere)
+        + " mm",
+        "session": str(out / "probe_test.csv"),
+        "finding": f,
+        "sessions": joint["sessions"],
+        "location_errors": joint["final_model"]["location_errors"],
+    }
 
 
 def _write_json(path: Path, data: object) -> None:

@@ -80,6 +80,8 @@ class MultiDiagnosisResult:
             }
             for s in self.raw.sessions
         ]
+        # A session not fitted alone (a one-pose probe test joined to the session before it)
+        out["session_notes"] = list(self.raw.notes)
         return out
 
 
@@ -96,6 +98,8 @@ def print_several(d: dict) -> None:
             "the machine (every session)" if f["where"] == "machine" else f"session {f['where']}"
         )
         print(f"finding {i} holds for {where}")
+    for note in d.get("session_notes", []):
+        print(f"note: {note}")
     print("sessions: residual RMS before -> after the findings")
     for s in d["sessions"]:
         print(

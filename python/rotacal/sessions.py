@@ -167,14 +167,22 @@ def load(path: str | Path, format: str | None = None) -> Session:
 
 
 def check_plausible(
-    session: Session, source: str = "<session>", max_deviation_mm: float | None = None
+    session: Session,
+    source: str = "<session>",
+    max_deviation_mm: float | None = None,
+    rotary_axes_may_rest: bool = False,
 ) -> Any:
     """Check a session against the nominal kinematics before any fit (C++ session/plausibility):
     refuses, with the likely cause named ("angles look like radians", "lengths look like
     inches", "all rotary angles equal", a wrong L0, ...), a session no machine with realistic
     errors can have produced. ``max_deviation_mm`` widens the limit on ``|measured - nominal|`` of
-    a ballbar length or of an R-test centre for an unusual session. Returns the report."""
+    a ballbar length or of an R-test centre for an unusual session. ``rotary_axes_may_rest``:
+    a session whose rotary axes never move is not refused for it (the one-pose added test of a
+    diagnosis of several sessions, joined to the session it was designed after). Returns the
+    report."""
     opts = _core.PlausibilityOptions()
+    if rotary_axes_may_rest:
+        opts.min_rotary_span_deg = 0.0
     if max_deviation_mm is not None:
         if not (0.0 < max_deviation_mm <= 1000.0):
             raise _core.InvalidArgument(

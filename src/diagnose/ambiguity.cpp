@@ -2,20 +2,54 @@
 // Wording of ambiguities: which test of the standard set-up separates two candidates that
 // explain this session's residuals equally well.
 #include <Eigen/SVD>
+#include <algorithm>
 #include <map>
 #include <set>
 #include <sstream>
 
+#include "rotacal/diagnose/multi_session.hpp"
 #include "scoring.hpp"
 
 namespace rotacal::diagnosis_detail {
 
+namespace {
+
+// Several sessions: the design command of each instrument among them, after one of its own
+// sessions (the design reads one session). A machine effect is shared by every session of the
+// machine, so a test of any of them may decide.
+std::string several_sessions_design(const MultiDiagnosisProblem& M, const std::string& pair) {
+  std::vector<std::pair<std::string, std::string>> by_instrument;  // instrument, its sessions
+  for (std::size_t k = 0; k < M.num_sessions(); ++k) {
+    const std::string instrument = M.session(k).problem->instrument(), name = M.session(k).name;
+    auto it = std::find_if(by_instrument.begin(), by_instrument.end(),
+                           [&](const auto& x) { return x.first == instrument; });
+    if (it == by_instrument.end())
+      by_instrument.push_back({instrument, name});
+    else
+      it->second += " or " + name;
+  }
+  std::string out;
+  for (const auto& [instrument, names] : by_instrument)
+    out += (out.empty() ? "" : ", or ") + std::string("`rotacal design ") + instrument +
+           " --separate " + pair + " --after SESSION` (SESSION: the file of session " + names + ")";
+  return out;
+}
+
+}  // namespace
+
 std::string separating_test(const DiagnosisProblem& P, const ModelFit& fit, const Score& a,
                             const Score& b, double sigma_mm) {
   // The design command of this session's own instrument (issue 50 item 5: a probe user was told
-  // to run `rotacal design ballbar|rtest`).
-  const std::string design = "`rotacal design " + P.instrument() + " --separate " + a.effect.id() +
-                             "," + b.effect.id() + " --after SESSION`";
+  // to run `rotacal design ballbar|rtest`), and of each instrument of several sessions.
+  const std::string pair = a.effect.id() + "," + b.effect.id();
+  const auto* several = dynamic_cast<const MultiDiagnosisProblem*>(&P);
+  const std::string design =
+      several ? several_sessions_design(*several, pair)
+              : "`rotacal design " + P.instrument() + " --separate " + pair + " --after SESSION`";
+  if (several)
+    return "none of these sessions' tests separates them; " + design +
+           " proposes the test that does, or says why none can (a machine effect is shared by "
+           "every session of the machine: a test of any of their instruments may decide)";
   if (P.reference_groups().empty())
     return "none of this session's tests separates them; " + design +
            " proposes the test that does, or says why none can";

@@ -12,17 +12,21 @@
 #include "rotacal/diagnose/ballbar_diagnosis.hpp"
 #include "rotacal/diagnose/probe_diagnosis.hpp"
 #include "rotacal/diagnose/rtest_diagnosis.hpp"
+#include "rotacal/probe/problem.hpp"
 
 namespace rotacal {
 
 DiagnosisSession DiagnosisSession::of(std::string name, BallbarSession session) {
-  return {std::move(name), std::make_shared<const BallbarDiagnosisProblem>(std::move(session))};
+  return {std::move(name), std::make_shared<const BallbarDiagnosisProblem>(std::move(session)),
+          nullptr};
 }
 DiagnosisSession DiagnosisSession::of(std::string name, RtestSession session) {
-  return {std::move(name), std::make_shared<const RtestDiagnosisProblem>(std::move(session))};
+  return {std::move(name), std::make_shared<const RtestDiagnosisProblem>(std::move(session)),
+          nullptr};
 }
 DiagnosisSession DiagnosisSession::of(std::string name, ProbeSession session) {
-  return {std::move(name), std::make_shared<const ProbeDiagnosisProblem>(std::move(session))};
+  auto touches = std::make_shared<const ProbeSession>(std::move(session));
+  return {std::move(name), std::make_shared<const ProbeDiagnosisProblem>(*touches), touches};
 }
 
 bool is_machine_effect(const Effect& e) {
@@ -54,9 +58,7 @@ bool is_parameter_of(const std::string& name, const std::string& id) {
 }
 
 void check_sessions(const std::vector<DiagnosisSession>& sessions) {
-  if (sessions.size() < 2)
-    throw InvalidArgument("diagnose: a diagnosis of several sessions needs at least two, got " +
-                          std::to_string(sessions.size()));
+  if (sessions.empty()) throw InvalidArgument("diagnose: no session to diagnose");
   std::set<std::string> names;
   for (const DiagnosisSession& s : sessions) {
     if (!s.problem) throw InvalidArgument("diagnose: session " + s.name + " holds no data");
@@ -81,6 +83,64 @@ void check_sessions(const std::vector<DiagnosisSession>& sessions) {
                             " is " + to_string(m) + ", " + s.name + " is " + to_string(ms) +
                             "; a diagnosis of several sessions is of one machine");
   }
+}
+
+bool same_sphere(const ProbeSession& a, const ProbeSession& b) {
+  return (a.sphere - b.sphere).norm() < 1e-6 &&
+         std::abs(a.sphere_diameter - b.sphere_diameter) < 1e-9 &&
+         std::abs(a.stylus_diameter - b.stylus_diameter) < 1e-9;
+}
+
+// A touch-probe session with no more touches than its own unknowns (location errors, sphere:
+// the one pose `design probe --after S` may propose) cannot be fitted alone, and with a sphere
+// of its own it would tell nothing. The design counted on the sphere staying on the table, so
+// its touches join the last earlier probe session of the same sphere as its continuation: times
+// after that session's (one mean touch spacing on), pose labels prefixed where they repeat.
+std::vector<std::string> join_continuations(std::vector<DiagnosisSession>& sessions) {
+  std::vector<std::string> notes;
+  for (std::size_t k = 0; k < sessions.size();) {
+    const std::shared_ptr<const ProbeSession> added = sessions[k].probe;
+    if (!added || added->samples.empty()) {
+      ++k;
+      continue;
+    }
+    const ProbeProblem alone(*added);
+    if (alone.num_residuals() > alone.num_parameters()) {
+      ++k;
+      continue;
+    }
+    std::size_t j = k;
+    for (std::size_t i = 0; i < k; ++i)
+      if (sessions[i].probe && same_sphere(*sessions[i].probe, *added)) j = i;
+    const std::string counts = std::to_string(alone.num_residuals()) + " touches for " +
+                               std::to_string(alone.num_parameters()) + " unknowns";
+    if (j == k)
+      throw InvalidArgument(
+          "diagnose: session " + sessions[k].name + " cannot be fitted alone (" + counts +
+          ") and no earlier touch-probe session of the same sphere (nominal centre and "
+          "diameters) precedes it to continue; give the session it was designed after first");
+    ProbeSession joined = *sessions[j].probe;
+    const std::vector<std::string> labels = joined.poses();
+    const double first = joined.samples.front().time, last = joined.samples.back().time;
+    const double spacing =
+        joined.samples.size() > 1 ? (last - first) / double(joined.samples.size() - 1) : 1.0;
+    const double shift = std::max(0.0, last + spacing - added->samples.front().time);
+    for (ProbeSample t : added->samples) {
+      if (std::find(labels.begin(), labels.end(), t.pose) != labels.end())
+        t.pose = sessions[k].name + ":" + t.pose;
+      t.time += shift;
+      joined.samples.push_back(std::move(t));
+    }
+    notes.push_back("session " + sessions[k].name + " is not fitted alone (" + counts +
+                    "): its touches are diagnosed as a continuation of session " +
+                    sessions[j].name +
+                    " (the sphere not moved between them, as `rotacal design probe --after` "
+                    "assumes), its times shifted by " +
+                    std::to_string(static_cast<long long>(std::lround(shift))) + " s");
+    sessions[j] = DiagnosisSession::of(sessions[j].name, std::move(joined));
+    sessions.erase(sessions.begin() + static_cast<std::ptrdiff_t>(k));
+  }
+  return notes;
 }
 
 }  // namespace
@@ -365,10 +425,16 @@ std::vector<Eigen::MatrixXd> MultiDiagnosisProblem::candidate_jacobians(
 
 MultiDiagnosis diagnose_sessions(std::vector<DiagnosisSession> sessions,
                                  const DiagnosisOptions& options) {
+  if (sessions.size() < 2)
+    throw InvalidArgument("diagnose: a diagnosis of several sessions needs at least two, got " +
+                          std::to_string(sessions.size()));
+  check_sessions(sessions);
+  std::vector<std::string> notes = join_continuations(sessions);
   const MultiDiagnosisProblem P(std::move(sessions));
   DiagnosisOptions o = options;
   o.noise.pool_by_session = true;  // each instrument its own AR coefficients
   MultiDiagnosis out;
+  out.notes = std::move(notes);
   out.diagnosis = diagnose(P, o);
   const Diagnosis& D = out.diagnosis;
   const auto rms_um = [](const Eigen::VectorXd& r) {

@@ -85,6 +85,51 @@ def demo_loop_checks(out: Path, stdout: str) -> None:
     assert f["where"] == "machine" and {"gravity_sag_A", "radial_motion_A_h2"} & group, f
     for x in j["sessions"]:
         assert x["residual_rms_after_um"] < 0.6, x
+    demo_probe_step_checks(out, stdout, model, rng, added)
+
+
+def demo_probe_step_checks(out: Path, stdout: str, model, rng, added: Path) -> None:
+    """The loop's step to the other instrument: no added ballbar test separates the sag from
+    radial_motion_A_h3, so the demo ran the probe's standard poses on the same machine. Those
+    poses (from the demo's probe_test.csv) re-simulated by refsim on the machine of truth.json
+    (the sphere with its own set-up error, white noise), diagnosed with the ballbar sessions: the
+    sag first by weight, for the machine, radial_motion_A_h3 ruled out; only radial_motion_A_h2,
+    of which the sag is a special case (no test separates them), may stay beside it."""
+    import numpy as np
+    from multi_diagnosis_data import refsim, template_poses, writers
+
+    import rotacal
+
+    loop = json.loads((out / "loop.json").read_text())
+    o = loop["other_instrument"]
+    assert "no added ballbar test separates what is left; the other instrument: touch probe" in (
+        stdout
+    )
+    assert "the three sessions together: " in stdout
+    assert "location errors of the final model (the three sessions):" in stdout
+    assert [x["name"] for x in o["sessions"]] == ["session", "added_test", "probe_test"]
+    t = template_poses(out / "probe_test.csv")
+    actual = t["sphere"] + rng.normal(0, 0.01, 3)
+    latched = refsim.probe_touches(
+        model, actual, t["sphere"], 25.0, 6.0, t["n"], np.radians(t["angles_deg"]), t["time"]
+    )
+    n = t["n"] / np.linalg.norm(t["n"], axis=1, keepdims=True)
+    latched = latched + rng.normal(0, 0.5e-3, len(latched))[:, None] * n
+    pr = writers.write_probe(
+        out / "probe_refsim.csv", refsim.builtin("AC-trt"), t, latched, 25.0, 6.0, noise_um=0.5
+    )
+    j = rotacal.diagnose(
+        [
+            ("session", rotacal.load(out / "session.csv")),
+            ("added", rotacal.load(added)),
+            ("probe", rotacal.load(pr)),
+        ]
+    ).to_dict()
+    f = j["findings"][0]
+    weights = {g["effect"]: g["weight"] for g in f["group"]}
+    assert f["where"] == "machine" and max(weights, key=weights.get) == "gravity_sag_A", f
+    assert set(weights) <= {"gravity_sag_A", "radial_motion_A_h2"}, weights
+    assert f["effect"] == "gravity_sag_A", f  # the result model holds the hidden cause
 
 
 def test_demo_finds_the_hidden_effect(tmp_path):

@@ -103,9 +103,15 @@ def test_a_shared_sag_is_ranked_first_with_more_weight_than_either_session_gives
     alone = [group(first(rotacal.diagnose(s, hold_by_weight=True).to_dict())) for s in (bb, pr)]
     for g in alone:
         assert len(g) >= 3 and "gravity_sag_A" in g, g
-    f = first(rotacal.diagnose([bb, pr], hold_by_weight=True).to_dict())
+    d = rotacal.diagnose([bb, pr], hold_by_weight=True).to_dict()
+    f = first(d)
     g = group(f)
     assert f["effect"] == "gravity_sag_A" and f["where"] == "machine", f
+    # Issue 50 item 5: the design command of each instrument, after its own session.
+    (say,) = [a["separating_test"] for a in d["ambiguous"] if "gravity_sag_A" in a["effects"]][:1]
+    assert "none of these sessions' tests" in say and "ballbar|rtest" not in say, say
+    assert "`rotacal design ballbar --separate " in say and "of session ballbar)" in say, say
+    assert "`rotacal design probe --separate " in say and "of session probe)" in say, say
     assert g["gravity_sag_A"] == max(g.values()), g
     assert g["gravity_sag_A"] > max(a["gravity_sag_A"] for a in alone) + 0.2, (g, alone)
     # Each session rules out members of the other's group: fewer members than either alone.
@@ -224,3 +230,42 @@ def test_the_added_nest_designed_after_an_rtest_session_is_diagnosed_with_it(tmp
     k = f["parameters"]["coning_B"]
     assert abs(k["value"] - 2.5e-5) < 3 * k["std"], k
     assert [x["name"] for x in d["sessions"]] == ["S", "added"]
+
+
+def test_a_one_pose_added_test_is_diagnosed_as_the_continuation_of_its_session(tmp_path):
+    """Issue 50 item 2, the bug the loop benchmark met: `design probe --after S` may propose one
+    pose (5 touches for 11 unknowns). Such a session cannot be fitted alone, and with a sphere of
+    its own it would tell nothing; the design counted on the sphere staying on the table. The
+    diagnosis of S and the added test (refsim, the sphere where it was) joins its touches to S,
+    says so, and the added pose rules out linear_scale_Z, which S alone kept in its group. A
+    one-pose session with no probe session of its sphere before it is refused, naming it."""
+    seed = 310
+    errors = machine_errors(AC, seed)
+    fx = {"gravity_sag_A": [0.0055]}
+    actual = [140.004, -10.012, 75.021]
+    s, s_path = probe(tmp_path, AC, errors, fx, seed, actual=actual, name="S.csv")
+    alone = first(rotacal.diagnose(s).to_dict())
+    assert not alone["named"] and "linear_scale_Z" in group(alone), alone
+    r = run_cli(
+        "design", "probe", "--separate", "linear_scale_Z,gravity_sag_A", "--after", s_path,
+        "-o", tmp_path / "added.ngc",
+    )  # fmt: skip
+    assert r.returncode == 0, r.stderr
+    poses = template_poses(tmp_path / "added.csv")
+    assert len(set(poses["pose"])) == 1 and len(poses["time"]) == 5, poses["pose"]
+    _, added_path = probe(
+        tmp_path, AC, errors, fx, seed + 1000, poses_of=poses, actual=actual, name="added.csv"
+    )
+    r = run_cli("diagnose", s_path, added_path, "--json", "--no-progress")
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout)
+    assert [x["name"] for x in d["sessions"]] == ["S"], d["sessions"]
+    (note,) = d["session_notes"]
+    assert "session added is not fitted alone (5 touches" in note and "session S" in note, note
+    f = first(d)
+    g = group(f)
+    assert "gravity_sag_A" in g and f["where"] == "machine", d["findings"]
+    assert "linear_scale_Z" not in g, g
+    bb, bb_path = ballbar(tmp_path, AC, errors, fx, seed)
+    with pytest.raises(rotacal.InvalidArgument, match="session added cannot be fitted alone"):
+        rotacal.diagnose([("ballbar", bb), ("added", rotacal.load(added_path))])

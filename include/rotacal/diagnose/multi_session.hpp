@@ -42,6 +42,9 @@ struct ProbeSession;
 struct DiagnosisSession {
   std::string name;
   std::shared_ptr<const DiagnosisProblem> problem;
+  /// The touches of a touch-probe session (else null): a session too short to be fitted alone
+  /// joins an earlier one of the same sphere as its continuation (diagnose_sessions).
+  std::shared_ptr<const ProbeSession> probe;
 
   static DiagnosisSession of(std::string name, BallbarSession session);
   static DiagnosisSession of(std::string name, RtestSession session);
@@ -55,7 +58,7 @@ bool is_machine_effect(const Effect& e);
 /// The sessions stacked as one problem of the engine (see the file comment).
 class MultiDiagnosisProblem : public DiagnosisProblem {
  public:
-  /// Throws InvalidArgument for fewer than two sessions, repeated or empty names (or a name
+  /// Throws InvalidArgument for no session, repeated or empty names (or a name
   /// with ':'), or sessions of different machines (naming them).
   explicit MultiDiagnosisProblem(std::vector<DiagnosisSession> sessions);
 
@@ -127,9 +130,16 @@ struct MultiDiagnosis {
   std::vector<Session> sessions;  ///< in input order
   /// Where finding i holds: "machine" or the name of its session.
   std::vector<std::string> where;
+  /// What was done to a session before the diagnosis: a touch-probe session with fewer touches
+  /// than its own unknowns (the one-pose added test `design probe --after S` may propose) is not
+  /// fitted alone but joined to the earlier probe session of the same sphere, as its
+  /// continuation (the design's assumption: the sphere stays on the table).
+  std::vector<std::string> notes;
 };
 
-/// Diagnose several sessions of one machine together. Throws as MultiDiagnosisProblem does.
+/// Diagnose several sessions of one machine together. Throws as MultiDiagnosisProblem does, for
+/// fewer than two sessions, and for a probe session too short to be fitted alone with no
+/// earlier probe session of the same sphere (nominal centre and diameters) to continue.
 MultiDiagnosis diagnose_sessions(std::vector<DiagnosisSession> sessions,
                                  const DiagnosisOptions& options = {});
 

@@ -71,6 +71,27 @@ def print_loop(loop: dict) -> None:
     print("location errors of the final model (both sessions):")
     for name, p in loop["location_errors"].items():
         print(f"  {name} = {units.estimate_text(p['value'], p['std'], p['unit'])}")
+    o = loop.get("other_instrument")
+    if not o:
+        return
+    print(f"no added ballbar test separates what is left; the other instrument: {o['test']}")
+    g = o["finding"]
+    if g is None:
+        print("the three sessions together: nothing significant")
+        return
+    if g["named"]:
+        print(f"the three sessions together: {g['effect']} alone (weight {g['weight']:.2f})")
+    else:
+        print(f"the three sessions together: one of {group_text(g)}")
+    print(model_text(g))
+    for x in o["sessions"]:
+        print(
+            f"  {x['name']}: residual RMS {x['residual_rms_before_um']:.3f} -> "
+            f"{x['residual_rms_after_um']:.3f} um"
+        )
+    print("location errors of the final model (the three sessions):")
+    for name, p in o["location_errors"].items():
+        print(f"  {name} = {units.estimate_text(p['value'], p['std'], p['unit'])}")
 
 
 def cmd_table2(a: argparse.Namespace) -> int:

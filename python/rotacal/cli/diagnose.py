@@ -105,7 +105,7 @@ def cmd_diagnose(a: argparse.Namespace) -> int:
             "diagnosed to the terminal or --json"
         )
     sizes = None if several else budget_sizes(a.budget_sizes)  # refused before any work
-    sessions = [load_session(f, a) for f in a.file]
+    sessions = [load_session(f, a, several=several) for f in a.file]
     stems = [Path(f).stem for f in a.file]
     if not several:
         what = sessions[0]

@@ -11,7 +11,7 @@ from typing import Any, Sequence
 from .. import _core, jsontext, rtest
 from ..machines import BALLBAR_NOISE_UM, PIVOT_ERROR_MM
 from ..outputs import write_output
-from ..sessions import check_plausible, load
+from ..sessions import check_plausible, kind, load
 from .options import (
     SEED,
     OptionError,
@@ -361,12 +361,17 @@ def add_plausibility_arg(q: argparse.ArgumentParser) -> None:
 
 
 def load_session(
-    path: str, a: argparse.Namespace | None = None, circular_tests: bool = False
+    path: str,
+    a: argparse.Namespace | None = None,
+    circular_tests: bool = False,
+    several: bool = False,
 ) -> Any:
     """The session of ``path``; what its reader warned about (e.g. repeated rows) on stderr.
     With the command's arguments ``a``, the session is also checked against the nominal
     kinematics before any fit (--max-deviation widens the limit); ISO 230-4 circular tests
-    are refused unless the command reads them (``circular_tests``: `rotacal report`)."""
+    are refused unless the command reads them (``circular_tests``: `rotacal report`). A
+    touch-probe session of a diagnosis of ``several`` may hold one pose (an added test that
+    continues the session it was designed after: diagnose/multi_session.hpp)."""
     s = load(path)
     for w in s.warnings:
         say(f"rotacal: warning: {path}: {w}")
@@ -380,7 +385,8 @@ def load_session(
                 f"{shell_word(path)}` gives G, G(b), H and their causes, `rotacal report {shell_word(path)} -o OUT.html` the report"
             )
         if not is_circular(s):
-            check_plausible(s, path, getattr(a, "max_deviation", None))
+            rest = several and kind(s) == "probe"
+            check_plausible(s, path, getattr(a, "max_deviation", None), rotary_axes_may_rest=rest)
     return s
 
 
