@@ -224,7 +224,15 @@ UncertaintyBudget budget_detail::budget_of(const BudgetedFit& m,
       if (free_index[static_cast<std::size_t>(j)] >= 0) cols.push_back(j);
     cov_a = (*m.covariance)(cols, cols);
   } else {
-    Eigen::JacobiSVD<Eigen::MatrixXd> svd_w(whiten(J), Eigen::ComputeThinV);
+    // J_w = Q R in place, then the SVD of the small R: J_w's singular values and V, without
+    // the SVD's own two n x f copies (352 MB of a 1,000,000-reading session's budget).
+    Eigen::MatrixXd J_w = whiten(J);
+    const Eigen::HouseholderQR<Eigen::Ref<Eigen::MatrixXd>> qr_w(J_w);
+    const Eigen::Index f = J.cols();
+    const Eigen::MatrixXd R_w =
+        J_w.rows() >= f ? Eigen::MatrixXd(qr_w.matrixQR().topRows(f).triangularView<Eigen::Upper>())
+                        : Eigen::MatrixXd(qr_w.matrixQR().triangularView<Eigen::Upper>());
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd_w(R_w, Eigen::ComputeThinV);
     Eigen::VectorXd inv_s = svd_w.singularValues();
     for (Eigen::Index i = 0; i < inv_s.size(); ++i)
       inv_s[i] = inv_s[i] > 1e-12 * inv_s[0] ? 1.0 / inv_s[i] : 0.0;
@@ -235,18 +243,23 @@ UncertaintyBudget budget_detail::budget_of(const BudgetedFit& m,
   // Unweighted least squares (what the fits do): bias = pinv(J) J_effect delta, by J's thin Q
   // formed once: each candidate then costs two products with it, where a decomposition's solve
   // applies every reflector to the candidate's n rows.
-  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr_j(J);
   std::optional<Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>> ls;  // J rank-deficient
-  Eigen::MatrixXd Q_j;
-  if (qr_j.rank() < J.cols())
-    ls.emplace(J);
-  else
-    Q_j = qr_j.householderQ() * Eigen::MatrixXd::Identity(J.rows(), J.cols());
+  Eigen::MatrixXd Q_j, R_j;  // J P = Q_j R_j; the decomposition itself released
+  Eigen::PermutationMatrix<Eigen::Dynamic> P_j;
+  {
+    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr_j(J);
+    if (qr_j.rank() < J.cols()) {
+      ls.emplace(J);
+    } else {
+      Q_j = qr_j.householderQ() * Eigen::MatrixXd::Identity(J.rows(), J.cols());
+      R_j = qr_j.matrixR().topLeftCorner(J.cols(), J.cols()).triangularView<Eigen::Upper>();
+      P_j = qr_j.colsPermutation();
+    }
+  }
   const auto bias_of = [&](const Eigen::MatrixXd& Jc) -> Eigen::MatrixXd {
     if (ls) return ls->solve(Jc);
     const Eigen::MatrixXd c = Q_j.transpose() * Jc;
-    return qr_j.colsPermutation() *
-           qr_j.matrixR().topLeftCorner(J.cols(), J.cols()).triangularView<Eigen::Upper>().solve(c);
+    return P_j * R_j.triangularView<Eigen::Upper>().solve(c);
   };
   const Eigen::VectorXd r_w = whiten(fit.residuals);
 
