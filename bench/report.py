@@ -77,6 +77,24 @@ BENCHMARKS: dict[str, tuple[str, str, str]] = {
         "Identification of a long recording, time and peak memory.",
         "{bin}/ballbar_long",
     ),
+    "long_session": (
+        "Long ballbar sessions as a user runs them: identify and diagnose, time and memory",
+        "`rotacal identify` with and without the uncertainty budget and `rotacal diagnose` on "
+        "reference-simulator sessions of 90,000 and 1,000,000 readings (15 min and 2.8 h at "
+        "100 Hz), each in its own process: wall and CPU time, peak memory and its bytes a "
+        "reading above `import rotacal` (issue 56: 90,000 identify <= 1 s and 150 MB; "
+        "1,000,000 identify <= 30 s, diagnose <= 10 min, <= 1 KB a reading).",
+        "{py} bench/long_session_budget.py --samples 90000,1000000 --diagnose "
+        "--keep /tmp/rotacal-long-sessions",
+    ),
+    "batch_throughput": (
+        "Batch: a confusion-grid slice on 1 and 2 local workers",
+        "The grid's first 2,000 sessions (AC-trt ballbar, white and pink noise) as a plain loop, "
+        "then through rotacal.batch on 1 and 2 local workers, with the same records all three "
+        "ways (issue 56: speed-up >= 1.8x on 2 cores, overhead per session <= 5 %). Needs an "
+        "idle computer.",
+        "{py} bench/batch_throughput.py --sessions 2000 --workers 1,2",
+    ),
     "realtime_bench": (
         "Real-time kinematics: forward and inverse per call",
         "The header-only evaluation of a fitted model with every catalogue term (49 effects), "

@@ -181,6 +181,15 @@ void bind_diagnosis_report(pyb::module_& m) {
       },
       pyb::arg("session"), pyb::arg("options") = DiagnosisOptions{},
       "Diagnose an R-test session (baseline: location errors and a probe zero per set-up).");
+  m.def(
+      "budget_diagnosis_ballbar",
+      [](const BallbarSession& session, const DiagnosisOptions& options) {
+        pyb::gil_scoped_release release;
+        return budget_diagnosis_ballbar(session, options);
+      },
+      pyb::arg("session"), pyb::arg("options") = DiagnosisOptions{},
+      "The diagnosis a budget rests on: a long session searched on a reduced design, what it "
+      "found diagnosed on every reading (diagnose/ballbar_diagnosis.hpp).");
 }
 
 }  // namespace

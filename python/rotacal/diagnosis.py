@@ -127,9 +127,21 @@ def uncertainty_budget(
 ) -> Any:
     """GUM / ISO/TR 230-9 budget of the location errors (diagnose/uncertainty_budget.hpp):
     type A from the noise model, type B per catalogue effect the diagnosed model leaves out.
-    Runs ``diagnose(session)`` if no diagnosis is given. ``sizes``: plausible_sizes() input."""
-    if diagnosis is None:
-        diagnosis = diagnose(session)
+    Runs ``diagnose(session)`` if no diagnosis is given (a ballbar session of more than 16,384
+    readings: its search on every k-th reading, _core.budget_diagnosis_ballbar). ``sizes``:
+    plausible_sizes() input."""
+    if diagnosis is None:  # a long ballbar session is searched on a reduced design
+        diagnosis = by_kind(
+            session,
+            {
+                BALLBAR: lambda: DiagnosisResult(
+                    _core.budget_diagnosis_ballbar(session, diagnosis_options())
+                ),
+                RTEST: lambda: diagnose(session),
+                PROBE: lambda: diagnose(session),
+            },
+            "uncertainty_budget",
+        )()
     o = plausible_sizes(sizes)
     return by_kind(
         session,

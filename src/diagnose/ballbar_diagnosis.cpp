@@ -255,4 +255,24 @@ Diagnosis diagnose_ballbar(BallbarSession session, const DiagnosisOptions& optio
   return diagnose(BallbarDiagnosisProblem(std::move(session), std::move(reference)), options);
 }
 
+Diagnosis budget_diagnosis_ballbar(const BallbarSession& session, const DiagnosisOptions& options,
+                                   std::size_t design_rows) {
+  const std::size_t n = session.samples.size();
+  if (design_rows == 0 || n <= 2 * design_rows) return diagnose_ballbar(session, options);
+  BallbarSession thin;  // the session's header, every k-th reading
+  thin.machine = session.machine;
+  thin.ballbar_length = session.ballbar_length;
+  thin.pivot = session.pivot;
+  thin.noise_um = session.noise_um;
+  const std::size_t k = (n + design_rows - 1) / design_rows;
+  thin.samples.reserve(n / k + 1);
+  for (std::size_t i = 0; i < n; i += k) thin.samples.push_back(session.samples[i]);
+  const Diagnosis searched = diagnose_ballbar(std::move(thin), options);
+  DiagnosisOptions on_all = options;
+  on_all.only.clear();
+  for (const Finding& f : searched.findings) on_all.only.push_back(f.effect.id());
+  if (on_all.only.empty()) on_all.max_findings = 0;  // only = {} would mean every candidate
+  return diagnose_ballbar(session, on_all);
+}
+
 }  // namespace rotacal

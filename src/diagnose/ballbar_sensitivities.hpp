@@ -68,12 +68,21 @@ class BallbarPlacesCache {
       if (it != known_.end()) return it->second;
     }
     auto made = std::make_shared<const BallbarPlaces>(make());
+    const auto values = static_cast<std::size_t>(made->d.size());
     std::lock_guard<std::mutex> lock(mutex_);
+    if (known_.count(key) || kept_values_ + values > kMaxKeptValues) return made;
+    kept_values_ += values;
     return known_.emplace(key, std::move(made)).first->second;
   }
 
+  /// Places are kept up to this many doubles (256 MB: every candidate's of a 90,000-reading
+  /// session), beyond that made again when asked: a 1,000,000-reading session's would fill
+  /// 1.3 GB (issue 56 bounds a long session at 1 KB a reading). Made or kept, they are equal.
+  static constexpr std::size_t kMaxKeptValues = std::size_t{32} << 20;
+
  private:
   std::mutex mutex_;
+  std::size_t kept_values_ = 0;
   std::map<std::string, std::shared_ptr<const BallbarPlaces>> known_;
 };
 

@@ -3,11 +3,13 @@
 // noise model, type B from the catalogue effects the final model leaves out.
 #include "rotacal/diagnose/uncertainty_budget.hpp"
 
+#include <Eigen/QR>
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
 
 #include "budget_detail.hpp"
 #include "rotacal/core/error.hpp"
@@ -152,10 +154,18 @@ namespace {
 // or the bound is no tighter.
 bool tighten_by_session(const Eigen::MatrixXd& perp_w, const Eigen::VectorXd& r_w,
                         std::vector<double>& a) {
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(perp_w, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  // perp_w = Q R: the SVD of the small R and Q^T r_w give what the SVD of perp_w would (its
+  // singular values and V, the estimate), without forming perp_w's n x p U, which cost the most
+  // of a long session's budget.
+  const Eigen::Index p = perp_w.cols();
+  if (p == 0 || perp_w.rows() < p) return false;
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(perp_w);
+  const Eigen::MatrixXd R = qr.matrixQR().topRows(p).triangularView<Eigen::Upper>();
+  const Eigen::VectorXd qt_r = (qr.householderQ().transpose() * r_w).head(p);
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(R, Eigen::ComputeFullU | Eigen::ComputeFullV);
   const Eigen::VectorXd s = svd.singularValues();
-  if (!s.size() || s[s.size() - 1] <= 1e-9 * std::max(1.0, s[0])) return false;
-  const Eigen::VectorXd est = svd.solve(r_w);
+  if (s[s.size() - 1] <= 1e-9 * std::max(1.0, s[0])) return false;
+  const Eigen::VectorXd est = svd.solve(qt_r);
   const Eigen::MatrixXd cov =
       svd.matrixV() * s.cwiseInverse().cwiseAbs2().asDiagonal() * svd.matrixV().transpose();
   bool tighter = false;
@@ -214,7 +224,15 @@ UncertaintyBudget budget_detail::budget_of(const BudgetedFit& m,
       if (free_index[static_cast<std::size_t>(j)] >= 0) cols.push_back(j);
     cov_a = (*m.covariance)(cols, cols);
   } else {
-    Eigen::JacobiSVD<Eigen::MatrixXd> svd_w(whiten(J), Eigen::ComputeThinV);
+    // J_w = Q R in place, then the SVD of the small R: J_w's singular values and V, without
+    // the SVD's own two n x f copies (352 MB of a 1,000,000-reading session's budget).
+    Eigen::MatrixXd J_w = whiten(J);
+    const Eigen::HouseholderQR<Eigen::Ref<Eigen::MatrixXd>> qr_w(J_w);
+    const Eigen::Index f = J.cols();
+    const Eigen::MatrixXd R_w =
+        J_w.rows() >= f ? Eigen::MatrixXd(qr_w.matrixQR().topRows(f).triangularView<Eigen::Upper>())
+                        : Eigen::MatrixXd(qr_w.matrixQR().triangularView<Eigen::Upper>());
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd_w(R_w, Eigen::ComputeThinV);
     Eigen::VectorXd inv_s = svd_w.singularValues();
     for (Eigen::Index i = 0; i < inv_s.size(); ++i)
       inv_s[i] = inv_s[i] > 1e-12 * inv_s[0] ? 1.0 / inv_s[i] : 0.0;
@@ -222,8 +240,27 @@ UncertaintyBudget budget_detail::budget_of(const BudgetedFit& m,
   }
   const double n_eff = W ? m.noise.effective_samples : static_cast<double>(n);
   const double dof_a = std::max(1.0, n_eff - static_cast<double>(J.cols()));
-  // Unweighted least squares (what the fits do): bias = pinv(J) J_effect delta.
-  const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> ls(J);
+  // Unweighted least squares (what the fits do): bias = pinv(J) J_effect delta, by J's thin Q
+  // formed once: each candidate then costs two products with it, where a decomposition's solve
+  // applies every reflector to the candidate's n rows.
+  std::optional<Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>> ls;  // J rank-deficient
+  Eigen::MatrixXd Q_j, R_j;  // J P = Q_j R_j; the decomposition itself released
+  Eigen::PermutationMatrix<Eigen::Dynamic> P_j;
+  {
+    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr_j(J);
+    if (qr_j.rank() < J.cols()) {
+      ls.emplace(J);
+    } else {
+      Q_j = qr_j.householderQ() * Eigen::MatrixXd::Identity(J.rows(), J.cols());
+      R_j = qr_j.matrixR().topLeftCorner(J.cols(), J.cols()).triangularView<Eigen::Upper>();
+      P_j = qr_j.colsPermutation();
+    }
+  }
+  const auto bias_of = [&](const Eigen::MatrixXd& Jc) -> Eigen::MatrixXd {
+    if (ls) return ls->solve(Jc);
+    const Eigen::MatrixXd c = Q_j.transpose() * Jc;
+    return P_j * R_j.triangularView<Eigen::Upper>().solve(c);
+  };
   const Eigen::VectorXd r_w = whiten(fit.residuals);
 
   struct Contribution {
@@ -240,7 +277,7 @@ UncertaintyBudget budget_detail::budget_of(const BudgetedFit& m,
     ROTACAL_ASSERT(i < candidates.size() && Jc.rows() == n);
     ++visited;
     const Effect& c = candidates[i];
-    const Eigen::MatrixXd B = ls.solve(Jc);  // d(free params) / d(effect params)
+    const Eigen::MatrixXd B = bias_of(Jc);  // d(free params) / d(effect params)
     std::vector<double> a = plausible_sizes(c, sizes, duration);
     // The session's own bound where it sees the effect, where it is tighter.
     const bool bounded = sizes.use_session_bounds && tighten_by_session(whiten(Jc - J * B), r_w, a);
