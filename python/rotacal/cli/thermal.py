@@ -207,6 +207,15 @@ def print_thermal(d: dict) -> None:
             else "unobservable"
         )
         print(f"lag {k}: tau = {tau}")
+    t = s["drift_test"]
+    if t["gains"]:
+        p = "p < 1e-300" if t["p_value"] == 0 else f"p = {t['p_value']:.3g}"
+        dof = f"F({t['gains']}, {t['residual_dof']:.0f})" if t["residual_dof"] else "chi-square"
+        print(
+            f"joint test of the {t['gains']} gains against 0 ({dof}): W = {t['statistic']:.1f}, "
+            f"{p}: "
+            + ("thermal drift found" if t["drift_found"] else f"no drift at {t['level']:g}")
+        )
     if s["no_significant_drift"]:
         print("no significant drift of any location error: tau rests on the noise alone")
     print(f"steady-state change after long turning at {s['tested_speed_rpm']:g} rev/min:")
