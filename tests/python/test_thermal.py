@@ -229,3 +229,18 @@ def test_thermal_options_refused_where_they_do_not_apply(shared_data):
     assert r.returncode == 3 and "--tolerance" in r.stderr
     r = run("identify", shared_data / "thermal_probe_ac.csv", "--monte-carlo", "5")
     assert r.returncode == 3 and "--monte-carlo: not for a thermal session" in r.stderr
+
+
+def test_diagnose_gives_a_thermal_finding_only_where_the_session_drifts(tmp_path, shared_data):
+    """`rotacal diagnose` of a thermal session adds the joint drift test (issue 53 item 4: a
+    session with no drift gives no thermal finding); its catalogue still pools the epochs."""
+    null = _refsim_session(tmp_path / "null.csv", [])
+    r = run("diagnose", null, "--no-budget", "--json")
+    assert r.returncode == 0, r.stderr
+    f = json.loads(r.stdout)["thermal"]
+    assert not f["drift_found"] and f["drift_test"]["gains"] == 11 and not f["significant"], f
+    assert "pooled" in f["baseline"]
+    text = run("diagnose", shared_data / "thermal_probe_ac.csv", "--no-budget")
+    assert text.returncode == 0, text.stderr
+    assert "thermal, axis C: joint test of the 11 gains" in text.stdout
+    assert "thermal drift found" in text.stdout and "E_X0C" in text.stdout
