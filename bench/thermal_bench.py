@@ -17,7 +17,8 @@ one factor, log-uniform in 0.5..2; 0.5 um white noise along each approach.
   identified alone, first draw);
 - null: no drift; a session whose joint drift test (summary's drift_test: all gains against 0
   with the fit's covariance, F at the noise model's dof, level 1 %) finds a drift is a false
-  finding; beside it the old rule (any gain beyond 3 sigma, one by one);
+  finding; beside it the old rule (any gain beyond 3 sigma, one by one); null_ar1 (not in the
+  default parts): the same with AR(1) 0.8 noise from touch to touch (the noise model's dof);
 - detection: the same test on drifting sessions, the gains x 0.5-2 (the issue's), x 0.02-0.05 and x 0.003-0.01;
 - two lags: tau2 = 4 tau1, K2 = 0.7 K1; named two-lag where BIC (n ln(RSS/n) + k ln n, k the
   observable parameters) of the two-lag fit is lower; one-lag sessions the same way;
@@ -264,19 +265,26 @@ def prediction(draws: int, rng, tmp: Path) -> None:
     print(f"draws where every error is within 2x its per-epoch sigma: {np.mean(ok):.1%}")
 
 
-def null(draws: int, rng, tmp: Path) -> None:
+def null(draws: int, rng, tmp: Path, rho: float = 0.0) -> None:
     t = shared_truth()
     found, one_by_one, pvals = 0, 0, []
     base = latched(t, [])
+    n = np.array([r[4] for r in ROWS])
     for d in range(draws):
-        f = write_session(tmp / "null.csv", noisy(base, rng))
+        touches = (
+            base + n * refsim.noise.ar1(["t"] * len(ROWS), rho, NOISE_MM, rng)[:, None]
+            if rho
+            else noisy(base, rng)
+        )
+        f = write_session(tmp / "null.csv", touches)
         s = identify(f, tolerance_mm=0.005)["summary"]
         found += s["drift_test"]["drift_found"]
         one_by_one += any(e.get("significant", False) for e in s["drifts"])
         pvals.append(s["drift_test"]["p_value"])
     level = s["drift_test"]["level"]
+    noise = f"AR(1) {rho:g} from touch to touch" if rho else "white"
     print(
-        f"null sessions (no drift): the joint drift test (F, level {level:g}) finds a drift in "
+        f"null sessions (no drift, {noise} noise): the joint drift test (F, level {level:g}) finds a drift in "
         f"{found}/{draws} ({found / draws:.1%}); a gain beyond 3 sigma, one by one: {one_by_one}/{draws}"
     )
     p = np.sort(pvals)
@@ -374,6 +382,7 @@ def main() -> None:
         "accuracy": accuracy,
         "prediction": prediction,
         "null": null,
+        "null_ar1": lambda k, rng, tmp: null(k, rng, tmp, rho=0.8),
         "detection": detection,
         "two_lags": two_lags,
     }

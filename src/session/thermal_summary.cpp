@@ -2,7 +2,6 @@
 // The thermal test's answers from its joint fit (session/thermal_summary.hpp).
 #include "rotacal/session/thermal_summary.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 
@@ -83,18 +82,19 @@ ThermalDriftTest thermal_drift_test(const ThermalIdentification& id, double leve
     g(a) = id.parameters[static_cast<std::size_t>(idx[a])].value;
     for (Eigen::Index b = 0; b < p; ++b) c(a, b) = id.covariance(idx[a], idx[b]);
   }
-  // Gains in mm and rad: the correlation matrix is what gets inverted, and directions its
-  // eigenvalues call singular (two lags nearly alike) are not tested.
+  // Gains in mm and rad: the correlation matrix R is what gets factored (pivoted LDLT, largest
+  // pivots first), and pivots it calls singular (two lags nearly alike) are not tested:
+  // W = sum over the kept pivots of y_i^2 / D_i, y = L^-1 P z.
   for (Eigen::Index a = 0; a < p; ++a) s(a) = std::sqrt(std::max(c(a, a), 0.0));
   if ((s.array() <= 0.0).any()) return t;
-  const Eigen::VectorXd z = g.cwiseQuotient(s);
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(
-      (c.array() / (s * s.transpose()).array()).matrix());
-  const double tiny = 1e-10 * eig.eigenvalues().maxCoeff();
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt((c.array() / (s * s.transpose()).array()).matrix());
+  const Eigen::VectorXd d = ldlt.vectorD();
+  const Eigen::VectorXd y =
+      ldlt.matrixL().solve(ldlt.transpositionsP() * Eigen::VectorXd(g.cwiseQuotient(s)));
+  const double tiny = 1e-10 * d.maxCoeff();
   for (Eigen::Index i = 0; i < p; ++i)
-    if (eig.eigenvalues()(i) > tiny) {
-      const double u = eig.eigenvectors().col(i).dot(z);
-      t.statistic += u * u / eig.eigenvalues()(i);
+    if (d(i) > tiny) {
+      t.statistic += y(i) * y(i) / d(i);
       ++t.gains;
     }
   t.residual_dof = id.residual_dof;
