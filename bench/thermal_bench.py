@@ -18,7 +18,8 @@ one factor, log-uniform in 0.5..2; 0.5 um white noise along each approach.
 - null: no drift; a session whose joint drift test (summary's drift_test: all gains against 0
   with the fit's covariance, F at the noise model's dof, level 1 %) finds a drift is a false
   finding; beside it the old rule (any gain beyond 3 sigma, one by one); null_ar1 (not in the
-  default parts): the same with AR(1) 0.8 noise from touch to touch (the noise model's dof);
+  default parts): the same with AR(1) 0.8 noise from touch to touch, identified with the noise
+  model (noise "auto": GLS refit, the test's dof from its effective samples);
 - detection: the same test on drifting sessions, the gains x 0.5-2 (the issue's), x 0.02-0.05 and x 0.003-0.01;
 - two lags: tau2 = 4 tau1, K2 = 0.7 K1; named two-lag where BIC (n ln(RSS/n) + k ln n, k the
   observable parameters) of the two-lag fit is lower; one-lag sessions the same way;
@@ -277,7 +278,8 @@ def null(draws: int, rng, tmp: Path, rho: float = 0.0) -> None:
             else noisy(base, rng)
         )
         f = write_session(tmp / "null.csv", touches)
-        s = identify(f, tolerance_mm=0.005)["summary"]
+        # coloured noise: the noise model and its GLS refit (the CLI's default), else white
+        s = identify(f, "auto" if rho else "white", tolerance_mm=0.005)["summary"]
         found += s["drift_test"]["drift_found"]
         one_by_one += any(e.get("significant", False) for e in s["drifts"])
         pvals.append(s["drift_test"]["p_value"])
@@ -393,7 +395,9 @@ def main() -> None:
                 timing(rng, Path(d), 3 if a.smoke else 15)
             else:
                 parts[p](
-                    slow if p in ("prediction", "detection", "two_lags") else draws, rng, Path(d)
+                    slow if p in ("prediction", "detection", "two_lags", "null_ar1") else draws,
+                    rng,
+                    Path(d),
                 )
             print(f"({p}: {time.process_time() - c0:.1f} CPU-s)\n")
 
