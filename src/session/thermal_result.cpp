@@ -2,6 +2,7 @@
 // The one thermal fit and its result, for every instrument (session/thermal_result.hpp).
 #include "rotacal/session/thermal_result.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "rotacal/core/time_constant_fit.hpp"
@@ -77,6 +78,15 @@ ThermalIdentification thermal_identification(const NoiseFit& nf, const ThermalFi
   out.residual_rms_um =
       std::sqrt(fit.residuals.squaredNorm() / static_cast<double>(fit.residuals.size())) * 1e3;
   if (nf.refit) out.noise = nf.noise.summary();
+  // The covariance rests on s^2 (white) or on the noise model (coloured), each estimated from
+  // the residuals: so many samples, or effective samples, less the free parameters.
+  double free = 0.0;
+  for (std::size_t j = 0; j < fit.free.size(); ++j)
+    free += fit.free[j] && fit.estimates[j].observable;
+  const double samples = nf.refit && nf.noise.effective_samples > 0.0
+                             ? nf.noise.effective_samples
+                             : static_cast<double>(fit.residuals.size());
+  out.residual_dof = std::max(1.0, samples - free);
   if (!out.converged) out.notes.push_back("the fit did not converge: " + fit.summary.message);
   if (!heated) out.notes.push_back("no duty: an ordinary session, its thermal gains unobservable");
   return out;

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "rotacal/core/error.hpp"
+#include "rotacal/core/stats.hpp"
 
 namespace rotacal {
 
@@ -63,6 +64,46 @@ std::optional<double> first_exceedance(const DriftCurve& c, double tol, double t
 
 }  // namespace
 
+ThermalDriftTest thermal_drift_test(const ThermalIdentification& id, double level) {
+  if (!(level > 0.0 && level < 1.0))
+    throw InvalidArgument("thermal drift test: the level must lie in (0, 1), got " +
+                          std::to_string(level));
+  ThermalDriftTest t;
+  t.level = level;
+  std::vector<int> idx;
+  for (std::size_t l = 0; l < id.lags.size(); ++l)
+    for (std::size_t k = 0; k < id.lags[l].gains.size(); ++k)
+      if (id.lags[l].gains[k].observable) idx.push_back(id.gain_index[l] + static_cast<int>(k));
+  const Eigen::Index p = static_cast<Eigen::Index>(idx.size());
+  if (p == 0) return t;
+  Eigen::VectorXd g(p), s(p);
+  Eigen::MatrixXd c(p, p);
+  for (Eigen::Index a = 0; a < p; ++a) {
+    g(a) = id.parameters[static_cast<std::size_t>(idx[a])].value;
+    for (Eigen::Index b = 0; b < p; ++b) c(a, b) = id.covariance(idx[a], idx[b]);
+  }
+  // Gains in mm and rad: the correlation matrix R is what gets factored (pivoted LDLT, largest
+  // pivots first), and pivots it calls singular (two lags nearly alike) are not tested:
+  // W = sum over the kept pivots of y_i^2 / D_i, y = L^-1 P z.
+  for (Eigen::Index a = 0; a < p; ++a) s(a) = std::sqrt(std::max(c(a, a), 0.0));
+  if ((s.array() <= 0.0).any()) return t;
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt((c.array() / (s * s.transpose()).array()).matrix());
+  const Eigen::VectorXd d = ldlt.vectorD();
+  const Eigen::VectorXd y =
+      ldlt.matrixL().solve(ldlt.transpositionsP() * Eigen::VectorXd(g.cwiseQuotient(s)));
+  const double tiny = 1e-10 * d.maxCoeff();
+  for (Eigen::Index i = 0; i < p; ++i)
+    if (d(i) > tiny) {
+      t.statistic += y(i) * y(i) / d(i);
+      ++t.gains;
+    }
+  t.residual_dof = id.residual_dof;
+  t.p_value = t.residual_dof > 0.0 ? stats::f_sf(t.statistic / t.gains, t.gains, t.residual_dof)
+                                   : stats::chi2_sf(t.statistic, t.gains);
+  t.drift_found = t.p_value < level;
+  return t;
+}
+
 ThermalSummary thermal_summary(const ThermalIdentification& id,
                                const ThermalSummaryOptions& options) {
   for (const auto& t : {options.tolerance_mm, options.tolerance_rad})
@@ -78,7 +119,10 @@ ThermalSummary thermal_summary(const ThermalIdentification& id,
     s.tau_observable.push_back(l.tau_observable);
     tau_max = std::max(tau_max, l.tau_s);
   }
-  if (id.lags.empty()) return s;
+  if (id.lags.empty()) {
+    s.no_significant_drift = true;
+    return s;
+  }
   const double scale = id.tested_speed_rpm / 100.0;
   for (std::size_t k = 0; k < id.lags[0].gains.size(); ++k) {
     const ThermalGainEstimate& g0 = id.lags[0].gains[k];
@@ -103,8 +147,8 @@ ThermalSummary thermal_summary(const ThermalIdentification& id,
     if (d.tolerance) d.exceeds_after_s = first_exceedance(curve, *d.tolerance, tau_max);
     s.drifts.push_back(d);
   }
-  s.no_significant_drift = std::none_of(s.drifts.begin(), s.drifts.end(),
-                                        [](const ThermalDrift& d) { return d.significant; });
+  s.drift_test = thermal_drift_test(id, options.drift_test_level);
+  s.no_significant_drift = !s.drift_test.drift_found;
   return s;
 }
 
@@ -113,6 +157,10 @@ nlohmann::ordered_json to_json(const ThermalSummary& s) {
   j["axis"] = s.axis ? std::string(1, s.axis) : std::string();
   j["tested_speed_rpm"] = s.tested_speed_rpm;
   j["no_significant_drift"] = s.no_significant_drift;
+  const ThermalDriftTest& t = s.drift_test;
+  j["drift_test"] = {
+      {"statistic", t.statistic}, {"gains", t.gains}, {"residual_dof", t.residual_dof},
+      {"p_value", t.p_value},     {"level", t.level}, {"drift_found", t.drift_found}};
   j["lags"] = nlohmann::ordered_json::array();
   for (std::size_t l = 0; l < s.tau_s.size(); ++l)
     j["lags"].push_back({{"tau_s", s.tau_s[l]},
@@ -161,6 +209,7 @@ nlohmann::ordered_json to_json(const ThermalIdentification& id) {
   j["n_samples"] = id.n_samples;
   j["n_epochs"] = id.n_epochs;
   j["residual_rms_um"] = id.residual_rms_um;
+  j["residual_dof"] = id.residual_dof;
   j["noise_model"] = id.noise;
   j["cold"] = nlohmann::ordered_json::array();
   for (const ThermalGainEstimate& c : id.cold) j["cold"].push_back(estimate_json(c));

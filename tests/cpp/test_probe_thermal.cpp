@@ -73,6 +73,10 @@ TEST_CASE("a thermal probe session without duty: gains unobservable, for that re
     CHECK_FALSE(g.observable);
     CHECK_THAT(g.reason, Catch::Contains("no heat input"));
   }
+  const ThermalSummary s = thermal_summary(id);  // nothing to test: no drift found
+  CHECK(s.drift_test.gains == 0);
+  CHECK_FALSE(s.drift_test.drift_found);
+  CHECK(s.no_significant_drift);
 }
 
 TEST_CASE("thermal summary of the shared probe session", "[probe][thermal]") {
@@ -114,6 +118,23 @@ TEST_CASE("thermal summary of the shared probe session", "[probe][thermal]") {
   CHECK(j["drifts"].size() == 11);
   CHECK(j["lags"][0]["tau_s"].get<double>() == tau);
   CHECK_THROWS_AS(thermal_summary(id, ThermalSummaryOptions{-1.0, {}}), InvalidArgument);
+  // The joint drift test's W against a direct solve with the raw covariance (it inverts the
+  // correlation matrix by its eigen-decomposition).
+  Eigen::VectorXd g(11);
+  Eigen::MatrixXd c(11, 11);
+  for (int a = 0; a < 11; ++a) {
+    g(a) = id.lags[0].gains[static_cast<std::size_t>(a)].value;
+    for (int b = 0; b < 11; ++b)
+      c(a, b) = id.covariance(id.gain_index[0] + a, id.gain_index[0] + b);
+  }
+  const ThermalDriftTest& dt = s.drift_test;
+  CHECK(dt.statistic == Approx(g.dot(c.ldlt().solve(g))).epsilon(1e-6));
+  CHECK(dt.gains == 11);
+  CHECK(dt.residual_dof == id.n_samples - 23.0);  // 1480 touches, 23 free parameters, white
+  CHECK(dt.drift_found);
+  CHECK_FALSE(s.no_significant_drift);
+  CHECK(j["drift_test"]["drift_found"].get<bool>());
+  CHECK_THROWS_AS(thermal_drift_test(id, 1.0), InvalidArgument);
 }
 
 TEST_CASE("the per-epoch peer on the shared probe session", "[probe][thermal]") {

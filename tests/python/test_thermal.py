@@ -101,6 +101,49 @@ def test_no_drift_gives_no_significant_drift(tmp_path):
             assert "tolerance" not in e and "exceeds_after_s" not in e
 
 
+def _drift_test(path):
+    from rotacal import _core
+
+    return _core.identify_thermal(str(path))
+
+
+def _joint_at_least_each_gain(d):
+    """W = z^T R^-1 z >= z_k^2 for every gain k (Cauchy-Schwarz): the joint statistic is never
+    below the largest single gain's (value / sigma)^2 of the same covariance."""
+    t = d["summary"]["drift_test"]
+    gains = d["identification"]["lags"][0]["gains"]
+    z2 = max((g["value"] / g["std"]) ** 2 for g in gains if g["observable"])
+    assert t["statistic"] >= z2 * (1 - 1e-9), (t, z2)
+    assert t["gains"] == sum(g["observable"] for g in gains)
+
+
+def test_joint_drift_test_decides_whether_the_session_drifts(tmp_path):
+    """One test of all gains against 0 (summary's drift_test, F at 1 %): a reference-simulator
+    session without drift passes, white and AR(1) 0.9 (where the noise model's effective
+    samples, 53 of 760 here, give the dof: 31); the shared session and one whose gains are 1/20
+    of its truth (E_X0C's steady change 1.2 um) are found drifting.
+    The false-alarm rate itself is bench/thermal_bench.py's (500 null sessions)."""
+    white = _drift_test(_refsim_session(tmp_path / "null.csv", []))
+    t = white["summary"]["drift_test"]
+    assert not t["drift_found"] and white["summary"]["no_significant_drift"], t
+    assert t["level"] == 0.01 and t["gains"] == 11 and 0.01 <= t["p_value"] <= 1
+    assert t["residual_dof"] == white["identification"]["n_samples"] - 23
+    _joint_at_least_each_gain(white)
+    ar = _drift_test(_refsim_session(tmp_path / "ar.csv", [], seed=3, rho=0.9))
+    t = ar["summary"]["drift_test"]
+    assert ar["identification"]["noise_model"], ar["identification"]
+    assert not t["drift_found"] and t["residual_dof"] < ar["identification"]["n_samples"] / 2, t
+    _joint_at_least_each_gain(ar)
+    lags = truth(SHARED / "thermal_probe_ac.csv")["thermal"]
+    small = [lags[0] | {"gains": {k: v / 20 for k, v in lags[0]["gains"].items()}}]
+    d = _drift_test(_refsim_session(tmp_path / "small.csv", small, seed=5, interval_s=600.0))
+    t = d["summary"]["drift_test"]
+    assert t["drift_found"] and not d["summary"]["no_significant_drift"], t
+    _joint_at_least_each_gain(d)
+    full = _drift_test(SHARED / "thermal_probe_ac.csv")["summary"]["drift_test"]
+    assert full["drift_found"] and full["p_value"] < 1e-12, full
+
+
 def test_two_lags_identified(tmp_path):
     """tau2 = 4 tau1, K2 = 0.7 K1 (the issue's two-lag case) in a 6 h test, epochs every 10 min:
     both taus and all 22 gains within 3 sigma; one lag leaves a lack of fit."""
@@ -186,3 +229,18 @@ def test_thermal_options_refused_where_they_do_not_apply(shared_data):
     assert r.returncode == 3 and "--tolerance" in r.stderr
     r = run("identify", shared_data / "thermal_probe_ac.csv", "--monte-carlo", "5")
     assert r.returncode == 3 and "--monte-carlo: not for a thermal session" in r.stderr
+
+
+def test_diagnose_gives_a_thermal_finding_only_where_the_session_drifts(tmp_path, shared_data):
+    """`rotacal diagnose` of a thermal session adds the joint drift test (issue 53 item 4: a
+    session with no drift gives no thermal finding); its catalogue still pools the epochs."""
+    null = _refsim_session(tmp_path / "null.csv", [])
+    r = run("diagnose", null, "--no-budget", "--json")
+    assert r.returncode == 0, r.stderr
+    f = json.loads(r.stdout)["thermal"]
+    assert not f["drift_found"] and f["drift_test"]["gains"] == 11 and not f["significant"], f
+    assert "pooled" in f["baseline"]
+    text = run("diagnose", shared_data / "thermal_probe_ac.csv", "--no-budget")
+    assert text.returncode == 0, text.stderr
+    assert "thermal, axis C: joint test of the 11 gains" in text.stdout
+    assert "thermal drift found" in text.stdout and "E_X0C" in text.stdout

@@ -63,6 +63,10 @@ struct ThermalIdentification {
   bool converged = false;
   double residual_rms_um = 0.0;
   std::size_t n_samples = 0, n_epochs = 0;
+  /// Degrees of freedom of the residuals behind the covariance: samples (the noise model's
+  /// effective samples where it is coloured) less the free parameters; 0: not known (the
+  /// summary's drift test then takes the covariance as exact).
+  double residual_dof = 0.0;
   std::string noise;  ///< the noise model's summary (empty: white)
   std::vector<std::string> notes;
   /// The per-epoch peer's series, what its lag was fitted to (session/thermal_series.hpp), at

@@ -124,6 +124,11 @@ def cmd_diagnose(a: argparse.Namespace) -> int:
     if not several and not a.no_budget:  # what left-out effects could put on each location error
         result.budget = uncertainty_budget(what, result, sizes=sizes)
     d = result.to_dict()
+    thermal = not several and _core.is_thermal_session(a.file[0])
+    if thermal:  # the drift's own test beside the pooled diagnosis (cli/thermal.py)
+        from .thermal import thermal_finding
+
+        d["thermal"] = thermal_finding(a.file[0])
     if a.report:
         from ..analysis import write_diagnosis_report
 
@@ -133,6 +138,10 @@ def cmd_diagnose(a: argparse.Namespace) -> int:
         print(jsontext.dumps(d))
     else:
         print_diagnosis(d)
+        if thermal:
+            from .thermal import print_thermal_finding
+
+            print_thermal_finding(d["thermal"])
         if several:
             print_several(d)
     return EXIT_OK

@@ -188,6 +188,44 @@ def _value(x: float, unit: str) -> str:
     return f"{x * 1e3:+.3f} um" if unit == "mm" else f"{x * 1e6:+.3f} urad"
 
 
+def _drift_test_line(t: dict) -> str:
+    p = "p < 1e-300" if t["p_value"] == 0 else f"p = {t['p_value']:.3g}"
+    dof = f"F({t['gains']}, {t['residual_dof']:.0f})" if t["residual_dof"] else "chi-square"
+    return (
+        f"joint test of the {t['gains']} gains against 0 ({dof}): W = {t['statistic']:.1f}, {p}: "
+        + ("thermal drift found" if t["drift_found"] else f"no drift at {t['level']:g}")
+    )
+
+
+def thermal_finding(path: str) -> dict:
+    """What `rotacal diagnose` says of a thermal session's drift: the joint fit's drift test
+    (one test of every gain against 0 at 1 %), each lag's tau and the errors whose drift is
+    significant alone. The catalogue's effects beside it are still tested with the epochs
+    pooled (issue 53 item 4: the drift is not yet in their baseline)."""
+    s = _core.identify_thermal(path)["summary"]
+    found = s["drift_test"]["drift_found"]
+    return {
+        "axis": s["axis"],
+        "drift_found": found,
+        "drift_test": s["drift_test"],
+        "lags": s["lags"] if found else [],
+        "significant": [e["name"] for e in s["drifts"] if found and e.get("significant")],
+        "baseline": "epochs pooled: the catalogue's effects are tested without the drift",
+    }
+
+
+def print_thermal_finding(f: dict) -> None:
+    if not f["drift_test"]["gains"]:
+        print("thermal: no gain determined (no heat input): no thermal finding")
+        return
+    print(f"thermal, axis {f['axis'] or '-'}: {_drift_test_line(f['drift_test'])}")
+    if f["drift_found"]:
+        taus = ", ".join(_minutes(lag["tau_s"]) for lag in f["lags"] if lag["observable"])
+        print(f"  tau {taus or 'unobservable'}; drifting alone beyond 3 sigma: "
+              f"{', '.join(f['significant']) or 'none'}")  # fmt: skip
+    print(f"  {f['baseline']} (rotacal identify fits the drift)")
+
+
 def print_thermal(d: dict) -> None:
     ident, s = d["identification"], d["summary"]
     axis = s["axis"] or "-"
@@ -207,6 +245,8 @@ def print_thermal(d: dict) -> None:
             else "unobservable"
         )
         print(f"lag {k}: tau = {tau}")
+    if s["drift_test"]["gains"]:
+        print(_drift_test_line(s["drift_test"]))
     if s["no_significant_drift"]:
         print("no significant drift of any location error: tau rests on the noise alone")
     print(f"steady-state change after long turning at {s['tested_speed_rpm']:g} rev/min:")
