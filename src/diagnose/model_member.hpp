@@ -23,14 +23,22 @@ struct HeldMember {
   std::string why;                  ///< in words, for the report
 };
 
+/// A member's refit may widen a location error's sigma by at most this factor over the model
+/// before the finding (a variance inflation of 100); beyond it the member is passed over.
+inline constexpr double kMaxLocationInflation = 10.0;
+
 /// The rule: by weight, the first member of `judged.group` (its weights in `judged`) whose refit
 /// from `before_effects` determines a parameter of it to DiagnosisOptions::min_determined_sigma
 /// (issue 29's rule 6 as issue 50 states it for the model member: a single parameter, not only
 /// a combination, so a warm-up whose d and tau trade off along a drift is not held); where a
 /// member nested in it (a special case with fewer parameters: every table motion of it is one of
 /// the other's, design/table_motion.hpp) is determined and within delta BIC <= 2 of it, that
-/// simpler one; where no member is determined, the baseline. `chosen_refit`: the search pick's.
+/// simpler one; where no member is determined, the baseline. A member beside which a location
+/// error is no longer determined (its sigma over kMaxLocationInflation times that in `before`,
+/// the fit of `before_effects`) is passed over as an undetermined one is, and the reason says so.
+/// `chosen_refit`: the search pick's.
 HeldMember hold_member(const SearchContext& S, const Round& R, const RivalJudgement& judged,
-                       const ModelFit& chosen_refit, const EffectModel& before_effects);
+                       const ModelFit& before, const ModelFit& chosen_refit,
+                       const EffectModel& before_effects);
 
 }  // namespace rotacal::diagnosis_detail
