@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 
+#include "model_member.hpp"
 #include "rotacal/ballbar/plan.hpp"
 #include "rotacal/core/stats.hpp"
 #include "search.hpp"
@@ -242,56 +243,6 @@ Diagnosis search_white(const DiagnosisProblem& P, const DiagnosisOptions& option
   }
   judge_kept(P, options, baseline, kept, nullptr, kept, cache, D);
   return D;
-}
-
-// How many sigma from zero the best-determined single parameter of F is as the result reports it
-// (F.parameters: the final fit's, time constants profiled, sigmas scaled).
-double reported_sigmas(const Finding& F) {
-  double best = 0.0;
-  for (const ParameterEstimate& p : F.parameters)
-    if (p.observable && p.std > 0.0 && std::isfinite(p.std))
-      best = std::max(best, std::abs(p.value) / p.std);
-  return best;
-}
-bool all_determined_as_reported(const DiagnosisOptions& options, const Diagnosis& D) {
-  return std::all_of(D.findings.begin(), D.findings.end(), [&](const Finding& F) {
-    return reported_sigmas(F) >= options.min_determined_sigma;
-  });
-}
-// The same of every finding before the last (a warm-up whose tau the profile leaves open
-// beside a drift found after it: thermal_warmup_Z then thermal_drift_Z on an AC-trt probe in
-// AR(1) 0.5 noise, seed 1454 of tests/python/test_probe_diagnosis.py; dropped, the drift
-// alone is determined, so it is not passed over).
-bool earlier_determined_as_reported(const DiagnosisOptions& options, const Diagnosis& D) {
-  return std::all_of(D.findings.begin(), D.findings.end() - 1, [&](const Finding& F) {
-    return reported_sigmas(F) >= options.min_determined_sigma;
-  });
-}
-
-// The last finding dropped (reported unobservable): its numbers, or an earlier finding's beside
-// it, are not determined by `how`. Where the model holds what the weights say and the last is
-// itself undetermined in a group with other scored members, it goes into `not_held` and the
-// caller runs the search again holding the next member; not where `may_pass_over` is false (an
-// earlier finding is undetermined too: beside that one, this one may be what the data show).
-void drop_last_finding(const DiagnosisOptions& options, bool last_determined,
-                       const std::string& how, Diagnosis& D, std::set<std::string>& not_held,
-                       bool may_pass_over = true) {
-  const std::string sigma =
-      std::to_string(static_cast<int>(options.min_determined_sigma)) + " sigma";
-  const Finding& last = D.findings.back();
-  if (options.hold_by_weight && !last_determined && may_pass_over &&
-      std::any_of(last.rivals.begin(), last.rivals.end(),
-                  [](const Alternative& a) { return a.in_group && !a.aliased; }))
-    not_held.insert(last.effect.id());
-  D.unobservable.push_back(
-      {last.effect.id(),
-       last_determined
-           ? "the search named it, but by " + how +
-                 " an earlier finding's parameters cannot be determined beside it "
-                 "(none reaches " +
-                 sigma + ")"
-           : "the search named it, but by " + how + " none of its parameters reaches " + sigma});
-  D.findings.pop_back();
 }
 
 // The findings' numbers by GLS under `gls_noise`, the covariance scaled by the whitened

@@ -6,6 +6,7 @@
 // extended model's: so the model holds what the weights say, the simplest of equals, and only
 // what the data determine.
 
+#include <set>
 #include <string>
 
 #include "rivals.hpp"
@@ -40,5 +41,19 @@ inline constexpr double kMaxLocationInflation = 10.0;
 HeldMember hold_member(const SearchContext& S, const Round& R, const RivalJudgement& judged,
                        const ModelFit& before, const ModelFit& chosen_refit,
                        const EffectModel& before_effects);
+
+/// Issue 29's rule 6 on the numbers the result reports (the final fit's, time constants profiled,
+/// sigmas scaled: Finding::parameters), for the final model's members (diagnosis.cpp): how many
+/// sigma from zero F's best-determined single parameter is; whether every finding, or every one
+/// before the last, has one at DiagnosisOptions::min_determined_sigma.
+double reported_sigmas(const Finding& F);
+bool all_determined_as_reported(const DiagnosisOptions& options, const Diagnosis& D);
+bool earlier_determined_as_reported(const DiagnosisOptions& options, const Diagnosis& D);
+
+/// The last finding of D dropped and reported unobservable, its numbers (or an earlier
+/// finding's beside it, `last_determined`) not determined by `how`; see model_member.cpp.
+void drop_last_finding(const DiagnosisOptions& options, bool last_determined,
+                       const std::string& how, Diagnosis& D, std::set<std::string>& not_held,
+                       bool may_pass_over = true);
 
 }  // namespace rotacal::diagnosis_detail
