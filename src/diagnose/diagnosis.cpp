@@ -159,28 +159,32 @@ Diagnosis search(const DiagnosisProblem& P, const DiagnosisOptions& options,
   const std::vector<int> fold = cv_folds(P, options.cv_blocks, noise.W ? model : nullptr);
   EffectModel effects;
   effects.linear_reference = P.mean_commanded_xyz();
+  // The search goes on from its picks, the model reports the held members (model_member.hpp):
+  // so the later rounds, and every name, are the same whichever member is held (holding
+  // another one before the next round left structure its pick explained: a radial_motion_C_h3
+  // + linear_scale_X ballbar named straightness_ZX alone, tests/cpp/test_diagnose_ballbar.cpp).
   EffectModel picks = effects;
   std::vector<bool> done(candidates.size(), false);
   bool first_round = true;
   while (static_cast<int>(D.findings.size()) < options.max_findings) {
-    const Round R = score_round(S, *fit, effects, done, first_round, D);
+    const Round R = score_round(S, *fit, picks, done, first_round, D);
     first_round = false;
-    const Choice choice = choose(S, R, *fit, effects, fold, done, D);
+    const Choice choice = choose(S, R, *fit, picks, fold, done, D);
     if (!choice.chosen) break;
-    const EffectModel before_effects = effects;
+    const EffectModel before_effects = picks;
     std::optional<Finding> F = name_finding(S, R, choice, *fit, before_effects, D);
     if (!F) continue;  // no member of its group determined: the model holds the baseline
-    // The model holds the member the weights say (model_member.hpp), not always the pick.
     for (std::size_t c = 0; c < candidates.size(); ++c)
       if (candidates[c] == F->effect) done[c] = true;
     effects.effects.push_back(F->effect);
     picks.effects.push_back(choice.chosen->effect);
-    fit = &cache.fit(P, effects);
+    fit = &cache.fit(P, picks);
     D.findings.push_back(std::move(*F));
   }
 
-  for (Finding& F : D.findings) F.parameters = parameters_of(*fit, F.effect);
-  D.final_fit = *fit;
+  const ModelFit& held = effects.effects.empty() ? *fit : cache.fit(P, effects);
+  for (Finding& F : D.findings) F.parameters = parameters_of(held, F.effect);
+  D.final_fit = held;
   cache.picks = std::move(picks);
   return D;
 }
