@@ -107,6 +107,12 @@ struct SearchCache {
   // passes over them, as over any undetermined member (model_member.hpp), so that the next member
   // by weight is held rather than the finding dropped. Kept with the fits the next pass reuses.
   std::set<std::string> not_held;
+  // The last search's picks, one per finding (the best-scoring member of its group that passed
+  // the search's tests), in the findings' order: where the model holds another member, the
+  // decisions that weigh every finding (white or coloured noise, the noise level of the white
+  // search) are judged on the picks' model, so that the names do not hang on which member is
+  // held (diagnosis.cpp).
+  EffectModel picks;
 
   static std::string key(const EffectModel& m) {
     std::string k;

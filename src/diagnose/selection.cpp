@@ -323,7 +323,7 @@ std::optional<Finding> name_finding(const SearchContext& S, const Round& R, cons
   }
 
   // The member the extended model holds (model_member.hpp); its numbers are the finding's.
-  const HeldMember held = hold_member(S, R, judged_rivals, fit, before_effects);
+  const HeldMember held = hold_member(S, R, judged_rivals, before, fit, before_effects);
   Finding F;
   F.model_reason = held.why;
   if (!held.member) {

