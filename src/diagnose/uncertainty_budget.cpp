@@ -180,6 +180,21 @@ bool tighten_by_session(const Eigen::MatrixXd& perp_w, const Eigen::VectorXd& r_
   return true;
 }
 
+// (J_w^T J_w)^-1 by J_w = Q R in place, then the SVD of the small R: J_w's singular values and
+// V, without the SVD's own two n x f copies (352 MB of a 1,000,000-reading session's budget).
+Eigen::MatrixXd gls_covariance(Eigen::MatrixXd J_w) {
+  const Eigen::HouseholderQR<Eigen::Ref<Eigen::MatrixXd>> qr_w(J_w);
+  const Eigen::Index f = J_w.cols();
+  const Eigen::MatrixXd R_w =
+      J_w.rows() >= f ? Eigen::MatrixXd(qr_w.matrixQR().topRows(f).triangularView<Eigen::Upper>())
+                      : Eigen::MatrixXd(qr_w.matrixQR().triangularView<Eigen::Upper>());
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd_w(R_w, Eigen::ComputeThinV);
+  Eigen::VectorXd inv_s = svd_w.singularValues();
+  for (Eigen::Index i = 0; i < inv_s.size(); ++i)
+    inv_s[i] = inv_s[i] > 1e-12 * inv_s[0] ? 1.0 / inv_s[i] : 0.0;
+  return svd_w.matrixV() * inv_s.cwiseAbs2().asDiagonal() * svd_w.matrixV().transpose();
+}
+
 }  // namespace
 
 UncertaintyBudget budget_detail::budget_of(const BudgetedFit& m,
@@ -224,19 +239,7 @@ UncertaintyBudget budget_detail::budget_of(const BudgetedFit& m,
       if (free_index[static_cast<std::size_t>(j)] >= 0) cols.push_back(j);
     cov_a = (*m.covariance)(cols, cols);
   } else {
-    // J_w = Q R in place, then the SVD of the small R: J_w's singular values and V, without
-    // the SVD's own two n x f copies (352 MB of a 1,000,000-reading session's budget).
-    Eigen::MatrixXd J_w = whiten(J);
-    const Eigen::HouseholderQR<Eigen::Ref<Eigen::MatrixXd>> qr_w(J_w);
-    const Eigen::Index f = J.cols();
-    const Eigen::MatrixXd R_w =
-        J_w.rows() >= f ? Eigen::MatrixXd(qr_w.matrixQR().topRows(f).triangularView<Eigen::Upper>())
-                        : Eigen::MatrixXd(qr_w.matrixQR().triangularView<Eigen::Upper>());
-    Eigen::JacobiSVD<Eigen::MatrixXd> svd_w(R_w, Eigen::ComputeThinV);
-    Eigen::VectorXd inv_s = svd_w.singularValues();
-    for (Eigen::Index i = 0; i < inv_s.size(); ++i)
-      inv_s[i] = inv_s[i] > 1e-12 * inv_s[0] ? 1.0 / inv_s[i] : 0.0;
-    cov_a = svd_w.matrixV() * inv_s.cwiseAbs2().asDiagonal() * svd_w.matrixV().transpose();
+    cov_a = gls_covariance(whiten(J));
   }
   const double n_eff = W ? m.noise.effective_samples : static_cast<double>(n);
   const double dof_a = std::max(1.0, n_eff - static_cast<double>(J.cols()));
