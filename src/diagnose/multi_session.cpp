@@ -3,8 +3,7 @@
 // problems stacked as one problem of the engine, the joint fit one GLS step from their own.
 #include "rotacal/diagnose/multi_session.hpp"
 
-#include <Eigen/Eigenvalues>
-#include <Eigen/QR>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <set>
@@ -334,8 +333,16 @@ ModelFit MultiDiagnosisProblem::fit_gls(const EffectModel& effects,
     noise->apply(Jw);
     noise->apply(bw);
   }
-  const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(Jw);
-  const Eigen::VectorXd theta_free = cod.solve(bw).col(0);
+  // One decomposition decides both the step and which parameters are determined: a direction
+  // whose singular value is below 1e-6 of the largest (1e-12 of the normal matrix's eigenvalues)
+  // gets no step. A column-pivoted solve with its own, looser rank test took the pivot y, z of an
+  // added axial_A arc (which no reading sees to first order) to 5660 and -5340 mm,
+  // and the candidates' Jacobians, taken at that pivot, hid a 4 um sag the first session alone
+  // finds (bench/diagnosis_loop.py, ballbar gravity_sag_A, seed 303).
+  constexpr double kNullSingular = 1e-6;
+  Eigen::BDCSVD<Eigen::MatrixXd> svd(Jw, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  svd.setThreshold(kNullSingular);
+  const Eigen::VectorXd theta_free = svd.solve(bw).col(0);
   Eigen::VectorXd theta = x0;
   for (std::size_t i = 0; i < free.size(); ++i)
     theta[free[i]] += theta_free[static_cast<Eigen::Index>(i)];
@@ -343,16 +350,16 @@ ModelFit MultiDiagnosisProblem::fit_gls(const EffectModel& effects,
   ModelFit out;
   out.effects = effects;
   out.residuals = b - Jf * theta_free;
-  out.num_free = static_cast<int>(cod.rank());
+  out.num_free = static_cast<int>(svd.rank());
   // The covariance: the pseudo-inverse of the (whitened) normal matrix, in units of the
   // whitened residuals under GLS, else of the weighted rows' noise (the first session's).
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Jw.transpose() * Jw);
-  const Eigen::VectorXd ev = eig.eigenvalues();
-  const double tol = ev.size() ? ev.maxCoeff() * 1e-12 : 0.0;
-  Eigen::VectorXd inv = Eigen::VectorXd::Zero(ev.size());
-  for (Eigen::Index i = 0; i < ev.size(); ++i)
-    if (ev[i] > tol) inv[i] = 1.0 / ev[i];
-  const Eigen::MatrixXd C = eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose();
+  const Eigen::VectorXd sv = svd.singularValues();
+  const Eigen::MatrixXd& V = svd.matrixV();
+  const double tol = sv.size() ? sv.maxCoeff() * kNullSingular : 0.0;
+  Eigen::VectorXd inv = Eigen::VectorXd::Zero(sv.size());
+  for (Eigen::Index i = 0; i < sv.size(); ++i)
+    if (sv[i] > tol) inv[i] = 1.0 / (sv[i] * sv[i]);
+  const Eigen::MatrixXd C = V * inv.asDiagonal() * V.transpose();
   double sigma = 1.0;
   if (!noise) {
     const double dof = std::max(1.0, static_cast<double>(n - out.num_free));
@@ -363,9 +370,9 @@ ModelFit MultiDiagnosisProblem::fit_gls(const EffectModel& effects,
   for (std::size_t i = 0; i < free.size(); ++i) {
     const Eigen::Index c = static_cast<Eigen::Index>(i);
     std_of[static_cast<std::size_t>(free[i])] = sigma * std::sqrt(std::max(0.0, C(c, c)));
-    double in_null = 0.0;  // its share of the directions the joint readings cannot see
-    for (Eigen::Index v = 0; v < ev.size(); ++v)
-      if (!(ev[v] > tol)) in_null += eig.eigenvectors()(c, v) * eig.eigenvectors()(c, v);
+    double in_null = 1.0;  // its share of the directions the joint readings cannot see
+    for (Eigen::Index v = 0; v < sv.size(); ++v)
+      if (sv[v] > tol) in_null -= V(c, v) * V(c, v);
     determined[static_cast<std::size_t>(free[i])] = in_null < 1e-6;
   }
   out.jacobian = J;
