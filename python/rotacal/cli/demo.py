@@ -47,51 +47,19 @@ def cmd_demo(a: argparse.Namespace) -> int:
 def print_loop(loop: dict) -> None:
     """The loop of a group (demo.close_the_loop): the deciding test, both sessions together, the
     gain and the location errors of the final model."""
-    from ..diagnosis import group_text, model_text
 
     for t in loop["tried"]:
         print(f"deciding test for {' and '.join(t['pair'])}: {t['verdict']}")
     if not loop.get("added_test"):
         print("no added test separates the group's members: the model rule decides between them")
         return
-    f = loop["finding"]
-    if f is None:
-        print("the session and the added test together: nothing significant")
+    if not _print_joint_step(loop, "the session and the added test together", "both sessions"):
         return
-    if f["named"]:
-        print(f"the session and the added test together: {f['effect']} (weight {f['weight']:.2f})")
-    else:
-        print(f"the session and the added test together: one of {group_text(f)}")
-    print(model_text(f))
-    for x in loop["sessions"]:
-        print(
-            f"  {x['name']}: residual RMS {x['residual_rms_before_um']:.3f} -> "
-            f"{x['residual_rms_after_um']:.3f} um"
-        )
-    print("location errors of the final model (both sessions):")
-    for name, p in loop["location_errors"].items():
-        print(f"  {name} = {units.estimate_text(p['value'], p['std'], p['unit'])}")
     o = loop.get("other_instrument")
     if not o:
         return
     print(f"no added ballbar test separates what is left; the other instrument: {o['test']}")
-    g = o["finding"]
-    if g is None:
-        print("the three sessions together: nothing significant")
-        return
-    if g["named"]:
-        print(f"the three sessions together: {g['effect']} alone (weight {g['weight']:.2f})")
-    else:
-        print(f"the three sessions together: one of {group_text(g)}")
-    print(model_text(g))
-    for x in o["sessions"]:
-        print(
-            f"  {x['name']}: residual RMS {x['residual_rms_before_um']:.3f} -> "
-            f"{x['residual_rms_after_um']:.3f} um"
-        )
-    print("location errors of the final model (the three sessions):")
-    for name, p in o["location_errors"].items():
-        print(f"  {name} = {units.estimate_text(p['value'], p['std'], p['unit'])}")
+    _print_joint_step(o, "the three sessions together", "the three sessions")
 
 
 def cmd_table2(a: argparse.Namespace) -> int:
@@ -176,3 +144,28 @@ def add_demo(sub: argparse._SubParsersAction) -> None:
 
 
 COMMANDS = {"table2": add_table2, "demo": add_demo}
+
+
+def _print_joint_step(step: dict, together: str, sessions: str) -> bool:
+    """One step of the loop: what the sessions diagnosed together found, each session's residual
+    before and after, and the final model's location errors; False where nothing was found."""
+    from ..diagnosis import group_text, model_text
+
+    f = step["finding"]
+    if f is None:
+        print(f"{together}: nothing significant")
+        return False
+    if f["named"]:
+        print(f"{together}: {f['effect']} alone (weight {f['weight']:.2f})")
+    else:
+        print(f"{together}: one of {group_text(f)}")
+    print(model_text(f))
+    for x in step["sessions"]:
+        print(
+            f"  {x['name']}: residual RMS {x['residual_rms_before_um']:.3f} -> "
+            f"{x['residual_rms_after_um']:.3f} um"
+        )
+    print(f"location errors of the final model ({sessions}):")
+    for name, p in step["location_errors"].items():
+        print(f"  {name} = {units.estimate_text(p['value'], p['std'], p['unit'])}")
+    return True
