@@ -248,7 +248,8 @@ def add_diagnose(sub: argparse._SubParsersAction) -> None:
         default=None,
         help="the extended model holds each group's member of the highest weight with a "
         "determined parameter (a nested one within delta BIC 2), not the search's pick "
-        f"(default: {'on' if _core.DiagnosisOptions().hold_by_weight else 'off'})",
+        f"(default: {'on' if _core.DiagnosisOptions().hold_by_weight else 'off'} for one session, "
+        "off for several)",
     )
     q.add_argument("--json", action="store_true")
     q.add_argument("--report", metavar="OUT.html", type=path("--report"))
