@@ -166,26 +166,44 @@ def test_sessions_of_different_machines_are_refused(tmp_path):
     assert "sessions of different machine types" in r.stderr and bb_path.stem in r.stderr, r.stderr
 
 
+# The loop's probe sessions (refsim): a 5.5 um sag of A on an AC-trt, the sphere where both
+# the session and its designed added test find it.
+SAG_FX = {"gravity_sag_A": [0.0055]}
+SPHERE = [140.004, -10.012, 75.021]
+
+
+def sag_probe_session(tmp_path, seed: int, session_seed: int):
+    """The session S (the default poses) of the machine of `seed`."""
+    errors = machine_errors(AC, seed)
+    return probe(tmp_path, AC, errors, SAG_FX, session_seed, actual=SPHERE, name="S.csv")
+
+
+def designed_probe_test(tmp_path, seed: int, s_path, pair: str, added_seed: int):
+    """`design probe --separate PAIR --after S -o added.ngc`, and its poses measured on the same
+    machine (refsim): the poses of its template and the added session's file."""
+    r = run_cli(
+        "design", "probe", "--separate", pair, "--after", s_path, "-o", tmp_path / "added.ngc",
+    )  # fmt: skip
+    assert r.returncode == 0, r.stderr
+    poses = template_poses(tmp_path / "added.csv")
+    errors = machine_errors(AC, seed)
+    _, added_path = probe(
+        tmp_path, AC, errors, SAG_FX, added_seed, poses_of=poses, actual=SPHERE, name="added.csv"
+    )
+    return poses, added_path
+
+
 def test_the_added_test_designed_after_a_session_is_diagnosed_with_it(tmp_path):
     """Issue 50 item 2, the loop: a probe session of the default poses leaves a hidden gravity sag
     of A (5.5 um) in a group; `design probe --separate ... --after S -o added.ngc` writes the added
     poses' session template added.csv; those poses, measured on the same machine (refsim, the
     sphere where it was), are a second session that `diagnose S added` uses with the first."""
     seed = 24
-    errors = machine_errors(AC, seed)
-    fx = {"gravity_sag_A": [0.0055]}
-    actual = [140.004, -10.012, 75.021]  # the sphere, where both sessions find it
-    s, s_path = probe(tmp_path, AC, errors, fx, seed + 2, actual=actual, name="S.csv")
+    s, s_path = sag_probe_session(tmp_path, seed, seed + 2)
     alone = first(rotacal.diagnose(s).to_dict())
     assert not alone["named"] and "gravity_sag_A" in group(alone), alone
-    r = run_cli(
-        "design", "probe", "--separate", "gravity_sag_A,tilt_motion_A_h2", "--after", s_path,
-        "-o", tmp_path / "added.ngc",
-    )  # fmt: skip
-    assert r.returncode == 0, r.stderr
-    poses = template_poses(tmp_path / "added.csv")
-    _, added_path = probe(
-        tmp_path, AC, errors, fx, seed + 3, poses_of=poses, actual=actual, name="added.csv"
+    _, added_path = designed_probe_test(
+        tmp_path, seed, s_path, "gravity_sag_A,tilt_motion_A_h2", seed + 3
     )
     r = run_cli("diagnose", s_path, added_path, "--json", "--no-progress")
     assert r.returncode == 0, r.stderr
@@ -242,22 +260,13 @@ def test_a_one_pose_added_test_is_diagnosed_as_the_continuation_of_its_session(t
     says so, and the added pose rules out linear_scale_Z, which S alone kept in its group. A
     one-pose session with no probe session of its sphere before it is refused, naming it."""
     seed = 310
-    errors = machine_errors(AC, seed)
-    fx = {"gravity_sag_A": [0.0055]}
-    actual = [140.004, -10.012, 75.021]
-    s, s_path = probe(tmp_path, AC, errors, fx, seed, actual=actual, name="S.csv")
+    s, s_path = sag_probe_session(tmp_path, seed, seed)
     alone = first(rotacal.diagnose(s).to_dict())
     assert not alone["named"] and "linear_scale_Z" in group(alone), alone
-    r = run_cli(
-        "design", "probe", "--separate", "linear_scale_Z,gravity_sag_A", "--after", s_path,
-        "-o", tmp_path / "added.ngc",
-    )  # fmt: skip
-    assert r.returncode == 0, r.stderr
-    poses = template_poses(tmp_path / "added.csv")
-    assert len(set(poses["pose"])) == 1 and len(poses["time"]) == 5, poses["pose"]
-    _, added_path = probe(
-        tmp_path, AC, errors, fx, seed + 1000, poses_of=poses, actual=actual, name="added.csv"
+    poses, added_path = designed_probe_test(
+        tmp_path, seed, s_path, "linear_scale_Z,gravity_sag_A", seed + 1000
     )
+    assert len(set(poses["pose"])) == 1 and len(poses["time"]) == 5, poses["pose"]
     r = run_cli("diagnose", s_path, added_path, "--json", "--no-progress")
     assert r.returncode == 0, r.stderr
     d = json.loads(r.stdout)
@@ -268,7 +277,7 @@ def test_a_one_pose_added_test_is_diagnosed_as_the_continuation_of_its_session(t
     g = group(f)
     assert "gravity_sag_A" in g and f["where"] == "machine", d["findings"]
     assert "linear_scale_Z" not in g, g
-    bb, bb_path = ballbar(tmp_path, AC, errors, fx, seed)
+    bb, bb_path = ballbar(tmp_path, AC, machine_errors(AC, seed), SAG_FX, seed)
     with pytest.raises(rotacal.InvalidArgument, match="session added cannot be fitted alone"):
         rotacal.diagnose([("ballbar", bb), ("added", rotacal.load(added_path))])
 
